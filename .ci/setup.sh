@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Idempotent set-up for a fresh machine: OSMesa (for the pyrender oracle), a
+# virtualenv in .venv, and the project installed editable with its dev extras.
+# Safe to run every time: each step is skipped when already done.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# 1. libOSMesa: pyrender renders off-screen through it (PYOPENGL_PLATFORM=osmesa).
+if ! ldconfig -p 2>/dev/null | grep -q 'libOSMesa\.so'; then
+    echo "setup: libOSMesa not found, installing libosmesa6 with apt-get" >&2
+    if [ "$(id -u)" = "0" ]; then SUDO=""; else SUDO="sudo"; fi
+    $SUDO apt-get update -qq >&2
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libosmesa6 >&2
+fi
+
+# 2. virtualenv + project. Re-install only when pyproject.toml changed.
+PY="${PYTHON:-python3}"
+if [ ! -x .venv/bin/python ]; then
+    "$PY" -m venv .venv
+fi
+stamp=".venv/.wirecheck-installed"
+want="$(sha256sum pyproject.toml | cut -d' ' -f1)"
+if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
+    .venv/bin/python -m pip install -q --upgrade pip >&2
+    .venv/bin/python -m pip install -q -e '.[dev]' >&2
+    echo "$want" > "$stamp"
+fi

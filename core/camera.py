@@ -1,0 +1,135 @@
+"""Cameras: a frozen dataclass validated when built, and ``world_to_cam``.
+
+Axes and signs are defined in :mod:`core.conventions`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .conventions import focal_px, principal_point
+from .errors import InputError
+
+PROJECTIONS = ("perspective", "orthographic")
+
+# A camera whose forward and up are closer than this to parallel has no
+# well-defined "right": |forward x up| below 1e-9 means the angle is < 1e-9 rad,
+# far below anything a user means on purpose, far above float64 noise (1e-16).
+_DEGENERATE_CROSS = 1e-9
+
+
+def _vec3(name: str, value) -> np.ndarray:
+    v = np.asarray(value, dtype=np.float64)
+    if v.shape != (3,):
+        raise InputError(f"camera {name}: expected 3 numbers, got {value!r}")
+    if not np.all(np.isfinite(v)):
+        raise InputError(f"camera {name}: expected finite numbers, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A pinhole (or orthographic) camera.
+
+    ``forward`` and ``up`` are stored unit length and orthogonal; build cameras
+    with :func:`look_at` (or :func:`from_vectors`) rather than by hand.
+    """
+
+    position: np.ndarray
+    forward: np.ndarray
+    up: np.ndarray
+    fov_y_deg: float = 60.0
+    width: int = 640
+    height: int = 480
+    near: float = 0.1
+    far: float = 100.0
+    projection: str = "perspective"
+    ortho_height: float = 2.0
+    right: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        position = _vec3("position", self.position)
+        forward = _vec3("forward", self.forward)
+        up = _vec3("up", self.up)
+        nf = np.linalg.norm(forward)
+        if nf == 0:
+            raise InputError("camera forward: expected a non-zero direction (is the camera at the look-at point?)")
+        forward = forward / nf
+        right = np.cross(forward, up)
+        nr = np.linalg.norm(right)
+        if nr < _DEGENERATE_CROSS * max(np.linalg.norm(up), 1e-300):
+            raise InputError(
+                f"camera up {up.tolist()}: expected a direction not parallel to forward {forward.tolist()}")
+        right = right / nr
+        up = np.cross(right, forward)  # re-orthogonalised, unit by construction
+        object.__setattr__(self, "position", position)
+        object.__setattr__(self, "forward", forward)
+        object.__setattr__(self, "up", up / np.linalg.norm(up))
+        object.__setattr__(self, "right", right)
+        for a in (self.position, self.forward, self.up, self.right):
+            a.setflags(write=False)
+        if self.projection not in PROJECTIONS:
+            raise InputError(f"camera projection {self.projection!r}: expected one of {', '.join(PROJECTIONS)}")
+        if not (isinstance(self.width, (int, np.integer)) and isinstance(self.height, (int, np.integer))) \
+                or self.width < 1 or self.height < 1:
+            raise InputError(f"camera size {self.width}x{self.height}: expected positive integers")
+        if self.projection == "perspective" and not (0.0 < float(self.fov_y_deg) < 180.0):
+            raise InputError(f"camera fov {self.fov_y_deg!r}: expected degrees in (0, 180)")
+        if not (math.isfinite(self.near) and math.isfinite(self.far)):
+            raise InputError(f"camera near/far {self.near!r}/{self.far!r}: expected finite numbers")
+        if self.projection == "perspective" and not self.near > 0:
+            raise InputError(f"camera near {self.near!r}: expected > 0 for a perspective camera")
+        if not self.far > self.near:
+            raise InputError(f"camera far {self.far!r}: expected > near ({self.near!r})")
+        if self.projection == "orthographic" and not (math.isfinite(self.ortho_height) and self.ortho_height > 0):
+            raise InputError(f"camera ortho-height {self.ortho_height!r}: expected > 0")
+
+    # ---- derived quantities (see core.conventions) -------------------------
+    @property
+    def focal_px(self) -> float:
+        return focal_px(self.fov_y_deg, self.height)
+
+    @property
+    def principal_point(self) -> tuple[float, float]:
+        return principal_point(self.width, self.height)
+
+    @property
+    def world_to_cam(self) -> np.ndarray:
+        """4x4 matrix taking p_world to p_cam (x right, y up, z forward)."""
+        m = np.eye(4)
+        r = np.stack([self.right, self.up, self.forward])
+        m[:3, :3] = r
+        m[:3, 3] = -r @ self.position
+        return m
+
+    def to_dict(self) -> dict:
+        return {
+            "position": [float(x) for x in self.position],
+            "forward": [float(x) for x in self.forward],
+            "up": [float(x) for x in self.up],
+            "fov_y_deg": float(self.fov_y_deg),
+            "width": int(self.width),
+            "height": int(self.height),
+            "near": float(self.near),
+            "far": float(self.far),
+            "projection": self.projection,
+            "ortho_height": float(self.ortho_height),
+        }
+
+
+def look_at(position, target, up=(0.0, 1.0, 0.0), **kwargs) -> Camera:
+    """A camera at ``position`` looking at ``target``; ``up`` need not be orthogonal."""
+    position = _vec3("position", position)
+    target = _vec3("look-at", target)
+    forward = target - position
+    if np.linalg.norm(forward) == 0:
+        raise InputError(f"camera position {position.tolist()}: expected a point different from look-at {target.tolist()}")
+    return Camera(position=position, forward=forward, up=_vec3("up", up), **kwargs)
+
+
+def camera_z(distance: float, **kwargs) -> Camera:
+    """The ``--camera-z D`` shortcut: at (0, 0, D) looking at the origin, up +Y."""
+    return look_at((0.0, 0.0, float(distance)), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), **kwargs)

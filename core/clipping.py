@@ -1,0 +1,87 @@
+"""Clipping segments in camera space, before the perspective divide.
+
+Every plane is a half-space ``n . p_cam + d >= 0`` (inside). A segment
+``p(t) = p0 + t (p1 - p0)``, t in [0, 1], is clipped against each plane in
+turn (Liang-Barsky): with signed distances ``d0, d1`` of its ends,
+
+    case 1  d0 >= 0 and d1 >= 0   both ends inside: kept as is
+    case 2  d0 <  0 and d1 <  0   both ends outside: dropped
+    case 3  d0 <  0 <= d1         enters: t_enter = max(t_enter, d0 / (d0 - d1))
+    case 4  d0 >= 0 >  d1         leaves: t_exit  = min(t_exit,  d0 / (d0 - d1))
+    case 5  after all planes, t_enter > t_exit: the pieces kept by different
+            planes do not overlap (e.g. the segment passes beside the frustum
+            corner): dropped
+
+A point exactly on a plane (d = 0) is inside: a segment lying on the near plane
+is drawn. The planes are near (z >= near), far (z <= far) and, so that no
+projected coordinate can overflow, the four sides of the image, written
+linearly in camera space (for perspective, ``x_px >= -0.5`` is
+``f x + (cx + 0.5) z >= 0``, valid once z > 0 is guaranteed by the near plane,
+which is therefore clipped first).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .camera import Camera
+
+
+def frustum_planes(camera: Camera, guard_px: float = 0.0, sides: bool = True) -> np.ndarray:
+    """``(P, 4)`` planes ``[nx, ny, nz, d]`` in camera space, near and far first.
+
+    The side planes sit ``guard_px`` pixels outside the image edges
+    ([-0.5, W - 0.5] x [-0.5, H - 0.5]).
+    """
+    planes = [[0.0, 0.0, 1.0, -camera.near], [0.0, 0.0, -1.0, camera.far]]
+    if sides:
+        cx, cy = camera.principal_point
+        left = cx + 0.5 + guard_px               # pixels from cx to the left edge
+        right = camera.width - 0.5 + guard_px - cx
+        top = cy + 0.5 + guard_px
+        bottom = camera.height - 0.5 + guard_px - cy
+        if camera.projection == "perspective":
+            f = camera.focal_px
+            planes += [[f, 0.0, left, 0.0], [-f, 0.0, right, 0.0],
+                       [0.0, -f, top, 0.0], [0.0, f, bottom, 0.0]]
+        else:
+            s = camera.height / camera.ortho_height
+            planes += [[s, 0.0, 0.0, left], [-s, 0.0, 0.0, right],
+                       [0.0, -s, 0.0, top], [0.0, s, 0.0, bottom]]
+    return np.asarray(planes, dtype=np.float64)
+
+
+def clip_segments(seg_cam: np.ndarray, planes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clip ``(M, 2, 3)`` segments against half-spaces; Liang-Barsky, vectorised.
+
+    Returns ``(kept, t_enter, t_exit)``: ``kept`` is ``(M,) bool`` and the kept
+    part of segment m is ``p0 + t (p1 - p0)`` for t in [t_enter[m], t_exit[m]].
+    """
+    p0 = seg_cam[:, 0, :]
+    p1 = seg_cam[:, 1, :]
+    m = len(seg_cam)
+    t_enter = np.zeros(m)
+    t_exit = np.ones(m)
+    kept = np.ones(m, dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for n_x, n_y, n_z, d in planes:
+            d0 = n_x * p0[:, 0] + n_y * p0[:, 1] + n_z * p0[:, 2] + d
+            d1 = n_x * p1[:, 0] + n_y * p1[:, 1] + n_z * p1[:, 2] + d
+            out0 = d0 < 0
+            out1 = d1 < 0
+            kept &= ~(out0 & out1)                          # case 2
+            t_cross = d0 / (d0 - d1)
+            enter = out0 & ~out1                            # case 3
+            t_enter = np.where(enter, np.maximum(t_enter, t_cross), t_enter)
+            leave = ~out0 & out1                            # case 4
+            t_exit = np.where(leave, np.minimum(t_exit, t_cross), t_exit)
+            kept &= ~(np.isnan(d0) | np.isnan(d1))          # NaN input: dropped
+    kept &= t_enter <= t_exit                               # case 5
+    return kept, t_enter, t_exit
+
+
+def apply_clip(seg_cam: np.ndarray, kept: np.ndarray, t_enter: np.ndarray, t_exit: np.ndarray) -> np.ndarray:
+    """The kept parts of the segments, ``(K, 2, 3)``."""
+    p0 = seg_cam[kept, 0, :]
+    d = seg_cam[kept, 1, :] - p0
+    return np.stack([p0 + t_enter[kept, None] * d, p0 + t_exit[kept, None] * d], axis=1)

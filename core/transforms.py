@@ -1,0 +1,77 @@
+"""Model transforms as 4x4 homogeneous matrices (column vectors, see core.conventions).
+
+All angles are in radians unless a name ends in ``_deg``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def rotate_x(theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]], dtype=np.float64)
+
+
+def rotate_y(theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]], dtype=np.float64)
+
+
+def rotate_z(theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], dtype=np.float64)
+
+
+def translate(offset) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = np.asarray(offset, dtype=np.float64)
+    return m
+
+
+def scale(factor: float) -> np.ndarray:
+    m = np.eye(4)
+    m[0, 0] = m[1, 1] = m[2, 2] = float(factor)
+    return m
+
+
+def compose(*matrices: np.ndarray) -> np.ndarray:
+    """``compose(A, B, C) == A @ B @ C``: the rightmost matrix applies first."""
+    out = np.eye(4)
+    for m in matrices:
+        out = out @ m
+    return out
+
+
+def apply(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Apply a 4x4 affine matrix to row-stacked points ``(N, 3) -> (N, 3)``."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A model's motion over a run.
+
+    ``turns`` are full turns about X, Y and Z over the whole run (an angular
+    velocity of ``360 * turns / frames`` degrees per frame); ``offset`` is a
+    translation and ``scale`` a uniform scale, both constant.
+    """
+
+    turns: tuple[float, float, float] = (1.0, 1.0, 0.0)
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    scale: float = 1.0
+
+    def model_matrix(self, t: float) -> np.ndarray:
+        """``T @ Rz @ Ry @ Rx @ S`` at time ``t`` in [0, 1); computed, never accumulated."""
+        # Reduce whole turns before converting to radians, so that a whole number
+        # of turns gives angle 0 exactly (sin(2*pi) is -2.4e-16, not 0).
+        ax, ay, az = (2.0 * math.pi * ((t * float(k)) % 1.0) for k in self.turns)
+        return compose(translate(self.offset), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale))
+
+    def frame_matrix(self, frame: int, frames: int) -> np.ndarray:
+        """Model matrix of 1-based ``frame`` out of ``frames``: t = (frame - 1) / frames."""
+        return self.model_matrix((frame - 1) / frames)
