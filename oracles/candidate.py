@@ -1,0 +1,75 @@
+"""The candidate contract: any projector crosscheck can judge.
+
+``FUNC(points, camera) -> ndarray (N, 2)``
+
+- ``points``: ``(N, 3)`` float64 world coordinates.
+- ``camera``: an object with ``position`` (3,), ``forward`` (3,) unit, ``up``
+  (3,) unit and orthogonal to forward, ``fov_y_deg``, ``width``, ``height``,
+  ``near``, ``far``, ``projection`` ("perspective" or "orthographic") and
+  ``ortho_height`` (world units visible vertically; orthographic only).
+- returns pixel coordinates in the project's pixel convention (x right, y down,
+  integer coordinates at pixel centres; core/conventions.py), NaN rows for the
+  points it clips (depth outside [near, far]).
+
+Given as ``--candidate FILE.py:FUNC`` or ``--candidate MODULE:FUNC``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from core.errors import InputError
+
+
+def load_candidate(spec: str):
+    """Resolve ``FILE.py:FUNC`` or ``MODULE:FUNC`` to a callable; InputError otherwise."""
+    if ":" not in spec:
+        raise InputError(f"--candidate {spec!r}: expected FILE.py:FUNC or MODULE:FUNC")
+    target, func_name = spec.rsplit(":", 1)
+    if target.endswith(".py") or "/" in target:
+        path = Path(target)
+        if not path.is_file():
+            raise InputError(f"--candidate {spec!r}: file {target!r} not found")
+        mod_name = f"wirecheck_candidate_{abs(hash(str(path.resolve())))}"
+        try:
+            module_spec = importlib.util.spec_from_file_location(mod_name, path)
+            module = importlib.util.module_from_spec(module_spec)
+            sys.modules[mod_name] = module
+            module_spec.loader.exec_module(module)
+        except Exception as exc:  # the user's file: report, don't trace back
+            raise InputError(f"--candidate {spec!r}: importing {target} failed: "
+                             f"{type(exc).__name__}: {exc}") from None
+    else:
+        try:
+            module = importlib.import_module(target)
+        except Exception as exc:
+            raise InputError(f"--candidate {spec!r}: importing module {target!r} failed: "
+                             f"{type(exc).__name__}: {exc}") from None
+    func = getattr(module, func_name, None)
+    if not callable(func):
+        raise InputError(f"--candidate {spec!r}: {target} has no callable {func_name!r}")
+    return func
+
+
+class CandidateError(RuntimeError):
+    """The candidate raised or returned something outside the contract."""
+
+
+def call_candidate(func, points: np.ndarray, camera) -> np.ndarray:
+    """Call the candidate and check its answer against the contract."""
+    try:
+        out = func(np.array(points, dtype=np.float64, copy=True), camera)
+    except Exception as exc:
+        raise CandidateError(f"candidate raised {type(exc).__name__}: {exc}") from exc
+    try:
+        out = np.asarray(out, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise CandidateError(f"candidate returned {type(out).__name__}: expected an (N, 2) float array") from exc
+    if out.shape != (len(points), 2):
+        raise CandidateError(f"candidate returned shape {out.shape}: expected ({len(points)}, 2)")
+    return out

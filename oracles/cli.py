@@ -1,0 +1,179 @@
+"""``crosscheck``: judge a projector against OpenCV and pyrender/OSMesa.
+
+Exit status: 0 when every case is within tolerance, 1 when any case fails,
+2 on usage or input errors (including libOSMesa missing when pyrender is asked for).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+from core.errors import InputError
+from core.scene import SCENE_DIR, builtin_names, load_scene
+
+from . import tolerances
+from .candidate import load_candidate
+from .cases import CASE_NAMES, cameras_for
+from .report import console_table, write_report
+from .runner import CoreCandidate, Motion, Tolerances, run_case
+
+ORACLES = ("opencv", "pyrender")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0])
+    p.add_argument("--scene", action="append", default=None,
+                   help="scene name or path; repeatable (default: every scene in scenes/)")
+    p.add_argument("--frames", type=int, default=24, help="frames of the scene's motion per case (default 24)")
+    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)}")
+    p.add_argument("--candidate", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
+                   help="the projector to judge (default: core/)")
+    p.add_argument("--oracles", default="opencv,pyrender", help="comma-separated: opencv, pyrender")
+    p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
+    p.add_argument("--tol-px", type=float, default=tolerances.VERTEX_TOL_PX,
+                   help=f"max vertex error in px (default {tolerances.VERTEX_TOL_PX})")
+    p.add_argument("--min-f1", type=float, default=tolerances.MIN_F1_1PX,
+                   help=f"min edge-pixel F1 at 1 px (default {tolerances.MIN_F1_1PX})")
+    p.add_argument("--min-f1-0px", type=float, default=tolerances.MIN_F1_0PX,
+                   help=f"min edge-pixel F1 at 0 px (default {tolerances.MIN_F1_0PX})")
+    p.add_argument("--report-dir", default=None, help="where to write the report (default reports/<run>)")
+    p.add_argument("--run", default=None, help="run name under reports/ (default: UTC time)")
+    return p
+
+
+def _parse(args):
+    if args.frames < 1:
+        raise InputError(f"--frames {args.frames}: expected an integer >= 1")
+    if not (math.isfinite(args.tol_px) and args.tol_px >= 0):
+        raise InputError(f"--tol-px {args.tol_px}: expected a number >= 0")
+    for opt, v in (("--min-f1", args.min_f1), ("--min-f1-0px", args.min_f1_0px)):
+        if not 0.0 <= v <= 1.0:
+            raise InputError(f"{opt} {v}: expected a number in [0, 1]")
+    oracles = [o.strip() for o in args.oracles.split(",") if o.strip()]
+    if not oracles or any(o not in ORACLES for o in oracles):
+        raise InputError(f"--oracles {args.oracles!r}: expected a comma-separated list of {', '.join(ORACLES)}")
+    if "opencv" not in oracles:
+        raise InputError(f"--oracles {args.oracles!r}: expected opencv among them (vertices are always checked)")
+    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+    bad = [c for c in cases if c not in CASE_NAMES]
+    if bad or not cases:
+        raise InputError(f"--cases {args.cases!r}: unknown {', '.join(bad) or '(none)'}; expected some of {', '.join(CASE_NAMES)}")
+    try:
+        spin = tuple(float(x) for x in args.spin.split(","))
+    except ValueError:
+        spin = ()
+    if len(spin) != 3 or not all(math.isfinite(x) for x in spin):
+        raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
+    names = args.scene or builtin_names()
+    scenes = [load_scene(n) for n in names]
+    candidate = load_candidate(args.candidate) if args.candidate else CoreCandidate()
+    return oracles, cases, spin, scenes, candidate
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        oracles, case_names, spin, scenes, candidate = _parse(args)
+    except InputError as exc:
+        print(f"crosscheck: error: {exc}", file=sys.stderr)
+        return 2
+    pyr = None
+    if "pyrender" in oracles:
+        from .pyrender_oracle import PyrenderOracle, osmesa_available
+
+        ok, message = osmesa_available()
+        if not ok:
+            print(f"crosscheck: error: {message} (or run with --oracles opencv)", file=sys.stderr)
+            return 2
+    if args.report_dir:
+        run_dir = Path(args.report_dir)
+    else:
+        run = args.run or datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+        run_dir = Path("reports") / run
+    try:
+        run_dir.parent.mkdir(parents=True, exist_ok=True)
+        if not os.access(run_dir.parent, os.W_OK):
+            raise OSError("permission denied")
+    except OSError as exc:
+        print(f"crosscheck: error: --report-dir {str(run_dir)!r}: cannot write there ({exc}): "
+              "expected a writable directory", file=sys.stderr)
+        return 2
+
+    tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
+    motion = Motion(turns=spin)
+    records, images, timing_cases = [], {}, []
+    t_run = time.perf_counter()
+    renderers = {}
+    try:
+        for scene in scenes:
+            for case in cameras_for(scene.radius):
+                if case.name not in case_names:
+                    continue
+                cam = case.camera
+                if "pyrender" in oracles:
+                    size = (cam.width, cam.height)
+                    if size not in renderers:
+                        renderers[size] = PyrenderOracle(*size)
+                    pyr = renderers[size]
+                result = run_case(scene, case, args.frames, candidate, motion, tol, pyrender_oracle=pyr)
+                records.append(result.record)
+                timing_cases.append({"scene": scene.name, "camera": case.name, **result.timing})
+                if result.worst_images:
+                    images[(scene.name, case.name)] = result.worst_images
+    finally:
+        for r in renderers.values():
+            r.close()
+
+    def mean_of(key):
+        vals = [t[key] for t in timing_cases if key in t]
+        return sum(vals) / len(vals) if vals else None
+
+    failed = sum(1 for r in records if r["verdict"] != "pass")
+    vertex_errs = [r["max_vertex_error_px"] for r in records if r.get("max_vertex_error_px") is not None]
+    f1_0 = [r["pixel_f1_0px"] for r in records if r.get("pixel_f1_0px") is not None]
+    f1_1 = [r["pixel_f1_1px"] for r in records if r.get("pixel_f1_1px") is not None]
+    report = {
+        "tool": "wirecheck crosscheck",
+        "verdict": "fail" if failed else "pass",
+        "candidate": args.candidate or "core",
+        "oracles": oracles,
+        "frames": args.frames,
+        "motion": {"turns": list(spin)},
+        "tolerances": tol.to_dict(),
+        "summary": {"cases": len(records), "passed": len(records) - failed, "failed": failed,
+                    "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
+                    "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
+                    "min_pixel_f1_1px": min(f1_1) if f1_1 else None},
+        "cases": records,
+        "timing": {"candidate_ms_per_frame": mean_of("candidate_ms_per_frame"),
+                   "opencv_ms_per_frame": mean_of("opencv_ms_per_frame"),
+                   "pyrender_ms_per_frame": mean_of("pyrender_ms_per_frame"),
+                   "wall_s": time.perf_counter() - t_run,
+                   "cases": timing_cases},
+    }
+    try:
+        write_report(run_dir, report, images)
+    except OSError as exc:
+        print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
+        return 2
+    print(console_table(records))
+    s = report["summary"]
+    print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance "
+          f"(vertex <= {tol.vertex_px:g} px, F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px})")
+    print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,129 @@
+"""report.json, report.md and report.html for a crosscheck run; atomic.
+
+The run directory is filled under a temporary name and renamed at the end,
+so a directory called ``reports/<run>`` is always complete. Timings live only
+under the top-level ``"timing"`` key; everything else is deterministic.
+"""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import numpy as np
+
+from core.output import FrameDir, json_dumps, png_bytes
+
+from .metrics import DIFF_COLOURS, diff_image
+
+
+def _fmt_err(v) -> str:
+    return "-" if v is None else f"{v:.2e}"
+
+
+def _fmt_f1(v) -> str:
+    return "-" if v is None else f"{v:.4f}"
+
+
+def fault_text(faults: list[dict]) -> str:
+    if not faults:
+        return "none"
+    parts = []
+    for f in faults:
+        extra = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
+                          for k, v in f.items() if k != "name")
+        parts.append(f"{f['name']}({extra})" if extra else f["name"])
+    return "; ".join(parts)
+
+
+def table_rows(cases: list[dict]) -> list[list[str]]:
+    return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _fmt_f1(c.get("pixel_f1_0px")),
+             _fmt_f1(c.get("pixel_f1_1px")), c["verdict"], fault_text(c["faults"])] for c in cases]
+
+
+HEADER = ["scene", "camera", "max vertex err (px)", "F1@0px", "F1@1px", "verdict", "faults"]
+
+
+def console_table(cases: list[dict]) -> str:
+    rows = [HEADER] + table_rows(cases)
+    widths = [max(len(r[i]) for r in rows) for i in range(len(HEADER) - 1)]
+    lines = []
+    for r in rows:
+        lines.append("  ".join(r[i].ljust(widths[i]) for i in range(len(widths))) + "  " + r[-1])
+    return "\n".join(lines)
+
+
+def markdown(report: dict) -> str:
+    s = report["summary"]
+    out = [f"# crosscheck report: {report['verdict'].upper()}", "",
+           f"Candidate: `{report['candidate']}`. Oracles: {', '.join(report['oracles'])}. "
+           f"Cases: {s['cases']} ({s['passed']} pass, {s['failed']} fail).", "",
+           "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
+           "| " + " | ".join(HEADER) + " |", "|" + "---|" * len(HEADER)]
+    for r in table_rows(report["cases"]):
+        out.append("| " + " | ".join(r) + " |")
+    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    if failing:
+        out += ["", "## Why cases failed", ""]
+        for c in failing:
+            out.append(f"- **{c['scene']} / {c['camera']}**: " + "; ".join(c["reasons"]))
+    out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames: `report.html`.", ""]
+    return "\n".join(out)
+
+
+def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
+    e = html.escape
+    legend = " ".join(f'<span style="color:rgb{col}">&#9632; {e(name.replace("_", " "))}</span>'
+                      for name, col in DIFF_COLOURS.items())
+    rows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in table_rows(report["cases"]))
+    parts = [
+        "<!doctype html><html><head><meta charset='utf-8'><title>crosscheck report</title>",
+        "<style>body{font-family:sans-serif;background:#fafafa;margin:2em}"
+        "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 8px}"
+        "img{image-rendering:pixelated;border:1px solid #888;max-width:32%;background:#000}"
+        ".fail{color:#b00}.pass{color:#070}figure{margin:0 0 2em 0}</style></head><body>",
+        f"<h1>crosscheck: <span class='{e(report['verdict'])}'>{e(report['verdict'].upper())}</span></h1>",
+        f"<p>Candidate <code>{e(report['candidate'])}</code>; oracles {e(', '.join(report['oracles']))}.</p>",
+        "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in HEADER) + "</tr>" + rows + "</table>",
+        f"<h2>Worst frames</h2><p>candidate / oracle (pyrender) / diff: {legend}</p>",
+    ]
+    for case, stem in shown:
+        parts.append(
+            f"<figure><figcaption><b>{e(case['scene'])} / {e(case['camera'])}</b>, frame "
+            f"{case.get('worst_pixel_frame')}: F1@0 {_fmt_f1(case.get('pixel_f1_0px'))}, "
+            f"F1@1 {_fmt_f1(case.get('pixel_f1_1px'))}, faults: {e(fault_text(case['faults']))}</figcaption>"
+            f"<img src='img/{stem}-candidate.png' alt='candidate'> <img src='img/{stem}-oracle.png' alt='oracle'> "
+            f"<img src='img/{stem}-diff.png' alt='diff'></figure>")
+    parts.append("</body></html>\n")
+    return "\n".join(parts)
+
+
+def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) -> Path:
+    """Write the run directory atomically; ``images[(scene, camera)] = {frame, candidate, oracle}``."""
+    run_dir = Path(run_dir)
+    run_dir.parent.mkdir(parents=True, exist_ok=True)
+    out = FrameDir(run_dir)
+    try:
+        (out.tmp / "img").mkdir()
+        # worst frames: every failing case, then the lowest F1 of the rest
+        ranked = sorted(report["cases"], key=lambda c: (c["verdict"] == "pass", c.get("pixel_f1_1px") or 0,
+                                                        c.get("pixel_f1_0px") or 0))
+        shown = []
+        for case in ranked:
+            key = (case["scene"], case["camera"])
+            if key not in images or (len(shown) >= worst_n and case["verdict"] == "pass"):
+                continue
+            im = images[key]
+            stem = f"{case['scene']}-{case['camera']}"
+            out.write(f"img/{stem}-candidate.png", png_bytes(np.where(im["candidate"], 255, 0).astype(np.uint8)))
+            out.write(f"img/{stem}-oracle.png", png_bytes(np.where(im["oracle"], 255, 0).astype(np.uint8)))
+            out.write(f"img/{stem}-diff.png", png_bytes(diff_image(im["candidate"], im["oracle"])))
+            shown.append((case, stem))
+        out.write("report.json", json_dumps(report).encode())
+        out.write("report.md", markdown(report).encode())
+        out.write("report.html", _html(report, shown).encode())
+        out.commit()
+    except BaseException:
+        out.abort()
+        raise
+    return run_dir
