@@ -1,0 +1,320 @@
+"""Name what is wrong with a candidate projector, from its pixels and an oracle's.
+
+``diagnose(cand_px, oracle_px, camera, tol_px=1e-6) -> list[dict]``
+
+Both inputs are ``(N, 2)`` pixel coordinates of the *same* world points (pooled
+over all frames of a case), with a non-finite row (NaN, in practice) where that
+projector clipped the point. A row with any non-finite coordinate counts as
+clipped. The answer is ``[]`` when the candidate agrees: the same points are
+visible to both, and on those the largest coordinate error is ``<= tol_px``.
+Otherwise it is a list of faults, the *primary* fault first (in the order of
+``FAULT_ORDER``), each a dict with ``"name"`` and fields.
+
+Method
+======
+1. **Visibility.** ``vis_c``/``vis_o`` = rows finite in the candidate/oracle.
+   If both see something between them and they have (nearly) no visible point
+   in common -- at most ``DEPTH_FLIP_MAX_OVERLAP`` of the union -- the candidate
+   looks backward: ``depth_flip``, and nothing else is reported (there is
+   nothing to fit). This includes "the candidate clips everything the oracle
+   shows" (a camera flipped away from a scene that lies wholly in front).
+2. **Affine fit.** On points visible to both, in coordinates centred on the
+   camera's principal point (``u = x - cx, v = y - cy``, ``cx = (W-1)/2``,
+   ``cy = (H-1)/2``), fit ``cand_c = A @ oracle_c + b`` by least squares.
+3. **Named model.** Snap ``A`` to the nearest signed axis permutation ``P``
+   (diagonal if ``|A00|+|A11| >= |A01|+|A10|``, else anti-diagonal; the signs
+   of the dominant entries), then refit each candidate axis separately:
+   ``cand_i = d_i * (P @ oracle_c)_i + b_i``. If that model (per-axis positive
+   scale + offset after a signed permutation) reproduces the candidate to
+   ``tol_px`` everywhere, the faults are read off ``P``, ``d`` and ``b``;
+   otherwise the map is a rotation, a shear, or not affine at all (a 3D error:
+   transposed rotation, wrong rotation order, roll...), and the answer is a
+   single ``unexplained``.
+4. **Significance.** A parameter is reported only when its effect on some
+   pixel exceeds ``tol_px``: ``|d_i - 1| * max|q_i| > tol_px`` for a scale,
+   ``|b_i - expected_i| > tol_px`` for an offset, ``|d_x - d_y| * max|q_x| >
+   tol_px`` for an aspect. So ``tol_px`` is the one knob: anything whose pixel
+   effect is below it counts as agreement, and there is no separate tolerance
+   on the entries of ``A`` (it would have to be ``tol_px / image extent``
+   anyway, which is what the pixel-effect test is). The snap to ``P`` is a
+   discrete choice, and a wrong snap cannot pass step 3's residual test.
+   A disagreement above ``tol_px`` that leaves no named parameter significant
+   is reported as ``unexplained`` (never ``[]``).
+
+Faults
+======
+==================  ==========================================  ===================================
+name                recognised by                               fields
+==================  ==========================================  ===================================
+depth_flip          visible sets (nearly) disjoint: the         oracle_visible, candidate_visible,
+                    candidate shows what the oracle clips and   common_visible
+                    clips what it shows
+axis_swap           ``P`` anti-diagonal (x and y exchanged)     --
+mirror_horizontal   ``P = diag(-1, 1)`` (after any swap)        --
+mirror_vertical     ``P = diag(1, -1)`` (after any swap)        --
+axis_flip           ``P = diag(-1, -1)``: turned 180 deg        --
+aspect_mismatch     ``d_x != d_y``                              implied_aspect, scale_x, scale_y
+fov_mismatch        ``d_y != 1`` (alone when ``d_x = d_y``,     scale, implied_fov_deg (None for
+                    else with aspect_mismatch)                  ortho), implied_ortho_height (None
+                                                                for perspective)
+pixel_offset        ``b`` minus the shift the named linear      dx, dy
+                    faults imply, nonzero
+unexplained         the named model does not fit (rotation,     residual_px (max), residual_rms_px,
+                    shear, not affine); or the visible sets     affine_residual_px, affine, offset,
+                    differ without a depth flip; or too few     rotation_deg, visibility_mismatches,
+                    common points to fit                        common_visible, underdetermined
+==================  ==========================================  ===================================
+
+Details and decisions
+---------------------
+* **Combinations.** Several named faults may come together (``fov_mismatch`` +
+  ``pixel_offset``; ``axis_swap`` + ``mirror_horizontal`` is a 90 deg turn).
+  Mirrors are named in the *candidate's* image axes, i.e. applied after the swap:
+  ``cand = M @ S @ oracle``.
+* **Expected shifts.** The mirrors and the flip of a candidate that mirrors
+  whole pixel coordinates (``x -> (W-1) - x``) are pure sign changes in centred
+  coordinates: no shift. A raw swap ``(x, y) -> (y, x)`` is ``u' = v + (cy-cx)``,
+  ``v' = u + (cx-cy)``: on a non-square image it shifts by ``cx - cy`` per axis.
+  A swap candidate might also centre with the other image size, or mirror with
+  ``W-1`` or ``H-1`` after swapping, so for a swap each axis may legitimately
+  shift by ``0`` or ``+-(cx - cy)``; the nearest of these is taken as expected
+  and only the rest is a ``pixel_offset``. (A genuine offset equal to
+  ``+-(cx-cy)`` on top of a swap is therefore not reported; on a square image
+  ``cx = cy`` and nothing is forgiven.)
+* **FOV.** ``d_y = f_cand / f`` is the candidate's vertical focal length over the
+  true one, so ``implied_fov_deg = 2 atan(tan(fov_y / 2) / d_y)``: the vertical
+  FOV (edge to edge, as in core.conventions) that the candidate effectively used.
+* **Aspect.** A GL-style candidate computes ``f_x = (W/2) / (a tan(fov_y/2))``
+  with its own aspect ``a``; so ``implied_aspect = (W/H) * d_y / d_x``. The right
+  answer is ``W/H``; a candidate that took ``f_x`` from the width
+  (``(W/2)/tan(fov/2)``) implicitly used ``a = 1``.
+* **Orthographic.** A wrong ortho scale is the orthographic analogue of a wrong
+  FOV and is named ``fov_mismatch`` too, with ``implied_ortho_height =
+  ortho_height / d_y`` (and ``implied_fov_deg = None``). The aspect formula is
+  the same (ortho width = ``a * ortho_height``).
+* **Degenerate inputs.** ``N = 0``, or both projectors clipping everything, is
+  agreement (``[]``). With fewer than 3 non-collinear common points (see
+  ``DEGENERATE_RATIO``) no linear map can be fitted; only a constant offset is
+  tried (``pixel_offset`` if it explains the points), else ``unexplained`` with
+  ``underdetermined = True``.
+* **rotation_deg** (in ``unexplained``) is the rotation part of ``A``,
+  ``atan2(A10 - A01, A00 + A11)``, in pixel axes (y down): a camera rolled by
+  +r about its forward axis shows as -r. With ``affine_residual_px <= tol_px``
+  the error is a pure image-plane map (a roll, a shear); otherwise it is a 3D
+  error (transposed rotation, rotation order, wrong position).
+* **Invisible faults.** A fault that does not change the pixels (a transposed
+  rotation on a camera whose rotation is symmetric, e.g. on the Z axis) cannot
+  be diagnosed and gives ``[]``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["diagnose", "primary", "FAULT_NAMES", "FAULT_ORDER",
+           "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
+
+#: All fault names, in priority order: the first fault of a diagnosis is the
+#: primary one. A depth flip hides everything else; a swap or mirror changes
+#: the picture more than a scale; an offset is the smallest visible effect.
+FAULT_ORDER = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
+               "mirror_vertical", "aspect_mismatch", "fov_mismatch",
+               "pixel_offset", "unexplained")
+FAULT_NAMES = frozenset(FAULT_ORDER)
+
+#: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
+#: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union
+#: in common, for a candidate that also differs at the near/far boundary or an
+#: orthographic camera whose [near, far] reaches slightly behind it; a real
+#: near/far error (the other reason visible sets differ) changes only the few
+#: points close to a plane, so it keeps far more than 1% in common.
+DEPTH_FLIP_MAX_OVERLAP = 0.01
+
+#: The common points must span 2D for a linear fit: the smaller singular value
+#: of the centred point cloud must be at least this fraction of the larger.
+#: Exactly collinear projected points give ~1e-16 (float noise); 1e-6 keeps the
+#: fit's condition number <= 1e6, so float64 noise (1e-16 relative) in the
+#: pixels moves the fitted map by < 1e-10 relative, far below any fault.
+DEGENERATE_RATIO = 1e-6
+
+
+def _sign(x: float) -> int:
+    return -1 if x < 0 else 1
+
+
+def _max_abs(a: np.ndarray) -> float:
+    return float(np.max(np.abs(a))) if a.size else 0.0
+
+
+def primary(faults: list[dict]) -> str:
+    """The primary fault's name, or ``"none"`` for an empty diagnosis."""
+    return faults[0]["name"] if faults else "none"
+
+
+def _sorted(faults: list[dict]) -> list[dict]:
+    return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
+
+
+def _fit_affine(o: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Least squares ``c = o @ A.T + b``; ``o`` normalised for conditioning."""
+    r = _max_abs(o) or 1.0
+    design = np.column_stack([o / r, np.ones(len(o))])
+    x, *_ = np.linalg.lstsq(design, c, rcond=None)
+    return x[:2].T / r, x[2]
+
+
+def _fit_axis(q: np.ndarray, c: np.ndarray) -> tuple[float, float]:
+    """Least squares ``c = d * q + b`` for one axis."""
+    r = _max_abs(q) or 1.0
+    design = np.column_stack([q / r, np.ones(len(q))])
+    x, *_ = np.linalg.lstsq(design, c, rcond=None)
+    return float(x[0] / r), float(x[1])
+
+
+def _unexplained(**fields) -> dict:
+    return {"name": "unexplained", **fields}
+
+
+def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
+    """Name the faults of a candidate projector; ``[]`` when it agrees.
+
+    Parameters
+    ----------
+    cand_px, oracle_px : (N, 2) array_like
+        Pixels of the same world points from the candidate and the oracle,
+        non-finite rows where that projector clipped the point.
+    camera : core.camera.Camera
+        The camera both were asked to use (for ``cx, cy``, the FOV or ortho
+        height, and the aspect).
+    tol_px : float
+        Agreement tolerance in pixels; a fault whose largest pixel effect is
+        below it is not reported.
+
+    Returns
+    -------
+    list of dict, primary fault first; see the module docstring.
+    """
+    cand = np.asarray(cand_px, dtype=np.float64)
+    orac = np.asarray(oracle_px, dtype=np.float64)
+    if cand.size == 0 and orac.size == 0:
+        return []
+    cand = cand.reshape(-1, 2) if cand.ndim != 2 else cand
+    orac = orac.reshape(-1, 2) if orac.ndim != 2 else orac
+    if cand.shape != orac.shape or cand.shape[1] != 2:
+        raise ValueError(f"diagnose: expected two (N, 2) arrays of the same N, got {cand.shape} and {orac.shape}")
+    tol = float(tol_px)
+    if not tol >= 0:
+        raise ValueError(f"diagnose: tol_px {tol_px!r}: expected >= 0")
+
+    vis_c = np.isfinite(cand).all(axis=1)
+    vis_o = np.isfinite(orac).all(axis=1)
+    both = vis_c & vis_o
+    n_both, n_union = int(both.sum()), int((vis_c | vis_o).sum())
+    mismatches = int((vis_c != vis_o).sum())
+    if n_union == 0:
+        return []                                   # N = 0 or both clip everything
+    if mismatches == 0 and _max_abs(cand[both] - orac[both]) <= tol:
+        return []
+
+    # 1. depth flip: visible sets (nearly) swapped
+    if mismatches and n_both <= DEPTH_FLIP_MAX_OVERLAP * n_union:
+        return [{"name": "depth_flip", "oracle_visible": int(vis_o.sum()),
+                 "candidate_visible": int(vis_c.sum()), "common_visible": n_both}]
+
+    vis_fields = {"visibility_mismatches": mismatches, "common_visible": n_both}
+    cx, cy = camera.principal_point
+    centre = np.array([cx, cy])
+    o = orac[both] - centre
+    c = cand[both] - centre
+
+    # degenerate: fewer than 3 non-collinear common points -> offset only
+    spread = o - o.mean(axis=0) if n_both else o
+    sv = np.linalg.svd(spread, compute_uv=False) if n_both >= 2 else np.zeros(2)
+    if n_both < 3 or sv[0] == 0 or sv[-1] < DEGENERATE_RATIO * sv[0]:
+        faults = []
+        if n_both:
+            off = (c - o).mean(axis=0)
+            resid = c - o - off
+            if _max_abs(resid) <= tol:
+                if _max_abs(off) > tol:
+                    faults.append({"name": "pixel_offset", "dx": float(off[0]), "dy": float(off[1])})
+                if mismatches:
+                    faults.append(_unexplained(residual_px=0.0, residual_rms_px=0.0, **vis_fields,
+                                               underdetermined=True))
+                return _sorted(faults)
+            res = c - o
+        else:
+            res = np.zeros((0, 2))
+        return [_unexplained(residual_px=_max_abs(res),
+                             residual_rms_px=float(np.sqrt(np.mean(res ** 2))) if res.size else 0.0,
+                             **vis_fields, underdetermined=True)]
+
+    # 2. affine fit
+    a, b = _fit_affine(o, c)
+    affine_res = c - (o @ a.T + b)
+    diag_weight = abs(a[0, 0]) + abs(a[1, 1])
+    swap = abs(a[0, 1]) + abs(a[1, 0]) > diag_weight
+    if swap:
+        signs = (_sign(a[0, 1]), _sign(a[1, 0]))
+        q = o[:, ::-1] * signs
+    else:
+        signs = (_sign(a[0, 0]), _sign(a[1, 1]))
+        q = o * signs
+
+    # 3. named model: per-axis positive scale + offset after the signed permutation
+    d = np.empty(2)
+    off = np.empty(2)
+    for i in range(2):
+        d[i], off[i] = _fit_axis(q[:, i], c[:, i])
+    named_res = c - (q * d + off)
+    reach = np.max(np.abs(q), axis=0)               # largest |coordinate| per candidate axis
+    named_max = _max_abs(named_res)
+    collapsed = bool(np.any(d * reach <= tol))       # an axis the candidate squashed flat
+    if named_max > tol or collapsed:
+        rot = math.degrees(math.atan2(a[1, 0] - a[0, 1], a[0, 0] + a[1, 1]))
+        return [_unexplained(residual_px=named_max,
+                             residual_rms_px=float(np.sqrt(np.mean(named_res ** 2))),
+                             affine_residual_px=_max_abs(affine_res),
+                             affine=a.tolist(), offset=b.tolist(), rotation_deg=rot,
+                             **vis_fields, underdetermined=False)]
+
+    # 4. read the faults off P, d, b
+    faults: list[dict] = []
+    if swap:
+        faults.append({"name": "axis_swap"})
+    mirror = {(-1, 1): "mirror_horizontal", (1, -1): "mirror_vertical", (-1, -1): "axis_flip"}.get(signs)
+    if mirror:
+        faults.append({"name": mirror})
+    sx, sy = float(d[0]), float(d[1])
+    if abs(sx - sy) * reach[0] > tol:
+        faults.append({"name": "aspect_mismatch",
+                       "implied_aspect": (camera.width / camera.height) * sy / sx,
+                       "scale_x": sx, "scale_y": sy})
+    if abs(sy - 1.0) * reach[1] > tol:
+        fault = {"name": "fov_mismatch", "scale": sy, "implied_fov_deg": None, "implied_ortho_height": None}
+        if camera.projection == "perspective":
+            half = math.tan(math.radians(camera.fov_y_deg) / 2.0)
+            fault["implied_fov_deg"] = math.degrees(2.0 * math.atan(half / sy))
+        else:
+            fault["implied_ortho_height"] = camera.ortho_height / sy
+        faults.append(fault)
+    expected = np.zeros(2)
+    if swap:
+        shift = cx - cy                               # a raw swap moves each axis by +-(cx - cy)
+        allowed = np.array([-shift, 0.0, shift])
+        expected = np.array([allowed[np.argmin(np.abs(allowed - off[i]))] for i in range(2)])
+    residual_offset = off - expected
+    if _max_abs(residual_offset) > tol:
+        faults.append({"name": "pixel_offset", "dx": float(residual_offset[0]), "dy": float(residual_offset[1])})
+    if mismatches or not faults:
+        # visible sets differ without a depth flip (near/far?), or an error too
+        # small to name: still a disagreement, so say so
+        faults.append(_unexplained(residual_px=named_max,
+                                   residual_rms_px=float(np.sqrt(np.mean(named_res ** 2))),
+                                   affine_residual_px=_max_abs(affine_res),
+                                   affine=a.tolist(), offset=b.tolist(),
+                                   rotation_deg=math.degrees(math.atan2(a[1, 0] - a[0, 1], a[0, 0] + a[1, 1])),
+                                   **vis_fields, underdetermined=False))
+    return _sorted(faults)

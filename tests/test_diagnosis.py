@@ -1,0 +1,417 @@
+"""oracles.diagnose: inject each fault into a copy of the projector, check the name.
+
+Every faulty projector below is a small re-implementation of
+``core.projection.project_points`` with one bug (or two) put in on purpose. The
+reference side is ``oracles.opencv_oracle.project`` when it imports, else
+core's own projector. Each (fault, camera) pair must give EXACTLY the expected
+set of fault names; the confusion matrix over all pairs is printed (``-s`` or
+``-rA``) and must be diagonal.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from core.camera import Camera, look_at
+from core.conventions import focal_px
+from core.projection import project_points
+from core.scene import load_scene
+from core.transforms import Motion, apply, rotate_z
+from oracles.diagnose import FAULT_ORDER, diagnose, primary
+
+try:
+    from oracles.opencv_oracle import project as oracle_project
+    ORACLE = "opencv"
+except ImportError:                                   # pragma: no cover - fallback only
+    oracle_project = project_points
+    ORACLE = "core"
+
+TOL = 1e-6
+FRAMES = 12
+SCENES = ("cube", "pyramid", "prism")
+
+
+# ---- points -----------------------------------------------------------------
+
+def pooled_points(motion: Motion = Motion(), frames: int = FRAMES) -> np.ndarray:
+    """World points of all bundled scenes over all frames of a run, stacked."""
+    out = []
+    for name in SCENES:
+        v = load_scene(name).vertices
+        out += [apply(motion.frame_matrix(k, frames), v) for k in range(1, frames + 1)]
+    return np.concatenate(out)
+
+
+POINTS = pooled_points()
+# For depth_flip with both sets non-empty: a camera inside a spread of points.
+POINTS_AROUND = pooled_points(Motion(turns=(1.0, 2.0, 1.0), scale=2.0))
+
+# ---- cameras ----------------------------------------------------------------
+
+CAMERAS = {
+    "axis": look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480),
+    "oblique": look_at((3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), fov_y_deg=60, width=640, height=480),
+    "tall": look_at((-1, 2, 6), (0.2, 0, 0), (0.1, 1, -0.2), fov_y_deg=50, width=320, height=480),
+    "wide": look_at((0.5, 0.8, 3.2), (0, 0, 0), (0, 1, 0), fov_y_deg=110, width=640, height=480),
+    "ortho": look_at((2, 3, 5), (0, 0, 0), (0.2, 1, 0), width=400, height=300,
+                     projection="orthographic", ortho_height=5.0),
+    # camera at the centre of the points: some in front, some behind
+    "inside": look_at((0, 0, 0), (0.1, 0.2, -1), (0, 1, 0), fov_y_deg=90, width=640, height=480),
+}
+
+
+def _with(camera: Camera, **changes) -> Camera:
+    kw = dict(position=camera.position, forward=camera.forward, up=camera.up, fov_y_deg=camera.fov_y_deg,
+              width=camera.width, height=camera.height, near=camera.near, far=camera.far,
+              projection=camera.projection, ortho_height=camera.ortho_height)
+    kw.update(changes)
+    return Camera(**kw)
+
+
+# ---- a re-implementation of the projector with knobs for the faults -----------
+
+def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None):
+    """core.projection.project_points, with the rotation, focal lengths (or
+    ortho scales) and principal point replaceable."""
+    p = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
+    r = np.stack([camera.right, camera.up, camera.forward]) if rotation is None else rotation
+    p_cam = (p - camera.position) @ r.T
+    z = p_cam[:, 2]
+    vis = (z >= camera.near) & (z <= camera.far)
+    pcx, pcy = camera.principal_point
+    cx = pcx if cx is None else cx
+    cy = pcy if cy is None else cy
+    if camera.projection == "perspective":
+        f = camera.focal_px
+        fx = f if fx is None else fx
+        fy = f if fy is None else fy
+        z_safe = np.where(vis, z, 1.0)
+        x, y = cx + fx * p_cam[:, 0] / z_safe, cy - fy * p_cam[:, 1] / z_safe
+    else:
+        s = camera.height / camera.ortho_height
+        fx = s if fx is None else fx
+        fy = s if fy is None else fy
+        x, y = cx + fx * p_cam[:, 0], cy - fy * p_cam[:, 1]
+    out = np.stack([x, y], axis=1)
+    out[~vis] = np.nan
+    return out
+
+
+def _scale_for(camera, fov_or_height):
+    """Focal length (perspective, from a vertical FOV) or ortho scale (from an ortho height)."""
+    if camera.projection == "perspective":
+        return focal_px(fov_or_height, camera.height)
+    return camera.height / fov_or_height
+
+
+def f_none(p, cam):
+    return _project(p, cam)
+
+
+def f_mirror_x(p, cam):
+    out = _project(p, cam)
+    out[:, 0] = (cam.width - 1) - out[:, 0]
+    return out
+
+
+def f_mirror_y(p, cam):
+    out = _project(p, cam)
+    out[:, 1] = (cam.height - 1) - out[:, 1]
+    return out
+
+
+def f_flip(p, cam):
+    return f_mirror_y(p, cam) * [-1, 1] + [cam.width - 1, 0]
+
+
+def f_swap(p, cam):
+    return _project(p, cam)[:, ::-1].copy()
+
+
+def f_swap_mirror(p, cam):
+    """Turned 90 degrees: swap, then mirror x of the result."""
+    out = f_swap(p, cam)
+    out[:, 0] = (cam.width - 1) - out[:, 0]
+    return out
+
+
+FOV_FACTOR = 0.8
+
+
+def implied_fov(cam):
+    """What the fov fault used: fov * 0.8 (perspective) or ortho_height * 0.8."""
+    return (cam.fov_y_deg if cam.projection == "perspective" else cam.ortho_height) * FOV_FACTOR
+
+
+def f_fov(p, cam):
+    s = _scale_for(cam, implied_fov(cam))
+    return _project(p, cam, fx=s, fy=s)
+
+
+def f_fov_horizontal(p, cam):
+    """The vertical FOV taken as the horizontal one (f from the width, both axes)."""
+    s = _scale_for(cam, cam.fov_y_deg if cam.projection == "perspective" else cam.ortho_height)
+    s *= cam.width / cam.height
+    return _project(p, cam, fx=s, fy=s)
+
+
+def f_aspect(p, cam):
+    """fx from the width-based formula: (W/2) / tan(fov/2), i.e. aspect 1."""
+    s = _scale_for(cam, cam.fov_y_deg if cam.projection == "perspective" else cam.ortho_height)
+    return _project(p, cam, fx=s * cam.width / cam.height)
+
+
+def f_fov_aspect(p, cam):
+    s = _scale_for(cam, implied_fov(cam))
+    return _project(p, cam, fx=s * cam.width / cam.height, fy=s)
+
+
+def f_offset(p, cam):
+    """Pixel-corner convention: cx = W/2, cy = H/2."""
+    return _project(p, cam, cx=cam.width / 2, cy=cam.height / 2)
+
+
+def f_fov_offset(p, cam):
+    return f_fov(p, cam) + 0.5
+
+
+def f_depth_flip(p, cam):
+    """Forward negated: the camera looks backward."""
+    return project_points(p, _with(cam, forward=-cam.forward))
+
+
+def f_transposed(p, cam):
+    r = np.stack([cam.right, cam.up, cam.forward])
+    return _project(p, cam, rotation=r.T)
+
+
+def f_roll(p, cam):
+    """A 0.5 degree roll error about the view axis."""
+    r = np.stack([cam.right, cam.up, cam.forward])
+    return _project(p, cam, rotation=rotate_z(math.radians(0.5))[:3, :3] @ r)
+
+
+FAULTS = {
+    "none": (f_none, set()),
+    "mirror_x": (f_mirror_x, {"mirror_horizontal"}),
+    "mirror_y": (f_mirror_y, {"mirror_vertical"}),
+    "flip": (f_flip, {"axis_flip"}),
+    "swap": (f_swap, {"axis_swap"}),
+    "fov": (f_fov, {"fov_mismatch"}),
+    "fov_horizontal": (f_fov_horizontal, {"fov_mismatch"}),
+    "aspect": (f_aspect, {"aspect_mismatch"}),
+    "offset": (f_offset, {"pixel_offset"}),
+    "depth_flip": (f_depth_flip, {"depth_flip"}),
+    "transposed": (f_transposed, {"unexplained"}),
+    "roll": (f_roll, {"unexplained"}),
+    # combinations
+    "swap_mirror": (f_swap_mirror, {"axis_swap", "mirror_horizontal"}),
+    "fov_aspect": (f_fov_aspect, {"aspect_mismatch", "fov_mismatch"}),
+    "fov_offset": (f_fov_offset, {"fov_mismatch", "pixel_offset"}),
+}
+SINGLE = [k for k in FAULTS if k not in ("swap_mirror", "fov_aspect", "fov_offset")]
+
+# (fault, camera) pairs. "inside" is for depth_flip only (both visible sets
+# non-empty); "transposed" is invisible on the "axis" camera (its rotation
+# diag(1, 1, -1) is its own transpose), tested separately below.
+MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
+CASES = [(f, c) for f in FAULTS for c in MAIN_CAMERAS if not (f == "transposed" and c == "axis")]
+CASES += [("none", "inside"), ("depth_flip", "inside"), ("roll", "inside")]
+
+
+def points_for(camera_name):
+    return POINTS_AROUND if camera_name == "inside" else POINTS
+
+
+def run_case(fault, camera_name):
+    cam = CAMERAS[camera_name]
+    pts = points_for(camera_name)
+    fn, _ = FAULTS[fault]
+    return diagnose(fn(pts, cam), oracle_project(pts, cam), cam, tol_px=TOL)
+
+
+@pytest.fixture(scope="module")
+def results():
+    return {(f, c): run_case(f, c) for f, c in CASES}
+
+
+# ---- the exact set of names per pair ---------------------------------------
+
+@pytest.mark.parametrize("fault,camera_name", CASES)
+def test_expected_names(results, fault, camera_name):
+    got = results[(fault, camera_name)]
+    names = [d["name"] for d in got]
+    assert set(names) == FAULTS[fault][1], got
+    assert len(names) == len(set(names))
+    assert names == sorted(names, key=FAULT_ORDER.index)          # primary first
+
+
+def test_inside_camera_sees_both_sides():
+    cam = CAMERAS["inside"]
+    vis = np.isfinite(oracle_project(POINTS_AROUND, cam)).all(axis=1)
+    back = np.isfinite(f_depth_flip(POINTS_AROUND, cam)).all(axis=1)
+    assert vis.sum() > 10 and back.sum() > 10 and not np.any(vis & back)
+
+
+def test_transposed_rotation_invisible_on_axis():
+    """diag(1, 1, -1) is its own transpose: no pixel changes, so nothing to name."""
+    assert run_case("transposed", "axis") == []
+
+
+# ---- the numbers -------------------------------------------------------------
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_implied_fov(results, camera_name):
+    cam = CAMERAS[camera_name]
+    for fault in ("fov", "fov_aspect", "fov_offset"):
+        (fov,) = [d for d in results[(fault, camera_name)] if d["name"] == "fov_mismatch"]
+        if cam.projection == "perspective":
+            assert fov["implied_fov_deg"] == pytest.approx(implied_fov(cam), abs=1e-6)
+            assert fov["implied_ortho_height"] is None
+        else:
+            assert fov["implied_fov_deg"] is None
+            assert fov["implied_ortho_height"] == pytest.approx(implied_fov(cam), rel=1e-9)
+
+
+@pytest.mark.parametrize("camera_name", ("axis", "tall", "wide"))
+def test_implied_fov_of_horizontal_fov(results, camera_name):
+    """f from the width: the vertical FOV it amounts to is 2 atan((H/W) tan(fov/2))."""
+    cam = CAMERAS[camera_name]
+    (fov,) = results[("fov_horizontal", camera_name)]
+    want = math.degrees(2 * math.atan(cam.height / cam.width * math.tan(math.radians(cam.fov_y_deg) / 2)))
+    assert fov["implied_fov_deg"] == pytest.approx(want, abs=1e-6)
+    # direction: a wider image with f from the width -> longer focal -> narrower FOV
+    assert (fov["implied_fov_deg"] < cam.fov_y_deg) == (cam.width > cam.height)
+
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_implied_aspect(results, camera_name):
+    for fault in ("aspect", "fov_aspect"):
+        (asp,) = [d for d in results[(fault, camera_name)] if d["name"] == "aspect_mismatch"]
+        assert asp["implied_aspect"] == pytest.approx(1.0, abs=1e-9)   # width-based fx = aspect 1
+
+
+@pytest.mark.parametrize("aspect", [1.0, 0.75, 4 / 3 * 1.1])
+def test_implied_aspect_gl_style(aspect):
+    """A GL-style candidate with its own aspect a: fx = (W/2) / (a tan(fov/2)) = f (W/H) / a."""
+    cam = CAMERAS["oblique"]
+    cand = _project(POINTS, cam, fx=cam.focal_px * (cam.width / cam.height) / aspect)
+    (asp,) = diagnose(cand, oracle_project(POINTS, cam), cam, tol_px=TOL)
+    assert asp["name"] == "aspect_mismatch"
+    assert asp["implied_aspect"] == pytest.approx(aspect, rel=1e-9)
+
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_half_pixel_offset(results, camera_name):
+    for fault in ("offset", "fov_offset"):
+        (off,) = [d for d in results[(fault, camera_name)] if d["name"] == "pixel_offset"]
+        assert off["dx"] == pytest.approx(0.5, abs=1e-6)
+        assert off["dy"] == pytest.approx(0.5, abs=1e-6)
+
+
+@pytest.mark.parametrize("camera_name", ("oblique", "tall"))
+def test_swap_with_offset(camera_name):
+    """The raw swap's own shift (cx - cy) is expected; an extra half pixel is not."""
+    cam = CAMERAS[camera_name]
+    got = diagnose(f_swap(POINTS, cam) + [0.5, -0.25], oracle_project(POINTS, cam), cam, tol_px=TOL)
+    assert [d["name"] for d in got] == ["axis_swap", "pixel_offset"]
+    assert (got[1]["dx"], got[1]["dy"]) == pytest.approx((0.5, -0.25), abs=1e-6)
+
+
+def test_unexplained_fields(results):
+    (u,) = results[("roll", "oblique")]
+    assert u["residual_px"] > TOL
+    assert u["affine_residual_px"] < TOL                 # a roll is an image rotation...
+    assert u["rotation_deg"] == pytest.approx(-0.5, abs=1e-6)   # ...of the roll angle (y down)
+    (t,) = results[("transposed", "oblique")]
+    assert t["residual_px"] > 1.0 and t["affine_residual_px"] > 1.0   # not affine at all
+
+
+# ---- degenerate inputs -------------------------------------------------------
+
+def test_degenerate_inputs():
+    cam = CAMERAS["axis"]
+    assert diagnose(np.zeros((0, 2)), np.zeros((0, 2)), cam) == []
+    nan = np.full((5, 2), np.nan)
+    assert diagnose(nan, nan, cam) == []
+    one = np.array([[10.0, 20.0]])
+    assert diagnose(one, one, cam) == []
+    (off,) = diagnose(one + 0.5, one, cam)
+    assert off["name"] == "pixel_offset" and (off["dx"], off["dy"]) == (0.5, 0.5)
+    # two points, mirrored: cannot be fitted -> unexplained, underdetermined
+    two = np.array([[10.0, 20.0], [30.0, 50.0]])
+    (u,) = diagnose(two * [-1, 1] + [cam.width - 1, 0], two, cam)
+    assert u["name"] == "unexplained" and u["underdetermined"]
+    # collinear points with an offset: the offset is still found
+    line = np.column_stack([np.linspace(0, 600, 7), np.full(7, 100.0)])
+    assert [d["name"] for d in diagnose(line + [0.5, 0.5], line, cam)] == ["pixel_offset"]
+    # the candidate clips everything the oracle shows: the flip of a scene in front
+    pts = oracle_project(POINTS, cam)
+    assert primary(diagnose(np.full_like(pts, np.nan), pts, cam)) == "depth_flip"
+    with pytest.raises(ValueError):
+        diagnose(np.zeros((3, 2)), np.zeros((4, 2)), cam)
+
+
+def test_visibility_mismatch_without_flip():
+    """A wrong far plane changes a few points only: unexplained, with the count."""
+    cam = _with(CAMERAS["oblique"], far=5.4)
+    cand = project_points(POINTS, _with(cam, far=5.6))
+    got = diagnose(cand, oracle_project(POINTS, cam), cam, tol_px=TOL)
+    assert [d["name"] for d in got] == ["unexplained"]
+    assert got[0]["visibility_mismatches"] > 0 and got[0]["residual_px"] <= TOL
+
+
+def test_below_tolerance_is_agreement():
+    cam = CAMERAS["oblique"]
+    ref = oracle_project(POINTS, cam)
+    assert diagnose(ref + 1e-7, ref, cam, tol_px=TOL) == []
+    assert primary(diagnose(ref + 1e-5, ref, cam, tol_px=TOL)) == "pixel_offset"
+
+
+def test_large_pooled_input_is_fast():
+    cam = CAMERAS["wide"]
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(-2, 2, size=(100_000, 3))
+    got = diagnose(f_fov_offset(pts, cam), oracle_project(pts, cam), cam, tol_px=TOL)
+    assert {d["name"] for d in got} == {"fov_mismatch", "pixel_offset"}
+
+
+# ---- confusion matrix --------------------------------------------------------
+
+def confusion(results):
+    """rows: injected single fault (by its expected primary name); columns: diagnosed primary."""
+    labels = ["none"] + list(FAULT_ORDER)
+    counts = Counter()
+    for (fault, cam), got in results.items():
+        if fault not in SINGLE:
+            continue
+        want = FAULTS[fault][1]
+        row = "none" if not want else min(want, key=FAULT_ORDER.index)
+        counts[(row, primary(got))] += 1
+    rows = [r for r in labels if any(counts[(r, c)] for c in labels)]
+    return labels, rows, counts
+
+
+def format_confusion(labels, rows, counts):
+    short = {n: n.replace("mirror_horizontal", "mirr_h").replace("mirror_vertical", "mirr_v")
+             .replace("_mismatch", "").replace("pixel_", "").replace("unexplained", "unexpl")
+             for n in labels}
+    width = max(len(r) for r in rows) + 1
+    lines = [f"confusion matrix (oracle: {ORACLE}; rows injected, columns diagnosed primary)",
+             " " * width + " ".join(f"{short[c]:>8}" for c in labels)]
+    for r in rows:
+        lines.append(f"{r:<{width}}" + " ".join(f"{counts[(r, c)] or '.':>8}" for c in labels))
+    return "\n".join(lines)
+
+
+def test_confusion_matrix_is_diagonal(results):
+    labels, rows, counts = confusion(results)
+    print()
+    print(format_confusion(labels, rows, counts))
+    off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
+    assert not off, off
+    assert set(rows) == set(labels)                      # every fault name was injected
