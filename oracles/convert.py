@@ -1,0 +1,233 @@
+"""Camera and model-matrix conversions into foreign conventions, and back.
+
+Independent of ``core``'s matrices and projection: a :class:`core.camera.Camera`
+is read only for its attributes (``position, forward, up, right, fov_y_deg,
+width, height, near, far, projection, ortho_height``), and the two-line focal
+length / principal point formulas of :mod:`core.conventions` are duplicated
+here on purpose::
+
+    f_px = (H / 2) / tan(fov_y / 2)
+    cx, cy = (W - 1) / 2, (H - 1) / 2         (integer pixel coords = centres)
+
+Our camera space is x right, y up, z forward (``core.conventions``); OpenCV's is
+x right, y down, z forward; pyrender's (OpenGL's) is x right, y up, z backward.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from core.camera import Camera
+
+__all__ = ["camera_to_opencv", "opencv_to_camera", "camera_to_pyrender",
+           "pyrender_pose_to_camera", "model_matrix"]
+
+# Relative tolerance for "K describes a centred, square-pixel camera": K built
+# by camera_to_opencv is exact to float64 rounding (~1e-16 relative); 1e-9
+# leaves room for a K that went through text or float32-free arithmetic.
+_K_RTOL = 1e-9
+
+
+def _focal_px(fov_y_deg: float, height: int) -> float:
+    # duplicate of core.conventions.focal_px (independence is the point)
+    return (height / 2.0) / math.tan(math.radians(fov_y_deg) / 2.0)
+
+
+def _principal_point(width: int, height: int) -> tuple[float, float]:
+    # duplicate of core.conventions.principal_point
+    return (width - 1) / 2.0, (height - 1) / 2.0
+
+
+def _cv2():
+    import cv2
+    return cv2
+
+
+# ---- OpenCV ---------------------------------------------------------------
+
+def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Our camera as OpenCV extrinsics and intrinsics.
+
+    OpenCV (``cv2.projectPoints``, pinhole model)::
+
+        p_cv = R @ X + t          camera x right, y down, z forward
+        [u, v, 1] ~ K @ p_cv      K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]
+
+    with integer pixel coordinates at pixel centres, as ours. So the rows of
+    ``R`` are ``right, -up, forward`` (our camera y negated), ``t = -R @
+    position``, ``rvec = cv2.Rodrigues(R)``, and ``K`` uses ``f_px`` and
+    ``(cx, cy)`` from ``core.conventions`` (recomputed here).
+
+    Orthographic cameras get the same ``rvec, tvec`` and an *affine* ``K``:
+    ``[[s, 0, cx], [0, s, cy], [0, 0, 1]]`` with ``s = H / ortho_height``,
+    meant as ``[u, v] = (K @ [x_cv, y_cv, 1])[:2]`` (no division by depth).
+    ``cv2.projectPoints`` has no orthographic model; do not pass it this K.
+
+    Parameters
+    ----------
+    camera : Camera
+
+    Returns
+    -------
+    rvec : (3,) ndarray, Rodrigues rotation vector world -> OpenCV camera.
+    tvec : (3,) ndarray, translation world -> OpenCV camera.
+    K : (3, 3) ndarray, intrinsics (affine for orthographic, see above).
+    """
+    r_cv = np.stack([camera.right, -camera.up, camera.forward]).astype(np.float64)
+    tvec = -r_cv @ np.asarray(camera.position, dtype=np.float64)
+    rvec, _ = _cv2().Rodrigues(r_cv)
+    cx, cy = _principal_point(camera.width, camera.height)
+    if camera.projection == "perspective":
+        f = _focal_px(camera.fov_y_deg, camera.height)
+    else:
+        f = camera.height / camera.ortho_height
+    k = np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]])
+    return rvec.reshape(3), tvec, k
+
+
+def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: float,
+                     projection: str = "perspective") -> Camera:
+    """Inverse of :func:`camera_to_opencv`.
+
+    From ``p_cv = R X + t`` (rows of ``R``: right, -up, forward)::
+
+        position = -R^T t,   right = R[0],  up = -R[1],  forward = R[2]
+        fov_y = 2 atan((H / 2) / fy)            (perspective)
+        ortho_height = H / fy                   (orthographic, affine K)
+
+    Raises ``ValueError`` if ``K`` is not a centred square-pixel camera (ours
+    cannot represent skew, fx != fy or an off-centre principal point).
+    """
+    cv2 = _cv2()
+    r_cv, _ = cv2.Rodrigues(np.asarray(rvec, dtype=np.float64).reshape(3, 1))
+    tvec = np.asarray(tvec, dtype=np.float64).reshape(3)
+    K = np.asarray(K, dtype=np.float64)
+    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
+    cx0, cy0 = _principal_point(width, height)
+    scale = max(abs(fx), abs(cx0), 1.0)
+    if not (math.isclose(fx, fy, rel_tol=_K_RTOL) and abs(K[0, 1]) <= _K_RTOL * scale
+            and abs(cx - cx0) <= _K_RTOL * scale and abs(cy - cy0) <= _K_RTOL * scale):
+        raise ValueError(f"K {K.tolist()}: expected square pixels, no skew and principal "
+                         f"point ({cx0}, {cy0}) for a {width}x{height} image")
+    position = -r_cv.T @ tvec
+    kwargs = dict(width=width, height=height, near=near, far=far, projection=projection)
+    if projection == "perspective":
+        kwargs["fov_y_deg"] = math.degrees(2.0 * math.atan((height / 2.0) / fy))
+    else:
+        kwargs["ortho_height"] = height / fy
+    return Camera(position=position, forward=r_cv[2], up=-r_cv[1], **kwargs)
+
+
+# ---- pyrender -------------------------------------------------------------
+
+def _pyrender():
+    os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+    import pyrender
+    return pyrender
+
+
+def camera_to_pyrender(camera: Camera):
+    """Our camera as a pyrender camera node pose and a pyrender camera.
+
+    pyrender (OpenGL) cameras look down their local -Z with +Y up, so the pose
+    (camera-to-world) has columns ``[right, up, -forward, position]``.
+
+    Perspective -> ``pyrender.IntrinsicsCamera(fx=f, fy=f, cx=cx + 0.5,
+    cy=cy + 0.5, znear=near, zfar=far)``. pyrender measures ``cx, cy`` from the
+    pixel *corner*: its ``IntrinsicsCamera.get_projection_matrix`` is::
+
+        P[0][0] = 2.0 * fx / width
+        P[1][1] = 2.0 * fy / height
+        P[0][2] = 1.0 - 2.0 * cx / width
+        P[1][2] = 2.0 * cy / height - 1.0
+        P[3][2] = -1.0
+
+    which, through the viewport transform (window x = (x_ndc + 1) W / 2, pixel
+    centres at half-integers) and the row flip of the read-back, gives
+    ``x_win = cx + fx x / d`` and ``row_win = cy - fy y / d`` in corner-origin
+    coordinates, i.e. ``x_px = x_win - 0.5``: hence the ``+ 0.5``.
+    (On macOS pyrender doubles fx, fy, cx, cy for retina; not handled here.)
+
+    Orthographic -> ``pyrender.OrthographicCamera(xmag=ortho_height/2 * W/H,
+    ymag=ortho_height/2, znear=near, zfar=far)`` (``P[0][0] = 1/xmag``,
+    ``P[1][1] = 1/ymag``; pyrender recomputes xmag from the viewport aspect).
+    pyrender requires ``znear > 0`` here, so orthographic cameras with
+    ``near <= 0`` raise ``ValueError``.
+
+    Returns
+    -------
+    pose : (4, 4) ndarray, camera-to-world.
+    pyrender_camera : pyrender.IntrinsicsCamera or pyrender.OrthographicCamera
+    """
+    pyrender = _pyrender()
+    pose = np.eye(4)
+    pose[:3, 0] = camera.right
+    pose[:3, 1] = camera.up
+    pose[:3, 2] = -np.asarray(camera.forward)
+    pose[:3, 3] = camera.position
+    w, h = camera.width, camera.height
+    if camera.projection == "perspective":
+        f = _focal_px(camera.fov_y_deg, h)
+        cx, cy = _principal_point(w, h)
+        cam = pyrender.IntrinsicsCamera(fx=f, fy=f, cx=cx + 0.5, cy=cy + 0.5,
+                                        znear=camera.near, zfar=camera.far)
+    else:
+        if not camera.near > 0:
+            raise ValueError(f"camera near {camera.near!r}: pyrender's OrthographicCamera needs znear > 0")
+        ymag = camera.ortho_height / 2.0
+        cam = pyrender.OrthographicCamera(xmag=ymag * w / h, ymag=ymag,
+                                          znear=camera.near, zfar=camera.far)
+    return pose, cam
+
+
+def pyrender_pose_to_camera(pose, pyrender_camera, width: int, height: int) -> Camera:
+    """Inverse of :func:`camera_to_pyrender`.
+
+    ``position = pose[:3, 3]``, ``up = pose[:3, 1]``, ``forward = -pose[:3, 2]``;
+    ``fov_y = 2 atan((H / 2) / fy)`` for an ``IntrinsicsCamera`` (which must be
+    centred: ``cx = W / 2``, ``cy = H / 2`` from the corner),
+    ``ortho_height = 2 ymag`` for an ``OrthographicCamera``.
+    """
+    pyrender = _pyrender()
+    pose = np.asarray(pose, dtype=np.float64)
+    kwargs = dict(width=width, height=height, near=pyrender_camera.znear, far=pyrender_camera.zfar)
+    if isinstance(pyrender_camera, pyrender.IntrinsicsCamera):
+        c = pyrender_camera
+        tol = _K_RTOL * max(c.fx, width, 1.0)
+        if not (math.isclose(c.fx, c.fy, rel_tol=_K_RTOL) and abs(c.cx - width / 2) <= tol
+                and abs(c.cy - height / 2) <= tol):
+            raise ValueError("pyrender camera: expected fx == fy and a centred principal point")
+        kwargs["fov_y_deg"] = math.degrees(2.0 * math.atan((height / 2.0) / c.fy))
+    elif isinstance(pyrender_camera, pyrender.OrthographicCamera):
+        kwargs["projection"] = "orthographic"
+        kwargs["ortho_height"] = 2.0 * pyrender_camera.ymag
+    else:
+        raise TypeError(f"unsupported pyrender camera {type(pyrender_camera).__name__}")
+    return Camera(position=pose[:3, 3], forward=-pose[:3, 2], up=pose[:3, 1], **kwargs)
+
+
+# ---- model motion ---------------------------------------------------------
+
+def model_matrix(turns, offset, scale: float, t: float) -> np.ndarray:
+    """The scene's model matrix at time ``t``, built with scipy.
+
+    Must equal ``T @ Rz(az) @ Ry(ay) @ Rx(ax) @ S`` with
+    ``a_i = 2 pi ((t * turns_i) % 1)`` (``core.conventions``, "Motion").
+    scipy: *lowercase* axes in ``Rotation.from_euler`` are extrinsic (about the
+    fixed axes, in the order given), so ``from_euler("xyz", [ax, ay, az])`` is
+    "rotate about x, then fixed y, then fixed z" = ``Rz @ Ry @ Rx`` (equal to the
+    intrinsic ``"ZYX"`` with angles ``[az, ay, ax]``).
+
+    Returns
+    -------
+    (4, 4) ndarray
+    """
+    ax, ay, az = (2.0 * math.pi * ((t * float(k)) % 1.0) for k in turns)
+    m = np.eye(4)
+    m[:3, :3] = Rotation.from_euler("xyz", [ax, ay, az]).as_matrix() * float(scale)
+    m[:3, 3] = np.asarray(offset, dtype=np.float64)
+    return m
