@@ -179,6 +179,13 @@ def render_run(s: Settings, log=None, progress=None) -> dict:
             frame = render_frame(s.scene.vertices, s.scene.edges, s.camera,
                                  s.motion.frame_matrix(k, s.frames), s.clip)
             render_seconds += time.perf_counter() - t0
+            overflow = frame.visible & ~np.isfinite(frame.p_px).all(axis=1)
+            if overflow.any():
+                i = int(np.flatnonzero(overflow)[0])
+                raise InputError(
+                    f"{s.scene.source}: vertex {i} {s.scene.vertices[i].tolist()} projects beyond the float64 "
+                    f"range in frame {k}: expected coordinates whose pixel position fits in a float64 "
+                    f"(|f * x / z| < 1.8e308)")
             if fdir is not None and "png" in s.formats:
                 fdir.write(f"frame_{k:04d}.png", output.png_bytes(frame.image))
             if fdir is not None and "ascii" in s.formats:

@@ -63,7 +63,7 @@ def clip_segments(seg_cam: np.ndarray, planes: np.ndarray) -> tuple[np.ndarray, 
     t_enter = np.zeros(m)
     t_exit = np.ones(m)
     kept = np.ones(m, dtype=bool)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # inf/NaN are handled below
         for n_x, n_y, n_z, d in planes:
             d0 = n_x * p0[:, 0] + n_y * p0[:, 1] + n_z * p0[:, 2] + d
             d1 = n_x * p1[:, 0] + n_y * p1[:, 1] + n_z * p1[:, 2] + d
@@ -80,8 +80,45 @@ def clip_segments(seg_cam: np.ndarray, planes: np.ndarray) -> tuple[np.ndarray, 
     return kept, t_enter, t_exit
 
 
-def apply_clip(seg_cam: np.ndarray, kept: np.ndarray, t_enter: np.ndarray, t_exit: np.ndarray) -> np.ndarray:
-    """The kept parts of the segments, ``(K, 2, 3)``."""
+def apply_clip(seg_cam: np.ndarray, kept: np.ndarray, t_enter: np.ndarray, t_exit: np.ndarray,
+               depth_range: tuple[float, float] | None = None) -> np.ndarray:
+    """The kept parts of the segments, ``(K, 2, 3)``.
+
+    ``p0 + t (p1 - p0)`` loses about ``eps * |p|`` of absolute precision: at
+    coordinates of 1e16 that is the whole near distance, and a clipped end
+    could land at z <= 0. Every kept point lies in the frustum by construction,
+    so with ``depth_range = (near, far)`` its depth is clamped back into it and
+    the divide stays safe whatever the magnitudes.
+    """
     p0 = seg_cam[kept, 0, :]
     d = seg_cam[kept, 1, :] - p0
-    return np.stack([p0 + t_enter[kept, None] * d, p0 + t_exit[kept, None] * d], axis=1)
+    out = np.stack([p0 + t_enter[kept, None] * d, p0 + t_exit[kept, None] * d], axis=1)
+    if depth_range is not None:
+        np.clip(out[..., 2], depth_range[0], depth_range[1], out=out[..., 2])
+    return out
+
+
+def clip_to_image(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Liang-Barsky in pixel space against [-0.5, W - 0.5] x [-0.5, H - 0.5].
+
+    A last guard before rasterizing: whatever precision the 3D clip lost, the
+    rasterizer is never asked to step through more than the image. Segments
+    with a non-finite end are dropped. Returns ``(kept, q0, q1)``.
+    """
+    d = p1_px - p0_px
+    t0 = np.zeros(len(d))
+    t1 = np.ones(len(d))
+    kept = np.all(np.isfinite(p0_px), axis=1) & np.all(np.isfinite(p1_px), axis=1)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for axis, lo, hi in ((0, -0.5, width - 0.5), (1, -0.5, height - 0.5)):
+            for p, q in ((-d[:, axis], p0_px[:, axis] - lo), (d[:, axis], hi - p0_px[:, axis])):
+                parallel = p == 0
+                kept &= ~(parallel & (q < 0))                   # parallel and outside
+                r = q / p
+                t0 = np.where(~parallel & (p < 0), np.maximum(t0, r), t0)
+                t1 = np.where(~parallel & (p > 0), np.minimum(t1, r), t1)
+        kept &= t0 <= t1
+        q0 = p0_px[kept] + t0[kept, None] * d[kept]
+        q1 = p0_px[kept] + t1[kept, None] * d[kept]
+    return kept, q0, q1

@@ -74,9 +74,11 @@ def render_frame(p_model: np.ndarray, edges: np.ndarray, camera: Camera,
                 # shortened by near/far (not by the image sides): count those too
                 nf_kept, nf_t0, nf_t1 = clipping.clip_segments(seg_cam, planes[:2])
                 clipped_edges = int(len(edges) - (nf_kept & (nf_t0 == 0) & (nf_t1 == 1)).sum())
-            seg_cam = clipping.apply_clip(seg_cam, kept, t0, t1)    # camera, inside the frustum
+            seg_cam = clipping.apply_clip(seg_cam, kept, t0, t1,
+                                          (camera.near, camera.far))  # camera, inside the frustum
             seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)  # pixels
-            seg0_px, seg1_px = seg_px[:, 0], seg_px[:, 1]
+            _, seg0_px, seg1_px = clipping.clip_to_image(seg_px[:, 0], seg_px[:, 1],
+                                                         camera.width, camera.height)  # pixels, on the image
         rr, cc = raster.line_pixels(seg0_px, seg1_px, camera.width, camera.height)
         image[rr, cc] = 255                                         # painted
     return Frame(image=image, p_px=p_px, depth=p_cam[:, 2], visible=visible,

@@ -24,17 +24,20 @@ def cam_to_px(p_cam: np.ndarray, camera: Camera) -> np.ndarray:
 
     Precondition for perspective: every ``z_cam`` is positive (callers clip at
     the near plane first). A point at z = 0 gives inf, z < 0 a mirrored point.
+    A result beyond the float64 range is inf, silently: callers check
+    (``renderer`` reports it as an input error).
     """
     cx, cy = camera.principal_point
-    if camera.projection == "perspective":
-        f = camera.focal_px
-        inv_z = 1.0 / p_cam[:, 2]
-        x_px = cx + f * p_cam[:, 0] * inv_z
-        y_px = cy - f * p_cam[:, 1] * inv_z
-    else:
-        s = camera.height / camera.ortho_height
-        x_px = cx + s * p_cam[:, 0]
-        y_px = cy - s * p_cam[:, 1]
+    with np.errstate(over="ignore"):
+        if camera.projection == "perspective":
+            f = camera.focal_px
+            inv_z = 1.0 / p_cam[:, 2]
+            x_px = cx + f * p_cam[:, 0] * inv_z
+            y_px = cy - f * p_cam[:, 1] * inv_z
+        else:
+            s = camera.height / camera.ortho_height
+            x_px = cx + s * p_cam[:, 0]
+            y_px = cy - s * p_cam[:, 1]
     return np.stack([x_px, y_px], axis=1)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from core.clipping import clip_to_image
 from core.raster import line_pixels
 
 from . import opencv_oracle
@@ -44,26 +45,6 @@ def clip_depth(p0_world, p1_world, camera):
     d = (p1_world - p0_world)[kept]
     ends = np.stack([p0_world[kept] + a[:, None] * d, p0_world[kept] + b[:, None] * d], axis=1)
     return kept, ends
-
-
-def clip_to_image(p0_px, p1_px, width, height):
-    """Liang-Barsky against [-0.5, W - 0.5] x [-0.5, H - 0.5]: ``(kept, q0, q1)``."""
-    d = p1_px - p0_px
-    t0 = np.zeros(len(d))
-    t1 = np.ones(len(d))
-    kept = np.all(np.isfinite(p0_px), axis=1) & np.all(np.isfinite(p1_px), axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for axis, lo, hi in ((0, -0.5, width - 0.5), (1, -0.5, height - 0.5)):
-            for p, q in ((-d[:, axis], p0_px[:, axis] - lo), (d[:, axis], hi - p0_px[:, axis])):
-                parallel = p == 0
-                kept &= ~(parallel & (q < 0))
-                r = q / p
-                t0 = np.where(~parallel & (p < 0), np.maximum(t0, r), t0)
-                t1 = np.where(~parallel & (p > 0), np.minimum(t1, r), t1)
-    kept &= t0 <= t1
-    q0 = p0_px[kept] + t0[kept, None] * d[kept]
-    q1 = p0_px[kept] + t1[kept, None] * d[kept]
-    return kept, q0, q1
 
 
 def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera) -> np.ndarray:

@@ -1,0 +1,195 @@
+"""Each convention of core/conventions.py pinned by a test that fails if it were reversed.
+
+Hand derivations are in the comments. Unless stated otherwise the camera is
+``camera_z(D)``: at (0, 0, D) looking at the origin with up +Y, so (derived in
+core/conventions.py) right = +X, up = +Y, forward = -Z and
+p_cam = (x, y, D - z) exactly (all rotation entries are 0 or +-1).
+"""
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from core.camera import Camera, camera_z, look_at
+from core.conventions import PIXEL_CENTRE_OFFSET, focal_px, principal_point
+from core.projection import project_points, world_to_cam
+from core.transforms import apply, compose, rotate_x, rotate_y, rotate_z, translate
+
+EPS = np.finfo(np.float64).eps  # 2.2e-16
+
+# Pixel tolerance for values of magnitude <= 640 computed with ~6 float64
+# operations (each <= 0.5 ulp = EPS/2 relative): 6 * 1.1e-16 * 640 = 4.3e-13.
+PX_TOL = 1e-12
+
+
+def cam(D=4.0, **kw):
+    kw.setdefault("width", 640)
+    kw.setdefault("height", 480)
+    kw.setdefault("fov_y_deg", 60.0)
+    return camera_z(D, **kw)
+
+
+# ---- screen orientation ------------------------------------------------------
+
+def test_plus_x_shows_on_the_right():
+    c = cam()
+    cx, cy = c.principal_point
+    (x, y), = project_points([[1.0, 0.0, 0.0]], c)
+    # p_cam = (1, 0, 4): x_px = cx + f/4 (> cx), y_px = cy.
+    assert x > cx
+    assert_allclose([x, y], [cx + c.focal_px / 4.0, cy], rtol=0, atol=PX_TOL)
+
+
+def test_plus_y_shows_up():
+    c = cam()
+    cx, cy = c.principal_point
+    (x, y), = project_points([[0.0, 1.0, 0.0]], c)
+    # p_cam = (0, 1, 4): y_px = cy - f/4 (< cy: pixel rows grow downward).
+    assert y < cy
+    assert_allclose([x, y], [cx, cy - c.focal_px / 4.0], rtol=0, atol=PX_TOL)
+
+
+def test_right_is_forward_cross_up_camera_z():
+    c = cam()
+    # forward = -Z, up = +Y: (-Z) x (+Y) = +X. (up x forward would give -X.)
+    assert_array_equal(c.forward, [0.0, 0.0, -1.0])
+    assert_array_equal(c.up, [0.0, 1.0, 0.0])
+    assert_array_equal(c.right, [1.0, 0.0, 0.0])
+
+
+def test_right_is_forward_cross_up_looking_down_plus_z():
+    # forward = +Z, up = +Y: (+Z) x (+Y) = (0*0 - 1*1, 1*0 - 0*0, 0) = -X.
+    c = look_at((0, 0, 0), (0, 0, 1), (0, 1, 0))
+    assert_array_equal(c.right, [-1.0, 0.0, 0.0])
+    # so a world point at +X shows on the LEFT of this camera
+    (x, _), = project_points([[1.0, 0.0, 5.0]], c)
+    assert x < c.principal_point[0]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_right_is_forward_cross_up_general(seed):
+    rng = np.random.default_rng(seed)
+    c = look_at(rng.normal(size=3) * 5, rng.normal(size=3), rng.normal(size=3))
+    # Unit vectors: cross-product rounding is a few EPS per component.
+    assert_allclose(c.right, np.cross(c.forward, c.up), rtol=0, atol=8 * EPS)
+    # camera basis is left-handed: right x up = -forward
+    assert_allclose(np.cross(c.right, c.up), -c.forward, rtol=0, atol=8 * EPS)
+
+
+def test_world_to_cam_rows_are_right_up_forward():
+    c = look_at((1.0, 2.0, 3.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    m = c.world_to_cam
+    assert_array_equal(m[0, :3], c.right)
+    assert_array_equal(m[1, :3], c.up)
+    assert_array_equal(m[2, :3], c.forward)
+    # the camera's own position maps to the camera-space origin; position is
+    # ~3.7 units, the 3-term dot product rounds ~3 times: 3 * EPS * 4 ~ 2.7e-15
+    assert_allclose(apply(m, [c.position])[0], [0, 0, 0], rtol=0, atol=1e-14)
+
+
+# ---- depth -------------------------------------------------------------------
+
+def test_depth_positive_in_front_negative_behind():
+    c = cam(D=4.0, near=0.1)
+    p_cam = world_to_cam(np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 5.0]]), c)
+    # origin is 4 in front of the camera; z = 5 is 1 behind it (p_cam z = D - z)
+    assert_array_equal(p_cam[:, 2], [4.0, -1.0])
+    px = project_points([[0.0, 0.0, 0.0], [0.0, 0.0, 5.0]], c)
+    assert np.all(np.isfinite(px[0]))
+    assert np.all(np.isnan(px[1]))
+
+
+# ---- pixel centres -------------------------------------------------------------
+
+@pytest.mark.parametrize("w,h,expected", [(640, 480, (319.5, 239.5)), (5, 3, (2.0, 1.0)), (1, 1, (0.0, 0.0))])
+def test_principal_point_is_image_centre_in_pixel_centre_coordinates(w, h, expected):
+    # Pixel (0,0) covers [-0.5, 0.5]; the image spans [-0.5, W-0.5], centre (W-1)/2.
+    assert principal_point(w, h) == expected
+    assert cam(width=w, height=h).principal_point == expected
+
+
+@pytest.mark.parametrize("w,h", [(640, 480), (5, 3), (101, 37)])
+def test_point_on_optical_axis_lands_on_principal_point(w, h):
+    c = cam(width=w, height=h)
+    px = project_points([[0.0, 0.0, 0.0], [0.0, 0.0, -7.0]], c)
+    # x_cam = y_cam = 0 exactly, so cx + f*0/z is cx exactly
+    assert_array_equal(px, [[(w - 1) / 2, (h - 1) / 2]] * 2)
+
+
+def test_gl_pixel_centre_offset_is_half():
+    # GL window coordinates put centres at half-integers; ours at integers.
+    assert PIXEL_CENTRE_OFFSET == 0.5
+
+
+# ---- field of view -------------------------------------------------------------
+
+def test_focal_length_formula():
+    # f = (H/2)/tan(fov/2); fov 90 -> f = 240 / tan(45 deg) = 240 (tan(pi/4) is
+    # 1 - 1.1e-16 in float64, so f = 240 * (1 + 1.1e-16): tolerance 2 ulp of 240)
+    assert_allclose(focal_px(90.0, 480), 240.0, rtol=2 * EPS)
+    # fov 60: tan 30 = 1/sqrt(3) -> f = 240 sqrt(3)
+    assert_allclose(focal_px(60.0, 480), 240.0 * math.sqrt(3.0), rtol=4 * EPS)
+
+
+@pytest.mark.parametrize("fov", [30.0, 60.0, 90.0, 120.0])
+@pytest.mark.parametrize("w,h", [(640, 480), (320, 240), (100, 300)])
+def test_vertical_fov_is_edge_to_edge(fov, w, h):
+    c = cam(D=10.0, fov_y_deg=fov, width=w, height=h, far=1000.0)
+    z = 5.0                                  # depth of the test points
+    ty = math.tan(math.radians(fov) / 2.0)
+    tx = (w / h) * ty                        # horizontal half-FOV tangent
+    # world z = D - z_cam. Top edge of the vertical FOV: y/z = tan(fov/2) ->
+    # y_px = cy - f*ty = (H-1)/2 - H/2 = -0.5 (top edge of row 0).
+    # Bottom: H - 0.5. Right: x/z = (W/H) ty -> x_px = (W-1)/2 + W/2 = W - 0.5.
+    pts = [[0.0, z * ty, 10.0 - z], [0.0, -z * ty, 10.0 - z],
+           [z * tx, 0.0, 10.0 - z], [-z * tx, 0.0, 10.0 - z]]
+    px = project_points(pts, c)
+    cx, cy = (w - 1) / 2, (h - 1) / 2
+    expected = [[cx, -0.5], [cx, h - 0.5], [w - 0.5, cy], [-0.5, cy]]
+    assert_allclose(px, expected, rtol=0, atol=PX_TOL)
+
+
+# ---- rotations and matrix order ----------------------------------------------
+
+# |cos(pi/2)| in float64 is 6.1e-17 < EPS: a 90-degree rotation of a unit
+# vector is exact up to EPS per component.
+@pytest.mark.parametrize("rot,src,dst", [
+    (rotate_z, [1, 0, 0], [0, 1, 0]),   # +X -> +Y
+    (rotate_x, [0, 1, 0], [0, 0, 1]),   # +Y -> +Z
+    (rotate_y, [0, 0, 1], [1, 0, 0]),   # +Z -> +X
+])
+def test_rotations_are_right_handed(rot, src, dst):
+    assert_allclose(apply(rot(math.pi / 2), [src])[0], dst, rtol=0, atol=EPS)
+
+
+def test_rotate_z_90_shows_counter_clockwise_on_screen():
+    # camera_z looks down -Z, so +Z points at the viewer: rotate_z(90) turns the
+    # point (1,0,0) (right of centre) to (0,1,0) (above centre) on screen.
+    c = cam(D=4.0)
+    cx, cy = c.principal_point
+    (x, y), = project_points(apply(rotate_z(math.pi / 2), [[1.0, 0.0, 0.0]]), c)
+    r = c.focal_px / 4.0
+    # x_cam = cos(pi/2) = 6e-17: x_px - cx = f * 6e-17 / 4 ~ 5e-15
+    assert_allclose([x, y], [cx, cy - r], rtol=0, atol=PX_TOL)
+
+
+def test_compose_applies_rightmost_first():
+    p = [[1.0, 0.0, 0.0]]
+    t = translate((1.0, 0.0, 0.0))
+    r = rotate_z(math.pi / 2)
+    # compose(T, R): rotate first: (1,0,0) -> (0,1,0), then +X: (1,1,0)
+    # compose(R, T): translate first: (2,0,0), then rotate: (0,2,0)
+    # cos(pi/2) = 6e-17 times coordinates <= 2 plus rounding: < 4 EPS
+    assert_allclose(apply(compose(t, r), p)[0], [1.0, 1.0, 0.0], rtol=0, atol=4 * EPS)
+    assert_allclose(apply(compose(r, t), p)[0], [0.0, 2.0, 0.0], rtol=0, atol=4 * EPS)
+
+
+def test_column_vector_convention_matches_matrix_product():
+    # p' = M @ p for column vectors; apply() of row-stacked points is the same.
+    m = compose(translate((1.0, -2.0, 3.0)), rotate_y(0.3), rotate_x(-1.1))
+    p = np.array([0.5, 2.0, -4.0])
+    expected = (m @ np.append(p, 1.0))[:3]
+    # |p| ~ 4.5, matrix entries <= 1: a few roundings of values ~ 5: 8 * EPS * 5
+    assert_allclose(apply(m, [p])[0], expected, rtol=0, atol=8 * EPS * 5)
