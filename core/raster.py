@@ -79,10 +79,22 @@ def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
         slope = np.where(da != 0, (b1 - b0) / da, 0.0)
     seg = np.repeat(np.arange(len(n)), n)
     i = lo[seg] + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
-    b = b0[seg] + (i - a0[seg]) * slope[seg]          # minor coordinate at i
+    # Minor coordinate at i, exactly: the ends are on the 1/256 grid, so in
+    # grid units b(i) = num / den with integers (|values| < 2^53 for any image
+    # that fits in memory), and rounding at exact halves cannot depend on the
+    # direction of travel through float error.
+    ia0, ia1 = (np.round(v * SUBPIXEL).astype(np.int64) for v in (a0, a1))
+    ib0, ib1 = (np.round(v * SUBPIXEL).astype(np.int64) for v in (b0, b1))
+    den = ia1 - ia0
+    sign = np.where(den < 0, -1, 1)
+    den_s = np.where(den == 0, 1, den * sign)[seg]                # > 0
+    num = sign[seg] * (ib0[seg] * den[seg] + (i * int(SUBPIXEL) - ia0[seg]) * (ib1 - ib0)[seg])
+    num = np.where(den[seg] == 0, ib0[seg], num)                 # zero length: b = b0
+    unit = int(SUBPIXEL) * den_s                                 # b = num / unit pixels
     xm = x_major[seg]
-    j = np.where(xm, np.floor(b + 0.5), np.ceil(b - 0.5))   # halves: +y, or -x
-    e = b - j                                          # offset from the pixel centre, [-0.5, 0.5]
+    j = np.where(xm, (2 * num + unit) // (2 * unit),             # floor(b + 1/2): halves to +y
+                 -((unit - 2 * num) // (2 * unit)))              # ceil(b - 1/2):  halves to -x
+    e = (num - j * unit) / unit                                  # offset from the pixel centre, [-1/2, 1/2]
     s = travel[seg]
     m = slope[seg] * s                                 # minor change per unit of travel, |m| <= 1
     # Distance u >= 0 along travel to where the line leaves the diamond:
