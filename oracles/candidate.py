@@ -35,7 +35,11 @@ def load_candidate(spec: str):
         path = Path(target)
         if not path.is_file():
             raise InputError(f"--candidate {spec!r}: file {target!r} not found")
-        mod_name = f"wirecheck_candidate_{abs(hash(str(path.resolve())))}"
+        mod_name = f"wirecheck_candidate_{path.stem}"
+        # like running a script: the candidate's own folder is importable
+        folder = str(path.resolve().parent)
+        if folder not in sys.path:
+            sys.path.insert(0, folder)
         try:
             module_spec = importlib.util.spec_from_file_location(mod_name, path)
             module = importlib.util.module_from_spec(module_spec)

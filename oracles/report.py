@@ -17,6 +17,26 @@ from core.output import FrameDir, json_dumps, png_bytes
 from .metrics import DIFF_COLOURS, diff_image
 
 
+#: What to check for each fault: one line each, for people reading the report.
+FAULT_HINTS = {
+    "mirror_horizontal": "left and right are exchanged: check right = forward x up (not up x forward) "
+                         "and x_px = cx + f x / z",
+    "mirror_vertical": "the picture is upside down: pixel y grows downward, so y_px = cy - f y / z",
+    "axis_flip": "the picture is turned 180 degrees: x and y are both negated (e.g. right and up "
+                 "both negated in the world-to-camera rotation)",
+    "axis_swap": "x and y are exchanged: return columns [x, y], not [row, col]",
+    "fov_mismatch": "the focal length is off: f = (H / 2) / tan(fov_y / 2) with the vertical FOV in "
+                    "radians; implied_fov_deg is the FOV that was used",
+    "aspect_mismatch": "x and y are scaled differently: use one focal length for both axes (square "
+                       "pixels); implied_aspect is the width/height ratio that was used",
+    "pixel_offset": "a constant shift: integer pixel coordinates are pixel centres and the principal "
+                    "point is ((W - 1) / 2, (H - 1) / 2); 0.5 is the pixel-corner convention",
+    "depth_flip": "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
+    "unexplained": "not a simple image-space fault: check the rotation order, a transposed "
+                   "world-to-camera matrix, the up vector (roll) and the near/far test",
+}
+
+
 def _fmt_err(v) -> str:
     return "-" if v is None else f"{v:.2e}"
 
@@ -67,6 +87,10 @@ def markdown(report: dict) -> str:
         out += ["", "## Why cases failed", ""]
         for c in failing:
             out.append(f"- **{c['scene']} / {c['camera']}**: " + "; ".join(c["reasons"]))
+        names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
+        if names:
+            out += ["", "## What to check", ""]
+            out += [f"- `{n}`: {FAULT_HINTS[n]}" for n in names]
     out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames: `report.html`.", ""]
     return "\n".join(out)
 
@@ -94,6 +118,10 @@ def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
             f"F1@1 {_fmt_f1(case.get('pixel_f1_1px'))}, faults: {e(fault_text(case['faults']))}</figcaption>"
             f"<img src='img/{stem}-candidate.png' alt='candidate'> <img src='img/{stem}-oracle.png' alt='oracle'> "
             f"<img src='img/{stem}-diff.png' alt='diff'></figure>")
+    names = sorted({f["name"] for c in report["cases"] for f in c["faults"]}, key=list(FAULT_HINTS).index)
+    if names:
+        parts.append("<h2>What to check</h2><ul>" + "".join(
+            f"<li><code>{e(n)}</code>: {e(FAULT_HINTS[n])}</li>" for n in names) + "</ul>")
     parts.append("</body></html>\n")
     return "\n".join(parts)
 

@@ -139,3 +139,17 @@ def test_subprocess_prints_table_and_path(tmp_path):
     assert proc.stdout.splitlines()[0].split()[:2] == ["scene", "camera"]
     assert proc.stdout.rstrip().endswith("(also report.md, report.html)")
     assert (out / "report.json").is_file()
+
+
+def test_every_fault_name_has_a_hint():
+    from oracles.diagnose import FAULT_NAMES
+    from oracles.report import FAULT_HINTS
+
+    assert set(FAULT_HINTS) == set(FAULT_NAMES)
+
+
+def test_failing_report_says_what_to_check(tmp_path):
+    _, _, out = run(tmp_path, "--candidate", f"{FAULTY}:mirrored", "--scene", "cube", "--frames", "2",
+                    "--cases", "oblique_roll")
+    md = (out / "report.md").read_text()
+    assert "## What to check" in md and "`mirror_horizontal`: left and right are exchanged" in md
