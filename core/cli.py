@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 from dataclasses import dataclass
@@ -299,6 +300,11 @@ def main(argv=None) -> int:
         close()
         print(f"renderer: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # stdout was closed (e.g. `renderer | head`): stop quietly, as a SIGPIPE would
+        close()
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except OSError as exc:
         close()
         print(f"renderer: error: writing to {str(s.out)!r} failed: {exc}", file=sys.stderr)
