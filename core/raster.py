@@ -39,6 +39,12 @@ import numpy as np
 #: Sub-pixel grid (1/256 px): llvmpipe's fixed-point precision for vertex positions.
 SUBPIXEL = 256.0
 
+#: Segments rasterized per batch. Keeps the per-sample temporaries small (a few
+#: hundred kB): one batch of 100k+ segments makes tens of MB of temporaries that
+#: glibc maps and unmaps on every frame, and the page faults cost as much as
+#: the arithmetic. Batching does not change the result (same pixels, same order).
+CHUNK_SEGMENTS = 4096
+
 
 def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
                 ) -> tuple[np.ndarray, np.ndarray]:
@@ -63,6 +69,16 @@ def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     if len(p0_px) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
+    if len(p0_px) <= CHUNK_SEGMENTS:
+        return _line_pixels(p0_px, p1_px, width, height)
+    parts = [_line_pixels(p0_px[k:k + CHUNK_SEGMENTS], p1_px[k:k + CHUNK_SEGMENTS], width, height)
+             for k in range(0, len(p0_px), CHUNK_SEGMENTS)]
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`line_pixels` of a non-empty batch of already snapped end points."""
     d = p1_px - p0_px
     x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
     # major (a) and minor (b) coordinates of both ends
@@ -108,4 +124,6 @@ def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     cc = np.where(xm, i, j)
     rr = np.where(xm, j, i)
     inside = (cc >= 0) & (cc < width) & (rr >= 0) & (rr < height)
+    if inside.all():                                   # the usual case: skip two gathers
+        return rr, cc
     return rr[inside], cc[inside]
