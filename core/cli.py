@@ -264,15 +264,19 @@ def summary_text(report: dict, render_seconds: float, wall_seconds: float) -> st
 
 
 def _progress_bar(total: int):
-    """A tqdm bar on stderr for long runs, only when stderr is a terminal."""
+    """A tqdm bar on stderr for long runs, only when stderr is a terminal.
+
+    Returns ``(update, close, write)``; ``write`` prints a line to stdout
+    without tearing the bar.
+    """
     if total < 50 or not sys.stderr.isatty():
-        return None, lambda: None
+        return None, lambda: None, print
     try:
         from tqdm import tqdm
     except ImportError:  # optional
-        return None, lambda: None
+        return None, lambda: None, print
     bar = tqdm(total=total, file=sys.stderr, unit="frame", leave=False)
-    return (lambda k: bar.update(1)), bar.close
+    return (lambda k: bar.update(1)), bar.close, (lambda line: tqdm.write(line, file=sys.stdout))
 
 
 def main(argv=None) -> int:
@@ -287,13 +291,14 @@ def main(argv=None) -> int:
     if s.frames >= 180:
         shown = {1, s.frames // 2, s.frames}
 
+    print(f"Scene: {s.scene.name} ({len(s.scene.vertices)} vertices, {len(s.scene.edges)} edges)")
+    progress, close, write = _progress_bar(s.frames)
+
     def log(k, frame):
         if args.verbose or k in shown:
-            print(f"Frame {k:0{width}d}: visible_vertices={frame.visible_vertices} "
-                  f"clipped={frame.clipped_vertices} {depth_text(frame)}", flush=False)
+            write(f"Frame {k:0{width}d}: visible_vertices={frame.visible_vertices} "
+                  f"clipped={frame.clipped_vertices} {depth_text(frame)}")
 
-    print(f"Scene: {s.scene.name} ({len(s.scene.vertices)} vertices, {len(s.scene.edges)} edges)")
-    progress, close = _progress_bar(s.frames)
     try:
         report = render_run(s, log=log, progress=progress)
     except InputError as exc:
