@@ -121,6 +121,8 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     scene = load_scene(a.scene)
     out = Path(a.out)
     _check_writable(out)
+    if "png" in formats or "ascii" in formats:
+        output.check_replaceable(out / f"{scene.name}-frames", "--out")
     return Settings(scene, camera, motion, a.frames, a.clip, formats, out, a.ascii_cols)
 
 
@@ -170,7 +172,7 @@ def render_run(s: Settings, log=None, progress=None) -> dict:
     txt_path = s.out / f"{name}-report.txt"
     sidecar = len(s.scene.vertices) > SIDECAR_VERTICES
     sidecar_path = s.out / f"{name}-vertices_px.npy"
-    fdir = output.FrameDir(frames_dir) if ("png" in s.formats or "ascii" in s.formats) else None
+    fdir = output.FrameDir(frames_dir, "--out") if ("png" in s.formats or "ascii" in s.formats) else None
     records, gif_images, all_px = [], [], []
     t_start = time.perf_counter()
     render_seconds = 0.0

@@ -86,18 +86,45 @@ def gif_bytes(images: list[np.ndarray], fps: float = 30.0) -> bytes:
     return buf.getvalue()
 
 
-class FrameDir:
-    """A frames directory filled under a temporary name, renamed on commit()."""
+#: Every directory wirecheck writes holds this empty file. An existing output
+#: directory is replaced only when it holds it (or is empty): a user's own
+#: folder or file is never deleted.
+MARKER = ".wirecheck-output"
 
-    def __init__(self, final: Path):
+
+def check_replaceable(path: Path, option: str) -> None:
+    """InputError unless ``path`` is absent, an empty directory, or an earlier output of ours."""
+    from .errors import InputError
+
+    path = Path(path)
+    if not path.exists() and not path.is_symlink():
+        return
+    if path.is_dir() and not path.is_symlink() and ((path / MARKER).is_file() or not any(path.iterdir())):
+        return
+    kind = "a directory not written by wirecheck" if path.is_dir() else "a file"
+    raise InputError(f"{option} {str(path)!r} is {kind}: expected a new path or an earlier wirecheck "
+                     "output (nothing was changed; move it away first)")
+
+
+class FrameDir:
+    """A directory filled under a temporary name, renamed over ``final`` on commit().
+
+    ``final`` may only be absent, empty, or an earlier output (see MARKER).
+    """
+
+    def __init__(self, final: Path, option: str = "output"):
         self.final = Path(final)
+        self.option = option
+        check_replaceable(self.final, option)
         self.tmp = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
         os.chmod(self.tmp, 0o777 & ~_umask())
+        (self.tmp / MARKER).write_bytes(b"")
 
     def write(self, name: str, data: bytes) -> None:
         (self.tmp / name).write_bytes(data)
 
     def commit(self) -> None:
+        check_replaceable(self.final, self.option)   # again: it may have appeared meanwhile
         if self.final.exists():
             old = self.final.with_name(f".{self.final.name}.old")
             if old.exists():

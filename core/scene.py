@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,6 +28,14 @@ from .errors import InputError
 SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
 NATIVE_SUFFIX = ".scene"
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".off", ".glb", ".gltf")
+#: A scene name becomes part of output file names: no path separators, no leading dot.
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+
+
+def _safe_stem(path) -> str:
+    """A file stem usable as a scene name (characters outside NAME_PATTERN become '_')."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem)
+    return stem if NAME_PATTERN.fullmatch(stem) else "_" + stem
 
 
 @dataclass(frozen=True)
@@ -46,7 +55,10 @@ class Scene:
         """Bounding-sphere radius about the origin (0 for an empty scene)."""
         if len(self.vertices) == 0:
             return 0.0
-        return float(np.sqrt((self.vertices ** 2).sum(axis=1).max()))
+        big = float(np.abs(self.vertices).max())       # scale first: squares of 1e155 overflow
+        if big == 0.0:
+            return 0.0
+        return big * float(np.sqrt(((self.vertices / big) ** 2).sum(axis=1).max()))
 
 
 def unique_edges(edges: np.ndarray) -> np.ndarray:
@@ -93,8 +105,9 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None)
             continue
         tag, *fields = line.split()
         if tag == "name":
-            if len(fields) != 1:
-                raise InputError(f"{path}:{lineno}: name {' '.join(fields)!r}: expected one word")
+            if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
+                raise InputError(f"{path}:{lineno}: name {' '.join(fields)!r}: expected one word of letters, "
+                                 "digits, '_', '.', '-' (it names output files)")
             name = fields[0]
         elif tag == "v":
             if len(fields) != 3:
@@ -112,7 +125,7 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None)
             raise InputError(f"{path}:{lineno}: {tag!r}: expected a line starting with 'v', 'e', 'f', 'name' or '#'")
     all_edges = np.concatenate([np.asarray(edges, dtype=np.intp).reshape(-1, 2), face_edges(faces)])
     return Scene(
-        name=name or Path(path).stem,
+        name=name or _safe_stem(path),
         vertices=np.asarray(vertices, dtype=np.float64).reshape(-1, 3),
         edges=unique_edges(all_edges),
         faces=tuple(faces),
@@ -149,13 +162,22 @@ def _obj_lines(path: Path) -> list[tuple[int, int]]:
 def load_mesh_file(path: Path) -> Scene:
     import trimesh  # lazy: only mesh files need it
 
+    if path.suffix.lower() == ".obj":
+        _obj_vertices(path)   # validate every 'v' line first: errors with file:line, not trimesh's
     try:
         loaded = trimesh.load(str(path), process=False, maintain_order=True)
     except Exception as exc:  # trimesh raises many types; one line for the user
         raise InputError(f"{path}: could not be read as {path.suffix[1:].upper()}: {exc}") from None
     if isinstance(loaded, trimesh.Scene):
         loaded = loaded.to_geometry() if hasattr(loaded, "to_geometry") else loaded.dump(concatenate=True)
-    vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64).reshape(-1, 3)
+    if path.suffix.lower() == ".stl" and hasattr(loaded, "merge_vertices"):
+        # STL stores every triangle's corners separately: merge equal positions,
+        # or every shared edge would be counted and drawn twice
+        loaded.merge_vertices()
+    vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    if vertices.size % 3 or (vertices.ndim == 2 and vertices.shape[1] != 3):
+        raise InputError(f"{path}: vertices of shape {vertices.shape}: expected 3 coordinates per vertex")
+    vertices = vertices.reshape(-1, 3)
     faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
     if faces.size == 0:
         faces = np.zeros((0, 3), dtype=np.intp)
@@ -171,7 +193,7 @@ def load_mesh_file(path: Path) -> Scene:
         bad = np.argwhere(~np.isfinite(vertices))[0]
         raise InputError(f"{path}: vertex {bad[0]} has {vertices[bad[0]].tolist()}: expected finite coordinates")
     all_edges = np.concatenate(edges) if edges else np.zeros((0, 2), dtype=np.intp)
-    return Scene(name=path.stem, vertices=vertices, edges=unique_edges(all_edges),
+    return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
                  faces=tuple(tuple(int(i) for i in f) for f in faces), source=str(path))
 
 
@@ -181,6 +203,8 @@ def _obj_vertices(path: Path) -> np.ndarray:
         for lineno, raw in enumerate(fh, start=1):
             parts = raw.split("#", 1)[0].split()
             if parts and parts[0] == "v":
+                if len(parts) < 4:
+                    raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
                 out.append([_number(path, lineno, t, "vertex coordinate") for t in parts[1:4]])
     return np.asarray(out, dtype=np.float64).reshape(-1, 3)
 
@@ -200,6 +224,8 @@ def load_scene(name_or_path: str) -> Scene:
         else:
             raise InputError(f"--scene {name_or_path!r}: expected a built-in scene "
                              f"({', '.join(builtin_names())}) or a file path")
+    if path.is_dir():
+        raise InputError(f"--scene {name_or_path!r} is a directory: expected a scene file")
     if not path.is_file():
         raise InputError(f"--scene {name_or_path!r}: file not found")
     suffix = path.suffix.lower()

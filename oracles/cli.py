@@ -9,12 +9,14 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import sys
 import time
 from datetime import datetime, timezone
 from pathlib import Path
 
 from core.errors import InputError
+from core.output import check_replaceable
 from core.scene import SCENE_DIR, builtin_names, load_scene
 
 from . import tolerances
@@ -100,11 +102,19 @@ def main(argv=None) -> int:
         run_dir = Path(args.report_dir)
     else:
         run = args.run or datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+        if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", run):
+            print(f"crosscheck: error: --run {run!r}: expected a name of letters, digits, '_', '.', '-' "
+                  "(no '/', not starting with '.')", file=sys.stderr)
+            return 2
         run_dir = Path("reports") / run
     try:
         run_dir.parent.mkdir(parents=True, exist_ok=True)
         if not os.access(run_dir.parent, os.W_OK):
             raise OSError("permission denied")
+        check_replaceable(run_dir, "--report-dir" if args.report_dir else "--run")
+    except InputError as exc:
+        print(f"crosscheck: error: {exc}", file=sys.stderr)
+        return 2
     except OSError as exc:
         print(f"crosscheck: error: --report-dir {str(run_dir)!r}: cannot write there ({exc}): "
               "expected a writable directory", file=sys.stderr)

@@ -130,7 +130,7 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
     """Write the run directory atomically; ``images[(scene, camera)] = {frame, candidate, oracle}``."""
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
-    out = FrameDir(run_dir)
+    out = FrameDir(run_dir, "--report-dir")
     try:
         (out.tmp / "img").mkdir()
         # worst frames: every failing case, then the lowest F1 of the rest

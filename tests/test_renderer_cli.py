@@ -19,6 +19,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
+from core.output import MARKER
 from core.cli import main
 from core.projection import project_points
 from core.camera import camera_z
@@ -126,7 +127,7 @@ def test_seed_json_depths_match_naive(seed_run, k):
 
 def test_seed_png_frames(seed_run):
     out = seed_run[0]
-    names = sorted(os.listdir(out / "cube-frames"))
+    names = sorted(n for n in os.listdir(out / "cube-frames") if n != MARKER)
     assert names == [f"frame_{k:04d}.png" for k in range(1, 181)]
     img = np.asarray(Image.open(out / "cube-frames" / "frame_0001.png"))
     assert img.shape == (480, 640) and img.dtype == np.uint8
@@ -151,7 +152,8 @@ def test_determinism_byte_identical_png_and_json(seed_run, tmp_path):
     rc, _, _ = run(SEED_ARGS, b)
     assert rc == 0
     assert (a / "cube-report.json").read_bytes() == (b / "cube-report.json").read_bytes()
-    fa, fb = sorted(os.listdir(a / "cube-frames")), sorted(os.listdir(b / "cube-frames"))
+    fa = sorted(n for n in os.listdir(a / "cube-frames") if n != MARKER)
+    fb = sorted(n for n in os.listdir(b / "cube-frames") if n != MARKER)
     assert fa == fb and len(fa) == 180
     for name in fa:
         assert (a / "cube-frames" / name).read_bytes() == (b / "cube-frames" / name).read_bytes(), name

@@ -192,9 +192,10 @@ def test_stl_written_by_trimesh_round_trips(tmp_path):
     p = tmp_path / "box.stl"
     box.export(p)
     s = load_scene(str(p))
-    # STL stores each triangle's 3 corners on their own and the loader does not merge
-    # (process=False): 36 vertices, and each triangle's 3 edges are distinct: 36 edges
-    assert s.vertices.shape == (36, 3) and s.edges.shape == (36, 2)
+    # STL stores each triangle's 3 corners on their own (36 here); the loader merges
+    # equal positions, giving the box's 8 corners, and the unique edges of its 12
+    # triangles: 12 cube edges + 6 face diagonals = 18 (trimesh's edges_unique agrees)
+    assert s.vertices.shape == (8, 3) and s.edges.shape == (18, 2)
     assert set(map(tuple, np.unique(np.abs(s.vertices), axis=0).tolist())) == {(1.0, 1.0, 1.0)}
 
 
