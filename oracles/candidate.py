@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import inspect
 import sys
 from pathlib import Path
 
@@ -45,18 +46,25 @@ def load_candidate(spec: str):
             module = importlib.util.module_from_spec(module_spec)
             sys.modules[mod_name] = module
             module_spec.loader.exec_module(module)
-        except Exception as exc:  # the user's file: report, don't trace back
+        except (Exception, SystemExit) as exc:  # the user's file: report, don't trace back, don't exit
             raise InputError(f"--candidate {spec!r}: importing {target} failed: "
                              f"{type(exc).__name__}: {exc}") from None
     else:
         try:
             module = importlib.import_module(target)
-        except Exception as exc:
+        except (Exception, SystemExit) as exc:
             raise InputError(f"--candidate {spec!r}: importing module {target!r} failed: "
                              f"{type(exc).__name__}: {exc}") from None
     func = getattr(module, func_name, None)
     if not callable(func):
         raise InputError(f"--candidate {spec!r}: {target} has no callable {func_name!r}")
+    try:
+        inspect.signature(func).bind(None, None)
+    except TypeError:
+        raise InputError(f"--candidate {spec!r}: {func_name}{inspect.signature(func)} cannot be called as "
+                         f"{func_name}(points, camera): expected the contract FUNC(points, camera)") from None
+    except ValueError:      # builtins without a signature: find out when called
+        pass
     return func
 
 
@@ -68,7 +76,7 @@ def call_candidate(func, points: np.ndarray, camera) -> np.ndarray:
     """Call the candidate and check its answer against the contract."""
     try:
         out = func(np.array(points, dtype=np.float64, copy=True), camera)
-    except Exception as exc:
+    except (Exception, SystemExit) as exc:   # a candidate must not end the run (nor pass CI by exiting 0)
         raise CandidateError(f"candidate raised {type(exc).__name__}: {exc}") from exc
     try:
         out = np.asarray(out, dtype=np.float64)
@@ -76,4 +84,14 @@ def call_candidate(func, points: np.ndarray, camera) -> np.ndarray:
         raise CandidateError(f"candidate returned {type(out).__name__}: expected an (N, 2) float array") from exc
     if out.shape != (len(points), 2):
         raise CandidateError(f"candidate returned shape {out.shape}: expected ({len(points)}, 2)")
+    infinite = np.isinf(out).any(axis=1)
+    if infinite.any():
+        k = int(np.flatnonzero(infinite)[0])
+        raise CandidateError(f"candidate returned {out[k].tolist()} for point {k} {np.asarray(points)[k].tolist()}: "
+                             "expected finite pixel coordinates, or NaN for a clipped point")
+    half = np.isnan(out).any(axis=1) & ~np.isnan(out).all(axis=1)
+    if half.any():
+        k = int(np.flatnonzero(half)[0])
+        raise CandidateError(f"candidate returned {out[k].tolist()} for point {k}: expected both coordinates "
+                             "NaN (clipped) or both finite")
     return out

@@ -127,7 +127,12 @@ def main(argv=None) -> int:
     renderers = {}
     try:
         for scene in scenes:
-            for case in cameras_for(scene.radius):
+            try:
+                scene_cases = cameras_for(scene.radius)
+            except InputError as exc:
+                print(f"crosscheck: error: {scene.source}: no camera fits this scene ({exc})", file=sys.stderr)
+                return 2
+            for case in scene_cases:
                 if case.name not in case_names:
                     continue
                 cam = case.camera
@@ -178,6 +183,11 @@ def main(argv=None) -> int:
         print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
         return 2
     print(console_table(records))
+    for r in records:
+        if r["verdict"] != "pass":
+            print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+        elif r.get("note"):
+            print(f"  {r['scene']} / {r['camera']}: {r['note']}")
     s = report["summary"]
     print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance "
           f"(vertex <= {tol.vertex_px:g} px, F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px})")

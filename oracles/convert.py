@@ -42,6 +42,21 @@ def _principal_point(width: int, height: int) -> tuple[float, float]:
     return (width - 1) / 2.0, (height - 1) / 2.0
 
 
+def camera_basis(camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(right, up, forward)`` built here from the spec's ``forward`` and ``up``.
+
+    Independent of core's ``Camera.right``: ``right = forward x up`` (the
+    project's handedness, stated in core.conventions), normalised, and
+    ``up = right x forward``. If core's cross product were reversed, the oracle
+    would not follow it.
+    """
+    forward = np.asarray(camera.forward, dtype=np.float64)
+    forward = forward / np.linalg.norm(forward)
+    right = np.cross(forward, np.asarray(camera.up, dtype=np.float64))
+    right = right / np.linalg.norm(right)
+    return right, np.cross(right, forward), forward
+
+
 def _cv2():
     import cv2
     return cv2
@@ -77,7 +92,8 @@ def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray
     tvec : (3,) ndarray, translation world -> OpenCV camera.
     K : (3, 3) ndarray, intrinsics (affine for orthographic, see above).
     """
-    r_cv = np.stack([camera.right, -camera.up, camera.forward]).astype(np.float64)
+    right, up, forward = camera_basis(camera)
+    r_cv = np.stack([right, -up, forward])
     tvec = -r_cv @ np.asarray(camera.position, dtype=np.float64)
     rvec, _ = _cv2().Rodrigues(r_cv)
     cx, cy = _principal_point(camera.width, camera.height)
@@ -165,9 +181,10 @@ def camera_to_pyrender(camera: Camera):
     """
     pyrender = _pyrender()
     pose = np.eye(4)
-    pose[:3, 0] = camera.right
-    pose[:3, 1] = camera.up
-    pose[:3, 2] = -np.asarray(camera.forward)
+    right, up, forward = camera_basis(camera)
+    pose[:3, 0] = right
+    pose[:3, 1] = up
+    pose[:3, 2] = -forward
     pose[:3, 3] = camera.position
     w, h = camera.width, camera.height
     if camera.projection == "perspective":

@@ -30,7 +30,7 @@ def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
         "visible_both": int(both.sum()),
         "candidate_only": int((cand_vis & ~orac_vis).sum()),   # shown by the candidate, clipped by the oracle
         "oracle_only": int((~cand_vis & orac_vis).sum()),      # clipped by the candidate, shown by the oracle
-        "max_px": 0.0, "mean_px": 0.0, "rms_px": 0.0, "worst_index": None,
+        "max_px": None, "mean_px": None, "rms_px": None, "worst_index": None,   # None: nothing compared
     }
     if both.any():
         err = np.hypot(*(cand_px[both] - oracle_px[both]).T)

@@ -13,7 +13,7 @@ import numpy as np
 
 from core.camera import Camera
 
-from .convert import camera_to_opencv
+from .convert import camera_basis, camera_to_opencv
 
 __all__ = ["project", "depth"]
 
@@ -21,7 +21,8 @@ __all__ = ["project", "depth"]
 def _r_t(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     # R rows: right, -up, forward (see convert.camera_to_opencv); built from the
     # camera's vectors rather than through Rodrigues, to keep depth exact.
-    r_cv = np.stack([camera.right, -camera.up, camera.forward]).astype(np.float64)
+    right, up, forward = camera_basis(camera)
+    r_cv = np.stack([right, -up, forward])
     return r_cv, -r_cv @ np.asarray(camera.position, dtype=np.float64)
 
 
@@ -76,6 +77,7 @@ def project(p_world: np.ndarray, camera: Camera) -> np.ndarray:
     else:
         d = p_world[visible] - camera.position
         s = k[0, 0]                                     # H / ortho_height
-        p_px[visible, 0] = k[0, 2] + s * (d @ camera.right)
-        p_px[visible, 1] = k[1, 2] - s * (d @ camera.up)
+        right, up, _ = camera_basis(camera)
+        p_px[visible, 0] = k[0, 2] + s * (d @ right)
+        p_px[visible, 1] = k[1, 2] - s * (d @ up)
     return p_px

@@ -8,6 +8,7 @@ under the top-level ``"timing"`` key; everything else is deterministic.
 from __future__ import annotations
 
 import html
+import math
 from pathlib import Path
 
 import numpy as np
@@ -126,6 +127,17 @@ def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
     return "\n".join(parts)
 
 
+def _finite_or_null(obj):
+    """JSON has no inf or NaN: such values (a candidate's overflow) become null."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite_or_null(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite_or_null(v) for v in obj]
+    return obj
+
+
 def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) -> Path:
     """Write the run directory atomically; ``images[(scene, camera)] = {frame, candidate, oracle}``."""
     run_dir = Path(run_dir)
@@ -147,6 +159,7 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
             out.write(f"img/{stem}-oracle.png", png_bytes(np.where(im["oracle"], 255, 0).astype(np.uint8)))
             out.write(f"img/{stem}-diff.png", png_bytes(diff_image(im["candidate"], im["oracle"])))
             shown.append((case, stem))
+        report = _finite_or_null(report)
         out.write("report.json", json_dumps(report).encode())
         out.write("report.md", markdown(report).encode())
         out.write("report.html", _html(report, shown).encode())

@@ -72,7 +72,8 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     edges = np.asarray(scene.edges)
     cand_all, orac_all = [], []
     frame_errors = []
-    f1_0, f1_1, prec_1, rec_1 = [], [], [], []
+    per_frame = []
+    f1_0, f1_1, prec_0, rec_0, prec_1, rec_1 = [], [], [], [], [], []
     worst = None                     # (key, frame, cand_img, oracle_img)
     t_cand = t_cv = t_pr = 0.0
     error = None
@@ -103,14 +104,21 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         cand_all.append(cand_px)
         orac_all.append(oracle_px)
         ve = metrics.vertex_errors(cand_px, oracle_px)
-        frame_errors.append((ve["max_px"], k, ve["worst_index"]))
+        if ve["max_px"] is not None:
+            frame_errors.append((ve["max_px"], k, ve["worst_index"]))
+        frame_rec = {"frame": k, "max_vertex_error_px": ve["max_px"], "mean_vertex_error_px": ve["mean_px"],
+                     "rms_vertex_error_px": ve["rms_px"], "visible_points": ve["visible_both"]}
+        per_frame.append(frame_rec)
         if pyrender_oracle is not None:
             t0 = time.perf_counter()
             orac_img, _depth = pyrender_oracle.render(scene.vertices, edges, cam, model_matrix=m)
             t_pr += time.perf_counter() - t0
             ps = metrics.pixel_scores(cand_img, orac_img)
             f1_0.append(ps["f1_0px"]); f1_1.append(ps["f1_1px"])
+            prec_0.append(ps["precision_0px"]); rec_0.append(ps["recall_0px"])
             prec_1.append(ps["precision_1px"]); rec_1.append(ps["recall_1px"])
+            frame_rec.update({key: ps[key] for key in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
+                                                       "precision_1px", "recall_1px")})
             key = (ps["f1_1px"], ps["f1_0px"])
             if want_images and (worst is None or key < worst[0]):
                 worst = (key, k, cand_img.copy(), orac_img.copy())
@@ -120,7 +128,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         cand = np.concatenate(cand_all)
         orac = np.concatenate(orac_all)
         ve = metrics.vertex_errors(cand, orac)
-        worst_v = max(frame_errors, key=lambda e: (e[0], -e[1]))
+        worst_v = max(frame_errors, key=lambda e: (e[0], -e[1])) if frame_errors else (None, None, None)
         rec.update({
             "max_vertex_error_px": ve["max_px"],
             "mean_vertex_error_px": ve["mean_px"],
@@ -140,6 +148,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         rec.update({
             "pixel_f1_0px": float(min(f1_0)), "pixel_f1_1px": float(min(f1_1)),
             "pixel_f1_0px_mean": float(np.mean(f1_0)), "pixel_f1_1px_mean": float(np.mean(f1_1)),
+            "pixel_precision_0px": float(min(prec_0)), "pixel_recall_0px": float(min(rec_0)),
             "pixel_precision_1px": float(min(prec_1)), "pixel_recall_1px": float(min(rec_1)),
             "worst_pixel_frame": worst_frame,
         })
@@ -149,8 +158,12 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     reasons = []
     if error:
         reasons.append(error)
+    if done and len(scene.vertices) == 0:
+        rec["note"] = "nothing to check: the scene has no vertices"
+    elif done and rec["visible_points"] == 0:
+        rec["note"] = "no point visible to both projectors: only the visible/clipped sets were compared"
     if done:
-        if rec["max_vertex_error_px"] > tol.vertex_px:
+        if rec["max_vertex_error_px"] is not None and rec["max_vertex_error_px"] > tol.vertex_px:
             reasons.append(f"max vertex error {rec['max_vertex_error_px']:.3g} px > {tol.vertex_px:.3g} px "
                            f"(frame {rec['worst_vertex']['frame']}, vertex {rec['worst_vertex']['vertex']})")
         vm = rec["visibility_mismatch"]
@@ -165,6 +178,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
             reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
     rec["verdict"] = "fail" if reasons else "pass"
     rec["reasons"] = reasons
+    rec["per_frame"] = per_frame
     timing = {"candidate_ms_per_frame": 1e3 * t_cand / max(done, 1),
               "opencv_ms_per_frame": 1e3 * t_cv / max(done, 1)}
     if pyrender_oracle is not None:

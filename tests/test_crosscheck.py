@@ -153,3 +153,56 @@ def test_failing_report_says_what_to_check(tmp_path):
                     "--cases", "oblique_roll")
     md = (out / "report.md").read_text()
     assert "## What to check" in md and "`mirror_horizontal`: left and right are exchanged" in md
+
+
+def _write(tmp_path, text):
+    f = tmp_path / "cand.py"
+    f.write_text(text)
+    return f
+
+
+def test_candidate_exiting_at_import_is_a_usage_error(tmp_path, capsys):
+    cand = _write(tmp_path, "import sys\nsys.exit(0)\ndef f(p, c):\n    return p[:, :2]\n")
+    assert cli.main(["--candidate", f"{cand}:f", "--report-dir", str(tmp_path / "r")]) == 2
+    assert "SystemExit" in capsys.readouterr().err
+
+
+def test_candidate_with_wrong_signature_is_a_usage_error(tmp_path, capsys):
+    cand = _write(tmp_path, "def f(points):\n    return points[:, :2]\n")
+    assert cli.main(["--candidate", f"{cand}:f", "--report-dir", str(tmp_path / "r")]) == 2
+    assert "f(points, camera)" in capsys.readouterr().err
+
+
+def test_candidate_exiting_during_the_run_fails_not_passes(tmp_path):
+    cand = _write(tmp_path, "def f(p, c):\n    raise SystemExit(0)\n")
+    code, report, _ = run(tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", "--frames", "1",
+                          "--cases", "on_axis")
+    assert code == 1 and "SystemExit" in report["cases"][0]["reasons"][0]
+
+
+def test_infinite_output_is_a_contract_violation(tmp_path, capsys):
+    cand = _write(tmp_path, "import numpy as np\ndef f(p, c):\n    return np.full((len(p), 2), np.inf)\n")
+    code, report, _ = run(tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", "--frames", "1",
+                          "--cases", "on_axis")
+    assert code == 1
+    assert "expected finite pixel coordinates" in report["cases"][0]["reasons"][0]
+    assert "expected finite pixel coordinates" in capsys.readouterr().out   # reasons on the console too
+
+
+def test_per_frame_errors_and_precision_recall_at_0px(tmp_path):
+    _, report, _ = run(tmp_path, "--scene", "cube", "--frames", "3", "--cases", "oblique_roll")
+    case = report["cases"][0]
+    assert [f["frame"] for f in case["per_frame"]] == [1, 2, 3]
+    assert max(f["max_vertex_error_px"] for f in case["per_frame"]) == case["max_vertex_error_px"]
+    assert case["pixel_f1_0px"] == min(f["f1_0px"] for f in case["per_frame"])
+    for key in ("pixel_precision_0px", "pixel_recall_0px"):
+        assert 0.98 <= case[key] <= 1.0          # measured >= 0.9958 (oracles/tolerances.py)
+
+
+def test_empty_scene_says_nothing_was_checked(tmp_path):
+    empty = tmp_path / "empty.scene"
+    empty.write_text("# no vertices\n")
+    code, report, _ = run(tmp_path, "--scene", str(empty), "--frames", "1", "--cases", "on_axis")
+    case = report["cases"][0]
+    assert code == 0 and case["max_vertex_error_px"] is None
+    assert case["note"].startswith("nothing to check")

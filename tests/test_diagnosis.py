@@ -4,8 +4,8 @@ Every faulty projector below is a small re-implementation of
 ``core.projection.project_points`` with one bug (or two) put in on purpose. The
 reference side is ``oracles.opencv_oracle.project`` when it imports, else
 core's own projector. Each (fault, camera) pair must give EXACTLY the expected
-set of fault names; the confusion matrix over all pairs is printed (``-s`` or
-``-rA``) and must be diagonal.
+set of fault names; the confusion matrix over all pairs is printed in the
+terminal summary (via tests/conftest.py) and must be diagonal.
 """
 
 from __future__ import annotations
@@ -30,6 +30,21 @@ except ImportError:                                   # pragma: no cover - fallb
     oracle_project = project_points
     ORACLE = "core"
 
+# ---- numeric error budget (the tolerances below are derived from this) -------
+# Pixel noise delta: the faulty projectors (numpy) and the oracle (cv2) compute
+# the same pixels in a different order, ~10 float64 operations on values up to
+# ~640 px: delta <= 2.2e-16 x 640 x 10 ~ 1.5e-12 px (measured 1.1e-13; the
+# "inside" camera, with points near its near plane at up to ~4e3 px, 1e-10).
+# diagnose's per-axis fit cand = d q + b has the design [q / max|q|, 1], of
+# condition number <= 2.3 for these cameras (measured), and every fitted axis
+# reaches >= 100 px from the centre. So a fitted scale d is off by
+# <= 2.3 x delta / 100 px ~ 3.5e-14 (relative), an offset b by
+# <= 2.3 x delta ~ 3.5e-12 px; the affine fit (same conditioning) alike.
+#
+# TOL, the agreement tolerance handed to diagnose: it must sit far above that
+# noise (1e-10 px at worst, "inside": 1e4 x margin) and far below the smallest
+# injected effect (the 0.5 deg roll moves pixels by ~1.25 px, the half-pixel
+# offset by 0.5 px, the fov factor 0.8 by tens of px: >= 5e5 x margin).
 TOL = 1e-6
 FRAMES = 12
 SCENES = ("cube", "pyramid", "prism")
@@ -270,10 +285,17 @@ def test_implied_fov(results, camera_name):
     for fault in ("fov", "fov_aspect", "fov_offset"):
         (fov,) = [d for d in results[(fault, camera_name)] if d["name"] == "fov_mismatch"]
         if cam.projection == "perspective":
-            assert fov["implied_fov_deg"] == pytest.approx(implied_fov(cam), abs=1e-6)
+            # implied_fov = 2 atan(t / d_y), t = tan(fov/2): |d fov / d ln d_y| =
+            # 2 t d_y / (t^2 + d_y^2) <= 1 rad = 57.3 deg, times d_y's relative
+            # error 3.5e-14 (budget above) ~ 2e-12 deg, plus a few ulp of the
+            # ~50 deg angle from tan/atan (~1e-14). Measured 6e-14 deg; 1e-9 deg
+            # leaves 500x margin over the bound (was 1e-6: loose by ~1e6).
+            assert fov["implied_fov_deg"] == pytest.approx(implied_fov(cam), abs=1e-9)
             assert fov["implied_ortho_height"] is None
         else:
             assert fov["implied_fov_deg"] is None
+            # ortho_height / d_y: relative error = d_y's, 3.5e-14, + 1 ulp of the
+            # division (measured 2.2e-16); rel 1e-9 leaves a wide margin.
             assert fov["implied_ortho_height"] == pytest.approx(implied_fov(cam), rel=1e-9)
 
 
@@ -283,7 +305,10 @@ def test_implied_fov_of_horizontal_fov(results, camera_name):
     cam = CAMERAS[camera_name]
     (fov,) = results[("fov_horizontal", camera_name)]
     want = math.degrees(2 * math.atan(cam.height / cam.width * math.tan(math.radians(cam.fov_y_deg) / 2)))
-    assert fov["implied_fov_deg"] == pytest.approx(want, abs=1e-6)
+    # Same error as in test_implied_fov: <= 57.3 deg x 3.5e-14 ~ 2e-12 deg, plus
+    # a few ulp of want's own tan/atan (~1e-14). Measured 3e-14; 1e-9 deg leaves
+    # 500x margin (was 1e-6: loose by ~1e6).
+    assert fov["implied_fov_deg"] == pytest.approx(want, abs=1e-9)
     # direction: a wider image with f from the width -> longer focal -> narrower FOV
     assert (fov["implied_fov_deg"] < cam.fov_y_deg) == (cam.width > cam.height)
 
@@ -292,7 +317,10 @@ def test_implied_fov_of_horizontal_fov(results, camera_name):
 def test_implied_aspect(results, camera_name):
     for fault in ("aspect", "fov_aspect"):
         (asp,) = [d for d in results[(fault, camera_name)] if d["name"] == "aspect_mismatch"]
-        assert asp["implied_aspect"] == pytest.approx(1.0, abs=1e-9)   # width-based fx = aspect 1
+        # width-based fx = aspect 1. implied_aspect = (W/H) d_y / d_x: two fitted
+        # scales, 3.5e-14 relative each, + 2 ulp of the products ~ 7e-14 on a
+        # value of ~1 (measured 9e-16); abs 1e-9 leaves >1e4 x margin.
+        assert asp["implied_aspect"] == pytest.approx(1.0, abs=1e-9)
 
 
 @pytest.mark.parametrize("aspect", [1.0, 0.75, 4 / 3 * 1.1])
@@ -302,6 +330,7 @@ def test_implied_aspect_gl_style(aspect):
     cand = _project(POINTS, cam, fx=cam.focal_px * (cam.width / cam.height) / aspect)
     (asp,) = diagnose(cand, oracle_project(POINTS, cam), cam, tol_px=TOL)
     assert asp["name"] == "aspect_mismatch"
+    # As in test_implied_aspect: ~7e-14 relative (measured 4.4e-16); rel 1e-9.
     assert asp["implied_aspect"] == pytest.approx(aspect, rel=1e-9)
 
 
@@ -309,8 +338,11 @@ def test_implied_aspect_gl_style(aspect):
 def test_half_pixel_offset(results, camera_name):
     for fault in ("offset", "fov_offset"):
         (off,) = [d for d in results[(fault, camera_name)] if d["name"] == "pixel_offset"]
-        assert off["dx"] == pytest.approx(0.5, abs=1e-6)
-        assert off["dy"] == pytest.approx(0.5, abs=1e-6)
+        # A fitted offset b is off by <= cond x delta = 2.3 x 1.5e-12 ~ 3.5e-12 px
+        # (budget above; measured 1.9e-14). 1e-9 px leaves ~300x margin
+        # (was 1e-6: loose by ~1e6, and as coarse as TOL itself).
+        assert off["dx"] == pytest.approx(0.5, abs=1e-9)
+        assert off["dy"] == pytest.approx(0.5, abs=1e-9)
 
 
 @pytest.mark.parametrize("camera_name", ("oblique", "tall"))
@@ -319,16 +351,29 @@ def test_swap_with_offset(camera_name):
     cam = CAMERAS[camera_name]
     got = diagnose(f_swap(POINTS, cam) + [0.5, -0.25], oracle_project(POINTS, cam), cam, tol_px=TOL)
     assert [d["name"] for d in got] == ["axis_swap", "pixel_offset"]
-    assert (got[1]["dx"], got[1]["dy"]) == pytest.approx((0.5, -0.25), abs=1e-6)
+    # As in test_half_pixel_offset: the fitted offset, minus the exactly
+    # representable expected shift cx - cy, is off by <= ~3.5e-12 px (measured
+    # 4.3e-14); 1e-9 px leaves ~300x margin (was 1e-6).
+    assert (got[1]["dx"], got[1]["dy"]) == pytest.approx((0.5, -0.25), abs=1e-9)
 
 
 def test_unexplained_fields(results):
     (u,) = results[("roll", "oblique")]
+    # A 0.5 deg roll moves points ~140 px from the centre by ~1.2 px (measured
+    # residual 1.25 px) >> TOL; a roll about the optical axis with fx = fy is
+    # exactly an image rotation, so its affine residual is only the pixel noise
+    # (measured 1.1e-13 px) << TOL.
     assert u["residual_px"] > TOL
     assert u["affine_residual_px"] < TOL                 # a roll is an image rotation...
-    assert u["rotation_deg"] == pytest.approx(-0.5, abs=1e-6)   # ...of the roll angle (y down)
+    # ...of the roll angle (y down). rotation_deg = atan2(A10 - A01, A00 + A11):
+    # entries of A off by <= 3.5e-14 (budget above), so the angle by ~1e-13 rad
+    # = 6e-12 deg (measured 9e-15); 1e-9 deg leaves ~150x margin (was 1e-6).
+    assert u["rotation_deg"] == pytest.approx(-0.5, abs=1e-9)
     (t,) = results[("transposed", "oblique")]
-    assert t["residual_px"] > 1.0 and t["affine_residual_px"] > 1.0   # not affine at all
+    # Not affine at all: measured residual 21.5 px, affine residual 1.8 px. The
+    # 1 px threshold is not a noise bound: it only has to be >> TOL (1e6 x) to
+    # show a 3D error that no image-plane map explains, with ~2x headroom.
+    assert t["residual_px"] > 1.0 and t["affine_residual_px"] > 1.0
 
 
 # ---- degenerate inputs -------------------------------------------------------
@@ -341,6 +386,8 @@ def test_degenerate_inputs():
     one = np.array([[10.0, 20.0]])
     assert diagnose(one, one, cam) == []
     (off,) = diagnose(one + 0.5, one, cam)
+    # exact equality: 10.5 - 10 and 20.5 - 20 are exact in float64, and the
+    # mean of one value is that value.
     assert off["name"] == "pixel_offset" and (off["dx"], off["dy"]) == (0.5, 0.5)
     # two points, mirrored: cannot be fitted -> unexplained, underdetermined
     two = np.array([[10.0, 20.0], [30.0, 50.0]])
@@ -362,12 +409,16 @@ def test_visibility_mismatch_without_flip():
     cand = project_points(POINTS, _with(cam, far=5.6))
     got = diagnose(cand, oracle_project(POINTS, cam), cam, tol_px=TOL)
     assert [d["name"] for d in got] == ["unexplained"]
+    # same camera apart from far: the common points' pixels agree to the pixel
+    # noise (~1e-13 px) <= TOL.
     assert got[0]["visibility_mismatches"] > 0 and got[0]["residual_px"] <= TOL
 
 
 def test_below_tolerance_is_agreement():
     cam = CAMERAS["oblique"]
     ref = oracle_project(POINTS, cam)
+    # 1e-7 and 1e-5 px bracket TOL = 1e-6 by 10x either way; adding them to
+    # pixels of <= ~640 px is exact to ~1e-13 px, far inside that bracket.
     assert diagnose(ref + 1e-7, ref, cam, tol_px=TOL) == []
     assert primary(diagnose(ref + 1e-5, ref, cam, tol_px=TOL)) == "pixel_offset"
 
@@ -408,10 +459,10 @@ def format_confusion(labels, rows, counts):
     return "\n".join(lines)
 
 
-def test_confusion_matrix_is_diagonal(results):
+def test_confusion_matrix_is_diagonal(results, summary_section):
     labels, rows, counts = confusion(results)
-    print()
-    print(format_confusion(labels, rows, counts))
+    # shown in the terminal summary of every run (tests/conftest.py), pass or fail
+    summary_section("diagnosis confusion matrix", format_confusion(labels, rows, counts))
     off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
     assert not off, off
     assert set(rows) == set(labels)                      # every fault name was injected

@@ -39,6 +39,9 @@ def test_opencv_hand_values_camera_z():
     # camera at (0,0,4) looking at -Z, up +Y: right = +X, so OpenCV rows are
     # (1,0,0), (0,-1,0), (0,0,-1): a rotation by pi about x; t = -R p = (0,0,4).
     rvec, tvec, k = convert.camera_to_opencv(CAMERAS["camera_z"])
+    # R = diag(1, -1, -1) is exact (unit axis vectors), and theta = pi takes
+    # OpenCV's diagonal branch: axis = sqrt((R_ii + 1) / 2) exact, theta from
+    # acos(-1) or atan2: a few ulp of pi. 4 ulp of pi.
     np.testing.assert_allclose(rvec, [math.pi, 0.0, 0.0], rtol=0, atol=4 * EPS * math.pi)
     np.testing.assert_array_equal(tvec, [0.0, 0.0, 4.0])
     # f = 240 / tan(45 deg); tan(pi/4) is 1 - 1 ulp in float64, so 2 ulp of 240.
@@ -69,6 +72,7 @@ def test_opencv_round_trip(name):
         # fov -> f -> fov through tan and atan: a few ulp of the angle.
         assert back.fov_y_deg == pytest.approx(cam.fov_y_deg, rel=8 * EPS)
     else:
+        # s = H / ortho_height, then H / s: two roundings, <= 1 ulp each; 4 eps.
         assert back.ortho_height == pytest.approx(cam.ortho_height, rel=4 * EPS)
 
 
@@ -86,6 +90,7 @@ def test_pyrender_hand_values_camera_z():
     np.testing.assert_array_equal(pose, [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 4], [0, 0, 0, 1]])
     # pyrender measures cx, cy from the corner: (W-1)/2 + 0.5 = W/2 exactly.
     assert (pcam.cx, pcam.cy) == (320.0, 240.0)
+    # f = 240 / tan(45 deg); tan(pi/4) is 1 - 1 ulp in float64 -> <= 2 ulp of 240.
     assert pcam.fx == pcam.fy == pytest.approx(240.0, rel=2 * EPS)
     assert (pcam.znear, pcam.zfar) == (1.0, 10.0)
     # pyrender's projection matrix maps the camera-space point (1, 1, -4) to
@@ -94,6 +99,12 @@ def test_pyrender_hand_values_camera_z():
     p = pcam.get_projection_matrix(640, 480) @ np.array([1.0, 1.0, -4.0, 1.0])
     ndc = p[:3] / p[3]
     x_win, y_win = (ndc[0] + 1) * 320, (ndc[1] + 1) * 240
+    # fx carries 2 ulp (above); P00 = 2 fx / W, the product with (1, 1, -4, 1)
+    # (P02 = 1 - 2 cx / W = 0 exactly), the division by w = 4 (exact), + 1 and
+    # x 320 add <= 1 ulp each: ~6 relative roundings on a value of ~380, i.e.
+    # <= 6 x 2.2e-16 x 380 ~ 5e-13 px (measured 0). 1e-12 leaves 2x margin --
+    # enough, since every step is counted -- and is far below the 0.5 px
+    # corner/centre shift the check is about.
     assert x_win - 0.5 == pytest.approx(379.5, abs=1e-12)
     assert (480 - y_win) - 0.5 == pytest.approx(179.5, abs=1e-12)
 
@@ -101,7 +112,9 @@ def test_pyrender_hand_values_camera_z():
 def test_pyrender_orthographic_magnification():
     cam = CAMERAS["ortho_oblique"]
     _, pcam = convert.camera_to_pyrender(cam)
-    assert pcam.ymag == 3.5 / 2
+    assert pcam.ymag == 3.5 / 2                      # halving is exact
+    # xmag = ymag * W / H: the same two roundings in the same order as the
+    # expected value, so equal; rel = 1 ulp in case pyrender re-rounds it.
     assert pcam.xmag == pytest.approx(3.5 / 2 * 160 / 90, rel=EPS)
 
 
@@ -119,9 +132,10 @@ def test_pyrender_round_trip(name):
         np.testing.assert_allclose(getattr(back, attr), getattr(cam, attr), rtol=0, atol=8 * EPS)
     assert (back.near, back.far, back.projection) == (cam.near, cam.far, cam.projection)
     if cam.projection == "perspective":
+        # fov -> f -> fov through tan and atan: a few ulp of the angle (as above).
         assert back.fov_y_deg == pytest.approx(cam.fov_y_deg, rel=8 * EPS)
     else:
-        assert back.ortho_height == cam.ortho_height
+        assert back.ortho_height == cam.ortho_height      # x / 2 then x 2: exact
 
 
 MOTIONS = [
@@ -148,7 +162,11 @@ def test_model_matrix_matches_core(motion, t):
 def test_model_matrix_hand_values():
     # a quarter turn about Z maps +X to +Y (right-handed, core.conventions)
     m = convert.model_matrix((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), 1.0, 0.25)
+    # cos(pi/2) rounds to 6e-17, not 0, and scipy's quaternion path adds a few
+    # ulp to entries of magnitude 1: 4 eps.
     np.testing.assert_allclose(m[:3, :3] @ [1, 0, 0], [0, 1, 0], rtol=0, atol=4 * EPS)
     # X first, then Y: Rx(90) takes +Y to +Z, Ry(90) takes +Z to +X.
     m = convert.model_matrix((1.0, 1.0, 0.0), (1.0, 2.0, 3.0), 2.0, 0.25)
+    # two quarter turns: a few ulp per entry, doubled by the composition (8 eps),
+    # times the scale 2; the translation is added exactly.
     np.testing.assert_allclose(m @ [0, 1, 0, 1], [1 + 2, 2, 3, 1], rtol=0, atol=8 * EPS * 2)
