@@ -15,6 +15,13 @@ fi
 
 # 2. virtualenv + project. Re-install only when pyproject.toml changed.
 PY="${PYTHON:-python3}"
+if [ ! -x .venv/bin/python ] && ! "$PY" -c "import ensurepip, venv" 2>/dev/null; then
+    # Debian's python3 splits venv/ensurepip into python3-venv
+    echo "setup: python3-venv missing, installing it with apt-get" >&2
+    if [ "$(id -u)" = "0" ]; then SUDO=""; else SUDO="sudo"; fi
+    $SUDO apt-get update -qq >&2
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq python3-venv >&2
+fi
 if [ ! -x .venv/bin/python ]; then
     "$PY" -m venv .venv
 fi

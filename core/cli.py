@@ -57,8 +57,8 @@ def build_parser() -> argparse.ArgumentParser:
     cam = p.add_argument_group("camera (conventions: core/conventions.py)")
     cam.add_argument("--camera-z", type=float, default=None, help="camera at (0,0,D) looking at the origin, up +Y (default 4)")
     cam.add_argument("--camera-pos", default=None, metavar="X,Y,Z")
-    cam.add_argument("--look-at", default="0,0,0", metavar="X,Y,Z")
-    cam.add_argument("--up", default="0,1,0", metavar="X,Y,Z")
+    cam.add_argument("--look-at", default=None, metavar="X,Y,Z", help="with --camera-pos (default 0,0,0)")
+    cam.add_argument("--up", default=None, metavar="X,Y,Z", help="with --camera-pos (default 0,1,0)")
     cam.add_argument("--fov", type=float, default=60.0, help="full vertical FOV in degrees, edge to edge (default 60)")
     cam.add_argument("--near", type=float, default=0.1)
     cam.add_argument("--far", type=float, default=100.0)
@@ -111,8 +111,12 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     if a.camera_pos is not None:
         if a.camera_z is not None:
             raise InputError("--camera-z and --camera-pos: expected one of them, not both")
-        camera = look_at(vec3("--camera-pos", a.camera_pos), vec3("--look-at", a.look_at), vec3("--up", a.up), **kwargs)
+        camera = look_at(vec3("--camera-pos", a.camera_pos), vec3("--look-at", a.look_at or "0,0,0"),
+                         vec3("--up", a.up or "0,1,0"), **kwargs)
     else:
+        if a.look_at is not None or a.up is not None:
+            raise InputError("--look-at/--up without --camera-pos: expected --camera-pos X,Y,Z with them "
+                             "(--camera-z always looks at the origin with up +Y)")
         d = 4.0 if a.camera_z is None else a.camera_z
         if not (math.isfinite(d) and d != 0):
             raise InputError(f"--camera-z {d}: expected a finite non-zero distance")
@@ -282,6 +286,15 @@ def _progress_bar(total: int):
 
 
 def main(argv=None) -> int:
+    try:
+        return _main(argv)
+    except BrokenPipeError:
+        # stdout was closed (e.g. `renderer | head`): stop quietly, as a SIGPIPE would
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+
+
+def _main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         s = settings_from_args(args)
@@ -308,10 +321,8 @@ def main(argv=None) -> int:
         print(f"renderer: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:
-        # stdout was closed (e.g. `renderer | head`): stop quietly, as a SIGPIPE would
         close()
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 141
+        raise
     except OSError as exc:
         close()
         print(f"renderer: error: writing to {str(s.out)!r} failed: {exc}", file=sys.stderr)

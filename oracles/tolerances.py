@@ -1,6 +1,7 @@
 """Every tolerance of crosscheck, in one place, each with the reason for its value.
 
-``--tol-px`` overrides VERTEX_TOL_PX; ``--min-f1`` overrides MIN_F1_1PX.
+``--tol-px`` overrides VERTEX_TOL_PX, ``--min-f1`` MIN_F1_1PX and
+``--min-f1-0px`` MIN_F1_0PX.
 """
 
 #: Max vertex error in pixels between the candidate and cv2.projectPoints.

@@ -76,3 +76,22 @@ def test_obj_short_vertex_line_names_the_line(tmp_path, capsys):
 def test_directory_as_scene(tmp_path, capsys):
     assert renderer_cli.main(["--scene", str(tmp_path), "--frames", "1"]) == 2
     assert "is a directory" in capsys.readouterr().err
+
+
+def test_up_without_camera_pos_is_refused_not_ignored(tmp_path, capsys):
+    assert renderer_cli.main(["--frames", "1", "--out", str(tmp_path), "--up", "1,0,0"]) == 2
+    assert "--camera-pos" in capsys.readouterr().err
+
+
+def test_closed_stdout_exits_quietly(tmp_path):
+    import subprocess
+    import sys
+
+    # `renderer | head -1`: the reader goes away after the first line
+    proc = subprocess.Popen([sys.executable, "-m", "core.cli", "--frames", "3", "--out", str(tmp_path)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.readline()
+    proc.stdout.close()
+    err = proc.stderr.read().decode()
+    proc.wait()
+    assert "Traceback" not in err and proc.returncode in (0, 141)   # 0 if it finished before the close
