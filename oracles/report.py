@@ -98,31 +98,46 @@ def markdown(report: dict) -> str:
 
 def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
     e = html.escape
-    legend = " ".join(f'<span style="color:rgb{col}">&#9632; {e(name.replace("_", " "))}</span>'
+    legend = " ".join(f'<span class="chip" style="color:rgb{col}">&#9632; {e(name.replace("_", " "))}</span>'
                       for name, col in DIFF_COLOURS.items())
     rows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in table_rows(report["cases"]))
     parts = [
         "<!doctype html><html><head><meta charset='utf-8'><title>crosscheck report</title>",
         "<style>body{font-family:sans-serif;background:#fafafa;margin:2em}"
         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 8px}"
-        "img{image-rendering:pixelated;border:1px solid #888;max-width:32%;background:#000}"
-        ".fail{color:#b00}.pass{color:#070}figure{margin:0 0 2em 0}</style></head><body>",
+        ".row{display:grid;grid-template-columns:repeat(3,1fr);gap:8px}"
+        ".row figure{margin:0}.row figcaption{font-size:90%;color:#444}"
+        # thin lines: scale smoothly when shrunk (pixelated scaling drops pixels); click for 1:1
+        ".row img{width:100%;image-rendering:auto;border:1px solid #888;background:#000}"
+        ".chip{background:#000;padding:1px 6px;border-radius:3px}"
+        ".fail{color:#b00}.pass{color:#070}section{margin:0 0 2em 0}</style></head><body>",
         f"<h1>crosscheck: <span class='{e(report['verdict'])}'>{e(report['verdict'].upper())}</span></h1>",
         f"<p>Candidate <code>{e(report['candidate'])}</code>; oracles {e(', '.join(report['oracles']))}.</p>",
         "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in HEADER) + "</tr>" + rows + "</table>",
-        f"<h2>Worst frames</h2><p>candidate / oracle (pyrender) / diff: {legend}</p>",
     ]
-    for case, stem in shown:
-        parts.append(
-            f"<figure><figcaption><b>{e(case['scene'])} / {e(case['camera'])}</b>, frame "
-            f"{case.get('worst_pixel_frame')}: F1@0 {_fmt_f1(case.get('pixel_f1_0px'))}, "
-            f"F1@1 {_fmt_f1(case.get('pixel_f1_1px'))}, faults: {e(fault_text(case['faults']))}</figcaption>"
-            f"<img src='img/{stem}-candidate.png' alt='candidate'> <img src='img/{stem}-oracle.png' alt='oracle'> "
-            f"<img src='img/{stem}-diff.png' alt='diff'></figure>")
+    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    if failing:
+        parts.append("<h2>Why cases failed</h2><ul>" + "".join(
+            f"<li><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e('; '.join(c['reasons']))}</li>"
+            for c in failing) + "</ul>")
     names = sorted({f["name"] for c in report["cases"] for f in c["faults"]}, key=list(FAULT_HINTS).index)
     if names:
         parts.append("<h2>What to check</h2><ul>" + "".join(
             f"<li><code>{e(n)}</code>: {e(FAULT_HINTS[n])}</li>" for n in names) + "</ul>")
+    parts += [
+        f"<h2>Worst frames</h2><p>Each row: the candidate's frame, the oracle's (pyrender), and their diff: "
+        f"{legend}. Click an image for full size.</p>",
+    ]
+    for case, stem in shown:
+        figs = "".join(
+            f"<figure><figcaption>{label}</figcaption><a href='img/{stem}-{kind}.png'>"
+            f"<img src='img/{stem}-{kind}.png' alt='{label}'></a></figure>"
+            for kind, label in (("candidate", "candidate"), ("oracle", "oracle (pyrender)"), ("diff", "diff")))
+        parts.append(
+            f"<section><p><b>{e(case['scene'])} / {e(case['camera'])}</b>, frame "
+            f"{case.get('worst_pixel_frame')}: F1@0 {_fmt_f1(case.get('pixel_f1_0px'))}, "
+            f"F1@1 {_fmt_f1(case.get('pixel_f1_1px'))}, faults: {e(fault_text(case['faults']))}</p>"
+            f"<div class='row'>{figs}</div></section>")
     parts.append("</body></html>\n")
     return "\n".join(parts)
 
