@@ -11,19 +11,18 @@ import math
 import os
 import re
 import sys
-import time
 from datetime import datetime, timezone
 from pathlib import Path
 
 from core.errors import InputError
 from core.output import check_replaceable
-from core.scene import SCENE_DIR, builtin_names, load_scene
+from core.scene import builtin_names, load_scene
 
 from . import tolerances
 from .candidate import load_candidate
-from .cases import CASE_NAMES, cameras_for
+from .cases import CASE_NAMES
 from .report import console_table, write_report
-from .runner import CoreCandidate, Motion, Tolerances, run_case
+from .runner import CoreCandidate, Tolerances, run_crosscheck
 
 ORACLES = ("opencv", "pyrender")
 
@@ -90,9 +89,8 @@ def main(argv=None) -> int:
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
         return 2
-    pyr = None
     if "pyrender" in oracles:
-        from .pyrender_oracle import PyrenderOracle, osmesa_available
+        from .pyrender_oracle import osmesa_available
 
         ok, message = osmesa_available()
         if not ok:
@@ -121,62 +119,15 @@ def main(argv=None) -> int:
         return 2
 
     tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
-    motion = Motion(turns=spin)
-    records, images, timing_cases = [], {}, []
-    t_run = time.perf_counter()
-    renderers = {}
     try:
-        for scene in scenes:
-            try:
-                scene_cases = cameras_for(scene.radius)
-            except InputError as exc:
-                print(f"crosscheck: error: {scene.source}: no camera fits this scene ({exc})", file=sys.stderr)
-                return 2
-            for case in scene_cases:
-                if case.name not in case_names:
-                    continue
-                cam = case.camera
-                if "pyrender" in oracles:
-                    size = (cam.width, cam.height)
-                    if size not in renderers:
-                        renderers[size] = PyrenderOracle(*size)
-                    pyr = renderers[size]
-                result = run_case(scene, case, args.frames, candidate, motion, tol, pyrender_oracle=pyr)
-                records.append(result.record)
-                timing_cases.append({"scene": scene.name, "camera": case.name, **result.timing})
-                if result.worst_images:
-                    images[(scene.name, case.name)] = result.worst_images
-    finally:
-        for r in renderers.values():
-            r.close()
-
-    def mean_of(key):
-        vals = [t[key] for t in timing_cases if key in t]
-        return sum(vals) / len(vals) if vals else None
-
-    failed = sum(1 for r in records if r["verdict"] != "pass")
-    vertex_errs = [r["max_vertex_error_px"] for r in records if r.get("max_vertex_error_px") is not None]
-    f1_0 = [r["pixel_f1_0px"] for r in records if r.get("pixel_f1_0px") is not None]
-    f1_1 = [r["pixel_f1_1px"] for r in records if r.get("pixel_f1_1px") is not None]
-    report = {
-        "tool": "wirecheck crosscheck",
-        "verdict": "fail" if failed else "pass",
-        "candidate": args.candidate or "core",
-        "oracles": oracles,
-        "frames": args.frames,
-        "motion": {"turns": list(spin)},
-        "tolerances": tol.to_dict(),
-        "summary": {"cases": len(records), "passed": len(records) - failed, "failed": failed,
-                    "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
-                    "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
-                    "min_pixel_f1_1px": min(f1_1) if f1_1 else None},
-        "cases": records,
-        "timing": {"candidate_ms_per_frame": mean_of("candidate_ms_per_frame"),
-                   "opencv_ms_per_frame": mean_of("opencv_ms_per_frame"),
-                   "pyrender_ms_per_frame": mean_of("pyrender_ms_per_frame"),
-                   "wall_s": time.perf_counter() - t_run,
-                   "cases": timing_cases},
-    }
+        report, images = run_crosscheck(scenes, candidate, frames=args.frames, case_names=case_names,
+                                        oracles=oracles, turns=spin, tol=tol,
+                                        candidate_name=args.candidate or "core")
+    except InputError as exc:
+        print(f"crosscheck: error: {exc}", file=sys.stderr)
+        return 2
+    records = report["cases"]
+    failed = report["summary"]["failed"]
     try:
         write_report(run_dir, report, images)
     except OSError as exc:

@@ -187,3 +187,78 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     if worst is not None:
         images = {"frame": worst[1], "candidate": worst[2], "oracle": worst[3]}
     return CaseResult(record=rec, worst_images=images, timing=timing)
+
+
+def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles=("opencv", "pyrender"),
+                   turns=(1.0, 1.0, 0.0), tol: Tolerances | None = None, candidate_name: str = "candidate"
+                   ) -> tuple[dict, dict]:
+    """Every scene under every case camera: the report dict and the worst-frame images.
+
+    ``images[(scene, camera)] = {"frame", "candidate", "oracle"}``. Raises
+    InputError when no camera can be placed for a scene (coordinates too large).
+    """
+    import time as _time
+
+    from core.errors import InputError
+
+    from .cases import cameras_for
+
+    tol = tol or Tolerances()
+    motion = Motion(turns=tuple(turns))
+    records, images, timing_cases = [], {}, []
+    t_run = _time.perf_counter()
+    renderers = {}
+    try:
+        for scene in scenes:
+            try:
+                scene_cases = cameras_for(scene.radius)
+            except InputError as exc:
+                raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
+            for case in scene_cases:
+                if case_names is not None and case.name not in case_names:
+                    continue
+                pyr = None
+                if "pyrender" in oracles:
+                    from .pyrender_oracle import PyrenderOracle
+
+                    size = (case.camera.width, case.camera.height)
+                    if size not in renderers:
+                        renderers[size] = PyrenderOracle(*size)
+                    pyr = renderers[size]
+                result = run_case(scene, case, frames, candidate, motion, tol, pyrender_oracle=pyr)
+                records.append(result.record)
+                timing_cases.append({"scene": scene.name, "camera": case.name, **result.timing})
+                if result.worst_images:
+                    images[(scene.name, case.name)] = result.worst_images
+    finally:
+        for r in renderers.values():
+            r.close()
+
+    def mean_of(key):
+        vals = [t[key] for t in timing_cases if key in t]
+        return sum(vals) / len(vals) if vals else None
+
+    failed = sum(1 for r in records if r["verdict"] != "pass")
+    vertex_errs = [r["max_vertex_error_px"] for r in records if r.get("max_vertex_error_px") is not None]
+    f1_0 = [r["pixel_f1_0px"] for r in records if r.get("pixel_f1_0px") is not None]
+    f1_1 = [r["pixel_f1_1px"] for r in records if r.get("pixel_f1_1px") is not None]
+    report = {
+        "tool": "wirecheck crosscheck",
+        "verdict": "fail" if failed else "pass",
+        "candidate": candidate_name,
+        "oracles": list(oracles),
+        "frames": frames,
+        "motion": {"turns": list(motion.turns)},
+        "tolerances": tol.to_dict(),
+        "summary": {"cases": len(records), "passed": len(records) - failed, "failed": failed,
+                    "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
+                    "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
+                    "min_pixel_f1_1px": min(f1_1) if f1_1 else None},
+        "cases": records,
+        "timing": {"candidate_ms_per_frame": mean_of("candidate_ms_per_frame"),
+                   "opencv_ms_per_frame": mean_of("opencv_ms_per_frame"),
+                   "pyrender_ms_per_frame": mean_of("pyrender_ms_per_frame"),
+                   "wall_s": _time.perf_counter() - t_run,
+                   "cases": timing_cases},
+    }
+    return report, images

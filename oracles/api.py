@@ -1,0 +1,61 @@
+"""crosscheck from Python: gate your own projector inside your own pytest suite.
+
+    from oracles.api import assert_projector
+
+    def test_my_projector_matches_the_references():
+        assert_projector(my_project)        # AssertionError naming the fault if not
+
+``my_project(points, camera) -> (N, 2)`` follows the candidate contract
+(:mod:`oracles.candidate`). By default only the OpenCV vertex oracle runs (fast,
+no OpenGL needed); pass ``oracles=("opencv", "pyrender")`` to compare drawn
+pixels too.
+"""
+
+from __future__ import annotations
+
+from core.scene import Scene, builtin_names, load_scene
+
+from . import tolerances
+from .candidate import load_candidate
+from .report import FAULT_HINTS, fault_text
+from .runner import Tolerances, run_crosscheck
+
+
+def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("opencv",),
+                    tol_px: float = tolerances.VERTEX_TOL_PX, min_f1: float = tolerances.MIN_F1_1PX,
+                    min_f1_0px: float = tolerances.MIN_F1_0PX, turns=(1.0, 1.0, 0.0)) -> dict:
+    """Run crosscheck on ``func`` and return the report dict (as in report.json).
+
+    ``func`` may be a callable or a ``"FILE.py:FUNC"`` / ``"MODULE:FUNC"`` string;
+    ``scenes`` are names, paths or :class:`core.scene.Scene` objects (default:
+    every bundled scene); ``cases`` a subset of :data:`oracles.cases.CASE_NAMES`.
+    """
+    name = func if isinstance(func, str) else getattr(func, "__qualname__", repr(func))
+    if isinstance(func, str):
+        func = load_candidate(func)
+    scene_objs = [s if isinstance(s, Scene) else load_scene(str(s)) for s in (scenes or builtin_names())]
+    if "pyrender" in oracles:
+        from .pyrender_oracle import osmesa_available
+
+        ok, message = osmesa_available()
+        if not ok:
+            raise RuntimeError(message)
+    report, _images = run_crosscheck(scene_objs, func, frames=frames, case_names=cases, oracles=oracles,
+                                     turns=turns, tol=Tolerances(tol_px, min_f1, min_f1_0px),
+                                     candidate_name=name)
+    return report
+
+
+def assert_projector(func, **kwargs) -> dict:
+    """:func:`check_projector`, raising AssertionError with the diagnosis when any case fails."""
+    report = check_projector(func, **kwargs)
+    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    if failing:
+        lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
+        for c in failing:
+            lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'])}; "
+                         + "; ".join(c["reasons"]))
+        names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
+        lines += [f"  what to check, {n}: {FAULT_HINTS[n]}" for n in names]
+        raise AssertionError("\n".join(lines))
+    return report
