@@ -74,7 +74,7 @@ def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
     with integer pixel coordinates at pixel centres, as ours. So the rows of
     ``R`` are ``right, -up, forward`` (our camera y negated), ``t = -R @
-    position``, ``rvec = cv2.Rodrigues(R)``, and ``K`` uses ``f_px`` and
+    position``, ``rvec`` = the rotation vector of ``R``, and ``K`` uses ``f_px`` and
     ``(cx, cy)`` from ``core.conventions`` (recomputed here).
 
     Orthographic cameras get the same ``rvec, tvec`` and an *affine* ``K``:
@@ -95,7 +95,10 @@ def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray
     right, up, forward = camera_basis(camera)
     r_cv = np.stack([right, -up, forward])
     tvec = -r_cv @ np.asarray(camera.position, dtype=np.float64)
-    rvec, _ = _cv2().Rodrigues(r_cv)
+    # R -> rvec with scipy (through a quaternion): cv2.Rodrigues(R) loses up to
+    # ~4e3 eps near 180-degree rotations (measured), which then shows as oracle
+    # error; the other direction (rvec -> R, inside projectPoints) is well conditioned.
+    rvec = Rotation.from_matrix(r_cv).as_rotvec()
     cx, cy = _principal_point(camera.width, camera.height)
     if camera.projection == "perspective":
         f = _focal_px(camera.fov_y_deg, camera.height)
