@@ -140,10 +140,6 @@ def _check_writable(out: Path) -> None:
         raise InputError(f"--out {str(out)!r}: cannot write there ({exc.strerror or exc}): expected a writable directory") from None
 
 
-def _num(x: float) -> float:
-    return float(x)
-
-
 def frame_record(k: int, frame, sidecar: bool) -> dict:
     rng = frame.depth_range
     rec = {

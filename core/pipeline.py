@@ -57,6 +57,8 @@ def render_frame(p_model: np.ndarray, edges: np.ndarray, camera: Camera,
     if visible.any():
         p_px[visible] = cam_to_px(p_cam[visible], camera)          # pixels
     ends_visible = visible[edges[:, 0]] & visible[edges[:, 1]] if len(edges) else np.zeros(0, bool)
+    # Depth is affine along an edge, so near/far leave an edge whole exactly when
+    # both ends are in [near, far]: every other edge is cut or dropped by them.
     clipped_edges = int(len(edges) - ends_visible.sum())
 
     if len(edges):
@@ -72,10 +74,6 @@ def render_frame(p_model: np.ndarray, edges: np.ndarray, camera: Camera,
             seg_cam = p_cam[edges]                                  # camera, (E, 2, 3)
             planes = clipping.frustum_planes(camera)
             kept, t0, t1 = clipping.clip_segments(seg_cam, planes)
-            if clip_mode == "clip":
-                # shortened by near/far (not by the image sides): count those too
-                nf_kept, nf_t0, nf_t1 = clipping.clip_segments(seg_cam, planes[:2])
-                clipped_edges = int(len(edges) - (nf_kept & (nf_t0 == 0) & (nf_t1 == 1)).sum())
             seg_cam = clipping.apply_clip(seg_cam, kept, t0, t1,
                                           (camera.near, camera.far))  # camera, inside the frustum
             seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)  # pixels

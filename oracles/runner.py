@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from core.scene import Scene
+from core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
 from . import metrics, opencv_oracle, tolerances
 from .candidate import CandidateError, call_candidate
@@ -38,13 +39,6 @@ class Tolerances:
     def to_dict(self) -> dict:
         return {"vertex_error_px": self.vertex_px, "min_pixel_f1_1px": self.min_f1_1px,
                 "min_pixel_f1_0px": self.min_f1_0px}
-
-
-@dataclass
-class Motion:
-    turns: tuple = (1.0, 1.0, 0.0)
-    offset: tuple = (0.0, 0.0, 0.0)
-    scale: float = 1.0
 
 
 @dataclass
@@ -79,9 +73,6 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     error = None
     if is_core:
         from core.pipeline import render_frame
-        from core.transforms import Motion as CoreMotion
-
-        core_motion = CoreMotion(turns=tuple(motion.turns), offset=tuple(motion.offset), scale=motion.scale)
     for k in range(1, frames + 1):
         t = (k - 1) / frames
         m = model_matrix(motion.turns, motion.offset, motion.scale, t)
@@ -92,7 +83,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         t0 = time.perf_counter()
         try:
             if is_core:
-                frame = render_frame(scene.vertices, edges, cam, core_motion.frame_matrix(k, frames), "clip")
+                frame = render_frame(scene.vertices, edges, cam, motion.frame_matrix(k, frames), "clip")
                 cand_px, cand_img = frame.p_px, frame.image > 0
             else:
                 cand_px = call_candidate(candidate, p_world, cam)
@@ -204,7 +195,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     from .cases import cameras_for
 
     tol = tol or Tolerances()
-    motion = Motion(turns=tuple(turns))
+    motion = Motion(turns=tuple(float(x) for x in turns))
     records, images, timing_cases = [], {}, []
     t_run = _time.perf_counter()
     renderers = {}

@@ -48,7 +48,7 @@ def naive_depth_range(k, frames, turns=(1.0, 1.0, 0.0), d=4.0):
     ax, ay = 2 * math.pi * t * turns[0], 2 * math.pi * t * turns[1]
     depths = []
     for x, y, z in CUBE:
-        y1, z1 = math.cos(ax) * y - math.sin(ax) * z, math.sin(ax) * y + math.cos(ax) * z
+        z1 = math.sin(ax) * y + math.cos(ax) * z          # only z matters for depth
         z2 = -math.sin(ay) * x + math.cos(ay) * z1
         depths.append(d - z2)
     return min(depths), max(depths)
