@@ -21,7 +21,8 @@ import numpy as np
 from . import output
 from .camera import Camera, camera_z, look_at
 from .errors import InputError
-from .pipeline import CLIP_MODES, render_frame
+from .pipeline import CLIP_MODES, RASTER_MODES, render_frame
+from .projection import DTYPES, localize
 from .scene import Scene, load_scene
 from .transforms import Motion
 
@@ -72,6 +73,10 @@ def build_parser() -> argparse.ArgumentParser:
     mot.add_argument("--scale", type=float, default=1.0)
     p.add_argument("--clip", choices=CLIP_MODES, default="clip",
                    help="clip: clip edges at near/far; endpoint: drop edges with a clipped end")
+    p.add_argument("--dtype", choices=DTYPES, default="float64",
+                   help="precision of every per-point operation (default float64; core/projection.py)")
+    p.add_argument("--raster", choices=RASTER_MODES, default="exact",
+                   help="exact: GL diamond-exit (matches Mesa); fast: integer DDA; aa: anti-aliased (Wu)")
     p.add_argument("--format", default="png", help="comma-separated: png, ascii, gif (default png)")
     p.add_argument("--ascii-cols", type=int, default=80)
     p.add_argument("--out", default="output", help="output directory (default output/)")
@@ -89,6 +94,8 @@ class Settings:
     formats: tuple[str, ...]
     out: Path
     ascii_cols: int
+    dtype: str = "float64"
+    raster: str = "exact"
 
 
 def settings_from_args(a: argparse.Namespace) -> Settings:
@@ -127,7 +134,8 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     _check_writable(out)
     if "png" in formats or "ascii" in formats:
         output.check_replaceable(out / f"{scene.name}-frames", "--out")
-    return Settings(scene, camera, motion, a.frames, a.clip, formats, out, a.ascii_cols)
+    return Settings(scene, camera, motion, a.frames, a.clip, formats, out, a.ascii_cols,
+                    dtype=a.dtype, raster=a.raster)
 
 
 def _check_writable(out: Path) -> None:
@@ -176,11 +184,12 @@ def render_run(s: Settings, log=None, progress=None) -> dict:
     records, gif_images, all_px = [], [], []
     t_start = time.perf_counter()
     render_seconds = 0.0
+    points = localize(s.scene.vertices, s.dtype)      # re-centred and cast once, not per frame
     try:
         for k in range(1, s.frames + 1):
             t0 = time.perf_counter()
-            frame = render_frame(s.scene.vertices, s.scene.edges, s.camera,
-                                 s.motion.frame_matrix(k, s.frames), s.clip)
+            frame = render_frame(points, s.scene.edges, s.camera,
+                                 s.motion.frame_matrix(k, s.frames), s.clip, raster=s.raster)
             render_seconds += time.perf_counter() - t0
             overflow = frame.visible & ~np.isfinite(frame.p_px).all(axis=1)
             if overflow.any():
@@ -218,6 +227,8 @@ def render_run(s: Settings, log=None, progress=None) -> dict:
         "motion": {"turns": list(s.motion.turns), "translate": list(s.motion.offset),
                    "scale": s.motion.scale, "frames": s.frames},
         "clip": s.clip,
+        "dtype": s.dtype,
+        "raster": s.raster,
         "summary": {
             "frames": s.frames,
             "frames_with_clipping": sum(1 for r in records if r["clipped"] or r["clipped_edges"]),
@@ -248,7 +259,7 @@ def summary_text(report: dict, render_seconds: float, wall_seconds: float) -> st
         f"up {[round(v, 6) for v in cam['up']]}",
         f"        fov_y={cam['fov_y_deg']} deg, {cam['width']}x{cam['height']}, near={cam['near']}, far={cam['far']}",
         f"Motion: turns={report['motion']['turns']} translate={report['motion']['translate']} scale={report['motion']['scale']}",
-        f"Clip mode: {report['clip']}",
+        f"Clip mode: {report['clip']}, dtype: {report['dtype']}, raster: {report['raster']}",
         f"Frames: {sm['frames']} ({sm['frames_with_clipping']} with clipping)",
         "Depth over the run: " + ("none visible" if sm["min_depth"] is None
                                   else f"[{sm['min_depth']:.4f}, {sm['max_depth']:.4f}]"),

@@ -60,8 +60,8 @@ def clip_segments(seg_cam: np.ndarray, planes: np.ndarray) -> tuple[np.ndarray, 
     p0 = seg_cam[:, 0, :]
     p1 = seg_cam[:, 1, :]
     m = len(seg_cam)
-    t_enter = np.zeros(m)
-    t_exit = np.ones(m)
+    t_enter = np.zeros(m, dtype=seg_cam.dtype)       # in the run's dtype (float32 or float64)
+    t_exit = np.ones(m, dtype=seg_cam.dtype)
     kept = np.ones(m, dtype=bool)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # inf/NaN are handled below
         for n_x, n_y, n_z, d in planes:
@@ -107,8 +107,8 @@ def clip_to_image(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     with a non-finite end are dropped. Returns ``(kept, q0, q1)``.
     """
     d = p1_px - p0_px
-    t0 = np.zeros(len(d))
-    t1 = np.ones(len(d))
+    t0 = np.zeros(len(d), dtype=d.dtype)
+    t1 = np.ones(len(d), dtype=d.dtype)
     kept = np.all(np.isfinite(p0_px), axis=1) & np.all(np.isfinite(p1_px), axis=1)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for axis, lo, hi in ((0, -0.5, width - 0.5), (1, -0.5, height - 0.5)):

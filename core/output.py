@@ -57,7 +57,7 @@ def png_bytes(image: np.ndarray) -> bytes:
 
 
 def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
-    """A text picture: '#' where any pixel of a character cell is drawn, '.' elsewhere.
+    """A text picture: '#' where any pixel of a character cell is drawn (>= 128), '.' elsewhere.
 
     Character cells are about twice as tall as wide, so a cell covers
     ``W / cols`` pixels across and twice that down.
@@ -67,7 +67,7 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
     rows = max(1, min(h, int(round(cols * h / w / 2.0))))
     c_edges = (np.arange(cols) * w) // cols
     r_edges = (np.arange(rows) * h) // rows
-    on = (image > 0).astype(np.int32)
+    on = (image >= 128).astype(np.int32)         # drawn: 255, or aa coverage >= 1/2
     cells = np.add.reduceat(np.add.reduceat(on, r_edges, axis=0), c_edges, axis=1) > 0
     lines = ["".join("#" if v else "." for v in row) for row in cells]
     return "\n".join(lines) + "\n"
