@@ -69,9 +69,19 @@ class Motion:
         """``T @ Rz @ Ry @ Rx @ S`` at time ``t`` in [0, 1); computed, never accumulated."""
         # Reduce whole turns before converting to radians, so that a whole number
         # of turns gives angle 0 exactly (sin(2*pi) is -2.4e-16, not 0).
-        ax, ay, az = (2.0 * math.pi * ((t * float(k)) % 1.0) for k in self.turns)
-        return compose(translate(self.offset), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale))
+        return self._matrix(tuple((t * float(k)) % 1.0 for k in self.turns))
 
     def frame_matrix(self, frame: int, frames: int) -> np.ndarray:
-        """Model matrix of 1-based ``frame`` out of ``frames``: t = (frame - 1) / frames."""
-        return self.model_matrix((frame - 1) / frames)
+        """Model matrix of 1-based ``frame`` out of ``frames``: t = (frame - 1) / frames.
+
+        The phase (fraction of a turn) is ``((frame - 1) * turns mod frames) / frames``:
+        the product and the ``fmod`` are exact in float64 for integer turns (and
+        any turns with few enough mantissa bits) up to 2^53, so a frame and the
+        frame one period later get bit-identical matrices, however many frames.
+        """
+        n = float(frames)
+        return self._matrix(tuple(math.fmod((frame - 1) * float(k), n) % n / n for k in self.turns))
+
+    def _matrix(self, phases) -> np.ndarray:
+        ax, ay, az = (2.0 * math.pi * p for p in phases)
+        return compose(translate(self.offset), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale))

@@ -101,7 +101,21 @@ def test_frame_one_is_rest_pose_identity():
 @pytest.mark.parametrize("k", [1, 2, 45, 90, 91, 179, 180])
 def test_frame_k_of_n_uses_t_equals_k_minus_1_over_n(k):
     m = Motion(turns=(1.0, 2.0, 0.5), offset=(1.0, 0.0, -2.0), scale=1.5)
-    assert_array_equal(m.frame_matrix(k, 180), m.model_matrix((k - 1) / 180))
+    # frame_matrix reduces the phase exactly ((k-1)*turns mod n, then / n) where
+    # model_matrix rounds t = (k-1)/n first: phases differ by at most 1 ulp of a
+    # value < 1 (eps), angles by 2*pi*eps, so entries (rotation x scale 1.5) by
+    # <= 2*pi*eps*1.5 per factor; 3 rotation factors: bound 3 * 2*pi*1.5 * eps.
+    bound = 3 * 2 * np.pi * 1.5 * np.finfo(float).eps
+    np.testing.assert_allclose(m.frame_matrix(k, 180), m.model_matrix((k - 1) / 180), rtol=0, atol=bound)
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 999, 123_457, 998_001])
+def test_frame_and_frame_one_period_later_are_bit_identical_over_a_million_frames(k):
+    # 1000 turns over 1,000,000 frames: a period of 1000 frames. The phase is
+    # exact integer arithmetic in float64 ((k-1)*1000 mod 1e6 < 2^53), so the
+    # matrices must match to the bit, with no accumulation.
+    m = Motion(turns=(1000.0, 1000.0, 250.0))
+    assert_array_equal(m.frame_matrix(k, 1_000_000), m.frame_matrix(k + 1000, 1_000_000))
 
 
 @pytest.mark.parametrize("turns,frames,k", [((2, 2, 0), 180, 91), ((3, 0, 0), 3, 2), ((6, 3, 0), 180, 61),
