@@ -111,11 +111,13 @@ def test_frame_k_of_n_uses_t_equals_k_minus_1_over_n(k):
 
 @pytest.mark.parametrize("k", [1, 2, 3, 999, 123_457, 998_001])
 def test_frame_and_frame_one_period_later_are_bit_identical_over_a_million_frames(k):
-    # 1000 turns over 1,000,000 frames: a period of 1000 frames. The phase is
-    # exact integer arithmetic in float64 ((k-1)*1000 mod 1e6 < 2^53), so the
-    # matrices must match to the bit, with no accumulation.
-    m = Motion(turns=(1000.0, 1000.0, 250.0))
-    assert_array_equal(m.frame_matrix(k, 1_000_000), m.frame_matrix(k + 1000, 1_000_000))
+    # 1000, 3000 and 500 turns over 1,000,000 frames: every axis repeats after
+    # 2000 frames (2000 * 500 = 1e6). The phase is exact integer arithmetic in
+    # float64 ((k-1)*turns < 2^53, fmod exact), so the matrices must match to the
+    # bit, with no accumulation; half a period later (z at half a turn) they must not.
+    m = Motion(turns=(1000.0, 3000.0, 500.0))
+    assert_array_equal(m.frame_matrix(k, 1_000_000), m.frame_matrix(k + 2000, 1_000_000))
+    assert not np.array_equal(m.frame_matrix(k, 1_000_000), m.frame_matrix(k + 1000, 1_000_000))
 
 
 @pytest.mark.parametrize("turns,frames,k", [((2, 2, 0), 180, 91), ((3, 0, 0), 3, 2), ((6, 3, 0), 180, 61),
