@@ -1,10 +1,12 @@
 """Line rasterization in numpy: segments in pixel space to pixel indices.
 
-Rasterizing is separate from painting: :func:`line_pixels` returns index
-arrays ``rr, cc`` and the caller writes ``img[rr, cc] = value``.
+Rasterizing is separate from painting: the ``line_*`` functions return index
+arrays ``rr, cc`` (and, for "aa", weights) and the caller writes the image.
+Pixel convention (core.conventions): integer coordinates are pixel centres,
+x right = columns, y down = rows. Three modes, :data:`RASTER_MODES`:
 
-The rule is OpenGL's *diamond-exit* rule for 1-pixel lines, written in our
-pixel convention (integer coordinates are pixel centres, core.conventions):
+``"exact"`` (:func:`line_pixels`) is OpenGL's *diamond-exit* rule for 1-pixel
+lines, as Mesa's llvmpipe implements it:
 
 1. End points are first snapped to 1/256 px, the sub-pixel precision of
    Mesa's llvmpipe (``FIXED_ORDER = 8``), so that near-ties break as it does.
@@ -24,17 +26,63 @@ Against Mesa llvmpipe (via pyrender/OSMesa) this reproduces random segments
 pixel for pixel in ~99 % of cases; the rest differ by one pixel at an end or
 at a tie (README, "Pixel agreement").
 
+``"fast"`` (:func:`line_pixels_fast`) is integer DDA (Bresenham's line; the
+pixels of ``cv2.line(..., LINE_8)`` except at ties, which OpenCV breaks
+toward the end with the smaller x). Both ends are rounded to the nearest pixel
+centre with ``floor(v + 1/2)`` (halves toward +x / +y: unlike round-half-even
+or half-away-from-zero this commutes with whole-pixel shifts). Between the
+rounded ends ``(x0, y0)``, ``(x1, y1)`` the major axis is x when
+``|x1 - x0| > |y1 - y0|``, else y; the line steps every integer major
+coordinate from one end to the other, both ends included
+(``max(|dx|, |dy|) + 1`` pixels, 8-connected; a zero-length segment draws its
+one pixel), and takes the pixel nearest the exact minor coordinate there,
+computed in integers: after ``k`` of ``n`` steps ``b = b0 + k db / n`` and the
+pixel is ``b0 + floor((2 k db + n) / (2 n))`` when y is minor (halves to +y)
+and ``b0 - floor((n - 2 k db) / (2 n))`` when x is minor (halves to -x): the
+tie rule of "exact". The rule depends on the point ``(i, b)`` only, so a
+reversed segment draws the same pixels.
+
+``"aa"`` (:func:`line_coverage_aa`, painted with :func:`paint_aa`) is Xiaolin
+Wu's anti-aliased line. Major axis as in "exact", ends not snapped or rounded.
+For every integer major coordinate ``i`` whose pixel interval
+``[i - 1/2, i + 1/2]`` overlaps the segment's major extent ``[a_lo, a_hi]``,
+let ``g`` be the overlap length (1 inside, Wu's end gap at the end pixels:
+the fraction of the end pixel the segment covers along the major axis) and
+``b`` the minor coordinate of the segment's line at ``i``; the two pixels
+``floor(b)`` and ``floor(b) + 1`` get weights ``(1 - f) g`` and ``f g`` with
+``f = b - floor(b)``. Zero weights are dropped, so a zero-length segment draws
+nothing, and a segment's weights add up to its major extent ``a_hi - a_lo``.
+:func:`paint_aa` adds coverage over segments, clips it to 1 and scales it to
+0..255 with ``floor(255 c + 1/2)``; a pixel counts as *drawn* (for
+comparisons with binary images) when its value is >= 128, i.e. its coverage is
+>= 1/2. Within a segment's interior the nearer of the two pixels has weight
+``max(1 - f, f) >= 1/2`` and the other ``<= 1/2``, so the thresholded line is
+the nearest-pixel DDA line of the *unrounded* segment (both pixels at an exact
+tie ``f = 1/2``); at the end pixels ``g < 1`` may drop it.
+
 >>> import numpy as np
 >>> rr, cc = line_pixels(np.array([[0.0, 0.0]]), np.array([[4.0, 2.0]]), 5, 3)
 >>> img = np.zeros((3, 5), dtype=int); img[rr, cc] = 1; img
 array([[1, 0, 0, 0, 0],
        [0, 1, 1, 0, 0],
        [0, 0, 0, 1, 0]])
+>>> rr, cc = line_pixels_fast(np.array([[0.0, 0.0]]), np.array([[4.0, 2.0]]), 5, 3)
+>>> img = np.zeros((3, 5), dtype=int); img[rr, cc] = 1; img
+array([[1, 0, 0, 0, 0],
+       [0, 1, 1, 0, 0],
+       [0, 0, 0, 1, 1]])
+>>> rr, cc, w = line_coverage_aa(np.array([[0.0, 0.0]]), np.array([[4.0, 1.0]]), 5, 2)
+>>> paint_aa(rr, cc, w, 5, 2)     # end pixels half covered; 191 = 0.75 * 255, 64 = 0.25 * 255
+array([[128, 191, 128,  64,   0],
+       [  0,  64, 128, 191, 128]], dtype=uint8)
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+#: The rasterization rules (module docstring): OpenGL diamond-exit, integer DDA, Wu anti-aliased.
+RASTER_MODES = ("exact", "fast", "aa")
 
 #: Sub-pixel grid (1/256 px): llvmpipe's fixed-point precision for vertex positions.
 SUBPIXEL = 256.0
@@ -127,3 +175,165 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     if inside.all():                                   # the usual case: skip two gathers
         return rr, cc
     return rr[inside], cc[inside]
+
+
+def _as_ends(p0_px, p1_px) -> tuple[np.ndarray, np.ndarray]:
+    return (np.asarray(p0_px, dtype=np.float64).reshape(-1, 2),
+            np.asarray(p1_px, dtype=np.float64).reshape(-1, 2))
+
+
+def _batched(fn, p0: np.ndarray, p1: np.ndarray, width: int, height: int) -> tuple:
+    """``fn`` over batches of :data:`CHUNK_SEGMENTS` segments, results concatenated."""
+    if len(p0) <= CHUNK_SEGMENTS:
+        return fn(p0, p1, width, height)
+    parts = [fn(p0[k:k + CHUNK_SEGMENTS], p1[k:k + CHUNK_SEGMENTS], width, height)
+             for k in range(0, len(p0), CHUNK_SEGMENTS)]
+    return tuple(np.concatenate(arrays) for arrays in zip(*parts))
+
+
+def _keep_inside(rr: np.ndarray, cc: np.ndarray, width: int, height: int, *extra: np.ndarray) -> tuple:
+    inside = (cc >= 0) & (cc < width) & (rr >= 0) & (rr < height)
+    if inside.all():                                   # the usual case: skip the gathers
+        return (rr, cc) + extra
+    return (rr[inside], cc[inside]) + tuple(e[inside] for e in extra)
+
+
+def line_pixels_fast(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Pixels of ``M`` segments by integer DDA (raster mode "fast", module docstring).
+
+    Ends are rounded to pixel centres with ``floor(v + 1/2)``; the line between
+    them is 8-connected and includes both ends: ``max(|dx|, |dy|) + 1`` pixels
+    of the rounded ends, each the nearest to the exact minor coordinate (ties
+    to +y when y is minor, to -x when x is minor, as in "exact"). Same
+    parameters and return values as :func:`line_pixels`; pixels outside the
+    image are dropped.
+    """
+    p0, p1 = _as_ends(p0_px, p1_px)
+    if len(p0) == 0:
+        empty = np.zeros(0, dtype=np.intp)
+        return empty, empty
+    return _batched(_line_pixels_fast, _round_half_up(p0), _round_half_up(p1), width, height)
+
+
+def _round_half_up(v: np.ndarray) -> np.ndarray:
+    """``floor(v + 1/2)`` as int64, exactly: ``v + 0.5`` itself can round up (0.49999999999999994 + 0.5 == 1.0)."""
+    r = np.floor(v)
+    return (r + (v - r >= 0.5)).astype(np.int64)           # v - floor(v) is exact
+
+
+def _line_pixels_fast(q0: np.ndarray, q1: np.ndarray, width: int, height: int
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`line_pixels_fast` of a non-empty batch of rounded (int64) end points."""
+    d = q1 - q0
+    x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
+    n = np.maximum(np.abs(d[:, 0]), np.abs(d[:, 1]))     # steps; n + 1 pixels
+    # After k steps: major = a0 + s k, minor = b0 + t q(k) with
+    #   q(k) = floor((2 k db' + n) / (2 n)),
+    # x-major: db' = dy, t = +1 (floor(b + 1/2): halves to +y);
+    # y-major: db' = -dx, t = -1 (ceil(b - 1/2) = b0 - floor((n - 2 k dx) / (2 n)): halves to -x).
+    # Written per axis, with no per-pixel select:
+    #   x = x0 + kx k + mx q,   y = y0 + ky k + my q.
+    sgn = np.sign(d)
+    kx = np.where(x_major, sgn[:, 0], 0)
+    ky = np.where(x_major, 0, sgn[:, 1])
+    mx = np.where(x_major, 0, -1)
+    my = np.where(x_major, 1, 0)
+    two_db = 2 * np.where(x_major, d[:, 1], -d[:, 0])
+    two_n = 2 * np.maximum(n, 1)                          # n = 0: k = 0 only, q = 0
+    count = n + 1
+    k = np.arange(int(count.sum()), dtype=np.int64) - np.repeat(np.cumsum(count) - count, count)
+    q = (k * np.repeat(two_db, count) + np.repeat(n, count)) // np.repeat(two_n, count)
+    cc = np.repeat(q0[:, 0], count) + np.repeat(kx, count) * k + np.repeat(mx, count) * q
+    rr = np.repeat(q0[:, 1], count) + np.repeat(ky, count) * k + np.repeat(my, count) * q
+    return _keep_inside(rr.astype(np.intp, copy=False), cc.astype(np.intp, copy=False), width, height)
+
+
+def line_coverage_aa(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Anti-aliased coverage of ``M`` segments, Xiaolin Wu's rule (raster mode "aa").
+
+    At each integer major coordinate ``i`` the segment reaches, the pixels
+    ``floor(b)`` and ``floor(b) + 1`` either side of the line's minor
+    coordinate ``b`` there get ``(1 - f) g`` and ``f g``, ``f = b - floor(b)``,
+    where ``g`` is the length of ``[i - 1/2, i + 1/2]`` the segment covers along
+    the major axis (1 except at the two end pixels). See the module docstring.
+
+    Parameters
+    ----------
+    p0_px, p1_px : (M, 2) ndarray of float
+        Segment ends ``[x, y]`` in pixel coordinates, not rounded or snapped.
+    width, height : int
+        Image size; pixels outside it are dropped.
+
+    Returns
+    -------
+    rr, cc : (K,) ndarray of intp
+        Row and column of each covered pixel; a pixel appears at most once per
+        segment but may repeat across segments (:func:`paint_aa` adds them).
+    weight : (K,) ndarray of float64
+        Coverage in (0, 1].
+    """
+    p0, p1 = _as_ends(p0_px, p1_px)
+    if len(p0) == 0:
+        empty = np.zeros(0, dtype=np.intp)
+        return empty, empty, np.zeros(0, dtype=np.float64)
+    return _batched(_line_coverage_aa, p0, p1, width, height)
+
+
+def _line_coverage_aa(p0: np.ndarray, p1: np.ndarray, width: int, height: int
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`line_coverage_aa` of a non-empty batch."""
+    d = p1 - p0
+    x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
+    a0 = np.where(x_major, p0[:, 0], p0[:, 1])
+    a1 = np.where(x_major, p1[:, 0], p1[:, 1])
+    b0 = np.where(x_major, p0[:, 1], p0[:, 0])
+    b1 = np.where(x_major, p1[:, 1], p1[:, 0])
+    # Work from the end with the smaller major coordinate, so that a reversed
+    # segment runs the same float operations and gets the same weights.
+    swap = a1 < a0
+    a_lo, a_hi = np.where(swap, a1, a0), np.where(swap, a0, a1)
+    b_lo, b_hi = np.where(swap, b1, b0), np.where(swap, b0, b1)
+    da = a_hi - a_lo
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.where(da > 0, (b_hi - b_lo) / da, 0.0)    # |slope| <= 1
+    # pixels lo..hi: those whose interval [i - 1/2, i + 1/2] overlaps [a_lo, a_hi]
+    # in more than a point (an end on a pixel boundary does not reach past it)
+    lo = _round_half_up(a_lo)                  # floor(a_lo + 1/2)
+    hi = -_round_half_up(-a_hi)                # ceil(a_hi - 1/2)
+    count = np.maximum(hi - lo + 1, 0)
+    seg = np.repeat(np.arange(len(count)), count)
+    i = lo[seg] + (np.arange(int(count.sum()), dtype=np.int64) - np.repeat(np.cumsum(count) - count, count))
+    fi = i.astype(np.float64)
+    al, ah = a_lo[seg], a_hi[seg]
+    g = np.minimum(ah, fi + 0.5) - np.maximum(al, fi - 0.5)   # 1 exactly inside: (i + 1/2) - (i - 1/2)
+    b = b_lo[seg] + (fi - al) * slope[seg]                    # the line's minor coordinate at i
+    jf = np.floor(b)
+    f = b - jf                                                # exact (the fraction bits of b)
+    # the pair (floor(b), floor(b) + 1) of each major step, side by side
+    major = np.repeat(i, 2)
+    minor = np.stack([jf, jf + 1.0], axis=1).ravel().astype(np.int64)
+    weight = np.stack([(1.0 - f) * g, f * g], axis=1).ravel()
+    xm = np.repeat(x_major[seg], 2)
+    cc = np.where(xm, major, minor).astype(np.intp, copy=False)
+    rr = np.where(xm, minor, major).astype(np.intp, copy=False)
+    keep = weight > 0
+    if not keep.all():
+        rr, cc, weight = rr[keep], cc[keep], weight[keep]
+    return _keep_inside(rr, cc, width, height, weight)
+
+
+def paint_aa(rr: np.ndarray, cc: np.ndarray, weight: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Accumulate coverage into an ``(height, width)`` uint8 image.
+
+    Coverage is summed per pixel (``np.bincount``), clipped to [0, 1] and
+    scaled with ``floor(255 c + 1/2)`` (halves up; deterministic). A pixel is
+    *drawn*, for comparisons with binary images, when its value is >= 128,
+    which is exactly coverage >= 1/2 (``255 c + 1/2 >= 128  <=>  c >= 1/2``).
+    """
+    rr = np.asarray(rr, dtype=np.intp)
+    cc = np.asarray(cc, dtype=np.intp)
+    acc = np.bincount(rr * width + cc, weights=np.asarray(weight, dtype=np.float64),
+                      minlength=width * height)
+    return np.floor(np.clip(acc, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8).reshape(height, width)
