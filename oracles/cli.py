@@ -2,6 +2,12 @@
 
 Exit status: 0 when every case is within tolerance, 1 when any case fails,
 2 on usage or input errors (including libOSMesa missing when pyrender is asked for).
+
+``--level vertices`` runs the OpenCV vertex check only (no drawing, no
+pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
+``--oracles opencv`` / ``--oracles opencv,pyrender`` is the older spelling of
+the same two levels. ``--every K`` checks frames 1, 1+K, ... of the motion;
+``--jobs N`` runs the cases in N worker processes (same report as one).
 """
 
 from __future__ import annotations
@@ -11,6 +17,7 @@ import math
 import os
 import re
 import sys
+from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -21,10 +28,12 @@ from core.scene import builtin_names, load_scene
 from . import tolerances
 from .candidate import load_candidate
 from .cases import CASE_NAMES
-from .report import console_table, write_report
-from .runner import CoreCandidate, Tolerances, run_crosscheck
+from .report import console_table, timing_line, write_report
+from .runner import LEVELS, CoreCandidate, Tolerances, level_for_oracles, run_crosscheck
 
 ORACLES = ("opencv", "pyrender")
+#: Options that configure the core candidate, with their defaults.
+CORE_OPTIONS = {"dtype": "float64", "clip": "clip", "raster": "exact"}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -40,7 +49,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)}")
     p.add_argument("--candidate", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
                    help="the projector to judge (default: core/)")
-    p.add_argument("--oracles", default="opencv,pyrender", help="comma-separated: opencv, pyrender")
+    p.add_argument("--level", choices=LEVELS, default=None,
+                   help="vertices: OpenCV vertex check only (no drawing, no pyrender); "
+                        "pixels: vertices and pyrender pixels (default)")
+    p.add_argument("--oracles", default=None,
+                   help="older spelling of --level: 'opencv' = vertices, 'opencv,pyrender' = pixels")
+    p.add_argument("--every", type=int, default=1, metavar="K",
+                   help="check frames 1, 1+K, 1+2K, ... of the motion (default 1: every frame)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="run the cases in N worker processes (default 1; same report for any N)")
+    p.add_argument("--dtype", choices=CoreCandidate.DTYPES, default=None,
+                   help="core candidate only: floating-point type of the pipeline (default float64)")
+    p.add_argument("--clip", choices=CoreCandidate.CLIPS, default=None,
+                   help="core candidate only: near/far handling of edges (default clip)")
+    p.add_argument("--raster", choices=CoreCandidate.RASTERS, default=None,
+                   help="core candidate only: line rasterizer (default exact; aa: drawn where >= 128)")
     p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
     p.add_argument("--tol-px", type=float, default=tolerances.VERTEX_TOL_PX,
                    help=f"max vertex error in px (default {tolerances.VERTEX_TOL_PX})")
@@ -61,11 +84,26 @@ def _parse(args):
     for opt, v in (("--min-f1", args.min_f1), ("--min-f1-0px", args.min_f1_0px)):
         if not 0.0 <= v <= 1.0:
             raise InputError(f"{opt} {v}: expected a number in [0, 1]")
-    oracles = [o.strip() for o in args.oracles.split(",") if o.strip()]
-    if not oracles or any(o not in ORACLES for o in oracles):
-        raise InputError(f"--oracles {args.oracles!r}: expected a comma-separated list of {', '.join(ORACLES)}")
-    if "opencv" not in oracles:
-        raise InputError(f"--oracles {args.oracles!r}: expected opencv among them (vertices are always checked)")
+    if args.every < 1:
+        raise InputError(f"--every {args.every}: expected an integer >= 1")
+    if args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs}: expected an integer >= 1")
+    level = args.level or "pixels"
+    if args.oracles is not None:
+        oracles = [o.strip() for o in args.oracles.split(",") if o.strip()]
+        if not oracles or any(o not in ORACLES for o in oracles):
+            raise InputError(f"--oracles {args.oracles!r}: expected a comma-separated list of {', '.join(ORACLES)}")
+        if "opencv" not in oracles:
+            raise InputError(f"--oracles {args.oracles!r}: expected opencv among them (vertices are always checked)")
+        implied = level_for_oracles(oracles)
+        if args.level is not None and args.level != implied:
+            raise InputError(f"--oracles {args.oracles!r} means --level {implied}, which contradicts "
+                             f"--level {args.level}: give only --level")
+        level = implied
+    core_given = [f"--{k}" for k in CORE_OPTIONS if getattr(args, k) is not None]
+    if args.candidate and core_given:
+        raise InputError(f"{', '.join(core_given)}: settings of the core candidate, not of --candidate "
+                         f"{args.candidate!r}: expected them without --candidate")
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
     bad = [c for c in cases if c not in CASE_NAMES]
     if bad or not cases:
@@ -78,23 +116,31 @@ def _parse(args):
         raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
     names = args.scene or builtin_names()
     scenes = [load_scene(n) for n in names]
-    candidate = load_candidate(args.candidate) if args.candidate else CoreCandidate()
-    return oracles, cases, spin, scenes, candidate
+    if args.candidate:
+        candidate = load_candidate(args.candidate)
+    else:
+        candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
+        missing = candidate.unsupported()
+        if missing:
+            raise InputError(", ".join(f"--{k} {getattr(candidate, k)}" for k in missing)
+                             + ": this core's render_frame takes no " + ", ".join(repr(k) for k in missing)
+                             + " keyword yet; expected the default")
+    return level, cases, spin, scenes, candidate
 
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        oracles, case_names, spin, scenes, candidate = _parse(args)
+        level, case_names, spin, scenes, candidate = _parse(args)
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
         return 2
-    if "pyrender" in oracles:
+    if level == "pixels":
         from .pyrender_oracle import osmesa_available
 
         ok, message = osmesa_available()
         if not ok:
-            print(f"crosscheck: error: {message} (or run with --oracles opencv)", file=sys.stderr)
+            print(f"crosscheck: error: {message} (or run with --level vertices)", file=sys.stderr)
             return 2
     if args.report_dir:
         run_dir = Path(args.report_dir)
@@ -121,10 +167,13 @@ def main(argv=None) -> int:
     tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
     try:
         report, images = run_crosscheck(scenes, candidate, frames=args.frames, case_names=case_names,
-                                        oracles=oracles, turns=spin, tol=tol,
-                                        candidate_name=args.candidate or "core")
+                                        level=level, turns=spin, tol=tol, every=args.every, jobs=args.jobs,
+                                        candidate_name=args.candidate or "core", candidate_spec=args.candidate)
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenProcessPool as exc:
+        print(f"crosscheck: error: a worker process died ({exc}); try --jobs 1", file=sys.stderr)
         return 2
     records = report["cases"]
     failed = report["summary"]["failed"]
@@ -142,6 +191,7 @@ def main(argv=None) -> int:
     s = report["summary"]
     print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance "
           f"(vertex <= {tol.vertex_px:g} px, F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px})")
+    print(timing_line(report))
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
     return 1 if failed else 0
 

@@ -2,7 +2,9 @@
 
 The run directory is filled under a temporary name and renamed at the end,
 so a directory called ``reports/<run>`` is always complete. Timings live only
-under the top-level ``"timing"`` key; everything else is deterministic.
+under the top-level ``"timing"`` key of report.json and in report.html;
+everything else, report.md included, is deterministic (the same for any
+``--jobs``).
 """
 
 from __future__ import annotations
@@ -74,11 +76,66 @@ def console_table(cases: list[dict]) -> str:
     return "\n".join(lines)
 
 
+LEVEL_TEXT = {
+    "vertices": "the candidate's vertex pixels against OpenCV only (nothing drawn, no pyrender)",
+    "pixels": "vertex pixels against OpenCV, and drawn frames against pyrender/OSMesa",
+}
+
+
+def level_text(report: dict) -> str:
+    level = report.get("level", "pixels")
+    return f"{level} ({LEVEL_TEXT[level]})" if level in LEVEL_TEXT else str(level)
+
+
+def frames_text(report: dict) -> str:
+    frames, every = report["frames"], report.get("every", 1)
+    if every == 1:
+        return f"all {frames} frames of the motion"
+    checked = list(range(1, frames + 1, every))
+    shown = ", ".join(map(str, checked)) if len(checked) <= 4 else ", ".join(map(str, checked[:3])) + ", ..."
+    return f"{len(checked)} of {frames} frames of the motion (frames {shown}: every {every})"
+
+
+def settings_text(report: dict) -> str:
+    settings = report.get("candidate_settings")
+    return ", ".join(f"{k} = {v}" for k, v in settings.items()) if settings else ""
+
+
+def _fmt_ms(v) -> str:
+    return "-" if v is None else f"{v:.3g}"
+
+
+def timing_rows(report: dict) -> list[list[str]]:
+    """Rows of ``[scene, camera, vertex stage ms/frame, pixel stage ms/frame]``, then the overall row."""
+    timing = report.get("timing") or {}
+    rows = [[t["scene"], t["camera"], _fmt_ms(t.get("vertex_stage_ms_per_frame")),
+             _fmt_ms(t.get("pixel_stage_ms_per_frame"))] for t in timing.get("cases", [])]
+    rows.append(["all cases", "", _fmt_ms(timing.get("vertex_stage_ms_per_frame")),
+                 _fmt_ms(timing.get("pixel_stage_ms_per_frame"))])
+    return rows
+
+
+TIMING_HEADER = ["scene", "camera", "vertex stage (ms/frame)", "pixel stage (ms/frame)"]
+
+
+def timing_line(report: dict) -> str:
+    """One console line: each level's time per frame, jobs and wall time."""
+    t = report.get("timing") or {}
+    parts = [f"vertex stage {_fmt_ms(t.get('vertex_stage_ms_per_frame'))} ms/frame"]
+    if t.get("pixel_stage_ms_per_frame") is not None:
+        parts.append(f"pixel stage {_fmt_ms(t.get('pixel_stage_ms_per_frame'))} ms/frame")
+    return (f"Level {report.get('level', 'pixels')}: " + ", ".join(parts)
+            + f" ({t.get('jobs', 1)} job(s), {t.get('wall_s', 0.0):.1f} s wall)")
+
+
 def markdown(report: dict) -> str:
     s = report["summary"]
+    settings = settings_text(report)
     out = [f"# crosscheck report: {report['verdict'].upper()}", "",
-           f"Candidate: `{report['candidate']}`. Oracles: {', '.join(report['oracles'])}. "
+           f"Candidate: `{report['candidate']}`" + (f" ({settings})" if settings else "")
+           + f". Oracles: {', '.join(report['oracles'])}. "
            f"Cases: {s['cases']} ({s['passed']} pass, {s['failed']} fail).", "",
+           f"Level: {level_text(report)}. Checked: {frames_text(report)}.", "",
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
            "| " + " | ".join(HEADER) + " |", "|" + "---|" * len(HEADER)]
     for r in table_rows(report["cases"]):
@@ -92,7 +149,9 @@ def markdown(report: dict) -> str:
         if names:
             out += ["", "## What to check", ""]
             out += [f"- `{n}`: {FAULT_HINTS[n]}" for n in names]
-    out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames: `report.html`.", ""]
+    out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames, and the time per frame "
+            "of each stage (vertex, pixel) per case: `report.html` (and `\"timing\"` in `report.json`; "
+            "timings are kept out of this file so that it is the same on every run).", ""]
     return "\n".join(out)
 
 
@@ -112,7 +171,10 @@ def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
         ".chip{background:#000;padding:1px 6px;border-radius:3px}"
         ".fail{color:#b00}.pass{color:#070}section{margin:0 0 2em 0}</style></head><body>",
         f"<h1>crosscheck: <span class='{e(report['verdict'])}'>{e(report['verdict'].upper())}</span></h1>",
-        f"<p>Candidate <code>{e(report['candidate'])}</code>; oracles {e(', '.join(report['oracles']))}.</p>",
+        f"<p>Candidate <code>{e(report['candidate'])}</code>"
+        + (f" ({e(settings_text(report))})" if settings_text(report) else "")
+        + f"; oracles {e(', '.join(report['oracles']))}.</p>",
+        f"<p>Level {e(level_text(report))}. Checked: {e(frames_text(report))}.</p>",
         "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in HEADER) + "</tr>" + rows + "</table>",
     ]
     failing = [c for c in report["cases"] if c["verdict"] != "pass"]
@@ -124,10 +186,22 @@ def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
     if names:
         parts.append("<h2>What to check</h2><ul>" + "".join(
             f"<li><code>{e(n)}</code>: {e(FAULT_HINTS[n])}</li>" for n in names) + "</ul>")
-    parts += [
-        f"<h2>Worst frames</h2><p>Each row: the candidate's frame, the oracle's (pyrender), and their diff: "
-        f"{legend}. Click an image for full size.</p>",
-    ]
+    timing = report.get("timing") or {}
+    if timing:
+        trows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in timing_rows(report))
+        parts.append(
+            "<h2>Time per frame</h2><p>Vertex stage: the candidate's projection and OpenCV; pixel stage: the "
+            "candidate's drawing, pyrender and the pixel metrics"
+            + (" (not run at level vertices)" if report.get("level") == "vertices" else "")
+            + f". {e(str(timing.get('jobs', 1)))} job(s), {timing.get('wall_s', 0.0):.2f} s wall.</p>"
+            "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in TIMING_HEADER) + "</tr>" + trows + "</table>")
+    if report.get("level") == "vertices":
+        parts.append("<h2>Worst frames</h2><p>None: nothing is drawn at level vertices "
+                     "(run with <code>--level pixels</code> to compare frames).</p>")
+    else:
+        parts.append(
+            f"<h2>Worst frames</h2><p>Each row: the candidate's frame, the oracle's (pyrender), and their diff: "
+            f"{legend}. Click an image for full size.</p>")
     for case, stem in shown:
         figs = "".join(
             f"<figure><figcaption>{label}</figcaption><a href='img/{stem}-{kind}.png'>"
