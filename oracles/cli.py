@@ -8,6 +8,12 @@ pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
 ``--oracles opencv`` / ``--oracles opencv,pyrender`` is the older spelling of
 the same two levels. ``--every K`` checks frames 1, 1+K, ... of the motion;
 ``--jobs N`` runs the cases in N worker processes (same report as one).
+
+``--sweep`` runs every core setting (dtype x clip x raster) on the scenes and
+a large mesh and writes a table and a Pareto plot (oracles/sweep.py); it
+exits 1 only when the default setting is out of tolerance. ``--suite
+extremes`` runs the numerical-extremes suite (oracles/extremes.py) and exits
+1 when any case exceeds its derived bound.
 """
 
 from __future__ import annotations
@@ -45,7 +51,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0])
     p.add_argument("--scene", action="append", default=None,
                    help="scene name or path; repeatable (default: every scene in scenes/)")
-    p.add_argument("--frames", type=int, default=24, help="frames of the scene's motion per case (default 24)")
+    p.add_argument("--frames", type=int, default=None,
+                   help="frames of the scene's motion per case (default 24; 12 with --sweep)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)}")
     p.add_argument("--candidate", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
                    help="the projector to judge (default: core/)")
@@ -71,12 +78,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"min edge-pixel F1 at 1 px (default {tolerances.MIN_F1_1PX})")
     p.add_argument("--min-f1-0px", type=float, default=tolerances.MIN_F1_0PX,
                    help=f"min edge-pixel F1 at 0 px (default {tolerances.MIN_F1_0PX})")
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--sweep", action="store_true",
+                      help="every --dtype x --clip x --raster setting of core on the scenes and a large mesh: "
+                           "table and Pareto plot of time per frame against accuracy")
+    mode.add_argument("--suite", choices=("extremes",), default=None,
+                      help="extremes: near plane, tiny/huge FOV, extreme aspect, far from the origin, "
+                           "1,000,000-frame periodicity, degenerate and non-finite inputs")
     p.add_argument("--report-dir", default=None, help="where to write the report (default reports/<run>)")
     p.add_argument("--run", default=None, help="run name under reports/ (default: UTC time)")
     return p
 
 
 def _parse(args):
+    if args.frames is None:
+        args.frames = 12 if args.sweep else 24
     if args.frames < 1:
         raise InputError(f"--frames {args.frames}: expected an integer >= 1")
     if not (math.isfinite(args.tol_px) and args.tol_px >= 0):
@@ -101,6 +117,10 @@ def _parse(args):
                              f"--level {args.level}: give only --level")
         level = implied
     core_given = [f"--{k}" for k in CORE_OPTIONS if getattr(args, k) is not None]
+    if (args.sweep or args.suite) and (core_given or args.candidate):
+        what = "--sweep" if args.sweep else f"--suite {args.suite}"
+        raise InputError(f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
+                         "itself; expected neither --candidate nor --dtype/--clip/--raster")
     if args.candidate and core_given:
         raise InputError(f"{', '.join(core_given)}: settings of the core candidate, not of --candidate "
                          f"{args.candidate!r}: expected them without --candidate")
@@ -165,6 +185,10 @@ def main(argv=None) -> int:
         return 2
 
     tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
+    if args.sweep:
+        return _sweep(args, scenes, case_names, spin, level, tol, run_dir)
+    if args.suite:
+        return _suite(level, run_dir)
     try:
         report, images = run_crosscheck(scenes, candidate, frames=args.frames, case_names=case_names,
                                         level=level, turns=spin, tol=tol, every=args.every, jobs=args.jobs,
@@ -193,6 +217,62 @@ def main(argv=None) -> int:
           f"(vertex <= {tol.vertex_px:g} px, F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px})")
     print(timing_line(report))
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
+    return 1 if failed else 0
+
+
+def _sweep(args, scenes, case_names, spin, level, tol, run_dir) -> int:
+    from .sweep import default_failures, large_mesh, markdown_table, run_sweep, write_sweep
+
+    def progress(text):
+        print(f"  {text}", file=sys.stderr, flush=True)
+
+    print(f"Sweep: 12 settings x {len(scenes)} scenes + a large mesh x {len(case_names)} cameras, "
+          f"{len(range(1, args.frames + 1, args.every))} frames each", file=sys.stderr)
+    try:
+        result = run_sweep(scenes, frames=args.frames, every=args.every, case_names=case_names, turns=spin,
+                           large=large_mesh(), pyrender=level == "pixels", progress=progress)
+        write_sweep(run_dir, result)
+    except InputError as exc:
+        print(f"crosscheck: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
+        return 2
+    print(markdown_table(result))
+    reasons = default_failures(result, tol.vertex_px, tol.min_f1_1px, tol.min_f1_0px)
+    if reasons:
+        print("FAIL: the default setting float64/clip/exact is out of tolerance: " + "; ".join(reasons))
+    else:
+        print("PASS: the default setting float64/clip/exact is within tolerance; the others are trade-offs")
+    print(f"Report: {run_dir / 'sweep.md'} (also sweep.json, sweep.html, sweep.png)")
+    return 1 if reasons else 0
+
+
+def _suite(level, run_dir) -> int:
+    from core.output import FrameDir, json_dumps
+
+    from .extremes import extremes_markdown, run_extremes
+
+    result = run_extremes(pyrender=level == "pixels")
+    md = extremes_markdown(result)
+    try:
+        run_dir.parent.mkdir(parents=True, exist_ok=True)
+        out = FrameDir(run_dir, "--report-dir")
+        try:
+            out.write("extremes.json", json_dumps(result).encode())
+            out.write("extremes.md", md.encode())
+            out.commit()
+        except BaseException:
+            out.abort()
+            raise
+    except OSError as exc:
+        print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
+        return 2
+    print(md)
+    failed = [c["name"] for c in result["cases"] if c["verdict"] != "pass"]
+    print(f"{result['verdict'].upper()}: {len(result['cases']) - len(failed)}/{len(result['cases'])} extreme cases "
+          "within their derived bounds" + (f" (failed: {', '.join(failed)})" if failed else ""))
+    print(f"Report: {run_dir / 'extremes.md'} (also extremes.json)")
     return 1 if failed else 0
 
 

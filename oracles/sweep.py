@@ -273,3 +273,66 @@ def plot_png(sweep: dict, path) -> None:
     fig.tight_layout()
     fig.savefig(path, format="png", metadata={"Software": None})
     plt.close(fig)
+
+
+def html(sweep: dict) -> str:
+    import html as _h
+
+    rows = []
+    for r in sweep["settings"]:
+        t = r["timing"]
+        rows.append("<tr>" + "".join(f"<td>{_h.escape(str(v))}</td>" for v in (
+            r["setting"] + (" (default)" if r["default"] else ""), _ms(t["ms_per_frame_bundled"]),
+            _ms(t["ms_per_frame_large"]), _e(r["max_vertex_error_px"]), _f(r["pixel_f1_0px"]),
+            _f(r["pixel_f1_1px"]), "yes" if t.get("pareto") else "")) + "</tr>")
+    big = sweep["large_mesh"]
+    return ("<!doctype html><meta charset='utf-8'><title>wirecheck sweep</title>"
+            "<style>body{font-family:sans-serif;margin:2em}td,th{padding:2px 8px;text-align:right}"
+            "td:first-child{text-align:left}</style>"
+            "<h1>wirecheck speed/accuracy sweep</h1>"
+            f"<p>Scenes: {_h.escape(', '.join(sweep['scenes']))}"
+            + (f"; large mesh: {_h.escape(big['name'])} ({big['vertices']:,} vertices, {big['edges']:,} edges)"
+               if big else "")
+            + f". Cases: {_h.escape(', '.join(sweep['cases']))}. Frames checked: {sweep['frames_checked']}.</p>"
+            "<table><tr><th>setting</th><th>ms/frame bundled</th><th>ms/frame large</th>"
+            "<th>max vertex error px</th><th>F1@0px min</th><th>F1@1px min</th><th>Pareto</th></tr>"
+            + "".join(rows) + "</table><p><img src='sweep.png' alt='Pareto plot'></p>\n")
+
+
+def write_sweep(run_dir, sweep: dict) -> None:
+    """``sweep.json`` (timings under each row's ``timing``), ``sweep.md``, ``sweep.html``, ``sweep.png``; atomic."""
+    import tempfile
+    from pathlib import Path
+
+    from core.output import FrameDir, json_dumps
+
+    run_dir = Path(run_dir)
+    run_dir.parent.mkdir(parents=True, exist_ok=True)
+    out = FrameDir(run_dir, "--report-dir")
+    try:
+        out.write("sweep.json", json_dumps(sweep).encode())
+        out.write("sweep.md", markdown(sweep).encode())
+        out.write("sweep.html", html(sweep).encode())
+        with tempfile.TemporaryDirectory() as tmp:
+            png = Path(tmp) / "sweep.png"
+            plot_png(sweep, png)
+            out.write("sweep.png", png.read_bytes())
+        out.commit()
+    except BaseException:
+        out.abort()
+        raise
+
+
+def default_failures(sweep: dict, vertex_px: float, min_f1_1px: float, min_f1_0px: float) -> list[str]:
+    """Why the default setting is out of tolerance (empty when it is within)."""
+    d = next(r for r in sweep["settings"] if r["default"])
+    reasons = []
+    if d["max_vertex_error_px"] is not None and d["max_vertex_error_px"] > vertex_px:
+        reasons.append(f"max vertex error {d['max_vertex_error_px']:.3g} px > {vertex_px:g}")
+    if d["visibility_mismatches"]:
+        reasons.append(f"{d['visibility_mismatches']} points clipped by one side only")
+    if d["pixel_f1_1px"] is not None and d["pixel_f1_1px"] < min_f1_1px:
+        reasons.append(f"F1@1px {d['pixel_f1_1px']:.4f} < {min_f1_1px}")
+    if d["pixel_f1_0px"] is not None and d["pixel_f1_0px"] < min_f1_0px:
+        reasons.append(f"F1@0px {d['pixel_f1_0px']:.4f} < {min_f1_0px}")
+    return reasons

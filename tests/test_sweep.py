@@ -101,3 +101,32 @@ def test_plot_and_markdown(small_sweep, tmp_path):
     md = sweep.markdown(small_sweep)
     rows = [ln for ln in md.splitlines() if ln.startswith("| ") and ("float64/" in ln or "float32/" in ln)]
     assert len(rows) == 12 and "| **float64/clip/exact** (default) |" in md
+
+
+def test_cli_sweep_writes_table_and_plot(tmp_path, capsys):
+    from oracles.cli import main
+
+    out = tmp_path / "sw"
+    rc = main(["--sweep", "--level", "vertices", "--scene", "cube", "--cases", "on_axis", "--frames", "2",
+               "--report-dir", str(out)])
+    assert rc == 0
+    assert sorted(p.name for p in out.iterdir()) == [".wirecheck-output", "sweep.html", "sweep.json",
+                                                      "sweep.md", "sweep.png"]
+    data = json.loads((out / "sweep.json").read_text())
+    assert len(data["settings"]) == 12 and data["oracles"] == ["opencv"]
+    assert data["frames_checked"] == 2
+    assert "PASS: the default setting" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("extra", [["--candidate", "tests/data/user_projector.py:project"], ["--dtype", "float32"],
+                                   ["--suite", "extremes"]])
+def test_cli_sweep_rejects_candidate_settings_and_suite(extra, tmp_path, capsys):
+    from oracles.cli import main
+
+    with pytest.raises(SystemExit) as exc:    # argparse: --suite and --sweep are exclusive
+        rc = main(["--sweep", *extra, "--report-dir", str(tmp_path / "x")])
+        raise SystemExit(rc)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("crosscheck: error:")
+    assert not (tmp_path / "x").exists()
