@@ -54,10 +54,12 @@ class Camera:
         position = _vec3("position", self.position)
         forward = _vec3("forward", self.forward)
         up = _vec3("up", self.up)
-        nf = np.linalg.norm(forward)
-        if nf == 0:
+        if not np.any(forward):
             raise InputError("camera forward: expected a non-zero direction (is the camera at the look-at point?)")
-        forward = forward / nf
+        forward = forward / np.abs(forward).max()   # scale first: norm() of 1e-200 underflows to 0
+        forward = forward / np.linalg.norm(forward)
+        if np.any(up):
+            up = up / np.abs(up).max()              # likewise for a tiny up
         right = np.cross(forward, up)
         nr = np.linalg.norm(right)
         if nr < _DEGENERATE_CROSS * max(np.linalg.norm(up), 1e-300):
@@ -86,6 +88,15 @@ class Camera:
             raise InputError(f"camera far {self.far!r}: expected > near ({self.near!r})")
         if self.projection == "orthographic" and not (math.isfinite(self.ortho_height) and self.ortho_height > 0):
             raise InputError(f"camera ortho-height {self.ortho_height!r}: expected > 0")
+        # A positive but tiny fov or ortho-height passes the range checks yet makes the
+        # focal length / pixel scale overflow to inf: say so here, not later as a
+        # "vertex projects beyond the float64 range".
+        if self.projection == "perspective" and not math.isfinite(self.focal_px):
+            raise InputError(f"camera fov {self.fov_y_deg!r}: focal length (H/2)/tan(fov/2) overflows float64; "
+                             "expected a larger fov")
+        if self.projection == "orthographic" and not math.isfinite(self.height / self.ortho_height):
+            raise InputError(f"camera ortho-height {self.ortho_height!r}: pixel scale H/ortho-height overflows "
+                             "float64; expected a larger ortho-height")
 
     # ---- derived quantities (see core.conventions) -------------------------
     @property
@@ -125,7 +136,7 @@ def look_at(position, target, up=(0.0, 1.0, 0.0), **kwargs) -> Camera:
     position = _vec3("position", position)
     target = _vec3("look-at", target)
     forward = target - position
-    if np.linalg.norm(forward) == 0:
+    if not np.any(forward):                     # exact test: norm() underflows to 0 below ~1e-160
         raise InputError(f"camera position {position.tolist()}: expected a point different from look-at {target.tolist()}")
     return Camera(position=position, forward=forward, up=_vec3("up", up), **kwargs)
 

@@ -103,12 +103,15 @@ def model_to_cam(points: LocalPoints, model_matrix: np.ndarray, camera: Camera) 
 def world_to_cam(p_world: np.ndarray, camera: Camera, dtype="float64") -> np.ndarray:
     """``(N, 3)`` world points to camera space (x right, y up, z forward = depth).
 
-    ``p_world - position`` in float64 first, then cast and rotate in ``dtype``.
+    The same camera-relative path as a frame: world points are the model points
+    of an identity model matrix, re-centred by :func:`localize` when far from
+    the origin; ``origin - position`` is rotated in float64 and cast once.
     """
-    dt = resolve_dtype(dtype)
-    p_rel = np.asarray(p_world, dtype=np.float64).reshape(-1, 3) - camera.position
-    r_cam = np.stack([camera.right, camera.up, camera.forward]).astype(dt)
-    return p_rel.astype(dt, copy=False) @ r_cam.T
+    return model_to_cam(localize(p_world, dtype), _IDENTITY, camera)
+
+
+_IDENTITY = np.eye(4)
+_IDENTITY.setflags(write=False)
 
 
 def depth_mask(p_cam: np.ndarray, camera: Camera) -> np.ndarray:
