@@ -140,11 +140,6 @@ def _parse(args):
         candidate = load_candidate(args.candidate)
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
-        missing = candidate.unsupported()
-        if missing:
-            raise InputError(", ".join(f"--{k} {getattr(candidate, k)}" for k in missing)
-                             + ": this core's render_frame takes no " + ", ".join(repr(k) for k in missing)
-                             + " keyword yet; expected the default")
     return level, cases, spin, scenes, candidate
 
 

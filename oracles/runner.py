@@ -85,8 +85,7 @@ class CoreCandidate:
     """core/ as the candidate: vertices (and frames) through core's whole pipeline.
 
     ``dtype``, ``clip`` and ``raster`` are passed to :func:`core.pipeline.render_frame`
-    (``clip`` as its ``clip_mode``); ``dtype`` and ``raster`` only when they differ
-    from the defaults, so a core without those keywords still runs the defaults.
+    (``clip`` as its ``clip_mode``).
     """
 
     dtype: str = "float64"
@@ -106,43 +105,29 @@ class CoreCandidate:
     def settings(self) -> dict:
         return {"dtype": self.dtype, "clip": self.clip, "raster": self.raster}
 
-    def unsupported(self) -> list[str]:
-        """Keywords these settings need that this core's ``render_frame`` does not take (yet)."""
-        import inspect
-
-        from core.pipeline import render_frame
-
-        params = inspect.signature(render_frame).parameters
-        if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
-            return []
-        return [k for k in self._frame_kw() if k not in params]
-
-    def _dtype_kw(self) -> dict:
-        return {} if self.dtype == "float64" else {"dtype": np.dtype(self.dtype)}
-
-    def _frame_kw(self) -> dict:
-        kw = self._dtype_kw()
-        if self.raster != "exact":
-            kw["raster"] = self.raster
-        return kw
-
     def __call__(self, points, camera):  # the candidate contract, for completeness
         from core.projection import project_points
 
-        return project_points(points, camera, **self._dtype_kw())
+        return project_points(points, camera, dtype=self.dtype)
 
-    def project(self, p_model: np.ndarray, camera, model_matrix: np.ndarray) -> np.ndarray:
+    def prepare(self, p_model: np.ndarray):
+        """The scene's vertices re-centred and cast once (``core.projection.localize``), as ``renderer`` does."""
+        from core.projection import localize
+
+        return localize(p_model, self.dtype)
+
+    def project(self, points, camera, model_matrix: np.ndarray) -> np.ndarray:
         """Vertex pixels from core's pipeline without drawing: ``render_frame`` given no edges."""
         from core.pipeline import render_frame
 
         no_edges = np.zeros((0, 2), dtype=np.intp)
-        return render_frame(p_model, no_edges, camera, model_matrix, self.clip, **self._frame_kw()).p_px
+        return render_frame(points, no_edges, camera, model_matrix, self.clip, raster=self.raster).p_px
 
-    def draw(self, p_model: np.ndarray, edges: np.ndarray, camera, model_matrix: np.ndarray) -> np.ndarray:
+    def draw(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray) -> np.ndarray:
         """The frame core draws, as a bool image (drawn where the image is >= 128)."""
         from core.pipeline import render_frame
 
-        frame = render_frame(p_model, edges, camera, model_matrix, self.clip, **self._frame_kw())
+        frame = render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster)
         return frame.image >= DRAWN_THRESHOLD
 
 
@@ -165,6 +150,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     # seconds: vertex stage = t_setup + t_cv + t_proj + t_vmetric; pixel stage = t_draw + t_pr + t_pmetric
     t_setup = t_cv = t_proj = t_vmetric = t_draw = t_pr = t_pmetric = 0.0
     error = None
+    core_points = candidate.prepare(scene.vertices) if is_core else None   # once per scene, not per frame
     for k in range(1, frames + 1, every):
         t0 = time.perf_counter()
         t = (k - 1) / frames
@@ -176,14 +162,14 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         try:
             if is_core:
                 m_core = motion.frame_matrix(k, frames)
-                cand_px = candidate.project(scene.vertices, cam, m_core)
+                cand_px = candidate.project(core_points, cam, m_core)
             else:
                 cand_px = call_candidate(candidate, p_world, cam)
             t3 = time.perf_counter()
             cand_img = None
             if pixels:
                 if is_core:
-                    cand_img = candidate.draw(scene.vertices, edges, cam, m_core)
+                    cand_img = candidate.draw(core_points, edges, cam, m_core)
                 else:
                     cand_img = draw_candidate(candidate, p_world, edges, cam)
             t4 = time.perf_counter()

@@ -205,7 +205,7 @@ def test_core_candidate_is_a_small_frozen_picklable_dataclass():
         CoreCandidate(raster="smooth")
 
 
-def test_core_settings_reach_render_frame_only_when_not_default(monkeypatch):
+def test_core_settings_reach_render_frame(monkeypatch):
     import core.pipeline
     from oracles.cases import cameras_for
 
@@ -226,10 +226,13 @@ def test_core_settings_reach_render_frame_only_when_not_default(monkeypatch):
     monkeypatch.setattr(core.pipeline, "render_frame", fake_render_frame)
     cam = cameras_for(1.0)[0].camera
     pts, edges = np.zeros((2, 3)), np.array([[0, 1]])
-    CoreCandidate().project(pts, cam, np.eye(4))
-    img = CoreCandidate(dtype="float32", clip="endpoint", raster="aa").draw(pts, edges, cam, np.eye(4))
-    assert calls[0] == ("clip", {})
-    assert calls[1] == ("endpoint", {"dtype": np.dtype("float32"), "raster": "aa"})
+    CoreCandidate().project(CoreCandidate().prepare(pts), cam, np.eye(4))
+    cand = CoreCandidate(dtype="float32", clip="endpoint", raster="aa")
+    prepared = cand.prepare(pts)
+    assert prepared.dtype == np.float32                  # the dtype reaches core through localize()
+    img = cand.draw(prepared, edges, cam, np.eye(4))
+    assert calls[0] == ("clip", {"raster": "exact"})
+    assert calls[1] == ("endpoint", {"raster": "aa"})
     assert img[0, :3].tolist() == [False, True, True] and img.sum() == 2
 
 
