@@ -334,6 +334,16 @@ def paint_aa(rr: np.ndarray, cc: np.ndarray, weight: np.ndarray, width: int, hei
     """
     rr = np.asarray(rr, dtype=np.intp)
     cc = np.asarray(cc, dtype=np.intp)
-    acc = np.bincount(rr * width + cc, weights=np.asarray(weight, dtype=np.float64),
-                      minlength=width * height)
+    weight = np.asarray(weight, dtype=np.float64)
+    flat = rr * width + cc
+    image = np.zeros(width * height, dtype=np.uint8)
+    if len(flat) * 8 < width * height:
+        # Few pixels (a small scene on a big image): sum per distinct pixel and
+        # touch only those, instead of five passes over a float image. bincount
+        # adds in input order on both paths, so the sums are bit-identical.
+        idx, inverse = np.unique(flat, return_inverse=True)
+        acc = np.bincount(inverse, weights=weight, minlength=len(idx))
+        image[idx] = np.floor(np.clip(acc, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+        return image.reshape(height, width)
+    acc = np.bincount(flat, weights=weight, minlength=width * height)
     return np.floor(np.clip(acc, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8).reshape(height, width)

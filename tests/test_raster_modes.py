@@ -510,3 +510,16 @@ def test_aa_batches_equal_one_call_per_segment():
     per = [line_coverage_aa(p0[k:k + 1], p1[k:k + 1], PW, PH) for k in range(m)]
     for a, k in zip(got, range(3)):
         assert_array_equal(a, np.concatenate([p[k] for p in per]))
+
+
+@pytest.mark.parametrize("n", [50, 5000])     # 50*8 < 40*30: sparse path; 5000*8 >= 1200: dense path
+def test_paint_aa_both_accumulation_paths_equal_an_in_order_reference(n):
+    # np.add.at sums in input order, as bincount does on both paths: bit-identical.
+    rng = np.random.default_rng(n)
+    w, h = 40, 30
+    rr, cc = rng.integers(0, h, n), rng.integers(0, w, n)
+    weight = rng.uniform(0.0, 0.7, n)
+    acc = np.zeros((h, w))
+    np.add.at(acc, (rr, cc), weight)
+    expected = np.floor(np.clip(acc, 0, 1) * 255 + 0.5).astype(np.uint8)
+    assert_array_equal(paint_aa(rr, cc, weight, w, h), expected)
