@@ -5,9 +5,11 @@ core.conventions for the spaces). Model to camera is one camera-relative
 model-view transform (core.projection explains why: precision in float32 and
 far from the origin); world coordinates are never formed per point.
 
-Only what a frame needs is computed: faces are never touched (a wireframe
-uses edges only), there is no depth buffer, and the clipping stage runs only
-when some vertex is outside [near, far] or off the image.
+Only what a frame needs is computed. A plain wireframe never touches faces
+and has no depth buffer; the clipping stage runs only when some vertex is
+outside [near, far] or off the image. Faces are triangulated and culled only
+for ``cull``, ``hidden_lines`` or ``style="shaded"``, and rasterized into a
+depth buffer (core.zbuffer) only for the last two.
 """
 
 from __future__ import annotations
@@ -16,21 +18,68 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import clipping, raster
+from . import clipping, culling, raster, shading, zbuffer
 from .camera import Camera
 from .projection import LocalPoints, cam_to_px, depth_mask, localize, model_to_cam, resolve_dtype
 
 CLIP_MODES = ("clip", "endpoint")
 RASTER_MODES = ("exact", "fast", "aa")
+STYLES = ("wireframe", "shaded")
+CULL_MODES = (None, "backface")
 
 
 @dataclass(frozen=True)
 class Frame:
-    image: np.ndarray          # (H, W) uint8: 255 on line pixels (raster "aa": coverage 0..255)
-    p_px: np.ndarray           # (N, 2) float64, NaN where clipped (computed in the run's dtype)
-    depth: np.ndarray          # (N,) float64 z_cam of every vertex
-    visible: np.ndarray        # (N,) bool: near <= depth <= far
-    clipped_edges: int         # edges dropped or shortened by near/far
+    """One rendered frame.
+
+    Fields
+    ------
+    image : (H, W) uint8
+        Wireframe: 255 on line pixels (raster "aa": coverage 0..255); with
+        ``hidden_lines``, the wireframe minus the hidden line pixels. Style
+        "shaded": the shaded image (same array as ``shaded``).
+    p_px : (N, 2) float64
+        Vertex pixels, NaN where clipped (computed in the run's dtype).
+    depth : (N,) float64
+        ``z_cam`` of every vertex.
+    visible : (N,) bool
+        ``near <= depth <= far``.
+    clipped_edges : int
+        Edges dropped or shortened by near/far (counted over all edges, before
+        back-face culling).
+    depth_image : (H, W) float64 or None
+        The depth buffer of the faces: linear ``z_cam`` of the nearest face at
+        each pixel centre, +inf where none. Only with ``hidden_lines`` or style
+        "shaded" (None otherwise).
+    face_ids : (H, W) int32 or None
+        Index (into ``faces``) of the polygon seen at each pixel, -1 where
+        none. Computed with ``depth_image``.
+    shaded : (H, W) uint8 or None
+        Flat-shaded grey levels (core.shading), 0 where no face. Style
+        "shaded" only.
+    faces_total : int
+        Number of polygons given (0 without faces).
+    faces_culled : int
+        Polygons culled as back faces (``cull="backface"``), 0 otherwise.
+    edges_culled : int
+        Edges not drawn because every face they belong to was culled.
+    hidden_pixels : int
+        With ``hidden_lines``: pixels that some edge reaches but only with
+        hidden samples, i.e. line pixels suppressed by the faces. 0 otherwise.
+    """
+
+    image: np.ndarray
+    p_px: np.ndarray
+    depth: np.ndarray
+    visible: np.ndarray
+    clipped_edges: int
+    depth_image: np.ndarray | None = None
+    face_ids: np.ndarray | None = None
+    shaded: np.ndarray | None = None
+    faces_total: int = 0
+    faces_culled: int = 0
+    edges_culled: int = 0
+    hidden_pixels: int = 0
 
     @property
     def mask(self) -> np.ndarray:
@@ -53,10 +102,21 @@ class Frame:
         d = self.depth[self.visible]
         return float(d.min()), float(d.max())
 
+    @property
+    def faces_visible(self) -> int | None:
+        """Polygons owning at least one pixel of the depth buffer (None without one)."""
+        if self.face_ids is None:
+            return None
+        ids = self.face_ids[self.face_ids >= 0]
+        return int(len(np.unique(ids)))
+
 
 def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.ndarray,
-                 clip_mode: str = "clip", *, dtype=None, raster: str = "exact") -> Frame:
-    """Project and draw one wireframe frame.
+                 clip_mode: str = "clip", *, dtype=None, raster: str = "exact",
+                 faces=None, cull: str | None = None, hidden_lines: bool = False,
+                 style: str = "wireframe", light_dir=None,
+                 ambient: float = shading.DEFAULT_AMBIENT) -> Frame:
+    """Project and draw one frame.
 
     ``p_model`` is an ``(N, 3)`` array or, to skip re-centring and casting on
     every frame, the :class:`~core.projection.LocalPoints` of
@@ -64,11 +124,38 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
     "float32") is the precision of every per-point operation; with
     ``LocalPoints`` it defaults to theirs. ``raster`` is one of
     :data:`RASTER_MODES` (core.raster).
+
+    Faces (all optional; without them the frame is the plain wireframe):
+
+    faces
+        Polygons as index tuples (counter-clockwise seen from outside), or an
+        ``(F, k)`` integer array; triangulated internally (core.culling).
+    cull
+        None or ``"backface"``: drop back faces (core.culling states the rule)
+        from the depth buffer, and draw an edge only when at least one of its
+        faces is kept, or when it belongs to no face.
+    hidden_lines
+        Rasterize the faces into a depth buffer (core.zbuffer) and do not draw
+        line pixels behind them (``z_line <= z_buffer + bias``, bias as
+        ``glPolygonOffset(1, 1)``; core.zbuffer).
+    style
+        ``"wireframe"`` or ``"shaded"`` (the image is flat-shaded faces,
+        core.shading; no lines are drawn and ``hidden_lines`` has no effect
+        on the image).
+    light_dir
+        World direction the light travels; default
+        :func:`core.shading.default_light_dir` (from the camera's upper left).
+    ambient
+        Ambient term of the shading, in [0, 1].
     """
     if clip_mode not in CLIP_MODES:
         raise ValueError(f"clip_mode {clip_mode!r}: expected one of {CLIP_MODES}")
     if raster not in RASTER_MODES:
         raise ValueError(f"raster {raster!r}: expected one of {RASTER_MODES}")
+    if style not in STYLES:
+        raise ValueError(f"style {style!r}: expected one of {STYLES}")
+    if cull not in CULL_MODES:
+        raise ValueError(f"cull {cull!r}: expected one of {CULL_MODES}")
     if isinstance(p_model, LocalPoints):
         points = p_model
         if dtype is not None and resolve_dtype(dtype) != points.dtype:
@@ -87,6 +174,37 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
     # both ends are in [near, far]: every other edge is cut or dropped by them.
     clipped_edges = int(len(edges) - ends_visible.sum())
 
+    shaded_style = style == "shaded"
+    use_faces = faces is not None and (cull is not None or hidden_lines or shaded_style)
+    extra = {}
+    if faces is not None:
+        extra["faces_total"] = len(faces)
+    depth_image = face_ids = tri_face_buf = grad = None
+    if use_faces:
+        fs = _faces_stage(p_cam, faces, camera, model_matrix, cull, hidden_lines or shaded_style)
+        extra.update(faces_culled=fs["faces_culled"])
+        if cull is not None and len(edges):
+            keep_edge = _edges_of_kept_faces(edges, faces, fs["face_kept"], n)
+            extra["edges_culled"] = int(len(edges) - keep_edge.sum())
+            edges = edges[keep_edge]
+            ends_visible = ends_visible[keep_edge]
+        depth_image, face_ids = fs.get("depth"), fs.get("face_ids")
+        tri_face_buf, grad = fs.get("tri_buf"), fs.get("grad")
+    elif hidden_lines or shaded_style:                              # no faces: an empty depth buffer
+        depth_image = np.full((camera.height, camera.width), np.inf)
+        face_ids = np.full((camera.height, camera.width), -1, dtype=np.int32)
+    if depth_image is not None:
+        extra.update(depth_image=depth_image, face_ids=face_ids)
+
+    if shaded_style:
+        normals = fs["normals_world"] if use_faces else np.zeros((0, 3))
+        light = shading.default_light_dir(camera) if light_dir is None else light_dir
+        image = shading.shade(face_ids, normals, light, ambient)     # shaded
+        extra["shaded"] = image
+        return Frame(image=image, p_px=p_px.astype(np.float64, copy=False),
+                     depth=p_cam[:, 2].astype(np.float64), visible=visible,
+                     clipped_edges=clipped_edges, **extra)
+
     image = np.zeros((camera.height, camera.width), dtype=np.uint8)
     if len(edges):
         on_image = _inside_image(p_px, camera)
@@ -95,6 +213,8 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
             # (np.take gathers rows of an (N, 2) array ~10x faster than p_px[idx].)
             seg0_px = np.take(p_px, edges[:, 0], axis=0)
             seg1_px = np.take(p_px, edges[:, 1], axis=0)
+            if hidden_lines:
+                ends = (seg0_px, seg1_px, p_cam[edges[:, 0], 2], p_cam[edges[:, 1], 2])
         else:
             if clip_mode == "endpoint":
                 edges = edges[ends_visible]                         # drop edges with a failing end
@@ -104,11 +224,92 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
             seg_cam = clipping.apply_clip(seg_cam, kept, t0, t1,
                                           (camera.near, camera.far))  # camera, inside the frustum
             seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)  # pixels
-            _, seg0_px, seg1_px = clipping.clip_to_image(seg_px[:, 0], seg_px[:, 1],
-                                                         camera.width, camera.height)  # pixels, on the image
-        _paint(image, seg0_px, seg1_px, raster)                     # painted
+            on, seg0_px, seg1_px = clipping.clip_to_image(seg_px[:, 0], seg_px[:, 1],
+                                                          camera.width, camera.height)  # pixels, on the image
+            if hidden_lines:
+                ends = (seg_px[on, 0], seg_px[on, 1], seg_cam[on, 0, 2], seg_cam[on, 1, 2])
+        if hidden_lines and tri_face_buf is not None and (tri_face_buf >= 0).any():
+            extra["hidden_pixels"] = _paint_visible(image, seg0_px, seg1_px, ends, raster,
+                                                    depth_image, tri_face_buf, grad, camera)
+        else:
+            _paint(image, seg0_px, seg1_px, raster)                 # painted
     return Frame(image=image, p_px=p_px.astype(np.float64, copy=False),
-                 depth=p_cam[:, 2].astype(np.float64), visible=visible, clipped_edges=clipped_edges)
+                 depth=p_cam[:, 2].astype(np.float64), visible=visible, clipped_edges=clipped_edges,
+                 **extra)
+
+
+def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: bool) -> dict:
+    """Triangulate, cull and (if ``need_depth``) depth-buffer the faces."""
+    tris, tri_face = culling._fan(faces)
+    n_faces = len(faces)
+    n = len(p_cam)
+    if len(tris) and (tris.min() < 0 or tris.max() >= n):
+        bad = int(tris.max()) if tris.max() >= n else int(tris.min())
+        raise ValueError(f"faces: vertex index {bad} out of range for {n} vertices")
+    tri_cam = p_cam.astype(np.float64, copy=False)[tris]           # camera, (T, 3, 3)
+    mirrored = bool(np.linalg.det(np.asarray(model_matrix, dtype=np.float64)[:3, :3]) < 0)
+    out = {"faces_culled": 0, "face_kept": None}
+    if cull == "backface":
+        keep_tri = culling.backface_keep(tri_cam, camera.projection, mirrored=mirrored)
+        face_kept = np.zeros(n_faces, dtype=bool)
+        face_kept[tri_face[keep_tri]] = True
+        has_tri = np.bincount(tri_face, minlength=n_faces) > 0
+        out["faces_culled"] = int((has_tri & ~face_kept).sum())
+        out["face_kept"] = face_kept
+        kept_idx = np.flatnonzero(keep_tri)
+    else:
+        kept_idx = np.arange(len(tris))
+    if not need_depth:
+        return out
+    # Outward normals (for shading): sum of fan cross products = the polygon's
+    # area vector (Newell). In camera space the cross product is -R n_world
+    # (core.culling), so n_world = -R^T n_cc; a mirroring model flips it again.
+    n_cc = np.zeros((n_faces, 3))
+    if len(tris):
+        np.add.at(n_cc, tri_face, culling.triangle_cross_cam(tri_cam))
+    r_cam = np.stack([camera.right, camera.up, camera.forward])
+    out["normals_world"] = (-1.0 if not mirrored else 1.0) * (n_cc @ r_cam)
+    tri_px, tri_z, src = zbuffer.project_triangles(tri_cam[kept_idx], camera)   # pixels (clipped)
+    depth, tri_buf = zbuffer.rasterize_triangles(tri_px, tri_z, camera.width, camera.height,
+                                                 camera.projection)            # depth buffer
+    poly_of = tri_face[kept_idx][src]                                          # clipped tri -> polygon
+    out["depth"] = depth
+    out["tri_buf"] = tri_buf
+    out["face_ids"] = np.where(tri_buf >= 0, poly_of[np.maximum(tri_buf, 0)], -1).astype(np.int32)
+    out["grad"] = zbuffer.triangle_gradients(tri_px, tri_z, camera.projection)
+    return out
+
+
+def _edges_of_kept_faces(edges: np.ndarray, faces, face_kept: np.ndarray, n: int) -> np.ndarray:
+    """``(E,) bool``: edges of at least one kept face, or of no face at all."""
+    i, j, owner, _ = culling.directed_edges(faces)
+    if len(i) == 0:
+        return np.ones(len(edges), dtype=bool)
+    lo, hi = np.minimum(i, j), np.maximum(i, j)
+    key = lo * (n + 1) + hi
+    e = np.sort(edges.astype(np.int64), axis=1)
+    ekey = e[:, 0] * (n + 1) + e[:, 1]
+    in_face = np.isin(ekey, key)
+    in_kept = np.isin(ekey, key[face_kept[owner]])
+    return in_kept | ~in_face
+
+
+def _paint_visible(image, seg0_px, seg1_px, ends, mode, depth, tri_buf, grad, camera) -> int:
+    """Paint the line pixels not hidden by the depth buffer; return the number of hidden pixels."""
+    h, w = image.shape
+    seg, rr, cc, weight = zbuffer.line_samples(seg0_px, seg1_px, w, h, mode)
+    vis = zbuffer.visible_line_samples(seg, rr, cc, *ends, depth, tri_buf, grad, camera,
+                                       zbuffer.SLOPE_FACTOR[mode])
+    all_px = np.unique(rr * w + cc)
+    shown = np.unique(rr[vis] * w + cc[vis])
+    if mode == "aa":
+        if vis.all():
+            _paint(image, seg0_px, seg1_px, mode)               # bit-identical to the plain wireframe
+        else:
+            image[...] = raster.paint_aa(rr[vis], cc[vis], weight[vis], w, h)
+    else:
+        image.reshape(-1)[shown] = 255
+    return int(len(all_px) - len(shown))
 
 
 def _paint(image: np.ndarray, seg0_px: np.ndarray, seg1_px: np.ndarray, mode: str) -> None:
