@@ -1,4 +1,4 @@
-"""Writing frames and reports: PNG (Pillow), ASCII, GIF, JSON; atomic writes.
+"""Writing frames and reports: PNG and GIF (Pillow), MP4 (PyAV), ASCII, JSON; atomic writes.
 
 Every file is written to a temporary name beside its destination and renamed
 into place, so an interrupted run never leaves a file that looks complete.
@@ -62,6 +62,8 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
     Character cells are about twice as tall as wide, so a cell covers
     ``W / cols`` pixels across and twice that down.
     """
+    if image.ndim == 3:                          # RGB (--axes): a cell is drawn when any channel is
+        image = np.maximum(np.maximum(image[:, :, 0], image[:, :, 1]), image[:, :, 2])
     h, w = image.shape[:2]
     cols = max(1, min(cols, w))
     rows = max(1, min(h, int(round(cols * h / w / 2.0))))
@@ -74,15 +76,125 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
 
 
 def gif_bytes(images: list[np.ndarray], fps: float = 30.0) -> bytes:
+    """An animated GIF (looping, ``fps`` frames per second, rounded to whole ms per frame).
+
+    Grey frames use a grey palette; RGB frames (``--axes``) an adaptive
+    palette per frame without dithering (a few exact colours, deterministic).
+    GIF delays are in 1/100 s, so 30 fps plays at 1/0.03 = 33.3 fps. Pillow
+    stores consecutive identical frames as one frame with their summed delay
+    (a scene that does not move gives a one-frame GIF of the same duration).
+    """
     import io
 
     from PIL import Image
 
-    frames = [Image.fromarray(np.ascontiguousarray(im)).convert("P") for im in images]
+    def to_p(im):
+        pic = Image.fromarray(np.ascontiguousarray(im))
+        if pic.mode == "RGB":
+            return pic.convert("P", palette=Image.Palette.ADAPTIVE, colors=256, dither=Image.Dither.NONE)
+        return pic.convert("P")
+
+    frames = [to_p(im) for im in images]
     buf = io.BytesIO()
     if frames:
         frames[0].save(buf, format="GIF", save_all=True, append_images=frames[1:],
                        duration=int(round(1000.0 / fps)), loop=0, optimize=False)
+    return buf.getvalue()
+
+
+#: MP4 settings: H.264 (libx264) in yuv420p, constant quality (CRF 18: lines
+#: stay sharp), one encoder thread and fixed options so that the same frames
+#: give the same bytes (x264 is deterministic with a fixed thread count).
+#: "veryfast": about 30 % faster than "medium" for 8 % larger files.
+MP4_CODEC = "libx264"
+MP4_OPTIONS = {"crf": "18", "preset": "veryfast", "tune": "animation"}
+
+
+def pad_even(image: np.ndarray) -> np.ndarray:
+    """Pad an image with black at the bottom/right to even width and height (yuv420p needs them).
+
+    Padding, not scaling: every pixel keeps its value and position.
+    """
+    h, w = image.shape[:2]
+    if h % 2 == 0 and w % 2 == 0:
+        return image
+    pad = [(0, h % 2), (0, w % 2)] + [(0, 0)] * (image.ndim - 2)
+    return np.pad(image, pad)
+
+
+class Mp4Writer:
+    """Encode frames one at a time into an H.264 MP4 (PyAV), atomically.
+
+    ``target`` is a path (written under a temporary name beside it and renamed
+    over it by :meth:`commit`; :meth:`abort` removes it) or a binary file
+    object (written in place). Frames are grey ``(H, W)`` or RGB ``(H, W, 3)``
+    uint8, all the same size; an odd width or height is padded by one black
+    row/column (:func:`pad_even`), never scaled. PyAV ships its own FFmpeg
+    libraries: no system ffmpeg is needed.
+    """
+
+    def __init__(self, target, fps: int = 30):
+        import av
+
+        self._av = av
+        self.final = None
+        if isinstance(target, (str, os.PathLike)):
+            self.final = Path(target)
+            fd, self.tmp = tempfile.mkstemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent)
+            os.close(fd)
+            target = self.tmp
+        self.container = av.open(target, mode="w", format="mp4")
+        self.fps = int(fps)
+        self.stream = None
+        self.frames = 0
+
+    def add(self, image: np.ndarray) -> None:
+        im = pad_even(np.ascontiguousarray(image))
+        if self.stream is None:
+            st = self.container.add_stream(MP4_CODEC, rate=self.fps, options=dict(MP4_OPTIONS))
+            st.width, st.height = im.shape[1], im.shape[0]
+            st.pix_fmt = "yuv420p"
+            st.codec_context.thread_count = 1          # deterministic bytes
+            st.codec_context.thread_type = "NONE"
+            self.stream, self.size = st, im.shape[:2]
+        if im.shape[:2] != self.size:
+            raise ValueError(f"mp4 frame of size {im.shape[:2]}: expected {self.size} like the first")
+        frame = self._av.VideoFrame.from_ndarray(im, format="rgb24" if im.ndim == 3 else "gray")
+        for packet in self.stream.encode(frame.reformat(format="yuv420p")):
+            self.container.mux(packet)
+        self.frames += 1
+
+    def _close(self) -> None:
+        if self.stream is not None:
+            for packet in self.stream.encode(None):
+                self.container.mux(packet)
+            self.stream = None
+        self.container.close()
+
+    def commit(self) -> None:
+        self._close()
+        if self.final is not None:
+            os.chmod(self.tmp, 0o666 & ~_umask())
+            os.replace(self.tmp, self.final)
+
+    def abort(self) -> None:
+        try:
+            self.container.close()
+        except Exception:       # noqa: BLE001 - cleaning up after another error
+            pass
+        if self.final is not None and os.path.exists(self.tmp):
+            os.unlink(self.tmp)
+
+
+def mp4_bytes(images: list[np.ndarray], fps: int = 30) -> bytes:
+    """The MP4 of ``images`` as bytes (:class:`Mp4Writer` into memory)."""
+    import io
+
+    buf = io.BytesIO()
+    writer = Mp4Writer(buf, fps)
+    for im in images:
+        writer.add(im)
+    writer.commit()
     return buf.getvalue()
 
 

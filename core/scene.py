@@ -1,12 +1,34 @@
-"""Scenes: vertices, edges and optional faces; the text format and mesh files.
+"""Scenes: one or more objects of vertices, edges and optional faces; the text format and mesh files.
 
 The text format (``scenes/README.md`` documents it for users)::
 
     # comment (anywhere after '#')
     name cube            optional; defaults to the file stem
-    v X Y Z              a vertex (0-based index in order of appearance)
+    v X Y Z              a vertex (0-based index, local to its object, in order of appearance)
     e I J                an edge between vertices I and J
     f I J K [L ...]      a face (polygon); its boundary edges join the edge set
+    object NAME          starts an object: the v/e/f lines after it belong to it
+    mesh PATH            the object's geometry from a mesh file (relative to the .scene file)
+    translate X Y Z      the object's offset (default 0 0 0)
+    scale S              the object's uniform scale (default 1)
+    spin X Y Z           the object's own full turns about X, Y, Z over the run (default 0 0 0)
+
+Lines before the first ``object`` form an implicit object named after the
+scene, so a file without ``object`` lines is one object with the identity
+motion (its arrays are exactly those of the single-object format).
+
+Several objects: ``Scene.vertices``, ``edges`` and ``faces`` hold every
+object, concatenated in file order (each object's indices offset by the
+vertices before it); ``Scene.objects`` says which vertex rows belong to which
+object and how it moves. The world position of a vertex of object ``o`` at
+frame ``k`` of ``n`` is::
+
+    p_world = M_run(k) @ M_o(k) @ p_model
+
+``M_o`` is the object's own motion (``translate``, ``scale``, ``spin``:
+``T @ Rz @ Ry @ Rx @ S`` as every core.transforms.Motion), applied first;
+``M_run`` is the run's motion (``renderer --spin/--translate/--scale``),
+applied after it to the whole scene. :func:`world_points` computes it.
 
 Other formats (``.obj .ply .stl .off .glb .gltf``) are loaded with trimesh
 (imported lazily): edges are the unique edges of the faces, and OBJ ``l``
@@ -15,6 +37,7 @@ elements become edges.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import re
@@ -24,18 +47,47 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .transforms import Motion, apply
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
+#: Example scenes: loadable by name (``--scene orrery``) but not built-ins, so
+#: ``crosscheck``'s default run (:func:`builtin_names`) does not include them.
+EXAMPLES_DIR = SCENE_DIR / "examples"
 NATIVE_SUFFIX = ".scene"
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".off", ".glb", ".gltf")
 #: A scene name becomes part of output file names: no path separators, no leading dot.
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+#: An object that does not move: no turns, no offset, scale 1.
+STATIC = Motion(turns=(0.0, 0.0, 0.0), offset=(0.0, 0.0, 0.0), scale=1.0)
 
 
 def _safe_stem(path) -> str:
     """A file stem usable as a scene name (characters outside NAME_PATTERN become '_')."""
     stem = re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem)
     return stem if NAME_PATTERN.fullmatch(stem) else "_" + stem
+
+
+def is_static(motion: Motion) -> bool:
+    """True when ``motion`` is the identity in every frame."""
+    return (all(float(t) == 0.0 for t in motion.turns) and all(float(o) == 0.0 for o in motion.offset)
+            and float(motion.scale) == 1.0)
+
+
+@dataclass(frozen=True)
+class SceneObject:
+    """One object of a scene: rows ``vertex_start:vertex_stop`` of ``Scene.vertices``.
+
+    ``motion`` is the object's own motion (applied before the run's motion).
+    """
+
+    name: str
+    vertex_start: int
+    vertex_stop: int
+    motion: Motion = STATIC
+
+    @property
+    def vertex_count(self) -> int:
+        return self.vertex_stop - self.vertex_start
 
 
 @dataclass(frozen=True)
@@ -45,20 +97,105 @@ class Scene:
     edges: np.ndarray                        # (E, 2) intp, unique, i < j
     faces: tuple = field(default=())         # tuple of index tuples (polygons)
     source: str = ""
+    #: The objects, in file order; () when built by hand means one static object of everything.
+    objects: tuple = field(default=())
+    #: None, or why the faces' winding is inconsistent (core.culling.winding_problem).
+    winding_note: str | None = None
 
     def __post_init__(self):
         self.vertices.setflags(write=False)
         self.edges.setflags(write=False)
+        if not self.objects:
+            object.__setattr__(self, "objects", (SceneObject(self.name, 0, len(self.vertices), STATIC),))
+
+    @property
+    def is_single_static(self) -> bool:
+        """One object with the identity motion: a frame's model matrix is the run's alone."""
+        return (len(self.objects) == 1 and is_static(self.objects[0].motion)
+                and self.objects[0].vertex_start == 0 and self.objects[0].vertex_stop == len(self.vertices))
 
     @property
     def radius(self) -> float:
-        """Bounding-sphere radius about the origin (0 for an empty scene)."""
-        if len(self.vertices) == 0:
-            return 0.0
-        big = float(np.abs(self.vertices).max())       # scale first: squares of 1e155 overflow
-        if big == 0.0:
-            return 0.0
-        return big * float(np.sqrt(((self.vertices / big) ** 2).sum(axis=1).max()))
+        """Bounding-sphere radius about the origin (0 for an empty scene).
+
+        With objects that move, a bound that holds in every frame of their own
+        motion: ``max_o |translate_o| + |scale_o| * r_o``, where ``r_o`` is the
+        radius of object ``o``'s vertices about its own origin (a spin keeps
+        that distance).
+        """
+        if self.is_single_static:
+            return _radius(self.vertices)
+        best = 0.0
+        for o in self.objects:
+            if o.vertex_count == 0:
+                continue
+            r = _radius(self.vertices[o.vertex_start:o.vertex_stop])
+            best = max(best, _radius(np.asarray([o.motion.offset], dtype=np.float64)) + abs(o.motion.scale) * r)
+        return best
+
+    def object_edge_ranges(self) -> list[tuple[int, int]]:
+        """``(start, stop)`` rows of ``edges`` of each object (edges are sorted, objects' vertices contiguous)."""
+        first = self.edges[:, 0] if len(self.edges) else np.zeros(0, dtype=np.intp)
+        return [(int(np.searchsorted(first, o.vertex_start)), int(np.searchsorted(first, o.vertex_stop)))
+                for o in self.objects]
+
+    def object_face_ranges(self) -> list[tuple[int, int]]:
+        """``(start, stop)`` items of ``faces`` of each object (faces are kept in object order)."""
+        first = np.asarray([f[0] for f in self.faces], dtype=np.intp)
+        out, start = [], 0
+        for o in self.objects:
+            stop = start + int(np.count_nonzero((first >= o.vertex_start) & (first < o.vertex_stop)))
+            out.append((start, stop))
+            start = stop
+        return out
+
+
+def _radius(vertices: np.ndarray) -> float:
+    if len(vertices) == 0:
+        return 0.0
+    big = float(np.abs(vertices).max())       # scale first: squares of 1e155 overflow
+    if big == 0.0:
+        return 0.0
+    return big * float(np.sqrt(((vertices / big) ** 2).sum(axis=1).max()))
+
+
+def object_matrix(obj: SceneObject, run_motion: Motion, frame: int, frames: int) -> np.ndarray:
+    """World matrix of ``obj`` at 1-based ``frame`` of ``frames``: ``M_run(k) @ M_o(k)``."""
+    return run_motion.frame_matrix(frame, frames) @ obj.motion.frame_matrix(frame, frames)
+
+
+def world_points(scene: Scene, run_motion: Motion, frame: int, frames: int) -> np.ndarray:
+    """``(N, 3)`` float64 world positions of every vertex at 1-based ``frame`` of ``frames``.
+
+    Object ``o``'s rows are ``(M_run(k) @ M_o(k)) p_model`` (module docstring).
+    """
+    out = np.empty((len(scene.vertices), 3), dtype=np.float64)
+    m_run = run_motion.frame_matrix(frame, frames)
+    for o in scene.objects:
+        rows = slice(o.vertex_start, o.vertex_stop)
+        out[rows] = apply(m_run @ o.motion.frame_matrix(frame, frames), scene.vertices[rows])
+    return out
+
+
+def object_spheres(scene: Scene) -> list[tuple[np.ndarray, float]]:
+    """Each object's bounding sphere in its model space: (centre, radius).
+
+    The centre is the midpoint of the bounding box; the radius the largest
+    distance from it, widened by 1e-9 relative (and 1e-300 absolute) so that
+    rounding in a frame's transform cannot put a vertex outside it.
+    An object without vertices gets radius -1 (nothing to draw, always culled).
+    """
+    out = []
+    for o in scene.objects:
+        v = scene.vertices[o.vertex_start:o.vertex_stop]
+        if len(v) == 0:
+            out.append((np.zeros(3), -1.0))
+            continue
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        centre = 0.5 * lo + 0.5 * hi
+        r = _radius(v - centre)
+        out.append((centre, r * (1.0 + 1e-9) + 1e-300))
+    return out
 
 
 def unique_edges(edges: np.ndarray) -> np.ndarray:
@@ -86,50 +223,170 @@ def _number(path, lineno, token, what):
     return value
 
 
-def _index(path, lineno, token, what, n_vertices):
+def _index(path, lineno, token, what, n_vertices, where="the scene has"):
     try:
         value = int(token)
     except ValueError:
         raise InputError(f"{path}:{lineno}: {what} index {token!r}: expected an integer") from None
     if not 0 <= value < n_vertices:
         raise InputError(f"{path}:{lineno}: {what} index {value}: expected 0..{n_vertices - 1} "
-                         f"(the scene has {n_vertices} vertices so far)")
+                         f"({where} {n_vertices} vertices so far)")
     return value
 
 
-def parse_scene_text(text: str, path: str = "<string>", name: str | None = None) -> Scene:
-    vertices, edges, faces = [], [], []
+def _winding_note(faces) -> str | None:
+    """core.culling.winding_problem(faces), or None without faces (or without core.culling)."""
+    if not faces:
+        return None
+    try:
+        from .culling import winding_problem
+    except ImportError:      # core.culling not in this build: no check
+        return None
+    return winding_problem(faces)
+
+
+class _Obj:
+    """An object while its lines are parsed."""
+
+    def __init__(self, name, lineno):
+        self.name, self.lineno = name, lineno
+        self.vertices, self.edges, self.faces = [], [], []
+        self.mesh = None                      # (lineno, Scene) of a 'mesh' line
+        self.geometry_line = None             # first v/e/f line
+        self.motion = {}                      # keyword -> (lineno, value)
+
+    def touched(self) -> bool:
+        return bool(self.vertices or self.edges or self.faces or self.mesh or self.motion)
+
+
+_MOTION_KEYS = {"translate": "offset", "scale": "scale", "spin": "turns"}
+
+
+def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
+                     base_dir: str | os.PathLike | None = None) -> Scene:
+    """Parse the text format. ``base_dir`` (default: the directory of ``path``) resolves ``mesh`` paths."""
+    base = Path(base_dir) if base_dir is not None else Path(path).parent
+    implicit = _Obj(None, 0)
+    objs = [implicit]
+    cur = implicit
+    single = True                 # no 'object' line yet: messages speak of "the scene"
     for lineno, raw in enumerate(text.splitlines(), start=1):
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
         tag, *fields = line.split()
+        where = "the scene has" if single else f"object {cur.name!r} has"
         if tag == "name":
             if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
                 raise InputError(f"{path}:{lineno}: name {' '.join(fields)!r}: expected one word of letters, "
                                  "digits, '_', '.', '-' (it names output files)")
             name = fields[0]
-        elif tag == "v":
-            if len(fields) != 3:
-                raise InputError(f"{path}:{lineno}: vertex {line!r}: expected 'v X Y Z' (3 numbers), got {len(fields)}")
-            vertices.append([_number(path, lineno, t, "vertex coordinate") for t in fields])
-        elif tag == "e":
-            if len(fields) != 2:
-                raise InputError(f"{path}:{lineno}: edge {line!r}: expected 'e I J' (2 indices), got {len(fields)}")
-            edges.append([_index(path, lineno, t, "edge", len(vertices)) for t in fields])
-        elif tag == "f":
-            if len(fields) < 3:
-                raise InputError(f"{path}:{lineno}: face {line!r}: expected 'f I J K ...' (3 or more indices), got {len(fields)}")
-            faces.append(tuple(_index(path, lineno, t, "face", len(vertices)) for t in fields))
+        elif tag in ("v", "e", "f"):
+            if cur.mesh is not None:
+                raise InputError(f"{path}:{lineno}: {line!r}: expected no v/e/f lines in an object that takes "
+                                 f"its geometry from 'mesh' (line {cur.mesh[0]}); start a new 'object' first")
+            cur.geometry_line = cur.geometry_line or lineno
+            if tag == "v":
+                if len(fields) != 3:
+                    raise InputError(f"{path}:{lineno}: vertex {line!r}: expected 'v X Y Z' (3 numbers), "
+                                     f"got {len(fields)}")
+                cur.vertices.append([_number(path, lineno, t, "vertex coordinate") for t in fields])
+            elif tag == "e":
+                if len(fields) != 2:
+                    raise InputError(f"{path}:{lineno}: edge {line!r}: expected 'e I J' (2 indices), got {len(fields)}")
+                cur.edges.append([_index(path, lineno, t, "edge", len(cur.vertices), where) for t in fields])
+            else:
+                if len(fields) < 3:
+                    raise InputError(f"{path}:{lineno}: face {line!r}: expected 'f I J K ...' (3 or more indices), "
+                                     f"got {len(fields)}")
+                cur.faces.append(tuple(_index(path, lineno, t, "face", len(cur.vertices), where) for t in fields))
+        elif tag == "object":
+            if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
+                raise InputError(f"{path}:{lineno}: object {' '.join(fields)!r}: expected 'object NAME', one word "
+                                 "of letters, digits, '_', '.', '-'")
+            dup = next((o for o in objs[1:] if o.name == fields[0]), None)
+            if dup is not None:
+                raise InputError(f"{path}:{lineno}: object {fields[0]!r}: expected a new name (line {dup.lineno} "
+                                 "already starts an object of that name)")
+            cur = _Obj(fields[0], lineno)
+            objs.append(cur)
+            single = False
+        elif tag == "mesh":
+            if len(fields) != 1:
+                raise InputError(f"{path}:{lineno}: mesh {' '.join(fields)!r}: expected 'mesh PATH' "
+                                 "(one path without spaces, relative to the scene file)")
+            if cur.mesh is not None or cur.geometry_line is not None:
+                first = cur.mesh[0] if cur.mesh is not None else cur.geometry_line
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected one source of geometry per "
+                                 f"object (line {first} already gives it); start a new 'object' first")
+            mesh_path = Path(fields[0])
+            if not mesh_path.is_absolute():
+                mesh_path = base / mesh_path
+            if mesh_path.suffix.lower() not in MESH_SUFFIXES:
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected a file ending in "
+                                 f"{' '.join(MESH_SUFFIXES)}")
+            if not mesh_path.is_file():
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected an existing file "
+                                 f"({mesh_path} not found)")
+            try:
+                cur.mesh = (lineno, load_mesh_file(mesh_path))
+            except InputError as exc:
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: {exc}") from None
+        elif tag in _MOTION_KEYS:
+            if tag in cur.motion:
+                raise InputError(f"{path}:{lineno}: {tag} {' '.join(fields)!r}: expected one '{tag}' per object "
+                                 f"(line {cur.motion[tag][0]} already gives it)")
+            if tag == "scale":
+                if len(fields) != 1:
+                    raise InputError(f"{path}:{lineno}: scale {' '.join(fields)!r}: expected 'scale S' (1 number)")
+                s = _number(path, lineno, fields[0], "scale")
+                if s == 0.0:
+                    raise InputError(f"{path}:{lineno}: scale {fields[0]!r}: expected a non-zero number")
+                cur.motion[tag] = (lineno, s)
+            else:
+                if len(fields) != 3:
+                    raise InputError(f"{path}:{lineno}: {tag} {' '.join(fields)!r}: expected '{tag} X Y Z' "
+                                     f"(3 numbers), got {len(fields)}")
+                cur.motion[tag] = (lineno, tuple(_number(path, lineno, t, tag) for t in fields))
         else:
-            raise InputError(f"{path}:{lineno}: {tag!r}: expected a line starting with 'v', 'e', 'f', 'name' or '#'")
-    all_edges = np.concatenate([np.asarray(edges, dtype=np.intp).reshape(-1, 2), face_edges(faces)])
+            raise InputError(f"{path}:{lineno}: {tag!r}: expected a line starting with 'v', 'e', 'f', 'name', "
+                             "'object', 'mesh', 'translate', 'scale', 'spin' or '#'")
+    scene_name = name or _safe_stem(path)
+    if len(objs) > 1 and not implicit.touched():
+        objs = objs[1:]                           # nothing before the first 'object'
+    implicit.name = scene_name
+    if len(objs) > 1 and objs[0] is implicit:
+        dup = next((o for o in objs[1:] if o.name == scene_name), None)
+        if dup is not None:
+            raise InputError(f"{path}:{dup.lineno}: object {dup.name!r}: expected a name other than the scene's "
+                             "(the lines before the first 'object' form an object named after the scene)")
+    vertices, edges, faces, objects = [], [], [], []
+    n = 0
+    for o in objs:
+        if o.mesh is not None:
+            m = o.mesh[1]
+            o_vertices, o_edges = m.vertices, m.edges
+            o_faces = m.faces
+        else:
+            o_vertices = np.asarray(o.vertices, dtype=np.float64).reshape(-1, 3)
+            o_edges = np.concatenate([np.asarray(o.edges, dtype=np.intp).reshape(-1, 2), face_edges(o.faces)])
+            o_faces = o.faces
+        vertices.append(o_vertices)
+        edges.append(np.asarray(o_edges, dtype=np.intp).reshape(-1, 2) + n)
+        faces += [tuple(int(i) + n for i in f) for f in o_faces]
+        kw = {key: o.motion[tag][1] for tag, key in _MOTION_KEYS.items() if tag in o.motion}
+        motion = Motion(**{"turns": (0.0, 0.0, 0.0), "offset": (0.0, 0.0, 0.0), "scale": 1.0, **kw})
+        objects.append(SceneObject(o.name, n, n + len(o_vertices), motion))
+        n += len(o_vertices)
+    faces = tuple(faces)
     return Scene(
-        name=name or _safe_stem(path),
-        vertices=np.asarray(vertices, dtype=np.float64).reshape(-1, 3),
-        edges=unique_edges(all_edges),
-        faces=tuple(faces),
+        name=scene_name,
+        vertices=np.concatenate(vertices).reshape(-1, 3) if vertices else np.zeros((0, 3)),
+        edges=unique_edges(np.concatenate(edges)) if edges else np.zeros((0, 2), dtype=np.intp),
+        faces=faces,
         source=str(path),
+        objects=tuple(objects),
+        winding_note=_winding_note(faces),
     )
 
 
@@ -193,8 +450,9 @@ def load_mesh_file(path: Path) -> Scene:
         bad = np.argwhere(~np.isfinite(vertices))[0]
         raise InputError(f"{path}: vertex {bad[0]} has {vertices[bad[0]].tolist()}: expected finite coordinates")
     all_edges = np.concatenate(edges) if edges else np.zeros((0, 2), dtype=np.intp)
+    faces = tuple(tuple(int(i) for i in f) for f in faces)
     return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
-                 faces=tuple(tuple(int(i) for i in f) for f in faces), source=str(path))
+                 faces=faces, source=str(path), winding_note=_winding_note(faces))
 
 
 def _obj_vertices(path: Path) -> np.ndarray:
@@ -210,20 +468,28 @@ def _obj_vertices(path: Path) -> np.ndarray:
 
 
 def builtin_names() -> list[str]:
+    """The built-in scenes: ``scenes/*.scene`` (not ``scenes/examples/``)."""
     return sorted(p.stem for p in SCENE_DIR.glob("*" + NATIVE_SUFFIX))
 
 
+def example_names() -> list[str]:
+    """The example scenes in ``scenes/examples/``: loadable by name, not run by default."""
+    return sorted(p.stem for p in EXAMPLES_DIR.glob("*" + NATIVE_SUFFIX))
+
+
 def load_scene(name_or_path: str) -> Scene:
-    """A built-in scene by name (``cube``) or a file path (.scene or a mesh format)."""
+    """A built-in or example scene by name (``cube``, ``orrery``) or a file path (.scene or a mesh format)."""
     path = Path(name_or_path)
     is_path = os.sep in name_or_path or path.suffix != ""
     if not is_path:
-        builtin = SCENE_DIR / (name_or_path + NATIVE_SUFFIX)
-        if builtin.is_file():
-            path = builtin
+        for folder in (SCENE_DIR, EXAMPLES_DIR):
+            candidate = folder / (name_or_path + NATIVE_SUFFIX)
+            if candidate.is_file():
+                path = candidate
+                break
         else:
             raise InputError(f"--scene {name_or_path!r}: expected a built-in scene "
-                             f"({', '.join(builtin_names())}) or a file path")
+                             f"({', '.join(builtin_names() + example_names())}) or a file path")
     if path.is_dir():
         raise InputError(f"--scene {name_or_path!r} is a directory: expected a scene file")
     if not path.is_file():
@@ -238,7 +504,9 @@ def load_scene(name_or_path: str) -> Scene:
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: could not be read: {exc}") from None
     scene = parse_scene_text(text, str(path))
-    if path.resolve().parent == SCENE_DIR:
-        # built-in: a checkout-independent source, so reports are the same everywhere
-        scene = Scene(scene.name, scene.vertices, scene.edges, scene.faces, f"scenes/{path.name}")
+    folder = path.resolve().parent
+    if folder in (SCENE_DIR, EXAMPLES_DIR):
+        # bundled: a checkout-independent source, so reports are the same everywhere
+        rel = folder.relative_to(SCENE_DIR.parent).as_posix()
+        scene = dataclasses.replace(scene, source=f"{rel}/{path.name}")
     return scene

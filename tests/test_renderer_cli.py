@@ -118,6 +118,16 @@ def test_seed_json_frame_one_hand_derived(seed_run):
     assert_allclose(fr["vertices_px"][0], [319.5 - F70 / 5, 239.5 + F70 / 5], rtol=0, atol=1e-12)
 
 
+def test_seed_json_drawing_defaults_and_objects(seed_run):
+    rep = json.loads((seed_run[0] / "cube-report.json").read_text())
+    assert rep["drawing"] == {"projection": "perspective", "axes": False, "axis_length": None, "cull": None,
+                              "hidden_lines": False, "style": "wireframe", "light": None, "object_culling": True}
+    assert rep["scene"]["objects"] == [{"name": "cube", "vertices": 8, "spin": [0.0, 0.0, 0.0],
+                                        "translate": [0.0, 0.0, 0.0], "scale": 1.0}]
+    assert "camera_orthographic" not in rep and "objects_culled" not in rep["summary"]
+    assert not (seed_run[0] / "cube-plots.png").exists()          # --plots is off by default
+
+
 @pytest.mark.parametrize("k", [2, 46, 90, 135, 180])
 def test_seed_json_depths_match_naive(seed_run, k):
     fr = json.loads((seed_run[0] / "cube-report.json").read_text())["frames"][k - 1]

@@ -205,3 +205,21 @@ def test_corrupt_mesh_file_is_input_error(tmp_path):
     with pytest.raises(InputError) as info:
         load_scene(str(p))
     assert str(p) in str(info.value)
+
+
+# ---- objects (tests/test_multi_object.py has the rest) -----------------------------------
+
+def test_example_scene_by_name_and_in_the_unknown_message():
+    s = load_scene("orrery")
+    assert s.source == "scenes/examples/orrery.scene" and len(s.objects) == 3
+    with pytest.raises(InputError, match="orrery"):
+        load_scene("nosuchscene")
+
+
+def test_single_object_scene_keeps_its_arrays_and_one_static_object():
+    s = parse_scene_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "t.scene")
+    assert len(s.objects) == 1 and s.is_single_static
+    o = s.objects[0]
+    assert (o.name, o.vertex_start, o.vertex_stop) == ("t", 0, 3)
+    assert o.motion.turns == (0.0, 0.0, 0.0) and o.motion.offset == (0.0, 0.0, 0.0) and o.motion.scale == 1.0
+    assert_array_equal(s.edges, [[0, 1], [0, 2], [1, 2]])
