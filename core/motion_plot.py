@@ -76,7 +76,11 @@ def plot_png(records: list[dict], title: str) -> bytes:
     ax_c.set_ylabel("count per frame")
     ax_c.set_xlabel("frame")
     ax_c.grid(True, alpha=0.3)
-    ax_c.set_ylim(bottom=0)
+    from matplotlib.ticker import MaxNLocator
+
+    ax_c.yaxis.set_major_locator(MaxNLocator(integer=True))     # counts are whole numbers
+    top = max((r.get(key, 0) or 0 for r in records for key, *_ in series), default=0)
+    ax_c.set_ylim(0, max(1, top * 1.05))                        # all zero: show 0..1, not 0..0.05
     if len(k):
         ax_c.set_xlim(k[0] - 0.5, k[-1] + 0.5)
     fig.suptitle(title)
