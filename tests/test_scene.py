@@ -223,3 +223,18 @@ def test_single_object_scene_keeps_its_arrays_and_one_static_object():
     assert (o.name, o.vertex_start, o.vertex_stop) == ("t", 0, 3)
     assert o.motion.turns == (0.0, 0.0, 0.0) and o.motion.offset == (0.0, 0.0, 0.0) and o.motion.scale == 1.0
     assert_array_equal(s.edges, [[0, 1], [0, 2], [1, 2]])
+
+
+def test_vectorised_edge_helpers_equal_their_plain_definitions():
+    # unique_edges: sort each pair, drop self-loops, np.unique(axis=0) (the definition);
+    # face_edges on an (F, k) array: the same pairs, in the same order, as on lists.
+    from core.scene import face_edges, unique_edges
+
+    rng = np.random.default_rng(3)
+    for n in (1, 7, 5000):
+        e = rng.integers(0, n, size=(4 * n, 2))
+        s = np.sort(e, axis=1)
+        expected = np.unique(s[s[:, 0] != s[:, 1]], axis=0).reshape(-1, 2)
+        np.testing.assert_array_equal(unique_edges(e), expected)
+        faces = rng.integers(0, n, size=(n, 4))
+        np.testing.assert_array_equal(face_edges(faces), face_edges(faces.tolist()))
