@@ -285,7 +285,10 @@ def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: b
     poly_of = tri_face[kept_idx][src]                                          # clipped tri -> polygon
     out["depth"] = depth
     out["tri_buf"] = tri_buf
-    out["face_ids"] = np.where(tri_buf >= 0, poly_of[np.maximum(tri_buf, 0)], -1).astype(np.int32)
+    if len(poly_of):
+        out["face_ids"] = np.where(tri_buf >= 0, poly_of[np.maximum(tri_buf, 0)], -1).astype(np.int32)
+    else:                                   # every face culled or clipped away: nothing covered
+        out["face_ids"] = np.full(tri_buf.shape, -1, dtype=np.int32)
     out["grad"] = zbuffer.triangle_gradients(tri_px, tri_z, camera.projection)
     return out
 

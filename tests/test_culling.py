@@ -172,3 +172,20 @@ def test_directed_edges_in_polygon_order():
     assert face.tolist() == [0, 0, 0, 0, 1, 1, 1] and pos.tolist() == [0, 1, 2, 3, 0, 1, 2]
     i2, j2, _, _ = directed_edges(np.array([[4, 5, 6]]))
     assert list(zip(i2.tolist(), j2.tolist())) == [(4, 5), (5, 6), (6, 4)]
+
+
+@pytest.mark.parametrize("kw", [{"hidden_lines": True}, {"style": "shaded"}])
+def test_every_face_culled_renders_an_empty_face_buffer(kw):
+    # A camera inside the cube sees every face from behind (outward normals point
+    # away from it), so back-face culling keeps none: no face covers any pixel,
+    # and with hidden lines every remaining edge (none: all belong to faces) is gone.
+    from core.camera import camera_z
+    from core.pipeline import render_frame
+    from core.scene import load_scene
+
+    cube = load_scene("cube")
+    cam = camera_z(0.5, near=0.1, far=10.0)
+    frame = render_frame(cube.vertices, cube.edges, cam, np.eye(4), faces=cube.faces, cull="backface", **kw)
+    assert frame.faces_culled == 6
+    assert (frame.face_ids == -1).all() and np.isinf(frame.depth_image).all()
+    assert not frame.image.any()
