@@ -9,6 +9,22 @@ pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
 the same two levels. ``--every K`` checks frames 1, 1+K, ... of the motion;
 ``--jobs N`` runs the cases in N worker processes (same report as one).
 
+Drawing modes of the core candidate (level pixels): ``--hidden-lines``
+(faces hide the lines behind them; pyrender draws them black with a polygon
+offset under the lines), ``--cull backface`` (back faces culled, and their
+edges when no front face owns them; checked against the oracle's own
+front-face test and GL culling) and ``--style shaded`` (core's depth buffer
+against pyrender's filled faces: silhouette IoU and depth error within a
+derived bound, oracles/tolerances.py). A scene without faces is then compared
+as a plain wireframe, or (shaded) checked for its vertices only, with a note.
+They need the core candidate and the pixel level: with ``--candidate``,
+``--level vertices``, ``--sweep`` or ``--suite``, and ``--hidden-lines`` with
+``--style shaded`` (a shaded frame has no lines), they are usage errors.
+
+The report directory also gets ``worst.gif`` (every checked frame of the
+worst case: candidate | oracle | diff), ``vertex_error.png`` and
+``pixels.png`` (per-frame plots of every case).
+
 ``--sweep`` runs every core setting (dtype x clip x raster) on the scenes and
 a large mesh and writes a table and a Pareto plot (oracles/sweep.py); it
 exits 1 only when the default setting is out of tolerance. ``--suite
@@ -35,7 +51,7 @@ from . import tolerances
 from .candidate import load_candidate
 from .cases import CASE_NAMES
 from .report import console_table, timing_line, write_report
-from .runner import LEVELS, CoreCandidate, Tolerances, level_for_oracles, run_crosscheck
+from .runner import LEVELS, CoreCandidate, RenderMode, Tolerances, level_for_oracles, run_crosscheck
 
 ORACLES = ("opencv", "pyrender")
 #: Options that configure the core candidate, with their defaults.
@@ -71,6 +87,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="core candidate only: near/far handling of edges (default clip)")
     p.add_argument("--raster", choices=CoreCandidate.RASTERS, default=None,
                    help="core candidate only: line rasterizer (default exact; aa: drawn where >= 128)")
+    p.add_argument("--style", choices=RenderMode.STYLES, default=None,
+                   help="core candidate, level pixels: wireframe (default), or shaded: core's depth buffer against "
+                        "pyrender's filled faces (silhouette IoU and depth error)")
+    p.add_argument("--hidden-lines", action="store_true", default=False,
+                   help="core candidate, level pixels: the scene's faces hide the lines behind them "
+                        "(pyrender: faces black with glPolygonOffset(1, 1), lines on top)")
+    p.add_argument("--cull", choices=RenderMode.CULLS, default=None,
+                   help="core candidate, level pixels: backface culls back faces and the edges only they own "
+                        "(default none)")
     p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
     p.add_argument("--tol-px", type=float, default=tolerances.VERTEX_TOL_PX,
                    help=f"max vertex error in px (default {tolerances.VERTEX_TOL_PX})")
@@ -78,6 +103,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"min edge-pixel F1 at 1 px (default {tolerances.MIN_F1_1PX})")
     p.add_argument("--min-f1-0px", type=float, default=tolerances.MIN_F1_0PX,
                    help=f"min edge-pixel F1 at 0 px (default {tolerances.MIN_F1_0PX})")
+    p.add_argument("--min-iou", type=float, default=tolerances.MIN_SILHOUETTE_IOU,
+                   help=f"--style shaded: min silhouette IoU (default {tolerances.MIN_SILHOUETTE_IOU})")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--sweep", action="store_true",
                       help="every --dtype x --clip x --raster setting of core on the scenes and a large mesh: "
@@ -97,7 +124,7 @@ def _parse(args):
         raise InputError(f"--frames {args.frames}: expected an integer >= 1")
     if not (math.isfinite(args.tol_px) and args.tol_px >= 0):
         raise InputError(f"--tol-px {args.tol_px}: expected a number >= 0")
-    for opt, v in (("--min-f1", args.min_f1), ("--min-f1-0px", args.min_f1_0px)):
+    for opt, v in (("--min-f1", args.min_f1), ("--min-f1-0px", args.min_f1_0px), ("--min-iou", args.min_iou)):
         if not 0.0 <= v <= 1.0:
             raise InputError(f"{opt} {v}: expected a number in [0, 1]")
     if args.every < 1:
@@ -124,6 +151,22 @@ def _parse(args):
     if args.candidate and core_given:
         raise InputError(f"{', '.join(core_given)}: settings of the core candidate, not of --candidate "
                          f"{args.candidate!r}: expected them without --candidate")
+    mode_given = [opt for opt, given in (("--style", args.style is not None), ("--hidden-lines", args.hidden_lines),
+                                         ("--cull", args.cull is not None)) if given]
+    if mode_given:
+        what = ", ".join(mode_given)
+        if args.sweep or args.suite:
+            raise InputError(f"{what} with {'--sweep' if args.sweep else '--suite ' + args.suite}: expected "
+                             "the drawing options in a plain crosscheck run only")
+        if args.candidate:
+            raise InputError(f"{what}: drawing modes of the core candidate; --candidate {args.candidate!r} only "
+                             "projects points: expected them without --candidate")
+        if level != "pixels":
+            raise InputError(f"{what} with --level {level}: faces are drawn and compared at the pixel level "
+                             "only: expected --level pixels (the default)")
+        if args.style == "shaded" and args.hidden_lines:
+            raise InputError("--hidden-lines with --style shaded: a shaded frame has no lines: expected one of them")
+    mode = RenderMode(style=args.style or "wireframe", hidden_lines=args.hidden_lines, cull=args.cull or "none")
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
     bad = [c for c in cases if c not in CASE_NAMES]
     if bad or not cases:
@@ -140,13 +183,13 @@ def _parse(args):
         candidate = load_candidate(args.candidate)
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
-    return level, cases, spin, scenes, candidate
+    return level, cases, spin, scenes, candidate, mode
 
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        level, case_names, spin, scenes, candidate = _parse(args)
+        level, case_names, spin, scenes, candidate, mode = _parse(args)
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
         return 2
@@ -179,7 +222,8 @@ def main(argv=None) -> int:
               "expected a writable directory", file=sys.stderr)
         return 2
 
-    tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
+    tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
+                     min_iou=args.min_iou)
     if args.sweep:
         return _sweep(args, scenes, case_names, spin, level, tol, run_dir)
     if args.suite:
@@ -187,7 +231,8 @@ def main(argv=None) -> int:
     try:
         report, images = run_crosscheck(scenes, candidate, frames=args.frames, case_names=case_names,
                                         level=level, turns=spin, tol=tol, every=args.every, jobs=args.jobs,
-                                        candidate_name=args.candidate or "core", candidate_spec=args.candidate)
+                                        candidate_name=args.candidate or "core", candidate_spec=args.candidate,
+                                        mode=mode)
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
         return 2
@@ -208,8 +253,10 @@ def main(argv=None) -> int:
         elif r.get("note"):
             print(f"  {r['scene']} / {r['camera']}: {r['note']}")
     s = report["summary"]
+    limits = (f"silhouette IoU >= {tol.min_iou}, depth error <= its bound" if mode.shaded
+              else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}")
     print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance "
-          f"(vertex <= {tol.vertex_px:g} px, F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px})")
+          f"(vertex <= {tol.vertex_px:g} px, {limits})")
     print(timing_line(report))
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
     return 1 if failed else 0

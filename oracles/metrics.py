@@ -92,3 +92,116 @@ def diff_image(cand: np.ndarray, oracle: np.ndarray) -> np.ndarray:
     img[cand & ~oracle] = DIFF_COLOURS["candidate_only"]
     img[~cand & oracle] = DIFF_COLOURS["oracle_only"]
     return img
+
+
+# ---------------------------------------------------------------- shaded frames: silhouette and depth
+
+_NEIGHBOURS = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
+
+
+def _shifted(a: np.ndarray, dy: int, dx: int, fill) -> np.ndarray:
+    """``out[y, x] = a[y + dy, x + dx]``, ``fill`` outside the image."""
+    out = np.full_like(a, fill)
+    h, w = a.shape
+    ys, yd = (slice(dy, h), slice(0, h - dy)) if dy >= 0 else (slice(0, h + dy), slice(-dy, h))
+    xs, xd = (slice(dx, w), slice(0, w - dx)) if dx >= 0 else (slice(0, w + dx), slice(-dx, w))
+    out[yd, xd] = a[ys, xs]
+    return out
+
+
+def interior(mask: np.ndarray) -> np.ndarray:
+    """Pixels of ``mask`` whose 8 neighbours are all in it (erosion by 1 px; outside the image counts as in)."""
+    out = mask.copy()
+    for dy, dx in _NEIGHBOURS:
+        out &= _shifted(mask, dy, dx, True)
+    return out
+
+
+def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Pixels next to a pixel that shows a triangle sharing no vertex with theirs.
+
+    ``ids`` is a triangle-id image (-1: none). Two triangles that share a vertex
+    meet there, so depth is continuous across the line between them; between
+    triangles that share none (an occluding object or fold in front of
+    another) depth jumps, and which of the two a pixel centre within
+    rounding of that line shows is decided by each renderer's rounding. Such
+    pixels (one on each side) are left out of the depth comparison.
+    """
+    out = np.zeros(ids.shape, bool)
+    triangles = np.asarray(triangles).reshape(-1, 3)
+    for dy, dx in _NEIGHBOURS[4:]:         # each unordered neighbour pair once; mark both ends
+        other = _shifted(ids, dy, dx, -1)
+        m = (ids != other) & (ids >= 0) & (other >= 0)
+        if not m.any():
+            continue
+        a, b = triangles[ids[m]], triangles[other[m]]
+        apart = ~(a[:, :, None] == b[:, None, :]).any(axis=(1, 2))
+        hit = np.zeros(ids.shape, bool)
+        hit[m] = apart                                   # this pixel, whose neighbour (dy, dx) is apart
+        out |= hit | _shifted(hit, -dy, -dx, False)      # and that neighbour
+    return out
+
+
+def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_depth: np.ndarray,
+                  depth_bound: np.ndarray | None = None, exclude: np.ndarray | None = None) -> dict:
+    """Silhouette IoU and depth errors of a shaded frame against the oracle's.
+
+    ``cand_depth``: the candidate's camera depth, +inf (or NaN) where nothing
+    covers the pixel; ``oracle_covered`` / ``oracle_depth``: the oracle's
+    coverage and camera depth. Depth is compared over the pixels covered by
+    both whose 8 neighbours are covered by both (no silhouette pixel of
+    either), minus ``exclude`` (occlusion boundaries). ``depth_bound`` (per
+    pixel, same shape) turns the errors into ``depth_error_ratio`` = max of
+    error / bound (<= 1: within the bound); ``depth_error_bound`` is the bound
+    at the pixel of ``depth_max_error``.
+    """
+    cand_depth = np.asarray(cand_depth, dtype=np.float64)
+    cand = np.isfinite(cand_depth)
+    orac = np.asarray(oracle_covered, bool)
+    if cand.shape != orac.shape:
+        raise ValueError(f"image shapes differ: {cand.shape} vs {orac.shape}")
+    union = int((cand | orac).sum())
+    inter = int((cand & orac).sum())
+    out = {"candidate_pixels": int(cand.sum()), "oracle_pixels": int(orac.sum()),
+           "silhouette_iou": 1.0 if union == 0 else inter / union,
+           "depth_pixels": 0, "depth_max_error": None, "depth_mean_error": None, "depth_error_bound": None,
+           "depth_error_ratio": None, "depth_worst_pixel": None}
+    compared = interior(cand) & interior(orac) & cand & orac
+    if exclude is not None:
+        compared &= ~exclude
+    if compared.any():
+        err = np.abs(cand_depth[compared] - np.asarray(oracle_depth, np.float64)[compared])
+        k = int(np.argmax(err))
+        idx = np.flatnonzero(compared.ravel())
+        out.update(depth_pixels=int(compared.sum()), depth_max_error=float(err[k]),
+                   depth_mean_error=float(err.mean()),
+                   depth_worst_pixel=[int(idx[k] // cand.shape[1]), int(idx[k] % cand.shape[1])])
+        if depth_bound is not None:
+            bound = np.asarray(depth_bound, np.float64)[compared]
+            out["depth_error_bound"] = float(bound[k])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = np.where(err == 0, 0.0, err / bound)
+            out["depth_error_ratio"] = float(ratio.max())
+    return out
+
+
+def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
+    """Largest |depth change| to a covered 4-neighbour, per pixel (0 where none)."""
+    d = np.where(covered, np.asarray(depth, np.float64), np.nan)
+    slope = np.zeros(d.shape)
+    for dy, dx in ((0, 1), (0, -1), (1, 0), (-1, 0)):
+        with np.errstate(invalid="ignore"):
+            slope = np.fmax(slope, np.abs(_shifted(d, dy, dx, np.nan) - d))
+    return np.nan_to_num(slope, nan=0.0)
+
+
+def depth_bound(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
+    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances)."""
+    from . import tolerances
+    from .pyrender_oracle import depth_step
+
+    depth = np.asarray(depth, np.float64)
+    eps32 = float(np.finfo(np.float32).eps)
+    return (tolerances.DEPTH_STEPS * depth_step(depth, camera)
+            + tolerances.DEPTH_SNAP_PX * depth_slope(depth, covered)
+            + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth))

@@ -5,7 +5,24 @@ Edges are drawn as one ``GL_LINES`` primitive, 1 px wide, white on black, with
 Mesa clips lines against near/far and the image sides, like core's "clip"
 mode. Face culling does not apply to lines; the optional faces are drawn black
 with a polygon offset so they hide the lines behind them without z-fighting
-with the lines on their own boundary.
+with the lines on their own boundary (hidden lines). With ``cull=True`` those
+occluding faces are single-sided: GL culls the back faces (counter-clockwise in
+the window = front, GL's default, which is counter-clockwise seen from outside
+in the scene files), so a back face hides nothing.
+
+:meth:`PyrenderOracle.render_faces` draws filled triangles for the shaded
+comparison: silhouette and depth, with ``RenderFlags.FLAT`` (no lights: neither
+coverage nor depth depends on lighting, and a lit image would depend on
+pyrender's PBR model, which is not what core's shading implements). Each
+triangle gets its own flat colour, its 24-bit index + 1, so the colour buffer
+is a triangle-id image (0: background), used to find occlusion boundaries.
+Depth is read from the 24-bit depth buffer directly and made linear here in
+float64: pyrender's own linearisation assumes a perspective projection (wrong
+for its OrthographicCamera) and runs in float32.
+
+Measured on this llvmpipe: the multisample buffers pyrender allocates are not
+used for these draws (the colour buffer has only 0 and 255, never partial
+coverage), so a pixel is covered exactly when its centre is (GL's rule).
 
 pyrender is imported lazily, after ``PYOPENGL_PLATFORM`` defaults to
 ``osmesa``. One :class:`PyrenderOracle` keeps one ``OffscreenRenderer`` and one
@@ -22,7 +39,7 @@ from core.camera import Camera
 
 from .convert import camera_to_pyrender
 
-__all__ = ["osmesa_available", "PyrenderOracle"]
+__all__ = ["osmesa_available", "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
 
 _INSTALL_HINT = "apt-get install -y libosmesa6"
 
@@ -58,6 +75,50 @@ def _fan(faces) -> np.ndarray:
     return np.asarray(tris, dtype=np.uint32).reshape(-1, 3)
 
 
+def _linear_depth(z_win: np.ndarray, camera: Camera) -> np.ndarray:
+    """Window depth in [0, 1] (float64) to camera depth, 0 where nothing was drawn (``z_win == 1``).
+
+    GL maps NDC z in [-1, 1] to the window's [0, 1]. pyrender's projection
+    matrices (``IntrinsicsCamera`` / ``OrthographicCamera.get_projection_matrix``)
+    give, with ``d`` the camera depth (distance along forward)::
+
+        perspective:   z_win = f (d - n) / ((f - n) d)   ->   d = f n / (f - z_win (f - n))
+        orthographic:  z_win = (d - n) / (f - n)         ->   d = n + z_win (f - n)
+    """
+    n, f = float(camera.near), float(camera.far)
+    drawn = z_win < 1.0
+    d = np.zeros(z_win.shape, np.float64)
+    z = z_win[drawn]
+    if camera.projection == "perspective":
+        d[drawn] = f * n / (f - z * (f - n))
+    else:
+        d[drawn] = n + z * (f - n)
+    return d
+
+
+def depth_step(depth, camera: Camera):
+    """One step of the 24-bit depth buffer, in camera depth units, at camera depth ``depth``.
+
+    ``dz_win = 1 / (2^24 - 1)``; the derivative of the maps in :func:`_linear_depth`:
+    perspective ``d'(z_win) = d^2 (f - n) / (f n)``, orthographic ``f - n``.
+    """
+    n, f = float(camera.near), float(camera.far)
+    depth = np.asarray(depth, dtype=np.float64)
+    if camera.projection == "perspective":
+        return depth ** 2 * (f - n) / (f * n) / DEPTH_LEVELS
+    return np.full(depth.shape, (f - n) / DEPTH_LEVELS)
+
+
+#: Levels of pyrender's GL_DEPTH_COMPONENT24 buffer: z_win = k / (2^24 - 1).
+DEPTH_LEVELS = float(2 ** 24 - 1)
+
+
+def _id_colours(count: int) -> np.ndarray:
+    """``(count, 3)`` uint8: triangle ``i`` as the 24-bit number ``i + 1`` (R high byte)."""
+    ids = np.arange(1, count + 1, dtype=np.uint32)
+    return np.stack([(ids >> 16) & 255, (ids >> 8) & 255, ids & 255], axis=1).astype(np.uint8)
+
+
 class PyrenderOracle:
     """A reusable pyrender/OSMesa wireframe renderer of fixed size.
 
@@ -78,8 +139,15 @@ class PyrenderOracle:
         self._scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
         self._mesh_node = None
         self._mesh_key = None
+        self._mesh_faces = None
         self._cam_node = None
         self._cam_key = None
+        # render_faces: a scene of its own, so that alternating with render() rebuilds nothing
+        self._fscene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
+        self._fmesh_node = None
+        self._fmesh_key = None
+        self._fcam_node = None
+        self._fcam_key = None
 
     # ---- lifetime ------------------------------------------------------
     def close(self) -> None:
@@ -94,10 +162,13 @@ class PyrenderOracle:
         self.close()
 
     # ---- scene updates -------------------------------------------------
-    def _set_mesh(self, vertices: np.ndarray, edges: np.ndarray, faces) -> None:
-        key = (vertices.tobytes(), edges.tobytes(), None if faces is None else tuple(map(tuple, faces)))
-        if key == self._mesh_key:
+    def _set_mesh(self, vertices: np.ndarray, edges: np.ndarray, faces, cull: bool = False) -> None:
+        # faces are compared by identity (a scene's faces are an immutable tuple, the same
+        # object every frame): turning 100k polygons into a key costs more than a frame
+        key = (vertices.tobytes(), edges.tobytes(), cull)
+        if key == self._mesh_key and faces is self._mesh_faces and (faces is None or isinstance(faces, tuple)):
             return
+        self._mesh_faces = faces
         if self._mesh_node is not None:
             self._scene.remove_node(self._mesh_node)
             self._mesh_node = None
@@ -110,29 +181,54 @@ class PyrenderOracle:
             prims.append(pr.Primitive(positions=positions, indices=edges.astype(np.uint32),
                                       mode=pr.constants.GLTF.LINES, material=white))
         if faces is not None and len(faces):
-            black = pr.MetallicRoughnessMaterial(baseColorFactor=[0.0, 0.0, 0.0, 1.0], doubleSided=True)
+            black = pr.MetallicRoughnessMaterial(baseColorFactor=[0.0, 0.0, 0.0, 1.0], doubleSided=not cull)
             prims.append(pr.Primitive(positions=positions, indices=_fan(faces),
                                       mode=pr.constants.GLTF.TRIANGLES, material=black))
         if prims:
             self._mesh_node = self._scene.add(pr.Mesh(prims))
 
-    def _set_camera(self, camera: Camera) -> None:
+    def _set_camera(self, camera: Camera, faces_scene: bool = False) -> None:
         if (camera.width, camera.height) != (self.width, self.height):
             raise ValueError(f"camera size {camera.width}x{camera.height}: this oracle renders "
                              f"{self.width}x{self.height}")
+        scene, node_attr, key_attr = ((self._fscene, "_fcam_node", "_fcam_key") if faces_scene
+                                      else (self._scene, "_cam_node", "_cam_key"))
         pose, cam = camera_to_pyrender(camera)
         key = (camera.projection, camera.fov_y_deg, camera.ortho_height, camera.near, camera.far)
-        if key != self._cam_key:
-            if self._cam_node is not None:
-                self._scene.remove_node(self._cam_node)
-            self._cam_node = self._scene.add(cam, pose=pose)
-            self._cam_key = key
+        if key != getattr(self, key_attr):
+            if getattr(self, node_attr) is not None:
+                scene.remove_node(getattr(self, node_attr))
+            setattr(self, node_attr, scene.add(cam, pose=pose))
+            setattr(self, key_attr, key)
         else:
-            self._scene.set_pose(self._cam_node, pose)
+            scene.set_pose(getattr(self, node_attr), pose)
+
+    def _set_faces(self, vertices: np.ndarray, triangles: np.ndarray, cull: bool) -> None:
+        key = (vertices.tobytes(), triangles.tobytes(), cull)
+        if key == self._fmesh_key:
+            return
+        if self._fmesh_node is not None:
+            self._fscene.remove_node(self._fmesh_node)
+            self._fmesh_node = None
+        self._fmesh_key = key
+        if len(triangles) == 0:
+            return
+        pr = self._pr
+        # every triangle its own three vertices, all of its id colour: the flat
+        # shader multiplies the (white) base colour by the interpolated vertex
+        # colour, which is then constant over the triangle
+        positions = vertices[triangles.reshape(-1)].astype(np.float32)
+        colours = np.repeat(_id_colours(len(triangles)), 3, axis=0)
+        colours = np.concatenate([colours, np.full((len(colours), 1), 255, np.uint8)], axis=1)
+        white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=not cull)
+        prim = pr.Primitive(positions=positions, color_0=colours,
+                            indices=np.arange(len(positions), dtype=np.uint32).reshape(-1, 3),
+                            mode=pr.constants.GLTF.TRIANGLES, material=white)
+        self._fmesh_node = self._fscene.add(pr.Mesh([prim]))
 
     # ---- rendering -----------------------------------------------------
     def render(self, vertices: np.ndarray, edges: np.ndarray, camera: Camera,
-               model_matrix: np.ndarray | None = None, faces=None
+               model_matrix: np.ndarray | None = None, faces=None, cull: bool = False
                ) -> tuple[np.ndarray, np.ndarray]:
         """Render a wireframe.
 
@@ -147,6 +243,9 @@ class PyrenderOracle:
             Pose of the mesh node; identity when None.
         faces : sequence of index tuples, optional
             Polygons drawn black (occluders); None draws every line.
+        cull : bool
+            Occluding faces single-sided: back faces (clockwise in the window)
+            are culled by GL and hide nothing.
 
         Returns
         -------
@@ -160,7 +259,7 @@ class PyrenderOracle:
         pr = self._pr
         vertices = np.ascontiguousarray(vertices, dtype=np.float64).reshape(-1, 3)
         edges = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
-        self._set_mesh(vertices, edges, faces)
+        self._set_mesh(vertices, edges, faces, bool(cull))
         self._set_camera(camera)
         if self._mesh_node is not None:
             pose = np.eye(4) if model_matrix is None else np.asarray(model_matrix, dtype=np.float64)
@@ -169,6 +268,88 @@ class PyrenderOracle:
             self._polygon_offset()
         colour, depth = self._renderer.render(self._scene, pr.RenderFlags.FLAT)
         return colour[:, :, 0] > 127, np.ascontiguousarray(depth, dtype=np.float32)
+
+    def render_faces(self, vertices: np.ndarray, triangles: np.ndarray, camera: Camera,
+                     model_matrix: np.ndarray | None = None, cull: bool = False, with_ids: bool = False):
+        """Render filled triangles: coverage and linear camera depth (and triangle ids).
+
+        Parameters
+        ----------
+        vertices : (N, 3) array_like
+            ``p_model`` (with ``model_matrix``) or ``p_world`` (without).
+        triangles : (T, 3) array_like of int
+        camera : Camera
+        model_matrix : (4, 4) array_like, optional
+        cull : bool
+            GL back-face culling (pyrender's default for a material that is not
+            ``doubleSided``): counter-clockwise in the window is front.
+        with_ids : bool
+            Also return the triangle-id image.
+
+        Returns
+        -------
+        covered : (H, W) bool, True where some triangle covers the pixel centre.
+        depth : (H, W) float64, camera depth of the nearest triangle (distance
+            along ``forward``), 0 where nothing was drawn; from the 24-bit
+            depth buffer (:func:`depth_step` is its resolution).
+        ids : (H, W) int64, only with ``with_ids``: index of the triangle seen
+            at each pixel, -1 where none.
+        """
+        if self._renderer is None:
+            raise RuntimeError("PyrenderOracle is closed")
+        pr = self._pr
+        vertices = np.ascontiguousarray(vertices, dtype=np.float64).reshape(-1, 3)
+        triangles = np.ascontiguousarray(triangles, dtype=np.int64).reshape(-1, 3)
+        if with_ids and len(triangles) >= 2 ** 24 - 1:
+            raise ValueError(f"{len(triangles)} triangles: the id image holds at most 2^24 - 2")
+        self._set_faces(vertices, triangles, bool(cull))
+        self._set_camera(camera, faces_scene=True)
+        if self._fmesh_node is not None:
+            pose = np.eye(4) if model_matrix is None else np.asarray(model_matrix, dtype=np.float64)
+            self._fscene.set_pose(self._fmesh_node, pose)
+        self._no_polygon_offset()
+        colour, _pyrender_depth = self._renderer.render(self._fscene, pr.RenderFlags.FLAT)
+        z_win = self._read_window_depth()
+        depth = _linear_depth(z_win, camera)
+        covered = z_win < 1.0
+        if not with_ids:
+            return covered, depth
+        c = colour.astype(np.int64)
+        ids = ((c[:, :, 0] << 16) | (c[:, :, 1] << 8) | c[:, :, 2]) - 1
+        if ids.max(initial=-1) >= len(triangles) or ((ids >= 0) != covered).any():
+            raise RuntimeError("pyrender's triangle-id colours came back altered (expected flat, unlit, "
+                               "exact 8-bit colours): cannot find occlusion boundaries")
+        return covered, depth, ids
+
+    def _read_window_depth(self) -> np.ndarray:
+        """The last render's depth buffer as window depth in [0, 1], float64, row 0 on top.
+
+        Read as GL_UNSIGNED_INT (exact: the 24-bit value ``k`` in the high
+        bits, ``z_win = k / (2^24 - 1)``) from where pyrender rendered: on
+        OSMesa (no framebuffer objects) the default framebuffer's front buffer,
+        as pyrender's ``read_depth_buf`` does, else its resolved main
+        framebuffer. pyrender's own depth image is not used: its linearisation
+        assumes a perspective projection and runs in float32.
+        """
+        from OpenGL import GL
+        platform = self._renderer._platform
+        platform.make_current()
+        try:
+            if platform.supports_framebuffers():
+                GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self._renderer._renderer._main_fb)
+            else:
+                GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, 0)
+                GL.glReadBuffer(GL.GL_FRONT)
+            buf = GL.glReadPixels(0, 0, self.width, self.height, GL.GL_DEPTH_COMPONENT, GL.GL_UNSIGNED_INT)
+        finally:
+            platform.make_uncurrent()
+        raw = np.frombuffer(buf, dtype=np.uint32).reshape(self.height, self.width)[::-1]
+        return (raw >> 8).astype(np.float64) / DEPTH_LEVELS
+
+    def _no_polygon_offset(self) -> None:
+        from OpenGL import GL
+        self._renderer._platform.make_current()
+        GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
 
     def _polygon_offset(self) -> None:
         # pyrender never touches GL_POLYGON_OFFSET_FILL, so set it on our

@@ -4,7 +4,10 @@ The run directory is filled under a temporary name and renamed at the end,
 so a directory called ``reports/<run>`` is always complete. Timings live only
 under the top-level ``"timing"`` key of report.json and in report.html;
 everything else, report.md included, is deterministic (the same for any
-``--jobs``).
+``--jobs``), and so are the figures (oracles.plots): ``vertex_error.png``
+(per-frame vertex error of every case), ``pixels.png`` (per-frame F1@0px, or
+silhouette IoU and depth error / bound when shaded) and ``worst.gif`` (every
+checked frame of the worst case: candidate | oracle | diff).
 """
 
 from __future__ import annotations
@@ -59,17 +62,36 @@ def fault_text(faults: list[dict]) -> str:
     return "; ".join(parts)
 
 
+def _is_shaded(cases: list[dict]) -> bool:
+    return any("silhouette_iou" in c for c in cases)
+
+
+def _fmt_ratio(v) -> str:
+    return "-" if v is None else f"{v:.3g}"
+
+
 def table_rows(cases: list[dict]) -> list[list[str]]:
+    if _is_shaded(cases):
+        return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _fmt_f1(c.get("silhouette_iou")),
+                 _fmt_err(c.get("depth_max_error")), _fmt_ratio(c.get("depth_error_ratio")), c["verdict"],
+                 fault_text(c["faults"])] for c in cases]
     return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _fmt_f1(c.get("pixel_f1_0px")),
              _fmt_f1(c.get("pixel_f1_1px")), c["verdict"], fault_text(c["faults"])] for c in cases]
 
 
 HEADER = ["scene", "camera", "max vertex err (px)", "F1@0px", "F1@1px", "verdict", "faults"]
+SHADED_HEADER = ["scene", "camera", "max vertex err (px)", "silhouette IoU", "max depth err", "depth err / bound",
+                 "verdict", "faults"]
+
+
+def header(cases: list[dict]) -> list[str]:
+    return SHADED_HEADER if _is_shaded(cases) else HEADER
 
 
 def console_table(cases: list[dict]) -> str:
-    rows = [HEADER] + table_rows(cases)
-    widths = [max(len(r[i]) for r in rows) for i in range(len(HEADER) - 1)]
+    head = header(cases)
+    rows = [head] + table_rows(cases)
+    widths = [max(len(r[i]) for r in rows) for i in range(len(head) - 1)]
     lines = []
     for r in rows:
         lines.append("  ".join(r[i].ljust(widths[i]) for i in range(len(widths))) + "  " + r[-1])
@@ -101,6 +123,44 @@ def settings_text(report: dict) -> str:
     return ", ".join(f"{k} = {v}" for k, v in settings.items()) if settings else ""
 
 
+def drawing_text(report: dict) -> str:
+    """The drawing mode in one sentence (style, hidden lines, culling)."""
+    style = report.get("style", "wireframe")
+    if report.get("level") == "vertices":
+        return "nothing drawn (level vertices)"
+    if style == "shaded":
+        what = ("shaded faces: core's depth buffer against pyrender's (flat, unlit), "
+                "silhouette IoU and depth error")
+    elif report.get("hidden_lines"):
+        what = "wireframe with hidden lines (pyrender: faces black with glPolygonOffset(1, 1), lines on top)"
+    else:
+        what = "wireframe"
+    cull = report.get("cull", "none")
+    cull_text = ("back faces culled (GL back-face culling in pyrender; the oracle's own front-face test "
+                 "picks the edges)" if cull == "backface" else "no culling")
+    return (f"style = {style}, hidden_lines = {str(bool(report.get('hidden_lines'))).lower()}, cull = {cull}: "
+            f"{what}; {cull_text}")
+
+
+def _figures(report: dict, files: set) -> list[tuple[str, str]]:
+    """(file, caption) of the figures written beside the report."""
+    out = []
+    if "vertex_error.png" in files:
+        out.append(("vertex_error.png", "per-frame max vertex error of every case (log scale)"))
+    if "pixels.png" in files:
+        out.append(("pixels.png", "per-frame silhouette IoU and depth error / bound of every case"
+                    if report.get("style") == "shaded" else "per-frame F1@0px of every case"))
+    return out
+
+
+def _worst_text(report: dict) -> str | None:
+    w = report.get("worst_case")
+    if not w:
+        return None
+    return (f"{w['scene']} / {w['camera']}, all {w['frames_checked']} checked frames "
+            "(candidate | oracle | diff; the bar under them is the frame's place in the run)")
+
+
 def _fmt_ms(v) -> str:
     return "-" if v is None else f"{v:.3g}"
 
@@ -128,16 +188,20 @@ def timing_line(report: dict) -> str:
             + f" ({t.get('jobs', 1)} job(s), {t.get('wall_s', 0.0):.1f} s wall)")
 
 
-def markdown(report: dict) -> str:
+def markdown(report: dict, files: set | None = None) -> str:
+    """report.md; ``files``: the figures written beside it (linked when present)."""
+    files = files or set()
     s = report["summary"]
     settings = settings_text(report)
+    head = header(report["cases"])
     out = [f"# crosscheck report: {report['verdict'].upper()}", "",
            f"Candidate: `{report['candidate']}`" + (f" ({settings})" if settings else "")
            + f". Oracles: {', '.join(report['oracles'])}. "
            f"Cases: {s['cases']} ({s['passed']} pass, {s['failed']} fail).", "",
            f"Level: {level_text(report)}. Checked: {frames_text(report)}.", "",
+           f"Drawing: {drawing_text(report)}.", "",
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
-           "| " + " | ".join(HEADER) + " |", "|" + "---|" * len(HEADER)]
+           "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
         out.append("| " + " | ".join(r) + " |")
     failing = [c for c in report["cases"] if c["verdict"] != "pass"]
@@ -149,13 +213,25 @@ def markdown(report: dict) -> str:
         if names:
             out += ["", "## What to check", ""]
             out += [f"- `{n}`: {FAULT_HINTS[n]}" for n in names]
+    figures = _figures(report, files)
+    if figures or "worst.gif" in files:
+        out += ["", "## Figures", ""]
+        if "worst.gif" in files and _worst_text(report):
+            out.append(f"- [worst.gif](worst.gif): the worst case, {_worst_text(report)}")
+        out += [f"- [{name}]({name}): {caption}" for name, caption in figures]
+    notes = [c for c in report["cases"] if c.get("note")]
+    if notes:
+        out += ["", "## Notes", ""]
+        out += [f"- {c['scene']} / {c['camera']}: {c['note']}" for c in notes]
     out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames, and the time per frame "
             "of each stage (vertex, pixel) per case: `report.html` (and `\"timing\"` in `report.json`; "
             "timings are kept out of this file so that it is the same on every run).", ""]
     return "\n".join(out)
 
 
-def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
+def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None) -> str:
+    files = files or set()
+    head = header(report["cases"])
     e = html.escape
     legend = " ".join(f'<span class="chip" style="color:rgb{col}">&#9632; {e(name.replace("_", " "))}</span>'
                       for name, col in DIFF_COLOURS.items())
@@ -169,13 +245,15 @@ def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
         # thin lines: scale smoothly when shrunk (pixelated scaling drops pixels); click for 1:1
         ".row img{width:100%;image-rendering:auto;border:1px solid #888;background:#000}"
         ".chip{background:#000;padding:1px 6px;border-radius:3px}"
+        ".anim{max-width:100%;image-rendering:pixelated;border:1px solid #888}.plot{max-width:100%}"
         ".fail{color:#b00}.pass{color:#070}section{margin:0 0 2em 0}</style></head><body>",
         f"<h1>crosscheck: <span class='{e(report['verdict'])}'>{e(report['verdict'].upper())}</span></h1>",
         f"<p>Candidate <code>{e(report['candidate'])}</code>"
         + (f" ({e(settings_text(report))})" if settings_text(report) else "")
         + f"; oracles {e(', '.join(report['oracles']))}.</p>",
         f"<p>Level {e(level_text(report))}. Checked: {e(frames_text(report))}.</p>",
-        "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in HEADER) + "</tr>" + rows + "</table>",
+        f"<p>Drawing: {e(drawing_text(report))}.</p>",
+        "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>" + rows + "</table>",
     ]
     failing = [c for c in report["cases"] if c["verdict"] != "pass"]
     if failing:
@@ -195,6 +273,13 @@ def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
             + (" (not run at level vertices)" if report.get("level") == "vertices" else "")
             + f". {e(str(timing.get('jobs', 1)))} job(s), {timing.get('wall_s', 0.0):.2f} s wall.</p>"
             "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in TIMING_HEADER) + "</tr>" + trows + "</table>")
+    if "worst.gif" in files and _worst_text(report):
+        parts.append(f"<h2>Worst case, every frame</h2><p>{e(_worst_text(report))}: "
+                     f"{legend}.</p><p><a href='worst.gif'><img class='anim' src='worst.gif' "
+                     "alt='worst case, every checked frame'></a></p>")
+    for name, caption in _figures(report, files):
+        parts.append(f"<h2>{e(caption[0].upper() + caption[1:])}</h2>"
+                     f"<p><a href='{name}'><img class='plot' src='{name}' alt='{e(caption)}'></a></p>")
     if report.get("level") == "vertices":
         parts.append("<h2>Worst frames</h2><p>None: nothing is drawn at level vertices "
                      "(run with <code>--level pixels</code> to compare frames).</p>")
@@ -207,10 +292,14 @@ def _html(report: dict, shown: list[tuple[dict, str]]) -> str:
             f"<figure><figcaption>{label}</figcaption><a href='img/{stem}-{kind}.png'>"
             f"<img src='img/{stem}-{kind}.png' alt='{label}'></a></figure>"
             for kind, label in (("candidate", "candidate"), ("oracle", "oracle (pyrender)"), ("diff", "diff")))
+        if "silhouette_iou" in case:
+            scores = (f"silhouette IoU {_fmt_f1(case.get('silhouette_iou'))}, depth error / bound "
+                      f"{_fmt_ratio(case.get('depth_error_ratio'))}")
+        else:
+            scores = f"F1@0 {_fmt_f1(case.get('pixel_f1_0px'))}, F1@1 {_fmt_f1(case.get('pixel_f1_1px'))}"
         parts.append(
             f"<section><p><b>{e(case['scene'])} / {e(case['camera'])}</b>, frame "
-            f"{case.get('worst_pixel_frame')}: F1@0 {_fmt_f1(case.get('pixel_f1_0px'))}, "
-            f"F1@1 {_fmt_f1(case.get('pixel_f1_1px'))}, faults: {e(fault_text(case['faults']))}</p>"
+            f"{case.get('worst_pixel_frame')}: {scores}, faults: {e(fault_text(case['faults']))}</p>"
             f"<div class='row'>{figs}</div></section>")
     parts.append("</body></html>\n")
     return "\n".join(parts)
@@ -228,7 +317,13 @@ def _finite_or_null(obj):
 
 
 def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) -> Path:
-    """Write the run directory atomically; ``images[(scene, camera)] = {frame, candidate, oracle}``."""
+    """Write the run directory atomically; ``images[(scene, camera)] = {frame, candidate, oracle}``.
+
+    ``images["animation"]`` (oracles.runner.run_crosscheck) becomes worst.gif;
+    the per-frame figures are drawn from the report itself.
+    """
+    from . import plots
+
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
     out = FrameDir(run_dir, "--report-dir")
@@ -249,9 +344,18 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
             out.write(f"img/{stem}-diff.png", png_bytes(diff_image(im["candidate"], im["oracle"])))
             shown.append((case, stem))
         report = _finite_or_null(report)
+        files = set()
+        if images.get("animation"):
+            out.write("worst.gif", plots.worst_gif(images["animation"]))
+            files.add("worst.gif")
+        for name, draw in (("vertex_error.png", plots.vertex_error_png), ("pixels.png", plots.pixel_png)):
+            data = draw(report)
+            if data is not None:
+                out.write(name, data)
+                files.add(name)
         out.write("report.json", json_dumps(report).encode())
-        out.write("report.md", markdown(report).encode())
-        out.write("report.html", _html(report, shown).encode())
+        out.write("report.md", markdown(report, files).encode())
+        out.write("report.html", _html(report, shown, files).encode())
         out.commit()
     except BaseException:
         out.abort()

@@ -16,6 +16,34 @@ motion (frames 1, 1 + every, 1 + 2 every, ...; frame k is at t = (k - 1) / frame
 
 then all frames' points are pooled for :func:`oracles.diagnose.diagnose`.
 
+Drawing modes (:class:`RenderMode`, the core candidate only; the pixel level):
+
+- ``hidden_lines``: core draws with ``hidden_lines=True`` and the scene's
+  faces; pyrender draws the same faces black with glPolygonOffset(1, 1) and
+  the lines on top. Judged by the same pixel F1 as a plain wireframe. A scene
+  without faces has nothing that could hide a line: it is compared as a plain
+  wireframe, with a note (not a failure), and ``"hidden_lines": false``.
+- ``cull="backface"``: core culls back faces (core.culling's rule) and draws an
+  edge only if it belongs to a kept face or to none. The oracle decides front
+  faces itself in float64 world space (oracles.faces), draws the kept edges,
+  and, with hidden lines, gives pyrender single-sided occluders (GL's own
+  back-face culling). On a closed mesh the hidden-line picture is the same
+  with or without culling (culling never changes what is visible); on an
+  open one the culled back faces hide nothing, in both.
+- ``style="shaded"``: core's depth buffer (``Frame.depth_image``) against
+  pyrender's rendering of the fan-triangulated faces (flat, no lights:
+  coverage and depth only): silhouette IoU, and depth error within a derived
+  bound per pixel (oracles.tolerances, oracles.metrics.shaded_scores). A scene
+  without faces has nothing to shade: only its vertices are checked, with a
+  note.
+
+Several objects (``Scene.objects``, when the scene is not one static object):
+the oracle side builds each object's matrix with scipy,
+``M_run(t) @ M_o(t)`` (oracles.faces.object_matrices), and gives OpenCV and
+pyrender world points (pyrender with an identity pose); core's side uses
+``core.scene.world_points`` and draws them with an identity model matrix. A
+single static object keeps the exact path above (pose = the run's matrix).
+
 Cases are independent, so :func:`run_crosscheck` can spread them over worker
 processes (``jobs``). Workers are started with the "spawn" method: an OSMesa
 context (and llvmpipe's threads) must never be inherited through ``fork``, so
@@ -27,6 +55,7 @@ is the same for any number of jobs.
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -67,10 +96,55 @@ class Tolerances:
     vertex_px: float = tolerances.VERTEX_TOL_PX
     min_f1_1px: float = tolerances.MIN_F1_1PX
     min_f1_0px: float = tolerances.MIN_F1_0PX
+    min_iou: float = tolerances.MIN_SILHOUETTE_IOU
 
-    def to_dict(self) -> dict:
+    def to_dict(self, shaded: bool = False) -> dict:
+        if shaded:
+            return {"vertex_error_px": self.vertex_px, "min_silhouette_iou": self.min_iou,
+                    "depth_error": DEPTH_BOUND_TEXT}
         return {"vertex_error_px": self.vertex_px, "min_pixel_f1_1px": self.min_f1_1px,
                 "min_pixel_f1_0px": self.min_f1_0px}
+
+
+#: The shaded depth bound, as stated in the report (oracles/tolerances.py derives it).
+DEPTH_BOUND_TEXT = (f"per pixel, {tolerances.DEPTH_STEPS:g} depth-buffer steps + slope/{1 / tolerances.DEPTH_SNAP_PX:g}"
+                    f" + {tolerances.DEPTH_EPS32:g} eps32 z")
+
+
+@dataclass(frozen=True)
+class RenderMode:
+    """What the pixel stage draws: the style, hidden lines and back-face culling (core candidate only)."""
+
+    style: str = "wireframe"
+    hidden_lines: bool = False
+    cull: str = "none"
+
+    STYLES: ClassVar[tuple] = ("wireframe", "shaded")
+    CULLS: ClassVar[tuple] = ("none", "backface")
+
+    def __post_init__(self):
+        for name, allowed in (("style", self.STYLES), ("cull", self.CULLS)):
+            if getattr(self, name) not in allowed:
+                raise ValueError(f"{name} {getattr(self, name)!r}: expected one of {', '.join(allowed)}")
+        if self.style == "shaded" and self.hidden_lines:
+            raise ValueError("hidden_lines: a shaded frame has no lines (hidden lines are for style wireframe)")
+
+    @property
+    def plain(self) -> bool:
+        """A plain wireframe: faces play no part."""
+        return self.style == "wireframe" and not self.hidden_lines and self.cull == "none"
+
+    @property
+    def shaded(self) -> bool:
+        return self.style == "shaded"
+
+    def to_dict(self) -> dict:
+        return {"style": self.style, "hidden_lines": self.hidden_lines, "cull": self.cull}
+
+    def core_kwargs(self) -> dict:
+        """Keywords of :func:`core.pipeline.render_frame`."""
+        return {"style": self.style, "hidden_lines": self.hidden_lines,
+                "cull": None if self.cull == "none" else self.cull}
 
 
 @dataclass
@@ -78,6 +152,8 @@ class CaseResult:
     record: dict                       # what goes into report.json
     worst_images: dict | None = None   # {"frame", "candidate", "oracle"} bool images
     timing: dict = field(default_factory=dict)
+    #: every checked frame's images, bit-packed: [(frame, candidate, oracle)] (for worst.gif)
+    frame_images: list | None = None
 
 
 @dataclass(frozen=True)
@@ -116,6 +192,12 @@ class CoreCandidate:
 
         return localize(p_model, self.dtype)
 
+    def world_points(self, scene, motion, frame: int, frames: int) -> np.ndarray:
+        """A scene of several objects: core's world points (``core.scene.world_points``) of one frame."""
+        from core.scene import world_points
+
+        return world_points(scene, motion, frame, frames)
+
     def project(self, points, camera, model_matrix: np.ndarray) -> np.ndarray:
         """Vertex pixels from core's pipeline without drawing: ``render_frame`` given no edges."""
         from core.pipeline import render_frame
@@ -130,46 +212,121 @@ class CoreCandidate:
         frame = render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster)
         return frame.image >= DRAWN_THRESHOLD
 
+    def render(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces, mode: RenderMode):
+        """core's :class:`~core.pipeline.Frame` in a drawing mode (faces None: the scene has none)."""
+        from core.pipeline import render_frame
+
+        return render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster, faces=faces,
+                            **mode.core_kwargs())
+
+    def draw_mode(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces,
+                  mode: RenderMode) -> np.ndarray:
+        """The frame core draws with hidden lines and/or culling, as a bool image."""
+        return self.render(points, edges, camera, model_matrix, faces, mode).image >= DRAWN_THRESHOLD
+
+    def shade(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces,
+              mode: RenderMode) -> np.ndarray:
+        """core's depth buffer of a shaded frame: ``(H, W)`` linear camera depth, +inf where empty."""
+        frame = self.render(points, edges, camera, model_matrix, faces, mode)
+        if frame.depth_image is None:
+            return np.full((camera.height, camera.width), np.inf)
+        return np.asarray(frame.depth_image, dtype=np.float64)
+
 
 def _per_frame_ms(seconds: float, frames: int) -> float:
     return 1e3 * seconds / max(frames, 1)
 
 
+def _case_faces(scene: Scene):
+    """The scene's polygons as a tuple of index tuples, None when it has none."""
+    faces = tuple(tuple(int(i) for i in f) for f in scene.faces)
+    return faces or None
+
+
 def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
-             tol: Tolerances, pyrender_oracle=None, want_images: bool = True, every: int = 1) -> CaseResult:
-    """One case; the pixel stage runs when ``pyrender_oracle`` is given."""
+             tol: Tolerances, pyrender_oracle=None, want_images: bool = True, every: int = 1,
+             mode: RenderMode | None = None, keep_frames: bool = False) -> CaseResult:
+    """One case; the pixel stage runs when ``pyrender_oracle`` is given.
+
+    ``mode`` is the drawing mode of the pixel stage (module docstring); with
+    ``keep_frames`` every checked frame's images are kept (bit-packed) in
+    :attr:`CaseResult.frame_images`.
+    """
+    from . import faces as oface
+
+    mode = mode or RenderMode()
     cam = case.camera
     is_core = isinstance(candidate, CoreCandidate)
     pixels = pyrender_oracle is not None
+    if not mode.plain and not is_core and pixels:
+        raise ValueError(f"drawing mode {mode.to_dict()}: only the core candidate draws faces")
     edges = np.asarray(scene.edges)
+    faces = _case_faces(scene)
+    use_faces = pixels and faces is not None and not mode.plain
+    single = scene.is_single_static
+    # core draws a multi-object scene from world points with an identity matrix:
+    # its faces come re-wound for mirrored objects (core.scene.oriented_faces)
+    core_faces = faces
+    if faces is not None and not single and isinstance(candidate, CoreCandidate):
+        from core.scene import oriented_faces
+
+        core_faces = oriented_faces(scene, motion)
+    if use_faces and mode.shaded:
+        tris, _owner = oface.fan(faces)
+    if use_faces and mode.cull == "backface":
+        owners = oface.EdgeOwners(edges, faces, len(scene.vertices))
     cand_all, orac_all = [], []
     frame_errors = []
     per_frame = []
     f1_0, f1_1, prec_0, rec_0, prec_1, rec_1 = [], [], [], [], [], []
+    shaded = []                      # per-frame shaded scores
+    kept_frames = [] if keep_frames and pixels else None
     worst = None                     # (key, frame, cand_img, oracle_img)
     # seconds: vertex stage = t_setup + t_cv + t_proj + t_vmetric; pixel stage = t_draw + t_pr + t_pmetric
     t_setup = t_cv = t_proj = t_vmetric = t_draw = t_pr = t_pmetric = 0.0
     error = None
-    core_points = candidate.prepare(scene.vertices) if is_core else None   # once per scene, not per frame
+    core_points = candidate.prepare(scene.vertices) if is_core and single else None   # once per scene
     for k in range(1, frames + 1, every):
         t0 = time.perf_counter()
         t = (k - 1) / frames
-        m = model_matrix(motion.turns, motion.offset, motion.scale, t)
-        p_world = scene.vertices @ m[:3, :3].T + m[:3, 3]
+        if single:
+            m = model_matrix(motion.turns, motion.offset, motion.scale, t)
+            p_world = scene.vertices @ m[:3, :3].T + m[:3, 3]
+            matrices = [m]
+            pr_vertices, pr_pose = scene.vertices, m
+        else:
+            matrices = oface.object_matrices(scene, motion.turns, t)
+            p_world = oface.world_points(scene, matrices)
+            pr_vertices, pr_pose = p_world, None
         t1 = time.perf_counter()
         oracle_px = opencv_oracle.project(p_world, cam)
         t2 = time.perf_counter()
         try:
             if is_core:
-                m_core = motion.frame_matrix(k, frames)
-                cand_px = candidate.project(core_points, cam, m_core)
+                try:
+                    if single:
+                        m_core, points = motion.frame_matrix(k, frames), core_points
+                    else:
+                        m_core = np.eye(4)
+                        points = candidate.prepare(candidate.world_points(scene, motion, k, frames))
+                    cand_px = candidate.project(points, cam, m_core)
+                except Exception as exc:      # core crashing is a failed case, not a crashed run
+                    raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc
             else:
                 cand_px = call_candidate(candidate, p_world, cam)
             t3 = time.perf_counter()
-            cand_img = None
+            cand_img = cand_depth = None
             if pixels:
                 if is_core:
-                    cand_img = candidate.draw(core_points, edges, cam, m_core)
+                    try:
+                        if mode.plain:
+                            cand_img = candidate.draw(points, edges, cam, m_core)
+                        elif mode.shaded:
+                            cand_depth = candidate.shade(points, edges, cam, m_core, core_faces, mode)
+                        else:
+                            cand_img = candidate.draw_mode(points, edges, cam, m_core, core_faces, mode)
+                    except Exception as exc:
+                        raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc
                 else:
                     cand_img = draw_candidate(candidate, p_world, edges, cam)
             t4 = time.perf_counter()
@@ -191,8 +348,37 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         per_frame.append(frame_rec)
         t6 = time.perf_counter()
         t_vmetric += t6 - t5
-        if pixels:
-            orac_img, _depth = pyrender_oracle.render(scene.vertices, edges, cam, model_matrix=m)
+        if not pixels:
+            continue
+        mirrored = (oface.mirrored_vertices(scene, matrices) if use_faces and mode.cull == "backface"
+                    else None)
+        if mode.shaded:
+            if use_faces:
+                orac_img, orac_depth, ids = pyrender_oracle.render_faces(
+                    pr_vertices, oface.gl_triangles(tris, mirrored), cam, model_matrix=pr_pose,
+                    cull=mode.cull == "backface", with_ids=True)
+            else:
+                orac_img = np.zeros((cam.height, cam.width), bool)
+            t7 = time.perf_counter()
+            t_pr += t7 - t6
+            cand_img = np.isfinite(cand_depth)
+            if use_faces:
+                ss = metrics.shaded_scores(cand_depth, orac_img, orac_depth,
+                                           metrics.depth_bound(orac_depth, orac_img, cam),
+                                           metrics.occlusion_boundary(ids, tris))
+                shaded.append((k, ss))
+                frame_rec.update({key: ss[key] for key in SHADED_FRAME_KEYS})
+                key = (ss["silhouette_iou"], -(ss["depth_error_ratio"] or 0.0))
+            else:
+                key = None
+        else:
+            draw_edges, occluders = edges, None
+            if use_faces and mode.cull == "backface":
+                draw_edges = edges[owners.kept(oface.front_faces(p_world, faces, cam, mirrored))]
+            if use_faces and mode.hidden_lines:
+                occluders = oface.gl_polygons(faces, mirrored)
+            orac_img, _depth = pyrender_oracle.render(pr_vertices, draw_edges, cam, model_matrix=pr_pose,
+                                                      faces=occluders, cull=mode.cull == "backface")
             t7 = time.perf_counter()
             t_pr += t7 - t6
             ps = metrics.pixel_scores(cand_img, orac_img)
@@ -202,12 +388,16 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
             frame_rec.update({key: ps[key] for key in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
                                                        "precision_1px", "recall_1px")})
             key = (ps["f1_1px"], ps["f1_0px"])
-            if want_images and (worst is None or key < worst[0]):
-                worst = (key, k, cand_img.copy(), orac_img.copy())
-            t_pmetric += time.perf_counter() - t7
+        if want_images and key is not None and (worst is None or key < worst[0]):
+            worst = (key, k, cand_img.copy(), orac_img.copy())
+        if kept_frames is not None:
+            kept_frames.append((k, np.packbits(cand_img), np.packbits(orac_img)))
+        t_pmetric += time.perf_counter() - t7
     done = len(cand_all)
     rec = {"scene": scene.name, "camera": case.name, "camera_spec": cam.to_dict(), "frames": frames,
            "frames_checked": done}
+    if pixels and mode.hidden_lines:
+        rec["hidden_lines"] = faces is not None
     if done:
         cand = np.concatenate(cand_all)
         orac = np.concatenate(orac_all)
@@ -238,6 +428,8 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         })
     else:
         rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
+    if pixels and mode.shaded:
+        rec.update(_shaded_summary(shaded, worst))
     rec["faults"] = faults
     reasons = []
     if error:
@@ -246,6 +438,10 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         rec["note"] = "nothing to check: the scene has no vertices"
     elif done and rec["visible_points"] == 0:
         rec["note"] = "no point visible to both projectors: only the visible/clipped sets were compared"
+    elif done and pixels and not mode.plain and faces is None:
+        rec["note"] = {"shaded": "no faces: nothing to shade; only the vertices were checked",
+                       "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe"
+                       }[mode.style]
     if done:
         if rec["max_vertex_error_px"] is not None and rec["max_vertex_error_px"] > tol.vertex_px:
             reasons.append(f"max vertex error {rec['max_vertex_error_px']:.3g} px > {tol.vertex_px:.3g} px "
@@ -260,6 +456,13 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
                            f"(frame {rec['worst_pixel_frame']})")
         if rec["pixel_f1_0px"] < tol.min_f1_0px:
             reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
+    if shaded:
+        if rec["silhouette_iou"] < tol.min_iou:
+            reasons.append(f"silhouette IoU {rec['silhouette_iou']:.4f} < {tol.min_iou} "
+                           f"(frame {rec['worst_pixel_frame']})")
+        if rec["depth_error_ratio"] is not None and rec["depth_error_ratio"] > 1.0:
+            reasons.append(f"depth error {rec['depth_max_error']:.3g} > its bound {rec['depth_error_bound']:.3g} "
+                           f"(error/bound up to {rec['depth_error_ratio']:.3g}, frame {rec['depth_worst_frame']})")
     rec["verdict"] = "fail" if reasons else "pass"
     rec["reasons"] = reasons
     rec["per_frame"] = per_frame
@@ -276,7 +479,35 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     images = None
     if worst is not None:
         images = {"frame": worst[1], "candidate": worst[2], "oracle": worst[3]}
-    return CaseResult(record=rec, worst_images=images, timing=timing)
+    return CaseResult(record=rec, worst_images=images, timing=timing, frame_images=kept_frames)
+
+
+#: Per-frame fields of a shaded comparison (oracles.metrics.shaded_scores).
+SHADED_FRAME_KEYS = ("silhouette_iou", "depth_pixels", "depth_max_error", "depth_mean_error",
+                     "depth_error_bound", "depth_error_ratio")
+
+
+def _shaded_summary(shaded: list, worst) -> dict:
+    """A case's shaded fields from its frames' scores (None where nothing was compared)."""
+    out = {"silhouette_iou": None, "silhouette_iou_mean": None, "depth_max_error": None,
+           "depth_mean_error": None, "depth_error_bound": None, "depth_error_ratio": None,
+           "depth_worst_frame": None, "depth_pixels": 0, "worst_pixel_frame": None}
+    if not shaded:
+        return out
+    ious = [s["silhouette_iou"] for _, s in shaded]
+    out.update(silhouette_iou=float(min(ious)), silhouette_iou_mean=float(np.mean(ious)),
+               worst_pixel_frame=worst[1] if worst else None)
+    with_depth = [(k, s) for k, s in shaded if s["depth_max_error"] is not None]
+    if with_depth:
+        pixels = sum(s["depth_pixels"] for _, s in with_depth)
+        k_err, s_err = max(with_depth, key=lambda e: (e[1]["depth_max_error"], -e[0]))
+        k_ratio, s_ratio = max(with_depth, key=lambda e: (e[1]["depth_error_ratio"], -e[0]))
+        out.update(depth_max_error=s_err["depth_max_error"], depth_error_bound=s_err["depth_error_bound"],
+                   depth_mean_error=float(sum(s["depth_mean_error"] * s["depth_pixels"]
+                                              for _, s in with_depth) / pixels),
+                   depth_error_ratio=s_ratio["depth_error_ratio"], depth_worst_frame=k_ratio,
+                   depth_pixels=int(pixels))
+    return out
 
 
 # ---------------------------------------------------------------- running cases, here or in workers
@@ -291,6 +522,8 @@ class _RunParams:
     motion: Motion
     tol: Tolerances
     candidate: object        # a picklable callable (CoreCandidate), or a "FILE.py:FUNC" spec string
+    mode: RenderMode = RenderMode()
+    keep_frames: bool = False   # every checked frame's images, for worst.gif
 
 
 class _CaseRunner:
@@ -321,13 +554,18 @@ class _CaseRunner:
             self.candidates[ref] = load_candidate(ref)
         return self.candidates[ref]
 
-    def renderer(self, camera):
+    _DUMMY_TRIANGLE = (np.array([[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.0, 0.5, 0.0]]),
+                       np.array([[0, 1, 2]], dtype=np.int64))
+
+    def renderer(self, camera, mode: RenderMode | None = None):
         size = (camera.width, camera.height)
         if size not in self.renderers:
             from .pyrender_oracle import PyrenderOracle
 
             self.renderers[size] = PyrenderOracle(*size)
             self.renderers[size].render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera)   # compiles the shaders
+            if mode is not None and mode.shaded:
+                self.renderers[size].render_faces(*self._DUMMY_TRIANGLE, camera)         # and the id shader
         return self.renderers[size]
 
     def warm_up(self, camera, candidate, level: str) -> None:
@@ -348,9 +586,10 @@ class _CaseRunner:
         candidate = self.candidate(params.candidate)
         if not self.warm:
             self.warm_up(case.camera, candidate, params.level)
-        pyr = self.renderer(case.camera) if params.level == "pixels" else None
+        pyr = self.renderer(case.camera, params.mode) if params.level == "pixels" else None
         return run_case(scene, case, params.frames, candidate, params.motion,
-                        params.tol, pyrender_oracle=pyr, every=params.every)
+                        params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
+                        keep_frames=params.keep_frames)
 
     def close(self) -> None:
         renderers, self.renderers = self.renderers, {}
@@ -374,13 +613,22 @@ def _worker_run(scene: Scene, case: Case, params: _RunParams) -> CaseResult:
     return _WORKER_RUNNER.run(scene, case, params)
 
 
-def _run_tasks(tasks, params: _RunParams, jobs: int) -> tuple[list[CaseResult], int]:
-    """Results in task order, and the number of worker processes used (0: in this process)."""
+def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None) -> tuple[list[CaseResult], int]:
+    """Results in task order, and the number of worker processes used (0: in this process).
+
+    ``on_result(result)`` is called on each result as it is gathered, in task
+    order (it may drop what it does not need to keep, e.g. frame images).
+    """
+    on_result = on_result or (lambda result: None)
     workers = min(jobs, len(tasks))
     if workers <= 1:
         runner = _CaseRunner()
         try:
-            return [runner.run(scene, case, params) for scene, case in tasks], 0
+            results = []
+            for scene, case in tasks:
+                results.append(runner.run(scene, case, params))
+                on_result(results[-1])
+            return results, 0
         finally:
             runner.close()
     import multiprocessing
@@ -391,10 +639,16 @@ def _run_tasks(tasks, params: _RunParams, jobs: int) -> tuple[list[CaseResult], 
     with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
         futures = [pool.submit(_worker_run, scene, case, params) for scene, case in tasks]
         try:
-            return [f.result() for f in futures], workers
+            results = []
+            for i, f in enumerate(futures):
+                results.append(f.result())
+                futures[i] = None          # the future held the result too
+                on_result(results[-1])
+            return results, workers
         except BaseException:
             for f in futures:
-                f.cancel()
+                if f is not None:
+                    f.cancel()
             raise
 
 
@@ -410,7 +664,8 @@ def _overall_ms(timing_cases: list[dict], key: str):
 def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles=None,
                    turns=(1.0, 1.0, 0.0), tol: Tolerances | None = None, candidate_name: str = "candidate",
                    *, level: str | None = None, every: int = 1, jobs: int = 1,
-                   candidate_spec: str | None = None) -> tuple[dict, dict]:
+                   candidate_spec: str | None = None, mode: RenderMode | None = None,
+                   animation: bool = True) -> tuple[dict, dict]:
     """Every scene under every case camera: the report dict and the worst-frame images.
 
     ``level`` is "vertices" (OpenCV only) or "pixels" (OpenCV and pyrender, the
@@ -421,9 +676,17 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     that is not core is then best given as ``candidate_spec`` ("FILE.py:FUNC"),
     which each worker loads (``candidate`` itself must otherwise be picklable).
 
-    ``images[(scene, camera)] = {"frame", "candidate", "oracle"}``. Raises
-    InputError when no camera can be placed for a scene (coordinates too large),
-    ValueError for a bad level, ``every`` or ``jobs``.
+    ``mode`` (:class:`RenderMode`) is the drawing mode of the pixel stage
+    (hidden lines, back-face culling, shaded); anything but the plain
+    wireframe needs the core candidate and level "pixels".
+
+    ``images[(scene, camera)] = {"frame", "candidate", "oracle"}``; with
+    ``animation`` (level pixels), ``images["animation"]`` holds every checked
+    frame of the worst case (lowest F1, or IoU when shaded, then largest
+    vertex error): ``{"scene", "camera", "frames": [k...], "candidate": [...],
+    "oracle": [...]}`` (bool images), for worst.gif. Raises InputError when no
+    camera can be placed for a scene (coordinates too large), ValueError for a
+    bad level, ``every``, ``jobs`` or mode.
     """
     from core.errors import InputError
 
@@ -441,6 +704,12 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         raise ValueError(f"every {every}: expected an integer >= 1")
     if jobs < 1:
         raise ValueError(f"jobs {jobs}: expected an integer >= 1")
+    mode = mode or RenderMode()
+    if not mode.plain:
+        if level != "pixels":
+            raise ValueError(f"drawing mode {mode.to_dict()}: needs level pixels (nothing is drawn at {level})")
+        if not isinstance(candidate, CoreCandidate):
+            raise ValueError(f"drawing mode {mode.to_dict()}: only the core candidate draws faces")
     tol = tol or Tolerances()
     motion = Motion(turns=tuple(float(x) for x in turns))
     t_run = time.perf_counter()
@@ -453,8 +722,11 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         tasks += [(scene, case) for case in scene_cases if case_names is None or case.name in case_names]
     is_core = isinstance(candidate, CoreCandidate)
     ref = candidate if is_core or candidate_spec is None else candidate_spec
-    params = _RunParams(frames=frames, every=every, level=level, motion=motion, tol=tol, candidate=ref)
-    results, workers = _run_tasks(tasks, params, jobs)
+    keep_frames = animation and level == "pixels"
+    params = _RunParams(frames=frames, every=every, level=level, motion=motion, tol=tol, candidate=ref,
+                        mode=mode, keep_frames=keep_frames)
+    worst = _WorstCase(mode)
+    results, workers = _run_tasks(tasks, params, jobs, on_result=worst.offer if keep_frames else None)
 
     records, images, timing_cases = [], {}, []
     for (scene, case), result in zip(tasks, results):
@@ -463,6 +735,11 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         if result.worst_images:
             images[(scene.name, case.name)] = result.worst_images
 
+    worst_case = None
+    if worst.result is not None:
+        images["animation"] = worst.animation()
+        worst_case = {"scene": images["animation"]["scene"], "camera": images["animation"]["camera"],
+                      "frames_checked": len(images["animation"]["frames"]), "animation": "worst.gif"}
     failed = sum(1 for r in records if r["verdict"] != "pass")
     vertex_errs = [r["max_vertex_error_px"] for r in records if r.get("max_vertex_error_px") is not None]
     f1_0 = [r["pixel_f1_0px"] for r in records if r.get("pixel_f1_0px") is not None]
@@ -477,23 +754,79 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
             timing[key] = _overall_ms(timing_cases, key)
     timing.update({"jobs": jobs, "workers": workers, "wall_s": time.perf_counter() - t_run,
                    "cases": timing_cases})
+    summary = {"cases": len(records), "passed": len(records) - failed, "failed": failed,
+               "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
+               "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
+               "min_pixel_f1_1px": min(f1_1) if f1_1 else None}
+    if mode.shaded and level == "pixels":
+        ious = [r["silhouette_iou"] for r in records if r.get("silhouette_iou") is not None]
+        derr = [r["depth_max_error"] for r in records if r.get("depth_max_error") is not None]
+        ratio = [r["depth_error_ratio"] for r in records if r.get("depth_error_ratio") is not None]
+        summary.update({"min_silhouette_iou": min(ious) if ious else None,
+                        "max_depth_error": max(derr) if derr else None,
+                        "max_depth_error_ratio": max(ratio) if ratio else None})
     report = {
         "tool": "wirecheck crosscheck",
         "verdict": "fail" if failed else "pass",
         "candidate": candidate_name,
         "candidate_settings": candidate.settings() if is_core else None,
         "level": level,
+        **mode.to_dict(),
         "oracles": list(LEVEL_ORACLES[level]),
         "frames": frames,
         "every": every,
         "frames_checked": len(range(1, frames + 1, every)),
         "motion": {"turns": list(motion.turns)},
-        "tolerances": tol.to_dict(),
-        "summary": {"cases": len(records), "passed": len(records) - failed, "failed": failed,
-                    "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
-                    "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
-                    "min_pixel_f1_1px": min(f1_1) if f1_1 else None},
+        "tolerances": tol.to_dict(shaded=mode.shaded),
+        "summary": summary,
+        **({"worst_case": worst_case} if worst_case else {}),
         "cases": records,
         "timing": timing,
     }
     return report, images
+
+
+def worst_key(record: dict) -> tuple:
+    """Ranking of cases for worst.gif, smallest = worst: lowest F1 (IoU when shaded), then largest vertex error."""
+    verr = record.get("max_vertex_error_px")
+    verr = -math.inf if verr is None else verr
+    if "silhouette_iou" in record:
+        iou = record.get("silhouette_iou")
+        ratio = record.get("depth_error_ratio") or 0.0
+        return (1.0 if iou is None else iou, -ratio, -verr)
+    f1_1, f1_0 = record.get("pixel_f1_1px"), record.get("pixel_f1_0px")
+    return (1.0 if f1_1 is None else f1_1, 1.0 if f1_0 is None else f1_0, -verr)
+
+
+class _WorstCase:
+    """Keeps the frame images of the worst case seen so far (cases offered in task order)."""
+
+    def __init__(self, mode: RenderMode):
+        self.mode = mode
+        self.result = None
+        self.key = None
+
+    def offer(self, result: CaseResult) -> None:
+        frames = result.frame_images
+        if not frames:
+            result.frame_images = None
+            return
+        key = worst_key(result.record)
+        if self.result is None or key < self.key:      # ties: the first case in order stays
+            if self.result is not None:
+                self.result.frame_images = None
+            self.result, self.key = result, key
+        else:
+            result.frame_images = None
+
+    def animation(self) -> dict:
+        rec = self.result.record
+        h, w = rec["camera_spec"]["height"], rec["camera_spec"]["width"]
+
+        def unpack(bits):
+            return np.unpackbits(bits, count=h * w).reshape(h, w).astype(bool)
+
+        frames = self.result.frame_images
+        return {"scene": rec["scene"], "camera": rec["camera"], "frames": [k for k, _, _ in frames],
+                "candidate": [unpack(c) for _, c, _ in frames], "oracle": [unpack(o) for _, _, o in frames],
+                "shaded": self.mode.shaded}

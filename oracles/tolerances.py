@@ -33,3 +33,66 @@ MIN_F1_0PX = 0.98
 
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)
+
+# ---------------------------------------------------------------- hidden lines, shaded, culling
+
+#: Hidden lines (``--hidden-lines``, and ``--cull backface``) are judged with the
+#: same F1 minimums as plain wireframes (MIN_F1_1PX, MIN_F1_0PX). pyrender draws
+#: the faces black with glPolygonOffset(1, 1) under the lines; core hides a
+#: line pixel behind its depth buffer with the linear-depth image of the same
+#: offset (core.zbuffer). Measured, core against pyrender, 24 frames of each
+#: of the 7 cameras: F1@1 = 1.0 everywhere; F1@0 >= 0.9956 (cube), 0.9984
+#: (icosphere(2)), 0.9961 (scenes/examples/orrery, three moving objects), as
+#: good as the plain wireframe (min 0.9958), so no looser bound is needed (a
+#: line pixel kept or lost at an occluding face's edge is within 1 px of the
+#: oracle's, which F1@1 absorbs).
+
+#: Minimum silhouette IoU (``--style shaded``): covered pixels of the
+#: candidate's depth buffer (finite) against pyrender's (depth buffer < 1).
+#: Both cover a pixel when its centre is inside a triangle after snapping the
+#: vertices to 1/256 px (llvmpipe; core.zbuffer emulates it), so the only
+#: differences are centres within float rounding of an edge. Measured, 24
+#: frames x 7 cameras: cube 8 of 168 frames below 1.0, min 0.99997;
+#: icosphere(2) 1 of 168, min 0.99999; orrery (three objects) 3 of 168, min
+#: 0.99982. A float64 ray-casting reference without the snap measured min
+#: 0.99963. 0.995 leaves room for smaller silhouettes
+#: (fewer pixels per boundary pixel, several objects) and still fails a
+#: mirrored silhouette and a half-pixel shift of a 200-px silhouette (every
+#: boundary pixel flips with probability 1/2: IoU ~ 1 - P/2A ~ 0.99).
+MIN_SILHOUETTE_IOU = 0.995
+
+#: The shaded depth comparison: |z_candidate - z_pyrender| at a pixel covered
+#: by both and not on either silhouette (eroded by 1 px) nor beside an occlusion
+#: boundary (oracles.metrics.occlusion_boundary) must be at most
+#:
+#:     bound(z) = DEPTH_STEPS * step(z) + DEPTH_SNAP_PX * slope + DEPTH_EPS32 * eps32 * z
+#:
+#: with z pyrender's depth at the pixel (linear camera depth, made linear in
+#: float64 from the 24-bit buffer by oracles.pyrender_oracle: compare like with
+#: like) and
+#:
+#: - ``step(z)``: one level of the 24-bit depth buffer in camera depth,
+#:   ``z^2 (far - near) / (far near (2^24 - 1))`` for perspective (window depth
+#:   ``f (z - n) / ((f - n) z)`` is non-linear in z) and ``(far - near) /
+#:   (2^24 - 1)`` for orthographic (window depth ``(z - n) / (f - n)`` is linear,
+#:   so the step is the same at every depth). DEPTH_STEPS = 4: one for the
+#:   conversion to 24 bits, up to three for llvmpipe's float32 evaluation of the
+#:   window-depth plane at the pixel (window depth is < 1, where one float32 ulp,
+#:   2^-24, is one level);
+#: - ``slope``: the largest change of pyrender's depth to a 4-neighbour of the
+#:   pixel (depth per pixel). llvmpipe snaps x and y to 1/256 px, moving the
+#:   depth plane by up to 1/512 px along each axis: |dz/dx|/512 + |dz/dy|/512 <=
+#:   slope / 256, so DEPTH_SNAP_PX = 1/256. This term dominates on faces seen
+#:   at a grazing angle (up to ~100 levels measured on the near_plane camera);
+#: - ``DEPTH_EPS32 * eps32 * z``: float32 geometry in GL (positions, model,
+#:   view and projection matrices, the divide): about 8 roundings of values of
+#:   size ~z, each <= eps32/2 relative, doubled: 16.
+#:
+#: Measured, core against pyrender (cube, icosphere(2), orrery; 7 cameras x
+#: 24 frames): the largest error / bound(z) is 0.48 (icosphere, non_square);
+#: without the slope term it would be 8.5 (cube, near_plane, 12 frames). A
+#: candidate whose depth is 1% too large (1.01 z) measured error / bound up to
+#: 820 (perspective) and 1700 (orthographic) on the cube.
+DEPTH_STEPS = 4.0
+DEPTH_SNAP_PX = 1.0 / 256.0
+DEPTH_EPS32 = 16.0
