@@ -28,7 +28,7 @@ from .camera import Camera, camera_z, look_at
 from .errors import InputError
 from .pipeline import CLIP_MODES, RASTER_MODES, render_frame
 from .projection import DTYPES, localize
-from .scene import Scene, load_scene, object_matrix, object_spheres, world_points
+from .scene import Scene, load_scene, object_matrix, object_spheres, oriented_faces, world_points
 from .transforms import Motion, apply
 
 FORMATS = ("png", "ascii", "gif", "mp4")
@@ -355,6 +355,8 @@ class FrameRenderer:
         self.spheres = object_spheres(scene)
         self.sphere_test = _sphere_test() if (s.object_culling and not self.single) else None
         self.extra_info = {}
+        # world points are drawn with an identity matrix: mirrored objects' faces re-wound
+        self.faces = scene.faces if self.single else oriented_faces(scene, s.motion)
 
     def render(self, k: int, camera: Camera):
         """``(frame, info)``: the pipeline's Frame and this frame's counts for :func:`frame_record`."""
@@ -374,7 +376,7 @@ class FrameRenderer:
                 f"{scene.vertices[i].tolist()} moves beyond the float64 range in frame {k}: expected "
                 f"coordinates whose world position (after the object's and the run's scale) fits in a float64")
         culled = self._culled_objects(k, camera) if self.sphere_test is not None else []
-        edges, faces, dropped = scene.edges, scene.faces, None
+        edges, faces, dropped = scene.edges, self.faces, None
         if culled:
             keep_e = np.ones(len(scene.edges), dtype=bool)
             keep_f = np.ones(len(scene.faces), dtype=bool)
@@ -383,7 +385,7 @@ class FrameRenderer:
                 keep_f[slice(*self.face_ranges[i])] = False
             dropped = scene.edges[~keep_e]
             edges = scene.edges[keep_e]
-            faces = tuple(f for f, keep in zip(scene.faces, keep_f) if keep)
+            faces = tuple(f for f, keep in zip(self.faces, keep_f) if keep)
         frame = render_frame(p_world, edges, camera, _IDENTITY, s.clip, dtype=s.dtype, raster=s.raster,
                              **_face_kwargs(s, faces))
         return frame, self._info(frame, dropped, len(culled))

@@ -164,6 +164,30 @@ def object_matrix(obj: SceneObject, run_motion: Motion, frame: int, frames: int)
     return run_motion.frame_matrix(frame, frames) @ obj.motion.frame_matrix(frame, frames)
 
 
+def oriented_faces(scene: Scene, run_motion: Motion) -> tuple:
+    """``scene.faces`` with the winding of mirrored objects reversed.
+
+    An object whose world matrix ``M_run @ M_o`` has a negative determinant (an
+    odd number of negative scales) turns its counter-clockwise faces clockwise.
+    Drawn from world points with an identity model matrix, the pipeline cannot
+    see that, so the faces are re-wound here; the sign is constant over a run
+    (rotations have determinant +1, scales are constant).
+    """
+    flip = []
+    for o in scene.objects:
+        det = (run_motion.scale * o.motion.scale) ** 3
+        flip.append(det < 0)
+    if not any(flip):
+        return scene.faces
+    starts = [o.vertex_start for o in scene.objects]
+    stops = [o.vertex_stop for o in scene.objects]
+    out = []
+    for f in scene.faces:
+        k = next(i for i, (a, b) in enumerate(zip(starts, stops)) if a <= f[0] < b)
+        out.append(tuple(reversed(f)) if flip[k] else tuple(f))
+    return tuple(out)
+
+
 def world_points(scene: Scene, run_motion: Motion, frame: int, frames: int) -> np.ndarray:
     """``(N, 3)`` float64 world positions of every vertex at 1-based ``frame`` of ``frames``.
 

@@ -4,6 +4,7 @@ import contextlib
 import io
 import json
 import math
+from pathlib import Path
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
@@ -316,3 +317,30 @@ def test_cull_and_hidden_lines_fields(tmp_path):
     # is in front of the front face, so no line pixel is hidden.
     assert fr["hidden_pixels"] == 0
     assert "faces_culled=5" in out
+
+
+def test_mirrored_object_is_culled_like_its_oracle(tmp_path, capsys):
+    # Object "b" has scale -1 (determinant -1): its counter-clockwise faces turn
+    # clockwise in the world. core draws multi-object scenes from world points
+    # with an identity matrix, so core.scene.oriented_faces re-winds them; without
+    # that, back-face culling would keep b's back faces and crosscheck (which
+    # judges front faces from the geometry, oracles/faces.py) would fail.
+    from oracles.cli import main
+
+    cube = (Path(__file__).resolve().parent.parent / "scenes" / "cube.scene").read_text()
+    body = "\n".join(line for line in cube.splitlines() if line.split("#")[0].strip().startswith(("v", "f")))
+    text = (f"object a\ntranslate -1.5 0 0\nscale 0.5\n{body}\n"
+            f"object b\ntranslate 1.5 0 0\nscale -0.5\nspin 0 1 0\n{body}\n")
+    path = tmp_path / "mirror.scene"
+    path.write_text(text)
+    from core.scene import load_scene, oriented_faces
+    from core.transforms import Motion
+
+    scene = load_scene(str(path))
+    faces = oriented_faces(scene, Motion())
+    n_a = len(scene.faces) // 2
+    assert faces[:n_a] == scene.faces[:n_a]                             # a: unchanged
+    assert faces[n_a:] == tuple(tuple(reversed(f)) for f in scene.faces[n_a:])   # b: re-wound
+    rc = main(["--scene", str(path), "--cases", "on_axis,oblique_roll", "--frames", "3", "--cull", "backface",
+               "--hidden-lines", "--report-dir", str(tmp_path / "rep")])
+    assert rc == 0, capsys.readouterr().out
