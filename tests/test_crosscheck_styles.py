@@ -131,13 +131,16 @@ def test_injected_shading_faults_are_caught():
 
 @needs_faces
 def test_faceless_scene_is_noted_not_failed(tmp_path):
-    code, report, out = run(tmp_path, "--style", "shaded", "--scene", "pyramid", "--frames", "2",
+    wire = tmp_path / "wire.scene"                      # the pyramid's edges, without faces
+    wire.write_text("v -1 -1 -1\nv 1 -1 -1\nv 1 -1 1\nv -1 -1 1\nv 0 1 0\n"
+                    "e 0 1\ne 1 2\ne 2 3\ne 3 0\ne 0 4\ne 1 4\ne 2 4\ne 3 4\n")
+    code, report, out = run(tmp_path, "--style", "shaded", "--scene", str(wire), "--frames", "2",
                             "--cases", "on_axis")
     case = report["cases"][0]
     assert code == 0 and case["verdict"] == "pass"
     assert case["note"] == "no faces: nothing to shade; only the vertices were checked"
     assert case["silhouette_iou"] is None and case["max_vertex_error_px"] < 1e-9
-    code, report, _ = run(tmp_path, "--hidden-lines", "--scene", "pyramid", "--frames", "2",
+    code, report, _ = run(tmp_path, "--hidden-lines", "--scene", str(wire), "--frames", "2",
                           "--cases", "on_axis", name="hidden")
     case = report["cases"][0]
     assert code == 0 and case["hidden_lines"] is False and case["pixel_f1_1px"] == 1.0

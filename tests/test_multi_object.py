@@ -292,7 +292,9 @@ def test_inconsistent_winding_warns_and_refuses_backface_culling(tmp_path):
 
 @pytest.mark.parametrize("flag", [["--hidden-lines"], ["--style", "shaded"], ["--cull", "backface"]])
 def test_face_options_need_faces(tmp_path, flag):
-    rc, out, err = run(["--scene", "pyramid", "--frames", "1"] + flag, tmp_path / "o")
+    wire = tmp_path / "wire.scene"                      # edges only: a wireframe with no faces
+    wire.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\ne 0 1\ne 1 2\n")
+    rc, out, err = run(["--scene", str(wire), "--frames", "1"] + flag, tmp_path / "o")
     assert (rc, out) == (2, "")
     assert err.startswith("renderer: error: ") and "has no faces" in err and len(err.splitlines()) == 1
 
