@@ -143,14 +143,27 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 
 
 def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_depth: np.ndarray,
-                  depth_bound: np.ndarray | None = None, exclude: np.ndarray | None = None) -> dict:
+                  depth_bound: np.ndarray | None = None, exclude: np.ndarray | None = None,
+                  cand_faces: np.ndarray | None = None, oracle_faces: np.ndarray | None = None) -> dict:
     """Silhouette IoU and depth errors of a shaded frame against the oracle's.
 
     ``cand_depth``: the candidate's camera depth, +inf (or NaN) where nothing
     covers the pixel; ``oracle_covered`` / ``oracle_depth``: the oracle's
     coverage and camera depth. Depth is compared over the pixels covered by
     both whose 8 neighbours are covered by both (no silhouette pixel of
-    either), minus ``exclude`` (occlusion boundaries). ``depth_bound`` (per
+    either), minus ``exclude`` (occlusion boundaries). With ``cand_faces`` and
+    ``oracle_faces`` (the polygon each shows, -1: none), depth is compared only
+    where both show the same polygon: where they differ, the two renderers made
+    a different *visibility* decision, which is legitimate only on a boundary
+    between the two polygons (a pixel centre within rounding of the line where
+    one face passes in front of another; e.g. faces meeting at a vertex, seen
+    from inside, with one of them cut by the near plane). Such pixels are
+    counted in ``face_disagreements``; those on no boundary between the two
+    polygons (no 3x3 neighbour where the oracle shows the candidate's polygon,
+    nor where the candidate shows the oracle's; a face seen edge-on is a
+    1-px sliver in one image) are ``face_disagreements_inside`` and must be 0:
+    a wrong face in the middle of a region is a visibility error.
+    ``depth_bound`` (per
     pixel, same shape) turns the errors into ``depth_error_ratio`` = max of
     error / bound (<= 1: within the bound); ``depth_error_bound`` is the bound
     at the pixel of ``depth_max_error``.
@@ -165,10 +178,21 @@ def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_dep
     out = {"candidate_pixels": int(cand.sum()), "oracle_pixels": int(orac.sum()),
            "silhouette_iou": 1.0 if union == 0 else inter / union,
            "depth_pixels": 0, "depth_max_error": None, "depth_mean_error": None, "depth_error_bound": None,
-           "depth_error_ratio": None, "depth_worst_pixel": None}
+           "depth_error_ratio": None, "depth_worst_pixel": None,
+           "face_disagreements": 0, "face_disagreements_inside": 0}
     compared = interior(cand) & interior(orac) & cand & orac
     if exclude is not None:
         compared &= ~exclude
+    if cand_faces is not None and oracle_faces is not None:
+        cf = np.asarray(cand_faces)
+        of = np.asarray(oracle_faces)
+        disagree = cand & orac & (cf != of)
+        near = np.zeros(cf.shape, bool)
+        for dy, dx in _NEIGHBOURS:     # on a boundary between the two faces in either image
+            near |= (_shifted(of, dy, dx, -2) == cf) | (_shifted(cf, dy, dx, -2) == of)
+        out["face_disagreements"] = int(disagree.sum())
+        out["face_disagreements_inside"] = int((disagree & ~near).sum())
+        compared &= ~disagree
     if compared.any():
         err = np.abs(cand_depth[compared] - np.asarray(oracle_depth, np.float64)[compared])
         k = int(np.argmax(err))

@@ -226,10 +226,15 @@ class CoreCandidate:
 
     def shade(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces,
               mode: RenderMode) -> np.ndarray:
-        """core's depth buffer of a shaded frame: ``(H, W)`` linear camera depth, +inf where empty."""
+        """core's depth buffer of a shaded frame: ``(H, W)`` linear camera depth, +inf where empty.
+
+        The polygon shown at each pixel (-1: none) is kept in ``self.last_face_ids``.
+        """
         frame = self.render(points, edges, camera, model_matrix, faces, mode)
         if frame.depth_image is None:
+            object.__setattr__(self, "last_face_ids", None)
             return np.full((camera.height, camera.width), np.inf)
+        object.__setattr__(self, "last_face_ids", frame.face_ids)
         return np.asarray(frame.depth_image, dtype=np.float64)
 
 
@@ -272,7 +277,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
 
         core_faces = oriented_faces(scene, motion)
     if use_faces and mode.shaded:
-        tris, _owner = oface.fan(faces)
+        tris, tri_owner = oface.fan(faces)
     if use_faces and mode.cull == "backface":
         owners = oface.EdgeOwners(edges, faces, len(scene.vertices))
     cand_all, orac_all = [], []
@@ -363,9 +368,12 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
             t_pr += t7 - t6
             cand_img = np.isfinite(cand_depth)
             if use_faces:
+                cand_faces = getattr(candidate, "last_face_ids", None)
+                orac_faces = np.where(ids >= 0, tri_owner[np.maximum(ids, 0)], -1)   # triangle -> polygon
                 ss = metrics.shaded_scores(cand_depth, orac_img, orac_depth,
                                            metrics.depth_bound(orac_depth, orac_img, cam),
-                                           metrics.occlusion_boundary(ids, tris))
+                                           metrics.occlusion_boundary(ids, tris),
+                                           cand_faces=cand_faces, oracle_faces=orac_faces)
                 shaded.append((k, ss))
                 frame_rec.update({key: ss[key] for key in SHADED_FRAME_KEYS})
                 key = (ss["silhouette_iou"], -(ss["depth_error_ratio"] or 0.0))
@@ -460,6 +468,9 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         if rec["silhouette_iou"] < tol.min_iou:
             reasons.append(f"silhouette IoU {rec['silhouette_iou']:.4f} < {tol.min_iou} "
                            f"(frame {rec['worst_pixel_frame']})")
+        if rec["face_disagreements_inside"]:
+            reasons.append(f"{rec['face_disagreements_inside']} pixels show a different face than the oracle "
+                           "away from any boundary between the two faces (a visibility error)")
         if rec["depth_error_ratio"] is not None and rec["depth_error_ratio"] > 1.0:
             reasons.append(f"depth error {rec['depth_max_error']:.3g} > its bound {rec['depth_error_bound']:.3g} "
                            f"(error/bound up to {rec['depth_error_ratio']:.3g}, frame {rec['depth_worst_frame']})")
@@ -484,16 +495,19 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
 
 #: Per-frame fields of a shaded comparison (oracles.metrics.shaded_scores).
 SHADED_FRAME_KEYS = ("silhouette_iou", "depth_pixels", "depth_max_error", "depth_mean_error",
-                     "depth_error_bound", "depth_error_ratio")
+                     "depth_error_bound", "depth_error_ratio", "face_disagreements", "face_disagreements_inside")
 
 
 def _shaded_summary(shaded: list, worst) -> dict:
     """A case's shaded fields from its frames' scores (None where nothing was compared)."""
     out = {"silhouette_iou": None, "silhouette_iou_mean": None, "depth_max_error": None,
            "depth_mean_error": None, "depth_error_bound": None, "depth_error_ratio": None,
-           "depth_worst_frame": None, "depth_pixels": 0, "worst_pixel_frame": None}
+           "depth_worst_frame": None, "depth_pixels": 0, "worst_pixel_frame": None,
+           "face_disagreements": 0, "face_disagreements_inside": 0}
     if not shaded:
         return out
+    out["face_disagreements"] = int(sum(s.get("face_disagreements", 0) for _, s in shaded))
+    out["face_disagreements_inside"] = int(sum(s.get("face_disagreements_inside", 0) for _, s in shaded))
     ious = [s["silhouette_iou"] for _, s in shaded]
     out.update(silhouette_iou=float(min(ious)), silhouette_iou_mean=float(np.mean(ious)),
                worst_pixel_frame=worst[1] if worst else None)

@@ -56,3 +56,27 @@ def test_diff_image_colours():
     assert d[0, 1].tolist() == [255, 70, 70]       # candidate only: red
     assert d[0, 2].tolist() == [60, 170, 255]      # oracle only: blue
     assert d[0, 3].tolist() == [0, 0, 0]
+
+
+def test_face_disagreements_on_a_boundary_are_allowed_inside_are_not():
+    # Oracle: face 0 on columns 0-4, face 1 on 5-9 of a 6x10 image, depth 1 everywhere.
+    from oracles.metrics import shaded_scores
+
+    of = np.zeros((6, 10), int)
+    of[:, 5:] = 1
+    depth = np.ones((6, 10))
+    covered = np.ones((6, 10), bool)
+    # Candidate puts the boundary one column later: column 5 disagrees, but face 0
+    # is next to it in the oracle's image: a boundary decision, allowed.
+    cf = np.zeros((6, 10), int)
+    cf[:, 6:] = 1
+    s = shaded_scores(depth, covered, depth, cand_faces=cf, oracle_faces=of)
+    assert (s["face_disagreements"], s["face_disagreements_inside"]) == (6, 0)
+    # Candidate shows face 0 on a 3x3 block (rows 1-3, columns 6-8) inside face 1's
+    # region. Its rim touches face 1 in the candidate's own image (like a 1-px
+    # sliver of a face seen edge-on would), but its centre (2, 7) has no neighbour
+    # showing the other's face in either image: one visibility error.
+    cf = of.copy()
+    cf[1:4, 6:9] = 0
+    s = shaded_scores(depth, covered, depth, cand_faces=cf, oracle_faces=of)
+    assert (s["face_disagreements"], s["face_disagreements_inside"]) == (9, 1)
