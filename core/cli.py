@@ -87,7 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
                      "orthographic camera at the same position and orientation with ortho-height = "
                      "2 d tan(fov/2), d = the distance to the look-at point (so things at the look-at "
                      "distance are the same size in both); a 1-px grey column between them, output width 2W+1")
-    cam.add_argument("--ortho-height", type=float, default=4.0,
+    cam.add_argument("--ortho-height", type=float, default=None,
                      help="world units visible vertically (orthographic; default 4)")
     mot = p.add_argument_group("motion (model matrix of frame k uses t = (k-1)/frames; in a scene of several "
                                "objects it applies to the whole scene, after each object's own motion)")
@@ -175,7 +175,8 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         raise InputError(f"--format {a.format!r}: expected a comma-separated list of {', '.join(FORMATS)}")
     both = a.projection == "both"
     kwargs = dict(fov_y_deg=a.fov, width=a.width, height=a.height, near=a.near, far=a.far,
-                  projection="perspective" if both else a.projection, ortho_height=a.ortho_height)
+                  projection="perspective" if both else a.projection,
+                  ortho_height=4.0 if a.ortho_height is None else a.ortho_height)
     if a.camera_pos is not None:
         if a.camera_z is not None:
             raise InputError("--camera-z and --camera-pos: expected one of them, not both")
@@ -191,6 +192,11 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
             raise InputError(f"--camera-z {d}: expected a finite non-zero distance")
         camera = camera_z(d, **kwargs)
         distance = abs(d)
+    if both and a.ortho_height is not None:
+        raise InputError(f"--ortho-height {a.ortho_height} with --projection both: the orthographic half's "
+                         "height is 2 d tan(fov/2), set by the perspective camera; expected no --ortho-height")
+    if a.style == "shaded" and a.hidden_lines:
+        raise InputError("--hidden-lines with --style shaded: a shaded frame draws no lines; expected one of them")
     ortho_camera = None
     if both:
         ortho_camera = orthographic_twin(camera, distance)
@@ -201,6 +207,8 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         light = vec3("--light", a.light)
         if not any(light):
             raise InputError(f"--light {a.light!r}: expected a non-zero direction")
+        big = max(abs(v) for v in light)
+        light = tuple(v / big for v in light)            # a direction: scale it to avoid over/underflow
     motion = Motion(turns=vec3("--spin", a.spin), offset=vec3("--translate", a.translate), scale=a.scale)
     if "mp4" in formats:
         try:
@@ -224,6 +232,9 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         if missing:
             raise InputError(f"{asked}: this build's render_frame has no {missing!r} argument "
                              "(core/pipeline.py): expected a build with faces support")
+    if a.axes and not math.isfinite(AXIS_LENGTH * scene.radius * abs(motion.scale)):
+        raise InputError(f"--axes with --scale {a.scale}: axis length 1.2 x radius {scene.radius:g} x |scale| "
+                         "overflows float64; expected a smaller --scale")
     if cull is not None and scene.winding_note:
         raise InputError(f"--cull backface: {scene.source}: {scene.winding_note}: expected faces wound "
                          "consistently (counter-clockwise seen from outside)")

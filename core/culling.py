@@ -148,6 +148,38 @@ def triangle_cross_cam(tri_cam: np.ndarray) -> np.ndarray:
     return np.cross(tri_cam[:, 1] - tri_cam[:, 0], tri_cam[:, 2] - tri_cam[:, 0])
 
 
+#: Relative tolerance of the orientation tests, in units of float64 eps: the
+#: cross product of two edges carries ~3 roundings per component relative to
+#: |e1| |e2|, the dot with the view vector ~3 more relative to |n| |p|; 16 eps
+#: covers both with margin. Inside it, the sign is rounding noise.
+ORIENTATION_EPS = 16 * np.finfo(np.float64).eps
+
+
+def degenerate(tri_cam: np.ndarray) -> np.ndarray:
+    """``(T,) bool``: zero-area triangles (collinear or repeated vertices, up to rounding).
+
+    ``|(b - a) x (c - a)| <= ORIENTATION_EPS |b - a| |c - a|``: the normal is
+    rounding noise. Such a face covers nothing and has no front or back: it is
+    culled and never rasterized, so its edges do not flicker with the noise.
+    """
+    tri_cam = np.asarray(tri_cam, dtype=np.float64).reshape(-1, 3, 3)
+    e1 = _unit_scale(tri_cam[:, 1] - tri_cam[:, 0])
+    e2 = _unit_scale(tri_cam[:, 2] - tri_cam[:, 0])
+    with np.errstate(over="ignore", invalid="ignore"):
+        n = np.linalg.norm(np.cross(e1, e2), axis=1)
+        scale = np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
+    return ~(n > ORIENTATION_EPS * scale)
+
+
+def _unit_scale(v: np.ndarray) -> np.ndarray:
+    """Rows divided by their largest |component| (zero rows kept): signs of the
+    products below do not depend on a positive scale, and at 1e-110 or 1e110
+    unscaled cross and dot products underflow or overflow."""
+    big = np.abs(v).max(axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(big > 0, v / np.where(big > 0, big, 1.0), 0.0)
+
+
 def backface_keep(tri_cam: np.ndarray, projection: str, mirrored: bool = False) -> np.ndarray:
     """``(T,) bool``: True for front-facing triangles (module docstring for the rule).
 
@@ -161,12 +193,19 @@ def backface_keep(tri_cam: np.ndarray, projection: str, mirrored: bool = False) 
         The model matrix has a negative determinant (reverses the winding).
     """
     tri_cam = np.asarray(tri_cam, dtype=np.float64).reshape(-1, 3, 3)
-    n_cc = triangle_cross_cam(tri_cam)
-    if projection == "perspective":
-        s = np.einsum("ij,ij->i", n_cc, tri_cam[:, 0])      # dot(n_cc, p_cam) = -dot(n_world, view)
-    else:
-        s = n_cc[:, 2]                                       # n_cc . (0, 0, 1) = -dot(n_world, forward)
-    return s < 0 if mirrored else s > 0
+    # Each vector scaled by a positive factor of its own: the signs are unchanged.
+    n_cc = np.cross(_unit_scale(tri_cam[:, 1] - tri_cam[:, 0]), _unit_scale(tri_cam[:, 2] - tri_cam[:, 0]))
+    with np.errstate(over="ignore", invalid="ignore"):
+        if projection == "perspective":
+            a = _unit_scale(tri_cam[:, 0])
+            s = np.einsum("ij,ij->i", n_cc, a)                 # dot(n_cc, p_cam) = -dot(n_world, view)
+            tol = ORIENTATION_EPS * np.linalg.norm(n_cc, axis=1) * np.linalg.norm(a, axis=1)
+        else:
+            s = n_cc[:, 2]                                       # n_cc . (0, 0, 1) = -dot(n_world, forward)
+            tol = ORIENTATION_EPS * np.linalg.norm(n_cc, axis=1)
+    # Edge-on (|s| within rounding of 0) and zero-area faces are culled: their sign is noise.
+    keep = s < -tol if mirrored else s > tol
+    return keep & ~degenerate(tri_cam)
 
 
 def sphere_outside_frustum(center_world, radius: float, camera: Camera) -> bool:

@@ -121,9 +121,13 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
     ``p_model`` is an ``(N, 3)`` array or, to skip re-centring and casting on
     every frame, the :class:`~core.projection.LocalPoints` of
     :func:`~core.projection.localize`. ``dtype`` ("float64" default, or
-    "float32") is the precision of every per-point operation; with
-    ``LocalPoints`` it defaults to theirs. ``raster`` is one of
-    :data:`RASTER_MODES` (core.raster).
+    "float32") is the precision of every per-point operation of the
+    projection and the wireframe; with ``LocalPoints`` it defaults to theirs.
+    The face stage (culling, z-buffer, shading) takes the camera-space
+    points in that precision but computes in float64: its decisions (which
+    face is nearer, which side a normal faces) are compared with a 24-bit
+    depth buffer and rounding signs, where float32 arithmetic would add noise
+    and no speed. ``raster`` is one of :data:`RASTER_MODES` (core.raster).
 
     Faces (all optional; without them the frame is the plain wireframe):
 
@@ -137,7 +141,10 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
     hidden_lines
         Rasterize the faces into a depth buffer (core.zbuffer) and do not draw
         line pixels behind them (``z_line <= z_buffer + bias``, bias as
-        ``glPolygonOffset(1, 1)``; core.zbuffer).
+        ``glPolygonOffset(1, 1)``; core.zbuffer). Like GL's, the bias includes
+        one step of a 24-bit buffer over [near, far]: with an extreme depth
+        range (say near = -1e8, far = 1e8 for an orthographic camera) that step
+        is ~12 units and hides nothing. Keep [near, far] tight.
     style
         ``"wireframe"`` or ``"shaded"`` (the image is flat-shaded faces,
         core.shading; no lines are drawn and ``hidden_lines`` has no effect
@@ -257,7 +264,8 @@ def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: b
         bad = int(tris.max()) if tris.max() >= n else int(tris.min())
         raise ValueError(f"faces: vertex index {bad} out of range for {n} vertices")
     tri_cam = p_cam.astype(np.float64, copy=False)[tris]           # camera, (T, 3, 3)
-    mirrored = bool(np.linalg.det(np.asarray(model_matrix, dtype=np.float64)[:3, :3]) < 0)
+    # the sign of the determinant from slogdet: det() of a scale of 1e-110 underflows to -0.0
+    mirrored = bool(np.linalg.slogdet(np.asarray(model_matrix, dtype=np.float64)[:3, :3])[0] < 0)
     out = {"faces_culled": 0, "face_kept": None}
     if cull == "backface":
         keep_tri = culling.backface_keep(tri_cam, camera.projection, mirrored=mirrored)
@@ -268,7 +276,7 @@ def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: b
         out["face_kept"] = face_kept
         kept_idx = np.flatnonzero(keep_tri)
     else:
-        kept_idx = np.arange(len(tris))
+        kept_idx = np.flatnonzero(~culling.degenerate(tri_cam))         # zero-area faces cover nothing
     if not need_depth:
         return out
     # Outward normals (for shading): sum of fan cross products = the polygon's

@@ -173,10 +173,8 @@ def oriented_faces(scene: Scene, run_motion: Motion) -> tuple:
     see that, so the faces are re-wound here; the sign is constant over a run
     (rotations have determinant +1, scales are constant).
     """
-    flip = []
-    for o in scene.objects:
-        det = (run_motion.scale * o.motion.scale) ** 3
-        flip.append(det < 0)
+    # sign of (s_run s_o)^3, from the signs alone: the product can overflow or underflow
+    flip = [(run_motion.scale < 0) != (o.motion.scale < 0) for o in scene.objects]
     if not any(flip):
         return scene.faces
     starts = [o.vertex_start for o in scene.objects]

@@ -42,6 +42,9 @@ def face_intensity(normals_world: np.ndarray, light_dir_world, ambient: float = 
     """
     n = np.asarray(normals_world, dtype=np.float64).reshape(-1, 3)
     light = np.asarray(light_dir_world, dtype=np.float64).reshape(3)
+    big = np.abs(light).max()
+    if np.isfinite(big) and big > 0:
+        light = light / big                      # a direction: scaled first, so norm() cannot over/underflow
     norm_l = np.linalg.norm(light)
     if not (np.isfinite(norm_l) and norm_l > 0):
         raise ValueError(f"light_dir {light.tolist()}: expected a finite non-zero direction")

@@ -144,6 +144,19 @@ def _parse(args):
                              f"--level {args.level}: give only --level")
         level = implied
     core_given = [f"--{k}" for k in CORE_OPTIONS if getattr(args, k) is not None]
+    if args.suite:
+        ignored = [opt for opt, given in (
+            ("--scene", args.scene is not None), ("--frames", args.frames != 24), ("--every", args.every != 1),
+            ("--cases", args.cases != ",".join(CASE_NAMES)), ("--spin", args.spin != "1,1,0"),
+            ("--jobs", args.jobs != 1), ("--tol-px", args.tol_px != tolerances.VERTEX_TOL_PX),
+            ("--min-f1", args.min_f1 != tolerances.MIN_F1_1PX),
+            ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX)) if given]
+        if ignored:
+            raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
+                             "bounds are fixed (oracles/extremes.py); expected only --level, --run or --report-dir")
+    if args.sweep and args.jobs != 1:
+        raise InputError(f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
+                         "the times compare; expected no --jobs")
     if (args.sweep or args.suite) and (core_given or args.candidate):
         what = "--sweep" if args.sweep else f"--suite {args.suite}"
         raise InputError(f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
@@ -179,6 +192,17 @@ def _parse(args):
         raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
     names = args.scene or builtin_names()
     scenes = [load_scene(n) for n in names]
+    if mode.cull == "backface":
+        wound = next((sc for sc in scenes if sc.faces and sc.winding_note), None)
+        if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
+            raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
+                             "consistently (counter-clockwise seen from outside)")
+    if args.sweep:
+        moving = [sc.name for sc in scenes if not sc.is_single_static]
+        if moving:
+            raise InputError(f"--sweep with scene {moving[0]!r}: it has several objects or objects with their own "
+                             "motion, which the sweep does not compose; expected single-object scenes "
+                             "(plain crosscheck checks these)")
     if args.candidate:
         candidate = load_candidate(args.candidate)
     else:

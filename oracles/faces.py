@@ -73,14 +73,29 @@ def front_faces(p_world: np.ndarray, faces, camera, mirrored: np.ndarray | None 
     if len(tris) == 0:
         return keep
     a, b, c = (p_world[tris[:, i]] for i in range(3))
-    n = np.cross(b - a, c - a)
+
+    def unit_scale(v):          # a positive factor per row: signs unchanged, no under/overflow at 1e+-110
+        big = np.abs(v).max(axis=1, keepdims=True)
+        return np.where(big > 0, v / np.where(big > 0, big, 1.0), 0.0)
+
+    e1, e2 = unit_scale(b - a), unit_scale(c - a)
+    n = np.cross(e1, e2)
     if mirrored is not None:
         n[mirrored[tris[:, 0]]] *= -1.0
-    if camera.projection == "perspective":
-        s = np.einsum("ij,ij->i", n, a - np.asarray(camera.position, dtype=np.float64))
-    else:
-        s = n @ camera_basis(camera)[2]
-    keep[owner[s < 0]] = True
+    # Within 16 eps of zero the sign is rounding noise (same margin as core, derived
+    # there): zero-area faces (|n| <= 16 eps |e1| |e2|) and edge-on ones are back faces.
+    eps16 = 16 * np.finfo(np.float64).eps
+    with np.errstate(over="ignore", invalid="ignore"):
+        n_len = np.linalg.norm(n, axis=1)
+        if camera.projection == "perspective":
+            view = unit_scale(a - np.asarray(camera.position, dtype=np.float64))
+            s = np.einsum("ij,ij->i", n, view)
+            tol = eps16 * n_len * np.linalg.norm(view, axis=1)
+        else:
+            s = n @ camera_basis(camera)[2]
+            tol = eps16 * n_len
+        flat = ~(n_len > eps16 * np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1))
+    keep[owner[(s < -tol) & ~flat]] = True
     return keep
 
 

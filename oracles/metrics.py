@@ -175,8 +175,13 @@ def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_dep
         raise ValueError(f"image shapes differ: {cand.shape} vs {orac.shape}")
     union = int((cand | orac).sum())
     inter = int((cand & orac).sum())
+    # Pixels covered by one image only that are interior in it (all 8 neighbours
+    # covered there): not a boundary decision but a hole or a misplaced region.
+    only = cand ^ orac
+    inside = (only & cand & interior(cand)) | (only & orac & interior(orac))
     out = {"candidate_pixels": int(cand.sum()), "oracle_pixels": int(orac.sum()),
-           "silhouette_iou": 1.0 if union == 0 else inter / union,
+           "silhouette_iou": 1.0 if union == 0 else inter / union, "silhouette_union_px": union,
+           "silhouette_mismatch_inside": int(inside.sum()),
            "depth_pixels": 0, "depth_max_error": None, "depth_mean_error": None, "depth_error_bound": None,
            "depth_error_ratio": None, "depth_worst_pixel": None,
            "face_disagreements": 0, "face_disagreements_inside": 0}

@@ -465,8 +465,11 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         if rec["pixel_f1_0px"] < tol.min_f1_0px:
             reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
     if shaded:
-        if rec["silhouette_iou"] < tol.min_iou:
-            reasons.append(f"silhouette IoU {rec['silhouette_iou']:.4f} < {tol.min_iou} "
+        if rec["silhouette_mismatch_inside"]:
+            reasons.append(f"{rec['silhouette_mismatch_inside']} pixels covered by one side only lie inside its "
+                           "silhouette, not on its boundary (a hole or a misplaced region)")
+        if rec["silhouette_iou_gated"] is not None and rec["silhouette_iou_gated"] < tol.min_iou:
+            reasons.append(f"silhouette IoU {rec['silhouette_iou_gated']:.4f} < {tol.min_iou} "
                            f"(frame {rec['worst_pixel_frame']})")
         if rec["face_disagreements_inside"]:
             reasons.append(f"{rec['face_disagreements_inside']} pixels show a different face than the oracle "
@@ -494,7 +497,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
 
 
 #: Per-frame fields of a shaded comparison (oracles.metrics.shaded_scores).
-SHADED_FRAME_KEYS = ("silhouette_iou", "depth_pixels", "depth_max_error", "depth_mean_error",
+SHADED_FRAME_KEYS = ("silhouette_iou", "silhouette_union_px", "silhouette_mismatch_inside", "depth_pixels", "depth_max_error", "depth_mean_error",
                      "depth_error_bound", "depth_error_ratio", "face_disagreements", "face_disagreements_inside")
 
 
@@ -503,9 +506,15 @@ def _shaded_summary(shaded: list, worst) -> dict:
     out = {"silhouette_iou": None, "silhouette_iou_mean": None, "depth_max_error": None,
            "depth_mean_error": None, "depth_error_bound": None, "depth_error_ratio": None,
            "depth_worst_frame": None, "depth_pixels": 0, "worst_pixel_frame": None,
-           "face_disagreements": 0, "face_disagreements_inside": 0}
+           "face_disagreements": 0, "face_disagreements_inside": 0,
+           "silhouette_mismatch_inside": 0, "silhouette_iou_gated": None}
     if not shaded:
         return out
+    from .tolerances import MIN_IOU_UNION_PX
+
+    out["silhouette_mismatch_inside"] = int(sum(s.get("silhouette_mismatch_inside", 0) for _, s in shaded))
+    gated = [s["silhouette_iou"] for _, s in shaded if s.get("silhouette_union_px", 0) >= MIN_IOU_UNION_PX]
+    out["silhouette_iou_gated"] = float(min(gated)) if gated else None     # IoU over frames big enough to judge
     out["face_disagreements"] = int(sum(s.get("face_disagreements", 0) for _, s in shaded))
     out["face_disagreements_inside"] = int(sum(s.get("face_disagreements_inside", 0) for _, s in shaded))
     ious = [s["silhouette_iou"] for _, s in shaded]

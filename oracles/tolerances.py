@@ -61,6 +61,15 @@ PIXEL_TOLS = (0, 1)
 #: boundary pixel flips with probability 1/2: IoU ~ 1 - P/2A ~ 0.99).
 MIN_SILHOUETTE_IOU = 0.995
 
+#: IoU is a ratio of areas: for a silhouette of a few pixels one boundary
+#: decision moves it by a large fraction (a zero-area face that GL's float32
+#: noise turns into 1 px while core draws none scores IoU 0). Below this union,
+#: in pixels, the IoU gate is not applied; the silhouettes must still differ
+#: only on their boundaries (metrics.shaded_scores' silhouette_mismatch_inside
+#: = 0, applied at every size). 400 px = a 20 x 20 silhouette, whose ~80
+#: boundary pixels are 20 % of its area.
+MIN_IOU_UNION_PX = 400
+
 #: The shaded depth comparison: |z_candidate - z_pyrender| at a pixel covered
 #: by both and not on either silhouette (eroded by 1 px) nor beside an occlusion
 #: boundary (oracles.metrics.occlusion_boundary) must be at most

@@ -80,3 +80,22 @@ def test_face_disagreements_on_a_boundary_are_allowed_inside_are_not():
     cf[1:4, 6:9] = 0
     s = shaded_scores(depth, covered, depth, cand_faces=cf, oracle_faces=of)
     assert (s["face_disagreements"], s["face_disagreements_inside"]) == (9, 1)
+
+
+def test_silhouette_mismatch_inside_counts_holes_not_boundary_shifts():
+    # Oracle covers a 6x6 block; the candidate covers it shifted right by one column:
+    # the mismatched columns are on each silhouette's boundary: 0 inside. A 1-px hole
+    # in the candidate's middle is inside the oracle's silhouette: 1.
+    from oracles.metrics import shaded_scores
+
+    orac = np.zeros((10, 12), bool)
+    orac[2:8, 2:8] = True
+    cand = np.zeros((10, 12), bool)
+    cand[2:8, 3:9] = True
+    depth = np.where(cand, 1.0, np.inf)
+    s = shaded_scores(depth, orac, np.ones((10, 12)))
+    assert s["silhouette_mismatch_inside"] == 0 and s["silhouette_union_px"] == 42
+    hole = np.where(orac, 1.0, np.inf)
+    hole[4, 4] = np.inf
+    s = shaded_scores(hole, orac, np.ones((10, 12)))
+    assert s["silhouette_mismatch_inside"] == 1
