@@ -197,12 +197,6 @@ def _parse(args):
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
-    if args.sweep:
-        moving = [sc.name for sc in scenes if not sc.is_single_static]
-        if moving:
-            raise InputError(f"--sweep with scene {moving[0]!r}: it has several objects or objects with their own "
-                             "motion, which the sweep does not compose; expected single-object scenes "
-                             "(plain crosscheck checks these)")
     if args.candidate:
         candidate = load_candidate(args.candidate)
     else:

@@ -61,7 +61,7 @@ def mirrored_vertices(scene, matrices) -> np.ndarray:
     """``(N,) bool``: vertices of objects whose matrix has a negative determinant."""
     out = np.zeros(len(scene.vertices), dtype=bool)
     for o, m in zip(scene.objects, matrices):
-        if np.linalg.det(m[:3, :3]) < 0:
+        if np.linalg.slogdet(m[:3, :3])[0] < 0:       # the sign alone: det() underflows at 1e-110 scales
             out[o.vertex_start:o.vertex_stop] = True
     return out
 

@@ -36,12 +36,15 @@ import numpy as np
 
 from core.pipeline import CLIP_MODES, RASTER_MODES, render_frame
 from core.projection import DTYPES, localize
-from core.scene import Scene, face_edges, unique_edges
+from core.scene import Scene, face_edges, unique_edges, world_points
 from core.transforms import Motion
 
+from . import faces as oface
 from . import metrics, opencv_oracle
 from .cases import cameras_for
 from .convert import model_matrix
+
+_EYE = np.eye(4)
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -85,6 +88,19 @@ def _pareto(rows: list[dict]) -> None:
             for o in rows if o is not r)
 
 
+def oracle_world_points(scene: Scene, motion: Motion, k: int, frames: int) -> np.ndarray:
+    """The oracle side's world points of frame ``k``, from scipy (independent of core.transforms).
+
+    A scene of several objects (or one with its own motion) composes each
+    object's matrix as ``M_run @ M_object`` (oracles.faces.object_matrices).
+    """
+    t = (k - 1) / frames
+    if scene.is_single_static:
+        m = model_matrix(motion.turns, motion.offset, motion.scale, t)
+        return scene.vertices @ m[:3, :3].T + m[:3, 3]
+    return oface.world_points(scene, oface.object_matrices(scene, motion.turns, t))
+
+
 def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=None,
               turns=(1.0, 1.0, 0.0), large: Scene | None = None, pyrender: bool = True,
               repeats: int = 3, progress=None) -> dict:
@@ -99,7 +115,8 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     try:
         for group, scene in groups:
             edges = np.asarray(scene.edges)
-            prepared = {d: localize(scene.vertices, d) for d in DTYPES}
+            single = scene.is_single_static
+            prepared = {d: localize(scene.vertices, d) for d in DTYPES} if single else None
             for case in cameras_for(scene.radius):
                 if case_names is not None and case.name not in case_names:
                     continue
@@ -113,18 +130,24 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                         oracles[size] = PyrenderOracle(*size)
                     pyr = oracles[size]
                 for k in frame_ids:
-                    m_oracle = model_matrix(motion.turns, motion.offset, motion.scale, (k - 1) / frames)
-                    p_world = scene.vertices @ m_oracle[:3, :3].T + m_oracle[:3, 3]
+                    p_world = oracle_world_points(scene, motion, k, frames)
+                    if single:
+                        m_oracle = model_matrix(motion.turns, motion.offset, motion.scale, (k - 1) / frames)
+                        ref_img = pyr.render(scene.vertices, edges, cam, model_matrix=m_oracle)[0] if pyr else None
+                    else:
+                        ref_img = pyr.render(p_world, edges, cam)[0] if pyr else None
                     ref_px = opencv_oracle.project(p_world, cam)
-                    ref_img = pyr.render(scene.vertices, edges, cam, model_matrix=m_oracle)[0] if pyr else None
-                    m_core = motion.frame_matrix(k, frames)
                     for s in settings:
                         a = acc[s.key]
-                        pts = prepared[s.dtype]
                         best = np.inf
                         for _ in range(repeats):
                             t0 = time.perf_counter()
-                            frame = render_frame(pts, edges, cam, m_core, s.clip, raster=s.raster)
+                            if single:
+                                frame = render_frame(prepared[s.dtype], edges, cam, motion.frame_matrix(k, frames),
+                                                     s.clip, raster=s.raster)
+                            else:   # as renderer does for such scenes: world points, identity model matrix
+                                pts = localize(world_points(scene, motion, k, frames), s.dtype)
+                                frame = render_frame(pts, edges, cam, _EYE, s.clip, raster=s.raster)
                             best = min(best, time.perf_counter() - t0)
                         a["t"][group].append(best)
                         ve = metrics.vertex_errors(frame.p_px, ref_px)

@@ -130,3 +130,27 @@ def test_cli_sweep_rejects_candidate_settings_and_suite(extra, tmp_path, capsys)
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("crosscheck: error:")
     assert not (tmp_path / "x").exists()
+
+
+@needs_osmesa
+def test_sweep_composes_each_objects_motion():
+    # The orrery's planet sits at x = 2.5 with its own spin: a sweep that ignored
+    # object motion put every object at the origin (3 units off) and still
+    # "passed" against an oracle making the same mistake. Now the oracle builds
+    # each object's matrix with scipy and core renders world points, as renderer
+    # does: the default setting meets the tolerances.
+    from core.scene import world_points
+    from core.transforms import Motion
+
+    orrery = load_scene("orrery")
+    assert not orrery.is_single_static
+    motion = Motion()
+    ref = sweep.oracle_world_points(orrery, motion, 3, 8)
+    # scipy's composition equals core's to rounding (entries ~3, a few eps each)
+    np.testing.assert_allclose(ref, world_points(orrery, motion, 3, 8), rtol=0, atol=1e-12)
+    naive = orrery.vertices @ motion.frame_matrix(3, 8)[:3, :3].T     # object motion ignored
+    assert np.abs(ref - naive).max() > 1.0
+    result = sweep.run_sweep([orrery], frames=2, case_names=["oblique_roll"], repeats=1)
+    d = next(r for r in result["settings"] if r["default"])
+    assert d["max_vertex_error_px"] <= 1e-6 and d["visibility_mismatches"] == 0
+    assert d["pixel_f1_1px"] >= 0.999 and d["pixel_f1_0px"] >= 0.98
