@@ -6,6 +6,7 @@ cd "$(dirname "$0")/../.."
 R=.venv/bin/renderer
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
+$R --scene cube --frames 180 --camera-z 4.0 --fov 70 --out "$T/seed" >/dev/null     # the README's first example
 CAM="--scene cube --frames 24 --camera-pos 2.5,2,3.5"
 $R $CAM --out "$T/wf" >/dev/null
 $R $CAM --cull backface --out "$T/cu" >/dev/null
@@ -29,7 +30,8 @@ for i, im in enumerate(tiles):
 strip.save(out / "styles.png", optimize=True)
 frame("both", 4).save(out / "perspective-orthographic.png", optimize=True)
 frame("orr", 10, "orrery").save(out / "orrery-axes.png", optimize=True)
+(out / "cube-frame_0020.png").write_bytes((t / "seed" / "cube-frames" / "frame_0020.png").read_bytes())
 (out / "orrery.gif").write_bytes((t / "orr" / "orrery.gif").read_bytes())
 (out / "orrery-plots.png").write_bytes((t / "orr" / "orrery-plots.png").read_bytes())
 PY
-echo "wrote reports/example/{styles,perspective-orthographic,orrery-axes,orrery-plots}.png, orrery.gif"
+echo "wrote reports/example/{cube-frame_0020,styles,perspective-orthographic,orrery-axes,orrery-plots}.png, orrery.gif"
