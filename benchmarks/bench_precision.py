@@ -33,21 +33,12 @@ from core.camera import look_at  # noqa: E402
 from core.projection import project_points  # noqa: E402
 from oracles import opencv_oracle  # noqa: E402
 from oracles.convert import camera_to_opencv  # noqa: E402
+from oracles.extremes import reference_project  # noqa: E402
 
 
 def reference(p_world, camera):
-    """The conventions' formula in np.longdouble (perspective only), NaN outside [near, far]."""
-    ld = np.longdouble
-    r = np.stack([camera.right, camera.up, camera.forward]).astype(ld)
-    p_cam = (np.asarray(p_world, ld) - camera.position.astype(ld)) @ r.T
-    z = p_cam[:, 2]
-    vis = (z >= ld(camera.near)) & (z <= ld(camera.far))
-    f = ld(camera.height) / 2 / np.tan(ld(np.deg2rad(camera.fov_y_deg)) / 2)
-    cx, cy = ld(camera.width - 1) / 2, ld(camera.height - 1) / 2
-    out = np.full((len(p_cam), 2), np.nan)
-    out[vis, 0] = (cx + f * p_cam[vis, 0] / z[vis]).astype(np.float64)
-    out[vis, 1] = (cy - f * p_cam[vis, 1] / z[vis]).astype(np.float64)
-    return out
+    """The conventions' formula in np.longdouble, NaN outside [near, far] (oracles.extremes)."""
+    return reference_project(p_world, camera)[1].astype(np.float64)
 
 
 def project_f32(p_world, camera):

@@ -228,10 +228,6 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         if not scene.faces:
             raise InputError(f"{asked}: scene {scene.name!r} ({scene.source}) has no faces: expected a scene "
                              "with faces ('f' lines or a mesh file)")
-        missing = _pipeline_missing(s)
-        if missing:
-            raise InputError(f"{asked}: this build's render_frame has no {missing!r} argument "
-                             "(core/pipeline.py): expected a build with faces support")
     if a.axes and not math.isfinite(AXIS_LENGTH * scene.radius * abs(motion.scale)):
         raise InputError(f"--axes with --scale {a.scale}: axis length 1.2 x radius {scene.radius:g} x |scale| "
                          "overflows float64; expected a smaller --scale")
@@ -255,17 +251,6 @@ def orthographic_twin(camera: Camera, distance: float) -> Camera:
     return Camera(position=camera.position, forward=camera.forward, up=camera.up, fov_y_deg=camera.fov_y_deg,
                   width=camera.width, height=camera.height, near=camera.near, far=camera.far,
                   projection="orthographic", ortho_height=height)
-
-
-def _pipeline_missing(s: Settings) -> str | None:
-    """The first render_frame keyword this run needs that core.pipeline does not take."""
-    import inspect
-
-    params = inspect.signature(render_frame).parameters
-    for name in _face_kwargs(s, ()):
-        if name not in params:
-            return name
-    return None
 
 
 def _face_kwargs(s: Settings, faces) -> dict:

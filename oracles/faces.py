@@ -57,6 +57,22 @@ def world_points(scene, matrices) -> np.ndarray:
     return out
 
 
+def frame_geometry(scene, motion, t: float):
+    """The oracle side of one frame at time ``t``: ``(p_world, matrices, pr_vertices, pr_pose)``.
+
+    A single static object: one scipy model matrix of the run's motion, and
+    pyrender gets the model points with that matrix as the node pose. Several
+    objects (or one with its own motion): each object's ``M_run @ M_o``
+    (:func:`object_matrices`), and pyrender gets the world points, no pose.
+    """
+    if scene.is_single_static:
+        m = model_matrix(motion.turns, motion.offset, motion.scale, t)
+        return scene.vertices @ m[:3, :3].T + m[:3, 3], [m], scene.vertices, m
+    matrices = object_matrices(scene, motion.turns, t)
+    p_world = world_points(scene, matrices)
+    return p_world, matrices, p_world, None
+
+
 def mirrored_vertices(scene, matrices) -> np.ndarray:
     """``(N,) bool``: vertices of objects whose matrix has a negative determinant."""
     out = np.zeros(len(scene.vertices), dtype=bool)

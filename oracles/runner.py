@@ -293,16 +293,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     core_points = candidate.prepare(scene.vertices) if is_core and single else None   # once per scene
     for k in range(1, frames + 1, every):
         t0 = time.perf_counter()
-        t = (k - 1) / frames
-        if single:
-            m = model_matrix(motion.turns, motion.offset, motion.scale, t)
-            p_world = scene.vertices @ m[:3, :3].T + m[:3, 3]
-            matrices = [m]
-            pr_vertices, pr_pose = scene.vertices, m
-        else:
-            matrices = oface.object_matrices(scene, motion.turns, t)
-            p_world = oface.world_points(scene, matrices)
-            pr_vertices, pr_pose = p_world, None
+        p_world, matrices, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
         t1 = time.perf_counter()
         oracle_px = opencv_oracle.project(p_world, cam)
         t2 = time.perf_counter()

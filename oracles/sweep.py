@@ -42,7 +42,6 @@ from core.transforms import Motion
 from . import faces as oface
 from . import metrics, opencv_oracle
 from .cases import cameras_for
-from .convert import model_matrix
 
 _EYE = np.eye(4)
 
@@ -88,19 +87,6 @@ def _pareto(rows: list[dict]) -> None:
             for o in rows if o is not r)
 
 
-def oracle_world_points(scene: Scene, motion: Motion, k: int, frames: int) -> np.ndarray:
-    """The oracle side's world points of frame ``k``, from scipy (independent of core.transforms).
-
-    A scene of several objects (or one with its own motion) composes each
-    object's matrix as ``M_run @ M_object`` (oracles.faces.object_matrices).
-    """
-    t = (k - 1) / frames
-    if scene.is_single_static:
-        m = model_matrix(motion.turns, motion.offset, motion.scale, t)
-        return scene.vertices @ m[:3, :3].T + m[:3, 3]
-    return oface.world_points(scene, oface.object_matrices(scene, motion.turns, t))
-
-
 def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=None,
               turns=(1.0, 1.0, 0.0), large: Scene | None = None, pyrender: bool = True,
               repeats: int = 3, progress=None) -> dict:
@@ -130,12 +116,8 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                         oracles[size] = PyrenderOracle(*size)
                     pyr = oracles[size]
                 for k in frame_ids:
-                    p_world = oracle_world_points(scene, motion, k, frames)
-                    if single:
-                        m_oracle = model_matrix(motion.turns, motion.offset, motion.scale, (k - 1) / frames)
-                        ref_img = pyr.render(scene.vertices, edges, cam, model_matrix=m_oracle)[0] if pyr else None
-                    else:
-                        ref_img = pyr.render(p_world, edges, cam)[0] if pyr else None
+                    p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
+                    ref_img = pyr.render(pr_vertices, edges, cam, model_matrix=pr_pose)[0] if pyr else None
                     ref_px = opencv_oracle.project(p_world, cam)
                     for s in settings:
                         a = acc[s.key]

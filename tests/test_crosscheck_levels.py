@@ -1,6 +1,5 @@
 """crosscheck --level, --every, --jobs and the core candidate's settings (--dtype, --clip, --raster)."""
 
-import inspect
 import json
 import pickle
 import sys
@@ -19,14 +18,6 @@ VERTEX_KEYS = ("max_vertex_error_px", "mean_vertex_error_px", "rms_vertex_error_
                "visible_points", "visibility_mismatch", "faults", "verdict")
 
 
-def _core_has(*names):
-    from core.pipeline import render_frame
-
-    return set(names) <= set(inspect.signature(render_frame).parameters)
-
-
-needs_core_settings = pytest.mark.skipif(not _core_has("dtype", "raster"),
-                                         reason="core.pipeline.render_frame has no dtype/raster keywords yet")
 
 
 def run(tmp_path, *args, name="run"):
@@ -253,7 +244,6 @@ def test_default_settings_are_recorded(tmp_path):
     assert "(dtype = float64, clip = clip, raster = exact)" in (out / "report.md").read_text()
 
 
-@needs_core_settings
 def test_float32_reaches_core(tmp_path):
     code, report, _ = run(tmp_path, "--level", "vertices", "--dtype", "float32", "--scene", "cube",
                           "--frames", "2", "--cases", "on_axis")
@@ -263,7 +253,6 @@ def test_float32_reaches_core(tmp_path):
     assert report["candidate_settings"]["dtype"] == "float32"
 
 
-@needs_core_settings
 @pytest.mark.parametrize("raster", ["fast", "aa"])
 def test_other_rasters_are_drawn_and_judged(tmp_path, raster):
     code, report, _ = run(tmp_path, "--raster", raster, "--scene", "cube", "--frames", "2",

@@ -101,12 +101,6 @@ def test_plots_survive_zero_none_and_failing_cases(tmp_path):
 
 @pytest.mark.parametrize("style", ["shaded"])
 def test_shaded_plot_has_iou_and_depth(tmp_path, style):
-    import inspect
-
-    from core.pipeline import render_frame
-
-    if "style" not in inspect.signature(render_frame).parameters:
-        pytest.skip("core.pipeline.render_frame has no style yet")
     code, report, out = run(tmp_path, "--style", style, "--scene", "cube", "--frames", "2", "--cases", "on_axis")
     assert code == 0 and (out / "pixels.png").is_file()
     size, frames = gif_frames(out / "worst.gif")

@@ -4,7 +4,6 @@ Every bound below is the derived one of oracles/tolerances.py (the numbers in
 comments are measured, core against pyrender/OSMesa on this machine's llvmpipe).
 """
 
-import inspect
 import json
 import sys
 from dataclasses import dataclass
@@ -20,23 +19,6 @@ ROOT = Path(__file__).resolve().parent.parent
 USER = ROOT / "tests" / "data" / "user_projector.py"
 
 
-def _core_has(*names):
-    from core.pipeline import render_frame
-
-    return set(names) <= set(inspect.signature(render_frame).parameters)
-
-
-needs_faces = pytest.mark.skipif(not _core_has("faces", "cull", "hidden_lines", "style"),
-                                 reason="core.pipeline.render_frame has no faces/cull/hidden_lines/style yet")
-
-
-def _scene_api():
-    import core.scene
-
-    return hasattr(core.scene, "world_points") and hasattr(core.scene, "SceneObject")
-
-
-needs_objects = pytest.mark.skipif(not _scene_api(), reason="core.scene has no objects / world_points yet")
 
 
 def run(tmp_path, *args, name="run"):
@@ -63,7 +45,6 @@ def _load(name_or_path):
 
 # ---------------------------------------------------------------- shaded
 
-@needs_faces
 def test_shaded_cube_and_icosphere_pass_perspective_and_orthographic(tmp_path, icosphere):
     code, report, out = run(tmp_path, "--style", "shaded", "--scene", "cube", "--scene", str(icosphere),
                             "--frames", "4", "--cases", "oblique_roll,orthographic")
@@ -110,7 +91,6 @@ class MirroredCore(CoreCandidate):
         return super().shade(*args)[:, ::-1]
 
 
-@needs_faces
 def test_injected_shading_faults_are_caught():
     cube = _load("cube")
     shaded = RenderMode(style="shaded")
@@ -132,7 +112,6 @@ def test_injected_shading_faults_are_caught():
     assert case["silhouette_mismatch_inside"] > 1000 and "inside its silhouette" in reasons
 
 
-@needs_faces
 def test_faceless_scene_is_noted_not_failed(tmp_path):
     wire = tmp_path / "wire.scene"                      # the pyramid's edges, without faces
     wire.write_text("v -1 -1 -1\nv 1 -1 -1\nv 1 -1 1\nv -1 -1 1\nv 0 1 0\n"
@@ -169,7 +148,6 @@ class InsideOutCore(CoreCandidate):
         return super().draw_mode(points, edges, camera, model_matrix, flipped, mode)
 
 
-@needs_faces
 def test_hidden_lines_cube_from_an_oblique_camera(tmp_path):
     code, report, out = run(tmp_path, "--hidden-lines", "--scene", "cube", "--frames", "4",
                             "--cases", "oblique_roll,orthographic")
@@ -189,7 +167,6 @@ def test_hidden_lines_cube_from_an_oblique_camera(tmp_path):
     assert report["cases"][0]["pixel_f1_1px"] < 0.95
 
 
-@needs_faces
 def test_culling_a_closed_mesh_changes_nothing_visible(icosphere):
     scenes = [_load("cube"), _load(icosphere)]
     cases = ["oblique_roll", "orthographic"]
@@ -274,7 +251,6 @@ class RunFirstCore(CoreCandidate):
         return out
 
 
-@needs_objects
 def test_two_objects_with_their_own_spins_pass_at_level_pixels(tmp_path):
     path = tmp_path / "pair.scene"
     path.write_text(TWO_OBJECTS)
@@ -286,17 +262,15 @@ def test_two_objects_with_their_own_spins_pass_at_level_pixels(tmp_path):
         # world points: core.scene.world_points against scipy's M_run @ M_o, both float64
         assert case["max_vertex_error_px"] < 1e-9
         assert case["pixel_f1_1px"] >= tolerances.MIN_F1_1PX
-    if _core_has("faces", "hidden_lines", "style"):
-        for mode in (RenderMode(hidden_lines=True), RenderMode(style="shaded")):
-            rep, _ = run_crosscheck([scene], CoreCandidate(), frames=3, case_names=["oblique_roll"], mode=mode,
-                                    animation=False)
-            assert rep["verdict"] == "pass", rep["cases"][0]["reasons"]
+    for mode in (RenderMode(hidden_lines=True), RenderMode(style="shaded")):
+        rep, _ = run_crosscheck([scene], CoreCandidate(), frames=3, case_names=["oblique_roll"], mode=mode,
+                                animation=False)
+        assert rep["verdict"] == "pass", rep["cases"][0]["reasons"]
     # composing the motions in the wrong order is caught by the vertex check
     bad, _ = run_crosscheck([scene], RunFirstCore(), frames=4, case_names=["oblique_roll"], level="vertices")
     assert bad["cases"][0]["verdict"] == "fail" and bad["cases"][0]["max_vertex_error_px"] > 1.0
 
 
-@needs_objects
 def test_one_static_object_keeps_the_single_object_path(tmp_path):
     # an explicit 'object' with no motion is the single-object scene: same records
     path = tmp_path / "cube1.scene"
@@ -342,7 +316,6 @@ def test_run_crosscheck_refuses_modes_it_cannot_check():
         RenderMode(style="shaded", hidden_lines=True)
 
 
-@needs_faces
 def test_workers_get_the_drawing_mode(tmp_path):
     args = ("--style", "shaded", "--cull", "backface", "--scene", "cube", "--frames", "2",
             "--cases", "on_axis,oblique_roll")

@@ -3,7 +3,6 @@
 import contextlib
 import io
 import json
-import math
 from pathlib import Path
 import numpy as np
 import pytest
@@ -219,7 +218,6 @@ def culling_scene(tmp_path):
 
 @pytest.mark.parametrize("extra", [[], ["--cull", "backface", "--hidden-lines"]], ids=["wireframe", "cull+hidden"])
 def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
-    pytest.importorskip("core.culling")
     scene = culling_scene(tmp_path)
     # camera at z = 4 looking down -Z, fov 60, 160x120: the cube 'behind' (centre z = 10, bounding
     # radius sqrt 3) is entirely behind the near plane (z_cam = 4 - 10 +- 1.74 < 0.1); 'aside' at
@@ -277,7 +275,6 @@ BAD_WINDING = CUBE_V + CUBE_FACES.replace("f 1 2 6 5", "f 5 6 2 1")     # one fa
 
 
 def test_inconsistent_winding_warns_and_refuses_backface_culling(tmp_path):
-    pytest.importorskip("core.culling")
     p = tmp_path / "flip.scene"
     p.write_text(BAD_WINDING)
     s = load_scene(str(p))
@@ -305,7 +302,6 @@ def test_light_needs_shaded(tmp_path):
 
 
 def test_cull_and_hidden_lines_fields(tmp_path):
-    pytest.importorskip("core.culling")
     # The cube at rest, perspective camera at (0, 0, 4): a face is front-facing when the camera
     # is on the outer side of its plane. Front (z = +1, camera z 4 > 1): kept. Back (z = -1):
     # culled. Side x = +1: the camera's x = 0 < 1, inner side: culled; likewise the other 3

@@ -145,7 +145,9 @@ def test_sweep_composes_each_objects_motion():
     orrery = load_scene("orrery")
     assert not orrery.is_single_static
     motion = Motion()
-    ref = sweep.oracle_world_points(orrery, motion, 3, 8)
+    from oracles.faces import frame_geometry
+
+    ref = frame_geometry(orrery, motion, 2 / 8)[0]                      # frame 3 of 8: t = 2/8
     # scipy's composition equals core's to rounding (entries ~3, a few eps each)
     np.testing.assert_allclose(ref, world_points(orrery, motion, 3, 8), rtol=0, atol=1e-12)
     naive = orrery.vertices @ motion.frame_matrix(3, 8)[:3, :3].T     # object motion ignored
