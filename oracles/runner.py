@@ -64,6 +64,8 @@ from typing import ClassVar
 import numpy as np
 
 from core.scene import Scene
+from core.pipeline import CLIP_MODES, RASTER_MODES
+from core.projection import DTYPES
 from core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
 from . import metrics, opencv_oracle, tolerances
@@ -169,9 +171,9 @@ class CoreCandidate:
     raster: str = "exact"
 
     name: ClassVar[str] = "core"
-    DTYPES: ClassVar[tuple] = ("float64", "float32")
-    CLIPS: ClassVar[tuple] = ("clip", "endpoint")
-    RASTERS: ClassVar[tuple] = ("exact", "fast", "aa")
+    DTYPES: ClassVar[tuple] = DTYPES              # core's own lists, so the two cannot drift apart
+    CLIPS: ClassVar[tuple] = CLIP_MODES
+    RASTERS: ClassVar[tuple] = RASTER_MODES
 
     def __post_init__(self):
         for name, allowed in (("dtype", self.DTYPES), ("clip", self.CLIPS), ("raster", self.RASTERS)):
