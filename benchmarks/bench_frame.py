@@ -54,11 +54,11 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
 
-from core.camera import camera_z  # noqa: E402
-from core.pipeline import render_frame  # noqa: E402
-from core.projection import project_points  # noqa: E402
-from core.scene import face_edges, load_scene, unique_edges  # noqa: E402
-from core.transforms import Motion  # noqa: E402
+from wirecheck.core.camera import camera_z  # noqa: E402
+from wirecheck.core.pipeline import render_frame  # noqa: E402
+from wirecheck.core.projection import project_points  # noqa: E402
+from wirecheck.core.scene import face_edges, load_scene, unique_edges  # noqa: E402
+from wirecheck.core.transforms import Motion  # noqa: E402
 
 FRAMES = 180
 WIDTH, HEIGHT = 640, 480

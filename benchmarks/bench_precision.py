@@ -29,11 +29,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from core.camera import look_at  # noqa: E402
-from core.projection import project_points  # noqa: E402
-from oracles import opencv_oracle  # noqa: E402
-from oracles.convert import camera_to_opencv  # noqa: E402
-from oracles.extremes import reference_project  # noqa: E402
+from wirecheck.core.camera import look_at  # noqa: E402
+from wirecheck.core.projection import project_points  # noqa: E402
+from wirecheck.oracles import opencv_oracle  # noqa: E402
+from wirecheck.oracles.convert import camera_to_opencv  # noqa: E402
+from wirecheck.oracles.extremes import reference_project  # noqa: E402
 
 
 def reference(p_world, camera):

@@ -62,12 +62,12 @@ import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
 
 from bench_scale import OpenBLAS, bench_group, fast_unique_edges, machine_info  # noqa: E402
-from core import clipping, raster  # noqa: E402
-from core.camera import camera_z  # noqa: E402
-from core.pipeline import render_frame  # noqa: E402
-from core.projection import cam_to_px, localize, model_to_cam  # noqa: E402
-from core.scene import Scene, load_scene  # noqa: E402
-from core.transforms import Motion  # noqa: E402
+from wirecheck.core import clipping, raster  # noqa: E402
+from wirecheck.core.camera import camera_z  # noqa: E402
+from wirecheck.core.pipeline import render_frame  # noqa: E402
+from wirecheck.core.projection import cam_to_px, localize, model_to_cam  # noqa: E402
+from wirecheck.core.scene import Scene, load_scene  # noqa: E402
+from wirecheck.core.transforms import Motion  # noqa: E402
 
 WIDTH, HEIGHT = 640, 480
 FRAMES = 180
@@ -136,7 +136,7 @@ class PyrenderScenes:
 
     def __init__(self, vertices, edges, faces, camera):
         import pyrender
-        from oracles.convert import camera_to_pyrender
+        from wirecheck.oracles.convert import camera_to_pyrender
         self.pr = pyrender
         self.renderer = pyrender.OffscreenRenderer(camera.width, camera.height)
         pose, cam = camera_to_pyrender(camera)
@@ -304,7 +304,7 @@ def main(argv=None) -> int:
     # ---- 4. pyrender
     pyr = None
     try:
-        from oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+        from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
         ok, msg = osmesa_available()
     except Exception as exc:  # noqa: BLE001
         ok, msg = False, f"{type(exc).__name__}: {exc}"

@@ -77,12 +77,12 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
 
-from core import raster  # noqa: E402
-from core.camera import camera_z  # noqa: E402
-from core.pipeline import render_frame  # noqa: E402
-from core.projection import cam_to_px, depth_mask, localize, model_to_cam  # noqa: E402
-from core.scene import load_scene, unique_edges  # noqa: E402
-from core.transforms import Motion  # noqa: E402
+from wirecheck.core import raster  # noqa: E402
+from wirecheck.core.camera import camera_z  # noqa: E402
+from wirecheck.core.pipeline import render_frame  # noqa: E402
+from wirecheck.core.projection import cam_to_px, depth_mask, localize, model_to_cam  # noqa: E402
+from wirecheck.core.scene import load_scene, unique_edges  # noqa: E402
+from wirecheck.core.transforms import Motion  # noqa: E402
 
 WIDTH, HEIGHT = 1280, 960
 FRAMES = 180                     # Motion() period; poses are frames of it

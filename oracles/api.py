@@ -1,6 +1,6 @@
 """crosscheck from Python: gate your own projector inside your own pytest suite.
 
-    from oracles.api import assert_projector
+    from wirecheck.oracles.api import assert_projector
 
     def test_my_projector_matches_the_references():
         assert_projector(my_project)        # AssertionError naming the fault if not
@@ -13,7 +13,7 @@ pixels too.
 
 from __future__ import annotations
 
-from core.scene import Scene, builtin_names, load_scene
+from wirecheck.core.scene import Scene, builtin_names, load_scene
 
 from . import tolerances
 from .candidate import load_candidate

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.errors import InputError
+from wirecheck.core.errors import InputError
 
 
 def load_candidate(spec: str):

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.camera import Camera, look_at
+from wirecheck.core.camera import Camera, look_at
 
 
 @dataclass(frozen=True)

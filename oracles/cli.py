@@ -43,9 +43,9 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
-from core.errors import InputError
-from core.output import check_replaceable
-from core.scene import builtin_names, load_scene
+from wirecheck.core.errors import InputError
+from wirecheck.core.output import check_replaceable
+from wirecheck.core.scene import builtin_names, load_scene
 
 from . import tolerances
 from .candidate import load_candidate
@@ -309,7 +309,7 @@ def _sweep(args, scenes, case_names, spin, level, tol, run_dir) -> int:
 
 
 def _suite(level, run_dir) -> int:
-    from core.output import FrameDir, json_dumps
+    from wirecheck.core.output import FrameDir, json_dumps
 
     from .extremes import extremes_markdown, run_extremes
 

@@ -21,7 +21,7 @@ import os
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from core.camera import Camera
+from wirecheck.core.camera import Camera
 
 __all__ = ["camera_to_opencv", "opencv_to_camera", "camera_to_pyrender",
            "pyrender_pose_to_camera", "model_matrix"]

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.clipping import clip_to_image
-from core.raster import line_pixels
+from wirecheck.core.clipping import clip_to_image
+from wirecheck.core.raster import line_pixels
 
 from . import opencv_oracle
 from .candidate import call_candidate

@@ -87,12 +87,12 @@ from pathlib import Path
 
 import numpy as np
 
-from core import clipping
-from core.camera import look_at
-from core.errors import InputError
-from core.pipeline import render_frame
-from core.projection import cam_to_px, localize, model_to_cam, project_points
-from core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z, translate
+from wirecheck.core import clipping
+from wirecheck.core.camera import look_at
+from wirecheck.core.errors import InputError
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.projection import cam_to_px, localize, model_to_cam, project_points
+from wirecheck.core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z, translate
 
 from . import metrics, opencv_oracle
 
@@ -1041,7 +1041,7 @@ def _run_cli(arg_lists, tmp: Path):
     procs = []
     for i, args in enumerate(arg_lists):
         out = tmp / f"out{i}"
-        procs.append(subprocess.Popen([sys.executable, "-m", "core.cli", *args, "--frames", "2", "--out", str(out)],
+        procs.append(subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", *args, "--frames", "2", "--out", str(out)],
                                       cwd=str(REPO_ROOT), env=env, stdin=subprocess.DEVNULL,
                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
     results = []

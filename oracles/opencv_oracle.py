@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.camera import Camera
+from wirecheck.core.camera import Camera
 
 from .convert import camera_basis, camera_to_opencv
 

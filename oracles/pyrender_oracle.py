@@ -35,7 +35,7 @@ import os
 
 import numpy as np
 
-from core.camera import Camera
+from wirecheck.core.camera import Camera
 
 from .convert import camera_to_pyrender
 

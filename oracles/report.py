@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.output import FrameDir, json_dumps, png_bytes
+from wirecheck.core.output import FrameDir, json_dumps, png_bytes
 
 from .metrics import DIFF_COLOURS, diff_image
 

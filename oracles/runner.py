@@ -63,10 +63,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from core.scene import Scene
-from core.pipeline import CLIP_MODES, RASTER_MODES
-from core.projection import DTYPES
-from core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
+from wirecheck.core.scene import Scene
+from wirecheck.core.pipeline import CLIP_MODES, RASTER_MODES
+from wirecheck.core.projection import DTYPES
+from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
 from . import metrics, opencv_oracle, tolerances
 from .candidate import CandidateError, call_candidate
@@ -184,39 +184,39 @@ class CoreCandidate:
         return {"dtype": self.dtype, "clip": self.clip, "raster": self.raster}
 
     def __call__(self, points, camera):  # the candidate contract, for completeness
-        from core.projection import project_points
+        from wirecheck.core.projection import project_points
 
         return project_points(points, camera, dtype=self.dtype)
 
     def prepare(self, p_model: np.ndarray):
         """The scene's vertices re-centred and cast once (``core.projection.localize``), as ``renderer`` does."""
-        from core.projection import localize
+        from wirecheck.core.projection import localize
 
         return localize(p_model, self.dtype)
 
     def world_points(self, scene, motion, frame: int, frames: int) -> np.ndarray:
         """A scene of several objects: core's world points (``core.scene.world_points``) of one frame."""
-        from core.scene import world_points
+        from wirecheck.core.scene import world_points
 
         return world_points(scene, motion, frame, frames)
 
     def project(self, points, camera, model_matrix: np.ndarray) -> np.ndarray:
         """Vertex pixels from core's pipeline without drawing: ``render_frame`` given no edges."""
-        from core.pipeline import render_frame
+        from wirecheck.core.pipeline import render_frame
 
         no_edges = np.zeros((0, 2), dtype=np.intp)
         return render_frame(points, no_edges, camera, model_matrix, self.clip, raster=self.raster).p_px
 
     def draw(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray) -> np.ndarray:
         """The frame core draws, as a bool image (drawn where the image is >= 128)."""
-        from core.pipeline import render_frame
+        from wirecheck.core.pipeline import render_frame
 
         frame = render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster)
         return frame.image >= DRAWN_THRESHOLD
 
     def render(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces, mode: RenderMode):
         """core's :class:`~core.pipeline.Frame` in a drawing mode (faces None: the scene has none)."""
-        from core.pipeline import render_frame
+        from wirecheck.core.pipeline import render_frame
 
         return render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster, faces=faces,
                             **mode.core_kwargs())
@@ -275,7 +275,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     # its faces come re-wound for mirrored objects (core.scene.oriented_faces)
     core_faces = faces
     if faces is not None and not single and isinstance(candidate, CoreCandidate):
-        from core.scene import oriented_faces
+        from wirecheck.core.scene import oriented_faces
 
         core_faces = oriented_faces(scene, motion)
     if use_faces and mode.shaded:
@@ -704,7 +704,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     camera can be placed for a scene (coordinates too large), ValueError for a
     bad level, ``every``, ``jobs`` or mode.
     """
-    from core.errors import InputError
+    from wirecheck.core.errors import InputError
 
     from .cases import cameras_for
 

@@ -34,10 +34,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.pipeline import CLIP_MODES, RASTER_MODES, render_frame
-from core.projection import DTYPES, localize
-from core.scene import Scene, face_edges, unique_edges, world_points
-from core.transforms import Motion
+from wirecheck.core.pipeline import CLIP_MODES, RASTER_MODES, render_frame
+from wirecheck.core.projection import DTYPES, localize
+from wirecheck.core.scene import Scene, face_edges, unique_edges, world_points
+from wirecheck.core.transforms import Motion
 
 from . import faces as oface
 from . import metrics, opencv_oracle
@@ -309,7 +309,7 @@ def write_sweep(run_dir, sweep: dict) -> None:
     import tempfile
     from pathlib import Path
 
-    from core.output import FrameDir, json_dumps
+    from wirecheck.core.output import FrameDir, json_dumps
 
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from oracles.api import assert_projector, check_projector
+from wirecheck.oracles.api import assert_projector, check_projector
 
 DATA = Path(__file__).parent / "data"
 

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from core.camera import camera_z
-from core.clipping import apply_clip, clip_segments, frustum_planes
-from core.pipeline import render_frame
-from core.projection import cam_to_px
-from core.raster import line_pixels
-from core.scene import load_scene
+from wirecheck.core.camera import camera_z
+from wirecheck.core.clipping import apply_clip, clip_segments, frustum_planes
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.projection import cam_to_px
+from wirecheck.core.raster import line_pixels
+from wirecheck.core.scene import load_scene
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16
 D = 10.0

@@ -4,9 +4,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core.camera import look_at
-from core.projection import project_points
-from oracles import opencv_oracle
+from wirecheck.core.camera import look_at
+from wirecheck.core.projection import project_points
+from wirecheck.oracles import opencv_oracle
 
 EPS = np.finfo(float).eps
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from oracles import cli
-from oracles.cases import CASE_NAMES
+from wirecheck.oracles import cli
+from wirecheck.oracles.cases import CASE_NAMES
 
 DATA = Path(__file__).parent / "data"
 USER = DATA / "user_projector.py"
@@ -134,7 +134,7 @@ def test_tolerance_override_turns_pass_into_fail(tmp_path):
 
 def test_subprocess_prints_table_and_path(tmp_path):
     out = tmp_path / "sub"
-    proc = subprocess.run([sys.executable, "-m", "oracles.cli", "--scene", "cube", "--frames", "2",
+    proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--scene", "cube", "--frames", "2",
                            "--cases", "on_axis", "--report-dir", str(out)],
                           capture_output=True, text=True, cwd=Path(__file__).parent.parent)
     assert proc.returncode == 0, proc.stderr
@@ -145,8 +145,8 @@ def test_subprocess_prints_table_and_path(tmp_path):
 
 
 def test_every_fault_name_has_a_hint():
-    from oracles.diagnose import FAULT_NAMES
-    from oracles.report import FAULT_HINTS
+    from wirecheck.oracles.diagnose import FAULT_NAMES
+    from wirecheck.oracles.report import FAULT_HINTS
 
     assert set(FAULT_HINTS) == set(FAULT_NAMES)
 

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from oracles import cli
-from oracles.runner import CoreCandidate
+from wirecheck.oracles import cli
+from wirecheck.oracles.runner import CoreCandidate
 
 DATA = Path(__file__).parent / "data"
 USER = DATA / "user_projector.py"
@@ -36,9 +36,9 @@ def without_timing(out: Path) -> str:
 # ---------------------------------------------------------------- --level
 
 def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeypatch):
-    import core.raster
-    import oracles.pyrender_oracle
-    import oracles.runner
+    from wirecheck.core import raster
+    from wirecheck.oracles import pyrender_oracle
+    from wirecheck.oracles import runner
 
     def forbidden(*_a, **_k):
         raise AssertionError("the pixel stage ran at level vertices")
@@ -46,9 +46,9 @@ def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeyp
     # pyrender cannot even be imported: the osmesa check, a PyrenderOracle or a
     # drawing would end the run with exit 2 or an AssertionError
     monkeypatch.setitem(sys.modules, "pyrender", None)
-    monkeypatch.setattr(oracles.pyrender_oracle.PyrenderOracle, "__init__", forbidden)
-    monkeypatch.setattr(core.raster, "line_pixels", forbidden)
-    monkeypatch.setattr(oracles.runner, "draw_candidate", forbidden)
+    monkeypatch.setattr(pyrender_oracle.PyrenderOracle, "__init__", forbidden)
+    monkeypatch.setattr(raster, "line_pixels", forbidden)
+    monkeypatch.setattr(runner, "draw_candidate", forbidden)
     code, report, out = run(tmp_path, "--level", "vertices", "--scene", "cube", "--frames", "3",
                             "--cases", "on_axis,near_plane")
     assert code == 0
@@ -197,8 +197,8 @@ def test_core_candidate_is_a_small_frozen_picklable_dataclass():
 
 
 def test_core_settings_reach_render_frame(monkeypatch):
-    import core.pipeline
-    from oracles.cases import cameras_for
+    from wirecheck.core import pipeline
+    from wirecheck.oracles.cases import cameras_for
 
     calls = []
 
@@ -214,7 +214,7 @@ def test_core_settings_reach_render_frame(monkeypatch):
         f.image, f.p_px = image, np.zeros((len(p_model), 2))
         return f
 
-    monkeypatch.setattr(core.pipeline, "render_frame", fake_render_frame)
+    monkeypatch.setattr(pipeline, "render_frame", fake_render_frame)
     cam = cameras_for(1.0)[0].camera
     pts, edges = np.zeros((2, 3)), np.array([[0, 1]])
     CoreCandidate().project(CoreCandidate().prepare(pts), cam, np.eye(4))

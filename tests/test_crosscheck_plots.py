@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from oracles import cli
-from oracles.metrics import DIFF_COLOURS
-from oracles.plots import STRIP_PX, worst_gif
-from oracles.runner import worst_key
+from wirecheck.oracles import cli
+from wirecheck.oracles.metrics import DIFF_COLOURS
+from wirecheck.oracles.plots import STRIP_PX, worst_gif
+from wirecheck.oracles.runner import worst_key
 
 
 def run(tmp_path, *args, name="run"):

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from oracles import cli, tolerances
-from oracles.runner import CoreCandidate, RenderMode, run_crosscheck
+from wirecheck.oracles import cli, tolerances
+from wirecheck.oracles.runner import CoreCandidate, RenderMode, run_crosscheck
 
 ROOT = Path(__file__).resolve().parent.parent
 USER = ROOT / "tests" / "data" / "user_projector.py"
@@ -38,7 +38,7 @@ def icosphere(tmp_path_factory):
 
 
 def _load(name_or_path):
-    from core.scene import load_scene
+    from wirecheck.core.scene import load_scene
 
     return load_scene(str(name_or_path))
 
@@ -241,7 +241,7 @@ class RunFirstCore(CoreCandidate):
     """A fault: the run's motion applied before each object's own (M_o @ M_run)."""
 
     def world_points(self, scene, motion, frame, frames):
-        from core.transforms import apply
+        from wirecheck.core.transforms import apply
 
         out = np.empty((len(scene.vertices), 3))
         m_run = motion.frame_matrix(frame, frames)
@@ -331,8 +331,8 @@ def test_workers_get_the_drawing_mode(tmp_path):
 
 def test_pyrender_depth_is_linear_camera_depth_in_both_projections():
     """The oracle's own depth: a plane at known depth, perspective and orthographic."""
-    from core.camera import camera_z
-    from oracles.pyrender_oracle import PyrenderOracle, depth_step
+    from wirecheck.core.camera import camera_z
+    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, depth_step
 
     quad = np.array([[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]])
     tris = np.array([[0, 1, 2], [0, 2, 3]])
@@ -357,7 +357,7 @@ if __name__ == "__main__":
 
 
 def test_occlusion_boundary_and_interior_by_hand():
-    from oracles.metrics import interior, occlusion_boundary, shaded_scores
+    from wirecheck.oracles.metrics import interior, occlusion_boundary, shaded_scores
 
     # triangles 0 and 1 share vertices (one surface), 2 shares none (another object)
     tris = np.array([[0, 1, 2], [1, 2, 3], [10, 11, 12]])

@@ -16,15 +16,15 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from core.camera import Camera, look_at
-from core.conventions import focal_px
-from core.projection import project_points
-from core.scene import load_scene
-from core.transforms import Motion, apply, rotate_z
-from oracles.diagnose import FAULT_ORDER, diagnose, primary
+from wirecheck.core.camera import Camera, look_at
+from wirecheck.core.conventions import focal_px
+from wirecheck.core.projection import project_points
+from wirecheck.core.scene import load_scene
+from wirecheck.core.transforms import Motion, apply, rotate_z
+from wirecheck.oracles.diagnose import FAULT_ORDER, diagnose, primary
 
 try:
-    from oracles.opencv_oracle import project as oracle_project
+    from wirecheck.oracles.opencv_oracle import project as oracle_project
     ORACLE = "opencv"
 except ImportError:                                   # pragma: no cover - fallback only
     oracle_project = project_points

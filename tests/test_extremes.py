@@ -13,9 +13,9 @@ import json
 import numpy as np
 import pytest
 
-from oracles import extremes
-from oracles.extremes import EXTREME_CASES, extremes_markdown, run_case, run_extremes
-from oracles.pyrender_oracle import osmesa_available
+from wirecheck.oracles import extremes
+from wirecheck.oracles.extremes import EXTREME_CASES, extremes_markdown, run_case, run_extremes
+from wirecheck.oracles.pyrender_oracle import osmesa_available
 
 HAVE_OSMESA = osmesa_available()[0]
 
@@ -107,13 +107,13 @@ def test_bounds_are_not_vacuous(suite_without_pyrender):
 def test_suite_catches_a_strict_near_test(monkeypatch):
     # Planted fault: visibility z > near instead of z >= near. A point exactly at
     # the near plane must then fail the near_plane case.
-    import core.pipeline
+    from wirecheck.core import pipeline
 
     def strict(p_cam, camera):
         z = p_cam[:, 2]
         return (z > z.dtype.type(camera.near)) & (z <= z.dtype.type(camera.far))
 
-    monkeypatch.setattr(core.pipeline, "depth_mask", strict)
+    monkeypatch.setattr(pipeline, "depth_mask", strict)
     case = run_case("near_plane", pyrender=False)
     assert case["verdict"] == "fail"
     assert any("visibility differs" in r and "near," in r + "," for r in case["reasons"]), case["reasons"]
@@ -141,7 +141,7 @@ def test_reference_is_independent_of_core_basis():
     # whose stored `right` were reversed would not move the reference.
     from types import SimpleNamespace
 
-    from core.camera import look_at
+    from wirecheck.core.camera import look_at
 
     cam = look_at((3, 2, 4), (0, 0, 0), (0.3, 1.0, 0.1), fov_y_deg=55)
     liar = SimpleNamespace(**{k: getattr(cam, k) for k in (
@@ -156,8 +156,8 @@ def test_reference_is_independent_of_core_basis():
 def test_camera_rejects_a_fov_or_ortho_height_whose_scale_overflows():
     # fov 1e-320 deg is in (0, 180) but (H/2)/tan(fov/2) = inf; ortho-height 1e-320
     # gives H/ortho_height = inf. The camera must name the parameter, not a vertex.
-    from core.camera import camera_z
-    from core.errors import InputError
+    from wirecheck.core.camera import camera_z
+    from wirecheck.core.errors import InputError
 
     with pytest.raises(InputError, match="camera fov 1e-320"):
         camera_z(4.0, fov_y_deg=1e-320)
@@ -168,7 +168,7 @@ def test_camera_rejects_a_fov_or_ortho_height_whose_scale_overflows():
 def test_look_at_accepts_a_camera_1e_minus_200_from_its_target():
     # |forward| = 1e-200 underflows to 0 in np.linalg.norm (its square is 1e-400):
     # the points differ, so the camera is valid and looks along -Z.
-    from core.camera import look_at
+    from wirecheck.core.camera import look_at
 
     cam = look_at((0.0, 0.0, 1e-200), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
     assert cam.forward.tolist() == [0.0, 0.0, -1.0] and cam.right.tolist() == [1.0, 0.0, 0.0]

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core import pipeline, raster, zbuffer
-from core.camera import look_at
-from core.pipeline import render_frame
-from oracles.metrics import pixel_scores
+from wirecheck.core import pipeline, raster, zbuffer
+from wirecheck.core.camera import look_at
+from wirecheck.core.pipeline import render_frame
+from wirecheck.oracles.metrics import pixel_scores
 
 CUBE_V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                    [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
@@ -177,7 +177,7 @@ def test_argument_checks():
 
 @pytest.fixture(scope="module")
 def oracle():
-    from oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
     ok, msg = osmesa_available()
     if not ok:
         pytest.skip(msg)

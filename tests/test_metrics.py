@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from oracles.metrics import diff_image, pixel_scores, vertex_errors
+from wirecheck.oracles.metrics import diff_image, pixel_scores, vertex_errors
 
 
 def test_vertex_errors_hand_values():
@@ -60,7 +60,7 @@ def test_diff_image_colours():
 
 def test_face_disagreements_on_a_boundary_are_allowed_inside_are_not():
     # Oracle: face 0 on columns 0-4, face 1 on 5-9 of a 6x10 image, depth 1 everywhere.
-    from oracles.metrics import shaded_scores
+    from wirecheck.oracles.metrics import shaded_scores
 
     of = np.zeros((6, 10), int)
     of[:, 5:] = 1
@@ -86,7 +86,7 @@ def test_silhouette_mismatch_inside_counts_holes_not_boundary_shifts():
     # Oracle covers a 6x6 block; the candidate covers it shifted right by one column:
     # the mismatched columns are on each silhouette's boundary: 0 inside. A 1-px hole
     # in the candidate's middle is inside the oracle's silhouette: 1.
-    from oracles.metrics import shaded_scores
+    from wirecheck.oracles.metrics import shaded_scores
 
     orac = np.zeros((10, 12), bool)
     orac[2:8, 2:8] = True

@@ -9,11 +9,11 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
-from core.cli import main
-from core.errors import InputError
-from core.scene import (SCENE_DIR, SceneObject, builtin_names, example_names, load_scene, object_matrix,
+from wirecheck.core.cli import main
+from wirecheck.core.errors import InputError
+from wirecheck.core.scene import (SCENE_DIR, SceneObject, builtin_names, example_names, load_scene, object_matrix,
                         parse_scene_text, world_points)
-from core.transforms import Motion
+from wirecheck.core.transforms import Motion
 
 EPS = np.finfo(np.float64).eps
 
@@ -255,8 +255,8 @@ def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
 def test_multi_object_frame_matches_world_points(tmp_path):
     # The renderer draws world_points with the identity: the JSON vertex pixels are the
     # projection of world_points (same formula, same order of operations).
-    from core.camera import camera_z
-    from core.projection import project_points
+    from wirecheck.core.camera import camera_z
+    from wirecheck.core.projection import project_points
 
     rc, _, err = run(["--scene", "orrery", "--frames", "4", "--camera-z", "8", "--spin", "0,1,0"], tmp_path)
     assert (rc, err) == (0, "")
@@ -323,7 +323,7 @@ def test_mirrored_object_is_culled_like_its_oracle(tmp_path, capsys):
     # with an identity matrix, so core.scene.oriented_faces re-winds them; without
     # that, back-face culling would keep b's back faces and crosscheck (which
     # judges front faces from the geometry, oracles/faces.py) would fail.
-    from oracles.cli import main
+    from wirecheck.oracles.cli import main
 
     cube = (Path(__file__).resolve().parent.parent / "scenes" / "cube.scene").read_text()
     body = "\n".join(line for line in cube.splitlines() if line.split("#")[0].strip().startswith(("v", "f")))
@@ -331,8 +331,8 @@ def test_mirrored_object_is_culled_like_its_oracle(tmp_path, capsys):
             f"object b\ntranslate 1.5 0 0\nscale -0.5\nspin 0 1 0\n{body}\n")
     path = tmp_path / "mirror.scene"
     path.write_text(text)
-    from core.scene import load_scene, oriented_faces
-    from core.transforms import Motion
+    from wirecheck.core.scene import load_scene, oriented_faces
+    from wirecheck.core.transforms import Motion
 
     scene = load_scene(str(path))
     faces = oriented_faces(scene, Motion())

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from core.camera import camera_z, look_at
-from core.transforms import Motion
-from oracles import convert
+from wirecheck.core.camera import camera_z, look_at
+from wirecheck.core.transforms import Motion
+from wirecheck.oracles import convert
 
 EPS = np.finfo(np.float64).eps
 

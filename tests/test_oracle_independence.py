@@ -4,8 +4,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from core.camera import look_at
-from oracles import opencv_oracle
+from wirecheck.core.camera import look_at
+from wirecheck.oracles import opencv_oracle
 
 
 def test_opencv_oracle_ignores_a_reversed_right():

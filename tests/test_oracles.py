@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from core.camera import camera_z, look_at
-from core.pipeline import render_frame
-from core.projection import project_points
-from core.scene import load_scene
-from core.transforms import Motion
-from oracles import opencv_oracle
-from oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+from wirecheck.core.camera import camera_z, look_at
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.projection import project_points
+from wirecheck.core.scene import load_scene
+from wirecheck.core.transforms import Motion
+from wirecheck.oracles import opencv_oracle
+from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
 
 EPS = np.finfo(np.float64).eps
 EPS32 = float(np.finfo(np.float32).eps)
@@ -37,7 +37,7 @@ def test_opencv_hand_values():
 
 def test_opencv_masks_outside_near_far():
     import cv2
-    from oracles.convert import camera_to_opencv
+    from wirecheck.oracles.convert import camera_to_opencv
     p_world = np.array([[1.0, 1.0, 8.0],          # behind the camera (depth -4)
                         [0.0, 0.0, 4.0],          # at the camera (depth 0)
                         [0.0, 0.0, 3.0],          # exactly on near (depth 1): visible

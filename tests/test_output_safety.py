@@ -2,9 +2,9 @@
 
 import pytest
 
-from core import cli as renderer_cli
-from core.output import MARKER
-from oracles import cli as crosscheck_cli
+from wirecheck.core import cli as renderer_cli
+from wirecheck.core.output import MARKER
+from wirecheck.oracles import cli as crosscheck_cli
 
 
 def test_rerun_replaces_earlier_frames(tmp_path):
@@ -88,7 +88,7 @@ def test_closed_stdout_exits_quietly(tmp_path):
     import sys
 
     # `renderer | head -1`: the reader goes away after the first line
-    proc = subprocess.Popen([sys.executable, "-m", "core.cli", "--frames", "3", "--out", str(tmp_path)],
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--frames", "3", "--out", str(tmp_path)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     proc.stdout.readline()
     proc.stdout.close()

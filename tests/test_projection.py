@@ -14,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
-from core.camera import Camera, camera_z, look_at
-from core.projection import cam_to_px, depth_mask, project_points, world_to_cam
-from core.transforms import apply, rotate_y, rotate_z
+from wirecheck.core.camera import Camera, camera_z, look_at
+from wirecheck.core.projection import cam_to_px, depth_mask, project_points, world_to_cam
+from wirecheck.core.transforms import apply, rotate_y, rotate_z
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16
 SQRT2, SQRT3, SQRT6 = math.sqrt(2.0), math.sqrt(3.0), math.sqrt(6.0)

@@ -28,13 +28,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core.camera import look_at
-from core.pipeline import render_frame
-from core.projection import project_points, unproject
-from core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z
-from oracles import opencv_oracle
-from oracles.convert import model_matrix as scipy_model_matrix
-from oracles.extremes import (EPS, EPS64, LD, REFERENCE_EXTENDED, camera_error, opencv_camera_error,
+from wirecheck.core.camera import look_at
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.projection import project_points, unproject
+from wirecheck.core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z
+from wirecheck.oracles import opencv_oracle
+from wirecheck.oracles.convert import model_matrix as scipy_model_matrix
+from wirecheck.oracles.extremes import (EPS, EPS64, LD, REFERENCE_EXTENDED, camera_error, opencv_camera_error,
                               pixel_bound, reference_project, reference_world)
 
 # The bounds are evaluated at a long-double reference: it must be wider than float64.

@@ -25,8 +25,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
-import core.raster
-from core.raster import SUBPIXEL, line_pixels
+from wirecheck.core import raster
+from wirecheck.core.raster import SUBPIXEL, line_pixels
 
 W, H = 12, 10
 
@@ -196,7 +196,7 @@ def test_several_segments_at_once_is_union_of_single_calls():
 
 
 def test_doctest_in_module_runs():
-    result = doctest.testmod(core.raster, verbose=False)
+    result = doctest.testmod(raster, verbose=False)
     assert result.attempted >= 1
     assert result.failed == 0
 

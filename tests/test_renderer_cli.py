@@ -19,11 +19,11 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
-from core.output import MARKER
-from core.cli import main
-from core.projection import project_points
-from core.camera import camera_z
-from core.transforms import Motion, apply
+from wirecheck.core.output import MARKER
+from wirecheck.core.cli import main
+from wirecheck.core.projection import project_points
+from wirecheck.core.camera import camera_z
+from wirecheck.core.transforms import Motion, apply
 
 EPS = np.finfo(np.float64).eps
 SEED_ARGS = ["--scene", "cube", "--frames", "180", "--camera-z", "4.0", "--fov", "70"]
@@ -171,7 +171,7 @@ def test_determinism_byte_identical_png_and_json(seed_run, tmp_path):
 
 def test_subprocess_entry_point(tmp_path):
     exe = shutil.which("renderer", path=str(Path(sys.executable).parent))
-    cmd = [exe] if exe else [sys.executable, "-m", "core.cli"]
+    cmd = [exe] if exe else [sys.executable, "-m", "wirecheck.core.cli"]
     out = tmp_path / "sub"
     proc = subprocess.run(cmd + SEED_ARGS + ["--out", str(out)], capture_output=True, text=True, timeout=120)
     assert (proc.stdout, proc.stderr, proc.returncode) == (seed_expected_stdout(out), "", 0)
@@ -248,7 +248,7 @@ def test_unwritable_out_under_a_regular_file(tmp_path):
 
 def test_bad_input_subprocess_no_traceback(tmp_path):
     # the same contract through a real process (stderr must be exactly one line)
-    proc = subprocess.run([sys.executable, "-m", "core.cli", "--fov", "0", "--out", str(tmp_path / "o")],
+    proc = subprocess.run([sys.executable, "-m", "wirecheck.core.cli", "--fov", "0", "--out", str(tmp_path / "o")],
                           capture_output=True, text=True, timeout=60)
     assert (proc.returncode, proc.stdout) == (2, "")
     assert proc.stderr == "renderer: error: --fov 0.0: expected degrees in (0, 180)\n"

@@ -10,8 +10,8 @@ import pytest
 from numpy.testing import assert_array_equal
 from PIL import Image
 
-from core.cli import SEPARATOR_GREY, main
-from core.output import pad_even
+from wirecheck.core.cli import SEPARATOR_GREY, main
+from wirecheck.core.output import pad_even
 
 
 def run(args, out):

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
-from core.errors import InputError
-from core.scene import builtin_names, load_scene, parse_scene_text, unique_edges
+from wirecheck.core.errors import InputError
+from wirecheck.core.scene import builtin_names, load_scene, parse_scene_text, unique_edges
 
 CUBE_CORNERS = [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]]
 
@@ -228,7 +228,7 @@ def test_single_object_scene_keeps_its_arrays_and_one_static_object():
 def test_vectorised_edge_helpers_equal_their_plain_definitions():
     # unique_edges: sort each pair, drop self-loops, np.unique(axis=0) (the definition);
     # face_edges on an (F, k) array: the same pairs, in the same order, as on lists.
-    from core.scene import face_edges, unique_edges
+    from wirecheck.core.scene import face_edges, unique_edges
 
     rng = np.random.default_rng(3)
     for n in (1, 7, 5000):

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from core.camera import look_at
-from core.pipeline import render_frame
-from core.shading import DEFAULT_AMBIENT, default_light_dir, face_intensity, shade
+from wirecheck.core.camera import look_at
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.shading import DEFAULT_AMBIENT, default_light_dir, face_intensity, shade
 
 CUBE_V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                    [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
@@ -90,7 +90,7 @@ def test_backface_culling_does_not_change_a_closed_mesh():
 
 @pytest.fixture(scope="module")
 def pyrender_renderer():
-    from oracles.pyrender_oracle import osmesa_available
+    from wirecheck.oracles.pyrender_oracle import osmesa_available
     ok, msg = osmesa_available()
     if not ok:
         pytest.skip(msg)
@@ -112,7 +112,7 @@ def test_shaded_silhouette_against_pyrender(projection, pyrender_renderer, summa
     import pyrender
     trimesh = pytest.importorskip("trimesh")
 
-    from oracles.convert import camera_to_pyrender
+    from wirecheck.oracles.convert import camera_to_pyrender
     ico = trimesh.creation.icosphere(subdivisions=3)
     v, f = np.asarray(ico.vertices), np.asarray(ico.faces)
     cam = look_at((2.5, 1.8, 3.3), (0.0, 0.0, 0.0), near=0.5, far=20.0, projection=projection,

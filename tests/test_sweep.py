@@ -10,11 +10,11 @@ import json
 import numpy as np
 import pytest
 
-from core.camera import camera_z
-from core.conventions import focal_px
-from core.scene import load_scene
-from oracles import sweep
-from oracles.pyrender_oracle import osmesa_available
+from wirecheck.core.camera import camera_z
+from wirecheck.core.conventions import focal_px
+from wirecheck.core.scene import load_scene
+from wirecheck.oracles import sweep
+from wirecheck.oracles.pyrender_oracle import osmesa_available
 
 needs_osmesa = pytest.mark.skipif(not osmesa_available()[0], reason="libOSMesa not available")
 
@@ -104,7 +104,7 @@ def test_plot_and_markdown(small_sweep, tmp_path):
 
 
 def test_cli_sweep_writes_table_and_plot(tmp_path, capsys):
-    from oracles.cli import main
+    from wirecheck.oracles.cli import main
 
     out = tmp_path / "sw"
     rc = main(["--sweep", "--level", "vertices", "--scene", "cube", "--cases", "on_axis", "--frames", "2",
@@ -121,7 +121,7 @@ def test_cli_sweep_writes_table_and_plot(tmp_path, capsys):
 @pytest.mark.parametrize("extra", [["--candidate", "tests/data/user_projector.py:project"], ["--dtype", "float32"],
                                    ["--suite", "extremes"]])
 def test_cli_sweep_rejects_candidate_settings_and_suite(extra, tmp_path, capsys):
-    from oracles.cli import main
+    from wirecheck.oracles.cli import main
 
     with pytest.raises(SystemExit) as exc:    # argparse: --suite and --sweep are exclusive
         rc = main(["--sweep", *extra, "--report-dir", str(tmp_path / "x")])
@@ -139,13 +139,13 @@ def test_sweep_composes_each_objects_motion():
     # "passed" against an oracle making the same mistake. Now the oracle builds
     # each object's matrix with scipy and core renders world points, as renderer
     # does: the default setting meets the tolerances.
-    from core.scene import world_points
-    from core.transforms import Motion
+    from wirecheck.core.scene import world_points
+    from wirecheck.core.transforms import Motion
 
     orrery = load_scene("orrery")
     assert not orrery.is_single_static
     motion = Motion()
-    from oracles.faces import frame_geometry
+    from wirecheck.oracles.faces import frame_geometry
 
     ref = frame_geometry(orrery, motion, 2 / 8)[0]                      # frame 3 of 8: t = 2/8
     # scipy's composition equals core's to rounding (entries ~3, a few eps each)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from core.transforms import Motion, apply, compose, rotate_x, rotate_y, rotate_z, scale, translate
+from wirecheck.core.transforms import Motion, apply, compose, rotate_x, rotate_y, rotate_z, scale, translate
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16
 AXES = {rotate_x: (1.0, 0.0, 0.0), rotate_y: (0.0, 1.0, 0.0), rotate_z: (0.0, 0.0, 1.0)}

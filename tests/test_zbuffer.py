@@ -12,10 +12,10 @@ import time
 import numpy as np
 import pytest
 
-from core import zbuffer
-from core.camera import look_at
-from core.projection import unproject, world_to_cam
-from core.zbuffer import clip_triangles_near, project_triangles, rasterize_triangles
+from wirecheck.core import zbuffer
+from wirecheck.core.camera import look_at
+from wirecheck.core.projection import unproject, world_to_cam
+from wirecheck.core.zbuffer import clip_triangles_near, project_triangles, rasterize_triangles
 
 EPS32 = float(np.finfo(np.float32).eps)
 
@@ -275,7 +275,7 @@ def _pyrender_faces(vertices, triangles, camera, renderer):
     """White flat faces (double sided) with pyrender: (covered mask, linear depth, 0 = empty)."""
     import pyrender
 
-    from oracles.convert import camera_to_pyrender
+    from wirecheck.oracles.convert import camera_to_pyrender
     scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
     mat = pyrender.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=True)
     scene.add(pyrender.Mesh([pyrender.Primitive(positions=vertices.astype(np.float32),
@@ -296,7 +296,7 @@ def _pyrender_faces(vertices, triangles, camera, renderer):
 
 @pytest.fixture(scope="module")
 def pyrender_renderer():
-    from oracles.pyrender_oracle import osmesa_available
+    from wirecheck.oracles.pyrender_oracle import osmesa_available
     ok, msg = osmesa_available()
     if not ok:
         pytest.skip(msg)

@@ -1,0 +1,55 @@
+"""wirecheck: a from-scratch wireframe projector, and a harness that proves projection code right.
+
+The public API, importable from the top level::
+
+    from wirecheck import assert_projector
+
+    def test_my_projector():
+        assert_projector(my_project)   # my_project(p_world (N, 3), camera) -> p_px (N, 2)
+
+- :func:`check_projector` / :func:`assert_projector`: crosscheck a projector
+  against OpenCV (vertices) and pyrender (pixels).
+- :class:`Camera`, :func:`look_at`, :func:`camera_z`: the camera (conventions in
+  :mod:`wirecheck.core.conventions`).
+- :func:`load_scene`, :class:`Scene`, :class:`Motion`: scenes and their motion.
+- :func:`project_points`, :func:`render_frame`, :class:`Frame`: core's projector
+  and one frame of its pipeline.
+
+In the source tree this file is the repository root's ``__init__.py``;
+``wirecheck.core``, ``wirecheck.oracles`` and ``wirecheck.scenes`` are the
+folders ``core/``, ``oracles/`` and ``scenes/`` (``pyproject.toml`` maps them).
+"""
+
+from importlib import import_module
+from importlib.metadata import PackageNotFoundError, version as _version
+
+# Names are imported on first use (PEP 562), so ``import wirecheck.core`` (the
+# renderer) never pays for the oracles' imports (OpenCV, scipy).
+_EXPORTS = {
+    "Camera": "core.camera", "camera_z": "core.camera", "look_at": "core.camera",
+    "InputError": "core.errors",
+    "Frame": "core.pipeline", "render_frame": "core.pipeline",
+    "project_points": "core.projection",
+    "Scene": "core.scene", "load_scene": "core.scene",
+    "Motion": "core.transforms",
+    "assert_projector": "oracles.api", "check_projector": "oracles.api",
+}
+
+try:
+    __version__ = _version("wirecheck")
+except PackageNotFoundError:  # pragma: no cover - a source tree that was never installed
+    __version__ = "0+unknown"
+
+__all__ = ["__version__", *sorted(_EXPORTS)]
+
+
+def __getattr__(name):
+    if name in _EXPORTS:
+        value = getattr(import_module(f".{_EXPORTS[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'wirecheck' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))
