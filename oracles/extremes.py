@@ -362,7 +362,9 @@ class _Pyrender:
     """One PyrenderOracle per image size, created on demand, closed by :meth:`close`."""
 
     def __init__(self, enabled: bool):
-        self.oracles = {}
+        from .pyrender_oracle import OracleCache
+
+        self.oracles = OracleCache()
         self.note = None
         self.enabled = enabled
         if not enabled:
@@ -374,17 +376,12 @@ class _Pyrender:
             self.enabled, self.note = False, f"pyrender unavailable: {msg}"
 
     def render(self, vertices, edges, camera, model_matrix=None) -> np.ndarray:
-        from .pyrender_oracle import PyrenderOracle
-        key = (camera.width, camera.height)
-        if key not in self.oracles:
-            self.oracles[key] = PyrenderOracle(*key)
-        mask, _ = self.oracles[key].render(vertices, edges, camera, model_matrix=model_matrix)
+        mask, _ = self.oracles.get(camera.width, camera.height).render(vertices, edges, camera,
+                                                                       model_matrix=model_matrix)
         return mask
 
     def close(self):
-        for o in self.oracles.values():
-            o.close()
-        self.oracles.clear()
+        self.oracles.close()
 
 
 def _pyrender_scores(pr: _Pyrender, frame_mask, vertices, edges, camera, model_matrix=None):

@@ -39,7 +39,7 @@ from wirecheck.core.camera import Camera
 
 from .convert import camera_to_pyrender
 
-__all__ = ["osmesa_available", "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
+__all__ = ["osmesa_available", "OracleCache", "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
 
 _INSTALL_HINT = "apt-get install -y libosmesa6"
 
@@ -359,3 +359,30 @@ class PyrenderOracle:
         self._renderer._platform.make_current()
         GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
         GL.glPolygonOffset(1.0, 1.0)
+
+
+class OracleCache:
+    """One :class:`PyrenderOracle` per image size, created on first use and closed together.
+
+    Each oracle owns an OpenGL context sized to its image, so callers that
+    render several cameras keep one per ``(width, height)``.
+    """
+
+    def __init__(self):
+        self._by_size: dict[tuple[int, int], PyrenderOracle] = {}
+
+    def get(self, width: int, height: int) -> PyrenderOracle:
+        """The oracle for images of ``width`` x ``height`` pixels (created if new)."""
+        key = (int(width), int(height))
+        if key not in self._by_size:
+            self._by_size[key] = PyrenderOracle(*key)
+        return self._by_size[key]
+
+    def __contains__(self, size) -> bool:
+        return tuple(size) in self._by_size
+
+    def close(self) -> None:
+        """Release every context; the cache may be used again afterwards."""
+        oracles, self._by_size = self._by_size, {}
+        for oracle in oracles.values():
+            oracle.close()

@@ -557,7 +557,9 @@ class _CaseRunner:
     _DUMMY_EDGES = np.array([[0, 1]], dtype=np.intp)
 
     def __init__(self):
-        self.renderers = {}
+        from .pyrender_oracle import OracleCache
+
+        self.renderers = OracleCache()
         self.candidates = {}
         self.warm = False
 
@@ -575,14 +577,13 @@ class _CaseRunner:
 
     def renderer(self, camera, mode: RenderMode | None = None):
         size = (camera.width, camera.height)
-        if size not in self.renderers:
-            from .pyrender_oracle import PyrenderOracle
-
-            self.renderers[size] = PyrenderOracle(*size)
-            self.renderers[size].render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera)   # compiles the shaders
+        new = size not in self.renderers
+        oracle = self.renderers.get(*size)
+        if new:
+            oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera)   # compiles the shaders
             if mode is not None and mode.shaded:
-                self.renderers[size].render_faces(*self._DUMMY_TRIANGLE, camera)         # and the id shader
-        return self.renderers[size]
+                oracle.render_faces(*self._DUMMY_TRIANGLE, camera)         # and the id shader
+        return oracle
 
     def warm_up(self, camera, candidate, level: str) -> None:
         pts, eye = self._DUMMY_POINTS, np.eye(4)
@@ -608,9 +609,7 @@ class _CaseRunner:
                         keep_frames=params.keep_frames)
 
     def close(self) -> None:
-        renderers, self.renderers = self.renderers, {}
-        for r in renderers.values():
-            r.close()
+        self.renderers.close()
 
 
 _WORKER_RUNNER: _CaseRunner | None = None

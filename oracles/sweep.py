@@ -97,7 +97,9 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     frame_ids = list(range(1, frames + 1, every))
     acc = {s.key: {"err": [], "f1_0": [], "f1_1": [], "t": {"bundled": [], "large": []},
                    "cand_only": 0, "orac_only": 0} for s in settings}
-    oracles = {}
+    from .pyrender_oracle import OracleCache
+
+    oracles = OracleCache()
     try:
         for group, scene in groups:
             edges = np.asarray(scene.edges)
@@ -109,12 +111,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                 cam = case.camera
                 pyr = None
                 if pyrender:
-                    from .pyrender_oracle import PyrenderOracle
-
-                    size = (cam.width, cam.height)
-                    if size not in oracles:
-                        oracles[size] = PyrenderOracle(*size)
-                    pyr = oracles[size]
+                    pyr = oracles.get(cam.width, cam.height)
                 for k in frame_ids:
                     p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
                     ref_img = pyr.render(pr_vertices, edges, cam, model_matrix=pr_pose)[0] if pyr else None
@@ -144,8 +141,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                 if progress:
                     progress(f"{scene.name}/{case.name}")
     finally:
-        for o in oracles.values():
-            o.close()
+        oracles.close()
 
     rows = []
     for s in settings:
