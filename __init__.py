@@ -21,7 +21,6 @@ folders ``core/``, ``oracles/`` and ``scenes/`` (``pyproject.toml`` maps them).
 """
 
 from importlib import import_module
-from importlib.metadata import PackageNotFoundError, version as _version
 
 # Names are imported on first use (PEP 562), so ``import wirecheck.core`` (the
 # renderer) never pays for the oracles' imports (OpenCV, scipy).
@@ -35,15 +34,22 @@ _EXPORTS = {
     "assert_projector": "oracles.api", "check_projector": "oracles.api",
 }
 
-try:
-    __version__ = _version("wirecheck")
-except PackageNotFoundError:  # pragma: no cover - a source tree that was never installed
-    __version__ = "0+unknown"
-
 __all__ = ["__version__", *sorted(_EXPORTS)]
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("wirecheck")
+    except PackageNotFoundError:  # a source tree that was never installed
+        return "0+unknown"
+
+
 def __getattr__(name):
+    if name == "__version__":       # importlib.metadata costs ~40 ms: only when asked
+        globals()[name] = _version()
+        return globals()[name]
     if name in _EXPORTS:
         value = getattr(import_module(f".{_EXPORTS[name]}", __name__), name)
         globals()[name] = value

@@ -10,7 +10,9 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import struct
 import tempfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -46,7 +48,15 @@ def json_dumps(obj) -> str:
 
 
 def png_bytes(image: np.ndarray) -> bytes:
-    """``(H, W)`` uint8 (or ``(H, W, 3)``) to PNG bytes. Row 0 is the top."""
+    """``(H, W)`` uint8 (or ``(H, W, 3)``) to PNG bytes. Row 0 is the top.
+
+    A grey image whose pixels are all 0 or 255 (every wireframe drawn with the
+    ``exact`` or ``fast`` raster) is written bilevel (:func:`bilevel_png_bytes`):
+    lossless, and 8 times less data to compress than 8-bit grey. Anything else
+    (``aa`` coverage, shading, RGB axes) goes through Pillow at zlib level 6.
+    """
+    if image.ndim == 2 and image.dtype == np.uint8 and not ((image + np.uint8(1)) & np.uint8(0xFE)).any():
+        return bilevel_png_bytes(image)       # (v + 1) & 0xFE is 0 exactly for v in {0, 255}
     import io
 
     from PIL import Image
@@ -54,6 +64,31 @@ def png_bytes(image: np.ndarray) -> bytes:
     buf = io.BytesIO()
     Image.fromarray(np.ascontiguousarray(image)).save(buf, format="PNG", compress_level=6)
     return buf.getvalue()
+
+
+#: zlib level of bilevel frames: level 1 is ~3x quicker than 6 on a line drawing
+#: for ~40 % more bytes (3.7 against 2.6 KB for a 640x480 frame of 12 edges).
+BILEVEL_ZLIB_LEVEL = 1
+
+
+def bilevel_png_bytes(image: np.ndarray) -> bytes:
+    """``(H, W)`` image to a 1-bit greyscale PNG: white where ``image >= 128``, black elsewhere.
+
+    Written here (PNG signature, IHDR, one IDAT, IEND; filter type 0 on every
+    row) because Pillow's encoder spends most of its time on the 8-bit rows.
+    Readers see 0/1 samples of bit depth 1 (Pillow opens it as mode ``"1"``;
+    ``.convert("L")`` gives 0/255; OpenCV's ``imread`` gives 0/255).
+    """
+    h, w = image.shape
+    rows = np.zeros((h, (w + 7) // 8 + 1), np.uint8)          # column 0: the row's filter byte (0, None)
+    rows[:, 1:] = np.packbits(image >= 128, axis=1)          # most significant bit = leftmost pixel
+    header = struct.pack(">IIBBBBB", w, h, 1, 0, 0, 0, 0)    # bit depth 1, colour type 0 (grey)
+    return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", header)
+            + _png_chunk(b"IDAT", zlib.compress(rows.tobytes(), BILEVEL_ZLIB_LEVEL)) + _png_chunk(b"IEND", b""))
+
+
+def _png_chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
 
 
 def ascii_frame(image: np.ndarray, cols: int = 80) -> str:

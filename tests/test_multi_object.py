@@ -244,8 +244,8 @@ def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
         assert (a["clipped"], a["clipped_edges"]) == (8, 12)
     assert on["summary"]["objects_culled"] == 6
     for k in (1, 2, 3):
-        im_on = np.asarray(Image.open(tmp_path / "on" / "three-frames" / f"frame_{k:04d}.png"))
-        im_off = np.asarray(Image.open(tmp_path / "off" / "three-frames" / f"frame_{k:04d}.png"))
+        im_on = np.asarray(Image.open(tmp_path / "on" / "three-frames" / f"frame_{k:04d}.png").convert("L"))
+        im_off = np.asarray(Image.open(tmp_path / "off" / "three-frames" / f"frame_{k:04d}.png").convert("L"))
         assert_array_equal(im_on, im_off)
         assert im_on.any()
         txt = f"frame_{k:04d}.txt"

@@ -139,7 +139,7 @@ def test_seed_png_frames(seed_run):
     out = seed_run[0]
     names = sorted(n for n in os.listdir(out / "cube-frames") if n != MARKER)
     assert names == [f"frame_{k:04d}.png" for k in range(1, 181)]
-    img = np.asarray(Image.open(out / "cube-frames" / "frame_0001.png"))
+    img = np.asarray(Image.open(out / "cube-frames" / "frame_0001.png").convert("L"))
     assert img.shape == (480, 640) and img.dtype == np.uint8
     assert set(np.unique(img).tolist()) == {0, 255}
     # rest pose: front face corners at 319.5 +- f/3 = 205.25 / 433.75 (cols 205..434),
@@ -186,7 +186,7 @@ def test_png_row_zero_is_top(tmp_path):
     # 479 - 354 = 125 .. 479 - 154 = 325 instead.
     rc, _, _ = run(["--scene", "pyramid", "--frames", "1", "--camera-z", "4", "--fov", "70"], tmp_path)
     assert rc == 0
-    img = np.asarray(Image.open(tmp_path / "pyramid-frames" / "frame_0001.png"))
+    img = np.asarray(Image.open(tmp_path / "pyramid-frames" / "frame_0001.png").convert("L"))
     rows = np.nonzero(img)[0]
     assert abs(rows.min() - round(239.5 - F70 / 4)) <= 1
     assert abs(rows.max() - round(239.5 + F70 / 3)) <= 1
@@ -271,7 +271,7 @@ def test_empty_mesh_renders_blank_frames(tmp_path):
         f"Summary: {out}/empty-report.txt",
     ]
     for k in (1, 2, 3):
-        img = np.asarray(Image.open(out / "empty-frames" / f"frame_{k:04d}.png"))
+        img = np.asarray(Image.open(out / "empty-frames" / f"frame_{k:04d}.png").convert("L"))
         assert img.shape == (480, 640) and not img.any()
     rep = json.loads((out / "empty-report.json").read_text())
     assert (rep["scene"]["vertices"], rep["scene"]["edges"]) == (0, 0)
@@ -288,8 +288,8 @@ def test_clip_mode_endpoint_draws_subset_of_clip(tmp_path):
     common = ["--scene", "cube", "--frames", "1", "--camera-z", "0.5", "--fov", "70"]
     assert run(common + ["--clip", "clip"], tmp_path / "c")[0] == 0
     assert run(common + ["--clip", "endpoint"], tmp_path / "e")[0] == 0
-    c = np.asarray(Image.open(tmp_path / "c" / "cube-frames" / "frame_0001.png")) > 0
-    e = np.asarray(Image.open(tmp_path / "e" / "cube-frames" / "frame_0001.png")) > 0
+    c = np.asarray(Image.open(tmp_path / "c" / "cube-frames" / "frame_0001.png").convert("L")) > 0
+    e = np.asarray(Image.open(tmp_path / "e" / "cube-frames" / "frame_0001.png").convert("L")) > 0
     # endpoint keeps only the back face square (cols 91..548, rows 11..468, see
     # test_clipping); clip adds the 4 diagonals, 11-12 pixels each, running to rows 0 / 479
     assert not (e & ~c).any()

@@ -25,7 +25,8 @@ def run(args, out):
 
 
 def frame(out, scene, k=1):
-    return np.asarray(Image.open(out / f"{scene}-frames" / f"frame_{k:04d}.png"))
+    im = Image.open(out / f"{scene}-frames" / f"frame_{k:04d}.png")
+    return np.asarray(im.convert("L") if im.mode == "1" else im)     # bilevel frames as 0/255
 
 
 # ---- --axes ---------------------------------------------------------------------------------
@@ -61,7 +62,8 @@ def test_axes_colours_and_directions(tmp_path):
 def test_no_axes_frames_stay_grey(tmp_path):
     rc, _, _ = run(["--scene", "cube", "--frames", "1", "--width", "64", "--height", "48"], tmp_path)
     assert rc == 0
-    assert Image.open(tmp_path / "cube-frames" / "frame_0001.png").mode == "L"
+    # grey, not RGB: a wireframe drawn with the exact raster is bilevel (0/255), written as 1-bit grey
+    assert Image.open(tmp_path / "cube-frames" / "frame_0001.png").mode == "1"
 
 
 def test_axes_are_clipped_like_edges(tmp_path):
