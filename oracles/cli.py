@@ -28,7 +28,7 @@ worst case: candidate | oracle | diff), ``vertex_error.png`` and
 ``--sweep`` runs every core setting (dtype x clip x raster) on the scenes and
 a large mesh and writes a table and a Pareto plot (oracles/sweep.py); it
 exits 1 only when the default setting is out of tolerance. ``--suite
-extremes`` runs the numerical-extremes suite (oracles/extremes.py) and exits
+extremes`` runs the numerical-extremes suite (oracles/extremes/) and exits
 1 when any case exceeds its derived bound.
 """
 
@@ -153,7 +153,7 @@ def _parse(args):
             ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX)) if given]
         if ignored:
             raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
-                             "bounds are fixed (oracles/extremes.py); expected only --level, --run or --report-dir")
+                             "bounds are fixed (oracles/extremes/); expected only --level, --run or --report-dir")
     if args.sweep and args.jobs != 1:
         raise InputError(f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
                          "the times compare; expected no --jobs")

@@ -1,9 +1,12 @@
-"""The extremes suite (oracles/extremes.py) through pytest: every case must pass its derived bounds.
+"""The extremes suite (oracles/extremes/) through pytest: every case must pass its derived bounds.
 
-Each case's bounds and their derivations live in oracles/extremes.py (module
-docstring and CASE_BOUNDS); here we assert the verdicts, that the suite works
-without OSMesa, that its output is deterministic and JSON-able, that the bounds
-are not vacuous, and that the suite does catch a planted fault.
+The bounds and their derivations live in oracles/extremes/bounds.py (each
+function's docstring); here we assert the verdicts, that the suite works
+without OSMesa, that its output is deterministic and JSON-able, that the
+derivations reach the report, that the bounds are not vacuous, and that the
+suite does catch a planted fault. The input-validation checks at the same
+extremes (up parallel to forward, NaN / inf input) are CLI tests
+(tests/test_renderer_cli.py).
 """
 
 from __future__ import annotations
@@ -14,16 +17,16 @@ import numpy as np
 import pytest
 
 from wirecheck.oracles import extremes
+from wirecheck.oracles.extremes import bounds, cases, measure
 from wirecheck.oracles.extremes import EXTREME_CASES, extremes_markdown, run_case, run_extremes
 from wirecheck.oracles.pyrender_oracle import osmesa_available
+from wirecheck.oracles.tolerances import MIN_F1_1PX_EXTREMES
 
 HAVE_OSMESA = osmesa_available()[0]
 
 # The reference needs a long double wider than float64 (x87 80-bit on x86-64 Linux).
 pytestmark = pytest.mark.skipif(not extremes.REFERENCE_EXTENDED,
                                 reason="np.longdouble is plain float64 here: no extended-precision reference")
-CLI_CASES = ("up_parallel", "nonfinite_input")
-PROJECTION_CASES = tuple(n for n in EXTREME_CASES if n not in CLI_CASES)
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +39,7 @@ def _why(case: dict) -> str:
     return f"{case['name']}: " + "; ".join(case["reasons"])
 
 
-@pytest.mark.parametrize("name", PROJECTION_CASES)
+@pytest.mark.parametrize("name", EXTREME_CASES)
 def test_case_passes(name):
     case = run_case(name, pyrender=HAVE_OSMESA)
     assert case["name"] == name
@@ -48,28 +51,7 @@ def test_case_passes(name):
         assert stats["max_error_px"] <= stats["bound_px"], (dt, stats)
         assert stats["visible_mismatch_outside_band"] == 0, (dt, stats)
     if HAVE_OSMESA and case["pyrender"] is not None and case["pyrender"]["f1_1px_judged"] is not None:
-        assert case["pyrender"]["f1_1px_judged"] >= extremes.MIN_F1_1PX
-
-
-@pytest.mark.parametrize("name", CLI_CASES)
-def test_cli_case_passes(name, suite_without_pyrender):
-    case = next(c for c in suite_without_pyrender["cases"] if c["name"] == name)
-    assert case["verdict"] == "pass", _why(case)
-    records = case["details"]["cli"]
-    assert records, "no CLI runs recorded"
-    for rec in records:
-        # exit status 2, one stderr line, no traceback (asserted again here, not only in the suite)
-        assert rec["exit"] == 2, rec
-        assert len(rec["stderr"].splitlines()) == 1, rec
-        assert rec["stderr"].startswith("renderer: error:") and "Traceback" not in rec["stderr"], rec
-
-
-def test_scene_files_with_nonfinite_vertices_name_file_line_and_value(suite_without_pyrender):
-    case = next(c for c in suite_without_pyrender["cases"] if c["name"] == "nonfinite_input")
-    scene_runs = [r for r in case["details"]["cli"] if r["args"][0] == "--scene"]
-    assert len(scene_runs) == len(extremes._NONFINITE_SCENES)
-    for rec, (fname, _, line, token) in zip(scene_runs, extremes._NONFINITE_SCENES):
-        assert f"<tmp>/{fname}:{line}:" in rec["stderr"] and token in rec["stderr"], rec
+        assert case["pyrender"]["f1_1px_judged"] >= MIN_F1_1PX_EXTREMES
 
 
 def test_suite_runs_without_pyrender(suite_without_pyrender):
@@ -86,12 +68,33 @@ def test_suite_runs_without_pyrender(suite_without_pyrender):
         assert f"| {name} |" in md and f"**{name}**" in md
 
 
+def test_report_prints_every_derivation(suite_without_pyrender):
+    # The derivations live in docstrings (bounds.py Notes, each case's Notes): each must be
+    # non-empty and reach extremes.md, and every bound a case names must be derived there.
+    res = suite_without_pyrender
+    md = extremes_markdown(res)
+    assert list(res["bounds"]) == [f.__name__ for f in bounds.DERIVED]
+    for name, text in res["bounds"].items():
+        assert len(text) > 80, name
+        for paragraph in text.split("\n\n"):
+            assert paragraph in md, (name, paragraph)
+    for case in cases.CASES:
+        c = next(r for r in res["cases"] if r["name"] == case.__name__)
+        assert c["bound_derivation"] == bounds.derivation(case) and c["bound_derivation"], c["name"]
+        assert f"Bound: {c['bound_derivation']}" in md
+        named = [b for b in ("camera_error", "pixel_bound", "focal_condition", "near_band", "clipped_end_bounds",
+                             "motion_matrix_error", "orthonormality_error") if b in c["bound_derivation"]]
+        assert named, c["name"]
+        assert all(f"- **{b}**: " in md for b in named), (c["name"], named)
+
+
 def test_results_are_deterministic(suite_without_pyrender):
     # everything but "timing" is a pure function of the code: run a case again, compare
     again = run_case("near_grazing", pyrender=False)
     first = next(c for c in suite_without_pyrender["cases"] if c["name"] == "near_grazing")
     assert json.dumps(again, sort_keys=True) == json.dumps(first, sort_keys=True)
-    assert set(suite_without_pyrender) == {"suite", "verdict", "pyrender", "reference", "cases", "timing"}
+    assert set(suite_without_pyrender) == {"suite", "verdict", "pyrender", "reference", "bounds", "cases",
+                                           "timing"}
 
 
 def test_bounds_are_not_vacuous(suite_without_pyrender):
@@ -122,7 +125,7 @@ def test_suite_catches_a_strict_near_test(monkeypatch):
 def test_suite_catches_a_tiny_pixel_offset(monkeypatch):
     # Planted fault: every float64 pixel 1e-9 px off. Invisible to a 1e-6 px
     # tolerance, but ~100x the derived float64 bound of the far-from-origin case.
-    real = extremes.render_frame
+    real = measure.render_frame
 
     def shifted(*args, **kwargs):
         frame = real(*args, **kwargs)
@@ -130,7 +133,7 @@ def test_suite_catches_a_tiny_pixel_offset(monkeypatch):
             object.__setattr__(frame, "p_px", frame.p_px + 1e-9)
         return frame
 
-    monkeypatch.setattr(extremes, "render_frame", shifted)
+    monkeypatch.setattr(measure, "render_frame", shifted)
     case = run_case("gimbal_lock", pyrender=False)
     assert case["verdict"] == "fail"
     assert any("float64: error" in r for r in case["reasons"]), case["reasons"]

@@ -6,7 +6,7 @@ OpenCV; here the same random cameras also run in **float32**, points may sit
 far from the world origin (camera-relative precision), and the model-view path
 of ``render_frame`` runs with random model matrices.
 
-Bounds come from oracles/extremes.py (``camera_error``, ``pixel_bound``; the
+Bounds come from oracles/extremes/bounds.py (``camera_error``, ``pixel_bound``; the
 derivation is its module docstring), evaluated at the long-double reference's
 camera coordinates and pixels:
 

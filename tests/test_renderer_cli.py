@@ -22,7 +22,8 @@ from PIL import Image
 from wirecheck.core.output import MARKER
 from wirecheck.core.cli import main
 from wirecheck.core.projection import project_points
-from wirecheck.core.camera import camera_z
+from wirecheck.core.camera import camera_z, look_at
+from wirecheck.core.errors import InputError
 from wirecheck.core.transforms import Motion, apply
 
 EPS = np.finfo(np.float64).eps
@@ -252,6 +253,91 @@ def test_bad_input_subprocess_no_traceback(tmp_path):
                           capture_output=True, text=True, timeout=60)
     assert (proc.returncode, proc.stdout) == (2, "")
     assert proc.stderr == "renderer: error: --fov 0.0: expected degrees in (0, 180)\n"
+
+
+# ---- non-finite input and up parallel to forward --------------------------------------
+
+#: (args, strings the one stderr line must contain): every camera option rejects NaN and inf.
+NONFINITE_ARGS = [
+    (["--camera-pos", "nan,0,4"], ["--camera-pos", "nan"]),
+    (["--camera-pos", "0,inf,4"], ["--camera-pos", "inf"]),
+    (["--camera-pos", "1,2,3", "--look-at", "0,nan,0"], ["--look-at", "nan"]),
+    (["--camera-pos", "1,2,3", "--up", "0,-inf,0"], ["--up", "inf"]),
+    (["--fov", "inf"], ["--fov", "inf"]),
+    (["--fov", "nan"], ["--fov", "nan"]),
+    (["--camera-z", "nan"], ["--camera-z", "nan"]),
+    (["--camera-z=-inf"], ["--camera-z", "inf"]),   # "--camera-z -inf": argparse takes -inf for an option
+    (["--near", "nan"], ["near", "nan"]),
+    (["--far", "inf"], ["far", "inf"]),
+    (["--projection", "orthographic", "--ortho-height", "nan"], ["ortho-height", "nan"]),
+    (["--scale", "inf"], ["--scale", "inf"]),
+    (["--spin", "nan,0,0"], ["--spin", "nan"]),
+    (["--translate", "0,0,inf"], ["--translate", "inf"]),
+    # up parallel and anti-parallel (scaled) to forward: |forward x up| = 0 (core/camera.py)
+    (["--camera-pos", "0,5,0", "--look-at", "0,0,0", "--up", "0,1,0"], ["up"]),
+    (["--camera-pos", "0,5,0", "--look-at", "0,0,0", "--up", "0,-3,0"], ["up"]),
+]
+
+#: (file name, text, the line the error must name, the token it must quote)
+NONFINITE_SCENES = [
+    ("nan_vertex.scene", "# a NaN vertex on line 3\nv 0 0 0\nv nan 1 0\nv 1 1 1\ne 0 1\ne 1 2\n", 3, "nan"),
+    ("inf_vertex.scene", "v 0 0 0\nv 1 1 1\nv 0 -inf 0\ne 0 1\ne 1 2\n", 3, "-inf"),
+    ("overflow_vertex.scene", "v 0 0 0\nv 1e999 1 1\ne 0 1\n", 2, "1e999"),
+    ("nan_vertex.obj", "v 0 0 0\nv 1 1 1\nv 1 NaN 0\nf 1 2 3\n", 3, "NaN"),
+]
+
+
+def assert_one_error_line(rc, stdout, stderr, needles):
+    """Exit 2, nothing on stdout, one 'renderer: error:' line on stderr naming every needle."""
+    lines = stderr.splitlines()
+    assert (rc, stdout) == (2, ""), stderr
+    assert len(lines) == 1 and lines[0].startswith("renderer: error: "), stderr
+    assert "Traceback" not in stderr
+    for n in needles:
+        assert n in lines[0], (n, lines[0])
+
+
+@pytest.mark.parametrize("args, needles", NONFINITE_ARGS, ids=[" ".join(a) for a, _ in NONFINITE_ARGS])
+def test_nonfinite_or_parallel_camera_one_line_exit_2(tmp_path, args, needles):
+    out = tmp_path / "out"
+    assert_one_error_line(*run(args + ["--frames", "2"], out), needles)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("fname, text, line, token", NONFINITE_SCENES, ids=[s[0] for s in NONFINITE_SCENES])
+def test_nonfinite_vertex_names_file_line_and_value(tmp_path, fname, text, line, token):
+    path = tmp_path / fname
+    path.write_text(text)
+    out = tmp_path / "out"
+    assert_one_error_line(*run(["--scene", str(path), "--frames", "2"], out), [f"{path}:{line}:", token])
+    assert not out.exists()
+
+
+def test_nonfinite_input_subprocess_no_traceback(tmp_path):
+    # the same contract through real processes: a NaN camera argument and a NaN vertex in a file
+    fname, text, line, token = NONFINITE_SCENES[0]
+    (tmp_path / fname).write_text(text)
+    for args, needles in ((["--camera-pos", "nan,0,4"], ["--camera-pos", "nan"]),
+                          (["--scene", str(tmp_path / fname)], [f"{tmp_path / fname}:{line}:", token])):
+        proc = subprocess.run([sys.executable, "-m", "wirecheck.core.cli", *args, "--frames", "2",
+                               "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
+        assert_one_error_line(proc.returncode, proc.stdout, proc.stderr, needles)
+
+
+@pytest.mark.parametrize("up", [(0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1e-3, 0.0)],
+                         ids=["parallel", "anti-parallel", "parallel-scaled"])
+def test_look_at_rejects_up_parallel_to_forward(up):
+    # |forward x up| = 0 < 1e-9 |up| (core/camera.py): InputError, no other exception type
+    with pytest.raises(InputError, match="parallel"):
+        look_at((0.0, 5.0, 0.0), (0.0, 0.0, 0.0), up)
+
+
+def test_look_at_up_1e_minus_6_off_forward_is_orthonormal():
+    # a valid (if odd) camera, not an error. forward = (0, -1, 0) exactly, so forward x up =
+    # (0, 0, 1e-6) has no rounding: only the normalisations round (~1 eps each); 8 eps allows them
+    cam = look_at((0.0, 5.0, 0.0), (0.0, 0.0, 0.0), (1e-6, 1.0, 0.0))
+    b = np.stack([cam.right, cam.up, cam.forward])
+    assert np.abs(b @ b.T - np.eye(3)).max() <= 8 * EPS
 
 
 # ---- empty mesh ------------------------------------------------------------------------
