@@ -7,7 +7,7 @@ far from the world origin (camera-relative precision), and the model-view path
 of ``render_frame`` runs with random model matrices.
 
 Bounds come from oracles/extremes/bounds.py (``camera_error``, ``pixel_bound``; the
-derivation is its module docstring), evaluated at the long-double reference's
+derivations are their docstrings), evaluated at the long-double reference's
 camera coordinates and pixels:
 
     e_i = 3 eps (|A| |p_local| + |t_mv_i|) + 2 eps64 (...) + 3 eps64 F   (camera x, y, z; render_frame)

@@ -78,7 +78,7 @@ def near_plane(c: CaseRecord, pr: Pyrender) -> None:
     bad_pp = [labels[i] for i in np.flatnonzero(np.isnan(pp[:, 0]) == rule)]
     c.check(not bad_pp, f"project_points visibility differs from the rule at: {', '.join(bad_pp)}")
     cv_vis = ~np.isnan(opencv_oracle.project(p, cam)[:, 0])
-    # float32: flips allowed only inside the derived band (_near_band): |z - plane| <= e_cam + eps32 |plane|
+    # float32: flips allowed only inside the derived band (near_band): |z - plane| <= e_cam + eps32 |plane|
     f32 = m["frames"]["float32"]
     flips = f32.visible != rule
     band = near_band(cam_ld, cam, camera_error("float32", p, None, cam), EPS32)
