@@ -125,6 +125,24 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--ascii-cols", type=int, default=80)
     p.add_argument("--out", default="output", help="output directory (default output/)")
     p.add_argument("--verbose", action="store_true", help="print every frame, not only first, middle and last")
+    ana = p.add_argument_group("analysis and the interactive viewer (docs/interactive.md)")
+    ana.add_argument("--profile", action="store_true",
+                     help="time every frame's stages (transform, faces, shading, clip, raster, compose, encode, "
+                     "write): a table on stdout and 'profile' in the JSON report")
+    ana.add_argument("--trace-vertex", type=int, default=None, metavar="I",
+                     help="print vertex I in every space (model, world, camera, clip, NDC, pixel), its visibility "
+                     "and its edges' clipping; also 'trace' in the JSON report")
+    ana.add_argument("--trace-frames", default=None, metavar="K,K,...",
+                     help="frames of --trace-vertex (default: first, middle, last)")
+    ana.add_argument("--compare", action="store_true",
+                     help="render the scene at two camera distances and two FOVs (--compare-z, --compare-fov) "
+                     "in a 2x2 picture and explain the difference with numbers measured from the frames")
+    ana.add_argument("--compare-z", default="3,6", metavar="D1,D2", help="--compare: camera distances (default 3,6)")
+    ana.add_argument("--compare-fov", default="60,90", metavar="F1,F2", help="--compare: FOVs (default 60,90)")
+    ana.add_argument("--interactive", action="store_true",
+                     help="serve a viewer on 127.0.0.1 (frames drawn by core; orbit, dolly, pan, the oracle "
+                     "overlay, the profiler); opens no browser; Ctrl-C stops it")
+    ana.add_argument("--port", type=int, default=0, help="--interactive: port (default 0: a free one, printed)")
     return p
 
 
@@ -354,12 +372,15 @@ class FrameRenderer:
         # world points are drawn with an identity matrix: mirrored objects' faces re-wound
         self.faces = scene.faces if self.single else oriented_faces(scene, s.motion)
 
-    def render(self, k: int, camera: Camera):
-        """``(frame, info)``: the pipeline's Frame and this frame's counts for :func:`frame_record`."""
+    def render(self, k: int, camera: Camera, timing: dict | None = None):
+        """``(frame, info)``: the pipeline's Frame and this frame's counts for :func:`frame_record`.
+
+        ``timing``: render_frame's per-stage seconds are added to it (core.profile).
+        """
         s, scene = self.s, self.s.scene
         if self.single:
             frame = render_frame(self.points, scene.edges, camera, s.motion.frame_matrix(k, s.frames), s.clip,
-                                 raster=s.raster, **_face_kwargs(s, scene.faces))
+                                 raster=s.raster, timing=timing, **_face_kwargs(s, scene.faces))
             return frame, self._info(frame, None, 0)
         with np.errstate(over="ignore", invalid="ignore"):   # overflow shows as inf: reported below
             p_world = world_points(scene, s.motion, k, s.frames)
@@ -383,7 +404,7 @@ class FrameRenderer:
             edges = scene.edges[keep_e]
             faces = tuple(f for f, keep in zip(self.faces, keep_f) if keep)
         frame = render_frame(p_world, edges, camera, _IDENTITY, s.clip, dtype=s.dtype, raster=s.raster,
-                             **_face_kwargs(s, faces))
+                             timing=timing, **_face_kwargs(s, faces))
         return frame, self._info(frame, dropped, len(culled))
 
     def _culled_objects(self, k: int, camera: Camera) -> list[int]:
@@ -486,10 +507,13 @@ def side_by_side(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return np.concatenate([left, sep, right], axis=1)
 
 
-def render_run(s: Settings, log=None, progress=None) -> dict:
+def render_run(s: Settings, log=None, progress=None, profiler=None, extra: dict | None = None) -> dict:
     """Render every frame, write outputs atomically, return the report dict.
 
     ``log(k, frame, info)`` is called for each frame (the CLI decides what to print).
+    ``profiler`` (a :class:`core.profile.FrameProfiler`) times each frame's
+    stages; its summary becomes the report's ``profile`` field. ``extra``
+    fields are added to the report (``trace``).
     """
     name = s.scene.name
     frames_dir = s.out / f"{name}-frames"
@@ -507,15 +531,19 @@ def render_run(s: Settings, log=None, progress=None) -> dict:
     render_seconds = 0.0
     renderer = FrameRenderer(s)
     layers = [axis_layers(s, cam) for cam in s.cameras] if s.axes else None
+    lap = profiler.lap if profiler is not None else (lambda stage, t: 0.0)
     try:
         if "mp4" in s.formats:
             mp4 = output.Mp4Writer(mp4_path, FPS)
         for k in range(1, s.frames + 1):
+            if profiler is not None:
+                profiler.begin()
             pictures, recs = [], []
             for c, cam in enumerate(s.cameras):
                 t0 = time.perf_counter()
-                frame, info = renderer.render(k, cam)
-                render_seconds += time.perf_counter() - t0
+                frame, info = renderer.render(k, cam, timing=profiler.current if profiler else None)
+                t = time.perf_counter()
+                render_seconds += t - t0
                 _check_overflow(s, frame, k)
                 img = picture(frame, s)
                 pictures.append(overlay(img, layers[c]) if layers else img)
@@ -524,19 +552,31 @@ def render_run(s: Settings, log=None, progress=None) -> dict:
                     all_px[c].append(frame.p_px)
                 if c == 0:
                     first = (frame, info)
+                lap("compose", t)
+            t = time.perf_counter()
             rec = recs[0]
             if len(recs) > 1:
                 rec["orthographic"] = {key: v for key, v in recs[1].items() if key != "frame"}
             image = pictures[0] if len(pictures) == 1 else side_by_side(*pictures)
+            t = lap("compose", t)
             if fdir is not None and "png" in s.formats:
-                fdir.write(f"frame_{k:04d}.png", output.png_bytes(image))
+                data = output.png_bytes(image)
+                t = lap("encode", t)
+                fdir.write(f"frame_{k:04d}.png", data)
+                t = lap("write", t)
             if fdir is not None and "ascii" in s.formats:
-                fdir.write(f"frame_{k:04d}.txt", output.ascii_frame(image, s.ascii_cols).encode())
+                data = output.ascii_frame(image, s.ascii_cols).encode()
+                t = lap("encode", t)
+                fdir.write(f"frame_{k:04d}.txt", data)
+                t = lap("write", t)
             if "gif" in s.formats:
                 gif_images.append(image)
             if mp4 is not None:
                 mp4.add(image)
+                t = lap("encode", t)
             records.append(rec)
+            if profiler is not None:
+                profiler.end()
             if log:
                 log(k, *first)
             if progress:
@@ -554,6 +594,9 @@ def render_run(s: Settings, log=None, progress=None) -> dict:
     if "gif" in s.formats:
         output.atomic_write_bytes(s.out / f"{name}.gif", output.gif_bytes(gif_images, FPS))
     report = _report(s, records)
+    report.update(extra or {})
+    if profiler is not None:
+        report["profile"] = profiler.summary()
     if sidecar:
         import io
 
@@ -720,6 +763,15 @@ def _main(argv=None) -> int:
     except InputError as exc:
         print(f"renderer: error: {exc}", file=sys.stderr)
         return 2
+    if args.interactive or args.compare:
+        from . import analysis
+
+        return analysis.run_mode(args, s)
+    try:
+        traces = _traces(args, s)
+    except InputError as exc:
+        print(f"renderer: error: {exc}", file=sys.stderr)
+        return 2
     width = max(3, len(str(s.frames)))
     shown = {1, (s.frames + 1) // 2, s.frames}
     if s.frames >= 180:
@@ -738,8 +790,14 @@ def _main(argv=None) -> int:
             write(f"Frame {k:0{width}d}: visible_vertices={frame.visible_vertices} "
                   f"clipped={frame.clipped_vertices} {depth_text(frame)}{extra}")
 
+    profiler = None
+    if args.profile:
+        from .profile import FrameProfiler
+
+        profiler = FrameProfiler()
     try:
-        report = render_run(s, log=log, progress=progress)
+        report = render_run(s, log=log, progress=progress, profiler=profiler,
+                            extra={"trace": traces} if traces else None)
     except InputError as exc:
         close()
         print(f"renderer: error: {exc}", file=sys.stderr)
@@ -752,6 +810,15 @@ def _main(argv=None) -> int:
         print(f"renderer: error: writing to {str(s.out)!r} failed: {exc}", file=sys.stderr)
         return 2
     close()
+    if traces:
+        from .trace import trace_text
+
+        for rec in traces:
+            print(trace_text(rec, s.camera), end="")
+    if profiler is not None:
+        from .profile import profile_table
+
+        print(profile_table(report["profile"]), end="")
     paths = report["_paths"]
     if paths["frames"] is not None:
         print(f"Exported frames: {paths['frames']}/")
@@ -762,6 +829,24 @@ def _main(argv=None) -> int:
         print(f"Plots: {paths['plots']}")
     print(f"Summary: {paths['txt']}")
     return 0
+
+
+def _traces(args, s: Settings) -> list[dict]:
+    """--trace-vertex: the vertex in every space in each traced frame (core.trace), [] without it."""
+    if args.trace_vertex is None:
+        if args.trace_frames is not None:
+            raise InputError(f"--trace-frames {args.trace_frames!r} without --trace-vertex: expected --trace-vertex I")
+        return []
+    from .trace import check_vertex, parse_frames, trace_vertex
+
+    check_vertex(s.scene, args.trace_vertex)
+    renderer = FrameRenderer(s)
+    out = []
+    for k in parse_frames(args.trace_frames, s.frames):
+        frame, _ = renderer.render(k, s.camera)
+        out.append(trace_vertex(s.scene, s.motion, s.camera, args.trace_vertex, k, s.frames,
+                                frame.p_px[args.trace_vertex]))
+    return out
 
 
 if __name__ == "__main__":

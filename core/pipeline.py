@@ -14,6 +14,7 @@ depth buffer (core.zbuffer) only for the last two.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +27,11 @@ CLIP_MODES = ("clip", "endpoint")
 RASTER_MODES = ("exact", "fast", "aa")
 STYLES = ("wireframe", "shaded")
 CULL_MODES = (None, "backface")
+#: The stages :func:`render_frame` times when given a ``timing`` dict, in pipeline order:
+#: transform (model -> camera -> pixels, depth test), faces (triangulate, cull,
+#: z-buffer), shading, clip (edges against the frustum and the image), raster
+#: (line pixels, with hidden lines their depth test, and painting).
+STAGES = ("transform", "faces", "shading", "clip", "raster")
 
 
 @dataclass(frozen=True)
@@ -115,7 +121,7 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
                  clip_mode: str = "clip", *, dtype=None, raster: str = "exact",
                  faces=None, cull: str | None = None, hidden_lines: bool = False,
                  style: str = "wireframe", light_dir=None,
-                 ambient: float = shading.DEFAULT_AMBIENT) -> Frame:
+                 ambient: float = shading.DEFAULT_AMBIENT, timing: dict | None = None) -> Frame:
     """Project and draw one frame.
 
     ``p_model`` is an ``(N, 3)`` array or, to skip re-centring and casting on
@@ -154,7 +160,14 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
         :func:`core.shading.default_light_dir` (from the camera's upper left).
     ambient
         Ambient term of the shading, in [0, 1].
+
+    timing
+        Optional dict: the seconds of each of :data:`STAGES` this frame ran are
+        added to it (laps that follow each other, so their sum is the call's
+        time but for building the returned Frame). None (the default) reads no
+        clock.
     """
+    t = _clock() if timing is not None else 0.0
     if clip_mode not in CLIP_MODES:
         raise ValueError(f"clip_mode {clip_mode!r}: expected one of {CLIP_MODES}")
     if raster not in RASTER_MODES:
@@ -184,6 +197,7 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
     # Depth is affine along an edge, so near/far leave an edge whole exactly when
     # both ends are in [near, far]: every other edge is cut or dropped by them.
     clipped_edges = int(len(edges) - ends_visible.sum())
+    t = _lap(timing, "transform", t)
 
     shaded_style = style == "shaded"
     use_faces = faces is not None and (cull is not None or hidden_lines or shaded_style)
@@ -206,12 +220,14 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
         face_ids = np.full((camera.height, camera.width), -1, dtype=np.int32)
     if depth_image is not None:
         extra.update(depth_image=depth_image, face_ids=face_ids)
+    t = _lap(timing, "faces", t)
 
     if shaded_style:
         normals = fs["normals_world"] if use_faces else np.zeros((0, 3))
         light = shading.default_light_dir(camera) if light_dir is None else light_dir
         image = shading.shade(face_ids, normals, light, ambient)     # shaded
         extra["shaded"] = image
+        _lap(timing, "shading", t)
         return Frame(image=image, p_px=p_px.astype(np.float64, copy=False),
                      depth=p_cam[:, 2].astype(np.float64), visible=visible,
                      clipped_edges=clipped_edges, **extra)
@@ -245,14 +261,28 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
             if hidden_lines:
                 ends = tuple(np.concatenate([a, b]) for a, b in zip(
                     ends, (seg_px[on, 0], seg_px[on, 1], seg_cam[on, 0, 2], seg_cam[on, 1, 2])))
+        t = _lap(timing, "clip", t)
         if hidden_lines and tri_face_buf is not None and (tri_face_buf >= 0).any():
             extra["hidden_pixels"] = _paint_visible(image, seg0_px, seg1_px, ends, raster,
                                                     depth_image, tri_face_buf, grad, camera)
         else:
             _paint(image, seg0_px, seg1_px, raster)                 # painted
+        _lap(timing, "raster", t)
     return Frame(image=image, p_px=p_px.astype(np.float64, copy=False),
                  depth=p_cam[:, 2].astype(np.float64), visible=visible, clipped_edges=clipped_edges,
                  **extra)
+
+
+_clock = time.perf_counter
+
+
+def _lap(timing: dict | None, stage: str, t0: float) -> float:
+    """Add the seconds since ``t0`` to ``timing[stage]`` and return the clock (0.0 when timing is None)."""
+    if timing is None:
+        return 0.0
+    t = _clock()
+    timing[stage] = timing.get(stage, 0.0) + (t - t0)
+    return t
 
 
 def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: bool) -> dict:
