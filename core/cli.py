@@ -763,10 +763,14 @@ def _main(argv=None) -> int:
     except InputError as exc:
         print(f"renderer: error: {exc}", file=sys.stderr)
         return 2
-    if args.interactive or args.compare:
-        from . import analysis
+    if args.interactive:
+        from .viewer import main_interactive
 
-        return analysis.run_mode(args, s)
+        return main_interactive(s, args.port)
+    if args.compare:
+        from .compare import main_compare
+
+        return main_compare(s, args.compare_z, args.compare_fov)
     try:
         traces = _traces(args, s)
     except InputError as exc:
