@@ -252,8 +252,11 @@ def _case_faces(scene: Scene):
 
 def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
              tol: Tolerances, pyrender_oracle=None, want_images: bool = True, every: int = 1,
-             mode: RenderMode | None = None, keep_frames: bool = False) -> CaseResult:
+             mode: RenderMode | None = None, keep_frames: bool = False, first: int = 1) -> CaseResult:
     """One case; the pixel stage runs when ``pyrender_oracle`` is given.
+
+    Frames ``first, first + every, ...`` up to ``frames`` are checked (the
+    viewer's overlay checks one frame: ``first=k, every=frames``).
 
     ``mode`` is the drawing mode of the pixel stage (module docstring); with
     ``keep_frames`` every checked frame's images are kept (bit-packed) in
@@ -293,7 +296,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     t_setup = t_cv = t_proj = t_vmetric = t_draw = t_pr = t_pmetric = 0.0
     error = None
     core_points = candidate.prepare(scene.vertices) if is_core and single else None   # once per scene
-    for k in range(1, frames + 1, every):
+    for k in range(first, frames + 1, every):
         t0 = time.perf_counter()
         p_world, matrices, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
         t1 = time.perf_counter()
