@@ -330,9 +330,11 @@ class Viewer:
                    "command": self.command(v), "image": image,
                    "vertices_px": [None if not vis else [float(x), float(y)]
                                    for (x, y), vis in zip(frame.p_px[:n].tolist(), frame.visible[:n].tolist())],
-                   "timing_ms": rec, "profile": self.profiler.summary(), "overlay": None}
+                   "timing_ms": rec, "profile": self.profiler.summary(), "overlay": None, "overlay_ms": 0.0}
             if want_overlay:
+                t0 = time.perf_counter()
                 out["overlay"] = self._overlay(s, v)
+                out["overlay_ms"] = 1e3 * (time.perf_counter() - t0)      # crosscheck of the view, not the frame
             return out
 
     def _overlay(self, s, v: View) -> dict:

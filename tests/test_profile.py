@@ -104,9 +104,10 @@ def test_renderer_profile_table_and_report(tmp_path):
         assert f"\n{name:<10} " in out
     # The laps cover the frame: what no stage claims (FrameRenderer's per-frame matrix,
     # building the Frame, the profiler's own calls) measured 0.7 % of the cube's frame
-    # (PNG encoding dominates). 10 % leaves room for a preemption of ~1 ms in a ~10 ms frame.
-    assert stages["other"]["share"] < 0.10
-    assert sum(stages[s]["share"] for s in STAGES) > 0.90
+    # unloaded and 4.8 % at load average 11 on 2 cores (PNG encoding and writing dominate).
+    # 15 % leaves room for that noise; a stage left untimed (encode alone is ~55 %) exceeds it.
+    assert stages["other"]["share"] < 0.15
+    assert sum(stages[s]["share"] for s in STAGES) > 0.85
     assert "Profile: 20 frames" in out
 
 

@@ -133,6 +133,6 @@ def test_modes_bad_input_and_motion(session):
 
 
 def test_profiler_shows_every_stage_and_the_page_logs_no_errors(session):
-    assert session["profileRows"] == list(STAGES) + ["transfer", "server", "roundtrip"]
+    assert session["profileRows"] == list(STAGES) + ["oracle", "transfer", "server", "roundtrip"]
     assert "frames/s over the last" in session["fpsText"]
     assert session["consoleErrors"] == []

@@ -4,9 +4,11 @@
 // is merged into the next request, so a slow frame never builds a backlog.
 "use strict";
 
-const STAGES = ["transform", "faces", "shading", "clip", "raster", "compose", "encode", "transfer"];
+// server stages (core.profile), the overlay's crosscheck, then what the server did not see
+const STAGES = ["transform", "faces", "shading", "clip", "raster", "compose", "encode", "oracle", "transfer"];
 const COLOURS = {transform: "#1f77b4", faces: "#ff7f0e", shading: "#2ca02c", clip: "#d62728",
-                 raster: "#9467bd", compose: "#8c564b", encode: "#e377c2", transfer: "#7f7f7f"};
+                 raster: "#9467bd", compose: "#8c564b", encode: "#e377c2", oracle: "#bcbd22",
+                 transfer: "#7f7f7f"};
 const WINDOW = 120;          // frames in the chart and the p50/p95
 const history = [];          // per frame: {stage: ms, roundtrip: ms, server: ms}
 let pending = [];            // ops not yet sent
@@ -74,7 +76,8 @@ function show(resp, roundtrip) {
                                                vertices_px: resp.vertices_px}, null, 1);
   const rec = {};
   for (const s of STAGES) rec[s] = resp.timing_ms[s] || 0;
-  rec.transfer = Math.max(0, roundtrip - resp.timing_ms.total);
+  rec.oracle = resp.overlay_ms || 0;
+  rec.transfer = Math.max(0, roundtrip - resp.timing_ms.total - rec.oracle);
   rec.roundtrip = roundtrip;
   rec.server = resp.timing_ms.total;
   history.push(rec);

@@ -35,3 +35,24 @@ frame("orr", 10, "orrery").save(out / "orrery-axes.png", optimize=True)
 (out / "orrery-plots.png").write_bytes((t / "orr" / "orrery-plots.png").read_bytes())
 PY
 echo "wrote reports/example/{cube-frame_0020,styles,perspective-orthographic,orrery-axes,orrery-plots}.png, orrery.gif"
+
+# renderer --compare (docs/interactive.md): the 2x2 picture of camera z 3/6 and FOV 60/90
+$R --compare --out "$T/cmp" > "$T/cmp.txt"
+cp "$T/cmp/cube-compare.png" reports/example/cube-compare.png
+# the viewer page after the browser test's drag, wheel, shift-drag and overlay (needs tests/browser/setup.sh)
+if [ -d tests/browser/node_modules/playwright-core ] && [ -x /usr/bin/chromium ]; then
+    .venv/bin/python - "$T" <<'PY'
+import subprocess, sys
+from wirecheck.core.cli import build_parser, settings_from_args
+from wirecheck.core.viewer import Server, Viewer
+from wirecheck.oracles.live import LiveOverlay
+s = settings_from_args(build_parser().parse_args(["--out", sys.argv[1] + "/viewer"]))
+server = Server(Viewer(s, overlay=LiveOverlay())).start()
+try:
+    subprocess.run(["node", "tests/browser/viewer_session.mjs", server.url, sys.argv[1] + "/session.json",
+                    "reports/example/viewer.png"], check=True)
+finally:
+    server.stop()
+PY
+    echo "wrote reports/example/cube-compare.png, viewer.png"
+fi

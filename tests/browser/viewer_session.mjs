@@ -3,13 +3,13 @@
 // live in tests/test_viewer_browser.py, which compares the records with
 // hand-derived numbers.
 //
-//   node viewer_session.mjs URL OUT.json
+//   node viewer_session.mjs URL OUT.json [SCREENSHOT.png]
 import { chromium } from "playwright-core";
 import { mkdtempSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
-const [url, outPath] = process.argv.slice(2);
+const [url, outPath, shotPath] = process.argv.slice(2);
 const userDataDir = mkdtempSync(join(tmpdir(), "wirecheck-chromium-"));
 const context = await chromium.launchPersistentContext(userDataDir, {
   executablePath: process.env.WIRECHECK_CHROMIUM || "/usr/bin/chromium",
@@ -72,6 +72,7 @@ await idle();
 await page.waitForSelector("#overlay-json", { state: "visible" });
 const overlay = JSON.parse(await page.textContent("#overlay-json"));
 const diffSrc = await page.getAttribute("#diff", "src");
+if (shotPath) await page.screenshot({ path: shotPath, fullPage: true });
 await page.uncheck("#overlay");
 await idle();
 
