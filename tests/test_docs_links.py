@@ -19,7 +19,6 @@ PENDING = {
     "docs/install.md",
     "docs/pytest.md",
     "docs/ci-workflow.md",
-    "docs/interactive.md",
 }
 
 _LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(([^()\s]+)(?:\s+\"[^\"]*\")?\)")
