@@ -99,7 +99,7 @@ def test_frame_is_core_render_frame_byte_for_byte(tmp_path):
                          hidden_lines=True)
     png = base64.b64decode(resp["image"])
     assert png == png_bytes(frame.image)
-    assert_array_equal(np.asarray(Image.open(io.BytesIO(png))), frame.image)
+    assert_array_equal(np.asarray(Image.open(io.BytesIO(png)).convert("L")), frame.image)   # bilevel PNG: 0/255
     assert resp["vertices_px"][6] == frame.p_px[6].tolist()
 
 
