@@ -378,8 +378,11 @@ class FrameRenderer:
         ``timing``: render_frame's per-stage seconds are added to it (core.profile).
         """
         s, scene = self.s, self.s.scene
+        t0 = time.perf_counter() if timing is not None else 0.0
         if self.single:
-            frame = render_frame(self.points, scene.edges, camera, s.motion.frame_matrix(k, s.frames), s.clip,
+            m = s.motion.frame_matrix(k, s.frames)
+            _add_time(timing, "transform", t0)                      # the model matrix is part of the transform
+            frame = render_frame(self.points, scene.edges, camera, m, s.clip,
                                  raster=s.raster, timing=timing, **_face_kwargs(s, scene.faces))
             return frame, self._info(frame, None, 0)
         with np.errstate(over="ignore", invalid="ignore"):   # overflow shows as inf: reported below
@@ -403,6 +406,7 @@ class FrameRenderer:
             dropped = scene.edges[~keep_e]
             edges = scene.edges[keep_e]
             faces = tuple(f for f, keep in zip(self.faces, keep_f) if keep)
+        _add_time(timing, "transform", t0)                          # world points and object culling
         frame = render_frame(p_world, edges, camera, _IDENTITY, s.clip, dtype=s.dtype, raster=s.raster,
                              timing=timing, **_face_kwargs(s, faces))
         return frame, self._info(frame, dropped, len(culled))
@@ -439,6 +443,11 @@ class FrameRenderer:
         if s.hidden_lines:
             info["hidden_pixels"] = getattr(frame, "hidden_pixels", None)
         return info
+
+
+def _add_time(timing: dict | None, stage: str, t0: float) -> None:
+    if timing is not None:
+        timing[stage] = timing.get(stage, 0.0) + (time.perf_counter() - t0)
 
 
 _IDENTITY = np.eye(4)
