@@ -26,8 +26,8 @@ import numpy as np
 from . import output
 from .camera import Camera, camera_z, look_at
 from .errors import InputError
-from .pipeline import CLIP_MODES, RASTER_MODES, render_frame
-from .projection import DTYPES, localize
+from .pipeline import CLIP_MODES, RASTER_MODES, draw_segments, render_frame
+from .projection import DTYPES, localize, world_to_cam
 from .scene import Scene, load_scene, object_matrix, object_spheres, oriented_faces, world_points
 from .transforms import Motion, apply
 
@@ -104,7 +104,8 @@ def build_parser() -> argparse.ArgumentParser:
     drw.add_argument("--axes", action="store_true",
                      help="draw the world axes from the origin, X red, Y green, Z blue, length 1.2 x the "
                      "scene's bounding radius x |--scale|, through the same camera and clipping as the "
-                     "edges, on top of the picture; frames become RGB (grey otherwise)")
+                     "edges, over the picture but, with --hidden-lines or --style shaded, hidden behind faces "
+                     "like the edges; frames become RGB (grey otherwise)")
     drw.add_argument("--cull", choices=CULL_CHOICES, default="none",
                      help="backface: drop faces turned away from the camera (needs consistent winding)")
     drw.add_argument("--hidden-lines", action="store_true", help="hide edges behind faces (z-buffer)")
@@ -469,14 +470,26 @@ def axis_length(s: "Settings") -> float:
     return AXIS_LENGTH * (r if r > 0 and math.isfinite(r) else 1.0)
 
 
-def axis_layers(s: "Settings", camera: Camera) -> list[tuple[tuple[int, int, int], np.ndarray]]:
+def axis_layers(s: "Settings", camera: Camera, frame=None) -> list[tuple[tuple[int, int, int], np.ndarray]]:
     """``[(rgb, coverage)]`` for the X, Y, Z axes: each drawn by core's pipeline as one edge.
 
-    The world axes do not move, so this is computed once per camera and run.
-    ``coverage`` is the edge's image (255 on its pixels; 0..255 for raster "aa").
+    The world axes do not move, so without faces this is computed once per
+    camera and run. With ``frame`` rendered with hidden lines or shaded (it
+    has a depth buffer), the axes are depth-tested against its faces like its
+    own edges (:func:`core.pipeline.draw_segments`), so they are computed per
+    frame. ``coverage`` is the edge's image (255 on its pixels; 0..255 for raster "aa").
     """
     n = axis_length(s)
     points = np.array([[0.0, 0.0, 0.0], [n, 0.0, 0.0], [0.0, n, 0.0], [0.0, 0.0, n]])
+    if frame is not None and getattr(frame, "tri_ids", None) is not None:
+        p_cam = world_to_cam(points, camera)                          # camera
+        layers = []
+        for i, (_, rgb) in enumerate(AXIS_COLOURS, start=1):
+            seg_cam = p_cam[[0, i]][None]
+            if s.clip == "endpoint" and not ((camera.near <= seg_cam[0, :, 2]) & (seg_cam[0, :, 2] <= camera.far)).all():
+                seg_cam = seg_cam[:0]                                 # --clip endpoint: a clipped end drops the edge
+            layers.append((rgb, draw_segments(seg_cam, camera, s.raster, occluders=frame)))
+        return layers
     layers = []
     for i, (_, rgb) in enumerate(AXIS_COLOURS, start=1):
         f = render_frame(points, np.array([[0, i]]), camera, _IDENTITY, s.clip, dtype=s.dtype, raster=s.raster)
@@ -555,7 +568,10 @@ def render_run(s: Settings, log=None, progress=None, profiler=None, extra: dict 
                 render_seconds += t - t0
                 _check_overflow(s, frame, k)
                 img = picture(frame, s)
-                pictures.append(overlay(img, layers[c]) if layers else img)
+                if layers and frame.tri_ids is not None:          # faces in a depth buffer: axes depth-tested
+                    pictures.append(overlay(img, axis_layers(s, cam, frame)))
+                else:
+                    pictures.append(overlay(img, layers[c]) if layers else img)
                 recs.append(frame_record(k, frame, sidecar, info))
                 if sidecar:
                     all_px[c].append(frame.p_px)

@@ -15,7 +15,7 @@ depth buffer (core.zbuffer) only for the last two.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -72,6 +72,11 @@ class Frame:
     hidden_pixels : int
         With ``hidden_lines``: pixels that some edge reaches but only with
         hidden samples, i.e. line pixels suppressed by the faces. 0 otherwise.
+    tri_ids : (H, W) int or None
+        With ``depth_image``: the (clipped) triangle seen at each pixel, -1
+        where none, and ``tri_grad`` its depth gradients: what
+        :func:`draw_segments` needs to hide other lines (the axes) behind
+        this frame's faces exactly as the frame's own edges are hidden.
     """
 
     image: np.ndarray
@@ -86,6 +91,8 @@ class Frame:
     faces_culled: int = 0
     edges_culled: int = 0
     hidden_pixels: int = 0
+    tri_ids: np.ndarray | None = field(default=None, repr=False)
+    tri_grad: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def mask(self) -> np.ndarray:
@@ -215,6 +222,8 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
             ends_visible = ends_visible[keep_edge]
         depth_image, face_ids = fs.get("depth"), fs.get("face_ids")
         tri_face_buf, grad = fs.get("tri_buf"), fs.get("grad")
+        if tri_face_buf is not None:
+            extra.update(tri_ids=tri_face_buf, tri_grad=grad)
     elif hidden_lines or shaded_style:                              # no faces: an empty depth buffer
         depth_image = np.full((camera.height, camera.width), np.inf)
         face_ids = np.full((camera.height, camera.width), -1, dtype=np.int32)
@@ -374,6 +383,34 @@ def _paint(image: np.ndarray, seg0_px: np.ndarray, seg1_px: np.ndarray, mode: st
     else:
         rr, cc, weight = raster.line_coverage_aa(seg0_px, seg1_px, w, h)
         image[...] = raster.paint_aa(rr, cc, weight, w, h)
+
+
+def draw_segments(seg_cam: np.ndarray, camera: Camera, raster: str = "exact", occluders: Frame | None = None
+                  ) -> np.ndarray:
+    """``(H, W) uint8``: camera-space segments ``(M, 2, 3)`` clipped and drawn as edges are.
+
+    With ``occluders`` (a Frame rendered with ``hidden_lines`` or style
+    "shaded" through the same camera), line pixels behind its faces are not
+    drawn: the same depth test and bias as the frame's own hidden lines
+    (core.zbuffer). Used for the axes, which are drawn over the picture.
+    """
+    if raster not in RASTER_MODES:
+        raise ValueError(f"raster {raster!r}: expected one of {RASTER_MODES}")
+    seg_cam = np.asarray(seg_cam, dtype=np.float64).reshape(-1, 2, 3)
+    image = np.zeros((camera.height, camera.width), dtype=np.uint8)
+    kept, t0, t1 = clipping.clip_segments(seg_cam, clipping.frustum_planes(camera))
+    seg_cam = clipping.apply_clip(seg_cam, kept, t0, t1, (camera.near, camera.far))   # camera, in the frustum
+    if len(seg_cam) == 0:
+        return image
+    seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)               # pixels
+    on, c0_px, c1_px = clipping.clip_to_image(seg_px[:, 0], seg_px[:, 1], camera.width, camera.height)
+    tri = None if occluders is None else occluders.tri_ids
+    if tri is not None and (tri >= 0).any():
+        ends = (seg_px[on, 0], seg_px[on, 1], seg_cam[on, 0, 2], seg_cam[on, 1, 2])
+        _paint_visible(image, c0_px, c1_px, ends, raster, occluders.depth_image, tri, occluders.tri_grad, camera)
+    else:
+        _paint(image, c0_px, c1_px, raster)
+    return image
 
 
 def _inside_image(p_px: np.ndarray, camera: Camera) -> np.ndarray:

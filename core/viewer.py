@@ -257,7 +257,7 @@ class Viewer:
         t1 = time.perf_counter()
         img = picture(frame, s)
         if s.axes:
-            img = overlay(img, axis_layers(s, s.camera))
+            img = overlay(img, axis_layers(s, s.camera, frame))
         t2 = time.perf_counter()
         png = output.png_bytes(img)
         t3 = time.perf_counter()
