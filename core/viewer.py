@@ -152,7 +152,6 @@ def pan(view: View, dx: float, dy: float, height: int) -> View:
                    target=tuple((np.asarray(view.target) + move).tolist()))
 
 
-#: Fields the page may set, with their parsers.
 def _number(name, text):
     try:
         v = float(text)
@@ -177,6 +176,7 @@ def _flag(name, value):
     return value
 
 
+#: Fields the page may set, with their parsers.
 FIELDS = {"fov": _number, "near": _number, "far": _number, "ortho_height": _number,
           "projection": _choice(("perspective", "orthographic")), "style": _choice(("wireframe", "shaded")),
           "hidden_lines": _flag, "cull": _flag, "axes": _flag}

@@ -19,8 +19,6 @@ import sys
 import threading
 import urllib.error
 import urllib.request
-from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
