@@ -50,6 +50,8 @@ from wirecheck.core.scene import builtin_names, load_scene
 from . import tolerances
 from .candidate import load_candidate
 from .cases import CASE_NAMES
+from .config import parse_cli
+from .junit import check_junit_target, write_junit
 from .report import console_table, timing_line, write_report
 from .runner import LEVELS, CoreCandidate, RenderMode, Tolerances, level_for_oracles, run_crosscheck
 
@@ -114,6 +116,12 @@ def build_parser() -> argparse.ArgumentParser:
                            "1,000,000-frame periodicity, degenerate and non-finite inputs")
     p.add_argument("--report-dir", default=None, help="where to write the report (default reports/<run>)")
     p.add_argument("--run", default=None, help="run name under reports/ (default: UTC time)")
+    p.add_argument("--junit-xml", default=None, metavar="FILE",
+                   help="also write JUnit XML: one test case per scene x camera, faults and reasons as the "
+                        "failure message (default: none)")
+    p.add_argument("--config", default=None, metavar="FILE",
+                   help="read [tool.wirecheck] from FILE (default: the nearest pyproject.toml at or above the "
+                        "working directory); options given here override it")
     return p
 
 
@@ -205,8 +213,15 @@ def _parse(args):
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
     try:
+        args, config, applied = parse_cli(build_parser(), argv)
+        if applied:
+            print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
+        if args.junit_xml and (args.sweep or args.suite):
+            raise InputError(f"--junit-xml with {'--sweep' if args.sweep else '--suite ' + args.suite}: "
+                             "expected it in a plain crosscheck run (one test case per scene x camera)")
+        if args.junit_xml:
+            check_junit_target(Path(args.junit_xml))
         level, case_names, spin, scenes, candidate, mode = _parse(args)
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
@@ -264,6 +279,15 @@ def main(argv=None) -> int:
     except OSError as exc:
         print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
         return 2
+    if args.junit_xml:
+        try:
+            write_junit(Path(args.junit_xml), report)
+        except InputError as exc:
+            print(f"crosscheck: error: {exc}", file=sys.stderr)
+            return 2
+        except OSError as exc:
+            print(f"crosscheck: error: --junit-xml {args.junit_xml!r}: writing failed: {exc}", file=sys.stderr)
+            return 2
     print(console_table(records))
     for r in records:
         if r["verdict"] != "pass":

@@ -1,0 +1,260 @@
+"""``[tool.wirecheck]`` in a project's ``pyproject.toml``: settings shared by crosscheck and the pytest plugin.
+
+::
+
+    [tool.wirecheck]
+    candidate = "src/myproj/projection.py:project"  # crosscheck --candidate; the fixture's default projector
+    scenes = ["cube", "tests/arm.scene"]   # built-in or example names, or paths relative to this file
+    cases = ["on_axis", "near_plane"]      # a subset of oracles.cases.CASE_NAMES
+    frames = 8                             # frames of the motion per case
+    level = "vertices"                     # or "pixels" (OpenCV and pyrender); or oracles = ["opencv"]
+    tol-px = 0.01                          # and min-f1, min-f1-0px: the crosscheck options of that name
+    spin = [1, 1, 0]                       # full turns about X, Y, Z over the frames
+
+Keys are crosscheck's option names. An explicit setting wins over this table
+(a command-line option, a keyword of the fixture's call), and the table over
+the built-in defaults. The table is read from the nearest ``pyproject.toml``
+at or above the working directory (crosscheck) or pytest's rootdir (the
+plugin); a ``pyproject.toml`` without the table means no settings.
+
+Every value is checked when the file is read: an unknown key, a wrong type,
+or a setting that selects nothing (no scenes, no cases, zero frames) is an
+:class:`~wirecheck.core.errors.InputError` naming the file, the key and the
+value, never a run that compares nothing.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from wirecheck.core.errors import InputError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+TABLE = "tool.wirecheck"
+
+#: The keys and what each must be (said in the error message).
+KEYS = {
+    "candidate": "a string FILE.py:FUNC or MODULE:FUNC",
+    "scenes": "a non-empty list of scene names or paths",
+    "cases": "a non-empty list of case names",
+    "frames": "an integer >= 1",
+    "level": "'vertices' or 'pixels'",
+    "oracles": "a list of 'opencv' and 'pyrender' with 'opencv' among them",
+    "tol-px": "a number >= 0",
+    "min-f1": "a number in [0, 1]",
+    "min-f1-0px": "a number in [0, 1]",
+    "spin": "a list of three finite numbers [X, Y, Z]",
+}
+
+#: Keyword of oracles.api.check_projector for each key (``level``/``oracles`` become ``oracles``).
+API_KEYWORDS = {"scenes": "scenes", "cases": "cases", "frames": "frames", "tol-px": "tol_px",
+                "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "turns"}
+
+
+@dataclass(frozen=True)
+class Config:
+    """Validated settings from one file; ``values`` holds only the keys the file sets.
+
+    Paths (``scenes`` entries that are files, a ``candidate`` FILE.py) are
+    absolute, resolved against the file's folder; ``level`` is set for either
+    ``level`` or ``oracles``.
+    """
+
+    path: Path | None = None
+    values: dict = field(default_factory=dict)
+
+    def api_kwargs(self) -> dict:
+        """The settings as keywords of :func:`wirecheck.oracles.api.check_projector`."""
+        from .runner import LEVEL_ORACLES
+
+        kwargs = {API_KEYWORDS[k]: v for k, v in self.values.items() if k in API_KEYWORDS}
+        if "level" in self.values:
+            kwargs["oracles"] = LEVEL_ORACLES[self.values["level"]]
+        return kwargs
+
+
+def find_pyproject(start: Path) -> Path | None:
+    """The nearest ``pyproject.toml`` at or above ``start``; None when there is none."""
+    start = Path(start).resolve()
+    for folder in (start, *start.parents):
+        candidate = folder / "pyproject.toml"
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def load_config(path: Path | None = None, start: Path | None = None) -> Config:
+    """Read and validate ``[tool.wirecheck]``.
+
+    ``path`` is a file named by the user (it must exist and hold the table);
+    without it the nearest ``pyproject.toml`` at or above ``start`` (default:
+    the working directory) is read, and no file or no table means no settings.
+    """
+    explicit = path is not None
+    path = Path(path) if explicit else find_pyproject(Path.cwd() if start is None else start)
+    if path is None:
+        return Config()
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise InputError(f"{path}: file not found: expected a pyproject.toml with a [{TABLE}] table") from None
+    except IsADirectoryError:
+        raise InputError(f"{path} is a directory: expected a pyproject.toml file") from None
+    except OSError as exc:
+        raise InputError(f"{path}: could not be read: {exc}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not valid TOML: {exc}") from None
+    table = data.get("tool", {}).get("wirecheck") if isinstance(data.get("tool"), dict) else None
+    if table is None:
+        if explicit:
+            raise InputError(f"{path}: no [{TABLE}] table: expected the settings there")
+        return Config(path=path)
+    if not isinstance(table, dict):
+        raise InputError(f"{path}: {TABLE} = {table!r}: expected a table [{TABLE}]")
+    return Config(path=path, values=validate(table, path))
+
+
+def validate(table: dict, path: Path) -> dict:
+    """The table's values checked against :data:`KEYS`, paths made absolute; InputError otherwise."""
+    from wirecheck.core.scene import builtin_names, example_names
+
+    from .cases import CASE_NAMES
+
+    def bad(key, value, expected=None):
+        return InputError(f"{path}: [{TABLE}] {key} = {value!r}: expected {expected or KEYS[key]}")
+
+    def number(value) -> bool:
+        return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+    def strings(value) -> bool:
+        return isinstance(value, list) and bool(value) and all(isinstance(v, str) and v.strip() for v in value)
+
+    out = {}
+    base = path.parent
+    for key, value in table.items():
+        if key not in KEYS:
+            close = difflib.get_close_matches(key, KEYS, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise InputError(f"{path}: [{TABLE}] unknown key {key!r}{hint}: expected some of {', '.join(KEYS)}")
+        if key == "candidate":
+            if not isinstance(value, str) or ":" not in value:
+                raise bad(key, value)
+            target, func = value.rsplit(":", 1)
+            if target.endswith(".py") or "/" in target:
+                target = str((base / target).resolve())
+            out[key] = f"{target}:{func}"
+        elif key == "scenes":
+            if not strings(value):
+                raise bad(key, value)
+            known = set(builtin_names()) | set(example_names())
+            scenes = []
+            for name in value:
+                if "/" in name or "\\" in name or Path(name).suffix:
+                    scene_path = (base / name).resolve()
+                    if not scene_path.is_file():
+                        raise bad(key, value, f"existing scene files: {str(scene_path)!r} is not a file")
+                    scenes.append(str(scene_path))
+                elif name in known:
+                    scenes.append(name)
+                else:
+                    raise bad(key, value, f"built-in or example scenes ({', '.join(sorted(known))}) or "
+                                          f"paths: {name!r} is neither")
+            out[key] = scenes
+        elif key == "cases":
+            unknown = [c for c in value if c not in CASE_NAMES] if strings(value) else None
+            if unknown is None or unknown:
+                raise bad(key, value, f"a non-empty list of some of {', '.join(CASE_NAMES)}"
+                                      + (f" ({', '.join(map(repr, unknown))} unknown)" if unknown else ""))
+            out[key] = list(value)
+        elif key == "frames":
+            if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
+                raise bad(key, value)
+            out[key] = value
+        elif key in ("level", "oracles"):
+            from .runner import LEVELS, level_for_oracles
+
+            if "level" in out:
+                raise InputError(f"{path}: [{TABLE}] both level and oracles: expected one of them")
+            if key == "level":
+                if value not in LEVELS:
+                    raise bad(key, value)
+                out["level"] = value
+            else:
+                try:
+                    out["level"] = level_for_oracles(value) if strings(value) else None
+                except ValueError:
+                    out["level"] = None
+                if out["level"] is None:
+                    raise bad(key, value)
+        elif key == "tol-px":
+            if not (number(value) and value >= 0):
+                raise bad(key, value)
+            out[key] = float(value)
+        elif key in ("min-f1", "min-f1-0px"):
+            if not (number(value) and 0 <= value <= 1):
+                raise bad(key, value)
+            out[key] = float(value)
+        elif key == "spin":
+            if not (isinstance(value, list) and len(value) == 3 and all(number(v) for v in value)):
+                raise bad(key, value)
+            out[key] = tuple(float(v) for v in value)
+    return out
+
+
+#: crosscheck's argparse destination for each key.
+CLI_DESTS = {"candidate": "candidate", "scenes": "scene", "cases": "cases", "frames": "frames", "level": "level",
+             "tol-px": "tol_px", "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "spin"}
+
+
+def _cli_value(key: str, value):
+    """A validated value as crosscheck's parser would have produced it from the command line."""
+    if key == "cases":
+        return ",".join(value)
+    if key == "spin":
+        return ",".join(repr(v) for v in value)
+    return value
+
+
+class _Unset:
+    """Marks an option the command line did not give (argparse keeps a namespace's existing values)."""
+
+
+def parse_cli(parser, argv=None):
+    """crosscheck's arguments over ``[tool.wirecheck]``: ``(args, config, keys_applied)``.
+
+    An option given on the command line wins, then the table (``--config FILE``,
+    default the nearest pyproject.toml), then the parser's default. ``--suite``
+    uses none of the table (its cases are fixed), ``--sweep`` not its
+    candidate (the sweep runs core), and ``--level``/``--oracles`` on the
+    command line replace its ``level``/``oracles``. Raises InputError for a
+    bad table; argparse exits 2 for bad options.
+    """
+    import argparse
+
+    unset = _Unset()
+    dests = [d for d in (*CLI_DESTS.values(), "oracles") if d != "scene"]   # append actions need a list
+    args = parser.parse_args(argv, namespace=argparse.Namespace(**{d: unset for d in dests}))
+    given = {d for d in dests if getattr(args, d) is not unset} | ({"scene"} if args.scene is not None else set())
+    for d in dests:
+        if d not in given:
+            setattr(args, d, parser.get_default(d))
+    config = load_config(Path(args.config) if args.config else None)
+    applied = []
+    if args.suite:
+        return args, config, applied
+    for key, value in config.values.items():
+        dest = CLI_DESTS[key]
+        if dest in given or (key == "level" and "oracles" in given) or (key == "candidate" and args.sweep):
+            continue
+        setattr(args, dest, _cli_value(key, value))
+        applied.append(key)
+    return args, config, applied
