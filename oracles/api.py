@@ -46,16 +46,24 @@ def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("op
     return report
 
 
+def failure_text(report: dict) -> str | None:
+    """The diagnosis of a report's failing cases (faults, reasons, what to check); None when all pass."""
+    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    if not failing:
+        return None
+    lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
+    for c in failing:
+        lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'])}; "
+                     + "; ".join(c["reasons"]))
+    names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
+    lines += [f"  what to check, {n}: {FAULT_HINTS[n]}" for n in names]
+    return "\n".join(lines)
+
+
 def assert_projector(func, **kwargs) -> dict:
     """:func:`check_projector`, raising AssertionError with the diagnosis when any case fails."""
     report = check_projector(func, **kwargs)
-    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
-    if failing:
-        lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
-        for c in failing:
-            lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'])}; "
-                         + "; ".join(c["reasons"]))
-        names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
-        lines += [f"  what to check, {n}: {FAULT_HINTS[n]}" for n in names]
-        raise AssertionError("\n".join(lines))
+    text = failure_text(report)
+    if text is not None:
+        raise AssertionError(text)
     return report

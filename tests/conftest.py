@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import pytest
 
+# tests/test_pytest_plugin.py runs a user's pytest on a small project
+pytest_plugins = ["pytester"]
+
 _SECTIONS = pytest.StashKey[list]()
 
 

@@ -1,0 +1,148 @@
+"""The pytest plugin (entry point ``pytest11``): check a projector in a project's own tests.
+
+::
+
+    def test_my_projector(wirecheck):
+        wirecheck(my_project)      # my_project(p_world (N, 3), camera) -> p_px (N, 2)
+
+The ``wirecheck`` fixture is a function: ``wirecheck(projector=None, **settings)``
+runs :func:`wirecheck.oracles.api.check_projector` and returns its report
+dict; when a case fails, the test fails with the diagnosis (faults, reasons,
+what to check) and a traceback that ends at the test's own line: the
+harness's frames are hidden (``__tracebackhide__``). ``projector`` is a
+callable or a ``"FILE.py:FUNC"`` string; without it, the ``candidate`` of
+``[tool.wirecheck]``.
+
+Settings, the first given wins: the call's keywords (those of
+``check_projector``), the command line (``--wirecheck-frames N``,
+``--wirecheck-level vertices|pixels``), ``[tool.wirecheck]`` in the
+nearest ``pyproject.toml`` at or above pytest's rootdir, or
+``--wirecheck-config FILE`` (oracles.config), then ``check_projector``'s
+defaults. A bad table is a pytest usage error before any test runs.
+
+``--wirecheck-report DIR`` writes report.json, report.md and report.html
+(oracles.report) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
+for a test's later checks).
+
+Nothing heavy is imported until the fixture is called: the plugin loads in
+every pytest run of an environment where wirecheck is installed.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+_SETTINGS = pytest.StashKey[dict]()
+_CANDIDATE = pytest.StashKey[object]()
+_WRITTEN = pytest.StashKey[list]()
+
+
+def pytest_addoption(parser):
+    group = parser.getgroup("wirecheck", "wirecheck: crosscheck a projector (the wirecheck fixture)")
+    group.addoption("--wirecheck-report", metavar="DIR", default=None,
+                    help="write the report (report.json, report.md, report.html) of every failing wirecheck "
+                         "check to DIR/<test id> (default: no reports)")
+    group.addoption("--wirecheck-frames", metavar="N", type=int, default=None,
+                    help="frames per case, over [tool.wirecheck] frames (default: the table's, else 8)")
+    group.addoption("--wirecheck-level", choices=("vertices", "pixels"), default=None,
+                    help="vertices: OpenCV only; pixels: OpenCV and pyrender (default: the table's, "
+                         "else vertices)")
+    group.addoption("--wirecheck-config", metavar="FILE", default=None,
+                    help="read [tool.wirecheck] from FILE (default: the nearest pyproject.toml at or above "
+                         "the rootdir)")
+
+
+def pytest_configure(config):
+    from wirecheck.core.errors import InputError
+
+    from .config import load_config
+
+    opt = config.option
+    try:
+        explicit = getattr(opt, "wirecheck_config", None)
+        table = load_config(Path(explicit) if explicit else None, start=config.rootpath)
+        settings = table.api_kwargs()
+        if opt.wirecheck_frames is not None:
+            if opt.wirecheck_frames < 1:
+                raise InputError(f"--wirecheck-frames {opt.wirecheck_frames}: expected an integer >= 1")
+            settings["frames"] = opt.wirecheck_frames
+        if opt.wirecheck_level is not None:
+            settings["oracles"] = ("opencv",) if opt.wirecheck_level == "vertices" else ("opencv", "pyrender")
+        report = opt.wirecheck_report
+        if report is not None and (Path(report).exists() and not Path(report).is_dir()):
+            raise InputError(f"--wirecheck-report {report!r} is not a directory: expected a folder for the reports")
+    except InputError as exc:
+        raise pytest.UsageError(f"wirecheck: {exc}") from None
+    config.stash[_SETTINGS] = settings
+    config.stash[_CANDIDATE] = table.values.get("candidate")
+    config.stash[_WRITTEN] = []
+
+
+def report_name(nodeid: str) -> str:
+    """A folder name for a test id: runs of other characters become ``_``."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", nodeid).strip("._-") or "test"
+
+
+def _write(config, nodeid: str, index: int, report: dict) -> str:
+    """Write the report of a failing check; the line to add to the failure message."""
+    from wirecheck.core.errors import InputError
+
+    from .report import write_report
+
+    root = Path(config.option.wirecheck_report)
+    run_dir = root / (report_name(nodeid) + (f"-{index}" if index > 1 else ""))
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+        write_report(run_dir, report, {})
+    except (InputError, OSError) as exc:
+        return f"  report not written: {exc}"
+    config.stash[_WRITTEN].append(run_dir)
+    return f"  report: {run_dir / 'report.html'}"
+
+
+@pytest.fixture
+def wirecheck(request):
+    """``wirecheck(projector=None, **settings) -> report``: crosscheck ``projector``, failing the test on a fault.
+
+    ``settings`` are keywords of :func:`wirecheck.oracles.api.check_projector`
+    (scenes, cases, frames, oracles, tol_px, min_f1, min_f1_0px, turns); they
+    win over ``--wirecheck-*`` options and ``[tool.wirecheck]``.
+    """
+    config = request.config
+    calls = []
+
+    def check(projector=None, **settings):
+        __tracebackhide__ = True
+        from .api import check_projector, failure_text
+
+        projector = projector if projector is not None else config.stash[_CANDIDATE]
+        if projector is None:
+            pytest.fail("wirecheck(): no projector: expected wirecheck(func) or candidate = \"FILE.py:FUNC\" "
+                        "in [tool.wirecheck]", pytrace=False)
+        calls.append(projector)
+        error = None
+        try:
+            report = check_projector(projector, **{**config.stash[_SETTINGS], **settings})
+        except (ValueError, TypeError) as exc:   # InputError is a ValueError: a bad setting or projector spec
+            error = f"wirecheck: {type(exc).__name__}: {exc}"
+        if error is not None:                     # outside the except: no chained harness traceback
+            pytest.fail(error)
+        text = failure_text(report)
+        if text is not None:
+            if config.option.wirecheck_report is not None:
+                text += "\n" + _write(config, request.node.nodeid, len(calls), report)
+            pytest.fail(text)
+        return report
+
+    return check
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    written = config.stash.get(_WRITTEN, [])
+    if written:
+        terminalreporter.write_sep("-", "wirecheck")
+        terminalreporter.write_line(f"{len(written)} report(s) of failing checks under "
+                                    f"{config.option.wirecheck_report}")

@@ -1,0 +1,134 @@
+"""The pytest plugin (oracles/pytest_plugin.py), run as a user's pytest would load it: by its entry point.
+
+Each test builds a small user project with pytester and runs pytest on it in
+process; the plugin is never named with ``-p``, so the ``pytest11`` entry point
+is what loads it.
+"""
+
+import json
+from importlib.metadata import entry_points
+from pathlib import Path
+
+import pytest
+
+DATA = Path(__file__).parent / "data"
+
+MIRRORED = '''
+def mirrored(points, camera):
+    px = project(points, camera)
+    px[:, 0] = (camera.width - 1) - px[:, 0]
+    return px
+'''
+
+USER_TESTS = '''
+from user_projector import project, mirrored
+
+
+def test_good(wirecheck):
+    report = wirecheck(project, scenes=["cube"], frames=2, cases=["on_axis", "orthographic"])
+    assert report["verdict"] == "pass" and report["summary"]["cases"] == 2
+
+
+def test_mirrored(wirecheck):
+    wirecheck(mirrored, scenes=["cube"], frames=2, cases=["on_axis"])
+'''
+
+
+@pytest.fixture
+def project(pytester):
+    pytester.makepyfile(user_projector=(DATA / "user_projector.py").read_text() + MIRRORED)
+    pytester.syspathinsert()
+    return pytester
+
+
+def test_registered_through_the_pytest11_entry_point():
+    eps = {ep.name: ep.value for ep in entry_points(group="pytest11")}
+    assert eps.get("wirecheck") == "wirecheck.oracles.pytest_plugin"
+
+
+def test_pass_and_fail_with_the_fault_and_without_harness_frames(project):
+    project.makepyfile(test_user=USER_TESTS)
+    result = project.runpytest()
+    result.assert_outcomes(passed=1, failed=1)
+    out = result.stdout.str()
+    # the user's own line is the traceback, then the diagnosis
+    result.stdout.fnmatch_lines([
+        ">       wirecheck(mirrored, scenes=[[]\"cube\"[]], frames=2, cases=[[]\"on_axis\"[]])",
+        "E       Failed: 1 of 1 crosscheck cases failed for mirrored:",
+        "E         cube / on_axis: faults: mirror_horizontal; max vertex error * px > 1e-06 px *",
+        "E         what to check, mirror_horizontal: left and right are exchanged*",
+        "test_user.py:10: Failed",
+    ])
+    for harness in ("pytest_plugin.py", "oracles/api.py", "oracles/runner.py", "During handling"):
+        assert harness not in out
+
+
+def test_settings_come_from_the_table_then_the_command_line_then_the_call(project):
+    project.makepyprojecttoml('[tool.wirecheck]\ncandidate = "user_projector.py:project"\nscenes = ["prism"]\n'
+                              'cases = ["near_plane", "wide_fov"]\nframes = 2\nlevel = "vertices"\n')
+    project.makepyfile(test_user='''
+def test_table(wirecheck, request):
+    report = wirecheck()                 # the table's candidate, scenes, cases
+    frames = request.config.getoption("wirecheck_frames") or 2
+    assert [(c["scene"], c["camera"]) for c in report["cases"]] == [("prism", "near_plane"), ("prism", "wide_fov")]
+    assert (report["frames"], report["level"]) == (frames, "vertices")
+
+
+def test_call_wins(wirecheck):
+    report = wirecheck(frames=4, cases=["orthographic"])
+    assert report["frames"] == 4 and [c["camera"] for c in report["cases"]] == ["orthographic"]
+''')
+    project.runpytest().assert_outcomes(passed=2)
+    project.runpytest("--wirecheck-frames", "3").assert_outcomes(passed=2)
+
+
+@pytest.mark.parametrize("table, needle", [
+    ("frame = 2\n", "unknown key 'frame' (did you mean 'frames'?)"),
+    ("cases = []\n", "cases = []: expected a non-empty list"),
+    ("frames = 0\n", "frames = 0: expected an integer >= 1"),
+])
+def test_a_bad_table_is_a_usage_error_before_any_test(project, table, needle):
+    path = project.makepyprojecttoml("[tool.wirecheck]\n" + table)
+    project.makepyfile(test_user=USER_TESTS)
+    result = project.runpytest()
+    assert result.ret == pytest.ExitCode.USAGE_ERROR
+    assert f"wirecheck: {path}: [tool.wirecheck] {needle}" in result.stderr.str()
+
+
+def test_zero_frames_on_the_command_line_is_a_usage_error(project):
+    project.makepyfile(test_user=USER_TESTS)
+    result = project.runpytest("--wirecheck-frames", "0")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR and "--wirecheck-frames 0" in result.stderr.str()
+
+
+def test_report_option_writes_the_report_of_each_failing_check(project):
+    project.makepyfile(test_user=USER_TESTS + '''
+
+def test_two_checks(wirecheck):
+    try:
+        wirecheck(mirrored, scenes=["cube"], frames=2, cases=["wide_fov"])
+    except BaseException:
+        pass
+    wirecheck(mirrored, scenes=["pyramid"], frames=2, cases=["oblique_roll"])
+''')
+    result = project.runpytest("--wirecheck-report", "reports")
+    result.assert_outcomes(passed=1, failed=2)
+    root = project.path / "reports"
+    assert sorted(p.name for p in root.iterdir()) == [
+        "test_user.py_test_mirrored", "test_user.py_test_two_checks", "test_user.py_test_two_checks-2"]
+    expected = {"test_user.py_test_mirrored": ("cube", "on_axis"), "test_user.py_test_two_checks": ("cube", "wide_fov"),
+                "test_user.py_test_two_checks-2": ("pyramid", "oblique_roll")}
+    for name, (scene, camera) in expected.items():
+        report = json.loads((root / name / "report.json").read_text())
+        case = report["cases"][0]
+        assert (case["scene"], case["camera"], case["faults"][0]["name"]) == (scene, camera, "mirror_horizontal")
+        assert (root / name / "report.html").is_file()
+    result.stdout.fnmatch_lines(["E         report: reports/test_user.py_test_mirrored/report.html",
+                                 "3 report(s) of failing checks under reports"])
+
+
+def test_no_projector_anywhere_fails_the_test(project):
+    project.makepyfile(test_user="def test_it(wirecheck):\n    wirecheck()\n")
+    result = project.runpytest()
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines(["*wirecheck(): no projector*"])
