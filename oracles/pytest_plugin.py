@@ -5,7 +5,7 @@
     def test_my_projector(wirecheck):
         wirecheck(my_project)      # my_project(p_world (N, 3), camera) -> p_px (N, 2)
 
-The ``wirecheck`` fixture is a function: ``wirecheck(projector=None, **settings)``
+The ``wirecheck`` fixture is callable (:class:`Check`): ``wirecheck(projector=None, **settings)``
 runs :func:`wirecheck.oracles.api.check_projector` and returns its report
 dict; when a case fails, the test fails with the diagnosis (faults, reasons,
 what to check) and a traceback that ends at the test's own line: the
@@ -103,26 +103,34 @@ def _write(config, nodeid: str, index: int, report: dict) -> str:
     return f"  report: {run_dir / 'report.html'}"
 
 
-@pytest.fixture
-def wirecheck(request):
-    """``wirecheck(projector=None, **settings) -> report``: crosscheck ``projector``, failing the test on a fault.
+class Check:
+    """The ``wirecheck`` fixture's value: ``check(projector=None, **settings) -> report``.
 
-    ``settings`` are keywords of :func:`wirecheck.oracles.api.check_projector`
-    (scenes, cases, frames, oracles, tol_px, min_f1, min_f1_0px, turns); they
-    win over ``--wirecheck-*`` options and ``[tool.wirecheck]``.
+    Crosschecks ``projector`` and fails the test with the diagnosis when a case
+    fails. ``settings`` are keywords of
+    :func:`wirecheck.oracles.api.check_projector` (scenes, cases, frames,
+    oracles, tol_px, min_f1, min_f1_0px, turns); they win over the
+    ``--wirecheck-*`` options and ``[tool.wirecheck]``.
     """
-    config = request.config
-    calls = []
 
-    def check(projector=None, **settings):
+    def __init__(self, config, nodeid: str):
+        self._config = config
+        self._nodeid = nodeid
+        self._calls = 0
+
+    def __repr__(self) -> str:
+        return f"<wirecheck fixture of {self._nodeid}>"
+
+    def __call__(self, projector=None, **settings) -> dict:
         __tracebackhide__ = True
         from .api import check_projector, failure_text
 
+        config = self._config
         projector = projector if projector is not None else config.stash[_CANDIDATE]
         if projector is None:
             pytest.fail("wirecheck(): no projector: expected wirecheck(func) or candidate = \"FILE.py:FUNC\" "
                         "in [tool.wirecheck]", pytrace=False)
-        calls.append(projector)
+        self._calls += 1
         error = None
         try:
             report = check_projector(projector, **{**config.stash[_SETTINGS], **settings})
@@ -133,11 +141,18 @@ def wirecheck(request):
         text = failure_text(report)
         if text is not None:
             if config.option.wirecheck_report is not None:
-                text += "\n" + _write(config, request.node.nodeid, len(calls), report)
+                text += "\n" + _write(config, self._nodeid, self._calls, report)
             pytest.fail(text)
         return report
 
-    return check
+
+@pytest.fixture
+def wirecheck(request) -> Check:
+    """``wirecheck(projector=None, **settings) -> report``: crosscheck ``projector``, failing the test on a fault.
+
+    See :class:`Check`.
+    """
+    return Check(request.config, request.node.nodeid)
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
