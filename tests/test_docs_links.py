@@ -16,9 +16,6 @@ ROOT = Path(__file__).resolve().parent.parent
 #: set when they are merged (an entry whose file exists is an error, so it cannot go stale).
 PENDING = {
     "docs/layout.md",
-    "docs/install.md",
-    "docs/pytest.md",
-    "docs/ci-workflow.md",
 }
 
 _LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(([^()\s]+)(?:\s+\"[^\"]*\")?\)")
