@@ -47,10 +47,12 @@ def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("op
 
 
 def failure_text(report: dict) -> str | None:
-    """The diagnosis of a report's failing cases (faults, reasons, what to check); None when all pass."""
+    """The diagnosis of a report's failing cases (faults, reasons, what to check); None when its verdict is pass."""
     failing = [c for c in report["cases"] if c["verdict"] != "pass"]
     if not failing:
-        return None
+        if report["verdict"] == "pass":
+            return None
+        return f"crosscheck of {report['candidate']}: verdict {report['verdict']} with no failing case"
     lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
     for c in failing:
         lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'])}; "

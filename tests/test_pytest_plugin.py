@@ -21,7 +21,7 @@ def mirrored(points, camera):
 '''
 
 USER_TESTS = '''
-from user_projector import project, mirrored
+from my_projection import project, mirrored
 
 
 def test_good(wirecheck):
@@ -36,7 +36,8 @@ def test_mirrored(wirecheck):
 
 @pytest.fixture
 def project(pytester):
-    pytester.makepyfile(user_projector=(DATA / "user_projector.py").read_text() + MIRRORED)
+    # not "user_projector": other tests import tests/data/user_projector.py under that name
+    pytester.makepyfile(my_projection=(DATA / "user_projector.py").read_text() + MIRRORED)
     pytester.syspathinsert()
     return pytester
 
@@ -64,7 +65,7 @@ def test_pass_and_fail_with_the_fault_and_without_harness_frames(project):
 
 
 def test_settings_come_from_the_table_then_the_command_line_then_the_call(project):
-    project.makepyprojecttoml('[tool.wirecheck]\ncandidate = "user_projector.py:project"\nscenes = ["prism"]\n'
+    project.makepyprojecttoml('[tool.wirecheck]\ncandidate = "my_projection.py:project"\nscenes = ["prism"]\n'
                               'cases = ["near_plane", "wide_fov"]\nframes = 2\nlevel = "vertices"\n')
     project.makepyfile(test_user='''
 def test_table(wirecheck, request):
@@ -132,3 +133,14 @@ def test_no_projector_anywhere_fails_the_test(project):
     result = project.runpytest()
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines(["*wirecheck(): no projector*"])
+
+
+def test_a_report_that_did_not_pass_is_never_silent():
+    from wirecheck.oracles.api import failure_text
+
+    # hand-made reports: the fixture fails whenever failure_text is not None
+    case = {"scene": "cube", "camera": "on_axis", "verdict": "pass", "faults": [], "reasons": []}
+    assert failure_text({"candidate": "f", "verdict": "pass", "cases": [case]}) is None
+    assert failure_text({"candidate": "f", "verdict": "fail", "cases": [case]}) == \
+        "crosscheck of f: verdict fail with no failing case"
+    assert failure_text({"candidate": "f", "verdict": "fail", "cases": []}) is not None
