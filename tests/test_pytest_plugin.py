@@ -144,3 +144,22 @@ def test_a_report_that_did_not_pass_is_never_silent():
     assert failure_text({"candidate": "f", "verdict": "fail", "cases": [case]}) == \
         "crosscheck of f: verdict fail with no failing case"
     assert failure_text({"candidate": "f", "verdict": "fail", "cases": []}) is not None
+
+
+def test_report_option_on_a_file_is_a_usage_error_and_the_file_is_kept(project):
+    project.makepyfile(test_user=USER_TESTS)
+    (project.path / "notes.txt").write_text("mine\n")
+    result = project.runpytest("--wirecheck-report", "notes.txt")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR and "is not a directory" in result.stderr.str()
+    assert (project.path / "notes.txt").read_text() == "mine\n"
+
+
+def test_a_report_folder_not_written_by_wirecheck_is_left_alone(project):
+    project.makepyfile(test_user=USER_TESTS)
+    theirs = project.path / "reports" / "test_user.py_test_mirrored"
+    theirs.mkdir(parents=True)
+    (theirs / "keep.txt").write_text("mine\n")
+    result = project.runpytest("--wirecheck-report", "reports")
+    result.assert_outcomes(passed=1, failed=1)
+    result.stdout.fnmatch_lines(["E         report not written: *not written by wirecheck*"])
+    assert [p.name for p in theirs.iterdir()] == ["keep.txt"] and (theirs / "keep.txt").read_text() == "mine\n"
