@@ -82,3 +82,15 @@ def test_missing_folder_is_refused_before_the_run(tmp_path, capsys):
     code = cli.main(["--report-dir", str(tmp_path / "out"), "--junit-xml", str(tmp_path / "no" / "j.xml"),
                      "--level", "vertices", "--scene", "cube"])
     assert code == 2 and "folder" in capsys.readouterr().err and not (tmp_path / "out").exists()
+
+
+def test_same_inputs_same_bytes_apart_from_time(tmp_path):
+    import re
+
+    runs = []
+    for name in ("a.xml", "b.xml"):
+        code, path = _run(tmp_path, "--scene", "cube", "--cases", "on_axis,wide_fov",
+                          "--candidate", f"{DATA / 'faulty_projectors.py'}:mirrored", junit=name)
+        assert code == 1
+        runs.append(re.sub(rb' time="[0-9.]+"', b' time="T"', path.read_bytes()))
+    assert runs[0] == runs[1] and runs[0].count(b' time="T"') == 4     # testsuites, testsuite, 2 testcases
