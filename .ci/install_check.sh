@@ -10,7 +10,8 @@ set -euo pipefail
 CHECKOUT="$(cd "$(dirname "$0")/.." && pwd -P)"
 PY="${PYTHON:-python3}"
 WORK="$(cd "$(mktemp -d "${TMPDIR:-/tmp}/wirecheck-install.XXXXXX")" && pwd -P)"
-trap 'step "removing $WORK"; rm -rf "$WORK"' EXIT
+# kept when a step failed (its outputs are the evidence), removed otherwise
+trap 'rc=$?; if [ "$rc" != 0 ]; then step "failed: $WORK kept"; else step "removing $WORK"; rm -rf "$WORK"; fi' EXIT
 t0=$SECONDS
 
 fail() { echo "install_check: FAIL: $*" >&2; exit 1; }
