@@ -13,7 +13,7 @@ its pyrender oracle) skips; the table gives what the stage would add per frame
 ``skipped / (run + skipped)``:
 
 * faces: the renderer's frame loop (``localize`` once, then
-  ``render_frame(points, scene.edges, ...)`` as ``core.cli.render_run`` calls
+  ``render_frame(points, scene.edges, ...)`` as ``core.run.render_run`` calls
   it) on a Scene with faces and on the same Scene without: the same work, so
   the same time within noise (checked). The skipped cost is per-face normals
   and the back-face test in numpy, from the frame's camera-space vertices.

@@ -144,3 +144,16 @@ def look_at(position, target, up=(0.0, 1.0, 0.0), **kwargs) -> Camera:
 def camera_z(distance: float, **kwargs) -> Camera:
     """The ``--camera-z D`` shortcut: at (0, 0, D) looking at the origin, up +Y."""
     return look_at((0.0, 0.0, float(distance)), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), **kwargs)
+
+
+def orthographic_twin(camera: Camera, distance: float) -> Camera:
+    """An orthographic camera with ``camera``'s pose and ``ortho_height = 2 d tan(fov_y / 2)``.
+
+    At depth ``d`` a perspective camera sees ``2 d tan(fov_y / 2)`` world units
+    vertically, so an object at the look-at distance ``d`` has the same size in
+    pixels in both pictures (nearer things are bigger only in perspective).
+    """
+    height = 2.0 * distance * math.tan(math.radians(camera.fov_y_deg) / 2.0)
+    return Camera(position=camera.position, forward=camera.forward, up=camera.up, fov_y_deg=camera.fov_y_deg,
+                  width=camera.width, height=camera.height, near=camera.near, far=camera.far,
+                  projection="orthographic", ortho_height=height)

@@ -18,6 +18,12 @@ projected coordinate can overflow, the four sides of the image, written
 linearly in camera space (for perspective, ``x_px >= -0.5`` is
 ``f x + (cx + 0.5) z >= 0``, valid once z > 0 is guaranteed by the near plane,
 which is therefore clipped first).
+
+Triangles (:func:`clip_triangles`, for the depth buffer of core.zbuffer) are
+clipped against one plane at a time by Sutherland-Hodgman: a triangle with 3
+vertices inside is kept, with 0 dropped, with 1 inside cut to one triangle,
+with 2 inside cut to a quad split along a diagonal (0-2 triangles out per
+triangle in, winding kept).
 """
 
 from __future__ import annotations
@@ -25,6 +31,10 @@ from __future__ import annotations
 import numpy as np
 
 from .camera import Camera
+
+#: How edges crossing near or far are handled: "clip" cuts them at the plane,
+#: "endpoint" drops an edge with an end outside [near, far].
+CLIP_MODES = ("clip", "endpoint")
 
 
 def frustum_planes(camera: Camera, guard_px: float = 0.0, sides: bool = True) -> np.ndarray:
@@ -122,3 +132,107 @@ def clip_to_image(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
         q0 = p0_px[kept] + t0[kept, None] * d[kept]
         q1 = p0_px[kept] + t1[kept, None] * d[kept]
     return kept, q0, q1
+
+
+# ---- triangles ----------------------------------------------------------------
+
+def clip_triangles(tri_cam: np.ndarray, planes, src: np.ndarray | None = None,
+                   snap_z: list | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Clip ``(T, 3, 3)`` camera-space triangles against half-spaces ``n . p + d >= 0``.
+
+    Sutherland-Hodgman, one plane at a time; per plane a triangle gives 0
+    (all vertices outside), 1 (all inside, or one inside) or 2 (two inside: a
+    quad, split along a diagonal) triangles, in the winding of the input. A
+    vertex on the plane (distance 0) is inside; pieces of zero area (a
+    triangle touching the plane from outside) are dropped, as are triangles
+    with a non-finite coordinate.
+
+    Parameters
+    ----------
+    tri_cam : (T, 3, 3) array
+    planes : (P, 4) array of ``[nx, ny, nz, d]``
+    src : (T,) intp, optional
+        Source index of each input triangle (default ``arange(T)``).
+    snap_z : list of (P,) float or None, optional
+        For each plane, a depth to set exactly on the vertices it creates (the
+        near/far planes: no rounding can put a clipped vertex at z < near).
+
+    Returns
+    -------
+    tri : (T', 3, 3) float64, in order of ``src``
+    src : (T',) intp, the input triangle each output triangle came from.
+    """
+    tri = np.asarray(tri_cam, dtype=np.float64).reshape(-1, 3, 3)
+    src = np.arange(len(tri), dtype=np.intp) if src is None else np.asarray(src, dtype=np.intp)
+    finite = np.isfinite(tri).all(axis=(1, 2))
+    if not finite.all():
+        tri, src = tri[finite], src[finite]
+    planes = np.asarray(planes, dtype=np.float64).reshape(-1, 4)
+    for p, plane in enumerate(planes):
+        z_new = None if snap_z is None else snap_z[p]
+        tri, src = _clip_plane(tri, src, plane[:3], plane[3], z_new)
+    order = np.argsort(src, kind="stable")
+    return tri[order], src[order]
+
+
+def _clip_plane(tri, src, n, d, z_new):
+    dist = tri @ n + d                                   # (T, 3)
+    inside = dist >= 0
+    count = inside.sum(axis=1)
+    if count.min(initial=3) == 3:
+        return tri, src
+    out_tri = [tri[count == 3]]
+    out_src = [src[count == 3]]
+    rot = np.arange(3)
+
+    def rotated(mask, first):
+        # vertices rotated so that vertex `first` comes first (winding kept)
+        idx = (first[:, None] + rot[None, :]) % 3
+        t = np.take_along_axis(tri[mask], idx[:, :, None], axis=1)
+        dd = np.take_along_axis(dist[mask], idx, axis=1)
+        return t, dd
+
+    def cut(p_in, d_in, p_out, d_out):
+        # point where the edge from an inside vertex to an outside one meets the plane
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = d_in / (d_in - d_out)
+        q = p_in + t[:, None] * (p_out - p_in)
+        if z_new is not None:
+            q[:, 2] = z_new
+        return q
+
+    # A piece with a vertex on the plane (distance 0) that would repeat that
+    # vertex has zero area and is not emitted.
+    one = count == 1                                     # A inside, B and C outside
+    if one.any():
+        t, dd = rotated(one, np.argmax(inside[one], axis=1))
+        a, b, c = t[:, 0], t[:, 1], t[:, 2]
+        keep = dd[:, 0] > 0                              # A on the plane: nothing left
+        out_tri.append(np.stack([a, cut(a, dd[:, 0], b, dd[:, 1]),
+                                 cut(a, dd[:, 0], c, dd[:, 2])], axis=1)[keep])
+        out_src.append(src[one][keep])
+    two = count == 2                                     # O outside, B and C inside
+    if two.any():
+        t, dd = rotated(two, np.argmin(inside[two], axis=1))
+        o, b, c = t[:, 0], t[:, 1], t[:, 2]
+        p_ob = cut(b, dd[:, 1], o, dd[:, 0])             # == b when b is on the plane
+        p_co = cut(c, dd[:, 2], o, dd[:, 0])             # == c when c is on the plane
+        k1, k2 = dd[:, 1] > 0, dd[:, 2] > 0
+        out_tri.append(np.stack([p_ob, b, c], axis=1)[k1])
+        out_tri.append(np.stack([p_ob, c, p_co], axis=1)[k2])
+        out_src += [src[two][k1], src[two][k2]]
+    return np.concatenate(out_tri), np.concatenate(out_src)
+
+
+def clip_triangles_near(tri_cam: np.ndarray, near: float, far: float | None = None
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """Clip triangles to ``z >= near`` (and ``z <= far`` when given); see :func:`clip_triangles`.
+
+    Returns ``(tri (T', 3, 3), src (T',))``; new vertices lie exactly on the plane.
+    """
+    planes = [[0.0, 0.0, 1.0, -float(near)]]
+    snap = [float(near)]
+    if far is not None:
+        planes.append([0.0, 0.0, -1.0, float(far)])
+        snap.append(float(far))
+    return clip_triangles(tri_cam, planes, snap_z=snap)

@@ -92,8 +92,8 @@ def measure(image: np.ndarray, row: int) -> dict | None:
 
 
 def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
-    """Render the four views; return (report, 2x2 picture). ``s`` is core.cli's Settings."""
-    from .cli import FrameRenderer, picture, side_by_side   # the renderer's own frame set-up
+    """Render the four views; return (report, 2x2 picture). ``s`` is the run's core.run.Settings."""
+    from .compose import picture, side_by_side
 
     from .scene import world_points
 
@@ -110,8 +110,8 @@ def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
         for fov in fovs:
             cam = camera_z(d, fov_y_deg=fov, width=s.camera.width, height=s.camera.height,
                            near=s.camera.near, far=s.camera.far)
-            frame, _ = FrameRenderer(replace(s, camera=cam, ortho_camera=None)).render(1, cam)
-            img = picture(frame, s)
+            frame, _ = replace(s, camera=cam, ortho_camera=None).scene_renderer().render(1, cam)
+            img = picture(frame, s.style)
             pics.append(img)
             m = measure(img, row)
             p = predicted(d, fov, s.camera.height, box)

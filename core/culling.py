@@ -41,8 +41,13 @@ import numpy as np
 from .camera import Camera
 from .clipping import frustum_planes
 
-__all__ = ["triangulate", "face_of_triangle", "directed_edges", "winding_problem", "backface_keep",
-           "sphere_outside_frustum"]
+__all__ = ["CULL_MODES", "CULL_CHOICES", "triangulate", "face_of_triangle", "directed_edges",
+           "winding_problem", "backface_keep", "sphere_outside_frustum"]
+
+#: Back-face culling of render_frame: None (off) or "backface".
+CULL_MODES = (None, "backface")
+#: The same, as the command lines spell them ("none": off).
+CULL_CHOICES = tuple("none" if m is None else m for m in CULL_MODES)
 
 
 def _fan(faces) -> tuple[np.ndarray, np.ndarray]:

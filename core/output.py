@@ -7,6 +7,7 @@ Frames go to a temporary directory that is renamed when the run finishes.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import shutil
@@ -57,8 +58,6 @@ def png_bytes(image: np.ndarray) -> bytes:
     """
     if image.ndim == 2 and image.dtype == np.uint8 and not ((image + np.uint8(1)) & np.uint8(0xFE)).any():
         return bilevel_png_bytes(image)       # (v + 1) & 0xFE is 0 exactly for v in {0, 255}
-    import io
-
     from PIL import Image
 
     buf = io.BytesIO()
@@ -110,7 +109,7 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
     return "\n".join(lines) + "\n"
 
 
-def gif_bytes(images: list[np.ndarray], fps: float = 30.0) -> bytes:
+def gif_bytes(images: list[np.ndarray], fps: float = 30.0, progress=None) -> bytes:
     """An animated GIF (looping, ``fps`` frames per second, rounded to whole ms per frame).
 
     Grey frames use a grey palette; RGB frames (``--axes``) an adaptive
@@ -118,22 +117,34 @@ def gif_bytes(images: list[np.ndarray], fps: float = 30.0) -> bytes:
     GIF delays are in 1/100 s, so 30 fps plays at 1/0.03 = 33.3 fps. Pillow
     stores consecutive identical frames as one frame with their summed delay
     (a scene that does not move gives a one-frame GIF of the same duration).
+    ``progress()`` is called once per frame converted and once per frame
+    written (fewer when frames merge).
     """
-    import io
-
     from PIL import Image
+
+    tick = progress or (lambda: None)
 
     def to_p(im):
         pic = Image.fromarray(np.ascontiguousarray(im))
         if pic.mode == "RGB":
-            return pic.convert("P", palette=Image.Palette.ADAPTIVE, colors=256, dither=Image.Dither.NONE)
-        return pic.convert("P")
+            pic = pic.convert("P", palette=Image.Palette.ADAPTIVE, colors=256, dither=Image.Dither.NONE)
+        else:
+            pic = pic.convert("P")
+        tick()
+        return pic
 
-    frames = [to_p(im) for im in images]
-    buf = io.BytesIO()
-    if frames:
-        frames[0].save(buf, format="GIF", save_all=True, append_images=frames[1:],
-                       duration=int(round(1000.0 / fps)), loop=0, optimize=False)
+    class Counting(io.BytesIO):
+        """Calls ``tick`` at each frame Pillow writes (each starts with a graphic control extension)."""
+
+        def write(self, data):
+            if bytes(data[:2]) == b"!\xf9":
+                tick()
+            return super().write(data)
+
+    buf = Counting()
+    if images:
+        to_p(images[0]).save(buf, format="GIF", save_all=True, append_images=(to_p(im) for im in images[1:]),
+                             duration=int(round(1000.0 / fps)), loop=0, optimize=False)
     return buf.getvalue()
 
 
@@ -223,8 +234,6 @@ class Mp4Writer:
 
 def mp4_bytes(images: list[np.ndarray], fps: int = 30) -> bytes:
     """The MP4 of ``images`` as bytes (:class:`Mp4Writer` into memory)."""
-    import io
-
     buf = io.BytesIO()
     writer = Mp4Writer(buf, fps)
     for im in images:

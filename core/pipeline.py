@@ -21,12 +21,13 @@ import numpy as np
 
 from . import clipping, culling, raster, shading, zbuffer
 from .camera import Camera
+from .clipping import CLIP_MODES
+from .culling import CULL_MODES
+from .hidden_lines import SLOPE_FACTOR, line_samples, visible_line_samples
 from .projection import LocalPoints, cam_to_px, depth_mask, localize, model_to_cam, resolve_dtype
+from .raster import RASTER_MODES
+from .shading import STYLES
 
-CLIP_MODES = ("clip", "endpoint")
-RASTER_MODES = ("exact", "fast", "aa")
-STYLES = ("wireframe", "shaded")
-CULL_MODES = (None, "backface")
 #: The stages :func:`render_frame` times when given a ``timing`` dict, in pipeline order:
 #: transform (model -> camera -> pixels, depth test), faces (triangulate, cull,
 #: z-buffer), shading, clip (edges against the frustum and the image), raster
@@ -357,9 +358,8 @@ def _edges_of_kept_faces(edges: np.ndarray, faces, face_kept: np.ndarray, n: int
 def _paint_visible(image, seg0_px, seg1_px, ends, mode, depth, tri_buf, grad, camera) -> int:
     """Paint the line pixels not hidden by the depth buffer; return the number of hidden pixels."""
     h, w = image.shape
-    seg, rr, cc, weight = zbuffer.line_samples(seg0_px, seg1_px, w, h, mode)
-    vis = zbuffer.visible_line_samples(seg, rr, cc, *ends, depth, tri_buf, grad, camera,
-                                       zbuffer.SLOPE_FACTOR[mode])
+    seg, rr, cc, weight = line_samples(seg0_px, seg1_px, w, h, mode)
+    vis = visible_line_samples(seg, rr, cc, *ends, depth, tri_buf, grad, camera, SLOPE_FACTOR[mode])
     all_px = np.unique(rr * w + cc)
     shown = np.unique(rr[vis] * w + cc[vis])
     if mode == "aa":

@@ -87,6 +87,11 @@ RASTER_MODES = ("exact", "fast", "aa")
 #: Sub-pixel grid (1/256 px): llvmpipe's fixed-point precision for vertex positions.
 SUBPIXEL = 256.0
 
+
+def snap_subpixel(p_px: np.ndarray) -> np.ndarray:
+    """Coordinates rounded to the :data:`SUBPIXEL` grid (float64)."""
+    return np.round(p_px * SUBPIXEL) / SUBPIXEL
+
 #: Segments rasterized per batch. Keeps the per-sample temporaries small (a few
 #: hundred kB): one batch of 100k+ segments makes tens of MB of temporaries that
 #: glibc maps and unmaps on every frame, and the page faults cost as much as
@@ -112,8 +117,8 @@ def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     rr, cc : (K,) ndarray of intp
         Row and column of each drawn pixel.
     """
-    p0_px = np.round(np.asarray(p0_px, dtype=np.float64).reshape(-1, 2) * SUBPIXEL) / SUBPIXEL
-    p1_px = np.round(np.asarray(p1_px, dtype=np.float64).reshape(-1, 2) * SUBPIXEL) / SUBPIXEL
+    p0_px = snap_subpixel(np.asarray(p0_px, dtype=np.float64).reshape(-1, 2))
+    p1_px = snap_subpixel(np.asarray(p1_px, dtype=np.float64).reshape(-1, 2))
     if len(p0_px) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
@@ -213,13 +218,14 @@ def line_pixels_fast(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: i
     if len(p0) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
-    return _batched(_line_pixels_fast, _round_half_up(p0), _round_half_up(p1), width, height)
+    return _batched(_line_pixels_fast, round_half_up(p0).astype(np.int64), round_half_up(p1).astype(np.int64),
+                    width, height)
 
 
-def _round_half_up(v: np.ndarray) -> np.ndarray:
-    """``floor(v + 1/2)`` as int64, exactly: ``v + 0.5`` itself can round up (0.49999999999999994 + 0.5 == 1.0)."""
+def round_half_up(v: np.ndarray) -> np.ndarray:
+    """``floor(v + 1/2)`` (float64), exactly: ``v + 0.5`` itself can round up (0.49999999999999994 + 0.5 == 1.0)."""
     r = np.floor(v)
-    return (r + (v - r >= 0.5)).astype(np.int64)           # v - floor(v) is exact
+    return r + (v - r >= 0.5)                              # v - floor(v) is exact
 
 
 def _line_pixels_fast(q0: np.ndarray, q1: np.ndarray, width: int, height: int
@@ -300,8 +306,8 @@ def _line_coverage_aa(p0: np.ndarray, p1: np.ndarray, width: int, height: int
         slope = np.where(da > 0, (b_hi - b_lo) / da, 0.0)    # |slope| <= 1
     # pixels lo..hi: those whose interval [i - 1/2, i + 1/2] overlaps [a_lo, a_hi]
     # in more than a point (an end on a pixel boundary does not reach past it)
-    lo = _round_half_up(a_lo)                  # floor(a_lo + 1/2)
-    hi = -_round_half_up(-a_hi)                # ceil(a_hi - 1/2)
+    lo = round_half_up(a_lo).astype(np.int64)     # floor(a_lo + 1/2)
+    hi = -round_half_up(-a_hi).astype(np.int64)  # ceil(a_hi - 1/2)
     count = np.maximum(hi - lo + 1, 0)
     seg = np.repeat(np.arange(len(count)), count)
     i = lo[seg] + (np.arange(int(count.sum()), dtype=np.int64) - np.repeat(np.cumsum(count) - count, count))

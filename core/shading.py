@@ -23,7 +23,10 @@ import numpy as np
 
 from .camera import Camera
 
-__all__ = ["DEFAULT_AMBIENT", "default_light_dir", "face_intensity", "shade"]
+__all__ = ["STYLES", "DEFAULT_AMBIENT", "default_light_dir", "face_intensity", "shade"]
+
+#: What a frame shows: the edges, or the faces flat-shaded.
+STYLES = ("wireframe", "shaded")
 
 DEFAULT_AMBIENT = 0.15
 

@@ -247,17 +247,17 @@ class Viewer:
     # ---- output
     def frame_png(self, v: View, timing: dict | None = None):
         """``(png bytes, Frame, settings)`` of view ``v``: exactly what ``renderer`` writes for its command line."""
-        from .cli import FrameRenderer, axis_layers, overlay, picture   # the renderer's own frame set-up
+        from .compose import overlay, picture
 
         s = self.settings(v)
         key = (s.style, s.hidden_lines, s.cull)
         if key not in self._renderers:
-            self._renderers[key] = FrameRenderer(s)
+            self._renderers[key] = s.scene_renderer()             # the renderer's own frame set-up
         frame, _ = self._renderers[key].render(v.frame, s.camera, timing=timing)
         t1 = time.perf_counter()
-        img = picture(frame, s)
+        img = picture(frame, s.style)
         if s.axes:
-            img = overlay(img, axis_layers(s, s.camera, frame))
+            img = overlay(img, s.axis_layers(s.camera, frame))
         t2 = time.perf_counter()
         png = output.png_bytes(img)
         t3 = time.perf_counter()

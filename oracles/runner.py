@@ -64,7 +64,8 @@ from typing import ClassVar
 import numpy as np
 
 from wirecheck.core.scene import Scene
-from wirecheck.core.pipeline import CLIP_MODES, RASTER_MODES
+from wirecheck.core.clipping import CLIP_MODES
+from wirecheck.core.raster import RASTER_MODES
 from wirecheck.core.projection import DTYPES
 from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 

@@ -34,8 +34,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wirecheck.core.pipeline import CLIP_MODES, RASTER_MODES, render_frame
+from wirecheck.core.clipping import CLIP_MODES
+from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import DTYPES, localize
+from wirecheck.core.raster import RASTER_MODES
 from wirecheck.core.scene import Scene, face_edges, unique_edges, world_points
 from wirecheck.core.transforms import Motion
 

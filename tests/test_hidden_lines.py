@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wirecheck.core import pipeline, raster, zbuffer
+from wirecheck.core import hidden_lines, pipeline, raster, zbuffer
 from wirecheck.core.camera import look_at
 from wirecheck.core.pipeline import render_frame
 from wirecheck.oracles.metrics import pixel_scores
@@ -38,7 +38,7 @@ def test_line_samples_are_core_raster_pixels_per_segment(mode):
     p1 = rng.uniform(-0.5, [w - 0.5, h - 0.5], size=(400, 2))
     p0[:100], p1[:100] = np.round(p0[:100] * 2) / 2, np.round(p1[:100] * 2) / 2   # ties
     p1[100:120] = p0[100:120]                                                    # zero length
-    seg, rr, cc, weight = zbuffer.line_samples(p0, p1, w, h, mode)
+    seg, rr, cc, weight = hidden_lines.line_samples(p0, p1, w, h, mode)
     fn = {"exact": raster.line_pixels, "fast": raster.line_pixels_fast, "aa": raster.line_coverage_aa}[mode]
     for m in range(len(p0)):
         ref = fn(p0[m:m + 1], p1[m:m + 1], w, h)
@@ -57,9 +57,9 @@ def test_line_sample_depth_is_perspective_correct():
     # segment from depth 2 to depth 8 along x: 1/z is linear in screen space
     a, b = np.array([[0.0, 5.0]]), np.array([[10.0, 5.0]])
     cc = np.arange(11)
-    z = zbuffer.line_sample_depth(np.zeros(11, int), np.full(11, 5), cc, a, b, [2.0], [8.0], "perspective")
+    z = hidden_lines.line_sample_depth(np.zeros(11, int), np.full(11, 5), cc, a, b, [2.0], [8.0], "perspective")
     np.testing.assert_allclose(1 / z, 0.5 + (0.125 - 0.5) * cc / 10, rtol=1e-15)
-    z = zbuffer.line_sample_depth(np.zeros(11, int), np.full(11, 5), cc, a, b, [2.0], [8.0], "orthographic")
+    z = hidden_lines.line_sample_depth(np.zeros(11, int), np.full(11, 5), cc, a, b, [2.0], [8.0], "orthographic")
     np.testing.assert_allclose(z, 2 + 6 * cc / 10, rtol=1e-15)
 
 
@@ -188,7 +188,7 @@ def oracle():
 def test_hidden_lines_against_pyrender(oracle, summary_section):
     """pyrender draws the faces black with glPolygonOffset(1, 1) and the lines on top.
 
-    Our bias is that offset in linear depth (core.zbuffer), so the same line
+    Our bias is that offset in linear depth (core.hidden_lines), so the same line
     pixels pass. Measured on 16 poses of a cube and an icosphere, both
     projections: F1@1px = 1.000 everywhere and F1@0 >= 0.998 (a pixel or two of
     a few thousand differ where a line grazes a face and the float32/24-bit

@@ -10,7 +10,8 @@ import pytest
 from numpy.testing import assert_array_equal
 from PIL import Image
 
-from wirecheck.core.cli import SEPARATOR_GREY, main
+from wirecheck.core.cli import main
+from wirecheck.core.compose import SEPARATOR_GREY
 from wirecheck.core.output import pad_even
 
 

@@ -15,7 +15,8 @@ import pytest
 from wirecheck.core import zbuffer
 from wirecheck.core.camera import look_at
 from wirecheck.core.projection import unproject, world_to_cam
-from wirecheck.core.zbuffer import clip_triangles_near, project_triangles, rasterize_triangles
+from wirecheck.core.clipping import clip_triangles_near
+from wirecheck.core.zbuffer import project_triangles, rasterize_triangles
 
 EPS32 = float(np.finfo(np.float32).eps)
 

@@ -1,0 +1,211 @@
+"""A renderer run: every frame of a scene's motion rendered, composed and written, and its report.
+
+:class:`Settings` says what to render (``renderer``'s options, validated by
+core.cli); :func:`render_run` renders frame 1..frames through
+:class:`core.frames.SceneRenderer` (one camera, or two side by side), writes
+the frames and animations atomically and returns the report dict
+(core.report).
+"""
+
+from __future__ import annotations
+
+import io
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import output
+from .camera import Camera
+from .compose import axis_layers, axis_length, overlay, picture, side_by_side
+from .errors import InputError
+from .frames import SceneRenderer
+from .report import frame_record, run_report, summary_text
+from .scene import Scene
+from .transforms import Motion
+
+#: Output formats: frames as PNG and ASCII text, animations as GIF and MP4.
+FORMATS = ("png", "ascii", "gif", "mp4")
+#: Frames per second of the GIF and MP4 animations.
+FPS = 30
+#: Above this many vertices the per-frame pixel coordinates go to a binary
+#: sidecar (float64 array, shape (frames, N, 2), NaN where clipped) instead of JSON.
+SIDECAR_VERTICES = 10_000
+
+
+@dataclass
+class Settings:
+    """One renderer run (``renderer``'s options, validated)."""
+
+    scene: Scene
+    camera: Camera
+    motion: Motion
+    frames: int
+    clip: str
+    formats: tuple[str, ...]
+    out: Path
+    ascii_cols: int
+    dtype: str = "float64"
+    raster: str = "exact"
+    ortho_camera: Camera | None = None       # --projection both: the right-hand camera
+    axes: bool = False
+    cull: str | None = None                  # None or "backface"
+    hidden_lines: bool = False
+    style: str = "wireframe"
+    light: tuple | None = None
+    object_culling: bool = True
+    plots: bool = False
+
+    @property
+    def cameras(self) -> tuple[Camera, ...]:
+        return (self.camera,) if self.ortho_camera is None else (self.camera, self.ortho_camera)
+
+    @property
+    def uses_faces(self) -> bool:
+        return self.cull is not None or self.hidden_lines or self.style != "wireframe"
+
+    def axis_layers(self, camera: Camera, frame=None) -> list:
+        """:func:`core.compose.axis_layers` of this run (``frame``: depth-tested against its faces)."""
+        return axis_layers(axis_length(self.scene.radius, self.motion.scale), camera, self.clip, self.dtype,
+                           self.raster, frame)
+
+    def scene_renderer(self) -> SceneRenderer:
+        return SceneRenderer(self.scene, self.motion, self.frames, clip=self.clip, dtype=self.dtype,
+                             raster=self.raster, cull=self.cull, hidden_lines=self.hidden_lines,
+                             style=self.style, light=self.light, object_culling=self.object_culling)
+
+
+def progress_steps(s: Settings) -> int:
+    """Steps :func:`render_run` reports to ``progress``: one per frame, then the animations' encoding."""
+    return s.frames * (2 if "gif" in s.formats else 1) + ("mp4" in s.formats)
+
+
+def render_run(s: Settings, log=None, progress=None, profiler=None, extra: dict | None = None) -> dict:
+    """Render every frame, write outputs atomically, return the report dict.
+
+    ``log(k, frame, info)`` is called for each frame (the caller decides what
+    to print); ``progress(stage)`` once per step of :func:`progress_steps`
+    (``stage``: "render", "gif" or "mp4"). ``profiler`` (a
+    :class:`core.profile.FrameProfiler`) times each frame's stages; its
+    summary becomes the report's ``profile`` field. ``extra`` fields are added
+    to the report (``trace``).
+    """
+    name = s.scene.name
+    frames_dir = s.out / f"{name}-frames"
+    json_path = s.out / f"{name}-report.json"
+    txt_path = s.out / f"{name}-report.txt"
+    plots_path = s.out / f"{name}-plots.png"
+    mp4_path = s.out / f"{name}.mp4"
+    step = progress or (lambda stage: None)
+    sidecar = len(s.scene.vertices) > SIDECAR_VERTICES
+    sidecar_paths = [s.out / f"{name}-vertices_px.npy", s.out / f"{name}-vertices_px-orthographic.npy"]
+    fdir = output.FrameDir(frames_dir, "--out") if ("png" in s.formats or "ascii" in s.formats) else None
+    mp4 = None
+    records, gif_images = [], []
+    all_px = [[] for _ in s.cameras]
+    t_start = time.perf_counter()
+    render_seconds = 0.0
+    renderer = s.scene_renderer()
+    layers = [s.axis_layers(cam) for cam in s.cameras] if s.axes else None
+    lap = profiler.lap if profiler is not None else (lambda stage, t: 0.0)
+    try:
+        if "mp4" in s.formats:
+            mp4 = output.Mp4Writer(mp4_path, FPS)
+        for k in range(1, s.frames + 1):
+            if profiler is not None:
+                profiler.begin()
+            pictures, recs = [], []
+            for c, cam in enumerate(s.cameras):
+                t0 = time.perf_counter()
+                frame, info = renderer.render(k, cam, timing=profiler.current if profiler else None)
+                t = time.perf_counter()
+                render_seconds += t - t0
+                _check_overflow(s, frame, k)
+                img = picture(frame, s.style)
+                if layers and frame.tri_ids is not None:          # faces in a depth buffer: axes depth-tested
+                    pictures.append(overlay(img, s.axis_layers(cam, frame)))
+                else:
+                    pictures.append(overlay(img, layers[c]) if layers else img)
+                recs.append(frame_record(k, frame, sidecar, info))
+                if sidecar:
+                    all_px[c].append(frame.p_px)
+                if c == 0:
+                    first = (frame, info)
+                lap("compose", t)
+            t = time.perf_counter()
+            rec = recs[0]
+            if len(recs) > 1:
+                rec["orthographic"] = {key: v for key, v in recs[1].items() if key != "frame"}
+            image = pictures[0] if len(pictures) == 1 else side_by_side(*pictures)
+            t = lap("compose", t)
+            for fmt, encode in (("png", output.png_bytes), ("ascii", lambda im: output.ascii_frame(
+                    im, s.ascii_cols).encode())):
+                if fdir is not None and fmt in s.formats:
+                    data = encode(image)
+                    t = lap("encode", t)
+                    fdir.write(f"frame_{k:04d}.{'png' if fmt == 'png' else 'txt'}", data)
+                    t = lap("write", t)
+            if "gif" in s.formats:
+                gif_images.append(image)
+            if mp4 is not None:
+                mp4.add(image)
+                t = lap("encode", t)
+            records.append(rec)
+            if profiler is not None:
+                profiler.end()
+            if log:
+                log(k, *first)
+            step("render")
+        if fdir is not None:
+            fdir.commit()
+        if mp4 is not None:
+            mp4.commit()
+            step("mp4")
+    except BaseException:
+        if fdir is not None:
+            fdir.abort()
+        if mp4 is not None:
+            mp4.abort()
+        raise
+    if "gif" in s.formats:
+        gif = output.gif_bytes(gif_images, FPS, progress=lambda: step("gif"))
+        output.atomic_write_bytes(s.out / f"{name}.gif", gif)
+    report = run_report(s, records)
+    report.update(extra or {})
+    if profiler is not None:
+        report["profile"] = profiler.summary()
+    if sidecar:
+        for c, path in enumerate(sidecar_paths[:len(s.cameras)]):
+            buf = io.BytesIO()
+            np.save(buf, np.stack(all_px[c]) if all_px[c] else np.zeros((0, 0, 2)))
+            output.atomic_write_bytes(path, buf.getvalue())
+        report["vertices_px_file"] = sidecar_paths[0].name
+        if s.ortho_camera is not None:
+            report["vertices_px_file_orthographic"] = sidecar_paths[1].name
+    plot_seconds = None
+    if s.plots:
+        from .motion_plot import plot_png
+
+        t0 = time.perf_counter()
+        cam_text = "perspective (left picture)" if s.ortho_camera is not None else s.camera.projection
+        output.atomic_write_bytes(plots_path, plot_png(records, f"{name}: {s.frames} frames, {cam_text} camera"))
+        plot_seconds = time.perf_counter() - t0
+    output.atomic_write_text(json_path, output.json_dumps(report))
+    wall = time.perf_counter() - t_start
+    output.atomic_write_text(txt_path, summary_text(report, render_seconds, wall, plot_seconds))
+    report["_paths"] = {"frames": frames_dir if fdir else None, "json": json_path, "txt": txt_path,
+                        "gif": s.out / f"{name}.gif" if "gif" in s.formats else None,
+                        "mp4": mp4_path if mp4 is not None else None,
+                        "plots": plots_path if s.plots else None}
+    return report
+
+
+def _check_overflow(s: Settings, frame, k: int) -> None:
+    overflow = frame.visible & ~np.isfinite(frame.p_px).all(axis=1)
+    if overflow.any():
+        i = int(np.flatnonzero(overflow)[0])
+        raise InputError(
+            f"{s.scene.source}: vertex {i} {s.scene.vertices[i].tolist()} projects beyond the float64 "
+            f"range in frame {k}: expected coordinates whose pixel position fits in a float64 "
+            f"(|f * x / z| < 1.8e308)")
