@@ -39,26 +39,21 @@ from __future__ import annotations
 import argparse
 import gc
 import json
-import os
-import platform
 import sys
 import time
 import tracemalloc
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+import cv2
+import numpy as np
+import trimesh
 
-import cv2  # noqa: E402
-import numpy as np  # noqa: E402
-import trimesh  # noqa: E402
-
-from wirecheck.core.camera import camera_z  # noqa: E402
-from wirecheck.core.pipeline import render_frame  # noqa: E402
-from wirecheck.core.projection import project_points  # noqa: E402
-from wirecheck.core.scene import face_edges, load_scene, unique_edges  # noqa: E402
-from wirecheck.core.transforms import Motion  # noqa: E402
+from _common import machine_info, print_machine, print_table
+from wirecheck.core.camera import camera_z
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.projection import project_points
+from wirecheck.core.scene import face_edges, load_scene, unique_edges
+from wirecheck.core.transforms import Motion
 
 FRAMES = 180
 WIDTH, HEIGHT = 640, 480
@@ -202,33 +197,6 @@ def peak_memory(p_model, edges, camera, matrix) -> dict:
             "input_bytes": int(p_model.nbytes + edges.nbytes)}
 
 
-def machine_info() -> dict:
-    cpu_model = platform.processor() or ""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    cpu_model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:
-        usable = os.cpu_count()
-    return {
-        "cpu_model": cpu_model,
-        "cpu_count": os.cpu_count(),
-        "cpus_usable": usable,
-        "platform": platform.platform(),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "cv2": cv2.__version__,
-        "cv2_threads": cv2.getNumThreads(),
-        "trimesh": trimesh.__version__,
-    }
-
-
 # ---------------------------------------------------------------- report
 def verdict(ok: bool) -> str:
     return "PASS" if ok else "MISS"
@@ -258,11 +226,7 @@ def main(argv=None) -> int:
     cases = load_cases()
     info = machine_info()
 
-    print("wirecheck frame benchmark")
-    print(f"  cpu: {info['cpu_model'] or '?'}; cpu_count={info['cpu_count']}, usable={info['cpus_usable']}")
-    print(f"  python {info['python']}, numpy {info['numpy']}, cv2 {info['cv2']} "
-          f"(threads {info['cv2_threads']}), trimesh {info['trimesh']}")
-    print(f"  {info['platform']}")
+    print_machine("wirecheck frame benchmark", info)
     print(f"  camera_z(4.0, fov_y_deg=70) {WIDTH}x{HEIGHT}, Motion() = {motion.turns} turns, {FRAMES} frames")
     print("  timed per frame: model transform + projection + raster + image, both implementations")
     print()
@@ -281,17 +245,16 @@ def main(argv=None) -> int:
 
     hdr = (f"{'case':<10} {'V':>6} {'E':>7}  {'impl':<7} {'median ms':>10} {'p90 ms':>9} "
            f"{'min ms':>9} {'mean ms':>9}  {'reps':>4}")
-    print(hdr)
-    print("-" * len(hdr))
+    rows = []
     for name, res in results.items():
         for impl in ("ours", "opencv"):
             s = res[impl]
-            print(f"{name:<10} {res['vertices']:>6} {res['edges']:>7}  {impl:<7} {s['median_ms']:>10.3f} "
-                  f"{s['p90_ms']:>9.3f} {s['min_median_ms']:>9.3f} {s['mean_ms']:>9.3f}  "
-                  f"{s['repeats']:>4}")
-        print(f"{'':<10} {'':>6} {'':>7}  {'ours/cv':<7} {res['ratio_median']:>10.2f} "
-              f"{res['ratio_p90']:>9.2f}")
-    print()
+            rows.append(f"{name:<10} {res['vertices']:>6} {res['edges']:>7}  {impl:<7} {s['median_ms']:>10.3f} "
+                        f"{s['p90_ms']:>9.3f} {s['min_median_ms']:>9.3f} {s['mean_ms']:>9.3f}  "
+                        f"{s['repeats']:>4}")
+        rows.append(f"{'':<10} {'':>6} {'':>7}  {'ours/cv':<7} {res['ratio_median']:>10.2f} "
+                    f"{res['ratio_p90']:>9.2f}")
+    print_table(None, hdr, rows)
     for name, res in results.items():
         c = res["checks"]
         print(f"check {name}: frames through the clipping path {c['frames_through_clipping']}/{FRAMES}; "

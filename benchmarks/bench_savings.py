@@ -52,22 +52,17 @@ from pathlib import Path
 
 os.environ["PYOPENGL_PLATFORM"] = "osmesa"        # before anything imports pyrender / OpenGL
 
-ROOT = Path(__file__).resolve().parent.parent
-HERE = Path(__file__).resolve().parent
-for p in (str(ROOT), str(HERE)):
-    if p not in sys.path:
-        sys.path.insert(0, p)
+import numpy as np
+import trimesh
 
-import numpy as np  # noqa: E402
-import trimesh  # noqa: E402
-
-from bench_scale import OpenBLAS, bench_group, fast_unique_edges, machine_info  # noqa: E402
-from wirecheck.core import clipping, raster  # noqa: E402
-from wirecheck.core.camera import camera_z  # noqa: E402
-from wirecheck.core.pipeline import render_frame  # noqa: E402
-from wirecheck.core.projection import cam_to_px, localize, model_to_cam  # noqa: E402
-from wirecheck.core.scene import Scene, load_scene  # noqa: E402
-from wirecheck.core.transforms import Motion  # noqa: E402
+from _common import loadavg, print_machine, print_table
+from bench_scale import OpenBLAS, bench_group, blas_info, fast_unique_edges
+from wirecheck.core import clipping, raster
+from wirecheck.core.camera import camera_z
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.projection import cam_to_px, localize, model_to_cam
+from wirecheck.core.scene import Scene, load_scene
+from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 640, 480
 FRAMES = 180
@@ -189,7 +184,7 @@ def main(argv=None) -> int:
            if args.quick else
            {"budget_s": 0.8, "rounds": 3, "max_passes": 50, "poses": 8, "load_subdiv": 7, "load_repeats": 3})
     blas = OpenBLAS()
-    info = machine_info(blas)
+    info = blas_info(blas)
     camera = make_camera()
     motion = Motion()
     mats = [motion.frame_matrix(1 + k * FRAMES // cfg["poses"], FRAMES) for k in range(cfg["poses"])]
@@ -200,12 +195,9 @@ def main(argv=None) -> int:
     faces = np.asarray(mesh.faces, dtype=np.intp)
     e = fast_unique_edges(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), len(v))
 
-    print("wirecheck savings benchmark: what the skipped stages would cost")
-    print(f"  cpu: {info['cpu_model'] or '?'}; cpu_count={info['cpu_count']}, usable={info['cpus_usable']}, "
-          f"RAM {info['mem_total_gib']:.1f} GiB; load average at start {' '.join(info['loadavg_start'] or [])}")
-    print(f"  python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}), "
-          f"cv2 {info['cv2']}, trimesh {info['trimesh']}")
-    print(f"  {info['platform']}")
+    print_machine("wirecheck savings benchmark: what the skipped stages would cost", info, libraries=(
+        f"python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}), "
+        f"cv2 {info['cv2']}, trimesh {info['trimesh']}"))
     print(f"  icosphere(6): {len(v):,} V, {len(e):,} E, {len(faces):,} F; camera_z(4.0, fov_y_deg=70) "
           f"{WIDTH}x{HEIGHT}; {n_poses} Motion() poses; mode {'quick' if args.quick else 'full'}")
     print(flush=True)
@@ -370,18 +362,17 @@ def main(argv=None) -> int:
     # ---- table
     print()
     hdr = f"{'stage':<36} {'skipped cost ms':>15} {'run cost ms':>12} {'saving':>7}"
-    print("skipped cost = what the stage would add; run cost = what runs now; saving = skipped / (run + skipped)")
-    print(hdr)
-    print("-" * len(hdr))
+    lines = []
     for r in rows:
         r["saving"] = r["skipped_ms"] / (r["run_ms"] + r["skipped_ms"]) if r["run_ms"] + r["skipped_ms"] > 0 else 0.0
         per = " (per load)" if r.get("per") == "load" else ""
-        print(f"{r['stage']:<36} {ms(r['skipped_ms']):>15} {ms(r['run_ms']):>12} {r['saving']:>7.1%}{per}")
-    print()
+        lines.append(f"{r['stage']:<36} {ms(r['skipped_ms']):>15} {ms(r['run_ms']):>12} {r['saving']:>7.1%}{per}")
+    print_table("skipped cost = what the stage would add; run cost = what runs now; "
+                "saving = skipped / (run + skipped)", hdr, lines)
     for r in rows:
         print(f"  {r['stage']}: {r['note']}")
     elapsed = time.perf_counter() - t_start
-    info["loadavg_end"] = open("/proc/loadavg").read().split()[:3] if os.path.exists("/proc/loadavg") else None
+    info["loadavg_end"] = loadavg()
     print(f"\nload average at end {' '.join(info['loadavg_end'] or [])}; total benchmark time {elapsed:.1f} s")
 
     if args.json:

@@ -61,7 +61,6 @@ import gc
 import glob
 import json
 import os
-import platform
 import resource
 import subprocess
 import sys
@@ -70,19 +69,18 @@ import tracemalloc
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
 
-import cv2  # noqa: E402
-import numpy as np  # noqa: E402
-import trimesh  # noqa: E402
+import cv2
+import numpy as np
+import trimesh
 
-from wirecheck.core import raster  # noqa: E402
-from wirecheck.core.camera import camera_z  # noqa: E402
-from wirecheck.core.pipeline import render_frame  # noqa: E402
-from wirecheck.core.projection import cam_to_px, depth_mask, localize, model_to_cam  # noqa: E402
-from wirecheck.core.scene import load_scene, unique_edges  # noqa: E402
-from wirecheck.core.transforms import Motion  # noqa: E402
+from _common import fmt_ms, loadavg, machine_info, print_machine, print_table
+from wirecheck.core import raster
+from wirecheck.core.camera import camera_z
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.projection import cam_to_px, depth_mask, localize, model_to_cam
+from wirecheck.core.scene import load_scene, unique_edges
+from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 1280, 960
 FRAMES = 180                     # Motion() period; poses are frames of it
@@ -92,9 +90,6 @@ RASTER_RATIO_TARGET = 2.0        # ours raster <= 2x cv2.polylines at the larges
 SLOPE_LIMIT = 1.15               # log-log slope of time vs V + E (1 = linear)
 RSS_GROWTH_LIMIT_MIB = 8.0       # RSS after the last frame - after frame 10
 TRACED_GROWTH_LIMIT_KIB = 64.0   # tracemalloc current after the last frame - after frame 10
-
-HAVE_FAST = hasattr(raster, "line_pixels_fast")
-HAVE_AA = hasattr(raster, "line_coverage_aa") and hasattr(raster, "paint_aa")
 
 
 # ---------------------------------------------------------------- meshes
@@ -350,18 +345,13 @@ def bench_mesh(name, family, v, e, camera, matrices, cfg, blas) -> dict:
             cv2.polylines(img, segs8[i], False, 255, 1, cv2.LINE_AA, 8)
             return img
 
-        rast = {"ours_exact": r_exact}
-        if HAVE_FAST:
-            rast["ours_fast"] = r_fast
-        if HAVE_AA:
-            rast["ours_aa"] = r_aa
-        rast["cv2_LINE_8"] = cv_l8
-        rast["cv2_LINE_8_shift8"] = cv_l8s8
-        if HAVE_AA and cfg["cv_aa"]:
+        rast = {"ours_exact": r_exact, "ours_fast": r_fast, "ours_aa": r_aa,
+                "cv2_LINE_8": cv_l8, "cv2_LINE_8_shift8": cv_l8s8}
+        if cfg["cv_aa"]:
             rast["cv2_LINE_AA_shift8"] = cv_aa
         res["raster"] = bench_group(rast, n_poses, budget, rounds, max_passes)
         # pixel agreement on pose 0 (outside the timing)
-        a_fast = r_fast(0) > 0 if HAVE_FAST else None
+        a_fast = r_fast(0) > 0
         a_ex = r_exact(0) > 0
         b8 = cv_l8(0) > 0
         b8s = cv_l8s8(0) > 0
@@ -372,17 +362,16 @@ def bench_mesh(name, family, v, e, camera, matrices, cfg, blas) -> dict:
         res["raster_pixels_pose0"] = {
             "ours_exact": int(a_ex.sum()), "cv2_LINE_8": int(b8.sum()), "cv2_LINE_8_shift8": int(b8s.sum()),
             "iou_exact_vs_cv2_shift8": iou(a_ex, b8s),
-            "iou_fast_vs_cv2_LINE_8": iou(a_fast, b8) if a_fast is not None else None,
+            "iou_fast_vs_cv2_LINE_8": iou(a_fast, b8),
         }
         del seg0, seg1, segs, segs8
     del px
 
     # ---- whole frame
     if not (big and cfg["skip_1m_frame"]):
-        frame = {"render_frame_exact": lambda i: render_frame(lp64, e, camera, mats[i])}
-        if HAVE_FAST:
-            frame["render_frame_fast"] = lambda i: render_frame(lp64, e, camera, mats[i], raster="fast")
-        if HAVE_AA and cfg["frame_aa"]:
+        frame = {"render_frame_exact": lambda i: render_frame(lp64, e, camera, mats[i]),
+                 "render_frame_fast": lambda i: render_frame(lp64, e, camera, mats[i], raster="fast")}
+        if cfg["frame_aa"]:
             frame["render_frame_aa"] = lambda i: render_frame(lp64, e, camera, mats[i], raster="aa")
         res["frame"] = bench_group(frame, n_poses, budget, rounds, max_passes)
     return res
@@ -508,50 +497,15 @@ def run_child(spec: dict) -> dict:
 
 
 # ---------------------------------------------------------------- machine
-def machine_info(blas: OpenBLAS) -> dict:
-    cpu_model = platform.processor() or ""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    cpu_model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:
-        usable = os.cpu_count()
-    try:
-        mem_total = int(open("/proc/meminfo").readline().split()[1]) / 2**20
-    except (OSError, ValueError, IndexError):
-        mem_total = None
-    return {
-        "cpu_model": cpu_model,
-        "cpu_count": os.cpu_count(),
-        "cpus_usable": usable,
-        "mem_total_gib": mem_total,
-        "platform": platform.platform(),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "cv2": cv2.__version__,
-        "cv2_threads": cv2.getNumThreads(),
-        "trimesh": trimesh.__version__,
-        "openblas_threads": blas.threads(),
-        "blas_env": {k: os.environ[k] for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-                     if k in os.environ},
-        "loadavg_start": open("/proc/loadavg").read().split()[:3] if os.path.exists("/proc/loadavg") else None,
-    }
+def blas_info(blas: OpenBLAS) -> dict:
+    """:func:`_common.machine_info` with OpenBLAS's thread count and the BLAS environment variables."""
+    return machine_info(openblas_threads=blas.threads(),
+                        blas_env={k: os.environ[k] for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                                             "MKL_NUM_THREADS") if k in os.environ})
 
 
 def verdict(ok: bool) -> str:
     return "PASS" if ok else "FAIL"
-
-
-def fmt_ms(x) -> str:
-    if x is None:
-        return "-"
-    return f"{x:.4f}" if x < 0.1 else f"{x:.3f}" if x < 10 else f"{x:.1f}"
 
 
 # ---------------------------------------------------------------- main
@@ -583,18 +537,13 @@ def main(argv=None) -> int:
     camera = make_camera()
     motion = Motion()
     matrices = [motion.frame_matrix(i, FRAMES) for i in range(1, FRAMES + 1)]
-    info = machine_info(blas)
+    info = blas_info(blas)
 
-    print("wirecheck scale benchmark")
-    print(f"  cpu: {info['cpu_model'] or '?'}; cpu_count={info['cpu_count']}, usable={info['cpus_usable']}, "
-          f"RAM {info['mem_total_gib']:.1f} GiB; load average at start {' '.join(info['loadavg_start'] or [])}")
-    print(f"  python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}"
-          f"{', env ' + str(info['blas_env']) if info['blas_env'] else ''}), cv2 {info['cv2']} "
-          f"(threads {info['cv2_threads']}), trimesh {info['trimesh']}")
-    print(f"  {info['platform']}")
-    print(f"  camera_z(4.0, fov_y_deg=70) {WIDTH}x{HEIGHT}, Motion() poses; "
-          f"raster modes: exact{', fast' if HAVE_FAST else ' (fast: not in core.raster, skipped)'}"
-          f"{', aa' if HAVE_AA else ' (aa: not in core.raster, skipped)'}")
+    print_machine("wirecheck scale benchmark", info, libraries=(
+        f"python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}"
+        f"{', env ' + str(info['blas_env']) if info['blas_env'] else ''}), cv2 {info['cv2']} "
+        f"(threads {info['cv2_threads']}), trimesh {info['trimesh']}"))
+    print(f"  camera_z(4.0, fov_y_deg=70) {WIDTH}x{HEIGHT}, Motion() poses; raster modes: exact, fast, aa")
     print(f"  mode: {'quick' if args.quick else 'full'}; per implementation and mesh: {cfg['rounds']} rounds, "
           f"passes over the poses from a {cfg['budget_s']:g} s budget (max {cfg['max_passes']})")
     print(flush=True)
@@ -629,54 +578,46 @@ def main(argv=None) -> int:
                  ("cv2_projectPoints", "cv2.pP"), ("cv2_transform", "cv2.xf")]
     hdr = (f"{'mesh':<9} {'V':>9} {'E':>9} | " + " ".join(f"{h:>9}" for _, h in proj_cols)
            + f" | {'pP/f64':>7} {'max|d| f64':>10} {'f32':>8} {'cv2.xf':>8}")
-    print("projection, model space -> (N, 2) pixels, median ms per call "
-          "(pP = cv2.projectPoints, xf = cv2.transform + convertPointsFromHomogeneous; max|d| = px vs cv2.pP)")
-    print(hdr)
-    print("-" * len(hdr))
+    rows = []
     for r in results:
         p = r["projection"]
         cells = " ".join(f"{fmt_ms(p[c]['median_ms']) if c in p else '-':>9}" for c, _ in proj_cols)
         d = r["max_abs_diff_px"]
-        print(f"{r['name']:<9} {r['vertices']:>9,} {r['edges']:>9,} | {cells} | "
-              f"{p['cv2_projectPoints']['median_ms'] / p['ours_f64']['median_ms']:>7.2f} "
-              f"{d['ours_f64']:>10.1e} {d['ours_f32']:>8.1e} {d['cv2_transform']:>8.1e}")
-    print()
+        rows.append(f"{r['name']:<9} {r['vertices']:>9,} {r['edges']:>9,} | {cells} | "
+                    f"{p['cv2_projectPoints']['median_ms'] / p['ours_f64']['median_ms']:>7.2f} "
+                    f"{d['ours_f64']:>10.1e} {d['ours_f32']:>8.1e} {d['cv2_transform']:>8.1e}")
+    print_table("projection, model space -> (N, 2) pixels, median ms per call (pP = cv2.projectPoints, "
+                "xf = cv2.transform + convertPointsFromHomogeneous; max|d| = px vs cv2.pP)", hdr, rows)
 
     rast_cols = [("ours_exact", "exact"), ("ours_fast", "fast"), ("ours_aa", "aa"),
                  ("cv2_LINE_8", "cv2 L8"), ("cv2_LINE_8_shift8", "cv2 L8 s8"), ("cv2_LINE_AA_shift8", "cv2 AA s8")]
     hdr = (f"{'mesh':<9} {'E':>9} | " + " ".join(f"{h:>9}" for _, h in rast_cols)
            + f" | {'fast/L8':>7} {'exact/s8':>8} {'aa/AA':>6}")
-    print(f"raster, pixel ends -> ({HEIGHT}, {WIDTH}) uint8 image incl. np.zeros, median ms per call "
-          "(L8 = cv2.polylines LINE_8 on rounded ends, s8 = shift=8 ends in 1/256 px)")
-    print(hdr)
-    print("-" * len(hdr))
-    for r in results:
+    def raster_row(r):
         if "raster" not in r:
-            print(f"{r['name']:<9} {r['edges']:>9,} | (skipped in --quick)")
-            continue
+            return f"{r['name']:<9} {r['edges']:>9,} | (skipped in --quick)"
         q = r["raster"]
         cells = " ".join(f"{fmt_ms(q[c]['median_ms']) if c in q else '-':>9}" for c, _ in rast_cols)
 
         def ratio(a, b):
             return f"{q[a]['median_ms'] / q[b]['median_ms']:.2f}" if a in q and b in q else "-"
-        print(f"{r['name']:<9} {r['edges']:>9,} | {cells} | {ratio('ours_fast', 'cv2_LINE_8'):>7} "
-              f"{ratio('ours_exact', 'cv2_LINE_8_shift8'):>8} {ratio('ours_aa', 'cv2_LINE_AA_shift8'):>6}")
-    print()
+        return (f"{r['name']:<9} {r['edges']:>9,} | {cells} | {ratio('ours_fast', 'cv2_LINE_8'):>7} "
+                f"{ratio('ours_exact', 'cv2_LINE_8_shift8'):>8} {ratio('ours_aa', 'cv2_LINE_AA_shift8'):>6}")
+    print_table(f"raster, pixel ends -> ({HEIGHT}, {WIDTH}) uint8 image incl. np.zeros, median ms per call "
+                "(L8 = cv2.polylines LINE_8 on rounded ends, s8 = shift=8 ends in 1/256 px)",
+                hdr, [raster_row(r) for r in results])
 
     frame_cols = [("render_frame_exact", "exact"), ("render_frame_fast", "fast"), ("render_frame_aa", "aa")]
     hdr = f"{'mesh':<9} {'V+E':>10} | " + " ".join(f"{h:>9}" for _, h in frame_cols) + " | clip poses"
-    print("whole frame, render_frame(LocalPoints, ...), median ms per call")
-    print(hdr)
-    print("-" * len(hdr))
-    for r in results:
+    def frame_row(r):
         if "frame" not in r:
-            print(f"{r['name']:<9} {r['vertices'] + r['edges']:>10,} | (skipped in --quick)")
-            continue
+            return f"{r['name']:<9} {r['vertices'] + r['edges']:>10,} | (skipped in --quick)"
         f = r["frame"]
         cells = " ".join(f"{fmt_ms(f[c]['median_ms']) if c in f else '-':>9}" for c, _ in frame_cols)
-        print(f"{r['name']:<9} {r['vertices'] + r['edges']:>10,} | {cells} | "
-              f"{r['poses_through_clipping']}/{r['poses']}")
-    print()
+        return (f"{r['name']:<9} {r['vertices'] + r['edges']:>10,} | {cells} | "
+                f"{r['poses_through_clipping']}/{r['poses']}")
+    print_table("whole frame, render_frame(LocalPoints, ...), median ms per call",
+                hdr, [frame_row(r) for r in results])
 
     # ---- slopes
     slopes = {}
@@ -793,7 +734,7 @@ def main(argv=None) -> int:
         print(f"  {status:<9} {t['name']}: {extra}")
 
     elapsed = time.perf_counter() - t_start
-    info["loadavg_end"] = open("/proc/loadavg").read().split()[:3] if os.path.exists("/proc/loadavg") else None
+    info["loadavg_end"] = loadavg()
     print(f"\nload average at end {' '.join(info['loadavg_end'] or [])}; total benchmark time {elapsed:.1f} s")
 
     if args.json:

@@ -40,9 +40,10 @@ Drawing modes (:class:`RenderMode`, the core candidate only; the pixel level):
 Several objects (``Scene.objects``, when the scene is not one static object):
 the oracle side builds each object's matrix with scipy,
 ``M_run(t) @ M_o(t)`` (oracles.faces.object_matrices), and gives OpenCV and
-pyrender world points (pyrender with an identity pose); core's side uses
-``core.scene.world_points`` and draws them with an identity model matrix. A
-single static object keeps the exact path above (pose = the run's matrix).
+pyrender world points (pyrender with an identity pose). core is set up as
+``renderer`` sets it up (:class:`core.frames.SceneRenderer`): its own world
+points drawn with an identity model matrix. A single static object keeps the
+exact path above (pose = the run's matrix).
 
 Cases are independent, so :func:`run_crosscheck` can spread them over worker
 processes (``jobs``). Workers are started with the "spawn" method: an OSMesa
@@ -190,16 +191,22 @@ class CoreCandidate:
         return project_points(points, camera, dtype=self.dtype)
 
     def prepare(self, p_model: np.ndarray):
-        """The scene's vertices re-centred and cast once (``core.projection.localize``), as ``renderer`` does."""
+        """Points re-centred and cast once (``core.projection.localize``), as ``renderer`` does."""
         from wirecheck.core.projection import localize
 
         return localize(p_model, self.dtype)
 
-    def world_points(self, scene, motion, frame: int, frames: int) -> np.ndarray:
-        """A scene of several objects: core's world points (``core.scene.world_points``) of one frame."""
-        from wirecheck.core.scene import world_points
+    def scene_frames(self, scene, motion, frames: int):
+        """core's scene-level renderer (:class:`core.frames.SceneRenderer`) in this candidate's settings.
 
-        return world_points(scene, motion, frame, frames)
+        Its :meth:`~core.frames.SceneRenderer.geometry` gives each frame's points
+        and model matrix, and its ``faces`` the faces as core draws them, as
+        ``renderer`` sets them up.
+        """
+        from wirecheck.core.frames import SceneRenderer
+
+        return SceneRenderer(scene, motion, frames, clip=self.clip, dtype=self.dtype, raster=self.raster,
+                             object_culling=False)
 
     def project(self, points, camera, model_matrix: np.ndarray) -> np.ndarray:
         """Vertex pixels from core's pipeline without drawing: ``render_frame`` given no edges."""
@@ -274,14 +281,10 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     edges = np.asarray(scene.edges)
     faces = _case_faces(scene)
     use_faces = pixels and faces is not None and not mode.plain
-    single = scene.is_single_static
-    # core draws a multi-object scene from world points with an identity matrix:
-    # its faces come re-wound for mirrored objects (core.scene.oriented_faces)
-    core_faces = faces
-    if faces is not None and not single and isinstance(candidate, CoreCandidate):
-        from wirecheck.core.scene import oriented_faces
-
-        core_faces = oriented_faces(scene, motion)
+    # core is set up as renderer sets it up (core.frames): its own matrices and world points,
+    # and, for a multi-object scene, faces re-wound for mirrored objects
+    core_frames = candidate.scene_frames(scene, motion, frames) if is_core else None
+    core_faces = core_frames.faces if is_core and faces is not None else faces
     if use_faces and mode.shaded:
         tris, tri_owner = oface.fan(faces)
     if use_faces and mode.cull == "backface":
@@ -296,7 +299,6 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     # seconds: vertex stage = t_setup + t_cv + t_proj + t_vmetric; pixel stage = t_draw + t_pr + t_pmetric
     t_setup = t_cv = t_proj = t_vmetric = t_draw = t_pr = t_pmetric = 0.0
     error = None
-    core_points = candidate.prepare(scene.vertices) if is_core and single else None   # once per scene
     for k in range(first, frames + 1, every):
         t0 = time.perf_counter()
         p_world, matrices, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
@@ -306,11 +308,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         try:
             if is_core:
                 try:
-                    if single:
-                        m_core, points = motion.frame_matrix(k, frames), core_points
-                    else:
-                        m_core = np.eye(4)
-                        points = candidate.prepare(candidate.world_points(scene, motion, k, frames))
+                    points, m_core = core_frames.geometry(k)
                     cand_px = candidate.project(points, cam, m_core)
                 except Exception as exc:      # core crashing is a failed case, not a crashed run
                     raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc

@@ -11,8 +11,8 @@ so each frame's references are computed once and shared:
 For each setting we record
 
 * ``ms_per_frame``: median time of ``core.pipeline.render_frame`` per frame,
-  split by scene group ("bundled" scenes and the "large" mesh), vertices
-  prepared once per scene with ``core.projection.localize`` as ``renderer`` does;
+  split by scene group ("bundled" scenes and the "large" mesh), each frame set
+  up by :class:`core.frames.SceneRenderer` as ``renderer`` sets it up;
 * ``max_vertex_error_px`` against OpenCV (over all frames and cases);
 * ``pixel_f1_0px`` / ``pixel_f1_1px``: the minimum over frames of the
   edge-pixel F1 against pyrender, and their means.
@@ -35,17 +35,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from wirecheck.core.clipping import CLIP_MODES
+from wirecheck.core.frames import SceneRenderer
 from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import DTYPES, localize
+from wirecheck.core.projection import DTYPES
 from wirecheck.core.raster import RASTER_MODES
-from wirecheck.core.scene import Scene, face_edges, unique_edges, world_points
+from wirecheck.core.scene import Scene, face_edges, unique_edges
 from wirecheck.core.transforms import Motion
 
 from . import faces as oface
 from . import metrics, opencv_oracle
 from .cases import cameras_for
-
-_EYE = np.eye(4)
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -105,8 +104,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     try:
         for group, scene in groups:
             edges = np.asarray(scene.edges)
-            single = scene.is_single_static
-            prepared = {d: localize(scene.vertices, d) for d in DTYPES} if single else None
+            core = {d: SceneRenderer(scene, motion, frames, dtype=d) for d in DTYPES}   # as renderer sets frames up
             for case in cameras_for(scene.radius):
                 if case_names is not None and case.name not in case_names:
                     continue
@@ -123,12 +121,8 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                         best = np.inf
                         for _ in range(repeats):
                             t0 = time.perf_counter()
-                            if single:
-                                frame = render_frame(prepared[s.dtype], edges, cam, motion.frame_matrix(k, frames),
-                                                     s.clip, raster=s.raster)
-                            else:   # as renderer does for such scenes: world points, identity model matrix
-                                pts = localize(world_points(scene, motion, k, frames), s.dtype)
-                                frame = render_frame(pts, edges, cam, _EYE, s.clip, raster=s.raster)
+                            points, m = core[s.dtype].geometry(k)
+                            frame = render_frame(points, edges, cam, m, s.clip, raster=s.raster)
                             best = min(best, time.perf_counter() - t0)
                         a["t"][group].append(best)
                         ve = metrics.vertex_errors(frame.p_px, ref_px)

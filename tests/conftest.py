@@ -1,4 +1,7 @@
-"""Shared test hooks: sections appended to the terminal summary.
+"""Shared fixtures (pyrender on OSMesa) and hooks (sections appended to the terminal summary).
+
+Helpers that are plain functions (running the CLIs, 8-connectivity) are in
+tests/helpers.py.
 
 A test asks for the ``summary_section`` fixture and calls it with a title and a
 block of text; after the run, ``pytest_terminal_summary`` prints each block as
@@ -33,3 +36,30 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         terminalreporter.write_sep("-", title)
         for line in text.splitlines():
             terminalreporter.write_line(line)
+
+
+@pytest.fixture(scope="module")
+def pyrender_renderer():
+    """A 640x480 ``pyrender.OffscreenRenderer`` on OSMesa (skips the test where OSMesa is missing)."""
+    from wirecheck.oracles.pyrender_oracle import osmesa_available
+
+    ok, msg = osmesa_available()
+    if not ok:
+        pytest.skip(msg)
+    import pyrender
+
+    r = pyrender.OffscreenRenderer(640, 480)
+    yield r
+    r.delete()
+
+
+@pytest.fixture(scope="module")
+def oracle():
+    """A 640x480 :class:`PyrenderOracle` (skips the test where OSMesa is missing)."""
+    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+
+    ok, msg = osmesa_available()
+    if not ok:
+        pytest.skip(msg)
+    with PyrenderOracle(640, 480) as o:
+        yield o

@@ -1,6 +1,5 @@
 """crosscheck end to end: exit codes, report contents, external candidates."""
 
-import json
 import subprocess
 import sys
 from pathlib import Path
@@ -9,6 +8,7 @@ import pytest
 
 from wirecheck.oracles import cli
 from wirecheck.oracles.cases import CASE_NAMES
+from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
 USER = DATA / "user_projector.py"
@@ -20,13 +20,6 @@ CASE_KEYS = {"scene", "camera", "frames", "max_vertex_error_px", "mean_vertex_er
 @pytest.fixture(autouse=True)
 def _data_on_path(monkeypatch):
     monkeypatch.syspath_prepend(str(DATA))   # faulty_projectors imports user_projector
-
-
-def run(tmp_path, *args, name="run"):
-    out = tmp_path / name
-    code = cli.main(["--report-dir", str(out), *args])
-    report = json.loads((out / "report.json").read_text()) if (out / "report.json").exists() else None
-    return code, report, out
 
 
 def test_core_passes_every_case_and_report_has_the_fields(tmp_path, capsys):

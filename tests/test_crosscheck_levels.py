@@ -10,6 +10,7 @@ import pytest
 
 from wirecheck.oracles import cli
 from wirecheck.oracles.runner import CoreCandidate
+from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
 USER = DATA / "user_projector.py"
@@ -18,13 +19,6 @@ VERTEX_KEYS = ("max_vertex_error_px", "mean_vertex_error_px", "rms_vertex_error_
                "visible_points", "visibility_mismatch", "faults", "verdict")
 
 
-
-
-def run(tmp_path, *args, name="run"):
-    out = tmp_path / name
-    code = cli.main(["--report-dir", str(out), *args])
-    report = json.loads((out / "report.json").read_text()) if (out / "report.json").exists() else None
-    return code, report, out
 
 
 def without_timing(out: Path) -> str:

@@ -1,22 +1,14 @@
 """crosscheck's figures: worst.gif (every checked frame of the worst case) and the per-frame plots."""
 
-import json
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.oracles import cli
 from wirecheck.oracles.metrics import DIFF_COLOURS
 from wirecheck.oracles.plots import STRIP_PX, worst_gif
 from wirecheck.oracles.runner import worst_key
-
-
-def run(tmp_path, *args, name="run"):
-    out = tmp_path / name
-    code = cli.main(["--report-dir", str(out), *args])
-    report = json.loads((out / "report.json").read_text()) if (out / "report.json").exists() else None
-    return code, report, out
+from helpers import run_crosscheck as run
 
 
 def gif_frames(path):

@@ -4,7 +4,6 @@ Every bound below is the derived one of oracles/tolerances.py (the numbers in
 comments are measured, core against pyrender/OSMesa on this machine's llvmpipe).
 """
 
-import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -12,20 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from wirecheck.core.frames import SceneRenderer
 from wirecheck.oracles import cli, tolerances
 from wirecheck.oracles.runner import CoreCandidate, RenderMode, run_crosscheck
+from helpers import run_crosscheck as run
 
 ROOT = Path(__file__).resolve().parent.parent
 USER = ROOT / "tests" / "data" / "user_projector.py"
 
 
-
-
-def run(tmp_path, *args, name="run"):
-    out = tmp_path / name
-    code = cli.main(["--report-dir", str(out), *args])
-    report = json.loads((out / "report.json").read_text()) if (out / "report.json").exists() else None
-    return code, report, out
 
 
 @pytest.fixture(scope="module")
@@ -236,19 +230,27 @@ f 1 2 6 5
 """
 
 
-@dataclass(frozen=True)
-class RunFirstCore(CoreCandidate):
+class RunFirstFrames(SceneRenderer):
     """A fault: the run's motion applied before each object's own (M_o @ M_run)."""
 
-    def world_points(self, scene, motion, frame, frames):
+    def world_points(self, k):
         from wirecheck.core.transforms import apply
 
+        scene = self.scene
         out = np.empty((len(scene.vertices), 3))
-        m_run = motion.frame_matrix(frame, frames)
+        m_run = self.motion.frame_matrix(k, self.frames)
         for o in scene.objects:
             rows = slice(o.vertex_start, o.vertex_stop)
-            out[rows] = apply(o.motion.frame_matrix(frame, frames) @ m_run, scene.vertices[rows])
+            out[rows] = apply(o.motion.frame_matrix(k, self.frames) @ m_run, scene.vertices[rows])
         return out
+
+
+@dataclass(frozen=True)
+class RunFirstCore(CoreCandidate):
+    """core with :class:`RunFirstFrames` setting up its frames."""
+
+    def scene_frames(self, scene, motion, frames):
+        return RunFirstFrames(scene, motion, frames, clip=self.clip, dtype=self.dtype, raster=self.raster)
 
 
 def test_two_objects_with_their_own_spins_pass_at_level_pixels(tmp_path):

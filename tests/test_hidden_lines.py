@@ -175,16 +175,6 @@ def test_argument_checks():
 
 # ---- against pyrender -------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def oracle():
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
-    ok, msg = osmesa_available()
-    if not ok:
-        pytest.skip(msg)
-    with PyrenderOracle(640, 480) as o:
-        yield o
-
-
 def test_hidden_lines_against_pyrender(oracle, summary_section):
     """pyrender draws the faces black with glPolygonOffset(1, 1) and the lines on top.
 

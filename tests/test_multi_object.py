@@ -1,7 +1,5 @@
 """Scenes of several objects: the format, world_points, object culling, winding, errors."""
 
-import contextlib
-import io
 import json
 from pathlib import Path
 import numpy as np
@@ -9,23 +7,13 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
-from wirecheck.core.cli import main
 from wirecheck.core.errors import InputError
 from wirecheck.core.scene import (SCENE_DIR, SceneObject, builtin_names, example_names, load_scene, object_matrix,
                         parse_scene_text, world_points)
 from wirecheck.core.transforms import Motion
+from helpers import run_renderer as run
 
 EPS = np.finfo(np.float64).eps
-
-
-def run(args, out):
-    o, e = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
-        try:
-            rc = main(list(args) + ["--out", str(out)])
-        except SystemExit as exc:
-            rc = exc.code
-    return rc, o.getvalue(), e.getvalue()
 
 
 def reference_parse(text):

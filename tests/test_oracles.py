@@ -9,7 +9,7 @@ from wirecheck.core.projection import project_points
 from wirecheck.core.scene import load_scene
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles import opencv_oracle
-from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+from wirecheck.oracles.pyrender_oracle import osmesa_available
 
 EPS = np.finfo(np.float64).eps
 EPS32 = float(np.finfo(np.float32).eps)
@@ -85,12 +85,6 @@ def test_opencv_agrees_with_core_oblique():
 
 _OK, _WHY = osmesa_available()
 needs_osmesa = pytest.mark.skipif(not _OK, reason=f"pyrender/OSMesa unavailable: {_WHY}")
-
-
-@pytest.fixture(scope="module")
-def oracle():
-    with PyrenderOracle(640, 480) as o:
-        yield o
 
 
 def _dilate(mask):

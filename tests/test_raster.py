@@ -27,6 +27,7 @@ from numpy.testing import assert_array_equal
 
 from wirecheck.core import raster
 from wirecheck.core.raster import SUBPIXEL, line_pixels
+from helpers import eight_connected
 
 W, H = 12, 10
 
@@ -253,23 +254,6 @@ def test_pixel_count_between_centres(i0, j0, i1, j1):
         assert (j0, i0) in got and (j1, i1) not in got
         # the segment closed at both ends is the union of both directions
         assert len(got | pixel_set((i1, j1), (i0, j0), PW, PH)) == max(abs(i1 - i0), abs(j1 - j0)) + 1
-
-
-def eight_connected(pixels):
-    pixels = set(pixels)
-    if not pixels:
-        return True
-    start = next(iter(pixels))
-    seen, stack = {start}, [start]
-    while stack:
-        r, c = stack.pop()
-        for dr in (-1, 0, 1):
-            for dc in (-1, 0, 1):
-                q = (r + dr, c + dc)
-                if q in pixels and q not in seen:
-                    seen.add(q)
-                    stack.append(q)
-    return seen == pixels
 
 
 @settings(max_examples=300, deadline=None)

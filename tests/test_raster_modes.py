@@ -30,7 +30,8 @@ from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
 from wirecheck.core.raster import (CHUNK_SEGMENTS, RASTER_MODES, line_coverage_aa, line_pixels, line_pixels_fast,
-                         paint_aa)
+                                   paint_aa)
+from helpers import eight_connected
 
 W, H = 12, 10
 EPS = np.finfo(np.float64).eps
@@ -304,23 +305,6 @@ def aa_reference(p0, p1):
             b = b0 + (i - a0) * (b1 - b0) / (a1 - a0)
             cols.append((i, g, b))
     return x_major, cols
-
-
-def eight_connected(pixels):
-    pixels = set(pixels)
-    if not pixels:
-        return True
-    start = next(iter(pixels))
-    seen, stack = {start}, [start]
-    while stack:
-        r, c = stack.pop()
-        for dr in (-1, 0, 1):
-            for dc in (-1, 0, 1):
-                q = (r + dr, c + dc)
-                if q in pixels and q not in seen:
-                    seen.add(q)
-                    stack.append(q)
-    return seen == pixels
 
 
 # ---- fast: properties ----------------------------------------------------------------------

@@ -4,8 +4,6 @@ In-process through core.cli.main([...]) (stdout/stderr captured), plus one
 subprocess run of the installed entry point.
 """
 
-import contextlib
-import io
 import json
 import math
 import os
@@ -20,27 +18,16 @@ from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
 from wirecheck.core.output import MARKER
-from wirecheck.core.cli import main
 from wirecheck.core.projection import project_points
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.errors import InputError
 from wirecheck.core.transforms import Motion, apply
+from helpers import run_renderer as run
 
 EPS = np.finfo(np.float64).eps
 SEED_ARGS = ["--scene", "cube", "--frames", "180", "--camera-z", "4.0", "--fov", "70"]
 CUBE = [(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1), (-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)]
 F70 = 240.0 / math.tan(math.radians(35.0))      # f = (H/2)/tan(fov/2) = 342.7555
-
-
-def run(args, out):
-    """main(args + --out out) with stdout/stderr captured: (rc, stdout, stderr)."""
-    o, e = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
-        try:
-            rc = main(list(args) + ["--out", str(out)])
-        except SystemExit as exc:       # argparse usage errors
-            rc = exc.code
-    return rc, o.getvalue(), e.getvalue()
 
 
 def naive_depth_range(k, frames, turns=(1.0, 1.0, 0.0), d=4.0):

@@ -1,7 +1,5 @@
 """Renderer outputs: --axes colours, mp4, gif, plots, --projection both."""
 
-import contextlib
-import io
 import json
 import math
 
@@ -10,19 +8,9 @@ import pytest
 from numpy.testing import assert_array_equal
 from PIL import Image
 
-from wirecheck.core.cli import main
 from wirecheck.core.compose import SEPARATOR_GREY
 from wirecheck.core.output import pad_even
-
-
-def run(args, out):
-    o, e = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
-        try:
-            rc = main(list(args) + ["--out", str(out)])
-        except SystemExit as exc:
-            rc = exc.code
-    return rc, o.getvalue(), e.getvalue()
+from helpers import run_renderer as run
 
 
 def frame(out, scene, k=1):

@@ -88,18 +88,6 @@ def test_backface_culling_does_not_change_a_closed_mesh():
     assert np.array_equal(a.image, b.image) and b.faces_culled == 3 and a.faces_culled == 0
 
 
-@pytest.fixture(scope="module")
-def pyrender_renderer():
-    from wirecheck.oracles.pyrender_oracle import osmesa_available
-    ok, msg = osmesa_available()
-    if not ok:
-        pytest.skip(msg)
-    import pyrender
-    r = pyrender.OffscreenRenderer(640, 480)
-    yield r
-    r.delete()
-
-
 @pytest.mark.parametrize("projection", ["perspective", "orthographic"])
 def test_shaded_silhouette_against_pyrender(projection, pyrender_renderer, summary_section):
     """Silhouette of the shaded image vs pyrender's faces (white, flat, double sided).

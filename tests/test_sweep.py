@@ -10,8 +10,6 @@ import json
 import numpy as np
 import pytest
 
-from wirecheck.core.camera import camera_z
-from wirecheck.core.conventions import focal_px
 from wirecheck.core.scene import load_scene
 from wirecheck.oracles import sweep
 from wirecheck.oracles.pyrender_oracle import osmesa_available

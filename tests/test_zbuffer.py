@@ -6,7 +6,6 @@ against pyrender (OSMesa / llvmpipe) on a cube and an icosphere.
 
 from __future__ import annotations
 
-import os
 import time
 
 import numpy as np
@@ -293,18 +292,6 @@ def _pyrender_faces(vertices, triangles, camera, renderer):
         n, f = camera.near, camera.far
         depth = np.where(depth > 0, f + n - n * f / np.where(depth > 0, depth, 1.0), 0.0)
     return colour[:, :, 0] > 127, depth
-
-
-@pytest.fixture(scope="module")
-def pyrender_renderer():
-    from wirecheck.oracles.pyrender_oracle import osmesa_available
-    ok, msg = osmesa_available()
-    if not ok:
-        pytest.skip(msg)
-    import pyrender
-    r = pyrender.OffscreenRenderer(640, 480)
-    yield r
-    r.delete()
 
 
 def _meshes():

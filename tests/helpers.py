@@ -1,0 +1,48 @@
+"""What several test modules share: the two CLIs run in-process, and 8-connectivity of pixels."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+
+
+def run_renderer(args, out) -> tuple[int, str, str]:
+    """``renderer`` with ``args + --out out``, stdout/stderr captured: ``(rc, stdout, stderr)``."""
+    from wirecheck.core.cli import main
+
+    o, e = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
+        try:
+            rc = main(list(args) + ["--out", str(out)])
+        except SystemExit as exc:       # argparse usage errors
+            rc = exc.code
+    return rc, o.getvalue(), e.getvalue()
+
+
+def run_crosscheck(tmp_path, *args, name="run"):
+    """``crosscheck --report-dir tmp_path/name args``: ``(exit code, report.json or None, run dir)``."""
+    from wirecheck.oracles import cli
+
+    out = tmp_path / name
+    code = cli.main(["--report-dir", str(out), *args])
+    report = json.loads((out / "report.json").read_text()) if (out / "report.json").exists() else None
+    return code, report, out
+
+
+def eight_connected(pixels) -> bool:
+    """True when the ``(row, col)`` pixels form one 8-connected set (or none)."""
+    pixels = set(pixels)
+    if not pixels:
+        return True
+    start = next(iter(pixels))
+    seen, stack = {start}, [start]
+    while stack:
+        r, c = stack.pop()
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                q = (r + dr, c + dc)
+                if q in pixels and q not in seen:
+                    seen.add(q)
+                    stack.append(q)
+    return seen == pixels
