@@ -14,6 +14,8 @@ The public API, importable from the top level::
 - :func:`load_scene`, :class:`Scene`, :class:`Motion`: scenes and their motion.
 - :func:`project_points`, :func:`render_frame`, :class:`Frame`: core's projector
   and one frame of its pipeline.
+- :class:`SceneRenderer`: frame ``k`` of a scene's motion, as ``renderer``
+  draws it (one static object or several moving ones).
 
 In the source tree this file is the repository root's ``__init__.py``;
 ``wirecheck.core``, ``wirecheck.oracles`` and ``wirecheck.scenes`` are the
@@ -29,6 +31,7 @@ _EXPORTS = {
     "InputError": "core.errors",
     "Frame": "core.pipeline", "render_frame": "core.pipeline",
     "project_points": "core.projection",
+    "SceneRenderer": "core.frames",
     "Scene": "core.scene", "load_scene": "core.scene",
     "Motion": "core.transforms",
     "assert_projector": "oracles.api", "check_projector": "oracles.api",

@@ -64,6 +64,14 @@ class SceneRenderer:
     object_culling : bool
         Leave out objects outside the frustum (scenes of several objects only;
         never changes the picture or the counts).
+
+    Examples
+    --------
+    >>> from wirecheck import Motion, SceneRenderer, camera_z, load_scene
+    >>> frames = SceneRenderer(load_scene("cube"), Motion(turns=(1, 1, 0)), 12)
+    >>> frame, info = frames.render(1, camera_z(4.0))
+    >>> frame.image.shape, frame.p_px.shape, info["clipped_edges"]
+    ((480, 640), (8, 2), 0)
     """
 
     def __init__(self, scene: Scene, motion: Motion, frames: int, *, clip: str = "clip",
@@ -87,12 +95,17 @@ class SceneRenderer:
         return self.cull is not None or self.hidden_lines or self.style != "wireframe"
 
     def world_points(self, k: int) -> np.ndarray:
-        """``(N, 3)`` float64 world points of frame ``k`` (inf where they overflow)."""
+        """``(N, 3)`` float64 world points ``p_world`` of frame ``k`` (inf where they overflow)."""
         with np.errstate(over="ignore", invalid="ignore"):
             return world_points(self.scene, self.motion, k, self.frames)
 
     def geometry(self, k: int) -> tuple[LocalPoints, np.ndarray]:
-        """``(points, model_matrix (4, 4))`` of frame ``k``, as :func:`render_frame` takes them."""
+        """Frame ``k`` as :func:`render_frame` takes it: ``(points, model_matrix)``.
+
+        ``points`` are the ``N`` vertices as :class:`~core.projection.LocalPoints`
+        (``p_model`` of a single static object, else ``p_world``);
+        ``model_matrix`` is ``(4, 4)`` float64 (the identity for world points).
+        """
         if self.single:
             return self.points, self.motion.frame_matrix(k, self.frames)
         return localize(self.world_points(k), self.dtype), IDENTITY
@@ -109,8 +122,13 @@ class SceneRenderer:
         return render_frame(points, _NO_EDGES, camera, model_matrix, self.clip, raster=self.raster).p_px
 
     def render(self, k: int, camera: Camera, timing: dict | None = None) -> tuple[Frame, dict]:
-        """``(frame, info)``: frame ``k`` and its counts (core.report.frame_record's ``info``).
+        """Frame ``k`` through ``camera``: ``(frame, info)``.
 
+        ``frame`` is the pipeline's :class:`~core.pipeline.Frame` (``image``
+        ``(H, W)`` uint8, ``p_px`` ``(N, 2)`` float64 with NaN where clipped,
+        ``depth`` ``(N,)``); ``info`` its counts for the report
+        (core.report.frame_record): ``clipped_edges`` and, when the run has them,
+        ``objects_culled``, ``faces_total``, ``faces_culled``, ``hidden_pixels``.
         ``timing``: render_frame's per-stage seconds are added to it, the
         frame's set-up (model matrix, world points, object culling) as
         "transform" (core.profile). Raises InputError when a world point of

@@ -77,8 +77,13 @@ class Settings:
 
 
 def progress_steps(s: Settings) -> int:
-    """Steps :func:`render_run` reports to ``progress``: one per frame, then the animations' encoding."""
-    return s.frames * (2 if "gif" in s.formats else 1) + ("mp4" in s.formats)
+    """Steps :func:`render_run` reports to ``progress``: one per frame, then the animations' encoding.
+
+    GIF: each frame converted, then each written (fewer when identical
+    neighbours merge); MP4: one for the encoder's flush (frames are encoded as
+    they are rendered).
+    """
+    return s.frames * (3 if "gif" in s.formats else 1) + ("mp4" in s.formats)
 
 
 def render_run(s: Settings, log=None, progress=None, profiler=None, extra: dict | None = None) -> dict:

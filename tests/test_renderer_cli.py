@@ -431,3 +431,32 @@ def test_huge_finite_vertex_is_not_a_crash(tmp_path):
         rep = json.loads((out / "huge-report.json").read_text())     # strict JSON parsed back
         for xy in rep["frames"][0]["vertices_px"]:
             assert xy is None or all(math.isfinite(v) for v in xy)
+
+
+# ---- --help and the progress bar ---------------------------------------------------
+
+def test_every_option_has_help_with_its_default_and_no_markup():
+    from wirecheck.core.cli import build_parser
+
+    parser = build_parser()
+    for action in parser._actions:
+        if action.dest != "help":
+            assert action.help and "default" in action.help, action.option_strings
+    text = parser.format_help()
+    assert "``" not in text and ":func:" not in text and ":mod:" not in text
+
+
+def test_progress_counts_every_frame_and_the_animation_encoding(tmp_path):
+    """One step per frame rendered, per GIF frame converted and written, and the MP4 flush.
+
+    The spinning cube's 6 frames all differ, so Pillow writes all 6 (identical
+    neighbours would merge): 6 + 2 x 6 + 1 = progress_steps.
+    """
+    from wirecheck.core.cli import build_parser, settings_from_args
+    from wirecheck.core.run import progress_steps, render_run
+
+    s = settings_from_args(build_parser().parse_args(["--frames", "6", "--format", "gif,mp4", "--out", str(tmp_path)]))
+    stages = []
+    render_run(s, progress=stages.append)
+    assert stages == ["render"] * 6 + ["mp4"] + ["gif"] * 12
+    assert len(stages) == progress_steps(s) == 19
