@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import json
 import os
 import platform
+from pathlib import Path
 
 
 def loadavg() -> list[str] | None:
@@ -66,6 +68,16 @@ def print_machine(title: str, info: dict, libraries: str | None = None) -> None:
     print(f"  {info['platform']}")
 
 
+def print_end(info: dict, t_start: float) -> float:
+    """Record the load at the end in ``info``, print it with the total time; return that time (s)."""
+    import time
+
+    elapsed = time.perf_counter() - t_start
+    info["loadavg_end"] = loadavg()
+    print(f"\nload average at end {' '.join(info['loadavg_end'] or [])}; total benchmark time {elapsed:.1f} s")
+    return elapsed
+
+
 def print_table(title: str | None, header: str, rows) -> None:
     """``title``, ``header``, a rule as wide as the header, then each row (an empty line after)."""
     if title:
@@ -82,3 +94,15 @@ def fmt_ms(x) -> str:
     if x is None:
         return "-"
     return f"{x:.4f}" if x < 0.1 else f"{x:.3f}" if x < 10 else f"{x:.1f}"
+
+
+def write_json(path, **payload) -> None:
+    """``payload`` (keyword order kept) as indented JSON at ``path`` (folders made as needed), and a line saying so."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    Path(path).write_text(json.dumps(payload, indent=2, default=str) + "\n")
+    print(f"wrote {path}")
+
+
+def verdict(ok: bool, miss: str = "FAIL") -> str:
+    """"PASS", or ``miss`` for a target not met."""
+    return "PASS" if ok else miss

@@ -38,17 +38,15 @@ from __future__ import annotations
 
 import argparse
 import gc
-import json
 import sys
 import time
 import tracemalloc
-from pathlib import Path
 
 import cv2
 import numpy as np
 import trimesh
 
-from _common import machine_info, print_machine, print_table
+from _common import machine_info, print_machine, print_table, verdict, write_json
 from wirecheck.core.camera import camera_z
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import project_points
@@ -198,10 +196,6 @@ def peak_memory(p_model, edges, camera, matrix) -> dict:
 
 
 # ---------------------------------------------------------------- report
-def verdict(ok: bool) -> str:
-    return "PASS" if ok else "MISS"
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true",
@@ -276,27 +270,19 @@ def main(argv=None) -> int:
     ]
     print("targets (ours, median per frame):")
     print(f"  cube frame <= {CUBE_TARGET_MS:g} ms                 {cube_ms:8.3f} ms  "
-          f"{verdict(targets[0]['pass'])}")
+          f"{verdict(targets[0]['pass'], 'MISS')}")
     print(f"  icosphere frame <= {ICO_TARGET_RATIO:g}x OpenCV ({ICO_TARGET_RATIO * ico_cv:.1f} ms)  "
-          f"{ico_ms:8.3f} ms  {verdict(targets[1]['pass'])}  (ratio {ico_ms / ico_cv:.2f})")
+          f"{ico_ms:8.3f} ms  {verdict(targets[1]['pass'], 'MISS')}  (ratio {ico_ms / ico_cv:.2f})")
     elapsed = time.perf_counter() - t_start
     print(f"\ntotal benchmark time {elapsed:.1f} s")
 
     if args.json:
-        payload = {
-            "machine": info,
-            "config": {"frames": FRAMES, "width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
-                       "motion_turns": list(motion.turns), "repeats": repeats, "warmup_frames": warmup,
-                       "quick": args.quick, "timed_region": "model transform + projection + raster + image, both",
-                       "statistic": "median over repeats of per-repeat median / p90 of per-frame times"},
-            "results": results,
-            "memory": memory,
-            "targets": targets,
-            "elapsed_s": elapsed,
-        }
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(payload, indent=2) + "\n")
-        print(f"wrote {args.json}")
+        config = {"frames": FRAMES, "width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
+                  "motion_turns": list(motion.turns), "repeats": repeats, "warmup_frames": warmup,
+                  "quick": args.quick, "timed_region": "model transform + projection + raster + image, both",
+                  "statistic": "median over repeats of per-repeat median / p90 of per-frame times"}
+        write_json(args.json, machine=info, config=config, results=results, memory=memory, targets=targets,
+                   elapsed_s=elapsed)
     return 0
 
 

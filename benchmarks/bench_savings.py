@@ -43,7 +43,6 @@ poses, rounds alternating the order; GC off).
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import tempfile
@@ -55,7 +54,7 @@ os.environ["PYOPENGL_PLATFORM"] = "osmesa"        # before anything imports pyre
 import numpy as np
 import trimesh
 
-from _common import loadavg, print_machine, print_table
+from _common import print_end, print_machine, print_table, write_json
 from bench_scale import OpenBLAS, bench_group, blas_info, fast_unique_edges
 from wirecheck.core import clipping, raster
 from wirecheck.core.camera import camera_z
@@ -371,18 +370,12 @@ def main(argv=None) -> int:
                 "saving = skipped / (run + skipped)", hdr, lines)
     for r in rows:
         print(f"  {r['stage']}: {r['note']}")
-    elapsed = time.perf_counter() - t_start
-    info["loadavg_end"] = loadavg()
-    print(f"\nload average at end {' '.join(info['loadavg_end'] or [])}; total benchmark time {elapsed:.1f} s")
+    elapsed = print_end(info, t_start)
 
     if args.json:
-        payload = {"machine": info,
-                   "config": {"width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
-                              "mesh": "icosphere(6)", "quick": args.quick, **cfg},
-                   "rows": rows, "details": details, "elapsed_s": elapsed}
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(payload, indent=2, default=str) + "\n")
-        print(f"wrote {args.json}")
+        config = {"width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
+                  "mesh": "icosphere(6)", "quick": args.quick, **cfg}
+        write_json(args.json, machine=info, config=config, rows=rows, details=details, elapsed_s=elapsed)
     return 0
 
 

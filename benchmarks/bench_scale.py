@@ -74,7 +74,7 @@ import cv2
 import numpy as np
 import trimesh
 
-from _common import fmt_ms, loadavg, machine_info, print_machine, print_table
+from _common import fmt_ms, machine_info, print_end, print_machine, print_table, verdict, write_json
 from wirecheck.core import raster
 from wirecheck.core.camera import camera_z
 from wirecheck.core.pipeline import render_frame
@@ -504,10 +504,6 @@ def blas_info(blas: OpenBLAS) -> dict:
                                                              "MKL_NUM_THREADS") if k in os.environ})
 
 
-def verdict(ok: bool) -> str:
-    return "PASS" if ok else "FAIL"
-
-
 # ---------------------------------------------------------------- main
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -719,9 +715,8 @@ def main(argv=None) -> int:
     for t in targets:
         extra = ""
         if "speedup" in t:
-            extra = f"ours {t['ours_ms']:.1f} ms, speedup {t['speedup']:.2f}x"
-            if "cv2_ms" in t:
-                extra = f"ours {t['ours_ms']:.1f} ms vs cv2 {t['cv2_ms']:.1f} ms, speedup {t['speedup']:.2f}x"
+            vs = f" vs cv2 {t['cv2_ms']:.1f} ms" if "cv2_ms" in t else ""
+            extra = f"ours {t['ours_ms']:.1f} ms{vs}, speedup {t['speedup']:.2f}x"
         elif "max_abs_diff_px" in t:
             extra = f"max |d| {t['max_abs_diff_px']:.2e} px (all sizes {t['max_abs_diff_px_all_sizes']:.2e})"
         elif "ratio" in t:
@@ -733,26 +728,14 @@ def main(argv=None) -> int:
         status = ("info " + verdict(t["pass"])) if t.get("info") else verdict(t["pass"])
         print(f"  {status:<9} {t['name']}: {extra}")
 
-    elapsed = time.perf_counter() - t_start
-    info["loadavg_end"] = loadavg()
-    print(f"\nload average at end {' '.join(info['loadavg_end'] or [])}; total benchmark time {elapsed:.1f} s")
+    elapsed = print_end(info, t_start)
 
     if args.json:
-        payload = {
-            "machine": info,
-            "config": {"width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
-                       "motion": "Motion(), frames of 180", "quick": args.quick,
-                       **{k: v for k, v in cfg.items()},
-                       "statistic": "median per-call time over rounds x passes x poses"},
-            "results": results,
-            "slopes": slopes,
-            "memory": mem,
-            "targets": targets,
-            "elapsed_s": elapsed,
-        }
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(payload, indent=2) + "\n")
-        print(f"wrote {args.json}")
+        config = {"width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
+                  "motion": "Motion(), frames of 180", "quick": args.quick, **cfg,
+                  "statistic": "median per-call time over rounds x passes x poses"}
+        write_json(args.json, machine=info, config=config, results=results, slopes=slopes, memory=mem,
+                   targets=targets, elapsed_s=elapsed)
     return 0
 
 

@@ -129,16 +129,25 @@ def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
-def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`line_pixels` of a non-empty batch of already snapped end points."""
+def major_minor(p0_px: np.ndarray, p1_px: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(x_major, a0, a1, b0, b1)`` of ``M`` segments: x is the major axis when ``|dx| > |dy|``.
+
+    ``x_major`` is ``(M,)`` bool; ``a0, a1`` are the ends' major and ``b0, b1``
+    their minor coordinates, ``(M,)`` each.
+    """
     d = p1_px - p0_px
     x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
-    # major (a) and minor (b) coordinates of both ends
     a0 = np.where(x_major, p0_px[:, 0], p0_px[:, 1])
     a1 = np.where(x_major, p1_px[:, 0], p1_px[:, 1])
     b0 = np.where(x_major, p0_px[:, 1], p0_px[:, 0])
     b1 = np.where(x_major, p1_px[:, 1], p1_px[:, 0])
+    return x_major, a0, a1, b0, b1
+
+
+def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`line_pixels` of a non-empty batch of already snapped end points."""
+    x_major, a0, a1, b0, b1 = major_minor(p0_px, p1_px)
     travel = np.where(a1 >= a0, 1.0, -1.0)            # direction along the major axis
     lo = np.floor(np.minimum(a0, a1)).astype(np.intp)  # candidate major coordinates lo..hi
     hi = np.ceil(np.maximum(a0, a1)).astype(np.intp)
@@ -290,12 +299,7 @@ def line_coverage_aa(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: i
 def _line_coverage_aa(p0: np.ndarray, p1: np.ndarray, width: int, height: int
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`line_coverage_aa` of a non-empty batch."""
-    d = p1 - p0
-    x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
-    a0 = np.where(x_major, p0[:, 0], p0[:, 1])
-    a1 = np.where(x_major, p1[:, 0], p1[:, 1])
-    b0 = np.where(x_major, p0[:, 1], p0[:, 0])
-    b1 = np.where(x_major, p1[:, 1], p1[:, 0])
+    x_major, a0, a1, b0, b1 = major_minor(p0, p1)
     # Work from the end with the smaller major coordinate, so that a reversed
     # segment runs the same float operations and gets the same weights.
     swap = a1 < a0

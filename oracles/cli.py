@@ -212,6 +212,12 @@ def _parse(args):
     return level, cases, spin, scenes, candidate, mode
 
 
+def _error(text: str) -> int:
+    """Print ``crosscheck: error: text`` on stderr; the exit status of a usage error (2)."""
+    print(f"crosscheck: error: {text}", file=sys.stderr)
+    return 2
+
+
 def main(argv=None) -> int:
     try:
         args, config, applied = parse_cli(build_parser(), argv)
@@ -224,23 +230,20 @@ def main(argv=None) -> int:
             check_junit_target(Path(args.junit_xml))
         level, case_names, spin, scenes, candidate, mode = _parse(args)
     except InputError as exc:
-        print(f"crosscheck: error: {exc}", file=sys.stderr)
-        return 2
+        return _error(str(exc))
     if level == "pixels":
         from .pyrender_oracle import osmesa_available
 
         ok, message = osmesa_available()
         if not ok:
-            print(f"crosscheck: error: {message} (or run with --level vertices)", file=sys.stderr)
-            return 2
+            return _error(f"{message} (or run with --level vertices)")
     if args.report_dir:
         run_dir = Path(args.report_dir)
     else:
         run = args.run or datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
         if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", run):
-            print(f"crosscheck: error: --run {run!r}: expected a name of letters, digits, '_', '.', '-' "
-                  "(no '/', not starting with '.')", file=sys.stderr)
-            return 2
+            return _error(f"--run {run!r}: expected a name of letters, digits, '_', '.', '-' "
+                          "(no '/', not starting with '.')")
         run_dir = Path("reports") / run
     try:
         run_dir.parent.mkdir(parents=True, exist_ok=True)
@@ -248,12 +251,10 @@ def main(argv=None) -> int:
             raise OSError("permission denied")
         check_replaceable(run_dir, "--report-dir" if args.report_dir else "--run")
     except InputError as exc:
-        print(f"crosscheck: error: {exc}", file=sys.stderr)
-        return 2
+        return _error(str(exc))
     except OSError as exc:
-        print(f"crosscheck: error: --report-dir {str(run_dir)!r}: cannot write there ({exc}): "
-              "expected a writable directory", file=sys.stderr)
-        return 2
+        return _error(f"--report-dir {str(run_dir)!r}: cannot write there ({exc}): "
+                      "expected a writable directory")
 
     tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
                      min_iou=args.min_iou)
@@ -267,27 +268,22 @@ def main(argv=None) -> int:
                                         candidate_name=args.candidate or "core", candidate_spec=args.candidate,
                                         mode=mode)
     except InputError as exc:
-        print(f"crosscheck: error: {exc}", file=sys.stderr)
-        return 2
+        return _error(str(exc))
     except BrokenProcessPool as exc:
-        print(f"crosscheck: error: a worker process died ({exc}); try --jobs 1", file=sys.stderr)
-        return 2
+        return _error(f"a worker process died ({exc}); try --jobs 1")
     records = report["cases"]
     failed = report["summary"]["failed"]
     try:
         write_report(run_dir, report, images)
     except OSError as exc:
-        print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
-        return 2
+        return _error(f"writing {str(run_dir)!r} failed: {exc}")
     if args.junit_xml:
         try:
             write_junit(Path(args.junit_xml), report)
         except InputError as exc:
-            print(f"crosscheck: error: {exc}", file=sys.stderr)
-            return 2
+            return _error(str(exc))
         except OSError as exc:
-            print(f"crosscheck: error: --junit-xml {args.junit_xml!r}: writing failed: {exc}", file=sys.stderr)
-            return 2
+            return _error(f"--junit-xml {args.junit_xml!r}: writing failed: {exc}")
     print(console_table(records))
     for r in records:
         if r["verdict"] != "pass":
@@ -317,11 +313,9 @@ def _sweep(args, scenes, case_names, spin, level, tol, run_dir) -> int:
                            large=large_mesh(), pyrender=level == "pixels", progress=progress)
         write_sweep(run_dir, result)
     except InputError as exc:
-        print(f"crosscheck: error: {exc}", file=sys.stderr)
-        return 2
+        return _error(str(exc))
     except OSError as exc:
-        print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
-        return 2
+        return _error(f"writing {str(run_dir)!r} failed: {exc}")
     print(markdown_table(result))
     reasons = default_failures(result, tol.vertex_px, tol.min_f1_1px, tol.min_f1_0px)
     if reasons:
@@ -350,8 +344,7 @@ def _suite(level, run_dir) -> int:
             out.abort()
             raise
     except OSError as exc:
-        print(f"crosscheck: error: writing {str(run_dir)!r} failed: {exc}", file=sys.stderr)
-        return 2
+        return _error(f"writing {str(run_dir)!r} failed: {exc}")
     print(md)
     failed = [c["name"] for c in result["cases"] if c["verdict"] != "pass"]
     print(f"{result['verdict'].upper()}: {len(result['cases']) - len(failed)}/{len(result['cases'])} extreme cases "

@@ -27,17 +27,7 @@ def _r_t(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
 
 
 def depth(p_world: np.ndarray, camera: Camera) -> np.ndarray:
-    """Camera depth ``z_cv`` (distance along ``forward``) of each point.
-
-    Parameters
-    ----------
-    p_world : (N, 3) array_like
-    camera : Camera
-
-    Returns
-    -------
-    (N,) ndarray of float64; OpenCV's z (ours is the same: forward).
-    """
+    """``(N,)`` float64: OpenCV's camera depth ``z_cv`` of ``(N, 3)`` world points (ours too: along ``forward``)."""
     p_world = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
     r_cv, t_cv = _r_t(camera)
     return p_world @ r_cv[2] + t_cv[2]

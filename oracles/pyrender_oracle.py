@@ -273,18 +273,11 @@ class PyrenderOracle:
                      model_matrix: np.ndarray | None = None, cull: bool = False, with_ids: bool = False):
         """Render filled triangles: coverage and linear camera depth (and triangle ids).
 
-        Parameters
-        ----------
-        vertices : (N, 3) array_like
-            ``p_model`` (with ``model_matrix``) or ``p_world`` (without).
-        triangles : (T, 3) array_like of int
-        camera : Camera
-        model_matrix : (4, 4) array_like, optional
-        cull : bool
-            GL back-face culling (pyrender's default for a material that is not
-            ``doubleSided``): counter-clockwise in the window is front.
-        with_ids : bool
-            Also return the triangle-id image.
+        ``vertices``, ``camera`` and ``model_matrix`` as in :meth:`render`;
+        ``triangles`` is ``(T, 3)`` int. ``cull``: GL back-face culling
+        (pyrender's default for a material that is not ``doubleSided``;
+        counter-clockwise in the window is front). ``with_ids``: also return
+        the triangle-id image.
 
         Returns
         -------
