@@ -32,7 +32,7 @@ _EXPORTS = {
     "Frame": "core.pipeline", "render_frame": "core.pipeline",
     "project_points": "core.projection",
     "SceneRenderer": "core.frames",
-    "Scene": "core.scene", "load_scene": "core.scene",
+    "Scene": "core.scene", "load_scene": "core.scene_files",
     "Motion": "core.transforms",
     "assert_projector": "oracles.api", "check_projector": "oracles.api",
 }

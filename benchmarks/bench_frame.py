@@ -8,7 +8,7 @@ Run from the repo root::
 Cases (both: camera ``camera_z(4.0, fov_y_deg=70)``, 640x480, ``Motion()``,
 180 frames, frame k at t = (k - 1) / 180):
 
-* ``cube``       the built-in scene ``core.scene.load_scene('cube')``
+* ``cube``       the built-in scene ``core.scene_files.load_scene('cube')``
 * ``icosphere``  ``trimesh.creation.icosphere(subdivisions=6)``: 40,962
   vertices, 122,880 unique edges (``core.scene.unique_edges(face_edges(...))``)
 
@@ -50,7 +50,8 @@ from _common import machine_info, print_machine, print_table, verdict, write_jso
 from wirecheck.core.camera import camera_z
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import project_points
-from wirecheck.core.scene import face_edges, load_scene, unique_edges
+from wirecheck.core.scene import face_edges, unique_edges
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion
 
 FRAMES = 180

@@ -34,7 +34,7 @@ its pyrender oracle) skips; the table gives what the stage would add per frame
 * scene loading: ``trimesh.load(process=True)`` against ``process=False``
   (core.scene.load_mesh_file uses ``process=False, maintain_order=True``) on a
   binary PLY of an icosphere with 163,842 vertices (``--quick``: 40,962)
-  written to a temporary directory; and ``core.scene.load_scene`` on it.
+  written to a temporary directory; and ``core.scene_files.load_scene`` on it.
 
 Statistics: as bench_scale.py (median per-call time over rounds x passes x
 poses, rounds alternating the order; GC off).
@@ -60,7 +60,8 @@ from wirecheck.core import clipping, raster
 from wirecheck.core.camera import camera_z
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import cam_to_px, localize, model_to_cam
-from wirecheck.core.scene import Scene, load_scene
+from wirecheck.core.scene import Scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 640, 480
@@ -356,7 +357,7 @@ def main(argv=None) -> int:
     rows.append({"stage": "load: trimesh process=True", "skipped_ms": load_med["process_true"] - load_med["process_false"],
                  "run_ms": load_med["process_false"], "per": "load",
                  "note": f"{len(big.vertices):,} V PLY ({size_mib:.1f} MiB), once per run; core uses process=False; "
-                         f"core.scene.load_scene total {ms(load_med['core_load_scene'])} ms"})
+                         f"core.scene_files.load_scene total {ms(load_med['core_load_scene'])} ms"})
 
     # ---- table
     print()

@@ -9,7 +9,7 @@ Meshes (all seen by ``camera_z(4.0, fov_y_deg=70)`` at 1280x960, posed by
 ``Motion()``; every vertex stays in [near, far] and on the image, so
 ``render_frame`` always takes its no-clip fast path, which is checked):
 
-* ``cube``    ``core.scene.load_scene('cube')``: 8 vertices, 12 edges
+* ``cube``    ``core.scene_files.load_scene('cube')``: 8 vertices, 12 edges
 * ``ico<s>``  ``trimesh.creation.icosphere(subdivisions=s)``, s = 0..8:
   12 .. 655,362 vertices; edges are the unique edges of the faces
 * ``grid<n>`` an n x n height field over [-1, 1]^2,
@@ -79,7 +79,8 @@ from wirecheck.core import raster
 from wirecheck.core.camera import camera_z
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import cam_to_px, depth_mask, localize, model_to_cam
-from wirecheck.core.scene import load_scene, unique_edges
+from wirecheck.core.scene import unique_edges
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 1280, 960

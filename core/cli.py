@@ -10,6 +10,7 @@ as one line with exit status 2.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import math
 import os
 import sys
@@ -25,7 +26,7 @@ from .projection import DTYPES
 from .raster import RASTER_MODES
 from .report import depth_text
 from .run import FORMATS, Settings, progress_steps, render_run
-from .scene import load_scene
+from .scene_files import load_scene
 from .shading import STYLES
 from .transforms import Motion
 
@@ -196,12 +197,8 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         big = max(abs(v) for v in light)
         light = tuple(v / big for v in light)            # a direction: scale it to avoid over/underflow
     motion = Motion(turns=vec3("--spin", a.spin), offset=vec3("--translate", a.translate), scale=a.scale)
-    if "mp4" in formats:
-        try:
-            import av  # noqa: F401 - only checking that it is there
-        except ImportError:
-            raise InputError("--format mp4: expected the PyAV package (pip install av; "
-                             "it is a dependency of wirecheck)") from None
+    if "mp4" in formats and importlib.util.find_spec("av") is None:
+        raise InputError("--format mp4: expected the PyAV package (pip install av; it is a dependency of wirecheck)")
     scene = load_scene(a.scene)
     cull = None if a.cull == "none" else a.cull
     s = Settings(scene, camera, motion, a.frames, a.clip, formats, Path(a.out), a.ascii_cols,

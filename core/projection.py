@@ -102,9 +102,9 @@ def model_to_cam(points: LocalPoints, model_matrix: np.ndarray, camera: Camera) 
 
     ``p_cam[:, i] = ((x R_i0 + y R_i1) + z R_i2) + t_i``, evaluated elementwise in
     blocks, not with ``@``: a matrix product goes to the BLAS library, whose
-    threads stall on a loaded machine (1M points: 16 ms on one thread, 240 ms
-    with two threads under load) and whose summation order depends on the CPU's
-    kernel. Elementwise numpy has one order everywhere: same inputs, same bytes.
+    threads stall on a loaded machine and whose summation order depends on the
+    CPU's kernel. Elementwise numpy has one order everywhere: same inputs, same
+    bytes.
     """
     r_mv, t_mv = model_view(model_matrix, camera, points.origin)
     dt = points.dtype

@@ -269,7 +269,7 @@ class Viewer:
     def command(self, v: View) -> str:
         """The ``renderer`` command line that writes this frame (``frame_<k>.png``), floats exact (repr)."""
         s = self.s
-        from .scene import builtin_names, example_names
+        from .scene_files import builtin_names, example_names
 
         scene = s.scene.name if s.scene.name in builtin_names() + example_names() else s.scene.source
         r = lambda xs: ",".join(repr(float(x)) for x in xs)            # noqa: E731 - repr round-trips floats

@@ -27,10 +27,8 @@ Triangle rasterization (:func:`rasterize_triangles`)
    evaluated at the centre on the plane through the three vertices
    (``1/z = 1/z_a + g . (p - a)``, ``g`` its screen-space gradient). That plane
    goes through the *unsnapped* vertices: snapping decides coverage only, as in
-   llvmpipe (measured on a cube at 640x480: a plane through the snapped
-   vertices differs from pyrender's depth by up to 1.1e-4, ~|dz/dpx| / 512;
-   the unsnapped plane by 6e-6, pyrender's own quantisation; see
-   tests/test_zbuffer.py for the bound).
+   llvmpipe (a plane through snapped vertices is off by ~|dz/dpx| / 512;
+   tests/test_zbuffer.py bounds the difference from pyrender's depth).
 4. Nearest wins; equal depths go to the lower triangle index.
 
 Work is vectorised over the rows of per-triangle bounding boxes (clipped to
@@ -39,7 +37,7 @@ centres form one span, solved per edge by a rounded division and then
 corrected by evaluating ``E`` exactly at its ends (so the top-left rule holds
 exactly). Batches hold at most :data:`CHUNK_SAMPLES` bounding-box pixels, big
 triangles split into row slabs, so memory stays bounded whatever the triangle
-sizes; 100k triangles of a sphere filling a 640x480 image take ~0.1-0.2 s.
+sizes.
 
 Triangles are clipped in camera space first (core.clipping.clip_triangles):
 against near and far always, and against side planes :data:`GUARD_PX` pixels

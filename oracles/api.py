@@ -13,7 +13,8 @@ pixels too.
 
 from __future__ import annotations
 
-from wirecheck.core.scene import Scene, builtin_names, load_scene
+from wirecheck.core.scene import Scene
+from wirecheck.core.scene_files import builtin_names, load_scene
 
 from . import tolerances
 from .candidate import load_candidate

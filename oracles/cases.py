@@ -18,8 +18,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from wirecheck.core.camera import Camera, look_at
 
 
@@ -54,4 +52,4 @@ def case_table() -> str:
     return __doc__.split("\n\n", 2)[2].strip()
 
 
-__all__ = ["Case", "cameras_for", "CASE_NAMES", "np"]
+__all__ = ["Case", "cameras_for", "CASE_NAMES"]

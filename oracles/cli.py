@@ -45,7 +45,7 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 from wirecheck.core.output import check_replaceable
-from wirecheck.core.scene import builtin_names, load_scene
+from wirecheck.core.scene_files import builtin_names, load_scene
 
 from . import tolerances
 from .candidate import load_candidate

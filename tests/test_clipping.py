@@ -16,7 +16,7 @@ from wirecheck.core.clipping import apply_clip, clip_segments, frustum_planes
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import cam_to_px
 from wirecheck.core.raster import line_pixels
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16
 D = 10.0

@@ -32,7 +32,7 @@ def icosphere(tmp_path_factory):
 
 
 def _load(name_or_path):
-    from wirecheck.core.scene import load_scene
+    from wirecheck.core.scene_files import load_scene
 
     return load_scene(str(name_or_path))
 

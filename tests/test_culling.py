@@ -181,7 +181,7 @@ def test_every_face_culled_renders_an_empty_face_buffer(kw):
     # and with hidden lines every remaining edge (none: all belong to faces) is gone.
     from wirecheck.core.camera import camera_z
     from wirecheck.core.pipeline import render_frame
-    from wirecheck.core.scene import load_scene
+    from wirecheck.core.scene_files import load_scene
 
     cube = load_scene("cube")
     cam = camera_z(0.5, near=0.1, far=10.0)

@@ -19,7 +19,7 @@ import pytest
 from wirecheck.core.camera import Camera, look_at
 from wirecheck.core.conventions import focal_px
 from wirecheck.core.projection import project_points
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion, apply, rotate_z
 from wirecheck.oracles.diagnose import FAULT_ORDER, diagnose, primary
 

@@ -13,7 +13,8 @@ import pytest
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.culling import backface_keep, degenerate
 from wirecheck.core.pipeline import render_frame
-from wirecheck.core.scene import load_scene, oriented_faces, parse_scene_text
+from wirecheck.core.scene import oriented_faces
+from wirecheck.core.scene_files import load_scene, parse_scene_text
 from wirecheck.core.transforms import Motion, scale
 
 

@@ -8,7 +8,7 @@ from numpy.testing import assert_array_equal
 import wirecheck
 from wirecheck.core import frames
 from wirecheck.core.camera import look_at
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles import opencv_oracle
 from wirecheck.oracles.faces import frame_geometry

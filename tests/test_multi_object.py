@@ -8,8 +8,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene import (SCENE_DIR, SceneObject, builtin_names, example_names, load_scene, object_matrix,
-                        parse_scene_text, world_points)
+from wirecheck.core.scene import object_matrix, SceneObject, world_points
+from wirecheck.core.scene_files import builtin_names, example_names, load_scene, parse_scene_text, SCENE_DIR
 from wirecheck.core.transforms import Motion
 from helpers import run_renderer as run
 
@@ -319,7 +319,8 @@ def test_mirrored_object_is_culled_like_its_oracle(tmp_path, capsys):
             f"object b\ntranslate 1.5 0 0\nscale -0.5\nspin 0 1 0\n{body}\n")
     path = tmp_path / "mirror.scene"
     path.write_text(text)
-    from wirecheck.core.scene import load_scene, oriented_faces
+    from wirecheck.core.scene import oriented_faces
+    from wirecheck.core.scene_files import load_scene
     from wirecheck.core.transforms import Motion
 
     scene = load_scene(str(path))

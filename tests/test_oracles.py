@@ -6,7 +6,7 @@ import pytest
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import project_points
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles import opencv_oracle
 from wirecheck.oracles.pyrender_oracle import osmesa_available

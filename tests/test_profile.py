@@ -12,7 +12,7 @@ from wirecheck.core.camera import camera_z
 from wirecheck.core.cli import main
 from wirecheck.core.pipeline import STAGES as PIPELINE_STAGES, render_frame
 from wirecheck.core.profile import STAGES, FrameProfiler, profile_table
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion
 
 

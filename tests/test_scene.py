@@ -5,7 +5,8 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene import builtin_names, load_scene, parse_scene_text, unique_edges
+from wirecheck.core.scene import unique_edges
+from wirecheck.core.scene_files import builtin_names, load_scene, parse_scene_text
 
 CUBE_CORNERS = [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]]
 

@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.oracles import sweep
 from wirecheck.oracles.pyrender_oracle import osmesa_available
 

@@ -16,7 +16,7 @@ from numpy.testing import assert_allclose
 
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.cli import main
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.trace import clip_matrix, ndc_to_px, trace_vertex
 from wirecheck.core.transforms import Motion
 

@@ -1,0 +1,346 @@
+"""Scene files: the text format, mesh files (trimesh) and the bundled scenes, read into core.scene.Scene.
+
+The text format (``scenes/README.md`` documents it for users)::
+
+    # comment (anywhere after '#')
+    name cube            optional; defaults to the file stem
+    v X Y Z              a vertex (0-based index, local to its object, in order of appearance)
+    e I J                an edge between vertices I and J
+    f I J K [L ...]      a face (polygon); its boundary edges join the edge set
+    object NAME          starts an object: the v/e/f lines after it belong to it
+    mesh PATH            the object's geometry from a mesh file (relative to the .scene file)
+    translate X Y Z      the object's offset (default 0 0 0)
+    scale S              the object's uniform scale (default 1)
+    spin X Y Z           the object's own full turns about X, Y, Z over the run (default 0 0 0)
+
+Lines before the first ``object`` form an implicit object named after the
+scene, so a file without ``object`` lines is one object with the identity
+motion (its arrays are exactly those of the single-object format).
+
+Other formats (``.obj .ply .stl .off .glb .gltf``) are loaded with trimesh
+(imported lazily): edges are the unique edges of the faces, and OBJ ``l``
+elements become edges.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .culling import winding_problem
+from .errors import InputError
+from .scene import Scene, SceneObject, face_edges, unique_edges
+from .transforms import Motion
+
+SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
+#: Example scenes: loadable by name (``--scene orrery``) but not built-ins, so
+#: ``crosscheck``'s default run (:func:`builtin_names`) does not include them.
+EXAMPLES_DIR = SCENE_DIR / "examples"
+NATIVE_SUFFIX = ".scene"
+MESH_SUFFIXES = (".obj", ".ply", ".stl", ".off", ".glb", ".gltf")
+#: A scene name becomes part of output file names: no path separators, no leading dot.
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+
+
+def _safe_stem(path) -> str:
+    """A file stem usable as a scene name (characters outside NAME_PATTERN become '_')."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem)
+    return stem if NAME_PATTERN.fullmatch(stem) else "_" + stem
+
+
+def _number(path, lineno, token, what):
+    try:
+        value = float(token)
+    except ValueError:
+        raise InputError(f"{path}:{lineno}: {what} {token!r}: expected a number") from None
+    if not math.isfinite(value):
+        raise InputError(f"{path}:{lineno}: {what} {token!r}: expected a finite number")
+    return value
+
+
+def _index(path, lineno, token, what, n_vertices, where="the scene has"):
+    try:
+        value = int(token)
+    except ValueError:
+        raise InputError(f"{path}:{lineno}: {what} index {token!r}: expected an integer") from None
+    if not 0 <= value < n_vertices:
+        raise InputError(f"{path}:{lineno}: {what} index {value}: expected 0..{n_vertices - 1} "
+                         f"({where} {n_vertices} vertices so far)")
+    return value
+
+
+def _winding_note(faces) -> str | None:
+    """core.culling.winding_problem(faces), or None without faces."""
+    return winding_problem(faces) if faces else None
+
+
+class _Obj:
+    """An object while its lines are parsed."""
+
+    def __init__(self, name, lineno):
+        self.name, self.lineno = name, lineno
+        self.vertices, self.edges, self.faces = [], [], []
+        self.mesh = None                      # (lineno, Scene) of a 'mesh' line
+        self.geometry_line = None             # first v/e/f line
+        self.motion = {}                      # keyword -> (lineno, value)
+
+    def touched(self) -> bool:
+        return bool(self.vertices or self.edges or self.faces or self.mesh or self.motion)
+
+
+_MOTION_KEYS = {"translate": "offset", "scale": "scale", "spin": "turns"}
+
+
+def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
+                     base_dir: str | os.PathLike | None = None) -> Scene:
+    """Parse the text format. ``base_dir`` (default: the directory of ``path``) resolves ``mesh`` paths."""
+    base = Path(base_dir) if base_dir is not None else Path(path).parent
+    implicit = _Obj(None, 0)
+    objs = [implicit]
+    cur = implicit
+    single = True                 # no 'object' line yet: messages speak of "the scene"
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        tag, *fields = line.split()
+        where = "the scene has" if single else f"object {cur.name!r} has"
+        if tag == "name":
+            if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
+                raise InputError(f"{path}:{lineno}: name {' '.join(fields)!r}: expected one word of letters, "
+                                 "digits, '_', '.', '-' (it names output files)")
+            name = fields[0]
+        elif tag in ("v", "e", "f"):
+            if cur.mesh is not None:
+                raise InputError(f"{path}:{lineno}: {line!r}: expected no v/e/f lines in an object that takes "
+                                 f"its geometry from 'mesh' (line {cur.mesh[0]}); start a new 'object' first")
+            cur.geometry_line = cur.geometry_line or lineno
+            if tag == "v":
+                if len(fields) != 3:
+                    raise InputError(f"{path}:{lineno}: vertex {line!r}: expected 'v X Y Z' (3 numbers), "
+                                     f"got {len(fields)}")
+                cur.vertices.append([_number(path, lineno, t, "vertex coordinate") for t in fields])
+            elif tag == "e":
+                if len(fields) != 2:
+                    raise InputError(f"{path}:{lineno}: edge {line!r}: expected 'e I J' (2 indices), got {len(fields)}")
+                cur.edges.append([_index(path, lineno, t, "edge", len(cur.vertices), where) for t in fields])
+            else:
+                if len(fields) < 3:
+                    raise InputError(f"{path}:{lineno}: face {line!r}: expected 'f I J K ...' (3 or more indices), "
+                                     f"got {len(fields)}")
+                cur.faces.append(tuple(_index(path, lineno, t, "face", len(cur.vertices), where) for t in fields))
+        elif tag == "object":
+            if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
+                raise InputError(f"{path}:{lineno}: object {' '.join(fields)!r}: expected 'object NAME', one word "
+                                 "of letters, digits, '_', '.', '-'")
+            dup = next((o for o in objs[1:] if o.name == fields[0]), None)
+            if dup is not None:
+                raise InputError(f"{path}:{lineno}: object {fields[0]!r}: expected a new name (line {dup.lineno} "
+                                 "already starts an object of that name)")
+            cur = _Obj(fields[0], lineno)
+            objs.append(cur)
+            single = False
+        elif tag == "mesh":
+            if len(fields) != 1:
+                raise InputError(f"{path}:{lineno}: mesh {' '.join(fields)!r}: expected 'mesh PATH' "
+                                 "(one path without spaces, relative to the scene file)")
+            if cur.mesh is not None or cur.geometry_line is not None:
+                first = cur.mesh[0] if cur.mesh is not None else cur.geometry_line
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected one source of geometry per "
+                                 f"object (line {first} already gives it); start a new 'object' first")
+            mesh_path = Path(fields[0])
+            if not mesh_path.is_absolute():
+                mesh_path = base / mesh_path
+            if mesh_path.suffix.lower() not in MESH_SUFFIXES:
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected a file ending in "
+                                 f"{' '.join(MESH_SUFFIXES)}")
+            if not mesh_path.is_file():
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected an existing file "
+                                 f"({mesh_path} not found)")
+            try:
+                cur.mesh = (lineno, load_mesh_file(mesh_path))
+            except InputError as exc:
+                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: {exc}") from None
+        elif tag in _MOTION_KEYS:
+            if tag in cur.motion:
+                raise InputError(f"{path}:{lineno}: {tag} {' '.join(fields)!r}: expected one '{tag}' per object "
+                                 f"(line {cur.motion[tag][0]} already gives it)")
+            if tag == "scale":
+                if len(fields) != 1:
+                    raise InputError(f"{path}:{lineno}: scale {' '.join(fields)!r}: expected 'scale S' (1 number)")
+                s = _number(path, lineno, fields[0], "scale")
+                if s == 0.0:
+                    raise InputError(f"{path}:{lineno}: scale {fields[0]!r}: expected a non-zero number")
+                cur.motion[tag] = (lineno, s)
+            else:
+                if len(fields) != 3:
+                    raise InputError(f"{path}:{lineno}: {tag} {' '.join(fields)!r}: expected '{tag} X Y Z' "
+                                     f"(3 numbers), got {len(fields)}")
+                cur.motion[tag] = (lineno, tuple(_number(path, lineno, t, tag) for t in fields))
+        else:
+            raise InputError(f"{path}:{lineno}: {tag!r}: expected a line starting with 'v', 'e', 'f', 'name', "
+                             "'object', 'mesh', 'translate', 'scale', 'spin' or '#'")
+    scene_name = name or _safe_stem(path)
+    if len(objs) > 1 and not implicit.touched():
+        objs = objs[1:]                           # nothing before the first 'object'
+    implicit.name = scene_name
+    if len(objs) > 1 and objs[0] is implicit:
+        dup = next((o for o in objs[1:] if o.name == scene_name), None)
+        if dup is not None:
+            raise InputError(f"{path}:{dup.lineno}: object {dup.name!r}: expected a name other than the scene's "
+                             "(the lines before the first 'object' form an object named after the scene)")
+    vertices, edges, faces, objects = [], [], [], []
+    n = 0
+    for o in objs:
+        if o.mesh is not None:
+            m = o.mesh[1]
+            o_vertices, o_edges = m.vertices, m.edges
+            o_faces = m.faces
+        else:
+            o_vertices = np.asarray(o.vertices, dtype=np.float64).reshape(-1, 3)
+            o_edges = np.concatenate([np.asarray(o.edges, dtype=np.intp).reshape(-1, 2), face_edges(o.faces)])
+            o_faces = o.faces
+        vertices.append(o_vertices)
+        edges.append(np.asarray(o_edges, dtype=np.intp).reshape(-1, 2) + n)
+        faces += [tuple(int(i) + n for i in f) for f in o_faces]
+        kw = {key: o.motion[tag][1] for tag, key in _MOTION_KEYS.items() if tag in o.motion}
+        motion = Motion(**{"turns": (0.0, 0.0, 0.0), "offset": (0.0, 0.0, 0.0), "scale": 1.0, **kw})
+        objects.append(SceneObject(o.name, n, n + len(o_vertices), motion))
+        n += len(o_vertices)
+    faces = tuple(faces)
+    return Scene(
+        name=scene_name,
+        vertices=np.concatenate(vertices).reshape(-1, 3) if vertices else np.zeros((0, 3)),
+        edges=unique_edges(np.concatenate(edges)) if edges else np.zeros((0, 2), dtype=np.intp),
+        faces=faces,
+        source=str(path),
+        objects=tuple(objects),
+        winding_note=_winding_note(faces),
+    )
+
+
+def _obj_lines(path: Path) -> list[tuple[int, int]]:
+    """Edges from OBJ ``l`` elements (1-based, possibly negative, 'v/vt' forms)."""
+    n_v = 0
+    pairs = []
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for lineno, raw in enumerate(fh, start=1):
+            parts = raw.split("#", 1)[0].split()
+            if not parts:
+                continue
+            if parts[0] == "v":
+                n_v += 1
+            elif parts[0] == "l":
+                idx = []
+                for tok in parts[1:]:
+                    try:
+                        k = int(tok.split("/")[0])
+                    except ValueError:
+                        raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected an integer") from None
+                    k = k - 1 if k > 0 else n_v + k
+                    if not 0 <= k < n_v:
+                        raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected 1..{n_v}")
+                    idx.append(k)
+                pairs += list(zip(idx[:-1], idx[1:]))
+    return pairs
+
+
+def load_mesh_file(path: Path) -> Scene:
+    import trimesh  # lazy: only mesh files need it
+
+    if path.suffix.lower() == ".obj":
+        _obj_vertices(path)   # validate every 'v' line first: errors with file:line, not trimesh's
+    try:
+        loaded = trimesh.load(str(path), process=False, maintain_order=True)
+    except Exception as exc:  # trimesh raises many types; one line for the user
+        raise InputError(f"{path}: could not be read as {path.suffix[1:].upper()}: {exc}") from None
+    if isinstance(loaded, trimesh.Scene):
+        loaded = loaded.to_geometry() if hasattr(loaded, "to_geometry") else loaded.dump(concatenate=True)
+    if path.suffix.lower() == ".stl" and hasattr(loaded, "merge_vertices"):
+        # STL stores every triangle's corners separately: merge equal positions,
+        # or every shared edge would be counted and drawn twice
+        loaded.merge_vertices()
+    vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    if vertices.size % 3 or (vertices.ndim == 2 and vertices.shape[1] != 3):
+        raise InputError(f"{path}: vertices of shape {vertices.shape}: expected 3 coordinates per vertex")
+    vertices = vertices.reshape(-1, 3)
+    faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
+    if faces.size == 0:
+        faces = np.zeros((0, 3), dtype=np.intp)
+    edges = [face_edges(faces)] if len(faces) else []
+    if path.suffix.lower() == ".obj":
+        line_pairs = _obj_lines(path)
+        if line_pairs:
+            if len(vertices) == 0 or max(max(p) for p in line_pairs) >= len(vertices):
+                # trimesh dropped the line-only vertices: read them ourselves
+                vertices = _obj_vertices(path)
+            edges.append(np.asarray(line_pairs, dtype=np.intp))
+    if not np.all(np.isfinite(vertices)):
+        bad = np.argwhere(~np.isfinite(vertices))[0]
+        raise InputError(f"{path}: vertex {bad[0]} has {vertices[bad[0]].tolist()}: expected finite coordinates")
+    all_edges = np.concatenate(edges) if edges else np.zeros((0, 2), dtype=np.intp)
+    faces = tuple(tuple(int(i) for i in f) for f in faces)
+    return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
+                 faces=faces, source=str(path), winding_note=_winding_note(faces))
+
+
+def _obj_vertices(path: Path) -> np.ndarray:
+    out = []
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for lineno, raw in enumerate(fh, start=1):
+            parts = raw.split("#", 1)[0].split()
+            if parts and parts[0] == "v":
+                if len(parts) < 4:
+                    raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
+                out.append([_number(path, lineno, t, "vertex coordinate") for t in parts[1:4]])
+    return np.asarray(out, dtype=np.float64).reshape(-1, 3)
+
+
+def builtin_names() -> list[str]:
+    """The built-in scenes: ``scenes/*.scene`` (not ``scenes/examples/``)."""
+    return sorted(p.stem for p in SCENE_DIR.glob("*" + NATIVE_SUFFIX))
+
+
+def example_names() -> list[str]:
+    """The example scenes in ``scenes/examples/``: loadable by name, not run by default."""
+    return sorted(p.stem for p in EXAMPLES_DIR.glob("*" + NATIVE_SUFFIX))
+
+
+def load_scene(name_or_path: str) -> Scene:
+    """A built-in or example scene by name (``cube``, ``orrery``) or a file path (.scene or a mesh format)."""
+    path = Path(name_or_path)
+    is_path = os.sep in name_or_path or path.suffix != ""
+    if not is_path:
+        for folder in (SCENE_DIR, EXAMPLES_DIR):
+            candidate = folder / (name_or_path + NATIVE_SUFFIX)
+            if candidate.is_file():
+                path = candidate
+                break
+        else:
+            raise InputError(f"--scene {name_or_path!r}: expected a built-in scene "
+                             f"({', '.join(builtin_names() + example_names())}) or a file path")
+    if path.is_dir():
+        raise InputError(f"--scene {name_or_path!r} is a directory: expected a scene file")
+    if not path.is_file():
+        raise InputError(f"--scene {name_or_path!r}: file not found")
+    suffix = path.suffix.lower()
+    if suffix in MESH_SUFFIXES:
+        return load_mesh_file(path)
+    if suffix not in (NATIVE_SUFFIX, ".txt"):
+        raise InputError(f"{path}: suffix {path.suffix!r}: expected {NATIVE_SUFFIX} or one of {' '.join(MESH_SUFFIXES)}")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: could not be read: {exc}") from None
+    scene = parse_scene_text(text, str(path))
+    folder = path.resolve().parent
+    if folder in (SCENE_DIR, EXAMPLES_DIR):
+        # bundled: a checkout-independent source, so reports are the same everywhere
+        rel = folder.relative_to(SCENE_DIR.parent).as_posix()
+        scene = dataclasses.replace(scene, source=f"{rel}/{path.name}")
+    return scene
