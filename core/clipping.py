@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .camera import Camera
+from .projection import cam_to_px
 
 #: How edges crossing near or far are handled: "clip" cuts them at the plane,
 #: "endpoint" drops an edge with an end outside [near, far].
@@ -106,6 +107,22 @@ def apply_clip(seg_cam: np.ndarray, kept: np.ndarray, t_enter: np.ndarray, t_exi
     if depth_range is not None:
         np.clip(out[..., 2], depth_range[0], depth_range[1], out=out[..., 2])
     return out
+
+
+def clip_edges(seg_cam: np.ndarray, camera: Camera) -> tuple[np.ndarray, ...]:
+    """Segments ``(E, 2, 3)`` in camera space clipped to the frustum, projected, then cut to the image.
+
+    Returns ``(seg_cam (K, 2, 3), seg_px (K, 2, 2), on (K,) bool, p0_px (M, 2),
+    p1_px (M, 2))``: the ``K`` segments left inside the frustum (camera space,
+    in ``seg_cam``'s dtype) and their pixels, which of them reach the image, and
+    those ``M`` cut to it (:func:`clip_to_image`).
+    """
+    planes = frustum_planes(camera).astype(seg_cam.dtype)
+    kept, t0, t1 = clip_segments(seg_cam, planes)
+    seg_cam = apply_clip(seg_cam, kept, t0, t1, (camera.near, camera.far))       # camera, inside the frustum
+    seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)         # pixels
+    on, p0_px, p1_px = clip_to_image(seg_px[:, 0], seg_px[:, 1], camera.width, camera.height)
+    return seg_cam, seg_px, on, p0_px, p1_px
 
 
 def clip_to_image(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int

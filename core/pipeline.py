@@ -258,14 +258,8 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
             c_edges = edges[~direct]
             if clip_mode == "endpoint":
                 c_edges = c_edges[ends_visible[~direct]]            # drop edges with a failing end
-            seg_cam = p_cam[c_edges]                                # camera, (E, 2, 3)
-            planes = clipping.frustum_planes(camera).astype(p_cam.dtype)
-            kept, t0, t1 = clipping.clip_segments(seg_cam, planes)
-            seg_cam = clipping.apply_clip(seg_cam, kept, t0, t1,
-                                          (camera.near, camera.far))  # camera, inside the frustum
-            seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)  # pixels
-            on, c0_px, c1_px = clipping.clip_to_image(seg_px[:, 0], seg_px[:, 1],
-                                                      camera.width, camera.height)  # pixels, on the image
+            # camera (clipped to the frustum), pixels, and pixels cut to the image
+            seg_cam, seg_px, on, c0_px, c1_px = clipping.clip_edges(p_cam[c_edges], camera)
             seg0_px = np.concatenate([seg0_px, c0_px])
             seg1_px = np.concatenate([seg1_px, c1_px])
             if hidden_lines:
@@ -398,12 +392,9 @@ def draw_segments(seg_cam: np.ndarray, camera: Camera, raster: str = "exact", oc
         raise ValueError(f"raster {raster!r}: expected one of {RASTER_MODES}")
     seg_cam = np.asarray(seg_cam, dtype=np.float64).reshape(-1, 2, 3)
     image = np.zeros((camera.height, camera.width), dtype=np.uint8)
-    kept, t0, t1 = clipping.clip_segments(seg_cam, clipping.frustum_planes(camera))
-    seg_cam = clipping.apply_clip(seg_cam, kept, t0, t1, (camera.near, camera.far))   # camera, in the frustum
+    seg_cam, seg_px, on, c0_px, c1_px = clipping.clip_edges(seg_cam, camera)
     if len(seg_cam) == 0:
         return image
-    seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)               # pixels
-    on, c0_px, c1_px = clipping.clip_to_image(seg_px[:, 0], seg_px[:, 1], camera.width, camera.height)
     tri = None if occluders is None else occluders.tri_ids
     if tri is not None and (tri >= 0).any():
         ends = (seg_px[on, 0], seg_px[on, 1], seg_cam[on, 0, 2], seg_cam[on, 1, 2])
