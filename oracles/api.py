@@ -19,7 +19,8 @@ from wirecheck.core.scene_files import builtin_names, load_scene
 from . import tolerances
 from .candidate import load_candidate
 from .report import FAULT_HINTS, fault_text
-from .runner import Tolerances, run_crosscheck
+from .runner import run_crosscheck
+from .tolerances import Tolerances
 
 
 def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("opencv",),

@@ -53,7 +53,9 @@ from .cases import CASE_NAMES
 from .config import parse_cli
 from .junit import check_junit_target, write_junit
 from .report import console_table, timing_line, write_report
-from .runner import LEVELS, CoreCandidate, RenderMode, Tolerances, level_for_oracles, run_crosscheck
+from .core_candidate import CoreCandidate, RenderMode
+from .runner import LEVELS, level_for_oracles, run_crosscheck
+from .tolerances import Tolerances
 
 ORACLES = ("opencv", "pyrender")
 #: Options that configure the core candidate, with their defaults.

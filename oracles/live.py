@@ -1,6 +1,6 @@
 """The viewer's oracle overlay: crosscheck for the one view on the screen.
 
-:class:`LiveOverlay` runs :func:`oracles.runner.run_case` (crosscheck's own case
+:class:`LiveOverlay` runs :func:`oracles.case.run_case` (crosscheck's own case
 runner) on the viewer's camera for its current frame only (``first=k,
 every=frames``), so its F1@0/@1, vertex error, faults and verdict are the ones
 crosscheck reports for that view. It returns pyrender's frame and the diff
@@ -25,7 +25,9 @@ from . import metrics
 from .cases import Case
 from .pyrender_oracle import OracleCache, osmesa_available
 from .report import fault_text
-from .runner import CoreCandidate, RenderMode, Tolerances, run_case
+from .case import run_case
+from .core_candidate import CoreCandidate, RenderMode
+from .tolerances import Tolerances
 
 
 def _b64_png(image: np.ndarray) -> str:

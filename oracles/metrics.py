@@ -54,6 +54,10 @@ def _within(mask_from: np.ndarray, mask_to: np.ndarray, tol: int) -> np.ndarray:
     return grown[mask_from]
 
 
+#: The per-frame scores of :func:`pixel_scores` a case keeps, in report order.
+PIXEL_SCORE_KEYS = ("f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px")
+
+
 def pixel_scores(cand: np.ndarray, oracle: np.ndarray, tols=(0, 1)) -> dict:
     """Precision, recall and F1 of ``cand`` against ``oracle`` (both (H, W) bool) at each tolerance."""
     cand = np.asarray(cand, bool)

@@ -4,6 +4,8 @@
 ``--min-f1-0px`` MIN_F1_0PX.
 """
 
+from dataclasses import dataclass
+
 #: Max vertex error in pixels between the candidate and cv2.projectPoints.
 #: Both compute in float64: relative error ~ a few eps (2.2e-16) per operation,
 #: times ~20 operations, times the pixel scale (|x_px| up to ~1e4 for the bundled
@@ -111,3 +113,26 @@ MIN_IOU_UNION_PX = 400
 DEPTH_STEPS = 4.0
 DEPTH_SNAP_PX = 1.0 / 256.0
 DEPTH_EPS32 = 16.0
+
+
+#: The shaded depth bound, as stated in the report.
+DEPTH_BOUND_TEXT = (f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 / DEPTH_SNAP_PX:g}"
+                    f" + {DEPTH_EPS32:g} eps32 z")
+
+
+@dataclass
+class Tolerances:
+    """The limits a run judges with (defaults: the values above; the CLI's --tol-px, --min-f1, ... override them)."""
+
+    vertex_px: float = VERTEX_TOL_PX
+    min_f1_1px: float = MIN_F1_1PX
+    min_f1_0px: float = MIN_F1_0PX
+    min_iou: float = MIN_SILHOUETTE_IOU
+
+    def to_dict(self, shaded: bool = False) -> dict:
+        """The report's ``tolerances`` field."""
+        if shaded:
+            return {"vertex_error_px": self.vertex_px, "min_silhouette_iou": self.min_iou,
+                    "depth_error": DEPTH_BOUND_TEXT}
+        return {"vertex_error_px": self.vertex_px, "min_pixel_f1_1px": self.min_f1_1px,
+                "min_pixel_f1_0px": self.min_f1_0px}

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from wirecheck.oracles import cli
-from wirecheck.oracles.runner import CoreCandidate
+from wirecheck.oracles.core_candidate import CoreCandidate
 from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
@@ -31,8 +31,8 @@ def without_timing(out: Path) -> str:
 
 def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeypatch):
     from wirecheck.core import raster
+    from wirecheck.oracles import case as case_module
     from wirecheck.oracles import pyrender_oracle
-    from wirecheck.oracles import runner
 
     def forbidden(*_a, **_k):
         raise AssertionError("the pixel stage ran at level vertices")
@@ -42,7 +42,7 @@ def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeyp
     monkeypatch.setitem(sys.modules, "pyrender", None)
     monkeypatch.setattr(pyrender_oracle.PyrenderOracle, "__init__", forbidden)
     monkeypatch.setattr(raster, "line_pixels", forbidden)
-    monkeypatch.setattr(runner, "draw_candidate", forbidden)
+    monkeypatch.setattr(case_module, "draw_candidate", forbidden)
     code, report, out = run(tmp_path, "--level", "vertices", "--scene", "cube", "--frames", "3",
                             "--cases", "on_axis,near_plane")
     assert code == 0

@@ -13,7 +13,8 @@ import pytest
 
 from wirecheck.core.frames import SceneRenderer
 from wirecheck.oracles import cli, tolerances
-from wirecheck.oracles.runner import CoreCandidate, RenderMode, run_crosscheck
+from wirecheck.oracles.core_candidate import CoreCandidate, RenderMode
+from wirecheck.oracles.runner import run_crosscheck
 from helpers import run_crosscheck as run
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -1,0 +1,250 @@
+"""One case: a scene under one camera, frame by frame, the candidate against the oracles.
+
+Frame ``k`` (1-based, at ``t = (k - 1) / frames``) goes through two stages:
+
+1. **vertex stage** (levels ``vertices`` and ``pixels``): the oracle side's world
+   points (oracles.faces.frame_geometry: scipy matrices, independent of core),
+   OpenCV's ``projectPoints`` of them, and the candidate's pixels of the same
+   points: core through its own pipeline (:func:`core.pipeline.render_frame`
+   given no edges, so nothing is drawn), any other candidate called on the
+   world points (oracles.candidate); :func:`vertex_stage` scores them;
+2. **pixel stage** (level ``pixels``): the candidate's frame (core's full
+   pipeline, or oracles.draw for another candidate) against pyrender's
+   rendering of the same edges, faces or shading (:func:`pixel_stage`).
+
+Then the frames are summed up into the case's record and judged
+(oracles.verdict). The drawing modes are described in oracles.runner.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wirecheck.core.scene import Scene
+from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
+
+from . import faces as oface
+from . import metrics, opencv_oracle
+from .candidate import CandidateError, call_candidate
+from .cases import Case
+from .core_candidate import CoreCandidate, RenderMode
+from .draw import draw_candidate
+from .tolerances import Tolerances
+from .verdict import SHADED_FRAME_KEYS, case_record, judge
+
+
+@dataclass
+class CaseResult:
+    record: dict                       # what goes into report.json
+    worst_images: dict | None = None   # {"frame", "candidate", "oracle"} bool images
+    timing: dict = field(default_factory=dict)
+    #: every checked frame's images, bit-packed: [(frame, candidate, oracle)] (for worst.gif)
+    frame_images: list | None = None
+
+
+class CaseSetup:
+    """What every frame of a case shares: the scene, the camera, the faces, the candidate's set-up."""
+
+    def __init__(self, scene: Scene, case: Case, frames: int, candidate, motion: Motion,
+                 mode: RenderMode, pixels: bool):
+        self.scene, self.case, self.cam, self.frames = scene, case, case.camera, frames
+        self.candidate, self.motion, self.mode, self.pixels = candidate, motion, mode, pixels
+        self.is_core = isinstance(candidate, CoreCandidate)
+        if not mode.plain and not self.is_core and pixels:
+            raise ValueError(f"drawing mode {mode.to_dict()}: only the core candidate draws faces")
+        self.edges = np.asarray(scene.edges)
+        self.faces = tuple(tuple(int(i) for i in f) for f in scene.faces) or None
+        self.use_faces = pixels and self.faces is not None and not mode.plain
+        # core is set up as renderer sets it up (core.frames): its own matrices and world points,
+        # and, for a multi-object scene, faces re-wound for mirrored objects
+        self.core_frames = candidate.scene_frames(scene, motion, frames) if self.is_core else None
+        self.core_faces = self.core_frames.faces if self.is_core and self.faces is not None else self.faces
+        if self.use_faces and mode.shaded:
+            self.tris, self.tri_owner = oface.fan(self.faces)
+        if self.use_faces and mode.cull == "backface":
+            self.owners = oface.EdgeOwners(self.edges, self.faces, len(scene.vertices))
+
+
+@dataclass
+class CaseFrames:
+    """What the checked frames of a case gathered, in frame order."""
+
+    cand_px: list = field(default_factory=list)         # (N, 2) per frame
+    oracle_px: list = field(default_factory=list)
+    frame_errors: list = field(default_factory=list)    # (max error px, frame, worst vertex)
+    per_frame: list = field(default_factory=list)       # the record's per_frame items
+    pixel: dict = field(default_factory=lambda: {key: [] for key in metrics.PIXEL_SCORE_KEYS})
+    shaded: list = field(default_factory=list)          # (frame, shaded scores)
+    kept: list | None = None                            # (frame, packed candidate, packed oracle)
+    worst: tuple | None = None                          # (key, frame, candidate image, oracle image)
+    error: str | None = None
+    #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + pr + pmetric
+    seconds: dict = field(default_factory=lambda: dict.fromkeys(
+        ("setup", "cv", "proj", "vmetric", "draw", "pr", "pmetric"), 0.0))
+
+    def add(self, key: str, t0: float) -> float:
+        t = time.perf_counter()
+        self.seconds[key] += t - t0
+        return t
+
+
+def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
+             tol: Tolerances, pyrender_oracle=None, want_images: bool = True, every: int = 1,
+             mode: RenderMode | None = None, keep_frames: bool = False, first: int = 1) -> CaseResult:
+    """One case; the pixel stage runs when ``pyrender_oracle`` is given.
+
+    Frames ``first, first + every, ...`` up to ``frames`` are checked (the
+    viewer's overlay checks one frame: ``first=k, every=frames``).
+
+    ``mode`` is the drawing mode of the pixel stage (oracles.runner); with
+    ``keep_frames`` every checked frame's images are kept (bit-packed) in
+    :attr:`CaseResult.frame_images`.
+    """
+    setup = CaseSetup(scene, case, frames, candidate, motion, mode or RenderMode(), pyrender_oracle is not None)
+    acc = CaseFrames(kept=[] if keep_frames and setup.pixels else None)
+    for k in range(first, frames + 1, every):
+        t0 = time.perf_counter()
+        geometry = oface.frame_geometry(scene, motion, (k - 1) / frames)
+        t1 = time.perf_counter()
+        oracle_px = opencv_oracle.project(geometry[0], setup.cam)
+        t2 = time.perf_counter()
+        try:
+            cand_px, points, m_core = candidate_vertices(setup, k, geometry[0])
+            t3 = time.perf_counter()
+            cand_img, cand_depth = candidate_frame(setup, points, m_core, geometry[0]) if setup.pixels else (None, None)
+            t4 = time.perf_counter()
+        except CandidateError as exc:
+            acc.error = f"frame {k}: {exc}"
+            break
+        acc.seconds["setup"] += t1 - t0
+        acc.seconds["cv"] += t2 - t1
+        acc.seconds["proj"] += t3 - t2
+        acc.seconds["draw"] += t4 - t3
+        t5 = time.perf_counter()
+        frame_rec = vertex_stage(acc, k, cand_px, oracle_px)
+        t6 = acc.add("vmetric", t5)
+        if setup.pixels:
+            pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6)
+    rec = case_record(setup, acc, tol)
+    judge(rec, tol, acc.error)
+    rec["per_frame"] = acc.per_frame
+    images = None
+    if acc.worst is not None:
+        images = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
+    return CaseResult(record=rec, worst_images=images, timing=case_timing(acc, setup.pixels),
+                      frame_images=acc.kept)
+
+
+def candidate_vertices(setup: CaseSetup, k: int, p_world: np.ndarray):
+    """``(cand_px (N, 2), points, m_core)`` of frame ``k``; CandidateError when the candidate fails.
+
+    ``points`` and ``m_core`` are core's own set-up of the frame (None for
+    another candidate), reused by :func:`candidate_frame`.
+    """
+    if not setup.is_core:
+        return call_candidate(setup.candidate, p_world, setup.cam), None, None
+    try:
+        points, m_core = setup.core_frames.geometry(k)
+        return setup.candidate.project(points, setup.cam, m_core), points, m_core
+    except Exception as exc:      # core crashing is a failed case, not a crashed run
+        raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc
+
+
+def candidate_frame(setup: CaseSetup, points, m_core, p_world: np.ndarray):
+    """``(image, depth)``: the candidate's frame (a bool image), or its depth buffer when shaded."""
+    cand, cam, mode = setup.candidate, setup.cam, setup.mode
+    if not setup.is_core:
+        return draw_candidate(cand, p_world, setup.edges, cam), None
+    try:
+        if mode.plain:
+            return cand.draw(points, setup.edges, cam, m_core), None
+        if mode.shaded:
+            return None, cand.shade(points, setup.edges, cam, m_core, setup.core_faces, mode)
+        return cand.draw_mode(points, setup.edges, cam, m_core, setup.core_faces, mode), None
+    except Exception as exc:
+        raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc
+
+
+def vertex_stage(acc: CaseFrames, k: int, cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
+    """Score frame ``k``'s vertex pixels against OpenCV's; keep them for the case; return the frame's record."""
+    acc.cand_px.append(cand_px)
+    acc.oracle_px.append(oracle_px)
+    ve = metrics.vertex_errors(cand_px, oracle_px)
+    if ve["max_px"] is not None:
+        acc.frame_errors.append((ve["max_px"], k, ve["worst_index"]))
+    frame_rec = {"frame": k, "max_vertex_error_px": ve["max_px"], "mean_vertex_error_px": ve["mean_px"],
+                 "rms_vertex_error_px": ve["rms_px"], "visible_points": ve["visible_both"]}
+    acc.per_frame.append(frame_rec)
+    return frame_rec
+
+
+def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geometry, cand_img, cand_depth,
+                pyrender_oracle, want_images: bool, t0: float) -> None:
+    """pyrender's frame ``k`` against the candidate's: scores into ``frame_rec`` and ``acc`` (time from ``t0``)."""
+    p_world, matrices, pr_vertices, pr_pose = geometry
+    mode, cam, scene = setup.mode, setup.cam, setup.scene
+    mirrored = (oface.mirrored_vertices(scene, matrices) if setup.use_faces and mode.cull == "backface"
+                else None)
+    if mode.shaded:
+        if setup.use_faces:
+            orac_img, orac_depth, ids = pyrender_oracle.render_faces(
+                pr_vertices, oface.gl_triangles(setup.tris, mirrored), cam, model_matrix=pr_pose,
+                cull=mode.cull == "backface", with_ids=True)
+        else:
+            orac_img = np.zeros((cam.height, cam.width), bool)
+        t1 = acc.add("pr", t0)
+        cand_img = np.isfinite(cand_depth)
+        if setup.use_faces:
+            cand_faces = getattr(setup.candidate, "last_face_ids", None)
+            orac_faces = np.where(ids >= 0, setup.tri_owner[np.maximum(ids, 0)], -1)   # triangle -> polygon
+            ss = metrics.shaded_scores(cand_depth, orac_img, orac_depth,
+                                       metrics.depth_bound(orac_depth, orac_img, cam),
+                                       metrics.occlusion_boundary(ids, setup.tris),
+                                       cand_faces=cand_faces, oracle_faces=orac_faces)
+            acc.shaded.append((k, ss))
+            frame_rec.update({key: ss[key] for key in SHADED_FRAME_KEYS})
+            key = (ss["silhouette_iou"], -(ss["depth_error_ratio"] or 0.0))
+        else:
+            key = None
+    else:
+        draw_edges, occluders = setup.edges, None
+        if setup.use_faces and mode.cull == "backface":
+            draw_edges = setup.edges[setup.owners.kept(oface.front_faces(p_world, setup.faces, cam, mirrored))]
+        if setup.use_faces and mode.hidden_lines:
+            occluders = oface.gl_polygons(setup.faces, mirrored)
+        orac_img, _depth = pyrender_oracle.render(pr_vertices, draw_edges, cam, model_matrix=pr_pose,
+                                                  faces=occluders, cull=mode.cull == "backface")
+        t1 = acc.add("pr", t0)
+        ps = metrics.pixel_scores(cand_img, orac_img)
+        for name, values in acc.pixel.items():
+            values.append(ps[name])
+        frame_rec.update({name: ps[name] for name in metrics.PIXEL_SCORE_KEYS})
+        key = (ps["f1_1px"], ps["f1_0px"])
+    if want_images and key is not None and (acc.worst is None or key < acc.worst[0]):
+        acc.worst = (key, k, cand_img.copy(), orac_img.copy())
+    if acc.kept is not None:
+        acc.kept.append((k, np.packbits(cand_img), np.packbits(orac_img)))
+    acc.add("pmetric", t1)
+
+
+def _per_frame_ms(seconds: float, frames: int) -> float:
+    return 1e3 * seconds / max(frames, 1)
+
+
+def case_timing(acc: CaseFrames, pixels: bool) -> dict:
+    """The case's milliseconds per checked frame, by stage and by side (candidate, OpenCV, pyrender)."""
+    sec, done = acc.seconds, len(acc.cand_px)
+    timing = {"frames_timed": done,
+              "vertex_stage_ms_per_frame": _per_frame_ms(sec["setup"] + sec["cv"] + sec["proj"] + sec["vmetric"], done),
+              "candidate_project_ms_per_frame": _per_frame_ms(sec["proj"], done),
+              "opencv_ms_per_frame": _per_frame_ms(sec["cv"], done)}
+    if pixels:
+        timing.update({"pixel_stage_ms_per_frame": _per_frame_ms(sec["draw"] + sec["pr"] + sec["pmetric"], done),
+                       "candidate_draw_ms_per_frame": _per_frame_ms(sec["draw"], done),
+                       "pyrender_ms_per_frame": _per_frame_ms(sec["pr"], done),
+                       "pixel_metrics_ms_per_frame": _per_frame_ms(sec["pmetric"], done)})
+    timing["candidate_ms_per_frame"] = _per_frame_ms(sec["proj"] + sec["draw"], done)
+    return timing

@@ -1,0 +1,139 @@
+"""A case's record (its line in report.json) from its frames, and the verdict with its reasons.
+
+A case fails for every limit of oracles.tolerances it misses, each named in a
+reason: the vertex error, points visible to one side only, the pixel F1 at 1
+and 0 px; shaded: regions covered by one side inside the other's silhouette,
+the silhouette IoU, faces that differ away from their boundaries, the depth
+error beyond its bound. A candidate that fails the contract (oracles.candidate)
+fails the case with that error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import metrics
+from .diagnose import diagnose
+from .tolerances import MIN_IOU_UNION_PX, Tolerances
+
+#: Per-frame fields of a shaded comparison (oracles.metrics.shaded_scores).
+SHADED_FRAME_KEYS = ("silhouette_iou", "silhouette_union_px", "silhouette_mismatch_inside", "depth_pixels",
+                     "depth_max_error", "depth_mean_error", "depth_error_bound", "depth_error_ratio",
+                     "face_disagreements", "face_disagreements_inside")
+
+
+def case_record(setup, acc, tol: Tolerances) -> dict:
+    """The case's fields from its frames (``setup``: oracles.case.CaseSetup, ``acc``: its CaseFrames).
+
+    Vertex errors pooled over the frames, the worst vertex, the faults
+    (oracles.diagnose), the pixel scores' minima and means, the shaded
+    summary, and a note when there was nothing to compare.
+    """
+    done = len(acc.cand_px)
+    rec = {"scene": setup.scene.name, "camera": setup.case.name, "camera_spec": setup.cam.to_dict(),
+           "frames": setup.frames, "frames_checked": done}
+    if setup.pixels and setup.mode.hidden_lines:
+        rec["hidden_lines"] = setup.faces is not None
+    faults = []
+    if done:
+        cand, orac = np.concatenate(acc.cand_px), np.concatenate(acc.oracle_px)
+        ve = metrics.vertex_errors(cand, orac)
+        worst_v = max(acc.frame_errors, key=lambda e: (e[0], -e[1])) if acc.frame_errors else (None, None, None)
+        rec.update({
+            "max_vertex_error_px": ve["max_px"],
+            "mean_vertex_error_px": ve["mean_px"],
+            "rms_vertex_error_px": ve["rms_px"],
+            "worst_vertex": {"frame": worst_v[1], "vertex": worst_v[2], "error_px": worst_v[0]},
+            "visible_points": ve["visible_both"],
+            "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
+        })
+        faults = diagnose(cand, orac, setup.cam, tol_px=tol.vertex_px)
+    else:
+        rec.update({"max_vertex_error_px": None, "mean_vertex_error_px": None, "rms_vertex_error_px": None})
+    px = acc.pixel
+    if px["f1_0px"]:
+        rec.update({
+            "pixel_f1_0px": float(min(px["f1_0px"])), "pixel_f1_1px": float(min(px["f1_1px"])),
+            "pixel_f1_0px_mean": float(np.mean(px["f1_0px"])), "pixel_f1_1px_mean": float(np.mean(px["f1_1px"])),
+            "pixel_precision_0px": float(min(px["precision_0px"])), "pixel_recall_0px": float(min(px["recall_0px"])),
+            "pixel_precision_1px": float(min(px["precision_1px"])), "pixel_recall_1px": float(min(px["recall_1px"])),
+            "worst_pixel_frame": acc.worst[1] if acc.worst else None,
+        })
+    else:
+        rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
+    if setup.pixels and setup.mode.shaded:
+        rec.update(shaded_summary(acc.shaded, acc.worst))
+    rec["faults"] = faults
+    if done and len(setup.scene.vertices) == 0:
+        rec["note"] = "nothing to check: the scene has no vertices"
+    elif done and rec["visible_points"] == 0:
+        rec["note"] = "no point visible to both projectors: only the visible/clipped sets were compared"
+    elif done and setup.pixels and not setup.mode.plain and setup.faces is None:
+        rec["note"] = {"shaded": "no faces: nothing to shade; only the vertices were checked",
+                       "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe"
+                       }[setup.mode.style]
+    return rec
+
+
+def shaded_summary(shaded: list, worst) -> dict:
+    """A case's shaded fields from its frames' scores (None where nothing was compared)."""
+    out = {"silhouette_iou": None, "silhouette_iou_mean": None, "depth_max_error": None,
+           "depth_mean_error": None, "depth_error_bound": None, "depth_error_ratio": None,
+           "depth_worst_frame": None, "depth_pixels": 0, "worst_pixel_frame": None,
+           "face_disagreements": 0, "face_disagreements_inside": 0,
+           "silhouette_mismatch_inside": 0, "silhouette_iou_gated": None}
+    if not shaded:
+        return out
+    out["silhouette_mismatch_inside"] = int(sum(s.get("silhouette_mismatch_inside", 0) for _, s in shaded))
+    gated = [s["silhouette_iou"] for _, s in shaded if s.get("silhouette_union_px", 0) >= MIN_IOU_UNION_PX]
+    out["silhouette_iou_gated"] = float(min(gated)) if gated else None     # IoU over frames big enough to judge
+    out["face_disagreements"] = int(sum(s.get("face_disagreements", 0) for _, s in shaded))
+    out["face_disagreements_inside"] = int(sum(s.get("face_disagreements_inside", 0) for _, s in shaded))
+    ious = [s["silhouette_iou"] for _, s in shaded]
+    out.update(silhouette_iou=float(min(ious)), silhouette_iou_mean=float(np.mean(ious)),
+               worst_pixel_frame=worst[1] if worst else None)
+    with_depth = [(k, s) for k, s in shaded if s["depth_max_error"] is not None]
+    if with_depth:
+        pixels = sum(s["depth_pixels"] for _, s in with_depth)
+        k_err, s_err = max(with_depth, key=lambda e: (e[1]["depth_max_error"], -e[0]))
+        k_ratio, s_ratio = max(with_depth, key=lambda e: (e[1]["depth_error_ratio"], -e[0]))
+        out.update(depth_max_error=s_err["depth_max_error"], depth_error_bound=s_err["depth_error_bound"],
+                   depth_mean_error=float(sum(s["depth_mean_error"] * s["depth_pixels"]
+                                              for _, s in with_depth) / pixels),
+                   depth_error_ratio=s_ratio["depth_error_ratio"], depth_worst_frame=k_ratio,
+                   depth_pixels=int(pixels))
+    return out
+
+
+def judge(rec: dict, tol: Tolerances, error: str | None = None) -> None:
+    """Set ``rec["verdict"]`` ("pass" or "fail") and ``rec["reasons"]`` (one line per limit missed)."""
+    reasons = [error] if error else []
+    if rec["frames_checked"]:
+        if rec["max_vertex_error_px"] is not None and rec["max_vertex_error_px"] > tol.vertex_px:
+            reasons.append(f"max vertex error {rec['max_vertex_error_px']:.3g} px > {tol.vertex_px:.3g} px "
+                           f"(frame {rec['worst_vertex']['frame']}, vertex {rec['worst_vertex']['vertex']})")
+        vm = rec["visibility_mismatch"]
+        if vm["candidate_only"] or vm["oracle_only"]:
+            reasons.append(f"visible sets differ: {vm['candidate_only']} points shown only by the candidate, "
+                           f"{vm['oracle_only']} only by the oracle")
+    if rec["pixel_f1_0px"] is not None:
+        if rec["pixel_f1_1px"] < tol.min_f1_1px:
+            reasons.append(f"pixel F1@1px {rec['pixel_f1_1px']:.4f} < {tol.min_f1_1px} "
+                           f"(frame {rec['worst_pixel_frame']})")
+        if rec["pixel_f1_0px"] < tol.min_f1_0px:
+            reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
+    if rec.get("silhouette_iou") is not None:
+        if rec["silhouette_mismatch_inside"]:
+            reasons.append(f"{rec['silhouette_mismatch_inside']} pixels covered by one side only lie inside its "
+                           "silhouette, not on its boundary (a hole or a misplaced region)")
+        if rec["silhouette_iou_gated"] is not None and rec["silhouette_iou_gated"] < tol.min_iou:
+            reasons.append(f"silhouette IoU {rec['silhouette_iou_gated']:.4f} < {tol.min_iou} "
+                           f"(frame {rec['worst_pixel_frame']})")
+        if rec["face_disagreements_inside"]:
+            reasons.append(f"{rec['face_disagreements_inside']} pixels show a different face than the oracle "
+                           "away from any boundary between the two faces (a visibility error)")
+        if rec["depth_error_ratio"] is not None and rec["depth_error_ratio"] > 1.0:
+            reasons.append(f"depth error {rec['depth_max_error']:.3g} > its bound {rec['depth_error_bound']:.3g} "
+                           f"(error/bound up to {rec['depth_error_ratio']:.3g}, frame {rec['depth_worst_frame']})")
+    rec["verdict"] = "fail" if reasons else "pass"
+    rec["reasons"] = reasons
