@@ -30,7 +30,7 @@ from __future__ import annotations
 import itertools
 import statistics
 import time
-from dataclasses import dataclass
+from collections import namedtuple
 
 import numpy as np
 
@@ -50,11 +50,8 @@ from .cases import cameras_for
 DEFAULT = ("float64", "clip", "exact")
 
 
-@dataclass(frozen=True)
-class Setting:
-    dtype: str
-    clip: str
-    raster: str
+class Setting(namedtuple("Setting", "dtype clip raster")):
+    """One setting of core: its dtype, clip mode and raster mode."""
 
     @property
     def key(self) -> str:

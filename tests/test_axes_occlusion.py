@@ -8,8 +8,6 @@ x_px <= 319.5 + f / 3 = 458.06, i.e. pixel centres up to column 458: the axis is
 hidden there and visible from column 459 to its end at 319.5 + f L / 4 = 535.5.
 """
 
-import contextlib
-import io
 import math
 
 import numpy as np
@@ -18,8 +16,8 @@ from numpy.testing import assert_array_equal
 from PIL import Image
 
 from wirecheck.core.camera import camera_z
-from wirecheck.core.cli import main
 from wirecheck.core.pipeline import draw_segments, render_frame
+from helpers import run_renderer
 
 F60 = 240.0 * math.sqrt(3.0)
 END = 319.5 + F60 * 1.2 * math.sqrt(3.0) / 4          # 535.5
@@ -32,8 +30,8 @@ def red_columns(path):
 
 
 def run(args, out):
-    with contextlib.redirect_stdout(io.StringIO()):
-        assert main(list(args) + ["--out", str(out)]) == 0
+    rc, _, err = run_renderer(args, out)
+    assert rc == 0, err
 
 
 @pytest.mark.parametrize("mode", [["--hidden-lines"], ["--style", "shaded"]])

@@ -5,8 +5,6 @@ docstring): front width 2f/(D-1), back 2f/(D+1), ratio (D+1)/(D-1) = 2 at D = 3
 and 1.4 at D = 6, depth compression 1/(D+1); FOV scale tan(30)/tan(45) = 1/sqrt(3).
 """
 
-import contextlib
-import io
 import json
 import math
 
@@ -14,15 +12,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.core.cli import main
 from wirecheck.core.compare import crossings
-
-
-def run(args, out):
-    o, e = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
-        rc = main(list(args) + ["--out", str(out)])
-    return rc, o.getvalue(), e.getvalue()
+from helpers import run_renderer as run
 
 
 def test_crossings_are_run_centres():

@@ -1,7 +1,5 @@
 """Per-stage frame timing: render_frame(timing=...), core.profile.FrameProfiler, ``renderer --profile``."""
 
-import contextlib
-import io
 import json
 
 import numpy as np
@@ -9,18 +7,11 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from wirecheck.core.camera import camera_z
-from wirecheck.core.cli import main
 from wirecheck.core.pipeline import STAGES as PIPELINE_STAGES, render_frame
 from wirecheck.core.profile import STAGES, FrameProfiler, profile_table
 from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion
-
-
-def run(args, out):
-    o, e = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
-        rc = main(list(args) + ["--out", str(out)])
-    return rc, o.getvalue(), e.getvalue()
+from helpers import run_renderer as run
 
 
 MODES = {"wireframe": {}, "hidden": {"hidden_lines": True}, "cull": {"cull": "backface"},

@@ -5,8 +5,6 @@ unit cube (vertex 6 = (1, 1, 1)), 640x480, near 0.1, far 100:
 f = (H/2)/tan(fov/2); at fov 60, f = 240 sqrt(3) = 415.6922.
 """
 
-import contextlib
-import io
 import json
 import math
 
@@ -15,22 +13,15 @@ import pytest
 from numpy.testing import assert_allclose
 
 from wirecheck.core.camera import camera_z, look_at
-from wirecheck.core.cli import main
 from wirecheck.core.scene_files import load_scene
 from wirecheck.core.trace import clip_matrix, ndc_to_px, trace_vertex
 from wirecheck.core.transforms import Motion
+from helpers import run_renderer as run
 
 F60 = 240.0 * math.sqrt(3.0)
 # float64 arithmetic on values of size ~500 with a handful of operations: 1e-9 is
 # ~10^4 eps x scale, far below anything a wrong formula would give
 TOL = 1e-9
-
-
-def run(args, out):
-    o, e = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
-        rc = main(list(args) + ["--out", str(out)])
-    return rc, o.getvalue(), e.getvalue()
 
 
 def test_rest_pose_every_space_by_hand():
