@@ -32,7 +32,7 @@ its pyrender oracle) skips; the table gives what the stage would add per frame
   polygon offset, as the oracle does when given faces). Scenes built here with
   one OffscreenRenderer; the oracle class itself is timed too.
 * scene loading: ``trimesh.load(process=True)`` against ``process=False``
-  (core.scene.load_mesh_file uses ``process=False, maintain_order=True``) on a
+  (core.scene_files.load_mesh_file uses ``process=False, maintain_order=True``) on a
   binary PLY of an icosphere with 163,842 vertices (``--quick``: 40,962)
   written to a temporary directory; and ``core.scene_files.load_scene`` on it.
 

@@ -125,7 +125,7 @@ def load_config(path: Path | None = None, start: Path | None = None) -> Config:
 
 def validate(table: dict, path: Path) -> dict:
     """The table's values checked against :data:`KEYS`, paths made absolute; InputError otherwise."""
-    from wirecheck.core.scene import builtin_names, example_names
+    from wirecheck.core.scene_files import builtin_names, example_names
 
     from .cases import CASE_NAMES
 
