@@ -13,59 +13,72 @@ pixels too.
 
 from __future__ import annotations
 
-from wirecheck.core.scene import Scene
-from wirecheck.core.scene_files import builtin_names, load_scene
-
-from . import tolerances
+from . import gate, tolerances
 from .candidate import load_candidate
-from .report import FAULT_HINTS, fault_text
+from .report import FAULT_HINTS, compared_text, fault_text, not_passed
 from .runner import run_crosscheck
 from .tolerances import Tolerances
 
 
 def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("opencv",),
                     tol_px: float = tolerances.VERTEX_TOL_PX, min_f1: float = tolerances.MIN_F1_1PX,
-                    min_f1_0px: float = tolerances.MIN_F1_0PX, turns=(1.0, 1.0, 0.0)) -> dict:
+                    min_f1_0px: float = tolerances.MIN_F1_0PX, turns=(1.0, 1.0, 0.0),
+                    allow_vacuous: bool = False) -> dict:
     """Run crosscheck on ``func`` and return the report dict (as in report.json).
 
     ``func`` may be a callable or a ``"FILE.py:FUNC"`` / ``"MODULE:FUNC"`` string;
-    ``scenes`` are names, paths or :class:`core.scene.Scene` objects (default:
-    every bundled scene); ``cases`` a subset of :data:`oracles.cases.CASE_NAMES`.
+    ``scenes`` are names, paths or :class:`core.scene.Scene` objects (default,
+    ``None``: every bundled scene); ``cases`` a subset of
+    :data:`oracles.cases.CASE_NAMES` (default, ``None``: all).
+
+    Inputs that would compare nothing -- no scene or case, an unknown or
+    repeated name, ``frames`` < 1, a NaN tolerance -- raise ValueError
+    (:class:`core.errors.InputError`; oracles.gate checks them for the CLI
+    too). A case that compared nothing (every point clipped in every frame)
+    has verdict ``"vacuous"`` and makes the report's verdict ``"fail"``
+    unless ``allow_vacuous``.
     """
     name = func if isinstance(func, str) else getattr(func, "__qualname__", repr(func))
     if isinstance(func, str):
         func = load_candidate(func)
-    scene_objs = [s if isinstance(s, Scene) else load_scene(str(s)) for s in (scenes or builtin_names())]
+    tol = Tolerances(tol_px, min_f1, min_f1_0px)
+    inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)    # before any OpenGL set-up
     if "pyrender" in oracles:
         from .pyrender_oracle import osmesa_available
 
         ok, message = osmesa_available()
         if not ok:
             raise RuntimeError(message)
-    report, _images = run_crosscheck(scene_objs, func, frames=frames, case_names=cases, oracles=oracles,
-                                     turns=turns, tol=Tolerances(tol_px, min_f1, min_f1_0px),
-                                     candidate_name=name)
+    report, _images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
+                                     oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
+                                     allow_vacuous=allow_vacuous)
     return report
 
 
 def failure_text(report: dict) -> str | None:
-    """The diagnosis of a report's failing cases (faults, reasons, what to check); None when its verdict is pass."""
-    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    """The diagnosis of a report's failing cases (faults, reasons, what to check); None when its verdict is pass.
+
+    Failing cases are the failed ones and the vacuous ones (compared nothing) unless the run allowed them.
+    """
+    failing = not_passed(report)
     if not failing:
         if report["verdict"] == "pass":
             return None
-        return f"crosscheck of {report['candidate']}: verdict {report['verdict']} with no failing case"
+        return (f"crosscheck of {report['candidate']}: verdict {report['verdict']} with no failing case"
+                + (f" ({compared_text(report)})" if "compared" in report else ""))
     lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
-    for c in failing:
-        lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'])}; "
+    for c in failing:          # a vacuous case's reason starts with "vacuous:"
+        lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'], c.get('camera_spec'))}; "
                      + "; ".join(c["reasons"]))
     names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
     lines += [f"  what to check, {n}: {FAULT_HINTS[n]}" for n in names]
+    if "compared" in report:
+        lines.append(f"  in all: {compared_text(report)}")
     return "\n".join(lines)
 
 
 def assert_projector(func, **kwargs) -> dict:
-    """:func:`check_projector`, raising AssertionError with the diagnosis when any case fails."""
+    """:func:`check_projector`, raising AssertionError with the diagnosis unless the report's verdict is pass."""
     report = check_projector(func, **kwargs)
     text = failure_text(report)
     if text is not None:

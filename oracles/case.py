@@ -81,6 +81,7 @@ class CaseFrames:
     kept: list | None = None                            # (frame, packed candidate, packed oracle)
     worst: tuple | None = None                          # (key, frame, candidate image, oracle image)
     error: str | None = None
+    drawn_px: int = 0                                   # pixels drawn by either side, over the frames (oracles.gate)
     #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + pr + pmetric
     seconds: dict = field(default_factory=lambda: dict.fromkeys(
         ("setup", "cv", "proj", "vmetric", "draw", "pr", "pmetric"), 0.0))
@@ -129,7 +130,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         if setup.pixels:
             pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6)
     rec = case_record(setup, acc, tol)
-    judge(rec, tol, acc.error)
+    judge(rec, tol, acc.error, points=len(scene.vertices))
     rec["per_frame"] = acc.per_frame
     images = None
     if acc.worst is not None:
@@ -205,6 +206,7 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
                                        metrics.occlusion_boundary(ids, setup.tris),
                                        cand_faces=cand_faces, oracle_faces=orac_faces)
             acc.shaded.append((k, ss))
+            acc.drawn_px += ss["silhouette_union_px"]
             frame_rec.update({key: ss[key] for key in SHADED_FRAME_KEYS})
             key = (ss["silhouette_iou"], -(ss["depth_error_ratio"] or 0.0))
         else:
@@ -219,6 +221,7 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
                                                   faces=occluders, cull=mode.cull == "backface")
         t1 = acc.add("pr", t0)
         ps = metrics.pixel_scores(cand_img, orac_img)
+        acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
         for name, values in acc.pixel.items():
             values.append(ps[name])
         frame_rec.update({name: ps[name] for name in metrics.PIXEL_SCORE_KEYS})

@@ -1,7 +1,9 @@
 """``crosscheck``: judge a projector against OpenCV and pyrender/OSMesa.
 
-Exit status: 0 when every case is within tolerance, 1 when any case fails,
-2 on usage or input errors (including libOSMesa missing when pyrender is asked for).
+Exit status: 0 when every case is within tolerance, 1 when any case fails or
+compared nothing (``vacuous``, unless ``--allow-vacuous``), 2 on usage or input
+errors (including libOSMesa missing when pyrender is asked for, and inputs that
+would compare nothing: oracles/gate.py).
 
 ``--level vertices`` runs the OpenCV vertex check only (no drawing, no
 pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
@@ -35,7 +37,6 @@ extremes`` runs the numerical-extremes suite (oracles/extremes/) and exits
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import re
 import sys
@@ -45,15 +46,15 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 from wirecheck.core.output import check_replaceable
-from wirecheck.core.scene_files import builtin_names, load_scene
 
-from . import tolerances
+from . import gate, tolerances
 from .candidate import load_candidate
 from .cases import CASE_NAMES
 from .config import parse_cli
 from .junit import check_junit_target, write_junit
-from .report import console_table, timing_line, write_report
 from .core_candidate import CoreCandidate, RenderMode
+from .progress import TerminalProgress
+from .report import compared_text, console_table, timing_line, vacuous_text, write_report
 from .runner import LEVELS, level_for_oracles, run_crosscheck
 from .tolerances import Tolerances
 
@@ -116,8 +117,13 @@ def build_parser() -> argparse.ArgumentParser:
     mode.add_argument("--suite", choices=("extremes",), default=None,
                       help="extremes: near plane, tiny/huge FOV, extreme aspect, far from the origin, "
                            "1,000,000-frame periodicity, degenerate and non-finite inputs")
-    p.add_argument("--report-dir", default=None, help="where to write the report (default reports/<run>)")
-    p.add_argument("--run", default=None, help="run name under reports/ (default: UTC time)")
+    p.add_argument("--allow-vacuous", action="store_true", default=False,
+                   help="a case that compared nothing (every point clipped, nothing drawn) does not fail the run "
+                        "(default: it does)")
+    p.add_argument("--report-dir", default=None,
+                   help="where to write the report: DIR, or DIR/RUN with --run (default reports/RUN)")
+    p.add_argument("--run", default=None, help="run name: the report folder's name, also in report.json "
+                                               "(default: UTC time, YYYYmmdd-HHMMSS)")
     p.add_argument("--junit-xml", default=None, metavar="FILE",
                    help="also write JUnit XML: one test case per scene x camera, faults and reasons as the "
                         "failure message (default: none)")
@@ -130,15 +136,6 @@ def build_parser() -> argparse.ArgumentParser:
 def _parse(args):
     if args.frames is None:
         args.frames = 12 if args.sweep else 24
-    if args.frames < 1:
-        raise InputError(f"--frames {args.frames}: expected an integer >= 1")
-    if not (math.isfinite(args.tol_px) and args.tol_px >= 0):
-        raise InputError(f"--tol-px {args.tol_px}: expected a number >= 0")
-    for opt, v in (("--min-f1", args.min_f1), ("--min-f1-0px", args.min_f1_0px), ("--min-iou", args.min_iou)):
-        if not 0.0 <= v <= 1.0:
-            raise InputError(f"{opt} {v}: expected a number in [0, 1]")
-    if args.every < 1:
-        raise InputError(f"--every {args.every}: expected an integer >= 1")
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs}: expected an integer >= 1")
     level = args.level or "pixels"
@@ -160,10 +157,15 @@ def _parse(args):
             ("--cases", args.cases != ",".join(CASE_NAMES)), ("--spin", args.spin != "1,1,0"),
             ("--jobs", args.jobs != 1), ("--tol-px", args.tol_px != tolerances.VERTEX_TOL_PX),
             ("--min-f1", args.min_f1 != tolerances.MIN_F1_1PX),
-            ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX)) if given]
+            ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX),
+            ("--min-iou", args.min_iou != tolerances.MIN_SILHOUETTE_IOU),
+            ("--allow-vacuous", args.allow_vacuous)) if given]
         if ignored:
             raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
                              "bounds are fixed (oracles/extremes/); expected only --level, --run or --report-dir")
+    if args.sweep and args.allow_vacuous:
+        raise InputError("--sweep with --allow-vacuous: the sweep's cases are the bundled scenes and a large mesh, "
+                         "which always show something: expected no --allow-vacuous")
     if args.sweep and args.jobs != 1:
         raise InputError(f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
                          "the times compare; expected no --jobs")
@@ -190,20 +192,14 @@ def _parse(args):
         if args.style == "shaded" and args.hidden_lines:
             raise InputError("--hidden-lines with --style shaded: a shaded frame has no lines: expected one of them")
     mode = RenderMode(style=args.style or "wireframe", hidden_lines=args.hidden_lines, cull=args.cull or "none")
-    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
-    bad = [c for c in cases if c not in CASE_NAMES]
-    if bad or not cases:
-        raise InputError(f"--cases {args.cases!r}: unknown {', '.join(bad) or '(none)'}; expected some of {', '.join(CASE_NAMES)}")
-    try:
-        spin = tuple(float(x) for x in args.spin.split(","))
-    except ValueError:
-        spin = ()
-    if len(spin) != 3 or not all(math.isfinite(x) for x in spin):
-        raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
-    names = args.scene or builtin_names()
-    scenes = [load_scene(n) for n in names]
+    tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
+                     min_iou=args.min_iou)
+    if args.suite:       # fixed cases and bounds (checked above): nothing of a run's inputs applies
+        return level, None, None, mode, tol
+    # the library's one check of what a run compares (oracles.gate), in the CLI's option names
+    inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
     if mode.cull == "backface":
-        wound = next((sc for sc in scenes if sc.faces and sc.winding_note), None)
+        wound = next((sc for sc in inputs.scenes if sc.faces and sc.winding_note), None)
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
@@ -211,7 +207,19 @@ def _parse(args):
         candidate = load_candidate(args.candidate)
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
-    return level, cases, spin, scenes, candidate, mode
+    return level, inputs, candidate, mode, tol
+
+
+def _run_dir(args) -> tuple[Path, str]:
+    """The report folder: DIR/RUN, DIR alone, or reports/RUN; and the option to name in errors."""
+    run = args.run if args.run is not None else (
+        None if args.report_dir else datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S"))
+    if run is not None and not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", run):
+        raise InputError(f"--run {run!r}: expected a name of letters, digits, '_', '.', '-' "
+                         "(no '/', not starting with '.')")
+    if args.report_dir:
+        return (Path(args.report_dir) / run, "--run") if run is not None else (Path(args.report_dir), "--report-dir")
+    return Path("reports") / run, "--run"
 
 
 def _error(text: str) -> int:
@@ -230,7 +238,8 @@ def main(argv=None) -> int:
                              "expected it in a plain crosscheck run (one test case per scene x camera)")
         if args.junit_xml:
             check_junit_target(Path(args.junit_xml))
-        level, case_names, spin, scenes, candidate, mode = _parse(args)
+        level, inputs, candidate, mode, tol = _parse(args)
+        run_dir, run_option = _run_dir(args)
     except InputError as exc:
         return _error(str(exc))
     if level == "pixels":
@@ -239,42 +248,41 @@ def main(argv=None) -> int:
         ok, message = osmesa_available()
         if not ok:
             return _error(f"{message} (or run with --level vertices)")
-    if args.report_dir:
-        run_dir = Path(args.report_dir)
-    else:
-        run = args.run or datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
-        if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", run):
-            return _error(f"--run {run!r}: expected a name of letters, digits, '_', '.', '-' "
-                          "(no '/', not starting with '.')")
-        run_dir = Path("reports") / run
     try:
         run_dir.parent.mkdir(parents=True, exist_ok=True)
         if not os.access(run_dir.parent, os.W_OK):
             raise OSError("permission denied")
-        check_replaceable(run_dir, "--report-dir" if args.report_dir else "--run")
+        check_replaceable(run_dir, run_option)
     except InputError as exc:
         return _error(str(exc))
     except OSError as exc:
         return _error(f"--report-dir {str(run_dir)!r}: cannot write there ({exc}): "
                       "expected a writable directory")
 
-    tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
-                     min_iou=args.min_iou)
     if args.sweep:
-        return _sweep(args, scenes, case_names, spin, level, tol, run_dir)
+        return _sweep(args, inputs, level, tol, run_dir)
     if args.suite:
         return _suite(level, run_dir)
+    progress = TerminalProgress(sys.stderr)
     try:
-        report, images = run_crosscheck(scenes, candidate, frames=args.frames, case_names=case_names,
-                                        level=level, turns=spin, tol=tol, every=args.every, jobs=args.jobs,
-                                        candidate_name=args.candidate or "core", candidate_spec=args.candidate,
-                                        mode=mode)
+        report, images = run_crosscheck(inputs.scenes, candidate, frames=inputs.frames,
+                                        case_names=inputs.case_names, level=level, turns=inputs.turns, tol=tol,
+                                        every=inputs.every, jobs=args.jobs, candidate_name=args.candidate or "core",
+                                        candidate_spec=args.candidate, mode=mode, allow_vacuous=args.allow_vacuous,
+                                        progress=progress.update if progress.active else None,
+                                        isolate=args.candidate is not None)
     except InputError as exc:
         return _error(str(exc))
     except BrokenProcessPool as exc:
+        if args.candidate:     # it ran in the workers (isolate): it ended one, so it fails, never passes
+            print(f"crosscheck: FAIL: a worker process running --candidate {args.candidate!r} ended ({exc}): "
+                  "the candidate exited or crashed its process; no report written", file=sys.stderr)
+            return 1
         return _error(f"a worker process died ({exc}); try --jobs 1")
+    finally:
+        progress.close()
+    report = {"run": args.run, **report}
     records = report["cases"]
-    failed = report["summary"]["failed"]
     try:
         write_report(run_dir, report, images)
     except OSError as exc:
@@ -295,24 +303,26 @@ def main(argv=None) -> int:
     s = report["summary"]
     limits = (f"silhouette IoU >= {tol.min_iou}, depth error <= its bound" if mode.shaded
               else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}")
-    print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance "
-          f"(vertex <= {tol.vertex_px:g} px, {limits})")
+    vacuous = vacuous_text(report)
+    print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases, {compared_text(report)} "
+          f"(vertex <= {tol.vertex_px:g} px, {limits})" + (f"; {vacuous}" if vacuous else ""))
     print(timing_line(report))
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
-    return 1 if failed else 0
+    return 0 if report["verdict"] == "pass" else 1
 
 
-def _sweep(args, scenes, case_names, spin, level, tol, run_dir) -> int:
+def _sweep(args, inputs, level, tol, run_dir) -> int:
     from .sweep import default_failures, large_mesh, markdown_table, run_sweep, write_sweep
 
     def progress(text):
         print(f"  {text}", file=sys.stderr, flush=True)
 
-    print(f"Sweep: 12 settings x {len(scenes)} scenes + a large mesh x {len(case_names)} cameras, "
-          f"{len(range(1, args.frames + 1, args.every))} frames each", file=sys.stderr)
+    print(f"Sweep: 12 settings x {len(inputs.scenes)} scenes + a large mesh x {len(inputs.case_names)} cameras, "
+          f"{inputs.frames_checked} frames each", file=sys.stderr)
     try:
-        result = run_sweep(scenes, frames=args.frames, every=args.every, case_names=case_names, turns=spin,
-                           large=large_mesh(), pyrender=level == "pixels", progress=progress)
+        result = run_sweep(list(inputs.scenes), frames=inputs.frames, every=inputs.every,
+                           case_names=list(inputs.case_names), turns=inputs.turns, large=large_mesh(),
+                           pyrender=level == "pixels", progress=progress)
         write_sweep(run_dir, result)
     except InputError as exc:
         return _error(str(exc))

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 
-from .report import FAULT_HINTS, fault_text
+from .report import FAULT_HINTS, fault_text, not_passed
 
 #: The root element's name: it marks a file as ours (one we may replace).
 SUITES_NAME = "wirecheck crosscheck"
@@ -52,9 +52,10 @@ def junit_xml(report: dict) -> bytes:
     """The report (oracles.runner.run_crosscheck) as JUnit XML bytes (UTF-8)."""
     cases = report["cases"]
     timing = {(t["scene"], t["camera"]): t for t in (report.get("timing") or {}).get("cases", [])}
-    failures = sum(1 for c in cases if c["verdict"] != "pass")
+    failing = {id(c) for c in not_passed(report)}     # a vacuous case allowed by --allow-vacuous is skipped
+    skipped = sum(1 for c in cases if c["verdict"] != "pass" and id(c) not in failing)
     wall = (report.get("timing") or {}).get("wall_s") or 0.0
-    counts = {"tests": str(len(cases)), "failures": str(failures), "errors": "0", "skipped": "0",
+    counts = {"tests": str(len(cases)), "failures": str(len(failing)), "errors": "0", "skipped": str(skipped),
               "time": f"{wall:.3f}"}
     root = ET.Element("testsuites", {"name": SUITES_NAME, **counts})
     suite = ET.SubElement(root, "testsuite", {"name": "crosscheck", **counts})
@@ -65,7 +66,9 @@ def junit_xml(report: dict) -> bytes:
     for c in cases:
         elem = ET.SubElement(suite, "testcase", {"classname": c["scene"], "name": c["camera"],
                                                  "time": f"{_seconds(timing.get((c['scene'], c['camera']))):.3f}"})
-        if c["verdict"] != "pass":
+        if c["verdict"] != "pass" and id(c) not in failing:
+            ET.SubElement(elem, "skipped", {"message": "; ".join(c["reasons"]) + " (allowed by --allow-vacuous)"})
+        elif c["verdict"] != "pass":
             kind = ",".join(f["name"] for f in c.get("faults") or []) or c["verdict"]
             failure = ET.SubElement(elem, "failure", {"message": failure_message(c), "type": kind})
             failure.text = failure_text(c)

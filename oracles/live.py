@@ -57,7 +57,8 @@ class LiveOverlay:
         out = {"frame": frame, "verdict": rec["verdict"], "reasons": rec["reasons"],
                "f1_0px": rec.get("pixel_f1_0px"), "f1_1px": rec.get("pixel_f1_1px"),
                "max_vertex_error_px": rec.get("max_vertex_error_px"),
-               "faults": [f["name"] for f in rec["faults"]], "faults_text": fault_text(rec["faults"]),
+               "faults": [f["name"] for f in rec["faults"]],
+               "faults_text": fault_text(rec["faults"], rec.get("camera_spec")),
                "silhouette_iou": rec.get("silhouette_iou"), "depth_error_ratio": rec.get("depth_error_ratio"),
                "oracle_image": None, "diff_image": None}
         if res.worst_images is not None:

@@ -20,6 +20,7 @@ import numpy as np
 
 from wirecheck.core.output import FrameDir, json_dumps, png_bytes
 
+from .fmt import distinct
 from .metrics import DIFF_COLOURS, diff_image
 
 
@@ -51,15 +52,54 @@ def _fmt_f1(v) -> str:
     return "-" if v is None else f"{v:.4f}"
 
 
-def fault_text(faults: list[dict]) -> str:
+def fault_nominals(camera: dict | None) -> dict:
+    """The value each fault field would have without the fault (``camera``: a record's ``camera_spec``)."""
+    out = {"scale": 1.0, "scale_x": 1.0, "scale_y": 1.0, "dx": 0.0, "dy": 0.0}
+    if camera:
+        out.update(implied_aspect=camera["width"] / camera["height"], implied_fov_deg=camera["fov_y_deg"],
+                   implied_ortho_height=camera["ortho_height"])
+    return out
+
+
+def fault_text(faults: list[dict], camera: dict | None = None) -> str:
+    """Faults in one line; each number with enough digits to differ from its nominal value (oracles.fmt)."""
     if not faults:
         return "none"
+    nominal = fault_nominals(camera)
     parts = []
     for f in faults:
-        extra = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
+        extra = ", ".join(f"{k}={distinct(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
                           for k, v in f.items() if k != "name")
         parts.append(f"{f['name']}({extra})" if extra else f["name"])
     return "; ".join(parts)
+
+
+def _count(n: int, unit: str) -> str:
+    return f"{n:,} {unit}" + ("" if n == 1 else "s")
+
+
+def compared_text(report: dict) -> str:
+    """How much a run compared, e.g. "504 frames, 4,032 vertices, 1,234,567 pixels compared"."""
+    c = report["compared"]
+    parts = [_count(c["frames"], "frame"), f"{c['vertices']:,} {'vertex' if c['vertices'] == 1 else 'vertices'}"]
+    if c.get("pixels") is not None:
+        parts.append(_count(c["pixels"], "pixel"))
+    return ", ".join(parts) + " compared"
+
+
+def vacuous_text(report: dict) -> str:
+    """"" or, when cases compared nothing, how many and whether that was allowed."""
+    n = report["summary"].get("vacuous", 0)
+    if not n:
+        return ""
+    allowed = "allowed by --allow-vacuous" if report.get("allow_vacuous") else "a failure unless --allow-vacuous"
+    return f"{_count(n, 'case')} vacuous (compared nothing: {allowed})"
+
+
+def not_passed(report: dict) -> list[dict]:
+    """The cases that make the run fail: failed ones, and vacuous ones unless allowed."""
+    allowed = ("pass", "vacuous") if report.get("allow_vacuous") else ("pass",)
+    return [c for c in report["cases"] if c["verdict"] not in allowed]
 
 
 def _is_shaded(cases: list[dict]) -> bool:
@@ -70,13 +110,19 @@ def _fmt_ratio(v) -> str:
     return "-" if v is None else f"{v:.3g}"
 
 
+def _pixel_f1(case: dict, key: str) -> str:
+    """An F1 for the table; "-" when no pixel was drawn by either side (two blank frames score 1.0)."""
+    return "-" if (case.get("compared") or {}).get("pixels") == 0 else _fmt_f1(case.get(key))
+
+
 def table_rows(cases: list[dict]) -> list[list[str]]:
     if _is_shaded(cases):
         return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _fmt_f1(c.get("silhouette_iou")),
                  _fmt_err(c.get("depth_max_error")), _fmt_ratio(c.get("depth_error_ratio")), c["verdict"],
-                 fault_text(c["faults"])] for c in cases]
-    return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _fmt_f1(c.get("pixel_f1_0px")),
-             _fmt_f1(c.get("pixel_f1_1px")), c["verdict"], fault_text(c["faults"])] for c in cases]
+                 fault_text(c["faults"], c.get("camera_spec"))] for c in cases]
+    return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _pixel_f1(c, "pixel_f1_0px"),
+             _pixel_f1(c, "pixel_f1_1px"), c["verdict"], fault_text(c["faults"], c.get("camera_spec"))]
+            for c in cases]
 
 
 HEADER = ["scene", "camera", "max vertex err (px)", "F1@0px", "F1@1px", "verdict", "faults"]
@@ -194,17 +240,19 @@ def markdown(report: dict, files: set | None = None) -> str:
     s = report["summary"]
     settings = settings_text(report)
     head = header(report["cases"])
-    out = [f"# crosscheck report: {report['verdict'].upper()}", "",
+    run = f" ({report['run']})" if report.get("run") else ""
+    out = [f"# crosscheck report{run}: {report['verdict'].upper()}", "",
            f"Candidate: `{report['candidate']}`" + (f" ({settings})" if settings else "")
            + f". Oracles: {', '.join(report['oracles'])}. "
-           f"Cases: {s['cases']} ({s['passed']} pass, {s['failed']} fail).", "",
+           f"Cases: {s['cases']} ({s['passed']} pass, {s['failed']} fail, {s.get('vacuous', 0)} vacuous). "
+           f"Compared: {compared_text(report)}." + (f" {vacuous_text(report)}." if vacuous_text(report) else ""), "",
            f"Level: {level_text(report)}. Checked: {frames_text(report)}.", "",
            f"Drawing: {drawing_text(report)}.", "",
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
         out.append("| " + " | ".join(r) + " |")
-    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    failing = not_passed(report)
     if failing:
         out += ["", "## Why cases failed", ""]
         for c in failing:
@@ -219,10 +267,12 @@ def markdown(report: dict, files: set | None = None) -> str:
         if "worst.gif" in files and _worst_text(report):
             out.append(f"- [worst.gif](worst.gif): the worst case, {_worst_text(report)}")
         out += [f"- [{name}]({name}): {caption}" for name, caption in figures]
-    notes = [c for c in report["cases"] if c.get("note")]
+    notes = [(c, c["note"]) for c in report["cases"] if c.get("note")]
+    notes += [(c, "; ".join(c["reasons"]) + " (allowed)") for c in report["cases"]
+              if c["verdict"] == "vacuous" and c not in failing]
     if notes:
         out += ["", "## Notes", ""]
-        out += [f"- {c['scene']} / {c['camera']}: {c['note']}" for c in notes]
+        out += [f"- {c['scene']} / {c['camera']}: {note}" for c, note in notes]
     out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames, and the time per frame "
             "of each stage (vertex, pixel) per case: `report.html` (and `\"timing\"` in `report.json`; "
             "timings are kept out of this file so that it is the same on every run).", ""]
@@ -251,11 +301,12 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         f"<p>Candidate <code>{e(report['candidate'])}</code>"
         + (f" ({e(settings_text(report))})" if settings_text(report) else "")
         + f"; oracles {e(', '.join(report['oracles']))}.</p>",
+        f"<p>Compared: {e(compared_text(report))}. {e(vacuous_text(report))}</p>",
         f"<p>Level {e(level_text(report))}. Checked: {e(frames_text(report))}.</p>",
         f"<p>Drawing: {e(drawing_text(report))}.</p>",
         "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>" + rows + "</table>",
     ]
-    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    failing = not_passed(report)
     if failing:
         parts.append("<h2>Why cases failed</h2><ul>" + "".join(
             f"<li><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e('; '.join(c['reasons']))}</li>"
@@ -299,7 +350,8 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
             scores = f"F1@0 {_fmt_f1(case.get('pixel_f1_0px'))}, F1@1 {_fmt_f1(case.get('pixel_f1_1px'))}"
         parts.append(
             f"<section><p><b>{e(case['scene'])} / {e(case['camera'])}</b>, frame "
-            f"{case.get('worst_pixel_frame')}: {scores}, faults: {e(fault_text(case['faults']))}</p>"
+            f"{case.get('worst_pixel_frame')}: {scores}, "
+            f"faults: {e(fault_text(case['faults'], case.get('camera_spec')))}</p>"
             f"<div class='row'>{figs}</div></section>")
     parts.append("</body></html>\n")
     return "\n".join(parts)

@@ -57,7 +57,7 @@ import numpy as np
 from wirecheck.core.scene import Scene
 from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
-from . import metrics, opencv_oracle
+from . import gate, metrics, opencv_oracle
 from .case import CaseResult, run_case
 from .cases import Case
 from .convert import model_matrix
@@ -182,15 +182,17 @@ def _worker_run(scene: Scene, case: Case, params: _RunParams) -> CaseResult:
     return _WORKER_RUNNER.run(scene, case, params)
 
 
-def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None) -> tuple[list[CaseResult], int]:
+def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None,
+               isolate: bool = False) -> tuple[list[CaseResult], int]:
     """Results in task order, and the number of worker processes used (0: in this process).
 
     ``on_result(result)`` is called on each result as it is gathered, in task
     order (it may drop what it does not need to keep, e.g. frame images).
+    ``isolate``: use a worker even for one job, so that the candidate cannot end this process.
     """
     on_result = on_result or (lambda result: None)
     workers = min(jobs, len(tasks))
-    if workers <= 1:
+    if workers <= 1 and not isolate:
         runner = _CaseRunner()
         try:
             results = []
@@ -234,7 +236,8 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
                    turns=(1.0, 1.0, 0.0), tol: Tolerances | None = None, candidate_name: str = "candidate",
                    *, level: str | None = None, every: int = 1, jobs: int = 1,
                    candidate_spec: str | None = None, mode: RenderMode | None = None,
-                   animation: bool = True) -> tuple[dict, dict]:
+                   animation: bool = True, allow_vacuous: bool = False, progress=None,
+                   isolate: bool = False) -> tuple[dict, dict]:
     """Every scene under every case camera: the report dict and the worst-frame images.
 
     ``level`` is "vertices" (OpenCV only) or "pixels" (OpenCV and pyrender, the
@@ -255,7 +258,17 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     vertex error): ``{"scene", "camera", "frames": [k...], "candidate": [...],
     "oracle": [...]}`` (bool images), for worst.gif. Raises InputError when no
     camera can be placed for a scene (coordinates too large), ValueError for a
-    bad level, ``every``, ``jobs`` or mode.
+    bad level, ``jobs`` or mode, and InputError (a ValueError) for inputs that
+    would compare nothing (:func:`oracles.gate.run_inputs`: no scene, case or
+    frame, an unknown or repeated name, ``every`` > ``frames``, a NaN tolerance).
+
+    A case that compared nothing is ``"vacuous"`` and fails the run unless
+    ``allow_vacuous`` (oracles.gate); ``report["compared"]`` counts what was
+    compared. ``progress(cases_done, cases, frames_done, frames)`` is called
+    before the first case and after each. With ``isolate`` the cases run in
+    worker processes even for ``jobs=1``: a candidate that ends its process
+    (``os._exit(0)``) raises BrokenProcessPool here instead of ending the run
+    with status 0; the candidate must then be given as ``candidate_spec``.
     """
     from wirecheck.core.errors import InputError
 
@@ -269,8 +282,6 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     level = level or "pixels"
     if level not in LEVELS:
         raise ValueError(f"level {level!r}: expected one of {', '.join(LEVELS)}")
-    if every < 1:
-        raise ValueError(f"every {every}: expected an integer >= 1")
     if jobs < 1:
         raise ValueError(f"jobs {jobs}: expected an integer >= 1")
     mode = mode or RenderMode()
@@ -280,22 +291,37 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         if not isinstance(candidate, CoreCandidate):
             raise ValueError(f"drawing mode {mode.to_dict()}: only the core candidate draws faces")
     tol = tol or Tolerances()
-    motion = Motion(turns=tuple(float(x) for x in turns))
+    inputs = gate.run_inputs(scenes, frames, every, case_names, turns, tol)
+    frames, every = inputs.frames, inputs.every
+    motion = Motion(turns=inputs.turns)
     t_run = time.perf_counter()
     tasks = []
-    for scene in scenes:
+    for scene in inputs.scenes:
         try:
             scene_cases = cameras_for(scene.radius)
         except InputError as exc:
             raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
-        tasks += [(scene, case) for case in scene_cases if case_names is None or case.name in case_names]
+        tasks += [(scene, case) for case in scene_cases if case.name in inputs.case_names]
     is_core = isinstance(candidate, CoreCandidate)
     ref = candidate if is_core or candidate_spec is None else candidate_spec
     keep_frames = animation and level == "pixels"
     params = _RunParams(frames=frames, every=every, level=level, motion=motion, tol=tol, candidate=ref,
                         mode=mode, keep_frames=keep_frames)
     worst = _WorstCase(mode)
-    results, workers = _run_tasks(tasks, params, jobs, on_result=worst.offer if keep_frames else None)
+    n_frames = len(tasks) * inputs.frames_checked
+    cases_done = 0
+
+    def on_result(result: CaseResult) -> None:
+        nonlocal cases_done
+        if keep_frames:
+            worst.offer(result)
+        cases_done += 1
+        if progress:
+            progress(cases_done, len(tasks), cases_done * inputs.frames_checked, n_frames)
+
+    if progress:
+        progress(0, len(tasks), 0, n_frames)
+    results, workers = _run_tasks(tasks, params, jobs, on_result=on_result, isolate=isolate)
 
     records, images, timing_cases = [], {}, []
     for (scene, case), result in zip(tasks, results):
@@ -309,7 +335,9 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         images["animation"] = worst.animation()
         worst_case = {"scene": images["animation"]["scene"], "camera": images["animation"]["camera"],
                       "frames_checked": len(images["animation"]["frames"]), "animation": "worst.gif"}
-    failed = sum(1 for r in records if r["verdict"] != "pass")
+    failed = sum(1 for r in records if r["verdict"] == "fail")
+    vacuous = sum(1 for r in records if r["verdict"] == "vacuous")
+    compared = gate.compared_totals(records, level)
     vertex_errs = [r["max_vertex_error_px"] for r in records if r.get("max_vertex_error_px") is not None]
     f1_0 = [r["pixel_f1_0px"] for r in records if r.get("pixel_f1_0px") is not None]
     f1_1 = [r["pixel_f1_1px"] for r in records if r.get("pixel_f1_1px") is not None]
@@ -323,7 +351,8 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
             timing[key] = _overall_ms(timing_cases, key)
     timing.update({"jobs": jobs, "workers": workers, "wall_s": time.perf_counter() - t_run,
                    "cases": timing_cases})
-    summary = {"cases": len(records), "passed": len(records) - failed, "failed": failed,
+    summary = {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
+               "vacuous": vacuous,
                "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
                "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
                "min_pixel_f1_1px": min(f1_1) if f1_1 else None}
@@ -336,7 +365,9 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
                         "max_depth_error_ratio": max(ratio) if ratio else None})
     report = {
         "tool": "wirecheck crosscheck",
-        "verdict": "fail" if failed else "pass",
+        "verdict": gate.run_verdict(records, compared, level, allow_vacuous),
+        "allow_vacuous": allow_vacuous,
+        "compared": compared,
         "candidate": candidate_name,
         "candidate_settings": candidate.settings() if is_core else None,
         "level": level,

@@ -321,6 +321,8 @@ def default_failures(sweep: dict, vertex_px: float, min_f1_1px: float, min_f1_0p
     """Why the default setting is out of tolerance (empty when it is within)."""
     d = next(r for r in sweep["settings"] if r["default"])
     reasons = []
+    if d["max_vertex_error_px"] is None:        # a gate never passes on nothing (oracles.gate)
+        reasons.append("no vertex was compared (every point clipped in every case)")
     if d["max_vertex_error_px"] is not None and d["max_vertex_error_px"] > vertex_px:
         reasons.append(f"max vertex error {d['max_vertex_error_px']:.3g} px > {vertex_px:g}")
     if d["visibility_mismatches"]:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import metrics
+from . import gate, metrics
 from .diagnose import diagnose
 from .tolerances import MIN_IOU_UNION_PX, Tolerances
 
@@ -64,11 +64,9 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
     if setup.pixels and setup.mode.shaded:
         rec.update(shaded_summary(acc.shaded, acc.worst))
     rec["faults"] = faults
-    if done and len(setup.scene.vertices) == 0:
-        rec["note"] = "nothing to check: the scene has no vertices"
-    elif done and rec["visible_points"] == 0:
-        rec["note"] = "no point visible to both projectors: only the visible/clipped sets were compared"
-    elif done and setup.pixels and not setup.mode.plain and setup.faces is None:
+    rec["compared"] = {"frames": done, "vertices": rec.get("visible_points", 0),
+                       "pixels": acc.drawn_px if setup.pixels else None}
+    if done and setup.pixels and not setup.mode.plain and setup.faces is None:
         rec["note"] = {"shaded": "no faces: nothing to shade; only the vertices were checked",
                        "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe"
                        }[setup.mode.style]
@@ -105,8 +103,12 @@ def shaded_summary(shaded: list, worst) -> dict:
     return out
 
 
-def judge(rec: dict, tol: Tolerances, error: str | None = None) -> None:
-    """Set ``rec["verdict"]`` ("pass" or "fail") and ``rec["reasons"]`` (one line per limit missed)."""
+def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | None = None) -> None:
+    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed).
+
+    "fail" when a limit is missed; else "vacuous" when the case compared nothing
+    (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.gate).
+    """
     reasons = [error] if error else []
     if rec["frames_checked"]:
         if rec["max_vertex_error_px"] is not None and rec["max_vertex_error_px"] > tol.vertex_px:
@@ -135,5 +137,5 @@ def judge(rec: dict, tol: Tolerances, error: str | None = None) -> None:
         if rec["depth_error_ratio"] is not None and rec["depth_error_ratio"] > 1.0:
             reasons.append(f"depth error {rec['depth_max_error']:.3g} > its bound {rec['depth_error_bound']:.3g} "
                            f"(error/bound up to {rec['depth_error_ratio']:.3g}, frame {rec['depth_worst_frame']})")
-    rec["verdict"] = "fail" if reasons else "pass"
-    rec["reasons"] = reasons
+    level = "vertices" if rec["compared"]["pixels"] is None else "pixels"
+    rec["verdict"], rec["reasons"] = gate.case_verdict(rec["compared"], reasons, level, points)

@@ -195,10 +195,15 @@ def test_per_frame_errors_and_precision_recall_at_0px(tmp_path):
         assert 0.98 <= case[key] <= 1.0          # measured >= 0.9958 (oracles/tolerances.py)
 
 
-def test_empty_scene_says_nothing_was_checked(tmp_path):
+def test_empty_scene_is_vacuous_and_fails_unless_allowed(tmp_path):
     empty = tmp_path / "empty.scene"
     empty.write_text("# no vertices\n")
     code, report, _ = run(tmp_path, "--scene", str(empty), "--frames", "1", "--cases", "on_axis")
     case = report["cases"][0]
-    assert code == 0 and case["max_vertex_error_px"] is None
-    assert case["note"].startswith("nothing to check")
+    assert code == 1 and report["verdict"] == "fail"
+    assert case["verdict"] == "vacuous" and case["max_vertex_error_px"] is None
+    assert case["reasons"] == ["vacuous: the scene has no vertices: nothing compared"]
+    assert report["compared"] == {"cases": 0, "frames": 1, "vertices": 0, "pixels": 0}
+    code, report, _ = run(tmp_path, "--scene", str(empty), "--frames", "1", "--cases", "on_axis",
+                          "--allow-vacuous", name="allowed")
+    assert code == 0 and report["verdict"] == "pass" and report["cases"][0]["verdict"] == "vacuous"

@@ -107,16 +107,21 @@ def test_injected_shading_faults_are_caught():
     assert case["silhouette_mismatch_inside"] > 1000 and "inside its silhouette" in reasons
 
 
-def test_faceless_scene_is_noted_not_failed(tmp_path):
+def test_faceless_scene_is_noted_and_vacuous_when_shaded(tmp_path):
     wire = tmp_path / "wire.scene"                      # the pyramid's edges, without faces
     wire.write_text("v -1 -1 -1\nv 1 -1 -1\nv 1 -1 1\nv -1 -1 1\nv 0 1 0\n"
                     "e 0 1\ne 1 2\ne 2 3\ne 3 0\ne 0 4\ne 1 4\ne 2 4\ne 3 4\n")
+    # shaded, no faces: nothing is shaded on either side, so the pixel level compared nothing (oracles.gate)
     code, report, out = run(tmp_path, "--style", "shaded", "--scene", str(wire), "--frames", "2",
                             "--cases", "on_axis")
     case = report["cases"][0]
-    assert code == 0 and case["verdict"] == "pass"
+    assert code == 1 and case["verdict"] == "vacuous" and case["compared"]["pixels"] == 0
+    assert "nothing compared at level pixels" in case["reasons"][0]
     assert case["note"] == "no faces: nothing to shade; only the vertices were checked"
     assert case["silhouette_iou"] is None and case["max_vertex_error_px"] < 1e-9
+    code, report, out = run(tmp_path, "--style", "shaded", "--scene", str(wire), "--frames", "2",
+                            "--cases", "on_axis", "--allow-vacuous", name="allowed")
+    assert code == 0 and report["verdict"] == "pass" and report["cases"][0]["verdict"] == "vacuous"
     code, report, _ = run(tmp_path, "--hidden-lines", "--scene", str(wire), "--frames", "2",
                           "--cases", "on_axis", name="hidden")
     case = report["cases"][0]
