@@ -32,10 +32,42 @@ def _vec3(name: str, value) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Camera:
-    """A pinhole (or orthographic) camera.
+    """A pinhole (or orthographic) camera, frozen and validated when built.
 
-    ``forward`` and ``up`` are stored unit length and orthogonal; build cameras
-    with :func:`look_at` (or :func:`from_vectors`) rather than by hand.
+    Build cameras with :func:`look_at` or :func:`camera_z` rather than by
+    hand. Axes, pixel centres and the FOV axis are those of
+    :mod:`wirecheck.core.conventions`.
+
+    Parameters
+    ----------
+    position : (3,) array_like of float
+        The centre of projection, world coordinates.
+    forward : (3,) array_like of float
+        View direction (any non-zero length; stored unit length).
+    up : (3,) array_like of float
+        Toward the top of the image; need not be orthogonal to ``forward``
+        (stored as its unit component orthogonal to it).
+    fov_y_deg : float
+        Full vertical field of view in degrees, edge to edge of the image
+        (perspective only), in (0, 180).
+    width, height : int
+        Image size in pixels.
+    near, far : float
+        Clip planes: a point is visible when ``near <= depth <= far``.
+    projection : {"perspective", "orthographic"}
+    ortho_height : float
+        World units visible vertically (orthographic only).
+
+    Attributes
+    ----------
+    right : (3,) ndarray of float64
+        ``forward x up``: toward the right of the image.
+
+    Raises
+    ------
+    InputError
+        Non-finite values, a zero ``forward``, ``up`` parallel to ``forward``,
+        or a size, FOV or clip range out of its domain.
     """
 
     position: np.ndarray
@@ -132,7 +164,28 @@ class Camera:
 
 
 def look_at(position, target, up=(0.0, 1.0, 0.0), **kwargs) -> Camera:
-    """A camera at ``position`` looking at ``target``; ``up`` need not be orthogonal."""
+    """A camera at ``position`` looking at ``target``.
+
+    Parameters
+    ----------
+    position, target : (3,) array_like of float
+        World coordinates; they must differ.
+    up : (3,) array_like of float
+        Toward the top of the image; need not be orthogonal to the view direction.
+    **kwargs
+        Any other :class:`Camera` field (``fov_y_deg``, ``width``, ``height``,
+        ``near``, ``far``, ``projection``, ``ortho_height``).
+
+    Returns
+    -------
+    Camera
+
+    Examples
+    --------
+    >>> cam = look_at((0, 0, 4), (0, 0, 0), fov_y_deg=70)
+    >>> cam.forward.tolist(), cam.up.tolist()
+    ([0.0, 0.0, -1.0], [0.0, 1.0, 0.0])
+    """
     position = _vec3("position", position)
     target = _vec3("look-at", target)
     forward = target - position
@@ -142,7 +195,19 @@ def look_at(position, target, up=(0.0, 1.0, 0.0), **kwargs) -> Camera:
 
 
 def camera_z(distance: float, **kwargs) -> Camera:
-    """The ``--camera-z D`` shortcut: at (0, 0, D) looking at the origin, up +Y."""
+    """The ``--camera-z D`` shortcut: a camera at (0, 0, D) looking at the origin, up +Y.
+
+    Parameters
+    ----------
+    distance : float
+        D, the camera's z coordinate (non-zero).
+    **kwargs
+        Any other :class:`Camera` field.
+
+    Returns
+    -------
+    Camera
+    """
     return look_at((0.0, 0.0, float(distance)), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), **kwargs)
 
 

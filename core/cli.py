@@ -54,8 +54,16 @@ def vec3(option: str, text: str) -> tuple[float, float, float]:
     return values
 
 
+def _version() -> str:
+    import wirecheck
+
+    return wirecheck.__version__
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="renderer", description=DESCRIPTION)
+    p.add_argument("--version", action="version", version=f"%(prog)s (wirecheck) {_version()}",
+                   help="print the installed wirecheck version and exit")
     p.add_argument("--scene", default="cube", help="built-in name (cube, pyramid, prism), an example "
                    "(orrery: scenes/examples/, several objects) or a file path (.scene, .obj, .ply, .stl, .off, "
                    ".glb) (default cube)")

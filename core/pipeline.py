@@ -37,10 +37,10 @@ STAGES = ("transform", "faces", "shading", "clip", "raster")
 
 @dataclass(frozen=True)
 class Frame:
-    """One rendered frame.
+    """One rendered frame (what :func:`render_frame` returns).
 
-    Fields
-    ------
+    Attributes
+    ----------
     image : (H, W) uint8
         Wireframe: 255 on line pixels (raster "aa": coverage 0..255); with
         ``hidden_lines``, the wireframe minus the hidden line pixels. Style
@@ -130,50 +130,59 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
                  faces=None, cull: str | None = None, hidden_lines: bool = False,
                  style: str = "wireframe", light_dir=None,
                  ambient: float = shading.DEFAULT_AMBIENT, timing: dict | None = None) -> Frame:
-    """Project and draw one frame.
+    """Project and draw one frame of a mesh's edges (and, optionally, its faces).
 
-    ``p_model`` is an ``(N, 3)`` array or, to skip re-centring and casting on
-    every frame, the :class:`~core.projection.LocalPoints` of
-    :func:`~core.projection.localize`. ``dtype`` ("float64" default, or
-    "float32") is the precision of every per-point operation of the
-    projection and the wireframe; with ``LocalPoints`` it defaults to theirs.
-    The face stage (culling, z-buffer, shading) takes the camera-space
-    points in that precision but computes in float64: its decisions (which
-    face is nearer, which side a normal faces) are compared with a 24-bit
-    depth buffer and rounding signs, where float32 arithmetic would add noise
-    and no speed. ``raster`` is one of :data:`RASTER_MODES` (core.raster).
-
-    Faces (all optional; without them the frame is the plain wireframe):
-
-    faces
-        Polygons as index tuples (counter-clockwise seen from outside), or an
-        ``(F, k)`` integer array; triangulated internally (core.culling).
-    cull
-        None or ``"backface"``: drop back faces (core.culling states the rule)
-        from the depth buffer, and draw an edge only when at least one of its
-        faces is kept, or when it belongs to no face.
-    hidden_lines
-        Rasterize the faces into a depth buffer (core.zbuffer) and do not draw
-        line pixels behind them (``z_line <= z_buffer + bias``, bias as
-        ``glPolygonOffset(1, 1)``; core.zbuffer). Like GL's, the bias includes
-        one step of a 24-bit buffer over [near, far]: with an extreme depth
-        range (say near = -1e8, far = 1e8 for an orthographic camera) that step
-        is ~12 units and hides nothing. Keep [near, far] tight.
-    style
-        ``"wireframe"`` or ``"shaded"`` (the image is flat-shaded faces,
-        core.shading; no lines are drawn and ``hidden_lines`` has no effect
-        on the image).
-    light_dir
-        World direction the light travels; default
-        :func:`core.shading.default_light_dir` (from the camera's upper left).
-    ambient
+    Parameters
+    ----------
+    p_model : (N, 3) array_like of float, or LocalPoints
+        Model-space vertices; or, to skip re-centring and casting on every
+        frame, the :class:`~wirecheck.core.projection.LocalPoints` of
+        :func:`~wirecheck.core.projection.localize`.
+    edges : (E, 2) array_like of int
+        Vertex index pairs.
+    camera : Camera
+    model_matrix : (4, 4) array_like of float
+        Model to world, column vectors (``p_world = M @ p_model``).
+    clip_mode : {"clip", "endpoint"}
+        ``"clip"``: edges are cut at the near and far planes before the
+        divide; ``"endpoint"``: an edge with a clipped end is dropped.
+    dtype : {"float64", "float32"}, optional
+        Precision of every per-point operation of the projection and the
+        wireframe (default float64; with ``LocalPoints``, theirs). The face
+        stage computes in float64: its decisions are compared with a 24-bit
+        depth buffer, where float32 would add noise and no speed.
+    raster : {"exact", "fast", "aa"}
+        The line rule (:mod:`wirecheck.core.raster`).
+    faces : sequence of tuple of int, or (F, k) array_like of int, optional
+        Polygons, counter-clockwise seen from outside; triangulated
+        internally. Without faces the frame is the plain wireframe.
+    cull : {None, "backface"}
+        Drop back faces (the rule: :mod:`wirecheck.core.culling`); an edge is
+        drawn when one of its faces is kept, or when it belongs to no face.
+    hidden_lines : bool
+        Do not draw line pixels behind the faces: our own z-buffer, and a
+        depth test biased as ``glPolygonOffset(1, 1)``. The bias includes one
+        step of a 24-bit buffer over [near, far], so keep [near, far] tight.
+    style : {"wireframe", "shaded"}
+        ``"shaded"``: the image is flat Lambert-shaded faces, no lines.
+    light_dir : (3,) array_like of float, optional
+        World direction the light travels (default: from the camera's upper left).
+    ambient : float
         Ambient term of the shading, in [0, 1].
+    timing : dict, optional
+        The seconds of each of :data:`STAGES` this frame ran are added to it
+        (consecutive laps). None (the default) reads no clock.
 
-    timing
-        Optional dict: the seconds of each of :data:`STAGES` this frame ran are
-        added to it (laps that follow each other, so their sum is the call's
-        time but for building the returned Frame). None (the default) reads no
-        clock.
+    Returns
+    -------
+    Frame
+        ``image`` (H, W) uint8, ``p_px`` (N, 2) float64 (NaN where clipped),
+        ``depth`` (N,), ``visible`` (N,) bool, and the face-stage fields.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``clip_mode``, ``raster``, ``style`` or ``cull``.
     """
     t = _clock() if timing is not None else 0.0
     if clip_mode not in CLIP_MODES:

@@ -183,10 +183,29 @@ def cam_to_px(p_cam: np.ndarray, camera: Camera) -> np.ndarray:
 
 
 def project_points(p_world: np.ndarray, camera: Camera, dtype="float64") -> np.ndarray:
-    """World points to float64 pixels, NaN rows for points outside [near, far].
+    """World points to pixels, NaN rows for points outside [near, far].
 
-    This is the candidate contract of ``crosscheck``: ``(N, 3) -> (N, 2)``.
-    ``dtype`` is the precision of the computation; the result is float64.
+    This is the candidate contract of ``crosscheck``.
+
+    Parameters
+    ----------
+    p_world : (N, 3) array_like of float
+        World coordinates.
+    camera : Camera
+    dtype : {"float64", "float32"}
+        Precision of the computation (camera-relative in both).
+
+    Returns
+    -------
+    p_px : (N, 2) ndarray of float64
+        Pixel coordinates (x right, y down, integers at pixel centres), NaN
+        where the point's depth is outside [near, far].
+
+    Examples
+    --------
+    >>> from wirecheck.core.camera import camera_z
+    >>> project_points([[0, 0, 0]], camera_z(4.0, width=640, height=480)).tolist()
+    [[319.5, 239.5]]
     """
     p_cam = world_to_cam(p_world, camera, dtype)
     visible = depth_mask(p_cam, camera)

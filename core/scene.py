@@ -53,6 +53,25 @@ class SceneObject:
 
 @dataclass(frozen=True)
 class Scene:
+    """A scene: one mesh, or several objects each with its own mesh and motion.
+
+    Parameters
+    ----------
+    name : str
+    vertices : (N, 3) ndarray of float64
+        Model-space points of every object, concatenated (read-only).
+    edges : (E, 2) ndarray of intp
+        Unique vertex index pairs, ``i < j``.
+    faces : tuple of tuple of int
+        Polygons, counter-clockwise seen from outside; ``()`` for none.
+    source : str
+        Where the scene came from (a path, or ``scenes/cube.scene`` for bundled ones).
+    objects : tuple of SceneObject
+        The objects in file order; ``()`` means one static object of everything.
+    winding_note : str or None
+        Why the faces' winding is inconsistent, if it is.
+    """
+
     name: str
     vertices: np.ndarray                     # (N, 3) float64, p_model
     edges: np.ndarray                        # (E, 2) intp, unique, i < j

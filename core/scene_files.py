@@ -312,7 +312,27 @@ def example_names() -> list[str]:
 
 
 def load_scene(name_or_path: str) -> Scene:
-    """A built-in or example scene by name (``cube``, ``orrery``) or a file path (.scene or a mesh format)."""
+    """A bundled scene by name, or a scene or mesh file by path.
+
+    Parameters
+    ----------
+    name_or_path : str
+        A built-in name (``cube``, ``pyramid``, ``prism``), an example name
+        (``orrery``), or a path to a ``.scene`` file (the format:
+        ``scenes/README.md``) or a mesh (.obj, .ply, .stl, .off, .glb, .gltf).
+
+    Returns
+    -------
+    Scene
+        ``vertices`` (N, 3) float64, ``edges`` (E, 2) int, ``faces`` (tuples
+        of vertex indices; empty without faces) and its objects.
+
+    Raises
+    ------
+    InputError
+        One sentence naming the file, the line and the value when the name is
+        unknown or the file is unreadable or malformed.
+    """
     path = Path(name_or_path)
     is_path = os.sep in name_or_path or path.suffix != ""
     if not is_path:

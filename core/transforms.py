@@ -56,9 +56,18 @@ def apply(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
 class Motion:
     """A model's motion over a run.
 
-    ``turns`` are full turns about X, Y and Z over the whole run (an angular
-    velocity of ``360 * turns / frames`` degrees per frame); ``offset`` is a
-    translation and ``scale`` a uniform scale, both constant.
+    Parameters
+    ----------
+    turns : (3,) tuple of float
+        Full turns about X, Y and Z over the whole run (``360 * turns / frames``
+        degrees per frame).
+    offset : (3,) tuple of float
+        A constant translation, world units.
+    scale : float
+        A constant uniform scale.
+
+    The model matrix at run fraction ``t`` in [0, 1) is
+    ``T(offset) @ Rz @ Ry @ Rx @ S(scale)`` (:mod:`wirecheck.core.conventions`).
     """
 
     turns: tuple[float, float, float] = (1.0, 1.0, 0.0)

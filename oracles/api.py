@@ -24,19 +24,48 @@ def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("op
                     tol_px: float = tolerances.VERTEX_TOL_PX, min_f1: float = tolerances.MIN_F1_1PX,
                     min_f1_0px: float = tolerances.MIN_F1_0PX, turns=(1.0, 1.0, 0.0),
                     allow_vacuous: bool = False) -> dict:
-    """Run crosscheck on ``func`` and return the report dict (as in report.json).
+    """Crosscheck a projector against OpenCV (and pyrender) and return the report.
 
-    ``func`` may be a callable or a ``"FILE.py:FUNC"`` / ``"MODULE:FUNC"`` string;
-    ``scenes`` are names, paths or :class:`core.scene.Scene` objects (default,
-    ``None``: every bundled scene); ``cases`` a subset of
-    :data:`oracles.cases.CASE_NAMES` (default, ``None``: all).
+    Parameters
+    ----------
+    func : callable or str
+        The candidate, ``func(points, camera) -> p_px``: ``points`` (N, 3)
+        float64 world coordinates, ``camera`` with the fields of
+        :class:`~wirecheck.core.camera.Camera`, ``p_px`` (N, 2) pixels with
+        NaN rows where clipped (:mod:`wirecheck.oracles.candidate`). Or a
+        ``"FILE.py:FUNC"`` / ``"MODULE:FUNC"`` string.
+    scenes : sequence of str or Scene, optional
+        Names, paths or :class:`~wirecheck.core.scene.Scene` objects
+        (default: every bundled scene).
+    frames : int
+        Frames of each scene's motion per case (>= 1).
+    cases : sequence of str, optional
+        A subset of :data:`wirecheck.oracles.cases.CASE_NAMES` (default: all).
+    oracles : tuple of {"opencv", "pyrender"}
+        ``("opencv",)`` compares vertices only (no OpenGL needed);
+        ``("opencv", "pyrender")`` compares drawn pixels too.
+    tol_px, min_f1, min_f1_0px : float
+        Vertex tolerance in pixels; F1 floors at 1 px and 0 px.
+    turns : (3,) tuple of float
+        The scenes' spin: full turns about X, Y, Z over the run.
+    allow_vacuous : bool
+        Let a case that compared nothing (every point clipped in every frame)
+        pass; by default its verdict ``"vacuous"`` fails the report.
 
-    Inputs that would compare nothing -- no scene or case, an unknown or
-    repeated name, ``frames`` < 1, a NaN tolerance -- raise ValueError
-    (:class:`core.errors.InputError`; oracles.gate checks them for the CLI
-    too). A case that compared nothing (every point clipped in every frame)
-    has verdict ``"vacuous"`` and makes the report's verdict ``"fail"``
-    unless ``allow_vacuous``.
+    Returns
+    -------
+    dict
+        The report, as written to report.json: ``verdict``, ``cases`` (each
+        with its ``verdict``, ``faults``, ``reasons`` and errors), ``compared``.
+
+    Raises
+    ------
+    ValueError
+        (:class:`~wirecheck.core.errors.InputError`) Inputs that would compare
+        nothing: no scene or case, an unknown or repeated name, ``frames`` < 1,
+        a NaN tolerance.
+    RuntimeError
+        ``"pyrender"`` asked for but OSMesa is missing.
     """
     name = func if isinstance(func, str) else getattr(func, "__qualname__", repr(func))
     if isinstance(func, str):
@@ -78,7 +107,25 @@ def failure_text(report: dict) -> str | None:
 
 
 def assert_projector(func, **kwargs) -> dict:
-    """:func:`check_projector`, raising AssertionError with the diagnosis unless the report's verdict is pass."""
+    """:func:`check_projector`, raising AssertionError with the diagnosis unless the verdict is pass.
+
+    Parameters
+    ----------
+    func : callable or str
+        The candidate, as for :func:`check_projector`.
+    **kwargs
+        Any keyword of :func:`check_projector`.
+
+    Returns
+    -------
+    dict
+        The report, when every case passed.
+
+    Raises
+    ------
+    AssertionError
+        Naming each failing case, its faults and reasons, and what to check.
+    """
     report = check_projector(func, **kwargs)
     text = failure_text(report)
     if text is not None:

@@ -68,8 +68,16 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def _version() -> str:
+    import wirecheck
+
+    return wirecheck.__version__
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0])
+    p.add_argument("--version", action="version", version=f"%(prog)s (wirecheck) {_version()}",
+                   help="print the installed wirecheck version and exit")
     p.add_argument("--scene", action="append", default=None,
                    help="scene name or path; repeatable (default: every scene in scenes/)")
     p.add_argument("--frames", type=int, default=None,

@@ -198,6 +198,7 @@ def test_several_segments_at_once_is_union_of_single_calls():
 
 def test_doctest_in_module_runs():
     result = doctest.testmod(raster, verbose=False)
+    assert result.attempted > 0
     assert result.attempted >= 1
     assert result.failed == 0
 
