@@ -31,9 +31,9 @@ from . import metrics, opencv_oracle
 from .candidate import CandidateError, call_candidate
 from .cases import Case
 from .core_candidate import CoreCandidate, RenderMode
-from .draw import draw_candidate
+from .draw import draw_candidate, oracle_segments
 from .tolerances import Tolerances
-from .verdict import SHADED_FRAME_KEYS, case_record, judge
+from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
 
 
 @dataclass
@@ -78,6 +78,7 @@ class CaseFrames:
     per_frame: list = field(default_factory=list)       # the record's per_frame items
     pixel: dict = field(default_factory=lambda: {key: [] for key in metrics.PIXEL_SCORE_KEYS})
     shaded: list = field(default_factory=list)          # (frame, shaded scores)
+    lines: list = field(default_factory=list)           # (frame, metrics.line_scores) of wireframes
     kept: list | None = None                            # (frame, packed candidate, packed oracle)
     worst: tuple | None = None                          # (key, frame, candidate image, oracle image)
     error: str | None = None
@@ -213,8 +214,11 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
             key = None
     else:
         draw_edges, occluders = setup.edges, None
+        seg0, seg1 = oracle_segments(p_world, setup.edges, cam)      # where the oracle's lines lie
         if setup.use_faces and mode.cull == "backface":
-            draw_edges = setup.edges[setup.owners.kept(oface.front_faces(p_world, setup.faces, cam, mirrored))]
+            kept = setup.owners.kept(oface.front_faces(p_world, setup.faces, cam, mirrored))
+            draw_edges = setup.edges[kept]
+            seg0[~kept] = seg1[~kept] = np.nan
         if setup.use_faces and mode.hidden_lines:
             occluders = oface.gl_polygons(setup.faces, mirrored)
         orac_img, _depth = pyrender_oracle.render(pr_vertices, draw_edges, cam, model_matrix=pr_pose,
@@ -225,6 +229,9 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         for name, values in acc.pixel.items():
             values.append(ps[name])
         frame_rec.update({name: ps[name] for name in metrics.PIXEL_SCORE_KEYS})
+        ls = metrics.line_scores(cand_img, orac_img, seg0, seg1)
+        acc.lines.append((k, ls))
+        frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
         key = (ps["f1_1px"], ps["f1_0px"])
     if want_images and key is not None and (acc.worst is None or key < acc.worst[0]):
         acc.worst = (key, k, cand_img.copy(), orac_img.copy())

@@ -113,7 +113,7 @@ import math
 
 import numpy as np
 
-__all__ = ["diagnose", "primary", "FAULT_NAMES", "FAULT_ORDER",
+__all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER",
            "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
 
 #: All fault names, in priority order: the first fault of a diagnosis is the
@@ -121,7 +121,7 @@ __all__ = ["diagnose", "primary", "FAULT_NAMES", "FAULT_ORDER",
 #: the picture more than a scale; an offset is the smallest visible effect.
 FAULT_ORDER = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
                "mirror_vertical", "aspect_mismatch", "fov_mismatch",
-               "pixel_offset", "unexplained")
+               "pixel_offset", "line_end_bias", "line_pixel_bias", "unexplained")
 FAULT_NAMES = frozenset(FAULT_ORDER)
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
@@ -318,3 +318,44 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
                                    rotation_deg=math.degrees(math.atan2(a[1, 0] - a[0, 1], a[0, 0] + a[1, 1])),
                                    **vis_fields, underdetermined=False))
     return _sorted(faults)
+
+
+#: A line end is named in ``line_end_bias`` when its net one-sided pixels are
+#: at least this many per line: a quarter pixel on average, far above what an
+#: unbiased rasterizer leaves (one-sided pixels at ends of both signs cancel).
+LINE_END_MIN_PX = 0.25
+
+
+def diagnose_lines(lines: dict, tol) -> list[dict]:
+    """Name a systematic line-pixel fault from a case's pooled line fields; [] when they pass.
+
+    ``lines`` is :func:`oracles.metrics.line_summary`'s output and ``tol`` the
+    run's tolerances; nothing is named unless :func:`oracles.metrics.line_failures`
+    fails it. The one-sided pixels are split by where they lie along the
+    oracle's segments (``one_sided_by_place``): net pixels per line at the
+    segment's first point (``start``) and last point (``end``), candidate minus
+    oracle (negative: the candidate's lines are short there). Where one end or
+    both carry at least :data:`LINE_END_MIN_PX` per line and together at least
+    half of the net imbalance, the fault is ``line_end_bias`` with ``end``
+    (``"first"``, ``"last"`` or ``"both"``) and ``pixels_per_line`` (signed);
+    otherwise ``line_pixel_bias`` (lines thicker or thinner, or stray pixels),
+    with the one-sided counts by place.
+    """
+    from .metrics import line_failures
+
+    if not line_failures(lines, tol):
+        return []
+    n = max(lines["lines_compared"], 1)
+    places = lines["one_sided_by_place"]
+    net = {p: places[p][0] - places[p][1] for p in places}          # candidate-only minus oracle-only
+    per_line = {"first": net["start"] / n, "last": net["end"] / n}
+    ends = [e for e in ("first", "last") if abs(per_line[e]) >= LINE_END_MIN_PX]
+    total = lines["imbalance"]
+    at_ends = sum(net[{"first": "start", "last": "end"}[e]] for e in ends)
+    if ends and abs(at_ends) >= 0.5 * abs(total):
+        return [{"name": "line_end_bias", "end": ends[0] if len(ends) == 1 else "both",
+                 "pixels_per_line": float(sum(per_line[e] for e in ends)), "lines": int(lines["lines_compared"]),
+                 "candidate_only": int(lines["candidate_only"]), "oracle_only": int(lines["oracle_only"])}]
+    return [{"name": "line_pixel_bias", "candidate_only": int(lines["candidate_only"]),
+             "oracle_only": int(lines["oracle_only"]),
+             **{f"net_{p}": int(net[p]) for p in ("start", "end", "middle", "stray")}}]

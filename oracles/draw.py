@@ -60,3 +60,20 @@ def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera) -> np.n
     rr, cc = line_pixels(q0, q1, camera.width, camera.height)
     image[rr, cc] = True
     return image
+
+
+def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera) -> tuple[np.ndarray, np.ndarray]:
+    """``(E, 2)`` twice: each edge's ends in pixels by OpenCV, clipped to [near, far] in depth; NaN if none left.
+
+    The oracle's float64 picture of where each line lies, for attributing
+    drawn pixels to edges (:func:`oracles.metrics.line_scores`).
+    """
+    p0 = np.full((len(edges), 2), np.nan)
+    p1 = np.full((len(edges), 2), np.nan)
+    if len(edges) == 0:
+        return p0, p1
+    kept, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera)
+    if len(ends):
+        px = opencv_oracle.project(ends.reshape(-1, 3), camera).reshape(-1, 2, 2)
+        p0[kept], p1[kept] = px[:, 0], px[:, 1]
+    return p0, p1

@@ -238,3 +238,247 @@ def depth_bound(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
     return (tolerances.DEPTH_STEPS * depth_step(depth, camera)
             + tolerances.DEPTH_SNAP_PX * depth_slope(depth, covered)
             + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth))
+
+
+# ---------------------------------------------------------------- one-sided pixels and per-edge counts
+
+def sign_test_p(k: int, n: int) -> float:
+    """Two-sided sign-test p-value: ``k`` of ``n`` differing pixels candidate-only, each with p = 1/2 under H0.
+
+    ``2 P(X <= min(k, n - k))`` for ``X ~ Binomial(n, 1/2)`` (the distribution is
+    symmetric, so this is the exact two-sided test), capped at 1; 1 when ``n = 0``.
+    """
+    if n <= 0:
+        return 1.0
+    from scipy.stats import binom
+
+    return float(min(1.0, 2.0 * binom.cdf(min(k, n - k), n, 0.5)))
+
+
+def pixel_balance(cand: np.ndarray, oracle: np.ndarray) -> dict:
+    """Pixels drawn by one image only: ``candidate_only``, ``oracle_only`` and ``imbalance`` (their difference)."""
+    cand = np.asarray(cand, bool)
+    oracle = np.asarray(oracle, bool)
+    c = int((cand & ~oracle).sum())
+    o = int((oracle & ~cand).sum())
+    return {"candidate_only": c, "oracle_only": o, "imbalance": c - o}
+
+
+def balance_scores(candidate_only: int, oracle_only: int, oracle_pixels: int) -> dict:
+    """A case's pooled balance: the net imbalance, as a fraction of the oracle's pixels, and its sign-test p."""
+    n = candidate_only + oracle_only
+    imbalance = candidate_only - oracle_only
+    return {"candidate_only": int(candidate_only), "oracle_only": int(oracle_only), "imbalance": int(imbalance),
+            "imbalance_fraction": imbalance / max(oracle_pixels, 1),
+            "balance_p_value": sign_test_p(candidate_only, n)}
+
+
+def _clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
+    d = p1 - p0
+    t0 = np.zeros(len(p0))
+    t1 = np.ones(len(p0))
+    keep = np.all(np.isfinite(p0) & np.isfinite(p1), axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for axis in range(2):
+            for p, q in ((-d[:, axis], p0[:, axis] - lo[axis]), (d[:, axis], hi[axis] - p0[:, axis])):
+                r = q / p
+                keep &= ~((p == 0) & (q < 0))
+                t0 = np.where(p < 0, np.maximum(t0, r), t0)
+                t1 = np.where(p > 0, np.minimum(t1, r), t1)
+    keep &= t0 <= t1
+    return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d
+
+
+def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
+                        radius: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pixels near each segment: ``(edge, pixel, major)``, three ``(K,)`` int arrays.
+
+    Pixel ``pixel`` (flat index ``y W + x``) is near segment ``edge``
+    (``p0_px[edge] -> p1_px[edge]``, pixel coordinates, core.conventions; NaN
+    rows are skipped) when its centre is within ``radius`` (Euclidean) of it;
+    ``major`` is the pixel's coordinate along the segment's major axis (x when
+    ``|dx| > |dy|``, else y). Every pixel a 1-px line rasterizer draws for a
+    segment lies within ``sqrt(2)/2`` of it (within 1/2 of the line across
+    the major axis, within 1/2 beyond an end along it), so ``radius = 1``
+    holds all of a line's pixels, from either renderer.
+    """
+    p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
+    p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
+    empty = np.zeros(0, dtype=np.int64)
+    if len(p0) == 0:
+        return empty, empty, empty
+    pad = radius + 1.0
+    keep, q0, q1 = _clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
+    ids = np.flatnonzero(keep)
+    if len(ids) == 0:
+        return empty, empty, empty
+    q0, q1 = q0[keep], q1[keep]
+    reach = int(np.ceil(radius)) + 1
+    # every pixel centre within ``radius`` of a segment is within ``reach`` (per
+    # axis) of the rounded point of some 1-px step along it
+    length = np.max(np.abs(q1 - q0), axis=1)
+    steps = np.ceil(length).astype(np.intp) + 1
+    seg = np.repeat(np.arange(len(ids)), steps)
+    t = (np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)) / np.maximum(steps - 1, 1)[seg]
+    pts = q0[seg] + t[:, None] * (q1 - q0)[seg]
+    offs = np.arange(-reach, reach + 1)
+    ox, oy = np.meshgrid(offs, offs)
+    cx = (np.round(pts[:, 0])[:, None] + ox.ravel()[None, :]).astype(np.int64).ravel()
+    cy = (np.round(pts[:, 1])[:, None] + oy.ravel()[None, :]).astype(np.int64).ravel()
+    sid = np.repeat(seg, ox.size)
+    inside = (cx >= 0) & (cx < width) & (cy >= 0) & (cy < height)
+    cx, cy, sid = cx[inside], cy[inside], sid[inside]
+    flat = np.unique(sid * (width * height) + cy * width + cx)      # (segment, pixel) pairs, once each
+    sid, pix = flat // (width * height), flat % (width * height)
+    c = np.column_stack([pix % width, pix // width]).astype(np.float64)
+    a, d = q0[sid], (q1 - q0)[sid]
+    dd = (d * d).sum(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.clip(np.where(dd > 0, ((c - a) * d).sum(axis=1) / dd, 0.0), 0.0, 1.0)
+    near = np.hypot(*(c - a - u[:, None] * d).T) <= radius
+    sid, pix = sid[near], pix[near]
+    x_major = np.abs(d[near, 0]) > np.abs(d[near, 1])
+    major = np.where(x_major, pix % width, pix // width)
+    return ids[sid].astype(np.int64), pix.astype(np.int64), major.astype(np.int64)
+
+
+def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
+    """``(n_edges,)`` int: each edge's length in drawn pixels, counted along its major axis.
+
+    ``near`` is :func:`edge_neighbourhoods`' output. An edge's count is the
+    number of distinct major-axis coordinates among the drawn pixels near it:
+    what a 1-px line of it covers, as in Khronos' per-line count, without
+    rendering lines singly. Which pixel a renderer takes at a major
+    coordinate (a tie across the line) does not change it; a pixel more or
+    less at an end does. Pixels of another line within 1 px (at a shared
+    vertex, a crossing) count for both lines, in both images alike.
+    """
+    edge, pix, major = near
+    drawn = np.asarray(image, bool).ravel()[pix]
+    span = int(major.max()) + 1 if len(major) else 1
+    keys = np.unique(edge[drawn] * span + major[drawn])
+    return np.bincount(keys // span, minlength=n_edges)[:n_edges]
+
+
+def edge_count_scores(cand: np.ndarray, oracle: np.ndarray, near: tuple, n_edges: int) -> dict:
+    """Per-edge pixel counts of both images (:func:`edge_counts`): the largest difference, and where."""
+    cc = edge_counts(cand, near, n_edges)
+    oc = edge_counts(oracle, near, n_edges)
+    diff = cc - oc
+    seen = (cc > 0) | (oc > 0)
+    k = int(np.argmax(np.abs(diff))) if n_edges else 0
+    return {"edges_compared": int(seen.sum()),
+            "edge_count_max_diff": int(abs(diff[k])) if n_edges else 0,
+            "edge_count_worst_edge": k if n_edges and diff[k] != 0 else None,
+            "edge_count_worst_diff": int(diff[k]) if n_edges else 0,
+            "edge_count_diff_sum": int(diff.sum()),
+            "edge_count_diffs": diff}
+
+
+#: A one-sided pixel within this distance (px) of a segment's start or end counts as at that end.
+END_REACH_PX = 1.5
+
+
+def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
+    """Where the one-sided pixels lie along the oracle's segments: at the start, at the end, or between.
+
+    Each candidate-only and oracle-only pixel is given to its nearest segment
+    (``p0_px[m] -> p1_px[m]``, the edge's first vertex to its second, clipped
+    to the near plane, then to the image's edges ``[-1/2, W - 1/2] x [-1/2,
+    H - 1/2]``, where a line leaving the picture ends); it is at the ``start`` (``end``) when within
+    :data:`END_REACH_PX` of that segment's first (last) point, else ``middle``
+    (also: within reach of both ends of a very short segment, or more than
+    1.5 px from every segment: ``stray``). Returns
+    ``{place: [candidate_only, oracle_only]}``.
+    """
+    out = {k: [0, 0] for k in ("start", "end", "middle", "stray")}
+    p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
+    p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
+    h, w = np.asarray(cand).shape
+    ok, p0, p1 = _clip_segments(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
+    p0, p1 = p0[ok], p1[ok]
+    for side, only in enumerate((np.asarray(cand, bool) & ~np.asarray(oracle, bool),
+                                 np.asarray(oracle, bool) & ~np.asarray(cand, bool))):
+        rr, cc = np.nonzero(only)
+        if len(rr) == 0:
+            continue
+        if len(p0) == 0:
+            out["stray"][side] += len(rr)
+            continue
+        c = np.column_stack([cc, rr]).astype(np.float64)
+        for k in range(0, len(c), 2048):                 # (pixels, segments) distances, in chunks
+            q = c[k:k + 2048, None, :]
+            d = (p1 - p0)[None]
+            dd = (d * d).sum(axis=2)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                u = np.clip(np.where(dd > 0, ((q - p0[None]) * d).sum(axis=2) / dd, 0.0), 0.0, 1.0)
+            dist = np.hypot(*np.moveaxis(q - p0[None] - u[..., None] * d, 2, 0))
+            m = np.argmin(dist, axis=1)
+            rows = np.arange(len(m))
+            near = dist[rows, m] <= END_REACH_PX
+            to_start = np.hypot(*(q[:, 0] - p0[m]).T) <= END_REACH_PX
+            to_end = np.hypot(*(q[:, 0] - p1[m]).T) <= END_REACH_PX
+            out["stray"][side] += int((~near).sum())
+            out["start"][side] += int((near & to_start & ~to_end).sum())
+            out["end"][side] += int((near & to_end & ~to_start).sum())
+            out["middle"][side] += int((near & (to_start == to_end)).sum())
+    return out
+
+
+def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
+    """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
+
+    ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
+    rows: not drawn). Returns :func:`pixel_balance`'s fields,
+    :func:`edge_count_scores`' (without the per-edge array) and ``ends``
+    (:func:`end_attribution`).
+    """
+    cand = np.asarray(cand, bool)
+    oracle = np.asarray(oracle, bool)
+    h, w = cand.shape
+    out = pixel_balance(cand, oracle)
+    out["oracle_pixels"] = int(oracle.sum())
+    near = edge_neighbourhoods(p0_px, p1_px, w, h)
+    ec = edge_count_scores(cand, oracle, near, len(np.asarray(p0_px).reshape(-1, 2)))
+    del ec["edge_count_diffs"]
+    out.update(ec)
+    out["ends"] = end_attribution(cand, oracle, p0_px, p1_px) if out["candidate_only"] + out["oracle_only"] else \
+        {k: [0, 0] for k in ("start", "end", "middle", "stray")}
+    return out
+
+
+def line_summary(frames: list) -> dict:
+    """A case's line fields pooled over its frames' :func:`line_scores` (``[(frame, scores)]``)."""
+    c = sum(s["candidate_only"] for _, s in frames)
+    o = sum(s["oracle_only"] for _, s in frames)
+    out = balance_scores(c, o, sum(s["oracle_pixels"] for _, s in frames))
+    k, worst = max(frames, key=lambda e: (e[1]["edge_count_max_diff"], -e[0])) if frames else (None, None)
+    ends = {p: [sum(s["ends"][p][i] for _, s in frames) for i in (0, 1)] for p in ("start", "end", "middle", "stray")}
+    out.update(edge_count_max_diff=worst["edge_count_max_diff"] if worst else 0,
+               edge_count_worst={"frame": k, "edge": worst["edge_count_worst_edge"],
+                                 "diff": worst["edge_count_worst_diff"]} if worst else None,
+               lines_compared=int(sum(s["edges_compared"] for _, s in frames)),
+               one_sided_by_place=ends)
+    return out
+
+
+def line_failures(lines: dict, tol) -> list[str]:
+    """Why a case's pooled line fields (:func:`line_summary`) fail ``tol`` (oracles.tolerances); [] if they pass.
+
+    The balance fails when the sign test rejects symmetry (p < ``tol.balance_alpha``)
+    *and* the net imbalance is more than ``tol.max_imbalance`` of the oracle's
+    pixels; the counts fail when some edge in some frame has more than
+    ``tol.max_edge_count_diff`` pixels more or fewer than the oracle's.
+    """
+    out = []
+    frac, p = lines["imbalance_fraction"], lines["balance_p_value"]
+    if p < tol.balance_alpha and abs(frac) > tol.max_imbalance:
+        out.append(f"one-sided pixels unbalanced: {lines['candidate_only']} candidate-only vs "
+                   f"{lines['oracle_only']} oracle-only, net {frac:+.3%} of the oracle's pixels "
+                   f"(> {tol.max_imbalance:.3%}; sign test p = {p:.2g} < {tol.balance_alpha:g})")
+    if lines["edge_count_max_diff"] > tol.max_edge_count_diff:
+        w = lines["edge_count_worst"]
+        out.append(f"edge {w['edge']} has {w['diff']:+d} pixels against the oracle's count "
+                   f"(allowed +-{tol.max_edge_count_diff}; frame {w['frame']})")
+    return out

@@ -38,6 +38,12 @@ FAULT_HINTS = {
                        "pixels); implied_aspect is the width/height ratio that was used",
     "pixel_offset": "a constant shift: integer pixel coordinates are pixel centres and the principal "
                     "point is ((W - 1) / 2, (H - 1) / 2); 0.5 is the pixel-corner convention",
+    "line_end_bias": "the vertices agree but the lines lose (or gain) pixels at one end: check the "
+                     "rasterizer's end rule (GL diamond exit: the start pixel is drawn when the start point "
+                     "is inside its diamond, the end pixel is not drawn when the end point is inside its own)",
+    "line_pixel_bias": "the vertices agree but the candidate draws systematically more (or fewer) line pixels "
+                       "than the oracle along the lines: check the line width (1 px) and the rounding of the "
+                       "minor coordinate (nearest pixel centre)",
     "depth_flip": "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
     "unexplained": "not a simple image-space fault: check the rotation order, a transposed "
                    "world-to-camera matrix, the up vector (roll) and the near/far test",

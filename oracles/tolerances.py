@@ -39,6 +39,11 @@ MIN_F1_1PX_EXTREMES = 0.99
 #: and fails a half-pixel offset (F1@0 ~ 0.5).
 MIN_F1_0PX = 0.98
 
+#: BALANCE (placeholder: derived below)
+BALANCE_ALPHA = 1e-4
+MAX_IMBALANCE_FRACTION = 1e-3
+MAX_EDGE_COUNT_DIFF = 1
+
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)
 
@@ -128,6 +133,9 @@ class Tolerances:
     min_f1_1px: float = MIN_F1_1PX
     min_f1_0px: float = MIN_F1_0PX
     min_iou: float = MIN_SILHOUETTE_IOU
+    balance_alpha: float = BALANCE_ALPHA
+    max_imbalance: float = MAX_IMBALANCE_FRACTION
+    max_edge_count_diff: int = MAX_EDGE_COUNT_DIFF
 
     def to_dict(self, shaded: bool = False) -> dict:
         """The report's ``tolerances`` field."""
@@ -135,4 +143,5 @@ class Tolerances:
             return {"vertex_error_px": self.vertex_px, "min_silhouette_iou": self.min_iou,
                     "depth_error": DEPTH_BOUND_TEXT}
         return {"vertex_error_px": self.vertex_px, "min_pixel_f1_1px": self.min_f1_1px,
-                "min_pixel_f1_0px": self.min_f1_0px}
+                "min_pixel_f1_0px": self.min_f1_0px, "balance_alpha": self.balance_alpha,
+                "max_imbalance_fraction": self.max_imbalance, "max_edge_count_diff": self.max_edge_count_diff}

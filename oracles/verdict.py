@@ -2,7 +2,8 @@
 
 A case fails for every limit of oracles.tolerances it misses, each named in a
 reason: the vertex error, points visible to one side only, the pixel F1 at 1
-and 0 px; shaded: regions covered by one side inside the other's silhouette,
+and 0 px, the one-sided pixel balance and the per-edge pixel counts of the
+lines (oracles.metrics.line_failures); shaded: regions covered by one side inside the other's silhouette,
 the silhouette IoU, faces that differ away from their boundaries, the depth
 error beyond its bound. A candidate that fails the contract (oracles.candidate)
 fails the case with that error.
@@ -13,8 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from . import gate, metrics
-from .diagnose import diagnose
+from .diagnose import diagnose, diagnose_lines
 from .tolerances import MIN_IOU_UNION_PX, Tolerances
+
+#: Per-frame fields of a wireframe's line comparison (oracles.metrics.line_scores).
+LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "edge_count_max_diff", "edge_count_worst_edge")
 
 #: Per-frame fields of a shaded comparison (oracles.metrics.shaded_scores).
 SHADED_FRAME_KEYS = ("silhouette_iou", "silhouette_union_px", "silhouette_mismatch_inside", "depth_pixels",
@@ -59,10 +63,13 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
             "pixel_precision_1px": float(min(px["precision_1px"])), "pixel_recall_1px": float(min(px["recall_1px"])),
             "worst_pixel_frame": acc.worst[1] if acc.worst else None,
         })
+        rec["lines"] = metrics.line_summary(acc.lines)
     else:
         rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
     if setup.pixels and setup.mode.shaded:
         rec.update(shaded_summary(acc.shaded, acc.worst))
+    if acc.lines and not faults:      # a line fault is named only when the vertices agree
+        faults = diagnose_lines(rec["lines"], tol)
     rec["faults"] = faults
     rec["compared"] = {"frames": done, "vertices": rec.get("visible_points", 0),
                        "pixels": acc.drawn_px if setup.pixels else None}
@@ -124,6 +131,8 @@ def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | No
                            f"(frame {rec['worst_pixel_frame']})")
         if rec["pixel_f1_0px"] < tol.min_f1_0px:
             reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
+        if "lines" in rec:
+            reasons += metrics.line_failures(rec["lines"], tol)
     if rec.get("silhouette_iou") is not None:
         if rec["silhouette_mismatch_inside"]:
             reasons.append(f"{rec['silhouette_mismatch_inside']} pixels covered by one side only lie inside its "
