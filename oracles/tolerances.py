@@ -42,7 +42,7 @@ MIN_F1_0PX = 0.98
 #: BALANCE (placeholder: derived below)
 BALANCE_ALPHA = 1e-4
 MAX_IMBALANCE_FRACTION = 1e-3
-MAX_EDGE_COUNT_DIFF = 1
+MAX_EDGE_COUNT_DIFF = 2
 
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)

@@ -126,8 +126,6 @@ def test_side_planes_pass_through_image_border(projection, guard):
     assert_array_equal(planes[:2], [[0, 0, 1, -1.0], [0, 0, -1, 100.0]])
     z = 7.0
     s = F / z if projection == "perspective" else H / 4.0     # pixels per camera unit at depth z
-    if projection == "perspective":
-        s = c.focal_px / z
     g = guard
     # border points (x_px, y_px) -> camera (x, y, z) with x = (x_px - cx)/s, y = (cy - y_px)/s
     border = {2: (-0.5 - g, CY), 3: (W - 0.5 + g, CY), 4: (CX, -0.5 - g), 5: (CX, H - 0.5 + g)}

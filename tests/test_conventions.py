@@ -24,6 +24,15 @@ EPS = np.finfo(np.float64).eps  # 2.2e-16
 PX_TOL = 1e-12
 
 
+# The default camera below, by hand (core/conventions.py): 640 x 480, so the
+# principal point is ((640 - 1) / 2, (480 - 1) / 2) = (319.5, 239.5); fov_y 60,
+# so f = (480 / 2) / tan(30 deg) = 240 sqrt(3) = 415.69 px. Literals, not
+# core's Camera.principal_point / focal_px: a test must not take its expected
+# value from the code under test.
+CX, CY = 319.5, 239.5
+F = 240.0 * math.sqrt(3.0)
+
+
 def cam(D=4.0, **kw):
     kw.setdefault("width", 640)
     kw.setdefault("height", 480)
@@ -35,20 +44,18 @@ def cam(D=4.0, **kw):
 
 def test_plus_x_shows_on_the_right():
     c = cam()
-    cx, cy = c.principal_point
     (x, y), = project_points([[1.0, 0.0, 0.0]], c)
     # p_cam = (1, 0, 4): x_px = cx + f/4 (> cx), y_px = cy.
-    assert x > cx
-    assert_allclose([x, y], [cx + c.focal_px / 4.0, cy], rtol=0, atol=PX_TOL)
+    assert x > CX
+    assert_allclose([x, y], [CX + F / 4.0, CY], rtol=0, atol=PX_TOL)
 
 
 def test_plus_y_shows_up():
     c = cam()
-    cx, cy = c.principal_point
     (x, y), = project_points([[0.0, 1.0, 0.0]], c)
     # p_cam = (0, 1, 4): y_px = cy - f/4 (< cy: pixel rows grow downward).
-    assert y < cy
-    assert_allclose([x, y], [cx, cy - c.focal_px / 4.0], rtol=0, atol=PX_TOL)
+    assert y < CY
+    assert_allclose([x, y], [CX, CY - F / 4.0], rtol=0, atol=PX_TOL)
 
 
 def test_right_is_forward_cross_up_camera_z():
@@ -65,7 +72,7 @@ def test_right_is_forward_cross_up_looking_down_plus_z():
     assert_array_equal(c.right, [-1.0, 0.0, 0.0])
     # so a world point at +X shows on the LEFT of this camera
     (x, _), = project_points([[1.0, 0.0, 5.0]], c)
-    assert x < c.principal_point[0]
+    assert x < CX              # look_at's defaults are 640 x 480 too
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -168,11 +175,9 @@ def test_rotate_z_90_shows_counter_clockwise_on_screen():
     # camera_z looks down -Z, so +Z points at the viewer: rotate_z(90) turns the
     # point (1,0,0) (right of centre) to (0,1,0) (above centre) on screen.
     c = cam(D=4.0)
-    cx, cy = c.principal_point
     (x, y), = project_points(apply(rotate_z(math.pi / 2), [[1.0, 0.0, 0.0]]), c)
-    r = c.focal_px / 4.0
     # x_cam = cos(pi/2) = 6e-17: x_px - cx = f * 6e-17 / 4 ~ 5e-15
-    assert_allclose([x, y], [cx, cy - r], rtol=0, atol=PX_TOL)
+    assert_allclose([x, y], [CX, CY - F / 4.0], rtol=0, atol=PX_TOL)
 
 
 def test_compose_applies_rightmost_first():

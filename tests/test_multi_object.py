@@ -241,10 +241,12 @@ def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
 
 
 def test_multi_object_frame_matches_world_points(tmp_path):
-    # The renderer draws world_points with the identity: the JSON vertex pixels are the
-    # projection of world_points (same formula, same order of operations).
+    # The renderer draws world_points with the identity: the JSON vertex pixels must be
+    # the projection of each object's M_run(t) @ M_o(t) -- here built independently of
+    # core, by scipy (oracles.faces) and projected by cv2.projectPoints. Two float64
+    # pipelines: ~20 roundings of values <= 640 px, ~3e-12; 1e-9 px leaves margin.
     from wirecheck.core.camera import camera_z
-    from wirecheck.core.projection import project_points
+    from wirecheck.oracles import faces as oface, opencv_oracle
 
     rc, _, err = run(["--scene", "orrery", "--frames", "4", "--camera-z", "8", "--spin", "0,1,0"], tmp_path)
     assert (rc, err) == (0, "")
@@ -252,7 +254,8 @@ def test_multi_object_frame_matches_world_points(tmp_path):
     s = load_scene("orrery")
     cam = camera_z(8.0, fov_y_deg=60.0, width=640, height=480)
     for k in (1, 3):
-        want = project_points(world_points(s, Motion(turns=(0.0, 1.0, 0.0)), k, 4), cam)
+        p_world = oface.world_points(s, oface.object_matrices(s, (0.0, 1.0, 0.0), (k - 1) / 4))
+        want = opencv_oracle.project(p_world, cam)
         assert_allclose(np.array(rep["frames"][k - 1]["vertices_px"], dtype=float), want, rtol=0, atol=1e-9)
     assert [o["name"] for o in rep["scene"]["objects"]] == ["sun", "planet", "moon"]
 

@@ -135,9 +135,14 @@ def test_seed_points_rotated_45_about_y_pixels():
     assert_allclose(px, expected, rtol=0, atol=1e-12)
 
 
+# The principal point of a 640 x 480 image, by hand (core/conventions.py):
+# ((640 - 1) / 2, (480 - 1) / 2). Literal: never core's Camera.principal_point.
+CX, CY = 319.5, 239.5
+
+
 def test_seed_farther_point_is_closer_to_principal_point():
     c = seed_camera()
-    cx, cy = c.principal_point
+    cx, cy = CX, CY
     px = project_points(apply(rotate_y(math.pi / 4), [[1.0, 1.0, 4.0], [1.0, 1.0, 8.0]]), c)
     off = px - [cx, cy]
     # |off1| = f sqrt(25 + 2)/3 = 80 sqrt3 * sqrt27 / 3 = 240 exactly;
@@ -152,8 +157,7 @@ def test_seed_farther_point_is_closer_to_principal_point():
 def test_perspective_shrink_by_depth_ratio_unrotated():
     # (1,1,4) and (1,1,8) before rotation: same x, y; depth ratio 2 -> offset ratio 2.
     c = seed_camera()
-    cx, cy = c.principal_point
-    off = project_points([[1.0, 1.0, 4.0], [1.0, 1.0, 8.0]], c) - [cx, cy]
+    off = project_points([[1.0, 1.0, 4.0], [1.0, 1.0, 8.0]], c) - [CX, CY]
     f = 80 * SQRT3
     # p_cam = (-1, 1, 4) and (-1, 1, 8): offsets (-f/4, -f/4) and (-f/8, -f/8)
     assert_allclose(off, [[-f / 4, -f / 4], [-f / 8, -f / 8]], rtol=0, atol=1e-12)
@@ -227,7 +231,8 @@ def test_orthographic_matches_naive():
 
 def test_depth_monotonicity():
     c = camera_z(10.0, fov_y_deg=60.0, near=0.5, far=100.0)
-    cx, cy = c.principal_point
+    cx, cy = CX, CY                                 # 640 x 480 (camera_z's default)
+    f = 240.0 * SQRT3                               # (480 / 2) / tan(30 deg)
     zw = np.linspace(9.5, -80.0, 60)              # depth D - z from 0.5 to 90, increasing
     pts = np.column_stack([np.ones_like(zw), np.ones_like(zw), zw])
     depth = world_to_cam(pts, c)[:, 2]
@@ -239,8 +244,8 @@ def test_depth_monotonicity():
     assert np.all(np.diff(off) < 0)
     # px = cx + f/z is rounded at magnitude <= cx + f/0.5 ~ 1150, so after subtracting
     # cx the offset carries an absolute error ~ 2 roundings of 1150: 4 EPS * 1200
-    assert_allclose(off, c.focal_px / depth, rtol=0, atol=4 * EPS * 1200)
-    assert_allclose(cy - px[:, 1], c.focal_px / depth, rtol=0, atol=4 * EPS * 1200)
+    assert_allclose(off, f / depth, rtol=0, atol=4 * EPS * 1200)
+    assert_allclose(cy - px[:, 1], f / depth, rtol=0, atol=4 * EPS * 1200)
 
 
 @pytest.mark.parametrize("deg", range(0, 361, 15))
@@ -249,10 +254,10 @@ def test_rotation_about_optical_axis_keeps_distance_to_principal_point(deg):
     # a circle of radius f/4 about (cx, cy), counter-clockwise on screen:
     # (cx + r cos theta, cy - r sin theta).
     c = camera_z(4.0, fov_y_deg=70.0)
-    cx, cy = c.principal_point
+    cx, cy = CX, CY                                 # 640 x 480 (camera_z's default)
     th = math.radians(deg)
     (x, y), = project_points(apply(rotate_z(th), [[1.0, 0.0, 0.0]]), c)
-    r = c.focal_px / 4.0
+    r = 240.0 / math.tan(math.radians(35.0)) / 4.0  # f = (480 / 2) / tan(70 deg / 2), at depth 4
     # cos/sin rounding EPS times r ~ 86, plus cx rounding: 4 EPS * 320
     assert_allclose([x, y], [cx + r * math.cos(th), cy - r * math.sin(th)], rtol=0, atol=4 * EPS * 320)
 

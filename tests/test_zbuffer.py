@@ -6,6 +6,7 @@ against pyrender (OSMesa / llvmpipe) on a cube and an icosphere.
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -91,14 +92,18 @@ def _plane_depth_along_rays(p_cam_tri, camera, rr, cc):
     n = np.cross(b - a, c - a)
     # a point on the ray of pixel (x, y) at depth z is unproject(px, z) (camera space: use z = 1)
     px = np.stack([cc, rr], 1).astype(float)
+    # by hand (core/conventions.py), not from core's Camera: the principal point
+    # ((W - 1) / 2, (H - 1) / 2) and f = (H / 2) / tan(fov_y / 2)
+    cx, cy = (camera.width - 1) / 2.0, (camera.height - 1) / 2.0
     if camera.projection == "perspective":
-        x1 = (px[:, 0] - camera.principal_point[0]) / camera.focal_px
-        y1 = -(px[:, 1] - camera.principal_point[1]) / camera.focal_px
+        f = (camera.height / 2.0) / math.tan(math.radians(camera.fov_y_deg) / 2.0)
+        x1 = (px[:, 0] - cx) / f
+        y1 = -(px[:, 1] - cy) / f
         d = np.stack([x1, y1, np.ones_like(x1)], 1)          # ray direction with z = 1
         return (n @ a) / (d @ n)                             # t = depth
     s = camera.height / camera.ortho_height
-    x = (px[:, 0] - camera.principal_point[0]) / s
-    y = -(px[:, 1] - camera.principal_point[1]) / s
+    x = (px[:, 0] - cx) / s
+    y = -(px[:, 1] - cy) / s
     return (n @ a - n[0] * x - n[1] * y) / n[2]
 
 
