@@ -98,3 +98,99 @@ def test_shaded_plot_has_iou_and_depth(tmp_path, style):
     size, frames = gif_frames(out / "worst.gif")
     assert len(frames) == 2 and size[0] == 3 * 640 + 2
     assert "per-frame silhouette IoU and depth error / bound" in (out / "report.md").read_text()
+
+
+# ---------------------------------------------------------------- what the plots show, read back
+
+# The first case's line is tab10[0] = (31, 119, 180); the tolerance / limit line
+# is "#b00" = (187, 0, 0). Anti-aliased over the white background these blend
+# towards white, so pixels are classified by hue: blue where B exceeds R by 60
+# (the blend half-way to white, (143, 187, 217), still does by 74), red where R
+# exceeds G and B by 80. Grid lines and text are grey or black.
+BLUE = "blue"
+RED = "red"
+
+
+def _pixels_of(png: bytes, hue):
+    """Rows and columns of the ``hue`` pixels of ``png``."""
+    img = np.asarray(Image.open(__import__("io").BytesIO(png)).convert("RGB")).astype(int)
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    mask = (b > r + 60) & (b > g + 20) if hue == BLUE else (r > g + 80) & (r > b + 80)
+    return np.nonzero(mask)
+
+
+def _curve_rows(png: bytes):
+    """Row of the first case's curve at its first, middle and last point (3 frames: equally spaced columns)."""
+    rr, cc = _pixels_of(png, BLUE)
+    assert len(rr) > 50, "no curve drawn"
+    # The legend's sample line is the same colour, apart (right of the axes):
+    # keep the widest run of adjacent columns, the curve.
+    cols = np.unique(cc)
+    runs = np.split(cols, np.flatnonzero(np.diff(cols) > 3) + 1)
+    run = max(runs, key=len)
+    keep = (cc >= run[0]) & (cc <= run[-1])
+    rr, cc = rr[keep], cc[keep]
+    # The markers (3 px) and the line end at the first and last frames: the
+    # curve's columns span [x1 - r, x3 + r]; frame 2 is midway.
+    lo, hi = cc.min(), cc.max()
+    cols = (lo + 1, (lo + hi) // 2, hi - 1)
+    return [float(np.median(rr[np.abs(cc - c) <= 1])) for c in cols], (lo, hi)
+
+
+def _limit_row(png: bytes) -> float:
+    rr, _ = _pixels_of(png, RED)
+    rows, counts = np.unique(rr, return_counts=True)
+    return float(rows[np.argmax(counts)])         # the dashed line: the row with most red pixels (not the label)
+
+
+def _report(per_frame, shaded=False, tol=None):
+    tolerances = ({"vertex_error_px": 1e-6, "min_silhouette_iou": 0.995} if shaded else
+                  {"vertex_error_px": tol or 1e-6, "min_pixel_f1_0px": 0.98})
+    return {"level": "pixels", "style": "shaded" if shaded else "wireframe", "tolerances": tolerances,
+            "cases": [{"scene": "s", "camera": "c", "per_frame": per_frame}]}
+
+
+def test_pixels_png_draws_the_f1_curve_and_its_limit_where_they_belong():
+    from wirecheck.oracles.plots import pixel_png
+
+    # F1@0 = 0.2, 0.6, 0.8 at frames 1..3, limit 0.98; linear y axis, rows grow downward
+    png = pixel_png(_report([{"frame": k, "f1_0px": v} for k, v in ((1, 0.2), (2, 0.6), (3, 0.8))]))
+    (y1, y2, y3), _ = _curve_rows(png)
+    y_lim = _limit_row(png)
+    assert y_lim < y3 < y2 < y1                   # 0.98 above 0.8 above 0.6 above 0.2
+    # linear axis: row gaps in proportion to value gaps, (0.6 - 0.2) / (0.8 - 0.6) = 2 and
+    # (0.98 - 0.8) / (0.8 - 0.6) = 0.9; ~110 px per 0.4, +-1.5 px of reading: +-5 %
+    assert abs((y1 - y2) / (y2 - y3) - 2.0) < 0.1
+    assert abs((y3 - y_lim) / (y2 - y3) - 0.9) < 0.1
+
+
+def test_vertex_error_png_is_a_log_axis_with_the_tolerance_line():
+    from wirecheck.oracles.plots import vertex_error_png
+
+    # errors 1e-12, 1e-10, 1e-8 and the tolerance 1e-6: equal steps of 100x, so
+    # on a log axis three equal row gaps (and 0 px would be drawn at 1e-16)
+    png = vertex_error_png(_report([{"frame": k, "max_vertex_error_px": v}
+                                    for k, v in ((1, 1e-12), (2, 1e-10), (3, 1e-8))]))
+    (y1, y2, y3), _ = _curve_rows(png)
+    y_tol = _limit_row(png)
+    assert y_tol < y3 < y2 < y1
+    gaps = np.array([y1 - y2, y2 - y3, y3 - y_tol])
+    assert gaps.min() > 20 and gaps.max() - gaps.min() <= 3, gaps    # equal within the reading (+-1.5 px)
+
+
+def test_shaded_pixels_png_has_two_panels_iou_above_depth():
+    from wirecheck.oracles.plots import pixel_png
+
+    frames = [{"frame": k, "silhouette_iou": v, "depth_error_ratio": r}
+              for k, v, r in ((1, 0.9, 0.01), (2, 0.95, 0.1), (3, 0.99, 1.0))]
+    png = pixel_png(_report(frames, shaded=True))
+    rr, cc = _pixels_of(png, BLUE)
+    h = Image.open(__import__("io").BytesIO(png)).size[1]
+    top, bottom = rr < h / 2, rr >= h / 2
+    assert top.sum() > 30 and bottom.sum() > 30                      # one curve in each panel
+    for part in (top, bottom):                                       # both rise left to right
+        left = rr[part & (cc <= cc[part].min() + 1)].mean()
+        right = rr[part & (cc >= cc[part].max() - 1)].mean()
+        assert right < left
+    red, _ = _pixels_of(png, RED)
+    assert (red < h / 2).any() and (red >= h / 2).any()              # a limit line in each: 0.995 and 1.0
