@@ -59,6 +59,12 @@ fov_mismatch        ``d_y != 1`` (alone when ``d_x = d_y``,     scale, implied_f
                                                                 for perspective)
 pixel_offset        ``b`` minus the shift the named linear      dx, dy
                     faults imply, nonzero
+line_end_bias       (pixels; vertices agree) one-sided pixels   end ("first", "last", "both"),
+                    fail the line gate and sit at line ends     pixels_per_line (signed), lines,
+                    (:func:`diagnose_lines`)                    candidate_only, oracle_only
+line_pixel_bias     (pixels; vertices agree) as above, but not  candidate_only, oracle_only,
+                    at the ends: thicker/thinner lines, strays  net_start, net_end, net_middle,
+                                                                net_stray
 unexplained         the named model does not fit (rotation,     residual_px (max), residual_rms_px,
                     shear, not affine); or the visible sets     affine_residual_px, affine, offset,
                     differ without a depth flip; or too few     rotation_deg, visibility_mismatches,

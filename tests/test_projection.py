@@ -325,3 +325,21 @@ def test_cam_to_px_perspective_formula_direct():
     # f = 25 / tan(45) = 25 (1 + 1.1e-16); cx = 49.5, cy = 24.5
     px = cam_to_px(np.array([[2.0, 1.0, 4.0], [-2.0, -1.0, 2.0]]), c)
     assert_allclose(px, [[49.5 + 12.5, 24.5 - 6.25], [49.5 - 25, 24.5 + 12.5]], rtol=0, atol=4 * EPS * 64)
+
+
+# ---- localize: far-off models are re-centred ------------------------------------------
+
+def test_localize_recentres_a_model_far_from_its_origin():
+    from wirecheck.core.projection import localize
+
+    # a box from (999, 1000, 1001) to (1001, 1002, 1003): centre (1000, 1001, 1002), half-extent 1;
+    # |centre| > 1, so the points are stored relative to the centre (exact: all small integers)
+    p = np.array([[999.0, 1000.0, 1001.0], [1001.0, 1002.0, 1003.0]])
+    lp = localize(p, "float32")
+    assert_array_equal(lp.origin, [1000.0, 1001.0, 1002.0])
+    assert_array_equal(lp.p_local, [[-1, -1, -1], [1, 1, 1]]) and lp.p_local.dtype == np.float32
+    # a box about its own origin stays as it is: centre (0.5, 0, 0), half-extent 1.5
+    q = np.array([[-1.0, -1.0, -1.0], [2.0, 1.0, 1.0]])
+    lq = localize(q)
+    assert_array_equal(lq.origin, [0.0, 0.0, 0.0])
+    assert_array_equal(lq.p_local, q)

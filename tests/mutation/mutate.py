@@ -1,0 +1,310 @@
+"""Mutation testing of core/ and oracles/: a small AST mutator, one mutant at a time.
+
+Each mutant changes one operator or constant in one module (the operators:
+``+ -``, ``* /``, ``// /``, ``**`` to ``*``, ``< <=``, ``> >=``, ``== !=``,
+``is`` / ``is not``, ``in`` / ``not in``, ``and`` / ``or``, dropping a ``not``
+or a unary minus, ``k`` to ``k + 1`` for an int, ``x`` to ``2 x`` (``0.0`` to
+``1.0``) for a float), is written into a private copy of the package (the
+working tree is never touched), and the module's own test files run against
+it (``pytest -x -p no:cacheprovider``, time-limited). A mutant is *killed*
+when they fail (or time out), *survived* when they pass. Survivors are either
+killed by a new test or listed in ``equivalent.json`` with the reason the
+change cannot be seen (their id: ``module:line:col:change``).
+
+Why our own mutator rather than mutmut or cosmic-ray: both run every mutant
+against a whole configured test command and keep a session database; here each
+module has a few relevant test files (seconds, not the 75-s suite), the
+machine has 2 shared cores, and ``wirecheck`` is an editable install whose
+package folders are mapped by setuptools (``package-dir``), which both tools'
+in-place file rewriting would put under the other helpers' feet. The mutator
+below is ~200 lines, has no state but its report, and runs in a copy.
+
+    .venv/bin/python tests/mutation/mutate.py [--sample N] [--seed S] [--module core/raster.py ...]
+                                             [--jobs J] [--report tests/mutation/report.md]
+
+``--sample N``: at most N mutants per module, drawn with ``--seed`` from all
+of that module's sites (the same N and seed give the same mutants). Not part
+of CI: a full run takes tens of minutes (docs/testing.md has the figures).
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from itertools import zip_longest
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+HERE = Path(__file__).resolve().parent
+
+#: The modules mutated, and the test files (with an optional -k expression) that judge each.
+TARGETS = {
+    "core/projection.py": (["tests/test_projection.py", "tests/test_conventions.py", "tests/test_core_vs_opencv.py"], None),
+    "core/clipping.py": (["tests/test_clipping.py"], None),
+    "core/raster.py": (["tests/test_raster.py", "tests/test_raster_modes.py"], None),
+    "core/camera.py": (["tests/test_conventions.py", "tests/test_projection.py", "tests/test_scene.py"], None),
+    "core/transforms.py": (["tests/test_transforms.py", "tests/test_conventions.py"], None),
+    "oracles/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
+    "oracles/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
+    "oracles/runner.py": (["tests/test_line_gate.py"], "decides"),
+    "oracles/convert.py": (["tests/test_oracle_convert.py"], None),
+}
+
+#: runner.py is mutated only in its verdict: the lines of ``run_case`` from
+#: ``reasons = []`` to ``rec["verdict"] = ...`` (found in the source, so the
+#: range follows edits).
+VERDICT_START, VERDICT_END = "    reasons = []\n", '    rec["verdict"] = '
+
+PER_MUTANT_TIMEOUT_S = 300
+
+_BINOPS = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult,
+           ast.FloorDiv: ast.Div, ast.Pow: ast.Mult}
+_CMPOPS = {ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt, ast.Eq: ast.NotEq,
+           ast.NotEq: ast.Eq, ast.Is: ast.IsNot, ast.IsNot: ast.Is, ast.In: ast.NotIn, ast.NotIn: ast.In}
+_SYMBOL = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.FloorDiv: "//", ast.Pow: "**",
+           ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!=",
+           ast.Is: "is", ast.IsNot: "is not", ast.In: "in", ast.NotIn: "not in", ast.And: "and", ast.Or: "or"}
+
+
+@dataclass(frozen=True)
+class Site:
+    """One mutation: the ``index``-th site of its module in walk order."""
+
+    module: str
+    index: int
+    line: int
+    col: int
+    change: str
+
+    @property
+    def id(self) -> str:
+        return f"{self.module}:{self.line}:{self.col}:{self.change}"
+
+
+def _docstring_nodes(tree) -> set:
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and node.body:
+            first = node.body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
+                out.add(id(first.value))
+    return out
+
+
+class _Mutator(ast.NodeTransformer):
+    """Walks a module; lists its sites, or applies the one numbered ``target``."""
+
+    def __init__(self, module: str, line_range, target: int | None = None):
+        self.module, self.range, self.target = module, line_range, target
+        self.sites: list[Site] = []
+        self.skip: set = set()
+
+    def _site(self, node, change: str) -> bool:
+        """Record a site; True when it is the one to apply."""
+        if self.range and not (self.range[0] <= node.lineno <= self.range[1]):
+            return False
+        self.sites.append(Site(self.module, len(self.sites), node.lineno, node.col_offset, change))
+        return self.target == len(self.sites) - 1
+
+    def visit_Module(self, node):
+        self.skip = _docstring_nodes(node)
+        return self.generic_visit(node)
+
+    def visit_BinOp(self, node):
+        self.generic_visit(node)
+        new = _BINOPS.get(type(node.op))
+        if new and self._site(node, f"{_SYMBOL[type(node.op)]}->{_SYMBOL[new]}"):
+            node.op = new()
+        return node
+
+    def visit_AugAssign(self, node):
+        self.generic_visit(node)
+        new = _BINOPS.get(type(node.op))
+        if new and self._site(node, f"{_SYMBOL[type(node.op)]}=->{_SYMBOL[new]}="):
+            node.op = new()
+        return node
+
+    def visit_Compare(self, node):
+        self.generic_visit(node)
+        for i, op in enumerate(node.ops):
+            new = _CMPOPS.get(type(op))
+            if new and self._site(node, f"{_SYMBOL[type(op)]}->{_SYMBOL[new]}#{i}"):
+                node.ops[i] = new()
+        return node
+
+    def visit_BoolOp(self, node):
+        self.generic_visit(node)
+        new = ast.Or if isinstance(node.op, ast.And) else ast.And
+        if self._site(node, f"{_SYMBOL[type(node.op)]}->{_SYMBOL[new]}"):
+            node.op = new()
+        return node
+
+    def visit_UnaryOp(self, node):
+        self.generic_visit(node)
+        if isinstance(node.op, (ast.Not, ast.USub)):
+            name = "not" if isinstance(node.op, ast.Not) else "-"
+            if self._site(node, f"drop {name}"):
+                return node.operand
+        return node
+
+    def visit_Constant(self, node):
+        v = node.value
+        if id(node) in self.skip or isinstance(v, bool) or not isinstance(v, (int, float)):
+            return node
+        new = v + 1 if isinstance(v, int) else (2.0 * v if v != 0 else 1.0)
+        if self._site(node, f"{v!r}->{new!r}"):
+            return ast.copy_location(ast.Constant(new), node)
+        return node
+
+    # annotations and default "dtype" strings are not behaviour: do not descend into annotations
+    def visit_arg(self, node):
+        return node
+
+    def visit_AnnAssign(self, node):
+        if node.value is not None:
+            node.value = self.visit(node.value)
+        return node
+
+
+def _line_range(module: str, source: str):
+    if module != "oracles/runner.py":
+        return None
+    lines = source.splitlines(keepends=True)
+    start = next(i for i, s in enumerate(lines, 1) if s == VERDICT_START)
+    end = next(i for i, s in enumerate(lines, 1) if i > start and s.startswith(VERDICT_END))
+    return (start, end)
+
+
+def sites(module: str) -> list[Site]:
+    source = (ROOT / module).read_text()
+    m = _Mutator(module, _line_range(module, source))
+    m.visit(ast.parse(source))
+    return m.sites
+
+
+def mutant_source(site: Site) -> str:
+    source = (ROOT / site.module).read_text()
+    m = _Mutator(site.module, _line_range(site.module, source), target=site.index)
+    tree = m.visit(ast.parse(source))
+    ast.fix_missing_locations(tree)
+    return ast.unparse(tree)
+
+
+def _copy_tree(dest: Path) -> Path:
+    """The package as ``dest/wirecheck`` (root __init__, core, oracles, scenes, tests, pyproject)."""
+    pkg = dest / "wirecheck"
+    pkg.mkdir(parents=True)
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc")
+    for name in ("core", "oracles", "scenes", "tests"):
+        shutil.copytree(ROOT / name, pkg / name, ignore=ignore)
+    for name in ("__init__.py", "pyproject.toml"):
+        shutil.copy2(ROOT / name, pkg / name)
+    return pkg
+
+
+def run_mutant(site: Site, pkg: Path) -> tuple[str, float]:
+    """``("killed" | "survived" | "timeout", seconds)`` for one mutant, in the copy at ``pkg``."""
+    tests, k = TARGETS[site.module]
+    target = pkg / site.module
+    original = target.read_text()
+    target.write_text(mutant_source(site))
+    env = {**os.environ, "PYTHONPATH": str(pkg.parent), "PYTHONDONTWRITEBYTECODE": "1",
+           "PYOPENGL_PLATFORM": os.environ.get("PYOPENGL_PLATFORM", "osmesa")}
+    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests] + (["-k", k] if k else [])
+    t0 = time.perf_counter()
+    try:
+        rc = subprocess.run(cmd, cwd=pkg, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            timeout=PER_MUTANT_TIMEOUT_S).returncode
+        verdict = "survived" if rc == 0 else "killed"
+    except subprocess.TimeoutExpired:
+        verdict = "timeout"
+    finally:
+        target.write_text(original)
+    return verdict, time.perf_counter() - t0
+
+
+def _check_copy_is_imported(pkg: Path) -> None:
+    """The tests must import the copy, not the editable install of the working tree."""
+    env = {**os.environ, "PYTHONPATH": str(pkg.parent), "PYTHONDONTWRITEBYTECODE": "1"}
+    out = subprocess.run([sys.executable, "-c", "import wirecheck.core.raster as r; print(r.__file__)"],
+                         cwd=pkg, env=env, capture_output=True, text=True, check=True).stdout.strip()
+    if not out.startswith(str(pkg)):
+        raise SystemExit(f"mutate: the copy is not what gets imported ({out})")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sample", type=int, default=None, help="at most N mutants per module (default: all)")
+    ap.add_argument("--seed", type=int, default=16)
+    ap.add_argument("--module", action="append", default=None, choices=sorted(TARGETS))
+    ap.add_argument("--only", action="append", default=None, help="run just these mutant ids")
+    ap.add_argument("--list", action="store_true", help="list the sites and exit")
+    ap.add_argument("--report", default=str(HERE / "report.md"))
+    args = ap.parse_args(argv)
+    modules = args.module or list(TARGETS)
+    chosen: list[Site] = []
+    for module in modules:
+        all_sites = sites(module)
+        pick = all_sites if args.sample is None or args.sample >= len(all_sites) else \
+            sorted(random.Random(f"{args.seed}:{module}").sample(all_sites, args.sample), key=lambda s: s.index)
+        chosen += pick
+        print(f"{module}: {len(all_sites)} sites, {len(pick)} chosen", flush=True)
+    if args.only:
+        chosen = [s for m in modules for s in sites(m) if s.id in set(args.only)]
+    # round robin over the modules: a run stopped early has looked at each of them
+    by_module = [[s for s in chosen if s.module == m] for m in modules]
+    chosen = [s for row in zip_longest(*by_module) for s in row if s is not None]
+    if args.list:
+        for s in chosen:
+            print(s.id)
+        return 0
+    equivalent = json.loads((HERE / "equivalent.json").read_text()) if (HERE / "equivalent.json").exists() else {}
+    results = []
+    with tempfile.TemporaryDirectory(prefix="wirecheck-mutants-") as tmp:
+        pkg = _copy_tree(Path(tmp))
+        _check_copy_is_imported(pkg)
+        for n, site in enumerate(chosen, 1):
+            verdict, seconds = run_mutant(site, pkg)
+            if verdict == "survived" and site.id in equivalent:
+                verdict = "equivalent"
+            results.append((site, verdict, seconds))
+            print(f"[{n}/{len(chosen)}] {verdict:10s} {seconds:5.1f}s {site.id}", flush=True)
+    write_report(Path(args.report), results, equivalent, args)
+    return 0
+
+
+def write_report(path: Path, results, equivalent: dict, args) -> None:
+    counts = {v: sum(1 for _, r, _ in results if r == v) for v in ("killed", "timeout", "survived", "equivalent")}
+    judged = counts["killed"] + counts["timeout"] + counts["survived"]
+    score = (counts["killed"] + counts["timeout"]) / judged if judged else float("nan")
+    lines = ["# Mutation report", "",
+             f"Command: `.venv/bin/python tests/mutation/mutate.py"
+             f"{f' --sample {args.sample}' if args.sample else ''} --seed {args.seed}`", "",
+             f"Mutants: {len(results)}; killed {counts['killed']} (+{counts['timeout']} by time-out), "
+             f"survived {counts['survived']}, equivalent {counts['equivalent']}. "
+             f"**Score: {score:.1%}** of the non-equivalent mutants killed.", "",
+             "| module | mutants | killed | survived | equivalent |", "|---|---|---|---|---|"]
+    for module in dict.fromkeys(s.module for s, _, _ in results):
+        rows = [r for s, r, _ in results if s.module == module]
+        lines.append(f"| {module} | {len(rows)} | {sum(r in ('killed', 'timeout') for r in rows)} | "
+                     f"{rows.count('survived')} | {rows.count('equivalent')} |")
+    lines += ["", "## Survivors", ""]
+    lines += [f"- `{s.id}`" for s, r, _ in results if r == "survived"] or ["(none)"]
+    lines += ["", "## Equivalent (tests/mutation/equivalent.json)", ""]
+    lines += [f"- `{s.id}`: {equivalent[s.id]}" for s, r, _ in results if r == "equivalent"] or ["(none)"]
+    lines += ["", "## Killed", ""]
+    lines += [f"- `{s.id}` ({sec:.0f} s)" for s, r, sec in results if r in ("killed", "timeout")]
+    path.write_text("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
