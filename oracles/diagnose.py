@@ -119,7 +119,7 @@ import math
 
 import numpy as np
 
-__all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER",
+__all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER", "LINE_FAULTS",
            "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
 
 #: All fault names, in priority order: the first fault of a diagnosis is the
@@ -129,6 +129,8 @@ FAULT_ORDER = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
                "mirror_vertical", "aspect_mismatch", "fov_mismatch",
                "pixel_offset", "line_end_bias", "line_pixel_bias", "unexplained")
 FAULT_NAMES = frozenset(FAULT_ORDER)
+#: The faults named from a wireframe's pixels (:func:`diagnose_lines`), not from its vertices.
+LINE_FAULTS = ("line_end_bias", "line_pixel_bias")
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
 #: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union

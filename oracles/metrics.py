@@ -294,9 +294,11 @@ def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height
                         radius: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pixels near each segment: ``(edge, pixel, major)``, three ``(K,)`` int arrays.
 
-    Pixel ``pixel`` (flat index ``y W + x``) is near segment ``edge``
+    Pixel ``pixel`` (flat index ``y W + x``) belongs to segment ``edge``
     (``p0_px[edge] -> p1_px[edge]``, pixel coordinates, core.conventions; NaN
-    rows are skipped) when its centre is within ``radius`` (Euclidean) of it;
+    rows are skipped) when its centre is within ``radius`` (Euclidean) of it
+    and no other segment is nearer (ties: the lower index), so each pixel
+    belongs to one segment at most;
     ``major`` is the pixel's coordinate along the segment's major axis (x when
     ``|dx| > |dy|``, else y). Every pixel a 1-px line rasterizer draws for a
     segment lies within ``sqrt(2)/2`` of it (within 1/2 of the line across
@@ -336,9 +338,16 @@ def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height
     dd = (d * d).sum(axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         u = np.clip(np.where(dd > 0, ((c - a) * d).sum(axis=1) / dd, 0.0), 0.0, 1.0)
-    near = np.hypot(*(c - a - u[:, None] * d).T) <= radius
-    sid, pix = sid[near], pix[near]
-    x_major = np.abs(d[near, 0]) > np.abs(d[near, 1])
+    dist = np.hypot(*(c - a - u[:, None] * d).T)
+    near = dist <= radius
+    sid, pix, dist, d = sid[near], pix[near], dist[near], d[near]
+    # each pixel to its nearest segment only (ties: the lower index), so that
+    # one pixel more or less changes one edge's count by at most one
+    order = np.lexsort((sid, dist, pix))
+    first = np.r_[True, pix[order][1:] != pix[order][:-1]]
+    keep = order[first]
+    sid, pix, d = sid[keep], pix[keep], d[keep]
+    x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
     major = np.where(x_major, pix % width, pix // width)
     return ids[sid].astype(np.int64), pix.astype(np.int64), major.astype(np.int64)
 
@@ -351,8 +360,9 @@ def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
     what a 1-px line of it covers, as in Khronos' per-line count, without
     rendering lines singly. Which pixel a renderer takes at a major
     coordinate (a tie across the line) does not change it; a pixel more or
-    less at an end does. Pixels of another line within 1 px (at a shared
-    vertex, a crossing) count for both lines, in both images alike.
+    less at an end does. A pixel counts for the nearest line only, in both
+    images alike (at a shared vertex or a crossing the lines share out the
+    pixels near it by distance).
     """
     edge, pix, major = near
     drawn = np.asarray(image, bool).ravel()[pix]

@@ -198,3 +198,13 @@ def test_column_vector_convention_matches_matrix_product():
     expected = (m @ np.append(p, 1.0))[:3]
     # |p| ~ 4.5, matrix entries <= 1: a few roundings of values ~ 5: 8 * EPS * 5
     assert_allclose(apply(m, [p])[0], expected, rtol=0, atol=8 * EPS * 5)
+
+
+def test_tiny_camera_offsets_still_give_unit_axes():
+    # position 1e-200 above the target: forward = (0, 0, -1e-200). Scaled by its
+    # largest component first it is (0, 0, -1) exactly; its norm taken directly
+    # would underflow (1e-400 -> 0) and give NaN.
+    c = look_at((0.0, 0.0, 1e-200), (0.0, 0.0, 0.0), (0.0, 1e-200, 0.0))
+    assert_array_equal(c.forward, [0.0, 0.0, -1.0])
+    assert_array_equal(c.up, [0.0, 1.0, 0.0])
+    assert_array_equal(c.right, [1.0, 0.0, 0.0])
