@@ -87,17 +87,18 @@ MAX_IMBALANCE_FRACTION = 1e-3
 
 #: Per-edge pixel counts (Khronos' criterion: a line's pixel count within +-1
 #: of the reference's). Without rendering each line singly, an edge's count is
-#: the number of distinct major-axis coordinates among drawn pixels within
-#: 1 px of its segment (oracles.metrics.edge_counts): a tie decided across the
-#: line does not change it, a pixel more or less at an end does. A
-#: neighbouring line's end pixel within 1 px of this one (at a shared vertex)
-#: counts for both, so the attributed count can move by Khronos' 1 for the
-#: line itself plus 1 for a neighbour's end: 2. Measured on the correct core
-#: over all 91 cases above: at most 1; an unbiased one-end-per-line noise
-#: (random_ends) reaches 2; the drop-last mutant reaches 3-4 where several
-#: lines meet (it loses an end pixel at each). A line drawn 3 or more pixels
-#: short or long, a gap, a missing or extra line fail.
-MAX_EDGE_COUNT_DIFF = 2
+#: the number of distinct major-axis coordinates among the drawn pixels nearest
+#: to its segment (within 1 px; oracles.metrics.edge_counts): a tie decided
+#: across the line does not change it, a pixel more or less at an end does.
+#: Where lines meet or cross, pixels are shared out by distance, and a tie
+#: pixel that moves across the line can move to a neighbour's share: one more
+#: pixel either way at each end. Measured over all 91 cases above: correct
+#: core at most 1 on the bundled scenes, the orrery and the hidden-line mode,
+#: 2 on the random edge soups (many crossings); unbiased one-end-per-line
+#: noise (random_ends) 2; the drop-last mutant 2. 3 (one above the largest
+#: measured) fails a line drawn 2 px short at both ends, a gap of 4 pixels, a
+#: missing or an extra line; the 1-px end bias is the balance test's to find.
+MAX_EDGE_COUNT_DIFF = 3
 
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)

@@ -243,13 +243,16 @@ def test_edge_count_tolerance_decides(monkeypatch, mutant_lines):
     _decides(lambda t: run(tol=t), "max_edge_count_diff", d, d - 1, "edge ")
 
 
-def test_plain_cases_carry_no_note():
-    # a face-less edge soup and the cube, as plain wireframes: both compared in
-    # full, so neither has a note (notes are for what could not be compared)
+def test_compared_cases_carry_no_note():
+    # a face-less edge soup and the cube as plain wireframes, and the cube with
+    # hidden lines: all compared in full, so none has a note (notes are for
+    # what could not be compared)
     from wirecheck.core.scene import parse_scene_text
 
     soup = parse_scene_text("name soup\nv -1 -1 0\nv 1 -1 0\nv 0 1 0.5\ne 0 1\ne 1 2\ne 2 0\n")
     report, _ = run_crosscheck([soup, load_scene("cube")], CoreCandidate(), frames=2, case_names=["on_axis"],
                                animation=False)
-    for case in report["cases"]:
+    hidden = run(frames=2, mode=RenderMode(hidden_lines=True))
+    for case in report["cases"] + hidden["cases"]:
         assert case["verdict"] == "pass" and case["visible_points"] > 0 and "note" not in case, case.get("note")
+    assert hidden["cases"][0]["hidden_lines"] is True
