@@ -83,7 +83,7 @@ def test_line_failures_and_diagnosis_on_a_summary():
     lines = {**metrics.balance_scores(10, 290, 40000), "edge_count_max_diff": 1,
              "edge_count_worst": {"frame": 1, "edge": 0, "diff": -1}, "lines_compared": 300,
              "one_sided_by_place": {"start": [0, 0], "end": [0, 290], "middle": [10, 0], "stray": [0, 0]}}
-    # net -280 / 40000 = -0.7 % (> 0.1 %), p ~ 1e-70 (< 1e-4)
+    # net -280 / 40000 = -0.7 % (> 0.1 %), p ~ 1e-70 (< 1e-3)
     assert len(metrics.line_failures(lines, tol)) == 1
     (fault,) = diagnose_lines(lines, tol)
     assert fault["name"] == "line_end_bias" and fault["end"] == "last"
