@@ -256,3 +256,24 @@ def test_compared_cases_carry_no_note():
     for case in report["cases"] + hidden["cases"]:
         assert case["verdict"] == "pass" and case["visible_points"] > 0 and "note" not in case, case.get("note")
     assert hidden["cases"][0]["hidden_lines"] is True
+
+
+class HidesOneCore(CoreCandidate):
+    """A candidate that clips vertex 0 in every frame (NaN), which the oracle shows."""
+
+    def project(self, points, camera, model_matrix):
+        p_px = super().project(points, camera, model_matrix).copy()
+        p_px[0] = np.nan
+        return p_px
+
+
+def test_one_sided_visibility_decides():
+    # vertex 0 of the cube is in front of the on_axis camera in every frame: the
+    # candidate clips it, the oracle shows it; only the oracle has points of its
+    # own (candidate_only 0), and that alone fails the case
+    report, _ = run_crosscheck([load_scene("cube")], HidesOneCore(), frames=2, case_names=["on_axis"], tol=OPEN,
+                               level="vertices", animation=False)
+    case = report["cases"][0]
+    assert case["visibility_mismatch"] == {"candidate_only": 0, "oracle_only": 2}
+    assert case["verdict"] == "fail" and case["reasons"] == [
+        "visible sets differ: 0 points shown only by the candidate, 2 only by the oracle"]

@@ -99,3 +99,17 @@ def test_silhouette_mismatch_inside_counts_holes_not_boundary_shifts():
     hole[4, 4] = np.inf
     s = shaded_scores(hole, orac, np.ones((10, 12)))
     assert s["silhouette_mismatch_inside"] == 1
+
+
+def test_occlusion_boundary_marks_both_sides_of_triangles_sharing_no_vertex():
+    # triangle 1 (vertices 3, 4, 5) left of triangle 0 (vertices 0, 1, 2): no shared
+    # vertex, so depth may jump between columns 1 and 2; both pixels are marked.
+    # Triangle 0 is id 0: an id test must count 0 as a triangle (-1 is "none").
+    from wirecheck.oracles.metrics import occlusion_boundary
+
+    tris = np.array([[0, 1, 2], [3, 4, 5]])
+    ids = np.array([[1, 1, 0, 0]])
+    assert occlusion_boundary(ids, tris).tolist() == [[False, True, True, False]]
+    shared = np.array([[0, 1, 2], [2, 3, 4]])            # sharing vertex 2: depth is continuous
+    assert not occlusion_boundary(ids, shared).any()
+    assert not occlusion_boundary(np.array([[-1, 0, 0, -1]]), tris).any()     # -1: no triangle

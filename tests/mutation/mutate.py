@@ -56,7 +56,7 @@ TARGETS = {
     "oracles/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
     "oracles/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
     "oracles/runner.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
-                          "decides or note or empty_scene or faceless"),
+                          "decides or note or empty_scene or faceless or visibility"),
     "oracles/convert.py": (["tests/test_oracle_convert.py"], None),
 }
 
