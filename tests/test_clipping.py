@@ -354,3 +354,21 @@ def test_clipped_ends_never_have_nonpositive_depth(p0, p1):
     with np.errstate(all="raise"):       # cam_to_px must never divide by z <= 0
         fr = render_frame(world([p0, p1]), np.array([[0, 1]]), c, np.eye(4))
     assert np.all(np.isfinite(fr.p_px[fr.visible]))
+
+
+# ---- the last guard: clip_to_image --------------------------------------------------
+
+@pytest.mark.parametrize("p1, want", [
+    ((10.0, 100.0), (10.0, 29.5)),      # down: stops at the bottom edge, y = H - 1/2
+    ((10.0, -100.0), (10.0, -0.5)),     # up: the top edge, y = -1/2
+    ((100.0, 5.0), (19.5, 5.0)),        # right: x = W - 1/2
+    ((-100.0, 5.0), (-0.5, 5.0)),       # left: x = -1/2
+])
+def test_clip_to_image_stops_at_each_image_edge(p1, want):
+    from wirecheck.core.clipping import clip_to_image
+
+    # from (10, 5) inside a 20 x 30 image; axis-parallel, so t is exact on the grid of halves
+    kept, q0, q1 = clip_to_image(np.array([[10.0, 5.0]]), np.array([p1]), 20, 30)
+    assert kept.tolist() == [True]
+    assert_array_equal(q0, [[10.0, 5.0]])
+    assert_allclose(q1, [want], rtol=0, atol=1e-12)      # t = (edge - 5) / 95 etc.: one rounding of ~100

@@ -208,3 +208,9 @@ def test_tiny_camera_offsets_still_give_unit_axes():
     assert_array_equal(c.forward, [0.0, 0.0, -1.0])
     assert_array_equal(c.up, [0.0, 1.0, 0.0])
     assert_array_equal(c.right, [1.0, 0.0, 0.0])
+
+
+def test_world_to_cam_of_camera_z_by_hand():
+    # camera_z(4): right +X, up +Y, forward -Z, at (0, 0, 4): p_cam = (x, y, 4 - z),
+    # an affine 4 x 4 whose last row is (0, 0, 0, 1)
+    assert_array_equal(cam(D=4.0).world_to_cam, [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, -1, 4], [0, 0, 0, 1]])
