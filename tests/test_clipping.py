@@ -372,3 +372,13 @@ def test_clip_to_image_stops_at_each_image_edge(p1, want):
     assert kept.tolist() == [True]
     assert_array_equal(q0, [[10.0, 5.0]])
     assert_allclose(q1, [want], rtol=0, atol=1e-12)      # t = (edge - 5) / 95 etc.: one rounding of ~100
+
+
+def test_clip_to_image_moves_a_start_outside_onto_the_edge():
+    from wirecheck.core.clipping import clip_to_image
+
+    # reversed: from (10, 100) below a 20 x 30 image up to (10, 5): the start moves to y = 29.5
+    kept, q0, q1 = clip_to_image(np.array([[10.0, 100.0]]), np.array([[10.0, 5.0]]), 20, 30)
+    assert kept.tolist() == [True]
+    assert_allclose(q0, [[10.0, 29.5]], rtol=0, atol=1e-12)
+    assert_array_equal(q1, [[10.0, 5.0]])

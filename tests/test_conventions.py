@@ -214,3 +214,12 @@ def test_world_to_cam_of_camera_z_by_hand():
     # camera_z(4): right +X, up +Y, forward -Z, at (0, 0, 4): p_cam = (x, y, 4 - z),
     # an affine 4 x 4 whose last row is (0, 0, 0, 1)
     assert_array_equal(cam(D=4.0).world_to_cam, [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, -1, 4], [0, 0, 0, 1]])
+
+
+def test_orthographic_scale_that_overflows_is_refused():
+    # H / ortho_height = 480 / 1e-320 = inf: refused when the camera is built, naming the field
+    from wirecheck.core.errors import InputError
+
+    with pytest.raises(InputError, match="ortho-height"):
+        cam(projection="orthographic", ortho_height=1e-320)
+    cam(projection="orthographic", ortho_height=1e-300)       # 4.8e302: finite, accepted

@@ -277,3 +277,24 @@ def test_one_sided_visibility_decides():
     assert case["visibility_mismatch"] == {"candidate_only": 0, "oracle_only": 2}
     assert case["verdict"] == "fail" and case["reasons"] == [
         "visible sets differ: 0 points shown only by the candidate, 2 only by the oracle"]
+
+
+def test_depth_bound_decides_at_exactly_one(monkeypatch):
+    # error / bound = 1 is within the bound (error <= bound); one ulp more is not
+    real = metrics.shaded_scores
+    shaded = RenderMode(style="shaded")
+
+    def ratio_set_to(value):
+        def scores(*args, **kwargs):
+            out = real(*args, **kwargs)
+            if out["depth_error_ratio"] is not None:
+                out["depth_error_ratio"] = value
+            return out
+        return scores
+
+    monkeypatch.setattr(metrics, "shaded_scores", ratio_set_to(1.0))
+    case = run(cases=("oblique_roll",), frames=2, tol=OPEN, mode=shaded)["cases"][0]
+    assert case["depth_error_ratio"] == 1.0 and case["verdict"] == "pass", case["reasons"]
+    monkeypatch.setattr(metrics, "shaded_scores", ratio_set_to(float(np.nextafter(1.0, 2.0))))
+    case = run(cases=("oblique_roll",), frames=2, tol=OPEN, mode=shaded)["cases"][0]
+    assert case["verdict"] == "fail" and len(case["reasons"]) == 1 and case["reasons"][0].startswith("depth error")

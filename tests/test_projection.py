@@ -343,3 +343,19 @@ def test_localize_recentres_a_model_far_from_its_origin():
     lq = localize(q)
     assert_array_equal(lq.origin, [0.0, 0.0, 0.0])
     assert_array_equal(lq.p_local, q)
+
+
+def test_float32_pixels_are_the_plain_float32_expressions():
+    # cam_to_px computes in p_cam's dtype: x_px = (x f) (1 / z) + cx, y_px = cy - (y f) (1 / z),
+    # every operation rounded to float32. The naive float32 numpy expressions give the same bits.
+    from wirecheck.core.camera import camera_z
+
+    c = camera_z(4.0, fov_y_deg=60.0)                    # 640 x 480
+    p = np.random.default_rng(3).uniform([-2, -2, 0.5], [2, 2, 9], size=(200, 3)).astype(np.float32)
+    f32 = np.float32(240.0 * SQRT3)                      # (480 / 2) / tan(30 deg), rounded to float32
+    inv_z = np.float32(1.0) / p[:, 2]
+    want_x = (p[:, 0] * f32) * inv_z + np.float32(CX)
+    want_y = np.float32(CY) - (p[:, 1] * f32) * inv_z
+    got = cam_to_px(p, c)
+    assert got.dtype == np.float32
+    assert_array_equal(got, np.column_stack([want_x, want_y]))
