@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from raster_mutants import drop_last, random_ends  # noqa: E402
 
 from wirecheck.core import raster  # noqa: E402
-from wirecheck.core.scene import load_scene, parse_scene_text  # noqa: E402
+from wirecheck.core.scene_files import load_scene, parse_scene_text  # noqa: E402
 from wirecheck.oracles.runner import CoreCandidate, RenderMode, run_crosscheck  # noqa: E402
 
 

@@ -55,15 +55,10 @@ TARGETS = {
     "core/transforms.py": (["tests/test_transforms.py", "tests/test_conventions.py"], None),
     "oracles/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
     "oracles/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
-    "oracles/runner.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
-                          "decides or note or empty_scene or faceless or visibility"),
+    "oracles/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
+                           "decides or note or empty_scene or faceless or visibility"),
     "oracles/convert.py": (["tests/test_oracle_convert.py"], None),
 }
-
-#: runner.py is mutated only in its verdict: the lines of ``run_case`` from
-#: ``reasons = []`` to ``rec["verdict"] = ...`` (found in the source, so the
-#: range follows edits).
-VERDICT_START, VERDICT_END = "    reasons = []\n", '    rec["verdict"] = '
 
 PER_MUTANT_TIMEOUT_S = 300
 
@@ -176,25 +171,16 @@ class _Mutator(ast.NodeTransformer):
         return node
 
 
-def _line_range(module: str, source: str):
-    if module != "oracles/runner.py":
-        return None
-    lines = source.splitlines(keepends=True)
-    start = next(i for i, s in enumerate(lines, 1) if s == VERDICT_START)
-    end = next(i for i, s in enumerate(lines, 1) if i > start and s.startswith(VERDICT_END))
-    return (start, end)
-
-
 def sites(module: str) -> list[Site]:
     source = (ROOT / module).read_text()
-    m = _Mutator(module, _line_range(module, source))
+    m = _Mutator(module, None)
     m.visit(ast.parse(source))
     return m.sites
 
 
 def mutant_source(site: Site) -> str:
     source = (ROOT / site.module).read_text()
-    m = _Mutator(site.module, _line_range(site.module, source), target=site.index)
+    m = _Mutator(site.module, None, target=site.index)
     tree = m.visit(ast.parse(source))
     ast.fix_missing_locations(tree)
     return ast.unparse(tree)
