@@ -2,7 +2,7 @@
 
 ``--tol-px`` overrides VERTEX_TOL_PX, ``--min-f1`` MIN_F1_1PX and
 ``--min-f1-0px`` MIN_F1_0PX; BALANCE_ALPHA, MAX_IMBALANCE_FRACTION and
-MAX_EDGE_COUNT_DIFF are fields of oracles.runner.Tolerances.
+MAX_EDGE_COUNT_DIFF are fields of :class:`Tolerances` (below).
 """
 
 from dataclasses import dataclass
