@@ -189,13 +189,27 @@ def test_min_f1_0px_decides():
     _decides(run_oblique, "min_f1_0px", f1, np.nextafter(f1, 2.0), "pixel F1@0px")
 
 
+class GrowCore(CoreCandidate):
+    """A candidate whose silhouette has one pixel more, just outside its boundary: IoU < 1."""
+
+    def shade(self, points, edges, camera, model_matrix, faces, mode):
+        depth = super().shade(points, edges, camera, model_matrix, faces, mode).copy()
+        covered = np.isfinite(depth)
+        rows, cols = np.nonzero(covered[:, 1:] & ~covered[:, :-1])    # uncovered, covered to its right
+        if len(rows):
+            depth[rows[0], cols[0]] = depth[rows[0], cols[0] + 1]
+        return depth
+
+
 def test_min_iou_decides():
     shaded = RenderMode(style="shaded")
 
     def run_shaded(t):
-        return run(cases=("oblique_roll",), frames=3, tol=t, mode=shaded)
+        report, _ = run_crosscheck([load_scene("cube")], GrowCore(), frames=3, case_names=["oblique_roll"], tol=t,
+                                   mode=shaded, animation=False)
+        return report
     iou = run_shaded(OPEN)["cases"][0]["silhouette_iou_gated"]
-    assert 0.99 < iou <= 1.0
+    assert 0.99 < iou < 1.0                 # one pixel more on a silhouette of thousands
     _decides(run_shaded, "min_iou", iou, np.nextafter(iou, 2.0), "silhouette IoU")
 
 
