@@ -445,7 +445,7 @@ def test_every_option_has_help_with_its_default_and_no_markup():
 
     parser = build_parser()
     for action in parser._actions:
-        if action.dest != "help":
+        if action.dest not in ("help", "version"):          # -h and --version take no value
             assert action.help and "default" in action.help, action.option_strings
     text = parser.format_help()
     assert "``" not in text and ":func:" not in text and ":mod:" not in text
