@@ -6,7 +6,17 @@
         assert_projector(my_project)        # AssertionError naming the fault if not
 
 ``my_project(points, camera) -> (N, 2)`` follows the candidate contract
-(:mod:`oracles.candidate`). By default only the OpenCV vertex oracle runs (fast,
+(:mod:`oracles.candidate`). A projector in another language is given as
+``cmd="./my_projector --flag"`` (the candidate protocol, docs/protocol.md).
+
+Isolation: a candidate given as a string (``"FILE.py:FUNC"``) or ``cmd`` runs
+in its own process under a per-request timeout (``timeout_s``), so a crash,
+``os._exit`` or a hang fails a case instead of ending or blocking your test
+run. A callable runs isolated too when another process can import it (a
+module-level function of an importable module); otherwise (a lambda, a
+closure, a bound method, a function of ``__main__``) it runs in this process,
+which is quicker but unprotected. ``isolate=True`` insists (ValueError when it
+cannot), ``isolate=False`` runs a callable in this process. By default only the OpenCV vertex oracle runs (fast,
 no OpenGL needed); pass ``oracles=("opencv", "pyrender")`` to compare drawn
 pixels too.
 """
@@ -14,21 +24,23 @@ pixels too.
 from __future__ import annotations
 
 from . import gate, tolerances
-from .candidate import load_candidate
+from .isolation import api_candidate
 from .report import FAULT_HINTS, compared_text, fault_text, not_passed
 from .runner import run_crosscheck
+from .subprocess_candidate import DEFAULT_TIMEOUT_S
 from .tolerances import Tolerances
 
 
-def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("opencv",),
+def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles=("opencv",),
                     tol_px: float = tolerances.VERTEX_TOL_PX, min_f1: float = tolerances.MIN_F1_1PX,
                     min_f1_0px: float = tolerances.MIN_F1_0PX, turns=(1.0, 1.0, 0.0),
-                    allow_vacuous: bool = False) -> dict:
+                    allow_vacuous: bool = False, *, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S,
+                    isolate: bool | None = None) -> dict:
     """Crosscheck a projector against OpenCV (and pyrender) and return the report.
 
     Parameters
     ----------
-    func : callable or str
+    func : callable or str, optional
         The candidate, ``func(points, camera) -> p_px``: ``points`` (N, 3)
         float64 world coordinates, ``camera`` with the fields of
         :class:`~wirecheck.core.camera.Camera`, ``p_px`` (N, 2) pixels with
@@ -51,6 +63,15 @@ def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("op
     allow_vacuous : bool
         Let a case that compared nothing (every point clipped in every frame)
         pass; by default its verdict ``"vacuous"`` fails the report.
+    cmd : str or sequence of str, optional
+        Instead of ``func``: a projector program speaking the candidate
+        protocol (docs/protocol.md), as a command line or an argv list.
+    timeout_s : float
+        Seconds each request to an isolated candidate may take (default 10).
+    isolate : bool, optional
+        None (default): run ``func`` in its own process when it is a string or
+        an importable module-level function; True: insist (ValueError if it
+        cannot be); False: run a callable in this process.
 
     Returns
     -------
@@ -67,11 +88,9 @@ def check_projector(func, scenes=None, frames: int = 8, cases=None, oracles=("op
     RuntimeError
         ``"pyrender"`` asked for but OSMesa is missing.
     """
-    name = func if isinstance(func, str) else getattr(func, "__qualname__", repr(func))
-    if isinstance(func, str):
-        func = load_candidate(func)
     tol = Tolerances(tol_px, min_f1, min_f1_0px)
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)    # before any OpenGL set-up
+    name, func = api_candidate(func, cmd, timeout_s, isolate)
     if "pyrender" in oracles:
         from .pyrender_oracle import osmesa_available
 
@@ -106,13 +125,13 @@ def failure_text(report: dict) -> str | None:
     return "\n".join(lines)
 
 
-def assert_projector(func, **kwargs) -> dict:
+def assert_projector(func=None, **kwargs) -> dict:
     """:func:`check_projector`, raising AssertionError with the diagnosis unless the verdict is pass.
 
     Parameters
     ----------
-    func : callable or str
-        The candidate, as for :func:`check_projector`.
+    func : callable or str, optional
+        The candidate, as for :func:`check_projector` (or ``cmd=`` among the keywords).
     **kwargs
         Any keyword of :func:`check_projector`.
 

@@ -20,6 +20,7 @@ import importlib
 import importlib.util
 import inspect
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -72,16 +73,39 @@ class CandidateError(RuntimeError):
     """The candidate raised or returned something outside the contract."""
 
 
+def _as_pixels(out) -> np.ndarray:
+    """The answer as a float64 array, or CandidateError: never a warning, never a silent cast.
+
+    Complex values (numpy would drop the imaginary part with a ComplexWarning),
+    integers too large for a float, and objects whose ``__array__`` or
+    ``__float__`` raise are contract violations.
+    """
+    what = type(out).__name__
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            arr = np.asarray(out)
+            if arr.dtype.kind == "c":
+                raise CandidateError(f"candidate returned complex numbers ({arr.dtype}): expected an (N, 2) "
+                                     "real float array")
+            return arr.astype(np.float64)
+    except CandidateError:
+        raise
+    except Exception as exc:   # OverflowError, a raising __array__/__float__, ragged lists, warnings
+        raise CandidateError(f"candidate returned {what} that is not an array of floats "
+                             f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}): "
+                             "expected an (N, 2) float array") from exc
+
+
 def call_candidate(func, points: np.ndarray, camera) -> np.ndarray:
     """Call the candidate and check its answer against the contract."""
     try:
         out = func(np.array(points, dtype=np.float64, copy=True), camera)
+    except CandidateError:                   # an isolated candidate's own one-line reason
+        raise
     except (Exception, SystemExit) as exc:   # a candidate must not end the run (nor pass CI by exiting 0)
         raise CandidateError(f"candidate raised {type(exc).__name__}: {exc}") from exc
-    try:
-        out = np.asarray(out, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise CandidateError(f"candidate returned {type(out).__name__}: expected an (N, 2) float array") from exc
+    out = _as_pixels(out)
     if out.shape != (len(points), 2):
         raise CandidateError(f"candidate returned shape {out.shape}: expected ({len(points)}, 2)")
     infinite = np.isinf(out).any(axis=1)

@@ -5,6 +5,13 @@ compared nothing (``vacuous``, unless ``--allow-vacuous``), 2 on usage or input
 errors (including libOSMesa missing when pyrender is asked for, and inputs that
 would compare nothing: oracles/gate.py).
 
+The candidate is core (in this process, trusted) unless ``--candidate
+FILE.py:FUNC`` or ``--candidate-cmd 'COMMAND ARGS'`` (a program in any
+language) is given: those run in their own process and are spoken to over
+the candidate protocol (docs/protocol.md, oracles/isolation.py),
+each request under ``--candidate-timeout`` seconds, so a candidate that
+exits, hangs or crashes fails its cases (exit 1) and never ends the run.
+
 ``--level vertices`` runs the OpenCV vertex check only (no drawing, no
 pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
 ``--oracles opencv`` / ``--oracles opencv,pyrender`` is the older spelling of
@@ -37,6 +44,7 @@ extremes`` runs the numerical-extremes suite (oracles/extremes/) and exits
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import re
 import sys
@@ -48,7 +56,8 @@ from wirecheck.core.errors import InputError
 from wirecheck.core.output import check_replaceable
 
 from . import gate, tolerances
-from .candidate import load_candidate
+from .isolation import external_candidate
+from .subprocess_candidate import DEFAULT_TIMEOUT_S
 from .cases import CASE_NAMES
 from .config import parse_cli
 from .junit import check_junit_target, write_junit
@@ -84,7 +93,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="frames of the scene's motion per case (default 24; 12 with --sweep)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)}")
     p.add_argument("--candidate", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
-                   help="the projector to judge (default: core/)")
+                   help="the projector to judge (default: core/); run in its own process")
+    p.add_argument("--candidate-cmd", default=None, metavar="'COMMAND ARGS'",
+                   help="a projector program in any language, spoken to over stdin/stdout (docs/protocol.md)")
+    p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
+                   help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--level", choices=LEVELS, default=None,
                    help="vertices: OpenCV vertex check only (no drawing, no pyrender); "
                         "pixels: vertices and pyrender pixels (default)")
@@ -159,6 +172,7 @@ def _parse(args):
                              f"--level {args.level}: give only --level")
         level = implied
     core_given = [f"--{k}" for k in CORE_OPTIONS if getattr(args, k) is not None]
+    external = _external_option(args)
     if args.suite:
         ignored = [opt for opt, given in (
             ("--scene", args.scene is not None), ("--frames", args.frames != 24), ("--every", args.every != 1),
@@ -177,13 +191,13 @@ def _parse(args):
     if args.sweep and args.jobs != 1:
         raise InputError(f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
                          "the times compare; expected no --jobs")
-    if (args.sweep or args.suite) and (core_given or args.candidate):
+    if (args.sweep or args.suite) and (core_given or external):
         what = "--sweep" if args.sweep else f"--suite {args.suite}"
         raise InputError(f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
                          "itself; expected neither --candidate nor --dtype/--clip/--raster")
-    if args.candidate and core_given:
-        raise InputError(f"{', '.join(core_given)}: settings of the core candidate, not of --candidate "
-                         f"{args.candidate!r}: expected them without --candidate")
+    if external and core_given:
+        raise InputError(f"{', '.join(core_given)}: settings of the core candidate, not of {external}: "
+                         "expected them without it")
     mode_given = [opt for opt, given in (("--style", args.style is not None), ("--hidden-lines", args.hidden_lines),
                                          ("--cull", args.cull is not None)) if given]
     if mode_given:
@@ -191,9 +205,9 @@ def _parse(args):
         if args.sweep or args.suite:
             raise InputError(f"{what} with {'--sweep' if args.sweep else '--suite ' + args.suite}: expected "
                              "the drawing options in a plain crosscheck run only")
-        if args.candidate:
-            raise InputError(f"{what}: drawing modes of the core candidate; --candidate {args.candidate!r} only "
-                             "projects points: expected them without --candidate")
+        if external:
+            raise InputError(f"{what}: drawing modes of the core candidate; {external} only "
+                             "projects points: expected them without it")
         if level != "pixels":
             raise InputError(f"{what} with --level {level}: faces are drawn and compared at the pixel level "
                              "only: expected --level pixels (the default)")
@@ -211,8 +225,8 @@ def _parse(args):
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
-    if args.candidate:
-        candidate = load_candidate(args.candidate)
+    if external:
+        candidate = external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
     return level, inputs, candidate, mode, tol
@@ -234,6 +248,18 @@ def _error(text: str) -> int:
     """Print ``crosscheck: error: text`` on stderr; the exit status of a usage error (2)."""
     print(f"crosscheck: error: {text}", file=sys.stderr)
     return 2
+
+
+def _external_option(args) -> str | None:
+    """``--candidate 'X'`` or ``--candidate-cmd 'X'`` as given (None: core); InputError for both or a bad timeout."""
+    if args.candidate is not None and args.candidate_cmd is not None:
+        raise InputError(f"--candidate {args.candidate!r} with --candidate-cmd {args.candidate_cmd!r}: "
+                         "expected one candidate")
+    if not (math.isfinite(args.candidate_timeout) and args.candidate_timeout > 0):
+        raise InputError(f"--candidate-timeout {args.candidate_timeout}: expected a number of seconds > 0")
+    if args.candidate is not None:            # '' too: an empty candidate is an error, never core
+        return f"--candidate {args.candidate!r}"
+    return f"--candidate-cmd {args.candidate_cmd!r}" if args.candidate_cmd is not None else None
 
 
 def main(argv=None) -> int:
@@ -273,19 +299,15 @@ def main(argv=None) -> int:
         return _suite(level, run_dir)
     progress = TerminalProgress(sys.stderr)
     try:
+        # an external candidate runs in its own process already (oracles.isolation): no worker needed
         report, images = run_crosscheck(inputs.scenes, candidate, frames=inputs.frames,
                                         case_names=inputs.case_names, level=level, turns=inputs.turns, tol=tol,
-                                        every=inputs.every, jobs=args.jobs, candidate_name=args.candidate or "core",
-                                        candidate_spec=args.candidate, mode=mode, allow_vacuous=args.allow_vacuous,
-                                        progress=progress.update if progress.active else None,
-                                        isolate=args.candidate is not None)
+                                        every=inputs.every, jobs=args.jobs, candidate_name=candidate.name,
+                                        mode=mode, allow_vacuous=args.allow_vacuous,
+                                        progress=progress.update if progress.active else None)
     except InputError as exc:
         return _error(str(exc))
     except BrokenProcessPool as exc:
-        if args.candidate:     # it ran in the workers (isolate): it ended one, so it fails, never passes
-            print(f"crosscheck: FAIL: a worker process running --candidate {args.candidate!r} ended ({exc}): "
-                  "the candidate exited or crashed its process; no report written", file=sys.stderr)
-            return 1
         return _error(f"a worker process died ({exc}); try --jobs 1")
     finally:
         progress.close()

@@ -4,6 +4,8 @@
 
     [tool.wirecheck]
     candidate = "src/myproj/projection.py:project"  # crosscheck --candidate; the fixture's default projector
+    # candidate-cmd = "./build/projector --flag"   # or a program (crosscheck --candidate-cmd; docs/protocol.md)
+    # candidate-timeout = 10                      # seconds per request to either
     scenes = ["cube", "tests/arm.scene"]   # built-in or example names, or paths relative to this file
     cases = ["on_axis", "near_plane"]      # a subset of oracles.cases.CASE_NAMES
     frames = 8                             # frames of the motion per case
@@ -43,6 +45,8 @@ TABLE = "tool.wirecheck"
 #: The keys and what each must be (said in the error message).
 KEYS = {
     "candidate": "a string FILE.py:FUNC or MODULE:FUNC",
+    "candidate-cmd": "a non-empty command string (a program speaking docs/protocol.md)",
+    "candidate-timeout": "a number of seconds > 0",
     "scenes": "a non-empty list of scene names or paths",
     "cases": "a non-empty list of case names",
     "frames": "an integer >= 1",
@@ -56,7 +60,7 @@ KEYS = {
 
 #: Keyword of oracles.api.check_projector for each key (``level``/``oracles`` become ``oracles``).
 API_KEYWORDS = {"scenes": "scenes", "cases": "cases", "frames": "frames", "tol-px": "tol_px",
-                "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "turns"}
+                "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "turns", "candidate-timeout": "timeout_s"}
 
 
 @dataclass(frozen=True)
@@ -152,6 +156,14 @@ def validate(table: dict, path: Path) -> dict:
             if target.endswith(".py") or "/" in target:
                 target = str((base / target).resolve())
             out[key] = f"{target}:{func}"
+        elif key == "candidate-cmd":
+            if not (isinstance(value, str) and value.strip()):
+                raise bad(key, value)
+            out[key] = value
+        elif key == "candidate-timeout":
+            if not (number(value) and value > 0):
+                raise bad(key, value)
+            out[key] = float(value)
         elif key == "scenes":
             if not strings(value):
                 raise bad(key, value)
@@ -207,11 +219,14 @@ def validate(table: dict, path: Path) -> dict:
             if not (isinstance(value, list) and len(value) == 3 and all(number(v) for v in value)):
                 raise bad(key, value)
             out[key] = tuple(float(v) for v in value)
+    if "candidate" in out and "candidate-cmd" in out:
+        raise InputError(f"{path}: [{TABLE}] both candidate and candidate-cmd: expected one of them")
     return out
 
 
 #: crosscheck's argparse destination for each key.
-CLI_DESTS = {"candidate": "candidate", "scenes": "scene", "cases": "cases", "frames": "frames", "level": "level",
+CLI_DESTS = {"candidate": "candidate", "candidate-cmd": "candidate_cmd", "candidate-timeout": "candidate_timeout",
+             "scenes": "scene", "cases": "cases", "frames": "frames", "level": "level",
              "tol-px": "tol_px", "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "spin"}
 
 
@@ -253,8 +268,9 @@ def parse_cli(parser, argv=None):
         return args, config, applied
     for key, value in config.values.items():
         dest = CLI_DESTS[key]
-        if dest in given or (key == "level" and "oracles" in given) or (key == "candidate" and args.sweep):
-            continue
+        picked = key in ("candidate", "candidate-cmd") and (args.sweep or {"candidate", "candidate_cmd"} & given)
+        if dest in given or (key == "level" and "oracles" in given) or picked:
+            continue                  # a candidate on the command line replaces the table's, of either kind
         setattr(args, dest, _cli_value(key, value))
         applied.append(key)
     return args, config, applied

@@ -23,8 +23,8 @@ from scipy.spatial.transform import Rotation
 
 from wirecheck.core.camera import Camera
 
-__all__ = ["camera_to_opencv", "opencv_to_camera", "camera_to_pyrender",
-           "pyrender_pose_to_camera", "model_matrix"]
+__all__ = ["camera_to_opencv", "opencv_matrices", "opencv_to_camera", "camera_to_pyrender",
+           "pyrender_pose_to_camera", "camera_to_gl", "model_matrix"]
 
 # Relative tolerance for "K describes a centred, square-pixel camera": K built
 # by camera_to_opencv is exact to float64 rounding (~1e-16 relative); 1e-9
@@ -106,6 +106,22 @@ def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray
         f = camera.height / camera.ortho_height
     k = np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]])
     return rvec.reshape(3), tvec, k
+
+
+def opencv_matrices(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``R, t, K`` of :func:`camera_to_opencv` as matrices: ``p_cv = R @ X + t``, ``K`` as there.
+
+    ``R`` is built from the camera's vectors (rows ``right, -up, forward``), not
+    through a rotation vector, so it carries no Rodrigues rounding.
+
+    Returns
+    -------
+    R : (3, 3) ndarray, t : (3,) ndarray, K : (3, 3) ndarray (affine for orthographic).
+    """
+    right, up, forward = camera_basis(camera)
+    r_cv = np.stack([right, -up, forward])
+    _rvec, _tvec, k = camera_to_opencv(camera)
+    return r_cv, -r_cv @ np.asarray(camera.position, dtype=np.float64), k
 
 
 def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: float,
@@ -228,6 +244,55 @@ def pyrender_pose_to_camera(pose, pyrender_camera, width: int, height: int) -> C
     else:
         raise TypeError(f"unsupported pyrender camera {type(pyrender_camera).__name__}")
     return Camera(position=pose[:3, 3], forward=-pose[:3, 2], up=pose[:3, 1], **kwargs)
+
+
+# ---- OpenGL (view and projection matrices) --------------------------------
+
+def camera_to_gl(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
+    """Our camera as OpenGL view and projection matrices (column vectors).
+
+    OpenGL (``gluLookAt`` / ``gluPerspective`` / ``glOrtho``)::
+
+        p_clip = P @ V @ [X, 1]        eye space x right, y up, z backward
+        p_ndc = p_clip[:3] / p_clip[3]   in [-1, 1]^3 inside the frustum
+        x_win = (x_ndc + 1) W / 2,  y_win = (y_ndc + 1) H / 2   (corner origin, y up)
+
+    ``V`` has rows ``right, up, -forward`` and translation ``-R @ position``.
+    Perspective ``P``: ``f = 1 / tan(fov_y / 2)``, ``a = W / H``::
+
+        [[f/a, 0, 0, 0], [0, f, 0, 0],
+         [0, 0, (far+near)/(near-far), 2 far near/(near-far)], [0, 0, -1, 0]]
+
+    Orthographic ``P`` (``glOrtho`` with ``top = ortho_height / 2``,
+    ``right = a top``): ``diag(1/right, 1/top, -2/(far-near), 1)`` with
+    ``P[2, 3] = -(far+near)/(far-near)``. Our pixels are then
+    ``x_px = x_win - 0.5``, ``y_px = H - y_win - 0.5`` (integer coordinates
+    at pixel centres, y down: core.conventions).
+
+    Returns
+    -------
+    view : (4, 4) ndarray, world -> GL eye.
+    projection : (4, 4) ndarray, GL eye -> clip.
+    """
+    right, up, forward = camera_basis(camera)
+    r_gl = np.stack([right, up, -forward])
+    view = np.eye(4)
+    view[:3, :3] = r_gl
+    view[:3, 3] = -r_gl @ np.asarray(camera.position, dtype=np.float64)
+    aspect = camera.width / camera.height
+    n, f = float(camera.near), float(camera.far)
+    proj = np.zeros((4, 4))
+    if camera.projection == "perspective":
+        g = 1.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0)
+        proj[0, 0], proj[1, 1] = g / aspect, g
+        proj[2, 2], proj[2, 3] = (f + n) / (n - f), 2.0 * f * n / (n - f)
+        proj[3, 2] = -1.0
+    else:
+        top = camera.ortho_height / 2.0
+        proj[0, 0], proj[1, 1] = 1.0 / (aspect * top), 1.0 / top
+        proj[2, 2], proj[2, 3] = -2.0 / (f - n), -(f + n) / (f - n)
+        proj[3, 3] = 1.0
+    return view, proj
 
 
 # ---- model motion ---------------------------------------------------------

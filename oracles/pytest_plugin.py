@@ -10,7 +10,8 @@ runs :func:`wirecheck.oracles.api.check_projector` and returns its report
 dict; when a case fails, the test fails with the diagnosis (faults, reasons,
 what to check) and a traceback that ends at the test's own line: the
 harness's frames are hidden (``__tracebackhide__``). ``projector`` is a
-callable or a ``"FILE.py:FUNC"`` string; without it, the ``candidate`` of
+callable or a ``"FILE.py:FUNC"`` string, or ``cmd="PROGRAM ARGS"`` a program
+(docs/protocol.md); without either, the ``candidate`` or ``candidate-cmd`` of
 ``[tool.wirecheck]``.
 
 Settings, the first given wins: the call's keywords (those of
@@ -37,6 +38,7 @@ import pytest
 
 _SETTINGS = pytest.StashKey[dict]()
 _CANDIDATE = pytest.StashKey[object]()
+_CMD = pytest.StashKey[object]()
 _WRITTEN = pytest.StashKey[list]()
 
 
@@ -78,6 +80,7 @@ def pytest_configure(config):
         raise pytest.UsageError(f"wirecheck: {exc}") from None
     config.stash[_SETTINGS] = settings
     config.stash[_CANDIDATE] = table.values.get("candidate")
+    config.stash[_CMD] = table.values.get("candidate-cmd")
     config.stash[_WRITTEN] = []
 
 
@@ -127,7 +130,9 @@ class Check:
 
         config = self._config
         projector = projector if projector is not None else config.stash[_CANDIDATE]
-        if projector is None:
+        if projector is None and "cmd" not in settings and config.stash[_CMD] is not None:
+            settings = {"cmd": config.stash[_CMD], **settings}      # the table's program
+        if projector is None and "cmd" not in settings:
             pytest.fail("wirecheck(): no projector: expected wirecheck(func) or candidate = \"FILE.py:FUNC\" "
                         "in [tool.wirecheck]", pytrace=False)
         self._calls += 1

@@ -158,9 +158,13 @@ class _CaseRunner:
         if not self.warm:
             self.warm_up(case.camera, candidate, params.level)
         pyr = self.renderer(case.camera, params.mode) if params.level == "pixels" else None
-        return run_case(scene, case, params.frames, candidate, params.motion,
-                        params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
-                        keep_frames=params.keep_frames)
+        result = run_case(scene, case, params.frames, candidate, params.motion,
+                          params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
+                          keep_frames=params.keep_frames)
+        stderr = candidate.take_stderr() if hasattr(candidate, "take_stderr") else ""
+        if stderr:          # an isolated candidate's stderr during this case (oracles.subprocess_candidate)
+            result.record["candidate_stderr"] = stderr
+        return result
 
     def close(self) -> None:
         self.renderers.close()
@@ -369,7 +373,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         "allow_vacuous": allow_vacuous,
         "compared": compared,
         "candidate": candidate_name,
-        "candidate_settings": candidate.settings() if is_core else None,
+        "candidate_settings": candidate.settings() if hasattr(candidate, "settings") else None,
         "level": level,
         **mode.to_dict(),
         "oracles": list(LEVEL_ORACLES[level]),

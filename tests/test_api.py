@@ -32,3 +32,42 @@ def test_check_projector_with_pixels():
     report = check_projector(f"{DATA / 'user_projector.py'}:project", scenes=["prism"], frames=2,
                              cases=["near_plane"], oracles=("opencv", "pyrender"))
     assert report["cases"][0]["pixel_f1_1px"] == 1.0      # measured 1.0 everywhere (README)
+
+
+def test_an_importable_callable_runs_isolated_and_a_lambda_in_process():
+    from wirecheck.core.projection import project_points
+    from wirecheck.oracles.isolation import api_candidate
+    from wirecheck.oracles.subprocess_candidate import SubprocessCandidate
+
+    name, cand = api_candidate(project_points)            # a module-level function: the host imports it
+    assert name == "project_points" and isinstance(cand, SubprocessCandidate)
+    assert cand.python_spec == "wirecheck.core.projection:project_points"
+    name, cand = api_candidate(lambda p, c: project_points(p, c))
+    assert name == "test_an_importable_callable_runs_isolated_and_a_lambda_in_process.<locals>.<lambda>"
+    assert not isinstance(cand, SubprocessCandidate)
+    with pytest.raises(ValueError, match="isolate=True"):
+        api_candidate(lambda p, c: p, isolate=True)
+
+
+def test_a_callable_that_kills_its_process_fails_instead_of_ending_pytest():
+    from data.hostile_projector import exits       # tests/ is on sys.path (rootdir conftest)
+
+    report = check_projector(exits, scenes=["cube"], frames=1, cases=["on_axis"])
+    assert report["verdict"] == "fail"
+    assert report["cases"][0]["reasons"] == ["frame 1: candidate exited with status 0 during a request of 8 points"]
+
+
+def test_a_program_is_judged_through_the_api_too(tmp_path):
+    import shutil
+    import subprocess
+
+    cc = shutil.which("cc")
+    if cc is None:
+        pytest.skip("no C compiler (cc)")
+    exe = tmp_path / "candidate"
+    subprocess.run([cc, "-O2", "-o", str(exe), str(Path(__file__).parent / "clients" / "candidate.c"), "-lm"],
+                   check=True)
+    report = assert_projector(cmd=str(exe), scenes=["cube"], frames=2)
+    # float64 from the same R, t, K as OpenCV (tests/test_candidate_programs.py): < 1e-9 px
+    assert report["summary"]["cases"] == 7 and report["summary"]["max_vertex_error_px"] < 1e-9
+    assert report["candidate"] == str(exe) and report["candidate_settings"]["command"] == [str(exe)]

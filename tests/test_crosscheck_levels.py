@@ -130,13 +130,13 @@ def test_jobs_2_gives_the_report_of_jobs_1(tmp_path):
 
 
 def test_file_candidate_runs_in_workers(tmp_path):
-    # a faulty projector from a file outside sys.path: each worker loads it from the spec
+    # a faulty projector from a file outside sys.path: each worker starts its own candidate host
     args = ("--candidate", f"{USER}:project_corner", "--scene", "prism", "--frames", "2",
             "--cases", "oblique_roll,non_square,orthographic")
     code1, _, out1 = run(tmp_path, *args, name="j1")
     code2, r2, out2 = run(tmp_path, *args, "--jobs", "2", name="j2")
     assert code1 == code2 == 1
-    assert r2["timing"]["workers"] == 2 and r2["candidate_settings"] is None
+    assert r2["timing"]["workers"] == 2 and r2["candidate_settings"]["isolation"] == "subprocess"
     for case in r2["cases"]:
         assert [f["name"] for f in case["faults"]] == ["pixel_offset"]
         assert case["pixel_f1_1px"] is not None

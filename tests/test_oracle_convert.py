@@ -170,3 +170,44 @@ def test_model_matrix_hand_values():
     # two quarter turns: a few ulp per entry, doubled by the composition (8 eps),
     # times the scale 2; the translation is added exactly.
     np.testing.assert_allclose(m @ [0, 1, 0, 1], [1 + 2, 2, 3, 1], rtol=0, atol=8 * EPS * 2)
+
+
+# ---- OpenGL matrices (the candidate protocol's view_matrix / projection_matrix)
+
+def test_gl_hand_values_camera_z():
+    # camera_z: at (0, 0, 4) looking down -Z, up +Y: GL eye space is world space shifted by -4 in z
+    view, proj = convert.camera_to_gl(CAMERAS["camera_z"])
+    expected_view = np.eye(4)
+    expected_view[2, 3] = -4.0
+    np.testing.assert_array_equal(view, expected_view)
+    # fov 90: f = 1 / tan(45 deg) = 1 (to 1 ulp); aspect 640/480; near 1, far 10
+    g = 1.0 / math.tan(math.radians(45.0))
+    expected = np.array([[g * 480 / 640, 0, 0, 0], [0, g, 0, 0],
+                         [0, 0, -11.0 / 9.0, -20.0 / 9.0], [0, 0, -1.0, 0]])
+    np.testing.assert_allclose(proj, expected, rtol=4 * EPS, atol=0)
+
+
+@pytest.mark.parametrize("name", sorted(CAMERAS))
+def test_gl_matrices_give_opencv_pixels(name):
+    # x_px = (x_ndc + 1) W/2 - 0.5, y_px = (1 - y_ndc) H/2 - 0.5 (docs/protocol.md); the NDC cube
+    # holds exactly the points with depth in [near, far] (z_ndc = -1 at near, +1 at far)
+    from wirecheck.oracles import opencv_oracle
+
+    cam = CAMERAS[name]
+    p_world = np.random.default_rng(5).uniform(-8, 8, (4000, 3))
+    view, proj = convert.camera_to_gl(cam)
+    clip = np.c_[p_world, np.ones(len(p_world))] @ (proj @ view).T
+    ndc = clip[:, :3] / clip[:, 3:]
+    px = np.c_[(ndc[:, 0] + 1) * cam.width / 2 - 0.5, (1 - ndc[:, 1]) * cam.height / 2 - 0.5]
+    ref = opencv_oracle.project(p_world, cam)
+    depth = opencv_oracle.depth(p_world, cam)
+    inside = (depth >= cam.near) & (depth <= cam.far)
+    assert (np.isfinite(ref[:, 0]) == inside).all() and 100 < inside.sum() < len(p_world)
+    # away from the planes (1e-9 relative), the NDC depth test decides visibility as the depth does
+    clear = np.abs(depth - cam.near) > 1e-9 * cam.far
+    clear &= np.abs(depth - cam.far) > 1e-9 * cam.far
+    assert ((np.abs(ndc[:, 2]) <= 1) == inside)[clear].all()
+    # float64 through a 4x4 product and a divide: ~10 eps relative, amplified by |p_world| / depth
+    # (<= 14 / 0.25 = 56) on coordinates < 1e5 px: < 1e-8 px; relative 1e-12 of the coordinate
+    err = np.abs(px[inside] - ref[inside]).max(axis=1)
+    assert (err <= 1e-12 * np.maximum(np.abs(ref[inside]).max(axis=1), 1.0)).all()

@@ -1,0 +1,448 @@
+"""A candidate that runs in its own process and speaks the candidate protocol (oracles.protocol).
+
+:class:`SubprocessCandidate` is a picklable description (the command and its
+timeouts); calling it follows the candidate contract (oracles.candidate). The
+live program belongs to the calling process: it is started on the first call,
+kept for the process's life (once per worker with ``--jobs``), and closed at
+exit. Whatever the program does, a call ends within the timeout with pixels or
+a :class:`~oracles.candidate.CandidateError` of one line:
+
+- it hangs: killed (its whole process group) after ``timeout_s``;
+- it dies (``os._exit``, a segfault, a signal): its exit status or signal;
+- it answers the wrong number of points, or garbage: what it wrote;
+- it answers ``{"error": ...}``: its message (the program lives on).
+
+After a kill or a death the next call starts the program again (a fresh
+process for the next case). A program that fails to start (dies, hangs or
+writes garbage before answering the header) fails every later call at once
+with the same reason, instead of being started again for every case.
+
+The program's stderr is a pipe read while waiting for each reply and
+drained after it, into a buffer that keeps the last ``STDERR_KEEP`` bytes:
+memory stays bounded however much the program writes, nothing goes to disk,
+and what the program wrote before its reply is always there (the report is
+the same on every run). :meth:`SubprocessCandidate.take_stderr` returns what
+was written since the last call.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import selectors
+import shlex
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import protocol
+from .candidate import CandidateError
+
+#: Default seconds a request may take (issue 15: a hang fails the case, not the run).
+DEFAULT_TIMEOUT_S = 10.0
+#: Start-up (until the program answers the header) gets at least this long: a
+#: Python host imports numpy and the candidate, ~0.3 s alone, seconds on a loaded machine.
+MIN_START_TIMEOUT_S = 10.0
+#: Bytes of the program's stderr kept per case (the tail).
+STDERR_KEEP = 64 * 1024
+#: Read/write chunk, and the pipe size asked for (Linux F_SETPIPE_SZ; 64 KB otherwise).
+_CHUNK = 1 << 20
+#: Seconds a program gets to exit after its stdin is closed, before it is killed.
+_EXIT_GRACE_S = 2.0
+
+
+class CandidateStartRefused(CandidateError):
+    """The program could not be started, or refused at start-up with ``{"error": ...}``: a usage error."""
+
+
+@dataclass(frozen=True)
+class SubprocessCandidate:
+    """A projector program spoken to over stdin/stdout (the candidate protocol).
+
+    Parameters
+    ----------
+    argv : tuple of str
+        The command and its arguments (no shell).
+    timeout_s : float
+        Seconds each request may take.
+    start_timeout_s : float or None
+        Seconds until the program answers the header (default: the larger of
+        ``timeout_s`` and ``MIN_START_TIMEOUT_S``).
+    label : str
+        The name in messages and the report.
+    env : tuple of (str, str)
+        Variables added to the program's environment.
+    python_spec : str or None
+        Set for a Python candidate run by :mod:`oracles.candidate_host`: its
+        messages are then the in-process contract's, verbatim.
+    """
+
+    argv: tuple
+    timeout_s: float = DEFAULT_TIMEOUT_S
+    start_timeout_s: float | None = None
+    label: str = ""
+    env: tuple = ()
+    python_spec: str | None = None
+
+    def __post_init__(self):
+        if not self.argv:
+            raise ValueError("argv: expected a command")
+        if not (self.timeout_s > 0 and np.isfinite(self.timeout_s)):
+            raise ValueError(f"timeout_s {self.timeout_s!r}: expected a number of seconds > 0")
+
+    @classmethod
+    def from_command(cls, command: str, timeout_s: float = DEFAULT_TIMEOUT_S, **kwargs) -> "SubprocessCandidate":
+        """From a command line, split as a POSIX shell would (``shlex.split``), run without a shell."""
+        try:
+            argv = tuple(shlex.split(command))
+        except ValueError as exc:
+            raise ValueError(f"{command!r}: {exc}") from None
+        if not argv:
+            raise ValueError(f"{command!r}: expected a command")
+        return cls(argv=argv, timeout_s=timeout_s, label=kwargs.pop("label", command), **kwargs)
+
+    @classmethod
+    def python(cls, spec: str, timeout_s: float = DEFAULT_TIMEOUT_S, pythonpath=(), **kwargs) -> "SubprocessCandidate":
+        """A ``FILE.py:FUNC`` / ``MODULE:FUNC`` candidate run isolated, by :mod:`oracles.candidate_host`.
+
+        ``pythonpath``: folders the host puts first on ``sys.path`` (for a
+        ``MODULE:FUNC`` importable only from the caller's path).
+        """
+        env = (("WIRECHECK_HOST_PATH", os.pathsep.join(pythonpath)),) if pythonpath else ()
+        return cls(argv=(sys.executable, "-m", "wirecheck.oracles.candidate_host", spec), timeout_s=timeout_s,
+                   label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
+
+    @property
+    def name(self) -> str:
+        return self.label or shlex.join(self.argv)
+
+    def settings(self) -> dict:
+        """For the report: how the candidate ran."""
+        return {"isolation": "subprocess", "protocol": protocol.VERSION,
+                "command": list(self.argv) if self.python_spec is None else None,
+                "timeout_s": self.timeout_s}
+
+    def __call__(self, points, camera) -> np.ndarray:
+        """The candidate contract: ``(N, 3)`` world points to ``(N, 2)`` pixels; CandidateError on any fault."""
+        return _live(self).project(np.asarray(points, dtype=np.float64).reshape(-1, 3), camera)
+
+    def start(self) -> None:
+        """Start the program now (if not running); CandidateError (CandidateStartRefused) if it cannot."""
+        _live(self).ensure_started()
+
+    def take_stderr(self) -> str:
+        """The program's stderr since the last call (its last STDERR_KEEP bytes), as text."""
+        program = _PROGRAMS.get(self)
+        return program.take_stderr() if program else ""
+
+    def close(self) -> None:
+        """Close the program (stdin closed, then killed after a grace period)."""
+        program = _PROGRAMS.pop(self, None)
+        if program:
+            program.close()
+
+
+#: The live programs of this process, by description.
+_PROGRAMS: dict = {}
+
+
+def _live(spec: SubprocessCandidate) -> "_Program":
+    program = _PROGRAMS.get(spec)
+    if program is None:
+        program = _PROGRAMS[spec] = _Program(spec)
+    return program
+
+
+@atexit.register
+def _close_all() -> None:
+    for spec in list(_PROGRAMS):
+        spec.close()
+
+
+def _die_with_parent() -> None:
+    """In the child, before exec: SIGKILL when crosscheck's process ends (Linux), so no hung program outlives a
+    killed run. Elsewhere a program still sees EOF on stdin when crosscheck ends."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)    # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
+class _Died(Exception):
+    pass
+
+
+class _TimedOut(Exception):
+    pass
+
+
+def _status_text(returncode) -> str:
+    if returncode is None:
+        return "closed its stdout"
+    if returncode < 0:
+        try:
+            return f"was killed by signal {signal.Signals(-returncode).name}"
+        except ValueError:
+            return f"was killed by signal {-returncode}"
+    return f"exited with status {returncode}"
+
+
+class _Program:
+    """One running program and its protocol state."""
+
+    def __init__(self, spec: SubprocessCandidate):
+        self.spec = spec
+        self.proc = None
+        self.start_error = None        # sticky: (exception class, message)
+        self.buf = bytearray()
+        self.requests = 0
+        self.camera = self.camera_json = None
+        self.err = bytearray()             # the program's stderr not yet taken (its tail)
+        self.err_cut = 0                   # bytes dropped from its front since the last take
+
+    # ---- life cycle
+
+    def ensure_started(self) -> None:
+        if self.start_error is not None:
+            cls, message = self.start_error
+            raise cls(message)
+        if self.proc is not None:
+            return
+        try:
+            self._start()
+        except CandidateError as exc:
+            self.start_error = (type(exc), str(exc))
+            raise
+
+    def _start(self) -> None:
+        spec = self.spec
+        env = dict(os.environ)
+        env.update(dict(spec.env))
+        try:
+            proc = subprocess.Popen(spec.argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    env=env, start_new_session=True, bufsize=0, preexec_fn=_die_with_parent)
+        except OSError as exc:
+            raise CandidateStartRefused(f"cannot start {spec.argv[0]!r}: {exc.strerror or exc}") from None
+        self.proc = proc
+        self.buf = bytearray()
+        for f in (proc.stdin, proc.stdout, proc.stderr):
+            os.set_blocking(f.fileno(), False)
+            try:
+                import fcntl
+
+                fcntl.fcntl(f.fileno(), fcntl.F_SETPIPE_SZ, _CHUNK)
+            except (ImportError, AttributeError, OSError):
+                pass                       # a smaller pipe only costs speed
+        limit = spec.start_timeout_s or max(spec.timeout_s, MIN_START_TIMEOUT_S)
+        what = "at start-up, before answering the protocol header"
+        try:
+            end = self._transfer(protocol.HEADER, self._line_end, time.monotonic() + limit)
+            line = bytes(self.buf[:end])
+            del self.buf[:end]
+            protocol.check_hello(line)
+        except _TimedOut:
+            self._kill()
+            raise CandidateError(f"candidate did not answer the protocol header within {limit:g} s "
+                                 f"(start-up); it was killed{self._stderr_hint()}") from None
+        except _Died:
+            status = self._reap()
+            raise CandidateError(f"candidate {status} {what}{self._stderr_hint()}") from None
+        except protocol.CandidateReportedError as exc:
+            self._kill()
+            raise CandidateStartRefused(str(exc) if spec.python_spec else f"candidate refused to start: {exc}") \
+                from None
+        except protocol.ProtocolError as exc:
+            self._kill()
+            raise CandidateError(f"candidate {exc}{self._stderr_hint()}") from None
+
+    def close(self) -> None:
+        proc, self.proc = self.proc, None
+        if proc is not None:
+            try:
+                proc.stdin.close()
+            except OSError:
+                pass
+            try:
+                proc.wait(timeout=_EXIT_GRACE_S)
+            except subprocess.TimeoutExpired:
+                self._killpg(proc)
+                proc.wait()
+            self._drain_stderr(proc)
+            proc.stdout.close()
+            proc.stderr.close()
+
+    @staticmethod
+    def _killpg(proc) -> None:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)     # the program and anything it started
+        except (ProcessLookupError, PermissionError):
+            try:
+                proc.kill()
+            except ProcessLookupError:
+                pass
+
+    def _kill(self) -> None:
+        proc, self.proc = self.proc, None
+        if proc is None:
+            return
+        self._killpg(proc)
+        proc.wait()
+        self._drain_stderr(proc)            # all it wrote is in the pipe now
+        for f in (proc.stdin, proc.stdout, proc.stderr):
+            try:
+                f.close()
+            except OSError:
+                pass
+
+    def _reap(self) -> str:
+        """After EOF on stdout: the exit status in words (killing it if it lingers)."""
+        proc = self.proc
+        try:
+            proc.wait(timeout=_EXIT_GRACE_S)
+        except subprocess.TimeoutExpired:
+            self._kill()
+            return "closed its stdout (and was killed)"
+        self._kill()           # closes the pipes; the group may hold children
+        return _status_text(proc.returncode)
+
+    # ---- requests
+
+    def project(self, p_world: np.ndarray, camera) -> np.ndarray:
+        self.ensure_started()
+        self.requests += 1
+        n = len(p_world)
+        if self.camera is not camera:          # a case asks with one camera object: its JSON is made once
+            self.camera, self.camera_json = camera, protocol.camera_text(camera)
+        payload = protocol.encode_request(self.requests, p_world, self.camera_json)
+        what = f"a request of {n} points"
+        header = {}
+
+        def reply_end(buf):
+            if "end" not in header:
+                line_end = self._line_end(buf)
+                if line_end is None:
+                    return None
+                header["line"] = line_end
+                header["end"] = line_end + protocol.reply_length(bytes(buf[:line_end]), n)
+            return header["end"]
+
+        try:
+            if self.buf:
+                raise protocol.ProtocolError(f"wrote {len(self.buf)} bytes outside a reply: "
+                                             f"{protocol.shown(bytes(self.buf))}")
+            end = self._transfer(payload, reply_end, time.monotonic() + self.spec.timeout_s)
+        except _TimedOut:
+            self._kill()
+            raise CandidateError(f"candidate timed out after {self.spec.timeout_s:g} s on {what}; it was killed "
+                                 f"(and is started again for the next case){self._stderr_hint()}") from None
+        except _Died:
+            status = self._reap()
+            raise CandidateError(f"candidate {status} during {what}{self._stderr_hint()}") from None
+        except protocol.CandidateReportedError as exc:
+            del self.buf[:header["line"]]
+            if self.spec.python_spec:
+                raise CandidateError(str(exc)) from None
+            raise CandidateError(f"candidate reported an error: {exc}") from None
+        except protocol.ProtocolError as exc:
+            self._kill()
+            raise CandidateError(f"candidate {exc} (on {what}); it was killed{self._stderr_hint()}") from None
+        with memoryview(self.buf) as view:          # decoded straight from the buffer (one copy)
+            p_px = protocol.decode_points(view[header["line"]:end], 2)
+        del self.buf[:end]
+        return p_px
+
+    def _line_end(self, buf) -> int | None:
+        """Index just past the first newline, None if none yet; ProtocolError if the line is too long."""
+        i = buf.find(b"\n", 0, protocol.MAX_LINE)
+        if i >= 0:
+            return i + 1
+        if len(buf) >= protocol.MAX_LINE:
+            raise protocol.ProtocolError(f"wrote {protocol.shown(bytes(buf))} with no newline in its first "
+                                         f"{protocol.MAX_LINE} bytes: expected a JSON line")
+        return None
+
+    def _transfer(self, payload: bytes, end_of, deadline: float) -> int:
+        """Write ``payload`` while reading into ``self.buf`` until ``end_of(buf)`` bytes are there.
+
+        Both directions at once (a program may answer while still reading);
+        _TimedOut past ``deadline``, _Died on EOF or a closed stdin.
+        """
+        proc = self.proc
+        w, r, e = proc.stdin.fileno(), proc.stdout.fileno(), proc.stderr.fileno()
+        view = memoryview(payload)
+        sent = 0
+        sel = selectors.DefaultSelector()
+        try:
+            if payload:
+                sel.register(w, selectors.EVENT_WRITE)
+            sel.register(r, selectors.EVENT_READ)
+            sel.register(e, selectors.EVENT_READ)
+            while True:
+                end = end_of(self.buf)
+                if end is not None and len(self.buf) >= end and sent == len(payload):
+                    self._drain_stderr(proc)      # what it wrote before replying
+                    return end
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise _TimedOut
+                for key, _ in sel.select(remaining):
+                    if key.fd == e:
+                        if not self._drain_stderr(proc):
+                            sel.unregister(e)       # closed: the program may live on without it
+                    elif key.fd == w:
+                        try:
+                            sent += os.write(w, view[sent:sent + _CHUNK])
+                        except BlockingIOError:
+                            continue
+                        except (BrokenPipeError, ConnectionResetError):
+                            raise _Died from None
+                        if sent == len(payload):
+                            sel.unregister(w)
+                    else:
+                        try:
+                            chunk = os.read(r, _CHUNK)
+                        except BlockingIOError:
+                            continue
+                        if not chunk:
+                            raise _Died
+                        self.buf += chunk
+        finally:
+            sel.close()
+
+    # ---- stderr
+
+    def _drain_stderr(self, proc) -> bool:
+        """Read what the program's stderr pipe holds into the kept tail; False once it is closed."""
+        fd = proc.stderr.fileno()
+        while True:
+            try:
+                chunk = os.read(fd, _CHUNK)
+            except BlockingIOError:
+                return True
+            except OSError:
+                return False
+            if not chunk:
+                return False
+            self.err += chunk
+            extra = len(self.err) - STDERR_KEEP
+            if extra > 0:
+                del self.err[:extra]
+                self.err_cut += extra
+
+    def take_stderr(self) -> str:
+        if self.proc is not None:
+            self._drain_stderr(self.proc)
+        text = (f"[... {self.err_cut} bytes before]\n" if self.err_cut else "") + self.err.decode("utf-8", "replace")
+        self.err, self.err_cut = bytearray(), 0
+        return text
+
+    def _stderr_hint(self) -> str:
+        """'; its stderr ends: "..."' from the last non-empty line of the program's stderr, if any."""
+        lines = [ln.strip() for ln in self.err[-4096:].decode("utf-8", "replace").splitlines() if ln.strip()]
+        return f"; its stderr ends: {lines[-1][:300]!r}" if lines else ""

@@ -1,0 +1,118 @@
+"""Hostile Python candidates (issue 15): each fails its case with one reason; crosscheck exits 1 with a report.
+
+Every candidate here runs in wirecheck's candidate host (oracles.candidate_host),
+so what it does to its own process never reaches crosscheck's.
+"""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from wirecheck.oracles import cli
+
+ROOT = Path(__file__).parent.parent
+
+#: (name, candidate source, a phrase the case's reason must hold)
+HOSTILE = [
+    ("os_exit_0_in_call", "import os\ndef f(p, c):\n    os._exit(0)\n",
+     "candidate exited with status 0 during a request of 8 points"),
+    ("os_exit_0_at_import", "import os\nos._exit(0)\ndef f(p, c):\n    return p[:, :2]\n",
+     "candidate exited with status 0 at start-up, before answering the protocol header"),
+    ("os_exit_3", "import os\ndef f(p, c):\n    os._exit(3)\n", "candidate exited with status 3 during"),
+    ("keyboard_interrupt", "def f(p, c):\n    raise KeyboardInterrupt\n", "candidate raised KeyboardInterrupt"),
+    ("generator_exit", "def f(p, c):\n    raise GeneratorExit('bye')\n", "candidate raised GeneratorExit: bye"),
+    ("segfault", "import ctypes\ndef f(p, c):\n    ctypes.string_at(0)\n",
+     "candidate was killed by signal SIGSEGV during a request of 8 points"),
+    ("huge_int", "def f(p, c):\n    return [[10**400, 0]] * len(p)\n",
+     "candidate returned list that is not an array of floats (OverflowError"),
+    ("array_raises", "class A:\n    def __array__(self, *a, **k):\n        raise RuntimeError('no array')\n"
+                     "def f(p, c):\n    return A()\n", "(RuntimeError: no array)"),
+    ("float_raises", "class F:\n    def __float__(self):\n        raise ValueError('no float')\n"
+                     "def f(p, c):\n    return [[F(), F()] for _ in p]\n", "(ValueError: no float)"),
+    ("complex", "import numpy as np\ndef f(p, c):\n    return np.zeros((len(p), 2)) + 1j\n",
+     "candidate returned complex numbers (complex128)"),
+]
+
+
+def _crosscheck(tmp_path, source, *extra):
+    cand = tmp_path / "hostile.py"
+    cand.write_text(source)
+    out = tmp_path / "report"
+    code = cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--cases", "on_axis,orthographic",
+                     "--frames", "2", "--level", "vertices", "--report-dir", str(out), *extra])
+    return code, json.loads((out / "report.json").read_text())
+
+
+@pytest.mark.parametrize("name,source,reason", HOSTILE, ids=[h[0] for h in HOSTILE])
+def test_hostile_candidate_fails_every_case_with_its_reason(tmp_path, capsys, name, source, reason):
+    code, report = _crosscheck(tmp_path, source)
+    err = capsys.readouterr().err
+    assert code == 1 and report["verdict"] == "fail"
+    assert report["summary"] == {**report["summary"], "cases": 2, "failed": 2}
+    for case in report["cases"]:
+        assert len(case["reasons"]) == 1 and case["reasons"][0].startswith("frame 1: ")
+        assert reason in case["reasons"][0], case["reasons"]
+    assert "Traceback" not in err and "Warning" not in err
+
+
+def test_hang_times_out_and_the_next_case_gets_a_fresh_process(tmp_path, capsys):
+    # the first process ever started sleeps; later ones (after the kill) answer correctly
+    flag = tmp_path / "started-once"
+    source = (f"import time, pathlib\nfrom wirecheck.core.projection import project_points\n"
+              f"FIRST = not pathlib.Path({str(flag)!r}).exists()\npathlib.Path({str(flag)!r}).touch()\n"
+              "def f(p, c):\n    if FIRST:\n        time.sleep(60)\n    return project_points(p, c)\n")
+    code, report = _crosscheck(tmp_path, source, "--candidate-timeout", "0.5")
+    first, second = report["cases"]
+    assert code == 1
+    assert first["reasons"] == ["frame 1: candidate timed out after 0.5 s on a request of 8 points; it was "
+                                "killed (and is started again for the next case)"]
+    assert second["verdict"] == "pass" and second["max_vertex_error_px"] < 1e-9
+
+
+def test_os_exit_0_as_a_real_process_exits_1_with_a_report(tmp_path):
+    cand = tmp_path / "bye.py"
+    cand.write_text("import os\ndef f(p, c):\n    os._exit(0)\n")
+    proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", f"{cand}:f",
+                           "--scene", "cube", "--frames", "1", "--report-dir", str(tmp_path / "r")],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc.returncode == 1 and proc.stderr == ""
+    report = json.loads((tmp_path / "r" / "report.json").read_text())
+    assert report["summary"]["failed"] == report["summary"]["cases"] == 7
+    assert "FAIL: 0/7 cases" in proc.stdout
+
+
+def test_candidate_stderr_and_prints_go_into_the_report_not_the_protocol(tmp_path):
+    source = ("import sys\nfrom wirecheck.core.projection import project_points\nprint('loaded')\n"
+              "def f(p, c):\n    print('stdout of f')\n    print('stderr of f', file=sys.stderr)\n"
+              "    return project_points(p, c)\n")
+    code, report = _crosscheck(tmp_path, source)
+    assert code == 0
+    # frames 1 and 2 of on_axis: one call each (vertex level); the import's print lands in the first case
+    assert report["cases"][0]["candidate_stderr"] == "loaded\n" + "stdout of f\nstderr of f\n" * 2
+    assert report["cases"][1]["candidate_stderr"] == "stdout of f\nstderr of f\n" * 2
+    assert report["candidate_settings"]["isolation"] == "subprocess"
+
+
+def test_bad_timeout_and_two_candidates_are_usage_errors(tmp_path, capsys):
+    assert cli.main(["--candidate-timeout", "0", "--report-dir", str(tmp_path / "a")]) == 2
+    assert "--candidate-timeout 0.0: expected a number of seconds > 0" in capsys.readouterr().err
+    assert cli.main(["--candidate", "x.py:f", "--candidate-cmd", "true", "--report-dir", str(tmp_path / "b")]) == 2
+    assert "expected one candidate" in capsys.readouterr().err
+
+
+def test_a_candidate_hanging_at_import_fails_every_case_and_is_started_once(tmp_path, monkeypatch):
+    from wirecheck.oracles import subprocess_candidate
+
+    # long enough for the host to start Python and import numpy on a loaded machine and reach the file
+    monkeypatch.setattr(subprocess_candidate, "MIN_START_TIMEOUT_S", 4.0)
+    starts = tmp_path / "starts"
+    source = f"import time\nwith open({str(starts)!r}, 'a') as f:\n    f.write('start\\n')\ntime.sleep(60)\n"
+    code, report = _crosscheck(tmp_path, source, "--candidate-timeout", "0.3")
+    assert code == 1
+    for case in report["cases"]:
+        assert case["reasons"] == ["frame 1: candidate did not answer the protocol header within 4 s "
+                                   "(start-up); it was killed"]
+    assert starts.read_text() == "start\n"       # not started again for the second case
