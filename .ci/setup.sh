@@ -32,3 +32,9 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
     .venv/bin/python -m pip install -q -e '.[dev]' >&2
     echo "$want" > "$stamp"
 fi
+
+# 3. The test suite's outside programs, each idempotent: Debian's chromium and
+# playwright-core for the viewer's browser test (tests/browser/setup.sh); cc,
+# node and three.js for the candidate-protocol clients (tests/clients/setup.sh).
+bash tests/browser/setup.sh
+bash tests/clients/setup.sh
