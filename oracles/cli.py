@@ -34,6 +34,10 @@ The report directory also gets ``worst.gif`` (every checked frame of the
 worst case: candidate | oracle | diff), ``vertex_error.png`` and
 ``pixels.png`` (per-frame plots of every case).
 
+``crosscheck export DIR`` writes a rendering job for any renderer, and
+``--candidate-frames DIR`` judges the renderer's own frames of it
+(oracles/frames_cli.py, docs/frames.md).
+
 ``--sweep`` runs every core setting (dtype x clip x raster) on the scenes and
 a large mesh and writes a table and a Pareto plot (oracles/sweep.py); it
 exits 1 only when the default setting is out of tolerance. ``--suite
@@ -98,6 +102,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a projector program in any language, spoken to over stdin/stdout (docs/protocol.md)")
     p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
+    p.add_argument("--candidate-frames", default=None, metavar="DIR",
+                   help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
+                        "(docs/frames.md)")
     p.add_argument("--level", choices=LEVELS, default=None,
                    help="vertices: OpenCV vertex check only (no drawing, no pyrender); "
                         "pixels: vertices and pyrender pixels (default)")
@@ -263,6 +270,11 @@ def _external_option(args) -> str | None:
 
 
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["export"]:                     # crosscheck export DIR: a job for image candidates
+        from .frames_cli import export_main
+
+        return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
         if applied:
@@ -293,6 +305,10 @@ def main(argv=None) -> int:
         return _error(f"--report-dir {str(run_dir)!r}: cannot write there ({exc}): "
                       "expected a writable directory")
 
+    if args.candidate_frames is not None:
+        from .frames_cli import frames_main
+
+        return frames_main(args, run_dir, from_config=set(applied))
     if args.sweep:
         return _sweep(args, inputs, level, tol, run_dir)
     if args.suite:

@@ -1,0 +1,197 @@
+"""``crosscheck export DIR``: a rendering job any renderer can do, judged later by its frames.
+
+The job is a folder::
+
+    DIR/README.md                        what to draw and where (for the renderer's author)
+    DIR/job.json                         the manifest: scenes, cases, frames, image rule, conventions
+    DIR/scenes/<scene>.obj               vertices ``v`` (model space), edges ``l``, faces ``f``
+    DIR/scenes/<scene>/frame_0001.obj    instead, for a scene of several moving objects: world space per frame
+    DIR/cameras/<scene>/<case>/frame_0001.json   the camera and model matrix of one frame
+    DIR/frames/<scene>/<case>/frame_0001.png     written by the renderer (not by export)
+
+A frame's JSON holds the camera in every form a renderer may want: the
+fields of the candidate contract (:mod:`oracles.candidate`), OpenCV's ``K, R,
+t`` (:func:`oracles.convert.opencv_matrices`), OpenGL's view and projection
+matrices (:func:`oracles.convert.camera_to_gl`) and the model matrix the
+oracles use (:func:`oracles.faces.frame_geometry`: scipy, not core). Matrices
+are nested lists of rows, for column vectors (``p = M @ [x, y, z, 1]``). The
+conventions are stated in the JSON itself (``conventions``), pointing to
+``core/conventions.py``.
+
+Frames are numbered as crosscheck's motion numbers them: frame ``k`` is at
+``t = (k - 1) / frames``; with ``every`` only frames 1, 1 + every, ... are in
+the job. ``oracles.frames_candidate`` reads the job back and judges the PNGs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from wirecheck.core.output import FrameDir, json_dumps
+
+from .cases import cameras_for
+from .convert import camera_to_gl, opencv_matrices
+
+#: Version of the job format; frames_candidate refuses any other.
+JOB_VERSION = 1
+JOB_KIND = "wirecheck frames job"
+
+CONVENTIONS = {
+    "statement": "core/conventions.py of wirecheck states these once; summarised here for the renderer",
+    "world": "right-handed; camera right = forward x up",
+    "pixels": "x right (columns), y down (rows), origin top-left; integer coordinates are pixel centres: "
+              "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2)",
+    "fov": "fov_y_deg is the vertical field of view, edge to edge of the image",
+    "orthographic": "ortho_height world units are visible vertically (edge to edge)",
+    "clipping": "a point is drawn when its depth along forward is in [near, far]; edges are clipped there",
+    "matrices": "nested lists of rows, for column vectors: p' = M @ p",
+    "model_matrix": "p_world = model_matrix @ [p_model, 1] (the OBJ's v are p_model)",
+    "opencv": "p_cv = R @ p_world + t; [u, v, 1] ~ K @ p_cv (perspective); u, v are our pixel coordinates",
+    "opengl": "p_clip = gl_projection @ gl_view @ [p_world, 1]; x_win = (x_ndc + 1) W / 2, "
+              "y_win = (y_ndc + 1) H / 2 (y up, corner origin); our x_px = x_win - 0.5, y_px = H - y_win - 0.5",
+}
+
+IMAGE_RULE = {
+    "wireframe": "PNG, the camera's width x height, black background, every visible edge as a 1-px aliased "
+                 "white line (no anti-aliasing, no line smoothing); a pixel counts as drawn when its "
+                 "luminance is >= 128",
+}
+
+
+def frame_name(k: int, ext: str) -> str:
+    return f"frame_{k:04d}.{ext}"
+
+
+def _rows(m) -> list:
+    return [[float(x) for x in row] for row in np.asarray(m, dtype=np.float64)]
+
+
+def _obj_text(vertices: np.ndarray, edges, faces, header: str) -> str:
+    lines = [f"# {header}"]
+    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(vertices, dtype=np.float64).tolist()]
+    lines += [f"l {int(a) + 1} {int(b) + 1}" for a, b in np.asarray(edges).reshape(-1, 2).tolist()]
+    lines += ["f " + " ".join(str(int(i) + 1) for i in f) for f in faces]
+    return "\n".join(lines) + "\n"
+
+
+def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames: int) -> dict:
+    """Everything a renderer needs to draw frame ``k`` of one case."""
+    r, t, kk = opencv_matrices(camera)
+    view, proj = camera_to_gl(camera)
+    return {"scene": scene, "case": case, "frame": k, "t": (k - 1) / frames,
+            "camera": camera.to_dict(), "right": [float(x) for x in camera.right],
+            "model_matrix": _rows(model),
+            "K": _rows(kk), "R": _rows(r), "t_cv": [float(x) for x in t],
+            "gl_view": _rows(view), "gl_projection": _rows(proj),
+            "conventions": "see job.json (conventions); core/conventions.py states them once"}
+
+
+def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> tuple[dict, dict]:
+    """The manifest and the files of a job: ``(job, {relative path: bytes})``."""
+    from wirecheck.core.transforms import Motion
+
+    from .faces import frame_geometry
+
+    motion = motion or Motion()
+    files: dict[str, bytes] = {}
+    scene_rows, case_rows = [], []
+    checked = list(range(1, frames + 1, every))
+    for scene in scenes:
+        single = scene.is_single_static
+        faces = [tuple(int(i) for i in f) for f in scene.faces]
+        if single:
+            path = f"scenes/{scene.name}.obj"
+            files[path] = _obj_text(scene.vertices, scene.edges, faces,
+                                    f"{scene.name}: model space; each frame's JSON has its model_matrix").encode()
+        scene_rows.append({"name": scene.name, "space": "model" if single else "world per frame",
+                           "obj": f"scenes/{scene.name}.obj" if single else f"scenes/{scene.name}/frame_NNNN.obj",
+                           "vertices": int(len(scene.vertices)), "edges": int(len(scene.edges)),
+                           "faces": len(faces)})
+        geometry = {}
+        for k in checked:
+            p_world, _m, _pr_vertices, pose = frame_geometry(scene, motion, (k - 1) / frames)
+            geometry[k] = pose if single else np.eye(4)
+            if not single:
+                files[f"scenes/{scene.name}/{frame_name(k, 'obj')}"] = _obj_text(
+                    p_world, scene.edges, faces, f"{scene.name} frame {k}: world space").encode()
+        for case in cameras_for(scene.radius):
+            if case_names is not None and case.name not in case_names:
+                continue
+            for k in checked:
+                files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
+                    camera_json(case.camera, geometry[k], scene.name, case.name, k, frames)).encode()
+            case_rows.append({"scene": scene.name, "case": case.name, "width": case.camera.width,
+                              "height": case.camera.height,
+                              "frames": [f"frames/{scene.name}/{case.name}/{frame_name(k, 'png')}" for k in checked]})
+    job = {"kind": JOB_KIND, "version": JOB_VERSION, "style": "wireframe", "frames": frames, "every": every,
+           "frame_numbers": checked, "motion": {"turns": list(motion.turns)},
+           "image": IMAGE_RULE["wireframe"], "conventions": CONVENTIONS,
+           "scenes": scene_rows, "cases": case_rows}
+    files["job.json"] = json_dumps(job).encode()
+    files["README.md"] = readme(job).encode()
+    return job, files
+
+
+def readme(job: dict) -> str:
+    n_frames = sum(len(c["frames"]) for c in job["cases"])
+    first = job["cases"][0]
+    return f"""# A wirecheck rendering job
+
+Draw every frame listed below with your renderer, then run
+
+    crosscheck --candidate-frames THIS_FOLDER
+
+to have your renderer's own pixels judged against pyrender (OpenGL) and
+wirecheck's core renderer: edge-pixel F1 at 0 and 1 px, diff images, the
+worst frames, and, when something is off, the name of the fault
+(mirror, axis swap, FOV, aspect, half-pixel offset, depth flip).
+
+## What to draw
+
+{job['image']}.
+
+- {len(job['cases'])} cases (a scene under a camera), {n_frames} frames in all.
+- Scenes: `scenes/<scene>.obj` (model space: `v` vertices, `l` edges, `f`
+  faces, 1-based). Draw the `l` edges (a line per edge); the faces are for
+  shaded renderers and for hidden lines, which this job does not ask for.
+- Cameras: `cameras/<scene>/<case>/frame_NNNN.json` gives the camera as
+  position/forward/up/fov_y_deg/width/height/near/far/projection/ortho_height,
+  as OpenCV `K`, `R`, `t_cv`, and as OpenGL `gl_view` and `gl_projection`, and
+  the frame's `model_matrix` (p_world = model_matrix @ [v, 1]). Matrices are
+  rows, for column vectors. The conventions are in `job.json` (`conventions`).
+- Clip edges at the near and far planes (depth along `forward` in
+  [near, far]); draw what falls inside the image.
+
+## Where to write
+
+`frames/<scene>/<case>/frame_NNNN.png`, the same numbers as the camera files,
+e.g. `{first['frames'][0]}` ({first['width']} x {first['height']}). Every
+listed frame must be there, at its camera's size. PNG, 8-bit grey or RGB(A).
+
+## Anti-aliasing
+
+Turn it off (WebGL: `antialias: false`; OpenGL: no multisampling, no
+GL_LINE_SMOOTH). An anti-aliased line is spread over two pixels of half
+intensity; thresholded at 128 it loses or doubles pixels, and the 0-px F1
+says so.
+"""
+
+
+def write_job(out_dir: Path, scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> dict:
+    """Write the job to ``out_dir`` atomically (a temporary folder renamed over it); the manifest."""
+    job, files = build_job(scenes, frames=frames, every=every, case_names=case_names, motion=motion)
+    out_dir = Path(out_dir)
+    out = FrameDir(out_dir, "export DIR")
+    try:
+        for rel, data in sorted(files.items()):
+            path = out.tmp / rel
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        (out.tmp / "frames").mkdir()
+        out.commit()
+    except BaseException:
+        out.abort()
+        raise
+    return job

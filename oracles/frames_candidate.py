@@ -1,0 +1,237 @@
+"""``crosscheck --candidate-frames DIR``: judge a renderer by its own frames.
+
+``DIR`` is a job written by :mod:`oracles.export` with the renderer's PNGs
+under ``frames/``. Each frame is compared with pyrender's rendering (the
+oracle the verdict rests on, as in the pixel level of crosscheck) and with
+core's, both drawn from the job's own files (OBJ vertices, the frame's
+camera and model matrix), by edge-pixel F1 at 0 and 1 px
+(:func:`oracles.metrics.pixel_scores`). The case's frames are then diagnosed
+from the images alone (:mod:`oracles.image_diagnose`).
+
+A gate never passes on nothing: the job must list cases and frames, every
+listed frame must be there at its camera's size and readable, and a PNG under
+``frames/`` that the job does not list is refused too (frames of another
+job). Each problem is one line of :class:`FramesError` (exit 2).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from wirecheck.core.errors import InputError
+
+from . import metrics
+from .export import JOB_KIND, JOB_VERSION, frame_name
+
+#: Problem lines shown before "... and N more".
+MAX_LINES = 20
+
+
+class FramesError(InputError):
+    """The job or its frames cannot be judged: one line per problem."""
+
+    def __init__(self, problems: list[str]):
+        self.problems = problems
+        shown = problems[:MAX_LINES]
+        more = len(problems) - len(shown)
+        super().__init__("\n".join(shown + ([f"... and {more} more"] if more else [])))
+
+
+def load_job(job_dir: Path) -> dict:
+    """The manifest ``DIR/job.json``, checked; FramesError otherwise."""
+    path = Path(job_dir) / "job.json"
+    if not Path(job_dir).is_dir():
+        raise FramesError([f"--candidate-frames {str(job_dir)!r}: not a directory: expected a job folder "
+                           "written by 'crosscheck export'"])
+    try:
+        job = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise FramesError([f"{path}: missing: expected a job folder written by 'crosscheck export'"]) from None
+    except (OSError, ValueError) as exc:
+        raise FramesError([f"{path}: unreadable ({exc}): expected the JSON 'crosscheck export' wrote"]) from None
+    if not isinstance(job, dict) or job.get("kind") != JOB_KIND:
+        raise FramesError([f"{path}: not a wirecheck frames job (kind {job.get('kind') if isinstance(job, dict) else None!r})"])
+    if job.get("version") != JOB_VERSION:
+        raise FramesError([f"{path}: job version {job.get('version')!r}: expected {JOB_VERSION} (export it again)"])
+    if not job.get("cases") or not any(c.get("frames") for c in job["cases"]):
+        raise FramesError([f"{path}: the job lists no frames: nothing to judge"])
+    return job
+
+
+def read_png(path: Path, width: int, height: int) -> np.ndarray:
+    """``(H, W)`` bool: drawn where the luminance is >= 128; ValueError with the reason otherwise."""
+    from PIL import Image
+
+    with Image.open(path) as im:
+        im.load()
+        size = im.size
+        if size != (width, height):
+            raise ValueError(f"size {size[0]}x{size[1]}: expected {width}x{height} (the camera's)")
+        grey = np.asarray(im.convert("RGB").convert("L"))
+    return grey >= 128
+
+
+def load_frames(job_dir: Path, job: dict) -> dict:
+    """Every listed frame as a bool image: ``{(scene, case): [(k, image)]}``; FramesError listing every problem."""
+    job_dir = Path(job_dir)
+    frames_dir = job_dir / "frames"
+    if not frames_dir.is_dir():
+        raise FramesError([f"{frames_dir}: missing: the renderer's frames go there "
+                           "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
+    found = {p.relative_to(job_dir).as_posix() for p in frames_dir.rglob("*") if p.is_file()}
+    if not found:
+        raise FramesError([f"{frames_dir}: empty: expected the renderer's frames "
+                           "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
+    listed = {f for c in job["cases"] for f in c["frames"]}
+    if not found & listed:
+        example = sorted(found)[0]
+        raise FramesError([f"{frames_dir}: none of its {len(found)} files is a frame of this job "
+                           f"(e.g. {example}; expected e.g. {sorted(listed)[0]}): frames of another job?"])
+    problems = [f"{job_dir / rel}: not a frame of this job (expected only the files job.json lists)"
+                for rel in sorted(found - listed)]
+    out = {}
+    for c in job["cases"]:
+        images = []
+        for rel in c["frames"]:
+            path = job_dir / rel
+            k = int(Path(rel).stem.split("_")[-1])
+            if rel not in found:
+                problems.append(f"{path}: missing (frame {k} of {c['scene']} / {c['case']})")
+                continue
+            try:
+                images.append((k, read_png(path, c["width"], c["height"])))
+            except ValueError as exc:
+                problems.append(f"{path}: {exc}")
+            except Exception as exc:       # Pillow's many ways to say "not an image"
+                problems.append(f"{path}: unreadable as PNG ({type(exc).__name__}: {exc})")
+        out[(c["scene"], c["case"])] = images
+    if problems:
+        raise FramesError(problems)
+    return out
+
+
+def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``."""
+    verts, edges = [], []
+    for line in Path(path).read_text().splitlines():
+        parts = line.split()
+        if parts and parts[0] == "v":
+            verts.append([float(x) for x in parts[1:4]])
+        elif parts and parts[0] == "l":
+            edges.append([int(x) - 1 for x in parts[1:3]])
+    return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
+
+
+def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int):
+    """``(p_model (N, 3), edges (E, 2), camera, model_matrix (4, 4))`` of one frame, from the job's files."""
+    from wirecheck.core.camera import Camera
+
+    job_dir = Path(job_dir)
+    row = next(s for s in job["scenes"] if s["name"] == scene)
+    obj = job_dir / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
+    p_model, edges = read_obj(obj)
+    cam_json = json.loads((job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}").read_text())
+    camera = Camera(**cam_json["camera"])
+    return p_model, edges, camera, np.asarray(cam_json["model_matrix"], dtype=np.float64)
+
+
+def _min_scores(scores: list[dict], prefix: str = "") -> dict:
+    keys = ("f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px")
+    return {f"{prefix}{k}": float(min(s[k] for s in scores)) for k in keys}
+
+
+def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, diagnose: bool = True):
+    """One case: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion."""
+    from wirecheck.core.pipeline import render_frame
+
+    from .image_diagnose import diagnose_images, flipped_camera, oracle_segments
+
+    per_frame, pr_scores, core_scores = [], [], []
+    worst = None
+    cand_imgs, segs, flipped = [], [], []
+    camera = None
+    for k, cand in images:
+        p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k)
+        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
+        core = render_frame(p_model, edges, camera, m).image >= 128
+        ps, cs = metrics.pixel_scores(cand, orac), metrics.pixel_scores(cand, core)
+        pr_scores.append(ps)
+        core_scores.append(cs)
+        per_frame.append({"frame": k, "f1_0px": ps["f1_0px"], "f1_1px": ps["f1_1px"],
+                          "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"],
+                          "candidate_pixels": ps["candidate_pixels"], "oracle_pixels": ps["oracle_pixels"]})
+        key = (ps["f1_1px"], ps["f1_0px"])
+        if worst is None or key < worst[0]:
+            worst = (key, k, cand.copy(), orac.copy())
+        if diagnose:
+            p_world = p_model @ m[:3, :3].T + m[:3, 3]
+            cand_imgs.append(cand)
+            segs.append(oracle_segments(p_world, edges, camera))
+            flipped.append(oracle_segments(p_world, edges, flipped_camera(camera)))
+    s = _min_scores(pr_scores)
+    rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
+           "frames_checked": len(images), "max_vertex_error_px": None,
+           "pixel_f1_0px": s["f1_0px"], "pixel_f1_1px": s["f1_1px"],
+           "pixel_f1_0px_mean": float(np.mean([x["f1_0px"] for x in pr_scores])),
+           "pixel_f1_1px_mean": float(np.mean([x["f1_1px"] for x in pr_scores])),
+           "pixel_precision_0px": s["precision_0px"], "pixel_recall_0px": s["recall_0px"],
+           "pixel_precision_1px": s["precision_1px"], "pixel_recall_1px": s["recall_1px"],
+           "core": _min_scores(core_scores), "worst_pixel_frame": worst[1]}
+    rec["faults"] = diagnose_images(cand_imgs, segs, camera, flipped) if diagnose else []
+    reasons = []
+    if rec["pixel_f1_1px"] < tol.min_f1_1px:
+        reasons.append(f"pixel F1@1px {rec['pixel_f1_1px']:.4f} < {tol.min_f1_1px} (frame {rec['worst_pixel_frame']})")
+    if rec["pixel_f1_0px"] < tol.min_f1_0px:
+        reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
+    if not any(x["candidate_pixels"] or x["oracle_pixels"] for x in pr_scores):
+        rec["note"] = "neither side drew a pixel in any frame of this case"
+    rec.update(verdict="fail" if reasons else "pass", reasons=reasons, per_frame=per_frame)
+    return rec, {"frame": worst[1], "candidate": worst[2], "oracle": worst[3]}
+
+
+def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None) -> tuple[dict, dict]:
+    """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
+
+    FramesError (exit 2) when the job or its frames are incomplete, of the
+    wrong size, unreadable, or not this job's.
+    """
+    from .pyrender_oracle import OracleCache
+    from .runner import Tolerances
+
+    tol = tol or Tolerances()
+    t0 = time.perf_counter()
+    job = load_job(job_dir)
+    frames = load_frames(job_dir, job)
+    oracles = OracleCache()
+    records, images = [], {}
+    try:
+        for c in job["cases"]:
+            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], frames[(c["scene"], c["case"])],
+                                    oracles, tol, diagnose=diagnose)
+            records.append(rec)
+            images[(c["scene"], c["case"])] = worst
+    finally:
+        oracles.close()
+    failed = sum(r["verdict"] != "pass" for r in records)
+    report = {
+        "tool": "wirecheck crosscheck", "verdict": "fail" if failed else "pass",
+        "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
+        "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
+        "frames": job["frames"], "every": job["every"], "frames_checked": len(job["frame_numbers"]),
+        "motion": job["motion"],
+        "tolerances": {"vertex_error_px": tol.vertex_px, "min_pixel_f1_1px": tol.min_f1_1px,
+                       "min_pixel_f1_0px": tol.min_f1_0px},
+        "summary": {"cases": len(records), "passed": len(records) - failed, "failed": failed,
+                    "max_vertex_error_px": None,
+                    "min_pixel_f1_0px": min(r["pixel_f1_0px"] for r in records),
+                    "min_pixel_f1_1px": min(r["pixel_f1_1px"] for r in records),
+                    "min_core_f1_0px": min(r["core"]["f1_0px"] for r in records),
+                    "min_core_f1_1px": min(r["core"]["f1_1px"] for r in records)},
+        "cases": records,
+        "timing": {"wall_s": time.perf_counter() - t0},
+    }
+    return report, images

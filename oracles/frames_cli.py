@@ -1,0 +1,130 @@
+"""The command lines of image candidates: ``crosscheck export DIR`` and ``crosscheck --candidate-frames DIR``.
+
+Both only parse and call :mod:`oracles.export` / :mod:`oracles.frames_candidate`;
+:mod:`oracles.cli` hands over to them. Exit status as crosscheck's: 0 pass,
+1 a case out of tolerance, 2 usage or input errors (one line each).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+from wirecheck.core.errors import InputError
+
+from .cases import CASE_NAMES
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _fail(message: str) -> int:
+    for line in str(message).splitlines():
+        print(f"crosscheck: error: {line}", file=sys.stderr)
+    return 2
+
+
+def export_main(argv) -> int:
+    """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z]``."""
+    from wirecheck.core.scene import builtin_names, load_scene
+    from wirecheck.core.transforms import Motion
+
+    from .export import write_job
+
+    p = _Parser(prog="crosscheck export",
+                description="write a rendering job (scenes as OBJ, a camera JSON per case and frame, a README) "
+                            "for any renderer; judge its frames with crosscheck --candidate-frames DIR")
+    p.add_argument("dir", help="the job folder to write (new, empty, or an earlier export)")
+    p.add_argument("--scene", action="append", default=None, help="scene name or path; repeatable (default: all)")
+    p.add_argument("--frames", type=int, default=24, help="frames of the motion (default 24)")
+    p.add_argument("--every", type=int, default=1, metavar="K", help="only frames 1, 1+K, ... (default 1)")
+    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)}")
+    p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
+    args = p.parse_args(argv)
+    try:
+        if args.frames < 1 or args.every < 1:
+            raise InputError(f"--frames {args.frames} --every {args.every}: expected integers >= 1")
+        cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+        bad = [c for c in cases if c not in CASE_NAMES]
+        if bad or not cases:
+            raise InputError(f"--cases {args.cases!r}: unknown {', '.join(bad) or '(none)'}; "
+                             f"expected some of {', '.join(CASE_NAMES)}")
+        try:
+            spin = tuple(float(x) for x in args.spin.split(","))
+        except ValueError:
+            spin = ()
+        if len(spin) != 3 or not all(math.isfinite(x) for x in spin):
+            raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
+        scenes = [load_scene(n) for n in (args.scene or builtin_names())]
+        out = Path(args.dir)
+        if not out.parent.is_dir():
+            raise InputError(f"export {args.dir!r}: its parent folder does not exist")
+        job = write_job(out, scenes, frames=args.frames, every=args.every, case_names=cases,
+                        motion=Motion(turns=spin))
+    except InputError as exc:
+        return _fail(str(exc))
+    except OSError as exc:
+        return _fail(f"export {args.dir!r}: cannot write there ({exc})")
+    n = sum(len(c["frames"]) for c in job["cases"])
+    print(f"Job: {out} ({len(job['cases'])} cases, {n} frames to draw; see {out / 'README.md'})")
+    print(f"Then: crosscheck --candidate-frames {out}")
+    return 0
+
+
+#: crosscheck options that mean nothing for a renderer's frames (the job fixes scenes, cases and frames).
+_NOT_WITH_FRAMES = ("scene", "candidate", "level", "oracles", "dtype", "clip", "raster", "style",
+                    "cull", "sweep", "suite")
+
+
+def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
+    """``crosscheck --candidate-frames DIR`` after :func:`oracles.cli.build_parser` parsed it.
+
+    ``from_config``: the ``[tool.wirecheck]`` keys that set ``args`` (not the
+    command line): the project's settings for projector checks, which a job's
+    frames do not use, so they are not usage errors here.
+    """
+    from .frames_candidate import run_frames
+    from .report import console_table, write_report
+    from .runner import Tolerances
+
+    from .config import CLI_DESTS
+
+    skip = {CLI_DESTS[k] for k in from_config if k in CLI_DESTS}
+    given = [f"--{k.replace('_', '-')}" for k in _NOT_WITH_FRAMES if getattr(args, k, None) and k not in skip]
+    given += ["--hidden-lines"] if args.hidden_lines else []
+    given += ["--cases"] if args.cases != ",".join(CASE_NAMES) and "cases" not in skip else []
+    given += ["--spin"] if args.spin != "1,1,0" and "spin" not in skip else []
+    given += [f"--{k}" for k, default in (("frames", 24), ("every", 1), ("jobs", 1))
+              if getattr(args, k) != default and k not in skip]
+    if given:
+        return _fail(f"--candidate-frames with {', '.join(given)}: the job fixes scenes, cases and frames, and "
+                     "its frames are drawn already: expected only --tol/--min-f1 options, --run or --report-dir")
+    tol = Tolerances(min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
+    try:
+        report, images = run_frames(Path(args.candidate_frames), tol=tol)
+    except InputError as exc:
+        return _fail(str(exc))
+    try:
+        write_report(run_dir, report, images)
+        if args.junit_xml:
+            from .junit import write_junit
+
+            write_junit(Path(args.junit_xml), report)
+    except InputError as exc:
+        return _fail(str(exc))
+    except OSError as exc:
+        return _fail(f"writing {str(run_dir)!r} or the JUnit file failed: {exc}")
+    print(console_table(report["cases"]))
+    for r in report["cases"]:
+        if r["verdict"] != "pass":
+            print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+    s = report["summary"]
+    print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "
+          f"(F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}); against core: F1@0px >= "
+          f"{s['min_core_f1_0px']:.4f}, F1@1px >= {s['min_core_f1_1px']:.4f}")
+    print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
+    return 1 if s["failed"] else 0

@@ -1,0 +1,435 @@
+"""Name what is wrong with a renderer from its images alone.
+
+``diagnose_images(cand_images, oracle_segments, camera, flipped_segments=None) -> list[dict]``
+
+The same fault names as the vertex diagnosis (:mod:`oracles.diagnose`, whose
+module docstring defines them and the conventions of their fields), found
+without the candidate's vertices: the candidate's drawn pixels are
+*registered* to the oracle's lines.
+
+Inputs, per frame of one case: the candidate's image (``(H, W)`` bool, drawn
+pixels True) and the oracle's line segments in pixels (``(K, 2, 2)``:
+depth-clipped in world space, projected by OpenCV, not clipped to the image;
+:func:`oracle_segments`). The segments are the exact lines a correct renderer
+would draw, so distances to them are sub-pixel, not quantised by a second
+rasteriser.
+
+Method
+======
+1. **Family.** In coordinates centred on the principal point (``u = x - cx``,
+   ``v = y - cy``), the candidate's line pixels ``c`` are modelled as
+   ``c = d * (P @ o) + b`` for a point ``o`` on the oracle's lines: ``P`` one of
+   the 8 signed axis permutations (identity, the mirrors, the flip, the swap and
+   the swap with each mirror), ``d`` a positive scale per axis, ``b`` an offset.
+   This is exactly the family :mod:`oracles.diagnose` reads its faults from.
+2. **Registration.** For each ``P``, from two starts (``d = 1, b = 0``; and
+   per-axis mean and spread of the two pixel sets), iterate (ICP): pair every
+   candidate pixel with the nearest point of the oracle's segments (mapped back
+   through the current ``d, P, b``), and every oracle sample (points every
+   :data:`SAMPLE_STEP_PX` along the segments) mapped into the candidate image
+   with the nearest candidate pixel (``scipy.ndimage.distance_transform_edt``'s
+   indices); drop pairs farther than :data:`PAIR_CAP_PX`; refit ``d, b`` per axis
+   by least squares (linear in ``d_i, b_i`` for fixed ``P``). Both directions
+   are needed: pixels-to-lines alone is minimised by shrinking the candidate
+   onto a line, lines-to-pixels alone by a candidate that draws everywhere.
+   All frames of a case are pooled into one fit, so the sub-pixel offset is
+   averaged over every line pixel of the case.
+3. **Residual and confidence.** The cost is the mean of the two directions'
+   mean distances, each capped at :data:`PAIR_CAP_PX` (a point with no partner
+   within the cap counts as the cap). The best ``P`` is the one of least cost;
+   ``residual_px`` is its cost and ``confidence = 1 - best / second`` compares
+   it with the best *other* permutation (1: only one explanation fits; 0: two
+   fit equally well).
+4. **Depth flip.** A renderer that looks backward draws what a camera with its
+   forward negated sees: ``flipped_segments``. When the candidate registers to
+   those better than to the oracle's own, the answer is ``depth_flip`` alone
+   (as in the vertex diagnosis). A candidate that draws nothing where the
+   oracle draws lines, while the backward camera also sees nothing, is the
+   image of "clips everything the oracle shows": ``depth_flip`` too.
+5. **Faults.** With ``residual_px <= RESIDUAL_MAX_PX`` the faults are read off
+   ``P``, ``d`` and ``b`` as in :mod:`oracles.diagnose` (step 4 there), with the
+   pixel tolerances :data:`SCALE_TOL_PX` (a scale's largest effect on a drawn
+   pixel) and :data:`OFFSET_TOL_PX`; otherwise the answer is ``unexplained``
+   (a rotation, a shear, a 3D error: nothing of the family draws these pixels).
+
+Every fault carries ``confidence`` and ``residual_px``; ``pixel_offset`` is
+given to sub-pixel (``dx, dy``), ``fov_mismatch`` with ``implied_fov_deg`` (or
+``implied_ortho_height``), ``aspect_mismatch`` with ``implied_aspect``.
+
+Limits (measured in tests/test_image_diagnosis.py, stated in docs/frames.md):
+the images must show enough line to fit (:data:`MIN_PIXELS` drawn pixels in a
+case), the fault must move lines by more than the tolerances above, and a
+scale below ~0.5 or above ~2 may not be recovered from the unit start.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .diagnose import FAULT_ORDER
+
+__all__ = ["diagnose_images", "oracle_segments", "flipped_camera", "PERMUTATIONS"]
+
+#: Oracle lines are sampled this often (px) for the lines-to-pixels direction:
+#: half a pixel, so every pixel a line crosses gets a sample.
+SAMPLE_STEP_PX = 0.5
+#: Pairs farther apart than this (px) are outliers (another line, a clipped
+#: part), not a correspondence; it also bounds each point's cost. 8 px is well
+#: above every in-family error the start leaves after the moment match (< 3 px
+#: measured) and below the spacing of most distinct lines.
+PAIR_CAP_PX = 8.0
+#: A case needs this many drawn candidate pixels to be fitted (a 4-parameter
+#: fit per axis pair is determined far earlier; 50 keeps stray pixels out).
+MIN_PIXELS = 50
+#: Points per frame and direction used in the fit (evenly subsampled above):
+#: enough for a sub-pixel mean, few enough for a fast fit.
+MAX_POINTS_PER_FRAME = 600
+#: ICP iterations of the final fit (converges in < 15 on the tests' cameras).
+ITERATIONS = 30
+#: Each permutation and start is first fitted this long on :data:`SCREEN_POINTS_PER_FRAME`
+#: points; only the best two permutations are fitted to the end.
+SCREEN_ITERATIONS = 6
+SCREEN_POINTS_PER_FRAME = 250
+#: A correct 1-px aliased renderer sits ~0.3 px from the exact lines (pixel
+#: centres are within 0.5 px of a line across its minor axis); an anti-aliased
+#: or 2-px-wide one ~0.5 px. A fit worse than this is no member of the family.
+RESIDUAL_MAX_PX = 0.85
+#: A scale is a fault when it moves some drawn pixel by more than this (px):
+#: a correct renderer's pooled scale is within 5e-4 of 1 (<= 0.05 px at the
+#: tests' reach of ~130 px), a 0.8 FOV factor moves lines by tens of px.
+SCALE_TOL_PX = 0.5
+#: The free affine fit's off-diagonal terms (rotation, shear) are a fault when
+#: they move a pixel by more than this: <= 0.04 px on a correct renderer,
+#: 0.77-1.17 px for a 0.5 degree roll (measured on the tests' cameras).
+ROTATION_TOL_PX = 0.3
+#: An offset is a fault when it exceeds this (px): the pooled fit's offset on
+#: a correct renderer stays within ~0.05 px; a half-pixel convention is 0.5.
+OFFSET_TOL_PX = 0.2
+
+
+def _perm(swap: bool, sx: int, sy: int) -> np.ndarray:
+    base = np.array([[0, 1], [1, 0]]) if swap else np.eye(2, dtype=int)
+    return np.diag([sx, sy]) @ base
+
+
+#: The 8 signed axis permutations ``P`` (``c = d * (P @ o) + b``), with the names they mean.
+PERMUTATIONS = {
+    (): _perm(False, 1, 1),
+    ("mirror_horizontal",): _perm(False, -1, 1),
+    ("mirror_vertical",): _perm(False, 1, -1),
+    ("axis_flip",): _perm(False, -1, -1),
+    ("axis_swap",): _perm(True, 1, 1),
+    ("axis_swap", "mirror_horizontal"): _perm(True, -1, 1),
+    ("axis_swap", "mirror_vertical"): _perm(True, 1, -1),
+    ("axis_swap", "axis_flip"): _perm(True, -1, -1),
+}
+
+
+# ---------------------------------------------------------------- the oracle's lines
+
+def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera) -> np.ndarray:
+    """The lines a correct renderer draws: ``(K, 2, 2)`` pixel segment ends.
+
+    Edges clipped to depth [near, far] in world space (:func:`oracles.draw.clip_depth`)
+    and projected by OpenCV (:func:`oracles.opencv_oracle.project`); not clipped
+    to the image.
+    """
+    from . import opencv_oracle
+    from .draw import clip_depth
+
+    edges = np.asarray(edges, dtype=np.intp).reshape(-1, 2)
+    if len(edges) == 0:
+        return np.zeros((0, 2, 2))
+    p_world = np.asarray(p_world, dtype=np.float64)
+    _, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera)
+    if len(ends) == 0:
+        return np.zeros((0, 2, 2))
+    px = opencv_oracle.project(ends.reshape(-1, 3), camera).reshape(-1, 2, 2)
+    return px[np.isfinite(px).all(axis=(1, 2))]
+
+
+def flipped_camera(camera):
+    """The camera looking backward (forward negated, up kept): what a depth-flipped renderer draws."""
+    from wirecheck.core.camera import Camera
+
+    return Camera(position=camera.position, forward=-np.asarray(camera.forward), up=camera.up,
+                  fov_y_deg=camera.fov_y_deg, width=camera.width, height=camera.height, near=camera.near,
+                  far=camera.far, projection=camera.projection, ortho_height=camera.ortho_height)
+
+
+# ---------------------------------------------------------------- geometry helpers
+
+def _nearest_on_segments(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For points ``q (N, 2)``: the nearest point on segments ``a -> b (K, 2)`` and its distance."""
+    out = np.empty_like(q)
+    dist = np.empty(len(q))
+    ab = b - a
+    len2 = np.maximum((ab ** 2).sum(axis=1), 1e-300)
+    step = max(1, 2_000_000 // max(len(a), 1))
+    for k in range(0, len(q), step):
+        qq = q[k:k + step]
+        t = np.clip(((qq[:, None, :] - a[None]) * ab[None]).sum(axis=2) / len2[None], 0.0, 1.0)
+        foot = a[None] + t[..., None] * ab[None]
+        d2 = ((foot - qq[:, None, :]) ** 2).sum(axis=2)
+        j = np.argmin(d2, axis=1)
+        rows = np.arange(len(qq))
+        out[k:k + step] = foot[rows, j]
+        dist[k:k + step] = np.sqrt(d2[rows, j])
+    return out, dist
+
+
+def _samples(segs: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Points every SAMPLE_STEP_PX along the segments, kept within the image grown by half its size per side."""
+    from wirecheck.core.clipping import clip_to_image
+
+    if len(segs) == 0:
+        return np.zeros((0, 2))
+    shift = np.array([width / 2.0, height / 2.0])
+    _, q0, q1 = clip_to_image(segs[:, 0] + shift, segs[:, 1] + shift, 2 * width, 2 * height)
+    q0, q1 = q0 - shift, q1 - shift
+    n = np.maximum(1, np.ceil(np.hypot(*(q1 - q0).T) / SAMPLE_STEP_PX).astype(int))
+    pts = [q0[i] + (q1[i] - q0[i]) * np.linspace(0.0, 1.0, n[i] + 1)[:, None] for i in range(len(q0))]
+    return np.concatenate(pts) if pts else np.zeros((0, 2))
+
+
+def _thin(points: np.ndarray, limit: int) -> np.ndarray:
+    if len(points) <= limit:
+        return points
+    return points[np.linspace(0, len(points) - 1, limit).round().astype(int)]
+
+
+@dataclass
+class _Frame:
+    """One frame, centred on the principal point: the candidate's pixels and the oracle's lines."""
+
+    cand: np.ndarray        # (N, 2) candidate pixel centres (subsampled)
+    nearest: np.ndarray     # (2, H, W) index of the nearest candidate pixel (distance_transform_edt)
+    seg_a: np.ndarray       # (K, 2) oracle segment starts
+    seg_b: np.ndarray       # (K, 2) and ends
+    samples: np.ndarray     # (M, 2) points along the oracle's segments (subsampled)
+
+
+class _Registration:
+    """The pooled frames of one case and the ICP fit of ``c = A (P o) + b`` (``A`` diagonal or affine)."""
+
+    def __init__(self, frames: list[_Frame], width: int, height: int, centre: np.ndarray):
+        self.frames = frames
+        self.w, self.h = width, height
+        self.centre = centre
+
+    def pairs(self, p: np.ndarray, a: np.ndarray, b: np.ndarray):
+        """Correspondences ``(u, c, dist, n_fwd, n_rev)`` for the model ``c ~ a @ u + b``, ``u = P o``."""
+        us, cs, dists, n_fwd, n_rev = [], [], [], 0, 0
+        back = p.T @ np.linalg.inv(a)                      # c -> o (a signed permutation's inverse is P.T)
+        for f in self.frames:
+            if len(f.cand) and len(f.seg_a):               # candidate pixels -> nearest oracle line point
+                foot, _ = _nearest_on_segments((f.cand - b) @ back.T, f.seg_a, f.seg_b)
+                u = foot @ p.T
+                us.append(u); cs.append(f.cand)
+                dists.append(np.hypot(*(u @ a.T + b - f.cand).T))
+                n_fwd += len(f.cand)
+            if len(f.samples) and len(f.cand):             # oracle samples -> nearest candidate pixel
+                u = f.samples @ p.T
+                t = u @ a.T + b + self.centre
+                col, row = np.round(t[:, 0]).astype(np.int64), np.round(t[:, 1]).astype(np.int64)
+                inside = (col >= 0) & (col < self.w) & (row >= 0) & (row < self.h)
+                if inside.any():
+                    c = np.stack([f.nearest[1][row[inside], col[inside]],
+                                  f.nearest[0][row[inside], col[inside]]], axis=1) - self.centre
+                    us.append(u[inside]); cs.append(c)
+                    dists.append(np.hypot(*(t[inside] - self.centre - c).T))
+                    n_rev += int(inside.sum())
+        if not us:
+            return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), 0, 0
+        return np.concatenate(us), np.concatenate(cs), np.concatenate(dists), n_fwd, n_rev
+
+    def cost(self, p, a, b) -> float:
+        """Mean capped distance, the two directions weighted equally; the cap when a direction is empty."""
+        _u, _c, dist, n_fwd, n_rev = self.pairs(p, a, b)
+        capped = np.minimum(dist, PAIR_CAP_PX)
+        fwd = capped[:n_fwd].mean() if n_fwd else PAIR_CAP_PX
+        rev = capped[n_fwd:].mean() if n_rev else PAIR_CAP_PX
+        return float(0.5 * (fwd + rev))
+
+    def fit(self, p: np.ndarray, a: np.ndarray, b: np.ndarray, iterations: int = ITERATIONS,
+            affine: bool = False):
+        """ICP from ``(a, b)``: ``(a, b, cost)``; ``a`` stays diagonal unless ``affine``."""
+        a, b = np.array(a, dtype=float), np.array(b, dtype=float)
+        for _ in range(iterations):
+            u, c, dist, _, _ = self.pairs(p, a, b)
+            keep = dist < PAIR_CAP_PX
+            if keep.sum() < 6:
+                break
+            new_a, new_b = a.copy(), b.copy()
+            for i in range(2):
+                cols = [u[keep, 0], u[keep, 1]] if affine else [u[keep, i]]
+                x, *_ = np.linalg.lstsq(np.column_stack(cols + [np.ones(int(keep.sum()))]), c[keep, i],
+                                        rcond=None)
+                if affine:
+                    new_a[i], new_b[i] = x[:2], x[2]
+                elif x[0] > 0:
+                    new_a[i, i], new_b[i] = x[0], x[1]
+            if abs(np.linalg.det(new_a)) < 1e-6:
+                break
+            moved = np.max(np.abs(new_a - a)) * max(self.w, self.h) + np.max(np.abs(new_b - b))
+            a, b = new_a, new_b
+            if moved < 1e-3:
+                break
+        return a, b, self.cost(p, a, b)
+
+    def moment_start(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per-axis scale and offset matching the mean and spread of the two point sets."""
+        cand = np.concatenate([f.cand for f in self.frames])
+        orac = np.concatenate([f.samples for f in self.frames]) @ p.T
+        sc, so = cand.std(axis=0), orac.std(axis=0)
+        d = np.clip(np.where(so > 0, sc / np.where(so > 0, so, 1.0), 1.0), 0.25, 4.0)
+        return np.diag(d), cand.mean(axis=0) - d * orac.mean(axis=0)
+
+
+def _register(coarse: _Registration, fine: _Registration):
+    """Every permutation screened on ``coarse``; the best two refined on ``fine``: ``[(cost, names, P, a, b)]``."""
+    screened = []
+    for names, p in PERMUTATIONS.items():
+        for a0, b0 in ((np.eye(2), np.zeros(2)), coarse.moment_start(p)):
+            a, b, cost = coarse.fit(p, a0, b0, iterations=SCREEN_ITERATIONS)
+            screened.append((cost, names, p, a, b))
+    best = {}
+    for cost, names, p, a, b in sorted(screened, key=lambda r: r[0]):
+        best.setdefault(names, (cost, names, p, a, b))
+    top = list(best.values())[:2]
+    out = []
+    for _cost, names, p, a, b in top:
+        a, b, cost = fine.fit(p, a, b)
+        out.append((cost, names, p, a, b))
+    return sorted(out, key=lambda r: r[0])
+
+
+def _frames(cand_images, segments, camera, limit: int = MAX_POINTS_PER_FRAME) -> list[_Frame]:
+    from scipy.ndimage import distance_transform_edt
+
+    cx, cy = camera.principal_point
+    centre = np.array([cx, cy])
+    out = []
+    for img, segs in zip(cand_images, segments):
+        img = np.asarray(img, bool)
+        if img.shape != (camera.height, camera.width):
+            raise ValueError(f"image shape {img.shape}: expected ({camera.height}, {camera.width})")
+        segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+        rr, cc = np.nonzero(img)
+        cand = _thin(np.stack([cc, rr], axis=1).astype(np.float64) - centre, limit)
+        nearest = (distance_transform_edt(~img, return_distances=False, return_indices=True)
+                   if len(cand) else None)
+        samples = _thin(_samples(segs, camera.width, camera.height), limit) - centre
+        out.append(_Frame(cand=cand, nearest=nearest, seg_a=segs[:, 0] - centre, seg_b=segs[:, 1] - centre,
+                          samples=samples))
+    return out
+
+
+def _in_image(segments, camera) -> int:
+    """Oracle samples inside the image, over all frames (is there anything to draw?)."""
+    n = 0
+    for segs in segments:
+        s = _samples(np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2), camera.width, camera.height)
+        n += int(((s[:, 0] >= -0.5) & (s[:, 0] <= camera.width - 0.5)
+                  & (s[:, 1] >= -0.5) & (s[:, 1] <= camera.height - 0.5)).sum())
+    return n
+
+
+def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list[dict]:
+    """Name the faults of a renderer from its frames; ``[]`` when its lines are the oracle's.
+
+    Parameters
+    ----------
+    cand_images : sequence of (H, W) bool ndarray
+        The candidate's frames of one case (drawn pixels True).
+    oracle_segs : sequence of (K, 2, 2) ndarray
+        The oracle's line segments of the same frames (:func:`oracle_segments`).
+    camera : core.camera.Camera
+        The case's camera (principal point, FOV or ortho height, size).
+    flipped_segs : sequence of (K, 2, 2) ndarray, optional
+        The lines seen by :func:`flipped_camera`; without them ``depth_flip``
+        is not considered.
+
+    Returns
+    -------
+    list of dict, primary fault first (:data:`oracles.diagnose.FAULT_ORDER`);
+    every fault has ``confidence`` and ``residual_px``.
+    """
+    cand_images = list(cand_images)
+    oracle_segs = list(oracle_segs)
+    if len(cand_images) != len(oracle_segs):
+        raise ValueError(f"{len(cand_images)} images but {len(oracle_segs)} frames of oracle lines")
+    cx, cy = camera.principal_point
+    centre = np.array([cx, cy])
+    drawn = sum(int(np.count_nonzero(i)) for i in cand_images)
+    oracle_drawn = _in_image(oracle_segs, camera)
+    flipped_drawn = _in_image(flipped_segs, camera) if flipped_segs is not None else None
+    if drawn == 0 and oracle_drawn == 0:
+        return []
+    if drawn == 0:
+        if flipped_drawn == 0:
+            return [{"name": "depth_flip", "confidence": 0.5, "residual_px": 0.0, "candidate_pixels": 0,
+                     "note": "the candidate drew nothing where the oracle draws lines; a camera looking "
+                             "backward sees nothing here either"}]
+        return [{"name": "unexplained", "confidence": 1.0, "residual_px": PAIR_CAP_PX, "candidate_pixels": 0,
+                 "note": "the candidate drew nothing where the oracle draws lines"}]
+    if drawn < MIN_PIXELS:
+        return [{"name": "unexplained", "confidence": 0.0, "residual_px": None, "candidate_pixels": drawn,
+                 "underdetermined": True,
+                 "note": f"only {drawn} drawn pixels: expected at least {MIN_PIXELS} to register"}]
+
+    frames = _frames(cand_images, oracle_segs, camera)
+    fine = _Registration(frames, camera.width, camera.height, centre)
+    coarse = _Registration(_frames(cand_images, oracle_segs, camera, SCREEN_POINTS_PER_FRAME),
+                           camera.width, camera.height, centre)
+    ranked = _register(coarse, fine)
+    cost, names, p, a, b = ranked[0]
+    second = ranked[1][0] if len(ranked) > 1 else PAIR_CAP_PX
+    confidence = float(max(0.0, 1.0 - cost / second)) if second > 0 else 0.0
+
+    if flipped_segs is not None and flipped_drawn:
+        back = _Registration(_frames(cand_images, flipped_segs, camera), camera.width, camera.height, centre)
+        b_cost = back.cost(np.eye(2), np.eye(2), np.zeros(2))
+        if b_cost < cost and b_cost <= RESIDUAL_MAX_PX:
+            return [{"name": "depth_flip", "confidence": float(max(0.0, 1.0 - b_cost / cost)),
+                     "residual_px": b_cost, "residual_unflipped_px": cost}]
+
+    # the named model against a free affine map: a rotation or shear the family cannot draw
+    reach = np.max(np.abs(np.concatenate([f.samples for f in frames]) @ p.T), axis=0)
+    reach = np.minimum(reach, [camera.width / 2.0, camera.height / 2.0])   # the part an image can show
+    a_free, b_free, cost_free = fine.fit(p, a, b, affine=True)
+    off_diagonal = max(abs(a_free[0, 1]) * reach[1], abs(a_free[1, 0]) * reach[0])
+    common = {"confidence": confidence, "residual_px": cost}
+    if cost > RESIDUAL_MAX_PX or off_diagonal > ROTATION_TOL_PX:
+        return [{"name": "unexplained", **common, "best_family": list(names) or ["none"],
+                 "scale": np.diag(a).tolist(), "offset": b.tolist(), "affine": a_free.tolist(),
+                 "affine_residual_px": cost_free, "off_diagonal_px": float(off_diagonal),
+                 "rotation_deg": math.degrees(math.atan2(a_free[1, 0] - a_free[0, 1],
+                                                         a_free[0, 0] + a_free[1, 1]))}]
+    d = np.diag(a)
+    faults = [{"name": n, **common} for n in names]
+    sx, sy = float(d[0]), float(d[1])
+    if abs(sx - sy) * reach[0] > SCALE_TOL_PX:
+        faults.append({"name": "aspect_mismatch", **common,
+                       "implied_aspect": (camera.width / camera.height) * sy / sx, "scale_x": sx, "scale_y": sy})
+    if abs(sy - 1.0) * reach[1] > SCALE_TOL_PX:
+        fault = {"name": "fov_mismatch", **common, "scale": sy, "implied_fov_deg": None,
+                 "implied_ortho_height": None}
+        if camera.projection == "perspective":
+            half = math.tan(math.radians(camera.fov_y_deg) / 2.0)
+            fault["implied_fov_deg"] = math.degrees(2.0 * math.atan(half / sy))
+        else:
+            fault["implied_ortho_height"] = camera.ortho_height / sy
+        faults.append(fault)
+    expected = np.zeros(2)
+    if "axis_swap" in names:
+        shift = cx - cy                               # as oracles.diagnose: a raw swap shifts by +-(cx - cy)
+        allowed = np.array([-shift, 0.0, shift])
+        expected = np.array([allowed[np.argmin(np.abs(allowed - b[i]))] for i in range(2)])
+    off = b - expected
+    if np.max(np.abs(off)) > OFFSET_TOL_PX:
+        faults.append({"name": "pixel_offset", **common, "dx": float(off[0]), "dy": float(off[1])})
+    return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
