@@ -1,0 +1,198 @@
+"""oracles.image_diagnose: faults named from images alone.
+
+Each fault is injected into a copy of core's projector (the faulty projectors
+of tests/test_diagnosis.py, the same ones the vertex diagnosis is proved on),
+drawn to images by core's rasteriser (oracles.draw.draw_candidate: depth clip,
+the faulty projection of the clipped ends, core.raster.line_pixels), and
+diagnosed from those images and the oracle's lines only: the faulty pixel
+coordinates never reach the diagnosis. A depth-flipped renderer is drawn with
+the camera looking backward (its own clipping then keeps what lies behind).
+The confusion matrix of primary faults is printed in the terminal summary and
+must be diagonal; anti-aliased and 2-px-wide drawings of a correct projector
+must come back with no fault.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from test_diagnosis import CAMERAS, FAULTS, FOV_FACTOR, SINGLE, format_confusion, implied_fov
+
+from wirecheck.core.clipping import clip_to_image
+from wirecheck.core.projection import project_points
+from wirecheck.core.raster import line_coverage_aa, line_pixels
+from wirecheck.core.scene import load_scene
+from wirecheck.core.transforms import Motion, apply
+from wirecheck.oracles.diagnose import FAULT_ORDER, primary
+from wirecheck.oracles.draw import clip_depth, draw_candidate
+from wirecheck.oracles.image_diagnose import (OFFSET_TOL_PX, diagnose_images, flipped_camera,
+                                              oracle_segments)
+
+SCENES = ("cube", "pyramid", "prism")
+FRAMES = (2, 7)                       # of 12: two poses per scene, six images per case
+MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
+# Every single fault on every camera ("transposed" is invisible on "axis", as in
+# test_diagnosis); the combinations on two cameras; the camera inside the scene
+# (scaled x2 around it) for a depth flip that shows the other side.
+CASES = [(f, c) for f in SINGLE for c in MAIN_CAMERAS if not (f == "transposed" and c == "axis")]
+CASES += [(f, c) for f in ("swap_mirror", "fov_aspect", "fov_offset") for c in ("oblique", "tall")]
+CASES += [(f, "inside") for f in ("none", "depth_flip", "roll")]
+
+
+def _scene_frames(camera_name):
+    motion = Motion(turns=(1.0, 2.0, 1.0), scale=2.0) if camera_name == "inside" else Motion()
+    for name in SCENES:
+        sc = load_scene(name)
+        for k in FRAMES:
+            yield apply(motion.frame_matrix(k, 12), sc.vertices), np.asarray(sc.edges)
+
+
+def _segments_px(fn, p_world, edges, cam):
+    """The faulty renderer's 2D segments (depth clip, its projection, image clip): ``(K, 2, 2)``."""
+    _, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], cam)
+    px = fn(ends.reshape(-1, 3), cam).reshape(-1, 2, 2)
+    _, q0, q1 = clip_to_image(px[:, 0], px[:, 1], cam.width, cam.height)
+    return q0, q1
+
+
+def draw_aa(fn, p_world, edges, cam):
+    """core's anti-aliased raster (Wu): every pixel with any coverage counts as drawn."""
+    q0, q1 = _segments_px(fn, p_world, edges, cam)
+    img = np.zeros((cam.height, cam.width), bool)
+    rr, cc, w = line_coverage_aa(q0, q1, cam.width, cam.height)
+    img[rr[w > 0], cc[w > 0]] = True
+    return img
+
+
+def draw_wide(fn, p_world, edges, cam, width_px=2.0):
+    """A GL-style wide line: pixels whose centre lies within width/2 of the segment (naive distance)."""
+    q0, q1 = _segments_px(fn, p_world, edges, cam)
+    img = np.zeros((cam.height, cam.width), bool)
+    yy, xx = np.mgrid[0:cam.height, 0:cam.width]
+    pts = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
+    for a, b in zip(q0, q1):
+        lo = np.floor(np.minimum(a, b) - width_px).astype(int)
+        hi = np.ceil(np.maximum(a, b) + width_px).astype(int)
+        box = (pts[:, 0] >= lo[0]) & (pts[:, 0] <= hi[0]) & (pts[:, 1] >= lo[1]) & (pts[:, 1] <= hi[1])
+        p = pts[box]
+        ab = b - a
+        t = np.clip(((p - a) @ ab) / max(ab @ ab, 1e-300), 0.0, 1.0)
+        near = np.hypot(*(a + t[:, None] * ab - p).T) <= width_px / 2.0
+        img.ravel()[np.flatnonzero(box)[near]] = True
+    return img
+
+
+def diagnose_fault(fault, camera_name, draw=draw_candidate):
+    cam = CAMERAS[camera_name]
+    fn, _ = FAULTS[fault]
+    images, segs, flipped = [], [], []
+    for p_world, edges in _scene_frames(camera_name):
+        if fault == "depth_flip":           # the renderer's camera looks backward, clipping included
+            images.append(draw(project_points, p_world, edges, flipped_camera(cam)))
+        else:
+            images.append(draw(fn, p_world, edges, cam))
+        segs.append(oracle_segments(p_world, edges, cam))
+        flipped.append(oracle_segments(p_world, edges, flipped_camera(cam)))
+    return diagnose_images(images, segs, cam, flipped)
+
+
+@pytest.fixture(scope="module")
+def results():
+    return {(f, c): diagnose_fault(f, c) for f, c in CASES}
+
+
+@pytest.mark.parametrize("fault,camera_name", CASES)
+def test_expected_names(results, fault, camera_name):
+    got = results[(fault, camera_name)]
+    assert {f["name"] for f in got} == FAULTS[fault][1], got
+
+
+def test_every_fault_has_confidence_and_residual(results):
+    for key, got in results.items():
+        for f in got:
+            assert 0.0 <= f["confidence"] <= 1.0, (key, f)
+            assert f["residual_px"] is not None and f["residual_px"] >= 0.0, (key, f)
+
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_implied_fov(results, camera_name):
+    # the injected FOV is 0.8 x the camera's (test_diagnosis.implied_fov); from pixels the
+    # scale is fitted to ~5e-4 (pooled ICP), so the implied FOV to 0.1 degree (0.01 of the height)
+    (f,) = results[("fov", camera_name)]
+    cam = CAMERAS[camera_name]
+    if cam.projection == "perspective":
+        assert f["implied_fov_deg"] == pytest.approx(implied_fov(cam), abs=0.1)
+    else:
+        assert f["implied_ortho_height"] == pytest.approx(cam.ortho_height * FOV_FACTOR, rel=2e-3)
+
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_implied_aspect(results, camera_name):
+    # f_aspect takes fx from the width: aspect 1 (test_diagnosis: implied aspect = 1)
+    (f,) = results[("aspect", camera_name)]
+    assert f["implied_aspect"] == pytest.approx(1.0, abs=5e-3)
+
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_half_pixel_offset_to_sub_pixel(results, camera_name):
+    # f_offset centres on (W/2, H/2): +0.5 px on both axes. Measured from pixels:
+    # dy within 0.02 px, dx within 0.12 px (x is the axis of the scenes' near-horizontal
+    # edges, whose pixels barely constrain a horizontal shift); both far from 0 and 1.
+    (f,) = results[("offset", camera_name)]
+    assert f["dx"] == pytest.approx(0.5, abs=0.15)
+    assert f["dy"] == pytest.approx(0.5, abs=0.15)
+
+
+def confusion(results):
+    labels = ["none"] + list(FAULT_ORDER)
+    counts = Counter()
+    for (fault, _cam), got in results.items():
+        if fault not in SINGLE:
+            continue
+        want = FAULTS[fault][1]
+        counts[("none" if not want else min(want, key=FAULT_ORDER.index), primary(got))] += 1
+    rows = [r for r in labels if any(counts[(r, c)] for c in labels)]
+    return labels, rows, counts
+
+
+def test_confusion_matrix_is_diagonal(results, summary_section):
+    labels, rows, counts = confusion(results)
+    text = format_confusion(labels, rows, counts).replace("confusion matrix (oracle", "images only (oracle lines")
+    summary_section("image diagnosis confusion matrix", text)
+    off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
+    assert not off, off
+    assert set(rows) == set(labels)                      # every fault name was injected
+
+
+# ---- drawings other than 1-px aliased lines: no false faults -----------------
+
+@pytest.mark.parametrize("draw", [draw_aa, draw_wide], ids=["antialiased", "2px"])
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_thick_correct_lines_are_no_fault(draw, camera_name, summary_section):
+    got = diagnose_fault("none", camera_name, draw=draw)
+    assert got == [], got
+
+
+@pytest.mark.parametrize("draw", [draw_aa, draw_wide], ids=["antialiased", "2px"])
+def test_thick_lines_keep_their_faults(draw):
+    # the faults are still named through thick lines, the half-pixel offset to 0.15 px
+    assert primary(diagnose_fault("mirror_x", "oblique", draw=draw)) == "mirror_horizontal"
+    (f,) = diagnose_fault("offset", "oblique", draw=draw)
+    assert f["name"] == "pixel_offset"
+    assert f["dy"] == pytest.approx(0.5, abs=0.15)
+    assert OFFSET_TOL_PX < 0.5 - 0.15                    # so the offset could not hide under the tolerance
+
+
+def test_blank_candidate_is_a_depth_flip_only_when_the_backward_view_is_empty():
+    cam = CAMERAS["axis"]
+    (p_world, edges), = list(_scene_frames("axis"))[:1]
+    blank = [np.zeros((cam.height, cam.width), bool)]
+    segs = [oracle_segments(p_world, edges, cam)]
+    assert primary(diagnose_images(blank, segs, cam, [np.zeros((0, 2, 2))])) == "depth_flip"
+    # the backward camera would see lines: drawing nothing is not a depth flip
+    assert primary(diagnose_images(blank, segs, cam, segs)) == "unexplained"
+    # nothing to draw, nothing drawn: agreement
+    assert diagnose_images(blank, [np.zeros((0, 2, 2))], cam) == []
