@@ -1,0 +1,226 @@
+"""Image candidates: ``crosscheck export DIR`` and ``crosscheck --candidate-frames DIR``.
+
+The job's camera JSON is checked against hand-written projections (the
+pinhole formula with K, R, t; the GL pipeline with the view and projection
+matrices) reproducing OpenCV's pixels; the judge is checked with frames whose
+verdict is known (core's own frames, a mirrored copy); and every way a frames
+folder could be judged on nothing (empty, absent, another job's, missing,
+wrong size, unreadable, extra) is an exit 2 with one line per problem and no
+report written.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.scene import load_scene
+from wirecheck.oracles import opencv_oracle
+from wirecheck.oracles.cli import main
+from wirecheck.oracles.export import build_job
+from wirecheck.oracles.frames_candidate import frame_inputs, load_job, read_obj
+
+ARGS = ["--scene", "cube", "--cases", "on_axis,non_square,orthographic", "--frames", "6", "--every", "3"]
+
+
+def _export(path: Path, args=ARGS) -> Path:
+    assert main(["export", str(path)] + args) == 0
+    return path
+
+
+@pytest.fixture(scope="module")
+def job_dir(tmp_path_factory) -> Path:
+    return _export(tmp_path_factory.mktemp("job") / "job")
+
+
+def _fill(job_dir: Path, transform=lambda img: img) -> None:
+    """Draw every listed frame with core from the job's own files (a renderer that is correct)."""
+    job = load_job(job_dir)
+    for c in job["cases"]:
+        for rel in c["frames"]:
+            k = int(Path(rel).stem.split("_")[-1])
+            p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
+            (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
+            Image.fromarray(transform(render_frame(p, e, cam, m).image)).save(job_dir / rel)
+
+
+@pytest.fixture
+def filled(job_dir, tmp_path) -> Path:
+    d = tmp_path / "filled"
+    shutil.copytree(job_dir, d)
+    _fill(d)
+    return d
+
+
+# ---- the job ----------------------------------------------------------------
+
+def test_job_lists_every_case_and_frame(job_dir):
+    job = json.loads((job_dir / "job.json").read_text())
+    assert [(c["scene"], c["case"]) for c in job["cases"]] == [("cube", "on_axis"), ("cube", "non_square"),
+                                                              ("cube", "orthographic")]
+    assert job["frame_numbers"] == [1, 4]
+    assert job["cases"][1]["frames"] == ["frames/cube/non_square/frame_0001.png",
+                                         "frames/cube/non_square/frame_0004.png"]
+    assert (job["cases"][1]["width"], job["cases"][1]["height"]) == (320, 480)
+    readme = (job_dir / "README.md").read_text()
+    assert "frames/<scene>/<case>/frame_NNNN.png" in readme and "antialias: false" in readme
+    assert (job_dir / "frames").is_dir() and not any((job_dir / "frames").iterdir())
+
+
+def test_obj_is_the_scene(job_dir):
+    v, e = read_obj(job_dir / "scenes" / "cube.obj")
+    scene = load_scene("cube")
+    assert np.array_equal(v, scene.vertices)          # repr() floats: exact round trip
+    assert np.array_equal(e, np.asarray(scene.edges))
+
+
+@pytest.mark.parametrize("case", ["on_axis", "non_square", "orthographic"])
+def test_camera_json_reproduces_opencv_pixels(job_dir, case):
+    # Hand-written projections from the JSON alone, against OpenCV's pixels of the same
+    # world points: float64 round-off on values ~1e3 px, so 1e-9 px is far above noise.
+    cam_json = json.loads((job_dir / "cameras" / "cube" / case / "frame_0004.json").read_text())
+    v, _ = read_obj(job_dir / "scenes" / "cube.obj")
+    m = np.array(cam_json["model_matrix"])
+    p_world = v @ m[:3, :3].T + m[:3, 3]
+    _p, _e, cam, _m = frame_inputs(job_dir, load_job(job_dir), "cube", case, 4)
+    want = opencv_oracle.project(p_world, cam)
+    k, r, t = np.array(cam_json["K"]), np.array(cam_json["R"]), np.array(cam_json["t_cv"])
+    p_cv = p_world @ r.T + t
+    if cam_json["camera"]["projection"] == "perspective":
+        uvw = p_cv @ k.T
+        pinhole = uvw[:, :2] / uvw[:, 2:]
+    else:                                               # K is affine: [u, v] = K[:2, :2] p_cv[:2] + K[:2, 2]
+        pinhole = p_cv[:, :2] @ k[:2, :2].T + k[:2, 2]
+    np.testing.assert_allclose(pinhole, want, atol=1e-9)
+    w, h = cam_json["camera"]["width"], cam_json["camera"]["height"]
+    clip = np.c_[p_world, np.ones(len(p_world))] @ (np.array(cam_json["gl_projection"])
+                                                   @ np.array(cam_json["gl_view"])).T
+    ndc = clip[:, :3] / clip[:, 3:]
+    gl_px = np.c_[(ndc[:, 0] + 1) * w / 2 - 0.5, h - (ndc[:, 1] + 1) * h / 2 - 0.5]
+    np.testing.assert_allclose(gl_px, want, atol=1e-9)
+    assert np.all(np.abs(ndc[:, 2]) <= 1)              # inside near/far: the cube is within the frustum
+
+
+def test_export_is_deterministic(tmp_path):
+    _job1, files1 = build_job([load_scene("cube")], frames=6, every=3)
+    _job2, files2 = build_job([load_scene("cube")], frames=6, every=3)
+    assert files1 == files2
+
+
+def test_export_refuses_a_foreign_folder(tmp_path, capsys):
+    d = tmp_path / "mine"
+    d.mkdir()
+    (d / "keep.txt").write_text("x")
+    assert main(["export", str(d)] + ARGS) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "not written by wirecheck" in err
+    assert (d / "keep.txt").read_text() == "x" and sorted(p.name for p in d.iterdir()) == ["keep.txt"]
+
+
+# ---- judging frames -----------------------------------------------------------
+
+def test_core_frames_pass(filled, tmp_path, capsys):
+    rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")])
+    out = capsys.readouterr().out
+    assert rc == 0, out
+    report = json.loads((tmp_path / "rep" / "report.json").read_text())
+    assert report["level"] == "frames" and report["summary"]["cases"] == 3
+    for c in report["cases"]:
+        # core judged against core: the same pixels
+        assert c["core"]["f1_0px"] == 1.0 and c["core"]["f1_1px"] == 1.0
+        assert c["pixel_f1_1px"] >= 0.999 and c["faults"] == []
+        assert c["frames_checked"] == 2
+    assert (tmp_path / "rep" / "report.html").is_file()
+
+
+def test_mirrored_frames_fail_and_are_named(filled, tmp_path, capsys):
+    _fill(filled, transform=lambda img: img[:, ::-1])
+    rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")])
+    out = capsys.readouterr().out
+    assert rc == 1
+    report = json.loads((tmp_path / "rep" / "report.json").read_text())
+    # non_square looks at the cube obliquely: the mirror shows. (on_axis at frames 1 and 4,
+    # t = 0 and 0.5 of turns (1, 1, 0), shows the cube square-on: a mirror changes nothing.)
+    by = {c["camera"]: c for c in report["cases"]}
+    assert by["non_square"]["verdict"] == "fail"
+    assert [f["name"] for f in by["non_square"]["faults"]] == ["mirror_horizontal"], out
+    assert by["on_axis"]["verdict"] == "pass" and by["on_axis"]["faults"] == []
+    assert (tmp_path / "rep" / "img").is_dir()
+
+
+def _judge(job: Path, tmp_path, capsys):
+    rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert not (tmp_path / "rep").exists()                # nothing written on an input error
+    return rc, err.strip().splitlines()
+
+
+def test_missing_frames_one_line_each(filled, tmp_path, capsys):
+    (filled / "frames/cube/on_axis/frame_0004.png").unlink()
+    (filled / "frames/cube/orthographic/frame_0001.png").unlink()
+    rc, lines = _judge(filled, tmp_path, capsys)
+    assert rc == 2 and len(lines) == 2
+    assert lines[0].endswith("frames/cube/on_axis/frame_0004.png: missing (frame 4 of cube / on_axis)")
+    assert "orthographic/frame_0001.png: missing" in lines[1]
+
+
+def test_wrong_size_and_unreadable(filled, tmp_path, capsys):
+    Image.fromarray(np.zeros((480, 640), np.uint8)).save(filled / "frames/cube/non_square/frame_0001.png")
+    (filled / "frames/cube/on_axis/frame_0001.png").write_bytes(b"not a png")
+    rc, lines = _judge(filled, tmp_path, capsys)
+    assert rc == 2 and len(lines) == 2
+    assert "on_axis/frame_0001.png: unreadable as PNG" in lines[0]
+    assert lines[1].endswith("non_square/frame_0001.png: size 640x480: expected 320x480 (the camera's)")
+
+
+def test_extra_frame_is_refused(filled, tmp_path, capsys):
+    shutil.copy(filled / "frames/cube/on_axis/frame_0001.png", filled / "frames/cube/on_axis/frame_0002.png")
+    rc, lines = _judge(filled, tmp_path, capsys)
+    assert rc == 2 and len(lines) == 1 and "frame_0002.png: not a frame of this job" in lines[0]
+
+
+def test_empty_or_absent_frames_folder(job_dir, tmp_path, capsys):
+    d = tmp_path / "empty"
+    shutil.copytree(job_dir, d)
+    rc, lines = _judge(d, tmp_path, capsys)
+    assert rc == 2 and len(lines) == 1 and "frames: empty" in lines[0]
+    shutil.rmtree(d / "frames")
+    rc, lines = _judge(d, tmp_path, capsys)
+    assert rc == 2 and len(lines) == 1 and "frames: missing" in lines[0]
+
+
+def test_frames_of_another_job(filled, tmp_path, capsys):
+    other = _export(tmp_path / "other", ["--scene", "pyramid", "--cases", "on_axis", "--frames", "6", "--every", "3"])
+    shutil.rmtree(other / "frames")
+    shutil.copytree(filled / "frames", other / "frames")
+    rc, lines = _judge(other, tmp_path, capsys)
+    assert rc == 2 and len(lines) == 1 and "none of its 6 files is a frame of this job" in lines[0]
+
+
+def test_not_a_job(tmp_path, capsys):
+    rc, lines = _judge(tmp_path / "nowhere", tmp_path, capsys)
+    assert rc == 2 and "not a directory" in lines[0]
+    d = tmp_path / "d"
+    d.mkdir()
+    rc, lines = _judge(d, tmp_path, capsys)
+    assert rc == 2 and "job.json: missing" in lines[0]
+    (d / "job.json").write_text(json.dumps({"kind": "wirecheck frames job", "version": 99}))
+    rc, lines = _judge(d, tmp_path, capsys)
+    assert rc == 2 and "job version 99: expected 1" in lines[0]
+    (d / "job.json").write_text(json.dumps({"kind": "wirecheck frames job", "version": 1, "cases": []}))
+    rc, lines = _judge(d, tmp_path, capsys)
+    assert rc == 2 and "lists no frames" in lines[0]
+
+
+def test_options_the_job_fixes_are_usage_errors(filled, tmp_path, capsys):
+    for extra in (["--scene", "cube"], ["--frames", "3"], ["--candidate", "wirecheck.core.projection:project_points"], ["--cases", "on_axis"]):
+        rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")] + extra)
+        err = capsys.readouterr().err
+        assert rc == 2 and "the job fixes scenes, cases and frames" in err, (extra, err)
