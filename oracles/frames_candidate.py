@@ -188,10 +188,9 @@ def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, 
     if rec["pixel_f1_0px"] < tol.min_f1_0px:
         reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
     if reasons and not rec["faults"]:
-        # as the vertex diagnosis: a disagreement is never "no fault"
-        rec["faults"] = [{"name": "unexplained", "confidence": None, "residual_px": None,
-                          "note": "no mirror, swap, scale or offset explains it: lines missing or extra, "
-                                  "or another rasterisation rule"}]
+        # as the vertex diagnosis: a disagreement is never "no fault". Here no mirror, swap,
+        # scale or offset explains the pixels: lines missing or extra, or another raster rule.
+        rec["faults"] = [{"name": "unexplained"}]
     if not any(x["candidate_pixels"] or x["oracle_pixels"] for x in pr_scores):
         rec["note"] = "neither side drew a pixel in any frame of this case"
     rec.update(verdict="fail" if reasons else "pass", reasons=reasons, per_frame=per_frame)
