@@ -224,3 +224,24 @@ def test_options_the_job_fixes_are_usage_errors(filled, tmp_path, capsys):
         rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")] + extra)
         err = capsys.readouterr().err
         assert rc == 2 and "the job fixes scenes, cases and frames" in err, (extra, err)
+
+
+def test_several_moving_objects_are_exported_in_world_space(tmp_path, capsys):
+    # the orrery's objects move on their own: one world-space OBJ per frame, identity model
+    # matrix, the vertices being the oracle's own world points (oracles.faces, scipy)
+    from wirecheck.core.transforms import Motion
+    from wirecheck.oracles.faces import frame_geometry
+
+    path = str(Path(__file__).parents[1] / "scenes" / "examples" / "orrery.scene")
+    job = _export(tmp_path / "job", ["--scene", path, "--cases", "oblique_roll", "--frames", "6", "--every", "3"])
+    scene = load_scene(path)
+    for k in (1, 4):
+        v, _e = read_obj(job / "scenes" / scene.name / f"frame_{k:04d}.obj")
+        p_world = frame_geometry(scene, Motion(), (k - 1) / 6)[0]
+        assert np.array_equal(v, p_world)
+        cam_json = json.loads((job / "cameras" / scene.name / "oblique_roll" / f"frame_{k:04d}.json").read_text())
+        assert np.array_equal(np.array(cam_json["model_matrix"]), np.eye(4))
+    _fill(job)
+    assert main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")]) == 0, capsys.readouterr()
+    (case,) = json.loads((tmp_path / "rep" / "report.json").read_text())["cases"]
+    assert case["core"]["f1_0px"] == 1.0 and case["faults"] == []
