@@ -245,3 +245,18 @@ def test_several_moving_objects_are_exported_in_world_space(tmp_path, capsys):
     assert main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")]) == 0, capsys.readouterr()
     (case,) = json.loads((tmp_path / "rep" / "report.json").read_text())["cases"]
     assert case["core"]["f1_0px"] == 1.0 and case["faults"] == []
+
+
+def test_project_settings_do_not_apply_to_frames_and_junit_is_written(filled, tmp_path, capsys):
+    # [tool.wirecheck] configures projector checks (scenes, cases, frames): a job's frames do not
+    # use them, so they are not usage errors here; --junit-xml gets one test case per case
+    cfg = tmp_path / "pyproject.toml"
+    cfg.write_text('[tool.wirecheck]\nscenes = ["pyramid"]\ncases = ["on_axis"]\nframes = 3\n')
+    junit = tmp_path / "frames.xml"
+    rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep"), "--config", str(cfg),
+               "--junit-xml", str(junit)])
+    assert rc == 0, capsys.readouterr().err
+    import xml.etree.ElementTree as ET
+
+    cases = ET.parse(junit).getroot().iter("testcase")
+    assert len(list(cases)) == 3
