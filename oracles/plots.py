@@ -68,8 +68,8 @@ def vertex_error_png(report: dict) -> bytes | None:
     from matplotlib.ticker import MaxNLocator
 
     cases = [c for c in report["cases"] if c.get("per_frame")]
-    if not cases:
-        return None
+    if not any(f.get("max_vertex_error_px") is not None for c in cases for f in c["per_frame"]):
+        return None                 # no vertex compared (a renderer's frames): no figure of nothing
     fig = _figure(1)
     ax = fig.add_subplot(1, 1, 1)
     for case, (colour, dash) in zip(cases, _styles(len(cases))):

@@ -136,7 +136,8 @@ def test_core_frames_pass(filled, tmp_path, capsys):
         assert c["core"]["f1_0px"] == 1.0 and c["core"]["f1_1px"] == 1.0
         assert c["pixel_f1_1px"] >= 0.999 and c["faults"] == []
         assert c["frames_checked"] == 2
-    assert (tmp_path / "rep" / "report.html").is_file()
+    assert (tmp_path / "rep" / "report.html").is_file() and (tmp_path / "rep" / "pixels.png").is_file()
+    assert not (tmp_path / "rep" / "vertex_error.png").exists()     # no vertex was compared
 
 
 def test_mirrored_frames_fail_and_are_named(filled, tmp_path, capsys):
