@@ -151,6 +151,7 @@ def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, 
     from .image_diagnose import diagnose_images, flipped_camera, oracle_segments
 
     per_frame, pr_scores, core_scores = [], [], []
+    drawn_px = 0
     worst = None
     cand_imgs, segs, flipped = [], [], []
     camera = None
@@ -161,6 +162,7 @@ def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, 
         ps, cs = metrics.pixel_scores(cand, orac), metrics.pixel_scores(cand, core)
         pr_scores.append(ps)
         core_scores.append(cs)
+        drawn_px += int((cand | orac).sum())
         per_frame.append({"frame": k, "f1_0px": ps["f1_0px"], "f1_1px": ps["f1_1px"],
                           "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"],
                           "candidate_pixels": ps["candidate_pixels"], "oracle_pixels": ps["oracle_pixels"]})
@@ -191,20 +193,27 @@ def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, 
         # as the vertex diagnosis: a disagreement is never "no fault". Here no mirror, swap,
         # scale or offset explains the pixels: lines missing or extra, or another raster rule.
         rec["faults"] = [{"name": "unexplained"}]
-    if not any(x["candidate_pixels"] or x["oracle_pixels"] for x in pr_scores):
-        rec["note"] = "neither side drew a pixel in any frame of this case"
-    rec.update(verdict="fail" if reasons else "pass", reasons=reasons, per_frame=per_frame)
+    rec["compared"] = {"frames": len(images), "vertices": 0, "pixels": drawn_px}
+    verdict = "fail" if reasons else "pass"
+    if not reasons and drawn_px == 0:           # as oracles.gate: a case that compared nothing
+        verdict = "vacuous"
+        reasons = [f"vacuous: neither side drew a pixel in {len(images)} frames: nothing compared"]
+    rec.update(verdict=verdict, reasons=reasons, per_frame=per_frame)
     return rec, {"frame": worst[1], "candidate": worst[2], "oracle": worst[3]}
 
 
-def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None) -> tuple[dict, dict]:
+def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
+               allow_vacuous: bool = False) -> tuple[dict, dict]:
     """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
+
+    A case where neither side drew a pixel is ``"vacuous"`` and fails the run
+    unless ``allow_vacuous`` (as :mod:`oracles.gate`); no vertex is compared here.
 
     FramesError (exit 2) when the job or its frames are incomplete, of the
     wrong size, unreadable, or not this job's.
     """
     from .pyrender_oracle import OracleCache
-    from .runner import Tolerances
+    from .tolerances import Tolerances
 
     tol = tol or Tolerances()
     t0 = time.perf_counter()
@@ -220,16 +229,23 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
             images[(c["scene"], c["case"])] = worst
     finally:
         oracles.close()
-    failed = sum(r["verdict"] != "pass" for r in records)
+    failed = sum(r["verdict"] == "fail" for r in records)
+    vacuous = sum(r["verdict"] == "vacuous" for r in records)
+    compared = {"cases": sum(r["verdict"] != "vacuous" for r in records),
+                "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
+                "pixels": sum(r["compared"]["pixels"] for r in records)}
+    bad = failed or not compared["frames"] or (not allow_vacuous and (vacuous or not compared["pixels"]))
     report = {
-        "tool": "wirecheck crosscheck", "verdict": "fail" if failed else "pass",
+        "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",
         "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
         "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
         "frames": job["frames"], "every": job["every"], "frames_checked": len(job["frame_numbers"]),
         "motion": job["motion"],
         "tolerances": {"vertex_error_px": tol.vertex_px, "min_pixel_f1_1px": tol.min_f1_1px,
                        "min_pixel_f1_0px": tol.min_f1_0px},
-        "summary": {"cases": len(records), "passed": len(records) - failed, "failed": failed,
+        "allow_vacuous": allow_vacuous, "compared": compared,
+        "summary": {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
+                    "vacuous": vacuous,
                     "max_vertex_error_px": None,
                     "min_pixel_f1_0px": min(r["pixel_f1_0px"] for r in records),
                     "min_pixel_f1_1px": min(r["pixel_f1_1px"] for r in records),

@@ -30,7 +30,7 @@ def _fail(message: str) -> int:
 
 def export_main(argv) -> int:
     """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z]``."""
-    from wirecheck.core.scene import builtin_names, load_scene
+    from wirecheck.core.scene_files import builtin_names, load_scene
     from wirecheck.core.transforms import Motion
 
     from .export import write_job
@@ -89,7 +89,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     """
     from .frames_candidate import run_frames
     from .report import console_table, write_report
-    from .runner import Tolerances
+    from .tolerances import Tolerances
 
     from .config import CLI_DESTS
 
@@ -105,7 +105,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
                      "its frames are drawn already: expected only --tol/--min-f1 options, --run or --report-dir")
     tol = Tolerances(min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
     try:
-        report, images = run_frames(Path(args.candidate_frames), tol=tol)
+        report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous)
     except InputError as exc:
         return _fail(str(exc))
     try:
@@ -120,11 +120,11 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
         return _fail(f"writing {str(run_dir)!r} or the JUnit file failed: {exc}")
     print(console_table(report["cases"]))
     for r in report["cases"]:
-        if r["verdict"] != "pass":
+        if r["verdict"] != "pass":          # failed, or vacuous (compared nothing)
             print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
     s = report["summary"]
     print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "
           f"(F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}); against core: F1@0px >= "
           f"{s['min_core_f1_0px']:.4f}, F1@1px >= {s['min_core_f1_1px']:.4f}")
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
-    return 1 if s["failed"] else 0
+    return 1 if report["verdict"] != "pass" else 0

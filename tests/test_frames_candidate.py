@@ -20,7 +20,7 @@ import pytest
 from PIL import Image
 
 from wirecheck.core.pipeline import render_frame
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.oracles import opencv_oracle
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.export import build_job
@@ -261,3 +261,19 @@ def test_project_settings_do_not_apply_to_frames_and_junit_is_written(filled, tm
 
     cases = ET.parse(junit).getroot().iter("testcase")
     assert len(list(cases)) == 3
+
+
+def test_a_case_where_nothing_is_drawn_is_vacuous(tmp_path, capsys):
+    # points without edges: the oracle draws nothing, a blank frame agrees with it, and that
+    # compares nothing (as oracles.gate): exit 1 unless --allow-vacuous
+    scene = tmp_path / "dots.scene"
+    scene.write_text("name dots\nv -1 -1 0\nv 1 1 0\nv 0 1 1\n")
+    job = _export(tmp_path / "job", ["--scene", str(scene), "--cases", "on_axis", "--frames", "2"])
+    for k in (1, 2):
+        (job / "frames/dots/on_axis").mkdir(parents=True, exist_ok=True)
+        Image.fromarray(np.zeros((480, 640), np.uint8)).save(job / f"frames/dots/on_axis/frame_{k:04d}.png")
+    assert main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "r1")]) == 1
+    (case,) = json.loads((tmp_path / "r1" / "report.json").read_text())["cases"]
+    assert case["verdict"] == "vacuous" and "nothing compared" in case["reasons"][0]
+    assert main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "r2"), "--allow-vacuous"]) == 0
+    capsys.readouterr()

@@ -24,7 +24,7 @@ from test_diagnosis import CAMERAS, FAULTS, FOV_FACTOR, SINGLE, format_confusion
 from wirecheck.core.clipping import clip_to_image
 from wirecheck.core.projection import project_points
 from wirecheck.core.raster import line_coverage_aa, line_pixels
-from wirecheck.core.scene import load_scene
+from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.diagnose import FAULT_ORDER, primary
 from wirecheck.oracles.draw import clip_depth, draw_candidate
