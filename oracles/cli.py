@@ -88,28 +88,28 @@ def _version() -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0])
+    p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0].replace("``", ""))
     p.add_argument("--version", action="version", version=f"%(prog)s (wirecheck) {_version()}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", action="append", default=None,
                    help="scene name or path; repeatable (default: every scene in scenes/)")
     p.add_argument("--frames", type=int, default=None,
                    help="frames of the scene's motion per case (default 24; 12 with --sweep)")
-    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)}")
+    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)} (default: all)")
     p.add_argument("--candidate", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
                    help="the projector to judge (default: core/); run in its own process")
     p.add_argument("--candidate-cmd", default=None, metavar="'COMMAND ARGS'",
-                   help="a projector program in any language, spoken to over stdin/stdout (docs/protocol.md)")
+                   help="a projector program in any language, spoken to over stdin/stdout (docs/protocol.md) (default: none)")
     p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
                    help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
-                        "(docs/frames.md)")
+                        "(docs/frames.md) (default: none)")
     p.add_argument("--level", choices=LEVELS, default=None,
                    help="vertices: OpenCV vertex check only (no drawing, no pyrender); "
                         "pixels: vertices and pyrender pixels (default)")
     p.add_argument("--oracles", default=None,
-                   help="older spelling of --level: 'opencv' = vertices, 'opencv,pyrender' = pixels")
+                   help="older spelling of --level: 'opencv' = vertices, 'opencv,pyrender' = pixels (default: from --level)")
     p.add_argument("--every", type=int, default=1, metavar="K",
                    help="check frames 1, 1+K, 1+2K, ... of the motion (default 1: every frame)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
@@ -125,11 +125,11 @@ def build_parser() -> argparse.ArgumentParser:
                         "pyrender's filled faces (silhouette IoU and depth error)")
     p.add_argument("--hidden-lines", action="store_true", default=False,
                    help="core candidate, level pixels: the scene's faces hide the lines behind them "
-                        "(pyrender: faces black with glPolygonOffset(1, 1), lines on top)")
+                        "(pyrender: faces black with glPolygonOffset(1, 1), lines on top) (default: off)")
     p.add_argument("--cull", choices=RenderMode.CULLS, default=None,
                    help="core candidate, level pixels: backface culls back faces and the edges only they own "
                         "(default none)")
-    p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
+    p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames (default 1,1,0)")
     p.add_argument("--tol-px", type=float, default=tolerances.VERTEX_TOL_PX,
                    help=f"max vertex error in px (default {tolerances.VERTEX_TOL_PX})")
     p.add_argument("--min-f1", type=float, default=tolerances.MIN_F1_1PX,
@@ -141,10 +141,10 @@ def build_parser() -> argparse.ArgumentParser:
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--sweep", action="store_true",
                       help="every --dtype x --clip x --raster setting of core on the scenes and a large mesh: "
-                           "table and Pareto plot of time per frame against accuracy")
+                           "table and Pareto plot of time per frame against accuracy (default: off)")
     mode.add_argument("--suite", choices=("extremes",), default=None,
                       help="extremes: near plane, tiny/huge FOV, extreme aspect, far from the origin, "
-                           "1,000,000-frame periodicity, degenerate and non-finite inputs")
+                           "1,000,000-frame periodicity, degenerate and non-finite inputs (default: none)")
     p.add_argument("--allow-vacuous", action="store_true", default=False,
                    help="a case that compared nothing (every point clipped, nothing drawn) does not fail the run "
                         "(default: it does)")
