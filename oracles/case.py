@@ -257,4 +257,9 @@ def case_timing(acc: CaseFrames, pixels: bool) -> dict:
                        "pyrender_ms_per_frame": _per_frame_ms(sec["pr"], done),
                        "pixel_metrics_ms_per_frame": _per_frame_ms(sec["pmetric"], done)})
     timing["candidate_ms_per_frame"] = _per_frame_ms(sec["proj"] + sec["draw"], done)
+    # the harness: the oracle side's geometry, the metrics (everything timed that is not
+    # the candidate, OpenCV or pyrender), against the oracles' own time
+    harness = sec["setup"] + sec["vmetric"] + sec["pmetric"]
+    timing["harness_ms_per_frame"] = _per_frame_ms(harness, done)
+    timing["oracles_ms_per_frame"] = _per_frame_ms(sec["cv"] + sec["pr"], done)
     return timing

@@ -80,6 +80,14 @@ def test_vertex_results_are_the_same_at_both_levels(tmp_path):
     timing = p["timing"]
     for t in [timing, *timing["cases"]]:
         assert t["vertex_stage_ms_per_frame"] > 0 and t["pixel_stage_ms_per_frame"] > 0
+        # the oracles are OpenCV and pyrender; the harness is what the stages spend besides
+        # them and the candidate (vertex stage = harness part + opencv + candidate projection)
+        assert t["oracles_ms_per_frame"] == pytest.approx(t["opencv_ms_per_frame"] + t["pyrender_ms_per_frame"])
+        assert t["harness_ms_per_frame"] == pytest.approx(
+            t["vertex_stage_ms_per_frame"] + t["pixel_stage_ms_per_frame"] - t["oracles_ms_per_frame"]
+            - t["candidate_project_ms_per_frame"] - t["candidate_draw_ms_per_frame"])
+    assert timing["harness_overhead_ratio"] == pytest.approx(timing["harness_ms_per_frame"]
+                                                             / timing["oracles_ms_per_frame"])
     html = (out_p / "report.html").read_text()
     assert "Time per frame" in html and "pixel stage (ms/frame)" in html
 
