@@ -312,3 +312,20 @@ def test_depth_bound_decides_at_exactly_one(monkeypatch):
     monkeypatch.setattr(metrics, "shaded_scores", ratio_set_to(float(np.nextafter(1.0, 2.0))))
     case = run(cases=("oblique_roll",), frames=2, tol=OPEN, mode=shaded)["cases"][0]
     assert case["verdict"] == "fail" and len(case["reasons"]) == 1 and case["reasons"][0].startswith("depth error")
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_edge_neighbourhoods_on_drawn_pixels_keep_their_rows(seed):
+    # A mask only drops pixels: every kept pixel keeps its segment (the nearest among the
+    # same candidates) and major coordinate, so per-edge counts of images inside the mask agree.
+    rng = np.random.default_rng(seed)
+    w, h = 40, 30
+    p0 = rng.uniform(-5, 45, (12, 2)); p1 = rng.uniform(-5, 45, (12, 2))
+    p0[3] = np.nan                                                    # an edge not drawn
+    image = rng.random((h, w)) < 0.3
+    full = metrics.edge_neighbourhoods(p0, p1, w, h)
+    sub = metrics.edge_neighbourhoods(p0, p1, w, h, mask=image)
+    keep = image.ravel()[full[1]]
+    rows = lambda t: sorted(zip(*(a.tolist() for a in t)))           # noqa: E731
+    assert rows(sub) == rows(tuple(a[keep] for a in full))
+    assert metrics.edge_counts(image, sub, 12).tolist() == metrics.edge_counts(image, full, 12).tolist()

@@ -113,3 +113,23 @@ def test_occlusion_boundary_marks_both_sides_of_triangles_sharing_no_vertex():
     shared = np.array([[0, 1, 2], [2, 3, 4]])            # sharing vertex 2: depth is continuous
     assert not occlusion_boundary(ids, shared).any()
     assert not occlusion_boundary(np.array([[-1, 0, 0, -1]]), tris).any()     # -1: no triangle
+
+
+def _within_naive(mask_from, mask_to, tol):
+    """The definition, pixel by pixel: a True of mask_to in the (2 tol + 1)^2 window, clipped to the image."""
+    h, w = mask_to.shape
+    return np.array([mask_to[max(r - tol, 0):r + tol + 1, max(c - tol, 0):c + tol + 1].any()
+                     for r, c in zip(*np.nonzero(mask_from))], bool)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_one_pixel_match_on_drawn_pixels_equals_the_definition(seed):
+    from wirecheck.oracles.metrics import _within
+
+    rng = np.random.default_rng(seed)
+    h, w = rng.integers(1, 30, 2)
+    a = rng.random((h, w)) < rng.uniform(0, 0.5)
+    b = rng.random((h, w)) < rng.uniform(0, 0.2)
+    b[0, :] |= rng.random(w) < 0.5                  # lines along the border: the window is clipped there
+    for tol in (0, 1, 2):
+        np.testing.assert_array_equal(_within(a, b, tol), _within_naive(a, b, tol))
