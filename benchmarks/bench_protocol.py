@@ -50,7 +50,7 @@ if str(ROOT) not in sys.path:
 import numpy as np  # noqa: E402
 
 from wirecheck.core.projection import project_points  # noqa: E402
-from wirecheck.core.scene import builtin_names, load_scene  # noqa: E402
+from wirecheck.core.scene_files import builtin_names, load_scene  # noqa: E402
 from wirecheck.core.transforms import Motion  # noqa: E402
 from wirecheck.oracles import faces as oface  # noqa: E402
 from wirecheck.oracles.candidate import call_candidate  # noqa: E402
