@@ -109,43 +109,11 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
     return "\n".join(lines) + "\n"
 
 
-def gif_bytes(images: list[np.ndarray], fps: float = 30.0, progress=None) -> bytes:
-    """An animated GIF (looping, ``fps`` frames per second, rounded to whole ms per frame).
+def gif_bytes(images, fps: float = 30.0, progress=None) -> bytes:
+    """An animated GIF of ``images`` as bytes (core.gif, which also streams to a file)."""
+    from .gif import gif_bytes as encode
 
-    Grey frames use a grey palette; RGB frames (``--axes``) an adaptive
-    palette per frame without dithering (a few exact colours, deterministic).
-    GIF delays are in 1/100 s, so 30 fps plays at 1/0.03 = 33.3 fps. Pillow
-    stores consecutive identical frames as one frame with their summed delay
-    (a scene that does not move gives a one-frame GIF of the same duration).
-    ``progress()`` is called once per frame converted and once per frame
-    written (fewer when frames merge).
-    """
-    from PIL import Image
-
-    tick = progress or (lambda: None)
-
-    def to_p(im):
-        pic = Image.fromarray(np.ascontiguousarray(im))
-        if pic.mode == "RGB":
-            pic = pic.convert("P", palette=Image.Palette.ADAPTIVE, colors=256, dither=Image.Dither.NONE)
-        else:
-            pic = pic.convert("P")
-        tick()
-        return pic
-
-    class Counting(io.BytesIO):
-        """Calls ``tick`` at each frame Pillow writes (each starts with a graphic control extension)."""
-
-        def write(self, data):
-            if bytes(data[:2]) == b"!\xf9":
-                tick()
-            return super().write(data)
-
-    buf = Counting()
-    if images:
-        to_p(images[0]).save(buf, format="GIF", save_all=True, append_images=(to_p(im) for im in images[1:]),
-                             duration=int(round(1000.0 / fps)), loop=0, optimize=False)
-    return buf.getvalue()
+    return encode(images, fps, progress)
 
 
 #: MP4 settings: H.264 (libx264) in yuv420p, constant quality (CRF 18: lines
@@ -282,10 +250,9 @@ class FrameDir:
     def commit(self) -> None:
         check_replaceable(self.final, self.option)   # again: it may have appeared meanwhile
         if self.final.exists():
-            old = self.final.with_name(f".{self.final.name}.old")
-            if old.exists():
-                shutil.rmtree(old)
-            os.replace(self.final, old)
+            # the old set moves into a new, uniquely named folder (never a fixed name the user may own)
+            old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".old", dir=self.final.parent))
+            os.replace(self.final, old / "old")
             os.replace(self.tmp, self.final)
             shutil.rmtree(old)
         else:
