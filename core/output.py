@@ -230,6 +230,34 @@ def check_replaceable(path: Path, option: str) -> None:
                      "output (nothing was changed; move it away first)")
 
 
+def check_report_dir(path: Path, option: str) -> None:
+    """InputError when a report folder at ``path`` could not be written or would pass for a scene.
+
+    A folder in the bundled ``scenes/`` (or named ``*.scene``, ``*.obj``, ...)
+    would be picked up as a scene by later runs (``crosscheck`` runs every
+    ``scenes/*.scene``). Nothing is created here: the caller creates the
+    parents only when it writes the report, so a failed run leaves no folder.
+    """
+    from .errors import InputError
+    from .scene_files import MESH_SUFFIXES, NATIVE_SUFFIX, SCENE_DIR
+
+    path = Path(path)
+    if path.suffix.lower() in (NATIVE_SUFFIX, ".txt", *MESH_SUFFIXES):
+        raise InputError(f"{option} {str(path)!r}: a folder named like a scene file ({path.suffix}) would be "
+                         "taken for a scene by later runs: expected another name")
+    resolved = path.resolve()
+    if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
+        raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected a "
+                         "report folder elsewhere (reports/ by default)")
+    parent = path.parent
+    while not parent.exists() and not parent.is_symlink() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not a directory: expected a folder path")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not writable: expected a writable folder")
+
+
 class FrameDir:
     """A directory filled under a temporary name, renamed over ``final`` on commit().
 
