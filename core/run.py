@@ -232,6 +232,6 @@ def _check_overflow(s: Settings, frame, k: int) -> None:
     if overflow.any():
         i = int(np.flatnonzero(overflow)[0])
         raise InputError(
-            f"{s.scene.source}: vertex {i} {s.scene.vertices[i].tolist()} projects beyond the float64 "
-            f"range in frame {k}: expected coordinates whose pixel position fits in a float64 "
-            f"(|f * x / z| < 1.8e308)")
+            f"{s.scene.source}: vertex {i} {s.scene.vertices[i].tolist()} projects beyond the {s.dtype} "
+            f"range in frame {k}: expected coordinates whose pixel position fits in a {s.dtype} "
+            f"(|f * x / z| < {float(np.finfo(s.dtype).max):.2g})")

@@ -130,7 +130,10 @@ class Staging:
             missing.append(p)
             p = p.parent
         for folder in reversed(missing):
-            folder.mkdir()
+            try:
+                folder.mkdir()
+            except FileExistsError:      # another run made it meanwhile: not ours to remove
+                continue
             self.created.append(folder)
 
     def path(self, name: str) -> Path:
@@ -179,9 +182,21 @@ class Staging:
 
 def _acquire(path: Path, option: str) -> Path:
     """Create the lock file exclusively with our pid; take over one whose process is gone."""
+    # written under a unique name, then hard-linked to LOCK: it appears with its content, atomically,
+    # and link() never follows or replaces whatever is at LOCK
+    fd, tmp = tempfile.mkstemp(prefix=".wirecheck-lock-", suffix=".tmp", dir=path.parent)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(f"{_LOCK_PREFIX}{os.getpid()}\n")
+    try:
+        return _link_lock(tmp, path, option)
+    finally:
+        os.unlink(tmp)
+
+
+def _link_lock(tmp: str, path: Path, option: str) -> Path:
     for _ in range(2):
         try:
-            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o644)
+            os.link(tmp, path)
         except FileExistsError:
             holder = _holder(path)
             if holder is None:
@@ -196,8 +211,6 @@ def _acquire(path: Path, option: str) -> Path:
             except FileNotFoundError:
                 pass
             continue
-        with os.fdopen(fd, "w") as fh:
-            fh.write(f"{_LOCK_PREFIX}{os.getpid()}\n")
         return path
     raise InputError(f"{option} {str(path.parent)!r}: could not take {path.name}: expected one run at a time")
 
