@@ -430,3 +430,14 @@ def test_killed_rerun_keeps_the_earlier_output(tmp_path):
     assert proc.returncode == 143
     assert {n: (out / n).read_bytes() for n in before} == before
     assert sorted(os.listdir(out)) == [MANIFEST, "cube-frames", "cube-report.json", "cube-report.txt"]
+
+
+def test_api_mesh_loading_is_quiet_too(tmp_path, capfd):
+    """load_scene (the API, no CLI guard around it) keeps trimesh's logged traceback off stderr."""
+    from wirecheck.core.scene import load_scene
+
+    stl = tmp_path / "n.stl"
+    stl.write_text("solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                   "endloop\nendfacet\nendsolid x\n")
+    assert len(load_scene(str(stl)).vertices) == 3
+    assert capfd.readouterr().err == ""
