@@ -22,6 +22,7 @@ import hashlib
 import json
 import os
 import shutil
+import signal
 import tempfile
 from pathlib import Path
 
@@ -142,6 +143,8 @@ class Staging:
 
     def commit(self) -> None:
         """Move every staged output into place, record it in the manifest, remove the temporaries."""
+        blocked = {signal.SIGINT, signal.SIGTERM}
+        signal.pthread_sigmask(signal.SIG_BLOCK, blocked)    # the moves finish together: no mixed set
         try:
             manifest = read_manifest(self.out, self.option)
             staged = [n for n in self.names if (self.tmp / n).exists()]
@@ -163,6 +166,7 @@ class Staging:
             self.created = []          # the outputs live there now
         finally:
             self.abort()
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, blocked)     # a pending signal is raised here
 
     def abort(self) -> None:
         """Remove the temporaries, the lock, and the folders this run created (when empty)."""

@@ -443,3 +443,15 @@ def test_api_mesh_loading_is_quiet_too(tmp_path):
     proc = subprocess.run([sys.executable, "-c", "import sys; from wirecheck import load_scene; "
                            "print(len(load_scene(sys.argv[1]).vertices))", str(stl)], capture_output=True, text=True)
     assert (proc.stdout, proc.stderr) == ("3\n", "")
+
+
+def test_crosscheck_users_old_folder_survives_a_report_replace(tmp_path, capsys):
+    args = ["--report-dir", str(tmp_path / "r"), "--scene", "cube", "--cases", "on_axis", "--level", "vertices",
+            "--frames", "1"]
+    assert crosscheck_cli.main(args) == 0
+    mine = tmp_path / ".r.old"
+    mine.mkdir()
+    (mine / "keep.txt").write_text("mine")
+    assert crosscheck_cli.main(args) == 0
+    assert (mine / "keep.txt").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".r.old", "r"]       # no other leftovers
