@@ -34,8 +34,12 @@ EXIT_USAGE = 2
 EXIT_INTERNAL = 3
 
 
-class Interrupted(BaseException):
-    """SIGINT or SIGTERM arrived: unwinds like KeyboardInterrupt, so every ``finally`` cleans up."""
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM arrived: unwinds as a KeyboardInterrupt, so every ``finally`` cleans up.
+
+    (A KeyboardInterrupt, so code that stops on Ctrl-C, the interactive viewer's server, stops on
+    SIGTERM the same way.)
+    """
 
     def __init__(self, signum: int):
         super().__init__(signal.Signals(signum).name)

@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 
 from fuzz.contract import SCENE_TEXTS, HypothesisPick, crosscheck_argv, make_scene_arg, mutate_text, renderer_argv, run_cli
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene import Scene, load_scene, parse_scene_text
+from wirecheck.core.scene import Scene
+from wirecheck.core.scene_files import load_scene, parse_scene_text
 
 SLOW = settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
 

@@ -19,7 +19,7 @@ from wirecheck.core import run as core_run
 from wirecheck.core.errors import InputError, one_line
 from wirecheck.core.limits import MAX_FACE_VERTICES, MAX_FRAMES, MAX_SIDE
 from wirecheck.core.output import MARKER
-from wirecheck.core.scene import SCENE_DIR, parse_scene_text
+from wirecheck.core.scene_files import SCENE_DIR, parse_scene_text
 from wirecheck.core.staging import LOCK, MANIFEST
 from wirecheck.oracles import cli as crosscheck_cli
 
