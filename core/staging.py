@@ -97,9 +97,22 @@ def check_out(out: Path, names, option: str = "--out") -> None:
         return
     if not os.access(out, os.W_OK | os.X_OK):
         raise InputError(f"{option} {str(out)!r} is not writable: expected a writable directory")
-    manifest = read_manifest(out, option)
-    for name in names:
-        check_replaceable(out, name, manifest, option)
+    _refuse_if_locked(out / LOCK, option)
+    try:
+        manifest = read_manifest(out, option)
+        for name in names:
+            check_replaceable(out, name, manifest, option)
+    except InputError:
+        _refuse_if_locked(out / LOCK, option)     # another run moving its outputs in: say that instead
+        raise
+
+
+def _refuse_if_locked(lock: Path, option: str) -> None:
+    holder = _holder(lock)
+    if holder is not None and holder != os.getpid() and _alive(holder):
+        raise InputError(f"{option} {str(lock.parent)!r} is being written by another wirecheck run "
+                         f"(process {holder}): expected one run per output folder at a time; "
+                         "wait for it or use another --out")
 
 
 class Staging:
@@ -206,10 +219,7 @@ def _link_lock(tmp: str, path: Path, option: str) -> Path:
             if holder is None:
                 raise InputError(f"{option} {str(path.parent)!r}: {path.name} there was not written by wirecheck: "
                                  "expected a wirecheck output folder or a new one (nothing was changed)") from None
-            if _alive(holder):
-                raise InputError(f"{option} {str(path.parent)!r} is being written by another wirecheck run "
-                                 f"(process {holder}): expected one run per output folder at a time; "
-                                 "wait for it or use another --out") from None
+            _refuse_if_locked(path, option)
             try:
                 path.unlink()            # stale: its process is gone
             except FileNotFoundError:

@@ -239,6 +239,7 @@ RENDERER_OPTIONS = {
     "--format": (["png", "ascii", "gif", "mp4", "png,gif", "png,ascii,gif"], ["bogus", "", "png,,", "gif,x"]),
     "--ascii-cols": (["80", "1", "7"], INTS), "--axes": None, "--hidden-lines": None, "--verbose": None,
     "--object-culling": None, "--no-object-culling": None, "--plots": None, "--bogus": None, "--help": None,
+    "--profile": None, "--compare": None, "--trace-vertex": (["0", "3"], INTS),
 }
 CROSSCHECK_OPTIONS = {
     "--frames": (["1", "2"], INTS), "--cases": (["on_axis", "near_plane", "on_axis,wide_fov"], ["x", "", ",,", "oblique"]),
@@ -270,7 +271,7 @@ def _options(pick: Pick, table: dict, rare: set[str]) -> list[str]:
 def renderer_argv(pick: Pick, box: Path, earlier: Path | None) -> list[str]:
     argv = ["--frames", pick.choice(["1", "2", "3"]), "--width", pick.choice(["16", "33", "64"]),
             "--height", pick.choice(["16", "24", "48"])]
-    argv += _options(pick, RENDERER_OPTIONS, rare={"--plots", "--help", "--bogus"})
+    argv += _options(pick, RENDERER_OPTIONS, rare={"--plots", "--help", "--bogus", "--compare"})
     if pick.chance(0.8):
         argv += ["--scene", make_scene_arg(pick, box)]
     if pick.chance(0.95):
@@ -329,7 +330,7 @@ def snapshot(box: Path) -> dict:
 
 
 OUTPUT_NAME = re.compile(r"(.+-frames(/(frame_\d{4,}\.(png|txt)|\.wirecheck-output))?|.+-report\.(json|txt)|"
-                         r".+\.(gif|mp4)|.+-plots\.png|.+-vertices_px(-orthographic)?\.npy|\.wirecheck-manifest\.json)")
+                         r".+\.(gif|mp4)|.+-plots\.png|.+-compare\.(png|json|txt)|.+-vertices_px(-orthographic)?\.npy|\.wirecheck-manifest\.json)")
 REPORT_NAME = re.compile(r"(report\.(json|md|html)|worst\.gif|vertex_error\.png|pixels\.png|img(/.*)?|"
                          r"\.wirecheck-output|sweep\..*|extremes\..*)")
 
