@@ -373,7 +373,7 @@ def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
                 o.problems.append(f"written outside the output: {p}")
             elif _inside(box / p, output_root) and not _is_output(p, box, output_root, cli, before):
                 o.problems.append(f"stray file in the output: {p}")
-        if cli == "renderer" and rc == 0 and output_root is not None:
+        if cli == "renderer" and rc == 0 and output_root is not None and new:   # (--help: rc 0, nothing new)
             o.problems += _partial(output_root, [box / p for p in new], [box / p for p in new + changed])
     return o
 
