@@ -281,8 +281,6 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
-        if applied:
-            print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
         if args.junit_xml and (args.sweep or args.suite):
             raise InputError(f"--junit-xml with {'--sweep' if args.sweep else '--suite ' + args.suite}: "
                              "expected it in a plain crosscheck run (one test case per scene x camera)")
@@ -292,6 +290,8 @@ def _main(argv=None) -> int:
         run_dir, run_option = _run_dir(args)
     except InputError as exc:
         return _error(str(exc))
+    if applied:      # after the checks: on a usage error the error is the only line
+        print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
     if level == "pixels":
         from .pyrender_oracle import osmesa_available
 

@@ -455,3 +455,10 @@ def test_crosscheck_users_old_folder_survives_a_report_replace(tmp_path, capsys)
     assert crosscheck_cli.main(args) == 0
     assert (mine / "keep.txt").read_text() == "mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == [".r.old", "r"]       # no other leftovers
+
+
+def test_settings_line_from_the_config_never_precedes_an_error(tmp_path, capsys, monkeypatch):
+    (tmp_path / "pyproject.toml").write_text('[tool.wirecheck]\nframes = 3\nlevel = "vertices"\n')
+    monkeypatch.chdir(tmp_path)
+    rc = crosscheck_cli.main(["--scene", "nosuch", "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err, "--scene 'nosuch'")
