@@ -462,3 +462,18 @@ def test_settings_line_from_the_config_never_precedes_an_error(tmp_path, capsys,
     monkeypatch.chdir(tmp_path)
     rc = crosscheck_cli.main(["--scene", "nosuch", "--report-dir", str(tmp_path / "r")])
     assert_one_error_line(rc, capsys.readouterr().err, "--scene 'nosuch'")
+
+
+def test_trace_with_a_far_plane_near_the_float64_limit(tmp_path, capsys):
+    """GL's clip z row holds 2 f n / (n - f): with far 1e308 it overflows; the trace says so (null in JSON)."""
+    rc, out, err = render(["--frames", "1", "--trace-vertex", "0", "--far", "1e308"], tmp_path / "o", capsys)
+    assert (rc, err) == (0, "")
+    trace = json.loads((tmp_path / "o" / "cube-report.json").read_text())["trace"][0]
+    assert trace["clip"][2] is None and trace["clip"][3] == trace["depth"]      # w = z_cam, finite
+    assert "overflow" in out
+
+
+def test_crosscheck_frame_count_limit(tmp_path, capsys):
+    rc = crosscheck_cli.main(["--frames", "100000000000000000000", "--scene", "cube", "--level", "vertices",
+                              "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err, f"1..{MAX_FRAMES:,}")
