@@ -242,16 +242,22 @@ def check_report_dir(path: Path, option: str) -> None:
     from .scene_files import MESH_SUFFIXES, NATIVE_SUFFIX, SCENE_DIR
 
     path = Path(path)
-    if path.suffix.lower() in (NATIVE_SUFFIX, ".txt", *MESH_SUFFIXES):
-        raise InputError(f"{option} {str(path)!r}: a folder named like a scene file ({path.suffix}) would be "
+    long = next((part for part in path.parts if len(os.fsencode(part)) > 255), None)
+    if long is not None:
+        raise InputError(f"{option} {str(path)[:60]!r}...: a name of {len(long)} characters: expected at most 255 "
+                         "bytes per folder name")
+    parent = path.parent
+    while not parent.exists() and not parent.is_symlink() and parent != parent.parent:
+        parent = parent.parent
+    created = path.relative_to(parent).parts          # the folders a report would create
+    named = next((p for p in created if Path(p).suffix.lower() in (NATIVE_SUFFIX, ".txt", *MESH_SUFFIXES)), None)
+    if named is not None:
+        raise InputError(f"{option} {str(path)!r}: a folder named like a scene file ({named}) would be "
                          "taken for a scene by later runs: expected another name")
     resolved = path.resolve()
     if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
         raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected a "
                          "report folder elsewhere (reports/ by default)")
-    parent = path.parent
-    while not parent.exists() and not parent.is_symlink() and parent != parent.parent:
-        parent = parent.parent
     if not parent.is_dir():
         raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not a directory: expected a folder path")
     if not os.access(parent, os.W_OK | os.X_OK):

@@ -477,3 +477,19 @@ def test_crosscheck_frame_count_limit(tmp_path, capsys):
     rc = crosscheck_cli.main(["--frames", "100000000000000000000", "--scene", "cube", "--level", "vertices",
                               "--report-dir", str(tmp_path / "r")])
     assert_one_error_line(rc, capsys.readouterr().err, f"1..{MAX_FRAMES:,}")
+
+
+def test_run_under_report_dir_never_creates_a_scene_named_folder(tmp_path, capsys):
+    target = tmp_path / "evil.scene"
+    rc = crosscheck_cli.main(["--report-dir", str(target), "--run", "r1", "--scene", "cube", "--level", "vertices",
+                              "--frames", "1", "--cases", "on_axis"])
+    assert_one_error_line(rc, capsys.readouterr().err, "evil.scene")
+    assert not target.exists()
+
+
+def test_run_name_too_long_leaves_no_reports_folder(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rc = crosscheck_cli.main(["--run", "x" * 300, "--scene", "cube", "--level", "vertices", "--frames", "1",
+                              "--cases", "on_axis"])
+    assert_one_error_line(rc, capsys.readouterr().err, "300 characters")
+    assert tree(tmp_path) == []

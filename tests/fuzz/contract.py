@@ -389,7 +389,10 @@ def _inside(path: Path, folder: Path) -> bool:
 def _output_root(argv, box: Path, cli: str, stdout: str) -> Path | None:
     flag = "--out" if cli == "renderer" else "--report-dir"
     if flag in argv and argv.index(flag) + 1 < len(argv):
-        return box / argv[len(argv) - 1 - argv[::-1].index(flag) + 1]
+        root = box / argv[len(argv) - 1 - argv[::-1].index(flag) + 1]
+        if cli == "crosscheck" and "--run" in argv:        # --run with --report-dir: DIR/RUN
+            return root / argv[len(argv) - 1 - argv[::-1].index("--run") + 1]
+        return root
     if cli == "renderer":
         return box / "output"
     m = re.search(r"Report: (\S+?)/(report\.json|sweep\.md|extremes\.md)", stdout)
