@@ -118,8 +118,8 @@ class Camera:
             raise InputError(f"camera near {self.near!r}: expected > 0 for a perspective camera")
         if not self.far > self.near:
             raise InputError(f"camera far {self.far!r}: expected > near ({self.near!r})")
-        if self.projection == "orthographic" and not (math.isfinite(self.ortho_height) and self.ortho_height > 0):
-            raise InputError(f"camera ortho-height {self.ortho_height!r}: expected > 0")
+        if not (math.isfinite(self.ortho_height) and self.ortho_height > 0):   # also perspective: it is reported
+            raise InputError(f"camera ortho-height {self.ortho_height!r}: expected a finite number > 0")
         # A positive but tiny fov or ortho-height passes the range checks yet makes the
         # focal length / pixel scale overflow to inf: say so here, not later as a
         # "vertex projects beyond the float64 range".

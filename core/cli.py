@@ -12,22 +12,23 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import math
-import os
 import sys
 from pathlib import Path
 
-from . import output
 from .camera import camera_z, look_at, orthographic_twin
 from .clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
 from .culling import CULL_CHOICES
 from .errors import InputError
+from .guard import run_cli
+from .limits import MAX_FRAMES, check_image_size, check_turns
 from .projection import DTYPES
 from .raster import RASTER_MODES
 from .report import depth_text
-from .run import FORMATS, Settings, progress_steps, render_run
+from .run import FORMATS, Settings, output_names, progress_steps, render_run
 from .scene_files import load_scene
 from .shading import STYLES
+from .staging import check_out
 from .transforms import Motion
 
 DESCRIPTION = "renderer: render a scene's motion to wireframe frames with per-frame diagnostics."
@@ -154,12 +155,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def settings_from_args(a: argparse.Namespace) -> Settings:
     """The run the options ask for; InputError (one line, naming the option) for anything invalid."""
-    if a.frames < 1:
-        raise InputError(f"--frames {a.frames}: expected an integer >= 1")
+    if not 1 <= a.frames <= MAX_FRAMES:
+        raise InputError(f"--frames {a.frames}: expected an integer in 1..{MAX_FRAMES:,} (limits.MAX_FRAMES)")
     if not (0.0 < a.fov < 180.0):
         raise InputError(f"--fov {a.fov}: expected degrees in (0, 180)")
-    if a.width < 1 or a.height < 1:
-        raise InputError(f"--width/--height {a.width}x{a.height}: expected positive integers")
+    check_image_size(a.width, a.height, "--width/--height")
+    if a.ortho_height is not None and not (math.isfinite(a.ortho_height) and a.ortho_height > 0):
+        raise InputError(f"--ortho-height {a.ortho_height}: expected a finite number > 0")
     if not (math.isfinite(a.scale) and a.scale != 0):
         raise InputError(f"--scale {a.scale}: expected a finite non-zero number")
     if a.ascii_cols < 1:
@@ -187,6 +189,7 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
             raise InputError(f"--camera-z {d}: expected a finite non-zero distance")
         camera = camera_z(d, **kwargs)
         distance = abs(d)
+    _check_dtype_range(camera, a)
     if both and a.ortho_height is not None:
         raise InputError(f"--ortho-height {a.ortho_height} with --projection both: the orthographic half's "
                          "height is 2 d tan(fov/2), set by the perspective camera; expected no --ortho-height")
@@ -204,7 +207,7 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
             raise InputError(f"--light {a.light!r}: expected a non-zero direction")
         big = max(abs(v) for v in light)
         light = tuple(v / big for v in light)            # a direction: scale it to avoid over/underflow
-    motion = Motion(turns=vec3("--spin", a.spin), offset=vec3("--translate", a.translate), scale=a.scale)
+    motion = Motion(turns=check_turns(vec3("--spin", a.spin), "--spin"), offset=vec3("--translate", a.translate), scale=a.scale)
     if "mp4" in formats and importlib.util.find_spec("av") is None:
         raise InputError("--format mp4: expected the PyAV package (pip install av; it is a dependency of wirecheck)")
     scene = load_scene(a.scene)
@@ -225,20 +228,23 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     if cull is not None and scene.winding_note:
         raise InputError(f"--cull backface: {scene.source}: {scene.winding_note}: expected faces wound "
                          "consistently (counter-clockwise seen from outside)")
-    _check_writable(s.out)
-    if "png" in formats or "ascii" in formats:
-        output.check_replaceable(s.out / f"{scene.name}-frames", "--out")
+    check_out(s.out, output_names(s))
     return s
 
 
-def _check_writable(out: Path) -> None:
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / ".wirecheck-write-test"
-        probe.write_bytes(b"")
-        probe.unlink()
-    except OSError as exc:
-        raise InputError(f"--out {str(out)!r}: cannot write there ({exc.strerror or exc}): expected a writable directory") from None
+def _check_dtype_range(camera, a) -> None:
+    """InputError when the camera's pixel scale overflows --dtype (float32 tops out at 3.4e38)."""
+    import numpy as np
+
+    big = float(np.finfo(a.dtype).max)
+    if camera.projection == "perspective" and not camera.focal_px < big:
+        raise InputError(f"--fov {a.fov} with --dtype {a.dtype}: focal length (H/2)/tan(fov/2) = "
+                         f"{camera.focal_px:.3g} px overflows {a.dtype} (largest {big:.3g}): expected a larger "
+                         "--fov or --dtype float64")
+    if camera.projection == "orthographic" and not camera.height / camera.ortho_height < big:
+        raise InputError(f"--ortho-height {camera.ortho_height} with --dtype {a.dtype}: pixel scale "
+                         f"H/ortho-height overflows {a.dtype} (largest {big:.3g}): expected a larger --ortho-height "
+                         "or --dtype float64")
 
 
 def _progress_bar(total: int, frames: int):
@@ -263,21 +269,12 @@ def _progress_bar(total: int, frames: int):
 
 
 def main(argv=None) -> int:
-    try:
-        return _main(argv)
-    except BrokenPipeError:
-        # stdout was closed (e.g. `renderer | head`): stop quietly, as a SIGPIPE would
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 141
+    return run_cli("renderer", _main, argv)
 
 
 def _main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        s = settings_from_args(args)
-    except InputError as exc:
-        print(f"renderer: error: {exc}", file=sys.stderr)
-        return 2
+    s = settings_from_args(args)          # InputError: one line, exit 2 (core.guard)
     if args.interactive:
         from .viewer import main_interactive
 
@@ -286,18 +283,12 @@ def _main(argv=None) -> int:
         from .compare import main_compare
 
         return main_compare(s, args.compare_z, args.compare_fov)
-    try:
-        traces = _traces(args, s)
-    except InputError as exc:
-        print(f"renderer: error: {exc}", file=sys.stderr)
-        return 2
+    traces = _traces(args, s)
     width = max(3, len(str(s.frames)))
     shown = {1, (s.frames + 1) // 2, s.frames}
     if s.frames >= 180:
         shown = {1, s.frames // 2, s.frames}
 
-    if s.scene.faces and s.scene.winding_note:
-        print(f"renderer: warning: {s.scene.source}: {s.scene.winding_note}", file=sys.stderr)
     objects = f", {len(s.scene.objects)} objects" if len(s.scene.objects) > 1 else ""
     print(f"Scene: {s.scene.name} ({len(s.scene.vertices)} vertices, {len(s.scene.edges)} edges{objects})")
     progress, close, write = _progress_bar(progress_steps(s), s.frames)
@@ -317,18 +308,10 @@ def _main(argv=None) -> int:
     try:
         report = render_run(s, log=log, progress=progress, profiler=profiler,
                             extra={"trace": traces} if traces else None)
-    except InputError as exc:
+    finally:
         close()
-        print(f"renderer: error: {exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:
-        close()
-        raise
-    except OSError as exc:
-        close()
-        print(f"renderer: error: writing to {str(s.out)!r} failed: {exc}", file=sys.stderr)
-        return 2
-    close()
+    if s.scene.faces and s.scene.winding_note:       # after the run: an error line is the only line
+        print(f"renderer: warning: {s.scene.source}: {s.scene.winding_note}", file=sys.stderr)
     if traces:
         from .trace import trace_text
 

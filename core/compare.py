@@ -183,13 +183,18 @@ def main_compare(s, z_text: str, fov_text: str) -> int:
         return 2
     text = explain(report)
     name = s.scene.name
+    from .staging import Staging
+
+    names = [f"{name}-compare.png", f"{name}-compare.json", f"{name}-compare.txt"]
+    stage = Staging(s.out, names)      # written together, never over a file wirecheck did not write
     try:
-        output.atomic_write_bytes(s.out / f"{name}-compare.png", output.png_bytes(grid))
-        output.atomic_write_text(s.out / f"{name}-compare.json", output.json_dumps(report))
-        output.atomic_write_text(s.out / f"{name}-compare.txt", text)
-    except OSError as exc:
-        print(f"renderer: error: writing to {str(s.out)!r} failed: {exc}", file=sys.stderr)
-        return 2
+        stage.path(names[0]).write_bytes(output.png_bytes(grid))
+        stage.path(names[1]).write_text(output.json_dumps(report), encoding="utf-8")
+        stage.path(names[2]).write_text(text, encoding="utf-8")
+        stage.commit()
+    except BaseException:
+        stage.abort()
+        raise
     print(text, end="")
     print(f"Picture: {s.out / f'{name}-compare.png'}")
     return 0

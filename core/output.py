@@ -109,43 +109,11 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
     return "\n".join(lines) + "\n"
 
 
-def gif_bytes(images: list[np.ndarray], fps: float = 30.0, progress=None) -> bytes:
-    """An animated GIF (looping, ``fps`` frames per second, rounded to whole ms per frame).
+def gif_bytes(images, fps: float = 30.0, progress=None) -> bytes:
+    """An animated GIF of ``images`` as bytes (core.gif, which also streams to a file)."""
+    from .gif import gif_bytes as encode
 
-    Grey frames use a grey palette; RGB frames (``--axes``) an adaptive
-    palette per frame without dithering (a few exact colours, deterministic).
-    GIF delays are in 1/100 s, so 30 fps plays at 1/0.03 = 33.3 fps. Pillow
-    stores consecutive identical frames as one frame with their summed delay
-    (a scene that does not move gives a one-frame GIF of the same duration).
-    ``progress()`` is called once per frame converted and once per frame
-    written (fewer when frames merge).
-    """
-    from PIL import Image
-
-    tick = progress or (lambda: None)
-
-    def to_p(im):
-        pic = Image.fromarray(np.ascontiguousarray(im))
-        if pic.mode == "RGB":
-            pic = pic.convert("P", palette=Image.Palette.ADAPTIVE, colors=256, dither=Image.Dither.NONE)
-        else:
-            pic = pic.convert("P")
-        tick()
-        return pic
-
-    class Counting(io.BytesIO):
-        """Calls ``tick`` at each frame Pillow writes (each starts with a graphic control extension)."""
-
-        def write(self, data):
-            if bytes(data[:2]) == b"!\xf9":
-                tick()
-            return super().write(data)
-
-    buf = Counting()
-    if images:
-        to_p(images[0]).save(buf, format="GIF", save_all=True, append_images=(to_p(im) for im in images[1:]),
-                             duration=int(round(1000.0 / fps)), loop=0, optimize=False)
-    return buf.getvalue()
+    return encode(images, fps, progress)
 
 
 #: MP4 settings: H.264 (libx264) in yuv420p, constant quality (CRF 18: lines
@@ -262,6 +230,40 @@ def check_replaceable(path: Path, option: str) -> None:
                      "output (nothing was changed; move it away first)")
 
 
+def check_report_dir(path: Path, option: str) -> None:
+    """InputError when a report folder at ``path`` could not be written or would pass for a scene.
+
+    A folder in the bundled ``scenes/`` (or named ``*.scene``, ``*.obj``, ...)
+    would be picked up as a scene by later runs (``crosscheck`` runs every
+    ``scenes/*.scene``). Nothing is created here: the caller creates the
+    parents only when it writes the report, so a failed run leaves no folder.
+    """
+    from .errors import InputError
+    from .scene_files import MESH_SUFFIXES, NATIVE_SUFFIX, SCENE_DIR
+
+    path = Path(path)
+    long = next((part for part in path.parts if len(os.fsencode(part)) > 255), None)
+    if long is not None:
+        raise InputError(f"{option} {str(path)[:60]!r}...: a name of {len(long)} characters: expected at most 255 "
+                         "bytes per folder name")
+    parent = path.parent
+    while not parent.exists() and not parent.is_symlink() and parent != parent.parent:
+        parent = parent.parent
+    created = path.relative_to(parent).parts          # the folders a report would create
+    named = next((p for p in created if Path(p).suffix.lower() in (NATIVE_SUFFIX, ".txt", *MESH_SUFFIXES)), None)
+    if named is not None:
+        raise InputError(f"{option} {str(path)!r}: a folder named like a scene file ({named}) would be "
+                         "taken for a scene by later runs: expected another name")
+    resolved = path.resolve()
+    if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
+        raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected a "
+                         "report folder elsewhere (reports/ by default)")
+    if not parent.is_dir():
+        raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not a directory: expected a folder path")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not writable: expected a writable folder")
+
+
 class FrameDir:
     """A directory filled under a temporary name, renamed over ``final`` on commit().
 
@@ -282,10 +284,9 @@ class FrameDir:
     def commit(self) -> None:
         check_replaceable(self.final, self.option)   # again: it may have appeared meanwhile
         if self.final.exists():
-            old = self.final.with_name(f".{self.final.name}.old")
-            if old.exists():
-                shutil.rmtree(old)
-            os.replace(self.final, old)
+            # the old set moves into a new, uniquely named folder (never a fixed name the user may own)
+            old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".old", dir=self.final.parent))
+            os.replace(self.final, old / "old")
             os.replace(self.tmp, self.final)
             shutil.rmtree(old)
         else:

@@ -3,13 +3,13 @@
 :class:`Settings` says what to render (``renderer``'s options, validated by
 core.cli); :func:`render_run` renders frame 1..frames through
 :class:`core.frames.SceneRenderer` (one camera, or two side by side), writes
-the frames and animations atomically and returns the report dict
-(core.report).
+the frames, animations and reports into one temporary folder, moves them into
+place together (core.staging) and returns the report dict (core.report).
 """
 
 from __future__ import annotations
 
-import io
+import contextlib
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,8 +21,10 @@ from .camera import Camera
 from .compose import axis_layers, axis_length, overlay, picture, side_by_side
 from .errors import InputError
 from .frames import SceneRenderer
+from .gif import GifWriter
 from .report import frame_record, run_report, summary_text
 from .scene import Scene
+from .staging import Staging
 from .transforms import Motion
 
 #: Output formats: frames as PNG and ASCII text, animations as GIF and MP4.
@@ -77,46 +79,71 @@ class Settings:
 
 
 def progress_steps(s: Settings) -> int:
-    """Steps :func:`render_run` reports to ``progress``: one per frame, then the animations' encoding.
+    """Steps :func:`render_run` reports to ``progress``: per frame rendered and per GIF frame, then the MP4 flush.
 
-    GIF: each frame converted, then each written (fewer when identical
-    neighbours merge); MP4: one for the encoder's flush (frames are encoded as
-    they are rendered).
+    Both animations are encoded as the frames are rendered (memory flat in the
+    frame count); the MP4 encoder's flush at the end is one more step.
     """
-    return s.frames * (3 if "gif" in s.formats else 1) + ("mp4" in s.formats)
+    return s.frames * (2 if "gif" in s.formats else 1) + ("mp4" in s.formats)
+
+
+def output_names(s: Settings) -> list[str]:
+    """The names a run of ``s`` may write in ``s.out`` (core.staging checks and moves them)."""
+    name = s.scene.name
+    names = [f"{name}-frames"] if ("png" in s.formats or "ascii" in s.formats) else []
+    names += [f"{name}.{fmt}" for fmt in ("gif", "mp4") if fmt in s.formats]
+    if len(s.scene.vertices) > SIDECAR_VERTICES:
+        names += [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"][:len(s.cameras)]
+    if s.plots:
+        names.append(f"{name}-plots.png")
+    return names + [f"{name}-report.json", f"{name}-report.txt"]
 
 
 def render_run(s: Settings, log=None, progress=None, profiler=None, extra: dict | None = None) -> dict:
-    """Render every frame, write outputs atomically, return the report dict.
+    """Render every frame, write the outputs together (core.staging), return the report dict.
 
-    ``log(k, frame, info)`` is called for each frame (the caller decides what
-    to print); ``progress(stage)`` once per step of :func:`progress_steps`
-    (``stage``: "render", "gif" or "mp4"). ``profiler`` (a
+    Every output is written into a temporary folder in ``s.out`` and moved
+    into place at the end; on any failure (or SIGINT/SIGTERM, raised as an
+    exception by core.guard) nothing of the run is left. ``log(k, frame,
+    info)`` is called for each frame (the caller decides what to print);
+    ``progress(stage)`` once per step of :func:`progress_steps` (``stage``:
+    "render", "gif" or "mp4"). ``profiler`` (a
     :class:`core.profile.FrameProfiler`) times each frame's stages; its
     summary becomes the report's ``profile`` field. ``extra`` fields are added
     to the report (``trace``).
     """
+    stage = Staging(s.out, output_names(s))
+    try:
+        report = _render_into(s, stage, log, progress or (lambda stage: None), profiler, extra)
+        stage.commit()
+    except BaseException:
+        stage.abort()
+        raise
+    return report
+
+
+def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dict:
     name = s.scene.name
-    frames_dir = s.out / f"{name}-frames"
-    json_path = s.out / f"{name}-report.json"
-    txt_path = s.out / f"{name}-report.txt"
-    plots_path = s.out / f"{name}-plots.png"
-    mp4_path = s.out / f"{name}.mp4"
-    step = progress or (lambda stage: None)
     sidecar = len(s.scene.vertices) > SIDECAR_VERTICES
-    sidecar_paths = [s.out / f"{name}-vertices_px.npy", s.out / f"{name}-vertices_px-orthographic.npy"]
-    fdir = output.FrameDir(frames_dir, "--out") if ("png" in s.formats or "ascii" in s.formats) else None
-    mp4 = None
-    records, gif_images = [], []
+    frames_dir = None
+    if "png" in s.formats or "ascii" in s.formats:
+        frames_dir = stage.path(f"{name}-frames")
+        frames_dir.mkdir()
+        (frames_dir / output.MARKER).write_bytes(b"")
+    records = []
     all_px = [[] for _ in s.cameras]
     t_start = time.perf_counter()
     render_seconds = 0.0
     renderer = s.scene_renderer()
     layers = [s.axis_layers(cam) for cam in s.cameras] if s.axes else None
     lap = profiler.lap if profiler is not None else (lambda stage, t: 0.0)
-    try:
+    with contextlib.ExitStack() as files:
+        mp4 = gif = None
         if "mp4" in s.formats:
-            mp4 = output.Mp4Writer(mp4_path, FPS)
+            mp4 = output.Mp4Writer(files.enter_context(open(stage.path(f"{name}.mp4"), "wb")), FPS)
+        if "gif" in s.formats:
+            gif = GifWriter(files.enter_context(open(stage.path(f"{name}.gif"), "wb")), FPS,
+                            progress=lambda: step("gif"))
         for k in range(1, s.frames + 1):
             if profiler is not None:
                 profiler.begin()
@@ -146,15 +173,16 @@ def render_run(s: Settings, log=None, progress=None, profiler=None, extra: dict 
             t = lap("compose", t)
             for fmt, encode in (("png", output.png_bytes), ("ascii", lambda im: output.ascii_frame(
                     im, s.ascii_cols).encode())):
-                if fdir is not None and fmt in s.formats:
+                if frames_dir is not None and fmt in s.formats:
                     data = encode(image)
                     t = lap("encode", t)
-                    fdir.write(f"frame_{k:04d}.{'png' if fmt == 'png' else 'txt'}", data)
+                    (frames_dir / f"frame_{k:04d}.{'png' if fmt == 'png' else 'txt'}").write_bytes(data)
                     t = lap("write", t)
-            if "gif" in s.formats:
-                gif_images.append(image)
             if mp4 is not None:
                 mp4.add(image)
+                t = lap("encode", t)
+            if gif is not None:
+                gif.add(image)
                 t = lap("encode", t)
             records.append(rec)
             if profiler is not None:
@@ -162,47 +190,40 @@ def render_run(s: Settings, log=None, progress=None, profiler=None, extra: dict 
             if log:
                 log(k, *first)
             step("render")
-        if fdir is not None:
-            fdir.commit()
         if mp4 is not None:
             mp4.commit()
             step("mp4")
-    except BaseException:
-        if fdir is not None:
-            fdir.abort()
-        if mp4 is not None:
-            mp4.abort()
-        raise
-    if "gif" in s.formats:
-        gif = output.gif_bytes(gif_images, FPS, progress=lambda: step("gif"))
-        output.atomic_write_bytes(s.out / f"{name}.gif", gif)
+        if gif is not None:
+            gif.close()
     report = run_report(s, records)
     report.update(extra or {})
     if profiler is not None:
         report["profile"] = profiler.summary()
     if sidecar:
-        for c, path in enumerate(sidecar_paths[:len(s.cameras)]):
-            buf = io.BytesIO()
-            np.save(buf, np.stack(all_px[c]) if all_px[c] else np.zeros((0, 0, 2)))
-            output.atomic_write_bytes(path, buf.getvalue())
-        report["vertices_px_file"] = sidecar_paths[0].name
+        names = [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"]
+        for c in range(len(s.cameras)):
+            np.save(stage.path(names[c]), np.stack(all_px[c]) if all_px[c] else np.zeros((0, 0, 2)))
+        report["vertices_px_file"] = names[0]
         if s.ortho_camera is not None:
-            report["vertices_px_file_orthographic"] = sidecar_paths[1].name
+            report["vertices_px_file_orthographic"] = names[1]
     plot_seconds = None
     if s.plots:
         from .motion_plot import plot_png
 
         t0 = time.perf_counter()
         cam_text = "perspective (left picture)" if s.ortho_camera is not None else s.camera.projection
-        output.atomic_write_bytes(plots_path, plot_png(records, f"{name}: {s.frames} frames, {cam_text} camera"))
+        stage.path(f"{name}-plots.png").write_bytes(plot_png(records, f"{name}: {s.frames} frames, {cam_text} camera"))
         plot_seconds = time.perf_counter() - t0
-    output.atomic_write_text(json_path, output.json_dumps(report))
+    stage.path(f"{name}-report.json").write_text(output.json_dumps(report), encoding="utf-8")
     wall = time.perf_counter() - t_start
-    output.atomic_write_text(txt_path, summary_text(report, render_seconds, wall, plot_seconds))
-    report["_paths"] = {"frames": frames_dir if fdir else None, "json": json_path, "txt": txt_path,
-                        "gif": s.out / f"{name}.gif" if "gif" in s.formats else None,
-                        "mp4": mp4_path if mp4 is not None else None,
-                        "plots": plots_path if s.plots else None}
+    stage.path(f"{name}-report.txt").write_text(summary_text(report, render_seconds, wall, plot_seconds),
+                                                encoding="utf-8")
+    out = s.out
+    report["_paths"] = {"frames": out / f"{name}-frames" if frames_dir else None,
+                        "json": out / f"{name}-report.json", "txt": out / f"{name}-report.txt",
+                        "gif": out / f"{name}.gif" if gif is not None else None,
+                        "mp4": out / f"{name}.mp4" if mp4 is not None else None,
+                        "plots": out / f"{name}-plots.png" if s.plots else None}
     return report
 
 
@@ -211,6 +232,6 @@ def _check_overflow(s: Settings, frame, k: int) -> None:
     if overflow.any():
         i = int(np.flatnonzero(overflow)[0])
         raise InputError(
-            f"{s.scene.source}: vertex {i} {s.scene.vertices[i].tolist()} projects beyond the float64 "
-            f"range in frame {k}: expected coordinates whose pixel position fits in a float64 "
-            f"(|f * x / z| < 1.8e308)")
+            f"{s.scene.source}: vertex {i} {s.scene.vertices[i].tolist()} projects beyond the {s.dtype} "
+            f"range in frame {k}: expected coordinates whose pixel position fits in a {s.dtype} "
+            f"(|f * x / z| < {float(np.finfo(s.dtype).max):.2g})")

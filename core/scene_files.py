@@ -33,7 +33,8 @@ from pathlib import Path
 import numpy as np
 
 from .culling import winding_problem
-from .errors import InputError
+from .errors import InputError, quiet_libraries
+from .limits import MAX_FACE_VERTICES, MAX_NAME, check_turns
 from .scene import Scene, SceneObject, face_edges, unique_edges
 from .transforms import Motion
 
@@ -133,6 +134,9 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
                 if len(fields) < 3:
                     raise InputError(f"{path}:{lineno}: face {line!r}: expected 'f I J K ...' (3 or more indices), "
                                      f"got {len(fields)}")
+                if len(fields) > MAX_FACE_VERTICES:
+                    raise InputError(f"{path}:{lineno}: face of {len(fields)} indices: expected at most "
+                                     f"{MAX_FACE_VERTICES} (a larger surface is a mesh: give it as a mesh file)")
                 cur.faces.append(tuple(_index(path, lineno, t, "face", len(cur.vertices), where) for t in fields))
         elif tag == "object":
             if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
@@ -181,11 +185,15 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
                 if len(fields) != 3:
                     raise InputError(f"{path}:{lineno}: {tag} {' '.join(fields)!r}: expected '{tag} X Y Z' "
                                      f"(3 numbers), got {len(fields)}")
-                cur.motion[tag] = (lineno, tuple(_number(path, lineno, t, tag) for t in fields))
+                values = tuple(_number(path, lineno, t, tag) for t in fields)
+                if tag == "spin":
+                    check_turns(values, f"{path}:{lineno}: spin")
+                cur.motion[tag] = (lineno, values)
         else:
             raise InputError(f"{path}:{lineno}: {tag!r}: expected a line starting with 'v', 'e', 'f', 'name', "
                              "'object', 'mesh', 'translate', 'scale', 'spin' or '#'")
     scene_name = name or _safe_stem(path)
+    _check_name_length(scene_name, path)
     if len(objs) > 1 and not implicit.touched():
         objs = objs[1:]                           # nothing before the first 'object'
     implicit.name = scene_name
@@ -224,6 +232,12 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
     )
 
 
+def _check_name_length(name: str, path) -> None:
+    if len(name) > MAX_NAME:
+        raise InputError(f"{path}: scene name {name[:40]!r}... of {len(name)} characters: expected at most "
+                         f"{MAX_NAME} (it names output files; give a shorter 'name' line or file name)")
+
+
 def _obj_lines(path: Path) -> list[tuple[int, int]]:
     """Edges from OBJ ``l`` elements (1-based, possibly negative, 'v/vt' forms)."""
     n_v = 0
@@ -256,22 +270,35 @@ def load_mesh_file(path: Path) -> Scene:
     if path.suffix.lower() == ".obj":
         _obj_vertices(path)   # validate every 'v' line first: errors with file:line, not trimesh's
     try:
-        loaded = trimesh.load(str(path), process=False, maintain_order=True)
+        with quiet_libraries():     # trimesh logs tracebacks it recovers from; numpy warns on NaN casts
+            loaded = trimesh.load(str(path), process=False, maintain_order=True)
     except Exception as exc:  # trimesh raises many types; one line for the user
-        raise InputError(f"{path}: could not be read as {path.suffix[1:].upper()}: {exc}") from None
+        raise InputError(f"{path}: could not be read as {path.suffix[1:].upper()}: "
+                         f"{type(exc).__name__}: {exc}") from None
     if isinstance(loaded, trimesh.Scene):
         loaded = loaded.to_geometry() if hasattr(loaded, "to_geometry") else loaded.dump(concatenate=True)
     if path.suffix.lower() == ".stl" and hasattr(loaded, "merge_vertices"):
         # STL stores every triangle's corners separately: merge equal positions,
         # or every shared edge would be counted and drawn twice
-        loaded.merge_vertices()
+        with quiet_libraries():
+            loaded.merge_vertices()
     vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
     if vertices.size % 3 or (vertices.ndim == 2 and vertices.shape[1] != 3):
         raise InputError(f"{path}: vertices of shape {vertices.shape}: expected 3 coordinates per vertex")
     vertices = vertices.reshape(-1, 3)
-    faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
+    try:
+        faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InputError(f"{path}: faces could not be read as integer indices ({exc})") from None
     if faces.size == 0:
         faces = np.zeros((0, 3), dtype=np.intp)
+    if faces.ndim != 2:
+        raise InputError(f"{path}: faces of shape {faces.shape}: expected rows of vertex indices")
+    bad = (faces < 0) | (faces >= len(vertices))
+    if bad.any():
+        f, k = (int(i) for i in np.argwhere(bad)[0])
+        raise InputError(f"{path}: face {f} has vertex index {int(faces[f, k])}: expected 0..{len(vertices) - 1} "
+                         f"(the file has {len(vertices)} vertices)")
     edges = [face_edges(faces)] if len(faces) else []
     if path.suffix.lower() == ".obj":
         line_pairs = _obj_lines(path)
@@ -285,6 +312,7 @@ def load_mesh_file(path: Path) -> Scene:
         raise InputError(f"{path}: vertex {bad[0]} has {vertices[bad[0]].tolist()}: expected finite coordinates")
     all_edges = np.concatenate(edges) if edges else np.zeros((0, 2), dtype=np.intp)
     faces = tuple(tuple(int(i) for i in f) for f in faces)
+    _check_name_length(_safe_stem(path), path)
     return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
                  faces=faces, source=str(path), winding_note=_winding_note(faces))
 
@@ -301,14 +329,19 @@ def _obj_vertices(path: Path) -> np.ndarray:
     return np.asarray(out, dtype=np.float64).reshape(-1, 3)
 
 
+def _short(text: str) -> str:
+    """``repr(text)``, cut to 80 characters (a path of 300 characters names nothing more in 300)."""
+    return repr(text) if len(text) <= 80 else f"{text[:60]!r}... ({len(text)} characters)"
+
+
 def builtin_names() -> list[str]:
     """The built-in scenes: ``scenes/*.scene`` (not ``scenes/examples/``)."""
-    return sorted(p.stem for p in SCENE_DIR.glob("*" + NATIVE_SUFFIX))
+    return sorted(p.stem for p in SCENE_DIR.glob("*" + NATIVE_SUFFIX) if p.is_file())
 
 
 def example_names() -> list[str]:
     """The example scenes in ``scenes/examples/``: loadable by name, not run by default."""
-    return sorted(p.stem for p in EXAMPLES_DIR.glob("*" + NATIVE_SUFFIX))
+    return sorted(p.stem for p in EXAMPLES_DIR.glob("*" + NATIVE_SUFFIX) if p.is_file())
 
 
 def load_scene(name_or_path: str) -> Scene:
@@ -344,10 +377,13 @@ def load_scene(name_or_path: str) -> Scene:
         else:
             raise InputError(f"--scene {name_or_path!r}: expected a built-in scene "
                              f"({', '.join(builtin_names() + example_names())}) or a file path")
-    if path.is_dir():
-        raise InputError(f"--scene {name_or_path!r} is a directory: expected a scene file")
-    if not path.is_file():
-        raise InputError(f"--scene {name_or_path!r}: file not found")
+    try:
+        if path.is_dir():
+            raise InputError(f"--scene {name_or_path!r} is a directory: expected a scene file")
+        if not path.is_file():
+            raise InputError(f"--scene {name_or_path!r}: file not found")
+    except OSError as exc:      # ENAMETOOLONG, ELOOP, EACCES on a folder of the path
+        raise InputError(f"--scene {_short(name_or_path)}: {exc.strerror or exc}: expected a readable file") from None
     suffix = path.suffix.lower()
     if suffix in MESH_SUFFIXES:
         return load_mesh_file(path)

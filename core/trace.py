@@ -119,13 +119,22 @@ def trace_vertex(scene: Scene, motion: Motion, camera: Camera, vertex: int, k: i
                     and -0.5 <= p_px[1] <= camera.height - 0.5)
     rec = {"frame": k, "t": (k - 1) / frames, "vertex": vertex,
            "model": p_model.tolist(), "world": p_world.tolist(), "camera": p_cam.tolist(),
-           "depth": float(p_cam[2]), "clip": p_clip.tolist(),
-           "ndc": None if p_ndc is None else p_ndc.tolist(),
+           "depth": float(p_cam[2]), "clip": _floats(p_clip),
+           "ndc": None if p_ndc is None else _floats(p_ndc),
            "pixel": None if p_px is None else p_px.tolist(),
-           "pixel_from_ndc": None if p_ndc is None else ndc_to_px(p_ndc, camera).tolist(),
+           "pixel_from_ndc": None if p_ndc is None else _floats(ndc_to_px(p_ndc, camera)),
            "visible": visible, "on_image": on_image,
            "edges": _edges(scene, motion, camera, vertex, k, frames, p_cam)}
     return rec
+
+
+def _floats(v) -> list:
+    """``v`` as a list, a value that overflowed float64 as None (JSON has no inf).
+
+    GL's clip form overflows where core's pipeline does not: its z row holds
+    2 f n / (n - f), infinite for a far plane near 1e308.
+    """
+    return [float(x) if np.isfinite(x) else None for x in np.asarray(v, dtype=np.float64)]
 
 
 def _edges(scene, motion, camera, vertex, k, frames, p_cam) -> list[dict]:
@@ -160,7 +169,7 @@ def _edges(scene, motion, camera, vertex, k, frames, p_cam) -> list[dict]:
 
 
 def _fmt(v, digits=6) -> str:
-    return "(" + ", ".join(f"{x: .{digits}f}" for x in v) + ")"
+    return "(" + ", ".join("overflow" if x is None else f"{x: .{digits}f}" for x in v) + ")"
 
 
 def trace_text(rec: dict, camera: Camera) -> str:

@@ -74,6 +74,11 @@ class Motion:
     offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
     scale: float = 1.0
 
+    def __post_init__(self):
+        from .limits import check_turns
+
+        check_turns(self.turns, "Motion turns")
+
     def model_matrix(self, t: float) -> np.ndarray:
         """``T @ Rz @ Ry @ Rx @ S`` at time ``t`` in [0, 1); computed, never accumulated."""
         # Reduce whole turns before converting to radians, so that a whole number

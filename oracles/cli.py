@@ -49,7 +49,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import re
 import sys
 from concurrent.futures.process import BrokenProcessPool
@@ -57,7 +56,8 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.output import check_replaceable
+from wirecheck.core.guard import run_cli
+from wirecheck.core.output import check_replaceable, check_report_dir
 
 from . import gate, tolerances
 from .isolation import external_candidate
@@ -270,6 +270,10 @@ def _external_option(args) -> str | None:
 
 
 def main(argv=None) -> int:
+    return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/guard.py)
+
+
+def _main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["export"]:                     # crosscheck export DIR: a job for image candidates
         from .frames_cli import export_main
@@ -277,8 +281,6 @@ def main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
-        if applied:
-            print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
         if args.junit_xml and (args.sweep or args.suite):
             raise InputError(f"--junit-xml with {'--sweep' if args.sweep else '--suite ' + args.suite}: "
                              "expected it in a plain crosscheck run (one test case per scene x camera)")
@@ -288,6 +290,8 @@ def main(argv=None) -> int:
         run_dir, run_option = _run_dir(args)
     except InputError as exc:
         return _error(str(exc))
+    if applied:      # after the checks: on a usage error the error is the only line
+        print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
     if level == "pixels":
         from .pyrender_oracle import osmesa_available
 
@@ -295,9 +299,7 @@ def main(argv=None) -> int:
         if not ok:
             return _error(f"{message} (or run with --level vertices)")
     try:
-        run_dir.parent.mkdir(parents=True, exist_ok=True)
-        if not os.access(run_dir.parent, os.W_OK):
-            raise OSError("permission denied")
+        check_report_dir(run_dir, run_option)
         check_replaceable(run_dir, run_option)
     except InputError as exc:
         return _error(str(exc))
@@ -330,6 +332,7 @@ def main(argv=None) -> int:
     report = {"run": args.run, **report}
     records = report["cases"]
     try:
+        run_dir.parent.mkdir(parents=True, exist_ok=True)     # only now: a failed run leaves no folder
         write_report(run_dir, report, images)
     except OSError as exc:
         return _error(f"writing {str(run_dir)!r} failed: {exc}")
@@ -366,6 +369,7 @@ def _sweep(args, inputs, level, tol, run_dir) -> int:
     print(f"Sweep: 12 settings x {len(inputs.scenes)} scenes + a large mesh x {len(inputs.case_names)} cameras, "
           f"{inputs.frames_checked} frames each", file=sys.stderr)
     try:
+        run_dir.parent.mkdir(parents=True, exist_ok=True)
         result = run_sweep(list(inputs.scenes), frames=inputs.frames, every=inputs.every,
                            case_names=list(inputs.case_names), turns=inputs.turns, large=large_mesh(),
                            pyrender=level == "pixels", progress=progress)

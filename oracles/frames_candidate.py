@@ -40,6 +40,9 @@ class FramesError(InputError):
         more = len(problems) - len(shown)
         super().__init__("\n".join(shown + ([f"... and {more} more"] if more else [])))
 
+    def __str__(self) -> str:       # one line per problem, kept apart (InputError joins lines into one)
+        return Exception.__str__(self)
+
 
 def load_job(job_dir: Path) -> dict:
     """The manifest ``DIR/job.json``, checked; FramesError otherwise."""

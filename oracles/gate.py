@@ -29,6 +29,7 @@ import numbers
 from dataclasses import dataclass
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.limits import MAX_FRAMES, check_turns
 from wirecheck.core import scene_files
 from wirecheck.core.scene import Scene
 from wirecheck.core.scene_files import builtin_names, load_scene
@@ -126,6 +127,8 @@ def run_inputs(scenes, frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=N
     them). The cheap checks come first; scenes may be files to read.
     """
     frames = _integer(frames, names["frames"], 1)
+    if frames > MAX_FRAMES:
+        raise InputError(f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (core/limits.py)")
     every = _integer(every, names["every"], 1)
     if every > frames:
         raise InputError(f"{names['every']} {every} with {names['frames']} {frames}: only frame 1 would be "
@@ -137,6 +140,7 @@ def run_inputs(scenes, frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=N
         turns = ()
     if len(turns) != 3 or not all(math.isfinite(x) for x in turns):
         raise InputError(f"{names['turns']} {given!r}: expected three finite numbers X,Y,Z")
+    check_turns(turns, names["turns"])
     if tol is not None:
         check_tolerances(tol, names)
     return RunInputs(scenes=resolve_scenes(scenes, names), frames=frames, every=every,

@@ -452,10 +452,10 @@ def test_every_option_has_help_with_its_default_and_no_markup():
 
 
 def test_progress_counts_every_frame_and_the_animation_encoding(tmp_path):
-    """One step per frame rendered, per GIF frame converted and written, and the MP4 flush.
+    """One step per frame rendered, per GIF frame encoded (as it is rendered), and the MP4 flush.
 
-    The spinning cube's 6 frames all differ, so Pillow writes all 6 (identical
-    neighbours would merge): 6 + 2 x 6 + 1 = progress_steps.
+    6 frames: 6 GIF steps, each before its frame's render step, then the
+    MP4 flush: 6 + 6 + 1 = 13 = progress_steps.
     """
     from wirecheck.core.cli import build_parser, settings_from_args
     from wirecheck.core.run import progress_steps, render_run
@@ -463,5 +463,5 @@ def test_progress_counts_every_frame_and_the_animation_encoding(tmp_path):
     s = settings_from_args(build_parser().parse_args(["--frames", "6", "--format", "gif,mp4", "--out", str(tmp_path)]))
     stages = []
     render_run(s, progress=stages.append)
-    assert stages == ["render"] * 6 + ["mp4"] + ["gif"] * 12
-    assert len(stages) == progress_steps(s) == 19
+    assert stages == ["gif", "render"] * 6 + ["mp4"]
+    assert len(stages) == progress_steps(s) == 13

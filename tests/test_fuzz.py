@@ -1,0 +1,86 @@
+"""Hypothesis over the scene parser, the mesh loader and both CLIs' arguments, in-process (issue 15).
+
+The contract and the input space are in tests/fuzz/contract.py; the long run
+(>= 10,000 inputs per CLI) is tests/fuzz/run_fuzz.py, its counts in
+docs/reliability.md.
+"""
+
+import tempfile
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from fuzz.contract import SCENE_TEXTS, HypothesisPick, crosscheck_argv, make_scene_arg, mutate_text, renderer_argv, run_cli
+from wirecheck.core.errors import InputError
+from wirecheck.core.scene import Scene
+from wirecheck.core.scene_files import load_scene, parse_scene_text
+
+SLOW = settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
+
+
+@pytest.fixture(scope="module")
+def earlier(tmp_path_factory):
+    """An earlier renderer output (with its manifest), copied into some output set-ups."""
+    from wirecheck.core import cli
+
+    out = tmp_path_factory.mktemp("earlier") / "out"
+    assert cli.main(["--frames", "2", "--width", "32", "--height", "24", "--format", "png,gif", "--out", str(out)]) == 0
+    return out
+
+
+@settings(max_examples=300, deadline=None)
+@given(data=st.data())
+def test_scene_parser_gives_a_scene_or_one_line(data):
+    pick = HypothesisPick(data)
+    text = mutate_text(pick, pick.choice(SCENE_TEXTS[:3]))
+    try:
+        scene = parse_scene_text(text, "f.scene")
+    except InputError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith("f.scene")
+    else:
+        assert isinstance(scene, Scene) and scene.vertices.shape[1] == 3
+
+
+@SLOW
+@given(data=st.data())
+def test_mesh_loader_gives_a_scene_or_one_line(data):
+    pick = HypothesisPick(data)
+    with tempfile.TemporaryDirectory() as d:
+        (Path(d) / "in").mkdir()
+        arg = make_scene_arg(pick, Path(d))
+        try:
+            scene = load_scene(arg)
+        except InputError as exc:
+            assert "\n" not in str(exc)
+        except OSError:                     # names the CLIs turn into one line (too long, not a folder)
+            pass
+        else:
+            assert len(scene.edges) == 0 or scene.edges.max() < len(scene.vertices)
+
+
+@SLOW
+@given(data=st.data())
+def test_renderer_contract(data, earlier):
+    from wirecheck.core import cli
+
+    with tempfile.TemporaryDirectory() as d:
+        box = Path(d)
+        (box / "in").mkdir()
+        argv = renderer_argv(HypothesisPick(data), box, earlier)
+        outcome = run_cli(cli.main, argv, box, "renderer")
+        assert outcome.problems == [], (argv, outcome)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck))
+@given(data=st.data())
+def test_crosscheck_contract(data, earlier):
+    from wirecheck.oracles import cli
+
+    with tempfile.TemporaryDirectory() as d:
+        box = Path(d)
+        (box / "in").mkdir()
+        argv = crosscheck_argv(HypothesisPick(data), box, earlier)
+        outcome = run_cli(cli.main, argv, box, "crosscheck")
+        assert outcome.problems == [], (argv, outcome)

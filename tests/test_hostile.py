@@ -1,0 +1,495 @@
+"""Hostile input (issue 15): one stderr line and exit 2, exit 3 for a bug, nothing half-written, nothing of the user's touched.
+
+Each test is one finding of the fuzzing that filed the issue.
+"""
+
+import json
+import os
+import signal
+import struct
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from wirecheck.core import cli as renderer_cli
+from wirecheck.core import run as core_run
+from wirecheck.core.errors import InputError, one_line
+from wirecheck.core.limits import MAX_FACE_VERTICES, MAX_FRAMES, MAX_SIDE
+from wirecheck.core.output import MARKER
+from wirecheck.core.scene_files import SCENE_DIR, parse_scene_text
+from wirecheck.core.staging import LOCK, MANIFEST
+from wirecheck.oracles import cli as crosscheck_cli
+
+
+def render(args, out, capsys):
+    rc = renderer_cli.main([*args, "--out", str(out)])
+    cap = capsys.readouterr()
+    return rc, cap.out, cap.err
+
+
+def assert_one_error_line(rc, err, *needles):
+    assert rc == 2, err
+    assert err.count("\n") == 1 and err.startswith(("renderer: error: ", "crosscheck: error: ")), err
+    assert "Traceback" not in err and "Warning" not in err
+    for n in needles:
+        assert n in err, (n, err)
+
+
+def tree(folder):
+    """Every path under ``folder`` (relative), to compare before and after."""
+    return sorted(os.path.relpath(os.path.join(d, n), folder) for d, ds, fs in os.walk(folder) for n in ds + fs)
+
+
+# ---- one error path ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-1", "0"])
+def test_ortho_height_not_finite_with_perspective(tmp_path, capsys, value):
+    rc, _, err = render(["--frames", "2", "--ortho-height", value], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, f"--ortho-height {float(value)}")
+    assert not (tmp_path / "o").exists()          # no cube-frames/ left behind (nor the folder)
+
+
+def test_huge_spin_option(tmp_path, capsys):
+    rc, _, err = render(["--frames", "7", "--spin", "1e308,0,0"], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, "--spin 1e+308 0 0", "2^53")
+
+
+def test_huge_spin_in_scene_file(tmp_path, capsys):
+    scene = tmp_path / "s.scene"
+    scene.write_text("v 0 0 0\nv 1 0 0\ne 0 1\nspin 1e308 0 0\n")
+    rc, _, err = render(["--frames", "7", "--scene", str(scene)], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, f"{scene}:4: spin 1e+308 0 0")
+
+
+def test_spin_limit_is_2_to_the_53(tmp_path, capsys):
+    # 2^53 turns is accepted (every frame at phase 0: an integer), one ulp of 2^53 more is not
+    assert render(["--frames", "3", "--spin", f"{2.0 ** 53:.17g},0,0"], tmp_path / "a", capsys)[0] == 0
+    rc, _, err = render(["--frames", "3", "--spin", f"{2.0 ** 53 + 2:.17g},0,0"], tmp_path / "b", capsys)
+    assert_one_error_line(rc, err, "--spin")
+
+
+def test_long_scene_name(tmp_path, capsys):
+    scene = tmp_path / "s.scene"
+    scene.write_text(f"name {'n' * 250}\nv 0 0 0\n")
+    rc, _, err = render(["--frames", "1", "--scene", str(scene)], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, "250 characters", "at most 100")
+    assert not (tmp_path / "o").exists()
+
+
+def test_long_scene_path(tmp_path, capsys):
+    rc, _, err = render(["--frames", "1", "--scene", str(tmp_path / ("p" * 300)) + ".scene"], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, "File name too long")
+
+
+def test_long_candidate_path(tmp_path, capsys):
+    rc = crosscheck_cli.main(["--candidate", str(tmp_path / ("c" * 300)) + ".py:f", "--scene", "cube",
+                              "--level", "vertices", "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err)
+    assert not (tmp_path / "r").exists()
+
+
+def _bad_ply(path):
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                    "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n")
+
+
+def _bad_glb(path):
+    """A binary glTF of one triangle (0, 1, 7) over 3 vertices, written by hand."""
+    pos = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes()
+    buf = pos + np.array([0, 1, 7], np.uint16).tobytes() + b"\0\0"
+    gltf = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+            "buffers": [{"byteLength": len(buf)}],
+            "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                            {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]},
+                          {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]}
+    j = json.dumps(gltf).encode()
+    j += b" " * (-len(j) % 4)
+    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 28 + len(j) + len(buf))
+                     + struct.pack("<II", len(j), 0x4E4F534A) + j + struct.pack("<II", len(buf), 0x004E4942) + buf)
+
+
+@pytest.mark.parametrize("make, suffix", [(_bad_ply, ".ply"), (_bad_glb, ".glb")])
+def test_face_index_out_of_range_renderer(tmp_path, capsys, make, suffix):
+    mesh = tmp_path / f"m{suffix}"
+    make(mesh)
+    rc, _, err = render(["--frames", "1", "--scene", str(mesh)], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, f"{mesh}: face 0 has vertex index 7: expected 0..2")
+
+
+@pytest.mark.parametrize("level", ["vertices", "pixels"])
+@pytest.mark.parametrize("make, suffix", [(_bad_ply, ".ply"), (_bad_glb, ".glb")])
+def test_face_index_out_of_range_crosscheck(tmp_path, capsys, make, suffix, level):
+    mesh = tmp_path / f"m{suffix}"
+    make(mesh)
+    rc = crosscheck_cli.main(["--scene", str(mesh), "--level", level, "--frames", "1", "--cases", "on_axis",
+                              "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err, "vertex index 7")
+    assert not (tmp_path / "r").exists()
+
+
+def test_ascii_stl_with_bad_facet_normal_is_quiet(tmp_path, capsys):
+    stl = tmp_path / "n.stl"
+    stl.write_text("solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                   "endloop\nendfacet\nendsolid x\n")
+    rc, out, err = render(["--frames", "1", "--scene", str(stl)], tmp_path / "o", capsys)
+    assert (rc, err) == (0, "")                   # trimesh's logged traceback is kept off stderr
+    assert "(3 vertices, 3 edges)" in out         # the triangle itself is read: the normals are unused
+
+
+def test_float32_tiny_fov_is_one_line_without_warnings(tmp_path, capsys):
+    rc, _, err = render(["--frames", "1", "--dtype", "float32", "--fov", "1e-300"], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, "--fov 1e-300 with --dtype float32", "overflows float32")
+
+
+def test_stl_with_nan_vertex_is_one_line(tmp_path, capsys):
+    stl = tmp_path / "nan.stl"
+    stl.write_text("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\nvertex 1 0 0\nvertex 0 1 0\n"
+                   "endloop\nendfacet\nendsolid x\n")
+    rc, _, err = render(["--frames", "1", "--scene", str(stl)], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, "vertex 0 has [0.0, 0.0, nan]")
+
+
+def test_winding_warning_never_precedes_an_error(tmp_path, capsys):
+    scene = tmp_path / "w.scene"
+    # faces 0-1-2 and 0-1-3 run edge 0->1 the same way (inconsistent winding); vertex 0's pixel
+    # x = f * 1e308 / 4 overflows float64 in frame 1
+    scene.write_text("v 1e308 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 0 1 2\nf 0 1 3\n")
+    rc, _, err = render(["--frames", "2", "--scene", str(scene)], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, "projects beyond the float64 range")
+    assert not (tmp_path / "o").exists()
+
+
+def test_winding_warning_still_shown_on_success(tmp_path, capsys):
+    scene = tmp_path / "w.scene"
+    scene.write_text("v 0 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 0 1 2\nf 0 1 3\n")
+    rc, _, err = render(["--frames", "1", "--scene", str(scene)], tmp_path / "o", capsys)
+    assert rc == 0 and err.startswith("renderer: warning: ") and err.count("\n") == 1
+
+
+def test_message_with_newlines_is_one_line():
+    assert str(InputError("--candidate 'x.py:f': importing x.py failed: ImportError: a\nb\n  c")) == \
+        "--candidate 'x.py:f': importing x.py failed: ImportError: a | b | c"
+    assert one_line("no break") == "no break"
+
+
+def test_candidate_import_error_with_newline(tmp_path, capsys):
+    cand = tmp_path / "cand.py"
+    cand.write_text("raise ImportError('first line\\nsecond line')\n")
+    crosscheck_cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--level", "vertices", "--frames", "1",
+                         "--cases", "on_axis", "--report-dir", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if err:                                  # refused at load: one line holding both lines of the message
+        assert err.count("\n") == 1 and "first line | second line" in err
+
+
+def test_non_utf8_mesh_files_are_read(tmp_path, capsys):
+    obj = tmp_path / "latin.obj"
+    obj.write_bytes("# caf\xe9 (Latin-1)\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".encode("latin-1"))
+    rc, out, err = render(["--frames", "1", "--scene", str(obj)], tmp_path / "o", capsys)
+    assert (rc, err) == (0, "") and "(3 vertices, 3 edges)" in out
+    stl = tmp_path / "latin.stl"
+    stl.write_bytes("solid caf\xe9\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                    "endloop\nendfacet\nendsolid caf\xe9\n".encode("latin-1"))
+    rc, out, err = render(["--frames", "1", "--scene", str(stl)], tmp_path / "o2", capsys)
+    assert "charset_normalizer" not in err and "Traceback" not in err
+    assert (rc, err) == (0, "") and "(3 vertices, 3 edges)" in out
+
+
+# ---- limits --------------------------------------------------------------------------------------
+
+def test_image_size_limit(tmp_path, capsys):
+    rc, _, err = render(["--width", "100000", "--height", "100000"], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, f"at most {MAX_SIDE} pixels a side")
+    rc, _, err = render(["--width", "16384", "--height", "16384"], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, "268,435,456 pixels", "at most 33,554,432")
+
+
+def test_frame_count_limit(tmp_path, capsys):
+    rc, _, err = render(["--frames", "100000000000000000000"], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, f"1..{MAX_FRAMES:,}")
+
+
+def test_polygon_size_limit(tmp_path):
+    n = MAX_FACE_VERTICES + 1
+    text = "".join(f"v {np.cos(t)} {np.sin(t)} 0\n" for t in np.linspace(0, 6, n)) + "f " + " ".join(map(str, range(n)))
+    with pytest.raises(InputError, match=f"s.scene:{n + 1}: face of {n} indices: expected at most"):
+        parse_scene_text(text, "s.scene")
+    parse_scene_text(text.rsplit(" ", 1)[0], "s.scene")     # MAX_FACE_VERTICES indices: accepted
+
+
+# ---- the guard: a bug is exit 3 and a log, never a traceback -----------------------------------
+
+def test_internal_error_renderer(tmp_path, capsys, monkeypatch):
+    def boom(*a, **k):
+        return 1 / 0
+
+    monkeypatch.setattr(renderer_cli, "render_run", boom)
+    rc, _, err = render(["--frames", "1"], tmp_path / "o", capsys)
+    assert rc == 3 and err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("renderer: internal error: ZeroDivisionError: division by zero")
+    log = err.split("the traceback is in ")[1].split(";")[0]
+    text = open(log).read()
+    os.unlink(log)
+    assert "Traceback (most recent call last)" in text and "in boom" in text
+
+
+def test_internal_error_crosscheck(tmp_path, capsys, monkeypatch):
+    def boom(*a, **k):
+        raise KeyError("x")
+
+    monkeypatch.setattr(crosscheck_cli, "run_crosscheck", boom)
+    rc = crosscheck_cli.main(["--scene", "cube", "--level", "vertices", "--report-dir", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert rc == 3 and err.count("\n") == 1 and err.startswith("crosscheck: internal error: KeyError")
+    os.unlink(err.split("the traceback is in ")[1].split(";")[0])
+
+
+# ---- never destroy what wirecheck did not write -------------------------------------------------
+
+def test_user_folder_named_like_the_old_backup_survives(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert render(["--frames", "2"], out, capsys)[0] == 0
+    mine = out / ".cube-frames.old"
+    mine.mkdir()
+    (mine / "keep.txt").write_text("mine")
+    assert render(["--frames", "3"], out, capsys)[0] == 0
+    assert (mine / "keep.txt").read_text() == "mine"
+    assert len([n for n in os.listdir(out / "cube-frames") if n != MARKER]) == 3
+
+
+def test_write_test_symlink_and_file_survive(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    target = tmp_path / "precious.txt"
+    target.write_text("data")
+    os.symlink(target, out / ".wirecheck-write-test")
+    assert render(["--frames", "1"], out, capsys)[0] == 0
+    assert target.read_text() == "data" and (out / ".wirecheck-write-test").is_symlink()
+
+
+@pytest.mark.parametrize("name", ["cube-report.txt", "cube-report.json", "cube.gif"])
+def test_users_file_with_an_output_name_is_refused(tmp_path, capsys, name):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / name).write_text("mine")
+    rc, _, err = render(["--frames", "1", "--format", "png,gif"], out, capsys)
+    assert_one_error_line(rc, err, name, "not written by wirecheck")
+    assert (out / name).read_text() == "mine" and tree(out) == [name]
+
+
+def test_output_edited_by_the_user_is_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert render(["--frames", "1"], out, capsys)[0] == 0
+    (out / "cube-report.txt").write_text("my notes")
+    rc, _, err = render(["--frames", "1"], out, capsys)
+    assert_one_error_line(rc, err, "changed since wirecheck wrote it")
+    assert (out / "cube-report.txt").read_text() == "my notes"
+
+
+def test_users_manifest_file_is_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / MANIFEST).write_text("my own json")
+    rc, _, err = render(["--frames", "1"], out, capsys)
+    assert_one_error_line(rc, err, "not written by wirecheck")
+    assert tree(out) == [MANIFEST]
+
+
+def test_symlink_with_an_output_name_is_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    target = tmp_path / "t.json"
+    target.write_text("{}")
+    os.symlink(target, out / "cube-report.json")
+    rc, _, err = render(["--frames", "1"], out, capsys)
+    assert_one_error_line(rc, err, "symbolic link")
+    assert target.read_text() == "{}"
+
+
+def test_report_json_as_a_directory_leaves_nothing(tmp_path, capsys):
+    out = tmp_path / "out"
+    (out / "cube-report.json").mkdir(parents=True)
+    (out / "cube-report.json" / "x").write_text("mine")
+    rc, _, err = render(["--frames", "2", "--format", "png,gif"], out, capsys)
+    assert_one_error_line(rc, err, "cube-report.json")
+    assert tree(out) == ["cube-report.json", "cube-report.json/x"]      # no cube-frames/, no cube.gif
+
+
+def test_failed_run_removes_the_folders_it_created(tmp_path, capsys, monkeypatch):
+    real = core_run._check_overflow
+
+    def fail_in_frame_3(s, frame, k):
+        if k == 3:
+            raise InputError("stop")
+        real(s, frame, k)
+
+    monkeypatch.setattr(core_run, "_check_overflow", fail_in_frame_3)
+    rc, _, _ = render(["--frames", "5", "--format", "png,gif,mp4"], tmp_path / "a" / "b", capsys)
+    assert rc == 2 and tree(tmp_path) == []                       # a/ and a/b/ were the run's: gone
+    (tmp_path / "kept").mkdir()
+    rc, _, _ = render(["--frames", "5", "--format", "png,gif,mp4"], tmp_path / "kept", capsys)
+    assert rc == 2 and tree(tmp_path) == ["kept"]                 # the user's folder stays, empty
+
+
+@pytest.mark.parametrize("where", ["in_scenes", "named_like_a_scene"])
+def test_report_dir_never_shadows_a_scene(tmp_path, capsys, where):
+    target = SCENE_DIR / "evil.scene" if where == "in_scenes" else tmp_path / "evil.scene"
+    rc = crosscheck_cli.main(["--report-dir", str(target), "--scene", "cube", "--level", "vertices",
+                              "--frames", "1", "--cases", "on_axis"])
+    assert_one_error_line(rc, capsys.readouterr().err, "--report-dir")
+    assert not target.exists()
+
+
+def test_failed_crosscheck_creates_no_report_parent(tmp_path, capsys):
+    rc = crosscheck_cli.main(["--report-dir", str(tmp_path / "a" / "r"), "--scene", "nosuch", "--level", "vertices"])
+    assert rc == 2 and tree(tmp_path) == []
+
+
+# ---- one writer at a time ------------------------------------------------------------------------
+
+def test_live_lock_is_refused_stale_lock_is_taken_over(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        (out / LOCK).write_text(f"wirecheck lock pid {sleeper.pid}\n")
+        rc, _, err = render(["--frames", "1"], out, capsys)
+        assert_one_error_line(rc, err, f"being written by another wirecheck run (process {sleeper.pid})")
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    assert render(["--frames", "1"], out, capsys)[0] == 0          # its process is gone: stale
+    assert not (out / LOCK).exists()
+
+
+def test_users_file_named_like_the_lock_is_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / LOCK).write_text("mine")
+    rc, _, err = render(["--frames", "1"], out, capsys)
+    assert_one_error_line(rc, err, "not written by wirecheck")
+    assert (out / LOCK).read_text() == "mine"
+
+
+def test_two_renderers_on_one_out_never_mix(tmp_path):
+    """Pairs of runs of different lengths at once: each exits 0 or refuses (2, the lock); the set is one run's."""
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "wirecheck.core.cli", "--width", "64", "--height", "48", "--out", str(out)]
+    for pair in range(4):
+        procs = [subprocess.Popen([*cmd, "--frames", str(n)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                 for n in (20 + pair, 27 + pair)]
+        results = [(p.wait(), p.stderr.read().decode()) for p in procs]
+        for p in procs:
+            p.stdout.close()
+            p.stderr.close()
+        for rc, err in results:
+            assert rc == 0 or (rc == 2 and "being written by another wirecheck run" in err), err
+        assert any(rc == 0 for rc, _ in results)
+        frames = len([n for n in os.listdir(out / "cube-frames") if n != MARKER])
+        report = json.loads((out / "cube-report.json").read_text())
+        assert frames == report["summary"]["frames"]
+        assert [n for n in os.listdir(out) if n.endswith(".tmp") or n == LOCK] == []
+
+
+# ---- killed: nothing half-written ------------------------------------------------------------------
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_killed_run_leaves_nothing(tmp_path, sig):
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--frames", "2000", "--verbose",
+                             "--format", "png,gif", "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    for _ in range(3):
+        proc.stdout.readline()                 # "Scene: ...", frames 1 and 2: it is writing
+    proc.send_signal(sig)
+    err = proc.communicate(timeout=60)[1].decode()
+    assert proc.returncode == 128 + sig and "Traceback" not in err and err.count("\n") == 1
+    assert not out.exists()                    # the run created out/: removed with its temporaries
+
+
+def test_killed_rerun_keeps_the_earlier_output(tmp_path):
+    out = tmp_path / "out"
+    assert subprocess.run([sys.executable, "-m", "wirecheck.core.cli", "--frames", "2", "--out", str(out)],
+                          capture_output=True).returncode == 0
+    before = {n: (out / n).read_bytes() for n in ("cube-report.json", "cube-report.txt")}
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--frames", "2000", "--verbose",
+                             "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    for _ in range(3):
+        proc.stdout.readline()
+    time.sleep(0.2)
+    proc.terminate()
+    proc.communicate(timeout=60)
+    assert proc.returncode == 143
+    assert {n: (out / n).read_bytes() for n in before} == before
+    assert sorted(os.listdir(out)) == [MANIFEST, "cube-frames", "cube-report.json", "cube-report.txt"]
+
+
+def test_api_mesh_loading_is_quiet_too(tmp_path):
+    """load_scene (the API, no CLI guard around it) keeps trimesh's logged traceback off stderr.
+
+    In a fresh interpreter: pytest's own log capture would hide the traceback.
+    """
+    stl = tmp_path / "n.stl"
+    stl.write_text("solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                   "endloop\nendfacet\nendsolid x\n")
+    proc = subprocess.run([sys.executable, "-c", "import sys; from wirecheck import load_scene; "
+                           "print(len(load_scene(sys.argv[1]).vertices))", str(stl)], capture_output=True, text=True)
+    assert (proc.stdout, proc.stderr) == ("3\n", "")
+
+
+def test_crosscheck_users_old_folder_survives_a_report_replace(tmp_path, capsys):
+    args = ["--report-dir", str(tmp_path / "r"), "--scene", "cube", "--cases", "on_axis", "--level", "vertices",
+            "--frames", "1"]
+    assert crosscheck_cli.main(args) == 0
+    mine = tmp_path / ".r.old"
+    mine.mkdir()
+    (mine / "keep.txt").write_text("mine")
+    assert crosscheck_cli.main(args) == 0
+    assert (mine / "keep.txt").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".r.old", "r"]       # no other leftovers
+
+
+def test_settings_line_from_the_config_never_precedes_an_error(tmp_path, capsys, monkeypatch):
+    (tmp_path / "pyproject.toml").write_text('[tool.wirecheck]\nframes = 3\nlevel = "vertices"\n')
+    monkeypatch.chdir(tmp_path)
+    rc = crosscheck_cli.main(["--scene", "nosuch", "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err, "--scene 'nosuch'")
+
+
+def test_trace_with_a_far_plane_near_the_float64_limit(tmp_path, capsys):
+    """GL's clip z row holds 2 f n / (n - f): with far 1e308 it overflows; the trace says so (null in JSON)."""
+    rc, out, err = render(["--frames", "1", "--trace-vertex", "0", "--far", "1e308"], tmp_path / "o", capsys)
+    assert (rc, err) == (0, "")
+    trace = json.loads((tmp_path / "o" / "cube-report.json").read_text())["trace"][0]
+    assert trace["clip"][2] is None and trace["clip"][3] == trace["depth"]      # w = z_cam, finite
+    assert "overflow" in out
+
+
+def test_crosscheck_frame_count_limit(tmp_path, capsys):
+    rc = crosscheck_cli.main(["--frames", "100000000000000000000", "--scene", "cube", "--level", "vertices",
+                              "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err, f"1..{MAX_FRAMES:,}")
+
+
+def test_run_under_report_dir_never_creates_a_scene_named_folder(tmp_path, capsys):
+    target = tmp_path / "evil.scene"
+    rc = crosscheck_cli.main(["--report-dir", str(target), "--run", "r1", "--scene", "cube", "--level", "vertices",
+                              "--frames", "1", "--cases", "on_axis"])
+    assert_one_error_line(rc, capsys.readouterr().err, "evil.scene")
+    assert not target.exists()
+
+
+def test_run_name_too_long_leaves_no_reports_folder(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rc = crosscheck_cli.main(["--run", "x" * 300, "--scene", "cube", "--level", "vertices", "--frames", "1",
+                              "--cases", "on_axis"])
+    assert_one_error_line(rc, capsys.readouterr().err, "300 characters")
+    assert tree(tmp_path) == []
