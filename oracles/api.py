@@ -12,11 +12,10 @@
 Isolation: a candidate given as a string (``"FILE.py:FUNC"``) or ``cmd`` runs
 in its own process under a per-request timeout (``timeout_s``), so a crash,
 ``os._exit`` or a hang fails a case instead of ending or blocking your test
-run. A callable runs isolated too when another process can import it (a
-module-level function of an importable module); otherwise (a lambda, a
-closure, a bound method, a function of ``__main__``) it runs in this process,
-which is quicker but unprotected. ``isolate=True`` insists (ValueError when it
-cannot), ``isolate=False`` runs a callable in this process. By default only the OpenCV vertex oracle runs (fast,
+run. A callable runs isolated too: in the candidate host when another
+process can import it (a module-level function of an importable module),
+else (a lambda, a closure, a bound method) in a forked copy of this process;
+``isolate=False`` runs it in this process, quicker but unprotected. By default only the OpenCV vertex oracle runs (fast,
 no OpenGL needed); pass ``oracles=("opencv", "pyrender")`` to compare drawn
 pixels too.
 """
@@ -69,9 +68,10 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     timeout_s : float
         Seconds each request to an isolated candidate may take (default 10).
     isolate : bool, optional
-        None (default): run ``func`` in its own process when it is a string or
-        an importable module-level function; True: insist (ValueError if it
-        cannot be); False: run a callable in this process.
+        None or True (default None): run ``func`` in its own process (the
+        candidate host for a string or an importable function, a forked copy
+        of this process for a lambda or a closure); False: run a callable in
+        this process (an ``os._exit`` in it then ends your test run).
 
     Returns
     -------

@@ -65,6 +65,14 @@ def serve(spec: str, stdin, stdout) -> int:
         send(protocol.encode_error(f"--candidate {spec!r}: importing failed: {type(exc).__name__}: {exc}"))
         return 0
     send(protocol.HEADER)
+    return serve_loaded(func, stdin, send)
+
+
+def serve_loaded(func, stdin, send) -> int:
+    """The request loop over a loaded candidate ``func`` (after the header is answered)."""
+    from . import protocol
+    from .candidate import CandidateError, call_candidate
+
     camera_key = camera = None
     while True:
         line = stdin.readline()

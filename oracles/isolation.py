@@ -4,8 +4,10 @@
 - ``--candidate FILE.py:FUNC`` / ``"FILE.py:FUNC"``: the candidate host in its
   own process (oracles.candidate_host).
 - ``--candidate-cmd 'COMMAND ARGS'`` / ``cmd=``: the program, in its own process.
-- an API callable: isolated when another process can import it
-  (:func:`importable_spec`), else in the caller's process (docs/protocol.md).
+- an API callable: in the candidate host when another process can import it
+  (:func:`importable_spec`), else (a lambda, a closure) in a forked copy of
+  the caller's process (POSIX); in the caller's process only with
+  ``isolate=False`` (docs/protocol.md).
 
 Every isolated candidate is started here once, so that a program that cannot
 start or refuses to is a usage error (exit 2) before any case runs.
@@ -105,11 +107,17 @@ def api_candidate(func=None, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S, iso
         check_python_spec(func)
         return func, started(SubprocessCandidate.python(func, timeout_s), "--candidate")
     name = getattr(func, "__qualname__", repr(func))
-    spec = importable_spec(func) if isolate is not False else None
-    if spec is None:
-        if isolate:
-            raise ValueError(f"isolate=True: {name} cannot be imported by another process (expected a "
-                             "module-level function of an importable module)")
+    if isolate is False:
         return name, func
+    spec = importable_spec(func)
+    if spec is None:
+        import os
+
+        if not hasattr(os, "fork"):
+            if isolate:
+                raise ValueError(f"isolate=True: {name} cannot be imported by another process (expected a "
+                                 "module-level function of an importable module) and this system cannot fork")
+            return name, func
+        return name, started(SubprocessCandidate.fork(func, timeout_s, label=name), "func")
     path = tuple(p for p in sys.path if isinstance(p, str))
     return name, started(SubprocessCandidate.python(spec, timeout_s, pythonpath=path, label=name), "--candidate")

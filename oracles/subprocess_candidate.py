@@ -79,6 +79,10 @@ class SubprocessCandidate:
     python_spec : str or None
         Set for a Python candidate run by :mod:`oracles.candidate_host`: its
         messages are then the in-process contract's, verbatim.
+    forked : callable or None
+        A Python callable no other process can import (a lambda, a closure):
+        run in a forked copy of this process (POSIX) that serves the same
+        protocol; ``argv`` is then only its label.
     """
 
     argv: tuple
@@ -87,6 +91,7 @@ class SubprocessCandidate:
     label: str = ""
     env: tuple = ()
     python_spec: str | None = None
+    forked: object = None
 
     def __post_init__(self):
         if not self.argv:
@@ -115,6 +120,12 @@ class SubprocessCandidate:
         env = (("WIRECHECK_HOST_PATH", os.pathsep.join(pythonpath)),) if pythonpath else ()
         return cls(argv=(sys.executable, "-m", "wirecheck.oracles.candidate_host", spec), timeout_s=timeout_s,
                    label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
+
+    @classmethod
+    def fork(cls, func, timeout_s: float = DEFAULT_TIMEOUT_S, label: str = "") -> "SubprocessCandidate":
+        """``func`` run in a forked child process (:class:`_ForkedChild`); POSIX only."""
+        return cls(argv=("<forked>",), timeout_s=timeout_s, label=label or repr(func), python_spec=label or repr(func),
+                   forked=func)
 
     @property
     def name(self) -> str:
@@ -174,6 +185,79 @@ def _die_with_parent() -> None:
         pass
 
 
+class _ForkedChild:
+    """A forked copy of this process serving the candidate protocol for ``func``: what Popen gives, for it.
+
+    The child gets its own session (so the program group can be killed), dies
+    with its parent (Linux), sends its prints and stderr to the stderr pipe,
+    and always ends with ``os._exit``: it never returns into the caller's code.
+    """
+
+    def __init__(self, func):
+        in_r, in_w = os.pipe()
+        out_r, out_w = os.pipe()
+        err_r, err_w = os.pipe()
+        pid = os.fork()
+        if pid == 0:                                   # the child
+            code = 1
+            try:
+                os.setsid()
+                _die_with_parent()
+                for fd in (in_w, out_r, err_r):
+                    os.close(fd)
+                os.dup2(err_w, 1)
+                os.dup2(err_w, 2)
+                sys.stdout = sys.stderr = open(2, "w", buffering=1, closefd=False)
+                from .candidate_host import serve_loaded
+
+                stdin, out = os.fdopen(in_r, "rb"), os.fdopen(out_w, "wb")
+
+                def send(data: bytes) -> None:
+                    out.write(data)
+                    out.flush()
+
+                if stdin.readline() == protocol.HEADER:
+                    send(protocol.HEADER)
+                    code = serve_loaded(func, stdin, send)
+                else:
+                    send(protocol.encode_error(f"expected the header {protocol.HEADER!r}"))
+                    code = 2
+            except BaseException:                      # noqa: BLE001 - the child must never return
+                code = 1
+            finally:
+                os._exit(code)
+        for fd in (in_r, out_w, err_w):
+            os.close(fd)
+        self.pid = pid
+        self.args = ("<forked>",)
+        self.returncode = None
+        self.stdin = os.fdopen(in_w, "wb", buffering=0)
+        self.stdout = os.fdopen(out_r, "rb", buffering=0)
+        self.stderr = os.fdopen(err_r, "rb", buffering=0)
+
+    def poll(self):
+        if self.returncode is None:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid:
+                self.returncode = os.waitstatus_to_exitcode(status)
+        return self.returncode
+
+    def wait(self, timeout=None):
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while self.poll() is None:
+            if deadline is not None and time.monotonic() > deadline:
+                raise subprocess.TimeoutExpired(self.args, timeout)
+            time.sleep(0.001)
+        return self.returncode
+
+    def kill(self) -> None:
+        if self.returncode is None:
+            try:
+                os.kill(self.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+
 class _Died(Exception):
     pass
 
@@ -225,8 +309,12 @@ class _Program:
         env = dict(os.environ)
         env.update(dict(spec.env))
         try:
-            proc = subprocess.Popen(spec.argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                    env=env, start_new_session=True, bufsize=0, preexec_fn=_die_with_parent)
+            if spec.forked is not None:
+                proc = _ForkedChild(spec.forked)
+            else:
+                proc = subprocess.Popen(spec.argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                        stderr=subprocess.PIPE, env=env, start_new_session=True, bufsize=0,
+                                        preexec_fn=_die_with_parent)
         except OSError as exc:
             raise CandidateStartRefused(f"cannot start {spec.argv[0]!r}: {exc.strerror or exc}") from None
         self.proc = proc

@@ -34,7 +34,7 @@ def test_check_projector_with_pixels():
     assert report["cases"][0]["pixel_f1_1px"] == 1.0      # measured 1.0 everywhere (README)
 
 
-def test_an_importable_callable_runs_isolated_and_a_lambda_in_process():
+def test_an_importable_callable_runs_in_the_host_and_a_lambda_in_a_fork():
     from wirecheck.core.projection import project_points
     from wirecheck.oracles.isolation import api_candidate
     from wirecheck.oracles.subprocess_candidate import SubprocessCandidate
@@ -42,11 +42,49 @@ def test_an_importable_callable_runs_isolated_and_a_lambda_in_process():
     name, cand = api_candidate(project_points)            # a module-level function: the host imports it
     assert name == "project_points" and isinstance(cand, SubprocessCandidate)
     assert cand.python_spec == "wirecheck.core.projection:project_points"
-    name, cand = api_candidate(lambda p, c: project_points(p, c))
-    assert name == "test_an_importable_callable_runs_isolated_and_a_lambda_in_process.<locals>.<lambda>"
-    assert not isinstance(cand, SubprocessCandidate)
-    with pytest.raises(ValueError, match="isolate=True"):
-        api_candidate(lambda p, c: p, isolate=True)
+    lam = lambda p, c: project_points(p, c)                # noqa: E731 - no other process can import it
+    name, cand = api_candidate(lam)
+    assert name == "test_an_importable_callable_runs_in_the_host_and_a_lambda_in_a_fork.<locals>.<lambda>"
+    assert isinstance(cand, SubprocessCandidate) and cand.forked is lam
+    cand.close()
+    assert api_candidate(lam, isolate=False) == (name, lam)
+
+
+def test_a_lambda_that_kills_its_process_fails_instead_of_ending_pytest():
+    # In a separate interpreter: if the closure ran in-process, os._exit(0) would end this
+    # pytest run with status 0 (a pass); there it ends the script before it prints.
+    import subprocess
+    import sys
+
+    script = """if True:
+        import os
+        from wirecheck import check_projector
+
+        def dies(points, camera):        # a closure: run in a forked copy of this process
+            os._exit(0)
+
+        report = check_projector(dies, scenes=["cube"], frames=1, cases=["on_axis"])
+        print(report["verdict"], report["cases"][0]["reasons"])
+    """
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "fail ['frame 1: candidate exited with status 0 during a request of 8 points']"
+
+
+def test_a_closure_in_a_fork_gives_the_in_process_results():
+    from wirecheck.core.projection import project_points
+
+    offset = 0.5                                           # a closure over a local: not importable
+
+    def shifted(points, camera):
+        return project_points(points, camera) + offset
+
+    kw = dict(scenes=["cube"], frames=2, cases=["on_axis", "oblique_roll"])
+    forked = check_projector(shifted, **kw)
+    here = check_projector(shifted, isolate=False, **kw)
+    assert forked["verdict"] == here["verdict"] == "fail"
+    assert [c["faults"] for c in forked["cases"]] == [c["faults"] for c in here["cases"]]
+    assert [c["max_vertex_error_px"] for c in forked["cases"]] == [c["max_vertex_error_px"] for c in here["cases"]]
 
 
 def test_a_callable_that_kills_its_process_fails_instead_of_ending_pytest():
