@@ -185,6 +185,29 @@ def _unexplained(**fields) -> dict:
     return {"name": "unexplained", **fields}
 
 
+def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> list[dict]:
+    """``aspect_mismatch`` and ``fov_mismatch`` from the fitted scales ``sx, sy`` of the pixel axes.
+
+    A scale is named when it moves the farthest point of its axis (``reach``,
+    pixels from the principal point) by more than ``tol`` pixels; the implied
+    aspect, FOV (perspective) or ortho height is what the candidate used.
+    ``fields`` are added to each fault (the image diagnosis' confidence).
+    """
+    faults = []
+    if abs(sx - sy) * reach[0] > tol:
+        faults.append({"name": "aspect_mismatch", **fields,
+                       "implied_aspect": (camera.width / camera.height) * sy / sx, "scale_x": sx, "scale_y": sy})
+    if abs(sy - 1.0) * reach[1] > tol:
+        fault = {"name": "fov_mismatch", **fields, "scale": sy, "implied_fov_deg": None, "implied_ortho_height": None}
+        if camera.projection == "perspective":
+            half = math.tan(math.radians(camera.fov_y_deg) / 2.0)
+            fault["implied_fov_deg"] = math.degrees(2.0 * math.atan(half / sy))
+        else:
+            fault["implied_ortho_height"] = camera.ortho_height / sy
+        faults.append(fault)
+    return faults
+
+
 def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
     """Name the faults of a candidate projector; ``[]`` when it agrees.
 
@@ -295,19 +318,7 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
     mirror = {(-1, 1): "mirror_horizontal", (1, -1): "mirror_vertical", (-1, -1): "axis_flip"}.get(signs)
     if mirror:
         faults.append({"name": mirror})
-    sx, sy = float(d[0]), float(d[1])
-    if abs(sx - sy) * reach[0] > tol:
-        faults.append({"name": "aspect_mismatch",
-                       "implied_aspect": (camera.width / camera.height) * sy / sx,
-                       "scale_x": sx, "scale_y": sy})
-    if abs(sy - 1.0) * reach[1] > tol:
-        fault = {"name": "fov_mismatch", "scale": sy, "implied_fov_deg": None, "implied_ortho_height": None}
-        if camera.projection == "perspective":
-            half = math.tan(math.radians(camera.fov_y_deg) / 2.0)
-            fault["implied_fov_deg"] = math.degrees(2.0 * math.atan(half / sy))
-        else:
-            fault["implied_ortho_height"] = camera.ortho_height / sy
-        faults.append(fault)
+    faults += scale_faults(float(d[0]), float(d[1]), reach, tol, camera)
     expected = np.zeros(2)
     if swap:
         shift = cx - cy                               # a raw swap moves each axis by +-(cx - cy)

@@ -73,7 +73,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .diagnose import FAULT_ORDER
+from .diagnose import FAULT_ORDER, scale_faults
 
 __all__ = ["diagnose_images", "oracle_segments", "flipped_camera", "PERMUTATIONS"]
 
@@ -455,19 +455,7 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
                                                          a_free[0, 0] + a_free[1, 1]))}]
     d = np.diag(a)
     faults = [{"name": n, **common} for n in names]
-    sx, sy = float(d[0]), float(d[1])
-    if abs(sx - sy) * reach[0] > SCALE_TOL_PX:
-        faults.append({"name": "aspect_mismatch", **common,
-                       "implied_aspect": (camera.width / camera.height) * sy / sx, "scale_x": sx, "scale_y": sy})
-    if abs(sy - 1.0) * reach[1] > SCALE_TOL_PX:
-        fault = {"name": "fov_mismatch", **common, "scale": sy, "implied_fov_deg": None,
-                 "implied_ortho_height": None}
-        if camera.projection == "perspective":
-            half = math.tan(math.radians(camera.fov_y_deg) / 2.0)
-            fault["implied_fov_deg"] = math.degrees(2.0 * math.atan(half / sy))
-        else:
-            fault["implied_ortho_height"] = camera.ortho_height / sy
-        faults.append(fault)
+    faults += scale_faults(float(d[0]), float(d[1]), reach, SCALE_TOL_PX, camera, **common)
     expected = np.zeros(2)
     if "axis_swap" in names:
         shift = cx - cy                               # as oracles.diagnose: a raw swap shifts by +-(cx - cy)

@@ -330,17 +330,12 @@ class _Program:
         limit = spec.start_timeout_s or max(spec.timeout_s, MIN_START_TIMEOUT_S)
         what = "at start-up, before answering the protocol header"
         try:
-            end = self._transfer(protocol.HEADER, self._line_end, time.monotonic() + limit)
+            end = self._exchange(protocol.HEADER, self._line_end, limit,
+                                 f"candidate did not answer the protocol header within {limit:g} s "
+                                 "(start-up); it was killed", what)
             line = bytes(self.buf[:end])
             del self.buf[:end]
             protocol.check_hello(line)
-        except _TimedOut:
-            self._kill()
-            raise CandidateError(f"candidate did not answer the protocol header within {limit:g} s "
-                                 f"(start-up); it was killed{self._stderr_hint()}") from None
-        except _Died:
-            status = self._reap()
-            raise CandidateError(f"candidate {status} {what}{self._stderr_hint()}") from None
         except protocol.CandidateReportedError as exc:
             self._kill()
             raise CandidateStartRefused(str(exc) if spec.python_spec else f"candidate refused to start: {exc}") \
@@ -424,14 +419,9 @@ class _Program:
             if self.buf:
                 raise protocol.ProtocolError(f"wrote {len(self.buf)} bytes outside a reply: "
                                              f"{protocol.shown(bytes(self.buf))}")
-            end = self._transfer(payload, reply_end, time.monotonic() + self.spec.timeout_s)
-        except _TimedOut:
-            self._kill()
-            raise CandidateError(f"candidate timed out after {self.spec.timeout_s:g} s on {what}; it was killed "
-                                 f"(and is started again for the next case){self._stderr_hint()}") from None
-        except _Died:
-            status = self._reap()
-            raise CandidateError(f"candidate {status} during {what}{self._stderr_hint()}") from None
+            end = self._exchange(payload, reply_end, self.spec.timeout_s,
+                                 f"candidate timed out after {self.spec.timeout_s:g} s on {what}; it was killed "
+                                 "(and is started again for the next case)", f"during {what}")
         except protocol.CandidateReportedError as exc:
             del self.buf[:header["line"]]
             if self.spec.python_spec:
@@ -444,6 +434,17 @@ class _Program:
             p_px = protocol.decode_points(view[header["line"]:end], 2)
         del self.buf[:end]
         return p_px
+
+    def _exchange(self, payload: bytes, end_of, limit_s: float, timed_out: str, died_while: str) -> int:
+        """:meth:`_transfer` within ``limit_s``; a hang (killed) or a death becomes one CandidateError."""
+        try:
+            return self._transfer(payload, end_of, time.monotonic() + limit_s)
+        except _TimedOut:
+            self._kill()
+            raise CandidateError(f"{timed_out}{self._stderr_hint()}") from None
+        except _Died:
+            status = self._reap()
+            raise CandidateError(f"candidate {status} {died_while}{self._stderr_hint()}") from None
 
     def _line_end(self, buf) -> int | None:
         """Index just past the first newline, None if none yet; ProtocolError if the line is too long."""
