@@ -9,6 +9,10 @@ drawn pixel within Chebyshev distance ``t`` (t = 1: its 3x3 neighbourhood).
     F1@t        = 2 P R / (P + R)
 
 Two blank images agree perfectly (F1 = 1); one blank and one not give 0.
+
+(About 520 lines: every comparison of two projections or two frames lives
+here, beside the conventions they share; the line gate's functions, from
+``sign_test_p`` down, are the part to move out if it grows.)
 """
 
 from __future__ import annotations

@@ -23,6 +23,10 @@ memory stays bounded however much the program writes, nothing goes to disk,
 and what the program wrote before its reply is always there (the report is
 the same on every run). :meth:`SubprocessCandidate.take_stderr` returns what
 was written since the last call.
+
+(About 540 lines: one program's life cycle, its non-blocking pipes and its
+protocol state are one state machine; :class:`_ForkedChild` is the Popen
+stand-in for callables run in a fork.)
 """
 
 from __future__ import annotations
