@@ -46,3 +46,12 @@ def eight_connected(pixels) -> bool:
                     seen.add(q)
                     stack.append(q)
     return seen == pixels
+
+
+def assert_help_states_defaults(parser) -> None:
+    """Every option of ``parser`` but -h/--version has help naming its default; no reStructuredText in --help."""
+    for action in parser._actions:
+        if action.dest not in ("help", "version"):          # -h and --version take no value
+            assert action.help and "default" in action.help, action.option_strings
+    text = parser.format_help()
+    assert "``" not in text and ":func:" not in text and ":mod:" not in text

@@ -6,7 +6,6 @@ Each test is one finding of the fuzzing that filed the issue.
 import json
 import os
 import signal
-import struct
 import subprocess
 import sys
 import time
@@ -22,6 +21,8 @@ from wirecheck.core.output import MARKER
 from wirecheck.core.scene_files import SCENE_DIR, parse_scene_text
 from wirecheck.core.staging import LOCK, MANIFEST
 from wirecheck.oracles import cli as crosscheck_cli
+
+from fuzz.contract import glb_bytes     # tests/ is on sys.path (rootdir conftest)
 
 
 def render(args, out, capsys):
@@ -98,21 +99,8 @@ def _bad_ply(path):
 
 
 def _bad_glb(path):
-    """A binary glTF of one triangle (0, 1, 7) over 3 vertices, written by hand."""
-    pos = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes()
-    buf = pos + np.array([0, 1, 7], np.uint16).tobytes() + b"\0\0"
-    gltf = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-            "buffers": [{"byteLength": len(buf)}],
-            "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
-                            {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
-            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                           "min": [0, 0, 0], "max": [1, 1, 0]},
-                          {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]}
-    j = json.dumps(gltf).encode()
-    j += b" " * (-len(j) % 4)
-    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 28 + len(j) + len(buf))
-                     + struct.pack("<II", len(j), 0x4E4F534A) + j + struct.pack("<II", len(buf), 0x004E4942) + buf)
+    """A binary glTF of one triangle (0, 1, 7) over 3 vertices, written by hand (tests/fuzz/contract.py)."""
+    path.write_bytes(glb_bytes((0, 1, 7)))
 
 
 @pytest.mark.parametrize("make, suffix", [(_bad_ply, ".ply"), (_bad_glb, ".glb")])

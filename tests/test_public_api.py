@@ -54,11 +54,7 @@ def test_version_option(main_module, capsys):
 
 
 def test_every_crosscheck_option_has_help_with_its_default_and_no_markup():
+    from helpers import assert_help_states_defaults
     from wirecheck.oracles.cli import build_parser
 
-    parser = build_parser()
-    for action in parser._actions:
-        if action.dest not in ("help", "version"):          # -h and --version take no value
-            assert action.help and "default" in action.help, action.option_strings
-    text = parser.format_help()
-    assert "``" not in text and ":func:" not in text and ":mod:" not in text
+    assert_help_states_defaults(build_parser())

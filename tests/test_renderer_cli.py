@@ -441,14 +441,10 @@ def test_huge_finite_vertex_is_not_a_crash(tmp_path):
 # ---- --help and the progress bar ---------------------------------------------------
 
 def test_every_option_has_help_with_its_default_and_no_markup():
+    from helpers import assert_help_states_defaults
     from wirecheck.core.cli import build_parser
 
-    parser = build_parser()
-    for action in parser._actions:
-        if action.dest not in ("help", "version"):          # -h and --version take no value
-            assert action.help and "default" in action.help, action.option_strings
-    text = parser.format_help()
-    assert "``" not in text and ":func:" not in text and ":mod:" not in text
+    assert_help_states_defaults(build_parser())
 
 
 def test_progress_counts_every_frame_and_the_animation_encoding(tmp_path):
