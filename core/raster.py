@@ -92,11 +92,18 @@ def snap_subpixel(p_px: np.ndarray) -> np.ndarray:
     """Coordinates rounded to the :data:`SUBPIXEL` grid (float64)."""
     return np.round(p_px * SUBPIXEL) / SUBPIXEL
 
-#: Segments rasterized per batch. Keeps the per-sample temporaries small (a few
-#: hundred kB): one batch of 100k+ segments makes tens of MB of temporaries that
-#: glibc maps and unmaps on every frame, and the page faults cost as much as
-#: the arithmetic. Batching does not change the result (same pixels, same order).
-CHUNK_SEGMENTS = 4096
+#: Segments rasterized per batch. Keeps the per-segment temporaries (about 30
+#: arrays of this length) inside the L2 cache: one batch of 100k+ segments
+#: makes tens of MB of temporaries that glibc maps and unmaps on every frame,
+#: and the page faults cost as much as the arithmetic. Batching does not change
+#: the result (same pixels, same order).
+CHUNK_SEGMENTS = 8192
+
+#: "exact" computes its integer grid arithmetic in float64 (exact below 2^53,
+#: and faster than int64 division) when every end is within this many grid
+#: units (1/256 px) of the origin: 2^23 units = 32,768 px. Then every product
+#: and sum in :func:`_line_pixels` stays below 2^51. Farther ends take int64.
+_FLOAT_GRID_LIMIT = 2.0 ** 23
 
 
 def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
@@ -115,17 +122,18 @@ def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     Returns
     -------
     rr, cc : (K,) ndarray of intp
-        Row and column of each drawn pixel.
+        Row and column of each drawn pixel: segment after segment, each
+        segment's pixels in increasing major coordinate.
     """
-    p0_px = snap_subpixel(np.asarray(p0_px, dtype=np.float64).reshape(-1, 2))
-    p1_px = snap_subpixel(np.asarray(p1_px, dtype=np.float64).reshape(-1, 2))
+    p0_px, p1_px = _as_ends(p0_px, p1_px)
     if len(p0_px) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
-    if len(p0_px) <= CHUNK_SEGMENTS:
-        return _line_pixels(p0_px, p1_px, width, height)
-    parts = [_line_pixels(p0_px[k:k + CHUNK_SEGMENTS], p1_px[k:k + CHUNK_SEGMENTS], width, height)
+    parts = [_line_pixels(snap_subpixel(p0_px[k:k + CHUNK_SEGMENTS]), snap_subpixel(p1_px[k:k + CHUNK_SEGMENTS]),
+                          width, height)
              for k in range(0, len(p0_px), CHUNK_SEGMENTS)]
+    if len(parts) == 1:
+        return parts[0]
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
@@ -144,51 +152,122 @@ def major_minor(p0_px: np.ndarray, p1_px: np.ndarray) -> tuple[np.ndarray, ...]:
     return x_major, a0, a1, b0, b1
 
 
+def _floor_div_float(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``floor(a / b)`` of exact integers held in float64, ``|a| < 2^53``: exact (see _line_pixels)."""
+    return np.floor(a / b)
+
+
+def _floor_div_int(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a // b
+
+
 def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
                  ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`line_pixels` of a non-empty batch of already snapped end points."""
-    x_major, a0, a1, b0, b1 = major_minor(p0_px, p1_px)
-    travel = np.where(a1 >= a0, 1.0, -1.0)            # direction along the major axis
-    lo = np.floor(np.minimum(a0, a1)).astype(np.intp)  # candidate major coordinates lo..hi
-    hi = np.ceil(np.maximum(a0, a1)).astype(np.intp)
-    n = hi - lo + 1
-    da = a1 - a0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.where(da != 0, (b1 - b0) / da, 0.0)
-    seg = np.repeat(np.arange(len(n)), n)
-    i = lo[seg] + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
-    # Minor coordinate at i, exactly: the ends are on the 1/256 grid, so in
-    # grid units b(i) = num / den with integers (|values| < 2^53 for any image
-    # that fits in memory), and rounding at exact halves cannot depend on the
-    # direction of travel through float error.
-    ia0, ia1 = (np.round(v * SUBPIXEL).astype(np.int64) for v in (a0, a1))
-    ib0, ib1 = (np.round(v * SUBPIXEL).astype(np.int64) for v in (b0, b1))
-    den = ia1 - ia0
-    sign = np.where(den < 0, -1, 1)
-    den_s = np.where(den == 0, 1, den * sign)[seg]                # > 0
-    num = sign[seg] * (ib0[seg] * den[seg] + (i * int(SUBPIXEL) - ia0[seg]) * (ib1 - ib0)[seg])
-    num = np.where(den[seg] == 0, ib0[seg], num)                 # zero length: b = b0
-    unit = int(SUBPIXEL) * den_s                                 # b = num / unit pixels
+    """:func:`line_pixels` of a non-empty batch of already snapped end points.
+
+    All in the segment's *travel* coordinate ``I = s i`` (``s = +1`` when the
+    major coordinate grows from start to end, else -1) and in integer grid
+    units (1/256 px), so that every rounding is decided exactly:
+
+    * the minor coordinate at major pixel ``i`` is ``b = num / unit`` with
+      integers ``unit = 256 |da|`` and ``num`` affine in ``I``; the drawn pixel
+      is ``j = t floor(P / Q)`` with ``P = 2 t num + unit``, ``Q = 2 unit``
+      (``t = +1`` for x-major: halves to +y; ``t = -1`` for y-major: halves
+      to -x). ``floor(P / Q)`` in float64 is exact: a non-integer quotient of
+      integers is at least ``1 / Q`` from the next integer, more than the
+      rounding error of ``P / Q`` while ``|P| < 2^53``.
+    * where the line leaves pixel ``I``'s diamond, ``X(I)``, lies in
+      ``[I, I + 1/2]``. Pixel ``I`` is drawn when ``A0 < X(I) <= A1`` (the
+      ends, in travel coordinates). Every ``I > floor(A0)`` passes the first
+      test (``X >= I > A0``), every ``I < floor(A1)`` the second
+      (``X <= I + 1/2 < A1``), and ``X(I)`` grows with ``I``: the drawn
+      pixels are ``floor(A0) .. floor(A1)`` less the first when
+      ``X(floor(A0)) <= A0`` and less the last when ``X(floor(A1)) > A1``.
+      So ``X`` is evaluated twice per segment (:func:`_exit_travel`), with the
+      float operations of the rule as stated, and the pixels between are
+      generated without a test.
+    """
+    g0 = p0_px * SUBPIXEL                       # grid units: exact integers (the ends are snapped)
+    g1 = p1_px * SUBPIXEL
+    if (min(g0.min(), g1.min()) >= -_FLOAT_GRID_LIMIT and max(g0.max(), g1.max()) <= _FLOAT_GRID_LIMIT):
+        floor_div, one = _floor_div_float, 1.0
+    else:
+        g0, g1 = g0.astype(np.int64), g1.astype(np.int64)
+        floor_div, one = _floor_div_int, 1
+    d = g1 - g0
+    ad = np.abs(d)
+    x_major = ad[:, 0] > ad[:, 1]
+    da = np.where(x_major, d[:, 0], d[:, 1])               # major and minor change, grid units
+    db = np.where(x_major, d[:, 1], d[:, 0])
+    ga0 = np.where(x_major, g0[:, 0], g0[:, 1])
+    gb0 = np.where(x_major, g0[:, 1], g0[:, 0])
+    s = np.where(da >= 0, one, -one)                        # direction of travel along the major axis
+    den = np.abs(da)
+    ta0 = s * ga0                                           # the ends in travel coordinates, grid units
+    ta1 = ta0 + den
+    np.maximum(den, one, out=den)                           # zero length: db = 0 too, any den > 0 will do
+    t = np.where(x_major, one, -one)                        # rounding side: +1 halves to +y, -1 halves to -x
+    # The diamond's exit (see _exit_travel): e = t E, m = db / den (the rule's
+    # slope times s, rounded once as the rule's float slope is), so
+    # u_a, u_b = (1/2 - e) / (1 + m), (1/2 + e) / (1 - m) = (1/2 -+ E) / (1 +- t m).
+    tm = db / den
+    tm *= t
+    d1 = 1.0 + tm
+    d2 = 1.0 - tm
+    unit = 256 * den
+    q = 2 * unit
+    # P(I) = 2 t num(I) + unit, num(I) = gb0 den + (256 I - ta0) db
+    t2db = 2 * t * db
+    p0 = 2 * t * gb0
+    p0 *= den
+    p0 += unit
+    p0 -= t2db * ta0
+    dp = 256 * t2db
+    i_start = floor_div(ta0, 256)
+    i_end = floor_div(ta1, 256)
+    first = i_start + (_exit_travel(i_start, p0, dp, q, unit, d1, d2, floor_div) <= ta0 / SUBPIXEL)
+    last = i_end - (_exit_travel(i_end, p0, dp, q, unit, d1, d2, floor_div) > ta1 / SUBPIXEL)
+    count = last - first
+    count += 1
+    count = np.maximum(count, 0).astype(np.intp)
+    # the drawn pixels, segment after segment, each in increasing major
+    # coordinate i = s I from i_lo: i = (sample index) + (i_lo - the segment's first sample index)
+    i_lo = np.where(s > 0, first, -last)
+    i_lo -= np.cumsum(count) - count
+    seg = np.repeat(np.arange(len(count)), count)
+    i = np.arange(len(seg), dtype=p0.dtype)
+    i += i_lo[seg]
+    dp *= s                                                 # P as a function of i
+    j = floor_div(p0[seg] + dp[seg] * i, q[seg])
+    j *= t[seg]
+    i = i.astype(np.intp)
+    j = j.astype(np.intp)
     xm = x_major[seg]
-    j = np.where(xm, (2 * num + unit) // (2 * unit),             # floor(b + 1/2): halves to +y
-                 -((unit - 2 * num) // (2 * unit)))              # ceil(b - 1/2):  halves to -x
-    e = (num - j * unit) / unit                                  # offset from the pixel centre, [-1/2, 1/2]
-    s = travel[seg]
-    m = slope[seg] * s                                 # minor change per unit of travel, |m| <= 1
-    # Distance u >= 0 along travel to where the line leaves the diamond:
-    # |u| + |e + m u| <= 1/2  <=>  u (1 + m) <= 1/2 - e  and  u (1 - m) <= 1/2 + e.
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u_a = np.where(1 + m > 0, (0.5 - e) / (1 + m), np.inf)
-        u_b = np.where(1 - m > 0, (0.5 + e) / (1 - m), np.inf)
-    exit_at = i + s * np.minimum(u_a, u_b)
-    drawn = (s * (exit_at - a0[seg]) > 0) & (s * (a1[seg] - exit_at) >= 0)
-    i, j, xm = i[drawn], j[drawn].astype(np.intp), xm[drawn]
     cc = np.where(xm, i, j)
     rr = np.where(xm, j, i)
+    if len(rr) == 0 or (rr.min() >= 0 and cc.min() >= 0 and rr.max() < height and cc.max() < width):
+        return rr, cc                                   # the usual case: skip the mask and two gathers
     inside = (cc >= 0) & (cc < width) & (rr >= 0) & (rr < height)
-    if inside.all():                                   # the usual case: skip two gathers
-        return rr, cc
     return rr[inside], cc[inside]
+
+
+def _exit_travel(i, p0, dp, q, unit, d1, d2, floor_div) -> np.ndarray:
+    """Travel coordinate ``X`` where the line leaves the diamond of pixel ``i`` (travel coordinates).
+
+    The rule's float operations on the rule's values (module docstring,
+    step 4): the offset from the pixel centre ``e = (num - j unit) / unit``,
+    exactly ``t (P - Q floor(P / Q) - unit) / Q``; the distance along travel
+    to the boundary ``u = min((1/2 - e) / (1 + m), (1/2 + e) / (1 - m))``
+    (a zero denominator: that bound is absent; ``fmin`` drops its inf or
+    NaN); ``X = I + u``. Comparing ``X`` with the ends gives the rule's
+    decisions bit for bit.
+    """
+    p = p0 + dp * i
+    e = (p - floor_div(p, q) * q - unit) / q
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.fmin((0.5 - e) / d1, (0.5 + e) / d2)
+    u += i
+    return u
 
 
 def _as_ends(p0_px, p1_px) -> tuple[np.ndarray, np.ndarray]:
