@@ -377,12 +377,12 @@ def _paint_visible(image, seg0_px, seg1_px, ends, mode, depth, tri_buf, grad, ca
 
 def _paint(image: np.ndarray, seg0_px: np.ndarray, seg1_px: np.ndarray, mode: str) -> None:
     h, w = image.shape
-    if mode == "exact":
-        rr, cc = raster.line_pixels(seg0_px, seg1_px, w, h)
-        image[rr, cc] = 255
-    elif mode == "fast":
-        rr, cc = raster.line_pixels_fast(seg0_px, seg1_px, w, h)
-        image[rr, cc] = 255
+    if mode in ("exact", "fast"):
+        fn = raster.line_pixels if mode == "exact" else raster.line_pixels_fast
+        rr, cc = fn(seg0_px, seg1_px, w, h)
+        flat = rr * w
+        flat += cc
+        image.reshape(-1)[flat] = 255       # a view (image is a fresh np.zeros); half the time of image[rr, cc]
     else:
         rr, cc, weight = raster.line_coverage_aa(seg0_px, seg1_px, w, h)
         image[...] = raster.paint_aa(rr, cc, weight, w, h)
