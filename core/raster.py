@@ -92,6 +92,7 @@ def snap_subpixel(p_px: np.ndarray) -> np.ndarray:
     """Coordinates rounded to the :data:`SUBPIXEL` grid (float64)."""
     return np.round(p_px * SUBPIXEL) / SUBPIXEL
 
+
 #: Segments rasterized per batch. Keeps the per-segment temporaries (about 30
 #: arrays of this length) inside the L2 cache: one batch of 100k+ segments
 #: makes tens of MB of temporaries that glibc maps and unmaps on every frame,
@@ -207,9 +208,8 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     ta1 = ta0 + den
     np.maximum(den, one, out=den)                           # zero length: db = 0 too, any den > 0 will do
     t = np.where(x_major, one, -one)                        # rounding side: +1 halves to +y, -1 halves to -x
-    # The diamond's exit (see _exit_travel): e = t E, m = db / den (the rule's
-    # slope times s, rounded once as the rule's float slope is), so
-    # u_a, u_b = (1/2 - e) / (1 + m), (1/2 + e) / (1 - m) = (1/2 -+ E) / (1 +- t m).
+    # The diamond's exit (_exit_travel) divides by 1 + t m and 1 - t m, with
+    # m = db / den: the rule's float slope times s (the same quotient, rounded once).
     tm = db / den
     tm *= t
     d1 = 1.0 + tm
@@ -255,17 +255,19 @@ def _exit_travel(i, p0, dp, q, unit, d1, d2, floor_div) -> np.ndarray:
     """Travel coordinate ``X`` where the line leaves the diamond of pixel ``i`` (travel coordinates).
 
     The rule's float operations on the rule's values (module docstring,
-    step 4): the offset from the pixel centre ``e = (num - j unit) / unit``,
-    exactly ``t (P - Q floor(P / Q) - unit) / Q``; the distance along travel
-    to the boundary ``u = min((1/2 - e) / (1 + m), (1/2 + e) / (1 - m))``
-    (a zero denominator: that bound is absent; ``fmin`` drops its inf or
-    NaN); ``X = I + u``. Comparing ``X`` with the ends gives the rule's
-    decisions bit for bit.
+    step 4). The offset from the pixel centre is ``e = (num - j unit) / unit``;
+    ``E = (P - Q floor(P / Q) - unit) / Q`` is ``t e`` exactly (the same
+    integers, divided once). The distance along travel to the boundary is
+    ``u = min((1/2 - e) / (1 + m), (1/2 + e) / (1 - m))``, here
+    ``min((1/2 - E) / (1 + t m), (1/2 + E) / (1 - t m))``: the same two
+    quotients, swapped when ``t = -1``. A zero denominator means that bound is
+    absent (``fmin`` drops its inf or NaN). ``X = I + u``: compared with the
+    ends it gives the rule's decisions bit for bit.
     """
     p = p0 + dp * i
-    e = (p - floor_div(p, q) * q - unit) / q
+    e_t = (p - floor_div(p, q) * q - unit) / q
     with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.fmin((0.5 - e) / d1, (0.5 + e) / d2)
+        u = np.fmin((0.5 - e_t) / d1, (0.5 + e_t) / d2)
     u += i
     return u
 
