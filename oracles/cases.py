@@ -12,6 +12,10 @@ the README ("Cases").
     narrow_fov    fov 8 at 25 r: nearly orthographic
     non_square    320x480 portrait, oblique, fov 50: aspect handling
     orthographic  orthographic from an oblique direction, 3r visible vertically
+    off_centre    calibrated K: principal point (70, -45) px off centre, fx = fy
+    non_square_pixels  calibrated K: fx = 1.3 fy (centred): per-axis focal lengths
+    distorted     calibrated K with OpenCV lens distortion (k1, k2, p1, p2, k3):
+                  vertices only (GL draws straight lines; the report says so)
 """
 
 from __future__ import annotations
@@ -42,6 +46,30 @@ def cameras_for(radius: float) -> list[Case]:
                                    near=0.1 * r, far=10 * r)),
         Case("orthographic", look_at((2 * r, 2 * r, 3 * r), o, (0, 1, 0), projection="orthographic",
                                      ortho_height=3 * r, near=0.1 * r, far=10 * r)),
+    ] + calibrated_cases(r, o)
+
+
+#: The distorted case's lens (OpenCV order k1, k2, p1, p2, k3): a moderate barrel
+#: lens of the size calibrations of webcams report. r * radial(r) is increasing
+#: out to the image corners (r_n <= 0.87 here: 1 + 3 k1 r2 + 5 k2 r2^2 + 7 k3 r2^3 > 0.6),
+#: so the image is not folded.
+DISTORTION = (-0.22, 0.06, 0.0012, -0.0009, -0.008)
+
+
+def calibrated_cases(r: float, o=(0.0, 0.0, 0.0)) -> list[Case]:
+    """The calibrated cameras (intrinsics fx, fy, cx, cy; lens distortion), 640x480, 2.6-3 r from ``o``."""
+    o = tuple(float(v) for v in o)
+
+    def at(offset):
+        return tuple(c + d * r for c, d in zip(o, offset))
+
+    return [
+        Case("off_centre", look_at(at((-1.5, 1.0, 2.6)), o, (0, 1, 0), near=0.1 * r, far=10 * r,
+                                   intrinsics=(460.0, 460.0, 319.5 + 70.0, 239.5 - 45.0))),
+        Case("non_square_pixels", look_at(at((1.2, -0.8, 2.8)), o, (0, 1, 0), near=0.1 * r, far=10 * r,
+                                          intrinsics=(520.0, 400.0, 319.5, 239.5))),
+        Case("distorted", look_at(at((0.4, 0.6, 2.6)), o, (0, 1, 0), near=0.1 * r, far=10 * r,
+                                  intrinsics=(470.0, 465.0, 325.2, 236.8), distortion=DISTORTION)),
     ]
 
 
@@ -52,4 +80,4 @@ def case_table() -> str:
     return __doc__.split("\n\n", 2)[2].strip()
 
 
-__all__ = ["Case", "cameras_for", "CASE_NAMES"]
+__all__ = ["Case", "cameras_for", "calibrated_cases", "CASE_NAMES", "DISTORTION"]
