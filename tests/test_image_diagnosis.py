@@ -26,7 +26,7 @@ from wirecheck.core.projection import project_points
 from wirecheck.core.raster import line_coverage_aa, line_pixels
 from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles.diagnose import FAULT_ORDER, LINE_FAULTS, primary
+from wirecheck.oracles.diagnose import FAULT_ORDER, LINE_FAULTS, VERTEX_ONLY_FAULTS, primary
 from wirecheck.oracles.draw import clip_depth, draw_candidate
 from wirecheck.oracles.image_diagnose import (OFFSET_TOL_PX, diagnose_images, flipped_camera,
                                               oracle_segments)
@@ -149,7 +149,8 @@ def test_half_pixel_offset_to_sub_pixel(results, camera_name):
 def confusion(results):
     # the vertex diagnosis' names; line_end_bias / line_pixel_bias are per-edge pixel counts
     # of a drawing the harness made itself (oracles.diagnose.diagnose_lines), not this family
-    labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS]
+    # (nor distortion_mismatch: frames of a distorted camera are not compared, oracles.case)
+    labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS + VERTEX_ONLY_FAULTS]
     counts = Counter()
     for (fault, _cam), got in results.items():
         if fault not in SINGLE:
