@@ -42,7 +42,8 @@ CONVENTIONS = {
     "statement": "core/conventions.py of wirecheck states these once; summarised here for the renderer",
     "world": "right-handed; camera right = forward x up",
     "pixels": "x right (columns), y down (rows), origin top-left; integer coordinates are pixel centres: "
-              "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2)",
+              "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2) unless the camera has "
+              "intrinsics [fx, fy, cx, cy] (then K and gl_projection hold them)",
     "fov": "fov_y_deg is the vertical field of view, edge to edge of the image",
     "orthographic": "ortho_height world units are visible vertically (edge to edge)",
     "clipping": "a point is drawn when its depth along forward is in [near, far]; edges are clipped there",
@@ -97,6 +98,7 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
     motion = motion or Motion()
     files: dict[str, bytes] = {}
     scene_rows, case_rows = [], []
+    skipped: set = set()
     checked = list(range(1, frames + 1, every))
     for scene in scenes:
         single = scene.is_single_static
@@ -119,12 +121,19 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
         for case in cameras_for(scene.radius):
             if case_names is not None and case.name not in case_names:
                 continue
+            if case.camera.distortion is not None:      # frames are judged by pixels: not for a lens (oracles.case)
+                skipped.add(case.name)
+                continue
             for k in checked:
                 files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
                     camera_json(case.camera, geometry[k], scene.name, case.name, k, frames)).encode()
             case_rows.append({"scene": scene.name, "case": case.name, "width": case.camera.width,
                               "height": case.camera.height,
                               "frames": [f"frames/{scene.name}/{case.name}/{frame_name(k, 'png')}" for k in checked]})
+    if not case_rows and skipped:
+        from wirecheck.core.errors import InputError
+        raise InputError(f"--cases {','.join(sorted(skipped))}: lens distortion: a frames job is judged by its "
+                         "pixels, which GL cannot draw through a lens; expected a case without distortion")
     job = {"kind": JOB_KIND, "version": JOB_VERSION, "style": "wireframe", "frames": frames, "every": every,
            "frame_numbers": checked, "motion": {"turns": list(motion.turns)},
            "image": IMAGE_RULE["wireframe"], "conventions": CONVENTIONS,

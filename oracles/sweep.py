@@ -107,7 +107,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                     continue
                 cam = case.camera
                 pyr = None
-                if pyrender:
+                if pyrender and cam.distortion is None:      # a lens: vertices only (oracles.case)
                     pyr = oracles.get(cam.width, cam.height)
                 for k in frame_ids:
                     p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
