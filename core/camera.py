@@ -283,10 +283,17 @@ class Camera:
             p[2, 2], p[2, 3], p[3, 3] = -2.0 / (f - n), -(f + n) / (f - n), 1.0
         return p
 
+    def _replace_lens(self, **changes) -> "Camera":
+        """``dataclasses.replace`` keeping the pose's vectors to the bit (re-normalising may move an ulp)."""
+        cam = replace(self, **changes)
+        for name in ("position", "forward", "up", "right"):
+            object.__setattr__(cam, name, getattr(self, name))
+        return cam
+
     def with_intrinsics(self, fx: float, fy: float, cx: float | None = None, cy: float | None = None) -> "Camera":
-        """This camera with calibrated intrinsics (``cx, cy`` default: centred)."""
+        """This camera (same pose, to the bit) with calibrated intrinsics (``cx, cy`` default: centred)."""
         c0x, c0y = principal_point(self.width, self.height)
-        return replace(self, intrinsics=(fx, fy, c0x if cx is None else cx, c0y if cy is None else cy))
+        return self._replace_lens(intrinsics=(fx, fy, c0x if cx is None else cx, c0y if cy is None else cy))
 
     def with_K(self, K) -> "Camera":  # noqa: N802
         """This camera with the intrinsics of a ``(3, 3)`` K: no skew, last row ``0 0 1``."""
@@ -297,8 +304,8 @@ class Camera:
         return self.with_intrinsics(k[0], k[4], k[2], k[5])
 
     def with_distortion(self, coefficients) -> "Camera":
-        """This camera with OpenCV distortion coefficients (``None``: none)."""
-        return replace(self, distortion=coefficients)
+        """This camera (same pose, to the bit) with OpenCV distortion coefficients (``None``: none)."""
+        return self._replace_lens(distortion=coefficients)
 
     @property
     def world_to_cam(self) -> np.ndarray:
