@@ -74,32 +74,6 @@ def test_centred_intrinsics_are_the_fov_camera_to_the_bit():
     assert twin.fov_y_deg == pytest.approx(55.0, rel=8 * EPS)
 
 
-def test_calibrated_hand_values():
-    """x_px = cx + fx x/z, y_px = cy - fy y/z (core.conventions): fx on columns, cx added.
-
-    Camera at (0, 0, 4) looking at -Z: p_cam = (x, y, 4 - z). The world point
-    (1, 2, 0) is p_cam (1, 2, 4): x = 100.25 + 500/4 = 225.25, y = 50.5 - 600/4
-    = -99.5, exact in float64 (dyadic). Swapping fx and fy, or cx and cy, or
-    the sign of the y term, changes both numbers.
-    """
-    cam = camera_z(4.0, width=640, height=480, intrinsics=(500.0, 300.0, 100.25, 50.5))
-    assert project_points([[1.0, 2.0, 0.0]], cam).tolist() == [[225.25, -99.5]]
-    np.testing.assert_array_equal(cam.K, [[500, 0, 100.25], [0, 300, 50.5], [0, 0, 1]])
-
-
-def test_distortion_hand_values():
-    """k1 on the y-down normalised point: (0, 0.5) -> 0.5 (1 + 0.1 / 4) = 0.5125 (exact)."""
-    # camera y up, so a point above the axis has y_n = -0.5 and moves further up
-    cam = camera_z(4.0, width=640, height=480, intrinsics=(400.0, 400.0, 320.0, 240.0),
-                   distortion=(0.1, 0.0, 0.0, 0.0))
-    assert project_points([[0.0, 2.0, 0.0]], cam).tolist() == [[320.0, 240.0 - 400.0 * 0.5125]]
-    # tangential p1: x_d = x + 2 p1 x y, y_d = y + p1 (r2 + 2 y^2); at (0.5, -0.5), p1 = 0.01:
-    # x_d = 0.5 - 0.005 = 0.495, y_d = -0.5 + 0.01 * 1.0 = -0.49 (core and the naive formula)
-    got = distort(np.array([[0.5, -0.5]]), (0.0, 0.0, 0.01, 0.0))
-    assert got.tolist() == [list(naive_distort(0.5, -0.5, (0.0, 0.0, 0.01, 0.0)))]
-    assert got[0] == pytest.approx([0.495, -0.49], abs=4 * EPS)
-
-
 @pytest.mark.parametrize("coeffs", [LENS, RATIONAL, (0.1, -0.02, 0.003, 0.001)], ids=["5", "8", "4"])
 def test_distort_matches_naive_formula(coeffs):
     p = np.random.default_rng(1).uniform(-0.9, 0.9, (1000, 2))
