@@ -29,9 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
+from wirecheck.core.errors import InputError
 from wirecheck.core.output import FrameDir, json_dumps
 
-from .cases import cameras_for
+from .cases import CASE_NAMES, cameras_for
 from .convert import camera_to_gl, opencv_matrices
 
 #: Version of the job format; frames_candidate refuses any other.
@@ -98,7 +99,6 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
     motion = motion or Motion()
     files: dict[str, bytes] = {}
     scene_rows, case_rows = [], []
-    skipped: set = set()
     checked = list(range(1, frames + 1, every))
     for scene in scenes:
         single = scene.is_single_static
@@ -118,22 +118,18 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
             if not single:
                 files[f"scenes/{scene.name}/{frame_name(k, 'obj')}"] = _obj_text(
                     p_world, scene.edges, faces, f"{scene.name} frame {k}: world space").encode()
-        for case in cameras_for(scene.radius):
-            if case_names is not None and case.name not in case_names:
+        for case in cameras_for(scene.radius, calibrated=True):
+            if case.name not in (CASE_NAMES if case_names is None else case_names):
                 continue
             if case.camera.distortion is not None:      # frames are judged by pixels: not for a lens (oracles.case)
-                skipped.add(case.name)
-                continue
+                raise InputError(f"--cases {case.name}: lens distortion: a frames job is judged by its pixels, "
+                                 "which GL cannot draw through a lens; expected cases without distortion")
             for k in checked:
                 files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
                     camera_json(case.camera, geometry[k], scene.name, case.name, k, frames)).encode()
             case_rows.append({"scene": scene.name, "case": case.name, "width": case.camera.width,
                               "height": case.camera.height,
                               "frames": [f"frames/{scene.name}/{case.name}/{frame_name(k, 'png')}" for k in checked]})
-    if not case_rows and skipped:
-        from wirecheck.core.errors import InputError
-        raise InputError(f"--cases {','.join(sorted(skipped))}: lens distortion: a frames job is judged by its "
-                         "pixels, which GL cannot draw through a lens; expected a case without distortion")
     job = {"kind": JOB_KIND, "version": JOB_VERSION, "style": "wireframe", "frames": frames, "every": every,
            "frame_numbers": checked, "motion": {"turns": list(motion.turns)},
            "image": IMAGE_RULE["wireframe"], "conventions": CONVENTIONS,

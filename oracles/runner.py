@@ -304,7 +304,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     tasks = []
     for scene in inputs.scenes:
         try:
-            scene_cases = cameras_for(scene.radius)
+            scene_cases = cameras_for(scene.radius, calibrated=True)
         except InputError as exc:
             raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
         tasks += [(scene, case) for case in scene_cases if case.name in inputs.case_names]

@@ -320,11 +320,66 @@ def test_faults_of_calibrated_candidates_through_crosscheck():
     assert c["faults"][0]["kind"] == "ignored"
 
 
-def test_export_skips_the_distorted_case(tmp_path):
+def test_export_calibrated_cases_and_refuses_a_lens(tmp_path):
     from wirecheck.core.scene_files import load_scene
+    from wirecheck.oracles.cases import CASE_NAMES
     from wirecheck.oracles.export import build_job
 
     job, files = build_job([load_scene("cube")], frames=2)
-    assert "distorted" not in {c["case"] for c in job["cases"]} and "off_centre" in {c["case"] for c in job["cases"]}
+    assert [c["case"] for c in job["cases"]] == list(CASE_NAMES)              # the default set, unchanged
+    job, files = build_job([load_scene("cube")], frames=2, case_names=["off_centre"])
+    cam = __import__("json").loads(files["cameras/cube/off_centre/frame_0001.json"])
+    assert cam["camera"]["intrinsics"] == [460.0, 460.0, 389.5, 194.5] and cam["K"][0][2] == 389.5
     with pytest.raises(InputError, match="lens distortion"):
-        build_job([load_scene("cube")], frames=2, case_names=["distorted"])
+        build_job([load_scene("cube")], frames=2, case_names=["off_centre", "distorted"])
+
+
+def test_calibrated_cases_run_only_when_named():
+    """The default set is the seven FOV cases: a FOV-only projector's verdicts do not change."""
+    from wirecheck.oracles.cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES, cameras_for
+    from wirecheck.oracles.gate import resolve_cases
+
+    assert CASE_NAMES == ("on_axis", "oblique_roll", "near_plane", "wide_fov", "narrow_fov", "non_square",
+                          "orthographic")
+    assert CALIBRATED_CASE_NAMES == ("off_centre", "non_square_pixels", "distorted")
+    assert resolve_cases(None) == CASE_NAMES and [c.name for c in cameras_for(2.0)] == list(CASE_NAMES)
+    assert resolve_cases("distorted,on_axis") == ("on_axis", "distorted")
+    assert [c.name for c in cameras_for(2.0, calibrated=True)] == list(ALL_CASE_NAMES)
+
+
+# ---- renderer flags ---------------------------------------------------------------------
+
+@pytest.mark.parametrize("args,match", [
+    (["--intrinsics", "500,400,300"], "--intrinsics '500,400,300': expected 4 finite numbers"),
+    (["--intrinsics=-5,400,300,200"], "expected focal lengths > 0"),
+    (["--intrinsics", "500,400,nan,200"], "expected 4 finite numbers"),
+    (["--intrinsics", "500,400,300,200", "--fov", "50"], "--fov and --intrinsics: expected one of them"),
+    (["--intrinsics", "500,400,300,200", "--projection", "both"], "expected --projection perspective"),
+    (["--distortion", "0.1,0,0"], "expected 4 or 5 or 8 finite numbers"),
+    (["--distortion", "1e9,0,0,0"], r"k1=1000000000.0: expected finite numbers with \|value\| <= 10000"),
+    (["--distortion", "0.1,0,0,0", "--hidden-lines"], "faces do not; expected a wireframe"),
+    (["--distortion", "0.1,0,0,0", "--compare"], "its cameras are set by FOV"),
+])
+def test_renderer_lens_flags_hostile(tmp_path, args, match):
+    import re
+
+    from helpers import run_renderer
+
+    out = tmp_path / "out"
+    rc, _, err = run_renderer(["--frames", "2", *args], out)
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and re.search(match, err), err
+    assert not out.exists()                                    # nothing written
+
+
+def test_renderer_centred_intrinsics_draw_the_fov_frames(tmp_path):
+    """--intrinsics f,f,(W-1)/2,(H-1)/2 with f of --fov 60 gives the same PNG bytes (one projection formula)."""
+    from helpers import run_renderer
+
+    f = focal_px(60.0, 480)
+    rc1, _, _ = run_renderer(["--frames", "3", "--format", "png"], tmp_path / "fov")
+    rc2, _, _ = run_renderer(["--frames", "3", "--format", "png", f"--intrinsics={f!r},{f!r},319.5,239.5"],
+                             tmp_path / "k")
+    assert rc1 == rc2 == 0
+    a = sorted((tmp_path / "fov" / "cube-frames").glob("*.png"))
+    b = sorted((tmp_path / "k" / "cube-frames").glob("*.png"))
+    assert len(a) == len(b) == 3 and [p.read_bytes() for p in a] == [p.read_bytes() for p in b]
