@@ -278,7 +278,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     """
     from wirecheck.core.errors import InputError
 
-    from .cases import cameras_for
+    from .cases import CASE_NAMES, cameras_for
 
     if oracles is not None:
         implied = level_for_oracles(oracles)
@@ -304,7 +304,8 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     tasks = []
     for scene in inputs.scenes:
         try:
-            scene_cases = cameras_for(scene.radius, calibrated=True)
+            scene_cases = (cameras_for(scene.radius, calibrated=True) if set(inputs.case_names) - set(CASE_NAMES)
+                           else cameras_for(scene.radius))
         except InputError as exc:
             raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
         tasks += [(scene, case) for case in scene_cases if case.name in inputs.case_names]

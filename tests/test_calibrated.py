@@ -383,3 +383,20 @@ def test_renderer_centred_intrinsics_draw_the_fov_frames(tmp_path):
     a = sorted((tmp_path / "fov" / "cube-frames").glob("*.png"))
     b = sorted((tmp_path / "k" / "cube-frames").glob("*.png"))
     assert len(a) == len(b) == 3 and [p.read_bytes() for p in a] == [p.read_bytes() for p in b]
+
+
+def test_wrappers_that_take_the_cameras_matrices():
+    """A cv2.projectPoints wrapper (K, R, t, distortion) passes every case, through the candidate host
+    (the protocol's camera rebuilt); a GL wrapper (projection @ view) passes all but the lens, named."""
+    from pathlib import Path
+
+    from wirecheck.oracles.api import check_projector
+    from wirecheck.oracles.cases import ALL_CASE_NAMES
+
+    spec = str(Path(__file__).parent / "data" / "matrix_projectors.py")
+    rep = check_projector(f"{spec}:opencv_style", scenes=["cube"], frames=3, cases=list(ALL_CASE_NAMES))
+    assert rep["verdict"] == "pass" and [c["camera"] for c in rep["cases"]] == list(ALL_CASE_NAMES)
+    rep = check_projector(f"{spec}:gl_style", scenes=["cube"], frames=3, cases=list(ALL_CASE_NAMES))
+    verdicts = {c["camera"]: (c["verdict"], [f["name"] for f in c["faults"]]) for c in rep["cases"]}
+    assert verdicts.pop("distorted") == ("fail", ["distortion_mismatch"])
+    assert set(verdicts.values()) == {("pass", [])}
