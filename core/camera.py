@@ -6,7 +6,7 @@ Axes and signs are defined in :mod:`core.conventions`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -19,6 +19,27 @@ PROJECTIONS = ("perspective", "orthographic")
 # well-defined "right": |forward x up| below 1e-9 means the angle is < 1e-9 rad,
 # far below anything a user means on purpose, far above float64 noise (1e-16).
 _DEGENERATE_CROSS = 1e-9
+
+
+#: Intrinsics are bounded by this factor of the larger image side: fx, fy, |cx|,
+#: |cy| <= 1e6 x side and fx, fy >= side / 1e6. A focal length of 1e6 sides is a
+#: field of view of 1e-4 degrees; one of 1e-6 sides sees all but 1e-4 degrees of
+#: the half-space, so pixels stay within ~1e12 of the image for points inside
+#: the frustum's reach, far from float64 (and float32) overflow.
+_MAX_INTRINSIC = 1e6
+
+
+def _numbers(name: str, value, shape: tuple) -> tuple:
+    """``value`` as a flat tuple of finite Python floats of ``shape``; InputError otherwise."""
+    try:
+        v = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        v = None
+    if v is None or v.shape != shape:
+        raise InputError(f"camera {name}: expected {' x '.join(map(str, shape))} numbers, got {value!r}")
+    if not np.all(np.isfinite(v)):
+        raise InputError(f"camera {name}: expected finite numbers, got {value!r}")
+    return tuple(float(x) for x in v.reshape(-1))
 
 
 def _vec3(name: str, value) -> np.ndarray:
@@ -57,6 +78,17 @@ class Camera:
     projection : {"perspective", "orthographic"}
     ortho_height : float
         World units visible vertically (orthographic only).
+    intrinsics : (4,) tuple of float or None
+        ``(fx, fy, cx, cy)`` in pixels, a calibrated pinhole camera
+        (perspective only; :mod:`wirecheck.core.conventions`, "Calibrated
+        cameras"). ``None`` (the default): ``fx = fy = f_px`` from
+        ``fov_y_deg`` and the centred principal point. When given,
+        ``fov_y_deg`` is replaced by the FOV ``fy`` implies, for reports.
+        Easiest built with :meth:`with_intrinsics` or :meth:`with_K`.
+    distortion : tuple of float or None
+        OpenCV lens distortion ``(k1, k2, p1, p2[, k3[, k4, k5, k6]])``
+        (4, 5 or 8 numbers; perspective only; :mod:`wirecheck.core.distortion`).
+        ``None`` or all zeros: no distortion (stored as ``None``).
 
     Attributes
     ----------
@@ -80,6 +112,8 @@ class Camera:
     far: float = 100.0
     projection: str = "perspective"
     ortho_height: float = 2.0
+    intrinsics: tuple | None = None
+    distortion: tuple | None = None
     right: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -120,6 +154,7 @@ class Camera:
             raise InputError(f"camera far {self.far!r}: expected > near ({self.near!r})")
         if not (math.isfinite(self.ortho_height) and self.ortho_height > 0):   # also perspective: it is reported
             raise InputError(f"camera ortho-height {self.ortho_height!r}: expected a finite number > 0")
+        self._check_intrinsics()
         # A positive but tiny fov or ortho-height passes the range checks yet makes the
         # focal length / pixel scale overflow to inf: say so here, not later as a
         # "vertex projects beyond the float64 range".
@@ -130,14 +165,147 @@ class Camera:
             raise InputError(f"camera ortho-height {self.ortho_height!r}: pixel scale H/ortho-height overflows "
                              "float64; expected a larger ortho-height")
 
+    def _check_intrinsics(self) -> None:
+        """Validate and normalise ``intrinsics`` and ``distortion`` (tuples of floats, or None)."""
+        from .distortion import check_coefficients
+
+        if self.intrinsics is not None:
+            values = _numbers("intrinsics fx,fy,cx,cy", self.intrinsics, (4,))
+            if self.projection != "perspective":
+                raise InputError(f"camera intrinsics {list(values)}: expected a perspective camera "
+                                 f"(got {self.projection})")
+            fx, fy, cx, cy = values
+            if not (fx > 0 and fy > 0):
+                raise InputError(f"camera intrinsics fx={fx!r}, fy={fy!r}: expected focal lengths > 0 (pixels)")
+            limit = _MAX_INTRINSIC * max(self.width, self.height)
+            if max(fx, fy, abs(cx), abs(cy)) > limit:
+                raise InputError(f"camera intrinsics {list(values)}: expected |fx|, |fy|, |cx|, |cy| <= "
+                                 f"{limit:g} ({_MAX_INTRINSIC:g} x the larger image side)")
+            if min(fx, fy) < max(self.width, self.height) / _MAX_INTRINSIC:
+                raise InputError(f"camera intrinsics fx={fx!r}, fy={fy!r}: expected focal lengths >= "
+                                 f"{max(self.width, self.height) / _MAX_INTRINSIC:g} px (the larger image "
+                                 f"side / {_MAX_INTRINSIC:g}: a field of view under 180 degrees by a margin)")
+            object.__setattr__(self, "intrinsics", values)
+            object.__setattr__(self, "fov_y_deg", math.degrees(2.0 * math.atan((self.height / 2.0) / fy)))
+        if self.distortion is not None:
+            coeffs = check_coefficients(self.distortion)
+            if coeffs is not None and self.projection != "perspective":
+                raise InputError(f"camera distortion {list(coeffs)}: expected a perspective camera "
+                                 f"(got {self.projection})")
+            object.__setattr__(self, "distortion", coeffs)
+
     # ---- derived quantities (see core.conventions) -------------------------
     @property
+    def calibrated(self) -> bool:
+        """True when built from intrinsics (fx, fy, cx, cy) rather than from the vertical FOV."""
+        return self.intrinsics is not None
+
+    @property
+    def focal_xy(self) -> tuple[float, float]:
+        """``(fx, fy)`` in pixels (perspective): the intrinsics, else ``f_px`` of the FOV for both."""
+        if self.intrinsics is not None:
+            return self.intrinsics[0], self.intrinsics[1]
+        f = focal_px(self.fov_y_deg, self.height)
+        return f, f
+
+    @property
     def focal_px(self) -> float:
-        return focal_px(self.fov_y_deg, self.height)
+        """The vertical focal length ``fy`` in pixels (``f_px`` of the FOV when not calibrated)."""
+        return self.focal_xy[1]
 
     @property
     def principal_point(self) -> tuple[float, float]:
+        """``(cx, cy)``: the intrinsics', else the centred one (core.conventions)."""
+        if self.intrinsics is not None:
+            return self.intrinsics[2], self.intrinsics[3]
         return principal_point(self.width, self.height)
+
+    @property
+    def K(self) -> np.ndarray:  # noqa: N802 (the name every calibration text uses)
+        """``(3, 3)`` intrinsic matrix ``[[fx, 0, cx], [0, fy, cy], [0, 0, 1]]`` (a new array).
+
+        Orthographic: the affine ``[[s, 0, cx], [0, s, cy], [0, 0, 1]]`` with
+        ``s = H / ortho_height`` (no division by depth).
+        """
+        cx, cy = self.principal_point
+        if self.projection == "perspective":
+            fx, fy = self.focal_xy
+        else:
+            fx = fy = self.height / self.ortho_height
+        return np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
+
+    # ---- the same camera as the matrices other libraries take (candidate contract) ----
+    @property
+    def R(self) -> np.ndarray:  # noqa: N802
+        """``(3, 3)`` world -> OpenCV camera rotation (rows right, -up, forward: OpenCV's y is down)."""
+        return np.stack([self.right, -self.up, self.forward])
+
+    @property
+    def t(self) -> np.ndarray:
+        """``(3,)`` world -> OpenCV camera translation: ``p_cv = R @ p_world + t``."""
+        return -self.R @ self.position
+
+    @property
+    def view_matrix(self) -> np.ndarray:
+        """``(4, 4)`` world -> OpenGL eye space (x right, y up, z backward: rows right, up, -forward)."""
+        m = np.eye(4)
+        m[:3, :3] = np.stack([self.right, self.up, -self.forward])
+        m[:3, 3] = -m[:3, :3] @ self.position
+        return m
+
+    @property
+    def projection_matrix(self) -> np.ndarray:
+        """``(4, 4)`` OpenGL eye -> clip (``glFrustum`` / ``glOrtho`` form; NDC z -1 at near).
+
+        Perspective, from the intrinsics (GL pixel centres at half-integers)::
+
+            [[2 fx / W, 0, 1 - 2 (cx + 0.5) / W, 0],
+             [0, 2 fy / H, 2 (cy + 0.5) / H - 1, 0],
+             [0, 0, (far + near) / (near - far), 2 far near / (near - far)],
+             [0, 0, -1, 0]]
+
+        so ``x_win = (x_ndc + 1) W / 2 = x_px + 0.5`` and ``y_win = H - (y_px +
+        0.5)`` (GL's window y is up). Orthographic: ``diag(2 s / W, 2 s / H,
+        -2 / (far - near), 1)`` with ``[2, 3] = -(far + near) / (far - near)``,
+        ``s = H / ortho_height``. Lens distortion is not in it.
+        """
+        w, h, n, f = self.width, self.height, float(self.near), float(self.far)
+        cx, cy = self.principal_point
+        p = np.zeros((4, 4))
+        if self.projection == "perspective":
+            fx, fy = self.focal_xy
+            p[0, 0], p[1, 1] = 2.0 * fx / w, 2.0 * fy / h
+            p[0, 2], p[1, 2] = 1.0 - 2.0 * (cx + 0.5) / w, 2.0 * (cy + 0.5) / h - 1.0
+            p[2, 2], p[2, 3], p[3, 2] = (f + n) / (n - f), 2.0 * f * n / (n - f), -1.0
+        else:
+            s = h / self.ortho_height
+            p[0, 0], p[1, 1] = 2.0 * s / w, 2.0 * s / h
+            p[2, 2], p[2, 3], p[3, 3] = -2.0 / (f - n), -(f + n) / (f - n), 1.0
+        return p
+
+    def _replace_lens(self, **changes) -> "Camera":
+        """``dataclasses.replace`` keeping the pose's vectors to the bit (re-normalising may move an ulp)."""
+        cam = replace(self, **changes)
+        for name in ("position", "forward", "up", "right"):
+            object.__setattr__(cam, name, getattr(self, name))
+        return cam
+
+    def with_intrinsics(self, fx: float, fy: float, cx: float | None = None, cy: float | None = None) -> "Camera":
+        """This camera (same pose, to the bit) with calibrated intrinsics (``cx, cy`` default: centred)."""
+        c0x, c0y = principal_point(self.width, self.height)
+        return self._replace_lens(intrinsics=(fx, fy, c0x if cx is None else cx, c0y if cy is None else cy))
+
+    def with_K(self, K) -> "Camera":  # noqa: N802
+        """This camera with the intrinsics of a ``(3, 3)`` K: no skew, last row ``0 0 1``."""
+        k = _numbers("K", K, (3, 3))
+        if k[1] != 0 or k[3] != 0 or (k[6], k[7], k[8]) != (0.0, 0.0, 1.0):
+            raise InputError(f"camera K {[list(k[i:i + 3]) for i in (0, 3, 6)]}: expected "
+                             "[[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (no skew)")
+        return self.with_intrinsics(k[0], k[4], k[2], k[5])
+
+    def with_distortion(self, coefficients) -> "Camera":
+        """This camera (same pose, to the bit) with OpenCV distortion coefficients (``None``: none)."""
+        return self._replace_lens(distortion=coefficients)
 
     @property
     def world_to_cam(self) -> np.ndarray:
@@ -160,6 +328,9 @@ class Camera:
             "far": float(self.far),
             "projection": self.projection,
             "ortho_height": float(self.ortho_height),
+            # only when set: the dictionary of an uncalibrated camera is unchanged
+            **({"intrinsics": list(self.intrinsics)} if self.intrinsics is not None else {}),
+            **({"distortion": list(self.distortion)} if self.distortion is not None else {}),
         }
 
 

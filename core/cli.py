@@ -15,7 +15,7 @@ import math
 import sys
 from pathlib import Path
 
-from .camera import camera_z, look_at, orthographic_twin
+from .camera import Camera, camera_z, look_at, orthographic_twin
 from .clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
 from .culling import CULL_CHOICES
@@ -76,7 +76,13 @@ def build_parser() -> argparse.ArgumentParser:
                      help="camera position, looking at --look-at with --up (default: --camera-z)")
     cam.add_argument("--look-at", default=None, metavar="X,Y,Z", help="with --camera-pos (default 0,0,0)")
     cam.add_argument("--up", default=None, metavar="X,Y,Z", help="with --camera-pos (default 0,1,0)")
-    cam.add_argument("--fov", type=float, default=60.0, help="full vertical FOV in degrees, edge to edge (default 60)")
+    cam.add_argument("--fov", type=float, default=None, help="full vertical FOV in degrees, edge to edge (default 60)")
+    cam.add_argument("--intrinsics", default=None, metavar="FX,FY,CX,CY",
+                     help="a calibrated camera instead of --fov: focal lengths and principal point in pixels, "
+                     "pixel centres at integers (core/conventions.py; default: none, from --fov)")
+    cam.add_argument("--distortion", default=None, metavar="K1,K2,P1,P2[,K3[,K4,K5,K6]]",
+                     help="OpenCV lens distortion of the vertices (edges stay straight lines between them; "
+                     "wireframes only) (default: none)")
     cam.add_argument("--near", type=float, default=0.1, help="near plane distance (default 0.1)")
     cam.add_argument("--far", type=float, default=100.0, help="far plane distance (default 100)")
     cam.add_argument("--width", type=int, default=640, help="image width in pixels (default 640)")
@@ -157,9 +163,12 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     """The run the options ask for; InputError (one line, naming the option) for anything invalid."""
     if not 1 <= a.frames <= MAX_FRAMES:
         raise InputError(f"--frames {a.frames}: expected an integer in 1..{MAX_FRAMES:,} (limits.MAX_FRAMES)")
+    fov_given = a.fov is not None
+    a.fov = 60.0 if a.fov is None else a.fov
     if not (0.0 < a.fov < 180.0):
         raise InputError(f"--fov {a.fov}: expected degrees in (0, 180)")
     check_image_size(a.width, a.height, "--width/--height")
+    lens = _lens_options(a, fov_given)
     if a.ortho_height is not None and not (math.isfinite(a.ortho_height) and a.ortho_height > 0):
         raise InputError(f"--ortho-height {a.ortho_height}: expected a finite number > 0")
     if not (math.isfinite(a.scale) and a.scale != 0):
@@ -173,7 +182,7 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     both = a.projection == "both"
     kwargs = dict(fov_y_deg=a.fov, width=a.width, height=a.height, near=a.near, far=a.far,
                   projection="perspective" if both else a.projection,
-                  ortho_height=4.0 if a.ortho_height is None else a.ortho_height)
+                  ortho_height=4.0 if a.ortho_height is None else a.ortho_height, **lens)
     if a.camera_pos is not None:
         if a.camera_z is not None:
             raise InputError("--camera-z and --camera-pos: expected one of them, not both")
@@ -230,6 +239,49 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
                          "consistently (counter-clockwise seen from outside)")
     check_out(s.out, output_names(s))
     return s
+
+
+def _numbers(option: str, text: str, counts: tuple) -> tuple:
+    """``"A,B,..."`` as finite floats, as many as one of ``counts``; InputError naming ``option`` otherwise."""
+    try:
+        values = tuple(float(p) for p in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) not in counts or not all(math.isfinite(v) for v in values):
+        raise InputError(f"{option} {text!r}: expected {' or '.join(map(str, counts))} finite numbers, "
+                         "comma-separated")
+    return values
+
+
+def _lens_options(a, fov_given: bool) -> dict:
+    """``--intrinsics`` and ``--distortion`` as Camera fields; InputError for a combination that ignores them."""
+    from .distortion import COEFFICIENT_COUNTS
+
+    out = {}
+    if a.intrinsics is not None:
+        if fov_given:
+            raise InputError("--fov and --intrinsics: expected one of them (the intrinsics give the focal lengths)")
+        out["intrinsics"] = _numbers("--intrinsics", a.intrinsics, (4,))
+    if a.distortion is not None:
+        out["distortion"] = _numbers("--distortion", a.distortion, COEFFICIENT_COUNTS)
+    if out:
+        given = " ".join(f"--{k}" for k in out)
+        if a.projection != "perspective":
+            raise InputError(f"{given} with --projection {a.projection}: expected --projection perspective "
+                             "(a calibrated camera is a pinhole)")
+        if a.compare or a.interactive:
+            raise InputError(f"{given} with --{'compare' if a.compare else 'interactive'}: its cameras are "
+                             "set by FOV; expected one of them")
+    if "distortion" in out and (a.hidden_lines or a.style == "shaded"):
+        raise InputError("--distortion with --hidden-lines or --style shaded: only vertices go through the lens, "
+                         "faces do not; expected a wireframe")
+    if out:
+        try:                                           # the camera's own checks, named by the option
+            Camera(position=(0.0, 0.0, 1.0), forward=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0),
+                   width=a.width, height=a.height, **out)
+        except InputError as exc:
+            raise InputError(f"{given} {' '.join(repr(getattr(a, k)) for k in out)}: {exc}") from None
+    return out
 
 
 def _check_dtype_range(camera, a) -> None:

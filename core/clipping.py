@@ -52,9 +52,9 @@ def frustum_planes(camera: Camera, guard_px: float = 0.0, sides: bool = True) ->
         top = cy + 0.5 + guard_px
         bottom = camera.height - 0.5 + guard_px - cy
         if camera.projection == "perspective":
-            f = camera.focal_px
-            planes += [[f, 0.0, left, 0.0], [-f, 0.0, right, 0.0],
-                       [0.0, -f, top, 0.0], [0.0, f, bottom, 0.0]]
+            fx, fy = camera.focal_xy          # a distorted camera: the undistorted frustum (core.distortion)
+            planes += [[fx, 0.0, left, 0.0], [-fx, 0.0, right, 0.0],
+                       [0.0, -fy, top, 0.0], [0.0, fy, bottom, 0.0]]
         else:
             s = camera.height / camera.ortho_height
             planes += [[s, 0.0, 0.0, left], [-s, 0.0, 0.0, right],

@@ -64,6 +64,31 @@ Orthographic, with ``ortho_height`` world units visible vertically::
     s = H / ortho_height                       (pixels per world unit)
     x_px = cx + s * x_cam,   y_px = cy - s * y_cam
 
+Calibrated cameras
+------------------
+A perspective camera may instead be given by its intrinsics ``fx, fy, cx,
+cy`` in pixels (``Camera.intrinsics``; OpenCV's ``K = [[fx, 0, cx], [0, fy,
+cy], [0, 0, 1]]``, no skew), with ``cx, cy`` in the same pixel-centre
+coordinates as above (a centred camera has ``cx = (W - 1) / 2``)::
+
+    x_px = cx + fx * x_cam / z_cam
+    y_px = cy - fy * y_cam / z_cam
+
+``fx`` scales image x (columns), ``fy`` image y (rows). A FOV camera is the
+special case ``fx = fy = f_px``, ``(cx, cy)`` centred; a calibrated camera's
+``fov_y_deg`` is the one ``fy`` implies, ``2 atan((H / 2) / fy)``.
+
+Lens distortion
+---------------
+Optional OpenCV coefficients ``(k1, k2, p1, p2[, k3[, k4, k5, k6]])``
+(``Camera.distortion``, perspective only) act on the ideal normalised
+coordinates in **OpenCV's axes, y down**: ``x_n = x_cam / z_cam``, ``y_n =
+-y_cam / z_cam``; then ``x_px = cx + fx x_d``, ``y_px = cy + fy y_d`` with
+``(x_d, y_d)`` from ``core.distortion`` (OpenCV's formula, so ``p1, p2`` and
+OpenCV's ``projectPoints`` agree in sign). Only vertices are distorted: edges
+are clipped against the undistorted frustum and drawn straight between
+distorted ends, so frames of a distorted camera are not pixel-compared.
+
 A point is *visible* when ``near <= z_cam <= far`` (both projections), and
 *clipped* otherwise; clipped points get NaN pixel coordinates. Points outside
 the image but inside [near, far] are visible (they have finite, off-image pixel

@@ -164,13 +164,15 @@ def cam_to_px(p_cam: np.ndarray, camera: Camera) -> np.ndarray:
     # In place, in the order of  x_px = cx + (f x) / z  and  y_px = cy - (f y) / z
     # (with 1/z computed once): the same bits as the plain expressions, fewer temporaries.
     with np.errstate(over="ignore", invalid="ignore"):
+        if camera.projection == "perspective" and camera.distortion is not None:
+            return _distorted_px(p_cam, camera, f_t, out)
         if camera.projection == "perspective":
-            f = f_t(camera.focal_px)
+            fx, fy = (f_t(f) for f in camera.focal_xy)
             inv_z = f_t(1.0) / p_cam[:, 2]
-            np.multiply(p_cam[:, 0], f, out=x_px)
+            np.multiply(p_cam[:, 0], fx, out=x_px)
             x_px *= inv_z
             x_px += cx
-            np.multiply(p_cam[:, 1], f, out=y_px)
+            np.multiply(p_cam[:, 1], fy, out=y_px)
             y_px *= inv_z
             np.subtract(cy, y_px, out=y_px)
         else:
@@ -179,6 +181,22 @@ def cam_to_px(p_cam: np.ndarray, camera: Camera) -> np.ndarray:
             x_px += cx
             np.multiply(p_cam[:, 1], s, out=y_px)
             np.subtract(cy, y_px, out=y_px)
+    return out
+
+
+def _distorted_px(p_cam: np.ndarray, camera: Camera, f_t, out: np.ndarray) -> np.ndarray:
+    """Perspective with lens distortion (core.distortion): ideal normalised, distorted, then pixels."""
+    from .distortion import distort
+
+    inv_z = f_t(1.0) / p_cam[:, 2]
+    p_n = np.empty(out.shape, dtype=out.dtype)
+    np.multiply(p_cam[:, 0], inv_z, out=p_n[:, 0])
+    np.multiply(p_cam[:, 1], -inv_z, out=p_n[:, 1])        # OpenCV's y is down
+    p_d = distort(p_n, camera.distortion)
+    fx, fy = (f_t(f) for f in camera.focal_xy)
+    cx, cy = (f_t(c) for c in camera.principal_point)
+    out[:, 0] = cx + fx * p_d[:, 0]
+    out[:, 1] = cy + fy * p_d[:, 1]
     return out
 
 
@@ -218,17 +236,21 @@ def project_points(p_world: np.ndarray, camera: Camera, dtype="float64") -> np.n
 def unproject(p_px: np.ndarray, depth: np.ndarray, camera: Camera) -> np.ndarray:
     """Pixels and camera depths ``z_cam`` back to world points (float64); inverse of projection.
 
-    Perspective: ``x_cam = (x_px - cx) z / f``, ``y_cam = -(y_px - cy) z / f``;
+    Perspective: ``x_cam = (x_px - cx) z / fx``, ``y_cam = -(y_px - cy) z / fy``;
     orthographic: ``x_cam = (x_px - cx) / s``, ``y_cam = -(y_px - cy) / s``.
-    Then ``p_world = position + R^T p_cam``.
+    Then ``p_world = position + R^T p_cam``. A distorted camera raises
+    ValueError (undistortion is iterative and not modelled here).
     """
+    if camera.distortion is not None:
+        raise ValueError("unproject: a camera with lens distortion is not supported (no undistortion model)")
     p_px = np.asarray(p_px, dtype=np.float64).reshape(-1, 2)
     z = np.asarray(depth, dtype=np.float64).reshape(-1)
     cx, cy = camera.principal_point
     if camera.projection == "perspective":
-        k = z / camera.focal_px
+        fx, fy = camera.focal_xy
+        kx, ky = z / fx, z / fy
     else:
-        k = np.full_like(z, camera.ortho_height / camera.height)
-    p_cam = np.stack([(p_px[:, 0] - cx) * k, -(p_px[:, 1] - cy) * k, z], axis=1)
+        kx = ky = np.full_like(z, camera.ortho_height / camera.height)
+    p_cam = np.stack([(p_px[:, 0] - cx) * kx, -(p_px[:, 1] - cy) * ky, z], axis=1)
     r_cam = np.stack([camera.right, camera.up, camera.forward])
     return p_cam @ r_cam + camera.position

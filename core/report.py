@@ -117,7 +117,9 @@ def summary_text(report: dict, render_seconds: float, wall_seconds: float, plot_
             f"{label}: {c['projection']} at {c['position']} forward {[round(v, 6) for v in c['forward']]} "
             f"up {[round(v, 6) for v in c['up']]}",
             f"{pad}  fov_y={c['fov_y_deg']} deg, {c['width']}x{c['height']}, near={c['near']}, far={c['far']}"
-            + (f", ortho_height={c['ortho_height']:.6g}" if c["projection"] == "orthographic" else ""),
+            + (f", ortho_height={c['ortho_height']:.6g}" if c["projection"] == "orthographic" else "")
+            + (f", intrinsics fx,fy,cx,cy={c['intrinsics']}" if c.get("intrinsics") else "")
+            + (f", distortion={c['distortion']} (vertices only)" if c.get("distortion") else ""),
         ]
     dr = report["drawing"]
     lines += [

@@ -38,9 +38,16 @@ def clip_matrix(camera: Camera) -> np.ndarray:
     left/bottom image edge to the right/top one, and z_ndc is -1 at near, +1 at
     far (``glFrustum`` with z negated, as camera z points forward here)::
 
-        x_clip = (2 f / W) x_cam      y_clip = (2 f / H) y_cam
+        x_clip = (2 fx / W) x_cam + (2 (cx + 0.5) / W - 1) z_cam
+        y_clip = (2 fy / H) y_cam + (1 - 2 (cy + 0.5) / H) z_cam
         z_clip = (far + near)/(far - near) z_cam - 2 far near/(far - near)
         w_clip = z_cam
+
+    (``glFrustum``'s off-centre terms; ``+ 0.5``: GL pixel centres sit at
+    half-integers, core.conventions. A centred camera, ``cx = (W - 1)/2``, has
+    both z terms exactly 0; fx = fy = f_px of the FOV unless calibrated.) The
+    undistorted projection: with lens distortion ``pixel_from_ndc`` is the
+    ideal pixel, not the distorted one drawn.
 
     Orthographic (``s = H / ortho_height`` px per unit): ``x_clip = (2 s / W)
     x_cam``, ``y_clip = (2 s / H) y_cam``, ``z_clip = 2 (z_cam - near)/(far -
@@ -49,8 +56,10 @@ def clip_matrix(camera: Camera) -> np.ndarray:
     w, h, n, f = camera.width, camera.height, camera.near, camera.far
     p = np.zeros((4, 4))
     if camera.projection == "perspective":
-        fp = camera.focal_px
-        p[0, 0], p[1, 1] = 2 * fp / w, 2 * fp / h
+        fx, fy = camera.focal_xy
+        cx, cy = camera.principal_point
+        p[0, 0], p[1, 1] = 2 * fx / w, 2 * fy / h
+        p[0, 2], p[1, 2] = 2 * (cx + 0.5) / w - 1, 1 - 2 * (cy + 0.5) / h
         p[2, 2], p[2, 3] = (f + n) / (f - n), -2 * f * n / (f - n)
         p[3, 2] = 1.0
     else:

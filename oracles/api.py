@@ -51,7 +51,8 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     frames : int
         Frames of each scene's motion per case (>= 1).
     cases : sequence of str, optional
-        A subset of :data:`wirecheck.oracles.cases.CASE_NAMES` (default: all).
+        Names from :data:`wirecheck.oracles.cases.ALL_CASE_NAMES` (default: the
+        default set ``CASE_NAMES``; the calibrated cases run when named).
     oracles : tuple of {"opencv", "pyrender"}
         ``("opencv",)`` compares vertices only (no OpenGL needed);
         ``("opencv", "pyrender")`` compares drawn pixels too.

@@ -6,7 +6,11 @@
 - ``camera``: an object with ``position`` (3,), ``forward`` (3,) unit, ``up``
   (3,) unit and orthogonal to forward, ``fov_y_deg``, ``width``, ``height``,
   ``near``, ``far``, ``projection`` ("perspective" or "orthographic") and
-  ``ortho_height`` (world units visible vertically; orthographic only).
+  ``ortho_height`` (world units visible vertically; orthographic only),
+  ``intrinsics`` (``(fx, fy, cx, cy)`` or None) and ``distortion`` (OpenCV's
+  coefficients or None); and, built from those, ``K`` (3x3), ``R``, ``t``
+  (world -> OpenCV camera: ``p_cv = R @ X + t``), ``view_matrix`` and
+  ``projection_matrix`` (OpenGL) -- a :class:`core.camera.Camera`.
 - returns pixel coordinates in the project's pixel convention (x right, y down,
   integer coordinates at pixel centres; core/conventions.py), NaN rows for the
   points it clips (depth outside [near, far]).

@@ -27,7 +27,8 @@ def _camera(msg: dict):
     vec = {k: np.array(msg[k], dtype=np.float64) for k in ("position", "forward", "up", "right")}
     cam = Camera(position=vec["position"], forward=vec["forward"], up=vec["up"], fov_y_deg=msg["fov_y_deg"],
                  width=msg["width"], height=msg["height"], near=msg["near"], far=msg["far"],
-                 projection=msg["projection"], ortho_height=msg["ortho_height"])
+                 projection=msg["projection"], ortho_height=msg["ortho_height"],
+                 intrinsics=msg.get("intrinsics"), distortion=msg.get("distortion"))
     for k, v in vec.items():
         v.setflags(write=False)
         object.__setattr__(cam, k, v)

@@ -62,7 +62,7 @@ from wirecheck.core.output import check_replaceable, check_report_dir
 from . import gate, tolerances
 from .isolation import external_candidate
 from .subprocess_candidate import DEFAULT_TIMEOUT_S
-from .cases import CASE_NAMES
+from .cases import ALL_CASE_NAMES, CASE_NAMES
 from .config import parse_cli
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
@@ -95,7 +95,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="scene name or path; repeatable (default: every scene in scenes/)")
     p.add_argument("--frames", type=int, default=None,
                    help="frames of the scene's motion per case (default 24; 12 with --sweep)")
-    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)} (default: all)")
+    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} "
+                   f"(default: {', '.join(CASE_NAMES)}; the calibrated ones run when named)")
     p.add_argument("--candidate", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
                    help="the projector to judge (default: core/); run in its own process")
     p.add_argument("--candidate-cmd", default=None, metavar="'COMMAND ARGS'",

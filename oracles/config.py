@@ -131,7 +131,7 @@ def validate(table: dict, path: Path) -> dict:
     """The table's values checked against :data:`KEYS`, paths made absolute; InputError otherwise."""
     from wirecheck.core.scene_files import builtin_names, example_names
 
-    from .cases import CASE_NAMES
+    from .cases import ALL_CASE_NAMES as CASE_NAMES
 
     def bad(key, value, expected=None):
         return InputError(f"{path}: [{TABLE}] {key} = {value!r}: expected {expected or KEYS[key]}")

@@ -2,12 +2,15 @@
 
 Independent of ``core``'s matrices and projection: a :class:`core.camera.Camera`
 is read only for its attributes (``position, forward, up, right, fov_y_deg,
-width, height, near, far, projection, ortho_height``), and the two-line focal
-length / principal point formulas of :mod:`core.conventions` are duplicated
-here on purpose::
+width, height, near, far, projection, ortho_height, intrinsics, distortion``),
+and the two-line focal length / principal point formulas of
+:mod:`core.conventions` are duplicated here on purpose::
 
     f_px = (H / 2) / tan(fov_y / 2)
     cx, cy = (W - 1) / 2, (H - 1) / 2         (integer pixel coords = centres)
+
+unless the camera is calibrated (``intrinsics = (fx, fy, cx, cy)``, taken as
+given). ``distortion`` is OpenCV's ``distCoeffs`` as is (:func:`distortion_coefficients`).
 
 Our camera space is x right, y up, z forward (``core.conventions``); OpenCV's is
 x right, y down, z forward; pyrender's (OpenGL's) is x right, y up, z backward.
@@ -23,7 +26,8 @@ from scipy.spatial.transform import Rotation
 
 from wirecheck.core.camera import Camera
 
-__all__ = ["camera_to_opencv", "opencv_matrices", "opencv_to_camera", "camera_to_pyrender",
+__all__ = ["camera_to_opencv", "opencv_matrices", "opencv_to_camera", "camera_to_pyrender", "intrinsics",
+           "distortion_coefficients",
            "pyrender_pose_to_camera", "camera_to_gl", "model_matrix"]
 
 # Relative tolerance for "K describes a centred, square-pixel camera": K built
@@ -40,6 +44,23 @@ def _focal_px(fov_y_deg: float, height: int) -> float:
 def _principal_point(width: int, height: int) -> tuple[float, float]:
     # duplicate of core.conventions.principal_point
     return (width - 1) / 2.0, (height - 1) / 2.0
+
+
+def intrinsics(camera) -> tuple[float, float, float, float]:
+    """``(fx, fy, cx, cy)`` of a perspective camera: its ``intrinsics`` if calibrated, else from the FOV."""
+    given = getattr(camera, "intrinsics", None)
+    if given is not None:
+        fx, fy, cx, cy = (float(v) for v in given)
+        return fx, fy, cx, cy
+    f = _focal_px(camera.fov_y_deg, camera.height)
+    cx, cy = _principal_point(camera.width, camera.height)
+    return f, f, cx, cy
+
+
+def distortion_coefficients(camera) -> np.ndarray:
+    """OpenCV's ``distCoeffs`` for the camera: its ``distortion`` as given, else ``zeros(5)`` (none)."""
+    given = getattr(camera, "distortion", None)
+    return np.zeros(5) if given is None else np.asarray(given, dtype=np.float64).reshape(-1)
 
 
 def camera_basis(camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -75,7 +96,9 @@ def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray
     with integer pixel coordinates at pixel centres, as ours. So the rows of
     ``R`` are ``right, -up, forward`` (our camera y negated), ``t = -R @
     position``, ``rvec`` = the rotation vector of ``R``, and ``K`` uses ``f_px`` and
-    ``(cx, cy)`` from ``core.conventions`` (recomputed here).
+    ``(cx, cy)`` from ``core.conventions`` (recomputed here), or the camera's
+    ``intrinsics`` when calibrated. Lens distortion is not in ``K``: pass
+    :func:`distortion_coefficients` as ``distCoeffs``.
 
     Orthographic cameras get the same ``rvec, tvec`` and an *affine* ``K``:
     ``[[s, 0, cx], [0, s, cy], [0, 0, 1]]`` with ``s = H / ortho_height``,
@@ -99,12 +122,12 @@ def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray
     # ~4e3 eps near 180-degree rotations (measured), which then shows as oracle
     # error; the other direction (rvec -> R, inside projectPoints) is well conditioned.
     rvec = Rotation.from_matrix(r_cv).as_rotvec()
-    cx, cy = _principal_point(camera.width, camera.height)
     if camera.projection == "perspective":
-        f = _focal_px(camera.fov_y_deg, camera.height)
+        fx, fy, cx, cy = intrinsics(camera)
     else:
-        f = camera.height / camera.ortho_height
-    k = np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]])
+        fx = fy = camera.height / camera.ortho_height
+        cx, cy = _principal_point(camera.width, camera.height)
+    k = np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
     return rvec.reshape(3), tvec, k
 
 
@@ -125,7 +148,7 @@ def opencv_matrices(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
 def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: float,
-                     projection: str = "perspective") -> Camera:
+                     projection: str = "perspective", dist=None) -> Camera:
     """Inverse of :func:`camera_to_opencv`.
 
     From ``p_cv = R X + t`` (rows of ``R``: right, -up, forward)::
@@ -134,8 +157,11 @@ def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: f
         fov_y = 2 atan((H / 2) / fy)            (perspective)
         ortho_height = H / fy                   (orthographic, affine K)
 
-    Raises ``ValueError`` if ``K`` is not a centred square-pixel camera (ours
-    cannot represent skew, fx != fy or an off-centre principal point).
+    A centred square-pixel ``K`` gives a FOV camera (as above); any other ``K``
+    without skew a calibrated camera (``intrinsics = (fx, fy, cx, cy)``,
+    perspective only). ``dist``: OpenCV ``distCoeffs`` (4, 5 or 8 numbers, or
+    None). Raises ``ValueError`` for skew, or an orthographic ``K`` that is
+    not centred and square.
     """
     cv2 = _cv2()
     r_cv, _ = cv2.Rodrigues(np.asarray(rvec, dtype=np.float64).reshape(3, 1))
@@ -144,14 +170,19 @@ def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: f
     fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
     cx0, cy0 = _principal_point(width, height)
     scale = max(abs(fx), abs(cx0), 1.0)
-    if not (math.isclose(fx, fy, rel_tol=_K_RTOL) and abs(K[0, 1]) <= _K_RTOL * scale
-            and abs(cx - cx0) <= _K_RTOL * scale and abs(cy - cy0) <= _K_RTOL * scale):
-        raise ValueError(f"K {K.tolist()}: expected square pixels, no skew and principal "
-                         f"point ({cx0}, {cy0}) for a {width}x{height} image")
+    if abs(K[0, 1]) > _K_RTOL * scale:
+        raise ValueError(f"K {K.tolist()}: expected no skew (K[0][1] = 0)")
+    centred = (math.isclose(fx, fy, rel_tol=_K_RTOL) and abs(cx - cx0) <= _K_RTOL * scale
+               and abs(cy - cy0) <= _K_RTOL * scale)
+    if not centred and projection != "perspective":
+        raise ValueError(f"K {K.tolist()}: expected square pixels and principal "
+                         f"point ({cx0}, {cy0}) for a {width}x{height} orthographic image")
     position = -r_cv.T @ tvec
-    kwargs = dict(width=width, height=height, near=near, far=far, projection=projection)
-    if projection == "perspective":
+    kwargs = dict(width=width, height=height, near=near, far=far, projection=projection, distortion=dist)
+    if projection == "perspective" and centred:
         kwargs["fov_y_deg"] = math.degrees(2.0 * math.atan((height / 2.0) / fy))
+    elif projection == "perspective":
+        kwargs["intrinsics"] = (fx, fy, cx, cy)
     else:
         kwargs["ortho_height"] = height / fy
     return Camera(position=position, forward=r_cv[2], up=-r_cv[1], **kwargs)
@@ -171,8 +202,9 @@ def camera_to_pyrender(camera: Camera):
     pyrender (OpenGL) cameras look down their local -Z with +Y up, so the pose
     (camera-to-world) has columns ``[right, up, -forward, position]``.
 
-    Perspective -> ``pyrender.IntrinsicsCamera(fx=f, fy=f, cx=cx + 0.5,
-    cy=cy + 0.5, znear=near, zfar=far)``. pyrender measures ``cx, cy`` from the
+    Perspective -> ``pyrender.IntrinsicsCamera(fx=fx, fy=fy, cx=cx + 0.5,
+    cy=cy + 0.5, znear=near, zfar=far)`` (``fx = fy = f`` and a centred
+    ``(cx, cy)`` unless the camera is calibrated). pyrender measures ``cx, cy`` from the
     pixel *corner*: its ``IntrinsicsCamera.get_projection_matrix`` is::
 
         P[0][0] = 2.0 * fx / width
@@ -191,7 +223,8 @@ def camera_to_pyrender(camera: Camera):
     ymag=ortho_height/2, znear=near, zfar=far)`` (``P[0][0] = 1/xmag``,
     ``P[1][1] = 1/ymag``; pyrender recomputes xmag from the viewport aspect).
     pyrender requires ``znear > 0`` here, so orthographic cameras with
-    ``near <= 0`` raise ``ValueError``.
+    ``near <= 0`` raise ``ValueError``, and so do cameras with lens distortion
+    (GL draws straight lines: there is no pyrender camera for them).
 
     Returns
     -------
@@ -206,10 +239,12 @@ def camera_to_pyrender(camera: Camera):
     pose[:3, 2] = -forward
     pose[:3, 3] = camera.position
     w, h = camera.width, camera.height
+    if getattr(camera, "distortion", None) is not None:
+        raise ValueError(f"camera distortion {list(camera.distortion)}: pyrender (GL) draws no lens distortion; "
+                         "only the vertices of a distorted camera can be compared")
     if camera.projection == "perspective":
-        f = _focal_px(camera.fov_y_deg, h)
-        cx, cy = _principal_point(w, h)
-        cam = pyrender.IntrinsicsCamera(fx=f, fy=f, cx=cx + 0.5, cy=cy + 0.5,
+        fx, fy, cx, cy = intrinsics(camera)
+        cam = pyrender.IntrinsicsCamera(fx=fx, fy=fy, cx=cx + 0.5, cy=cy + 0.5,
                                         znear=camera.near, zfar=camera.far)
     else:
         if not camera.near > 0:
@@ -224,9 +259,10 @@ def pyrender_pose_to_camera(pose, pyrender_camera, width: int, height: int) -> C
     """Inverse of :func:`camera_to_pyrender`.
 
     ``position = pose[:3, 3]``, ``up = pose[:3, 1]``, ``forward = -pose[:3, 2]``;
-    ``fov_y = 2 atan((H / 2) / fy)`` for an ``IntrinsicsCamera`` (which must be
-    centred: ``cx = W / 2``, ``cy = H / 2`` from the corner),
-    ``ortho_height = 2 ymag`` for an ``OrthographicCamera``.
+    ``fov_y = 2 atan((H / 2) / fy)`` for a centred square-pixel
+    ``IntrinsicsCamera`` (``cx = W / 2``, ``cy = H / 2`` from the corner, ``fx
+    = fy``), else a calibrated camera with ``intrinsics = (fx, fy, cx - 0.5,
+    cy - 0.5)``; ``ortho_height = 2 ymag`` for an ``OrthographicCamera``.
     """
     pyrender = _pyrender()
     pose = np.asarray(pose, dtype=np.float64)
@@ -234,10 +270,11 @@ def pyrender_pose_to_camera(pose, pyrender_camera, width: int, height: int) -> C
     if isinstance(pyrender_camera, pyrender.IntrinsicsCamera):
         c = pyrender_camera
         tol = _K_RTOL * max(c.fx, width, 1.0)
-        if not (math.isclose(c.fx, c.fy, rel_tol=_K_RTOL) and abs(c.cx - width / 2) <= tol
+        if (math.isclose(c.fx, c.fy, rel_tol=_K_RTOL) and abs(c.cx - width / 2) <= tol
                 and abs(c.cy - height / 2) <= tol):
-            raise ValueError("pyrender camera: expected fx == fy and a centred principal point")
-        kwargs["fov_y_deg"] = math.degrees(2.0 * math.atan((height / 2.0) / c.fy))
+            kwargs["fov_y_deg"] = math.degrees(2.0 * math.atan((height / 2.0) / c.fy))
+        else:
+            kwargs["intrinsics"] = (c.fx, c.fy, c.cx - 0.5, c.cy - 0.5)
     elif isinstance(pyrender_camera, pyrender.OrthographicCamera):
         kwargs["projection"] = "orthographic"
         kwargs["ortho_height"] = 2.0 * pyrender_camera.ymag
@@ -263,6 +300,13 @@ def camera_to_gl(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
         [[f/a, 0, 0, 0], [0, f, 0, 0],
          [0, 0, (far+near)/(near-far), 2 far near/(near-far)], [0, 0, -1, 0]]
 
+    A calibrated camera (``fx, fy, cx, cy``) gets ``glFrustum``'s off-centre
+    form instead: ``P[0, 0] = 2 fx / W``, ``P[1, 1] = 2 fy / H``, ``P[0, 2] =
+    1 - 2 (cx + 0.5) / W``, ``P[1, 2] = 2 (cy + 0.5) / H - 1`` (pyrender's
+    ``IntrinsicsCamera`` matrix, with its corner-origin ``cx + 0.5``); centred
+    and square, it is the matrix above. Lens distortion is not in ``P``
+    (GL cannot divide it in).
+
     Orthographic ``P`` (``glOrtho`` with ``top = ortho_height / 2``,
     ``right = a top``): ``diag(1/right, 1/top, -2/(far-near), 1)`` with
     ``P[2, 3] = -(far+near)/(far-near)``. Our pixels are then
@@ -283,8 +327,14 @@ def camera_to_gl(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     n, f = float(camera.near), float(camera.far)
     proj = np.zeros((4, 4))
     if camera.projection == "perspective":
-        g = 1.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0)
-        proj[0, 0], proj[1, 1] = g / aspect, g
+        if getattr(camera, "intrinsics", None) is None:
+            g = 1.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0)
+            proj[0, 0], proj[1, 1] = g / aspect, g
+        else:
+            fx, fy, cx, cy = intrinsics(camera)
+            w, h = camera.width, camera.height
+            proj[0, 0], proj[1, 1] = 2.0 * fx / w, 2.0 * fy / h
+            proj[0, 2], proj[1, 2] = 1.0 - 2.0 * (cx + 0.5) / w, 2.0 * (cy + 0.5) / h - 1.0
         proj[2, 2], proj[2, 3] = (f + n) / (n - f), 2.0 * f * n / (n - f)
         proj[3, 2] = -1.0
     else:

@@ -59,6 +59,10 @@ fov_mismatch        ``d_y != 1`` (alone when ``d_x = d_y``,     scale, implied_f
                                                                 for perspective)
 pixel_offset        ``b`` minus the shift the named linear      dx, dy
                     faults imply, nonzero
+distortion_mismatch the named model fails, and OpenCV's radial-  kind ("added", "ignored", "k1_sign",
+                    tangential profile on the camera's K        "magnitude"), k1, k2, k3, p1, p2
+                    explains the candidate: a lens error        (the candidate's), radial_error_px,
+                    (oracles.lens_diagnose)                     at_radius_px, residual_px
 line_end_bias       (pixels; vertices agree) one-sided pixels   end ("first", "last", "both"),
                     fail the line gate and sit at line ends     pixels_per_line (signed), lines,
                     (:func:`diagnose_lines`)                    candidate_only, oracle_only
@@ -119,7 +123,7 @@ import math
 
 import numpy as np
 
-__all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER", "LINE_FAULTS",
+__all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER", "LINE_FAULTS", "VERTEX_ONLY_FAULTS",
            "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
 
 #: All fault names, in priority order: the first fault of a diagnosis is the
@@ -127,10 +131,12 @@ __all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER"
 #: the picture more than a scale; an offset is the smallest visible effect.
 FAULT_ORDER = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
                "mirror_vertical", "aspect_mismatch", "fov_mismatch",
-               "pixel_offset", "line_end_bias", "line_pixel_bias", "unexplained")
+               "pixel_offset", "distortion_mismatch", "line_end_bias", "line_pixel_bias", "unexplained")
 FAULT_NAMES = frozenset(FAULT_ORDER)
 #: The faults named from a wireframe's pixels (:func:`diagnose_lines`), not from its vertices.
 LINE_FAULTS = ("line_end_bias", "line_pixel_bias")
+#: The faults named from vertices only: frames of a distorted camera are not compared (oracles.case).
+VERTEX_ONLY_FAULTS = ("distortion_mismatch",)
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
 #: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union
@@ -304,6 +310,10 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
     named_max = _max_abs(named_res)
     collapsed = bool(np.any(d * reach <= tol))       # an axis the candidate squashed flat
     if named_max > tol or collapsed:
+        from .lens_diagnose import distortion_fault       # a lens error bends the picture: not affine
+        lens = None if mismatches or collapsed else distortion_fault(cand[both], orac[both], camera, tol)
+        if lens is not None:
+            return [lens]
         rot = math.degrees(math.atan2(a[1, 0] - a[0, 1], a[0, 0] + a[1, 1]))
         return [_unexplained(residual_px=named_max,
                              residual_rms_px=float(np.sqrt(np.mean(named_res ** 2))),

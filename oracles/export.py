@@ -29,9 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
+from wirecheck.core.errors import InputError
 from wirecheck.core.output import FrameDir, json_dumps
 
-from .cases import cameras_for
+from .cases import CASE_NAMES, cameras_for
 from .convert import camera_to_gl, opencv_matrices
 
 #: Version of the job format; frames_candidate refuses any other.
@@ -42,7 +43,8 @@ CONVENTIONS = {
     "statement": "core/conventions.py of wirecheck states these once; summarised here for the renderer",
     "world": "right-handed; camera right = forward x up",
     "pixels": "x right (columns), y down (rows), origin top-left; integer coordinates are pixel centres: "
-              "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2)",
+              "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2) unless the camera has "
+              "intrinsics [fx, fy, cx, cy] (then K and gl_projection hold them)",
     "fov": "fov_y_deg is the vertical field of view, edge to edge of the image",
     "orthographic": "ortho_height world units are visible vertically (edge to edge)",
     "clipping": "a point is drawn when its depth along forward is in [near, far]; edges are clipped there",
@@ -116,9 +118,12 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
             if not single:
                 files[f"scenes/{scene.name}/{frame_name(k, 'obj')}"] = _obj_text(
                     p_world, scene.edges, faces, f"{scene.name} frame {k}: world space").encode()
-        for case in cameras_for(scene.radius):
-            if case_names is not None and case.name not in case_names:
+        for case in cameras_for(scene.radius, calibrated=True):
+            if case.name not in (CASE_NAMES if case_names is None else case_names):
                 continue
+            if case.camera.distortion is not None:      # frames are judged by pixels: not for a lens (oracles.case)
+                raise InputError(f"--cases {case.name}: lens distortion: a frames job is judged by its pixels, "
+                                 "which GL cannot draw through a lens; expected cases without distortion")
             for k in checked:
                 files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
                     camera_json(case.camera, geometry[k], scene.name, case.name, k, frames)).encode()

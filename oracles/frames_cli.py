@@ -14,7 +14,7 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 
-from .cases import CASE_NAMES
+from .cases import ALL_CASE_NAMES, CASE_NAMES
 
 
 class _Parser(argparse.ArgumentParser):
@@ -42,17 +42,17 @@ def export_main(argv) -> int:
     p.add_argument("--scene", action="append", default=None, help="scene name or path; repeatable (default: all)")
     p.add_argument("--frames", type=int, default=24, help="frames of the motion (default 24)")
     p.add_argument("--every", type=int, default=1, metavar="K", help="only frames 1, 1+K, ... (default 1)")
-    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(CASE_NAMES)}")
+    p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} (default: {', '.join(CASE_NAMES)})")
     p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
     args = p.parse_args(argv)
     try:
         if args.frames < 1 or args.every < 1:
             raise InputError(f"--frames {args.frames} --every {args.every}: expected integers >= 1")
         cases = [c.strip() for c in args.cases.split(",") if c.strip()]
-        bad = [c for c in cases if c not in CASE_NAMES]
+        bad = [c for c in cases if c not in ALL_CASE_NAMES]
         if bad or not cases:
             raise InputError(f"--cases {args.cases!r}: unknown {', '.join(bad) or '(none)'}; "
-                             f"expected some of {', '.join(CASE_NAMES)}")
+                             f"expected some of {', '.join(ALL_CASE_NAMES)}")
         try:
             spin = tuple(float(x) for x in args.spin.split(","))
         except ValueError:

@@ -34,7 +34,7 @@ from wirecheck.core import scene_files
 from wirecheck.core.scene import Scene
 from wirecheck.core.scene_files import builtin_names, load_scene
 
-from .cases import CASE_NAMES
+from .cases import ALL_CASE_NAMES, CASE_NAMES
 
 #: How each input is called in messages: by the Python API, and by the ``crosscheck`` CLI.
 API_NAMES = {"scenes": "scenes", "frames": "frames", "every": "every", "cases": "cases", "turns": "turns",
@@ -51,7 +51,7 @@ class RunInputs:
     scenes: tuple            # of core.scene.Scene, distinct names
     frames: int              # >= 1
     every: int               # 1 <= every <= frames
-    case_names: tuple        # of CASE_NAMES, distinct, in CASE_NAMES order
+    case_names: tuple        # of ALL_CASE_NAMES, distinct, in that order
     turns: tuple             # three finite floats
 
     @property
@@ -93,19 +93,19 @@ def resolve_scenes(scenes, names: dict = API_NAMES) -> tuple:
 
 
 def resolve_cases(cases, names: dict = API_NAMES) -> tuple:
-    """Case names from a list or a comma-separated string (``None``: all), in CASE_NAMES order."""
+    """Case names from a list or a comma-separated string (``None``: the default set), in ALL_CASE_NAMES order."""
     name = names["cases"]
     if cases is None:
         return CASE_NAMES
     given = [c.strip() for c in cases.split(",") if c.strip()] if isinstance(cases, str) else list(cases)
-    bad = [c for c in given if not isinstance(c, str) or c not in CASE_NAMES]
+    bad = [c for c in given if not isinstance(c, str) or c not in ALL_CASE_NAMES]
     if bad or not given:
         raise InputError(f"{name} {cases!r}: {'unknown ' + ', '.join(map(repr, bad)) if bad else 'no case named'}; "
-                         f"expected some of {', '.join(CASE_NAMES)}")
+                         f"expected some of {', '.join(ALL_CASE_NAMES)}")
     twice = sorted({c for c in given if given.count(c) > 1})
     if twice:
         raise InputError(f"{name} {cases!r}: {', '.join(twice)} given twice: expected each case once")
-    return tuple(c for c in CASE_NAMES if c in given)
+    return tuple(c for c in ALL_CASE_NAMES if c in given)
 
 
 def check_tolerances(tol, names: dict = API_NAMES) -> None:

@@ -166,7 +166,8 @@ def flipped_camera(camera):
 
     return Camera(position=camera.position, forward=-np.asarray(camera.forward), up=camera.up,
                   fov_y_deg=camera.fov_y_deg, width=camera.width, height=camera.height, near=camera.near,
-                  far=camera.far, projection=camera.projection, ortho_height=camera.ortho_height)
+                  far=camera.far, projection=camera.projection, ortho_height=camera.ortho_height,
+                  intrinsics=getattr(camera, "intrinsics", None))
 
 
 # ---------------------------------------------------------------- geometry helpers

@@ -13,7 +13,7 @@ import numpy as np
 
 from wirecheck.core.camera import Camera
 
-from .convert import camera_basis, camera_to_opencv
+from .convert import camera_basis, camera_to_opencv, distortion_coefficients
 
 __all__ = ["project", "depth"]
 
@@ -36,8 +36,10 @@ def depth(p_world: np.ndarray, camera: Camera) -> np.ndarray:
 def project(p_world: np.ndarray, camera: Camera) -> np.ndarray:
     """Project world points to pixels; NaN rows outside ``[near, far]``.
 
-    Perspective: ``cv2.projectPoints`` (float64, zero distortion) with
-    ``rvec, tvec, K`` from :func:`oracles.convert.camera_to_opencv`.
+    Perspective: ``cv2.projectPoints`` (float64) with ``rvec, tvec, K`` from
+    :func:`oracles.convert.camera_to_opencv` and the camera's distortion
+    coefficients (:func:`oracles.convert.distortion_coefficients`; zeros when
+    it has none).
     Orthographic: the closed form (no OpenCV model exists)::
 
         s = H / ortho_height
@@ -62,7 +64,8 @@ def project(p_world: np.ndarray, camera: Camera) -> np.ndarray:
     rvec, tvec, k = camera_to_opencv(camera)
     if camera.projection == "perspective":
         import cv2
-        pts, _ = cv2.projectPoints(p_world[visible].reshape(-1, 1, 3), rvec, tvec, k, np.zeros(5))
+        pts, _ = cv2.projectPoints(p_world[visible].reshape(-1, 1, 3), rvec, tvec, k,
+                                   distortion_coefficients(camera))
         p_px[visible] = pts.reshape(-1, 2)
     else:
         d = p_world[visible] - camera.position

@@ -17,7 +17,9 @@ wirecheck closes the program's stdin when it is done; the program then exits.
 The camera object holds every field of the Python contract (oracles.candidate)
 and the same camera as matrices, built on the oracle side (oracles.convert):
 OpenCV's ``K``, ``R``, ``t`` and OpenGL's ``view_matrix`` and
-``projection_matrix`` (row-major nested lists, column-vector convention).
+``projection_matrix`` (row-major nested lists, column-vector convention);
+``intrinsics`` (``[fx, fy, cx, cy]``) and ``distortion`` (OpenCV's
+``distCoeffs``) are ``null`` unless the camera is calibrated / has a lens.
 """
 
 from __future__ import annotations
@@ -69,6 +71,8 @@ def camera_message(camera) -> dict:
         "width": int(camera.width), "height": int(camera.height),
         "near": _json_number(camera.near), "far": _json_number(camera.far),
         "projection": camera.projection, "ortho_height": _json_number(camera.ortho_height),
+        "intrinsics": None if camera.intrinsics is None else vec(camera.intrinsics),
+        "distortion": None if camera.distortion is None else vec(camera.distortion),
         "K": rows(k), "R": rows(r_cv), "t": vec(t_cv),
         "view_matrix": rows(view), "projection_matrix": rows(proj),
     }

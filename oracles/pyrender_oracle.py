@@ -194,7 +194,7 @@ class PyrenderOracle:
         scene, node_attr, key_attr = ((self._fscene, "_fcam_node", "_fcam_key") if faces_scene
                                       else (self._scene, "_cam_node", "_cam_key"))
         pose, cam = camera_to_pyrender(camera)
-        key = (camera.projection, camera.fov_y_deg, camera.ortho_height, camera.near, camera.far)
+        key = (camera.projection, camera.fov_y_deg, camera.ortho_height, camera.near, camera.far, camera.intrinsics)
         if key != getattr(self, key_attr):
             if getattr(self, node_attr) is not None:
                 scene.remove_node(getattr(self, node_attr))

@@ -38,6 +38,9 @@ FAULT_HINTS = {
                        "pixels); implied_aspect is the width/height ratio that was used",
     "pixel_offset": "a constant shift: integer pixel coordinates are pixel centres and the principal "
                     "point is ((W - 1) / 2, (H - 1) / 2); 0.5 is the pixel-corner convention",
+    "distortion_mismatch": "the lens distortion differs from the camera's (kind: ignored, k1's sign, or a "
+                           "coefficient's size): apply OpenCV's model to x/z, y/z with y down, before K: "
+                           "r2 = x^2 + y^2, x (1 + k1 r2 + k2 r2^2 + k3 r2^3) + 2 p1 x y + p2 (r2 + 2 x^2)",
     "line_end_bias": "the vertices agree but the lines lose (or gain) pixels at one end: check the "
                      "rasterizer's end rule (GL diamond exit: the start pixel is drawn when the start point "
                      "is inside its diamond, the end pixel is not drawn when the end point is inside its own)",
@@ -64,6 +67,8 @@ def fault_nominals(camera: dict | None) -> dict:
     if camera:
         out.update(implied_aspect=camera["width"] / camera["height"], implied_fov_deg=camera["fov_y_deg"],
                    implied_ortho_height=camera["ortho_height"])
+        lens = list(camera.get("distortion") or []) + [0.0] * 8            # k1, k2, p1, p2, k3, ...
+        out.update(k1=lens[0], k2=lens[1], p1=lens[2], p2=lens[3], k3=lens[4])
     return out
 
 

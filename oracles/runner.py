@@ -134,6 +134,8 @@ class _CaseRunner:
         new = size not in self.renderers
         oracle = self.renderers.get(*size)
         if new:
+            if camera.distortion is not None:          # GL has no lens; the shaders do not depend on it
+                camera = camera.with_distortion(None)
             oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera)   # compiles the shaders
             if mode is not None and mode.shaded:
                 oracle.render_faces(*self._DUMMY_TRIANGLE, camera)         # and the id shader
@@ -276,7 +278,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     """
     from wirecheck.core.errors import InputError
 
-    from .cases import cameras_for
+    from .cases import CASE_NAMES, cameras_for
 
     if oracles is not None:
         implied = level_for_oracles(oracles)
@@ -302,10 +304,15 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     tasks = []
     for scene in inputs.scenes:
         try:
-            scene_cases = cameras_for(scene.radius)
+            scene_cases = (cameras_for(scene.radius, calibrated=True) if set(inputs.case_names) - set(CASE_NAMES)
+                           else cameras_for(scene.radius))
         except InputError as exc:
             raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
         tasks += [(scene, case) for case in scene_cases if case.name in inputs.case_names]
+    if level == "pixels" and tasks and all(case.camera.distortion is not None for _, case in tasks):
+        raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their pixels "
+                         "are not compared (GL draws straight lines), so the run would compare no pixel; "
+                         "expected level vertices or a case without distortion")
     is_core = isinstance(candidate, CoreCandidate)
     ref = candidate if is_core or candidate_spec is None else candidate_spec
     keep_frames = animation and level == "pixels"

@@ -44,7 +44,7 @@ from wirecheck.core.transforms import Motion
 
 from . import faces as oface
 from . import metrics, opencv_oracle
-from .cases import cameras_for
+from .cases import CASE_NAMES, cameras_for
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -102,12 +102,12 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
         for group, scene in groups:
             edges = np.asarray(scene.edges)
             core = {d: SceneRenderer(scene, motion, frames, dtype=d) for d in DTYPES}   # as renderer sets frames up
-            for case in cameras_for(scene.radius):
-                if case_names is not None and case.name not in case_names:
+            for case in cameras_for(scene.radius, calibrated=True):
+                if case.name not in (CASE_NAMES if case_names is None else case_names):
                     continue
                 cam = case.camera
                 pyr = None
-                if pyrender:
+                if pyrender and cam.distortion is None:      # a lens: vertices only (oracles.case)
                     pyr = oracles.get(cam.width, cam.height)
                 for k in frame_ids:
                     p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)

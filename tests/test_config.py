@@ -129,7 +129,7 @@ def test_crosscheck_bad_table_is_exit_2_with_one_line(tmp_path, monkeypatch, cap
     err = capsys.readouterr().err
     assert code == 2 and err == f"crosscheck: error: {path}: [tool.wirecheck] cases = []: expected a non-empty " \
                                 "list of some of on_axis, oblique_roll, near_plane, wide_fov, narrow_fov, " \
-                                "non_square, orthographic\n"
+                                "non_square, orthographic, off_centre, non_square_pixels, distorted\n"
     assert not (tmp_path / "out").exists()
 
 

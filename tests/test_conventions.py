@@ -223,3 +223,34 @@ def test_orthographic_scale_that_overflows_is_refused():
     with pytest.raises(InputError, match="ortho-height"):
         cam(projection="orthographic", ortho_height=1e-320)
     cam(projection="orthographic", ortho_height=1e-300)       # 4.8e302: finite, accepted
+
+
+def test_calibrated_intrinsics_fx_on_columns_cx_added():
+    """x_px = cx + fx x/z, y_px = cy - fy y/z (core.conventions): fx on columns, cx added.
+
+    Camera at (0, 0, 4) looking at -Z: p_cam = (x, y, 4 - z). The world point
+    (1, 2, 0) is p_cam (1, 2, 4): x = 100.25 + 500/4 = 225.25, y = 50.5 - 600/4
+    = -99.5, exact in float64 (dyadic). Swapping fx and fy, or cx and cy, or
+    the sign of the y term, changes both numbers.
+    """
+    cam = camera_z(4.0, width=640, height=480, intrinsics=(500.0, 300.0, 100.25, 50.5))
+    assert project_points([[1.0, 2.0, 0.0]], cam).tolist() == [[225.25, -99.5]]
+    np.testing.assert_array_equal(cam.K, [[500, 0, 100.25], [0, 300, 50.5], [0, 0, 1]])
+
+
+def test_distortion_acts_on_y_down_normalised_points():
+    """OpenCV's model on (x/z, -y/z): y down, so p1/p2 keep OpenCV's signs.
+
+    Camera at (0, 0, 4), K = [[400, 0, 320], [0, 400, 240]]. World (2, 2, 0) is
+    p_cam (2, 2, 4): x_n = 0.5, y_n = -0.5 (y down). With p1 = 0.01 alone:
+    x_d = x + 2 p1 x y = 0.5 - 0.005 = 0.495, y_d = y + p1 (r2 + 2 y^2) = -0.5 +
+    0.01 = -0.49, so the pixel is (320 + 198, 240 - 196) = (518, 44). A y-up
+    normalised point (0.5, +0.5) would give (522, 36); a reversed p1 (512, 36).
+    k1 alone scales the radius: world (0, 2, 0) -> y_n = -0.5, r2 = 0.25,
+    y_d = -0.5 (1 + 0.1 / 4) = -0.5125, y_px = 240 - 205 = 35.
+    """
+    cam = camera_z(4.0, width=640, height=480, intrinsics=(400.0, 400.0, 320.0, 240.0))
+    got = project_points([[2.0, 2.0, 0.0]], cam.with_distortion((0.0, 0.0, 0.01, 0.0)))
+    assert_allclose(got, [[518.0, 44.0]], rtol=0, atol=PX_TOL)
+    got = project_points([[0.0, 2.0, 0.0]], cam.with_distortion((0.1, 0.0, 0.0, 0.0)))
+    assert_allclose(got, [[320.0, 35.0]], rtol=0, atol=PX_TOL)

@@ -79,19 +79,52 @@ CAMERAS = {
 }
 
 
+# Calibrated cameras (core.conventions, "Calibrated cameras", "Lens distortion"):
+# off-centre principal points, fx != fy, and two lenses (barrel with k3 and
+# tangential terms; pincushion, 4 coefficients). Image corners reach r_n ~ 0.85,
+# where both lenses are still monotonic (no fold-over).
+LENS_BARREL = (-0.22, 0.06, 0.0012, -0.0009, -0.008)
+LENS_PINCUSHION = (0.15, -0.04, -0.002, 0.0015)
+CAMERAS.update({
+    "k_offc": look_at((3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), width=640, height=480,
+                      intrinsics=(520.0, 520.0, 360.25, 210.5)),
+    "k_aniso": look_at((-1, 2, 6), (0.2, 0, 0), (0.1, 1, -0.2), width=320, height=480,
+                       intrinsics=(700.0, 560.0, 150.0, 250.0)),
+    "k_barrel": look_at((0.5, 0.8, 4.0), (0, 0, 0), (0, 1, 0), width=640, height=480,
+                        intrinsics=(470.0, 465.0, 325.2, 236.8), distortion=LENS_BARREL),
+    "k_pincushion": look_at((-2.5, 1.5, 3.0), (0, 0, 0), (0, 1, 0), width=640, height=480,
+                            intrinsics=(560.0, 540.0, 300.0, 250.0), distortion=LENS_PINCUSHION),
+})
+LENS_CAMERAS = ("k_barrel", "k_pincushion")
+CALIBRATED_CAMERAS = ("k_offc", "k_aniso") + LENS_CAMERAS
+
+
 def _with(camera: Camera, **changes) -> Camera:
     kw = dict(position=camera.position, forward=camera.forward, up=camera.up, fov_y_deg=camera.fov_y_deg,
               width=camera.width, height=camera.height, near=camera.near, far=camera.far,
-              projection=camera.projection, ortho_height=camera.ortho_height)
+              projection=camera.projection, ortho_height=camera.ortho_height,
+              intrinsics=camera.intrinsics, distortion=camera.distortion)
     kw.update(changes)
     return Camera(**kw)
 
 
 # ---- a re-implementation of the projector with knobs for the faults -----------
 
-def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None):
+def naive_distort(x, y, coeffs):
+    """OpenCV's distortion (its documentation's formula), written out term by term; y down."""
+    k1, k2, p1, p2, k3, k4, k5, k6 = tuple(coeffs) + (0.0,) * (8 - len(coeffs))
+    r2 = x ** 2 + y ** 2
+    radial = (1 + k1 * r2 + k2 * r2 ** 2 + k3 * r2 ** 3) / (1 + k4 * r2 + k5 * r2 ** 2 + k6 * r2 ** 3)
+    return (x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x ** 2),
+            y * radial + p1 * (r2 + 2 * y ** 2) + 2 * p2 * x * y)
+
+
+_LENS = "the camera's"
+
+
+def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None, dist=_LENS):
     """core.projection.project_points, with the rotation, focal lengths (or
-    ortho scales) and principal point replaceable."""
+    ortho scales), principal point and lens distortion replaceable."""
     p = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
     r = np.stack([camera.right, camera.up, camera.forward]) if rotation is None else rotation
     p_cam = (p - camera.position) @ r.T
@@ -100,12 +133,17 @@ def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=No
     pcx, pcy = camera.principal_point
     cx = pcx if cx is None else cx
     cy = pcy if cy is None else cy
+    dist = camera.distortion if dist is _LENS else dist
     if camera.projection == "perspective":
-        f = camera.focal_px
-        fx = f if fx is None else fx
-        fy = f if fy is None else fy
+        cfx, cfy = camera.focal_xy
+        fx = cfx if fx is None else fx
+        fy = cfy if fy is None else fy
         z_safe = np.where(vis, z, 1.0)
-        x, y = cx + fx * p_cam[:, 0] / z_safe, cy - fy * p_cam[:, 1] / z_safe
+        if dist is None:
+            x, y = cx + fx * p_cam[:, 0] / z_safe, cy - fy * p_cam[:, 1] / z_safe
+        else:
+            xd, yd = naive_distort(p_cam[:, 0] / z_safe, -p_cam[:, 1] / z_safe, dist)
+            x, y = cx + fx * xd, cy + fy * yd
     else:
         s = camera.height / camera.ortho_height
         fx = s if fx is None else fx
@@ -164,6 +202,9 @@ def implied_fov(cam):
 
 def f_fov(p, cam):
     s = _scale_for(cam, implied_fov(cam))
+    if cam.calibrated:                        # both focal lengths scaled alike: fx/fy kept
+        fx, fy = cam.focal_xy
+        return _project(p, cam, fx=fx * s / fy, fy=s)
     return _project(p, cam, fx=s, fy=s)
 
 
@@ -210,6 +251,40 @@ def f_roll(p, cam):
     return _project(p, cam, rotation=rotate_z(math.radians(0.5))[:3, :3] @ r)
 
 
+PP_SHIFT = (3.25, -1.5)
+
+
+def f_pp_offset(p, cam):
+    """The principal point off by (3.25, -1.5) px."""
+    cx, cy = cam.principal_point
+    return _project(p, cam, cx=cx + PP_SHIFT[0], cy=cy + PP_SHIFT[1])
+
+
+def f_fxfy_swap(p, cam):
+    """fx and fy exchanged."""
+    fx, fy = cam.focal_xy
+    return _project(p, cam, fx=fy, fy=fx)
+
+
+def f_lens_ignored(p, cam):
+    return _project(p, cam, dist=None)
+
+
+def _lens_with(cam, index, factor):
+    c = list(cam.distortion)
+    c[index] *= factor
+    return tuple(c)
+
+
+def f_k1_sign(p, cam):
+    return _project(p, cam, dist=_lens_with(cam, 0, -1.0))
+
+
+def f_k2_wrong(p, cam):
+    """k2 twice its size."""
+    return _project(p, cam, dist=_lens_with(cam, 1, 2.0))
+
+
 FAULTS = {
     "none": (f_none, set()),
     "mirror_x": (f_mirror_x, {"mirror_horizontal"}),
@@ -227,15 +302,31 @@ FAULTS = {
     "swap_mirror": (f_swap_mirror, {"axis_swap", "mirror_horizontal"}),
     "fov_aspect": (f_fov_aspect, {"aspect_mismatch", "fov_mismatch"}),
     "fov_offset": (f_fov_offset, {"fov_mismatch", "pixel_offset"}),
+    # calibrated cameras. Swapping fx and fy scales x by fy/fx and y by fx/fy:
+    # both an aspect and a vertical focal length error, aspect first.
+    "pp_offset": (f_pp_offset, {"pixel_offset"}),
+    "fxfy_swap": (f_fxfy_swap, {"aspect_mismatch", "fov_mismatch"}),
+    "lens_ignored": (f_lens_ignored, {"distortion_mismatch"}),
+    "k1_sign": (f_k1_sign, {"distortion_mismatch"}),
+    "k2_wrong": (f_k2_wrong, {"distortion_mismatch"}),
 }
 SINGLE = [k for k in FAULTS if k not in ("swap_mirror", "fov_aspect", "fov_offset")]
+#: Faults that need a calibrated camera: fx != fy, or a lens.
+CALIBRATED_FAULTS = {"fxfy_swap": ("k_aniso", "k_barrel", "k_pincushion"),
+                     "lens_ignored": LENS_CAMERAS, "k1_sign": LENS_CAMERAS, "k2_wrong": LENS_CAMERAS}
 
 # (fault, camera) pairs. "inside" is for depth_flip only (both visible sets
 # non-empty); "transposed" is invisible on the "axis" camera (its rotation
 # diag(1, 1, -1) is its own transpose), tested separately below.
 MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
-CASES = [(f, c) for f in FAULTS for c in MAIN_CAMERAS if not (f == "transposed" and c == "axis")]
+CASES = [(f, c) for f in FAULTS for c in MAIN_CAMERAS
+         if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS]
 CASES += [("none", "inside"), ("depth_flip", "inside"), ("roll", "inside")]
+# calibrated cameras: the faults of a principal point, of fx/fy and of the lens, and
+# the unexplained ones, which a lens profile must not absorb
+CASES += [(f, c) for f in ("none", "pp_offset", "fov", "depth_flip", "roll", "transposed")
+          for c in CALIBRATED_CAMERAS]
+CASES += [(f, c) for f, cams in CALIBRATED_FAULTS.items() for c in cams]
 
 
 def points_for(camera_name):
@@ -355,6 +446,53 @@ def test_swap_with_offset(camera_name):
     # representable expected shift cx - cy, is off by <= ~3.5e-12 px (measured
     # 4.3e-14); 1e-9 px leaves ~300x margin (was 1e-6).
     assert (got[1]["dx"], got[1]["dy"]) == pytest.approx((0.5, -0.25), abs=1e-9)
+
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS + CALIBRATED_CAMERAS)
+def test_principal_point_offset(results, camera_name):
+    (off,) = results[("pp_offset", camera_name)]
+    # As in test_half_pixel_offset: <= ~3.5e-12 px from the fit; 1e-9 px.
+    assert (off["dx"], off["dy"]) == pytest.approx(PP_SHIFT, abs=1e-9)
+
+
+@pytest.mark.parametrize("camera_name", CALIBRATED_FAULTS["fxfy_swap"])
+def test_fxfy_swap_scales(results, camera_name):
+    """Swapped, x is scaled by fy / fx and y by fx / fy."""
+    fx, fy = CAMERAS[camera_name].focal_xy
+    asp, fov = results[("fxfy_swap", camera_name)]
+    # fitted scales: 3.5e-14 relative (budget above; the lens cameras' fit has
+    # the same conditioning, measured 1e-15); rel 1e-9.
+    assert (asp["scale_x"], asp["scale_y"]) == pytest.approx((fy / fx, fx / fy), rel=1e-9)
+    assert fov["scale"] == pytest.approx(fx / fy, rel=1e-9)
+
+
+LENS_KINDS = {"lens_ignored": "ignored", "k1_sign": "k1_sign", "k2_wrong": "magnitude"}
+LENS_OF = {"lens_ignored": lambda cam: (0.0, 0.0, 0.0, 0.0), "k1_sign": lambda cam: _lens_with(cam, 0, -1.0),
+           "k2_wrong": lambda cam: _lens_with(cam, 1, 2.0)}
+
+
+@pytest.mark.parametrize("camera_name", LENS_CAMERAS)
+@pytest.mark.parametrize("fault", list(LENS_KINDS))
+def test_lens_fault_reads_the_candidates_lens(results, fault, camera_name):
+    """kind, and the coefficients the candidate used (k1, k2, k3, p1, p2), read off the radial profile."""
+    (got,) = results[(fault, camera_name)]
+    assert got["kind"] == LENS_KINDS[fault]
+    lens = tuple(LENS_OF[fault](CAMERAS[camera_name])) + (0.0,) * 5
+    want = {"k1": lens[0], "k2": lens[1], "p1": lens[2], "p2": lens[3], "k3": lens[4]}
+    # Pixel noise <= 1.5e-12 px (budget above) is <= 3.2e-15 in normalised units
+    # (f >= 465 px). The profile's design, columns scaled to 1, has condition
+    # number <= 92 (measured on both lenses) and its smallest column (r^7, k3)
+    # reaches 0.0039: a coefficient is off by <= 92 x 3.2e-15 / 0.0039 ~ 7.5e-11
+    # (measured <= 1.4e-13). 1e-9 leaves >10x over the bound.
+    assert {k: got[k] for k in want} == pytest.approx(want, abs=1e-9)
+    assert got["residual_px"] <= TOL
+
+
+def test_lens_added_to_a_camera_without_one():
+    cam = CAMERAS["k_offc"]
+    (got,) = diagnose(_project(POINTS, cam, dist=LENS_PINCUSHION), oracle_project(POINTS, cam), cam, tol_px=TOL)
+    assert (got["name"], got["kind"]) == ("distortion_mismatch", "added")
+    assert got["k1"] == pytest.approx(LENS_PINCUSHION[0], abs=1e-9)       # bound as above
 
 
 def test_unexplained_fields(results):

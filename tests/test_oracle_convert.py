@@ -78,10 +78,25 @@ def test_opencv_round_trip(name):
 
 def test_opencv_to_camera_rejects_foreign_k():
     rvec, tvec, k = convert.camera_to_opencv(CAMERAS["camera_z"])
+    skewed = k.copy()
+    skewed[0, 1] = 0.5                               # skew: no camera of ours has it
+    with pytest.raises(ValueError, match="skew"):
+        convert.opencv_to_camera(rvec, tvec, skewed, 640, 480, 1.0, 10.0)
+    rvec, tvec, k = convert.camera_to_opencv(CAMERAS["ortho_oblique"])
+    k = k.copy()
+    k[0, 2] += 3.0                                   # orthographic cameras stay centred
+    with pytest.raises(ValueError, match="principal point"):
+        convert.opencv_to_camera(rvec, tvec, k, 160, 90, 1.0, 10.0, projection="orthographic")
+
+
+def test_opencv_to_camera_off_centre_k_is_calibrated():
+    rvec, tvec, k = convert.camera_to_opencv(CAMERAS["camera_z"])
     k = k.copy()
     k[0, 2] += 3.0                                   # off-centre principal point
-    with pytest.raises(ValueError, match="principal point"):
-        convert.opencv_to_camera(rvec, tvec, k, 640, 480, 1.0, 10.0)
+    cam = convert.opencv_to_camera(rvec, tvec, k, 640, 480, 1.0, 10.0, dist=(0.1, 0.0, 0.0, 0.0))
+    # the K entries are carried over as they are: exact
+    assert cam.intrinsics == (k[0, 0], k[1, 1], 322.5, 239.5)
+    assert cam.distortion == (0.1, 0.0, 0.0, 0.0)
 
 
 def test_pyrender_hand_values_camera_z():
