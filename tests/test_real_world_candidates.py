@@ -73,3 +73,42 @@ def test_pygame_tutorial_as_written_is_a_horizontal_fov_and_a_corner_centre():
         assert faults["fov_mismatch"]["scale"] == pytest.approx(w / h, rel=REL)
         assert faults["pixel_offset"]["dx"] == pytest.approx(0.5, abs=1e-6)
         assert faults["pixel_offset"]["dy"] == pytest.approx(0.5, abs=1e-6)
+
+
+import opencv_k  # noqa: E402
+
+CALIBRATED = ["off_centre", "non_square_pixels", "distorted"]
+
+
+def test_opencv_k_by_hand_passes_calibrated_and_distorted_cases():
+    # The documented projectPoints model written out in numpy: every case passes.
+    report = _check(opencv_k.project, ["on_axis"] + CALIBRATED)
+    assert report["verdict"] == "pass"
+    assert {c["camera"] for c in report["cases"]} == {"on_axis", *CALIBRATED}
+
+
+def _lens_faults(func):
+    report = _check(func, CALIBRATED)
+    assert report["verdict"] == "fail"
+    for case in report["cases"]:
+        if case["camera"] != "distorted":
+            assert case["verdict"] == "pass", case["camera"]   # no lens there: nothing to get wrong
+    return [(case["camera_spec"]["distortion"], _faults(case)["distortion_mismatch"])
+            for case in report["cases"] if case["camera"] == "distorted"]
+
+
+def test_opencv_k_without_the_lens_is_distortion_ignored():
+    for coeffs, fault in _lens_faults(opencv_k.project_no_lens):
+        assert fault["kind"] == "ignored"
+        # the candidate behaves as a lens with every coefficient zero
+        assert fault["k1"] == pytest.approx(0.0, abs=1e-9) and fault["k2"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_opencv_k_with_k1_flipped_is_named_with_the_candidates_k1():
+    for coeffs, fault in _lens_faults(opencv_k.project_k1_sign):
+        assert fault["kind"] == "k1_sign"
+        # the fitted lens is the camera's with k1 negated; other coefficients as given.
+        # 1e-9: the fit is linear least squares over exact float64 pixels (residual ~1e-13 px)
+        assert fault["k1"] == pytest.approx(-coeffs[0], abs=1e-9)
+        assert fault["k2"] == pytest.approx(coeffs[1], abs=1e-9)
+        assert (fault["p1"], fault["p2"]) == pytest.approx((coeffs[2], coeffs[3]), abs=1e-9)
