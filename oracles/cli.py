@@ -96,6 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", type=int, default=None,
                    help="frames of the scene's motion per case (default 24; 12 with --sweep)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} "
+                   f"or the groups default, calibrated, all "
                    f"(default: {', '.join(CASE_NAMES)}; the calibrated ones run when named)")
     p.add_argument("--candidate", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
                    help="the projector to judge (default: core/); run in its own process")

@@ -34,7 +34,7 @@ from wirecheck.core import scene_files
 from wirecheck.core.scene import Scene
 from wirecheck.core.scene_files import builtin_names, load_scene
 
-from .cases import ALL_CASE_NAMES, CASE_NAMES
+from .cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES
 
 #: How each input is called in messages: by the Python API, and by the ``crosscheck`` CLI.
 API_NAMES = {"scenes": "scenes", "frames": "frames", "every": "every", "cases": "cases", "turns": "turns",
@@ -92,16 +92,24 @@ def resolve_scenes(scenes, names: dict = API_NAMES) -> tuple:
     return out
 
 
+#: Names for groups of cases, usable among case names: ``--cases default,calibrated``.
+CASE_GROUPS = {"default": CASE_NAMES, "calibrated": CALIBRATED_CASE_NAMES, "all": ALL_CASE_NAMES}
+
+
 def resolve_cases(cases, names: dict = API_NAMES) -> tuple:
-    """Case names from a list or a comma-separated string (``None``: the default set), in ALL_CASE_NAMES order."""
+    """Case names from a list or a comma-separated string (``None``: the default set), in ALL_CASE_NAMES order.
+
+    A group name (:data:`CASE_GROUPS`) stands for its cases.
+    """
     name = names["cases"]
     if cases is None:
         return CASE_NAMES
     given = [c.strip() for c in cases.split(",") if c.strip()] if isinstance(cases, str) else list(cases)
+    given = [member for c in given for member in (CASE_GROUPS.get(c, (c,)) if isinstance(c, str) else (c,))]
     bad = [c for c in given if not isinstance(c, str) or c not in ALL_CASE_NAMES]
     if bad or not given:
         raise InputError(f"{name} {cases!r}: {'unknown ' + ', '.join(map(repr, bad)) if bad else 'no case named'}; "
-                         f"expected some of {', '.join(ALL_CASE_NAMES)}")
+                         f"expected some of {', '.join(ALL_CASE_NAMES)} or a group: {', '.join(CASE_GROUPS)}")
     twice = sorted({c for c in given if given.count(c) > 1})
     if twice:
         raise InputError(f"{name} {cases!r}: {', '.join(twice)} given twice: expected each case once")

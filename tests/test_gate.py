@@ -332,3 +332,18 @@ def test_fault_numbers_are_printed_distinct_from_their_nominal_values():
     # far from nominal: 4 significant digits, as before
     assert distinct(1.5, 4 / 3) == "1.5" and distinct(0.25, 0.0) == "0.25"
     assert distinct(1.0000004e-06, 1e-06) == "1.0000004e-06"
+
+
+# ---------------------------------------------------------------- case groups
+
+def test_case_groups_expand_to_their_members_in_table_order():
+    # The groups are written out by hand here (the case table in docs/crosscheck.md),
+    # not read from gate.CASE_GROUPS.
+    default = ("on_axis", "oblique_roll", "near_plane", "wide_fov", "narrow_fov", "non_square", "orthographic")
+    calibrated = ("off_centre", "non_square_pixels", "distorted")
+    assert gate.resolve_cases("default") == default
+    assert gate.resolve_cases("calibrated") == calibrated
+    assert gate.resolve_cases("all") == default + calibrated
+    assert gate.resolve_cases("calibrated,on_axis") == ("on_axis",) + calibrated
+    with pytest.raises(InputError, match="distorted given twice"):
+        gate.resolve_cases("calibrated,distorted")
