@@ -59,7 +59,7 @@ from wirecheck.core.transforms import Motion   # parameters only: the oracle's m
 
 from . import gate, metrics, opencv_oracle
 from .case import CaseResult, run_case
-from .cases import Case
+from .cases import Case, case_motion
 from .convert import model_matrix
 from .core_candidate import CoreCandidate, RenderMode
 from .tolerances import Tolerances
@@ -158,9 +158,10 @@ class _CaseRunner:
         if not self.warm:
             self.warm_up(case.camera, candidate, params.level)
         pyr = self.renderer(case.camera, params.mode) if params.level == "pixels" else None
-        result = run_case(scene, case, params.frames, candidate, params.motion,
+        result = run_case(scene, case, params.frames, candidate, case_motion(params.motion, case),
                           params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
                           keep_frames=params.keep_frames)
+        result.record["framing"] = case.framing()
         stderr = candidate.take_stderr() if hasattr(candidate, "take_stderr") else ""
         if stderr:          # an isolated candidate's stderr during this case (oracles.subprocess_candidate)
             result.record["candidate_stderr"] = stderr
@@ -276,7 +277,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     """
     from wirecheck.core.errors import InputError
 
-    from .cases import cameras_for
+    from .cases import cases_for
 
     if oracles is not None:
         implied = level_for_oracles(oracles)
@@ -302,7 +303,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     tasks = []
     for scene in inputs.scenes:
         try:
-            scene_cases = cameras_for(scene.radius)
+            scene_cases = cases_for(scene, motion)
         except InputError as exc:
             raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
         tasks += [(scene, case) for case in scene_cases if case.name in inputs.case_names]

@@ -44,7 +44,7 @@ from wirecheck.core.transforms import Motion
 
 from . import faces as oface
 from . import metrics, opencv_oracle
-from .cases import cameras_for
+from .cases import CASE_NAMES, case_motion, cases_for
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -101,8 +101,10 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     try:
         for group, scene in groups:
             edges = np.asarray(scene.edges)
-            core = {d: SceneRenderer(scene, motion, frames, dtype=d) for d in DTYPES}   # as renderer sets frames up
-            for case in cameras_for(scene.radius):
+            cases = cases_for(scene, motion)
+            scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
+            core = {d: SceneRenderer(scene, scene_motion, frames, dtype=d) for d in DTYPES}   # as renderer sets frames up
+            for case in cases:
                 if case_names is not None and case.name not in case_names:
                     continue
                 cam = case.camera
@@ -110,7 +112,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                 if pyrender:
                     pyr = oracles.get(cam.width, cam.height)
                 for k in frame_ids:
-                    p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
+                    p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, scene_motion, (k - 1) / frames)
                     ref_img = pyr.render(pr_vertices, edges, cam, model_matrix=pr_pose)[0] if pyr else None
                     ref_px = opencv_oracle.project(p_world, cam)
                     for s in settings:
@@ -160,7 +162,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
         "large_mesh": None if large is None else {"name": large.name, "source": large.source,
                                                   "vertices": int(len(large.vertices)),
                                                   "edges": int(len(large.edges))},
-        "cases": list(case_names) if case_names is not None else [c.name for c in cameras_for(1.0)],
+        "cases": list(case_names) if case_names is not None else list(CASE_NAMES),
         "frames": frames, "every": every, "frames_checked": len(frame_ids),
         "motion": {"turns": list(motion.turns)},
         "oracles": ["opencv"] + (["pyrender"] if pyrender else []),
