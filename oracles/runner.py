@@ -1,4 +1,4 @@
-"""Run the cases: candidate vs OpenCV (vertices) and vs pyrender/OSMesa (pixels).
+"""Run the cases: candidate vs OpenCV (vertices) and vs pyrender on OSMesa or EGL (pixels).
 
 Each case (a scene under one camera) is run by :func:`oracles.case.run_case`:
 frames 1, 1 + every, 1 + 2 every, ... of the scene's motion, a vertex stage
@@ -43,12 +43,17 @@ each worker creates its own :class:`PyrenderOracle` objects (one per image
 size, cached for the worker's life) and loads a ``FILE.py:FUNC`` candidate
 itself from the spec string. Results are gathered in case order, so the report
 is the same for any number of jobs.
+
+Each scene's cases are framed on it (oracles.cases: the cameras about its
+framing sphere, the run's turns about the framing centre); each record says
+how (``"framing"``). The report names the GL that drew the oracle's frames
+(``"oracle_gl"``: :meth:`oracles.pyrender_oracle.PyrenderOracle.gl_info`;
+null at level vertices).
 """
 
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 
@@ -162,6 +167,7 @@ class _CaseRunner:
                           params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
                           keep_frames=params.keep_frames)
         result.record["framing"] = case.framing()
+        result.gl_info = pyr.gl_info() if pyr is not None else None
         stderr = candidate.take_stderr() if hasattr(candidate, "take_stderr") else ""
         if stderr:          # an isolated candidate's stderr during this case (oracles.subprocess_candidate)
             result.record["candidate_stderr"] = stderr
@@ -178,7 +184,9 @@ def _worker_init() -> None:
     global _WORKER_RUNNER
     from multiprocessing.util import Finalize
 
-    os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+    from .pyrender_oracle import gl_platform
+
+    gl_platform()          # the parent's PYOPENGL_PLATFORM (crosscheck --gl), inherited; osmesa if unset
     _WORKER_RUNNER = _CaseRunner()
     Finalize(_WORKER_RUNNER, _WORKER_RUNNER.close, exitpriority=10)   # free the GL contexts at exit
 
@@ -329,6 +337,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     results, workers = _run_tasks(tasks, params, jobs, on_result=on_result, isolate=isolate)
 
     records, images, timing_cases = [], {}, []
+    gl = next((r.gl_info for r in results if r.gl_info is not None), None)   # one driver per machine
     for (scene, case), result in zip(tasks, results):
         records.append(result.record)
         timing_cases.append({"scene": scene.name, "camera": case.name, **result.timing})
@@ -382,6 +391,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         "level": level,
         **mode.to_dict(),
         "oracles": list(LEVEL_ORACLES[level]),
+        "oracle_gl": gl,
         "frames": frames,
         "every": every,
         "frames_checked": len(range(1, frames + 1, every)),
