@@ -2,7 +2,7 @@
 
 Every camera is placed relative to the scene's framing sphere, centre ``c`` and
 radius ``r`` (:func:`framing`), so the same set fits any scene, wherever it
-is. The table is repeated in the README ("Cases").
+is. The table is repeated in docs/crosscheck.md ("Cases").
 
     name          what it exercises
     on_axis       camera at c + 3r on +Z, looking at c, fov 60, 640x480

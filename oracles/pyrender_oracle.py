@@ -521,6 +521,11 @@ class OracleCache:
     def __contains__(self, size) -> bool:
         return tuple(size) in self._by_size
 
+    def gl_info(self) -> dict | None:
+        """:meth:`PyrenderOracle.gl_info` of the first oracle made (one driver per process); None before any."""
+        first = next(iter(self._by_size.values()), None)
+        return None if first is None else first.gl_info()
+
     def close(self) -> None:
         """Release every context; the cache may be used again afterwards."""
         oracles, self._by_size = self._by_size, {}

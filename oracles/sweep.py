@@ -45,6 +45,7 @@ from wirecheck.core.transforms import Motion
 from . import faces as oface
 from . import metrics, opencv_oracle
 from .cases import CASE_NAMES, case_motion, cases_for
+from .report import gl_text
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -135,6 +136,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                             a["f1_1"].append(ps["f1_1px"])
                 if progress:
                     progress(f"{scene.name}/{case.name}")
+        gl = oracles.gl_info()
     finally:
         oracles.close()
 
@@ -166,6 +168,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
         "frames": frames, "every": every, "frames_checked": len(frame_ids),
         "motion": {"turns": list(motion.turns)},
         "oracles": ["opencv"] + (["pyrender"] if pyrender else []),
+        "oracle_gl": gl,
         "timing_method": f"min of {repeats} calls of render_frame per frame, median over frames",
         "settings": rows,
     }
@@ -207,6 +210,7 @@ def markdown(sweep: dict) -> str:
            f"Cases: {', '.join(sweep['cases'])}; frames {sweep['frames_checked']} of {sweep['frames']} "
            f"(every {sweep['every']}); oracles: {', '.join(sweep['oracles'])}.",
            f"Timing: {sweep['timing_method']}.", "",
+           *([f"Oracle GL: {gl_text(sweep)}.", ""] if gl_text(sweep) else []),
            markdown_table(sweep), "", "![Pareto plot](sweep.png)", ""]
     return "\n".join(out)
 

@@ -49,8 +49,8 @@ def test_the_off_centre_box_fills_the_derived_fraction_of_the_image():
     The front face (z = centre + h) is at depth d = 3 sqrt(3) h - h and half as
     wide as the box, so its half-width in pixels is f h / d with
     f = 240 / tan(30 deg) = 240 sqrt(3): 240 sqrt(3) / (3 sqrt(3) - 1) = 99.07 px,
-    41 % of the image's 480 rows. Origin framing (main before this change) gave
-    6.3 px: r = |FAR| + sqrt(3) h = 1108.
+    41 % of the image's 480 rows. Framing on the origin gave a half-width of
+    6.3 px: r = |FAR| + sqrt(3) h = 1108, 240 sqrt(3) h / (3 r - h).
     """
     scene = far_box()
     case = cases_for(scene)[0]
