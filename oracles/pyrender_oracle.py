@@ -109,10 +109,6 @@ def gl_available() -> tuple[bool, str]:
     if platform not in GL_PLATFORMS:
         return False, (f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on "
                        f"{' or '.join(repr(p) for p in GL_PLATFORMS)}")
-    try:
-        import pyrender  # noqa: F401
-    except Exception as exc:
-        return False, f"pyrender cannot be imported ({type(exc).__name__}: {exc}); pip install pyrender2"
     if platform == "osmesa":
         try:
             from OpenGL import osmesa
@@ -120,6 +116,11 @@ def gl_available() -> tuple[bool, str]:
         except Exception as exc:  # ImportError, OSError, AttributeError, NullFunctionError
             return False, (f"libOSMesa cannot be loaded ({type(exc).__name__}: {exc}); "
                            f"install it with: {_INSTALL_HINT['osmesa']}")
+    try:
+        import pyrender  # noqa: F401
+    except Exception as exc:
+        return False, f"pyrender cannot be imported ({type(exc).__name__}: {exc}); pip install pyrender2"
+    if platform == "osmesa":
         return True, "OSMesa available"
     if platform not in _EGL_CHECKED:
         try:

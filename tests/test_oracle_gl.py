@@ -133,3 +133,18 @@ def test_the_platform_cannot_change_once_opengl_is_loaded(monkeypatch):
     with pytest.raises(InputError, match="already loaded .* for 'osmesa'"):
         select_gl("egl")
     assert select_gl("osmesa") == "osmesa"
+
+
+def test_no_usable_egl_is_one_line_with_the_install_hint(tmp_path):
+    """glvnd given no EGL vendor (as on a machine without Mesa's EGL): exit 2, one line, nothing written."""
+    out = tmp_path / "r"
+    env = {**os.environ, "__EGL_VENDOR_LIBRARY_FILENAMES": str(tmp_path / "no-vendor.json")}
+    env.pop("PYOPENGL_PLATFORM", None)
+    proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--gl", "egl", "--scene", "cube",
+                           "--frames", "1", "--report-dir", str(out)], env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "no EGL context can be created" in lines[0]
+    assert "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri" in lines[0]
+    assert not out.exists()
