@@ -20,12 +20,12 @@ about the centre ``c`` of the scene's box over its objects' motions
 (:func:`centred_sphere`), with the run turning about ``c`` instead
 (``Motion.pivot``, :func:`case_motion`). The scene is framed on ``c`` when
 the origin is outside that box (a mesh placed away from the origin: it now
-spins in place and fills the image), or when the origin's sphere is more than
-:data:`REFRAME_RATIO` times the centred one (the origin at a corner of the
-scene). A scene modelled about the origin (every bundled scene) keeps its
-origin framing and spin, bit for bit; its origin sphere is then at most
-``1 + sqrt(3)`` times the centred one (each half-extent of the box is at most
-``r``), and in practice at most :data:`REFRAME_RATIO` times.
+spins in place and fills the image), or when the origin's sphere is at least
+:data:`REFRAME_RATIO` times the centred one (the origin near a corner of the
+box; with the origin inside, the ratio is at most ``1 + sqrt(3)``, as each
+half-extent of the box is at most ``r``). Otherwise, as for a scene modelled
+about the origin (every bundled scene: ratios 1 to 1.05), the origin framing
+and spin are kept, bit for bit.
 """
 
 from __future__ import annotations
