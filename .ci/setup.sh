@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Idempotent set-up for a fresh machine: OSMesa (for the pyrender oracle), a
-# virtualenv in .venv, and the project installed editable with its dev extras.
+# Idempotent set-up for a fresh machine: OSMesa and Mesa's EGL (the pyrender
+# oracle's two GL platforms), a virtualenv in .venv, and the project installed
+# editable with its dev extras.
 # Safe to run every time: each step is skipped when already done.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,6 +12,15 @@ if ! ldconfig -p 2>/dev/null | grep -q 'libOSMesa\.so'; then
     if [ "$(id -u)" = "0" ]; then SUDO=""; else SUDO="sudo"; fi
     $SUDO apt-get update -qq >&2
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libosmesa6 >&2
+fi
+
+# 1b. Mesa's EGL: crosscheck --gl egl (PYOPENGL_PLATFORM=egl) draws through it,
+# on the CPU (llvmpipe, from libgl1-mesa-dri) where there is no GPU.
+if ! ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\.so' || ! ldconfig -p 2>/dev/null | grep -q 'libEGL\.so\.1'; then
+    echo "setup: Mesa's EGL not found, installing libegl1 libegl-mesa0 libgl1-mesa-dri with apt-get" >&2
+    if [ "$(id -u)" = "0" ]; then SUDO=""; else SUDO="sudo"; fi
+    $SUDO apt-get update -qq >&2
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libegl1 libegl-mesa0 libgl1-mesa-dri >&2
 fi
 
 # 2. virtualenv + project. Re-install only when pyproject.toml changed.

@@ -130,6 +130,11 @@ class Scene:
         return out
 
 
+def radius_about(points: np.ndarray, centre) -> float:
+    """Largest distance of ``(N, 3)`` points from ``centre`` (0 for none), without overflowing squares."""
+    return _radius(np.asarray(points, dtype=np.float64) - np.asarray(centre, dtype=np.float64))
+
+
 def _radius(vertices: np.ndarray) -> float:
     if len(vertices) == 0:
         return 0.0

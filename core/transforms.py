@@ -65,14 +65,20 @@ class Motion:
         A constant translation, world units.
     scale : float
         A constant uniform scale.
+    pivot : (3,) tuple of float
+        The point the scale and turns are about, model units (crosscheck spins
+        a scene about the centre its cameras are framed on, oracles.cases).
 
     The model matrix at run fraction ``t`` in [0, 1) is
-    ``T(offset) @ Rz @ Ry @ Rx @ S(scale)`` (:mod:`wirecheck.core.conventions`).
+    ``T(offset) @ Rz @ Ry @ Rx @ S(scale)`` about the origin, and
+    ``T(offset + pivot) @ Rz @ Ry @ Rx @ S(scale) @ T(-pivot)`` about a pivot
+    (:mod:`wirecheck.core.conventions`).
     """
 
     turns: tuple[float, float, float] = (1.0, 1.0, 0.0)
     offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
     scale: float = 1.0
+    pivot: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
         from .limits import check_turns
@@ -98,4 +104,8 @@ class Motion:
 
     def _matrix(self, phases) -> np.ndarray:
         ax, ay, az = (2.0 * math.pi * p for p in phases)
-        return compose(translate(self.offset), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale))
+        if not any(float(p) for p in self.pivot):      # about the origin: no T(pivot) factors at all
+            return compose(translate(self.offset), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale))
+        to_pivot = tuple(float(o) + float(p) for o, p in zip(self.offset, self.pivot))
+        return compose(translate(to_pivot), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale),
+                       translate(tuple(-float(p) for p in self.pivot)))

@@ -49,6 +49,8 @@ class CaseResult:
     timing: dict = field(default_factory=dict)
     #: every checked frame's images, bit-packed: [(frame, candidate, oracle)] (for worst.gif)
     frame_images: list | None = None
+    #: the GL that drew the oracle's frames (PyrenderOracle.gl_info), None at level vertices
+    gl_info: dict | None = None
 
 
 class CaseSetup:

@@ -1,4 +1,4 @@
-"""``crosscheck``: judge a projector against OpenCV and pyrender/OSMesa.
+"""``crosscheck``: judge a projector against OpenCV and pyrender (OSMesa or EGL).
 
 Exit status: 0 when every case is within tolerance, 1 when any case fails or
 compared nothing (``vacuous``, unless ``--allow-vacuous``), 2 on usage or input
@@ -112,6 +112,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "pixels: vertices and pyrender pixels (default)")
     p.add_argument("--oracles", default=None,
                    help="older spelling of --level: 'opencv' = vertices, 'opencv,pyrender' = pixels (default: from --level)")
+    p.add_argument("--gl", choices=("osmesa", "egl"), default=None,
+                   help="the OpenGL platform pyrender draws on (level pixels): osmesa, or egl (Mesa's on the CPU, "
+                        "or a GPU's driver) (default: $PYOPENGL_PLATFORM, else osmesa)")
     p.add_argument("--every", type=int, default=1, metavar="K",
                    help="check frames 1, 1+K, 1+2K, ... of the motion (default 1: every frame)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
@@ -295,11 +298,17 @@ def _main(argv=None) -> int:
     if applied:      # after the checks: on a usage error the error is the only line
         print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
     if level == "pixels":
-        from .pyrender_oracle import osmesa_available
+        from .pyrender_oracle import gl_available, select_gl
 
-        ok, message = osmesa_available()
+        try:
+            select_gl(args.gl)
+        except InputError as exc:
+            return _error(str(exc))
+        ok, message = gl_available()
         if not ok:
             return _error(f"{message} (or run with --level vertices)")
+    elif args.gl is not None:
+        return _error(f"--gl {args.gl} with --level {level}: nothing is drawn at that level; expected no --gl")
     try:
         check_report_dir(run_dir, run_option)
         check_replaceable(run_dir, run_option)

@@ -347,11 +347,12 @@ def camera_to_gl(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
 
 # ---- model motion ---------------------------------------------------------
 
-def model_matrix(turns, offset, scale: float, t: float) -> np.ndarray:
+def model_matrix(turns, offset, scale: float, t: float, pivot=(0.0, 0.0, 0.0)) -> np.ndarray:
     """The scene's model matrix at time ``t``, built with scipy.
 
     Must equal ``T @ Rz(az) @ Ry(ay) @ Rx(ax) @ S`` with
-    ``a_i = 2 pi ((t * turns_i) % 1)`` (``core.conventions``, "Motion").
+    ``a_i = 2 pi ((t * turns_i) % 1)`` (``core.conventions``, "Motion"); about
+    a non-zero ``pivot`` c, ``p -> R S (p - c) + c + offset``.
     scipy: *lowercase* axes in ``Rotation.from_euler`` are extrinsic (about the
     fixed axes, in the order given), so ``from_euler("xyz", [ax, ay, az])`` is
     "rotate about x, then fixed y, then fixed z" = ``Rz @ Ry @ Rx`` (equal to the
@@ -365,4 +366,7 @@ def model_matrix(turns, offset, scale: float, t: float) -> np.ndarray:
     m = np.eye(4)
     m[:3, :3] = Rotation.from_euler("xyz", [ax, ay, az]).as_matrix() * float(scale)
     m[:3, 3] = np.asarray(offset, dtype=np.float64)
+    c = np.asarray(pivot, dtype=np.float64)
+    if c.any():
+        m[:3, 3] += c - m[:3, :3] @ c
     return m

@@ -32,7 +32,7 @@ import numpy as np
 from wirecheck.core.errors import InputError
 from wirecheck.core.output import FrameDir, json_dumps
 
-from .cases import CASE_NAMES, cameras_for
+from .cases import CASE_NAMES, case_motion, cases_for
 from .convert import camera_to_gl, opencv_matrices
 
 #: Version of the job format; frames_candidate refuses any other.
@@ -111,14 +111,16 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
                            "obj": f"scenes/{scene.name}.obj" if single else f"scenes/{scene.name}/frame_NNNN.obj",
                            "vertices": int(len(scene.vertices)), "edges": int(len(scene.edges)),
                            "faces": len(faces)})
+        cases = cases_for(scene, motion, calibrated=True)
+        scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
         geometry = {}
         for k in checked:
-            p_world, _m, _pr_vertices, pose = frame_geometry(scene, motion, (k - 1) / frames)
+            p_world, _m, _pr_vertices, pose = frame_geometry(scene, scene_motion, (k - 1) / frames)
             geometry[k] = pose if single else np.eye(4)
             if not single:
                 files[f"scenes/{scene.name}/{frame_name(k, 'obj')}"] = _obj_text(
                     p_world, scene.edges, faces, f"{scene.name} frame {k}: world space").encode()
-        for case in cameras_for(scene.radius, calibrated=True):
+        for case in cases:
             if case.name not in (CASE_NAMES if case_names is None else case_names):
                 continue
             if case.camera.distortion is not None:      # frames are judged by pixels: not for a lens (oracles.case)

@@ -38,9 +38,12 @@ def fan(faces) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(tris, dtype=np.int64).reshape(-1, 3), np.asarray(owner, dtype=np.int64)
 
 
-def object_matrices(scene, run_turns, t: float) -> list[np.ndarray]:
-    """Each object's world matrix at time ``t``: ``M_run(t) @ M_o(t)`` (object's motion first), via scipy."""
-    m_run = model_matrix(run_turns, (0.0, 0.0, 0.0), 1.0, t)
+def object_matrices(scene, run_turns, t: float, pivot=(0.0, 0.0, 0.0)) -> list[np.ndarray]:
+    """Each object's world matrix at time ``t``: ``M_run(t) @ M_o(t)`` (object's motion first), via scipy.
+
+    The run turns about ``pivot`` (core.transforms.Motion).
+    """
+    m_run = model_matrix(run_turns, (0.0, 0.0, 0.0), 1.0, t, pivot)
     out = []
     for o in scene.objects:
         m = o.motion
@@ -66,9 +69,9 @@ def frame_geometry(scene, motion, t: float):
     (:func:`object_matrices`), and pyrender gets the world points, no pose.
     """
     if scene.is_single_static:
-        m = model_matrix(motion.turns, motion.offset, motion.scale, t)
+        m = model_matrix(motion.turns, motion.offset, motion.scale, t, motion.pivot)
         return scene.vertices @ m[:3, :3].T + m[:3, 3], [m], scene.vertices, m
-    matrices = object_matrices(scene, motion.turns, t)
+    matrices = object_matrices(scene, motion.turns, t, motion.pivot)
     p_world = world_points(scene, matrices)
     return p_world, matrices, p_world, None
 

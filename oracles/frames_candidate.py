@@ -230,6 +230,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
                                     oracles, tol, diagnose=diagnose)
             records.append(rec)
             images[(c["scene"], c["case"])] = worst
+        gl = oracles.gl_info()
     finally:
         oracles.close()
     failed = sum(r["verdict"] == "fail" for r in records)
@@ -242,6 +243,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
         "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",
         "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
         "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
+        "oracle_gl": gl,
         "frames": job["frames"], "every": job["every"], "frames_checked": len(job["frame_numbers"]),
         "motion": job["motion"],
         "tolerances": {"vertex_error_px": tol.vertex_px, "min_pixel_f1_1px": tol.min_f1_1px,

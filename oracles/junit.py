@@ -63,6 +63,8 @@ def junit_xml(report: dict) -> bytes:
     for name in ("candidate", "level", "frames", "every"):
         if report.get(name) is not None:
             ET.SubElement(props, "property", {"name": name, "value": str(report[name])})
+    for key, value in (report.get("oracle_gl") or {}).items():     # the GL that drew the oracle's frames
+        ET.SubElement(props, "property", {"name": f"oracle_gl_{key}", "value": str(value)})
     for c in cases:
         elem = ET.SubElement(suite, "testcase", {"classname": c["scene"], "name": c["camera"],
                                                  "time": f"{_seconds(timing.get((c['scene'], c['camera']))):.3f}"})

@@ -1,4 +1,4 @@
-"""Reference wireframe rasterisation with pyrender on OSMesa (Mesa llvmpipe).
+"""Reference wireframe rasterisation with pyrender on OSMesa or EGL.
 
 Edges are drawn as one ``GL_LINES`` primitive, 1 px wide, white on black, with
 ``RenderFlags.FLAT`` (unlit shader: colour = base colour, no lights needed).
@@ -20,18 +20,32 @@ Depth is read from the 24-bit depth buffer directly and made linear here in
 float64: pyrender's own linearisation assumes a perspective projection (wrong
 for its OrthographicCamera) and runs in float32.
 
-Measured on this llvmpipe: the multisample buffers pyrender allocates are not
-used for these draws (the colour buffer has only 0 and 255, never partial
-coverage), so a pixel is covered exactly when its centre is (GL's rule).
+Aliased, whatever the driver: the oracle draws into single-sample buffers, so
+a pixel is covered exactly when its centre is (GL's rule) and a line pixel is
+0 or 255. On OSMesa pyrender draws into the context's own buffer, which has
+no samples. With framebuffer objects (EGL) pyrender allocates 4x multisample
+buffers and enables ``GL_MULTISAMPLE`` on every pass; Mesa's llvmpipe and the
+NVIDIA driver then both anti-alias lines (coverage 64/128/191). The oracle
+re-allocates those buffers with 0 samples (:func:`_single_sample`), and
+``GL_MULTISAMPLE`` has no effect without sample buffers (multisample
+rasterisation needs ``SAMPLE_BUFFERS`` = 1, GL 4.6 core, 14.3.1). Depth then
+comes from the pixel centre too.
 
-pyrender is imported lazily, after ``PYOPENGL_PLATFORM`` defaults to
-``osmesa``. One :class:`PyrenderOracle` keeps one ``OffscreenRenderer`` and one
-scene; frames update node poses only (creating a renderer costs ~100 ms).
+The GL platform is ``PYOPENGL_PLATFORM``: ``osmesa`` (the default, set here
+when unset) or ``egl`` (Mesa's EGL on the CPU, or a vendor's driver on a
+GPU); :func:`select_gl` sets it (``crosscheck --gl``). It must be chosen
+before PyOpenGL is imported. :meth:`PyrenderOracle.gl_info` reads the
+context's ``GL_VENDOR``, ``GL_RENDERER`` and ``GL_VERSION`` for the reports.
+
+pyrender is imported lazily. One :class:`PyrenderOracle` keeps one
+``OffscreenRenderer`` and one scene; frames update node poses only (creating
+a renderer costs ~100 ms).
 """
 
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
 
@@ -39,34 +53,136 @@ from wirecheck.core.camera import Camera
 
 from .convert import camera_to_pyrender
 
-__all__ = ["osmesa_available", "OracleCache", "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
+__all__ = ["GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
+           "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
 
-_INSTALL_HINT = "apt-get install -y libosmesa6"
+#: The OpenGL platforms the oracle draws on (``PYOPENGL_PLATFORM``); the first is the default.
+GL_PLATFORMS = ("osmesa", "egl")
+
+_INSTALL_HINT = {"osmesa": "apt-get install -y libosmesa6",
+                 "egl": "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri"}
 
 
-def osmesa_available() -> tuple[bool, str]:
-    """Whether pyrender can render offscreen with OSMesa here.
+def gl_platform() -> str:
+    """The platform pyrender draws on: ``PYOPENGL_PLATFORM``, set to ``osmesa`` when unset."""
+    os.environ.setdefault("PYOPENGL_PLATFORM", GL_PLATFORMS[0])
+    return os.environ["PYOPENGL_PLATFORM"]
+
+
+def select_gl(name: str | None) -> str:
+    """Set ``PYOPENGL_PLATFORM`` to ``name`` (None: keep it, default osmesa); return the platform.
+
+    Raises InputError for a platform other than :data:`GL_PLATFORMS`, or when
+    PyOpenGL was already loaded in this process for another one (it reads the
+    variable once, at import).
+    """
+    from wirecheck.core.errors import InputError
+
+    if name is None:
+        return gl_platform()
+    if name not in GL_PLATFORMS:
+        raise InputError(f"--gl {name!r}: expected one of {', '.join(GL_PLATFORMS)}")
+    current = os.environ.get("PYOPENGL_PLATFORM")
+    if "OpenGL.platform" in sys.modules and current != name:
+        raise InputError(f"--gl {name}: OpenGL is already loaded in this process for {current!r}; "
+                         f"set PYOPENGL_PLATFORM={name} before it starts")
+    os.environ["PYOPENGL_PLATFORM"] = name
+    return name
+
+
+_EGL_CHECKED: dict[str, tuple[bool, str]] = {}
+
+
+def gl_available() -> tuple[bool, str]:
+    """Whether pyrender can render offscreen here on :func:`gl_platform`.
+
+    OSMesa: libOSMesa loads. EGL: a 1x1 context can be created and made
+    current (the only reliable test: libEGL may load with no usable device),
+    checked once per process.
 
     Returns
     -------
     ok : bool
-    message : str, one line; with an install hint when libOSMesa cannot load.
+    message : str, one line; with an install hint when the library cannot load.
     """
-    os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
-    platform = os.environ["PYOPENGL_PLATFORM"]
-    if platform != "osmesa":
-        return False, f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle needs 'osmesa'"
-    try:
-        from OpenGL import osmesa
-        osmesa.OSMesaCreateContextAttribs  # noqa: B018 - raises if the symbol is missing
-    except Exception as exc:  # ImportError, OSError, AttributeError, NullFunctionError
-        return False, (f"libOSMesa cannot be loaded ({type(exc).__name__}: {exc}); "
-                       f"install it with: {_INSTALL_HINT}")
+    platform = gl_platform()
+    if platform not in GL_PLATFORMS:
+        return False, (f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on "
+                       f"{' or '.join(repr(p) for p in GL_PLATFORMS)}")
+    if platform == "osmesa":
+        try:
+            from OpenGL import osmesa
+            osmesa.OSMesaCreateContextAttribs  # noqa: B018 - raises if the symbol is missing
+        except Exception as exc:  # ImportError, OSError, AttributeError, NullFunctionError
+            return False, (f"libOSMesa cannot be loaded ({type(exc).__name__}: {exc}); "
+                           f"install it with: {_INSTALL_HINT['osmesa']}")
     try:
         import pyrender  # noqa: F401
     except Exception as exc:
         return False, f"pyrender cannot be imported ({type(exc).__name__}: {exc}); pip install pyrender2"
-    return True, "OSMesa available"
+    if platform == "osmesa":
+        return True, "OSMesa available"
+    if platform not in _EGL_CHECKED:
+        try:
+            PyrenderOracle(1, 1).close()
+            _EGL_CHECKED[platform] = (True, "EGL available")
+        except Exception as exc:  # RuntimeError, OSError, ImportError, GLError: no usable EGL
+            msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
+            _EGL_CHECKED[platform] = (False, f"no EGL context can be created ({msg}); "
+                                             f"install it with: {_INSTALL_HINT['egl']}")
+    return _EGL_CHECKED[platform]
+
+
+def osmesa_available() -> tuple[bool, str]:
+    """:func:`gl_available` (the older name, from when OSMesa was the only platform)."""
+    return gl_available()
+
+
+def _spare_the_display(platform) -> None:
+    """Closing an EGL context leaves the display initialised, for the other oracles.
+
+    pyrender's ``EGLPlatform.delete_context`` ends with ``eglTerminate`` of
+    its display, and every context on one device shares that display: closing
+    one oracle (an :class:`OracleCache` holds one per image size) would leave
+    the others with ``EGL_BAD_DISPLAY``. Here only the context is destroyed;
+    the display lives as long as the process. Only this platform instance is
+    changed.
+    """
+    from OpenGL import EGL
+
+    def delete_context():
+        if platform._egl_context is not None:
+            EGL.eglMakeCurrent(platform._egl_display, EGL.EGL_NO_SURFACE, EGL.EGL_NO_SURFACE, EGL.EGL_NO_CONTEXT)
+            EGL.eglDestroyContext(platform._egl_display, platform._egl_context)
+            platform._egl_context = None
+
+    platform.delete_context = delete_context
+
+
+def _single_sample(renderer) -> None:
+    """Make pyrender ``renderer``'s offscreen framebuffer single-sample (module docstring).
+
+    pyrender's ``_configure_main_framebuffer`` allocates the colour and depth
+    renderbuffers it draws into with 4 samples; after it, they are given
+    storage again with 0 samples (the framebuffer keeps them attached), once
+    per framebuffer it creates. Only this renderer instance is changed.
+    """
+    from OpenGL import GL
+
+    configure = renderer._configure_main_framebuffer
+
+    def configure_single_sample():
+        configure()
+        key = (renderer._main_fb_ms, renderer._main_fb_dims)
+        if key == getattr(renderer, "_wirecheck_single_sample", None):
+            return
+        w, h = renderer._main_fb_dims
+        for buffer, fmt in ((renderer._main_cb_ms, GL.GL_RGBA), (renderer._main_db_ms, GL.GL_DEPTH_COMPONENT24)):
+            GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, buffer)
+            GL.glRenderbufferStorageMultisample(GL.GL_RENDERBUFFER, 0, fmt, w, h)
+        renderer._wirecheck_single_sample = key
+
+    renderer._configure_main_framebuffer = configure_single_sample
 
 
 def _fan(faces) -> np.ndarray:
@@ -120,7 +236,7 @@ def _id_colours(count: int) -> np.ndarray:
 
 
 class PyrenderOracle:
-    """A reusable pyrender/OSMesa wireframe renderer of fixed size.
+    """A reusable pyrender wireframe renderer of fixed size, on :func:`gl_platform`.
 
     Parameters
     ----------
@@ -131,11 +247,15 @@ class PyrenderOracle:
     """
 
     def __init__(self, width: int, height: int):
-        os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+        self.platform = gl_platform()
         import pyrender
         self._pr = pyrender
         self.width, self.height = int(width), int(height)
         self._renderer = pyrender.OffscreenRenderer(self.width, self.height)
+        _single_sample(self._renderer._renderer)
+        if self.platform == "egl":
+            _spare_the_display(self._renderer._platform)
+        self._gl_info = None
         self._scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
         self._mesh_node = None
         self._mesh_key = None
@@ -160,6 +280,34 @@ class PyrenderOracle:
 
     def __exit__(self, *exc):
         self.close()
+
+    def gl_info(self) -> dict:
+        """The GL that draws this oracle's frames, read from its context (once).
+
+        ``{"platform", "vendor", "renderer", "version", "samples"}``: the
+        ``PYOPENGL_PLATFORM``, ``glGetString`` of ``GL_VENDOR``,
+        ``GL_RENDERER`` and ``GL_VERSION``, and ``GL_SAMPLES`` of the
+        framebuffer pyrender draws into (0: aliased, module docstring).
+        """
+        if self._gl_info is None:
+            from OpenGL import GL
+            if self._renderer is None:
+                raise RuntimeError("PyrenderOracle is closed")
+            platform = self._renderer._platform
+            platform.make_current()
+            try:
+                strings = {key: GL.glGetString(name).decode("utf-8", "replace") for key, name in
+                           (("vendor", GL.GL_VENDOR), ("renderer", GL.GL_RENDERER), ("version", GL.GL_VERSION))}
+                draw_fb = 0
+                if platform.supports_framebuffers():
+                    self._renderer._renderer._configure_main_framebuffer()
+                    draw_fb = self._renderer._renderer._main_fb_ms
+                GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, draw_fb)
+                samples = int(GL.glGetIntegerv(GL.GL_SAMPLES))
+            finally:
+                platform.make_uncurrent()
+            self._gl_info = {"platform": self.platform, **strings, "samples": samples}
+        return dict(self._gl_info)
 
     # ---- scene updates -------------------------------------------------
     def _set_mesh(self, vertices: np.ndarray, edges: np.ndarray, faces, cull: bool = False) -> None:
@@ -373,6 +521,11 @@ class OracleCache:
 
     def __contains__(self, size) -> bool:
         return tuple(size) in self._by_size
+
+    def gl_info(self) -> dict | None:
+        """:meth:`PyrenderOracle.gl_info` of the first oracle made (one driver per process); None before any."""
+        first = next(iter(self._by_size.values()), None)
+        return None if first is None else first.gl_info()
 
     def close(self) -> None:
         """Release every context; the cache may be used again afterwards."""

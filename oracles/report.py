@@ -157,7 +157,7 @@ def console_table(cases: list[dict]) -> str:
 
 LEVEL_TEXT = {
     "vertices": "the candidate's vertex pixels against OpenCV only (nothing drawn, no pyrender)",
-    "pixels": "vertex pixels against OpenCV, and drawn frames against pyrender/OSMesa",
+    "pixels": "vertex pixels against OpenCV, and drawn frames against pyrender",
 }
 
 
@@ -197,6 +197,15 @@ def drawing_text(report: dict) -> str:
                  "picks the edges)" if cull == "backface" else "no culling")
     return (f"style = {style}, hidden_lines = {str(bool(report.get('hidden_lines'))).lower()}, cull = {cull}: "
             f"{what}; {cull_text}")
+
+
+def gl_text(report: dict) -> str | None:
+    """The GL that drew the oracle's frames, in one line (None when pyrender did not run)."""
+    gl = report.get("oracle_gl")
+    if not gl:
+        return None
+    buffers = "single-sample buffers" if gl["samples"] == 0 else f"{gl['samples']}x multisample buffers"
+    return f"pyrender on {gl['platform']}: {gl['vendor']}, {gl['renderer']}, OpenGL {gl['version']}, {buffers}"
 
 
 def _figures(report: dict, files: set) -> list[tuple[str, str]]:
@@ -259,6 +268,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            f"Compared: {compared_text(report)}." + (f" {vacuous_text(report)}." if vacuous_text(report) else ""), "",
            f"Level: {level_text(report)}. Checked: {frames_text(report)}.", "",
            f"Drawing: {drawing_text(report)}.", "",
+           *([f"Oracle GL: {gl_text(report)}.", ""] if gl_text(report) else []),
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
@@ -315,6 +325,7 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         f"<p>Compared: {e(compared_text(report))}. {e(vacuous_text(report))}</p>",
         f"<p>Level {e(level_text(report))}. Checked: {e(frames_text(report))}.</p>",
         f"<p>Drawing: {e(drawing_text(report))}.</p>",
+        f"<p>Oracle GL: {e(gl_text(report))}.</p>" if gl_text(report) else "",
         "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>" + rows + "</table>",
     ]
     failing = not_passed(report)

@@ -1,4 +1,4 @@
-"""Run the cases: candidate vs OpenCV (vertices) and vs pyrender/OSMesa (pixels).
+"""Run the cases: candidate vs OpenCV (vertices) and vs pyrender on OSMesa or EGL (pixels).
 
 Each case (a scene under one camera) is run by :func:`oracles.case.run_case`:
 frames 1, 1 + every, 1 + 2 every, ... of the scene's motion, a vertex stage
@@ -43,12 +43,17 @@ each worker creates its own :class:`PyrenderOracle` objects (one per image
 size, cached for the worker's life) and loads a ``FILE.py:FUNC`` candidate
 itself from the spec string. Results are gathered in case order, so the report
 is the same for any number of jobs.
+
+Each scene's cases are framed on it (oracles.cases: the cameras about its
+framing sphere, the run's turns about the framing centre); each record says
+how (``"framing"``). The report names the GL that drew the oracle's frames
+(``"oracle_gl"``: :meth:`oracles.pyrender_oracle.PyrenderOracle.gl_info`;
+null at level vertices).
 """
 
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 
@@ -59,7 +64,7 @@ from wirecheck.core.transforms import Motion   # parameters only: the oracle's m
 
 from . import gate, metrics, opencv_oracle
 from .case import CaseResult, run_case
-from .cases import Case
+from .cases import Case, case_motion
 from .convert import model_matrix
 from .core_candidate import CoreCandidate, RenderMode
 from .tolerances import Tolerances
@@ -160,9 +165,11 @@ class _CaseRunner:
         if not self.warm:
             self.warm_up(case.camera, candidate, params.level)
         pyr = self.renderer(case.camera, params.mode) if params.level == "pixels" else None
-        result = run_case(scene, case, params.frames, candidate, params.motion,
+        result = run_case(scene, case, params.frames, candidate, case_motion(params.motion, case),
                           params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
                           keep_frames=params.keep_frames)
+        result.record["framing"] = case.framing()
+        result.gl_info = pyr.gl_info() if pyr is not None else None
         stderr = candidate.take_stderr() if hasattr(candidate, "take_stderr") else ""
         if stderr:          # an isolated candidate's stderr during this case (oracles.subprocess_candidate)
             result.record["candidate_stderr"] = stderr
@@ -179,7 +186,9 @@ def _worker_init() -> None:
     global _WORKER_RUNNER
     from multiprocessing.util import Finalize
 
-    os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+    from .pyrender_oracle import gl_platform
+
+    gl_platform()          # the parent's PYOPENGL_PLATFORM (crosscheck --gl), inherited; osmesa if unset
     _WORKER_RUNNER = _CaseRunner()
     Finalize(_WORKER_RUNNER, _WORKER_RUNNER.close, exitpriority=10)   # free the GL contexts at exit
 
@@ -278,7 +287,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     """
     from wirecheck.core.errors import InputError
 
-    from .cases import CASE_NAMES, cameras_for
+    from .cases import CASE_NAMES, cases_for
 
     if oracles is not None:
         implied = level_for_oracles(oracles)
@@ -304,8 +313,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     tasks = []
     for scene in inputs.scenes:
         try:
-            scene_cases = (cameras_for(scene.radius, calibrated=True) if set(inputs.case_names) - set(CASE_NAMES)
-                           else cameras_for(scene.radius))
+            scene_cases = cases_for(scene, motion, calibrated=bool(set(inputs.case_names) - set(CASE_NAMES)))
         except InputError as exc:
             raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
         tasks += [(scene, case) for case in scene_cases if case.name in inputs.case_names]
@@ -335,6 +343,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     results, workers = _run_tasks(tasks, params, jobs, on_result=on_result, isolate=isolate)
 
     records, images, timing_cases = [], {}, []
+    gl = next((r.gl_info for r in results if r.gl_info is not None), None)   # one driver per machine
     for (scene, case), result in zip(tasks, results):
         records.append(result.record)
         timing_cases.append({"scene": scene.name, "camera": case.name, **result.timing})
@@ -388,6 +397,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         "level": level,
         **mode.to_dict(),
         "oracles": list(LEVEL_ORACLES[level]),
+        "oracle_gl": gl,
         "frames": frames,
         "every": every,
         "frames_checked": len(range(1, frames + 1, every)),

@@ -44,7 +44,8 @@ from wirecheck.core.transforms import Motion
 
 from . import faces as oface
 from . import metrics, opencv_oracle
-from .cases import CASE_NAMES, cameras_for
+from .cases import CASE_NAMES, case_motion, cases_for
+from .report import gl_text
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -101,8 +102,10 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     try:
         for group, scene in groups:
             edges = np.asarray(scene.edges)
-            core = {d: SceneRenderer(scene, motion, frames, dtype=d) for d in DTYPES}   # as renderer sets frames up
-            for case in cameras_for(scene.radius, calibrated=True):
+            cases = cases_for(scene, motion, calibrated=True)
+            scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
+            core = {d: SceneRenderer(scene, scene_motion, frames, dtype=d) for d in DTYPES}   # as renderer sets frames up
+            for case in cases:
                 if case.name not in (CASE_NAMES if case_names is None else case_names):
                     continue
                 cam = case.camera
@@ -110,7 +113,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                 if pyrender and cam.distortion is None:      # a lens: vertices only (oracles.case)
                     pyr = oracles.get(cam.width, cam.height)
                 for k in frame_ids:
-                    p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, (k - 1) / frames)
+                    p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, scene_motion, (k - 1) / frames)
                     ref_img = pyr.render(pr_vertices, edges, cam, model_matrix=pr_pose)[0] if pyr else None
                     ref_px = opencv_oracle.project(p_world, cam)
                     for s in settings:
@@ -133,6 +136,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                             a["f1_1"].append(ps["f1_1px"])
                 if progress:
                     progress(f"{scene.name}/{case.name}")
+        gl = oracles.gl_info()
     finally:
         oracles.close()
 
@@ -160,10 +164,11 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
         "large_mesh": None if large is None else {"name": large.name, "source": large.source,
                                                   "vertices": int(len(large.vertices)),
                                                   "edges": int(len(large.edges))},
-        "cases": list(case_names) if case_names is not None else [c.name for c in cameras_for(1.0)],
+        "cases": list(case_names) if case_names is not None else list(CASE_NAMES),
         "frames": frames, "every": every, "frames_checked": len(frame_ids),
         "motion": {"turns": list(motion.turns)},
         "oracles": ["opencv"] + (["pyrender"] if pyrender else []),
+        "oracle_gl": gl,
         "timing_method": f"min of {repeats} calls of render_frame per frame, median over frames",
         "settings": rows,
     }
@@ -205,6 +210,7 @@ def markdown(sweep: dict) -> str:
            f"Cases: {', '.join(sweep['cases'])}; frames {sweep['frames_checked']} of {sweep['frames']} "
            f"(every {sweep['every']}); oracles: {', '.join(sweep['oracles'])}.",
            f"Timing: {sweep['timing_method']}.", "",
+           *([f"Oracle GL: {gl_text(sweep)}.", ""] if gl_text(sweep) else []),
            markdown_table(sweep), "", "![Pareto plot](sweep.png)", ""]
     return "\n".join(out)
 

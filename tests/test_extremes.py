@@ -93,8 +93,9 @@ def test_results_are_deterministic(suite_without_pyrender):
     again = run_case("near_grazing", pyrender=False)
     first = next(c for c in suite_without_pyrender["cases"] if c["name"] == "near_grazing")
     assert json.dumps(again, sort_keys=True) == json.dumps(first, sort_keys=True)
-    assert set(suite_without_pyrender) == {"suite", "verdict", "pyrender", "reference", "bounds", "cases",
-                                           "timing"}
+    assert set(suite_without_pyrender) == {"suite", "verdict", "pyrender", "oracle_gl", "reference", "bounds",
+                                           "cases", "timing"}
+    assert suite_without_pyrender["oracle_gl"] is None        # no GL drew anything
 
 
 def test_bounds_are_not_vacuous(suite_without_pyrender):

@@ -164,7 +164,7 @@ def test_candidate_returning_an_empty_array_fails():
 @pytest.fixture()
 def camera_looking_away(monkeypatch):
     """Every case camera replaced by one that looks away from the scene: every point is clipped."""
-    def away(radius):
+    def away(radius, *_framing):
         r = radius if radius > 0 else 1.0
         cam = look_at((0, 0, 3 * r), (0, 0, 6 * r), (0, 1, 0), fov_y_deg=60, near=0.1 * r, far=10 * r)
         return [cases_mod.Case("on_axis", cam)]

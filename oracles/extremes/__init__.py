@@ -93,6 +93,7 @@ def run_extremes(pyrender: bool = True) -> dict:
         "suite": "extremes",
         "verdict": "pass" if all(c["verdict"] == "pass" for c in cases) else "fail",
         "pyrender": pr.enabled,
+        "oracle_gl": pr.gl,
         "reference": {"dtype": "longdouble", "eps": REFERENCE_EPS, "extended": REFERENCE_EXTENDED},
         "bounds": {f.__name__: derivation(f) for f in DERIVED},
         "cases": cases,

@@ -116,6 +116,7 @@ class Pyrender:
         from ..pyrender_oracle import OracleCache
 
         self.oracles = OracleCache()
+        self.gl = None
         self.note = None
         self.enabled = enabled
         if not enabled:
@@ -140,4 +141,6 @@ class Pyrender:
                 "pyrender_pixels": s["oracle_pixels"]}, None
 
     def close(self):
+        """Release the GL contexts; :attr:`gl` keeps the GL that drew (None if nothing was drawn)."""
+        self.gl = self.oracles.gl_info()
         self.oracles.close()

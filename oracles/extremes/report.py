@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..report import gl_text
+
 
 def _fmt(v, digits=2):
     if v is None:
@@ -49,6 +51,7 @@ def _bound_lines(bounds: dict) -> list[str]:
 def extremes_markdown(result: dict) -> str:
     """A Markdown table of the cases, one line per case on what it checks and its bound, the derivations."""
     lines = [f"## Extremes suite: {result['verdict'].upper()}", "",
+             *([f"Oracle GL: {gl_text(result)}.", ""] if gl_text(result) else []),
              "| case | float64 error px | bound px | float32 error px | bound px | pyrender F1@1 | verdict |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for c in result["cases"]:
