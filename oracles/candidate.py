@@ -15,6 +15,13 @@
   integer coordinates at pixel centres; core/conventions.py), NaN rows for the
   points it clips (depth outside [near, far]).
 
+The candidate's precision (oracles.tolerances.PRECISIONS) is inferred from
+the dtype of the array it returns: ``float32`` (or ``float16``) means float32,
+anything else float64. A program over the candidate protocol says it in its
+reply (docs/protocol.md). A precision declared by the user
+(``--candidate-precision``) wins over the inferred one
+(:func:`case_precision`).
+
 Given as ``--candidate FILE.py:FUNC`` or ``--candidate MODULE:FUNC``.
 """
 
@@ -101,14 +108,46 @@ def _as_pixels(out) -> np.ndarray:
                              "expected an (N, 2) float array") from exc
 
 
+def returned_precision(out) -> str:
+    """The precision an answer's dtype shows: ``"float32"`` for float32 (or float16), else ``"float64"``."""
+    dtype = getattr(out, "dtype", None)
+    return "float32" if dtype is not None and dtype.kind == "f" and dtype.itemsize <= 4 else "float64"
+
+
+def case_precision(declared: str | None, returned: set) -> tuple[str, str]:
+    """``(precision, source)`` a case is judged at.
+
+    ``declared`` (the user's ``--candidate-precision``) wins; else float32 when
+    any answer of the case was float32 (``returned``: the precisions seen),
+    else float64. ``source`` is ``"declared"``, ``"returned"`` or ``"default"``
+    (nothing returned yet, e.g. the candidate failed at once).
+    """
+    if declared is not None:
+        return declared, "declared"
+    if not returned:
+        return "float64", "default"
+    return ("float32" if "float32" in returned else "float64"), "returned"
+
+
 def call_candidate(func, points: np.ndarray, camera) -> np.ndarray:
     """Call the candidate and check its answer against the contract."""
+    return call_candidate_precision(func, points, camera)[0]
+
+
+def call_candidate_precision(func, points: np.ndarray, camera) -> tuple[np.ndarray, str]:
+    """:func:`call_candidate`, and the precision of the answer (:func:`returned_precision`).
+
+    A candidate with ``answer_precision()`` (a program over the protocol,
+    oracles.subprocess_candidate) says its own, the wire being float64.
+    """
     try:
         out = func(np.array(points, dtype=np.float64, copy=True), camera)
     except CandidateError:                   # an isolated candidate's own one-line reason
         raise
     except (Exception, SystemExit) as exc:   # a candidate must not end the run (nor pass CI by exiting 0)
         raise CandidateError(f"candidate raised {type(exc).__name__}: {exc}") from exc
+    told = getattr(func, "answer_precision", None)
+    precision = told() if callable(told) else returned_precision(out)
     out = _as_pixels(out)
     if out.shape != (len(points), 2):
         raise CandidateError(f"candidate returned shape {out.shape}: expected ({len(points)}, 2)")
@@ -122,4 +161,4 @@ def call_candidate(func, points: np.ndarray, camera) -> np.ndarray:
         k = int(np.flatnonzero(half)[0])
         raise CandidateError(f"candidate returned {out[k].tolist()} for point {k}: expected both coordinates "
                              "NaN (clipped) or both finite")
-    return out
+    return out, precision

@@ -72,7 +72,7 @@ def serve(spec: str, stdin, stdout) -> int:
 def serve_loaded(func, stdin, send) -> int:
     """The request loop over a loaded candidate ``func`` (after the header is answered)."""
     from . import protocol
-    from .candidate import CandidateError, call_candidate
+    from .candidate import CandidateError, call_candidate_precision
 
     camera_key = camera = None
     while True:
@@ -86,14 +86,14 @@ def serve_loaded(func, stdin, send) -> int:
         if key != camera_key:              # the same camera for a case's requests: built once
             camera_key, camera = key, _camera(request["camera"])
         try:
-            p_px = call_candidate(func, p_world, camera)
+            p_px, precision = call_candidate_precision(func, p_world, camera)
         except CandidateError as exc:
             send(protocol.encode_error(str(exc)))
             continue
         except BaseException as exc:     # KeyboardInterrupt, GeneratorExit: this request fails
             send(protocol.encode_error(f"candidate raised {type(exc).__name__}: {exc}"))
             continue
-        send(protocol.encode_reply(p_px))
+        send(protocol.encode_reply(p_px, precision))    # the dtype the function returned, for the harness
 
 
 def main(argv=None) -> int:

@@ -7,7 +7,9 @@ Frame ``k`` (1-based, at ``t = (k - 1) / frames``) goes through two stages:
    OpenCV's ``projectPoints`` of them, and the candidate's pixels of the same
    points: core through its own pipeline (:func:`core.pipeline.render_frame`
    given no edges, so nothing is drawn), any other candidate called on the
-   world points (oracles.candidate); :func:`vertex_stage` scores them;
+   world points (oracles.candidate); :func:`vertex_stage` scores them and keeps
+   the case's scale for the precision-derived vertex bound
+   (oracles.tolerances.vertex_scale);
 2. **pixel stage** (level ``pixels``): the candidate's frame (core's full
    pipeline, or oracles.draw for another candidate) against pyrender's
    rendering of the same edges, faces or shading (:func:`pixel_stage`).
@@ -27,8 +29,8 @@ from wirecheck.core.scene import Scene
 from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
 from . import faces as oface
-from . import metrics, opencv_oracle
-from .candidate import CandidateError, call_candidate
+from . import metrics, opencv_oracle, tolerances
+from .candidate import CandidateError, call_candidate_precision, case_precision
 from .cases import Case
 from .core_candidate import CoreCandidate, RenderMode
 from .draw import draw_candidate, oracle_segments
@@ -84,6 +86,8 @@ class CaseFrames:
     """What the checked frames of a case gathered, in frame order."""
 
     cand_px: list = field(default_factory=list)         # (N, 2) per frame
+    returned: set = field(default_factory=set)          # the precisions of the candidate's answers
+    scale: float = 0.0                                  # largest tolerances.vertex_scale over the frames
     oracle_px: list = field(default_factory=list)
     frame_errors: list = field(default_factory=list)    # (max error px, frame, worst vertex)
     per_frame: list = field(default_factory=list)       # the record's per_frame items
@@ -125,9 +129,12 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         oracle_px = opencv_oracle.project(geometry[0], setup.cam)
         t2 = time.perf_counter()
         try:
-            cand_px, points, m_core = candidate_vertices(setup, k, geometry[0])
+            cand_px, points, m_core, returned = candidate_vertices(setup, k, geometry[0])
+            acc.returned.add(returned)
             t3 = time.perf_counter()
-            cand_img, cand_depth = candidate_frame(setup, points, m_core, geometry[0]) if setup.pixels else (None, None)
+            precision = case_precision(tol.precision, acc.returned)[0]
+            cand_img, cand_depth = (candidate_frame(setup, points, m_core, geometry[0], precision) if setup.pixels
+                                    else (None, None))
             t4 = time.perf_counter()
         except CandidateError as exc:
             acc.error = f"frame {k}: {exc}"
@@ -138,6 +145,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         acc.seconds["draw"] += t4 - t3
         t5 = time.perf_counter()
         frame_rec = vertex_stage(acc, k, cand_px, oracle_px)
+        acc.scale = max(acc.scale, tolerances.vertex_scale(geometry[0], oracle_px, setup.cam))
         t6 = acc.add("vmetric", t5)
         if setup.pixels:
             pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6)
@@ -154,25 +162,30 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
 
 
 def candidate_vertices(setup: CaseSetup, k: int, p_world: np.ndarray):
-    """``(cand_px (N, 2), points, m_core)`` of frame ``k``; CandidateError when the candidate fails.
+    """``(cand_px (N, 2), points, m_core, precision)`` of frame ``k``; CandidateError when the candidate fails.
 
     ``points`` and ``m_core`` are core's own set-up of the frame (None for
-    another candidate), reused by :func:`candidate_frame`.
+    another candidate), reused by :func:`candidate_frame`; ``precision`` is
+    that of the answer (core: its ``dtype``).
     """
     if not setup.is_core:
-        return call_candidate(setup.candidate, p_world, setup.cam), None, None
+        cand_px, precision = call_candidate_precision(setup.candidate, p_world, setup.cam)
+        return cand_px, None, None, precision
     try:
         points, m_core = setup.core_frames.geometry(k)
-        return setup.candidate.project(points, setup.cam, m_core), points, m_core
+        return setup.candidate.project(points, setup.cam, m_core), points, m_core, setup.candidate.dtype
     except Exception as exc:      # core crashing is a failed case, not a crashed run
         raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc
 
 
-def candidate_frame(setup: CaseSetup, points, m_core, p_world: np.ndarray):
-    """``(image, depth)``: the candidate's frame (a bool image), or its depth buffer when shaded."""
+def candidate_frame(setup: CaseSetup, points, m_core, p_world: np.ndarray, precision: str = "float64"):
+    """``(image, depth)``: the candidate's frame (a bool image), or its depth buffer when shaded.
+
+    ``precision``: the candidate's, for the ends clipped at the near and far planes (oracles.draw).
+    """
     cand, cam, mode = setup.candidate, setup.cam, setup.mode
     if not setup.is_core:
-        return draw_candidate(cand, p_world, setup.edges, cam), None
+        return draw_candidate(cand, p_world, setup.edges, cam, precision), None
     try:
         if mode.plain:
             return cand.draw(points, setup.edges, cam, m_core), None

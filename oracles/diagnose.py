@@ -1,6 +1,6 @@
 """Name what is wrong with a candidate projector, from its pixels and an oracle's.
 
-``diagnose(cand_px, oracle_px, camera, tol_px=1e-6) -> list[dict]``
+``diagnose(cand_px, oracle_px, camera, tol_px=1e-6, float32_px=None) -> list[dict]``
 
 Both inputs are ``(N, 2)`` pixel coordinates of the *same* world points (pooled
 over all frames of a case), with a non-finite row (NaN, in practice) where that
@@ -69,11 +69,30 @@ line_end_bias       (pixels; vertices agree) one-sided pixels   end ("first", "l
 line_pixel_bias     (pixels; vertices agree) as above, but not  candidate_only, oracle_only,
                     at the ends: thicker/thinner lines, strays  net_start, net_end, net_middle,
                                                                 net_stray
+precision_limited   (a candidate judged at float64) the         residual_px, float64_bound_px,
+                    disagreement is float32 rounding: the       float32_bound_px
+                    diagnosis at the float32 bound explains
+                    it (see "Precision" below)
 unexplained         the named model does not fit (rotation,     residual_px (max), residual_rms_px,
                     shear, not affine); or the visible sets     affine_residual_px, affine, offset,
                     differ without a depth flip; or too few     rotation_deg, visibility_mismatches,
                     common points to fit                        common_visible, underdetermined
 ==================  ==========================================  ===================================
+
+Precision
+---------
+``tol_px`` is the caller's bound for the candidate's precision
+(oracles.tolerances.vertex_bound: 1e-6 px for float64, ~1e-3 px for a
+float32 candidate on the bundled cases), so steps 3 and 4 fit *through* the
+candidate's rounding noise: a float32 projector with a mirror and a half-pixel
+offset is named ``mirror_vertical`` + ``pixel_offset``, not ``unexplained``.
+A candidate judged at float64 whose error is float32 rounding is told so: with
+``float32_px`` (the float32 bound of the same points) given, the diagnosis is
+run again at ``float32_px``; when that one names no ``unexplained`` (nor a
+depth flip) and differs from the float64 one (other names, or a named model
+that leaves more than ``tol_px``), the answer is its faults plus
+``precision_limited`` (the residual left by them and both bounds). A float64
+mirror fitted to 1e-13 px stays a plain ``mirror_vertical``.
 
 Details and decisions
 ---------------------
@@ -131,7 +150,8 @@ __all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER"
 #: the picture more than a scale; an offset is the smallest visible effect.
 FAULT_ORDER = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
                "mirror_vertical", "aspect_mismatch", "fov_mismatch",
-               "pixel_offset", "distortion_mismatch", "line_end_bias", "line_pixel_bias", "unexplained")
+               "pixel_offset", "distortion_mismatch", "line_end_bias", "line_pixel_bias", "precision_limited",
+               "unexplained")
 FAULT_NAMES = frozenset(FAULT_ORDER)
 #: The faults named from a wireframe's pixels (:func:`diagnose_lines`), not from its vertices.
 LINE_FAULTS = ("line_end_bias", "line_pixel_bias")
@@ -214,8 +234,13 @@ def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> l
     return faults
 
 
-def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
+def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float | None = None) -> list[dict]:
     """Name the faults of a candidate projector; ``[]`` when it agrees.
+
+    With ``float32_px`` (the float32 rounding bound of these points,
+    oracles.tolerances.vertex_bound; given for a candidate judged at float64)
+    a disagreement at ``tol_px`` that the same diagnosis at ``float32_px``
+    explains is named ``precision_limited`` (module docstring).
 
     Parameters
     ----------
@@ -233,6 +258,23 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
     -------
     list of dict, primary fault first; see the module docstring.
     """
+    faults = _diagnose_at(cand_px, oracle_px, camera, tol_px)
+    if not faults or float32_px is None or not float32_px > tol_px:
+        return faults
+    info: dict = {}
+    coarse = _diagnose_at(cand_px, oracle_px, camera, float32_px, info)
+    names = [f["name"] for f in faults]
+    if any(f["name"] in ("unexplained", "depth_flip") for f in coarse) or "depth_flip" in names:
+        return faults                  # float32 rounding does not explain it either
+    if info["residual_px"] <= tol_px and names == [f["name"] for f in coarse]:
+        return faults                  # the same faults, fitted to float64 accuracy: not a rounding matter
+    return _sorted(coarse + [{"name": "precision_limited", "residual_px": info["residual_px"],
+                              "float64_bound_px": float(tol_px), "float32_bound_px": float(float32_px)}])
+
+
+def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = None) -> list[dict]:
+    """:func:`diagnose` at one tolerance; ``info["residual_px"]``: the named model's largest residual."""
+    info = {} if info is None else info
     cand = np.asarray(cand_px, dtype=np.float64)
     orac = np.asarray(oracle_px, dtype=np.float64)
     if cand.size == 0 and orac.size == 0:
@@ -252,7 +294,8 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
     mismatches = int((vis_c != vis_o).sum())
     if n_union == 0:
         return []                                   # N = 0 or both clip everything
-    if mismatches == 0 and _max_abs(cand[both] - orac[both]) <= tol:
+    info["residual_px"] = _max_abs(cand[both] - orac[both])
+    if mismatches == 0 and info["residual_px"] <= tol:
         return []
 
     # 1. depth flip: visible sets (nearly) swapped
@@ -274,6 +317,7 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
         if n_both:
             off = (c - o).mean(axis=0)
             resid = c - o - off
+            info["residual_px"] = _max_abs(resid)
             if _max_abs(resid) <= tol:
                 if _max_abs(off) > tol:
                     faults.append({"name": "pixel_offset", "dx": float(off[0]), "dy": float(off[1])})
@@ -307,7 +351,7 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6) -> list[dict]:
         d[i], off[i] = _fit_axis(q[:, i], c[:, i])
     named_res = c - (q * d + off)
     reach = np.max(np.abs(q), axis=0)               # largest |coordinate| per candidate axis
-    named_max = _max_abs(named_res)
+    named_max = info["residual_px"] = _max_abs(named_res)
     collapsed = bool(np.any(d * reach <= tol))       # an axis the candidate squashed flat
     if named_max > tol or collapsed:
         from .lens_diagnose import distortion_fault       # a lens error bends the picture: not affine

@@ -5,6 +5,16 @@ clips each edge in world space against the near and far planes (depth is
 affine along a segment, so this is exact), asks the candidate to project the
 clipped ends, clips the 2D segments to the image and rasterises them with
 core's line rasterizer. A correct candidate then draws what core draws.
+
+A clipped end lies on the near (or far) plane, where the candidate's own depth
+test decides in its own precision: computed in float32, the end's depth may
+come out a rounding below ``near`` and the candidate rightly clips it, losing
+the whole edge. So each clipped end is moved inside ``[near, far]`` by more
+than the candidate's depth rounding at that point, ``DEPTH_ROUNDINGS eps
+(|X| + |C|)`` (oracles.tolerances; eps of the candidate's precision), and
+never less than ``_INWARD`` of the kept segment. A correct candidate at its
+precision then cannot reject it; the end moves by ~1e-6 of a unit in depth
+for float32 (a small fraction of a pixel unless the edge is seen end-on).
 """
 
 from __future__ import annotations
@@ -16,16 +26,29 @@ from wirecheck.core.raster import line_pixels
 
 from . import opencv_oracle
 from .candidate import call_candidate
+from .tolerances import DEPTH_ROUNDINGS, EPS
 
-#: Clipped ends are moved this fraction of the kept segment inward, so that a
-#: point computed to lie exactly on the near plane is not clipped by the
-#: candidate because of one ulp of rounding (1e-9 of a segment is far below a
-#: pixel for any segment shorter than 1e8 px).
+#: Clipped ends are moved at least this fraction of the kept segment inward
+#: (1e-9 of a segment is far below a pixel for any segment shorter than 1e8 px).
 _INWARD = 1e-9
+#: At most this fraction of the kept segment: a kept part shorter than the
+#: depth margin keeps its middle half.
+_MAX_INWARD = 0.25
 
 
-def clip_depth(p0_world, p1_world, camera):
-    """Keep the parts of segments with depth in [near, far]: ``(kept, ends (K, 2, 3))``."""
+def depth_margin(p_world: np.ndarray, camera, precision: str) -> np.ndarray:
+    """``(N,)``: how far a candidate of ``precision`` may misplace each point's depth, ``DEPTH_ROUNDINGS eps (|X| + |C|)``."""
+    size = np.linalg.norm(p_world, axis=1) + float(np.linalg.norm(camera.position))
+    return DEPTH_ROUNDINGS * EPS[precision] * size
+
+
+def clip_depth(p0_world, p1_world, camera, precision: str = "float64"):
+    """Keep the parts of segments with depth in [near, far]: ``(kept, ends (K, 2, 3))``.
+
+    A clipped end is moved inward by :func:`depth_margin` at ``precision`` in
+    depth (module docstring), at least ``_INWARD`` and at most ``_MAX_INWARD``
+    of the kept part.
+    """
     d0 = opencv_oracle.depth(p0_world, camera)
     d1 = opencv_oracle.depth(p1_world, camera)
     t_in = np.zeros(len(d0))
@@ -40,19 +63,24 @@ def clip_depth(p0_world, p1_world, camera):
             t_in = np.where((s0 < 0) & (s1 < 0), 2.0, t_in)   # both outside: drop
     kept = t_in <= t_out
     span = (t_out - t_in)[kept]
-    a = t_in[kept] + np.where(t_in[kept] > 0, _INWARD * span, 0.0)
-    b = t_out[kept] - np.where(t_out[kept] < 1, _INWARD * span, 0.0)
     d = (p1_world - p0_world)[kept]
+    margin = np.maximum(depth_margin(p0_world[kept], camera, precision),
+                        depth_margin(p1_world[kept], camera, precision))
+    with np.errstate(divide="ignore", invalid="ignore"):   # depth constant along it: never clipped, never moved
+        margin_t = margin / np.abs(d1 - d0)[kept]
+    inward = np.clip(margin_t, _INWARD * span, _MAX_INWARD * span)
+    a = t_in[kept] + np.where(t_in[kept] > 0, inward, 0.0)
+    b = t_out[kept] - np.where(t_out[kept] < 1, inward, 0.0)
     ends = np.stack([p0_world[kept] + a[:, None] * d, p0_world[kept] + b[:, None] * d], axis=1)
     return kept, ends
 
 
-def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera) -> np.ndarray:
-    """``(H, W)`` bool image of the candidate's wireframe."""
+def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera, precision: str = "float64") -> np.ndarray:
+    """``(H, W)`` bool image of the candidate's wireframe (``precision``: the candidate's, for the clipped ends)."""
     image = np.zeros((camera.height, camera.width), bool)
     if len(edges) == 0:
         return image
-    _, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera)
+    _, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera, precision)
     if len(ends) == 0:
         return image
     px = call_candidate(func, ends.reshape(-1, 3), camera).reshape(-1, 2, 2)

@@ -92,10 +92,25 @@ def encode_request(request_id: int, p_world: np.ndarray, camera_json: str) -> by
     return out
 
 
-def encode_reply(p_px: np.ndarray) -> bytes:
-    """One reply: ``{"n": N}`` and the pixels, ``(N, 2)`` float64."""
+def encode_reply(p_px: np.ndarray, precision: str = "float64") -> bytes:
+    """One reply: ``{"n": N}`` (with ``"precision": "float32"`` for a float32 answer) and the pixels, float64."""
     p_px = np.ascontiguousarray(p_px, dtype=WIRE_DTYPE).reshape(-1, 2)
-    return json.dumps({"n": len(p_px)}).encode() + b"\n" + p_px.tobytes()
+    head = {"n": len(p_px), **({"precision": precision} if precision != "float64" else {})}
+    return json.dumps(head).encode() + b"\n" + p_px.tobytes()
+
+
+#: The values a reply's optional ``precision`` may take (oracles.tolerances.PRECISIONS).
+REPLY_PRECISIONS = ("float32", "float64")
+
+
+def reply_precision(line: bytes) -> str:
+    """The precision a reply line declares (``"float64"`` when it says none); ProtocolError for another value."""
+    obj = parse_line(line, "a reply")
+    precision = obj.get("precision", "float64")
+    if precision not in REPLY_PRECISIONS:
+        raise ProtocolError(f"wrote the reply {shown(line)}: expected \"precision\" to be one of "
+                            f"{', '.join(REPLY_PRECISIONS)}")
+    return precision
 
 
 def encode_error(message: str) -> bytes:

@@ -47,6 +47,8 @@ FAULT_HINTS = {
     "line_pixel_bias": "the vertices agree but the candidate draws systematically more (or fewer) line pixels "
                        "than the oracle along the lines: check the line width (1 px) and the rounding of the "
                        "minor coordinate (nearest pixel centre)",
+    "precision_limited": "the error is the size of float32 rounding, not a convention error: compute in "
+                         "float64 or declare float32 (--candidate-precision float32)",
     "depth_flip": "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
     "unexplained": "not a simple image-space fault: check the rotation order, a transposed "
                    "world-to-camera matrix, the up vector (roll) and the near/far test",

@@ -145,6 +145,11 @@ class SubprocessCandidate:
         """The candidate contract: ``(N, 3)`` world points to ``(N, 2)`` pixels; CandidateError on any fault."""
         return _live(self).project(np.asarray(points, dtype=np.float64).reshape(-1, 3), camera)
 
+    def answer_precision(self) -> str:
+        """The precision the program's last reply declared (``"float64"`` when it said none; docs/protocol.md)."""
+        program = _PROGRAMS.get(self)
+        return program.precision if program else "float64"
+
     def start(self) -> None:
         """Start the program now (if not running); CandidateError (CandidateStartRefused) if it cannot."""
         _live(self).ensure_started()
@@ -291,6 +296,7 @@ class _Program:
         self.buf = bytearray()
         self.requests = 0
         self.camera = self.camera_json = None
+        self.precision = "float64"         # what the last reply declared
         self.err = bytearray()             # the program's stderr not yet taken (its tail)
         self.err_cut = 0                   # bytes dropped from its front since the last take
 
@@ -417,6 +423,7 @@ class _Program:
                     return None
                 header["line"] = line_end
                 header["end"] = line_end + protocol.reply_length(bytes(buf[:line_end]), n)
+                header["precision"] = protocol.reply_precision(bytes(buf[:line_end]))
             return header["end"]
 
         try:
@@ -437,6 +444,7 @@ class _Program:
         with memoryview(self.buf) as view:          # decoded straight from the buffer (one copy)
             p_px = protocol.decode_points(view[header["line"]:end], 2)
         del self.buf[:end]
+        self.precision = header["precision"]
         return p_px
 
     def _exchange(self, payload: bytes, end_of, limit_s: float, timed_out: str, died_while: str) -> int:

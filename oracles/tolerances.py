@@ -7,13 +7,110 @@ MAX_EDGE_COUNT_DIFF are fields of :class:`Tolerances` (below).
 
 from dataclasses import dataclass
 
-#: Max vertex error in pixels between the candidate and cv2.projectPoints.
-#: Both compute in float64: relative error ~ a few eps (2.2e-16) per operation,
-#: times ~20 operations, times the pixel scale (|x_px| up to ~1e4 for the bundled
+#: Max vertex error in pixels between the candidate and cv2.projectPoints, for
+#: a float64 candidate (the floor of every vertex bound, below). Both compute
+#: in float64: relative error ~ a few eps (2.2e-16) per operation, times ~20
+#: operations, times the pixel scale (|x_px| up to ~1e4 for the bundled
 #: cases) gives ~1e-11 px. 1e-6 px leaves five orders of margin for that and
 #: still catches any real convention error (the smallest, a half-pixel offset,
 #: is 0.5 px).
 VERTEX_TOL_PX = 1e-6
+
+# ---------------------------------------------------------------- the candidate's precision
+
+#: The precisions a candidate may compute in (declared with
+#: ``--candidate-precision``, or inferred from the dtype of what it returns).
+PRECISIONS = ("float32", "float64")
+
+#: Machine epsilon (the spacing of floats at 1.0) of each precision.
+EPS = {"float32": 2.0 ** -23, "float64": 2.0 ** -52}
+
+# A candidate that computes in float32 (glm, PyTorch3D, a GL shader) is off
+# from the float64 oracle by its own rounding, which 1e-6 px cannot absorb.
+# Its vertex bound is derived from its precision and the scale of the case.
+# For a point X seen by a camera at C with depth z, focal length f px (the
+# larger of fx, fy) and pixel p = (x, y), u = p - (cx, cy):
+#
+# - the world-to-camera transform R (X - C) (or V @ [X, 1]) rounds values of
+#   size |X| + |C|: an absolute error of a few eps (|X| + |C|) on each camera
+#   coordinate, whatever the order of the operations;
+# - the perspective divide turns an error dx in x_cam and dz in z into
+#   f (dx + |x_cam / z| dz) / z = (f + |u|) (|X| + |C|) eps / z pixels
+#   (|x_cam / z| f = |u|); orthographic: s (|X| + |C|) eps, s = px per unit;
+# - the viewport (x = (ndc + 1) W/2 - 0.5, or cx + f x/z) rounds values of
+#   size |x| + |y| and W + H: (|x| + |y| + W + H) eps.
+#
+# So each point's error is at most VERTEX_ROUNDINGS eps times its scale
+#
+#     scale = (f + |u_x| + |u_y|) (|X| + |C|) / z + |x| + |y| + W + H     (perspective)
+#     scale = s (|X| + |C|) + |x| + |y| + W + H                             (orthographic)
+#
+# and a case's bound is VERTEX_ROUNDINGS eps max(scale) over its visible
+# points and frames (:func:`vertex_scale`, :func:`vertex_bound`), never below
+# VERTEX_TOL_PX. For float64 that product is ~1e-11 px on the bundled cases,
+# so VERTEX_TOL_PX (1e-6) is the bound; for float32 it is ~1e-3 px,
+# still three orders below the smallest convention error (0.5 px).
+#
+# Measured (benchmarks/measure_precision.py: three float32 projectors -- a
+# glm-style GL pipeline, core --dtype float32, an OpenCV-style K [R|t] --
+# on the bundled scenes and the orrery under every case camera, 24 frames
+# each): the largest error / (eps scale) of any point is 0.72 (glm, orrery,
+# narrow_fov; core 0.16, K [R|t] 0.18); the largest float32 vertex error
+# 4.5e-4 px, the bounds 1.2e-3 to 3.4e-3 px.
+
+#: Roundings of size eps x scale a correct projector may accumulate (see
+#: above): 4, 5.5x the largest measured error / (eps scale).
+VERTEX_ROUNDINGS = 4.0
+
+#: The near-plane margin of oracles.draw, in roundings of eps (|X| + |C|): a
+#: correct candidate's view depth of X is within this many of the exact depth,
+#: so an end moved this far inside [near, far] passes its own depth test.
+#: Measured (same run): a float32 glm view depth is off by at most 1.05
+#: eps32 (|X| + |C|); 4 leaves ~4x.
+DEPTH_ROUNDINGS = 4.0
+
+
+def vertex_scale(p_world, p_px, camera) -> float:
+    """The largest per-point scale of a frame (pixels per unit of relative rounding; formula above).
+
+    Parameters
+    ----------
+    p_world : (N, 3) array_like
+        World points.
+    p_px : (N, 2) array_like
+        Their pixels by the oracle; NaN rows (clipped points) are left out.
+    camera : core.camera.Camera
+
+    Returns
+    -------
+    float, 0.0 when no point is visible.
+    """
+    import numpy as np
+
+    from .convert import opencv_matrices
+
+    p_world = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
+    p_px = np.asarray(p_px, dtype=np.float64).reshape(-1, 2)
+    seen = np.isfinite(p_px).all(axis=1)
+    if not seen.any():
+        return 0.0
+    r_cv, t_cv, k = opencv_matrices(camera)
+    x, p = p_world[seen], p_px[seen]
+    size = np.linalg.norm(x, axis=1) + float(np.linalg.norm(camera.position))
+    reach = np.abs(p - k[:2, 2]).sum(axis=1)
+    focal = max(abs(k[0, 0]), abs(k[1, 1]))
+    viewport = np.abs(p).sum(axis=1) + camera.width + camera.height
+    if camera.projection == "perspective":
+        z = x @ r_cv[2] + t_cv[2]
+        scale = (focal + reach) * size / z + viewport
+    else:
+        scale = focal * size + viewport
+    return float(np.max(scale))
+
+
+def vertex_bound(precision: str, scale: float, floor: float = VERTEX_TOL_PX) -> float:
+    """A case's vertex bound in pixels: ``max(floor, VERTEX_ROUNDINGS eps(precision) scale)``."""
+    return max(float(floor), VERTEX_ROUNDINGS * EPS[precision] * float(scale))
 
 #: Minimum edge-pixel F1 at 1 px (Chebyshev) against pyrender/OSMesa.
 #: Measured: 1.0 in every one of 1,512 frames (3 scenes x 7 cameras x 72
@@ -190,7 +287,12 @@ DEPTH_BOUND_TEXT = (f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 /
 
 @dataclass
 class Tolerances:
-    """The limits a run judges with (defaults: the values above; the CLI's --tol-px, --min-f1, ... override them)."""
+    """The limits a run judges with (defaults: the values above; the CLI's --tol-px, --min-f1, ... override them).
+
+    ``vertex_px`` is the floor of each case's vertex bound (:func:`vertex_bound`);
+    ``precision`` the candidate's declared precision (``--candidate-precision``),
+    None to infer it from the candidate's answers (oracles.candidate.case_precision).
+    """
 
     vertex_px: float = VERTEX_TOL_PX
     min_f1_1px: float = MIN_F1_1PX
@@ -199,12 +301,20 @@ class Tolerances:
     balance_alpha: float = BALANCE_ALPHA
     max_imbalance: float = MAX_IMBALANCE_FRACTION
     max_edge_count_diff: int = MAX_EDGE_COUNT_DIFF
+    precision: str | None = None
+
+    def __post_init__(self):
+        if self.precision is not None and self.precision not in PRECISIONS:
+            raise ValueError(f"precision {self.precision!r}: expected one of {', '.join(PRECISIONS)} (or None: "
+                             "inferred from the candidate's answers)")
 
     def to_dict(self, shaded: bool = False) -> dict:
         """The report's ``tolerances`` field."""
         if shaded:
-            return {"vertex_error_px": self.vertex_px, "min_silhouette_iou": self.min_iou,
+            return {"vertex_error_px": self.vertex_px, "candidate_precision": self.precision,
+                    "min_silhouette_iou": self.min_iou,
                     "depth_error": DEPTH_BOUND_TEXT}
-        return {"vertex_error_px": self.vertex_px, "min_pixel_f1_1px": self.min_f1_1px,
+        return {"vertex_error_px": self.vertex_px, "candidate_precision": self.precision,
+                "min_pixel_f1_1px": self.min_f1_1px,
                 "min_pixel_f1_0px": self.min_f1_0px, "balance_alpha": self.balance_alpha,
                 "max_imbalance_fraction": self.max_imbalance, "max_edge_count_diff": self.max_edge_count_diff}

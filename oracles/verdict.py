@@ -14,8 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import gate, metrics
+from .candidate import case_precision
 from .diagnose import diagnose, diagnose_lines
-from .tolerances import MIN_IOU_UNION_PX, Tolerances
+from .tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
 #: Per-frame fields of a wireframe's line comparison (oracles.metrics.line_scores).
 LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "edge_count_max_diff", "edge_count_worst_edge")
@@ -31,11 +32,21 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
 
     Vertex errors pooled over the frames, the worst vertex, the faults
     (oracles.diagnose), the pixel scores' minima and means, the shaded
-    summary, and a note when there was nothing to compare.
+    summary, and a note when there was nothing to compare. ``precision``
+    says what the candidate was judged as (declared, or as it returned; core:
+    its ``--dtype``) and ``vertex_bound_px`` the bound its vertices were held
+    to (oracles.tolerances.vertex_bound).
     """
     done = len(acc.cand_px)
     rec = {"scene": setup.scene.name, "camera": setup.case.name, "camera_spec": setup.cam.to_dict(),
            "frames": setup.frames, "frames_checked": done}
+    precision, source = case_precision(tol.precision, acc.returned)
+    if setup.is_core and tol.precision is None and acc.returned:
+        source = "core --dtype"
+    bound = vertex_bound(precision, acc.scale, tol.vertex_px)
+    rec["precision"] = {"judged_as": precision, "source": source,
+                        "returned": sorted(acc.returned) if acc.returned else None}
+    rec["vertex_bound_px"] = bound
     if setup.pixels and setup.mode.hidden_lines:
         rec["hidden_lines"] = setup.faces is not None
     faults = []
@@ -51,7 +62,8 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
             "visible_points": ve["visible_both"],
             "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
         })
-        faults = diagnose(cand, orac, setup.cam, tol_px=tol.vertex_px)
+        bound32 = vertex_bound("float32", acc.scale, tol.vertex_px) if precision == "float64" else None
+        faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32)
     else:
         rec.update({"max_vertex_error_px": None, "mean_vertex_error_px": None, "rms_vertex_error_px": None})
     px = acc.pixel
@@ -118,9 +130,12 @@ def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | No
     """
     reasons = [error] if error else []
     if rec["frames_checked"]:
-        if rec["max_vertex_error_px"] is not None and rec["max_vertex_error_px"] > tol.vertex_px:
-            reasons.append(f"max vertex error {rec['max_vertex_error_px']:.3g} px > {tol.vertex_px:.3g} px "
-                           f"(frame {rec['worst_vertex']['frame']}, vertex {rec['worst_vertex']['vertex']})")
+        bound = rec.get("vertex_bound_px", tol.vertex_px)
+        if rec["max_vertex_error_px"] is not None and rec["max_vertex_error_px"] > bound:
+            judged = rec.get("precision", {}).get("judged_as", "float64")
+            reasons.append(f"max vertex error {rec['max_vertex_error_px']:.3g} px > {bound:.3g} px "
+                           f"({judged} bound; frame {rec['worst_vertex']['frame']}, "
+                           f"vertex {rec['worst_vertex']['vertex']})")
         vm = rec["visibility_mismatch"]
         if vm["candidate_only"] or vm["oracle_only"]:
             reasons.append(f"visible sets differ: {vm['candidate_only']} points shown only by the candidate, "
