@@ -34,7 +34,7 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
                     tol_px: float = tolerances.VERTEX_TOL_PX, min_f1: float = tolerances.MIN_F1_1PX,
                     min_f1_0px: float = tolerances.MIN_F1_0PX, turns=(1.0, 1.0, 0.0),
                     allow_vacuous: bool = False, *, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S,
-                    isolate: bool | None = None) -> dict:
+                    isolate: bool | None = None, precision: str | None = None) -> dict:
     """Crosscheck a projector against OpenCV (and pyrender) and return the report.
 
     Parameters
@@ -73,6 +73,13 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
         candidate host for a string or an importable function, a forked copy
         of this process for a lambda or a closure); False: run a callable in
         this process (an ``os._exit`` in it then ends your test run).
+    precision : {"float32", "float64"}, optional
+        What the projector computes in; its vertex bound is derived from it
+        (:func:`wirecheck.oracles.tolerances.vertex_bound`). Default None:
+        inferred from the dtype it returns (float32 arrays: float32). A
+        declared precision wins over the returned dtype: float64 declared and
+        float32 returned is judged at float64, and its float32 rounding is
+        named ``precision_limited``.
 
     Returns
     -------
@@ -85,11 +92,11 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     ValueError
         (:class:`~wirecheck.core.errors.InputError`) Inputs that would compare
         nothing: no scene or case, an unknown or repeated name, ``frames`` < 1,
-        a NaN tolerance.
+        a NaN tolerance, a precision other than float32 or float64.
     RuntimeError
         ``"pyrender"`` asked for but OSMesa is missing.
     """
-    tol = Tolerances(tol_px, min_f1, min_f1_0px)
+    tol = Tolerances(tol_px, min_f1, min_f1_0px, precision=_precision(precision))
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)    # before any OpenGL set-up
     name, func = api_candidate(func, cmd, timeout_s, isolate)
     if "pyrender" in oracles:
@@ -102,6 +109,16 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
                                      oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
                                      allow_vacuous=allow_vacuous)
     return report
+
+
+def _precision(precision):
+    """``precision`` checked: None, "float32" or "float64"; InputError (a ValueError) otherwise."""
+    from wirecheck.core.errors import InputError
+
+    if precision is not None and precision not in tolerances.PRECISIONS:
+        raise InputError(f"precision {precision!r}: expected one of {', '.join(tolerances.PRECISIONS)} "
+                         "(or None: inferred from the dtype the projector returns)")
+    return precision
 
 
 def failure_text(report: dict) -> str | None:

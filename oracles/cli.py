@@ -67,7 +67,7 @@ from .config import parse_cli
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
 from .progress import TerminalProgress
-from .report import compared_text, console_table, timing_line, vacuous_text, write_report
+from .report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import LEVELS, level_for_oracles, run_crosscheck
 from .tolerances import Tolerances
 
@@ -104,6 +104,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a projector program in any language, spoken to over stdin/stdout (docs/protocol.md) (default: none)")
     p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
+    p.add_argument("--candidate-precision", choices=tolerances.PRECISIONS, default=None,
+                   help="what the candidate computes in; its vertex bound is derived from it (oracles/tolerances.py) "
+                        "(default: from the dtype it returns, float64 over the protocol unless its replies say "
+                        "float32; core: --dtype)")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
                    help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
                         "(docs/frames.md) (default: none)")
@@ -193,6 +197,7 @@ def _parse(args):
             ("--min-f1", args.min_f1 != tolerances.MIN_F1_1PX),
             ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX),
             ("--min-iou", args.min_iou != tolerances.MIN_SILHOUETTE_IOU),
+            ("--candidate-precision", args.candidate_precision is not None),
             ("--allow-vacuous", args.allow_vacuous)) if given]
         if ignored:
             raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
@@ -207,6 +212,9 @@ def _parse(args):
         what = "--sweep" if args.sweep else f"--suite {args.suite}"
         raise InputError(f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
                          "itself; expected neither --candidate nor --dtype/--clip/--raster")
+    if args.sweep and args.candidate_precision is not None:
+        raise InputError(f"--sweep with --candidate-precision {args.candidate_precision}: the sweep runs each core "
+                         "--dtype at its own precision: expected no --candidate-precision")
     if external and core_given:
         raise InputError(f"{', '.join(core_given)}: settings of the core candidate, not of {external}: "
                          "expected them without it")
@@ -227,7 +235,7 @@ def _parse(args):
             raise InputError("--hidden-lines with --style shaded: a shaded frame has no lines: expected one of them")
     mode = RenderMode(style=args.style or "wireframe", hidden_lines=args.hidden_lines, cull=args.cull or "none")
     tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
-                     min_iou=args.min_iou)
+                     min_iou=args.min_iou, precision=args.candidate_precision)
     if args.suite:       # fixed cases and bounds (checked above): nothing of a run's inputs applies
         return level, None, None, mode, tol
     # the library's one check of what a run compares (oracles.gate), in the CLI's option names
@@ -365,10 +373,18 @@ def _main(argv=None) -> int:
               else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}")
     vacuous = vacuous_text(report)
     print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases, {compared_text(report)} "
-          f"(vertex <= {tol.vertex_px:g} px, {limits})" + (f"; {vacuous}" if vacuous else ""))
+          f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else ""))
+    if precision_text(report):
+        print(f"Candidate precision: {precision_text(report)}")
     print(timing_line(report))
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
     return 0 if report["verdict"] == "pass" else 1
+
+
+def _vertex_limit(report: dict, tol) -> str:
+    """``1e-06 px``, or, when a case's precision raised it, where to find the bounds."""
+    bounds = {c.get("vertex_bound_px", tol.vertex_px) for c in report["cases"]}
+    return f"{tol.vertex_px:g} px" if bounds <= {tol.vertex_px} else "the bound of the candidate's precision"
 
 
 def _sweep(args, inputs, level, tol, run_dir) -> int:

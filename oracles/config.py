@@ -6,6 +6,7 @@
     candidate = "src/myproj/projection.py:project"  # crosscheck --candidate; the fixture's default projector
     # candidate-cmd = "./build/projector --flag"   # or a program (crosscheck --candidate-cmd; docs/protocol.md)
     # candidate-timeout = 10                      # seconds per request to either
+    # candidate-precision = "float32"             # what it computes in (default: from the dtype it returns)
     scenes = ["cube", "tests/arm.scene"]   # built-in or example names, or paths relative to this file
     cases = ["on_axis", "near_plane"]      # a subset of oracles.cases.CASE_NAMES
     frames = 8                             # frames of the motion per case
@@ -47,6 +48,7 @@ KEYS = {
     "candidate": "a string FILE.py:FUNC or MODULE:FUNC",
     "candidate-cmd": "a non-empty command string (a program speaking docs/protocol.md)",
     "candidate-timeout": "a number of seconds > 0",
+    "candidate-precision": "'float32' or 'float64'",
     "scenes": "a non-empty list of scene names or paths",
     "cases": "a non-empty list of case names",
     "frames": "an integer >= 1",
@@ -60,7 +62,8 @@ KEYS = {
 
 #: Keyword of oracles.api.check_projector for each key (``level``/``oracles`` become ``oracles``).
 API_KEYWORDS = {"scenes": "scenes", "cases": "cases", "frames": "frames", "tol-px": "tol_px",
-                "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "turns", "candidate-timeout": "timeout_s"}
+                "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "turns", "candidate-timeout": "timeout_s",
+                "candidate-precision": "precision"}
 
 
 @dataclass(frozen=True)
@@ -164,6 +167,12 @@ def validate(table: dict, path: Path) -> dict:
             if not (number(value) and value > 0):
                 raise bad(key, value)
             out[key] = float(value)
+        elif key == "candidate-precision":
+            from .tolerances import PRECISIONS
+
+            if value not in PRECISIONS:
+                raise bad(key, value)
+            out[key] = value
         elif key == "scenes":
             if not strings(value):
                 raise bad(key, value)
@@ -226,6 +235,7 @@ def validate(table: dict, path: Path) -> dict:
 
 #: crosscheck's argparse destination for each key.
 CLI_DESTS = {"candidate": "candidate", "candidate-cmd": "candidate_cmd", "candidate-timeout": "candidate_timeout",
+             "candidate-precision": "candidate_precision",
              "scenes": "scene", "cases": "cases", "frames": "frames", "level": "level",
              "tol-px": "tol_px", "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "spin"}
 

@@ -77,7 +77,7 @@ def export_main(argv) -> int:
 
 #: crosscheck options that mean nothing for a renderer's frames (the job fixes scenes, cases and frames).
 _NOT_WITH_FRAMES = ("scene", "candidate", "level", "oracles", "dtype", "clip", "raster", "style",
-                    "cull", "sweep", "suite")
+                    "cull", "sweep", "suite", "candidate_precision")
 
 
 def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:

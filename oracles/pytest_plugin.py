@@ -112,7 +112,7 @@ class Check:
     Crosschecks ``projector`` and fails the test with the diagnosis when a case
     fails. ``settings`` are keywords of
     :func:`wirecheck.oracles.api.check_projector` (scenes, cases, frames,
-    oracles, tol_px, min_f1, min_f1_0px, turns); they win over the
+    oracles, tol_px, min_f1, min_f1_0px, turns, precision); they win over the
     ``--wirecheck-*`` options and ``[tool.wirecheck]``.
     """
 

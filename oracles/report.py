@@ -256,6 +256,22 @@ def timing_line(report: dict) -> str:
             + f" ({t.get('jobs', 1)} job(s), {t.get('wall_s', 0.0):.1f} s wall)")
 
 
+def precision_text(report: dict) -> str:
+    """"float32 (returned); vertex bound 1.15e-03 to 2.70e-03 px": what the candidate was judged as (oracles.tolerances)."""
+    cases = [c for c in report["cases"] if c.get("precision")]
+    if not cases:
+        return ""
+    def one(p: dict) -> str:
+        other = [r for r in p.get("returned") or [] if r != p["judged_as"]]
+        return f"{p['judged_as']} ({p['source']}" + (f"; returned {', '.join(other)})" if other else ")")
+
+    judged = sorted({one(c["precision"]) for c in cases})
+    bounds = [c["vertex_bound_px"] for c in cases]
+    lo, hi = min(bounds), max(bounds)
+    span = f"{lo:.3g} px" if lo == hi else f"{lo:.3g} to {hi:.3g} px"
+    return f"{', '.join(judged)}; vertex bound {span}"
+
+
 def markdown(report: dict, files: set | None = None) -> str:
     """report.md; ``files``: the figures written beside it (linked when present)."""
     files = files or set()
@@ -272,6 +288,8 @@ def markdown(report: dict, files: set | None = None) -> str:
            f"Drawing: {drawing_text(report)}.", "",
            *([f"Oracle GL: {gl_text(report)}.", ""] if gl_text(report) else []),
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
+           *([f"Candidate precision: {precision_text(report)} (oracles/tolerances.py).", ""]
+             if precision_text(report) else []),
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
         out.append("| " + " | ".join(r) + " |")
@@ -328,6 +346,7 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         f"<p>Level {e(level_text(report))}. Checked: {e(frames_text(report))}.</p>",
         f"<p>Drawing: {e(drawing_text(report))}.</p>",
         f"<p>Oracle GL: {e(gl_text(report))}.</p>" if gl_text(report) else "",
+        *([f"<p>Candidate precision: {e(precision_text(report))}.</p>"] if precision_text(report) else []),
         "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>" + rows + "</table>",
     ]
     failing = not_passed(report)
