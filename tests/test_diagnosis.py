@@ -22,6 +22,7 @@ from wirecheck.core.projection import project_points
 from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion, apply, rotate_z
 from wirecheck.oracles.diagnose import FAULT_ORDER, LINE_FAULTS, diagnose, primary
+from wirecheck.oracles.tolerances import vertex_bound, vertex_scale
 
 try:
     from wirecheck.oracles.opencv_oracle import project as oracle_project
@@ -122,23 +123,26 @@ def naive_distort(x, y, coeffs):
 _LENS = "the camera's"
 
 
-def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None, dist=_LENS):
+def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None, dist=_LENS,
+             dtype=np.float64):
     """core.projection.project_points, with the rotation, focal lengths (or
-    ortho scales), principal point and lens distortion replaceable."""
-    p = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
+    ortho scales), principal point and lens distortion replaceable; every value
+    in ``dtype`` (float32: the float32 twin of a fault)."""
+    p = np.asarray(p_world, dtype=dtype).reshape(-1, 3)
     r = np.stack([camera.right, camera.up, camera.forward]) if rotation is None else rotation
-    p_cam = (p - camera.position) @ r.T
+    r, position = np.asarray(r, dtype=dtype), np.asarray(camera.position, dtype=dtype)
+    p_cam = (p - position) @ r.T
     z = p_cam[:, 2]
-    vis = (z >= camera.near) & (z <= camera.far)
+    vis = (z >= dtype(camera.near)) & (z <= dtype(camera.far))
     pcx, pcy = camera.principal_point
-    cx = pcx if cx is None else cx
-    cy = pcy if cy is None else cy
+    cx = dtype(pcx if cx is None else cx)
+    cy = dtype(pcy if cy is None else cy)
     dist = camera.distortion if dist is _LENS else dist
     if camera.projection == "perspective":
         cfx, cfy = camera.focal_xy
-        fx = cfx if fx is None else fx
-        fy = cfy if fy is None else fy
-        z_safe = np.where(vis, z, 1.0)
+        fx = dtype(cfx if fx is None else fx)
+        fy = dtype(cfy if fy is None else fy)
+        z_safe = np.where(vis, z, dtype(1.0))
         if dist is None:
             x, y = cx + fx * p_cam[:, 0] / z_safe, cy - fy * p_cam[:, 1] / z_safe
         else:
@@ -146,8 +150,8 @@ def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=No
             x, y = cx + fx * xd, cy + fy * yd
     else:
         s = camera.height / camera.ortho_height
-        fx = s if fx is None else fx
-        fy = s if fy is None else fy
+        fx = dtype(s if fx is None else fx)
+        fy = dtype(s if fy is None else fy)
         x, y = cx + fx * p_cam[:, 0], cy - fy * p_cam[:, 1]
     out = np.stack([x, y], axis=1)
     out[~vis] = np.nan
@@ -161,33 +165,33 @@ def _scale_for(camera, fov_or_height):
     return camera.height / fov_or_height
 
 
-def f_none(p, cam):
-    return _project(p, cam)
+def f_none(p, cam, dtype=np.float64):
+    return _project(p, cam, dtype=dtype)
 
 
-def f_mirror_x(p, cam):
-    out = _project(p, cam)
+def f_mirror_x(p, cam, dtype=np.float64):
+    out = _project(p, cam, dtype=dtype)
     out[:, 0] = (cam.width - 1) - out[:, 0]
     return out
 
 
-def f_mirror_y(p, cam):
-    out = _project(p, cam)
+def f_mirror_y(p, cam, dtype=np.float64):
+    out = _project(p, cam, dtype=dtype)
     out[:, 1] = (cam.height - 1) - out[:, 1]
     return out
 
 
-def f_flip(p, cam):
-    return f_mirror_y(p, cam) * [-1, 1] + [cam.width - 1, 0]
+def f_flip(p, cam, dtype=np.float64):
+    return f_mirror_y(p, cam, dtype) * np.array([-1, 1], dtype) + np.array([cam.width - 1, 0], dtype)
 
 
-def f_swap(p, cam):
-    return _project(p, cam)[:, ::-1].copy()
+def f_swap(p, cam, dtype=np.float64):
+    return _project(p, cam, dtype=dtype)[:, ::-1].copy()
 
 
-def f_swap_mirror(p, cam):
+def f_swap_mirror(p, cam, dtype=np.float64):
     """Turned 90 degrees: swap, then mirror x of the result."""
-    out = f_swap(p, cam)
+    out = f_swap(p, cam, dtype)
     out[:, 0] = (cam.width - 1) - out[:, 0]
     return out
 
@@ -200,74 +204,79 @@ def implied_fov(cam):
     return (cam.fov_y_deg if cam.projection == "perspective" else cam.ortho_height) * FOV_FACTOR
 
 
-def f_fov(p, cam):
+def f_fov(p, cam, dtype=np.float64):
     s = _scale_for(cam, implied_fov(cam))
     if cam.calibrated:                        # both focal lengths scaled alike: fx/fy kept
         fx, fy = cam.focal_xy
-        return _project(p, cam, fx=fx * s / fy, fy=s)
-    return _project(p, cam, fx=s, fy=s)
+        return _project(p, cam, fx=fx * s / fy, fy=s, dtype=dtype)
+    return _project(p, cam, fx=s, fy=s, dtype=dtype)
 
 
-def f_fov_horizontal(p, cam):
+def f_fov_horizontal(p, cam, dtype=np.float64):
     """The vertical FOV taken as the horizontal one (f from the width, both axes)."""
     s = _scale_for(cam, cam.fov_y_deg if cam.projection == "perspective" else cam.ortho_height)
     s *= cam.width / cam.height
-    return _project(p, cam, fx=s, fy=s)
+    return _project(p, cam, fx=s, fy=s, dtype=dtype)
 
 
-def f_aspect(p, cam):
+def f_aspect(p, cam, dtype=np.float64):
     """fx from the width-based formula: (W/2) / tan(fov/2), i.e. aspect 1."""
     s = _scale_for(cam, cam.fov_y_deg if cam.projection == "perspective" else cam.ortho_height)
-    return _project(p, cam, fx=s * cam.width / cam.height)
+    return _project(p, cam, fx=s * cam.width / cam.height, dtype=dtype)
 
 
-def f_fov_aspect(p, cam):
+def f_fov_aspect(p, cam, dtype=np.float64):
     s = _scale_for(cam, implied_fov(cam))
-    return _project(p, cam, fx=s * cam.width / cam.height, fy=s)
+    return _project(p, cam, fx=s * cam.width / cam.height, fy=s, dtype=dtype)
 
 
-def f_offset(p, cam):
+def f_offset(p, cam, dtype=np.float64):
     """Pixel-corner convention: cx = W/2, cy = H/2."""
-    return _project(p, cam, cx=cam.width / 2, cy=cam.height / 2)
+    return _project(p, cam, cx=cam.width / 2, cy=cam.height / 2, dtype=dtype)
 
 
-def f_fov_offset(p, cam):
-    return f_fov(p, cam) + 0.5
+def f_fov_offset(p, cam, dtype=np.float64):
+    return f_fov(p, cam, dtype) + dtype(0.5)
 
 
-def f_depth_flip(p, cam):
+def f_depth_flip(p, cam, dtype=np.float64):
     """Forward negated: the camera looks backward."""
-    return project_points(p, _with(cam, forward=-cam.forward))
+    return _project(p, _with(cam, forward=-cam.forward), dtype=dtype)
 
 
-def f_transposed(p, cam):
+def f_transposed(p, cam, dtype=np.float64):
     r = np.stack([cam.right, cam.up, cam.forward])
-    return _project(p, cam, rotation=r.T)
+    return _project(p, cam, rotation=r.T, dtype=dtype)
 
 
-def f_roll(p, cam):
+def f_roll(p, cam, dtype=np.float64):
     """A 0.5 degree roll error about the view axis."""
     r = np.stack([cam.right, cam.up, cam.forward])
-    return _project(p, cam, rotation=rotate_z(math.radians(0.5))[:3, :3] @ r)
+    return _project(p, cam, rotation=rotate_z(math.radians(0.5))[:3, :3] @ r, dtype=dtype)
+
+
+def f_float32_arith(p, cam, dtype=np.float64):
+    """Correct, but computed in float32 whatever ``dtype``: float32 rounding in a float64-judged candidate."""
+    return f_none(p, cam, np.float32).astype(np.float64)
 
 
 PP_SHIFT = (3.25, -1.5)
 
 
-def f_pp_offset(p, cam):
+def f_pp_offset(p, cam, dtype=np.float64):
     """The principal point off by (3.25, -1.5) px."""
     cx, cy = cam.principal_point
-    return _project(p, cam, cx=cx + PP_SHIFT[0], cy=cy + PP_SHIFT[1])
+    return _project(p, cam, cx=cx + PP_SHIFT[0], cy=cy + PP_SHIFT[1], dtype=dtype)
 
 
-def f_fxfy_swap(p, cam):
+def f_fxfy_swap(p, cam, dtype=np.float64):
     """fx and fy exchanged."""
     fx, fy = cam.focal_xy
-    return _project(p, cam, fx=fy, fy=fx)
+    return _project(p, cam, fx=fy, fy=fx, dtype=dtype)
 
 
-def f_lens_ignored(p, cam):
-    return _project(p, cam, dist=None)
+def f_lens_ignored(p, cam, dtype=np.float64):
+    return _project(p, cam, dist=None, dtype=dtype)
 
 
 def _lens_with(cam, index, factor):
@@ -276,17 +285,18 @@ def _lens_with(cam, index, factor):
     return tuple(c)
 
 
-def f_k1_sign(p, cam):
-    return _project(p, cam, dist=_lens_with(cam, 0, -1.0))
+def f_k1_sign(p, cam, dtype=np.float64):
+    return _project(p, cam, dist=_lens_with(cam, 0, -1.0), dtype=dtype)
 
 
-def f_k2_wrong(p, cam):
+def f_k2_wrong(p, cam, dtype=np.float64):
     """k2 twice its size."""
-    return _project(p, cam, dist=_lens_with(cam, 1, 2.0))
+    return _project(p, cam, dist=_lens_with(cam, 1, 2.0), dtype=dtype)
 
 
 FAULTS = {
     "none": (f_none, set()),
+    "float32_arith": (f_float32_arith, {"precision_limited"}),
     "mirror_x": (f_mirror_x, {"mirror_horizontal"}),
     "mirror_y": (f_mirror_y, {"mirror_vertical"}),
     "flip": (f_flip, {"axis_flip"}),
@@ -333,16 +343,36 @@ def points_for(camera_name):
     return POINTS_AROUND if camera_name == "inside" else POINTS
 
 
-def run_case(fault, camera_name):
+def float32_bound(pts, cam, ref) -> float:
+    """The float32 vertex bound of these points (oracles.tolerances: derived from eps32 and the scene's scale)."""
+    return vertex_bound("float32", vertex_scale(pts, ref, cam), TOL)
+
+
+def run_case(fault, camera_name, dtype=np.float64):
+    """Diagnose ``fault`` on a camera; float64: at TOL, with the float32 bound for precision_limited (as
+    oracles.verdict does for a float64 candidate); float32 (the twin): at the float32 bound."""
     cam = CAMERAS[camera_name]
     pts = points_for(camera_name)
     fn, _ = FAULTS[fault]
-    return diagnose(fn(pts, cam), oracle_project(pts, cam), cam, tol_px=TOL)
+    ref = oracle_project(pts, cam)
+    bound32 = float32_bound(pts, cam, ref)
+    if dtype == np.float32:
+        return diagnose(fn(pts, cam, np.float32), ref, cam, tol_px=bound32)
+    return diagnose(fn(pts, cam), ref, cam, tol_px=TOL, float32_px=bound32)
 
 
 @pytest.fixture(scope="module")
 def results():
     return {(f, c): run_case(f, c) for f, c in CASES}
+
+
+#: The float32 twins: every fault but float32_arith (float32 already), computed in float32.
+CASES32 = [(f, c) for f, c in CASES if f != "float32_arith"]
+
+
+@pytest.fixture(scope="module")
+def results32():
+    return {(f, c): run_case(f, c, np.float32) for f, c in CASES32}
 
 
 # ---- the exact set of names per pair ---------------------------------------
@@ -354,6 +384,33 @@ def test_expected_names(results, fault, camera_name):
     assert set(names) == FAULTS[fault][1], got
     assert len(names) == len(set(names))
     assert names == sorted(names, key=FAULT_ORDER.index)          # primary first
+
+
+@pytest.mark.parametrize("fault,camera_name", CASES32)
+def test_float32_twin_gets_the_same_names(results, results32, fault, camera_name):
+    """The fault computed in float32 and judged at the float32 bound: the names of its float64 twin."""
+    got = results32[(fault, camera_name)]
+    assert [d["name"] for d in got] == [d["name"] for d in results[(fault, camera_name)]], got
+
+
+@pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
+def test_float32_twin_offset_and_fov(results32, camera_name):
+    cam = CAMERAS[camera_name]
+    bound = float32_bound(POINTS, cam, oracle_project(POINTS, cam))
+    (off,) = [d for d in results32[("fov_offset", camera_name)] if d["name"] == "pixel_offset"]
+    # the fitted offset carries the float32 noise, at most the bound (a fit averages it down)
+    assert abs(off["dx"] - 0.5) <= bound and abs(off["dy"] - 0.5) <= bound
+    (fov,) = [d for d in results32[("fov", camera_name)] if d["name"] == "fov_mismatch"]
+    # the scale d_y is off by <= bound / reach (>= 100 px) relative, ~1e-5; 1e-3 deg on ~50 deg is above that
+    got = fov["implied_fov_deg"] if cam.projection == "perspective" else fov["implied_ortho_height"]
+    assert got == pytest.approx(implied_fov(cam), rel=1e-4)
+
+
+def test_float32_arith_is_precision_limited_not_unexplained(results):
+    for cam in MAIN_CAMERAS:
+        (f,) = results[("float32_arith", cam)]
+        assert f["name"] == "precision_limited"
+        assert TOL < f["residual_px"] <= f["float32_bound_px"]
 
 
 def test_inside_camera_sees_both_sides():
@@ -605,3 +662,12 @@ def test_confusion_matrix_is_diagonal(results, summary_section):
     off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
     assert not off, off
     assert set(rows) == set(labels)                      # every fault name was injected
+
+
+def test_float32_confusion_matrix_is_diagonal(results32, summary_section):
+    labels, rows, counts = confusion(results32)
+    summary_section("diagnosis confusion matrix, float32 twins (judged at the float32 bound)",
+                    format_confusion(labels, rows, counts))
+    off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
+    assert not off, off
+    assert set(rows) == set(labels) - {"precision_limited"}   # every fault but the float64-only one
