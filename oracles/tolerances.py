@@ -45,10 +45,10 @@ EPS = {"float32": 2.0 ** -23, "float64": 2.0 ** -52}
 #     scale = (f + |u_x| + |u_y|) (|X| + |C|) / z + |x| + |y| + W + H     (perspective)
 #     scale = s (|X| + |C|) + |x| + |y| + W + H                             (orthographic)
 #
-# and a case's bound is VERTEX_ROUNDINGS eps max(scale) over its visible
-# points and frames (:func:`vertex_scale`, :func:`vertex_bound`), never below
-# VERTEX_TOL_PX. For float64 that product is ~1e-11 px on the bundled cases,
-# so VERTEX_TOL_PX (1e-6) is the bound; for float32 it is ~1e-3 px,
+# and a float32 case's bound is VERTEX_ROUNDINGS eps32 max(scale) over its
+# visible points and frames (:func:`vertex_scale`, :func:`vertex_bound`), never
+# below VERTEX_TOL_PX (``--tol-px``). For float64 that product is ~1e-11 px on
+# the bundled cases, so VERTEX_TOL_PX (1e-6) is the bound; for float32 it is ~1e-3 px,
 # still three orders below the smallest convention error (0.5 px).
 #
 # Measured (benchmarks/measure_precision.py: three float32 projectors -- a
@@ -109,7 +109,14 @@ def vertex_scale(p_world, p_px, camera) -> float:
 
 
 def vertex_bound(precision: str, scale: float, floor: float = VERTEX_TOL_PX) -> float:
-    """A case's vertex bound in pixels: ``max(floor, VERTEX_ROUNDINGS eps(precision) scale)``."""
+    """A case's vertex bound in pixels: ``max(floor, VERTEX_ROUNDINGS eps32 scale)`` for float32, ``floor`` for float64.
+
+    ``floor`` is ``--tol-px`` (VERTEX_TOL_PX): for float64 it is the bound
+    itself, five orders above the derived ~1e-11 px, so that ``--tol-px``
+    keeps its meaning for a float64 candidate (0 fails any error).
+    """
+    if precision == "float64":
+        return float(floor)
     return max(float(floor), VERTEX_ROUNDINGS * EPS[precision] * float(scale))
 
 #: Minimum edge-pixel F1 at 1 px (Chebyshev) against pyrender/OSMesa.

@@ -68,8 +68,10 @@ def test_vertex_bound_by_hand():
     # the same few float64 operations in another order: equal to ~1e-13 relative
     assert got == pytest.approx(scale, rel=1e-12)
     assert vertex_bound("float32", got) == pytest.approx(VERTEX_ROUNDINGS * 2.0 ** -23 * scale, rel=1e-12)
-    # float64: VERTEX_ROUNDINGS eps64 scale ~ 1.9e-12 px is below the floor, which is the bound
+    # float64: the floor (--tol-px) is the bound, 1e6 x VERTEX_ROUNDINGS eps64 scale ~ 1.9e-12 px; 0 stays 0
     assert vertex_bound("float64", got) == tolerances.VERTEX_TOL_PX
+    assert vertex_bound("float64", got, floor=0.0) == 0.0
+    assert vertex_bound("float32", got, floor=1.0) == 1.0          # a larger --tol-px wins
     assert vertex_scale(np.zeros((1, 3)), np.full((1, 2), np.nan), cam) == 0.0        # nothing visible
 
 
