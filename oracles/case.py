@@ -33,7 +33,7 @@ from . import metrics, opencv_oracle, tolerances
 from .candidate import CandidateError, call_candidate_precision, case_precision
 from .cases import Case
 from .core_candidate import CoreCandidate, RenderMode
-from .draw import draw_candidate, oracle_segments
+from .draw import depth_margin, draw_candidate, oracle_segments
 from .tolerances import Tolerances
 from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
 
@@ -87,6 +87,7 @@ class CaseFrames:
 
     cand_px: list = field(default_factory=list)         # (N, 2) per frame
     returned: set = field(default_factory=set)          # the precisions of the candidate's answers
+    depth_ties: int = 0                                 # points left out by forgive_depth_ties
     scale: float = 0.0                                  # largest tolerances.vertex_scale over the frames
     oracle_px: list = field(default_factory=list)
     frame_errors: list = field(default_factory=list)    # (max error px, frame, worst vertex)
@@ -144,6 +145,8 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         acc.seconds["proj"] += t3 - t2
         acc.seconds["draw"] += t4 - t3
         t5 = time.perf_counter()
+        if precision != "float64":
+            cand_px, oracle_px = forgive_depth_ties(acc, geometry[0], setup.cam, cand_px, oracle_px, precision)
         frame_rec = vertex_stage(acc, k, cand_px, oracle_px)
         acc.scale = max(acc.scale, tolerances.vertex_scale(geometry[0], oracle_px, setup.cam))
         t6 = acc.add("vmetric", t5)
@@ -194,6 +197,27 @@ def candidate_frame(setup: CaseSetup, points, m_core, p_world: np.ndarray, preci
         return cand.draw_mode(points, setup.edges, cam, m_core, setup.core_faces, mode), None
     except Exception as exc:
         raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc
+
+
+def forgive_depth_ties(acc: CaseFrames, p_world: np.ndarray, camera, cand_px: np.ndarray, oracle_px: np.ndarray,
+                       precision: str) -> tuple[np.ndarray, np.ndarray]:
+    """Leave out points whose depth is within the candidate's rounding of near or far and that one side clips.
+
+    A float32 candidate decides such a point on its own rounded depth
+    (oracles.draw.depth_margin), so either answer is correct; the point is
+    counted in ``acc.depth_ties`` (the record's ``depth_ties``) and compared
+    as clipped by both.
+    """
+    depth = opencv_oracle.depth(p_world, camera)
+    margin = depth_margin(p_world, camera, precision)
+    tie = (np.abs(depth - camera.near) <= margin) | (np.abs(depth - camera.far) <= margin)
+    tie &= np.isfinite(cand_px).all(axis=1) != np.isfinite(oracle_px).all(axis=1)
+    if not tie.any():
+        return cand_px, oracle_px
+    acc.depth_ties += int(tie.sum())
+    cand_px, oracle_px = cand_px.copy(), oracle_px.copy()
+    cand_px[tie] = oracle_px[tie] = np.nan
+    return cand_px, oracle_px
 
 
 def vertex_stage(acc: CaseFrames, k: int, cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:

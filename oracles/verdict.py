@@ -47,6 +47,8 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
     rec["precision"] = {"judged_as": precision, "source": source,
                         "returned": sorted(acc.returned) if acc.returned else None}
     rec["vertex_bound_px"] = bound
+    if acc.depth_ties:       # points on near/far to within the candidate's rounding, clipped by one side only
+        rec["depth_ties"] = acc.depth_ties
     if setup.pixels and setup.mode.hidden_lines:
         rec["hidden_lines"] = setup.faces is not None
     faults = []

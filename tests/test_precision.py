@@ -255,3 +255,30 @@ def test_config_key_candidate_precision(tmp_path):
     path.write_text('[tool.wirecheck]\ncandidate-precision = "double"\n')
     with pytest.raises(InputError, match="candidate-precision = 'double': expected 'float32' or 'float64'"):
         load_config(path)
+
+
+def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
+    """A vertex on the near plane (to float32 rounding) clipped by the float32 candidate only is not a failure."""
+    from wirecheck.core.scene import Scene
+    from wirecheck.core.scene_files import load_scene
+    from wirecheck.oracles.cases import cameras_for
+
+    cube = load_scene("cube")
+    cam = next(c.camera for c in cameras_for(cube.radius) if c.name == "near_plane")
+    # depth near (1 + 1e-12): visible in float64 (rounding ~1e-16), not resolvable in float32 (eps 1.2e-7);
+    # inside the cube's bounding sphere, so the case camera is the cube's
+    tie = cam.position + cam.near * (1 + 1e-12) * cam.forward
+    scene = Scene(name="tie", vertices=np.vstack([cube.vertices, tie]), edges=np.asarray(cube.edges))
+    assert scene.radius == cube.radius
+
+    def clips_the_tie(points, camera):
+        out = glm_f32.project(points, camera)
+        out[np.all(np.abs(points - tie) < 1e-12, axis=1)] = np.nan     # its rounding went the other way
+        return out
+
+    kwargs = dict(isolate=False, scenes=[scene], frames=1, cases=["near_plane"], turns=(0, 0, 0))
+    (case,) = check_projector(clips_the_tie, **kwargs)["cases"]
+    assert case["verdict"] == "pass" and case["depth_ties"] == 1, case["reasons"]
+    # declared float64, the same answer fails: float64 leaves no room for a tie there
+    (strict,) = check_projector(clips_the_tie, precision="float64", **kwargs)["cases"]
+    assert strict["verdict"] == "fail" and "visible sets differ" in " ".join(strict["reasons"])
