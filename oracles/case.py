@@ -31,6 +31,7 @@ from wirecheck.core.transforms import Motion   # parameters only: the oracle's m
 from . import faces as oface
 from . import metrics, opencv_oracle, tolerances
 from .candidate import CandidateError, call_candidate_precision, case_precision
+from .convert import opencv_matrices
 from .cases import Case
 from .core_candidate import CoreCandidate, RenderMode
 from .draw import depth_margin, draw_candidate, oracle_segments
@@ -66,6 +67,7 @@ class CaseSetup:
         self.pixels = pixels and getattr(case.camera, "distortion", None) is None
         self.pixels_skipped = pixels and not self.pixels
         self.is_core = isinstance(candidate, CoreCandidate)
+        self.cv_matrices = opencv_matrices(self.cam)       # R, t, K once, for tolerances.vertex_scale
         if not mode.plain and not self.is_core and pixels:
             raise ValueError(f"drawing mode {mode.to_dict()}: only the core candidate draws faces")
         self.edges = np.asarray(scene.edges)
@@ -146,9 +148,9 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         acc.seconds["draw"] += t4 - t3
         t5 = time.perf_counter()
         if precision != "float64":
-            cand_px, oracle_px = forgive_depth_ties(acc, geometry[0], setup.cam, cand_px, oracle_px, precision)
+            cand_px, oracle_px = forgive_depth_ties(acc, setup, geometry[0], cand_px, oracle_px, precision)
         frame_rec = vertex_stage(acc, k, cand_px, oracle_px)
-        acc.scale = max(acc.scale, tolerances.vertex_scale(geometry[0], oracle_px, setup.cam))
+        acc.scale = max(acc.scale, tolerances.vertex_scale(geometry[0], oracle_px, setup.cam, setup.cv_matrices))
         t6 = acc.add("vmetric", t5)
         if setup.pixels:
             pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6)
@@ -199,8 +201,8 @@ def candidate_frame(setup: CaseSetup, points, m_core, p_world: np.ndarray, preci
         raise CandidateError(f"core raised {type(exc).__name__}: {exc}") from exc
 
 
-def forgive_depth_ties(acc: CaseFrames, p_world: np.ndarray, camera, cand_px: np.ndarray, oracle_px: np.ndarray,
-                       precision: str) -> tuple[np.ndarray, np.ndarray]:
+def forgive_depth_ties(acc: CaseFrames, setup: CaseSetup, p_world: np.ndarray, cand_px: np.ndarray,
+                       oracle_px: np.ndarray, precision: str) -> tuple[np.ndarray, np.ndarray]:
     """Leave out points whose depth is within the candidate's rounding of near or far and that one side clips.
 
     A float32 candidate decides such a point on its own rounded depth
@@ -208,7 +210,8 @@ def forgive_depth_ties(acc: CaseFrames, p_world: np.ndarray, camera, cand_px: np
     counted in ``acc.depth_ties`` (the record's ``depth_ties``) and compared
     as clipped by both.
     """
-    depth = opencv_oracle.depth(p_world, camera)
+    camera, (r_cv, t_cv, _k) = setup.cam, setup.cv_matrices
+    depth = p_world @ r_cv[2] + t_cv[2]                  # as opencv_oracle.depth
     margin = depth_margin(p_world, camera, precision)
     tie = (np.abs(depth - camera.near) <= margin) | (np.abs(depth - camera.far) <= margin)
     tie &= np.isfinite(cand_px).all(axis=1) != np.isfinite(oracle_px).all(axis=1)

@@ -70,7 +70,7 @@ VERTEX_ROUNDINGS = 4.0
 DEPTH_ROUNDINGS = 4.0
 
 
-def vertex_scale(p_world, p_px, camera) -> float:
+def vertex_scale(p_world, p_px, camera, matrices=None) -> float:
     """The largest per-point scale of a frame (pixels per unit of relative rounding; formula above).
 
     Parameters
@@ -80,6 +80,9 @@ def vertex_scale(p_world, p_px, camera) -> float:
     p_px : (N, 2) array_like
         Their pixels by the oracle; NaN rows (clipped points) are left out.
     camera : core.camera.Camera
+    matrices : tuple, optional
+        ``oracles.convert.opencv_matrices(camera)``, when the caller has them
+        (built once per case: they cost ~1 ms, as much as OpenCV's projection).
 
     Returns
     -------
@@ -94,7 +97,7 @@ def vertex_scale(p_world, p_px, camera) -> float:
     seen = np.isfinite(p_px).all(axis=1)
     if not seen.any():
         return 0.0
-    r_cv, t_cv, k = opencv_matrices(camera)
+    r_cv, t_cv, k = opencv_matrices(camera) if matrices is None else matrices
     x, p = p_world[seen], p_px[seen]
     size = np.linalg.norm(x, axis=1) + float(np.linalg.norm(camera.position))
     reach = np.abs(p - k[:2, 2]).sum(axis=1)
