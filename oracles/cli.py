@@ -11,6 +11,9 @@ language) is given: those run in their own process and are spoken to over
 the candidate protocol (docs/protocol.md, oracles/isolation.py),
 each request under ``--candidate-timeout`` seconds, so a candidate that
 exits, hangs or crashes fails its cases (exit 1) and never ends the run.
+``--candidate-precision float32|float64`` says what it computes in (default:
+the dtype it returns; core: ``--dtype``): a float32 candidate's vertices are
+held to a bound derived from float32 rounding (oracles/tolerances.py).
 
 ``--level vertices`` runs the OpenCV vertex check only (no drawing, no
 pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.

@@ -156,7 +156,7 @@ FAULT_NAMES = frozenset(FAULT_ORDER)
 #: The faults named from a wireframe's pixels (:func:`diagnose_lines`), not from its vertices.
 LINE_FAULTS = ("line_end_bias", "line_pixel_bias")
 #: The faults named from vertices only: frames of a distorted camera are not compared (oracles.case).
-VERTEX_ONLY_FAULTS = ("distortion_mismatch",)
+VERTEX_ONLY_FAULTS = ("distortion_mismatch", "precision_limited")
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
 #: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union
