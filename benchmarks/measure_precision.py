@@ -1,7 +1,9 @@
 """Measure how far correct float32 projectors are from the float64 oracle (oracles/tolerances.py cites this run).
 
-For three correct float32 projectors -- a glm-style GL pipeline
-(tests/data/candidates/glm_f32.py), core's own pipeline with ``--dtype
+For five correct float32 projectors -- two glm-style GL pipelines
+(tests/data/candidates/glm_f32.py, tests/data/real_world/glm_gl.py: P V
+premultiplied, GL's clip test), DirectXMath's left-handed one
+(tests/data/real_world/d3d_lh.py), core's own pipeline with ``--dtype
 float32``, and an OpenCV-style ``K [R | t]`` in float32 -- on the bundled
 scenes (and the orrery example) under every crosscheck case camera: the
 largest vertex error, the largest ``error / (eps32 scale)`` of any point
@@ -23,8 +25,11 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "data" / "candidates"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "data" / "real_world"))
 
+import d3d_lh  # noqa: E402
 import glm_f32  # noqa: E402
+import glm_gl  # noqa: E402
 
 from wirecheck.core.scene_files import load_scene  # noqa: E402
 from wirecheck.core.transforms import Motion  # noqa: E402
@@ -58,10 +63,10 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     motion = Motion()
     core32 = CoreCandidate(dtype="float32")
-    worst = {"glm": 0.0, "core": 0.0, "kcv": 0.0}
+    worst = {"glm": 0.0, "glm_gl": 0.0, "d3d": 0.0, "core": 0.0, "kcv": 0.0}
     depth_ratio = 0.0
-    print(f"{'scene':<8} {'case':<13} {'bound px':>9} | max err px: {'glm':>8} {'core':>8} {'kcv':>8}"
-          f" | err/(eps scale): {'glm':>5} {'core':>5} {'kcv':>5}")
+    print(f"{'scene':<8} {'case':<13} {'bound px':>9} | max err px: "
+          + " ".join(f"{k:>8}" for k in worst) + " | err/(eps scale): " + " ".join(f"{k:>6}" for k in worst))
     for name in ("cube", "pyramid", "prism", "orrery"):
         scene = load_scene(name)
         for case in cameras_for(scene.radius):
@@ -75,6 +80,8 @@ def main(argv=None) -> int:
                 orac = opencv_oracle.project(p_world, cam)
                 points, m_core = frames.geometry(f)
                 cands = {"glm": glm_f32.project(p_world, cam).astype(np.float64),
+                         "glm_gl": glm_gl.project(p_world, cam).astype(np.float64),
+                         "d3d": d3d_lh.project(p_world, cam).astype(np.float64),
                          "core": core32.project(points, cam, m_core),
                          "kcv": kcv_f32(p_world, cam).astype(np.float64)}
                 seen = np.isfinite(orac).all(axis=1)
@@ -99,10 +106,10 @@ def main(argv=None) -> int:
             bound = tolerances.vertex_bound("float32", scale_max)
             for key in worst:
                 worst[key] = max(worst[key], ratios[key])
-            print(f"{name:<8} {case.name:<13} {bound:9.2e} | {'':11} {errs['glm']:8.1e} {errs['core']:8.1e} "
-                  f"{errs['kcv']:8.1e} | {'':16} {ratios['glm']:5.2f} {ratios['core']:5.2f} {ratios['kcv']:5.2f}")
-    print(f"largest error / (eps32 scale): {worst}; largest float32 depth error / (eps32 (|X|+|C|)): "
-          f"{depth_ratio:.2f}")
+            print(f"{name:<8} {case.name:<13} {bound:9.2e} | {'':11} " + " ".join(f"{errs[k]:8.1e}" for k in worst)
+                  + f" | {'':16} " + " ".join(f"{ratios[k]:6.2f}" for k in worst))
+    print("largest error / (eps32 scale): " + ", ".join(f"{k} {v:.2f}" for k, v in worst.items())
+          + f"; largest float32 depth error / (eps32 (|X|+|C|)): {depth_ratio:.2f}")
     return 0
 
 

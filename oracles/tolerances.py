@@ -51,15 +51,16 @@ EPS = {"float32": 2.0 ** -23, "float64": 2.0 ** -52}
 # the bundled cases, so VERTEX_TOL_PX (1e-6) is the bound; for float32 it is ~1e-3 px,
 # still three orders below the smallest convention error (0.5 px).
 #
-# Measured (benchmarks/measure_precision.py: three float32 projectors -- a
-# glm-style GL pipeline, core --dtype float32, an OpenCV-style K [R|t] --
-# on the bundled scenes and the orrery under every case camera, 24 frames
-# each): the largest error / (eps scale) of any point is 0.72 (glm, orrery,
-# narrow_fov; core 0.16, K [R|t] 0.18); the largest float32 vertex error
-# 4.5e-4 px, the bounds 1.2e-3 to 3.4e-3 px.
+# Measured (benchmarks/measure_precision.py: five float32 projectors -- two
+# glm-style GL pipelines, DirectXMath's left-handed one, core --dtype float32,
+# an OpenCV-style K [R|t] -- on the bundled scenes and the orrery under every
+# case camera, 24 frames each): the largest error / (eps scale) of any point
+# is 0.74 (glm with P V premultiplied, orrery, narrow_fov; core 0.16, K [R|t]
+# 0.18); the largest float32 vertex error 4.6e-4 px, the bounds 1.2e-3 to
+# 3.4e-3 px.
 
 #: Roundings of size eps x scale a correct projector may accumulate (see
-#: above): 4, 5.5x the largest measured error / (eps scale).
+#: above): 4, 5.4x the largest measured error / (eps scale).
 VERTEX_ROUNDINGS = 4.0
 
 #: The near-plane margin of oracles.draw, in roundings of eps (|X| + |C|): a

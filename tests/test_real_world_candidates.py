@@ -112,3 +112,47 @@ def test_opencv_k_with_k1_flipped_is_named_with_the_candidates_k1():
         assert fault["k1"] == pytest.approx(-coeffs[0], abs=1e-9)
         assert fault["k2"] == pytest.approx(coeffs[1], abs=1e-9)
         assert (fault["p1"], fault["p2"]) == pytest.approx((coeffs[2], coeffs[3]), abs=1e-9)
+
+
+# ---- float32 candidates (glm, DirectXMath): judged at their precision (oracles/tolerances.py) ----
+
+ALL_CASES = PERSPECTIVE + ["orthographic"]
+
+
+def _judged_float32(case):
+    # the float32 arrays they return make them float32 candidates, held to the derived
+    # bound (~1e-3 px on these cases) instead of 1e-6 px
+    assert case["precision"]["judged_as"] == "float32" and case["precision"]["source"] == "returned"
+    assert 1e-4 < case["vertex_bound_px"] < 5e-3
+
+
+@pytest.mark.parametrize("func", [glm_gl.project, d3d_lh.project], ids=["glm", "d3d"])
+def test_float32_gl_and_d3d_projectors_wrapped_correctly_pass_at_both_levels(func):
+    report = _check(func, ALL_CASES)
+    assert report["verdict"] == "pass"
+    for case in report["cases"]:
+        _judged_float32(case)
+    pixels = _check(func, ["near_plane", "wide_fov", "orthographic"], oracles=("opencv", "pyrender"))
+    assert pixels["verdict"] == "pass"
+    assert all(c["pixel_f1_1px"] == 1.0 for c in pixels["cases"])
+
+
+def test_glm_window_coordinates_are_a_vertical_mirror_and_half_a_pixel():
+    # projectNO's window: x_win = x_px + 0.5 and y_win = H - y_px - 0.5 = (H - 1) - y_px + 0.5:
+    # y mirrored about the image centre, and +0.5 on both axes.
+    report = _check(glm_gl.project_naive, ALL_CASES)
+    for case in report["cases"]:
+        _judged_float32(case)
+        faults = _faults(case)
+        assert list(faults) == ["mirror_vertical", "pixel_offset"], case["faults"]
+        # fitted through float32 noise: the offset within the case's bound of 0.5
+        assert faults["pixel_offset"]["dx"] == pytest.approx(0.5, abs=case["vertex_bound_px"])
+        assert faults["pixel_offset"]["dy"] == pytest.approx(0.5, abs=case["vertex_bound_px"])
+
+
+def test_d3d_left_handed_on_a_right_handed_world_is_a_horizontal_mirror():
+    # LookAtLH's x = up x z is -(forward x up) = -right in a right-handed world: x mirrored.
+    report = _check(d3d_lh.project_naive, ALL_CASES)
+    for case in report["cases"]:
+        _judged_float32(case)
+        assert [f["name"] for f in case["faults"]] == ["mirror_horizontal"], case["faults"]
