@@ -88,11 +88,12 @@ candidate's rounding noise: a float32 projector with a mirror and a half-pixel
 offset is named ``mirror_vertical`` + ``pixel_offset``, not ``unexplained``.
 A candidate judged at float64 whose error is float32 rounding is told so: with
 ``float32_px`` (the float32 bound of the same points) given, the diagnosis is
-run again at ``float32_px``; when that one names no ``unexplained`` (nor a
-depth flip) and differs from the float64 one (other names, or a named model
-that leaves more than ``tol_px``), the answer is its faults plus
+run again at ``float32_px`` when the float64 one leaves noise (its named model
+misses by more than ``tol_px``); when the float32 one names no
+``unexplained`` (nor a depth flip), the answer is its faults plus
 ``precision_limited`` (the residual left by them and both bounds). A float64
-mirror fitted to 1e-13 px stays a plain ``mirror_vertical``.
+mirror, or a genuine 1e-4 px offset, fitted to 1e-13 px stays a plain
+``mirror_vertical`` or ``pixel_offset``: rounding leaves noise, a fault does not.
 
 Details and decisions
 ---------------------
@@ -258,17 +259,17 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float
     -------
     list of dict, primary fault first; see the module docstring.
     """
-    faults = _diagnose_at(cand_px, oracle_px, camera, tol_px)
+    fine: dict = {}
+    faults = _diagnose_at(cand_px, oracle_px, camera, tol_px, fine)
     if not faults or float32_px is None or not float32_px > tol_px:
         return faults
-    info: dict = {}
-    coarse = _diagnose_at(cand_px, oracle_px, camera, float32_px, info)
-    names = [f["name"] for f in faults]
-    if any(f["name"] in ("unexplained", "depth_flip") for f in coarse) or "depth_flip" in names:
+    if fine.get("residual_px", 0.0) <= tol_px:
+        return faults                  # a named model fits to float64 accuracy: no rounding noise to explain
+    coarse_info: dict = {}
+    coarse = _diagnose_at(cand_px, oracle_px, camera, float32_px, coarse_info)
+    if any(f["name"] in ("unexplained", "depth_flip") for f in coarse):
         return faults                  # float32 rounding does not explain it either
-    if info["residual_px"] <= tol_px and names == [f["name"] for f in coarse]:
-        return faults                  # the same faults, fitted to float64 accuracy: not a rounding matter
-    return _sorted(coarse + [{"name": "precision_limited", "residual_px": info["residual_px"],
+    return _sorted(coarse + [{"name": "precision_limited", "residual_px": coarse_info["residual_px"],
                               "float64_bound_px": float(tol_px), "float32_bound_px": float(float32_px)}])
 
 

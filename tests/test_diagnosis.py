@@ -406,6 +406,17 @@ def test_float32_twin_offset_and_fov(results32, camera_name):
     assert got == pytest.approx(implied_fov(cam), rel=1e-4)
 
 
+def test_a_small_float64_fault_is_not_precision_limited():
+    """A genuine 1e-4 px offset (below the float32 bound, ~1e-3 px) in float64 arithmetic leaves no noise:
+    it is a pixel_offset, not float32 rounding."""
+    cam = CAMERAS["oblique"]
+    ref = oracle_project(POINTS, cam)
+    got = diagnose(f_none(POINTS, cam) + 1e-4, ref, cam, tol_px=TOL, float32_px=float32_bound(POINTS, cam, ref))
+    assert [d["name"] for d in got] == ["pixel_offset"], got
+    # pixels of <= ~640 px plus 1e-4 are exact to ~1e-13 px; the fitted offset alike (budget above)
+    assert got[0]["dx"] == pytest.approx(1e-4, abs=1e-9)
+
+
 def test_float32_arith_is_precision_limited_not_unexplained(results):
     for cam in MAIN_CAMERAS:
         (f,) = results[("float32_arith", cam)]
