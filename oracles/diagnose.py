@@ -90,7 +90,8 @@ A candidate judged at float64 whose error is float32 rounding is told so: with
 ``float32_px`` (the float32 bound of the same points) given, the diagnosis is
 run again at ``float32_px`` when the float64 one leaves noise (its named model
 misses by more than ``tol_px``); when the float32 one names no
-``unexplained`` (nor a depth flip), the answer is its faults plus
+``unexplained`` (nor a depth flip) and its named model leaves at most
+``float32_px`` (a lens error leaves more), the answer is its faults plus
 ``precision_limited`` (the residual left by them and both bounds). A float64
 mirror, or a genuine 1e-4 px offset, fitted to 1e-13 px stays a plain
 ``mirror_vertical`` or ``pixel_offset``: rounding leaves noise, a fault does not.
@@ -156,7 +157,8 @@ FAULT_ORDER = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
 FAULT_NAMES = frozenset(FAULT_ORDER)
 #: The faults named from a wireframe's pixels (:func:`diagnose_lines`), not from its vertices.
 LINE_FAULTS = ("line_end_bias", "line_pixel_bias")
-#: The faults named from vertices only: frames of a distorted camera are not compared (oracles.case).
+#: The faults named from vertices only: frames of a distorted camera are not compared (oracles.case),
+#: and float32 rounding (precision_limited) is far below a pixel.
 VERTEX_ONLY_FAULTS = ("distortion_mismatch", "precision_limited")
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
@@ -267,8 +269,8 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float
         return faults                  # a named model fits to float64 accuracy: no rounding noise to explain
     coarse_info: dict = {}
     coarse = _diagnose_at(cand_px, oracle_px, camera, float32_px, coarse_info)
-    if any(f["name"] in ("unexplained", "depth_flip") for f in coarse):
-        return faults                  # float32 rounding does not explain it either
+    if any(f["name"] in ("unexplained", "depth_flip") for f in coarse) or coarse_info["residual_px"] > float32_px:
+        return faults                  # float32 rounding does not explain it either (e.g. a lens bends the map)
     return _sorted(coarse + [{"name": "precision_limited", "residual_px": coarse_info["residual_px"],
                               "float64_bound_px": float(tol_px), "float32_bound_px": float(float32_px)}])
 
