@@ -81,7 +81,12 @@ def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None) ->
         scene = _load(entry)
         cases = scene_cases(scene, case_names, params.motion)
     except InputError as exc:
-        record.update(verdict="error", error=str(exc).replace(f"{entry.name}: ", "", 1))
+        text = str(exc)
+        if text.startswith(f"{entry.name}:"):    # "NAME: why" or "NAME:LINE: why": the record names the mesh
+            rest = text[len(entry.name) + 1:]
+            line, sep, why = rest.partition(": ")
+            text = f"line {line}: {why}" if sep and line.isdigit() else rest.lstrip()
+        record.update(verdict="error", error=text)
         return record, {"mesh": entry.name, "load_s": time.perf_counter() - t0, "cases": []}
     t_load = time.perf_counter() - t0
     record.update(vertices=len(scene.vertices), edges=len(scene.edges), faces=len(scene.faces))
