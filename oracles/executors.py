@@ -145,6 +145,8 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
     """
     if spec.kind == "dask":
         with _dask_client(spec) as client:
+            if initializer is not None:
+                client.run(initializer)          # on every worker, before the first task
             yield client.get_executor(), dask_workers(client)
         return
     workers = min(spec.jobs, n_tasks)
@@ -156,8 +158,29 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
 
     workers = max(workers, 1)
     ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=initializer) as pool:
+    barrier = ctx.Barrier(workers)
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_pool_init,
+                             initargs=(initializer, barrier)) as pool:
+        # start every worker now (the pool starts one per task submitted while none is idle, and each
+        # waits for the others): the run's time then counts tasks, not interpreters starting
+        for f in [pool.submit(_pool_ready) for _ in range(workers)]:
+            f.result()
         yield pool, workers
+
+
+_BARRIER = None
+
+
+def _pool_init(initializer, barrier) -> None:
+    global _BARRIER
+    _BARRIER = barrier
+    if initializer is not None:
+        initializer()
+
+
+def _pool_ready() -> None:
+    """Returns once every worker of the pool has started (each holds one of these tasks meanwhile)."""
+    _BARRIER.wait(timeout=600)
 
 
 def gather_in_order(executor, fn, items, on_result=None) -> list:
