@@ -61,24 +61,28 @@ def is_mesh_file(name: str) -> bool:
 
 
 def walk_folder(root: Path) -> tuple[list[MeshEntry], int]:
-    """The mesh files under ``root`` (sorted, links to folders followed once) and the count of other files."""
+    """The mesh files under ``root`` (sorted, links to folders followed once) and the count of other files.
+
+    Depth-first with an explicit stack (a folder nested thousands deep is not a recursion limit).
+    """
     entries, other = [], 0
     seen = set()
-
-    def visit(folder: Path, rel: str) -> None:
-        nonlocal other
+    stack = [(Path(root), "")]
+    while stack:
+        folder, rel = stack.pop()
         try:
             st = folder.stat()
             key = (st.st_dev, st.st_ino)
             if key in seen:           # a link loop, or a second link to a folder already walked
-                return
+                continue
             seen.add(key)
             with os.scandir(folder) as it:
                 items = sorted(it, key=lambda e: e.name)
         except OSError as exc:
             entries.append(MeshEntry(name=rel or ".", path=str(folder),
                                      error=f"folder could not be read: {exc.strerror or exc}"))
-            return
+            continue
+        folders = []
         for item in items:
             item_rel = f"{rel}/{item.name}" if rel else item.name
             try:
@@ -86,13 +90,12 @@ def walk_folder(root: Path) -> tuple[list[MeshEntry], int]:
             except OSError:
                 is_dir = False
             if is_dir:
-                visit(Path(item.path), item_rel)
+                folders.append((Path(item.path), item_rel))
             elif is_mesh_file(item.name):
                 entries.append(MeshEntry(name=item_rel, path=os.path.abspath(item.path)))
             else:
                 other += 1
-
-    visit(root, "")
+        stack += reversed(folders)            # the first in name order is walked first
     return entries, other
 
 

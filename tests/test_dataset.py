@@ -295,3 +295,24 @@ def test_progress_bar_on_a_terminal_only():
 def test_cli_progress_is_off_when_stderr_is_not_a_terminal(meshes, tmp_path):
     code, stdout, stderr = _cli(["--report-dir", tmp_path / "r", "--scene", meshes, *FAST, "--allow-load-errors"])
     assert code == 0 and stderr == "" and "PASS: 3/4 meshes passed" in stdout
+
+
+def test_a_deep_folder_is_walked_without_recursion(tmp_path):
+    # deeper than the recursion limit allows a recursive walk: the limit is lowered to 100 frames above
+    # this one (not the folder made deeper than 1000: shutil.rmtree, and so pytest's clean-up, recurse)
+    depth = 0
+    frame = sys._getframe()
+    while frame is not None:
+        depth, frame = depth + 1, frame.f_back
+    deep = tmp_path
+    for _ in range(200):
+        deep = deep / "d"
+        deep.mkdir()
+    (deep / "m.obj").write_text("v 0 0 0\n")
+    limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(depth + 100)
+    try:
+        entries, _ = walk_folder(tmp_path)
+    finally:
+        sys.setrecursionlimit(limit)
+    assert [e.name for e in entries] == ["/".join(["d"] * 200) + "/m.obj"]
