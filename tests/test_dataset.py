@@ -268,6 +268,16 @@ def test_report_is_the_same_for_jobs_1_jobs_2_and_a_local_dask_cluster(meshes, t
     assert reports["one"][0]["summary"]["passed"] == 3        # and they compared something
 
 
+def test_a_plain_run_on_a_local_dask_cluster_gives_the_report_of_jobs_1(tmp_path):
+    args = ("--scene", "cube", "--scene", "pyramid", *FAST)
+    code1, r1, out1 = run(tmp_path, *args, name="one")
+    code2, r2, out2 = run(tmp_path, *args, "--executor", "dask", "--jobs", "2", name="dask")
+    assert code1 == code2 == 0
+    assert (r2["timing"]["executor"], r2["timing"]["workers"]) == ("dask", 2)
+    assert _without_timing(out1) == _without_timing(out2)
+    assert (out1 / "report.md").read_bytes() == (out2 / "report.md").read_bytes()
+
+
 # ---------------------------------------------------------------- progress
 
 class _Tty(io.StringIO):
