@@ -116,12 +116,18 @@ def faults_by_count(meshes: list[dict]) -> list[dict]:
             for f, n in sorted(cases.items(), key=lambda item: (-item[1], item[0]))]
 
 
+#: Failed cases are worse than vacuous ones, which are worse than passes, whatever their scores
+#: (a case fails on a reason its F1 may not show, e.g. one-sided pixels, oracles.verdict).
+_VERDICT_RANK = {"fail": 0, "vacuous": 1, "pass": 2}
+
+
 def worst_cases(meshes: list[dict], n: int = WORST_N) -> list[dict]:
-    """The ``n`` worst cases over the dataset (oracles.runner.worst_key; ties keep dataset order)."""
+    """The ``n`` worst cases over the dataset: failed first, then by oracles.runner.worst_key (ties: dataset order)."""
     rows = [c for m in meshes for c in m.get("cases", []) if c.get("compared", {}).get("frames")]
     keep = ("scene", "camera", "verdict", "max_vertex_error_px", "pixel_f1_0px", "pixel_f1_1px",
             "silhouette_iou", "depth_error_ratio", "faults", "reasons")
-    return [{k: c[k] for k in keep if k in c} for c in sorted(rows, key=worst_key)[:n]]
+    ranked = sorted(rows, key=lambda c: (_VERDICT_RANK.get(c["verdict"], 0), worst_key(c)))
+    return [{k: c[k] for k in keep if k in c} for c in ranked[:n]]
 
 
 def summarize(meshes: list[dict], level: str, allow_vacuous: bool, allow_load_errors: bool) -> tuple[str, dict, dict]:

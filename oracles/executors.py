@@ -123,6 +123,30 @@ def _dask_client(spec: ExecutorSpec):
                 cluster.close()
 
 
+def heap_for_arrays() -> bool:
+    """Undo, in a Dask worker, what ``MALLOC_TRIM_THRESHOLD_`` does to glibc's heap; True if it did.
+
+    Dask's nanny starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to give
+    memory back to the OS sooner). With glibc, any explicit threshold also freezes
+    the mmap threshold at 128 KiB, so every image-sized array (a 640x480 frame is
+    0.3 to 2.5 MB) is a fresh mmap, page-faulted anew: a mesh took twice as long in
+    a Dask worker as in a process-pool worker until this raised both thresholds
+    (32 MiB for mmap, glibc's maximum on 64-bit; 64 MiB for trimming). Elsewhere
+    (no such variable, or not glibc) nothing changes.
+    """
+    import ctypes
+    import os
+
+    if "MALLOC_TRIM_THRESHOLD_" not in os.environ:
+        return False
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+    except OSError:
+        return False
+    m_trim_threshold, m_mmap_threshold = -1, -3           # glibc's <malloc.h>
+    return bool(libc.mallopt(m_mmap_threshold, 32 * 2**20)) and bool(libc.mallopt(m_trim_threshold, 64 * 2**20))
+
+
 def dask_failure(exc: BaseException) -> str:
     """One line for a task that failed on a Dask worker (a worker died, or lacks wirecheck)."""
     text = " ".join(str(exc).split())[:300]
@@ -145,6 +169,7 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
     """
     if spec.kind == "dask":
         with _dask_client(spec) as client:
+            client.run(heap_for_arrays)
             if initializer is not None:
                 client.run(initializer)          # on every worker, before the first task
             yield client.get_executor(), dask_workers(client)

@@ -238,6 +238,19 @@ def test_summary_counts_faults_and_ranks_worst_cases(meshes, tmp_path, monkeypat
     assert "| cyl.stl | fail | on_axis, orthographic |" in md and "| broken.obj | line 1:" in md
 
 
+def test_a_failed_case_ranks_worse_than_any_pass_whatever_its_f1():
+    from wirecheck.oracles.dataset_run import worst_cases
+
+    def case(mesh, verdict, f1):
+        return {"scene": mesh, "camera": "on_axis", "verdict": verdict, "pixel_f1_1px": f1, "pixel_f1_0px": f1,
+                "max_vertex_error_px": 0.0, "faults": [], "reasons": [], "compared": {"frames": 2}}
+
+    meshes = [{"mesh": m, "cases": [case(m, v, f1)]} for m, v, f1 in
+              [("a", "pass", 0.97), ("b", "fail", 1.0), ("c", "pass", 0.99), ("d", "vacuous", 1.0)]]
+    # b failed on a reason its F1 does not show (e.g. one-sided pixels): it is the worst
+    assert [c["scene"] for c in worst_cases(meshes, n=3)] == ["b", "d", "a"]
+
+
 def test_a_scene_list_with_a_missing_file_reports_it(meshes, tmp_path):
     lst = tmp_path / "set.txt"
     lst.write_text(f"{meshes / 'box.obj'}\ngone.obj\n")
