@@ -34,6 +34,13 @@ The report directory also gets ``worst.gif`` (every checked frame of the
 worst case: candidate | oracle | diff), ``vertex_error.png`` and
 ``pixels.png`` (per-frame plots of every case).
 
+``--scene DIR`` (a folder of mesh files) and ``--scene-list FILE`` run a
+dataset: one task per mesh, a mesh that cannot be loaded counted and reported
+(it fails the run unless ``--allow-load-errors``), one summary
+(oracles/dataset_run.py, docs/datasets.md). ``--executor dask`` runs the
+cases or meshes on a Dask cluster: a local one of ``--jobs`` workers, or
+``--scheduler tcp://HOST:PORT``'s (oracles/executors.py); same report.
+
 ``crosscheck export DIR`` writes a rendering job for any renderer, and
 ``--candidate-frames DIR`` judges the renderer's own frames of it
 (oracles/frames_cli.py, docs/frames.md).
@@ -279,6 +286,9 @@ def _executor(args) -> ExecutorSpec:
         check_scheduler_address(args.scheduler)
     if not (math.isfinite(args.scheduler_timeout) and args.scheduler_timeout > 0):
         raise InputError(f"--scheduler-timeout {args.scheduler_timeout}: expected a number of seconds > 0")
+    if args.scheduler is None and args.scheduler_timeout != DEFAULT_CONNECT_TIMEOUT_S:
+        raise InputError(f"--scheduler-timeout {args.scheduler_timeout:g} without --scheduler: it bounds reaching "
+                         "a cluster's scheduler: expected --scheduler tcp://HOST:PORT")
     if kind == "dask" and (args.sweep or args.suite or args.candidate_frames is not None):
         what = "--sweep" if args.sweep else f"--suite {args.suite}" if args.suite else "--candidate-frames"
         raise InputError(f"--executor dask with {what}: expected it in a plain crosscheck run or a dataset run")
@@ -288,10 +298,13 @@ def _executor(args) -> ExecutorSpec:
 
 def _dataset(args):
     """The dataset of ``--scene DIR`` / ``--scene-list FILE`` (oracles.dataset), or None for a plain run."""
+    from wirecheck.core.scene_files import builtin_names, example_names
+
     from .dataset import dataset_entries
 
     scenes = args.scene or []
-    folders = [s for s in scenes if Path(s).is_dir()]
+    named = set(builtin_names() + example_names())      # a bundled name wins over a folder of that name
+    folders = [s for s in scenes if s not in named and Path(s).is_dir()]
     if not folders and not args.scene_list:
         if args.allow_load_errors:
             raise InputError("--allow-load-errors without a dataset: expected --scene DIR or --scene-list FILE")

@@ -164,6 +164,9 @@ def _empty_folder(tmp_path):
     (lambda t: ["--scene", t, "--scheduler", "tcp://127.0.0.1:8786", "--jobs", "2"], "expected no --jobs"),
     (lambda t: ["--scene", t, "--executor", "local", "--scheduler", "tcp://127.0.0.1:8786"],
      "expected --executor dask"),
+    (lambda t: ["--scene", t, "--executor", "dask", "--scheduler-timeout", "3"], "3 without --scheduler"),
+    (lambda t: ["--scene", t, "--scheduler", "tcp://127.0.0.1:8786", "--scheduler-timeout", "nan"],
+     "--scheduler-timeout nan: expected a number of seconds > 0"),
 ])
 def test_errors_are_one_line_exit_2_and_write_nothing(tmp_path, make, message):
     args = make(tmp_path)
@@ -181,6 +184,13 @@ def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+def test_a_bundled_name_wins_over_a_folder_of_that_name(tmp_path, monkeypatch):
+    (tmp_path / "cube").mkdir()           # a folder named like the bundled scene, in the working directory
+    monkeypatch.chdir(tmp_path)
+    code, report, _ = run(tmp_path, "--scene", "cube", "--level", "vertices", *FAST)
+    assert code == 0 and "meshes" not in report and {c["scene"] for c in report["cases"]} == {"cube"}
 
 
 def test_unreachable_scheduler_is_one_line_within_the_timeout(meshes, tmp_path):
