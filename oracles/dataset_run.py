@@ -69,8 +69,8 @@ def _load(entry: MeshEntry):
     return dataclasses.replace(scene, name=entry.name, source=entry.name)
 
 
-def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None) -> tuple[dict, dict]:
-    """``(mesh record, timing)`` of one mesh under every case in ``case_names``.
+def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None) -> tuple[dict, dict, dict | None]:
+    """``(mesh record, timing, oracle GL info or None)`` of one mesh under every case in ``case_names``.
 
     ``runner`` (:class:`oracles.runner._CaseRunner`): None in a worker process
     (its own runner, made on first use).
@@ -87,7 +87,7 @@ def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None) ->
             line, sep, why = rest.partition(": ")
             text = f"line {line}: {why}" if sep and line.isdigit() else rest.lstrip()
         record.update(verdict="error", error=text)
-        return record, {"mesh": entry.name, "load_s": time.perf_counter() - t0, "cases": []}
+        return record, {"mesh": entry.name, "load_s": time.perf_counter() - t0, "cases": []}, None
     t_load = time.perf_counter() - t0
     record.update(vertices=len(scene.vertices), edges=len(scene.edges), faces=len(scene.faces))
     results = [runner.run(scene, case, params) for case in cases]
@@ -97,10 +97,11 @@ def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None) ->
     record["cases"] = rows
     timing = {"mesh": entry.name, "load_s": t_load, "check_s": time.perf_counter() - t0 - t_load,
               "cases": [{"camera": case.name, **r.timing} for case, r in zip(cases, results)]}
-    return record, timing
+    gl = next((r.gl_info for r in results if getattr(r, "gl_info", None) is not None), None)
+    return record, timing, gl
 
 
-def _worker_check_mesh(entry: MeshEntry, params: _RunParams, case_names) -> tuple[dict, dict]:
+def _worker_check_mesh(entry: MeshEntry, params: _RunParams, case_names) -> tuple[dict, dict, dict | None]:
     with _WORKER_LOCK:
         return check_mesh(entry, params, case_names, worker_runner())
 
@@ -168,6 +169,14 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     tol = tol or Tolerances()
     executor = executor or ExecutorSpec()
     inputs = gate.run_settings(frames, every, case_names, turns, tol)
+    if level == "pixels":
+        from .cases import calibrated_cases
+
+        distorted = {c.name for c in calibrated_cases(1.0) if c.camera.distortion is not None}
+        if set(inputs.case_names) <= distorted:      # as oracles.runner.run_crosscheck says it
+            raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their "
+                             "pixels are not compared (GL draws straight lines), so the run would compare no "
+                             "pixel; expected level vertices or a case without distortion")
     params = _RunParams(frames=inputs.frames, every=inputs.every, level=level, motion=Motion(turns=inputs.turns),
                         tol=tol, candidate=candidate, mode=mode, keep_frames=False)
     entries = list(dataset.entries)
@@ -213,6 +222,7 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
         "candidate": candidate_name,
         "candidate_settings": candidate.settings() if hasattr(candidate, "settings") else None,
         "level": level,
+        "oracle_gl": next((r[2] for r in results if r[2] is not None), None),   # one driver per machine
         **mode.to_dict(),
         "oracles": list(LEVEL_ORACLES[level]),
         "frames": inputs.frames,

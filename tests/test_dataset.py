@@ -145,6 +145,12 @@ def _none_loads(tmp_path):
     return ["--scene", tmp_path / "d"]
 
 
+def _only_distorted(tmp_path):
+    (tmp_path / "d").mkdir()
+    (tmp_path / "d" / "a.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    return ["--scene", tmp_path / "d", "--cases", "distorted"]
+
+
 def _empty_folder(tmp_path):
     (tmp_path / "d").mkdir()
     return ["--scene", tmp_path / "d"]
@@ -154,6 +160,7 @@ def _empty_folder(tmp_path):
     (_empty_folder, "no mesh files in this folder (looked for .obj .ply .stl .off .glb .gltf; 0 other files)"),
     (_no_meshes, "no mesh files in this folder (looked for .obj .ply .stl .off .glb .gltf; 1 other files)"),
     (_empty_list, "no paths in this list (only blank lines and comments): nothing to check"),
+    (_only_distorted, "cases distorted at level pixels: lens distortion: their pixels are not compared"),
     (_none_loads, "none of the 2 meshes could be loaded (first: a.obj: line 1: vertex 'v 1 2'"),
     (lambda t: ["--scene", "cube", "--scene", t], "--scene 'cube' with a dataset"),
     (lambda t: ["--scene-list", t / "nope.txt"], "No such file or directory: expected a readable file of paths"),
