@@ -37,6 +37,13 @@ The report directory also gets ``worst.gif`` (every checked frame of the
 worst case: candidate | oracle | diff), ``vertex_error.png`` and
 ``pixels.png`` (per-frame plots of every case).
 
+``--scene DIR`` (a folder of mesh files) and ``--scene-list FILE`` run a
+dataset: one task per mesh, a mesh that cannot be loaded counted and reported
+(it fails the run unless ``--allow-load-errors``), one summary
+(oracles/dataset_run.py, docs/datasets.md). ``--executor dask`` runs the
+cases or meshes on a Dask cluster: a local one of ``--jobs`` workers, or
+``--scheduler tcp://HOST:PORT``'s (oracles/executors.py); same report.
+
 ``crosscheck export DIR`` writes a rendering job for any renderer, and
 ``--candidate-frames DIR`` judges the renderer's own frames of it
 (oracles/frames_cli.py, docs/frames.md).
@@ -66,6 +73,7 @@ from . import gate, tolerances
 from .isolation import external_candidate
 from .subprocess_candidate import DEFAULT_TIMEOUT_S
 from .cases import ALL_CASE_NAMES, CASE_NAMES
+from .executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
@@ -95,7 +103,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"%(prog)s (wirecheck) {_version()}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", action="append", default=None,
-                   help="scene name or path; repeatable (default: every scene in scenes/)")
+                   help="scene name or path, or a folder of mesh files (a dataset, walked recursively); "
+                        "repeatable (default: every scene in scenes/)")
+    p.add_argument("--scene-list", action="append", default=None, metavar="FILE",
+                   help="a dataset: mesh file paths, one per line ('#' comments, blank lines; relative to FILE's "
+                        "folder); repeatable (default: none)")
+    p.add_argument("--allow-load-errors", action="store_true", default=False,
+                   help="dataset runs: a mesh that cannot be loaded is reported and counted but does not fail "
+                        "the run (default: it fails the run)")
     p.add_argument("--frames", type=int, default=None,
                    help="frames of the scene's motion per case (default 24; 12 with --sweep)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} "
@@ -126,6 +141,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="check frames 1, 1+K, 1+2K, ... of the motion (default 1: every frame)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="run the cases in N worker processes (default 1; same report for any N)")
+    p.add_argument("--executor", choices=EXECUTORS, default=None,
+                   help="local: this process or --jobs worker processes; dask: Dask distributed, a local "
+                        "cluster of --jobs workers on 127.0.0.1 or --scheduler's cluster (default local)")
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                   help="the Dask scheduler of a cluster (docs/datasets.md); implies --executor dask "
+                        "(default: none, a local cluster)")
+    p.add_argument("--scheduler-timeout", type=float, default=DEFAULT_CONNECT_TIMEOUT_S, metavar="SECONDS",
+                   help=f"seconds to reach --scheduler and see a worker (default {DEFAULT_CONNECT_TIMEOUT_S:g})")
     p.add_argument("--dtype", choices=CoreCandidate.DTYPES, default=None,
                    help="core candidate only: floating-point type of the pipeline (default float64)")
     p.add_argument("--clip", choices=CoreCandidate.CLIPS, default=None,
@@ -178,6 +201,8 @@ def _parse(args):
         args.frames = 12 if args.sweep else 24
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs}: expected an integer >= 1")
+    args.executor_spec = _executor(args)
+    args.dataset = _dataset(args)
     level = args.level or "pixels"
     if args.oracles is not None:
         oracles = [o.strip() for o in args.oracles.split(",") if o.strip()]
@@ -242,7 +267,11 @@ def _parse(args):
     if args.suite:       # fixed cases and bounds (checked above): nothing of a run's inputs applies
         return level, None, None, mode, tol
     # the library's one check of what a run compares (oracles.gate), in the CLI's option names
-    inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
+    if args.dataset is not None:      # the meshes are read where they are checked (oracles.dataset_run)
+        inputs = gate.run_settings(args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
+    else:
+        inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol,
+                                 names=gate.CLI_NAMES)
     if mode.cull == "backface":
         wound = next((sc for sc in inputs.scenes if sc.faces and sc.winding_note), None)
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
@@ -253,6 +282,55 @@ def _parse(args):
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
     return level, inputs, candidate, mode, tol
+
+
+def _executor(args) -> ExecutorSpec:
+    """The executor of ``--executor``, ``--jobs``, ``--scheduler``; InputError for a contradiction."""
+    kind = args.executor or ("dask" if args.scheduler is not None else "local")
+    if args.scheduler is not None:
+        if kind != "dask":
+            raise InputError(f"--scheduler {args.scheduler!r} with --executor {kind}: a scheduler is Dask's: "
+                             "expected --executor dask (or no --executor)")
+        if args.jobs != 1:
+            raise InputError(f"--jobs {args.jobs} with --scheduler: the cluster's workers are those started with "
+                             "'dask worker': expected no --jobs")
+        check_scheduler_address(args.scheduler)
+    if not (math.isfinite(args.scheduler_timeout) and args.scheduler_timeout > 0):
+        raise InputError(f"--scheduler-timeout {args.scheduler_timeout}: expected a number of seconds > 0")
+    if args.scheduler is None and args.scheduler_timeout != DEFAULT_CONNECT_TIMEOUT_S:
+        raise InputError(f"--scheduler-timeout {args.scheduler_timeout:g} without --scheduler: it bounds reaching "
+                         "a cluster's scheduler: expected --scheduler tcp://HOST:PORT")
+    if kind == "dask" and (args.sweep or args.suite or args.candidate_frames is not None):
+        what = "--sweep" if args.sweep else f"--suite {args.suite}" if args.suite else "--candidate-frames"
+        raise InputError(f"--executor dask with {what}: expected it in a plain crosscheck run or a dataset run")
+    return ExecutorSpec(kind=kind, jobs=args.jobs, scheduler=args.scheduler,
+                        connect_timeout_s=args.scheduler_timeout)
+
+
+def _dataset(args):
+    """The dataset of ``--scene DIR`` / ``--scene-list FILE`` (oracles.dataset), or None for a plain run."""
+    from wirecheck.core.scene_files import builtin_names, example_names
+
+    from .dataset import dataset_entries
+
+    scenes = args.scene or []
+    named = set(builtin_names() + example_names())      # a bundled name wins over a folder of that name
+    folders = [s for s in scenes if s not in named and Path(s).is_dir()]
+    if not folders and not args.scene_list:
+        if args.allow_load_errors:
+            raise InputError("--allow-load-errors without a dataset: expected --scene DIR or --scene-list FILE")
+        return None
+    if len(folders) != len(scenes):
+        other = next(s for s in scenes if s not in folders)
+        raise InputError(f"--scene {other!r} with a dataset (--scene DIR or --scene-list): expected only folders "
+                         "and lists (put single mesh files in a --scene-list)")
+    other = [opt for opt, given in (("--sweep", args.sweep), ("--suite", args.suite),
+                                    ("--candidate-frames", args.candidate_frames is not None),
+                                    ("--junit-xml", args.junit_xml is not None)) if given]
+    if other:
+        raise InputError(f"a dataset (--scene DIR or --scene-list) with {', '.join(other)}: expected a plain "
+                         "crosscheck run over the meshes")
+    return dataset_entries(folders, args.scene_list or [])
 
 
 def _run_dir(args) -> tuple[Path, str]:
@@ -333,6 +411,8 @@ def _main(argv=None) -> int:
         from .frames_cli import frames_main
 
         return frames_main(args, run_dir, from_config=set(applied))
+    if getattr(args, "dataset", None) is not None:
+        return _dataset_main(args, level, inputs, candidate, mode, tol, run_dir)
     if args.sweep:
         return _sweep(args, inputs, level, tol, run_dir)
     if args.suite:
@@ -344,11 +424,16 @@ def _main(argv=None) -> int:
                                         case_names=inputs.case_names, level=level, turns=inputs.turns, tol=tol,
                                         every=inputs.every, jobs=args.jobs, candidate_name=candidate.name,
                                         mode=mode, allow_vacuous=args.allow_vacuous,
-                                        progress=progress.update if progress.active else None)
+                                        progress=progress.update if progress.active else None,
+                                        executor=args.executor_spec)
     except InputError as exc:
         return _error(str(exc))
     except BrokenProcessPool as exc:
         return _error(f"a worker process died ({exc}); try --jobs 1")
+    except Exception as exc:
+        if args.executor_spec.kind != "dask":
+            raise
+        return _error(dask_failure(exc))
     finally:
         progress.close()
     report = {"run": args.run, **report}
@@ -388,6 +473,38 @@ def _vertex_limit(report: dict, tol) -> str:
     """``1e-06 px``, or, when a case's precision raised it, where to find the bounds."""
     bounds = {c.get("vertex_bound_px", tol.vertex_px) for c in report["cases"]}
     return f"{tol.vertex_px:g} px" if bounds <= {tol.vertex_px} else "the bound of the candidate's precision"
+
+
+def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
+    """A dataset run (oracles.dataset_run): progress, the report, the summary on stdout."""
+    from .dataset_report import DatasetProgress, console_summary, write_dataset_report
+    from .dataset_run import run_dataset
+
+    progress = DatasetProgress(sys.stderr)
+    try:
+        report = run_dataset(args.dataset, candidate, frames=inputs.frames, case_names=inputs.case_names,
+                             turns=inputs.turns, tol=tol, level=level, every=inputs.every, mode=mode,
+                             candidate_name=candidate.name, allow_vacuous=args.allow_vacuous,
+                             allow_load_errors=args.allow_load_errors, executor=args.executor_spec,
+                             progress=progress.update if progress.active else None)
+    except InputError as exc:
+        return _error(str(exc))
+    except BrokenProcessPool as exc:
+        return _error(f"a worker process died ({exc}); try --jobs 1")
+    except Exception as exc:
+        if args.executor_spec.kind != "dask":
+            raise
+        return _error(dask_failure(exc))
+    finally:
+        progress.close()
+    report = {"run": args.run, **report}
+    try:
+        write_dataset_report(run_dir, report)
+    except OSError as exc:
+        return _error(f"writing {str(run_dir)!r} failed: {exc}")
+    print(console_summary(report))
+    print(f"Report: {run_dir / 'report.json'} (also report.md)")
+    return 0 if report["verdict"] == "pass" else 1
 
 
 def _sweep(args, inputs, level, tol, run_dir) -> int:

@@ -24,6 +24,7 @@ either side, summed over frames; ``None`` at level vertices).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 from dataclasses import dataclass
@@ -134,6 +135,13 @@ def run_inputs(scenes, frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=N
     ``cases`` and ``turns`` may be comma-separated strings (as the CLI takes
     them). The cheap checks come first; scenes may be files to read.
     """
+    settings = run_settings(frames, every, cases, turns, tol, names)
+    return dataclasses.replace(settings, scenes=resolve_scenes(scenes, names))
+
+
+def run_settings(frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None,
+                 names: dict = API_NAMES) -> RunInputs:
+    """:func:`run_inputs` without the scenes (``scenes=()``): a dataset's meshes are checked as they load."""
     frames = _integer(frames, names["frames"], 1)
     if frames > MAX_FRAMES:
         raise InputError(f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (core/limits.py)")
@@ -151,8 +159,7 @@ def run_inputs(scenes, frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=N
     check_turns(turns, names["turns"])
     if tol is not None:
         check_tolerances(tol, names)
-    return RunInputs(scenes=resolve_scenes(scenes, names), frames=frames, every=every,
-                     case_names=resolve_cases(cases, names), turns=turns)
+    return RunInputs(scenes=(), frames=frames, every=every, case_names=resolve_cases(cases, names), turns=turns)
 
 
 # ---------------------------------------------------------------- verdicts

@@ -54,6 +54,7 @@ null at level vertices).
 from __future__ import annotations
 
 import math
+import threading
 import time
 from dataclasses import dataclass
 
@@ -67,6 +68,7 @@ from .case import CaseResult, run_case
 from .cases import Case, case_motion
 from .convert import model_matrix
 from .core_candidate import CoreCandidate, RenderMode
+from .executors import ExecutorSpec, gather_in_order, open_executor
 from .tolerances import Tolerances
 
 #: Oracle fidelity levels, cheapest first, and the oracles each one runs.
@@ -180,6 +182,7 @@ class _CaseRunner:
 
 
 _WORKER_RUNNER: _CaseRunner | None = None
+_WORKER_LOCK = threading.Lock()
 
 
 def _worker_init() -> None:
@@ -193,49 +196,57 @@ def _worker_init() -> None:
     Finalize(_WORKER_RUNNER, _WORKER_RUNNER.close, exitpriority=10)   # free the GL contexts at exit
 
 
+def worker_runner() -> _CaseRunner:
+    """This worker process's runner, made on first use (a Dask worker has no initializer)."""
+    if _WORKER_RUNNER is None:
+        _worker_init()
+    return _WORKER_RUNNER
+
+
 def _worker_run(scene: Scene, case: Case, params: _RunParams) -> CaseResult:
-    return _WORKER_RUNNER.run(scene, case, params)
+    with _WORKER_LOCK:      # a Dask worker may run tasks in several threads: one GL user at a time
+        return worker_runner().run(scene, case, params)
 
 
 def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None,
-               isolate: bool = False) -> tuple[list[CaseResult], int]:
+               isolate: bool = False, executor: ExecutorSpec | None = None) -> tuple[list[CaseResult], int]:
     """Results in task order, and the number of worker processes used (0: in this process).
 
     ``on_result(result)`` is called on each result as it is gathered, in task
     order (it may drop what it does not need to keep, e.g. frame images).
     ``isolate``: use a worker even for one job, so that the candidate cannot end this process.
+    ``executor`` (oracles.executors): where the tasks run (default: ``jobs`` local processes).
     """
     on_result = on_result or (lambda result: None)
-    workers = min(jobs, len(tasks))
-    if workers <= 1 and not isolate:
-        runner = _CaseRunner()
-        try:
-            results = []
-            for scene, case in tasks:
-                results.append(runner.run(scene, case, params))
-                on_result(results[-1])
-            return results, 0
-        finally:
-            runner.close()
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+    spec = executor or ExecutorSpec(jobs=jobs)
+    with open_executor(spec, len(tasks), initializer=_worker_init, isolate=isolate) as (pool, workers):
+        if pool is None:
+            runner = _CaseRunner()
+            try:
+                results = []
+                for scene, case in tasks:
+                    results.append(runner.run(scene, case, params))
+                    on_result(results[-1])
+                return results, 0
+            finally:
+                runner.close()
+        return gather_in_order(pool, _worker_run, [(scene, case, params) for scene, case in tasks], on_result), workers
 
-    # "spawn": a fresh interpreter per worker, so no OpenGL/OSMesa state or thread is inherited.
-    ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
-        futures = [pool.submit(_worker_run, scene, case, params) for scene, case in tasks]
-        try:
-            results = []
-            for i, f in enumerate(futures):
-                results.append(f.result())
-                futures[i] = None          # the future held the result too
-                on_result(results[-1])
-            return results, workers
-        except BaseException:
-            for f in futures:
-                if f is not None:
-                    f.cancel()
-            raise
+
+def scene_cases(scene: Scene, case_names, motion: Motion) -> list[Case]:
+    """The cases of ``scene`` named in ``case_names`` (framed on the scene, oracles.cases.cases_for).
+
+    InputError when no camera fits the scene.
+    """
+    from wirecheck.core.errors import InputError
+
+    from .cases import CASE_NAMES, cases_for
+
+    try:
+        cases = cases_for(scene, motion, calibrated=bool(set(case_names) - set(CASE_NAMES)))
+    except InputError as exc:
+        raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
+    return [case for case in cases if case.name in case_names]
 
 
 def _overall_ms(timing_cases: list[dict], key: str):
@@ -252,7 +263,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
                    *, level: str | None = None, every: int = 1, jobs: int = 1,
                    candidate_spec: str | None = None, mode: RenderMode | None = None,
                    animation: bool = True, allow_vacuous: bool = False, progress=None,
-                   isolate: bool = False) -> tuple[dict, dict]:
+                   isolate: bool = False, executor: ExecutorSpec | None = None) -> tuple[dict, dict]:
     """Every scene under every case camera: the report dict and the worst-frame images.
 
     ``level`` is "vertices" (OpenCV only) or "pixels" (OpenCV and pyrender, the
@@ -284,10 +295,10 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     worker processes even for ``jobs=1``: a candidate that ends its process
     (``os._exit(0)``) raises BrokenProcessPool here instead of ending the run
     with status 0; the candidate must then be given as ``candidate_spec``.
+    ``executor`` (:class:`oracles.executors.ExecutorSpec`) sends the cases to
+    a Dask cluster instead (same report; ``jobs`` is then the spec's).
     """
     from wirecheck.core.errors import InputError
-
-    from .cases import CASE_NAMES, cases_for
 
     if oracles is not None:
         implied = level_for_oracles(oracles)
@@ -310,13 +321,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     frames, every = inputs.frames, inputs.every
     motion = Motion(turns=inputs.turns)
     t_run = time.perf_counter()
-    tasks = []
-    for scene in inputs.scenes:
-        try:
-            scene_cases = cases_for(scene, motion, calibrated=bool(set(inputs.case_names) - set(CASE_NAMES)))
-        except InputError as exc:
-            raise InputError(f"{scene.source}: no camera fits this scene ({exc})") from None
-        tasks += [(scene, case) for case in scene_cases if case.name in inputs.case_names]
+    tasks = [(scene, case) for scene in inputs.scenes for case in scene_cases(scene, inputs.case_names, motion)]
     if level == "pixels" and tasks and all(case.camera.distortion is not None for _, case in tasks):
         raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their pixels "
                          "are not compared (GL draws straight lines), so the run would compare no pixel; "
@@ -340,7 +345,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
 
     if progress:
         progress(0, len(tasks), 0, n_frames)
-    results, workers = _run_tasks(tasks, params, jobs, on_result=on_result, isolate=isolate)
+    results, workers = _run_tasks(tasks, params, jobs, on_result=on_result, isolate=isolate, executor=executor)
 
     records, images, timing_cases = [], {}, []
     gl = next((r.gl_info for r in results if r.gl_info is not None), None)   # one driver per machine
@@ -373,7 +378,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     if level == "pixels":
         for key in ("candidate_draw_ms_per_frame", "pyrender_ms_per_frame", "pixel_metrics_ms_per_frame"):
             timing[key] = _overall_ms(timing_cases, key)
-    timing.update({"jobs": jobs, "workers": workers, "wall_s": time.perf_counter() - t_run,
+    timing.update({"executor": executor.kind if executor else "local", "jobs": jobs, "workers": workers, "wall_s": time.perf_counter() - t_run,
                    "cases": timing_cases})
     summary = {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
                "vacuous": vacuous,

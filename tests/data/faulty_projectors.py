@@ -16,3 +16,12 @@ def crashes(points, camera):
 
 def wrong_shape(points, camera):
     return np.zeros((len(points), 3))
+
+
+def offset_when_large(points, camera):
+    """Correct for points within 1.5 of the origin, half a pixel off (the pixel-corner mistake) when any is
+    farther: a candidate that fails the large meshes of a dataset and passes the small ones
+    (tests/test_dataset.py; rotations about the origin keep a point's distance)."""
+    if len(points) == 0 or np.max(np.linalg.norm(points, axis=1)) <= 1.5:
+        return project(points, camera)
+    return project(points, camera, cx=camera.width / 2, cy=camera.height / 2)
