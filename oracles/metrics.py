@@ -76,7 +76,6 @@ class FramePixels:
         self.oracle_idx = np.flatnonzero(oracle)
         self.cand_in_oracle = oracle.reshape(-1)[self.cand_idx]
         self.oracle_in_cand = cand.reshape(-1)[self.oracle_idx]
-        self._codes = {}
 
     @property
     def both(self) -> int:
@@ -91,35 +90,33 @@ class FramePixels:
         """Flat indices of the pixels drawn by either image, ascending."""
         return np.sort(np.concatenate([self.cand_idx, self.oracle_idx[~self.oracle_in_cand]]))
 
-    def _padded_codes(self, tol: int):
-        """``(codes, width)``: a flat uint8 image padded by ``tol`` (1: candidate drew, 2: oracle drew)."""
-        if tol not in self._codes:
-            h, w = self.shape
-            w_pad = w + 2 * tol
-            codes = np.zeros((h + 2 * tol) * w_pad, np.uint8)
-            for bit, idx in ((1, self.cand_idx), (2, self.oracle_idx)):
-                codes[(idx // w + tol) * w_pad + idx % w + tol] |= bit
-            self._codes[tol] = codes, w_pad
-        return self._codes[tol]
-
     def within(self, tol: int, of_candidate: bool = True) -> np.ndarray:
         """For each drawn pixel of one image (row-major): is a pixel of the other within ``tol`` (Chebyshev)?
 
         ``of_candidate``: the candidate's pixels against the oracle's (else the
-        reverse). ``(2 tol + 1)^2`` lookups per drawn pixel in a copy of both
-        images padded by ``tol`` (outside the image counts as not drawn).
+        reverse). ``(2 tol + 1)^2`` lookups per drawn pixel in the other image,
+        or, when some drawn pixel is within ``tol`` of the image's border, in
+        a copy of it padded by ``tol`` (outside the image counts as not drawn).
         """
         if tol == 0:
             return self.cand_in_oracle if of_candidate else self.oracle_in_cand
-        idx, other = (self.cand_idx, 2) if of_candidate else (self.oracle_idx, 1)
+        idx, other, other_idx = ((self.cand_idx, self.oracle, self.oracle_idx) if of_candidate
+                                 else (self.oracle_idx, self.cand, self.cand_idx))
         if len(idx) == 0:
             return np.zeros(0, bool)
-        codes, w_pad = self._padded_codes(tol)
-        w = self.shape[1]
-        centre = (idx // w + tol) * w_pad + idx % w + tol          # each pixel's index in the padded image
+        h, w = self.shape
+        rows = idx // w
+        cols = idx - rows * w
+        if rows[0] >= tol and rows[-1] < h - tol and cols.min() >= tol and cols.max() < w - tol:
+            flat, w_look, centre = other.reshape(-1), w, idx
+        else:                      # a window crosses the border: look up in a padded copy
+            w_look = w + 2 * tol
+            flat = np.zeros((h + 2 * tol) * w_look, bool)
+            flat[other_idx + (other_idx // w) * 2 * tol + tol * w_look + tol] = True
+            centre = idx + rows * 2 * tol + tol * w_look + tol
         offs = np.arange(-tol, tol + 1)
-        window = (offs[:, None] * w_pad + offs[None, :]).ravel()
-        return (codes[centre[:, None] + window[None, :]] & other).any(axis=1)
+        window = (offs[:, None] * w_look + offs[None, :]).ravel()
+        return flat[window[:, None] + centre[None, :]].any(axis=0)
 
 
 def _within(mask_from: np.ndarray, mask_to: np.ndarray, tol: int) -> np.ndarray:
@@ -351,16 +348,14 @@ def balance_scores(candidate_only: int, oracle_only: int, oracle_pixels: int) ->
 def _clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
     """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
     d = p1 - p0
-    t0 = np.zeros(len(p0))
-    t1 = np.ones(len(p0))
-    keep = np.all(np.isfinite(p0) & np.isfinite(p1), axis=1)
+    # the four boundaries at once: p t <= q for (x >= lo_x, y >= lo_y, x <= hi_x, y <= hi_y)
+    p = np.concatenate([-d, d], axis=1)
+    q = np.concatenate([p0 - lo, hi - p0], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        for axis in range(2):
-            for p, q in ((-d[:, axis], p0[:, axis] - lo[axis]), (d[:, axis], hi[axis] - p0[:, axis])):
-                r = q / p
-                keep &= ~((p == 0) & (q < 0))
-                t0 = np.where(p < 0, np.maximum(t0, r), t0)
-                t1 = np.where(p > 0, np.minimum(t1, r), t1)
+        r = q / p
+        keep = np.isfinite(p0 + p1).all(axis=1) & ~((p == 0) & (q < 0)).any(axis=1)
+        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))     # entering: the last boundary
+        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))      # leaving: the first
     keep &= t0 <= t1
     return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d
 
@@ -430,8 +425,9 @@ def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height
         drawn[pixels] = True
         drawn = drawn[cy * width + cx]
         cx, cy, sid = cx[drawn], cy[drawn], sid[drawn]
-    flat = np.unique(sid * (width * height) + cy * width + cx)      # (segment, pixel) pairs, once each
-    sid, pix = flat // (width * height), flat % (width * height)
+    n_seg = len(ids)
+    flat = np.unique((cy * width + cx) * n_seg + sid)      # (pixel, segment) pairs, once each, pixel-major
+    pix, sid = flat // n_seg, flat % n_seg
     return _nearest_segment(ids, q0, q1, sid, pix, width, radius)
 
 
@@ -442,16 +438,19 @@ def _pairs_by_box(pixels: np.ndarray, q0: np.ndarray, q1: np.ndarray, width: int
     1/2 px, against rounding); :func:`_nearest_segment` keeps the near ones.
     """
     grow = radius + 0.5
-    lo, hi = np.minimum(q0, q1) - grow, np.maximum(q0, q1) + grow
-    x = (pixels % width).astype(np.float64)[:, None]
-    y = (pixels // width).astype(np.float64)[:, None]
-    hit = (x >= lo[:, 0]) & (x <= hi[:, 0]) & (y >= lo[:, 1]) & (y <= hi[:, 1])
+    # whole pixels: x >= lo exactly when x >= ceil(lo); x - lo in [0, span] as one unsigned compare
+    lo = np.ceil(np.minimum(q0, q1) - grow).astype(np.int64)
+    span = (np.floor(np.maximum(q0, q1) + grow).astype(np.int64) - lo).astype(np.uint64)
+    y = pixels // width
+    x = pixels - y * width
+    hit = (((x[:, None] - lo[:, 0]).astype(np.uint64) <= span[:, 0])
+           & ((y[:, None] - lo[:, 1]).astype(np.uint64) <= span[:, 1]))
     p, s = np.nonzero(hit)
     return s, pixels[p]
 
 
 def _nearest_segment(ids, q0, q1, sid, pix, width: int, radius: float):
-    """:func:`edge_neighbourhoods`' rows from candidate ``(segment, pixel)`` pairs (each pair once)."""
+    """:func:`edge_neighbourhoods`' rows from candidate ``(segment, pixel)`` pairs (each once, pixel-major)."""
     d_seg = q1 - q0
     dd_seg = d_seg[:, 0] * d_seg[:, 0] + d_seg[:, 1] * d_seg[:, 1]
     # the point of the segment nearest the pixel centre: a + u d, u in [0, 1]
@@ -462,12 +461,19 @@ def _nearest_segment(ids, q0, q1, sid, pix, width: int, radius: float):
     dist = np.hypot(ex - u * dx, ey - u * dy)
     near = np.flatnonzero(dist <= radius)
     # each pixel to its nearest segment only (ties: the lower index), so that
-    # one pixel more or less changes one edge's count by at most one
-    order = near[np.lexsort((sid[near], dist[near], pix[near]))]
-    first = np.ones(len(order), bool)                  # (np.r_[True, ...] would be 1 long with no pairs)
-    first[1:] = pix[order[1:]] != pix[order[:-1]]
-    keep = order[first]
-    sid, pix = sid[keep], pix[keep]
+    # one pixel more or less changes one edge's count by at most one; only
+    # pixels near several segments need the choice (the pairs are pixel-major)
+    shared = pix[near[1:]] == pix[near[:-1]]
+    if shared.any():
+        several = np.zeros(len(near), bool)
+        several[1:] |= shared
+        several[:-1] |= shared
+        multi = near[several]
+        order = multi[np.lexsort((sid[multi], dist[multi], pix[multi]))]
+        first = np.ones(len(order), bool)
+        first[1:] = pix[order[1:]] != pix[order[:-1]]
+        near = np.sort(np.concatenate([near[~several], order[first]]))   # back in pixel order
+    sid, pix = sid[near], pix[near]
     x_major = np.abs(d_seg[sid, 0]) > np.abs(d_seg[sid, 1])
     major = np.where(x_major, pix % width, pix // width)
     return ids[sid].astype(np.int64), pix.astype(np.int64), major.astype(np.int64)
