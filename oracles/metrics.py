@@ -10,7 +10,10 @@ drawn pixel within Chebyshev distance ``t`` (t = 1: its 3x3 neighbourhood).
 
 Two blank images agree perfectly (F1 = 1); one blank and one not give 0.
 
-(About 520 lines: every comparison of two projections or two frames lives
+A wireframe frame's metrics share one scan of each image (:class:`FramePixels`,
+:func:`frame_scores`); after it they work on the drawn pixels only.
+
+(About 630 lines: every comparison of two projections or two frames lives
 here, beside the conventions they share; the line gate's functions, from
 ``sign_test_p`` down, are the part to move out if it grows.)
 """
