@@ -178,16 +178,17 @@ def _nearest_on_segments(q: np.ndarray, a: np.ndarray, b: np.ndarray):
     dist = np.empty(len(q))
     which = np.empty(len(q), dtype=np.intp)
     ab = b - a
-    len2 = np.maximum((ab ** 2).sum(axis=1), 1e-300)
+    len2 = np.maximum(ab[:, 0] * ab[:, 0] + ab[:, 1] * ab[:, 1], 1e-300)
     step = max(1, 2_000_000 // max(len(a), 1))
     for k in range(0, len(q), step):
-        qq = q[k:k + step]
-        t = np.clip(((qq[:, None, :] - a[None]) * ab[None]).sum(axis=2) / len2[None], 0.0, 1.0)
-        foot = a[None] + t[..., None] * ab[None]
-        d2 = ((foot - qq[:, None, :]) ** 2).sum(axis=2)
+        qx, qy = q[k:k + step, 0:1], q[k:k + step, 1:2]          # (n, 1): against every segment at once
+        t = np.clip(((qx - a[:, 0]) * ab[:, 0] + (qy - a[:, 1]) * ab[:, 1]) / len2, 0.0, 1.0)
+        fx, fy = a[:, 0] + t * ab[:, 0], a[:, 1] + t * ab[:, 1]
+        dx, dy = fx - qx, fy - qy
+        d2 = dx * dx + dy * dy
         j = np.argmin(d2, axis=1)
-        rows = np.arange(len(qq))
-        out[k:k + step] = foot[rows, j]
+        rows = np.arange(len(qx))
+        out[k:k + step, 0], out[k:k + step, 1] = fx[rows, j], fy[rows, j]
         dist[k:k + step] = np.sqrt(d2[rows, j])
         which[k:k + step] = j
     return out, dist, which

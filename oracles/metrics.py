@@ -10,7 +10,10 @@ drawn pixel within Chebyshev distance ``t`` (t = 1: its 3x3 neighbourhood).
 
 Two blank images agree perfectly (F1 = 1); one blank and one not give 0.
 
-(About 520 lines: every comparison of two projections or two frames lives
+A wireframe frame's metrics share one scan of each image (:class:`FramePixels`,
+:func:`frame_scores`); after it they work on the drawn pixels only.
+
+(About 630 lines: every comparison of two projections or two frames lives
 here, beside the conventions they share; the line gate's functions, from
 ``sign_test_p`` down, are the part to move out if it grows.)
 """
@@ -48,53 +51,106 @@ def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
     return out
 
 
-def _within(mask_from: np.ndarray, mask_to: np.ndarray, tol: int) -> np.ndarray:
-    """For each True pixel of ``mask_from`` (row-major order): is a True pixel of ``mask_to`` within ``tol`` (Chebyshev)?
+class FramePixels:
+    """The drawn pixels of a candidate frame and the oracle's, found once and shared by one frame's metrics.
 
-    Works on the drawn pixels only: ``(2 tol + 1)^2`` lookups per pixel of
-    ``mask_from`` in a copy of ``mask_to`` padded by ``tol``, never a pass over
-    the whole image per offset (a wireframe covers under 1 % of it).
+    A wireframe covers under 1 % of an image, so each image is scanned once
+    (``np.flatnonzero``) and every metric after that (:func:`pixel_scores`,
+    :func:`line_scores`) works on the drawn pixels' indices: lookups, not
+    passes over the whole image.
+
+    Attributes
+    ----------
+    shape : (H, W)
+    cand_idx, oracle_idx : (Nc,), (No,) ndarray of intp
+        Flat indices ``y W + x`` of each image's drawn pixels, ascending (row-major).
+    cand_in_oracle, oracle_in_cand : (Nc,), (No,) ndarray of bool
+        Whether each drawn pixel is drawn in the other image too.
     """
-    if tol == 0:
-        return mask_to[mask_from]
-    rr, cc = np.nonzero(mask_from)
-    if len(rr) == 0:
-        return np.zeros(0, bool)
-    h, w = mask_to.shape
-    padded = np.zeros((h + 2 * tol, w + 2 * tol), bool)
-    padded[tol:tol + h, tol:tol + w] = mask_to
-    w_pad = w + 2 * tol
-    flat = padded.ravel()
-    centre = (rr + tol) * w_pad + (cc + tol)                # each pixel's index in the padded image
-    found = np.zeros(len(rr), bool)
-    for dy in range(-tol, tol + 1):
-        for dx in range(-tol, tol + 1):
-            found |= flat[centre + (dy * w_pad + dx)]
-    return found
+
+    def __init__(self, cand: np.ndarray, oracle: np.ndarray):
+        cand = np.asarray(cand, bool)
+        oracle = np.asarray(oracle, bool)
+        if cand.shape != oracle.shape:
+            raise ValueError(f"image shapes differ: {cand.shape} vs {oracle.shape}")
+        self.shape = cand.shape
+        self.cand, self.oracle = cand, oracle
+        self.cand_idx = np.flatnonzero(cand)
+        self.oracle_idx = np.flatnonzero(oracle)
+        self.cand_in_oracle = oracle.reshape(-1)[self.cand_idx]
+        self.oracle_in_cand = cand.reshape(-1)[self.oracle_idx]
+
+    @property
+    def both(self) -> int:
+        """Pixels drawn by both images."""
+        return int(np.count_nonzero(self.cand_in_oracle))
+
+    def only(self) -> tuple[np.ndarray, np.ndarray]:
+        """Flat indices of the candidate-only and the oracle-only pixels, ascending."""
+        return self.cand_idx[~self.cand_in_oracle], self.oracle_idx[~self.oracle_in_cand]
+
+    def drawn(self) -> np.ndarray:
+        """Flat indices of the pixels drawn by either image, ascending."""
+        return np.sort(np.concatenate([self.cand_idx, self.oracle_idx[~self.oracle_in_cand]]))
+
+    def within(self, tol: int, of_candidate: bool = True) -> np.ndarray:
+        """For each drawn pixel of one image (row-major): is a pixel of the other within ``tol`` (Chebyshev)?
+
+        ``of_candidate``: the candidate's pixels against the oracle's (else the
+        reverse). ``(2 tol + 1)^2`` lookups per drawn pixel in the other image,
+        or, when some drawn pixel is within ``tol`` of the image's border, in
+        a copy of it padded by ``tol`` (outside the image counts as not drawn).
+        """
+        if tol == 0:
+            return self.cand_in_oracle if of_candidate else self.oracle_in_cand
+        idx, other, other_idx = ((self.cand_idx, self.oracle, self.oracle_idx) if of_candidate
+                                 else (self.oracle_idx, self.cand, self.cand_idx))
+        if len(idx) == 0:
+            return np.zeros(0, bool)
+        h, w = self.shape
+        rows = idx // w
+        cols = idx - rows * w
+        if rows[0] >= tol and rows[-1] < h - tol and cols.min() >= tol and cols.max() < w - tol:
+            flat, w_look, centre = other.reshape(-1), w, idx
+        else:                      # a window crosses the border: look up in a padded copy
+            w_look = w + 2 * tol
+            flat = np.zeros((h + 2 * tol) * w_look, bool)
+            flat[other_idx + (other_idx // w) * 2 * tol + tol * w_look + tol] = True
+            centre = idx + rows * 2 * tol + tol * w_look + tol
+        offs = np.arange(-tol, tol + 1)
+        window = (offs[:, None] * w_look + offs[None, :]).ravel()
+        return flat[window[:, None] + centre[None, :]].any(axis=0)
+
+
+def _within(mask_from: np.ndarray, mask_to: np.ndarray, tol: int) -> np.ndarray:
+    """For each True pixel of ``mask_from`` (row-major order): is a True pixel of ``mask_to`` within ``tol`` (Chebyshev)?"""
+    return FramePixels(mask_from, mask_to).within(tol)
 
 
 #: The per-frame scores of :func:`pixel_scores` a case keeps, in report order.
 PIXEL_SCORE_KEYS = ("f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px")
 
 
-def pixel_scores(cand: np.ndarray, oracle: np.ndarray, tols=(0, 1)) -> dict:
-    """Precision, recall and F1 of ``cand`` against ``oracle`` (both (H, W) bool) at each tolerance."""
-    cand = np.asarray(cand, bool)
-    oracle = np.asarray(oracle, bool)
-    if cand.shape != oracle.shape:
-        raise ValueError(f"image shapes differ: {cand.shape} vs {oracle.shape}")
-    out = {"candidate_pixels": int(cand.sum()), "oracle_pixels": int(oracle.sum()),
-           "both_pixels": int((cand & oracle).sum())}
+def pixel_scores(cand: np.ndarray, oracle: np.ndarray, tols=(0, 1), pixels: FramePixels | None = None) -> dict:
+    """Precision, recall and F1 of ``cand`` against ``oracle`` (both (H, W) bool) at each tolerance.
+
+    ``pixels``: the frame's :class:`FramePixels`, when the caller has it (then
+    ``cand`` and ``oracle`` are not read).
+    """
+    fp = pixels if pixels is not None else FramePixels(cand, oracle)
+    n_cand, n_orac = len(fp.cand_idx), len(fp.oracle_idx)
+    out = {"candidate_pixels": n_cand, "oracle_pixels": n_orac, "both_pixels": fp.both}
     for t in tols:
-        if not cand.any() and not oracle.any():
+        if not n_cand and not n_orac:
             p = r = f1 = 1.0
-        elif not cand.any() or not oracle.any():
-            p = 1.0 if not cand.any() else 0.0
-            r = 1.0 if not oracle.any() else 0.0
+        elif not n_cand or not n_orac:
+            p = 1.0 if not n_cand else 0.0
+            r = 1.0 if not n_orac else 0.0
             f1 = 0.0
         else:
-            p = float(_within(cand, oracle, t).mean())
-            r = float(_within(oracle, cand, t).mean())
+            # a count over a length: the float the mean of the bool array gives
+            p = int(np.count_nonzero(fp.within(t, True))) / n_cand
+            r = int(np.count_nonzero(fp.within(t, False))) / n_orac
             f1 = 0.0 if p + r == 0 else 2 * p * r / (p + r)
         out[f"precision_{t}px"] = p
         out[f"recall_{t}px"] = r
@@ -295,22 +351,21 @@ def balance_scores(candidate_only: int, oracle_only: int, oracle_pixels: int) ->
 def _clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
     """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
     d = p1 - p0
-    t0 = np.zeros(len(p0))
-    t1 = np.ones(len(p0))
-    keep = np.all(np.isfinite(p0) & np.isfinite(p1), axis=1)
+    # the four boundaries at once: p t <= q for (x >= lo_x, y >= lo_y, x <= hi_x, y <= hi_y)
+    p = np.concatenate([-d, d], axis=1)
+    q = np.concatenate([p0 - lo, hi - p0], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        for axis in range(2):
-            for p, q in ((-d[:, axis], p0[:, axis] - lo[axis]), (d[:, axis], hi[axis] - p0[:, axis])):
-                r = q / p
-                keep &= ~((p == 0) & (q < 0))
-                t0 = np.where(p < 0, np.maximum(t0, r), t0)
-                t1 = np.where(p > 0, np.minimum(t1, r), t1)
+        r = q / p
+        keep = np.isfinite(p0 + p1).all(axis=1) & ~((p == 0) & (q < 0)).any(axis=1)
+        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))     # entering: the last boundary
+        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))      # leaving: the first
     keep &= t0 <= t1
     return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d
 
 
 def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
-                        radius: float = 1.0, mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                        radius: float = 1.0, mask: np.ndarray | None = None,
+                        pixels: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pixels near each segment: ``(edge, pixel, major)``, three ``(K,)`` int arrays.
 
     Pixel ``pixel`` (flat index ``y W + x``) belongs to segment ``edge``
@@ -327,7 +382,15 @@ def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height
     ``mask`` ((H, W) bool, optional) keeps only the pixels where it is True
     (the drawn ones, for :func:`edge_counts`): each pixel's nearest segment
     is decided among the same segments, so the kept pixels' rows are the
-    same as without it, for a fraction of the work.
+    same as without it, for a fraction of the work. ``pixels`` (ascending
+    flat indices, e.g. :meth:`FramePixels.drawn`) is the same as a mask True
+    at those pixels only.
+
+    Two ways, the same rows: from the segments (1-px steps along each, the
+    ``(2 reach + 1)^2`` pixels around each step; cost ~ total length), or,
+    given the drawn pixels, from them (each pixel against the segments whose
+    box, grown by the radius, holds it; cost ~ pixels x segments), whichever
+    is cheaper.
     """
     p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
     p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
@@ -345,6 +408,11 @@ def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height
     # axis) of the rounded point of some 1-px step along it
     length = np.max(np.abs(q1 - q0), axis=1)
     steps = np.ceil(length).astype(np.intp) + 1
+    if pixels is None and mask is not None:
+        pixels = np.flatnonzero(np.asarray(mask, bool))
+    if pixels is not None and len(pixels) * len(q0) <= (2 * reach + 1) ** 2 * int(steps.sum()):
+        sid, pix = _pairs_by_box(np.asarray(pixels, np.int64), q0, q1, width, radius)
+        return _nearest_segment(ids, q0, q1, sid, pix, width, radius)
     seg = np.repeat(np.arange(len(ids)), steps)
     t = (np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)) / np.maximum(steps - 1, 1)[seg]
     pts = q0[seg] + t[:, None] * (q1 - q0)[seg]
@@ -355,26 +423,61 @@ def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height
     sid = np.repeat(seg, ox.size)
     inside = (cx >= 0) & (cx < width) & (cy >= 0) & (cy < height)
     cx, cy, sid = cx[inside], cy[inside], sid[inside]
-    if mask is not None:
-        drawn = np.asarray(mask, bool).ravel()[cy * width + cx]
+    if pixels is not None:
+        drawn = np.zeros(width * height, bool)
+        drawn[pixels] = True
+        drawn = drawn[cy * width + cx]
         cx, cy, sid = cx[drawn], cy[drawn], sid[drawn]
-    flat = np.unique(sid * (width * height) + cy * width + cx)      # (segment, pixel) pairs, once each
-    sid, pix = flat // (width * height), flat % (width * height)
-    c = np.column_stack([pix % width, pix // width]).astype(np.float64)
-    a, d = q0[sid], (q1 - q0)[sid]
-    dd = (d * d).sum(axis=1)
+    n_seg = len(ids)
+    flat = np.unique((cy * width + cx) * n_seg + sid)      # (pixel, segment) pairs, once each, pixel-major
+    pix, sid = flat // n_seg, flat % n_seg
+    return _nearest_segment(ids, q0, q1, sid, pix, width, radius)
+
+
+def _pairs_by_box(pixels: np.ndarray, q0: np.ndarray, q1: np.ndarray, width: int, radius: float):
+    """``(segment, pixel)`` pairs, pixel-major: each pixel with every segment whose box grown by ``radius`` holds it.
+
+    A superset of the pairs within ``radius`` (the box is grown by a further
+    1/2 px, against rounding); :func:`_nearest_segment` keeps the near ones.
+    """
+    grow = radius + 0.5
+    # whole pixels: x >= lo exactly when x >= ceil(lo); x - lo in [0, span] as one unsigned compare
+    lo = np.ceil(np.minimum(q0, q1) - grow).astype(np.int64)
+    span = (np.floor(np.maximum(q0, q1) + grow).astype(np.int64) - lo).astype(np.uint64)
+    y = pixels // width
+    x = pixels - y * width
+    hit = (((x[:, None] - lo[:, 0]).astype(np.uint64) <= span[:, 0])
+           & ((y[:, None] - lo[:, 1]).astype(np.uint64) <= span[:, 1]))
+    p, s = np.nonzero(hit)
+    return s, pixels[p]
+
+
+def _nearest_segment(ids, q0, q1, sid, pix, width: int, radius: float):
+    """:func:`edge_neighbourhoods`' rows from candidate ``(segment, pixel)`` pairs (each once, pixel-major)."""
+    d_seg = q1 - q0
+    dd_seg = d_seg[:, 0] * d_seg[:, 0] + d_seg[:, 1] * d_seg[:, 1]
+    # the point of the segment nearest the pixel centre: a + u d, u in [0, 1]
+    ex, ey = (pix % width).astype(np.float64) - q0[sid, 0], (pix // width).astype(np.float64) - q0[sid, 1]
+    dx, dy, dd = d_seg[sid, 0], d_seg[sid, 1], dd_seg[sid]
     with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.clip(np.where(dd > 0, ((c - a) * d).sum(axis=1) / dd, 0.0), 0.0, 1.0)
-    dist = np.hypot(*(c - a - u[:, None] * d).T)
-    near = dist <= radius
-    sid, pix, dist, d = sid[near], pix[near], dist[near], d[near]
+        u = np.clip(np.where(dd > 0, (ex * dx + ey * dy) / dd, 0.0), 0.0, 1.0)
+    dist = np.hypot(ex - u * dx, ey - u * dy)
+    near = np.flatnonzero(dist <= radius)
     # each pixel to its nearest segment only (ties: the lower index), so that
-    # one pixel more or less changes one edge's count by at most one
-    order = np.lexsort((sid, dist, pix))
-    first = np.r_[True, pix[order][1:] != pix[order][:-1]]
-    keep = order[first]
-    sid, pix, d = sid[keep], pix[keep], d[keep]
-    x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
+    # one pixel more or less changes one edge's count by at most one; only
+    # pixels near several segments need the choice (the pairs are pixel-major)
+    shared = pix[near[1:]] == pix[near[:-1]]
+    if shared.any():
+        several = np.zeros(len(near), bool)
+        several[1:] |= shared
+        several[:-1] |= shared
+        multi = near[several]
+        order = multi[np.lexsort((sid[multi], dist[multi], pix[multi]))]
+        first = np.ones(len(order), bool)
+        first[1:] = pix[order[1:]] != pix[order[:-1]]
+        near = np.sort(np.concatenate([near[~several], order[first]]))   # back in pixel order
+    sid, pix = sid[near], pix[near]
+    x_major = np.abs(d_seg[sid, 0]) > np.abs(d_seg[sid, 1])
     major = np.where(x_major, pix % width, pix // width)
     return ids[sid].astype(np.int64), pix.astype(np.int64), major.astype(np.int64)
 
@@ -392,10 +495,12 @@ def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
     pixels near it by distance).
     """
     edge, pix, major = near
-    drawn = np.asarray(image, bool).ravel()[pix]
+    drawn = np.asarray(image, bool).reshape(-1)[pix]
     span = int(major.max()) + 1 if len(major) else 1
-    keys = np.unique(edge[drawn] * span + major[drawn])
-    return np.bincount(keys // span, minlength=n_edges)[:n_edges]
+    keys = np.sort(edge[drawn] * span + major[drawn])
+    distinct = np.ones(len(keys), bool)
+    distinct[1:] = keys[1:] != keys[:-1]
+    return np.bincount(keys[distinct] // span, minlength=n_edges)[:n_edges]
 
 
 def edge_count_scores(cand: np.ndarray, oracle: np.ndarray, near: tuple, n_edges: int) -> dict:
@@ -429,15 +534,19 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
     1.5 px from every segment: ``stray``). Returns
     ``{place: [candidate_only, oracle_only]}``.
     """
+    return _end_places(FramePixels(cand, oracle), p0_px, p1_px)
+
+
+def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
+    """:func:`end_attribution` of the frame whose drawn pixels are ``fp``."""
     out = {k: [0, 0] for k in ("start", "end", "middle", "stray")}
     p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
     p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
-    h, w = np.asarray(cand).shape
+    h, w = fp.shape
     ok, p0, p1 = _clip_segments(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
     p0, p1 = p0[ok], p1[ok]
-    for side, only in enumerate((np.asarray(cand, bool) & ~np.asarray(oracle, bool),
-                                 np.asarray(oracle, bool) & ~np.asarray(cand, bool))):
-        rr, cc = np.nonzero(only)
+    for side, only in enumerate(fp.only()):
+        rr, cc = only // w, only % w
         if len(rr) == 0:
             continue
         if len(p0) == 0:
@@ -463,26 +572,33 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
     return out
 
 
-def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
+def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray,
+                pixels: FramePixels | None = None) -> dict:
     """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
     rows: not drawn). Returns :func:`pixel_balance`'s fields,
     :func:`edge_count_scores`' (without the per-edge array) and ``ends``
-    (:func:`end_attribution`).
+    (:func:`end_attribution`). ``pixels``: the frame's :class:`FramePixels`,
+    when the caller has it.
     """
-    cand = np.asarray(cand, bool)
-    oracle = np.asarray(oracle, bool)
-    h, w = cand.shape
-    out = pixel_balance(cand, oracle)
-    out["oracle_pixels"] = int(oracle.sum())
-    near = edge_neighbourhoods(p0_px, p1_px, w, h, mask=cand | oracle)   # counts look at drawn pixels only
-    ec = edge_count_scores(cand, oracle, near, len(np.asarray(p0_px).reshape(-1, 2)))
+    fp = pixels if pixels is not None else FramePixels(cand, oracle)
+    h, w = fp.shape
+    both = fp.both
+    c, o = len(fp.cand_idx) - both, len(fp.oracle_idx) - both
+    out = {"candidate_only": c, "oracle_only": o, "imbalance": c - o, "oracle_pixels": len(fp.oracle_idx)}
+    near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=fp.drawn())    # counts look at drawn pixels only
+    ec = edge_count_scores(fp.cand, fp.oracle, near, len(np.asarray(p0_px).reshape(-1, 2)))
     del ec["edge_count_diffs"]
     out.update(ec)
-    out["ends"] = end_attribution(cand, oracle, p0_px, p1_px) if out["candidate_only"] + out["oracle_only"] else \
-        {k: [0, 0] for k in ("start", "end", "middle", "stray")}
+    out["ends"] = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray")}
     return out
+
+
+def frame_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray) -> tuple[dict, dict]:
+    """A wireframe frame's :func:`pixel_scores` and :func:`line_scores`, from one :class:`FramePixels`."""
+    fp = FramePixels(cand, oracle)
+    return pixel_scores(cand, oracle, pixels=fp), line_scores(cand, oracle, p0_px, p1_px, pixels=fp)
 
 
 def line_summary(frames: list) -> dict:

@@ -7,7 +7,11 @@ A test asks for the ``summary_section`` fixture and calls it with a title and a
 block of text; after the run, ``pytest_terminal_summary`` prints each block as
 its own section, so it appears in the plain ``python -m pytest -q`` output (no
 ``-s`` or ``-rA`` needed). Used by tests/test_diagnosis.py for its confusion
-matrix.
+matrix. The block travels in the test's report (``user_properties``), so it is
+printed under pytest-xdist too, where tests run in worker processes.
+
+Sharing expensive set-up (pyrender contexts, crosscheck runs) and keeping the
+suite fast: docs/testing.md.
 """
 
 from __future__ import annotations
@@ -17,30 +21,40 @@ import pytest
 # tests/test_pytest_plugin.py runs a user's pytest on a small project
 pytest_plugins = ["pytester"]
 
-_SECTIONS = pytest.StashKey[list]()
+_SECTION = "wirecheck_summary_section"      # the user_properties key of a summary block
+_SECTIONS: list[tuple[str, str]] = []       # gathered in the process that prints the summary
 
 
 @pytest.fixture
 def summary_section(request):
     """``summary_section(title, text)``: print ``text`` under ``title`` at the end of the run."""
-    sections = request.config.stash.setdefault(_SECTIONS, [])
 
     def add(title: str, text: str) -> None:
-        sections.append((title, text))
+        request.node.user_properties.append((_SECTION, (title, text)))
 
     return add
 
 
+def pytest_runtest_logreport(report):
+    # called for every test's report in the main process (xdist forwards the workers' reports)
+    if report.when == "call":
+        _SECTIONS.extend(tuple(value) for key, value in report.user_properties if key == _SECTION)
+
+
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
-    for title, text in config.stash.get(_SECTIONS, []):
+    for title, text in _SECTIONS:
         terminalreporter.write_sep("-", title)
         for line in text.splitlines():
             terminalreporter.write_line(line)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def pyrender_renderer():
-    """A 640x480 ``pyrender.OffscreenRenderer`` on OSMesa (skips the test where OSMesa is missing)."""
+    """A 640x480 ``pyrender.OffscreenRenderer`` on OSMesa, one per test process (skips the test where OSMesa is missing).
+
+    Shared by every test that asks: render into a ``pyrender.Scene`` of your own
+    and leave the renderer as you found it (no ``delete``, no viewport change).
+    """
     from wirecheck.oracles.pyrender_oracle import osmesa_available
 
     ok, msg = osmesa_available()
@@ -53,9 +67,13 @@ def pyrender_renderer():
     r.delete()
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def oracle():
-    """A 640x480 :class:`PyrenderOracle` (skips the test where OSMesa is missing)."""
+    """A 640x480 :class:`PyrenderOracle`, one per test process (skips the test where OSMesa is missing).
+
+    Shared by every test that asks (it keeps no state between calls that a
+    later call does not set again); do not close it.
+    """
     from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
 
     ok, msg = osmesa_available()
@@ -63,3 +81,14 @@ def oracle():
         pytest.skip(msg)
     with PyrenderOracle(640, 480) as o:
         yield o
+
+
+def pytest_collection_modifyitems(config, items):
+    """Test files holding a ``slow`` test run first (stable order otherwise).
+
+    With ``-n 2 --dist loadfile`` each file runs whole on one worker; starting
+    the longest files first keeps one worker from being left with a long file
+    at the end while the other is idle.
+    """
+    slow_files = {item.path for item in items if item.get_closest_marker("slow")}
+    items.sort(key=lambda item: item.path not in slow_files)

@@ -72,6 +72,7 @@ def test_hang_times_out_and_the_next_case_gets_a_fresh_process(tmp_path, capsys)
     assert second["verdict"] == "pass" and second["max_vertex_error_px"] < 1e-9
 
 
+@pytest.mark.slow
 def test_os_exit_0_as_a_real_process_exits_1_with_a_report(tmp_path):
     cand = tmp_path / "bye.py"
     cand.write_text("import os\ndef f(p, c):\n    os._exit(0)\n")

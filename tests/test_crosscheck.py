@@ -125,6 +125,7 @@ def test_tolerance_override_turns_pass_into_fail(tmp_path):
     assert "max vertex error" in report["cases"][0]["reasons"][0]
 
 
+@pytest.mark.slow
 def test_subprocess_prints_table_and_path(tmp_path):
     out = tmp_path / "sub"
     proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--scene", "cube", "--frames", "2",

@@ -119,6 +119,7 @@ def test_every_3_over_7_frames_checks_1_4_7_at_their_own_times(tmp_path):
 
 # ---------------------------------------------------------------- --jobs
 
+@pytest.mark.slow
 def test_jobs_2_gives_the_report_of_jobs_1(tmp_path):
     args = ("--scene", "cube", "--scene", "pyramid", "--frames", "3", "--cases", "on_axis,near_plane")
     code1, r1, out1 = run(tmp_path, *args, "--jobs", "1", name="j1")
@@ -137,6 +138,7 @@ def test_jobs_2_gives_the_report_of_jobs_1(tmp_path):
         assert (out1 / "img" / name).read_bytes() == (out2 / "img" / name).read_bytes()
 
 
+@pytest.mark.slow
 def test_file_candidate_runs_in_workers(tmp_path):
     # a faulty projector from a file outside sys.path: each worker starts its own candidate host
     args = ("--candidate", f"{USER}:project_corner", "--scene", "prism", "--frames", "2",

@@ -329,6 +329,7 @@ def test_run_crosscheck_refuses_modes_it_cannot_check():
         RenderMode(style="shaded", hidden_lines=True)
 
 
+@pytest.mark.slow
 def test_workers_get_the_drawing_mode(tmp_path):
     args = ("--style", "shaded", "--cull", "backface", "--scene", "cube", "--frames", "2",
             "--cases", "on_axis,oblique_roll")

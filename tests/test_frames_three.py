@@ -33,6 +33,8 @@ import pytest
 
 from wirecheck.oracles.cli import main
 
+pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
+
 TESTS = Path(__file__).parent
 SCRIPT = TESTS / "browser" / "frames_three.mjs"
 THREE = TESTS / "clients" / "three" / "node_modules" / "three" / "build" / "three.module.js"

@@ -433,6 +433,7 @@ def test_api_mesh_loading_is_quiet_too(tmp_path):
     assert (proc.stdout, proc.stderr) == ("3\n", "")
 
 
+@pytest.mark.slow
 def test_crosscheck_users_old_folder_survives_a_report_replace(tmp_path, capsys):
     args = ["--report-dir", str(tmp_path / "r"), "--scene", "cube", "--cases", "on_axis", "--level", "vertices",
             "--frames", "1"]

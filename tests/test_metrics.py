@@ -133,3 +133,49 @@ def test_one_pixel_match_on_drawn_pixels_equals_the_definition(seed):
     b[0, :] |= rng.random(w) < 0.5                  # lines along the border: the window is clipped there
     for tol in (0, 1, 2):
         np.testing.assert_array_equal(_within(a, b, tol), _within_naive(a, b, tol))
+
+
+def _neighbourhoods_naive(p0, p1, w, h, pixels, radius=1.0):
+    """The definition, pixel by pixel: the nearest segment within ``radius`` (ties: the lower index)."""
+    rows = []
+    for pix in pixels:
+        c = np.array([pix % w, pix // w], float)
+        best = None
+        for e, (a, b) in enumerate(zip(p0, p1)):
+            if not np.all(np.isfinite([a, b])):
+                continue
+            d = b - a
+            u = 0.0 if d @ d == 0 else min(max((c - a) @ d / (d @ d), 0.0), 1.0)
+            dist = np.linalg.norm(c - a - u * d)
+            if dist <= radius and (best is None or dist < best[0]):
+                best = (dist, e, pix % w if abs(d[0]) > abs(d[1]) else pix // w)
+        if best is not None:
+            rows.append((best[1], int(pix), int(best[2])))
+    return rows
+
+
+@pytest.mark.parametrize("seed", range(10))
+@pytest.mark.parametrize("density", [0.02, 0.6])
+def test_edge_neighbourhoods_of_drawn_pixels_equal_the_definition(seed, density):
+    # density 0.02: few drawn pixels, found from the pixels (pixels x segments); 0.6: from
+    # 1-px steps along the segments. Non-integer ends: no exact distance ties to decide.
+    from wirecheck.oracles.metrics import edge_neighbourhoods
+
+    rng = np.random.default_rng(seed)
+    w, h = 36, 24
+    p0 = rng.uniform(-3, 39, (10, 2))
+    p1 = p0 + rng.normal(0, 12, (10, 2))
+    p1[2] = p0[2] + 0.3                                   # a very short segment
+    p0[5] = np.nan                                        # an edge not drawn
+    pixels = np.flatnonzero(rng.random(w * h) < density)
+    got = edge_neighbourhoods(p0, p1, w, h, pixels=pixels)
+    assert list(zip(*(a.tolist() for a in got))) == _neighbourhoods_naive(p0, p1, w, h, pixels)
+    assert got[1].tolist() == sorted(got[1].tolist())     # one row per pixel, in pixel order
+
+
+def test_line_scores_with_nothing_drawn_near_an_edge_on_screen():
+    from wirecheck.oracles.metrics import line_scores
+
+    blank = np.zeros((24, 36), bool)
+    s = line_scores(blank, blank, np.array([[2.0, 3.0]]), np.array([[30.0, 20.0]]))
+    assert (s["candidate_only"], s["oracle_only"], s["edges_compared"], s["edge_count_max_diff"]) == (0, 0, 0, 0)

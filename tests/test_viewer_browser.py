@@ -28,6 +28,8 @@ from wirecheck.core.pipeline import render_frame
 from wirecheck.core.transforms import Motion
 from wirecheck.core.viewer import DOLLY_PER_UNIT, STAGES, Server, Viewer
 
+pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
+
 BROWSER_DIR = Path(__file__).parent / "browser"
 CHROMIUM = os.environ.get("WIRECHECK_CHROMIUM", "/usr/bin/chromium")
 F60 = 240.0 * math.sqrt(3.0)
