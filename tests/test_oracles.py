@@ -212,3 +212,33 @@ def test_pyrender_faces_hide_back_edges(oracle):
     # ~ 9.5e-6 at depth 4 (near 0.1, far 100). Allow 4 units.
     unit = 16.0 * (100.0 - 0.1) / (100.0 * 0.1) * 2.0 ** -24
     assert depth[240, 320] == pytest.approx(4.0, abs=4 * unit)
+
+
+def test_opencv_oracle_conversion_cache_follows_the_camera():
+    # The oracle keeps the last camera's OpenCV conversion. Alternating two cameras must give
+    # each its own projection: compared with cv2.projectPoints called here directly on
+    # hand-built R, t, K (rows right, -up, forward; f = (H/2)/tan(fov/2); c = (W-1)/2, (H-1)/2).
+    import cv2
+    from scipy.spatial.transform import Rotation
+    from wirecheck.core.camera import look_at
+    from wirecheck.oracles import opencv_oracle
+
+    pts = np.array([[0.3, -0.2, 0.1], [-0.5, 0.4, -0.3]])
+    cams = [look_at((0, 0, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=60),
+            look_at((3, 1, 2), (0, 0, 0), (0, 1, 0), fov_y_deg=40, width=320, height=240)]
+
+    def by_hand(cam):
+        fwd = -np.asarray(cam.position) / np.linalg.norm(cam.position)
+        right = np.cross(fwd, (0, 1, 0)); right /= np.linalg.norm(right)
+        up = np.cross(right, fwd)
+        r = np.stack([right, -up, fwd])
+        f = (cam.height / 2) / np.tan(np.radians(cam.fov_y_deg) / 2)
+        k = np.array([[f, 0, (cam.width - 1) / 2], [0, f, (cam.height - 1) / 2], [0, 0, 1]])
+        out, _ = cv2.projectPoints(pts.reshape(-1, 1, 3), Rotation.from_matrix(r).as_rotvec(),
+                                   -r @ np.asarray(cam.position), k, np.zeros(5))
+        return out.reshape(-1, 2)
+
+    for cam in cams + cams[::-1] + cams:
+        # 1e-9 px: both sides are float64 projectPoints on matrices equal to ~1e-16 relative,
+        # at pixel magnitudes < 1e3
+        np.testing.assert_allclose(opencv_oracle.project(pts, cam), by_hand(cam), rtol=0, atol=1e-9)
