@@ -256,7 +256,8 @@ def test_huge_projected_coordinates_are_guard_band_clipped():
 
 # ---- speed ------------------------------------------------------------------
 
-def test_100k_triangles_at_640x480_well_under_a_second(summary_section):
+def test_100k_triangles_at_640x480_cover_the_image(summary_section):
+    # Its time is printed, not asserted: speed lives in benchmarks/ (bench_scale), not in timed tests.
     trimesh = pytest.importorskip("trimesh")
     ico = trimesh.creation.icosphere(subdivisions=6)                  # 81920 triangles
     faces = np.asarray(ico.faces)
@@ -271,7 +272,6 @@ def test_100k_triangles_at_640x480_well_under_a_second(summary_section):
     summary_section("zbuffer speed", f"rasterize_triangles: {len(faces)} triangles at 640x480, "
                     f"{int((face >= 0).sum())} pixels covered: {best * 1e3:.0f} ms (best of 3)")
     assert (face >= 0).sum() > 100_000
-    assert best < 1.0
 
 
 # ---- against pyrender ---------------------------------------------------------
