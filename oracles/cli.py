@@ -418,24 +418,15 @@ def _main(argv=None) -> int:
     if args.suite:
         return _suite(level, run_dir)
     progress = TerminalProgress(sys.stderr)
-    try:
-        # an external candidate runs in its own process already (oracles.isolation): no worker needed
-        report, images = run_crosscheck(inputs.scenes, candidate, frames=inputs.frames,
-                                        case_names=inputs.case_names, level=level, turns=inputs.turns, tol=tol,
-                                        every=inputs.every, jobs=args.jobs, candidate_name=candidate.name,
-                                        mode=mode, allow_vacuous=args.allow_vacuous,
-                                        progress=progress.update if progress.active else None,
-                                        executor=args.executor_spec)
-    except InputError as exc:
-        return _error(str(exc))
-    except BrokenProcessPool as exc:
-        return _error(f"a worker process died ({exc}); try --jobs 1")
-    except Exception as exc:
-        if args.executor_spec.kind != "dask":
-            raise
-        return _error(dask_failure(exc))
-    finally:
-        progress.close()
+    # an external candidate runs in its own process already (oracles.isolation): no worker needed
+    result, status = _run_guarded(args, progress, lambda: run_crosscheck(
+        inputs.scenes, candidate, frames=inputs.frames, case_names=inputs.case_names, level=level,
+        turns=inputs.turns, tol=tol, every=inputs.every, jobs=args.jobs, candidate_name=candidate.name,
+        mode=mode, allow_vacuous=args.allow_vacuous, progress=progress.update if progress.active else None,
+        executor=args.executor_spec))
+    if status is not None:
+        return status
+    report, images = result
     report = {"run": args.run, **report}
     records = report["cases"]
     try:
@@ -469,6 +460,27 @@ def _main(argv=None) -> int:
     return 0 if report["verdict"] == "pass" else 1
 
 
+def _run_guarded(args, progress, run):
+    """``(run(), None)``, or ``(None, exit status)`` with its failure as one error line; closes ``progress``.
+
+    A bad input, a dead worker process and (on Dask) a failed task or cluster
+    are the user's to fix; anything else on the local executor is a bug and
+    propagates (core.guard logs it).
+    """
+    try:
+        return run(), None
+    except InputError as exc:
+        return None, _error(str(exc))
+    except BrokenProcessPool as exc:
+        return None, _error(f"a worker process died ({exc}); try --jobs 1")
+    except Exception as exc:
+        if args.executor_spec.kind != "dask":
+            raise
+        return None, _error(dask_failure(exc))
+    finally:
+        progress.close()
+
+
 def _vertex_limit(report: dict, tol) -> str:
     """``1e-06 px``, or, when a case's precision raised it, where to find the bounds."""
     bounds = {c.get("vertex_bound_px", tol.vertex_px) for c in report["cases"]}
@@ -481,22 +493,13 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
     from .dataset_run import run_dataset
 
     progress = DatasetProgress(sys.stderr)
-    try:
-        report = run_dataset(args.dataset, candidate, frames=inputs.frames, case_names=inputs.case_names,
-                             turns=inputs.turns, tol=tol, level=level, every=inputs.every, mode=mode,
-                             candidate_name=candidate.name, allow_vacuous=args.allow_vacuous,
-                             allow_load_errors=args.allow_load_errors, executor=args.executor_spec,
-                             progress=progress.update if progress.active else None)
-    except InputError as exc:
-        return _error(str(exc))
-    except BrokenProcessPool as exc:
-        return _error(f"a worker process died ({exc}); try --jobs 1")
-    except Exception as exc:
-        if args.executor_spec.kind != "dask":
-            raise
-        return _error(dask_failure(exc))
-    finally:
-        progress.close()
+    report, status = _run_guarded(args, progress, lambda: run_dataset(
+        args.dataset, candidate, frames=inputs.frames, case_names=inputs.case_names, turns=inputs.turns,
+        tol=tol, level=level, every=inputs.every, mode=mode, candidate_name=candidate.name,
+        allow_vacuous=args.allow_vacuous, allow_load_errors=args.allow_load_errors, executor=args.executor_spec,
+        progress=progress.update if progress.active else None))
+    if status is not None:
+        return status
     report = {"run": args.run, **report}
     try:
         write_dataset_report(run_dir, report)
