@@ -99,6 +99,10 @@ def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
 
     box = box_of(world_points(s.scene, s.motion, 1, s.frames))        # at rest, with --scale/--translate
     depth = box["z_front"] - box["z_back"]
+    if not (depth > 0 and box["half_width"] > 0):      # the widths and their ratio would divide by zero
+        raise InputError(f"--compare: scene {s.scene.name!r} at rest spans x up to {box['half_width']:g} and z from "
+                         f"{box['z_back']:g} to {box['z_front']:g}: expected a scene with width in x and depth in z "
+                         "(the comparison measures its front and back widths)")
     for d in distances:
         if not d - box["z_front"] > s.camera.near:
             raise InputError(f"--compare-z {d:g}: the scene's front (z = {box['z_front']:g}) must be beyond the "

@@ -75,3 +75,17 @@ def test_bad_compare_input(tmp_path, args, needle):
     rc, _, err = run(args, tmp_path)
     assert rc == 2 and needle in err and err.count("\n") == 1
     assert not (tmp_path / "cube-compare.png").exists()
+
+
+@pytest.mark.parametrize("verts, what", [
+    ("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n", "flat in z"),     # no depth: front width = back width
+    ("v 0 -1 -1\nv 0 1 -1\nv 0 1 1\nv 0 -1 1\n", "flat in x"),     # no width: nothing to measure
+])
+def test_compare_on_a_scene_without_width_or_depth_is_one_error_line(tmp_path, verts, what):
+    # Found by the renderer fuzz: such a scene divided by zero (exit 3) in the predicted widths.
+    mesh = tmp_path / "flat.obj"
+    mesh.write_text(verts + "f 1 2 3 4\n")
+    rc, out, err = run(["--scene", str(mesh), "--compare"], tmp_path / "out")
+    assert rc == 2, what
+    assert "--compare: scene 'flat'" in err and "expected a scene with width in x and depth in z" in err
+    assert err.count("\n") == 1 and not (tmp_path / "out").exists()
