@@ -167,13 +167,15 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         acc.seconds["draw"] += own_draw
         acc.seconds["hdraw"] += t4 - t3 - own_draw
         t5 = time.perf_counter()
+        projected = oracle_px                          # OpenCV's pixels of every point, for the oracle's segments
         if precision != "float64":
             cand_px, oracle_px = forgive_depth_ties(acc, setup, geometry[0], cand_px, oracle_px, precision)
         frame_rec = vertex_stage(acc, k, cand_px, oracle_px)
         acc.scale = max(acc.scale, tolerances.vertex_scale(geometry[0], oracle_px, setup.cam, setup.cv_matrices))
         t6 = acc.add("vmetric", t5)
         if setup.pixels:
-            pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6)
+            pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6,
+                        projected)
     rec = case_record(setup, acc, tol)
     if setup.pixels_skipped:
         rec["note"] = PIXELS_NOT_COMPARED
@@ -257,8 +259,11 @@ def vertex_stage(acc: CaseFrames, k: int, cand_px: np.ndarray, oracle_px: np.nda
 
 
 def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geometry, cand_img, cand_depth,
-                pyrender_oracle, want_images: bool, t0: float) -> None:
-    """pyrender's frame ``k`` against the candidate's: scores into ``frame_rec`` and ``acc`` (time from ``t0``)."""
+                pyrender_oracle, want_images: bool, t0: float, oracle_px: np.ndarray | None = None) -> None:
+    """pyrender's frame ``k`` against the candidate's: scores into ``frame_rec`` and ``acc`` (time from ``t0``).
+
+    ``oracle_px``: OpenCV's pixels of the frame's world points, when the vertex stage has them.
+    """
     p_world, matrices, pr_vertices, pr_pose = geometry
     mode, cam, scene = setup.mode, setup.cam, setup.scene
     mirrored = (oface.mirrored_vertices(scene, matrices) if setup.use_faces and mode.cull == "backface"
@@ -289,7 +294,7 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
             key = None
     else:
         draw_edges, occluders = setup.edges, None
-        seg0, seg1 = oracle_segments(p_world, setup.edges, cam)      # where the oracle's lines lie
+        seg0, seg1 = oracle_segments(p_world, setup.edges, cam, oracle_px)      # where the oracle's lines lie
         if setup.use_faces and mode.cull == "backface":
             kept = setup.owners.kept(oface.front_faces(p_world, setup.faces, cam, mirrored))
             draw_edges = setup.edges[kept]

@@ -18,6 +18,7 @@ x right, y down, z forward; pyrender's (OpenGL's) is x right, y up, z backward.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 
@@ -360,8 +361,21 @@ def model_matrix(turns, offset, scale: float, t: float, pivot=(0.0, 0.0, 0.0)) -
 
     Returns
     -------
-    (4, 4) ndarray
+    (4, 4) ndarray, the caller's own (a copy of the memoised matrix).
     """
+    # keyed on the floats' bytes: -0.0 and 0.0 stay apart, a NaN finds itself
+    key = np.concatenate([np.ravel(turns), np.ravel(offset), [scale, t], np.ravel(pivot)]).astype(np.float64)
+    return _model_matrix(key.tobytes()).copy()
+
+
+@functools.lru_cache(maxsize=4096)
+def _model_matrix(key: bytes) -> np.ndarray:
+    """:func:`model_matrix` memoised on its arguments' float64 bytes: every camera of a scene asks for the
+    same frames' matrices, and scipy's ``Rotation`` costs ~0.1 ms a call (4,096 entries of 128 B)."""
+    v = np.frombuffer(key, dtype=np.float64)
+    if len(v) != 11:
+        raise ValueError(f"model_matrix: turns, offset and pivot take 3 values each, got {len(v) - 2} in all")
+    turns, offset, scale, t, pivot = v[0:3], v[3:6], v[6], v[7], v[8:11]
     ax, ay, az = (2.0 * math.pi * ((t * float(k)) % 1.0) for k in turns)
     m = np.eye(4)
     m[:3, :3] = Rotation.from_euler("xyz", [ax, ay, az]).as_matrix() * float(scale)

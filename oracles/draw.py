@@ -90,18 +90,32 @@ def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera, precisi
     return image
 
 
-def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera) -> tuple[np.ndarray, np.ndarray]:
+def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera,
+                    p_px: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(E, 2)`` twice: each edge's ends in pixels by OpenCV, clipped to [near, far] in depth; NaN if none left.
 
     The oracle's float64 picture of where each line lies, for attributing
     drawn pixels to edges (:func:`oracles.metrics.line_scores`).
+    ``p_px``: ``opencv_oracle.project(p_world, camera)``, when the caller has
+    it; an edge whose two ends are both in [near, far] then takes its ends
+    from it, and only the edges the depth planes cut are clipped and projected.
     """
     p0 = np.full((len(edges), 2), np.nan)
     p1 = np.full((len(edges), 2), np.nan)
     if len(edges) == 0:
         return p0, p1
-    kept, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera)
+    cut = np.ones(len(edges), bool)
+    if p_px is not None:
+        seen = np.isfinite(p_px).all(axis=1)          # project's NaN rows: depth outside [near, far]
+        whole = seen[edges[:, 0]] & seen[edges[:, 1]]
+        p0[whole], p1[whole] = p_px[edges[whole, 0]], p_px[edges[whole, 1]]
+        cut = ~whole
+        if not cut.any():
+            return p0, p1
+    e = edges[cut]
+    kept, ends = clip_depth(p_world[e[:, 0]], p_world[e[:, 1]], camera)
     if len(ends):
         px = opencv_oracle.project(ends.reshape(-1, 3), camera).reshape(-1, 2, 2)
-        p0[kept], p1[kept] = px[:, 0], px[:, 1]
+        rows = np.flatnonzero(cut)[kept]
+        p0[rows], p1[rows] = px[:, 0], px[:, 1]
     return p0, p1

@@ -187,6 +187,18 @@ def test_model_matrix_hand_values():
     np.testing.assert_allclose(m @ [0, 1, 0, 1], [1 + 2, 2, 3, 1], rtol=0, atol=8 * EPS * 2)
 
 
+def test_model_matrix_memo_gives_each_caller_its_own_matrix():
+    """model_matrix is memoised: a caller writing into its matrix must not change the next caller's."""
+    first = convert.model_matrix((0.0, 0.0, 1.0), (1.0, 2.0, 3.0), 1.0, 0.25)
+    first[:] = 0.0
+    again = convert.model_matrix((0.0, 0.0, 1.0), (1.0, 2.0, 3.0), 1.0, 0.25)
+    np.testing.assert_array_equal(again[:3, 3], [1.0, 2.0, 3.0])      # the offset, copied exactly
+    # -0.0 and 0.0 compare equal but are different inputs: each gets its own translation's sign
+    neg = convert.model_matrix((0.0, 0.0, 0.0), (-0.0, 0.0, 0.0), 1.0, 0.0)
+    pos = convert.model_matrix((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 1.0, 0.0)
+    assert np.signbit(neg[0, 3]) and not np.signbit(pos[0, 3])
+
+
 # ---- OpenGL matrices (the candidate protocol's view_matrix / projection_matrix)
 
 def test_gl_hand_values_camera_z():
