@@ -11,10 +11,8 @@ temporary report folder. The ratio is the one the run writes into
 ``report.json`` (``timing.harness_overhead_ratio``; its definition:
 docs/performance.md#harness-overhead), so both sides are measured in the same
 run, frame by frame; the median over the repeats is the result. The harness
-is broken down by wrapping four of its functions (``oracles.faces.frame_geometry``,
-``oracles.draw.oracle_segments``, ``oracles.metrics.vertex_errors``,
-``oracles.metrics.frame_scores``) in timers here, which the report does not
-do. Also printed: the per-run costs the per-frame ratio leaves out (set-up,
+is broken down by wrapping some of its functions (``PARTS``) in timers
+here, which the report does not do. Also printed: the per-run costs the per-frame ratio leaves out (set-up,
 reports and plots), from the process's wall time.
 """
 
@@ -43,7 +41,11 @@ TARGET = 0.15
 PARTS = (("wirecheck.oracles.case:oface.frame_geometry", "oracle-side geometry (scipy model matrix)"),
          ("wirecheck.oracles.case:oracle_segments", "oracle's segments (depth clip + OpenCV of the ends)"),
          ("wirecheck.oracles.metrics:vertex_errors", "vertex metrics"),
-         ("wirecheck.oracles.metrics:frame_scores", "pixel + line metrics"))
+         ("wirecheck.oracles.metrics:FramePixels.__init__", "pixel metrics (scan + F1)"),
+         ("wirecheck.oracles.metrics:pixel_scores", "pixel metrics (scan + F1)"),
+         ("wirecheck.oracles.metrics:LineBatch.add", "line metrics (batched per case)"),
+         ("wirecheck.oracles.metrics:LineBatch.flush", "line metrics (batched per case)"))
+LABELS = tuple(dict.fromkeys(label for _, label in PARTS))
 
 
 def _wrap(spec: str, seconds: dict, label: str) -> None:
@@ -114,10 +116,10 @@ def main(argv=None) -> int:
     print(f"{'med':>4}  " + "  ".join(f"{med[k]:>22.4f}" for k in keys))
 
     print("\nharness, by part (ms/frame, median over runs; timers added by this benchmark):")
-    for _, label in PARTS:
+    for label in LABELS:
         print(f"  {label:55s} {statistics.median(r['parts_ms_per_frame'][label] for r in runs):8.3f}")
     print(f"  {'(the rest: bookkeeping, images kept for the report)':55s} "
-          f"{med['harness_ms_per_frame'] - sum(statistics.median(r['parts_ms_per_frame'][l] for r in runs) for _, l in PARTS):8.3f}")
+          f"{med['harness_ms_per_frame'] - sum(statistics.median(r['parts_ms_per_frame'][l] for r in runs) for l in LABELS):8.3f}")
 
     run_s = statistics.median(r["run_s"] for r in runs)
     wall_s = statistics.median(r["wall_s"] for r in runs)

@@ -45,6 +45,32 @@ PIXELS_NOT_COMPARED = ("lens distortion: pixels not compared (GL draws straight 
                        "distortion coefficients")
 
 
+@dataclass(frozen=True)
+class KeptImage:
+    """A bool image kept for worst.gif: its drawn pixels' flat indices (a wireframe: ~1 % of the
+    image, already found by metrics.FramePixels), or its bits packed (a filled silhouette)."""
+
+    shape: tuple
+    flat: np.ndarray | None = None
+    bits: np.ndarray | None = None
+
+    @classmethod
+    def of(cls, image: np.ndarray, flat: np.ndarray | None = None) -> "KeptImage":
+        """``image`` kept: as ``flat`` (its drawn pixels' ascending flat indices) when given, else packed."""
+        if flat is not None:
+            return cls(image.shape, flat=flat)
+        return cls(image.shape, bits=np.packbits(image))
+
+    def image(self) -> np.ndarray:
+        """The ``(H, W)`` bool image back."""
+        h, w = self.shape
+        if self.flat is not None:
+            out = np.zeros(h * w, bool)
+            out[self.flat] = True
+            return out.reshape(h, w)
+        return np.unpackbits(self.bits, count=h * w).reshape(h, w).astype(bool)
+
+
 @dataclass
 class CaseResult:
     record: dict                       # what goes into report.json
@@ -113,9 +139,10 @@ class CaseFrames:
     pixel: dict = field(default_factory=lambda: {key: [] for key in metrics.PIXEL_SCORE_KEYS})
     shaded: list = field(default_factory=list)          # (frame, shaded scores)
     lines: list = field(default_factory=list)           # (frame, metrics.line_scores) of wireframes
-    kept: list | None = None                            # (frame, packed candidate, packed oracle)
+    kept: list | None = None                            # (frame, KeptImage candidate, KeptImage oracle)
     worst: tuple | None = None                          # (key, frame, candidate image, oracle image)
     error: str | None = None
+    line_batch: metrics.LineBatch = field(default_factory=metrics.LineBatch)   # frames waiting for line scores
     drawn_px: int = 0                                   # pixels drawn by either side, over the frames (oracles.gate)
     #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + hdraw + pr + pmetric
     #: (hdraw: the harness drawing an external candidate's frame, less the candidate's own calls)
@@ -137,7 +164,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     viewer's overlay checks one frame: ``first=k, every=frames``).
 
     ``mode`` is the drawing mode of the pixel stage (oracles.runner); with
-    ``keep_frames`` every checked frame's images are kept (bit-packed) in
+    ``keep_frames`` every checked frame's images are kept (:class:`KeptImage`) in
     :attr:`CaseResult.frame_images`.
     """
     setup = CaseSetup(scene, case, frames, candidate, motion, mode or RenderMode(), pyrender_oracle is not None)
@@ -176,6 +203,9 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         if setup.pixels:
             pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6,
                         projected)
+    t7 = time.perf_counter()
+    record_lines(acc, acc.line_batch.flush())
+    acc.add("pmetric", t7)
     rec = case_record(setup, acc, tol)
     if setup.pixels_skipped:
         rec["note"] = PIXELS_NOT_COMPARED
@@ -266,6 +296,7 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
     """
     p_world, matrices, pr_vertices, pr_pose = geometry
     mode, cam, scene = setup.mode, setup.cam, setup.scene
+    fp = None                                       # the wireframe's drawn pixels (metrics.FramePixels)
     mirrored = (oface.mirrored_vertices(scene, matrices) if setup.use_faces and mode.cull == "backface"
                 else None)
     if mode.shaded:
@@ -305,19 +336,27 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         orac_img, _depth = pyrender_oracle.render(pr_vertices, draw_edges, cam, model_matrix=pr_pose,
                                                   faces=occluders, cull=mode.cull == "backface")
         t1 = acc.add("pr", t0)
-        ps, ls = metrics.frame_scores(cand_img, orac_img, seg0, seg1)     # one scan of each image
+        fp = metrics.FramePixels(cand_img, orac_img)                     # one scan of each image
+        ps = metrics.pixel_scores(None, None, pixels=fp)
         acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
         for name, values in acc.pixel.items():
             values.append(ps[name])
         frame_rec.update({name: ps[name] for name in metrics.PIXEL_SCORE_KEYS})
-        acc.lines.append((k, ls))
-        frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
+        record_lines(acc, acc.line_batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
         key = (ps["f1_1px"], ps["f1_0px"])
     if want_images and key is not None and (acc.worst is None or key < acc.worst[0]):
         acc.worst = (key, k, cand_img.copy(), orac_img.copy())
     if acc.kept is not None:
-        acc.kept.append((k, np.packbits(cand_img), np.packbits(orac_img)))
+        acc.kept.append((k, KeptImage.of(cand_img, fp.cand_idx if fp else None),
+                         KeptImage.of(orac_img, fp.oracle_idx if fp else None)))
     acc.add("pmetric", t1)
+
+
+def record_lines(acc: CaseFrames, scored: list) -> None:
+    """Frames' line scores (metrics.LineBatch: ``[((frame, frame record), scores)]``) into ``acc`` and their records."""
+    for (k, frame_rec), ls in scored:
+        acc.lines.append((k, ls))
+        frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
 
 
 def _per_frame_ms(seconds: float, frames: int) -> float:

@@ -22,6 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .segment_pixels import clip_segments as _clip_segments
+from .segment_pixels import edge_neighbourhoods, frames_neighbourhoods   # noqa: F401 (part of this module's API)
+
 
 def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
     """Compare ``(N, 2)`` projections with NaN rows for clipped points.
@@ -57,7 +60,9 @@ class FramePixels:
     A wireframe covers under 1 % of an image, so each image is scanned once
     (``np.flatnonzero``) and every metric after that (:func:`pixel_scores`,
     :func:`line_scores`) works on the drawn pixels' indices: lookups, not
-    passes over the whole image.
+    passes over the whole image. The images themselves are not kept, so a
+    case can hold its frames' pixels until it scores their lines together
+    (:class:`LineBatch`).
 
     Attributes
     ----------
@@ -74,7 +79,6 @@ class FramePixels:
         if cand.shape != oracle.shape:
             raise ValueError(f"image shapes differ: {cand.shape} vs {oracle.shape}")
         self.shape = cand.shape
-        self.cand, self.oracle = cand, oracle
         self.cand_idx = np.flatnonzero(cand)
         self.oracle_idx = np.flatnonzero(oracle)
         self.cand_in_oracle = oracle.reshape(-1)[self.cand_idx]
@@ -85,41 +89,55 @@ class FramePixels:
         """Pixels drawn by both images."""
         return int(np.count_nonzero(self.cand_in_oracle))
 
+    @property
+    def identical(self) -> bool:
+        """Whether the two images draw the same pixels."""
+        return len(self.cand_idx) == len(self.oracle_idx) == self.both
+
     def only(self) -> tuple[np.ndarray, np.ndarray]:
         """Flat indices of the candidate-only and the oracle-only pixels, ascending."""
         return self.cand_idx[~self.cand_in_oracle], self.oracle_idx[~self.oracle_in_cand]
 
     def drawn(self) -> np.ndarray:
         """Flat indices of the pixels drawn by either image, ascending."""
+        if self.identical:
+            return self.cand_idx
         return np.sort(np.concatenate([self.cand_idx, self.oracle_idx[~self.oracle_in_cand]]))
+
+    def has(self, flat: np.ndarray, of_candidate: bool = True) -> np.ndarray:
+        """``(K,)`` bool: whether the candidate's (else the oracle's) image draws each flat index."""
+        idx = self.cand_idx if of_candidate else self.oracle_idx
+        flat = np.asarray(flat, np.int64)
+        if len(idx) == 0:
+            return np.zeros(flat.shape, bool)
+        at = np.minimum(np.searchsorted(idx, flat), len(idx) - 1)
+        return idx[at] == flat
 
     def within(self, tol: int, of_candidate: bool = True) -> np.ndarray:
         """For each drawn pixel of one image (row-major): is a pixel of the other within ``tol`` (Chebyshev)?
 
         ``of_candidate``: the candidate's pixels against the oracle's (else the
-        reverse). ``(2 tol + 1)^2`` lookups per drawn pixel in the other image,
-        or, when some drawn pixel is within ``tol`` of the image's border, in
-        a copy of it padded by ``tol`` (outside the image counts as not drawn).
+        reverse). A pixel both draw is within any ``tol``; for the others, the
+        ``(2 tol + 1)^2`` pixels around each are looked up among the other
+        image's (outside the image counts as not drawn).
         """
+        inside = self.cand_in_oracle if of_candidate else self.oracle_in_cand
         if tol == 0:
-            return self.cand_in_oracle if of_candidate else self.oracle_in_cand
-        idx, other, other_idx = ((self.cand_idx, self.oracle, self.oracle_idx) if of_candidate
-                                 else (self.oracle_idx, self.cand, self.cand_idx))
-        if len(idx) == 0:
-            return np.zeros(0, bool)
+            return inside
+        idx = self.cand_idx if of_candidate else self.oracle_idx
+        out = inside.copy()
+        rest = np.flatnonzero(~inside)
+        if len(rest) == 0:
+            return out
         h, w = self.shape
-        rows = idx // w
-        cols = idx - rows * w
-        if rows[0] >= tol and rows[-1] < h - tol and cols.min() >= tol and cols.max() < w - tol:
-            flat, w_look, centre = other.reshape(-1), w, idx
-        else:                      # a window crosses the border: look up in a padded copy
-            w_look = w + 2 * tol
-            flat = np.zeros((h + 2 * tol) * w_look, bool)
-            flat[other_idx + (other_idx // w) * 2 * tol + tol * w_look + tol] = True
-            centre = idx + rows * 2 * tol + tol * w_look + tol
+        rows, cols = np.divmod(idx[rest], w)
         offs = np.arange(-tol, tol + 1)
-        window = (offs[:, None] * w_look + offs[None, :]).ravel()
-        return flat[window[:, None] + centre[None, :]].any(axis=0)
+        ry = (rows[:, None, None] + offs[None, :, None]).repeat(len(offs), axis=2)
+        cx = (cols[:, None, None] + offs[None, None, :]).repeat(len(offs), axis=1)
+        valid = (ry >= 0) & (ry < h) & (cx >= 0) & (cx < w)
+        found = self.has(np.where(valid, ry * w + cx, -1).reshape(len(rest), -1), not of_candidate)
+        out[rest] = (found & valid.reshape(len(rest), -1)).any(axis=1)
+        return out
 
 
 def _within(mask_from: np.ndarray, mask_to: np.ndarray, tol: int) -> np.ndarray:
@@ -348,140 +366,6 @@ def balance_scores(candidate_only: int, oracle_only: int, oracle_pixels: int) ->
             "balance_p_value": sign_test_p(candidate_only, n)}
 
 
-def _clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-    """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
-    d = p1 - p0
-    # the four boundaries at once: p t <= q for (x >= lo_x, y >= lo_y, x <= hi_x, y <= hi_y)
-    p = np.concatenate([-d, d], axis=1)
-    q = np.concatenate([p0 - lo, hi - p0], axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = q / p
-        keep = np.isfinite(p0 + p1).all(axis=1) & ~((p == 0) & (q < 0)).any(axis=1)
-        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))     # entering: the last boundary
-        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))      # leaving: the first
-    keep &= t0 <= t1
-    return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d
-
-
-def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
-                        radius: float = 1.0, mask: np.ndarray | None = None,
-                        pixels: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The pixels near each segment: ``(edge, pixel, major)``, three ``(K,)`` int arrays.
-
-    Pixel ``pixel`` (flat index ``y W + x``) belongs to segment ``edge``
-    (``p0_px[edge] -> p1_px[edge]``, pixel coordinates, core.conventions; NaN
-    rows are skipped) when its centre is within ``radius`` (Euclidean) of it
-    and no other segment is nearer (ties: the lower index), so each pixel
-    belongs to one segment at most;
-    ``major`` is the pixel's coordinate along the segment's major axis (x when
-    ``|dx| > |dy|``, else y). Every pixel a 1-px line rasterizer draws for a
-    segment lies within ``sqrt(2)/2`` of it (within 1/2 of the line across
-    the major axis, within 1/2 beyond an end along it), so ``radius = 1``
-    holds all of a line's pixels, from either renderer.
-
-    ``mask`` ((H, W) bool, optional) keeps only the pixels where it is True
-    (the drawn ones, for :func:`edge_counts`): each pixel's nearest segment
-    is decided among the same segments, so the kept pixels' rows are the
-    same as without it, for a fraction of the work. ``pixels`` (ascending
-    flat indices, e.g. :meth:`FramePixels.drawn`) is the same as a mask True
-    at those pixels only.
-
-    Two ways, the same rows: from the segments (1-px steps along each, the
-    ``(2 reach + 1)^2`` pixels around each step; cost ~ total length), or,
-    given the drawn pixels, from them (each pixel against the segments whose
-    box, grown by the radius, holds it; cost ~ pixels x segments), whichever
-    is cheaper.
-    """
-    p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
-    p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
-    empty = np.zeros(0, dtype=np.int64)
-    if len(p0) == 0:
-        return empty, empty, empty
-    pad = radius + 1.0
-    keep, q0, q1 = _clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
-    ids = np.flatnonzero(keep)
-    if len(ids) == 0:
-        return empty, empty, empty
-    q0, q1 = q0[keep], q1[keep]
-    reach = int(np.ceil(radius)) + 1
-    # every pixel centre within ``radius`` of a segment is within ``reach`` (per
-    # axis) of the rounded point of some 1-px step along it
-    length = np.max(np.abs(q1 - q0), axis=1)
-    steps = np.ceil(length).astype(np.intp) + 1
-    if pixels is None and mask is not None:
-        pixels = np.flatnonzero(np.asarray(mask, bool))
-    if pixels is not None and len(pixels) * len(q0) <= (2 * reach + 1) ** 2 * int(steps.sum()):
-        sid, pix = _pairs_by_box(np.asarray(pixels, np.int64), q0, q1, width, radius)
-        return _nearest_segment(ids, q0, q1, sid, pix, width, radius)
-    seg = np.repeat(np.arange(len(ids)), steps)
-    t = (np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)) / np.maximum(steps - 1, 1)[seg]
-    pts = q0[seg] + t[:, None] * (q1 - q0)[seg]
-    offs = np.arange(-reach, reach + 1)
-    ox, oy = np.meshgrid(offs, offs)
-    cx = (np.round(pts[:, 0])[:, None] + ox.ravel()[None, :]).astype(np.int64).ravel()
-    cy = (np.round(pts[:, 1])[:, None] + oy.ravel()[None, :]).astype(np.int64).ravel()
-    sid = np.repeat(seg, ox.size)
-    inside = (cx >= 0) & (cx < width) & (cy >= 0) & (cy < height)
-    cx, cy, sid = cx[inside], cy[inside], sid[inside]
-    if pixels is not None:
-        drawn = np.zeros(width * height, bool)
-        drawn[pixels] = True
-        drawn = drawn[cy * width + cx]
-        cx, cy, sid = cx[drawn], cy[drawn], sid[drawn]
-    n_seg = len(ids)
-    flat = np.unique((cy * width + cx) * n_seg + sid)      # (pixel, segment) pairs, once each, pixel-major
-    pix, sid = flat // n_seg, flat % n_seg
-    return _nearest_segment(ids, q0, q1, sid, pix, width, radius)
-
-
-def _pairs_by_box(pixels: np.ndarray, q0: np.ndarray, q1: np.ndarray, width: int, radius: float):
-    """``(segment, pixel)`` pairs, pixel-major: each pixel with every segment whose box grown by ``radius`` holds it.
-
-    A superset of the pairs within ``radius`` (the box is grown by a further
-    1/2 px, against rounding); :func:`_nearest_segment` keeps the near ones.
-    """
-    grow = radius + 0.5
-    # whole pixels: x >= lo exactly when x >= ceil(lo); x - lo in [0, span] as one unsigned compare
-    lo = np.ceil(np.minimum(q0, q1) - grow).astype(np.int64)
-    span = (np.floor(np.maximum(q0, q1) + grow).astype(np.int64) - lo).astype(np.uint64)
-    y = pixels // width
-    x = pixels - y * width
-    hit = (((x[:, None] - lo[:, 0]).astype(np.uint64) <= span[:, 0])
-           & ((y[:, None] - lo[:, 1]).astype(np.uint64) <= span[:, 1]))
-    p, s = np.nonzero(hit)
-    return s, pixels[p]
-
-
-def _nearest_segment(ids, q0, q1, sid, pix, width: int, radius: float):
-    """:func:`edge_neighbourhoods`' rows from candidate ``(segment, pixel)`` pairs (each once, pixel-major)."""
-    d_seg = q1 - q0
-    dd_seg = d_seg[:, 0] * d_seg[:, 0] + d_seg[:, 1] * d_seg[:, 1]
-    # the point of the segment nearest the pixel centre: a + u d, u in [0, 1]
-    ex, ey = (pix % width).astype(np.float64) - q0[sid, 0], (pix // width).astype(np.float64) - q0[sid, 1]
-    dx, dy, dd = d_seg[sid, 0], d_seg[sid, 1], dd_seg[sid]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.clip(np.where(dd > 0, (ex * dx + ey * dy) / dd, 0.0), 0.0, 1.0)
-    dist = np.hypot(ex - u * dx, ey - u * dy)
-    near = np.flatnonzero(dist <= radius)
-    # each pixel to its nearest segment only (ties: the lower index), so that
-    # one pixel more or less changes one edge's count by at most one; only
-    # pixels near several segments need the choice (the pairs are pixel-major)
-    shared = pix[near[1:]] == pix[near[:-1]]
-    if shared.any():
-        several = np.zeros(len(near), bool)
-        several[1:] |= shared
-        several[:-1] |= shared
-        multi = near[several]
-        order = multi[np.lexsort((sid[multi], dist[multi], pix[multi]))]
-        first = np.ones(len(order), bool)
-        first[1:] = pix[order[1:]] != pix[order[:-1]]
-        near = np.sort(np.concatenate([near[~several], order[first]]))   # back in pixel order
-    sid, pix = sid[near], pix[near]
-    x_major = np.abs(d_seg[sid, 0]) > np.abs(d_seg[sid, 1])
-    major = np.where(x_major, pix % width, pix // width)
-    return ids[sid].astype(np.int64), pix.astype(np.int64), major.astype(np.int64)
-
-
 def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
     """``(n_edges,)`` int: each edge's length in drawn pixels, counted along its major axis.
 
@@ -494,8 +378,12 @@ def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
     images alike (at a shared vertex or a crossing the lines share out the
     pixels near it by distance).
     """
-    edge, pix, major = near
-    drawn = np.asarray(image, bool).reshape(-1)[pix]
+    return _counts(np.asarray(image, bool).reshape(-1)[near[1]], near, n_edges)
+
+
+def _counts(drawn: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
+    """:func:`edge_counts` given, for each of ``near``'s rows, whether its pixel is drawn."""
+    edge, _pix, major = near
     span = int(major.max()) + 1 if len(major) else 1
     keys = np.sort(edge[drawn] * span + major[drawn])
     distinct = np.ones(len(keys), bool)
@@ -505,8 +393,12 @@ def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
 
 def edge_count_scores(cand: np.ndarray, oracle: np.ndarray, near: tuple, n_edges: int) -> dict:
     """Per-edge pixel counts of both images (:func:`edge_counts`): the largest difference, and where."""
-    cc = edge_counts(cand, near, n_edges)
-    oc = edge_counts(oracle, near, n_edges)
+    return _count_scores(edge_counts(cand, near, n_edges), edge_counts(oracle, near, n_edges))
+
+
+def _count_scores(cc: np.ndarray, oc: np.ndarray) -> dict:
+    """:func:`edge_count_scores` of the two images' per-edge counts."""
+    n_edges = len(cc)
     diff = cc - oc
     seen = (cc > 0) | (oc > 0)
     k = int(np.argmax(np.abs(diff))) if n_edges else 0
@@ -573,22 +465,27 @@ def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
 
 
 def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray,
-                pixels: FramePixels | None = None) -> dict:
+                pixels: FramePixels | None = None, near: tuple | None = None) -> dict:
     """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
     rows: not drawn). Returns :func:`pixel_balance`'s fields,
     :func:`edge_count_scores`' (without the per-edge array) and ``ends``
     (:func:`end_attribution`). ``pixels``: the frame's :class:`FramePixels`,
-    when the caller has it.
+    when the caller has it (then ``cand`` and ``oracle`` are not read);
+    ``near``: :func:`edge_neighbourhoods` of the segments on the drawn
+    pixels (``fp.drawn()``), when the caller has it (:class:`LineBatch`).
     """
     fp = pixels if pixels is not None else FramePixels(cand, oracle)
     h, w = fp.shape
     both = fp.both
     c, o = len(fp.cand_idx) - both, len(fp.oracle_idx) - both
     out = {"candidate_only": c, "oracle_only": o, "imbalance": c - o, "oracle_pixels": len(fp.oracle_idx)}
-    near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=fp.drawn())    # counts look at drawn pixels only
-    ec = edge_count_scores(fp.cand, fp.oracle, near, len(np.asarray(p0_px).reshape(-1, 2)))
+    if near is None:
+        near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=fp.drawn())    # counts look at drawn pixels only
+    n_edges = len(np.asarray(p0_px).reshape(-1, 2))
+    cc = _counts(fp.has(near[1], True), near, n_edges)
+    ec = _count_scores(cc, cc if fp.identical else _counts(fp.has(near[1], False), near, n_edges))
     del ec["edge_count_diffs"]
     out.update(ec)
     out["ends"] = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray")}
@@ -599,6 +496,47 @@ def frame_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px:
     """A wireframe frame's :func:`pixel_scores` and :func:`line_scores`, from one :class:`FramePixels`."""
     fp = FramePixels(cand, oracle)
     return pixel_scores(cand, oracle, pixels=fp), line_scores(cand, oracle, p0_px, p1_px, pixels=fp)
+
+
+class LineBatch:
+    """Wireframe frames waiting for their :func:`line_scores`, scored together.
+
+    Pairing the drawn pixels with the segments (:func:`frames_neighbourhoods`)
+    on a frame of ~1,000 drawn pixels costs mostly numpy's per-call overhead,
+    so a case's frames are paired in one pass. A frame waits until
+    :meth:`flush`, or until the waiting frames hold ``limit`` pixels and
+    segments (memory stays bounded on large meshes: a 100k-edge frame goes
+    alone).
+    """
+
+    def __init__(self, limit: int = 1 << 18):
+        self.limit = limit
+        self._waiting: list = []
+        self._size = 0
+
+    def add(self, key, pixels: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> list:
+        """Queue a frame (``key``: the caller's, given back); ``[(key, line_scores)]`` of the frames flushed."""
+        drawn = pixels.drawn()
+        self._waiting.append((key, pixels, p0_px, p1_px, drawn))
+        self._size += len(drawn) + len(p0_px)
+        return self.flush() if self._size >= self.limit else []
+
+    def flush(self) -> list:
+        """``[(key, line_scores)]`` of every waiting frame, in the order they came."""
+        out, waiting = [], self._waiting
+        self._waiting, self._size = [], 0
+        start = 0
+        while start < len(waiting):              # runs of one image size, paired together
+            shape = waiting[start][1].shape
+            stop = start
+            while stop < len(waiting) and waiting[stop][1].shape == shape:
+                stop += 1
+            run = waiting[start:stop]
+            nears = frames_neighbourhoods([(p0, p1, drawn) for _, _, p0, p1, drawn in run], shape[1], shape[0])
+            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, near=near))
+                       for (key, fp, p0, p1, _), near in zip(run, nears))
+            start = stop
+        return out
 
 
 def line_summary(frames: list) -> dict:

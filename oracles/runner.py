@@ -451,12 +451,7 @@ class _WorstCase:
 
     def animation(self) -> dict:
         rec = self.result.record
-        h, w = rec["camera_spec"]["height"], rec["camera_spec"]["width"]
-
-        def unpack(bits):
-            return np.unpackbits(bits, count=h * w).reshape(h, w).astype(bool)
-
         frames = self.result.frame_images
         return {"scene": rec["scene"], "camera": rec["camera"], "frames": [k for k, _, _ in frames],
-                "candidate": [unpack(c) for _, c, _ in frames], "oracle": [unpack(o) for _, _, o in frames],
+                "candidate": [c.image() for _, c, _ in frames], "oracle": [o.image() for _, _, o in frames],
                 "shaded": self.mode.shaded}

@@ -173,6 +173,53 @@ def test_edge_neighbourhoods_of_drawn_pixels_equal_the_definition(seed, density)
     assert got[1].tolist() == sorted(got[1].tolist())     # one row per pixel, in pixel order
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_frames_neighbourhoods_give_each_frame_its_own_rows(seed):
+    """Frames paired in one pass (stacked with a gap) get the definition's rows, frame by frame.
+
+    The frames' segments reach past the image's top and bottom, where the
+    stacked frames meet: a pair across two frames would show up as a row
+    the definition does not have.
+    """
+    from wirecheck.oracles.metrics import frames_neighbourhoods
+
+    rng = np.random.default_rng(100 + seed)
+    w, h = 30, 12
+    frames = []
+    for _ in range(int(rng.integers(2, 6))):
+        n = int(rng.integers(0, 8))
+        p0 = rng.uniform(-4, 34, (n, 2))
+        p1 = np.column_stack([rng.uniform(-4, 34, n), rng.choice([-3.5, 15.5], n)])   # through top or bottom
+        if n > 1:
+            p1[1, 1] = p0[1, 1]                              # horizontal
+        frames.append((p0, p1, np.flatnonzero(rng.random(w * h) < rng.uniform(0.05, 0.7))))
+    got = frames_neighbourhoods(frames, w, h)
+    assert len(got) == len(frames)
+    for (p0, p1, pixels), rows in zip(frames, got):
+        assert list(zip(*(a.tolist() for a in rows))) == _neighbourhoods_naive(p0, p1, w, h, pixels)
+
+
+def test_line_batch_scores_as_frame_by_frame():
+    """LineBatch's scores equal line_scores of each frame alone, whether it flushes on size or at the end."""
+    from wirecheck.oracles.metrics import FramePixels, LineBatch, line_scores
+
+    rng = np.random.default_rng(5)
+    w, h = 40, 30
+    frames = []
+    for k in range(7):
+        p0, p1 = rng.uniform(0, 40, (6, 2)), rng.uniform(0, 30, (6, 2))
+        cand, orac = rng.random((h, w)) < 0.1, rng.random((h, w)) < 0.1
+        frames.append((k, cand, orac, p0, p1))
+    alone = [line_scores(c, o, p0, p1) for _, c, o, p0, p1 in frames]
+    for limit in (1, 50, 1 << 20):                       # every frame alone, a few together, all together
+        batch, got = LineBatch(limit=limit), []
+        for k, c, o, p0, p1 in frames:
+            got += batch.add(k, FramePixels(c, o), p0, p1)
+        got += batch.flush()
+        assert [k for k, _ in got] == list(range(7))
+        assert [s for _, s in got] == alone
+
+
 def test_line_scores_with_nothing_drawn_near_an_edge_on_screen():
     from wirecheck.oracles.metrics import line_scores
 
