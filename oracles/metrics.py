@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from .segment_pixels import clip_segments as _clip_segments
-from .segment_pixels import edge_neighbourhoods, frames_neighbourhoods   # noqa: F401 (part of this module's API)
+from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
 
 
 def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
@@ -398,11 +398,14 @@ def edge_count_scores(cand: np.ndarray, oracle: np.ndarray, near: tuple, n_edges
 
 def _count_scores(cc: np.ndarray, oc: np.ndarray) -> dict:
     """:func:`edge_count_scores` of the two images' per-edge counts."""
-    n_edges = len(cc)
-    diff = cc - oc
-    seen = (cc > 0) | (oc > 0)
+    return _diff_scores(cc - oc, int(((cc > 0) | (oc > 0)).sum()))
+
+
+def _diff_scores(diff: np.ndarray, compared: int) -> dict:
+    """:func:`edge_count_scores` of the per-edge count differences and the number of edges counted."""
+    n_edges = len(diff)
     k = int(np.argmax(np.abs(diff))) if n_edges else 0
-    return {"edges_compared": int(seen.sum()),
+    return {"edges_compared": compared,
             "edge_count_max_diff": int(abs(diff[k])) if n_edges else 0,
             "edge_count_worst_edge": k if n_edges and diff[k] != 0 else None,
             "edge_count_worst_diff": int(diff[k]) if n_edges else 0,
@@ -465,7 +468,7 @@ def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
 
 
 def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray,
-                pixels: FramePixels | None = None, near: tuple | None = None) -> dict:
+                pixels: FramePixels | None = None, counts: tuple | None = None) -> dict:
     """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
@@ -473,19 +476,22 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
     :func:`edge_count_scores`' (without the per-edge array) and ``ends``
     (:func:`end_attribution`). ``pixels``: the frame's :class:`FramePixels`,
     when the caller has it (then ``cand`` and ``oracle`` are not read);
-    ``near``: :func:`edge_neighbourhoods` of the segments on the drawn
-    pixels (``fp.drawn()``), when the caller has it (:class:`LineBatch`).
+    ``counts``: ``(diff, compared)``, the per-edge count differences and the
+    number of edges counted, when the caller has them
+    (:func:`frames_count_differences`, :class:`LineBatch`).
     """
     fp = pixels if pixels is not None else FramePixels(cand, oracle)
     h, w = fp.shape
     both = fp.both
     c, o = len(fp.cand_idx) - both, len(fp.oracle_idx) - both
     out = {"candidate_only": c, "oracle_only": o, "imbalance": c - o, "oracle_pixels": len(fp.oracle_idx)}
-    if near is None:
+    if counts is None:
         near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=fp.drawn())    # counts look at drawn pixels only
-    n_edges = len(np.asarray(p0_px).reshape(-1, 2))
-    cc = _counts(fp.has(near[1], True), near, n_edges)
-    ec = _count_scores(cc, cc if fp.identical else _counts(fp.has(near[1], False), near, n_edges))
+        n_edges = len(np.asarray(p0_px).reshape(-1, 2))
+        cc = _counts(fp.has(near[1], True), near, n_edges)
+        ec = _count_scores(cc, cc if fp.identical else _counts(fp.has(near[1], False), near, n_edges))
+    else:
+        ec = _diff_scores(*counts)
     del ec["edge_count_diffs"]
     out.update(ec)
     out["ends"] = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray")}
@@ -501,9 +507,10 @@ def frame_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px:
 class LineBatch:
     """Wireframe frames waiting for their :func:`line_scores`, scored together.
 
-    Pairing the drawn pixels with the segments (:func:`frames_neighbourhoods`)
-    on a frame of ~1,000 drawn pixels costs mostly numpy's per-call overhead,
-    so a case's frames are paired in one pass. A frame waits until
+    The per-edge counts (:func:`frames_count_differences`: only where the
+    frames differ, and each edge's midpoint) of a frame of ~1,000 drawn
+    pixels cost mostly numpy's per-call overhead, so a case's frames are
+    counted in one pass. A frame waits until
     :meth:`flush`, or until the waiting frames hold ``limit`` pixels and
     segments (memory stays bounded on large meshes: a 100k-edge frame goes
     alone).
@@ -516,9 +523,8 @@ class LineBatch:
 
     def add(self, key, pixels: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> list:
         """Queue a frame (``key``: the caller's, given back); ``[(key, line_scores)]`` of the frames flushed."""
-        drawn = pixels.drawn()
-        self._waiting.append((key, pixels, p0_px, p1_px, drawn))
-        self._size += len(drawn) + len(p0_px)
+        self._waiting.append((key, pixels, p0_px, p1_px))
+        self._size += len(pixels.cand_idx) + len(pixels.oracle_idx) + len(p0_px)
         return self.flush() if self._size >= self.limit else []
 
     def flush(self) -> list:
@@ -532,9 +538,9 @@ class LineBatch:
             while stop < len(waiting) and waiting[stop][1].shape == shape:
                 stop += 1
             run = waiting[start:stop]
-            nears = frames_neighbourhoods([(p0, p1, drawn) for _, _, p0, p1, drawn in run], shape[1], shape[0])
-            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, near=near))
-                       for (key, fp, p0, p1, _), near in zip(run, nears))
+            counts = frames_count_differences([(p0, p1, fp) for _, fp, p0, p1 in run], shape[1], shape[0])
+            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c))
+                       for (key, fp, p0, p1), c in zip(run, counts))
             start = stop
         return out
 

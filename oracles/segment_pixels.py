@@ -29,6 +29,12 @@ import numpy as np
 
 _EMPTY = np.zeros(0, dtype=np.int64)
 
+#: :func:`frames_count_differences` counts every drawn pixel at once when the frames hold more than
+#: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
+#: looking at midpoints and one-sided pixels first would pair most pixels several times over).
+DENSE = 8
+
+
 
 def clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
     """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
@@ -81,89 +87,317 @@ def frames_neighbourhoods(frames, width: int, height: int, radius: float = 1.0) 
     """
     if not frames:
         return []
-    pad = radius + 1.0
-    grow = radius + 0.5            # each box is grown by a further 1/2 px, against rounding
-    pitch = height                                         # frame k's rows start at k H in the stack
-    seg0, seg1, seg_frame, edge_of = [], [], [], []
-    pix, pix_frame = [], []
-    for k, (p0, p1, pixels) in enumerate(frames):
-        p0 = np.asarray(p0, np.float64).reshape(-1, 2)
-        p1 = np.asarray(p1, np.float64).reshape(-1, 2)
-        seg0.append(p0)
-        seg1.append(p1)
-        seg_frame.append(np.full(len(p0), k, np.int64))
-        edge_of.append(np.arange(len(p0), dtype=np.int64))
-        pixels = np.asarray(pixels, np.int64).reshape(-1)
-        pix.append(pixels)
-        pix_frame.append(np.full(len(pixels), k, np.int64))
-    n_pix = np.array([len(p) for p in pix])
-    empty = [(_EMPTY, _EMPTY, _EMPTY) for _ in frames]
-    p0, p1 = np.concatenate(seg0), np.concatenate(seg1)
-    keep, q0, q1 = clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
-    if not keep.any() or not n_pix.sum():
-        return empty
-    q0, q1 = q0[keep], q1[keep]
-    s_frame, s_edge = np.concatenate(seg_frame)[keep], np.concatenate(edge_of)[keep]
-    pix, p_frame = np.concatenate(pix), np.concatenate(pix_frame)
-
-    # pixels in the frame's own coordinates and in the stack (frame k's rows start at k * pitch)
-    y = pix // width
-    x = pix - y * width
-    stacked = (y + p_frame * pitch) * width + x          # ascending: frame-major, then row-major
-    # each row a segment's grown box spans, with the columns the segment's part within ``grow``
-    # of that row reaches, grown: a pixel centre within ``radius`` of the segment is in them
-    # (the nearest point is within ``radius`` in y, so in that part, and within ``radius`` in x)
-    d_seg = q1 - q0
-    # (rows of the frame only: a row off it would slice the next frame's pixels)
-    row_lo = np.maximum(np.ceil(np.minimum(q0[:, 1], q1[:, 1]) - grow), 0).astype(np.int64)
-    row_hi = np.minimum(np.floor(np.maximum(q0[:, 1], q1[:, 1]) + grow), height - 1).astype(np.int64)
-    n_rows = np.maximum(row_hi - row_lo + 1, 0)
-    seg = np.repeat(np.arange(len(q0)), n_rows)
-    row = row_lo[seg] + np.arange(int(n_rows.sum())) - np.repeat(np.cumsum(n_rows) - n_rows, n_rows)
-    dy = d_seg[seg, 1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ta = np.where(dy != 0, (row - grow - q0[seg, 1]) / dy, 0.0)
-        tb = np.where(dy != 0, (row + grow - q0[seg, 1]) / dy, 1.0)
-    xa = q0[seg, 0] + np.clip(np.minimum(ta, tb), 0.0, 1.0) * d_seg[seg, 0]
-    xb = q0[seg, 0] + np.clip(np.maximum(ta, tb), 0.0, 1.0) * d_seg[seg, 0]
-    col_lo = np.maximum(np.ceil(np.minimum(xa, xb) - grow), 0).astype(np.int64)
-    col_hi = np.minimum(np.floor(np.maximum(xa, xb) + grow), width - 1).astype(np.int64)
-    # the drawn pixels of one row between two columns are one slice of ``stacked``
-    start = (row + s_frame[seg] * pitch) * width
-    a = np.searchsorted(stacked, start + col_lo)
-    n = np.maximum(np.searchsorted(stacked, start + col_hi + 1) - a, 0)
-    sid = np.repeat(seg, n)
-    pos = np.arange(int(n.sum())) + np.repeat(a - (np.cumsum(n) - n), n)
-
-    # the point of the segment nearest the pixel centre: a + u d, u in [0, 1], in the frame's coordinates
-    dd_seg = d_seg[:, 0] * d_seg[:, 0] + d_seg[:, 1] * d_seg[:, 1]
-    ex, ey = x[pos] - q0[sid, 0], y[pos] - q0[sid, 1]
-    dx, dy, dd = d_seg[sid, 0], d_seg[sid, 1], dd_seg[sid]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.clip(np.where(dd > 0, (ex * dx + ey * dy) / dd, 0.0), 0.0, 1.0)
-    dist = np.hypot(ex - u * dx, ey - u * dy)
-    near = dist <= radius
-    sid, pos, dist = sid[near], pos[near], dist[near]
-    # each pixel to its nearest segment only (ties: the lower index), so that one pixel more or
-    # less changes one edge's count by at most one; only pixels near several segments need the choice
-    several = np.bincount(pos, minlength=len(stacked))[pos] > 1
-    if several.any():
-        multi = np.flatnonzero(several)
-        order = multi[np.lexsort((sid[multi], dist[multi], pos[multi]))]
-        first = np.ones(len(order), bool)
-        first[1:] = pos[order[1:]] != pos[order[:-1]]
-        chosen = np.concatenate([np.flatnonzero(~several), order[first]])
-        sid, pos = sid[chosen], pos[chosen]
-    # one row per pixel: back in pixel order by placing each row at its pixel
-    slot = np.full(len(stacked), -1, np.int64)
-    slot[pos] = np.arange(len(pos))
-    rows = slot[slot >= 0]
-    sid, pos = sid[rows], pos[rows]
-    x_major = np.abs(d_seg[sid, 0]) > np.abs(d_seg[sid, 1])
-    major = np.where(x_major, x[pos], y[pos])
-    edge, local = s_edge[sid], pix[pos]
-    cut = np.searchsorted(pos, np.cumsum(n_pix)[:-1])      # the frames' rows, split
+    segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius)
+    px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
+    sid, pos = segs.owners(px, *segs.pairs(px))
+    edge, local, major = segs.rows(px, sid, pos)
+    cut = np.searchsorted(pos, np.cumsum(px.counts)[:-1])      # the frames' rows, split
     return list(zip(np.split(edge, cut), np.split(local, cut), np.split(major, cut)))
+
+
+def frames_count_differences(frames, width: int, height: int, radius: float = 1.0) -> list[tuple]:
+    """Per-edge count differences of several frames, looking only where they can differ.
+
+    An edge's count (oracles.metrics.edge_counts) is the number of distinct
+    major-axis coordinates among the drawn pixels it owns (module docstring).
+    Owning is a property of the pixel and the segments alone, so:
+
+    - an edge that owns no one-sided pixel owns the same pixels in both
+      images, and its counts are equal: only the owners of one-sided pixels
+      are counted, from the drawn pixels near them;
+    - an edge is *compared* (counted in either image) when it owns some
+      drawn pixel: most do at the pixel nearest their midpoint, and only the
+      rest are looked for among the drawn pixels near them.
+
+    The results equal the full count over every drawn pixel
+    (:func:`frames_neighbourhoods` and oracles.metrics.edge_counts), for a
+    fraction of the work when the frames mostly agree.
+
+    Parameters
+    ----------
+    frames : sequence of (p0_px (E, 2), p1_px (E, 2), pixels)
+        Each frame's segments and its two images' drawn pixels
+        (oracles.metrics.FramePixels: ``cand_idx``, ``oracle_idx``, ``drawn()``, ``only()``).
+
+    Returns
+    -------
+    list of (diff (E,) int64, compared int), one per frame: candidate count
+    minus oracle count per edge, and how many edges either image counts.
+    """
+    if not frames:
+        return []
+    segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius)
+    cand = _Pixels.of_frames([fp.cand_idx for _, _, fp in frames], width, height)
+    orac = _Pixels.of_frames([fp.oracle_idx for _, _, fp in frames], width, height)
+    drawn = _Pixels.of_frames([fp.drawn() for _, _, fp in frames], width, height)
+    one_sided = _Pixels.of_frames([np.sort(np.concatenate(fp.only())) for _, _, fp in frames], width, height)
+    n_frames = len(frames)
+    first_edge = np.cumsum(segs.counts) - segs.counts          # frame k's edges in one flat array of all
+    diff_all = np.zeros(int(segs.counts.sum()), np.int64)
+    if len(segs) == 0 or len(drawn) == 0:
+        return [(d, 0) for d in np.split(diff_all, first_edge[1:])]
+    if len(segs) * DENSE > len(drawn):          # a dense mesh: one pass over every drawn pixel is cheaper
+        sid, pos = segs.owners(drawn, *segs.pairs(drawn))
+        _, _, major = segs.rows(drawn, sid, pos)
+        in_cand, in_orac = cand.has(drawn.stacked[pos]), orac.has(drawn.stacked[pos])
+        cc, oc = (_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac))
+        diff_all[first_edge[segs.frame] + segs.edge] = cc - oc
+        n_compared = np.bincount(segs.frame[(cc > 0) | (oc > 0)], minlength=n_frames)
+        return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
+
+    # 1. compared edges: the owner of each segment's midpoint pixel, when that pixel is drawn ...
+    mid = np.floor((segs.q0 + segs.q1) / 2 + 0.5).astype(np.int64)
+    on = (mid[:, 0] >= 0) & (mid[:, 0] < width) & (mid[:, 1] >= 0) & (mid[:, 1] < height)
+    mid_stacked = np.where(on, (mid[:, 1] + segs.frame * height) * width + mid[:, 0], -1)
+    on &= drawn.has(mid_stacked)
+    mids = drawn.subset(_unique(np.searchsorted(drawn.stacked, mid_stacked[on])))
+    m_sid, m_pos = segs.owners(mids, *segs.pairs_any(mids))
+    compared = np.zeros(len(segs), bool)
+    owner_at = np.full(len(mids), -1, np.int64)
+    owner_at[m_pos] = m_sid
+    seg_on = np.flatnonzero(on)
+    compared[seg_on] = owner_at[np.searchsorted(mids.stacked, mid_stacked[seg_on])] == seg_on
+    # ... and for the others, the owners of the drawn pixels near them
+    rest = np.flatnonzero(~compared)
+    if len(rest):
+        near = drawn.subset(_unique(segs.pairs(drawn, rest)[1]))
+        compared[_unique(segs.owners(near, *segs.pairs_any(near))[0])] = True
+    n_compared = np.bincount(segs.frame[compared], minlength=n_frames)
+
+    # 2. count differences: the owners of one-sided pixels, counted on the drawn pixels near them
+    if len(one_sided):
+        owners = _unique(segs.owners(one_sided, *segs.pairs_any(one_sided))[0])
+        if len(owners):
+            near = drawn.subset(_unique(segs.pairs(drawn, owners)[1]))
+            sid, pos = segs.owners(near, *segs.pairs_any(near))     # (other edges' rows too: not read)
+            _, _, major = segs.rows(near, sid, pos)
+            in_cand, in_orac = cand.has(near.stacked[pos]), orac.has(near.stacked[pos])
+            counts = [_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac)]
+            diff_all[first_edge[segs.frame[owners]] + segs.edge[owners]] = (counts[0] - counts[1])[owners]
+    return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
+
+
+def _unique(a: np.ndarray) -> np.ndarray:
+    """The distinct values of an int array, ascending (a sort: numpy's hashed unique is slower on these sizes)."""
+    a = np.sort(a)
+    if len(a) > 1:
+        a = a[np.concatenate([[True], a[1:] != a[:-1]])]
+    return a
+
+
+def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int) -> np.ndarray:
+    """``(n_segments,)``: the number of distinct ``major`` values of each segment's rows."""
+    span = int(major.max()) + 1 if len(major) else 1
+    keys = _unique(sid * span + major)
+    return np.bincount(keys // span, minlength=n_segments)
+
+
+class _Pixels:
+    """Pixels of several frames of one size, stacked: frame ``k``'s rows start at row ``k H``.
+
+    ``stacked``: flat indices in the stack, ascending (frame-major, then
+    row-major); ``counts``: pixels per frame, when built from frames.
+    """
+
+    def __init__(self, stacked: np.ndarray, width: int, height: int, counts: np.ndarray | None = None):
+        self.stacked, self.width, self.height, self.counts = stacked, width, height, counts
+
+    @classmethod
+    def of_frames(cls, per_frame, width: int, height: int) -> "_Pixels":
+        """From one ascending flat-index array per frame."""
+        per_frame = [np.asarray(p, np.int64).reshape(-1) for p in per_frame]
+        counts = np.array([len(p) for p in per_frame], np.int64)
+        if not per_frame:
+            return cls(_EMPTY, width, height, counts)
+        offset = np.repeat(np.arange(len(per_frame), dtype=np.int64) * (width * height), counts)
+        return cls(np.concatenate(per_frame) + offset, width, height, counts)
+
+    def __len__(self) -> int:
+        return len(self.stacked)
+
+    def at(self, pos=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(frame, y, x)`` of the pixels at positions ``pos`` (default all), in their frames' coordinates."""
+        s = self.stacked if pos is None else self.stacked[pos]
+        row = s // self.width
+        frame = row // self.height
+        return frame, row - frame * self.height, s - row * self.width
+
+    def has(self, stacked: np.ndarray) -> np.ndarray:
+        """Whether each stacked flat index is one of these pixels."""
+        stacked = np.asarray(stacked, np.int64)
+        if len(self.stacked) == 0:
+            return np.zeros(stacked.shape, bool)
+        at = np.minimum(np.searchsorted(self.stacked, stacked), len(self.stacked) - 1)
+        return self.stacked[at] == stacked
+
+    def subset(self, pos: np.ndarray) -> "_Pixels":
+        """The pixels at ascending positions ``pos``."""
+        return _Pixels(self.stacked[pos], self.width, self.height)
+
+
+class _Segments:
+    """Segments of several frames of one size, clipped to each frame's box grown by ``radius + 1``."""
+
+    def __init__(self, per_frame, width: int, height: int, radius: float):
+        self.width, self.height, self.radius = width, height, radius
+        pad = radius + 1.0
+        self.grow = radius + 0.5            # each box is grown by a further 1/2 px, against rounding
+        p0 = [np.asarray(a, np.float64).reshape(-1, 2) for a, _ in per_frame]
+        p1 = [np.asarray(b, np.float64).reshape(-1, 2) for _, b in per_frame]
+        self.counts = np.array([len(a) for a in p0], np.int64)
+        frame = np.repeat(np.arange(len(p0)), self.counts)
+        edge = np.arange(int(self.counts.sum())) - np.repeat(np.cumsum(self.counts) - self.counts, self.counts)
+        p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
+        p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
+        keep, q0, q1 = clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
+        self.q0, self.q1 = q0[keep], q1[keep]
+        self.frame, self.edge = frame[keep], edge[keep]
+        self.d = self.q1 - self.q0
+        self.dd = self.d[:, 0] * self.d[:, 0] + self.d[:, 1] * self.d[:, 1]
+        self._cells = None                       # the grid of pairs_any, made on first use
+        self._rows = None                        # _rows_spanned, counted on first use
+
+    def __len__(self) -> int:
+        return len(self.q0)
+
+    def pairs(self, px: _Pixels, which: np.ndarray | None = None):
+        """``(sid, pos, dist)``: each pair of a segment (of ``which``, default all) and a pixel within ``radius``.
+
+        Row by row (:meth:`_spans` of 1-row bands): the pixels of a row
+        between two columns are one slice of ``stacked``; each is measured.
+        """
+        if which is None:
+            which = np.arange(len(self))
+        if len(which) == 0 or len(px) == 0:
+            return _EMPTY, _EMPTY, np.zeros(0)
+        seg, row, col_lo, col_hi = self._spans(which, 1)
+        w, h = self.width, self.height
+        # the pixels of one row between two columns are one slice of ``stacked``
+        start = (row + self.frame[seg] * h) * w
+        a = np.searchsorted(px.stacked, start + col_lo)
+        n = np.maximum(np.searchsorted(px.stacked, start + col_hi + 1) - a, 0)
+        sid = np.repeat(seg, n)
+        pos = np.arange(int(n.sum())) + np.repeat(a - (np.cumsum(n) - n), n)
+        return self._near(px, sid, pos)
+
+    def pairs_any(self, px: _Pixels):
+        """:meth:`pairs` over all segments, for a subset of the pixels: through a grid of cells.
+
+        Each segment is listed in the square cells its part near each band of
+        cell rows reaches (as :meth:`pairs` does row by row); a pixel is
+        measured against the segments listed in its cell. Cost ~ pixels x
+        segments per cell, whatever the segments' total length. The cells'
+        side follows the segments' typical length (:meth:`_cell_side`), so a
+        dense mesh's many short segments are not listed together.
+        """
+        if len(px) == 0 or len(self) == 0:
+            return _EMPTY, _EMPTY, np.zeros(0)
+        keys, listed = self._cell_index()
+        frame, y, x = px.at()
+        cell = self._cell
+        key = (frame * self._cells_y + y // cell) * self._cells_x + x // cell
+        a = np.searchsorted(keys, key, side="left")
+        n = np.searchsorted(keys, key, side="right") - a
+        if int(n.sum()) > 2 * (self._rows_spanned() + len(px)):     # crowded cells: row by row is cheaper
+            return self.pairs(px)
+        pos = np.repeat(np.arange(len(px)), n)
+        sid = listed[np.arange(int(n.sum())) + np.repeat(a - (np.cumsum(n) - n), n)]
+        return self._near(px, sid, pos)
+
+    def _cell_index(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(keys, sid)``, sorted by key: each segment once per cell it is listed in (:meth:`pairs_any`)."""
+        if self._cells is None:
+            cell = self._cell = self._cell_side()
+            self._cells_x, self._cells_y = -(-self.width // cell), -(-self.height // cell)
+            seg, band, col_lo, col_hi = self._spans(np.arange(len(self)), cell)
+            c0 = col_lo // cell
+            n = np.where(col_lo > col_hi, 0, col_hi // cell - c0 + 1)
+            sid = np.repeat(seg, n)
+            cx = np.repeat(c0, n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+            keys = (self.frame[sid] * self._cells_y + np.repeat(band, n)) * self._cells_x + cx
+            order = np.argsort(keys, kind="stable")
+            self._cells = (keys[order], sid[order])
+        return self._cells
+
+    def _rows_spanned(self) -> int:
+        """How many (segment, row) slices :meth:`pairs` takes over all segments."""
+        if self._rows is None:
+            lo = np.maximum(np.ceil(np.minimum(self.q0[:, 1], self.q1[:, 1]) - self.grow), 0)
+            hi = np.minimum(np.floor(np.maximum(self.q0[:, 1], self.q1[:, 1]) + self.grow), self.height - 1)
+            self._rows = int(np.maximum(hi - lo + 1, 0).sum())
+        return self._rows
+
+    def _cell_side(self) -> int:
+        """The grid's cell side (px): the segments' median length, a power of two in [4, 32].
+
+        A segment is listed in ~(length / side + 1) cells per band of cells it
+        crosses, and a cell holds ~(side / length + 1) segments of each line
+        through it: a side near the typical length keeps both near 1.
+        """
+        length = np.median(np.abs(self.d).max(axis=1)) if len(self) else 16.0
+        return int(2 ** np.clip(np.round(np.log2(max(length, 1.0))), 2, 5))
+
+    def _spans(self, which: np.ndarray, band: int):
+        """``(seg, b, col_lo, col_hi)``: for each band of ``band`` rows a segment's grown box spans (rows
+        of the frame only), the columns its part within ``grow`` of the band reaches, grown, clipped to the
+        frame (a pixel centre within ``radius`` of the segment in those rows is in those columns: the
+        nearest point is within ``radius`` in y, so in that part, and within ``radius`` in x)."""
+        q0, q1, d, grow, w, h = self.q0, self.q1, self.d, self.grow, self.width, self.height
+        b_lo = np.maximum(np.ceil(np.minimum(q0[which, 1], q1[which, 1]) - grow), 0).astype(np.int64) // band
+        b_hi = np.minimum(np.floor(np.maximum(q0[which, 1], q1[which, 1]) + grow), h - 1).astype(np.int64) // band
+        n = np.maximum(b_hi - b_lo + 1, 0)
+        seg = np.repeat(which, n)
+        b = np.repeat(b_lo, n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        top, bottom = b * band - grow, b * band + (band - 1) + grow
+        dy = d[seg, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ta = np.where(dy != 0, (top - q0[seg, 1]) / dy, 0.0)
+            tb = np.where(dy != 0, (bottom - q0[seg, 1]) / dy, 1.0)
+        xa = q0[seg, 0] + np.clip(np.minimum(ta, tb), 0.0, 1.0) * d[seg, 0]
+        xb = q0[seg, 0] + np.clip(np.maximum(ta, tb), 0.0, 1.0) * d[seg, 0]
+        col_lo = np.maximum(np.ceil(np.minimum(xa, xb) - grow), 0).astype(np.int64)
+        col_hi = np.minimum(np.floor(np.maximum(xa, xb) + grow), w - 1).astype(np.int64)
+        return seg, b, col_lo, col_hi
+
+    def _near(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
+        """The pairs ``(sid, pos)`` within ``radius``, with their distances."""
+        q0, d = self.q0, self.d
+        # the point of the segment nearest the pixel centre: a + u d, u in [0, 1], in the frame's coordinates
+        _, y, x = px.at(pos)
+        ex, ey = x - q0[sid, 0], y - q0[sid, 1]
+        dx, dy, dd = d[sid, 0], d[sid, 1], self.dd[sid]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = np.clip(np.where(dd > 0, (ex * dx + ey * dy) / dd, 0.0), 0.0, 1.0)
+        dist = np.hypot(ex - u * dx, ey - u * dy)
+        near = dist <= self.radius
+        return sid[near], pos[near], dist[near]
+
+    def owners(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray, dist: np.ndarray):
+        """``(sid, pos)`` of :meth:`pairs` (over all segments), one per pixel, ascending by pixel.
+
+        Each pixel goes to its nearest segment only (ties: the lower index),
+        so that one pixel more or less changes one edge's count by at most one;
+        only pixels near several segments need the choice.
+        """
+        several = np.bincount(pos, minlength=len(px))[pos] > 1
+        if several.any():
+            multi = np.flatnonzero(several)
+            order = multi[np.lexsort((sid[multi], dist[multi], pos[multi]))]
+            first = np.ones(len(order), bool)
+            first[1:] = pos[order[1:]] != pos[order[:-1]]
+            chosen = np.concatenate([np.flatnonzero(~several), order[first]])
+            sid, pos = sid[chosen], pos[chosen]
+        # back in pixel order by placing each row at its pixel
+        slot = np.full(len(px), -1, np.int64)
+        slot[pos] = np.arange(len(pos))
+        rows = slot[slot >= 0]
+        return sid[rows], pos[rows]
+
+    def rows(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
+        """``(edge, pixel, major)`` of owner pairs (module docstring), pixels flat in their frames."""
+        x_major = np.abs(self.d[sid, 0]) > np.abs(self.d[sid, 1])
+        _, y, x = px.at(pos)
+        return self.edge[sid], y * self.width + x, np.where(x_major, x, y)
 
 
 def _from_segments(p0_px, p1_px, width: int, height: int, radius: float):
@@ -187,5 +421,5 @@ def _from_segments(p0_px, p1_px, width: int, height: int, radius: float):
     cx = (np.round(pts[:, 0])[:, None] + ox.ravel()[None, :]).astype(np.int64).ravel()
     cy = (np.round(pts[:, 1])[:, None] + oy.ravel()[None, :]).astype(np.int64).ravel()
     inside = (cx >= 0) & (cx < width) & (cy >= 0) & (cy < height)
-    pixels = np.unique(cy[inside] * width + cx[inside])     # every candidate pixel, once, ascending
+    pixels = _unique(cy[inside] * width + cx[inside])     # every candidate pixel, once, ascending
     return frames_neighbourhoods([(p0, p1, pixels)], width, height, radius)[0]

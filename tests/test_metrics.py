@@ -199,15 +199,24 @@ def test_frames_neighbourhoods_give_each_frame_its_own_rows(seed):
         assert list(zip(*(a.tolist() for a in rows))) == _neighbourhoods_naive(p0, p1, w, h, pixels)
 
 
-def test_line_batch_scores_as_frame_by_frame():
-    """LineBatch's scores equal line_scores of each frame alone, whether it flushes on size or at the end."""
+@pytest.mark.parametrize("dense", [False, True], ids=["long-segments", "dense-mesh"])
+def test_line_batch_scores_as_frame_by_frame(dense):
+    """LineBatch's scores equal line_scores of each frame alone, whether it flushes on size or at the end.
+
+    Long segments take the midpoint and one-sided path of frames_count_differences;
+    many short ones (more than one per DENSE drawn pixels) the one-pass path.
+    """
     from wirecheck.oracles.metrics import FramePixels, LineBatch, line_scores
 
     rng = np.random.default_rng(5)
     w, h = 40, 30
     frames = []
     for k in range(7):
-        p0, p1 = rng.uniform(0, 40, (6, 2)), rng.uniform(0, 30, (6, 2))
+        if dense:
+            p0 = rng.uniform(0, 30, (80, 2))
+            p1 = p0 + rng.uniform(-2, 2, (80, 2))
+        else:
+            p0, p1 = rng.uniform(0, 40, (6, 2)), rng.uniform(0, 30, (6, 2))
         cand, orac = rng.random((h, w)) < 0.1, rng.random((h, w)) < 0.1
         frames.append((k, cand, orac, p0, p1))
     alone = [line_scores(c, o, p0, p1) for _, c, o, p0, p1 in frames]
@@ -220,9 +229,50 @@ def test_line_batch_scores_as_frame_by_frame():
         assert [s for _, s in got] == alone
 
 
+def test_line_batch_counts_by_hand():
+    """Edge counts where frames mostly agree (the midpoint path), with a duplicate edge and a short line.
+
+    40 x 20 image. Edge 0: (2, 5) -> (30, 5), a row of 29 pixels; edge 1 the
+    same segment again (its pixels are equally near both: they go to edge 0,
+    the lower index, so edge 1 counts nothing and is not compared); edge 2:
+    (10, 12) -> (10, 17), a column of 6 pixels. The candidate lacks edge 2's
+    last pixel (10, 17): edge 2 counts 5 against the oracle's 6, diff -1.
+    """
+    from wirecheck.oracles.metrics import FramePixels, LineBatch, line_scores
+
+    p0 = np.array([[2.0, 5.0], [2.0, 5.0], [10.0, 12.0]])
+    p1 = np.array([[30.0, 5.0], [30.0, 5.0], [10.0, 17.0]])
+    oracle = np.zeros((20, 40), bool)
+    oracle[5, 2:31] = True
+    oracle[12:18, 10] = True
+    cand = oracle.copy()
+    cand[17, 10] = False
+    batch = LineBatch()
+    got = batch.add("same", FramePixels(oracle, oracle), p0, p1) + batch.add("short", FramePixels(cand, oracle), p0, p1)
+    got += batch.flush()
+    scores = dict(got)
+    assert scores["same"]["edges_compared"] == 2 and scores["same"]["edge_count_max_diff"] == 0
+    short = scores["short"]
+    assert (short["edges_compared"], short["edge_count_worst_edge"], short["edge_count_worst_diff"]) == (2, 2, -1)
+    assert short["edge_count_diff_sum"] == -1
+    assert scores["short"] == line_scores(cand, oracle, p0, p1)      # the full count over every drawn pixel
+
+
 def test_line_scores_with_nothing_drawn_near_an_edge_on_screen():
     from wirecheck.oracles.metrics import line_scores
 
     blank = np.zeros((24, 36), bool)
     s = line_scores(blank, blank, np.array([[2.0, 3.0]]), np.array([[30.0, 20.0]]))
     assert (s["candidate_only"], s["oracle_only"], s["edges_compared"], s["edge_count_max_diff"]) == (0, 0, 0, 0)
+
+
+@pytest.mark.parametrize("how", ["flat", "bits"])
+def test_kept_image_gives_the_image_back(how):
+    """worst.gif's kept frames: a wireframe kept as its drawn pixels' indices, a silhouette as bits."""
+    from wirecheck.oracles.case import KeptImage
+
+    image = np.zeros((5, 7), bool)
+    image[0, 0] = image[4, 6] = image[2, 3] = True        # the corners and the middle
+    kept = KeptImage.of(image, np.flatnonzero(image) if how == "flat" else None)
+    assert (kept.flat is not None) == (how == "flat")
+    np.testing.assert_array_equal(kept.image(), image)

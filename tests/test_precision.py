@@ -282,3 +282,21 @@ def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
     # declared float64, the same answer fails: float64 leaves no room for a tie there
     (strict,) = check_projector(clips_the_tie, precision="float64", **kwargs)["cases"]
     assert strict["verdict"] == "fail" and "visible sets differ" in " ".join(strict["reasons"])
+
+
+@pytest.mark.parametrize("limit", [1, 20, 1 << 16])
+def test_scale_batch_is_the_largest_frame_scale(limit):
+    """A case measures its frames' vertex scales together (oracles.case.ScaleBatch): the largest of
+    the frames' own scales, whether it measures each frame alone, a few together or all at the end."""
+    from wirecheck.oracles import opencv_oracle
+    from wirecheck.oracles.case import ScaleBatch
+
+    rng = np.random.default_rng(11)
+    cam = look_at((0.0, 1.0, 6.0), (0.0, 0.0, 0.0), fov_y_deg=60.0, width=320, height=240, near=0.5, far=40.0)
+    frames = [rng.uniform(-3, 3, (int(rng.integers(1, 15)), 3)) * rng.choice([1.0, 30.0]) for _ in range(9)]
+    expected = max(vertex_scale(p, opencv_oracle.project(p, cam), cam) for p in frames)
+    assert expected > 0
+    batch = ScaleBatch(limit=limit)
+    for p in frames:
+        batch.add(p, opencv_oracle.project(p, cam), cam)
+    assert batch.flush(cam) == expected
