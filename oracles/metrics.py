@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .segment_pixels import clip_segments as _clip_segments
+from .segment_pixels import nearest_segments
 from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
 
 
@@ -435,35 +435,22 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
 def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
     """:func:`end_attribution` of the frame whose drawn pixels are ``fp``."""
     out = {k: [0, 0] for k in ("start", "end", "middle", "stray")}
-    p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
-    p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
     h, w = fp.shape
-    ok, p0, p1 = _clip_segments(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
-    p0, p1 = p0[ok], p1[ok]
+    box = ((-0.5, -0.5), (w - 0.5, h - 0.5))                  # where a line leaving the picture ends
     for side, only in enumerate(fp.only()):
-        rr, cc = only // w, only % w
-        if len(rr) == 0:
+        if len(only) == 0:
             continue
-        if len(p0) == 0:
-            out["stray"][side] += len(rr)
-            continue
-        c = np.column_stack([cc, rr]).astype(np.float64)
-        for k in range(0, len(c), 2048):                 # (pixels, segments) distances, in chunks
-            q = c[k:k + 2048, None, :]
-            d = (p1 - p0)[None]
-            dd = (d * d).sum(axis=2)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                u = np.clip(np.where(dd > 0, ((q - p0[None]) * d).sum(axis=2) / dd, 0.0), 0.0, 1.0)
-            dist = np.hypot(*np.moveaxis(q - p0[None] - u[..., None] * d, 2, 0))
-            m = np.argmin(dist, axis=1)
-            rows = np.arange(len(m))
-            near = dist[rows, m] <= END_REACH_PX
-            to_start = np.hypot(*(q[:, 0] - p0[m]).T) <= END_REACH_PX
-            to_end = np.hypot(*(q[:, 0] - p1[m]).T) <= END_REACH_PX
-            out["stray"][side] += int((~near).sum())
-            out["start"][side] += int((near & to_start & ~to_end).sum())
-            out["end"][side] += int((near & to_end & ~to_start).sum())
-            out["middle"][side] += int((near & (to_start == to_end)).sum())
+        # each pixel's nearest segment within reach (the segments near it only, not all of them)
+        owner, q0, q1 = nearest_segments(p0_px, p1_px, only, w, h, END_REACH_PX, box)
+        near = owner >= 0
+        m = owner[near]
+        c = np.column_stack([only[near] % w, only[near] // w]).astype(np.float64)
+        to_start = np.hypot(*(c - q0[m]).T) <= END_REACH_PX
+        to_end = np.hypot(*(c - q1[m]).T) <= END_REACH_PX
+        out["stray"][side] += int((~near).sum())
+        out["start"][side] += int((to_start & ~to_end).sum())
+        out["end"][side] += int((to_end & ~to_start).sum())
+        out["middle"][side] += int((to_start == to_end).sum())
     return out
 
 

@@ -192,6 +192,36 @@ def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int) -
     return np.bincount(keys // span, minlength=n_segments)
 
 
+def nearest_segments(p0_px: np.ndarray, p1_px: np.ndarray, pixels: np.ndarray, width: int, height: int,
+                     radius: float, box: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each pixel's nearest segment within ``radius``, among the segments clipped to ``box``.
+
+    Parameters
+    ----------
+    p0_px, p1_px : (E, 2) array_like
+        Segments in pixels (NaN rows skipped).
+    pixels : (P,) array_like of int
+        Ascending flat indices ``y W + x``.
+    radius : float
+    box : ((x, y), (x, y))
+        The corners the segments are clipped to first.
+
+    Returns
+    -------
+    owner : (P,) int64
+        Index into the kept segments of each pixel's nearest one within
+        ``radius`` (ties: the lower index), -1 where none is that near.
+    q0, q1 : (K, 2) float64
+        The kept segments, clipped.
+    """
+    segs = _Segments([(p0_px, p1_px)], width, height, radius, box=box)
+    px = _Pixels.of_frames([pixels], width, height)
+    owner = np.full(len(px), -1, np.int64)
+    sid, pos = segs.owners(px, *segs.pairs_any(px))
+    owner[pos] = sid
+    return owner, segs.q0, segs.q1
+
+
 class _Pixels:
     """Pixels of several frames of one size, stacked: frame ``k``'s rows start at row ``k H``.
 
@@ -236,11 +266,13 @@ class _Pixels:
 
 
 class _Segments:
-    """Segments of several frames of one size, clipped to each frame's box grown by ``radius + 1``."""
+    """Segments of several frames of one size, clipped to each frame's box grown by ``radius + 1``
+    (or to ``box``, ``(lo, hi)`` corners, when given)."""
 
-    def __init__(self, per_frame, width: int, height: int, radius: float):
+    def __init__(self, per_frame, width: int, height: int, radius: float, box: tuple | None = None):
         self.width, self.height, self.radius = width, height, radius
         pad = radius + 1.0
+        lo, hi = box if box is not None else ((-pad, -pad), (width - 1 + pad, height - 1 + pad))
         self.grow = radius + 0.5            # each box is grown by a further 1/2 px, against rounding
         p0 = [np.asarray(a, np.float64).reshape(-1, 2) for a, _ in per_frame]
         p1 = [np.asarray(b, np.float64).reshape(-1, 2) for _, b in per_frame]
@@ -249,7 +281,8 @@ class _Segments:
         edge = np.arange(int(self.counts.sum())) - np.repeat(np.cumsum(self.counts) - self.counts, self.counts)
         p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
         p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
-        keep, q0, q1 = clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
+        keep, q0, q1 = clip_segments(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
+        self.keep = keep
         self.q0, self.q1 = q0[keep], q1[keep]
         self.frame, self.edge = frame[keep], edge[keep]
         self.d = self.q1 - self.q0

@@ -276,3 +276,43 @@ def test_kept_image_gives_the_image_back(how):
     kept = KeptImage.of(image, np.flatnonzero(image) if how == "flat" else None)
     assert (kept.flat is not None) == (how == "flat")
     np.testing.assert_array_equal(kept.image(), image)
+
+
+def _ends_naive(cand, oracle, p0, p1, reach=1.5):
+    """end_attribution's definition, pixel by pixel: the nearest segment (clipped to the image's edges)."""
+    from wirecheck.oracles.segment_pixels import clip_segments
+
+    h, w = cand.shape
+    ok, q0, q1 = clip_segments(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
+    q0, q1 = q0[ok], q1[ok]
+    out = {k: [0, 0] for k in ("start", "end", "middle", "stray")}
+    for side, only in enumerate((cand & ~oracle, oracle & ~cand)):
+        for y, x in zip(*np.nonzero(only)):
+            c = np.array([x, y], float)
+            best = None
+            for a, b in zip(q0, q1):
+                d = b - a
+                u = 0.0 if d @ d == 0 else min(max((c - a) @ d / (d @ d), 0.0), 1.0)
+                dist = np.hypot(*(c - a - u * d))
+                if best is None or dist < best[0]:
+                    best = (dist, a, b)
+            if best is None or best[0] > reach:
+                out["stray"][side] += 1
+                continue
+            s, e = np.hypot(*(c - best[1])) <= reach, np.hypot(*(c - best[2])) <= reach
+            out["start" if s and not e else "end" if e and not s else "middle"][side] += 1
+    return out
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_end_attribution_equals_the_definition(seed):
+    from wirecheck.oracles.metrics import end_attribution
+
+    rng = np.random.default_rng(200 + seed)
+    w, h = 30, 20
+    p0 = rng.uniform(-5, 35, (9, 2))
+    p1 = p0 + rng.normal(0, 8, (9, 2))
+    p1[3] = p0[3]                                       # a point
+    p0[4] = np.nan                                      # not drawn
+    cand, oracle = rng.random((h, w)) < 0.15, rng.random((h, w)) < 0.15
+    assert end_attribution(cand, oracle, p0, p1) == _ends_naive(cand, oracle, p0, p1)
