@@ -235,6 +235,7 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
             pixel_stage(setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6,
                         projected)
     t7 = time.perf_counter()
+    score_vertices(acc)
     acc.scale = acc.scales.flush(setup.cam, setup.cv_matrices)
     t7 = acc.add("vmetric", t7)
     record_lines(acc, acc.line_batch.flush())
@@ -309,16 +310,26 @@ def forgive_depth_ties(acc: CaseFrames, setup: CaseSetup, p_world: np.ndarray, c
 
 
 def vertex_stage(acc: CaseFrames, k: int, cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
-    """Score frame ``k``'s vertex pixels against OpenCV's; keep them for the case; return the frame's record."""
+    """Keep frame ``k``'s vertex pixels and OpenCV's for the case; return the frame's record.
+
+    The record's vertex fields are filled by :func:`score_vertices`, for all
+    frames at once (metrics.vertex_errors_frames).
+    """
     acc.cand_px.append(cand_px)
     acc.oracle_px.append(oracle_px)
-    ve = metrics.vertex_errors(cand_px, oracle_px)
-    if ve["max_px"] is not None:
-        acc.frame_errors.append((ve["max_px"], k, ve["worst_index"]))
-    frame_rec = {"frame": k, "max_vertex_error_px": ve["max_px"], "mean_vertex_error_px": ve["mean_px"],
-                 "rms_vertex_error_px": ve["rms_px"], "visible_points": ve["visible_both"]}
+    frame_rec = {"frame": k, "max_vertex_error_px": None, "mean_vertex_error_px": None,
+                 "rms_vertex_error_px": None, "visible_points": None}
     acc.per_frame.append(frame_rec)
     return frame_rec
+
+
+def score_vertices(acc: CaseFrames) -> None:
+    """Every kept frame's vertex errors into its record and ``acc.frame_errors``."""
+    for frame_rec, ve in zip(acc.per_frame, metrics.vertex_errors_frames(acc.cand_px, acc.oracle_px)):
+        if ve["max_px"] is not None:
+            acc.frame_errors.append((ve["max_px"], frame_rec["frame"], ve["worst_index"]))
+        frame_rec.update({"max_vertex_error_px": ve["max_px"], "mean_vertex_error_px": ve["mean_px"],
+                          "rms_vertex_error_px": ve["rms_px"], "visible_points": ve["visible_both"]})
 
 
 def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geometry, cand_img, cand_depth,

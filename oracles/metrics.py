@@ -54,6 +54,33 @@ def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
     return out
 
 
+def vertex_errors_frames(cand_frames: list, oracle_frames: list) -> list[dict]:
+    """:func:`vertex_errors` of several frames: ``[vertex_errors(c, o) for c, o in zip(...)]``, the same floats.
+
+    Frames of one size whose points are all visible on both sides and finite
+    are scored together (the row-wise reductions of a ``(F, N)`` array add
+    each row as a 1-D array is added); the others one by one.
+    """
+    out: list = [None] * len(cand_frames)
+    sizes = {np.shape(c) for c in cand_frames} | {np.shape(o) for o in oracle_frames}
+    if len(sizes) == 1 and cand_frames and len(cand_frames[0]):
+        c, o = np.stack(cand_frames), np.stack(oracle_frames)
+        with np.errstate(invalid="ignore", over="ignore"):
+            d = c - o
+            err = np.hypot(d[..., 0], d[..., 1])
+            whole = np.isfinite(c).all(axis=(1, 2)) & np.isfinite(o).all(axis=(1, 2)) & np.isfinite(err).all(axis=1)
+        if whole.any():
+            e = err[whole]
+            k = np.argmax(e, axis=1)
+            mx, mean, rms = e[np.arange(len(e)), k], e.mean(axis=1), np.sqrt((e ** 2).mean(axis=1))
+            n = c.shape[1]
+            for j, f in enumerate(np.flatnonzero(whole)):
+                out[f] = {"points": n, "visible_both": n, "candidate_only": 0, "oracle_only": 0,
+                          "max_px": float(mx[j]), "mean_px": float(mean[j]), "rms_px": float(rms[j]),
+                          "worst_index": int(k[j])}
+    return [r if r is not None else vertex_errors(c, o) for r, c, o in zip(out, cand_frames, oracle_frames)]
+
+
 class FramePixels:
     """The drawn pixels of a candidate frame and the oracle's, found once and shared by one frame's metrics.
 

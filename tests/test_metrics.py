@@ -316,3 +316,20 @@ def test_end_attribution_equals_the_definition(seed):
     p0[4] = np.nan                                      # not drawn
     cand, oracle = rng.random((h, w)) < 0.15, rng.random((h, w)) < 0.15
     assert end_attribution(cand, oracle, p0, p1) == _ends_naive(cand, oracle, p0, p1)
+
+
+def test_vertex_errors_frames_equal_frame_by_frame():
+    """A case's frames scored together give each frame's own vertex_errors, to the bit (NaN rows: clipped)."""
+    import json
+
+    from wirecheck.oracles.metrics import vertex_errors, vertex_errors_frames
+
+    rng = np.random.default_rng(9)
+    cand = [rng.normal(300, 200, (13, 2)) for _ in range(10)]
+    orac = [c + rng.normal(0, 1e-3, c.shape) for c in cand]
+    cand[2][4] = np.nan                                  # clipped by the candidate only: shown by the oracle only
+    orac[5][0] = np.nan                                  # clipped by the oracle only: shown by the candidate only
+    cand[7][3, 1] = np.inf                               # a broken answer
+    got = vertex_errors_frames(cand, orac)
+    assert json.dumps(got) == json.dumps([vertex_errors(c, o) for c, o in zip(cand, orac)])
+    assert got[2]["oracle_only"] == 1 and got[5]["candidate_only"] == 1 and got[7]["max_px"] == float("inf")
