@@ -16,11 +16,17 @@ along its segment's major axis (x when ``|dx| > |dy|``, else y).
 Given the drawn pixels (the usual case), pairs are found row by row: the
 pixels are sorted row-major, so the ones of one row between two columns are
 one slice of them. For each row a segment's grown box spans, the slice runs
-over the columns its part near that row reaches; each pair found is measured. The frames of a case are done in one pass
-(:func:`frames_neighbourhoods`): they are stacked one above the other, and
-a segment looks only at its own frame's rows, so no pair mixes two frames and
-each frame's rows are the ones it would get alone; distances are measured in
-the frame's own coordinates, so they are the same floats too.
+over the columns its part near that row reaches; each pair found is
+measured. For a few pixels, a grid of cells lists the segments near each
+cell instead. The frames of a case are done in one pass: they are stacked
+one above the other, and a segment looks only at its own frame's rows, so no
+pair mixes two frames and each frame's rows are the ones it would get alone;
+distances are measured in the frame's own coordinates, so they are the same
+floats too.
+
+The line gate's counts (:func:`frames_count_differences`) and ends
+(:func:`nearest_segments`) use this pairing; :func:`edge_neighbourhoods`
+gives the rows themselves.
 """
 
 from __future__ import annotations
@@ -33,7 +39,6 @@ _EMPTY = np.zeros(0, dtype=np.int64)
 #: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
 #: looking at midpoints and one-sided pixels first would pair most pixels several times over).
 DENSE = 8
-
 
 
 def clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
@@ -131,50 +136,54 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     orac = _Pixels.of_frames([fp.oracle_idx for _, _, fp in frames], width, height)
     drawn = _Pixels.of_frames([fp.drawn() for _, _, fp in frames], width, height)
     one_sided = _Pixels.of_frames([np.sort(np.concatenate(fp.only())) for _, _, fp in frames], width, height)
-    n_frames = len(frames)
     first_edge = np.cumsum(segs.counts) - segs.counts          # frame k's edges in one flat array of all
     diff_all = np.zeros(int(segs.counts.sum()), np.int64)
-    if len(segs) == 0 or len(drawn) == 0:
-        return [(d, 0) for d in np.split(diff_all, first_edge[1:])]
-    if len(segs) * DENSE > len(drawn):          # a dense mesh: one pass over every drawn pixel is cheaper
-        sid, pos = segs.owners(drawn, *segs.pairs(drawn))
-        _, _, major = segs.rows(drawn, sid, pos)
-        in_cand, in_orac = cand.has(drawn.stacked[pos]), orac.has(drawn.stacked[pos])
-        cc, oc = (_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac))
-        diff_all[first_edge[segs.frame] + segs.edge] = cc - oc
-        n_compared = np.bincount(segs.frame[(cc > 0) | (oc > 0)], minlength=n_frames)
-        return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
+    compared = np.zeros(len(segs), bool)
+    if len(segs) and len(drawn):
+        if len(segs) * DENSE > len(drawn):          # a dense mesh: one pass over every drawn pixel is cheaper
+            owners = np.arange(len(segs))
+            cc, oc = _counts_near(segs, cand, orac, drawn, every=True)
+            compared = (cc > 0) | (oc > 0)
+        else:
+            compared = _compared(segs, drawn)
+            owners = _unique(segs.owners(one_sided, *segs.pairs_any(one_sided))[0])
+            cc = oc = np.zeros(len(segs), np.int64)
+            if len(owners):
+                cc, oc = _counts_near(segs, cand, orac, drawn.subset(_unique(segs.pairs(drawn, owners)[1])))
+        diff_all[first_edge[segs.frame[owners]] + segs.edge[owners]] = (cc - oc)[owners]
+    n_compared = np.bincount(segs.frame[compared], minlength=len(frames))
+    return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
 
-    # 1. compared edges: the owner of each segment's midpoint pixel, when that pixel is drawn ...
+
+def _compared(segs: "_Segments", drawn: "_Pixels") -> np.ndarray:
+    """``(S,)`` bool: whether each segment owns a drawn pixel (the pixel at its midpoint, or another near it)."""
+    w, h = segs.width, segs.height
     mid = np.floor((segs.q0 + segs.q1) / 2 + 0.5).astype(np.int64)
-    on = (mid[:, 0] >= 0) & (mid[:, 0] < width) & (mid[:, 1] >= 0) & (mid[:, 1] < height)
-    mid_stacked = np.where(on, (mid[:, 1] + segs.frame * height) * width + mid[:, 0], -1)
+    on = (mid[:, 0] >= 0) & (mid[:, 0] < w) & (mid[:, 1] >= 0) & (mid[:, 1] < h)
+    mid_stacked = np.where(on, (mid[:, 1] + segs.frame * h) * w + mid[:, 0], -1)
     on &= drawn.has(mid_stacked)
     mids = drawn.subset(_unique(np.searchsorted(drawn.stacked, mid_stacked[on])))
     m_sid, m_pos = segs.owners(mids, *segs.pairs_any(mids))
-    compared = np.zeros(len(segs), bool)
     owner_at = np.full(len(mids), -1, np.int64)
     owner_at[m_pos] = m_sid
     seg_on = np.flatnonzero(on)
+    compared = np.zeros(len(segs), bool)
     compared[seg_on] = owner_at[np.searchsorted(mids.stacked, mid_stacked[seg_on])] == seg_on
-    # ... and for the others, the owners of the drawn pixels near them
-    rest = np.flatnonzero(~compared)
+    rest = np.flatnonzero(~compared)           # the others: the owners of the drawn pixels near them
     if len(rest):
         near = drawn.subset(_unique(segs.pairs(drawn, rest)[1]))
         compared[_unique(segs.owners(near, *segs.pairs_any(near))[0])] = True
-    n_compared = np.bincount(segs.frame[compared], minlength=n_frames)
+    return compared
 
-    # 2. count differences: the owners of one-sided pixels, counted on the drawn pixels near them
-    if len(one_sided):
-        owners = _unique(segs.owners(one_sided, *segs.pairs_any(one_sided))[0])
-        if len(owners):
-            near = drawn.subset(_unique(segs.pairs(drawn, owners)[1]))
-            sid, pos = segs.owners(near, *segs.pairs_any(near))     # (other edges' rows too: not read)
-            _, _, major = segs.rows(near, sid, pos)
-            in_cand, in_orac = cand.has(near.stacked[pos]), orac.has(near.stacked[pos])
-            counts = [_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac)]
-            diff_all[first_edge[segs.frame[owners]] + segs.edge[owners]] = (counts[0] - counts[1])[owners]
-    return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
+
+def _counts_near(segs: "_Segments", cand: "_Pixels", orac: "_Pixels", near: "_Pixels", every: bool = False):
+    """``(cc, oc)``, ``(S,)`` each: every segment's count in the candidate's and the oracle's image, over
+    the drawn pixels ``near`` only (right for the segments all of whose pixels are among them);
+    ``every``: ``near`` is every drawn pixel (paired row by row)."""
+    sid, pos = segs.owners(near, *(segs.pairs(near) if every else segs.pairs_any(near)))
+    _, _, major = segs.rows(near, sid, pos)
+    in_cand, in_orac = cand.has(near.stacked[pos]), orac.has(near.stacked[pos])
+    return tuple(_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac))
 
 
 def _unique(a: np.ndarray) -> np.ndarray:
