@@ -323,7 +323,8 @@ class _Segments:
         return self._near(px, sid, pos)
 
     def pairs_any(self, px: _Pixels):
-        """:meth:`pairs` over all segments, for a subset of the pixels: through a grid of cells.
+        """:meth:`pairs` over all segments, for a subset of the pixels: each against every segment of its
+        frame when that is few pairs (and no grid is made yet), else through a grid of cells.
 
         Each segment is listed in the square cells its part near each band of
         cell rows reaches (as :meth:`pairs` does row by row); a pixel is
@@ -334,8 +335,16 @@ class _Segments:
         """
         if len(px) == 0 or len(self) == 0:
             return _EMPTY, _EMPTY, np.zeros(0)
+        frame = px.at()[0]
+        per_frame = np.bincount(self.frame, minlength=int(frame.max()) + 1)
+        n = per_frame[frame]                                 # each pixel against all of its frame's segments
+        if self._cells is None and int(n.sum()) <= 4 * (len(px) + len(self)):
+            first = np.cumsum(per_frame) - per_frame         # segments are in frame order
+            pos = np.repeat(np.arange(len(px)), n)
+            sid = np.arange(int(n.sum())) + np.repeat(first[frame] - (np.cumsum(n) - n), n)
+            return self._near(px, sid, pos)
         keys, listed = self._cell_index()
-        frame, y, x = px.at()
+        _, y, x = px.at()
         cell = self._cell
         key = (frame * self._cells_y + y // cell) * self._cells_x + x // cell
         a = np.searchsorted(keys, key, side="left")
@@ -376,7 +385,8 @@ class _Segments:
         crosses, and a cell holds ~(side / length + 1) segments of each line
         through it: a side near the typical length keeps both near 1.
         """
-        length = np.median(np.abs(self.d).max(axis=1)) if len(self) else 16.0
+        lengths = np.sort(np.abs(self.d).max(axis=1))
+        length = lengths[len(lengths) // 2] if len(lengths) else 16.0
         return int(2 ** np.clip(np.round(np.log2(max(length, 1.0))), 2, 5))
 
     def _spans(self, which: np.ndarray, band: int):
