@@ -3,7 +3,9 @@
 One ``<testcase classname=SCENE name=CAMERA>`` per case of the report; a case
 that did not pass gets a ``<failure>`` whose ``message`` is its faults and
 reasons on one line and whose text adds what to check for each fault
-(oracles.report.FAULT_HINTS). The ``time`` attributes are the only fields that
+(oracles.report.FAULT_HINTS). A case's ``note`` (what was not compared, and
+why) is its testcase's property ``note`` and its ``<system-out>`` (the part
+most dashboards show). The ``time`` attributes are the only fields that
 change between runs of the same inputs (they come from the report's
 ``"timing"``). The file is written to a temporary name and renamed into place,
 and only a new path or an earlier file of ours is replaced.
@@ -68,12 +70,16 @@ def junit_xml(report: dict) -> bytes:
     for c in cases:
         elem = ET.SubElement(suite, "testcase", {"classname": c["scene"], "name": c["camera"],
                                                  "time": f"{_seconds(timing.get((c['scene'], c['camera']))):.3f}"})
+        if c.get("note"):
+            ET.SubElement(ET.SubElement(elem, "properties"), "property", {"name": "note", "value": c["note"]})
         if c["verdict"] != "pass" and id(c) not in failing:
             ET.SubElement(elem, "skipped", {"message": "; ".join(c["reasons"]) + " (allowed by --allow-vacuous)"})
         elif c["verdict"] != "pass":
             kind = ",".join(f["name"] for f in c.get("faults") or []) or c["verdict"]
             failure = ET.SubElement(elem, "failure", {"message": failure_message(c), "type": kind})
             failure.text = failure_text(c)
+        if c.get("note"):
+            ET.SubElement(elem, "system-out").text = f"note: {c['note']}\n"
     ET.indent(root)
     return b'<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
 

@@ -272,6 +272,16 @@ def precision_text(report: dict) -> str:
     return f"{', '.join(judged)}; vertex bound {span}"
 
 
+def case_notes(report: dict) -> list[tuple[dict, str]]:
+    """``(case, text)`` for each case's ``note`` (what was not compared, and why), then each vacuous
+    case allowed by ``--allow-vacuous`` (its reasons): the Notes of report.md and report.html."""
+    failing = not_passed(report)
+    notes = [(c, c["note"]) for c in report["cases"] if c.get("note")]
+    notes += [(c, "; ".join(c["reasons"]) + " (allowed)") for c in report["cases"]
+              if c["verdict"] == "vacuous" and c not in failing]
+    return notes
+
+
 def markdown(report: dict, files: set | None = None) -> str:
     """report.md; ``files``: the figures written beside it (linked when present)."""
     files = files or set()
@@ -308,9 +318,7 @@ def markdown(report: dict, files: set | None = None) -> str:
         if "worst.gif" in files and _worst_text(report):
             out.append(f"- [worst.gif](worst.gif): the worst case, {_worst_text(report)}")
         out += [f"- [{name}]({name}): {caption}" for name, caption in figures]
-    notes = [(c, c["note"]) for c in report["cases"] if c.get("note")]
-    notes += [(c, "; ".join(c["reasons"]) + " (allowed)") for c in report["cases"]
-              if c["verdict"] == "vacuous" and c not in failing]
+    notes = case_notes(report)
     if notes:
         out += ["", "## Notes", ""]
         out += [f"- {c['scene']} / {c['camera']}: {note}" for c, note in notes]
@@ -354,6 +362,11 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append("<h2>Why cases failed</h2><ul>" + "".join(
             f"<li><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e('; '.join(c['reasons']))}</li>"
             for c in failing) + "</ul>")
+    notes = case_notes(report)
+    if notes:
+        parts.append("<h2>Notes</h2><ul>" + "".join(
+            f"<li class='note'><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e(note)}</li>" for c, note in notes)
+            + "</ul>")
     names = sorted({f["name"] for c in report["cases"] for f in c["faults"]}, key=list(FAULT_HINTS).index)
     if names:
         parts.append("<h2>What to check</h2><ul>" + "".join(
@@ -394,7 +407,8 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append(
             f"<section><p><b>{e(case['scene'])} / {e(case['camera'])}</b>, frame "
             f"{case.get('worst_pixel_frame')}: {scores}, "
-            f"faults: {e(fault_text(case['faults'], case.get('camera_spec')))}</p>"
+            f"faults: {e(fault_text(case['faults'], case.get('camera_spec')))}"
+            + (f"; note: {e(case['note'])}" if case.get("note") else "") + "</p>"
             f"<div class='row'>{figs}</div></section>")
     parts.append("</body></html>\n")
     return "\n".join(parts)
