@@ -56,6 +56,11 @@ class Dataset:
         return {"sources": list(self.sources), "meshes": len(self.entries), "other_files": self.other_files}
 
 
+def printable(name: str) -> str:
+    """``name`` with the bytes of a non-UTF-8 file name (surrogates from os) as ``\\xNN`` escapes."""
+    return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+
+
 def is_mesh_file(name: str) -> bool:
     return Path(name).suffix.lower() in MESH_SUFFIXES
 
@@ -158,9 +163,13 @@ def dataset_entries(folders=(), lists=()) -> Dataset:
         entries += found
     if not entries:
         raise InputError("no dataset given: expected --scene DIR or --scene-list FILE")
+    # a file name that is not UTF-8 (os gives its bytes as surrogates) is named with \x escapes:
+    # the reports are UTF-8 text (a surrogate cannot be written there)
+    entries = [MeshEntry(printable(e.name), e.path, e.error) for e in entries]
     entries.sort(key=lambda e: e.name)
     for a, b in zip(entries, entries[1:]):
         if a.name == b.name:
-            raise InputError(f"two meshes named {a.name!r} ({a.path}, {b.path}): the report names meshes by "
-                             "their path under the folder or in the list: expected each name once")
-    return Dataset(entries=tuple(entries), sources=tuple(str(s) for s in (*folders, *lists)), other_files=other)
+            raise InputError(f"two meshes named {a.name!r} ({printable(a.path)}, {printable(b.path)}): the report "
+                             "names meshes by their path under the folder or in the list: expected each name once")
+    return Dataset(entries=tuple(entries), sources=tuple(printable(str(s)) for s in (*folders, *lists)),
+                   other_files=other)
