@@ -92,6 +92,12 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+#: Most worker processes --jobs may ask for, on this machine or a local Dask cluster.
+MAX_JOBS = 256
+#: Longest --scheduler-timeout: 1e308 s waited for ever on an address where no scheduler runs.
+MAX_SCHEDULER_TIMEOUT_S = 3600.0
+
+
 def _version() -> str:
     import wirecheck
 
@@ -201,6 +207,8 @@ def _parse(args):
         args.frames = 12 if args.sweep else 24
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs}: expected an integer >= 1")
+    if args.jobs > MAX_JOBS:
+        raise InputError(f"--jobs {args.jobs}: expected at most {MAX_JOBS} worker processes")
     args.executor_spec = _executor(args)
     args.dataset = _dataset(args)
     level = args.level or "pixels"
@@ -295,8 +303,9 @@ def _executor(args) -> ExecutorSpec:
             raise InputError(f"--jobs {args.jobs} with --scheduler: the cluster's workers are those started with "
                              "'dask worker': expected no --jobs")
         check_scheduler_address(args.scheduler)
-    if not (math.isfinite(args.scheduler_timeout) and args.scheduler_timeout > 0):
-        raise InputError(f"--scheduler-timeout {args.scheduler_timeout}: expected a number of seconds > 0")
+    if not (math.isfinite(args.scheduler_timeout) and 0 < args.scheduler_timeout <= MAX_SCHEDULER_TIMEOUT_S):
+        raise InputError(f"--scheduler-timeout {args.scheduler_timeout:g}: expected a number of seconds > 0 and "
+                         f"<= {MAX_SCHEDULER_TIMEOUT_S:g}")
     if args.scheduler is None and args.scheduler_timeout != DEFAULT_CONNECT_TIMEOUT_S:
         raise InputError(f"--scheduler-timeout {args.scheduler_timeout:g} without --scheduler: it bounds reaching "
                          "a cluster's scheduler: expected --scheduler tcp://HOST:PORT")

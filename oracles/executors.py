@@ -84,8 +84,11 @@ def _quiet_dask():
 
 
 @contextlib.contextmanager
-def _dask_client(spec: ExecutorSpec):
-    """A connected ``distributed.Client`` with at least one worker; InputError when there is none in time."""
+def _dask_client(spec: ExecutorSpec, n_workers: int | None = None):
+    """A connected ``distributed.Client`` with at least one worker; InputError when there is none in time.
+
+    A local cluster starts ``n_workers`` (default ``spec.jobs``) processes.
+    """
     try:
         from distributed import Client, LocalCluster
     except ImportError as exc:       # pragma: no cover - a dependency in pyproject.toml
@@ -93,7 +96,7 @@ def _dask_client(spec: ExecutorSpec):
             from None
     with _quiet_dask():
         if spec.scheduler is None:
-            cluster = LocalCluster(n_workers=spec.jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
+            cluster = LocalCluster(n_workers=n_workers or spec.jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
                                    dashboard_address=None, silence_logs=logging.CRITICAL)
             try:
                 client = Client(cluster)
@@ -108,6 +111,12 @@ def _dask_client(spec: ExecutorSpec):
                 raise InputError(f"--scheduler {spec.scheduler}: no Dask scheduler answered within "
                                  f"{spec.connect_timeout_s:g} s ({type(exc).__name__}): expected a running "
                                  "'dask scheduler' at that address") from None
+            except TypeError as exc:
+                if not spec.scheduler.startswith("tls://"):
+                    raise
+                # distributed wants an ssl.SSLContext from the Dask config's TLS settings
+                raise InputError(f"--scheduler {spec.scheduler}: TLS without certificates ({exc}): expected the "
+                                 "Dask config's distributed.comm.tls settings, or a tcp:// address") from None
         try:
             if spec.scheduler is not None:
                 try:
@@ -168,7 +177,8 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
     even for one job, so that a candidate cannot end this process.
     """
     if spec.kind == "dask":
-        with _dask_client(spec) as client:
+        # a local cluster starts no more workers than there are tasks (like the process pool below)
+        with _dask_client(spec, min(spec.jobs, max(n_tasks, 1))) as client:
             client.run(heap_for_arrays)
             if initializer is not None:
                 client.run(initializer)          # on every worker, before the first task

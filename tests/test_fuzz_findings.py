@@ -52,3 +52,56 @@ def test_two_inputs_naming_one_mesh_name_it_printably(tmp_path, capsys):
     assert code == 2 and err.count("\n") == 1 and "two meshes named" in err
     assert "bad\\xff.obj" in err and "\udcff" not in err
     assert not (tmp_path / "run").exists()
+
+
+def _error_line(capsys, argv) -> str:
+    code = cli.main(argv)
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, (code, err)
+    return err
+
+
+@pytest.mark.parametrize("extra, message", [
+    # a local Dask cluster of 99999 workers never started (killed after 200 s, a RuntimeError from
+    # distributed on the way)
+    (["--executor", "dask", "--jobs", "99999"], "--jobs 99999: expected at most 256 worker processes"),
+    (["--jobs", "257"], "--jobs 257: expected at most 256 worker processes"),
+    # 1e308 s: waited for ever on an address where nothing listens
+    (["--scheduler", "tcp://127.0.0.1:1", "--scheduler-timeout", "1e308"],
+     "--scheduler-timeout 1e+308: expected a number of seconds > 0 and <= 3600"),
+])
+def test_executor_bounds(tmp_path, capsys, extra, message):
+    err = _error_line(capsys, ["--report-dir", str(tmp_path / "run"), "--level", "vertices", "--frames", "1",
+                               "--scene", "cube", "--cases", "on_axis", *extra])
+    assert message in err and not (tmp_path / "run").exists()
+
+
+def test_tls_scheduler_without_certificates_is_an_input_error(tmp_path, capsys):
+    # tls:// passes the address check; distributed then raised a TypeError (no ssl_context), reported
+    # as "a Dask task failed ... every worker needs the same wirecheck": not the cause.
+    pytest.importorskip("distributed")
+    err = _error_line(capsys, ["--report-dir", str(tmp_path / "run"), "--level", "vertices", "--frames", "1",
+                               "--scene", "cube", "--cases", "on_axis", "--scheduler", "tls://127.0.0.1:1",
+                               "--scheduler-timeout", "1"])
+    assert "--scheduler tls://127.0.0.1:1: TLS without certificates" in err and "Dask task failed" not in err
+    assert not (tmp_path / "run").exists()
+
+
+def test_local_dask_cluster_starts_no_more_workers_than_tasks(monkeypatch):
+    # --executor dask --jobs 8 for 1 task: 1 worker process, as the local process pool does.
+    from wirecheck.oracles import executors
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def fake_client(spec, n_workers=None):
+        seen["n_workers"] = n_workers
+        raise Stop
+
+    monkeypatch.setattr(executors, "_dask_client", fake_client)
+    with pytest.raises(Stop):
+        with executors.open_executor(executors.ExecutorSpec(kind="dask", jobs=8), n_tasks=1):
+            pass
+    assert seen == {"n_workers": 1}
