@@ -348,24 +348,28 @@ def _register(coarse: _Registration, fine: _Registration):
     return sorted(out, key=lambda r: r[0])
 
 
-def _frames(cand_images, segments, camera, limit: int = MAX_POINTS_PER_FRAME) -> list[_Frame]:
+def _frames(cand_images, segments, camera, limit: int = MAX_POINTS_PER_FRAME, nearest=None) -> list[_Frame]:
+    """``nearest``: the ``_Frame.nearest`` of earlier frames of the same images, reused (it does not depend
+    on ``limit`` or the lines), instead of a distance transform per image."""
     from scipy.ndimage import distance_transform_edt
 
     cx, cy = camera.principal_point
     centre = np.array([cx, cy])
     out = []
-    for img, segs in zip(cand_images, segments):
+    for i, (img, segs) in enumerate(zip(cand_images, segments)):
         img = np.asarray(img, bool)
         if img.shape != (camera.height, camera.width):
             raise ValueError(f"image shape {img.shape}: expected ({camera.height}, {camera.width})")
         segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
         rr, cc = np.nonzero(img)
         cand = _thin(np.stack([cc, rr], axis=1).astype(np.float64) - centre, limit)
-        nearest = (distance_transform_edt(~img, return_distances=False, return_indices=True)
-                   if len(cand) else None)
+        if nearest is not None:
+            near = nearest[i]
+        else:
+            near = distance_transform_edt(~img, return_distances=False, return_indices=True) if len(cand) else None
         samples, tangents = _samples(segs, camera.width, camera.height)
         keep = np.unique(np.linspace(0, len(samples) - 1, min(limit, len(samples))).round().astype(int))
-        out.append(_Frame(cand=cand, nearest=nearest, seg_a=segs[:, 0] - centre, seg_b=segs[:, 1] - centre,
+        out.append(_Frame(cand=cand, nearest=near, seg_a=segs[:, 0] - centre, seg_b=segs[:, 1] - centre,
                           samples=samples[keep] - centre, sample_tangents=tangents[keep],
                           seg_tangents=_unit(segs[:, 1] - segs[:, 0])))
     return out
@@ -425,8 +429,9 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
                  "note": f"only {drawn} drawn pixels: expected at least {MIN_PIXELS} to register"}]
 
     frames = _frames(cand_images, oracle_segs, camera)
+    nearest = [f.nearest for f in frames]                  # one distance transform per image
     fine = _Registration(frames, camera.width, camera.height, centre)
-    coarse = _Registration(_frames(cand_images, oracle_segs, camera, SCREEN_POINTS_PER_FRAME),
+    coarse = _Registration(_frames(cand_images, oracle_segs, camera, SCREEN_POINTS_PER_FRAME, nearest),
                            camera.width, camera.height, centre)
     ranked = _register(coarse, fine)
     plain = next(r for r in ranked if r[1] == ())
@@ -437,7 +442,8 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
     confidence = float(max(0.0, 1.0 - cost / second)) if second > 0 else 0.0
 
     if flipped_segs is not None and flipped_drawn:
-        back = _Registration(_frames(cand_images, flipped_segs, camera), camera.width, camera.height, centre)
+        back = _Registration(_frames(cand_images, flipped_segs, camera, nearest=nearest), camera.width,
+                             camera.height, centre)
         b_cost = back.cost(np.eye(2), np.eye(2), np.zeros(2))
         if b_cost < cost and b_cost <= RESIDUAL_MAX_PX:
             return [{"name": "depth_flip", "confidence": float(max(0.0, 1.0 - b_cost / cost)),

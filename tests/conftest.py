@@ -16,6 +16,8 @@ suite fast: docs/testing.md.
 
 from __future__ import annotations
 
+from collections import Counter
+
 import pytest
 
 # tests/test_pytest_plugin.py runs a user's pytest on a small project
@@ -84,11 +86,14 @@ def oracle():
 
 
 def pytest_collection_modifyitems(config, items):
-    """Test files holding a ``slow`` test run first (stable order otherwise).
+    """Test files holding ``slow`` tests run first, the most slow tests first (stable order otherwise).
 
-    With ``-n 2 --dist loadfile`` each file runs whole on one worker; starting
-    the longest files first keeps one worker from being left with a long file
-    at the end while the other is idle.
+    With ``-n 2 --dist loadfile`` each file runs whole on one worker, and
+    xdist hands out files in this order (pyproject's ``--no-loadscope-reorder``
+    keeps xdist from reordering by test count instead): starting the longest
+    files first and ending on short ones keeps one worker from being left alone
+    with a long file while the other is idle. The count of slow tests is the
+    cost estimate (tests/test_image_diagnosis.py, all slow, the longest, first).
     """
-    slow_files = {item.path for item in items if item.get_closest_marker("slow")}
-    items.sort(key=lambda item: item.path not in slow_files)
+    slow = Counter(item.path for item in items if item.get_closest_marker("slow"))
+    items.sort(key=lambda item: -slow[item.path])

@@ -76,8 +76,11 @@ def test_hang_times_out_and_the_next_case_gets_a_fresh_process(tmp_path, capsys)
 def test_os_exit_0_as_a_real_process_exits_1_with_a_report(tmp_path):
     cand = tmp_path / "bye.py"
     cand.write_text("import os\ndef f(p, c):\n    os._exit(0)\n")
+    # --level vertices: every case fails at its first request, before any pixel is drawn
+    # (pixel_f1 is None at either level); the pixel level would only load pyrender for nothing
     proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", f"{cand}:f",
-                           "--scene", "cube", "--frames", "1", "--report-dir", str(tmp_path / "r")],
+                           "--scene", "cube", "--frames", "1", "--level", "vertices",
+                           "--report-dir", str(tmp_path / "r")],
                           capture_output=True, text=True, cwd=ROOT, timeout=300)
     assert proc.returncode == 1 and proc.stderr == ""
     report = json.loads((tmp_path / "r" / "report.json").read_text())

@@ -285,6 +285,7 @@ def _without_timing(out: Path) -> dict:
     return report
 
 
+@pytest.mark.slow
 def test_report_is_the_same_for_jobs_1_jobs_2_and_a_local_dask_cluster(meshes, tmp_path):
     runs = {"one": ["--jobs", "1"], "two": ["--jobs", "2"], "dask": ["--executor", "dask", "--jobs", "2"]}
     reports = {}
@@ -298,6 +299,7 @@ def test_report_is_the_same_for_jobs_1_jobs_2_and_a_local_dask_cluster(meshes, t
     assert reports["one"][0]["summary"]["passed"] == 3        # and they compared something
 
 
+@pytest.mark.slow
 def test_a_plain_run_on_a_local_dask_cluster_gives_the_report_of_jobs_1(tmp_path):
     args = ("--scene", "cube", "--scene", "pyramid", *FAST)
     code1, r1, out1 = run(tmp_path, *args, name="one")

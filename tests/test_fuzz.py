@@ -73,6 +73,7 @@ def test_renderer_contract(data, earlier):
         assert outcome.problems == [], (argv, outcome)
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck))
 @given(data=st.data())
 def test_crosscheck_contract(data, earlier):

@@ -8,6 +8,7 @@ where that is a failure. On this machine EGL is Mesa's llvmpipe on the CPU;
 a GPU's driver takes the same path.
 """
 
+import functools
 import json
 import os
 import subprocess
@@ -32,12 +33,22 @@ def _env(platform: str) -> dict:
     return {**os.environ, "PYOPENGL_PLATFORM": platform}
 
 
-def probe(platform: str) -> dict:
-    """gl_probe.py's answer on ``platform``; skip (or fail, when required) where it has no GL."""
+@functools.cache
+def _probe_answer(platform: str) -> dict:
+    """gl_probe.py's JSON on ``platform``, run once per test process (an interpreter that loads pyrender: ~1.5 s)."""
     proc = subprocess.run([sys.executable, str(PROBE)], env=_env(platform), capture_output=True, text=True,
                           timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
-    answer = json.loads(proc.stdout)
+    return json.loads(proc.stdout)
+
+
+def probe(platform: str) -> dict:
+    """gl_probe.py's answer on ``platform``; skip (or fail, when required) where it has no GL.
+
+    The answer is shared by the tests that ask (read-only): the probe is
+    deterministic for a platform, and each run of it starts an interpreter.
+    """
+    answer = _probe_answer(platform)
     if not answer["available"]:
         if REQUIRED.get(platform):
             pytest.fail(f"{platform} required (WIRECHECK_REQUIRE_EGL=1) but {answer['why']}")
@@ -102,6 +113,7 @@ def test_no_gl_is_named_where_none_drew(tmp_path):
     assert "Oracle GL" not in (out / "report.md").read_text()
 
 
+@pytest.mark.slow
 def test_crosscheck_on_egl_passes_and_says_egl(tmp_path):
     """The bundled cube through ``crosscheck --gl egl``: every case passes at F1@1px = 1, drawn by EGL."""
     probe("egl")
