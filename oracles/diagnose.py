@@ -407,7 +407,9 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
 
     ``lines`` is :func:`oracles.metrics.line_summary`'s output and ``tol`` the
     run's tolerances; nothing is named unless :func:`oracles.metrics.line_failures`
-    fails it. The one-sided pixels are split by where they lie along the
+    fails it. The decided one-sided pixels (sub-pixel ties left out, as in the
+    balance; ``candidate_only`` and ``oracle_only`` below count these) are
+    split by where they lie along the
     oracle's segments (``one_sided_by_place``): net pixels per line at the
     segment's first point (``start``) and last point (``end``), candidate minus
     oracle (negative: the candidate's lines are short there). Where one end or
@@ -427,11 +429,12 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     per_line = {"first": net["start"] / n, "last": net["end"] / n}
     ends = [e for e in ("first", "last") if abs(per_line[e]) >= LINE_END_MIN_PX]
     total = lines["imbalance"]
+    tc, to = lines["subpixel_ties"]
+    decided = {"candidate_only": int(lines["candidate_only"] - tc), "oracle_only": int(lines["oracle_only"] - to)}
     at_ends = sum(net[{"first": "start", "last": "end"}[e]] for e in ends)
     if ends and abs(at_ends) >= 0.5 * abs(total):
         return [{"name": "line_end_bias", "end": ends[0] if len(ends) == 1 else "both",
                  "pixels_per_line": float(sum(per_line[e] for e in ends)), "lines": int(lines["lines_compared"]),
-                 "candidate_only": int(lines["candidate_only"]), "oracle_only": int(lines["oracle_only"])}]
-    return [{"name": "line_pixel_bias", "candidate_only": int(lines["candidate_only"]),
-             "oracle_only": int(lines["oracle_only"]),
+                 **decided}]
+    return [{"name": "line_pixel_bias", **decided,
              **{f"net_{p}": int(net[p]) for p in ("start", "end", "middle", "stray")}}]

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import line_ties
 from .segment_pixels import nearest_segments
 from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
 
@@ -384,13 +385,19 @@ def pixel_balance(cand: np.ndarray, oracle: np.ndarray) -> dict:
     return {"candidate_only": c, "oracle_only": o, "imbalance": c - o}
 
 
-def balance_scores(candidate_only: int, oracle_only: int, oracle_pixels: int) -> dict:
-    """A case's pooled balance: the net imbalance, as a fraction of the oracle's pixels, and its sign-test p."""
-    n = candidate_only + oracle_only
-    imbalance = candidate_only - oracle_only
-    return {"candidate_only": int(candidate_only), "oracle_only": int(oracle_only), "imbalance": int(imbalance),
-            "imbalance_fraction": imbalance / max(oracle_pixels, 1),
-            "balance_p_value": sign_test_p(candidate_only, n)}
+def balance_scores(candidate_only: int, oracle_only: int, oracle_pixels: int, ties=(0, 0)) -> dict:
+    """A case's pooled balance: the net imbalance, as a fraction of the oracle's pixels, and its sign-test p.
+
+    ``ties``: how many of the candidate-only and of the oracle-only pixels are
+    sub-pixel ties (oracles.line_ties), reported as ``subpixel_ties`` and left
+    out of ``imbalance``, its fraction and the sign test: those are over the
+    decided one-sided pixels only.
+    """
+    tc, to = (int(t) for t in ties)
+    c, o = candidate_only - tc, oracle_only - to
+    return {"candidate_only": int(candidate_only), "oracle_only": int(oracle_only), "subpixel_ties": [tc, to],
+            "imbalance": int(c - o), "imbalance_fraction": (c - o) / max(oracle_pixels, 1),
+            "balance_p_value": sign_test_p(c, c + o)}
 
 
 def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
@@ -453,7 +460,10 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
     H - 1/2]``, where a line leaving the picture ends); it is at the ``start`` (``end``) when within
     :data:`END_REACH_PX` of that segment's first (last) point, else ``middle``
     (also: within reach of both ends of a very short segment, or more than
-    1.5 px from every segment: ``stray``). Returns
+    1.5 px from every segment: ``stray``), or, before any of those, a
+    sub-pixel ``tie`` of its nearest segment (oracles.line_ties: the line
+    crosses beside it within the oracle's precision of the pixel's edge, and
+    the other image drew the pixel across that edge). Returns
     ``{place: [candidate_only, oracle_only]}``.
     """
     return _end_places(FramePixels(cand, oracle), p0_px, p1_px)
@@ -461,7 +471,7 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
 
 def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
     """:func:`end_attribution` of the frame whose drawn pixels are ``fp``."""
-    out = {k: [0, 0] for k in ("start", "end", "middle", "stray")}
+    out = {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
     h, w = fp.shape
     box = ((-0.5, -0.5), (w - 0.5, h - 0.5))                  # where a line leaving the picture ends
     for side, only in enumerate(fp.only()):
@@ -472,6 +482,10 @@ def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
         near = owner >= 0
         m = owner[near]
         c = np.column_stack([only[near] % w, only[near] // w]).astype(np.float64)
+        tie, partner = line_ties.tie_crossings(c, q0[m], q1[m])
+        tie &= line_ties.partner_drawn(partner, fp.shape, lambda flat: fp.has(flat, side == 1))   # by the other image
+        out["tie"][side] += int(tie.sum())
+        c, m = c[~tie], m[~tie]
         to_start = np.hypot(*(c - q0[m]).T) <= END_REACH_PX
         to_end = np.hypot(*(c - q1[m]).T) <= END_REACH_PX
         out["stray"][side] += int((~near).sum())
@@ -487,8 +501,10 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
     rows: not drawn). Returns :func:`pixel_balance`'s fields,
-    :func:`edge_count_scores`' (without the per-edge array) and ``ends``
-    (:func:`end_attribution`). ``pixels``: the frame's :class:`FramePixels`,
+    :func:`edge_count_scores`' (without the per-edge array), ``ends``
+    (:func:`end_attribution`, the decided one-sided pixels) and
+    ``subpixel_ties`` (``[candidate_only, oracle_only]``: those that are
+    sub-pixel ties, oracles.line_ties). ``pixels``: the frame's :class:`FramePixels`,
     when the caller has it (then ``cand`` and ``oracle`` are not read);
     ``counts``: ``(diff, compared)``, the per-edge count differences and the
     number of edges counted, when the caller has them
@@ -508,7 +524,9 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
         ec = _diff_scores(*counts)
     del ec["edge_count_diffs"]
     out.update(ec)
-    out["ends"] = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray")}
+    ends = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
+    out["subpixel_ties"] = ends.pop("tie")
+    out["ends"] = ends
     return out
 
 
@@ -563,7 +581,8 @@ def line_summary(frames: list) -> dict:
     """A case's line fields pooled over its frames' :func:`line_scores` (``[(frame, scores)]``)."""
     c = sum(s["candidate_only"] for _, s in frames)
     o = sum(s["oracle_only"] for _, s in frames)
-    out = balance_scores(c, o, sum(s["oracle_pixels"] for _, s in frames))
+    ties = [sum(s["subpixel_ties"][i] for _, s in frames) for i in (0, 1)]
+    out = balance_scores(c, o, sum(s["oracle_pixels"] for _, s in frames), ties)
     k, worst = max(frames, key=lambda e: (e[1]["edge_count_max_diff"], -e[0])) if frames else (None, None)
     ends = {p: [sum(s["ends"][p][i] for _, s in frames) for i in (0, 1)] for p in ("start", "end", "middle", "stray")}
     out.update(edge_count_max_diff=worst["edge_count_max_diff"] if worst else 0,
@@ -579,14 +598,17 @@ def line_failures(lines: dict, tol) -> list[str]:
 
     The balance fails when the sign test rejects symmetry (p < ``tol.balance_alpha``)
     *and* the net imbalance is more than ``tol.max_imbalance`` of the oracle's
-    pixels; the counts fail when some edge in some frame has more than
+    pixels, both over the decided one-sided pixels (sub-pixel ties left out,
+    :func:`balance_scores`); the counts fail when some edge in some frame has more than
     ``tol.max_edge_count_diff`` pixels more or fewer than the oracle's.
     """
     out = []
     frac, p = lines["imbalance_fraction"], lines["balance_p_value"]
     if p < tol.balance_alpha and abs(frac) > tol.max_imbalance:
-        out.append(f"one-sided pixels unbalanced: {lines['candidate_only']} candidate-only vs "
-                   f"{lines['oracle_only']} oracle-only, net {frac:+.3%} of the oracle's pixels "
+        tc, to = lines["subpixel_ties"]
+        ties = f" (and {tc} + {to} sub-pixel ties, left out)" if tc + to else ""
+        out.append(f"one-sided pixels unbalanced: {lines['candidate_only'] - tc} candidate-only vs "
+                   f"{lines['oracle_only'] - to} oracle-only{ties}, net {frac:+.3%} of the oracle's pixels "
                    f"(> {tol.max_imbalance:.3%}; sign test p = {p:.2g} < {tol.balance_alpha:g})")
     if lines["edge_count_max_diff"] > tol.max_edge_count_diff:
         w = lines["edge_count_worst"]

@@ -215,6 +215,53 @@ MAX_IMBALANCE_FRACTION = 1e-3
 #: missing or an extra line; the 1-px end bias is the balance test's to find.
 MAX_EDGE_COUNT_DIFF = 3
 
+# Sub-pixel ties (oracles.line_ties). A one-sided pixel beside a row (column)
+# where its segment crosses within the oracle's sub-pixel precision of the
+# boundary between two pixels is decided by how the ends were rounded, not by
+# the line: it is counted as a tie (``subpixel_ties``) and left out of the
+# sign test and the size condition above (found on a generated 24-sided
+# cylinder seen along its axis: a cap's spoke and a side edge overlap, cross
+# a row 0.0007 px from the half pixel, and Mesa puts one on each side; 8
+# oracle-only pixels a frame, none the other way, p = 3e-5).
+#
+# How far can a GL rasterizer move an end before it decides? Per coordinate:
+#
+# - the snap to its sub-pixel grid, 2^-SUBPIXEL_BITS px: at most half a step.
+#   GL only requires SUBPIXEL_BITS >= 4; the oracle, Mesa's llvmpipe, uses 8
+#   (FIXED_ORDER 8; core.raster emulates it): 2^-9 px;
+# - the float32 rounding of the window coordinates before the snap: at most
+#   VERTEX_ROUNDINGS eps32 scale (above), <= 2^-9 px while scale <= 4,096 px,
+#   and 4x the largest float32 vertex error measured (4.6e-4 px).
+#
+# So each end is within TIE_END_PX = 2^-9 + 2^-9 = 2^-8 px of the exact one.
+# Where a segment of minor/major slope |m| <= 1 crosses a row between its
+# ends, an end moved by (e_x, e_y) moves the line across the row by
+# e_x - m e_y (|.| <= (1 + |m|) TIE_END_PX), and the crossing is a weighted
+# mean of the two ends' moves: within (1 + |m|) TIE_END_PX <= 2^-7 px of the
+# exact crossing. Farther from the boundary the oracle decides as the exact
+# line does; closer, its answer is not the line's, and a candidate that
+# differs there is not wrong. 8 bits, not the spec's 4: the oracle's own
+# precision is what makes its answer undecided; a candidate that snaps coarser
+# differs from it outside this zone too, at random, which the sign test
+# already takes (a wider zone, (1 + |m|) 2^-5, would excuse 1 in 8 crossings).
+# A scale above 4,096 px (a float32 rounding above 2^-9) makes the zone
+# narrower than the oracle's real one: a tie may then count as decided (a
+# false alarm, never a hidden fault). A tie moves no pixel between major
+# coordinates, so the per-edge counts need no such rule.
+#
+# What it cannot hide: a pixel is a tie only where the crossing is within
+# 2^-7 px of the half pixel (at most 2 x 2^-7 = 1/64 of a line's rows) and
+# the image without it drew the pixel across that boundary (a pixel lost or
+# added with no partner stays decided): a line shifted by 1 px or drawn 1 px
+# thicker keeps at least 63/64 of its one-sided pixels in the test.
+
+#: Sub-pixel bits of the oracle's rasterizer (Mesa llvmpipe; the GL minimum is 4).
+SUBPIXEL_BITS = 8
+
+#: How far a renderer may move a segment's end before deciding, per coordinate (px): the snap's
+#: half step 2^-(SUBPIXEL_BITS + 1) plus 2^-9 of float32 rounding (derivation above).
+TIE_END_PX = 2.0 ** -(SUBPIXEL_BITS + 1) + 2.0 ** -9
+
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)
 

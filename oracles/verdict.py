@@ -19,7 +19,7 @@ from .diagnose import diagnose, diagnose_lines
 from .tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
 #: Per-frame fields of a wireframe's line comparison (oracles.metrics.line_scores).
-LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "edge_count_max_diff", "edge_count_worst_edge")
+LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
 
 #: Per-frame fields of a shaded comparison (oracles.metrics.shaded_scores).
 SHADED_FRAME_KEYS = ("silhouette_iou", "silhouette_union_px", "silhouette_mismatch_inside", "depth_pixels",
