@@ -72,7 +72,7 @@ def test_end_attribution_finds_the_missing_last_pixel():
     oracle = np.zeros((5, 10), bool); oracle[2, 1:9] = True
     cand = oracle.copy(); cand[2, 8] = False; cand[2, 0] = True    # last pixel lost; one more before the start
     ends = metrics.end_attribution(cand, oracle, p0, p1)
-    assert ends == {"start": [1, 0], "end": [0, 1], "middle": [0, 0], "stray": [0, 0]}
+    assert ends == {"start": [1, 0], "end": [0, 1], "middle": [0, 0], "stray": [0, 0], "tie": [0, 0]}
     cand2 = oracle.copy(); cand2[2, 4] = False                     # a pixel lost in the middle
     assert metrics.end_attribution(cand2, oracle, p0, p1)["middle"] == [0, 1]
 
