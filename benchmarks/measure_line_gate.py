@@ -4,7 +4,9 @@ For core's exact raster (correct), the drop-last-pixel mutant and an unbiased
 random-end renderer (tests/raster_mutants.py), over the bundled scenes, the
 orrery example, the hidden-line + back-face mode and random edge soups, under
 every crosscheck camera: cases passed, pooled candidate-only / oracle-only
-pixels, the largest |net imbalance| / oracle pixels, the smallest sign-test p
+pixels and how many of them are sub-pixel ties (oracles.line_ties), the
+largest |net imbalance| / oracle pixels and the smallest sign-test p (both
+over the decided pixels, ties left out)
 and the largest per-edge count difference.
 
     .venv/bin/python benchmarks/measure_line_gate.py [--frames 24]
@@ -52,12 +54,14 @@ def summarise(label: str, report: dict) -> str:
     lines = [c["lines"] for c in cases]
     c = sum(x["candidate_only"] for x in lines)
     o = sum(x["oracle_only"] for x in lines)
+    tc = sum(x["subpixel_ties"][0] for x in lines)
+    to = sum(x["subpixel_ties"][1] for x in lines)
     frac = max(abs(x["imbalance_fraction"]) for x in lines)
     p = min(x["balance_p_value"] for x in lines)
     cnt = max(x["edge_count_max_diff"] for x in lines)
     passed = sum(x["verdict"] == "pass" for x in cases)
     ends = sum(1 for x in cases if x["faults"] and x["faults"][0]["name"] == "line_end_bias")
-    return (f"| {label} | {passed}/{len(cases)} | {c} | {o} | {frac:.2e} | {p:.2g} | {cnt} | {ends} |")
+    return (f"| {label} | {passed}/{len(cases)} | {c} | {o} | {tc} + {to} | {frac:.2e} | {p:.2g} | {cnt} | {ends} |")
 
 
 def main(argv=None) -> int:
@@ -68,9 +72,9 @@ def main(argv=None) -> int:
     sets = [("bundled", bundled, None), ("orrery", [load_scene("orrery")], None),
             ("hidden+cull", bundled + [load_scene("orrery")], RenderMode(hidden_lines=True, cull="backface")),
             ("random", random_scenes(), None)]
-    print("| scenes, raster | passed | cand-only | oracle-only | max abs net/oracle px | min p | "
+    print("| scenes, raster | passed | cand-only | oracle-only | of them ties | max abs net/oracle px | min p | "
           "max edge count diff | line_end_bias |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     original = raster._line_pixels
     for raster_name, fn in (("correct", original), ("drop last", drop_last), ("random ends", random_ends)):
         raster._line_pixels = fn
