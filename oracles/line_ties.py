@@ -72,8 +72,8 @@ def tie_crossings(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray,
         with np.errstate(divide="ignore", invalid="ignore"):
             t = (q[:, major] - a[:, major]) / dj          # where the segment reaches the pixel's row/column
             slope = np.abs(dn / dj)
+            off = a[:, minor] + t * dn - q[:, minor]      # crossing minus the pixel centre, across the line
         ok &= (t >= 0.0) & (t <= 1.0)
-        off = a[:, minor] + t * dn - q[:, minor]          # crossing minus the pixel centre, across the line
         hit = ok & ~tie & (np.abs(np.abs(off) - 0.5) <= (1.0 + slope) * end_px)
         tie |= hit
         partner[hit, minor] += np.where(off[hit] > 0, 1, -1)

@@ -278,6 +278,25 @@ def test_kept_image_gives_the_image_back(how):
     np.testing.assert_array_equal(kept.image(), image)
 
 
+def _is_tie(c, a, b, other, end_px=2.0 ** -8):
+    """oracles.line_ties' rule for one pixel ``c`` of segment ``a -> b``, written out per axis (y-major first)."""
+    d = b - a
+    for major in (1, 0):
+        minor = 1 - major
+        if d[major] == 0 or abs(d[major]) < abs(d[minor]):
+            continue
+        t = (c[major] - a[major]) / d[major]
+        if not 0 <= t <= 1:
+            continue
+        off = a[minor] + t * d[minor] - c[minor]
+        if abs(abs(off) - 0.5) <= (1 + abs(d[minor] / d[major])) * end_px:
+            p = c.astype(int)
+            p[minor] += 1 if off > 0 else -1
+            h, w = other.shape
+            return bool(0 <= p[0] < w and 0 <= p[1] < h and other[p[1], p[0]])
+    return False
+
+
 def _ends_naive(cand, oracle, p0, p1, reach=1.5):
     """end_attribution's definition, pixel by pixel: the nearest segment (clipped to the image's edges)."""
     from wirecheck.oracles.segment_pixels import clip_segments
@@ -285,7 +304,8 @@ def _ends_naive(cand, oracle, p0, p1, reach=1.5):
     h, w = cand.shape
     ok, q0, q1 = clip_segments(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
     q0, q1 = q0[ok], q1[ok]
-    out = {k: [0, 0] for k in ("start", "end", "middle", "stray")}
+    out = {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
+    other = (oracle, cand)
     for side, only in enumerate((cand & ~oracle, oracle & ~cand)):
         for y, x in zip(*np.nonzero(only)):
             c = np.array([x, y], float)
@@ -298,6 +318,9 @@ def _ends_naive(cand, oracle, p0, p1, reach=1.5):
                     best = (dist, a, b)
             if best is None or best[0] > reach:
                 out["stray"][side] += 1
+                continue
+            if _is_tie(c, best[1], best[2], other[side]):
+                out["tie"][side] += 1
                 continue
             s, e = np.hypot(*(c - best[1])) <= reach, np.hypot(*(c - best[2])) <= reach
             out["start" if s and not e else "end" if e and not s else "middle"][side] += 1
@@ -316,6 +339,23 @@ def test_end_attribution_equals_the_definition(seed):
     p0[4] = np.nan                                      # not drawn
     cand, oracle = rng.random((h, w)) < 0.15, rng.random((h, w)) < 0.15
     assert end_attribution(cand, oracle, p0, p1) == _ends_naive(cand, oracle, p0, p1)
+
+
+def test_end_attribution_equals_the_definition_at_ties():
+    # segment ends on the half-pixel grid: many rows are crossed exactly at a pixel's edge (sub-pixel ties)
+    from wirecheck.oracles.metrics import end_attribution
+
+    ties = 0
+    for seed in range(8):
+        rng = np.random.default_rng(300 + seed)
+        w, h = 30, 20
+        p0 = np.round(rng.uniform(-5, 35, (9, 2)) * 2) / 2
+        p1 = p0 + np.round(rng.normal(0, 8, (9, 2)) * 2) / 2
+        cand, oracle = rng.random((h, w)) < 0.3, rng.random((h, w)) < 0.3
+        got = end_attribution(cand, oracle, p0, p1)
+        assert got == _ends_naive(cand, oracle, p0, p1)
+        ties += sum(got["tie"])
+    assert ties > 0                                     # the tie rule was exercised
 
 
 def test_vertex_errors_frames_equal_frame_by_frame():
