@@ -80,16 +80,19 @@ def tie_crossings(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray,
     return tie, partner
 
 
-def partner_drawn(partner: np.ndarray, shape: tuple, drawn) -> np.ndarray:
-    """``(P,)`` bool: whether each ``partner`` pixel ``[x, y]`` is drawn (outside the ``(H, W)`` image: not).
+def partner_drawn(partner: np.ndarray, frame: np.ndarray, shape: tuple, drawn: np.ndarray) -> np.ndarray:
+    """``(P,)`` bool: whether each ``partner`` pixel ``[x, y]`` of frame ``frame`` is drawn (outside the
+    ``(H, W)`` image: not).
 
-    ``drawn``: a function from ``(K,)`` flat indices ``y W + x`` to ``(K,)`` bool
-    (oracles.metrics.FramePixels.has of the image that lacks the tie pixel).
+    ``drawn``: ascending flat indices ``k H W + y W + x`` of the pixels drawn in
+    each frame ``k`` by the image that lacks the tie pixel.
     """
     h, w = shape
     x, y = partner[:, 0], partner[:, 1]
     inside = (x >= 0) & (x < w) & (y >= 0) & (y < h)
     out = np.zeros(len(partner), bool)
-    if inside.any():
-        out[inside] = drawn(y[inside] * w + x[inside])
+    if inside.any() and len(drawn):
+        key = (np.asarray(frame)[inside] * (h * w) + y[inside] * w + x[inside]).astype(np.int64)
+        at = np.minimum(np.searchsorted(drawn, key), len(drawn) - 1)
+        out[inside] = drawn[at] == key
     return out

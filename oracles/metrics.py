@@ -471,32 +471,48 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
 
 def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
     """:func:`end_attribution` of the frame whose drawn pixels are ``fp``."""
-    out = {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
-    h, w = fp.shape
+    return frames_end_places([(fp, p0_px, p1_px)])[0]
+
+
+def frames_end_places(frames) -> list[dict]:
+    """:func:`end_attribution` of several frames of one size (``[(FramePixels, p0_px, p1_px)]``), in one pass,
+    with the sub-pixel ties apart (``"tie"``)."""
+    out = [{k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")} for _ in frames]
+    if not frames:
+        return out
+    h, w = frames[0][0].shape
     box = ((-0.5, -0.5), (w - 0.5, h - 0.5))                  # where a line leaving the picture ends
-    for side, only in enumerate(fp.only()):
-        if len(only) == 0:
+    for side in (0, 1):
+        only = [fp.only()[side] for fp, _, _ in frames]
+        if not sum(len(o) for o in only):
             continue
         # each pixel's nearest segment within reach (the segments near it only, not all of them)
-        owner, q0, q1 = nearest_segments(p0_px, p1_px, only, w, h, END_REACH_PX, box)
+        owner, q0, q1, frame = nearest_segments([(p0, p1, o) for (_, p0, p1), o in zip(frames, only)],
+                                                w, h, END_REACH_PX, box)
+        pix = np.concatenate(only)
         near = owner >= 0
-        m = owner[near]
-        c = np.column_stack([only[near] % w, only[near] // w]).astype(np.float64)
+        m, f = owner[near], frame[near]
+        c = np.column_stack([pix[near] % w, pix[near] // w]).astype(np.float64)
         tie, partner = line_ties.tie_crossings(c, q0[m], q1[m])
-        tie &= line_ties.partner_drawn(partner, fp.shape, lambda flat: fp.has(flat, side == 1))   # by the other image
-        out["tie"][side] += int(tie.sum())
-        c, m = c[~tie], m[~tie]
+        if tie.any():                   # a tie needs its partner pixel drawn by the other image
+            other = [fp.cand_idx if side == 1 else fp.oracle_idx for fp, _, _ in frames]
+            drawn = np.concatenate([o + k * h * w for k, o in enumerate(other)])    # ascending: frame after frame
+            tie &= line_ties.partner_drawn(partner, f, (h, w), drawn)
         to_start = np.hypot(*(c - q0[m]).T) <= END_REACH_PX
         to_end = np.hypot(*(c - q1[m]).T) <= END_REACH_PX
-        out["stray"][side] += int((~near).sum())
-        out["start"][side] += int((to_start & ~to_end).sum())
-        out["end"][side] += int((to_end & ~to_start).sum())
-        out["middle"][side] += int((to_start == to_end).sum())
+        n = len(frames)
+        place = {"tie": tie, "start": ~tie & to_start & ~to_end, "end": ~tie & to_end & ~to_start,
+                 "middle": ~tie & (to_start == to_end)}
+        for name, hit in place.items():
+            for k, v in enumerate(np.bincount(f[hit], minlength=n)):
+                out[k][name][side] += int(v)
+        for k, v in enumerate(np.bincount(frame[~near], minlength=n)):
+            out[k]["stray"][side] += int(v)
     return out
 
 
 def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray,
-                pixels: FramePixels | None = None, counts: tuple | None = None) -> dict:
+                pixels: FramePixels | None = None, counts: tuple | None = None, ends: dict | None = None) -> dict:
     """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
@@ -508,7 +524,8 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
     when the caller has it (then ``cand`` and ``oracle`` are not read);
     ``counts``: ``(diff, compared)``, the per-edge count differences and the
     number of edges counted, when the caller has them
-    (:func:`frames_count_differences`, :class:`LineBatch`).
+    (:func:`frames_count_differences`, :class:`LineBatch`); ``ends``: the
+    frame's :func:`frames_end_places`, when the caller has it.
     """
     fp = pixels if pixels is not None else FramePixels(cand, oracle)
     h, w = fp.shape
@@ -524,7 +541,9 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
         ec = _diff_scores(*counts)
     del ec["edge_count_diffs"]
     out.update(ec)
-    ends = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
+    if ends is None:
+        ends = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
+    ends = dict(ends)
     out["subpixel_ties"] = ends.pop("tie")
     out["ends"] = ends
     return out
@@ -571,8 +590,9 @@ class LineBatch:
                 stop += 1
             run = waiting[start:stop]
             counts = frames_count_differences([(p0, p1, fp) for _, fp, p0, p1 in run], shape[1], shape[0])
-            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c))
-                       for (key, fp, p0, p1), c in zip(run, counts))
+            ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run])
+            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e))
+                       for (key, fp, p0, p1), c, e in zip(run, counts, ends))
             start = stop
         return out
 

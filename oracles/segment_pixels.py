@@ -201,34 +201,35 @@ def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int) -
     return np.bincount(keys // span, minlength=n_segments)
 
 
-def nearest_segments(p0_px: np.ndarray, p1_px: np.ndarray, pixels: np.ndarray, width: int, height: int,
-                     radius: float, box: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each pixel's nearest segment within ``radius``, among the segments clipped to ``box``.
+def nearest_segments(frames, width: int, height: int, radius: float, box: tuple):
+    """Each pixel's nearest segment within ``radius``, among its frame's segments clipped to ``box``.
 
     Parameters
     ----------
-    p0_px, p1_px : (E, 2) array_like
-        Segments in pixels (NaN rows skipped).
-    pixels : (P,) array_like of int
-        Ascending flat indices ``y W + x``.
+    frames : sequence of (p0_px (E, 2), p1_px (E, 2), pixels (P,))
+        Each frame's segments in pixels (NaN rows skipped) and some of its
+        pixels (ascending flat indices ``y W + x``).
     radius : float
     box : ((x, y), (x, y))
         The corners the segments are clipped to first.
 
     Returns
     -------
-    owner : (P,) int64
-        Index into the kept segments of each pixel's nearest one within
-        ``radius`` (ties: the lower index), -1 where none is that near.
+    owner : (sum P,) int64
+        The pixels of all frames in order: index into ``q0, q1`` of each
+        one's nearest segment within ``radius`` (ties: the lower index), -1
+        where none is that near.
     q0, q1 : (K, 2) float64
-        The kept segments, clipped.
+        The kept segments of all frames, clipped, frame after frame.
+    frame : (sum P,) int64
+        Each pixel's frame.
     """
-    segs = _Segments([(p0_px, p1_px)], width, height, radius, box=box)
-    px = _Pixels.of_frames([pixels], width, height)
+    segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius, box=box)
+    px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
     owner = np.full(len(px), -1, np.int64)
     sid, pos = segs.owners(px, *segs.pairs_any(px))
     owner[pos] = sid
-    return owner, segs.q0, segs.q1
+    return owner, segs.q0, segs.q1, px.at()[0]
 
 
 class _Pixels:
