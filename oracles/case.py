@@ -139,10 +139,10 @@ class ScaleBatch:
         self._waiting: list = []
         self._rows = 0
 
-    def add(self, p_world: np.ndarray, p_px: np.ndarray, camera=None, matrices=None) -> None:
+    def add(self, p_world: np.ndarray, p_px: np.ndarray, camera, matrices=None) -> None:
         self._waiting.append((p_world, p_px))
         self._rows += len(p_world)
-        if self._rows >= self.limit and camera is not None:
+        if self._rows >= self.limit:
             self.flush(camera, matrices)
 
     def flush(self, camera, matrices=None) -> float:

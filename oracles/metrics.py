@@ -10,12 +10,10 @@ drawn pixel within Chebyshev distance ``t`` (t = 1: its 3x3 neighbourhood).
 
 Two blank images agree perfectly (F1 = 1); one blank and one not give 0.
 
-A wireframe frame's metrics share one scan of each image (:class:`FramePixels`,
-:func:`frame_scores`); after it they work on the drawn pixels only.
-
-(About 630 lines: every comparison of two projections or two frames lives
-here, beside the conventions they share; the line gate's functions, from
-``sign_test_p`` down, are the part to move out if it grows.)
+A wireframe frame's metrics share one scan of each image (:class:`FramePixels`);
+after it they work on the drawn pixels only, and a case's line metrics are
+computed for its frames together (:class:`LineBatch`; the pairing of pixels
+with segments is oracles.segment_pixels).
 """
 
 from __future__ import annotations
@@ -111,6 +109,7 @@ class FramePixels:
         self.oracle_idx = np.flatnonzero(oracle)
         self.cand_in_oracle = oracle.reshape(-1)[self.cand_idx]
         self.oracle_in_cand = cand.reshape(-1)[self.oracle_idx]
+        self._only = None
 
     @property
     def both(self) -> int:
@@ -123,8 +122,10 @@ class FramePixels:
         return len(self.cand_idx) == len(self.oracle_idx) == self.both
 
     def only(self) -> tuple[np.ndarray, np.ndarray]:
-        """Flat indices of the candidate-only and the oracle-only pixels, ascending."""
-        return self.cand_idx[~self.cand_in_oracle], self.oracle_idx[~self.oracle_in_cand]
+        """Flat indices of the candidate-only and the oracle-only pixels, ascending (found once)."""
+        if self._only is None:
+            self._only = (self.cand_idx[~self.cand_in_oracle], self.oracle_idx[~self.oracle_in_cand])
+        return self._only
 
     def drawn(self) -> np.ndarray:
         """Flat indices of the pixels drawn by either image, ascending."""
@@ -547,12 +548,6 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
     out["subpixel_ties"] = ends.pop("tie")
     out["ends"] = ends
     return out
-
-
-def frame_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray) -> tuple[dict, dict]:
-    """A wireframe frame's :func:`pixel_scores` and :func:`line_scores`, from one :class:`FramePixels`."""
-    fp = FramePixels(cand, oracle)
-    return pixel_scores(cand, oracle, pixels=fp), line_scores(cand, oracle, p0_px, p1_px, pixels=fp)
 
 
 class LineBatch:

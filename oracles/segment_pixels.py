@@ -292,7 +292,6 @@ class _Segments:
         p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
         p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
         keep, q0, q1 = clip_segments(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
-        self.keep = keep
         self.q0, self.q1 = q0[keep], q1[keep]
         self.frame, self.edge = frame[keep], edge[keep]
         self.d = self.q1 - self.q0
