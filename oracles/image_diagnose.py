@@ -117,6 +117,10 @@ ROTATION_TOL_PX = 0.3
 #: An offset is a fault when it exceeds this (px): the pooled fit's offset on
 #: a correct renderer stays within ~0.05 px; a half-pixel convention is 0.5.
 OFFSET_TOL_PX = 0.2
+#: The fit pairs a case's candidate pixels with their frame's segments in one
+#: array of (pixels x most segments in a frame) up to this many elements (a
+#: few tens of MB); more (a dense mesh) are paired frame by frame.
+STACK_LIMIT = 1 << 20
 
 
 def _perm(swap: bool, sx: int, sy: int) -> np.ndarray:
@@ -243,40 +247,110 @@ class _Frame:
 
 
 class _Registration:
-    """The pooled frames of one case and the ICP fit of ``c = A (P o) + b`` (``A`` diagonal or affine)."""
+    """The pooled frames of one case and the ICP fit of ``c = A (P o) + b`` (``A`` diagonal or affine).
+
+    The frames are stacked once: every candidate pixel beside its own frame's
+    segments (padded to the longest frame, :data:`STACK_LIMIT` elements at
+    most; above it frame by frame), every oracle sample beside its frame's
+    nearest-pixel map; an ICP step is then a few array operations, not a few
+    per frame.
+    """
 
     def __init__(self, frames: list[_Frame], width: int, height: int, centre: np.ndarray):
         self.frames = frames
         self.w, self.h = width, height
         self.centre = centre
+        fwd = [f for f in frames if len(f.cand) and len(f.seg_a)]
+        self._fwd_frames = fwd
+        self._cand = np.concatenate([f.cand for f in fwd]) if fwd else np.zeros((0, 2))
+        k_max = max((len(f.seg_a) for f in fwd), default=0)
+        self._stacked = len(self._cand) * k_max <= STACK_LIMIT
+        if self._stacked and fwd:
+            counts = [len(f.cand) for f in fwd]
+            seg_a = np.zeros((len(fwd), k_max, 2))
+            ab = np.zeros((len(fwd), k_max, 2))
+            tangents = np.zeros((len(fwd), k_max, 2))
+            pad = np.ones((len(fwd), k_max), bool)
+            for i, f in enumerate(fwd):
+                k = len(f.seg_a)
+                seg_a[i, :k], ab[i, :k], tangents[i, :k], pad[i, :k] = f.seg_a, f.seg_b - f.seg_a, f.seg_tangents, False
+            frame = np.repeat(np.arange(len(fwd)), counts)
+            # (N, K) each, contiguous: the ICP step's arithmetic runs on whole arrays
+            self._ax, self._ay = seg_a[frame, :, 0], seg_a[frame, :, 1]
+            self._abx, self._aby = ab[frame, :, 0], ab[frame, :, 1]
+            self._len2 = np.maximum(self._abx * self._abx + self._aby * self._aby, 1e-300)
+            self._seg_tangents, self._pad = tangents[frame], pad[frame]
+        rev = [f for f in frames if len(f.samples) and len(f.cand)]
+        self._rev_frames = rev
+        self._samples = np.concatenate([f.samples for f in rev]) if rev else np.zeros((0, 2))
+        self._sample_tangents = np.concatenate([f.sample_tangents for f in rev]) if rev else np.zeros((0, 2))
+        self._rev_bounds = np.cumsum([0] + [len(f.samples) for f in rev])
+
+    def _forward(self, q: np.ndarray):
+        """Nearest oracle line point of each candidate pixel mapped to ``q`` (o space), its frame's lines
+        only: ``(foot (N, 2), segment tangent (N, 2))``."""
+        if not self._stacked:
+            feet, tangents, start = [], [], 0
+            for f in self._fwd_frames:
+                foot, _, j = _nearest_on_segments(q[start:start + len(f.cand)], f.seg_a, f.seg_b)
+                feet.append(foot)
+                tangents.append(f.seg_tangents[j])
+                start += len(f.cand)
+            return np.concatenate(feet), np.concatenate(tangents)
+        qx, qy = q[:, 0:1], q[:, 1:2]
+        t = (qx - self._ax) * self._abx                    # the projection onto each segment, clipped
+        t += (qy - self._ay) * self._aby
+        t /= self._len2
+        np.clip(t, 0.0, 1.0, out=t)
+        dx = t * self._abx
+        dx += self._ax
+        dx -= qx
+        dy = t * self._aby
+        dy += self._ay
+        dy -= qy
+        dx *= dx
+        dy *= dy
+        dx += dy                                           # squared distance to each segment
+        dx[self._pad] = np.inf
+        j = np.argmin(dx, axis=1)
+        rows = np.arange(len(q))
+        tj = t[rows, j]
+        foot = np.stack([self._ax[rows, j] + tj * self._abx[rows, j], self._ay[rows, j] + tj * self._aby[rows, j]],
+                        axis=1)
+        return foot, self._seg_tangents[rows, j]
 
     def pairs(self, p: np.ndarray, a: np.ndarray, b: np.ndarray):
         """Correspondences ``(u, c, dist, tangent_u, n_fwd, n_rev)`` for ``c ~ a @ u + b``, ``u = P o``.
 
         The first ``n_fwd`` pair candidate pixels with their nearest oracle
-        line point, the rest oracle samples with their nearest candidate pixel;
-        ``tangent_u`` is the oracle line's direction at ``u``.
+        line point (on their own frame's lines), the rest oracle samples with
+        their frame's nearest candidate pixel; ``tangent_u`` is the oracle
+        line's direction at ``u``.
         """
-        us, cs, dists, ts, n_fwd, n_rev = [], [], [], [], 0, 0
+        us, cs, dists, ts = [], [], [], []
         back = p.T @ np.linalg.inv(a)                      # c -> o (a signed permutation's inverse is P.T)
-        for f in self.frames:
-            if len(f.cand) and len(f.seg_a):               # candidate pixels -> nearest oracle line point
-                foot, _, j = _nearest_on_segments((f.cand - b) @ back.T, f.seg_a, f.seg_b)
-                u = foot @ p.T
-                us.append(u); cs.append(f.cand); ts.append(f.seg_tangents[j] @ p.T)
-                dists.append(np.hypot(*(u @ a.T + b - f.cand).T))
-                n_fwd += len(f.cand)
-            if len(f.samples) and len(f.cand):             # oracle samples -> nearest candidate pixel
-                u = f.samples @ p.T
-                t = u @ a.T + b + self.centre
-                col, row = np.round(t[:, 0]).astype(np.int64), np.round(t[:, 1]).astype(np.int64)
-                inside = (col >= 0) & (col < self.w) & (row >= 0) & (row < self.h)
-                if inside.any():
-                    c = np.stack([f.nearest[1][row[inside], col[inside]],
-                                  f.nearest[0][row[inside], col[inside]]], axis=1) - self.centre
-                    us.append(u[inside]); cs.append(c); ts.append(f.sample_tangents[inside] @ p.T)
-                    dists.append(np.hypot(*(t[inside] - self.centre - c).T))
-                    n_rev += int(inside.sum())
+        if len(self._cand):                                # candidate pixels -> nearest oracle line point
+            foot, tangent = self._forward((self._cand - b) @ back.T)
+            u = foot @ p.T
+            us.append(u); cs.append(self._cand); ts.append(tangent @ p.T)
+            dists.append(np.hypot(*(u @ a.T + b - self._cand).T))
+        n_fwd = len(self._cand)
+        n_rev = 0
+        if len(self._samples):                             # oracle samples -> nearest candidate pixel
+            u = self._samples @ p.T
+            t = u @ a.T + b + self.centre
+            col, row = np.round(t[:, 0]).astype(np.int64), np.round(t[:, 1]).astype(np.int64)
+            inside = (col >= 0) & (col < self.w) & (row >= 0) & (row < self.h)
+            if inside.any():
+                flat = np.where(inside, row * self.w + col, 0)
+                near = np.empty((len(flat), 2), dtype=np.int64)
+                for f, lo, hi in zip(self._rev_frames, self._rev_bounds[:-1], self._rev_bounds[1:]):
+                    near[lo:hi, 0] = f.nearest[1].ravel()[flat[lo:hi]]
+                    near[lo:hi, 1] = f.nearest[0].ravel()[flat[lo:hi]]
+                c = near[inside] - self.centre
+                us.append(u[inside]); cs.append(c); ts.append(self._sample_tangents[inside] @ p.T)
+                dists.append(np.hypot(*(t[inside] - self.centre - c).T))
+                n_rev = int(inside.sum())
         if not us:
             return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), 0, 0
         return (np.concatenate(us), np.concatenate(cs), np.concatenate(dists), np.concatenate(ts),
