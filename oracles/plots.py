@@ -10,6 +10,7 @@ per case.
 from __future__ import annotations
 
 import io
+import math
 
 import numpy as np
 
@@ -25,6 +26,8 @@ _PALETTE = [(0, 0, 0), (255, 255, 255), DIFF_COLOURS["candidate_only"], DIFF_COL
 #: worst.gif: delay per frame (ms) and the height of the progress strip under the panels (px).
 GIF_FRAME_MS = 120
 STRIP_PX = 3
+#: A log axis spanning more decades than this has ticks and labels at powers of ten only.
+MINOR_TICKS_MAX_DECADES = 2.0
 
 
 def _figure(rows: int):
@@ -57,6 +60,30 @@ def _series(case: dict, key: str):
     return frames, values
 
 
+_SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
+
+
+def _decade_label(value: float, _pos=None) -> str:
+    """``10⁻⁶`` for a power of ten, in plain Unicode (DejaVu Sans has the superscripts); '' otherwise."""
+    if not value > 0:
+        return ""
+    e = round(math.log10(value))
+    return "10" + str(e).translate(_SUPERSCRIPT) if math.isclose(value, 10.0 ** e) else ""
+
+
+def _log_y(ax) -> None:
+    """Log y axis labelled at powers of ten. Over more than :data:`MINOR_TICKS_MAX_DECADES`
+    decades the unlabelled minor ticks are left out (a figure's cost was mostly their tick
+    objects and the mathtext of the default labels, re-parsed for every figure)."""
+    from matplotlib.ticker import FuncFormatter, NullLocator
+
+    ax.set_yscale("log")
+    lo, hi = ax.get_ylim()
+    if hi > lo > 0 and math.log10(hi / lo) > MINOR_TICKS_MAX_DECADES:
+        ax.yaxis.set_major_formatter(FuncFormatter(_decade_label))
+        ax.yaxis.set_minor_locator(NullLocator())
+
+
 def _legend(ax, n: int) -> None:
     if n:
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, frameon=False,
@@ -82,7 +109,7 @@ def vertex_error_png(report: dict) -> bytes | None:
         ax.axhline(tol, color="#b00", linewidth=1, linestyle="--")
         ax.text(1.0, tol, f" tolerance {tol:g} px", color="#b00", fontsize=7, va="bottom", ha="right",
                 transform=ax.get_yaxis_transform())
-    ax.set_yscale("log")
+    _log_y(ax)
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("frame")
     ax.set_ylabel("max vertex error (px)")
@@ -120,7 +147,7 @@ def pixel_png(report: dict) -> bytes | None:
             ax.text(1.0, limit, f" limit {limit:g}", color="#b00", fontsize=7, va="bottom", ha="right",
                     transform=ax.get_yaxis_transform())
         if log:
-            ax.set_yscale("log")
+            _log_y(ax)
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_xlabel("frame")
         ax.set_ylabel(label)

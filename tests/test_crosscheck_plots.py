@@ -194,3 +194,39 @@ def test_shaded_pixels_png_has_two_panels_iou_above_depth():
         assert right < left
     red, _ = _pixels_of(png, RED)
     assert (red < h / 2).any() and (red >= h / 2).any()              # a limit line in each: 0.995 and 1.0
+
+
+def test_decade_labels_are_unicode_powers_of_ten():
+    from wirecheck.oracles.plots import _decade_label
+
+    # hand-written: superscript minus U+207B, superscript digits (U+2070, U+00B9, U+00B2, U+00B3, U+2074..9)
+    assert _decade_label(1e-6) == "10\u207b\u2076"
+    assert _decade_label(1e-16) == "10\u207b\u00b9\u2076"
+    assert _decade_label(1.0) == "10\u2070"
+    assert _decade_label(1000.0) == "10\u00b3"
+    assert _decade_label(2e-6) == "" and _decade_label(0.0) == "" and _decade_label(-1.0) == ""
+
+
+def test_a_wide_log_axis_is_labelled_at_powers_of_ten_without_minor_ticks():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from wirecheck.oracles.plots import _log_y
+
+    def axis(lo, hi):
+        fig = Figure()
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot(1, 1, 1)
+        ax.plot([0, 1], [lo, hi])
+        _log_y(ax)
+        fig.canvas.draw()
+        return ax
+
+    wide = axis(1e-16, 1e-6)                               # 10 decades: more than plots.MINOR_TICKS_MAX_DECADES
+    assert len(wide.yaxis.get_minorticklocs()) == 0
+    labels = [t.get_text() for t in wide.get_yticklabels() if t.get_text()]
+    assert labels and all(s.startswith("10") and "$" not in s for s in labels)
+    assert "10\u207b\u2078" in labels or "10\u207b\u2077" in labels   # some decade inside the span
+    # a narrow span keeps matplotlib's own minor ticks (and labels between decades)
+    narrow = axis(2e-13, 6e-13)
+    assert len(narrow.yaxis.get_minorticklocs()) > 0
