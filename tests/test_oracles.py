@@ -242,3 +242,39 @@ def test_opencv_oracle_conversion_cache_follows_the_camera():
         # 1e-9 px: both sides are float64 projectPoints on matrices equal to ~1e-16 relative,
         # at pixel magnitudes < 1e3
         np.testing.assert_allclose(opencv_oracle.project(pts, cam), by_hand(cam), rtol=0, atol=1e-9)
+
+
+@needs_osmesa
+def test_closing_the_oracle_frees_its_context_without_a_full_collection(monkeypatch):
+    # pyrender's OffscreenRenderer.delete() ends with gc.collect(): ~0.1 s in a process holding
+    # a test suite's objects, on every crosscheck run. close() frees the same GL resources and
+    # destroys the context, and collects nothing itself; a second oracle draws the same pixels.
+    import gc
+
+    from wirecheck.oracles.pyrender_oracle import PyrenderOracle
+
+    edges = np.array([[0, 1], [1, 2]])
+    p_world = np.array([[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0]])
+    cam = camera_z(3.0, fov_y_deg=60.0, width=64, height=48)
+    first = PyrenderOracle(64, 48)
+    before, _ = first.render(p_world, edges, cam)
+    renderer = first._renderer
+    freed = []
+
+    def spy(obj, name):
+        real = getattr(type(obj), name)
+        monkeypatch.setattr(type(obj), name, lambda self, *a: freed.append(name) or real(self, *a))
+
+    spy(renderer._renderer, "delete")
+    spy(renderer._platform, "delete_context")
+    collections = []
+    monkeypatch.setattr(gc, "collect", lambda *a: collections.append(a) or 0)
+    first.close()
+    assert collections == []                                # no full collection
+    # pyrender's order: GL objects, then the context (the platform's __del__ may destroy it again)
+    assert freed[:2] == ["delete", "delete_context"]
+    assert renderer._platform is None and renderer._renderer is None
+    monkeypatch.undo()
+    with PyrenderOracle(64, 48) as second:
+        again, _ = second.render(p_world, edges, cam)
+    assert before.sum() > 20 and np.array_equal(before, again)
