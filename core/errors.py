@@ -62,3 +62,18 @@ def quiet_libraries(loggers=("trimesh",)):
         for log, propagate in saved:
             log.removeHandler(handler)
             log.propagate = propagate
+
+
+def nonempty(text: str) -> str:
+    """An argparse ``type`` for paths: ``text``, or a usage error for ``''``.
+
+    An empty value (an unset shell variable in ``--out "$DIR"``) would
+    otherwise mean the working directory (``Path('')`` is ``.``) or the
+    option's default, silently.
+    """
+    if text == "":
+        import argparse
+
+        raise argparse.ArgumentTypeError("'' (empty): expected a name or path (an empty value, often an unset shell "
+                                         "variable, would silently mean the working directory or the default)")
+    return text

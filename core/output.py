@@ -268,7 +268,10 @@ def check_report_dir(path: Path, option: str) -> None:
     if named is not None:
         raise InputError(f"{option} {str(path)!r}: a folder named like a scene file ({named}) would be "
                          "taken for a scene by later runs: expected another name")
-    resolved = path.resolve()
+    try:
+        resolved = path.resolve()
+    except (RuntimeError, OSError) as exc:         # a symbolic link loop: Python 3.11 raises RuntimeError
+        raise InputError(f"{option} {str(path)!r}: {exc}: expected a folder path") from None
     if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
         raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected a "
                          "report folder elsewhere (reports/ by default)")

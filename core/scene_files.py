@@ -267,8 +267,11 @@ def _obj_lines(path: Path) -> list[tuple[int, int]]:
 def load_mesh_file(path: Path) -> Scene:
     import trimesh  # lazy: only mesh files need it
 
-    if path.suffix.lower() == ".obj":
-        _obj_vertices(path)   # validate every 'v' line first: errors with file:line, not trimesh's
+    suffix = path.suffix.lower()
+    if suffix == ".obj":
+        _check_obj(path)      # every 'v' and 'f' line first: errors with file:line, not trimesh's
+    elif suffix == ".stl":
+        _check_stl(path)      # trimesh reads a truncated or foreign STL as an empty mesh, silently
     try:
         with quiet_libraries():     # trimesh logs tracebacks it recovers from; numpy warns on NaN casts
             loaded = trimesh.load(str(path), process=False, maintain_order=True)
@@ -286,6 +289,8 @@ def load_mesh_file(path: Path) -> Scene:
     if vertices.size % 3 or (vertices.ndim == 2 and vertices.shape[1] != 3):
         raise InputError(f"{path}: vertices of shape {vertices.shape}: expected 3 coordinates per vertex")
     vertices = vertices.reshape(-1, 3)
+    if suffix == ".ply":
+        _check_ply_count(path, len(vertices))
     try:
         faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
     except (TypeError, ValueError, OverflowError) as exc:
@@ -315,6 +320,119 @@ def load_mesh_file(path: Path) -> Scene:
     _check_name_length(_safe_stem(path), path)
     return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
                  faces=faces, source=str(path), winding_note=_winding_note(faces))
+
+
+#: OBJ statements (the Wavefront spec's, free-form geometry included); others are ignored by readers,
+#: so a file without vertices is only "empty" when every line is one of these.
+OBJ_KEYWORDS = frozenset(
+    "v vt vn vp f fo l p o g s mg mtllib usemtl usemap maplib lod bevel c_interp d_interp shadow_obj "
+    "trace_obj ctech stech cstype deg bmat step curv curv2 surf parm trim hole scrv sp end con call csh".split())
+
+
+def _check_obj(path: Path) -> None:
+    """InputError (file:line) for a bad 'v' line, a face index out of range, or nothing OBJ in the file.
+
+    Face indices are 1-based, or negative counting back from the vertices read
+    so far (the OBJ spec); 0 and anything beyond are named here rather than
+    left to trimesh's IndexError without a line. A file with no vertex whose
+    lines are not OBJ statements (binary data, another format renamed) is not
+    an empty mesh: its first such line is named.
+    """
+    n_v, faces, foreign = 0, [], None
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for lineno, raw in enumerate(fh, start=1):
+            parts = raw.split("#", 1)[0].split()
+            if not parts:
+                continue
+            if parts[0] == "v":
+                if len(parts) < 4:
+                    raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
+                for t in parts[1:4]:
+                    _number(path, lineno, t, "vertex coordinate")
+                n_v += 1
+            elif parts[0] in ("f", "fo"):
+                faces.append((lineno, n_v, parts[1:]))
+            elif parts[0] not in OBJ_KEYWORDS and foreign is None:
+                foreign = (lineno, raw.strip())
+    for lineno, before, tokens in faces:
+        for tok in tokens:
+            try:
+                k = int(tok.split("/")[0])
+            except ValueError:
+                raise InputError(f"{path}:{lineno}: face index {tok!r}: expected an integer") from None
+            if not (1 <= k <= n_v or (k < 0 and before + k >= 0)):
+                back = f" or -{before}..-1 (vertices before this line)" if before else ""
+                raise InputError(f"{path}:{lineno}: face index {tok!r}: expected 1..{n_v}{back}"
+                                 if n_v else f"{path}:{lineno}: face index {tok!r}: the file has no vertices "
+                                 "('v X Y Z' lines): expected some")
+    if n_v == 0 and foreign is not None:
+        lineno, text = foreign
+        raise InputError(f"{path}:{lineno}: {_short(text)}: expected an OBJ statement (v, f, l, o, g, ...); "
+                         "no vertex in the file")
+
+
+def _check_stl(path: Path) -> None:
+    """InputError unless ``path`` is a complete binary STL or a well-formed ASCII one (with file:line)."""
+    data = path.read_bytes()
+    if len(data) >= 84:
+        count = int.from_bytes(data[80:84], "little")
+        if len(data) == 84 + 50 * count:
+            return                                        # binary, even when the header starts with 'solid'
+    if not data.lstrip()[:5].lower() == b"solid":
+        if len(data) < 84:
+            raise InputError(f"{path}: {len(data)} bytes: expected a binary STL (an 84-byte header, then 50 "
+                             "bytes a triangle) or an ASCII STL starting with 'solid'")
+        raise InputError(f"{path}: {len(data)} bytes, its header declares {count} triangles: expected "
+                         f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)")
+    _check_ascii_stl(path, data.decode("latin-1"))
+
+
+_STL_TOKENS = frozenset(("solid", "facet", "outer", "vertex", "endloop", "endfacet", "endsolid"))
+
+
+def _check_ascii_stl(path: Path, text: str) -> None:
+    """InputError (file:line) unless every line is an STL statement and every facet has 3 vertices."""
+    in_facet, vertices, lineno, last = False, 0, 0, None
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        parts = raw.split()
+        if not parts:
+            continue
+        tag = parts[0].lower()
+        if tag not in _STL_TOKENS:
+            raise InputError(f"{path}:{lineno}: {_short(raw.strip())}: expected an ASCII STL statement "
+                             "(solid, facet normal, outer loop, vertex X Y Z, endloop, endfacet, endsolid)")
+        if tag == "vertex":
+            if len(parts) != 4 or not in_facet:
+                raise InputError(f"{path}:{lineno}: {_short(raw.strip())}: expected 'vertex X Y Z' inside a facet")
+            for t in parts[1:]:
+                _number(path, lineno, t, "vertex coordinate")
+            vertices += 1
+        elif tag == "facet":
+            if in_facet:
+                raise InputError(f"{path}:{lineno}: facet: expected 'endfacet' before the next facet")
+            in_facet, vertices = True, 0
+        elif tag == "endfacet":
+            if not in_facet or vertices != 3:
+                raise InputError(f"{path}:{lineno}: endfacet after {vertices} vertices: expected a facet of "
+                                 "3 vertices")
+            in_facet = False
+        last = tag
+    if in_facet or last != "endsolid":
+        raise InputError(f"{path}:{lineno}: the file ends {'inside a facet' if in_facet else 'without endsolid'}: "
+                         "expected a complete ASCII STL (truncated?)")
+
+
+def _check_ply_count(path: Path, n_read: int) -> None:
+    """InputError when fewer vertices were read than the PLY header declares (a truncated file)."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16).split(b"end_header", 1)[0].decode("latin-1")
+    for lineno, line in enumerate(head.splitlines(), start=1):
+        parts = line.split()
+        if parts[:2] == ["element", "vertex"] and len(parts) == 3 and parts[2].isdigit():
+            if int(parts[2]) != n_read:
+                raise InputError(f"{path}:{lineno}: {line.strip()!r}, but {n_read} vertices were read: expected "
+                                 "a complete file (truncated?)")
+            return
 
 
 def _obj_vertices(path: Path) -> np.ndarray:
@@ -381,7 +499,12 @@ def load_scene(name_or_path: str) -> Scene:
         if path.is_dir():
             raise InputError(f"--scene {name_or_path!r} is a directory: expected a scene file")
         if not path.is_file():
-            raise InputError(f"--scene {name_or_path!r}: file not found")
+            try:
+                os.stat(path)         # ELOOP (a symbolic link loop), EACCES: named by the OSError below
+            except FileNotFoundError:
+                raise InputError(f"--scene {name_or_path!r}: file not found") from None
+            raise InputError(f"--scene {name_or_path!r}: not a regular file (a device, FIFO or socket): "
+                             "expected a scene file")
     except OSError as exc:      # ENAMETOOLONG, ELOOP, EACCES on a folder of the path
         raise InputError(f"--scene {_short(name_or_path)}: {exc.strerror or exc}: expected a readable file") from None
     suffix = path.suffix.lower()

@@ -141,7 +141,7 @@ def test_stl_with_nan_vertex_is_one_line(tmp_path, capsys):
     stl.write_text("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\nvertex 1 0 0\nvertex 0 1 0\n"
                    "endloop\nendfacet\nendsolid x\n")
     rc, _, err = render(["--frames", "1", "--scene", str(stl)], tmp_path / "o", capsys)
-    assert_one_error_line(rc, err, "vertex 0 has [0.0, 0.0, nan]")
+    assert_one_error_line(rc, err, f"{stl}:4: vertex coordinate 'nan': expected a finite number")   # its line
 
 
 def test_winding_warning_never_precedes_an_error(tmp_path, capsys):
