@@ -289,8 +289,6 @@ def load_mesh_file(path: Path) -> Scene:
     if vertices.size % 3 or (vertices.ndim == 2 and vertices.shape[1] != 3):
         raise InputError(f"{path}: vertices of shape {vertices.shape}: expected 3 coordinates per vertex")
     vertices = vertices.reshape(-1, 3)
-    if suffix == ".ply":
-        _check_ply_count(path, len(vertices))
     try:
         faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
     except (TypeError, ValueError, OverflowError) as exc:
@@ -299,6 +297,8 @@ def load_mesh_file(path: Path) -> Scene:
         faces = np.zeros((0, 3), dtype=np.intp)
     if faces.ndim != 2:
         raise InputError(f"{path}: faces of shape {faces.shape}: expected rows of vertex indices")
+    if suffix == ".ply":
+        _check_ply_counts(path, len(vertices), len(faces))
     bad = (faces < 0) | (faces >= len(vertices))
     if bad.any():
         f, k = (int(i) for i in np.argwhere(bad)[0])
@@ -422,17 +422,21 @@ def _check_ascii_stl(path: Path, text: str) -> None:
                          "expected a complete ASCII STL (truncated?)")
 
 
-def _check_ply_count(path: Path, n_read: int) -> None:
-    """InputError when fewer vertices were read than the PLY header declares (a truncated file)."""
+def _check_ply_counts(path: Path, n_vertices: int, n_faces: int) -> None:
+    """InputError when fewer vertices or faces were read than the PLY header declares (a truncated file).
+
+    trimesh reads what is there and drops a short face row silently. Faces may
+    be more than declared (polygons split into triangles), never fewer.
+    """
     with open(path, "rb") as fh:
         head = fh.read(1 << 16).split(b"end_header", 1)[0].decode("latin-1")
     for lineno, line in enumerate(head.splitlines(), start=1):
         parts = line.split()
-        if parts[:2] == ["element", "vertex"] and len(parts) == 3 and parts[2].isdigit():
-            if int(parts[2]) != n_read:
-                raise InputError(f"{path}:{lineno}: {line.strip()!r}, but {n_read} vertices were read: expected "
+        if parts[:1] == ["element"] and len(parts) == 3 and parts[2].isdigit() and parts[1] in ("vertex", "face"):
+            declared, read = int(parts[2]), n_vertices if parts[1] == "vertex" else n_faces
+            if read < declared or (parts[1] == "vertex" and read != declared):
+                raise InputError(f"{path}:{lineno}: {line.strip()!r}, but {read} {'vertices' if parts[1] == 'vertex' else 'faces'} were read: expected "
                                  "a complete file (truncated?)")
-            return
 
 
 def _obj_vertices(path: Path) -> np.ndarray:

@@ -33,7 +33,7 @@ def render(args, out, capsys):
 
 def assert_one_error_line(rc, err, *needles):
     assert rc == 2, err
-    assert err.count("\n") == 1 and err.startswith(("renderer: error: ", "crosscheck: error: ")), err
+    assert err.count("\n") == 1 and err.endswith("\n") and err.startswith(("renderer: error: ", "crosscheck: error: ")), err
     assert "Traceback" not in err and "Warning" not in err
     for n in needles:
         assert n in err, (n, err)
@@ -482,3 +482,124 @@ def test_run_name_too_long_leaves_no_reports_folder(tmp_path, capsys, monkeypatc
                               "--cases", "on_axis"])
     assert_one_error_line(rc, capsys.readouterr().err, "300 characters")
     assert tree(tmp_path) == []
+
+
+# ---- a mesh file named on the command line: unparsable is a usage error, empty says so ------------
+
+PLY_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 1\nproperty list uchar int vertex_indices\nend_header\n")
+ASCII_STL = ("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+             "endsolid s\n")
+
+
+def _binary_stl(count: int, triangles: int) -> bytes:
+    """A binary STL whose header declares ``count`` triangles and that holds ``triangles`` (zeros) of 50 bytes."""
+    return b"\0" * 80 + count.to_bytes(4, "little") + b"\0" * (50 * triangles)
+
+
+def crosscheck_file(path, tmp_path, capsys, *extra):
+    """crosscheck --scene PATH at level vertices, one frame, one case: (rc, stdout, stderr)."""
+    rc = crosscheck_cli.main(["--scene", str(path), "--level", "vertices", "--frames", "1", "--cases", "on_axis",
+                              "--report-dir", str(tmp_path / "r"), *extra])
+    cap = capsys.readouterr()
+    return rc, cap.out, cap.err
+
+
+@pytest.mark.parametrize("name, data, needle", [
+    # binary data renamed .obj: before, an empty scene, exit 1 'vacuous' with nothing on stderr
+    ("garbage.obj", b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\xff\xfe", "garbage.obj:1: "),
+    ("faces_only.obj", b"f 1 2 3\n", "faces_only.obj:1: face index '1': the file has no vertices"),
+    ("negative.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "negative.obj:4: face index '-4': expected 1..3"),
+    ("zero.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "zero.obj:4: face index '0': expected 1..3"),
+    ("huge.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", "huge.obj:4: face index '9999"),
+    ("empty.stl", b"", "empty.stl: 0 bytes: expected a binary STL"),
+    ("truncated.stl", _binary_stl(5, 2), "truncated.stl: 184 bytes, its header declares 5 triangles: expected "
+                                         "84 + 50 x 5 = 334 bytes"),
+    ("billion.stl", _binary_stl(10**9, 1), "billion.stl: 134 bytes, its header declares 1000000000 triangles"),
+    ("cut.stl", ASCII_STL[:64].encode(), "cut.stl:5: the file ends inside a facet"),       # after 2 vertices
+    ("cut_vertex.stl", ASCII_STL[:70].encode(), "cut_vertex.stl:6: 'vertex': expected 'vertex X Y Z'"),
+    ("noend.stl", ASCII_STL[:-len("endsolid s\n")].encode(), "noend.stl:8: the file ends without endsolid"),
+    ("foreign.stl", b"solid s\nfacet normal 0 0 1\nbogus line\n", "foreign.stl:3: 'bogus line': expected an ASCII STL"),
+    ("two.stl", ASCII_STL.replace("vertex 0 1 0\n", "").encode(), "two.stl:7: endfacet after 2 vertices"),
+    ("few_vertices.ply", (PLY_HEAD + "0 0 0\n1 0 0\n").encode(),
+     "few_vertices.ply:3: 'element vertex 3', but 2 vertices were read"),
+    ("few_faces.ply", (PLY_HEAD + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n").encode(),   # a short row: trimesh drops it
+     "few_faces.ply:7: 'element face 1', but 0 faces were read"),
+])
+def test_unparsable_mesh_file_is_a_usage_error(tmp_path, capsys, name, data, needle):
+    mesh = tmp_path / name
+    mesh.write_bytes(data)
+    rc, out, err = crosscheck_file(mesh, tmp_path, capsys)
+    assert_one_error_line(rc, err, f"{tmp_path}/{needle}")
+    assert out == "" and not (tmp_path / "r").exists()          # no report of a run that never started
+
+
+@pytest.mark.parametrize("name, text", [("empty.obj", ""), ("groups.obj", "# exported\no thing\ng part\n"),
+                                        ("empty.stl", "solid s\nendsolid s\n"), ("empty.scene", "# none\n")])
+def test_valid_empty_file_is_vacuous_and_says_so_on_stderr(tmp_path, capsys, name, text):
+    mesh = tmp_path / name
+    mesh.write_text(text)
+    stem = name.split(".")[0]
+    line = f"crosscheck: {mesh}: no vertices: every case of scene {stem!r} compares nothing (vacuous: %s)\n"
+    rc, _, err = crosscheck_file(mesh, tmp_path, capsys)
+    assert (rc, err) == (1, line % "the run fails")              # a gate never passes on nothing
+    rc, _, err = crosscheck_file(mesh, tmp_path, capsys, "--allow-vacuous", "--run", "allowed")
+    assert (rc, err) == (0, line % "allowed by --allow-vacuous")
+
+
+def test_loadable_meshes_are_still_read(tmp_path, capsys):
+    """The checks above refuse nothing valid: a quad PLY (split into 2 triangles), negative OBJ indices,
+    a binary STL whose header starts with 'solid'."""
+    (tmp_path / "quad.ply").write_text(PLY_HEAD.replace("vertex 3", "vertex 4") + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
+                                       "4 0 1 2 3\n")
+    (tmp_path / "rel.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n")
+    tri = np.array([[0, 0, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes() + b"\0\0"
+    (tmp_path / "b.stl").write_bytes(b"solid but binary".ljust(80, b" ") + (1).to_bytes(4, "little") + tri)
+    for name, counts in (("quad.ply", "(4 vertices, 5 edges)"), ("rel.obj", "(3 vertices, 3 edges)"),
+                         ("b.stl", "(3 vertices, 3 edges)")):
+        rc, out, err = render(["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / name.replace(".", "_"),
+                              capsys)
+        assert (rc, err) == (0, "") and counts in out, name
+
+
+# ---- option values that would silently mean something else --------------------------------------
+
+@pytest.mark.parametrize("option", ["--scene", "--scene-list", "--report-dir", "--junit-xml", "--config",
+                                    "--candidate-frames"])
+def test_empty_path_option_is_a_usage_error(tmp_path, capsys, monkeypatch, option):
+    # before: --scene '' ran the working directory as a dataset, --junit-xml '' wrote no XML,
+    # --report-dir '' / --config '' fell back to their defaults
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "kept.obj").write_text("v 0 0 0\n")
+    with pytest.raises(SystemExit) as exit_:          # argparse's usage error: one line, exit 2
+        crosscheck_cli.main(["--level", "vertices", "--frames", "1", "--cases", "on_axis", option, ""])
+    rc = exit_.value.code
+    assert_one_error_line(rc, capsys.readouterr().err, f"argument {option}: '' (empty): expected a name or path")
+    assert tree(tmp_path) == ["kept.obj"]
+
+
+def test_renderer_empty_out_is_a_usage_error(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)                   # before: frames and reports written into the working directory
+    with pytest.raises(SystemExit) as exit_:
+        renderer_cli.main(["--frames", "1", "--format", "ascii", "--out", ""])
+    rc = exit_.value.code
+    assert_one_error_line(rc, capsys.readouterr().err, "argument --out: '' (empty)")
+    assert tree(tmp_path) == []
+
+
+def test_report_dir_through_a_symlink_loop_is_a_usage_error(tmp_path, capsys):
+    (tmp_path / "a").symlink_to(tmp_path / "b")
+    (tmp_path / "b").symlink_to(tmp_path / "a")
+    rc = crosscheck_cli.main(["--level", "vertices", "--frames", "1", "--cases", "on_axis",
+                              "--report-dir", str(tmp_path / "a")])
+    assert_one_error_line(rc, capsys.readouterr().err, f"--report-dir '{tmp_path}/a': Symlink loop")   # was exit 3
+
+
+def test_scene_symlink_loop_and_fifo_are_named(tmp_path, capsys):
+    (tmp_path / "a.obj").symlink_to(tmp_path / "b.obj")
+    (tmp_path / "b.obj").symlink_to(tmp_path / "a.obj")
+    os.mkfifo(tmp_path / "f.obj")
+    for name, needle in (("a.obj", "Too many levels of symbolic links"), ("f.obj", "not a regular file"),
+                         ("missing.obj", "file not found")):          # before: 'file not found' for all three
+        rc, _, err = render(["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / "o", capsys)
+        assert_one_error_line(rc, err, f"--scene '{tmp_path / name}': {needle}")
