@@ -8,6 +8,7 @@ docs/reliability.md.
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -85,3 +86,34 @@ def test_crosscheck_contract(data, earlier):
         argv = crosscheck_argv(HypothesisPick(data), box, earlier)
         outcome = run_cli(cli.main, argv, box, "crosscheck")
         assert outcome.problems == [], (argv, outcome)
+
+
+#: Complete small meshes of the formats whose readers accept a truncated file (tests/test_hostile.py has one
+#: hand-made case each); every shorter prefix must be refused, never read as a smaller mesh.
+_TRIANGLE = np.array([[0, 0, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes() + b"\0\0"
+COMPLETE = {
+    "binary.stl": b"\0" * 80 + (2).to_bytes(4, "little") + _TRIANGLE * 2,
+    "ascii.stl": ("solid s\n" + "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                  "endloop\nendfacet\nendsolid s\n").encode(),
+    "ascii.ply": ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                  "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                  "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n").encode(),
+}
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck))
+@given(name=st.sampled_from(sorted(COMPLETE)), data=st.data())
+def test_a_truncated_mesh_file_is_refused_or_read_whole(name, data):
+    full_bytes = COMPLETE[name]
+    cut = data.draw(st.integers(0, len(full_bytes) - 1), label="cut")
+    with tempfile.TemporaryDirectory() as d:
+        whole, part = Path(d) / f"whole_{name}", Path(d) / f"part_{name}"
+        whole.write_bytes(full_bytes)
+        part.write_bytes(full_bytes[:cut])
+        full = load_scene(str(whole))
+        try:
+            scene = load_scene(str(part))
+        except InputError as exc:
+            assert "\n" not in str(exc) and str(exc).startswith(str(part))
+        else:   # only a cut in the last line's name or newline leaves the mesh whole
+            assert (scene.vertices.tolist(), scene.faces) == (full.vertices.tolist(), full.faces), cut
