@@ -60,9 +60,74 @@ def load_job(job_dir: Path) -> dict:
         raise FramesError([f"{path}: not a wirecheck frames job (kind {job.get('kind') if isinstance(job, dict) else None!r})"])
     if job.get("version") != JOB_VERSION:
         raise FramesError([f"{path}: job version {job.get('version')!r}: expected {JOB_VERSION} (export it again)"])
-    if not job.get("cases") or not any(c.get("frames") for c in job["cases"]):
+    if not job.get("cases"):
         raise FramesError([f"{path}: the job lists no frames: nothing to judge"])
+    problem = _job_problem(job)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem} (export the job again)"])
     return job
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _job_problem(job: dict) -> str | None:
+    """What in a job.json is not as ``crosscheck export`` writes it, in one phrase; None when all is.
+
+    A job is hand-editable JSON: every field the judging reads is checked here,
+    so that an edited or damaged one is a usage error naming the field, never a
+    crash later or numbers in the report that mean nothing.
+    """
+    from wirecheck.core.limits import MAX_FRAMES, check_image_size
+    from wirecheck.core.scene_files import NAME_PATTERN
+
+    frames, every = job.get("frames"), job.get("every")
+    if not (_is_int(frames) and 1 <= frames <= MAX_FRAMES):
+        return f"frames {frames!r}: expected an integer in 1..{MAX_FRAMES}"
+    if not (_is_int(every) and 1 <= every <= frames):
+        return f"every {every!r}: expected an integer in 1..frames ({frames})"
+    checked = list(range(1, frames + 1, every))
+    if job.get("frame_numbers") != checked:
+        return f"frame_numbers {str(job.get('frame_numbers'))[:60]}: expected 1, 1+every, ... up to frames"
+    turns = (job.get("motion") or {}).get("turns") if isinstance(job.get("motion"), dict) else None
+    if not (isinstance(turns, list) and len(turns) == 3
+            and all(isinstance(t, (int, float)) and not isinstance(t, bool) and np.isfinite(t) for t in turns)):
+        return f"motion.turns {turns!r}: expected three finite numbers"
+    if job.get("style") != "wireframe":
+        return f"style {job.get('style')!r}: expected 'wireframe' (the frames judged are wireframes)"
+    scenes, cases = job.get("scenes"), job.get("cases")
+    if not (isinstance(scenes, list) and scenes and all(isinstance(r, dict) for r in scenes)):
+        return "scenes: expected a list of the job's scenes"
+    names = set()
+    for r in scenes:
+        name, obj = r.get("name"), r.get("obj")
+        if not (isinstance(name, str) and NAME_PATTERN.fullmatch(name)) or name in names:
+            return f"scene name {name!r}: expected a name of letters, digits, '_', '.', '-', each scene once"
+        names.add(name)
+        expected = {"model": f"scenes/{name}.obj", "world per frame": f"scenes/{name}/frame_NNNN.obj"}
+        if expected.get(r.get("space")) != obj:
+            return (f"scene {name!r}: space {r.get('space')!r}, obj {obj!r}: expected space 'model' with "
+                    f"obj {expected['model']!r}, or 'world per frame' with {expected['world per frame']!r}")
+        if r.get("space") == "model" and not all(_is_int(r.get(k)) and r[k] >= 0 for k in ("vertices", "edges")):
+            return f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}: expected counts"
+    if not (isinstance(cases, list) and all(isinstance(c, dict) for c in cases)):
+        return "cases: expected a list of the job's cases"
+    for c in cases:
+        scene, case, w, h = c.get("scene"), c.get("case"), c.get("width"), c.get("height")
+        if scene not in names or not (isinstance(case, str) and NAME_PATTERN.fullmatch(case)):
+            return f"case {scene!r} / {case!r}: expected a scene of 'scenes' and a case name"
+        if not (_is_int(w) and _is_int(h)):
+            return f"case {scene} / {case}: width {w!r}, height {h!r}: expected integers"
+        try:
+            check_image_size(w, h, f"case {scene} / {case}: width x height")
+        except InputError as exc:
+            return str(exc)
+        listed = [f"frames/{scene}/{case}/{frame_name(k, 'png')}" for k in checked]
+        if c.get("frames") != listed:
+            return (f"case {scene} / {case}: frames {str(c.get('frames'))[:80]}: expected "
+                    f"frames/{scene}/{case}/frame_NNNN.png for each of frame_numbers")
+    return None
 
 
 def read_png(path: Path, width: int, height: int) -> np.ndarray:
@@ -118,28 +183,63 @@ def load_frames(job_dir: Path, job: dict) -> dict:
 
 
 def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``."""
+    """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``.
+
+    FramesError (file:line) for a record that is not as export writes it: 3
+    finite coordinates, 2 indices of vertices before it.
+    """
     verts, edges = [], []
-    for line in Path(path).read_text().splitlines():
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise FramesError([f"{path}: unreadable ({exc}): expected the OBJ 'crosscheck export' wrote"]) from None
+    for lineno, line in enumerate(text.splitlines(), start=1):
         parts = line.split()
-        if parts and parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts and parts[0] == "l":
-            edges.append([int(x) - 1 for x in parts[1:3]])
+        try:
+            if parts and parts[0] == "v":
+                verts.append([float(x) for x in parts[1:]])
+                if len(parts) != 4 or not np.all(np.isfinite(verts[-1])):
+                    raise ValueError
+            elif parts and parts[0] == "l":
+                edges.append([int(x) - 1 for x in parts[1:]])
+                if len(parts) != 3 or not all(0 <= i < len(verts) for i in edges[-1]):
+                    raise ValueError
+        except ValueError:
+            raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
+                               f"(1..{len(verts)}), as 'crosscheck export' wrote"]) from None
     return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
+
+
+def _frame_camera(path: Path):
+    """``(camera, model_matrix (4, 4))`` of a frame's JSON; FramesError naming the file otherwise."""
+    from wirecheck.core.camera import Camera
+
+    try:
+        cam_json = json.loads(path.read_text(encoding="utf-8"))
+        camera = Camera(**cam_json["camera"])
+        m = np.asarray(cam_json["model_matrix"], dtype=np.float64)
+        if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+            raise ValueError(f"model_matrix of shape {m.shape}: expected 4x4 finite numbers")
+    except FileNotFoundError:
+        raise FramesError([f"{path}: missing: expected the camera 'crosscheck export' wrote"]) from None
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+        what = f"no {exc}" if isinstance(exc, KeyError) else str(exc)
+        raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {what}): expected the camera JSON "
+                           "'crosscheck export' wrote"]) from None
+    return camera, m
 
 
 def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int):
     """``(p_model (N, 3), edges (E, 2), camera, model_matrix (4, 4))`` of one frame, from the job's files."""
-    from wirecheck.core.camera import Camera
-
     job_dir = Path(job_dir)
-    row = next(s for s in job["scenes"] if s["name"] == scene)
+    row = next(s for s in job["scenes"] if s["name"] == scene)       # load_job checked it is there
     obj = job_dir / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
     p_model, edges = read_obj(obj)
-    cam_json = json.loads((job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}").read_text())
-    camera = Camera(**cam_json["camera"])
-    return p_model, edges, camera, np.asarray(cam_json["model_matrix"], dtype=np.float64)
+    if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
+        raise FramesError([f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
+                           f"{row['edges']} (job.json's; the file was changed or cut short)"])
+    camera, m = _frame_camera(job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}")
+    return p_model, edges, camera, m
 
 
 def _min_scores(scores: list[dict], prefix: str = "") -> dict:

@@ -4,6 +4,7 @@ Each test is one finding of the fuzzing that filed the issue.
 """
 
 import json
+import shutil
 import os
 import signal
 import subprocess
@@ -603,3 +604,84 @@ def test_scene_symlink_loop_and_fifo_are_named(tmp_path, capsys):
                          ("missing.obj", "file not found")):          # before: 'file not found' for all three
         rc, _, err = render(["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / "o", capsys)
         assert_one_error_line(rc, err, f"--scene '{tmp_path / name}': {needle}")
+
+
+# ---- a frames job (crosscheck export DIR) edited or damaged by hand --------------------------------
+
+@pytest.fixture(scope="module")
+def blank_job(tmp_path_factory):
+    """A job of cube / on_axis, frames 1 and 3 of 4, with black PNGs at the camera's size (640x480)."""
+    from PIL import Image
+
+    job = tmp_path_factory.mktemp("job") / "job"
+    assert crosscheck_cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "4",
+                                "--every", "2"]) == 0
+    (job / "frames/cube/on_axis").mkdir(parents=True)
+    for k in (1, 3):
+        Image.new("L", (640, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
+    return job
+
+
+def _set(*path_value):
+    *path, value = path_value
+
+    def edit(job):
+        node = job
+        for key in path[:-1]:
+            node = node[key]
+        node[path[-1]] = value
+    return edit
+
+
+@pytest.mark.parametrize("edit, needle", [
+    # before: exit 3 (a traceback in a log) for these three ...
+    (_set("every", 0), "job.json: every 0: expected an integer in 1..frames (4)"),
+    (_set("scenes", []), "job.json: scenes: expected a list of the job's scenes"),
+    (_set("cases", 0, "scene", "sphere"), "job.json: case 'sphere' / 'on_axis': expected a scene of 'scenes'"),
+    # ... and exit 1 with the value copied into the report, or the file read from elsewhere, for these
+    (_set("frames", "x"), "job.json: frames 'x': expected an integer in 1..100000"),
+    (_set("frames", True), "job.json: frames True: expected an integer"),
+    (_set("frame_numbers", []), "job.json: frame_numbers []: expected 1, 1+every, ... up to frames"),
+    (_set("motion", "turns", [float("nan"), 0, 0]), "job.json: motion.turns [nan, 0, 0]: expected three finite"),
+    (_set("style", "shaded"), "job.json: style 'shaded': expected 'wireframe'"),
+    (_set("scenes", 0, "obj", "/etc/passwd"), "job.json: scene 'cube': space 'model', obj '/etc/passwd': expected"),
+    (_set("cases", 0, "width", 0), "job.json: case cube / on_axis: width x height 0x480: expected positive"),
+    (_set("cases", 0, "frames", ["../../x.png", "frames/cube/on_axis/frame_0003.png"]),
+     "job.json: case cube / on_axis: frames ['../../x.png'"),
+])
+def test_edited_job_json_is_one_line_exit_2(blank_job, tmp_path, capsys, edit, needle):
+    job_dir = tmp_path / "job"
+    shutil.copytree(blank_job, job_dir)
+    job = json.loads((job_dir / "job.json").read_text())
+    edit(job)
+    (job_dir / "job.json").write_text(json.dumps(job))
+    rc = crosscheck_cli.main(["--candidate-frames", str(job_dir), "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err, f"{job_dir}/{needle}", "(export the job again)")
+    assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize("rel, data, needle", [
+    # before: exit 3 for each (UnicodeDecodeError, JSONDecodeError, KeyError), exit 1 for the empty OBJ
+    ("scenes/cube.obj", b"\xff\0garbage", "scenes/cube.obj: unreadable ('utf-8' codec"),
+    ("scenes/cube.obj", b"", "scenes/cube.obj: 0 vertices, 0 edges: expected 8 and 12"),
+    ("scenes/cube.obj", b"v 0 0 0\nl 1 2\n", "scenes/cube.obj:2: 'l 1 2': expected 'v X Y Z' (finite) or 'l I J' (1..1)"),
+    ("scenes/cube.obj", b"v 0 nan 0\n", "scenes/cube.obj:1: 'v 0 nan 0': expected 'v X Y Z' (finite)"),
+    ("cameras/cube/on_axis/frame_0001.json", b"{", "cameras/cube/on_axis/frame_0001.json: unreadable (JSONDecodeError: "),
+    ("cameras/cube/on_axis/frame_0001.json", b"{}", "cameras/cube/on_axis/frame_0001.json: unreadable (KeyError: no 'camera')"),
+    ("cameras/cube/on_axis/frame_0001.json", b'{"camera": {"width": 3}}', "cameras/cube/on_axis/frame_0001.json: unreadable (TypeError: "),
+])
+def test_damaged_job_file_is_one_line_exit_2(blank_job, tmp_path, capsys, rel, data, needle):
+    job_dir = tmp_path / "job"
+    shutil.copytree(blank_job, job_dir)
+    (job_dir / rel).write_bytes(data)
+    rc = crosscheck_cli.main(["--candidate-frames", str(job_dir), "--report-dir", str(tmp_path / "r")])
+    assert_one_error_line(rc, capsys.readouterr().err, f"{job_dir}/{needle}")
+    assert not (tmp_path / "r").exists()
+
+
+def test_the_blank_job_itself_is_judged(blank_job, tmp_path, capsys):
+    """The set-up above is a valid job: unedited, its black frames are judged (vacuous? no: the oracle draws
+    the cube, so every case fails), exit 1, nothing on stderr."""
+    rc = crosscheck_cli.main(["--candidate-frames", str(blank_job), "--report-dir", str(tmp_path / "r")])
+    cap = capsys.readouterr()
+    assert (rc, cap.err) == (1, "") and "pixel F1@1px 0.0000 < 0.999" in cap.out
