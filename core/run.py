@@ -217,7 +217,7 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
     stage.path(f"{name}-report.json").write_text(output.json_dumps(report), encoding="utf-8")
     wall = time.perf_counter() - t_start
     stage.path(f"{name}-report.txt").write_text(summary_text(report, render_seconds, wall, plot_seconds),
-                                                encoding="utf-8")
+                                                encoding="utf-8", errors="backslashreplace")   # a non-UTF-8 path
     out = s.out
     report["_paths"] = {"frames": out / f"{name}-frames" if frames_dir else None,
                         "json": out / f"{name}-report.json", "txt": out / f"{name}-report.txt",

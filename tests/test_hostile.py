@@ -685,3 +685,14 @@ def test_the_blank_job_itself_is_judged(blank_job, tmp_path, capsys):
     rc = crosscheck_cli.main(["--candidate-frames", str(blank_job), "--report-dir", str(tmp_path / "r")])
     cap = capsys.readouterr()
     assert (rc, cap.err) == (1, "") and "pixel F1@1px 0.0000 < 0.999" in cap.out
+
+
+def test_scene_at_a_non_utf8_path_is_rendered(tmp_path, capsys):
+    """Linux paths are bytes: b'm\\xfe.obj' reaches Python as 'm\\udcfe.obj', which UTF-8 cannot encode.
+    Before, the summary's 'from PATH' line ended the run with exit 3; it is written with a backslash escape."""
+    mesh = tmp_path / os.fsdecode(b"m\xfe.obj")
+    mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    rc, out, err = render(["--frames", "1", "--scene", str(mesh)], tmp_path / "o", capsys)
+    assert (rc, err) == (0, "") and "(3 vertices, 3 edges)" in out
+    first = (tmp_path / "o" / "m_-report.txt").read_text(encoding="utf-8").splitlines()[0]
+    assert first == f"Scene: m_ (3 vertices, 3 edges) from {tmp_path}/m\\udcfe.obj"
