@@ -272,6 +272,8 @@ def load_mesh_file(path: Path) -> Scene:
         _check_obj(path)      # every 'v' and 'f' line first: errors with file:line, not trimesh's
     elif suffix == ".stl":
         _check_stl(path)      # trimesh reads a truncated or foreign STL as an empty mesh, silently
+    elif suffix == ".gltf":
+        _check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
     try:
         with quiet_libraries():     # trimesh logs tracebacks it recovers from; numpy warns on NaN casts
             loaded = trimesh.load(str(path), process=False, maintain_order=True)
@@ -385,6 +387,20 @@ def _check_stl(path: Path) -> None:
         raise InputError(f"{path}: {len(data)} bytes, its header declares {count} triangles: expected "
                          f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)")
     _check_ascii_stl(path, data.decode("latin-1"))
+
+
+def _check_json(path: Path) -> None:
+    """InputError (file:line:column) unless ``path`` holds one JSON object, as a .gltf does."""
+    import json
+
+    try:
+        doc = json.loads(path.read_bytes())
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start}): expected glTF JSON") from None
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}:{exc.lineno}:{exc.colno}: not JSON ({exc.msg}): expected glTF JSON") from None
+    if not isinstance(doc, dict):
+        raise InputError(f"{path}: a JSON {type(doc).__name__}: expected a glTF object ({{\"asset\": ...}})")
 
 
 _STL_TOKENS = frozenset(("solid", "facet", "outer", "vertex", "endloop", "endfacet", "endsolid"))

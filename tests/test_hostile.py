@@ -522,6 +522,9 @@ def crosscheck_file(path, tmp_path, capsys, *extra):
     ("noend.stl", ASCII_STL[:-len("endsolid s\n")].encode(), "noend.stl:8: the file ends without endsolid"),
     ("foreign.stl", b"solid s\nfacet normal 0 0 1\nbogus line\n", "foreign.stl:3: 'bogus line': expected an ASCII STL"),
     ("two.stl", ASCII_STL.replace("vertex 0 1 0\n", "").encode(), "two.stl:7: endfacet after 2 vertices"),
+    # before: "could not be read as GLTF: FileNotFoundError: model.gltf", naming a file that is not there
+    ("broken.gltf", b'{"asset": ', "broken.gltf:1:11: not JSON (Expecting value): expected glTF JSON"),
+    ("array.gltf", b"[1, 2]", "array.gltf: a JSON list: expected a glTF object"),
     ("few_vertices.ply", (PLY_HEAD + "0 0 0\n1 0 0\n").encode(),
      "few_vertices.ply:3: 'element vertex 3', but 2 vertices were read"),
     ("few_faces.ply", (PLY_HEAD + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n").encode(),   # a short row: trimesh drops it
