@@ -272,6 +272,8 @@ def load_mesh_file(path: Path) -> Scene:
         _check_obj(path)      # every 'v' and 'f' line first: errors with file:line, not trimesh's
     elif suffix == ".stl":
         _check_stl(path)      # trimesh reads a truncated or foreign STL as an empty mesh, silently
+    elif suffix == ".off":
+        _check_off(path)      # trimesh takes any first line for 'OFF' and reads a short face list as none
     elif suffix == ".gltf":
         _check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
     try:
@@ -387,6 +389,40 @@ def _check_stl(path: Path) -> None:
         raise InputError(f"{path}: {len(data)} bytes, its header declares {count} triangles: expected "
                          f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)")
     _check_ascii_stl(path, data.decode("latin-1"))
+
+
+def _check_off(path: Path) -> None:
+    """InputError (file:line) unless ``path`` is an OFF file: 'OFF', counts, then as many vertices and faces."""
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        rows = [(n, line.split("#", 1)[0].split()) for n, line in enumerate(fh, start=1)]
+    rows = [(n, parts) for n, parts in rows if parts]
+    if not rows or rows[0][1][0] not in ("OFF", "COFF"):
+        n, parts = rows[0] if rows else (1, ["(empty)"])
+        raise InputError(f"{path}:{n}: {_short(' '.join(parts))}: expected the header 'OFF' (or 'COFF')")
+    head_n, head = rows[0]
+    if len(head) == 1:                                    # the counts on the next line
+        rows = rows[1:]
+        head_n, head = rows[0] if rows else (head_n, [])
+        head = ["OFF", *head]
+    counts = head[1:4]
+    if len(counts) < 2 or not all(t.isdigit() for t in counts):
+        raise InputError(f"{path}:{head_n}: counts {_short(' '.join(head[1:]))}: expected 'VERTICES FACES EDGES' "
+                         "(integers >= 0)")
+    n_v, n_f = int(counts[0]), int(counts[1])
+    body = rows[1:]
+    if len(body) < n_v + n_f:
+        raise InputError(f"{path}:{head_n}: {n_v} vertices and {n_f} faces declared, {len(body)} lines follow: "
+                         "expected a complete file (truncated?)")
+    for n, parts in body[:n_v]:
+        if len(parts) < 3:
+            raise InputError(f"{path}:{n}: vertex {_short(' '.join(parts))}: expected 'X Y Z'")
+        for t in parts[:3]:
+            _number(path, n, t, "vertex coordinate")
+    for n, parts in body[n_v:n_v + n_f]:
+        size = int(parts[0]) if parts[0].isdigit() else -1
+        if size < 3 or len(parts) < size + 1 or not all(t.isdigit() and int(t) < n_v for t in parts[1:size + 1]):
+            raise InputError(f"{path}:{n}: face {_short(' '.join(parts))}: expected 'N I1 ... IN', N >= 3, "
+                             f"indices 0..{n_v - 1}")
 
 
 def _check_json(path: Path) -> None:

@@ -88,7 +88,7 @@ def test_crosscheck_contract(data, earlier):
         assert outcome.problems == [], (argv, outcome)
 
 
-#: Complete small meshes of the formats whose readers accept a truncated file (tests/test_hostile.py has one
+#: Complete small meshes of the formats whose readers (trimesh) accept a truncated file (tests/test_hostile.py has one
 #: hand-made case each); every shorter prefix must be refused, never read as a smaller mesh.
 _TRIANGLE = np.array([[0, 0, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes() + b"\0\0"
 COMPLETE = {
@@ -98,6 +98,7 @@ COMPLETE = {
     "ascii.ply": ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
                   "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
                   "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n").encode(),
+    "mesh.off": b"OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
 }
 
 

@@ -522,6 +522,13 @@ def crosscheck_file(path, tmp_path, capsys, *extra):
     ("noend.stl", ASCII_STL[:-len("endsolid s\n")].encode(), "noend.stl:8: the file ends without endsolid"),
     ("foreign.stl", b"solid s\nfacet normal 0 0 1\nbogus line\n", "foreign.stl:3: 'bogus line': expected an ASCII STL"),
     ("two.stl", ASCII_STL.replace("vertex 0 1 0\n", "").encode(), "two.stl:7: endfacet after 2 vertices"),
+    # before: read as 3 vertices without faces, as no vertices, as no faces; the rest without a line
+    ("header.off", b"NOTOFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n", "header.off:1: 'NOTOFF': expected the header 'OFF'"),
+    ("negative.off", b"OFF\n-3 0 0\n", "negative.off:2: counts '-3 0 0': expected 'VERTICES FACES EDGES'"),
+    ("noface.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n",
+     "noface.off:2: 3 vertices and 1 faces declared, 3 lines follow: expected a complete file"),
+    ("index.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "index.off:6: face '3 0 1 9': expected"),
+    ("empty.off", b"", "empty.off:1: '(empty)': expected the header 'OFF'"),
     # before: "could not be read as GLTF: FileNotFoundError: model.gltf", naming a file that is not there
     ("broken.gltf", b'{"asset": ', "broken.gltf:1:11: not JSON (Expecting value): expected glTF JSON"),
     ("array.gltf", b"[1, 2]", "array.gltf: a JSON list: expected a glTF object"),
@@ -553,14 +560,15 @@ def test_valid_empty_file_is_vacuous_and_says_so_on_stderr(tmp_path, capsys, nam
 
 def test_loadable_meshes_are_still_read(tmp_path, capsys):
     """The checks above refuse nothing valid: a quad PLY (split into 2 triangles), negative OBJ indices,
-    a binary STL whose header starts with 'solid'."""
+    a binary STL whose header starts with 'solid', an OFF quad with its counts on the header line and a colour."""
     (tmp_path / "quad.ply").write_text(PLY_HEAD.replace("vertex 3", "vertex 4") + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
                                        "4 0 1 2 3\n")
     (tmp_path / "rel.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n")
+    (tmp_path / "c.off").write_text("# a comment\nOFF 4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 255 0 0\n")
     tri = np.array([[0, 0, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes() + b"\0\0"
     (tmp_path / "b.stl").write_bytes(b"solid but binary".ljust(80, b" ") + (1).to_bytes(4, "little") + tri)
     for name, counts in (("quad.ply", "(4 vertices, 5 edges)"), ("rel.obj", "(3 vertices, 3 edges)"),
-                         ("b.stl", "(3 vertices, 3 edges)")):
+                         ("b.stl", "(3 vertices, 3 edges)"), ("c.off", "(4 vertices, 5 edges)")):
         rc, out, err = render(["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / name.replace(".", "_"),
                               capsys)
         assert (rc, err) == (0, "") and counts in out, name
