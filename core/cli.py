@@ -19,7 +19,7 @@ from .camera import Camera, camera_z, look_at, orthographic_twin
 from .clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
 from .culling import CULL_CHOICES
-from .errors import InputError, nonempty
+from .errors import InputError, check_not_empty
 from .guard import run_cli
 from .limits import MAX_FRAMES, check_image_size, check_turns
 from .projection import DTYPES
@@ -134,7 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "faces/objects, hidden pixels when on) against frame number (default off: matplotlib "
                    "adds about 1 s)")
     p.add_argument("--ascii-cols", type=int, default=80, help="columns of the ascii frames (default 80)")
-    p.add_argument("--out", type=nonempty, default="output", help="output directory (default output/)")
+    p.add_argument("--out", default="output", help="output directory (default output/)")
     p.add_argument("--verbose", action="store_true",
                    help="print every frame (default off: only the first, middle and last)")
     ana = p.add_argument_group("analysis and the interactive viewer (docs/interactive.md)")
@@ -163,6 +163,7 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     """The run the options ask for; InputError (one line, naming the option) for anything invalid."""
     if not 1 <= a.frames <= MAX_FRAMES:
         raise InputError(f"--frames {a.frames}: expected an integer in 1..{MAX_FRAMES:,} (limits.MAX_FRAMES)")
+    check_not_empty([("--out", a.out)])
     fov_given = a.fov is not None
     a.fov = 60.0 if a.fov is None else a.fov
     if not (0.0 < a.fov < 180.0):

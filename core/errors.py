@@ -64,16 +64,15 @@ def quiet_libraries(loggers=("trimesh",)):
             log.propagate = propagate
 
 
-def nonempty(text: str) -> str:
-    """An argparse ``type`` for paths: ``text``, or a usage error for ``''``.
+
+def check_not_empty(options) -> None:
+    """InputError for the first ``(option, value)`` whose value is ``''`` (or a list holding ``''``).
 
     An empty value (an unset shell variable in ``--out "$DIR"``) would
     otherwise mean the working directory (``Path('')`` is ``.``) or the
     option's default, silently.
     """
-    if text == "":
-        import argparse
-
-        raise argparse.ArgumentTypeError("'' (empty): expected a name or path (an empty value, often an unset shell "
-                                         "variable, would silently mean the working directory or the default)")
-    return text
+    for option, value in options:
+        if value == "" or (isinstance(value, list) and "" in value):
+            raise InputError(f"{option} '': expected a name or path (an empty value, often an unset shell "
+                             "variable, would silently mean the working directory or the default)")

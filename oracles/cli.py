@@ -65,7 +65,7 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
-from wirecheck.core.errors import InputError, nonempty
+from wirecheck.core.errors import InputError, check_not_empty
 from wirecheck.core.guard import run_cli
 from wirecheck.core.output import check_replaceable, check_report_dir
 
@@ -108,10 +108,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0].replace("``", ""))
     p.add_argument("--version", action="version", version=f"%(prog)s (wirecheck) {_version()}",
                    help="print the installed wirecheck version and exit")
-    p.add_argument("--scene", type=nonempty, action="append", default=None,
+    p.add_argument("--scene", action="append", default=None,
                    help="scene name or path, or a folder of mesh files (a dataset, walked recursively); "
                         "repeatable (default: every scene in scenes/)")
-    p.add_argument("--scene-list", type=nonempty, action="append", default=None, metavar="FILE",
+    p.add_argument("--scene-list", action="append", default=None, metavar="FILE",
                    help="a dataset: mesh file paths, one per line ('#' comments, blank lines; relative to FILE's "
                         "folder); repeatable (default: none)")
     p.add_argument("--allow-load-errors", action="store_true", default=False,
@@ -132,7 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="what the candidate computes in; its vertex bound is derived from it (oracles/tolerances.py) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
-    p.add_argument("--candidate-frames", type=nonempty, default=None, metavar="DIR",
+    p.add_argument("--candidate-frames", default=None, metavar="DIR",
                    help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
                         "(docs/frames.md) (default: none)")
     p.add_argument("--level", choices=LEVELS, default=None,
@@ -189,14 +189,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--allow-vacuous", action="store_true", default=False,
                    help="a case that compared nothing (every point clipped, nothing drawn) does not fail the run "
                         "(default: it does)")
-    p.add_argument("--report-dir", type=nonempty, default=None,
+    p.add_argument("--report-dir", default=None,
                    help="where to write the report: DIR, or DIR/RUN with --run (default reports/RUN)")
     p.add_argument("--run", default=None, help="run name: the report folder's name, also in report.json "
                                                "(default: UTC time, YYYYmmdd-HHMMSS)")
-    p.add_argument("--junit-xml", type=nonempty, default=None, metavar="FILE",
+    p.add_argument("--junit-xml", default=None, metavar="FILE",
                    help="also write JUnit XML: one test case per scene x camera, faults and reasons as the "
                         "failure message (default: none)")
-    p.add_argument("--config", type=nonempty, default=None, metavar="FILE",
+    p.add_argument("--config", default=None, metavar="FILE",
                    help="read [tool.wirecheck] from FILE (default: the nearest pyproject.toml at or above the "
                         "working directory); options given here override it")
     return p
@@ -384,6 +384,8 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
+        check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (
+            "scene", "scene_list", "candidate_frames", "report_dir", "junit_xml", "config"))
         if args.junit_xml and (args.sweep or args.suite):
             raise InputError(f"--junit-xml with {'--sweep' if args.sweep else '--suite ' + args.suite}: "
                              "expected it in a plain crosscheck run (one test case per scene x camera)")
