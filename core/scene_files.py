@@ -342,7 +342,7 @@ def _check_obj(path: Path) -> None:
     lines are not OBJ statements (binary data, another format renamed) is not
     an empty mesh: its first such line is named.
     """
-    n_v, faces, foreign = 0, [], None
+    n_v, foreign, beyond = 0, None, None          # beyond: (index, line, token) of the largest 1-based index
     with open(path, encoding="utf-8", errors="replace") as fh:
         for lineno, raw in enumerate(fh, start=1):
             parts = raw.split("#", 1)[0].split()
@@ -355,20 +355,23 @@ def _check_obj(path: Path) -> None:
                     _number(path, lineno, t, "vertex coordinate")
                 n_v += 1
             elif parts[0] in ("f", "fo"):
-                faces.append((lineno, n_v, parts[1:]))
+                for tok in parts[1:]:
+                    try:
+                        k = int(tok.split("/")[0])
+                    except ValueError:
+                        raise InputError(f"{path}:{lineno}: face index {tok!r}: expected an integer") from None
+                    if k == 0 or n_v + k < 0:
+                        raise InputError(f"{path}:{lineno}: face index {tok!r}: expected a 1-based index or "
+                                         f"-1..-{n_v} (counting back over the {n_v} vertices before this line)")
+                    if beyond is None or k > beyond[0]:
+                        beyond = (k, lineno, tok)
             elif parts[0] not in OBJ_KEYWORDS and foreign is None:
                 foreign = (lineno, raw.strip())
-    for lineno, before, tokens in faces:
-        for tok in tokens:
-            try:
-                k = int(tok.split("/")[0])
-            except ValueError:
-                raise InputError(f"{path}:{lineno}: face index {tok!r}: expected an integer") from None
-            if not (1 <= k <= n_v or (k < 0 and before + k >= 0)):
-                back = f" or -{before}..-1 (vertices before this line)" if before else ""
-                raise InputError(f"{path}:{lineno}: face index {tok!r}: expected 1..{n_v}{back}"
-                                 if n_v else f"{path}:{lineno}: face index {tok!r}: the file has no vertices "
-                                 "('v X Y Z' lines): expected some")
+    if beyond is not None and beyond[0] > n_v:
+        k, lineno, tok = beyond
+        raise InputError(f"{path}:{lineno}: face index {tok!r}: " + (
+            f"expected 1..{n_v} (the file has {n_v} vertices)" if n_v else
+            "the file has no vertices ('v X Y Z' lines): expected some"))
     if n_v == 0 and foreign is not None:
         lineno, text = foreign
         raise InputError(f"{path}:{lineno}: {_short(text)}: expected an OBJ statement (v, f, l, o, g, ...); "
@@ -377,18 +380,20 @@ def _check_obj(path: Path) -> None:
 
 def _check_stl(path: Path) -> None:
     """InputError unless ``path`` is a complete binary STL or a well-formed ASCII one (with file:line)."""
-    data = path.read_bytes()
-    if len(data) >= 84:
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        data = fh.read(84)
+    if size >= 84:
         count = int.from_bytes(data[80:84], "little")
-        if len(data) == 84 + 50 * count:
+        if size == 84 + 50 * count:
             return                                        # binary, even when the header starts with 'solid'
     if not data.lstrip()[:5].lower() == b"solid":
-        if len(data) < 84:
-            raise InputError(f"{path}: {len(data)} bytes: expected a binary STL (an 84-byte header, then 50 "
+        if size < 84:
+            raise InputError(f"{path}: {size} bytes: expected a binary STL (an 84-byte header, then 50 "
                              "bytes a triangle) or an ASCII STL starting with 'solid'")
-        raise InputError(f"{path}: {len(data)} bytes, its header declares {count} triangles: expected "
+        raise InputError(f"{path}: {size} bytes, its header declares {count} triangles: expected "
                          f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)")
-    _check_ascii_stl(path, data.decode("latin-1"))
+    _check_ascii_stl(path, path.read_bytes().decode("latin-1"))
 
 
 def _check_off(path: Path) -> None:

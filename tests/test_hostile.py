@@ -509,9 +509,9 @@ def crosscheck_file(path, tmp_path, capsys, *extra):
 @pytest.mark.parametrize("name, data, needle", [
     # binary data renamed .obj: before, an empty scene, exit 1 'vacuous' with nothing on stderr
     ("garbage.obj", b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\xff\xfe", "garbage.obj:1: "),
-    ("faces_only.obj", b"f 1 2 3\n", "faces_only.obj:1: face index '1': the file has no vertices"),
-    ("negative.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "negative.obj:4: face index '-4': expected 1..3"),
-    ("zero.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "zero.obj:4: face index '0': expected 1..3"),
+    ("faces_only.obj", b"f 1 2 3\n", "faces_only.obj:1: face index '3': the file has no vertices"),
+    ("negative.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "negative.obj:4: face index '-4': expected a 1-based index or -1..-3"),
+    ("zero.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "zero.obj:4: face index '0': expected a 1-based index or -1..-3"),
     ("huge.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", "huge.obj:4: face index '9999"),
     ("empty.stl", b"", "empty.stl: 0 bytes: expected a binary STL"),
     ("truncated.stl", _binary_stl(5, 2), "truncated.stl: 184 bytes, its header declares 5 triangles: expected "
