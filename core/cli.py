@@ -12,8 +12,31 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import math
+import os
 import sys
 from pathlib import Path
+
+
+def _load_numpy_single_threaded() -> None:
+    """Import numpy with OpenBLAS sized to one thread, when this module is the first to import it.
+
+    At load, OpenBLAS starts one worker per CPU, and they spin: ~50 ms of CPU
+    (a fifth of the seed command's) that buys the renderer nothing, whose
+    matrix products are 3x3 and 4x4 (core.projection keeps large point arrays
+    off the BLAS). ``OPENBLAS_NUM_THREADS`` is read only while the library
+    loads, so it is set for the import and removed again: programs this one
+    starts do not inherit it. A value the user set is left as it is.
+    """
+    if "numpy" in sys.modules or "OPENBLAS_NUM_THREADS" in os.environ:
+        return
+    os.environ["OPENBLAS_NUM_THREADS"] = "1"
+    try:
+        import numpy  # noqa: F401
+    finally:
+        del os.environ["OPENBLAS_NUM_THREADS"]
+
+
+_load_numpy_single_threaded()
 
 from .camera import Camera, camera_z, look_at, orthographic_twin
 from .clipping import CLIP_MODES
@@ -61,9 +84,17 @@ def _version() -> str:
     return wirecheck.__version__
 
 
+class _VersionAction(argparse._VersionAction):
+    """``--version``, the installed version looked up only when asked (importlib.metadata costs ~25 ms)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        self.version = self.version.format(_version())
+        super().__call__(parser, namespace, values, option_string)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="renderer", description=DESCRIPTION)
-    p.add_argument("--version", action="version", version=f"%(prog)s (wirecheck) {_version()}",
+    p.add_argument("--version", action=_VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", default="cube", help="built-in name (cube, pyramid, prism), an example "
                    "(orrery: scenes/examples/, several objects) or a file path (.scene, .obj, .ply, .stl, .off, "

@@ -212,12 +212,15 @@ def unique_edges(edges: np.ndarray) -> np.ndarray:
     edges = edges[edges[:, 0] != edges[:, 1]]
     if len(edges) == 0:
         return np.zeros((0, 2), dtype=np.intp)
-    # One integer key per edge, i * (max + 1) + j, and a 1-D np.unique: the same
-    # sorted rows as np.unique(axis=0), ~3x faster (no structured-dtype view).
-    # Indices are < 2^31 in any mesh that fits in memory, so keys fit in int64.
+    # One integer key per edge, i * (max + 1) + j, sorted, and each key unlike its
+    # predecessor kept: the same sorted rows as np.unique(axis=0), ~3x faster (no
+    # structured-dtype view); not 1-D np.unique either, which imports numpy.ma
+    # (~15 ms of the seed command). Indices are < 2^31 in any mesh that fits in
+    # memory, so keys fit in int64.
     span = int(edges.max()) + 1
     if edges.min() >= 0 and span < 2**31:
-        keys = np.unique(edges[:, 0].astype(np.int64) * span + edges[:, 1])
+        keys = np.sort(edges[:, 0].astype(np.int64) * span + edges[:, 1])
+        keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))]
         return np.stack([keys // span, keys % span], axis=1).astype(np.intp)
     return np.unique(edges, axis=0)
 
