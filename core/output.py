@@ -56,8 +56,8 @@ def png_bytes(image: np.ndarray) -> bytes:
     lossless, and 8 times less data to compress than 8-bit grey. Anything else
     (``aa`` coverage, shading, RGB axes) goes through Pillow at zlib level 6.
     """
-    if image.ndim == 2 and image.dtype == np.uint8 and not ((image + np.uint8(1)) & np.uint8(0xFE)).any():
-        return bilevel_png_bytes(image)       # (v + 1) & 0xFE is 0 exactly for v in {0, 255}
+    if image.ndim == 2 and image.dtype == np.uint8 and (image.size == 0 or (image - np.uint8(1)).min() >= 254):
+        return bilevel_png_bytes(image)       # v - 1 (mod 256) is 255 or 254 exactly for v in {0, 255}
     from PIL import Image
 
     buf = io.BytesIO()
@@ -80,7 +80,9 @@ def bilevel_png_bytes(image: np.ndarray) -> bytes:
     """
     h, w = image.shape
     rows = np.zeros((h, (w + 7) // 8 + 1), np.uint8)          # column 0: the row's filter byte (0, None)
-    rows[:, 1:] = np.packbits(image >= 128, axis=1)          # most significant bit = leftmost pixel
+    on = image >= 128
+    # most significant bit = leftmost pixel; rows of whole bytes pack as one run (~3x quicker than axis=1)
+    rows[:, 1:] = np.packbits(on.reshape(-1)).reshape(h, -1) if w % 8 == 0 else np.packbits(on, axis=1)
     header = struct.pack(">IIBBBBB", w, h, 1, 0, 0, 0, 0)    # bit depth 1, colour type 0 (grey)
     return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", header)
             + _png_chunk(b"IDAT", zlib.compress(rows.tobytes(), BILEVEL_ZLIB_LEVEL)) + _png_chunk(b"IEND", b""))
