@@ -39,6 +39,17 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
         raise
 
 
+def write_file(path, data: bytes) -> None:
+    """``Path(path).write_bytes(data)`` in three system calls (no buffered file object: ~25 us less a file)."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+    finally:
+        os.close(fd)
+
+
 def atomic_write_text(path: Path, text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
 

@@ -176,7 +176,7 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
                 if frames_dir is not None and fmt in s.formats:
                     data = encode(image)
                     t = lap("encode", t)
-                    (frames_dir / f"frame_{k:04d}.{'png' if fmt == 'png' else 'txt'}").write_bytes(data)
+                    output.write_file(frames_dir / f"frame_{k:04d}.{'png' if fmt == 'png' else 'txt'}", data)
                     t = lap("write", t)
             if mp4 is not None:
                 mp4.add(image)
