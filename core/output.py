@@ -67,13 +67,19 @@ def png_bytes(image: np.ndarray) -> bytes:
     lossless, and 8 times less data to compress than 8-bit grey. Anything else
     (``aa`` coverage, shading, RGB axes) goes through Pillow at zlib level 6.
     """
-    if image.ndim == 2 and image.dtype == np.uint8 and (image.size == 0 or (image - np.uint8(1)).min() >= 254):
-        return bilevel_png_bytes(image)       # v - 1 (mod 256) is 255 or 254 exactly for v in {0, 255}
+    if is_bilevel(image):
+        return bilevel_png_bytes(image)
     from PIL import Image
 
     buf = io.BytesIO()
     Image.fromarray(np.ascontiguousarray(image)).save(buf, format="PNG", compress_level=6)
     return buf.getvalue()
+
+
+def is_bilevel(image: np.ndarray) -> bool:
+    """Whether ``image`` is ``(H, W)`` uint8 with every pixel 0 or 255 (:func:`png_bytes` writes it bilevel)."""
+    # v - 1 (mod 256) is 255 or 254 exactly for v in {0, 255}: one subtraction and a min
+    return image.ndim == 2 and image.dtype == np.uint8 and (image.size == 0 or (image - np.uint8(1)).min() >= 254)
 
 
 #: zlib level of bilevel frames: level 1 is ~3x quicker than 6 on a line drawing
@@ -90,13 +96,27 @@ def bilevel_png_bytes(image: np.ndarray) -> bytes:
     ``.convert("L")`` gives 0/255; OpenCV's ``imread`` gives 0/255).
     """
     h, w = image.shape
+    return bilevel_png_from_rows(bilevel_rows(image), w, h)
+
+
+def bilevel_rows(image: np.ndarray) -> bytes:
+    """The scanlines of :func:`bilevel_png_bytes`: per row, filter byte 0 then the row's bits packed.
+
+    ``(H, W)`` image in, ``H * (ceil(W / 8) + 1)`` bytes out (what IDAT compresses).
+    """
+    h, w = image.shape
     rows = np.zeros((h, (w + 7) // 8 + 1), np.uint8)          # column 0: the row's filter byte (0, None)
     on = image >= 128
     # most significant bit = leftmost pixel; rows of whole bytes pack as one run (~3x quicker than axis=1)
-    rows[:, 1:] = np.packbits(on.reshape(-1)).reshape(h, -1) if w % 8 == 0 else np.packbits(on, axis=1)
-    header = struct.pack(">IIBBBBB", w, h, 1, 0, 0, 0, 0)    # bit depth 1, colour type 0 (grey)
+    rows[:, 1:] = np.packbits(on.reshape(-1)).reshape(h, w // 8) if w % 8 == 0 else np.packbits(on, axis=1)
+    return rows.tobytes()
+
+
+def bilevel_png_from_rows(rows: bytes, width: int, height: int) -> bytes:
+    """The 1-bit greyscale PNG of :func:`bilevel_rows`' scanlines of a ``width x height`` image."""
+    header = struct.pack(">IIBBBBB", width, height, 1, 0, 0, 0, 0)    # bit depth 1, colour type 0 (grey)
     return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", header)
-            + _png_chunk(b"IDAT", zlib.compress(rows.tobytes(), BILEVEL_ZLIB_LEVEL)) + _png_chunk(b"IEND", b""))
+            + _png_chunk(b"IDAT", zlib.compress(rows, BILEVEL_ZLIB_LEVEL)) + _png_chunk(b"IEND", b""))
 
 
 def _png_chunk(kind: bytes, data: bytes) -> bytes:

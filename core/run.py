@@ -20,6 +20,7 @@ from . import output
 from .camera import Camera
 from .compose import axis_layers, axis_length, overlay, picture, side_by_side
 from .errors import InputError
+from .frame_writer import ForkedPngWriter, can_fork
 from .frames import SceneRenderer
 from .gif import GifWriter
 from .report import frame_record, run_report, summary_text
@@ -141,6 +142,9 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
         mp4 = gif = None
         if "mp4" in s.formats:
             mp4 = output.Mp4Writer(files.enter_context(open(stage.path(f"{name}.mp4"), "wb")), FPS)
+        png_writer = None            # PNG frames by a second process (--profile times them in line)
+        if frames_dir is not None and "png" in s.formats and profiler is None and can_fork(s.frames):
+            png_writer = files.enter_context(ForkedPngWriter())
         if "gif" in s.formats:
             gif = GifWriter(files.enter_context(open(stage.path(f"{name}.gif"), "wb")), FPS,
                             progress=lambda: step("gif"))
@@ -173,7 +177,9 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
             t = lap("compose", t)
             for fmt, encode in (("png", output.png_bytes), ("ascii", lambda im: output.ascii_frame(
                     im, s.ascii_cols).encode())):
-                if frames_dir is not None and fmt in s.formats:
+                if fmt == "png" and png_writer is not None:
+                    png_writer.put(frames_dir / f"frame_{k:04d}.png", image)
+                elif frames_dir is not None and fmt in s.formats:
                     data = encode(image)
                     t = lap("encode", t)
                     output.write_file(frames_dir / f"frame_{k:04d}.{'png' if fmt == 'png' else 'txt'}", data)
@@ -190,6 +196,8 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
             if log:
                 log(k, *first)
             step("render")
+        if png_writer is not None:
+            png_writer.close()
         if mp4 is not None:
             mp4.commit()
             step("mp4")
