@@ -139,12 +139,12 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
     layers = [s.axis_layers(cam) for cam in s.cameras] if s.axes else None
     lap = profiler.lap if profiler is not None else (lambda stage, t: 0.0)
     with contextlib.ExitStack() as files:
-        mp4 = gif = None
-        if "mp4" in s.formats:
-            mp4 = output.Mp4Writer(files.enter_context(open(stage.path(f"{name}.mp4"), "wb")), FPS)
-        png_writer = None            # PNG frames by a second process (--profile times them in line)
+        mp4 = gif = png_writer = None
+        # PNG frames by a second process (--profile times them in line), forked before the encoders open
         if frames_dir is not None and "png" in s.formats and profiler is None and can_fork(s.frames):
             png_writer = files.enter_context(ForkedPngWriter())
+        if "mp4" in s.formats:
+            mp4 = output.Mp4Writer(files.enter_context(open(stage.path(f"{name}.mp4"), "wb")), FPS)
         if "gif" in s.formats:
             gif = GifWriter(files.enter_context(open(stage.path(f"{name}.gif"), "wb")), FPS,
                             progress=lambda: step("gif"))
