@@ -342,6 +342,7 @@ def _progress_bar(total: int, frames: int):
         return None, lambda: None, print
     from tqdm import tqdm
 
+    tqdm.monitor_interval = 0       # no monitor thread: core.frame_writer forks only a single-threaded process
     bar = tqdm(total=total, file=sys.stderr, unit="step", desc="render", leave=False)
 
     def step(stage: str) -> None:

@@ -26,7 +26,6 @@ from __future__ import annotations
 import os
 import signal
 import struct
-import sys
 import threading
 from pathlib import Path
 
@@ -37,7 +36,7 @@ from .output import bilevel_png_from_rows, bilevel_rows, is_bilevel, png_bytes, 
 #: Fewer frames than this are written in line: forking costs a few ms.
 MIN_FRAMES = 32
 
-_HEADER = struct.Struct(">III I")      # width, height, length of the path, length of the scanlines
+_HEADER = struct.Struct(">IIII")      # width, height, length of the path, length of the scanlines
 
 
 def can_fork(frames: int) -> bool:
@@ -67,8 +66,6 @@ class ForkedPngWriter:
     def __init__(self):
         to_child, self._pipe = os.pipe()
         errors, self._child_errors = os.pipe()
-        sys.stdout.flush()
-        sys.stderr.flush()
         pid = os.fork()
         if pid == 0:                                        # the child: never returns
             os.close(self._pipe)
