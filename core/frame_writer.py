@@ -5,7 +5,7 @@ bits, compressing them (zlib) and creating the file. Threads do not overlap
 that with rendering (the rendering holds the GIL nearly all the time; measured:
 slower than writing in line), so :class:`ForkedPngWriter` forks one child
 that does the compressing and the writing. The parent packs each bilevel
-frame's scanlines (:func:`core.output.bilevel_rows`, 1/8 of the pixels) and
+frame's scanlines (:func:`core.output.bilevel_rows`, 1/8 of the image's bytes) and
 sends them down a pipe; the child compresses them and writes the file with the
 same functions as :func:`core.output.png_bytes`, so the files are the same
 bytes. A frame that is not bilevel (anti-aliased, shaded, RGB) is encoded and
