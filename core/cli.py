@@ -43,7 +43,7 @@ from .clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
 from .culling import CULL_CHOICES
 from .errors import InputError, check_not_empty
-from .guard import run_cli
+from .guard import VersionAction, run_cli
 from .limits import MAX_FRAMES, check_image_size, check_turns
 from .projection import DTYPES
 from .raster import RASTER_MODES
@@ -78,23 +78,9 @@ def vec3(option: str, text: str) -> tuple[float, float, float]:
     return values
 
 
-def _version() -> str:
-    import wirecheck
-
-    return wirecheck.__version__
-
-
-class _VersionAction(argparse._VersionAction):
-    """``--version``, the installed version looked up only when asked (importlib.metadata costs ~25 ms)."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        self.version = self.version.format(_version())
-        super().__call__(parser, namespace, values, option_string)
-
-
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="renderer", description=DESCRIPTION)
-    p.add_argument("--version", action=_VersionAction, version="%(prog)s (wirecheck) {}",
+    p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", default="cube", help="built-in name (cube, pyramid, prism), an example "
                    "(orrery: scenes/examples/, several objects) or a file path (.scene, .obj, .ply, .stl, .off, "

@@ -66,7 +66,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from wirecheck.core.errors import InputError, check_not_empty
-from wirecheck.core.guard import run_cli
+from wirecheck.core.guard import VersionAction, run_cli
 from wirecheck.core.output import check_replaceable, check_report_dir
 
 from . import gate, tolerances
@@ -98,15 +98,9 @@ MAX_JOBS = 256
 MAX_SCHEDULER_TIMEOUT_S = 3600.0
 
 
-def _version() -> str:
-    import wirecheck
-
-    return wirecheck.__version__
-
-
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0].replace("``", ""))
-    p.add_argument("--version", action="version", version=f"%(prog)s (wirecheck) {_version()}",
+    p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", action="append", default=None,
                    help="scene name or path, or a folder of mesh files (a dataset, walked recursively); "
