@@ -77,15 +77,17 @@ def test_os_exit_0_as_a_real_process_exits_1_with_a_report(tmp_path):
     cand = tmp_path / "bye.py"
     cand.write_text("import os\ndef f(p, c):\n    os._exit(0)\n")
     # --level vertices: every case fails at its first request, before any pixel is drawn
-    # (pixel_f1 is None at either level); the pixel level would only load pyrender for nothing
+    # (pixel_f1 is None at either level); the pixel level would only load pyrender for nothing.
+    # Two cases: the second one's candidate is a fresh host after the first one's exit (each
+    # further case would only start one more Python for the same check)
     proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", f"{cand}:f",
-                           "--scene", "cube", "--frames", "1", "--level", "vertices",
-                           "--report-dir", str(tmp_path / "r")],
+                           "--scene", "cube", "--frames", "1", "--cases", "on_axis,orthographic",
+                           "--level", "vertices", "--report-dir", str(tmp_path / "r")],
                           capture_output=True, text=True, cwd=ROOT, timeout=300)
     assert proc.returncode == 1 and proc.stderr == ""
     report = json.loads((tmp_path / "r" / "report.json").read_text())
-    assert report["summary"]["failed"] == report["summary"]["cases"] == 7
-    assert "FAIL: 0/7 cases" in proc.stdout
+    assert report["summary"]["failed"] == report["summary"]["cases"] == 2
+    assert "FAIL: 0/2 cases" in proc.stdout
 
 
 def test_candidate_stderr_and_prints_go_into_the_report_not_the_protocol(tmp_path):
