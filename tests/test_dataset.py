@@ -285,27 +285,61 @@ def _without_timing(out: Path) -> dict:
     return report
 
 
+@pytest.fixture(scope="module")
+def dask_scheduler() -> str:
+    """The address of a Dask ``LocalCluster`` of 2 worker processes on 127.0.0.1, shared by this file's runs.
+
+    Starting a cluster (a nanny and a worker process per worker, each importing
+    distributed, then wirecheck and pyrender on its first task) costs ~6 s of CPU;
+    the runs below reach this one with ``--scheduler``, as a user reaches theirs.
+    The cluster ``crosscheck --executor dask`` starts itself without ``--scheduler``
+    has its own test (test_the_default_dask_executor_starts_its_own_local_cluster).
+    """
+    import logging
+
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None, silence_logs=logging.CRITICAL) as cluster:
+        yield cluster.scheduler_address
+
+
 @pytest.mark.slow
-def test_report_is_the_same_for_jobs_1_jobs_2_and_a_local_dask_cluster(meshes, tmp_path):
-    runs = {"one": ["--jobs", "1"], "two": ["--jobs", "2"], "dask": ["--executor", "dask", "--jobs", "2"]}
+def test_report_is_the_same_for_jobs_1_jobs_2_and_a_dask_cluster(meshes, tmp_path, dask_scheduler):
+    runs = {"one": ["--jobs", "1"], "two": ["--jobs", "2"],
+            "dask": ["--executor", "dask", "--scheduler", dask_scheduler]}
     reports = {}
     for name, extra in runs.items():
         code, report, out = run(tmp_path, "--scene", meshes, *FAST, *extra, name=name)
         assert code == 1                                     # broken.obj
         reports[name] = (_without_timing(out), (out / "report.md").read_bytes())
         assert report["timing"]["executor"] == ("dask" if name == "dask" else "local")
-    assert json.loads((tmp_path / "dask" / "report.json").read_text())["timing"]["workers"] == 2
+    timing = json.loads((tmp_path / "dask" / "report.json").read_text())["timing"]
+    assert (timing["workers"], timing["scheduler"]) == (2, dask_scheduler)
     assert reports["one"] == reports["two"] == reports["dask"]
     assert reports["one"][0]["summary"]["passed"] == 3        # and they compared something
 
 
 @pytest.mark.slow
-def test_a_plain_run_on_a_local_dask_cluster_gives_the_report_of_jobs_1(tmp_path):
+def test_a_plain_run_on_a_dask_cluster_gives_the_report_of_jobs_1(tmp_path, dask_scheduler):
     args = ("--scene", "cube", "--scene", "pyramid", *FAST)
+    code1, r1, out1 = run(tmp_path, *args, name="one")
+    code2, r2, out2 = run(tmp_path, *args, "--executor", "dask", "--scheduler", dask_scheduler, name="dask")
+    assert code1 == code2 == 0
+    assert (r2["timing"]["executor"], r2["timing"]["workers"]) == ("dask", 2)
+    assert _without_timing(out1) == _without_timing(out2)
+    assert (out1 / "report.md").read_bytes() == (out2 / "report.md").read_bytes()
+
+
+@pytest.mark.slow
+def test_the_default_dask_executor_starts_its_own_local_cluster(tmp_path):
+    # no --scheduler: crosscheck starts a LocalCluster of --jobs workers but no more than the tasks
+    # (here one: a second worker would only import wirecheck for nothing), runs on it and closes it
+    args = ("--scene", "cube", "--frames", "2", "--cases", "oblique_roll")
     code1, r1, out1 = run(tmp_path, *args, name="one")
     code2, r2, out2 = run(tmp_path, *args, "--executor", "dask", "--jobs", "2", name="dask")
     assert code1 == code2 == 0
-    assert (r2["timing"]["executor"], r2["timing"]["workers"]) == ("dask", 2)
+    assert (r2["timing"]["executor"], r2["timing"]["workers"]) == ("dask", 1)
     assert _without_timing(out1) == _without_timing(out2)
     assert (out1 / "report.md").read_bytes() == (out2 / "report.md").read_bytes()
 
