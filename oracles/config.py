@@ -80,10 +80,11 @@ class Config:
 
     def api_kwargs(self) -> dict:
         """The settings as keywords of :func:`wirecheck.oracles.api.check_projector`."""
-        from .runner import LEVEL_ORACLES
-
         kwargs = {API_KEYWORDS[k]: v for k, v in self.values.items() if k in API_KEYWORDS}
         if "level" in self.values:
+            # only here: every pytest start calls this (the plugin), and the runner costs ~0.7 s to import
+            from .runner import LEVEL_ORACLES
+
             kwargs["oracles"] = LEVEL_ORACLES[self.values["level"]]
         return kwargs
 

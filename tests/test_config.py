@@ -35,6 +35,21 @@ def test_values_are_read_and_paths_resolved_against_the_file(tmp_path):
                                    "oracles": ("opencv",)}
 
 
+def test_settings_without_a_level_import_no_runner(tmp_path):
+    # the pytest plugin reads the table at every pytest start (pytest_configure), used or not: the
+    # runner (scipy, trimesh; ~0.7 s) is imported only for a level. A fresh process: this one has it
+    import subprocess
+    import sys
+
+    _project(tmp_path, "frames = 3\n")
+    code = ("import sys; from pathlib import Path; from wirecheck.oracles.config import load_config; "
+            f"kw = load_config(start=Path({str(tmp_path)!r})).api_kwargs(); "
+            "print(kw, sorted(m for m in ('wirecheck.oracles.runner', 'scipy') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "{'frames': 3} []\n"
+
+
 def test_nearest_pyproject_wins_and_one_without_the_table_means_no_settings(tmp_path):
     _project(tmp_path, "frames = 3\n")
     inner = tmp_path / "sub"
