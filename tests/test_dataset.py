@@ -203,7 +203,10 @@ def test_a_bundled_name_wins_over_a_folder_of_that_name(tmp_path, monkeypatch):
 def test_unreachable_scheduler_is_one_line_within_the_timeout(meshes, tmp_path):
     port = _free_port()             # nothing listens there once the socket is closed
     t0 = time.monotonic()
+    # --level vertices: the run ends at connecting, before any mesh; the pixel level would only make
+    # the process import pyrender and open OSMesa first (~0.7 s of CPU)
     proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--scene", str(meshes), *FAST,
+                           "--level", "vertices",
                            "--scheduler", f"tcp://127.0.0.1:{port}", "--scheduler-timeout", "1",
                            "--report-dir", str(tmp_path / "r")], capture_output=True, text=True, timeout=120)
     elapsed = time.monotonic() - t0
