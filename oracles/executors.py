@@ -84,6 +84,34 @@ def _quiet_dask():
 
 
 @contextlib.contextmanager
+def _environ_kept():
+    """Undo, on leaving, what starting a local cluster wrote into this process's environment.
+
+    Dask's nanny sets its ``distributed.nanny.pre-spawn-environ`` (by default
+    ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS``, ``MKL_NUM_THREADS`` = 1 and
+    ``MALLOC_TRIM_THRESHOLD_``) in ``os.environ`` of the process that starts it,
+    for its workers to inherit, and leaves them there: every later subprocess of
+    an API caller (or of a test run) would start numpy with one BLAS thread.
+    Only those variables are put back, and only where they changed.
+    """
+    import os
+
+    import dask
+
+    keys = set(dask.config.get("distributed.nanny.pre-spawn-environ", default={}) or {})
+    before = {k: os.environ.get(k) for k in keys}
+    try:
+        yield
+    finally:
+        for key, value in before.items():
+            if os.environ.get(key) != value:
+                if value is None:
+                    del os.environ[key]
+                else:
+                    os.environ[key] = value
+
+
+@contextlib.contextmanager
 def _dask_client(spec: ExecutorSpec, n_workers: int | None = None):
     """A connected ``distributed.Client`` with at least one worker; InputError when there is none in time.
 
@@ -94,7 +122,7 @@ def _dask_client(spec: ExecutorSpec, n_workers: int | None = None):
     except ImportError as exc:       # pragma: no cover - a dependency in pyproject.toml
         raise InputError(f"--executor dask: {exc}: expected the 'distributed' package (pip install distributed)") \
             from None
-    with _quiet_dask():
+    with _quiet_dask(), _environ_kept():
         if spec.scheduler is None:
             cluster = LocalCluster(n_workers=n_workers or spec.jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
                                    dashboard_address=None, silence_logs=logging.CRITICAL)

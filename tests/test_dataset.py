@@ -302,8 +302,14 @@ def dask_scheduler() -> str:
 
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None, silence_logs=logging.CRITICAL) as cluster:
+    from wirecheck.oracles.executors import _environ_kept
+
+    # the nanny leaves OPENBLAS_NUM_THREADS=1 & co. in this process's environment, for every later
+    # test's subprocess (oracles.executors._environ_kept): put back once the workers have started
+    with _environ_kept():
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address=None, silence_logs=logging.CRITICAL)
+    with cluster:
         yield cluster.scheduler_address
 
 
@@ -335,12 +341,16 @@ def test_a_plain_run_on_a_dask_cluster_gives_the_report_of_jobs_1(tmp_path, dask
 
 
 @pytest.mark.slow
-def test_the_default_dask_executor_starts_its_own_local_cluster(tmp_path):
+def test_the_default_dask_executor_starts_its_own_local_cluster(tmp_path, monkeypatch):
     # no --scheduler: crosscheck starts a LocalCluster of --jobs workers but no more than the tasks
     # (here one: a second worker would only import wirecheck for nothing), runs on it and closes it
     args = ("--scene", "cube", "--frames", "2", "--cases", "oblique_roll")
     code1, r1, out1 = run(tmp_path, *args, name="one")
+    # Dask's nanny sets these in the starting process for its workers: crosscheck puts them back
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
     code2, r2, out2 = run(tmp_path, *args, "--executor", "dask", "--jobs", "2", name="dask")
+    assert (os.environ.get("OMP_NUM_THREADS"), os.environ.get("OPENBLAS_NUM_THREADS")) == ("3", None)
     assert code1 == code2 == 0
     assert (r2["timing"]["executor"], r2["timing"]["workers"]) == ("dask", 1)
     assert _without_timing(out1) == _without_timing(out2)
