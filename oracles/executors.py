@@ -13,6 +13,11 @@ Tasks are submitted through ``Client.get_executor()``, a
 :class:`concurrent.futures.Executor`, so callers treat both kinds alike and
 gather results in task order: the report does not depend on where a task ran.
 
+Worker processes of a local pool start with one BLAS/OpenMP thread each
+(:data:`WORKER_ENVIRON`, unless the caller set those variables), as Dask's
+nanny starts its workers: the pool already runs a process per core, and
+OpenBLAS's own threads in each would only spin against the other workers.
+
 Connecting is bounded: a scheduler that does not answer, or answers with no
 worker, within ``connect_timeout_s`` is an :class:`~wirecheck.core.errors.InputError`.
 """
@@ -22,6 +27,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+import os
 import re
 from dataclasses import dataclass
 
@@ -81,6 +87,23 @@ def _quiet_dask():
     finally:
         for lg, level in zip(loggers, levels):
             lg.setLevel(level)
+
+
+#: The environment a local pool's workers start with where the caller has not set these
+#: (Dask's distributed.nanny.pre-spawn-environ gives its workers the same threads).
+WORKER_ENVIRON = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _worker_environ():
+    """:data:`WORKER_ENVIRON` in ``os.environ`` while workers are spawned (they inherit it); then removed."""
+    added = {k: v for k, v in WORKER_ENVIRON.items() if k not in os.environ}
+    os.environ.update(added)
+    try:
+        yield
+    finally:
+        for key in added:
+            os.environ.pop(key, None)
 
 
 @contextlib.contextmanager
@@ -226,8 +249,9 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
                              initargs=(initializer, barrier)) as pool:
         # start every worker now (the pool starts one per task submitted while none is idle, and each
         # waits for the others): the run's time then counts tasks, not interpreters starting
-        for f in [pool.submit(_pool_ready) for _ in range(workers)]:
-            f.result()
+        with _worker_environ():
+            for f in [pool.submit(_pool_ready) for _ in range(workers)]:
+                f.result()
         yield pool, workers
 
 
