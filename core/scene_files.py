@@ -238,29 +238,34 @@ def _check_name_length(name: str, path) -> None:
                          f"{MAX_NAME} (it names output files; give a shorter 'name' line or file name)")
 
 
+def _obj_statements(path: Path):
+    """``(line number, tokens, raw line)`` of each OBJ line that holds a statement (comments dropped)."""
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for lineno, raw in enumerate(fh, start=1):
+            parts = raw.split("#", 1)[0].split()
+            if parts:
+                yield lineno, parts, raw
+
+
 def _obj_lines(path: Path) -> list[tuple[int, int]]:
     """Edges from OBJ ``l`` elements (1-based, possibly negative, 'v/vt' forms)."""
     n_v = 0
     pairs = []
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        for lineno, raw in enumerate(fh, start=1):
-            parts = raw.split("#", 1)[0].split()
-            if not parts:
-                continue
-            if parts[0] == "v":
-                n_v += 1
-            elif parts[0] == "l":
-                idx = []
-                for tok in parts[1:]:
-                    try:
-                        k = int(tok.split("/")[0])
-                    except ValueError:
-                        raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected an integer") from None
-                    k = k - 1 if k > 0 else n_v + k
-                    if not 0 <= k < n_v:
-                        raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected 1..{n_v}")
-                    idx.append(k)
-                pairs += list(zip(idx[:-1], idx[1:]))
+    for lineno, parts, _raw in _obj_statements(path):
+        if parts[0] == "v":
+            n_v += 1
+        elif parts[0] == "l":
+            idx = []
+            for tok in parts[1:]:
+                try:
+                    k = int(tok.split("/")[0])
+                except ValueError:
+                    raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected an integer") from None
+                k = k - 1 if k > 0 else n_v + k
+                if not 0 <= k < n_v:
+                    raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected 1..{n_v}")
+                idx.append(k)
+            pairs += list(zip(idx[:-1], idx[1:]))
     return pairs
 
 
@@ -343,30 +348,26 @@ def _check_obj(path: Path) -> None:
     an empty mesh: its first such line is named.
     """
     n_v, foreign, beyond = 0, None, None          # beyond: (index, line, token) of the largest 1-based index
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        for lineno, raw in enumerate(fh, start=1):
-            parts = raw.split("#", 1)[0].split()
-            if not parts:
-                continue
-            if parts[0] == "v":
-                if len(parts) < 4:
-                    raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
-                for t in parts[1:4]:
-                    _number(path, lineno, t, "vertex coordinate")
-                n_v += 1
-            elif parts[0] in ("f", "fo"):
-                for tok in parts[1:]:
-                    try:
-                        k = int(tok.split("/")[0])
-                    except ValueError:
-                        raise InputError(f"{path}:{lineno}: face index {tok!r}: expected an integer") from None
-                    if k == 0 or n_v + k < 0:
-                        raise InputError(f"{path}:{lineno}: face index {tok!r}: expected a 1-based index or "
-                                         f"-1..-{n_v} (counting back over the {n_v} vertices before this line)")
-                    if beyond is None or k > beyond[0]:
-                        beyond = (k, lineno, tok)
-            elif parts[0] not in OBJ_KEYWORDS and foreign is None:
-                foreign = (lineno, raw.strip())
+    for lineno, parts, raw in _obj_statements(path):
+        if parts[0] == "v":
+            if len(parts) < 4:
+                raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
+            for t in parts[1:4]:
+                _number(path, lineno, t, "vertex coordinate")
+            n_v += 1
+        elif parts[0] in ("f", "fo"):
+            for tok in parts[1:]:
+                try:
+                    k = int(tok.split("/")[0])
+                except ValueError:
+                    raise InputError(f"{path}:{lineno}: face index {tok!r}: expected an integer") from None
+                if k == 0 or n_v + k < 0:
+                    raise InputError(f"{path}:{lineno}: face index {tok!r}: expected a 1-based index or "
+                                     f"-1..-{n_v} (counting back over the {n_v} vertices before this line)")
+                if beyond is None or k > beyond[0]:
+                    beyond = (k, lineno, tok)
+        elif parts[0] not in OBJ_KEYWORDS and foreign is None:
+            foreign = (lineno, raw.strip())
     if beyond is not None and beyond[0] > n_v:
         k, lineno, tok = beyond
         raise InputError(f"{path}:{lineno}: face index {tok!r}: " + (
@@ -498,13 +499,11 @@ def _check_ply_counts(path: Path, n_vertices: int, n_faces: int) -> None:
 
 def _obj_vertices(path: Path) -> np.ndarray:
     out = []
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        for lineno, raw in enumerate(fh, start=1):
-            parts = raw.split("#", 1)[0].split()
-            if parts and parts[0] == "v":
-                if len(parts) < 4:
-                    raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
-                out.append([_number(path, lineno, t, "vertex coordinate") for t in parts[1:4]])
+    for lineno, parts, raw in _obj_statements(path):
+        if parts[0] == "v":
+            if len(parts) < 4:
+                raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
+            out.append([_number(path, lineno, t, "vertex coordinate") for t in parts[1:4]])
     return np.asarray(out, dtype=np.float64).reshape(-1, 3)
 
 
