@@ -64,7 +64,6 @@ def quiet_libraries(loggers=("trimesh",)):
             log.propagate = propagate
 
 
-
 def check_not_empty(options) -> None:
     """InputError for the first ``(option, value)`` whose value is ``''`` (or a list holding ``''``).
 

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .output import bilevel_png_from_rows, bilevel_rows, is_bilevel, png_bytes, write_file
+from .output import bilevel_png_from_rows, bilevel_rows, is_bilevel, png_bytes, write_all, write_file
 
 #: Fewer frames than this are written in line: forking costs a few ms.
 MIN_FRAMES = 32
@@ -84,7 +84,7 @@ class ForkedPngWriter:
         rows = bilevel_rows(image)
         h, w = image.shape
         try:
-            _write_all(self._pipe, _HEADER.pack(w, h, len(name), len(rows)) + name + rows)
+            write_all(self._pipe, _HEADER.pack(w, h, len(name), len(rows)) + name + rows)
         except BrokenPipeError:                             # the child stopped: say why
             self._finish()
             raise RuntimeError("frame writer process ended early") from None
@@ -145,15 +145,9 @@ def _child(source: int, errors: int) -> None:
         report = f"{type(exc).__name__}: {exc}".encode()
     finally:
         try:
-            _write_all(errors, report)
+            write_all(errors, report)
         finally:
             os._exit(0 if not report else 1)
-
-
-def _write_all(fd: int, data: bytes) -> None:
-    view = memoryview(data)
-    while view:
-        view = view[os.write(fd, view):]
 
 
 def _read_all(fd: int) -> bytes:
