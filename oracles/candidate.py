@@ -27,6 +27,7 @@ Given as ``--candidate FILE.py:FUNC`` or ``--candidate MODULE:FUNC``.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.util
 import inspect
@@ -37,6 +38,18 @@ from pathlib import Path
 import numpy as np
 
 from wirecheck.core.errors import InputError
+
+
+@contextlib.contextmanager
+def _no_bytecode_files():
+    """Import without writing ``__pycache__`` folders: the candidate's folder (and its package's) are the
+    user's, and wirecheck changes nothing it did not write (Python would add ``.pyc`` files beside the source)."""
+    before = sys.dont_write_bytecode
+    sys.dont_write_bytecode = True
+    try:
+        yield
+    finally:
+        sys.dont_write_bytecode = before
 
 
 def load_candidate(spec: str):
@@ -54,16 +67,18 @@ def load_candidate(spec: str):
         if folder not in sys.path:
             sys.path.insert(0, folder)
         try:
-            module_spec = importlib.util.spec_from_file_location(mod_name, path)
-            module = importlib.util.module_from_spec(module_spec)
-            sys.modules[mod_name] = module
-            module_spec.loader.exec_module(module)
+            with _no_bytecode_files():
+                module_spec = importlib.util.spec_from_file_location(mod_name, path)
+                module = importlib.util.module_from_spec(module_spec)
+                sys.modules[mod_name] = module
+                module_spec.loader.exec_module(module)
         except (Exception, SystemExit) as exc:  # the user's file: report, don't trace back, don't exit
             raise InputError(f"--candidate {spec!r}: importing {target} failed: "
                              f"{type(exc).__name__}: {exc}") from None
     else:
         try:
-            module = importlib.import_module(target)
+            with _no_bytecode_files():
+                module = importlib.import_module(target)
         except (Exception, SystemExit) as exc:
             raise InputError(f"--candidate {spec!r}: importing module {target!r} failed: "
                              f"{type(exc).__name__}: {exc}") from None

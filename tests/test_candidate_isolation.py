@@ -122,3 +122,34 @@ def test_a_candidate_hanging_at_import_fails_every_case_and_is_started_once(tmp_
         assert case["reasons"] == ["frame 1: candidate did not answer the protocol header within 4 s "
                                    "(start-up); it was killed"]
     assert starts.read_text() == "start\n"       # not started again for the second case
+
+
+@pytest.mark.parametrize("source,code", [("def f(p, c):\n    return p[:, :2] * 0.0\n", 1),
+                                         ("raise ImportError('at import')\n", 2)], ids=["runs", "import_fails"])
+@pytest.mark.parametrize("isolated", [True, False], ids=["host", "in_process"])
+def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, source, code, isolated):
+    # Python writes __pycache__/NAME.cpython-3X.pyc beside a module it imports unless told not to;
+    # the candidate's folder is the user's, and wirecheck changes nothing it did not write. With
+    # bytecode writing on, in this process and in the host it starts (found by tests/test_fuzz.py
+    # where PYTHONDONTWRITEBYTECODE was unset):
+    from wirecheck.oracles import api
+
+    monkeypatch.delenv("PYTHONDONTWRITEBYTECODE", raising=False)
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
+    folder = tmp_path / "user"
+    folder.mkdir()
+    (folder / "proj.py").write_text(source)
+    if isolated:
+        got = cli.main(["--candidate", f"{folder / 'proj.py'}:f", "--scene", "cube", "--cases", "on_axis",
+                        "--frames", "1", "--level", "vertices", "--report-dir", str(tmp_path / "rep")])
+        assert got == code
+    elif code == 2:
+        with pytest.raises(Exception, match="at import"):
+            api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
+                                isolate=False)
+    else:
+        report = api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
+                                     isolate=False)
+        assert report["verdict"] == "fail"
+    assert sorted(p.name for p in folder.rglob("*")) == ["proj.py"]
+    assert sys.dont_write_bytecode is False                   # set back after the import
