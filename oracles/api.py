@@ -15,7 +15,9 @@ in its own process under a per-request timeout (``timeout_s``), so a crash,
 run. A callable runs isolated too: in the candidate host when another
 process can import it (a module-level function of an importable module),
 else (a lambda, a closure, a bound method) in a forked copy of this process;
-``isolate=False`` runs it in this process, quicker but unprotected. By default only the OpenCV vertex oracle runs (fast,
+``isolate=False`` runs it in this process, quicker but unprotected. An
+isolated candidate's process is started for one call and ends with it (none
+is left idle in a test run of many checks). By default only the OpenCV vertex oracle runs (fast,
 no OpenGL needed); pass ``oracles=("opencv", "pyrender")`` to compare drawn
 pixels too.
 """
@@ -26,7 +28,7 @@ from . import gate, tolerances
 from .isolation import api_candidate
 from .report import FAULT_HINTS, compared_text, fault_text, not_passed
 from .runner import run_crosscheck
-from .subprocess_candidate import DEFAULT_TIMEOUT_S
+from .subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
 from .tolerances import Tolerances
 
 
@@ -98,16 +100,17 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     """
     tol = Tolerances(tol_px, min_f1, min_f1_0px, precision=_precision(precision))
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)    # before any OpenGL set-up
-    name, func = api_candidate(func, cmd, timeout_s, isolate)
-    if "pyrender" in oracles:
-        from .pyrender_oracle import osmesa_available
+    with closing_started():                 # an isolated candidate's process ends with this check
+        name, func = api_candidate(func, cmd, timeout_s, isolate)
+        if "pyrender" in oracles:
+            from .pyrender_oracle import osmesa_available
 
-        ok, message = osmesa_available()
-        if not ok:
-            raise RuntimeError(message)
-    report, _images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
-                                     oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
-                                     allow_vacuous=allow_vacuous)
+            ok, message = osmesa_available()
+            if not ok:
+                raise RuntimeError(message)
+        report, _images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
+                                         oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
+                                         allow_vacuous=allow_vacuous)
     return report
 
 

@@ -367,7 +367,10 @@ def _external_option(args) -> str | None:
 
 
 def main(argv=None) -> int:
-    return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/guard.py)
+    from .subprocess_candidate import closing_started
+
+    with closing_started():                       # the run's candidate program ends with the run
+        return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/guard.py)
 
 
 def _main(argv=None) -> int:

@@ -32,6 +32,7 @@ stand-in for callables run in a fork.)
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import selectors
 import shlex
@@ -175,6 +176,23 @@ def _live(spec: SubprocessCandidate) -> "_Program":
     if program is None:
         program = _PROGRAMS[spec] = _Program(spec)
     return program
+
+
+@contextlib.contextmanager
+def closing_started():
+    """Close, when the block ends, every program started inside it: a run's candidates end with the run.
+
+    A process that makes many runs (a test suite calling the API or ``cli.main``
+    once per test, each with its own candidate) would otherwise keep an idle
+    program per candidate until it exits. Programs live before the block are
+    left running.
+    """
+    before = set(_PROGRAMS)
+    try:
+        yield
+    finally:
+        for spec in [s for s in _PROGRAMS if s not in before]:
+            spec.close()
 
 
 @atexit.register

@@ -153,3 +153,44 @@ def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, sou
         assert report["verdict"] == "fail"
     assert sorted(p.name for p in folder.rglob("*")) == ["proj.py"]
     assert sys.dont_write_bytecode is False                   # set back after the import
+
+
+def _alive(pid: int) -> bool:
+    """``pid`` is a live process (not reaped and not a zombie)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except FileNotFoundError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.parametrize("how", ["cli", "api_file", "api_callable", "api_cmd"])
+def test_a_candidates_process_ends_with_its_run(tmp_path, how):
+    # a process making many runs (a user's pytest) must not keep an idle candidate process per
+    # run: each run's program (host, fork or command) has ended and been reaped when it returns
+    import os
+
+    from wirecheck.oracles import api
+
+    pids = tmp_path / "pids"
+    source = (f"import os\nwith open({str(pids)!r}, 'a') as fh:\n    fh.write(f'{{os.getpid()}}\\n')\n"
+              "def f(p, c):\n    return p[:, :2] * 0.0\n")
+    cand = tmp_path / "proj.py"
+    cand.write_text(source)
+    args = dict(scenes=["cube"], cases=["on_axis"], frames=1)
+    if how == "cli":
+        assert cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--cases", "on_axis", "--frames", "1",
+                         "--level", "vertices", "--report-dir", str(tmp_path / "rep")]) == 1
+    elif how == "api_file":
+        assert api.check_projector(f"{cand}:f", **args)["verdict"] == "fail"
+    elif how == "api_callable":
+        def closure(p, c):                       # not importable by another process: run in a fork
+            pids.open("a").write(f"{os.getpid()}\n")
+            return p[:, :2] * 0.0
+        assert api.check_projector(closure, **args)["verdict"] == "fail"
+    else:
+        assert api.check_projector(cmd=[sys.executable, "-m", "wirecheck.oracles.candidate_host", f"{cand}:f"],
+                                   **args)["verdict"] == "fail"
+    started = {int(x) for x in pids.read_text().split()} - {os.getpid()}
+    assert len(started) == 1, started                      # one program, started once for the run
+    assert not _alive(started.pop())
