@@ -238,7 +238,7 @@ class _Frame:
     """One frame, centred on the principal point: the candidate's pixels and the oracle's lines."""
 
     cand: np.ndarray        # (N, 2) candidate pixel centres (subsampled)
-    nearest: np.ndarray     # (2, H, W) index of the nearest candidate pixel (distance_transform_edt)
+    nearest: np.ndarray     # (H * W,) int32 flat index (row * W + col) of each pixel's nearest candidate pixel
     seg_a: np.ndarray       # (K, 2) oracle segment starts
     seg_b: np.ndarray       # (K, 2) and ends
     samples: np.ndarray     # (M, 2) points along the oracle's segments (subsampled)
@@ -337,20 +337,26 @@ class _Registration:
         n_fwd = len(self._cand)
         n_rev = 0
         if len(self._samples):                             # oracle samples -> nearest candidate pixel
-            u = self._samples @ p.T
-            t = u @ a.T + b + self.centre
-            col, row = np.round(t[:, 0]).astype(np.int64), np.round(t[:, 1]).astype(np.int64)
-            inside = (col >= 0) & (col < self.w) & (row >= 0) & (row < self.h)
-            if inside.any():
-                flat = np.where(inside, row * self.w + col, 0)
-                near = np.empty((len(flat), 2), dtype=np.int64)
-                for f, lo, hi in zip(self._rev_frames, self._rev_bounds[:-1], self._rev_bounds[1:]):
-                    near[lo:hi, 0] = f.nearest[1].ravel()[flat[lo:hi]]
-                    near[lo:hi, 1] = f.nearest[0].ravel()[flat[lo:hi]]
-                c = near[inside] - self.centre
-                us.append(u[inside]); cs.append(c); ts.append(self._sample_tangents[inside] @ p.T)
-                dists.append(np.hypot(*(t[inside] - self.centre - c).T))
-                n_rev = int(inside.sum())
+            t = self._samples @ (a @ p).T + (b + self.centre)
+            col, row = np.rint(t[:, 0]), np.rint(t[:, 1])
+            inside = np.flatnonzero((col >= 0) & (col < self.w) & (row >= 0) & (row < self.h))
+            if len(inside):
+                flat = (row[inside] * self.w + col[inside]).astype(np.int64)
+                near = np.empty(len(inside), dtype=np.int64)
+                bounds = np.searchsorted(inside, self._rev_bounds)
+                for f, lo, hi in zip(self._rev_frames, bounds[:-1], bounds[1:]):
+                    near[lo:hi] = f.nearest[flat[lo:hi]]
+                c = np.empty((len(inside), 2))
+                c[:, 1], c[:, 0] = np.divmod(near, self.w)
+                c -= self.centre
+                us.append(self._samples[inside] @ p.T)
+                cs.append(c)
+                ts.append(self._sample_tangents[inside] @ p.T)
+                d = t[inside]
+                d -= self.centre
+                d -= c
+                dists.append(np.hypot(d[:, 0], d[:, 1]))
+                n_rev = len(inside)
         if not us:
             return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), 0, 0
         return (np.concatenate(us), np.concatenate(cs), np.concatenate(dists), np.concatenate(ts),
@@ -439,8 +445,12 @@ def _frames(cand_images, segments, camera, limit: int = MAX_POINTS_PER_FRAME, ne
         cand = _thin(np.stack([cc, rr], axis=1).astype(np.float64) - centre, limit)
         if nearest is not None:
             near = nearest[i]
+        elif len(cand):
+            rows, cols = distance_transform_edt(~img, return_distances=False, return_indices=True)
+            flat_type = np.int32 if img.size < 2 ** 31 else np.int64
+            near = (rows.astype(flat_type, copy=False) * img.shape[1] + cols).ravel()
         else:
-            near = distance_transform_edt(~img, return_distances=False, return_indices=True) if len(cand) else None
+            near = None
         samples, tangents = _samples(segs, camera.width, camera.height)
         keep = np.unique(np.linspace(0, len(samples) - 1, min(limit, len(samples))).round().astype(int))
         out.append(_Frame(cand=cand, nearest=near, seg_a=segs[:, 0] - centre, seg_b=segs[:, 1] - centre,

@@ -26,10 +26,16 @@ def _camera():
 
 
 def _case(rng):
-    """Three frames: 1, 4 and 7 random segments, and random drawn pixels (frame 1 draws none)."""
+    """Three frames: 1, 4 and 7 random segments, and random drawn pixels (frame 1 draws none).
+
+    Frame 0 also has a segment left of the image: its samples map outside it, so the reverse
+    pairs of a later frame start at another place among the samples inside than among all samples.
+    """
     segs, images = [], []
     for k, n_px in ((1, 40), (4, 0), (7, 90)):
         segs.append(rng.uniform([-5, -5], [W + 5, H + 5], size=(k, 2, 2)))
+        if k == 1:
+            segs[-1] = np.concatenate([segs[-1], [[[-20.0, 5.0], [-8.0, 30.0]]]])
         img = np.zeros((H, W), bool)
         img.ravel()[rng.choice(W * H, n_px, replace=False)] = True
         images.append(img)
