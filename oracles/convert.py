@@ -23,7 +23,6 @@ import math
 import os
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from wirecheck.core.camera import Camera
 
@@ -84,6 +83,14 @@ def _cv2():
     return cv2
 
 
+def _rotation():
+    """scipy's ``Rotation``, imported on first use: a process that only encodes or decodes the candidate
+    protocol (the candidate host) never builds a rotation, and scipy.spatial is ~0.3 s of its start."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation
+
+
 # ---- OpenCV ---------------------------------------------------------------
 
 def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -122,7 +129,7 @@ def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray
     # R -> rvec with scipy (through a quaternion): cv2.Rodrigues(R) loses up to
     # ~4e3 eps near 180-degree rotations (measured), which then shows as oracle
     # error; the other direction (rvec -> R, inside projectPoints) is well conditioned.
-    rvec = Rotation.from_matrix(r_cv).as_rotvec()
+    rvec = _rotation().from_matrix(r_cv).as_rotvec()
     if camera.projection == "perspective":
         fx, fy, cx, cy = intrinsics(camera)
     else:
@@ -378,7 +385,7 @@ def _model_matrix(key: bytes) -> np.ndarray:
     turns, offset, scale, t, pivot = v[0:3], v[3:6], v[6], v[7], v[8:11]
     ax, ay, az = (2.0 * math.pi * ((t * float(k)) % 1.0) for k in turns)
     m = np.eye(4)
-    m[:3, :3] = Rotation.from_euler("xyz", [ax, ay, az]).as_matrix() * float(scale)
+    m[:3, :3] = _rotation().from_euler("xyz", [ax, ay, az]).as_matrix() * float(scale)
     m[:3, 3] = np.asarray(offset, dtype=np.float64)
     c = np.asarray(pivot, dtype=np.float64)
     if c.any():

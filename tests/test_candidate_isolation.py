@@ -194,3 +194,20 @@ def test_a_candidates_process_ends_with_its_run(tmp_path, how):
     started = {int(x) for x in pids.read_text().split()} - {os.getpid()}
     assert len(started) == 1, started                      # one program, started once for the run
     assert not _alive(started.pop())
+
+
+def test_the_candidate_host_loads_no_oracle_library(tmp_path):
+    # The host starts once per run (per worker): what it imports is start-up time of every
+    # isolated candidate. It decodes requests and encodes replies: no scipy (convert's Rotation,
+    # ~0.3 s of a 0.4 s start), OpenCV, pyrender, trimesh or matplotlib. The candidate records
+    # the modules of the process it is called in.
+    seen = tmp_path / "modules.json"
+    cand = tmp_path / "proj.py"
+    cand.write_text(f"import json, sys\ndef f(p, c):\n    with open({str(seen)!r}, 'w') as fh:\n"
+                    "        json.dump(sorted(sys.modules), fh)\n    return p[:, :2] * 0.0\n")
+    assert cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--cases", "on_axis", "--frames", "1",
+                     "--level", "vertices", "--report-dir", str(tmp_path / "rep")]) == 1
+    modules = json.loads(seen.read_text())
+    heavy = ("scipy", "cv2", "pyrender", "trimesh", "matplotlib", "OpenGL")
+    assert [m for m in modules if m.split(".")[0] in heavy] == []
+    assert "wirecheck.oracles.protocol" in modules and "numpy" in modules   # the host's own modules are seen
