@@ -101,6 +101,9 @@ def main(argv=None) -> int:
     if len(argv) != 1:
         print("usage: python -m wirecheck.oracles.candidate_host FILE.py:FUNC|MODULE:FUNC", file=sys.stderr)
         return 2
+    # this process is wirecheck's: nothing the candidate imports, at start-up or inside a call,
+    # leaves a __pycache__ folder in the user's folders
+    sys.dont_write_bytecode = True
     extra = os.environ.get("WIRECHECK_HOST_PATH")
     if extra:
         sys.path[:0] = [p for p in extra.split(os.pathsep) if p]

@@ -230,6 +230,7 @@ class _ForkedChild:
             try:
                 os.setsid()
                 _die_with_parent()
+                sys.dont_write_bytecode = True         # as the candidate host: no __pycache__ from its imports
                 for fd in (in_w, out_r, err_r):
                     os.close(fd)
                 os.dup2(err_w, 1)

@@ -125,14 +125,21 @@ def test_a_candidate_hanging_at_import_fails_every_case_and_is_started_once(tmp_
     assert starts.read_text() == "start\n"       # not started again for the second case
 
 
-@pytest.mark.parametrize("source,code", [("def f(p, c):\n    return p[:, :2] * 0.0\n", 1),
-                                         ("raise ImportError('at import')\n", 2)], ids=["runs", "import_fails"])
-@pytest.mark.parametrize("isolated", [True, False], ids=["host", "in_process"])
-def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, source, code, isolated):
+LAZY = "def f(p, c):\n    import helper\n    return helper.g(p)\n"       # imports its sibling inside a call
+
+
+RUNS, IMPORT_FAILS = "def f(p, c):\n    return p[:, :2] * 0.0\n", "raise ImportError('at import')\n"
+
+
+@pytest.mark.parametrize("isolated,source,code", [
+    (True, RUNS, 1), (True, IMPORT_FAILS, 2), (True, LAZY, 1), (False, RUNS, 1), (False, IMPORT_FAILS, 2),
+], ids=["host-runs", "host-import_fails", "host-imports_in_a_call", "in_process-runs", "in_process-import_fails"])
+def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, isolated, source, code):
     # Python writes __pycache__/NAME.cpython-3X.pyc beside a module it imports unless told not to;
     # the candidate's folder is the user's, and wirecheck changes nothing it did not write. With
     # bytecode writing on, in this process and in the host it starts (found by tests/test_fuzz.py
-    # where PYTHONDONTWRITEBYTECODE was unset):
+    # where PYTHONDONTWRITEBYTECODE was unset). In this process (isolate=False) only the import of
+    # the candidate is wirecheck's: what the function imports when called is the user's process.
     from wirecheck.oracles import api
 
     monkeypatch.delenv("PYTHONDONTWRITEBYTECODE", raising=False)
@@ -140,6 +147,7 @@ def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, sou
     folder = tmp_path / "user"
     folder.mkdir()
     (folder / "proj.py").write_text(source)
+    (folder / "helper.py").write_text("def g(p):\n    return p[:, :2] * 0.0\n")
     if isolated:
         got = cli.main(["--candidate", f"{folder / 'proj.py'}:f", "--scene", "cube", "--cases", "on_axis",
                         "--frames", "1", "--level", "vertices", "--report-dir", str(tmp_path / "rep")])
@@ -152,7 +160,7 @@ def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, sou
         report = api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
                                      isolate=False)
         assert report["verdict"] == "fail"
-    assert sorted(p.name for p in folder.rglob("*")) == ["proj.py"]
+    assert sorted(p.name for p in folder.rglob("*")) == ["helper.py", "proj.py"]
     assert sys.dont_write_bytecode is False                   # set back after the import
 
 
@@ -212,3 +220,23 @@ def test_the_candidate_host_loads_no_oracle_library(tmp_path):
     heavy = ("scipy", "cv2", "pyrender", "trimesh", "matplotlib", "OpenGL")
     assert [m for m in modules if m.split(".")[0] in heavy] == []
     assert "wirecheck.oracles.protocol" in modules and "numpy" in modules   # the host's own modules are seen
+
+
+def test_a_forked_candidates_imports_write_no_bytecode_files(tmp_path, monkeypatch):
+    # a closure runs in a fork of this process (wirecheck's child, as the host): what it imports
+    # there leaves no __pycache__ beside the imported module
+    from wirecheck.oracles import api
+
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
+    folder = tmp_path / "user"
+    folder.mkdir()
+    (folder / "fork_helper.py").write_text("def g(p):\n    return p[:, :2] * 0.0\n")
+
+    def closure(p, c):
+        sys.path.insert(0, str(folder))
+        import fork_helper
+        return fork_helper.g(p)
+
+    assert api.check_projector(closure, scenes=["cube"], cases=["on_axis"], frames=1)["verdict"] == "fail"
+    assert "fork_helper" not in sys.modules                   # imported in the child only
+    assert sorted(p.name for p in folder.rglob("*")) == ["fork_helper.py"]
