@@ -311,7 +311,11 @@ def load_mesh_file(path: Path) -> Scene:
     bad = (faces < 0) | (faces >= len(vertices))
     if bad.any():
         f, k = (int(i) for i in np.argwhere(bad)[0])
-        raise InputError(f"{path}: face {f} has vertex index {int(faces[f, k])}: expected 0..{len(vertices) - 1} "
+        value = int(faces[f, k])
+        # the readers store indices as 32-bit integers: one beyond that range is read as -2**31
+        said = (f"a vertex index beyond 32-bit integers (read as {value})" if value in (-2 ** 31, 2 ** 31 - 1)
+                else f"vertex index {value}")
+        raise InputError(f"{path}: face {f} has {said}: expected 0..{len(vertices) - 1} "
                          f"(the file has {len(vertices)} vertices)")
     edges = [face_edges(faces)] if len(faces) else []
     if path.suffix.lower() == ".obj":

@@ -112,6 +112,18 @@ def test_face_index_out_of_range_renderer(tmp_path, capsys, make, suffix):
     assert_one_error_line(rc, err, f"{mesh}: face 0 has vertex index 7: expected 0..2")
 
 
+@pytest.mark.parametrize("index", ["2147483650", "4294967297", "99999999999999999999"])
+def test_a_face_index_beyond_32_bits_is_not_reported_as_another_number(tmp_path, capsys, index):
+    # trimesh stores PLY indices as int32: 2**31 + 2 and 2**32 + 1 are both read as -2**31. The
+    # message must not pass that number off as the file's: it says what happened instead.
+    mesh = tmp_path / "m.ply"
+    mesh.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                    f"0 0 0\n1 0 0\n0 1 0\n3 0 1 {index}\n")
+    rc, _, err = render(["--frames", "1", "--scene", str(mesh)], tmp_path / "o", capsys)
+    assert_one_error_line(rc, err, f"{mesh}: face 0 has a vertex index beyond 32-bit integers")
+
+
 @pytest.mark.parametrize("level", ["vertices", "pixels"])
 @pytest.mark.parametrize("make, suffix", [(_bad_ply, ".ply"), (_bad_glb, ".glb")])
 def test_face_index_out_of_range_crosscheck(tmp_path, capsys, make, suffix, level):
