@@ -204,7 +204,11 @@ def worker_runner() -> _CaseRunner:
 
 
 def _worker_run(scene: Scene, case: Case, params: _RunParams) -> CaseResult:
+    from .subprocess_candidate import SubprocessCandidate, close_all_but
+
     with _WORKER_LOCK:      # a Dask worker may run tasks in several threads: one GL user at a time
+        # a worker outlives a run on a Dask cluster: programs of earlier runs' candidates end here
+        close_all_but(params.candidate if isinstance(params.candidate, SubprocessCandidate) else None)
         return worker_runner().run(scene, case, params)
 
 

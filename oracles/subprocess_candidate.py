@@ -195,6 +195,16 @@ def closing_started():
             spec.close()
 
 
+def close_all_but(keep=None) -> None:
+    """Close every live program but ``keep``'s (a :class:`SubprocessCandidate`, or None: close all).
+
+    A long-lived worker (a Dask cluster's) serves run after run: it keeps the
+    program of the run it is serving, not an idle one per candidate it has served.
+    """
+    for spec in [s for s in _PROGRAMS if s != keep]:
+        spec.close()
+
+
 @atexit.register
 def _close_all() -> None:
     for spec in list(_PROGRAMS):

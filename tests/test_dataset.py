@@ -340,6 +340,32 @@ def test_a_plain_run_on_a_dask_cluster_gives_the_report_of_jobs_1(tmp_path, dask
     assert (out1 / "report.md").read_bytes() == (out2 / "report.md").read_bytes()
 
 
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.slow
+def test_a_clusters_workers_keep_no_idle_program_per_earlier_candidate(tmp_path, dask_scheduler):
+    # A cluster's workers outlive the runs they serve. Three runs of three candidates (each host
+    # records its pid when it starts): without the bound, every host started would still be
+    # running after the runs, idle (3 or more); with it, each of the 2 workers keeps at most
+    # the program of the last run it served.
+    pids = tmp_path / "pids"
+    for k in range(3):
+        cand = tmp_path / f"cand{k}.py"
+        cand.write_text(f"import os\nwith open({str(pids)!r}, 'a') as fh:\n    fh.write(f'{{os.getpid()}}\\n')\n"
+                        "from wirecheck.core.projection import project_points as f\n")
+        code, report, _ = run(tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", *FAST, "--level", "vertices",
+                              "--executor", "dask", "--scheduler", dask_scheduler, name=f"r{k}")
+        assert code == 0 and report["summary"]["passed"] == 2
+    started = [int(x) for x in pids.read_text().split()]
+    assert len(set(started)) >= 3                      # each run started its own program
+    assert sum(_alive(pid) for pid in set(started)) <= 2
+
+
 @pytest.mark.slow
 def test_the_default_dask_executor_starts_its_own_local_cluster(tmp_path, monkeypatch):
     # no --scheduler: crosscheck starts a LocalCluster of --jobs workers but no more than the tasks
