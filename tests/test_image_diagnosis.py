@@ -213,3 +213,34 @@ def test_blank_candidate_is_a_depth_flip_only_when_the_backward_view_is_empty():
     assert primary(diagnose_images(blank, segs, cam, segs)) == "unexplained"
     # nothing to draw, nothing drawn: agreement
     assert diagnose_images(blank, [np.zeros((0, 2, 2))], cam) == []
+
+
+@pytest.mark.parametrize("fault", ["none", "fov_offset", "mirror_x"])
+def test_a_case_of_many_frames_is_fitted_on_the_points_of_six(fault, monkeypatch):
+    # 24 frames of the cube: every frame contributes, MAX_POINTS_PER_CASE // 24 = 150 points per
+    # frame and direction (six frames keep their 600 each), so the fit costs what a six-frame
+    # case costs; the names are those of the six-frame cases above
+    from wirecheck.oracles import image_diagnose
+
+    sizes = []
+    init = image_diagnose._Registration.__init__
+
+    def counting(self, frames, *args):
+        init(self, frames, *args)
+        sizes.append((len(frames), len(self._cand), len(self._samples)))
+
+    monkeypatch.setattr(image_diagnose._Registration, "__init__", counting)
+    cam = CAMERAS["oblique"]
+    fn, want = FAULTS[fault]
+    sc = load_scene("cube")
+    images, segs = [], []
+    for k in range(24):
+        p_world = apply(Motion().frame_matrix(k, 24), sc.vertices)
+        images.append(draw_candidate(fn, p_world, np.asarray(sc.edges), cam))
+        segs.append(oracle_segments(p_world, np.asarray(sc.edges), cam))
+    got = diagnose_images(images, segs, cam)
+    assert {f["name"] for f in got} == want, got
+    fine, coarse = sizes[0], sizes[1]                   # the fit's and the screening's registrations
+    assert fine[0] == 24 and 24 * 100 < fine[1] <= image_diagnose.MAX_POINTS_PER_CASE
+    assert 24 * 100 < fine[2] <= image_diagnose.MAX_POINTS_PER_CASE
+    assert coarse[1] <= image_diagnose.SCREEN_POINTS_PER_CASE and coarse[2] <= image_diagnose.SCREEN_POINTS_PER_CASE

@@ -106,3 +106,33 @@ def test_pairs_are_each_frames_own_nearest(monkeypatch, stack_limit, names):
     got_rounded = np.hypot(*(np.round(u[n_fwd:] @ a.T + b + centre) - centre - c[n_fwd:]).T)
     np.testing.assert_allclose(got_rounded, want_d, atol=1e-9)
     assert np.all(np.abs(dist[n_fwd:] - got_rounded) <= np.sqrt(0.5) + 1e-9)
+
+
+@pytest.mark.parametrize("where", ["corner", "middle", "two_clusters", "everywhere"])
+def test_the_nearest_pixel_map_is_exact_within_the_pairs_reach(where):
+    # brute force over every pixel of a 120 x 90 image: the distance to the map's pixel equals the
+    # distance to the nearest drawn pixel wherever that is within the cap plus a rounded sample's
+    # 0.71 px (pairs the fit can keep); farther away, the map's pixel is farther than that too
+    # (the pair is dropped and the cost capped, whichever pixel it is)
+    from wirecheck.oracles.image_diagnose import PAIR_CAP_PX, _nearest_pixel_map
+
+    rng = np.random.default_rng(3)
+    img = np.zeros((90, 120), bool)
+    boxes = {"corner": [(0, 12, 0, 15)], "middle": [(40, 50, 50, 64)],
+             "two_clusters": [(5, 12, 8, 20), (70, 85, 90, 118)], "everywhere": [(0, 90, 0, 120)]}[where]
+    for r0, r1, c0, c1 in boxes:
+        img[r0:r1, c0:c1] = rng.random((r1 - r0, c1 - c0)) < 0.2
+    rr, cc = np.nonzero(img)
+    near = _nearest_pixel_map(img, rr, cc)
+    qr, qc = np.mgrid[0:90, 0:120]
+    q = np.stack([qr.ravel(), qc.ravel()], axis=1).astype(float)
+    drawn = np.stack([rr, cc], axis=1).astype(float)
+    d_true = np.min(np.hypot(q[:, None, 0] - drawn[None, :, 0], q[:, None, 1] - drawn[None, :, 1]), axis=1)
+    d_map = np.hypot(q[:, 0] - near // 120, q[:, 1] - near % 120)
+    assert img.ravel()[near].all()                              # always a drawn pixel
+    reach = PAIR_CAP_PX + np.sqrt(0.5)
+    inside = d_true <= reach
+    assert inside.sum() > 300                                  # both parts are checked on many pixels
+    assert (~inside).sum() > 500 or where == "everywhere"      # (everywhere: the box is the whole image)
+    np.testing.assert_array_equal(d_map[inside], d_true[inside])
+    assert np.all(d_map[~inside] > reach)
