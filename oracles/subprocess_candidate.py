@@ -58,6 +58,8 @@ STDERR_KEEP = 64 * 1024
 _CHUNK = 1 << 20
 #: Seconds a program gets to exit after its stdin is closed, before it is killed.
 _EXIT_GRACE_S = 2.0
+#: Seconds a killed program's group gets to be gone (a SIGKILL ends a process in milliseconds).
+_GROUP_END_S = 1.0
 
 
 class CandidateStartRefused(CandidateError):
@@ -296,6 +298,43 @@ class _ForkedChild:
                 pass
 
 
+def _await_group_end(pgid: int) -> None:
+    """Return once no process of group ``pgid`` (killed) runs, or after ``_GROUP_END_S``.
+
+    A SIGKILL is delivered asynchronously: without this, a program's own child
+    could still be running when the call that ended it returns. A member that
+    has ended but is not this process's child is left to its new parent (init)
+    to reap; where there is no ``/proc``, this returns at once.
+    """
+    deadline = time.monotonic() + _GROUP_END_S
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(pgid, 0)
+        except (ProcessLookupError, PermissionError):
+            return                     # no member at all: the usual case, at the cost of one call
+        if not _group_runs(pgid):
+            return
+        time.sleep(0.001)
+
+
+def _group_runs(pgid: int) -> bool:
+    """Whether ``/proc`` shows a process of group ``pgid`` that is not a zombie (False without ``/proc``)."""
+    try:
+        names = os.listdir("/proc")
+    except OSError:
+        return False
+    for name in names:
+        if name.isdigit():
+            try:
+                with open(f"/proc/{name}/stat", "rb") as fh:
+                    state, _ppid, pgrp = fh.read().rsplit(b")", 1)[1].split()[:3]
+            except (OSError, ValueError):
+                continue
+            if int(pgrp) == pgid and state != b"Z":
+                return True
+    return False
+
+
 class _Died(Exception):
     pass
 
@@ -393,8 +432,12 @@ class _Program:
             try:
                 proc.wait(timeout=_EXIT_GRACE_S)
             except subprocess.TimeoutExpired:
-                self._killpg(proc)
-                proc.wait()
+                pass
+            # the program if it lingers, and what it started that still runs (a shell's child, a
+            # helper): its group outlives a leader that exited (only a new session of its own escapes)
+            self._killpg(proc)
+            proc.wait()
+            _await_group_end(proc.pid)
             self._drain_stderr(proc)
             proc.stdout.close()
             proc.stderr.close()
@@ -415,6 +458,7 @@ class _Program:
             return
         self._killpg(proc)
         proc.wait()
+        _await_group_end(proc.pid)
         self._drain_stderr(proc)            # all it wrote is in the pipe now
         for f in (proc.stdin, proc.stdout, proc.stderr):
             try:

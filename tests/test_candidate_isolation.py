@@ -205,6 +205,33 @@ def test_a_candidates_process_ends_with_its_run(tmp_path, how):
     assert not _alive(started.pop())
 
 
+@pytest.mark.parametrize("how", ["cmd_shell", "fork_child"])
+def test_what_a_candidate_started_ends_with_its_run(tmp_path, how):
+    # a program may start processes of its own (a shell's background job, a helper): they are in
+    # its process group and end with the run, though the program itself exits cleanly on EOF
+    import os
+
+    from wirecheck.oracles import api
+
+    pid_file = tmp_path / "child.pid"
+    cand = tmp_path / "proj.py"
+    cand.write_text("def f(p, c):\n    return p[:, :2] * 0.0\n")
+    args = dict(scenes=["cube"], cases=["on_axis"], frames=1)
+    if how == "cmd_shell":
+        cmd = (f"sleep 300 & echo $! > {pid_file}; "
+               f"exec {sys.executable} -m wirecheck.oracles.candidate_host {cand}:f")
+        assert api.check_projector(cmd=["sh", "-c", cmd], **args)["verdict"] == "fail"
+    else:
+        def closure(p, c):                       # run in a fork; starts a child there, once
+            import subprocess
+
+            if not pid_file.exists():
+                pid_file.write_text(str(subprocess.Popen(["sleep", "300"]).pid))
+            return p[:, :2] * 0.0
+        assert api.check_projector(closure, **args)["verdict"] == "fail"
+    child = int(pid_file.read_text())
+    assert child != os.getpid() and not _alive(child)
+
 def test_the_candidate_host_loads_no_oracle_library(tmp_path):
     # The host starts once per run (per worker): what it imports is start-up time of every
     # isolated candidate. It decodes requests and encodes replies: no scipy (convert's Rotation,
