@@ -41,33 +41,61 @@ from wirecheck.core.errors import InputError
 
 
 @contextlib.contextmanager
-def _no_bytecode_files():
-    """Import without writing ``__pycache__`` folders: the candidate's folder (and its package's) are the
-    user's, and wirecheck changes nothing it did not write (Python would add ``.pyc`` files beside the source)."""
+def _candidate_imports(folder: str | None = None):
+    """While wirecheck imports or calls a candidate it loaded: no bytecode written, and ``folder`` importable.
+
+    The candidate's folder (and its package's) are the user's, and wirecheck
+    changes nothing it did not write (Python would add ``__pycache__`` beside
+    each source it imports, at load or lazily inside a call). A ``FILE.py``
+    candidate's own folder is importable, as when running a script, only
+    meanwhile: left first on ``sys.path``, its ``helper.py`` or ``utils.py``
+    would shadow the caller's own modules of those names after the check.
+    """
     before = sys.dont_write_bytecode
     sys.dont_write_bytecode = True
+    added = folder is not None and folder not in sys.path
+    if added:
+        sys.path.insert(0, folder)
     try:
         yield
     finally:
         sys.dont_write_bytecode = before
+        if added and folder in sys.path:
+            sys.path.remove(folder)
+
+
+class _Loaded:
+    """A candidate :func:`load_candidate` imported: each call inside :func:`_candidate_imports` (its folder)."""
+
+    def __init__(self, func, folder: str | None):
+        self.func, self.folder = func, folder
+
+    def __call__(self, points, camera):
+        with _candidate_imports(self.folder):
+            return self.func(points, camera)
+
+    def __repr__(self) -> str:
+        return repr(self.func)
 
 
 def load_candidate(spec: str):
-    """Resolve ``FILE.py:FUNC`` or ``MODULE:FUNC`` to a callable; InputError otherwise."""
+    """Resolve ``FILE.py:FUNC`` or ``MODULE:FUNC`` to a callable; InputError otherwise.
+
+    The callable calls the candidate as :func:`_candidate_imports` says (its
+    folder importable meanwhile, no bytecode written).
+    """
     if ":" not in spec:
         raise InputError(f"--candidate {spec!r}: expected FILE.py:FUNC or MODULE:FUNC")
     target, func_name = spec.rsplit(":", 1)
+    folder = None
     if target.endswith(".py") or "/" in target:
         path = Path(target)
         if not path.is_file():
             raise InputError(f"--candidate {spec!r}: file {target!r} not found")
         mod_name = f"wirecheck_candidate_{path.stem}"
-        # like running a script: the candidate's own folder is importable
-        folder = str(path.resolve().parent)
-        if folder not in sys.path:
-            sys.path.insert(0, folder)
+        folder = str(path.resolve().parent)        # like running a script: the candidate's own folder is importable
         try:
-            with _no_bytecode_files():
+            with _candidate_imports(folder):
                 module_spec = importlib.util.spec_from_file_location(mod_name, path)
                 module = importlib.util.module_from_spec(module_spec)
                 sys.modules[mod_name] = module
@@ -77,7 +105,7 @@ def load_candidate(spec: str):
                              f"{type(exc).__name__}: {exc}") from None
     else:
         try:
-            with _no_bytecode_files():
+            with _candidate_imports():
                 module = importlib.import_module(target)
         except (Exception, SystemExit) as exc:
             raise InputError(f"--candidate {spec!r}: importing module {target!r} failed: "
@@ -92,7 +120,7 @@ def load_candidate(spec: str):
                          f"{func_name}(points, camera): expected the contract FUNC(points, camera)") from None
     except ValueError:      # builtins without a signature: find out when called
         pass
-    return func
+    return _Loaded(func, folder)
 
 
 class CandidateError(RuntimeError):

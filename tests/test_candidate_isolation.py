@@ -138,8 +138,7 @@ def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, iso
     # Python writes __pycache__/NAME.cpython-3X.pyc beside a module it imports unless told not to;
     # the candidate's folder is the user's, and wirecheck changes nothing it did not write. With
     # bytecode writing on, in this process and in the host it starts (found by tests/test_fuzz.py
-    # where PYTHONDONTWRITEBYTECODE was unset). In this process (isolate=False) only the import of
-    # the candidate is wirecheck's: what the function imports when called is the user's process.
+    # where PYTHONDONTWRITEBYTECODE was unset). In this process (isolate=False): the next test.
     from wirecheck.oracles import api
 
     monkeypatch.delenv("PYTHONDONTWRITEBYTECODE", raising=False)
@@ -163,6 +162,34 @@ def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, iso
     assert sorted(p.name for p in folder.rglob("*")) == ["helper.py", "proj.py"]
     assert sys.dont_write_bytecode is False                   # set back after the import
 
+
+def test_an_in_process_candidate_leaves_the_callers_imports_as_they_were(tmp_path, monkeypatch):
+    # isolate=False: a FILE.py candidate's folder is importable while wirecheck imports and calls it
+    # (a sibling imported inside a call is found), and gets no __pycache__ from that import. After
+    # the check sys.path is the caller's again: left first there, the candidate's helper.py or
+    # utils.py would shadow the caller's modules of those names for the rest of its test run.
+    import uuid
+
+    from wirecheck.oracles import api
+
+    monkeypatch.delenv("PYTHONDONTWRITEBYTECODE", raising=False)
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    path_before = list(sys.path)
+    sibling = f"sibling_{uuid.uuid4().hex}"             # not yet in sys.modules: really imported here
+    folder = tmp_path / "user"
+    folder.mkdir()
+    (folder / "proj.py").write_text(f"def f(p, c):\n    import {sibling}\n    return {sibling}.g(p, c)\n")
+    (folder / f"{sibling}.py").write_text("from wirecheck.core.projection import project_points\n"
+                                          "def g(p, c):\n    return project_points(p, c)\n")
+    try:
+        report = api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
+                                     isolate=False)
+    finally:
+        sys.modules.pop(sibling, None)
+    assert report["verdict"] == "pass"                      # core's projection, reached through the sibling
+    assert sorted(p.name for p in folder.rglob("*")) == sorted(["proj.py", f"{sibling}.py"])
+    assert sys.path == path_before and sys.dont_write_bytecode is False
 
 def _alive(pid: int) -> bool:
     """``pid`` is a live process (not reaped and not a zombie)."""
