@@ -247,12 +247,31 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
     barrier = ctx.Barrier(workers)
     with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_pool_init,
                              initargs=(initializer, barrier)) as pool:
-        # start every worker now (the pool starts one per task submitted while none is idle, and each
-        # waits for the others): the run's time then counts tasks, not interpreters starting
-        with _worker_environ():
-            for f in [pool.submit(_pool_ready) for _ in range(workers)]:
-                f.result()
-        yield pool, workers
+        try:
+            # start every worker now (the pool starts one per task submitted while none is idle, and each
+            # waits for the others): the run's time then counts tasks, not interpreters starting
+            with _worker_environ():
+                for f in [pool.submit(_pool_ready) for _ in range(workers)]:
+                    f.result()
+            yield pool, workers
+        except BaseException:
+            _stop_workers(pool)
+            raise
+
+
+def _stop_workers(pool) -> None:
+    """End a pool's workers now: the run was interrupted (Ctrl-C, SIGTERM) or failed.
+
+    The pool's own shutdown would wait for the tasks running, each up to a candidate's
+    timeout (a hung candidate: 10 s by default). A worker's candidate program dies with it
+    (oracles.subprocess_candidate: it is killed when its parent ends).
+    """
+    processes = list((getattr(pool, "_processes", None) or {}).values())     # CPython's pid -> Process
+    pool.shutdown(wait=False, cancel_futures=True)                           # (which forgets them)
+    for proc in processes:
+        proc.terminate()
+    for proc in processes:
+        proc.join(timeout=5)
 
 
 _BARRIER = None

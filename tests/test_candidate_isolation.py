@@ -294,3 +294,39 @@ def test_a_forked_candidates_imports_write_no_bytecode_files(tmp_path, monkeypat
     assert api.check_projector(closure, scenes=["cube"], cases=["on_axis"], frames=1)["verdict"] == "fail"
     assert "fork_helper" not in sys.modules                   # imported in the child only
     assert sorted(p.name for p in folder.rglob("*")) == ["fork_helper.py"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_an_interrupted_run_with_workers_does_not_wait_for_hung_candidates(tmp_path, sig):
+    # Both workers' candidates hang in a call (each writes its pid first); the run gets SIGINT or
+    # SIGTERM (a CI job cancelled: the signal reaches crosscheck's process only). The pool's own
+    # shutdown would wait out the 60 s request timeout; the run ends at once instead (20 s: a
+    # third of it, far above a loaded machine's seconds), with 130 / 143, and no candidate left.
+    import signal
+    import time
+
+    called = tmp_path / "called"
+    called.mkdir()
+    cand = tmp_path / "hang.py"
+    cand.write_text(f"import os, time\ndef f(p, c):\n    open(os.path.join({str(called)!r}, str(os.getpid())), 'w').close()\n"
+                    "    time.sleep(600)\n")
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", f"{cand}:f", "--scene", "cube",
+                             "--cases", "on_axis,orthographic", "--frames", "1", "--level", "vertices", "--jobs", "2",
+                             "--candidate-timeout", "60", "--report-dir", str(tmp_path / "rep")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while len(list(called.iterdir())) < 2 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    hosts = [int(p.name) for p in called.iterdir()]
+    assert len(hosts) == 2, proc.poll()                      # both workers are inside a hung call
+    t0 = time.monotonic()
+    proc.send_signal(getattr(signal, sig))
+    _out, err = proc.communicate(timeout=60)
+    assert time.monotonic() - t0 < 20, err
+    assert proc.returncode == 128 + getattr(signal, sig) and "Traceback" not in err
+    deadline = time.monotonic() + 5                          # the hosts die with their workers (SIGKILL)
+    while any(_alive(pid) for pid in hosts) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not any(_alive(pid) for pid in hosts)
+    assert not (tmp_path / "rep").exists()
