@@ -225,8 +225,10 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     dp = 256 * t2db
     i_start = floor_div(ta0, 256)
     i_end = floor_div(ta1, 256)
-    first = i_start + (_exit_travel(i_start, p0, dp, q, unit, d1, d2, floor_div) <= ta0 / SUBPIXEL)
-    last = i_end - (_exit_travel(i_end, p0, dp, q, unit, d1, d2, floor_div) > ta1 / SUBPIXEL)
+    # X(I) <= A0 as u(I) <= A0 - I: the end's offset from the pixel, exact (a whole number of grid
+    # units over 256), so the decision does not depend on where the pixel is (I + u would round)
+    first = i_start + (_exit_travel(i_start, p0, dp, q, unit, d1, d2, floor_div) <= (ta0 - 256 * i_start) / SUBPIXEL)
+    last = i_end - (_exit_travel(i_end, p0, dp, q, unit, d1, d2, floor_div) > (ta1 - 256 * i_end) / SUBPIXEL)
     count = last - first
     count += 1
     count = np.maximum(count, 0).astype(np.intp)
@@ -252,7 +254,7 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
 
 
 def _exit_travel(i, p0, dp, q, unit, d1, d2, floor_div) -> np.ndarray:
-    """Travel coordinate ``X`` where the line leaves the diamond of pixel ``i`` (travel coordinates).
+    """Travel ``u = X - I`` from the centre of pixel ``I`` to where the line leaves its diamond.
 
     The rule's float operations on the rule's values (module docstring,
     step 4). The offset from the pixel centre is ``e = (num - j unit) / unit``;
@@ -261,14 +263,15 @@ def _exit_travel(i, p0, dp, q, unit, d1, d2, floor_div) -> np.ndarray:
     ``u = min((1/2 - e) / (1 + m), (1/2 + e) / (1 - m))``, here
     ``min((1/2 - E) / (1 + t m), (1/2 + E) / (1 - t m))``: the same two
     quotients, swapped when ``t = -1``. A zero denominator means that bound is
-    absent (``fmin`` drops its inf or NaN). ``X = I + u``: compared with the
-    ends it gives the rule's decisions bit for bit.
+    absent (``fmin`` drops its inf or NaN). ``u`` is compared with the ends'
+    offsets ``A - I`` (exact), not ``X = I + u`` with ``A``: the sum would round
+    by the size of ``I``, and an end exactly on a diamond's edge (common on the
+    1/256 grid) would be decided differently a whole pixel away.
     """
     p = p0 + dp * i
     e_t = (p - floor_div(p, q) * q - unit) / q
     with np.errstate(divide="ignore", invalid="ignore"):
         u = np.fmin((0.5 - e_t) / d1, (0.5 + e_t) / d2)
-    u += i
     return u
 
 

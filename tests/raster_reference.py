@@ -46,8 +46,10 @@ def candidates_reference(p0_px, p1_px, width, height):
     with np.errstate(divide="ignore", invalid="ignore"):
         u_a = np.where(1 + m > 0, (0.5 - e) / (1 + m), np.inf)
         u_b = np.where(1 - m > 0, (0.5 + e) / (1 - m), np.inf)
-    exit_at = i + s * np.minimum(u_a, u_b)
-    drawn = (s * (exit_at - a0[seg]) > 0) & (s * (a1[seg] - exit_at) >= 0)
+    # the exit point i + s u against the ends, as u against the ends' offsets from i (exact: the
+    # sum would round by the size of i, and an end on a diamond's edge would depend on where it is)
+    u = np.minimum(u_a, u_b)
+    drawn = (u > s * (a0[seg] - i)) & (u <= s * (a1[seg] - i))
     i, j, xm = i[drawn], j[drawn].astype(np.intp), xm[drawn]
     cc = np.where(xm, i, j)
     rr = np.where(xm, j, i)
