@@ -24,6 +24,7 @@ function addOp(op) {
   if (tail && tail.op === op.op && (op.op === "orbit" || op.op === "pan")) { tail.dx += op.dx; tail.dy += op.dy; }
   else if (tail && tail.op === op.op && op.op === "dolly") { tail.delta += op.delta; }
   else if (tail && tail.op === op.op && op.op === "step") { tail.n += op.n; }
+  else if (tail && tail.op === op.op && op.op === "set" && tail.field === op.field) { tail.value = op.value; }
   else { pending.push(op); }
   pump();
 }
