@@ -87,6 +87,9 @@ MAX_BODY_BYTES = 64 * 1024
 #: dropped: a local client sends a 1 KiB request in well under a millisecond, so 10 s only ever
 #: ends clients that announce more than they send (they would otherwise hold a thread forever).
 REQUEST_TIMEOUT_S = 10.0
+#: How often the serving loop checks for :meth:`Server.stop` (http.server's default 0.5 s made every
+#: stop, and so every test's server, take up to half a second).
+POLL_S = 0.05
 
 
 @dataclass(frozen=True)
@@ -536,11 +539,11 @@ def _handler(viewer: Viewer):
                                    f"Content-Length {n}: expected at most {MAX_BODY_BYTES} bytes")
             try:
                 raw = self.rfile.read(n)
-            except (ConnectionError, TimeoutError):
+            except (ConnectionError, TimeoutError):        # the socket timeout: REQUEST_TIMEOUT_S
                 raw = b""
             if len(raw) != n:
-                raise RequestError(HTTPStatus.BAD_REQUEST,
-                                   f"request body: {len(raw)} bytes arrived of Content-Length {n}")
+                raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: fewer bytes arrived than Content-Length "
+                                                           f"{n} within {REQUEST_TIMEOUT_S:g} s")
             return raw
 
         def _no_method(self):
@@ -568,7 +571,8 @@ class Server:
     def __init__(self, viewer: Viewer, port: int = 0, host: str = "127.0.0.1"):
         self.httpd = _HTTPServer((host, port), _handler(viewer))
         self.viewer = viewer
-        self.thread = threading.Thread(target=self.httpd.serve_forever, name="wirecheck-viewer", daemon=True)
+        self.thread = threading.Thread(target=self.httpd.serve_forever, kwargs={"poll_interval": POLL_S},
+                                       name="wirecheck-viewer", daemon=True)
 
     @property
     def url(self) -> str:
