@@ -284,3 +284,19 @@ def test_any_ops_give_a_frame_or_an_error_with_the_view_kept(tmp_path):
             assert viewer.view == before
 
     check()
+
+
+def test_an_internal_failure_is_one_line_on_stderr_and_the_server_goes_on(server, capsys, monkeypatch):
+    calls = []
+
+    def broken(v, timing=None):
+        calls.append(v)
+        raise RuntimeError("simulated bug")
+
+    monkeypatch.setattr(server.viewer, "frame_png", broken)
+    status, _, _ = _post(server, {"ops": []})
+    assert status is None and len(calls) == 1                       # the connection closed, unanswered
+    err = capsys.readouterr().err
+    assert err == "renderer: viewer: request from 127.0.0.1 failed: RuntimeError: simulated bug\n"
+    monkeypatch.undo()
+    assert _view(server)["frame"] == 1                               # and the next request is served
