@@ -54,8 +54,8 @@ import time
 from dataclasses import asdict, dataclass, replace
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
-from urllib.parse import urlsplit
 from importlib import resources
+from urllib.parse import urlsplit
 
 import numpy as np
 
@@ -241,7 +241,8 @@ class Viewer:
 
         ``{"op": "orbit"|"pan", "dx", "dy"}``, ``{"op": "dolly", "delta"}``,
         ``{"op": "set", "field", "value"}`` (:data:`FIELDS`), ``{"op": "step", "n"}``
-        (frames, wrapping), ``{"op": "reset"}``.
+        (frames, wrapping), ``{"op": "reset"}``. At most :data:`MAX_OPS` ops; an op
+        that would take the camera out of the float64 range is refused.
         """
         if not isinstance(ops, list):
             raise InputError(f"ops {_short(ops)}: expected a list")
