@@ -17,7 +17,10 @@ job). Each problem is one line of :class:`FramesError` (exit 2).
 from __future__ import annotations
 
 import json
+import os
+import stat
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +32,9 @@ from .export import JOB_KIND, JOB_VERSION, frame_name
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
+#: Entries walked under ``frames/`` before the walk stops: a job lists at most
+#: MAX_FRAMES frames per case, and links between folders must not make the walk unbounded.
+MAX_WALK = 200_000
 
 
 class FramesError(InputError):
@@ -44,17 +50,53 @@ class FramesError(InputError):
         return Exception.__str__(self)
 
 
+def file_problem(path: Path) -> str | None:
+    """Why ``path`` is not a regular file to read, in a phrase (``"missing"``, ``"a FIFO"``, ...); None if it is one.
+
+    Checked before any open: opening a FIFO named like a job's file would block
+    the run forever, and a folder or device is no file of a job.
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "a broken link" if os.path.islink(path) else "missing"
+    except OSError as exc:          # a link loop, a name too long
+        return f"unreadable ({exc.strerror or exc})"
+    if stat.S_ISREG(mode):
+        return None
+    kind = ("a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
+            "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else
+            "not a file")
+    return f"{kind}, not a regular file"
+
+
+def _no_duplicate_keys(pairs: list) -> dict:
+    """``json.loads``' object hook: a key given twice is a ValueError (JSON keeps the last one, silently)."""
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"key {key!r} given twice")
+        out[key] = value
+    return out
+
+
+def read_json(path: Path):
+    """The JSON of a job file (UTF-8, a BOM allowed); ValueError for a key given twice."""
+    return json.loads(Path(path).read_text(encoding="utf-8-sig"), object_pairs_hook=_no_duplicate_keys)
+
+
 def load_job(job_dir: Path) -> dict:
     """The manifest ``DIR/job.json``, checked; FramesError otherwise."""
     path = Path(job_dir) / "job.json"
     if not Path(job_dir).is_dir():
         raise FramesError([f"--candidate-frames {str(job_dir)!r}: not a directory: expected a job folder "
                            "written by 'crosscheck export'"])
+    problem = file_problem(path)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem}: expected a job folder written by 'crosscheck export'"])
     try:
-        job = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise FramesError([f"{path}: missing: expected a job folder written by 'crosscheck export'"]) from None
-    except (OSError, ValueError) as exc:
+        job = read_json(path)
+    except (OSError, ValueError, RecursionError) as exc:        # RecursionError: arrays nested 100,000 deep
         raise FramesError([f"{path}: unreadable ({exc}): expected the JSON 'crosscheck export' wrote"]) from None
     if not isinstance(job, dict) or job.get("kind") != JOB_KIND:
         raise FramesError([f"{path}: not a wirecheck frames job (kind {job.get('kind') if isinstance(job, dict) else None!r})"])
@@ -113,10 +155,14 @@ def _job_problem(job: dict) -> str | None:
             return f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}: expected counts"
     if not (isinstance(cases, list) and all(isinstance(c, dict) for c in cases)):
         return "cases: expected a list of the job's cases"
+    pairs = set()
     for c in cases:
         scene, case, w, h = c.get("scene"), c.get("case"), c.get("width"), c.get("height")
         if scene not in names or not (isinstance(case, str) and NAME_PATTERN.fullmatch(case)):
             return f"case {scene!r} / {case!r}: expected a scene of 'scenes' and a case name"
+        if (scene, case) in pairs:      # judged twice, it would count twice in the summary
+            return f"case {scene} / {case}: listed twice: expected each case once"
+        pairs.add((scene, case))
         if not (_is_int(w) and _is_int(h)):
             return f"case {scene} / {case}: width {w!r}, height {h!r}: expected integers"
         try:
@@ -130,17 +176,79 @@ def _job_problem(job: dict) -> str | None:
     return None
 
 
+class FrameProblem(ValueError):
+    """A frame file that is not an image the job asked for: the reason, in a phrase."""
+
+
+#: 16-bit grey samples at or above this are drawn: 128 / 255 of full scale, as 8-bit's 128
+#: (an 8-bit value x is 257 x in 16 bits, so 8- and 16-bit copies of one image read the same).
+THRESHOLD_16 = 128 * 257
+
+
 def read_png(path: Path, width: int, height: int) -> np.ndarray:
-    """``(H, W)`` bool: drawn where the luminance is >= 128; ValueError with the reason otherwise."""
+    """``(H, W)`` bool: drawn where the luminance over the rule's black background is >= 128.
+
+    One still PNG of the camera's size is expected; anything else is a
+    :class:`FrameProblem`. A pixel's luminance is Pillow's (ITU-R 601-2) of its
+    RGB, times its alpha (``A / 255``; palette transparency included): the
+    pixel as it shows over black, so a transparent pixel is never drawn. 16-bit
+    grey is read at its full scale (:data:`THRESHOLD_16`). The size is checked
+    before any pixel is decoded (a huge image costs nothing).
+    """
     from PIL import Image
 
-    with Image.open(path) as im:
-        im.load()
-        size = im.size
-        if size != (width, height):
-            raise ValueError(f"size {size[0]}x{size[1]}: expected {width}x{height} (the camera's)")
-        grey = np.asarray(im.convert("RGB").convert("L"))
-    return grey >= 128
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked next
+        with Image.open(path) as im:
+            if im.format != "PNG":
+                raise FrameProblem(f"a {im.format} image: expected a PNG")
+            if getattr(im, "n_frames", 1) != 1:
+                raise FrameProblem(f"an animated PNG of {im.n_frames} frames: expected one still image")
+            if im.size != (width, height):
+                raise FrameProblem(f"size {im.size[0]}x{im.size[1]}: expected {width}x{height} (the camera's)")
+            im.load()
+            if im.mode in ("I", "I;16", "I;16B", "I;16L"):          # 16-bit grey
+                return np.asarray(im).astype(np.int64) >= THRESHOLD_16
+            rgba = im.convert("RGBA")
+            grey = np.asarray(rgba.convert("RGB").convert("L")).astype(np.int64)
+            alpha = np.asarray(rgba)[..., 3].astype(np.int64)
+    return grey * alpha >= 128 * 255           # exact: grey >= 128 where opaque
+
+
+def _walk(frames_dir: Path) -> list[Path]:
+    """Every entry under ``frames_dir`` that is not a folder; links to folders followed, a link loop is not.
+
+    A folder is not entered again below itself (a loop); the walk stops with a
+    FramesError past :data:`MAX_WALK` entries. A folder that cannot be listed
+    is skipped: its listed frames are reported one by one.
+    """
+    out, n = [], 0
+    stack = [(frames_dir, frozenset())]
+    while stack:
+        folder, above = stack.pop()
+        try:
+            st = folder.stat()
+            key = (st.st_dev, st.st_ino)
+            if key in above:
+                continue
+            with os.scandir(folder) as it:
+                items = sorted(it, key=lambda e: e.name)
+        except OSError:
+            continue
+        for item in items:
+            n += 1
+            if n > MAX_WALK:
+                raise FramesError([f"{frames_dir}: more than {MAX_WALK:,} files and folders: expected the "
+                                   "job's frames (frames/<scene>/<case>/frame_NNNN.png)"])
+            try:
+                is_dir = item.is_dir()
+            except OSError:
+                is_dir = False
+            if is_dir:
+                stack.append((Path(item.path), above | {key}))
+            else:
+                out.append(Path(item.path))
+    return out
 
 
 def load_frames(job_dir: Path, job: dict) -> dict:
@@ -148,9 +256,10 @@ def load_frames(job_dir: Path, job: dict) -> dict:
     job_dir = Path(job_dir)
     frames_dir = job_dir / "frames"
     if not frames_dir.is_dir():
-        raise FramesError([f"{frames_dir}: missing: the renderer's frames go there "
+        problem = file_problem(frames_dir)
+        raise FramesError([f"{frames_dir}: {problem or 'a file, not a folder'}: the renderer's frames go there "
                            "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
-    found = {p.relative_to(job_dir).as_posix() for p in frames_dir.rglob("*") if p.is_file()}
+    found = {p.relative_to(job_dir).as_posix() for p in _walk(frames_dir)}
     if not found:
         raise FramesError([f"{frames_dir}: empty: expected the renderer's frames "
                            "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
@@ -167,12 +276,13 @@ def load_frames(job_dir: Path, job: dict) -> dict:
         for rel in c["frames"]:
             path = job_dir / rel
             k = int(Path(rel).stem.split("_")[-1])
-            if rel not in found:
-                problems.append(f"{path}: missing (frame {k} of {c['scene']} / {c['case']})")
+            problem = file_problem(path)
+            if problem is not None:
+                problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
                 continue
             try:
                 images.append((k, read_png(path, c["width"], c["height"])))
-            except ValueError as exc:
+            except FrameProblem as exc:
                 problems.append(f"{path}: {exc}")
             except Exception as exc:       # Pillow's many ways to say "not an image"
                 problems.append(f"{path}: unreadable as PNG ({type(exc).__name__}: {exc})")
@@ -189,6 +299,9 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     finite coordinates, 2 indices of vertices before it.
     """
     verts, edges = [], []
+    problem = file_problem(path)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem}: expected the OBJ 'crosscheck export' wrote"])
     try:
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
@@ -214,15 +327,16 @@ def _frame_camera(path: Path):
     """``(camera, model_matrix (4, 4))`` of a frame's JSON; FramesError naming the file otherwise."""
     from wirecheck.core.camera import Camera
 
+    problem = file_problem(path)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])
     try:
-        cam_json = json.loads(path.read_text(encoding="utf-8"))
+        cam_json = read_json(path)
         camera = Camera(**cam_json["camera"])
         m = np.asarray(cam_json["model_matrix"], dtype=np.float64)
         if m.shape != (4, 4) or not np.all(np.isfinite(m)):
             raise ValueError(f"model_matrix of shape {m.shape}: expected 4x4 finite numbers")
-    except FileNotFoundError:
-        raise FramesError([f"{path}: missing: expected the camera 'crosscheck export' wrote"]) from None
-    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, OverflowError, RecursionError) as exc:
         what = f"no {exc}" if isinstance(exc, KeyError) else str(exc)
         raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {what}): expected the camera JSON "
                            "'crosscheck export' wrote"]) from None
@@ -238,7 +352,14 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int):
     if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
         raise FramesError([f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
                            f"{row['edges']} (job.json's; the file was changed or cut short)"])
-    camera, m = _frame_camera(job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}")
+    path = job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}"
+    camera, m = _frame_camera(path)
+    c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
+    if (camera.width, camera.height) != (c["width"], c["height"]):     # the frames were read at the job's size
+        size = f"{camera.width}x{camera.height}"
+        raise FramesError([f"{path}: camera {size[:40]}{'...' if len(size) > 40 else ''}: expected "
+                           f"{c['width']}x{c['height']} "
+                           f"(job.json's size of {scene} / {case}; export the job again)"])
     return p_model, edges, camera, m
 
 

@@ -1,0 +1,235 @@
+"""Hostile inputs of ``crosscheck --candidate-frames DIR`` and of dataset runs: one line, exit 2, never a hang.
+
+Each test is a finding of an attack on those inputs (frame PNGs of every
+colour type, files that are not regular files, links, hand-edited JSON, scene
+lists written on other systems) and failed before its fix. Expected masks are
+derived by hand from the image rule (docs/frames.md): a pixel is drawn when its
+luminance over the black background, ``L * A / 255``, is at least 128.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import signal
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from wirecheck.oracles import cli as crosscheck_cli
+from wirecheck.oracles.frames_candidate import FrameProblem, FramesError, frame_inputs, load_frames, load_job, read_png
+
+
+def assert_one_error_line(rc, err, *needles):
+    assert rc == 2, err
+    assert err.count("\n") == 1 and err.startswith("crosscheck: error: "), err
+    assert "Traceback" not in err
+    for n in needles:
+        assert n in err, (n, err)
+
+
+@contextlib.contextmanager
+def no_block(seconds=5):
+    """Fail (instead of hanging the suite) when the block blocks: opening a FIFO waits for a writer forever."""
+    def expire(*_):
+        raise TimeoutError(f"blocked for {seconds} s (a FIFO opened?)")
+    old = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+# ---- one frame PNG: what is read as drawn ------------------------------------------------------
+
+def _png(tmp_path, array, mode=None, **save):
+    path = tmp_path / "f.png"
+    Image.fromarray(array, mode).save(path, **save) if mode else Image.fromarray(array).save(path, **save)
+    return path
+
+
+def test_16_bit_grey_is_read_at_its_full_scale(tmp_path):
+    """128/255 of full scale is 128 * 257 = 32896 in 16 bits. Before, Pillow's conversion clipped 16-bit
+    values to 255, so a background of 256 (0.4 % grey, black to the eye) was drawn everywhere."""
+    values = np.array([[0, 256, 32895, 32896, 65535]], np.uint16)
+    assert read_png(_png(tmp_path, values), 5, 1).tolist() == [[False, False, False, True, True]]
+
+
+def test_alpha_is_composited_over_the_black_background(tmp_path):
+    """White (L = 255) at alpha A shows as 255 * A / 255 = A over black: drawn when A >= 128. Before, alpha was
+    dropped: a white image with a transparent background read as drawn everywhere."""
+    rgba = np.zeros((1, 5, 4), np.uint8)
+    rgba[..., :3] = 255
+    rgba[0, :, 3] = [0, 127, 128, 255, 0]
+    rgba[0, 4] = [0, 0, 0, 255]                         # opaque black: not drawn
+    assert read_png(_png(tmp_path, rgba, "RGBA"), 5, 1).tolist() == [[False, False, True, True, False]]
+    la = np.array([[[255, 0], [255, 255], [100, 255]]], np.uint8)      # grey 100 < 128 even opaque
+    assert read_png(_png(tmp_path, la, "LA"), 3, 1).tolist() == [[False, True, False]]
+
+
+def test_palette_transparency_counts_as_alpha(tmp_path):
+    """Index 1 is white but listed transparent (tRNS): not drawn. Before, it read as drawn."""
+    im = Image.new("P", (3, 1))
+    im.putpalette([0, 0, 0, 255, 255, 255, 255, 255, 255])
+    im.putdata([0, 1, 2])
+    path = tmp_path / "p.png"
+    im.save(path, transparency=1)
+    assert read_png(path, 3, 1).tolist() == [[False, False, True]]
+
+
+def test_one_bit_and_opaque_grey_read_as_before(tmp_path):
+    """Opaque images keep the plain rule, L >= 128 (the composite is exact at A = 255)."""
+    assert read_png(_png(tmp_path, np.array([[False, True]])), 2, 1).tolist() == [[False, True]]
+    assert read_png(_png(tmp_path, np.array([[127, 128]], np.uint8)), 2, 1).tolist() == [[False, True]]
+
+
+@pytest.mark.parametrize("fmt", ["JPEG", "GIF", "BMP", "TIFF"])
+def test_another_format_named_png_is_refused(tmp_path, fmt):
+    """JPEG is lossy (ringing turns pixels on near a line): the job asks for PNG. Before, any format Pillow
+    reads was judged."""
+    path = tmp_path / "f.png"
+    Image.new("L", (4, 4)).save(path, format=fmt)
+    with pytest.raises(FrameProblem, match=f"a {fmt} image: expected a PNG"):
+        read_png(path, 4, 4)
+
+
+def test_an_animated_png_is_refused(tmp_path):
+    """Which of its frames is the frame? Before, the first was judged silently."""
+    path = tmp_path / "f.png"
+    Image.new("L", (4, 4)).save(path, save_all=True, append_images=[Image.new("L", (4, 4), 255)])
+    with pytest.raises(FrameProblem, match="an animated PNG of 2 frames: expected one still image"):
+        read_png(path, 4, 4)
+
+
+# ---- a job on disk -----------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def blank_job(tmp_path_factory):
+    """cube / on_axis, frames 1 and 3 of 4, black 640x480 PNGs (judged: exit 1, tests/test_hostile.py)."""
+    job = tmp_path_factory.mktemp("job") / "job"
+    assert crosscheck_cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "4",
+                                "--every", "2"]) == 0
+    (job / "frames/cube/on_axis").mkdir(parents=True)
+    for k in (1, 3):
+        Image.new("L", (640, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
+    return job
+
+
+@pytest.fixture
+def job(blank_job, tmp_path):
+    d = tmp_path / "job"
+    shutil.copytree(blank_job, d)
+    return d
+
+
+def judge(job, tmp_path, capsys):
+    with no_block():
+        rc = crosscheck_cli.main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert not (tmp_path / "r").exists()
+    return rc, err
+
+
+FRAME = "frames/cube/on_axis/frame_0001.png"
+
+
+@pytest.mark.parametrize("make, needle", [
+    (lambda p: os.mkfifo(p), "a FIFO, not a regular file"),
+    (lambda p: p.mkdir(), "a folder, not a regular file"),
+    (lambda p: p.symlink_to("/dev/null"), "a device, not a regular file"),
+    (lambda p: p.symlink_to(p.parent / "nowhere.png"), "a broken link"),
+])
+def test_a_frame_that_is_not_a_regular_file_is_named_so(job, tmp_path, capsys, make, needle):
+    """Before: each read 'missing', which sends the user looking for a file that is there."""
+    (job / FRAME).unlink()
+    make(job / FRAME)
+    rc, err = judge(job, tmp_path, capsys)
+    assert_one_error_line(rc, err, f"{job / FRAME}: {needle} (frame 1 of cube / on_axis)")
+
+
+@pytest.mark.parametrize("rel, needle", [
+    ("cameras/cube/on_axis/frame_0001.json", "a FIFO, not a regular file: expected the camera"),
+    ("scenes/cube.obj", "a FIFO, not a regular file: expected the OBJ"),
+    ("job.json", "a FIFO, not a regular file: expected a job folder"),
+])
+def test_a_fifo_in_place_of_a_job_file_never_blocks(job, tmp_path, capsys, rel, needle):
+    """Before: the run opened the FIFO and waited for a writer forever."""
+    (job / rel).unlink()
+    os.mkfifo(job / rel)
+    rc, err = judge(job, tmp_path, capsys)
+    assert_one_error_line(rc, err, f"{job / rel}: {needle}")
+
+
+def test_frames_folder_that_is_a_link_loop(job, tmp_path, capsys):
+    shutil.rmtree(job / "frames")
+    (job / "frames").symlink_to(job / "loop")
+    (job / "loop").symlink_to(job / "frames")
+    rc, err = judge(job, tmp_path, capsys)          # before: "frames: missing"
+    assert_one_error_line(rc, err, f"{job / 'frames'}: unreadable (Too many levels of symbolic links)")
+
+
+def test_frames_under_a_linked_folder_are_found_and_loops_end(job, tmp_path):
+    """frames/cube links to the renderer's output folder elsewhere; a link inside it points back up (a loop).
+    Before: 'frames: empty' (the walk did not follow links to folders) though every frame opens."""
+    shutil.move(job / "frames/cube", tmp_path / "out")
+    (job / "frames/cube").symlink_to(tmp_path / "out")
+    (tmp_path / "out/on_axis/up").symlink_to(tmp_path / "out")
+    frames = load_frames(job, load_job(job))
+    assert [k for k, _ in frames[("cube", "on_axis")]] == [1, 3]
+
+
+def _edit_job(job, edit):
+    data = json.loads((job / "job.json").read_text())
+    edit(data)
+    (job / "job.json").write_text(json.dumps(data))
+
+
+def test_a_case_listed_twice_is_refused(job, tmp_path, capsys):
+    """Before: judged twice and counted twice ('PASS: 2/2 cases')."""
+    _edit_job(job, lambda d: d["cases"].append(d["cases"][0]))
+    rc, err = judge(job, tmp_path, capsys)
+    assert_one_error_line(rc, err, "job.json: case cube / on_axis: listed twice: expected each case once")
+
+
+def test_job_size_edited_to_fit_the_frames_is_refused(job, tmp_path, capsys):
+    """job.json says 320 wide, the camera 640; frames cut to 320 pass the size check. Before: exit 3
+    ('image shapes differ') when the oracle's 640-wide frame met them."""
+    _edit_job(job, lambda d: d["cases"][0].update(width=320))
+    for k in (1, 3):
+        Image.new("L", (320, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
+    rc, err = judge(job, tmp_path, capsys)
+    assert_one_error_line(rc, err, "cameras/cube/on_axis/frame_0001.json: camera 640x480: expected 320x480")
+
+
+def test_a_camera_width_beyond_64_bits_is_one_line(job, tmp_path, capsys):
+    """Before: exit 3 (OverflowError: Python int too large to convert to C long) when GL was asked for it."""
+    path = job / "cameras/cube/on_axis/frame_0001.json"
+    cam = json.loads(path.read_text())
+    cam["camera"]["width"] = 10 ** 400
+    path.write_text(json.dumps(cam))
+    rc, err = judge(job, tmp_path, capsys)
+    assert_one_error_line(rc, err, f"{path}: camera 1{'0' * 39}...: expected 640x480 (job.json's size")
+
+
+def test_a_key_given_twice_is_refused_and_a_bom_is_read(job, tmp_path, capsys):
+    """JSON keeps the last of two equal keys, silently: an edit above the original would be ignored."""
+    text = (job / "job.json").read_text()
+    (job / "job.json").write_text('{"every": 1,' + text.lstrip()[1:])
+    rc, err = judge(job, tmp_path, capsys)
+    assert_one_error_line(rc, err, "job.json: unreadable (key 'every' given twice)")
+    (job / "job.json").write_bytes(b"\xef\xbb\xbf" + text.encode())      # a Windows editor's BOM
+    assert load_job(job)["every"] == 2                                     # before: "Unexpected UTF-8 BOM"
+
+
+def test_frame_inputs_of_the_blank_job_are_as_exported(blank_job):
+    """The fixtures above are a valid job: its camera is the 640x480 of job.json (the check does not misfire)."""
+    job = load_job(blank_job)
+    _p, _e, camera, m = frame_inputs(blank_job, job, "cube", "on_axis", 3)
+    assert (camera.width, camera.height) == (640, 480) and m.shape == (4, 4)
+    with pytest.raises(FramesError):
+        frame_inputs(blank_job, {**job, "cases": [{**job["cases"][0], "height": 479}]}, "cube", "on_axis", 3)
