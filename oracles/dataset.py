@@ -14,19 +14,23 @@ load (the run reports it like an unreadable mesh, it is not silently skipped).
 
 A scene list is UTF-8 text, one path per line; blank lines and lines whose
 first non-blank character is ``#`` are ignored; relative paths are relative
-to the list's folder. Every entry must name a mesh file by its suffix; one
-that does not exist is a load error of the run (a moved file in a long list),
-one listed twice is a usage error.
+to the list's folder (so a list moves with its meshes; a list read from a pipe,
+``<(find ...)``, needs absolute paths); a UTF-8 byte-order mark and CRLF line
+ends are read. Every entry must name a mesh file by its suffix; one that does
+not exist is a load error of the run (a moved file in a long list), one listed
+twice (by another spelling, or a link to it) is a usage error.
 
 Names: a mesh is named by its path relative to the folder given
 (``chairs/a.obj``; with several folders, prefixed by the folder as given),
-or as written in the list; names are unique within a dataset
+or as written in the list, made one printable line (:func:`printable`: a file
+name may hold a newline or an ESC); names are unique within a dataset
 (``dataset_entries`` refuses two inputs that yield one name).
 """
 
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -56,9 +60,16 @@ class Dataset:
         return {"sources": list(self.sources), "meshes": len(self.entries), "other_files": self.other_files}
 
 
+#: Control characters (C0, DEL, C1): legal in a Linux file name, but a newline would split a
+#: report line in two and an ESC would drive the user's terminal.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
+
+
 def printable(name: str) -> str:
-    """``name`` with the bytes of a non-UTF-8 file name (surrogates from os) as ``\\xNN`` escapes."""
-    return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    """``name`` as one line of text: a non-UTF-8 file name's bytes (surrogates from os) and control
+    characters (a newline, a tab, an ESC) as backslash escapes (``\\xfe``, ``\\n``, ``\\x1b``)."""
+    text = name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), text)
 
 
 def is_mesh_file(name: str) -> bool:
@@ -107,7 +118,7 @@ def walk_folder(root: Path) -> tuple[list[MeshEntry], int]:
 def read_list(list_path: Path) -> list[MeshEntry]:
     """The entries of a scene list; InputError (with FILE:LINE) for a line that names no mesh file."""
     try:
-        text = list_path.read_text(encoding="utf-8")
+        text = list_path.read_text(encoding="utf-8-sig")      # a BOM (Windows editors) is not part of line 1
     except UnicodeDecodeError as exc:
         raise InputError(f"--scene-list {str(list_path)!r}: not UTF-8 text ({exc.reason} at byte {exc.start}): "
                          "expected one path per line") from None
@@ -127,10 +138,11 @@ def read_list(list_path: Path) -> list[MeshEntry]:
                              f"{' '.join(MESH_SUFFIXES)} (folders go in --scene DIR)")
         path = Path(line) if Path(line).is_absolute() else base / line
         key = os.path.normpath(os.path.abspath(path))
-        if key in lines:
-            raise InputError(f"{list_path}:{lineno}: {line!r}: listed twice (line {lines[key]}): "
-                             "expected each mesh once")
-        lines[key] = lineno
+        same = os.path.realpath(key)            # a link to a mesh already listed is that mesh
+        if same in lines:
+            raise InputError(f"{list_path}:{lineno}: {line!r}: listed twice (line {lines[same]}"
+                             f"{'' if same == key else ', through a link'}): expected each mesh once")
+        lines[same] = lineno
         entries.append(MeshEntry(name=os.path.normpath(line), path=key))
     return entries
 

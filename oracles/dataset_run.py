@@ -29,7 +29,7 @@ import os
 import time
 from pathlib import Path
 
-from wirecheck.core.errors import InputError
+from wirecheck.core.errors import InputError, one_line
 
 from . import gate
 from .core_candidate import CoreCandidate, RenderMode
@@ -65,7 +65,9 @@ def _load(entry: MeshEntry):
         scene = load_mesh_file(Path(entry.path))
     except Exception as exc:         # any reader's failure is this mesh's, never the run's end
         text = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
-        raise InputError(text.replace(f"{entry.path}: ", "").replace(entry.path, entry.name)) from None
+        for path in (entry.path, one_line(entry.path)):        # as the reader wrote it, or made one line
+            text = text.replace(f"{path}: ", "").replace(path, entry.name)
+        raise InputError(text) from None
     return dataclasses.replace(scene, name=entry.name, source=entry.name)
 
 

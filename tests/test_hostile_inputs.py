@@ -233,3 +233,49 @@ def test_frame_inputs_of_the_blank_job_are_as_exported(blank_job):
     assert (camera.width, camera.height) == (640, 480) and m.shape == (4, 4)
     with pytest.raises(FramesError):
         frame_inputs(blank_job, {**job, "cases": [{**job["cases"][0], "height": 479}]}, "cube", "on_axis", 3)
+
+
+# ---- datasets: --scene DIR, --scene-list FILE ---------------------------------------------------
+
+TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+
+
+def test_a_scene_list_with_a_bom_and_crlf_lines(tmp_path):
+    """A list saved by a Windows editor. Before: line 1 named '\\ufeffa.obj' (file not found)."""
+    from wirecheck.oracles.dataset import read_list
+
+    (tmp_path / "a.obj").write_text(TRI)
+    (tmp_path / "b.obj").write_text(TRI)
+    (tmp_path / "set.txt").write_bytes(b"\xef\xbb\xbfa.obj\r\n\r\n  # comment\r\nb.obj\r\n")
+    entries = read_list(tmp_path / "set.txt")
+    assert [(e.name, e.path) for e in entries] == [("a.obj", str(tmp_path / "a.obj")),
+                                                  ("b.obj", str(tmp_path / "b.obj"))]
+
+
+def test_a_mesh_listed_again_through_a_link_is_refused(tmp_path):
+    """Before: checked and counted twice (PASS: 2/2 meshes for one mesh)."""
+    from wirecheck.core.errors import InputError
+    from wirecheck.oracles.dataset import read_list
+
+    (tmp_path / "a.obj").write_text(TRI)
+    (tmp_path / "b.obj").symlink_to(tmp_path / "a.obj")
+    (tmp_path / "set.txt").write_text("a.obj\nb.obj\n")
+    with pytest.raises(InputError, match=r"set.txt:2: 'b.obj': listed twice \(line 1, through a link\)"):
+        read_list(tmp_path / "set.txt")
+
+
+def test_control_characters_in_mesh_names_are_escaped(tmp_path, capsys):
+    """Linux file names may hold a newline, a tab or an ESC. Before, they went raw into stdout and the reports:
+    a name split a summary line in two, and '\\x1b[31m' recoloured the user's terminal."""
+    (tmp_path / "d").mkdir()
+    (tmp_path / "d/a\nb.obj").write_text("v 1\n")                 # unreadable: named in 'Could not be loaded'
+    (tmp_path / "d/ok.obj").write_text(TRI)
+    (tmp_path / "d/c\x1b[31m.obj").write_text(TRI)
+    rc = crosscheck_cli.main(["--scene", str(tmp_path / "d"), "--level", "vertices", "--frames", "1",
+                              "--cases", "on_axis", "--report-dir", str(tmp_path / "r")])
+    out = capsys.readouterr().out
+    assert rc == 1 and "\x1b" not in out
+    assert "  a\\nb.obj: line 1: vertex 'v 1': expected 'v X Y Z' (3 numbers)\n" in out      # path stripped
+    assert "  c\\x1b[31m.obj / on_axis: pass" in out
+    report = json.loads((tmp_path / "r" / "report.json").read_text())
+    assert sorted(m["mesh"] for m in report["meshes"]) == ["a\\nb.obj", "c\\x1b[31m.obj", "ok.obj"]
