@@ -58,7 +58,7 @@ CONVENTIONS = {
 IMAGE_RULE = {
     "wireframe": "PNG, the camera's width x height, black background, every visible edge as a 1-px aliased "
                  "white line (no anti-aliasing, no line smoothing); a pixel counts as drawn when its "
-                 "luminance is >= 128",
+                 "luminance over black is >= 128 (luminance x alpha / 255; a transparent pixel is not drawn)",
 }
 
 
@@ -175,7 +175,8 @@ worst frames, and, when something is off, the name of the fault
 
 `frames/<scene>/<case>/frame_NNNN.png`, the same numbers as the camera files,
 e.g. `{first['frames'][0]}` ({first['width']} x {first['height']}). Every
-listed frame must be there, at its camera's size. PNG, 8-bit grey or RGB(A).
+listed frame must be there, at its camera's size: one still PNG (8- or
+16-bit grey, RGB, RGBA or palette; no JPEG renamed, no animated PNG).
 
 ## Anti-aliasing
 
