@@ -268,15 +268,37 @@ def mp4_bytes(images: list[np.ndarray], fps: int = 30) -> bytes:
 MARKER = ".wirecheck-output"
 
 
+def _users_frames(path: Path) -> str | None:
+    """The first entry of a frames job's ``frames/`` (``crosscheck export``), which the user's renderer fills; None if none.
+
+    The job is an output of ours, but what its ``frames/`` holds is not: the
+    job is not replaced while that folder holds anything.
+    """
+    frames = path / "frames"
+    if not ((path / "job.json").is_file() and frames.is_dir() and not frames.is_symlink()):
+        return "frames (a link)" if frames.is_symlink() else None
+    with os.scandir(frames) as it:
+        first = next(it, None)
+    return None if first is None else f"frames/{first.name}"
+
+
 def check_replaceable(path: Path, option: str) -> None:
-    """InputError unless ``path`` is absent, an empty directory, or an earlier output of ours."""
+    """InputError unless ``path`` is absent, an empty directory, or an earlier output of ours.
+
+    A frames job whose ``frames/`` the renderer has filled is not replaced (:func:`_users_frames`).
+    """
     from .errors import InputError
 
     path = Path(path)
     if not path.exists() and not path.is_symlink():
         return
     if path.is_dir() and not path.is_symlink() and ((path / MARKER).is_file() or not any(path.iterdir())):
-        return
+        drawn = _users_frames(path) if (path / MARKER).is_file() else None
+        if drawn is None:
+            return
+        raise InputError(f"{option} {str(path)!r} is a frames job holding files a renderer wrote ({drawn}): "
+                         "expected a new path or an earlier wirecheck output (nothing was changed; "
+                         "move the frames away first)")
     kind = "a directory not written by wirecheck" if path.is_dir() else "a file"
     raise InputError(f"{option} {str(path)!r} is {kind}: expected a new path or an earlier wirecheck "
                      "output (nothing was changed; move it away first)")

@@ -103,6 +103,11 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     if given:
         return _fail(f"--candidate-frames with {', '.join(given)}: the job fixes scenes, cases and frames, and "
                      "its frames are drawn already: expected only --tol/--min-f1 options, --run or --report-dir")
+    job_dir = Path(args.candidate_frames)
+    job_real, run_real = job_dir.resolve(), Path(run_dir).resolve()
+    if run_real == job_real or job_real in run_real.parents or run_real in job_real.parents:
+        return _fail(f"--report-dir {str(run_dir)!r} and the job {str(job_dir)!r} overlap: the job holds the "
+                     "renderer's frames and is only read: expected a report folder outside the job")
     tol = Tolerances(min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
     try:
         report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous)

@@ -235,6 +235,44 @@ def test_frame_inputs_of_the_blank_job_are_as_exported(blank_job):
         frame_inputs(blank_job, {**job, "cases": [{**job["cases"][0], "height": 479}]}, "cube", "on_axis", 3)
 
 
+# ---- the job is read, never written ------------------------------------------------------------
+
+def _tree(folder):
+    return sorted((str(p.relative_to(folder)), p.is_file() and p.read_bytes()) for p in folder.rglob("*"))
+
+
+@pytest.mark.parametrize("argv", [
+    lambda job, tmp: ["--candidate-frames", str(job), "--report-dir", str(job)],
+    lambda job, tmp: ["--level", "vertices", "--frames", "1", "--cases", "on_axis", "--report-dir", str(job)],
+    lambda job, tmp: ["export", str(job), "--scene", "cube", "--cases", "on_axis"],
+])
+def test_a_job_with_drawn_frames_is_never_replaced(job, tmp_path, capsys, argv):
+    """The job carries wirecheck's output marker (export wrote it), but frames/ holds the renderer's files.
+    Before: each command replaced the whole job by its own output, deleting the renderer's frames."""
+    before = _tree(job)
+    rc = crosscheck_cli.main(argv(job, tmp_path))
+    assert_one_error_line(rc, capsys.readouterr().err,
+                          f"'{job}' is a frames job holding files a renderer wrote (frames/cube)")
+    assert _tree(job) == before
+
+
+@pytest.mark.parametrize("inside", ["frames/new", "scenes/x"])
+def test_a_report_inside_the_job_is_refused(job, tmp_path, capsys, inside):
+    """Before: written there (exit 0); in frames/ it made the next judgement fail ('not a frame of this job')."""
+    before = _tree(job)
+    rc = crosscheck_cli.main(["--candidate-frames", str(job), "--report-dir", str(job / inside)])
+    assert_one_error_line(rc, capsys.readouterr().err, f"--report-dir '{job / inside}' and the job '{job}' overlap")
+    assert _tree(job) == before
+
+
+def test_an_exported_job_not_yet_drawn_is_still_exported_again(job, capsys):
+    """The refusal above needs drawn frames: an earlier export with an empty frames/ is replaced, as documented."""
+    shutil.rmtree(job / "frames")
+    (job / "frames").mkdir()
+    assert crosscheck_cli.main(["export", str(job), "--scene", "pyramid", "--cases", "on_axis", "--frames", "1"]) == 0
+    assert [s["name"] for s in load_job(job)["scenes"]] == ["pyramid"]
+
+
 # ---- datasets: --scene DIR, --scene-list FILE ---------------------------------------------------
 
 TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
