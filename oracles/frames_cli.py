@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -104,10 +105,14 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
         return _fail(f"--candidate-frames with {', '.join(given)}: the job fixes scenes, cases and frames, and "
                      "its frames are drawn already: expected only --tol/--min-f1 options, --run or --report-dir")
     job_dir = Path(args.candidate_frames)
-    job_real, run_real = job_dir.resolve(), Path(run_dir).resolve()
-    if run_real == job_real or job_real in run_real.parents or run_real in job_real.parents:
-        return _fail(f"--report-dir {str(run_dir)!r} and the job {str(job_dir)!r} overlap: the job holds the "
-                     "renderer's frames and is only read: expected a report folder outside the job")
+    # os.path.realpath: unlike Path.resolve() in 3.11, no RuntimeError for a link loop (judged later)
+    job_real, frames_real, run_real = (Path(os.path.realpath(p)) for p in (job_dir, job_dir / "frames", run_dir))
+    if run_real == job_real or job_real in run_real.parents and (run_real == frames_real
+                                                                 or frames_real in run_real.parents):
+        # the job's own folder or its frames/ (the renderer's files, which a later judgement reads):
+        # never written; a report elsewhere in the job (reports/ when run from inside it) is harmless
+        return _fail(f"report folder {str(run_dir)!r}: the job {str(job_dir)!r} itself or its frames/ "
+                     "(the renderer's files, only read): expected a report folder outside them")
     tol = Tolerances(min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
     try:
         report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous)

@@ -256,13 +256,17 @@ def test_a_job_with_drawn_frames_is_never_replaced(job, tmp_path, capsys, argv):
     assert _tree(job) == before
 
 
-@pytest.mark.parametrize("inside", ["frames/new", "scenes/x"])
-def test_a_report_inside_the_job_is_refused(job, tmp_path, capsys, inside):
-    """Before: written there (exit 0); in frames/ it made the next judgement fail ('not a frame of this job')."""
+def test_a_report_in_the_frames_folder_is_refused(job, tmp_path, capsys, monkeypatch):
+    """Before: written there (exit 0), which made the next judgement fail ('not a frame of this job').
+    A report elsewhere in the job (reports/RUN when run from inside it) is harmless and still written."""
     before = _tree(job)
-    rc = crosscheck_cli.main(["--candidate-frames", str(job), "--report-dir", str(job / inside)])
-    assert_one_error_line(rc, capsys.readouterr().err, f"--report-dir '{job / inside}' and the job '{job}' overlap")
+    rc = crosscheck_cli.main(["--candidate-frames", str(job), "--report-dir", str(job / "frames/new")])
+    assert_one_error_line(rc, capsys.readouterr().err,
+                          f"report folder '{job / 'frames/new'}': the job '{job}' itself or its frames/")
     assert _tree(job) == before
+    monkeypatch.chdir(job)
+    assert crosscheck_cli.main(["--candidate-frames", ".", "--run", "r"]) == 1      # black frames: a fail
+    assert (job / "reports/r/report.json").is_file()
 
 
 def test_an_exported_job_not_yet_drawn_is_still_exported_again(job, capsys):
