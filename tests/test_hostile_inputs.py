@@ -183,6 +183,20 @@ def test_frames_under_a_linked_folder_are_found_and_loops_end(job, tmp_path):
     assert [k for k, _ in frames[("cube", "on_axis")]] == [1, 3]
 
 
+def test_the_frames_walk_is_bounded(job, monkeypatch):
+    """Links between folders can make a tree of any size (two links to one folder in each of n folders:
+    2**n paths); the walk stops at MAX_WALK entries. Here 4 entries are the job's (cube, on_axis, 2 frames):
+    the bound at 4 passes, and two links to on_axis (each seen with its 2 frames: 6 more) pass it."""
+    from wirecheck.oracles import frames_candidate
+
+    monkeypatch.setattr(frames_candidate, "MAX_WALK", 4)
+    assert len(load_frames(job, load_job(job))[("cube", "on_axis")]) == 2
+    for name in ("a", "b"):
+        (job / "frames" / name).symlink_to(job / "frames/cube/on_axis")
+    with pytest.raises(FramesError, match=r"frames: more than 4 files and folders: expected the job's frames"):
+        load_frames(job, load_job(job))
+
+
 def _edit_job(job, edit):
     data = json.loads((job / "job.json").read_text())
     edit(data)
