@@ -112,7 +112,9 @@ def load_config(path: Path | None = None, start: Path | None = None) -> Config:
         return Config()
     try:
         with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+            # a UTF-8 byte-order mark (Windows editors) is not TOML: tomllib's message for it is
+            # "Invalid statement (at line 1, column 1)", which points nowhere useful
+            data = tomllib.loads(fh.read().decode("utf-8-sig"))
     except FileNotFoundError:
         raise InputError(f"{path}: file not found: expected a pyproject.toml with a [{TABLE}] table") from None
     except IsADirectoryError:
@@ -121,6 +123,9 @@ def load_config(path: Path | None = None, start: Path | None = None) -> Config:
         raise InputError(f"{path}: could not be read: {exc}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:           # tomllib recurses per nested array or inline table
+        raise InputError(f"{path}: not valid TOML here: arrays or tables nested too deep for the "
+                         "reader: expected the settings of docs (a few levels at most)") from None
     table = data.get("tool", {}).get("wirecheck") if isinstance(data.get("tool"), dict) else None
     if table is None:
         if explicit:

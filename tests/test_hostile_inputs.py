@@ -335,3 +335,23 @@ def test_control_characters_in_mesh_names_are_escaped(tmp_path, capsys):
     assert "  c\\x1b[31m.obj / on_axis: pass" in out
     report = json.loads((tmp_path / "r" / "report.json").read_text())
     assert sorted(m["mesh"] for m in report["meshes"]) == ["a\\nb.obj", "c\\x1b[31m.obj", "ok.obj"]
+
+
+# ---- [tool.wirecheck] in pyproject.toml --------------------------------------------------------
+
+def test_pyproject_nested_too_deep_is_one_line(tmp_path):
+    """Before: exit 3 (RecursionError from tomllib)."""
+    from wirecheck.core.errors import InputError
+    from wirecheck.oracles.config import load_config
+
+    (tmp_path / "pyproject.toml").write_text("[tool.wirecheck]\nframes = " + "[" * 50000 + "]" * 50000 + "\n")
+    with pytest.raises(InputError, match="pyproject.toml: not valid TOML here: arrays or tables nested too deep"):
+        load_config(start=tmp_path)
+
+
+def test_pyproject_with_a_bom_is_read(tmp_path):
+    """Before: 'not valid TOML: Invalid statement (at line 1, column 1)'."""
+    from wirecheck.oracles.config import load_config
+
+    (tmp_path / "pyproject.toml").write_bytes(b"\xef\xbb\xbf[tool.wirecheck]\nframes = 2\n")
+    assert load_config(start=tmp_path).values["frames"] == 2
