@@ -180,9 +180,10 @@ class FrameProblem(ValueError):
     """A frame file that is not an image the job asked for: the reason, in a phrase."""
 
 
-#: 16-bit grey samples at or above this are drawn: 128 / 255 of full scale, as 8-bit's 128
-#: (an 8-bit value x is 257 x in 16 bits, so 8- and 16-bit copies of one image read the same).
-THRESHOLD_16 = 128 * 257
+#: 16-bit grey samples at or above this are drawn: a high byte of 128 or more, as Pillow reads
+#: 16-bit RGB(A) (by its high byte), so every 16-bit colour type reads alike; an 8-bit value x
+#: is 257 x in 16 bits, whose high byte is x: 8- and 16-bit copies of one image read the same.
+THRESHOLD_16 = 128 << 8
 
 
 def read_png(path: Path, width: int, height: int) -> np.ndarray:

@@ -54,9 +54,10 @@ def _png(tmp_path, array, mode=None, **save):
 
 
 def test_16_bit_grey_is_read_at_its_full_scale(tmp_path):
-    """128/255 of full scale is 128 * 257 = 32896 in 16 bits. Before, Pillow's conversion clipped 16-bit
-    values to 255, so a background of 256 (0.4 % grey, black to the eye) was drawn everywhere."""
-    values = np.array([[0, 256, 32895, 32896, 65535]], np.uint16)
+    """Drawn when the high byte is >= 128, i.e. from 128 * 256 = 32768 (as Pillow reads 16-bit RGB). Before,
+    Pillow's conversion clipped 16-bit values to 255, so a background of 256 (0.4 % grey, black to the eye)
+    was drawn everywhere."""
+    values = np.array([[0, 256, 32767, 32768, 65535]], np.uint16)
     assert read_png(_png(tmp_path, values), 5, 1).tolist() == [[False, False, False, True, True]]
 
 
