@@ -209,11 +209,14 @@ def read_png(path: Path, width: int, height: int) -> np.ndarray:
                 raise FrameProblem(f"size {im.size[0]}x{im.size[1]}: expected {width}x{height} (the camera's)")
             im.load()
             if im.mode in ("I", "I;16", "I;16B", "I;16L"):          # 16-bit grey
-                return np.asarray(im).astype(np.int64) >= THRESHOLD_16
+                return np.asarray(im) >= THRESHOLD_16
+            if not (im.mode in ("RGBA", "LA", "PA", "RGBa", "La") or "transparency" in im.info):   # opaque
+                grey = im if im.mode == "L" else im.convert("RGB").convert("L")   # L, the usual: as it is
+                return np.asarray(grey) >= 128
             rgba = im.convert("RGBA")
-            grey = np.asarray(rgba.convert("RGB").convert("L")).astype(np.int64)
-            alpha = np.asarray(rgba)[..., 3].astype(np.int64)
-    return grey * alpha >= 128 * 255           # exact: grey >= 128 where opaque
+            grey = np.asarray(rgba.convert("RGB").convert("L"), dtype=np.uint16)
+            alpha = np.asarray(rgba.getchannel("A"), dtype=np.uint16)
+    return grey * alpha >= 128 * 255           # exact (at most 255 * 255 < 2**16): grey >= 128 where opaque
 
 
 def _walk(frames_dir: Path) -> list[Path]:

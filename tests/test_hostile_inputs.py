@@ -83,6 +83,14 @@ def test_palette_transparency_counts_as_alpha(tmp_path):
     assert read_png(path, 3, 1).tolist() == [[False, False, True]]
 
 
+def test_a_transparent_grey_value_counts_as_alpha(tmp_path):
+    """Grey PNG with a tRNS grey value (255 transparent): white reads as not drawn, 200 as drawn. The
+    opaque grey image has a fast path that must not skip this."""
+    path = tmp_path / "lt.png"
+    Image.fromarray(np.array([[255, 200, 0]], np.uint8)).save(path, transparency=255)
+    assert read_png(path, 3, 1).tolist() == [[False, True, False]]
+
+
 def test_one_bit_and_opaque_grey_read_as_before(tmp_path):
     """Opaque images keep the plain rule, L >= 128 (the composite is exact at A = 255)."""
     assert read_png(_png(tmp_path, np.array([[False, True]])), 2, 1).tolist() == [[False, True]]
