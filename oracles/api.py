@@ -25,6 +25,7 @@ pixels too.
 from __future__ import annotations
 
 from . import gate, tolerances
+from .caller_state import caller_state_kept
 from .isolation import api_candidate
 from .report import FAULT_HINTS, compared_text, fault_text, not_passed
 from .runner import run_crosscheck
@@ -98,9 +99,15 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     RuntimeError
         ``"pyrender"`` asked for but OSMesa is missing.
     """
+    func, cmd = _candidate_args(func, cmd)
+    _flag(allow_vacuous, "allow_vacuous")
+    if isolate is not None:
+        _flag(isolate, "isolate", "(or None: the default)")
+    timeout_s = _seconds(timeout_s)
+    oracles = _oracles(oracles)
     tol = Tolerances(tol_px, min_f1, min_f1_0px, precision=_precision(precision))
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)    # before any OpenGL set-up
-    with closing_started():                 # an isolated candidate's process ends with this check
+    with caller_state_kept(), closing_started():    # the caller's globals as they were; no process left
         name, func = api_candidate(func, cmd, timeout_s, isolate)
         if "pyrender" in oracles:
             from .pyrender_oracle import osmesa_available
@@ -112,6 +119,78 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
                                          oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
                                          allow_vacuous=allow_vacuous)
     return report
+
+
+def _candidate_args(func, cmd):
+    """``(func, cmd)`` checked: exactly one given, ``func`` a callable of two arguments or a spec string,
+    ``cmd`` a command string or a sequence of strings; TypeError/ValueError naming the argument otherwise."""
+    import inspect
+    import os
+
+    if func is None and cmd is None:
+        raise ValueError("no candidate: expected func (a callable or \"FILE.py:FUNC\") or cmd (a program)")
+    if func is not None and cmd is not None:
+        raise ValueError(f"func {_short(func)} and cmd {_short(cmd)}: expected one candidate, not both")
+    if cmd is not None:
+        if isinstance(cmd, (str, os.PathLike)):
+            return None, os.fspath(cmd)
+        argv = list(cmd) if isinstance(cmd, (list, tuple)) else None
+        if argv is None or not all(isinstance(a, (str, os.PathLike)) for a in argv):
+            raise TypeError(f"cmd {_short(cmd)}: expected a command line (str) or an argv list of str")
+        return None, [os.fspath(a) for a in argv]
+    if isinstance(func, str):
+        return func, None
+    if not callable(func):
+        raise TypeError(f"func {_short(func)}: expected a callable func(points, camera) or a \"FILE.py:FUNC\" / "
+                        "\"MODULE:FUNC\" string")
+    try:
+        signature = inspect.signature(func)
+    except (TypeError, ValueError):          # builtins and C callables without one: found out when called
+        return func, None
+    try:
+        signature.bind(None, None)
+    except TypeError:
+        name = getattr(func, "__qualname__", None) or _short(func)
+        raise TypeError(f"func {name}{signature} cannot be called as func(points, camera): expected "
+                        "the candidate contract (wirecheck.oracles.candidate)") from None
+    return func, None
+
+
+def _short(value) -> str:
+    """``repr(value)`` on one line, at most 80 characters."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _flag(value, name: str, extra: str = "") -> bool:
+    """A bool (numpy's too); TypeError otherwise: ``allow_vacuous="no"`` is truthy and would let nothing pass."""
+    import numpy as np
+
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} {_short(value)}: expected True or False{' ' + extra if extra else ''}")
+    return bool(value)
+
+
+def _seconds(timeout_s) -> float:
+    """``timeout_s`` as a finite float > 0; ValueError/TypeError naming it otherwise."""
+    import math
+    import numbers
+
+    if isinstance(timeout_s, bool) or not isinstance(timeout_s, numbers.Real):
+        raise TypeError(f"timeout_s {_short(timeout_s)}: expected a number of seconds > 0")
+    if not (math.isfinite(timeout_s) and timeout_s > 0):
+        raise ValueError(f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0")
+    return float(timeout_s)
+
+
+def _oracles(oracles) -> tuple:
+    """``oracles`` as a tuple of names; a string is one name or a comma-separated list (``"opencv,pyrender"``)."""
+    if isinstance(oracles, str):
+        return tuple(o.strip() for o in oracles.split(",") if o.strip())
+    if not isinstance(oracles, (list, tuple)) or not all(isinstance(o, str) for o in oracles):
+        raise TypeError(f"oracles {_short(oracles)}: expected a tuple of names among opencv, pyrender "
+                        "(\"opencv\": vertices; (\"opencv\", \"pyrender\"): pixels too)")
+    return tuple(oracles)
 
 
 def _precision(precision):

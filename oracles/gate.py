@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import os
 from dataclasses import dataclass
 
 from wirecheck.core.errors import InputError
@@ -78,9 +79,14 @@ def resolve_scenes(scenes, names: dict = API_NAMES) -> tuple:
             raise InputError(f"no bundled scenes found in {scene_files.SCENE_DIR}: the installation is incomplete "
                              f"(expected scenes/*.scene); name a scene file with {names['scenes']}")
         scenes = bundled
-    elif isinstance(scenes, (str, Scene)):
+    elif isinstance(scenes, (str, os.PathLike, Scene)):
         scenes = [scenes]
-    out = tuple(s if isinstance(s, Scene) else load_scene(str(s)) for s in scenes)
+    given = _listed(scenes, names["scenes"], "a scene name, a path or a Scene, or a list of them")
+    odd = [s for s in given if not isinstance(s, (str, os.PathLike, Scene))]
+    if odd:
+        raise InputError(f"{names['scenes']}: {odd[0]!r} ({type(odd[0]).__name__}): expected a scene name, "
+                         "a path or a Scene")
+    out = tuple(s if isinstance(s, Scene) else load_scene(os.fspath(s)) for s in given)
     if not out:
         raise InputError(f"{names['scenes']}: no scene given: expected at least one scene "
                          "(or none at all for every bundled scene)")
@@ -91,6 +97,13 @@ def resolve_scenes(scenes, names: dict = API_NAMES) -> tuple:
                              f"{s.source or '?'}): expected each scene once")
         seen[s.name] = s.source
     return out
+
+
+def _listed(values, name: str, expected: str) -> list:
+    """``list(values)``, or InputError naming ``name`` when it is not a collection (``scenes=42``)."""
+    if isinstance(values, (bytes, dict)) or not hasattr(values, "__iter__"):
+        raise InputError(f"{name} {values!r}: expected {expected}")
+    return list(values)
 
 
 #: Names for groups of cases, usable among case names: ``--cases default,calibrated``.
@@ -105,7 +118,8 @@ def resolve_cases(cases, names: dict = API_NAMES) -> tuple:
     name = names["cases"]
     if cases is None:
         return CASE_NAMES
-    given = [c.strip() for c in cases.split(",") if c.strip()] if isinstance(cases, str) else list(cases)
+    given = ([c.strip() for c in cases.split(",") if c.strip()] if isinstance(cases, str)
+             else _listed(cases, name, "a list of case names or a comma-separated string"))
     given = [member for c in given for member in (CASE_GROUPS.get(c, (c,)) if isinstance(c, str) else (c,))]
     bad = [c for c in given if not isinstance(c, str) or c not in ALL_CASE_NAMES]
     if bad or not given:
@@ -120,11 +134,11 @@ def resolve_cases(cases, names: dict = API_NAMES) -> tuple:
 def check_tolerances(tol, names: dict = API_NAMES) -> None:
     """A NaN tolerance would pass everything (no comparison with NaN is true): InputError."""
     v = tol.vertex_px
-    if not (isinstance(v, numbers.Real) and math.isfinite(v) and v >= 0):
+    if isinstance(v, bool) or not (isinstance(v, numbers.Real) and math.isfinite(v) and v >= 0):
         raise InputError(f"{names['vertex_px']} {v!r}: expected a finite number >= 0 (pixels)")
     for field in ("min_f1_1px", "min_f1_0px", "min_iou"):
         v = getattr(tol, field)
-        if not (isinstance(v, numbers.Real) and 0.0 <= v <= 1.0):
+        if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0.0 <= v <= 1.0):
             raise InputError(f"{names[field]} {v!r}: expected a number in [0, 1]")
 
 
