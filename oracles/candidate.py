@@ -127,10 +127,15 @@ class CandidateError(RuntimeError):
     """The candidate raised or returned something outside the contract."""
 
 
+#: Array kinds that numpy casts to float64 but that are not pixel coordinates.
+_KINDS = {"b": "booleans", "U": "strings", "S": "bytes", "M": "datetimes", "m": "time deltas", "V": "records"}
+
+
 def _as_pixels(out) -> np.ndarray:
     """The answer as a float64 array, or CandidateError: never a warning, never a silent cast.
 
     Complex values (numpy would drop the imaginary part with a ComplexWarning),
+    booleans, strings, datetimes and records (numpy would cast them to numbers),
     integers too large for a float, and objects whose ``__array__`` or
     ``__float__`` raise are contract violations.
     """
@@ -142,6 +147,9 @@ def _as_pixels(out) -> np.ndarray:
             if arr.dtype.kind == "c":
                 raise CandidateError(f"candidate returned complex numbers ({arr.dtype}): expected an (N, 2) "
                                      "real float array")
+            if arr.dtype.kind in "bUSMmV":     # would cast to numbers that are not pixels (True: 1.0, "3": 3.0)
+                raise CandidateError(f"candidate returned an array of {arr.dtype} ({_KINDS[arr.dtype.kind]}): "
+                                     "expected an (N, 2) float array")
             return arr.astype(np.float64)
     except CandidateError:
         raise
