@@ -3,7 +3,8 @@
 One ``<testcase classname=SCENE name=CAMERA>`` per case of the report; a case
 that did not pass gets a ``<failure>`` whose ``message`` is its faults and
 reasons on one line and whose text adds what to check for each fault
-(oracles.report.FAULT_HINTS). A case's ``note`` (what was not compared, and
+(oracles.report.FAULT_HINTS). Characters XML cannot hold are written as
+escapes (:func:`xml_safe`). A case's ``note`` (what was not compared, and
 why) is its testcase's property ``note`` and its ``<system-out>`` (the part
 most dashboards show). The ``time`` attributes are the only fields that
 change between runs of the same inputs (they come from the report's
@@ -14,6 +15,7 @@ and only a new path or an earlier file of ours is replaced.
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -23,6 +25,28 @@ from .report import FAULT_HINTS, fault_text, not_passed
 
 #: The root element's name: it marks a file as ours (one we may replace).
 SUITES_NAME = "wirecheck crosscheck"
+
+
+#: Characters XML 1.0 cannot hold, even escaped: C0 controls but tab, newline and carriage return;
+#: lone surrogates (a non-UTF-8 file name's bytes, decoded by Python with surrogateescape); U+FFFE, U+FFFF.
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def _escaped(match) -> str:
+    code = ord(match.group())
+    if 0xDC80 <= code <= 0xDCFF:         # surrogateescape: the file name's original byte
+        return f"\\x{code - 0xDC00:02x}"
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+
+
+def xml_safe(text: str) -> str:
+    """``text`` with each character XML cannot hold written as a Python escape (``\\x01``, ``\\xff``).
+
+    A scene, camera, candidate or reason may carry any character (a file
+    name's control characters or undecodable bytes); ElementTree would write
+    them as they are, and the file would not parse.
+    """
+    return _NOT_XML.sub(_escaped, text)
 
 
 def _seconds(timing: dict | None) -> float:
@@ -80,6 +104,10 @@ def junit_xml(report: dict) -> bytes:
             failure.text = failure_text(c)
         if c.get("note"):
             ET.SubElement(elem, "system-out").text = f"note: {c['note']}\n"
+    for elem in root.iter():
+        elem.attrib = {k: xml_safe(v) for k, v in elem.attrib.items()}
+        if elem.text:
+            elem.text = xml_safe(elem.text)
     ET.indent(root)
     return b'<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
 

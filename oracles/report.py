@@ -463,8 +463,9 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
                 out.write(name, data)
                 files.add(name)
         out.write("report.json", json_dumps(report).encode())
-        out.write("report.md", markdown(report, files).encode())
-        out.write("report.html", _html(report, shown, files).encode())
+        # a name from a non-UTF-8 file name holds its bytes as lone surrogates: written as \udcff escapes
+        out.write("report.md", markdown(report, files).encode("utf-8", "backslashreplace"))
+        out.write("report.html", _html(report, shown, files).encode("utf-8", "backslashreplace"))
         out.commit()
     except BaseException:
         out.abort()
