@@ -39,7 +39,6 @@ import pytest
 _SETTINGS = pytest.StashKey[dict]()
 _CANDIDATE = pytest.StashKey[object]()
 _CMD = pytest.StashKey[object]()
-_WRITTEN = pytest.StashKey[list]()
 
 
 def pytest_addoption(parser):
@@ -81,7 +80,6 @@ def pytest_configure(config):
     config.stash[_SETTINGS] = settings
     config.stash[_CANDIDATE] = table.values.get("candidate")
     config.stash[_CMD] = table.values.get("candidate-cmd")
-    config.stash[_WRITTEN] = []
 
 
 def report_name(nodeid: str) -> str:
@@ -89,8 +87,14 @@ def report_name(nodeid: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", nodeid).strip("._-") or "test"
 
 
-def _write(config, nodeid: str, index: int, report: dict) -> str:
-    """Write the report of a failing check; the line to add to the failure message."""
+def _write(config, node, index: int, report: dict) -> str:
+    """Write the report of a failing check; the line to add to the failure message.
+
+    The folder is also the test's ``user_properties`` entry ``wirecheck_report``:
+    it reaches the terminal summary from pytest-xdist workers, and pytest's own
+    ``--junitxml`` as a property of the test.
+    """
+    nodeid = node.nodeid
     from wirecheck.core.errors import InputError
 
     from .report import write_report
@@ -102,7 +106,7 @@ def _write(config, nodeid: str, index: int, report: dict) -> str:
         write_report(run_dir, report, {})
     except (InputError, OSError) as exc:
         return f"  report not written: {exc}"
-    config.stash[_WRITTEN].append(run_dir)
+    node.user_properties.append(("wirecheck_report", str(run_dir)))
     return f"  report: {run_dir / 'report.html'}"
 
 
@@ -116,9 +120,10 @@ class Check:
     ``--wirecheck-*`` options and ``[tool.wirecheck]``.
     """
 
-    def __init__(self, config, nodeid: str):
+    def __init__(self, config, node):
         self._config = config
-        self._nodeid = nodeid
+        self._node = node
+        self._nodeid = node.nodeid
         self._calls = 0
 
     def __repr__(self) -> str:
@@ -146,7 +151,7 @@ class Check:
         text = failure_text(report)
         if text is not None:
             if config.option.wirecheck_report is not None:
-                text += "\n" + _write(config, self._nodeid, self._calls, report)
+                text += "\n" + _write(config, self._node, self._calls, report)
             pytest.fail(text)
         return report
 
@@ -157,11 +162,13 @@ def wirecheck(request) -> Check:
 
     See :class:`Check`.
     """
-    return Check(request.config, request.node.nodeid)
+    return Check(request.config, request.node)
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
-    written = config.stash.get(_WRITTEN, [])
+    # from the tests' reports, not this process's state: under pytest-xdist the checks ran in workers
+    written = sorted({value for reports in terminalreporter.stats.values() for r in reports
+                      for name, value in getattr(r, "user_properties", ()) if name == "wirecheck_report"})
     if written:
         terminalreporter.write_sep("-", "wirecheck")
         terminalreporter.write_line(f"{len(written)} report(s) of failing checks under "
