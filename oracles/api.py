@@ -56,15 +56,16 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     cases : sequence of str, optional
         Names from :data:`wirecheck.oracles.cases.ALL_CASE_NAMES` (default: the
         default set ``CASE_NAMES``; the calibrated cases run when named).
-    oracles : tuple of {"opencv", "pyrender"}
+    oracles : tuple of {"opencv", "pyrender"}, or str
         ``("opencv",)`` compares vertices only (no OpenGL needed);
-        ``("opencv", "pyrender")`` compares drawn pixels too.
+        ``("opencv", "pyrender")`` compares drawn pixels too. A string is
+        one name or a comma-separated list (``"opencv,pyrender"``).
     tol_px, min_f1, min_f1_0px : float
         Vertex tolerance in pixels; F1 floors at 1 px and 0 px.
     turns : (3,) tuple of float
         The scenes' spin: full turns about X, Y, Z over the run.
     allow_vacuous : bool
-        Let a case that compared nothing (every point clipped in every frame)
+        (True or False, nothing else: ``"no"`` would be truthy.) Let a case that compared nothing (every point clipped in every frame)
         pass; by default its verdict ``"vacuous"`` fails the report.
     cmd : str or sequence of str, optional
         Instead of ``func``: a projector program speaking the candidate
@@ -95,9 +96,22 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     ValueError
         (:class:`~wirecheck.core.errors.InputError`) Inputs that would compare
         nothing: no scene or case, an unknown or repeated name, ``frames`` < 1,
-        a NaN tolerance, a precision other than float32 or float64.
+        a NaN or boolean tolerance, a precision other than float32 or float64,
+        ``timeout_s`` not finite and > 0; neither ``func`` nor ``cmd``, or both.
+    TypeError
+        An argument of the wrong kind, named with its value and what was
+        expected: ``func`` not callable (nor a string) or not callable as
+        ``func(points, camera)``, ``cmd`` not a string or a list of strings,
+        a ``timeout_s``, ``isolate`` or ``allow_vacuous`` of the wrong type.
     RuntimeError
         ``"pyrender"`` asked for but OSMesa is missing.
+
+    Notes
+    -----
+    The caller's process-wide settings are as they were after the call
+    (:mod:`wirecheck.oracles.caller_state`): warning filters, numpy's error
+    state and print options, ``os.environ``, ``sys.path``, the current
+    directory, logging and signal handlers.
     """
     func, cmd = _candidate_args(func, cmd)
     _flag(allow_vacuous, "allow_vacuous")

@@ -23,7 +23,9 @@ defaults. A bad table is a pytest usage error before any test runs.
 
 ``--wirecheck-report DIR`` writes report.json, report.md and report.html
 (oracles.report) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
-for a test's later checks).
+for a test's later checks); the terminal summary counts them, under
+pytest-xdist too (each test's ``user_properties`` carries its folder as
+``wirecheck_report``, which pytest's ``--junitxml`` also lists).
 
 Nothing heavy is imported until the fixture is called: the plugin loads in
 every pytest run of an environment where wirecheck is installed.
