@@ -244,7 +244,20 @@ def test_a_candidate_at_a_non_utf8_path_gets_its_reports(tmp_path, capsys):
 
 # ---------------------------------------------------------------- the pytest plugin
 
-def test_the_report_summary_comes_from_the_test_reports(pytester):
+@pytest.fixture(scope="module")
+def loaded(tmp_path_factory):
+    """A failing check's report written once here, so that pytester's in-process runs import nothing new.
+
+    Such a run unloads the modules it imported, and a C extension (numpy.fft's, under matplotlib) cannot
+    load twice in one process: the next run's import would fail.
+    """
+    from wirecheck.oracles.report import write_report
+
+    report = check_projector(lambda p, c: project_points(p, c) + 0.5, isolate=False, **ONE)
+    write_report(tmp_path_factory.mktemp("loaded") / "r", report, {})
+
+
+def test_the_report_summary_comes_from_the_test_reports(pytester, loaded):
     # under pytest-xdist the checks run in workers: the summary counts what the reports carry
     # (user_properties), not what the controller's process wrote; pytest's --junitxml gets the path
     pytester.makepyfile(test_user='''
@@ -259,3 +272,30 @@ def test_shifted(wirecheck):
     prop = ET.parse(pytester.path / "pytest.xml").getroot().find(".//testcase/properties/property")
     assert (prop.get("name"), prop.get("value")) == ("wirecheck_report", "reps/test_user.py_test_shifted")
     assert (pytester.path / "reps" / "test_user.py_test_shifted" / "report.json").is_file()
+
+
+def test_test_ids_that_differ_only_in_replaced_characters_get_their_own_reports(pytester, loaded):
+    # "[a b]" and "[a_b]" were both DIR/test_user.py_test_shift_a_b: the second report replaced the
+    # first; a parameter id "cube-2" was the folder name of test_shift[cube]'s second check
+    pytester.makepyfile(test_user='''
+import pytest
+from wirecheck.core.projection import project_points
+
+@pytest.mark.parametrize("shift", [0.5, 0.25, 0.125, 2.0], ids=["a b", "a_b", "cube-2", "cube"])
+def test_shift(wirecheck, shift):
+    try:
+        wirecheck(lambda p, c: project_points(p, c) + shift, scenes=["cube"], frames=1, cases=["on_axis"],
+                  isolate=False)
+    finally:
+        if shift == 2.0:
+            wirecheck(lambda p, c: project_points(p, c) + 1.0, scenes=["cube"], frames=1, cases=["on_axis"],
+                      isolate=False)
+''')
+    result = pytester.runpytest("--wirecheck-report", "reps", "-p", "no:xdist")
+    result.assert_outcomes(failed=4)
+    folders = sorted((pytester.path / "reps").iterdir())
+    # each shift moves every vertex by (s, s): max error s * sqrt(2), one folder per check
+    errors = sorted(round(json.loads((f / "report.json").read_text())["summary"]["max_vertex_error_px"] ** 2 / 2, 6)
+                    for f in folders)
+    assert errors == [0.015625, 0.0625, 0.25, 1.0, 4.0] and len(folders) == 5
+    assert "test_user.py_test_shift_a_b" in [f.name for f in folders]
