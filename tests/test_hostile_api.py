@@ -299,3 +299,12 @@ def test_shift(wirecheck, shift):
                     for f in folders)
     assert errors == [0.015625, 0.0625, 0.25, 1.0, 4.0] and len(folders) == 5
     assert "test_user.py_test_shift_a_b" in [f.name for f in folders]
+
+
+def test_a_long_test_id_gets_a_folder_name_the_file_system_takes(tmp_path):
+    from wirecheck.oracles.pytest_plugin import report_name
+
+    # a parametrized id of 300 characters: 120 kept + "-" + 8 hex digits, under NAME_MAX (255 bytes)
+    names = [report_name(f"t.py::test[{c * 300}]") for c in "xy"]
+    assert [len(n) for n in names] == [129, 129] and names[0] != names[1]
+    (tmp_path / names[0]).mkdir()           # before: OSError "File name too long", "report not written"
