@@ -65,8 +65,9 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     turns : (3,) tuple of float
         The scenes' spin: full turns about X, Y, Z over the run.
     allow_vacuous : bool
-        (True or False, nothing else: ``"no"`` would be truthy.) Let a case that compared nothing (every point clipped in every frame)
-        pass; by default its verdict ``"vacuous"`` fails the report.
+        Let a case that compared nothing (every point clipped in every frame)
+        pass; by default its verdict ``"vacuous"`` fails the report. True or
+        False only (a string such as ``"no"`` would be truthy).
     cmd : str or sequence of str, optional
         Instead of ``func``: a projector program speaking the candidate
         protocol (docs/protocol.md), as a command line or an argv list.
