@@ -191,6 +191,7 @@ from wirecheck.oracles.api import check_projector
 from wirecheck.core.projection import project_points
 before = state()
 check_projector(project_points, scenes=["cube"], frames=1, cases=["on_axis"], isolate=False)
+check_projector(lambda p, c: project_points(p, c), scenes=["cube"], frames=1, cases=["on_axis"])   # forked
 print(json.dumps([before, state()]))
 """
 
