@@ -29,6 +29,12 @@ import pytest
 # (tests/test_renderer_imports.py). A value set outside is kept.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+# pytester's in-process runs (tests/test_pytest_plugin.py) unload every module first imported
+# inside them; numpy's C extensions cannot be loaded twice in one process, so numpy (and its
+# numpy.fft, imported by the libraries a check loads) is loaded here, after the line above,
+# before the first such run, whichever file runs first or alone.
+import numpy.fft  # noqa: E402, F401
+
 # tests/test_pytest_plugin.py runs a user's pytest on a small project
 pytest_plugins = ["pytester"]
 
