@@ -85,7 +85,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scene", default="cube", help="built-in name (cube, pyramid, prism), an example "
                    "(orrery: scenes/examples/, several objects) or a file path (.scene, .obj, .ply, .stl, .off, "
                    ".glb) (default cube)")
-    p.add_argument("--frames", type=int, default=180, help="number of frames (default 180)")
+    p.add_argument("--frames", type=int, default=None, help="number of frames (default 180)")
     cam = p.add_argument_group("camera (conventions: core/conventions.py)")
     cam.add_argument("--camera-z", type=float, default=None, metavar="D",
                      help="camera at (0,0,D) looking at the origin, up +Y (default 4)")
@@ -114,7 +114,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="world units visible vertically (orthographic; default 4)")
     mot = p.add_argument_group("motion (model matrix of frame k uses t = (k-1)/frames; in a scene of several "
                                "objects it applies to the whole scene, after each object's own motion)")
-    mot.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the run (default 1,1,0)")
+    mot.add_argument("--spin", default=None, metavar="X,Y,Z", help="full turns about X, Y, Z over the run (default 1,1,0)")
     mot.add_argument("--translate", default="0,0,0", metavar="X,Y,Z",
                      help="offset reached at the end of the run, growing linearly (default 0,0,0)")
     mot.add_argument("--scale", type=float, default=1.0, help="uniform scale, non-zero (default 1)")
@@ -143,15 +143,15 @@ def build_parser() -> argparse.ArgumentParser:
     drw.add_argument("--object-culling", action=argparse.BooleanOptionalAction, default=True,
                      help="scenes of several objects: skip objects whose bounding sphere is outside the "
                      "frustum (default on; never changes the picture or the vertex and edge counts)")
-    p.add_argument("--format", default="png", help="comma-separated: png, ascii, gif, mp4 (default png). mp4: "
+    p.add_argument("--format", default=None, help="comma-separated: png, ascii, gif, mp4 (default png). mp4: "
                    "H.264 yuv420p via PyAV, 30 fps; an odd width or height is padded with one black "
                    "row/column, never scaled")
-    p.add_argument("--plots", action=argparse.BooleanOptionalAction, default=False,
+    p.add_argument("--plots", action=argparse.BooleanOptionalAction, default=None,
                    help="also write <scene>-plots.png: depth range, clipped vertices/edges (and culled "
                    "faces/objects, hidden pixels when on) against frame number (default off: matplotlib "
                    "adds about 1 s)")
-    p.add_argument("--ascii-cols", type=int, default=80, help="columns of the ascii frames (default 80)")
-    p.add_argument("--out", default="output", help="output directory (default output/)")
+    p.add_argument("--ascii-cols", type=int, default=None, help="columns of the ascii frames (default 80)")
+    p.add_argument("--out", default=None, help="output directory (default output/)")
     p.add_argument("--verbose", action="store_true",
                    help="print every frame (default off: only the first, middle and last)")
     ana = p.add_argument_group("analysis and the interactive viewer (docs/interactive.md)")
@@ -167,17 +167,71 @@ def build_parser() -> argparse.ArgumentParser:
                      help="render the scene at two camera distances and two FOVs (--compare-z, --compare-fov) "
                      "in a 2x2 picture and explain the difference with numbers measured from the frames "
                      "(default off)")
-    ana.add_argument("--compare-z", default="3,6", metavar="D1,D2", help="--compare: camera distances (default 3,6)")
-    ana.add_argument("--compare-fov", default="60,90", metavar="F1,F2", help="--compare: FOVs (default 60,90)")
+    ana.add_argument("--compare-z", default=None, metavar="D1,D2", help="--compare: camera distances (default 3,6)")
+    ana.add_argument("--compare-fov", default=None, metavar="F1,F2", help="--compare: FOVs (default 60,90)")
     ana.add_argument("--interactive", action="store_true",
                      help="serve a viewer on 127.0.0.1 (frames drawn by core; orbit, dolly, pan, the oracle "
                      "overlay, the profiler); opens no browser; Ctrl-C stops it (default off)")
-    ana.add_argument("--port", type=int, default=0, help="--interactive: port (default 0: a free one, printed)")
+    ana.add_argument("--port", type=int, default=None, help="--interactive: port (default 0: a free one, printed)")
     return p
+
+
+#: Options whose default is None so that one given explicitly is seen: their defaults once checked.
+DEFAULTS = {"frames": 180, "spin": "1,1,0", "format": "png", "plots": False, "ascii_cols": 80, "out": "output",
+            "compare_z": "3,6", "compare_fov": "60,90", "port": 0}
+
+#: Options a mode never reads (option, attribute), refused rather than silently ignored.
+_UNUSED = {
+    "compare": [("--frames", "frames"), ("--format", "format"), ("--plots/--no-plots", "plots"),
+                ("--ascii-cols", "ascii_cols"), ("--verbose", "verbose"), ("--profile", "profile"),
+                ("--trace-vertex", "trace_vertex"), ("--trace-frames", "trace_frames"), ("--fov", "fov"),
+                ("--camera-z", "camera_z"), ("--camera-pos", "camera_pos"), ("--look-at", "look_at"),
+                ("--up", "up"), ("--ortho-height", "ortho_height"), ("--spin", "spin"), ("--axes", "axes"),
+                ("--interactive", "interactive"), ("--port", "port")],
+    "interactive": [("--out", "out"), ("--format", "format"), ("--plots/--no-plots", "plots"),
+                    ("--ascii-cols", "ascii_cols"), ("--verbose", "verbose"), ("--profile", "profile"),
+                    ("--trace-vertex", "trace_vertex"), ("--trace-frames", "trace_frames"),
+                    ("--compare-z", "compare_z"), ("--compare-fov", "compare_fov")],
+}
+
+
+def _given(a, attr: str) -> bool:
+    return getattr(a, attr) not in (None, False)
+
+
+def check_combinations(a: argparse.Namespace) -> None:
+    """InputError for an option that the other options make ineffective (it would be silently ignored)."""
+    for mode, unused in _UNUSED.items():
+        if getattr(a, mode):
+            for option, attr in unused:
+                if _given(a, attr):
+                    raise InputError(f"{option} with --{mode}: --{mode} does not use it; expected one of them")
+    if a.compare and a.projection != "perspective":
+        raise InputError(f"--projection {a.projection} with --compare: its four cameras are perspective; "
+                         "expected one of them")
+    for option, attr, needs, on in (("--port", "port", "--interactive", a.interactive),
+                                    ("--compare-z", "compare_z", "--compare", a.compare),
+                                    ("--compare-fov", "compare_fov", "--compare", a.compare)):
+        if _given(a, attr) and not on:
+            raise InputError(f"{option} {getattr(a, attr)!r} without {needs}: expected {needs} with it "
+                             "(it has no effect otherwise)")
+    if a.ortho_height is not None and a.projection == "perspective" and math.isfinite(a.ortho_height) \
+            and a.ortho_height > 0 and not a.compare:
+        raise InputError(f"--ortho-height {a.ortho_height} with --projection perspective: expected "
+                         "--projection orthographic with it (it has no effect otherwise)")
+    if a.ascii_cols is not None and not a.compare and not a.interactive:
+        formats = [f.strip() for f in (a.format or DEFAULTS["format"]).split(",")]
+        if "ascii" not in formats:
+            raise InputError(f"--ascii-cols {a.ascii_cols} without ascii in --format: expected --format "
+                             "with ascii (it has no effect otherwise)")
 
 
 def settings_from_args(a: argparse.Namespace) -> Settings:
     """The run the options ask for; InputError (one line, naming the option) for anything invalid."""
+    check_combinations(a)
+    for attr, value in DEFAULTS.items():
+        if getattr(a, attr) is None:
+            setattr(a, attr, value)
     if not 1 <= a.frames <= MAX_FRAMES:
         raise InputError(f"--frames {a.frames}: expected an integer in 1..{MAX_FRAMES:,} (limits.MAX_FRAMES)")
     check_not_empty([("--out", a.out)])
@@ -193,10 +247,14 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         raise InputError(f"--scale {a.scale}: expected a finite non-zero number")
     if a.ascii_cols < 1:
         raise InputError(f"--ascii-cols {a.ascii_cols}: expected an integer >= 1")
-    formats = tuple(f.strip() for f in a.format.split(",") if f.strip())
+    formats = tuple(f.strip() for f in a.format.split(","))
     bad = [f for f in formats if f not in FORMATS]
-    if bad or not formats:
-        raise InputError(f"--format {a.format!r}: expected a comma-separated list of {', '.join(FORMATS)}")
+    if bad:
+        raise InputError(f"--format {a.format!r}: {bad[0]!r} is not a format: expected a comma-separated list "
+                         f"of {', '.join(FORMATS)} (lower case, no empty item)")
+    twice = next((f for i, f in enumerate(formats) if f in formats[:i]), None)
+    if twice is not None:
+        raise InputError(f"--format {a.format!r}: {twice!r} given twice: expected each format once")
     both = a.projection == "both"
     kwargs = dict(fov_y_deg=a.fov, width=a.width, height=a.height, near=a.near, far=a.far,
                   projection="perspective" if both else a.projection,
@@ -225,6 +283,10 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     ortho_camera = None
     if both:
         ortho_camera = orthographic_twin(camera, distance)
+    frame_width = 2 * a.width + 1 if both else a.width
+    if "ascii" in formats and a.ascii_cols > frame_width:
+        raise InputError(f"--ascii-cols {a.ascii_cols}: expected at most the frame's width, {frame_width} pixels "
+                         "(a character covers at least one pixel)")
     light = None
     if a.light is not None:
         if a.style != "shaded":
@@ -255,8 +317,23 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     if cull is not None and scene.winding_note:
         raise InputError(f"--cull backface: {scene.source}: {scene.winding_note}: expected faces wound "
                          "consistently (counter-clockwise seen from outside)")
-    check_out(s.out, output_names(s))
+    if not a.interactive:
+        _check_out_of_scenes(s.out)
+        check_out(s.out, output_names(s))
     return s
+
+
+def _check_out_of_scenes(out: Path) -> None:
+    """InputError when ``--out`` is the bundled scenes folder or inside it (outputs there would pass for scenes)."""
+    from .scene_files import SCENE_DIR
+
+    try:
+        resolved = out.resolve()
+    except (RuntimeError, OSError) as exc:         # a symbolic link loop: Python 3.11 raises RuntimeError
+        raise InputError(f"--out {str(out)!r}: {exc}: expected a folder path") from None
+    if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
+        raise InputError(f"--out {str(out)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected an "
+                         "output folder elsewhere (output/ by default)")
 
 
 def _numbers(option: str, text: str, counts: tuple) -> tuple:

@@ -58,9 +58,9 @@ def _number(path, lineno, token, what):
     try:
         value = float(token)
     except ValueError:
-        raise InputError(f"{path}:{lineno}: {what} {token!r}: expected a number") from None
+        raise InputError(f"{path}:{lineno}: {what} {_short(token)}: expected a number") from None
     if not math.isfinite(value):
-        raise InputError(f"{path}:{lineno}: {what} {token!r}: expected a finite number")
+        raise InputError(f"{path}:{lineno}: {what} {_short(token)}: expected a finite number")
     return value
 
 
@@ -68,7 +68,7 @@ def _index(path, lineno, token, what, n_vertices, where="the scene has"):
     try:
         value = int(token)
     except ValueError:
-        raise InputError(f"{path}:{lineno}: {what} index {token!r}: expected an integer") from None
+        raise InputError(f"{path}:{lineno}: {what} index {_short(token)}: expected an integer") from None
     if not 0 <= value < n_vertices:
         raise InputError(f"{path}:{lineno}: {what} index {value}: expected 0..{n_vertices - 1} "
                          f"({where} {n_vertices} vertices so far)")
@@ -105,7 +105,9 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
     objs = [implicit]
     cur = implicit
     single = True                 # no 'object' line yet: messages speak of "the scene"
-    for lineno, raw in enumerate(text.splitlines(), start=1):
+    # lines end at "\n" (and "\r\n") only, as editors count them: str.splitlines() would also end one at
+    # U+2028, U+0085, \x0c, \x1c..\x1e, turning the rest of a comment into a statement
+    for lineno, raw in enumerate(text.split("\n"), start=1):
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
@@ -113,26 +115,26 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
         where = "the scene has" if single else f"object {cur.name!r} has"
         if tag == "name":
             if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
-                raise InputError(f"{path}:{lineno}: name {' '.join(fields)!r}: expected one word of letters, "
+                raise InputError(f"{path}:{lineno}: name {_short(' '.join(fields))}: expected one word of letters, "
                                  "digits, '_', '.', '-' (it names output files)")
             name = fields[0]
         elif tag in ("v", "e", "f"):
             if cur.mesh is not None:
-                raise InputError(f"{path}:{lineno}: {line!r}: expected no v/e/f lines in an object that takes "
+                raise InputError(f"{path}:{lineno}: {_short(line)}: expected no v/e/f lines in an object that takes "
                                  f"its geometry from 'mesh' (line {cur.mesh[0]}); start a new 'object' first")
             cur.geometry_line = cur.geometry_line or lineno
             if tag == "v":
                 if len(fields) != 3:
-                    raise InputError(f"{path}:{lineno}: vertex {line!r}: expected 'v X Y Z' (3 numbers), "
+                    raise InputError(f"{path}:{lineno}: vertex {_short(line)}: expected 'v X Y Z' (3 numbers), "
                                      f"got {len(fields)}")
                 cur.vertices.append([_number(path, lineno, t, "vertex coordinate") for t in fields])
             elif tag == "e":
                 if len(fields) != 2:
-                    raise InputError(f"{path}:{lineno}: edge {line!r}: expected 'e I J' (2 indices), got {len(fields)}")
+                    raise InputError(f"{path}:{lineno}: edge {_short(line)}: expected 'e I J' (2 indices), got {len(fields)}")
                 cur.edges.append([_index(path, lineno, t, "edge", len(cur.vertices), where) for t in fields])
             else:
                 if len(fields) < 3:
-                    raise InputError(f"{path}:{lineno}: face {line!r}: expected 'f I J K ...' (3 or more indices), "
+                    raise InputError(f"{path}:{lineno}: face {_short(line)}: expected 'f I J K ...' (3 or more indices), "
                                      f"got {len(fields)}")
                 if len(fields) > MAX_FACE_VERTICES:
                     raise InputError(f"{path}:{lineno}: face of {len(fields)} indices: expected at most "
@@ -140,57 +142,57 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
                 cur.faces.append(tuple(_index(path, lineno, t, "face", len(cur.vertices), where) for t in fields))
         elif tag == "object":
             if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
-                raise InputError(f"{path}:{lineno}: object {' '.join(fields)!r}: expected 'object NAME', one word "
+                raise InputError(f"{path}:{lineno}: object {_short(' '.join(fields))}: expected 'object NAME', one word "
                                  "of letters, digits, '_', '.', '-'")
             dup = next((o for o in objs[1:] if o.name == fields[0]), None)
             if dup is not None:
-                raise InputError(f"{path}:{lineno}: object {fields[0]!r}: expected a new name (line {dup.lineno} "
+                raise InputError(f"{path}:{lineno}: object {_short(fields[0])}: expected a new name (line {dup.lineno} "
                                  "already starts an object of that name)")
             cur = _Obj(fields[0], lineno)
             objs.append(cur)
             single = False
         elif tag == "mesh":
             if len(fields) != 1:
-                raise InputError(f"{path}:{lineno}: mesh {' '.join(fields)!r}: expected 'mesh PATH' "
+                raise InputError(f"{path}:{lineno}: mesh {_short(' '.join(fields))}: expected 'mesh PATH' "
                                  "(one path without spaces, relative to the scene file)")
             if cur.mesh is not None or cur.geometry_line is not None:
                 first = cur.mesh[0] if cur.mesh is not None else cur.geometry_line
-                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected one source of geometry per "
+                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected one source of geometry per "
                                  f"object (line {first} already gives it); start a new 'object' first")
             mesh_path = Path(fields[0])
             if not mesh_path.is_absolute():
                 mesh_path = base / mesh_path
             if mesh_path.suffix.lower() not in MESH_SUFFIXES:
-                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected a file ending in "
+                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected a file ending in "
                                  f"{' '.join(MESH_SUFFIXES)}")
             if not mesh_path.is_file():
-                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: expected an existing file "
+                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected an existing file "
                                  f"({mesh_path} not found)")
             try:
                 cur.mesh = (lineno, load_mesh_file(mesh_path))
             except InputError as exc:
-                raise InputError(f"{path}:{lineno}: mesh {fields[0]!r}: {exc}") from None
+                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: {exc}") from None
         elif tag in _MOTION_KEYS:
             if tag in cur.motion:
-                raise InputError(f"{path}:{lineno}: {tag} {' '.join(fields)!r}: expected one '{tag}' per object "
+                raise InputError(f"{path}:{lineno}: {tag} {_short(' '.join(fields))}: expected one '{tag}' per object "
                                  f"(line {cur.motion[tag][0]} already gives it)")
             if tag == "scale":
                 if len(fields) != 1:
-                    raise InputError(f"{path}:{lineno}: scale {' '.join(fields)!r}: expected 'scale S' (1 number)")
+                    raise InputError(f"{path}:{lineno}: scale {_short(' '.join(fields))}: expected 'scale S' (1 number)")
                 s = _number(path, lineno, fields[0], "scale")
                 if s == 0.0:
-                    raise InputError(f"{path}:{lineno}: scale {fields[0]!r}: expected a non-zero number")
+                    raise InputError(f"{path}:{lineno}: scale {_short(fields[0])}: expected a non-zero number")
                 cur.motion[tag] = (lineno, s)
             else:
                 if len(fields) != 3:
-                    raise InputError(f"{path}:{lineno}: {tag} {' '.join(fields)!r}: expected '{tag} X Y Z' "
+                    raise InputError(f"{path}:{lineno}: {tag} {_short(' '.join(fields))}: expected '{tag} X Y Z' "
                                      f"(3 numbers), got {len(fields)}")
                 values = tuple(_number(path, lineno, t, tag) for t in fields)
                 if tag == "spin":
                     check_turns(values, f"{path}:{lineno}: spin")
                 cur.motion[tag] = (lineno, values)
         else:
-            raise InputError(f"{path}:{lineno}: {tag!r}: expected a line starting with 'v', 'e', 'f', 'name', "
+            raise InputError(f"{path}:{lineno}: {_short(tag)}: expected a line starting with 'v', 'e', 'f', 'name', "
                              "'object', 'mesh', 'translate', 'scale', 'spin' or '#'")
     scene_name = name or _safe_stem(path)
     _check_name_length(scene_name, path)
@@ -260,10 +262,10 @@ def _obj_lines(path: Path) -> list[tuple[int, int]]:
                 try:
                     k = int(tok.split("/")[0])
                 except ValueError:
-                    raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected an integer") from None
+                    raise InputError(f"{path}:{lineno}: line element index {_short(tok)}: expected an integer") from None
                 k = k - 1 if k > 0 else n_v + k
                 if not 0 <= k < n_v:
-                    raise InputError(f"{path}:{lineno}: line element index {tok!r}: expected 1..{n_v}")
+                    raise InputError(f"{path}:{lineno}: line element index {_short(tok)}: expected 1..{n_v}")
                 idx.append(k)
             pairs += list(zip(idx[:-1], idx[1:]))
     return pairs
@@ -355,7 +357,7 @@ def _check_obj(path: Path) -> None:
     for lineno, parts, raw in _obj_statements(path):
         if parts[0] == "v":
             if len(parts) < 4:
-                raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
+                raise InputError(f"{path}:{lineno}: vertex {_short(raw.strip())}: expected 'v X Y Z' (3 numbers)")
             for t in parts[1:4]:
                 _number(path, lineno, t, "vertex coordinate")
             n_v += 1
@@ -364,9 +366,9 @@ def _check_obj(path: Path) -> None:
                 try:
                     k = int(tok.split("/")[0])
                 except ValueError:
-                    raise InputError(f"{path}:{lineno}: face index {tok!r}: expected an integer") from None
+                    raise InputError(f"{path}:{lineno}: face index {_short(tok)}: expected an integer") from None
                 if k == 0 or n_v + k < 0:
-                    raise InputError(f"{path}:{lineno}: face index {tok!r}: expected a 1-based index or "
+                    raise InputError(f"{path}:{lineno}: face index {_short(tok)}: expected a 1-based index or "
                                      f"-1..-{n_v} (counting back over the {n_v} vertices before this line)")
                 if beyond is None or k > beyond[0]:
                     beyond = (k, lineno, tok)
@@ -374,7 +376,7 @@ def _check_obj(path: Path) -> None:
             foreign = (lineno, raw.strip())
     if beyond is not None and beyond[0] > n_v:
         k, lineno, tok = beyond
-        raise InputError(f"{path}:{lineno}: face index {tok!r}: " + (
+        raise InputError(f"{path}:{lineno}: face index {_short(tok)}: " + (
             f"expected 1..{n_v} (the file has {n_v} vertices)" if n_v else
             "the file has no vertices ('v X Y Z' lines): expected some"))
     if n_v == 0 and foreign is not None:
@@ -506,7 +508,7 @@ def _obj_vertices(path: Path) -> np.ndarray:
     for lineno, parts, raw in _obj_statements(path):
         if parts[0] == "v":
             if len(parts) < 4:
-                raise InputError(f"{path}:{lineno}: vertex {raw.strip()!r}: expected 'v X Y Z' (3 numbers)")
+                raise InputError(f"{path}:{lineno}: vertex {_short(raw.strip())}: expected 'v X Y Z' (3 numbers)")
             out.append([_number(path, lineno, t, "vertex coordinate") for t in parts[1:4]])
     return np.asarray(out, dtype=np.float64).reshape(-1, 3)
 
@@ -577,7 +579,7 @@ def load_scene(name_or_path: str) -> Scene:
     if suffix not in (NATIVE_SUFFIX, ".txt"):
         raise InputError(f"{path}: suffix {path.suffix!r}: expected {NATIVE_SUFFIX} or one of {' '.join(MESH_SUFFIXES)}")
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")      # a byte-order mark (Windows editors) is not a tag
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: could not be read: {exc}") from None
     scene = parse_scene_text(text, str(path))
