@@ -44,6 +44,7 @@ from .compose import AXIS_LENGTH
 from .culling import CULL_CHOICES
 from .errors import InputError, check_not_empty
 from .guard import VersionAction, run_cli
+from .numbers import plain_float, plain_int
 from .limits import MAX_FRAMES, check_image_size, check_turns
 from .projection import DTYPES
 from .raster import RASTER_MODES
@@ -70,7 +71,7 @@ def vec3(option: str, text: str) -> tuple[float, float, float]:
     """``"X,Y,Z"`` as three finite floats; InputError naming ``option`` otherwise."""
     parts = text.split(",")
     try:
-        values = tuple(float(p) for p in parts)
+        values = tuple(plain_float(p) for p in parts)
     except ValueError:
         raise InputError(f"{option} {text!r}: expected three numbers X,Y,Z") from None
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
@@ -85,39 +86,39 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scene", default="cube", help="built-in name (cube, pyramid, prism), an example "
                    "(orrery: scenes/examples/, several objects) or a file path (.scene, .obj, .ply, .stl, .off, "
                    ".glb) (default cube)")
-    p.add_argument("--frames", type=int, default=None, help="number of frames (default 180)")
+    p.add_argument("--frames", type=plain_int, default=None, help="number of frames (default 180)")
     cam = p.add_argument_group("camera (conventions: core/conventions.py)")
-    cam.add_argument("--camera-z", type=float, default=None, metavar="D",
+    cam.add_argument("--camera-z", type=plain_float, default=None, metavar="D",
                      help="camera at (0,0,D) looking at the origin, up +Y (default 4)")
     cam.add_argument("--camera-pos", default=None, metavar="X,Y,Z",
                      help="camera position, looking at --look-at with --up (default: --camera-z)")
     cam.add_argument("--look-at", default=None, metavar="X,Y,Z", help="with --camera-pos (default 0,0,0)")
     cam.add_argument("--up", default=None, metavar="X,Y,Z", help="with --camera-pos (default 0,1,0)")
-    cam.add_argument("--fov", type=float, default=None, help="full vertical FOV in degrees, edge to edge (default 60)")
+    cam.add_argument("--fov", type=plain_float, default=None, help="full vertical FOV in degrees, edge to edge (default 60)")
     cam.add_argument("--intrinsics", default=None, metavar="FX,FY,CX,CY",
                      help="a calibrated camera instead of --fov: focal lengths and principal point in pixels, "
                      "pixel centres at integers (core/conventions.py; default: none, from --fov)")
     cam.add_argument("--distortion", default=None, metavar="K1,K2,P1,P2[,K3[,K4,K5,K6]]",
                      help="OpenCV lens distortion of the vertices (edges stay straight lines between them; "
                      "wireframes only) (default: none)")
-    cam.add_argument("--near", type=float, default=0.1, help="near plane distance (default 0.1)")
-    cam.add_argument("--far", type=float, default=100.0, help="far plane distance (default 100)")
-    cam.add_argument("--width", type=int, default=640, help="image width in pixels (default 640)")
-    cam.add_argument("--height", type=int, default=480, help="image height in pixels (default 480)")
+    cam.add_argument("--near", type=plain_float, default=0.1, help="near plane distance (default 0.1)")
+    cam.add_argument("--far", type=plain_float, default=100.0, help="far plane distance (default 100)")
+    cam.add_argument("--width", type=plain_int, default=640, help="image width in pixels (default 640)")
+    cam.add_argument("--height", type=plain_int, default=480, help="image height in pixels (default 480)")
     cam.add_argument("--projection", choices=PROJECTION_CHOICES, default="perspective",
                      help="both: every frame twice, side by side: perspective on the left, on the right an "
                      "orthographic camera at the same position and orientation with ortho-height = "
                      "2 d tan(fov/2), d = the distance to the look-at point (so things at the look-at "
                      "distance are the same size in both); a 1-px grey column between them, output width 2W+1 "
                      "(default perspective)")
-    cam.add_argument("--ortho-height", type=float, default=None,
+    cam.add_argument("--ortho-height", type=plain_float, default=None,
                      help="world units visible vertically (orthographic; default 4)")
     mot = p.add_argument_group("motion (model matrix of frame k uses t = (k-1)/frames; in a scene of several "
                                "objects it applies to the whole scene, after each object's own motion)")
     mot.add_argument("--spin", default=None, metavar="X,Y,Z", help="full turns about X, Y, Z over the run (default 1,1,0)")
     mot.add_argument("--translate", default="0,0,0", metavar="X,Y,Z",
                      help="offset reached at the end of the run, growing linearly (default 0,0,0)")
-    mot.add_argument("--scale", type=float, default=1.0, help="uniform scale, non-zero (default 1)")
+    mot.add_argument("--scale", type=plain_float, default=1.0, help="uniform scale, non-zero (default 1)")
     p.add_argument("--clip", choices=CLIP_MODES, default="clip",
                    help="clip: clip edges at near/far; endpoint: drop edges with a clipped end (default clip)")
     p.add_argument("--dtype", choices=DTYPES, default="float64",
@@ -150,7 +151,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write <scene>-plots.png: depth range, clipped vertices/edges (and culled "
                    "faces/objects, hidden pixels when on) against frame number (default off: matplotlib "
                    "adds about 1 s)")
-    p.add_argument("--ascii-cols", type=int, default=None, help="columns of the ascii frames (default 80)")
+    p.add_argument("--ascii-cols", type=plain_int, default=None, help="columns of the ascii frames (default 80)")
     p.add_argument("--out", default=None, help="output directory (default output/)")
     p.add_argument("--verbose", action="store_true",
                    help="print every frame (default off: only the first, middle and last)")
@@ -158,7 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
     ana.add_argument("--profile", action="store_true",
                      help="time every frame's stages (transform, faces, shading, clip, raster, compose, encode, "
                      "write): a table on stdout and 'profile' in the JSON report (default off)")
-    ana.add_argument("--trace-vertex", type=int, default=None, metavar="I",
+    ana.add_argument("--trace-vertex", type=plain_int, default=None, metavar="I",
                      help="print vertex I in every space (model, world, camera, clip, NDC, pixel), its visibility "
                      "and its edges' clipping; also 'trace' in the JSON report (default: none)")
     ana.add_argument("--trace-frames", default=None, metavar="K,K,...",
@@ -172,7 +173,7 @@ def build_parser() -> argparse.ArgumentParser:
     ana.add_argument("--interactive", action="store_true",
                      help="serve a viewer on 127.0.0.1 (frames drawn by core; orbit, dolly, pan, the oracle "
                      "overlay, the profiler); opens no browser; Ctrl-C stops it (default off)")
-    ana.add_argument("--port", type=int, default=None, help="--interactive: port (default 0: a free one, printed)")
+    ana.add_argument("--port", type=plain_int, default=None, help="--interactive: port (default 0: a free one, printed)")
     return p
 
 
@@ -339,7 +340,7 @@ def _check_out_of_scenes(out: Path) -> None:
 def _numbers(option: str, text: str, counts: tuple) -> tuple:
     """``"A,B,..."`` as finite floats, as many as one of ``counts``; InputError naming ``option`` otherwise."""
     try:
-        values = tuple(float(p) for p in text.split(","))
+        values = tuple(plain_float(p) for p in text.split(","))
     except ValueError:
         values = ()
     if len(values) not in counts or not all(math.isfinite(v) for v in values):

@@ -39,6 +39,7 @@ import numpy as np
 from . import output
 from .camera import camera_z
 from .errors import InputError
+from .numbers import plain_float
 
 #: Drawn pixels: at least half coverage (raster "aa"), as the crosscheck's threshold.
 DRAWN = 128
@@ -47,7 +48,7 @@ DRAWN = 128
 def parse_pair(option: str, text: str, lo: float, hi: float) -> tuple[float, float]:
     """``"3,6"`` to (3.0, 6.0), each finite and in (lo, hi); InputError otherwise."""
     try:
-        vals = tuple(float(x) for x in text.split(","))
+        vals = tuple(plain_float(x) for x in text.split(","))
     except ValueError:
         vals = ()
     if len(vals) != 2 or not all(math.isfinite(v) and lo < v < hi for v in vals):

@@ -34,6 +34,7 @@ import numpy as np
 
 from .culling import winding_problem
 from .errors import InputError, quiet_libraries
+from .numbers import plain_float, plain_int
 from .limits import MAX_FACE_VERTICES, MAX_NAME, check_turns
 from .scene import Scene, SceneObject, face_edges, unique_edges
 from .transforms import Motion
@@ -56,7 +57,7 @@ def _safe_stem(path) -> str:
 
 def _number(path, lineno, token, what):
     try:
-        value = float(token)
+        value = plain_float(token)
     except ValueError:
         raise InputError(f"{path}:{lineno}: {what} {_short(token)}: expected a number") from None
     if not math.isfinite(value):
@@ -66,7 +67,7 @@ def _number(path, lineno, token, what):
 
 def _index(path, lineno, token, what, n_vertices, where="the scene has"):
     try:
-        value = int(token)
+        value = plain_int(token)
     except ValueError:
         raise InputError(f"{path}:{lineno}: {what} index {_short(token)}: expected an integer") from None
     if not 0 <= value < n_vertices:
@@ -253,10 +254,13 @@ def _obj_lines(path: Path) -> list[tuple[int, int]]:
     """Edges from OBJ ``l`` elements (1-based, possibly negative, 'v/vt' forms)."""
     n_v = 0
     pairs = []
-    for lineno, parts, _raw in _obj_statements(path):
+    for lineno, parts, raw in _obj_statements(path):
         if parts[0] == "v":
             n_v += 1
         elif parts[0] == "l":
+            if len(parts) < 3:          # a line of one vertex draws nothing
+                raise InputError(f"{path}:{lineno}: line element {_short(raw.strip())}: expected 2 or more "
+                                 "vertex indices")
             idx = []
             for tok in parts[1:]:
                 try:
@@ -362,6 +366,8 @@ def _check_obj(path: Path) -> None:
                 _number(path, lineno, t, "vertex coordinate")
             n_v += 1
         elif parts[0] in ("f", "fo"):
+            if len(parts) < 4:          # readers drop such a face silently: the user's edges vanish
+                raise InputError(f"{path}:{lineno}: face {_short(raw.strip())}: expected 3 or more vertex indices")
             for tok in parts[1:]:
                 try:
                     k = int(tok.split("/")[0])

@@ -23,6 +23,7 @@ import numpy as np
 from . import clipping
 from .camera import Camera
 from .errors import InputError
+from .numbers import plain_int
 from .projection import cam_to_px, world_to_cam
 from .scene import Scene, object_matrix
 from .transforms import Motion, apply
@@ -97,7 +98,7 @@ def parse_frames(text: str | None, frames: int) -> list[int]:
     if text is None:
         return sorted({1, max(1, frames // 2) if frames >= 180 else (frames + 1) // 2, frames})
     try:
-        ks = [int(x) for x in text.split(",") if x.strip()]
+        ks = [plain_int(x) for x in text.split(",") if x.strip()]
     except ValueError:
         ks = []
     if not ks or any(not 1 <= k <= frames for k in ks):

@@ -366,7 +366,8 @@ def test_renderer_lens_flags_hostile(tmp_path, args, match):
     from helpers import run_renderer
 
     out = tmp_path / "out"
-    rc, _, err = run_renderer(["--frames", "2", *args], out)
+    frames = [] if "--compare" in args else ["--frames", "2"]      # --compare refuses --frames (it renders at rest)
+    rc, _, err = run_renderer([*frames, *args], out)
     assert rc == 2 and len(err.strip().splitlines()) == 1 and re.search(match, err), err
     assert not out.exists()                                    # nothing written
 

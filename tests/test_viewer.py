@@ -213,8 +213,7 @@ def test_overlay_f1_equals_metrics_computed_independently(tmp_path):
 
 def test_interactive_cli_serves_and_stops_on_ctrl_c(tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--interactive", "--frames", "4",
-                             "--out", str(tmp_path / "o")], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--interactive", "--frames", "4"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env=env)
     try:
         line = proc.stdout.readline()
@@ -233,5 +232,5 @@ def test_interactive_cli_serves_and_stops_on_ctrl_c(tmp_path):
 def test_bad_port_is_exit_2(tmp_path):
     e = io.StringIO()
     with contextlib.redirect_stderr(e):
-        rc = main(["--interactive", "--port", "70000", "--out", str(tmp_path)])
+        rc = main(["--interactive", "--port", "70000"])       # no --out: --interactive writes nothing
     assert rc == 2 and "--port 70000" in e.getvalue() and e.getvalue().count("\n") == 1
