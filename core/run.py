@@ -132,7 +132,8 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
         frames_dir.mkdir()
         (frames_dir / output.MARKER).write_bytes(b"")
     records = []
-    all_px = [[] for _ in s.cameras]
+    sidecar_names = [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"]
+    all_px = [None for _ in s.cameras]       # the sidecars, filled frame by frame (memory flat in the frame count)
     t_start = time.perf_counter()
     render_seconds = 0.0
     renderer = s.scene_renderer()
@@ -165,7 +166,12 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
                     pictures.append(overlay(img, layers[c]) if layers else img)
                 recs.append(frame_record(k, frame, sidecar, info))
                 if sidecar:
-                    all_px[c].append(frame.p_px)
+                    if all_px[c] is None:           # the bytes np.save writes, one frame at a time
+                        all_px[c] = files.enter_context(open(stage.path(sidecar_names[c]), "wb"))
+                        np.lib.format.write_array_header_1_0(all_px[c], {
+                            "descr": np.lib.format.dtype_to_descr(frame.p_px.dtype), "fortran_order": False,
+                            "shape": (s.frames, *frame.p_px.shape)})
+                    all_px[c].write(np.ascontiguousarray(frame.p_px).tobytes())
                 if c == 0:
                     first = (frame, info)
                 lap("compose", t)
@@ -208,12 +214,9 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
     if profiler is not None:
         report["profile"] = profiler.summary()
     if sidecar:
-        names = [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"]
-        for c in range(len(s.cameras)):
-            np.save(stage.path(names[c]), np.stack(all_px[c]) if all_px[c] else np.zeros((0, 0, 2)))
-        report["vertices_px_file"] = names[0]
+        report["vertices_px_file"] = sidecar_names[0]
         if s.ortho_camera is not None:
-            report["vertices_px_file_orthographic"] = names[1]
+            report["vertices_px_file_orthographic"] = sidecar_names[1]
     plot_seconds = None
     if s.plots:
         from .motion_plot import plot_png
