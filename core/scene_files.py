@@ -25,6 +25,7 @@ elements become edges.
 from __future__ import annotations
 
 import dataclasses
+import io
 import math
 import os
 import re
@@ -287,9 +288,14 @@ def load_mesh_file(path: Path) -> Scene:
         _check_off(path)      # trimesh takes any first line for 'OFF' and reads a short face list as none
     elif suffix == ".gltf":
         _check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
+    source = {"file_obj": str(path)}
+    if suffix == ".obj":
+        absolute = _obj_absolute_indices(path)
+        if absolute is not None:
+            source = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}
     try:
         with quiet_libraries():     # trimesh logs tracebacks it recovers from; numpy warns on NaN casts
-            loaded = trimesh.load(str(path), process=False, maintain_order=True)
+            loaded = trimesh.load(**source, process=False, maintain_order=True)
     except Exception as exc:  # trimesh raises many types; one line for the user
         raise InputError(f"{path}: could not be read as {path.suffix[1:].upper()}: "
                          f"{type(exc).__name__}: {exc}") from None
@@ -389,6 +395,35 @@ def _check_obj(path: Path) -> None:
         lineno, text = foreign
         raise InputError(f"{path}:{lineno}: {_short(text)}: expected an OBJ statement (v, f, l, o, g, ...); "
                          "no vertex in the file")
+
+
+def _obj_absolute_indices(path: Path) -> str | None:
+    """The OBJ text with every negative (relative) index of f/fo/l made absolute; None when there is none.
+
+    The OBJ spec counts a negative index back from the vertices (texture
+    coordinates, normals) read *so far*; trimesh counts it from the end of the
+    file (a face before a later 'v' line took other vertices, silently) and
+    fails on 'f -3/1 ...' and 'f -3//1 ...'.
+    """
+    counts = {"v": 0, "vt": 0, "vn": 0}
+    kinds = ("v", "vt", "vn")                   # the fields of 'v/vt/vn'
+    lines, changed = [], False
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for raw in fh:
+            parts = raw.split("#", 1)[0].split()
+            if parts and parts[0] in counts:
+                counts[parts[0]] += 1
+            elif parts and parts[0] in ("f", "fo", "l") and "-" in raw.split("#", 1)[0]:
+                tokens = []
+                for tok in parts[1:]:
+                    fields = tok.split("/")
+                    for i, field in enumerate(fields[:3]):
+                        if field.startswith("-") and field[1:].isdigit():
+                            fields[i] = str(counts[kinds[i]] + 1 + int(field))
+                    tokens.append("/".join(fields))
+                raw, changed = " ".join([parts[0], *tokens]) + "\n", True
+            lines.append(raw)
+    return "".join(lines) if changed else None
 
 
 def _check_stl(path: Path) -> None:
