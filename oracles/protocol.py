@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 
@@ -99,6 +100,8 @@ def encode_reply(p_px: np.ndarray, precision: str = "float64") -> bytes:
     return json.dumps(head).encode() + b"\n" + p_px.tobytes()
 
 
+#: The keys a reply line may hold (an error reply: ``error``, and others are ignored).
+REPLY_KEYS = ("n", "precision")
 #: The values a reply's optional ``precision`` may take (oracles.tolerances.PRECISIONS).
 REPLY_PRECISIONS = ("float32", "float64")
 
@@ -123,11 +126,27 @@ def shown(data: bytes, limit: int = 60) -> str:
     return repr(data[:limit]) + ("..." if len(data) > limit else "")
 
 
+class _DuplicateKey(ValueError):
+    pass
+
+
+def _unique_keys(pairs) -> dict:
+    """``object_pairs_hook``: a key twice is ambiguous (parsers keep the first or the last), so garbage."""
+    obj = dict(pairs)
+    if len(obj) != len(pairs):
+        seen = set()
+        raise _DuplicateKey(next(k for k, _ in pairs if k in seen or seen.add(k)))
+    return obj
+
+
 def parse_line(line: bytes, what: str) -> dict:
-    """A JSON object line; ProtocolError naming ``what`` otherwise."""
+    """A JSON object line; ProtocolError naming ``what`` otherwise (a key twice included)."""
     try:
-        obj = json.loads(line.decode("utf-8"))
-    except (UnicodeDecodeError, ValueError):
+        obj = json.loads(line.decode("utf-8"), object_pairs_hook=_unique_keys)
+    except _DuplicateKey as exc:
+        raise ProtocolError(f"wrote {shown(line)} instead of {what}: the key {shown(str(exc))} twice "
+                            "(expected each key once)") from None
+    except (UnicodeDecodeError, ValueError, RecursionError):   # RecursionError: arrays nested too deep
         raise ProtocolError(f"wrote garbage instead of {what}: {shown(line)} (expected one JSON line)") from None
     if not isinstance(obj, dict):
         raise ProtocolError(f"wrote {shown(line)} instead of {what}: expected a JSON object")
@@ -142,11 +161,16 @@ def reply_length(line: bytes, n_expected: int) -> int:
     obj = parse_line(line, "a reply")
     if "error" in obj:
         raise CandidateReportedError(" ".join(str(obj["error"]).split())[:500])
+    unknown = sorted(set(obj) - set(REPLY_KEYS))
+    if unknown:      # an echo of the request ({"request":..,"n":N,...}) must not pass for a reply
+        raise ProtocolError(f"wrote the reply {shown(line)}: the key {shown(unknown[0], 30)} is not one of a "
+                            f"reply's ({', '.join(REPLY_KEYS)})")
     n = obj.get("n")
     if not isinstance(n, int) or isinstance(n, bool):
         raise ProtocolError(f"wrote the reply {shown(line)}: expected {{\"n\": {n_expected}}} or {{\"error\": ...}}")
     if n != n_expected:
-        raise ProtocolError(f"answered {n} points to a request of {n_expected}: expected {n_expected}")
+        digits = str(n)       # a reply line holds up to MAX_LINE digits: the reason shows the first 24
+        raise ProtocolError(f"answered {digits if len(digits) <= 24 else digits[:24] + '...'} points to a request of {n_expected}: expected {n_expected}")
     return n * REPLY_POINT_BYTES
 
 
@@ -167,7 +191,6 @@ def check_hello(line: bytes) -> None:
         obj = parse_line(line, "the header")
         if "error" in obj:
             raise CandidateReportedError(" ".join(str(obj["error"]).split())[:500])
-    if line.startswith(b"wirecheck-candidate "):
-        raise ProtocolError(f"speaks {line.decode(errors='replace').strip()!r}: this wirecheck speaks "
-                            f"{HEADER.decode().strip()!r}")
+    if re.fullmatch(rb"wirecheck-candidate [0-9]{1,9}\n", line):      # another version, byte for byte
+        raise ProtocolError(f"speaks {line.decode().strip()!r}: this wirecheck speaks {HEADER.decode().strip()!r}")
     raise ProtocolError(f"answered the header with {shown(line)}: expected {HEADER!r}")
