@@ -58,6 +58,8 @@ STDERR_KEEP = 64 * 1024
 _CHUNK = 1 << 20
 #: Seconds a program gets to exit after its stdin is closed, before it is killed.
 _EXIT_GRACE_S = 2.0
+#: Seconds, at least, to collect the exit status of a program whose pipe ended (one that is exiting).
+_REAP_MIN_S = 0.05
 #: Seconds a killed program's group gets to be gone (a SIGKILL ends a process in milliseconds).
 _GROUP_END_S = 1.0
 
@@ -317,6 +319,68 @@ def _await_group_end(pgid: int) -> None:
         time.sleep(0.001)
 
 
+def _pipe_ends(proc) -> dict:
+    """``{pipe inode: access mode}`` of the program's ends of its three pipes (read stdin, write stdout, stderr)."""
+    try:
+        return {os.fstat(proc.stdin.fileno()).st_ino: os.O_RDONLY,
+                os.fstat(proc.stdout.fileno()).st_ino: os.O_WRONLY,
+                os.fstat(proc.stderr.fileno()).st_ino: os.O_WRONLY}
+    except (OSError, ValueError):
+        return {}
+
+
+def _kill_pipe_holders(ends: dict) -> None:
+    """SIGKILL every other process that ``/proc`` shows holding one of the program's pipe ends ``ends``.
+
+    A process the program started in a session of its own (``setsid``, a
+    daemon) escapes its process group, but while it holds the program's stdout
+    or stdin it is still the program's, and it would outlive the run. (A process
+    that closed them is out of reach; this process's own ends, and a fork of
+    it that inherited them, are the other direction and are left alone.)
+    """
+    if not ends:
+        return
+    try:
+        names = os.listdir("/proc")
+    except OSError:
+        return
+    me, held = os.getpid(), []
+    for name in names:
+        if not name.isdigit() or int(name) == me:
+            continue
+        try:
+            for fd in os.listdir(f"/proc/{name}/fd"):
+                link = os.readlink(f"/proc/{name}/fd/{fd}")
+                if not link.startswith("pipe:["):
+                    continue
+                mode = ends.get(int(link[6:-1]))
+                if mode is None:
+                    continue
+                with open(f"/proc/{name}/fdinfo/{fd}") as fh:
+                    flags = next(int(ln.split()[1], 8) for ln in fh if ln.startswith("flags:"))
+                if flags & os.O_ACCMODE == mode:
+                    held.append(int(name))
+                    break
+        except (OSError, ValueError, StopIteration):
+            continue
+    for pid in held:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.kill(pid, signal.SIGKILL)
+    deadline = time.monotonic() + _GROUP_END_S
+    while held and time.monotonic() < deadline:
+        held = [pid for pid in held if _runs(pid)]
+        time.sleep(0.001)
+
+
+def _runs(pid: int) -> bool:
+    """Whether ``/proc`` shows ``pid`` running (not a zombie)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[1].split()[0] != b"Z"
+    except (OSError, IndexError):
+        return False
+
+
 def _group_runs(pgid: int) -> bool:
     """Whether ``/proc`` shows a process of group ``pgid`` that is not a zombie (False without ``/proc``)."""
     try:
@@ -336,7 +400,7 @@ def _group_runs(pgid: int) -> bool:
 
 
 class _Died(Exception):
-    pass
+    """The pipe ended: ``args[0]`` is which ("stdout": EOF on it; "stdin": the program stopped reading)."""
 
 
 class _TimedOut(Exception):
@@ -352,6 +416,13 @@ def _status_text(returncode) -> str:
         except ValueError:
             return f"was killed by signal {-returncode}"
     return f"exited with status {returncode}"
+
+
+def _early(sent: int, total: int) -> str:
+    """The reason for a reply (an error reply too) that came before the request was all written: the
+    program would read the rest as its next request."""
+    return (f"answered before reading the whole request ({sent} of {total} bytes had reached its stdin): "
+            "expected the reply after the request")
 
 
 class _Program:
@@ -425,6 +496,7 @@ class _Program:
     def close(self) -> None:
         proc, self.proc = self.proc, None
         if proc is not None:
+            ends = _pipe_ends(proc)
             try:
                 proc.stdin.close()
             except OSError:
@@ -438,6 +510,7 @@ class _Program:
             self._killpg(proc)
             proc.wait()
             _await_group_end(proc.pid)
+            _kill_pipe_holders(ends)
             self._drain_stderr(proc)
             proc.stdout.close()
             proc.stderr.close()
@@ -459,6 +532,7 @@ class _Program:
         self._killpg(proc)
         proc.wait()
         _await_group_end(proc.pid)
+        _kill_pipe_holders(_pipe_ends(proc))
         self._drain_stderr(proc)            # all it wrote is in the pipe now
         for f in (proc.stdin, proc.stdout, proc.stderr):
             try:
@@ -466,14 +540,19 @@ class _Program:
             except OSError:
                 pass
 
-    def _reap(self) -> str:
-        """After EOF on stdout: the exit status in words (killing it if it lingers)."""
+    def _reap(self, pipe: str, deadline: float) -> str:
+        """After a pipe ended: the exit status in words, or (alive at ``deadline``) what it did, then killed.
+
+        The wait counts against the request's own time (at least ``_REAP_MIN_S``,
+        for a program that is exiting): a program that closes a pipe and lives on
+        ends the request within its timeout, as a hang does.
+        """
         proc = self.proc
         try:
-            proc.wait(timeout=_EXIT_GRACE_S)
+            proc.wait(timeout=max(deadline - time.monotonic(), _REAP_MIN_S))
         except subprocess.TimeoutExpired:
             self._kill()
-            return "closed its stdout (and was killed)"
+            return f"closed its {pipe} but went on running (it was killed)"
         self._kill()           # closes the pipes; the group may hold children
         return _status_text(proc.returncode)
 
@@ -500,6 +579,7 @@ class _Program:
             return header["end"]
 
         try:
+            self._read_pending()
             if self.buf:
                 raise protocol.ProtocolError(f"wrote {len(self.buf)} bytes outside a reply: "
                                              f"{protocol.shown(bytes(self.buf))}")
@@ -522,13 +602,14 @@ class _Program:
 
     def _exchange(self, payload: bytes, end_of, limit_s: float, timed_out: str, died_while: str) -> int:
         """:meth:`_transfer` within ``limit_s``; a hang (killed) or a death becomes one CandidateError."""
+        deadline = time.monotonic() + limit_s
         try:
-            return self._transfer(payload, end_of, time.monotonic() + limit_s)
+            return self._transfer(payload, end_of, deadline)
         except _TimedOut:
             self._kill()
             raise CandidateError(f"{timed_out}{self._stderr_hint()}") from None
-        except _Died:
-            status = self._reap()
+        except _Died as exc:
+            status = self._reap(exc.args[0], deadline)
             raise CandidateError(f"candidate {status} {died_while}{self._stderr_hint()}") from None
 
     def _line_end(self, buf) -> int | None:
@@ -558,8 +639,15 @@ class _Program:
             sel.register(r, selectors.EVENT_READ)
             sel.register(e, selectors.EVENT_READ)
             while True:
-                end = end_of(self.buf)
-                if end is not None and len(self.buf) >= end and sent == len(payload):
+                try:
+                    end = end_of(self.buf)
+                except protocol.CandidateReportedError:
+                    if sent < len(payload):
+                        raise protocol.ProtocolError(_early(sent, len(payload))) from None
+                    raise
+                if end is not None and len(self.buf) >= end:
+                    if sent < len(payload):       # its answer cannot depend on bytes it never got
+                        raise protocol.ProtocolError(_early(sent, len(payload)))
                     self._drain_stderr(proc)      # what it wrote before replying
                     return end
                 remaining = deadline - time.monotonic()
@@ -575,7 +663,7 @@ class _Program:
                         except BlockingIOError:
                             continue
                         except (BrokenPipeError, ConnectionResetError):
-                            raise _Died from None
+                            raise _Died("stdin") from None
                         if sent == len(payload):
                             sel.unregister(w)
                     else:
@@ -584,10 +672,19 @@ class _Program:
                         except BlockingIOError:
                             continue
                         if not chunk:
-                            raise _Died
+                            raise _Died("stdout")
                         self.buf += chunk
         finally:
             sel.close()
+
+    def _read_pending(self) -> None:
+        """Read into ``self.buf`` what the program wrote since its last reply (nothing, if it keeps to the
+        protocol): bytes sent ahead of a request are then named as such, not taken as its reply."""
+        try:
+            chunk = os.read(self.proc.stdout.fileno(), protocol.MAX_LINE)
+        except (BlockingIOError, OSError):
+            return
+        self.buf += chunk          # b"" (EOF) too: the exchange then finds it
 
     # ---- stderr
 
