@@ -121,6 +121,13 @@ def encode_error(message: str) -> bytes:
     return json.dumps({"error": " ".join(str(message).split())}).encode() + b"\n"
 
 
+def error_text(value) -> str:
+    """A program's ``{"error": ...}`` as one line for the console and the report: whitespace runs made one
+    space, other control characters (a terminal's escape sequences, NUL) escaped, at most 500 characters."""
+    text = " ".join(str(value).split())
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)[:500]
+
+
 def shown(data: bytes, limit: int = 60) -> str:
     """Bytes as a short repr for an error line."""
     return repr(data[:limit]) + ("..." if len(data) > limit else "")
@@ -160,7 +167,7 @@ def reply_length(line: bytes, n_expected: int) -> int:
     """
     obj = parse_line(line, "a reply")
     if "error" in obj:
-        raise CandidateReportedError(" ".join(str(obj["error"]).split())[:500])
+        raise CandidateReportedError(error_text(obj["error"]))
     unknown = sorted(set(obj) - set(REPLY_KEYS))
     if unknown:      # an echo of the request ({"request":..,"n":N,...}) must not pass for a reply
         raise ProtocolError(f"wrote the reply {shown(line)}: the key {shown(unknown[0], 30)} is not one of a "
@@ -190,7 +197,7 @@ def check_hello(line: bytes) -> None:
     if line.startswith(b"{"):
         obj = parse_line(line, "the header")
         if "error" in obj:
-            raise CandidateReportedError(" ".join(str(obj["error"]).split())[:500])
+            raise CandidateReportedError(error_text(obj["error"]))
     if re.fullmatch(rb"wirecheck-candidate [0-9]{1,9}\n", line):      # another version, byte for byte
         raise ProtocolError(f"speaks {line.decode().strip()!r}: this wirecheck speaks {HEADER.decode().strip()!r}")
     raise ProtocolError(f"answered the header with {shown(line)}: expected {HEADER!r}")

@@ -118,6 +118,13 @@ def test_bytes_written_before_a_request_are_not_its_reply(tmp_path):
                             + repr(b'{"n": 8}\n' + bytes(51)) + "... (on a request of 8 points); it was killed")
 
 
+def test_an_error_reply_reaches_the_console_as_one_printable_line(tmp_path):
+    # an error text is the program's: its escape sequences went raw to the console (and the report)
+    error = json.dumps({"error": "bad\x1b[2K\x1b[1Gcamera\x00\x07\nx"}).encode() + b"\n"
+    cand = _candidate(tmp_path, HELLO + "while True:\n    " + READ + f"    o.write({error!r}); o.flush()\n")
+    assert _fault(cand) == "candidate reported an error: bad\\x1b[2K\\x1b[1Gcamera\\x00\\x07 x"
+
+
 # ---- the payload
 
 def test_payload_values_arrive_bit_for_bit_and_an_infinity_fails(tmp_path):
