@@ -236,3 +236,25 @@ def test_crosscheck_fails_every_case_of_a_program_that_closes_its_stdout(tmp_pat
     for case in report["cases"]:
         assert case["reasons"] == ["frame 1: candidate closed its stdout but went on running (it was killed) "
                                    "during a request of 8 points"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_program_whose_parent_exits_leaving_a_silent_child_times_out_and_the_child_ends(tmp_path):
+    # the child keeps the pipes open (no EOF for wirecheck) and never answers: a timeout, and the
+    # child (still in the program's group) is killed with it
+    pid_file = tmp_path / "child"
+    body = HELLO + (f"if os.fork():\n    os._exit(0)\nopen({str(pid_file)!r}, 'w').write(str(os.getpid()))\n"
+                    "time.sleep(300)\n")
+    assert _fault(_candidate(tmp_path, body, timeout_s=0.3)).startswith("candidate timed out after 0.3 s")
+    assert not _alive(int(pid_file.read_text()))
+
+
+def test_check_projector_cmd_fails_a_program_that_echoes_its_requests(tmp_path):
+    from wirecheck.oracles import api
+
+    report = api.check_projector(cmd=["sh", "-c", "read h; echo 'wirecheck-candidate 1'; exec cat"],
+                                 scenes=["cube"], cases=["on_axis"], frames=1)
+    assert report["verdict"] == "fail" and report["summary"]["failed"] == 1
+    (reason,) = report["cases"][0]["reasons"]
+    assert reason.startswith("frame 1: candidate wrote the reply b'{\"request\":1,\"n\":8,\"camera\":") and \
+        reason.endswith("the key 'camera' is not one of a reply's (n, precision) (on a request of 8 points); it was killed")
