@@ -226,6 +226,13 @@ def _die_with_parent() -> None:
         pass
 
 
+def _live_pipe_fds() -> list:
+    """This process's ends of every live program's pipes: a fork closes them, or a program would never see
+    EOF on its stdin while the fork lives (its close would wait out ``_EXIT_GRACE_S``, then kill it)."""
+    return [f.fileno() for program in _PROGRAMS.values() if program.proc is not None
+            for f in (program.proc.stdin, program.proc.stdout, program.proc.stderr) if not f.closed]
+
+
 class _ForkedChild:
     """A forked copy of this process serving the candidate protocol for ``func``: what Popen gives, for it.
 
@@ -245,7 +252,7 @@ class _ForkedChild:
                 os.setsid()
                 _die_with_parent()
                 sys.dont_write_bytecode = True         # as the candidate host: no __pycache__ from its imports
-                for fd in (in_w, out_r, err_r):
+                for fd in (in_w, out_r, err_r, *_live_pipe_fds()):
                     os.close(fd)
                 os.dup2(err_w, 1)
                 os.dup2(err_w, 2)

@@ -258,3 +258,19 @@ def test_check_projector_cmd_fails_a_program_that_echoes_its_requests(tmp_path):
     (reason,) = report["cases"][0]["reasons"]
     assert reason.startswith("frame 1: candidate wrote the reply b'{\"request\":1,\"n\":8,\"camera\":") and \
         reason.endswith("the key 'camera' is not one of a reply's (n, precision) (on a request of 8 points); it was killed")
+
+
+def test_a_forked_candidate_does_not_hold_another_programs_stdin_open(tmp_path):
+    # a fork inherited this process's end of every live program's stdin: closing that program then
+    # gave it no EOF, so it was killed after the 2 s grace instead of exiting (its marker unwritten)
+    marker = tmp_path / "eof"
+    first = SubprocessCandidate(argv=("sh", "-c", f"read h; echo 'wirecheck-candidate 1'; cat > /dev/null; "
+                                                  f"echo eof > {marker}"))
+    first.start()
+    forked = SubprocessCandidate.fork(lambda p, c: p[:, :2] * 0.0, label="lambda")
+    forked.start()
+    try:
+        first.close()
+        assert marker.read_text() == "eof\n"
+    finally:
+        forked.close()
