@@ -9,8 +9,14 @@ a :class:`~oracles.candidate.CandidateError` of one line:
 
 - it hangs: killed (its whole process group) after ``timeout_s``;
 - it dies (``os._exit``, a segfault, a signal): its exit status or signal;
-- it answers the wrong number of points, or garbage: what it wrote;
+- it closes its stdout or stdin and lives on: that, killed within ``timeout_s``;
+- it answers the wrong number of points, or garbage, or before reading the
+  request, or writes between requests: what it wrote;
 - it answers ``{"error": ...}``: its message (the program lives on).
+
+The timeout is per request (writing it and reading the whole reply), not per
+read. A kill reaches the program's process group and (Linux) any process that
+holds the program's end of one of its pipes.
 
 After a kill or a death the next call starts the program again (a fresh
 process for the next case). A program that fails to start (dies, hangs or
@@ -24,7 +30,7 @@ and what the program wrote before its reply is always there (the report is
 the same on every run). :meth:`SubprocessCandidate.take_stderr` returns what
 was written since the last call.
 
-(About 540 lines: one program's life cycle, its non-blocking pipes and its
+(About 700 lines: one program's life cycle, its non-blocking pipes and its
 protocol state are one state machine; :class:`_ForkedChild` is the Popen
 stand-in for callables run in a fork.)
 """
