@@ -417,7 +417,18 @@ class _Died(Exception):
 
 
 class _TimedOut(Exception):
-    pass
+    """The deadline passed: ``args[0]`` says how far the exchange got (:func:`_progress`)."""
+
+
+def _progress(sent: int, total: int, got: int, end) -> str:
+    """How far a timed-out request got, for its reason ('' when all was sent and nothing came back)."""
+    if sent < total:
+        return f" ({sent} of the request's {total} bytes had reached its stdin)"
+    if got and end is None:
+        return f" (its reply line had {got} bytes and no newline)"
+    if got:
+        return f" (its reply had {got} of {end} bytes)"
+    return ""
 
 
 def _status_text(returncode) -> str:
@@ -597,7 +608,7 @@ class _Program:
                 raise protocol.ProtocolError(f"wrote {len(self.buf)} bytes outside a reply: "
                                              f"{protocol.shown(bytes(self.buf))}")
             end = self._exchange(payload, reply_end, self.spec.timeout_s,
-                                 f"candidate timed out after {self.spec.timeout_s:g} s on {what}; it was killed "
+                                 f"candidate timed out after {self.spec.timeout_s:g} s on {what}{{progress}}; it was killed "
                                  "(and is started again for the next case)", f"during {what}")
         except protocol.CandidateReportedError as exc:
             del self.buf[:header["line"]]
@@ -618,9 +629,9 @@ class _Program:
         deadline = time.monotonic() + limit_s
         try:
             return self._transfer(payload, end_of, deadline)
-        except _TimedOut:
+        except _TimedOut as exc:
             self._kill()
-            raise CandidateError(f"{timed_out}{self._stderr_hint()}") from None
+            raise CandidateError(f"{timed_out.format(progress=exc.args[0])}{self._stderr_hint()}") from None
         except _Died as exc:
             status = self._reap(exc.args[0], deadline)
             raise CandidateError(f"candidate {status} {died_while}{self._stderr_hint()}") from None
@@ -665,7 +676,7 @@ class _Program:
                     return end
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
-                    raise _TimedOut
+                    raise _TimedOut(_progress(sent, len(payload), len(self.buf), end))
                 for key, _ in sel.select(remaining):
                     if key.fd == e:
                         if not self._drain_stderr(proc):
