@@ -568,12 +568,12 @@ class _Program:
         """After a pipe ended: the exit status in words, or (alive at ``deadline``) what it did, then killed.
 
         The wait counts against the request's own time (at least ``_REAP_MIN_S``,
-        for a program that is exiting): a program that closes a pipe and lives on
-        ends the request within its timeout, as a hang does.
+        for a program that is exiting; at most ``_EXIT_GRACE_S``): a program that
+        closes a pipe and lives on ends the request within its timeout, as a hang does.
         """
         proc = self.proc
         try:
-            proc.wait(timeout=max(deadline - time.monotonic(), _REAP_MIN_S))
+            proc.wait(timeout=max(min(deadline - time.monotonic(), _EXIT_GRACE_S), _REAP_MIN_S))
         except subprocess.TimeoutExpired:
             self._kill()
             return f"closed its {pipe} but went on running (it was killed)"
