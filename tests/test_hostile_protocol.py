@@ -173,10 +173,12 @@ def test_a_program_that_closes_a_pipe_and_lives_on_ends_within_the_timeout(tmp_p
     assert time.monotonic() - t < 10           # 0.3 s, a kill, slack for a loaded machine (was >= 30 s)
 
 
-def test_a_reply_before_the_request_is_read_fails_at_once(tmp_path):
-    # reads the request line, not its 24 MB of points, and answers: it was a timeout (the harness
-    # waited to write the rest), now the protocol fault, without waiting
-    body = HELLO + 'n = json.loads(i.readline())["n"]\n' + ZEROS + "time.sleep(60)\n"
+@pytest.mark.parametrize("answer", [ZEROS, 'o.write(b\'{"error": "no"}\\n\'); o.flush()\n'], ids=["reply", "error"])
+def test_a_reply_before_the_request_is_read_fails_at_once(tmp_path, answer):
+    # reads the request line, not its 24 MB of points, and answers: a reply was a timeout (the harness
+    # waited to write the rest), an error reply kept the program with the rest of the request unsent
+    # (it would read the next request's bytes as these points); now the protocol fault, at once
+    body = HELLO + 'n = json.loads(i.readline())["n"]\n' + answer + "time.sleep(60)\n"
     t = time.monotonic()
     reason = _fault(_candidate(tmp_path, body, timeout_s=30), n=1_000_000)
     assert reason.startswith("candidate answered before reading the whole request (")
