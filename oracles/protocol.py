@@ -177,7 +177,8 @@ def reply_length(line: bytes, n_expected: int) -> int:
         raise ProtocolError(f"wrote the reply {shown(line)}: expected {{\"n\": {n_expected}}} or {{\"error\": ...}}")
     if n != n_expected:
         digits = str(n)       # a reply line holds up to MAX_LINE digits: the reason shows the first 24
-        raise ProtocolError(f"answered {digits if len(digits) <= 24 else digits[:24] + '...'} points to a request of {n_expected}: expected {n_expected}")
+        digits = digits if len(digits) <= 24 else digits[:24] + "..."
+        raise ProtocolError(f"answered {digits} points to a request of {n_expected}: expected {n_expected}")
     return n * REPLY_POINT_BYTES
 
 

@@ -608,7 +608,8 @@ class _Program:
                 raise protocol.ProtocolError(f"wrote {len(self.buf)} bytes outside a reply: "
                                              f"{protocol.shown(bytes(self.buf))}")
             end = self._exchange(payload, reply_end, self.spec.timeout_s,
-                                 f"candidate timed out after {self.spec.timeout_s:g} s on {what}{{progress}}; it was killed "
+                                 f"candidate timed out after {self.spec.timeout_s:g} s on {what}{{progress}}; "
+                                 "it was killed "
                                  "(and is started again for the next case)", f"during {what}")
         except protocol.CandidateReportedError as exc:
             del self.buf[:header["line"]]

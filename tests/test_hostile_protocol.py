@@ -49,6 +49,14 @@ def _fault(cand, n=8) -> str:
     return str(info.value)
 
 
+def _wait_for(path: Path) -> None:
+    """Until ``path`` (written by the program) is there and not empty: 10 s for a loaded machine."""
+    for _ in range(1000):
+        if path.exists() and path.read_text():
+            return
+        time.sleep(0.01)
+
+
 def _alive(pid: int) -> bool:
     try:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
@@ -70,7 +78,8 @@ def test_a_header_that_differs_by_a_byte_is_shown_as_written(tmp_path, hello, sh
 
 
 def test_the_header_twice_is_bytes_outside_a_reply(tmp_path):
-    cand = _candidate(tmp_path, HELLO + HELLO + SERVE)
+    # one write: both lines reach the pipe together (a write under PIPE_BUF is atomic), before any request
+    cand = _candidate(tmp_path, 'o.write(b"wirecheck-candidate 1\\n" * 2); o.flush()\n' + SERVE)
     assert _fault(cand) == ("candidate wrote 22 bytes outside a reply: b'wirecheck-candidate 1\\n' (on a request of "
                             "8 points); it was killed")
 
@@ -112,9 +121,11 @@ def test_a_program_that_echoes_the_request_does_not_pass_for_a_reply(tmp_path):
 
 def test_bytes_written_before_a_request_are_not_its_reply(tmp_path):
     # a reply to a request never sent: it sat in the pipe and was taken for the next request's reply
-    cand = _candidate(tmp_path, HELLO + "time.sleep(0.05)\n" + 'n = 8\n' + ZEROS + SERVE)
-    cand.start()
-    time.sleep(0.4)                     # the early reply is in the pipe (0.05 s after the header, plus slack)
+    written = tmp_path / "written"
+    early = 'time.sleep(0.05)\nn = 8\n' + ZEROS + f"open({str(written)!r}, 'w').write('1')\n"
+    cand = _candidate(tmp_path, HELLO + early + SERVE)
+    cand.start()                        # reads the header; the early reply follows it 0.05 s later
+    _wait_for(written)
     assert _fault(cand) == ("candidate wrote 137 bytes outside a reply: "
                             + repr(b'{"n": 8}\n' + bytes(51)) + "... (on a request of 8 points); it was killed")
 
@@ -132,7 +143,8 @@ def test_payload_values_arrive_bit_for_bit_and_an_infinity_fails(tmp_path):
     # -0.0, the smallest denormal and NaN for a clipped point are valid answers, passed through exactly; an
     # infinity is the contract's fault
     values = [-0.0, 5e-324, np.nan, np.nan, 1e308, -2.5]
-    body = HELLO + READ + f'o.write(b"{{\\"n\\": 3}}\\n" + struct.pack("<6d", *[float(v) for v in {[str(v) for v in values]!r}])); o.flush()\n' + SERVE
+    texts = [str(v) for v in values]          # 'nan' and '5e-324' through float(), exactly
+    body = HELLO + READ + f'o.write(b"{{\\"n\\": 3}}\\n" + struct.pack("<6d", *map(float, {texts!r}))); o.flush()\n' + SERVE
     cand = _candidate(tmp_path, body)
     got = call_candidate(cand, np.zeros((3, 3)), CAMERA)
     cand.close()
@@ -165,7 +177,10 @@ def test_a_program_that_closes_a_pipe_and_lives_on_ends_within_the_timeout(tmp_p
     # was: the exit grace (2 s; 30 s here, so that the bound below separates the two) past a 0.3 s
     # timeout, and "closed its stdout" for a closed stdin too
     monkeypatch.setattr(subprocess_candidate, "_EXIT_GRACE_S", 30.0)
-    cand = _candidate(tmp_path, HELLO + f"os.close({fd}); time.sleep(60)\n", timeout_s=0.3)
+    # stdin is closed before the header is answered, so the request finds it closed (not in a race)
+    closing = f"os.close({fd})\n"
+    body = (closing + HELLO if fd == 0 else HELLO + closing) + "time.sleep(60)\n"
+    cand = _candidate(tmp_path, body, timeout_s=0.3)
     cand.start()
     t = time.monotonic()
     reason = _fault(cand)
@@ -208,7 +223,7 @@ def test_a_line_of_100_mb_without_a_newline_is_cut_at_the_line_limit(tmp_path):
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_sigstop_on_itself_is_a_timeout_and_the_process_ends(tmp_path):
     pid_file = tmp_path / "pid"
-    body = HELLO + f"open({str(pid_file)!r}, 'w').write(str(os.getpid()))\n" + READ + \
+    body = f"open({str(pid_file)!r}, 'w').write(str(os.getpid()))\n" + HELLO + READ + \
         "os.kill(os.getpid(), signal.SIGSTOP)\n" + ZEROS
     assert _fault(_candidate(tmp_path, body, timeout_s=0.3)).startswith("candidate timed out after 0.3 s")
     assert not _alive(int(pid_file.read_text()))
@@ -223,10 +238,7 @@ def test_a_process_started_in_a_session_of_its_own_ends_with_the_program(tmp_pat
                     "    time.sleep(300)\n") + SERVE
     cand = _candidate(tmp_path, body)
     assert call_candidate(cand, np.zeros((8, 3)), CAMERA).tolist() == [[0.0, 0.0]] * 8
-    for _ in range(100):                   # the child writes its pid soon after the fork
-        if pid_file.exists() and pid_file.read_text():
-            break
-        time.sleep(0.01)
+    _wait_for(pid_file)                    # the child writes its pid soon after the fork
     orphan = int(pid_file.read_text())
     assert _alive(orphan)
     cand.close()
@@ -254,8 +266,9 @@ def test_a_program_whose_parent_exits_leaving_a_silent_child_times_out_and_the_c
     # the child keeps the pipes open (no EOF for wirecheck) and never answers: a timeout, and the
     # child (still in the program's group) is killed with it
     pid_file = tmp_path / "child"
-    body = HELLO + (f"if os.fork():\n    os._exit(0)\nopen({str(pid_file)!r}, 'w').write(str(os.getpid()))\n"
-                    "time.sleep(300)\n")
+    # the parent writes the child's pid before it answers the header, then exits
+    body = (f"child = os.fork()\nif child:\n    open({str(pid_file)!r}, 'w').write(str(child))\n    " + HELLO
+            + "    os._exit(0)\ntime.sleep(300)\n")
     assert _fault(_candidate(tmp_path, body, timeout_s=0.3)).startswith("candidate timed out after 0.3 s")
     assert not _alive(int(pid_file.read_text()))
 
@@ -267,8 +280,9 @@ def test_check_projector_cmd_fails_a_program_that_echoes_its_requests(tmp_path):
                                  scenes=["cube"], cases=["on_axis"], frames=1)
     assert report["verdict"] == "fail" and report["summary"]["failed"] == 1
     (reason,) = report["cases"][0]["reasons"]
-    assert reason.startswith("frame 1: candidate wrote the reply b'{\"request\":1,\"n\":8,\"camera\":") and \
-        reason.endswith("the key 'camera' is not one of a reply's (n, precision) (on a request of 8 points); it was killed")
+    assert reason.startswith("frame 1: candidate wrote the reply b'{\"request\":1,\"n\":8,\"camera\":")
+    assert reason.endswith("the key 'camera' is not one of a reply's (n, precision) (on a request of 8 points); "
+                           "it was killed")
 
 
 def test_a_forked_candidate_does_not_hold_another_programs_stdin_open(tmp_path):
