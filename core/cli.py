@@ -44,8 +44,9 @@ from .compose import AXIS_LENGTH
 from .culling import CULL_CHOICES
 from .errors import InputError, check_not_empty
 from .guard import VersionAction, run_cli
-from .numbers import plain_float, plain_int
 from .limits import MAX_FRAMES, check_image_size, check_turns
+from .numbers import plain_float, plain_int
+from .output import check_outside_scenes
 from .projection import DTYPES
 from .raster import RASTER_MODES
 from .report import depth_text
@@ -319,22 +320,9 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         raise InputError(f"--cull backface: {scene.source}: {scene.winding_note}: expected faces wound "
                          "consistently (counter-clockwise seen from outside)")
     if not a.interactive:
-        _check_out_of_scenes(s.out)
+        check_outside_scenes(s.out, "--out", "an output folder elsewhere (output/ by default)")
         check_out(s.out, output_names(s))
     return s
-
-
-def _check_out_of_scenes(out: Path) -> None:
-    """InputError when ``--out`` is the bundled scenes folder or inside it (outputs there would pass for scenes)."""
-    from .scene_files import SCENE_DIR
-
-    try:
-        resolved = out.resolve()
-    except (RuntimeError, OSError) as exc:         # a symbolic link loop: Python 3.11 raises RuntimeError
-        raise InputError(f"--out {str(out)!r}: {exc}: expected a folder path") from None
-    if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
-        raise InputError(f"--out {str(out)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected an "
-                         "output folder elsewhere (output/ by default)")
 
 
 def _numbers(option: str, text: str, counts: tuple) -> tuple:

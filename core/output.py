@@ -304,6 +304,20 @@ def check_replaceable(path: Path, option: str) -> None:
                      "output (nothing was changed; move it away first)")
 
 
+def check_outside_scenes(path: Path, option: str, expected: str) -> None:
+    """InputError when ``path`` is the bundled scenes folder or inside it: outputs there would pass for
+    scenes in later runs. ``expected``: what to give instead, for the message."""
+    from .errors import InputError
+    from .scene_files import SCENE_DIR
+
+    try:
+        resolved = Path(path).resolve()
+    except (RuntimeError, OSError) as exc:         # a symbolic link loop: Python 3.11 raises RuntimeError
+        raise InputError(f"{option} {str(path)!r}: {exc}: expected a folder path") from None
+    if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
+        raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected {expected}")
+
+
 def check_report_dir(path: Path, option: str) -> None:
     """InputError when a report folder at ``path`` could not be written or would pass for a scene.
 
@@ -313,7 +327,7 @@ def check_report_dir(path: Path, option: str) -> None:
     parents only when it writes the report, so a failed run leaves no folder.
     """
     from .errors import InputError
-    from .scene_files import MESH_SUFFIXES, NATIVE_SUFFIX, SCENE_DIR
+    from .scene_files import MESH_SUFFIXES, NATIVE_SUFFIX
 
     path = Path(path)
     long = next((part for part in path.parts if len(os.fsencode(part)) > 255), None)
@@ -328,13 +342,7 @@ def check_report_dir(path: Path, option: str) -> None:
     if named is not None:
         raise InputError(f"{option} {str(path)!r}: a folder named like a scene file ({named}) would be "
                          "taken for a scene by later runs: expected another name")
-    try:
-        resolved = path.resolve()
-    except (RuntimeError, OSError) as exc:         # a symbolic link loop: Python 3.11 raises RuntimeError
-        raise InputError(f"{option} {str(path)!r}: {exc}: expected a folder path") from None
-    if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
-        raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected a "
-                         "report folder elsewhere (reports/ by default)")
+    check_outside_scenes(path, option, "a report folder elsewhere (reports/ by default)")
     if not parent.is_dir():
         raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not a directory: expected a folder path")
     if not os.access(parent, os.W_OK | os.X_OK):

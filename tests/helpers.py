@@ -55,3 +55,19 @@ def assert_help_states_defaults(parser) -> None:
             assert action.help and "default" in action.help, action.option_strings
     text = parser.format_help()
     assert "``" not in text and ":func:" not in text and ":mod:" not in text
+
+
+def blank_job(job):
+    """Export a frames job of cube / on_axis, frames 1 and 3 of 4, into ``job`` and fill it with black
+    640x480 PNGs (a renderer that drew nothing: judged, it fails); returns ``job``."""
+    from PIL import Image
+
+    from wirecheck.oracles import cli
+
+    assert cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "4",
+                     "--every", "2"]) == 0
+    (job / "frames/cube/on_axis").mkdir(parents=True)
+    for k in (1, 3):
+        Image.new("L", (640, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
+    return job
+

@@ -23,6 +23,7 @@ from wirecheck.core.scene_files import SCENE_DIR, parse_scene_text
 from wirecheck.core.staging import LOCK, MANIFEST
 from wirecheck.oracles import cli as crosscheck_cli
 
+import helpers
 from fuzz.contract import glb_bytes     # tests/ is on sys.path (rootdir conftest)
 
 
@@ -630,15 +631,7 @@ def test_scene_symlink_loop_and_fifo_are_named(tmp_path, capsys):
 @pytest.fixture(scope="module")
 def blank_job(tmp_path_factory):
     """A job of cube / on_axis, frames 1 and 3 of 4, with black PNGs at the camera's size (640x480)."""
-    from PIL import Image
-
-    job = tmp_path_factory.mktemp("job") / "job"
-    assert crosscheck_cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "4",
-                                "--every", "2"]) == 0
-    (job / "frames/cube/on_axis").mkdir(parents=True)
-    for k in (1, 3):
-        Image.new("L", (640, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
-    return job
+    return helpers.blank_job(tmp_path_factory.mktemp("job") / "job")
 
 
 def _set(*path_value):

@@ -22,6 +22,8 @@ from PIL import Image
 from wirecheck.oracles import cli as crosscheck_cli
 from wirecheck.oracles.frames_candidate import FrameProblem, FramesError, frame_inputs, load_frames, load_job, read_png
 
+import helpers                          # tests/ is on sys.path (rootdir conftest)
+
 
 def assert_one_error_line(rc, err, *needles):
     assert rc == 2, err
@@ -120,13 +122,7 @@ def test_an_animated_png_is_refused(tmp_path):
 @pytest.fixture(scope="module")
 def blank_job(tmp_path_factory):
     """cube / on_axis, frames 1 and 3 of 4, black 640x480 PNGs (judged: exit 1, tests/test_hostile.py)."""
-    job = tmp_path_factory.mktemp("job") / "job"
-    assert crosscheck_cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "4",
-                                "--every", "2"]) == 0
-    (job / "frames/cube/on_axis").mkdir(parents=True)
-    for k in (1, 3):
-        Image.new("L", (640, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
-    return job
+    return helpers.blank_job(tmp_path_factory.mktemp("job") / "job")
 
 
 @pytest.fixture
