@@ -118,7 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
                                "objects it applies to the whole scene, after each object's own motion)")
     mot.add_argument("--spin", default=None, metavar="X,Y,Z", help="full turns about X, Y, Z over the run (default 1,1,0)")
     mot.add_argument("--translate", default="0,0,0", metavar="X,Y,Z",
-                     help="offset reached at the end of the run, growing linearly (default 0,0,0)")
+                     help="constant offset of the scene, the same in every frame (default 0,0,0)")
     mot.add_argument("--scale", type=plain_float, default=1.0, help="uniform scale, non-zero (default 1)")
     p.add_argument("--clip", choices=CLIP_MODES, default="clip",
                    help="clip: clip edges at near/far; endpoint: drop edges with a clipped end (default clip)")
