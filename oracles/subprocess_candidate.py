@@ -385,13 +385,19 @@ def _kill_pipe_holders(ends: dict) -> None:
         time.sleep(0.001)
 
 
-def _runs(pid: int) -> bool:
-    """Whether ``/proc`` shows ``pid`` running (not a zombie)."""
+def _running_group(pid) -> int | None:
+    """The process group of ``pid`` if ``/proc`` shows it running (not a zombie), else None."""
     try:
         with open(f"/proc/{pid}/stat", "rb") as fh:
-            return fh.read().rsplit(b")", 1)[1].split()[0] != b"Z"
-    except (OSError, IndexError):
-        return False
+            state, _ppid, pgrp = fh.read().rsplit(b")", 1)[1].split()[:3]
+        return None if state == b"Z" else int(pgrp)
+    except (OSError, ValueError):
+        return None
+
+
+def _runs(pid: int) -> bool:
+    """Whether ``/proc`` shows ``pid`` running (not a zombie)."""
+    return _running_group(pid) is not None
 
 
 def _group_runs(pgid: int) -> bool:
@@ -400,16 +406,7 @@ def _group_runs(pgid: int) -> bool:
         names = os.listdir("/proc")
     except OSError:
         return False
-    for name in names:
-        if name.isdigit():
-            try:
-                with open(f"/proc/{name}/stat", "rb") as fh:
-                    state, _ppid, pgrp = fh.read().rsplit(b")", 1)[1].split()[:3]
-            except (OSError, ValueError):
-                continue
-            if int(pgrp) == pgid and state != b"Z":
-                return True
-    return False
+    return any(name.isdigit() and _running_group(name) == pgid for name in names)
 
 
 class _Died(Exception):

@@ -71,3 +71,15 @@ def blank_job(job):
         Image.new("L", (640, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
     return job
 
+
+def process_runs(pid: int) -> bool:
+    """Whether ``/proc`` shows ``pid`` running: False once it has ended, reaped or not (a zombie has ended;
+    only its parent's reaping is left). Linux."""
+    from pathlib import Path
+
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+    return state != "Z"
+

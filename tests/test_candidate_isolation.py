@@ -13,6 +13,8 @@ import pytest
 
 from wirecheck.oracles import cli
 
+from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)
+
 ROOT = Path(__file__).parent.parent
 
 #: (name, candidate source, a phrase the case's reason must hold)
@@ -191,15 +193,6 @@ def test_an_in_process_candidate_leaves_the_callers_imports_as_they_were(tmp_pat
     assert sorted(p.name for p in folder.rglob("*")) == sorted(["proj.py", f"{sibling}.py"])
     assert sys.path == path_before and sys.dont_write_bytecode is False
 
-def _alive(pid: int) -> bool:
-    """``pid`` is a live process (not reaped and not a zombie)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except FileNotFoundError:
-        return False
-    return state != "Z"
-
-
 @pytest.mark.parametrize("how", ["cli", "api_file", "api_callable", "api_cmd"])
 def test_a_candidates_process_ends_with_its_run(tmp_path, how):
     # a process making many runs (a user's pytest) must not keep an idle candidate process per
@@ -229,7 +222,7 @@ def test_a_candidates_process_ends_with_its_run(tmp_path, how):
                                    **args)["verdict"] == "fail"
     started = {int(x) for x in pids.read_text().split()} - {os.getpid()}
     assert len(started) == 1, started                      # one program, started once for the run
-    assert not _alive(started.pop())
+    assert not process_runs(started.pop())
 
 
 @pytest.mark.parametrize("how", ["cmd_shell", "fork_child"])
@@ -257,7 +250,7 @@ def test_what_a_candidate_started_ends_with_its_run(tmp_path, how):
             return p[:, :2] * 0.0
         assert api.check_projector(closure, **args)["verdict"] == "fail"
     child = int(pid_file.read_text())
-    assert child != os.getpid() and not _alive(child)
+    assert child != os.getpid() and not process_runs(child)
 
 def test_the_candidate_host_loads_no_oracle_library(tmp_path):
     # The host starts once per run (per worker): what it imports is start-up time of every
@@ -326,7 +319,7 @@ def test_an_interrupted_run_with_workers_does_not_wait_for_hung_candidates(tmp_p
     assert time.monotonic() - t0 < 20, err
     assert proc.returncode == 128 + getattr(signal, sig) and "Traceback" not in err
     deadline = time.monotonic() + 5                          # the hosts die with their workers (SIGKILL)
-    while any(_alive(pid) for pid in hosts) and time.monotonic() < deadline:
+    while any(process_runs(pid) for pid in hosts) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert not any(_alive(pid) for pid in hosts)
+    assert not any(process_runs(pid) for pid in hosts)
     assert not (tmp_path / "rep").exists()

@@ -19,6 +19,8 @@ from wirecheck.oracles import cli, opencv_oracle
 from wirecheck.oracles.cases import cameras_for
 from wirecheck.oracles.subprocess_candidate import SubprocessCandidate
 
+from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)
+
 CLIENTS = Path(__file__).parent / "clients"
 THREE = CLIENTS / "three"
 REQUIRED = os.environ.get("WIRECHECK_REQUIRE_CLIENTS") == "1"
@@ -240,14 +242,6 @@ def test_an_empty_command_is_a_usage_error_never_core(tmp_path, capsys):
     assert not (tmp_path / "r").exists()
 
 
-def _alive(pid: int) -> bool:
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (FileNotFoundError, ProcessLookupError):
-        return False
-    return state != "Z"                       # a zombie has ended; only its parent's reaping is left
-
-
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux's")
 def test_a_hung_program_does_not_outlive_a_killed_crosscheck(tmp_path):
     import signal
@@ -266,14 +260,14 @@ def test_a_hung_program_does_not_outlive_a_killed_crosscheck(tmp_path):
     try:
         assert parent.stdout.readline() == "ready\n"
         pid = int(pid_file.read_text())
-        assert _alive(pid)
+        assert process_runs(pid)
         parent.send_signal(signal.SIGKILL)       # no atexit, no cleanup: only the death signal can act
         parent.wait()
         for _ in range(100):                     # the kernel delivers it at once; allow 5 s on a loaded machine
-            if not _alive(pid):
+            if not process_runs(pid):
                 break
             time.sleep(0.05)
-        assert not _alive(pid)
+        assert not process_runs(pid)
     finally:
         parent.kill()
 

@@ -14,7 +14,7 @@ from wirecheck.core.errors import InputError
 from wirecheck.oracles import cli
 from wirecheck.oracles.dataset import dataset_entries, read_list, walk_folder
 from wirecheck.oracles.dataset_report import DatasetProgress
-from helpers import run_crosscheck
+from helpers import process_runs, run_crosscheck
 
 
 def run(tmp_path, *args, name="run"):
@@ -340,13 +340,6 @@ def test_a_plain_run_on_a_dask_cluster_gives_the_report_of_jobs_1(tmp_path, dask
     assert (out1 / "report.md").read_bytes() == (out2 / "report.md").read_bytes()
 
 
-def _alive(pid: int) -> bool:
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except FileNotFoundError:
-        return False
-
-
 @pytest.mark.slow
 def test_a_clusters_workers_keep_no_idle_program_per_earlier_candidate(tmp_path, dask_scheduler):
     # A cluster's workers outlive the runs they serve. Three runs of three candidates (each host
@@ -363,7 +356,7 @@ def test_a_clusters_workers_keep_no_idle_program_per_earlier_candidate(tmp_path,
         assert code == 0 and report["summary"]["passed"] == 2
     started = [int(x) for x in pids.read_text().split()]
     assert len(set(started)) >= 3                      # each run started its own program
-    assert sum(_alive(pid) for pid in set(started)) <= 2
+    assert sum(process_runs(pid) for pid in set(started)) <= 2
 
 
 @pytest.mark.slow

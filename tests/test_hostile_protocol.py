@@ -22,6 +22,8 @@ from wirecheck.oracles.candidate import CandidateError, call_candidate
 from wirecheck.oracles.cases import cameras_for
 from wirecheck.oracles.subprocess_candidate import SubprocessCandidate
 
+from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)
+
 CAMERA = cameras_for(1.0)[1].camera
 #: reads wirecheck's header; BODY then answers it (or not)
 HEAD = "import json, os, signal, struct, sys, time\ni, o = sys.stdin.buffer, sys.stdout.buffer\ni.readline()\n"
@@ -55,13 +57,6 @@ def _wait_for(path: Path) -> None:
         if path.exists() and path.read_text():
             return
         time.sleep(0.01)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except FileNotFoundError:
-        return False
 
 
 # ---- the header
@@ -226,7 +221,7 @@ def test_sigstop_on_itself_is_a_timeout_and_the_process_ends(tmp_path):
     body = f"open({str(pid_file)!r}, 'w').write(str(os.getpid()))\n" + HELLO + READ + \
         "os.kill(os.getpid(), signal.SIGSTOP)\n" + ZEROS
     assert _fault(_candidate(tmp_path, body, timeout_s=0.3)).startswith("candidate timed out after 0.3 s")
-    assert not _alive(int(pid_file.read_text()))
+    assert not process_runs(int(pid_file.read_text()))
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
@@ -240,9 +235,9 @@ def test_a_process_started_in_a_session_of_its_own_ends_with_the_program(tmp_pat
     assert call_candidate(cand, np.zeros((8, 3)), CAMERA).tolist() == [[0.0, 0.0]] * 8
     _wait_for(pid_file)                    # the child writes its pid soon after the fork
     orphan = int(pid_file.read_text())
-    assert _alive(orphan)
+    assert process_runs(orphan)
     cand.close()
-    assert not _alive(orphan)
+    assert not process_runs(orphan)
 
 
 # ---- through crosscheck: exit 1, every case failing with the one reason, no traceback
@@ -270,7 +265,7 @@ def test_a_program_whose_parent_exits_leaving_a_silent_child_times_out_and_the_c
     body = (f"child = os.fork()\nif child:\n    open({str(pid_file)!r}, 'w').write(str(child))\n    " + HELLO
             + "    os._exit(0)\ntime.sleep(300)\n")
     assert _fault(_candidate(tmp_path, body, timeout_s=0.3)).startswith("candidate timed out after 0.3 s")
-    assert not _alive(int(pid_file.read_text()))
+    assert not process_runs(int(pid_file.read_text()))
 
 
 def test_check_projector_cmd_fails_a_program_that_echoes_its_requests(tmp_path):
