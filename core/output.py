@@ -18,6 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .owned import MARKER
+from .owned import TAG as _TAG
+
 
 def _umask() -> int:
     mask = os.umask(0)
@@ -262,10 +265,9 @@ def mp4_bytes(images: list[np.ndarray], fps: int = 30) -> bytes:
     return buf.getvalue()
 
 
-#: Every directory wirecheck writes holds this empty file. An existing output
-#: directory is replaced only when it holds it (or is empty): a user's own
-#: folder or file is never deleted.
-MARKER = ".wirecheck-output"
+#: Every directory wirecheck writes holds this file: the listing of what it wrote there (core.owned).
+#: An existing output directory is replaced only when everything in it is listed (or it is empty): a
+#: user's own folder, or a user's file put into a folder of ours, is never deleted.
 
 
 def _users_frames(path: Path) -> str | None:
@@ -283,24 +285,26 @@ def _users_frames(path: Path) -> str | None:
 
 
 def check_replaceable(path: Path, option: str) -> None:
-    """InputError unless ``path`` is absent, an empty directory, or an earlier output of ours.
+    """InputError unless ``path`` is absent, an empty directory, or an earlier output folder of ours.
 
-    A frames job whose ``frames/`` the renderer has filled is not replaced (:func:`_users_frames`).
+    Everything in an earlier output must be what wirecheck wrote there (its
+    listing, core.owned): a user's file inside it is named and nothing is
+    replaced. A frames job whose ``frames/`` the renderer has filled says so (:func:`_users_frames`).
     """
     from .errors import InputError
+    from .owned import ours
 
     path = Path(path)
-    if not path.exists() and not path.is_symlink():
+    if path.is_dir() and not path.is_symlink() and (path / MARKER).is_file():
+        drawn = _users_frames(path)
+        if drawn is not None:
+            raise InputError(f"{option} {str(path)!r} is a frames job holding files a renderer wrote ({drawn}): "
+                             "expected a new path or an earlier wirecheck output (nothing was changed; "
+                             "move the frames away first)")
+    why = ours(path)
+    if why is None:
         return
-    if path.is_dir() and not path.is_symlink() and ((path / MARKER).is_file() or not any(path.iterdir())):
-        drawn = _users_frames(path) if (path / MARKER).is_file() else None
-        if drawn is None:
-            return
-        raise InputError(f"{option} {str(path)!r} is a frames job holding files a renderer wrote ({drawn}): "
-                         "expected a new path or an earlier wirecheck output (nothing was changed; "
-                         "move the frames away first)")
-    kind = "a directory not written by wirecheck" if path.is_dir() else "a file"
-    raise InputError(f"{option} {str(path)!r} is {kind}: expected a new path or an earlier wirecheck "
+    raise InputError(f"{option} {str(path)!r} is {why}: expected a new path or an earlier wirecheck "
                      "output (nothing was changed; move it away first)")
 
 
@@ -350,32 +354,76 @@ def check_report_dir(path: Path, option: str) -> None:
 
 
 class FrameDir:
-    """A directory filled under a temporary name, renamed over ``final`` on commit().
+    """A directory filled under a temporary name, then put in place of ``final`` by commit().
 
-    ``final`` may only be absent, empty, or an earlier output (see MARKER).
+    ``final`` may only be absent, empty, or an earlier output whose listing
+    names everything in it (:func:`check_replaceable`). One run writes a
+    given ``final`` at a time (a lock beside it, core.lockfile). The commit
+    is one step where Linux allows: the new folder and the old one swap
+    places (``renameat2(RENAME_EXCHANGE)``), so a run killed at any moment
+    leaves the old folder or the new one; the temporaries a killed run left
+    beside ``final`` (``.<name>.<unique>.tmp``, marked by core.owned.TAG)
+    are removed by the next run that writes ``final``.
     """
 
     def __init__(self, final: Path, option: str = "output"):
+        from .lockfile import Lock
+
         self.final = Path(final)
         self.option = option
+        self.tmp = None
         check_replaceable(self.final, option)
-        self.tmp = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
-        os.chmod(self.tmp, 0o777 & ~_umask())
-        (self.tmp / MARKER).write_bytes(b"")
+        self._lock = Lock(self.final.parent / f".{self.final.name}.wirecheck-lock", option, str(self.final))
+        try:
+            self._remove_leftovers()
+            check_replaceable(self.final, option)        # again, under the lock
+            self.tmp = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
+            (self.tmp / _TAG).write_bytes(b"")
+            os.chmod(self.tmp, 0o777 & ~_umask())
+            (self.tmp / MARKER).write_bytes(b"")
+        except BaseException:
+            self.abort()
+            raise
+
+    def _remove_leftovers(self) -> None:
+        """Remove the temporaries of killed runs for this ``final`` (ours alone: no live run holds the lock)."""
+        from .owned import is_leftover
+
+        prefix = f".{self.final.name}."
+        for entry in os.scandir(self.final.parent):
+            unique = entry.name[len(prefix):-len(".tmp")]
+            if (entry.name.startswith(prefix) and entry.name.endswith(".tmp") and len(unique) == 8
+                    and unique.replace("_", "").isalnum() and is_leftover(Path(entry.path))):
+                shutil.rmtree(entry.path, ignore_errors=True)
 
     def write(self, name: str, data: bytes) -> None:
         (self.tmp / name).write_bytes(data)
 
     def commit(self) -> None:
-        check_replaceable(self.final, self.option)   # again: it may have appeared meanwhile
-        if self.final.exists():
-            # the old set moves into a new, uniquely named folder (never a fixed name the user may own)
-            old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".old", dir=self.final.parent))
-            os.replace(self.final, old / "old")
-            os.replace(self.tmp, self.final)
+        from .owned import exchange, rename, seal
+
+        check_replaceable(self.final, self.option)   # again: it may have changed meanwhile
+        seal(self.tmp)
+        if os.path.lexists(self.final) and exchange(self.tmp, self.final):
+            os.unlink(self.final / _TAG)             # in place: tmp holds the old folder (sealed) now
+        elif os.path.lexists(self.final):
+            # no exchange here: the old set moves into a new, uniquely named temporary first
+            old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
+            (old / _TAG).write_bytes(b"")
+            rename(self.final, old / "old")
+            rename(self.tmp, self.final)
+            os.unlink(self.final / _TAG)
             shutil.rmtree(old)
         else:
-            os.replace(self.tmp, self.final)
+            rename(self.tmp, self.final)
+            os.unlink(self.final / _TAG)
+        self.abort()
 
     def abort(self) -> None:
-        shutil.rmtree(self.tmp, ignore_errors=True)
+        if self.tmp is not None:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            self.tmp = None
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
+

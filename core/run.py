@@ -89,9 +89,9 @@ def progress_steps(s: Settings) -> int:
 
 
 def output_names(s: Settings) -> list[str]:
-    """The names a run of ``s`` may write in ``s.out`` (core.staging checks and moves them)."""
+    """The names a run of ``s`` may write in ``s.out`` (core.staging checks and moves them; a folder ends in ``/``)."""
     name = s.scene.name
-    names = [f"{name}-frames"] if ("png" in s.formats or "ascii" in s.formats) else []
+    names = [f"{name}-frames/"] if ("png" in s.formats or "ascii" in s.formats) else []
     names += [f"{name}.{fmt}" for fmt in ("gif", "mp4") if fmt in s.formats]
     if len(s.scene.vertices) > SIDECAR_VERTICES:
         names += [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"][:len(s.cameras)]
