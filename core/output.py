@@ -404,19 +404,18 @@ class FrameDir:
 
         check_replaceable(self.final, self.option)   # again: it may have changed meanwhile
         seal(self.tmp)
+        os.unlink(self.tmp / _TAG)                   # sealed: its listing marks it as ours from here on
         if os.path.lexists(self.final) and exchange(self.tmp, self.final):
-            os.unlink(self.final / _TAG)             # in place: tmp holds the old folder (sealed) now
+            pass                                     # in place: tmp holds the old folder now
         elif os.path.lexists(self.final):
             # no exchange here: the old set moves into a new, uniquely named temporary first
             old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
             (old / _TAG).write_bytes(b"")
             rename(self.final, old / "old")
             rename(self.tmp, self.final)
-            os.unlink(self.final / _TAG)
             shutil.rmtree(old)
         else:
             rename(self.tmp, self.final)
-            os.unlink(self.final / _TAG)
         self.abort()
 
     def abort(self) -> None:

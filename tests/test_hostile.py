@@ -357,19 +357,49 @@ def test_failed_crosscheck_creates_no_report_parent(tmp_path, capsys):
 
 # ---- one writer at a time ------------------------------------------------------------------------
 
-def test_live_lock_is_refused_stale_lock_is_taken_over(tmp_path, capsys):
+_HOLD = ("import fcntl, os, sys, time\n"
+         "fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)\n"
+         "fcntl.flock(fd, fcntl.LOCK_EX)\n"
+         "os.write(fd, b'wirecheck lock pid %d\\n' % os.getpid())\n"
+         "print('held', flush=True)\n"
+         "time.sleep(60)\n")
+
+
+def test_a_held_lock_is_refused_until_its_process_dies(tmp_path, capsys):
+    """A live run's lock refuses a second run; SIGKILL of the holder frees it at once (the kernel drops flock)."""
     out = tmp_path / "out"
     out.mkdir()
-    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    holder = subprocess.Popen([sys.executable, "-c", _HOLD, str(out / LOCK)], stdout=subprocess.PIPE)
     try:
-        (out / LOCK).write_text(f"wirecheck lock pid {sleeper.pid}\n")
+        assert holder.stdout.readline() == b"held\n"
         rc, _, err = render(["--frames", "1"], out, capsys)
-        assert_one_error_line(rc, err, f"being written by another wirecheck run (process {sleeper.pid})")
+        assert_one_error_line(rc, err, f"being written by another wirecheck run (process {holder.pid})")
+        assert not (out / "cube-report.json").exists()
     finally:
-        sleeper.kill()
-        sleeper.wait()
-    assert render(["--frames", "1"], out, capsys)[0] == 0          # its process is gone: stale
+        holder.kill()
+        holder.wait()
+        holder.stdout.close()
+    assert render(["--frames", "1"], out, capsys)[0] == 0          # killed: no lock left to block
     assert not (out / LOCK).exists()
+
+
+@pytest.mark.parametrize("who", ["dead", "reused_by_sleep"])
+def test_a_lock_file_whose_pid_is_gone_or_reused_never_blocks(tmp_path, capsys, who):
+    """Issue 25: a pid-file lock blocked forever once its pid was reused (a `sleep`). An flock is the process's
+    own: a file naming a dead pid, or a live unrelated one, holds no lock."""
+    out = tmp_path / "out"
+    out.mkdir()
+    other = subprocess.Popen(["sleep", "60"])
+    try:
+        if who == "dead":
+            other.kill()
+            other.wait()
+        (out / LOCK).write_text(f"wirecheck lock pid {other.pid}\n")
+        assert render(["--frames", "1"], out, capsys)[0] == 0
+        assert (out / "cube-report.json").is_file() and not (out / LOCK).exists()
+    finally:
+        other.kill()
+        other.wait()
 
 
 def test_users_file_named_like_the_lock_is_refused(tmp_path, capsys):

@@ -95,3 +95,127 @@ def test_closed_stdout_exits_quietly(tmp_path):
     err = proc.stderr.read().decode()
     proc.wait()
     assert "Traceback" not in err and proc.returncode in (0, 141)   # 0 if it finished before the close
+
+
+# ---- a user's file inside a folder wirecheck wrote (issue 25, item 1) ----------------------------------
+
+def _snapshot(folder):
+    """Every path under ``folder`` with its bytes (None for a folder, the target for a link)."""
+    import os
+
+    out = {}
+    for d, ds, fs in os.walk(folder):
+        for n in ds + fs:
+            p = os.path.join(d, n)
+            rel = os.path.relpath(p, folder)
+            out[rel] = (os.readlink(p) if os.path.islink(p) else None if os.path.isdir(p)
+                        else open(p, "rb").read())
+    return out
+
+
+def _render_out(out):
+    return renderer_cli.main(["--frames", "2", "--width", "64", "--height", "48", "--out", str(out)])
+
+
+def _report(rep):
+    return crosscheck_cli.main(["--report-dir", str(rep), "--scene", "cube", "--cases", "on_axis",
+                                "--frames", "1", "--oracles", "opencv"])
+
+
+def _export(job):
+    return crosscheck_cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "2"])
+
+
+#: (the command, the folder of ours it wrote, where in it the user's things go)
+KINDS = {"renderer": (_render_out, "cube-frames"), "report": (_report, "."), "export": (_export, ".")}
+
+
+def _plant(folder, how):
+    """Put the user's thing ``how`` into the folder of ours; its name (relative to ``folder``) for the message."""
+    import os
+
+    if how == "file":
+        (folder / "analysis.md").write_text("my notes")
+        return "analysis.md"
+    if how == "nested":                  # into a sub-folder wirecheck made (a report's img/, a job's cameras/)
+        sub = next((p for p in sorted(folder.rglob("*")) if p.is_dir() and not p.name.startswith(".")), folder)
+        (sub / "render.sh").write_text("#!/bin/sh\n")
+        return str((sub / "render.sh").relative_to(folder))
+    if how == "edited":                  # a file of ours, changed since: the user's now
+        mine = next(p for p in sorted(folder.rglob("*")) if p.is_file() and not p.name.startswith("."))
+        mine.write_bytes(mine.read_bytes() + b"edited")
+        return str(mine.relative_to(folder))
+    if how == "folder":
+        (folder / "mine").mkdir()
+        return "mine/"
+    if how == "link":
+        os.symlink("/etc/hostname", folder / "link")
+        return "link"
+    raise AssertionError(how)
+
+
+@pytest.mark.parametrize("how", ["file", "nested", "edited", "folder", "link"])
+@pytest.mark.parametrize("kind", sorted(KINDS))
+def test_a_users_thing_inside_a_folder_of_ours_is_never_touched(tmp_path, capsys, kind, how):
+    """Before (issue 25): the folder carried the marker, so a rerun replaced it whole, deleting the user's
+    file with exit 0. Now the rerun refuses with one line naming it, and nothing under the target changes."""
+    command, sub = KINDS[kind]
+    target = tmp_path / "t"
+    assert command(target) == 0
+    name = _plant(target / sub, how)
+    before = _snapshot(tmp_path)
+    capsys.readouterr()
+    assert command(target) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert name.rstrip("/") in err and "nothing was changed" in err, err
+    assert _snapshot(tmp_path) == before                 # every byte, every name: no leftovers either
+
+
+@pytest.mark.parametrize("kind", sorted(KINDS))
+def test_a_rerun_over_our_own_folder_still_replaces_it(tmp_path, kind):
+    """The listing holds every file of ours: an untouched earlier output is replaced, not refused."""
+    command, sub = KINDS[kind]
+    target = tmp_path / "t"
+    assert command(target) == 0
+    first = _snapshot(target)
+    assert command(target) == 0
+    assert sorted(_snapshot(target)) == sorted(first)
+    assert [p.name for p in tmp_path.iterdir()] == ["t"]         # no temporaries, no lock left beside it
+
+
+def test_a_legacy_empty_marker_lists_nothing(tmp_path, capsys):
+    """A folder with the empty marker of an earlier wirecheck and other files: whose they are is unknown, so
+    it is refused (the earlier rule replaced it whole)."""
+    (tmp_path / "cube-frames").mkdir()
+    (tmp_path / "cube-frames" / MARKER).write_bytes(b"")
+    (tmp_path / "cube-frames" / "frame_0001.png").write_bytes(b"not known to be ours")
+    assert _render_out(tmp_path) == 2
+    assert "frame_0001.png (a file not written by wirecheck)" in capsys.readouterr().err
+    assert (tmp_path / "cube-frames" / "frame_0001.png").read_bytes() == b"not known to be ours"
+
+
+@pytest.mark.parametrize("name", ["cube-report.json", "cube-report.txt"])
+def test_an_empty_folder_named_like_an_output_file_is_refused_up_front(tmp_path, capsys, name):
+    """Before (issue 25): it passed the check, and the commit failed after cube-frames/ was moved in,
+    leaving a mixed set that wedged every later run. Now: one line, nothing moved, and once the user's
+    folder is gone the next run succeeds."""
+    assert _render_out(tmp_path) == 0
+    (tmp_path / name).unlink()
+    (tmp_path / name).mkdir()
+    before = _snapshot(tmp_path)
+    capsys.readouterr()
+    assert renderer_cli.main(["--frames", "3", "--width", "64", "--height", "48", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{name}' is a directory where wirecheck writes a file" in err, err
+    assert _snapshot(tmp_path) == before
+    (tmp_path / name).rmdir()
+    assert _render_out(tmp_path) == 0
+
+
+def test_a_users_file_beside_the_outputs_survives_every_rerun(tmp_path):
+    """--out is the user's folder: their files there are never in the set wirecheck moves."""
+    (tmp_path / "notes.txt").write_text("keep")
+    for _ in range(3):
+        assert _render_out(tmp_path) == 0
+    assert (tmp_path / "notes.txt").read_text() == "keep"
