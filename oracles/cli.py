@@ -359,8 +359,11 @@ def _external_option(args) -> str | None:
     if args.candidate is not None and args.candidate_cmd is not None:
         raise InputError(f"--candidate {args.candidate!r} with --candidate-cmd {args.candidate_cmd!r}: "
                          "expected one candidate")
-    if not (math.isfinite(args.candidate_timeout) and args.candidate_timeout > 0):
-        raise InputError(f"--candidate-timeout {args.candidate_timeout}: expected a number of seconds > 0")
+    from .subprocess_candidate import MAX_TIMEOUT_S
+
+    if not (math.isfinite(args.candidate_timeout) and 0 < args.candidate_timeout <= MAX_TIMEOUT_S):
+        raise InputError(f"--candidate-timeout {args.candidate_timeout:g}: expected a number of seconds > 0 "
+                         f"and at most {MAX_TIMEOUT_S:g} (one day)")
     if args.candidate is not None:            # '' too: an empty candidate is an error, never core
         return f"--candidate {args.candidate!r}"
     return f"--candidate-cmd {args.candidate_cmd!r}" if args.candidate_cmd is not None else None

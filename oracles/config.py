@@ -47,7 +47,7 @@ TABLE = "tool.wirecheck"
 KEYS = {
     "candidate": "a string FILE.py:FUNC or MODULE:FUNC",
     "candidate-cmd": "a non-empty command string (a program speaking docs/protocol.md)",
-    "candidate-timeout": "a number of seconds > 0",
+    "candidate-timeout": "a number of seconds > 0 and at most 86400 (one day)",
     "candidate-precision": "'float32' or 'float64'",
     "scenes": "a non-empty list of scene names or paths",
     "cases": "a non-empty list of case names",
@@ -158,6 +158,9 @@ def validate(table: dict, path: Path) -> dict:
             close = difflib.get_close_matches(key, KEYS, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise InputError(f"{path}: [{TABLE}] unknown key {key!r}{hint}: expected some of {', '.join(KEYS)}")
+        if "\x00" in (value if isinstance(value, str) else "".join(v for v in value if isinstance(v, str))
+                       if isinstance(value, list) else ""):
+            raise bad(key, value, "text without a NUL character (no file name or command holds one)")
         if key == "candidate":
             if not isinstance(value, str) or ":" not in value:
                 raise bad(key, value)
@@ -170,7 +173,9 @@ def validate(table: dict, path: Path) -> dict:
                 raise bad(key, value)
             out[key] = value
         elif key == "candidate-timeout":
-            if not (number(value) and value > 0):
+            from .subprocess_candidate import MAX_TIMEOUT_S
+
+            if not (number(value) and 0 < value <= MAX_TIMEOUT_S):
                 raise bad(key, value)
             out[key] = float(value)
         elif key == "candidate-precision":

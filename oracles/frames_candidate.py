@@ -158,7 +158,7 @@ def _job_problem(job: dict) -> str | None:
     pairs = set()
     for c in cases:
         scene, case, w, h = c.get("scene"), c.get("case"), c.get("width"), c.get("height")
-        if scene not in names or not (isinstance(case, str) and NAME_PATTERN.fullmatch(case)):
+        if not isinstance(scene, str) or scene not in names or not (isinstance(case, str) and NAME_PATTERN.fullmatch(case)):
             return f"case {scene!r} / {case!r}: expected a scene of 'scenes' and a case name"
         if (scene, case) in pairs:      # judged twice, it would count twice in the summary
             return f"case {scene} / {case}: listed twice: expected each case once"

@@ -47,8 +47,12 @@ def export_main(argv) -> int:
     p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
     args = p.parse_args(argv)
     try:
-        if args.frames < 1 or args.every < 1:
-            raise InputError(f"--frames {args.frames} --every {args.every}: expected integers >= 1")
+        from wirecheck.core.limits import MAX_FRAMES
+        from wirecheck.core.output import check_replaceable
+
+        if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
+            raise InputError(f"--frames {args.frames} --every {args.every}: expected --frames in 1..{MAX_FRAMES:,} "
+                             "(core/limits.py, as renderer and crosscheck) and --every >= 1")
         cases = [c.strip() for c in args.cases.split(",") if c.strip()]
         bad = [c for c in cases if c not in ALL_CASE_NAMES]
         if bad or not cases:
@@ -60,10 +64,13 @@ def export_main(argv) -> int:
             spin = ()
         if len(spin) != 3 or not all(math.isfinite(x) for x in spin):
             raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
-        scenes = [load_scene(n) for n in (args.scene or builtin_names())]
         out = Path(args.dir)
         if not out.parent.is_dir():
             raise InputError(f"export {args.dir!r}: its parent folder does not exist")
+        if not os.access(out.parent, os.W_OK | os.X_OK):
+            raise InputError(f"export {args.dir!r}: {str(out.parent)!r} is not writable: expected a writable folder")
+        check_replaceable(out, "export DIR")           # the target first: nothing is built for a refused one
+        scenes = [load_scene(n) for n in (args.scene or builtin_names())]
         job = write_job(out, scenes, frames=args.frames, every=args.every, case_names=cases,
                         motion=Motion(turns=spin))
     except InputError as exc:

@@ -15,7 +15,9 @@ and only a new path or an earlier file of ours is replaced.
 from __future__ import annotations
 
 import math
+import os
 import re
+import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -120,6 +122,13 @@ def check_junit_target(path: Path, option: str = "--junit-xml") -> None:
     if not path.parent.is_dir():
         raise InputError(f"{option} {str(path)!r}: folder {str(path.parent)!r} not found: expected an "
                          "existing folder")
+    try:           # a unique temporary name, removed at once: the folder takes files (os.access lies to root)
+        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise InputError(f"{option} {str(path)!r}: folder {str(path.parent)!r} is not writable ({exc.strerror}): "
+                         "expected a writable folder") from None
     if path.exists() or path.is_symlink():
         try:
             ours = path.is_file() and not path.is_symlink() and ET.parse(path).getroot().get("name") == SUITES_NAME
