@@ -362,7 +362,7 @@ def _external_option(args) -> str | None:
     from .subprocess_candidate import MAX_TIMEOUT_S
 
     if not (math.isfinite(args.candidate_timeout) and 0 < args.candidate_timeout <= MAX_TIMEOUT_S):
-        raise InputError(f"--candidate-timeout {args.candidate_timeout:g}: expected a number of seconds > 0 "
+        raise InputError(f"--candidate-timeout {args.candidate_timeout}: expected a number of seconds > 0 "
                          f"and at most {MAX_TIMEOUT_S:g} (one day)")
     if args.candidate is not None:            # '' too: an empty candidate is an error, never core
         return f"--candidate {args.candidate!r}"

@@ -129,3 +129,12 @@ def test_an_unhashable_scene_in_job_json_is_one_line(tmp_path, capsys, scene):
     one_line(rc, capsys.readouterr().err, "job.json: case ", "expected a scene of 'scenes'")
     assert not (tmp_path / "r").exists()
     shutil.rmtree(job)
+
+
+def test_the_api_timeout_has_the_same_limit():
+    """check_projector(timeout_s=3e6) reached the same poll as the CLI: OverflowError in the middle of a run."""
+    from wirecheck.oracles.api import check_projector
+
+    with pytest.raises(ValueError, match=r"timeout_s 3000000.0: expected a finite number of seconds > 0 and at "
+                                         r"most 86400 \(one day\)"):
+        check_projector(cmd="true", timeout_s=3e6)
