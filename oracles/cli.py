@@ -513,6 +513,8 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
         progress=progress.update if progress.active else None))
     if status is not None:
         return status
+    if args.dataset.skipped_line() is not None:     # FIFOs, devices: never opened (oracles.dataset)
+        print(f"crosscheck: {args.dataset.skipped_line()}", file=sys.stderr)
     report = {"run": args.run, **report}
     try:
         write_dataset_report(run_dir, report)
