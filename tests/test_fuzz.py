@@ -13,7 +13,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fuzz.contract import SCENE_TEXTS, HypothesisPick, crosscheck_argv, make_scene_arg, mutate_text, renderer_argv, run_cli
+from fuzz.contract import (SCENE_TEXTS, HypothesisPick, Pick, crosscheck_argv, make_scene_arg, mutate_text, outside_box,
+                           renderer_argv, run_cli)
 from wirecheck.core.errors import InputError
 from wirecheck.core.scene import Scene
 from wirecheck.core.scene_files import load_scene, parse_scene_text
@@ -86,6 +87,30 @@ def test_crosscheck_contract(data, earlier):
         argv = crosscheck_argv(HypothesisPick(data), box, earlier)
         outcome = run_cli(cli.main, argv, box, "crosscheck")
         assert outcome.problems == [], (argv, outcome)
+
+
+def test_generated_inputs_stay_inside_their_folder(earlier):
+    """The generators name no path outside the input's folder: '--scene ..' and '--scene /' made a dataset walk of
+    the whole system temporary folder (another program's FIFO there hung the run for 10 minutes)."""
+    import random
+
+    for cli, make in (("renderer", renderer_argv), ("crosscheck", crosscheck_argv)):
+        values = set()
+        for i in range(400):
+            with tempfile.TemporaryDirectory() as d:
+                box = Path(d)
+                (box / "in").mkdir()
+                argv = make(Pick(random.Random(f"inside-{cli}-{i}")), box, earlier)
+                assert outside_box(argv, box) == [], (cli, i, argv)
+                values.update(v for o, v in zip(argv, argv[1:]) if o == "--scene" and not v.startswith(d))
+        assert {"in", "nosuch"} <= values, values       # the relative values are still drawn
+
+
+def test_outside_box_sees_parent_and_root(tmp_path):
+    """The check itself: the two values the generator used to draw are outside; the box's own folders are not."""
+    assert outside_box(["--scene", "..", "--out", "/", "--report-dir", "in/../..", "--cases", "/x"], tmp_path) == [
+        "--scene ..", "--out /", "--report-dir in/../.."]
+    assert outside_box(["--scene", ".", "--scene", str(tmp_path / "in" / ".."), "--out", "out"], tmp_path) == []
 
 
 #: Complete small meshes of the formats whose readers (trimesh) accept a truncated file (tests/test_hostile.py has one

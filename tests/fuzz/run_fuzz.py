@@ -38,6 +38,8 @@ def category(problem: str) -> str:
         return "exit codes outside {0, 1, 2, 3}" if problem != "exit 3" else "internal errors (exit 3)"
     if problem.startswith("user file"):
         return "user files touched"
+    if problem.startswith("input outside"):
+        return "inputs outside their folder"
     if "stderr lines" in problem:
         return "exit 2 without exactly one stderr line"
     return "partial outputs or leftovers"
@@ -94,6 +96,7 @@ def fuzz(cli: str, n: int, seed: int, earlier: Path, log, start: int = 0) -> dic
             "internal errors (exit 3)": problems["internal errors (exit 3)"],
             "exit 2 without exactly one stderr line": problems["exit 2 without exactly one stderr line"],
             "timeouts": problems["timeouts"],
+            "inputs outside their folder": problems["inputs outside their folder"],
             "examples": examples}
 
 
@@ -120,14 +123,15 @@ def main(argv=None) -> int:
         print(f"{r['cli']}: {r['inputs']} inputs in {r['seconds']} s; exit codes {r['exit_codes']}")
         for key in ("tracebacks", "exit codes outside {0, 1, 2, 3}", "partial outputs or leftovers",
                     "user files touched", "internal errors (exit 3)", "exit 2 without exactly one stderr line",
-                    "timeouts"):
+                    "timeouts", "inputs outside their folder"):
             print(f"  {key}: {r[key]}")
         for ex in r["examples"][:5]:
             print(f"  e.g. input {ex['input']}: exit {ex['rc']} {ex['problems']}: {ex['argv']}")
     if a.json:
         Path(a.json).write_text(json.dumps(results, indent=1) + "\n")
     bad = sum(r[k] for r in results for k in ("tracebacks", "exit codes outside {0, 1, 2, 3}",
-                                              "partial outputs or leftovers", "user files touched", "timeouts"))
+                                              "partial outputs or leftovers", "user files touched", "timeouts",
+                                              "inputs outside their folder"))
     return 1 if bad else 0
 
 
