@@ -74,7 +74,7 @@ from .isolation import external_candidate
 from .subprocess_candidate import DEFAULT_TIMEOUT_S
 from .cases import ALL_CASE_NAMES, CASE_NAMES
 from .executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS, ExecutorSpec, check_scheduler_address, dask_failure
-from .config import parse_cli
+from .config import parse_cli, trust_line
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
 from .progress import TerminalProgress
@@ -280,6 +280,8 @@ def _parse(args):
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
     if external:
+        if getattr(args, "candidate_from", None) is not None:    # before the program runs (docs/pytest.md)
+            print(trust_line(*args.candidate_from), file=sys.stderr, flush=True)
         candidate = external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
@@ -381,6 +383,8 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
+        args.candidate_from = next(((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd")
+                                    if key in applied), None)
         check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (
             "scene", "scene_list", "candidate_frames", "report_dir", "junit_xml", "config"))
         if args.junit_xml and (args.sweep or args.suite):
