@@ -65,8 +65,12 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
-from wirecheck.core.errors import InputError, check_not_empty
-from wirecheck.core.guard import VersionAction, run_cli
+from wirecheck.core.guard import interrupts_from_start
+
+interrupts_from_start("crosscheck")    # before the imports below: Ctrl-C while starting is one line, no traceback
+
+from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
+from wirecheck.core.guard import VersionAction, run_cli  # noqa: E402
 from wirecheck.core.output import check_replaceable, check_report_dir
 
 from . import gate, tolerances

@@ -143,3 +143,19 @@ def test_a_truncated_mesh_file_is_refused_or_read_whole(name, data):
             assert "\n" not in str(exc) and str(exc).startswith(str(part))
         else:   # only a cut in the last line's name or newline leaves the mesh whole
             assert (scene.vertices.tolist(), scene.faces) == (full.vertices.tolist(), full.faces), cut
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck))
+@given(data=st.data())
+def test_hostile_png_frames_read_or_one_printable_phrase(data):
+    """The image rule on damaged PNGs of every colour type and depth (tests/fuzz/png_inputs.py): a bool image of
+    the camera's size or one FrameProblem line without control characters."""
+    from fuzz.png_inputs import check_png, hostile_png
+    from wirecheck.oracles.png_frame import FrameProblem, read_png
+
+    pick = HypothesisPick(data)
+    width, height = pick.integer(1, 9), pick.integer(1, 5)
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "frame.png"
+        path.write_bytes(hostile_png(pick, width, height))
+        assert check_png(read_png, FrameProblem, path, width, height) == []

@@ -206,3 +206,25 @@ def test_sigint_from_outside_during_a_load_ends_the_run(tmp_path):
     assert proc.returncode == 130, err
     assert time.monotonic() - t0 < 30 and "interrupted by SIGINT" in err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("prog, module, sig, code", [("renderer", "wirecheck.core.cli", signal.SIGINT, 130),
+                                                     ("crosscheck", "wirecheck.oracles.cli", signal.SIGTERM, 143)])
+def test_a_signal_while_the_cli_is_still_starting_is_one_line(prog, module, sig, code):
+    """Between the CLI module's first line and its guard (the imports of numpy, trimesh, pyrender: seconds on a
+    busy machine) a Ctrl-C printed a KeyboardInterrupt traceback. The console script's name turns the early
+    handler on; the signal is sent where the imports have just finished, before main() runs."""
+    script = (f"import os, signal, sys, time\nsys.argv[0] = '/venv/bin/{prog}'\nimport {module}\n"
+              f"os.kill(os.getpid(), {int(sig)})\ntime.sleep(30)\nprint('not ended')\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert (proc.returncode, proc.stdout) == (code, "")
+    assert proc.stderr == f"{prog}: interrupted by {signal.Signals(sig).name} while starting: nothing written\n"
+
+
+def test_importing_the_cli_elsewhere_keeps_the_handlers():
+    """A program (here pytest) that imports the CLI modules keeps its own SIGINT/SIGTERM handlers."""
+    import wirecheck.core.cli  # noqa: F401
+    import wirecheck.oracles.cli  # noqa: F401
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        assert not getattr(signal.getsignal(sig), "wirecheck_starting", False)
