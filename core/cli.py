@@ -16,6 +16,10 @@ import os
 import sys
 from pathlib import Path
 
+from .guard import interrupts_from_start
+
+interrupts_from_start("renderer")      # before the imports below: Ctrl-C while starting is one line, no traceback
+
 
 def _load_numpy_single_threaded() -> None:
     """Import numpy with OpenBLAS sized to one thread, when this module is the first to import it.

@@ -65,8 +65,12 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
-from wirecheck.core.errors import InputError, check_not_empty
-from wirecheck.core.guard import VersionAction, run_cli
+from wirecheck.core.guard import interrupts_from_start
+
+interrupts_from_start("crosscheck")    # before the imports below: Ctrl-C while starting is one line, no traceback
+
+from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
+from wirecheck.core.guard import VersionAction, run_cli  # noqa: E402
 from wirecheck.core.output import check_replaceable, check_report_dir
 
 from . import gate, tolerances
@@ -74,7 +78,7 @@ from .isolation import external_candidate
 from .subprocess_candidate import DEFAULT_TIMEOUT_S
 from .cases import ALL_CASE_NAMES, CASE_NAMES
 from .executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS, ExecutorSpec, check_scheduler_address, dask_failure
-from .config import parse_cli
+from .config import parse_cli, trust_line
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
 from .progress import TerminalProgress
@@ -280,6 +284,8 @@ def _parse(args):
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
     if external:
+        if getattr(args, "candidate_from", None) is not None:    # before the program runs (docs/pytest.md)
+            print(trust_line(*args.candidate_from), file=sys.stderr, flush=True)
         candidate = external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
@@ -384,6 +390,8 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
+        args.candidate_from = next(((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd")
+                                    if key in applied), None)
         check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (
             "scene", "scene_list", "candidate_frames", "report_dir", "junit_xml", "config"))
         if args.junit_xml and (args.sweep or args.suite):
@@ -516,6 +524,8 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
         progress=progress.update if progress.active else None))
     if status is not None:
         return status
+    if args.dataset.skipped_line() is not None:     # FIFOs, devices: never opened (oracles.dataset)
+        print(f"crosscheck: {args.dataset.skipped_line()}", file=sys.stderr)
     report = {"run": args.run, **report}
     try:
         write_dataset_report(run_dir, report)

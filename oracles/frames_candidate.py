@@ -18,9 +18,7 @@ from __future__ import annotations
 
 import json
 import os
-import stat
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +27,7 @@ from wirecheck.core.errors import InputError
 
 from . import metrics
 from .export import JOB_KIND, JOB_VERSION, frame_name
+from .png_frame import FrameProblem, escape_controls, file_problem, read_png  # noqa: F401 (re-exported)
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
@@ -41,33 +40,13 @@ class FramesError(InputError):
     """The job or its frames cannot be judged: one line per problem."""
 
     def __init__(self, problems: list[str]):
-        self.problems = problems
+        self.problems = problems = [escape_controls(p) for p in problems]    # a file name may hold an ESC
         shown = problems[:MAX_LINES]
         more = len(problems) - len(shown)
         super().__init__("\n".join(shown + ([f"... and {more} more"] if more else [])))
 
     def __str__(self) -> str:       # one line per problem, kept apart (InputError joins lines into one)
         return Exception.__str__(self)
-
-
-def file_problem(path: Path) -> str | None:
-    """Why ``path`` is not a regular file to read, in a phrase (``"missing"``, ``"a FIFO"``, ...); None if it is one.
-
-    Checked before any open: opening a FIFO named like a job's file would block
-    the run forever, and a folder or device is no file of a job.
-    """
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        return "a broken link" if os.path.islink(path) else "missing"
-    except OSError as exc:          # a link loop, a name too long
-        return f"unreadable ({exc.strerror or exc})"
-    if stat.S_ISREG(mode):
-        return None
-    kind = ("a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
-            "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else
-            "not a file")
-    return f"{kind}, not a regular file"
 
 
 def _no_duplicate_keys(pairs: list) -> dict:
@@ -174,49 +153,6 @@ def _job_problem(job: dict) -> str | None:
             return (f"case {scene} / {case}: frames {str(c.get('frames'))[:80]}: expected "
                     f"frames/{scene}/{case}/frame_NNNN.png for each of frame_numbers")
     return None
-
-
-class FrameProblem(ValueError):
-    """A frame file that is not an image the job asked for: the reason, in a phrase."""
-
-
-#: 16-bit grey samples at or above this are drawn: a high byte of 128 or more, as Pillow reads
-#: 16-bit RGB(A) (by its high byte), so every 16-bit colour type reads alike; an 8-bit value x
-#: is 257 x in 16 bits, whose high byte is x: 8- and 16-bit copies of one image read the same.
-THRESHOLD_16 = 128 << 8
-
-
-def read_png(path: Path, width: int, height: int) -> np.ndarray:
-    """``(H, W)`` bool: drawn where the luminance over the rule's black background is >= 128.
-
-    One still PNG of the camera's size is expected; anything else is a
-    :class:`FrameProblem`. A pixel's luminance is Pillow's (ITU-R 601-2) of its
-    RGB, times its alpha (``A / 255``; palette transparency included): the
-    pixel as it shows over black, so a transparent pixel is never drawn. 16-bit
-    grey is read at its full scale (:data:`THRESHOLD_16`). The size is checked
-    before any pixel is decoded (a huge image costs nothing).
-    """
-    from PIL import Image
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked next
-        with Image.open(path) as im:
-            if im.format != "PNG":
-                raise FrameProblem(f"a {im.format} image: expected a PNG")
-            if getattr(im, "n_frames", 1) != 1:
-                raise FrameProblem(f"an animated PNG of {im.n_frames} frames: expected one still image")
-            if im.size != (width, height):
-                raise FrameProblem(f"size {im.size[0]}x{im.size[1]}: expected {width}x{height} (the camera's)")
-            im.load()
-            if im.mode in ("I", "I;16", "I;16B", "I;16L"):          # 16-bit grey
-                return np.asarray(im) >= THRESHOLD_16
-            if not (im.mode in ("RGBA", "LA", "PA", "RGBa", "La") or "transparency" in im.info):   # opaque
-                grey = im if im.mode == "L" else im.convert("RGB").convert("L")   # L, the usual: as it is
-                return np.asarray(grey) >= 128
-            rgba = im.convert("RGBA")
-            grey = np.asarray(rgba.convert("RGB").convert("L"), dtype=np.uint16)
-            alpha = np.asarray(rgba.getchannel("A"), dtype=np.uint16)
-    return grey * alpha >= 128 * 255           # exact (at most 255 * 255 < 2**16): grey >= 128 where opaque
 
 
 def _walk(frames_dir: Path) -> list[Path]:

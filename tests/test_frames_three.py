@@ -58,9 +58,15 @@ def _require():
 
 
 def _draw(job: Path, *flags: str) -> None:
+    """Draw ``job`` with three.js; Chromium's profile goes to a folder beside it and must be gone after (each run
+    left a 2-3 MB wirecheck-chromium-* profile in the system temporary folder)."""
+    profiles = job.parent / "profiles"
+    profiles.mkdir(exist_ok=True)
     proc = subprocess.run(["node", str(SCRIPT), str(job), str(THREE), *flags], capture_output=True, text=True,
-                          timeout=300, env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM))
+                          timeout=300, env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM,
+                                                WIRECHECK_PROFILE_PARENT=str(profiles)))
     assert proc.returncode == 0, proc.stderr[-3000:]
+    assert sorted(p.name for p in profiles.iterdir()) == [], "Chromium's profile was left behind"
 
 
 @pytest.fixture(scope="module")
