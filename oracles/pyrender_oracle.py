@@ -52,6 +52,7 @@ import numpy as np
 from wirecheck.core.camera import Camera
 
 from .convert import camera_to_pyrender
+from .pyrender_programs import stabilise_program_cache
 
 __all__ = ["GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
            "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
@@ -273,6 +274,7 @@ class PyrenderOracle:
         self.width, self.height = int(width), int(height)
         self._renderer = pyrender.OffscreenRenderer(self.width, self.height)
         _single_sample(self._renderer._renderer)
+        stabilise_program_cache(self._renderer._renderer)      # one program per shader, not per frame
         if self.platform == "egl":
             _spare_the_display(self._renderer._platform)
         self._gl_info = None
