@@ -36,6 +36,7 @@ from .cases import Case
 from .core_candidate import CoreCandidate, RenderMode
 from .draw import depth_margin, draw_candidate, oracle_segments
 from .tolerances import Tolerances
+from .oracle_precision import judge_oracle_precision
 from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
 
 
@@ -175,6 +176,7 @@ class CaseFrames:
     error: str | None = None
     line_batch: metrics.LineBatch = field(default_factory=metrics.LineBatch)   # frames waiting for line scores
     drawn_px: int = 0                                   # pixels drawn by either side, over the frames (oracles.gate)
+    oracle_bound_px: float = 0.0                        # pyrender's own error bound, largest over the frames
     #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + hdraw + pr + pmetric
     #: (hdraw: the harness drawing an external candidate's frame, less the candidate's own calls)
     seconds: dict = field(default_factory=lambda: dict.fromkeys(
@@ -244,6 +246,8 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     if setup.pixels_skipped:
         rec["note"] = PIXELS_NOT_COMPARED
     judge(rec, tol, acc.error, points=len(scene.vertices))
+    judge_oracle_precision(rec, acc.oracle_bound_px if setup.pixels else None, judge, tol, acc.error,
+                           len(scene.vertices))
     rec["per_frame"] = acc.per_frame
     images = None
     if acc.worst is not None:
@@ -353,6 +357,8 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         else:
             orac_img = np.zeros((cam.height, cam.width), bool)
         t1 = acc.add("pr", t0)
+        if setup.use_faces:
+            acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(pyrender_oracle, "last_bound_px", 0.0))
         cand_img = np.isfinite(cand_depth)
         if setup.use_faces:
             cand_faces = getattr(setup.candidate, "last_face_ids", None)
@@ -380,6 +386,7 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         orac_img, _depth = pyrender_oracle.render(pr_vertices, draw_edges, cam, model_matrix=pr_pose,
                                                   faces=occluders, cull=mode.cull == "backface")
         t1 = acc.add("pr", t0)
+        acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(pyrender_oracle, "last_bound_px", 0.0))
         fp = metrics.FramePixels(cand_img, orac_img)                     # one scan of each image
         ps = metrics.pixel_scores(None, None, pixels=fp)
         acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]

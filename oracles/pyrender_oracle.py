@@ -39,7 +39,16 @@ context's ``GL_VENDOR``, ``GL_RENDERER`` and ``GL_VERSION`` for the reports.
 
 pyrender is imported lazily. One :class:`PyrenderOracle` keeps one
 ``OffscreenRenderer`` and one scene; frames update node poses only (creating
-a renderer costs ~100 ms).
+a renderer costs ~100 ms), and its shader programs are compiled once
+(oracles.pyrender_programs: pyrender's own cache compiled one per frame).
+
+What pyrender receives is re-centred in float64 (it computes in float32):
+each mesh is uploaded once as its vertices' offsets from their centre
+(convert.centre_of), and the mesh node's pose takes them straight to eye
+space with the camera node at the identity (convert.gl_eye_pose), so the GPU
+rounds magnitudes of the mesh's size and its distance from the camera, not
+of the scene's distance from the world origin. :attr:`PyrenderOracle.last_bound_px`
+is the oracle's own error bound for the last frame (oracles.oracle_precision).
 """
 
 from __future__ import annotations
@@ -51,7 +60,9 @@ import numpy as np
 
 from wirecheck.core.camera import Camera
 
-from .convert import camera_to_pyrender
+from .convert import camera_to_pyrender, centre_of, gl_eye_pose
+from .oracle_precision import frame_bound_px, mesh_radius
+from .pyrender_programs import stabilise_program_cache
 
 __all__ = ["GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
            "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
@@ -273,6 +284,7 @@ class PyrenderOracle:
         self.width, self.height = int(width), int(height)
         self._renderer = pyrender.OffscreenRenderer(self.width, self.height)
         _single_sample(self._renderer._renderer)
+        stabilise_program_cache(self._renderer._renderer)      # one program per shader, not per frame
         if self.platform == "egl":
             _spare_the_display(self._renderer._platform)
         self._gl_info = None
@@ -280,12 +292,15 @@ class PyrenderOracle:
         self._mesh_node = None
         self._mesh_key = None
         self._mesh_faces = None
+        self._mesh_centre, self._mesh_radius = np.zeros(3), 0.0     # of the uploaded vertices (float64)
+        self.last_bound_px = 0.0      # oracle_precision.frame_bound_px of the last frame drawn
         self._cam_node = None
         self._cam_key = None
         # render_faces: a scene of its own, so that alternating with render() rebuilds nothing
         self._fscene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
         self._fmesh_node = None
         self._fmesh_key = None
+        self._fmesh_centre, self._fmesh_radius = np.zeros(3), 0.0
         self._fcam_node = None
         self._fcam_key = None
 
@@ -343,7 +358,10 @@ class PyrenderOracle:
         self._mesh_key = key
         pr = self._pr
         prims = []
-        positions = vertices.astype(np.float32)
+        # re-centred in float64 before the float32 upload (convert.gl_eye_pose): one upload per mesh
+        self._mesh_centre = centre_of(vertices)
+        positions = (vertices - self._mesh_centre).astype(np.float32)
+        self._mesh_radius = mesh_radius(vertices - self._mesh_centre)
         if len(edges):
             white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0])
             prims.append(pr.Primitive(positions=positions, indices=edges.astype(np.uint32),
@@ -361,15 +379,15 @@ class PyrenderOracle:
                              f"{self.width}x{self.height}")
         scene, node_attr, key_attr = ((self._fscene, "_fcam_node", "_fcam_key") if faces_scene
                                       else (self._scene, "_cam_node", "_cam_key"))
-        pose, cam = camera_to_pyrender(camera)
+        # the camera node stays at the identity: the mesh node's pose takes its vertices to eye space
+        # (convert.gl_eye_pose), so the camera's position never reaches float32
         key = (camera.projection, camera.fov_y_deg, camera.ortho_height, camera.near, camera.far, camera.intrinsics)
         if key != getattr(self, key_attr):
+            _pose, cam = camera_to_pyrender(camera)
             if getattr(self, node_attr) is not None:
                 scene.remove_node(getattr(self, node_attr))
-            setattr(self, node_attr, scene.add(cam, pose=pose))
+            setattr(self, node_attr, scene.add(cam, pose=np.eye(4)))
             setattr(self, key_attr, key)
-        else:
-            scene.set_pose(getattr(self, node_attr), pose)
 
     def _set_faces(self, vertices: np.ndarray, triangles: np.ndarray, cull: bool) -> None:
         key = (vertices.tobytes(), triangles.tobytes(), cull)
@@ -385,7 +403,10 @@ class PyrenderOracle:
         # every triangle its own three vertices, all of its id colour: the flat
         # shader multiplies the (white) base colour by the interpolated vertex
         # colour, which is then constant over the triangle
-        positions = vertices[triangles.reshape(-1)].astype(np.float32)
+        self._fmesh_centre = centre_of(vertices)
+        centred = vertices - self._fmesh_centre
+        self._fmesh_radius = mesh_radius(centred)
+        positions = centred[triangles.reshape(-1)].astype(np.float32)
         colours = np.repeat(_id_colours(len(triangles)), 3, axis=0)
         colours = np.concatenate([colours, np.full((len(colours), 1), 255, np.uint8)], axis=1)
         white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=not cull)
@@ -429,9 +450,11 @@ class PyrenderOracle:
         edges = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
         self._set_mesh(vertices, edges, faces, bool(cull))
         self._set_camera(camera)
+        self.last_bound_px = 0.0
         if self._mesh_node is not None:
-            pose = np.eye(4) if model_matrix is None else np.asarray(model_matrix, dtype=np.float64)
+            pose = gl_eye_pose(camera, model_matrix, self._mesh_centre)
             self._scene.set_pose(self._mesh_node, pose)
+            self.last_bound_px = frame_bound_px(camera, pose, self._mesh_radius)
         if faces is not None and len(faces):
             self._polygon_offset()
         colour, depth = self._renderer.render(self._scene, pr.RenderFlags.FLAT)
@@ -465,9 +488,11 @@ class PyrenderOracle:
             raise ValueError(f"{len(triangles)} triangles: the id image holds at most 2^24 - 2")
         self._set_faces(vertices, triangles, bool(cull))
         self._set_camera(camera, faces_scene=True)
+        self.last_bound_px = 0.0
         if self._fmesh_node is not None:
-            pose = np.eye(4) if model_matrix is None else np.asarray(model_matrix, dtype=np.float64)
+            pose = gl_eye_pose(camera, model_matrix, self._fmesh_centre)
             self._fscene.set_pose(self._fmesh_node, pose)
+            self.last_bound_px = frame_bound_px(camera, pose, self._fmesh_radius)
         self._no_polygon_offset()
         colour, _pyrender_depth = self._renderer.render(self._fscene, pr.RenderFlags.FLAT)
         z_win = self._read_window_depth()
