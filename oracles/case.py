@@ -393,7 +393,8 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         for name, values in acc.pixel.items():
             values.append(ps[name])
         frame_rec.update({name: ps[name] for name in metrics.PIXEL_SCORE_KEYS})
-        record_lines(acc, acc.line_batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
+        at = len(acc.pixel["f1_0px"]) - 1                                # this frame's place in acc.pixel
+        record_lines(acc, acc.line_batch.add((k, frame_rec, at), fp, seg0, seg1))    # scored with later frames
         key = (ps["f1_1px"], ps["f1_0px"])
     if want_images and key is not None and (acc.worst is None or key < acc.worst[0]):
         acc.worst = (key, k, cand_img.copy(), orac_img.copy())
@@ -404,10 +405,18 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
 
 
 def record_lines(acc: CaseFrames, scored: list) -> None:
-    """Frames' line scores (metrics.LineBatch: ``[((frame, frame record), scores)]``) into ``acc`` and their records."""
-    for (k, frame_rec), ls in scored:
+    """Frames' line scores (metrics.LineBatch: ``[((frame, frame record, place in acc.pixel), scores)]``) into
+    ``acc`` and their records.
+
+    A frame with sub-pixel ties has its scores at 0 px replaced by those with
+    the ties undecided (metrics.line_scores' ``tie_resolved``), in its record
+    and in ``acc.pixel``: F1@0px judges the decided pixels, as the balance does.
+    """
+    for (k, frame_rec, at), ls in scored:
         acc.lines.append((k, ls))
         frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
+        for name, value in (ls["tie_resolved"] or {}).items():
+            frame_rec[name] = acc.pixel[name][at] = value
 
 
 def _per_frame_ms(seconds: float, frames: int) -> float:

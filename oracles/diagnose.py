@@ -417,20 +417,21 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     half of the net imbalance, the fault is ``line_end_bias`` with ``end``
     (``"first"``, ``"last"`` or ``"both"``) and ``pixels_per_line`` (signed);
     otherwise ``line_pixel_bias`` (lines thicker or thinner, or stray pixels),
-    with the one-sided counts by place.
+    with the one-sided counts by place. Nothing is named when every one-sided
+    pixel is a tie (0 decided on either side).
     """
     from .metrics import line_failures
 
-    if not line_failures(lines, tol):
-        return []
+    tc, to = lines["subpixel_ties"]
+    decided = {"candidate_only": int(lines["candidate_only"] - tc), "oracle_only": int(lines["oracle_only"] - to)}
+    if not line_failures(lines, tol) or not (decided["candidate_only"] or decided["oracle_only"]):
+        return []                     # no line fault on undecided pixels alone
     n = max(lines["lines_compared"], 1)
     places = lines["one_sided_by_place"]
     net = {p: places[p][0] - places[p][1] for p in places}          # candidate-only minus oracle-only
     per_line = {"first": net["start"] / n, "last": net["end"] / n}
     ends = [e for e in ("first", "last") if abs(per_line[e]) >= LINE_END_MIN_PX]
     total = lines["imbalance"]
-    tc, to = lines["subpixel_ties"]
-    decided = {"candidate_only": int(lines["candidate_only"] - tc), "oracle_only": int(lines["oracle_only"] - to)}
     at_ends = sum(net[{"first": "start", "last": "end"}[e]] for e in ends)
     if ends and abs(at_ends) >= 0.5 * abs(total):
         return [{"name": "line_end_bias", "end": ends[0] if len(ends) == 1 else "both",
