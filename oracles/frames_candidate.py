@@ -333,8 +333,13 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
 
 
-def _frame_camera(path: Path):
-    """``(camera, model_matrix (4, 4))`` of a frame's JSON; FramesError naming the file otherwise."""
+def _frame_camera(path: Path, cache: dict | None = None):
+    """``(camera, model_matrix (4, 4))`` of a frame's JSON; FramesError naming the file otherwise.
+
+    ``cache``: the last camera made, by its JSON fields; the same fields give
+    the same Camera object back (a case's camera is fixed: converted once by
+    oracles.opencv_oracle, which keeps the last camera by identity).
+    """
     from wirecheck.core.camera import Camera
 
     problem = file_problem(path)
@@ -342,7 +347,12 @@ def _frame_camera(path: Path):
         raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])
     try:
         cam_json = read_json(path)
-        camera = Camera(**cam_json["camera"])
+        if cache is not None and cache.get("camera_json") == cam_json["camera"]:
+            camera = cache["camera"]
+        else:
+            camera = Camera(**cam_json["camera"])
+            if cache is not None:
+                cache.update(camera_json=cam_json["camera"], camera=camera)
         m = np.asarray(cam_json["model_matrix"], dtype=np.float64)
         if m.shape != (4, 4) or not np.all(np.isfinite(m)):
             raise ValueError(f"model_matrix of shape {m.shape}: expected 4x4 finite numbers")
@@ -353,17 +363,26 @@ def _frame_camera(path: Path):
     return camera, m
 
 
-def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int):
-    """``(p_model (N, 3), edges (E, 2), camera, model_matrix (4, 4))`` of one frame, from the job's files."""
+def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache: dict | None = None):
+    """``(p_model (N, 3), edges (E, 2), camera, model_matrix (4, 4))`` of one frame, from the job's files.
+
+    ``cache``: a dict kept by the caller over one case's frames: the scene's
+    OBJ (model space) is then read once, and an unchanged camera made once.
+    """
     job_dir = Path(job_dir)
     row = next(s for s in job["scenes"] if s["name"] == scene)       # load_job checked it is there
     obj = job_dir / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
-    p_model, edges = read_obj(obj)
+    if cache is not None and cache.get("obj") == obj:
+        p_model, edges = cache["mesh"]
+    else:
+        p_model, edges = read_obj(obj)
+        if cache is not None and row["space"] == "model":
+            cache.update(obj=obj, mesh=(p_model, edges))
     if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
         raise FramesError([f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
                            f"{row['edges']} (job.json's; the file was changed or cut short)"])
     path = job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}"
-    camera, m = _frame_camera(path)
+    camera, m = _frame_camera(path, cache)
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     if (camera.width, camera.height) != (c["width"], c["height"]):     # the frames were read at the job's size
         size = f"{camera.width}x{camera.height}"

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import metrics
+from . import metrics, opencv_oracle
 from .judge import decide, line_faults, pixel_fields
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
@@ -92,11 +92,12 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     numbers = [int(Path(rel).stem.split("_")[-1]) for rel in c["frames"]]
     kept = diagnosis_frames(len(numbers)) if diagnose else set()
     acc = _CaseFrames()
-    camera = None
+    camera, cache = None, {}
     for i, (k, rel) in enumerate(zip(numbers, c["frames"])):
-        p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k)
+        p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k, cache)
         p_world = p_model @ m[:3, :3].T + m[:3, 3]
-        seg0, seg1 = line_segments(p_world, edges, camera)              # where the oracle's lines lie
+        # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
+        seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], (seg0, seg1))
         orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
         core = render_frame(p_model, edges, camera, m).image >= 128

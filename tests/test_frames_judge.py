@@ -31,7 +31,7 @@ from wirecheck.oracles.runner import CoreCandidate, Tolerances, run_crosscheck
 
 from raster_mutants import drop_last
 
-# frames 1 and 4 of 6 (a cube a quarter and a half turn on: not square-on), one perspective, one ortho
+# frames 1 and 4 of 6 (the cube square-on and half a turn on), seen by an oblique camera and an orthographic one
 ARGS = ["--scene", "cube", "--cases", "oblique_roll,orthographic", "--frames", "6", "--every", "3"]
 
 # Every other criterion switched off so that only the one under test can decide
@@ -193,3 +193,18 @@ def test_diagnosis_frames_are_evenly_spread():
     kept = sorted(diagnosis_frames(720, 24))
     assert len(kept) == 24 and kept[0] == 0 and kept[-1] == 719
     assert all(31 <= b - a <= 32 for a, b in zip(kept, kept[1:]))
+
+
+def test_readme_says_when_every_frame_is_a_quarter_turn():
+    from wirecheck.oracles.export import build_job
+
+    cube = [load_scene("cube")]
+    # frame k turns (k - 1) / frames of a turn about X and Y (spin 1,1,0): with 4 frames, 0, 1/4, 1/2, 3/4
+    _job, files = build_job(cube, frames=4, case_names=["on_axis"])
+    readme = files["README.md"].decode()
+    assert "## What this job cannot reveal" in readme
+    assert "**Every frame of this job is a quarter-turn pose** (frames 1, 2, 3, 4 of\n4, spin 1,1,0)" in readme
+    # frames 1, 6, 11, 16, 21 of 24: frame 6 turns 5/24 of a turn = 5/6 of a quarter: oblique
+    _job, files = build_job(cube, frames=24, every=5, case_names=["on_axis"])
+    readme = files["README.md"].decode()
+    assert "## What this job cannot reveal" in readme and "quarter-turn pose" not in readme
