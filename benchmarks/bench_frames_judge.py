@@ -78,12 +78,23 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     if oracle_name == "core":
         pyrender_oracle.OracleCache.get = lambda self, w, h: CoreOracle()
         pyrender_oracle.OracleCache.gl_info = lambda self: None
+    inside = {"s": 0.0}                        # the oracle's seconds inside the judge
+    render = (CoreOracle if oracle_name == "core" else PyrenderOracle).render
+
+    def timed(self, *args, **kwargs):
+        t = time.perf_counter()
+        try:
+            return render(self, *args, **kwargs)
+        finally:
+            inside["s"] += time.perf_counter() - t
+    (CoreOracle if oracle_name == "core" else PyrenderOracle).render = timed
 
     t0 = time.perf_counter()
     report, _ = run_frames(path)
     wall = time.perf_counter() - t0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     frames = report["compared"]["frames"]
+    (CoreOracle if oracle_name == "core" else PyrenderOracle).render = render
     job = load_job(path)
     c = job["cases"][0]
     oracle, seconds = None, 0.0
@@ -99,7 +110,8 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     oracle.close()
     return {"frames": frames, "verdict": report["verdict"], "peak_rss_mb": round(peak, 1),
             "judge_s": round(wall, 2), "judge_ms_per_frame": round(1e3 * wall / frames, 2),
-            "pyrender_ms_per_frame": round(1e3 * seconds / frames, 2)}
+            "pyrender_ms_per_frame": round(1e3 * seconds / frames, 2),
+            "oracle_in_judge_ms_per_frame": round(1e3 * inside["s"] / frames, 2)}
 
 
 def main(argv=None) -> int:
@@ -123,11 +135,15 @@ def main(argv=None) -> int:
             out = subprocess.run([sys.executable, __file__, "--child", str(job), "--oracle", a.oracle], capture_output=True, text=True,
                                  check=True)
             rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
+    # pyrender ms/frame: a fresh oracle drawing the job's frames after the judging; oracle in judge: the
+    # oracle's own calls while judging (pyrender's, or core's with --oracle core); the rest is the judge's
     print(f"{'frames':>7} {'verdict':>8} {'peak RSS MB':>12} {'judge ms/frame':>15} {'pyrender ms/frame':>18} "
-          f"{'judge/pyrender':>15}")
+          f"{'judge/pyrender':>15} {'oracle in judge':>16} {'rest/pyrender':>14}")
     for r in rows:
+        rest = r["judge_ms_per_frame"] - r["oracle_in_judge_ms_per_frame"]
         print(f"{r['frames']:>7} {r['verdict']:>8} {r['peak_rss_mb']:>12.1f} {r['judge_ms_per_frame']:>15.2f} "
-              f"{r['pyrender_ms_per_frame']:>18.2f} {r['judge_ms_per_frame'] / r['pyrender_ms_per_frame']:>15.2f}")
+              f"{r['pyrender_ms_per_frame']:>18.2f} {r['judge_ms_per_frame'] / r['pyrender_ms_per_frame']:>15.2f} "
+              f"{r['oracle_in_judge_ms_per_frame']:>16.2f} {rest / r['pyrender_ms_per_frame']:>14.2f}")
     first, last = rows[0], rows[-1]
     print(f"peak RSS {last['frames']} / {first['frames']} frames: {last['peak_rss_mb'] / first['peak_rss_mb']:.2f} "
           "(target <= 1.5)")
