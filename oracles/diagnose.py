@@ -242,9 +242,12 @@ def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> l
         if (abs(sx - minus_one["x"]) * reach[0] <= tol or abs(sx / sy - minus_one["x"]) * reach[0] <= tol
                 or abs(sy / sx - minus_one["y"]) * reach[1] <= tol):
             fault["hint"] = MINUS_ONE_HINT
+        elif abs(sx / sy - (w / h) ** 2) * reach[0] <= tol:
+            fault["hint"] = ("implied_aspect is H/W: the aspect was taken the wrong way round (height / width "
+                             "where width / height is expected)")
         elif abs(sx / sy - w / h) * reach[0] <= tol or abs(sx / sy - h / w) * reach[0] <= tol:
-            fault["hint"] = ("x is scaled by W/H (or H/W) against y: the aspect was taken the wrong way round "
-                             "(H/W for W/H) or fx from the width: fx = fy for square pixels")
+            fault["hint"] = ("x is scaled by W/H (or H/W) against y: fx was taken from the width (aspect 1): "
+                             "fx = fy for square pixels")
         faults.append(fault)
     if abs(sy - 1.0) * reach[1] > tol:
         fault = {"name": "fov_mismatch", **fields, "scale": sy, "implied_fov_deg": None, "implied_ortho_height": None}
