@@ -288,10 +288,14 @@ def precision_text(report: dict) -> str:
 
 
 def case_notes(report: dict) -> list[tuple[dict, str]]:
-    """``(case, text)`` for each case's ``note`` (what was not compared, and why), then each vacuous
-    case allowed by ``--allow-vacuous`` (its reasons): the Notes of report.md and report.html."""
+    """``(case, text)`` for each case's ``note`` (what was not compared, and why), each case whose
+    clipped ends were placed for the candidate's probed planes (``clipped_ends``, oracles.clip_planes),
+    then each vacuous case allowed by ``--allow-vacuous`` (its reasons): the Notes of report.md and
+    report.html."""
     failing = not_passed(report)
     notes = [(c, c["note"]) for c in report["cases"] if c.get("note")]
+    notes += [(c, f"clipped ends moved {c['clipped_ends']['inward_depth']:.3g} inside the planes: "
+                  f"{c['clipped_ends']['reason']}") for c in report["cases"] if c.get("clipped_ends")]
     notes += [(c, "; ".join(c["reasons"]) + " (allowed)") for c in report["cases"]
               if c["verdict"] == "vacuous" and c not in failing]
     return notes

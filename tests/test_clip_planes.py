@@ -143,6 +143,9 @@ def test_float32_matrix_projector_keeps_its_clipped_ends():
     planes = probe_planes(gl_float32_matrix.project, wirecheck.oracles.cases.cases_for(_cube(0.9))[2].camera)
     assert case["clipped_ends"]["inward_depth"] > 0 and "float32 rounding" in case["clipped_ends"]["reason"]
     assert planes["near_fit"] > case["camera_spec"]["near"]
+    # said in report.md's Notes
+    from wirecheck.oracles.report import case_notes
+    assert any("clipped ends moved" in text for _c, text in case_notes(report))
 
 
 def test_float32_matrix_slack_is_what_keeps_the_ends(monkeypatch):
