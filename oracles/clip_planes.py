@@ -86,6 +86,8 @@ def probe_planes(func, camera) -> dict | None:
     from .candidate import CandidateError
 
     near, far = float(camera.near), float(camera.far)
+    if not 0 < near < far < np.inf:
+        return None                                   # no positive depth range to probe
     grid = np.geomspace(1e-9 * near, 1e3 * far, GRID_POINTS)
     grid = np.unique(np.concatenate([grid, [near, far]]))
     try:

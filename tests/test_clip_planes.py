@@ -154,3 +154,20 @@ def test_float32_matrix_slack_is_what_keeps_the_ends(monkeypatch):
     report = wirecheck.check_projector(gl_float32_matrix.project, scenes=[_cube(0.9)], cases=["near_plane"],
                                        frames=8, isolate=False, oracles=("opencv", "pyrender"))
     assert report["cases"][0]["verdict"] == "fail"
+
+
+def test_float32_matrix_constants_are_precision_limited():
+    """The same projector on on_axis (fov 60: 1/tan(30 deg) and 1/(aspect tan) rounded to float32, scales
+    1 - 4e-8 and 1 - 2e-8): its vertices are exact to ~1e-13 px for that map, so the fit names the map,
+    and the map is float32 rounding of its constants: precision_limited, never fov_mismatch(scale=0.99999998)
+    or aspect_mismatch(implied_aspect=1.3333334)."""
+    report = wirecheck.check_projector(gl_float32_matrix.project, scenes=["cube"], cases=["on_axis"], frames=3,
+                                       isolate=False)
+    (case,) = report["cases"]
+    assert [(f["name"], f.get("kind")) for f in case["faults"]] == [("precision_limited", "float32_constants")]
+    eps32 = 2.0 ** -23
+    f = case["faults"][0]
+    assert 0 < abs(f["scale_y"] - 1) <= eps32 and 0 < abs(f["scale_x"] - 1) <= 2 * eps32
+    # the float64 control passes
+    assert wirecheck.check_projector(gl_float32_matrix.project_exact, scenes=["cube"], cases=["on_axis"],
+                                     frames=3, isolate=False)["verdict"] == "pass"
