@@ -27,7 +27,7 @@ from __future__ import annotations
 from . import gate, tolerances
 from .caller_state import caller_state_kept
 from .isolation import api_candidate
-from .report import FAULT_HINTS, compared_text, fault_text, not_passed
+from .report import fault_hints, compared_text, fault_text, not_passed
 from .runner import run_crosscheck
 from .subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
 from .tolerances import Tolerances
@@ -236,8 +236,7 @@ def failure_text(report: dict) -> str | None:
     for c in failing:          # a vacuous case's reason starts with "vacuous:"
         lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'], c.get('camera_spec'))}; "
                      + "; ".join(c["reasons"]))
-    names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
-    lines += [f"  what to check, {n}: {FAULT_HINTS[n]}" for n in names]
+    lines += [f"  what to check, {n}: {h}" for n, h in fault_hints(f for c in failing for f in c["faults"])]
     if "compared" in report:
         lines.append(f"  in all: {compared_text(report)}")
     return "\n".join(lines)

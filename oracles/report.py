@@ -50,9 +50,24 @@ FAULT_HINTS = {
     "precision_limited": "the error is the size of float32 rounding, not a convention error: compute in "
                          "float64 or declare float32 (--candidate-precision float32)",
     "depth_flip": "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
+    "clipping_plane": "the points kept differ from near <= z <= far (z = forward . (p - position)): kind and "
+                      "near_fit/far_fit say where the candidate clips (z_positive: at z > 0, not near; "
+                      "float32_near: near rounded to float32; none: never; swapped: near and far exchanged)",
+    "ambiguous": "the images fit two faults equally well (a symmetric view cannot tell them apart): "
+                 "check both, see alternatives",
     "unexplained": "not a simple image-space fault: check the rotation order, a transposed "
                    "world-to-camera matrix, the up vector (roll) and the near/far test",
 }
+
+
+def fault_hints(faults) -> list[tuple[str, str]]:
+    """``(name, what to check)`` for each distinct fault of ``faults``, in FAULT_HINTS order: a fault's own
+    ``hint`` (set where its values say more, e.g. a FOV scale of W/H) or its name's."""
+    seen = {}
+    for f in faults:
+        if f.get("name") in FAULT_HINTS:
+            seen.setdefault((f["name"], f.get("hint") or FAULT_HINTS[f["name"]]), None)
+    return sorted(seen, key=lambda nh: list(FAULT_HINTS).index(nh[0]))
 
 
 def _fmt_err(v) -> str:
@@ -82,7 +97,7 @@ def fault_text(faults: list[dict], camera: dict | None = None) -> str:
     parts = []
     for f in faults:
         extra = ", ".join(f"{k}={distinct(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
-                          for k, v in f.items() if k != "name")
+                          for k, v in f.items() if k not in ("name", "hint"))
         parts.append(f"{f['name']}({extra})" if extra else f["name"])
     return "; ".join(parts)
 
@@ -273,10 +288,14 @@ def precision_text(report: dict) -> str:
 
 
 def case_notes(report: dict) -> list[tuple[dict, str]]:
-    """``(case, text)`` for each case's ``note`` (what was not compared, and why), then each vacuous
-    case allowed by ``--allow-vacuous`` (its reasons): the Notes of report.md and report.html."""
+    """``(case, text)`` for each case's ``note`` (what was not compared, and why), each case whose
+    clipped ends were placed for the candidate's probed planes (``clipped_ends``, oracles.clip_planes),
+    then each vacuous case allowed by ``--allow-vacuous`` (its reasons): the Notes of report.md and
+    report.html."""
     failing = not_passed(report)
     notes = [(c, c["note"]) for c in report["cases"] if c.get("note")]
+    notes += [(c, f"clipped ends moved {c['clipped_ends']['inward_depth']:.3g} inside the planes: "
+                  f"{c['clipped_ends']['reason']}") for c in report["cases"] if c.get("clipped_ends")]
     notes += [(c, "; ".join(c["reasons"]) + " (allowed)") for c in report["cases"]
               if c["verdict"] == "vacuous" and c not in failing]
     return notes
@@ -308,10 +327,10 @@ def markdown(report: dict, files: set | None = None) -> str:
         out += ["", "## Why cases failed", ""]
         for c in failing:
             out.append(f"- **{c['scene']} / {c['camera']}**: " + "; ".join(c["reasons"]))
-        names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
+        names = fault_hints(f for c in failing for f in c["faults"])
         if names:
             out += ["", "## What to check", ""]
-            out += [f"- `{n}`: {FAULT_HINTS[n]}" for n in names]
+            out += [f"- `{n}`: {h}" for n, h in names]
     figures = _figures(report, files)
     if figures or "worst.gif" in files:
         out += ["", "## Figures", ""]
@@ -367,10 +386,10 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append("<h2>Notes</h2><ul>" + "".join(
             f"<li class='note'><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e(note)}</li>" for c, note in notes)
             + "</ul>")
-    names = sorted({f["name"] for c in report["cases"] for f in c["faults"]}, key=list(FAULT_HINTS).index)
+    names = fault_hints(f for c in report["cases"] for f in c["faults"])
     if names:
         parts.append("<h2>What to check</h2><ul>" + "".join(
-            f"<li><code>{e(n)}</code>: {e(FAULT_HINTS[n])}</li>" for n in names) + "</ul>")
+            f"<li><code>{e(n)}</code>: {e(h)}</li>" for n, h in names) + "</ul>")
     timing = report.get("timing") or {}
     if timing:
         trows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in timing_rows(report))

@@ -67,7 +67,7 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
             "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
         })
         bound32 = vertex_bound("float32", acc.scale, tol.vertex_px) if precision == "float64" else None
-        faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32)
+        faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32, planes=acc.planes)
     else:
         rec.update({"max_vertex_error_px": None, "mean_vertex_error_px": None, "rms_vertex_error_px": None})
     px = acc.pixel
