@@ -247,6 +247,10 @@ def main(argv=None) -> int:
         print(f"{module}: {len(all_sites)} sites, {len(pick)} chosen", flush=True)
     if args.only:
         chosen = [s for m in modules for s in sites(m) if s.id in set(args.only)]
+        unknown = sorted(set(args.only) - {s.id for s in chosen})
+        if unknown:    # ids carry line numbers: an old one would otherwise run nothing, silently
+            raise SystemExit(f"mutate: --only {unknown[0]!r} matches no mutation site (ids are "
+                             "module:line:column:operator and move with the code: see --list)")
     # round robin over the modules: a run stopped early has looked at each of them
     by_module = [[s for s in chosen if s.module == m] for m in modules]
     chosen = [s for row in zip_longest(*by_module) for s in row if s is not None]
