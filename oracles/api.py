@@ -105,7 +105,8 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
         ``func(points, camera)``, ``cmd`` not a string or a list of strings,
         a ``timeout_s``, ``isolate`` or ``allow_vacuous`` of the wrong type.
     RuntimeError
-        ``"pyrender"`` asked for but OSMesa is missing.
+        (:class:`~wirecheck.oracles.pyrender_oracle.GLUnavailable`) ``"pyrender"`` asked for
+        but its GL cannot draw here: one line naming the missing library and its fix.
 
     Notes
     -----
@@ -125,11 +126,11 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     with caller_state_kept(), closing_started():    # the caller's globals as they were; no process left
         name, func = api_candidate(func, cmd, timeout_s, isolate)
         if "pyrender" in oracles:
-            from .pyrender_oracle import osmesa_available
+            from .pyrender_oracle import GLUnavailable, gl_available
 
-            ok, message = osmesa_available()
+            ok, message = gl_available()
             if not ok:
-                raise RuntimeError(message)
+                raise GLUnavailable(message)
         report, _images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
                                          oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
                                          allow_vacuous=allow_vacuous)
