@@ -78,6 +78,7 @@ from .config import parse_cli
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
 from .progress import TerminalProgress
+from .compared import hint_lines, what_text
 from .report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import LEVELS, level_for_oracles, run_crosscheck
 from .tolerances import Tolerances
@@ -123,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--candidate-precision", choices=tolerances.PRECISIONS, default=None,
-                   help="what the candidate computes in; its vertex bound is derived from it (oracles/tolerances.py) "
+                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.tolerances) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
@@ -454,12 +455,15 @@ def _main(argv=None) -> int:
             return _error(str(exc))
         except OSError as exc:
             return _error(f"--junit-xml {args.junit_xml!r}: writing failed: {exc}")
+    print(what_text(report))
     print(console_table(records))
     for r in records:
         if r["verdict"] != "pass":
             print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
         elif r.get("note"):
             print(f"  {r['scene']} / {r['camera']}: {r['note']}")
+    for line in hint_lines(report, [r for r in records if r["verdict"] != "pass"]):
+        print(line)
     s = report["summary"]
     limits = (f"silhouette IoU >= {tol.min_iou}, depth error <= its bound" if mode.shaded
               else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}")

@@ -158,7 +158,8 @@ class Check:
         self._calls += 1
         error, trace = None, True
         try:
-            report = check_projector(projector, **{**config.stash[_SETTINGS], **settings})
+            # the table was read at start-up (rootdir or --wirecheck-config): not again from the cwd
+            report = check_projector(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
         except (ValueError, TypeError) as exc:   # InputError is a ValueError: a bad setting or projector spec
             error = f"wirecheck: {type(exc).__name__}: {exc}"
         except RuntimeError as exc:

@@ -298,7 +298,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            f"Drawing: {drawing_text(report)}.", "",
            *([f"Oracle GL: {gl_text(report)}.", ""] if gl_text(report) else []),
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
-           *([f"Candidate precision: {precision_text(report)} (oracles/tolerances.py).", ""]
+           *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.tolerances).", ""]
              if precision_text(report) else []),
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
@@ -322,7 +322,7 @@ def markdown(report: dict, files: set | None = None) -> str:
     if notes:
         out += ["", "## Notes", ""]
         out += [f"- {c['scene']} / {c['camera']}: {note}" for c, note in notes]
-    out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames, and the time per frame "
+    out += ["", "Conventions: see `wirecheck.core.conventions`. Images of the worst frames, and the time per frame "
             "of each stage (vertex, pixel) per case: `report.html` (and `\"timing\"` in `report.json`; "
             "timings are kept out of this file so that it is the same on every run).", ""]
     return "\n".join(out)
