@@ -78,7 +78,7 @@ from .config import parse_cli
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
 from .progress import TerminalProgress
-from .compared import hint_lines, what_text
+from .compared import hint_lines, reason_text, what_text
 from .report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import LEVELS, level_for_oracles, run_crosscheck
 from .tolerances import Tolerances
@@ -459,7 +459,7 @@ def _main(argv=None) -> int:
     print(console_table(records))
     for r in records:
         if r["verdict"] != "pass":
-            print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+            print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
         elif r.get("note"):
             print(f"  {r['scene']} / {r['camera']}: {r['note']}")
     for line in hint_lines(report, [r for r in records if r["verdict"] != "pass"]):

@@ -41,3 +41,14 @@ def hint_lines(report: dict, failing: list) -> list[str]:
     names = sorted({f["name"] for c in failing for f in c["faults"] if f["name"] in FAULT_HINTS},
                    key=list(FAULT_HINTS).index)
     return [f"  what to check, {n}: {FAULT_HINTS[n]}" for n in names]
+
+
+#: Reasons the CLI prints per failing case; the rest are in report.md (a line a reader can take in).
+CLI_REASONS = 2
+
+
+def reason_text(reasons: list[str], keep: int = CLI_REASONS) -> str:
+    """The first ``keep`` reasons of a case joined by ``; ``, and how many more report.md has."""
+    shown = "; ".join(reasons[:keep])
+    more = len(reasons) - keep
+    return shown + (f"; +{more} more in report.md" if more > 0 else "")

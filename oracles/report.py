@@ -81,10 +81,18 @@ def fault_text(faults: list[dict], camera: dict | None = None) -> str:
     nominal = fault_nominals(camera)
     parts = []
     for f in faults:
-        extra = ", ".join(f"{k}={distinct(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
-                          for k, v in f.items() if k != "name")
+        extra = ", ".join(f"{k}={_param(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
+                          for k, v in f.items() if k != "name" and v is not None)   # None: not implied
         parts.append(f"{f['name']}({extra})" if extra else f["name"])
     return "; ".join(parts)
+
+
+def _param(value: float, nominal: float | None) -> str:
+    """A fault's number: digits until it differs from ``nominal``, unless it differs by float64 rounding
+    only (64 eps relative: ``scale_y=0.9999999999999998`` is ``scale_y=1``)."""
+    if nominal is not None and abs(value - nominal) <= 64 * 2.0 ** -52 * max(abs(value), abs(nominal)):
+        return distinct(value)
+    return distinct(value, nominal)
 
 
 def _count(n: int, unit: str) -> str:
