@@ -38,6 +38,7 @@ def _load_numpy_single_threaded() -> None:
 
 _load_numpy_single_threaded()
 
+from .cli_help import RENDERER_EXAMPLES, usage_hint
 from .camera import Camera, camera_z, look_at, orthographic_twin
 from .clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
@@ -65,7 +66,7 @@ class _Parser(argparse.ArgumentParser):
     """argparse, but a usage error is one line on stderr and exit status 2."""
 
     def error(self, message):
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {usage_hint(message)}\n")
 
 
 def vec3(option: str, text: str) -> tuple[float, float, float]:
@@ -81,7 +82,8 @@ def vec3(option: str, text: str) -> tuple[float, float, float]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="renderer", description=DESCRIPTION)
+    p = _Parser(prog="renderer", description=DESCRIPTION, epilog=RENDERER_EXAMPLES,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", default="cube", help="built-in name (cube, pyramid, prism), an example "

@@ -65,6 +65,7 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
+from wirecheck.core.cli_help import CROSSCHECK_EXAMPLES, usage_hint
 from wirecheck.core.errors import InputError, check_not_empty
 from wirecheck.core.guard import VersionAction, run_cli
 from wirecheck.core.output import check_replaceable, check_report_dir
@@ -90,7 +91,7 @@ CORE_OPTIONS = {"dtype": "float64", "clip": "clip", "raster": "exact"}
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit 2
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {usage_hint(message)}\n")
 
 
 #: Most worker processes --jobs may ask for, on this machine or a local Dask cluster.
@@ -100,7 +101,8 @@ MAX_SCHEDULER_TIMEOUT_S = 3600.0
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0].replace("``", ""))
+    p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0].replace("``", ""), epilog=CROSSCHECK_EXAMPLES,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", action="append", default=None,
