@@ -576,7 +576,8 @@ def _suite(level, run_dir) -> int:
             raise
     except OSError as exc:
         return _error(f"writing {str(run_dir)!r} failed: {exc}")
-    print(md)
+    print(md.split("\n\n- **", 1)[0].rstrip())   # the table; derivations and notes are in extremes.md
+    print(f"(the bounds' derivations and each case's notes: {run_dir / 'extremes.md'})\n")
     failed = [c["name"] for c in result["cases"] if c["verdict"] != "pass"]
     print(f"{result['verdict'].upper()}: {len(result['cases']) - len(failed)}/{len(result['cases'])} extreme cases "
           "within their derived bounds" + (f" (failed: {', '.join(failed)})" if failed else ""))
