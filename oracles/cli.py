@@ -474,7 +474,8 @@ def _main(argv=None) -> int:
           f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else ""))
     if precision_text(report):
         print(f"Candidate precision: {precision_text(report)}")
-    print(timing_line(report))
+    from .wall import process_age_s
+    print(timing_line(report)[:-1] + f"; {process_age_s():.1f} s in all, with start-up and the report)")
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
     return 0 if report["verdict"] == "pass" else 1
 

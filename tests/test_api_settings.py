@@ -2,8 +2,10 @@
 says first what was compared (level, frames, cases): the API's defaults (vertices, 8 frames)
 are not crosscheck's (pixels, 24 frames), and a reader must see which were used."""
 
+import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -72,6 +74,7 @@ def test_pytest_shows_the_callers_line_not_wirecheck_source(project):
 
 
 def test_cli_says_what_it_compared_and_each_hint_once(tmp_path):
+    started = time.monotonic()
     done = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", MIRRORED, "--scene", "cube",
                            "--cases", "on_axis,oblique_roll", "--level", "vertices", "--frames", "2",
                            "--report-dir", str(tmp_path / "r")], cwd=tmp_path, capture_output=True, text=True,
@@ -81,3 +84,9 @@ def test_cli_says_what_it_compared_and_each_hint_once(tmp_path):
     assert lines[0] == "Compared: level vertices (OpenCV), 2 frames per case, 2 cases (1 scene x 2 cameras)"
     hints = [line for line in lines if line.startswith("  what to check, ")]
     assert len(hints) == 1 and hints[0].startswith("  what to check, mirror_horizontal: left and right")
+    # the wall time printed counts the process from its start: more than the cases' own wall (imports
+    # alone take > 0.1 s), less than this test measured around the whole subprocess
+    m = re.search(r"\(1 job\(s\), ([\d.]+) s wall; ([\d.]+) s in all, with start-up and the report\)", done.stdout)
+    assert m, done.stdout
+    cases_wall, in_all = float(m.group(1)), float(m.group(2))
+    assert cases_wall + 0.1 < in_all <= time.monotonic() - started + 0.05   # 0.05: the one-decimal rounding
