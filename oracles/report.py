@@ -22,6 +22,7 @@ from wirecheck.core.output import FrameDir, json_dumps, png_bytes
 
 from .fmt import distinct
 from .metrics import DIFF_COLOURS, diff_image
+from .report_crops import crop_caption, crop_image
 
 
 #: What to check for each fault: one line each, for people reading the report.
@@ -336,7 +337,7 @@ def markdown(report: dict, files: set | None = None) -> str:
     return "\n".join(out)
 
 
-def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None) -> str:
+def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = None) -> str:
     files = files or set()
     head = header(report["cases"])
     e = html.escape
@@ -347,10 +348,11 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         "<!doctype html><html><head><meta charset='utf-8'><title>crosscheck report</title>",
         "<style>body{font-family:sans-serif;background:#fafafa;margin:2em}"
         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 8px}"
-        ".row{display:grid;grid-template-columns:repeat(3,1fr);gap:8px}"
+        ".row{display:grid;grid-template-columns:repeat(4,1fr);gap:8px}"
         ".row figure{margin:0}.row figcaption{font-size:90%;color:#444}"
         # thin lines: scale smoothly when shrunk (pixelated scaling drops pixels); click for 1:1
         ".row img{width:100%;image-rendering:auto;border:1px solid #888;background:#000}"
+        ".row .crop img{width:auto;max-width:100%;image-rendering:pixelated}"   # enlarged: blocks stay blocks
         ".chip{background:#000;padding:1px 6px;border-radius:3px}"
         ".anim{max-width:100%;image-rendering:pixelated;border:1px solid #888}.plot{max-width:100%}"
         ".fail{color:#b00}.pass{color:#070}section{margin:0 0 2em 0}</style></head><body>",
@@ -380,7 +382,7 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append("<h2>What to check</h2><ul>" + "".join(
             f"<li><code>{e(n)}</code>: {e(FAULT_HINTS[n])}</li>" for n in names) + "</ul>")
     timing = report.get("timing") or {}
-    if timing:
+    if timing and any(cell != _fmt_ms(None) for row in timing_rows(report) for cell in row[2:]):   # not all dashes
         trows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in timing_rows(report))
         parts.append(
             "<h2>Time per frame</h2><p>Vertex stage: the candidate's projection and OpenCV; pixel stage: the "
@@ -402,11 +404,13 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append(
             f"<h2>Worst frames</h2><p>Each row: the candidate's frame, the oracle's (pyrender), and their diff: "
             f"{legend}. Click an image for full size.</p>")
-    for case, stem in shown:
+    for case, stem, crop in shown:
         figs = "".join(
             f"<figure><figcaption>{label}</figcaption><a href='img/{stem}-{kind}.png'>"
             f"<img src='img/{stem}-{kind}.png' alt='{label}'></a></figure>"
             for kind, label in (("candidate", "candidate"), ("oracle", "oracle (pyrender)"), ("diff", "diff")))
+        figs += (f"<figure class='crop'><figcaption>{e(crop)}</figcaption><a href='img/{stem}-crop.png'>"
+                 f"<img src='img/{stem}-crop.png' alt='{e(crop)}'></a></figure>")
         if "silhouette_iou" in case:
             scores = (f"silhouette IoU {_fmt_f1(case.get('silhouette_iou'))}, depth error / bound "
                       f"{_fmt_ratio(case.get('depth_error_ratio'))}")
@@ -459,7 +463,9 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
             out.write(f"img/{stem}-candidate.png", png_bytes(np.where(im["candidate"], 255, 0).astype(np.uint8)))
             out.write(f"img/{stem}-oracle.png", png_bytes(np.where(im["oracle"], 255, 0).astype(np.uint8)))
             out.write(f"img/{stem}-diff.png", png_bytes(diff_image(im["candidate"], im["oracle"])))
-            shown.append((case, stem))
+            crop, window = crop_image(im["candidate"], im["oracle"])
+            out.write(f"img/{stem}-crop.png", png_bytes(crop))
+            shown.append((case, stem, crop_caption(window)))
         report = _finite_or_null(report)
         files = set()
         if images.get("animation"):
