@@ -158,7 +158,7 @@ def run_settings(frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None,
     """:func:`run_inputs` without the scenes (``scenes=()``): a dataset's meshes are checked as they load."""
     frames = _integer(frames, names["frames"], 1)
     if frames > MAX_FRAMES:
-        raise InputError(f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (core/limits.py)")
+        raise InputError(f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (wirecheck.core.limits)")
     every = _integer(every, names["every"], 1)
     if every > frames:
         raise InputError(f"{names['every']} {every} with {names['frames']} {frames}: only frame 1 would be "

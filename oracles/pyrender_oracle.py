@@ -64,11 +64,15 @@ from .convert import camera_to_pyrender, centre_of, gl_eye_pose
 from .oracle_precision import frame_bound_px, mesh_radius
 from .pyrender_programs import stabilise_program_cache
 
-__all__ = ["GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
+__all__ = ["GLUnavailable", "GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
            "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
 
 #: The OpenGL platforms the oracle draws on (``PYOPENGL_PLATFORM``); the first is the default.
 GL_PLATFORMS = ("osmesa", "egl")
+
+class GLUnavailable(RuntimeError):
+    """The pixel oracle cannot draw here: the message is one line naming the missing piece and its fix."""
+
 
 _INSTALL_HINT = {"osmesa": "apt-get install -y libosmesa6",
                  "egl": "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri"}
@@ -120,17 +124,17 @@ def gl_available() -> tuple[bool, str]:
     if platform not in GL_PLATFORMS:
         return False, (f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on "
                        f"{' or '.join(repr(p) for p in GL_PLATFORMS)}")
-    if platform == "osmesa":
-        try:
-            from OpenGL import osmesa
-            osmesa.OSMesaCreateContextAttribs  # noqa: B018 - raises if the symbol is missing
-        except Exception as exc:  # ImportError, OSError, AttributeError, NullFunctionError
-            return False, (f"libOSMesa cannot be loaded ({type(exc).__name__}: {exc}); "
-                           f"install it with: {_INSTALL_HINT['osmesa']}")
+    missing = _missing_gl_library(platform)
+    if missing is not None:
+        return False, missing
     try:
         import pyrender  # noqa: F401
     except Exception as exc:
-        return False, f"pyrender cannot be imported ({type(exc).__name__}: {exc}); pip install pyrender2"
+        if "glGetError" in str(exc) or str(exc).startswith("Library "):   # a GL library PyOpenGL could not load
+            return False, (f"OpenGL's library cannot be loaded on {platform} ({type(exc).__name__}: {exc}); "
+                           f"install it with: {_INSTALL_HINT[platform]}")
+        return False, (f"pyrender cannot be imported ({type(exc).__name__}: {exc}); "
+                       "install it with: pip install 'pyrender2>=0.2,<1'")
     if platform == "osmesa":
         return True, "OSMesa available"
     if platform not in _EGL_CHECKED:
@@ -142,6 +146,47 @@ def gl_available() -> tuple[bool, str]:
             _EGL_CHECKED[platform] = (False, f"no EGL context can be created ({msg}); "
                                              f"install it with: {_INSTALL_HINT['egl']}")
     return _EGL_CHECKED[platform]
+
+
+def _missing_gl_library(platform: str) -> str | None:
+    """One line naming the GL library that PyOpenGL cannot load on ``platform``, with its fix; None if all load.
+
+    PyOpenGL does not raise when a platform's library is missing: it leaves ``PLATFORM.GL`` None,
+    and the first GL call (pyrender's import) fails with ``'NoneType' object has no attribute
+    'glGetError'``, which names neither the library nor the fix. So the libraries are looked at
+    here, before pyrender is imported: libOSMesa (and its ``OSMesaCreateContextAttribs``, Mesa
+    >= 11.2) for osmesa; libEGL and libGL/libOpenGL for egl.
+    """
+    hint = _INSTALL_HINT[platform]
+    try:
+        from OpenGL import platform as gl_platform_module
+        loaded = gl_platform_module.PLATFORM
+    except Exception as exc:  # ImportError, OSError: the platform module itself cannot load
+        msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+        return f"OpenGL cannot load its {platform} platform ({msg}); install it with: {hint}"
+    if platform == "osmesa":
+        lib = _loaded(loaded, "GL")
+        if lib is None:
+            return f"libOSMesa cannot be loaded (no libOSMesa.so found); install it with: {hint}"
+        if not hasattr(lib, "OSMesaCreateContextAttribs"):
+            return (f"libOSMesa ({getattr(lib, '_name', '?')}) lacks OSMesaCreateContextAttribs (Mesa "
+                    f"before 11.2: no core-profile context for pyrender); install a newer one with: {hint}")
+        return None
+    if _loaded(loaded, "EGL") is None:
+        return f"libEGL cannot be loaded (no libEGL.so found: Mesa's EGL); install it with: {hint}"
+    gl = _loaded(loaded, "GL")
+    if gl is None or "GLES" in str(getattr(gl, "_name", "")):   # PyOpenGL falls back to GLES: not enough
+        return ("libGL / libOpenGL cannot be loaded (no libGL.so found); install it with: "
+                "apt-get install -y libgl1 libopengl0")
+    return None
+
+
+def _loaded(platform_object, name: str):
+    """``platform_object.<name>`` (a ctypes library, loaded on first access), or None when it cannot load."""
+    try:
+        return getattr(platform_object, name)
+    except Exception:  # ImportError, OSError: PyOpenGL's lazy properties raise on some versions
+        return None
 
 
 def osmesa_available() -> tuple[bool, str]:

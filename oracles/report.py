@@ -22,6 +22,7 @@ from wirecheck.core.output import FrameDir, json_dumps, png_bytes
 
 from .fmt import distinct
 from .metrics import DIFF_COLOURS, diff_image
+from .report_crops import crop_caption, crop_image
 
 
 #: What to check for each fault: one line each, for people reading the report.
@@ -96,10 +97,18 @@ def fault_text(faults: list[dict], camera: dict | None = None) -> str:
     nominal = fault_nominals(camera)
     parts = []
     for f in faults:
-        extra = ", ".join(f"{k}={distinct(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
-                          for k, v in f.items() if k not in ("name", "hint"))
+        extra = ", ".join(f"{k}={_param(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
+                          for k, v in f.items() if k not in ("name", "hint") and v is not None)   # None: not implied
         parts.append(f"{f['name']}({extra})" if extra else f["name"])
     return "; ".join(parts)
+
+
+def _param(value: float, nominal: float | None) -> str:
+    """A fault's number: digits until it differs from ``nominal``, unless it differs by float64 rounding
+    only (64 eps relative: ``scale_y=0.9999999999999998`` is ``scale_y=1``)."""
+    if nominal is not None and abs(value - nominal) <= 64 * 2.0 ** -52 * max(abs(value), abs(nominal)):
+        return distinct(value)
+    return distinct(value, nominal)
 
 
 def _count(n: int, unit: str) -> str:
@@ -317,7 +326,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            f"Drawing: {drawing_text(report)}.", "",
            *([f"Oracle GL: {gl_text(report)}.", ""] if gl_text(report) else []),
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
-           *([f"Candidate precision: {precision_text(report)} (oracles/tolerances.py).", ""]
+           *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.tolerances).", ""]
              if precision_text(report) else []),
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
@@ -341,13 +350,13 @@ def markdown(report: dict, files: set | None = None) -> str:
     if notes:
         out += ["", "## Notes", ""]
         out += [f"- {c['scene']} / {c['camera']}: {note}" for c, note in notes]
-    out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames, and the time per frame "
+    out += ["", "Conventions: see `wirecheck.core.conventions`. Images of the worst frames, and the time per frame "
             "of each stage (vertex, pixel) per case: `report.html` (and `\"timing\"` in `report.json`; "
             "timings are kept out of this file so that it is the same on every run).", ""]
     return "\n".join(out)
 
 
-def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None) -> str:
+def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = None) -> str:
     files = files or set()
     head = header(report["cases"])
     e = html.escape
@@ -358,10 +367,11 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         "<!doctype html><html><head><meta charset='utf-8'><title>crosscheck report</title>",
         "<style>body{font-family:sans-serif;background:#fafafa;margin:2em}"
         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 8px}"
-        ".row{display:grid;grid-template-columns:repeat(3,1fr);gap:8px}"
+        ".row{display:grid;grid-template-columns:repeat(4,1fr);gap:8px}"
         ".row figure{margin:0}.row figcaption{font-size:90%;color:#444}"
         # thin lines: scale smoothly when shrunk (pixelated scaling drops pixels); click for 1:1
         ".row img{width:100%;image-rendering:auto;border:1px solid #888;background:#000}"
+        ".row .crop img{width:auto;max-width:100%;image-rendering:pixelated}"   # enlarged: blocks stay blocks
         ".chip{background:#000;padding:1px 6px;border-radius:3px}"
         ".anim{max-width:100%;image-rendering:pixelated;border:1px solid #888}.plot{max-width:100%}"
         ".fail{color:#b00}.pass{color:#070}section{margin:0 0 2em 0}</style></head><body>",
@@ -391,7 +401,7 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append("<h2>What to check</h2><ul>" + "".join(
             f"<li><code>{e(n)}</code>: {e(h)}</li>" for n, h in names) + "</ul>")
     timing = report.get("timing") or {}
-    if timing:
+    if timing and any(cell != _fmt_ms(None) for row in timing_rows(report) for cell in row[2:]):   # not all dashes
         trows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in timing_rows(report))
         parts.append(
             "<h2>Time per frame</h2><p>Vertex stage: the candidate's projection and OpenCV; pixel stage: the "
@@ -413,11 +423,13 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append(
             f"<h2>Worst frames</h2><p>Each row: the candidate's frame, the oracle's (pyrender), and their diff: "
             f"{legend}. Click an image for full size.</p>")
-    for case, stem in shown:
+    for case, stem, crop in shown:
         figs = "".join(
             f"<figure><figcaption>{label}</figcaption><a href='img/{stem}-{kind}.png'>"
             f"<img src='img/{stem}-{kind}.png' alt='{label}'></a></figure>"
             for kind, label in (("candidate", "candidate"), ("oracle", "oracle (pyrender)"), ("diff", "diff")))
+        figs += (f"<figure class='crop'><figcaption>{e(crop)}</figcaption><a href='img/{stem}-crop.png'>"
+                 f"<img src='img/{stem}-crop.png' alt='{e(crop)}'></a></figure>")
         if "silhouette_iou" in case:
             scores = (f"silhouette IoU {_fmt_f1(case.get('silhouette_iou'))}, depth error / bound "
                       f"{_fmt_ratio(case.get('depth_error_ratio'))}")
@@ -470,7 +482,9 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
             out.write(f"img/{stem}-candidate.png", png_bytes(np.where(im["candidate"], 255, 0).astype(np.uint8)))
             out.write(f"img/{stem}-oracle.png", png_bytes(np.where(im["oracle"], 255, 0).astype(np.uint8)))
             out.write(f"img/{stem}-diff.png", png_bytes(diff_image(im["candidate"], im["oracle"])))
-            shown.append((case, stem))
+            crop, window = crop_image(im["candidate"], im["oracle"])
+            out.write(f"img/{stem}-crop.png", png_bytes(crop))
+            shown.append((case, stem, crop_caption(window)))
         report = _finite_or_null(report)
         files = set()
         if images.get("animation"):
