@@ -49,6 +49,9 @@ name                recognised by                               fields
 depth_flip          visible sets (nearly) disjoint: the         oracle_visible, candidate_visible,
                     candidate shows what the oracle clips and   common_visible
                     clips what it shows
+clipping_plane      the visible sets differ and the candidate's kind ("z_positive", "float32_near",
+                    own planes, probed (``planes``,            "float32_far", "near", "far", "none",
+                    oracles.clip_planes), are not the camera's  "swapped"), near_fit, far_fit, near, far
 axis_swap           ``P`` anti-diagonal (x and y exchanged)     --
 mirror_horizontal   ``P = diag(-1, 1)`` (after any swap)        --
 mirror_vertical     ``P = diag(1, -1)`` (after any swap)        --
@@ -72,7 +75,9 @@ line_pixel_bias     (pixels; vertices agree) as above, but not  candidate_only, 
 precision_limited   (a candidate judged at float64) the         residual_px, float64_bound_px,
                     disagreement is float32 rounding: the       float32_bound_px
                     diagnosis at the float32 bound explains
-                    it (see "Precision" below)
+                    it (see "Precision" below); or the fitted  (kind "float32_constants": scale_x,
+                    scales and offset are float32 rounding of   scale_y, dx, dy)
+                    the constants (:func:`rounded_constants`)
 unexplained         the named model does not fit (rotation,     residual_px (max), residual_rms_px,
                     shear, not affine); or the visible sets     affine_residual_px, affine, offset,
                     differ without a depth flip; or too few     rotation_deg, visibility_mismatches,

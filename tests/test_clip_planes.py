@@ -130,6 +130,7 @@ def _cube(scale):
     return Scene(name=f"cube_x{scale}", vertices=s.vertices * scale, edges=s.edges, faces=s.faces)
 
 
+@pytest.mark.slow                      # crosscheck runs
 def test_float32_matrix_projector_keeps_its_clipped_ends():
     """PyGLM's float32 perspective in a float64 projector: on the cube scaled 0.9 its near plane is
     near (1 + 8.6e-8) (float32 rounding of A, B in -w <= A z + B), and edges cross near in near_plane.
@@ -148,6 +149,7 @@ def test_float32_matrix_projector_keeps_its_clipped_ends():
     assert any("clipped ends moved" in text for _c, text in case_notes(report))
 
 
+@pytest.mark.slow                      # crosscheck runs
 def test_float32_matrix_slack_is_what_keeps_the_ends(monkeypatch):
     """The control: the same run with the slack taken away fails on line pixels."""
     monkeypatch.setattr(clip_planes, "depth_slack", lambda planes, camera: (0.0, None))
@@ -156,6 +158,7 @@ def test_float32_matrix_slack_is_what_keeps_the_ends(monkeypatch):
     assert report["cases"][0]["verdict"] == "fail"
 
 
+@pytest.mark.slow                      # crosscheck runs
 def test_float32_matrix_constants_are_precision_limited():
     """The same projector on on_axis (fov 60: 1/tan(30 deg) and 1/(aspect tan) rounded to float32, scales
     1 - 4e-8 and 1 - 2e-8): its vertices are exact to ~1e-13 px for that map, so the fit names the map,

@@ -20,7 +20,8 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from test_diagnosis import CALIBRATED_FAULTS, CAMERAS, CLIP_FAULTS, FAULTS, FOV_FACTOR, SINGLE, format_confusion, implied_fov
+from diagnosis_faults import CALIBRATED_FAULTS, CAMERAS, CLIP_FAULTS, FAULTS, FOV_FACTOR, SINGLE, implied_fov
+from test_diagnosis import format_confusion
 
 from wirecheck.core.camera import look_at
 from wirecheck.core.clipping import clip_to_image

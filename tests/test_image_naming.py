@@ -20,6 +20,7 @@ from wirecheck.oracles.image_diagnose import OFFSET_TOL_PX, diagnose_images
 CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
 CX, CY = CAM.principal_point
 SCALE = 0.75
+pytestmark = pytest.mark.slow          # two image diagnoses, ~5 s each
 
 
 def _rectangle(right, left, bottom, top):
