@@ -87,16 +87,18 @@ def frame_bound_px(camera, eye_pose, radius: float) -> float:
 
     a = np.asarray(eye_pose, dtype=np.float64)
     _view, proj = camera_to_gl(camera)
-    rho = float(np.linalg.norm(a[:3, :3], 2)) * float(radius)
-    mag = np.abs(a[:3, 3]) + rho                              # |e_j| and its terms, every drawn point
-    m_clip = np.abs(proj[:, :3]) @ mag + np.abs(proj[:, 3])   # magnitude of each clip coordinate's terms
-    w_term = CLIP_W_ROUNDINGS * m_clip[3] if camera.projection == "perspective" else 0.0   # ortho: c_w = 1
-    w_lo = max(float(camera.near), -float(a[2, 3]) - rho) if camera.projection == "perspective" else 1.0
-    bx = U32 * (camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[0] + w_term) / w_lo
-    by = U32 * (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[1] + w_term) / w_lo
-    bx += VIEWPORT_ROUNDINGS * U32 * camera.width
-    by += VIEWPORT_ROUNDINGS * U32 * camera.height
-    return float(max(bx, by))
+    with np.errstate(over="ignore", invalid="ignore"):      # an overflow is no bound: inf below
+        rho = float(np.linalg.norm(a[:3, :3], 2)) * float(radius)
+        mag = np.abs(a[:3, 3]) + rho                              # |e_j| and its terms, every drawn point
+        m_clip = np.abs(proj[:, :3]) @ mag + np.abs(proj[:, 3])   # magnitude of each clip coordinate's terms
+        w_term = CLIP_W_ROUNDINGS * m_clip[3] if camera.projection == "perspective" else 0.0   # ortho: c_w = 1
+        w_lo = max(float(camera.near), -float(a[2, 3]) - rho) if camera.projection == "perspective" else 1.0
+        bx = U32 * (camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[0] + w_term) / w_lo
+        by = U32 * (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[1] + w_term) / w_lo
+        bx += VIEWPORT_ROUNDINGS * U32 * camera.width
+        by += VIEWPORT_ROUNDINGS * U32 * camera.height
+    both = np.array([bx, by], dtype=np.float64)
+    return float(both.max()) if np.isfinite(both).all() else float("inf")   # no finite bound: none at all
 
 
 def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:

@@ -137,8 +137,9 @@ def test_a_case_beyond_the_oracles_precision_is_named_and_does_not_blame_the_can
     from wirecheck.oracles.pyrender_oracle import PyrenderOracle
     from wirecheck.oracles.tolerances import Tolerances
 
-    # a 1,400-unit cube seen from 3 units inside one face's plane with near 0.01: the nearest drawn point
-    # is 0.01 deep and the magnitudes are ~1e3, so the bound is ~u 160 7 1e3 / 0.01 ~ 0.7 px >> 2^-9
+    # a 1,400-unit cube seen from 3 units above one face with near 0.01: the nearest drawn point is 0.01
+    # deep and the clip magnitudes ~2e3 (703 to the centre + rho 1.2e3), so the w term alone is
+    # u 160 7 2e3 / 0.01 ~ 13 px (the bound: 29 px), far beyond 2^-9
     scene = load_scene(str(write_cube(tmp_path / "big.obj", 0.0, scale=1000.0)))
     cam = Camera(position=(0.0, 0.0, 703.0), forward=(0.1, 0.05, -1.0), up=(0.0, 1.0, 0.0), width=320,
                  height=240, near=0.01, far=5000.0, fov_y_deg=60.0)
@@ -149,3 +150,10 @@ def test_a_case_beyond_the_oracles_precision_is_named_and_does_not_blame_the_can
     assert rec["oracle_bound_px"] > 100 * op.ORACLE_LIMIT_PX
     assert rec["verdict"] == "vacuous" and rec["oracle_precision"] is True
     assert rec["reasons"][0].startswith("oracle_precision: the pyrender oracle's own error bound")
+
+
+def test_a_bound_that_overflows_is_no_bound_and_beyond_the_limit():
+    # a radius of 1e308 makes the magnitudes overflow float64: no finite bound, so the case cannot be judged
+    cam = _camera((0.0, 0.0, 5.0))
+    bound = op.frame_bound_px(cam, gl_eye_pose(cam, None, (0.0, 0.0, 0.0)), 1e308)
+    assert bound == float("inf") and bound > op.ORACLE_LIMIT_PX
