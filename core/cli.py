@@ -16,6 +16,10 @@ import os
 import sys
 from pathlib import Path
 
+from .guard import interrupts_from_start
+
+interrupts_from_start("renderer")      # before the imports below: Ctrl-C while starting is one line, no traceback
+
 
 def _load_numpy_single_threaded() -> None:
     """Import numpy with OpenBLAS sized to one thread, when this module is the first to import it.
@@ -38,6 +42,7 @@ def _load_numpy_single_threaded() -> None:
 
 _load_numpy_single_threaded()
 
+from .cli_help import RENDERER_EXAMPLES, usage_hint
 from .camera import Camera, camera_z, look_at, orthographic_twin
 from .clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
@@ -65,7 +70,7 @@ class _Parser(argparse.ArgumentParser):
     """argparse, but a usage error is one line on stderr and exit status 2."""
 
     def error(self, message):
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {usage_hint(message)}\n")
 
 
 def vec3(option: str, text: str) -> tuple[float, float, float]:
@@ -81,14 +86,15 @@ def vec3(option: str, text: str) -> tuple[float, float, float]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="renderer", description=DESCRIPTION)
+    p = _Parser(prog="renderer", description=DESCRIPTION, epilog=RENDERER_EXAMPLES,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", default="cube", help="built-in name (cube, pyramid, prism), an example "
                    "(orrery: scenes/examples/, several objects) or a file path (.scene, .obj, .ply, .stl, .off, "
                    ".glb) (default cube)")
     p.add_argument("--frames", type=plain_int, default=None, help="number of frames (default 180)")
-    cam = p.add_argument_group("camera (conventions: core/conventions.py)")
+    cam = p.add_argument_group("camera (conventions: wirecheck.core.conventions)")
     cam.add_argument("--camera-z", type=plain_float, default=None, metavar="D",
                      help="camera at (0,0,D) looking at the origin, up +Y (default 4)")
     cam.add_argument("--camera-pos", default=None, metavar="X,Y,Z",
@@ -98,7 +104,7 @@ def build_parser() -> argparse.ArgumentParser:
     cam.add_argument("--fov", type=plain_float, default=None, help="full vertical FOV in degrees, edge to edge (default 60)")
     cam.add_argument("--intrinsics", default=None, metavar="FX,FY,CX,CY",
                      help="a calibrated camera instead of --fov: focal lengths and principal point in pixels, "
-                     "pixel centres at integers (core/conventions.py; default: none, from --fov)")
+                     "pixel centres at integers (wirecheck.core.conventions; default: none, from --fov)")
     cam.add_argument("--distortion", default=None, metavar="K1,K2,P1,P2[,K3[,K4,K5,K6]]",
                      help="OpenCV lens distortion of the vertices (edges stay straight lines between them; "
                      "wireframes only) (default: none)")
@@ -123,7 +129,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--clip", choices=CLIP_MODES, default="clip",
                    help="clip: clip edges at near/far; endpoint: drop edges with a clipped end (default clip)")
     p.add_argument("--dtype", choices=DTYPES, default="float64",
-                   help="precision of every per-point operation (default float64; core/projection.py)")
+                   help="precision of every per-point operation (default float64; wirecheck.core.projection)")
     p.add_argument("--raster", choices=RASTER_MODES, default="exact",
                    help="exact: GL diamond-exit (matches Mesa); fast: integer DDA; aa: anti-aliased (Wu) "
                    "(default exact)")

@@ -47,10 +47,10 @@ def check_image_size(width: int, height: int, option: str, sides: int = 1) -> No
         raise InputError(f"{option} {width}x{height}: expected positive integers")
     if width > MAX_SIDE or height > MAX_SIDE:
         raise InputError(f"{option} {width}x{height}: expected at most {MAX_SIDE} pixels a side "
-                         "(the largest viewport OpenGL drivers render; core/limits.py)")
+                         "(the largest viewport OpenGL drivers render; wirecheck.core.limits)")
     if width * height > MAX_PIXELS:
         raise InputError(f"{option} {width}x{height}: {width * height:,} pixels: expected at most "
-                         f"{MAX_PIXELS:,} (about 1 GB of buffers with --hidden-lines; core/limits.py)")
+                         f"{MAX_PIXELS:,} (about 1 GB of buffers with --hidden-lines; wirecheck.core.limits)")
 
 
 def check_turns(turns, what: str) -> tuple:
@@ -58,5 +58,5 @@ def check_turns(turns, what: str) -> tuple:
     for t in turns:
         if not (math.isfinite(t) and abs(t) <= MAX_TURNS):
             raise InputError(f"{what} {' '.join(f'{v:g}' for v in turns)}: expected turns with |t| <= 2^53 "
-                             "(a float64 holds no fraction of a turn beyond; core/limits.py)")
+                             "(a float64 holds no fraction of a turn beyond; wirecheck.core.limits)")
     return tuple(turns)

@@ -26,16 +26,18 @@ from __future__ import annotations
 
 import dataclasses
 import io
-import math
 import os
 import re
+import stat
 from pathlib import Path
 
 import numpy as np
 
 from .culling import winding_problem
 from .errors import InputError, quiet_libraries
-from .numbers import plain_float, plain_int
+from .mesh_companions import companion_resolver, file_kind, interrupts_kept
+from .mesh_checks import check_json, check_off, check_ply_counts, check_stl, number as _number, short as _short
+from .numbers import plain_int
 from .limits import MAX_FACE_VERTICES, MAX_NAME, check_turns
 from .scene import Scene, SceneObject, face_edges, unique_edges
 from .transforms import Motion
@@ -54,16 +56,6 @@ def _safe_stem(path) -> str:
     """A file stem usable as a scene name (characters outside NAME_PATTERN become '_')."""
     stem = re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem)
     return stem if NAME_PATTERN.fullmatch(stem) else "_" + stem
-
-
-def _number(path, lineno, token, what):
-    try:
-        value = plain_float(token)
-    except ValueError:
-        raise InputError(f"{path}:{lineno}: {what} {_short(token)}: expected a number") from None
-    if not math.isfinite(value):
-        raise InputError(f"{path}:{lineno}: {what} {_short(token)}: expected a finite number")
-    return value
 
 
 def _index(path, lineno, token, what, n_vertices, where="the scene has"):
@@ -277,28 +269,46 @@ def _obj_lines(path: Path) -> list[tuple[int, int]]:
 
 
 def load_mesh_file(path: Path) -> Scene:
+    """A mesh file read with trimesh into a Scene; InputError (one line) for a file that is not one.
+
+    Companion files the mesh names (an OBJ's ``mtllib``, a texture, a glTF
+    buffer) are read only when they are regular files (core.mesh_companions):
+    a FIFO or a device there is refused by name, never opened, so loading never
+    blocks. Ctrl-C and SIGTERM during trimesh's reading end the run even though
+    trimesh catches every exception around it.
+    """
     import trimesh  # lazy: only mesh files need it
 
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise InputError(f"{path}: {exc.strerror or exc}: expected a readable mesh file") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(f"{path} is {file_kind(st.st_mode)}: expected a regular mesh file (never opened: "
+                         "reading it could block forever)")
     suffix = path.suffix.lower()
     if suffix == ".obj":
         _check_obj(path)      # every 'v' and 'f' line first: errors with file:line, not trimesh's
     elif suffix == ".stl":
-        _check_stl(path)      # trimesh reads a truncated or foreign STL as an empty mesh, silently
+        check_stl(path)      # trimesh reads a truncated or foreign STL as an empty mesh, silently
     elif suffix == ".off":
-        _check_off(path)      # trimesh takes any first line for 'OFF' and reads a short face list as none
+        check_off(path)      # trimesh takes any first line for 'OFF' and reads a short face list as none
     elif suffix == ".gltf":
-        _check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
-    source = {"file_obj": str(path)}
+        check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
+    resolver = companion_resolver(path)
+    source = {"file_obj": str(path), "resolver": resolver}
     if suffix == ".obj":
         absolute = _obj_absolute_indices(path)
-        if absolute is not None:
-            source = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}
+        if absolute is not None:     # read from memory: no resolver, so trimesh reads no companion
+            source, resolver = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}, None
     try:
-        with quiet_libraries():     # trimesh logs tracebacks it recovers from; numpy warns on NaN casts
+        with interrupts_kept(), quiet_libraries():  # trimesh logs tracebacks it recovers from; numpy warns
             loaded = trimesh.load(**source, process=False, maintain_order=True)
     except Exception as exc:  # trimesh raises many types; one line for the user
+        _check_refused(path, resolver)
         raise InputError(f"{path}: could not be read as {path.suffix[1:].upper()}: "
                          f"{type(exc).__name__}: {exc}") from None
+    _check_refused(path, resolver)
     if isinstance(loaded, trimesh.Scene):
         loaded = loaded.to_geometry() if hasattr(loaded, "to_geometry") else loaded.dump(concatenate=True)
     if path.suffix.lower() == ".stl" and hasattr(loaded, "merge_vertices"):
@@ -319,7 +329,7 @@ def load_mesh_file(path: Path) -> Scene:
     if faces.ndim != 2:
         raise InputError(f"{path}: faces of shape {faces.shape}: expected rows of vertex indices")
     if suffix == ".ply":
-        _check_ply_counts(path, len(vertices), len(faces))
+        check_ply_counts(path, len(vertices), len(faces))
     bad = (faces < 0) | (faces >= len(vertices))
     if bad.any():
         f, k = (int(i) for i in np.argwhere(bad)[0])
@@ -345,6 +355,14 @@ def load_mesh_file(path: Path) -> Scene:
     _check_name_length(_safe_stem(path), path)
     return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
                  faces=faces, source=str(path), winding_note=_winding_note(faces))
+
+
+def _check_refused(path: Path, resolver) -> None:
+    """InputError naming the first companion file of ``path`` the resolver refused (a FIFO, a device)."""
+    if resolver is not None and resolver.refused:
+        name, exc = resolver.refused[0]
+        raise InputError(f"{path}: the file it names {_short(name)} ({exc.path}) is {exc.kind}: expected a "
+                         "regular file (never opened: reading it could block forever)")
 
 
 #: OBJ statements (the Wavefront spec's, free-form geometry included); others are ignored by readers,
@@ -426,124 +444,6 @@ def _obj_absolute_indices(path: Path) -> str | None:
     return "".join(lines) if changed else None
 
 
-def _check_stl(path: Path) -> None:
-    """InputError unless ``path`` is a complete binary STL or a well-formed ASCII one (with file:line)."""
-    size = path.stat().st_size
-    with open(path, "rb") as fh:
-        data = fh.read(84)
-    if size >= 84:
-        count = int.from_bytes(data[80:84], "little")
-        if size == 84 + 50 * count:
-            return                                        # binary, even when the header starts with 'solid'
-    if not data.lstrip()[:5].lower() == b"solid":
-        if size < 84:
-            raise InputError(f"{path}: {size} bytes: expected a binary STL (an 84-byte header, then 50 "
-                             "bytes a triangle) or an ASCII STL starting with 'solid'")
-        raise InputError(f"{path}: {size} bytes, its header declares {count} triangles: expected "
-                         f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)")
-    _check_ascii_stl(path, path.read_bytes().decode("latin-1"))
-
-
-def _check_off(path: Path) -> None:
-    """InputError (file:line) unless ``path`` is an OFF file: 'OFF', counts, then as many vertices and faces."""
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        rows = [(n, line.split("#", 1)[0].split()) for n, line in enumerate(fh, start=1)]
-    rows = [(n, parts) for n, parts in rows if parts]
-    if not rows or rows[0][1][0] not in ("OFF", "COFF"):
-        n, parts = rows[0] if rows else (1, ["(empty)"])
-        raise InputError(f"{path}:{n}: {_short(' '.join(parts))}: expected the header 'OFF' (or 'COFF')")
-    head_n, head = rows[0]
-    if len(head) == 1:                                    # the counts on the next line
-        rows = rows[1:]
-        head_n, head = rows[0] if rows else (head_n, [])
-        head = ["OFF", *head]
-    counts = head[1:4]
-    if len(counts) < 2 or not all(t.isdigit() for t in counts):
-        raise InputError(f"{path}:{head_n}: counts {_short(' '.join(head[1:]))}: expected 'VERTICES FACES EDGES' "
-                         "(integers >= 0)")
-    n_v, n_f = int(counts[0]), int(counts[1])
-    body = rows[1:]
-    if len(body) < n_v + n_f:
-        raise InputError(f"{path}:{head_n}: {n_v} vertices and {n_f} faces declared, {len(body)} lines follow: "
-                         "expected a complete file (truncated?)")
-    for n, parts in body[:n_v]:
-        if len(parts) < 3:
-            raise InputError(f"{path}:{n}: vertex {_short(' '.join(parts))}: expected 'X Y Z'")
-        for t in parts[:3]:
-            _number(path, n, t, "vertex coordinate")
-    for n, parts in body[n_v:n_v + n_f]:
-        size = int(parts[0]) if parts[0].isdigit() else -1
-        if size < 3 or len(parts) < size + 1 or not all(t.isdigit() and int(t) < n_v for t in parts[1:size + 1]):
-            raise InputError(f"{path}:{n}: face {_short(' '.join(parts))}: expected 'N I1 ... IN', N >= 3, "
-                             f"indices 0..{n_v - 1}")
-
-
-def _check_json(path: Path) -> None:
-    """InputError (file:line:column) unless ``path`` holds one JSON object, as a .gltf does."""
-    import json
-
-    try:
-        doc = json.loads(path.read_bytes())
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start}): expected glTF JSON") from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}:{exc.lineno}:{exc.colno}: not JSON ({exc.msg}): expected glTF JSON") from None
-    if not isinstance(doc, dict):
-        raise InputError(f"{path}: a JSON {type(doc).__name__}: expected a glTF object ({{\"asset\": ...}})")
-
-
-_STL_TOKENS = frozenset(("solid", "facet", "outer", "vertex", "endloop", "endfacet", "endsolid"))
-
-
-def _check_ascii_stl(path: Path, text: str) -> None:
-    """InputError (file:line) unless every line is an STL statement and every facet has 3 vertices."""
-    in_facet, vertices, lineno, last = False, 0, 0, None
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        parts = raw.split()
-        if not parts:
-            continue
-        tag = parts[0].lower()
-        if tag not in _STL_TOKENS:
-            raise InputError(f"{path}:{lineno}: {_short(raw.strip())}: expected an ASCII STL statement "
-                             "(solid, facet normal, outer loop, vertex X Y Z, endloop, endfacet, endsolid)")
-        if tag == "vertex":
-            if len(parts) != 4 or not in_facet:
-                raise InputError(f"{path}:{lineno}: {_short(raw.strip())}: expected 'vertex X Y Z' inside a facet")
-            for t in parts[1:]:
-                _number(path, lineno, t, "vertex coordinate")
-            vertices += 1
-        elif tag == "facet":
-            if in_facet:
-                raise InputError(f"{path}:{lineno}: facet: expected 'endfacet' before the next facet")
-            in_facet, vertices = True, 0
-        elif tag == "endfacet":
-            if not in_facet or vertices != 3:
-                raise InputError(f"{path}:{lineno}: endfacet after {vertices} vertices: expected a facet of "
-                                 "3 vertices")
-            in_facet = False
-        last = tag
-    if in_facet or last != "endsolid":
-        raise InputError(f"{path}:{lineno}: the file ends {'inside a facet' if in_facet else 'without endsolid'}: "
-                         "expected a complete ASCII STL (truncated?)")
-
-
-def _check_ply_counts(path: Path, n_vertices: int, n_faces: int) -> None:
-    """InputError when fewer vertices or faces were read than the PLY header declares (a truncated file).
-
-    trimesh reads what is there and drops a short face row silently. Faces may
-    be more than declared (polygons split into triangles), never fewer.
-    """
-    with open(path, "rb") as fh:
-        head = fh.read(1 << 16).split(b"end_header", 1)[0].decode("latin-1")
-    for lineno, line in enumerate(head.splitlines(), start=1):
-        parts = line.split()
-        if parts[:1] == ["element"] and len(parts) == 3 and parts[2].isdigit() and parts[1] in ("vertex", "face"):
-            declared, read = int(parts[2]), n_vertices if parts[1] == "vertex" else n_faces
-            if read < declared or (parts[1] == "vertex" and read != declared):
-                raise InputError(f"{path}:{lineno}: {line.strip()!r}, but {read} {'vertices' if parts[1] == 'vertex' else 'faces'} were read: expected "
-                                 "a complete file (truncated?)")
-
-
 def _obj_vertices(path: Path) -> np.ndarray:
     out = []
     for lineno, parts, raw in _obj_statements(path):
@@ -552,11 +452,6 @@ def _obj_vertices(path: Path) -> np.ndarray:
                 raise InputError(f"{path}:{lineno}: vertex {_short(raw.strip())}: expected 'v X Y Z' (3 numbers)")
             out.append([_number(path, lineno, t, "vertex coordinate") for t in parts[1:4]])
     return np.asarray(out, dtype=np.float64).reshape(-1, 3)
-
-
-def _short(text: str) -> str:
-    """``repr(text)``, cut to 80 characters (a path of 300 characters names nothing more in 300)."""
-    return repr(text) if len(text) <= 80 else f"{text[:60]!r}... ({len(text)} characters)"
 
 
 def builtin_names() -> list[str]:

@@ -27,18 +27,31 @@ from __future__ import annotations
 from . import gate, tolerances
 from .caller_state import caller_state_kept
 from .isolation import api_candidate
-from .report import FAULT_HINTS, compared_text, fault_text, not_passed
+from .compared import hint_lines, what_text
+from .report import compared_text, fault_text, not_passed
 from .runner import run_crosscheck
 from .subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
 from .tolerances import Tolerances
 
 
-def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles=("opencv",),
-                    tol_px: float = tolerances.VERTEX_TOL_PX, min_f1: float = tolerances.MIN_F1_1PX,
-                    min_f1_0px: float = tolerances.MIN_F1_0PX, turns=(1.0, 1.0, 0.0),
-                    allow_vacuous: bool = False, *, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S,
-                    isolate: bool | None = None, precision: str | None = None) -> dict:
+#: check_projector's settings when neither the call nor ``[tool.wirecheck]`` gives them: vertices
+#: (OpenCV only, no OpenGL) over 8 frames, quick enough for a unit test; crosscheck's own are
+#: pixels over 24 frames (docs/pytest.md, "Two questions, two sets of defaults").
+API_DEFAULTS = {"frames": 8, "oracles": ("opencv",), "tol_px": tolerances.VERTEX_TOL_PX,
+                "min_f1": tolerances.MIN_F1_1PX, "min_f1_0px": tolerances.MIN_F1_0PX,
+                "turns": (1.0, 1.0, 0.0), "timeout_s": DEFAULT_TIMEOUT_S}
+
+
+def check_projector(func=None, scenes=None, frames: int | None = None, cases=None, oracles=None,
+                    tol_px: float | None = None, min_f1: float | None = None,
+                    min_f1_0px: float | None = None, turns=None,
+                    allow_vacuous: bool = False, *, cmd=None, timeout_s: float | None = None,
+                    isolate: bool | None = None, precision: str | None = None, config=None) -> dict:
     """Crosscheck a projector against OpenCV (and pyrender) and return the report.
+
+    A setting not given (None) comes from ``[tool.wirecheck]`` in the nearest ``pyproject.toml``
+    at or above the working directory, as for crosscheck, else from :data:`API_DEFAULTS`
+    (every bundled scene, the default cases, 8 frames, vertices only).
 
     Parameters
     ----------
@@ -85,6 +98,9 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
         declared precision wins over the returned dtype: float64 declared and
         float32 returned is judged at float64, and its float32 rounding is
         named ``precision_limited``.
+    config : str, Path or False, optional
+        The file whose ``[tool.wirecheck]`` fills the settings not given (default: the nearest
+        ``pyproject.toml`` at or above the working directory); False: no file.
 
     Returns
     -------
@@ -105,7 +121,8 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
         ``func(points, camera)``, ``cmd`` not a string or a list of strings,
         a ``timeout_s``, ``isolate`` or ``allow_vacuous`` of the wrong type.
     RuntimeError
-        ``"pyrender"`` asked for but OSMesa is missing.
+        (:class:`~wirecheck.oracles.pyrender_oracle.GLUnavailable`) ``"pyrender"`` asked for
+        but its GL cannot draw here: one line naming the missing library and its fix.
 
     Notes
     -----
@@ -114,6 +131,14 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     state and print options, ``os.environ``, ``sys.path``, the current
     directory, logging and signal handlers.
     """
+    given = {"scenes": scenes, "frames": frames, "cases": cases, "oracles": oracles, "tol_px": tol_px,
+             "min_f1": min_f1, "min_f1_0px": min_f1_0px, "turns": turns, "timeout_s": timeout_s,
+             "precision": precision}
+    settings = settings_for(given, config)
+    scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns, timeout_s, precision = (
+        settings.get(k) for k in given)
+    if func is None and cmd is None:            # the table's candidate, as for the fixture
+        func, cmd = settings.get("candidate"), settings.get("candidate_cmd")
     func, cmd = _candidate_args(func, cmd)
     _flag(allow_vacuous, "allow_vacuous")
     if isolate is not None:
@@ -125,15 +150,36 @@ def check_projector(func=None, scenes=None, frames: int = 8, cases=None, oracles
     with caller_state_kept(), closing_started():    # the caller's globals as they were; no process left
         name, func = api_candidate(func, cmd, timeout_s, isolate)
         if "pyrender" in oracles:
-            from .pyrender_oracle import osmesa_available
+            from .pyrender_oracle import GLUnavailable, gl_available
 
-            ok, message = osmesa_available()
+            ok, message = gl_available()
             if not ok:
-                raise RuntimeError(message)
+                raise GLUnavailable(message)
         report, _images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
                                          oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
                                          allow_vacuous=allow_vacuous)
     return report
+
+
+def settings_for(given: dict, config=None) -> dict:
+    """``given`` (keywords of :func:`check_projector`, None = not given) over ``[tool.wirecheck]``
+    (``config``: a file, None = the nearest pyproject.toml, False = none) over :data:`API_DEFAULTS`.
+
+    Raises InputError (a ValueError) for a bad table, naming the file, the key and the value.
+    """
+    from pathlib import Path
+
+    from .config import load_config
+
+    table = {}
+    if config is not False:
+        loaded = load_config(Path(config) if config is not None else None)
+        table = loaded.api_kwargs()
+        table["candidate"] = loaded.values.get("candidate")
+        table["candidate_cmd"] = loaded.values.get("candidate-cmd")
+    out = {**API_DEFAULTS, **{k: v for k, v in table.items() if v is not None}}
+    out.update({k: v for k, v in given.items() if v is not None})
+    return out
 
 
 def _candidate_args(func, cmd):
@@ -233,11 +279,11 @@ def failure_text(report: dict) -> str | None:
         return (f"crosscheck of {report['candidate']}: verdict {report['verdict']} with no failing case"
                 + (f" ({compared_text(report)})" if "compared" in report else ""))
     lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
+    lines[0] = f"{what_text(report)}\n{lines[0]}"
     for c in failing:          # a vacuous case's reason starts with "vacuous:"
         lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'], c.get('camera_spec'))}; "
                      + "; ".join(c["reasons"]))
-    names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
-    lines += [f"  what to check, {n}: {FAULT_HINTS[n]}" for n in names]
+    lines += hint_lines(report, failing)
     if "compared" in report:
         lines.append(f"  in all: {compared_text(report)}")
     return "\n".join(lines)
@@ -263,6 +309,7 @@ def assert_projector(func=None, **kwargs) -> dict:
     AssertionError
         Naming each failing case, its faults and reasons, and what to check.
     """
+    __tracebackhide__ = True                     # pytest: the failure points at the caller's line
     report = check_projector(func, **kwargs)
     text = failure_text(report)
     if text is not None:

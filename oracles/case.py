@@ -36,6 +36,7 @@ from .cases import Case
 from .core_candidate import CoreCandidate, RenderMode
 from .draw import depth_margin, draw_candidate, oracle_segments
 from .tolerances import Tolerances
+from .oracle_precision import judge_oracle_precision
 from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
 
 
@@ -109,6 +110,32 @@ class CaseSetup:
             self.owners = oface.EdgeOwners(self.edges, self.faces, len(scene.vertices))
         # the harness draws another candidate's frame; only the candidate's calls in it are its time
         self.timed = None if self.is_core else TimedCalls(candidate)
+        self._planes: dict | None = None
+        self._probed = False
+        #: depth (world units) clipped ends are moved inside near/far beyond the precision's margin,
+        #: and why (oracles.clip_planes.depth_slack); None until an edge crosses a plane
+        self.slack, self.slack_why = 0.0, None
+
+    def planes(self) -> dict | None:
+        """The candidate's own near and far planes (oracles.clip_planes.probe_planes), probed once; None
+        for core (its planes are the camera's by construction) or when the probe cannot run."""
+        if not self._probed and not self.is_core:
+            from .clip_planes import probe_planes
+            self._planes, self._probed = probe_planes(self.timed, self.cam), True
+        return self._planes
+
+    def draw_slack(self, p_world: np.ndarray) -> float:
+        """:attr:`slack` for a frame: probed when some edge of the frame crosses near or far."""
+        if self.is_core or self._probed or len(self.edges) == 0:
+            return self.slack
+        r_cv, t_cv, _k = self.cv_matrices
+        depth = p_world @ r_cv[2] + t_cv[2]                  # as opencv_oracle.depth
+        d0, d1 = depth[self.edges[:, 0]], depth[self.edges[:, 1]]
+        crosses = any(((d0 < plane) != (d1 < plane)).any() for plane in (self.cam.near, self.cam.far))
+        if crosses:
+            from .clip_planes import depth_slack
+            self.slack, self.slack_why = depth_slack(self.planes(), self.cam)
+        return self.slack
 
 
 class TimedCalls:
@@ -175,6 +202,8 @@ class CaseFrames:
     error: str | None = None
     line_batch: metrics.LineBatch = field(default_factory=metrics.LineBatch)   # frames waiting for line scores
     drawn_px: int = 0                                   # pixels drawn by either side, over the frames (oracles.gate)
+    oracle_bound_px: float = 0.0                        # pyrender's own error bound, largest over the frames
+    planes: dict | None = None                          # the candidate's probed planes (oracles.clip_planes)
     #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + hdraw + pr + pmetric
     #: (hdraw: the harness drawing an external candidate's frame, less the candidate's own calls)
     seconds: dict = field(default_factory=lambda: dict.fromkeys(
@@ -236,20 +265,32 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
                         projected)
     t7 = time.perf_counter()
     score_vertices(acc)
+    if acc.cand_px and not setup.is_core and visibility_differs(acc):
+        acc.planes = setup.planes()                # where the candidate clips, to name a clipping_plane
     acc.scale = acc.scales.flush(setup.cam, setup.cv_matrices)
     t7 = acc.add("vmetric", t7)
     record_lines(acc, acc.line_batch.flush())
     acc.add("pmetric", t7)
     rec = case_record(setup, acc, tol)
+    if setup.slack_why:          # the clipped ends were placed for the candidate's own (float32-rounded) planes
+        rec["clipped_ends"] = {"inward_depth": setup.slack, "reason": setup.slack_why}
     if setup.pixels_skipped:
         rec["note"] = PIXELS_NOT_COMPARED
     judge(rec, tol, acc.error, points=len(scene.vertices))
+    judge_oracle_precision(rec, acc.oracle_bound_px if setup.pixels else None, judge, tol, acc.error,
+                           len(scene.vertices))
     rec["per_frame"] = acc.per_frame
     images = None
     if acc.worst is not None:
         images = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
     return CaseResult(record=rec, worst_images=images, timing=case_timing(acc, setup.pixels),
                       frame_images=acc.kept)
+
+
+def visibility_differs(acc: CaseFrames) -> bool:
+    """Whether some point of the case is visible to one side only."""
+    return any((np.isfinite(c).all(axis=1) != np.isfinite(o).all(axis=1)).any()
+               for c, o in zip(acc.cand_px, acc.oracle_px))
 
 
 def candidate_vertices(setup: CaseSetup, k: int, p_world: np.ndarray):
@@ -276,7 +317,7 @@ def candidate_frame(setup: CaseSetup, points, m_core, p_world: np.ndarray, preci
     """
     cand, cam, mode = setup.candidate, setup.cam, setup.mode
     if not setup.is_core:
-        return draw_candidate(setup.timed, p_world, setup.edges, cam, precision), None
+        return draw_candidate(setup.timed, p_world, setup.edges, cam, precision, setup.draw_slack(p_world)), None
     try:
         if mode.plain:
             return cand.draw(points, setup.edges, cam, m_core), None
@@ -353,6 +394,8 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         else:
             orac_img = np.zeros((cam.height, cam.width), bool)
         t1 = acc.add("pr", t0)
+        if setup.use_faces:
+            acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(pyrender_oracle, "last_bound_px", 0.0))
         cand_img = np.isfinite(cand_depth)
         if setup.use_faces:
             cand_faces = getattr(setup.candidate, "last_face_ids", None)
@@ -380,13 +423,15 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         orac_img, _depth = pyrender_oracle.render(pr_vertices, draw_edges, cam, model_matrix=pr_pose,
                                                   faces=occluders, cull=mode.cull == "backface")
         t1 = acc.add("pr", t0)
+        acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(pyrender_oracle, "last_bound_px", 0.0))
         fp = metrics.FramePixels(cand_img, orac_img)                     # one scan of each image
         ps = metrics.pixel_scores(None, None, pixels=fp)
         acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
         for name, values in acc.pixel.items():
             values.append(ps[name])
         frame_rec.update({name: ps[name] for name in metrics.PIXEL_SCORE_KEYS})
-        record_lines(acc, acc.line_batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
+        at = len(acc.pixel["f1_0px"]) - 1                                # this frame's place in acc.pixel
+        record_lines(acc, acc.line_batch.add((k, frame_rec, at), fp, seg0, seg1))    # scored with later frames
         key = (ps["f1_1px"], ps["f1_0px"])
     if want_images and key is not None and (acc.worst is None or key < acc.worst[0]):
         acc.worst = (key, k, cand_img.copy(), orac_img.copy())
@@ -397,10 +442,18 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
 
 
 def record_lines(acc: CaseFrames, scored: list) -> None:
-    """Frames' line scores (metrics.LineBatch: ``[((frame, frame record), scores)]``) into ``acc`` and their records."""
-    for (k, frame_rec), ls in scored:
+    """Frames' line scores (metrics.LineBatch: ``[((frame, frame record, place in acc.pixel), scores)]``) into
+    ``acc`` and their records.
+
+    A frame with sub-pixel ties has its scores at 0 px replaced by those with
+    the ties undecided (metrics.line_scores' ``tie_resolved``), in its record
+    and in ``acc.pixel``: F1@0px judges the decided pixels, as the balance does.
+    """
+    for (k, frame_rec, at), ls in scored:
         acc.lines.append((k, ls))
         frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
+        for name, value in (ls["tie_resolved"] or {}).items():
+            frame_rec[name] = acc.pixel[name][at] = value
 
 
 def _per_frame_ms(seconds: float, frames: int) -> float:

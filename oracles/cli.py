@@ -65,8 +65,13 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
-from wirecheck.core.errors import InputError, check_not_empty
-from wirecheck.core.guard import VersionAction, run_cli
+from wirecheck.core.guard import interrupts_from_start
+
+interrupts_from_start("crosscheck")    # before the imports below: Ctrl-C while starting is one line, no traceback
+
+from wirecheck.core.cli_help import CROSSCHECK_EXAMPLES, usage_hint  # noqa: E402
+from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
+from wirecheck.core.guard import VersionAction, run_cli  # noqa: E402
 from wirecheck.core.output import check_replaceable, check_report_dir
 
 from . import gate, tolerances
@@ -74,10 +79,11 @@ from .isolation import external_candidate
 from .subprocess_candidate import DEFAULT_TIMEOUT_S
 from .cases import ALL_CASE_NAMES, CASE_NAMES
 from .executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS, ExecutorSpec, check_scheduler_address, dask_failure
-from .config import parse_cli
+from .config import parse_cli, trust_line
 from .junit import check_junit_target, write_junit
 from .core_candidate import CoreCandidate, RenderMode
 from .progress import TerminalProgress
+from .compared import hint_lines, reason_text, what_text
 from .report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import LEVELS, level_for_oracles, run_crosscheck
 from .tolerances import Tolerances
@@ -89,7 +95,7 @@ CORE_OPTIONS = {"dtype": "float64", "clip": "clip", "raster": "exact"}
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit 2
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {usage_hint(message)}\n")
 
 
 #: Most worker processes --jobs may ask for, on this machine or a local Dask cluster.
@@ -99,7 +105,8 @@ MAX_SCHEDULER_TIMEOUT_S = 3600.0
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0].replace("``", ""))
+    p = _Parser(prog="crosscheck", description=__doc__.split("\n")[0].replace("``", ""), epilog=CROSSCHECK_EXAMPLES,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
     p.add_argument("--scene", action="append", default=None,
@@ -123,7 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--candidate-precision", choices=tolerances.PRECISIONS, default=None,
-                   help="what the candidate computes in; its vertex bound is derived from it (oracles/tolerances.py) "
+                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.tolerances) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
@@ -280,6 +287,8 @@ def _parse(args):
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
     if external:
+        if getattr(args, "candidate_from", None) is not None:    # before the program runs (docs/pytest.md)
+            print(trust_line(*args.candidate_from), file=sys.stderr, flush=True)
         candidate = external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
     else:
         candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
@@ -384,6 +393,8 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
+        args.candidate_from = next(((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd")
+                                    if key in applied), None)
         check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (
             "scene", "scene_list", "candidate_frames", "report_dir", "junit_xml", "config"))
         if args.junit_xml and (args.sweep or args.suite):
@@ -457,12 +468,15 @@ def _main(argv=None) -> int:
             return _error(str(exc))
         except OSError as exc:
             return _error(f"--junit-xml {args.junit_xml!r}: writing failed: {exc}")
+    print(what_text(report))
     print(console_table(records))
     for r in records:
         if r["verdict"] != "pass":
-            print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+            print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
         elif r.get("note"):
             print(f"  {r['scene']} / {r['camera']}: {r['note']}")
+    for line in hint_lines(report, [r for r in records if r["verdict"] != "pass"]):
+        print(line)
     s = report["summary"]
     limits = (f"silhouette IoU >= {tol.min_iou}, depth error <= its bound" if mode.shaded
               else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}")
@@ -471,7 +485,8 @@ def _main(argv=None) -> int:
           f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else ""))
     if precision_text(report):
         print(f"Candidate precision: {precision_text(report)}")
-    print(timing_line(report))
+    from .wall import process_age_s
+    print(timing_line(report)[:-1] + f"; {process_age_s():.1f} s in all, with start-up and the report)")
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
     return 0 if report["verdict"] == "pass" else 1
 
@@ -516,6 +531,8 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
         progress=progress.update if progress.active else None))
     if status is not None:
         return status
+    if args.dataset.skipped_line() is not None:     # FIFOs, devices: never opened (oracles.dataset)
+        print(f"crosscheck: {args.dataset.skipped_line()}", file=sys.stderr)
     report = {"run": args.run, **report}
     try:
         write_dataset_report(run_dir, report)
@@ -573,7 +590,8 @@ def _suite(level, run_dir) -> int:
             raise
     except OSError as exc:
         return _error(f"writing {str(run_dir)!r} failed: {exc}")
-    print(md)
+    print(md.split("\n\n- **", 1)[0].rstrip())   # the table; derivations and notes are in extremes.md
+    print(f"(the bounds' derivations and each case's notes: {run_dir / 'extremes.md'})\n")
     failed = [c["name"] for c in result["cases"] if c["verdict"] != "pass"]
     print(f"{result['verdict'].upper()}: {len(result['cases']) - len(failed)}/{len(result['cases'])} extreme cases "
           "within their derived bounds" + (f" (failed: {', '.join(failed)})" if failed else ""))

@@ -260,6 +260,22 @@ def _cli_value(key: str, value):
     return value
 
 
+def trust_line(path: Path, key: str, value: str) -> str:
+    """The stderr line said before crosscheck runs a candidate that a settings file chose (docs/pytest.md).
+
+    A ``[tool.wirecheck]`` table is trusted as pytest trusts a ``conftest.py``:
+    running crosscheck in a folder runs the program its nearest pyproject.toml
+    names. The line names the file and the program before it starts, so a
+    table the user did not write is seen, not silently obeyed.
+    """
+    from .dataset import printable
+
+    what = "program" if key == "candidate-cmd" else "Python candidate (its file is imported and run)"
+    return (f"crosscheck: {printable(str(path))} [{TABLE}] chose the {what}: {key} = {printable(repr(value))}; "
+            "it runs now with your permissions (as pytest runs a conftest.py): give --candidate, --candidate-cmd "
+            "or --config FILE to choose otherwise")
+
+
 class _Unset:
     """Marks an option the command line did not give (argparse keeps a namespace's existing values)."""
 

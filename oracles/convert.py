@@ -28,7 +28,7 @@ from wirecheck.core.camera import Camera
 
 __all__ = ["camera_to_opencv", "opencv_matrices", "opencv_to_camera", "camera_to_pyrender", "intrinsics",
            "distortion_coefficients",
-           "pyrender_pose_to_camera", "camera_to_gl", "model_matrix"]
+           "pyrender_pose_to_camera", "camera_to_gl", "model_matrix", "centre_of", "gl_eye_pose"]
 
 # Relative tolerance for "K describes a centred, square-pixel camera": K built
 # by camera_to_opencv is exact to float64 rounding (~1e-16 relative); 1e-9
@@ -351,6 +351,50 @@ def camera_to_gl(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
         proj[2, 2], proj[2, 3] = -2.0 / (f - n), -(f + n) / (f - n)
         proj[3, 3] = 1.0
     return view, proj
+
+
+# ---- re-centring for float32 (pyrender) ----------------------------------
+
+def centre_of(vertices) -> np.ndarray:
+    """``(3,)`` float64: the midpoint of the finite rows' bounding box (zeros when none is finite).
+
+    The point the pyrender oracle subtracts, in float64, from the vertices
+    before they are rounded to float32 (:func:`gl_eye_pose`): what pyrender
+    then holds is each vertex's offset from it, at most the mesh's half
+    diagonal, wherever the mesh is.
+    """
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    v = v[np.isfinite(v).all(axis=1)]
+    if len(v) == 0:
+        return np.zeros(3)
+    return 0.5 * (v.min(axis=0) + v.max(axis=0))
+
+
+def gl_eye_pose(camera, model_matrix=None, centre=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """``(4, 4)`` float64: centred model coordinates ``q = p - centre`` to GL eye coordinates.
+
+    The world position of ``p`` is ``M p = M_lin q + (M_lin c + t)``; the eye
+    coordinates are ``R_gl (M p - position)`` with ``R_gl``'s rows ``right,
+    up, -forward`` (:func:`camera_basis`), so::
+
+        pose[:3, :3] = R_gl M_lin
+        pose[:3, 3]  = R_gl ((M_lin c + t) - position)     (the centre in eye space)
+
+    all in float64 here, with the centre's world position taken relative to
+    the camera before anything is rounded. Given to pyrender as the mesh
+    node's pose with the camera node at the identity, it leaves the GPU only
+    magnitudes of the mesh's size and of its distance from the camera to hold
+    in float32, not the scene's distance from the world origin.
+    """
+    right, up, forward = camera_basis(camera)
+    r_gl = np.stack([right, up, -forward])
+    m = np.eye(4) if model_matrix is None else np.asarray(model_matrix, dtype=np.float64)
+    c = np.asarray(centre, dtype=np.float64)
+    c_world = m[:3, :3] @ c + m[:3, 3]
+    pose = np.eye(4)
+    pose[:3, :3] = r_gl @ m[:3, :3]
+    pose[:3, 3] = r_gl @ (c_world - np.asarray(camera.position, dtype=np.float64))
+    return pose
 
 
 # ---- model motion ---------------------------------------------------------

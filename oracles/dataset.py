@@ -9,7 +9,10 @@ Folders are walked recursively in sorted order. Symbolic links to folders are
 followed once: a folder reached again (a link loop, or two links to one place)
 is skipped, so the walk always ends. A file is a mesh when its suffix is one
 of :data:`core.scene_files.MESH_SUFFIXES` (any case); other files are counted
-and ignored. A folder that cannot be listed becomes an entry that fails to
+and ignored. A mesh-named path that is not a regular file (a FIFO, a device,
+a socket) is skipped and listed in ``Dataset.skipped``, never opened: reading
+a FIFO blocks forever, a device may never end (the CLI names them in one
+line, the report lists them). A folder that cannot be listed becomes an entry that fails to
 load (the run reports it like an unreadable mesh, it is not silently skipped).
 
 A scene list is UTF-8 text, one path per line; blank lines and lines whose
@@ -31,10 +34,12 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.mesh_companions import file_kind
 from wirecheck.core.scene_files import MESH_SUFFIXES
 
 
@@ -55,9 +60,22 @@ class Dataset:
     entries: tuple          # of MeshEntry
     sources: tuple          # the folders and lists given, as given
     other_files: int = 0    # files without a mesh suffix, ignored
+    skipped: tuple = ()     # (name, what it is) of each mesh-named FIFO, device or socket: never opened
 
     def to_dict(self) -> dict:
-        return {"sources": list(self.sources), "meshes": len(self.entries), "other_files": self.other_files}
+        out = {"sources": list(self.sources), "meshes": len(self.entries), "other_files": self.other_files}
+        if self.skipped:
+            out["skipped"] = [f"{name} ({kind})" for name, kind in self.skipped]
+        return out
+
+    def skipped_line(self) -> str | None:
+        """One line naming the skipped non-regular files (at most 5 by name), or None."""
+        if not self.skipped:
+            return None
+        named = ", ".join(f"{name} ({kind})" for name, kind in self.skipped[:5])
+        more = f" and {len(self.skipped) - 5} more" if len(self.skipped) > 5 else ""
+        return (f"skipped {len(self.skipped)} mesh-named file(s) that are not regular files, never opened: "
+                f"{named}{more}")
 
 
 #: Control characters (C0, DEL, C1): legal in a Linux file name, but a newline would split a
@@ -76,8 +94,11 @@ def is_mesh_file(name: str) -> bool:
     return Path(name).suffix.lower() in MESH_SUFFIXES
 
 
-def walk_folder(root: Path) -> tuple[list[MeshEntry], int]:
+def walk_folder(root: Path, skipped: list | None = None) -> tuple[list[MeshEntry], int]:
     """The mesh files under ``root`` (sorted, links to folders followed once) and the count of other files.
+
+    ``skipped`` (a list) receives ``(name, what it is)`` of each mesh-named
+    FIFO, device or socket: looked at with ``stat`` only, never opened.
 
     Depth-first with an explicit stack (a folder nested thousands deep is not a recursion limit).
     """
@@ -108,11 +129,25 @@ def walk_folder(root: Path) -> tuple[list[MeshEntry], int]:
             if is_dir:
                 folders.append((Path(item.path), item_rel))
             elif is_mesh_file(item.name):
+                kind = _not_regular(item)
+                if kind is not None:
+                    if skipped is not None:
+                        skipped.append((printable(item_rel), kind))
+                    continue
                 entries.append(MeshEntry(name=item_rel, path=os.path.abspath(item.path)))
             else:
                 other += 1
         stack += reversed(folders)            # the first in name order is walked first
     return entries, other
+
+
+def _not_regular(item: os.DirEntry) -> str | None:
+    """What ``item`` is when it exists and is not a regular file (links followed); None otherwise."""
+    try:
+        mode = item.stat().st_mode          # follows links; a broken link is the loader's "file not found"
+    except OSError:
+        return None
+    return None if stat.S_ISREG(mode) else file_kind(mode)
 
 
 def read_list(list_path: Path) -> list[MeshEntry]:
@@ -153,15 +188,19 @@ def dataset_entries(folders=(), lists=()) -> Dataset:
     Entries are sorted by name (the report's order, whatever the order of
     the walk); a name given by two inputs is an InputError.
     """
-    entries, other = [], 0
+    entries, other, skipped = [], 0, []
     for folder in folders:
         root = Path(folder)
         if not root.is_dir():
             raise InputError(f"--scene {str(folder)!r}: expected a folder of mesh files")
-        found, n_other = walk_folder(root)
+        n_skipped = len(skipped)
+        found, n_other = walk_folder(root, skipped)
         if not found:
+            odd = len(skipped) - n_skipped
             raise InputError(f"--scene {str(folder)!r}: no mesh files in this folder "
-                             f"(looked for {' '.join(MESH_SUFFIXES)}; {n_other} other files): nothing to check")
+                             f"(looked for {' '.join(MESH_SUFFIXES)}; {n_other} other files"
+                             f"{f', {odd} mesh-named files that are not regular files' if odd else ''}): "
+                             "nothing to check")
         if len(folders) > 1:      # several folders may each hold a 0001.obj: name them by folder too
             prefix = str(folder).rstrip("/\\") or "/"
             found = [MeshEntry(f"{prefix}/{e.name}", e.path, e.error) for e in found]
@@ -184,4 +223,4 @@ def dataset_entries(folders=(), lists=()) -> Dataset:
             raise InputError(f"two meshes named {a.name!r} ({printable(a.path)}, {printable(b.path)}): the report "
                              "names meshes by their path under the folder or in the list: expected each name once")
     return Dataset(entries=tuple(entries), sources=tuple(printable(str(s)) for s in (*folders, *lists)),
-                   other_files=other)
+                   other_files=other, skipped=tuple(skipped))

@@ -144,13 +144,15 @@ import math
 
 import numpy as np
 
+from .clip_planes import clip_fault
+
 __all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER", "LINE_FAULTS", "VERTEX_ONLY_FAULTS",
            "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
 
 #: All fault names, in priority order: the first fault of a diagnosis is the
 #: primary one. A depth flip hides everything else; a swap or mirror changes
 #: the picture more than a scale; an offset is the smallest visible effect.
-FAULT_ORDER = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
+FAULT_ORDER = ("depth_flip", "clipping_plane", "axis_swap", "ambiguous", "axis_flip", "mirror_horizontal",
                "mirror_vertical", "aspect_mismatch", "fov_mismatch",
                "pixel_offset", "distortion_mismatch", "line_end_bias", "line_pixel_bias", "precision_limited",
                "unexplained")
@@ -158,8 +160,9 @@ FAULT_NAMES = frozenset(FAULT_ORDER)
 #: The faults named from a wireframe's pixels (:func:`diagnose_lines`), not from its vertices.
 LINE_FAULTS = ("line_end_bias", "line_pixel_bias")
 #: The faults named from vertices only: frames of a distorted camera are not compared (oracles.case),
-#: and float32 rounding (precision_limited) is far below a pixel.
-VERTEX_ONLY_FAULTS = ("distortion_mismatch", "precision_limited")
+#: float32 rounding (precision_limited) is far below a pixel, and a clipping plane is probed on the
+#: candidate's projector (oracles.clip_planes).
+VERTEX_ONLY_FAULTS = ("clipping_plane", "distortion_mismatch", "precision_limited")
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
 #: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union
@@ -175,6 +178,9 @@ DEPTH_FLIP_MAX_OVERLAP = 0.01
 #: fit's condition number <= 1e6, so float64 noise (1e-16 relative) in the
 #: pixels moves the fitted map by < 1e-10 relative, far below any fault.
 DEGENERATE_RATIO = 1e-6
+
+#: Machine epsilon of float32 (oracles.tolerances.EPS), for :func:`rounded_constants`.
+EPS32 = 2.0 ** -23
 
 
 def _sign(x: float) -> int:
@@ -214,6 +220,11 @@ def _unexplained(**fields) -> dict:
     return {"name": "unexplained", **fields}
 
 
+#: The hint of a scale of (W - 1) / W or (H - 1) / H.
+MINUS_ONE_HINT = ("the scale is (W - 1) / W (or (H - 1) / H): the pixel count minus one was used as the image "
+                  "size (x = (ndc + 1) (W - 1) / 2); use x = (ndc + 1) W / 2 - 0.5")
+
+
 def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> list[dict]:
     """``aspect_mismatch`` and ``fov_mismatch`` from the fitted scales ``sx, sy`` of the pixel axes.
 
@@ -223,11 +234,28 @@ def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> l
     ``fields`` are added to each fault (the image diagnosis' confidence).
     """
     faults = []
+    w, h = camera.width, camera.height
+    minus_one = {"x": (w - 1) / w, "y": (h - 1) / h}
     if abs(sx - sy) * reach[0] > tol:
-        faults.append({"name": "aspect_mismatch", **fields,
-                       "implied_aspect": (camera.width / camera.height) * sy / sx, "scale_x": sx, "scale_y": sy})
+        fault = {"name": "aspect_mismatch", **fields,
+                 "implied_aspect": (w / h) * sy / sx, "scale_x": sx, "scale_y": sy}
+        if (abs(sx - minus_one["x"]) * reach[0] <= tol or abs(sx / sy - minus_one["x"]) * reach[0] <= tol
+                or abs(sy / sx - minus_one["y"]) * reach[1] <= tol):
+            fault["hint"] = MINUS_ONE_HINT
+        elif abs(sx / sy - (w / h) ** 2) * reach[0] <= tol:
+            fault["hint"] = ("implied_aspect is H/W: the aspect was taken the wrong way round (height / width "
+                             "where width / height is expected)")
+        elif abs(sx / sy - w / h) * reach[0] <= tol or abs(sx / sy - h / w) * reach[0] <= tol:
+            fault["hint"] = ("x is scaled by W/H (or H/W) against y: fx was taken from the width (aspect 1): "
+                             "fx = fy for square pixels")
+        faults.append(fault)
     if abs(sy - 1.0) * reach[1] > tol:
         fault = {"name": "fov_mismatch", **fields, "scale": sy, "implied_fov_deg": None, "implied_ortho_height": None}
+        if abs(sy - w / h) * reach[1] <= tol or abs(sy - h / w) * reach[1] <= tol:
+            fault["hint"] = ("the scale is W/H (or H/W): you used the horizontal FOV (or the width) where the "
+                             "vertical one is expected: f = (H / 2) / tan(fov_y / 2)")
+        elif abs(sy - minus_one["y"]) * reach[1] <= tol:
+            fault["hint"] = MINUS_ONE_HINT
         if camera.projection == "perspective":
             half = math.tan(math.radians(camera.fov_y_deg) / 2.0)
             fault["implied_fov_deg"] = math.degrees(2.0 * math.atan(half / sy))
@@ -237,13 +265,16 @@ def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> l
     return faults
 
 
-def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float | None = None) -> list[dict]:
+def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float | None = None,
+             planes: dict | None = None) -> list[dict]:
     """Name the faults of a candidate projector; ``[]`` when it agrees.
 
     With ``float32_px`` (the float32 rounding bound of these points,
     oracles.tolerances.vertex_bound; given for a candidate judged at float64)
     a disagreement at ``tol_px`` that the same diagnosis at ``float32_px``
-    explains is named ``precision_limited`` (module docstring).
+    explains is named ``precision_limited`` (module docstring). With
+    ``planes`` (oracles.clip_planes.probe_planes: the candidate's own near and
+    far, probed) a visible set that differs is named ``clipping_plane``.
 
     Parameters
     ----------
@@ -261,22 +292,80 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float
     -------
     list of dict, primary fault first; see the module docstring.
     """
+    return [_advised(f, tol_px) for f in _diagnose(cand_px, oracle_px, camera, tol_px, float32_px, planes)]
+
+
+def _advised(fault: dict, tol_px: float) -> dict:
+    """An ``unexplained`` whose pixels agree to ``tol_px`` gets the visibility advice (its ``hint``)."""
+    if fault["name"] != "unexplained" or not fault.get("residual_px", 0.0) <= tol_px:
+        return fault
+    a, b = fault.get("candidate_only", 0), fault.get("oracle_only", 0)
+    return {**fault, "hint": (
+        f"the pixels agree (residual {fault['residual_px']:.2g} px <= the {tol_px:.2g} px bound); only the "
+        f"visible sets differ: {a} points shown only by the candidate, {b} only by the oracle. Check the "
+        "near/far test (near <= z <= far, z = forward . (p - position)), points behind the camera, and any "
+        "visibility or raster step, not the rotation")}
+
+
+def _diagnose(cand_px, oracle_px, camera, tol_px, float32_px, planes) -> list[dict]:
     fine: dict = {}
-    faults = _diagnose_at(cand_px, oracle_px, camera, tol_px, fine)
+    faults = _diagnose_at(cand_px, oracle_px, camera, tol_px, fine, planes)
     if not faults or float32_px is None or not float32_px > tol_px:
         return faults
     if fine.get("residual_px", 0.0) <= tol_px:
-        return faults                  # a named model fits to float64 accuracy: no rounding noise to explain
+        # a named model fits to float64 accuracy: no rounding noise; but its scales and offset may be
+        # the rounding of a float32 constant (a float32 K or GL matrix in a float64 projector)
+        return rounded_constants(faults, camera, fine, tol_px, float32_px)
     coarse_info: dict = {}
-    coarse = _diagnose_at(cand_px, oracle_px, camera, float32_px, coarse_info)
+    coarse = _diagnose_at(cand_px, oracle_px, camera, float32_px, coarse_info, planes)
     if any(f["name"] in ("unexplained", "depth_flip") for f in coarse) or coarse_info["residual_px"] > float32_px:
         return faults                  # float32 rounding does not explain it either (e.g. a lens bends the map)
     return _sorted(coarse + [{"name": "precision_limited", "residual_px": coarse_info["residual_px"],
                               "float64_bound_px": float(tol_px), "float32_bound_px": float(float32_px)}])
 
 
-def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = None) -> list[dict]:
-    """:func:`diagnose` at one tolerance; ``info["residual_px"]``: the named model's largest residual."""
+#: Float32 roundings a constant of a float64 projector may carry into the fitted map: a float32 focal
+#: length, aspect or GL matrix entry is off by <= 0.5 eps32 relative, and a scale or aspect composes two
+#: such constants (fx from f and the aspect): 1 eps32; 2 leaves 2x.
+CONSTANT_ROUNDINGS = 2.0
+#: The named faults a float32 constant can fake (mirrors and swaps are exact in any precision).
+_ROUNDABLE = ("aspect_mismatch", "fov_mismatch", "pixel_offset")
+
+
+def rounded_constants(faults: list[dict], camera, info: dict, tol_px: float, float32_px: float) -> list[dict]:
+    """``faults`` with scale and offset faults replaced by ``precision_limited`` when the fitted map's
+    deviation from identity is within float32 rounding of the case's constants.
+
+    Scales within :data:`CONSTANT_ROUNDINGS` eps32 of 1 and an offset within
+    :data:`CONSTANT_ROUNDINGS` eps32 x (the farthest pixel from the principal
+    point) are the rounding of a float32 K, aspect or matrix (``fov_mismatch(scale=1.00000001)``,
+    ``aspect_mismatch(implied_aspect=1.3333334)``, ``pixel_offset(dx=-6.1e-06)``); a genuine 1e-4 px
+    offset on a 640-px image is above its 7.6e-5 px and stays named.
+    """
+    named = [f for f in faults if f["name"] in _ROUNDABLE]
+    if not named or any(f["name"] in ("unexplained", "depth_flip", "clipping_plane") for f in faults):
+        return faults
+    eps = CONSTANT_ROUNDINGS * EPS32
+    d = info.get("scale")
+    if d is None:
+        return faults
+    shift = [f for f in faults if f["name"] == "pixel_offset"]
+    off = np.array([shift[0]["dx"], shift[0]["dy"]]) if shift else np.zeros(2)
+    cx, cy = camera.principal_point
+    reach = max(cx, cy, camera.width - 1 - cx, camera.height - 1 - cy)
+    if np.max(np.abs(d - 1.0)) > eps or np.max(np.abs(off)) > eps * reach:
+        return faults
+    kept = [f for f in faults if f["name"] not in _ROUNDABLE]
+    return _sorted(kept + [{"name": "precision_limited", "kind": "float32_constants",
+                            "residual_px": float(info["residual_px"]), "scale_x": float(d[0]),
+                            "scale_y": float(d[1]), "dx": float(off[0]), "dy": float(off[1]),
+                            "float64_bound_px": float(tol_px), "float32_bound_px": float(float32_px)}])
+
+
+def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = None,
+                 planes: dict | None = None) -> list[dict]:
+    """:func:`diagnose` at one tolerance; ``info["residual_px"]``: the named model's largest residual,
+    ``info["scale"]``, ``info["offset"]``, ``info["reach"]``: the named model's per-axis fit."""
     info = {} if info is None else info
     cand = np.asarray(cand_px, dtype=np.float64)
     orac = np.asarray(oracle_px, dtype=np.float64)
@@ -301,12 +390,16 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     if mismatches == 0 and info["residual_px"] <= tol:
         return []
 
+    clip = clip_fault(planes, camera) if mismatches else None
+    if clip is not None and clip["kind"] == "swapped":
+        return [clip]                               # keeps nothing, in front or behind: not a flip
     # 1. depth flip: visible sets (nearly) swapped
     if mismatches and n_both <= DEPTH_FLIP_MAX_OVERLAP * n_union:
         return [{"name": "depth_flip", "oracle_visible": int(vis_o.sum()),
                  "candidate_visible": int(vis_c.sum()), "common_visible": n_both}]
 
-    vis_fields = {"visibility_mismatches": mismatches, "common_visible": n_both}
+    vis_fields = {"visibility_mismatches": mismatches, "common_visible": n_both,
+                  "candidate_only": int((vis_c & ~vis_o).sum()), "oracle_only": int((vis_o & ~vis_c).sum())}
     cx, cy = camera.principal_point
     centre = np.array([cx, cy])
     o = orac[both] - centre
@@ -324,7 +417,9 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
             if _max_abs(resid) <= tol:
                 if _max_abs(off) > tol:
                     faults.append({"name": "pixel_offset", "dx": float(off[0]), "dy": float(off[1])})
-                if mismatches:
+                if clip is not None:
+                    faults.append(clip)
+                elif mismatches:
                     faults.append(_unexplained(residual_px=0.0, residual_rms_px=0.0, **vis_fields,
                                                underdetermined=True))
                 return _sorted(faults)
@@ -355,6 +450,7 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     named_res = c - (q * d + off)
     reach = np.max(np.abs(q), axis=0)               # largest |coordinate| per candidate axis
     named_max = info["residual_px"] = _max_abs(named_res)
+    info.update(scale=d.copy(), offset=off.copy(), reach=np.max(np.abs(q), axis=0))
     collapsed = bool(np.any(d * reach <= tol))       # an axis the candidate squashed flat
     if named_max > tol or collapsed:
         from .lens_diagnose import distortion_fault       # a lens error bends the picture: not affine
@@ -384,7 +480,9 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     residual_offset = off - expected
     if _max_abs(residual_offset) > tol:
         faults.append({"name": "pixel_offset", "dx": float(residual_offset[0]), "dy": float(residual_offset[1])})
-    if mismatches or not faults:
+    if clip is not None:
+        faults.append(clip)                       # the visible sets differ where the probed planes say
+    elif mismatches or not faults:
         # visible sets differ without a depth flip (near/far?), or an error too
         # small to name: still a disagreement, so say so
         faults.append(_unexplained(residual_px=named_max,
@@ -417,20 +515,21 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     half of the net imbalance, the fault is ``line_end_bias`` with ``end``
     (``"first"``, ``"last"`` or ``"both"``) and ``pixels_per_line`` (signed);
     otherwise ``line_pixel_bias`` (lines thicker or thinner, or stray pixels),
-    with the one-sided counts by place.
+    with the one-sided counts by place. Nothing is named when every one-sided
+    pixel is a tie (0 decided on either side).
     """
     from .metrics import line_failures
 
-    if not line_failures(lines, tol):
-        return []
+    tc, to = lines["subpixel_ties"]
+    decided = {"candidate_only": int(lines["candidate_only"] - tc), "oracle_only": int(lines["oracle_only"] - to)}
+    if not line_failures(lines, tol) or not (decided["candidate_only"] or decided["oracle_only"]):
+        return []                     # no line fault on undecided pixels alone
     n = max(lines["lines_compared"], 1)
     places = lines["one_sided_by_place"]
     net = {p: places[p][0] - places[p][1] for p in places}          # candidate-only minus oracle-only
     per_line = {"first": net["start"] / n, "last": net["end"] / n}
     ends = [e for e in ("first", "last") if abs(per_line[e]) >= LINE_END_MIN_PX]
     total = lines["imbalance"]
-    tc, to = lines["subpixel_ties"]
-    decided = {"candidate_only": int(lines["candidate_only"] - tc), "oracle_only": int(lines["oracle_only"] - to)}
     at_ends = sum(net[{"first": "start", "last": "end"}[e]] for e in ends)
     if ends and abs(at_ends) >= 0.5 * abs(total):
         return [{"name": "line_end_bias", "end": ends[0] if len(ends) == 1 else "both",

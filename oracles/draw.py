@@ -42,12 +42,13 @@ def depth_margin(p_world: np.ndarray, camera, precision: str) -> np.ndarray:
     return DEPTH_ROUNDINGS * EPS[precision] * size
 
 
-def clip_depth(p0_world, p1_world, camera, precision: str = "float64"):
+def clip_depth(p0_world, p1_world, camera, precision: str = "float64", slack: float = 0.0):
     """Keep the parts of segments with depth in [near, far]: ``(kept, ends (K, 2, 3))``.
 
     A clipped end is moved inward by :func:`depth_margin` at ``precision`` in
-    depth (module docstring), at least ``_INWARD`` and at most ``_MAX_INWARD``
-    of the kept part.
+    depth (module docstring), or by ``slack`` (depth units) when larger: the
+    candidate's own planes, probed, lie that far inside (oracles.clip_planes.depth_slack);
+    at least ``_INWARD`` and at most ``_MAX_INWARD`` of the kept part.
     """
     d0 = opencv_oracle.depth(p0_world, camera)
     d1 = opencv_oracle.depth(p1_world, camera)
@@ -64,8 +65,8 @@ def clip_depth(p0_world, p1_world, camera, precision: str = "float64"):
     kept = t_in <= t_out
     span = (t_out - t_in)[kept]
     d = (p1_world - p0_world)[kept]
-    margin = np.maximum(depth_margin(p0_world[kept], camera, precision),
-                        depth_margin(p1_world[kept], camera, precision))
+    margin = np.maximum(np.maximum(depth_margin(p0_world[kept], camera, precision),
+                                   depth_margin(p1_world[kept], camera, precision)), slack)
     with np.errstate(divide="ignore", invalid="ignore"):   # depth constant along it: never clipped, never moved
         margin_t = margin / np.abs(d1 - d0)[kept]
     inward = np.clip(margin_t, _INWARD * span, _MAX_INWARD * span)
@@ -75,12 +76,14 @@ def clip_depth(p0_world, p1_world, camera, precision: str = "float64"):
     return kept, ends
 
 
-def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera, precision: str = "float64") -> np.ndarray:
-    """``(H, W)`` bool image of the candidate's wireframe (``precision``: the candidate's, for the clipped ends)."""
+def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera, precision: str = "float64",
+                   slack: float = 0.0) -> np.ndarray:
+    """``(H, W)`` bool image of the candidate's wireframe (``precision``: the candidate's, and ``slack``:
+    its probed planes' depth offset, for the clipped ends; :func:`clip_depth`)."""
     image = np.zeros((camera.height, camera.width), bool)
     if len(edges) == 0:
         return image
-    _, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera, precision)
+    _, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera, precision, slack)
     if len(ends) == 0:
         return image
     px = call_candidate(func, ends.reshape(-1, 3), camera).reshape(-1, 2, 2)

@@ -141,6 +141,41 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
     return job, files
 
 
+def quarter_turn_frames(job: dict) -> bool:
+    """Whether every checked frame's pose turns the scene by whole quarter turns about each axis.
+
+    Frame ``k`` turns by ``turns * (k - 1) / frames`` of a full turn about X, Y
+    and Z (core.transforms.Motion): with ``--frames 4`` and the default spin
+    every frame is a quarter-turn pose, which shows a cube square-on.
+    """
+    turns = np.asarray(job["motion"]["turns"], dtype=np.float64)
+    quarters = [turns * 4.0 * (k - 1) / job["frames"] for k in job["frame_numbers"]]
+    return all(np.all(np.abs(q - np.round(q)) < 1e-9) for q in quarters)
+
+
+def short_job_note(job: dict) -> str:
+    """The README's section on what the job's frames cannot reveal."""
+    n = len(job["frame_numbers"])
+    text = f"""## What this job cannot reveal
+
+The verdict rests on the {n} frame{'s' if n != 1 else ''} listed per case, and on nothing between them: a
+fault that shows only at other poses (a line crossing the near plane, an edge
+leaving the picture at some angle) goes unseen. The faults are named from at
+most 24 of a case's frames (evenly spaced)."""
+    if quarter_turn_frames(job):
+        shown = ", ".join(str(k) for k in job["frame_numbers"][:6]) + (", ..." if n > 6 else "")
+        text += f"""
+
+**Every frame of this job is a quarter-turn pose** (frames {shown} of
+{job['frames']}, spin {','.join(f'{t:g}' for t in job['motion']['turns'])}): a cube is seen square-on in each, a
+picture that a mirror, an axis swap or flip, a transposed rotation, a wrong
+rotation order or a camera looking backward can map onto itself, so such
+faults may draw the very pixels a correct renderer draws and pass. Export
+more frames, or a number of frames that is not a multiple of 4 (e.g.
+`--frames 24 --every 5`, `--frames 7`), to see the scene at oblique poses."""
+    return text + "\n"
+
+
 def readme(job: dict) -> str:
     n_frames = sum(len(c["frames"]) for c in job["cases"])
     first = job["cases"][0]
@@ -151,9 +186,11 @@ Draw every frame listed below with your renderer, then run
     crosscheck --candidate-frames THIS_FOLDER
 
 to have your renderer's own pixels judged against pyrender (OpenGL) and
-wirecheck's core renderer: edge-pixel F1 at 0 and 1 px, diff images, the
-worst frames, and, when something is off, the name of the fault
-(mirror, axis swap, FOV, aspect, half-pixel offset, depth flip).
+wirecheck's core renderer, by the same rules as a projector: edge-pixel F1
+at 0 and 1 px, the balance of pixels drawn by one side only, each line's
+length in pixels, diff images, the worst frames, and, when something is off,
+the name of the fault (mirror, axis swap, FOV, aspect, half-pixel offset,
+depth flip, lines short or long at an end).
 
 ## What to draw
 
@@ -184,7 +221,8 @@ Turn it off (WebGL: `antialias: false`; OpenGL: no multisampling, no
 GL_LINE_SMOOTH). An anti-aliased line is spread over two pixels of half
 intensity; thresholded at 128 it loses or doubles pixels, and the 0-px F1
 says so.
-"""
+
+""" + short_job_note(job)
 
 
 def write_job(out_dir: Path, scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> dict:

@@ -1,12 +1,9 @@
-"""``crosscheck --candidate-frames DIR``: judge a renderer by its own frames.
+"""``crosscheck --candidate-frames DIR``: a renderer's frames job, read and checked.
 
 ``DIR`` is a job written by :mod:`oracles.export` with the renderer's PNGs
-under ``frames/``. Each frame is compared with pyrender's rendering (the
-oracle the verdict rests on, as in the pixel level of crosscheck) and with
-core's, both drawn from the job's own files (OBJ vertices, the frame's
-camera and model matrix), by edge-pixel F1 at 0 and 1 px
-(:func:`oracles.metrics.pixel_scores`). The case's frames are then diagnosed
-from the images alone (:mod:`oracles.image_diagnose`).
+under ``frames/``. This module reads and checks the job (its manifest, OBJ,
+cameras and frames); :mod:`oracles.frames_judge` judges the frames, one at a
+time, by the one judge of every path (:mod:`oracles.judge`).
 
 A gate never passes on nothing: the job must list cases and frames, every
 listed frame must be there at its camera's size and readable, and a PNG under
@@ -18,17 +15,14 @@ from __future__ import annotations
 
 import json
 import os
-import stat
-import time
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from wirecheck.core.errors import InputError
 
-from . import metrics
 from .export import JOB_KIND, JOB_VERSION, frame_name
+from .png_frame import FrameProblem, escape_controls, file_problem, read_png  # noqa: F401 (re-exported)
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
@@ -41,33 +35,13 @@ class FramesError(InputError):
     """The job or its frames cannot be judged: one line per problem."""
 
     def __init__(self, problems: list[str]):
-        self.problems = problems
+        self.problems = problems = [escape_controls(p) for p in problems]    # a file name may hold an ESC
         shown = problems[:MAX_LINES]
         more = len(problems) - len(shown)
         super().__init__("\n".join(shown + ([f"... and {more} more"] if more else [])))
 
     def __str__(self) -> str:       # one line per problem, kept apart (InputError joins lines into one)
         return Exception.__str__(self)
-
-
-def file_problem(path: Path) -> str | None:
-    """Why ``path`` is not a regular file to read, in a phrase (``"missing"``, ``"a FIFO"``, ...); None if it is one.
-
-    Checked before any open: opening a FIFO named like a job's file would block
-    the run forever, and a folder or device is no file of a job.
-    """
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        return "a broken link" if os.path.islink(path) else "missing"
-    except OSError as exc:          # a link loop, a name too long
-        return f"unreadable ({exc.strerror or exc})"
-    if stat.S_ISREG(mode):
-        return None
-    kind = ("a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
-            "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else
-            "not a file")
-    return f"{kind}, not a regular file"
 
 
 def _no_duplicate_keys(pairs: list) -> dict:
@@ -176,49 +150,6 @@ def _job_problem(job: dict) -> str | None:
     return None
 
 
-class FrameProblem(ValueError):
-    """A frame file that is not an image the job asked for: the reason, in a phrase."""
-
-
-#: 16-bit grey samples at or above this are drawn: a high byte of 128 or more, as Pillow reads
-#: 16-bit RGB(A) (by its high byte), so every 16-bit colour type reads alike; an 8-bit value x
-#: is 257 x in 16 bits, whose high byte is x: 8- and 16-bit copies of one image read the same.
-THRESHOLD_16 = 128 << 8
-
-
-def read_png(path: Path, width: int, height: int) -> np.ndarray:
-    """``(H, W)`` bool: drawn where the luminance over the rule's black background is >= 128.
-
-    One still PNG of the camera's size is expected; anything else is a
-    :class:`FrameProblem`. A pixel's luminance is Pillow's (ITU-R 601-2) of its
-    RGB, times its alpha (``A / 255``; palette transparency included): the
-    pixel as it shows over black, so a transparent pixel is never drawn. 16-bit
-    grey is read at its full scale (:data:`THRESHOLD_16`). The size is checked
-    before any pixel is decoded (a huge image costs nothing).
-    """
-    from PIL import Image
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked next
-        with Image.open(path) as im:
-            if im.format != "PNG":
-                raise FrameProblem(f"a {im.format} image: expected a PNG")
-            if getattr(im, "n_frames", 1) != 1:
-                raise FrameProblem(f"an animated PNG of {im.n_frames} frames: expected one still image")
-            if im.size != (width, height):
-                raise FrameProblem(f"size {im.size[0]}x{im.size[1]}: expected {width}x{height} (the camera's)")
-            im.load()
-            if im.mode in ("I", "I;16", "I;16B", "I;16L"):          # 16-bit grey
-                return np.asarray(im) >= THRESHOLD_16
-            if not (im.mode in ("RGBA", "LA", "PA", "RGBa", "La") or "transparency" in im.info):   # opaque
-                grey = im if im.mode == "L" else im.convert("RGB").convert("L")   # L, the usual: as it is
-                return np.asarray(grey) >= 128
-            rgba = im.convert("RGBA")
-            grey = np.asarray(rgba.convert("RGB").convert("L"), dtype=np.uint16)
-            alpha = np.asarray(rgba.getchannel("A"), dtype=np.uint16)
-    return grey * alpha >= 128 * 255           # exact (at most 255 * 255 < 2**16): grey >= 128 where opaque
-
-
 def _walk(frames_dir: Path) -> list[Path]:
     """Every entry under ``frames_dir`` that is not a folder; links to folders followed, a link loop is not.
 
@@ -257,6 +188,15 @@ def _walk(frames_dir: Path) -> list[Path]:
 
 def load_frames(job_dir: Path, job: dict) -> dict:
     """Every listed frame as a bool image: ``{(scene, case): [(k, image)]}``; FramesError listing every problem."""
+    return _frames(job_dir, job, keep=True)
+
+
+def check_frames(job_dir: Path, job: dict) -> None:
+    """:func:`load_frames`' checks, every frame read and dropped (memory flat in the job's length)."""
+    _frames(job_dir, job, keep=False)
+
+
+def _frames(job_dir: Path, job: dict, keep: bool) -> dict:
     job_dir = Path(job_dir)
     frames_dir = job_dir / "frames"
     if not frames_dir.is_dir():
@@ -285,7 +225,9 @@ def load_frames(job_dir: Path, job: dict) -> dict:
                 problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
                 continue
             try:
-                images.append((k, read_png(path, c["width"], c["height"])))
+                image = read_png(path, c["width"], c["height"])
+                if keep:
+                    images.append((k, image))
             except FrameProblem as exc:
                 problems.append(f"{path}: {exc}")
             except Exception as exc:       # Pillow's many ways to say "not an image"
@@ -327,8 +269,13 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
 
 
-def _frame_camera(path: Path):
-    """``(camera, model_matrix (4, 4))`` of a frame's JSON; FramesError naming the file otherwise."""
+def _frame_camera(path: Path, cache: dict | None = None):
+    """``(camera, model_matrix (4, 4))`` of a frame's JSON; FramesError naming the file otherwise.
+
+    ``cache``: the last camera made, by its JSON fields; the same fields give
+    the same Camera object back (a case's camera is fixed: converted once by
+    oracles.opencv_oracle, which keeps the last camera by identity).
+    """
     from wirecheck.core.camera import Camera
 
     problem = file_problem(path)
@@ -336,7 +283,12 @@ def _frame_camera(path: Path):
         raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])
     try:
         cam_json = read_json(path)
-        camera = Camera(**cam_json["camera"])
+        if cache is not None and cache.get("camera_json") == cam_json["camera"]:
+            camera = cache["camera"]
+        else:
+            camera = Camera(**cam_json["camera"])
+            if cache is not None:
+                cache.update(camera_json=cam_json["camera"], camera=camera)
         m = np.asarray(cam_json["model_matrix"], dtype=np.float64)
         if m.shape != (4, 4) or not np.all(np.isfinite(m)):
             raise ValueError(f"model_matrix of shape {m.shape}: expected 4x4 finite numbers")
@@ -347,17 +299,26 @@ def _frame_camera(path: Path):
     return camera, m
 
 
-def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int):
-    """``(p_model (N, 3), edges (E, 2), camera, model_matrix (4, 4))`` of one frame, from the job's files."""
+def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache: dict | None = None):
+    """``(p_model (N, 3), edges (E, 2), camera, model_matrix (4, 4))`` of one frame, from the job's files.
+
+    ``cache``: a dict kept by the caller over one case's frames: the scene's
+    OBJ (model space) is then read once, and an unchanged camera made once.
+    """
     job_dir = Path(job_dir)
     row = next(s for s in job["scenes"] if s["name"] == scene)       # load_job checked it is there
     obj = job_dir / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
-    p_model, edges = read_obj(obj)
+    if cache is not None and cache.get("obj") == obj:
+        p_model, edges = cache["mesh"]
+    else:
+        p_model, edges = read_obj(obj)
+        if cache is not None and row["space"] == "model":
+            cache.update(obj=obj, mesh=(p_model, edges))
     if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
         raise FramesError([f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
                            f"{row['edges']} (job.json's; the file was changed or cut short)"])
     path = job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}"
-    camera, m = _frame_camera(path)
+    camera, m = _frame_camera(path, cache)
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     if (camera.width, camera.height) != (c["width"], c["height"]):     # the frames were read at the job's size
         size = f"{camera.width}x{camera.height}"
@@ -367,121 +328,16 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int):
     return p_model, edges, camera, m
 
 
-def _min_scores(scores: list[dict], prefix: str = "") -> dict:
-    keys = ("f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px")
-    return {f"{prefix}{k}": float(min(s[k] for s in scores)) for k in keys}
+def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True):
+    """One case, judged frame by frame: :func:`oracles.frames_judge.judge_case`."""
+    from .frames_judge import judge_case as judge
 
-
-def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, diagnose: bool = True):
-    """One case: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion."""
-    from wirecheck.core.pipeline import render_frame
-
-    from .image_diagnose import diagnose_images, flipped_camera, oracle_segments
-
-    per_frame, pr_scores, core_scores = [], [], []
-    drawn_px = 0
-    worst = None
-    cand_imgs, segs, flipped = [], [], []
-    camera = None
-    for k, cand in images:
-        p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k)
-        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
-        core = render_frame(p_model, edges, camera, m).image >= 128
-        ps, cs = metrics.pixel_scores(cand, orac), metrics.pixel_scores(cand, core)
-        pr_scores.append(ps)
-        core_scores.append(cs)
-        drawn_px += int((cand | orac).sum())
-        per_frame.append({"frame": k, "f1_0px": ps["f1_0px"], "f1_1px": ps["f1_1px"],
-                          "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"],
-                          "candidate_pixels": ps["candidate_pixels"], "oracle_pixels": ps["oracle_pixels"]})
-        key = (ps["f1_1px"], ps["f1_0px"])
-        if worst is None or key < worst[0]:
-            worst = (key, k, cand.copy(), orac.copy())
-        if diagnose:
-            p_world = p_model @ m[:3, :3].T + m[:3, 3]
-            cand_imgs.append(cand)
-            segs.append(oracle_segments(p_world, edges, camera))
-            flipped.append(oracle_segments(p_world, edges, flipped_camera(camera)))
-    s = _min_scores(pr_scores)
-    rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
-           "frames_checked": len(images), "max_vertex_error_px": None,
-           "pixel_f1_0px": s["f1_0px"], "pixel_f1_1px": s["f1_1px"],
-           "pixel_f1_0px_mean": float(np.mean([x["f1_0px"] for x in pr_scores])),
-           "pixel_f1_1px_mean": float(np.mean([x["f1_1px"] for x in pr_scores])),
-           "pixel_precision_0px": s["precision_0px"], "pixel_recall_0px": s["recall_0px"],
-           "pixel_precision_1px": s["precision_1px"], "pixel_recall_1px": s["recall_1px"],
-           "core": _min_scores(core_scores), "worst_pixel_frame": worst[1]}
-    rec["faults"] = diagnose_images(cand_imgs, segs, camera, flipped) if diagnose else []
-    reasons = []
-    if rec["pixel_f1_1px"] < tol.min_f1_1px:
-        reasons.append(f"pixel F1@1px {rec['pixel_f1_1px']:.4f} < {tol.min_f1_1px} (frame {rec['worst_pixel_frame']})")
-    if rec["pixel_f1_0px"] < tol.min_f1_0px:
-        reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
-    if reasons and not rec["faults"]:
-        # as the vertex diagnosis: a disagreement is never "no fault". Here no mirror, swap,
-        # scale or offset explains the pixels: lines missing or extra, or another raster rule.
-        rec["faults"] = [{"name": "unexplained"}]
-    rec["compared"] = {"frames": len(images), "vertices": 0, "pixels": drawn_px}
-    verdict = "fail" if reasons else "pass"
-    if not reasons and drawn_px == 0:           # as oracles.gate: a case that compared nothing
-        verdict = "vacuous"
-        reasons = [f"vacuous: neither side drew a pixel in {len(images)} frames: nothing compared"]
-    rec.update(verdict=verdict, reasons=reasons, per_frame=per_frame)
-    return rec, {"frame": worst[1], "candidate": worst[2], "oracle": worst[3]}
+    return judge(job_dir, job, scene, case, oracles, tol, diagnose)
 
 
 def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
                allow_vacuous: bool = False) -> tuple[dict, dict]:
-    """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
+    """Judge the job's frames: :func:`oracles.frames_judge.run_frames`."""
+    from .frames_judge import run_frames as run
 
-    A case where neither side drew a pixel is ``"vacuous"`` and fails the run
-    unless ``allow_vacuous`` (as :mod:`oracles.gate`); no vertex is compared here.
-
-    FramesError (exit 2) when the job or its frames are incomplete, of the
-    wrong size, unreadable, or not this job's.
-    """
-    from .pyrender_oracle import OracleCache
-    from .tolerances import Tolerances
-
-    tol = tol or Tolerances()
-    t0 = time.perf_counter()
-    job = load_job(job_dir)
-    frames = load_frames(job_dir, job)
-    oracles = OracleCache()
-    records, images = [], {}
-    try:
-        for c in job["cases"]:
-            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], frames[(c["scene"], c["case"])],
-                                    oracles, tol, diagnose=diagnose)
-            records.append(rec)
-            images[(c["scene"], c["case"])] = worst
-        gl = oracles.gl_info()
-    finally:
-        oracles.close()
-    failed = sum(r["verdict"] == "fail" for r in records)
-    vacuous = sum(r["verdict"] == "vacuous" for r in records)
-    compared = {"cases": sum(r["verdict"] != "vacuous" for r in records),
-                "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
-                "pixels": sum(r["compared"]["pixels"] for r in records)}
-    bad = failed or not compared["frames"] or (not allow_vacuous and (vacuous or not compared["pixels"]))
-    report = {
-        "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",
-        "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
-        "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
-        "oracle_gl": gl,
-        "frames": job["frames"], "every": job["every"], "frames_checked": len(job["frame_numbers"]),
-        "motion": job["motion"],
-        "tolerances": {"vertex_error_px": tol.vertex_px, "min_pixel_f1_1px": tol.min_f1_1px,
-                       "min_pixel_f1_0px": tol.min_f1_0px},
-        "allow_vacuous": allow_vacuous, "compared": compared,
-        "summary": {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
-                    "vacuous": vacuous,
-                    "max_vertex_error_px": None,
-                    "min_pixel_f1_0px": min(r["pixel_f1_0px"] for r in records),
-                    "min_pixel_f1_1px": min(r["pixel_f1_1px"] for r in records),
-                    "min_core_f1_0px": min(r["core"]["f1_0px"] for r in records),
-                    "min_core_f1_1px": min(r["core"]["f1_1px"] for r in records)},
-        "cases": records,
-        "timing": {"wall_s": time.perf_counter() - t0},
-    }
-    return report, images
+    return run(job_dir, tol, diagnose, name, allow_vacuous)

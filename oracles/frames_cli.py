@@ -110,7 +110,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
               if getattr(args, k) != default and k not in skip]
     if given:
         return _fail(f"--candidate-frames with {', '.join(given)}: the job fixes scenes, cases and frames, and "
-                     "its frames are drawn already: expected only --tol/--min-f1 options, --run or --report-dir")
+                     "its frames are drawn already: expected only --tol-px, --min-f1, --min-f1-0px, --run or --report-dir")
     job_dir = Path(args.candidate_frames)
     # os.path.realpath: unlike Path.resolve() in 3.11, no RuntimeError for a link loop (judged later)
     job_real, frames_real, run_real = (Path(os.path.realpath(p)) for p in (job_dir, job_dir / "frames", run_dir))

@@ -158,7 +158,7 @@ def run_settings(frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None,
     """:func:`run_inputs` without the scenes (``scenes=()``): a dataset's meshes are checked as they load."""
     frames = _integer(frames, names["frames"], 1)
     if frames > MAX_FRAMES:
-        raise InputError(f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (core/limits.py)")
+        raise InputError(f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (wirecheck.core.limits)")
     every = _integer(every, names["every"], 1)
     if every > frames:
         raise InputError(f"{names['every']} {every} with {names['frames']} {frames}: only frame 1 would be "
@@ -185,11 +185,17 @@ def _frames(n: int) -> str:
 def vacuous_reason(compared: dict, level: str, points: int | None = None) -> str | None:
     """Why a case compared nothing (None when it compared something at every level it ran).
 
-    ``points``: the scene's vertex count, to say why no vertex was compared.
+    ``points``: the scene's vertex count, to say why no vertex was compared. ``level``:
+    ``"vertices"``, ``"pixels"`` (both compared) or ``"frames"`` (a renderer's
+    frames, oracles.frames_judge: pixels only).
     """
     frames = compared["frames"]
     if frames == 0:
         return "nothing compared: no frame was checked"
+    if level == "frames":            # a renderer's frames: pixels only, no vertex is compared
+        if not compared["pixels"]:
+            return f"vacuous: neither side drew a pixel in {_frames(frames)}: nothing compared"
+        return None
     if compared["vertices"] == 0 and points == 0:
         return "vacuous: the scene has no vertices: nothing compared"
     if compared["vertices"] == 0:

@@ -37,9 +37,9 @@ Method
 3. **Residual and confidence.** The cost is the mean of the two directions'
    mean distances, each capped at :data:`PAIR_CAP_PX` (a point with no partner
    within the cap counts as the cap). The best ``P`` is the one of least cost;
-   ``residual_px`` is its cost and ``confidence = 1 - best / second`` compares
-   it with the best *other* permutation (1: only one explanation fits; 0: two
-   fit equally well).
+   ``residual_px`` is its cost. A named fault's ``confidence`` is ``1 - cost /
+   cost without it`` (:mod:`oracles.image_naming`); ``unexplained``'s is ``1 -
+   best / second`` against the best *other* permutation.
 4. **Depth flip.** A renderer that looks backward draws what a camera with its
    forward negated sees: ``flipped_segments``. When the candidate registers to
    those better than to the oracle's own, the answer is ``depth_flip`` alone
@@ -56,9 +56,13 @@ Every fault carries ``confidence`` and ``residual_px``; ``pixel_offset`` is
 given to sub-pixel (``dx, dy``), ``fov_mismatch`` with ``implied_fov_deg`` (or
 ``implied_ortho_height``), ``aspect_mismatch`` with ``implied_aspect``.
 An offset is compared with the offset the same fit finds for a correct
-aliased drawing of the same lines (:func:`quantisation_bias`), which is also
-given as ``uncertainty_px``: lines all at one fractional pixel position (a
-cube square-on to a nearly orthographic camera) cannot show an offset below it.
+aliased drawing of the fitted model's lines (the oracle's, scaled and mirrored
+as fitted: :func:`quantisation_bias`), which is also given as
+``uncertainty_px``: lines all at one fractional pixel position (a cube
+square-on to a nearly orthographic camera) cannot show an offset below it.
+Two permutations that fit equally well are ``ambiguous``; each fault's
+confidence measures that fault; a fit that no start explains is restarted
+from the scales convention mistakes give (:mod:`oracles.image_naming`).
 
 Limits (measured in tests/test_image_diagnosis.py, stated in docs/frames.md):
 the images must show enough line to fit (:data:`MIN_PIXELS` drawn pixels in a
@@ -73,7 +77,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .diagnose import FAULT_ORDER, scale_faults
+from .image_naming import name_faults, quantisation_bias, restart_scales, rotation_deg
 
 __all__ = ["diagnose_images", "oracle_segments", "flipped_camera", "PERMUTATIONS"]
 
@@ -549,6 +553,8 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
     coarse = _Registration(_frames(cand_images, oracle_segs, camera, screen, nearest),
                            camera.width, camera.height, centre)
     ranked = _register(coarse, fine)
+    if ranked[0][0] > RESIDUAL_MAX_PX:               # no member fits from the usual starts: a large scale?
+        ranked = restart_scales(coarse, fine, ranked, camera)
     plain = next(r for r in ranked if r[1] == ())
     if plain[0] <= ranked[0][0] * (1.0 + AMBIGUOUS_RATIO):
         ranked = [plain] + [r for r in ranked if r is not plain]     # a symmetric picture: no permutation
@@ -569,55 +575,11 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
     reach = np.minimum(reach, [camera.width / 2.0, camera.height / 2.0])   # the part an image can show
     a_free, b_free, cost_free = fine.fit(p, a, b, affine=True)
     off_diagonal = max(abs(a_free[0, 1]) * reach[1], abs(a_free[1, 0]) * reach[0])
-    common = {"confidence": confidence, "residual_px": cost}
     if cost > RESIDUAL_MAX_PX or off_diagonal > ROTATION_TOL_PX:
-        return [{"name": "unexplained", **common, "best_family": list(names) or ["none"],
+        return [{"name": "unexplained", "confidence": confidence, "residual_px": cost,
+                 "best_family": list(names) or ["none"],
                  "scale": np.diag(a).tolist(), "offset": b.tolist(), "affine": a_free.tolist(),
                  "affine_residual_px": cost_free, "off_diagonal_px": float(off_diagonal),
-                 "rotation_deg": math.degrees(math.atan2(a_free[1, 0] - a_free[0, 1],
-                                                         a_free[0, 0] + a_free[1, 1]))}]
-    d = np.diag(a)
-    faults = [{"name": n, **common} for n in names]
-    faults += scale_faults(float(d[0]), float(d[1]), reach, SCALE_TOL_PX, camera, **common)
-    expected = np.zeros(2)
-    if "axis_swap" in names:
-        shift = cx - cy                               # as oracles.diagnose: a raw swap shifts by +-(cx - cy)
-        allowed = np.array([-shift, 0.0, shift])
-        expected = np.array([allowed[np.argmin(np.abs(allowed - b[i]))] for i in range(2)])
-    off = b - expected
-    bias = quantisation_bias(oracle_segs, camera)
-    if np.max(np.abs(off - bias)) > OFFSET_TOL_PX:
-        faults.append({"name": "pixel_offset", **common, "dx": float(off[0]), "dy": float(off[1]),
-                       "uncertainty_px": float(np.max(np.abs(bias)))})
-    return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
-
-
-def quantisation_bias(oracle_segs, camera) -> np.ndarray:
-    """The offset this fit finds for a *correct* aliased drawing of these lines: ``(2,)`` px.
-
-    Pixel centres sit up to half a pixel from a line; over slanted lines at
-    every fractional position this averages out (< 0.05 px measured), but lines
-    that are all axis-aligned at one fractional position (a cube square-on,
-    nearly orthographic) are drawn half a pixel off in one direction, and no
-    image can tell that from an offset. The oracle's own lines drawn by core's
-    rasteriser (integer pixel centres, like GL's rule on these lines) give that
-    bias; an offset is a fault only when it differs from it.
-    """
-    from wirecheck.core.clipping import clip_to_image
-    from wirecheck.core.raster import line_pixels
-
-    images = []
-    for segs in oracle_segs:
-        segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-        img = np.zeros((camera.height, camera.width), bool)
-        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
-        rr, cc = line_pixels(q0, q1, camera.width, camera.height)
-        img[rr, cc] = True
-        images.append(img)
-    centre = np.array(camera.principal_point)
-    limit = _points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)    # as diagnose_images
-    reg = _Registration(_frames(images, oracle_segs, camera, limit), camera.width, camera.height, centre)
-    if not any(len(f.cand) for f in reg.frames):
-        return np.zeros(2)
-    _a, b, _cost = reg.fit(np.eye(2), np.eye(2), np.zeros(2))
-    return b
+                 "rotation_deg": rotation_deg(a_free)}]
+    return name_faults(fine, ranked, plain, camera, oracle_segs, reach, quantisation_bias, SCALE_TOL_PX,
+                       OFFSET_TOL_PX, AMBIGUOUS_RATIO, cost)

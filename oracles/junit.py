@@ -23,7 +23,7 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 
-from .report import FAULT_HINTS, fault_text, not_passed
+from .report import fault_hints, fault_text, not_passed
 
 #: The root element's name: it marks a file as ours (one we may replace).
 SUITES_NAME = "wirecheck crosscheck"
@@ -71,8 +71,7 @@ def failure_text(case: dict) -> str:
     lines = [f"{case['scene']} / {case['camera']}: verdict {case['verdict']}",
              f"faults: {fault_text(case.get('faults') or [])}"]
     lines += [f"reason: {r}" for r in case.get("reasons") or []]
-    lines += [f"what to check, {f['name']}: {FAULT_HINTS[f['name']]}"
-              for f in case.get("faults") or [] if f.get("name") in FAULT_HINTS]
+    lines += [f"what to check, {n}: {h}" for n, h in fault_hints(case.get("faults") or [])]
     return "\n".join(lines) + "\n"
 
 

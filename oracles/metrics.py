@@ -20,8 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import line_ties
-from .segment_pixels import nearest_segments
+from .line_ends import END_REACH_PX, PLACES, end_attribution, frames_end_places, resolve_ties  # noqa: F401
 from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
 
 
@@ -110,6 +109,17 @@ class FramePixels:
         self.cand_in_oracle = oracle.reshape(-1)[self.cand_idx]
         self.oracle_in_cand = cand.reshape(-1)[self.oracle_idx]
         self._only = None
+
+    @classmethod
+    def from_indices(cls, shape: tuple, cand_idx: np.ndarray, oracle_idx: np.ndarray) -> "FramePixels":
+        """The frame whose images draw the ascending flat indices ``cand_idx`` and ``oracle_idx`` (``(H, W)`` ``shape``)."""
+        fp = cls.__new__(cls)
+        fp.shape = tuple(shape)
+        fp.cand_idx, fp.oracle_idx = cand_idx, oracle_idx
+        fp.cand_in_oracle = np.isin(cand_idx, oracle_idx, assume_unique=True)
+        fp.oracle_in_cand = np.isin(oracle_idx, cand_idx, assume_unique=True)
+        fp._only = None
+        return fp
 
     @property
     def both(self) -> int:
@@ -448,105 +458,55 @@ def _diff_scores(diff: np.ndarray, compared: int) -> dict:
             "edge_count_diffs": diff}
 
 
-#: A one-sided pixel within this distance (px) of a segment's start or end counts as at that end.
-END_REACH_PX = 1.5
-
-
-def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
-    """Where the one-sided pixels lie along the oracle's segments: at the start, at the end, or between.
-
-    Each candidate-only and oracle-only pixel is given to its nearest segment
-    (``p0_px[m] -> p1_px[m]``, the edge's first vertex to its second, clipped
-    to the near plane, then to the image's edges ``[-1/2, W - 1/2] x [-1/2,
-    H - 1/2]``, where a line leaving the picture ends); it is at the ``start`` (``end``) when within
-    :data:`END_REACH_PX` of that segment's first (last) point, else ``middle``
-    (also: within reach of both ends of a very short segment, or more than
-    1.5 px from every segment: ``stray``), or, before any of those, a
-    sub-pixel ``tie`` of its nearest segment (oracles.line_ties: the line
-    crosses beside it within the oracle's precision of the pixel's edge, and
-    the other image drew the pixel across that edge). Returns
-    ``{place: [candidate_only, oracle_only]}``.
-    """
-    return _end_places(FramePixels(cand, oracle), p0_px, p1_px)
-
-
-def _end_places(fp: FramePixels, p0_px: np.ndarray, p1_px: np.ndarray) -> dict:
-    """:func:`end_attribution` of the frame whose drawn pixels are ``fp``."""
-    return frames_end_places([(fp, p0_px, p1_px)])[0]
-
-
-def frames_end_places(frames) -> list[dict]:
-    """:func:`end_attribution` of several frames of one size (``[(FramePixels, p0_px, p1_px)]``), in one pass,
-    with the sub-pixel ties apart (``"tie"``)."""
-    out = [{k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")} for _ in frames]
-    if not frames:
-        return out
-    h, w = frames[0][0].shape
-    box = ((-0.5, -0.5), (w - 0.5, h - 0.5))                  # where a line leaving the picture ends
-    for side in (0, 1):
-        only = [fp.only()[side] for fp, _, _ in frames]
-        if not sum(len(o) for o in only):
-            continue
-        # each pixel's nearest segment within reach (the segments near it only, not all of them)
-        owner, q0, q1, frame = nearest_segments([(p0, p1, o) for (_, p0, p1), o in zip(frames, only)],
-                                                w, h, END_REACH_PX, box)
-        pix = np.concatenate(only)
-        near = owner >= 0
-        m, f = owner[near], frame[near]
-        c = np.column_stack([pix[near] % w, pix[near] // w]).astype(np.float64)
-        tie, partner = line_ties.tie_crossings(c, q0[m], q1[m])
-        if tie.any():                   # a tie needs its partner pixel drawn by the other image
-            other = [fp.cand_idx if side == 1 else fp.oracle_idx for fp, _, _ in frames]
-            drawn = np.concatenate([o + k * h * w for k, o in enumerate(other)])    # ascending: frame after frame
-            tie &= line_ties.partner_drawn(partner, f, (h, w), drawn)
-        to_start = np.hypot(*(c - q0[m]).T) <= END_REACH_PX
-        to_end = np.hypot(*(c - q1[m]).T) <= END_REACH_PX
-        n = len(frames)
-        place = {"tie": tie, "start": ~tie & to_start & ~to_end, "end": ~tie & to_end & ~to_start,
-                 "middle": ~tie & (to_start == to_end)}
-        for name, hit in place.items():
-            for k, v in enumerate(np.bincount(f[hit], minlength=n)):
-                out[k][name][side] += int(v)
-        for k, v in enumerate(np.bincount(frame[~near], minlength=n)):
-            out[k]["stray"][side] += int(v)
-    return out
-
-
 def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray,
-                pixels: FramePixels | None = None, counts: tuple | None = None, ends: dict | None = None) -> dict:
+                pixels: FramePixels | None = None, counts: tuple | None = None, ends: dict | None = None,
+                ties: tuple | None = None) -> dict:
     """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
     rows: not drawn). Returns :func:`pixel_balance`'s fields,
     :func:`edge_count_scores`' (without the per-edge array), ``ends``
-    (:func:`end_attribution`, the decided one-sided pixels) and
+    (:func:`end_attribution`, the decided one-sided pixels),
     ``subpixel_ties`` (``[candidate_only, oracle_only]``: those that are
-    sub-pixel ties, oracles.line_ties). ``pixels``: the frame's :class:`FramePixels`,
-    when the caller has it (then ``cand`` and ``oracle`` are not read);
-    ``counts``: ``(diff, compared)``, the per-edge count differences and the
-    number of edges counted, when the caller has them
-    (:func:`frames_count_differences`, :class:`LineBatch`); ``ends``: the
-    frame's :func:`frames_end_places`, when the caller has it.
+    sub-pixel ties, oracles.line_ties) and ``tie_resolved``: None when the
+    frame has no tie, else the frame's F1, precision and recall at 0 px
+    (``f1_0px``, ``precision_0px``, ``recall_0px``) with the candidate given
+    the oracle's value at every tie (oracles.line_ends.resolve_ties); the
+    per-edge counts are always taken so. A tie is undecided in every criterion.
+
+    ``pixels``: the frame's :class:`FramePixels`, when the caller has it (then
+    ``cand`` and ``oracle`` are not read); ``counts``: ``(diff, compared)``,
+    the per-edge count differences (ties resolved) and the number of edges
+    counted, when the caller has them (:func:`frames_count_differences`,
+    :class:`LineBatch`); ``ends`` and ``ties``: the frame's
+    :func:`frames_end_places` and its tie pixels, when the caller has them.
     """
     fp = pixels if pixels is not None else FramePixels(cand, oracle)
     h, w = fp.shape
     both = fp.both
     c, o = len(fp.cand_idx) - both, len(fp.oracle_idx) - both
     out = {"candidate_only": c, "oracle_only": o, "imbalance": c - o, "oracle_pixels": len(fp.oracle_idx)}
+    if ends is None:
+        found: list = []
+        ends = frames_end_places([(fp, p0_px, p1_px)], found)[0] if c + o else {k: [0, 0] for k in PLACES}
+        ties = found[0] if found else None
+    rp = resolve_ties(fp, ties) if ties is not None else fp          # the candidate as the oracle at the ties
     if counts is None:
-        near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=fp.drawn())    # counts look at drawn pixels only
+        near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=rp.drawn())    # counts look at drawn pixels only
         n_edges = len(np.asarray(p0_px).reshape(-1, 2))
-        cc = _counts(fp.has(near[1], True), near, n_edges)
-        ec = _count_scores(cc, cc if fp.identical else _counts(fp.has(near[1], False), near, n_edges))
+        cc = _counts(rp.has(near[1], True), near, n_edges)
+        ec = _count_scores(cc, cc if rp.identical else _counts(rp.has(near[1], False), near, n_edges))
     else:
         ec = _diff_scores(*counts)
     del ec["edge_count_diffs"]
     out.update(ec)
-    if ends is None:
-        ends = _end_places(fp, p0_px, p1_px) if c + o else {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
     ends = dict(ends)
     out["subpixel_ties"] = ends.pop("tie")
     out["ends"] = ends
+    out["tie_resolved"] = None
+    if rp is not fp:
+        ps = pixel_scores(None, None, tols=(0,), pixels=rp)
+        out["tie_resolved"] = {k: ps[k] for k in ("f1_0px", "precision_0px", "recall_0px")}
     return out
 
 
@@ -584,10 +544,12 @@ class LineBatch:
             while stop < len(waiting) and waiting[stop][1].shape == shape:
                 stop += 1
             run = waiting[start:stop]
-            counts = frames_count_differences([(p0, p1, fp) for _, fp, p0, p1 in run], shape[1], shape[0])
-            ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run])
-            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e))
-                       for (key, fp, p0, p1), c, e in zip(run, counts, ends))
+            ties: list = []
+            ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run], ties)
+            counts = frames_count_differences([(p0, p1, resolve_ties(fp, t)) for (_, fp, p0, p1), t in zip(run, ties)],
+                                              shape[1], shape[0])       # counted with the ties undecided
+            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e, ties=t))
+                       for (key, fp, p0, p1), c, e, t in zip(run, counts, ends, ties))
             start = stop
         return out
 

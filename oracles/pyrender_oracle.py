@@ -39,7 +39,16 @@ context's ``GL_VENDOR``, ``GL_RENDERER`` and ``GL_VERSION`` for the reports.
 
 pyrender is imported lazily. One :class:`PyrenderOracle` keeps one
 ``OffscreenRenderer`` and one scene; frames update node poses only (creating
-a renderer costs ~100 ms).
+a renderer costs ~100 ms), and its shader programs are compiled once
+(oracles.pyrender_programs: pyrender's own cache compiled one per frame).
+
+What pyrender receives is re-centred in float64 (it computes in float32):
+each mesh is uploaded once as its vertices' offsets from their centre
+(convert.centre_of), and the mesh node's pose takes them straight to eye
+space with the camera node at the identity (convert.gl_eye_pose), so the GPU
+rounds magnitudes of the mesh's size and its distance from the camera, not
+of the scene's distance from the world origin. :attr:`PyrenderOracle.last_bound_px`
+is the oracle's own error bound for the last frame (oracles.oracle_precision).
 """
 
 from __future__ import annotations
@@ -51,13 +60,19 @@ import numpy as np
 
 from wirecheck.core.camera import Camera
 
-from .convert import camera_to_pyrender
+from .convert import camera_to_pyrender, centre_of, gl_eye_pose
+from .oracle_precision import frame_bound_px, mesh_radius
+from .pyrender_programs import stabilise_program_cache
 
-__all__ = ["GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
+__all__ = ["GLUnavailable", "GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
            "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
 
 #: The OpenGL platforms the oracle draws on (``PYOPENGL_PLATFORM``); the first is the default.
 GL_PLATFORMS = ("osmesa", "egl")
+
+class GLUnavailable(RuntimeError):
+    """The pixel oracle cannot draw here: the message is one line naming the missing piece and its fix."""
+
 
 _INSTALL_HINT = {"osmesa": "apt-get install -y libosmesa6",
                  "egl": "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri"}
@@ -109,17 +124,17 @@ def gl_available() -> tuple[bool, str]:
     if platform not in GL_PLATFORMS:
         return False, (f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on "
                        f"{' or '.join(repr(p) for p in GL_PLATFORMS)}")
-    if platform == "osmesa":
-        try:
-            from OpenGL import osmesa
-            osmesa.OSMesaCreateContextAttribs  # noqa: B018 - raises if the symbol is missing
-        except Exception as exc:  # ImportError, OSError, AttributeError, NullFunctionError
-            return False, (f"libOSMesa cannot be loaded ({type(exc).__name__}: {exc}); "
-                           f"install it with: {_INSTALL_HINT['osmesa']}")
+    missing = _missing_gl_library(platform)
+    if missing is not None:
+        return False, missing
     try:
         import pyrender  # noqa: F401
     except Exception as exc:
-        return False, f"pyrender cannot be imported ({type(exc).__name__}: {exc}); pip install pyrender2"
+        if "glGetError" in str(exc) or str(exc).startswith("Library "):   # a GL library PyOpenGL could not load
+            return False, (f"OpenGL's library cannot be loaded on {platform} ({type(exc).__name__}: {exc}); "
+                           f"install it with: {_INSTALL_HINT[platform]}")
+        return False, (f"pyrender cannot be imported ({type(exc).__name__}: {exc}); "
+                       "install it with: pip install 'pyrender2>=0.2,<1'")
     if platform == "osmesa":
         return True, "OSMesa available"
     if platform not in _EGL_CHECKED:
@@ -131,6 +146,47 @@ def gl_available() -> tuple[bool, str]:
             _EGL_CHECKED[platform] = (False, f"no EGL context can be created ({msg}); "
                                              f"install it with: {_INSTALL_HINT['egl']}")
     return _EGL_CHECKED[platform]
+
+
+def _missing_gl_library(platform: str) -> str | None:
+    """One line naming the GL library that PyOpenGL cannot load on ``platform``, with its fix; None if all load.
+
+    PyOpenGL does not raise when a platform's library is missing: it leaves ``PLATFORM.GL`` None,
+    and the first GL call (pyrender's import) fails with ``'NoneType' object has no attribute
+    'glGetError'``, which names neither the library nor the fix. So the libraries are looked at
+    here, before pyrender is imported: libOSMesa (and its ``OSMesaCreateContextAttribs``, Mesa
+    >= 11.2) for osmesa; libEGL and libGL/libOpenGL for egl.
+    """
+    hint = _INSTALL_HINT[platform]
+    try:
+        from OpenGL import platform as gl_platform_module
+        loaded = gl_platform_module.PLATFORM
+    except Exception as exc:  # ImportError, OSError: the platform module itself cannot load
+        msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+        return f"OpenGL cannot load its {platform} platform ({msg}); install it with: {hint}"
+    if platform == "osmesa":
+        lib = _loaded(loaded, "GL")
+        if lib is None:
+            return f"libOSMesa cannot be loaded (no libOSMesa.so found); install it with: {hint}"
+        if not hasattr(lib, "OSMesaCreateContextAttribs"):
+            return (f"libOSMesa ({getattr(lib, '_name', '?')}) lacks OSMesaCreateContextAttribs (Mesa "
+                    f"before 11.2: no core-profile context for pyrender); install a newer one with: {hint}")
+        return None
+    if _loaded(loaded, "EGL") is None:
+        return f"libEGL cannot be loaded (no libEGL.so found: Mesa's EGL); install it with: {hint}"
+    gl = _loaded(loaded, "GL")
+    if gl is None or "GLES" in str(getattr(gl, "_name", "")):   # PyOpenGL falls back to GLES: not enough
+        return ("libGL / libOpenGL cannot be loaded (no libGL.so found); install it with: "
+                "apt-get install -y libgl1 libopengl0")
+    return None
+
+
+def _loaded(platform_object, name: str):
+    """``platform_object.<name>`` (a ctypes library, loaded on first access), or None when it cannot load."""
+    try:
+        return getattr(platform_object, name)
+    except Exception:  # ImportError, OSError: PyOpenGL's lazy properties raise on some versions
+        return None
 
 
 def osmesa_available() -> tuple[bool, str]:
@@ -273,6 +329,7 @@ class PyrenderOracle:
         self.width, self.height = int(width), int(height)
         self._renderer = pyrender.OffscreenRenderer(self.width, self.height)
         _single_sample(self._renderer._renderer)
+        stabilise_program_cache(self._renderer._renderer)      # one program per shader, not per frame
         if self.platform == "egl":
             _spare_the_display(self._renderer._platform)
         self._gl_info = None
@@ -280,12 +337,15 @@ class PyrenderOracle:
         self._mesh_node = None
         self._mesh_key = None
         self._mesh_faces = None
+        self._mesh_centre, self._mesh_radius = np.zeros(3), 0.0     # of the uploaded vertices (float64)
+        self.last_bound_px = 0.0      # oracle_precision.frame_bound_px of the last frame drawn
         self._cam_node = None
         self._cam_key = None
         # render_faces: a scene of its own, so that alternating with render() rebuilds nothing
         self._fscene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
         self._fmesh_node = None
         self._fmesh_key = None
+        self._fmesh_centre, self._fmesh_radius = np.zeros(3), 0.0
         self._fcam_node = None
         self._fcam_key = None
 
@@ -343,7 +403,10 @@ class PyrenderOracle:
         self._mesh_key = key
         pr = self._pr
         prims = []
-        positions = vertices.astype(np.float32)
+        # re-centred in float64 before the float32 upload (convert.gl_eye_pose): one upload per mesh
+        self._mesh_centre = centre_of(vertices)
+        positions = (vertices - self._mesh_centre).astype(np.float32)
+        self._mesh_radius = mesh_radius(vertices - self._mesh_centre)
         if len(edges):
             white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0])
             prims.append(pr.Primitive(positions=positions, indices=edges.astype(np.uint32),
@@ -361,15 +424,15 @@ class PyrenderOracle:
                              f"{self.width}x{self.height}")
         scene, node_attr, key_attr = ((self._fscene, "_fcam_node", "_fcam_key") if faces_scene
                                       else (self._scene, "_cam_node", "_cam_key"))
-        pose, cam = camera_to_pyrender(camera)
+        # the camera node stays at the identity: the mesh node's pose takes its vertices to eye space
+        # (convert.gl_eye_pose), so the camera's position never reaches float32
         key = (camera.projection, camera.fov_y_deg, camera.ortho_height, camera.near, camera.far, camera.intrinsics)
         if key != getattr(self, key_attr):
+            _pose, cam = camera_to_pyrender(camera)
             if getattr(self, node_attr) is not None:
                 scene.remove_node(getattr(self, node_attr))
-            setattr(self, node_attr, scene.add(cam, pose=pose))
+            setattr(self, node_attr, scene.add(cam, pose=np.eye(4)))
             setattr(self, key_attr, key)
-        else:
-            scene.set_pose(getattr(self, node_attr), pose)
 
     def _set_faces(self, vertices: np.ndarray, triangles: np.ndarray, cull: bool) -> None:
         key = (vertices.tobytes(), triangles.tobytes(), cull)
@@ -385,7 +448,10 @@ class PyrenderOracle:
         # every triangle its own three vertices, all of its id colour: the flat
         # shader multiplies the (white) base colour by the interpolated vertex
         # colour, which is then constant over the triangle
-        positions = vertices[triangles.reshape(-1)].astype(np.float32)
+        self._fmesh_centre = centre_of(vertices)
+        centred = vertices - self._fmesh_centre
+        self._fmesh_radius = mesh_radius(centred)
+        positions = centred[triangles.reshape(-1)].astype(np.float32)
         colours = np.repeat(_id_colours(len(triangles)), 3, axis=0)
         colours = np.concatenate([colours, np.full((len(colours), 1), 255, np.uint8)], axis=1)
         white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=not cull)
@@ -429,9 +495,11 @@ class PyrenderOracle:
         edges = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
         self._set_mesh(vertices, edges, faces, bool(cull))
         self._set_camera(camera)
+        self.last_bound_px = 0.0
         if self._mesh_node is not None:
-            pose = np.eye(4) if model_matrix is None else np.asarray(model_matrix, dtype=np.float64)
+            pose = gl_eye_pose(camera, model_matrix, self._mesh_centre)
             self._scene.set_pose(self._mesh_node, pose)
+            self.last_bound_px = frame_bound_px(camera, pose, self._mesh_radius)
         if faces is not None and len(faces):
             self._polygon_offset()
         colour, depth = self._renderer.render(self._scene, pr.RenderFlags.FLAT)
@@ -465,9 +533,11 @@ class PyrenderOracle:
             raise ValueError(f"{len(triangles)} triangles: the id image holds at most 2^24 - 2")
         self._set_faces(vertices, triangles, bool(cull))
         self._set_camera(camera, faces_scene=True)
+        self.last_bound_px = 0.0
         if self._fmesh_node is not None:
-            pose = np.eye(4) if model_matrix is None else np.asarray(model_matrix, dtype=np.float64)
+            pose = gl_eye_pose(camera, model_matrix, self._fmesh_centre)
             self._fscene.set_pose(self._fmesh_node, pose)
+            self.last_bound_px = frame_bound_px(camera, pose, self._fmesh_radius)
         self._no_polygon_offset()
         colour, _pyrender_depth = self._renderer.render(self._fscene, pr.RenderFlags.FLAT)
         z_win = self._read_window_depth()

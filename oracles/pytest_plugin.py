@@ -156,13 +156,19 @@ class Check:
             pytest.fail("wirecheck(): no projector: expected wirecheck(func) or candidate = \"FILE.py:FUNC\" "
                         "in [tool.wirecheck]", pytrace=False)
         self._calls += 1
-        error = None
+        error, trace = None, True
         try:
-            report = check_projector(projector, **{**config.stash[_SETTINGS], **settings})
+            # the table was read at start-up (rootdir or --wirecheck-config): not again from the cwd
+            report = check_projector(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
         except (ValueError, TypeError) as exc:   # InputError is a ValueError: a bad setting or projector spec
             error = f"wirecheck: {type(exc).__name__}: {exc}"
+        except RuntimeError as exc:
+            from .pyrender_oracle import GLUnavailable
+            if not isinstance(exc, GLUnavailable):
+                raise
+            error, trace = f"wirecheck: {exc}", False   # the missing GL library and its fix: one line
         if error is not None:                     # outside the except: no chained harness traceback
-            pytest.fail(error)
+            pytest.fail(error, pytrace=trace)
         text = failure_text(report)
         if text is not None:
             if config.option.wirecheck_report is not None:

@@ -22,6 +22,7 @@ from wirecheck.core.output import FrameDir, json_dumps, png_bytes
 
 from .fmt import distinct
 from .metrics import DIFF_COLOURS, diff_image
+from .report_crops import crop_caption, crop_image
 
 
 #: What to check for each fault: one line each, for people reading the report.
@@ -50,9 +51,24 @@ FAULT_HINTS = {
     "precision_limited": "the error is the size of float32 rounding, not a convention error: compute in "
                          "float64 or declare float32 (--candidate-precision float32)",
     "depth_flip": "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
+    "clipping_plane": "the points kept differ from near <= z <= far (z = forward . (p - position)): kind and "
+                      "near_fit/far_fit say where the candidate clips (z_positive: at z > 0, not near; "
+                      "float32_near: near rounded to float32; none: never; swapped: near and far exchanged)",
+    "ambiguous": "the images fit two faults equally well (a symmetric view cannot tell them apart): "
+                 "check both, see alternatives",
     "unexplained": "not a simple image-space fault: check the rotation order, a transposed "
                    "world-to-camera matrix, the up vector (roll) and the near/far test",
 }
+
+
+def fault_hints(faults) -> list[tuple[str, str]]:
+    """``(name, what to check)`` for each distinct fault of ``faults``, in FAULT_HINTS order: a fault's own
+    ``hint`` (set where its values say more, e.g. a FOV scale of W/H) or its name's."""
+    seen = {}
+    for f in faults:
+        if f.get("name") in FAULT_HINTS:
+            seen.setdefault((f["name"], f.get("hint") or FAULT_HINTS[f["name"]]), None)
+    return sorted(seen, key=lambda nh: list(FAULT_HINTS).index(nh[0]))
 
 
 def _fmt_err(v) -> str:
@@ -81,10 +97,18 @@ def fault_text(faults: list[dict], camera: dict | None = None) -> str:
     nominal = fault_nominals(camera)
     parts = []
     for f in faults:
-        extra = ", ".join(f"{k}={distinct(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
-                          for k, v in f.items() if k != "name")
+        extra = ", ".join(f"{k}={_param(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
+                          for k, v in f.items() if k not in ("name", "hint") and v is not None)   # None: not implied
         parts.append(f"{f['name']}({extra})" if extra else f["name"])
     return "; ".join(parts)
+
+
+def _param(value: float, nominal: float | None) -> str:
+    """A fault's number: digits until it differs from ``nominal``, unless it differs by float64 rounding
+    only (64 eps relative: ``scale_y=0.9999999999999998`` is ``scale_y=1``)."""
+    if nominal is not None and abs(value - nominal) <= 64 * 2.0 ** -52 * max(abs(value), abs(nominal)):
+        return distinct(value)
+    return distinct(value, nominal)
 
 
 def _count(n: int, unit: str) -> str:
@@ -273,10 +297,14 @@ def precision_text(report: dict) -> str:
 
 
 def case_notes(report: dict) -> list[tuple[dict, str]]:
-    """``(case, text)`` for each case's ``note`` (what was not compared, and why), then each vacuous
-    case allowed by ``--allow-vacuous`` (its reasons): the Notes of report.md and report.html."""
+    """``(case, text)`` for each case's ``note`` (what was not compared, and why), each case whose
+    clipped ends were placed for the candidate's probed planes (``clipped_ends``, oracles.clip_planes),
+    then each vacuous case allowed by ``--allow-vacuous`` (its reasons): the Notes of report.md and
+    report.html."""
     failing = not_passed(report)
     notes = [(c, c["note"]) for c in report["cases"] if c.get("note")]
+    notes += [(c, f"clipped ends moved {c['clipped_ends']['inward_depth']:.3g} inside the planes: "
+                  f"{c['clipped_ends']['reason']}") for c in report["cases"] if c.get("clipped_ends")]
     notes += [(c, "; ".join(c["reasons"]) + " (allowed)") for c in report["cases"]
               if c["verdict"] == "vacuous" and c not in failing]
     return notes
@@ -298,7 +326,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            f"Drawing: {drawing_text(report)}.", "",
            *([f"Oracle GL: {gl_text(report)}.", ""] if gl_text(report) else []),
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
-           *([f"Candidate precision: {precision_text(report)} (oracles/tolerances.py).", ""]
+           *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.tolerances).", ""]
              if precision_text(report) else []),
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
@@ -308,10 +336,10 @@ def markdown(report: dict, files: set | None = None) -> str:
         out += ["", "## Why cases failed", ""]
         for c in failing:
             out.append(f"- **{c['scene']} / {c['camera']}**: " + "; ".join(c["reasons"]))
-        names = sorted({f["name"] for c in failing for f in c["faults"]}, key=list(FAULT_HINTS).index)
+        names = fault_hints(f for c in failing for f in c["faults"])
         if names:
             out += ["", "## What to check", ""]
-            out += [f"- `{n}`: {FAULT_HINTS[n]}" for n in names]
+            out += [f"- `{n}`: {h}" for n, h in names]
     figures = _figures(report, files)
     if figures or "worst.gif" in files:
         out += ["", "## Figures", ""]
@@ -322,13 +350,13 @@ def markdown(report: dict, files: set | None = None) -> str:
     if notes:
         out += ["", "## Notes", ""]
         out += [f"- {c['scene']} / {c['camera']}: {note}" for c, note in notes]
-    out += ["", "Conventions: see `core/conventions.py`. Images of the worst frames, and the time per frame "
+    out += ["", "Conventions: see `wirecheck.core.conventions`. Images of the worst frames, and the time per frame "
             "of each stage (vertex, pixel) per case: `report.html` (and `\"timing\"` in `report.json`; "
             "timings are kept out of this file so that it is the same on every run).", ""]
     return "\n".join(out)
 
 
-def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None) -> str:
+def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = None) -> str:
     files = files or set()
     head = header(report["cases"])
     e = html.escape
@@ -339,10 +367,11 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         "<!doctype html><html><head><meta charset='utf-8'><title>crosscheck report</title>",
         "<style>body{font-family:sans-serif;background:#fafafa;margin:2em}"
         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 8px}"
-        ".row{display:grid;grid-template-columns:repeat(3,1fr);gap:8px}"
+        ".row{display:grid;grid-template-columns:repeat(4,1fr);gap:8px}"
         ".row figure{margin:0}.row figcaption{font-size:90%;color:#444}"
         # thin lines: scale smoothly when shrunk (pixelated scaling drops pixels); click for 1:1
         ".row img{width:100%;image-rendering:auto;border:1px solid #888;background:#000}"
+        ".row .crop img{width:auto;max-width:100%;image-rendering:pixelated}"   # enlarged: blocks stay blocks
         ".chip{background:#000;padding:1px 6px;border-radius:3px}"
         ".anim{max-width:100%;image-rendering:pixelated;border:1px solid #888}.plot{max-width:100%}"
         ".fail{color:#b00}.pass{color:#070}section{margin:0 0 2em 0}</style></head><body>",
@@ -367,12 +396,12 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append("<h2>Notes</h2><ul>" + "".join(
             f"<li class='note'><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e(note)}</li>" for c, note in notes)
             + "</ul>")
-    names = sorted({f["name"] for c in report["cases"] for f in c["faults"]}, key=list(FAULT_HINTS).index)
+    names = fault_hints(f for c in report["cases"] for f in c["faults"])
     if names:
         parts.append("<h2>What to check</h2><ul>" + "".join(
-            f"<li><code>{e(n)}</code>: {e(FAULT_HINTS[n])}</li>" for n in names) + "</ul>")
+            f"<li><code>{e(n)}</code>: {e(h)}</li>" for n, h in names) + "</ul>")
     timing = report.get("timing") or {}
-    if timing:
+    if timing and any(cell != _fmt_ms(None) for row in timing_rows(report) for cell in row[2:]):   # not all dashes
         trows = "".join("<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in timing_rows(report))
         parts.append(
             "<h2>Time per frame</h2><p>Vertex stage: the candidate's projection and OpenCV; pixel stage: the "
@@ -394,11 +423,13 @@ def _html(report: dict, shown: list[tuple[dict, str]], files: set | None = None)
         parts.append(
             f"<h2>Worst frames</h2><p>Each row: the candidate's frame, the oracle's (pyrender), and their diff: "
             f"{legend}. Click an image for full size.</p>")
-    for case, stem in shown:
+    for case, stem, crop in shown:
         figs = "".join(
             f"<figure><figcaption>{label}</figcaption><a href='img/{stem}-{kind}.png'>"
             f"<img src='img/{stem}-{kind}.png' alt='{label}'></a></figure>"
             for kind, label in (("candidate", "candidate"), ("oracle", "oracle (pyrender)"), ("diff", "diff")))
+        figs += (f"<figure class='crop'><figcaption>{e(crop)}</figcaption><a href='img/{stem}-crop.png'>"
+                 f"<img src='img/{stem}-crop.png' alt='{e(crop)}'></a></figure>")
         if "silhouette_iou" in case:
             scores = (f"silhouette IoU {_fmt_f1(case.get('silhouette_iou'))}, depth error / bound "
                       f"{_fmt_ratio(case.get('depth_error_ratio'))}")
@@ -451,7 +482,9 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
             out.write(f"img/{stem}-candidate.png", png_bytes(np.where(im["candidate"], 255, 0).astype(np.uint8)))
             out.write(f"img/{stem}-oracle.png", png_bytes(np.where(im["oracle"], 255, 0).astype(np.uint8)))
             out.write(f"img/{stem}-diff.png", png_bytes(diff_image(im["candidate"], im["oracle"])))
-            shown.append((case, stem))
+            crop, window = crop_image(im["candidate"], im["oracle"])
+            out.write(f"img/{stem}-crop.png", png_bytes(crop))
+            shown.append((case, stem, crop_caption(window)))
         report = _finite_or_null(report)
         files = set()
         if images.get("animation"):

@@ -1,7 +1,8 @@
 """A case's record (its line in report.json) from its frames, and the verdict with its reasons.
 
-A case fails for every limit of oracles.tolerances it misses, each named in a
-reason: the vertex error, points visible to one side only, the pixel F1 at 1
+The verdict is decided by oracles.judge, the one judge of every path (a
+projector's, core's, a renderer's frames). A case fails for every limit of
+oracles.tolerances it misses, each named in a reason: the vertex error, points visible to one side only, the pixel F1 at 1
 and 0 px, the one-sided pixel balance and the per-edge pixel counts of the
 lines (oracles.metrics.line_failures); shaded: regions covered by one side inside the other's silhouette,
 the silhouette IoU, faces that differ away from their boundaries, the depth
@@ -13,9 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import gate, metrics
+from . import metrics
 from .candidate import case_precision
-from .diagnose import diagnose, diagnose_lines
+from .diagnose import diagnose
+from .judge import decide, line_faults, pixel_fields
 from .tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
 #: Per-frame fields of a wireframe's line comparison (oracles.metrics.line_scores).
@@ -65,25 +67,19 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
             "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
         })
         bound32 = vertex_bound("float32", acc.scale, tol.vertex_px) if precision == "float64" else None
-        faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32)
+        faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32, planes=acc.planes)
     else:
         rec.update({"max_vertex_error_px": None, "mean_vertex_error_px": None, "rms_vertex_error_px": None})
     px = acc.pixel
     if px["f1_0px"]:
-        rec.update({
-            "pixel_f1_0px": float(min(px["f1_0px"])), "pixel_f1_1px": float(min(px["f1_1px"])),
-            "pixel_f1_0px_mean": float(np.mean(px["f1_0px"])), "pixel_f1_1px_mean": float(np.mean(px["f1_1px"])),
-            "pixel_precision_0px": float(min(px["precision_0px"])), "pixel_recall_0px": float(min(px["recall_0px"])),
-            "pixel_precision_1px": float(min(px["precision_1px"])), "pixel_recall_1px": float(min(px["recall_1px"])),
-            "worst_pixel_frame": acc.worst[1] if acc.worst else None,
-        })
+        rec.update(pixel_fields(px, acc.worst[1] if acc.worst else None))
         rec["lines"] = metrics.line_summary(acc.lines)
     else:
         rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
     if setup.pixels and setup.mode.shaded:
         rec.update(shaded_summary(acc.shaded, acc.worst))
-    if acc.lines and not faults:      # a line fault is named only when the vertices agree
-        faults = diagnose_lines(rec["lines"], tol)
+    if acc.lines:                     # a line fault is named only when the vertices agree
+        faults = line_faults(rec, tol, faults)
     rec["faults"] = faults
     rec["compared"] = {"frames": done, "vertices": rec.get("visible_points", 0),
                        "pixels": acc.drawn_px if setup.pixels else None}
@@ -125,43 +121,9 @@ def shaded_summary(shaded: list, worst) -> dict:
 
 
 def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | None = None) -> None:
-    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed).
+    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed): :func:`oracles.judge.decide`.
 
     "fail" when a limit is missed; else "vacuous" when the case compared nothing
     (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.gate).
     """
-    reasons = [error] if error else []
-    if rec["frames_checked"]:
-        bound = rec.get("vertex_bound_px", tol.vertex_px)
-        if rec["max_vertex_error_px"] is not None and rec["max_vertex_error_px"] > bound:
-            judged = rec.get("precision", {}).get("judged_as", "float64")
-            reasons.append(f"max vertex error {rec['max_vertex_error_px']:.3g} px > {bound:.3g} px "
-                           f"({judged} bound; frame {rec['worst_vertex']['frame']}, "
-                           f"vertex {rec['worst_vertex']['vertex']})")
-        vm = rec["visibility_mismatch"]
-        if vm["candidate_only"] or vm["oracle_only"]:
-            reasons.append(f"visible sets differ: {vm['candidate_only']} points shown only by the candidate, "
-                           f"{vm['oracle_only']} only by the oracle")
-    if rec["pixel_f1_0px"] is not None:
-        if rec["pixel_f1_1px"] < tol.min_f1_1px:
-            reasons.append(f"pixel F1@1px {rec['pixel_f1_1px']:.4f} < {tol.min_f1_1px} "
-                           f"(frame {rec['worst_pixel_frame']})")
-        if rec["pixel_f1_0px"] < tol.min_f1_0px:
-            reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
-        if "lines" in rec:
-            reasons += metrics.line_failures(rec["lines"], tol)
-    if rec.get("silhouette_iou") is not None:
-        if rec["silhouette_mismatch_inside"]:
-            reasons.append(f"{rec['silhouette_mismatch_inside']} pixels covered by one side only lie inside its "
-                           "silhouette, not on its boundary (a hole or a misplaced region)")
-        if rec["silhouette_iou_gated"] is not None and rec["silhouette_iou_gated"] < tol.min_iou:
-            reasons.append(f"silhouette IoU {rec['silhouette_iou_gated']:.4f} < {tol.min_iou} "
-                           f"(frame {rec['worst_pixel_frame']})")
-        if rec["face_disagreements_inside"]:
-            reasons.append(f"{rec['face_disagreements_inside']} pixels show a different face than the oracle "
-                           "away from any boundary between the two faces (a visibility error)")
-        if rec["depth_error_ratio"] is not None and rec["depth_error_ratio"] > 1.0:
-            reasons.append(f"depth error {rec['depth_max_error']:.3g} > its bound {rec['depth_error_bound']:.3g} "
-                           f"(error/bound up to {rec['depth_error_ratio']:.3g}, frame {rec['depth_worst_frame']})")
-    level = "vertices" if rec["compared"]["pixels"] is None else "pixels"
-    rec["verdict"], rec["reasons"] = gate.case_verdict(rec["compared"], reasons, level, points)
+    decide(rec, tol, error, points)

@@ -29,6 +29,10 @@ import pytest
 # (tests/test_renderer_imports.py). A value set outside is kept.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+# tests/data/docs_project is a user's project (docs/pytest.md's samples run pytest inside a copy
+# of it, tests/docs_samples.py); its tests are not this suite's.
+collect_ignore = ["data/docs_project"]
+
 # pytester's in-process runs (tests/test_pytest_plugin.py) unload every module first imported
 # inside them; numpy's C extensions cannot be loaded twice in one process, so numpy (and its
 # numpy.fft, imported by the libraries a check loads) is loaded here, after the line above,

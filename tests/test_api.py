@@ -24,7 +24,8 @@ def test_faulty_projector_raises_with_the_fault_and_the_hint():
     with pytest.raises(AssertionError) as info:
         assert_projector(mod.project_corner, scenes=["pyramid"], frames=2, cases=["on_axis", "orthographic"])
     text = str(info.value)
-    assert text.startswith("2 of 2 crosscheck cases failed for project_corner")
+    assert text.startswith("Compared: level vertices (OpenCV), 2 frames per case, 2 cases (1 scene x 2 cameras)\n"
+                           "2 of 2 crosscheck cases failed for project_corner")
     assert "pixel_offset(dx=0.5, dy=0.5)" in text and "pixel-corner convention" in text
 
 

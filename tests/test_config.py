@@ -167,3 +167,40 @@ def test_suite_and_sweep_leave_the_table_alone(tmp_path, monkeypatch):
     assert applied == [] and args.frames is None and args.cases == ",".join(CASE_NAMES) and args.candidate is None
     args, _, applied = parse_cli(cli.build_parser(), ["--sweep"])                # the sweep runs core
     assert applied == ["cases", "frames"] and args.candidate is None and args.frames == 3
+
+
+def test_a_program_chosen_by_the_table_is_named_before_it_runs(tmp_path, monkeypatch, capsys):
+    """The trust model (docs/pytest.md, 'Whose settings run'): a [tool.wirecheck] table is trusted as pytest trusts
+    a conftest.py, and crosscheck says which file chose which program on stderr before starting it. Here the start
+    is intercepted: what stderr held at that moment is the one line naming both."""
+    path = _project(tmp_path, 'candidate-cmd = "./evil --flag"\nscenes = ["cube"]\ncases = ["on_axis"]\n'
+                              'level = "vertices"\n')
+    seen = []
+
+    def intercept(spec, command, timeout_s):
+        seen.append((command, capsys.readouterr().err))
+        raise InputError("intercepted before the program started")
+
+    monkeypatch.setattr(cli, "external_candidate", intercept)
+    code, _ = _cli(tmp_path, monkeypatch)
+    assert code == 2 and seen == [("./evil --flag", (
+        f"crosscheck: {path} [tool.wirecheck] chose the program: candidate-cmd = './evil --flag'; it runs now "
+        "with your permissions (as pytest runs a conftest.py): give --candidate, --candidate-cmd or --config FILE "
+        "to choose otherwise\n"))]
+    seen.clear()
+    capsys.readouterr()
+    code, _ = _cli(tmp_path, monkeypatch, "--candidate-cmd", "./mine")        # the user's own choice: no line
+    assert code == 2 and seen == [("./mine", "")]
+
+
+def test_a_python_candidate_chosen_by_the_table_is_named_too(tmp_path, monkeypatch, capsys):
+    (tmp_path / "proj.py").write_text((DATA / "user_projector.py").read_text())
+    path = _project(tmp_path, 'candidate = "proj.py:project"\nscenes = ["cube"]\ncases = ["on_axis"]\nframes = 2\n'
+                              'level = "vertices"\n')
+    code, _ = _cli(tmp_path, monkeypatch)
+    lines = capsys.readouterr().err.splitlines()
+    assert code == 0
+    assert lines[0] == (f"crosscheck: {path} [tool.wirecheck] chose the Python candidate (its file is imported and "
+                        f"run): candidate = '{tmp_path / 'proj.py'}:project'; it runs now with your permissions (as "
+                        "pytest runs a conftest.py): give --candidate, --candidate-cmd or --config FILE to choose "
+                        "otherwise"), lines

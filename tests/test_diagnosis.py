@@ -21,6 +21,7 @@ from wirecheck.core.conventions import focal_px
 from wirecheck.core.projection import project_points
 from wirecheck.core.scene_files import load_scene
 from wirecheck.core.transforms import Motion, apply, rotate_z
+from wirecheck.oracles.clip_planes import probe_planes
 from wirecheck.oracles.diagnose import FAULT_ORDER, LINE_FAULTS, diagnose, primary
 from wirecheck.oracles.tolerances import vertex_bound, vertex_scale
 
@@ -77,6 +78,8 @@ CAMERAS = {
                      projection="orthographic", ortho_height=5.0),
     # camera at the centre of the points: some in front, some behind
     "inside": look_at((0, 0, 0), (0.1, 0.2, -1), (0, 1, 0), fov_y_deg=90, width=640, height=480),
+    # the same, with near and far inside the points' depths (|p| <= ~3.5): both planes cut some
+    "clip": look_at((0, 0, 0), (0.1, 0.2, -1), (0, 1, 0), fov_y_deg=90, width=640, height=480, near=1.0, far=3.0),
 }
 
 
@@ -124,16 +127,16 @@ _LENS = "the camera's"
 
 
 def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None, dist=_LENS,
-             dtype=np.float64):
+             dtype=np.float64, keep=None):
     """core.projection.project_points, with the rotation, focal lengths (or
-    ortho scales), principal point and lens distortion replaceable; every value
-    in ``dtype`` (float32: the float32 twin of a fault)."""
+    ortho scales), principal point, lens distortion and depth test (``keep(z, camera)``)
+    replaceable; every value in ``dtype`` (float32: the float32 twin of a fault)."""
     p = np.asarray(p_world, dtype=dtype).reshape(-1, 3)
     r = np.stack([camera.right, camera.up, camera.forward]) if rotation is None else rotation
     r, position = np.asarray(r, dtype=dtype), np.asarray(camera.position, dtype=dtype)
     p_cam = (p - position) @ r.T
     z = p_cam[:, 2]
-    vis = (z >= dtype(camera.near)) & (z <= dtype(camera.far))
+    vis = (z >= dtype(camera.near)) & (z <= dtype(camera.far)) if keep is None else keep(z, camera)
     pcx, pcy = camera.principal_point
     cx = dtype(pcx if cx is None else cx)
     cy = dtype(pcy if cy is None else cy)
@@ -294,8 +297,35 @@ def f_k2_wrong(p, cam, dtype=np.float64):
     return _project(p, cam, dist=_lens_with(cam, 1, 2.0), dtype=dtype)
 
 
+def f_float32_k(p, cam, dtype=np.float64):
+    """float64 arithmetic with float32 constants (a np.float32 K): fitted scales 1 + ~3e-8."""
+    fx, fy = cam.focal_xy if cam.projection == "perspective" else (_scale_for(cam, cam.ortho_height),) * 2
+    cx, cy = cam.principal_point
+    f32 = [float(np.float32(v)) for v in (fx, fy, cx, cy)]
+    return _project(p, cam, fx=f32[0], fy=f32[1], cx=f32[2], cy=f32[3], dtype=dtype)
+
+
+def f_clip_z_positive(p, cam, dtype=np.float64):
+    """Keeps every point in front (z > 0), not only beyond near."""
+    return _project(p, cam, dtype=dtype, keep=lambda z, c: (z > 0) & (z <= dtype(c.far)))
+
+
+def f_clip_none(p, cam, dtype=np.float64):
+    """Never clips (no NaN): points behind the camera come out mirrored through the centre."""
+    return _project(p, cam, dtype=dtype, keep=lambda z, c: np.abs(z) > 0)
+
+
+def f_clip_swapped(p, cam, dtype=np.float64):
+    """near and far exchanged in near <= z <= far: keeps nothing."""
+    return _project(p, cam, dtype=dtype, keep=lambda z, c: (z >= dtype(c.far)) & (z <= dtype(c.near)))
+
+
 FAULTS = {
     "none": (f_none, set()),
+    "float32_k": (f_float32_k, {"precision_limited"}),
+    "clip_z_positive": (f_clip_z_positive, {"clipping_plane"}),
+    "clip_none": (f_clip_none, {"clipping_plane"}),
+    "clip_swapped": (f_clip_swapped, {"clipping_plane"}),
     "float32_arith": (f_float32_arith, {"precision_limited"}),
     "mirror_x": (f_mirror_x, {"mirror_horizontal"}),
     "mirror_y": (f_mirror_y, {"mirror_vertical"}),
@@ -322,6 +352,8 @@ FAULTS = {
 }
 SINGLE = [k for k in FAULTS if k not in ("swap_mirror", "fov_aspect", "fov_offset")]
 #: Faults that need a calibrated camera: fx != fy, or a lens.
+#: Faults of the depth test, on the "clip" camera only (its near and far planes cut the points).
+CLIP_FAULTS = ("clip_z_positive", "clip_none", "clip_swapped")
 CALIBRATED_FAULTS = {"fxfy_swap": ("k_aniso", "k_barrel", "k_pincushion"),
                      "lens_ignored": LENS_CAMERAS, "k1_sign": LENS_CAMERAS, "k2_wrong": LENS_CAMERAS}
 
@@ -330,8 +362,11 @@ CALIBRATED_FAULTS = {"fxfy_swap": ("k_aniso", "k_barrel", "k_pincushion"),
 # diag(1, 1, -1) is its own transpose), tested separately below.
 MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
 CASES = [(f, c) for f in FAULTS for c in MAIN_CAMERAS
-         if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS]
+         if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS and f not in CLIP_FAULTS
+         # the ortho camera's constants (scale 300/5 = 60, cx 199.5, cy 149.5) are exact in float32
+         and not (f == "float32_k" and c == "ortho")]
 CASES += [("none", "inside"), ("depth_flip", "inside"), ("roll", "inside")]
+CASES += [(f, "clip") for f in ("none", "depth_flip") + CLIP_FAULTS]
 # calibrated cameras: the faults of a principal point, of fx/fy and of the lens, and
 # the unexplained ones, which a lens profile must not absorb
 CASES += [(f, c) for f in ("none", "pp_offset", "fov", "depth_flip", "roll", "transposed")
@@ -340,7 +375,7 @@ CASES += [(f, c) for f, cams in CALIBRATED_FAULTS.items() for c in cams]
 
 
 def points_for(camera_name):
-    return POINTS_AROUND if camera_name == "inside" else POINTS
+    return POINTS_AROUND if camera_name in ("inside", "clip") else POINTS
 
 
 def float32_bound(pts, cam, ref) -> float:
@@ -356,9 +391,11 @@ def run_case(fault, camera_name, dtype=np.float64):
     fn, _ = FAULTS[fault]
     ref = oracle_project(pts, cam)
     bound32 = float32_bound(pts, cam, ref)
+    # the candidate's own planes, probed as oracles.case does when the visible sets differ
     if dtype == np.float32:
-        return diagnose(fn(pts, cam, np.float32), ref, cam, tol_px=bound32)
-    return diagnose(fn(pts, cam), ref, cam, tol_px=TOL, float32_px=bound32)
+        planes = probe_planes(lambda q, c: fn(q, c, np.float32), cam)
+        return diagnose(fn(pts, cam, np.float32), ref, cam, tol_px=bound32, planes=planes)
+    return diagnose(fn(pts, cam), ref, cam, tol_px=TOL, float32_px=bound32, planes=probe_planes(fn, cam))
 
 
 @pytest.fixture(scope="module")
@@ -367,7 +404,7 @@ def results():
 
 
 #: The float32 twins: every fault but float32_arith (float32 already), computed in float32.
-CASES32 = [(f, c) for f, c in CASES if f != "float32_arith"]
+CASES32 = [(f, c) for f, c in CASES if f not in ("float32_arith", "float32_k")]
 
 
 @pytest.fixture(scope="module")
@@ -470,6 +507,43 @@ def test_implied_fov_of_horizontal_fov(results, camera_name):
     assert fov["implied_fov_deg"] == pytest.approx(want, abs=1e-9)
     # direction: a wider image with f from the width -> longer focal -> narrower FOV
     assert (fov["implied_fov_deg"] < cam.fov_y_deg) == (cam.width > cam.height)
+    # the scale is W/H exactly (to ~3.5e-14, above): the hint says which FOV was used
+    assert "horizontal FOV (or the width)" in fov["hint"]
+
+
+def test_scale_hints_only_for_their_ratios(results):
+    """A 0.8 FOV factor is no W/H: the generic hint (report.FAULT_HINTS) stays."""
+    (fov,) = results[("fov", "axis")]
+    assert "hint" not in fov
+
+
+@pytest.mark.parametrize("camera_name", ["axis", "tall"])
+def test_pixel_count_minus_one_hint(camera_name):
+    """x = (ndc + 1) (W - 1) / 2: x scaled by (W - 1) / W, y by (H - 1) / H (about the centre: no offset)."""
+    cam = CAMERAS[camera_name]
+    fx, fy = cam.focal_xy
+    w, h = cam.width, cam.height
+    got = diagnose(_project(POINTS, cam, fx=fx * (w - 1) / w, fy=fy * (h - 1) / h), oracle_project(POINTS, cam),
+                   cam, tol_px=TOL)
+    faults = {f["name"]: f for f in got}
+    assert set(faults) == {"aspect_mismatch", "fov_mismatch"}
+    assert "pixel count minus one" in faults["aspect_mismatch"]["hint"]
+    assert "pixel count minus one" in faults["fov_mismatch"]["hint"]
+
+
+def test_float32_aspect_is_precision_limited():
+    """A GL-style fx = (W / 2) / (a tan(fov / 2)) with a = float32(4 / 3) = 1.3333334: x scaled by
+    1 - 3e-8, 1e-5 px at the image edge (> TOL), far below any aspect fault: precision_limited, not
+    aspect_mismatch(implied_aspect=1.3333334)."""
+    cam = CAMERAS["axis"]
+    a32 = float(np.float32(cam.width / cam.height))
+    fy = cam.focal_xy[1]
+    ref = oracle_project(POINTS, cam)
+    got = diagnose(_project(POINTS, cam, fx=fy * (cam.width / cam.height) / a32), ref, cam, tol_px=TOL,
+                   float32_px=float32_bound(POINTS, cam, ref))
+    assert [(f["name"], f.get("kind")) for f in got] == [("precision_limited", "float32_constants")], got
+    # the fitted scale is (W/H) / a32 to ~3.5e-14 relative (budget above)
+    assert got[0]["scale_x"] / got[0]["scale_y"] == pytest.approx((cam.width / cam.height) / a32, rel=1e-12)
 
 
 @pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
@@ -642,7 +716,7 @@ def test_large_pooled_input_is_fast():
 def confusion(results):
     """rows: injected single fault (by its expected primary name); columns: diagnosed primary."""
     # the vertex faults: the line faults come from the pixels (tests/test_line_gate.py)
-    labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS]
+    labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS + ("ambiguous",)]   # ambiguous: images only
     counts = Counter()
     for (fault, cam), got in results.items():
         if fault not in SINGLE:

@@ -13,7 +13,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fuzz.contract import SCENE_TEXTS, HypothesisPick, crosscheck_argv, make_scene_arg, mutate_text, renderer_argv, run_cli
+from fuzz.contract import (SCENE_TEXTS, HypothesisPick, Pick, crosscheck_argv, make_scene_arg, mutate_text, outside_box,
+                           renderer_argv, run_cli)
 from wirecheck.core.errors import InputError
 from wirecheck.core.scene import Scene
 from wirecheck.core.scene_files import load_scene, parse_scene_text
@@ -88,6 +89,30 @@ def test_crosscheck_contract(data, earlier):
         assert outcome.problems == [], (argv, outcome)
 
 
+def test_generated_inputs_stay_inside_their_folder(earlier):
+    """The generators name no path outside the input's folder: '--scene ..' and '--scene /' made a dataset walk of
+    the whole system temporary folder (another program's FIFO there hung the run for 10 minutes)."""
+    import random
+
+    for cli, make in (("renderer", renderer_argv), ("crosscheck", crosscheck_argv)):
+        values = set()
+        for i in range(400):
+            with tempfile.TemporaryDirectory() as d:
+                box = Path(d)
+                (box / "in").mkdir()
+                argv = make(Pick(random.Random(f"inside-{cli}-{i}")), box, earlier)
+                assert outside_box(argv, box) == [], (cli, i, argv)
+                values.update(v for o, v in zip(argv, argv[1:]) if o == "--scene" and not v.startswith(d))
+        assert {"in", "nosuch"} <= values, values       # the relative values are still drawn
+
+
+def test_outside_box_sees_parent_and_root(tmp_path):
+    """The check itself: the two values the generator used to draw are outside; the box's own folders are not."""
+    assert outside_box(["--scene", "..", "--out", "/", "--report-dir", "in/../..", "--cases", "/x"], tmp_path) == [
+        "--scene ..", "--out /", "--report-dir in/../.."]
+    assert outside_box(["--scene", ".", "--scene", str(tmp_path / "in" / ".."), "--out", "out"], tmp_path) == []
+
+
 #: Complete small meshes of the formats whose readers (trimesh) accept a truncated file (tests/test_hostile.py has one
 #: hand-made case each); every shorter prefix must be refused, never read as a smaller mesh.
 _TRIANGLE = np.array([[0, 0, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes() + b"\0\0"
@@ -118,3 +143,19 @@ def test_a_truncated_mesh_file_is_refused_or_read_whole(name, data):
             assert "\n" not in str(exc) and str(exc).startswith(str(part))
         else:   # only a cut in the last line's name or newline leaves the mesh whole
             assert (scene.vertices.tolist(), scene.faces) == (full.vertices.tolist(), full.faces), cut
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck))
+@given(data=st.data())
+def test_hostile_png_frames_read_or_one_printable_phrase(data):
+    """The image rule on damaged PNGs of every colour type and depth (tests/fuzz/png_inputs.py): a bool image of
+    the camera's size or one FrameProblem line without control characters."""
+    from fuzz.png_inputs import check_png, hostile_png
+    from wirecheck.oracles.png_frame import FrameProblem, read_png
+
+    pick = HypothesisPick(data)
+    width, height = pick.integer(1, 9), pick.integer(1, 5)
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "frame.png"
+        path.write_bytes(hostile_png(pick, width, height))
+        assert check_png(read_png, FrameProblem, path, width, height) == []

@@ -20,8 +20,9 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from test_diagnosis import CALIBRATED_FAULTS, CAMERAS, FAULTS, FOV_FACTOR, SINGLE, format_confusion, implied_fov
+from test_diagnosis import CALIBRATED_FAULTS, CAMERAS, CLIP_FAULTS, FAULTS, FOV_FACTOR, SINGLE, format_confusion, implied_fov
 
+from wirecheck.core.camera import look_at
 from wirecheck.core.clipping import clip_to_image
 from wirecheck.core.projection import project_points
 from wirecheck.core.raster import line_coverage_aa, line_pixels
@@ -41,15 +42,29 @@ MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
 # (scaled x2 around it) for a depth flip that shows the other side.
 # (Not the faults that need fx != fy or a lens: test_diagnosis' calibrated cameras; nor
 # float32_arith, float32 rounding of ~1e-5 px: a vertex-level fault a drawing cannot show.)
+# Nor float32_k (float32 constants, ~1e-5 px) nor the depth-test faults (CLIP_FAULTS: probed on the
+# projector, oracles.clip_planes).
 CASES = [(f, c) for f in SINGLE for c in MAIN_CAMERAS
-         if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS and f != "float32_arith"]
+         if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS
+         and f not in ("float32_arith", "float32_k") + CLIP_FAULTS]
 CASES += [(f, c) for f in ("swap_mirror", "fov_aspect", "fov_offset") for c in ("oblique", "tall")]
 CASES += [(f, "inside") for f in ("none", "depth_flip", "roll")]
+# A view the images cannot decide a mirror on: the cube alone, centred, orthographic (its picture is
+# centrally symmetric, so a left-right mirror is also an up-down one: both fit, the identity does not)
+CASES += [(f, "ortho_cube") for f in ("none", "mirror_x", "mirror_y")]
+IMAGE_CAMERAS = {**CAMERAS, "ortho_cube": look_at((2, 3, 5), (0, 0, 0), (0.2, 1, 0), width=400, height=300,
+                                                  projection="orthographic", ortho_height=5.0)}
+#: The names a case expects where they are not its fault's (test_diagnosis.FAULTS).
+EXPECTED = {("mirror_x", "ortho_cube"): {"ambiguous"}, ("mirror_y", "ortho_cube"): {"ambiguous"}}
+
+
+def expected(fault, camera_name):
+    return EXPECTED.get((fault, camera_name), FAULTS[fault][1])
 
 
 def _scene_frames(camera_name):
     motion = Motion(turns=(1.0, 2.0, 1.0), scale=2.0) if camera_name == "inside" else Motion()
-    for name in SCENES:
+    for name in ("cube",) if camera_name == "ortho_cube" else SCENES:
         sc = load_scene(name)
         for k in FRAMES:
             yield apply(motion.frame_matrix(k, 12), sc.vertices), np.asarray(sc.edges)
@@ -91,7 +106,7 @@ def draw_wide(fn, p_world, edges, cam, width_px=2.0):
 
 
 def diagnose_fault(fault, camera_name, draw=draw_candidate):
-    cam = CAMERAS[camera_name]
+    cam = IMAGE_CAMERAS[camera_name]
     fn, _ = FAULTS[fault]
     images, segs, flipped = [], [], []
     for p_world, edges in _scene_frames(camera_name):
@@ -117,11 +132,12 @@ def _memoised_quantisation_bias():
 
     compute, done = image_diagnose.quantisation_bias, {}
 
-    def cached(oracle_segs, camera):
+    def cached(oracle_segs, camera, p=None, d=None):
         segs = [np.asarray(s, dtype=np.float64) for s in oracle_segs]
-        key = (pickle.dumps(camera), tuple((s.shape, s.tobytes()) for s in segs))
+        model = tuple(None if v is None else np.asarray(v, dtype=np.float64).tobytes() for v in (p, d))
+        key = (pickle.dumps(camera), tuple((s.shape, s.tobytes()) for s in segs), model)
         if key not in done:
-            done[key] = compute(oracle_segs, camera)
+            done[key] = compute(oracle_segs, camera, p, d)
         return done[key].copy()
 
     return cached
@@ -139,7 +155,19 @@ def results():
 @pytest.mark.parametrize("fault,camera_name", CASES)
 def test_expected_names(results, fault, camera_name):
     got = results[(fault, camera_name)]
-    assert {f["name"] for f in got} == FAULTS[fault][1], got
+    assert {f["name"] for f in got} == expected(fault, camera_name), got
+
+
+@pytest.mark.parametrize("fault", ["mirror_x", "mirror_y"])
+def test_an_undecidable_mirror_gives_both_names_and_hints(results, fault):
+    from wirecheck.oracles.report import FAULT_HINTS, fault_hints
+
+    (amb,) = results[(fault, "ortho_cube")]
+    assert sorted(amb["alternatives"]) == ["mirror_horizontal", "mirror_vertical"]
+    (hint,) = [h for n, h in fault_hints([amb]) if n == "ambiguous"]
+    assert FAULT_HINTS["mirror_horizontal"] in hint and FAULT_HINTS["mirror_vertical"] in hint
+    # the confidence measures the mirror against no mirror (which does not fit), not against the other mirror
+    assert amb["confidence"] > 0.5
 
 
 def test_every_fault_has_confidence_and_residual(results):
@@ -185,10 +213,10 @@ def confusion(results):
     # nor precision_limited: float32 rounding is far below a pixel)
     labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS + VERTEX_ONLY_FAULTS]
     counts = Counter()
-    for (fault, _cam), got in results.items():
+    for (fault, cam), got in results.items():
         if fault not in SINGLE:
             continue
-        want = FAULTS[fault][1]
+        want = expected(fault, cam)
         counts[("none" if not want else min(want, key=FAULT_ORDER.index), primary(got))] += 1
     rows = [r for r in labels if any(counts[(r, c)] for c in labels)]
     return labels, rows, counts

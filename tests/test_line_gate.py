@@ -181,11 +181,15 @@ def test_min_f1_1px_decides():
     _decides(run_stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
 
 
-def test_min_f1_0px_decides():
+def test_min_f1_0px_decides(monkeypatch):
+    # F1@0px is over the decided pixels (sub-pixel ties take the oracle's value), so core's own
+    # ties do not lower it: the unbiased random-end renderer's decided end pixels do
+    monkeypatch.setattr(raster, "_line_pixels", random_ends)
+
     def run_oblique(t):
         return run(cases=("oblique_roll",), tol=t)
     f1 = run_oblique(OPEN)["cases"][0]["pixel_f1_0px"]
-    assert 0.99 < f1 < 1.0                  # a few tie pixels per frame decided the other way
+    assert 0.99 < f1 < 1.0                  # a quarter of the lines a pixel short or long: ~0.3 % of pixels
     _decides(run_oblique, "min_f1_0px", f1, np.nextafter(f1, 2.0), "pixel F1@0px")
 
 

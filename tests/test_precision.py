@@ -235,10 +235,12 @@ def test_correct_float32_projector_passes_every_case_at_the_pixel_level(pixels_a
 
 
 def test_old_near_plane_nudge_fails_a_correct_float32_projector(pixels_available, monkeypatch):
-    """Break on purpose: the 1e-9 nudge alone drops near-plane edges of a correct float32 projector."""
-    from wirecheck.oracles import draw
+    """Break on purpose: the 1e-9 nudge alone drops near-plane edges of a correct float32 projector
+    (neither the precision's depth margin nor the probed planes' slack, oracles.clip_planes)."""
+    from wirecheck.oracles import clip_planes, draw
 
     monkeypatch.setattr(draw, "depth_margin", lambda p, camera, precision: np.zeros(len(p)))
+    monkeypatch.setattr(clip_planes, "depth_slack", lambda planes, camera: (0.0, None))
     report = check_projector(glm_f32.project, isolate=False, frames=2, oracles=("opencv", "pyrender"),
                              cases=["near_plane"])
     assert report["verdict"] == "fail"

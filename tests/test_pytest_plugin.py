@@ -55,7 +55,8 @@ def test_pass_and_fail_with_the_fault_and_without_harness_frames(project):
     # the user's own line is the traceback, then the diagnosis
     result.stdout.fnmatch_lines([
         ">       wirecheck(mirrored, scenes=[[]\"cube\"[]], frames=2, cases=[[]\"on_axis\"[]])",
-        "E       Failed: 1 of 1 crosscheck cases failed for mirrored:",
+        "E       Failed: Compared: level vertices (OpenCV), 2 frames per case, 1 case (1 scene x 1 camera)",
+        "E       1 of 1 crosscheck cases failed for mirrored:",
         "E         cube / on_axis: faults: mirror_horizontal; max vertex error * px > 1e-06 px *",
         "E         what to check, mirror_horizontal: left and right are exchanged*",
         "test_user.py:10: Failed",

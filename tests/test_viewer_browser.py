@@ -63,17 +63,25 @@ def session(tmp_path_factory):
     overlay = LiveOverlay()
     server = Server(Viewer(s, overlay=overlay)).start()
     out = tmp / "session.json"
+    profiles = tmp / "profiles"            # Chromium's profile goes here, not into the system temporary folder
+    profiles.mkdir()
     try:
         proc = subprocess.run(["node", str(BROWSER_DIR / "viewer_session.mjs"), server.url, str(out)],
                               capture_output=True, text=True, timeout=180,
-                              env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM))
+                              env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM, WIRECHECK_PROFILE_PARENT=str(profiles)))
     finally:
         server.stop()
     assert proc.returncode == 0, proc.stderr[-3000:]
     data = json.loads(out.read_text())
+    data["profiles_left"] = sorted(p.name for p in profiles.iterdir())
     data["by"] = {r["label"]: r for r in data["records"]}
     data["scene"] = s.scene
     return data
+
+
+def test_the_chromium_profile_is_removed(session):
+    """Each session made a wirecheck-chromium-* profile (2-3 MB) and left it in the system temporary folder."""
+    assert session["profiles_left"] == []
 
 
 def test_orbit_drag_moves_a_known_vertex_to_its_predicted_pixel(session):

@@ -62,7 +62,7 @@ def extremes_markdown(result: dict) -> str:
     lines += ["", "Bound px is the bound at the point of the largest error (every point's error must be "
                   "within its own bound). pyrender F1@1: the smallest over the frames a case judges; "
                   "(info) frames are reported, not judged. "
-                  "Errors are against a long-double reference computed from core/conventions.py.", ""]
+                  "Errors are against a long-double reference computed from wirecheck.core.conventions.", ""]
     for c in result["cases"]:
         lines += _case_lines(c)
     lines += _bound_lines(result["bounds"])

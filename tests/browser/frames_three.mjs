@@ -9,7 +9,7 @@
 //
 //   node frames_three.mjs JOB_DIR THREE_MODULE_JS [--antialias]
 import { chromium } from "playwright-core";
-import { mkdirSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { dirname, join } from "node:path";
 
@@ -65,7 +65,10 @@ window.drawFrame = ({ width, height, camera, model, positions, antialias }) => {
 window.ready = true;
 </script></body></html>`;
 
-const userDataDir = mkdtempSync(join(tmpdir(), "wirecheck-chromium-"));
+// Chromium's profile (2-3 MB): in WIRECHECK_PROFILE_PARENT when the test gives one (its own temporary
+// folder, so even a killed run leaves nothing in the system's), removed whenever node exits.
+const userDataDir = mkdtempSync(join(process.env.WIRECHECK_PROFILE_PARENT || tmpdir(), "wirecheck-chromium-"));
+process.on("exit", () => rmSync(userDataDir, { recursive: true, force: true, maxRetries: 3 }));
 const context = await chromium.launchPersistentContext(userDataDir, {
   executablePath: process.env.WIRECHECK_CHROMIUM || "/usr/bin/chromium",
   headless: true,

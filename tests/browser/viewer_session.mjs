@@ -5,12 +5,15 @@
 //
 //   node viewer_session.mjs URL OUT.json [SCREENSHOT.png]
 import { chromium } from "playwright-core";
-import { mkdtempSync, writeFileSync } from "node:fs";
+import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 
 const [url, outPath, shotPath] = process.argv.slice(2);
-const userDataDir = mkdtempSync(join(tmpdir(), "wirecheck-chromium-"));
+// Chromium's profile (2-3 MB): in WIRECHECK_PROFILE_PARENT when the test gives one (its own temporary
+// folder, so even a killed run leaves nothing in the system's), removed whenever node exits.
+const userDataDir = mkdtempSync(join(process.env.WIRECHECK_PROFILE_PARENT || tmpdir(), "wirecheck-chromium-"));
+process.on("exit", () => rmSync(userDataDir, { recursive: true, force: true, maxRetries: 3 }));
 const context = await chromium.launchPersistentContext(userDataDir, {
   executablePath: process.env.WIRECHECK_CHROMIUM || "/usr/bin/chromium",
   headless: true,

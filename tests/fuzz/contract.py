@@ -149,13 +149,22 @@ def mutate_bytes(pick: Pick, data: bytes) -> bytes:
 
 def make_scene_arg(pick: Pick, box: Path) -> str:
     """A --scene value: a built-in or bogus name, or a (mutated) file written into ``box/in``."""
-    kind = pick.choice(["builtin"] * 3 + ["bogus", "scene", "scene", "scene", "obj", "ply", "stl", "off", "glb", "long"])
+    kind = pick.choice(["builtin"] * 3 + ["bogus", "scene", "scene", "scene", "obj", "ply", "stl", "off", "glb", "long",
+                                          "companion", "dataset"])
     if kind == "builtin":
         return pick.choice(["cube", "pyramid", "prism", "orrery"])
     if kind == "bogus":
-        return pick.choice(["nosuch", "", ".", "..", "/", "cube.scene", "x" * 300, "a/b", "/dev/null", "in"])
+        # every path stays inside box: '..' or '/' made a dataset walk of the whole system temporary folder
+        # (another program's FIFO there hung a run); the box's own FIFO stands for them
+        value = pick.choice(["nosuch", "", ".", "in/..", "cube.scene", "x" * 300, "a/b", "pipe.obj", "in"])
+        if value == "pipe.obj":
+            os.mkfifo(box / "in" / value)
+            return str(box / "in" / value)
+        return str(box / "in" / "..") if value == "in/.." else value
     if kind == "long":
         return str(box / "in" / ("p" * 300)) + ".scene"
+    if kind in ("companion", "dataset"):
+        return fifo_inputs(pick, box, kind)
     folder = box / "in"
     (folder / "m.obj").write_text(OBJ)
     (folder / "m.stl").write_text(STL)
@@ -173,6 +182,54 @@ def make_scene_arg(pick: Pick, box: Path) -> str:
     path = folder / f"m{pick.integer(0, 9)}.{kind}"
     path.write_bytes(mutate_bytes(pick, data) if pick.chance(0.4) else data)
     return str(path)
+
+
+def fifo_inputs(pick: Pick, box: Path, kind: str) -> str:
+    """A mesh whose companion file (mtllib, map_Kd, a glTF buffer) is a FIFO, or a dataset folder holding such
+    meshes, a FIFO named like a mesh and a good mesh. Opening any FIFO here blocks forever (no writer)."""
+    folder = box / "in" / ("ds" if kind == "dataset" else "")
+    folder.mkdir(exist_ok=True)
+    made = []
+    for which in (pick.choice(["mtllib", "map_Kd", "gltf"]),) if kind == "companion" else ("mtllib", "gltf", "pipe"):
+        if which == "mtllib":
+            (folder / "a.obj").write_text("mtllib a.mtl\n" + OBJ)
+            os.mkfifo(folder / "a.mtl")
+            made.append(folder / "a.obj")
+        elif which == "map_Kd":
+            (folder / "b.obj").write_text("mtllib b.mtl\nusemtl x\n" + OBJ)
+            (folder / "b.mtl").write_text("newmtl x\nmap_Kd b.png\n")
+            os.mkfifo(folder / "b.png")
+            made.append(folder / "b.obj")
+        elif which == "gltf":
+            doc = {"asset": {"version": "2.0"}, "buffers": [{"uri": "c.bin", "byteLength": 36}],
+                   "bufferViews": [{"buffer": 0, "byteLength": 36}],
+                   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                                  "max": [1, 1, 0], "min": [0, 0, 0]}],
+                   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "nodes": [{"mesh": 0}],
+                   "scenes": [{"nodes": [0]}], "scene": 0}
+            (folder / "c.gltf").write_text(json.dumps(doc))
+            os.mkfifo(folder / "c.bin")
+            made.append(folder / "c.gltf")
+        else:
+            os.mkfifo(folder / "pipe.ply")
+            (folder / "good.obj").write_text(OBJ)
+    return str(folder) if kind == "dataset" else str(made[0])
+
+
+#: The options whose values name paths a run reads or writes: each must stay inside the input's box.
+PATH_OPTIONS = ("--scene", "--scene-list", "--out", "--report-dir")
+
+
+def outside_box(argv: list[str], box: Path) -> list[str]:
+    """The values of PATH_OPTIONS in ``argv`` that name a path outside ``box`` (relative ones from ``box``)."""
+    root = os.path.realpath(box)
+    bad = []
+    for opt, value in zip(argv, argv[1:]):
+        if opt in PATH_OPTIONS and value and (os.sep in value or value in (".", "..")):
+            where = os.path.realpath(os.path.join(box, value))
+            if os.path.commonpath([root, where]) != root:
+                bad.append(f"{opt} {value}")
+    return bad
 
 
 # ---- output set-ups: the user's things in and around the output folder ------------------------------
@@ -328,6 +385,8 @@ def snapshot(box: Path) -> dict:
                 snap[rel] = ("link", os.readlink(p))
             elif p.is_dir():
                 snap[rel] = ("dir", None)
+            elif not p.is_file():           # a FIFO: never opened (no writer: open blocks forever)
+                snap[rel] = ("fifo", None)
             else:
                 snap[rel] = ("file", hashlib.sha256(p.read_bytes()).hexdigest())
     return snap
@@ -342,6 +401,7 @@ REPORT_NAME = re.compile(r"(report\.(json|md|html)|worst\.gif|vertex_error\.png|
 def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
     """Run ``main(argv)`` in ``box`` (the current folder during the call) and check the contract."""
     before = snapshot(box)
+    outside = outside_box(argv, box)
     out, err = io.StringIO(), io.StringIO()
     cwd = os.getcwd()
     os.chdir(box)
@@ -354,6 +414,7 @@ def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
     finally:
         os.chdir(cwd)
     o = Outcome(rc, out.getvalue(), err.getvalue())
+    o.problems += [f"input outside its folder: {v}" for v in outside]
     after = snapshot(box)
     if rc not in (0, 1, 2):
         o.problems.append(f"exit {rc}")

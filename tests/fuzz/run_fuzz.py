@@ -38,6 +38,8 @@ def category(problem: str) -> str:
         return "exit codes outside {0, 1, 2, 3}" if problem != "exit 3" else "internal errors (exit 3)"
     if problem.startswith("user file"):
         return "user files touched"
+    if problem.startswith("input outside"):
+        return "inputs outside their folder"
     if "stderr lines" in problem:
         return "exit 2 without exactly one stderr line"
     return "partial outputs or leftovers"
@@ -94,13 +96,68 @@ def fuzz(cli: str, n: int, seed: int, earlier: Path, log, start: int = 0) -> dic
             "internal errors (exit 3)": problems["internal errors (exit 3)"],
             "exit 2 without exactly one stderr line": problems["exit 2 without exactly one stderr line"],
             "timeouts": problems["timeouts"],
+            "inputs outside their folder": problems["inputs outside their folder"],
             "examples": examples}
+
+
+def fuzz_png(n: int, seed: int, start: int = 0) -> dict:
+    """``n`` damaged PNG frames through read_png (tests/fuzz/png_inputs.py): outcomes and problems by kind."""
+    from fuzz.png_inputs import check_png, hostile_png
+    from wirecheck.oracles.png_frame import FrameProblem, read_png
+
+    outcomes, problems, examples = collections.Counter(), collections.Counter(), []
+    t0 = time.perf_counter()
+    signal.signal(signal.SIGALRM, _timeout)
+    with tempfile.TemporaryDirectory(prefix="wirecheck-fuzz-png-") as d:
+        path = Path(d) / "frame.png"
+        for i in range(start, start + n):
+            pick = Pick(random.Random(f"{seed}-png-{i}"))
+            width, height = pick.integer(1, 9), pick.integer(1, 5)
+            path.write_bytes(hostile_png(pick, width, height))
+            signal.alarm(TIMEOUT_S)
+            try:
+                found = check_png(read_png, FrameProblem, path, width, height)
+                try:
+                    read_png(path, width, height)
+                    outcomes["read"] += 1
+                except Exception:      # noqa: BLE001 - counted: FrameProblem or the traceback found above
+                    outcomes["refused"] += 1
+            except FuzzTimeout:
+                found = [f"timeout: over {TIMEOUT_S} s"]
+            finally:
+                signal.alarm(0)
+            for p in found:
+                problems[p.split(":")[0]] += 1
+            if found and len(examples) < 10:
+                examples.append({"input": i, "problems": found})
+    return {"surface": "png", "inputs": n, "seconds": round(time.perf_counter() - t0), "outcomes": dict(outcomes),
+            "problems": dict(problems), "examples": examples}
+
+
+def fuzz_interrupts(n: int, seed: int, start: int = 0) -> dict:
+    """``n`` renderer processes signalled at random moments (tests/fuzz/interrupts.py)."""
+    from fuzz.interrupts import interrupt_one
+
+    codes, problems, examples = collections.Counter(), collections.Counter(), []
+    t0 = time.perf_counter()
+    for i in range(start, start + n):
+        with tempfile.TemporaryDirectory(prefix="wirecheck-fuzz-sig-") as d:
+            rc, found = interrupt_one(Pick(random.Random(f"{seed}-interrupt-{i}")), Path(d))
+        codes[rc] += 1
+        for p in found:
+            problems[p.split(":")[0]] += 1
+        if found and len(examples) < 10:
+            examples.append({"input": i, "rc": rc, "problems": found})
+    return {"surface": "interrupt", "inputs": n, "seconds": round(time.perf_counter() - t0),
+            "exit_codes": dict(sorted(codes.items())), "problems": dict(problems), "examples": examples}
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--inputs", type=int, default=10_000, help="inputs per CLI (default 10000)")
-    p.add_argument("--cli", choices=("renderer", "crosscheck", "both"), default="both")
+    p.add_argument("--cli", choices=("renderer", "crosscheck", "both", "png", "interrupt"), default="both",
+                   help="png: damaged PNG frames for the image rule; interrupt: SIGINT/SIGTERM at random moments "
+                        "of renderer processes reading a textured OBJ")
     p.add_argument("--seed", type=int, default=15)
     p.add_argument("--start", type=int, default=0, help="first input's index (split a run over processes)")
     p.add_argument("--json", default=None, help="also write the results here")
@@ -109,6 +166,12 @@ def main(argv=None) -> int:
     os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
     from wirecheck.core import cli as renderer
 
+    if a.cli in ("png", "interrupt"):
+        r = (fuzz_png if a.cli == "png" else fuzz_interrupts)(a.inputs, a.seed, a.start)
+        print(json.dumps(r, indent=1))
+        if a.json:
+            Path(a.json).write_text(json.dumps([r], indent=1) + "\n")
+        return 1 if r["problems"] else 0
     results = []
     with tempfile.TemporaryDirectory(prefix="wirecheck-fuzz-earlier-") as d:
         earlier = Path(d) / "out"
@@ -120,14 +183,15 @@ def main(argv=None) -> int:
         print(f"{r['cli']}: {r['inputs']} inputs in {r['seconds']} s; exit codes {r['exit_codes']}")
         for key in ("tracebacks", "exit codes outside {0, 1, 2, 3}", "partial outputs or leftovers",
                     "user files touched", "internal errors (exit 3)", "exit 2 without exactly one stderr line",
-                    "timeouts"):
+                    "timeouts", "inputs outside their folder"):
             print(f"  {key}: {r[key]}")
         for ex in r["examples"][:5]:
             print(f"  e.g. input {ex['input']}: exit {ex['rc']} {ex['problems']}: {ex['argv']}")
     if a.json:
         Path(a.json).write_text(json.dumps(results, indent=1) + "\n")
     bad = sum(r[k] for r in results for k in ("tracebacks", "exit codes outside {0, 1, 2, 3}",
-                                              "partial outputs or leftovers", "user files touched", "timeouts"))
+                                              "partial outputs or leftovers", "user files touched", "timeouts",
+                                              "inputs outside their folder"))
     return 1 if bad else 0
 
 

@@ -58,6 +58,9 @@ TARGETS = {
     "oracles/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
                            "decides or note or empty_scene or faceless or visibility"),
     "oracles/convert.py": (["tests/test_oracle_convert.py"], None),
+    "oracles/judge.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
+                          "tests/test_crosscheck_styles.py"],
+                         "decides or note or empty_scene or faceless or visibility or line_end_bias or exact"),
 }
 
 PER_MUTANT_TIMEOUT_S = 300
@@ -247,6 +250,15 @@ def main(argv=None) -> int:
         print(f"{module}: {len(all_sites)} sites, {len(pick)} chosen", flush=True)
     if args.only:
         chosen = [s for m in modules for s in sites(m) if s.id in set(args.only)]
+        unknown = [i for i in args.only if i not in {s.id for s in chosen}]
+        if unknown:         # a score over nothing would overwrite the report with "Score: nan%"
+            print(f"mutate: error: --only {unknown[0]!r}: no mutant of {', '.join(modules)} has this id: expected "
+                  "one that --list prints (MODULE:LINE:COL:CHANGE)", file=sys.stderr)
+            return 2
+    if not chosen:
+        print("mutate: error: no mutant chosen: expected --sample N >= 1 or a module with mutation sites",
+              file=sys.stderr)
+        return 2
     # round robin over the modules: a run stopped early has looked at each of them
     by_module = [[s for s in chosen if s.module == m] for m in modules]
     chosen = [s for row in zip_longest(*by_module) for s in row if s is not None]
@@ -265,6 +277,10 @@ def main(argv=None) -> int:
                 verdict = "equivalent"
             results.append((site, verdict, seconds))
             print(f"[{n}/{len(chosen)}] {verdict:10s} {seconds:5.1f}s {site.id}", flush=True)
+    if not any(r != "equivalent" for _, r, _ in results):
+        print(f"mutate: error: all {len(results)} chosen mutants are listed as equivalent: no score to report; "
+              f"{args.report} left as it was", file=sys.stderr)
+        return 2
     write_report(Path(args.report), results, equivalent, args)
     return 0
 

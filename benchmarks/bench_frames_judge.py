@@ -1,0 +1,157 @@
+"""The frames judge (``crosscheck --candidate-frames``): peak memory by job length, time per frame vs pyrender.
+
+    .venv/bin/python benchmarks/bench_frames_judge.py                     # 24 and 720 frames (~2 min on 2 cores)
+    .venv/bin/python benchmarks/bench_frames_judge.py --frames 24,96      # quicker
+
+For each length a job is exported (the cube, case ``on_axis``, every frame
+checked) and its frames drawn by core (a correct renderer); then a fresh
+interpreter judges it (oracles.frames_judge.run_frames) and reports its peak
+resident memory (``ru_maxrss``) and wall time, and, in the same process and
+on the same frames afterwards, pyrender drawing each frame alone (the
+oracle's share of the judging: ``PyrenderOracle.render``, its context
+already made). Printed: peak RSS of each job and the ratio of the longest to
+the shortest (target <= 1.5: memory flat in the job's length), and the
+judge's seconds per frame against pyrender's on the same frames (target <= 1.5).
+
+``--oracle core`` judges against core's drawing instead of pyrender's (the
+oracle stands in, its verdict the same on core's frames): the judge's own
+memory, without what pyrender's renders keep (the oracle's growth is
+measured apart, by the default run's numbers against these).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from _common import loadavg  # noqa: E402
+
+
+def make_job(path: Path, frames: int) -> None:
+    """Export a job of ``frames`` frames (every one checked) and draw them with core."""
+    from PIL import Image
+
+    from wirecheck.core.pipeline import render_frame
+    from wirecheck.oracles.cli import main
+    from wirecheck.oracles.frames_candidate import frame_inputs, load_job
+
+    assert main(["export", str(path), "--scene", "cube", "--cases", "on_axis", "--frames", str(frames)]) == 0
+    job = load_job(path)
+    for c in job["cases"]:
+        for rel in c["frames"]:
+            k = int(Path(rel).stem.split("_")[-1])
+            p, e, cam, m = frame_inputs(path, job, c["scene"], c["case"], k)
+            (path / rel).parent.mkdir(parents=True, exist_ok=True)
+            Image.fromarray(render_frame(p, e, cam, m).image).save(path / rel)
+
+
+class CoreOracle:
+    """core's drawing in the place of pyrender's (``--oracle core``): nothing kept between frames."""
+
+    def render(self, p_model, edges, camera, model_matrix=None):
+        from wirecheck.core.pipeline import render_frame
+
+        return render_frame(p_model, edges, camera, model_matrix).image >= 128, None
+
+    def gl_info(self):
+        return None
+
+    def close(self):
+        pass
+
+
+def judge(path: Path, oracle_name: str = "pyrender") -> dict:
+    """Judge the job (this process only): peak RSS, seconds per frame, and pyrender's per frame after."""
+    from wirecheck.oracles import pyrender_oracle
+    from wirecheck.oracles.frames_candidate import frame_inputs, load_job
+    from wirecheck.oracles.frames_judge import run_frames
+    from wirecheck.oracles.pyrender_oracle import PyrenderOracle
+
+    if oracle_name == "core":
+        pyrender_oracle.OracleCache.get = lambda self, w, h: CoreOracle()
+        pyrender_oracle.OracleCache.gl_info = lambda self: None
+    inside = {"s": 0.0}                        # the oracle's seconds inside the judge
+    render = (CoreOracle if oracle_name == "core" else PyrenderOracle).render
+
+    def timed(self, *args, **kwargs):
+        t = time.perf_counter()
+        try:
+            return render(self, *args, **kwargs)
+        finally:
+            inside["s"] += time.perf_counter() - t
+    (CoreOracle if oracle_name == "core" else PyrenderOracle).render = timed
+
+    t0 = time.perf_counter()
+    report, _ = run_frames(path)
+    wall = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    frames = report["compared"]["frames"]
+    (CoreOracle if oracle_name == "core" else PyrenderOracle).render = render
+    job = load_job(path)
+    c = job["cases"][0]
+    oracle, seconds = None, 0.0
+    for rel in c["frames"]:
+        k = int(Path(rel).stem.split("_")[-1])
+        p, e, cam, m = frame_inputs(path, job, c["scene"], c["case"], k)
+        if oracle is None:
+            oracle = PyrenderOracle(cam.width, cam.height)
+            oracle.render(p, e, cam, model_matrix=m)           # the context made, as in the judge
+        t = time.perf_counter()
+        oracle.render(p, e, cam, model_matrix=m)
+        seconds += time.perf_counter() - t
+    oracle.close()
+    return {"frames": frames, "verdict": report["verdict"], "peak_rss_mb": round(peak, 1),
+            "judge_s": round(wall, 2), "judge_ms_per_frame": round(1e3 * wall / frames, 2),
+            "pyrender_ms_per_frame": round(1e3 * seconds / frames, 2),
+            "oracle_in_judge_ms_per_frame": round(1e3 * inside["s"] / frames, 2)}
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--frames", default="24,720", help="job lengths, comma-separated (default 24,720)")
+    p.add_argument("--oracle", choices=("pyrender", "core"), default="pyrender",
+                   help="what the judge compares with (core: the judge's own memory, without pyrender's)")
+    p.add_argument("--child", help=argparse.SUPPRESS)
+    a = p.parse_args(argv)
+    if a.child:
+        print(json.dumps(judge(Path(a.child), a.oracle)))
+        return 0
+    lengths = [int(x) for x in a.frames.split(",")]
+    print(f"# bench_frames_judge: cube / on_axis, frames {lengths}, judged against {a.oracle}; "
+          f"load at start {loadavg()}")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in lengths:
+            job = Path(tmp) / f"job{n}"
+            make_job(job, n)
+            out = subprocess.run([sys.executable, __file__, "--child", str(job), "--oracle", a.oracle], capture_output=True, text=True,
+                                 check=True)
+            rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
+    # pyrender ms/frame: a fresh oracle drawing the job's frames after the judging; oracle in judge: the
+    # oracle's own calls while judging (pyrender's, or core's with --oracle core); the rest is the judge's
+    print(f"{'frames':>7} {'verdict':>8} {'peak RSS MB':>12} {'judge ms/frame':>15} {'pyrender ms/frame':>18} "
+          f"{'judge/pyrender':>15} {'oracle in judge':>16} {'rest/pyrender':>14}")
+    for r in rows:
+        rest = r["judge_ms_per_frame"] - r["oracle_in_judge_ms_per_frame"]
+        print(f"{r['frames']:>7} {r['verdict']:>8} {r['peak_rss_mb']:>12.1f} {r['judge_ms_per_frame']:>15.2f} "
+              f"{r['pyrender_ms_per_frame']:>18.2f} {r['judge_ms_per_frame'] / r['pyrender_ms_per_frame']:>15.2f} "
+              f"{r['oracle_in_judge_ms_per_frame']:>16.2f} {rest / r['pyrender_ms_per_frame']:>14.2f}")
+    first, last = rows[0], rows[-1]
+    print(f"peak RSS {last['frames']} / {first['frames']} frames: {last['peak_rss_mb'] / first['peak_rss_mb']:.2f} "
+          "(target <= 1.5)")
+    print(f"judge / pyrender per frame ({last['frames']} frames): "
+          f"{last['judge_ms_per_frame'] / last['pyrender_ms_per_frame']:.2f} (target <= 1.5)")
+    print(f"# load at end {loadavg()}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

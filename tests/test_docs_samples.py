@@ -1,0 +1,151 @@
+"""What README.md and docs/*.md show is what the programs do.
+
+- every command sample (a block starting with a ``$`` line, or one marked ``<!-- command: -->``)
+  is run and its output compared with the doc (tests/docs_samples.py: times, dates and report
+  folders normalised; ``...`` elides lines). One run serves every sample showing the same
+  command (the main job is in README.md and docs/crosscheck.md);
+- the option tables of docs/renderer.md and docs/crosscheck.md name every option of the
+  parsers and no other;
+- every code fence is closed, and none is opened inside another.
+
+After a change of output, regenerate the samples: ``python tests/docs_samples.py --update``.
+"""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+import docs_samples as ds
+
+SAMPLES = [s for s in ds.all_samples() if s.not_run is None]
+
+
+@pytest.fixture(scope="module")
+def runner():
+    r = ds.Runner()
+    yield r
+    r.close()
+
+
+def _param(sample):
+    marks = [pytest.mark.slow] if sample.slow else []
+    return pytest.param(sample, id=sample.where, marks=marks)
+
+
+def test_the_docs_have_samples_of_each_program():
+    # a parser that finds nothing would pass every sample test below: the docs show at least
+    # the main job, a fault report, the renderer and the pytest plugin
+    commands = " ".join(c.text for s in SAMPLES for c in s.commands)
+    for program in ("crosscheck", "renderer", "pytest"):
+        assert program in commands
+    assert len(SAMPLES) >= 10
+
+
+@pytest.mark.parametrize("sample", [_param(s) for s in SAMPLES])
+def test_sample_is_what_the_program_prints(sample, runner):
+    problems = ds.check(sample, runner)
+    assert not problems, "\n\n".join(problems)
+
+
+def test_not_run_samples_say_why():
+    for s in ds.all_samples():
+        if s.not_run is not None:
+            assert len(s.not_run) >= 10, f"{s.where}: 'not run' needs a reason"
+
+
+# -- the comparison itself (hand-made outputs: no program run) --------------------------------
+
+def test_an_edited_number_is_a_difference():
+    doc = ["PASS: 21/21 cases, 504 frames", "Level pixels: vertex stage 1.59 ms/frame (11.9 s wall)"]
+    run = ["PASS: 21/21 cases, 504 frames", "Level pixels: vertex stage 4.27 ms/frame (42.7 s wall)"]
+    assert ds.matches(doc, run)                       # times differ: normalised
+    assert not ds.matches(["PASS: 20/21 cases, 504 frames", doc[1]], run)   # a count does not
+    assert not ds.matches(doc, run + ["Candidate precision: float64"])        # a line more
+
+
+def test_elision_stands_for_any_lines_and_only_where_it_is():
+    run = ["head", "a", "b", "c", "", "FAIL: 0/7", "Report: reports/20261127-042124/report.json"]
+    assert ds.matches(["head", "...", "", "FAIL: 0/7", "Report: reports/20261121-193000/report.json"], run)
+    assert ds.matches(["head", "a", "b", "c", "...", "FAIL: 0/7", "..."], run)
+    assert not ds.matches(["head", "...", "FAIL: 0/6", "..."], run)
+    assert not ds.matches(["a", "..."], run)          # the head is compared from the first line
+
+
+def test_update_keeps_the_shape_of_a_block():
+    doc = ["scene camera", "cube on_axis 1", "...", "  cube / on_axis: reason", "  ...", "",
+           "FAIL: 0/7 cases", "Report: reports/20261121-193000/report.json"]
+    run = ["scene camera", "cube on_axis 1", "cube oblique 2", "cube wide 3",
+           "  cube / on_axis: reason (float64 bound)", "  cube / oblique: reason", "",
+           "FAIL: 0/7 cases", "Candidate precision: float64", "Report: reports/20261127-042124/report.json"]
+    assert ds.reshape(doc, run) == [
+        "scene camera", "cube on_axis 1", "...", "  cube / on_axis: reason (float64 bound)",
+        "  ...", "", "FAIL: 0/7 cases", "Candidate precision: float64",
+        "Report: reports/20261127-042124/report.json"]
+    assert ds.matches(ds.reshape(doc, run), run)
+
+
+def test_update_then_check_round_trips(tmp_path):
+    doc = tmp_path / "page.md"
+    doc.write_text("Intro\n\n```\n$ printf 'a\\nb\\nc\\nd\\n'\na\n...\nd\nold line\n```\n\n"
+                   "    $ echo 'took 1.5 s'\n    took 9.9 s\n", encoding="utf-8")
+    runner = ds.Runner()
+    try:
+        (first, second) = ds.samples(doc)
+        assert ds.check(first, runner)                # "old line" is not printed
+        assert not ds.check(second, runner)           # a time: normalised
+        ds.update([doc], runner)
+        assert doc.read_text(encoding="utf-8") == (
+            "Intro\n\n```\n$ printf 'a\\nb\\nc\\nd\\n'\na\n...\nd\n```\n\n"
+            "    $ echo 'took 1.5 s'\n    took 1.5 s\n")
+        assert not any(ds.check(s, runner) for s in ds.samples(doc))
+    finally:
+        runner.close()
+
+
+# -- option tables --------------------------------------------------------------------------
+
+def _table_options(path):
+    """Every ``--option`` in the first column of the Markdown tables of ``path``."""
+    found = set()
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("|"):
+            first = re.split(r"(?<!\\)\|", line)[1]
+            found |= set(re.findall(r"--[a-z][a-z0-9-]*", first))
+    return found
+
+
+def _parser_options(parser):
+    return {s for a in parser._actions for s in a.option_strings
+            if s.startswith("--") and s != "--help"}
+
+
+@pytest.mark.parametrize("program", ["renderer", "crosscheck"])
+def test_option_table_is_the_parser(program):
+    if program == "renderer":
+        from wirecheck.core.cli import build_parser
+    else:
+        from wirecheck.oracles.cli import build_parser
+    documented = _table_options(ds.ROOT / "docs" / f"{program}.md")
+    real = _parser_options(build_parser())
+    assert "--version" in real and len(real) > 20      # the parser was read
+    assert not real - documented, f"options of {program} missing from docs/{program}.md's table"
+    assert not documented - real, f"docs/{program}.md documents options {program} does not have"
+
+
+# -- fences ---------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("path", ds.doc_files(), ids=lambda p: p.name)
+def test_fences_are_balanced(path):
+    assert ds.unbalanced_fences(path) == []
+
+
+def test_an_unbalanced_fence_is_found(tmp_path):
+    page = tmp_path / "p.md"
+    # crosscheck.md's old mistake: a report excerpt left open, so a heading became code and the
+    # next ```python closed it
+    page.write_text("```\nreport excerpt\n\n## Heading\n\n```python\ncode\n```\n", encoding="utf-8")
+    assert [m.split(": ", 1)[0][-6:] for m in ds.unbalanced_fences(page)] == ["p.md:6"]
+    page.write_text("text\n```\ncode\n", encoding="utf-8")
+    assert [m.split(": ", 1)[0][-6:] for m in ds.unbalanced_fences(page)] == ["p.md:2"]

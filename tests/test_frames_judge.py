@@ -1,0 +1,210 @@
+"""The frames path judged by the one judge (oracles.judge): lines, balance, per-edge counts, each threshold.
+
+A job is exported and its frames drawn by core (tests/test_frames_candidate.py
+shows how): core's exact frames must pass; the same frames with every line's
+last pixel dropped (tests/raster_mutants.drop_last, ~8 pixels a frame, all at
+one end) must fail as ``line_end_bias``, as on the projector path; and for
+each threshold a frame set where it alone turns pass into fail (every other
+criterion switched off, as tests/test_line_gate.py does for the projector
+path). The frames path and the projector path must count the same one-sided
+pixels for the same frames.
+"""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from wirecheck.core import raster
+from wirecheck.core.pipeline import render_frame
+from wirecheck.core.scene_files import load_scene
+from wirecheck.oracles import tolerances
+from wirecheck.oracles.cli import main
+from wirecheck.oracles.frames_candidate import frame_inputs, load_job
+from wirecheck.oracles.frames_judge import diagnosis_frames, run_frames
+from wirecheck.oracles.runner import CoreCandidate, Tolerances, run_crosscheck
+
+from raster_mutants import drop_last
+
+# frames 1 and 4 of 6 (the cube square-on and half a turn on), seen by an oblique camera and an orthographic one
+ARGS = ["--scene", "cube", "--cases", "oblique_roll,orthographic", "--frames", "6", "--every", "3"]
+
+# Every other criterion switched off so that only the one under test can decide
+# (as tests/test_line_gate.OPEN): F1 floors 0, balance alpha 0 (p < 0 never), counts of any size.
+OPEN = Tolerances(vertex_px=1.0, min_f1_1px=0.0, min_f1_0px=0.0, min_iou=0.0, balance_alpha=0.0,
+                  max_imbalance=1.0, max_edge_count_diff=10 ** 6)
+
+
+@pytest.fixture(scope="module")
+def job_dir(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("job") / "job"
+    assert main(["export", str(path)] + ARGS) == 0
+    return path
+
+
+def _fill(job_dir: Path, edit=lambda img: img) -> None:
+    """Draw every listed frame with core from the job's own files; ``edit`` changes the image first."""
+    job = load_job(job_dir)
+    for c in job["cases"]:
+        for rel in c["frames"]:
+            k = int(Path(rel).stem.split("_")[-1])
+            p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
+            (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
+            Image.fromarray(edit(render_frame(p, e, cam, m).image.copy())).save(job_dir / rel)
+
+
+def _filled(job_dir: Path, tmp: Path, edit=lambda img: img) -> Path:
+    d = tmp / "filled"
+    shutil.copytree(job_dir, d)
+    _fill(d, edit)
+    return d
+
+
+@pytest.fixture(scope="module")
+def exact(job_dir, tmp_path_factory) -> Path:
+    return _filled(job_dir, tmp_path_factory.mktemp("exact"))
+
+
+@pytest.fixture(scope="module")
+def short(job_dir, tmp_path_factory) -> Path:
+    """Core's frames with every line's last pixel dropped (the rasterizer patched while they are drawn)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(raster, "_line_pixels", drop_last)
+        return _filled(job_dir, tmp_path_factory.mktemp("short"))
+
+
+@pytest.fixture(scope="module")
+def stray(job_dir, tmp_path_factory) -> Path:
+    """Core's frames and pixel (0, 0), far from every line (F1@1px < 1, nothing else changes but balance)."""
+    def edit(img):
+        img[0, 0] = 255
+        return img
+    return _filled(job_dir, tmp_path_factory.mktemp("stray"), edit)
+
+
+def test_core_exact_frames_pass_with_line_scores(exact):
+    report, _ = run_frames(exact)
+    assert report["verdict"] == "pass", [c["reasons"] for c in report["cases"]]
+    for case in report["cases"]:
+        lines = case["lines"]
+        # core's exact lines against Mesa's: a few tie pixels decided either way, none systematic
+        assert abs(lines["imbalance_fraction"]) <= tolerances.MAX_IMBALANCE_FRACTION
+        assert lines["edge_count_max_diff"] <= 1 and lines["lines_compared"] > 0
+        assert case["faults"] == [] and all("candidate_only" in f for f in case["per_frame"])
+    # the report states every limit the frames were judged by, the line gate's included
+    assert report["tolerances"]["max_edge_count_diff"] == tolerances.MAX_EDGE_COUNT_DIFF
+    assert report["tolerances"]["balance_alpha"] == tolerances.BALANCE_ALPHA
+
+
+def test_frames_minus_each_last_pixel_fail_as_line_end_bias(short):
+    report, _ = run_frames(short)
+    assert report["verdict"] == "fail"
+    for case in report["cases"]:
+        # what the old frames judge saw: F1 at both tolerances above its floors (so it passed, exit 0)
+        assert case["pixel_f1_1px"] >= tolerances.MIN_F1_1PX and case["pixel_f1_0px"] >= tolerances.MIN_F1_0PX
+        assert case["verdict"] == "fail"
+        assert case["reasons"][0].startswith("one-sided pixels unbalanced"), case["reasons"]
+        assert case["lines"]["oracle_only"] > 5 * case["lines"]["candidate_only"]
+        (fault,) = case["faults"]
+        # most of the 12 lines lose their last pixel; some of those are drawn by a line starting
+        # there: as on the projector path (tests/test_line_gate.py), -0.3 to -1 per line
+        assert fault["name"] == "line_end_bias" and fault["end"] == "last", fault
+        assert -1.0 <= fault["pixels_per_line"] <= -0.3, fault
+
+
+def test_frames_cli_exit_1_for_the_short_lines(short, tmp_path, capsys):
+    assert main(["--candidate-frames", str(short), "--report-dir", str(tmp_path / "rep")]) == 1
+    assert "line_end_bias" in capsys.readouterr().out
+
+
+def test_both_paths_count_the_same_one_sided_pixels(monkeypatch, short):
+    """The projector path on core (rasterizer patched alike) against the frames path on core's PNGs."""
+    monkeypatch.setattr(raster, "_line_pixels", drop_last)
+    projector, _ = run_crosscheck([load_scene("cube")], CoreCandidate(), frames=6, every=3,
+                                  case_names=["oblique_roll", "orthographic"], animation=False)
+    frames, _ = run_frames(short)
+    keys = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "one_sided_by_place")
+    for p, f in zip(projector["cases"], frames["cases"]):
+        assert (p["scene"], p["camera"]) == (f["scene"], f["camera"])
+        assert {k: p["lines"][k] for k in keys} == {k: f["lines"][k] for k in keys}
+        assert [x["name"] for x in p["faults"]] == [x["name"] for x in f["faults"]] == ["line_end_bias"]
+
+
+# ---------------------------------------------------------------- each threshold decides, on the frames path
+
+def _decides(job, field, at, past, prefix, base=OPEN):
+    """``field`` = ``at`` passes, ``field`` = ``past`` fails, with exactly the one reason ``prefix``."""
+    ok, _ = run_frames(job, tol=replace(base, **{field: at}))
+    assert ok["verdict"] == "pass", [c["reasons"] for c in ok["cases"]]
+    bad, _ = run_frames(job, tol=replace(base, **{field: past}))
+    worst = [c for c in bad["cases"] if c["verdict"] == "fail"]
+    assert bad["verdict"] == "fail" and worst
+    for c in worst:
+        assert len(c["reasons"]) == 1 and c["reasons"][0].startswith(prefix), c["reasons"]
+
+
+def _lowest(job, key):
+    report, _ = run_frames(job, tol=OPEN)
+    assert report["verdict"] == "pass"
+    return min(c[key] for c in report["cases"])
+
+
+def test_min_f1_1px_decides_on_frames(stray):
+    f1 = _lowest(stray, "pixel_f1_1px")
+    assert 0.99 < f1 < 1.0                  # one stray pixel among ~1,000
+    _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
+
+
+def test_min_f1_0px_decides_on_frames(short):
+    f1 = _lowest(short, "pixel_f1_0px")
+    assert 0.98 < f1 < 1.0                  # ~8 end pixels among ~1,000
+    _decides(short, "min_f1_0px", f1, np.nextafter(f1, 2.0), "pixel F1@0px")
+
+
+def test_balance_decides_on_frames(short):
+    report, _ = run_frames(short, tol=OPEN)
+    fracs = [abs(c["lines"]["imbalance_fraction"]) for c in report["cases"]]
+    ps = [c["lines"]["balance_p_value"] for c in report["cases"]]
+    assert min(fracs) > 2e-3 and max(ps) < 1e-3     # ~8 of ~1,000 pixels a frame, all one-sided one way
+    # the net fraction alone (alpha 1: every p rejects symmetry): allowed up to the largest case's, then
+    # just below the smallest case's
+    _decides(short, "max_imbalance", max(fracs), np.nextafter(min(fracs), 0.0), "one-sided pixels unbalanced",
+             base=replace(OPEN, balance_alpha=1.0))
+    # the sign test alone (any net fraction too much): alpha 0 never rejects, just above the largest p does
+    _decides(short, "balance_alpha", 0.0, np.nextafter(max(ps), 2.0), "one-sided pixels unbalanced",
+             base=replace(OPEN, max_imbalance=0.0))
+
+
+def test_edge_count_decides_on_frames(short):
+    report, _ = run_frames(short, tol=OPEN)
+    worst = max(c["lines"]["edge_count_max_diff"] for c in report["cases"])
+    assert worst >= 1                       # a line one pixel short
+    _decides(short, "max_edge_count_diff", worst, worst - 1, "edge ")
+
+
+def test_diagnosis_frames_are_evenly_spread():
+    assert diagnosis_frames(5, 24) == {0, 1, 2, 3, 4}
+    # 720 frames, 24 kept: 0 and 719, steps of 719 / 23 = 31.26 rounded
+    kept = sorted(diagnosis_frames(720, 24))
+    assert len(kept) == 24 and kept[0] == 0 and kept[-1] == 719
+    assert all(31 <= b - a <= 32 for a, b in zip(kept, kept[1:]))
+
+
+def test_readme_says_when_every_frame_is_a_quarter_turn():
+    from wirecheck.oracles.export import build_job
+
+    cube = [load_scene("cube")]
+    # frame k turns (k - 1) / frames of a turn about X and Y (spin 1,1,0): with 4 frames, 0, 1/4, 1/2, 3/4
+    _job, files = build_job(cube, frames=4, case_names=["on_axis"])
+    readme = files["README.md"].decode()
+    assert "## What this job cannot reveal" in readme
+    assert "**Every frame of this job is a quarter-turn pose** (frames 1, 2, 3, 4 of\n4, spin 1,1,0)" in readme
+    # frames 1, 6, 11, 16, 21 of 24: frame 6 turns 5/24 of a turn = 5/6 of a quarter: oblique
+    _job, files = build_job(cube, frames=24, every=5, case_names=["on_axis"])
+    readme = files["README.md"].decode()
+    assert "## What this job cannot reveal" in readme and "quarter-turn pose" not in readme

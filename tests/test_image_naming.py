@@ -1,0 +1,57 @@
+"""oracles.image_naming: an offset is judged against the fitted model's own lines.
+
+A rectangle of axis-aligned lines is drawn by core's rasteriser, scaled 0.75 about the principal point
+(a pure FOV fault). Its edges lie at u = 98.7 and -90.65 px from the centre (cx = 319.5, cy = 239.5):
+the oracle's lines at x = 418.2 and 228.85 round by -0.2 and +0.15 (mean -0.025 px: no bias), the
+scaled ones at 393.525 and 251.5125 round by +0.475 and +0.4875 (mean +0.48 px): a correct drawing of
+the scaled lines sits 0.48 px off, beyond the 0.2-px offset tolerance, and is no pixel_offset.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wirecheck.core.camera import look_at
+from wirecheck.core.raster import line_pixels
+from wirecheck.oracles import image_diagnose
+from wirecheck.oracles.image_diagnose import OFFSET_TOL_PX, diagnose_images
+
+CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
+CX, CY = CAM.principal_point
+SCALE = 0.75
+
+
+def _rectangle(right, left, bottom, top):
+    c = np.array([[-left, -top], [right, -top], [right, bottom], [-left, bottom]]) + [CX, CY]
+    return np.stack([c, np.roll(c, -1, axis=0)], axis=1)
+
+
+def _draw(segs):
+    img = np.zeros((CAM.height, CAM.width), bool)
+    rr, cc = line_pixels(segs[:, 0], segs[:, 1], CAM.width, CAM.height)
+    img[rr, cc] = True
+    return img
+
+
+SEGS = [_rectangle(98.7, 90.65, 98.7, 90.65)] * 2
+CAND = [_draw((s - [CX, CY]) * SCALE + [CX, CY]) for s in SEGS]
+
+
+def test_rounding_of_the_scaled_lines_is_no_offset():
+    got = diagnose_images(CAND, SEGS, CAM)
+    assert [f["name"] for f in got] == ["fov_mismatch"], got
+    # two lines per axis, each rounded to its pixel: the scale to ~1 px over ~190 px, 5e-3 relative
+    assert got[0]["scale"] == pytest.approx(SCALE, abs=5e-3)
+
+
+def test_the_oracles_bias_would_have_named_an_offset(monkeypatch):
+    """The control: judged against the oracle lines' bias (-0.025 px) the 0.48 px is an offset."""
+    bias = image_diagnose.quantisation_bias
+    oracle_bias = bias(SEGS, CAM)
+    model_bias = bias(SEGS, CAM, np.eye(2), np.array([SCALE, SCALE]))
+    # hand-derived above: the model's lines sit 0.48 px off on both axes, the oracle's ~0
+    assert np.all(np.abs(oracle_bias) < 0.1) and np.all(np.abs(model_bias - 0.48) < 0.05)
+    assert np.max(np.abs(model_bias - oracle_bias)) > OFFSET_TOL_PX
+    monkeypatch.setattr(image_diagnose, "quantisation_bias", lambda segs, cam, p=None, d=None: bias(segs, cam))
+    assert "pixel_offset" in [f["name"] for f in diagnose_images(CAND, SEGS, CAM)]
