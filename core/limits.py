@@ -26,6 +26,11 @@ MAX_SIDE = 16384
 #: above 1000 x 1000), so the largest frame stays under 1 GB of memory.
 MAX_PIXELS = 2 ** 25
 
+#: Largest seconds a candidate's request may take (crosscheck --candidate-timeout, [tool.wirecheck],
+#: check_projector's timeout_s): one day. The wait is a ``poll`` whose timeout, in milliseconds, is a C int
+#: (at most 2^31 - 1 ms, 24.8 days: beyond it Python raises OverflowError); no request needs a day.
+MAX_CANDIDATE_TIMEOUT_S = 86_400.0
+
 #: Largest |turns| of a spin. Beyond 2^53 a float64 holds no fraction of a
 #: turn (every frame would be at phase 0), and (frame - 1) * turns must stay
 #: finite for the phase computation (core.transforms.Motion.frame_matrix).
@@ -60,3 +65,10 @@ def check_turns(turns, what: str) -> tuple:
             raise InputError(f"{what} {' '.join(f'{v:g}' for v in turns)}: expected turns with |t| <= 2^53 "
                              "(a float64 holds no fraction of a turn beyond; wirecheck.core.limits)")
     return tuple(turns)
+
+
+def check_candidate_timeout(seconds: float, option: str) -> None:
+    """InputError unless ``seconds`` is finite, > 0 and at most MAX_CANDIDATE_TIMEOUT_S."""
+    if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
+        raise InputError(f"{option} {seconds}: expected a number of seconds > 0 and at most "
+                         f"{MAX_CANDIDATE_TIMEOUT_S:.0f} (one day; core/limits.py)")

@@ -13,6 +13,7 @@ locked, written or removed.
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import os
 from pathlib import Path
@@ -42,7 +43,10 @@ class Lock:
         for _ in range(10):
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o666)
-            except OSError:          # a link (ELOOP), a folder (EISDIR), ...
+            except OSError as exc:
+                if exc.errno not in (errno.ELOOP, errno.EISDIR):      # not a link or a folder in its place
+                    raise InputError(f"{option} {what!r}: cannot create {self.path.name} there ({exc.strerror}): "
+                                     "expected a writable folder and a shorter name") from None
                 raise InputError(f"{option} {what!r}: {self.path.name} there was not written by wirecheck: "
                                  "expected a wirecheck output folder or a new one (nothing was changed)") from None
             try:

@@ -239,11 +239,11 @@ def _seconds(timeout_s) -> float:
 
     if isinstance(timeout_s, bool) or not isinstance(timeout_s, numbers.Real):
         raise TypeError(f"timeout_s {_short(timeout_s)}: expected a number of seconds > 0")
-    from .subprocess_candidate import MAX_TIMEOUT_S
+    from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 
-    if not (math.isfinite(timeout_s) and 0 < timeout_s <= MAX_TIMEOUT_S):
+    if not (math.isfinite(timeout_s) and 0 < timeout_s <= MAX_CANDIDATE_TIMEOUT_S):
         raise ValueError(f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0 and at most "
-                         f"{MAX_TIMEOUT_S:g} (one day)")
+                         f"{MAX_CANDIDATE_TIMEOUT_S:g} (one day)")
     return float(timeout_s)
 
 

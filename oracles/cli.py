@@ -72,6 +72,7 @@ interrupts_from_start("crosscheck")    # before the imports below: Ctrl-C while 
 from wirecheck.core.cli_help import CROSSCHECK_EXAMPLES, usage_hint  # noqa: E402
 from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
 from wirecheck.core.guard import VersionAction, run_cli  # noqa: E402
+from wirecheck.core.limits import check_candidate_timeout
 from wirecheck.core.output import check_replaceable, check_report_dir
 
 from . import gate, tolerances
@@ -368,11 +369,7 @@ def _external_option(args) -> str | None:
     if args.candidate is not None and args.candidate_cmd is not None:
         raise InputError(f"--candidate {args.candidate!r} with --candidate-cmd {args.candidate_cmd!r}: "
                          "expected one candidate")
-    from .subprocess_candidate import MAX_TIMEOUT_S
-
-    if not (math.isfinite(args.candidate_timeout) and 0 < args.candidate_timeout <= MAX_TIMEOUT_S):
-        raise InputError(f"--candidate-timeout {args.candidate_timeout}: expected a number of seconds > 0 "
-                         f"and at most {MAX_TIMEOUT_S:g} (one day)")
+    check_candidate_timeout(args.candidate_timeout, "--candidate-timeout")
     if args.candidate is not None:            # '' too: an empty candidate is an error, never core
         return f"--candidate {args.candidate!r}"
     return f"--candidate-cmd {args.candidate_cmd!r}" if args.candidate_cmd is not None else None

@@ -173,9 +173,9 @@ def validate(table: dict, path: Path) -> dict:
                 raise bad(key, value)
             out[key] = value
         elif key == "candidate-timeout":
-            from .subprocess_candidate import MAX_TIMEOUT_S
+            from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 
-            if not (number(value) and 0 < value <= MAX_TIMEOUT_S):
+            if not (number(value) and 0 < value <= MAX_CANDIDATE_TIMEOUT_S):
                 raise bad(key, value)
             out[key] = float(value)
         elif key == "candidate-precision":

@@ -55,9 +55,6 @@ from .candidate import CandidateError
 
 #: Default seconds a request may take (issue 15: a hang fails the case, not the run).
 DEFAULT_TIMEOUT_S = 10.0
-#: Largest --candidate-timeout: one day. The wait is a ``poll`` whose timeout, in milliseconds, is a C int
-#: (at most 2^31 - 1 ms, 24.8 days: beyond it Python raises OverflowError); no request needs a day.
-MAX_TIMEOUT_S = 86_400.0
 #: Start-up (until the program answers the header) gets at least this long: a
 #: Python host imports numpy and the candidate, ~0.3 s alone, seconds on a loaded machine.
 MIN_START_TIMEOUT_S = 10.0

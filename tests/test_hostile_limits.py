@@ -14,9 +14,9 @@ import time
 
 import pytest
 
+from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S as MAX_TIMEOUT_S
 from wirecheck.core.limits import MAX_FRAMES
 from wirecheck.oracles import cli as crosscheck_cli
-from wirecheck.oracles.subprocess_candidate import MAX_TIMEOUT_S
 
 import helpers                          # tests/ is on sys.path (rootdir conftest)
 

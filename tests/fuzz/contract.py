@@ -241,7 +241,7 @@ def setup_out(pick: Pick, box: Path, earlier: Path | None) -> str:
     """Create the output folder's starting state in ``box``; return the --out value."""
     out = box / "out"
     kind = pick.choice(["absent"] * 3 + ["empty", "decoys", "decoys", "earlier", "earlier", "earlier", "nested",
-                                          "file", "under_file", "long", "foreign_output"])
+                                          "file", "under_file", "long", "foreign_output", "user_in_output"])
     if kind == "absent":
         return str(out)
     if kind == "nested":
@@ -255,8 +255,12 @@ def setup_out(pick: Pick, box: Path, earlier: Path | None) -> str:
         out.write_bytes(DECOY)
         return str(out / "sub")
     out.mkdir()
-    if kind == "earlier" and earlier is not None:
+    if kind in ("earlier", "user_in_output") and earlier is not None:
         shutil.copytree(earlier, out, dirs_exist_ok=True, symlinks=True)
+    if kind == "user_in_output" and earlier is not None:    # issue 25: the user's file inside a folder of ours
+        where = pick.choice(["cube-frames/note.txt", "cube-frames/mine/note.txt", "cube-frames/frame_0099.png"])
+        (out / where).parent.mkdir(exist_ok=True)
+        (out / where).write_bytes(DECOY)
     if kind in ("decoys", "earlier", "foreign_output"):
         (out / "notes.txt").write_bytes(DECOY)
         old = out / pick.choice([".cube-frames.old", ".pyramid-frames.old", ".r.old"])
@@ -423,7 +427,9 @@ def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
     new = [p for p in after if p not in before]
     output_root = _output_root(argv, box, cli, o.stdout)
     for p in changed + gone:
-        if rc in (0, 1) and output_root is not None and _inside(box / p, output_root) and _is_output(p, box, output_root, cli, before):
+        decoy = before[p] == ("file", hashlib.sha256(DECOY).hexdigest())   # the user's, whatever its name
+        if (rc in (0, 1) and output_root is not None and _inside(box / p, output_root) and not decoy
+                and _is_output(p, box, output_root, cli, before)):
             continue                          # an earlier output of wirecheck's, replaced
         o.problems.append(f"user file touched: {p}")
     if rc not in (0, 1) and new:
