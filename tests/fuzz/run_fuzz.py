@@ -138,18 +138,19 @@ def fuzz_interrupts(n: int, seed: int, start: int = 0) -> dict:
     """``n`` renderer processes signalled at random moments (tests/fuzz/interrupts.py)."""
     from fuzz.interrupts import interrupt_one
 
-    codes, problems, examples = collections.Counter(), collections.Counter(), []
+    codes, problems, notes, examples = collections.Counter(), collections.Counter(), collections.Counter(), []
     t0 = time.perf_counter()
     for i in range(start, start + n):
         with tempfile.TemporaryDirectory(prefix="wirecheck-fuzz-sig-") as d:
             rc, found = interrupt_one(Pick(random.Random(f"{seed}-interrupt-{i}")), Path(d))
         codes[rc] += 1
         for p in found:
-            problems[p.split(":")[0]] += 1
-        if found and len(examples) < 10:
+            (notes if p.startswith("note: ") else problems)[p.split(":")[0] if not p.startswith("note: ") else p[6:]] += 1
+        if any(not p.startswith("note: ") for p in found) and len(examples) < 10:
             examples.append({"input": i, "rc": rc, "problems": found})
     return {"surface": "interrupt", "inputs": n, "seconds": round(time.perf_counter() - t0),
-            "exit_codes": dict(sorted(codes.items())), "problems": dict(problems), "examples": examples}
+            "exit_codes": dict(sorted(codes.items())), "problems": dict(problems), "notes": dict(notes),
+            "examples": examples}
 
 
 def main(argv=None) -> int:
