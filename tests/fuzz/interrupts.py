@@ -70,7 +70,7 @@ def interrupt_one(pick, box: Path, timeout_s: float = 60) -> tuple[int, list[str
         if not any(out.glob("a-report.json")):
             problems.append("exit 0 without the report")
     elif rc == -sig and not out.exists():
-        problems.append("note: killed by the kernel's default SIGTERM before wirecheck's first line")
+        problems.append("note: killed by the signal's default action before wirecheck's first line")
     else:
         problems.append(f"exit {rc} after {signal.Signals(sig).name}: {err.strip()[-200:]}")
     return rc, problems
