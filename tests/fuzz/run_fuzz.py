@@ -2,6 +2,8 @@
 
     nice .venv/bin/python tests/fuzz/run_fuzz.py --inputs 10000          # both CLIs (~40 min on 2 busy cores)
     .venv/bin/python tests/fuzz/run_fuzz.py --inputs 200 --cli renderer  # a quick look
+    .venv/bin/python tests/fuzz/run_fuzz.py --inputs 5000 --cli png      # damaged PNG frames (png_inputs.py)
+    .venv/bin/python tests/fuzz/run_fuzz.py --inputs 100 --cli interrupt # signals at random moments (interrupts.py)
 
 Prints, per CLI, the inputs run, the exit codes seen and the four counts the
 contract needs at 0 (tracebacks, exit codes outside {0, 1, 2, 3}, partial
