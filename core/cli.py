@@ -9,16 +9,16 @@ as one line with exit status 2.
 
 from __future__ import annotations
 
-import argparse
+from .startup import interrupts_from_start
+
+interrupts_from_start("renderer")      # first: Ctrl-C while the imports below run is one line, no traceback
+
+import argparse  # noqa: E402
 import importlib.util
 import math
 import os
 import sys
 from pathlib import Path
-
-from .guard import interrupts_from_start
-
-interrupts_from_start("renderer")      # before the imports below: Ctrl-C while starting is one line, no traceback
 
 
 def _load_numpy_single_threaded() -> None:

@@ -51,26 +51,6 @@ def _raise_interrupted(signum, frame):
     raise Interrupted(signum)
 
 
-def interrupts_from_start(prog: str) -> None:
-    """From the CLI module's first lines, until :func:`run_cli` takes over: SIGINT/SIGTERM end the process at once
-    with one line and 128 + the signal (nothing has been written yet), not a KeyboardInterrupt traceback from
-    the middle of an import (numpy, trimesh, pyrender take seconds on a busy machine).
-
-    Only in the console script ``prog`` itself (``sys.argv[0]``), in its main thread: a program or a test that
-    imports the CLI module keeps its own handlers.
-    """
-    if os.path.basename(sys.argv[0]) != prog or not _main_thread():
-        return
-
-    def starting(signum, frame):
-        os.write(2, f"{prog}: interrupted by {signal.Signals(signum).name} while starting: nothing written\n".encode())
-        os._exit(128 + signum)
-
-    starting.wirecheck_starting = True
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, starting)
-
-
 def error_line(prog: str, exc: BaseException) -> str | None:
     """The one stderr line for an error the user can act on, or None for a bug."""
     if isinstance(exc, InputError):

@@ -57,17 +57,17 @@ extremes`` runs the numerical-extremes suite (oracles/extremes/) and exits
 
 from __future__ import annotations
 
-import argparse
+from wirecheck.core.startup import interrupts_from_start
+
+interrupts_from_start("crosscheck")    # first: Ctrl-C while the imports below run is one line, no traceback
+
+import argparse  # noqa: E402
 import math
 import re
 import sys
 from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
-
-from wirecheck.core.guard import interrupts_from_start
-
-interrupts_from_start("crosscheck")    # before the imports below: Ctrl-C while starting is one line, no traceback
 
 from wirecheck.core.cli_help import CROSSCHECK_EXAMPLES, usage_hint  # noqa: E402
 from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402

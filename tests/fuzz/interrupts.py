@@ -16,10 +16,22 @@ import sys
 import time
 from pathlib import Path
 
+ROOT = Path(__file__).resolve().parent.parent.parent
+
 OBJ = "mtllib m.mtl\nusemtl x\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n"
 #: a 1x1 grey PNG, the material's texture
 TEXTURE = bytes.fromhex("89504e470d0a1a0a0000000d4948445200000001000000010800000000"
                         "3a7e9b550000000a49444154789c63600000000200015e8a1a6c0000000049454e44ae426082")
+
+
+def _before_first_line(err: str) -> bool:
+    """True when a KeyboardInterrupt traceback has no frame of core/cli.py past its interrupts_from_start line."""
+    import re
+
+    start = next(n for n, line in enumerate((ROOT / "core" / "cli.py").read_text().splitlines(), 1)
+                 if line.startswith("interrupts_from_start("))
+    lines = [int(m) for m in re.findall(r'core/cli\.py", line (\d+)', err)]
+    return "KeyboardInterrupt" in err and all(n <= start for n in lines)
 
 
 def interrupt_one(pick, box: Path, timeout_s: float = 60) -> tuple[int, list[str]]:
@@ -45,9 +57,9 @@ def interrupt_one(pick, box: Path, timeout_s: float = 60) -> tuple[int, list[str
         return -1, [f"timeout: over {timeout_s:g} s after {signal.Signals(sig).name}"]
     rc, problems = proc.returncode, []
     if "Traceback" in err:
-        where = "during the imports, before the CLI's guard" if "core/cli.py\", line" not in err.split(
-            "KeyboardInterrupt")[0].split("in main")[0] and "run_cli" not in err else "in the run"
-        problems.append(f"traceback on stderr ({where})")
+        if _before_first_line(err) and not out.exists():     # no code of wirecheck's ran yet: counted apart
+            return rc, ["note: interrupted in Python's own start-up (site, encodings), before wirecheck's first line"]
+        problems.append("traceback on stderr (in the run)")
     if rc == 128 + sig and "while starting: nothing written" in err:
         if out.exists():
             problems.append(f"exit {rc} while starting, with an output folder")
@@ -57,8 +69,8 @@ def interrupt_one(pick, box: Path, timeout_s: float = 60) -> tuple[int, list[str
     elif rc == 0:
         if not any(out.glob("a-report.json")):
             problems.append("exit 0 without the report")
-    elif rc == -sig and not out.exists() and not err:
-        pass            # before the CLI's first line ran (the interpreter's own start): the kernel's default
+    elif rc == -sig and not out.exists():
+        problems.append("note: killed by the signal's default action before wirecheck's first line")
     else:
         problems.append(f"exit {rc} after {signal.Signals(sig).name}: {err.strip()[-200:]}")
     return rc, problems

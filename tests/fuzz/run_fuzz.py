@@ -2,6 +2,8 @@
 
     nice .venv/bin/python tests/fuzz/run_fuzz.py --inputs 10000          # both CLIs (~40 min on 2 busy cores)
     .venv/bin/python tests/fuzz/run_fuzz.py --inputs 200 --cli renderer  # a quick look
+    .venv/bin/python tests/fuzz/run_fuzz.py --inputs 5000 --cli png      # damaged PNG frames (png_inputs.py)
+    .venv/bin/python tests/fuzz/run_fuzz.py --inputs 100 --cli interrupt # signals at random moments (interrupts.py)
 
 Prints, per CLI, the inputs run, the exit codes seen and the four counts the
 contract needs at 0 (tracebacks, exit codes outside {0, 1, 2, 3}, partial
@@ -138,18 +140,19 @@ def fuzz_interrupts(n: int, seed: int, start: int = 0) -> dict:
     """``n`` renderer processes signalled at random moments (tests/fuzz/interrupts.py)."""
     from fuzz.interrupts import interrupt_one
 
-    codes, problems, examples = collections.Counter(), collections.Counter(), []
+    codes, problems, notes, examples = collections.Counter(), collections.Counter(), collections.Counter(), []
     t0 = time.perf_counter()
     for i in range(start, start + n):
         with tempfile.TemporaryDirectory(prefix="wirecheck-fuzz-sig-") as d:
             rc, found = interrupt_one(Pick(random.Random(f"{seed}-interrupt-{i}")), Path(d))
         codes[rc] += 1
         for p in found:
-            problems[p.split(":")[0]] += 1
-        if found and len(examples) < 10:
+            (notes if p.startswith("note: ") else problems)[p.split(":")[0] if not p.startswith("note: ") else p[6:]] += 1
+        if any(not p.startswith("note: ") for p in found) and len(examples) < 10:
             examples.append({"input": i, "rc": rc, "problems": found})
     return {"surface": "interrupt", "inputs": n, "seconds": round(time.perf_counter() - t0),
-            "exit_codes": dict(sorted(codes.items())), "problems": dict(problems), "examples": examples}
+            "exit_codes": dict(sorted(codes.items())), "problems": dict(problems), "notes": dict(notes),
+            "examples": examples}
 
 
 def main(argv=None) -> int:
