@@ -130,6 +130,7 @@ def main(argv=None) -> int:
                     "'' for none)")
     ap.add_argument("--mutant-meshes", type=int, default=None,
                     help="run the mutants on the first N meshes only (default: all)")
+    ap.add_argument("--skip-core", action="store_true", help="run the mutants only (core's numbers from another run)")
     ap.add_argument("--quick", action="store_true", help="14 meshes, 2 cases (on_axis, orthographic) x 2 frames")
     ap.add_argument("--json", default=None, help="also write the results as JSON to this file")
     args = ap.parse_args(argv)
@@ -152,11 +153,13 @@ def main(argv=None) -> int:
               f"{max(m.vertices for m in made)} vertices, written in {time.perf_counter() - t0:.1f} s; "
               f"{args.frames} frames x {len(args.cases.split(','))} cases per mesh\n", flush=True)
         t0 = time.perf_counter()
-        rows = case_rows(run(tmp, args.frames, args.cases))
+        rows = {} if args.skip_core else case_rows(run(tmp, args.frames, args.cases))
         core_s = time.perf_counter() - t0
-        print(f"core as the candidate ({core_s:.0f} s, {core_s / len(made):.2f} s per mesh):")
+        if rows:
+            print(f"core as the candidate ({core_s:.0f} s, {core_s / len(made):.2f} s per mesh):")
         result = {}
-        for label, names in (("all", set(rows)), ("near", set(rows) - far), ("far", set(rows) & far)):
+        groups = (("all", set(rows)), ("near", set(rows) - far), ("far", set(rows) & far)) if rows else ()
+        for label, names in groups:
             cases = [c for name in names for c in rows[name]]
             k = sum(c[1] == "fail" for c in cases)
             bad = sum(any(c[1] == "fail" for c in rows[name]) for name in names)
