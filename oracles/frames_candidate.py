@@ -187,14 +187,21 @@ THRESHOLD_16 = 128 << 8
 
 
 def read_png(path: Path, width: int, height: int) -> np.ndarray:
-    """``(H, W)`` bool: drawn where the luminance over the rule's black background is >= 128.
+    """``(H, W)`` bool: drawn where the luminance over the rule's black background is >= 128 (:func:`read_grey`)."""
+    return read_grey(path, width, height) >= 128
+
+
+def read_grey(path: Path, width: int, height: int) -> np.ndarray:
+    """``(H, W)`` uint8: each pixel's luminance over the rule's black background, rounded down.
 
     One still PNG of the camera's size is expected; anything else is a
     :class:`FrameProblem`. A pixel's luminance is Pillow's (ITU-R 601-2) of its
     RGB, times its alpha (``A / 255``; palette transparency included): the
     pixel as it shows over black, so a transparent pixel is never drawn. 16-bit
-    grey is read at its full scale (:data:`THRESHOLD_16`). The size is checked
-    before any pixel is decoded (a huge image costs nothing).
+    grey is read by its high byte (:data:`THRESHOLD_16`). Rounded down, a value
+    is >= 128 exactly where the unrounded one is: the drawn pixels of the rule.
+    The grey levels are the coverage of antialiased lines (:mod:`oracles.line_style`).
+    The size is checked before any pixel is decoded (a huge image costs nothing).
     """
     from PIL import Image
 
@@ -208,15 +215,15 @@ def read_png(path: Path, width: int, height: int) -> np.ndarray:
             if im.size != (width, height):
                 raise FrameProblem(f"size {im.size[0]}x{im.size[1]}: expected {width}x{height} (the camera's)")
             im.load()
-            if im.mode in ("I", "I;16", "I;16B", "I;16L"):          # 16-bit grey
-                return np.asarray(im) >= THRESHOLD_16
+            if im.mode in ("I", "I;16", "I;16B", "I;16L"):          # 16-bit grey: its high byte
+                return (np.clip(np.asarray(im, dtype=np.int64), 0, 65535) >> 8).astype(np.uint8)
             if not (im.mode in ("RGBA", "LA", "PA", "RGBa", "La") or "transparency" in im.info):   # opaque
                 grey = im if im.mode == "L" else im.convert("RGB").convert("L")   # L, the usual: as it is
-                return np.asarray(grey) >= 128
+                return np.array(grey, dtype=np.uint8)
             rgba = im.convert("RGBA")
             grey = np.asarray(rgba.convert("RGB").convert("L"), dtype=np.uint16)
             alpha = np.asarray(rgba.getchannel("A"), dtype=np.uint16)
-    return grey * alpha >= 128 * 255           # exact (at most 255 * 255 < 2**16): grey >= 128 where opaque
+    return (grey * alpha // 255).astype(np.uint8)      # exact (at most 255 * 255 < 2**16); >= 128 iff grey * alpha >= 128 * 255
 
 
 def _walk(frames_dir: Path) -> list[Path]:
@@ -256,7 +263,8 @@ def _walk(frames_dir: Path) -> list[Path]:
 
 
 def load_frames(job_dir: Path, job: dict) -> dict:
-    """Every listed frame as a bool image: ``{(scene, case): [(k, image)]}``; FramesError listing every problem."""
+    """Every listed frame as a grey image (:func:`read_grey`): ``{(scene, case): [(k, image)]}``; FramesError listing
+    every problem."""
     job_dir = Path(job_dir)
     frames_dir = job_dir / "frames"
     if not frames_dir.is_dir():
@@ -285,7 +293,7 @@ def load_frames(job_dir: Path, job: dict) -> dict:
                 problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
                 continue
             try:
-                images.append((k, read_png(path, c["width"], c["height"])))
+                images.append((k, read_grey(path, c["width"], c["height"])))
             except FrameProblem as exc:
                 problems.append(f"{path}: {exc}")
             except Exception as exc:       # Pillow's many ways to say "not an image"
@@ -372,9 +380,16 @@ def _min_scores(scores: list[dict], prefix: str = "") -> dict:
     return {f"{prefix}{k}": float(min(s[k] for s in scores)) for k in keys}
 
 
-def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, diagnose: bool = True):
-    """One case: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion."""
+def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, diagnose: bool = True,
+               line_rule: str = "gl"):
+    """One case: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
+
+    ``images``: ``[(k, grey (H, W) uint8)]``; the style of their lines is read and their geometry
+    measured (:mod:`oracles.line_style`), ``line_rule`` says whether aliased lines are held to GL's rule.
+    """
     from wirecheck.core.pipeline import render_frame
+
+    from .line_style import CaseStyle
 
     from .image_diagnose import diagnose_images, flipped_camera, oracle_segments
 
@@ -383,9 +398,11 @@ def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, 
     worst = None
     cand_imgs, segs, flipped = [], [], []
     camera = None
-    for k, cand in images:
+    style = CaseStyle(line_rule)
+    for k, grey in images:
         p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k)
         orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
+        cand = style.frame(grey, orac, p_model, edges, camera, m)      # the pixels compared (>= 128)
         core = render_frame(p_model, edges, camera, m).image >= 128
         ps, cs = metrics.pixel_scores(cand, orac), metrics.pixel_scores(cand, core)
         pr_scores.append(ps)
@@ -417,6 +434,7 @@ def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, 
         reasons.append(f"pixel F1@1px {rec['pixel_f1_1px']:.4f} < {tol.min_f1_1px} (frame {rec['worst_pixel_frame']})")
     if rec["pixel_f1_0px"] < tol.min_f1_0px:
         reasons.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
+    reasons = style.judge(rec, reasons, tol)        # the line style's reading, its geometry and faults join
     if reasons and not rec["faults"]:
         # as the vertex diagnosis: a disagreement is never "no fault". Here no mirror, swap,
         # scale or offset explains the pixels: lines missing or extra, or another raster rule.
@@ -431,11 +449,13 @@ def judge_case(job_dir, job, scene: str, case: str, images: list, oracles, tol, 
 
 
 def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False) -> tuple[dict, dict]:
+               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
     """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
 
     A case where neither side drew a pixel is ``"vacuous"`` and fails the run
     unless ``allow_vacuous`` (as :mod:`oracles.gate`); no vertex is compared here.
+    ``line_rule``: ``"gl"`` holds aliased lines to GL's pixel rule, ``"geometry"``
+    judges where the lines are only (:mod:`oracles.line_style`).
 
     FramesError (exit 2) when the job or its frames are incomplete, of the
     wrong size, unreadable, or not this job's.
@@ -452,7 +472,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     try:
         for c in job["cases"]:
             rec, worst = judge_case(job_dir, job, c["scene"], c["case"], frames[(c["scene"], c["case"])],
-                                    oracles, tol, diagnose=diagnose)
+                                    oracles, tol, diagnose=diagnose, line_rule=line_rule)
             records.append(rec)
             images[(c["scene"], c["case"])] = worst
         gl = oracles.gl_info()
@@ -473,7 +493,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
         "motion": job["motion"],
         "tolerances": {"vertex_error_px": tol.vertex_px, "min_pixel_f1_1px": tol.min_f1_1px,
                        "min_pixel_f1_0px": tol.min_f1_0px},
-        "allow_vacuous": allow_vacuous, "compared": compared,
+        "allow_vacuous": allow_vacuous, "line_rule": line_rule, "compared": compared,
         "summary": {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
                     "vacuous": vacuous,
                     "max_vertex_error_px": None,

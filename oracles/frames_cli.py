@@ -115,7 +115,8 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
                      "(the renderer's files, only read): expected a report folder outside them")
     tol = Tolerances(min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
     try:
-        report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous)
+        report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous,
+                                    line_rule=args.line_rule or "gl")
     except InputError as exc:
         return _fail(str(exc))
     try:
