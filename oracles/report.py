@@ -47,6 +47,9 @@ FAULT_HINTS = {
     "line_pixel_bias": "the vertices agree but the candidate draws systematically more (or fewer) line pixels "
                        "than the oracle along the lines: check the line width (1 px) and the rounding of the "
                        "minor coordinate (nearest pixel centre)",
+    "raster_rule": "the lines are where the oracle's are but their pixels follow another aliased line rule than "
+                   "GL's (Pillow's, TinyGL's: ends snapped to pixel centres, another choice across the line): check "
+                   "the line rasteriser, not the camera; --line-rule geometry judges the geometry only",
     "precision_limited": "the error is the size of float32 rounding, not a convention error: compute in "
                          "float64 or declare float32 (--candidate-precision float32)",
     "depth_flip": "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
