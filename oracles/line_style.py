@@ -85,6 +85,11 @@ MIN_MASS = 0.5
 MAX_SAMPLES_PER_FRAME = 4000
 #: Fewer samples than this in a case: the geometry is not measured (too little free line).
 MIN_SAMPLES = 20
+#: The geometry is measured only where at least this share of the windows along the oracle's lines
+#: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
+MIN_FOUND_SHARE = 0.5
+#: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
+PLACEMENT_FAULTS = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal", "mirror_vertical")
 #: Aliased lines of another rule: the largest pooled centre offset (px) that is still "the geometry is
 #: right". A rule that snaps the ends to pixel centres (Pillow's ImageDraw.line, TinyGL) moves each line
 #: by up to half a pixel; pooled over a case's lines measured 0.00-0.27 px on the bundled scenes and
@@ -125,18 +130,20 @@ def _seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.hypot(*(foot - q[:, None, :]).transpose(2, 0, 1))
 
 
-def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME):
-    """The centroid samples of one frame: ``(normal (M, 2), offset (M,), segment (M,), width (M,))``.
+def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME) -> dict:
+    """The centroid samples of one frame (module docstring), as a dict of arrays of ``M`` samples.
 
     ``cov``: ``(H, W)`` float coverage (0 background, 1 a fully drawn pixel);
     ``segs``: ``(K, 2, 2)`` the oracle's segments in pixels. ``offset`` is the
-    measured centre minus the exact line, along the unit ``normal``; ``width``
-    the coverage across the line there (px, perpendicular to the line).
+    measured centre minus the exact line along the unit ``normal``, at
+    ``point`` on the exact line; ``width`` the coverage across the line there
+    (px, perpendicular to the line); ``segment`` its segment. ``windows``: the
+    windows looked at (clear of junctions), of which the ``M`` held a line.
     """
     h, w = cov.shape
     r = PROFILE_RADIUS_PX
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    normals, offsets, which, points, widths = [], [], [], [], []
+    parts = []
     for i, (a, b) in enumerate(segs):
         d = b - a
         length = float(np.hypot(*d))
@@ -147,12 +154,9 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
         guard = GUARD_PX * abs(d[major]) / length            # GUARD_PX along the line, on the major axis
         extent = w if major == 0 else h
         pos = np.arange(max(np.ceil(lo + guard), 0), min(np.floor(hi - guard), extent - 1) + 1)
-        if len(pos) == 0:
-            continue
         minor_exact = a[1 - major] + (pos - a[major]) * d[1 - major] / d[major]
         centre = np.rint(minor_exact)
-        minor_extent = h if major == 0 else w
-        inside = (centre - r >= 0) & (centre + r <= minor_extent - 1)
+        inside = (centre - r >= 0) & (centre + r <= (h if major == 0 else w) - 1)
         pos, minor_exact, centre = pos[inside], minor_exact[inside], centre[inside]
         if len(pos) == 0:
             continue
@@ -161,38 +165,59 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
         rows_i, cols_i = (win, cols) if major == 0 else (cols, win)
         g = cov[rows_i.astype(np.intp), cols_i.astype(np.intp)]
         mass = g.sum(axis=1)
-        ok = mass >= MIN_MASS
-        if not ok.any():
-            continue
-        centroid = (g[ok] * win[ok]).sum(axis=1) / mass[ok]
-        resid_minor = centroid - minor_exact[ok]                      # along the minor axis
+        centroid = (g * win).sum(axis=1) / np.maximum(mass, 1e-300)
         unit = d / length
         normal = np.array([-unit[1], unit[0]])
+        pt = np.empty((len(pos), 2))
+        pt[:, major], pt[:, 1 - major] = pos, minor_exact
         # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
-        offsets.append(resid_minor * normal[1 - major])
-        widths.append(mass[ok] * abs(normal[1 - major]))        # a column crosses the line at 1 / |n_minor|
-        normals.append(np.repeat(normal[None], ok.sum(), axis=0))
-        which.append(np.full(ok.sum(), i))
-        pt = np.empty((ok.sum(), 2))
-        pt[:, major], pt[:, 1 - major] = pos[ok], minor_exact[ok]
-        points.append(pt)
-    if not offsets:
-        return np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.intp), np.zeros(0)
-    normal, offset, seg, pt, width = (np.concatenate(normals), np.concatenate(offsets), np.concatenate(which),
-                                      np.concatenate(points), np.concatenate(widths))
-    if len(segs) > 1:                                   # drop samples near another segment (a junction, a crossing)
-        keep = np.ones(len(pt), bool)
-        for k in range(0, len(pt), 2048):
-            dist = _seg_distance(pt[k:k + 2048], segs[:, 0], segs[:, 1])
-            dist[np.arange(len(dist)), seg[k:k + 2048]] = np.inf
+        parts.append({"normal": np.repeat(normal[None], len(pos), axis=0),
+                      "offset": (centroid - minor_exact) * normal[1 - major],
+                      "width": mass * abs(normal[1 - major]),          # a column crosses the line at 1 / |n_minor|
+                      "segment": np.full(len(pos), i), "point": pt, "mass": mass})
+    keys = ("normal", "offset", "width", "segment", "point", "mass")
+    if not parts:
+        out = {k: np.zeros((0, 2)) if k in ("normal", "point") else np.zeros(0) for k in keys}
+        out["windows"] = 0
+        return out
+    out = {k: np.concatenate([p[k] for p in parts]) for k in keys}
+    if len(segs) > 1:                                   # drop windows near another segment (a junction, a crossing)
+        keep = np.ones(len(out["point"]), bool)
+        for k in range(0, len(keep), 2048):
+            dist = _seg_distance(out["point"][k:k + 2048], segs[:, 0], segs[:, 1])
+            dist[np.arange(len(dist)), out["segment"][k:k + 2048].astype(np.intp)] = np.inf
             keep[k:k + 2048] = dist.min(axis=1) > GUARD_PX
-        normal, offset, seg, width = normal[keep], offset[keep], seg[keep], width[keep]
-    keep = np.abs(offset) <= r - 0.5                    # a centroid at the window's edge is another line's
-    normal, offset, seg, width = normal[keep], offset[keep], seg[keep], width[keep]
-    if len(offset) > limit:
-        idx = np.linspace(0, len(offset) - 1, limit).round().astype(int)
-        normal, offset, seg, width = normal[idx], offset[idx], seg[idx], width[idx]
-    return normal, offset, seg, width
+        out = {k: v[keep] for k, v in out.items()}
+    windows = len(out["offset"])
+    # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
+    keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
+    out = {k: v[keep] for k, v in out.items()}
+    if len(out["offset"]) > limit:
+        idx = np.linspace(0, len(out["offset"]) - 1, limit).round().astype(int)
+        out = {k: v[idx] for k, v in out.items()}
+    out["windows"] = windows
+    return out
+
+
+def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre: np.ndarray):
+    """The map that moves the exact lines onto the measured centres: ``(d (2,), m (2, 2)) or None``.
+
+    Least squares of ``n . (d + m (p - centre)) = offset``: ``d`` the offset at
+    the principal point, ``m`` the scale, rotation and shear (``A - I``). None
+    when the samples cannot fix the six numbers (too few, or lines of too few
+    directions and places).
+    """
+    if len(offset) < MIN_SAMPLES:
+        return None
+    q = point - centre
+    design = np.column_stack([normal, normal[:, :1] * q, normal[:, 1:] * q])   # d_x, d_y, m_xx, m_xy, m_yx, m_yy
+    scale = np.maximum(np.abs(design).max(axis=0), 1e-12)
+    sv = np.linalg.svd(design / scale, compute_uv=False)
+    if sv[-1] < 1e-3 * sv[0]:
+        return None
+    x, *_ = np.linalg.lstsq(design / scale, offset, rcond=None)
+    x = x / scale
+    return x[:2], x[2:].reshape(2, 2)
 
 
 def pooled_offset(normal: np.ndarray, offset: np.ndarray):
@@ -266,7 +291,7 @@ class CaseStyle:
     ``frame`` is called once per frame with the candidate's grey image (it
     returns the bool pixels the F1 scores compare: drawn where >= 128, the
     rule of docs/frames.md); ``judge`` once, after the F1 reasons are known.
-    Only sums and samples are kept between frames, never an image.
+    Only sums, samples and the frames' segments are kept between frames, never an image.
     """
 
     def __init__(self, line_rule: str = "gl"):
@@ -275,10 +300,11 @@ class CaseStyle:
         self.line_rule = line_rule
         self.hist = np.zeros(256, np.int64)
         self.length_px = 0.0
-        self.samples = []                       # (normal, offset) per frame, coverage-normalised later
+        self.samples = []                       # measure() of each frame
         self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
                        "farther": 0}
-        self._frames = []                       # (segs, binary samples of the reference) per frame
+        self._frames = []                       # (segments, image shape) of each frame, for the reference
+        self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m) -> np.ndarray:
         """Read one frame (``grey`` ``(H, W)`` uint8, ``orac`` pyrender's bool pixels); the pixels compared."""
@@ -289,19 +315,22 @@ class CaseStyle:
         if grey.dtype == bool:
             grey = grey.astype(np.uint8) * 255
         segs = _segments(p_model, edges, camera, m)
+        self.centre = np.array(camera.principal_point, dtype=float)
         self.hist += np.bincount(grey.ravel(), minlength=256)[:256]
         if len(segs):
             _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
-        level = max(int(grey.max()), 1)
-        normal, offset, _, width = measure(grey / level, segs)
-        self.samples.append((normal, offset, width))
+        self.samples.append(measure(grey / max(int(grey.max()), 1), segs))     # the frame's line level is 1
         self._frames.append((segs, grey.shape))
         counts = _off_by_one(cand, orac, segs.reshape(-1, 2))
         self.raster = {k: v + counts[k] for k, v in self.raster.items()}
         return cand
 
     # ---- reading the case
+
+    def _pooled(self, key: str, samples=None) -> np.ndarray:
+        samples = self.samples if samples is None else samples
+        return np.concatenate([x[key] for x in samples]) if samples else np.zeros(0)
 
     def classify(self) -> dict:
         """``{"style", "width_px", "grey_share", "level"}`` from the pooled histogram and the samples' widths."""
@@ -313,7 +342,7 @@ class CaseStyle:
         level = int(np.searchsorted(cum, LEVEL_PERCENTILE / 100.0 * n)) + 1
         values = np.arange(1, 256)
         grey = drawn[(values > level / 8.0) & (values < level * 7.0 / 8.0)].sum()
-        widths = np.concatenate([x[2] for x in self.samples]) if self.samples else np.zeros(0)
+        widths = self._pooled("width")
         if len(widths) >= MIN_SAMPLES:          # across the free parts of the lines: no junction or crossing
             width = float(np.median(widths))
         else:                                   # too little free line: all coverage over the lines' length
@@ -323,24 +352,49 @@ class CaseStyle:
         style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
         return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level}
 
+    def _fit(self, samples):
+        """``(d (2,), affine)`` over ``samples``: ``d`` the pooled offset (:func:`pooled_offset`), ``affine``
+        the ``(d, m)`` of :func:`fit_lines` (None when not fixed); None with too few samples."""
+        normal, offset = self._pooled("normal", samples).reshape(-1, 2), self._pooled("offset", samples)
+        point = self._pooled("point", samples).reshape(-1, 2)
+        if len(offset) < MIN_SAMPLES:
+            return None
+        d, _ = pooled_offset(normal, offset)
+        return d, fit_lines(normal, offset, point, self.centre)
+
     def geometry(self, read: dict) -> dict:
-        """The pooled offset of the case's lines, and the bias a correct drawing of this style shows."""
-        normal = np.concatenate([s[0] for s in self.samples]) if self.samples else np.zeros((0, 2))
-        offset = np.concatenate([s[1] for s in self.samples]) if self.samples else np.zeros(0)
-        d, determined = pooled_offset(normal, offset)
-        bias = np.zeros(2)
-        binary = read["grey_share"] <= GREY_SHARE_MAX
-        if binary and determined.any():
-            rn, ro = [], []
-            for segs, shape in self._frames:
-                n_ref, o_ref, _, _ = measure(_reference(segs, shape, read["width_px"]).astype(float), segs)
-                rn.append(n_ref)
-                ro.append(o_ref)
-            bias, _ = pooled_offset(np.concatenate(rn), np.concatenate(ro))
-        return {"samples": int(len(offset)), "offset_px": [float(d[0]), float(d[1])],
-                "determined": [bool(determined[0]), bool(determined[1])],
-                "bias_px": [float(bias[0]), float(bias[1])],
-                "spread_px": float(np.std(offset)) if len(offset) else None}
+        """Where the case's lines are against the oracle's (module docstring), less what a correct drawing shows.
+
+        ``offset_px``: the pooled offset. ``warp_px``: how far, along the lines' normals, a scale, rotation
+        or shear moves them beyond that offset: the 99th percentile over the samples of the affine fit's
+        value there less the offset's (fitted values, not the map's parameters: lines of few directions
+        fix the values where the lines are, not the map everywhere).
+        """
+        windows = sum(x["windows"] for x in self.samples)
+        n = len(self._pooled("offset"))
+        geo = {"samples": n, "windows": windows, "found_share": n / windows if windows else 0.0,
+               "offset_px": None, "bias_px": None, "warp_px": None}
+        fit = self._fit(self.samples)
+        if fit is None:
+            return geo
+        d, affine = fit
+        ref_d, ref_affine = np.zeros(2), None
+        if read["grey_share"] <= GREY_SHARE_MAX:        # binary: quantised; the same measure on a correct drawing
+            ref = self._fit([measure(_reference(segs, shape, read["width_px"]).astype(float), segs)
+                             for segs, shape in self._frames])
+            if ref is not None:
+                ref_d, ref_affine = ref
+        normal, point = self._pooled("normal").reshape(-1, 2), self._pooled("point").reshape(-1, 2)
+
+        def fitted(aff, const):
+            if aff is None:
+                return np.zeros(len(normal))
+            return (normal * (aff[0] + (point - self.centre) @ aff[1].T - const)).sum(axis=1)
+
+        warp = np.abs(fitted(affine, d) - fitted(ref_affine, ref_d))
+        geo.update(offset_px=[float(v) for v in d - ref_d], bias_px=[float(v) for v in ref_d],
+                   warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0)
+        return geo
 
     def judge(self, rec: dict, reasons: list, tol) -> list:
         """The case's reasons with the style's judgement joined; ``rec`` gains ``line_style`` and faults.
@@ -348,16 +402,13 @@ class CaseStyle:
         ``reasons``: the F1 reasons (each starting "pixel F1@1px" or "pixel F1@0px").
         """
         from .diagnose import FAULT_ORDER
-        from .image_diagnose import OFFSET_TOL_PX
+        from .image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX
 
         read = self.classify()
         geo = self.geometry(read)
         style = read["style"]
-        by_rule = style == "aliased" and self.line_rule == "gl"
-        d, bias = np.array(geo["offset_px"]), np.array(geo["bias_px"])
-        measured = geo["samples"] >= MIN_SAMPLES
-        off = float(np.max(np.abs(d - bias)))
         aliased = style == "aliased"
+        by_rule = aliased and self.line_rule == "gl"
         tol_px = RULE_OFFSET_MAX_PX if aliased else OFFSET_TOL_PX
         out = {**read, "line_rule": self.line_rule,
                "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
@@ -369,33 +420,45 @@ class CaseStyle:
         f0 = [r for r in reasons if r.startswith("pixel F1@0px")]
         if not by_rule:
             reasons = [r for r in reasons if r not in f0]
-        # lines the registration finds mirrored, swapped or scaled are not where the oracle's are: a centroid
-        # of what lies near the oracle's lines then measures stray crossings, not an offset
-        placed = all(f["name"] in ("pixel_offset", "unexplained") for f in faults)
-        measured = measured and placed
-        if measured and off > tol_px and not aliased:
-            # the measured offset replaces the registration's (pooled over thick pixels, ~0.06 px off)
-            faults = [f for f in faults if f["name"] not in ("pixel_offset", "unexplained")]
-            faults.append({"name": "pixel_offset", "dx": float(d[0] - bias[0]), "dy": float(d[1] - bias[1]),
-                           "uncertainty_px": float(np.max(np.abs(bias))), "confidence": 1.0,
-                           "residual_px": geo["spread_px"], "measured_by": "line centroids"})
-        if measured and off > tol_px and not by_rule:
-            reasons.append(f"line centres offset by ({d[0] - bias[0]:.2f}, {d[1] - bias[1]:.2f}) px "
-                           f"> {tol_px} ({style} lines, {geo['samples']} samples)")
+        # lines mirrored or swapped, or mostly away from the oracle's, are not measured: a centroid of what
+        # lies near the oracle's lines would be of stray crossings; the registration's faults stand
+        placed = (geo["offset_px"] is not None and geo["found_share"] >= MIN_FOUND_SHARE
+                  and not any(f["name"] in PLACEMENT_FAULTS for f in faults))
+        d = np.array(geo["offset_px"]) if placed else np.zeros(2)
+        off = float(np.max(np.abs(d)))
+        moved = placed and off > tol_px
+        # binary lines are quantised line by line (up to half a pixel each, which the reference drawing
+        # matches only for its own rule): their warp is judged with that half pixel added
+        warp_tol = SCALE_TOL_PX + (0.5 if read["grey_share"] <= GREY_SHARE_MAX else 0.0)
+        out["warp_tol_px"] = warp_tol
+        warped = placed and geo["warp_px"] > warp_tol
+        if placed and not by_rule:
+            # the centres are finer than the registration over thick or other-rule pixels: its offset and
+            # scale faults give way to the measure's
+            faults = [f for f in faults if f["name"] not in ("pixel_offset", "fov_mismatch", "aspect_mismatch")
+                      or warped and f["name"] != "pixel_offset"]
+            if moved:
+                faults = [f for f in faults if f["name"] != "unexplained"]
+                faults.append({"name": "pixel_offset", "dx": float(d[0]), "dy": float(d[1]),
+                               "uncertainty_px": float(np.max(np.abs(geo["bias_px"]))), "confidence": 1.0,
+                               "residual_px": None, "measured_by": "line centroids"})
+                reasons.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {tol_px} "
+                               f"({style} lines, {geo['samples']} samples)")
+            if warped:
+                reasons.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
+                               f"or shear > {warp_tol} ({style} lines)")
         rs = self.raster
         if aliased and rs["differing"]:
             out["raster_rule"] = {
                 "share_off_by_one_across": rs["off_by_one_across"] / max(rs["oracle_pixels"], 1),
                 "share_off_by_one_at_ends": rs["off_by_one_at_ends"] / max(rs["oracle_pixels"], 1),
                 "share_farther": rs["farther"] / max(rs["oracle_pixels"], 1)}
-        geometry_right = measured and off <= tol_px
-        if aliased and not by_rule and geometry_right:      # the geometry only: within the rule's snap
-            faults = [f for f in faults if f["name"] != "pixel_offset"]
-        if by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0:
+        geometry_right = placed and not moved and not warped
+        if by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0 \
+                and all(f["name"] in ("unexplained", "pixel_offset") for f in faults):
             faults = [f for f in faults if f["name"] not in ("unexplained", "pixel_offset")]
             faults.append({"name": "raster_rule", **out["raster_rule"], "confidence": 1.0,
-                           "offset_px": [float(d[0] - bias[0]), float(d[1] - bias[1])],
-                           "residual_px": geo["spread_px"],
+                           "offset_px": [float(d[0]), float(d[1])], "residual_px": None,
                            "note": f"the lines are where the oracle's are (centres within {off:.2f} px) but "
                                    "their pixels follow another line rule than GL's: check the line "
                                    "rasteriser (its rule across the line and at the ends), not the camera; "

@@ -123,6 +123,22 @@ def test_half_pixel_offset_is_measured(job_dir, tmp_path, capsys, draw):
         assert any("line centres offset" in r for r in c["reasons"])
 
 
+def test_a_small_scale_error_of_antialiased_lines_fails(job_dir, tmp_path, capsys):
+    # the lines scaled about the principal point so that the farthest end moves 0.8 px: within F1@1px's
+    # 1 px, so only the measured centres can fail it (0.8 > SCALE_TOL_PX, 0.5)
+    def scaled(segs, w, h):
+        c = np.array([(w - 1) / 2.0, (h - 1) / 2.0])       # the principal point of the job's centred cameras
+        reach = np.max(np.hypot(*(segs.reshape(-1, 2) - c).T))
+        return draw_antialiased(c + (segs - c) * (1.0 + 0.8 / reach), w, h)
+
+    rc, report = _judge(_fill(job_dir, tmp_path, scaled), tmp_path)
+    assert rc == 1
+    for c in report["cases"]:
+        assert c["verdict"] == "fail", c["line_style"]["geometry"]
+        assert any("moved by up to" in r for r in c["reasons"]), c["reasons"]
+        assert 0.5 < c["line_style"]["geometry"]["warp_px"] <= 0.8 + 0.05
+
+
 def test_pillow_rule_is_named_raster_rule(job_dir, tmp_path, capsys):
     job = _fill(job_dir, tmp_path, draw_pillow)
     rc, report = _judge(job, tmp_path)
@@ -168,7 +184,8 @@ def test_measure_recovers_a_known_offset():
     a, b = np.array([20.0, 30.0]), np.array([180.0, 30.0 + 160.0 * np.tan(np.radians(20))])
     n = np.array([-(b - a)[1], (b - a)[0]]) / np.hypot(*(b - a))
     img = _band(np.array([[a, b]]) + 0.3 * n, 200, 120, 0.5, 4) / 255.0
-    normal, offset, _seg, width = measure(img, np.array([[a, b]]))
+    got = measure(img, np.array([[a, b]]))
+    normal, offset, width = got["normal"], got["offset"], got["width"]
     assert len(offset) > 100 and MIN_MASS < 1.0
     assert np.median(offset) == pytest.approx(0.3, abs=0.01)
     assert np.median(width) == pytest.approx(1.0, abs=0.05)
