@@ -18,21 +18,28 @@ The width is the median coverage across the line over the samples below (a
 1-px aliased line 0.71 to 1, a 1-px antialiased line 1, a 3-px line 3); with too
 few samples, the drawn coverage per unit length of the lines in the image.
 
-Geometry (:class:`CaseStyle`): each oracle segment (``p0_px``, ``p1_px``,
-:func:`oracles.image_diagnose.oracle_segments`, from the job's cameras) is
-sampled at every integer step of its major axis; at each step the
-intensity-weighted centroid of the image across the line (along the minor
-axis, :data:`PROFILE_RADIUS_PX` each side) is the line's centre there. Samples
-within :data:`GUARD_PX` of another segment or of the segment's own ends
-(junctions: another line's pixels pull the centroid) are dropped. The
+Geometry (:class:`CaseStyle`, :func:`measure`): each oracle segment
+(``p0_px``, ``p1_px``, :func:`oracles.image_diagnose.oracle_segments`, from the
+job's cameras) is sampled at every integer step of its major axis; at each
+step the intensity-weighted centroid of the image across the line (along the
+minor axis, :data:`PROFILE_RADIUS_PX` each side) is the line's centre there.
+Windows within :data:`GUARD_PX` of another segment or of the segment's own
+ends (junctions: another line's pixels pull the centroid) are dropped. The
 centroid's distance from the exact line, along the line's normal, is the
-sample's offset; the case's offset ``(dx, dy)`` is the least-squares solution
-of ``n . (dx, dy) = offset`` over every sample of every frame. For binary
-styles the same measure on a correct drawing of the same lines (core's GL-like
-raster for aliased lines; pixel centres within half the width for wide ones)
-gives the quantisation bias (lines at one fractional position, a cube
-square-on, sit up to half a pixel off in every correct drawing); the offset is
-judged against it, as in :func:`oracles.image_diagnose.quantisation_bias`.
+sample's offset. Pooled over every sample of a case's frames:
+
+- ``offset_px``: the least-squares ``(dx, dy)`` of ``n . (dx, dy) = offset``;
+- ``warp_px``: how much more an affine map (a scale, rotation or shear about
+  the principal point) moves the lines, along their normals, than that
+  offset (the 99th percentile over the samples, :meth:`CaseStyle.geometry`).
+
+For binary styles the same measure on a correct drawing of the same lines
+(core's GL-like raster for aliased lines; pixel centres within half the width
+for wide ones) is subtracted: lines at one fractional position (a cube
+square-on) sit up to half a pixel off in every correct drawing, as in
+:func:`oracles.image_diagnose.quantisation_bias`. Lines that the registration
+finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
+the windows, are not measured (the centroids would be of stray crossings).
 
 Raster rule (aliased lines): the pixels where the candidate and pyrender
 differ are counted; one with a pixel of the other side among its 8 neighbours
@@ -42,14 +49,18 @@ across the line otherwise.
 The verdict (:meth:`CaseStyle.judge`):
 
 - ``aliased`` with ``line_rule="gl"`` (default): F1@0px holds, as before.
-  When F1@0px alone fails, the geometry measures right and every differing
-  pixel is off by one, the fault is ``raster_rule`` (the shares across the
-  line and at the ends), never ``unexplained``.
+  When F1@0px alone fails, the lines are measured in place (offset within
+  :data:`RULE_OFFSET_MAX_PX`, no warp) and every differing pixel is off by
+  one, the fault is ``raster_rule`` (the shares across the line and at the
+  ends), never ``unexplained``.
 - ``antialiased`` and ``wide``, or any style with ``line_rule="geometry"``:
   F1@0px is reported, not judged (an antialiased or wide image cannot be held
   to GL's pixel rule); the geometry is judged instead: an offset beyond
-  :data:`oracles.image_diagnose.OFFSET_TOL_PX` fails as ``pixel_offset`` with
-  the measured ``dx, dy``. F1@1px holds for every style.
+  :data:`oracles.image_diagnose.OFFSET_TOL_PX` (aliased lines of another rule:
+  :data:`RULE_OFFSET_MAX_PX`) fails as ``pixel_offset`` with the measured
+  ``dx, dy``, a warp beyond :data:`oracles.image_diagnose.SCALE_TOL_PX` (binary
+  lines: half a pixel more) fails too; the registration's offset and scale
+  faults give way to the measure's. F1@1px holds for every style.
 """
 
 from __future__ import annotations
