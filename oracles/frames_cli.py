@@ -89,6 +89,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     frames do not use, so they are not usage errors here.
     """
     from .frames_candidate import run_frames
+    from .line_style import summary_lines
     from .report import console_table, write_report
     from .tolerances import Tolerances
 
@@ -130,6 +131,8 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     except OSError as exc:
         return _fail(f"writing {str(run_dir)!r} or the JUnit file failed: {exc}")
     print(console_table(report["cases"]))
+    for line in summary_lines(report["cases"]):
+        print(line)
     for r in report["cases"]:
         if r["verdict"] != "pass":          # failed, or vacuous (compared nothing)
             print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))

@@ -477,3 +477,20 @@ class CaseStyle:
         rec["faults"] = sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
         rec["line_style"] = out
         return reasons
+
+
+def summary_lines(cases: list) -> list[str]:
+    """One line per line style read in a run's cases (``line_style`` of each): the style, the cases
+    and widths, how they were judged and what the style cannot show. Empty when no case has one."""
+    by = {}
+    for c in cases:
+        ls = c.get("line_style")
+        if ls:
+            by.setdefault((ls["style"], ls["line_rule"]), []).append(ls)
+    out = []
+    for (style, rule), rows in sorted(by.items()):
+        widths = [r["width_px"] for r in rows]
+        out.append(f"Line style read: {style} ({len(rows)} case{'s' if len(rows) != 1 else ''}, "
+                   f"{min(widths):.2f}-{max(widths):.2f} px wide, --line-rule {rule}): judged by "
+                   f"{rows[0]['judged_by']}; cannot show {CANNOT_SHOW[style]}")
+    return out

@@ -285,6 +285,13 @@ def case_notes(report: dict) -> list[tuple[dict, str]]:
     return notes
 
 
+def _line_styles(report: dict) -> list[str]:
+    """The line styles read from a renderer's frames (--candidate-frames; oracles.line_style)."""
+    from .line_style import summary_lines
+
+    return summary_lines(report["cases"])
+
+
 def markdown(report: dict, files: set | None = None) -> str:
     """report.md; ``files``: the figures written beside it (linked when present)."""
     files = files or set()
@@ -303,6 +310,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
            *([f"Candidate precision: {precision_text(report)} (oracles/tolerances.py).", ""]
              if precision_text(report) else []),
+           *[x for line in _line_styles(report) for x in (line + ".", "")],
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
         out.append("| " + " | ".join(r) + " |")

@@ -108,6 +108,10 @@ def test_correct_antialiased_and_wide_lines_pass(job_dir, tmp_path, capsys, draw
         # 3 px: each pixel centre within 1.5 px of the line, about 3 pixels across; 1 px antialiased: 1
         assert c["line_style"]["width_px"] == pytest.approx(3.0 if style == "wide" else 1.0, abs=0.1)
         assert "GL's pixel rule" in c["line_style"]["cannot_show"]
+    # the report says which style was read, how it was judged and what it cannot show
+    said = f"Line style read: {style} (4 cases"
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert said in out and said in md and "cannot show GL's pixel rule" in md
 
 
 @pytest.mark.parametrize("draw", [draw_antialiased, draw_wide], ids=["antialiased", "3px"])
