@@ -99,6 +99,18 @@ MIN_SAMPLES = 20
 #: The geometry is measured only where at least this share of the windows along the oracle's lines
 #: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
 MIN_FOUND_SHARE = 0.5
+#: A segment end is measured when no other segment comes this close to it (px): the profile along the
+#: line (4 px past the end) stays clear of every other line's window.
+FREE_END_PX = GUARD_PX + 4.0
+#: Along-line profile of an end: from this far inside the line (px) to END_REACH_PX past its end.
+END_INSIDE_PX = 6.0
+END_REACH_PX = 4.0
+#: An end is short when the line's coverage falls to half before this (px, negative: inside the
+#: segment; a butt end falls at 0, a round or square cap up to half the width past it), long when
+#: it stays above half this far past half the width. A dropped or added pixel moves it by 1.
+END_TOL_PX = 0.5
+#: Ends a case must have measured for their median to be judged.
+MIN_ENDS = 4
 #: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
 PLACEMENT_FAULTS = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal", "mirror_vertical")
 #: Aliased lines of another rule: the largest pooled centre offset (px) that is still "the geometry is
@@ -210,6 +222,62 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     return out
 
 
+def _bilinear(cov: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Coverage at points ``q (..., 2)`` (x, y; pixel centres at integers), bilinear; 0 outside."""
+    h, w = cov.shape
+    x0, y0 = np.floor(q[..., 0]).astype(np.intp), np.floor(q[..., 1]).astype(np.intp)
+    fx, fy = q[..., 0] - x0, q[..., 1] - y0
+    out = np.zeros(q.shape[:-1])
+    for dx, dy, wgt in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)), (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
+        xx, yy = x0 + dx, y0 + dy
+        ok = (xx >= 0) & (xx < w) & (yy >= 0) & (yy < h)
+        out[ok] += wgt[ok] * cov[yy[ok], xx[ok]]
+    return out
+
+
+def measure_ends(cov: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """Where each free end of the oracle's segments stops in the image: ``(E,)`` px past the exact end.
+
+    An end is free when inside the image (the profile too) and no other
+    segment comes within :data:`FREE_END_PX`. Along the line, from
+    :data:`END_INSIDE_PX` inside to :data:`END_REACH_PX` past the end, every
+    0.25 px, the coverage summed across the line (bilinear, 0.5 px steps,
+    :data:`PROFILE_RADIUS_PX` each side) is the line's width there; the end is
+    where it last falls to half the width of the line's inner part.
+    """
+    h, w = cov.shape
+    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+    out = []
+    s = np.arange(-END_INSIDE_PX, END_REACH_PX + 1e-9, 0.25)
+    t = np.arange(-PROFILE_RADIUS_PX, PROFILE_RADIUS_PX + 1e-9, 0.5)
+    margin = PROFILE_RADIUS_PX + END_REACH_PX + 2
+    for i, (a, b) in enumerate(segs):
+        length = float(np.hypot(*(b - a)))
+        if length < END_INSIDE_PX + 2:
+            continue
+        unit = (b - a) / length
+        normal = np.array([-unit[1], unit[0]])
+        others = np.delete(segs, i, axis=0)
+        for end, out_dir in ((a, -unit), (b, unit)):
+            if not (margin <= end[0] <= w - 1 - margin and margin <= end[1] <= h - 1 - margin):
+                continue
+            if len(others) and _seg_distance(end[None], others[:, 0], others[:, 1]).min() <= FREE_END_PX:
+                continue
+            q = end + s[:, None, None] * out_dir + t[None, :, None] * normal      # (len(s), len(t), 2)
+            mass = _bilinear(cov, q).sum(axis=1) * 0.5
+            inner = float(np.median(mass[s <= -2.5]))
+            if inner < MIN_MASS:
+                continue
+            above = np.flatnonzero(mass >= inner / 2.0)
+            k = above.max()
+            if k + 1 >= len(s):                      # still drawn at the end of the reach
+                out.append(float(s[-1]))
+                continue
+            m0, m1 = mass[k], mass[k + 1]         # cross half the inner width between s[k] and s[k + 1]
+            out.append(float(s[k] + (s[k + 1] - s[k]) * (m0 - inner / 2.0) / max(m0 - m1, 1e-12)))
+    return np.asarray(out)
+
+
 def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre: np.ndarray):
     """The map that moves the exact lines onto the measured centres: ``(d (2,), m (2, 2)) or None``.
 
@@ -312,6 +380,7 @@ class CaseStyle:
         self.hist = np.zeros(256, np.int64)
         self.length_px = 0.0
         self.samples = []                       # measure() of each frame
+        self.ends = []                          # measure_ends() of each frame
         self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
                        "farther": 0}
         self._frames = []                       # (segments, image shape) of each frame, for the reference
@@ -331,7 +400,9 @@ class CaseStyle:
         if len(segs):
             _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
-        self.samples.append(measure(grey / max(int(grey.max()), 1), segs))     # the frame's line level is 1
+        cov = grey / max(int(grey.max()), 1)                                   # the frame's line level is 1
+        self.samples.append(measure(cov, segs))
+        self.ends.append(measure_ends(cov, segs))
         self._frames.append((segs, grey.shape))
         counts = _off_by_one(cand, orac, segs.reshape(-1, 2))
         self.raster = {k: v + counts[k] for k, v in self.raster.items()}
@@ -383,8 +454,10 @@ class CaseStyle:
         """
         windows = sum(x["windows"] for x in self.samples)
         n = len(self._pooled("offset"))
+        ends = np.concatenate(self.ends) if self.ends else np.zeros(0)
         geo = {"samples": n, "windows": windows, "found_share": n / windows if windows else 0.0,
-               "offset_px": None, "bias_px": None, "warp_px": None}
+               "offset_px": None, "bias_px": None, "warp_px": None, "ends_measured": int(len(ends)),
+               "end_px": float(np.median(ends)) if len(ends) else None}
         fit = self._fit(self.samples)
         if fit is None:
             return geo
@@ -455,6 +528,16 @@ class CaseStyle:
                                "residual_px": None, "measured_by": "line centroids"})
                 reasons.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {tol_px} "
                                f"({style} lines, {geo['samples']} samples)")
+            end = geo["end_px"]
+            if geo["ends_measured"] >= MIN_ENDS and (end < -END_TOL_PX or end > read["width_px"] / 2 + END_TOL_PX):
+                short = end < 0
+                faults.append({"name": "line_end_bias", "end_px": end, "ends_measured": geo["ends_measured"],
+                               "confidence": 1.0, "residual_px": None, "measured_by": "line ends",
+                               "note": f"the lines {'stop' if short else 'run on'} {abs(end):.2f} px "
+                                       f"{'before' if short else 'past'} their ends (median of "
+                                       f"{geo['ends_measured']} free ends; a cap may add half the width)"})
+                reasons.append(f"line ends {end:+.2f} px from the segments' ends: expected "
+                               f"{-END_TOL_PX} to {read['width_px'] / 2 + END_TOL_PX:.2f} ({style} lines)")
             if warped:
                 reasons.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
                                f"or shear > {warp_tol} ({style} lines)")

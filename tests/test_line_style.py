@@ -214,3 +214,32 @@ def test_line_rule_needs_frames(tmp_path, capsys):
                "--report-dir", str(tmp_path / "rep")])
     err = capsys.readouterr().err
     assert rc == 2 and "--line-rule geometry without --candidate-frames" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("short_px, named", [(0.0, False), (1.0, True), (-1.0, True)],
+                         ids=["correct", "dropped", "extra"])
+def test_a_dropped_or_extra_end_is_named(short_px, named):
+    # three separate lines (six free ends) seen by an orthographic camera at 1 px per unit, drawn
+    # antialiased (round caps of radius 0.5: the cap's chord is half the width 0.43 px past the end;
+    # measured 0.27-0.46 with the end's sub-pixel phase), with 1 px dropped from (or added to) each
+    # end: measured -0.73..-0.54 / 1.25..1.51, beyond -END_TOL_PX (-0.5) / width / 2 + END_TOL_PX (1.0)
+    from wirecheck.core.camera import Camera
+    from wirecheck.oracles.line_style import CaseStyle
+
+    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
+                 projection="orthographic", ortho_height=140.0)
+    p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0],
+                  [40.0, 40.0, 0.0], [80.3, -40.7, 0.0]])
+    edges = np.array([[0, 1], [2, 3], [4, 5]])
+    segs = oracle_segments(p, edges, cam)
+    u = (segs[:, 1] - segs[:, 0]) / np.hypot(*(segs[:, 1] - segs[:, 0]).T)[:, None]
+    drawn = np.stack([segs[:, 0] + short_px * u, segs[:, 1] - short_px * u], axis=1)
+    style = CaseStyle()
+    style.frame(draw_antialiased(drawn, 220, 140), np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
+    rec = {"faults": []}
+    reasons = style.judge(rec, [], None)
+    geo = rec["line_style"]["geometry"]
+    assert rec["line_style"]["style"] == "antialiased" and geo["ends_measured"] == 6
+    assert geo["end_px"] == pytest.approx(0.37 - short_px, abs=0.15)
+    assert [f["name"] for f in rec["faults"]] == (["line_end_bias"] if named else [])
+    assert any("line ends" in r for r in reasons) == named
