@@ -109,7 +109,11 @@ def test_three_js_has_no_named_fault(judged):
     # line_pixel_bias there (measured: 15 oracle-only vs 0 decided candidate-only pixels, edge 3 -10).
     # Known, for the tie rule to settle (issue 23); every other case names nothing.
     assert named.pop(("cube", "narrow_fov")) in ([], ["unexplained"], ["line_pixel_bias"], ["raster_rule"])
-    assert all(names in ([], ["unexplained"], ["raster_rule"]) for names in named.values()), named
+    # SwiftShader's line rule is not Mesa's: where it differs, a raster fault (raster_rule, or the
+    # one-sided counts' line_pixel_bias where F1@0px itself holds), never a convention fault
+    odd = {key: names for key, names in named.items()
+           if names not in ([], ["unexplained"], ["raster_rule"], ["line_pixel_bias"])}
+    assert not odd, odd
     # a case failing by F1@0px alone (SwiftShader's line rule, not Mesa's) is named for its rule
     for c in report["cases"]:
         if c["reasons"] and all(r.startswith("pixel F1@0px") for r in c["reasons"]):
