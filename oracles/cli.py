@@ -137,6 +137,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
                    help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
                         "(docs/frames.md) (default: none)")
+    p.add_argument("--line-rule", choices=("gl", "geometry"), default=None,
+                   help="--candidate-frames: gl holds aliased 1-px lines to GL's pixel rule (F1@0px); geometry "
+                        "judges where the lines are only (antialiased and wide lines always are) (default: gl)")
     p.add_argument("--level", choices=LEVELS, default=None,
                    help="vertices: OpenCV vertex check only (no drawing, no pyrender); "
                         "pixels: vertices and pyrender pixels (default)")
@@ -426,6 +429,9 @@ def _main(argv=None) -> int:
         return _error(f"--report-dir {str(run_dir)!r}: cannot write there ({exc}): "
                       "expected a writable directory")
 
+    if args.line_rule is not None and args.candidate_frames is None:
+        return _error(f"--line-rule {args.line_rule} without --candidate-frames: a projector's lines are drawn by "
+                      "the harness (GL's rule); expected --line-rule only with --candidate-frames DIR")
     if args.candidate_frames is not None:
         from .frames_cli import frames_main
 

@@ -159,11 +159,12 @@ __all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER"
 #: the picture more than a scale; an offset is the smallest visible effect.
 FAULT_ORDER = ("depth_flip", "clipping_plane", "axis_swap", "ambiguous", "axis_flip", "mirror_horizontal",
                "mirror_vertical", "aspect_mismatch", "fov_mismatch",
-               "pixel_offset", "distortion_mismatch", "line_end_bias", "line_pixel_bias", "precision_limited",
-               "unexplained")
+               "pixel_offset", "distortion_mismatch", "line_end_bias", "line_pixel_bias", "raster_rule",
+               "precision_limited", "unexplained")
 FAULT_NAMES = frozenset(FAULT_ORDER)
-#: The faults named from a wireframe's pixels (:func:`diagnose_lines`), not from its vertices.
-LINE_FAULTS = ("line_end_bias", "line_pixel_bias")
+#: The faults named from a wireframe's pixels (:func:`diagnose_lines`; raster_rule: oracles.line_style), not
+#: from its vertices.
+LINE_FAULTS = ("line_end_bias", "line_pixel_bias", "raster_rule")
 #: The faults named from vertices only: frames of a distorted camera are not compared (oracles.case),
 #: float32 rounding (precision_limited) is far below a pixel, and a clipping plane is probed on the
 #: candidate's projector (oracles.clip_planes).

@@ -56,9 +56,10 @@ CONVENTIONS = {
 }
 
 IMAGE_RULE = {
-    "wireframe": "PNG, the camera's width x height, black background, every visible edge as a 1-px aliased "
-                 "white line (no anti-aliasing, no line smoothing); a pixel counts as drawn when its "
-                 "luminance over black is >= 128 (luminance x alpha / 255; a transparent pixel is not drawn)",
+    "wireframe": "PNG, the camera's width x height, black background, every visible edge as a white line: "
+                 "1-px aliased (held to GL's pixel rule), or anti-aliased, or up to ~3 px wide (judged by where "
+                 "the lines' centres are); a pixel's luminance over black (luminance x alpha / 255) is its "
+                 "coverage, and it counts as drawn when >= 128 (a transparent pixel is not drawn)",
 }
 
 
@@ -215,12 +216,16 @@ e.g. `{first['frames'][0]}` ({first['width']} x {first['height']}). Every
 listed frame must be there, at its camera's size: one still PNG (8- or
 16-bit grey, RGB, RGBA or palette; no JPEG renamed, no animated PNG).
 
-## Anti-aliasing
+## Line style
 
-Turn it off (WebGL: `antialias: false`; OpenGL: no multisampling, no
-GL_LINE_SMOOTH). An anti-aliased line is spread over two pixels of half
-intensity; thresholded at 128 it loses or doubles pixels, and the 0-px F1
-says so.
+Any: the judge reads it from the frames. A 1-px aliased line (WebGL:
+`antialias: false`; OpenGL: no multisampling, no GL_LINE_SMOOTH) is held to
+GL's pixel rule: the 0-px F1 compares pixel for pixel. Anti-aliased lines and
+lines up to ~3 px wide cannot follow that rule; they are judged by where each
+line's centre lies (to a fraction of a pixel), and the report says which style
+it read. Aliased lines of another rule (Pillow's ImageDraw.line, TinyGL) fail
+the 0-px F1 as `raster_rule`; `crosscheck --candidate-frames DIR --line-rule
+geometry` judges their geometry only.
 
 """ + short_job_note(job)
 

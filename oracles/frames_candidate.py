@@ -22,7 +22,7 @@ import numpy as np
 from wirecheck.core.errors import InputError
 
 from .export import JOB_KIND, JOB_VERSION, frame_name
-from .png_frame import FrameProblem, escape_controls, file_problem, read_png  # noqa: F401 (re-exported)
+from .png_frame import FrameProblem, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
@@ -187,7 +187,8 @@ def _walk(frames_dir: Path) -> list[Path]:
 
 
 def load_frames(job_dir: Path, job: dict) -> dict:
-    """Every listed frame as a bool image: ``{(scene, case): [(k, image)]}``; FramesError listing every problem."""
+    """Every listed frame as a grey image (oracles.png_frame.read_grey): ``{(scene, case): [(k, image)]}``;
+    FramesError listing every problem."""
     return _frames(job_dir, job, keep=True)
 
 
@@ -225,7 +226,7 @@ def _frames(job_dir: Path, job: dict, keep: bool) -> dict:
                 problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
                 continue
             try:
-                image = read_png(path, c["width"], c["height"])
+                image = read_grey(path, c["width"], c["height"])
                 if keep:
                     images.append((k, image))
             except FrameProblem as exc:
@@ -328,16 +329,16 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
     return p_model, edges, camera, m
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True):
+def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
     """One case, judged frame by frame: :func:`oracles.frames_judge.judge_case`."""
     from .frames_judge import judge_case as judge
 
-    return judge(job_dir, job, scene, case, oracles, tol, diagnose)
+    return judge(job_dir, job, scene, case, oracles, tol, diagnose, line_rule)
 
 
 def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False) -> tuple[dict, dict]:
+               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
     """Judge the job's frames: :func:`oracles.frames_judge.run_frames`."""
     from .frames_judge import run_frames as run
 
-    return run(job_dir, tol, diagnose, name, allow_vacuous)
+    return run(job_dir, tol, diagnose, name, allow_vacuous, line_rule)

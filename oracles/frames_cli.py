@@ -96,6 +96,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     frames do not use, so they are not usage errors here.
     """
     from .frames_candidate import run_frames
+    from .line_style import summary_lines
     from .report import console_table, write_report
     from .tolerances import Tolerances
 
@@ -122,7 +123,8 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
                      "(the renderer's files, only read): expected a report folder outside them")
     tol = Tolerances(min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
     try:
-        report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous)
+        report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous,
+                                    line_rule=args.line_rule or "gl")
     except InputError as exc:
         return _fail(str(exc))
     try:
@@ -136,6 +138,8 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     except OSError as exc:
         return _fail(f"writing {str(run_dir)!r} or the JUnit file failed: {exc}")
     print(console_table(report["cases"]))
+    for line in summary_lines(report["cases"]):
+        print(line)
     for r in report["cases"]:
         if r["verdict"] != "pass":          # failed, or vacuous (compared nothing)
             print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from . import metrics, opencv_oracle
-from .judge import decide, line_faults, pixel_fields
+from .judge import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (image_diagnose.MAX_POINTS_PER_CASE),
@@ -41,18 +41,18 @@ DIAGNOSIS_FRAMES = 24
 LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
 
 
-def candidate_pixels(path: Path, width: int, height: int, segments=None) -> np.ndarray:
+def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarray, frame: tuple) -> np.ndarray:
     """The ``(H, W)`` bool image of the pixels a frame file draws: what the judge compares with the oracle's.
 
-    Every frame of the frames path goes through here, once. Today: aliased
-    1-px lines read by their luminance (oracles.frames_candidate.read_png).
-    ``segments``: ``(p0_px, p1_px)``, the oracle's segments of the frame
-    (oracles.draw.oracle_segments), for a reader that measures lines of
-    another style against them.
+    Every frame of the frames path goes through here, once: its grey levels
+    (oracles.png_frame.read_grey) are read by the case's line style
+    (oracles.line_style.CaseStyle.frame: the style, line centres and ends
+    measured against ``frame`` = ``(p_model, edges, camera, model_matrix)``),
+    and the pixels compared are those drawn by the rule (coverage >= 128).
     """
-    from .frames_candidate import read_png
+    from .png_frame import read_grey
 
-    return read_png(path, width, height)
+    return style.frame(read_grey(path, width, height), orac, *frame)
 
 
 def diagnosis_frames(n: int, limit: int = DIAGNOSIS_FRAMES) -> set:
@@ -80,8 +80,14 @@ class _CaseFrames:
             frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True):
-    """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion."""
+def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
+    """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
+
+    ``line_rule``: ``"gl"`` holds aliased 1-px lines to GL's pixel rule,
+    ``"geometry"`` judges where the lines are only (oracles.line_style).
+    """
+    from .line_style import CaseStyle
+
     from wirecheck.core.pipeline import render_frame
 
     from .draw import oracle_segments as line_segments
@@ -92,14 +98,15 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     numbers = [int(Path(rel).stem.split("_")[-1]) for rel in c["frames"]]
     kept = diagnosis_frames(len(numbers)) if diagnose else set()
     acc = _CaseFrames()
+    style = CaseStyle(line_rule)
     camera, cache = None, {}
     for i, (k, rel) in enumerate(zip(numbers, c["frames"])):
         p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k, cache)
         p_world = p_model @ m[:3, :3].T + m[:3, 3]
         # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
         seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
-        cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], (seg0, seg1))
         orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
+        cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m))
         core = render_frame(p_model, edges, camera, m).image >= 128
         fp = metrics.FramePixels(cand, orac)
         ps = metrics.pixel_scores(None, None, pixels=fp)
@@ -128,6 +135,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         faults = diagnose_images([_image(flat, shape) for flat, shape, _, _ in acc.diag],
                                  [s for _, _, s, _ in acc.diag], camera, [f for _, _, _, f in acc.diag])
     rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
+    # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
+    style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol))
     rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
     decide(rec, tol, level="frames")
     rec["per_frame"] = acc.per_frame
@@ -152,7 +161,7 @@ def case_record(job: dict, scene: str, case: str, camera, acc: _CaseFrames, chec
 
 
 def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False) -> tuple[dict, dict]:
+               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
     """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
 
     Every listed frame is checked first (oracles.frames_candidate.check_frames:
@@ -173,7 +182,8 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     records, images = [], {}
     try:
         for c in job["cases"]:
-            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], oracles, tol, diagnose=diagnose)
+            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], oracles, tol, diagnose=diagnose,
+                                    line_rule=line_rule)
             records.append(rec)
             images[(c["scene"], c["case"])] = worst
         gl = oracles.gl_info()
@@ -195,7 +205,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
         "frames": job["frames"], "every": job["every"], "frames_checked": len(job["frame_numbers"]),
         "motion": job["motion"],
         "tolerances": tolerances,
-        "allow_vacuous": allow_vacuous, "compared": compared,
+        "allow_vacuous": allow_vacuous, "line_rule": line_rule, "compared": compared,
         "summary": {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
                     "vacuous": vacuous,
                     "max_vertex_error_px": None,

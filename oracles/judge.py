@@ -10,7 +10,10 @@ same record fields from its frames; this module alone decides on them:
 - the pixel F1 at 1 px and at 0 px (``pixel_f1_1px``, ``pixel_f1_0px``: the
   worst frame's), the one-sided pixel balance (a sign test) and the per-edge
   pixel counts of the lines, sub-pixel ties left out
-  (:func:`oracles.metrics.line_failures` on the record's ``lines``);
+  (:func:`oracles.metrics.line_failures` on the record's ``lines``); for a
+  renderer's lines of a style GL's pixel rule cannot hold (anti-aliased, wide),
+  the line centres, ends and warp measured from its images instead
+  (``line_style``, oracles.line_style);
 - the shaded limits (regions inside a silhouette, IoU, faces, depth);
 - the gate (:mod:`oracles.gate`): a case that misses no limit but compared
   nothing is ``"vacuous"``;
@@ -82,12 +85,26 @@ def reasons(rec: dict, tol: Tolerances, error: str | None = None) -> list[str]:
         if rec["pixel_f1_1px"] < tol.min_f1_1px:
             out.append(f"pixel F1@1px {rec['pixel_f1_1px']:.4f} < {tol.min_f1_1px} "
                        f"(frame {rec['worst_pixel_frame']})")
-        if rec["pixel_f1_0px"] < tol.min_f1_0px:
-            out.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
-        if "lines" in rec:
-            out += metrics.line_failures(rec["lines"], tol)
+        out += pixel_rule_reasons(rec, tol) if rec.get("line_style", {}).get("pixel_rule", True) else []
+        out += rec.get("line_style", {}).get("failures", [])
     if rec.get("silhouette_iou") is not None:
         out += _shaded_reasons(rec, tol)
+    return out
+
+
+def pixel_rule_reasons(rec: dict, tol: Tolerances) -> list[str]:
+    """The limits of GL's pixel rule the record misses: F1@0px, the balance, the per-edge counts.
+
+    They decide unless the lines read from a renderer's frames are of a style
+    that cannot follow the rule (anti-aliased, wide; or ``--line-rule
+    geometry``): ``rec["line_style"]["pixel_rule"]`` False (oracles.line_style),
+    whose geometric ``failures`` decide instead.
+    """
+    out = []
+    if rec["pixel_f1_0px"] < tol.min_f1_0px:
+        out.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
+    if "lines" in rec:
+        out += metrics.line_failures(rec["lines"], tol)
     return out
 
 

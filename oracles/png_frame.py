@@ -225,10 +225,18 @@ def _luminance(rgb8: np.ndarray) -> np.ndarray:
 
 
 def read_png(path: Path, width: int, height: int) -> np.ndarray:
-    """``(H, W)`` bool: drawn where ``L x A >= 128 x 255`` (module docstring); FrameProblem otherwise.
+    """``(H, W)`` bool: drawn where ``L x A >= 128 x 255`` (module docstring); FrameProblem otherwise."""
+    return read_grey(path, width, height) >= 128
 
-    One still PNG of the camera's size is expected. The size is checked before
-    any pixel is decoded (a huge image costs nothing).
+
+def read_grey(path: Path, width: int, height: int) -> np.ndarray:
+    """``(H, W)`` uint8: each pixel's luminance over black, ``floor(L x A / 255)``; FrameProblem otherwise.
+
+    Rounded down, a value is >= 128 exactly where ``L x A >= 128 x 255``: the
+    drawn pixels of the rule (:func:`read_png`). The grey levels are the
+    coverage of anti-aliased lines (oracles.line_style). One still PNG of the
+    camera's size is expected. The size is checked before any pixel is decoded
+    (a huge image costs nothing).
     """
     with open(path, "rb") as fh:
         try:
@@ -268,4 +276,4 @@ def read_png(path: Path, width: int, height: int) -> np.ndarray:
     else:
         grey = samples.astype(np.uint16) if samples.ndim == 2 else _luminance(samples)
         alpha = alpha8
-    return grey.astype(np.uint32) * alpha >= 128 * 255     # grey >= 128 where opaque; never where transparent
+    return (grey.astype(np.uint32) * alpha // 255).astype(np.uint8)    # 0 where transparent

@@ -48,6 +48,9 @@ FAULT_HINTS = {
     "line_pixel_bias": "the vertices agree but the candidate draws systematically more (or fewer) line pixels "
                        "than the oracle along the lines: check the line width (1 px) and the rounding of the "
                        "minor coordinate (nearest pixel centre)",
+    "raster_rule": "the lines are where the oracle's are but their pixels follow another aliased line rule than "
+                   "GL's (Pillow's, TinyGL's: ends snapped to pixel centres, another choice across the line): check "
+                   "the line rasteriser, not the camera; --line-rule geometry judges the geometry only",
     "precision_limited": "the error is the size of float32 rounding, not a convention error: compute in "
                          "float64 or declare float32 (--candidate-precision float32)",
     "depth_flip": "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
@@ -310,6 +313,13 @@ def case_notes(report: dict) -> list[tuple[dict, str]]:
     return notes
 
 
+def _line_styles(report: dict) -> list[str]:
+    """The line styles read from a renderer's frames (--candidate-frames; oracles.line_style)."""
+    from .line_style import summary_lines
+
+    return summary_lines(report["cases"])
+
+
 def markdown(report: dict, files: set | None = None) -> str:
     """report.md; ``files``: the figures written beside it (linked when present)."""
     files = files or set()
@@ -328,6 +338,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
            *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.tolerances).", ""]
              if precision_text(report) else []),
+           *[x for line in _line_styles(report) for x in (line + ".", "")],
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in table_rows(report["cases"]):
         out.append("| " + " | ".join(r) + " |")

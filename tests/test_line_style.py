@@ -1,0 +1,245 @@
+"""Any line style on the frames path: antialiased, wide and other aliased rules judged by their geometry.
+
+Frames are drawn here from the job's exact segments (the oracle's lines,
+``oracles.image_diagnose.oracle_segments``: OpenCV's projection of the depth-
+clipped edges, equal to core's to ~1e-13 px): antialiased as 4x4 supersampled
+coverage of a 1-px line, wide as every pixel centre within 1.5 px of the line
+(3 px), and with Pillow's ``ImageDraw.line`` (ends rounded to pixel centres,
+Pillow's own aliased rule). A half-pixel convention error is the same lines
+shifted by (0.5, 0.5).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image, ImageDraw
+
+from wirecheck.core.clipping import clip_to_image
+from wirecheck.oracles.cli import main
+from wirecheck.oracles.frames_candidate import frame_inputs, load_job, read_grey
+from wirecheck.oracles.image_diagnose import oracle_segments
+from wirecheck.oracles.image_diagnose import OFFSET_TOL_PX
+from wirecheck.oracles.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset
+
+# oblique views: the lines slant, so every frame shows both offset components
+ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6",
+        "--every", "3"]
+
+
+def _band(segs, w, h, half, ss):
+    """Coverage (uint8) of lines of half-width ``half`` px: pixels' ``ss x ss`` sub-centres within it."""
+    hi_w, hi_h = w * ss, h * ss
+    acc = np.zeros((hi_h, hi_w), bool)
+    for a, b in segs:
+        a, b = (a + 0.5) * ss - 0.5, (b + 0.5) * ss - 0.5         # pixel centres at integers, in sub-pixels
+        lo = np.maximum(np.floor(np.minimum(a, b) - half * ss - 1), 0).astype(int)
+        top = np.minimum(np.ceil(np.maximum(a, b) + half * ss + 1), [hi_w - 1, hi_h - 1]).astype(int)
+        if np.any(top < lo):
+            continue
+        yy, xx = np.mgrid[lo[1]:top[1] + 1, lo[0]:top[0] + 1]
+        q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
+        ab = b - a
+        t = np.clip(((q - a) @ ab) / max(ab @ ab, 1e-300), 0.0, 1.0)
+        near = np.hypot(*(a + t[:, None] * ab - q).T) <= half * ss
+        acc[yy.ravel()[near], xx.ravel()[near]] = True
+    return np.floor(acc.reshape(h, ss, w, ss).mean(axis=(1, 3)) * 255 + 0.5).astype(np.uint8)
+
+
+def draw_antialiased(segs, w, h):
+    return _band(segs, w, h, 0.5, 4)
+
+
+def draw_wide(segs, w, h):
+    return _band(segs, w, h, 1.5, 1)
+
+
+def draw_pillow(segs, w, h):
+    im = Image.new("L", (w, h), 0)
+    d = ImageDraw.Draw(im)
+    _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
+    for a, b in zip(q0, q1):
+        d.line([tuple(np.rint(a)), tuple(np.rint(b))], fill=255, width=1)
+    return np.asarray(im)
+
+
+@pytest.fixture(scope="module")
+def job_dir(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("style") / "job"
+    assert main(["export", str(path)] + ARGS) == 0
+    return path
+
+
+def _fill(job_dir: Path, tmp_path: Path, draw, shift=(0.0, 0.0)) -> Path:
+    d = tmp_path / "filled"
+    shutil.copytree(job_dir, d)
+    job = load_job(d)
+    for c in job["cases"]:
+        for rel in c["frames"]:
+            k = int(Path(rel).stem.split("_")[-1])
+            p, e, cam, m = frame_inputs(d, job, c["scene"], c["case"], k)
+            segs = oracle_segments(p @ m[:3, :3].T + m[:3, 3], e, cam) + np.asarray(shift)
+            (d / rel).parent.mkdir(parents=True, exist_ok=True)
+            Image.fromarray(draw(segs, cam.width, cam.height)).save(d / rel)
+    return d
+
+
+def _judge(job: Path, tmp_path: Path, *extra) -> tuple[int, dict]:
+    rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep"), *extra])
+    return rc, json.loads((tmp_path / "rep" / "report.json").read_text())
+
+
+@pytest.mark.parametrize("draw, style", [(draw_antialiased, "antialiased"), (draw_wide, "wide")],
+                         ids=["antialiased", "3px"])
+def test_correct_antialiased_and_wide_lines_pass(job_dir, tmp_path, capsys, draw, style):
+    rc, report = _judge(_fill(job_dir, tmp_path, draw), tmp_path)
+    out = capsys.readouterr().out
+    assert rc == 0, out
+    assert len(report["cases"]) == 4
+    for c in report["cases"]:
+        assert c["line_style"]["style"] == style
+        # GL's pixel rule would fail them (the bound is 0.98): it is reported, not judged
+        assert c["pixel_f1_0px"] < 0.98 and c["pixel_f1_1px"] >= 0.999
+        assert c["verdict"] == "pass" and c["faults"] == [], c["faults"]
+        # 3 px: each pixel centre within 1.5 px of the line, about 3 pixels across; 1 px antialiased: 1
+        assert c["line_style"]["width_px"] == pytest.approx(3.0 if style == "wide" else 1.0, abs=0.1)
+        assert "GL's pixel rule" in c["line_style"]["cannot_show"]
+    # the report says which style was read, how it was judged and what it cannot show
+    said = f"Line style read: {style} (4 cases"
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert said in out and said in md and "cannot show GL's pixel rule" in md
+
+
+@pytest.mark.parametrize("draw", [draw_antialiased, draw_wide], ids=["antialiased", "3px"])
+def test_half_pixel_offset_is_measured(job_dir, tmp_path, capsys, draw):
+    rc, report = _judge(_fill(job_dir, tmp_path, draw, shift=(0.5, 0.5)), tmp_path)
+    assert rc == 1
+    for c in report["cases"]:
+        assert c["verdict"] == "fail"
+        (f,) = c["faults"]
+        assert f["name"] == "pixel_offset"
+        # the lines were drawn 0.5 px right and down: their measured centres within 0.05 px of it
+        assert f["dx"] == pytest.approx(0.5, abs=0.05) and f["dy"] == pytest.approx(0.5, abs=0.05)
+        assert any("line centres offset" in r for r in c["reasons"])
+
+
+def test_a_small_scale_error_of_antialiased_lines_fails(job_dir, tmp_path, capsys):
+    # the lines scaled about the principal point so that the farthest end moves 0.8 px: within F1@1px's
+    # 1 px, so only the measured centres can fail it (0.8 > SCALE_TOL_PX, 0.5)
+    def scaled(segs, w, h):
+        c = np.array([(w - 1) / 2.0, (h - 1) / 2.0])       # the principal point of the job's centred cameras
+        reach = np.max(np.hypot(*(segs.reshape(-1, 2) - c).T))
+        return draw_antialiased(c + (segs - c) * (1.0 + 0.8 / reach), w, h)
+
+    rc, report = _judge(_fill(job_dir, tmp_path, scaled), tmp_path)
+    assert rc == 1
+    for c in report["cases"]:
+        assert c["verdict"] == "fail", c["line_style"]["geometry"]
+        assert any("moved by up to" in r for r in c["reasons"]), c["reasons"]
+        assert 0.5 < c["line_style"]["geometry"]["warp_px"] <= 0.8 + 0.05
+
+
+def test_pillow_rule_is_named_raster_rule(job_dir, tmp_path, capsys):
+    job = _fill(job_dir, tmp_path, draw_pillow)
+    rc, report = _judge(job, tmp_path)
+    assert rc == 1
+    for c in report["cases"]:
+        assert c["line_style"]["style"] == "aliased"
+        assert c["verdict"] == "fail" and c["pixel_f1_1px"] >= 0.999 and c["pixel_f1_0px"] < 0.98
+        (f,) = c["faults"]                                  # no rotation, mirror or offset
+        assert f["name"] == "raster_rule", c["faults"]
+        assert f["share_off_by_one_across"] > 0.1 and f["share_farther"] == 0.0
+        assert f["share_off_by_one_at_ends"] < f["share_off_by_one_across"]
+        assert "rotation" not in f["note"] and "--line-rule geometry" in f["note"]
+    # the user's choice: the geometry only
+    shutil.rmtree(tmp_path / "rep")
+    rc, report = _judge(job, tmp_path, "--line-rule", "geometry")
+    assert rc == 0, [c["reasons"] for c in report["cases"]]
+    assert report["line_rule"] == "geometry"
+    assert all(c["faults"] == [] for c in report["cases"])
+
+
+def test_half_pixel_offset_of_aliased_lines_is_no_raster_rule(job_dir, tmp_path, capsys):
+    # core's GL-like lines drawn 0.5 px off: every differing pixel is off by one too, but the lines
+    # moved as a whole (0.5 > RULE_OFFSET_MAX_PX): a pixel offset, not a rule
+    from wirecheck.core.raster import line_pixels
+
+    def draw_gl(segs, w, h):
+        img = np.zeros((h, w), np.uint8)
+        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
+        rr, cc = line_pixels(q0, q1, w, h)
+        img[rr, cc] = 255
+        return img
+
+    rc, report = _judge(_fill(job_dir, tmp_path, draw_gl, shift=(0.5, 0.5)), tmp_path)
+    assert rc == 1 and 0.5 > RULE_OFFSET_MAX_PX
+    for c in report["cases"]:
+        names = [f["name"] for f in c["faults"]]
+        assert "raster_rule" not in names and "pixel_offset" in names, names
+
+
+def test_measure_recovers_a_known_offset():
+    # one antialiased line at 20 degrees, drawn 0.3 px along its normal: the centroid finds 0.3
+    # (coverage of a 4x4 supersampled box filter is symmetric about the line: no bias above ~0.01 px)
+    a, b = np.array([20.0, 30.0]), np.array([180.0, 30.0 + 160.0 * np.tan(np.radians(20))])
+    n = np.array([-(b - a)[1], (b - a)[0]]) / np.hypot(*(b - a))
+    img = _band(np.array([[a, b]]) + 0.3 * n, 200, 120, 0.5, 4) / 255.0
+    got = measure(img, np.array([[a, b]]))
+    normal, offset, width = got["normal"], got["offset"], got["width"]
+    assert len(offset) > 100 and MIN_MASS < 1.0
+    assert np.median(offset) == pytest.approx(0.3, abs=0.01)
+    assert np.median(width) == pytest.approx(1.0, abs=0.05)
+    d, determined = pooled_offset(normal, offset)
+    # one direction of normal: the offset along the line is not determined; along n it is 0.3
+    assert float(d @ n) == pytest.approx(0.3, abs=0.01) and OFFSET_TOL_PX < 0.3
+
+
+def test_read_grey_keeps_coverage_and_the_rule(tmp_path):
+    rgba = np.zeros((1, 4, 4), np.uint8)
+    rgba[0, :, :3] = 255
+    rgba[0, :, 3] = [0, 100, 129, 255]             # white at alpha 100: 255 * 100 / 255 = 100
+    path = tmp_path / "f.png"
+    Image.fromarray(rgba, "RGBA").save(path)
+    assert read_grey(path, 4, 1).tolist() == [[0, 100, 129, 255]]
+    Image.fromarray(np.array([[127, 128, 64]], np.uint8)).save(path)
+    assert read_grey(path, 3, 1).tolist() == [[127, 128, 64]]
+
+
+def test_line_rule_needs_frames(tmp_path, capsys):
+    rc = main(["--line-rule", "geometry", "--scene", "cube", "--level", "vertices",
+               "--report-dir", str(tmp_path / "rep")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--line-rule geometry without --candidate-frames" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("short_px, named", [(0.0, False), (1.0, True), (-1.0, True)],
+                         ids=["correct", "dropped", "extra"])
+def test_a_dropped_or_extra_end_is_named(short_px, named):
+    # three separate lines (six free ends) seen by an orthographic camera at 1 px per unit, drawn
+    # antialiased (round caps of radius 0.5: the cap's chord is half the width 0.43 px past the end;
+    # measured 0.27-0.46 with the end's sub-pixel phase), with 1 px dropped from (or added to) each
+    # end: measured -0.73..-0.54 / 1.25..1.51, beyond -END_TOL_PX (-0.5) / width / 2 + END_TOL_PX (1.0)
+    from wirecheck.core.camera import Camera
+    from wirecheck.oracles.line_style import CaseStyle
+
+    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
+                 projection="orthographic", ortho_height=140.0)
+    p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0],
+                  [40.0, 40.0, 0.0], [80.3, -40.7, 0.0]])
+    edges = np.array([[0, 1], [2, 3], [4, 5]])
+    segs = oracle_segments(p, edges, cam)
+    u = (segs[:, 1] - segs[:, 0]) / np.hypot(*(segs[:, 1] - segs[:, 0]).T)[:, None]
+    drawn = np.stack([segs[:, 0] + short_px * u, segs[:, 1] - short_px * u], axis=1)
+    style = CaseStyle()
+    style.frame(draw_antialiased(drawn, 220, 140), np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
+    rec = {"faults": []}
+    reasons = style.judge(rec, [], None)
+    geo = rec["line_style"]["geometry"]
+    assert rec["line_style"]["style"] == "antialiased" and geo["ends_measured"] == 6
+    assert geo["end_px"] == pytest.approx(0.37 - short_px, abs=0.15)
+    assert [f["name"] for f in rec["faults"]] == (["line_end_bias"] if named else [])
+    assert any("line ends" in r for r in reasons) == named
