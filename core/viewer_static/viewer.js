@@ -36,12 +36,18 @@ function pump() {
   const ops = pending;
   pending = [];
   const t0 = performance.now();
+  // a frame takes milliseconds; the overlay's first frame seconds (pyrender starts): say so
+  const busy = setTimeout(() => {
+    $("busy").textContent = overlayOn ? "drawing the oracle overlay (pyrender; the first takes a few seconds)\u2026"
+                                      : "drawing\u2026";
+    $("busy").hidden = false;
+  }, 300);
   fetch("/api/frame", {method: "POST", headers: {"Content-Type": "application/json"},
                        body: JSON.stringify({ops: ops, overlay: overlayOn})})
     .then((r) => r.json())
     .then((resp) => show(resp, performance.now() - t0))
     .catch((err) => showMessage("request failed: " + err))
-    .finally(() => { inflight = false; pump(); });
+    .finally(() => { clearTimeout(busy); $("busy").hidden = true; inflight = false; pump(); });
 }
 
 function refresh() { forceNext = true; pump(); }
@@ -173,4 +179,7 @@ $("copy").addEventListener("click", () => {
   if (navigator.clipboard) navigator.clipboard.writeText(text).catch(fallback); else fallback();
 });
 
-refresh();
+// a reload starts fresh: the server's view goes back to the start, and the browser's remembered
+// form state (the overlay box) is cleared
+$("overlay").checked = false;
+addOp({op: "reset"});
