@@ -154,6 +154,11 @@ def _missing_gl_library(platform: str) -> str | None:
         msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
         return f"OpenGL cannot load its {platform} platform ({msg}); install it with: {hint}"
     if platform == "osmesa":
+        try:
+            from OpenGL import osmesa  # noqa: F401 - PyOpenGL's binding: fails on some versions without the library
+        except Exception as exc:  # ImportError, OSError, AttributeError
+            msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+            return f"libOSMesa cannot be loaded ({msg}); install it with: {hint}"
         lib = _loaded(loaded, "GL")
         if lib is None:
             return f"libOSMesa cannot be loaded (no libOSMesa.so found); install it with: {hint}"
