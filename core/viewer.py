@@ -277,7 +277,7 @@ class Viewer:
                 raise InputError(f"step {_short(n)}: expected an integer")
             v = replace(v, frame=(v.frame - 1 + n) % self.s.frames + 1)
         elif kind == "reset":
-            v = self.start                # the starting view, frame included: what the page first showed
+            v = replace(self.start, frame=v.frame)
         else:
             raise InputError(f"op {_short(op)}: expected orbit, pan, dolly, set, step or reset")
         return v

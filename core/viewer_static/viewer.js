@@ -35,6 +35,8 @@ function pump() {
   forceNext = false;
   const ops = pending;
   pending = [];
+  // the server's reset keeps the frame; the page's reset (and a fresh page) goes back to frame 1 too
+  const resets = ops.some((o) => o.op === "reset");
   const t0 = performance.now();
   // a frame takes milliseconds; the overlay's first frame seconds (pyrender starts): say so
   const busy = setTimeout(() => {
@@ -45,7 +47,10 @@ function pump() {
   fetch("/api/frame", {method: "POST", headers: {"Content-Type": "application/json"},
                        body: JSON.stringify({ops: ops, overlay: overlayOn})})
     .then((r) => r.json())
-    .then((resp) => show(resp, performance.now() - t0))
+    .then((resp) => {
+      show(resp, performance.now() - t0);
+      if (resets && resp.view && resp.view.frame !== 1) addOp({op: "step", n: 1 - resp.view.frame});
+    })
     .catch((err) => showMessage("request failed: " + err))
     .finally(() => { clearTimeout(busy); $("busy").hidden = true; inflight = false; pump(); });
 }
