@@ -149,22 +149,23 @@ def gl_available() -> tuple[bool, str]:
 
 
 def _missing_gl_library(platform: str) -> str | None:
-    """One line naming the GL library that PyOpenGL cannot load on ``platform``, with its fix; None if all load.
+    """One line naming the GL library PyOpenGL cannot load on ``platform``, with its fix; None if all load.
 
-    PyOpenGL does not raise when a platform's library is missing: it leaves ``PLATFORM.GL`` None,
-    and the first GL call (pyrender's import) fails with ``'NoneType' object has no attribute
-    'glGetError'``, which names neither the library nor the fix. So the libraries are looked at
-    here, before pyrender is imported: libOSMesa (and its ``OSMesaCreateContextAttribs``, Mesa
-    >= 11.2) for osmesa; libEGL and libGL/libOpenGL for egl.
-    """
+    PyOpenGL leaves a missing library None and pyrender's import then fails with ``'NoneType' object
+    has no attribute 'glGetError'``: so libOSMesa (with ``OSMesaCreateContextAttribs``, Mesa >= 11.2),
+    or libEGL and libGL, are looked at here, before pyrender is imported."""
     hint = _INSTALL_HINT[platform]
     try:
         from OpenGL import platform as gl_platform_module
         loaded = gl_platform_module.PLATFORM
     except Exception as exc:  # ImportError, OSError: the platform module itself cannot load
-        msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
-        return f"OpenGL cannot load its {platform} platform ({msg}); install it with: {hint}"
+        return f"OpenGL cannot load its {platform} platform ({type(exc).__name__}: {exc}); install it with: {hint}"
     if platform == "osmesa":
+        try:
+            from OpenGL import osmesa  # noqa: F401 - PyOpenGL's binding: fails on some versions without the library
+        except Exception as exc:  # ImportError, OSError, AttributeError
+            msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+            return f"libOSMesa cannot be loaded ({msg}); install it with: {hint}"
         lib = _loaded(loaded, "GL")
         if lib is None:
             return f"libOSMesa cannot be loaded (no libOSMesa.so found); install it with: {hint}"

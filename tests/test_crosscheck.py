@@ -133,7 +133,10 @@ def test_subprocess_prints_table_and_path(tmp_path):
                           capture_output=True, text=True, cwd=Path(__file__).parent.parent)
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr == ""
-    assert proc.stdout.splitlines()[0].split()[:2] == ["scene", "camera"]
+    # first what was compared (oracles.compared), then the table
+    assert proc.stdout.splitlines()[0] == ("Compared: level pixels (OpenCV and pyrender), 2 frames per case, "
+                                           "1 case (1 scene x 1 camera)")
+    assert proc.stdout.splitlines()[1].split()[:2] == ["scene", "camera"]
     assert proc.stdout.rstrip().endswith("(also report.md, report.html)")
     assert (out / "report.json").is_file()
 

@@ -149,3 +149,10 @@ def test_an_unbalanced_fence_is_found(tmp_path):
     assert [m.split(": ", 1)[0][-6:] for m in ds.unbalanced_fences(page)] == ["p.md:6"]
     page.write_text("text\n```\ncode\n", encoding="utf-8")
     assert [m.split(": ", 1)[0][-6:] for m in ds.unbalanced_fences(page)] == ["p.md:2"]
+
+
+def test_every_cwd_directive_names_a_folder_of_the_repository():
+    folders = {s.cwd for s in ds.all_samples() if s.cwd}
+    assert folders, "the pytest and renderer samples run in folders of their own"
+    for folder in folders:
+        assert (ds.ROOT / folder).is_dir() and not folder.startswith(("/", "..")), folder

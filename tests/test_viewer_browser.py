@@ -145,3 +145,18 @@ def test_profiler_shows_every_stage_and_the_page_logs_no_errors(session):
     assert session["profileRows"] == list(STAGES) + ["oracle", "transfer", "server", "roundtrip"]
     assert "frames/s over the last" in session["fpsText"]
     assert session["consoleErrors"] == []
+
+
+def test_rough_edges_loading_banner_controls_reset_reload(session):
+    # the first overlay takes seconds (pyrender starts): the page says so meanwhile
+    assert session["busyShown"] and "overlay" in session["busyShown"]
+    # 1,400 x 900 with the overlay on: the controls' column starts inside the window, right of the panes
+    box = session["controlsBox"]
+    assert box["x"] + min(box["width"], 300) <= 1400 and 0 <= box["y"] < 900
+    # scrolled to the end of a 600-px-high window, the error banner is still at the top of the view
+    assert session["messageBox"] is not None and 0 <= session["messageBox"]["y"] < 600
+    by = session["by"]
+    assert by["played"]["json"]["frame"] > 2
+    start = by["start"]["json"]["view"]
+    assert by["reset"]["json"]["view"] == start and by["reset"]["json"]["frame"] == 1    # frame reset too
+    assert by["reload"]["json"]["view"] == start and session["overlayAfterReload"] is False

@@ -35,13 +35,24 @@ function pump() {
   forceNext = false;
   const ops = pending;
   pending = [];
+  // the server's reset keeps the frame; the page's reset (and a fresh page) goes back to frame 1 too
+  const resets = ops.some((o) => o.op === "reset");
   const t0 = performance.now();
+  // a frame takes milliseconds; the overlay's first frame seconds (pyrender starts): say so
+  const busy = setTimeout(() => {
+    $("busy").textContent = overlayOn ? "drawing the oracle overlay (pyrender; the first takes a few seconds)\u2026"
+                                      : "drawing\u2026";
+    $("busy").hidden = false;
+  }, 300);
   fetch("/api/frame", {method: "POST", headers: {"Content-Type": "application/json"},
                        body: JSON.stringify({ops: ops, overlay: overlayOn})})
     .then((r) => r.json())
-    .then((resp) => show(resp, performance.now() - t0))
+    .then((resp) => {
+      show(resp, performance.now() - t0);
+      if (resets && resp.view && resp.view.frame !== 1) addOp({op: "step", n: 1 - resp.view.frame});
+    })
     .catch((err) => showMessage("request failed: " + err))
-    .finally(() => { inflight = false; pump(); });
+    .finally(() => { clearTimeout(busy); $("busy").hidden = true; inflight = false; pump(); });
 }
 
 function refresh() { forceNext = true; pump(); }
@@ -173,4 +184,7 @@ $("copy").addEventListener("click", () => {
   if (navigator.clipboard) navigator.clipboard.writeText(text).catch(fallback); else fallback();
 });
 
-refresh();
+// a reload starts fresh: the server's view goes back to the start, and the browser's remembered
+// form state (the overlay box) is cleared
+$("overlay").checked = false;
+addOp({op: "reset"});

@@ -69,13 +69,19 @@ await page.keyboard.up("Shift");
 await idle();
 records.push(await snap("pan"));
 
-// the oracle overlay for this view
+// the oracle overlay for this view: the page says it is drawing while pyrender starts
 await page.check("#overlay");
+const busyShown = await page.waitForSelector("#busy", { state: "visible", timeout: 5000 })
+  .then(() => page.textContent("#busy")).catch(() => null);
 await idle();
 await page.waitForSelector("#overlay-json", { state: "visible" });
 const overlay = JSON.parse(await page.textContent("#overlay-json"));
 const diffSrc = await page.getAttribute("#diff", "src");
 if (shotPath) await page.screenshot({ path: shotPath, fullPage: true });
+// at 1,400 x 900 with the overlay's three panes, the controls stay in view
+await page.setViewportSize({ width: 1400, height: 900 });
+const controlsBox = await page.locator("#controls").boundingBox();
+await page.setViewportSize({ width: 1600, height: 1200 });
 await page.uncheck("#overlay");
 await idle();
 
@@ -94,6 +100,12 @@ await page.fill("#near", "500");
 await page.locator("#near").blur();
 await idle();
 records.push(await snap("near-far"));
+// the error stays in view when the page is scrolled to its end
+await page.setViewportSize({ width: 1400, height: 600 });
+await page.evaluate(() => window.scrollTo(0, document.body.scrollHeight));
+const messageBox = await page.locator("#message").boundingBox();
+await page.evaluate(() => window.scrollTo(0, 0));
+await page.setViewportSize({ width: 1600, height: 1200 });
 
 // the server still answers: step one frame
 await page.click("#step");
@@ -107,9 +119,21 @@ await page.click("#play");
 await idle();
 records.push(await snap("played"));
 
+// reset: the starting view, frame included; then a step and a reload: a fresh start again
+await page.click("#reset");
+await idle();
+records.push(await snap("reset"));
+await page.click("#step");
+await idle();
+await page.reload();
+await idle();
+records.push(await snap("reload"));
+const overlayAfterReload = await page.isChecked("#overlay");
+
 const profileRows = await page.$$eval("#profile-table tbody tr", (rows) => rows.map((r) => r.dataset.stage));
 const fpsText = await page.textContent("#fps");
 
 await context.close();
 writeFileSync(outPath, JSON.stringify({ records, overlay, diffSrc: diffSrc ? diffSrc.length : 0,
-                                        profileRows, fpsText, consoleErrors }, null, 1));
+                                        profileRows, fpsText, consoleErrors, busyShown, controlsBox,
+                                        messageBox, overlayAfterReload }, null, 1));
