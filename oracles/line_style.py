@@ -41,6 +41,10 @@ square-on) sit up to half a pixel off in every correct drawing, as in
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
 the windows, are not measured (the centroids would be of stray crossings).
 
+Ends (:func:`measure_ends`): each free end's coverage along its line, where it
+falls to half the line's width; the median over a case's free ends is judged
+(:data:`END_TOL_PX`, past the cap of half the width a renderer may draw).
+
 Raster rule (aliased lines): the pixels where the candidate and pyrender
 differ are counted; one with a pixel of the other side among its 8 neighbours
 is "off by one", at an end when within :data:`END_RADIUS_PX` of a segment end,
@@ -59,8 +63,9 @@ The verdict (:meth:`CaseStyle.judge`):
   :data:`oracles.image_diagnose.OFFSET_TOL_PX` (aliased lines of another rule:
   :data:`RULE_OFFSET_MAX_PX`) fails as ``pixel_offset`` with the measured
   ``dx, dy``, a warp beyond :data:`oracles.image_diagnose.SCALE_TOL_PX` (binary
-  lines: half a pixel more) fails too; the registration's offset and scale
-  faults give way to the measure's. F1@1px holds for every style.
+  lines: half a pixel more) fails too, and so do ends that stop short or run
+  on (``line_end_bias``); the registration's offset and scale faults give way
+  to the measure's. F1@1px holds for every style.
 """
 
 from __future__ import annotations
@@ -123,15 +128,15 @@ RULE_OFFSET_MAX_PX = 0.35
 CAN_SHOW = {
     "aliased": "every pixel: the line rule (GL's or another), the geometry to the pixel, "
                "pixel offsets pooled over the lines",
-    "antialiased": "each line's centre to a fraction of a pixel (the coverage centroid): offsets, "
-                   "missing or extra lines",
-    "wide": "each line's centre to a fraction of a pixel (the centroid across the line): offsets, "
-            "missing or extra lines",
+    "antialiased": "each line's centre to a fraction of a pixel (the coverage centroid): offsets, scale, "
+                   "missing or extra lines, where free ends stop",
+    "wide": "each line's centre to a fraction of a pixel (the centroid across the line): offsets, scale, "
+            "missing or extra lines, where free ends stop (beyond the cap)",
 }
 CANNOT_SHOW = {
     "aliased": "nothing the other styles show",
     "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, "
-                   "not judged",
+                   "not judged; an end where lines meet",
     "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other "
             "line's width covers it)",
 }
