@@ -90,6 +90,8 @@ WIDE_MIN_PX = 1.75
 #: grey (between 1/8 and 7/8 of the line's level): antialiased lines have a third or more
 #: (measured: 4x4 supersampled 1-px lines 0.6-0.8).
 GREY_SHARE_MAX = 0.05
+#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it.
+LEVEL_SHARE_MIN = 0.002
 #: The line's level: this percentile of the drawn pixels' values (robust to a few bright
 #: crossings of antialiased lines).
 LEVEL_PERCENTILE = 99
@@ -424,7 +426,7 @@ class CaseStyle:
         drawn = self.hist[1:]
         n = int(drawn.sum())
         if n == 0:
-            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0}
+            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1}
         cum = np.cumsum(drawn)
         level = int(np.searchsorted(cum, LEVEL_PERCENTILE / 100.0 * n)) + 1
         values = np.arange(1, 256)
@@ -437,7 +439,11 @@ class CaseStyle:
             width = coverage / self.length_px if self.length_px > 0 else 0.0
         grey_share = float(grey) / n
         style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
-        return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level}
+        # coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's step on
+        # lines that all sit at one fractional position; that half step is added to the offset's tolerance
+        steps = max(int((drawn >= LEVEL_SHARE_MIN * n).sum()), 1)
+        return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level,
+                "coverage_steps": steps}
 
     def _fit(self, samples):
         """``(d (2,), affine)`` over ``samples``: ``d`` the pooled offset (:func:`pooled_offset`), ``affine``
@@ -498,7 +504,9 @@ class CaseStyle:
         style = read["style"]
         aliased = style == "aliased"
         by_rule = aliased and self.line_rule == "gl"
-        tol_px = RULE_OFFSET_MAX_PX if aliased else OFFSET_TOL_PX
+        binary = read["grey_share"] <= GREY_SHARE_MAX
+        tol_px = (RULE_OFFSET_MAX_PX if aliased else
+                  OFFSET_TOL_PX + (0.0 if binary else 0.5 / read["coverage_steps"]))
         out = {**read, "line_rule": self.line_rule,
                "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
                             "the geometry (line centres); F1@0px is reported, not judged",
@@ -518,7 +526,7 @@ class CaseStyle:
         moved = placed and off > tol_px
         # binary lines are quantised line by line (up to half a pixel each, which the reference drawing
         # matches only for its own rule): their warp is judged with that half pixel added
-        warp_tol = SCALE_TOL_PX + (0.5 if read["grey_share"] <= GREY_SHARE_MAX else 0.0)
+        warp_tol = SCALE_TOL_PX + (0.5 if binary else 0.0)
         out["warp_tol_px"] = warp_tol
         warped = placed and geo["warp_px"] > warp_tol
         if placed and not by_rule:
