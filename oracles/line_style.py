@@ -41,9 +41,9 @@ square-on) sit up to half a pixel off in every correct drawing, as in
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
 the windows, are not measured (the centroids would be of stray crossings).
 
-Ends (:func:`measure_ends`): each free end's coverage along its line, where it
+Ends (:func:`oracles.line_ends.measure_ends`): each free end's coverage along its line, where it
 falls to half the line's width; the median over a case's free ends is judged
-(:data:`END_TOL_PX`, past the cap of half the width a renderer may draw).
+(:data:`oracles.line_ends.END_TOL_PX`, past the cap of half the width a renderer may draw).
 
 Raster rule (aliased lines): the pixels where the candidate and pyrender
 differ are counted; one with a pixel of the other side among its 8 neighbours
@@ -101,23 +101,14 @@ MIN_MASS = 0.5
 #: Samples a case keeps per frame (evenly thinned above): thousands of samples pin the pooled
 #: offset far below 0.05 px, and the measure costs about the same whatever the mesh.
 MAX_SAMPLES_PER_FRAME = 4000
+#: ... and per case: past it every frame's samples are halved, so a case's memory stays bounded
+#: whatever its number of frames (the offset is a mean over tens of thousands of samples either way).
+MAX_SAMPLES_PER_CASE = 48_000
 #: Fewer samples than this in a case: the geometry is not measured (too little free line).
 MIN_SAMPLES = 20
 #: The geometry is measured only where at least this share of the windows along the oracle's lines
 #: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
 MIN_FOUND_SHARE = 0.5
-#: A segment end is measured when no other segment comes this close to it (px): the profile along the
-#: line (4 px past the end) stays clear of every other line's window.
-FREE_END_PX = GUARD_PX + 4.0
-#: Along-line profile of an end: from this far inside the line (px) to END_REACH_PX past its end.
-END_INSIDE_PX = 6.0
-END_REACH_PX = 4.0
-#: An end is short when the line's coverage falls to half before this (px, negative: inside the
-#: segment; a butt end falls at 0, a round or square cap up to half the width past it), long when
-#: it stays above half this far past half the width. A dropped or added pixel moves it by 1.
-END_TOL_PX = 0.5
-#: Ends a case must have measured for their median to be judged.
-MIN_ENDS = 4
 #: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
 PLACEMENT_FAULTS = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal", "mirror_vertical")
 #: Aliased lines of another rule: the largest pooled centre offset (px) that is still "the geometry is
@@ -168,7 +159,8 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     measured centre minus the exact line along the unit ``normal``, at
     ``point`` on the exact line; ``width`` the coverage across the line there
     (px, perpendicular to the line); ``segment`` its segment. ``windows``: the
-    windows looked at (clear of junctions), of which the ``M`` held a line.
+    windows looked at (clear of junctions); ``found``: those that held a line
+    (``M`` of them kept, at most ``limit``).
     """
     h, w = cov.shape
     r = PROFILE_RADIUS_PX
@@ -208,7 +200,7 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     keys = ("normal", "offset", "width", "segment", "point", "mass")
     if not parts:
         out = {k: np.zeros((0, 2)) if k in ("normal", "point") else np.zeros(0) for k in keys}
-        out["windows"] = 0
+        out["windows"] = out["found"] = 0
         return out
     out = {k: np.concatenate([p[k] for p in parts]) for k in keys}
     if len(segs) > 1:                                   # drop windows near another segment (a junction, a crossing)
@@ -222,67 +214,12 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
     keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
     out = {k: v[keep] for k, v in out.items()}
-    if len(out["offset"]) > limit:
-        idx = np.linspace(0, len(out["offset"]) - 1, limit).round().astype(int)
+    found = len(out["offset"])
+    if found > limit:
+        idx = np.linspace(0, found - 1, limit).round().astype(int)
         out = {k: v[idx] for k, v in out.items()}
-    out["windows"] = windows
+    out["windows"], out["found"] = windows, found
     return out
-
-
-def _bilinear(cov: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Coverage at points ``q (..., 2)`` (x, y; pixel centres at integers), bilinear; 0 outside."""
-    h, w = cov.shape
-    x0, y0 = np.floor(q[..., 0]).astype(np.intp), np.floor(q[..., 1]).astype(np.intp)
-    fx, fy = q[..., 0] - x0, q[..., 1] - y0
-    out = np.zeros(q.shape[:-1])
-    for dx, dy, wgt in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)), (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
-        xx, yy = x0 + dx, y0 + dy
-        ok = (xx >= 0) & (xx < w) & (yy >= 0) & (yy < h)
-        out[ok] += wgt[ok] * cov[yy[ok], xx[ok]]
-    return out
-
-
-def measure_ends(cov: np.ndarray, segs: np.ndarray) -> np.ndarray:
-    """Where each free end of the oracle's segments stops in the image: ``(E,)`` px past the exact end.
-
-    An end is free when inside the image (the profile too) and no other
-    segment comes within :data:`FREE_END_PX`. Along the line, from
-    :data:`END_INSIDE_PX` inside to :data:`END_REACH_PX` past the end, every
-    0.25 px, the coverage summed across the line (bilinear, 0.5 px steps,
-    :data:`PROFILE_RADIUS_PX` each side) is the line's width there; the end is
-    where it last falls to half the width of the line's inner part.
-    """
-    h, w = cov.shape
-    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    out = []
-    s = np.arange(-END_INSIDE_PX, END_REACH_PX + 1e-9, 0.25)
-    t = np.arange(-PROFILE_RADIUS_PX, PROFILE_RADIUS_PX + 1e-9, 0.5)
-    margin = PROFILE_RADIUS_PX + END_REACH_PX + 2
-    for i, (a, b) in enumerate(segs):
-        length = float(np.hypot(*(b - a)))
-        if length < END_INSIDE_PX + 2:
-            continue
-        unit = (b - a) / length
-        normal = np.array([-unit[1], unit[0]])
-        others = np.delete(segs, i, axis=0)
-        for end, out_dir in ((a, -unit), (b, unit)):
-            if not (margin <= end[0] <= w - 1 - margin and margin <= end[1] <= h - 1 - margin):
-                continue
-            if len(others) and _seg_distance(end[None], others[:, 0], others[:, 1]).min() <= FREE_END_PX:
-                continue
-            q = end + s[:, None, None] * out_dir + t[None, :, None] * normal      # (len(s), len(t), 2)
-            mass = _bilinear(cov, q).sum(axis=1) * 0.5
-            inner = float(np.median(mass[s <= -2.5]))
-            if inner < MIN_MASS:
-                continue
-            above = np.flatnonzero(mass >= inner / 2.0)
-            k = above.max()
-            if k + 1 >= len(s):                      # still drawn at the end of the reach
-                out.append(float(s[-1]))
-                continue
-            m0, m1 = mass[k], mass[k + 1]         # cross half the inner width between s[k] and s[k + 1]
-            out.append(float(s[k] + (s[k + 1] - s[k]) * (m0 - inner / 2.0) / max(m0 - m1, 1e-12)))
-    return np.asarray(out)
 
 
 def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre: np.ndarray):
@@ -371,13 +308,18 @@ def _off_by_one(cand: np.ndarray, orac: np.ndarray, ends: np.ndarray) -> dict:
             "farther": int((~off1).sum())}
 
 
+def _halve(samples: dict) -> dict:
+    """Every other sample of a frame's :func:`measure` (its counts kept)."""
+    return {k: (v if np.ndim(v) == 0 else v[::2]) for k, v in samples.items()}
+
+
 class CaseStyle:
     """One case's frames read for style and geometry, frame by frame; then the case judged.
 
     ``frame`` is called once per frame with the candidate's grey image (it
     returns the bool pixels the F1 scores compare: drawn where >= 128, the
     rule of docs/frames.md); ``judge`` once, after the F1 reasons are known.
-    Only sums, samples and the frames' segments are kept between frames, never an image.
+    Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
     def __init__(self, line_rule: str = "gl"):
@@ -390,7 +332,7 @@ class CaseStyle:
         self.ends = []                          # measure_ends() of each frame
         self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
                        "farther": 0}
-        self._frames = []                       # (segments, image shape) of each frame, for the reference
+        self.reference = []                     # measure() of a correct binary drawing of each binary frame
         self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m) -> np.ndarray:
@@ -408,9 +350,18 @@ class CaseStyle:
             _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
         cov = grey / max(int(grey.max()), 1)                                   # the frame's line level is 1
-        self.samples.append(measure(cov, segs))
-        self.ends.append(measure_ends(cov, segs))
-        self._frames.append((segs, grey.shape))
+        from . import line_ends
+
+        got = measure(cov, segs)
+        self.samples.append(got)
+        self.ends.append(line_ends.measure_ends(cov, segs))
+        drawn = grey[grey > 0]
+        if len(drawn) and np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) <= GREY_SHARE_MAX:
+            width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
+            self.reference.append(measure(_reference(segs, grey.shape, width).astype(float), segs))
+        if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
+            self.samples = [_halve(x) for x in self.samples]
+            self.reference = [_halve(x) for x in self.reference]
         counts = _off_by_one(cand, orac, segs.reshape(-1, 2))
         self.raster = {k: v + counts[k] for k, v in self.raster.items()}
         return cand
@@ -463,10 +414,10 @@ class CaseStyle:
         value there less the offset's (fitted values, not the map's parameters: lines of few directions
         fix the values where the lines are, not the map everywhere).
         """
-        windows = sum(x["windows"] for x in self.samples)
+        windows, found = sum(x["windows"] for x in self.samples), sum(x["found"] for x in self.samples)
         n = len(self._pooled("offset"))
         ends = np.concatenate(self.ends) if self.ends else np.zeros(0)
-        geo = {"samples": n, "windows": windows, "found_share": n / windows if windows else 0.0,
+        geo = {"samples": n, "windows": windows, "found_share": found / windows if windows else 0.0,
                "offset_px": None, "bias_px": None, "warp_px": None, "ends_measured": int(len(ends)),
                "end_px": float(np.median(ends)) if len(ends) else None}
         fit = self._fit(self.samples)
@@ -475,8 +426,7 @@ class CaseStyle:
         d, affine = fit
         ref_d, ref_affine = np.zeros(2), None
         if read["grey_share"] <= GREY_SHARE_MAX:        # binary: quantised; the same measure on a correct drawing
-            ref = self._fit([measure(_reference(segs, shape, read["width_px"]).astype(float), segs)
-                             for segs, shape in self._frames])
+            ref = self._fit(self.reference) if len(self.reference) == len(self.samples) else None
             if ref is not None:
                 ref_d, ref_affine = ref
         normal, point = self._pooled("normal").reshape(-1, 2), self._pooled("point").reshape(-1, 2)
@@ -498,6 +448,7 @@ class CaseStyle:
         """
         from .diagnose import FAULT_ORDER
         from .image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX
+        from .line_ends import END_TOL_PX, MIN_ENDS
 
         read = self.classify()
         geo = self.geometry(read)
