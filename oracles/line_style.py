@@ -290,19 +290,25 @@ def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
 
 def _off_by_one(cand: np.ndarray, orac: np.ndarray, ends: np.ndarray) -> dict:
     """Pixels where ``cand`` and ``orac`` differ, counted by where they are (module docstring)."""
-    from scipy.ndimage import binary_dilation
-
-    eight = np.ones((3, 3), bool)
-    extra, missing = cand & ~orac, orac & ~cand
-    near_other = (extra & binary_dilation(orac, eight)) | (missing & binary_dilation(cand, eight))
-    rr, cc = np.nonzero(extra | missing)
+    h, w = cand.shape
+    rr, cc = np.nonzero(cand != orac)
+    other = np.where(cand[rr, cc], 0, 1)                # 0: look in orac (an extra pixel), 1: in cand
+    pair = (orac, cand)
+    off1 = np.zeros(len(rr), bool)
+    for dy in (-1, 0, 1):                               # a pixel of the other side among the 8 neighbours
+        for dx in (-1, 0, 1):
+            if dx or dy:
+                y, x = np.clip(rr + dy, 0, h - 1), np.clip(cc + dx, 0, w - 1)
+                inside = (rr + dy == y) & (cc + dx == x)
+                for side in (0, 1):
+                    sel = inside & (other == side)
+                    off1[sel] |= pair[side][y[sel], x[sel]]
     at_end = np.zeros(len(rr), bool)
     if len(rr) and len(ends):
         q = np.stack([cc, rr], axis=1).astype(float)
         for k in range(0, len(q), 4096):
             d = np.hypot(q[k:k + 4096, None, 0] - ends[None, :, 0], q[k:k + 4096, None, 1] - ends[None, :, 1])
             at_end[k:k + 4096] = d.min(axis=1) <= END_RADIUS_PX
-    off1 = near_other[rr, cc]
     return {"oracle_pixels": int(orac.sum()), "differing": int(len(rr)),
             "off_by_one_across": int((off1 & ~at_end).sum()), "off_by_one_at_ends": int((off1 & at_end).sum()),
             "farther": int((~off1).sum())}
