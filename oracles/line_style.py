@@ -41,6 +41,10 @@ square-on) sit up to half a pixel off in every correct drawing, as in
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
 the windows, are not measured (the centroids would be of stray crossings).
 
+Ends (:func:`oracles.free_ends.measure_ends`): each free end's coverage along its line, where it
+falls to half the line's width; the median over a case's free ends is judged
+(:data:`oracles.free_ends.END_TOL_PX`, past the cap of half the width a renderer may draw).
+
 Raster rule (aliased lines): the pixels where the candidate and pyrender
 differ are counted; one with a pixel of the other side among its 8 neighbours
 is "off by one", at an end when within :data:`END_RADIUS_PX` of a segment end,
@@ -59,8 +63,9 @@ The verdict (:meth:`CaseStyle.judge`):
   :data:`oracles.image_diagnose.OFFSET_TOL_PX` (aliased lines of another rule:
   :data:`RULE_OFFSET_MAX_PX`) fails as ``pixel_offset`` with the measured
   ``dx, dy``, a warp beyond :data:`oracles.image_diagnose.SCALE_TOL_PX` (binary
-  lines: half a pixel more) fails too; the registration's offset and scale
-  faults give way to the measure's. F1@1px holds for every style.
+  lines: half a pixel more) fails too, and so do ends that stop short or run
+  on (``line_end_bias``); the registration's offset and scale faults give way
+  to the measure's. F1@1px holds for every style.
 """
 
 from __future__ import annotations
@@ -85,6 +90,8 @@ WIDE_MIN_PX = 1.75
 #: grey (between 1/8 and 7/8 of the line's level): antialiased lines have a third or more
 #: (measured: 4x4 supersampled 1-px lines 0.6-0.8).
 GREY_SHARE_MAX = 0.05
+#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it.
+LEVEL_SHARE_MIN = 0.002
 #: The line's level: this percentile of the drawn pixels' values (robust to a few bright
 #: crossings of antialiased lines).
 LEVEL_PERCENTILE = 99
@@ -94,23 +101,14 @@ MIN_MASS = 0.5
 #: Samples a case keeps per frame (evenly thinned above): thousands of samples pin the pooled
 #: offset far below 0.05 px, and the measure costs about the same whatever the mesh.
 MAX_SAMPLES_PER_FRAME = 4000
+#: ... and per case: past it every frame's samples are halved, so a case's memory stays bounded
+#: whatever its number of frames (the offset is a mean over tens of thousands of samples either way).
+MAX_SAMPLES_PER_CASE = 48_000
 #: Fewer samples than this in a case: the geometry is not measured (too little free line).
 MIN_SAMPLES = 20
 #: The geometry is measured only where at least this share of the windows along the oracle's lines
 #: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
 MIN_FOUND_SHARE = 0.5
-#: A segment end is measured when no other segment comes this close to it (px): the profile along the
-#: line (4 px past the end) stays clear of every other line's window.
-FREE_END_PX = GUARD_PX + 4.0
-#: Along-line profile of an end: from this far inside the line (px) to END_REACH_PX past its end.
-END_INSIDE_PX = 6.0
-END_REACH_PX = 4.0
-#: An end is short when the line's coverage falls to half before this (px, negative: inside the
-#: segment; a butt end falls at 0, a round or square cap up to half the width past it), long when
-#: it stays above half this far past half the width. A dropped or added pixel moves it by 1.
-END_TOL_PX = 0.5
-#: Ends a case must have measured for their median to be judged.
-MIN_ENDS = 4
 #: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
 #: Line faults named from the one-sided pixel counts (oracles.diagnose.diagnose_lines): GL's rule.
 COUNT_FAULTS = ("line_end_bias", "line_pixel_bias")
@@ -125,15 +123,15 @@ RULE_OFFSET_MAX_PX = 0.35
 CAN_SHOW = {
     "aliased": "every pixel: the line rule (GL's or another), the geometry to the pixel, "
                "pixel offsets pooled over the lines",
-    "antialiased": "each line's centre to a fraction of a pixel (the coverage centroid): offsets, "
-                   "missing or extra lines",
-    "wide": "each line's centre to a fraction of a pixel (the centroid across the line): offsets, "
-            "missing or extra lines",
+    "antialiased": "each line's centre to a fraction of a pixel (the coverage centroid): offsets, scale, "
+                   "missing or extra lines, where free ends stop",
+    "wide": "each line's centre to a fraction of a pixel (the centroid across the line): offsets, scale, "
+            "missing or extra lines, where free ends stop (beyond the cap)",
 }
 CANNOT_SHOW = {
     "aliased": "nothing the other styles show",
     "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, "
-                   "not judged",
+                   "not judged; an end where lines meet",
     "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other "
             "line's width covers it)",
 }
@@ -163,7 +161,8 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     measured centre minus the exact line along the unit ``normal``, at
     ``point`` on the exact line; ``width`` the coverage across the line there
     (px, perpendicular to the line); ``segment`` its segment. ``windows``: the
-    windows looked at (clear of junctions), of which the ``M`` held a line.
+    windows looked at (clear of junctions); ``found``: those that held a line
+    (``M`` of them kept, at most ``limit``).
     """
     h, w = cov.shape
     r = PROFILE_RADIUS_PX
@@ -203,7 +202,7 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     keys = ("normal", "offset", "width", "segment", "point", "mass")
     if not parts:
         out = {k: np.zeros((0, 2)) if k in ("normal", "point") else np.zeros(0) for k in keys}
-        out["windows"] = 0
+        out["windows"] = out["found"] = 0
         return out
     out = {k: np.concatenate([p[k] for p in parts]) for k in keys}
     if len(segs) > 1:                                   # drop windows near another segment (a junction, a crossing)
@@ -217,67 +216,12 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
     keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
     out = {k: v[keep] for k, v in out.items()}
-    if len(out["offset"]) > limit:
-        idx = np.linspace(0, len(out["offset"]) - 1, limit).round().astype(int)
+    found = len(out["offset"])
+    if found > limit:
+        idx = np.linspace(0, found - 1, limit).round().astype(int)
         out = {k: v[idx] for k, v in out.items()}
-    out["windows"] = windows
+    out["windows"], out["found"] = windows, found
     return out
-
-
-def _bilinear(cov: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Coverage at points ``q (..., 2)`` (x, y; pixel centres at integers), bilinear; 0 outside."""
-    h, w = cov.shape
-    x0, y0 = np.floor(q[..., 0]).astype(np.intp), np.floor(q[..., 1]).astype(np.intp)
-    fx, fy = q[..., 0] - x0, q[..., 1] - y0
-    out = np.zeros(q.shape[:-1])
-    for dx, dy, wgt in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)), (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
-        xx, yy = x0 + dx, y0 + dy
-        ok = (xx >= 0) & (xx < w) & (yy >= 0) & (yy < h)
-        out[ok] += wgt[ok] * cov[yy[ok], xx[ok]]
-    return out
-
-
-def measure_ends(cov: np.ndarray, segs: np.ndarray) -> np.ndarray:
-    """Where each free end of the oracle's segments stops in the image: ``(E,)`` px past the exact end.
-
-    An end is free when inside the image (the profile too) and no other
-    segment comes within :data:`FREE_END_PX`. Along the line, from
-    :data:`END_INSIDE_PX` inside to :data:`END_REACH_PX` past the end, every
-    0.25 px, the coverage summed across the line (bilinear, 0.5 px steps,
-    :data:`PROFILE_RADIUS_PX` each side) is the line's width there; the end is
-    where it last falls to half the width of the line's inner part.
-    """
-    h, w = cov.shape
-    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    out = []
-    s = np.arange(-END_INSIDE_PX, END_REACH_PX + 1e-9, 0.25)
-    t = np.arange(-PROFILE_RADIUS_PX, PROFILE_RADIUS_PX + 1e-9, 0.5)
-    margin = PROFILE_RADIUS_PX + END_REACH_PX + 2
-    for i, (a, b) in enumerate(segs):
-        length = float(np.hypot(*(b - a)))
-        if length < END_INSIDE_PX + 2:
-            continue
-        unit = (b - a) / length
-        normal = np.array([-unit[1], unit[0]])
-        others = np.delete(segs, i, axis=0)
-        for end, out_dir in ((a, -unit), (b, unit)):
-            if not (margin <= end[0] <= w - 1 - margin and margin <= end[1] <= h - 1 - margin):
-                continue
-            if len(others) and _seg_distance(end[None], others[:, 0], others[:, 1]).min() <= FREE_END_PX:
-                continue
-            q = end + s[:, None, None] * out_dir + t[None, :, None] * normal      # (len(s), len(t), 2)
-            mass = _bilinear(cov, q).sum(axis=1) * 0.5
-            inner = float(np.median(mass[s <= -2.5]))
-            if inner < MIN_MASS:
-                continue
-            above = np.flatnonzero(mass >= inner / 2.0)
-            k = above.max()
-            if k + 1 >= len(s):                      # still drawn at the end of the reach
-                out.append(float(s[-1]))
-                continue
-            m0, m1 = mass[k], mass[k + 1]         # cross half the inner width between s[k] and s[k + 1]
-            out.append(float(s[k] + (s[k + 1] - s[k]) * (m0 - inner / 2.0) / max(m0 - m1, 1e-12)))
-    return np.asarray(out)
 
 
 def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre: np.ndarray):
@@ -348,22 +292,33 @@ def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
 
 def _off_by_one(cand: np.ndarray, orac: np.ndarray, ends: np.ndarray) -> dict:
     """Pixels where ``cand`` and ``orac`` differ, counted by where they are (module docstring)."""
-    from scipy.ndimage import binary_dilation
-
-    eight = np.ones((3, 3), bool)
-    extra, missing = cand & ~orac, orac & ~cand
-    near_other = (extra & binary_dilation(orac, eight)) | (missing & binary_dilation(cand, eight))
-    rr, cc = np.nonzero(extra | missing)
+    h, w = cand.shape
+    rr, cc = np.nonzero(cand != orac)
+    other = np.where(cand[rr, cc], 0, 1)                # 0: look in orac (an extra pixel), 1: in cand
+    pair = (orac, cand)
+    off1 = np.zeros(len(rr), bool)
+    for dy in (-1, 0, 1):                               # a pixel of the other side among the 8 neighbours
+        for dx in (-1, 0, 1):
+            if dx or dy:
+                y, x = np.clip(rr + dy, 0, h - 1), np.clip(cc + dx, 0, w - 1)
+                inside = (rr + dy == y) & (cc + dx == x)
+                for side in (0, 1):
+                    sel = inside & (other == side)
+                    off1[sel] |= pair[side][y[sel], x[sel]]
     at_end = np.zeros(len(rr), bool)
     if len(rr) and len(ends):
         q = np.stack([cc, rr], axis=1).astype(float)
         for k in range(0, len(q), 4096):
             d = np.hypot(q[k:k + 4096, None, 0] - ends[None, :, 0], q[k:k + 4096, None, 1] - ends[None, :, 1])
             at_end[k:k + 4096] = d.min(axis=1) <= END_RADIUS_PX
-    off1 = near_other[rr, cc]
     return {"oracle_pixels": int(orac.sum()), "differing": int(len(rr)),
             "off_by_one_across": int((off1 & ~at_end).sum()), "off_by_one_at_ends": int((off1 & at_end).sum()),
             "farther": int((~off1).sum())}
+
+
+def _halve(samples: dict) -> dict:
+    """Every other sample of a frame's :func:`measure` (its counts kept)."""
+    return {k: (v if np.ndim(v) == 0 else v[::2]) for k, v in samples.items()}
 
 
 class CaseStyle:
@@ -372,7 +327,7 @@ class CaseStyle:
     ``frame`` is called once per frame with the candidate's grey image (it
     returns the bool pixels the F1 scores compare: drawn where >= 128, the
     rule of docs/frames.md); ``judge`` once, after the F1 reasons are known.
-    Only sums, samples and the frames' segments are kept between frames, never an image.
+    Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
     def __init__(self, line_rule: str = "gl"):
@@ -385,7 +340,7 @@ class CaseStyle:
         self.ends = []                          # measure_ends() of each frame
         self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
                        "farther": 0}
-        self._frames = []                       # (segments, image shape) of each frame, for the reference
+        self.reference = []                     # measure() of a correct binary drawing of each binary frame
         self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m) -> np.ndarray:
@@ -403,9 +358,18 @@ class CaseStyle:
             _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
         cov = grey / max(int(grey.max()), 1)                                   # the frame's line level is 1
-        self.samples.append(measure(cov, segs))
-        self.ends.append(measure_ends(cov, segs))
-        self._frames.append((segs, grey.shape))
+        from . import free_ends
+
+        got = measure(cov, segs)
+        self.samples.append(got)
+        self.ends.append(free_ends.measure_ends(cov, segs))
+        drawn = grey[grey > 0]
+        if len(drawn) and np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) <= GREY_SHARE_MAX:
+            width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
+            self.reference.append(measure(_reference(segs, grey.shape, width).astype(float), segs))
+        if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
+            self.samples = [_halve(x) for x in self.samples]
+            self.reference = [_halve(x) for x in self.reference]
         counts = _off_by_one(cand, orac, segs.reshape(-1, 2))
         self.raster = {k: v + counts[k] for k, v in self.raster.items()}
         return cand
@@ -421,7 +385,7 @@ class CaseStyle:
         drawn = self.hist[1:]
         n = int(drawn.sum())
         if n == 0:
-            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0}
+            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1}
         cum = np.cumsum(drawn)
         level = int(np.searchsorted(cum, LEVEL_PERCENTILE / 100.0 * n)) + 1
         values = np.arange(1, 256)
@@ -434,7 +398,11 @@ class CaseStyle:
             width = coverage / self.length_px if self.length_px > 0 else 0.0
         grey_share = float(grey) / n
         style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
-        return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level}
+        # coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's step on
+        # lines that all sit at one fractional position; that half step is added to the offset's tolerance
+        steps = max(int((drawn >= LEVEL_SHARE_MIN * n).sum()), 1)
+        return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level,
+                "coverage_steps": steps}
 
     def _fit(self, samples):
         """``(d (2,), affine)`` over ``samples``: ``d`` the pooled offset (:func:`pooled_offset`), ``affine``
@@ -454,10 +422,10 @@ class CaseStyle:
         value there less the offset's (fitted values, not the map's parameters: lines of few directions
         fix the values where the lines are, not the map everywhere).
         """
-        windows = sum(x["windows"] for x in self.samples)
+        windows, found = sum(x["windows"] for x in self.samples), sum(x["found"] for x in self.samples)
         n = len(self._pooled("offset"))
         ends = np.concatenate(self.ends) if self.ends else np.zeros(0)
-        geo = {"samples": n, "windows": windows, "found_share": n / windows if windows else 0.0,
+        geo = {"samples": n, "windows": windows, "found_share": found / windows if windows else 0.0,
                "offset_px": None, "bias_px": None, "warp_px": None, "ends_measured": int(len(ends)),
                "end_px": float(np.median(ends)) if len(ends) else None}
         fit = self._fit(self.samples)
@@ -466,8 +434,7 @@ class CaseStyle:
         d, affine = fit
         ref_d, ref_affine = np.zeros(2), None
         if read["grey_share"] <= GREY_SHARE_MAX:        # binary: quantised; the same measure on a correct drawing
-            ref = self._fit([measure(_reference(segs, shape, read["width_px"]).astype(float), segs)
-                             for segs, shape in self._frames])
+            ref = self._fit(self.reference) if len(self.reference) == len(self.samples) else None
             if ref is not None:
                 ref_d, ref_affine = ref
         normal, point = self._pooled("normal").reshape(-1, 2), self._pooled("point").reshape(-1, 2)
@@ -493,13 +460,16 @@ class CaseStyle:
         """
         from .diagnose import FAULT_ORDER
         from .image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX
+        from .free_ends import END_TOL_PX, MIN_ENDS
 
         read = self.classify()
         geo = self.geometry(read)
         style = read["style"]
         aliased = style == "aliased"
         by_rule = aliased and self.line_rule == "gl"
-        tol_px = RULE_OFFSET_MAX_PX if aliased else OFFSET_TOL_PX
+        binary = read["grey_share"] <= GREY_SHARE_MAX
+        tol_px = (RULE_OFFSET_MAX_PX if aliased else
+                  OFFSET_TOL_PX + (0.0 if binary else 0.5 / read["coverage_steps"]))
         out = {**read, "line_rule": self.line_rule,
                "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
                             "the geometry (line centres); F1@0px is reported, not judged",
@@ -522,7 +492,7 @@ class CaseStyle:
         moved = placed and off > tol_px
         # binary lines are quantised line by line (up to half a pixel each, which the reference drawing
         # matches only for its own rule): their warp is judged with that half pixel added
-        warp_tol = SCALE_TOL_PX + (0.5 if read["grey_share"] <= GREY_SHARE_MAX else 0.0)
+        warp_tol = SCALE_TOL_PX + (0.5 if binary else 0.0)
         out["warp_tol_px"] = warp_tol
         warped = placed and geo["warp_px"] > warp_tol
         if placed and not by_rule:

@@ -243,3 +243,25 @@ def test_a_dropped_or_extra_end_is_named(short_px, named):
     assert geo["end_px"] == pytest.approx(0.37 - short_px, abs=0.15)
     assert [f["name"] for f in rec["faults"]] == (["line_end_bias"] if named else [])
     assert any("line ends" in r for r in reasons) == named
+
+
+def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
+    # past MAX_SAMPLES_PER_CASE every frame's samples are halved: memory bounded whatever the number of
+    # frames, the counts that say how much line was found kept (found_share stays 1: a correct drawing)
+    from wirecheck.core.camera import Camera
+    from wirecheck.oracles import line_style
+
+    monkeypatch.setattr(line_style, "MAX_SAMPLES_PER_CASE", 600)
+    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
+                 projection="orthographic", ortho_height=140.0)
+    p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0]])
+    edges = np.array([[0, 1], [2, 3]])
+    image = draw_antialiased(oracle_segments(p, edges, cam), 220, 140)
+    style = line_style.CaseStyle()
+    for _ in range(8):
+        style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
+        assert sum(len(x["offset"]) for x in style.samples + style.reference) <= 600
+    rec = {"faults": []}
+    style.judge(rec, [], None)
+    geo = rec["line_style"]["geometry"]
+    assert geo["found_share"] == 1.0 and max(map(abs, geo["offset_px"])) < 0.05 and rec["faults"] == []

@@ -60,3 +60,45 @@ def test_matplotlib_y_up_is_named_mirror_vertical(job_dir, tmp_path, capsys):
     for c in report["cases"]:
         assert c["verdict"] == "fail" and primary(c["faults"]) == "mirror_vertical", c["faults"]
         assert not any(f.get("measured_by") == "line centroids" for f in c["faults"])
+
+
+# ---- moderngl: OpenGL on EGL (Mesa's llvmpipe here), aliased and 4x MSAA ----
+
+MODERNGL = Path(__file__).parent / "clients" / "moderngl_frames.py"
+
+
+def _require_egl():
+    moderngl = pytest.importorskip("moderngl")
+    try:
+        moderngl.create_standalone_context(backend="egl").release()
+    except Exception as exc:        # no EGL display or driver: nothing to draw with
+        pytest.skip(f"moderngl has no EGL context here: {exc}")
+
+
+def _render_gl(job_dir: Path, tmp_path: Path, *options) -> tuple[int, dict]:
+    job = tmp_path / "job"
+    shutil.copytree(job_dir, job)
+    subprocess.run([sys.executable, str(MODERNGL), str(job), *options], check=True, timeout=120)
+    rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")])
+    return rc, json.loads((tmp_path / "rep" / "report.json").read_text())
+
+
+@pytest.mark.parametrize("samples, style", [("0", "aliased"), ("4", "antialiased")])
+def test_moderngl_correct_setup_passes(job_dir, tmp_path, capsys, samples, style):
+    _require_egl()
+    rc, report = _render_gl(job_dir, tmp_path, "--samples", samples)
+    assert rc == 0, capsys.readouterr().out
+    for c in report["cases"]:
+        assert c["line_style"]["style"] == style and c["faults"] == []
+        if style == "aliased":          # GL's rule, as the oracle's (Mesa): pixel for pixel (measured >= 0.999)
+            assert c["pixel_f1_0px"] >= 0.98
+        else:                           # 4x MSAA: coverage in quarters; GL's rule would fail it
+            assert c["line_style"]["coverage_steps"] == 4 and c["pixel_f1_0px"] < 0.98
+
+
+def test_moderngl_rows_not_flipped_is_named_mirror_vertical(job_dir, tmp_path, capsys):
+    _require_egl()
+    rc, report = _render_gl(job_dir, tmp_path, "--no-flip")
+    assert rc == 1
+    for c in report["cases"]:
+        assert c["verdict"] == "fail" and primary(c["faults"]) == "mirror_vertical", c["faults"]
