@@ -60,7 +60,7 @@ TARGETS = {
     "oracles/convert.py": (["tests/test_oracle_convert.py"], None),
     "oracles/judge.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
                           "tests/test_crosscheck_styles.py"],
-                         "decides or note or empty_scene or faceless or visibility or line_end_bias or exact"),
+                         "decides or note or empty_scene or faceless or visibility or line_end_bias or exact or geometric"),
 }
 
 PER_MUTANT_TIMEOUT_S = 300
