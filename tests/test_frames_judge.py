@@ -162,6 +162,7 @@ def _decides(job, field, at, past, prefix, base=OPEN):
     assert bad["verdict"] == "fail" and worst
     for c in worst:
         assert len(c["reasons"]) == 1 and c["reasons"][0].startswith(prefix), c["reasons"]
+    return worst
 
 
 def _lowest(job, key):
@@ -173,7 +174,10 @@ def _lowest(job, key):
 def test_min_f1_1px_decides_on_frames(stray):
     f1 = _lowest(stray, "pixel_f1_1px")
     assert 0.99 < f1 < 1.0                  # one stray pixel among ~1,000
-    _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
+    failed = _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
+    # the geometry is right (nothing named from the images) and the line gate is off: a failure
+    # nothing explains is `unexplained`, never "no fault" (oracles.judge.decide)
+    assert all(c["faults"] == [{"name": "unexplained"}] for c in failed), [c["faults"] for c in failed]
 
 
 def test_min_f1_0px_decides_on_frames(short):
