@@ -122,6 +122,22 @@ def test_frames_cli_exit_1_for_the_short_lines(short, tmp_path, capsys):
     assert "line_end_bias" in capsys.readouterr().out
 
 
+@pytest.fixture(scope="module")
+def mirrored(job_dir, tmp_path_factory) -> Path:
+    """Core's frames flipped left to right (a renderer with x mirrored)."""
+    return _filled(job_dir, tmp_path_factory.mktemp("mirrored"), lambda img: img[:, ::-1].copy())
+
+
+def test_a_geometric_fault_is_named_before_the_lines(mirrored):
+    # a mirrored picture fails the line gate too (whole lines elsewhere: per-edge counts off by
+    # tens of pixels), but the fault is the mirror, named from the images; a line fault is named
+    # only when the geometry agrees
+    report, _ = run_frames(mirrored)
+    case = next(c for c in report["cases"] if c["camera"] == "oblique_roll")
+    assert case["verdict"] == "fail" and case["lines"]["edge_count_max_diff"] > tolerances.MAX_EDGE_COUNT_DIFF
+    assert [f["name"] for f in case["faults"]] == ["mirror_horizontal"], case["faults"]
+
+
 def test_both_paths_count_the_same_one_sided_pixels(monkeypatch, short):
     """The projector path on core (rasterizer patched alike) against the frames path on core's PNGs."""
     monkeypatch.setattr(raster, "_line_pixels", drop_last)
@@ -146,6 +162,7 @@ def _decides(job, field, at, past, prefix, base=OPEN):
     assert bad["verdict"] == "fail" and worst
     for c in worst:
         assert len(c["reasons"]) == 1 and c["reasons"][0].startswith(prefix), c["reasons"]
+    return worst
 
 
 def _lowest(job, key):
@@ -157,7 +174,10 @@ def _lowest(job, key):
 def test_min_f1_1px_decides_on_frames(stray):
     f1 = _lowest(stray, "pixel_f1_1px")
     assert 0.99 < f1 < 1.0                  # one stray pixel among ~1,000
-    _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
+    failed = _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
+    # the geometry is right (nothing named from the images) and the line gate is off: a failure
+    # nothing explains is `unexplained`, never "no fault" (oracles.judge.decide)
+    assert all(c["faults"] == [{"name": "unexplained"}] for c in failed), [c["faults"] for c in failed]
 
 
 def test_min_f1_0px_decides_on_frames(short):

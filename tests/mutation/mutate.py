@@ -59,8 +59,9 @@ TARGETS = {
                            "decides or note or empty_scene or faceless or visibility"),
     "oracles/convert.py": (["tests/test_oracle_convert.py"], None),
     "oracles/judge.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
-                          "tests/test_crosscheck_styles.py"],
-                         "decides or note or empty_scene or faceless or visibility or line_end_bias or exact"),
+                          "tests/test_crosscheck_styles.py", "tests/test_gate.py"],
+                         "decides or note or empty_scene or faceless or visibility or line_end_bias or exact or geometric "
+                         "or vacuous"),
 }
 
 PER_MUTANT_TIMEOUT_S = 300
