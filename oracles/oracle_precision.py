@@ -114,8 +114,8 @@ def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error,
         return
     rec["oracle_bound_px"] = float(bound_px)
     rec["oracle_limit_px"] = ORACLE_LIMIT_PX
-    if not bound_px > ORACLE_LIMIT_PX:
-        return
+    if not bound_px > ORACLE_LIMIT_PX or rec.get("verdict") == "vacuous":
+        return          # within the limit; or nothing was compared, which the case already says
     vertices_only = {k: v for k, v in rec.items() if k != "lines"}
     vertices_only.update(pixel_f1_0px=None, pixel_f1_1px=None, silhouette_iou=None,
                          compared=dict(rec["compared"], pixels=None))

@@ -133,7 +133,8 @@ def test_jobs_2_gives_the_report_of_jobs_1(tmp_path):
     assert without_timing(out1) == without_timing(out2)            # byte for byte, apart from timing
     assert (out1 / "report.md").read_bytes() == (out2 / "report.md").read_bytes()
     imgs = sorted(p.name for p in (out1 / "img").iterdir())
-    assert len(imgs) == 12 and imgs == sorted(p.name for p in (out2 / "img").iterdir())
+    # 4 worst frames x (candidate, oracle, diff, and the enlarged crop of the worst disagreement)
+    assert len(imgs) == 16 and imgs == sorted(p.name for p in (out2 / "img").iterdir())
     for name in imgs:
         assert (out1 / "img" / name).read_bytes() == (out2 / "img" / name).read_bytes()
 

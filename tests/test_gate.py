@@ -330,7 +330,7 @@ def test_fault_numbers_are_printed_distinct_from_their_nominal_values():
     text = fault_text(faults, camera)
     # 4:3 = 1.33333...: 4 significant digits print both as 1.333, 5 tell them apart
     assert "implied_aspect=1.3326," in text and "scale_x=1.0005," in text and "scale_y=1)" in text
-    assert "scale=0.99999," in text and "implied_fov_deg=60.0004," in text
+    assert "scale=0.99999," in text and "implied_fov_deg=60.0004)" in text
     # far from nominal: 4 significant digits, as before
     assert distinct(1.5, 4 / 3) == "1.5" and distinct(0.25, 0.0) == "0.25"
     assert distinct(1.0000004e-06, 1e-06) == "1.0000004e-06"
