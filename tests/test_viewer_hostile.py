@@ -24,7 +24,8 @@ from PIL import Image
 
 import wirecheck.core.viewer as viewer_mod
 from wirecheck.core.cli import build_parser, settings_from_args
-from wirecheck.core.viewer import FIELDS, MAX_BODY_BYTES, MAX_OPS, Server, View, Viewer
+from wirecheck.core.viewer import FIELDS, MAX_OPS, View, Viewer
+from wirecheck.core.viewer_http import MAX_BODY_BYTES, Server
 
 W, H = 64, 48
 # a few float64 rotations of values ~4 (test_viewer.py's TOL)
