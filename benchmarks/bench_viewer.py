@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from wirecheck.core.cli import build_parser, settings_from_args
-from wirecheck.core.viewer import STAGES, Server, Viewer
+from wirecheck.core.viewer import STAGES, Viewer
+from wirecheck.core.viewer_http import Server
 
 MODES = {"wireframe": [], "hidden-lines": ["--hidden-lines"], "shaded": ["--style", "shaded"]}
 

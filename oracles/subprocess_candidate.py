@@ -31,7 +31,7 @@ the same on every run). :meth:`SubprocessCandidate.take_stderr` returns what
 was written since the last call.
 
 (About 700 lines: one program's life cycle, its non-blocking pipes and its
-protocol state are one state machine; :class:`_ForkedChild` is the Popen
+protocol state are one state machine; :class:`ForkedChild` is the Popen
 stand-in for callables run in a fork.)
 """
 
@@ -51,6 +51,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import protocol
+from .forked_candidate import ForkedChild
+from .processes import await_group_end, die_with_parent, kill_pipe_holders, pipe_ends
 from .candidate import CandidateError
 
 #: Default seconds a request may take (issue 15: a hang fails the case, not the run).
@@ -66,8 +68,6 @@ _CHUNK = 1 << 20
 _EXIT_GRACE_S = 2.0
 #: Seconds, at least, to collect the exit status of a program whose pipe ended (one that is exiting).
 _REAP_MIN_S = 0.05
-#: Seconds a killed program's group gets to be gone (a SIGKILL ends a process in milliseconds).
-_GROUP_END_S = 1.0
 
 
 class CandidateStartRefused(CandidateError):
@@ -138,7 +138,7 @@ class SubprocessCandidate:
 
     @classmethod
     def fork(cls, func, timeout_s: float = DEFAULT_TIMEOUT_S, label: str = "") -> "SubprocessCandidate":
-        """``func`` run in a forked child process (:class:`_ForkedChild`); POSIX only."""
+        """``func`` run in a forked child process (:class:`ForkedChild`); POSIX only."""
         return cls(argv=("<forked>",), timeout_s=timeout_s, label=label or repr(func), python_spec=label or repr(func),
                    forked=func)
 
@@ -221,192 +221,11 @@ def _close_all() -> None:
         spec.close()
 
 
-def _die_with_parent() -> None:
-    """In the child, before exec: SIGKILL when crosscheck's process ends (Linux), so no hung program outlives a
-    killed run. Elsewhere a program still sees EOF on stdin when crosscheck ends."""
-    try:
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)    # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        pass
-
-
 def _live_pipe_fds() -> list:
     """This process's ends of every live program's pipes: a fork closes them, or a program would never see
     EOF on its stdin while the fork lives (its close would wait out ``_EXIT_GRACE_S``, then kill it)."""
     return [f.fileno() for program in _PROGRAMS.values() if program.proc is not None
             for f in (program.proc.stdin, program.proc.stdout, program.proc.stderr) if not f.closed]
-
-
-class _ForkedChild:
-    """A forked copy of this process serving the candidate protocol for ``func``: what Popen gives, for it.
-
-    The child gets its own session (so the program group can be killed), dies
-    with its parent (Linux), sends its prints and stderr to the stderr pipe,
-    and always ends with ``os._exit``: it never returns into the caller's code.
-    """
-
-    def __init__(self, func):
-        in_r, in_w = os.pipe()
-        out_r, out_w = os.pipe()
-        err_r, err_w = os.pipe()
-        pid = os.fork()
-        if pid == 0:                                   # the child
-            code = 1
-            try:
-                os.setsid()
-                _die_with_parent()
-                sys.dont_write_bytecode = True         # as the candidate host: no __pycache__ from its imports
-                for fd in (in_w, out_r, err_r, *_live_pipe_fds()):
-                    os.close(fd)
-                os.dup2(err_w, 1)
-                os.dup2(err_w, 2)
-                sys.stdout = sys.stderr = open(2, "w", buffering=1, closefd=False)
-                from .candidate_host import serve_loaded
-
-                stdin, out = os.fdopen(in_r, "rb"), os.fdopen(out_w, "wb")
-
-                def send(data: bytes) -> None:
-                    out.write(data)
-                    out.flush()
-
-                if stdin.readline() == protocol.HEADER:
-                    send(protocol.HEADER)
-                    code = serve_loaded(func, stdin, send)
-                else:
-                    send(protocol.encode_error(f"expected the header {protocol.HEADER!r}"))
-                    code = 2
-            except BaseException:                      # noqa: BLE001 - the child must never return
-                code = 1
-            finally:
-                os._exit(code)
-        for fd in (in_r, out_w, err_w):
-            os.close(fd)
-        self.pid = pid
-        self.args = ("<forked>",)
-        self.returncode = None
-        self.stdin = os.fdopen(in_w, "wb", buffering=0)
-        self.stdout = os.fdopen(out_r, "rb", buffering=0)
-        self.stderr = os.fdopen(err_r, "rb", buffering=0)
-
-    def poll(self):
-        if self.returncode is None:
-            pid, status = os.waitpid(self.pid, os.WNOHANG)
-            if pid:
-                self.returncode = os.waitstatus_to_exitcode(status)
-        return self.returncode
-
-    def wait(self, timeout=None):
-        deadline = None if timeout is None else time.monotonic() + timeout
-        while self.poll() is None:
-            if deadline is not None and time.monotonic() > deadline:
-                raise subprocess.TimeoutExpired(self.args, timeout)
-            time.sleep(0.001)
-        return self.returncode
-
-    def kill(self) -> None:
-        if self.returncode is None:
-            try:
-                os.kill(self.pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-
-
-def _await_group_end(pgid: int) -> None:
-    """Return once no process of group ``pgid`` (killed) runs, or after ``_GROUP_END_S``.
-
-    A SIGKILL is delivered asynchronously: without this, a program's own child
-    could still be running when the call that ended it returns. A member that
-    has ended but is not this process's child is left to its new parent (init)
-    to reap; where there is no ``/proc``, this returns at once.
-    """
-    deadline = time.monotonic() + _GROUP_END_S
-    while time.monotonic() < deadline:
-        try:
-            os.killpg(pgid, 0)
-        except (ProcessLookupError, PermissionError):
-            return                     # no member at all: the usual case, at the cost of one call
-        if not _group_runs(pgid):
-            return
-        time.sleep(0.001)
-
-
-def _pipe_ends(proc) -> dict:
-    """``{pipe inode: access mode}`` of the program's ends of its three pipes (read stdin, write stdout, stderr)."""
-    try:
-        return {os.fstat(proc.stdin.fileno()).st_ino: os.O_RDONLY,
-                os.fstat(proc.stdout.fileno()).st_ino: os.O_WRONLY,
-                os.fstat(proc.stderr.fileno()).st_ino: os.O_WRONLY}
-    except (OSError, ValueError):
-        return {}
-
-
-def _kill_pipe_holders(ends: dict) -> None:
-    """SIGKILL every other process that ``/proc`` shows holding one of the program's pipe ends ``ends``.
-
-    A process the program started in a session of its own (``setsid``, a
-    daemon) escapes its process group, but while it holds the program's stdout
-    or stdin it is still the program's, and it would outlive the run. (A process
-    that closed them is out of reach; this process's own ends, and a fork of
-    it that inherited them, are the other direction and are left alone.)
-    """
-    if not ends:
-        return
-    try:
-        names = os.listdir("/proc")
-    except OSError:
-        return
-    me, held = os.getpid(), []
-    for name in names:
-        if not name.isdigit() or int(name) == me:
-            continue
-        try:
-            for fd in os.listdir(f"/proc/{name}/fd"):
-                link = os.readlink(f"/proc/{name}/fd/{fd}")
-                if not link.startswith("pipe:["):
-                    continue
-                mode = ends.get(int(link[6:-1]))
-                if mode is None:
-                    continue
-                with open(f"/proc/{name}/fdinfo/{fd}") as fh:
-                    flags = next(int(ln.split()[1], 8) for ln in fh if ln.startswith("flags:"))
-                if flags & os.O_ACCMODE == mode:
-                    held.append(int(name))
-                    break
-        except (OSError, ValueError, StopIteration):
-            continue
-    for pid in held:
-        with contextlib.suppress(ProcessLookupError, PermissionError):
-            os.kill(pid, signal.SIGKILL)
-    deadline = time.monotonic() + _GROUP_END_S
-    while held and time.monotonic() < deadline:
-        held = [pid for pid in held if _runs(pid)]
-        time.sleep(0.001)
-
-
-def _running_group(pid) -> int | None:
-    """The process group of ``pid`` if ``/proc`` shows it running (not a zombie), else None."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as fh:
-            state, _ppid, pgrp = fh.read().rsplit(b")", 1)[1].split()[:3]
-        return None if state == b"Z" else int(pgrp)
-    except (OSError, ValueError):
-        return None
-
-
-def _runs(pid: int) -> bool:
-    """Whether ``/proc`` shows ``pid`` running (not a zombie)."""
-    return _running_group(pid) is not None
-
-
-def _group_runs(pgid: int) -> bool:
-    """Whether ``/proc`` shows a process of group ``pgid`` that is not a zombie (False without ``/proc``)."""
-    try:
-        names = os.listdir("/proc")
-    except OSError:
-        return False
-    return any(name.isdigit() and _running_group(name) == pgid for name in names)
 
 
 class _Died(Exception):
@@ -480,11 +299,11 @@ class _Program:
         env.update(dict(spec.env))
         try:
             if spec.forked is not None:
-                proc = _ForkedChild(spec.forked)
+                proc = ForkedChild(spec.forked, _live_pipe_fds())
             else:
                 proc = subprocess.Popen(spec.argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                         stderr=subprocess.PIPE, env=env, start_new_session=True, bufsize=0,
-                                        preexec_fn=_die_with_parent)
+                                        preexec_fn=die_with_parent)
         except OSError as exc:
             raise CandidateStartRefused(f"cannot start {spec.argv[0]!r}: {exc.strerror or exc}") from None
         self.proc = proc
@@ -517,7 +336,7 @@ class _Program:
     def close(self) -> None:
         proc, self.proc = self.proc, None
         if proc is not None:
-            ends = _pipe_ends(proc)
+            ends = pipe_ends(proc)
             try:
                 proc.stdin.close()
             except OSError:
@@ -530,8 +349,8 @@ class _Program:
             # helper): its group outlives a leader that exited (only a new session of its own escapes)
             self._killpg(proc)
             proc.wait()
-            _await_group_end(proc.pid)
-            _kill_pipe_holders(ends)
+            await_group_end(proc.pid)
+            kill_pipe_holders(ends)
             self._drain_stderr(proc)
             proc.stdout.close()
             proc.stderr.close()
@@ -552,8 +371,8 @@ class _Program:
             return
         self._killpg(proc)
         proc.wait()
-        _await_group_end(proc.pid)
-        _kill_pipe_holders(_pipe_ends(proc))
+        await_group_end(proc.pid)
+        kill_pipe_holders(pipe_ends(proc))
         self._drain_stderr(proc)            # all it wrote is in the pipe now
         for f in (proc.stdin, proc.stdout, proc.stderr):
             try:

@@ -31,7 +31,8 @@ from wirecheck.core.output import png_bytes
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.projection import project_points
 from wirecheck.core.transforms import Motion
-from wirecheck.core.viewer import DOLLY_PER_UNIT, Server, View, Viewer, dolly, orbit, pan
+from wirecheck.core.viewer import DOLLY_PER_UNIT, View, Viewer, dolly, orbit, pan
+from wirecheck.core.viewer_http import Server
 
 F60 = 240.0 * math.sqrt(3.0)
 # a few float64 rotations of values ~4: 1e-12 is ~10^3 eps x scale

@@ -26,7 +26,8 @@ from wirecheck.core.camera import look_at
 from wirecheck.core.cli import build_parser, settings_from_args
 from wirecheck.core.pipeline import render_frame
 from wirecheck.core.transforms import Motion
-from wirecheck.core.viewer import DOLLY_PER_UNIT, STAGES, Server, Viewer
+from wirecheck.core.viewer import DOLLY_PER_UNIT, STAGES, Viewer
+from wirecheck.core.viewer_http import Server
 
 pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
 

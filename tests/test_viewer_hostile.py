@@ -22,9 +22,10 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from PIL import Image
 
-import wirecheck.core.viewer as viewer_mod
+import wirecheck.core.viewer_http as viewer_http_mod
 from wirecheck.core.cli import build_parser, settings_from_args
-from wirecheck.core.viewer import FIELDS, MAX_BODY_BYTES, MAX_OPS, Server, View, Viewer
+from wirecheck.core.viewer import FIELDS, MAX_OPS, View, Viewer
+from wirecheck.core.viewer_http import MAX_BODY_BYTES, Server
 
 W, H = 64, 48
 # a few float64 rotations of values ~4 (test_viewer.py's TOL)
@@ -121,7 +122,7 @@ def test_a_bad_request_is_a_4xx_json_error_and_the_view_stays(server, capsys, bo
 
 def test_a_body_shorter_than_its_length_is_dropped_after_the_timeout(tmp_path, monkeypatch, capsys):
     # the server waits REQUEST_TIMEOUT_S for the rest; 0.3 s here (set before the handler class is made)
-    monkeypatch.setattr(viewer_mod, "REQUEST_TIMEOUT_S", 0.3)
+    monkeypatch.setattr(viewer_http_mod, "REQUEST_TIMEOUT_S", 0.3)
     srv = Server(Viewer(_settings(tmp_path))).start()
     try:
         status, _, resp = _request(srv, body=b'{"ops": []}', length="100")
