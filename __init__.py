@@ -29,10 +29,10 @@ from importlib import import_module
 _EXPORTS = {
     "Camera": "core.camera", "camera_z": "core.camera", "look_at": "core.camera",
     "InputError": "core.errors",
-    "Frame": "core.pipeline", "render_frame": "core.pipeline",
-    "project_points": "core.projection",
-    "SceneRenderer": "core.frames",
-    "Scene": "core.scene", "load_scene": "core.scene_files",
+    "Frame": "core.projector.pipeline", "render_frame": "core.projector.pipeline",
+    "project_points": "core.projector.projection",
+    "SceneRenderer": "core.scene.frames",
+    "Scene": "core.scene.model", "load_scene": "core.scene.files",
     "Motion": "core.transforms",
     "assert_projector": "oracles.api", "check_projector": "oracles.api",
 }

@@ -13,7 +13,7 @@ origin-centred, written as OBJ, PLY, STL and OFF in turn (seeded: the same
 files every run). Each mesh is checked by the core candidate at the pixel
 level under a stated budget (default 2 cameras x 2 frames: ``--cases``,
 ``--frames``), as ``crosscheck`` would check it, by the library call the CLI
-makes (:func:`oracles.dataset_run.run_dataset`) with three executors:
+makes (:func:`oracles.datasets.dataset_run.run_dataset`) with three executors:
 
 * ``jobs 1``: in this process;
 * ``jobs 2``: a process pool of 2 spawn workers;
@@ -75,8 +75,8 @@ def make_dataset(folder: Path, n: int, seed: int = 12) -> list[tuple[str, int]]:
 
 
 def run(dataset, spec, frames: int, cases: str) -> dict:
-    from wirecheck.oracles.core_candidate import CoreCandidate
-    from wirecheck.oracles.dataset_run import run_dataset
+    from wirecheck.oracles.candidates.core_candidate import CoreCandidate
+    from wirecheck.oracles.datasets.dataset_run import run_dataset
 
     candidate = CoreCandidate()
     return run_dataset(dataset, candidate, frames=frames, case_names=cases, candidate_name="core", executor=spec)
@@ -91,8 +91,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.meshes < 2 or args.frames < 1:
         ap.error("expected --meshes >= 2 and --frames >= 1")
-    from wirecheck.oracles.dataset import dataset_entries
-    from wirecheck.oracles.executors import ExecutorSpec
+    from wirecheck.oracles.datasets.dataset import dataset_entries
+    from wirecheck.oracles.datasets.executors import ExecutorSpec
 
     t_start = time.perf_counter()
     info = machine_info(meshes=args.meshes, frames=args.frames, cases=args.cases)

@@ -9,9 +9,9 @@ Cases (both: camera ``camera_z(4.0, fov_y_deg=70)``, 640x480, ``Motion()``,
 180 frames, frame k at t = (k - 1) / 180; ``--quick`` times every 3rd frame
 of the icosphere):
 
-* ``cube``       the built-in scene ``core.scene_files.load_scene('cube')``
+* ``cube``       the built-in scene ``core.scene.files.load_scene('cube')``
 * ``icosphere``  ``trimesh.creation.icosphere(subdivisions=6)``: 40,962
-  vertices, 122,880 unique edges (``core.scene.unique_edges(face_edges(...))``)
+  vertices, 122,880 unique edges (``core.scene.model.unique_edges(face_edges(...))``)
 
 A *frame* is the same work on every side: this frame's model matrix and the
 scene's model-space vertices in, a finished image in host memory out (model
@@ -21,7 +21,7 @@ is built once outside the timing on every side: our ``LocalPoints``
 scene, whose vertex and index buffers go to the GL driver once (at the warm-up
 render), as a viewer would keep them.
 
-* ``ours``      ``core.pipeline.render_frame(LocalPoints, edges, camera, M)``,
+* ``ours``      ``core.projector.pipeline.render_frame(LocalPoints, edges, camera, M)``,
   raster "exact" (GL's diamond-exit rule): model -> camera -> pixels, the
   clip test, the line pixels, painting into a new ``(H, W) uint8`` image.
 * ``pyrender``  ``scene.set_pose(mesh_node, M)`` and
@@ -70,12 +70,12 @@ import numpy as np
 import trimesh
 
 from _common import machine_info, print_machine, print_table, verdict, write_json
-from wirecheck.core import raster
+from wirecheck.core.projector import raster
 from wirecheck.core.camera import camera_z
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import localize, project_points
-from wirecheck.core.scene import face_edges, unique_edges
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import localize, project_points
+from wirecheck.core.scene.model import face_edges, unique_edges
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
 
 FRAMES = 180
@@ -130,7 +130,7 @@ class PyrenderFrame:
     def __init__(self, p_model, edges, camera):
         os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
         import pyrender
-        from wirecheck.oracles.convert import camera_to_pyrender
+        from wirecheck.oracles.references.convert import camera_to_pyrender
         self._pr = pyrender
         self.renderer = pyrender.OffscreenRenderer(camera.width, camera.height)
         self.scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
@@ -154,7 +154,7 @@ class PyrenderFrame:
 def pyrender_unavailable() -> str | None:
     """Why pyrender cannot render here (None when it can)."""
     os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
-    from wirecheck.oracles.pyrender_oracle import osmesa_available
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available
     ok, why = osmesa_available()
     return None if ok else why
 

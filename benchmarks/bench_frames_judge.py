@@ -5,7 +5,7 @@
 
 For each length a job is exported (the cube, case ``on_axis``, every frame
 checked) and its frames drawn by core (a correct renderer); then a fresh
-interpreter judges it (oracles.frames_judge.run_frames) and reports its peak
+interpreter judges it (oracles.judge.frames_judge.run_frames) and reports its peak
 resident memory (``ru_maxrss``) and wall time, and, in the same process and
 on the same frames afterwards, pyrender drawing each frame alone (the
 oracle's share of the judging: ``PyrenderOracle.render``, its context
@@ -39,9 +39,9 @@ def make_job(path: Path, frames: int) -> None:
     """Export a job of ``frames`` frames (every one checked) and draw them with core."""
     from PIL import Image
 
-    from wirecheck.core.pipeline import render_frame
+    from wirecheck.core.projector.pipeline import render_frame
     from wirecheck.oracles.cli import main
-    from wirecheck.oracles.frames_candidate import frame_inputs, load_job
+    from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 
     assert main(["export", str(path), "--scene", "cube", "--cases", "on_axis", "--frames", str(frames)]) == 0
     job = load_job(path)
@@ -57,7 +57,7 @@ class CoreOracle:
     """core's drawing in the place of pyrender's (``--oracle core``): nothing kept between frames."""
 
     def render(self, p_model, edges, camera, model_matrix=None):
-        from wirecheck.core.pipeline import render_frame
+        from wirecheck.core.projector.pipeline import render_frame
 
         return render_frame(p_model, edges, camera, model_matrix).image >= 128, None
 
@@ -70,10 +70,10 @@ class CoreOracle:
 
 def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     """Judge the job (this process only): peak RSS, seconds per frame, and pyrender's per frame after."""
-    from wirecheck.oracles import pyrender_oracle
-    from wirecheck.oracles.frames_candidate import frame_inputs, load_job
-    from wirecheck.oracles.frames_judge import run_frames
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle
+    from wirecheck.oracles.references import pyrender_oracle
+    from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
+    from wirecheck.oracles.judge.frames_judge import run_frames
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
 
     if oracle_name == "core":
         pyrender_oracle.OracleCache.get = lambda self, w, h: CoreOracle()

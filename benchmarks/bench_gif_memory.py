@@ -1,4 +1,4 @@
-"""Peak memory of a GIF of many frames: core.gif's streaming writer against Pillow's ``save_all``.
+"""Peak memory of a GIF of many frames: core.outputs.gif's streaming writer against Pillow's ``save_all``.
 
     .venv/bin/python benchmarks/bench_gif_memory.py                 # 2,000 frames, 640x480 (~3 min on 2 cores)
     .venv/bin/python benchmarks/bench_gif_memory.py --frames 200    # quicker
@@ -6,7 +6,7 @@
 Each encoder runs in a fresh interpreter on the same frames (the spinning
 cube, ``renderer``'s defaults: 640x480, one turn about X and Y) and reports
 its peak resident memory (``ru_maxrss``) and the GIF's size. "pillow" is what
-``renderer --format gif`` did before core.gif: every frame converted to a
+``renderer --format gif`` did before core.outputs.gif: every frame converted to a
 palette image and kept until ``save_all`` writes them.
 """
 
@@ -22,9 +22,9 @@ import time
 
 
 def encode(mode: str, frames: int) -> dict:
-    from wirecheck.core.compose import picture
-    from wirecheck.core.frames import SceneRenderer
-    from wirecheck.core.scene import load_scene
+    from wirecheck.core.app.compose import picture
+    from wirecheck.core.scene.frames import SceneRenderer
+    from wirecheck.core.scene.model import load_scene
     from wirecheck.core.transforms import Motion
     from wirecheck.core.camera import camera_z
 
@@ -34,7 +34,7 @@ def encode(mode: str, frames: int) -> dict:
     t0 = time.perf_counter()
     buf = io.BytesIO()
     if mode == "stream":
-        from wirecheck.core.gif import GifWriter
+        from wirecheck.core.outputs.gif import GifWriter
 
         w = GifWriter(buf, 30)
         for im in images:

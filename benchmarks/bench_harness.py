@@ -39,14 +39,14 @@ from _common import machine_info, print_end, print_machine  # noqa: E402
 TARGET = 0.15
 
 #: (module attribute to wrap, label): the harness's parts, timed in this process only
-PARTS = (("wirecheck.oracles.case:oface.frame_geometry", "oracle-side geometry (scipy model matrix)"),
-         ("wirecheck.oracles.case:oracle_segments", "oracle's segments (depth clip + OpenCV of the ends)"),
-         ("wirecheck.oracles.metrics:vertex_errors_frames", "vertex metrics (errors, scale; per case)"),
-         ("wirecheck.oracles.case:ScaleBatch.flush", "vertex metrics (errors, scale; per case)"),
-         ("wirecheck.oracles.metrics:FramePixels.__init__", "pixel metrics (scan + F1)"),
-         ("wirecheck.oracles.metrics:pixel_scores", "pixel metrics (scan + F1)"),
-         ("wirecheck.oracles.metrics:LineBatch.add", "line metrics (batched per case)"),
-         ("wirecheck.oracles.metrics:LineBatch.flush", "line metrics (batched per case)"))
+PARTS = (("wirecheck.oracles.judge.case:oface.frame_geometry", "oracle-side geometry (scipy model matrix)"),
+         ("wirecheck.oracles.judge.case:oracle_segments", "oracle's segments (depth clip + OpenCV of the ends)"),
+         ("wirecheck.oracles.judge.metrics:vertex_errors_frames", "vertex metrics (errors, scale; per case)"),
+         ("wirecheck.oracles.judge.case:ScaleBatch.flush", "vertex metrics (errors, scale; per case)"),
+         ("wirecheck.oracles.judge.metrics:FramePixels.__init__", "pixel metrics (scan + F1)"),
+         ("wirecheck.oracles.judge.metrics:pixel_scores", "pixel metrics (scan + F1)"),
+         ("wirecheck.oracles.judge.metrics:LineBatch.add", "line metrics (batched per case)"),
+         ("wirecheck.oracles.judge.metrics:LineBatch.flush", "line metrics (batched per case)"))
 LABELS = tuple(dict.fromkeys(label for _, label in PARTS))
 
 

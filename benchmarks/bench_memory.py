@@ -8,14 +8,14 @@ Run from the repo root::
     .venv/bin/python benchmarks/bench_memory.py --json out.json
 
 Each size runs in a fresh process (``crosscheck``'s library call,
-:func:`oracles.dataset_run.run_dataset`, ``jobs 1``, the core candidate at
+:func:`oracles.datasets.dataset_run.run_dataset`, ``jobs 1``, the core candidate at
 the pixel level): ``N`` copies of one 4-face mesh (a tetrahedron, OBJ) in a
 temporary folder, ``--cases`` cameras x ``--frames`` frames each, so the
 320-mesh run draws 8x the frames of the 40-mesh one with the same image
 sizes. The child prints its own peak resident set (``VmHWM`` of
 /proc/self/status). Target: the 320-mesh peak within 1.3x of the 40-mesh
 peak (a run's memory does not grow with the work). ``--as-shipped`` undoes
-:func:`oracles.pyrender_programs.stabilise_program_cache` in the child, to
+:func:`oracles.references.pyrender_programs.stabilise_program_cache` in the child, to
 show what the fix is worth (pyrender compiles a shader program per frame).
 """
 
@@ -43,11 +43,11 @@ TETRA_OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 
 CHILD = r"""
 import json, sys, time
 if {as_shipped!r}:
-    import wirecheck.oracles.pyrender_oracle as po
+    import wirecheck.oracles.references.pyrender_oracle as po
     po.stabilise_program_cache = lambda renderer: None
-from wirecheck.oracles.core_candidate import CoreCandidate
-from wirecheck.oracles.dataset import dataset_entries
-from wirecheck.oracles.dataset_run import run_dataset
+from wirecheck.oracles.candidates.core_candidate import CoreCandidate
+from wirecheck.oracles.datasets.dataset import dataset_entries
+from wirecheck.oracles.datasets.dataset_run import run_dataset
 t0 = time.perf_counter()
 report = run_dataset(dataset_entries([{folder!r}]), CoreCandidate(), frames={frames}, case_names={cases!r},
                      candidate_name="core")

@@ -2,9 +2,9 @@
 
 For each stress case, the same world points are projected by
 
-- ``ours f64``: ``core.projection.project_points(dtype="float64")`` (the default);
+- ``ours f64``: ``core.projector.projection.project_points(dtype="float64")`` (the default);
 - ``ours f32``: ``project_points(dtype="float32")``: camera-relative, the camera
-  position subtracted in float64 before the cast (core/projection.py);
+  position subtracted in float64 before the cast (core/projector/projection.py);
 - ``naive f32``: the same formula in float32 *without* the camera-relative
   step (points and position cast first), what a projector that stores world
   coordinates and matrices in float32, as GPUs and many engines do, gets;
@@ -30,9 +30,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from wirecheck.core.camera import look_at  # noqa: E402
-from wirecheck.core.projection import project_points  # noqa: E402
-from wirecheck.oracles import opencv_oracle  # noqa: E402
-from wirecheck.oracles.convert import camera_to_opencv  # noqa: E402
+from wirecheck.core.projector.projection import project_points  # noqa: E402
+from wirecheck.oracles.references import opencv_oracle  # noqa: E402
+from wirecheck.oracles.references.convert import camera_to_opencv  # noqa: E402
 from wirecheck.oracles.extremes import reference_project  # noqa: E402
 
 

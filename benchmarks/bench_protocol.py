@@ -5,11 +5,11 @@ Run from the repo root (the three.js row needs ``npm ci`` in tests/clients/three
 
     .venv/bin/python benchmarks/bench_protocol.py [--quick] [--json PATH]
 
-Candidates, each called through :func:`oracles.candidate.call_candidate` as
+Candidates, each called through :func:`oracles.candidates.candidate.call_candidate` as
 crosscheck calls it (the answer checked against the contract):
 
-* ``in-process``  ``core.projection.project_points``, a Python callable in this process
-* ``python-host`` the same function run isolated (``python -m wirecheck.oracles.candidate_host``)
+* ``in-process``  ``core.projector.projection.project_points``, a Python callable in this process
+* ``python-host`` the same function run isolated (``python -m wirecheck.oracles.candidates.candidate_host``)
 * ``c``           tests/clients/candidate.c built with ``cc -O2``
 * ``three.js``    tests/clients/three/candidate.mjs on node (if node and three are installed)
 * ``null``, ``null-host``: a projector that returns zeros, in-process and in the
@@ -21,7 +21,7 @@ Workloads:
 * ``frame``: what one frame of a pixel-level crosscheck asks of a candidate,
   on every bundled scene under every case camera (frame 1 of the motion): one
   request with the scene's vertices and one with the depth-clipped ends of its
-  edges (oracles.draw). Per implementation, the median over all (scene, case)
+  edges (oracles.candidates.draw). Per implementation, the median over all (scene, case)
   pairs of the median of ``repeats`` timings.
 * ``1M``: one request of 1,000,000 random points in front of the oblique camera:
   median of ``repeats``.
@@ -49,14 +49,14 @@ if str(ROOT) not in sys.path:
 
 import numpy as np  # noqa: E402
 
-from wirecheck.core.projection import project_points  # noqa: E402
-from wirecheck.core.scene_files import builtin_names, load_scene  # noqa: E402
+from wirecheck.core.projector.projection import project_points  # noqa: E402
+from wirecheck.core.scene.files import builtin_names, load_scene  # noqa: E402
 from wirecheck.core.transforms import Motion  # noqa: E402
-from wirecheck.oracles import faces as oface  # noqa: E402
-from wirecheck.oracles.candidate import call_candidate  # noqa: E402
-from wirecheck.oracles.cases import cameras_for  # noqa: E402
-from wirecheck.oracles.draw import clip_depth  # noqa: E402
-from wirecheck.oracles.subprocess_candidate import SubprocessCandidate  # noqa: E402
+from wirecheck.oracles.references import faces as oface  # noqa: E402
+from wirecheck.oracles.candidates.candidate import call_candidate  # noqa: E402
+from wirecheck.oracles.judge.cases import cameras_for  # noqa: E402
+from wirecheck.oracles.candidates.draw import clip_depth  # noqa: E402
+from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate  # noqa: E402
 
 
 def _median_time(fn, repeats: int) -> float:
@@ -70,7 +70,7 @@ def _median_time(fn, repeats: int) -> float:
 
 def candidates(workdir: Path) -> dict:
     out = {"in-process": project_points,
-           "python-host": SubprocessCandidate.python("wirecheck.core.projection:project_points", timeout_s=120)}
+           "python-host": SubprocessCandidate.python("wirecheck.core.projector.projection:project_points", timeout_s=120)}
     null = workdir / "null_projector.py"
     null.write_text("import numpy as np\ndef null(p, c):\n    return np.zeros((len(p), 2))\n")
     out["null"] = lambda p, c: np.zeros((len(p), 2))

@@ -13,7 +13,7 @@ its pyrender oracle) skips; the table gives what the stage would add per frame
 ``skipped / (run + skipped)``:
 
 * faces: the renderer's frame loop (``localize`` once, then
-  ``render_frame(points, scene.edges, ...)`` as ``core.run.render_run`` calls
+  ``render_frame(points, scene.edges, ...)`` as ``core.app.run.render_run`` calls
   it) on a Scene with faces and on the same Scene without: the same work, so
   the same time within noise (checked). The skipped cost is per-face normals
   and the back-face test in numpy, from the frame's camera-space vertices.
@@ -32,9 +32,9 @@ its pyrender oracle) skips; the table gives what the stage would add per frame
   polygon offset, as the oracle does when given faces). Scenes built here with
   one OffscreenRenderer; the oracle class itself is timed too.
 * scene loading: ``trimesh.load(process=True)`` against ``process=False``
-  (core.scene_files.load_mesh_file uses ``process=False, maintain_order=True``) on a
+  (core.scene.files.load_mesh_file uses ``process=False, maintain_order=True``) on a
   binary PLY of an icosphere with 163,842 vertices (``--quick``: 40,962)
-  written to a temporary directory; and ``core.scene_files.load_scene`` on it.
+  written to a temporary directory; and ``core.scene.files.load_scene`` on it.
 
 Statistics: as bench_scale.py (median per-call time over rounds x passes x
 poses, rounds alternating the order; GC off).
@@ -56,12 +56,12 @@ import trimesh
 
 from _common import print_end, print_machine, print_table, write_json
 from bench_scale import OpenBLAS, bench_group, blas_info, fast_unique_edges
-from wirecheck.core import clipping, raster
+from wirecheck.core.projector import clipping, raster
 from wirecheck.core.camera import camera_z
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import cam_to_px, localize, model_to_cam
-from wirecheck.core.scene import Scene
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import cam_to_px, localize, model_to_cam
+from wirecheck.core.scene.model import Scene
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 640, 480
@@ -131,7 +131,7 @@ class PyrenderScenes:
 
     def __init__(self, vertices, edges, faces, camera):
         import pyrender
-        from wirecheck.oracles.convert import camera_to_pyrender
+        from wirecheck.oracles.references.convert import camera_to_pyrender
         self.pr = pyrender
         self.renderer = pyrender.OffscreenRenderer(camera.width, camera.height)
         pose, cam = camera_to_pyrender(camera)
@@ -296,7 +296,7 @@ def main(argv=None) -> int:
     # ---- 4. pyrender
     pyr = None
     try:
-        from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+        from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available
         ok, msg = osmesa_available()
     except Exception as exc:  # noqa: BLE001
         ok, msg = False, f"{type(exc).__name__}: {exc}"
@@ -357,7 +357,7 @@ def main(argv=None) -> int:
     rows.append({"stage": "load: trimesh process=True", "skipped_ms": load_med["process_true"] - load_med["process_false"],
                  "run_ms": load_med["process_false"], "per": "load",
                  "note": f"{len(big.vertices):,} V PLY ({size_mib:.1f} MiB), once per run; core uses process=False; "
-                         f"core.scene_files.load_scene total {ms(load_med['core_load_scene'])} ms"})
+                         f"core.scene.files.load_scene total {ms(load_med['core_load_scene'])} ms"})
 
     # ---- table
     print()

@@ -9,7 +9,7 @@ Meshes (all seen by ``camera_z(4.0, fov_y_deg=70)`` at 1280x960, posed by
 ``Motion()``; every vertex stays in [near, far] and on the image, so
 ``render_frame`` always takes its no-clip fast path, which is checked):
 
-* ``cube``    ``core.scene_files.load_scene('cube')``: 8 vertices, 12 edges
+* ``cube``    ``core.scene.files.load_scene('cube')``: 8 vertices, 12 edges
 * ``ico<s>``  ``trimesh.creation.icosphere(subdivisions=s)``, s = 0..8:
   12 .. 655,362 vertices; edges are the unique edges of the faces
 * ``grid<n>`` an n x n height field over [-1, 1]^2,
@@ -31,7 +31,7 @@ Stages, each timed per call on the same poses for every implementation:
   projectPoints' Jacobian: ``cv2.transform`` by ``K [R | t]`` and
   ``cv2.convertPointsFromHomogeneous``.
 * raster, pixel coordinates (computed outside the timing) to a (960, 1280)
-  uint8 image, ``np.zeros`` included for all: ``core.raster.line_pixels``
+  uint8 image, ``np.zeros`` included for all: ``core.projector.raster.line_pixels``
   (exact), ``line_pixels_fast`` (integer DDA) and ``line_coverage_aa`` +
   ``paint_aa`` against ``cv2.polylines(img, segs, False, 255, 1, LINE_8)`` on
   the (E, 2, 2) int32 array of rounded ends, the same with ``shift=8``
@@ -77,12 +77,12 @@ import numpy as np
 import trimesh
 
 from _common import fmt_ms, machine_info, print_end, print_machine, print_table, verdict, write_json
-from wirecheck.core import raster
+from wirecheck.core.projector import raster
 from wirecheck.core.camera import camera_z
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import cam_to_px, depth_mask, localize, model_to_cam
-from wirecheck.core.scene import unique_edges
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import cam_to_px, depth_mask, localize, model_to_cam
+from wirecheck.core.scene.model import unique_edges
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 1280, 960
@@ -101,7 +101,7 @@ def make_camera():
 
 
 def fast_unique_edges(edges: np.ndarray, n_vertices: int) -> np.ndarray:
-    """``core.scene.unique_edges`` via a 1-D key (``np.unique(axis=0)`` takes ~6 s at 2M edges)."""
+    """``core.scene.model.unique_edges`` via a 1-D key (``np.unique(axis=0)`` takes ~6 s at 2M edges)."""
     e = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
     e = e[e[:, 0] != e[:, 1]]
     key = np.unique(e[:, 0] * n_vertices + e[:, 1])

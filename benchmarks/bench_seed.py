@@ -50,7 +50,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     ours, peer = [], []
     with tempfile.TemporaryDirectory() as tmp:
-        ours_cmd = [sys.executable, "-m", "wirecheck.core.cli", "--scene", "cube", "--frames", str(args.frames),
+        ours_cmd = [sys.executable, "-m", "wirecheck.core.app.cli", "--scene", "cube", "--frames", str(args.frames),
                     "--camera-z", "4.0", "--fov", "70", "--out", f"{tmp}/ours"]
         peer_cmd = [sys.executable, str(HERE / "peer_seed_pyrender.py"), f"{tmp}/peer", "--frames", str(args.frames)]
         wall(ours_cmd), wall(peer_cmd)                 # untimed: bytecode written, files cached

@@ -11,7 +11,7 @@ Run from the repo root::
 
 The dataset (benchmarks/specificity_dataset.py, seeded) is written into a
 temporary folder and checked as ``crosscheck --scene DIR`` checks a folder
-(:func:`oracles.dataset_run.run_dataset`, level pixels, in this process):
+(:func:`oracles.datasets.dataset_run.run_dataset`, level pixels, in this process):
 
 * **core** as the candidate. It is correct by construction, so every failed
   case is a false fail. Printed: false fails per 1,000 cases with the exact
@@ -19,7 +19,7 @@ temporary folder and checked as ``crosscheck --scene DIR`` checks a folder
   ``1 - 0.025^(1/n)``, about the rule of three's 3/n -- for all meshes, for
   those near the origin and for those moved 1e3 ... 1e5 away (``far``), and
   each failed case's reasons.
-* **mutants**: core with its line rasterizer (``core.raster._line_pixels``)
+* **mutants**: core with its line rasterizer (``core.projector.raster._line_pixels``)
   replaced, vertices untouched (``--mutants``, on the first
   ``--mutant-meshes`` meshes near the origin: a far mesh can fail with core
   itself, so a catch there would say nothing):
@@ -84,7 +84,7 @@ def _shifted(dx: float):
 
 
 def mutant(name: str):
-    """The replacement of ``core.raster._line_pixels`` called ``name`` (module docstring)."""
+    """The replacement of ``core.projector.raster._line_pixels`` called ``name`` (module docstring)."""
     from raster_mutants import drop_last
 
     return {"drop_end": lambda: drop_last, "biased_rule": lambda: _shifted(0.25),
@@ -93,11 +93,11 @@ def mutant(name: str):
 
 def run(folder: str, frames: int, cases: str, line_pixels=None) -> dict:
     """The dataset report of core (its rasterizer replaced by ``line_pixels`` if given) on ``folder``."""
-    from wirecheck.core import raster
-    from wirecheck.oracles.core_candidate import CoreCandidate
-    from wirecheck.oracles.dataset import dataset_entries
-    from wirecheck.oracles.dataset_run import run_dataset
-    from wirecheck.oracles.executors import ExecutorSpec
+    from wirecheck.core.projector import raster
+    from wirecheck.oracles.candidates.core_candidate import CoreCandidate
+    from wirecheck.oracles.datasets.dataset import dataset_entries
+    from wirecheck.oracles.datasets.dataset_run import run_dataset
+    from wirecheck.oracles.datasets.executors import ExecutorSpec
 
     original = raster._line_pixels
     if line_pixels is not None:

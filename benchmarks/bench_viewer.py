@@ -11,7 +11,7 @@ renderer loads a mesh). For each scene and drawing mode a viewer server runs on
 127.0.0.1 and a client (urllib, one request at a time, as the page does) sends
 N orbit drags of 5 px; each reply carries core's PNG frame. Reported: frames per
 second over the round trips (everything but the browser's decode and paint), the
-round trip's p50/p95, and the server's per-stage p50 (core.profile).
+round trip's p50/p95, and the server's per-stage p50 (core.app.profile).
 
 Informational: no target is gated (times on a shared machine vary); the
 README's figure comes from this script.
@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from wirecheck.core.cli import build_parser, settings_from_args
-from wirecheck.core.viewer import STAGES, Viewer
-from wirecheck.core.viewer_http import Server
+from wirecheck.core.app.cli import build_parser, settings_from_args
+from wirecheck.core.app.viewer import STAGES, Viewer
+from wirecheck.core.app.viewer_http import Server
 
 MODES = {"wireframe": [], "hidden-lines": ["--hidden-lines"], "shaded": ["--style", "shaded"]}
 

@@ -1,10 +1,10 @@
-"""Measure the line gate's statistics (oracles/tolerances.py cites this run).
+"""Measure the line gate's statistics (oracles/judge/tolerances.py cites this run).
 
 For core's exact raster (correct), the drop-last-pixel mutant and an unbiased
 random-end renderer (tests/raster_mutants.py), over the bundled scenes, the
 orrery example, the hidden-line + back-face mode and random edge soups, under
 every crosscheck camera: cases passed, pooled candidate-only / oracle-only
-pixels and how many of them are sub-pixel ties (oracles.line_ties), the
+pixels and how many of them are sub-pixel ties (oracles.judge.line_ties), the
 largest |net imbalance| / oracle pixels and the smallest sign-test p (both
 over the decided pixels, ties left out)
 and the largest per-edge count difference.
@@ -26,8 +26,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from raster_mutants import drop_last, random_ends  # noqa: E402
 
-from wirecheck.core import raster  # noqa: E402
-from wirecheck.core.scene_files import load_scene, parse_scene_text  # noqa: E402
+from wirecheck.core.projector import raster  # noqa: E402
+from wirecheck.core.scene.files import load_scene, parse_scene_text  # noqa: E402
 from wirecheck.oracles.runner import CoreCandidate, RenderMode, run_crosscheck  # noqa: E402
 
 

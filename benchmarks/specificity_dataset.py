@@ -11,7 +11,7 @@ The kinds, in turn (``KINDS``):
 * ``primitive``: every closed trimesh primitive (box, icosahedron, icosphere,
   UV sphere, capsule, torus, annulus, revolved profile);
 * ``cylinder`` / ``cone``: 3 to 64 sections (the side edges seen end-on
-  overlap the caps' spokes: the sub-pixel ties of oracles.line_ties);
+  overlap the caps' spokes: the sub-pixel ties of oracles.judge.line_ties);
 * ``extrusion``: a random star-shaped polygon, fan-triangulated and extruded;
 * ``hull``: the convex hull of 8 to 60 random points;
 * ``plate``: a box 1e-3 to 1e-2 of its width thick;

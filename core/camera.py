@@ -87,7 +87,7 @@ class Camera:
         Easiest built with :meth:`with_intrinsics` or :meth:`with_K`.
     distortion : tuple of float or None
         OpenCV lens distortion ``(k1, k2, p1, p2[, k3[, k4, k5, k6]])``
-        (4, 5 or 8 numbers; perspective only; :mod:`wirecheck.core.distortion`).
+        (4, 5 or 8 numbers; perspective only; :mod:`wirecheck.core.projector.distortion`).
         ``None`` or all zeros: no distortion (stored as ``None``).
 
     Attributes
@@ -167,7 +167,7 @@ class Camera:
 
     def _check_intrinsics(self) -> None:
         """Validate and normalise ``intrinsics`` and ``distortion`` (tuples of floats, or None)."""
-        from .distortion import check_coefficients
+        from .projector.distortion import check_coefficients
 
         if self.intrinsics is not None:
             values = _numbers("intrinsics fx,fy,cx,cy", self.intrinsics, (4,))

@@ -29,7 +29,7 @@ x right, y up, z forward (along the view direction). Depth is ``z``: positive
 in front of the camera. The rows of the rotation ``world_to_cam`` are
 ``right, up, forward``; ``p_cam = R (p_world - position)``.
 (This basis is left-handed: right x up = -forward. It is exactly OpenCV's camera
-space with y negated; see ``oracles/convert.py``.)
+space with y negated; see ``oracles/references/convert.py``.)
 
 Pixel space
 -----------
@@ -84,7 +84,7 @@ Optional OpenCV coefficients ``(k1, k2, p1, p2[, k3[, k4, k5, k6]])``
 (``Camera.distortion``, perspective only) act on the ideal normalised
 coordinates in **OpenCV's axes, y down**: ``x_n = x_cam / z_cam``, ``y_n =
 -y_cam / z_cam``; then ``x_px = cx + fx x_d``, ``y_px = cy + fy y_d`` with
-``(x_d, y_d)`` from ``core.distortion`` (OpenCV's formula, so ``p1, p2`` and
+``(x_d, y_d)`` from ``core.projector.distortion`` (OpenCV's formula, so ``p1, p2`` and
 OpenCV's ``projectPoints`` agree in sign). Only vertices are distorted: edges
 are clipped against the undistorted frustum and drawn straight between
 distorted ends, so frames of a distorted camera are not pixel-compared.
@@ -103,7 +103,7 @@ Column vectors and 4x4 homogeneous matrices: ``p' = M @ p``. A composite
 same thing, not a row-vector convention. ``compose(A, B, C) == A @ B @ C``
 (C first). The model matrix of a frame is ``T @ R_z @ R_y @ R_x @ S``: scale,
 then rotate about X, then Y, then Z (all about the model origin), then
-translate. A motion with a pivot ``c`` (crosscheck's framing, oracles.cases)
+translate. A motion with a pivot ``c`` (crosscheck's framing, oracles.judge.cases)
 scales and turns about ``c`` instead: ``T(offset + c) @ R_z @ R_y @ R_x @ S @ T(-c)``.
 
 Rotations are right-handed (counter-clockwise when the axis points at the

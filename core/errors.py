@@ -1,6 +1,6 @@
 """The one exception type for bad input, and quieting the libraries that would print around it.
 
-CLIs turn an :class:`InputError` into one stderr line, exit 2 (core.guard).
+CLIs turn an :class:`InputError` into one stderr line, exit 2 (core.app.guard).
 """
 
 from __future__ import annotations

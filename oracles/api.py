@@ -6,7 +6,7 @@
         assert_projector(my_project)        # AssertionError naming the fault if not
 
 ``my_project(points, camera) -> (N, 2)`` follows the candidate contract
-(:mod:`oracles.candidate`). A projector in another language is given as
+(:mod:`oracles.candidates.candidate`). A projector in another language is given as
 ``cmd="./my_projector --flag"`` (the candidate protocol, docs/protocol.md).
 
 Isolation: a candidate given as a string (``"FILE.py:FUNC"``) or ``cmd`` runs
@@ -24,14 +24,14 @@ pixels too.
 
 from __future__ import annotations
 
-from . import gate, tolerances
-from .caller_state import caller_state_kept
-from .isolation import api_candidate
-from .compared import hint_lines, what_text
-from .report import compared_text, fault_text, not_passed
+from .judge import gate, tolerances
+from .candidates.caller_state import caller_state_kept
+from .candidates.isolation import api_candidate
+from .reports.compared import hint_lines, what_text
+from .reports.report import compared_text, fault_text, not_passed
 from .runner import run_crosscheck
-from .subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
-from .tolerances import Tolerances
+from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
+from .judge.tolerances import Tolerances
 
 
 #: check_projector's settings when neither the call nor ``[tool.wirecheck]`` gives them: vertices
@@ -59,15 +59,15 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
         The candidate, ``func(points, camera) -> p_px``: ``points`` (N, 3)
         float64 world coordinates, ``camera`` with the fields of
         :class:`~wirecheck.core.camera.Camera`, ``p_px`` (N, 2) pixels with
-        NaN rows where clipped (:mod:`wirecheck.oracles.candidate`). Or a
+        NaN rows where clipped (:mod:`wirecheck.oracles.candidates.candidate`). Or a
         ``"FILE.py:FUNC"`` / ``"MODULE:FUNC"`` string.
     scenes : sequence of str or Scene, optional
-        Names, paths or :class:`~wirecheck.core.scene.Scene` objects
+        Names, paths or :class:`~wirecheck.core.scene.model.Scene` objects
         (default: every bundled scene).
     frames : int
         Frames of each scene's motion per case (>= 1).
     cases : sequence of str, optional
-        Names from :data:`wirecheck.oracles.cases.ALL_CASE_NAMES` (default: the
+        Names from :data:`wirecheck.oracles.judge.cases.ALL_CASE_NAMES` (default: the
         default set ``CASE_NAMES``; the calibrated cases run when named).
     oracles : tuple of {"opencv", "pyrender"}, or str
         ``("opencv",)`` compares vertices only (no OpenGL needed);
@@ -93,7 +93,7 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
         this process (an ``os._exit`` in it then ends your test run).
     precision : {"float32", "float64"}, optional
         What the projector computes in; its vertex bound is derived from it
-        (:func:`wirecheck.oracles.tolerances.vertex_bound`). Default None:
+        (:func:`wirecheck.oracles.judge.tolerances.vertex_bound`). Default None:
         inferred from the dtype it returns (float32 arrays: float32). A
         declared precision wins over the returned dtype: float64 declared and
         float32 returned is judged at float64, and its float32 rounding is
@@ -121,13 +121,13 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
         ``func(points, camera)``, ``cmd`` not a string or a list of strings,
         a ``timeout_s``, ``isolate`` or ``allow_vacuous`` of the wrong type.
     RuntimeError
-        (:class:`~wirecheck.oracles.pyrender_oracle.GLUnavailable`) ``"pyrender"`` asked for
+        (:class:`~wirecheck.oracles.references.pyrender_oracle.GLUnavailable`) ``"pyrender"`` asked for
         but its GL cannot draw here: one line naming the missing library and its fix.
 
     Notes
     -----
     The caller's process-wide settings are as they were after the call
-    (:mod:`wirecheck.oracles.caller_state`): warning filters, numpy's error
+    (:mod:`wirecheck.oracles.candidates.caller_state`): warning filters, numpy's error
     state and print options, ``os.environ``, ``sys.path``, the current
     directory, logging and signal handlers.
     """
@@ -150,7 +150,7 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     with caller_state_kept(), closing_started():    # the caller's globals as they were; no process left
         name, func = api_candidate(func, cmd, timeout_s, isolate)
         if "pyrender" in oracles:
-            from .pyrender_oracle import GLUnavailable, gl_available
+            from .references.pyrender_oracle import GLUnavailable, gl_available
 
             ok, message = gl_available()
             if not ok:
@@ -213,7 +213,7 @@ def _candidate_args(func, cmd):
     except TypeError:
         name = getattr(func, "__qualname__", None) or _short(func)
         raise TypeError(f"func {name}{signature} cannot be called as func(points, camera): expected "
-                        "the candidate contract (wirecheck.oracles.candidate)") from None
+                        "the candidate contract (wirecheck.oracles.candidates.candidate)") from None
     return func, None
 
 

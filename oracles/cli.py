@@ -3,17 +3,17 @@
 Exit status: 0 when every case is within tolerance, 1 when any case fails or
 compared nothing (``vacuous``, unless ``--allow-vacuous``), 2 on usage or input
 errors (including libOSMesa missing when pyrender is asked for, and inputs that
-would compare nothing: oracles/gate.py).
+would compare nothing: oracles/judge/gate.py).
 
 The candidate is core (in this process, trusted) unless ``--candidate
 FILE.py:FUNC`` or ``--candidate-cmd 'COMMAND ARGS'`` (a program in any
 language) is given: those run in their own process and are spoken to over
-the candidate protocol (docs/protocol.md, oracles/isolation.py),
+the candidate protocol (docs/protocol.md, oracles/candidates/isolation.py),
 each request under ``--candidate-timeout`` seconds, so a candidate that
 exits, hangs or crashes fails its cases (exit 1) and never ends the run.
 ``--candidate-precision float32|float64`` says what it computes in (default:
 the dtype it returns; core: ``--dtype``): a float32 candidate's vertices are
-held to a bound derived from float32 rounding (oracles/tolerances.py).
+held to a bound derived from float32 rounding (oracles/judge/tolerances.py).
 
 ``--level vertices`` runs the OpenCV vertex check only (no drawing, no
 pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
@@ -27,7 +27,7 @@ offset under the lines), ``--cull backface`` (back faces culled, and their
 edges when no front face owns them; checked against the oracle's own
 front-face test and GL culling) and ``--style shaded`` (core's depth buffer
 against pyrender's filled faces: silhouette IoU and depth error within a
-derived bound, oracles/tolerances.py). A scene without faces is then compared
+derived bound, oracles/judge/tolerances.py). A scene without faces is then compared
 as a plain wireframe, or (shaded) checked for its vertices only, with a note.
 They need the core candidate and the pixel level: with ``--candidate``,
 ``--level vertices``, ``--sweep`` or ``--suite``, and ``--hidden-lines`` with
@@ -40,9 +40,9 @@ worst case: candidate | oracle | diff), ``vertex_error.png`` and
 ``--scene DIR`` (a folder of mesh files) and ``--scene-list FILE`` run a
 dataset: one task per mesh, a mesh that cannot be loaded counted and reported
 (it fails the run unless ``--allow-load-errors``), one summary
-(oracles/dataset_run.py, docs/datasets.md). ``--executor dask`` runs the
+(oracles/datasets/dataset_run.py, docs/datasets.md). ``--executor dask`` runs the
 cases or meshes on a Dask cluster: a local one of ``--jobs`` workers, or
-``--scheduler tcp://HOST:PORT``'s (oracles/executors.py); same report.
+``--scheduler tcp://HOST:PORT``'s (oracles/datasets/executors.py); same report.
 
 ``crosscheck export DIR`` writes a rendering job for any renderer, and
 ``--candidate-frames DIR`` judges the renderer's own frames of it
@@ -57,7 +57,7 @@ extremes`` runs the numerical-extremes suite (oracles/extremes/) and exits
 
 from __future__ import annotations
 
-from wirecheck.core.startup import interrupts_from_start
+from wirecheck.core.app.startup import interrupts_from_start
 
 interrupts_from_start("crosscheck")    # first: Ctrl-C while the imports below run is one line, no traceback
 
@@ -69,22 +69,22 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
-from wirecheck.core.guard import run_cli  # noqa: E402
+from wirecheck.core.app.guard import run_cli  # noqa: E402
 from wirecheck.core.limits import check_candidate_timeout
-from wirecheck.core.output import check_replaceable, check_report_dir
+from wirecheck.core.outputs.output import check_replaceable, check_report_dir
 
-from . import gate, tolerances
-from .isolation import external_candidate
-from .cases import CASE_NAMES
-from .executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
+from .judge import gate, tolerances
+from .candidates.isolation import external_candidate
+from .judge.cases import CASE_NAMES
+from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli, trust_line
-from .junit import check_junit_target, write_junit
-from .core_candidate import CoreCandidate, RenderMode
-from .progress import TerminalProgress
-from .compared import hint_lines, reason_text, what_text
-from .report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
+from .reports.junit import check_junit_target, write_junit
+from .candidates.core_candidate import CoreCandidate, RenderMode
+from .reports.progress import TerminalProgress
+from .reports.compared import hint_lines, reason_text, what_text
+from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import level_for_oracles, run_crosscheck
-from .tolerances import Tolerances
+from .judge.tolerances import Tolerances
 from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
 
 ORACLES = ("opencv", "pyrender")
@@ -164,8 +164,8 @@ def _parse(args):
                      min_iou=args.min_iou, precision=args.candidate_precision)
     if args.suite:       # fixed cases and bounds (checked above): nothing of a run's inputs applies
         return level, None, None, mode, tol
-    # the library's one check of what a run compares (oracles.gate), in the CLI's option names
-    if args.dataset is not None:      # the meshes are read where they are checked (oracles.dataset_run)
+    # the library's one check of what a run compares (oracles.judge.gate), in the CLI's option names
+    if args.dataset is not None:      # the meshes are read where they are checked (oracles.datasets.dataset_run)
         inputs = gate.run_settings(args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
     else:
         inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol,
@@ -209,10 +209,10 @@ def _executor(args) -> ExecutorSpec:
 
 
 def _dataset(args):
-    """The dataset of ``--scene DIR`` / ``--scene-list FILE`` (oracles.dataset), or None for a plain run."""
-    from wirecheck.core.scene_files import builtin_names, example_names
+    """The dataset of ``--scene DIR`` / ``--scene-list FILE`` (oracles.datasets.dataset), or None for a plain run."""
+    from wirecheck.core.scene.files import builtin_names, example_names
 
-    from .dataset import dataset_entries
+    from .datasets.dataset import dataset_entries
 
     scenes = args.scene or []
     named = set(builtin_names() + example_names())      # a bundled name wins over a folder of that name
@@ -264,10 +264,10 @@ def _external_option(args) -> str | None:
 
 
 def main(argv=None) -> int:
-    from .subprocess_candidate import closing_started
+    from .candidates.subprocess_candidate import closing_started
 
     with closing_started():                       # the run's candidate program ends with the run
-        return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/guard.py)
+        return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/app/guard.py)
 
 
 def _main(argv=None) -> int:
@@ -294,7 +294,7 @@ def _main(argv=None) -> int:
     if applied:      # after the checks: on a usage error the error is the only line
         print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
     if level == "pixels":
-        from .pyrender_oracle import gl_available, select_gl
+        from .references.pyrender_oracle import gl_available, select_gl
 
         try:
             select_gl(args.gl)
@@ -333,7 +333,7 @@ def _main(argv=None) -> int:
                   f"(vacuous: {'allowed by --allow-vacuous' if args.allow_vacuous else 'the run fails'})",
                   file=sys.stderr)
     progress = TerminalProgress(sys.stderr)
-    # an external candidate runs in its own process already (oracles.isolation): no worker needed
+    # an external candidate runs in its own process already (oracles.candidates.isolation): no worker needed
     result, status = _run_guarded(args, progress, lambda: run_crosscheck(
         inputs.scenes, candidate, frames=inputs.frames, case_names=inputs.case_names, level=level,
         turns=inputs.turns, tol=tol, every=inputs.every, jobs=args.jobs, candidate_name=candidate.name,
@@ -373,7 +373,7 @@ def _main(argv=None) -> int:
           f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else ""))
     if precision_text(report):
         print(f"Candidate precision: {precision_text(report)}")
-    from .wall import process_age_s
+    from .reports.wall import process_age_s
     print(timing_line(report)[:-1] + f"; {process_age_s():.1f} s in all, with start-up and the report)")
     print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
     return 0 if report["verdict"] == "pass" else 1
@@ -384,7 +384,7 @@ def _run_guarded(args, progress, run):
 
     A bad input, a dead worker process and (on Dask) a failed task or cluster
     are the user's to fix; anything else on the local executor is a bug and
-    propagates (core.guard logs it).
+    propagates (core.app.guard logs it).
     """
     try:
         return run(), None
@@ -407,9 +407,9 @@ def _vertex_limit(report: dict, tol) -> str:
 
 
 def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
-    """A dataset run (oracles.dataset_run): progress, the report, the summary on stdout."""
-    from .dataset_report import DatasetProgress, console_summary, write_dataset_report
-    from .dataset_run import run_dataset
+    """A dataset run (oracles.datasets.dataset_run): progress, the report, the summary on stdout."""
+    from .datasets.dataset_report import DatasetProgress, console_summary, write_dataset_report
+    from .datasets.dataset_run import run_dataset
 
     progress = DatasetProgress(sys.stderr)
     report, status = _run_guarded(args, progress, lambda: run_dataset(
@@ -419,7 +419,7 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
         progress=progress.update if progress.active else None))
     if status is not None:
         return status
-    if args.dataset.skipped_line() is not None:     # FIFOs, devices: never opened (oracles.dataset)
+    if args.dataset.skipped_line() is not None:     # FIFOs, devices: never opened (oracles.datasets.dataset)
         print(f"crosscheck: {args.dataset.skipped_line()}", file=sys.stderr)
     report = {"run": args.run, **report}
     try:
@@ -460,7 +460,7 @@ def _sweep(args, inputs, level, tol, run_dir) -> int:
 
 
 def _suite(level, run_dir) -> int:
-    from wirecheck.core.output import FrameDir, json_dumps
+    from wirecheck.core.outputs.output import FrameDir, json_dumps
 
     from .extremes import extremes_markdown, run_extremes
 

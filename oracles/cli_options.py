@@ -8,15 +8,15 @@ from __future__ import annotations
 
 import argparse
 
-from wirecheck.core.cli_help import CROSSCHECK_EXAMPLES, usage_hint
-from wirecheck.core.guard import VersionAction
+from wirecheck.core.app.cli_help import CROSSCHECK_EXAMPLES, usage_hint
+from wirecheck.core.app.guard import VersionAction
 
-from . import tolerances
-from .cases import ALL_CASE_NAMES, CASE_NAMES
-from .core_candidate import CoreCandidate, RenderMode
-from .executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS
+from .judge import tolerances
+from .judge.cases import ALL_CASE_NAMES, CASE_NAMES
+from .candidates.core_candidate import CoreCandidate, RenderMode
+from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS
 from .runner import LEVELS
-from .subprocess_candidate import DEFAULT_TIMEOUT_S
+from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S
 
 #: The first line of ``crosscheck --help``.
 DESCRIPTION = "crosscheck: judge a projector against OpenCV and pyrender (OSMesa or EGL)."
@@ -59,7 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--candidate-precision", choices=tolerances.PRECISIONS, default=None,
-                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.tolerances) "
+                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.judge.tolerances) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",

@@ -1,6 +1,6 @@
 """The command lines of image candidates: ``crosscheck export DIR`` and ``crosscheck --candidate-frames DIR``.
 
-Both only parse and call :mod:`oracles.export` / :mod:`oracles.frames_candidate`;
+Both only parse and call :mod:`oracles.candidates.export` / :mod:`oracles.candidates.frames_candidate`;
 :mod:`oracles.cli` hands over to them. Exit status as crosscheck's: 0 pass,
 1 a case out of tolerance, 2 usage or input errors (one line each).
 """
@@ -15,7 +15,7 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 
-from .cases import ALL_CASE_NAMES, CASE_NAMES
+from .judge.cases import ALL_CASE_NAMES, CASE_NAMES
 
 
 class _Parser(argparse.ArgumentParser):
@@ -31,10 +31,10 @@ def _fail(message: str) -> int:
 
 def export_main(argv) -> int:
     """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z]``."""
-    from wirecheck.core.scene_files import builtin_names, load_scene
+    from wirecheck.core.scene.files import builtin_names, load_scene
     from wirecheck.core.transforms import Motion
 
-    from .export import write_job
+    from .candidates.export import write_job
 
     p = _Parser(prog="crosscheck export",
                 description="write a rendering job (scenes as OBJ, a camera JSON per case and frame, a README) "
@@ -48,7 +48,7 @@ def export_main(argv) -> int:
     args = p.parse_args(argv)
     try:
         from wirecheck.core.limits import MAX_FRAMES
-        from wirecheck.core.output import check_replaceable
+        from wirecheck.core.outputs.output import check_replaceable
 
         if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
             raise InputError(f"--frames {args.frames} --every {args.every}: expected --frames in 1..{MAX_FRAMES:,} "
@@ -95,10 +95,10 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     command line): the project's settings for projector checks, which a job's
     frames do not use, so they are not usage errors here.
     """
-    from .frames_candidate import run_frames
-    from .line_style import summary_lines
-    from .report import console_table, write_report
-    from .tolerances import Tolerances
+    from .candidates.frames_candidate import run_frames
+    from .judge.line_style import summary_lines
+    from .reports.report import console_table, write_report
+    from .judge.tolerances import Tolerances
 
     from .config import CLI_DESTS
 
@@ -130,7 +130,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     try:
         write_report(run_dir, report, images)
         if args.junit_xml:
-            from .junit import write_junit
+            from .reports.junit import write_junit
 
             write_junit(Path(args.junit_xml), report)
     except InputError as exc:

@@ -1,10 +1,10 @@
 """The viewer's oracle overlay: crosscheck for the one view on the screen.
 
-:class:`LiveOverlay` runs :func:`oracles.case.run_case` (crosscheck's own case
+:class:`LiveOverlay` runs :func:`oracles.judge.case.run_case` (crosscheck's own case
 runner) on the viewer's camera for its current frame only (``first=k,
 every=frames``), so its F1@0/@1, vertex error, faults and verdict are the ones
 crosscheck reports for that view. It returns pyrender's frame and the diff
-(white both, red core only, blue oracle only; oracles.metrics.diff_image) as
+(white both, red core only, blue oracle only; oracles.judge.metrics.diff_image) as
 PNGs for the page.
 
 Every OpenGL call runs on one worker thread: an OSMesa context is made current
@@ -19,15 +19,15 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from wirecheck.core.output import png_bytes
+from wirecheck.core.outputs.output import png_bytes
 
-from . import metrics
-from .cases import Case
-from .pyrender_oracle import OracleCache, osmesa_available
-from .report import fault_text
-from .case import run_case
-from .core_candidate import CoreCandidate, RenderMode
-from .tolerances import Tolerances
+from .judge import metrics
+from .judge.cases import Case
+from .references.pyrender_oracle import OracleCache, osmesa_available
+from .reports.report import fault_text
+from .judge.case import run_case
+from .candidates.core_candidate import CoreCandidate, RenderMode
+from .judge.tolerances import Tolerances
 
 
 def _b64_png(image: np.ndarray) -> str:
@@ -35,7 +35,7 @@ def _b64_png(image: np.ndarray) -> str:
 
 
 class LiveOverlay:
-    """``overlay(settings, camera, frame) -> dict`` for :class:`wirecheck.core.viewer.Viewer`."""
+    """``overlay(settings, camera, frame) -> dict`` for :class:`wirecheck.core.app.viewer.Viewer`."""
 
     def __init__(self):
         ok, message = osmesa_available()

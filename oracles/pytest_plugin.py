@@ -22,7 +22,7 @@ nearest ``pyproject.toml`` at or above pytest's rootdir, or
 defaults. A bad table is a pytest usage error before any test runs.
 
 ``--wirecheck-report DIR`` writes report.json, report.md and report.html
-(oracles.report) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
+(oracles.reports.report) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
 for a test's later checks); the terminal summary counts them, under
 pytest-xdist too (each test's ``user_properties`` carries its folder as
 ``wirecheck_report``, which pytest's ``--junitxml`` also lists).
@@ -112,7 +112,7 @@ def _write(config, node, index: int, report: dict) -> str:
     nodeid = node.nodeid
     from wirecheck.core.errors import InputError
 
-    from .report import write_report
+    from .reports.report import write_report
 
     root = Path(config.option.wirecheck_report)
     run_dir = root / (report_name(nodeid) + (f"-{index}" if index > 1 else ""))
@@ -163,7 +163,7 @@ class Check:
         except (ValueError, TypeError) as exc:   # InputError is a ValueError: a bad setting or projector spec
             error = f"wirecheck: {type(exc).__name__}: {exc}"
         except RuntimeError as exc:
-            from .pyrender_oracle import GLUnavailable
+            from .references.pyrender_oracle import GLUnavailable
             if not isinstance(exc, GLUnavailable):
                 raise
             error, trace = f"wirecheck: {exc}", False   # the missing GL library and its fix: one line

@@ -1,8 +1,8 @@
 """Run the cases: candidate vs OpenCV (vertices) and vs pyrender on OSMesa or EGL (pixels).
 
-Each case (a scene under one camera) is run by :func:`oracles.case.run_case`:
+Each case (a scene under one camera) is run by :func:`oracles.judge.case.run_case`:
 frames 1, 1 + every, 1 + 2 every, ... of the scene's motion, a vertex stage
-and a pixel stage per frame, then the record and its verdict (oracles.verdict).
+and a pixel stage per frame, then the record and its verdict (oracles.judge.verdict).
 This module runs every case of a run, here or in worker processes, and sums
 them up into the report.
 
@@ -13,9 +13,9 @@ Drawing modes (:class:`RenderMode`, the core candidate only; the pixel level):
   the lines on top. Judged by the same pixel F1 as a plain wireframe. A scene
   without faces has nothing that could hide a line: it is compared as a plain
   wireframe, with a note (not a failure), and ``"hidden_lines": false``.
-- ``cull="backface"``: core culls back faces (core.culling's rule) and draws an
+- ``cull="backface"``: core culls back faces (core.projector.culling's rule) and draws an
   edge only if it belongs to a kept face or to none. The oracle decides front
-  faces itself in float64 world space (oracles.faces), draws the kept edges,
+  faces itself in float64 world space (oracles.references.faces), draws the kept edges,
   and, with hidden lines, gives pyrender single-sided occluders (GL's own
   back-face culling). On a closed mesh the hidden-line picture is the same
   with or without culling (culling never changes what is visible); on an
@@ -23,15 +23,15 @@ Drawing modes (:class:`RenderMode`, the core candidate only; the pixel level):
 - ``style="shaded"``: core's depth buffer (``Frame.depth_image``) against
   pyrender's rendering of the fan-triangulated faces (flat, no lights:
   coverage and depth only): silhouette IoU, and depth error within a derived
-  bound per pixel (oracles.tolerances, oracles.metrics.shaded_scores). A scene
+  bound per pixel (oracles.judge.tolerances, oracles.judge.metrics.shaded_scores). A scene
   without faces has nothing to shade: only its vertices are checked, with a
   note.
 
 Several objects (``Scene.objects``, when the scene is not one static object):
 the oracle side builds each object's matrix with scipy,
-``M_run(t) @ M_o(t)`` (oracles.faces.object_matrices), and gives OpenCV and
+``M_run(t) @ M_o(t)`` (oracles.references.faces.object_matrices), and gives OpenCV and
 pyrender world points (pyrender with an identity pose). core is set up as
-``renderer`` sets it up (:class:`core.frames.SceneRenderer`): its own world
+``renderer`` sets it up (:class:`core.scene.frames.SceneRenderer`): its own world
 points drawn with an identity model matrix. A single static object: pyrender
 gets the model points with the run's scipy matrix as pose, core its own model
 matrix of the run.
@@ -44,10 +44,10 @@ size, cached for the worker's life) and loads a ``FILE.py:FUNC`` candidate
 itself from the spec string. Results are gathered in case order, so the report
 is the same for any number of jobs.
 
-Each scene's cases are framed on it (oracles.cases: the cameras about its
+Each scene's cases are framed on it (oracles.judge.cases: the cameras about its
 framing sphere, the run's turns about the framing centre); each record says
 how (``"framing"``). The report names the GL that drew the oracle's frames
-(``"oracle_gl"``: :meth:`oracles.pyrender_oracle.PyrenderOracle.gl_info`;
+(``"oracle_gl"``: :meth:`oracles.references.pyrender_oracle.PyrenderOracle.gl_info`;
 null at level vertices).
 """
 
@@ -60,16 +60,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wirecheck.core.scene import Scene
+from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
-from . import gate, metrics, opencv_oracle
-from .case import CaseResult, run_case
-from .cases import Case, case_motion
-from .convert import model_matrix
-from .core_candidate import CoreCandidate, RenderMode
-from .executors import ExecutorSpec, gather_in_order, open_executor
-from .tolerances import Tolerances
+from .judge import gate, metrics
+from .references import opencv_oracle
+from .judge.case import CaseResult, run_case
+from .judge.cases import Case, case_motion
+from .references.convert import model_matrix
+from .candidates.core_candidate import CoreCandidate, RenderMode
+from .datasets.executors import ExecutorSpec, gather_in_order, open_executor
+from .judge.tolerances import Tolerances
 
 #: Oracle fidelity levels, cheapest first, and the oracles each one runs.
 LEVELS = ("vertices", "pixels")
@@ -118,7 +119,7 @@ class _CaseRunner:
     _DUMMY_EDGES = np.array([[0, 1]], dtype=np.intp)
 
     def __init__(self):
-        from .pyrender_oracle import OracleCache
+        from .references.pyrender_oracle import OracleCache
 
         self.renderers = OracleCache()
         self.candidates = {}
@@ -128,7 +129,7 @@ class _CaseRunner:
         if not isinstance(ref, str):
             return ref
         if ref not in self.candidates:
-            from .candidate import load_candidate
+            from .candidates.candidate import load_candidate
 
             self.candidates[ref] = load_candidate(ref)
         return self.candidates[ref]
@@ -173,7 +174,7 @@ class _CaseRunner:
         result.record["framing"] = case.framing()
         result.gl_info = pyr.gl_info() if pyr is not None else None
         stderr = candidate.take_stderr() if hasattr(candidate, "take_stderr") else ""
-        if stderr:          # an isolated candidate's stderr during this case (oracles.subprocess_candidate)
+        if stderr:          # an isolated candidate's stderr during this case (oracles.candidates.subprocess_candidate)
             result.record["candidate_stderr"] = stderr
         return result
 
@@ -189,7 +190,7 @@ def _worker_init() -> None:
     global _WORKER_RUNNER
     from multiprocessing.util import Finalize
 
-    from .pyrender_oracle import gl_platform
+    from .references.pyrender_oracle import gl_platform
 
     gl_platform()          # the parent's PYOPENGL_PLATFORM (crosscheck --gl), inherited; osmesa if unset
     _WORKER_RUNNER = _CaseRunner()
@@ -204,7 +205,7 @@ def worker_runner() -> _CaseRunner:
 
 
 def _worker_run(scene: Scene, case: Case, params: _RunParams) -> CaseResult:
-    from .subprocess_candidate import SubprocessCandidate, close_all_but
+    from .candidates.subprocess_candidate import SubprocessCandidate, close_all_but
 
     with _WORKER_LOCK:      # a Dask worker may run tasks in several threads: one GL user at a time
         # a worker outlives a run on a Dask cluster: programs of earlier runs' candidates end here
@@ -219,7 +220,7 @@ def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None,
     ``on_result(result)`` is called on each result as it is gathered, in task
     order (it may drop what it does not need to keep, e.g. frame images).
     ``isolate``: use a worker even for one job, so that the candidate cannot end this process.
-    ``executor`` (oracles.executors): where the tasks run (default: ``jobs`` local processes).
+    ``executor`` (oracles.datasets.executors): where the tasks run (default: ``jobs`` local processes).
     """
     on_result = on_result or (lambda result: None)
     spec = executor or ExecutorSpec(jobs=jobs)
@@ -238,13 +239,13 @@ def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None,
 
 
 def scene_cases(scene: Scene, case_names, motion: Motion) -> list[Case]:
-    """The cases of ``scene`` named in ``case_names`` (framed on the scene, oracles.cases.cases_for).
+    """The cases of ``scene`` named in ``case_names`` (framed on the scene, oracles.judge.cases.cases_for).
 
     InputError when no camera fits the scene.
     """
     from wirecheck.core.errors import InputError
 
-    from .cases import CASE_NAMES, cases_for
+    from .judge.cases import CASE_NAMES, cases_for
 
     try:
         cases = cases_for(scene, motion, calibrated=bool(set(case_names) - set(CASE_NAMES)))
@@ -289,17 +290,17 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     "oracle": [...]}`` (bool images), for worst.gif. Raises InputError when no
     camera can be placed for a scene (coordinates too large), ValueError for a
     bad level, ``jobs`` or mode, and InputError (a ValueError) for inputs that
-    would compare nothing (:func:`oracles.gate.run_inputs`: no scene, case or
+    would compare nothing (:func:`oracles.judge.gate.run_inputs`: no scene, case or
     frame, an unknown or repeated name, ``every`` > ``frames``, a NaN tolerance).
 
     A case that compared nothing is ``"vacuous"`` and fails the run unless
-    ``allow_vacuous`` (oracles.gate); ``report["compared"]`` counts what was
+    ``allow_vacuous`` (oracles.judge.gate); ``report["compared"]`` counts what was
     compared. ``progress(cases_done, cases, frames_done, frames)`` is called
     before the first case and after each. With ``isolate`` the cases run in
     worker processes even for ``jobs=1``: a candidate that ends its process
     (``os._exit(0)``) raises BrokenProcessPool here instead of ending the run
     with status 0; the candidate must then be given as ``candidate_spec``.
-    ``executor`` (:class:`oracles.executors.ExecutorSpec`) sends the cases to
+    ``executor`` (:class:`oracles.datasets.executors.ExecutorSpec`) sends the cases to
     a Dask cluster instead (same report; ``jobs`` is then the spec's).
     """
     from wirecheck.core.errors import InputError

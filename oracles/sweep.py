@@ -2,7 +2,7 @@
 
 The settings are dtype x clip mode x raster mode (2 x 2 x 3 = 12). Each is run
 on the bundled scenes and on a large mesh (an icosphere) under every case
-camera (oracles/cases.py). The oracles' answers do not depend on the setting,
+camera (oracles/judge/cases.py). The oracles' answers do not depend on the setting,
 so each frame's references are computed once and shared:
 
 * OpenCV's ``projectPoints`` of the frame's world points (vertex reference);
@@ -10,9 +10,9 @@ so each frame's references are computed once and shared:
 
 For each setting we record
 
-* ``ms_per_frame``: median time of ``core.pipeline.render_frame`` per frame,
+* ``ms_per_frame``: median time of ``core.projector.pipeline.render_frame`` per frame,
   split by scene group ("bundled" scenes and the "large" mesh), each frame set
-  up by :class:`core.frames.SceneRenderer` as ``renderer`` sets it up;
+  up by :class:`core.scene.frames.SceneRenderer` as ``renderer`` sets it up;
 * ``max_vertex_error_px`` against OpenCV (over all frames and cases);
 * ``pixel_f1_0px`` / ``pixel_f1_1px``: the minimum over frames of the
   edge-pixel F1 against pyrender, and their means.
@@ -34,18 +34,19 @@ from collections import namedtuple
 
 import numpy as np
 
-from wirecheck.core.clipping import CLIP_MODES
-from wirecheck.core.frames import SceneRenderer
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import DTYPES
-from wirecheck.core.raster import RASTER_MODES
-from wirecheck.core.scene import Scene, face_edges, unique_edges
+from wirecheck.core.projector.clipping import CLIP_MODES
+from wirecheck.core.scene.frames import SceneRenderer
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import DTYPES
+from wirecheck.core.projector.raster import RASTER_MODES
+from wirecheck.core.scene.model import Scene, face_edges, unique_edges
 from wirecheck.core.transforms import Motion
 
-from . import faces as oface
-from . import metrics, opencv_oracle
-from .cases import CASE_NAMES, case_motion, cases_for
-from .report import gl_text
+from .references import faces as oface
+from .judge import metrics
+from .references import opencv_oracle
+from .judge.cases import CASE_NAMES, case_motion, cases_for
+from .reports.report import gl_text
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -96,7 +97,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     frame_ids = list(range(1, frames + 1, every))
     acc = {s.key: {"err": [], "f1_0": [], "f1_1": [], "t": {"bundled": [], "large": []},
                    "cand_only": 0, "orac_only": 0} for s in settings}
-    from .pyrender_oracle import OracleCache
+    from .references.pyrender_oracle import OracleCache
 
     oracles = OracleCache()
     try:
@@ -110,7 +111,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
                     continue
                 cam = case.camera
                 pyr = None
-                if pyrender and cam.distortion is None:      # a lens: vertices only (oracles.case)
+                if pyrender and cam.distortion is None:      # a lens: vertices only (oracles.judge.case)
                     pyr = oracles.get(cam.width, cam.height)
                 for k in frame_ids:
                     p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, scene_motion, (k - 1) / frames)
@@ -304,7 +305,7 @@ def write_sweep(run_dir, sweep: dict) -> None:
     import tempfile
     from pathlib import Path
 
-    from wirecheck.core.output import FrameDir, json_dumps
+    from wirecheck.core.outputs.output import FrameDir, json_dumps
 
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
@@ -327,7 +328,7 @@ def default_failures(sweep: dict, vertex_px: float, min_f1_1px: float, min_f1_0p
     """Why the default setting is out of tolerance (empty when it is within)."""
     d = next(r for r in sweep["settings"] if r["default"])
     reasons = []
-    if d["max_vertex_error_px"] is None:        # a gate never passes on nothing (oracles.gate)
+    if d["max_vertex_error_px"] is None:        # a gate never passes on nothing (oracles.judge.gate)
         reasons.append("no vertex was compared (every point clipped in every case)")
     if d["max_vertex_error_px"] is not None and d["max_vertex_error_px"] > vertex_px:
         reasons.append(f"max vertex error {d['max_vertex_error_px']:.3g} px > {vertex_px:g}")

@@ -76,7 +76,7 @@ def pyrender_renderer():
     Shared by every test that asks: render into a ``pyrender.Scene`` of your own
     and leave the renderer as you found it (no ``delete``, no viewport change).
     """
-    from wirecheck.oracles.pyrender_oracle import osmesa_available
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
     ok, msg = osmesa_available()
     if not ok:
@@ -95,7 +95,7 @@ def oracle():
     Shared by every test that asks (it keeps no state between calls that a
     later call does not set again); do not close it.
     """
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available
 
     ok, msg = osmesa_available()
     if not ok:

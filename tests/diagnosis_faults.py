@@ -1,6 +1,6 @@
 """The faulty projectors of the diagnosis proofs (tests/test_diagnosis.py, tests/test_image_diagnosis.py).
 
-Every faulty projector is a small re-implementation of ``core.projection.project_points`` with one bug
+Every faulty projector is a small re-implementation of ``core.projector.projection.project_points`` with one bug
 (or two) put in on purpose, on the cameras below; ``FAULTS`` maps each to the names it must get.
 """
 
@@ -75,7 +75,7 @@ _LENS = "the camera's"
 
 def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None, dist=_LENS,
              dtype=np.float64, keep=None):
-    """core.projection.project_points, with the rotation, focal lengths (or
+    """core.projector.projection.project_points, with the rotation, focal lengths (or
     ortho scales), principal point, lens distortion and depth test (``keep(z, camera)``)
     replaceable; every value in ``dtype`` (float32: the float32 twin of a fault)."""
     p = np.asarray(p_world, dtype=dtype).reshape(-1, 3)

@@ -9,7 +9,7 @@ import json
 
 def run_renderer(args, out) -> tuple[int, str, str]:
     """``renderer`` with ``args + --out out``, stdout/stderr captured: ``(rc, stdout, stderr)``."""
-    from wirecheck.core.cli import main
+    from wirecheck.core.app.cli import main
 
     o, e = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):

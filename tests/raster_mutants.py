@@ -1,12 +1,12 @@
 """Rasterizer mutants for the line gate's tests and its measurement (benchmarks/measure_line_gate.py).
 
-Each has the signature of ``core.raster._line_pixels`` and is patched in its
+Each has the signature of ``core.projector.raster._line_pixels`` and is patched in its
 place (in-process): ``drop_last`` is biased, ``random_ends`` is not.
 """
 
 import numpy as np
 
-from wirecheck.core import raster
+from wirecheck.core.projector import raster
 
 _LINE_PIXELS = raster._line_pixels   # the real one, kept before any patch
 

@@ -1,18 +1,18 @@
 """The "exact" raster as main computed it before the two-test rewrite: every candidate pixel tested.
 
 ``candidates_reference(p0, p1, w, h)`` has the signature of
-``core.raster._line_pixels`` (ends already snapped to 1/256 px) and follows the
-rule of core/raster.py's docstring literally: for every integer major
+``core.projector.raster._line_pixels`` (ends already snapped to 1/256 px) and follows the
+rule of core/projector/raster.py's docstring literally: for every integer major
 coordinate ``i`` between ``floor`` and ``ceil`` of the ends, the pixel nearest
 the line (integer arithmetic, ties as stated), then the diamond-exit test at
-that pixel. core's :func:`~wirecheck.core.raster._line_pixels` must return the
+that pixel. core's :func:`~wirecheck.core.projector.raster._line_pixels` must return the
 same arrays (same pixels, same order) on every input: it only skips the tests
 whose outcome the rule fixes and does the arithmetic in another order.
 """
 
 import numpy as np
 
-from wirecheck.core.raster import SUBPIXEL, major_minor
+from wirecheck.core.projector.raster import SUBPIXEL, major_minor
 
 
 def candidates_reference(p0_px, p1_px, width, height):

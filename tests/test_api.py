@@ -11,7 +11,7 @@ DATA = Path(__file__).parent / "data"
 
 def test_correct_external_projector_passes():
     report = assert_projector(f"{DATA / 'user_projector.py'}:project", scenes=["cube"], frames=3)
-    # float64 on both sides: ~1e-11 px at most (oracles/tolerances.py derivation)
+    # float64 on both sides: ~1e-11 px at most (oracles/judge/tolerances.py derivation)
     assert report["verdict"] == "pass" and report["summary"]["max_vertex_error_px"] < 1e-9
 
 
@@ -36,13 +36,13 @@ def test_check_projector_with_pixels():
 
 
 def test_an_importable_callable_runs_in_the_host_and_a_lambda_in_a_fork():
-    from wirecheck.core.projection import project_points
-    from wirecheck.oracles.isolation import api_candidate
-    from wirecheck.oracles.subprocess_candidate import SubprocessCandidate
+    from wirecheck.core.projector.projection import project_points
+    from wirecheck.oracles.candidates.isolation import api_candidate
+    from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate
 
     name, cand = api_candidate(project_points)            # a module-level function: the host imports it
     assert name == "project_points" and isinstance(cand, SubprocessCandidate)
-    assert cand.python_spec == "wirecheck.core.projection:project_points"
+    assert cand.python_spec == "wirecheck.core.projector.projection:project_points"
     lam = lambda p, c: project_points(p, c)                # noqa: E731 - no other process can import it
     name, cand = api_candidate(lam)
     assert name == "test_an_importable_callable_runs_in_the_host_and_a_lambda_in_a_fork.<locals>.<lambda>"
@@ -73,7 +73,7 @@ def test_a_lambda_that_kills_its_process_fails_instead_of_ending_pytest():
 
 
 def test_a_closure_in_a_fork_gives_the_in_process_results():
-    from wirecheck.core.projection import project_points
+    from wirecheck.core.projector.projection import project_points
 
     offset = 0.5                                           # a closure over a local: not importable
 

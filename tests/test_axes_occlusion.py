@@ -16,7 +16,7 @@ from numpy.testing import assert_array_equal
 from PIL import Image
 
 from wirecheck.core.camera import camera_z
-from wirecheck.core.pipeline import draw_segments, render_frame
+from wirecheck.core.projector.pipeline import draw_segments, render_frame
 from helpers import run_renderer
 
 F60 = 240.0 * math.sqrt(3.0)

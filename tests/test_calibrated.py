@@ -1,8 +1,8 @@
 """Calibrated pinhole cameras (fx, fy, cx, cy) and OpenCV lens distortion.
 
-core.camera / core.projection / core.distortion / core.clipping / core.trace
+core.camera / core.projector.projection / core.projector.distortion / core.projector.clipping / core.app.trace
 against hand-derived values, a naive reference of OpenCV's distortion formula,
-and cv2.projectPoints (independent); the oracle conversions (oracles.convert,
+and cv2.projectPoints (independent); the oracle conversions (oracles.references.convert,
 the protocol's camera) against core's own matrices; the crosscheck cases
 off_centre, non_square_pixels (pyrender's IntrinsicsCamera) and distorted
 (vertices only, said in the report); hostile camera input.
@@ -15,13 +15,14 @@ import math
 import numpy as np
 import pytest
 
-from wirecheck.core import clipping, trace
+from wirecheck.core.projector import clipping
+from wirecheck.core.app import trace
 from wirecheck.core.camera import Camera, camera_z, look_at
 from wirecheck.core.conventions import focal_px
-from wirecheck.core.distortion import distort
+from wirecheck.core.projector.distortion import distort
 from wirecheck.core.errors import InputError
-from wirecheck.core.projection import cam_to_px, project_points, unproject, world_to_cam
-from wirecheck.oracles import convert, opencv_oracle
+from wirecheck.core.projector.projection import cam_to_px, project_points, unproject, world_to_cam
+from wirecheck.oracles.references import convert, opencv_oracle
 
 EPS = np.finfo(np.float64).eps
 LENS = (-0.22, 0.06, 0.0012, -0.0009, -0.008)
@@ -169,7 +170,7 @@ CALIBRATED = {
 
 @pytest.mark.parametrize("name", list(CALIBRATED))
 def test_contract_matrices_match_the_oracle_side(name):
-    """Camera.K/R/t/view/projection (core) equal oracles.convert's (built independently)."""
+    """Camera.K/R/t/view/projection (core) equal oracles.references.convert's (built independently)."""
     cam = CALIBRATED[name]
     r, t, k = convert.opencv_matrices(cam)
     view, proj = convert.camera_to_gl(cam)
@@ -208,8 +209,8 @@ def test_pyrender_intrinsics_camera_and_round_trip():
 
 
 def test_protocol_camera_and_host_rebuild():
-    from wirecheck.oracles.candidate_host import _camera
-    from wirecheck.oracles.protocol import camera_message
+    from wirecheck.oracles.candidates.candidate_host import _camera
+    from wirecheck.oracles.candidates.protocol import camera_message
 
     cam = CALIBRATED["aniso"]
     msg = camera_message(cam)
@@ -255,8 +256,8 @@ def test_crosscheck_calibrated_cases(tmp_path):
     """core against pyrender's IntrinsicsCamera and cv2.projectPoints; the lens case by its vertices."""
     from helpers import run_crosscheck
 
-    from wirecheck.oracles.case import PIXELS_NOT_COMPARED
-    from wirecheck.oracles.pyrender_oracle import osmesa_available
+    from wirecheck.oracles.judge.case import PIXELS_NOT_COMPARED
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
     if not osmesa_available()[0]:
         pytest.skip("no OSMesa")
@@ -278,7 +279,7 @@ def test_crosscheck_calibrated_cases(tmp_path):
 
 
 def LENS_OF_CASES():  # noqa: N802
-    from wirecheck.oracles.cases import DISTORTION
+    from wirecheck.oracles.judge.cases import DISTORTION
     return DISTORTION
 
 
@@ -321,9 +322,9 @@ def test_faults_of_calibrated_candidates_through_crosscheck():
 
 
 def test_export_calibrated_cases_and_refuses_a_lens(tmp_path):
-    from wirecheck.core.scene_files import load_scene
-    from wirecheck.oracles.cases import CASE_NAMES
-    from wirecheck.oracles.export import build_job
+    from wirecheck.core.scene.files import load_scene
+    from wirecheck.oracles.judge.cases import CASE_NAMES
+    from wirecheck.oracles.candidates.export import build_job
 
     job, files = build_job([load_scene("cube")], frames=2)
     assert [c["case"] for c in job["cases"]] == list(CASE_NAMES)              # the default set, unchanged
@@ -336,8 +337,8 @@ def test_export_calibrated_cases_and_refuses_a_lens(tmp_path):
 
 def test_calibrated_cases_run_only_when_named():
     """The default set is the seven FOV cases: a FOV-only projector's verdicts do not change."""
-    from wirecheck.oracles.cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES, cameras_for
-    from wirecheck.oracles.gate import resolve_cases
+    from wirecheck.oracles.judge.cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES, cameras_for
+    from wirecheck.oracles.judge.gate import resolve_cases
 
     assert CASE_NAMES == ("on_axis", "oblique_roll", "near_plane", "wide_fov", "narrow_fov", "non_square",
                           "orthographic")
@@ -392,7 +393,7 @@ def test_wrappers_that_take_the_cameras_matrices():
     from pathlib import Path
 
     from wirecheck.oracles.api import check_projector
-    from wirecheck.oracles.cases import ALL_CASE_NAMES
+    from wirecheck.oracles.judge.cases import ALL_CASE_NAMES
 
     spec = str(Path(__file__).parent / "data" / "matrix_projectors.py")
     rep = check_projector(f"{spec}:opencv_style", scenes=["cube"], frames=3, cases=list(ALL_CASE_NAMES))

@@ -1,6 +1,6 @@
 """Hostile Python candidates (issue 15): each fails its case with one reason; crosscheck exits 1 with a report.
 
-Every candidate here runs in wirecheck's candidate host (oracles.candidate_host),
+Every candidate here runs in wirecheck's candidate host (oracles.candidates.candidate_host),
 so what it does to its own process never reaches crosscheck's.
 """
 
@@ -63,7 +63,7 @@ def test_hostile_candidate_fails_every_case_with_its_reason(tmp_path, capsys, na
 def test_hang_times_out_and_the_next_case_gets_a_fresh_process(tmp_path, capsys):
     # the first process ever started sleeps; later ones (after the kill) answer correctly
     flag = tmp_path / "started-once"
-    source = (f"import time, pathlib\nfrom wirecheck.core.projection import project_points\n"
+    source = (f"import time, pathlib\nfrom wirecheck.core.projector.projection import project_points\n"
               f"FIRST = not pathlib.Path({str(flag)!r}).exists()\npathlib.Path({str(flag)!r}).touch()\n"
               "def f(p, c):\n    if FIRST:\n        time.sleep(60)\n    return project_points(p, c)\n")
     code, report = _crosscheck(tmp_path, source, "--candidate-timeout", "0.5")
@@ -93,7 +93,7 @@ def test_os_exit_0_as_a_real_process_exits_1_with_a_report(tmp_path):
 
 
 def test_candidate_stderr_and_prints_go_into_the_report_not_the_protocol(tmp_path):
-    source = ("import sys\nfrom wirecheck.core.projection import project_points\nprint('loaded')\n"
+    source = ("import sys\nfrom wirecheck.core.projector.projection import project_points\nprint('loaded')\n"
               "def f(p, c):\n    print('stdout of f')\n    print('stderr of f', file=sys.stderr)\n"
               "    return project_points(p, c)\n")
     code, report = _crosscheck(tmp_path, source)
@@ -112,7 +112,7 @@ def test_bad_timeout_and_two_candidates_are_usage_errors(tmp_path, capsys):
 
 
 def test_a_candidate_hanging_at_import_fails_every_case_and_is_started_once(tmp_path, monkeypatch):
-    from wirecheck.oracles import subprocess_candidate
+    from wirecheck.oracles.candidates import subprocess_candidate
 
     # long enough for the host to reach the file on a loaded machine: it starts in ~0.15 s
     # (test_the_candidate_host_loads_no_oracle_library), ~1 s beside two busy test workers
@@ -182,7 +182,7 @@ def test_an_in_process_candidate_leaves_the_callers_imports_as_they_were(tmp_pat
     folder = tmp_path / "user"
     folder.mkdir()
     (folder / "proj.py").write_text(f"def f(p, c):\n    import {sibling}\n    return {sibling}.g(p, c)\n")
-    (folder / f"{sibling}.py").write_text("from wirecheck.core.projection import project_points\n"
+    (folder / f"{sibling}.py").write_text("from wirecheck.core.projector.projection import project_points\n"
                                           "def g(p, c):\n    return project_points(p, c)\n")
     try:
         report = api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
@@ -218,7 +218,7 @@ def test_a_candidates_process_ends_with_its_run(tmp_path, how):
             return p[:, :2] * 0.0
         assert api.check_projector(closure, **args)["verdict"] == "fail"
     else:
-        assert api.check_projector(cmd=[sys.executable, "-m", "wirecheck.oracles.candidate_host", f"{cand}:f"],
+        assert api.check_projector(cmd=[sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", f"{cand}:f"],
                                    **args)["verdict"] == "fail"
     started = {int(x) for x in pids.read_text().split()} - {os.getpid()}
     assert len(started) == 1, started                      # one program, started once for the run
@@ -239,7 +239,7 @@ def test_what_a_candidate_started_ends_with_its_run(tmp_path, how):
     args = dict(scenes=["cube"], cases=["on_axis"], frames=1)
     if how == "cmd_shell":
         cmd = (f"sleep 300 & echo $! > {pid_file}; "
-               f"exec {sys.executable} -m wirecheck.oracles.candidate_host {cand}:f")
+               f"exec {sys.executable} -m wirecheck.oracles.candidates.candidate_host {cand}:f")
         assert api.check_projector(cmd=["sh", "-c", cmd], **args)["verdict"] == "fail"
     else:
         def closure(p, c):                       # run in a fork; starts a child there, once
@@ -266,7 +266,7 @@ def test_the_candidate_host_loads_no_oracle_library(tmp_path):
     modules = json.loads(seen.read_text())
     heavy = ("scipy", "cv2", "pyrender", "trimesh", "matplotlib", "OpenGL")
     assert [m for m in modules if m.split(".")[0] in heavy] == []
-    assert "wirecheck.oracles.protocol" in modules and "numpy" in modules   # the host's own modules are seen
+    assert "wirecheck.oracles.candidates.protocol" in modules and "numpy" in modules   # the host's own modules are seen
 
 
 def test_a_forked_candidates_imports_write_no_bytecode_files(tmp_path, monkeypatch):
@@ -290,7 +290,7 @@ def test_a_forked_candidates_imports_write_no_bytecode_files(tmp_path, monkeypat
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("sig", ["SIGINT"])       # SIGTERM takes the same path (core.guard: both unwind alike)
+@pytest.mark.parametrize("sig", ["SIGINT"])       # SIGTERM takes the same path (core.app.guard: both unwind alike)
 def test_an_interrupted_run_with_workers_does_not_wait_for_hung_candidates(tmp_path, sig):
     # Both workers' candidates hang in a call (each writes its pid first); the run gets SIGINT
     # (sent to crosscheck's process only, as a CI runner's cancel does). The pool's own

@@ -15,9 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wirecheck.oracles import cli, opencv_oracle
-from wirecheck.oracles.cases import cameras_for
-from wirecheck.oracles.subprocess_candidate import SubprocessCandidate
+from wirecheck.oracles import cli
+from wirecheck.oracles.references import opencv_oracle
+from wirecheck.oracles.judge.cases import cameras_for
+from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate
 
 from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)
 
@@ -253,7 +254,7 @@ def test_a_hung_program_does_not_outlive_a_killed_crosscheck(tmp_path):
                     f"open({str(pid_file)!r}, 'w').write(str(os.getpid()))\n"
                     "sys.stdout.buffer.write(b'wirecheck-candidate 1\\n'); sys.stdout.flush()\ntime.sleep(600)\n")
     parent = subprocess.Popen([sys.executable, "-c",
-                               "import sys\nfrom wirecheck.oracles.subprocess_candidate import SubprocessCandidate\n"
+                               "import sys\nfrom wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate\n"
                                f"SubprocessCandidate(argv=(sys.executable, {str(prog)!r})).start()\n"
                                "print('ready', flush=True)\nimport time; time.sleep(600)\n"],
                               stdout=subprocess.PIPE, text=True)
@@ -296,7 +297,7 @@ def test_table_candidate_cmd_runs_and_a_command_line_candidate_replaces_the_tabl
     assert report["candidate"] == c_client and report["candidate_settings"]["timeout_s"] == 5.0
     # the command line's --candidate (mirrored: fails) wins over the table's program
     mirrored = tmp_path / "mirrored.py"
-    mirrored.write_text("from wirecheck.core.projection import project_points\n"
+    mirrored.write_text("from wirecheck.core.projector.projection import project_points\n"
                         "def f(p, c):\n    px = project_points(p, c)\n    px[:, 0] = c.width - 1 - px[:, 0]\n"
                         "    return px\n")
     assert cli.main(["--config", str(table), "--candidate", f"{mirrored}:f", "--report-dir", str(tmp_path / "m")]) == 1

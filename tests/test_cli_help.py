@@ -7,8 +7,8 @@ import sys
 
 import pytest
 
-from wirecheck.core.cli import build_parser as renderer_parser
-from wirecheck.core.cli_help import CROSSCHECK_EXAMPLES, RENDERER_EXAMPLES, usage_hint
+from wirecheck.core.app.cli import build_parser as renderer_parser
+from wirecheck.core.app.cli_help import CROSSCHECK_EXAMPLES, RENDERER_EXAMPLES, usage_hint
 from wirecheck.oracles.cli import build_parser as crosscheck_parser
 
 
@@ -45,7 +45,7 @@ def test_a_negative_value_without_equals_gets_the_hint():
 
 
 def test_renderer_says_so_in_one_line():
-    done = subprocess.run([sys.executable, "-m", "wirecheck.core.cli", "--distortion", "-0.2,0.05,0,0"],
+    done = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--distortion", "-0.2,0.05,0,0"],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 2
     assert done.stderr.splitlines() == ["renderer: error: argument --distortion: expected one argument (a value "

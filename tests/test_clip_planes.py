@@ -1,4 +1,4 @@
-"""oracles.clip_planes and the clipping_plane fault: exact candidates that clip at the wrong place.
+"""oracles.diagnosis.clip_planes and the clipping_plane fault: exact candidates that clip at the wrong place.
 
 Each candidate below is exact (float64 pinhole, the camera's own K) wherever it draws, and differs only
 in its depth test; the expected planes are the values written into its test, never the probe's.
@@ -13,13 +13,13 @@ import pytest
 
 import wirecheck
 from wirecheck.core.camera import look_at
-from wirecheck.core.scene import Scene
-from wirecheck.core.scene_files import load_scene
-from wirecheck.oracles import clip_planes
-from wirecheck.oracles.clip_planes import clip_fault, depth_slack, probe_planes
-from wirecheck.oracles.diagnose import diagnose
-from wirecheck.oracles.opencv_oracle import project as oracle_project
-from wirecheck.oracles.report import fault_hints
+from wirecheck.core.scene.model import Scene
+from wirecheck.core.scene.files import load_scene
+from wirecheck.oracles.diagnosis import clip_planes
+from wirecheck.oracles.diagnosis.clip_planes import clip_fault, depth_slack, probe_planes
+from wirecheck.oracles.diagnosis.diagnose import diagnose
+from wirecheck.oracles.references.opencv_oracle import project as oracle_project
+from wirecheck.oracles.reports.report import fault_hints
 
 sys.path.insert(0, str(Path(__file__).parent / "data"))
 import gl_float32_matrix  # noqa: E402
@@ -141,11 +141,11 @@ def test_float32_matrix_projector_keeps_its_clipped_ends():
     (case,) = report["cases"]
     assert case["verdict"] == "pass", case["reasons"]
     assert "line_pixel_bias" not in {f["name"] for f in case["faults"]}
-    planes = probe_planes(gl_float32_matrix.project, wirecheck.oracles.cases.cases_for(_cube(0.9))[2].camera)
+    planes = probe_planes(gl_float32_matrix.project, wirecheck.oracles.judge.cases.cases_for(_cube(0.9))[2].camera)
     assert case["clipped_ends"]["inward_depth"] > 0 and "float32 rounding" in case["clipped_ends"]["reason"]
     assert planes["near_fit"] > case["camera_spec"]["near"]
     # said in report.md's Notes
-    from wirecheck.oracles.report import case_notes
+    from wirecheck.oracles.reports.report import case_notes
     assert any("clipped ends moved" in text for _c, text in case_notes(report))
 
 

@@ -1,4 +1,4 @@
-"""core.clipping (cases 1-5 of its docstring) and clip safety of the whole frame pipeline.
+"""core.projector.clipping (cases 1-5 of its docstring) and clip safety of the whole frame pipeline.
 
 Unless stated otherwise the camera is camera_z(10, fov 90, 640x480, near 1):
 p_cam = (x, y, 10 - z_world) exactly, f = 240 / tan(45 deg) = 240 (1 + 1.1e-16),
@@ -12,11 +12,11 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from wirecheck.core.camera import camera_z
-from wirecheck.core.clipping import apply_clip, clip_segments, frustum_planes
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import cam_to_px
-from wirecheck.core.raster import line_pixels
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.clipping import apply_clip, clip_segments, frustum_planes
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import cam_to_px
+from wirecheck.core.projector.raster import line_pixels
+from wirecheck.core.scene.files import load_scene
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16
 D = 10.0
@@ -47,7 +47,7 @@ def drawn(image):
 
 def raster_image(segments_px, w=W, h=H):
     """Expected image: the HAND-DERIVED pixel-space ends of each (clipped) segment,
-    rasterised with core.raster (tested on its own in test_raster.py). This isolates
+    rasterised with core.projector.raster (tested on its own in test_raster.py). This isolates
     what these tests check, the clipping, from the raster rule's end-pixel choices."""
     img = np.zeros((h, w), np.uint8)
     for p0, p1 in segments_px:
@@ -340,7 +340,7 @@ DEPTH_SPANNING = [
 
 @pytest.mark.parametrize("p0,p1", DEPTH_SPANNING)
 def test_clipped_ends_never_have_nonpositive_depth(p0, p1):
-    """Docstring of core.clipping: no point with z < near is ever divided by.
+    """Docstring of core.projector.clipping: no point with z < near is ever divided by.
 
     The exact clipped ends have z in [near, far] = [1, 100]; apply_clip's
     p0 + t (p1 - p0) can be off by ~ EPS * |p| (cancellation), which is harmless at
@@ -365,7 +365,7 @@ def test_clipped_ends_never_have_nonpositive_depth(p0, p1):
     ((-100.0, 5.0), (-0.5, 5.0)),       # left: x = -1/2
 ])
 def test_clip_to_image_stops_at_each_image_edge(p1, want):
-    from wirecheck.core.clipping import clip_to_image
+    from wirecheck.core.projector.clipping import clip_to_image
 
     # from (10, 5) inside a 20 x 30 image; axis-parallel, so t is exact on the grid of halves
     kept, q0, q1 = clip_to_image(np.array([[10.0, 5.0]]), np.array([p1]), 20, 30)
@@ -375,7 +375,7 @@ def test_clip_to_image_stops_at_each_image_edge(p1, want):
 
 
 def test_clip_to_image_moves_a_start_outside_onto_the_edge():
-    from wirecheck.core.clipping import clip_to_image
+    from wirecheck.core.projector.clipping import clip_to_image
 
     # reversed: from (10, 100) below a 20 x 30 image up to (10, 5): the start moves to y = 29.5
     kept, q0, q1 = clip_to_image(np.array([[10.0, 100.0]]), np.array([[10.0, 5.0]]), 20, 30)

@@ -1,6 +1,6 @@
 """A commit killed (SIGKILL) after each of its renames: the next run repairs or replaces, never wedges.
 
-core.owned counts the renames of a commit and, with WIRECHECK_KILL_AFTER_RENAME=k, the process sends
+core.outputs.owned counts the renames of a commit and, with WIRECHECK_KILL_AFTER_RENAME=k, the process sends
 itself SIGKILL right after the k-th. For every k of a commit, in a subprocess over an earlier set: the
 killed run leaves the old set, the new set or a journal; the next plain run exits 0 with a consistent
 set (every listed hash true, the report's frame count = the PNGs); a user's file beside the outputs is
@@ -15,13 +15,13 @@ import sys
 
 import pytest
 
-from wirecheck.core import cli as renderer_cli
-from wirecheck.core.owned import MARKER, foreign, sha256
-from wirecheck.core.staging import JOURNAL, LOCK, MANIFEST
+from wirecheck.core.app import cli as renderer_cli
+from wirecheck.core.outputs.owned import MARKER, foreign, sha256
+from wirecheck.core.outputs.staging import JOURNAL, LOCK, MANIFEST
 from wirecheck.oracles import cli as crosscheck_cli
 
 OPTIONS = ["--width", "32", "--height", "24", "--format", "png,gif"]
-RENDER = [sys.executable, "-m", "wirecheck.core.cli", *OPTIONS]
+RENDER = [sys.executable, "-m", "wirecheck.core.app.cli", *OPTIONS]
 
 
 def _render(frames, out):
@@ -47,7 +47,7 @@ def _renderer_set(out):
     return report["summary"]["frames"], len(pngs), hashes_true
 
 
-# Renames of this commit, counted by hand from core/staging.py: the journal (1), cube-frames/ (2: the old
+# Renames of this commit, counted by hand from core/outputs/staging.py: the journal (1), cube-frames/ (2: the old
 # folder aside, the new one in), cube.gif, cube-report.json, cube-report.txt (1 each), the manifest (1).
 RENDERER_RENAMES = 7
 

@@ -1,6 +1,6 @@
 """``renderer --compare``: two camera distances and two FOVs, measured from the frames.
 
-Predictions are hand-derived for the unit cube on axis (core/compare.py's
+Predictions are hand-derived for the unit cube on axis (core/app/compare.py's
 docstring): front width 2f/(D-1), back 2f/(D+1), ratio (D+1)/(D-1) = 2 at D = 3
 and 1.4 at D = 6, depth compression 1/(D+1); FOV scale tan(30)/tan(45) = 1/sqrt(3).
 """
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.core.compare import crossings
+from wirecheck.core.app.compare import crossings
 from helpers import run_renderer as run
 
 

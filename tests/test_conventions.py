@@ -14,7 +14,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.conventions import PIXEL_CENTRE_OFFSET, focal_px, principal_point
-from wirecheck.core.projection import project_points, world_to_cam
+from wirecheck.core.projector.projection import project_points, world_to_cam
 from wirecheck.core.transforms import apply, compose, rotate_x, rotate_y, rotate_z, translate
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16

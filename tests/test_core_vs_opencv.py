@@ -5,8 +5,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.projection import project_points
-from wirecheck.oracles import opencv_oracle
+from wirecheck.core.projector.projection import project_points
+from wirecheck.oracles.references import opencv_oracle
 
 EPS = np.finfo(float).eps
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from wirecheck.oracles import cli
-from wirecheck.oracles.core_candidate import CoreCandidate
+from wirecheck.oracles.candidates.core_candidate import CoreCandidate
 from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
@@ -30,9 +30,9 @@ def without_timing(out: Path) -> str:
 # ---------------------------------------------------------------- --level
 
 def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeypatch):
-    from wirecheck.core import raster
-    from wirecheck.oracles import case as case_module
-    from wirecheck.oracles import pyrender_oracle
+    from wirecheck.core.projector import raster
+    from wirecheck.oracles.judge import case as case_module
+    from wirecheck.oracles.references import pyrender_oracle
 
     def forbidden(*_a, **_k):
         raise AssertionError("the pixel stage ran at level vertices")
@@ -202,8 +202,8 @@ def test_core_candidate_is_a_small_frozen_picklable_dataclass():
 
 
 def test_core_settings_reach_render_frame(monkeypatch):
-    from wirecheck.core import pipeline
-    from wirecheck.oracles.cases import cameras_for
+    from wirecheck.core.projector import pipeline
+    from wirecheck.oracles.judge.cases import cameras_for
 
     calls = []
 
@@ -238,7 +238,7 @@ def test_clip_endpoint_reaches_core_and_the_pixel_oracle_sees_it(tmp_path):
                           "--cases", "near_plane,on_axis")
     assert code == 1
     assert report["candidate_settings"] == {"dtype": "float64", "clip": "endpoint", "raster": "exact"}
-    on_axis, near = report["cases"]          # cases run in the order of oracles.cases.CASE_NAMES
+    on_axis, near = report["cases"]          # cases run in the order of oracles.judge.cases.CASE_NAMES
     assert near["max_vertex_error_px"] < 1e-9 and near["pixel_f1_1px"] < 0.9      # measured 0.72
     assert on_axis["verdict"] == "pass" and on_axis["pixel_f1_1px"] == 1.0     # nothing to clip there
 

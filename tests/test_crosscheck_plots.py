@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.oracles.metrics import DIFF_COLOURS
-from wirecheck.oracles.plots import STRIP_PX, worst_gif
+from wirecheck.oracles.judge.metrics import DIFF_COLOURS
+from wirecheck.oracles.reports.plots import STRIP_PX, worst_gif
 from wirecheck.oracles.runner import worst_key
 from helpers import run_crosscheck as run
 
@@ -151,7 +151,7 @@ def _report(per_frame, shaded=False, tol=None):
 
 
 def test_pixels_png_draws_the_f1_curve_and_its_limit_where_they_belong():
-    from wirecheck.oracles.plots import pixel_png
+    from wirecheck.oracles.reports.plots import pixel_png
 
     # F1@0 = 0.2, 0.6, 0.8 at frames 1..3, limit 0.98; linear y axis, rows grow downward
     png = pixel_png(_report([{"frame": k, "f1_0px": v} for k, v in ((1, 0.2), (2, 0.6), (3, 0.8))]))
@@ -165,7 +165,7 @@ def test_pixels_png_draws_the_f1_curve_and_its_limit_where_they_belong():
 
 
 def test_vertex_error_png_is_a_log_axis_with_the_tolerance_line():
-    from wirecheck.oracles.plots import vertex_error_png
+    from wirecheck.oracles.reports.plots import vertex_error_png
 
     # errors 1e-12, 1e-10, 1e-8 and the tolerance 1e-6: equal steps of 100x, so
     # on a log axis three equal row gaps (and 0 px would be drawn at 1e-16)
@@ -179,7 +179,7 @@ def test_vertex_error_png_is_a_log_axis_with_the_tolerance_line():
 
 
 def test_shaded_pixels_png_has_two_panels_iou_above_depth():
-    from wirecheck.oracles.plots import pixel_png
+    from wirecheck.oracles.reports.plots import pixel_png
 
     frames = [{"frame": k, "silhouette_iou": v, "depth_error_ratio": r}
               for k, v, r in ((1, 0.9, 0.01), (2, 0.95, 0.1), (3, 0.99, 1.0))]
@@ -197,7 +197,7 @@ def test_shaded_pixels_png_has_two_panels_iou_above_depth():
 
 
 def test_decade_labels_are_unicode_powers_of_ten():
-    from wirecheck.oracles.plots import _decade_label
+    from wirecheck.oracles.reports.plots import _decade_label
 
     # hand-written: superscript minus U+207B, superscript digits (U+2070, U+00B9, U+00B2, U+00B3, U+2074..9)
     assert _decade_label(1e-6) == "10\u207b\u2076"
@@ -211,7 +211,7 @@ def test_a_wide_log_axis_is_labelled_at_powers_of_ten_without_minor_ticks():
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from wirecheck.oracles.plots import _log_y
+    from wirecheck.oracles.reports.plots import _log_y
 
     def axis(lo, hi):
         fig = Figure()

@@ -1,6 +1,6 @@
 """crosscheck --hidden-lines, --cull backface, --style shaded and scenes of several objects.
 
-Every bound below is the derived one of oracles/tolerances.py (the numbers in
+Every bound below is the derived one of oracles/judge/tolerances.py (the numbers in
 comments are measured, core against pyrender/OSMesa on this machine's llvmpipe).
 """
 
@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wirecheck.core.frames import SceneRenderer
-from wirecheck.oracles import cli, tolerances
-from wirecheck.oracles.core_candidate import CoreCandidate, RenderMode
+from wirecheck.core.scene.frames import SceneRenderer
+from wirecheck.oracles import cli
+from wirecheck.oracles.judge import tolerances
+from wirecheck.oracles.candidates.core_candidate import CoreCandidate, RenderMode
 from wirecheck.oracles.runner import run_crosscheck
 from helpers import run_crosscheck as run
 
@@ -33,7 +34,7 @@ def icosphere(tmp_path_factory):
 
 
 def _load(name_or_path):
-    from wirecheck.core.scene_files import load_scene
+    from wirecheck.core.scene.files import load_scene
 
     return load_scene(str(name_or_path))
 
@@ -116,7 +117,7 @@ def test_faceless_scene_is_noted_and_vacuous_when_shaded(tmp_path):
     wire = tmp_path / "wire.scene"                      # the pyramid's edges, without faces
     wire.write_text("v -1 -1 -1\nv 1 -1 -1\nv 1 -1 1\nv -1 -1 1\nv 0 1 0\n"
                     "e 0 1\ne 1 2\ne 2 3\ne 3 0\ne 0 4\ne 1 4\ne 2 4\ne 3 4\n")
-    # shaded, no faces: nothing is shaded on either side, so the pixel level compared nothing (oracles.gate)
+    # shaded, no faces: nothing is shaded on either side, so the pixel level compared nothing (oracles.judge.gate)
     code, report, out = run(tmp_path, "--style", "shaded", "--scene", str(wire), "--frames", "2",
                             "--cases", "on_axis")
     case = report["cases"][0]
@@ -272,7 +273,7 @@ def test_two_objects_with_their_own_spins_pass_at_level_pixels(tmp_path):
     code, report, _ = run(tmp_path, "--scene", str(path), "--frames", "4", "--cases", "oblique_roll,orthographic")
     assert code == 0, [c["reasons"] for c in report["cases"]]
     for case in report["cases"]:
-        # world points: core.scene.world_points against scipy's M_run @ M_o, both float64
+        # world points: core.scene.model.world_points against scipy's M_run @ M_o, both float64
         assert case["max_vertex_error_px"] < 1e-9
         assert case["pixel_f1_1px"] >= tolerances.MIN_F1_1PX
     for mode in (RenderMode(hidden_lines=True), RenderMode(style="shaded")):
@@ -346,7 +347,7 @@ def test_workers_get_the_drawing_mode(tmp_path):
 def test_pyrender_depth_is_linear_camera_depth_in_both_projections():
     """The oracle's own depth: a plane at known depth, perspective and orthographic."""
     from wirecheck.core.camera import camera_z
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, depth_step
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, depth_step
 
     quad = np.array([[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]])
     tris = np.array([[0, 1, 2], [0, 2, 3]])
@@ -371,7 +372,7 @@ if __name__ == "__main__":
 
 
 def test_occlusion_boundary_and_interior_by_hand():
-    from wirecheck.oracles.metrics import interior, occlusion_boundary, shaded_scores
+    from wirecheck.oracles.judge.metrics import interior, occlusion_boundary, shaded_scores
 
     # triangles 0 and 1 share vertices (one surface), 2 shares none (another object)
     tris = np.array([[0, 1, 2], [1, 2, 3], [10, 11, 12]])

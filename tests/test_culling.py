@@ -1,4 +1,4 @@
-"""core.culling: triangulation, winding checks, back faces, bounding-sphere culling."""
+"""core.projector.culling: triangulation, winding checks, back faces, bounding-sphere culling."""
 
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.culling import (backface_keep, face_of_triangle, sphere_outside_frustum, triangulate,
+from wirecheck.core.projector.culling import (backface_keep, face_of_triangle, sphere_outside_frustum, triangulate,
                           winding_problem)
-from wirecheck.core.projection import world_to_cam
+from wirecheck.core.projector.projection import world_to_cam
 
 # scenes/cube.scene, faces counter-clockwise seen from outside
 CUBE_V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
@@ -153,7 +153,7 @@ def test_sphere_culling_never_culls_a_visible_point(projection):
     rng = np.random.default_rng(0)
     cam = look_at((1.0, 2.0, 6.0), (0.0, 0.0, 0.0), near=0.5, far=12.0, projection=projection,
                   ortho_height=4.0)
-    from wirecheck.core.projection import project_points
+    from wirecheck.core.projector.projection import project_points
     for _ in range(300):
         c = rng.normal(size=3) * 5
         r = rng.uniform(0.1, 2.0)
@@ -166,7 +166,7 @@ def test_sphere_culling_never_culls_a_visible_point(projection):
 
 
 def test_directed_edges_in_polygon_order():
-    from wirecheck.core.culling import directed_edges
+    from wirecheck.core.projector.culling import directed_edges
     i, j, face, pos = directed_edges([(0, 1, 2, 3), (4, 5, 6)])
     assert list(zip(i.tolist(), j.tolist())) == [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 4)]
     assert face.tolist() == [0, 0, 0, 0, 1, 1, 1] and pos.tolist() == [0, 1, 2, 3, 0, 1, 2]
@@ -180,8 +180,8 @@ def test_every_face_culled_renders_an_empty_face_buffer(kw):
     # away from it), so back-face culling keeps none: no face covers any pixel,
     # and with hidden lines every remaining edge (none: all belong to faces) is gone.
     from wirecheck.core.camera import camera_z
-    from wirecheck.core.pipeline import render_frame
-    from wirecheck.core.scene_files import load_scene
+    from wirecheck.core.projector.pipeline import render_frame
+    from wirecheck.core.scene.files import load_scene
 
     cube = load_scene("cube")
     cam = camera_z(0.5, near=0.1, far=10.0)

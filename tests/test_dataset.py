@@ -12,8 +12,8 @@ import pytest
 
 from wirecheck.core.errors import InputError
 from wirecheck.oracles import cli
-from wirecheck.oracles.dataset import dataset_entries, read_list, walk_folder
-from wirecheck.oracles.dataset_report import DatasetProgress
+from wirecheck.oracles.datasets.dataset import dataset_entries, read_list, walk_folder
+from wirecheck.oracles.datasets.dataset_report import DatasetProgress
 from helpers import process_runs, run_crosscheck
 
 
@@ -259,7 +259,7 @@ def test_summary_counts_faults_and_ranks_worst_cases(meshes, tmp_path, monkeypat
 
 
 def test_a_failed_case_ranks_worse_than_any_pass_whatever_its_f1():
-    from wirecheck.oracles.dataset_run import worst_cases
+    from wirecheck.oracles.datasets.dataset_run import worst_cases
 
     def case(mesh, verdict, f1):
         return {"scene": mesh, "camera": "on_axis", "verdict": verdict, "pixel_f1_1px": f1, "pixel_f1_0px": f1,
@@ -302,10 +302,10 @@ def dask_scheduler() -> str:
 
     from distributed import LocalCluster
 
-    from wirecheck.oracles.executors import _environ_kept
+    from wirecheck.oracles.datasets.executors import _environ_kept
 
     # the nanny leaves OPENBLAS_NUM_THREADS=1 & co. in this process's environment, for every later
-    # test's subprocess (oracles.executors._environ_kept): put back once the workers have started
+    # test's subprocess (oracles.datasets.executors._environ_kept): put back once the workers have started
     with _environ_kept():
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                dashboard_address=None, silence_logs=logging.CRITICAL)
@@ -350,7 +350,7 @@ def test_a_clusters_workers_keep_no_idle_program_per_earlier_candidate(tmp_path,
     for k in range(3):
         cand = tmp_path / f"cand{k}.py"
         cand.write_text(f"import os\nwith open({str(pids)!r}, 'a') as fh:\n    fh.write(f'{{os.getpid()}}\\n')\n"
-                        "from wirecheck.core.projection import project_points as f\n")
+                        "from wirecheck.core.projector.projection import project_points as f\n")
         code, report, _ = run(tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", *FAST, "--level", "vertices",
                               "--executor", "dask", "--scheduler", dask_scheduler, name=f"r{k}")
         assert code == 0 and report["summary"]["passed"] == 2

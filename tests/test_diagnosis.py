@@ -1,8 +1,8 @@
-"""oracles.diagnose: inject each fault into a copy of the projector, check the name.
+"""oracles.diagnosis.diagnose: inject each fault into a copy of the projector, check the name.
 
 Every faulty projector (tests/diagnosis_faults.py) is a small re-implementation of
-``core.projection.project_points`` with one bug (or two) put in on purpose. The
-reference side is ``oracles.opencv_oracle.project`` when it imports, else
+``core.projector.projection.project_points`` with one bug (or two) put in on purpose. The
+reference side is ``oracles.references.opencv_oracle.project`` when it imports, else
 core's own projector. Each (fault, camera) pair must give EXACTLY the expected
 set of fault names; the confusion matrix over all pairs is printed in the
 terminal summary (via tests/conftest.py) and must be diagonal.
@@ -16,12 +16,12 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from wirecheck.core.projection import project_points
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.projection import project_points
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles.clip_planes import probe_planes
-from wirecheck.oracles.diagnose import FAULT_ORDER, LINE_FAULTS, diagnose, primary
-from wirecheck.oracles.tolerances import vertex_bound, vertex_scale
+from wirecheck.oracles.diagnosis.clip_planes import probe_planes
+from wirecheck.oracles.diagnosis.diagnose import FAULT_ORDER, LINE_FAULTS, diagnose, primary
+from wirecheck.oracles.judge.tolerances import vertex_bound, vertex_scale
 
 from diagnosis_faults import (  # the faulty projectors and their cameras
     CAMERAS, LENS_PINCUSHION, LENS_CAMERAS, CALIBRATED_CAMERAS, _with, _project, f_none, f_swap, implied_fov,
@@ -29,7 +29,7 @@ from diagnosis_faults import (  # the faulty projectors and their cameras
 )
 
 try:
-    from wirecheck.oracles.opencv_oracle import project as oracle_project
+    from wirecheck.oracles.references.opencv_oracle import project as oracle_project
     ORACLE = "opencv"
 except ImportError:                                   # pragma: no cover - fallback only
     oracle_project = project_points
@@ -93,19 +93,19 @@ def points_for(camera_name):
 
 
 def float32_bound(pts, cam, ref) -> float:
-    """The float32 vertex bound of these points (oracles.tolerances: derived from eps32 and the scene's scale)."""
+    """The float32 vertex bound of these points (oracles.judge.tolerances: derived from eps32 and the scene's scale)."""
     return vertex_bound("float32", vertex_scale(pts, ref, cam), TOL)
 
 
 def run_case(fault, camera_name, dtype=np.float64):
     """Diagnose ``fault`` on a camera; float64: at TOL, with the float32 bound for precision_limited (as
-    oracles.verdict does for a float64 candidate); float32 (the twin): at the float32 bound."""
+    oracles.judge.verdict does for a float64 candidate); float32 (the twin): at the float32 bound."""
     cam = CAMERAS[camera_name]
     pts = points_for(camera_name)
     fn, _ = FAULTS[fault]
     ref = oracle_project(pts, cam)
     bound32 = float32_bound(pts, cam, ref)
-    # the candidate's own planes, probed as oracles.case does when the visible sets differ
+    # the candidate's own planes, probed as oracles.judge.case does when the visible sets differ
     if dtype == np.float32:
         planes = probe_planes(lambda q, c: fn(q, c, np.float32), cam)
         return diagnose(fn(pts, cam, np.float32), ref, cam, tol_px=bound32, planes=planes)

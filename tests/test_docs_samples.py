@@ -124,7 +124,7 @@ def _parser_options(parser):
 @pytest.mark.parametrize("program", ["renderer", "crosscheck"])
 def test_option_table_is_the_parser(program):
     if program == "renderer":
-        from wirecheck.core.cli import build_parser
+        from wirecheck.core.app.cli import build_parser
     else:
         from wirecheck.oracles.cli import build_parser
     documented = _table_options(ds.ROOT / "docs" / f"{program}.md")

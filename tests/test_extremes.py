@@ -19,8 +19,8 @@ import pytest
 from wirecheck.oracles import extremes
 from wirecheck.oracles.extremes import bounds, cases, measure
 from wirecheck.oracles.extremes import EXTREME_CASES, extremes_markdown, run_case, run_extremes
-from wirecheck.oracles.pyrender_oracle import osmesa_available
-from wirecheck.oracles.tolerances import MIN_F1_1PX_EXTREMES
+from wirecheck.oracles.references.pyrender_oracle import osmesa_available
+from wirecheck.oracles.judge.tolerances import MIN_F1_1PX_EXTREMES
 
 HAVE_OSMESA = osmesa_available()[0]
 
@@ -111,7 +111,7 @@ def test_bounds_are_not_vacuous(suite_without_pyrender):
 def test_suite_catches_a_strict_near_test(monkeypatch):
     # Planted fault: visibility z > near instead of z >= near. A point exactly at
     # the near plane must then fail the near_plane case.
-    from wirecheck.core import pipeline
+    from wirecheck.core.projector import pipeline
 
     def strict(p_cam, camera):
         z = p_cam[:, 2]

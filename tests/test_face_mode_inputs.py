@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import camera_z, look_at
-from wirecheck.core.culling import backface_keep, degenerate
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.scene import oriented_faces
-from wirecheck.core.scene_files import load_scene, parse_scene_text
+from wirecheck.core.projector.culling import backface_keep, degenerate
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.scene.model import oriented_faces
+from wirecheck.core.scene.files import load_scene, parse_scene_text
 from wirecheck.core.transforms import Motion, scale
 
 
@@ -29,7 +29,7 @@ def _cli(module, args, tmp_path):
     (["--projection", "both", "--ortho-height", "40"], "--ortho-height 40.0 with --projection both"),
 ])
 def test_renderer_rejects_contradictory_or_overflowing_options(args, needle, tmp_path):
-    rc, out, err = _cli("wirecheck.core.cli", ["--frames", "2", "--out", str(tmp_path / "o"), *args], tmp_path)
+    rc, out, err = _cli("wirecheck.core.app.cli", ["--frames", "2", "--out", str(tmp_path / "o"), *args], tmp_path)
     assert rc == 2 and needle in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "o" / "cube-frames").exists()
 
@@ -38,7 +38,7 @@ def test_renderer_rejects_contradictory_or_overflowing_options(args, needle, tmp
 def test_light_direction_of_any_finite_magnitude_works(light, tmp_path):
     # a direction: only its sign pattern and ratios matter; it is scaled by its
     # largest component before normalising, so neither overflows nor underflows
-    rc, out, err = _cli("wirecheck.core.cli", ["--frames", "1", "--style", "shaded", "--light", light,
+    rc, out, err = _cli("wirecheck.core.app.cli", ["--frames", "1", "--style", "shaded", "--light", light,
                                      "--out", str(tmp_path / "o")], tmp_path)
     assert rc == 0, err
 

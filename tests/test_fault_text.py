@@ -1,6 +1,6 @@
 """A fault's parameters are printed to what they mean: no float64 rounding digits, no fields that are not implied."""
 
-from wirecheck.oracles.report import fault_text
+from wirecheck.oracles.reports.report import fault_text
 
 
 def test_a_parameter_one_rounding_from_nominal_prints_as_nominal():
@@ -21,7 +21,7 @@ def test_a_field_that_is_not_implied_is_left_out():
 
 
 def test_the_cli_shows_two_reasons_and_counts_the_rest():
-    from wirecheck.oracles.compared import reason_text
+    from wirecheck.oracles.reports.compared import reason_text
 
     reasons = ["max vertex error 289 px > 1e-06 px", "pixel F1@1px 0.0614 < 0.999", "pixel F1@0px 0.0117 < 0.98",
                "edge 9 has -193 pixels against the oracle's count"]

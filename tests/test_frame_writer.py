@@ -1,4 +1,4 @@
-"""core.frame_writer: PNG frames written by a forked child are the in-line encoder's bytes; errors reach the parent."""
+"""core.outputs.frame_writer: PNG frames written by a forked child are the in-line encoder's bytes; errors reach the parent."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import sys
 import numpy as np
 import pytest
 
-from wirecheck.core.frame_writer import ForkedPngWriter, can_fork
-from wirecheck.core.output import MARKER, is_bilevel, png_bytes
+from wirecheck.core.outputs.frame_writer import ForkedPngWriter, can_fork
+from wirecheck.core.outputs.output import MARKER, is_bilevel, png_bytes
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
 
@@ -57,7 +57,7 @@ def test_leaving_on_an_error_waits_for_the_child_and_keeps_the_callers_error(tmp
 def test_no_fork_with_other_threads_few_frames_or_one_cpu():
     """In a fresh interpreter (this one may hold other threads: pytest-xdist's)."""
     code = ("import os, threading\n"
-            "from wirecheck.core.frame_writer import MIN_FRAMES, can_fork\n"
+            "from wirecheck.core.outputs.frame_writer import MIN_FRAMES, can_fork\n"
             "alone = can_fork(MIN_FRAMES), can_fork(MIN_FRAMES - 1)\n"
             "stop = threading.Event(); t = threading.Thread(target=stop.wait); t.start()\n"
             "threaded = can_fork(10_000)\n"
@@ -73,7 +73,7 @@ def test_no_fork_with_other_threads_few_frames_or_one_cpu():
 def test_renderer_frames_from_the_child_equal_the_in_line_ones(tmp_path):
     """The seed command's path (frames >= MIN_FRAMES, two CPUs) against --profile's (always in line)."""
     def frames(out, *extra):
-        cmd = [sys.executable, "-m", "wirecheck.core.cli", "--frames", "40", "--fov", "70", "--out", str(out), *extra]
+        cmd = [sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "40", "--fov", "70", "--out", str(out), *extra]
         assert subprocess.run(cmd, capture_output=True).returncode == 0
         d = out / "cube-frames"
         return {n: (d / n).read_bytes() for n in sorted(os.listdir(d)) if n != MARKER}

@@ -1,4 +1,4 @@
-"""core.frames.SceneRenderer: the scene-level API renderer and crosscheck share."""
+"""core.scene.frames.SceneRenderer: the scene-level API renderer and crosscheck share."""
 
 import doctest
 
@@ -6,12 +6,12 @@ import numpy as np
 from numpy.testing import assert_array_equal
 
 import wirecheck
-from wirecheck.core import frames
+from wirecheck.core.scene import frames
 from wirecheck.core.camera import look_at
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
-from wirecheck.oracles import opencv_oracle
-from wirecheck.oracles.faces import frame_geometry
+from wirecheck.oracles.references import opencv_oracle
+from wirecheck.oracles.references.faces import frame_geometry
 
 CAM = look_at((0.0, 2.0, 9.0), (0.0, 0.0, 0.0), near=0.5, far=50.0)
 

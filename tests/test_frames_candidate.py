@@ -19,12 +19,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.scene_files import load_scene
-from wirecheck.oracles import opencv_oracle
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.scene.files import load_scene
+from wirecheck.oracles.references import opencv_oracle
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.export import build_job
-from wirecheck.oracles.frames_candidate import frame_inputs, load_job, read_obj
+from wirecheck.oracles.candidates.export import build_job
+from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job, read_obj
 
 ARGS = ["--scene", "cube", "--cases", "on_axis,non_square,orthographic", "--frames", "6", "--every", "3"]
 
@@ -221,7 +221,7 @@ def test_not_a_job(tmp_path, capsys):
 
 
 def test_options_the_job_fixes_are_usage_errors(filled, tmp_path, capsys):
-    for extra in (["--scene", "cube"], ["--frames", "3"], ["--candidate", "wirecheck.core.projection:project_points"], ["--cases", "on_axis"]):
+    for extra in (["--scene", "cube"], ["--frames", "3"], ["--candidate", "wirecheck.core.projector.projection:project_points"], ["--cases", "on_axis"]):
         rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")] + extra)
         err = capsys.readouterr().err
         assert rc == 2 and "the job fixes scenes, cases and frames" in err, (extra, err)
@@ -229,9 +229,9 @@ def test_options_the_job_fixes_are_usage_errors(filled, tmp_path, capsys):
 
 def test_several_moving_objects_are_exported_in_world_space(tmp_path, capsys):
     # the orrery's objects move on their own: one world-space OBJ per frame, identity model
-    # matrix, the vertices being the oracle's own world points (oracles.faces, scipy)
+    # matrix, the vertices being the oracle's own world points (oracles.references.faces, scipy)
     from wirecheck.core.transforms import Motion
-    from wirecheck.oracles.faces import frame_geometry
+    from wirecheck.oracles.references.faces import frame_geometry
 
     path = str(Path(__file__).parents[1] / "scenes" / "examples" / "orrery.scene")
     job = _export(tmp_path / "job", ["--scene", path, "--cases", "oblique_roll", "--frames", "6", "--every", "3"])
@@ -265,7 +265,7 @@ def test_project_settings_do_not_apply_to_frames_and_junit_is_written(filled, tm
 
 def test_a_case_where_nothing_is_drawn_is_vacuous(tmp_path, capsys):
     # points without edges: the oracle draws nothing, a blank frame agrees with it, and that
-    # compares nothing (as oracles.gate): exit 1 unless --allow-vacuous
+    # compares nothing (as oracles.judge.gate): exit 1 unless --allow-vacuous
     scene = tmp_path / "dots.scene"
     scene.write_text("name dots\nv -1 -1 0\nv 1 1 0\nv 0 1 1\n")
     job = _export(tmp_path / "job", ["--scene", str(scene), "--cases", "on_axis", "--frames", "2"])

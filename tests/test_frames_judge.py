@@ -1,4 +1,4 @@
-"""The frames path judged by the one judge (oracles.judge): lines, balance, per-edge counts, each threshold.
+"""The frames path judged by the one judge (oracles.judge.decide): lines, balance, per-edge counts, each threshold.
 
 A job is exported and its frames drawn by core (tests/test_frames_candidate.py
 shows how): core's exact frames must pass; the same frames with every line's
@@ -20,13 +20,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.core import raster
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.scene_files import load_scene
-from wirecheck.oracles import tolerances
+from wirecheck.core.projector import raster
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.scene.files import load_scene
+from wirecheck.oracles.judge import tolerances
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.frames_candidate import frame_inputs, load_job
-from wirecheck.oracles.frames_judge import diagnosis_frames, run_frames
+from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
+from wirecheck.oracles.judge.frames_judge import diagnosis_frames, run_frames
 from wirecheck.oracles.runner import CoreCandidate, Tolerances, run_crosscheck
 
 from raster_mutants import drop_last
@@ -176,7 +176,7 @@ def test_min_f1_1px_decides_on_frames(stray):
     assert 0.99 < f1 < 1.0                  # one stray pixel among ~1,000
     failed = _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
     # the geometry is right (nothing named from the images) and the line gate is off: a failure
-    # nothing explains is `unexplained`, never "no fault" (oracles.judge.decide)
+    # nothing explains is `unexplained`, never "no fault" (oracles.judge.decide.decide)
     assert all(c["faults"] == [{"name": "unexplained"}] for c in failed), [c["faults"] for c in failed]
 
 
@@ -216,7 +216,7 @@ def test_diagnosis_frames_are_evenly_spread():
 
 
 def test_readme_says_when_every_frame_is_a_quarter_turn():
-    from wirecheck.oracles.export import build_job
+    from wirecheck.oracles.candidates.export import build_job
 
     cube = [load_scene("cube")]
     # frame k turns (k - 1) / frames of a turn about X and Y (spin 1,1,0): with 4 frames, 0, 1/4, 1/2, 3/4

@@ -105,7 +105,7 @@ def test_three_js_has_no_named_fault(judged):
     # cube / narrow_fov, frame 1: edge 3 runs within 0.01 px of the pixel edge x = 398.5 over rows
     # 201-209; SwiftShader takes the pixel right of it (x = 399, also the next edge's), Mesa the left one.
     # Ties that close are decided by the renderer's sub-pixel grid, coarser than the oracle's precision
-    # (oracles.line_ties), so they count as decided one-sided pixels: the line gate names
+    # (oracles.judge.line_ties), so they count as decided one-sided pixels: the line gate names
     # line_pixel_bias there (measured: 15 oracle-only vs 0 decided candidate-only pixels, edge 3 -10).
     # Known, for the tie rule to settle (issue 23); every other case names nothing.
     assert named.pop(("cube", "narrow_fov")) in ([], ["unexplained"], ["line_pixel_bias"], ["raster_rule"])

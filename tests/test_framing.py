@@ -1,18 +1,18 @@
-"""Case cameras framed on the scene (oracles.cases.framing): a mesh far from the origin fills the image."""
+"""Case cameras framed on the scene (oracles.judge.cases.framing): a mesh far from the origin fills the image."""
 
 import math
 
 import numpy as np
 import pytest
 
-from wirecheck.core.scene import Scene, SceneObject
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.scene.model import Scene, SceneObject
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles import faces as oface
-from wirecheck.oracles import opencv_oracle
-from wirecheck.oracles.cases import case_motion, cases_for, framing
-from wirecheck.oracles.convert import model_matrix
-from wirecheck.oracles.pyrender_oracle import osmesa_available
+from wirecheck.oracles.references import faces as oface
+from wirecheck.oracles.references import opencv_oracle
+from wirecheck.oracles.judge.cases import case_motion, cases_for, framing
+from wirecheck.oracles.references.convert import model_matrix
+from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 from helpers import run_crosscheck
 
 HALF = 50.0                                  # the box's half-size
@@ -88,7 +88,7 @@ def test_crosscheck_of_the_off_centre_box_passes_comparing_its_lines(tmp_path):
 
 def test_every_bundled_scene_keeps_the_origin_framing():
     # hand values: the cube's and pyramid's corners are at sqrt(3), the prism's at sqrt(2);
-    # the orrery's bound is |planet offset| 2.5 + scale 0.5 * sqrt(3) (core.scene.Scene.radius)
+    # the orrery's bound is |planet offset| 2.5 + scale 0.5 * sqrt(3) (core.scene.model.Scene.radius)
     expected = {"cube": math.sqrt(3), "pyramid": math.sqrt(3), "prism": math.sqrt(2), "orrery": 2.5 + 0.5 * math.sqrt(3)}
     for name, r in expected.items():
         centre, radius, pivot = framing(load_scene(name))

@@ -16,8 +16,8 @@ from hypothesis import strategies as st
 from fuzz.contract import (SCENE_TEXTS, HypothesisPick, Pick, crosscheck_argv, make_scene_arg, mutate_text, outside_box,
                            renderer_argv, run_cli)
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene import Scene
-from wirecheck.core.scene_files import load_scene, parse_scene_text
+from wirecheck.core.scene.model import Scene
+from wirecheck.core.scene.files import load_scene, parse_scene_text
 
 SLOW = settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
 
@@ -25,7 +25,7 @@ SLOW = settings(max_examples=40, deadline=None, suppress_health_check=list(Healt
 @pytest.fixture(scope="module")
 def earlier(tmp_path_factory):
     """An earlier renderer output (with its manifest), copied into some output set-ups."""
-    from wirecheck.core import cli
+    from wirecheck.core.app import cli
 
     out = tmp_path_factory.mktemp("earlier") / "out"
     assert cli.main(["--frames", "2", "--width", "32", "--height", "24", "--format", "png,gif", "--out", str(out)]) == 0
@@ -65,7 +65,7 @@ def test_mesh_loader_gives_a_scene_or_one_line(data):
 @SLOW
 @given(data=st.data())
 def test_renderer_contract(data, earlier):
-    from wirecheck.core import cli
+    from wirecheck.core.app import cli
 
     with tempfile.TemporaryDirectory() as d:
         box = Path(d)
@@ -151,7 +151,7 @@ def test_hostile_png_frames_read_or_one_printable_phrase(data):
     """The image rule on damaged PNGs of every colour type and depth (tests/fuzz/png_inputs.py): a bool image of
     the camera's size or one FrameProblem line without control characters."""
     from fuzz.png_inputs import check_png, hostile_png
-    from wirecheck.oracles.png_frame import FrameProblem, read_png
+    from wirecheck.oracles.candidates.png_frame import FrameProblem, read_png
 
     pick = HypothesisPick(data)
     width, height = pick.integer(1, 9), pick.integer(1, 5)

@@ -1,4 +1,4 @@
-"""A gate never passes on nothing (oracles.gate): every way a check could compare nothing.
+"""A gate never passes on nothing (oracles.judge.gate): every way a check could compare nothing.
 
 Inputs that would compare nothing are usage errors, the same through the CLI
 (exit 2, one stderr line, no traceback, no report) and the API (ValueError).
@@ -17,8 +17,9 @@ import pytest
 
 from wirecheck.core.camera import look_at
 from wirecheck.core.errors import InputError
-from wirecheck.oracles import cases as cases_mod
-from wirecheck.oracles import cli, gate
+from wirecheck.oracles.judge import cases as cases_mod
+from wirecheck.oracles import cli
+from wirecheck.oracles.judge import gate
 from wirecheck.oracles.api import assert_projector, check_projector
 from wirecheck.oracles.runner import CoreCandidate, run_crosscheck
 
@@ -68,7 +69,7 @@ def test_cli_inputs_that_compare_nothing_exit_2(tmp_path, capsys, args, needle):
 def test_cli_empty_scene_folder_and_unmatched_glob_exit_2(tmp_path, capsys):
     folder = tmp_path / "scenes"
     folder.mkdir()
-    # a folder is a dataset (oracles/dataset.py): an empty one has nothing to check
+    # a folder is a dataset (oracles/datasets/dataset.py): an empty one has nothing to check
     assert "no mesh files in this folder" in cli_usage_error(tmp_path, capsys, "--level", "vertices",
                                                              "--scene", str(folder))
     # a shell glob that matches nothing arrives as the pattern itself
@@ -111,7 +112,7 @@ def test_every_larger_than_frames_is_an_error_in_the_library():
 
 
 def test_no_bundled_scenes_found_is_a_usage_error(tmp_path, capsys, monkeypatch):
-    import wirecheck.core.scene_files as scene_mod
+    import wirecheck.core.scene.files as scene_mod
 
     monkeypatch.setattr(scene_mod, "SCENE_DIR", tmp_path / "empty")     # an installation without scenes
     assert "no bundled scenes found" in cli_usage_error(tmp_path, capsys, "--level", "vertices")
@@ -147,7 +148,7 @@ def test_candidate_that_ends_the_process_with_status_0_fails(tmp_path):
                            "vertices", "--candidate", f"{killer}:project", "--scene", "cube", "--frames", "1",
                            "--cases", "on_axis"], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 1, (proc.returncode, proc.stderr)
-    # the candidate runs in its own process (oracles.isolation): its case fails and the report is written
+    # the candidate runs in its own process (oracles.candidates.isolation): its case fails and the report is written
     assert proc.stderr == "" and "FAIL: 0/1 cases" in proc.stdout
     report = json.loads((out / "report.json").read_text())
     assert report["cases"][0]["reasons"] == ["frame 1: candidate exited with status 0 during a request of 8 points"]
@@ -321,8 +322,8 @@ def test_no_progress_when_stderr_is_not_a_terminal(tmp_path, capsys):
 # ---------------------------------------------------------------- fault numbers tell the value from nominal
 
 def test_fault_numbers_are_printed_distinct_from_their_nominal_values():
-    from wirecheck.oracles.fmt import distinct
-    from wirecheck.oracles.report import fault_text
+    from wirecheck.oracles.reports.fmt import distinct
+    from wirecheck.oracles.reports.report import fault_text
 
     camera = {"width": 640, "height": 480, "fov_y_deg": 60.0, "ortho_height": 3.0}
     faults = [{"name": "aspect_mismatch", "implied_aspect": 1.33264, "scale_x": 1.0005, "scale_y": 1.0},

@@ -1,11 +1,11 @@
-"""The streaming GIF writer (core/gif.py), decoded by Pillow: the reference reader."""
+"""The streaming GIF writer (core/outputs/gif.py), decoded by Pillow: the reference reader."""
 
 import io
 
 import numpy as np
 from PIL import Image, ImageSequence
 
-from wirecheck.core.gif import GifWriter, gif_bytes
+from wirecheck.core.outputs.gif import GifWriter, gif_bytes
 
 
 def decoded(data: bytes):

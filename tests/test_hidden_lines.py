@@ -1,14 +1,14 @@
-"""Hidden-line suppression and back-face culling in core.pipeline.render_frame."""
+"""Hidden-line suppression and back-face culling in core.projector.pipeline.render_frame."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from wirecheck.core import hidden_lines, pipeline, raster, zbuffer
+from wirecheck.core.projector import hidden_lines, pipeline, raster, zbuffer
 from wirecheck.core.camera import look_at
-from wirecheck.core.pipeline import render_frame
-from wirecheck.oracles.metrics import pixel_scores
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.oracles.judge.metrics import pixel_scores
 
 CUBE_V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                    [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
@@ -178,7 +178,7 @@ def test_argument_checks():
 def test_hidden_lines_against_pyrender(oracle, summary_section):
     """pyrender draws the faces black with glPolygonOffset(1, 1) and the lines on top.
 
-    Our bias is that offset in linear depth (core.hidden_lines), so the same line
+    Our bias is that offset in linear depth (core.projector.hidden_lines), so the same line
     pixels pass. Measured on 16 poses of a cube and an icosphere, both
     projections: F1@1px = 1.000 everywhere and F1@0 >= 0.998 (a pixel or two of
     a few thousand differ where a line grazes a face and the float32/24-bit

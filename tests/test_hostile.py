@@ -14,13 +14,13 @@ import time
 import numpy as np
 import pytest
 
-from wirecheck.core import cli as renderer_cli
-from wirecheck.core import run as core_run
+from wirecheck.core.app import cli as renderer_cli
+from wirecheck.core.app import run as core_run
 from wirecheck.core.errors import InputError, one_line
 from wirecheck.core.limits import MAX_FACE_VERTICES, MAX_FRAMES, MAX_SIDE
-from wirecheck.core.output import MARKER
-from wirecheck.core.scene_files import SCENE_DIR, parse_scene_text
-from wirecheck.core.staging import LOCK, MANIFEST
+from wirecheck.core.outputs.output import MARKER
+from wirecheck.core.scene.files import SCENE_DIR, parse_scene_text
+from wirecheck.core.outputs.staging import LOCK, MANIFEST
 from wirecheck.oracles import cli as crosscheck_cli
 
 import helpers
@@ -414,7 +414,7 @@ def test_users_file_named_like_the_lock_is_refused(tmp_path, capsys):
 def test_two_renderers_on_one_out_never_mix(tmp_path):
     """Pairs of runs of different lengths at once: each exits 0 or refuses (2, the lock); the set is one run's."""
     out = tmp_path / "out"
-    cmd = [sys.executable, "-m", "wirecheck.core.cli", "--width", "64", "--height", "48", "--out", str(out)]
+    cmd = [sys.executable, "-m", "wirecheck.core.app.cli", "--width", "64", "--height", "48", "--out", str(out)]
     for pair in range(4):
         procs = [subprocess.Popen([*cmd, "--frames", str(n)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
                  for n in (20 + pair, 27 + pair)]
@@ -436,7 +436,7 @@ def test_two_renderers_on_one_out_never_mix(tmp_path):
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_killed_run_leaves_nothing(tmp_path, sig):
     out = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--frames", "2000", "--verbose",
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2000", "--verbose",
                              "--format", "png,gif", "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     for _ in range(3):
@@ -449,10 +449,10 @@ def test_killed_run_leaves_nothing(tmp_path, sig):
 
 def test_killed_rerun_keeps_the_earlier_output(tmp_path):
     out = tmp_path / "out"
-    assert subprocess.run([sys.executable, "-m", "wirecheck.core.cli", "--frames", "2", "--out", str(out)],
+    assert subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2", "--out", str(out)],
                           capture_output=True).returncode == 0
     before = {n: (out / n).read_bytes() for n in ("cube-report.json", "cube-report.txt")}
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--frames", "2000", "--verbose",
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2000", "--verbose",
                              "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     for _ in range(3):
         proc.stdout.readline()

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wirecheck.core.projection import project_points
+from wirecheck.core.projector.projection import project_points
 from wirecheck.oracles.api import check_projector
 
 DATA = Path(__file__).parent / "data"
@@ -66,7 +66,7 @@ def test_arguments_given_in_other_reasonable_forms_work():
     # a Path for one scene, a string for one oracle, numpy arrays of names, a numpy integer of frames
     report = check_projector(project_points, scenes=Path(DATA.parent.parent / "scenes" / "cube.scene"),
                              frames=np.int64(1), cases=np.array(["on_axis"]), oracles="opencv", isolate=False)
-    # float64 on both sides: ~1e-11 px at most (oracles/tolerances.py derivation)
+    # float64 on both sides: ~1e-11 px at most (oracles/judge/tolerances.py derivation)
     assert report["verdict"] == "pass" and report["level"] == "vertices"
     assert report["compared"] == {"cases": 1, "frames": 1, "vertices": 8, "pixels": None}
     assert report["summary"]["max_vertex_error_px"] < 1e-9
@@ -135,7 +135,7 @@ def test_answers_outside_the_contract_fail_with_one_reason(name):
 
 
 def test_float16_and_integers_are_judged_and_fail_on_their_rounding():
-    # float16 is judged as float32 (oracles/candidate.py): its ~0.1 px rounding at a 640 px image
+    # float16 is judged as float32 (oracles/candidates/candidate.py): its ~0.1 px rounding at a 640 px image
     # (eps16 = 9.8e-4 x 320 px / 2) is far over the float32 bound; integer pixels miss by up to 0.5 px
     for dtype, judged in ((np.float16, "float32"), (np.int64, "float64")):
         report = check_projector(lambda p, c: np.round(project_points(p, c)).astype(dtype), isolate=False, **ONE)
@@ -187,7 +187,7 @@ def state():
             dict.__getitem__(sys.modules["matplotlib"].rcParams, "backend")}
 
 from wirecheck.oracles.api import check_projector
-from wirecheck.core.projection import project_points
+from wirecheck.core.projector.projection import project_points
 before = state()
 check_projector(project_points, scenes=["cube"], frames=1, cases=["on_axis"], isolate=False)
 check_projector(lambda p, c: project_points(p, c), scenes=["cube"], frames=1, cases=["on_axis"])   # forked
@@ -210,7 +210,7 @@ def test_a_first_check_in_a_process_leaves_its_imports_side_effects_behind():
 # ---------------------------------------------------------------- reports and JUnit XML hold any name
 
 def test_junit_xml_with_control_characters_and_undecodable_bytes_parses():
-    from wirecheck.oracles.junit import junit_xml
+    from wirecheck.oracles.reports.junit import junit_xml
 
     # a scene or candidate named by a file name: control characters, "]]>", lone surrogates
     # (Python's surrogateescape for a non-UTF-8 byte); ElementTree writes them as they are
@@ -251,7 +251,7 @@ def loaded(tmp_path_factory):
     Such a run unloads the modules it imported, and a C extension (numpy.fft's, under matplotlib) cannot
     load twice in one process: the next run's import would fail.
     """
-    from wirecheck.oracles.report import write_report
+    from wirecheck.oracles.reports.report import write_report
 
     report = check_projector(lambda p, c: project_points(p, c) + 0.5, isolate=False, **ONE)
     write_report(tmp_path_factory.mktemp("loaded") / "r", report, {})
@@ -261,7 +261,7 @@ def test_the_report_summary_comes_from_the_test_reports(pytester, loaded):
     # under pytest-xdist the checks run in workers: the summary counts what the reports carry
     # (user_properties), not what the controller's process wrote; pytest's --junitxml gets the path
     pytester.makepyfile(test_user='''
-from wirecheck.core.projection import project_points
+from wirecheck.core.projector.projection import project_points
 
 def test_shifted(wirecheck):
     wirecheck(lambda p, c: project_points(p, c) + 0.5, scenes=["cube"], frames=1, cases=["on_axis"], isolate=False)
@@ -279,7 +279,7 @@ def test_test_ids_that_differ_only_in_replaced_characters_get_their_own_reports(
     # first; a parameter id "cube-2" was the folder name of test_shift[cube]'s second check
     pytester.makepyfile(test_user='''
 import pytest
-from wirecheck.core.projection import project_points
+from wirecheck.core.projector.projection import project_points
 
 @pytest.mark.parametrize("shift", [0.5, 0.25, 0.125, 2.0], ids=["a b", "a_b", "cube-2", "cube"])
 def test_shift(wirecheck, shift):

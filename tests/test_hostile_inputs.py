@@ -20,7 +20,7 @@ import pytest
 from PIL import Image
 
 from wirecheck.oracles import cli as crosscheck_cli
-from wirecheck.oracles.frames_candidate import FrameProblem, FramesError, frame_inputs, load_frames, load_job, read_png
+from wirecheck.oracles.candidates.frames_candidate import FrameProblem, FramesError, frame_inputs, load_frames, load_job, read_png
 
 import helpers                          # tests/ is on sys.path (rootdir conftest)
 
@@ -192,7 +192,7 @@ def test_the_frames_walk_is_bounded(job, monkeypatch):
     """Links between folders can make a tree of any size (two links to one folder in each of n folders:
     2**n paths); the walk stops at MAX_WALK entries. Here 4 entries are the job's (cube, on_axis, 2 frames):
     the bound at 4 passes, and two links to on_axis (each seen with its 2 frames: 6 more) pass it."""
-    from wirecheck.oracles import frames_candidate
+    from wirecheck.oracles.candidates import frames_candidate
 
     monkeypatch.setattr(frames_candidate, "MAX_WALK", 4)
     assert len(load_frames(job, load_job(job))[("cube", "on_axis")]) == 2
@@ -303,7 +303,7 @@ TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 
 def test_a_scene_list_with_a_bom_and_crlf_lines(tmp_path):
     """A list saved by a Windows editor. Before: line 1 named '\\ufeffa.obj' (file not found)."""
-    from wirecheck.oracles.dataset import read_list
+    from wirecheck.oracles.datasets.dataset import read_list
 
     (tmp_path / "a.obj").write_text(TRI)
     (tmp_path / "b.obj").write_text(TRI)
@@ -316,7 +316,7 @@ def test_a_scene_list_with_a_bom_and_crlf_lines(tmp_path):
 def test_a_mesh_listed_again_through_a_link_is_refused(tmp_path):
     """Before: checked and counted twice (PASS: 2/2 meshes for one mesh)."""
     from wirecheck.core.errors import InputError
-    from wirecheck.oracles.dataset import read_list
+    from wirecheck.oracles.datasets.dataset import read_list
 
     (tmp_path / "a.obj").write_text(TRI)
     (tmp_path / "b.obj").symlink_to(tmp_path / "a.obj")

@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wirecheck.oracles import cli, subprocess_candidate
-from wirecheck.oracles.candidate import CandidateError, call_candidate
-from wirecheck.oracles.cases import cameras_for
-from wirecheck.oracles.subprocess_candidate import SubprocessCandidate
+from wirecheck.oracles import cli
+from wirecheck.oracles.candidates import subprocess_candidate
+from wirecheck.oracles.candidates.candidate import CandidateError, call_candidate
+from wirecheck.oracles.judge.cases import cameras_for
+from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate
 
 from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)
 

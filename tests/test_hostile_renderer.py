@@ -13,8 +13,8 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from wirecheck.core import cli as renderer_cli
-from wirecheck.core.scene_files import SCENE_DIR
+from wirecheck.core.app import cli as renderer_cli
+from wirecheck.core.scene.files import SCENE_DIR
 
 SMALL = ["--width", "16", "--height", "8"]          # frames as small as the contract allows: every test stays fast
 
@@ -205,7 +205,7 @@ def test_obj_negative_indices_with_slash_forms_are_read(tmp_path, capsys):
 
 
 def test_obj_negative_indices_count_back_from_this_line_not_the_end_of_the_file(tmp_path):
-    from wirecheck.core.scene_files import load_scene
+    from wirecheck.core.scene.files import load_scene
 
     # 'f -3 -2 -1' after three vertices is vertices 1 2 3 (0-based 0 1 2), whatever follows;
     # trimesh counted back from the file's 4 vertices and drew the face (1, 2, 3) instead

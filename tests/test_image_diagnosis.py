@@ -1,9 +1,9 @@
-"""oracles.image_diagnose: faults named from images alone.
+"""oracles.diagnosis.image_diagnose: faults named from images alone.
 
 Each fault is injected into a copy of core's projector (the faulty projectors
 of tests/test_diagnosis.py, the same ones the vertex diagnosis is proved on),
-drawn to images by core's rasteriser (oracles.draw.draw_candidate: depth clip,
-the faulty projection of the clipped ends, core.raster.line_pixels), and
+drawn to images by core's rasteriser (oracles.candidates.draw.draw_candidate: depth clip,
+the faulty projection of the clipped ends, core.projector.raster.line_pixels), and
 diagnosed from those images and the oracle's lines only: the faulty pixel
 coordinates never reach the diagnosis. A depth-flipped renderer is drawn with
 the camera looking backward (its own clipping then keeps what lies behind).
@@ -24,14 +24,14 @@ from diagnosis_faults import CALIBRATED_FAULTS, CAMERAS, CLIP_FAULTS, FAULTS, FO
 from test_diagnosis import format_confusion
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.clipping import clip_to_image
-from wirecheck.core.projection import project_points
-from wirecheck.core.raster import line_coverage_aa, line_pixels
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.clipping import clip_to_image
+from wirecheck.core.projector.projection import project_points
+from wirecheck.core.projector.raster import line_coverage_aa, line_pixels
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles.diagnose import FAULT_ORDER, LINE_FAULTS, VERTEX_ONLY_FAULTS, primary
-from wirecheck.oracles.draw import clip_depth, draw_candidate
-from wirecheck.oracles.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+from wirecheck.oracles.diagnosis.diagnose import FAULT_ORDER, LINE_FAULTS, VERTEX_ONLY_FAULTS, primary
+from wirecheck.oracles.candidates.draw import clip_depth, draw_candidate
+from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
 
 pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
 
@@ -44,7 +44,7 @@ MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
 # (Not the faults that need fx != fy or a lens: test_diagnosis' calibrated cameras; nor
 # float32_arith, float32 rounding of ~1e-5 px: a vertex-level fault a drawing cannot show.)
 # Nor float32_k (float32 constants, ~1e-5 px) nor the depth-test faults (CLIP_FAULTS: probed on the
-# projector, oracles.clip_planes).
+# projector, oracles.diagnosis.clip_planes).
 CASES = [(f, c) for f in SINGLE for c in MAIN_CAMERAS
          if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS
          and f not in ("float32_arith", "float32_k") + CLIP_FAULTS]
@@ -129,7 +129,7 @@ def _memoised_quantisation_bias():
     (the camera and the segments' bytes), so the value is the one the
     function gives.
     """
-    from wirecheck.oracles import image_diagnose
+    from wirecheck.oracles.diagnosis import image_diagnose
 
     compute, done = image_diagnose.quantisation_bias, {}
 
@@ -146,7 +146,7 @@ def _memoised_quantisation_bias():
 
 @pytest.fixture(scope="module")
 def results():
-    from wirecheck.oracles import image_diagnose
+    from wirecheck.oracles.diagnosis import image_diagnose
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(image_diagnose, "quantisation_bias", _memoised_quantisation_bias())
@@ -161,7 +161,7 @@ def test_expected_names(results, fault, camera_name):
 
 @pytest.mark.parametrize("fault", ["mirror_x", "mirror_y"])
 def test_an_undecidable_mirror_gives_both_names_and_hints(results, fault):
-    from wirecheck.oracles.report import FAULT_HINTS, fault_hints
+    from wirecheck.oracles.reports.report import FAULT_HINTS, fault_hints
 
     (amb,) = results[(fault, "ortho_cube")]
     assert sorted(amb["alternatives"]) == ["mirror_horizontal", "mirror_vertical"]
@@ -209,8 +209,8 @@ def test_half_pixel_offset_to_sub_pixel(results, camera_name):
 
 def confusion(results):
     # the vertex diagnosis' names; line_end_bias / line_pixel_bias are per-edge pixel counts
-    # of a drawing the harness made itself (oracles.diagnose.diagnose_lines), not this family
-    # (nor distortion_mismatch: frames of a distorted camera are not compared, oracles.case;
+    # of a drawing the harness made itself (oracles.diagnosis.diagnose.diagnose_lines), not this family
+    # (nor distortion_mismatch: frames of a distorted camera are not compared, oracles.judge.case;
     # nor precision_limited: float32 rounding is far below a pixel)
     labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS + VERTEX_ONLY_FAULTS]
     counts = Counter()
@@ -249,7 +249,7 @@ def test_a_case_of_many_frames_is_fitted_on_the_points_of_six(fault, monkeypatch
     # 24 frames of the cube: every frame contributes, MAX_POINTS_PER_CASE // 24 = 150 points per
     # frame and direction (six frames keep their 600 each), so the fit costs what a six-frame
     # case costs; the names are those of the six-frame cases above
-    from wirecheck.oracles import image_diagnose
+    from wirecheck.oracles.diagnosis import image_diagnose
 
     sizes = []
     init = image_diagnose._Registration.__init__

@@ -1,10 +1,10 @@
-"""oracles.image_diagnose on short jobs: four quarter-turn frames of one scene, as ``--frames 4`` exports.
+"""oracles.diagnosis.image_diagnose on short jobs: four quarter-turn frames of one scene, as ``--frames 4`` exports.
 
-Core draws each case (oracles.draw.draw_candidate) with one fault put in: the intrinsics scaled (the
+Core draws each case (oracles.candidates.draw.draw_candidate) with one fault put in: the intrinsics scaled (the
 FOV or aspect a real renderer was given wrongly), the rows or columns flipped, the principal point
 moved half a pixel. The expected names and parameters are the injected ones; the confusion matrix
 of primary names is printed in the terminal summary and must be diagonal. Measured before
-oracles.image_naming: the FOV and mirror cases carried a spurious ``pixel_offset`` or none at all,
+oracles.diagnosis.image_naming: the FOV and mirror cases carried a spurious ``pixel_offset`` or none at all,
 fx x 16/9 and K x 4/3 were ``unexplained``, the undecidable mirror was ``mirror_vertical``.
 """
 
@@ -18,14 +18,14 @@ import pytest
 from test_diagnosis import format_confusion
 
 from wirecheck.core.camera import Camera
-from wirecheck.core.projection import project_points
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.projection import project_points
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles.cases import case_motion, cases_for
-from wirecheck.oracles.diagnose import FAULT_ORDER, primary
-from wirecheck.oracles.draw import draw_candidate
-from wirecheck.oracles.image_diagnose import diagnose_images, flipped_camera, oracle_segments
-from wirecheck.oracles.report import fault_hints
+from wirecheck.oracles.judge.cases import case_motion, cases_for
+from wirecheck.oracles.diagnosis.diagnose import FAULT_ORDER, primary
+from wirecheck.oracles.candidates.draw import draw_candidate
+from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+from wirecheck.oracles.reports.report import fault_hints
 
 pytestmark = pytest.mark.slow
 FRAMES = 4

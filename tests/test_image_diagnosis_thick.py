@@ -1,4 +1,4 @@
-"""oracles.image_diagnose on drawings other than 1-px aliased lines: no false faults, and faults still named.
+"""oracles.diagnosis.image_diagnose on drawings other than 1-px aliased lines: no false faults, and faults still named.
 
 Split from tests/test_image_diagnosis.py (which draws and diagnoses the
 faults, and holds the drawing helpers) so that ``pytest -n 2 --dist loadfile``
@@ -11,8 +11,8 @@ import pytest
 
 from test_image_diagnosis import MAIN_CAMERAS, diagnose_fault, draw_aa, draw_wide
 
-from wirecheck.oracles.diagnose import primary
-from wirecheck.oracles.image_diagnose import OFFSET_TOL_PX
+from wirecheck.oracles.diagnosis.diagnose import primary
+from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX
 
 pytestmark = pytest.mark.slow          # ~1 s per diagnosis of six images
 

@@ -1,4 +1,4 @@
-"""oracles.image_naming: an offset is judged against the fitted model's own lines.
+"""oracles.diagnosis.image_naming: an offset is judged against the fitted model's own lines.
 
 A rectangle of axis-aligned lines is drawn by core's rasteriser, scaled 0.75 about the principal point
 (a pure FOV fault). Its edges lie at u = 98.7 and -90.65 px from the centre (cx = 319.5, cy = 239.5):
@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.raster import line_pixels
-from wirecheck.oracles import image_diagnose
-from wirecheck.oracles.image_diagnose import OFFSET_TOL_PX, diagnose_images
+from wirecheck.core.projector.raster import line_pixels
+from wirecheck.oracles.diagnosis import image_diagnose
+from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX, diagnose_images
 
 CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
 CX, CY = CAM.principal_point

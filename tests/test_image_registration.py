@@ -1,4 +1,4 @@
-"""oracles.image_diagnose's correspondences, against a point-by-point reference.
+"""oracles.diagnosis.image_diagnose's correspondences, against a point-by-point reference.
 
 The ICP fit pairs every candidate pixel with the nearest point of its own
 frame's oracle lines, and every oracle sample with its frame's nearest drawn
@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import Camera
-from wirecheck.oracles import image_diagnose
-from wirecheck.oracles.image_diagnose import PERMUTATIONS, _frames, _Registration
+from wirecheck.oracles.diagnosis import image_diagnose
+from wirecheck.oracles.diagnosis.image_diagnose import PERMUTATIONS, _frames, _Registration
 
 W, H = 64, 48
 
@@ -114,7 +114,7 @@ def test_the_nearest_pixel_map_is_exact_within_the_pairs_reach(where):
     # distance to the nearest drawn pixel wherever that is within the cap plus a rounded sample's
     # 0.71 px (pairs the fit can keep); farther away, the map's pixel is farther than that too
     # (the pair is dropped and the cost capped, whichever pixel it is)
-    from wirecheck.oracles.image_diagnose import PAIR_CAP_PX, _nearest_pixel_map
+    from wirecheck.oracles.diagnosis.image_diagnose import PAIR_CAP_PX, _nearest_pixel_map
 
     rng = np.random.default_rng(3)
     img = np.zeros((90, 120), bool)

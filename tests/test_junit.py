@@ -1,4 +1,4 @@
-"""crosscheck --junit-xml (oracles/junit.py): one testcase per scene x camera, failures that name the fault."""
+"""crosscheck --junit-xml (oracles/reports/junit.py): one testcase per scene x camera, failures that name the fault."""
 
 import json
 import xml.etree.ElementTree as ET

@@ -14,10 +14,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from wirecheck.core import raster
-from wirecheck.core.scene_files import load_scene
-from wirecheck.oracles import metrics, tolerances
-from wirecheck.oracles.diagnose import diagnose_lines
+from wirecheck.core.projector import raster
+from wirecheck.core.scene.files import load_scene
+from wirecheck.oracles.judge import metrics, tolerances
+from wirecheck.oracles.diagnosis.diagnose import diagnose_lines
 from wirecheck.oracles.runner import CoreCandidate, RenderMode, Tolerances, run_crosscheck
 
 from raster_mutants import drop_last, random_ends
@@ -265,7 +265,7 @@ def test_compared_cases_carry_no_note():
     # a face-less edge soup and the cube as plain wireframes, and the cube with
     # hidden lines: all compared in full, so none has a note (notes are for
     # what could not be compared)
-    from wirecheck.core.scene_files import parse_scene_text
+    from wirecheck.core.scene.files import parse_scene_text
 
     soup = parse_scene_text("name soup\nv -1 -1 0\nv 1 -1 0\nv 0 1 0.5\ne 0 1\ne 1 2\ne 2 0\n")
     report, _ = run_crosscheck([soup, load_scene("cube")], CoreCandidate(), frames=2, case_names=["on_axis"],

@@ -1,7 +1,7 @@
 """Any line style on the frames path: antialiased, wide and other aliased rules judged by their geometry.
 
 Frames are drawn here from the job's exact segments (the oracle's lines,
-``oracles.image_diagnose.oracle_segments``: OpenCV's projection of the depth-
+``oracles.diagnosis.image_diagnose.oracle_segments``: OpenCV's projection of the depth-
 clipped edges, equal to core's to ~1e-13 px): antialiased as 4x4 supersampled
 coverage of a 1-px line, wide as every pixel centre within 1.5 px of the line
 (3 px), and with Pillow's ``ImageDraw.line`` (ends rounded to pixel centres,
@@ -19,12 +19,12 @@ import numpy as np
 import pytest
 from PIL import Image, ImageDraw
 
-from wirecheck.core.clipping import clip_to_image
+from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.frames_candidate import frame_inputs, load_job, read_grey
-from wirecheck.oracles.image_diagnose import oracle_segments
-from wirecheck.oracles.image_diagnose import OFFSET_TOL_PX
-from wirecheck.oracles.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset
+from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job, read_grey
+from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
+from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX
+from wirecheck.oracles.judge.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset
 
 # oblique views: the lines slant, so every frame shows both offset components
 ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6",
@@ -166,7 +166,7 @@ def test_pillow_rule_is_named_raster_rule(job_dir, tmp_path, capsys):
 def test_half_pixel_offset_of_aliased_lines_is_no_raster_rule(job_dir, tmp_path, capsys):
     # core's GL-like lines drawn 0.5 px off: every differing pixel is off by one too, but the lines
     # moved as a whole (0.5 > RULE_OFFSET_MAX_PX): a pixel offset, not a rule
-    from wirecheck.core.raster import line_pixels
+    from wirecheck.core.projector.raster import line_pixels
 
     def draw_gl(segs, w, h):
         img = np.zeros((h, w), np.uint8)
@@ -224,7 +224,7 @@ def test_a_dropped_or_extra_end_is_named(short_px, named):
     # measured 0.27-0.46 with the end's sub-pixel phase), with 1 px dropped from (or added to) each
     # end: measured -0.73..-0.54 / 1.25..1.51, beyond -END_TOL_PX (-0.5) / width / 2 + END_TOL_PX (1.0)
     from wirecheck.core.camera import Camera
-    from wirecheck.oracles.line_style import CaseStyle
+    from wirecheck.oracles.judge.line_style import CaseStyle
 
     cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
                  projection="orthographic", ortho_height=140.0)
@@ -249,7 +249,7 @@ def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
     # past MAX_SAMPLES_PER_CASE every frame's samples are halved: memory bounded whatever the number of
     # frames, the counts that say how much line was found kept (found_share stays 1: a correct drawing)
     from wirecheck.core.camera import Camera
-    from wirecheck.oracles import line_style
+    from wirecheck.oracles.judge import line_style
 
     monkeypatch.setattr(line_style, "MAX_SAMPLES_PER_CASE", 600)
     cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,

@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.diagnose import primary
+from wirecheck.oracles.diagnosis.diagnose import primary
 
 from test_line_style import ARGS
 

@@ -1,7 +1,7 @@
-"""Sub-pixel ties in the line gate (oracles.line_ties): what is excused, and what is not.
+"""Sub-pixel ties in the line gate (oracles.judge.line_ties): what is excused, and what is not.
 
 Hand-built frames first (expected values worked out in the comments from the
-rule in oracles/tolerances.py: a tie when the segment crosses the pixel's row
+rule in oracles/judge/tolerances.py: a tie when the segment crosses the pixel's row
 within (1 + |m|) TIE_END_PX = (1 + |m|) 2^-8 px of the pixel's edge, and the
 other image drew the pixel across that edge); then crosscheck end to end: the
 generated cylinder that showed the false alarm passes, and lines drawn 1 px
@@ -11,14 +11,14 @@ thicker, shifted, or short at one end are still named.
 import numpy as np
 import pytest
 
-from wirecheck.core import raster
-from wirecheck.core.scene_files import load_scene
-from wirecheck.oracles import line_ties, metrics, tolerances
+from wirecheck.core.projector import raster
+from wirecheck.core.scene.files import load_scene
+from wirecheck.oracles.judge import line_ties, metrics, tolerances
 from wirecheck.oracles.runner import CoreCandidate, run_crosscheck
 
 from raster_mutants import drop_last
 
-E = 2.0 ** -8          # TIE_END_PX: 2^-9 snap + 2^-9 float32 (oracles/tolerances.py)
+E = 2.0 ** -8          # TIE_END_PX: 2^-9 snap + 2^-9 float32 (oracles/judge/tolerances.py)
 
 
 def test_tie_end_px_is_the_derived_value():

@@ -18,14 +18,14 @@ from pathlib import Path
 import pytest
 
 from helpers import run_renderer
-from wirecheck.core import mesh_companions
+from wirecheck.core.scene import mesh_companions
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene_files import load_mesh_file
-from wirecheck.oracles.dataset import dataset_entries
+from wirecheck.core.scene.files import load_mesh_file
+from wirecheck.oracles.datasets.dataset import dataset_entries
 
 TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 ROOT = Path(__file__).resolve().parent.parent
-CLI = {"renderer": "wirecheck.core.cli", "crosscheck": "wirecheck.oracles.cli"}
+CLI = {"renderer": "wirecheck.core.app.cli", "crosscheck": "wirecheck.oracles.cli"}
 
 
 @contextlib.contextmanager
@@ -189,7 +189,7 @@ def test_sigint_from_outside_during_a_load_ends_the_run(tmp_path):
             "def slow(path):\n"
             "    print('reading', flush=True); time.sleep(60)\n"
             "mc.read_regular = slow\n"
-            "from wirecheck.core.cli import main\n"
+            "from wirecheck.core.app.cli import main\n"
             f"sys.exit(main(['--scene', {str(tmp_path / 'a.obj')!r}, '--frames', '1', "
             f"'--out', {str(tmp_path / 'out')!r}]))\n")
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -208,7 +208,7 @@ def test_sigint_from_outside_during_a_load_ends_the_run(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.parametrize("prog, module, sig, code", [("renderer", "wirecheck.core.cli", signal.SIGINT, 130),
+@pytest.mark.parametrize("prog, module, sig, code", [("renderer", "wirecheck.core.app.cli", signal.SIGINT, 130),
                                                      ("crosscheck", "wirecheck.oracles.cli", signal.SIGTERM, 143)])
 def test_a_signal_while_the_cli_is_still_starting_is_one_line(prog, module, sig, code):
     """Between the CLI module's first line and its guard (the imports of numpy, trimesh, pyrender: seconds on a
@@ -223,7 +223,7 @@ def test_a_signal_while_the_cli_is_still_starting_is_one_line(prog, module, sig,
 
 def test_importing_the_cli_elsewhere_keeps_the_handlers():
     """A program (here pytest) that imports the CLI modules keeps its own SIGINT/SIGTERM handlers."""
-    import wirecheck.core.cli  # noqa: F401
+    import wirecheck.core.app.cli  # noqa: F401
     import wirecheck.oracles.cli  # noqa: F401
 
     for sig in (signal.SIGINT, signal.SIGTERM):

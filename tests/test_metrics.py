@@ -1,9 +1,9 @@
-"""oracles.metrics against hand-counted images and hand-derived errors."""
+"""oracles.judge.metrics against hand-counted images and hand-derived errors."""
 
 import numpy as np
 import pytest
 
-from wirecheck.oracles.metrics import diff_image, pixel_scores, vertex_errors
+from wirecheck.oracles.judge.metrics import diff_image, pixel_scores, vertex_errors
 
 
 def test_vertex_errors_hand_values():
@@ -60,7 +60,7 @@ def test_diff_image_colours():
 
 def test_face_disagreements_on_a_boundary_are_allowed_inside_are_not():
     # Oracle: face 0 on columns 0-4, face 1 on 5-9 of a 6x10 image, depth 1 everywhere.
-    from wirecheck.oracles.metrics import shaded_scores
+    from wirecheck.oracles.judge.metrics import shaded_scores
 
     of = np.zeros((6, 10), int)
     of[:, 5:] = 1
@@ -86,7 +86,7 @@ def test_silhouette_mismatch_inside_counts_holes_not_boundary_shifts():
     # Oracle covers a 6x6 block; the candidate covers it shifted right by one column:
     # the mismatched columns are on each silhouette's boundary: 0 inside. A 1-px hole
     # in the candidate's middle is inside the oracle's silhouette: 1.
-    from wirecheck.oracles.metrics import shaded_scores
+    from wirecheck.oracles.judge.metrics import shaded_scores
 
     orac = np.zeros((10, 12), bool)
     orac[2:8, 2:8] = True
@@ -105,7 +105,7 @@ def test_occlusion_boundary_marks_both_sides_of_triangles_sharing_no_vertex():
     # triangle 1 (vertices 3, 4, 5) left of triangle 0 (vertices 0, 1, 2): no shared
     # vertex, so depth may jump between columns 1 and 2; both pixels are marked.
     # Triangle 0 is id 0: an id test must count 0 as a triangle (-1 is "none").
-    from wirecheck.oracles.metrics import occlusion_boundary
+    from wirecheck.oracles.judge.metrics import occlusion_boundary
 
     tris = np.array([[0, 1, 2], [3, 4, 5]])
     ids = np.array([[1, 1, 0, 0]])
@@ -124,7 +124,7 @@ def _within_naive(mask_from, mask_to, tol):
 
 @pytest.mark.parametrize("seed", range(12))
 def test_one_pixel_match_on_drawn_pixels_equals_the_definition(seed):
-    from wirecheck.oracles.metrics import _within
+    from wirecheck.oracles.judge.metrics import _within
 
     rng = np.random.default_rng(seed)
     h, w = rng.integers(1, 30, 2)
@@ -159,7 +159,7 @@ def _neighbourhoods_naive(p0, p1, w, h, pixels, radius=1.0):
 def test_edge_neighbourhoods_of_drawn_pixels_equal_the_definition(seed, density):
     # density 0.02: few drawn pixels, found from the pixels (pixels x segments); 0.6: from
     # 1-px steps along the segments. Non-integer ends: no exact distance ties to decide.
-    from wirecheck.oracles.metrics import edge_neighbourhoods
+    from wirecheck.oracles.judge.metrics import edge_neighbourhoods
 
     rng = np.random.default_rng(seed)
     w, h = 36, 24
@@ -181,7 +181,7 @@ def test_frames_neighbourhoods_give_each_frame_its_own_rows(seed):
     stacked frames meet: a pair across two frames would show up as a row
     the definition does not have.
     """
-    from wirecheck.oracles.metrics import frames_neighbourhoods
+    from wirecheck.oracles.judge.metrics import frames_neighbourhoods
 
     rng = np.random.default_rng(100 + seed)
     w, h = 30, 12
@@ -206,7 +206,7 @@ def test_line_batch_scores_as_frame_by_frame(dense):
     Long segments take the midpoint and one-sided path of frames_count_differences;
     many short ones (more than one per DENSE drawn pixels) the one-pass path.
     """
-    from wirecheck.oracles.metrics import FramePixels, LineBatch, line_scores
+    from wirecheck.oracles.judge.metrics import FramePixels, LineBatch, line_scores
 
     rng = np.random.default_rng(5)
     w, h = 40, 30
@@ -238,7 +238,7 @@ def test_line_batch_counts_by_hand():
     (10, 12) -> (10, 17), a column of 6 pixels. The candidate lacks edge 2's
     last pixel (10, 17): edge 2 counts 5 against the oracle's 6, diff -1.
     """
-    from wirecheck.oracles.metrics import FramePixels, LineBatch, line_scores
+    from wirecheck.oracles.judge.metrics import FramePixels, LineBatch, line_scores
 
     p0 = np.array([[2.0, 5.0], [2.0, 5.0], [10.0, 12.0]])
     p1 = np.array([[30.0, 5.0], [30.0, 5.0], [10.0, 17.0]])
@@ -259,7 +259,7 @@ def test_line_batch_counts_by_hand():
 
 
 def test_line_scores_with_nothing_drawn_near_an_edge_on_screen():
-    from wirecheck.oracles.metrics import line_scores
+    from wirecheck.oracles.judge.metrics import line_scores
 
     blank = np.zeros((24, 36), bool)
     s = line_scores(blank, blank, np.array([[2.0, 3.0]]), np.array([[30.0, 20.0]]))
@@ -269,7 +269,7 @@ def test_line_scores_with_nothing_drawn_near_an_edge_on_screen():
 @pytest.mark.parametrize("how", ["flat", "bits"])
 def test_kept_image_gives_the_image_back(how):
     """worst.gif's kept frames: a wireframe kept as its drawn pixels' indices, a silhouette as bits."""
-    from wirecheck.oracles.case import KeptImage
+    from wirecheck.oracles.judge.case import KeptImage
 
     image = np.zeros((5, 7), bool)
     image[0, 0] = image[4, 6] = image[2, 3] = True        # the corners and the middle
@@ -279,7 +279,7 @@ def test_kept_image_gives_the_image_back(how):
 
 
 def _is_tie(c, a, b, other, end_px=2.0 ** -8):
-    """oracles.line_ties' rule for one pixel ``c`` of segment ``a -> b``, written out per axis (y-major first)."""
+    """oracles.judge.line_ties' rule for one pixel ``c`` of segment ``a -> b``, written out per axis (y-major first)."""
     d = b - a
     for major in (1, 0):
         minor = 1 - major
@@ -299,7 +299,7 @@ def _is_tie(c, a, b, other, end_px=2.0 ** -8):
 
 def _ends_naive(cand, oracle, p0, p1, reach=1.5):
     """end_attribution's definition, pixel by pixel: the nearest segment (clipped to the image's edges)."""
-    from wirecheck.oracles.segment_pixels import clip_segments
+    from wirecheck.oracles.judge.segment_pixels import clip_segments
 
     h, w = cand.shape
     ok, q0, q1 = clip_segments(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
@@ -329,7 +329,7 @@ def _ends_naive(cand, oracle, p0, p1, reach=1.5):
 
 @pytest.mark.parametrize("seed", range(8))
 def test_end_attribution_equals_the_definition(seed):
-    from wirecheck.oracles.metrics import end_attribution
+    from wirecheck.oracles.judge.metrics import end_attribution
 
     rng = np.random.default_rng(200 + seed)
     w, h = 30, 20
@@ -343,7 +343,7 @@ def test_end_attribution_equals_the_definition(seed):
 
 def test_end_attribution_equals_the_definition_at_ties():
     # segment ends on the half-pixel grid: many rows are crossed exactly at a pixel's edge (sub-pixel ties)
-    from wirecheck.oracles.metrics import end_attribution
+    from wirecheck.oracles.judge.metrics import end_attribution
 
     ties = 0
     for seed in range(8):
@@ -362,7 +362,7 @@ def test_vertex_errors_frames_equal_frame_by_frame():
     """A case's frames scored together give each frame's own vertex_errors, to the bit (NaN rows: clipped)."""
     import json
 
-    from wirecheck.oracles.metrics import vertex_errors, vertex_errors_frames
+    from wirecheck.oracles.judge.metrics import vertex_errors, vertex_errors_frames
 
     rng = np.random.default_rng(9)
     cand = [rng.normal(300, 200, (13, 2)) for _ in range(10)]

@@ -1,7 +1,7 @@
 """MP4 bytes depend on the frames alone: not on the heap's leftovers, the CPU count or the library version.
 
 x264's macroblock-tree rate control reads heap memory it never wrote (see
-core.output.MP4_OPTIONS), so the bytes of an encode depended on what the
+core.outputs.output.MP4_OPTIONS), so the bytes of an encode depended on what the
 process had freed before it: the same test gave different bytes in a pytest
 worker that had run other tests first. glibc's ``mallopt(M_PERTURB, p)``
 fills every block malloc hands out with ``p ^ 0xff`` (and every freed block
@@ -15,7 +15,7 @@ import hashlib
 import numpy as np
 import pytest
 
-from wirecheck.core.output import MP4_OPTIONS, mp4_bytes
+from wirecheck.core.outputs.output import MP4_OPTIONS, mp4_bytes
 
 pytest.importorskip("av")
 

@@ -8,8 +8,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene import object_matrix, SceneObject, world_points
-from wirecheck.core.scene_files import builtin_names, example_names, load_scene, parse_scene_text, SCENE_DIR
+from wirecheck.core.scene.model import object_matrix, SceneObject, world_points
+from wirecheck.core.scene.files import builtin_names, example_names, load_scene, parse_scene_text, SCENE_DIR
 from wirecheck.core.transforms import Motion
 from helpers import run_renderer as run
 
@@ -243,10 +243,10 @@ def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
 def test_multi_object_frame_matches_world_points(tmp_path):
     # The renderer draws world_points with the identity: the JSON vertex pixels must be
     # the projection of each object's M_run(t) @ M_o(t) -- here built independently of
-    # core, by scipy (oracles.faces) and projected by cv2.projectPoints. Two float64
+    # core, by scipy (oracles.references.faces) and projected by cv2.projectPoints. Two float64
     # pipelines: ~20 roundings of values <= 640 px, ~3e-12; 1e-9 px leaves margin.
     from wirecheck.core.camera import camera_z
-    from wirecheck.oracles import faces as oface, opencv_oracle
+    from wirecheck.oracles.references import faces as oface, opencv_oracle
 
     rc, _, err = run(["--scene", "orrery", "--frames", "4", "--camera-z", "8", "--spin", "0,1,0"], tmp_path)
     assert (rc, err) == (0, "")
@@ -311,9 +311,9 @@ def test_cull_and_hidden_lines_fields(tmp_path):
 def test_mirrored_object_is_culled_like_its_oracle(tmp_path, capsys):
     # Object "b" has scale -1 (determinant -1): its counter-clockwise faces turn
     # clockwise in the world. core draws multi-object scenes from world points
-    # with an identity matrix, so core.scene.oriented_faces re-winds them; without
+    # with an identity matrix, so core.scene.model.oriented_faces re-winds them; without
     # that, back-face culling would keep b's back faces and crosscheck (which
-    # judges front faces from the geometry, oracles/faces.py) would fail.
+    # judges front faces from the geometry, oracles/references/faces.py) would fail.
     from wirecheck.oracles.cli import main
 
     cube = (Path(__file__).resolve().parent.parent / "scenes" / "cube.scene").read_text()
@@ -322,8 +322,8 @@ def test_mirrored_object_is_culled_like_its_oracle(tmp_path, capsys):
             f"object b\ntranslate 1.5 0 0\nscale -0.5\nspin 0 1 0\n{body}\n")
     path = tmp_path / "mirror.scene"
     path.write_text(text)
-    from wirecheck.core.scene import oriented_faces
-    from wirecheck.core.scene_files import load_scene
+    from wirecheck.core.scene.model import oriented_faces
+    from wirecheck.core.scene.files import load_scene
     from wirecheck.core.transforms import Motion
 
     scene = load_scene(str(path))

@@ -19,10 +19,10 @@ def _mutate():
 def test_only_with_an_unknown_id_is_exit_2_and_writes_nothing(tmp_path, capsys):
     committed = hashlib.sha256((MUTATION / "report.md").read_bytes()).hexdigest()
     report = tmp_path / "report.md"
-    rc = _mutate().main(["--module", "core/clipping.py", "--only", "core/clipping.py:1:1:nosuch",
+    rc = _mutate().main(["--module", "core/projector/clipping.py", "--only", "core/projector/clipping.py:1:1:nosuch",
                          "--report", str(report)])
     err = capsys.readouterr().err
-    assert rc == 2 and err == ("mutate: error: --only 'core/clipping.py:1:1:nosuch': no mutant of core/clipping.py "
+    assert rc == 2 and err == ("mutate: error: --only 'core/projector/clipping.py:1:1:nosuch': no mutant of core/projector/clipping.py "
                                "has this id: expected one that --list prints (MODULE:LINE:COL:CHANGE)\n")
     assert not report.exists()
     assert hashlib.sha256((MUTATION / "report.md").read_bytes()).hexdigest() == committed
@@ -31,11 +31,11 @@ def test_only_with_an_unknown_id_is_exit_2_and_writes_nothing(tmp_path, capsys):
 def test_only_with_known_ids_still_chooses_them(capsys):
     """The check above refuses only what matches nothing: an id --list prints is chosen (listed, not run)."""
     mutate = _mutate()
-    first = mutate.sites("core/clipping.py")[0].id
-    rc = mutate.main(["--module", "core/clipping.py", "--only", first, "--list"])
+    first = mutate.sites("core/projector/clipping.py")[0].id
+    rc = mutate.main(["--module", "core/projector/clipping.py", "--only", first, "--list"])
     assert rc == 0 and capsys.readouterr().out.splitlines()[-1] == first
 
 
 def test_a_sample_of_zero_is_exit_2(tmp_path, capsys):
-    rc = _mutate().main(["--module", "core/clipping.py", "--sample", "0", "--report", str(tmp_path / "r.md")])
+    rc = _mutate().main(["--module", "core/projector/clipping.py", "--sample", "0", "--report", str(tmp_path / "r.md")])
     assert rc == 2 and "no mutant chosen" in capsys.readouterr().err and not (tmp_path / "r.md").exists()

@@ -1,4 +1,4 @@
-"""oracles.convert: hand-derived values and round trips of both conversions."""
+"""oracles.references.convert: hand-derived values and round trips of both conversions."""
 
 import math
 
@@ -7,7 +7,7 @@ import pytest
 
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.transforms import Motion
-from wirecheck.oracles import convert
+from wirecheck.oracles.references import convert
 
 EPS = np.finfo(np.float64).eps
 
@@ -218,7 +218,7 @@ def test_gl_hand_values_camera_z():
 def test_gl_matrices_give_opencv_pixels(name):
     # x_px = (x_ndc + 1) W/2 - 0.5, y_px = (1 - y_ndc) H/2 - 0.5 (docs/protocol.md); the NDC cube
     # holds exactly the points with depth in [near, far] (z_ndc = -1 at near, +1 at far)
-    from wirecheck.oracles import opencv_oracle
+    from wirecheck.oracles.references import opencv_oracle
 
     cam = CAMERAS[name]
     p_world = np.random.default_rng(5).uniform(-8, 8, (4000, 3))

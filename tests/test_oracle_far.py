@@ -5,8 +5,8 @@ the origin, the rounding of the vertices alone (2^-24 x 1e5 = 6e-3 units) is
 0.6 px at 100 px per unit: the oracle's lines moved and correct code failed.
 The oracle now hands pyrender each vertex's offset from the mesh's centre
 and a node pose taking it to eye space, both computed in float64
-(oracles.convert.gl_eye_pose), and records its own error bound per case
-(oracles.oracle_precision).
+(oracles.references.convert.gl_eye_pose), and records its own error bound per case
+(oracles.references.oracle_precision).
 """
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wirecheck.oracles.pyrender_oracle import osmesa_available
+from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
 from wirecheck.core.camera import Camera
-from wirecheck.oracles import oracle_precision as op
-from wirecheck.oracles.convert import camera_to_gl, centre_of, gl_eye_pose
+from wirecheck.oracles.references import oracle_precision as op
+from wirecheck.oracles.references.convert import camera_to_gl, centre_of, gl_eye_pose
 
 _OK, _WHY = osmesa_available()
 needs_gl = pytest.mark.skipif(not _OK, reason=f"pyrender/OSMesa unavailable: {_WHY}")
@@ -101,7 +101,7 @@ def test_the_bound_of_a_centred_camera_by_hand():
 
 @needs_gl
 def test_a_mesh_1e5_from_the_origin_passes_with_core_and_fails_half_a_pixel_off(tmp_path):
-    from wirecheck.core.projection import project_points
+    from wirecheck.core.projector.projection import project_points
     from wirecheck.oracles.api import check_projector
 
     obj = write_cube(tmp_path / "far.obj", FAR)
@@ -129,13 +129,13 @@ def test_a_mesh_1e5_from_the_origin_passes_with_core_and_fails_half_a_pixel_off(
 
 @needs_gl
 def test_a_case_beyond_the_oracles_precision_is_named_and_does_not_blame_the_candidate(tmp_path):
-    from wirecheck.core.scene_files import load_scene
+    from wirecheck.core.scene.files import load_scene
     from wirecheck.core.transforms import Motion
-    from wirecheck.oracles.case import run_case
-    from wirecheck.oracles.cases import Case
-    from wirecheck.oracles.core_candidate import CoreCandidate
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle
-    from wirecheck.oracles.tolerances import Tolerances
+    from wirecheck.oracles.judge.case import run_case
+    from wirecheck.oracles.judge.cases import Case
+    from wirecheck.oracles.candidates.core_candidate import CoreCandidate
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
+    from wirecheck.oracles.judge.tolerances import Tolerances
 
     # a 1,400-unit cube seen from 3 units above one face with near 0.01: the nearest drawn point is 0.01
     # deep and the clip magnitudes ~2e3 (703 to the centre + rho 1.2e3), so the w term alone is

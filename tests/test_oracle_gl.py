@@ -19,7 +19,7 @@ import pytest
 
 from wirecheck.core.errors import InputError
 from wirecheck.oracles import cli
-from wirecheck.oracles.pyrender_oracle import osmesa_available, select_gl
+from wirecheck.oracles.references.pyrender_oracle import osmesa_available, select_gl
 from helpers import run_crosscheck
 
 PROBE = Path(__file__).parent / "data" / "gl_probe.py"

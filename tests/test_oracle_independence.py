@@ -5,7 +5,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from wirecheck.core.camera import look_at
-from wirecheck.oracles import opencv_oracle
+from wirecheck.oracles.references import opencv_oracle
 
 
 def test_opencv_oracle_ignores_a_reversed_right():

@@ -3,7 +3,7 @@
 pyrender keyed its shader programs by a ctypes pointer to the context, a new
 object (equal to no other) on every call: each frame compiled and kept a new
 program, 0.4-0.8 MB (measured here: 0.77 MB per 160x120 frame on OSMesa; the
-issue: 0.4 MB a frame, 0.6 MB an overlay request). oracles/pyrender_programs.py
+issue: 0.4 MB a frame, 0.6 MB an overlay request). oracles/references/pyrender_programs.py
 keys them by the context's address.
 
 Memory is read from /proc/self/statm (resident pages) after a warm-up, so
@@ -21,7 +21,7 @@ import os
 import numpy as np
 import pytest
 
-from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available
+from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available
 
 from wirecheck.core.camera import Camera
 
@@ -79,8 +79,8 @@ def test_a_thousand_oracle_frames_grow_memory_by_less_than_0_05_mb_each():
 
 @needs_gl
 def test_the_viewer_overlay_grows_memory_by_less_than_0_05_mb_a_request(tmp_path):
-    from wirecheck.core.cli import build_parser, settings_from_args
-    from wirecheck.core.viewer import Viewer
+    from wirecheck.core.app.cli import build_parser, settings_from_args
+    from wirecheck.core.app.viewer import Viewer
     from wirecheck.oracles.live import LiveOverlay
 
     s = settings_from_args(build_parser().parse_args(["--frames", "10", "--width", "96", "--height", "72",

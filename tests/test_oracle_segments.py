@@ -1,4 +1,4 @@
-"""oracles.draw.oracle_segments: the oracle's segments, against pixels derived by hand.
+"""oracles.candidates.draw.oracle_segments: the oracle's segments, against pixels derived by hand.
 
 Camera at the origin looking down -z, 640 x 480, fov_y 90 deg: f = 240 px
 (H / 2 / tan 45 deg), principal point (319.5, 239.5) (pixel centres on
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import look_at
-from wirecheck.oracles import opencv_oracle
-from wirecheck.oracles.draw import oracle_segments
+from wirecheck.oracles.references import opencv_oracle
+from wirecheck.oracles.candidates.draw import oracle_segments
 
 CAM = look_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), fov_y_deg=90.0, width=640, height=480, near=1.0, far=10.0)
 
@@ -28,7 +28,7 @@ EXPECTED_P0 = np.array([[319.5 + 120.0, 239.5], [319.5 + 120.0, 239.5], [np.nan,
 EXPECTED_P1 = np.array([[319.5 - 60.0, 239.5 - 30.0], [319.5 + 40.0, 239.5], [np.nan, np.nan], [319.5 + 96.0, 239.5]])
 
 #: A cut end moves inside [near, far] by at least 1e-9 of the edge's parameter
-#: (oracles.draw._INWARD; the depth margin, ~2e-15 in depth here, is smaller).
+#: (oracles.candidates.draw._INWARD; the depth margin, ~2e-15 in depth here, is smaller).
 #: Edge 1 at the near plane: depth changes 2.5 per unit of the parameter, and
 #: the pixel 240 x / z^2 = 120 px per unit of depth, so 300 px per unit of the
 #: parameter: the end moves <= 3e-7 px (edge 3 at the far plane: <= 3e-8 px).

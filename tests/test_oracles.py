@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import camera_z, look_at
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import project_points
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import project_points
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
-from wirecheck.oracles import opencv_oracle
-from wirecheck.oracles.pyrender_oracle import osmesa_available
+from wirecheck.oracles.references import opencv_oracle
+from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
 EPS = np.finfo(np.float64).eps
 EPS32 = float(np.finfo(np.float32).eps)
@@ -37,7 +37,7 @@ def test_opencv_hand_values():
 
 def test_opencv_masks_outside_near_far():
     import cv2
-    from wirecheck.oracles.convert import camera_to_opencv
+    from wirecheck.oracles.references.convert import camera_to_opencv
     p_world = np.array([[1.0, 1.0, 8.0],          # behind the camera (depth -4)
                         [0.0, 0.0, 4.0],          # at the camera (depth 0)
                         [0.0, 0.0, 3.0],          # exactly on near (depth 1): visible
@@ -221,7 +221,7 @@ def test_opencv_oracle_conversion_cache_follows_the_camera():
     import cv2
     from scipy.spatial.transform import Rotation
     from wirecheck.core.camera import look_at
-    from wirecheck.oracles import opencv_oracle
+    from wirecheck.oracles.references import opencv_oracle
 
     pts = np.array([[0.3, -0.2, 0.1], [-0.5, 0.4, -0.3]])
     cams = [look_at((0, 0, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=60),
@@ -251,7 +251,7 @@ def test_closing_the_oracle_frees_its_context_without_a_full_collection(monkeypa
     # destroys the context, and collects nothing itself; a second oracle draws the same pixels.
     import gc
 
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
 
     edges = np.array([[0, 1], [1, 2]])
     p_world = np.array([[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0]])

@@ -2,8 +2,8 @@
 
 import pytest
 
-from wirecheck.core import cli as renderer_cli
-from wirecheck.core.output import MARKER
+from wirecheck.core.app import cli as renderer_cli
+from wirecheck.core.outputs.output import MARKER
 from wirecheck.oracles import cli as crosscheck_cli
 
 
@@ -88,7 +88,7 @@ def test_closed_stdout_exits_quietly(tmp_path):
     import sys
 
     # `renderer | head -1`: the reader goes away after the first line
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--frames", "3", "--out", str(tmp_path)],
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "3", "--out", str(tmp_path)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     proc.stdout.readline()
     proc.stdout.close()

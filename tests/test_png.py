@@ -1,4 +1,4 @@
-"""core.output's PNG writer: bilevel frames decoded by two independent readers (Pillow, OpenCV)."""
+"""core.outputs.output's PNG writer: bilevel frames decoded by two independent readers (Pillow, OpenCV)."""
 
 import io
 import struct
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.core.output import png_bytes
+from wirecheck.core.outputs.output import png_bytes
 
 
 def _line_drawing(h, w, seed):

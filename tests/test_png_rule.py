@@ -2,7 +2,7 @@
 
 The PNGs are written here byte by byte (signature, chunks with their CRC, filter-0 scanlines packed at
 the file's bit depth), not by Pillow, so each file is exactly the case it names. The expected pixels
-are derived by hand from the rule (oracles/png_frame.py): drawn where L x A >= 128 x 255 with the
+are derived by hand from the rule (oracles/candidates/png_frame.py): drawn where L x A >= 128 x 255 with the
 samples on 8 bits (1/2/4-bit scaled by 255, 85, 17; 16-bit by their high byte) and a tRNS colour
 transparent at the file's full depth.
 """
@@ -19,7 +19,7 @@ import pytest
 
 import helpers
 from wirecheck.oracles import cli as crosscheck_cli
-from wirecheck.oracles.png_frame import FrameProblem, read_png
+from wirecheck.oracles.candidates.png_frame import FrameProblem, read_png
 
 
 def chunk(kind: bytes, data: bytes) -> bytes:

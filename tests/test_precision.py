@@ -18,10 +18,11 @@ import pytest
 
 from helpers import run_crosscheck
 from wirecheck.core.camera import look_at
-from wirecheck.oracles import protocol, tolerances
+from wirecheck.oracles.candidates import protocol
+from wirecheck.oracles.judge import tolerances
 from wirecheck.oracles.api import check_projector, failure_text
-from wirecheck.oracles.candidate import case_precision, returned_precision
-from wirecheck.oracles.tolerances import EPS, VERTEX_ROUNDINGS, Tolerances, vertex_bound, vertex_scale
+from wirecheck.oracles.candidates.candidate import case_precision, returned_precision
+from wirecheck.oracles.judge.tolerances import EPS, VERTEX_ROUNDINGS, Tolerances, vertex_bound, vertex_scale
 
 DATA = Path(__file__).parent / "data" / "candidates"
 sys.path.insert(0, str(DATA))
@@ -59,7 +60,7 @@ def test_declared_precision_wins_over_the_returned_one():
 # ---- the bound -------------------------------------------------------------------------
 
 def test_vertex_bound_by_hand():
-    """One point at the origin seen from (0, 0, 5), fov 60, 640x480: the formula of oracles/tolerances.py by hand."""
+    """One point at the origin seen from (0, 0, 5), fov 60, 640x480: the formula of oracles/judge/tolerances.py by hand."""
     cam = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
     f = 240 / math.tan(math.radians(30))                     # 415.69 px
     # u = 0 (the point is at the principal point (319.5, 239.5)); |X| = 0, |C| = 5, z = 5
@@ -130,7 +131,7 @@ def test_declared_float64_returning_float32_is_judged_at_float64():
 
 def test_declared_float32_loosens_a_float64_candidate():
     """A float64 projector declared float32 is held to the float32 bound (a 1e-5 px error then passes)."""
-    from wirecheck.core.projection import project_points
+    from wirecheck.core.projector.projection import project_points
 
     def off_by_1e5(points, camera):
         return project_points(points, camera) + 1e-5          # 10x the float64 floor, ~100x below the float32 bound
@@ -189,7 +190,7 @@ def test_cli_declared_precision(tmp_path, capsys):
 
 @pytest.fixture(scope="module")
 def pixels_available():
-    from wirecheck.oracles.pyrender_oracle import osmesa_available
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
     ok, msg = osmesa_available()
     if not ok:
@@ -198,8 +199,8 @@ def pixels_available():
 
 def _near_plane_crossings():
     """The cube's edges under the near_plane case camera, and the camera: some edges cross the near plane."""
-    from wirecheck.core.scene_files import load_scene
-    from wirecheck.oracles.cases import cameras_for
+    from wirecheck.core.scene.files import load_scene
+    from wirecheck.oracles.judge.cases import cameras_for
 
     scene = load_scene("cube")
     cam = next(c.camera for c in cameras_for(scene.radius) if c.name == "near_plane")
@@ -214,7 +215,8 @@ def _float32_near_rejects(ends, cam) -> int:
 
 
 def test_clipped_ends_survive_a_float32_depth_test(monkeypatch):
-    from wirecheck.oracles import draw, opencv_oracle
+    from wirecheck.oracles.candidates import draw
+    from wirecheck.oracles.references import opencv_oracle
 
     p0, p1, cam = _near_plane_crossings()
     d0, d1 = opencv_oracle.depth(p0, cam), opencv_oracle.depth(p1, cam)
@@ -236,8 +238,9 @@ def test_correct_float32_projector_passes_every_case_at_the_pixel_level(pixels_a
 
 def test_old_near_plane_nudge_fails_a_correct_float32_projector(pixels_available, monkeypatch):
     """Break on purpose: the 1e-9 nudge alone drops near-plane edges of a correct float32 projector
-    (neither the precision's depth margin nor the probed planes' slack, oracles.clip_planes)."""
-    from wirecheck.oracles import clip_planes, draw
+    (neither the precision's depth margin nor the probed planes' slack, oracles.diagnosis.clip_planes)."""
+    from wirecheck.oracles.diagnosis import clip_planes
+    from wirecheck.oracles.candidates import draw
 
     monkeypatch.setattr(draw, "depth_margin", lambda p, camera, precision: np.zeros(len(p)))
     monkeypatch.setattr(clip_planes, "depth_slack", lambda planes, camera: (0.0, None))
@@ -261,9 +264,9 @@ def test_config_key_candidate_precision(tmp_path):
 
 def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
     """A vertex on the near plane (to float32 rounding) clipped by the float32 candidate only is not a failure."""
-    from wirecheck.core.scene import Scene
-    from wirecheck.core.scene_files import load_scene
-    from wirecheck.oracles.cases import cameras_for
+    from wirecheck.core.scene.model import Scene
+    from wirecheck.core.scene.files import load_scene
+    from wirecheck.oracles.judge.cases import cameras_for
 
     cube = load_scene("cube")
     cam = next(c.camera for c in cameras_for(cube.radius) if c.name == "near_plane")
@@ -288,10 +291,10 @@ def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
 
 @pytest.mark.parametrize("limit", [1, 20, 1 << 16])
 def test_scale_batch_is_the_largest_frame_scale(limit):
-    """A case measures its frames' vertex scales together (oracles.case.ScaleBatch): the largest of
+    """A case measures its frames' vertex scales together (oracles.judge.case.ScaleBatch): the largest of
     the frames' own scales, whether it measures each frame alone, a few together or all at the end."""
-    from wirecheck.oracles import opencv_oracle
-    from wirecheck.oracles.case import ScaleBatch
+    from wirecheck.oracles.references import opencv_oracle
+    from wirecheck.oracles.judge.case import ScaleBatch
 
     rng = np.random.default_rng(11)
     cam = look_at((0.0, 1.0, 6.0), (0.0, 0.0, 0.0), fov_y_deg=60.0, width=320, height=240, near=0.5, far=40.0)

@@ -1,4 +1,4 @@
-"""Per-stage frame timing: render_frame(timing=...), core.profile.FrameProfiler, ``renderer --profile``."""
+"""Per-stage frame timing: render_frame(timing=...), core.app.profile.FrameProfiler, ``renderer --profile``."""
 
 import json
 
@@ -7,9 +7,9 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from wirecheck.core.camera import camera_z
-from wirecheck.core.pipeline import STAGES as PIPELINE_STAGES, render_frame
-from wirecheck.core.profile import STAGES, FrameProfiler, profile_table
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.projector.pipeline import STAGES as PIPELINE_STAGES, render_frame
+from wirecheck.core.app.profile import STAGES, FrameProfiler, profile_table
+from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
 from helpers import run_renderer as run
 
@@ -39,7 +39,7 @@ def test_timing_changes_no_pixel_and_times_the_stages_that_ran(mode):
 def test_timing_accumulates_over_calls(monkeypatch):
     # a clock that ticks 1 s per reading: each stage's lap is a whole number of
     # ticks whatever the machine's load, so three frames' must be three times one's
-    from wirecheck.core import pipeline
+    from wirecheck.core.projector import pipeline
 
     ticks = iter(range(10 ** 6))
     monkeypatch.setattr(pipeline, "_clock", lambda: float(next(ticks)))

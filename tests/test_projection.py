@@ -1,4 +1,4 @@
-"""core.projection against hand-derived values and a naive per-point projector.
+"""core.projector.projection against hand-derived values and a naive per-point projector.
 
 ``naive_project`` below is an independent reference written from
 core/conventions.py in plain Python math (no numpy, no core code): it builds
@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
 from wirecheck.core.camera import Camera, camera_z, look_at
-from wirecheck.core.projection import cam_to_px, depth_mask, project_points, world_to_cam
+from wirecheck.core.projector.projection import cam_to_px, depth_mask, project_points, world_to_cam
 from wirecheck.core.transforms import apply, rotate_y, rotate_z
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16
@@ -330,7 +330,7 @@ def test_cam_to_px_perspective_formula_direct():
 # ---- localize: far-off models are re-centred ------------------------------------------
 
 def test_localize_recentres_a_model_far_from_its_origin():
-    from wirecheck.core.projection import localize
+    from wirecheck.core.projector.projection import localize
 
     # a box from (999, 1000, 1001) to (1001, 1002, 1003): centre (1000, 1001, 1002), half-extent 1;
     # |centre| > 1, so the points are stored relative to the centre (exact: all small integers)

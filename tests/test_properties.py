@@ -29,11 +29,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import project_points, unproject
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import project_points, unproject
 from wirecheck.core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z
-from wirecheck.oracles import opencv_oracle
-from wirecheck.oracles.convert import model_matrix as scipy_model_matrix
+from wirecheck.oracles.references import opencv_oracle
+from wirecheck.oracles.references.convert import model_matrix as scipy_model_matrix
 from wirecheck.oracles.extremes import (EPS, EPS64, LD, REFERENCE_EXTENDED, camera_error, opencv_camera_error,
                               pixel_bound, reference_project, reference_world)
 
@@ -128,7 +128,7 @@ def test_render_frame_model_view_matches_opencv(seed, fov, size, radius, far_awa
     rng = np.random.default_rng(seed)
     turns = rng.uniform(-3, 3, 3)
     offset = far_away * rng.normal(size=3) / math.sqrt(3)
-    # the model matrix comes from scipy (oracles.convert), not core.transforms
+    # the model matrix comes from scipy (oracles.references.convert), not core.transforms
     m = scipy_model_matrix(turns, offset, scale, float(rng.uniform(0, 1)))
     p_model = rng.uniform(-1, 1, (150, 3)) * radius
     distance = 4 * radius * scale

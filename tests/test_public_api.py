@@ -6,7 +6,8 @@ import inspect
 import pytest
 
 import wirecheck
-from wirecheck.core import camera, projection
+from wirecheck.core import camera
+from wirecheck.core.projector import projection
 
 EXPORTED = [n for n in wirecheck.__all__ if n != "__version__"]
 
@@ -42,7 +43,7 @@ def test_version_is_the_installed_distributions():
     assert wirecheck.__version__ == version("wirecheck")
 
 
-@pytest.mark.parametrize("main_module", ["wirecheck.core.cli", "wirecheck.oracles.cli"])
+@pytest.mark.parametrize("main_module", ["wirecheck.core.app.cli", "wirecheck.oracles.cli"])
 def test_version_option(main_module, capsys):
     from importlib import import_module
     from importlib.metadata import version

@@ -1,7 +1,7 @@
-"""core.raster.line_pixels: one test per geometric case (expected image built by
+"""core.projector.raster.line_pixels: one test per geometric case (expected image built by
 slicing, scikit-image style), the module doctest, and hypothesis properties against
 ``naive_diamond_exit``, an independent per-pixel implementation of the rule stated in
-core/raster.py's docstring (GL's diamond-exit rule, pixel centres at integers):
+core/projector/raster.py's docstring (GL's diamond-exit rule, pixel centres at integers):
 
     ends snapped to 1/256 px; pixel (c, r) is drawn when the segment's line crosses
     the open diamond |x - c| + |y - r| < 1/2 and the point where it leaves the
@@ -25,8 +25,8 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
-from wirecheck.core import raster
-from wirecheck.core.raster import SUBPIXEL, line_pixels
+from wirecheck.core.projector import raster
+from wirecheck.core.projector.raster import SUBPIXEL, line_pixels
 from helpers import eight_connected
 
 W, H = 12, 10

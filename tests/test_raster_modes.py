@@ -1,8 +1,8 @@
-"""core.raster's "fast" (integer DDA) and "aa" (Xiaolin Wu) modes.
+"""core.projector.raster's "fast" (integer DDA) and "aa" (Xiaolin Wu) modes.
 
 Hand-derived images for the simple cases, then hypothesis properties against
 independent per-pixel references written here with exact ``Fraction`` arithmetic
-from the rules stated in core/raster.py's docstring:
+from the rules stated in core/projector/raster.py's docstring:
 
 fast  ends rounded with floor(v + 1/2) (exact halves up, toward +x / +y); major axis
       x when |dx| > |dy| of the rounded ends, else y; at every integer major
@@ -29,7 +29,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
-from wirecheck.core.raster import (CHUNK_SEGMENTS, RASTER_MODES, line_coverage_aa, line_pixels, line_pixels_fast,
+from wirecheck.core.projector.raster import (CHUNK_SEGMENTS, RASTER_MODES, line_coverage_aa, line_pixels, line_pixels_fast,
                                    paint_aa)
 from helpers import eight_connected
 

@@ -1,4 +1,4 @@
-"""core.raster._line_pixels (the "exact" rule, two exit tests per segment) against the
+"""core.projector.raster._line_pixels (the "exact" rule, two exit tests per segment) against the
 candidate-by-candidate reference of tests/raster_reference.py, which tests every pixel
 the rule could draw.
 
@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
-from wirecheck.core import raster
+from wirecheck.core.projector import raster
 from raster_reference import candidates_reference
 
 W, H = 40, 30
@@ -125,7 +125,7 @@ def test_icosphere_frame_segments_equal_reference():
     # the benchmark's case: 122,880 short segments (~1.2 px) of a projected icosphere
     trimesh = pytest.importorskip("trimesh")
     from wirecheck.core.camera import camera_z
-    from wirecheck.core.pipeline import render_frame
+    from wirecheck.core.projector.pipeline import render_frame
     from wirecheck.core.transforms import Motion
     ico = trimesh.creation.icosphere(subdivisions=6)
     e = np.asarray(ico.edges_unique)

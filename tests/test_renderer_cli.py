@@ -1,6 +1,6 @@
 """The ``renderer`` CLI: output lines, JSON report, PNG frames, determinism, bad input.
 
-In-process through core.cli.main([...]) (stdout/stderr captured), plus one
+In-process through core.app.cli.main([...]) (stdout/stderr captured), plus one
 subprocess run of the installed entry point.
 """
 
@@ -17,7 +17,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
-from wirecheck.core.output import MARKER
+from wirecheck.core.outputs.output import MARKER
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.errors import InputError
 from helpers import run_renderer as run
@@ -157,7 +157,7 @@ def test_determinism_byte_identical_png_and_json(seed_run, tmp_path):
 
 def test_subprocess_entry_point(tmp_path):
     exe = shutil.which("renderer", path=str(Path(sys.executable).parent))
-    cmd = [exe] if exe else [sys.executable, "-m", "wirecheck.core.cli"]
+    cmd = [exe] if exe else [sys.executable, "-m", "wirecheck.core.app.cli"]
     out = tmp_path / "sub"
     proc = subprocess.run(cmd + SEED_ARGS + ["--out", str(out)], capture_output=True, text=True, timeout=120)
     assert (proc.stdout, proc.stderr, proc.returncode) == (seed_expected_stdout(out), "", 0)
@@ -234,7 +234,7 @@ def test_unwritable_out_under_a_regular_file(tmp_path):
 
 def test_bad_input_subprocess_no_traceback(tmp_path):
     # the same contract through a real process (stderr must be exactly one line)
-    proc = subprocess.run([sys.executable, "-m", "wirecheck.core.cli", "--fov", "0", "--out", str(tmp_path / "o")],
+    proc = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--fov", "0", "--out", str(tmp_path / "o")],
                           capture_output=True, text=True, timeout=60)
     assert (proc.returncode, proc.stdout) == (2, "")
     assert proc.stderr == "renderer: error: --fov 0.0: expected degrees in (0, 180)\n"
@@ -304,7 +304,7 @@ def test_nonfinite_input_subprocess_no_traceback(tmp_path):
     (tmp_path / fname).write_text(text)
     for args, needles in ((["--camera-pos", "nan,0,4"], ["--camera-pos", "nan"]),
                           (["--scene", str(tmp_path / fname)], [f"{tmp_path / fname}:{line}:", token])):
-        proc = subprocess.run([sys.executable, "-m", "wirecheck.core.cli", *args, "--frames", "2",
+        proc = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", *args, "--frames", "2",
                                "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
         assert_one_error_line(proc.returncode, proc.stdout, proc.stderr, needles)
 
@@ -402,8 +402,8 @@ def test_sidecar_for_large_scene(tmp_path):
     # cv2.projectPoints (oracles/). Two float64 pipelines with different
     # operations: ~20 roundings of values <= 640 px each, 20 * EPS * 640 ~ 3e-12;
     # 1e-9 px leaves margin and any convention error is >= 0.5 px.
-    from wirecheck.oracles import opencv_oracle
-    from wirecheck.oracles.convert import model_matrix
+    from wirecheck.oracles.references import opencv_oracle
+    from wirecheck.oracles.references.convert import model_matrix
 
     for k in (1, 2):
         m = model_matrix((1.0, 1.0, 0.0), (0.0, 0.0, 0.0), 1.0, (k - 1) / 2)
@@ -442,7 +442,7 @@ def test_huge_finite_vertex_is_not_a_crash(tmp_path):
 
 def test_every_option_has_help_with_its_default_and_no_markup():
     from helpers import assert_help_states_defaults
-    from wirecheck.core.cli import build_parser
+    from wirecheck.core.app.cli import build_parser
 
     assert_help_states_defaults(build_parser())
 
@@ -453,8 +453,8 @@ def test_progress_counts_every_frame_and_the_animation_encoding(tmp_path):
     6 frames: 6 GIF steps, each before its frame's render step, then the
     MP4 flush: 6 + 6 + 1 = 13 = progress_steps.
     """
-    from wirecheck.core.cli import build_parser, settings_from_args
-    from wirecheck.core.run import progress_steps, render_run
+    from wirecheck.core.app.cli import build_parser, settings_from_args
+    from wirecheck.core.app.run import progress_steps, render_run
 
     s = settings_from_args(build_parser().parse_args(["--frames", "6", "--format", "gif,mp4", "--out", str(tmp_path)]))
     stages = []

@@ -36,7 +36,7 @@ def _fresh(code: str, tmp_path) -> dict:
 def test_a_png_run_loads_none_of_the_optional_libraries(tmp_path):
     got = _fresh(
         "import json, sys\n"
-        "from wirecheck.core.cli import main\n"
+        "from wirecheck.core.app.cli import main\n"
         "status = main(['--scene', 'cube', '--frames', '4', '--out', 'out'])\n"
         "print(json.dumps({'status': status, 'modules': sorted(sys.modules)}))\n", tmp_path)
     assert got["status"] == 0
@@ -53,6 +53,6 @@ def test_the_cli_loads_numpy_with_one_blas_thread_and_leaves_the_environment_as_
              "print(json.dumps({{'threads': len(os.listdir('/proc/self/task')), "
              "'env': os.environ.get('OPENBLAS_NUM_THREADS')}}))\n")
     plain = _fresh(count.format("import numpy"), tmp_path)
-    cli = _fresh(count.format("import wirecheck.core.cli"), tmp_path)
+    cli = _fresh(count.format("import wirecheck.core.app.cli"), tmp_path)
     assert plain["threads"] > 1               # numpy alone starts OpenBLAS workers here: the check can fail
     assert cli == {"threads": 1, "env": None}  # none with the CLI, and no variable left for child processes

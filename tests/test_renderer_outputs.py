@@ -8,8 +8,8 @@ import pytest
 from numpy.testing import assert_array_equal
 from PIL import Image
 
-from wirecheck.core.compose import SEPARATOR_GREY
-from wirecheck.core.output import pad_even
+from wirecheck.core.app.compose import SEPARATOR_GREY
+from wirecheck.core.outputs.output import pad_even
 from helpers import run_renderer as run
 
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.oracles.metrics import DIFF_COLOURS
-from wirecheck.oracles.report_crops import CROP_PX, SCALE, crop_image, worst_window
+from wirecheck.oracles.judge.metrics import DIFF_COLOURS
+from wirecheck.oracles.reports.report_crops import CROP_PX, SCALE, crop_image, worst_window
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -7,9 +7,9 @@ from html.parser import HTMLParser
 
 import pytest
 
-from wirecheck.oracles.case import PIXELS_NOT_COMPARED
-from wirecheck.oracles.junit import junit_xml
-from wirecheck.oracles.report import _html, markdown
+from wirecheck.oracles.judge.case import PIXELS_NOT_COMPARED
+from wirecheck.oracles.reports.junit import junit_xml
+from wirecheck.oracles.reports.report import _html, markdown
 
 
 class _Text(HTMLParser):
@@ -52,7 +52,7 @@ def junit_notes(data: bytes) -> dict:
 
 def test_distorted_case_note_in_html_and_junit(tmp_path):
     # The distorted camera at level pixels: its vertices are compared, its pixels are not
-    # (oracles/case.py); the note says so in all four outputs, and only for that case.
+    # (oracles/judge/case.py); the note says so in all four outputs, and only for that case.
     from wirecheck.oracles import cli
 
     out, xml_path = tmp_path / "run", tmp_path / "junit.xml"

@@ -1,12 +1,12 @@
-"""core.scene: built-in scenes, the text format and its errors, mesh files via trimesh."""
+"""core.scene.model: built-in scenes, the text format and its errors, mesh files via trimesh."""
 
 import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene import unique_edges
-from wirecheck.core.scene_files import builtin_names, load_scene, parse_scene_text
+from wirecheck.core.scene.model import unique_edges
+from wirecheck.core.scene.files import builtin_names, load_scene, parse_scene_text
 
 CUBE_CORNERS = [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]]
 
@@ -229,7 +229,7 @@ def test_single_object_scene_keeps_its_arrays_and_one_static_object():
 def test_vectorised_edge_helpers_equal_their_plain_definitions():
     # unique_edges: sort each pair, drop self-loops, np.unique(axis=0) (the definition);
     # face_edges on an (F, k) array: the same pairs, in the same order, as on lists.
-    from wirecheck.core.scene import face_edges, unique_edges
+    from wirecheck.core.scene.model import face_edges, unique_edges
 
     rng = np.random.default_rng(3)
     for n in (1, 7, 5000):

@@ -1,4 +1,4 @@
-"""core.shading and render_frame(style="shaded"): flat Lambert shading on our own z-buffer."""
+"""core.projector.shading and render_frame(style="shaded"): flat Lambert shading on our own z-buffer."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.shading import DEFAULT_AMBIENT, default_light_dir, face_intensity, shade
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.shading import DEFAULT_AMBIENT, default_light_dir, face_intensity, shade
 
 CUBE_V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                    [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
@@ -100,7 +100,7 @@ def test_shaded_silhouette_against_pyrender(projection, pyrender_renderer, summa
     import pyrender
     trimesh = pytest.importorskip("trimesh")
 
-    from wirecheck.oracles.convert import camera_to_pyrender
+    from wirecheck.oracles.references.convert import camera_to_pyrender
     ico = trimesh.creation.icosphere(subdivisions=3)
     v, f = np.asarray(ico.vertices), np.asarray(ico.faces)
     cam = look_at((2.5, 1.8, 3.3), (0.0, 0.0, 0.0), near=0.5, far=20.0, projection=projection,

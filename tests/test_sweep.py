@@ -10,9 +10,9 @@ import json
 import numpy as np
 import pytest
 
-from wirecheck.core.scene_files import load_scene
+from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles import sweep
-from wirecheck.oracles.pyrender_oracle import osmesa_available
+from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
 needs_osmesa = pytest.mark.skipif(not osmesa_available()[0], reason="libOSMesa not available")
 
@@ -41,7 +41,7 @@ def test_sweep_accuracy_by_setting(small_sweep):
     rows = {r["setting"]: r for r in small_sweep["settings"]}
     assert len(rows) == 12
     assert sum(r["default"] for r in rows.values()) == 1 and rows["float64/clip/exact"]["default"]
-    # float64: the crosscheck tolerance (1e-6 px; its basis is in oracles/tolerances.py).
+    # float64: the crosscheck tolerance (1e-6 px; its basis is in oracles/judge/tolerances.py).
     # float32: each coordinate passes ~6 roundings (rotation: 3 products + 2 sums;
     # translation; divide; f*; cx+) of relative size eps32/2, on pixel values up
     # to ~|x_px| <= 640 (the image) and on the camera-relative coordinates scaled
@@ -54,7 +54,7 @@ def test_sweep_accuracy_by_setting(small_sweep):
             assert r["max_vertex_error_px"] <= 1e-6, key
         else:
             assert 1e-9 < r["max_vertex_error_px"] <= bound32, key
-    # the default setting meets crosscheck's gates (oracles/tolerances.py)
+    # the default setting meets crosscheck's gates (oracles/judge/tolerances.py)
     d = rows["float64/clip/exact"]
     assert d["pixel_f1_1px"] >= 0.999 and d["pixel_f1_0px"] >= 0.98
     # near_plane crosses the near plane: "endpoint" drops the crossing edges that
@@ -137,13 +137,13 @@ def test_sweep_composes_each_objects_motion():
     # "passed" against an oracle making the same mistake. Now the oracle builds
     # each object's matrix with scipy and core renders world points, as renderer
     # does: the default setting meets the tolerances.
-    from wirecheck.core.scene import world_points
+    from wirecheck.core.scene.model import world_points
     from wirecheck.core.transforms import Motion
 
     orrery = load_scene("orrery")
     assert not orrery.is_single_static
     motion = Motion()
-    from wirecheck.oracles.faces import frame_geometry
+    from wirecheck.oracles.references.faces import frame_geometry
 
     ref = frame_geometry(orrery, motion, 2 / 8)[0]                      # frame 3 of 8: t = 2/8
     # scipy's composition equals core's to rounding (entries ~3, a few eps each)

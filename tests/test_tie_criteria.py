@@ -1,6 +1,6 @@
 """Ties are ties in every criterion: F1@0px, the per-edge counts and the balance leave the same pixels undecided.
 
-The ties are oracles.line_ties' (a one-sided pixel beside a crossing within
+The ties are oracles.judge.line_ties' (a one-sided pixel beside a crossing within
 (1 + |m|) 2^-8 px of the pixel's edge, its partner across that edge drawn by
 the other image). Hand-built frames first, with the expected values worked
 out in the comments; then crosscheck end to end on generated cylinders and a
@@ -11,9 +11,9 @@ every line's end pixel, which the tie handling must not excuse.
 import numpy as np
 import pytest
 
-from wirecheck.core import raster
-from wirecheck.oracles import line_ends, metrics, tolerances
-from wirecheck.oracles.diagnose import diagnose_lines
+from wirecheck.core.projector import raster
+from wirecheck.oracles.judge import line_ends, metrics, tolerances
+from wirecheck.oracles.diagnosis.diagnose import diagnose_lines
 
 from raster_mutants import drop_last
 
@@ -114,7 +114,7 @@ def cone_59(folder):
 
 
 def check(path, frames=2, cases=("on_axis",)):
-    from wirecheck.core.scene_files import load_scene
+    from wirecheck.core.scene.files import load_scene
     from wirecheck.oracles.runner import CoreCandidate, run_crosscheck
 
     report, _ = run_crosscheck([load_scene(str(path))], CoreCandidate(), frames=frames, case_names=list(cases),

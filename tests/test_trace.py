@@ -13,8 +13,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 from wirecheck.core.camera import camera_z, look_at
-from wirecheck.core.scene_files import load_scene
-from wirecheck.core.trace import clip_matrix, ndc_to_px, trace_vertex
+from wirecheck.core.scene.files import load_scene
+from wirecheck.core.app.trace import clip_matrix, ndc_to_px, trace_vertex
 from wirecheck.core.transforms import Motion
 from helpers import run_renderer as run
 

@@ -26,13 +26,13 @@ from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.cli import build_parser, main, settings_from_args
-from wirecheck.core.output import png_bytes
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import project_points
+from wirecheck.core.app.cli import build_parser, main, settings_from_args
+from wirecheck.core.outputs.output import png_bytes
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import project_points
 from wirecheck.core.transforms import Motion
-from wirecheck.core.viewer import DOLLY_PER_UNIT, View, Viewer, dolly, orbit, pan
-from wirecheck.core.viewer_http import Server
+from wirecheck.core.app.viewer import DOLLY_PER_UNIT, View, Viewer, dolly, orbit, pan
+from wirecheck.core.app.viewer_http import Server
 
 F60 = 240.0 * math.sqrt(3.0)
 # a few float64 rotations of values ~4: 1e-12 is ~10^3 eps x scale
@@ -180,8 +180,9 @@ def test_http_api_and_clean_stop(tmp_path):
 
 
 def test_overlay_f1_equals_metrics_computed_independently(tmp_path):
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, osmesa_available   # sets PYOPENGL_PLATFORM first
-    from wirecheck.oracles import metrics, opencv_oracle
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available   # sets PYOPENGL_PLATFORM first
+    from wirecheck.oracles.judge import metrics
+    from wirecheck.oracles.references import opencv_oracle
     from wirecheck.oracles.live import LiveOverlay
 
     ok, why = osmesa_available()
@@ -205,7 +206,7 @@ def test_overlay_f1_equals_metrics_computed_independently(tmp_path):
     p_world = cube.vertices @ m[:3, :3].T + m[:3, 3]
     # F1@0px is over the decided pixels: at a sub-pixel tie the candidate takes the oracle's value
     # (metrics.line_scores' tie_resolved, on OpenCV's segments of the frame)
-    from wirecheck.oracles.draw import oracle_segments
+    from wirecheck.oracles.candidates.draw import oracle_segments
     ls = metrics.line_scores(core_img, oracle_img, *oracle_segments(p_world, cube.edges, cam))
     assert ov["f1_0px"] == (ls["tie_resolved"] or ps)["f1_0px"] and ov["f1_1px"] == ps["f1_1px"]
     assert 0.5 < ps["f1_0px"] <= ov["f1_0px"] <= 1.0         # a real comparison: both drew the cube
@@ -218,7 +219,7 @@ def test_overlay_f1_equals_metrics_computed_independently(tmp_path):
 
 def test_interactive_cli_serves_and_stops_on_ctrl_c(tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.cli", "--interactive", "--frames", "4"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--interactive", "--frames", "4"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env=env)
     try:
         line = proc.stdout.readline()

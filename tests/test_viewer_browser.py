@@ -23,11 +23,11 @@ import pytest
 from numpy.testing import assert_allclose
 
 from wirecheck.core.camera import look_at
-from wirecheck.core.cli import build_parser, settings_from_args
-from wirecheck.core.pipeline import render_frame
+from wirecheck.core.app.cli import build_parser, settings_from_args
+from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.transforms import Motion
-from wirecheck.core.viewer import DOLLY_PER_UNIT, STAGES, Viewer
-from wirecheck.core.viewer_http import Server
+from wirecheck.core.app.viewer import DOLLY_PER_UNIT, STAGES, Viewer
+from wirecheck.core.app.viewer_http import Server
 
 pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
 
@@ -54,7 +54,7 @@ def session(tmp_path_factory):
         if os.environ.get("WIRECHECK_REQUIRE_BROWSER") == "1":
             pytest.fail(f"browser test required (WIRECHECK_REQUIRE_BROWSER=1) but {why}")
         pytest.skip(f"browser test skipped: {why}")
-    from wirecheck.oracles.pyrender_oracle import osmesa_available   # sets PYOPENGL_PLATFORM first
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available   # sets PYOPENGL_PLATFORM first
     from wirecheck.oracles.live import LiveOverlay
 
     ok, why = osmesa_available()
@@ -111,8 +111,8 @@ def test_wheel_dollies_and_shift_drag_pans(session):
 
 
 def test_overlay_f1_matches_independent_metrics_for_that_view(session):
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle
-    from wirecheck.oracles import metrics
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
+    from wirecheck.oracles.judge import metrics
 
     ov = session["overlay"]
     v = session["by"]["pan"]["json"]["view"]

@@ -1,7 +1,7 @@
 """The viewer's HTTP API under hostile requests: any local process or web page can reach it.
 
 Each request is sent byte for byte over a socket to an in-process Server on
-port 0 (64x48 frames: cheap). What must hold for every one (core/viewer.py's
+port 0 (64x48 frames: cheap). What must hold for every one (core/app/viewer.py's
 module docstring, docs/interactive.md "Error answers"): a 4xx with a JSON
 ``{"error": ...}`` or a valid frame, never a dropped connection, a 500, a
 stalled thread or a traceback on the terminal, and the view the next request
@@ -22,10 +22,10 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from PIL import Image
 
-import wirecheck.core.viewer_http as viewer_http_mod
-from wirecheck.core.cli import build_parser, settings_from_args
-from wirecheck.core.viewer import FIELDS, MAX_OPS, View, Viewer
-from wirecheck.core.viewer_http import MAX_BODY_BYTES, Server
+import wirecheck.core.app.viewer_http as viewer_http_mod
+from wirecheck.core.app.cli import build_parser, settings_from_args
+from wirecheck.core.app.viewer import FIELDS, MAX_OPS, View, Viewer
+from wirecheck.core.app.viewer_http import MAX_BODY_BYTES, Server
 
 W, H = 64, 48
 # a few float64 rotations of values ~4 (test_viewer.py's TOL)

@@ -1,4 +1,4 @@
-"""core.zbuffer: triangle clipping, coverage (top-left rule), perspective-correct depth.
+"""core.projector.zbuffer: triangle clipping, coverage (top-left rule), perspective-correct depth.
 
 Checked by hand on tiny cases, against a brute-force exact reference, and
 against pyrender (OSMesa / llvmpipe) on a cube and an icosphere.
@@ -12,11 +12,11 @@ import time
 import numpy as np
 import pytest
 
-from wirecheck.core import zbuffer
+from wirecheck.core.projector import zbuffer
 from wirecheck.core.camera import look_at
-from wirecheck.core.projection import unproject, world_to_cam
-from wirecheck.core.clipping import clip_triangles_near
-from wirecheck.core.zbuffer import project_triangles, rasterize_triangles
+from wirecheck.core.projector.projection import unproject, world_to_cam
+from wirecheck.core.projector.clipping import clip_triangles_near
+from wirecheck.core.projector.zbuffer import project_triangles, rasterize_triangles
 
 EPS32 = float(np.finfo(np.float32).eps)
 
@@ -280,7 +280,7 @@ def _pyrender_faces(vertices, triangles, camera, renderer):
     """White flat faces (double sided) with pyrender: (covered mask, linear depth, 0 = empty)."""
     import pyrender
 
-    from wirecheck.oracles.convert import camera_to_pyrender
+    from wirecheck.oracles.references.convert import camera_to_pyrender
     scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
     mat = pyrender.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=True)
     scene.add(pyrender.Mesh([pyrender.Primitive(positions=vertices.astype(np.float32),

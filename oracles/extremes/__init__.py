@@ -1,11 +1,11 @@
 """The extremes suite: core at the edges of its input space, against derived error bounds.
 
-Each case (cases.py) runs core (``core.pipeline.render_frame`` and
-``core.projection.project_points``) in float64 and float32 and compares it with
+Each case (cases.py) runs core (``core.projector.pipeline.render_frame`` and
+``core.projector.projection.project_points``) in float64 and float32 and compares it with
 
 - an **extended-precision reference** (reference.py): ``core.conventions`` in
   ``np.longdouble``, none of core's functions;
-- **OpenCV** (``oracles.opencv_oracle.project``, float64 ``cv2.projectPoints``),
+- **OpenCV** (``oracles.references.opencv_oracle.project``, float64 ``cv2.projectPoints``),
   whose own error against the reference is reported and checked against its
   own bound. OpenCV is not camera-relative, so far from the origin it is the
   less accurate of the two: its error is information;

@@ -34,7 +34,7 @@ def derivation(func) -> str:
 
 
 def localize_origin(p_model) -> np.ndarray:
-    """``(3,)`` the re-centring origin documented in core.projection.localize (recomputed here)."""
+    """``(3,)`` the re-centring origin documented in core.projector.projection.localize (recomputed here)."""
     p = np.asarray(p_model, np.float64).reshape(-1, 3)
     fin = np.isfinite(p).all(axis=1)
     if not fin.any():
@@ -66,7 +66,7 @@ def camera_error(dtype: str, p_model, model_matrix, camera, model_err: float = 0
     -----
     core computes ``p_cam = R_mv p_local + t_mv`` with ``R_mv = R A`` and
     ``t_mv = R (A o + t - position)`` formed in float64 and then cast
-    (core/projection.py). Each camera coordinate i is a 3-term dot product plus
+    (core/projector/projection.py). Each camera coordinate i is a 3-term dot product plus
     the translation's component i: with the casts of ``p_local``, ``R_mv`` and
     ``t_mv`` that is at most ~6 roundings of ``u``, i.e.
     ``e_i = 3 eps (|A| |p_local| + |t_mv_i|)``. The "world" path casts the

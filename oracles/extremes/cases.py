@@ -11,14 +11,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from wirecheck.core import clipping
+from wirecheck.core.projector import clipping
 from wirecheck.core.camera import look_at
 from wirecheck.core.errors import InputError
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import DTYPES, cam_to_px, localize, model_to_cam, project_points
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import DTYPES, cam_to_px, localize, model_to_cam, project_points
 from wirecheck.core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z, translate
 
-from .. import opencv_oracle
+from ..references import opencv_oracle
 from .bounds import (EPS, EPS32, camera_error, clipped_end_bounds, focal_condition, motion_matrix_error,
                      near_band, orthonormality_error)
 from .measure import Pyrender, err_px, measure

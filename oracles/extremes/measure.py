@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from wirecheck.core.pipeline import render_frame
-from wirecheck.core.projection import DTYPES, project_points
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.projector.projection import DTYPES, project_points
 
-from .. import metrics, opencv_oracle
+from ..judge import metrics
+from ..references import opencv_oracle
 from .bounds import EPS, EPS64, camera_error, near_band, opencv_camera_error, pixel_bound
 from .reference import LD, reference_project, reference_world
 
@@ -113,7 +114,7 @@ class Pyrender:
     """One PyrenderOracle per image size (pyrender_oracle.OracleCache), or a note saying why none."""
 
     def __init__(self, enabled: bool):
-        from ..pyrender_oracle import OracleCache
+        from ..references.pyrender_oracle import OracleCache
 
         self.oracles = OracleCache()
         self.gl = None
@@ -122,7 +123,7 @@ class Pyrender:
         if not enabled:
             self.note = "pyrender disabled (run_extremes(pyrender=False))"
             return
-        from ..pyrender_oracle import osmesa_available
+        from ..references.pyrender_oracle import osmesa_available
         ok, msg = osmesa_available()
         if not ok:
             self.enabled, self.note = False, f"pyrender unavailable: {msg}"

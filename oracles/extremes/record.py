@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from wirecheck.core.projection import DTYPES
+from wirecheck.core.projector.projection import DTYPES
 
-from ..tolerances import MIN_F1_1PX_EXTREMES
+from ..judge.tolerances import MIN_F1_1PX_EXTREMES
 from .measure import within
 
 #: The stats a record keeps, as :func:`measure.measure` names them.

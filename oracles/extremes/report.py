@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..report import gl_text
+from ..reports.report import gl_text
 
 
 def _fmt(v, digits=2):

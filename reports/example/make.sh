@@ -43,8 +43,8 @@ cp "$T/cmp/cube-compare.png" reports/example/cube-compare.png
 if [ -d tests/browser/node_modules/playwright-core ] && [ -x /usr/bin/chromium ]; then
     .venv/bin/python - "$T" <<'PY'
 import subprocess, sys
-from wirecheck.core.cli import build_parser, settings_from_args
-from wirecheck.core.viewer import Server, Viewer
+from wirecheck.core.app.cli import build_parser, settings_from_args
+from wirecheck.core.app.viewer import Server, Viewer
 from wirecheck.oracles.live import LiveOverlay
 s = settings_from_args(build_parser().parse_args(["--out", sys.argv[1] + "/viewer"]))
 server = Server(Viewer(s, overlay=LiveOverlay())).start()

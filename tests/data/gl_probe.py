@@ -26,7 +26,7 @@ def plain_renderer(width: int, height: int):
     """pyrender's OffscreenRenderer as pyrender sets it up (its 4x buffers), kept from ending the EGL display."""
     import pyrender
 
-    from wirecheck.oracles.pyrender_oracle import _spare_the_display
+    from wirecheck.oracles.references.pyrender_oracle import _spare_the_display
 
     r = pyrender.OffscreenRenderer(width, height)
     if hasattr(r._platform, "_egl_display"):
@@ -43,7 +43,7 @@ def coverage_levels(renderer, scene) -> list:
 
 def main() -> int:
     from wirecheck.core.camera import look_at
-    from wirecheck.oracles.pyrender_oracle import PyrenderOracle, gl_available
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, gl_available
 
     ok, why = gl_available()
     if not ok:

@@ -25,7 +25,7 @@ TEXTURE = bytes.fromhex("89504e470d0a1a0a0000000d4948445200000001000000010800000
 
 
 def _before_first_line(err: str) -> bool:
-    """True when a KeyboardInterrupt traceback has no frame of core/cli.py past its interrupts_from_start line."""
+    """True when a KeyboardInterrupt traceback has no frame of core/app/cli.py past its interrupts_from_start line."""
     import re
 
     start = next(n for n, line in enumerate((ROOT / "core" / "cli.py").read_text().splitlines(), 1)

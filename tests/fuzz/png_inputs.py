@@ -1,4 +1,4 @@
-"""Hostile PNG frames for the image rule (oracles/png_frame.py), and the contract read_png keeps on each.
+"""Hostile PNG frames for the image rule (oracles/candidates/png_frame.py), and the contract read_png keeps on each.
 
 A draw starts from a valid PNG of a random colour type and bit depth (with or
 without PLTE and tRNS, written byte by byte), then damages it: flipped bytes,

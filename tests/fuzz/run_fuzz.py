@@ -60,7 +60,7 @@ def _timeout(signum, frame):
 
 
 def fuzz(cli: str, n: int, seed: int, earlier: Path, log, start: int = 0) -> dict:
-    from wirecheck.core import cli as renderer
+    from wirecheck.core.app import cli as renderer
     from wirecheck.oracles import cli as crosscheck
 
     main = renderer.main if cli == "renderer" else crosscheck.main
@@ -105,7 +105,7 @@ def fuzz(cli: str, n: int, seed: int, earlier: Path, log, start: int = 0) -> dic
 def fuzz_png(n: int, seed: int, start: int = 0) -> dict:
     """``n`` damaged PNG frames through read_png (tests/fuzz/png_inputs.py): outcomes and problems by kind."""
     from fuzz.png_inputs import check_png, hostile_png
-    from wirecheck.oracles.png_frame import FrameProblem, read_png
+    from wirecheck.oracles.candidates.png_frame import FrameProblem, read_png
 
     outcomes, problems, examples = collections.Counter(), collections.Counter(), []
     t0 = time.perf_counter()
@@ -167,7 +167,7 @@ def main(argv=None) -> int:
     a = p.parse_args(argv)
     warnings.simplefilter("ignore")       # the CLIs capture their own; the harness's are not the contract's
     os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
-    from wirecheck.core import cli as renderer
+    from wirecheck.core.app import cli as renderer
 
     if a.cli in ("png", "interrupt"):
         r = (fuzz_png if a.cli == "png" else fuzz_interrupts)(a.inputs, a.seed, a.start)

@@ -19,7 +19,7 @@ package folders are mapped by setuptools (``package-dir``), which both tools'
 in-place file rewriting would put under the other helpers' feet. The mutator
 below is ~200 lines, has no state but its report, and runs in a copy.
 
-    .venv/bin/python tests/mutation/mutate.py [--sample N] [--seed S] [--module core/raster.py ...]
+    .venv/bin/python tests/mutation/mutate.py [--sample N] [--seed S] [--module core/projector/raster.py ...]
                                              [--jobs J] [--report tests/mutation/report.md]
 
 ``--sample N``: at most N mutants per module, drawn with ``--seed`` from all
@@ -48,17 +48,17 @@ HERE = Path(__file__).resolve().parent
 
 #: The modules mutated, and the test files (with an optional -k expression) that judge each.
 TARGETS = {
-    "core/projection.py": (["tests/test_projection.py", "tests/test_conventions.py", "tests/test_core_vs_opencv.py"], None),
-    "core/clipping.py": (["tests/test_clipping.py"], None),
-    "core/raster.py": (["tests/test_raster.py", "tests/test_raster_modes.py"], None),
+    "core/projector/projection.py": (["tests/test_projection.py", "tests/test_conventions.py", "tests/test_core_vs_opencv.py"], None),
+    "core/projector/clipping.py": (["tests/test_clipping.py"], None),
+    "core/projector/raster.py": (["tests/test_raster.py", "tests/test_raster_modes.py"], None),
     "core/camera.py": (["tests/test_conventions.py", "tests/test_projection.py", "tests/test_scene.py"], None),
     "core/transforms.py": (["tests/test_transforms.py", "tests/test_conventions.py"], None),
-    "oracles/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
-    "oracles/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
-    "oracles/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
+    "oracles/judge/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
+    "oracles/diagnosis/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
+    "oracles/judge/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
                            "decides or note or empty_scene or faceless or visibility"),
-    "oracles/convert.py": (["tests/test_oracle_convert.py"], None),
-    "oracles/judge.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
+    "oracles/references/convert.py": (["tests/test_oracle_convert.py"], None),
+    "oracles/judge/decide.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
                           "tests/test_crosscheck_styles.py", "tests/test_gate.py"],
                          "decides or note or empty_scene or faceless or visibility or line_end_bias or exact or geometric "
                          "or vacuous"),
@@ -226,7 +226,7 @@ def run_mutant(site: Site, pkg: Path) -> tuple[str, float]:
 def _check_copy_is_imported(pkg: Path) -> None:
     """The tests must import the copy, not the editable install of the working tree."""
     env = {**os.environ, "PYTHONPATH": str(pkg.parent), "PYTHONDONTWRITEBYTECODE": "1"}
-    out = subprocess.run([sys.executable, "-c", "import wirecheck.core.raster as r; print(r.__file__)"],
+    out = subprocess.run([sys.executable, "-c", "import wirecheck.core.projector.raster as r; print(r.__file__)"],
                          cwd=pkg, env=env, capture_output=True, text=True, check=True).stdout.strip()
     if not out.startswith(str(pkg)):
         raise SystemExit(f"mutate: the copy is not what gets imported ({out})")

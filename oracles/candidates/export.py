@@ -1,0 +1,248 @@
+"""``crosscheck export DIR``: a rendering job any renderer can do, judged later by its frames.
+
+The job is a folder::
+
+    DIR/README.md                        what to draw and where (for the renderer's author)
+    DIR/job.json                         the manifest: scenes, cases, frames, image rule, conventions
+    DIR/scenes/<scene>.obj               vertices ``v`` (model space), edges ``l``, faces ``f``
+    DIR/scenes/<scene>/frame_0001.obj    instead, for a scene of several moving objects: world space per frame
+    DIR/cameras/<scene>/<case>/frame_0001.json   the camera and model matrix of one frame
+    DIR/frames/<scene>/<case>/frame_0001.png     written by the renderer (not by export)
+
+A frame's JSON holds the camera in every form a renderer may want: the
+fields of the candidate contract (:mod:`oracles.candidates.candidate`), OpenCV's ``K, R,
+t`` (:func:`oracles.references.convert.opencv_matrices`), OpenGL's view and projection
+matrices (:func:`oracles.references.convert.camera_to_gl`) and the model matrix the
+oracles use (:func:`oracles.references.faces.frame_geometry`: scipy, not core). Matrices
+are nested lists of rows, for column vectors (``p = M @ [x, y, z, 1]``). The
+conventions are stated in the JSON itself (``conventions``), pointing to
+``core/conventions.py``.
+
+Frames are numbered as crosscheck's motion numbers them: frame ``k`` is at
+``t = (k - 1) / frames``; with ``every`` only frames 1, 1 + every, ... are in
+the job. ``oracles.candidates.frames_candidate`` reads the job back and judges the PNGs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from wirecheck.core.errors import InputError
+from wirecheck.core.outputs.output import FrameDir, json_dumps
+
+from ..judge.cases import CASE_NAMES, case_motion, cases_for
+from ..references.convert import camera_to_gl, opencv_matrices
+
+#: Version of the job format; frames_candidate refuses any other.
+JOB_VERSION = 1
+JOB_KIND = "wirecheck frames job"
+
+CONVENTIONS = {
+    "statement": "core/conventions.py of wirecheck states these once; summarised here for the renderer",
+    "world": "right-handed; camera right = forward x up",
+    "pixels": "x right (columns), y down (rows), origin top-left; integer coordinates are pixel centres: "
+              "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2) unless the camera has "
+              "intrinsics [fx, fy, cx, cy] (then K and gl_projection hold them)",
+    "fov": "fov_y_deg is the vertical field of view, edge to edge of the image",
+    "orthographic": "ortho_height world units are visible vertically (edge to edge)",
+    "clipping": "a point is drawn when its depth along forward is in [near, far]; edges are clipped there",
+    "matrices": "nested lists of rows, for column vectors: p' = M @ p",
+    "model_matrix": "p_world = model_matrix @ [p_model, 1] (the OBJ's v are p_model)",
+    "opencv": "p_cv = R @ p_world + t; [u, v, 1] ~ K @ p_cv (perspective); u, v are our pixel coordinates",
+    "opengl": "p_clip = gl_projection @ gl_view @ [p_world, 1]; x_win = (x_ndc + 1) W / 2, "
+              "y_win = (y_ndc + 1) H / 2 (y up, corner origin); our x_px = x_win - 0.5, y_px = H - y_win - 0.5",
+}
+
+IMAGE_RULE = {
+    "wireframe": "PNG, the camera's width x height, black background, every visible edge as a white line: "
+                 "1-px aliased (held to GL's pixel rule), or anti-aliased, or up to ~3 px wide (judged by where "
+                 "the lines' centres are); a pixel's luminance over black (luminance x alpha / 255) is its "
+                 "coverage, and it counts as drawn when >= 128 (a transparent pixel is not drawn)",
+}
+
+
+def frame_name(k: int, ext: str) -> str:
+    return f"frame_{k:04d}.{ext}"
+
+
+def _rows(m) -> list:
+    return [[float(x) for x in row] for row in np.asarray(m, dtype=np.float64)]
+
+
+def _obj_text(vertices: np.ndarray, edges, faces, header: str) -> str:
+    lines = [f"# {header}"]
+    lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(vertices, dtype=np.float64).tolist()]
+    lines += [f"l {int(a) + 1} {int(b) + 1}" for a, b in np.asarray(edges).reshape(-1, 2).tolist()]
+    lines += ["f " + " ".join(str(int(i) + 1) for i in f) for f in faces]
+    return "\n".join(lines) + "\n"
+
+
+def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames: int) -> dict:
+    """Everything a renderer needs to draw frame ``k`` of one case."""
+    r, t, kk = opencv_matrices(camera)
+    view, proj = camera_to_gl(camera)
+    return {"scene": scene, "case": case, "frame": k, "t": (k - 1) / frames,
+            "camera": camera.to_dict(), "right": [float(x) for x in camera.right],
+            "model_matrix": _rows(model),
+            "K": _rows(kk), "R": _rows(r), "t_cv": [float(x) for x in t],
+            "gl_view": _rows(view), "gl_projection": _rows(proj),
+            "conventions": "see job.json (conventions); core/conventions.py states them once"}
+
+
+def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> tuple[dict, dict]:
+    """The manifest and the files of a job: ``(job, {relative path: bytes})``."""
+    from wirecheck.core.transforms import Motion
+
+    from ..references.faces import frame_geometry
+
+    motion = motion or Motion()
+    files: dict[str, bytes] = {}
+    scene_rows, case_rows = [], []
+    checked = list(range(1, frames + 1, every))
+    for scene in scenes:
+        single = scene.is_single_static
+        faces = [tuple(int(i) for i in f) for f in scene.faces]
+        if single:
+            path = f"scenes/{scene.name}.obj"
+            files[path] = _obj_text(scene.vertices, scene.edges, faces,
+                                    f"{scene.name}: model space; each frame's JSON has its model_matrix").encode()
+        scene_rows.append({"name": scene.name, "space": "model" if single else "world per frame",
+                           "obj": f"scenes/{scene.name}.obj" if single else f"scenes/{scene.name}/frame_NNNN.obj",
+                           "vertices": int(len(scene.vertices)), "edges": int(len(scene.edges)),
+                           "faces": len(faces)})
+        cases = cases_for(scene, motion, calibrated=True)
+        scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
+        geometry = {}
+        for k in checked:
+            p_world, _m, _pr_vertices, pose = frame_geometry(scene, scene_motion, (k - 1) / frames)
+            geometry[k] = pose if single else np.eye(4)
+            if not single:
+                files[f"scenes/{scene.name}/{frame_name(k, 'obj')}"] = _obj_text(
+                    p_world, scene.edges, faces, f"{scene.name} frame {k}: world space").encode()
+        for case in cases:
+            if case.name not in (CASE_NAMES if case_names is None else case_names):
+                continue
+            if case.camera.distortion is not None:      # frames are judged by pixels: not for a lens (oracles.judge.case)
+                raise InputError(f"--cases {case.name}: lens distortion: a frames job is judged by its pixels, "
+                                 "which GL cannot draw through a lens; expected cases without distortion")
+            for k in checked:
+                files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
+                    camera_json(case.camera, geometry[k], scene.name, case.name, k, frames)).encode()
+            case_rows.append({"scene": scene.name, "case": case.name, "width": case.camera.width,
+                              "height": case.camera.height,
+                              "frames": [f"frames/{scene.name}/{case.name}/{frame_name(k, 'png')}" for k in checked]})
+    job = {"kind": JOB_KIND, "version": JOB_VERSION, "style": "wireframe", "frames": frames, "every": every,
+           "frame_numbers": checked, "motion": {"turns": list(motion.turns)},
+           "image": IMAGE_RULE["wireframe"], "conventions": CONVENTIONS,
+           "scenes": scene_rows, "cases": case_rows}
+    files["job.json"] = json_dumps(job).encode()
+    files["README.md"] = readme(job).encode()
+    return job, files
+
+
+def quarter_turn_frames(job: dict) -> bool:
+    """Whether every checked frame's pose turns the scene by whole quarter turns about each axis.
+
+    Frame ``k`` turns by ``turns * (k - 1) / frames`` of a full turn about X, Y
+    and Z (core.transforms.Motion): with ``--frames 4`` and the default spin
+    every frame is a quarter-turn pose, which shows a cube square-on.
+    """
+    turns = np.asarray(job["motion"]["turns"], dtype=np.float64)
+    quarters = [turns * 4.0 * (k - 1) / job["frames"] for k in job["frame_numbers"]]
+    return all(np.all(np.abs(q - np.round(q)) < 1e-9) for q in quarters)
+
+
+def short_job_note(job: dict) -> str:
+    """The README's section on what the job's frames cannot reveal."""
+    n = len(job["frame_numbers"])
+    text = f"""## What this job cannot reveal
+
+The verdict rests on the {n} frame{'s' if n != 1 else ''} listed per case, and on nothing between them: a
+fault that shows only at other poses (a line crossing the near plane, an edge
+leaving the picture at some angle) goes unseen. The faults are named from at
+most 24 of a case's frames (evenly spaced)."""
+    if quarter_turn_frames(job):
+        shown = ", ".join(str(k) for k in job["frame_numbers"][:6]) + (", ..." if n > 6 else "")
+        text += f"""
+
+**Every frame of this job is a quarter-turn pose** (frames {shown} of
+{job['frames']}, spin {','.join(f'{t:g}' for t in job['motion']['turns'])}): a cube is seen square-on in each, a
+picture that a mirror, an axis swap or flip, a transposed rotation, a wrong
+rotation order or a camera looking backward can map onto itself, so such
+faults may draw the very pixels a correct renderer draws and pass. Export
+more frames, or a number of frames that is not a multiple of 4 (e.g.
+`--frames 24 --every 5`, `--frames 7`), to see the scene at oblique poses."""
+    return text + "\n"
+
+
+def readme(job: dict) -> str:
+    n_frames = sum(len(c["frames"]) for c in job["cases"])
+    first = job["cases"][0]
+    return f"""# A wirecheck rendering job
+
+Draw every frame listed below with your renderer, then run
+
+    crosscheck --candidate-frames THIS_FOLDER
+
+to have your renderer's own pixels judged against pyrender (OpenGL) and
+wirecheck's core renderer, by the same rules as a projector: edge-pixel F1
+at 0 and 1 px, the balance of pixels drawn by one side only, each line's
+length in pixels, diff images, the worst frames, and, when something is off,
+the name of the fault (mirror, axis swap, FOV, aspect, half-pixel offset,
+depth flip, lines short or long at an end).
+
+## What to draw
+
+{job['image']}.
+
+- {len(job['cases'])} cases (a scene under a camera), {n_frames} frames in all.
+- Scenes: `scenes/<scene>.obj` (model space: `v` vertices, `l` edges, `f`
+  faces, 1-based). Draw the `l` edges (a line per edge); the faces are for
+  shaded renderers and for hidden lines, which this job does not ask for.
+- Cameras: `cameras/<scene>/<case>/frame_NNNN.json` gives the camera as
+  position/forward/up/fov_y_deg/width/height/near/far/projection/ortho_height,
+  as OpenCV `K`, `R`, `t_cv`, and as OpenGL `gl_view` and `gl_projection`, and
+  the frame's `model_matrix` (p_world = model_matrix @ [v, 1]). Matrices are
+  rows, for column vectors. The conventions are in `job.json` (`conventions`).
+- Clip edges at the near and far planes (depth along `forward` in
+  [near, far]); draw what falls inside the image.
+
+## Where to write
+
+`frames/<scene>/<case>/frame_NNNN.png`, the same numbers as the camera files,
+e.g. `{first['frames'][0]}` ({first['width']} x {first['height']}). Every
+listed frame must be there, at its camera's size: one still PNG (8- or
+16-bit grey, RGB, RGBA or palette; no JPEG renamed, no animated PNG).
+
+## Line style
+
+Any: the judge reads it from the frames. A 1-px aliased line (WebGL:
+`antialias: false`; OpenGL: no multisampling, no GL_LINE_SMOOTH) is held to
+GL's pixel rule: the 0-px F1 compares pixel for pixel. Anti-aliased lines and
+lines up to ~3 px wide cannot follow that rule; they are judged by where each
+line's centre lies (to a fraction of a pixel), and the report says which style
+it read. Aliased lines of another rule (Pillow's ImageDraw.line, TinyGL) fail
+the 0-px F1 as `raster_rule`; `crosscheck --candidate-frames DIR --line-rule
+geometry` judges their geometry only.
+
+""" + short_job_note(job)
+
+
+def write_job(out_dir: Path, scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> dict:
+    """Write the job to ``out_dir`` atomically (a temporary folder renamed over it); the manifest."""
+    job, files = build_job(scenes, frames=frames, every=every, case_names=case_names, motion=motion)
+    out_dir = Path(out_dir)
+    out = FrameDir(out_dir, "export DIR")
+    try:
+        for rel, data in sorted(files.items()):
+            path = out.tmp / rel
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        (out.tmp / "frames").mkdir()
+        out.commit()
+    except BaseException:
+        out.abort()
+        raise
+    return job

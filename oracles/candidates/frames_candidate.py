@@ -1,0 +1,344 @@
+"""``crosscheck --candidate-frames DIR``: a renderer's frames job, read and checked.
+
+``DIR`` is a job written by :mod:`oracles.candidates.export` with the renderer's PNGs
+under ``frames/``. This module reads and checks the job (its manifest, OBJ,
+cameras and frames); :mod:`oracles.judge.frames_judge` judges the frames, one at a
+time, by the one judge of every path (:mod:`oracles.judge.decide`).
+
+A gate never passes on nothing: the job must list cases and frames, every
+listed frame must be there at its camera's size and readable, and a PNG under
+``frames/`` that the job does not list is refused too (frames of another
+job). Each problem is one line of :class:`FramesError` (exit 2).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from wirecheck.core.errors import InputError
+
+from .export import JOB_KIND, JOB_VERSION, frame_name
+from .png_frame import FrameProblem, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
+
+#: Problem lines shown before "... and N more".
+MAX_LINES = 20
+#: Entries walked under ``frames/`` before the walk stops: a job lists at most
+#: MAX_FRAMES frames per case, and links between folders must not make the walk unbounded.
+MAX_WALK = 200_000
+
+
+class FramesError(InputError):
+    """The job or its frames cannot be judged: one line per problem."""
+
+    def __init__(self, problems: list[str]):
+        self.problems = problems = [escape_controls(p) for p in problems]    # a file name may hold an ESC
+        shown = problems[:MAX_LINES]
+        more = len(problems) - len(shown)
+        super().__init__("\n".join(shown + ([f"... and {more} more"] if more else [])))
+
+    def __str__(self) -> str:       # one line per problem, kept apart (InputError joins lines into one)
+        return Exception.__str__(self)
+
+
+def _no_duplicate_keys(pairs: list) -> dict:
+    """``json.loads``' object hook: a key given twice is a ValueError (JSON keeps the last one, silently)."""
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"key {key!r} given twice")
+        out[key] = value
+    return out
+
+
+def read_json(path: Path):
+    """The JSON of a job file (UTF-8, a BOM allowed); ValueError for a key given twice."""
+    return json.loads(Path(path).read_text(encoding="utf-8-sig"), object_pairs_hook=_no_duplicate_keys)
+
+
+def load_job(job_dir: Path) -> dict:
+    """The manifest ``DIR/job.json``, checked; FramesError otherwise."""
+    path = Path(job_dir) / "job.json"
+    if not Path(job_dir).is_dir():
+        raise FramesError([f"--candidate-frames {str(job_dir)!r}: not a directory: expected a job folder "
+                           "written by 'crosscheck export'"])
+    problem = file_problem(path)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem}: expected a job folder written by 'crosscheck export'"])
+    try:
+        job = read_json(path)
+    except (OSError, ValueError, RecursionError) as exc:        # RecursionError: arrays nested 100,000 deep
+        raise FramesError([f"{path}: unreadable ({exc}): expected the JSON 'crosscheck export' wrote"]) from None
+    if not isinstance(job, dict) or job.get("kind") != JOB_KIND:
+        raise FramesError([f"{path}: not a wirecheck frames job (kind {job.get('kind') if isinstance(job, dict) else None!r})"])
+    if job.get("version") != JOB_VERSION:
+        raise FramesError([f"{path}: job version {job.get('version')!r}: expected {JOB_VERSION} (export it again)"])
+    if not job.get("cases"):
+        raise FramesError([f"{path}: the job lists no frames: nothing to judge"])
+    problem = _job_problem(job)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem} (export the job again)"])
+    return job
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _job_problem(job: dict) -> str | None:
+    """What in a job.json is not as ``crosscheck export`` writes it, in one phrase; None when all is.
+
+    A job is hand-editable JSON: every field the judging reads is checked here,
+    so that an edited or damaged one is a usage error naming the field, never a
+    crash later or numbers in the report that mean nothing.
+    """
+    from wirecheck.core.limits import MAX_FRAMES, check_image_size
+    from wirecheck.core.scene.files import NAME_PATTERN
+
+    frames, every = job.get("frames"), job.get("every")
+    if not (_is_int(frames) and 1 <= frames <= MAX_FRAMES):
+        return f"frames {frames!r}: expected an integer in 1..{MAX_FRAMES}"
+    if not (_is_int(every) and 1 <= every <= frames):
+        return f"every {every!r}: expected an integer in 1..frames ({frames})"
+    checked = list(range(1, frames + 1, every))
+    if job.get("frame_numbers") != checked:
+        return f"frame_numbers {str(job.get('frame_numbers'))[:60]}: expected 1, 1+every, ... up to frames"
+    turns = (job.get("motion") or {}).get("turns") if isinstance(job.get("motion"), dict) else None
+    if not (isinstance(turns, list) and len(turns) == 3
+            and all(isinstance(t, (int, float)) and not isinstance(t, bool) and np.isfinite(t) for t in turns)):
+        return f"motion.turns {turns!r}: expected three finite numbers"
+    if job.get("style") != "wireframe":
+        return f"style {job.get('style')!r}: expected 'wireframe' (the frames judged are wireframes)"
+    scenes, cases = job.get("scenes"), job.get("cases")
+    if not (isinstance(scenes, list) and scenes and all(isinstance(r, dict) for r in scenes)):
+        return "scenes: expected a list of the job's scenes"
+    names = set()
+    for r in scenes:
+        name, obj = r.get("name"), r.get("obj")
+        if not (isinstance(name, str) and NAME_PATTERN.fullmatch(name)) or name in names:
+            return f"scene name {name!r}: expected a name of letters, digits, '_', '.', '-', each scene once"
+        names.add(name)
+        expected = {"model": f"scenes/{name}.obj", "world per frame": f"scenes/{name}/frame_NNNN.obj"}
+        if expected.get(r.get("space")) != obj:
+            return (f"scene {name!r}: space {r.get('space')!r}, obj {obj!r}: expected space 'model' with "
+                    f"obj {expected['model']!r}, or 'world per frame' with {expected['world per frame']!r}")
+        if r.get("space") == "model" and not all(_is_int(r.get(k)) and r[k] >= 0 for k in ("vertices", "edges")):
+            return f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}: expected counts"
+    if not (isinstance(cases, list) and all(isinstance(c, dict) for c in cases)):
+        return "cases: expected a list of the job's cases"
+    pairs = set()
+    for c in cases:
+        scene, case, w, h = c.get("scene"), c.get("case"), c.get("width"), c.get("height")
+        if not isinstance(scene, str) or scene not in names or not (isinstance(case, str) and NAME_PATTERN.fullmatch(case)):
+            return f"case {scene!r} / {case!r}: expected a scene of 'scenes' and a case name"
+        if (scene, case) in pairs:      # judged twice, it would count twice in the summary
+            return f"case {scene} / {case}: listed twice: expected each case once"
+        pairs.add((scene, case))
+        if not (_is_int(w) and _is_int(h)):
+            return f"case {scene} / {case}: width {w!r}, height {h!r}: expected integers"
+        try:
+            check_image_size(w, h, f"case {scene} / {case}: width x height")
+        except InputError as exc:
+            return str(exc)
+        listed = [f"frames/{scene}/{case}/{frame_name(k, 'png')}" for k in checked]
+        if c.get("frames") != listed:
+            return (f"case {scene} / {case}: frames {str(c.get('frames'))[:80]}: expected "
+                    f"frames/{scene}/{case}/frame_NNNN.png for each of frame_numbers")
+    return None
+
+
+def _walk(frames_dir: Path) -> list[Path]:
+    """Every entry under ``frames_dir`` that is not a folder; links to folders followed, a link loop is not.
+
+    A folder is not entered again below itself (a loop); the walk stops with a
+    FramesError past :data:`MAX_WALK` entries. A folder that cannot be listed
+    is skipped: its listed frames are reported one by one.
+    """
+    out, n = [], 0
+    stack = [(frames_dir, frozenset())]
+    while stack:
+        folder, above = stack.pop()
+        try:
+            st = folder.stat()
+            key = (st.st_dev, st.st_ino)
+            if key in above:
+                continue
+            with os.scandir(folder) as it:
+                items = sorted(it, key=lambda e: e.name)
+        except OSError:
+            continue
+        for item in items:
+            n += 1
+            if n > MAX_WALK:
+                raise FramesError([f"{frames_dir}: more than {MAX_WALK:,} files and folders: expected the "
+                                   "job's frames (frames/<scene>/<case>/frame_NNNN.png)"])
+            try:
+                is_dir = item.is_dir()
+            except OSError:
+                is_dir = False
+            if is_dir:
+                stack.append((Path(item.path), above | {key}))
+            else:
+                out.append(Path(item.path))
+    return out
+
+
+def load_frames(job_dir: Path, job: dict) -> dict:
+    """Every listed frame as a grey image (oracles.candidates.png_frame.read_grey): ``{(scene, case): [(k, image)]}``;
+    FramesError listing every problem."""
+    return _frames(job_dir, job, keep=True)
+
+
+def check_frames(job_dir: Path, job: dict) -> None:
+    """:func:`load_frames`' checks, every frame read and dropped (memory flat in the job's length)."""
+    _frames(job_dir, job, keep=False)
+
+
+def _frames(job_dir: Path, job: dict, keep: bool) -> dict:
+    job_dir = Path(job_dir)
+    frames_dir = job_dir / "frames"
+    if not frames_dir.is_dir():
+        problem = file_problem(frames_dir)
+        raise FramesError([f"{frames_dir}: {problem or 'a file, not a folder'}: the renderer's frames go there "
+                           "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
+    found = {p.relative_to(job_dir).as_posix() for p in _walk(frames_dir)}
+    if not found:
+        raise FramesError([f"{frames_dir}: empty: expected the renderer's frames "
+                           "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
+    listed = {f for c in job["cases"] for f in c["frames"]}
+    if not found & listed:
+        example = sorted(found)[0]
+        raise FramesError([f"{frames_dir}: none of its {len(found)} files is a frame of this job "
+                           f"(e.g. {example}; expected e.g. {sorted(listed)[0]}): frames of another job?"])
+    problems = [f"{job_dir / rel}: not a frame of this job (expected only the files job.json lists)"
+                for rel in sorted(found - listed)]
+    out = {}
+    for c in job["cases"]:
+        images = []
+        for rel in c["frames"]:
+            path = job_dir / rel
+            k = int(Path(rel).stem.split("_")[-1])
+            problem = file_problem(path)
+            if problem is not None:
+                problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
+                continue
+            try:
+                image = read_grey(path, c["width"], c["height"])
+                if keep:
+                    images.append((k, image))
+            except FrameProblem as exc:
+                problems.append(f"{path}: {exc}")
+            except Exception as exc:       # Pillow's many ways to say "not an image"
+                problems.append(f"{path}: unreadable as PNG ({type(exc).__name__}: {exc})")
+        out[(c["scene"], c["case"])] = images
+    if problems:
+        raise FramesError(problems)
+    return out
+
+
+def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``.
+
+    FramesError (file:line) for a record that is not as export writes it: 3
+    finite coordinates, 2 indices of vertices before it.
+    """
+    verts, edges = [], []
+    problem = file_problem(path)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem}: expected the OBJ 'crosscheck export' wrote"])
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise FramesError([f"{path}: unreadable ({exc}): expected the OBJ 'crosscheck export' wrote"]) from None
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        parts = line.split()
+        try:
+            if parts and parts[0] == "v":
+                verts.append([float(x) for x in parts[1:]])
+                if len(parts) != 4 or not np.all(np.isfinite(verts[-1])):
+                    raise ValueError
+            elif parts and parts[0] == "l":
+                edges.append([int(x) - 1 for x in parts[1:]])
+                if len(parts) != 3 or not all(0 <= i < len(verts) for i in edges[-1]):
+                    raise ValueError
+        except ValueError:
+            raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
+                               f"(1..{len(verts)}), as 'crosscheck export' wrote"]) from None
+    return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
+
+
+def _frame_camera(path: Path, cache: dict | None = None):
+    """``(camera, model_matrix (4, 4))`` of a frame's JSON; FramesError naming the file otherwise.
+
+    ``cache``: the last camera made, by its JSON fields; the same fields give
+    the same Camera object back (a case's camera is fixed: converted once by
+    oracles.references.opencv_oracle, which keeps the last camera by identity).
+    """
+    from wirecheck.core.camera import Camera
+
+    problem = file_problem(path)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])
+    try:
+        cam_json = read_json(path)
+        if cache is not None and cache.get("camera_json") == cam_json["camera"]:
+            camera = cache["camera"]
+        else:
+            camera = Camera(**cam_json["camera"])
+            if cache is not None:
+                cache.update(camera_json=cam_json["camera"], camera=camera)
+        m = np.asarray(cam_json["model_matrix"], dtype=np.float64)
+        if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+            raise ValueError(f"model_matrix of shape {m.shape}: expected 4x4 finite numbers")
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, OverflowError, RecursionError) as exc:
+        what = f"no {exc}" if isinstance(exc, KeyError) else str(exc)
+        raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {what}): expected the camera JSON "
+                           "'crosscheck export' wrote"]) from None
+    return camera, m
+
+
+def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache: dict | None = None):
+    """``(p_model (N, 3), edges (E, 2), camera, model_matrix (4, 4))`` of one frame, from the job's files.
+
+    ``cache``: a dict kept by the caller over one case's frames: the scene's
+    OBJ (model space) is then read once, and an unchanged camera made once.
+    """
+    job_dir = Path(job_dir)
+    row = next(s for s in job["scenes"] if s["name"] == scene)       # load_job checked it is there
+    obj = job_dir / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
+    if cache is not None and cache.get("obj") == obj:
+        p_model, edges = cache["mesh"]
+    else:
+        p_model, edges = read_obj(obj)
+        if cache is not None and row["space"] == "model":
+            cache.update(obj=obj, mesh=(p_model, edges))
+    if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
+        raise FramesError([f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
+                           f"{row['edges']} (job.json's; the file was changed or cut short)"])
+    path = job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}"
+    camera, m = _frame_camera(path, cache)
+    c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
+    if (camera.width, camera.height) != (c["width"], c["height"]):     # the frames were read at the job's size
+        size = f"{camera.width}x{camera.height}"
+        raise FramesError([f"{path}: camera {size[:40]}{'...' if len(size) > 40 else ''}: expected "
+                           f"{c['width']}x{c['height']} "
+                           f"(job.json's size of {scene} / {case}; export the job again)"])
+    return p_model, edges, camera, m
+
+
+def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
+    """One case, judged frame by frame: :func:`oracles.judge.frames_judge.judge_case`."""
+    from ..judge.frames_judge import judge_case as judge
+
+    return judge(job_dir, job, scene, case, oracles, tol, diagnose, line_rule)
+
+
+def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
+               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
+    """Judge the job's frames: :func:`oracles.judge.frames_judge.run_frames`."""
+    from ..judge.frames_judge import run_frames as run
+
+    return run(job_dir, tol, diagnose, name, allow_vacuous, line_rule)

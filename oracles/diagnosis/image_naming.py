@@ -1,0 +1,180 @@
+"""Naming a registered picture: from the fitted ``c = d (P o) + b`` to faults (oracles.diagnosis.image_diagnose).
+
+The registration (:mod:`oracles.diagnosis.image_diagnose`) fits every signed axis
+permutation ``P`` with per-axis scales ``d`` and an offset ``b``; this module
+reads the faults off the winner, and says what the images cannot decide:
+
+* **Ambiguity.** When a second permutation other than the identity fits
+  within :data:`oracles.diagnosis.image_diagnose.AMBIGUOUS_RATIO` of the best (a
+  horizontal mirror of a view that is also up-down symmetric: a cube
+  square-on, an orthographic view), the permutations they do not share are
+  reported as one ``ambiguous`` fault with ``alternatives`` (both names) and a
+  hint that gives both names' hints; the names they share (an ``axis_swap``
+  in both) are named as usual.
+* **Offset against the model's own lines.** A fitted offset is a fault only
+  when it differs from the offset the same fit finds for a correct drawing of
+  the *fitted model's* lines (the oracle's lines scaled and mirrored by ``d``
+  and ``P``; :func:`oracles.diagnosis.image_diagnose.quantisation_bias`): scaled lines
+  sit at other fractional pixel positions than the oracle's, with a
+  quantisation bias of their own (0.17 px measured on quarter-turn frames of a
+  0.75 FOV fault), which is no ``pixel_offset``.
+* **Confidence of each fault.** ``1 - cost / cost without it``: a permutation
+  (or ``ambiguous``) against the identity's fit, a scale against the unit scale
+  (``fov_mismatch``) or equal scales (``aspect_mismatch``), an offset against
+  the model's bias. It measures the named fault, not how far the mirror
+  alternatives are (0 on a symmetric picture whatever its fault).
+* **Scale starts.** Few frames of a large scale fault (fx x 16/9, K x 4/3) can
+  trap the fit from the unit and moment starts in a wrong affine map; when the
+  best fit is no member of the family, the identity and the best permutation
+  are fitted again from the scales a convention mistake gives
+  (:func:`scale_starts`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales"]
+
+#: Ratios a convention mistake scales an axis by: H/W and W/H (the aspect or FOV of the other axis),
+#: the common aspects 4/3 and 16/9 and their inverses, and 2 and 1/2 (a half-angle or a half-size).
+_RATIOS = (4 / 3, 3 / 4, 16 / 9, 9 / 16, 2.0, 0.5)
+
+
+def scale_starts(camera) -> list[np.ndarray]:
+    """``(2,)`` scale starts ``(d_x, d_y)``: each ratio on both axes, on x alone and on y alone."""
+    ratios = sorted(set(_RATIOS) | {camera.width / camera.height, camera.height / camera.width})
+    out = []
+    for r in ratios:
+        out += [np.array([r, r]), np.array([r, 1.0]), np.array([1.0, r])]
+    return out
+
+
+def _hint(name: str) -> str:
+    from ..reports.report import FAULT_HINTS
+
+    return FAULT_HINTS.get(name, "")
+
+
+def ambiguous_fault(names: tuple, other: tuple, **common) -> tuple[list[dict], dict]:
+    """``(shared faults, ambiguous fault)`` for two permutations' names that fit equally well."""
+    shared = [n for n in names if n in other]
+    alternatives = ["+".join(n for n in group if n not in shared) or "none" for group in (names, other)]
+    hints = "; ".join(f"if {alt}: {_hint(alt.split('+')[0])}" for alt in alternatives if alt != "none")
+    return ([{"name": n, **common} for n in shared],
+            {"name": "ambiguous", **common, "alternatives": alternatives,
+             "hint": f"the images fit {alternatives[0]} and {alternatives[1]} equally well (a symmetric view "
+                     f"cannot tell them apart): {hints}"})
+
+
+def _confidence(cost: float, without: float) -> float:
+    return float(max(0.0, 1.0 - cost / without)) if without > 0 else 0.0
+
+
+def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_tol, offset_tol, ratio,
+                residual) -> list[dict]:
+    """The faults of the winner of ``ranked`` (``[(cost, names, P, a, b)]``, best first; ``plain``: the
+    identity's fit), in the vocabulary of :func:`oracles.diagnosis.diagnose.scale_faults`.
+
+    ``reg``: the fine registration (its ``cost``), ``bias_fn``: ``quantisation_bias(segs, camera, p, d)``,
+    ``scale_tol``/``offset_tol``: the pixel tolerances of a scale and an offset, ``ratio``: the ambiguity
+    ratio, ``residual``: the winner's cost.
+    """
+    from .diagnose import FAULT_ORDER, scale_faults
+
+    cost, names, p, a, b = ranked[0]
+    d = np.diag(a)
+    cx, cy = camera.principal_point
+    faults: list[dict] = []
+    if names:
+        common = {"confidence": _confidence(cost, plain[0]), "residual_px": residual}
+        other = next((r for r in ranked[1:] if r[1] not in ((), names)), None)
+        if other is not None and other[0] <= cost * (1.0 + ratio):
+            shared, amb = ambiguous_fault(names, other[1], **common)
+            faults += shared + [amb]
+        else:
+            faults += [{"name": n, **common} for n in names]
+    scale = scale_faults(float(d[0]), float(d[1]), reach, scale_tol, camera, confidence=0.0, residual_px=residual)
+    for f in scale:
+        undo = np.eye(2) if f["name"] == "fov_mismatch" else np.diag([d[1], d[1]])
+        f["confidence"] = _confidence(cost, reg.cost(p, undo, b))
+        faults.append(f)
+    expected = np.zeros(2)
+    if "axis_swap" in names:
+        shift = cx - cy                               # as oracles.diagnosis.diagnose: a raw swap shifts by +-(cx - cy)
+        allowed = np.array([-shift, 0.0, shift])
+        expected = np.array([allowed[np.argmin(np.abs(allowed - b[i]))] for i in range(2)])
+    off = b - expected
+    bias = bias_fn(oracle_segs, camera, p, d)
+    if np.max(np.abs(off - bias)) > offset_tol:
+        faults.append({"name": "pixel_offset", "confidence": _confidence(cost, reg.cost(p, a, expected + bias)),
+                       "residual_px": residual, "dx": float(off[0]), "dy": float(off[1]),
+                       "uncertainty_px": float(np.max(np.abs(bias)))})
+    return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
+
+
+def rotation_deg(a_free: np.ndarray) -> float:
+    """The rotation part of a free affine map (y down), in degrees."""
+    return math.degrees(math.atan2(a_free[1, 0] - a_free[0, 1], a_free[0, 0] + a_free[1, 1]))
+
+
+def restart_scales(coarse, fine, ranked: list, camera) -> list:
+    """``ranked`` with the identity and the best permutation fitted again from :func:`scale_starts`."""
+    from .image_diagnose import PERMUTATIONS, SCREEN_ITERATIONS
+
+    screened = []
+    for names, p in {(): PERMUTATIONS[()], ranked[0][1]: ranked[0][2]}.items():
+        for d0 in scale_starts(camera):
+            a, b, c = coarse.fit(p, np.diag(d0), np.zeros(2), iterations=SCREEN_ITERATIONS)
+            screened.append((c, names, p, a, b))
+    best = {}
+    for c, names, p, a, b in sorted(screened, key=lambda r: r[0]):
+        best.setdefault(names, (c, names, p, a, b))
+    out = {r[1]: r for r in ranked}
+    for c, names, p, a, b in best.values():
+        a, b, c = fine.fit(p, a, b)
+        if c < out[names][0]:
+            out[names] = (c, names, p, a, b)
+    return sorted(out.values(), key=lambda r: r[0])
+
+
+def quantisation_bias(oracle_segs, camera, p=None, d=None) -> np.ndarray:
+    """The offset this fit finds for a *correct* aliased drawing of these lines: ``(2,)`` px.
+
+    With ``p`` and ``d`` (a signed axis permutation and per-axis scales), of
+    the lines mapped by ``u -> d (p u)`` about the principal point: the bias of
+    a fitted model's own lines (oracles.diagnosis.image_naming).
+
+    Pixel centres sit up to half a pixel from a line; over slanted lines at
+    every fractional position this averages out (< 0.05 px measured), but lines
+    that are all axis-aligned at one fractional position (a cube square-on,
+    nearly orthographic) are drawn half a pixel off in one direction, and no
+    image can tell that from an offset. The oracle's own lines drawn by core's
+    rasteriser (integer pixel centres, like GL's rule on these lines) give that
+    bias; an offset is a fault only when it differs from it.
+    """
+    from wirecheck.core.projector.clipping import clip_to_image
+    from wirecheck.core.projector.raster import line_pixels
+
+    from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
+
+    p = np.eye(2) if p is None else np.asarray(p, dtype=np.float64)
+    d = np.ones(2) if d is None else np.asarray(d, dtype=np.float64)
+    centre = np.array(camera.principal_point)
+    images = []
+    for segs in oracle_segs:
+        segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+        segs = ((segs - centre) @ p.T) * d + centre              # the model's lines (identity: the oracle's)
+        img = np.zeros((camera.height, camera.width), bool)
+        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+        rr, cc = line_pixels(q0, q1, camera.width, camera.height)
+        img[rr, cc] = True
+        images.append(img)
+    limit = _points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)    # as diagnose_images
+    reg = _Registration(_frames(images, oracle_segs, camera, limit), camera.width, camera.height, centre)
+    if not any(len(f.cand) for f in reg.frames):
+        return np.zeros(2)
+    _a, b, _cost = reg.fit(p, np.diag(d), np.zeros(2))
+    return b

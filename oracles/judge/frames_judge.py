@@ -1,0 +1,220 @@
+"""Judge a renderer's own frames (``crosscheck --candidate-frames DIR``), frame by frame, by the one judge.
+
+Each listed frame of a job (oracles.candidates.export, checked by
+oracles.candidates.frames_candidate) is read (:func:`candidate_pixels`: the one place
+where a frame's file becomes the bool image of drawn pixels that is judged),
+drawn by pyrender from the job's own files (OBJ vertices, the frame's camera
+and model matrix: the oracle the verdict rests on) and by core (a second
+opinion, reported, never deciding), and scored as the projector path scores
+its frames: edge-pixel F1 at 0 and 1 px (oracles.judge.metrics.pixel_scores), and
+the line scores against the oracle's segments (oracles.judge.metrics.line_scores:
+one-sided pixels and their balance, per-edge counts, where the one-sided
+pixels lie, sub-pixel ties), the segments known from the job's camera and
+scene (oracles.candidates.draw.oracle_segments). The case's faults are named from the
+images (oracles.diagnosis.image_diagnose); when those name nothing, from the lines
+(``line_end_bias``, ``line_pixel_bias``: oracles.judge.decide.line_faults). The
+verdict is oracles.judge.decide.decide's, at level ``frames`` (no vertex compared).
+
+Frames are streamed: a frame's images are dropped once it is scored, so
+memory does not grow with the job. What is kept per case: the worst frame's
+two images (for report.md's picture), at most :data:`DIAGNOSIS_FRAMES`
+frames' drawn pixels for the image diagnosis (evenly spaced over the case;
+its samples are capped per case anyway), and a per-frame record of numbers.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import metrics
+from ..references import opencv_oracle
+from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
+
+#: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
+#: The diagnosis samples at most 3,600 points a case (image_diagnose.MAX_POINTS_PER_CASE),
+#: 150 a frame at 24 frames: more frames would add few points each and cost memory.
+DIAGNOSIS_FRAMES = 24
+
+#: Per-frame fields of the line comparison, as the projector path's (oracles.judge.verdict.LINE_FRAME_KEYS).
+LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
+
+
+def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarray, frame: tuple) -> np.ndarray:
+    """The ``(H, W)`` bool image of the pixels a frame file draws: what the judge compares with the oracle's.
+
+    Every frame of the frames path goes through here, once: its grey levels
+    (oracles.candidates.png_frame.read_grey) are read by the case's line style
+    (oracles.judge.line_style.CaseStyle.frame: the style, line centres and ends
+    measured against ``frame`` = ``(p_model, edges, camera, model_matrix)``),
+    and the pixels compared are those drawn by the rule (coverage >= 128).
+    """
+    from ..candidates.png_frame import read_grey
+
+    return style.frame(read_grey(path, width, height), orac, *frame)
+
+
+def diagnosis_frames(n: int, limit: int = DIAGNOSIS_FRAMES) -> set:
+    """The indices (0-based, of a case's ``n`` frames) kept for the image diagnosis: all, or ``limit`` evenly spaced."""
+    if n <= limit:
+        return set(range(n))
+    return {int(i) for i in np.round(np.linspace(0, n - 1, limit))}
+
+
+class _CaseFrames:
+    """What a case's frames gathered, frame by frame (no image kept beyond :data:`DIAGNOSIS_FRAMES`)."""
+
+    def __init__(self):
+        self.pixel = {key: [] for key in metrics.PIXEL_SCORE_KEYS}
+        self.core_min = {}
+        self.per_frame, self.lines = [], []
+        self.batch = metrics.LineBatch()
+        self.drawn_px = 0
+        self.worst = None                  # ((f1_1px, f1_0px), frame, candidate, oracle)
+        self.diag = []                     # (KeptImage-like flat indices, shape, segments, flipped)
+
+    def record_lines(self, scored: list) -> None:
+        for (k, frame_rec), ls in scored:
+            self.lines.append((k, ls))
+            frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
+
+
+def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
+    """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
+
+    ``line_rule``: ``"gl"`` holds aliased 1-px lines to GL's pixel rule,
+    ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
+    """
+    from .line_style import CaseStyle
+
+    from wirecheck.core.projector.pipeline import render_frame
+
+    from ..candidates.draw import oracle_segments as line_segments
+    from ..candidates.frames_candidate import frame_inputs
+    from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+
+    c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
+    numbers = [int(Path(rel).stem.split("_")[-1]) for rel in c["frames"]]
+    kept = diagnosis_frames(len(numbers)) if diagnose else set()
+    acc = _CaseFrames()
+    style = CaseStyle(line_rule)
+    camera, cache = None, {}
+    for i, (k, rel) in enumerate(zip(numbers, c["frames"])):
+        p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k, cache)
+        p_world = p_model @ m[:3, :3].T + m[:3, 3]
+        # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
+        seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
+        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
+        cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m))
+        core = render_frame(p_model, edges, camera, m).image >= 128
+        fp = metrics.FramePixels(cand, orac)
+        ps = metrics.pixel_scores(None, None, pixels=fp)
+        cs = metrics.pixel_scores(cand, core)
+        for key, values in acc.pixel.items():
+            values.append(ps[key])
+        for key in metrics.PIXEL_SCORE_KEYS:
+            acc.core_min[key] = min(acc.core_min.get(key, 1.0), float(cs[key]))
+        acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
+        frame_rec = {"frame": k, "f1_0px": ps["f1_0px"], "f1_1px": ps["f1_1px"],
+                     "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"],
+                     "candidate_pixels": ps["candidate_pixels"], "oracle_pixels": ps["oracle_pixels"]}
+        acc.per_frame.append(frame_rec)
+        acc.record_lines(acc.batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
+        key = (ps["f1_1px"], ps["f1_0px"])
+        if acc.worst is None or key < acc.worst[0]:
+            acc.worst = (key, k, cand.copy(), orac.copy())
+        if i in kept:
+            acc.diag.append((fp.cand_idx, cand.shape, oracle_segments(p_world, edges, camera),
+                             oracle_segments(p_world, edges, flipped_camera(camera))))
+        del cand, orac, core, fp
+    acc.record_lines(acc.batch.flush())
+    rec = case_record(job, scene, case, camera, acc, len(numbers))
+    faults = []
+    if diagnose:
+        faults = diagnose_images([_image(flat, shape) for flat, shape, _, _ in acc.diag],
+                                 [s for _, _, s, _ in acc.diag], camera, [f for _, _, _, f in acc.diag])
+    rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
+    # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
+    style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol))
+    rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
+    decide(rec, tol, level="frames")
+    rec["per_frame"] = acc.per_frame
+    return rec, {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
+
+
+def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:
+    out = np.zeros(shape[0] * shape[1], bool)
+    out[flat] = True
+    return out.reshape(shape)
+
+
+def case_record(job: dict, scene: str, case: str, camera, acc: _CaseFrames, checked: int) -> dict:
+    """A case's fields (before faults and verdict) from its frames' scores."""
+    rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
+           "frames_checked": checked, "max_vertex_error_px": None}
+    rec.update(pixel_fields(acc.pixel, acc.worst[1]))
+    rec["core"] = {f"{k}": acc.core_min[k] for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
+                                                        "precision_1px", "recall_1px")}
+    rec["lines"] = metrics.line_summary(acc.lines)
+    return rec
+
+
+def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
+               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
+    """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
+
+    Every listed frame is checked first (oracles.candidates.frames_candidate.check_frames:
+    FramesError, exit 2, listing every frame that is missing, of the wrong
+    size, unreadable or not this job's), then the cases are judged one frame
+    at a time. A case where neither side drew a pixel is ``"vacuous"`` and
+    fails the run unless ``allow_vacuous`` (as :mod:`oracles.judge.gate`).
+    """
+    from ..candidates.frames_candidate import check_frames, load_job
+    from ..references.pyrender_oracle import OracleCache
+    from .tolerances import Tolerances
+
+    tol = tol or Tolerances()
+    t0 = time.perf_counter()
+    job = load_job(job_dir)
+    check_frames(job_dir, job)
+    oracles = OracleCache()
+    records, images = [], {}
+    try:
+        for c in job["cases"]:
+            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], oracles, tol, diagnose=diagnose,
+                                    line_rule=line_rule)
+            records.append(rec)
+            images[(c["scene"], c["case"])] = worst
+        gl = oracles.gl_info()
+    finally:
+        oracles.close()
+    failed = sum(r["verdict"] == "fail" for r in records)
+    vacuous = sum(r["verdict"] == "vacuous" for r in records)
+    compared = {"cases": sum(r["verdict"] != "vacuous" for r in records),
+                "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
+                "pixels": sum(r["compared"]["pixels"] for r in records)}
+    bad = failed or not compared["frames"] or (not allow_vacuous and (vacuous or not compared["pixels"]))
+    tolerances = tol.to_dict()
+    del tolerances["candidate_precision"]                 # no vertex is compared: no precision judged
+    report = {
+        "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",
+        "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
+        "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
+        "oracle_gl": gl,
+        "frames": job["frames"], "every": job["every"], "frames_checked": len(job["frame_numbers"]),
+        "motion": job["motion"],
+        "tolerances": tolerances,
+        "allow_vacuous": allow_vacuous, "line_rule": line_rule, "compared": compared,
+        "summary": {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
+                    "vacuous": vacuous,
+                    "max_vertex_error_px": None,
+                    "min_pixel_f1_0px": min(r["pixel_f1_0px"] for r in records),
+                    "min_pixel_f1_1px": min(r["pixel_f1_1px"] for r in records),
+                    "min_core_f1_0px": min(r["core"]["f1_0px"] for r in records),
+                    "min_core_f1_1px": min(r["core"]["f1_1px"] for r in records)},
+        "cases": records,
+        "timing": {"wall_s": time.perf_counter() - t0},
+    }
+    return report, images

@@ -1,0 +1,560 @@
+"""A renderer's line style, read from its frames, and its lines' geometry measured from the image.
+
+The frames path (:mod:`oracles.candidates.frames_candidate`) compares a renderer's
+frames with pyrender's by edge-pixel F1 at 0 and 1 px. F1@0px holds a
+renderer to GL's pixel rule, which only a 1-px aliased line can follow: a
+correct renderer that antialiases, draws wider lines, or follows another
+aliased rule (Pillow's, TinyGL's) fails it with nothing wrong in its
+geometry. This module reads what the frames hold and judges the geometry to
+the same standard whatever the style.
+
+Styles (:func:`classify`, from the images alone, pooled over a case's frames):
+
+- ``aliased``: binary pixels (one level), about one pixel across the line;
+- ``antialiased``: grey levels (coverage), about one pixel across;
+- ``wide``: :data:`WIDE_MIN_PX` or more across (binary or grey), up to ~3 px.
+
+The width is the median coverage across the line over the samples below (a
+1-px aliased line 0.71 to 1, a 1-px antialiased line 1, a 3-px line 3); with too
+few samples, the drawn coverage per unit length of the lines in the image.
+
+Geometry (:class:`CaseStyle`, :func:`measure`): each oracle segment
+(``p0_px``, ``p1_px``, :func:`oracles.diagnosis.image_diagnose.oracle_segments`, from the
+job's cameras) is sampled at every integer step of its major axis; at each
+step the intensity-weighted centroid of the image across the line (along the
+minor axis, :data:`PROFILE_RADIUS_PX` each side) is the line's centre there.
+Windows within :data:`GUARD_PX` of another segment or of the segment's own
+ends (junctions: another line's pixels pull the centroid) are dropped. The
+centroid's distance from the exact line, along the line's normal, is the
+sample's offset. Pooled over every sample of a case's frames:
+
+- ``offset_px``: the least-squares ``(dx, dy)`` of ``n . (dx, dy) = offset``;
+- ``warp_px``: how much more an affine map (a scale, rotation or shear about
+  the principal point) moves the lines, along their normals, than that
+  offset (the 99th percentile over the samples, :meth:`CaseStyle.geometry`).
+
+For binary styles the same measure on a correct drawing of the same lines
+(core's GL-like raster for aliased lines; pixel centres within half the width
+for wide ones) is subtracted: lines at one fractional position (a cube
+square-on) sit up to half a pixel off in every correct drawing, as in
+:func:`oracles.diagnosis.image_diagnose.quantisation_bias`. Lines that the registration
+finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
+the windows, are not measured (the centroids would be of stray crossings).
+
+Ends (:func:`oracles.judge.free_ends.measure_ends`): each free end's coverage along its line, where it
+falls to half the line's width; the median over a case's free ends is judged
+(:data:`oracles.judge.free_ends.END_TOL_PX`, past the cap of half the width a renderer may draw).
+
+Raster rule (aliased lines): the pixels where the candidate and pyrender
+differ are counted; one with a pixel of the other side among its 8 neighbours
+is "off by one", at an end when within :data:`END_RADIUS_PX` of a segment end,
+across the line otherwise.
+
+The verdict (:meth:`CaseStyle.judge`):
+
+- ``aliased`` with ``line_rule="gl"`` (default): F1@0px holds, as before.
+  When F1@0px alone fails, the lines are measured in place (offset within
+  :data:`RULE_OFFSET_MAX_PX`, no warp) and every differing pixel is off by
+  one, the fault is ``raster_rule`` (the shares across the line and at the
+  ends), never ``unexplained``.
+- ``antialiased`` and ``wide``, or any style with ``line_rule="geometry"``:
+  F1@0px is reported, not judged (an antialiased or wide image cannot be held
+  to GL's pixel rule); the geometry is judged instead: an offset beyond
+  :data:`oracles.diagnosis.image_diagnose.OFFSET_TOL_PX` (aliased lines of another rule:
+  :data:`RULE_OFFSET_MAX_PX`) fails as ``pixel_offset`` with the measured
+  ``dx, dy``, a warp beyond :data:`oracles.diagnosis.image_diagnose.SCALE_TOL_PX` (binary
+  lines: half a pixel more) fails too, and so do ends that stop short or run
+  on (``line_end_bias``); the registration's offset and scale faults give way
+  to the measure's. F1@1px holds for every style.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+STYLES = ("aliased", "antialiased", "wide")
+LINE_RULES = ("gl", "geometry")
+
+#: Half the window across a line in which its centroid is taken (px): a 3-px line's half width
+#: (1.5) plus an antialiased fringe (1) plus a pixel of slack for a half-pixel offset.
+PROFILE_RADIUS_PX = 3
+#: A sample is dropped when another segment, or its own segment's end, is this close (px):
+#: the window plus half a pixel, so no other line's pixel enters it.
+GUARD_PX = PROFILE_RADIUS_PX + 1.5
+#: A differing pixel this close to a segment end (px) is counted "at the end".
+END_RADIUS_PX = 1.5
+#: Coverage per unit length from which a line is ``wide``: a 1-px aliased line has at most
+#: sqrt(2) = 1.41 pixels per unit length (diagonal), a 2-px line 2.
+WIDE_MIN_PX = 1.75
+#: A case is binary (aliased) when at most this share of its drawn pixels is an intermediate
+#: grey (between 1/8 and 7/8 of the line's level): antialiased lines have a third or more
+#: (measured: 4x4 supersampled 1-px lines 0.6-0.8).
+GREY_SHARE_MAX = 0.05
+#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it.
+LEVEL_SHARE_MIN = 0.002
+#: The line's level: this percentile of the drawn pixels' values (robust to a few bright
+#: crossings of antialiased lines).
+LEVEL_PERCENTILE = 99
+#: A sample's window must hold this much coverage (in units of a fully covered pixel) to be a
+#: sample of the line: half a pixel's worth, so a missing line is no sample (F1 fails on it).
+MIN_MASS = 0.5
+#: Samples a case keeps per frame (evenly thinned above): thousands of samples pin the pooled
+#: offset far below 0.05 px, and the measure costs about the same whatever the mesh.
+MAX_SAMPLES_PER_FRAME = 4000
+#: ... and per case: past it every frame's samples are halved, so a case's memory stays bounded
+#: whatever its number of frames (the offset is a mean over tens of thousands of samples either way).
+MAX_SAMPLES_PER_CASE = 48_000
+#: Fewer samples than this in a case: the geometry is not measured (too little free line).
+MIN_SAMPLES = 20
+#: The geometry is measured only where at least this share of the windows along the oracle's lines
+#: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
+MIN_FOUND_SHARE = 0.5
+#: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
+#: Line faults named from the one-sided pixel counts (oracles.diagnosis.diagnose.diagnose_lines): GL's rule.
+COUNT_FAULTS = ("line_end_bias", "line_pixel_bias")
+PLACEMENT_FAULTS = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal", "mirror_vertical")
+#: Aliased lines of another rule: the largest pooled centre offset (px) that is still "the geometry is
+#: right". A rule that snaps the ends to pixel centres (Pillow's ImageDraw.line, TinyGL) moves each line
+#: by up to half a pixel; pooled over a case's lines measured 0.00-0.27 px on the bundled scenes and
+#: cases (Pillow), where a half-pixel offset measures 0.50. So an aliased image of another rule cannot
+#: show an offset below this; the registration's pixel_offset (image_diagnose) is kept above it.
+RULE_OFFSET_MAX_PX = 0.35
+
+CAN_SHOW = {
+    "aliased": "every pixel: the line rule (GL's or another), the geometry to the pixel, "
+               "pixel offsets pooled over the lines",
+    "antialiased": "each line's centre to a fraction of a pixel (the coverage centroid): offsets, scale, "
+                   "missing or extra lines, where free ends stop",
+    "wide": "each line's centre to a fraction of a pixel (the centroid across the line): offsets, scale, "
+            "missing or extra lines, where free ends stop (beyond the cap)",
+}
+CANNOT_SHOW = {
+    "aliased": "nothing the other styles show",
+    "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, "
+                   "not judged; an end where lines meet",
+    "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other "
+            "line's width covers it)",
+}
+
+
+def _segments(p_model, edges, camera, m) -> np.ndarray:
+    from ..diagnosis.image_diagnose import oracle_segments
+
+    p_world = np.asarray(p_model, dtype=np.float64) @ m[:3, :3].T + m[:3, 3]
+    return oracle_segments(p_world, edges, camera)
+
+
+def _seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)``."""
+    ab = b - a
+    len2 = np.maximum((ab * ab).sum(axis=1), 1e-300)
+    t = np.clip(((q[:, None, :] - a[None]) * ab[None]).sum(axis=2) / len2, 0.0, 1.0)
+    foot = a[None] + t[..., None] * ab[None]
+    return np.hypot(*(foot - q[:, None, :]).transpose(2, 0, 1))
+
+
+def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME) -> dict:
+    """The centroid samples of one frame (module docstring), as a dict of arrays of ``M`` samples.
+
+    ``cov``: ``(H, W)`` float coverage (0 background, 1 a fully drawn pixel);
+    ``segs``: ``(K, 2, 2)`` the oracle's segments in pixels. ``offset`` is the
+    measured centre minus the exact line along the unit ``normal``, at
+    ``point`` on the exact line; ``width`` the coverage across the line there
+    (px, perpendicular to the line); ``segment`` its segment. ``windows``: the
+    windows looked at (clear of junctions); ``found``: those that held a line
+    (``M`` of them kept, at most ``limit``).
+    """
+    h, w = cov.shape
+    r = PROFILE_RADIUS_PX
+    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+    parts = []
+    for i, (a, b) in enumerate(segs):
+        d = b - a
+        length = float(np.hypot(*d))
+        if length < 2 * GUARD_PX + 1:
+            continue
+        major = 0 if abs(d[0]) >= abs(d[1]) else 1
+        lo, hi = sorted((a[major], b[major]))
+        guard = GUARD_PX * abs(d[major]) / length            # GUARD_PX along the line, on the major axis
+        extent = w if major == 0 else h
+        pos = np.arange(max(np.ceil(lo + guard), 0), min(np.floor(hi - guard), extent - 1) + 1)
+        minor_exact = a[1 - major] + (pos - a[major]) * d[1 - major] / d[major]
+        centre = np.rint(minor_exact)
+        inside = (centre - r >= 0) & (centre + r <= (h if major == 0 else w) - 1)
+        pos, minor_exact, centre = pos[inside], minor_exact[inside], centre[inside]
+        if len(pos) == 0:
+            continue
+        win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
+        cols = np.broadcast_to(pos[:, None], win.shape)
+        rows_i, cols_i = (win, cols) if major == 0 else (cols, win)
+        g = cov[rows_i.astype(np.intp), cols_i.astype(np.intp)]
+        mass = g.sum(axis=1)
+        centroid = (g * win).sum(axis=1) / np.maximum(mass, 1e-300)
+        unit = d / length
+        normal = np.array([-unit[1], unit[0]])
+        pt = np.empty((len(pos), 2))
+        pt[:, major], pt[:, 1 - major] = pos, minor_exact
+        # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
+        parts.append({"normal": np.repeat(normal[None], len(pos), axis=0),
+                      "offset": (centroid - minor_exact) * normal[1 - major],
+                      "width": mass * abs(normal[1 - major]),          # a column crosses the line at 1 / |n_minor|
+                      "segment": np.full(len(pos), i), "point": pt, "mass": mass})
+    keys = ("normal", "offset", "width", "segment", "point", "mass")
+    if not parts:
+        out = {k: np.zeros((0, 2)) if k in ("normal", "point") else np.zeros(0) for k in keys}
+        out["windows"] = out["found"] = 0
+        return out
+    out = {k: np.concatenate([p[k] for p in parts]) for k in keys}
+    if len(segs) > 1:                                   # drop windows near another segment (a junction, a crossing)
+        keep = np.ones(len(out["point"]), bool)
+        for k in range(0, len(keep), 2048):
+            dist = _seg_distance(out["point"][k:k + 2048], segs[:, 0], segs[:, 1])
+            dist[np.arange(len(dist)), out["segment"][k:k + 2048].astype(np.intp)] = np.inf
+            keep[k:k + 2048] = dist.min(axis=1) > GUARD_PX
+        out = {k: v[keep] for k, v in out.items()}
+    windows = len(out["offset"])
+    # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
+    keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
+    out = {k: v[keep] for k, v in out.items()}
+    found = len(out["offset"])
+    if found > limit:
+        idx = np.linspace(0, found - 1, limit).round().astype(int)
+        out = {k: v[idx] for k, v in out.items()}
+    out["windows"], out["found"] = windows, found
+    return out
+
+
+def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre: np.ndarray):
+    """The map that moves the exact lines onto the measured centres: ``(d (2,), m (2, 2)) or None``.
+
+    Least squares of ``n . (d + m (p - centre)) = offset``: ``d`` the offset at
+    the principal point, ``m`` the scale, rotation and shear (``A - I``). None
+    when the samples cannot fix the six numbers (too few, or lines of too few
+    directions and places).
+    """
+    if len(offset) < MIN_SAMPLES:
+        return None
+    q = point - centre
+    design = np.column_stack([normal, normal[:, :1] * q, normal[:, 1:] * q])   # d_x, d_y, m_xx, m_xy, m_yx, m_yy
+    scale = np.maximum(np.abs(design).max(axis=0), 1e-12)
+    sv = np.linalg.svd(design / scale, compute_uv=False)
+    if sv[-1] < 1e-3 * sv[0]:
+        return None
+    x, *_ = np.linalg.lstsq(design / scale, offset, rcond=None)
+    x = x / scale
+    return x[:2], x[2:].reshape(2, 2)
+
+
+def pooled_offset(normal: np.ndarray, offset: np.ndarray):
+    """``(d (2,), determined (2,) bool)``: the least-squares ``d`` with ``n . d = offset``.
+
+    A component the normals do not constrain (every line parallel to it, e.g.
+    only horizontal lines say nothing of ``dx``) is 0 and not determined.
+    """
+    if len(offset) < MIN_SAMPLES:
+        return np.zeros(2), np.zeros(2, bool)
+    nn = normal.T @ normal
+    determined = np.diag(nn) >= 0.05 * len(offset)     # >= 5 % of the samples' weight on that axis
+    d = np.zeros(2)
+    idx = np.flatnonzero(determined)
+    if len(idx):
+        sol, *_ = np.linalg.lstsq(normal[:, idx], offset, rcond=None)
+        d[idx] = sol
+    return d, determined
+
+
+def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
+    """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width."""
+    from wirecheck.core.projector.clipping import clip_to_image
+    from wirecheck.core.projector.raster import line_pixels
+
+    h, w = shape
+    img = np.zeros(shape, bool)
+    if len(segs) == 0:
+        return img
+    if width_px < WIDE_MIN_PX:
+        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
+        rr, cc = line_pixels(q0, q1, w, h)
+        img[rr, cc] = True
+        return img
+    half = round(width_px) / 2.0
+    for a, b in segs:
+        lo = np.maximum(np.floor(np.minimum(a, b) - half), 0).astype(int)
+        hi = np.minimum(np.ceil(np.maximum(a, b) + half), [w - 1, h - 1]).astype(int)
+        if np.any(hi < lo):
+            continue
+        yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
+        q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
+        near = _seg_distance(q, a[None], b[None])[:, 0] <= half
+        img[yy.ravel()[near], xx.ravel()[near]] = True
+    return img
+
+
+def _off_by_one(cand: np.ndarray, orac: np.ndarray, ends: np.ndarray) -> dict:
+    """Pixels where ``cand`` and ``orac`` differ, counted by where they are (module docstring)."""
+    h, w = cand.shape
+    rr, cc = np.nonzero(cand != orac)
+    other = np.where(cand[rr, cc], 0, 1)                # 0: look in orac (an extra pixel), 1: in cand
+    pair = (orac, cand)
+    off1 = np.zeros(len(rr), bool)
+    for dy in (-1, 0, 1):                               # a pixel of the other side among the 8 neighbours
+        for dx in (-1, 0, 1):
+            if dx or dy:
+                y, x = np.clip(rr + dy, 0, h - 1), np.clip(cc + dx, 0, w - 1)
+                inside = (rr + dy == y) & (cc + dx == x)
+                for side in (0, 1):
+                    sel = inside & (other == side)
+                    off1[sel] |= pair[side][y[sel], x[sel]]
+    at_end = np.zeros(len(rr), bool)
+    if len(rr) and len(ends):
+        q = np.stack([cc, rr], axis=1).astype(float)
+        for k in range(0, len(q), 4096):
+            d = np.hypot(q[k:k + 4096, None, 0] - ends[None, :, 0], q[k:k + 4096, None, 1] - ends[None, :, 1])
+            at_end[k:k + 4096] = d.min(axis=1) <= END_RADIUS_PX
+    return {"oracle_pixels": int(orac.sum()), "differing": int(len(rr)),
+            "off_by_one_across": int((off1 & ~at_end).sum()), "off_by_one_at_ends": int((off1 & at_end).sum()),
+            "farther": int((~off1).sum())}
+
+
+def _halve(samples: dict) -> dict:
+    """Every other sample of a frame's :func:`measure` (its counts kept)."""
+    return {k: (v if np.ndim(v) == 0 else v[::2]) for k, v in samples.items()}
+
+
+class CaseStyle:
+    """One case's frames read for style and geometry, frame by frame; then the case judged.
+
+    ``frame`` is called once per frame with the candidate's grey image (it
+    returns the bool pixels the F1 scores compare: drawn where >= 128, the
+    rule of docs/frames.md); ``judge`` once, after the F1 reasons are known.
+    Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
+    """
+
+    def __init__(self, line_rule: str = "gl"):
+        if line_rule not in LINE_RULES:
+            raise ValueError(f"line rule {line_rule!r}: expected one of {', '.join(LINE_RULES)}")
+        self.line_rule = line_rule
+        self.hist = np.zeros(256, np.int64)
+        self.length_px = 0.0
+        self.samples = []                       # measure() of each frame
+        self.ends = []                          # measure_ends() of each frame
+        self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
+                       "farther": 0}
+        self.reference = []                     # measure() of a correct binary drawing of each binary frame
+        self.centre = np.zeros(2)
+
+    def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m) -> np.ndarray:
+        """Read one frame (``grey`` ``(H, W)`` uint8, ``orac`` pyrender's bool pixels); the pixels compared."""
+        from wirecheck.core.projector.clipping import clip_to_image
+
+        grey = np.asarray(grey)
+        cand = grey >= 128
+        if grey.dtype == bool:
+            grey = grey.astype(np.uint8) * 255
+        segs = _segments(p_model, edges, camera, m)
+        self.centre = np.array(camera.principal_point, dtype=float)
+        self.hist += np.bincount(grey.ravel(), minlength=256)[:256]
+        if len(segs):
+            _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+            self.length_px += float(np.hypot(*(q1 - q0).T).sum())
+        cov = grey / max(int(grey.max()), 1)                                   # the frame's line level is 1
+        from . import free_ends
+
+        got = measure(cov, segs)
+        self.samples.append(got)
+        self.ends.append(free_ends.measure_ends(cov, segs))
+        drawn = grey[grey > 0]
+        if len(drawn) and np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) <= GREY_SHARE_MAX:
+            width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
+            self.reference.append(measure(_reference(segs, grey.shape, width).astype(float), segs))
+        if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
+            self.samples = [_halve(x) for x in self.samples]
+            self.reference = [_halve(x) for x in self.reference]
+        counts = _off_by_one(cand, orac, segs.reshape(-1, 2))
+        self.raster = {k: v + counts[k] for k, v in self.raster.items()}
+        return cand
+
+    # ---- reading the case
+
+    def _pooled(self, key: str, samples=None) -> np.ndarray:
+        samples = self.samples if samples is None else samples
+        return np.concatenate([x[key] for x in samples]) if samples else np.zeros(0)
+
+    def classify(self) -> dict:
+        """``{"style", "width_px", "grey_share", "level"}`` from the pooled histogram and the samples' widths."""
+        drawn = self.hist[1:]
+        n = int(drawn.sum())
+        if n == 0:
+            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1}
+        cum = np.cumsum(drawn)
+        level = int(np.searchsorted(cum, LEVEL_PERCENTILE / 100.0 * n)) + 1
+        values = np.arange(1, 256)
+        grey = drawn[(values > level / 8.0) & (values < level * 7.0 / 8.0)].sum()
+        widths = self._pooled("width")
+        if len(widths) >= MIN_SAMPLES:          # across the free parts of the lines: no junction or crossing
+            width = float(np.median(widths))
+        else:                                   # too little free line: all coverage over the lines' length
+            coverage = float((np.minimum(values / level, 1.0) * drawn).sum())
+            width = coverage / self.length_px if self.length_px > 0 else 0.0
+        grey_share = float(grey) / n
+        style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
+        # coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's step on
+        # lines that all sit at one fractional position; that half step is added to the offset's tolerance
+        steps = max(int((drawn >= LEVEL_SHARE_MIN * n).sum()), 1)
+        return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level,
+                "coverage_steps": steps}
+
+    def _fit(self, samples):
+        """``(d (2,), affine)`` over ``samples``: ``d`` the pooled offset (:func:`pooled_offset`), ``affine``
+        the ``(d, m)`` of :func:`fit_lines` (None when not fixed); None with too few samples."""
+        normal, offset = self._pooled("normal", samples).reshape(-1, 2), self._pooled("offset", samples)
+        point = self._pooled("point", samples).reshape(-1, 2)
+        if len(offset) < MIN_SAMPLES:
+            return None
+        d, _ = pooled_offset(normal, offset)
+        return d, fit_lines(normal, offset, point, self.centre)
+
+    def geometry(self, read: dict) -> dict:
+        """Where the case's lines are against the oracle's (module docstring), less what a correct drawing shows.
+
+        ``offset_px``: the pooled offset. ``warp_px``: how far, along the lines' normals, a scale, rotation
+        or shear moves them beyond that offset: the 99th percentile over the samples of the affine fit's
+        value there less the offset's (fitted values, not the map's parameters: lines of few directions
+        fix the values where the lines are, not the map everywhere).
+        """
+        windows, found = sum(x["windows"] for x in self.samples), sum(x["found"] for x in self.samples)
+        n = len(self._pooled("offset"))
+        ends = np.concatenate(self.ends) if self.ends else np.zeros(0)
+        geo = {"samples": n, "windows": windows, "found_share": found / windows if windows else 0.0,
+               "offset_px": None, "bias_px": None, "warp_px": None, "ends_measured": int(len(ends)),
+               "end_px": float(np.median(ends)) if len(ends) else None}
+        fit = self._fit(self.samples)
+        if fit is None:
+            return geo
+        d, affine = fit
+        ref_d, ref_affine = np.zeros(2), None
+        if read["grey_share"] <= GREY_SHARE_MAX:        # binary: quantised; the same measure on a correct drawing
+            ref = self._fit(self.reference) if len(self.reference) == len(self.samples) else None
+            if ref is not None:
+                ref_d, ref_affine = ref
+        normal, point = self._pooled("normal").reshape(-1, 2), self._pooled("point").reshape(-1, 2)
+
+        def fitted(aff, const):
+            if aff is None:
+                return np.zeros(len(normal))
+            return (normal * (aff[0] + (point - self.centre) @ aff[1].T - const)).sum(axis=1)
+
+        warp = np.abs(fitted(affine, d) - fitted(ref_affine, ref_d))
+        geo.update(offset_px=[float(v) for v in d - ref_d], bias_px=[float(v) for v in ref_d],
+                   warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0)
+        return geo
+
+    def judge(self, rec: dict, reasons: list, tol, rule_reasons=None) -> list:
+        """The case's reasons with the style's judgement joined; ``rec`` gains ``line_style`` and faults.
+
+        ``reasons``: the case's reasons under every criterion (oracles.judge.decide.reasons);
+        ``rule_reasons``: those of GL's pixel rule (F1@0px, the balance, the per-edge
+        counts; default: the F1@0px ones). ``rec["line_style"]`` says whether the
+        pixel rule decides (``pixel_rule``) and the style's own failures
+        (``failures``), which oracles.judge.decide.decide then applies.
+        """
+        from ..diagnosis.diagnose import FAULT_ORDER
+        from ..diagnosis.image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX
+        from .free_ends import END_TOL_PX, MIN_ENDS
+
+        read = self.classify()
+        geo = self.geometry(read)
+        style = read["style"]
+        aliased = style == "aliased"
+        by_rule = aliased and self.line_rule == "gl"
+        binary = read["grey_share"] <= GREY_SHARE_MAX
+        tol_px = (RULE_OFFSET_MAX_PX if aliased else
+                  OFFSET_TOL_PX + (0.0 if binary else 0.5 / read["coverage_steps"]))
+        out = {**read, "line_rule": self.line_rule,
+               "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
+                            "the geometry (line centres); F1@0px is reported, not judged",
+               "can_show": CAN_SHOW[style], "cannot_show": CANNOT_SHOW[style], "offset_tol_px": tol_px,
+               "geometry": geo}
+        reasons = list(reasons)
+        faults = list(rec.get("faults") or [])
+        given = list(reasons)
+        f0 = [r for r in reasons if (r in rule_reasons if rule_reasons is not None else r.startswith("pixel F1@0px"))]
+        if not by_rule:
+            reasons = [r for r in reasons if r not in f0]
+            # the counts' line faults are GL's rule too: lines of another style are judged by their ends instead
+            faults = [f for f in faults if f["name"] not in COUNT_FAULTS or "measured_by" in f]
+        # lines mirrored or swapped, or mostly away from the oracle's, are not measured: a centroid of what
+        # lies near the oracle's lines would be of stray crossings; the registration's faults stand
+        placed = (geo["offset_px"] is not None and geo["found_share"] >= MIN_FOUND_SHARE
+                  and not any(f["name"] in PLACEMENT_FAULTS for f in faults))
+        d = np.array(geo["offset_px"]) if placed else np.zeros(2)
+        off = float(np.max(np.abs(d)))
+        moved = placed and off > tol_px
+        # binary lines are quantised line by line (up to half a pixel each, which the reference drawing
+        # matches only for its own rule): their warp is judged with that half pixel added
+        warp_tol = SCALE_TOL_PX + (0.5 if binary else 0.0)
+        out["warp_tol_px"] = warp_tol
+        warped = placed and geo["warp_px"] > warp_tol
+        if placed and not by_rule:
+            # the centres are finer than the registration over thick or other-rule pixels: its offset and
+            # scale faults give way to the measure's
+            faults = [f for f in faults if f["name"] not in ("pixel_offset", "fov_mismatch", "aspect_mismatch")
+                      or warped and f["name"] != "pixel_offset"]
+            if moved:
+                faults = [f for f in faults if f["name"] != "unexplained"]
+                faults.append({"name": "pixel_offset", "dx": float(d[0]), "dy": float(d[1]),
+                               "uncertainty_px": float(np.max(np.abs(geo["bias_px"]))), "confidence": 1.0,
+                               "residual_px": None, "measured_by": "line centroids"})
+                reasons.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {tol_px} "
+                               f"({style} lines, {geo['samples']} samples)")
+            end = geo["end_px"]
+            if geo["ends_measured"] >= MIN_ENDS and (end < -END_TOL_PX or end > read["width_px"] / 2 + END_TOL_PX):
+                short = end < 0
+                faults.append({"name": "line_end_bias", "end_px": end, "ends_measured": geo["ends_measured"],
+                               "confidence": 1.0, "residual_px": None, "measured_by": "line ends",
+                               "note": f"the lines {'stop' if short else 'run on'} {abs(end):.2f} px "
+                                       f"{'before' if short else 'past'} their ends (median of "
+                                       f"{geo['ends_measured']} free ends; a cap may add half the width)"})
+                reasons.append(f"line ends {end:+.2f} px from the segments' ends: expected "
+                               f"{-END_TOL_PX} to {read['width_px'] / 2 + END_TOL_PX:.2f} ({style} lines)")
+            if warped:
+                reasons.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
+                               f"or shear > {warp_tol} ({style} lines)")
+        rs = self.raster
+        if aliased and rs["differing"]:
+            out["raster_rule"] = {
+                "share_off_by_one_across": rs["off_by_one_across"] / max(rs["oracle_pixels"], 1),
+                "share_off_by_one_at_ends": rs["off_by_one_at_ends"] / max(rs["oracle_pixels"], 1),
+                "share_farther": rs["farther"] / max(rs["oracle_pixels"], 1)}
+        geometry_right = placed and not moved and not warped
+        if by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0 \
+                and any(r.startswith("pixel F1@0px") for r in f0) \
+                and all(f["name"] in ("unexplained", "pixel_offset", "line_pixel_bias") for f in faults):
+            faults = [f for f in faults if f["name"] not in ("unexplained", "pixel_offset", "line_pixel_bias")]
+            faults.append({"name": "raster_rule", **out["raster_rule"], "confidence": 1.0,
+                           "offset_px": [float(d[0]), float(d[1])], "residual_px": None,
+                           "note": f"the lines are where the oracle's are (centres within {off:.2f} px) but "
+                                   "their pixels follow another line rule than GL's: check the line "
+                                   "rasteriser (its rule across the line and at the ends), not the camera; "
+                                   "--line-rule geometry judges the geometry only"})
+        rec["faults"] = sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
+        out.update(pixel_rule=by_rule, failures=[r for r in reasons if r not in given])
+        rec["line_style"] = out
+        return reasons
+
+
+def summary_lines(cases: list) -> list[str]:
+    """One line per line style read in a run's cases (``line_style`` of each): the style, the cases
+    and widths, how they were judged and what the style cannot show. Empty when no case has one."""
+    by = {}
+    for c in cases:
+        ls = c.get("line_style")
+        if ls:
+            by.setdefault((ls["style"], ls["line_rule"]), []).append(ls)
+    out = []
+    for (style, rule), rows in sorted(by.items()):
+        widths = [r["width_px"] for r in rows]
+        out.append(f"Line style read: {style} ({len(rows)} case{'s' if len(rows) != 1 else ''}, "
+                   f"{min(widths):.2f}-{max(widths):.2f} px wide, --line-rule {rule}): judged by "
+                   f"{rows[0]['judged_by']}; cannot show {CANNOT_SHOW[style]}")
+    return out

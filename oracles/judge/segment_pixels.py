@@ -1,0 +1,477 @@
+"""Which oracle segment each pixel near the lines belongs to: the pairing behind the line gate's edge counts.
+
+A pixel (flat index ``y W + x``, pixel centres on integers, core.conventions)
+belongs to segment ``e`` (``p0_px[e] -> p1_px[e]``, NaN rows skipped) when
+its centre is within ``radius`` (Euclidean) of the segment and no other
+segment is nearer (ties: the lower index), so each pixel belongs to one
+segment at most. Every pixel a 1-px line rasterizer draws for a segment lies
+within ``sqrt(2)/2`` of it (within 1/2 of the line across the major axis,
+within 1/2 beyond an end along it), so ``radius = 1`` holds all of a line's
+pixels, from either renderer.
+
+The rows come back as three ``(K,)`` int64 arrays ``(edge, pixel, major)``,
+one row per pixel, ascending by pixel; ``major`` is the pixel's coordinate
+along its segment's major axis (x when ``|dx| > |dy|``, else y).
+
+Given the drawn pixels (the usual case), pairs are found row by row: the
+pixels are sorted row-major, so the ones of one row between two columns are
+one slice of them. For each row a segment's grown box spans, the slice runs
+over the columns its part near that row reaches; each pair found is
+measured. For a few pixels, a grid of cells lists the segments near each
+cell instead. The frames of a case are done in one pass: they are stacked
+one above the other, and a segment looks only at its own frame's rows, so no
+pair mixes two frames and each frame's rows are the ones it would get alone;
+distances are measured in the frame's own coordinates, so they are the same
+floats too.
+
+The line gate's counts (:func:`frames_count_differences`) and ends
+(:func:`nearest_segments`) use this pairing; :func:`edge_neighbourhoods`
+gives the rows themselves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_EMPTY = np.zeros(0, dtype=np.int64)
+
+#: :func:`frames_count_differences` counts every drawn pixel at once when the frames hold more than
+#: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
+#: looking at midpoints and one-sided pixels first would pair most pixels several times over).
+DENSE = 8
+
+
+def clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
+    d = p1 - p0
+    # the four boundaries at once: p t <= q for (x >= lo_x, y >= lo_y, x <= hi_x, y <= hi_y)
+    p = np.concatenate([-d, d], axis=1)
+    q = np.concatenate([p0 - lo, hi - p0], axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = q / p
+        keep = np.isfinite(p0 + p1).all(axis=1) & ~((p == 0) & (q < 0)).any(axis=1)
+        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))     # entering: the last boundary
+        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))      # leaving: the first
+    keep &= t0 <= t1
+    return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d
+
+
+def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
+                        radius: float = 1.0, mask: np.ndarray | None = None,
+                        pixels: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pixels near each segment: ``(edge, pixel, major)`` (module docstring).
+
+    ``mask`` ((H, W) bool, optional) keeps only the pixels where it is True
+    (the drawn ones): each pixel's nearest segment is decided among the same
+    segments, so the kept pixels' rows are the same as without it, for a
+    fraction of the work. ``pixels`` (ascending flat indices) is the same as a
+    mask True at those pixels only. Without either, every pixel of the image
+    is a candidate (found from the segments: the ``(2 reach + 1)^2`` pixels
+    around each 1-px step along them).
+    """
+    if pixels is None and mask is not None:
+        pixels = np.flatnonzero(np.asarray(mask, bool))
+    if pixels is not None:
+        return frames_neighbourhoods([(p0_px, p1_px, pixels)], width, height, radius)[0]
+    return _from_segments(p0_px, p1_px, width, height, radius)
+
+
+def frames_neighbourhoods(frames, width: int, height: int, radius: float = 1.0) -> list[tuple]:
+    """:func:`edge_neighbourhoods` of several frames of one size, in one pass (module docstring).
+
+    Parameters
+    ----------
+    frames : sequence of (p0_px (E, 2), p1_px (E, 2), pixels (P,))
+        Each frame's segments and its drawn pixels (ascending flat indices).
+    width, height : int
+    radius : float
+
+    Returns
+    -------
+    list of (edge, pixel, major), one per frame, each three (K,) int64 arrays.
+    """
+    if not frames:
+        return []
+    segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius)
+    px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
+    sid, pos = segs.owners(px, *segs.pairs(px))
+    edge, local, major = segs.rows(px, sid, pos)
+    cut = np.searchsorted(pos, np.cumsum(px.counts)[:-1])      # the frames' rows, split
+    return list(zip(np.split(edge, cut), np.split(local, cut), np.split(major, cut)))
+
+
+def frames_count_differences(frames, width: int, height: int, radius: float = 1.0) -> list[tuple]:
+    """Per-edge count differences of several frames, looking only where they can differ.
+
+    An edge's count (oracles.judge.metrics.edge_counts) is the number of distinct
+    major-axis coordinates among the drawn pixels it owns (module docstring).
+    Owning is a property of the pixel and the segments alone, so:
+
+    - an edge that owns no one-sided pixel owns the same pixels in both
+      images, and its counts are equal: only the owners of one-sided pixels
+      are counted, from the drawn pixels near them;
+    - an edge is *compared* (counted in either image) when it owns some
+      drawn pixel: most do at the pixel nearest their midpoint, and only the
+      rest are looked for among the drawn pixels near them.
+
+    The results equal the full count over every drawn pixel
+    (:func:`frames_neighbourhoods` and oracles.judge.metrics.edge_counts), for a
+    fraction of the work when the frames mostly agree.
+
+    Parameters
+    ----------
+    frames : sequence of (p0_px (E, 2), p1_px (E, 2), pixels)
+        Each frame's segments and its two images' drawn pixels
+        (oracles.judge.metrics.FramePixels: ``cand_idx``, ``oracle_idx``, ``drawn()``, ``only()``).
+
+    Returns
+    -------
+    list of (diff (E,) int64, compared int), one per frame: candidate count
+    minus oracle count per edge, and how many edges either image counts.
+    """
+    if not frames:
+        return []
+    segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius)
+    cand = _Pixels.of_frames([fp.cand_idx for _, _, fp in frames], width, height)
+    orac = _Pixels.of_frames([fp.oracle_idx for _, _, fp in frames], width, height)
+    drawn = _Pixels.of_frames([fp.drawn() for _, _, fp in frames], width, height)
+    one_sided = _Pixels.of_frames([np.sort(np.concatenate(fp.only())) for _, _, fp in frames], width, height)
+    first_edge = np.cumsum(segs.counts) - segs.counts          # frame k's edges in one flat array of all
+    diff_all = np.zeros(int(segs.counts.sum()), np.int64)
+    compared = np.zeros(len(segs), bool)
+    if len(segs) and len(drawn):
+        if len(segs) * DENSE > len(drawn):          # a dense mesh: one pass over every drawn pixel is cheaper
+            owners = np.arange(len(segs))
+            cc, oc = _counts_near(segs, cand, orac, drawn, every=True)
+            compared = (cc > 0) | (oc > 0)
+        else:
+            compared = _compared(segs, drawn)
+            owners = _unique(segs.owners(one_sided, *segs.pairs_any(one_sided))[0])
+            cc = oc = np.zeros(len(segs), np.int64)
+            if len(owners):
+                cc, oc = _counts_near(segs, cand, orac, drawn.subset(_unique(segs.pairs(drawn, owners)[1])))
+        diff_all[first_edge[segs.frame[owners]] + segs.edge[owners]] = (cc - oc)[owners]
+    n_compared = np.bincount(segs.frame[compared], minlength=len(frames))
+    return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
+
+
+def _compared(segs: "_Segments", drawn: "_Pixels") -> np.ndarray:
+    """``(S,)`` bool: whether each segment owns a drawn pixel (the pixel at its midpoint, or another near it)."""
+    w, h = segs.width, segs.height
+    mid = np.floor((segs.q0 + segs.q1) / 2 + 0.5).astype(np.int64)
+    on = (mid[:, 0] >= 0) & (mid[:, 0] < w) & (mid[:, 1] >= 0) & (mid[:, 1] < h)
+    mid_stacked = np.where(on, (mid[:, 1] + segs.frame * h) * w + mid[:, 0], -1)
+    on &= drawn.has(mid_stacked)
+    mids = drawn.subset(_unique(np.searchsorted(drawn.stacked, mid_stacked[on])))
+    m_sid, m_pos = segs.owners(mids, *segs.pairs_any(mids))
+    owner_at = np.full(len(mids), -1, np.int64)
+    owner_at[m_pos] = m_sid
+    seg_on = np.flatnonzero(on)
+    compared = np.zeros(len(segs), bool)
+    compared[seg_on] = owner_at[np.searchsorted(mids.stacked, mid_stacked[seg_on])] == seg_on
+    rest = np.flatnonzero(~compared)           # the others: the owners of the drawn pixels near them
+    if len(rest):
+        near = drawn.subset(_unique(segs.pairs(drawn, rest)[1]))
+        compared[_unique(segs.owners(near, *segs.pairs_any(near))[0])] = True
+    return compared
+
+
+def _counts_near(segs: "_Segments", cand: "_Pixels", orac: "_Pixels", near: "_Pixels", every: bool = False):
+    """``(cc, oc)``, ``(S,)`` each: every segment's count in the candidate's and the oracle's image, over
+    the drawn pixels ``near`` only (right for the segments all of whose pixels are among them);
+    ``every``: ``near`` is every drawn pixel (paired row by row)."""
+    sid, pos = segs.owners(near, *(segs.pairs(near) if every else segs.pairs_any(near)))
+    _, _, major = segs.rows(near, sid, pos)
+    in_cand, in_orac = cand.has(near.stacked[pos]), orac.has(near.stacked[pos])
+    return tuple(_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac))
+
+
+def _unique(a: np.ndarray) -> np.ndarray:
+    """The distinct values of an int array, ascending (a sort: numpy's hashed unique is slower on these sizes)."""
+    a = np.sort(a)
+    if len(a) > 1:
+        a = a[np.concatenate([[True], a[1:] != a[:-1]])]
+    return a
+
+
+def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int) -> np.ndarray:
+    """``(n_segments,)``: the number of distinct ``major`` values of each segment's rows."""
+    span = int(major.max()) + 1 if len(major) else 1
+    keys = _unique(sid * span + major)
+    return np.bincount(keys // span, minlength=n_segments)
+
+
+def nearest_segments(frames, width: int, height: int, radius: float, box: tuple):
+    """Each pixel's nearest segment within ``radius``, among its frame's segments clipped to ``box``.
+
+    Parameters
+    ----------
+    frames : sequence of (p0_px (E, 2), p1_px (E, 2), pixels (P,))
+        Each frame's segments in pixels (NaN rows skipped) and some of its
+        pixels (ascending flat indices ``y W + x``).
+    radius : float
+    box : ((x, y), (x, y))
+        The corners the segments are clipped to first.
+
+    Returns
+    -------
+    owner : (sum P,) int64
+        The pixels of all frames in order: index into ``q0, q1`` of each
+        one's nearest segment within ``radius`` (ties: the lower index), -1
+        where none is that near.
+    q0, q1 : (K, 2) float64
+        The kept segments of all frames, clipped, frame after frame.
+    frame : (sum P,) int64
+        Each pixel's frame.
+    """
+    segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius, box=box)
+    px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
+    owner = np.full(len(px), -1, np.int64)
+    sid, pos = segs.owners(px, *segs.pairs_any(px))
+    owner[pos] = sid
+    return owner, segs.q0, segs.q1, px.at()[0]
+
+
+class _Pixels:
+    """Pixels of several frames of one size, stacked: frame ``k``'s rows start at row ``k H``.
+
+    ``stacked``: flat indices in the stack, ascending (frame-major, then
+    row-major); ``counts``: pixels per frame, when built from frames.
+    """
+
+    def __init__(self, stacked: np.ndarray, width: int, height: int, counts: np.ndarray | None = None):
+        self.stacked, self.width, self.height, self.counts = stacked, width, height, counts
+
+    @classmethod
+    def of_frames(cls, per_frame, width: int, height: int) -> "_Pixels":
+        """From one ascending flat-index array per frame."""
+        per_frame = [np.asarray(p, np.int64).reshape(-1) for p in per_frame]
+        counts = np.array([len(p) for p in per_frame], np.int64)
+        if not per_frame:
+            return cls(_EMPTY, width, height, counts)
+        offset = np.repeat(np.arange(len(per_frame), dtype=np.int64) * (width * height), counts)
+        return cls(np.concatenate(per_frame) + offset, width, height, counts)
+
+    def __len__(self) -> int:
+        return len(self.stacked)
+
+    def at(self, pos=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(frame, y, x)`` of the pixels at positions ``pos`` (default all), in their frames' coordinates."""
+        s = self.stacked if pos is None else self.stacked[pos]
+        row = s // self.width
+        frame = row // self.height
+        return frame, row - frame * self.height, s - row * self.width
+
+    def has(self, stacked: np.ndarray) -> np.ndarray:
+        """Whether each stacked flat index is one of these pixels."""
+        stacked = np.asarray(stacked, np.int64)
+        if len(self.stacked) == 0:
+            return np.zeros(stacked.shape, bool)
+        at = np.minimum(np.searchsorted(self.stacked, stacked), len(self.stacked) - 1)
+        return self.stacked[at] == stacked
+
+    def subset(self, pos: np.ndarray) -> "_Pixels":
+        """The pixels at ascending positions ``pos``."""
+        return _Pixels(self.stacked[pos], self.width, self.height)
+
+
+class _Segments:
+    """Segments of several frames of one size, clipped to each frame's box grown by ``radius + 1``
+    (or to ``box``, ``(lo, hi)`` corners, when given)."""
+
+    def __init__(self, per_frame, width: int, height: int, radius: float, box: tuple | None = None):
+        self.width, self.height, self.radius = width, height, radius
+        pad = radius + 1.0
+        lo, hi = box if box is not None else ((-pad, -pad), (width - 1 + pad, height - 1 + pad))
+        self.grow = radius + 0.5            # each box is grown by a further 1/2 px, against rounding
+        p0 = [np.asarray(a, np.float64).reshape(-1, 2) for a, _ in per_frame]
+        p1 = [np.asarray(b, np.float64).reshape(-1, 2) for _, b in per_frame]
+        self.counts = np.array([len(a) for a in p0], np.int64)
+        frame = np.repeat(np.arange(len(p0)), self.counts)
+        edge = np.arange(int(self.counts.sum())) - np.repeat(np.cumsum(self.counts) - self.counts, self.counts)
+        p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
+        p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
+        keep, q0, q1 = clip_segments(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
+        self.q0, self.q1 = q0[keep], q1[keep]
+        self.frame, self.edge = frame[keep], edge[keep]
+        self.d = self.q1 - self.q0
+        self.dd = self.d[:, 0] * self.d[:, 0] + self.d[:, 1] * self.d[:, 1]
+        self._cells = None                       # the grid of pairs_any, made on first use
+        self._rows = None                        # _rows_spanned, counted on first use
+
+    def __len__(self) -> int:
+        return len(self.q0)
+
+    def pairs(self, px: _Pixels, which: np.ndarray | None = None):
+        """``(sid, pos, dist)``: each pair of a segment (of ``which``, default all) and a pixel within ``radius``.
+
+        Row by row (:meth:`_spans` of 1-row bands): the pixels of a row
+        between two columns are one slice of ``stacked``; each is measured.
+        """
+        if which is None:
+            which = np.arange(len(self))
+        if len(which) == 0 or len(px) == 0:
+            return _EMPTY, _EMPTY, np.zeros(0)
+        seg, row, col_lo, col_hi = self._spans(which, 1)
+        w, h = self.width, self.height
+        # the pixels of one row between two columns are one slice of ``stacked``
+        start = (row + self.frame[seg] * h) * w
+        a = np.searchsorted(px.stacked, start + col_lo)
+        n = np.maximum(np.searchsorted(px.stacked, start + col_hi + 1) - a, 0)
+        sid = np.repeat(seg, n)
+        pos = np.arange(int(n.sum())) + np.repeat(a - (np.cumsum(n) - n), n)
+        return self._near(px, sid, pos)
+
+    def pairs_any(self, px: _Pixels):
+        """:meth:`pairs` over all segments, for a subset of the pixels: each against every segment of its
+        frame when that is few pairs (and no grid is made yet), else through a grid of cells.
+
+        Each segment is listed in the square cells its part near each band of
+        cell rows reaches (as :meth:`pairs` does row by row); a pixel is
+        measured against the segments listed in its cell. Cost ~ pixels x
+        segments per cell, whatever the segments' total length. The cells'
+        side follows the segments' typical length (:meth:`_cell_side`), so a
+        dense mesh's many short segments are not listed together.
+        """
+        if len(px) == 0 or len(self) == 0:
+            return _EMPTY, _EMPTY, np.zeros(0)
+        frame = px.at()[0]
+        per_frame = np.bincount(self.frame, minlength=int(frame.max()) + 1)
+        n = per_frame[frame]                                 # each pixel against all of its frame's segments
+        if self._cells is None and int(n.sum()) <= 4 * (len(px) + len(self)):
+            first = np.cumsum(per_frame) - per_frame         # segments are in frame order
+            pos = np.repeat(np.arange(len(px)), n)
+            sid = np.arange(int(n.sum())) + np.repeat(first[frame] - (np.cumsum(n) - n), n)
+            return self._near(px, sid, pos)
+        keys, listed = self._cell_index()
+        _, y, x = px.at()
+        cell = self._cell
+        key = (frame * self._cells_y + y // cell) * self._cells_x + x // cell
+        a = np.searchsorted(keys, key, side="left")
+        n = np.searchsorted(keys, key, side="right") - a
+        if int(n.sum()) > 2 * (self._rows_spanned() + len(px)):     # crowded cells: row by row is cheaper
+            return self.pairs(px)
+        pos = np.repeat(np.arange(len(px)), n)
+        sid = listed[np.arange(int(n.sum())) + np.repeat(a - (np.cumsum(n) - n), n)]
+        return self._near(px, sid, pos)
+
+    def _cell_index(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(keys, sid)``, sorted by key: each segment once per cell it is listed in (:meth:`pairs_any`)."""
+        if self._cells is None:
+            cell = self._cell = self._cell_side()
+            self._cells_x, self._cells_y = -(-self.width // cell), -(-self.height // cell)
+            seg, band, col_lo, col_hi = self._spans(np.arange(len(self)), cell)
+            c0 = col_lo // cell
+            n = np.where(col_lo > col_hi, 0, col_hi // cell - c0 + 1)
+            sid = np.repeat(seg, n)
+            cx = np.repeat(c0, n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+            keys = (self.frame[sid] * self._cells_y + np.repeat(band, n)) * self._cells_x + cx
+            order = np.argsort(keys, kind="stable")
+            self._cells = (keys[order], sid[order])
+        return self._cells
+
+    def _rows_spanned(self) -> int:
+        """How many (segment, row) slices :meth:`pairs` takes over all segments."""
+        if self._rows is None:
+            lo = np.maximum(np.ceil(np.minimum(self.q0[:, 1], self.q1[:, 1]) - self.grow), 0)
+            hi = np.minimum(np.floor(np.maximum(self.q0[:, 1], self.q1[:, 1]) + self.grow), self.height - 1)
+            self._rows = int(np.maximum(hi - lo + 1, 0).sum())
+        return self._rows
+
+    def _cell_side(self) -> int:
+        """The grid's cell side (px): the segments' median length, a power of two in [4, 32].
+
+        A segment is listed in ~(length / side + 1) cells per band of cells it
+        crosses, and a cell holds ~(side / length + 1) segments of each line
+        through it: a side near the typical length keeps both near 1.
+        """
+        lengths = np.sort(np.abs(self.d).max(axis=1))
+        length = lengths[len(lengths) // 2] if len(lengths) else 16.0
+        return int(2 ** np.clip(np.round(np.log2(max(length, 1.0))), 2, 5))
+
+    def _spans(self, which: np.ndarray, band: int):
+        """``(seg, b, col_lo, col_hi)``: for each band of ``band`` rows a segment's grown box spans (rows
+        of the frame only), the columns its part within ``grow`` of the band reaches, grown, clipped to the
+        frame (a pixel centre within ``radius`` of the segment in those rows is in those columns: the
+        nearest point is within ``radius`` in y, so in that part, and within ``radius`` in x)."""
+        q0, q1, d, grow, w, h = self.q0, self.q1, self.d, self.grow, self.width, self.height
+        b_lo = np.maximum(np.ceil(np.minimum(q0[which, 1], q1[which, 1]) - grow), 0).astype(np.int64) // band
+        b_hi = np.minimum(np.floor(np.maximum(q0[which, 1], q1[which, 1]) + grow), h - 1).astype(np.int64) // band
+        n = np.maximum(b_hi - b_lo + 1, 0)
+        seg = np.repeat(which, n)
+        b = np.repeat(b_lo, n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        top, bottom = b * band - grow, b * band + (band - 1) + grow
+        dy = d[seg, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ta = np.where(dy != 0, (top - q0[seg, 1]) / dy, 0.0)
+            tb = np.where(dy != 0, (bottom - q0[seg, 1]) / dy, 1.0)
+        xa = q0[seg, 0] + np.clip(np.minimum(ta, tb), 0.0, 1.0) * d[seg, 0]
+        xb = q0[seg, 0] + np.clip(np.maximum(ta, tb), 0.0, 1.0) * d[seg, 0]
+        col_lo = np.maximum(np.ceil(np.minimum(xa, xb) - grow), 0).astype(np.int64)
+        col_hi = np.minimum(np.floor(np.maximum(xa, xb) + grow), w - 1).astype(np.int64)
+        return seg, b, col_lo, col_hi
+
+    def _near(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
+        """The pairs ``(sid, pos)`` within ``radius``, with their distances."""
+        q0, d = self.q0, self.d
+        # the point of the segment nearest the pixel centre: a + u d, u in [0, 1], in the frame's coordinates
+        _, y, x = px.at(pos)
+        ex, ey = x - q0[sid, 0], y - q0[sid, 1]
+        dx, dy, dd = d[sid, 0], d[sid, 1], self.dd[sid]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = np.clip(np.where(dd > 0, (ex * dx + ey * dy) / dd, 0.0), 0.0, 1.0)
+        dist = np.hypot(ex - u * dx, ey - u * dy)
+        near = dist <= self.radius
+        return sid[near], pos[near], dist[near]
+
+    def owners(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray, dist: np.ndarray):
+        """``(sid, pos)`` of :meth:`pairs` (over all segments), one per pixel, ascending by pixel.
+
+        Each pixel goes to its nearest segment only (ties: the lower index),
+        so that one pixel more or less changes one edge's count by at most one;
+        only pixels near several segments need the choice.
+        """
+        several = np.bincount(pos, minlength=len(px))[pos] > 1
+        if several.any():
+            multi = np.flatnonzero(several)
+            order = multi[np.lexsort((sid[multi], dist[multi], pos[multi]))]
+            first = np.ones(len(order), bool)
+            first[1:] = pos[order[1:]] != pos[order[:-1]]
+            chosen = np.concatenate([np.flatnonzero(~several), order[first]])
+            sid, pos = sid[chosen], pos[chosen]
+        # back in pixel order by placing each row at its pixel
+        slot = np.full(len(px), -1, np.int64)
+        slot[pos] = np.arange(len(pos))
+        rows = slot[slot >= 0]
+        return sid[rows], pos[rows]
+
+    def rows(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
+        """``(edge, pixel, major)`` of owner pairs (module docstring), pixels flat in their frames."""
+        x_major = np.abs(self.d[sid, 0]) > np.abs(self.d[sid, 1])
+        _, y, x = px.at(pos)
+        return self.edge[sid], y * self.width + x, np.where(x_major, x, y)
+
+
+def _from_segments(p0_px, p1_px, width: int, height: int, radius: float):
+    """:func:`edge_neighbourhoods` with every pixel a candidate: the pixels around 1-px steps along each segment."""
+    p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
+    p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
+    pad = radius + 1.0
+    keep, q0, q1 = clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
+    if not keep.any():
+        return _EMPTY, _EMPTY, _EMPTY
+    q0, q1 = q0[keep], q1[keep]
+    reach = int(np.ceil(radius)) + 1
+    # every pixel centre within ``radius`` of a segment is within ``reach`` (per
+    # axis) of the rounded point of some 1-px step along it
+    steps = np.ceil(np.max(np.abs(q1 - q0), axis=1)).astype(np.intp) + 1
+    seg = np.repeat(np.arange(len(q0)), steps)
+    t = (np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)) / np.maximum(steps - 1, 1)[seg]
+    pts = q0[seg] + t[:, None] * (q1 - q0)[seg]
+    offs = np.arange(-reach, reach + 1)
+    ox, oy = np.meshgrid(offs, offs)
+    cx = (np.round(pts[:, 0])[:, None] + ox.ravel()[None, :]).astype(np.int64).ravel()
+    cy = (np.round(pts[:, 1])[:, None] + oy.ravel()[None, :]).astype(np.int64).ravel()
+    inside = (cx >= 0) & (cx < width) & (cy >= 0) & (cy < height)
+    pixels = _unique(cy[inside] * width + cx[inside])     # every candidate pixel, once, ascending
+    return frames_neighbourhoods([(p0, p1, pixels)], width, height, radius)[0]

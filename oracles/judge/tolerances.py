@@ -1,0 +1,391 @@
+"""Every tolerance of crosscheck, in one place, each with the reason for its value.
+
+``--tol-px`` overrides VERTEX_TOL_PX, ``--min-f1`` MIN_F1_1PX and
+``--min-f1-0px`` MIN_F1_0PX; BALANCE_ALPHA, MAX_IMBALANCE_FRACTION and
+MAX_EDGE_COUNT_DIFF are fields of :class:`Tolerances` (below).
+"""
+
+from dataclasses import dataclass
+
+#: Max vertex error in pixels between the candidate and cv2.projectPoints, for
+#: a float64 candidate (the floor of every vertex bound, below). Both compute
+#: in float64: relative error ~ a few eps (2.2e-16) per operation, times ~20
+#: operations, times the pixel scale (|x_px| up to ~1e4 for the bundled
+#: cases) gives ~1e-11 px. 1e-6 px leaves five orders of margin for that and
+#: still catches any real convention error (the smallest, a half-pixel offset,
+#: is 0.5 px).
+VERTEX_TOL_PX = 1e-6
+
+# ---------------------------------------------------------------- the candidate's precision
+
+#: The precisions a candidate may compute in (declared with
+#: ``--candidate-precision``, or inferred from the dtype of what it returns).
+PRECISIONS = ("float32", "float64")
+
+#: Machine epsilon (the spacing of floats at 1.0) of each precision.
+EPS = {"float32": 2.0 ** -23, "float64": 2.0 ** -52}
+
+# A candidate that computes in float32 (glm, PyTorch3D, a GL shader) is off
+# from the float64 oracle by its own rounding, which 1e-6 px cannot absorb.
+# Its vertex bound is derived from its precision and the scale of the case.
+# For a point X seen by a camera at C with depth z, focal length f px (the
+# larger of fx, fy) and pixel p = (x, y), u = p - (cx, cy):
+#
+# - the world-to-camera transform R (X - C) (or V @ [X, 1]) rounds values of
+#   size |X| + |C|: an absolute error of a few eps (|X| + |C|) on each camera
+#   coordinate, whatever the order of the operations;
+# - the perspective divide turns an error dx in x_cam and dz in z into
+#   f (dx + |x_cam / z| dz) / z = (f + |u|) (|X| + |C|) eps / z pixels
+#   (|x_cam / z| f = |u|); orthographic: s (|X| + |C|) eps, s = px per unit;
+# - the viewport (x = (ndc + 1) W/2 - 0.5, or cx + f x/z) rounds values of
+#   size |x| + |y| and W + H: (|x| + |y| + W + H) eps.
+#
+# So each point's error is at most VERTEX_ROUNDINGS eps times its scale
+#
+#     scale = (f + |u_x| + |u_y|) (|X| + |C|) / z + |x| + |y| + W + H     (perspective)
+#     scale = s (|X| + |C|) + |x| + |y| + W + H                             (orthographic)
+#
+# and a float32 case's bound is VERTEX_ROUNDINGS eps32 max(scale) over its
+# visible points and frames (:func:`vertex_scale`, :func:`vertex_bound`), never
+# below VERTEX_TOL_PX (``--tol-px``). For float64 that product is ~1e-11 px on
+# the bundled cases, so VERTEX_TOL_PX (1e-6) is the bound; for float32 it is ~1e-3 px,
+# still three orders below the smallest convention error (0.5 px).
+#
+# Measured (benchmarks/measure_precision.py: five float32 projectors -- two
+# glm-style GL pipelines, DirectXMath's left-handed one, core --dtype float32,
+# an OpenCV-style K [R|t] -- on the bundled scenes and the orrery under every
+# case camera, 24 frames each): the largest error / (eps scale) of any point
+# is 0.74 (glm with P V premultiplied, orrery, narrow_fov; core 0.16, K [R|t]
+# 0.18); the largest float32 vertex error 4.6e-4 px, the bounds 1.2e-3 to
+# 3.4e-3 px.
+
+#: Roundings of size eps x scale a correct projector may accumulate (see
+#: above): 4, 5.4x the largest measured error / (eps scale).
+VERTEX_ROUNDINGS = 4.0
+
+#: The near-plane margin of oracles.candidates.draw, in roundings of eps (|X| + |C|): a
+#: correct candidate's view depth of X is within this many of the exact depth,
+#: so an end moved this far inside [near, far] passes its own depth test.
+#: Measured (same run): a float32 glm view depth is off by at most 1.05
+#: eps32 (|X| + |C|); 4 leaves ~4x.
+DEPTH_ROUNDINGS = 4.0
+
+
+def vertex_scale(p_world, p_px, camera, matrices=None) -> float:
+    """The largest per-point scale of a frame (pixels per unit of relative rounding; formula above).
+
+    Parameters
+    ----------
+    p_world : (N, 3) array_like
+        World points.
+    p_px : (N, 2) array_like
+        Their pixels by the oracle; NaN rows (clipped points) are left out.
+    camera : core.camera.Camera
+    matrices : tuple, optional
+        ``oracles.references.convert.opencv_matrices(camera)``, when the caller has them
+        (built once per case: they cost ~1 ms, as much as OpenCV's projection).
+
+    Returns
+    -------
+    float, 0.0 when no point is visible.
+    """
+    import numpy as np
+
+    from ..references.convert import opencv_matrices
+
+    p_world = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
+    p_px = np.asarray(p_px, dtype=np.float64).reshape(-1, 2)
+    seen = np.isfinite(p_px).all(axis=1)
+    if not seen.any():
+        return 0.0
+    r_cv, t_cv, k = opencv_matrices(camera) if matrices is None else matrices
+    x, p = p_world[seen], p_px[seen]
+    size = np.linalg.norm(x, axis=1) + float(np.linalg.norm(camera.position))
+    reach = np.abs(p - k[:2, 2]).sum(axis=1)
+    focal = max(abs(k[0, 0]), abs(k[1, 1]))
+    viewport = np.abs(p).sum(axis=1) + camera.width + camera.height
+    if camera.projection == "perspective":
+        z = x @ r_cv[2] + t_cv[2]
+        scale = (focal + reach) * size / z + viewport
+    else:
+        scale = focal * size + viewport
+    return float(np.max(scale))
+
+
+def vertex_bound(precision: str, scale: float, floor: float = VERTEX_TOL_PX) -> float:
+    """A case's vertex bound in pixels: ``max(floor, VERTEX_ROUNDINGS eps32 scale)`` for float32, ``floor`` for float64.
+
+    ``floor`` is ``--tol-px`` (VERTEX_TOL_PX): for float64 it is the bound
+    itself, five orders above the derived ~1e-11 px, so that ``--tol-px``
+    keeps its meaning for a float64 candidate (0 fails any error).
+    """
+    if precision == "float64":
+        return float(floor)
+    return max(float(floor), VERTEX_ROUNDINGS * EPS[precision] * float(scale))
+
+#: Minimum edge-pixel F1 at 1 px (Chebyshev) against pyrender/OSMesa.
+#: Measured: 1.0 in every one of 1,512 frames (3 scenes x 7 cameras x 72
+#: frames) and in 432 frames of four other cameras (README, "Pixel
+#: agreement"): a pixel that is not within 1 px of the oracle's line is a real
+#: error. 0.999 allows one stray pixel per ~1,000 line pixels, for
+#: float32-vs-float64 decisions in the shader that a 1-px tolerance cannot absorb
+#: (none seen so far), and catches a half-pixel offset (F1@1 stays 1.0 for that
+#: one: the vertex check is what catches it).
+MIN_F1_1PX = 0.999
+
+#: Minimum edge-pixel F1 at 1 px in the extremes suite (oracles.extremes), on
+#: the frames a case judges (where the frame is well conditioned for a float32
+#: GL pipeline). Lower than MIN_F1_1PX: those frames have few, extreme lines,
+#: where one stray end pixel weighs more than in ~1,500 ordinary frames.
+MIN_F1_1PX_EXTREMES = 0.99
+
+#: Minimum edge-pixel F1 at 0 px. core/projector/raster.py emulates GL's diamond-exit
+#: rule, llvmpipe's tie directions and its 1/256 px vertex snap; what is left
+#: are decisions within ~1/512 px of a boundary, where llvmpipe decides on
+#: float32 vertices and we on float64. Measured minimum over 1,512 frames of
+#: the bundled cases: 0.9958 (worst frame of a case; mean 0.9997). 0.98 leaves
+#: room for scenes with many short edges (each differing pixel weighs more)
+#: and fails a half-pixel offset (F1@0 ~ 0.5).
+MIN_F1_0PX = 0.98
+
+# ---------------------------------------------------------------- systematic line-pixel defects
+
+# F1 at a fixed floor cannot see a defect that costs one pixel per line: a
+# rasterizer that drops the last pixel of every line keeps F1@1 = 1.0 and F1@0
+# at 0.993-0.997, above MIN_F1_0PX. What it cannot hide is *direction*: two
+# unbiased renderers (core and llvmpipe, llvmpipe and NVIDIA) differ where a
+# pixel centre is within rounding of a decision, and such a pixel goes to
+# either side with equal chance, so candidate-only and oracle-only pixels come
+# in equal numbers. A dropped (or added) end pixel is one-sided.
+#
+# Measured (benchmarks/measure_line_gate.py, 24 frames of every case camera;
+# pooled per case; "decided" are the one-sided pixels that are not sub-pixel
+# ties, oracles.judge.line_ties, which the sign test and the size condition count):
+#
+# | scenes                         | correct core: one-sided | decided  | max abs net / oracle px | min p |
+# |--------------------------------|-------------------------|----------|-------------------------|-------|
+# | cube, pyramid, prism (21)      | 179 vs 181              | 2 vs 0   | 3.8e-5                  | 1     |
+# | orrery (7)                     | 57 vs 51                | 6 vs 0   | 9.7e-5                  | 0.5   |
+# | hidden lines + backface (28)   | 169 vs 165              | 5 vs 0   | 1.3e-4                  | 0.5   |
+# | 5 random edge soups (35)       | 664 vs 669              | 14 vs 17 | 4.0e-5                  | 0.25  |
+#
+# and for the drop-last-pixel mutant (decided pixels): every plain bundled
+# case fails (1 vs 3,458 pooled, p <= 2.3e-72 in each case; net -0.31 % to
+# -0.79 % of the oracle's pixels); orrery 3 vs 3,378; hidden lines + culling
+# 1 vs 5,031, the fewest in one case 0 vs 12 (cube, near_plane: the camera
+# inside the cube sees few line ends); random edge soups 1 vs 11,473, 35/35
+# fail.
+#
+# The random-end renderer (tests/raster_mutants.random_ends: each line loses
+# or gains one pixel at a random end, q = 0.25 each) is unbiased per line, and
+# passes every bundled, orrery and hidden-line case (56/56; decided 718 vs
+# 688, 662 vs 698, 1,028 vs 930; smallest p 0.0038, net below 1.2e-3). On
+# the random edge soups it fails 5 of 35 cases (3,409 vs 2,296, p down to
+# 3e-11): where several lines end at one vertex, a lost end pixel is usually
+# still drawn by another line, a gained one beyond the vertex is not, so in
+# the image its noise is biased toward extra pixels, and the gate says so.
+
+#: The sign test on a case's pooled one-sided pixels. Under H0 (an unbiased
+#: renderer) each differing pixel is candidate-only with p = 1/2, and the
+#: two-sided p-value is ``2 P(X <= min(k, n - k))``, X ~ Binomial(n, 1/2)
+#: (oracles.judge.metrics.sign_test_p). alpha = 1e-3: a case fails the test with
+#: 11 one-sided pixels all on one side (2 x 2^-11 = 9.8e-4), which is what
+#: the drop-last mutant leaves in the hardest case measured (hidden lines +
+#: back-face culling, cube, near_plane: 0 vs 12, p = 4.9e-4; at alpha 1e-4 it
+#: passed). By chance alone an unbiased candidate fails the sign test in at
+#: most 21 x 1e-3 = 2 % of 21-case runs (Bonferroni), and then must also meet
+#: the size condition below, which noise of the measured size never does; the
+#: correct core's smallest p is 0.25, the random-end noise's 0.0038 on the
+#: bundled scenes, the mutant's at most 4.9e-4 (2.3e-72 or smaller on the
+#: plain bundled cases).
+BALANCE_ALPHA = 1e-3
+
+#: ... and the imbalance must be large enough to matter: the net one-sided
+#: pixels (candidate-only minus oracle-only) more than this fraction of the
+#: oracle's line pixels, pooled over the case. 1e-3 (one net pixel per 1,000,
+#: the scale MIN_F1_1PX allows for stray pixels) is 7x the largest net
+#: measured on the correct core (1.3e-4, hidden lines + culling) and 3x below the
+#: smallest the mutant makes (3.1e-3, pyramid near_plane). The size condition
+#: is what keeps a noisy but unbiased candidate passing: at the Mesa-vs-NVIDIA
+#: level (F1@0 0.99993 over 504 frames, 7e-5 of pixels differing) the whole
+#: difference is below 1e-3, whatever its direction; a candidate with 40x
+#: that noise at line ends, unbiased per line (tests/raster_mutants.random_ends),
+#: passes the bundled scenes (see above for where it does not).
+MAX_IMBALANCE_FRACTION = 1e-3
+
+#: Per-edge pixel counts (Khronos' criterion: a line's pixel count within +-1
+#: of the reference's). Without rendering each line singly, an edge's count is
+#: the number of distinct major-axis coordinates among the drawn pixels nearest
+#: to its segment (within 1 px; oracles.judge.metrics.edge_counts): a tie decided
+#: across the line does not change it, a pixel more or less at an end does.
+#: Where lines meet or cross, pixels are shared out by distance, and a tie
+#: pixel that moves across the line can move to a neighbour's share: one more
+#: pixel either way at each end. Measured over all 91 cases above: correct
+#: core at most 1 on the bundled scenes, the orrery and the hidden-line mode,
+#: 2 on the random edge soups (many crossings); unbiased one-end-per-line
+#: noise (random_ends) 2; the drop-last mutant 2. 3 (one above the largest
+#: measured) fails a line drawn 2 px short at both ends, a gap of 4 pixels, a
+#: missing or an extra line; the 1-px end bias is the balance test's to find.
+MAX_EDGE_COUNT_DIFF = 3
+
+# Sub-pixel ties (oracles.judge.line_ties). A one-sided pixel beside a row (column)
+# where its segment crosses within the oracle's sub-pixel precision of the
+# boundary between two pixels is decided by how the ends were rounded, not by
+# the line: it is counted as a tie (``subpixel_ties``) and left out of the
+# sign test and the size condition above (found on a generated 24-sided
+# cylinder seen along its axis: a cap's spoke and a side edge overlap, cross
+# a row 0.0007 px from the half pixel, and Mesa puts one on each side; 8
+# oracle-only pixels a frame, none the other way, p = 3e-5).
+#
+# How far can a GL rasterizer move an end before it decides? Per coordinate:
+#
+# - the snap to its sub-pixel grid, 2^-SUBPIXEL_BITS px: at most half a step.
+#   GL only requires SUBPIXEL_BITS >= 4; the oracle, Mesa's llvmpipe, uses 8
+#   (FIXED_ORDER 8; core.projector.raster emulates it): 2^-9 px;
+# - the float32 rounding of the window coordinates before the snap: at most
+#   VERTEX_ROUNDINGS eps32 scale (above), <= 2^-9 px while scale <= 4,096 px,
+#   and 4x the largest float32 vertex error measured (4.6e-4 px).
+#
+# So each end is within TIE_END_PX = 2^-9 + 2^-9 = 2^-8 px of the exact one.
+# Where a segment of minor/major slope |m| <= 1 crosses a row between its
+# ends, an end moved by (e_x, e_y) moves the line across the row by
+# e_x - m e_y (|.| <= (1 + |m|) TIE_END_PX), and the crossing is a weighted
+# mean of the two ends' moves: within (1 + |m|) TIE_END_PX <= 2^-7 px of the
+# exact crossing. Farther from the boundary the oracle decides as the exact
+# line does; closer, its answer is not the line's, and a candidate that
+# differs there is not wrong. 8 bits, not the spec's 4: the oracle's own
+# precision is what makes its answer undecided; a candidate that snaps coarser
+# differs from it outside this zone too, at random, which the sign test
+# already takes (a wider zone, (1 + |m|) 2^-5, would excuse 1 in 8 crossings).
+# A scale above 4,096 px (a float32 rounding above 2^-9) makes the zone
+# narrower than the oracle's real one: a tie may then count as decided (a
+# false alarm, never a hidden fault). A tie moves no pixel between major
+# coordinates, so the per-edge counts need no such rule.
+#
+# What it cannot hide: a pixel is a tie only where the crossing is within
+# 2^-7 px of the half pixel (at most 2 x 2^-7 = 1/64 of a line's rows) and
+# the image without it drew the pixel across that boundary (a pixel lost or
+# added with no partner stays decided): a line shifted by 1 px or drawn 1 px
+# thicker keeps at least 63/64 of its one-sided pixels in the test.
+
+#: Sub-pixel bits of the oracle's rasterizer (Mesa llvmpipe; the GL minimum is 4).
+SUBPIXEL_BITS = 8
+
+#: How far a renderer may move a segment's end before deciding, per coordinate (px): the snap's
+#: half step 2^-(SUBPIXEL_BITS + 1) plus 2^-9 of float32 rounding (derivation above).
+TIE_END_PX = 2.0 ** -(SUBPIXEL_BITS + 1) + 2.0 ** -9
+
+#: Pixel tolerances at which precision/recall/F1 are reported.
+PIXEL_TOLS = (0, 1)
+
+# ---------------------------------------------------------------- hidden lines, shaded, culling
+
+#: Hidden lines (``--hidden-lines``, and ``--cull backface``) are judged with the
+#: same F1 minimums as plain wireframes (MIN_F1_1PX, MIN_F1_0PX). pyrender draws
+#: the faces black with glPolygonOffset(1, 1) under the lines; core hides a
+#: line pixel behind its depth buffer with the linear-depth image of the same
+#: offset (core.projector.zbuffer). Measured, core against pyrender, 24 frames of each
+#: of the 7 cameras: F1@1 = 1.0 everywhere; F1@0 >= 0.9956 (cube), 0.9984
+#: (icosphere(2)), 0.9961 (scenes/examples/orrery, three moving objects), as
+#: good as the plain wireframe (min 0.9958), so no looser bound is needed (a
+#: line pixel kept or lost at an occluding face's edge is within 1 px of the
+#: oracle's, which F1@1 absorbs).
+
+#: Minimum silhouette IoU (``--style shaded``): covered pixels of the
+#: candidate's depth buffer (finite) against pyrender's (depth buffer < 1).
+#: Both cover a pixel when its centre is inside a triangle after snapping the
+#: vertices to 1/256 px (llvmpipe; core.projector.zbuffer emulates it), so the only
+#: differences are centres within float rounding of an edge. Measured, 24
+#: frames x 7 cameras: cube 8 of 168 frames below 1.0, min 0.99997;
+#: icosphere(2) 1 of 168, min 0.99999; orrery (three objects) 3 of 168, min
+#: 0.99982. A float64 ray-casting reference without the snap measured min
+#: 0.99963. 0.995 leaves room for smaller silhouettes
+#: (fewer pixels per boundary pixel, several objects) and still fails a
+#: mirrored silhouette and a half-pixel shift of a 200-px silhouette (every
+#: boundary pixel flips with probability 1/2: IoU ~ 1 - P/2A ~ 0.99).
+MIN_SILHOUETTE_IOU = 0.995
+
+#: IoU is a ratio of areas: for a silhouette of a few pixels one boundary
+#: decision moves it by a large fraction (a zero-area face that GL's float32
+#: noise turns into 1 px while core draws none scores IoU 0). Below this union,
+#: in pixels, the IoU gate is not applied; the silhouettes must still differ
+#: only on their boundaries (metrics.shaded_scores' silhouette_mismatch_inside
+#: = 0, applied at every size). 400 px = a 20 x 20 silhouette, whose ~80
+#: boundary pixels are 20 % of its area.
+MIN_IOU_UNION_PX = 400
+
+#: The shaded depth comparison: |z_candidate - z_pyrender| at a pixel covered
+#: by both and not on either silhouette (eroded by 1 px) nor beside an occlusion
+#: boundary (oracles.judge.metrics.occlusion_boundary) must be at most
+#:
+#:     bound(z) = DEPTH_STEPS * step(z) + DEPTH_SNAP_PX * slope + DEPTH_EPS32 * eps32 * z
+#:
+#: with z pyrender's depth at the pixel (linear camera depth, made linear in
+#: float64 from the 24-bit buffer by oracles.references.pyrender_oracle: compare like with
+#: like) and
+#:
+#: - ``step(z)``: one level of the 24-bit depth buffer in camera depth,
+#:   ``z^2 (far - near) / (far near (2^24 - 1))`` for perspective (window depth
+#:   ``f (z - n) / ((f - n) z)`` is non-linear in z) and ``(far - near) /
+#:   (2^24 - 1)`` for orthographic (window depth ``(z - n) / (f - n)`` is linear,
+#:   so the step is the same at every depth). DEPTH_STEPS = 4: one for the
+#:   conversion to 24 bits, up to three for llvmpipe's float32 evaluation of the
+#:   window-depth plane at the pixel (window depth is < 1, where one float32 ulp,
+#:   2^-24, is one level);
+#: - ``slope``: the largest change of pyrender's depth to a 4-neighbour of the
+#:   pixel (depth per pixel). llvmpipe snaps x and y to 1/256 px, moving the
+#:   depth plane by up to 1/512 px along each axis: |dz/dx|/512 + |dz/dy|/512 <=
+#:   slope / 256, so DEPTH_SNAP_PX = 1/256. This term dominates on faces seen
+#:   at a grazing angle (up to ~100 levels measured on the near_plane camera);
+#: - ``DEPTH_EPS32 * eps32 * z``: float32 geometry in GL (positions, model,
+#:   view and projection matrices, the divide): about 8 roundings of values of
+#:   size ~z, each <= eps32/2 relative, doubled: 16.
+#:
+#: Measured, core against pyrender (cube, icosphere(2), orrery; 7 cameras x
+#: 24 frames): the largest error / bound(z) is 0.48 (icosphere, non_square);
+#: without the slope term it would be 8.5 (cube, near_plane, 12 frames). A
+#: candidate whose depth is 1% too large (1.01 z) measured error / bound up to
+#: 820 (perspective) and 1700 (orthographic) on the cube.
+DEPTH_STEPS = 4.0
+DEPTH_SNAP_PX = 1.0 / 256.0
+DEPTH_EPS32 = 16.0
+
+
+#: The shaded depth bound, as stated in the report.
+DEPTH_BOUND_TEXT = (f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 / DEPTH_SNAP_PX:g}"
+                    f" + {DEPTH_EPS32:g} eps32 z")
+
+
+@dataclass
+class Tolerances:
+    """The limits a run judges with (defaults: the values above; the CLI's --tol-px, --min-f1, ... override them).
+
+    ``vertex_px`` is the floor of each case's vertex bound (:func:`vertex_bound`);
+    ``precision`` the candidate's declared precision (``--candidate-precision``),
+    None to infer it from the candidate's answers (oracles.candidates.candidate.case_precision).
+    """
+
+    vertex_px: float = VERTEX_TOL_PX
+    min_f1_1px: float = MIN_F1_1PX
+    min_f1_0px: float = MIN_F1_0PX
+    min_iou: float = MIN_SILHOUETTE_IOU
+    balance_alpha: float = BALANCE_ALPHA
+    max_imbalance: float = MAX_IMBALANCE_FRACTION
+    max_edge_count_diff: int = MAX_EDGE_COUNT_DIFF
+    precision: str | None = None
+
+    def __post_init__(self):
+        if self.precision is not None and self.precision not in PRECISIONS:
+            raise ValueError(f"precision {self.precision!r}: expected one of {', '.join(PRECISIONS)} (or None: "
+                             "inferred from the candidate's answers)")
+
+    def to_dict(self, shaded: bool = False) -> dict:
+        """The report's ``tolerances`` field."""
+        if shaded:
+            return {"vertex_error_px": self.vertex_px, "candidate_precision": self.precision,
+                    "min_silhouette_iou": self.min_iou,
+                    "depth_error": DEPTH_BOUND_TEXT}
+        return {"vertex_error_px": self.vertex_px, "candidate_precision": self.precision,
+                "min_pixel_f1_1px": self.min_f1_1px,
+                "min_pixel_f1_0px": self.min_f1_0px, "balance_alpha": self.balance_alpha,
+                "max_imbalance_fraction": self.max_imbalance, "max_edge_count_diff": self.max_edge_count_diff}

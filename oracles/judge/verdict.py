@@ -1,0 +1,129 @@
+"""A case's record (its line in report.json) from its frames, and the verdict with its reasons.
+
+The verdict is decided by oracles.judge.decide, the one judge of every path (a
+projector's, core's, a renderer's frames). A case fails for every limit of
+oracles.judge.tolerances it misses, each named in a reason: the vertex error, points visible to one side only, the pixel F1 at 1
+and 0 px, the one-sided pixel balance and the per-edge pixel counts of the
+lines (oracles.judge.metrics.line_failures); shaded: regions covered by one side inside the other's silhouette,
+the silhouette IoU, faces that differ away from their boundaries, the depth
+error beyond its bound. A candidate that fails the contract (oracles.candidates.candidate)
+fails the case with that error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import metrics
+from ..candidates.candidate import case_precision
+from ..diagnosis.diagnose import diagnose
+from .decide import decide, line_faults, pixel_fields
+from .tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
+
+#: Per-frame fields of a wireframe's line comparison (oracles.judge.metrics.line_scores).
+LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
+
+#: Per-frame fields of a shaded comparison (oracles.judge.metrics.shaded_scores).
+SHADED_FRAME_KEYS = ("silhouette_iou", "silhouette_union_px", "silhouette_mismatch_inside", "depth_pixels",
+                     "depth_max_error", "depth_mean_error", "depth_error_bound", "depth_error_ratio",
+                     "face_disagreements", "face_disagreements_inside")
+
+
+def case_record(setup, acc, tol: Tolerances) -> dict:
+    """The case's fields from its frames (``setup``: oracles.judge.case.CaseSetup, ``acc``: its CaseFrames).
+
+    Vertex errors pooled over the frames, the worst vertex, the faults
+    (oracles.diagnosis.diagnose), the pixel scores' minima and means, the shaded
+    summary, and a note when there was nothing to compare. ``precision``
+    says what the candidate was judged as (declared, or as it returned; core:
+    its ``--dtype``) and ``vertex_bound_px`` the bound its vertices were held
+    to (oracles.judge.tolerances.vertex_bound).
+    """
+    done = len(acc.cand_px)
+    rec = {"scene": setup.scene.name, "camera": setup.case.name, "camera_spec": setup.cam.to_dict(),
+           "frames": setup.frames, "frames_checked": done}
+    precision, source = case_precision(tol.precision, acc.returned)
+    if setup.is_core and tol.precision is None and acc.returned:
+        source = "core --dtype"
+    bound = vertex_bound(precision, acc.scale, tol.vertex_px)
+    rec["precision"] = {"judged_as": precision, "source": source,
+                        "returned": sorted(acc.returned) if acc.returned else None}
+    rec["vertex_bound_px"] = bound
+    if acc.depth_ties:       # points on near/far to within the candidate's rounding, clipped by one side only
+        rec["depth_ties"] = acc.depth_ties
+    if setup.pixels and setup.mode.hidden_lines:
+        rec["hidden_lines"] = setup.faces is not None
+    faults = []
+    if done:
+        cand, orac = np.concatenate(acc.cand_px), np.concatenate(acc.oracle_px)
+        ve = metrics.vertex_errors(cand, orac)
+        worst_v = max(acc.frame_errors, key=lambda e: (e[0], -e[1])) if acc.frame_errors else (None, None, None)
+        rec.update({
+            "max_vertex_error_px": ve["max_px"],
+            "mean_vertex_error_px": ve["mean_px"],
+            "rms_vertex_error_px": ve["rms_px"],
+            "worst_vertex": {"frame": worst_v[1], "vertex": worst_v[2], "error_px": worst_v[0]},
+            "visible_points": ve["visible_both"],
+            "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
+        })
+        bound32 = vertex_bound("float32", acc.scale, tol.vertex_px) if precision == "float64" else None
+        faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32, planes=acc.planes)
+    else:
+        rec.update({"max_vertex_error_px": None, "mean_vertex_error_px": None, "rms_vertex_error_px": None})
+    px = acc.pixel
+    if px["f1_0px"]:
+        rec.update(pixel_fields(px, acc.worst[1] if acc.worst else None))
+        rec["lines"] = metrics.line_summary(acc.lines)
+    else:
+        rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
+    if setup.pixels and setup.mode.shaded:
+        rec.update(shaded_summary(acc.shaded, acc.worst))
+    if acc.lines:                     # a line fault is named only when the vertices agree
+        faults = line_faults(rec, tol, faults)
+    rec["faults"] = faults
+    rec["compared"] = {"frames": done, "vertices": rec.get("visible_points", 0),
+                       "pixels": acc.drawn_px if setup.pixels else None}
+    if done and setup.pixels and not setup.mode.plain and setup.faces is None:
+        rec["note"] = {"shaded": "no faces: nothing to shade; only the vertices were checked",
+                       "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe"
+                       }[setup.mode.style]
+    return rec
+
+
+def shaded_summary(shaded: list, worst) -> dict:
+    """A case's shaded fields from its frames' scores (None where nothing was compared)."""
+    out = {"silhouette_iou": None, "silhouette_iou_mean": None, "depth_max_error": None,
+           "depth_mean_error": None, "depth_error_bound": None, "depth_error_ratio": None,
+           "depth_worst_frame": None, "depth_pixels": 0, "worst_pixel_frame": None,
+           "face_disagreements": 0, "face_disagreements_inside": 0,
+           "silhouette_mismatch_inside": 0, "silhouette_iou_gated": None}
+    if not shaded:
+        return out
+    out["silhouette_mismatch_inside"] = int(sum(s.get("silhouette_mismatch_inside", 0) for _, s in shaded))
+    gated = [s["silhouette_iou"] for _, s in shaded if s.get("silhouette_union_px", 0) >= MIN_IOU_UNION_PX]
+    out["silhouette_iou_gated"] = float(min(gated)) if gated else None     # IoU over frames big enough to judge
+    out["face_disagreements"] = int(sum(s.get("face_disagreements", 0) for _, s in shaded))
+    out["face_disagreements_inside"] = int(sum(s.get("face_disagreements_inside", 0) for _, s in shaded))
+    ious = [s["silhouette_iou"] for _, s in shaded]
+    out.update(silhouette_iou=float(min(ious)), silhouette_iou_mean=float(np.mean(ious)),
+               worst_pixel_frame=worst[1] if worst else None)
+    with_depth = [(k, s) for k, s in shaded if s["depth_max_error"] is not None]
+    if with_depth:
+        pixels = sum(s["depth_pixels"] for _, s in with_depth)
+        k_err, s_err = max(with_depth, key=lambda e: (e[1]["depth_max_error"], -e[0]))
+        k_ratio, s_ratio = max(with_depth, key=lambda e: (e[1]["depth_error_ratio"], -e[0]))
+        out.update(depth_max_error=s_err["depth_max_error"], depth_error_bound=s_err["depth_error_bound"],
+                   depth_mean_error=float(sum(s["depth_mean_error"] * s["depth_pixels"]
+                                              for _, s in with_depth) / pixels),
+                   depth_error_ratio=s_ratio["depth_error_ratio"], depth_worst_frame=k_ratio,
+                   depth_pixels=int(pixels))
+    return out
+
+
+def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | None = None) -> None:
+    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed): :func:`oracles.judge.decide.decide`.
+
+    "fail" when a limit is missed; else "vacuous" when the case compared nothing
+    (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.judge.gate).
+    """
+    decide(rec, tol, error, points)

@@ -1,0 +1,128 @@
+"""The pyrender oracle's own error bound, and a case that asks for more than the oracle can give.
+
+pyrender draws in float32 (``P V M p`` in its vertex shader). The oracle
+hands it coordinates it can hold (oracles.references.convert.gl_eye_pose): each vertex
+as its offset ``q`` from the mesh's centre, rounded to float32 once per mesh,
+and the mesh node's pose taking ``q`` straight to eye space, computed in
+float64 with the camera at the origin. What the GPU then rounds is of the
+size of the mesh (``rho = |M_lin|_2 max|q|``) and of the centre's eye
+coordinates ``t``, never of the scene's distance from the world origin.
+
+The bound (per frame, :func:`frame_bound_px`), with ``u = 2^-24`` (float32's
+unit roundoff):
+
+- every eye coordinate ``e_j`` of a drawn point (a vertex, or a point of a
+  segment between two, clipped ones included) is a sum of terms of total
+  magnitude at most ``mag_j = |t_j| + rho``;
+- the clip coordinates ``c = P e`` then carry at most ``k u (|P| [mag, 1])``
+  of absolute error, counting the roundings the shader's ``P * V * M *
+  inst_m * vec4(q, 1)`` makes (left to right; ``V`` and ``inst_m`` are the
+  identity, so ``P V`` and ``* inst_m`` are exact): for ``c_x`` and ``c_y``
+  (:data:`CLIP_XY_ROUNDINGS`, 10) the float32 rounding of ``q`` (1), of the
+  pose (1) and of ``P`` (1), the ``(P V) M`` product (a row of ``P`` has at
+  most two non-zero entries: 2), its product with ``(q, 1)`` (a 4-term sum:
+  4) and GL's clip-space interpolation of a clipped end (1); for ``c_w =
+  -e_z`` (:data:`CLIP_W_ROUNDINGS`, 7) the same less ``P`` and the ``(P V)
+  M`` product, whose row is ``-1`` times the pose's (exact);
+- the divide and the viewport: ``x_win = (c_x / c_w + 1) W / 2`` moves by
+  ``(W / 2) (dc_x + |x_ndc| dc_w) / c_w``, with ``|x_ndc| <= 1`` for what
+  lands in the image and ``c_w`` at least the depth ``w_lo = max(near,
+  d_centre - rho)`` of the nearest drawn point (orthographic: ``c_w = 1``
+  exactly), plus :data:`VIEWPORT_ROUNDINGS` ``u W`` for the divide (``u
+  W / 2``) and the scale and offset (``u W``): 2.
+
+The case's bound is the largest over its frames (the record's
+``oracle_bound_px``). The line gate's tie zone assumes the oracle's window
+coordinates within ``2^-9`` px of exact (the float32 share of
+oracles.judge.tolerances.TIE_END_PX); a case whose bound exceeds
+:data:`ORACLE_LIMIT_PX` asks for more than the oracle can give, and its
+pixels are not judged: :func:`judge_oracle_precision` makes it an
+``oracle_precision`` case that fails the run without blaming the candidate.
+On the bundled scenes the bound is ~1e-4 to 1e-3 px, wherever the scene is
+put; before the re-centring a mesh 1e5 from the origin moved the oracle's
+lines by up to 78 px.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["U32", "CLIP_XY_ROUNDINGS", "CLIP_W_ROUNDINGS", "VIEWPORT_ROUNDINGS", "ORACLE_LIMIT_PX", "mesh_radius", "frame_bound_px",
+           "judge_oracle_precision"]
+
+#: float32's unit roundoff (half its epsilon): one rounding moves a value v by at most U32 |v|.
+U32 = 2.0 ** -24
+
+#: Roundings of the magnitude of clip x and y (module docstring: 1 + 1 + 1 + 2 + 4 + 1).
+CLIP_XY_ROUNDINGS = 10
+
+#: Roundings of the magnitude of clip w (module docstring: 1 + 1 + 4 + 1).
+CLIP_W_ROUNDINGS = 7
+
+#: Roundings of the window size W (module docstring: the divide 1/2, the scale and offset 1; 2 kept).
+VIEWPORT_ROUNDINGS = 2
+
+#: The oracle's window coordinates must be within this of exact: the float32 share (2^-9 px) of
+#: oracles.judge.tolerances.TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle.
+ORACLE_LIMIT_PX = 2.0 ** -9
+
+
+def mesh_radius(centred) -> float:
+    """The largest Euclidean norm of the finite rows of ``centred`` (vertices minus their centre), float64."""
+    v = np.asarray(centred, dtype=np.float64).reshape(-1, 3)
+    v = v[np.isfinite(v).all(axis=1)]
+    return float(np.sqrt((v * v).sum(axis=1)).max()) if len(v) else 0.0
+
+
+def frame_bound_px(camera, eye_pose, radius: float) -> float:
+    """The oracle's own error in pixels for one frame (module docstring), from what pyrender receives.
+
+    Parameters
+    ----------
+    camera : Camera
+    eye_pose : (4, 4) float64, centred model coordinates to GL eye (oracles.references.convert.gl_eye_pose).
+    radius : float, the largest ``|q|`` of the uploaded vertices (:func:`mesh_radius`).
+    """
+    from .convert import camera_to_gl
+
+    a = np.asarray(eye_pose, dtype=np.float64)
+    _view, proj = camera_to_gl(camera)
+    with np.errstate(over="ignore", invalid="ignore"):      # an overflow is no bound: inf below
+        rho = float(np.linalg.norm(a[:3, :3], 2)) * float(radius)
+        mag = np.abs(a[:3, 3]) + rho                              # |e_j| and its terms, every drawn point
+        m_clip = np.abs(proj[:, :3]) @ mag + np.abs(proj[:, 3])   # magnitude of each clip coordinate's terms
+        w_term = CLIP_W_ROUNDINGS * m_clip[3] if camera.projection == "perspective" else 0.0   # ortho: c_w = 1
+        w_lo = max(float(camera.near), -float(a[2, 3]) - rho) if camera.projection == "perspective" else 1.0
+        bx = U32 * (camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[0] + w_term) / w_lo
+        by = U32 * (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[1] + w_term) / w_lo
+        bx += VIEWPORT_ROUNDINGS * U32 * camera.width
+        by += VIEWPORT_ROUNDINGS * U32 * camera.height
+    both = np.array([bx, by], dtype=np.float64)
+    return float(both.max()) if np.isfinite(both).all() else float("inf")   # no finite bound: none at all
+
+
+def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:
+    """Record the case's ``oracle_bound_px``; where it exceeds :data:`ORACLE_LIMIT_PX`, judge without pixels.
+
+    ``rec`` was judged by ``judge`` (oracles.judge.verdict.judge). Beyond the limit
+    the pixel comparison says nothing about the candidate: the case is judged
+    again on its vertices alone, and its verdict is ``"fail"`` only for a
+    vertex failure, else ``"vacuous"`` (fails the run, oracles.judge.gate) with an
+    ``oracle_precision`` reason first, naming the bound and the limit.
+    """
+    if bound_px is None:
+        return
+    rec["oracle_bound_px"] = float(bound_px)
+    rec["oracle_limit_px"] = ORACLE_LIMIT_PX
+    if not bound_px > ORACLE_LIMIT_PX or rec.get("verdict") == "vacuous":
+        return          # within the limit; or nothing was compared, which the case already says
+    vertices_only = {k: v for k, v in rec.items() if k != "lines"}
+    vertices_only.update(pixel_f1_0px=None, pixel_f1_1px=None, silhouette_iou=None,
+                         compared=dict(rec["compared"], pixels=None))
+    judge(vertices_only, tol, error, points=points)
+    why = (f"oracle_precision: the pyrender oracle's own error bound {bound_px:.3g} px exceeds "
+           f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged")
+    vertex_reasons = vertices_only["reasons"] if vertices_only["verdict"] == "fail" else []
+    rec["verdict"] = "fail" if vertex_reasons else "vacuous"
+    rec["reasons"] = [why] + vertex_reasons
+    rec["oracle_precision"] = True
