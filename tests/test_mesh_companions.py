@@ -185,7 +185,7 @@ def test_sigint_from_outside_during_a_load_ends_the_run(tmp_path):
     (tmp_path / "a.obj").write_text("mtllib m.mtl\n" + TRIANGLE)
     (tmp_path / "m.mtl").write_text("newmtl x\n")
     code = ("import sys, time\n"
-            "from wirecheck.core import mesh_companions as mc\n"
+            "from wirecheck.core.scene import mesh_companions as mc\n"
             "def slow(path):\n"
             "    print('reading', flush=True); time.sleep(60)\n"
             "mc.read_regular = slow\n"

@@ -17,6 +17,7 @@ import math
 import os
 import shutil
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -47,6 +48,23 @@ def _missing() -> str | None:
     return None
 
 
+class _SlowFirst:
+    """The overlay, its first answer 1 s late: pyrender's start-up on a cold machine (seconds), which a
+    warm one may not show; the page's loading line appears after 0.3 s of waiting (viewer.js)."""
+
+    def __init__(self, overlay):
+        self.overlay, self.first = overlay, True
+
+    def __call__(self, *args):
+        if self.first:
+            self.first = False
+            time.sleep(1.0)
+        return self.overlay(*args)
+
+    def close(self):
+        self.overlay.close()
+
+
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
     why = _missing()
@@ -61,7 +79,7 @@ def session(tmp_path_factory):
     assert ok, why
     tmp = tmp_path_factory.mktemp("browser")
     s = settings_from_args(build_parser().parse_args(["--frames", "180", "--out", str(tmp / "out")]))
-    overlay = LiveOverlay()
+    overlay = _SlowFirst(LiveOverlay())
     server = Server(Viewer(s, overlay=overlay)).start()
     out = tmp / "session.json"
     profiles = tmp / "profiles"            # Chromium's profile goes here, not into the system temporary folder
