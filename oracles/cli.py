@@ -81,6 +81,7 @@ from .config import parse_cli, trust_line
 from .reports.junit import check_junit_target, write_junit
 from .candidates.core_candidate import CoreCandidate, RenderMode
 from .reports.progress import TerminalProgress
+from .reports.report_option import check_no_report, report_line
 from .reports.compared import hint_lines, reason_text, what_text
 from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import level_for_oracles, run_crosscheck
@@ -287,6 +288,7 @@ def _main(argv=None) -> int:
                              "expected it in a plain crosscheck run (one test case per scene x camera)")
         if args.junit_xml:
             check_junit_target(Path(args.junit_xml))
+        check_no_report(args)
         level, inputs, candidate, mode, tol = _parse(args)
         run_dir, run_option = _run_dir(args)
     except InputError as exc:
@@ -306,8 +308,9 @@ def _main(argv=None) -> int:
     elif args.gl is not None:
         return _error(f"--gl {args.gl} with --level {level}: nothing is drawn at that level; expected no --gl")
     try:
-        check_report_dir(run_dir, run_option)
-        check_replaceable(run_dir, run_option)
+        if not args.no_report:
+            check_report_dir(run_dir, run_option)
+            check_replaceable(run_dir, run_option)
     except InputError as exc:
         return _error(str(exc))
     except OSError as exc:
@@ -345,8 +348,9 @@ def _main(argv=None) -> int:
     report = {"run": args.run, **report}
     records = report["cases"]
     try:
-        run_dir.parent.mkdir(parents=True, exist_ok=True)     # only now: a failed run leaves no folder
-        write_report(run_dir, report, images)
+        if not args.no_report:
+            run_dir.parent.mkdir(parents=True, exist_ok=True)     # only now: a failed run leaves no folder
+            write_report(run_dir, report, images)
     except OSError as exc:
         return _error(f"writing {str(run_dir)!r} failed: {exc}")
     if args.junit_xml:
@@ -375,7 +379,7 @@ def _main(argv=None) -> int:
         print(f"Candidate precision: {precision_text(report)}")
     from .reports.wall import process_age_s
     print(timing_line(report)[:-1] + f"; {process_age_s():.1f} s in all, with start-up and the report)")
-    print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
+    print(report_line(args, run_dir, "report.json", "report.md, report.html"))
     return 0 if report["verdict"] == "pass" else 1
 
 
@@ -423,11 +427,12 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
         print(f"crosscheck: {args.dataset.skipped_line()}", file=sys.stderr)
     report = {"run": args.run, **report}
     try:
-        write_dataset_report(run_dir, report)
+        if not args.no_report:
+            write_dataset_report(run_dir, report)
     except OSError as exc:
         return _error(f"writing {str(run_dir)!r} failed: {exc}")
     print(console_summary(report))
-    print(f"Report: {run_dir / 'report.json'} (also report.md)")
+    print(report_line(args, run_dir, "report.json", "report.md"))
     return 0 if report["verdict"] == "pass" else 1
 
 

@@ -122,6 +122,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--allow-vacuous", action="store_true", default=False,
                    help="a case that compared nothing (every point clipped, nothing drawn) does not fail the run "
                         "(default: it does)")
+    p.add_argument("--no-report", action="store_true", default=False,
+                   help="write no report folder: the table and the verdict are printed only (--junit-xml is still "
+                        "written); not with --report-dir, --run, --sweep, --suite, --candidate-frames "
+                        "(default: the report is written to reports/RUN)")
     p.add_argument("--report-dir", default=None,
                    help="where to write the report: DIR, or DIR/RUN with --run (default reports/RUN)")
     p.add_argument("--run", default=None, help="run name: the report folder's name, also in report.json "

@@ -102,6 +102,7 @@ class _RunParams:
     candidate: object        # a picklable callable (CoreCandidate), or a "FILE.py:FUNC" spec string
     mode: RenderMode = RenderMode()
     keep_frames: bool = False   # every checked frame's images, for worst.gif
+    keep_points: bool = False   # the worst frame's points of each case, for worst_points.png (level vertices)
 
 
 class _CaseRunner:
@@ -170,7 +171,7 @@ class _CaseRunner:
         pyr = self.renderer(case.camera, params.mode) if params.level == "pixels" else None
         result = run_case(scene, case, params.frames, candidate, case_motion(params.motion, case),
                           params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
-                          keep_frames=params.keep_frames)
+                          keep_frames=params.keep_frames, keep_points=params.keep_points)
         result.record["framing"] = case.framing()
         result.gl_info = pyr.gl_info() if pyr is not None else None
         stderr = candidate.take_stderr() if hasattr(candidate, "take_stderr") else ""
@@ -287,7 +288,10 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     ``animation`` (level pixels), ``images["animation"]`` holds every checked
     frame of the worst case (lowest F1, or IoU when shaded, then largest
     vertex error): ``{"scene", "camera", "frames": [k...], "candidate": [...],
-    "oracle": [...]}`` (bool images), for worst.gif. Raises InputError when no
+    "oracle": [...]}`` (bool images), for worst.gif; at level vertices,
+    ``images["points"]`` holds the worst vertex's frame of the case with the
+    largest vertex error (oracles.judge.case.worst_points), for
+    worst_points.png. Raises InputError when no
     camera can be placed for a scene (coordinates too large), ValueError for a
     bad level, ``jobs`` or mode, and InputError (a ValueError) for inputs that
     would compare nothing (:func:`oracles.judge.gate.run_inputs`: no scene, case or
@@ -335,15 +339,21 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     ref = candidate if is_core or candidate_spec is None else candidate_spec
     keep_frames = animation and level == "pixels"
     params = _RunParams(frames=frames, every=every, level=level, motion=motion, tol=tol, candidate=ref,
-                        mode=mode, keep_frames=keep_frames)
+                        mode=mode, keep_frames=keep_frames, keep_points=level == "vertices")
     worst = _WorstCase(mode)
     n_frames = len(tasks) * inputs.frames_checked
     cases_done = 0
+
+    worst_points = []        # the case with the largest vertex error so far (inf included); ties: the first
 
     def on_result(result: CaseResult) -> None:
         nonlocal cases_done
         if keep_frames:
             worst.offer(result)
+        if result.worst_points is not None:
+            if not worst_points or _points_error(result.worst_points) > _points_error(worst_points[0]):
+                worst_points[:] = [result.worst_points]
+            result.worst_points = None          # kept once, not per case
         cases_done += 1
         if progress:
             progress(cases_done, len(tasks), cases_done * inputs.frames_checked, n_frames)
@@ -360,6 +370,8 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         if result.worst_images:
             images[(scene.name, case.name)] = result.worst_images
 
+    if worst_points:
+        images["points"] = worst_points[0]
     worst_case = None
     if worst.result is not None:
         images["animation"] = worst.animation()
@@ -419,6 +431,10 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         "timing": timing,
     }
     return report, images
+
+
+def _points_error(points: dict) -> float:
+    return -math.inf if points["error_px"] is None else points["error_px"]
 
 
 def worst_key(record: dict) -> tuple:

@@ -82,6 +82,8 @@ class CaseResult:
     frame_images: list | None = None
     #: the GL that drew the oracle's frames (PyrenderOracle.gl_info), None at level vertices
     gl_info: dict | None = None
+    #: with ``keep_points`` (level vertices): the worst frame's points, :func:`worst_points`
+    worst_points: dict | None = None
 
 
 class CaseSetup:
@@ -218,7 +220,8 @@ class CaseFrames:
 
 def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
              tol: Tolerances, pyrender_oracle=None, want_images: bool = True, every: int = 1,
-             mode: RenderMode | None = None, keep_frames: bool = False, first: int = 1) -> CaseResult:
+             mode: RenderMode | None = None, keep_frames: bool = False, first: int = 1,
+             keep_points: bool = False) -> CaseResult:
     """One case; the pixel stage runs when ``pyrender_oracle`` is given.
 
     Frames ``first, first + every, ...`` up to ``frames`` are checked (the
@@ -226,7 +229,8 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
 
     ``mode`` is the drawing mode of the pixel stage (oracles.runner); with
     ``keep_frames`` every checked frame's images are kept (:class:`KeptImage`) in
-    :attr:`CaseResult.frame_images`.
+    :attr:`CaseResult.frame_images`; with ``keep_points`` the worst frame's
+    points of both sides in :attr:`CaseResult.worst_points`.
     """
     setup = CaseSetup(scene, case, frames, candidate, motion, mode or RenderMode(), pyrender_oracle is not None)
     acc = CaseFrames(kept=[] if keep_frames and setup.pixels else None)
@@ -285,7 +289,19 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
     if acc.worst is not None:
         images = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
     return CaseResult(record=rec, worst_images=images, timing=case_timing(acc, setup.pixels),
-                      frame_images=acc.kept)
+                      frame_images=acc.kept, worst_points=worst_points(setup, acc, rec) if keep_points else None)
+
+
+def worst_points(setup: CaseSetup, acc: CaseFrames, rec: dict) -> dict | None:
+    """The frame of the case's worst vertex: both sides' pixels (``(N, 2)``, NaN where a side
+    clipped the point), the vertex, its error and the image size; None when nothing was compared."""
+    worst = rec.get("worst_vertex") or {}
+    if worst.get("frame") is None:
+        return None
+    i = next(i for i, f in enumerate(acc.per_frame) if f["frame"] == worst["frame"])
+    return {"scene": rec["scene"], "camera": rec["camera"], "frame": worst["frame"], "vertex": worst["vertex"],
+            "error_px": worst["error_px"], "size": (int(setup.cam.width), int(setup.cam.height)),
+            "candidate": np.asarray(acc.cand_px[i], np.float64), "oracle": np.asarray(acc.oracle_px[i], np.float64)}
 
 
 def visibility_differs(acc: CaseFrames) -> bool:

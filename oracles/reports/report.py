@@ -242,6 +242,9 @@ def _figures(report: dict, files: set) -> list[tuple[str, str]]:
     out = []
     if "vertex_error.png" in files:
         out.append(("vertex_error.png", "per-frame max vertex error of every case (log scale)"))
+    if "worst_points.png" in files:
+        out.append(("worst_points.png", "the worst case's frame: the candidate's points (x) over OpenCV's (o), "
+                    "the worst vertex ringed"))
     if "pixels.png" in files:
         out.append(("pixels.png", "per-frame silhouette IoU and depth error / bound of every case"
                     if report.get("style") == "shaded" else "per-frame F1@0px of every case"))
@@ -470,10 +473,12 @@ def _finite_or_null(obj):
 def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) -> Path:
     """Write the run directory atomically; ``images[(scene, camera)] = {frame, candidate, oracle}``.
 
-    ``images["animation"]`` (oracles.runner.run_crosscheck) becomes worst.gif;
+    ``images["animation"]`` (oracles.runner.run_crosscheck) becomes worst.gif,
+    ``images["points"]`` (level vertices) worst_points.png;
     the per-frame figures are drawn from the report itself.
     """
     from . import plots
+    from .points_plot import points_png
 
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
@@ -501,6 +506,9 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
         if images.get("animation"):
             out.write("worst.gif", plots.worst_gif(images["animation"]))
             files.add("worst.gif")
+        if images.get("points") and report.get("level") == "vertices":
+            out.write("worst_points.png", points_png(images["points"]))
+            files.add("worst_points.png")
         for name, draw in (("vertex_error.png", plots.vertex_error_png), ("pixels.png", plots.pixel_png)):
             data = draw(report)
             if data is not None:
