@@ -115,6 +115,17 @@ def case_rows(report: dict) -> dict:
                         for c in m.get("cases", [])] for m in report["meshes"]}
 
 
+def tally(rows: dict, names) -> dict:
+    """Counts over the meshes ``names`` of ``rows`` (:func:`case_rows`): cases, failed cases, vacuous cases
+    (e.g. ``oracle_precision``: no false fail of the candidate, but the gate's run does not pass on them),
+    and meshes with a failed case and with a failed or vacuous one."""
+    cases = [c for name in names for c in rows[name]]
+    return {"cases": len(cases), "cases_failed": sum(c[1] == "fail" for c in cases),
+            "cases_vacuous": sum(c[1] == "vacuous" for c in cases), "meshes": len(names),
+            "meshes_failed": sum(any(c[1] == "fail" for c in rows[name]) for name in names),
+            "meshes_not_passed": sum(any(c[1] in ("fail", "vacuous") for c in rows[name]) for name in names)}
+
+
 def rate_line(label: str, k: int, n: int, unit: str) -> str:
     lo, hi = clopper_pearson(k, n)
     three = f"; rule of three {3e3 / n:.2f}" if k == 0 and n else ""       # one-sided 95 % bound for 0 of n
@@ -162,22 +173,25 @@ def main(argv=None) -> int:
         result = {}
         groups = (("all", set(rows)), ("near", set(rows) - far), ("far", set(rows) & far)) if rows else ()
         for label, names in groups:
-            cases = [c for name in names for c in rows[name]]
-            k = sum(c[1] == "fail" for c in cases)
-            bad = sum(any(c[1] == "fail" for c in rows[name]) for name in names)
-            print(rate_line(label, k, len(cases), "cases failed") + f"; {bad}/{len(names)} meshes")
-            result[label] = {"cases": len(cases), "cases_failed": k, "meshes": len(names), "meshes_failed": bad,
-                             "per_1000": 1e3 * k / max(len(cases), 1),
-                             "ci95_per_1000": [1e3 * x for x in clopper_pearson(k, len(cases))]}
+            t = tally(rows, names)
+            k, n, v = t["cases_failed"], t["cases"], t["cases_vacuous"]
+            print(rate_line(label, k, n, "cases failed") + f"; {t['meshes_failed']}/{t['meshes']} meshes")
+            if v:
+                print(rate_line("", k + v, n, "failed or vacuous") + f"; {t['meshes_not_passed']}/{t['meshes']} meshes")
+            result[label] = dict(t, per_1000=1e3 * k / max(n, 1),
+                                 ci95_per_1000=[1e3 * x for x in clopper_pearson(k, n)],
+                                 not_passed_per_1000=1e3 * (k + v) / max(n, 1),
+                                 not_passed_ci95_per_1000=[1e3 * x for x in clopper_pearson(k + v, n)])
         errors = [name for name, cs in rows.items() if not cs]
         if errors:
             print(f"  could not be checked: {', '.join(errors)}")
-        failed = [(name, c) for name in sorted(rows) for c in rows[name] if c[1] == "fail"]
+        failed = [(name, c) for name in sorted(rows) for c in rows[name] if c[1] in ("fail", "vacuous")]
         for name, (camera, _v, reasons, faults) in failed:
-            print(f"    {name} / {camera}{' (far)' if name in far else ''}: {'; '.join(reasons)}"
+            print(f"    {name} / {camera}{' (far)' if name in far else ''} [{_v}]: {'; '.join(reasons)}"
                   f"{' [' + ', '.join(faults) + ']' if faults else ''}")
         out["core"] = {"seconds": core_s, "rates": result,
-                       "failed": [{"mesh": n, "camera": c[0], "reasons": c[2], "faults": c[3]} for n, c in failed]}
+                       "failed": [{"mesh": n, "camera": c[0], "verdict": c[1], "reasons": c[2], "faults": c[3]}
+                                                        for n, c in failed]}
         if mutants:
             sub = Path(tmp) / "mutants"
             sub.mkdir()

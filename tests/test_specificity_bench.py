@@ -46,3 +46,15 @@ def test_clopper_pearson_by_hand():
     # 5 of 10: the tabulated exact interval 0.1871 .. 0.8129
     lo, hi = bench_specificity.clopper_pearson(5, 10)
     assert (round(lo, 4), round(hi, 4)) == (0.1871, 0.8129)
+
+
+def test_tally_counts_vacuous_cases_apart_from_false_fails():
+    # an oracle_precision case is "vacuous": no false fail of the candidate, but the gate's run does not pass,
+    # so the benchmark must count it (hand-made rows: mesh a fails one case, b is vacuous once, c passes)
+    rows = {"a": [("on_axis", "fail", ["x"], []), ("wide_fov", "pass", [], [])],
+            "b": [("on_axis", "vacuous", ["oracle_precision: ..."], []), ("wide_fov", "vacuous", ["..."], [])],
+            "c": [("on_axis", "pass", [], []), ("wide_fov", "pass", [], [])]}
+    t = bench_specificity.tally(rows, ["a", "b", "c"])
+    assert t == {"cases": 6, "cases_failed": 1, "cases_vacuous": 2, "meshes": 3, "meshes_failed": 1,
+                 "meshes_not_passed": 2}
+    assert bench_specificity.tally(rows, ["c"])["meshes_not_passed"] == 0
