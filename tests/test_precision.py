@@ -305,3 +305,12 @@ def test_scale_batch_is_the_largest_frame_scale(limit):
     for p in frames:
         batch.add(p, opencv_oracle.project(p, cam), cam)
     assert batch.flush(cam) == expected
+
+
+def test_float64_bound_is_its_own_rounding_where_that_exceeds_the_floor():
+    # float64's derived term: VERTEX_ROUNDINGS (4) x eps64 (2^-52 = 2.22e-16) x the case's scale.
+    # Scale 1e4 px (an ordinary scene): 8.9e-12 px, five orders under the 1e-6 floor: the floor.
+    # Scale 1e12 px (a 1e-2 mesh 5e4 from the origin, seen from 0.1 away): 8.9e-4 px, the bound.
+    assert vertex_bound("float64", 1e4) == tolerances.VERTEX_TOL_PX
+    assert vertex_bound("float64", 1e12) == pytest.approx(4 * 2.0 ** -52 * 1e12, rel=1e-15)
+    assert vertex_bound("float64", 1e12, floor=0.0) == 0.0      # --tol-px 0: any error fails
