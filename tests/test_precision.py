@@ -314,3 +314,4 @@ def test_float64_bound_is_its_own_rounding_where_that_exceeds_the_floor():
     assert vertex_bound("float64", 1e4) == tolerances.VERTEX_TOL_PX
     assert vertex_bound("float64", 1e12) == pytest.approx(4 * 2.0 ** -52 * 1e12, rel=1e-15)
     assert vertex_bound("float64", 1e12, floor=0.0) == 0.0      # --tol-px 0: any error fails
+    assert vertex_bound("float64", 1e12, floor=1e-9) == 1e-9    # a --tol-px given is the bound

@@ -115,16 +115,17 @@ def vertex_scale(p_world, p_px, camera, matrices=None) -> float:
 def vertex_bound(precision: str, scale: float, floor: float = VERTEX_TOL_PX) -> float:
     """A case's vertex bound in pixels: ``max(floor, VERTEX_ROUNDINGS eps scale)``, eps the precision's.
 
-    ``floor`` is ``--tol-px`` (VERTEX_TOL_PX). For float64 the derived term is
-    ~1e-11 px on ordinary scenes, five orders under the floor, which is then
-    the bound; it exceeds the floor only where float64 itself cannot do better:
-    a mesh 1e3 to 1e5 from the origin seen from close by (the specificity
-    dataset, docs/tolerances.md: core and OpenCV then differ by 1e-6 to 1.2e-5
-    px, 0.05 to 0.37 of the derived term). ``floor`` 0 keeps its meaning for a
-    float64 candidate: any error fails.
+    ``floor`` is ``--tol-px`` (default VERTEX_TOL_PX). For float64 the derived
+    term is ~1e-11 px on ordinary scenes, five orders under the default, which
+    is then the bound; it exceeds it only where float64 itself cannot do
+    better: a mesh 1e3 to 1e5 from the origin seen from close by (the
+    specificity dataset, docs/tolerances.md: core and OpenCV then differ by
+    1e-6 to 1.2e-5 px, 0.05 to 0.37 of the derived term). A ``--tol-px`` the
+    user gives keeps its meaning for a float64 candidate: it is the bound (0
+    fails any error).
     """
-    if precision == "float64" and float(floor) == 0.0:
-        return 0.0
+    if precision == "float64" and float(floor) != VERTEX_TOL_PX:
+        return float(floor)
     return max(float(floor), VERTEX_ROUNDINGS * EPS[precision] * float(scale))
 
 #: Minimum edge-pixel F1 at 1 px (Chebyshev) against pyrender/OSMesa.

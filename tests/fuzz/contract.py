@@ -394,7 +394,7 @@ def snapshot(box: Path) -> dict:
 
 OUTPUT_NAME = re.compile(r"(.+-frames(/(frame_\d{4,}\.(png|txt)|\.wirecheck-output))?|.+-report\.(json|txt)|"
                          r".+\.(gif|mp4)|.+-plots\.png|.+-compare\.(png|json|txt)|.+-vertices_px(-orthographic)?\.npy|\.wirecheck-manifest\.json)")
-REPORT_NAME = re.compile(r"(report\.(json|md|html)|worst\.gif|vertex_error\.png|pixels\.png|img(/.*)?|"
+REPORT_NAME = re.compile(r"(report\.(json|md|html)|worst\.gif|vertex_error\.png|worst_points\.png|pixels\.png|img(/.*)?|"
                          r"\.wirecheck-output|sweep\..*|extremes\..*)")
 
 
