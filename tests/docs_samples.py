@@ -282,6 +282,8 @@ class Runner:
         env["COLUMNS"] = "80"             # argparse and pytest wrap to the terminal's width
         env.pop("PYTEST_ADDOPTS", None)
         env.pop("PYTEST_XDIST_WORKER", None)
+        for name in ("CI", "BUILD_NUMBER"):   # pytest prints its summary lines whole under CI: a user's terminal
+            env.pop(name, None)
         env["PYTHONDONTWRITEBYTECODE"] = "1"
         # `pytest` is the environment's (the venv has no pytest script of its own)
         script = f'pytest() {{ "{ROOT / ".venv" / "bin" / "python"}" -m pytest "$@"; }}\n{command}'
