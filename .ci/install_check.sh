@@ -67,11 +67,11 @@ fi
 
 # 3. The user's project: its own core/ and oracles/ packages (tripwires where
 # a bare `core`/`oracles` import by wirecheck would land), its projector in
-# core/projector/projection.py, settings in [tool.wirecheck], and a pytest suite.
+# core/projection.py, settings in [tool.wirecheck], and a pytest suite.
 P="$WORK/project"
 mkdir -p "$P/core" "$P/oracles" "$P/tests"
 echo '"""The user'"'"'s own package called core."""' >"$P/core/__init__.py"
-for f in core/scene/model.py core/errors.py oracles/__init__.py oracles/api.py; do
+for f in core/scene.py core/errors.py oracles/__init__.py oracles/api.py; do
     echo "raise ImportError('the user project\\'s $f was imported: wirecheck must import only wirecheck.*')" >"$P/$f"
 done
 {
@@ -96,14 +96,14 @@ pythonpath = ["."]
 testpaths = ["tests"]
 
 [tool.wirecheck]
-candidate = "core/projector/projection.py:project"
+candidate = "core/projection.py:project"
 scenes = ["cube", "pyramid"]
 cases = ["on_axis", "near_plane", "orthographic"]
 frames = 4
 level = "pixels"
 EOF
 cat >"$P/tests/test_projection.py" <<'EOF'
-from core.projector.projection import mirrored, project   # the user's own `core` package
+from core.projection import mirrored, project   # the user's own `core` package
 
 
 def test_projector_matches_the_references(wirecheck):
@@ -131,7 +131,7 @@ n_png=$(find "$P/frames" -name '*.png' | wc -l)
 
 expect 0 crosscheck "$VENV/bin/crosscheck" --run pass --junit-xml junit-pass.xml
 has crosscheck "PASS: 6/6 cases"
-expect 1 crosscheck-faulty "$VENV/bin/crosscheck" --candidate core/projector/projection.py:mirrored --run faulty \
+expect 1 crosscheck-faulty "$VENV/bin/crosscheck" --candidate core/projection.py:mirrored --run faulty \
     --junit-xml junit-faulty.xml
 has crosscheck-faulty "FAIL: 0/6 cases"
 has crosscheck-faulty "mirror_horizontal"
