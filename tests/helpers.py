@@ -1,10 +1,12 @@
-"""What several test modules share: the two CLIs run in-process, and 8-connectivity of pixels."""
+"""What several test modules share: the two CLIs run in-process, 8-connectivity of pixels, a guard against
+blocking, and a frames job drawn by core."""
 
 from __future__ import annotations
 
 import contextlib
 import io
 import json
+import signal
 
 
 def run_renderer(args, out) -> tuple[int, str, str]:
@@ -83,3 +85,37 @@ def process_runs(pid: int) -> bool:
         return False
     return state != "Z"
 
+
+
+@contextlib.contextmanager
+def no_block(seconds=5):
+    """Fail (instead of hanging the suite) when the block blocks: opening a FIFO waits for a writer forever."""
+    def expire(*_):
+        raise TimeoutError(f"blocked for {seconds} s (a FIFO opened?)")
+    old = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def fill_job(job_dir, edit=lambda img: img) -> None:
+    """Draw every listed frame of an exported job with core from the job's own files (a correct renderer);
+    ``edit`` changes each image before it is written."""
+    from pathlib import Path
+
+    from PIL import Image
+
+    from wirecheck.core.projector.pipeline import render_frame
+    from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
+
+    job_dir = Path(job_dir)
+    job = load_job(job_dir)
+    for c in job["cases"]:
+        for rel in c["frames"]:
+            k = int(Path(rel).stem.split("_")[-1])
+            p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
+            (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
+            Image.fromarray(edit(render_frame(p, e, cam, m).image.copy())).save(job_dir / rel)

@@ -19,12 +19,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles.references import opencv_oracle
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.candidates.export import build_job
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job, read_obj
+from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 
 ARGS = ["--scene", "cube", "--cases", "on_axis,non_square,orthographic", "--frames", "6", "--every", "3"]
 
@@ -39,22 +39,11 @@ def job_dir(tmp_path_factory) -> Path:
     return _export(tmp_path_factory.mktemp("job") / "job")
 
 
-def _fill(job_dir: Path, transform=lambda img: img) -> None:
-    """Draw every listed frame with core from the job's own files (a renderer that is correct)."""
-    job = load_job(job_dir)
-    for c in job["cases"]:
-        for rel in c["frames"]:
-            k = int(Path(rel).stem.split("_")[-1])
-            p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
-            (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
-            Image.fromarray(transform(render_frame(p, e, cam, m).image)).save(job_dir / rel)
-
-
 @pytest.fixture
 def filled(job_dir, tmp_path) -> Path:
     d = tmp_path / "filled"
     shutil.copytree(job_dir, d)
-    _fill(d)
+    fill_job(d)
     return d
 
 
@@ -141,7 +130,7 @@ def test_core_frames_pass(filled, tmp_path, capsys):
 
 
 def test_mirrored_frames_fail_and_are_named(filled, tmp_path, capsys):
-    _fill(filled, transform=lambda img: img[:, ::-1])
+    fill_job(filled, lambda img: img[:, ::-1])
     rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")])
     out = capsys.readouterr().out
     assert rc == 1
@@ -242,7 +231,7 @@ def test_several_moving_objects_are_exported_in_world_space(tmp_path, capsys):
         assert np.array_equal(v, p_world)
         cam_json = json.loads((job / "cameras" / scene.name / "oblique_roll" / f"frame_{k:04d}.json").read_text())
         assert np.array_equal(np.array(cam_json["model_matrix"]), np.eye(4))
-    _fill(job)
+    fill_job(job)
     assert main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")]) == 0, capsys.readouterr()
     (case,) = json.loads((tmp_path / "rep" / "report.json").read_text())["cases"]
     assert case["core"]["f1_0px"] == 1.0 and case["faults"] == []

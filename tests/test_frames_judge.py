@@ -18,18 +18,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from wirecheck.core.projector import raster
-from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles.judge import tolerances
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 from wirecheck.oracles.judge.frames_judge import diagnosis_frames, run_frames
 from wirecheck.oracles.runner import CoreCandidate, Tolerances, run_crosscheck
 
 from raster_mutants import drop_last
+from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 
 # frames 1 and 4 of 6 (the cube square-on and half a turn on), seen by an oblique camera and an orthographic one
 ARGS = ["--scene", "cube", "--cases", "oblique_roll,orthographic", "--frames", "6", "--every", "3"]
@@ -47,21 +45,10 @@ def job_dir(tmp_path_factory) -> Path:
     return path
 
 
-def _fill(job_dir: Path, edit=lambda img: img) -> None:
-    """Draw every listed frame with core from the job's own files; ``edit`` changes the image first."""
-    job = load_job(job_dir)
-    for c in job["cases"]:
-        for rel in c["frames"]:
-            k = int(Path(rel).stem.split("_")[-1])
-            p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
-            (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
-            Image.fromarray(edit(render_frame(p, e, cam, m).image.copy())).save(job_dir / rel)
-
-
 def _filled(job_dir: Path, tmp: Path, edit=lambda img: img) -> Path:
     d = tmp / "filled"
     shutil.copytree(job_dir, d)
-    _fill(d, edit)
+    fill_job(d, edit)
     return d
 
 

@@ -9,11 +9,9 @@ luminance over the black background, ``L * A / 255``, is at least 128.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import shutil
-import signal
 
 import numpy as np
 import pytest
@@ -23,6 +21,7 @@ from wirecheck.oracles import cli as crosscheck_cli
 from wirecheck.oracles.candidates.frames_candidate import FrameProblem, FramesError, frame_inputs, load_frames, load_job, read_png
 
 import helpers                          # tests/ is on sys.path (rootdir conftest)
+from helpers import no_block  # tests/ is on sys.path (rootdir conftest)
 
 
 def assert_one_error_line(rc, err, *needles):
@@ -31,20 +30,6 @@ def assert_one_error_line(rc, err, *needles):
     assert "Traceback" not in err
     for n in needles:
         assert n in err, (n, err)
-
-
-@contextlib.contextmanager
-def no_block(seconds=5):
-    """Fail (instead of hanging the suite) when the block blocks: opening a FIFO waits for a writer forever."""
-    def expire(*_):
-        raise TimeoutError(f"blocked for {seconds} s (a FIFO opened?)")
-    old = signal.signal(signal.SIGALRM, expire)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 # ---- one frame PNG: what is read as drawn ------------------------------------------------------

@@ -6,7 +6,6 @@ alarm (in-process) or a subprocess timeout, so a regression fails the test inste
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import signal
@@ -17,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers import run_renderer
+from helpers import no_block, run_renderer
 from wirecheck.core.scene import mesh_companions
 from wirecheck.core.errors import InputError
 from wirecheck.core.scene.files import load_mesh_file
@@ -26,20 +25,6 @@ from wirecheck.oracles.datasets.dataset import dataset_entries
 TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 ROOT = Path(__file__).resolve().parent.parent
 CLI = {"renderer": "wirecheck.core.app.cli", "crosscheck": "wirecheck.oracles.cli"}
-
-
-@contextlib.contextmanager
-def no_block(seconds=10):
-    """Fail (instead of hanging the suite) when the block blocks, as opening a FIFO with no writer does."""
-    def expire(*_):
-        raise TimeoutError(f"blocked for {seconds} s (a FIFO opened?)")
-    old = signal.signal(signal.SIGALRM, expire)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 def _gltf(folder: Path, uri: str) -> Path:
@@ -79,7 +64,7 @@ COMPANIONS = {"mtllib": _mtllib_fifo, "map_Kd": _texture_fifo, "gltf_buffer": _b
 @pytest.mark.parametrize("kind", COMPANIONS)
 def test_a_fifo_companion_is_refused_by_name_never_opened(tmp_path, kind):
     mesh, companion = COMPANIONS[kind](tmp_path)
-    with no_block(), pytest.raises(InputError) as info:
+    with no_block(10), pytest.raises(InputError) as info:
         load_mesh_file(mesh)
     assert str(info.value) == (f"{mesh}: the file it names {companion!r} ({tmp_path / companion}) is a FIFO: "
                                "expected a regular file (never opened: reading it could block forever)")
@@ -100,13 +85,13 @@ def test_a_companion_that_is_a_link_to_a_device_is_refused(tmp_path):
     refuses it before our check; the mesh loads without it, as with any missing material."""
     (tmp_path / "a.obj").write_text("mtllib z.mtl\n" + TRIANGLE)
     (tmp_path / "z.mtl").symlink_to("/dev/zero")
-    with no_block():
+    with no_block(10):
         assert len(load_mesh_file(tmp_path / "a.obj").vertices) == 3
 
 
 def test_renderer_refuses_a_fifo_companion_in_one_line(tmp_path):
     mesh, companion = _mtllib_fifo(tmp_path)
-    with no_block():
+    with no_block(10):
         rc, _, err = run_renderer(["--scene", str(mesh), "--frames", "1"], tmp_path / "out")
     assert rc == 2 and err.count("\n") == 1 and f"the file it names {companion!r}" in err, err
     assert not (tmp_path / "out").exists()
@@ -143,7 +128,7 @@ def test_dataset_walk_skips_non_regular_mesh_names_with_stat_only(tmp_path):
     os.mkfifo(tmp_path / "p.obj")
     (tmp_path / "n.ply").symlink_to("/dev/null")      # a character device, through a link
     os.mkfifo(tmp_path / "other.txt")                 # not mesh-named: counted as another file, as before
-    with no_block():
+    with no_block(10):
         ds = dataset_entries([tmp_path])
     assert [e.name for e in ds.entries] == ["a.obj"]
     assert ds.skipped == (("n.ply", "a character device"), ("p.obj", "a FIFO"))
@@ -152,7 +137,7 @@ def test_dataset_walk_skips_non_regular_mesh_names_with_stat_only(tmp_path):
 
 def test_a_folder_of_only_fifos_is_nothing_to_check(tmp_path):
     os.mkfifo(tmp_path / "p.obj")
-    with no_block(), pytest.raises(InputError, match=r"no mesh files in this folder .*1 mesh-named files that "
+    with no_block(10), pytest.raises(InputError, match=r"no mesh files in this folder .*1 mesh-named files that "
                                                       r"are not regular files\): nothing to check"):
         dataset_entries([tmp_path])
 
