@@ -101,9 +101,10 @@ def no_block(seconds=5):
         signal.signal(signal.SIGALRM, old)
 
 
-def fill_job(job_dir, edit=lambda img: img) -> None:
+def fill_job(job_dir, edit=lambda img: img, camera=lambda cam: cam) -> None:
     """Draw every listed frame of an exported job with core from the job's own files (a correct renderer);
-    ``edit`` changes each image before it is written."""
+    ``edit`` changes each image before it is written, ``camera`` the job's camera before it draws (a fault
+    injected: scaled intrinsics)."""
     from pathlib import Path
 
     from PIL import Image
@@ -118,4 +119,4 @@ def fill_job(job_dir, edit=lambda img: img) -> None:
             k = int(Path(rel).stem.split("_")[-1])
             p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
             (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
-            Image.fromarray(edit(render_frame(p, e, cam, m).image.copy())).save(job_dir / rel)
+            Image.fromarray(edit(render_frame(p, e, camera(cam), m).image.copy())).save(job_dir / rel)
