@@ -163,8 +163,14 @@ def test_min_f1_1px_decides_on_frames(stray):
     assert 0.99 < f1 < 1.0                  # one stray pixel among ~1,000
     failed = _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
     # the geometry is right (nothing named from the images) and the line gate is off: a failure
-    # nothing explains is `unexplained`, never "no fault" (oracles.judge.decide.decide)
-    assert all(c["faults"] == [{"name": "unexplained"}] for c in failed), [c["faults"] for c in failed]
+    # nothing explains is `unexplained`, never "no fault" (oracles.judge.decide.decide); its advice says
+    # which sets differ (oracles.diagnosis.image_visibility): pixel (0, 0), far from every line, in each of
+    # the case's two frames, and no oracle pixel missing
+    for c in failed:
+        (fault,) = c["faults"]
+        assert fault["name"] == "unexplained", c["faults"]
+        assert (fault["candidate_only_px"], fault["oracle_only_px"]) == (2, 0), fault
+        assert "rotation" not in fault["hint"].replace("not the rotation", ""), fault
 
 
 def test_min_f1_0px_decides_on_frames(short):

@@ -171,6 +171,16 @@ def test_an_undecidable_mirror_gives_both_names_and_hints(results, fault):
     assert amb["confidence"] > 0.5
 
 
+def test_a_rotation_keeps_the_rotation_advice(results):
+    # a roll or a transposed rotation moves the lines: the visibility advice (oracles.diagnosis.image_visibility,
+    # for lines in place whose drawn sets differ) is never given to it
+    rotations = [key for key in results if key[0] in ("roll", "transposed")]
+    assert len(rotations) >= 5
+    for key in rotations:
+        for f in results[key]:
+            assert f["name"] == "unexplained" and "hint" not in f and "candidate_only_px" not in f, (key, f)
+
+
 def test_every_fault_has_confidence_and_residual(results):
     for key, got in results.items():
         for f in got:

@@ -50,7 +50,8 @@ Method
    ``P``, ``d`` and ``b`` as in :mod:`oracles.diagnosis.diagnose` (step 4 there), with the
    pixel tolerances :data:`SCALE_TOL_PX` (a scale's largest effect on a drawn
    pixel) and :data:`OFFSET_TOL_PX`; otherwise the answer is ``unexplained``
-   (a rotation, a shear, a 3D error: nothing of the family draws these pixels).
+   (a rotation, a shear, a 3D error: nothing of the family draws these pixels), or, when
+   the identity fits and only the drawn sets differ, the visibility advice (:mod:`.image_visibility`).
 
 Every fault carries ``confidence`` and ``residual_px``; ``pixel_offset`` is
 given to sub-pixel (``dx, dy``), ``fov_mismatch`` with ``implied_fov_deg`` (or
@@ -78,6 +79,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .image_naming import name_faults, quantisation_bias, restart_scales, rotation_deg
+from .image_visibility import in_place, visibility_fault
 
 __all__ = ["diagnose_images", "oracle_segments", "flipped_camera", "PERMUTATIONS"]
 
@@ -379,6 +381,12 @@ class _Registration:
         rev = capped[n_fwd:].mean() if n_rev else PAIR_CAP_PX
         return float(0.5 * (fwd + rev))
 
+    def matched(self, p, a, b) -> float:
+        """Mean distance of the pairs within the cap, the two directions weighted equally (0 with none)."""
+        _u, _c, dist, _t, n_fwd, _n_rev = self.pairs(p, a, b)
+        means = [d[d < PAIR_CAP_PX].mean() for d in (dist[:n_fwd], dist[n_fwd:]) if (d < PAIR_CAP_PX).any()]
+        return float(np.mean(means)) if means else 0.0
+
     def fit(self, p: np.ndarray, a: np.ndarray, b: np.ndarray, iterations: int = ITERATIONS,
             affine: bool = False):
         """ICP from ``(a, b)``: ``(a, b, cost)``; ``a`` stays diagonal unless ``affine``."""
@@ -576,10 +584,15 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
     a_free, b_free, cost_free = fine.fit(p, a, b, affine=True)
     off_diagonal = max(abs(a_free[0, 1]) * reach[1], abs(a_free[1, 0]) * reach[0])
     if cost > RESIDUAL_MAX_PX or off_diagonal > ROTATION_TOL_PX:
-        return [{"name": "unexplained", "confidence": confidence, "residual_px": cost,
+        fault = {"name": "unexplained", "confidence": confidence, "residual_px": cost,
                  "best_family": list(names) or ["none"],
                  "scale": np.diag(a).tolist(), "offset": b.tolist(), "affine": a_free.tolist(),
                  "affine_residual_px": cost_free, "off_diagonal_px": float(off_diagonal),
-                 "rotation_deg": rotation_deg(a_free)}]
+                 "rotation_deg": rotation_deg(a_free)}
+        matched = fine.matched(p, a, b)         # the lines in place, only the drawn sets differ?
+        if in_place(names, np.diag(a), b, off_diagonal, reach, matched,
+                    (SCALE_TOL_PX, OFFSET_TOL_PX, ROTATION_TOL_PX, RESIDUAL_MAX_PX)):
+            fault = visibility_fault(fault, cand_images, oracle_segs, camera, matched)
+        return [fault]
     return name_faults(fine, ranked, plain, camera, oracle_segs, reach, quantisation_bias, SCALE_TOL_PX,
                        OFFSET_TOL_PX, AMBIGUOUS_RATIO, cost)

@@ -94,6 +94,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     from ..candidates.draw import oracle_segments as line_segments
     from ..candidates.frames_candidate import frame_inputs
     from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+    from ..diagnosis.image_visibility import frames_visibility
 
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     numbers = [int(Path(rel).stem.split("_")[-1]) for rel in c["frames"]]
@@ -132,14 +133,17 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     acc.record_lines(acc.batch.flush())
     rec = case_record(job, scene, case, camera, acc, len(numbers))
     faults = []
+    images, segments = [_image(flat, shape) for flat, shape, _, _ in acc.diag], [s for _, _, s, _ in acc.diag]
     if diagnose:
-        faults = diagnose_images([_image(flat, shape) for flat, shape, _, _ in acc.diag],
-                                 [s for _, _, s, _ in acc.diag], camera, [f for _, _, _, f in acc.diag])
+        faults = diagnose_images(images, segments, camera, [f for _, _, _, f in acc.diag])
     rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
     # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
     style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol))
     rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
     decide(rec, tol, level="frames")
+    if diagnose and not faults and rec["verdict"] == "fail":
+        # the images fit the oracle's lines (nothing named from them) and the case fails: which sets differ?
+        rec["faults"] = frames_visibility(rec["faults"], images, segments, camera, len(numbers))
     rec["per_frame"] = acc.per_frame
     return rec, {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
 
