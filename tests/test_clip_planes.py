@@ -116,6 +116,36 @@ def test_visibility_only_unexplained_advises_visibility_not_rotation():
     assert "rotation" not in u["hint"].replace("not the rotation", "")
 
 
+# A far plane that float32 cannot hold: 6.1 rounds down to 6.0999999046 (1.6e-8 relative, within the
+# float32 limit of clip_planes, 4 eps32 (1 + far / near) = 1.1e-6, and far above PLANE_REL_TOL's 1e-9)
+CAM_F32_FAR = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480, near=4.5, far=6.1)
+F32_FAR = float(np.float32(CAM_F32_FAR.far))
+
+
+def test_a_float32_far_plane_is_named_float32_far():
+    """An exact projector whose far test went through float32 (``z <= float32(far)``): it drops the points
+    between float32(far) and far that the oracle keeps, and nothing else."""
+    assert F32_FAR < CAM_F32_FAR.far
+    func = lambda points, camera: pinhole(points, camera, lambda z, c: (z >= c.near) & (z <= np.float32(c.far)))
+    gap = np.linspace(F32_FAR, CAM_F32_FAR.far, 5)[1:-1]                  # kept by the oracle, dropped here
+    pts = np.concatenate([POINTS, CAM_F32_FAR.position + gap[:, None] * np.asarray(CAM_F32_FAR.forward)])
+    ref = oracle_project(pts, CAM_F32_FAR)
+    cand = func(pts, CAM_F32_FAR)
+    assert int((np.isfinite(ref).all(axis=1) & ~np.isfinite(cand).all(axis=1)).sum()) == len(gap)
+    planes = probe_planes(func, CAM_F32_FAR)
+    got = diagnose(cand, ref, CAM_F32_FAR, tol_px=1e-6, float32_px=1e-3, planes=planes)
+    assert [(f["name"], f["kind"]) for f in got] == [("clipping_plane", "float32_far")], got
+    (f,) = got
+    # near is the camera's; far is float32(far): the probe brackets a plane to ~3e-12 relative (0.16 / 63^6),
+    # so 1e-10 tells F32_FAR from far (1.6e-8 apart), which REL (1e-6) could not
+    assert f["near_fit"] == pytest.approx(CAM_F32_FAR.near, rel=REL)
+    assert f["far_fit"] == pytest.approx(F32_FAR, rel=1e-10) and f["far_fit"] != pytest.approx(CAM_F32_FAR.far,
+                                                                                               rel=1e-9)
+    assert (f["near"], f["far"]) == (CAM_F32_FAR.near, CAM_F32_FAR.far)
+    hint = dict(fault_hints(got))["clipping_plane"]
+    assert hint == clip_planes.HINTS["float32_far"] and "far plane went through float32" in hint
+
+
 def test_a_broken_probe_is_no_fault():
     def crashes_on_axis(points, camera):
         raise ZeroDivisionError("boom")
