@@ -16,6 +16,7 @@ from collections import Counter
 import numpy as np
 import pytest
 
+from wirecheck.core.camera import look_at
 from wirecheck.core.projector.projection import project_points
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
@@ -258,6 +259,22 @@ def test_float32_aspect_is_precision_limited():
     assert [(f["name"], f.get("kind")) for f in got] == [("precision_limited", "float32_constants")], got
     # the fitted scale is (W/H) / a32 to ~3.5e-14 relative (budget above)
     assert got[0]["scale_x"] / got[0]["scale_y"] == pytest.approx((cam.width / cam.height) / a32, rel=1e-12)
+
+
+def test_float32_principal_point_is_precision_limited():
+    """A float64 projector whose principal point went through float32 (cx = 360.3 -> 360.29998779): the
+    lines shift by -1.2e-5 px, above TOL and far below any convention's half pixel: precision_limited with
+    that offset, not pixel_offset(dx=-1.2e-05). Judged without the float32 bound it stays pixel_offset."""
+    cam = look_at((3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), width=640, height=480, intrinsics=(520.0, 520.0, 360.3, 210.7))
+    cx32, cy32 = float(np.float32(360.3)), float(np.float32(210.7))
+    ref = oracle_project(POINTS, cam)
+    cand = _project(POINTS, cam, cx=cx32, cy=cy32)
+    got = diagnose(cand, ref, cam, tol_px=TOL, float32_px=float32_bound(POINTS, cam, ref))
+    assert [(f["name"], f.get("kind")) for f in got] == [("precision_limited", "float32_constants")], got
+    # the fitted offset is the rounding itself: pixels of ~600 px exact to ~1e-13 px (budget above)
+    assert got[0]["dx"] == pytest.approx(cx32 - 360.3, abs=1e-11)
+    assert got[0]["dy"] == pytest.approx(cy32 - 210.7, abs=1e-11)
+    assert [f["name"] for f in diagnose(cand, ref, cam, tol_px=TOL)] == ["pixel_offset"]
 
 
 @pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
