@@ -146,6 +146,23 @@ def test_a_float32_far_plane_is_named_float32_far():
     assert hint == clip_planes.HINTS["float32_far"] and "far plane went through float32" in hint
 
 
+@pytest.mark.parametrize("name,kind", [("z_positive", "z_positive"), ("none", "none")])
+def test_a_run_names_the_clipping_plane(name, kind):
+    """Through check_projector (the probe run by the judge, oracles.judge.case): the near_plane case, whose near
+    plane cuts the cube, fails as clipping_plane of its kind with its hint (was unexplained(residual_px=3e-13)
+    with the rotation advice); on_axis, where nothing is clipped, passes."""
+    report = wirecheck.check_projector(_candidate(name), scenes=["cube"], cases=["near_plane", "on_axis"], frames=4,
+                                       isolate=False)
+    by = {c["camera"]: c for c in report["cases"]}
+    assert by["on_axis"]["verdict"] == "pass" and by["on_axis"]["faults"] == []
+    case = by["near_plane"]
+    assert case["verdict"] == "fail"
+    assert [(f["name"], f["kind"]) for f in case["faults"]] == [("clipping_plane", kind)], case["faults"]
+    # z > 0 keeps points at 1e-9 near, the probe's nearest depth: near_fit 0.0; never clipping: no plane
+    assert case["faults"][0]["near_fit"] == (0.0 if kind == "z_positive" else None)
+    assert dict(fault_hints(case["faults"]))["clipping_plane"] == clip_planes.HINTS[kind]
+
+
 def test_a_broken_probe_is_no_fault():
     def crashes_on_axis(points, camera):
         raise ZeroDivisionError("boom")
