@@ -111,3 +111,27 @@ def test_a_rolled_camera_keeps_the_rotation_advice(judged):
     assert "hint" not in case["faults"][0], case["faults"]
     assert dict(fault_hints(case["faults"]))["unexplained"] == FAULT_HINTS["unexplained"]
     assert "rotation order" in FAULT_HINTS["unexplained"]
+
+
+def test_a_line_width_fault_stays_a_line_fault():
+    """oracles.diagnosis.image_visibility.frames_visibility on drawn lines: a square's four lines drawn one pixel
+    thicker (every pixel also one column right: 1 px from the line, never farther) keep their line_pixel_bias;
+    the same lines with a piece of one missing (a far plane cutting it) are the visibility question."""
+    from wirecheck.oracles.diagnosis.image_visibility import frames_visibility
+
+    cam = Camera(position=(0, 0, 0), forward=(0, 0, -1), up=(0, 1, 0), width=64, height=48)
+    segs = np.array([[[10, 10], [50, 10]], [[50, 10], [50, 40]], [[50, 40], [10, 40]], [[10, 40], [10, 10]]], float)
+    exact = np.zeros((48, 64), bool)
+    exact[10, 10:51] = exact[40, 10:51] = exact[10:41, 10] = exact[10:41, 50] = True    # the square's pixels
+    thick = exact.copy()
+    thick[:, 1:] |= exact[:, :-1]
+    width_fault = {"name": "line_pixel_bias", "candidate_only": int((thick & ~exact).sum()), "oracle_only": 0}
+    assert frames_visibility([width_fault], [thick], [segs], cam, 1) == [width_fault]
+    cut = exact.copy()
+    cut[40, 10:31] = False                             # 21 pixels of the bottom line missing
+    piece_fault = {"name": "line_pixel_bias", "candidate_only": 0, "oracle_only": 21}
+    (got,) = frames_visibility([piece_fault], [cut], [segs], cam, 1)
+    # 19 of them beyond 1 px: (40, 30) is 1 px from the kept (40, 31), (40, 10) 1 px from the kept (39, 10);
+    # (40, 11) is sqrt(2) from (39, 10)
+    assert got["name"] == "unexplained" and got["line_fault"] == piece_fault
+    assert (got["candidate_only_px"], got["oracle_only_px"]) == (0, 19), got
