@@ -94,6 +94,9 @@ def test_a_near_plane_too_far_is_a_visibility_question(judged, mistake):
     assert fault["oracle_only_px"] == pytest.approx(_missing_px(job_dir, MISTAKES[mistake]), rel=0.02), fault
     (name, hint), = fault_hints(case["faults"])
     assert "near/far test" in hint and "rotation order" not in hint, hint
+    # near x 1.5: the images name nothing; the one-sided line pixels would be line_pixel_bias ("check the line
+    # width"), but they are whole pieces of line
+    assert fault.get("line_fault") == (None if mistake == "near2" else "line_pixel_bias"), fault
 
 
 def test_the_image_fit_says_its_pairs_are_a_correct_drawings(judged):
@@ -133,5 +136,5 @@ def test_a_line_width_fault_stays_a_line_fault():
     (got,) = frames_visibility([piece_fault], [cut], [segs], cam, 1)
     # 19 of them beyond 1 px: (40, 30) is 1 px from the kept (40, 31), (40, 10) 1 px from the kept (39, 10);
     # (40, 11) is sqrt(2) from (39, 10)
-    assert got["name"] == "unexplained" and got["line_fault"] == piece_fault
+    assert got["name"] == "unexplained" and got["line_fault"] == "line_pixel_bias"
     assert (got["candidate_only_px"], got["oracle_only_px"]) == (0, 19), got

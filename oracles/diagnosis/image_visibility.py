@@ -103,7 +103,7 @@ def frames_visibility(faults: list, cand_images, oracle_segs, camera, frames_che
     one-sided pixels are mostly whole pieces of line (at least half of its decided one-sided pixels, per
     frame, lie farther than :data:`NEAR_PX` from the other side: a line drawn too thick or too thin never
     leaves a pixel that far) is a visibility difference, not a line width: it becomes that ``unexplained``,
-    the line fault kept under ``line_fault``. ``cand_images``, ``oracle_segs``: the diagnosed frames (of the
+    the line fault's name kept under ``line_fault``. ``cand_images``, ``oracle_segs``: the diagnosed frames (of the
     case's ``frames_checked``).
     """
     if len(faults) != 1 or not len(cand_images) or faults[0]["name"] not in ("unexplained", "line_pixel_bias"):
@@ -114,5 +114,5 @@ def frames_visibility(faults: list, cand_images, oracle_segs, camera, frames_che
     decided = faults[0]["candidate_only"] + faults[0]["oracle_only"]
     if sum(counts) * frames_checked < 0.5 * decided * len(cand_images):
         return faults
-    return [visibility_fault({"name": "unexplained", "line_fault": faults[0]}, cand_images, oracle_segs, camera,
+    return [visibility_fault({"name": "unexplained", "line_fault": faults[0]["name"]}, cand_images, oracle_segs, camera,
                              None, counts)]
