@@ -131,6 +131,22 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     state and print options, ``os.environ``, ``sys.path``, the current
     directory, logging and signal handlers.
     """
+    report, _images = run_check(func, scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns,
+                                allow_vacuous, cmd=cmd, timeout_s=timeout_s, isolate=isolate, precision=precision,
+                                config=config)
+    return report
+
+
+def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol_px=None, min_f1=None,
+              min_f1_0px=None, turns=None, allow_vacuous=False, *, cmd=None, timeout_s=None, isolate=None,
+              precision=None, config=None) -> tuple[dict, dict]:
+    """:func:`check_projector`'s work: the report and its pictures' data.
+
+    The second value is what :func:`wirecheck.oracles.reports.report.write_report` draws: the
+    worst frames' images at level pixels, the worst case's points (``images["points"]``,
+    worst_points.png) at level vertices; the ``wirecheck`` fixture's ``--wirecheck-report``
+    writes them, so its reports show what crosscheck's show.
+    """
     given = {"scenes": scenes, "frames": frames, "cases": cases, "oracles": oracles, "tol_px": tol_px,
              "min_f1": min_f1, "min_f1_0px": min_f1_0px, "turns": turns, "timeout_s": timeout_s,
              "precision": precision}
@@ -155,10 +171,10 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
             ok, message = gl_available()
             if not ok:
                 raise GLUnavailable(message)
-        report, _images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
+        report, images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
                                          oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
                                          allow_vacuous=allow_vacuous)
-    return report
+    return report, images
 
 
 def settings_for(given: dict, config=None) -> dict:
