@@ -18,7 +18,10 @@ block change that:
 Commands run in a fresh temporary folder that links ``.venv``, ``tests`` and ``scenes`` of the
 checkout (so ``.venv/bin/crosscheck`` and ``tests/data/...`` mean what they mean in a checkout,
 and the outputs a command writes do not land in the checkout), with ``.venv/bin`` first on PATH;
-the folder's path is printed as ``/home/me/myproj`` (:data:`USER_PROJECT`).
+the folder's path is printed as ``/home/me/myproj`` (:data:`USER_PROJECT`). A plain
+``crosscheck`` or ``renderer`` command runs as its console script's ``main()`` in a fork of
+this process, its heavy imports done once (:func:`_run_forked`); ``X >/dev/null; Y`` runs
+``Y`` in the folder of ``X``'s own run (:meth:`Runner.output`).
 
 Comparison (:func:`matches`) is line by line after :func:`normalise` (times, dates, report
 folder names, ports and rounding-level vertex errors become placeholders: they change on every
