@@ -23,7 +23,7 @@ defaults. A bad table is a pytest usage error before any test runs.
 
 ``--wirecheck-report DIR`` writes report.json, report.md and report.html
 (oracles.reports.report, with crosscheck's pictures: worst_points.png at level vertices, the
-worst frames at level pixels) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
+worst frames and worst.gif at level pixels) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
 for a test's later checks); the terminal summary counts them, under
 pytest-xdist too (each test's ``user_properties`` carries its folder as
 ``wirecheck_report``, which pytest's ``--junitxml`` also lists).
