@@ -421,9 +421,20 @@ def _run_forked(program: str, args: list[str], work: str, env: dict) -> list[str
         finally:
             os._exit(code if isinstance(code, int) else 1)
     os.close(write_end)
-    chunks = []
-    with open(read_end, "rb") as pipe:
-        while chunk := pipe.read(65536):
+    import select
+    import time
+
+    chunks, deadline = [], time.monotonic() + COMMAND_TIMEOUT_S
+    with open(read_end, "rb", buffering=0) as pipe:
+        while True:                                     # as subprocess.run(timeout=...): a hung run is an error
+            ready, _, _ = select.select([pipe], [], [], max(0.0, deadline - time.monotonic()))
+            if not ready:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                raise subprocess.TimeoutExpired([program, *args], COMMAND_TIMEOUT_S)
+            chunk = pipe.read(65536)
+            if not chunk:
+                break
             chunks.append(chunk)
     os.waitpid(pid, 0)
     return b"".join(chunks).decode("utf-8", "replace").splitlines()

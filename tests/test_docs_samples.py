@@ -188,3 +188,10 @@ def test_a_report_excerpt_reads_the_folder_of_the_run_it_follows():
     assert shown and len(runner._cache) == 2 and len(runner._folders) == 1     # the renderer ran once
     # what the renderer wrote, as a run of the whole line in an empty folder lists it (less the links)
     assert [n for n in listing if n not in (".venv", "scenes", "tests")] == again and again
+
+
+def test_a_forked_command_past_its_time_is_killed(tmp_path, monkeypatch):
+    # 180 frames of the cube take ~0.3 s of CPU here (seconds on a loaded machine); 0.01 s is far less
+    monkeypatch.setattr(ds, "COMMAND_TIMEOUT_S", 0.01)
+    with pytest.raises(ds.subprocess.TimeoutExpired):
+        ds._run_forked("renderer", ["--scene", "cube", "--frames", "180"], str(tmp_path), ds.Runner._env())
