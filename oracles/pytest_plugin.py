@@ -134,7 +134,7 @@ class Check:
     Crosschecks ``projector`` and fails the test with the diagnosis when a case
     fails. ``settings`` are keywords of
     :func:`wirecheck.oracles.api.check_projector` (scenes, cases, frames,
-    oracles, tol_px, min_f1, min_f1_0px, turns, precision); they win over the
+    oracles, tol_px, min_f1, min_f1_0px, turns, precision, report_dir); they win over the
     ``--wirecheck-*`` options and ``[tool.wirecheck]``.
     """
 
@@ -161,8 +161,16 @@ class Check:
         self._calls += 1
         error, trace = None, True
         try:
+            from .api import _report_dir
+
+            settings = dict(settings)
+            run_dir = _report_dir(settings.pop("report_dir", None))   # check_projector's: written pass or fail
             # the table was read at start-up (rootdir or --wirecheck-config): not again from the cwd
             report, images = run_check(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
+            if run_dir is not None:
+                from .reports.report import write_report
+
+                write_report(run_dir, report, images)
         except (ValueError, TypeError) as exc:   # InputError is a ValueError: a bad setting or projector spec
             error = f"wirecheck: {type(exc).__name__}: {exc}"
         except RuntimeError as exc:
@@ -174,6 +182,8 @@ class Check:
             pytest.fail(error, pytrace=trace)
         text = failure_text(report)
         if text is not None:
+            if run_dir is not None:
+                text += f"\n  report: {run_dir / 'report.html'}"
             if config.option.wirecheck_report is not None:
                 text += "\n" + _write(config, self._node, self._calls, report, images)
             pytest.fail(text)

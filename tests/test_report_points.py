@@ -112,7 +112,7 @@ def shifted(points, camera):
 
 
 def test_shifted(wirecheck):
-    wirecheck(shifted, scenes=["cube"], frames=1, cases=["on_axis"])
+    wirecheck(shifted, scenes=["cube"], frames=1, cases=["on_axis"], report_dir="own")
 '''
 
 
@@ -137,6 +137,10 @@ def test_the_fixtures_vertex_report_plots_the_points_where_they_were_projected(p
     result.assert_outcomes(failed=1)
     out = pytester.path / "reports" / "test_user.py_test_shifted"
     assert "src='worst_points.png'" in (out / "report.html").read_text()
+    # the call's own report_dir (check_projector's keyword) holds the same report
+    own = pytester.path / "own"
+    assert (own / "worst_points.png").read_bytes() == (out / "worst_points.png").read_bytes()
+    result.stdout.fnmatch_lines(["E         report: own/report.html"])
     # the frame's points as the candidate returned them (one frame: the cube's 8 corners); OpenCV's
     # are these less the shift (user_projector.project agrees with OpenCV to ~1e-13 px:
     # tests/test_api.py), so the expected picture comes from the candidate, not from the plot's code
@@ -166,3 +170,36 @@ def test_the_fixtures_vertex_report_plots_the_points_where_they_were_projected(p
     for marks, p_px in ((crosses, p_cand), (circles, p_orac)):
         d = np.linalg.norm(marks[:, None, :] - placed(p_px)[None, :, :], axis=2)
         assert d.min(axis=0).max() < 1.5 and d.min(axis=1).max() < 1.5     # each point has its mark, and back
+
+
+def test_the_api_writes_the_same_picture_as_crosscheck(tmp_path):
+    # assert_projector(report_dir=...) writes the report crosscheck --report-dir writes for the same run:
+    # the same worst_points.png, byte for byte (a report is deterministic), and says where it is
+    from wirecheck import assert_projector
+
+    settings = ("--scene", "cube", "--cases", "on_axis", "--frames", "2", "--level", "vertices")
+    code, _, cli_dir = run(tmp_path, "--candidate", CORNER, *settings)
+    api_dir = tmp_path / "api"
+    try:
+        assert_projector(CORNER, scenes=["cube"], cases=["on_axis"], frames=2, config=False, report_dir=api_dir)
+        raise RuntimeError("a half-pixel offset passed")
+    except AssertionError as exc:
+        message = str(exc)
+    assert code == 1 and message.endswith(f"report: {api_dir / 'report.html'}")
+    cli_png = (cli_dir / "worst_points.png").read_bytes()
+    assert (api_dir / "worst_points.png").read_bytes() == cli_png
+    assert "src='worst_points.png'" in (api_dir / "report.html").read_text()
+
+
+def test_a_report_dir_that_is_not_a_folder_is_refused_before_the_run(tmp_path):
+    import pytest
+
+    from wirecheck import check_projector
+
+    mine = tmp_path / "notes.txt"
+    mine.write_text("mine\n")
+    with pytest.raises(ValueError, match="notes.txt' is a file: expected a folder"):
+        check_projector(CORNER, report_dir=mine, config=False)
+    with pytest.raises(TypeError, match="report_dir 42: expected a folder path"):
+        check_projector(CORNER, report_dir=42, config=False)
+    assert mine.read_text() == "mine\n"
