@@ -71,4 +71,4 @@ def check_candidate_timeout(seconds: float, option: str) -> None:
     """InputError unless ``seconds`` is finite, > 0 and at most MAX_CANDIDATE_TIMEOUT_S."""
     if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
         raise InputError(f"{option} {seconds}: expected a number of seconds > 0 and at most "
-                         f"{MAX_CANDIDATE_TIMEOUT_S:.0f} (one day; core/limits.py)")
+                         f"{MAX_CANDIDATE_TIMEOUT_S:.0f} (one day; wirecheck.core.limits)")

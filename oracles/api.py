@@ -46,7 +46,8 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
                     tol_px: float | None = None, min_f1: float | None = None,
                     min_f1_0px: float | None = None, turns=None,
                     allow_vacuous: bool = False, *, cmd=None, timeout_s: float | None = None,
-                    isolate: bool | None = None, precision: str | None = None, config=None) -> dict:
+                    isolate: bool | None = None, precision: str | None = None, config=None,
+                    report_dir=None) -> dict:
     """Crosscheck a projector against OpenCV (and pyrender) and return the report.
 
     A setting not given (None) comes from ``[tool.wirecheck]`` in the nearest ``pyproject.toml``
@@ -101,6 +102,11 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     config : str, Path or False, optional
         The file whose ``[tool.wirecheck]`` fills the settings not given (default: the nearest
         ``pyproject.toml`` at or above the working directory); False: no file.
+    report_dir : str or Path, optional
+        Write the report there as crosscheck's ``--report-dir`` does: report.json, report.md and
+        report.html with their pictures (worst_points.png at level vertices; the worst frames,
+        their crops and worst.gif at level pixels). A folder wirecheck did not write is never
+        replaced (ValueError). Default None: nothing is written.
 
     Returns
     -------
@@ -114,7 +120,8 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
         (:class:`~wirecheck.core.errors.InputError`) Inputs that would compare
         nothing: no scene or case, an unknown or repeated name, ``frames`` < 1,
         a NaN or boolean tolerance, a precision other than float32 or float64,
-        ``timeout_s`` not finite and > 0; neither ``func`` nor ``cmd``, or both.
+        ``timeout_s`` not finite and > 0; neither ``func`` nor ``cmd``, or both;
+        a ``report_dir`` that is a file, or a folder with files wirecheck did not write.
     TypeError
         An argument of the wrong kind, named with its value and what was
         expected: ``func`` not callable (nor a string) or not callable as
@@ -130,6 +137,45 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     (:mod:`wirecheck.oracles.candidates.caller_state`): warning filters, numpy's error
     state and print options, ``os.environ``, ``sys.path``, the current
     directory, logging and signal handlers.
+    """
+    run_dir = _report_dir(report_dir)
+    report, images = run_check(func, scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns,
+                               allow_vacuous, cmd=cmd, timeout_s=timeout_s, isolate=isolate, precision=precision,
+                               config=config)
+    if run_dir is not None:
+        from .reports.report import write_report
+
+        write_report(run_dir, report, images)
+    return report
+
+
+def _report_dir(report_dir):
+    """``report_dir`` as a Path (None: none), checked before anything runs: TypeError for a non-path,
+    ValueError (InputError) for a path that is a file."""
+    import os
+    from pathlib import Path
+
+    from wirecheck.core.errors import InputError
+
+    if report_dir is None:
+        return None
+    if isinstance(report_dir, bool) or not isinstance(report_dir, (str, os.PathLike)):
+        raise TypeError(f"report_dir {_short(report_dir)}: expected a folder path (str or Path), or None")
+    path = Path(report_dir)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"report_dir {str(path)!r} is a file: expected a folder for the report")
+    return path
+
+
+def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol_px=None, min_f1=None,
+              min_f1_0px=None, turns=None, allow_vacuous=False, *, cmd=None, timeout_s=None, isolate=None,
+              precision=None, config=None) -> tuple[dict, dict]:
+    """:func:`check_projector`'s work: the report and its pictures' data.
+
+    The second value is what :func:`wirecheck.oracles.reports.report.write_report` draws: the
+    worst frames' images at level pixels, the worst case's points (``images["points"]``,
+    worst_points.png) at level vertices; the ``wirecheck`` fixture's ``--wirecheck-report``
+    writes them, so its reports show what crosscheck's show.
     """
     given = {"scenes": scenes, "frames": frames, "cases": cases, "oracles": oracles, "tol_px": tol_px,
              "min_f1": min_f1, "min_f1_0px": min_f1_0px, "turns": turns, "timeout_s": timeout_s,
@@ -155,10 +201,10 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
             ok, message = gl_available()
             if not ok:
                 raise GLUnavailable(message)
-        report, _images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
+        report, images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
                                          oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
                                          allow_vacuous=allow_vacuous)
-    return report
+    return {"run": None, **report}, images        # report.json's fields: "run" is crosscheck's --run name
 
 
 def settings_for(given: dict, config=None) -> dict:
@@ -313,5 +359,9 @@ def assert_projector(func=None, **kwargs) -> dict:
     report = check_projector(func, **kwargs)
     text = failure_text(report)
     if text is not None:
+        if kwargs.get("report_dir") is not None:
+            from pathlib import Path
+
+            text += f"\n  report: {Path(kwargs['report_dir']) / 'report.html'}"
         raise AssertionError(text)
     return report

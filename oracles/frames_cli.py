@@ -52,7 +52,7 @@ def export_main(argv) -> int:
 
         if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
             raise InputError(f"--frames {args.frames} --every {args.every}: expected --frames in 1..{MAX_FRAMES:,} "
-                             "(core/limits.py, as renderer and crosscheck) and --every >= 1")
+                             "(wirecheck.core.limits, as renderer and crosscheck) and --every >= 1")
         cases = [c.strip() for c in args.cases.split(",") if c.strip()]
         bad = [c for c in cases if c not in ALL_CASE_NAMES]
         if bad or not cases:

@@ -22,7 +22,8 @@ nearest ``pyproject.toml`` at or above pytest's rootdir, or
 defaults. A bad table is a pytest usage error before any test runs.
 
 ``--wirecheck-report DIR`` writes report.json, report.md and report.html
-(oracles.reports.report) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
+(oracles.reports.report, with crosscheck's pictures: worst_points.png at level vertices, the
+worst frames and worst.gif at level pixels) of every failing check to ``DIR/<test id>`` (``-2``, ``-3``
 for a test's later checks); the terminal summary counts them, under
 pytest-xdist too (each test's ``user_properties`` carries its folder as
 ``wirecheck_report``, which pytest's ``--junitxml`` also lists).
@@ -102,8 +103,10 @@ def report_name(nodeid: str) -> str:
     return name
 
 
-def _write(config, node, index: int, report: dict) -> str:
-    """Write the report of a failing check; the line to add to the failure message.
+def _write(config, node, index: int, report: dict, images: dict) -> str:
+    """Write the report of a failing check, with its pictures (``images`` from
+    :func:`wirecheck.oracles.api.run_check`: the worst frames, or worst_points.png at level
+    vertices, as crosscheck's own reports); the line to add to the failure message.
 
     The folder is also the test's ``user_properties`` entry ``wirecheck_report``:
     it reaches the terminal summary from pytest-xdist workers, and pytest's own
@@ -118,7 +121,7 @@ def _write(config, node, index: int, report: dict) -> str:
     run_dir = root / (report_name(nodeid) + (f"-{index}" if index > 1 else ""))
     try:
         root.mkdir(parents=True, exist_ok=True)
-        write_report(run_dir, report, {})
+        write_report(run_dir, report, images)
     except (InputError, OSError) as exc:
         return f"  report not written: {exc}"
     node.user_properties.append(("wirecheck_report", str(run_dir)))
@@ -131,7 +134,7 @@ class Check:
     Crosschecks ``projector`` and fails the test with the diagnosis when a case
     fails. ``settings`` are keywords of
     :func:`wirecheck.oracles.api.check_projector` (scenes, cases, frames,
-    oracles, tol_px, min_f1, min_f1_0px, turns, precision); they win over the
+    oracles, tol_px, min_f1, min_f1_0px, turns, precision, report_dir); they win over the
     ``--wirecheck-*`` options and ``[tool.wirecheck]``.
     """
 
@@ -146,7 +149,7 @@ class Check:
 
     def __call__(self, projector=None, **settings) -> dict:
         __tracebackhide__ = True
-        from .api import check_projector, failure_text
+        from .api import failure_text, run_check
 
         config = self._config
         projector = projector if projector is not None else config.stash[_CANDIDATE]
@@ -158,8 +161,16 @@ class Check:
         self._calls += 1
         error, trace = None, True
         try:
+            from .api import _report_dir
+
+            settings = dict(settings)
+            run_dir = _report_dir(settings.pop("report_dir", None))   # check_projector's: written pass or fail
             # the table was read at start-up (rootdir or --wirecheck-config): not again from the cwd
-            report = check_projector(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
+            report, images = run_check(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
+            if run_dir is not None:
+                from .reports.report import write_report
+
+                write_report(run_dir, report, images)
         except (ValueError, TypeError) as exc:   # InputError is a ValueError: a bad setting or projector spec
             error = f"wirecheck: {type(exc).__name__}: {exc}"
         except RuntimeError as exc:
@@ -171,8 +182,10 @@ class Check:
             pytest.fail(error, pytrace=trace)
         text = failure_text(report)
         if text is not None:
+            if run_dir is not None:
+                text += f"\n  report: {run_dir / 'report.html'}"
             if config.option.wirecheck_report is not None:
-                text += "\n" + _write(config, self._node, self._calls, report)
+                text += "\n" + _write(config, self._node, self._calls, report, images)
             pytest.fail(text)
         return report
 

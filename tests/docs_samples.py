@@ -18,7 +18,10 @@ block change that:
 Commands run in a fresh temporary folder that links ``.venv``, ``tests`` and ``scenes`` of the
 checkout (so ``.venv/bin/crosscheck`` and ``tests/data/...`` mean what they mean in a checkout,
 and the outputs a command writes do not land in the checkout), with ``.venv/bin`` first on PATH;
-the folder's path is printed as ``/home/me/myproj`` (:data:`USER_PROJECT`).
+the folder's path is printed as ``/home/me/myproj`` (:data:`USER_PROJECT`). A plain
+``crosscheck`` or ``renderer`` command runs as its console script's ``main()`` in a fork of
+this process, its heavy imports done once (:func:`_run_forked`); ``X >/dev/null; Y`` runs
+``Y`` in the folder of ``X``'s own run (:meth:`Runner.output`).
 
 Comparison (:func:`matches`) is line by line after :func:`normalise` (times, dates, report
 folder names, ports and rounding-level vertex errors become placeholders: they change on every
@@ -260,23 +263,31 @@ class Runner:
 
     def __init__(self):
         self._cache: dict[tuple, list[str]] = {}
+        self._folders: dict[tuple, str] = {}
         self._dirs: list[str] = []
 
     def output(self, command: str, cwd: str | None = None) -> list[str]:
+        """What ``command`` prints (stdout and stderr), run in ``cwd``'s copy.
+
+        ``X >/dev/null; Y`` with ``X`` a plain console-script command (:data:`_PLAIN_CLI`) runs
+        ``Y`` in the folder where ``X`` ran for its own sample (or runs ``X`` there first): a
+        report excerpt reads the report of the run the doc shows instead of running it again.
+        ``X``'s output is dropped, as ``>/dev/null`` drops it; a sample of ``X`` itself compares
+        all of it."""
         key = (command, cwd)
         if key not in self._cache:
-            self._cache[key] = self._run(command, cwd)
+            after = _AFTER.match(command)
+            if after and _PLAIN_CLI.match(after.group(1)):
+                first = after.group(1)
+                self.output(first, cwd)
+                work = self._folders[(first, cwd)]
+                self._cache[key] = _shown(self._run_bash(after.group(2), work, self._env()), work)
+            else:
+                self._cache[key] = self._run(command, cwd)
         return self._cache[key]
 
-    def _run(self, command: str, cwd: str | None) -> list[str]:
-        work = tempfile.mkdtemp(prefix="wirecheck-docs-")
-        self._dirs.append(work)
-        if cwd:
-            shutil.copytree(ROOT / cwd, work, dirs_exist_ok=True,
-                            ignore=shutil.ignore_patterns("__pycache__", ".pytest_cache"))
-        for name in (".venv", "tests", "scenes"):
-            if not os.path.exists(os.path.join(work, name)):
-                os.symlink(ROOT / name, os.path.join(work, name))
+    @staticmethod
+    def _env() -> dict:
         env = dict(os.environ)
         env["PATH"] = f"{ROOT / '.venv' / 'bin'}{os.pathsep}{env.get('PATH', '')}"
         env["COLUMNS"] = "80"             # argparse and pytest wrap to the terminal's width
@@ -285,22 +296,148 @@ class Runner:
         for name in ("CI", "BUILD_NUMBER"):   # pytest prints its summary lines whole under CI: a user's terminal
             env.pop(name, None)
         env["PYTHONDONTWRITEBYTECODE"] = "1"
+        return env
+
+    def _run(self, command: str, cwd: str | None) -> list[str]:
+        work = tempfile.mkdtemp(prefix="wirecheck-docs-")
+        self._dirs.append(work)
+        self._folders[(command, cwd)] = work
+        if cwd:
+            shutil.copytree(ROOT / cwd, work, dirs_exist_ok=True,
+                            ignore=shutil.ignore_patterns("__pycache__", ".pytest_cache"))
+        for name in (".venv", "tests", "scenes"):
+            if not os.path.exists(os.path.join(work, name)):
+                os.symlink(ROOT / name, os.path.join(work, name))
+        env = self._env()
+        plain = _PLAIN_CLI.match(command)
+        if plain and "OpenGL" not in sys.modules:
+            return _shown(_run_forked(plain.group(1), command.split()[1:], work, env), work)
+        return _shown(self._run_bash(command, work, env), work)
+
+    @staticmethod
+    def _run_bash(command: str, work: str, env: dict) -> list[str]:
         # `pytest` is the environment's (the venv has no pytest script of its own)
         script = f'pytest() {{ "{ROOT / ".venv" / "bin" / "python"}" -m pytest "$@"; }}\n{command}'
         done = subprocess.run(["bash", "-c", script], cwd=work, env=env, stdin=subprocess.DEVNULL,
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                               timeout=COMMAND_TIMEOUT_S, text=True)
-        # the folder is the doc's user project (pytest.md: /home/me/myproj)
-        lines = done.stdout.replace(os.path.realpath(work), USER_PROJECT).replace(
-            work, USER_PROJECT).splitlines()
-        while lines and not lines[-1].strip():
-            lines.pop()
-        return lines
+        return done.stdout.splitlines()
 
     def close(self):
         for d in self._dirs:
             shutil.rmtree(d, ignore_errors=True)
         self._dirs.clear()
+
+
+def _shown(lines: list[str], work: str) -> list[str]:
+    """``lines`` as the doc shows them: the folder is the doc's user project (pytest.md:
+    /home/me/myproj), no blank lines at the end."""
+    lines = [line.replace(os.path.realpath(work), USER_PROJECT).replace(work, USER_PROJECT) for line in lines]
+    while lines and not lines[-1].strip():
+        lines.pop()
+    return lines
+
+
+#: ``X >/dev/null; Y``: Y reads what X wrote (Runner.output).
+_AFTER = re.compile(r"^(.*?) >/dev/null; (.*)$")
+#: A command that is one of the console scripts with plain words for arguments (no quoting, pipe,
+#: redirection or second command): it runs as the script's ``main()`` in a fork of this process
+#: (:func:`_run_forked`), not through bash and a new interpreter.
+_PLAIN_CLI = re.compile(r"^(?:\.venv/bin/)?(crosscheck|renderer)(?: [A-Za-z0-9_./:,=+-]+)*$")
+_MAINS = {"crosscheck": "wirecheck.oracles.cli", "renderer": "wirecheck.core.app.cli"}
+#: Imported once here before the first fork, so that no run pays for them again; none of them
+#: loads OpenGL (a fork must pick its GL platform itself, as a new process does).
+_WARM = ("numpy", "scipy.spatial.transform", "cv2", "matplotlib.figure", "matplotlib.backends.backend_agg",
+         "PIL.Image", *_MAINS.values())
+
+
+def _warm_up() -> None:
+    import importlib
+
+    environ = dict(os.environ)
+    try:
+        for name in _WARM:
+            importlib.import_module(name)
+    finally:                             # cv2's import adds to LD_LIBRARY_PATH: this process's is kept
+        for name in set(os.environ) - set(environ):
+            del os.environ[name]
+        for name, value in environ.items():
+            if os.environ.get(name) != value:
+                os.environ[name] = value
+
+
+def _run_forked(program: str, args: list[str], work: str, env: dict) -> list[str]:
+    """``program ARGS`` as its console script would run it, in a fork of this process with the
+    heavy imports done (the samples' CPU time was mostly interpreters starting and importing).
+
+    What the command sees is a new process's: its own folder, environment, stdin /dev/null,
+    stdout and stderr one pipe (as ``bash -c CMD 2>&1``: stdout block-buffered, stderr
+    line-buffered), ``sys.argv``, default signal handlers, no inherited ``atexit`` handler;
+    its exit status is not compared (neither is a subprocess's)."""
+    import atexit
+    import importlib
+    import io
+    import signal
+
+    _warm_up()
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:                                        # the child: never returns
+        code = 3
+        try:
+            os.close(read_end)
+            os.dup2(write_end, 1)
+            os.dup2(write_end, 2)
+            os.close(write_end)
+            os.dup2(os.open(os.devnull, os.O_RDONLY), 0)
+            os.chdir(work)
+            os.environ.clear()
+            os.environ.update(env)
+            for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGPIPE):
+                signal.signal(sig, signal.default_int_handler if sig == signal.SIGINT else signal.SIG_DFL)
+            sys.stdin = open(0, closefd=False)
+            sys.stdout = io.TextIOWrapper(open(1, "wb", closefd=False), encoding="utf-8")
+            sys.stderr = io.TextIOWrapper(open(2, "wb", closefd=False), encoding="utf-8",
+                                          errors="backslashreplace", line_buffering=True)
+            sys.__stdin__, sys.__stdout__, sys.__stderr__ = sys.stdin, sys.stdout, sys.stderr
+            sys.argv = [str(ROOT / ".venv" / "bin" / program), *args]
+            atexit._clear()                         # this process's handlers are not the program's
+            module = importlib.import_module(_MAINS[program])
+            candidates = sys.modules.get("wirecheck.oracles.candidates.subprocess_candidate")
+            if candidates is not None:              # its handler was registered before the fork
+                atexit.register(candidates._close_all)
+            try:
+                code = module.main()
+            except SystemExit as exc:
+                code = exc.code
+            atexit._run_exitfuncs()
+            sys.stdout.flush()
+            sys.stderr.flush()
+        except BaseException:                       # noqa: BLE001 - shown as the run's output
+            import traceback
+
+            traceback.print_exc()
+            sys.stderr.flush()
+        finally:
+            os._exit(code if isinstance(code, int) else 1)
+    os.close(write_end)
+    import select
+    import time
+
+    chunks, deadline = [], time.monotonic() + COMMAND_TIMEOUT_S
+    with open(read_end, "rb", buffering=0) as pipe:
+        while True:                                     # as subprocess.run(timeout=...): a hung run is an error
+            ready, _, _ = select.select([pipe], [], [], max(0.0, deadline - time.monotonic()))
+            if not ready:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                raise subprocess.TimeoutExpired([program, *args], COMMAND_TIMEOUT_S)
+            chunk = pipe.read(65536)
+            if not chunk:
+                break
+            chunks.append(chunk)
+    os.waitpid(pid, 0)
+    return b"".join(chunks).decode("utf-8", "replace").splitlines()
 
 
 def check(sample: Sample, runner: Runner) -> list[str]:

@@ -90,3 +90,15 @@ def test_cli_says_what_it_compared_and_each_hint_once(tmp_path):
     assert m, done.stdout
     cases_wall, in_all = float(m.group(1)), float(m.group(2))
     assert cases_wall + 0.1 < in_all <= time.monotonic() - started + 0.05   # 0.05: the one-decimal rounding
+
+
+def test_the_returned_report_has_the_fields_of_report_json(tmp_path):
+    # docs/pytest.md: check_projector "returns the report (the fields of report.json)"; the same
+    # run from the command line writes the report.json it is compared with
+    from helpers import run_crosscheck
+
+    settings = ("--scene", "cube", "--cases", "on_axis", "--frames", "1", "--level", "vertices")
+    code, written, _ = run_crosscheck(tmp_path, "--candidate", GOOD, *settings)
+    report = check_projector(GOOD, scenes=["cube"], cases=["on_axis"], frames=1, config=False)
+    assert code == 0 and report["verdict"] == "pass"
+    assert list(report) == list(written) and report["run"] is None

@@ -14,6 +14,7 @@ After a change of output, regenerate the samples: ``python tests/docs_samples.py
 from __future__ import annotations
 
 import re
+import tempfile
 
 import pytest
 
@@ -156,3 +157,41 @@ def test_every_cwd_directive_names_a_folder_of_the_repository():
     assert folders, "the pytest and renderer samples run in folders of their own"
     for folder in folders:
         assert (ds.ROOT / folder).is_dir() and not folder.startswith(("/", "..")), folder
+
+
+# -- running: a fork of this process prints what a new process prints -------------------------
+
+FORKED = ["renderer --scene cube --frames 2 --camera-z 4.0 --trace-vertex 6 --trace-frames 1",   # stdout
+          "renderer --camera-pos 0,4,0",                   # one stderr line, exit 2
+          "crosscheck --scene cube --level vertices --frames 1 --cases on_axis --no-report"]
+
+
+@pytest.mark.parametrize("command", FORKED)
+def test_a_forked_command_prints_what_bash_running_it_prints(command, tmp_path):
+    assert ds._PLAIN_CLI.match(command)
+    env = ds.Runner._env()
+    forked = ds._run_forked(command.split()[0], command.split()[1:], str(tmp_path), env)
+    bash = ds.Runner._run_bash(command, str(tmp_path), env)
+    assert forked and ds.matches(bash, forked)             # times normalised, every other character the same
+
+
+def test_a_report_excerpt_reads_the_folder_of_the_run_it_follows():
+    runner = ds.Runner()
+    try:
+        first = "renderer --scene cube --frames 2 --camera-z 4.0"
+        shown = runner.output(first)
+        listing = runner.output(f"{first} >/dev/null; ls -A | sort")
+        again = runner._run_bash(f"{first} >/dev/null; ls -A | sort", tempfile.mkdtemp(dir=runner._dirs[0]),
+                                 runner._env())
+    finally:
+        runner.close()
+    assert shown and len(runner._cache) == 2 and len(runner._folders) == 1     # the renderer ran once
+    # what the renderer wrote, as a run of the whole line in an empty folder lists it (less the links)
+    assert [n for n in listing if n not in (".venv", "scenes", "tests")] == again and again
+
+
+def test_a_forked_command_past_its_time_is_killed(tmp_path, monkeypatch):
+    # 180 frames of the cube take ~0.3 s of CPU here (seconds on a loaded machine); 0.01 s is far less
+    monkeypatch.setattr(ds, "COMMAND_TIMEOUT_S", 0.01)
+    with pytest.raises(ds.subprocess.TimeoutExpired):
+        ds._run_forked("renderer", ["--scene", "cube", "--frames", "180"], str(tmp_path), ds.Runner._env())

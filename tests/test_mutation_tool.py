@@ -39,3 +39,16 @@ def test_only_with_known_ids_still_chooses_them(capsys):
 def test_a_sample_of_zero_is_exit_2(tmp_path, capsys):
     rc = _mutate().main(["--module", "core/projector/clipping.py", "--sample", "0", "--report", str(tmp_path / "r.md")])
     assert rc == 2 and "no mutant chosen" in capsys.readouterr().err and not (tmp_path / "r.md").exists()
+
+
+def test_the_mutant_ids_in_the_docs_name_mutants_that_exist():
+    # docs/testing.md shows `mutate.py --only 'ID'`; ids move with the code (module:line:column:change),
+    # and an id matching nothing is an error: each one shown must be a site of today's code
+    import re
+
+    shown = re.findall(r"--only '([^']+)'", (MUTATION.parent.parent / "docs" / "testing.md").read_text())
+    assert shown                                          # the page was read
+    mutate = _mutate()
+    for mutant in shown:
+        module = mutant.split(":")[0]
+        assert mutant in {s.id for s in mutate.sites(module)}, mutant

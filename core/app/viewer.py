@@ -379,27 +379,31 @@ class Viewer:
 
 
 def _load_overlay():
-    """The oracle overlay (wirecheck.oracles.live), or None when the oracles cannot load."""
+    """``(overlay, None)``: the oracle overlay (wirecheck.oracles.live); ``(None, why)`` when it cannot
+    load, ``why`` one line (no libOSMesa: the missing library and the command that installs it)."""
     try:
         from importlib import import_module
 
-        return import_module("wirecheck.oracles.live").LiveOverlay()
+        return import_module("wirecheck.oracles.live").LiveOverlay(), None
     except Exception as exc:                             # e.g. no libOSMesa: the viewer runs without it
-        print(f"renderer: warning: oracle overlay unavailable: {exc}", file=sys.stderr)
-        return None
+        why = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"renderer: warning: oracle overlay unavailable: {why}", file=sys.stderr)
+        return None, why
 
 
 class _LazyOverlay:
-    """Loads the oracle overlay on its first use (most sessions never turn it on)."""
+    """Loads the oracle overlay on its first use (most sessions never turn it on); when it cannot
+    load, every request's error says why and how to fix it, in the page's banner."""
 
     def __init__(self):
-        self._impl, self._tried = None, False
+        self._impl, self._why, self._tried = None, None, False
 
     def __call__(self, s, camera, frame):
         if not self._tried:
-            self._tried, self._impl = True, _load_overlay()
+            self._tried = True
+            self._impl, self._why = _load_overlay()
         if self._impl is None:
-            return {"error": "the oracle overlay is not available (see the server's stderr)"}
+            return {"error": f"the oracle overlay is not available: {self._why}"}
         return self._impl(s, camera, frame)
 
     def close(self):

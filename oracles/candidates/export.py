@@ -40,7 +40,7 @@ JOB_VERSION = 1
 JOB_KIND = "wirecheck frames job"
 
 CONVENTIONS = {
-    "statement": "core/conventions.py of wirecheck states these once; summarised here for the renderer",
+    "statement": "wirecheck.core.conventions states these once; summarised here for the renderer",
     "world": "right-handed; camera right = forward x up",
     "pixels": "x right (columns), y down (rows), origin top-left; integer coordinates are pixel centres: "
               "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2) unless the camera has "
@@ -88,7 +88,7 @@ def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames
             "model_matrix": _rows(model),
             "K": _rows(kk), "R": _rows(r), "t_cv": [float(x) for x in t],
             "gl_view": _rows(view), "gl_projection": _rows(proj),
-            "conventions": "see job.json (conventions); core/conventions.py states them once"}
+            "conventions": "see job.json (conventions); wirecheck.core.conventions states them once"}
 
 
 def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> tuple[dict, dict]:

@@ -38,7 +38,7 @@ def _case_lines(c: dict) -> list[str]:
 
 def _bound_lines(bounds: dict) -> list[str]:
     lines = ["", "### Bounds", "",
-             "Derivations (oracles/extremes/bounds.py, each function's docstring): u = eps / 2 is the unit "
+             "Derivations (wirecheck.oracles.extremes.bounds, each function's docstring): u = eps / 2 is the unit "
              "roundoff of the run's dtype, eps64 float64's eps.", ""]
     for name, text in bounds.items():
         first, *rest = text.split("\n\n")
