@@ -35,7 +35,7 @@ from wirecheck.oracles.diagnosis.diagnose import primary
 sys.path.insert(0, str(Path(__file__).parent / "clients"))
 import heldout_draw as hd  # noqa: E402
 
-# 29 crosscheck runs end to end (~27 s of CPU in all, about a second each)
+# 32 crosscheck runs end to end (~27 s of CPU in all, about a second each)
 pytestmark = pytest.mark.slow
 
 #: Each job: (scene, case); frames 1 and 4 of 6.
