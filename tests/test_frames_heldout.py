@@ -1,0 +1,229 @@
+"""A held-out check of the frames judge: renderers and line styles no other test uses, drawn by code of our own.
+
+``tests/clients/heldout_draw.py`` draws a ``crosscheck export`` job from the
+job's camera contract alone (the GL matrices, or the camera fields; nothing of
+wirecheck): Pillow's ``ImageDraw.line`` (1-3 px, and 4x supersampled),
+matplotlib's Agg ``Line2D`` (0.5-2 px, antialiased on and off, in display
+pixels), OpenCV's ``cv2.line`` (LINE_8, LINE_4, LINE_AA with 4 sub-pixel
+bits), a Xiaolin Wu and a Bresenham line written here. The rule measured
+(guide: a gate never fails correct code, on inputs nobody tuned it to): a
+correct renderer passes, or, aliased by another rule than GL's, is named
+``raster_rule`` and passes ``--line-rule geometry``; one typical mistake per
+renderer fails with its own name. A correct renderer that fails is a finding
+of the judge's, kept here as ``xfail(strict=True)`` with its measured numbers
+(docs/frames.md, "Held-out renderers").
+
+Small jobs keep the file near a minute on one core: one case, frames 1 and 4
+of 6 (pyramid / oblique_roll: slanted lines, so an offset shows in x and y);
+the xfails use the case where each was measured to fail.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import sys
+from functools import partial
+from pathlib import Path
+
+import pytest
+
+from wirecheck.oracles.cli import main
+from wirecheck.oracles.diagnosis.diagnose import primary
+
+sys.path.insert(0, str(Path(__file__).parent / "clients"))
+import heldout_draw as hd  # noqa: E402
+
+# 32 crosscheck runs end to end (~27 s of CPU in all, about a second each)
+pytestmark = pytest.mark.slow
+
+#: Each job: (scene, case); frames 1 and 4 of 6.
+JOBS = {"slanted": ("pyramid", "oblique_roll"), "centre_line": ("prism", "on_axis"),
+        "square_on": ("cube", "narrow_fov")}
+
+
+@pytest.fixture(scope="module")
+def jobs(tmp_path_factory) -> dict:
+    out = {}
+    for name, (scene, case) in JOBS.items():
+        path = tmp_path_factory.mktemp("heldout") / name
+        assert main(["export", str(path), "--scene", scene, "--cases", case, "--frames", "6", "--every", "3"]) == 0
+        out[name] = path
+    return out
+
+
+def _judge(jobs, tmp_path, job, draw, project=hd.project_gl, rule="gl", **mistake) -> tuple[int, dict]:
+    """The job drawn by ``draw`` through ``project`` (with the mistake, if any), judged: (exit, its one case)."""
+    d = tmp_path / "job"
+    shutil.copytree(jobs[job], d)
+    hd.render(d, draw, project, **mistake)
+    rc = main(["--candidate-frames", str(d), "--report-dir", str(tmp_path / "rep"), "--line-rule", rule])
+    (case,) = json.loads((tmp_path / "rep" / "report.json").read_text())["cases"]
+    assert case["frames_checked"] == 2                  # both frames judged: not a pass on nothing
+    return rc, case
+
+
+@pytest.mark.parametrize("project", [hd.project_gl, hd.project_lookat])
+def test_own_projections_are_the_oracle_lines(jobs, project):
+    # what makes the renderers below "correct": both routes of heldout_draw give the oracle's segments
+    # (OpenCV's projection of the depth-clipped edges). Bound 1e-5 px: ends clipped at the near plane
+    # differ by up to 2e-6 px (measured over the full job's near_plane cases: the clip's parameter is
+    # computed another way); every other end to 1e-9 px
+    from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
+    from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
+
+    for d in jobs.values():
+        job = load_job(d)
+        frames = list(hd.job_frames(d))
+        assert len(frames) == 2
+        for _, v, e, cam, model in frames:
+            p, edges, camera, m = frame_inputs(d, job, cam["scene"], cam["case"], cam["frame"])
+            ref = oracle_segments(p @ m[:3, :3].T + m[:3, 3], edges, camera)
+            got = project(v, e, cam, model=model)
+            assert got.shape == ref.shape and len(ref) >= 5
+            assert abs(got - ref).max() < 1e-5
+
+
+mpl = hd.draw_matplotlib
+cv2_line = hd.draw_cv2
+
+# (id, drawer, projection, the style read): correct set-ups that pass on GL's rule
+PASSING = [
+    ("pillow_supersampled_4x", hd.draw_pillow_supersampled, hd.project_gl, "antialiased"),
+    ("matplotlib_aa_1.0px", partial(mpl, linewidth_px=1.0), hd.project_lookat, "antialiased"),
+    ("matplotlib_aa_1.5px", partial(mpl, linewidth_px=1.5), hd.project_lookat, "antialiased"),
+    ("matplotlib_aa_2.0px", partial(mpl, linewidth_px=2.0), hd.project_lookat, "wide"),
+    ("matplotlib_aliased_1.0px", partial(mpl, linewidth_px=1.0, antialiased=False), hd.project_lookat, "wide"),
+    ("matplotlib_aliased_1.5px", partial(mpl, linewidth_px=1.5, antialiased=False), hd.project_lookat, "wide"),
+    ("matplotlib_aliased_2.0px", partial(mpl, linewidth_px=2.0, antialiased=False), hd.project_lookat, "wide"),
+    ("wu", hd.draw_wu, hd.project_gl, "antialiased"),
+    ("cv2_LINE_AA", partial(cv2_line, line_type="LINE_AA"), hd.project_gl, "antialiased"),
+]
+
+
+@pytest.mark.parametrize("draw, project, style", [p[1:] for p in PASSING], ids=[p[0] for p in PASSING])
+def test_correct_renderer_passes(jobs, tmp_path, capsys, draw, project, style):
+    rc, c = _judge(jobs, tmp_path, "slanted", draw, project)
+    assert rc == 0 and c["verdict"] == "pass", (c["reasons"], c["faults"])
+    assert c["faults"] == [] and c["line_style"]["style"] == style
+    # the centres measured where the oracle's lines are: within OFFSET_TOL_PX (0.2); measured <= 0.09
+    assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.2
+
+
+# aliased by another rule than GL's: every differing pixel off by one, the lines in place
+OTHER_RULE = [
+    ("pillow_1px", hd.draw_pillow, hd.project_gl),
+    ("bresenham", hd.draw_bresenham, hd.project_lookat),
+    ("cv2_LINE_8", partial(cv2_line, line_type="LINE_8"), hd.project_gl),
+    ("cv2_LINE_4", partial(cv2_line, line_type="LINE_4"), hd.project_gl),
+]
+
+
+@pytest.mark.parametrize("draw, project", [p[1:] for p in OTHER_RULE], ids=[p[0] for p in OTHER_RULE])
+def test_another_aliased_rule_is_raster_rule_and_passes_on_geometry(jobs, tmp_path, capsys, draw, project):
+    rc, c = _judge(jobs, tmp_path, "slanted", draw, project)
+    assert rc == 1 and c["line_style"]["style"] == "aliased"
+    (f,) = c["faults"]
+    assert f["name"] == "raster_rule" and f["share_farther"] == 0.0, c["faults"]
+    assert c["pixel_f1_1px"] >= 0.999 and c["pixel_f1_0px"] < 0.98      # F1@0px alone failed
+    shutil.rmtree(tmp_path / "job"), shutil.rmtree(tmp_path / "rep")
+    rc, c = _judge(jobs, tmp_path, "slanted", draw, project, rule="geometry")
+    assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["reasons"], c["faults"])
+
+
+# ---- one typical mistake per renderer, named ----
+
+HALF = {"half_pixel": True}
+MISTAKES = [
+    # the viewport without its -0.5 (GL route): lines 0.5 px right and down
+    ("pillow_supersampled_4x_half_pixel", hd.draw_pillow_supersampled, hd.project_gl, HALF, (0.5, 0.5)),
+    ("wu_half_pixel", hd.draw_wu, hd.project_gl, HALF, (0.5, 0.5)),
+    ("cv2_LINE_AA_half_pixel", partial(cv2_line, line_type="LINE_AA"), hd.project_gl, HALF, (0.5, 0.5)),
+    # matplotlib's display pixels without the +0.5 of a pixel's centre: 0.5 px left and up
+    ("matplotlib_aa_1.5px_half_pixel", partial(mpl, linewidth_px=1.5, half_pixel=True), hd.project_lookat, {},
+     (-0.5, -0.5)),
+]
+
+
+@pytest.mark.parametrize("draw, project, mistake, offset", [m[1:] for m in MISTAKES], ids=[m[0] for m in MISTAKES])
+def test_half_pixel_mistake_is_pixel_offset_measured(jobs, tmp_path, capsys, draw, project, mistake, offset):
+    rc, c = _judge(jobs, tmp_path, "slanted", draw, project, **mistake)
+    assert rc == 1 and c["verdict"] == "fail"
+    (f,) = c["faults"]
+    assert f["name"] == "pixel_offset" and f["measured_by"] == "line centroids", c["faults"]
+    # the injected offset, recovered from the lines' centres to 0.05 px (issue 23's proof)
+    assert f["dx"] == pytest.approx(offset[0], abs=0.05) and f["dy"] == pytest.approx(offset[1], abs=0.05)
+
+
+NAMED = [
+    ("matplotlib_aa_1.0px_rows_not_flipped", partial(mpl, linewidth_px=1.0), hd.project_lookat,
+     {"flip_rows": False}, "slanted", "mirror_vertical"),
+    # square-on (cube / narrow_fov): the FOV alone is named; on pyramid / oblique_roll see the findings
+    ("bresenham_fov_of_the_wrong_axis", hd.draw_bresenham, hd.project_lookat, {"fov_axis": "x"}, "square_on",
+     "fov_mismatch"),
+    ("cv2_LINE_8_fov_of_the_wrong_axis", partial(cv2_line, line_type="LINE_8"), hd.project_lookat,
+     {"fov_axis": "x"}, "square_on", "fov_mismatch"),
+]
+
+
+def _wrong_axis_fov_deg(job: Path) -> float:
+    """The vertical FOV drawn by a renderer that spans ``fov_y_deg`` over the width: 2 atan(tan(fov/2) H / W)."""
+    cam = json.loads(next((job / "cameras").rglob("frame_0001.json")).read_text())["camera"]
+    half = math.tan(math.radians(cam["fov_y_deg"]) / 2)
+    return math.degrees(2 * math.atan(half * cam["height"] / cam["width"]))
+
+
+@pytest.mark.parametrize("draw, project, mistake, job, name", [m[1:] for m in NAMED], ids=[m[0] for m in NAMED])
+def test_typical_mistake_is_named(jobs, tmp_path, capsys, draw, project, mistake, job, name):
+    rc, c = _judge(jobs, tmp_path, job, draw, project, **mistake)
+    assert rc == 1 and c["verdict"] == "fail"
+    assert [f["name"] for f in c["faults"]] == [name], c["faults"]
+    if name == "fov_mismatch":
+        # f larger by W / H: the implied vertical FOV to 0.1 deg (0.2 % of a 12-deg FOV: the fit's scale
+        # error, 1.331-1.337 measured for 4/3)
+        assert c["faults"][0]["implied_fov_deg"] == pytest.approx(_wrong_axis_fov_deg(jobs[job]), abs=0.1)
+
+
+# ---- findings: correct renderers the judge fails (measured; docs/frames.md, "Held-out renderers") ----
+
+FINDINGS = [
+    # Pillow's wide lines: ends snapped to pixel centres and an asymmetric even width; F1@1px 0.995, unexplained
+    ("pillow_2px", partial(hd.draw_pillow, width=2), hd.project_gl, "slanted"),
+    ("pillow_3px", partial(hd.draw_pillow, width=3), hd.project_gl, "slanted"),
+    # a 0.5-px antialiased line peaks at coverage 0.5 (grey 127 < 128): most pixels not drawn, F1@1px 0.87
+    ("matplotlib_aa_0.5px", partial(mpl, linewidth_px=0.5), hd.project_lookat, "slanted"),
+    # the vertical edge at x = 319.5 (the principal point of a 640-wide image): coverage 127 | 127, not drawn
+    ("matplotlib_aa_1.0px_centre_line", partial(mpl, linewidth_px=1.0), hd.project_lookat, "centre_line"),
+    # Agg's binary 1.5-px lines, nearly axis-aligned, square-on: pixel_offset (0.27, 0.02) against the band
+    ("matplotlib_aliased_1.5px_square_on", partial(mpl, linewidth_px=1.5, antialiased=False), hd.project_lookat,
+     "square_on"),
+    # cv2 LINE_8 puts the x = 319.5 edge in the other column than GL's: aspect_mismatch + pixel_offset(0.39, 0)
+    ("cv2_LINE_8_centre_line", partial(cv2_line, line_type="LINE_8"), hd.project_gl, "centre_line"),
+]
+
+
+@pytest.mark.xfail(strict=True, reason="a correct renderer the frames judge fails: see docs/frames.md")
+@pytest.mark.parametrize("draw, project, job", [f[1:] for f in FINDINGS], ids=[f[0] for f in FINDINGS])
+def test_finding_correct_renderer_passes(jobs, tmp_path, capsys, draw, project, job):
+    rc, c = _judge(jobs, tmp_path, job, draw, project)
+    assert rc == 0 and c["verdict"] == "pass", (c["pixel_f1_1px"], c["faults"], c["line_style"]["geometry"])
+
+
+@pytest.mark.xfail(strict=True, reason="a mistake misnamed: see docs/frames.md, Held-out renderers")
+def test_finding_pillow_half_pixel_is_named_pixel_offset(jobs, tmp_path, capsys):
+    # Pillow 1 px with the viewport's -0.5 left out fails, as it must, but as `unexplained`: its centres
+    # measured (0.61, 0.46) px off with a warp of 0.37 (Pillow's ends snapped to pixel centres), so neither
+    # raster_rule (offset <= 0.35) nor the registration's pixel_offset takes it
+    rc, c = _judge(jobs, tmp_path, "slanted", hd.draw_pillow, hd.project_gl, half_pixel=True)
+    assert rc == 1
+    assert primary(c["faults"]) == "pixel_offset", (c["faults"], c["line_style"]["geometry"])
+
+
+@pytest.mark.xfail(strict=True, reason="a mistake misnamed: see docs/frames.md, Held-out renderers")
+def test_finding_fov_of_the_wrong_axis_on_a_slanted_view_is_named(jobs, tmp_path, capsys):
+    # Bresenham with the FOV spanned over the width, pyramid / oblique_roll (2 frames): F1@1px 0.12, the fit
+    # finds no start (warp 3.8 px): `unexplained`, not fov_mismatch (named on 17 of the other 20 cases)
+    rc, c = _judge(jobs, tmp_path, "slanted", hd.draw_bresenham, hd.project_lookat, fov_axis="x")
+    assert rc == 1
+    assert primary(c["faults"]) == "fov_mismatch", (c["faults"], c["line_style"]["geometry"])
