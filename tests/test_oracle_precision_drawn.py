@@ -137,9 +137,11 @@ def test_random_segments_near_a_wide_camera_stay_within_their_bounds(seed):
     edges = edges[edges[:, 0] != edges[:, 1]]
     cam = Camera(position=(0.0, 0.0, 0.0), forward=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0), width=320, height=240,
                  near=0.03, far=10.0, fov_y_deg=120.0)
-    errs, bounds, _pose, _q = _errors_and_bounds(v, edges, cam)
+    errs, bounds, pose, q = _errors_and_bounds(v, edges, cam)
     assert len(errs) > 100
     assert (errs <= bounds).all(), (errs / bounds).max()
+    # never above the bounding sphere's bound (the whole mesh's largest magnitude, nearest depth)
+    assert op.drawn_bound_px(cam, pose, q, edges) <= op.frame_bound_px(cam, pose, op.mesh_radius(q))
 
 
 def test_the_drawn_bound_by_hand_and_never_above_the_spheres():
