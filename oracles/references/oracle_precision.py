@@ -35,10 +35,10 @@ That is :func:`frame_bound_px`, from the mesh's radius alone: every drawn
 point is taken as large as the largest and as near as the bounding sphere
 (or the near plane) allows. The oracle itself takes :func:`drawn_bound_px`,
 the same roundings counted per drawn segment, from what that segment's ends
-are: the magnitudes ``mag_j`` of its two vertices' own terms (``sum_k
-|M_jk| |q_k| + |t_j|``, the larger of the two; at most ``|t_j| + rho`` by
-Cauchy-Schwarz) and the depth of its nearest drawn point, ``max(near,
-min(w_a, w_b))`` (a point of a segment is a convex combination of its ends,
+are: each end's own magnitudes ``mag_j`` (``sum_k |M_jk| |q_k| + |t_j|``, at
+most ``|t_j| + rho`` by Cauchy-Schwarz) through ``P`` to its window error
+times its depth (the larger of the two ends'), over the depth of the
+segment's nearest drawn point, ``max(near, min(w_a, w_b))`` (a point of a segment is a convex combination of its ends,
 in eye space and, after clipping, in clip space: its depth is at least the
 smaller end's; a clipped end lies on the near plane, at depth ``near``
 exactly, or on a side or far plane, between its ends' depths). Where the
@@ -141,32 +141,33 @@ def drawn_bound_px(camera, eye_pose, q_model, segments) -> float:
     seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
     _view, proj = camera_to_gl(camera)
     perspective = camera.projection == "perspective"
-    viewport = VIEWPORT_ROUNDINGS * U32 * max(camera.width, camera.height)
+    viewport = VIEWPORT_ROUNDINGS * U32 * max(camera.width, camera.height)    # the divide, scale and offset
     if not len(seg):
         return float(viewport)
     with np.errstate(over="ignore", invalid="ignore"):
         lin, t = a[:3, :3], a[:3, 3]
         term = np.abs(q) @ np.abs(lin).T + np.abs(t)                  # (N, 3): magnitude of each e_j's terms
-        mag = np.maximum(term[seg[:, 0]], term[seg[:, 1]])            # (E, 3): the larger end's
-        m_clip = mag @ np.abs(proj[:, :3]).T + np.abs(proj[:, 3])     # (E, 4): each clip coordinate's terms
+        m_clip = term @ np.abs(proj[:, :3]).T + np.abs(proj[:, 3])    # (N, 4): each clip coordinate's terms
+        w_term = CLIP_W_ROUNDINGS * m_clip[:, 3] if perspective else 0.0     # orthographic: c_w = 1 exactly
+        # each vertex's error in the window times its depth (x and y, the larger): a segment's drawn
+        # points (its clipped ends too) are convex combinations of its ends, within the larger end's
+        num = np.maximum((camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 0] + w_term),
+                         (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 1] + w_term))
+        num_seg = np.maximum(num[seg[:, 0]], num[seg[:, 1]])
         if perspective:
             depth = -(q @ lin[2] + t[2])                              # (N,): w = -e_z, float64
             w_a, w_b = depth[seg[:, 0]], depth[seg[:, 1]]
-            # behind near by more than its own rounding: GL draws nothing of it
-            drawn = np.maximum(w_a, w_b) >= camera.near - 2 * CLIP_W_ROUNDINGS * U32 * m_clip[:, 3]
+            # behind near by more than the rounding of its depth (2 x its clip w's): GL draws nothing of it
+            reach = 2 * CLIP_W_ROUNDINGS * U32 * m_clip[:, 3]
+            drawn = np.maximum(w_a + reach[seg[:, 0]], w_b + reach[seg[:, 1]]) >= camera.near
             w_lo = np.maximum(float(camera.near), np.minimum(w_a, w_b))
-            w_term = CLIP_W_ROUNDINGS * m_clip[:, 3]
-        else:                                                         # orthographic: c_w = 1 exactly
-            drawn = np.ones(len(seg), bool)
-            w_lo, w_term = 1.0, 0.0
-        bx = U32 * (camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 0] + w_term) / w_lo
-        by = U32 * (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 1] + w_term) / w_lo
-        bx = bx + VIEWPORT_ROUNDINGS * U32 * camera.width
-        by = by + VIEWPORT_ROUNDINGS * U32 * camera.height
-        both = np.maximum(bx, by)[drawn]
-    if not np.isfinite(both).all() or not np.isfinite(m_clip).all():
+            num_seg, w_lo = num_seg[drawn], w_lo[drawn]
+        else:
+            w_lo = 1.0
+        both = U32 * num_seg / w_lo
+    if not np.isfinite(num).all() or not np.isfinite(both).all():
         return float("inf")                       # no finite bound: none at all
-    return float(both.max()) if len(both) else float(viewport)
+    return float(both.max(initial=0.0)) + viewport
 
 
 def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:
