@@ -297,6 +297,22 @@ def _is_tie(c, a, b, other, end_px=2.0 ** -8):
     return False
 
 
+def _is_end_tie(c, a, b, w, h, end_px=2.0 ** -8):
+    """oracles.judge.line_ties' end rule for one pixel ``c`` of segment ``a -> b``, end by end: | |E - c|_1 - 1/2 |
+    within 2 end_px, on the diamond's exit side (L1 distance growing along b - a), not an end on the border."""
+    d, zone = b - a, 2 * end_px
+    if not d.any():
+        return False
+    for e in (a, b):
+        if min(abs(e[0] + 0.5), abs(e[0] - (w - 0.5)), abs(e[1] + 0.5), abs(e[1] - (h - 0.5))) <= 1e-6:
+            continue
+        off = e - c
+        slope = sum(abs(d[k]) if abs(off[k]) <= zone else np.sign(off[k]) * d[k] for k in (0, 1))
+        if abs(abs(off).sum() - 0.5) <= zone and slope >= 0:
+            return True
+    return False
+
+
 def _ends_naive(cand, oracle, p0, p1, reach=1.5):
     """end_attribution's definition, pixel by pixel: the nearest segment (clipped to the image's edges)."""
     from wirecheck.oracles.judge.segment_pixels import clip_segments
@@ -319,7 +335,7 @@ def _ends_naive(cand, oracle, p0, p1, reach=1.5):
             if best is None or best[0] > reach:
                 out["stray"][side] += 1
                 continue
-            if _is_tie(c, best[1], best[2], other[side]):
+            if _is_tie(c, best[1], best[2], other[side]) or _is_end_tie(c, best[1], best[2], w, h):
                 out["tie"][side] += 1
                 continue
             s, e = np.hypot(*(c - best[1])) <= reach, np.hypot(*(c - best[2])) <= reach

@@ -1,7 +1,8 @@
 """Where a frame's one-sided line pixels lie along the oracle's segments, and which are sub-pixel ties.
 
 Each pixel drawn by one image only is given to its nearest segment and
-placed: a sub-pixel ``tie`` of that segment (oracles.judge.line_ties), else at its
+placed: a sub-pixel ``tie`` of that segment (oracles.judge.line_ties: a crossing or an
+end within the oracle's precision of the pixel's edge), else at its
 ``start`` or ``end`` (within :data:`END_REACH_PX` of that point), in the
 ``middle``, or ``stray`` (no segment within reach). The line gate's balance
 test and its fault names read the decided places (oracles.judge.metrics,
@@ -43,7 +44,9 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
     1.5 px from every segment: ``stray``), or, before any of those, a
     sub-pixel ``tie`` of its nearest segment (oracles.judge.line_ties: the line
     crosses beside it within the oracle's precision of the pixel's edge, and
-    the other image drew the pixel across that edge). Returns
+    the other image drew the pixel across that edge; or an end of the segment,
+    not one made by the image's border, lies within that precision of where
+    the segment leaves the pixel's diamond). Returns
     ``{place: [candidate_only, oracle_only]}``.
     """
     from .metrics import FramePixels
@@ -79,10 +82,12 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
         m, f = owner[near], frame[near]
         c = np.column_stack([pix[near] % w, pix[near] // w]).astype(np.float64)
         tie, partner = line_ties.tie_crossings(c, q0[m], q1[m])
-        if tie.any():                   # a tie needs its partner pixel drawn by the other image
+        if tie.any():                   # a crossing tie needs its partner pixel drawn by the other image
             other = [fp.cand_idx if side == 1 else fp.oracle_idx for fp, _, _ in frames]
             drawn = np.concatenate([o + k * h * w for k, o in enumerate(other)])    # ascending: frame after frame
             tie &= line_ties.partner_drawn(partner, f, (h, w), drawn)
+        tie |= line_ties.tie_ends(c, q0[m], q1[m], box)      # an end within the oracle's precision of its exit
+        if tie.any():
             tied, tied_frame = pix[near][tie], f[tie]
             for k in np.unique(tied_frame):
                 found[k][side] = np.sort(tied[tied_frame == k]).astype(np.int64)

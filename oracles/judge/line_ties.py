@@ -1,4 +1,4 @@
-"""Sub-pixel ties: one-sided line pixels that the line itself does not decide.
+r"""Sub-pixel ties: one-sided line pixels that the line itself does not decide.
 
 A 1-px line (GL's diamond-exit rule; core.projector.raster) draws, at each pixel row a
 y-major segment crosses, the pixel whose column holds the crossing (columns
@@ -28,6 +28,29 @@ its partner across that boundary (``k`` for ``k + 1`` and the reverse): the
 two images chose differently at the tie, or one drew both of its pixels (two
 overlapping segments decided apart). A pixel lost from a line (a gap, a
 dropped end) or drawn off it has no drawn partner and stays decided.
+
+Ties at the ends (:func:`tie_ends`). A line's first and last pixels are
+decided by its ends, not by a crossing: pixel ``P`` is drawn when the segment
+exits ``P``'s diamond, so where an end ``E`` lies on the diamond's exit side
+(going on along the segment from ``E`` leaves the diamond), ``P`` is drawn
+exactly when ``E`` is outside it, ``|E - P|_1 >= 1/2``::
+
+         /\
+        / P\ *E        E at the diamond's exit: drawn when |E - P|_1 >= 1/2
+        \  /
+         \/
+
+An end moved by at most ``end_px`` per coordinate moves ``|E - P|_1`` by at
+most ``2 end_px``: within that of ``1/2`` the oracle's answer is its
+rounding's, not the line's, and ``P`` is a tie whichever image drew it. There
+is no partner to ask for (the other answer is "not drawn"), so what it can
+excuse is bounded by the zone alone: an end falls in it with probability
+about ``4 (2 end_px) / 2 = 4 end_px`` (the band ``2 end_px`` wide in ``L1``
+along the diamond's exit half, ``sqrt 2`` long, over a pixel's area), 1/64
+of line ends: a line short or long at every end is still named on the rest.
+An end on the image's border (where a line leaving the picture is cut for
+the comparison, not by the renderer) is no end of the line and decides
+nothing.
 """
 
 from __future__ import annotations
@@ -78,6 +101,36 @@ def tie_crossings(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray,
         tie |= hit
         partner[hit, minor] += np.where(off[hit] > 0, 1, -1)
     return tie, partner
+
+
+def tie_ends(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray, box: tuple | None = None,
+             end_px: float = TIE_END_PX) -> np.ndarray:
+    """``(P,)`` bool: which pixels are decided by an end of their segment within ``end_px`` per coordinate.
+
+    Pixel ``q`` is an end tie (module docstring) when an end ``E`` of its
+    segment ``a -> b`` has ``| |E - q|_1 - 1/2 | <= 2 end_px`` and lies on
+    the exit side of ``q``'s diamond: the ``L1`` distance from ``q`` grows
+    along ``b - a`` at ``E`` (a coordinate of ``E - q`` within ``2 end_px``
+    of 0 counts either way). ``box``: ``((x, y), (x, y))``, the corners the
+    segments were cut to; an end within ``1e-6`` px of its border is left out.
+    """
+    q = np.asarray(q_px, np.float64).reshape(-1, 2)
+    a = np.asarray(a_px, np.float64).reshape(-1, 2)
+    b = np.asarray(b_px, np.float64).reshape(-1, 2)
+    d = b - a
+    zone = 2.0 * end_px
+    tie = np.zeros(len(q), bool)
+    for e in (a, b):
+        off = e - q
+        near = np.abs(np.abs(off).sum(axis=1) - 0.5) <= zone
+        slope_l1 = np.where(np.abs(off) <= zone, np.abs(d), np.sign(off) * d).sum(axis=1)
+        real = (d != 0).any(axis=1)
+        if box is not None:
+            (x0, y0), (x1, y1) = box
+            edge = np.column_stack([e[:, 0] - x0, x1 - e[:, 0], e[:, 1] - y0, y1 - e[:, 1]])
+            real &= ~(np.abs(edge) <= 1e-6).any(axis=1)
+        tie |= near & (slope_l1 >= 0) & real
+    return tie
 
 
 def partner_drawn(partner: np.ndarray, frame: np.ndarray, shape: tuple, drawn: np.ndarray) -> np.ndarray:

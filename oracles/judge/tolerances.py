@@ -272,6 +272,14 @@ MAX_EDGE_COUNT_DIFF = 3
 # the image without it drew the pixel across that boundary (a pixel lost or
 # added with no partner stays decided): a line shifted by 1 px or drawn 1 px
 # thicker keeps at least 63/64 of its one-sided pixels in the test.
+#
+# A line's end pixel is decided by the end, not by a crossing: with the end E
+# on its diamond's exit side, the pixel P is drawn exactly when |E - P|_1 >=
+# 1/2, and an end moved by TIE_END_PX per coordinate moves |E - P|_1 by at
+# most 2 TIE_END_PX = 2^-7. Closer to 1/2 than that, P is a tie too
+# (oracles.judge.line_ties.tie_ends), whichever image drew it; an end falls
+# there for about 4 TIE_END_PX = 1/64 of line ends, so a line short or long at
+# every end keeps the rest in the test.
 
 #: Sub-pixel bits of the oracle's rasterizer (Mesa llvmpipe; the GL minimum is 4).
 SUBPIXEL_BITS = 8

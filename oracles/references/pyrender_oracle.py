@@ -58,7 +58,7 @@ from wirecheck.core.camera import Camera
 
 from .convert import camera_to_pyrender, centre_of, gl_eye_pose
 from .gl_platform import GL_PLATFORMS, GLUnavailable, gl_available, gl_platform, osmesa_available, select_gl
-from .oracle_precision import frame_bound_px, mesh_radius
+from .oracle_precision import drawn_bound_px
 from .pyrender_programs import stabilise_program_cache
 
 __all__ = ["GLUnavailable", "GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
@@ -207,15 +207,17 @@ class PyrenderOracle:
         self._mesh_node = None
         self._mesh_key = None
         self._mesh_faces = None
-        self._mesh_centre, self._mesh_radius = np.zeros(3), 0.0     # of the uploaded vertices (float64)
-        self.last_bound_px = 0.0      # oracle_precision.frame_bound_px of the last frame drawn
+        self._mesh_centre = np.zeros(3)                       # of the uploaded vertices (float64)
+        self._mesh_q, self._mesh_segments = np.zeros((0, 3)), np.zeros((0, 2), np.int64)   # what GL draws
+        self.last_bound_px = 0.0      # oracle_precision.drawn_bound_px of the last frame drawn
         self._cam_node = None
         self._cam_key = None
         # render_faces: a scene of its own, so that alternating with render() rebuilds nothing
         self._fscene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
         self._fmesh_node = None
         self._fmesh_key = None
-        self._fmesh_centre, self._fmesh_radius = np.zeros(3), 0.0
+        self._fmesh_centre = np.zeros(3)
+        self._fmesh_q, self._fmesh_segments = np.zeros((0, 3)), np.zeros((0, 2), np.int64)
         self._fcam_node = None
         self._fcam_key = None
 
@@ -276,14 +278,17 @@ class PyrenderOracle:
         # re-centred in float64 before the float32 upload (convert.gl_eye_pose): one upload per mesh
         self._mesh_centre = centre_of(vertices)
         positions = (vertices - self._mesh_centre).astype(np.float32)
-        self._mesh_radius = mesh_radius(vertices - self._mesh_centre)
+        self._mesh_q = positions.astype(np.float64)
+        tris = _fan(faces) if faces is not None and len(faces) else np.zeros((0, 3), np.uint32)
+        t = tris.astype(np.int64)         # the occluding faces decide which line pixels are hidden: theirs too
+        self._mesh_segments = np.concatenate([edges, t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
         if len(edges):
             white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0])
             prims.append(pr.Primitive(positions=positions, indices=edges.astype(np.uint32),
                                       mode=pr.constants.GLTF.LINES, material=white))
-        if faces is not None and len(faces):
+        if len(tris):
             black = pr.MetallicRoughnessMaterial(baseColorFactor=[0.0, 0.0, 0.0, 1.0], doubleSided=not cull)
-            prims.append(pr.Primitive(positions=positions, indices=_fan(faces),
+            prims.append(pr.Primitive(positions=positions, indices=tris,
                                       mode=pr.constants.GLTF.TRIANGLES, material=black))
         if prims:
             self._mesh_node = self._scene.add(pr.Mesh(prims))
@@ -320,8 +325,10 @@ class PyrenderOracle:
         # colour, which is then constant over the triangle
         self._fmesh_centre = centre_of(vertices)
         centred = vertices - self._fmesh_centre
-        self._fmesh_radius = mesh_radius(centred)
         positions = centred[triangles.reshape(-1)].astype(np.float32)
+        self._fmesh_q = positions.astype(np.float64)
+        corner = np.arange(len(positions), dtype=np.int64).reshape(-1, 3)     # each triangle's three edges
+        self._fmesh_segments = np.concatenate([corner[:, [0, 1]], corner[:, [1, 2]], corner[:, [2, 0]]])
         colours = np.repeat(_id_colours(len(triangles)), 3, axis=0)
         colours = np.concatenate([colours, np.full((len(colours), 1), 255, np.uint8)], axis=1)
         white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=not cull)
@@ -369,7 +376,7 @@ class PyrenderOracle:
         if self._mesh_node is not None:
             pose = gl_eye_pose(camera, model_matrix, self._mesh_centre)
             self._scene.set_pose(self._mesh_node, pose)
-            self.last_bound_px = frame_bound_px(camera, pose, self._mesh_radius)
+            self.last_bound_px = drawn_bound_px(camera, pose, self._mesh_q, self._mesh_segments)
         if faces is not None and len(faces):
             self._polygon_offset()
         colour, depth = self._renderer.render(self._scene, pr.RenderFlags.FLAT)
@@ -407,7 +414,7 @@ class PyrenderOracle:
         if self._fmesh_node is not None:
             pose = gl_eye_pose(camera, model_matrix, self._fmesh_centre)
             self._fscene.set_pose(self._fmesh_node, pose)
-            self.last_bound_px = frame_bound_px(camera, pose, self._fmesh_radius)
+            self.last_bound_px = drawn_bound_px(camera, pose, self._fmesh_q, self._fmesh_segments)
         self._no_polygon_offset()
         colour, _pyrender_depth = self._renderer.render(self._fscene, pr.RenderFlags.FLAT)
         z_win = self._read_window_depth()
