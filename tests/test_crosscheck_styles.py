@@ -154,6 +154,19 @@ class InsideOutCore(CoreCandidate):
         return super().draw_mode(points, edges, camera, model_matrix, flipped, mode)
 
 
+def test_core_case_fields_hidden_lines_only_where_asked_and_precision_from_dtype():
+    # a case says whether faces hid its lines ("hidden_lines") only when it drew lines with hidden-line
+    # removal asked for: a plain wireframe of the cube (which has faces) hides nothing and says nothing
+    plain, _ = run_crosscheck([_load("cube")], CoreCandidate(), frames=2, case_names=["on_axis"], animation=False)
+    hidden, _ = run_crosscheck([_load("cube")], CoreCandidate(), frames=2, case_names=["on_axis"], animation=False,
+                               mode=RenderMode(hidden_lines=True))
+    assert plain["verdict"] == hidden["verdict"] == "pass"
+    assert "hidden_lines" not in plain["cases"][0] and hidden["cases"][0]["hidden_lines"] is True
+    # core, no precision declared: judged at its own --dtype (float64 by default), and the report says so
+    assert plain["cases"][0]["precision"] == {"judged_as": "float64", "source": "core --dtype",
+                                              "returned": ["float64"]}
+
+
 def test_hidden_lines_cube_from_an_oblique_camera(tmp_path):
     code, report, out = run(tmp_path, "--hidden-lines", "--scene", "cube", "--frames", "4",
                             "--cases", "oblique_roll,orthographic")
