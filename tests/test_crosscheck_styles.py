@@ -162,6 +162,9 @@ def test_core_case_fields_hidden_lines_only_where_asked_and_precision_from_dtype
                                mode=RenderMode(hidden_lines=True))
     assert plain["verdict"] == hidden["verdict"] == "pass"
     assert "hidden_lines" not in plain["cases"][0] and hidden["cases"][0]["hidden_lines"] is True
+    # and a wireframe has no shaded fields (regions, faces, depth): no face was filled to compare them
+    assert not {"silhouette_iou", "depth_max_error", "face_disagreements"} & (set(plain["cases"][0])
+                                                                              | set(hidden["cases"][0]))
     # core, no precision declared: judged at its own --dtype (float64 by default), and the report says so
     assert plain["cases"][0]["precision"] == {"judged_as": "float64", "source": "core --dtype",
                                               "returned": ["float64"]}
