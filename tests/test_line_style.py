@@ -287,3 +287,26 @@ def test_off_by_one_pixels_at_the_image_border(row):
     # (3, row), (3, inner), (4, inner): 7 of the 9, the other 2 ((2, row), (2, inner)) across
     assert got == {"oracle_pixels": 4, "differing": 9, "off_by_one_across": 2, "off_by_one_at_ends": 7,
                    "farther": 0}
+
+
+def test_only_binary_frames_get_a_reference_drawing():
+    # the quantisation of binary lines is measured on a correct binary drawing of the same lines and
+    # subtracted (module docstring); grey (antialiased) frames are not quantised and get none. The frames:
+    # two lines antialiased (4 x 4 supersampled: a third or more of the drawn pixels grey), and the same
+    # thresholded at 128 (binary: no grey at all)
+    from wirecheck.core.camera import Camera
+    from wirecheck.oracles.judge import line_style
+
+    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
+                 projection="orthographic", ortho_height=140.0)
+    p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0]])
+    edges = np.array([[0, 1], [2, 3]])
+    grey = draw_antialiased(oracle_segments(p, edges, cam), 220, 140)
+    drawn = grey[grey > 0]
+    assert np.mean((drawn > 255 / 8) & (drawn < 255 * 7 / 8)) > 0.3          # the frame is grey
+    binary = np.where(grey >= 128, 255, 0).astype(np.uint8)
+    for image, references in ((grey, 0), (binary, 2)):
+        style = line_style.CaseStyle()
+        for _ in range(2):
+            style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
+        assert len(style.reference) == references

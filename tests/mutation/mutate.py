@@ -65,7 +65,8 @@ TARGETS = {
     "oracles/judge/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
     "oracles/diagnosis/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
     "oracles/judge/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
-                           "decides or note or empty_scene or faceless or visibility or core_case_fields"),
+                           "decides or note or empty_scene or faceless or visibility or core_case_fields "
+                           "or shaded_summary"),
     "oracles/references/convert.py": (["tests/test_oracle_convert.py"], None),
     "oracles/judge/decide.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
                           "tests/test_crosscheck_styles.py", "tests/test_gate.py"],
