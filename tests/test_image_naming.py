@@ -76,3 +76,15 @@ def test_scale_starts_are_the_convention_mistakes_ratios():
     assert starts(look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), width=640, height=360)) == expected(mistakes)
     # a square camera's W/H = H/W = 1 adds only the unit scale
     assert starts(look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), width=480, height=480)) == expected(mistakes + [1.0])
+
+
+def test_a_swap_about_the_principal_point_is_no_offset():
+    # x and y exchanged about the principal point ((u, v) -> (v, u), centred): an axis swap whose fitted
+    # offset is 0, one of the offsets a swap may carry (0, or +-(cx - cy) for a swap of raw pixel
+    # coordinates, 80 px here): named axis_swap alone, no pixel_offset. The lines: an asymmetric open
+    # polyline within 150 px of the centre (inside the 640 x 480 image either way round), two frames
+    pts = np.array([[-150.0, -120.0], [130.0, -60.0], [40.0, 140.0], [-90.0, 60.0], [-20.0, -10.0]])
+    segs = np.stack([pts[:-1], pts[1:]], axis=1) + [CX, CY]
+    swapped = (segs - [CX, CY])[:, :, ::-1] + [CX, CY]
+    got = diagnose_images([_draw(swapped)] * 2, [segs] * 2, CAM)
+    assert [f["name"] for f in got] == ["axis_swap"], got

@@ -5,8 +5,9 @@ Each mutant changes one operator or constant in one module (the operators:
 ``is`` / ``is not``, ``in`` / ``not in``, ``and`` / ``or``, dropping a ``not``
 or a unary minus, ``k`` to ``k + 1`` for an int, ``x`` to ``2 x`` (``0.0`` to
 ``1.0``) for a float), is written into a private copy of the package (the
-working tree is never touched), and the module's own test files run against
-it (``pytest -x -p no:cacheprovider``, time-limited). A mutant is *killed*
+working tree is never touched), and the module's own tests run against it
+(``TARGETS``: test files or ``file::test`` node ids and an optional ``-k``;
+``pytest -x -p no:cacheprovider``, time-limited). A mutant is *killed*
 when they fail (or time out), *survived* when they pass. Survivors are either
 killed by a new test or listed in ``equivalent.json`` with the reason the
 change cannot be seen (their id: ``module:line:col:change``).
@@ -20,7 +21,7 @@ in-place file rewriting would put under the other helpers' feet. The mutator
 below is ~200 lines, has no state but its report, and runs in a copy.
 
     .venv/bin/python tests/mutation/mutate.py [--sample N] [--seed S] [--module core/projector/raster.py ...]
-                                             [--jobs J] [--report tests/mutation/report.md]
+                                             [--only ID ...] [--list] [--report tests/mutation/report.md]
 
 ``--sample N``: at most N mutants per module, drawn with ``--seed`` from all
 of that module's sites (the same N and seed give the same mutants). Not part
