@@ -310,3 +310,23 @@ def test_only_binary_frames_get_a_reference_drawing():
         for _ in range(2):
             style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
         assert len(style.reference) == references
+
+
+def test_summary_lines_one_per_style_and_rule():
+    # report.md / stdout: one line per (style, line rule) read in a run's cases, by hand for three cases:
+    # two antialiased ones (widths 1.02 and 0.98) and one aliased under --line-rule geometry; a case with
+    # no line style (a projector's) adds nothing
+    from wirecheck.oracles.judge.line_style import CANNOT_SHOW, summary_lines
+
+    def case(style, rule, width, judged_by):
+        return {"line_style": {"style": style, "line_rule": rule, "width_px": width, "judged_by": judged_by}}
+
+    by_centres = "the geometry (line centres); F1@0px is reported, not judged"
+    cases = [case("antialiased", "gl", 1.02, by_centres), {"faults": []},
+             case("aliased", "geometry", 1.0, by_centres), case("antialiased", "gl", 0.98, by_centres)]
+    assert summary_lines(cases) == [
+        f"Line style read: aliased (1 case, 1.00-1.00 px wide, --line-rule geometry): judged by {by_centres}; "
+        f"cannot show {CANNOT_SHOW['aliased']}",
+        f"Line style read: antialiased (2 cases, 0.98-1.02 px wide, --line-rule gl): judged by {by_centres}; "
+        f"cannot show {CANNOT_SHOW['antialiased']}"]
+    assert summary_lines([{"faults": []}]) == []
