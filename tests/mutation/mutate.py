@@ -315,7 +315,7 @@ def write_report(path: Path, results, equivalent: dict, args) -> None:
     score = (counts["killed"] + counts["timeout"]) / judged if judged else float("nan")
     lines = ["# Mutation report", "",
              f"Command: `.venv/bin/python tests/mutation/mutate.py"
-             f"{f' --sample {args.sample}' if args.sample else ''} --seed {args.seed}"
+             f"{f' --sample {args.sample}' if args.sample else ''}{'' if args.only else f' --seed {args.seed}'}"
              f"{''.join(f' --module {m}' for m in args.module or [])}"
              f"{''.join(f' --only {i}' for i in args.only or [])}"
              f"{'' if Path(args.report) == HERE / 'report.md' else f' --report {args.report}'}`", "",
