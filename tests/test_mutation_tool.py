@@ -1,4 +1,5 @@
-"""tests/mutation/mutate.py refuses a run over nothing instead of writing "Score: nan%" (issue 25, item 11)."""
+"""tests/mutation/mutate.py refuses a run over nothing instead of writing "Score: nan%" (issue 25, item 11), and its
+TARGETS name modules and tests that exist."""
 
 import hashlib
 import importlib.util
@@ -39,3 +40,15 @@ def test_only_with_known_ids_still_chooses_them(capsys):
 def test_a_sample_of_zero_is_exit_2(tmp_path, capsys):
     rc = _mutate().main(["--module", "core/projector/clipping.py", "--sample", "0", "--report", str(tmp_path / "r.md")])
     assert rc == 2 and "no mutant chosen" in capsys.readouterr().err and not (tmp_path / "r.md").exists()
+
+
+def test_every_target_names_a_module_and_tests_that_exist():
+    # a mutant run against a test path or node id that no longer exists would be "killed" by pytest's
+    # collection error (exit 4), not by a test: every module, test file and ``file::test`` must exist
+    root = MUTATION.parent.parent
+    for module, (tests, _k) in _mutate().TARGETS.items():
+        assert (root / module).is_file(), module
+        for entry in tests:
+            path, _, name = entry.partition("::")
+            assert (root / path).is_file(), (module, entry)
+            assert not name or f"def {name}(" in (root / path).read_text(), (module, entry)
