@@ -41,6 +41,37 @@ def _load(name_or_path):
 
 # ---------------------------------------------------------------- shaded
 
+def _shaded_frame(iou, union, depth_px, depth_max, depth_mean, bound, faces=0, faces_inside=0):
+    return {"silhouette_iou": iou, "silhouette_union_px": union, "silhouette_mismatch_inside": 0,
+            "depth_pixels": depth_px, "depth_max_error": depth_max, "depth_mean_error": depth_mean,
+            "depth_error_bound": bound, "depth_error_ratio": None if depth_max is None else depth_max / bound,
+            "face_disagreements": faces, "face_disagreements_inside": faces_inside}
+
+
+def test_shaded_summary_pools_the_frames():
+    from wirecheck.oracles.judge.verdict import shaded_summary
+
+    # no shaded frame: nothing compared, so nothing disagrees (zeros, no depth, no IoU)
+    empty = shaded_summary([], None)
+    assert (empty["face_disagreements"], empty["face_disagreements_inside"], empty["depth_pixels"]) == (0, 0, 0)
+    assert empty["silhouette_iou"] is None and empty["depth_max_error"] is None
+    # three frames by hand: frame 3 has no depth compared (None); frames 1 and 2 tie on the depth error
+    # ratio (0.5 = 1e-3 / 2e-3 = 2e-3 / 4e-3), so the worst depth frame is the first of them, 1, as the
+    # worst vertex and pixel frames are; the mean depth error is per pixel over both frames:
+    # (10 x 1e-4 + 30 x 5e-4) / 40 = 4e-4; the gated IoU leaves out frame 2 (union 100 < MIN_IOU_UNION_PX)
+    frames = [(1, _shaded_frame(0.98, 900, 10, 1e-3, 1e-4, 2e-3, faces=4, faces_inside=1)),
+              (2, _shaded_frame(0.50, 100, 30, 2e-3, 5e-4, 4e-3, faces=2)),
+              (3, _shaded_frame(0.97, 800, 0, None, None, 1e-3))]
+    out = shaded_summary(frames, ((0.9, 0.9), 2))
+    assert out["depth_worst_frame"] == 1 and out["depth_error_ratio"] == pytest.approx(0.5, rel=1e-12)
+    assert out["depth_max_error"] == pytest.approx(2e-3, rel=1e-12)       # the largest error, frame 2's
+    assert out["depth_error_bound"] == pytest.approx(4e-3, rel=1e-12)     # and its own bound
+    assert out["depth_mean_error"] == pytest.approx(4e-4, rel=1e-12) and out["depth_pixels"] == 40
+    assert out["silhouette_iou"] == 0.50 and out["silhouette_iou_gated"] == 0.97
+    assert (out["face_disagreements"], out["face_disagreements_inside"]) == (6, 1)
+    assert out["worst_pixel_frame"] == 2
+
+
 def test_shaded_cube_and_icosphere_pass_perspective_and_orthographic(tmp_path, icosphere):
     code, report, out = run(tmp_path, "--style", "shaded", "--scene", "cube", "--scene", str(icosphere),
                             "--frames", "4", "--cases", "oblique_roll,orthographic")
@@ -152,6 +183,22 @@ class InsideOutCore(CoreCandidate):
     def draw_mode(self, points, edges, camera, model_matrix, faces, mode):
         flipped = tuple(tuple(reversed(f)) for f in faces)
         return super().draw_mode(points, edges, camera, model_matrix, flipped, mode)
+
+
+def test_core_case_fields_hidden_lines_only_where_asked_and_precision_from_dtype():
+    # a case says whether faces hid its lines ("hidden_lines") only when it drew lines with hidden-line
+    # removal asked for: a plain wireframe of the cube (which has faces) hides nothing and says nothing
+    plain, _ = run_crosscheck([_load("cube")], CoreCandidate(), frames=2, case_names=["on_axis"], animation=False)
+    hidden, _ = run_crosscheck([_load("cube")], CoreCandidate(), frames=2, case_names=["on_axis"], animation=False,
+                               mode=RenderMode(hidden_lines=True))
+    assert plain["verdict"] == hidden["verdict"] == "pass"
+    assert "hidden_lines" not in plain["cases"][0] and hidden["cases"][0]["hidden_lines"] is True
+    # and a wireframe has no shaded fields (regions, faces, depth): no face was filled to compare them
+    assert not {"silhouette_iou", "depth_max_error", "face_disagreements"} & (set(plain["cases"][0])
+                                                                              | set(hidden["cases"][0]))
+    # core, no precision declared: judged at its own --dtype (float64 by default), and the report says so
+    assert plain["cases"][0]["precision"] == {"judged_as": "float64", "source": "core --dtype",
+                                              "returned": ["float64"]}
 
 
 def test_hidden_lines_cube_from_an_oblique_camera(tmp_path):

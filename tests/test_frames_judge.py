@@ -88,6 +88,36 @@ def test_core_exact_frames_pass_with_line_scores(exact):
     assert report["tolerances"]["balance_alpha"] == tolerances.BALANCE_ALPHA
 
 
+def test_compared_counts_and_the_worst_frame(exact):
+    """``compared``: the frames, no vertex, and the pixels drawn by either side (the gate's "nothing
+    compared"); the worst frame's images are that frame's."""
+    from PIL import Image
+
+    from wirecheck.oracles.candidates.frames_candidate import load_job
+
+    report, images = run_frames(exact)
+    job = load_job(exact)
+    for case, listed in zip(report["cases"], job["cases"]):
+        per = case["per_frame"]
+        # the worst frame's images: the frame of least (F1@1px, F1@0px), the first of ties, and its PNG's pixels
+        worst = min(per, key=lambda f: (f["f1_1px"], f["f1_0px"]))["frame"]
+        im = images[(case["scene"], case["camera"])]
+        assert im["frame"] == case["worst_pixel_frame"] == worst
+        rel = listed["frames"][[f["frame"] for f in per].index(worst)]
+        assert np.array_equal(im["candidate"], np.asarray(Image.open(exact / rel).convert("L")) >= 128)
+        # the candidate's count, read here from its PNGs by the frames rule (drawn where grey >= 128)
+        assert [f["candidate_pixels"] for f in per] == \
+            [int((np.asarray(Image.open(exact / rel).convert("L")) >= 128).sum()) for rel in listed["frames"]]
+        # |A u B| lies in [max(|A|, |B|), |A| + |B|), the upper end open as the two sides share pixels
+        # (core's exact lines against the oracle's: F1@0px near 1)
+        low = sum(max(f["candidate_pixels"], f["oracle_pixels"]) for f in per)
+        high = sum(f["candidate_pixels"] + f["oracle_pixels"] for f in per)
+        assert low <= case["compared"]["pixels"] < high, (low, case["compared"]["pixels"], high)
+        # every listed frame compared, and no vertex: a renderer's frames carry none
+        assert (case["compared"]["frames"], case["compared"]["vertices"]) == (len(listed["frames"]), 0)
+    assert report["compared"]["pixels"] == sum(c["compared"]["pixels"] for c in report["cases"])
+
+
 def test_frames_minus_each_last_pixel_fail_as_line_end_bias(short):
     report, _ = run_frames(short)
     assert report["verdict"] == "fail"

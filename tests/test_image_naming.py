@@ -56,3 +56,35 @@ def test_the_oracles_bias_would_have_named_an_offset(monkeypatch):
     assert np.max(np.abs(model_bias - oracle_bias)) > OFFSET_TOL_PX
     monkeypatch.setattr(image_diagnose, "quantisation_bias", lambda segs, cam, p=None, d=None: bias(segs, cam))
     assert "pixel_offset" in [f["name"] for f in diagnose_images(CAND, SEGS, CAM)]
+
+
+def test_scale_starts_are_the_convention_mistakes_ratios():
+    # the restarts of a fit no usual start explains (image_naming.scale_starts) are the scales a convention
+    # mistake gives: an aspect of 4:3 or 16:9 either way round, a half or double angle or size (2, 1/2), and
+    # the camera's own W/H and H/W; each on both axes, on x alone and on y alone
+    from wirecheck.oracles.diagnosis.image_naming import scale_starts
+
+    def starts(camera):
+        return sorted({tuple(round(float(v), 12) for v in d) for d in scale_starts(camera)})
+
+    def expected(ratios):
+        return sorted({tuple(round(v, 12) for v in d)
+                       for r in ratios for d in ((r, r), (r, 1.0), (1.0, r))})
+
+    mistakes = [4 / 3, 3 / 4, 16 / 9, 9 / 16, 2.0, 0.5]
+    # a 16:9 camera's W/H and H/W are among the mistakes: nothing more
+    assert starts(look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), width=640, height=360)) == expected(mistakes)
+    # a square camera's W/H = H/W = 1 adds only the unit scale
+    assert starts(look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), width=480, height=480)) == expected(mistakes + [1.0])
+
+
+def test_a_swap_about_the_principal_point_is_no_offset():
+    # x and y exchanged about the principal point ((u, v) -> (v, u), centred): an axis swap whose fitted
+    # offset is 0, one of the offsets a swap may carry (0, or +-(cx - cy) for a swap of raw pixel
+    # coordinates, 80 px here): named axis_swap alone, no pixel_offset. The lines: an asymmetric open
+    # polyline within 150 px of the centre (inside the 640 x 480 image either way round), two frames
+    pts = np.array([[-150.0, -120.0], [130.0, -60.0], [40.0, 140.0], [-90.0, 60.0], [-20.0, -10.0]])
+    segs = np.stack([pts[:-1], pts[1:]], axis=1) + [CX, CY]
+    swapped = (segs - [CX, CY])[:, :, ::-1] + [CX, CY]
+    got = diagnose_images([_draw(swapped)] * 2, [segs] * 2, CAM)
+    assert [f["name"] for f in got] == ["axis_swap"], got

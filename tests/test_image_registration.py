@@ -137,3 +137,20 @@ def test_the_nearest_pixel_map_is_exact_within_the_pairs_reach(where):
     assert (~inside).sum() > 500 or where == "everywhere"      # (everywhere: the box is the whole image)
     np.testing.assert_array_equal(d_map[inside], d_true[inside])
     assert np.all(d_map[~inside] > reach)
+
+
+def test_oracle_samples_reach_half_the_image_beyond_each_side():
+    # oracle samples are taken along the lines within the image grown by half its size per side
+    # (a scale fault of 1/2 brings those parts into the picture): a segment crossing far past every side
+    # is sampled exactly across the grown image, [-0.5 - W/2, W - 0.5 + W/2] (clip_to_image's pixel-edge
+    # bounds, shifted), at SAMPLE_STEP_PX = 0.5 px: 2 W / 0.5 steps, 4 W + 1 samples; likewise for H
+    horizontal = np.array([[[-10.0 * W, 20.25], [11.0 * W, 20.25]]])
+    pts, tangents = image_diagnose._samples(horizontal, W, H)
+    assert len(pts) == 4 * W + 1
+    assert pts[0] == pytest.approx([-0.5 - W / 2, 20.25]) and pts[-1] == pytest.approx([W - 0.5 + W / 2, 20.25])
+    assert np.allclose(np.diff(pts[:, 0]), 0.5) and np.allclose(tangents, [1.0, 0.0])
+    vertical = np.array([[[30.25, 9.0 * H], [30.25, -12.0 * H]]])        # drawn upward: samples run from the start
+    pts, tangents = image_diagnose._samples(vertical, W, H)
+    assert len(pts) == 4 * H + 1
+    assert pts[0] == pytest.approx([30.25, H - 0.5 + H / 2]) and pts[-1] == pytest.approx([30.25, -0.5 - H / 2])
+    assert np.allclose(tangents, [0.0, -1.0])

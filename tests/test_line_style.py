@@ -265,3 +265,68 @@ def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
     style.judge(rec, [], None)
     geo = rec["line_style"]["geometry"]
     assert geo["found_share"] == 1.0 and max(map(abs, geo["offset_px"])) < 0.05 and rec["faults"] == []
+
+
+@pytest.mark.parametrize("row", [0, -1], ids=["first_row", "last_row"])
+def test_off_by_one_pixels_at_the_image_border(row):
+    # the raster-rule counts of line_style._off_by_one on a 4 x 5 image, by hand: the oracle draws a line
+    # along a border row, the candidate draws it one row inwards and one pixel longer at the right. Each of
+    # the 4 + 5 differing pixels has a pixel of the other side among its 8 neighbours (those beyond the
+    # image are none): all off by one; a mutant that looks past the border fails on the border row
+    from wirecheck.oracles.judge.line_style import _off_by_one
+
+    h, w = 4, 5
+    inner = 1 if row == 0 else h - 2
+    orac = np.zeros((h, w), bool)
+    cand = np.zeros((h, w), bool)
+    orac[row, 0:4] = True
+    cand[inner, 0:5] = True
+    ends = np.array([[0.0, row % h], [4.0, row % h]])           # the segment's ends (x, y)
+    got = _off_by_one(cand, orac, ends)
+    # at the ends: within END_RADIUS_PX = 1.5 px of (0, row): (0, row), (1, row), (0, inner), (1, inner); of (4, row):
+    # (3, row), (3, inner), (4, inner): 7 of the 9, the other 2 ((2, row), (2, inner)) across
+    assert got == {"oracle_pixels": 4, "differing": 9, "off_by_one_across": 2, "off_by_one_at_ends": 7,
+                   "farther": 0}
+
+
+def test_only_binary_frames_get_a_reference_drawing():
+    # the quantisation of binary lines is measured on a correct binary drawing of the same lines and
+    # subtracted (module docstring); grey (antialiased) frames are not quantised and get none. The frames:
+    # two lines antialiased (4 x 4 supersampled: a third or more of the drawn pixels grey), and the same
+    # thresholded at 128 (binary: no grey at all)
+    from wirecheck.core.camera import Camera
+    from wirecheck.oracles.judge import line_style
+
+    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
+                 projection="orthographic", ortho_height=140.0)
+    p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0]])
+    edges = np.array([[0, 1], [2, 3]])
+    grey = draw_antialiased(oracle_segments(p, edges, cam), 220, 140)
+    drawn = grey[grey > 0]
+    assert np.mean((drawn > 255 / 8) & (drawn < 255 * 7 / 8)) > 0.3          # the frame is grey
+    binary = np.where(grey >= 128, 255, 0).astype(np.uint8)
+    for image, references in ((grey, 0), (binary, 2)):
+        style = line_style.CaseStyle()
+        for _ in range(2):
+            style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
+        assert len(style.reference) == references
+
+
+def test_summary_lines_one_per_style_and_rule():
+    # report.md / stdout: one line per (style, line rule) read in a run's cases, by hand for three cases:
+    # two antialiased ones (widths 1.02 and 0.98) and one aliased under --line-rule geometry; a case with
+    # no line style (a projector's) adds nothing
+    from wirecheck.oracles.judge.line_style import CANNOT_SHOW, summary_lines
+
+    def case(style, rule, width, judged_by):
+        return {"line_style": {"style": style, "line_rule": rule, "width_px": width, "judged_by": judged_by}}
+
+    by_centres = "the geometry (line centres); F1@0px is reported, not judged"
+    cases = [case("antialiased", "gl", 1.02, by_centres), {"faults": []},
+             case("aliased", "geometry", 1.0, by_centres), case("antialiased", "gl", 0.98, by_centres)]
+    assert summary_lines(cases) == [
+        f"Line style read: aliased (1 case, 1.00-1.00 px wide, --line-rule geometry): judged by {by_centres}; "
+        f"cannot show {CANNOT_SHOW['aliased']}",
+        f"Line style read: antialiased (2 cases, 0.98-1.02 px wide, --line-rule gl): judged by {by_centres}; "
+        f"cannot show {CANNOT_SHOW['antialiased']}"]
+    assert summary_lines([{"faults": []}]) == []

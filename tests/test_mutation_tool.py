@@ -1,4 +1,5 @@
-"""tests/mutation/mutate.py refuses a run over nothing instead of writing "Score: nan%" (issue 25, item 11)."""
+"""tests/mutation/mutate.py refuses a run over nothing instead of writing "Score: nan%" (issue 25, item 11), and its
+TARGETS name modules and tests that exist."""
 
 import hashlib
 import importlib.util
@@ -52,3 +53,15 @@ def test_the_mutant_ids_in_the_docs_name_mutants_that_exist():
     for mutant in shown:
         module = mutant.split(":")[0]
         assert mutant in {s.id for s in mutate.sites(module)}, mutant
+
+
+def test_every_target_names_a_module_and_tests_that_exist():
+    # a mutant run against a test path or node id that no longer exists would be "killed" by pytest's
+    # collection error (exit 4), not by a test: every module, test file and ``file::test`` must exist
+    root = MUTATION.parent.parent
+    for module, (tests, _k) in _mutate().TARGETS.items():
+        assert (root / module).is_file(), module
+        for entry in tests:
+            path, _, name = entry.partition("::")
+            assert (root / path).is_file(), (module, entry)
+            assert not name or f"def {name}(" in (root / path).read_text(), (module, entry)

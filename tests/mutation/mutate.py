@@ -5,8 +5,9 @@ Each mutant changes one operator or constant in one module (the operators:
 ``is`` / ``is not``, ``in`` / ``not in``, ``and`` / ``or``, dropping a ``not``
 or a unary minus, ``k`` to ``k + 1`` for an int, ``x`` to ``2 x`` (``0.0`` to
 ``1.0``) for a float), is written into a private copy of the package (the
-working tree is never touched), and the module's own test files run against
-it (``pytest -x -p no:cacheprovider``, time-limited). A mutant is *killed*
+working tree is never touched), and the module's own tests run against it
+(``TARGETS``: test files or ``file::test`` node ids and an optional ``-k``;
+``pytest -x -p no:cacheprovider``, time-limited). A mutant is *killed*
 when they fail (or time out), *survived* when they pass. Survivors are either
 killed by a new test or listed in ``equivalent.json`` with the reason the
 change cannot be seen (their id: ``module:line:col:change``).
@@ -20,7 +21,7 @@ in-place file rewriting would put under the other helpers' feet. The mutator
 below is ~200 lines, has no state but its report, and runs in a copy.
 
     .venv/bin/python tests/mutation/mutate.py [--sample N] [--seed S] [--module core/projector/raster.py ...]
-                                             [--jobs J] [--report tests/mutation/report.md]
+                                             [--only ID ...] [--list] [--report tests/mutation/report.md]
 
 ``--sample N``: at most N mutants per module, drawn with ``--seed`` from all
 of that module's sites (the same N and seed give the same mutants). Not part
@@ -46,7 +47,16 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 
-#: The modules mutated, and the test files (with an optional -k expression) that judge each.
+#: The image diagnosis's own test files, less test_image_diagnosis.py's module fixture (80 s): its two tests
+#: that do not use it (a blank candidate, a case of many frames) are selected by node id.
+_IMAGE_TESTS = ["tests/test_image_naming.py", "tests/test_image_registration.py", "tests/test_image_diagnosis_short.py",
+                "tests/test_image_diagnosis_thick.py",
+                "tests/test_image_diagnosis.py::test_blank_candidate_is_a_depth_flip_only_when_the_backward_view_is_empty",
+                "tests/test_image_diagnosis.py::test_a_case_of_many_frames_is_fitted_on_the_points_of_six"]
+
+#: The modules mutated, and the tests that judge each: test files or node ids (``file::test``), with an
+#: optional -k expression over them all. Only the tests that exercise the module: a mutant costs seconds
+#: to a minute, not the whole suite's minutes.
 TARGETS = {
     "core/projector/projection.py": (["tests/test_projection.py", "tests/test_conventions.py", "tests/test_core_vs_opencv.py"], None),
     "core/projector/clipping.py": (["tests/test_clipping.py"], None),
@@ -56,12 +66,25 @@ TARGETS = {
     "oracles/judge/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
     "oracles/diagnosis/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
     "oracles/judge/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
-                           "decides or note or empty_scene or faceless or visibility"),
+                           "decides or note or empty_scene or faceless or visibility or core_case_fields "
+                           "or shaded_summary"),
     "oracles/references/convert.py": (["tests/test_oracle_convert.py"], None),
     "oracles/judge/decide.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
                           "tests/test_crosscheck_styles.py", "tests/test_gate.py"],
                          "decides or note or empty_scene or faceless or visibility or line_end_bias or exact or geometric "
                          "or vacuous"),
+    # the frames path: its judge (run_frames, judge_case) is exercised by test_frames_judge.py (each threshold
+    # deciding on PNG frames) and by the run_frames cases of test_frames_candidate.py (pass, named fault, vacuous)
+    "oracles/judge/frames_judge.py": (["tests/test_frames_judge.py",
+                                       "tests/test_frames_candidate.py::test_core_frames_pass",
+                                       "tests/test_frames_candidate.py::test_mirrored_frames_fail_and_are_named",
+                                       "tests/test_frames_candidate.py::test_a_case_where_nothing_is_drawn_is_vacuous"],
+                                      None),
+    "oracles/judge/line_style.py": (["tests/test_line_style.py"], None),
+    # the image diagnosis: every test file but the 80-s confusion matrix of test_image_diagnosis.py (its
+    # module fixture diagnoses ~100 cases); the short job's matrix and the thick lines cover the same names
+    "oracles/diagnosis/image_diagnose.py": (_IMAGE_TESTS, None),
+    "oracles/diagnosis/image_naming.py": (_IMAGE_TESTS, None),
 }
 
 PER_MUTANT_TIMEOUT_S = 300
@@ -292,7 +315,10 @@ def write_report(path: Path, results, equivalent: dict, args) -> None:
     score = (counts["killed"] + counts["timeout"]) / judged if judged else float("nan")
     lines = ["# Mutation report", "",
              f"Command: `.venv/bin/python tests/mutation/mutate.py"
-             f"{f' --sample {args.sample}' if args.sample else ''} --seed {args.seed}`", "",
+             f"{f' --sample {args.sample}' if args.sample else ''}{'' if args.only else f' --seed {args.seed}'}"
+             f"{''.join(f' --module {m}' for m in args.module or [])}"
+             f"{''.join(f' --only {i}' for i in args.only or [])}"
+             f"{'' if Path(args.report) == HERE / 'report.md' else f' --report {args.report}'}`", "",
              f"Mutants: {len(results)}; killed {counts['killed']} (+{counts['timeout']} by time-out), "
              f"survived {counts['survived']}, equivalent {counts['equivalent']}. "
              f"**Score: {score:.1%}** of the non-equivalent mutants killed.", "",
