@@ -153,18 +153,18 @@ def _seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.hypot(*(foot - q[:, None, :]).transpose(2, 0, 1))
 
 
-def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME) -> dict:
-    """The centroid samples of one frame (module docstring), as a dict of arrays of ``M`` samples.
+def windows(segs: np.ndarray, shape) -> dict:
+    """Where :func:`measure` looks along the oracle's segments, clear of junctions: the image's part of it.
 
-    ``cov``: ``(H, W)`` float coverage (0 background, 1 a fully drawn pixel);
-    ``segs``: ``(K, 2, 2)`` the oracle's segments in pixels. ``offset`` is the
-    measured centre minus the exact line along the unit ``normal``, at
-    ``point`` on the exact line; ``width`` the coverage across the line there
-    (px, perpendicular to the line); ``segment`` its segment. ``windows``: the
-    windows looked at (clear of junctions); ``found``: those that held a line
-    (``M`` of them kept, at most ``limit``).
+    Depends on the segments and the image size only, so one frame's windows
+    serve every image measured on its lines (the candidate's, a reference
+    drawing's). ``rows``, ``cols``: ``(n, 2 PROFILE_RADIUS_PX + 1)`` pixel
+    indices of each window across its line; ``minor``: their coordinate along
+    the minor axis; ``exact``: the exact line's there; ``across``: the unit
+    normal's minor component; ``normal``, ``segment``, ``point``: as
+    :func:`measure` returns them.
     """
-    h, w = cov.shape
+    h, w = shape
     r = PROFILE_RADIUS_PX
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
     parts = []
@@ -187,23 +187,18 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
         win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
         cols = np.broadcast_to(pos[:, None], win.shape)
         rows_i, cols_i = (win, cols) if major == 0 else (cols, win)
-        g = cov[rows_i.astype(np.intp), cols_i.astype(np.intp)]
-        mass = g.sum(axis=1)
-        centroid = (g * win).sum(axis=1) / np.maximum(mass, 1e-300)
         unit = d / length
         normal = np.array([-unit[1], unit[0]])
         pt = np.empty((len(pos), 2))
         pt[:, major], pt[:, 1 - major] = pos, minor_exact
-        # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
-        parts.append({"normal": np.repeat(normal[None], len(pos), axis=0),
-                      "offset": (centroid - minor_exact) * normal[1 - major],
-                      "width": mass * abs(normal[1 - major]),          # a column crosses the line at 1 / |n_minor|
-                      "segment": np.full(len(pos), i), "point": pt, "mass": mass})
-    keys = ("normal", "offset", "width", "segment", "point", "mass")
+        parts.append({"rows": rows_i.astype(np.intp), "cols": cols_i.astype(np.intp), "minor": win,
+                      "exact": minor_exact, "across": np.full(len(pos), normal[1 - major]),
+                      "normal": np.repeat(normal[None], len(pos), axis=0), "segment": np.full(len(pos), i),
+                      "point": pt})
+    keys = ("rows", "cols", "minor", "exact", "across", "normal", "segment", "point")
     if not parts:
-        out = {k: np.zeros((0, 2)) if k in ("normal", "point") else np.zeros(0) for k in keys}
-        out["windows"] = out["found"] = 0
-        return out
+        return {k: np.zeros((0, 2 * r + 1) if k in ("rows", "cols", "minor") else (0, 2) if k in ("normal", "point")
+                            else 0, np.intp if k in ("rows", "cols") else np.float64) for k in keys}
     out = {k: np.concatenate([p[k] for p in parts]) for k in keys}
     if len(segs) > 1:                                   # drop windows near another segment (a junction, a crossing)
         keep = np.ones(len(out["point"]), bool)
@@ -212,7 +207,33 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
             dist[np.arange(len(dist)), out["segment"][k:k + 2048].astype(np.intp)] = np.inf
             keep[k:k + 2048] = dist.min(axis=1) > GUARD_PX
         out = {k: v[keep] for k, v in out.items()}
-    windows = len(out["offset"])
+    return out
+
+
+def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME, wins: dict | None = None,
+            level: float = 1.0) -> dict:
+    """The centroid samples of one frame (module docstring), as a dict of arrays of ``M`` samples.
+
+    ``cov / level``: ``(H, W)`` coverage (0 background, 1 a fully drawn pixel;
+    ``cov`` may be the grey levels and ``level`` the line's, so that only the
+    windows' pixels are divided); ``segs``: ``(K, 2, 2)`` the oracle's segments
+    in pixels; ``wins``: their :func:`windows`, when the caller has them.
+    ``offset`` is the measured centre minus the exact line along the unit
+    ``normal``, at ``point`` on the exact line; ``width`` the coverage across
+    the line there (px, perpendicular to the line); ``segment`` its segment.
+    ``windows``: the windows looked at (clear of junctions); ``found``: those
+    that held a line (``M`` of them kept, at most ``limit``).
+    """
+    r = PROFILE_RADIUS_PX
+    wins = windows(segs, np.shape(cov)) if wins is None else wins
+    g = cov[wins["rows"], wins["cols"]] / level
+    mass = g.sum(axis=1)
+    centroid = (g * wins["minor"]).sum(axis=1) / np.maximum(mass, 1e-300)
+    # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
+    out = {"normal": wins["normal"], "offset": (centroid - wins["exact"]) * wins["across"],
+           "width": mass * np.abs(wins["across"]),          # a column crosses the line at 1 / |n_minor|
+           "segment": wins["segment"], "point": wins["point"], "mass": mass}
+    windows_n = len(out["offset"])
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
     keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
     out = {k: v[keep] for k, v in out.items()}
@@ -220,7 +241,7 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     if found > limit:
         idx = np.linspace(0, found - 1, limit).round().astype(int)
         out = {k: v[idx] for k, v in out.items()}
-    out["windows"], out["found"] = windows, found
+    out["windows"], out["found"] = windows_n, found
     return out
 
 
@@ -317,8 +338,9 @@ def _off_by_one(cand: np.ndarray, orac: np.ndarray, ends: np.ndarray) -> dict:
 
 
 def _halve(samples: dict) -> dict:
-    """Every other sample of a frame's :func:`measure` (its counts kept)."""
-    return {k: (v if np.ndim(v) == 0 else v[::2]) for k, v in samples.items()}
+    """Every other sample of a frame's :func:`measure` (its counts kept), copied: a view would keep the
+    whole of the arrays alive, and a case's memory would grow with its frames."""
+    return {k: (v if np.ndim(v) == 0 else v[::2].copy()) for k, v in samples.items()}
 
 
 class CaseStyle:
@@ -343,30 +365,36 @@ class CaseStyle:
         self.reference = []                     # measure() of a correct binary drawing of each binary frame
         self.centre = np.zeros(2)
 
-    def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m) -> np.ndarray:
-        """Read one frame (``grey`` ``(H, W)`` uint8, ``orac`` pyrender's bool pixels); the pixels compared."""
+    def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
+        """Read one frame (``grey`` ``(H, W)`` uint8, ``orac`` pyrender's bool pixels); the pixels compared.
+
+        ``segs``: the frame's oracle segments (:func:`oracles.diagnosis.image_diagnose.oracle_segments`
+        of ``p_model`` moved by ``m``), when the caller has them.
+        """
         from wirecheck.core.projector.clipping import clip_to_image
+
+        from . import free_ends
 
         grey = np.asarray(grey)
         cand = grey >= 128
         if grey.dtype == bool:
             grey = grey.astype(np.uint8) * 255
-        segs = _segments(p_model, edges, camera, m)
+        segs = _segments(p_model, edges, camera, m) if segs is None else segs
         self.centre = np.array(camera.principal_point, dtype=float)
-        self.hist += np.bincount(grey.ravel(), minlength=256)[:256]
+        drawn = grey[grey > 0]
+        self.hist += np.bincount(drawn, minlength=256)[:256]
+        self.hist[0] += grey.size - len(drawn)
         if len(segs):
             _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
-        cov = grey / max(int(grey.max()), 1)                                   # the frame's line level is 1
-        from . import free_ends
-
-        got = measure(cov, segs)
+        level = max(int(drawn.max()) if len(drawn) else 0, 1)              # the frame's line level is 1
+        wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
+        got = measure(grey, segs, wins=wins, level=level)
         self.samples.append(got)
-        self.ends.append(free_ends.measure_ends(cov, segs))
-        drawn = grey[grey > 0]
+        self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if len(drawn) and np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) <= GREY_SHARE_MAX:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
-            self.reference.append(measure(_reference(segs, grey.shape, width).astype(float), segs))
+            self.reference.append(measure(_reference(segs, grey.shape, width), segs, wins=wins))
         if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
             self.samples = [_halve(x) for x in self.samples]
             self.reference = [_halve(x) for x in self.reference]
