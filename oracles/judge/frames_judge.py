@@ -136,6 +136,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
                                 segs, (job_dir, job))
         core = render_frame(p_model, edges, camera, m).image >= 128
         fp = metrics.FramePixels(cand, orac)
+        style.count_rule(fp, segs)
         ps = metrics.pixel_scores(None, None, pixels=fp)
         cs = metrics.pixel_scores(cand, core)
         for key, values in acc.pixel.items():

@@ -145,12 +145,12 @@ def _segments(p_model, edges, camera, m) -> np.ndarray:
 
 
 def _seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)``."""
-    ab = b - a
-    len2 = np.maximum((ab * ab).sum(axis=1), 1e-300)
-    t = np.clip(((q[:, None, :] - a[None]) * ab[None]).sum(axis=2) / len2, 0.0, 1.0)
-    foot = a[None] + t[..., None] * ab[None]
-    return np.hypot(*(foot - q[:, None, :]).transpose(2, 0, 1))
+    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)`` (x and y apart: no (N, K, 2) array)."""
+    abx, aby = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+    len2 = np.maximum(abx * abx + aby * aby, 1e-300)
+    qx, qy = q[:, 0:1], q[:, 1:2]
+    t = np.clip(((qx - a[:, 0]) * abx + (qy - a[:, 1]) * aby) / len2, 0.0, 1.0)
+    return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
 
 
 def windows(segs: np.ndarray, shape) -> dict:
@@ -158,53 +158,54 @@ def windows(segs: np.ndarray, shape) -> dict:
 
     Depends on the segments and the image size only, so one frame's windows
     serve every image measured on its lines (the candidate's, a reference
-    drawing's). ``rows``, ``cols``: ``(n, 2 PROFILE_RADIUS_PX + 1)`` pixel
-    indices of each window across its line; ``minor``: their coordinate along
-    the minor axis; ``exact``: the exact line's there; ``across``: the unit
-    normal's minor component; ``normal``, ``segment``, ``point``: as
-    :func:`measure` returns them.
+    drawing's). Along each segment long enough, at every integer step of its
+    major axis :data:`GUARD_PX` clear of its ends and inside the image, a
+    window across it; segment by segment, each in ascending steps. ``rows``,
+    ``cols``: ``(n, 2 PROFILE_RADIUS_PX + 1)`` pixel indices of each window;
+    ``minor``: their coordinate along the minor axis; ``exact``: the exact
+    line's there; ``across``: the unit normal's minor component; ``normal``,
+    ``segment``, ``point``: as :func:`measure` returns them.
     """
     h, w = shape
     r = PROFILE_RADIUS_PX
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    parts = []
-    for i, (a, b) in enumerate(segs):
-        d = b - a
-        length = float(np.hypot(*d))
-        if length < 2 * GUARD_PX + 1:
-            continue
-        major = 0 if abs(d[0]) >= abs(d[1]) else 1
-        lo, hi = sorted((a[major], b[major]))
-        guard = GUARD_PX * abs(d[major]) / length            # GUARD_PX along the line, on the major axis
-        extent = w if major == 0 else h
-        pos = np.arange(max(np.ceil(lo + guard), 0), min(np.floor(hi - guard), extent - 1) + 1)
-        minor_exact = a[1 - major] + (pos - a[major]) * d[1 - major] / d[major]
-        centre = np.rint(minor_exact)
-        inside = (centre - r >= 0) & (centre + r <= (h if major == 0 else w) - 1)
-        pos, minor_exact, centre = pos[inside], minor_exact[inside], centre[inside]
-        if len(pos) == 0:
-            continue
-        win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
-        cols = np.broadcast_to(pos[:, None], win.shape)
-        rows_i, cols_i = (win, cols) if major == 0 else (cols, win)
-        unit = d / length
-        normal = np.array([-unit[1], unit[0]])
-        pt = np.empty((len(pos), 2))
-        pt[:, major], pt[:, 1 - major] = pos, minor_exact
-        parts.append({"rows": rows_i.astype(np.intp), "cols": cols_i.astype(np.intp), "minor": win,
-                      "exact": minor_exact, "across": np.full(len(pos), normal[1 - major]),
-                      "normal": np.repeat(normal[None], len(pos), axis=0), "segment": np.full(len(pos), i),
-                      "point": pt})
-    keys = ("rows", "cols", "minor", "exact", "across", "normal", "segment", "point")
-    if not parts:
-        return {k: np.zeros((0, 2 * r + 1) if k in ("rows", "cols", "minor") else (0, 2) if k in ("normal", "point")
-                            else 0, np.intp if k in ("rows", "cols") else np.float64) for k in keys}
-    out = {k: np.concatenate([p[k] for p in parts]) for k in keys}
-    if len(segs) > 1:                                   # drop windows near another segment (a junction, a crossing)
-        keep = np.ones(len(out["point"]), bool)
+    a, b = segs[:, 0], segs[:, 1]
+    d = b - a
+    length = np.hypot(d[:, 0], d[:, 1])
+    i = np.flatnonzero(length >= 2 * GUARD_PX + 1)
+    a, b, d, length = a[i], b[i], d[i], length[i]
+    major = np.where(np.abs(d[:, 0]) >= np.abs(d[:, 1]), 0, 1)
+    minor = 1 - major
+    k = np.arange(len(i))
+    a_maj, b_maj, d_maj = a[k, major], b[k, major], d[k, major]
+    a_min, d_min = a[k, minor], d[k, minor]
+    guard = GUARD_PX * np.abs(d_maj) / length                # GUARD_PX along the line, on the major axis
+    extent = np.where(major == 0, w, h)
+    start = np.maximum(np.ceil(np.minimum(a_maj, b_maj) + guard), 0)
+    stop = np.minimum(np.floor(np.maximum(a_maj, b_maj) - guard), extent - 1)
+    count = np.maximum(stop - start + 1, 0).astype(np.intp)
+    owner = np.repeat(np.arange(len(i)), count)             # the windows, segment by segment
+    pos = start[owner] + (np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count))
+    minor_exact = a_min[owner] + (pos - a_maj[owner]) * d_min[owner] / d_maj[owner]
+    centre = np.rint(minor_exact)
+    inside = (centre - r >= 0) & (centre + r <= np.where(major == 0, h, w)[owner] - 1)
+    owner, pos, minor_exact, centre = owner[inside], pos[inside], minor_exact[inside], centre[inside]
+    unit = d / length[:, None]
+    normal = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
+    win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
+    cols = np.broadcast_to(pos[:, None], win.shape)
+    horizontal = (major == 0)[owner][:, None]
+    pt = np.empty((len(pos), 2))
+    pt[:, 0] = np.where(horizontal[:, 0], pos, minor_exact)
+    pt[:, 1] = np.where(horizontal[:, 0], minor_exact, pos)
+    out = {"rows": np.where(horizontal, win, cols).astype(np.intp), "cols": np.where(horizontal, cols, win).astype(np.intp),
+           "minor": win, "exact": minor_exact, "across": normal[owner, minor[owner]],
+           "normal": normal[owner], "segment": i[owner], "point": pt}
+    if len(segs) > 1 and len(pos):                      # drop windows near another segment (a junction, a crossing)
+        keep = np.ones(len(pos), bool)
         for k in range(0, len(keep), 2048):
-            dist = _seg_distance(out["point"][k:k + 2048], segs[:, 0], segs[:, 1])
-            dist[np.arange(len(dist)), out["segment"][k:k + 2048].astype(np.intp)] = np.inf
+            dist = _seg_distance(pt[k:k + 2048], segs[:, 0], segs[:, 1])
+            dist[np.arange(len(dist)), out["segment"][k:k + 2048]] = np.inf
             keep[k:k + 2048] = dist.min(axis=1) > GUARD_PX
         out = {k: v[keep] for k, v in out.items()}
     return out
@@ -311,28 +312,29 @@ def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
     return img
 
 
-def _off_by_one(cand: np.ndarray, orac: np.ndarray, ends: np.ndarray) -> dict:
-    """Pixels where ``cand`` and ``orac`` differ, counted by where they are (module docstring)."""
-    h, w = cand.shape
-    rr, cc = np.nonzero(cand != orac)
-    other = np.where(cand[rr, cc], 0, 1)                # 0: look in orac (an extra pixel), 1: in cand
-    pair = (orac, cand)
+def _off_by_one(fp, ends: np.ndarray) -> dict:
+    """Pixels where the candidate and the oracle differ (``fp``: the frame's
+    oracles.judge.metrics.FramePixels), counted by where they are (module docstring)."""
+    h, w = fp.shape
+    c_only, o_only = fp.only()
+    flat = np.concatenate([c_only, o_only])
+    rr, cc = np.divmod(flat, w)
+    extra = np.arange(len(flat)) < len(c_only)          # a candidate-only pixel: look in the oracle's, else in the candidate's
     off1 = np.zeros(len(rr), bool)
     for dy in (-1, 0, 1):                               # a pixel of the other side among the 8 neighbours
         for dx in (-1, 0, 1):
             if dx or dy:
-                y, x = np.clip(rr + dy, 0, h - 1), np.clip(cc + dx, 0, w - 1)
-                inside = (rr + dy == y) & (cc + dx == x)
-                for side in (0, 1):
-                    sel = inside & (other == side)
-                    off1[sel] |= pair[side][y[sel], x[sel]]
+                y, x = rr + dy, cc + dx
+                inside = (y >= 0) & (y < h) & (x >= 0) & (x < w)
+                for side, sel in ((False, inside & extra), (True, inside & ~extra)):
+                    off1[sel] |= fp.has(y[sel] * w + x[sel], of_candidate=side)
     at_end = np.zeros(len(rr), bool)
     if len(rr) and len(ends):
         q = np.stack([cc, rr], axis=1).astype(float)
         for k in range(0, len(q), 4096):
             d = np.hypot(q[k:k + 4096, None, 0] - ends[None, :, 0], q[k:k + 4096, None, 1] - ends[None, :, 1])
             at_end[k:k + 4096] = d.min(axis=1) <= END_RADIUS_PX
-    return {"oracle_pixels": int(orac.sum()), "differing": int(len(rr)),
+    return {"oracle_pixels": int(len(fp.oracle_idx)), "differing": int(len(rr)),
             "off_by_one_across": int((off1 & ~at_end).sum()), "off_by_one_at_ends": int((off1 & at_end).sum()),
             "farther": int((~off1).sum())}
 
@@ -348,7 +350,8 @@ class CaseStyle:
 
     ``frame`` is called once per frame with the candidate's grey image (it
     returns the bool pixels the F1 scores compare: drawn where >= 128, the
-    rule of docs/frames.md); ``judge`` once, after the F1 reasons are known.
+    rule of docs/frames.md), then ``count_rule`` with those pixels and the
+    oracle's; ``judge`` once, after the F1 reasons are known.
     Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
@@ -398,9 +401,13 @@ class CaseStyle:
         if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
             self.samples = [_halve(x) for x in self.samples]
             self.reference = [_halve(x) for x in self.reference]
-        counts = _off_by_one(cand, orac, segs.reshape(-1, 2))
-        self.raster = {k: v + counts[k] for k, v in self.raster.items()}
         return cand
+
+    def count_rule(self, fp, segs: np.ndarray) -> None:
+        """Count one frame's differing pixels by where they lie (the raster rule's shares; :func:`_off_by_one`):
+        ``fp`` the frame's oracles.judge.metrics.FramePixels of the pixels :meth:`frame` returned and pyrender's."""
+        counts = _off_by_one(fp, np.asarray(segs, dtype=np.float64).reshape(-1, 2))
+        self.raster = {k: v + counts[k] for k, v in self.raster.items()}
 
     # ---- reading the case
 
