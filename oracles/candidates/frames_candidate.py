@@ -110,6 +110,9 @@ def _job_problem(job: dict) -> str | None:
     if not (isinstance(turns, list) and len(turns) == 3
             and all(isinstance(t, (int, float)) and not isinstance(t, bool) and np.isfinite(t) for t in turns)):
         return f"motion.turns {turns!r}: expected three finite numbers"
+    phase = job["motion"].get("phase", 0.0)
+    if not (isinstance(phase, (int, float)) and not isinstance(phase, bool) and 0.0 <= phase < 1.0):
+        return f"motion.phase {phase!r}: expected a number in [0, 1) (crosscheck export --phase)"
     if job.get("style") != "wireframe":
         return f"style {job.get('style')!r}: expected 'wireframe' (the frames judged are wireframes)"
     scenes, cases = job.get("scenes"), job.get("cases")
