@@ -95,7 +95,6 @@ class CoreOracle:
 def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     """Judge the job (this process only): peak RSS, seconds per frame, and pyrender's per frame after."""
     import cv2  # noqa: F401  (the modules the judging imports, before the clock: an interpreter's start)
-    import pyrender  # noqa: F401
     import scipy.ndimage  # noqa: F401
     import scipy.spatial.transform  # noqa: F401
 
@@ -103,6 +102,9 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     import wirecheck.oracles.judge.decide  # noqa: F401
     import wirecheck.oracles.judge.line_style  # noqa: F401
     from wirecheck.oracles.references import pyrender_oracle
+
+    pyrender_oracle.gl_platform()               # the GL platform chosen before pyrender is imported
+    import pyrender  # noqa: F401
     from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
     from wirecheck.oracles.judge.frames_judge import run_frames
     from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
