@@ -116,8 +116,8 @@ class FramePixels:
         fp = cls.__new__(cls)
         fp.shape = tuple(shape)
         fp.cand_idx, fp.oracle_idx = cand_idx, oracle_idx
-        fp.cand_in_oracle = np.isin(cand_idx, oracle_idx, assume_unique=True)
-        fp.oracle_in_cand = np.isin(oracle_idx, cand_idx, assume_unique=True)
+        fp.cand_in_oracle = fp.has(cand_idx, of_candidate=False)       # a binary search each: no sort
+        fp.oracle_in_cand = fp.has(oracle_idx, of_candidate=True)
         fp._only = None
         return fp
 
