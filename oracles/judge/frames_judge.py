@@ -138,7 +138,9 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         fp = metrics.FramePixels(cand, orac)
         style.count_rule(fp, segs)
         ps = metrics.pixel_scores(None, None, pixels=fp)
-        cs = metrics.pixel_scores(cand, core)
+        # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
+        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(
+            core.shape, fp.cand_idx, np.flatnonzero(core)))
         for key, values in acc.pixel.items():
             values.append(ps[key])
         for key in metrics.PIXEL_SCORE_KEYS:
