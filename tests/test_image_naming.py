@@ -14,7 +14,7 @@ import pytest
 
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.raster import line_pixels
-from wirecheck.oracles.diagnosis import image_diagnose
+from wirecheck.oracles.diagnosis import image_diagnose, image_naming
 from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX, diagnose_images
 
 CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
@@ -55,7 +55,31 @@ def test_the_oracles_bias_would_have_named_an_offset(monkeypatch):
     assert np.all(np.abs(oracle_bias) < 0.1) and np.all(np.abs(model_bias - 0.48) < 0.05)
     assert np.max(np.abs(model_bias - oracle_bias)) > OFFSET_TOL_PX
     monkeypatch.setattr(image_diagnose, "quantisation_bias", lambda segs, cam, p=None, d=None: bias(segs, cam))
+    # axis-aligned lines are the same pixels under either aliased rule (rule_bias may read either): GL's here
+    monkeypatch.setattr(image_naming, "rule_bias", lambda *args: ("gl", args[-1]))
     assert "pixel_offset" in [f["name"] for f in diagnose_images(CAND, SEGS, CAM)]
+
+
+def test_the_aliased_rule_is_read_from_the_pixels():
+    """A slanted triangle drawn by GL's rule (core's exact) and by the rule that rounds ends first (Bresenham's):
+    rule_bias reads each one's rule, and the bias it returns is that rule's own."""
+    from wirecheck.core.projector.raster import line_pixels_fast
+
+    # ends at fractional positions (0.3-0.45 px from a pixel centre): rounding them moves each line
+    tri = np.array([[CX - 101.3, CY + 60.4], [CX + 87.35, CY + 75.7], [CX + 12.6, CY - 93.45]])
+    segs = [np.stack([tri, np.roll(tri, -1, axis=0)], axis=1)] * 2
+    eye, one = np.eye(2), np.ones(2)
+    gl_bias = image_naming.quantisation_bias(segs, CAM)
+    snapped_bias = image_naming.quantisation_bias(segs, CAM, snapped=True)
+    for draw, rule in ((line_pixels, "gl"), (line_pixels_fast, "snapped")):
+        img = np.zeros((CAM.height, CAM.width), bool)
+        rr, cc = draw(segs[0][:, 0], segs[0][:, 1], CAM.width, CAM.height)
+        img[rr, cc] = True
+        # a correct drawing's fitted offset is its rule's bias (the definition of quantisation_bias)
+        b = gl_bias if rule == "gl" else snapped_bias
+        got, bias = image_naming.rule_bias([img, img], segs, CAM, eye, one, b, gl_bias)
+        assert got == rule
+        np.testing.assert_array_equal(bias, b)
 
 
 def test_scale_starts_are_the_convention_mistakes_ratios():

@@ -595,4 +595,4 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
             fault = visibility_fault(fault, cand_images, oracle_segs, camera, matched)
         return [fault]
     return name_faults(fine, ranked, plain, camera, oracle_segs, reach, quantisation_bias, SCALE_TOL_PX,
-                       OFFSET_TOL_PX, AMBIGUOUS_RATIO, cost)
+                       OFFSET_TOL_PX, AMBIGUOUS_RATIO, cost, cand_images)

@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-__all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales"]
+__all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales", "rule_bias"]
 
 #: Ratios a convention mistake scales an axis by: H/W and W/H (the aspect or FOV of the other axis),
 #: the common aspects 4/3 and 16/9 and their inverses, and 2 and 1/2 (a half-angle or a half-size).
@@ -74,13 +74,14 @@ def _confidence(cost: float, without: float) -> float:
 
 
 def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_tol, offset_tol, ratio,
-                residual) -> list[dict]:
+                residual, cand_images=None) -> list[dict]:
     """The faults of the winner of ``ranked`` (``[(cost, names, P, a, b)]``, best first; ``plain``: the
     identity's fit), in the vocabulary of :func:`oracles.diagnosis.diagnose.scale_faults`.
 
     ``reg``: the fine registration (its ``cost``), ``bias_fn``: ``quantisation_bias(segs, camera, p, d)``,
     ``scale_tol``/``offset_tol``: the pixel tolerances of a scale and an offset, ``ratio``: the ambiguity
-    ratio, ``residual``: the winner's cost.
+    ratio, ``residual``: the winner's cost, ``cand_images``: the candidate's frames (the aliased rule read
+    from them sets the bias an offset is compared with, :func:`rule_bias`; without them GL's).
     """
     from .diagnose import FAULT_ORDER, scale_faults
 
@@ -108,10 +109,13 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
         expected = np.array([allowed[np.argmin(np.abs(allowed - b[i]))] for i in range(2)])
     off = b - expected
     bias = bias_fn(oracle_segs, camera, p, d)
+    rule = "gl"
+    if np.max(np.abs(off - bias)) > offset_tol and cand_images is not None:
+        rule, bias = rule_bias(cand_images, oracle_segs, camera, p, d, b, bias)   # another rule's own bias?
     if np.max(np.abs(off - bias)) > offset_tol:
         faults.append({"name": "pixel_offset", "confidence": _confidence(cost, reg.cost(p, a, expected + bias)),
                        "residual_px": residual, "dx": float(off[0]), "dy": float(off[1]),
-                       "uncertainty_px": float(np.max(np.abs(bias)))})
+                       "uncertainty_px": float(np.max(np.abs(bias))), "bias_rule": rule})
     return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
 
 
@@ -140,7 +144,32 @@ def restart_scales(coarse, fine, ranked: list, camera) -> list:
     return sorted(out.values(), key=lambda r: r[0])
 
 
-def quantisation_bias(oracle_segs, camera, p=None, d=None) -> np.ndarray:
+def _model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -> list[np.ndarray]:
+    """The fitted model's lines (``u -> d (p u)`` about the principal point, then ``+ shift``) drawn aliased.
+
+    ``snapped``: by the rule that rounds each end to a pixel centre first (core's
+    ``line_pixels_fast``: Bresenham's, OpenCV's LINE_8, Pillow's 1-px line); otherwise by
+    core's exact rule (integer pixel centres, GL's rule on these lines).
+    """
+    from wirecheck.core.projector.clipping import clip_to_image
+    from wirecheck.core.projector.raster import line_pixels, line_pixels_fast
+
+    centre = np.array(camera.principal_point)
+    shift = np.zeros(2) if shift is None else np.asarray(shift, dtype=np.float64)
+    draw = line_pixels_fast if snapped else line_pixels
+    images = []
+    for segs in oracle_segs:
+        segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+        segs = ((segs - centre) @ p.T) * d + centre + shift      # the model's lines (identity: the oracle's)
+        img = np.zeros((camera.height, camera.width), bool)
+        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+        rr, cc = draw(q0, q1, camera.width, camera.height)
+        img[rr, cc] = True
+        images.append(img)
+    return images
+
+
+def quantisation_bias(oracle_segs, camera, p=None, d=None, snapped: bool = False) -> np.ndarray:
     """The offset this fit finds for a *correct* aliased drawing of these lines: ``(2,)`` px.
 
     With ``p`` and ``d`` (a signed axis permutation and per-axis scales), of
@@ -153,28 +182,72 @@ def quantisation_bias(oracle_segs, camera, p=None, d=None) -> np.ndarray:
     nearly orthographic) are drawn half a pixel off in one direction, and no
     image can tell that from an offset. The oracle's own lines drawn by core's
     rasteriser (integer pixel centres, like GL's rule on these lines) give that
-    bias; an offset is a fault only when it differs from it.
+    bias; an offset is a fault only when it differs from it. ``snapped``: drawn
+    by the rule that rounds the ends to pixel centres first (:func:`rule_bias`).
     """
-    from wirecheck.core.projector.clipping import clip_to_image
-    from wirecheck.core.projector.raster import line_pixels
-
     from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
 
     p = np.eye(2) if p is None else np.asarray(p, dtype=np.float64)
     d = np.ones(2) if d is None else np.asarray(d, dtype=np.float64)
     centre = np.array(camera.principal_point)
-    images = []
-    for segs in oracle_segs:
-        segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-        segs = ((segs - centre) @ p.T) * d + centre              # the model's lines (identity: the oracle's)
-        img = np.zeros((camera.height, camera.width), bool)
-        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
-        rr, cc = line_pixels(q0, q1, camera.width, camera.height)
-        img[rr, cc] = True
-        images.append(img)
+    images = _model_images(oracle_segs, camera, p, d, snapped=snapped)
     limit = _points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)    # as diagnose_images
     reg = _Registration(_frames(images, oracle_segs, camera, limit), camera.width, camera.height, centre)
     if not any(len(f.cand) for f in reg.frames):
         return np.zeros(2)
     _a, b, _cost = reg.fit(p, np.diag(d), np.zeros(2))
     return b
+
+
+def _model_lines(oracle_segs, camera, p, d, shift, snapped: bool) -> list[np.ndarray]:
+    """The model's lines moved by ``shift``, clipped to the image; ``snapped``: each end rounded to a pixel centre."""
+    from wirecheck.core.projector.clipping import clip_to_image
+
+    centre = np.array(camera.principal_point)
+    out = []
+    for segs in oracle_segs:
+        segs = ((np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2) - centre) @ p.T) * d + centre + shift
+        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+        q = np.stack([q0, q1], axis=1)
+        out.append(np.floor(q + 0.5) if snapped else q)
+    return out
+
+
+def _lines_cost(cand_images, lines, camera) -> float:
+    """The registration's cost of the candidate's pixels against ``lines`` as they are (no fit)."""
+    from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
+
+    limit = _points_per_frame(len(lines), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
+    reg = _Registration(_frames(cand_images, lines, camera, limit), camera.width, camera.height,
+                        np.array(camera.principal_point))
+    return reg.cost(np.eye(2), np.eye(2), np.zeros(2))
+
+
+#: Shifts (px) about the snapped rule's line position at which its ends are rounded: the fitted offset's
+#: own error (~0.01 px pooled) decides the rounding of ends that fall on a half pixel (an orthographic
+#: view scaled by 4/3 puts many there), so each axis is tried at the position and 0.02 px either side.
+_JITTER = [np.array([sx, sy]) for sx in (-0.02, 0.0, 0.02) for sy in (-0.02, 0.0, 0.02)]
+
+
+def rule_bias(cand_images, oracle_segs, camera, p, d, b, gl_bias) -> tuple[str, np.ndarray]:
+    """``(rule read, its bias)``: which aliased rule drew the candidate's lines, GL's or ends snapped.
+
+    An aliased rule that rounds each end to a pixel centre before stepping
+    (Bresenham, OpenCV's LINE_8) moves each line by up to half a pixel: pooled
+    over a case's few lines its own bias reaches 0.19-0.25 px (measured on
+    quarter-turn cubes and pyramids given a 4/3 FOV), where GL's rule has 0.02.
+    Each rule's account of the candidate: GL's, the model's lines where the fit
+    put them (offset ``b``); the snapped rule's, the model's lines moved by
+    ``b`` less that rule's bias with their ends rounded to pixel centres (the
+    segments such a renderer steps along, whatever its tie-breaking; the
+    best of :data:`_JITTER`'s positions). The rule
+    whose lines the candidate's pixels fit closer (the registration's cost) is
+    the one read: a GL-rule renderer with a half-pixel offset lies on its
+    exact lines, so its offset is still measured against GL's bias.
+    """
+    snapped_bias = quantisation_bias(oracle_segs, camera, p, d, snapped=True)
+    gl = _lines_cost(cand_images, _model_lines(oracle_segs, camera, p, d, b, False), camera)
+    # the renderer's lines are known to the fit's precision; ends at a half pixel round either way under it
+    snapped = min(_lines_cost(cand_images, _model_lines(oracle_segs, camera, p, d, b - snapped_bias + step, True),
+                              camera) for step in _JITTER)
+    return ("snapped", snapped_bias) if snapped < gl else ("gl", np.asarray(gl_bias))
