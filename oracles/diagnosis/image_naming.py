@@ -17,7 +17,10 @@ reads the faults off the winner, and says what the images cannot decide:
   and ``P``; :func:`oracles.diagnosis.image_diagnose.quantisation_bias`): scaled lines
   sit at other fractional pixel positions than the oracle's, with a
   quantisation bias of their own (0.17 px measured on quarter-turn frames of a
-  0.75 FOV fault), which is no ``pixel_offset``.
+  0.75 FOV fault), which is no ``pixel_offset``. The drawing's aliased rule is
+  the one read from the candidate's pixels (:func:`rule_bias`): GL's, or one that
+  rounds the ends to pixel centres first (Bresenham, OpenCV's LINE_8), whose
+  rounded ends have a bias of their own.
 * **Confidence of each fault.** ``1 - cost / cost without it``: a permutation
   (or ``ambiguous``) against the identity's fit, a scale against the unit scale
   (``fov_mismatch``) or equal scales (``aspect_mismatch``), an offset against
