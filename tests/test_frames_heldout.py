@@ -30,7 +30,6 @@ from pathlib import Path
 import pytest
 
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.diagnosis.diagnose import primary
 
 sys.path.insert(0, str(Path(__file__).parent / "clients"))
 import heldout_draw as hd  # noqa: E402
@@ -224,20 +223,23 @@ def test_finding_correct_renderer_passes(jobs, tmp_path, capsys, draw, project, 
     assert rc == 0 and c["verdict"] == "pass", (c["pixel_f1_1px"], c["faults"], c["line_style"]["geometry"])
 
 
-@pytest.mark.xfail(strict=True, reason="a mistake misnamed: see docs/frames.md, Held-out renderers")
-def test_finding_pillow_half_pixel_is_named_pixel_offset(jobs, tmp_path, capsys):
-    # Pillow 1 px with the viewport's -0.5 left out fails, as it must, but as `unexplained`: its centres
-    # measured (0.61, 0.46) px off with a warp of 0.37 (Pillow's ends snapped to pixel centres), so neither
-    # raster_rule (offset <= 0.35) nor the registration's pixel_offset takes it
+def test_pillow_half_pixel_is_pixel_offset_against_its_rules_bias(jobs, tmp_path, capsys):
+    # Pillow 1 px with the viewport's -0.5 left out: its ends are rounded to pixel centres (the rule read,
+    # bias_rule "snapped"), whose free fit has a shear of its own (0.35 px) that is no rotation. Named
+    # pixel_offset alone, the injected (0.5, 0.5) to 0.25 px: the rounded ends' bias at the offset lines and
+    # at the correct ones differ by up to a snapped rule's pooled bias (0.19-0.25 px measured); (0.62, 0.42)
     rc, c = _judge(jobs, tmp_path, "slanted", hd.draw_pillow, hd.project_gl, half_pixel=True)
-    assert rc == 1
-    assert primary(c["faults"]) == "pixel_offset", (c["faults"], c["line_style"]["geometry"])
+    assert rc == 1 and c["verdict"] == "fail"
+    (f,) = c["faults"]
+    assert f["name"] == "pixel_offset" and f["bias_rule"] == "snapped", c["faults"]
+    assert f["dx"] == pytest.approx(0.5, abs=0.25) and f["dy"] == pytest.approx(0.5, abs=0.25)
 
 
-@pytest.mark.xfail(strict=True, reason="a mistake misnamed: see docs/frames.md, Held-out renderers")
-def test_finding_fov_of_the_wrong_axis_on_a_slanted_view_is_named(jobs, tmp_path, capsys):
-    # Bresenham with the FOV spanned over the width, pyramid / oblique_roll (2 frames): F1@1px 0.12, the fit
-    # finds no start (warp 3.8 px): `unexplained`, not fov_mismatch (named on 17 of the other 20 cases)
+def test_fov_of_the_wrong_axis_on_a_slanted_view_is_named(jobs, tmp_path, capsys):
+    # Bresenham with the FOV spanned over the width, pyramid / oblique_roll (2 frames): the free fit's shear
+    # (0.35 px, over the 0.3 of a rotation) is the rounded ends' own, measured on the model drawn by that rule
     rc, c = _judge(jobs, tmp_path, "slanted", hd.draw_bresenham, hd.project_lookat, fov_axis="x")
     assert rc == 1
-    assert primary(c["faults"]) == "fov_mismatch", (c["faults"], c["line_style"]["geometry"])
+    assert [f["name"] for f in c["faults"]] == ["fov_mismatch"], c["faults"]
+    key, value, tol = _wrong_axis(jobs["slanted"])
+    assert c["faults"][0][key] == pytest.approx(value, abs=tol)

@@ -78,7 +78,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .image_naming import name_faults, quantisation_bias, restart_scales, rotation_deg
+from .image_naming import name_faults, quantisation_bias, restart_scales, rotation_deg, rule_off_diagonal
 from .image_visibility import in_place, visibility_fault
 
 __all__ = ["diagnose_images", "oracle_segments", "flipped_camera", "PERMUTATIONS"]
@@ -583,6 +583,8 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
     reach = np.minimum(reach, [camera.width / 2.0, camera.height / 2.0])   # the part an image can show
     a_free, b_free, cost_free = fine.fit(p, a, b, affine=True)
     off_diagonal = max(abs(a_free[0, 1]) * reach[1], abs(a_free[1, 0]) * reach[0])
+    if cost <= RESIDUAL_MAX_PX and off_diagonal > ROTATION_TOL_PX:     # another aliased rule's own shear?
+        off_diagonal = rule_off_diagonal(cand_images, oracle_segs, camera, (p, a, b), a_free, reach, off_diagonal)
     if cost > RESIDUAL_MAX_PX or off_diagonal > ROTATION_TOL_PX:
         fault = {"name": "unexplained", "confidence": confidence, "residual_px": cost,
                  "best_family": list(names) or ["none"],
