@@ -564,8 +564,8 @@ class CaseStyle:
         geometry_right = placed and not moved and not warped
         if by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0 \
                 and any(r.startswith("pixel F1@0px") for r in f0) \
-                and all(f["name"] in ("unexplained", "pixel_offset", "line_pixel_bias") for f in faults):
-            faults = [f for f in faults if f["name"] not in ("unexplained", "pixel_offset", "line_pixel_bias")]
+                and all(f["name"] in ("unexplained", "pixel_offset") + COUNT_FAULTS for f in faults):
+            faults = [f for f in faults if f["name"] not in ("unexplained", "pixel_offset") + COUNT_FAULTS]
             faults.append({"name": "raster_rule", **out["raster_rule"], "confidence": 1.0,
                            "offset_px": [float(d[0]), float(d[1])], "residual_px": None,
                            "note": f"the lines are where the oracle's are (centres within {off:.2f} px) but "
