@@ -1,17 +1,23 @@
 """The frames judge (``crosscheck --candidate-frames``): peak memory by job length, time per frame vs pyrender.
 
-    .venv/bin/python benchmarks/bench_frames_judge.py                     # 24 and 720 frames (~2 min on 2 cores)
+    .venv/bin/python benchmarks/bench_frames_judge.py                     # 24 and 720 frames at 640x480 (minutes)
     .venv/bin/python benchmarks/bench_frames_judge.py --frames 24,96      # quicker
+    .venv/bin/python benchmarks/bench_frames_judge.py --size 160x120      # the memory target, small images (quick)
 
 For each length a job is exported (the cube, case ``on_axis``, every frame
-checked) and its frames drawn by core (a correct renderer); then a fresh
-interpreter judges it (oracles.judge.frames_judge.run_frames) and reports its peak
+checked; ``--size``: its camera's image size changed in the job's files) and
+its frames drawn by core (a correct renderer); then a fresh interpreter
+judges it (oracles.judge.frames_judge.run_frames) and reports its peak
 resident memory (``ru_maxrss``) and wall time, and, in the same process and
 on the same frames afterwards, pyrender drawing each frame alone (the
 oracle's share of the judging: ``PyrenderOracle.render``, its context
-already made). Printed: peak RSS of each job and the ratio of the longest to
-the shortest (target <= 1.5: memory flat in the job's length), and the
-judge's seconds per frame against pyrender's on the same frames (target <= 1.5).
+already made). The modules the judge uses are imported before the clock
+starts (an interpreter's start, as pyrender's context is made outside its
+timing); everything else the judging does is timed, the pre-check of every
+frame and the image diagnosis included. Printed: peak RSS of each job and
+the ratio of the longest to the shortest (target <= 1.5: memory flat in the
+job's length), and the judge's seconds per frame against pyrender's on the
+same frames (target <= 1.5), both measured in this run.
 
 ``--oracle core`` judges against core's drawing instead of pyrender's (the
 oracle stands in, its verdict the same on core's frames): the judge's own
@@ -35,8 +41,24 @@ sys.path.insert(0, str(Path(__file__).parent))
 from _common import loadavg  # noqa: E402
 
 
-def make_job(path: Path, frames: int) -> None:
-    """Export a job of ``frames`` frames (every one checked) and draw them with core."""
+def resize_job(path: Path, width: int, height: int) -> None:
+    """Give every camera of an exported job the image size ``width`` x ``height`` (job.json and each frame's
+    ``camera``; the frames judge reads no other field of a frame's JSON; the principal point follows the size)."""
+    import json as _json
+
+    job = _json.loads((path / "job.json").read_text())
+    for c in job["cases"]:
+        c["width"], c["height"] = width, height
+    (path / "job.json").write_text(_json.dumps(job))
+    for f in sorted((path / "cameras").rglob("*.json")):
+        cam = _json.loads(f.read_text())
+        cam["camera"]["width"], cam["camera"]["height"] = width, height
+        f.write_text(_json.dumps(cam))
+
+
+def make_job(path: Path, frames: int, size: tuple | None = None) -> None:
+    """Export a job of ``frames`` frames (every one checked; ``size``: ``(W, H)`` of its images) and draw them
+    with core."""
     from PIL import Image
 
     from wirecheck.core.projector.pipeline import render_frame
@@ -44,6 +66,8 @@ def make_job(path: Path, frames: int) -> None:
     from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 
     assert main(["export", str(path), "--scene", "cube", "--cases", "on_axis", "--frames", str(frames)]) == 0
+    if size is not None:
+        resize_job(path, *size)
     job = load_job(path)
     for c in job["cases"]:
         for rel in c["frames"]:
@@ -70,7 +94,17 @@ class CoreOracle:
 
 def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     """Judge the job (this process only): peak RSS, seconds per frame, and pyrender's per frame after."""
+    import cv2  # noqa: F401  (the modules the judging imports, before the clock: an interpreter's start)
+    import scipy.ndimage  # noqa: F401
+    import scipy.spatial.transform  # noqa: F401
+
+    import wirecheck.oracles.diagnosis.image_diagnose  # noqa: F401
+    import wirecheck.oracles.judge.decide  # noqa: F401
+    import wirecheck.oracles.judge.line_style  # noqa: F401
     from wirecheck.oracles.references import pyrender_oracle
+
+    pyrender_oracle.gl_platform()               # the GL platform chosen before pyrender is imported
+    import pyrender  # noqa: F401
     from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
     from wirecheck.oracles.judge.frames_judge import run_frames
     from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
@@ -119,19 +153,21 @@ def main(argv=None) -> int:
     p.add_argument("--frames", default="24,720", help="job lengths, comma-separated (default 24,720)")
     p.add_argument("--oracle", choices=("pyrender", "core"), default="pyrender",
                    help="what the judge compares with (core: the judge's own memory, without pyrender's)")
+    p.add_argument("--size", help="image size WxH of the job's camera (default: the case's own, 640x480)")
     p.add_argument("--child", help=argparse.SUPPRESS)
     a = p.parse_args(argv)
+    size = tuple(int(v) for v in a.size.lower().split("x")) if a.size else None
     if a.child:
         print(json.dumps(judge(Path(a.child), a.oracle)))
         return 0
     lengths = [int(x) for x in a.frames.split(",")]
-    print(f"# bench_frames_judge: cube / on_axis, frames {lengths}, judged against {a.oracle}; "
-          f"load at start {loadavg()}")
+    print(f"# bench_frames_judge: cube / on_axis, frames {lengths}, {a.size or '640x480'}, judged against "
+          f"{a.oracle}; load at start {loadavg()}")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in lengths:
             job = Path(tmp) / f"job{n}"
-            make_job(job, n)
+            make_job(job, n, size)
             out = subprocess.run([sys.executable, __file__, "--child", str(job), "--oracle", a.oracle], capture_output=True, text=True,
                                  check=True)
             rows.append(json.loads(out.stdout.strip().splitlines()[-1]))

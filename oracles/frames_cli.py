@@ -30,7 +30,7 @@ def _fail(message: str) -> int:
 
 
 def export_main(argv) -> int:
-    """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z]``."""
+    """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z] [--phase F]``."""
     from wirecheck.core.scene.files import builtin_names, load_scene
     from wirecheck.core.transforms import Motion
 
@@ -45,6 +45,9 @@ def export_main(argv) -> int:
     p.add_argument("--every", type=int, default=1, metavar="K", help="only frames 1, 1+K, ... (default 1)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} (default: {', '.join(CASE_NAMES)})")
     p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
+    p.add_argument("--phase", type=float, default=0.0, metavar="F",
+                   help="move every frame on by F of a frame's step, 0 <= F < 1: frame k at t = (k - 1 + F) / "
+                        "frames (default 0: crosscheck's own poses; 0.3: no frame of --frames 4 is a quarter turn)")
     args = p.parse_args(argv)
     try:
         from wirecheck.core.limits import MAX_FRAMES
@@ -53,6 +56,8 @@ def export_main(argv) -> int:
         if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
             raise InputError(f"--frames {args.frames} --every {args.every}: expected --frames in 1..{MAX_FRAMES:,} "
                              "(wirecheck.core.limits, as renderer and crosscheck) and --every >= 1")
+        if not 0.0 <= args.phase < 1.0:                # NaN too
+            raise InputError(f"--phase {args.phase!r}: expected a number in [0, 1) (a share of a frame's step)")
         cases = [c.strip() for c in args.cases.split(",") if c.strip()]
         bad = [c for c in cases if c not in ALL_CASE_NAMES]
         if bad or not cases:
@@ -72,7 +77,7 @@ def export_main(argv) -> int:
         check_replaceable(out, "export DIR")           # the target first: nothing is built for a refused one
         scenes = [load_scene(n) for n in (args.scene or builtin_names())]
         job = write_job(out, scenes, frames=args.frames, every=args.every, case_names=cases,
-                        motion=Motion(turns=spin))
+                        motion=Motion(turns=spin), phase=args.phase)
     except InputError as exc:
         return _fail(str(exc))
     except OSError as exc:

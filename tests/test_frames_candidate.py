@@ -170,6 +170,27 @@ def test_wrong_size_and_unreadable(filled, tmp_path, capsys):
     assert lines[1].endswith("non_square/frame_0001.png: size 640x480: expected 320x480 (the camera's)")
 
 
+def _damage_pixels(path: Path) -> None:
+    """Zero 16 bytes of the first IDAT's data: the header and size stay right, the pixels cannot be decoded."""
+    data = bytearray(path.read_bytes())
+    at = data.index(b"IDAT") + 4 + 2                  # past the zlib header
+    data[at:at + 16] = bytes(16)
+    path.write_bytes(bytes(data))
+
+
+def test_frames_that_cannot_be_decoded_are_all_listed(filled, tmp_path, capsys):
+    # frames are decoded once, as they are judged (the check before reads headers and sizes): a frame whose
+    # pixels cannot be decoded, met after other frames were judged, still lists every such frame of the job
+    # (the last frame of the first case, the first of the last case), exit 2, no report written
+    for rel in ("frames/cube/on_axis/frame_0004.png", "frames/cube/orthographic/frame_0001.png"):
+        _damage_pixels(filled / rel)
+    rc, lines = _judge(filled, tmp_path, capsys)
+    assert rc == 2 and len(lines) == 2, lines
+    assert "on_axis/frame_0004.png: unreadable as PNG" in lines[0]
+    assert "orthographic/frame_0001.png: unreadable as PNG" in lines[1]
+    assert not (tmp_path / "rep").exists()
+
+
 def test_extra_frame_is_refused(filled, tmp_path, capsys):
     shutil.copy(filled / "frames/cube/on_axis/frame_0001.png", filled / "frames/cube/on_axis/frame_0002.png")
     rc, lines = _judge(filled, tmp_path, capsys)

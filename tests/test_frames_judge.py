@@ -12,6 +12,7 @@ pixels for the same frames.
 
 from __future__ import annotations
 
+import json
 import shutil
 from dataclasses import replace
 from pathlib import Path
@@ -221,3 +222,58 @@ def test_readme_says_when_every_frame_is_a_quarter_turn():
     _job, files = build_job(cube, frames=24, every=5, case_names=["on_axis"])
     readme = files["README.md"].decode()
     assert "## What this job cannot reveal" in readme and "quarter-turn pose" not in readme
+
+
+def _core_frames(files: dict, job: dict, scene) -> dict:
+    """Core's drawing of every frame of a built job (``{case: [bool image per frame]}``), from its camera files."""
+    import json
+
+    from wirecheck.core.camera import Camera
+    from wirecheck.core.projector.pipeline import render_frame
+
+    out = {}
+    for c in job["cases"]:
+        out[c["case"]] = []
+        for k in job["frame_numbers"]:
+            cj = json.loads(files[f"cameras/{scene.name}/{c['case']}/frame_{k:04d}.json"])
+            out[c["case"]].append(render_frame(scene.vertices, scene.edges, Camera(**cj["camera"]),
+                                               np.asarray(cj["model_matrix"])).image >= 128)
+    return out
+
+
+def test_export_phase_moves_a_short_job_off_the_quarter_turns(tmp_path, capsys):
+    from itertools import combinations
+
+    from wirecheck.oracles.candidates.export import build_job, quarter_turn_frames
+    from wirecheck.oracles.candidates.frames_candidate import FramesError, load_job
+
+    cube = load_scene("cube")
+    cases = ["on_axis", "oblique_roll", "orthographic"]
+    # --frames 4, crosscheck's own poses: quarter turns (0, 1/4, 1/2, 3/4 of a turn about X and Y); the
+    # cube on the optical axis is then square-on in every frame: four identical pictures, each its own
+    # mirror image (left-right and up-down), which a mirrored renderer draws pixel for pixel
+    job, files = build_job([cube], frames=4, case_names=cases)
+    on_axis = _core_frames(files, job, cube)["on_axis"]
+    assert quarter_turn_frames(job) and all((img == on_axis[0]).all() for img in on_axis)
+    assert all((img[:, ::-1] == img).all() and (img[::-1] == img).all() for img in on_axis)
+    # --phase 0.3: frame k at t = (k - 0.7) / 4 (0.3 of a frame's step on): no quarter turn; in no case
+    # do two frames draw the same pixels, nor is a frame its own mirror image
+    job, files = build_job([cube], frames=4, case_names=cases, phase=0.3)
+    assert not quarter_turn_frames(job) and job["motion"]["phase"] == 0.3
+    assert json.loads(files["cameras/cube/on_axis/frame_0002.json"])["t"] == pytest.approx(1.3 / 4, abs=1e-15)
+    for case, images in _core_frames(files, job, cube).items():
+        assert not any((a == b).all() for a, b in combinations(images, 2)), case
+        assert not any((img[:, ::-1] == img).all() or (img[::-1] == img).all() for img in images), case
+    readme = files["README.md"].decode()
+    assert "quarter-turn pose" not in readme and "(`--phase 0.3`)" in readme
+    # the job reads back; a phase outside [0, 1) is refused, on the command line and in job.json
+    path = tmp_path / "job"
+    assert main(["export", str(path), "--scene", "cube", "--cases", "on_axis", "--frames", "4", "--phase", "0.3"]) == 0
+    assert load_job(path)["motion"]["phase"] == 0.3
+    assert main(["export", str(tmp_path / "bad"), "--scene", "cube", "--frames", "4", "--phase", "1"]) == 2
+    assert "--phase 1.0: expected a number in [0, 1)" in capsys.readouterr().err
+    manifest = json.loads((path / "job.json").read_text())
+    manifest["motion"]["phase"] = -0.5
+    (path / "job.json").write_text(json.dumps(manifest))
+    with pytest.raises(FramesError, match=r"motion.phase -0.5: expected a number in \[0, 1\)"):
+        load_job(path)

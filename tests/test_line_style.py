@@ -207,6 +207,11 @@ def test_read_grey_keeps_coverage_and_the_rule(tmp_path):
     assert read_grey(path, 4, 1).tolist() == [[0, 100, 129, 255]]
     Image.fromarray(np.array([[127, 128, 64]], np.uint8)).save(path)
     assert read_grey(path, 3, 1).tolist() == [[127, 128, 64]]
+    # opaque 8-bit RGB: the luminance L = 0.299 R + 0.587 G + 0.114 B (ITU-R 601-2) in Pillow's fixed point,
+    # (R 19595 + G 38470 + B 7471 + 2^15) >> 16: red 76.7 -> 76, green 150.2 -> 150, blue 29.6 -> 29
+    rgb = np.array([[[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]]], np.uint8)
+    Image.fromarray(rgb, "RGB").save(path)
+    assert read_grey(path, 4, 1).tolist() == [[76, 150, 29, 255]]
 
 
 def test_line_rule_needs_frames(tmp_path, capsys):
@@ -261,6 +266,10 @@ def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
     for _ in range(8):
         style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
         assert sum(len(x["offset"]) for x in style.samples + style.reference) <= 600
+        # the halved samples hold their own memory: a view (x[::2]) would keep every frame's whole arrays
+        # alive, and the case's memory would grow with its frames whatever the samples kept
+        assert all(v.base is None for x in style.samples + style.reference for v in x.values()
+                   if isinstance(v, np.ndarray))
     rec = {"faults": []}
     style.judge(rec, [], None)
     geo = rec["line_style"]["geometry"]

@@ -20,7 +20,11 @@ conventions are stated in the JSON itself (``conventions``), pointing to
 
 Frames are numbered as crosscheck's motion numbers them: frame ``k`` is at
 ``t = (k - 1) / frames``; with ``every`` only frames 1, 1 + every, ... are in
-the job. ``oracles.candidates.frames_candidate`` reads the job back and judges the PNGs.
+the job. ``phase`` (``crosscheck export --phase F``, ``0 <= F < 1``) moves
+every frame on by ``F`` of a frame's step, ``t = (k - 1 + F) / frames``: a
+short job whose frames would all be quarter-turn poses (a cube square-on,
+which some faults draw pixel for pixel as a correct renderer does) then sees
+the scene at oblique poses; its frames are then not crosscheck's own. ``oracles.candidates.frames_candidate`` reads the job back and judges the PNGs.
 """
 
 from __future__ import annotations
@@ -79,11 +83,16 @@ def _obj_text(vertices: np.ndarray, edges, faces, header: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames: int) -> dict:
+def frame_time(k: int, frames: int, phase: float = 0.0) -> float:
+    """``t`` of frame ``k`` (module docstring): ``(k - 1 + phase) / frames``."""
+    return (k - 1 + phase) / frames if phase else (k - 1) / frames
+
+
+def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames: int, phase: float = 0.0) -> dict:
     """Everything a renderer needs to draw frame ``k`` of one case."""
     r, t, kk = opencv_matrices(camera)
     view, proj = camera_to_gl(camera)
-    return {"scene": scene, "case": case, "frame": k, "t": (k - 1) / frames,
+    return {"scene": scene, "case": case, "frame": k, "t": frame_time(k, frames, phase),
             "camera": camera.to_dict(), "right": [float(x) for x in camera.right],
             "model_matrix": _rows(model),
             "K": _rows(kk), "R": _rows(r), "t_cv": [float(x) for x in t],
@@ -91,8 +100,10 @@ def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames
             "conventions": "see job.json (conventions); wirecheck.core.conventions states them once"}
 
 
-def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> tuple[dict, dict]:
-    """The manifest and the files of a job: ``(job, {relative path: bytes})``."""
+def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=None,
+              phase: float = 0.0) -> tuple[dict, dict]:
+    """The manifest and the files of a job: ``(job, {relative path: bytes})``; ``phase``: module docstring
+    (0: crosscheck's own poses, and job.json without a ``motion.phase``)."""
     from wirecheck.core.transforms import Motion
 
     from ..references.faces import frame_geometry
@@ -116,7 +127,7 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
         scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
         geometry = {}
         for k in checked:
-            p_world, _m, _pr_vertices, pose = frame_geometry(scene, scene_motion, (k - 1) / frames)
+            p_world, _m, _pr_vertices, pose = frame_geometry(scene, scene_motion, frame_time(k, frames, phase))
             geometry[k] = pose if single else np.eye(4)
             if not single:
                 files[f"scenes/{scene.name}/{frame_name(k, 'obj')}"] = _obj_text(
@@ -129,12 +140,13 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
                                  "which GL cannot draw through a lens; expected cases without distortion")
             for k in checked:
                 files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
-                    camera_json(case.camera, geometry[k], scene.name, case.name, k, frames)).encode()
+                    camera_json(case.camera, geometry[k], scene.name, case.name, k, frames, phase)).encode()
             case_rows.append({"scene": scene.name, "case": case.name, "width": case.camera.width,
                               "height": case.camera.height,
                               "frames": [f"frames/{scene.name}/{case.name}/{frame_name(k, 'png')}" for k in checked]})
     job = {"kind": JOB_KIND, "version": JOB_VERSION, "style": "wireframe", "frames": frames, "every": every,
-           "frame_numbers": checked, "motion": {"turns": list(motion.turns)},
+           "frame_numbers": checked,
+           "motion": {"turns": list(motion.turns), **({"phase": float(phase)} if phase else {})},
            "image": IMAGE_RULE["wireframe"], "conventions": CONVENTIONS,
            "scenes": scene_rows, "cases": case_rows}
     files["job.json"] = json_dumps(job).encode()
@@ -145,12 +157,14 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
 def quarter_turn_frames(job: dict) -> bool:
     """Whether every checked frame's pose turns the scene by whole quarter turns about each axis.
 
-    Frame ``k`` turns by ``turns * (k - 1) / frames`` of a full turn about X, Y
-    and Z (core.transforms.Motion): with ``--frames 4`` and the default spin
-    every frame is a quarter-turn pose, which shows a cube square-on.
+    Frame ``k`` turns by ``turns * t`` of a full turn about X, Y and Z
+    (core.transforms.Motion; ``t`` of :func:`frame_time`): with ``--frames 4``
+    and the default spin every frame is a quarter-turn pose, which shows a
+    cube square-on (``--phase 0.3``: none is).
     """
     turns = np.asarray(job["motion"]["turns"], dtype=np.float64)
-    quarters = [turns * 4.0 * (k - 1) / job["frames"] for k in job["frame_numbers"]]
+    phase = float(job["motion"].get("phase", 0.0))
+    quarters = [turns * 4.0 * frame_time(k, job["frames"], phase) for k in job["frame_numbers"]]
     return all(np.all(np.abs(q - np.round(q)) < 1e-9) for q in quarters)
 
 
@@ -163,6 +177,12 @@ The verdict rests on the {n} frame{'s' if n != 1 else ''} listed per case, and o
 fault that shows only at other poses (a line crossing the near plane, an edge
 leaving the picture at some angle) goes unseen. The faults are named from at
 most 24 of a case's frames (evenly spaced)."""
+    phase = float(job["motion"].get("phase", 0.0))
+    if phase:
+        text += f"""
+
+Every frame is moved on by {phase:g} of a frame's step (`--phase {phase:g}`): frame `k` is
+drawn at `t = (k - 1 + {phase:g}) / {job['frames']}` of the motion, not at crosscheck's own `(k - 1) / {job['frames']}`."""
     if quarter_turn_frames(job):
         shown = ", ".join(str(k) for k in job["frame_numbers"][:6]) + (", ..." if n > 6 else "")
         text += f"""
@@ -172,7 +192,10 @@ most 24 of a case's frames (evenly spaced)."""
 picture that a mirror, an axis swap or flip, a transposed rotation, a wrong
 rotation order or a camera looking backward can map onto itself, so such
 faults may draw the very pixels a correct renderer draws and pass. Export
-more frames, or a number of frames that is not a multiple of 4 (e.g.
+it again with `--phase 0.3` (every frame moved on by 0.3 of a frame's step:
+no frame is then a quarter turn, and with 1 to 8 frames no two frames of a
+bundled scene and case draw the same pixels, nor is one its own mirror
+image), more frames, or a number of frames that is not a multiple of 4 (e.g.
 `--frames 24 --every 5`, `--frames 7`), to see the scene at oblique poses."""
     return text + "\n"
 
@@ -230,9 +253,10 @@ geometry` judges their geometry only.
 """ + short_job_note(job)
 
 
-def write_job(out_dir: Path, scenes, frames: int = 24, every: int = 1, case_names=None, motion=None) -> dict:
+def write_job(out_dir: Path, scenes, frames: int = 24, every: int = 1, case_names=None, motion=None,
+              phase: float = 0.0) -> dict:
     """Write the job to ``out_dir`` atomically (a temporary folder renamed over it); the manifest."""
-    job, files = build_job(scenes, frames=frames, every=every, case_names=case_names, motion=motion)
+    job, files = build_job(scenes, frames=frames, every=every, case_names=case_names, motion=motion, phase=phase)
     out_dir = Path(out_dir)
     out = FrameDir(out_dir, "export DIR")
     try:

@@ -22,7 +22,7 @@ import numpy as np
 from wirecheck.core.errors import InputError
 
 from .export import JOB_KIND, JOB_VERSION, frame_name
-from .png_frame import FrameProblem, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
+from .png_frame import FrameProblem, check_png, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
@@ -110,6 +110,9 @@ def _job_problem(job: dict) -> str | None:
     if not (isinstance(turns, list) and len(turns) == 3
             and all(isinstance(t, (int, float)) and not isinstance(t, bool) and np.isfinite(t) for t in turns)):
         return f"motion.turns {turns!r}: expected three finite numbers"
+    phase = job["motion"].get("phase", 0.0)
+    if not (isinstance(phase, (int, float)) and not isinstance(phase, bool) and 0.0 <= phase < 1.0):
+        return f"motion.phase {phase!r}: expected a number in [0, 1) (crosscheck export --phase)"
     if job.get("style") != "wireframe":
         return f"style {job.get('style')!r}: expected 'wireframe' (the frames judged are wireframes)"
     scenes, cases = job.get("scenes"), job.get("cases")
@@ -192,12 +195,18 @@ def load_frames(job_dir: Path, job: dict) -> dict:
     return _frames(job_dir, job, keep=True)
 
 
-def check_frames(job_dir: Path, job: dict) -> None:
-    """:func:`load_frames`' checks, every frame read and dropped (memory flat in the job's length)."""
-    _frames(job_dir, job, keep=False)
+def check_frames(job_dir: Path, job: dict, decode: bool = True) -> None:
+    """:func:`load_frames`' checks, every frame read and dropped (memory flat in the job's length).
+
+    ``decode=False``: every check but the decoding of the pixels (the files, their PNG headers and
+    sizes, the frames of another job): the judge then decodes each frame once, as it judges it, and
+    calls this again with ``decode=True`` on a frame it cannot decode, so that the same problems are
+    listed as a full check would list them (oracles.judge.frames_judge.read_frame).
+    """
+    _frames(job_dir, job, keep=False, decode=decode)
 
 
-def _frames(job_dir: Path, job: dict, keep: bool) -> dict:
+def _frames(job_dir: Path, job: dict, keep: bool, decode: bool = True) -> dict:
     job_dir = Path(job_dir)
     frames_dir = job_dir / "frames"
     if not frames_dir.is_dir():
@@ -226,6 +235,9 @@ def _frames(job_dir: Path, job: dict, keep: bool) -> dict:
                 problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
                 continue
             try:
+                if not decode:
+                    check_png(path, c["width"], c["height"])
+                    continue
                 image = read_grey(path, c["width"], c["height"])
                 if keep:
                     images.append((k, image))

@@ -229,15 +229,9 @@ def read_png(path: Path, width: int, height: int) -> np.ndarray:
     return read_grey(path, width, height) >= 128
 
 
-def read_grey(path: Path, width: int, height: int) -> np.ndarray:
-    """``(H, W)`` uint8: each pixel's luminance over black, ``floor(L x A / 255)``; FrameProblem otherwise.
-
-    Rounded down, a value is >= 128 exactly where ``L x A >= 128 x 255``: the
-    drawn pixels of the rule (:func:`read_png`). The grey levels are the
-    coverage of anti-aliased lines (oracles.judge.line_style). One still PNG of the
-    camera's size is expected. The size is checked before any pixel is decoded
-    (a huge image costs nothing).
-    """
+def check_png(path: Path, width: int, height: int) -> dict:
+    """The checks of :func:`read_grey` made before a pixel is decoded (signature, chunks, the camera's size):
+    the header's ``{width, height, depth, colour, palette, trns}``; FrameProblem otherwise."""
     with open(path, "rb") as fh:
         try:
             info = read_header(fh)
@@ -247,7 +241,26 @@ def read_grey(path: Path, width: int, height: int) -> np.ndarray:
             raise
     if (info["width"], info["height"]) != (width, height):
         raise FrameProblem(f"size {info['width']}x{info['height']}: expected {width}x{height} (the camera's)")
+    return info
+
+
+def read_grey(path: Path, width: int, height: int) -> np.ndarray:
+    """``(H, W)`` uint8: each pixel's luminance over black, ``floor(L x A / 255)``; FrameProblem otherwise.
+
+    Rounded down, a value is >= 128 exactly where ``L x A >= 128 x 255``: the
+    drawn pixels of the rule (:func:`read_png`). The grey levels are the
+    coverage of anti-aliased lines (oracles.judge.line_style). One still PNG of the
+    camera's size is expected. The size is checked before any pixel is decoded
+    (a huge image costs nothing).
+    """
+    info = check_png(path, width, height)
+    colour, depth, trns = info["colour"], info["depth"], info["trns"]
     try:
+        if trns is None and depth == 8 and colour in (0, 2):    # 8-bit grey or RGB, opaque: the samples' L
+            mode, pixels = _decode(path)
+            if mode in ("L", "RGB") and pixels.shape[:2] == (height, width):
+                return (np.array(pixels, np.uint8) if mode == "L" else
+                        _luminance(pixels[..., :3]).astype(np.uint8))
         samples, alpha8 = _samples(path, info)
     except FrameProblem:
         raise
@@ -255,7 +268,6 @@ def read_grey(path: Path, width: int, height: int) -> np.ndarray:
         raise FrameProblem(f"unreadable as PNG ({type(exc).__name__}: {escape_controls(exc)[:200]})") from None
     if samples.shape[:2] != (height, width):
         raise FrameProblem(f"decoded to {samples.shape[1]}x{samples.shape[0]}: expected {width}x{height}")
-    colour, depth, trns = info["colour"], info["depth"], info["trns"]
     if colour == 3:
         palette, n = info["palette"], len(info["palette"])
         if int(samples.max(initial=0)) >= n:

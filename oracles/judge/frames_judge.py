@@ -42,18 +42,42 @@ DIAGNOSIS_FRAMES = 24
 LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
 
 
-def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarray, frame: tuple) -> np.ndarray:
+def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarray, frame: tuple,
+                     segs: np.ndarray | None = None, job=None) -> np.ndarray:
     """The ``(H, W)`` bool image of the pixels a frame file draws: what the judge compares with the oracle's.
 
     Every frame of the frames path goes through here, once: its grey levels
-    (oracles.candidates.png_frame.read_grey) are read by the case's line style
+    (:func:`read_frame`) are read by the case's line style
     (oracles.judge.line_style.CaseStyle.frame: the style, line centres and ends
-    measured against ``frame`` = ``(p_model, edges, camera, model_matrix)``),
-    and the pixels compared are those drawn by the rule (coverage >= 128).
+    measured against ``frame`` = ``(p_model, edges, camera, model_matrix)``
+    and its oracle segments ``segs``), and the pixels compared are those drawn
+    by the rule (coverage >= 128). ``job``: ``(job_dir, job)``, for
+    :func:`read_frame`'s listing of a job's problems.
     """
-    from ..candidates.png_frame import read_grey
+    return style.frame(read_frame(path, width, height, job), orac, *frame, segs=segs)
 
-    return style.frame(read_grey(path, width, height), orac, *frame)
+
+def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
+    """A frame's grey levels (oracles.candidates.png_frame.read_grey), decoded once, as it is judged.
+
+    The job's frames were checked before the judging began, all but their
+    pixels' decoding (oracles.candidates.frames_candidate.check_frames with
+    ``decode=False``): a frame that cannot be decoded makes the full check run
+    (``job``: ``(job_dir, job)``), so that every problem of the job is listed,
+    as when the check decodes every frame first; FramesError either way.
+    """
+    from ..candidates.frames_candidate import FramesError, check_frames
+    from ..candidates.png_frame import FrameProblem, read_grey
+
+    try:
+        return read_grey(path, width, height)
+    except FrameProblem as exc:
+        problem = str(exc)
+    except Exception as exc:       # noqa: BLE001 - Pillow's many ways to say "not an image"
+        problem = f"unreadable as PNG ({type(exc).__name__}: {exc})"
+    if job is not None:
+        check_frames(*job)                      # raises, listing every problem of the job
+    raise FramesError([f"{path}: {problem}"])
 
 
 def diagnosis_frames(n: int, limit: int = DIAGNOSIS_FRAMES) -> set:
@@ -107,12 +131,17 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         p_world = p_model @ m[:3, :3].T + m[:3, 3]
         # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
         seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
+        segs = oracle_segments(p_world, edges, camera)             # the lines a correct renderer draws
         orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
-        cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m))
+        cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
+                                segs, (job_dir, job))
         core = render_frame(p_model, edges, camera, m).image >= 128
         fp = metrics.FramePixels(cand, orac)
+        style.count_rule(fp, segs)
         ps = metrics.pixel_scores(None, None, pixels=fp)
-        cs = metrics.pixel_scores(cand, core)
+        # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
+        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(
+            core.shape, fp.cand_idx, np.flatnonzero(core)))
         for key, values in acc.pixel.items():
             values.append(ps[key])
         for key in metrics.PIXEL_SCORE_KEYS:
@@ -127,7 +156,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         if acc.worst is None or key < acc.worst[0]:
             acc.worst = (key, k, cand.copy(), orac.copy())
         if i in kept:
-            acc.diag.append((fp.cand_idx, cand.shape, oracle_segments(p_world, edges, camera),
+            acc.diag.append((fp.cand_idx, cand.shape, segs,
                              oracle_segments(p_world, edges, flipped_camera(camera))))
         del cand, orac, core, fp
     acc.record_lines(acc.batch.flush())
@@ -171,8 +200,9 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
 
     Every listed frame is checked first (oracles.candidates.frames_candidate.check_frames:
     FramesError, exit 2, listing every frame that is missing, of the wrong
-    size, unreadable or not this job's), then the cases are judged one frame
-    at a time. A case where neither side drew a pixel is ``"vacuous"`` and
+    size, not a PNG or not this job's), then the cases are judged one frame
+    at a time, each frame decoded once (a frame that cannot be decoded: the
+    same FramesError, :func:`read_frame`). A case where neither side drew a pixel is ``"vacuous"`` and
     fails the run unless ``allow_vacuous`` (as :mod:`oracles.judge.gate`).
     """
     from ..candidates.frames_candidate import check_frames, load_job
@@ -182,7 +212,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     tol = tol or Tolerances()
     t0 = time.perf_counter()
     job = load_job(job_dir)
-    check_frames(job_dir, job)
+    check_frames(job_dir, job, decode=False)          # each frame is decoded once, as it is judged
     oracles = OracleCache()
     records, images = [], {}
     try:

@@ -29,8 +29,8 @@ END_TOL_PX = 0.5
 MIN_ENDS = 4
 
 
-def _bilinear(cov: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Coverage at points ``q (..., 2)`` (x, y; pixel centres at integers), bilinear; 0 outside."""
+def _bilinear(cov: np.ndarray, q: np.ndarray, level: float = 1.0) -> np.ndarray:
+    """Coverage ``cov / level`` at points ``q (..., 2)`` (x, y; pixel centres at integers), bilinear; 0 outside."""
     h, w = cov.shape
     x0, y0 = np.floor(q[..., 0]).astype(np.intp), np.floor(q[..., 1]).astype(np.intp)
     fx, fy = q[..., 0] - x0, q[..., 1] - y0
@@ -38,11 +38,11 @@ def _bilinear(cov: np.ndarray, q: np.ndarray) -> np.ndarray:
     for dx, dy, wgt in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)), (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
         xx, yy = x0 + dx, y0 + dy
         ok = (xx >= 0) & (xx < w) & (yy >= 0) & (yy < h)
-        out[ok] += wgt[ok] * cov[yy[ok], xx[ok]]
+        out[ok] += wgt[ok] * (cov[yy[ok], xx[ok]] / level)
     return out
 
 
-def measure_ends(cov: np.ndarray, segs: np.ndarray) -> np.ndarray:
+def measure_ends(cov: np.ndarray, segs: np.ndarray, level: float = 1.0) -> np.ndarray:
     """Where each free end of the oracle's segments stops in the image: ``(E,)`` px past the exact end.
 
     An end is free when inside the image (the profile too) and no other
@@ -50,36 +50,50 @@ def measure_ends(cov: np.ndarray, segs: np.ndarray) -> np.ndarray:
     :data:`END_INSIDE_PX` inside to :data:`END_REACH_PX` past the end, every
     0.25 px, the coverage summed across the line (bilinear, 0.5 px steps,
     :data:`PROFILE_RADIUS_PX` each side) is the line's width there; the end is
-    where it last falls to half the width of the line's inner part.
+    where it last falls to half the width of the line's inner part. The
+    coverage is ``cov / level`` (``cov`` may be the grey levels, ``level`` the line's).
+    Every end's test and profile are computed together; the ends come in the
+    segments' order, each segment's start before its end.
     """
     h, w = cov.shape
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    out = []
     s = np.arange(-END_INSIDE_PX, END_REACH_PX + 1e-9, 0.25)
     t = np.arange(-PROFILE_RADIUS_PX, PROFILE_RADIUS_PX + 1e-9, 0.5)
     margin = PROFILE_RADIUS_PX + END_REACH_PX + 2
-    for i, (a, b) in enumerate(segs):
-        length = float(np.hypot(*(b - a)))
-        if length < END_INSIDE_PX + 2:
+    d = segs[:, 1] - segs[:, 0]
+    length = np.hypot(d[:, 0], d[:, 1])
+    long_enough = np.flatnonzero(length >= END_INSIDE_PX + 2)
+    if len(long_enough) == 0:
+        return np.zeros(0)
+    unit = d[long_enough] / length[long_enough, None]
+    normal = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
+    # each segment's start (outward: -unit), then its end (+unit)
+    seg = np.repeat(long_enough, 2)
+    end = segs[long_enough].reshape(-1, 2)
+    out_dir = np.stack([-unit, unit], axis=1).reshape(-1, 2)
+    normal = np.repeat(normal, 2, axis=0)
+    free = ((margin <= end[:, 0]) & (end[:, 0] <= w - 1 - margin)
+            & (margin <= end[:, 1]) & (end[:, 1] <= h - 1 - margin))
+    if len(segs) > 1 and free.any():
+        dist = _seg_distance(end, segs[:, 0], segs[:, 1])
+        dist[np.arange(len(end)), seg] = np.inf                 # its own segment
+        free &= dist.min(axis=1) > FREE_END_PX
+    end, out_dir, normal = end[free], out_dir[free], normal[free]
+    if len(end) == 0:
+        return np.zeros(0)
+    q = (end[:, None, None, :] + s[None, :, None, None] * out_dir[:, None, None, :]
+         + t[None, None, :, None] * normal[:, None, None, :])                 # (ends, len(s), len(t), 2)
+    masses = _bilinear(cov, q, level).sum(axis=2) * 0.5
+    out = []
+    for mass in masses:
+        inner = float(np.median(mass[s <= -2.5]))
+        if inner < MIN_MASS:
             continue
-        unit = (b - a) / length
-        normal = np.array([-unit[1], unit[0]])
-        others = np.delete(segs, i, axis=0)
-        for end, out_dir in ((a, -unit), (b, unit)):
-            if not (margin <= end[0] <= w - 1 - margin and margin <= end[1] <= h - 1 - margin):
-                continue
-            if len(others) and _seg_distance(end[None], others[:, 0], others[:, 1]).min() <= FREE_END_PX:
-                continue
-            q = end + s[:, None, None] * out_dir + t[None, :, None] * normal      # (len(s), len(t), 2)
-            mass = _bilinear(cov, q).sum(axis=1) * 0.5
-            inner = float(np.median(mass[s <= -2.5]))
-            if inner < MIN_MASS:
-                continue
-            above = np.flatnonzero(mass >= inner / 2.0)
-            k = above.max()
-            if k + 1 >= len(s):                      # still drawn at the end of the reach
-                out.append(float(s[-1]))
-                continue
-            m0, m1 = mass[k], mass[k + 1]         # cross half the inner width between s[k] and s[k + 1]
-            out.append(float(s[k] + (s[k + 1] - s[k]) * (m0 - inner / 2.0) / max(m0 - m1, 1e-12)))
+        above = np.flatnonzero(mass >= inner / 2.0)
+        k = above.max()
+        if k + 1 >= len(s):                      # still drawn at the end of the reach
+            out.append(float(s[-1]))
+            continue
+        m0, m1 = mass[k], mass[k + 1]         # cross half the inner width between s[k] and s[k + 1]
+        out.append(float(s[k] + (s[k + 1] - s[k]) * (m0 - inner / 2.0) / max(m0 - m1, 1e-12)))
     return np.asarray(out)

@@ -145,74 +145,96 @@ def _segments(p_model, edges, camera, m) -> np.ndarray:
 
 
 def _seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)``."""
-    ab = b - a
-    len2 = np.maximum((ab * ab).sum(axis=1), 1e-300)
-    t = np.clip(((q[:, None, :] - a[None]) * ab[None]).sum(axis=2) / len2, 0.0, 1.0)
-    foot = a[None] + t[..., None] * ab[None]
-    return np.hypot(*(foot - q[:, None, :]).transpose(2, 0, 1))
+    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)`` (x and y apart: no (N, K, 2) array)."""
+    abx, aby = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+    len2 = np.maximum(abx * abx + aby * aby, 1e-300)
+    qx, qy = q[:, 0:1], q[:, 1:2]
+    t = np.clip(((qx - a[:, 0]) * abx + (qy - a[:, 1]) * aby) / len2, 0.0, 1.0)
+    return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
 
 
-def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME) -> dict:
-    """The centroid samples of one frame (module docstring), as a dict of arrays of ``M`` samples.
+def windows(segs: np.ndarray, shape) -> dict:
+    """Where :func:`measure` looks along the oracle's segments, clear of junctions: the image's part of it.
 
-    ``cov``: ``(H, W)`` float coverage (0 background, 1 a fully drawn pixel);
-    ``segs``: ``(K, 2, 2)`` the oracle's segments in pixels. ``offset`` is the
-    measured centre minus the exact line along the unit ``normal``, at
-    ``point`` on the exact line; ``width`` the coverage across the line there
-    (px, perpendicular to the line); ``segment`` its segment. ``windows``: the
-    windows looked at (clear of junctions); ``found``: those that held a line
-    (``M`` of them kept, at most ``limit``).
+    Depends on the segments and the image size only, so one frame's windows
+    serve every image measured on its lines (the candidate's, a reference
+    drawing's). Along each segment long enough, at every integer step of its
+    major axis :data:`GUARD_PX` clear of its ends and inside the image, a
+    window across it; segment by segment, each in ascending steps. ``rows``,
+    ``cols``: ``(n, 2 PROFILE_RADIUS_PX + 1)`` pixel indices of each window;
+    ``minor``: their coordinate along the minor axis; ``exact``: the exact
+    line's there; ``across``: the unit normal's minor component; ``normal``,
+    ``segment``, ``point``: as :func:`measure` returns them.
     """
-    h, w = cov.shape
+    h, w = shape
     r = PROFILE_RADIUS_PX
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    parts = []
-    for i, (a, b) in enumerate(segs):
-        d = b - a
-        length = float(np.hypot(*d))
-        if length < 2 * GUARD_PX + 1:
-            continue
-        major = 0 if abs(d[0]) >= abs(d[1]) else 1
-        lo, hi = sorted((a[major], b[major]))
-        guard = GUARD_PX * abs(d[major]) / length            # GUARD_PX along the line, on the major axis
-        extent = w if major == 0 else h
-        pos = np.arange(max(np.ceil(lo + guard), 0), min(np.floor(hi - guard), extent - 1) + 1)
-        minor_exact = a[1 - major] + (pos - a[major]) * d[1 - major] / d[major]
-        centre = np.rint(minor_exact)
-        inside = (centre - r >= 0) & (centre + r <= (h if major == 0 else w) - 1)
-        pos, minor_exact, centre = pos[inside], minor_exact[inside], centre[inside]
-        if len(pos) == 0:
-            continue
-        win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
-        cols = np.broadcast_to(pos[:, None], win.shape)
-        rows_i, cols_i = (win, cols) if major == 0 else (cols, win)
-        g = cov[rows_i.astype(np.intp), cols_i.astype(np.intp)]
-        mass = g.sum(axis=1)
-        centroid = (g * win).sum(axis=1) / np.maximum(mass, 1e-300)
-        unit = d / length
-        normal = np.array([-unit[1], unit[0]])
-        pt = np.empty((len(pos), 2))
-        pt[:, major], pt[:, 1 - major] = pos, minor_exact
-        # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
-        parts.append({"normal": np.repeat(normal[None], len(pos), axis=0),
-                      "offset": (centroid - minor_exact) * normal[1 - major],
-                      "width": mass * abs(normal[1 - major]),          # a column crosses the line at 1 / |n_minor|
-                      "segment": np.full(len(pos), i), "point": pt, "mass": mass})
-    keys = ("normal", "offset", "width", "segment", "point", "mass")
-    if not parts:
-        out = {k: np.zeros((0, 2)) if k in ("normal", "point") else np.zeros(0) for k in keys}
-        out["windows"] = out["found"] = 0
-        return out
-    out = {k: np.concatenate([p[k] for p in parts]) for k in keys}
-    if len(segs) > 1:                                   # drop windows near another segment (a junction, a crossing)
-        keep = np.ones(len(out["point"]), bool)
+    a, b = segs[:, 0], segs[:, 1]
+    d = b - a
+    length = np.hypot(d[:, 0], d[:, 1])
+    i = np.flatnonzero(length >= 2 * GUARD_PX + 1)
+    a, b, d, length = a[i], b[i], d[i], length[i]
+    major = np.where(np.abs(d[:, 0]) >= np.abs(d[:, 1]), 0, 1)
+    minor = 1 - major
+    k = np.arange(len(i))
+    a_maj, b_maj, d_maj = a[k, major], b[k, major], d[k, major]
+    a_min, d_min = a[k, minor], d[k, minor]
+    guard = GUARD_PX * np.abs(d_maj) / length                # GUARD_PX along the line, on the major axis
+    extent = np.where(major == 0, w, h)
+    start = np.maximum(np.ceil(np.minimum(a_maj, b_maj) + guard), 0)
+    stop = np.minimum(np.floor(np.maximum(a_maj, b_maj) - guard), extent - 1)
+    count = np.maximum(stop - start + 1, 0).astype(np.intp)
+    owner = np.repeat(np.arange(len(i)), count)             # the windows, segment by segment
+    pos = start[owner] + (np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count))
+    minor_exact = a_min[owner] + (pos - a_maj[owner]) * d_min[owner] / d_maj[owner]
+    centre = np.rint(minor_exact)
+    inside = (centre - r >= 0) & (centre + r <= np.where(major == 0, h, w)[owner] - 1)
+    owner, pos, minor_exact, centre = owner[inside], pos[inside], minor_exact[inside], centre[inside]
+    unit = d / length[:, None]
+    normal = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
+    win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
+    cols = np.broadcast_to(pos[:, None], win.shape)
+    horizontal = (major == 0)[owner][:, None]
+    pt = np.empty((len(pos), 2))
+    pt[:, 0] = np.where(horizontal[:, 0], pos, minor_exact)
+    pt[:, 1] = np.where(horizontal[:, 0], minor_exact, pos)
+    out = {"rows": np.where(horizontal, win, cols).astype(np.intp), "cols": np.where(horizontal, cols, win).astype(np.intp),
+           "minor": win, "exact": minor_exact, "across": normal[owner, minor[owner]],
+           "normal": normal[owner], "segment": i[owner], "point": pt}
+    if len(segs) > 1 and len(pos):                      # drop windows near another segment (a junction, a crossing)
+        keep = np.ones(len(pos), bool)
         for k in range(0, len(keep), 2048):
-            dist = _seg_distance(out["point"][k:k + 2048], segs[:, 0], segs[:, 1])
-            dist[np.arange(len(dist)), out["segment"][k:k + 2048].astype(np.intp)] = np.inf
+            dist = _seg_distance(pt[k:k + 2048], segs[:, 0], segs[:, 1])
+            dist[np.arange(len(dist)), out["segment"][k:k + 2048]] = np.inf
             keep[k:k + 2048] = dist.min(axis=1) > GUARD_PX
         out = {k: v[keep] for k, v in out.items()}
-    windows = len(out["offset"])
+    return out
+
+
+def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME, wins: dict | None = None,
+            level: float = 1.0) -> dict:
+    """The centroid samples of one frame (module docstring), as a dict of arrays of ``M`` samples.
+
+    ``cov / level``: ``(H, W)`` coverage (0 background, 1 a fully drawn pixel;
+    ``cov`` may be the grey levels and ``level`` the line's, so that only the
+    windows' pixels are divided); ``segs``: ``(K, 2, 2)`` the oracle's segments
+    in pixels; ``wins``: their :func:`windows`, when the caller has them.
+    ``offset`` is the measured centre minus the exact line along the unit
+    ``normal``, at ``point`` on the exact line; ``width`` the coverage across
+    the line there (px, perpendicular to the line); ``segment`` its segment.
+    ``windows``: the windows looked at (clear of junctions); ``found``: those
+    that held a line (``M`` of them kept, at most ``limit``).
+    """
+    r = PROFILE_RADIUS_PX
+    wins = windows(segs, np.shape(cov)) if wins is None else wins
+    g = cov[wins["rows"], wins["cols"]] / level
+    mass = g.sum(axis=1)
+    centroid = (g * wins["minor"]).sum(axis=1) / np.maximum(mass, 1e-300)
+    # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
+    out = {"normal": wins["normal"], "offset": (centroid - wins["exact"]) * wins["across"],
+           "width": mass * np.abs(wins["across"]),          # a column crosses the line at 1 / |n_minor|
+           "segment": wins["segment"], "point": wins["point"], "mass": mass}
+    windows_n = len(out["offset"])
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
     keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
     out = {k: v[keep] for k, v in out.items()}
@@ -220,7 +242,7 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     if found > limit:
         idx = np.linspace(0, found - 1, limit).round().astype(int)
         out = {k: v[idx] for k, v in out.items()}
-    out["windows"], out["found"] = windows, found
+    out["windows"], out["found"] = windows_n, found
     return out
 
 
@@ -290,35 +312,37 @@ def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
     return img
 
 
-def _off_by_one(cand: np.ndarray, orac: np.ndarray, ends: np.ndarray) -> dict:
-    """Pixels where ``cand`` and ``orac`` differ, counted by where they are (module docstring)."""
-    h, w = cand.shape
-    rr, cc = np.nonzero(cand != orac)
-    other = np.where(cand[rr, cc], 0, 1)                # 0: look in orac (an extra pixel), 1: in cand
-    pair = (orac, cand)
+def _off_by_one(fp, ends: np.ndarray) -> dict:
+    """Pixels where the candidate and the oracle differ (``fp``: the frame's
+    oracles.judge.metrics.FramePixels), counted by where they are (module docstring)."""
+    h, w = fp.shape
+    c_only, o_only = fp.only()
+    flat = np.concatenate([c_only, o_only])
+    rr, cc = np.divmod(flat, w)
+    extra = np.arange(len(flat)) < len(c_only)          # a candidate-only pixel: look in the oracle's, else in the candidate's
     off1 = np.zeros(len(rr), bool)
     for dy in (-1, 0, 1):                               # a pixel of the other side among the 8 neighbours
         for dx in (-1, 0, 1):
             if dx or dy:
-                y, x = np.clip(rr + dy, 0, h - 1), np.clip(cc + dx, 0, w - 1)
-                inside = (rr + dy == y) & (cc + dx == x)
-                for side in (0, 1):
-                    sel = inside & (other == side)
-                    off1[sel] |= pair[side][y[sel], x[sel]]
+                y, x = rr + dy, cc + dx
+                inside = (y >= 0) & (y < h) & (x >= 0) & (x < w)
+                for side, sel in ((False, inside & extra), (True, inside & ~extra)):
+                    off1[sel] |= fp.has(y[sel] * w + x[sel], of_candidate=side)
     at_end = np.zeros(len(rr), bool)
     if len(rr) and len(ends):
         q = np.stack([cc, rr], axis=1).astype(float)
         for k in range(0, len(q), 4096):
             d = np.hypot(q[k:k + 4096, None, 0] - ends[None, :, 0], q[k:k + 4096, None, 1] - ends[None, :, 1])
             at_end[k:k + 4096] = d.min(axis=1) <= END_RADIUS_PX
-    return {"oracle_pixels": int(orac.sum()), "differing": int(len(rr)),
+    return {"oracle_pixels": int(len(fp.oracle_idx)), "differing": int(len(rr)),
             "off_by_one_across": int((off1 & ~at_end).sum()), "off_by_one_at_ends": int((off1 & at_end).sum()),
             "farther": int((~off1).sum())}
 
 
 def _halve(samples: dict) -> dict:
-    """Every other sample of a frame's :func:`measure` (its counts kept)."""
-    return {k: (v if np.ndim(v) == 0 else v[::2]) for k, v in samples.items()}
+    """Every other sample of a frame's :func:`measure` (its counts kept), copied: a view would keep the
+    whole of the arrays alive, and a case's memory would grow with its frames."""
+    return {k: (v if np.ndim(v) == 0 else v[::2].copy()) for k, v in samples.items()}
 
 
 class CaseStyle:
@@ -326,7 +350,8 @@ class CaseStyle:
 
     ``frame`` is called once per frame with the candidate's grey image (it
     returns the bool pixels the F1 scores compare: drawn where >= 128, the
-    rule of docs/frames.md); ``judge`` once, after the F1 reasons are known.
+    rule of docs/frames.md), then ``count_rule`` with those pixels and the
+    oracle's; ``judge`` once, after the F1 reasons are known.
     Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
@@ -343,36 +368,46 @@ class CaseStyle:
         self.reference = []                     # measure() of a correct binary drawing of each binary frame
         self.centre = np.zeros(2)
 
-    def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m) -> np.ndarray:
-        """Read one frame (``grey`` ``(H, W)`` uint8, ``orac`` pyrender's bool pixels); the pixels compared."""
+    def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
+        """Read one frame (``grey`` ``(H, W)`` uint8, ``orac`` pyrender's bool pixels); the pixels compared.
+
+        ``segs``: the frame's oracle segments (:func:`oracles.diagnosis.image_diagnose.oracle_segments`
+        of ``p_model`` moved by ``m``), when the caller has them.
+        """
         from wirecheck.core.projector.clipping import clip_to_image
+
+        from . import free_ends
 
         grey = np.asarray(grey)
         cand = grey >= 128
         if grey.dtype == bool:
             grey = grey.astype(np.uint8) * 255
-        segs = _segments(p_model, edges, camera, m)
+        segs = _segments(p_model, edges, camera, m) if segs is None else segs
         self.centre = np.array(camera.principal_point, dtype=float)
-        self.hist += np.bincount(grey.ravel(), minlength=256)[:256]
+        drawn = grey[grey > 0]
+        self.hist += np.bincount(drawn, minlength=256)[:256]
+        self.hist[0] += grey.size - len(drawn)
         if len(segs):
             _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
-        cov = grey / max(int(grey.max()), 1)                                   # the frame's line level is 1
-        from . import free_ends
-
-        got = measure(cov, segs)
+        level = max(int(drawn.max()) if len(drawn) else 0, 1)              # the frame's line level is 1
+        wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
+        got = measure(grey, segs, wins=wins, level=level)
         self.samples.append(got)
-        self.ends.append(free_ends.measure_ends(cov, segs))
-        drawn = grey[grey > 0]
+        self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if len(drawn) and np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) <= GREY_SHARE_MAX:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
-            self.reference.append(measure(_reference(segs, grey.shape, width).astype(float), segs))
+            self.reference.append(measure(_reference(segs, grey.shape, width), segs, wins=wins))
         if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
             self.samples = [_halve(x) for x in self.samples]
             self.reference = [_halve(x) for x in self.reference]
-        counts = _off_by_one(cand, orac, segs.reshape(-1, 2))
-        self.raster = {k: v + counts[k] for k, v in self.raster.items()}
         return cand
+
+    def count_rule(self, fp, segs: np.ndarray) -> None:
+        """Count one frame's differing pixels by where they lie (the raster rule's shares; :func:`_off_by_one`):
+        ``fp`` the frame's oracles.judge.metrics.FramePixels of the pixels :meth:`frame` returned and pyrender's."""
+        counts = _off_by_one(fp, np.asarray(segs, dtype=np.float64).reshape(-1, 2))
+        self.raster = {k: v + counts[k] for k, v in self.raster.items()}
 
     # ---- reading the case
 

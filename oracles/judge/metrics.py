@@ -116,8 +116,8 @@ class FramePixels:
         fp = cls.__new__(cls)
         fp.shape = tuple(shape)
         fp.cand_idx, fp.oracle_idx = cand_idx, oracle_idx
-        fp.cand_in_oracle = np.isin(cand_idx, oracle_idx, assume_unique=True)
-        fp.oracle_in_cand = np.isin(oracle_idx, cand_idx, assume_unique=True)
+        fp.cand_in_oracle = fp.has(cand_idx, of_candidate=False)       # a binary search each: no sort
+        fp.oracle_in_cand = fp.has(oracle_idx, of_candidate=True)
         fp._only = None
         return fp
 
@@ -460,7 +460,7 @@ def _diff_scores(diff: np.ndarray, compared: int) -> dict:
 
 def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray,
                 pixels: FramePixels | None = None, counts: tuple | None = None, ends: dict | None = None,
-                ties: tuple | None = None) -> dict:
+                ties: tuple | None = None, resolved: FramePixels | None = None) -> dict:
     """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
@@ -479,7 +479,8 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
     the per-edge count differences (ties resolved) and the number of edges
     counted, when the caller has them (:func:`frames_count_differences`,
     :class:`LineBatch`); ``ends`` and ``ties``: the frame's
-    :func:`frames_end_places` and its tie pixels, when the caller has them.
+    :func:`frames_end_places` and its tie pixels, when the caller has them;
+    ``resolved``: ``resolve_ties(pixels, ties)``, when the caller has it.
     """
     fp = pixels if pixels is not None else FramePixels(cand, oracle)
     h, w = fp.shape
@@ -490,7 +491,10 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
         found: list = []
         ends = frames_end_places([(fp, p0_px, p1_px)], found)[0] if c + o else {k: [0, 0] for k in PLACES}
         ties = found[0] if found else None
-    rp = resolve_ties(fp, ties) if ties is not None else fp          # the candidate as the oracle at the ties
+    if resolved is not None:                                         # the caller's resolve_ties(fp, ties)
+        rp = resolved
+    else:
+        rp = resolve_ties(fp, ties) if ties is not None else fp      # the candidate as the oracle at the ties
     if counts is None:
         near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=rp.drawn())    # counts look at drawn pixels only
         n_edges = len(np.asarray(p0_px).reshape(-1, 2))
@@ -546,10 +550,11 @@ class LineBatch:
             run = waiting[start:stop]
             ties: list = []
             ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run], ties)
-            counts = frames_count_differences([(p0, p1, resolve_ties(fp, t)) for (_, fp, p0, p1), t in zip(run, ties)],
+            resolved = [resolve_ties(fp, t) for (_, fp, _, _), t in zip(run, ties)]      # once a frame
+            counts = frames_count_differences([(p0, p1, rp) for (_, _, p0, p1), rp in zip(run, resolved)],
                                               shape[1], shape[0])       # counted with the ties undecided
-            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e, ties=t))
-                       for (key, fp, p0, p1), c, e, t in zip(run, counts, ends, ties))
+            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e, ties=t, resolved=rp))
+                       for (key, fp, p0, p1), c, e, t, rp in zip(run, counts, ends, ties, resolved))
             start = stop
         return out
 
