@@ -33,10 +33,9 @@ sample's offset. Pooled over every sample of a case's frames:
   the principal point) moves the lines, along their normals, than that
   offset (the 99th percentile over the samples, :meth:`CaseStyle.geometry`).
 
-For binary styles the same measure on a correct drawing of the same lines
-(core's GL-like raster for aliased lines; pixel centres within half the width
-for wide ones) is subtracted: lines at one fractional position (a cube
-square-on) sit up to half a pixel off in every correct drawing, as in
+For binary styles the same measure on a correct drawing of the same lines (core's GL-like raster
+for aliased lines; pixel centres within half the width for wide ones) is subtracted: lines at one
+fractional position (a cube square-on) sit up to half a pixel off in every correct drawing, as in
 :func:`oracles.diagnosis.image_diagnose.quantisation_bias`; at an exact tie (a band edge on a pixel
 centre) either choice reads 0 (:func:`oracles.judge.line_ties.fold_ties`). Lines that the registration
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
@@ -351,8 +350,8 @@ class CaseStyle:
 
     ``frame`` is called once per frame with the candidate's grey image (it
     returns the bool pixels the F1 scores compare: drawn where >= 128, the
-    rule of docs/frames.md), then ``count_rule`` with those pixels and the
-    oracle's; ``judge`` once, after the F1 reasons are known.
+    rule of docs/frames.md, and on grey levels a thin line's ridge, oracles.judge.coverage_pixels),
+    then ``count_rule`` with those pixels and the oracle's; ``judge`` once, after the F1 reasons are known.
     Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
@@ -377,7 +376,7 @@ class CaseStyle:
         """
         from wirecheck.core.projector.clipping import clip_to_image
 
-        from . import free_ends, line_ties
+        from . import coverage_pixels, free_ends, line_ties
 
         grey = np.asarray(grey)
         cand = grey >= 128
@@ -396,7 +395,9 @@ class CaseStyle:
         got = measure(grey, segs, wins=wins, level=level)
         self.samples.append(got)
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
-        if len(drawn) and np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) <= GREY_SHARE_MAX:
+        if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
+            cand = coverage_pixels.drawn(grey)          # grey levels: a thin line's ridge is drawn too
+        else:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             ref = measure(_reference(segs, grey.shape, width), segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
