@@ -35,7 +35,7 @@ from wirecheck.oracles.diagnosis.diagnose import primary
 sys.path.insert(0, str(Path(__file__).parent / "clients"))
 import heldout_draw as hd  # noqa: E402
 
-# 33 crosscheck runs end to end (~27 s of CPU in all, about a second each)
+# 32 crosscheck runs end to end (~27 s of CPU in all, about a second each)
 pytestmark = pytest.mark.slow
 
 #: Each job: (scene, case); frames 1 and 4 of 6.
@@ -193,8 +193,8 @@ FINDINGS = [
     # line: F1@1px 0.995 (width 2) and 0.995 (width 3) < 0.999, unexplained
     ("pillow_2px", partial(hd.draw_pillow, width=2), hd.project_gl, "slanted"),
     ("pillow_3px", partial(hd.draw_pillow, width=3), hd.project_gl, "slanted"),
-    # cv2 LINE_8 rounds its ends to whole pixels, ties up: the apex at x = 319.5 ends three lines there, all
-    # moved right; pooled (0.36, 0.15) against the reference (0.00, 0.13) -> over 0.35: aspect_mismatch. (The
+    # cv2 LINE_8 rounds its ends to whole pixels, ties up: two vertices at x = 319.5 end four slanted lines
+    # there (0.19-0.46 px off each); pooled 0.36 px -> over 0.35: aspect_mismatch + pixel_offset. (The
     # vertical edge at x = 319.5 itself, a tie across the line, now counts either column: line_ties.fold_ties)
     ("cv2_LINE_8_centre_line", partial(cv2_line, line_type="LINE_8"), hd.project_gl, "centre_line"),
 ]

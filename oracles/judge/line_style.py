@@ -130,10 +130,10 @@ CAN_SHOW = {
 }
 CANNOT_SHOW = {
     "aliased": "nothing the other styles show",
-    "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, "
-                   "not judged; an end where lines meet",
-    "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other "
-            "line's width covers it)",
+    "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, not judged; an "
+                   "end where lines meet; a line under 0.5 px wide (coverage_pixels: no drawn pixel at a tie)",
+    "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other line's "
+            "width covers it); binary: a centre offset under 0.35 px (an even width leans half a pixel)",
 }
 
 
