@@ -283,6 +283,7 @@ def test_off_by_one_pixels_at_the_image_border(row):
     # the 4 + 5 differing pixels has a pixel of the other side among its 8 neighbours (those beyond the
     # image are none): all off by one; a mutant that looks past the border fails on the border row
     from wirecheck.oracles.judge.line_style import _off_by_one
+    from wirecheck.oracles.judge.metrics import FramePixels
 
     h, w = 4, 5
     inner = 1 if row == 0 else h - 2
@@ -291,7 +292,7 @@ def test_off_by_one_pixels_at_the_image_border(row):
     orac[row, 0:4] = True
     cand[inner, 0:5] = True
     ends = np.array([[0.0, row % h], [4.0, row % h]])           # the segment's ends (x, y)
-    got = _off_by_one(cand, orac, ends)
+    got = _off_by_one(FramePixels(cand, orac), ends)
     # at the ends: within END_RADIUS_PX = 1.5 px of (0, row): (0, row), (1, row), (0, inner), (1, inner); of (4, row):
     # (3, row), (3, inner), (4, inner): 7 of the 9, the other 2 ((2, row), (2, inner)) across
     assert got == {"oracle_pixels": 4, "differing": 9, "off_by_one_across": 2, "off_by_one_at_ends": 7,

@@ -33,11 +33,11 @@ sample's offset. Pooled over every sample of a case's frames:
   the principal point) moves the lines, along their normals, than that
   offset (the 99th percentile over the samples, :meth:`CaseStyle.geometry`).
 
-For binary styles the same measure on a correct drawing of the same lines
-(core's GL-like raster for aliased lines; pixel centres within half the width
-for wide ones) is subtracted: lines at one fractional position (a cube
-square-on) sit up to half a pixel off in every correct drawing, as in
-:func:`oracles.diagnosis.image_diagnose.quantisation_bias`. Lines that the registration
+For binary styles the same measure on a correct drawing of the same lines (core's GL-like raster
+for aliased lines; pixel centres within half the width for wide ones) is subtracted: lines at one
+fractional position (a cube square-on) sit up to half a pixel off in every correct drawing, as in
+:func:`oracles.diagnosis.image_diagnose.quantisation_bias`; at an exact tie (a band edge on a pixel
+centre) either choice reads 0 (:func:`oracles.judge.line_ties.fold_ties`). Lines that the registration
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
 the windows, are not measured (the centroids would be of stray crossings).
 
@@ -60,7 +60,7 @@ The verdict (:meth:`CaseStyle.judge`):
 - ``antialiased`` and ``wide``, or any style with ``line_rule="geometry"``:
   F1@0px is reported, not judged (an antialiased or wide image cannot be held
   to GL's pixel rule); the geometry is judged instead: an offset beyond
-  :data:`oracles.diagnosis.image_diagnose.OFFSET_TOL_PX` (aliased lines of another rule:
+  :data:`oracles.diagnosis.image_diagnose.OFFSET_TOL_PX` (binary lines, 1 px or wide:
   :data:`RULE_OFFSET_MAX_PX`) fails as ``pixel_offset`` with the measured
   ``dx, dy``, a warp beyond :data:`oracles.diagnosis.image_diagnose.SCALE_TOL_PX` (binary
   lines: half a pixel more) fails too, and so do ends that stop short or run
@@ -130,10 +130,10 @@ CAN_SHOW = {
 }
 CANNOT_SHOW = {
     "aliased": "nothing the other styles show",
-    "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, "
-                   "not judged; an end where lines meet",
-    "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other "
-            "line's width covers it)",
+    "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, not judged; an "
+                   "end where lines meet; a line under 0.5 px wide (coverage_pixels: no drawn pixel at a tie)",
+    "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other line's "
+            "width covers it); binary: a centre offset under 0.35 px (an even width leans half a pixel)",
 }
 
 
@@ -350,8 +350,8 @@ class CaseStyle:
 
     ``frame`` is called once per frame with the candidate's grey image (it
     returns the bool pixels the F1 scores compare: drawn where >= 128, the
-    rule of docs/frames.md), then ``count_rule`` with those pixels and the
-    oracle's; ``judge`` once, after the F1 reasons are known.
+    rule of docs/frames.md, and on grey levels a thin line's ridge, oracles.judge.coverage_pixels),
+    then ``count_rule`` with those pixels and the oracle's; ``judge`` once, after the F1 reasons are known.
     Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
@@ -376,7 +376,7 @@ class CaseStyle:
         """
         from wirecheck.core.projector.clipping import clip_to_image
 
-        from . import free_ends
+        from . import coverage_pixels, free_ends, line_ties
 
         grey = np.asarray(grey)
         cand = grey >= 128
@@ -395,9 +395,14 @@ class CaseStyle:
         got = measure(grey, segs, wins=wins, level=level)
         self.samples.append(got)
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
-        if len(drawn) and np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) <= GREY_SHARE_MAX:
+        if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
+            cand = coverage_pixels.drawn(grey)          # grey levels: a thin line's ridge is drawn too
+        else:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
-            self.reference.append(measure(_reference(segs, grey.shape, width), segs, wins=wins))
+            ref = measure(_reference(segs, grey.shape, width), segs, wins=wins)
+            for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
+                line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1)
+            self.reference.append(ref)
         if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
             self.samples = [_halve(x) for x in self.samples]
             self.reference = [_halve(x) for x in self.reference]
@@ -503,8 +508,8 @@ class CaseStyle:
         aliased = style == "aliased"
         by_rule = aliased and self.line_rule == "gl"
         binary = read["grey_share"] <= GREY_SHARE_MAX
-        tol_px = (RULE_OFFSET_MAX_PX if aliased else
-                  OFFSET_TOL_PX + (0.0 if binary else 0.5 / read["coverage_steps"]))
+        # binary lines, 1 px or wide, are held to another aliased rule's bound (a wide rule snaps its ends too)
+        tol_px = RULE_OFFSET_MAX_PX if binary else OFFSET_TOL_PX + 0.5 / read["coverage_steps"]
         out = {**read, "line_rule": self.line_rule,
                "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
                             "the geometry (line centres); F1@0px is reported, not judged",

@@ -149,3 +149,29 @@ def partner_drawn(partner: np.ndarray, frame: np.ndarray, shape: tuple, drawn: n
         at = np.minimum(np.searchsorted(drawn, key), len(drawn) - 1)
         out[inside] = drawn[at] == key
     return out
+
+
+def fold_ties(samples: dict, band_px: int, end_px: float = TIE_END_PX) -> None:
+    """Count either choice at an exact tie of a binary line's band as right, in place: ``samples`` of
+    oracles.judge.line_style.measure, on a binary drawing whose lines are ``band_px`` pixels across.
+
+    A binary line ``band_px`` pixels across whose band edge (the exact minor coordinate
+    plus ``band_px / 2``) falls on a pixel centre (within ``(1 + |m|) end_px``, as
+    :func:`tie_crossings`) must leave out one of the two edge pixels: a correct
+    renderer's centroid there is half a pixel to either side (a 1-px line at
+    x = 319.5 drawn in column 319 or 320; the reference drawing takes both).
+    Such a sample's offset across the line, ``e`` along the minor axis, is moved
+    half a pixel towards zero (``e - sign(e) min(|e|, 1/2)``): both choices
+    read 0, no bias either way; a line a whole pixel off still reads half a pixel.
+    """
+    normal, offset, point = samples["normal"], samples["offset"], samples["point"]
+    if len(offset) == 0:
+        return
+    minor = (np.abs(normal[:, 1]) > np.abs(normal[:, 0])).astype(np.intp)   # the normal's larger component
+    k = np.arange(len(offset))
+    across = normal[k, minor]
+    slope = np.sqrt(np.maximum(1.0 / across ** 2 - 1.0, 0.0))
+    edge = point[k, minor] + band_px / 2.0
+    tie = np.abs(edge - np.rint(edge)) <= (1.0 + slope) * end_px
+    e = offset[tie] / across[tie]
+    offset[tie] = (e - np.sign(e) * np.minimum(np.abs(e), 0.5)) * across[tie]
