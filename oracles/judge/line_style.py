@@ -401,7 +401,7 @@ class CaseStyle:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             ref = measure(_reference(segs, grey.shape, width), segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
-                line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1)
+                line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
             self.reference.append(ref)
         if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
             self.samples = [_halve(x) for x in self.samples]
