@@ -200,17 +200,41 @@ def test_typical_mistake_is_named(jobs, tmp_path, capsys, draw, project, mistake
 
 # ---- findings: correct renderers the judge fails (measured; docs/frames.md, "Held-out renderers") ----
 
-FINDINGS = [
-    # Pillow's wide lines: ends snapped to pixel centres and an asymmetric even width; the centres now within
-    # RULE_OFFSET_MAX_PX (measured (0.03, -0.10) and (0.07, -0.05) px), but pixels 2 px from the oracle's 1-px
-    # line: F1@1px 0.995 (width 2) and 0.995 (width 3) < 0.999, unexplained
-    ("pillow_2px", partial(hd.draw_pillow, width=2), hd.project_gl, "slanted"),
-    ("pillow_3px", partial(hd.draw_pillow, width=3), hd.project_gl, "slanted"),
-    # cv2 LINE_8 rounds its ends to whole pixels, ties up: two vertices at x = 319.5 end four slanted lines
-    # there (0.19-0.46 px off each); pooled 0.36 px -> over 0.35: aspect_mismatch + pixel_offset. (The
-    # vertical edge at x = 319.5 itself, a tie across the line, now counts either column: line_ties.fold_ties)
-    ("cv2_LINE_8_centre_line", partial(cv2_line, line_type="LINE_8"), hd.project_gl, "centre_line"),
-]
+@pytest.mark.parametrize("width", [2, 3])
+def test_pillow_wide_lines_pass_on_f1_at_their_width(jobs, tmp_path, capsys, width):
+    # Pillow's wide lines: ends snapped to pixel centres and an asymmetric even width; their centres within
+    # RULE_OFFSET_MAX_PX (measured (0.03, -0.10) and (0.07, -0.05) px), and pixels 2 px from the oracle's 1-px
+    # line: F1@1px 0.995 < 0.999 (the gate's), which failed them as `unexplained`. Read wide (width 2: 1.83,
+    # 3: ~3), they are held to F1 at 1 + ceil((n - 1) / 2) = 2 px for n = 2 or 3 pixels across (f1_radius)
+    rc, c = _judge(jobs, tmp_path, "slanted", partial(hd.draw_pillow, width=width), hd.project_gl)
+    assert c["line_style"]["style"] == "wide" and c["f1_radius_px"] == 2 == c["line_style"]["f1_radius_px"]
+    assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["reasons"], c["faults"])
+    assert c["pixel_f1_1px"] < 0.999 <= c["pixel_f1_radius"]        # the radius decided: F1@1px alone fails
+    assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.35
+
+
+def test_cv2_line_8_end_ties_pass_on_geometry(jobs, tmp_path, capsys):
+    # cv2 LINE_8 rounds its ends to whole pixels, ties up: two vertices at x = 319.5 (prism / on_axis) end four
+    # slanted lines there, each moved (1 - t) / 2 px along x: pooled 0.36 px, over RULE_OFFSET_MAX_PX (0.35),
+    # pixel_offset. A line with an end on a pixel boundary cannot tell that rounding from an offset, so its
+    # samples are left out (line_ties.drop_end_ties): measured on the other lines (780 of 1994 samples),
+    # (0.00, 0.00) px, no fault, under --line-rule geometry
+    rc, c = _judge(jobs, tmp_path, "centre_line", partial(cv2_line, line_type="LINE_8"), hd.project_gl,
+                   rule="geometry")
+    assert c["line_style"]["style"] == "aliased"
+    assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["faults"], c["line_style"]["geometry"])
+    assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.35
+
+
+@pytest.mark.xfail(strict=True, reason="a correct renderer misnamed: see docs/frames.md, Held-out renderers")
+def test_finding_cv2_line_8_centre_line_is_named_raster_rule(jobs, tmp_path, capsys):
+    # the same under GL's rule fails F1@0px, as another rule must, but the registration's aspect_mismatch
+    # (scale_x 0.999, confidence 0.12) and pixel_offset (0.39 px) over the rounded ends stand beside it, so
+    # raster_rule (which gives way to no scale fault) is not named, though the centres measure 0.00 px and a
+    # warp of 0.28 px (under its 1.0)
+    rc, c = _judge(jobs, tmp_path, "centre_line", partial(cv2_line, line_type="LINE_8"), hd.project_gl)
+    assert rc == 1
+    assert [f["name"] for f in c["faults"]] == ["raster_rule"], c["faults"]
 
 
 THIN = [
@@ -245,13 +269,6 @@ def test_wide_binary_square_on_is_held_to_another_rules_bound(jobs, tmp_path, ca
     assert c["line_style"]["style"] == "wide" and c["line_style"]["offset_tol_px"] == 0.35
     assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["faults"], c["line_style"]["geometry"])
     assert 0.2 < max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.35
-
-
-@pytest.mark.xfail(strict=True, reason="a correct renderer the frames judge fails: see docs/frames.md")
-@pytest.mark.parametrize("draw, project, job", [f[1:] for f in FINDINGS], ids=[f[0] for f in FINDINGS])
-def test_finding_correct_renderer_passes(jobs, tmp_path, capsys, draw, project, job):
-    rc, c = _judge(jobs, tmp_path, job, draw, project)
-    assert rc == 0 and c["verdict"] == "pass", (c["pixel_f1_1px"], c["faults"], c["line_style"]["geometry"])
 
 
 def test_pillow_half_pixel_is_pixel_offset_against_its_rules_bias(jobs, tmp_path, capsys):

@@ -54,3 +54,44 @@ def test_an_even_width_ties_on_a_pixel_centre():
     assert np.abs(_vertical(320.0, [319, 320])).max() < 1e-12
     assert np.abs(_vertical(320.0, [320, 321])).max() < 1e-12
     assert _vertical(319.5, [320, 321]) == pytest.approx(1.0, abs=1e-9)
+
+
+# ---- ties at a segment's ends (oracles.judge.line_ties.drop_end_ties) ----
+
+def _samples(segment, n):
+    """``n`` hand-built samples of segment index ``segment`` (offsets 0.5: a half-pixel offset)."""
+    return {"offset": np.full(n, 0.5), "normal": np.tile([1.0, 0.0], (n, 1)), "point": np.zeros((n, 2)),
+            "width": np.ones(n), "mass": np.ones(n), "segment": np.full(n, segment, np.intp), "windows": n,
+            "found": n}
+
+
+def _join(*parts):
+    return {k: (np.concatenate([p[k] for p in parts]) if isinstance(parts[0][k], np.ndarray)
+                else sum(p[k] for p in parts)) for k in parts[0]}
+
+
+# segment 0 ends at x = 319.5 (a boundary: columns 319 and 320 equally near); segment 1 nowhere near one:
+# x = 319.4 is 0.1 px from it, y = 40.3 0.2 px, far beyond TIE_END_PX = 2^-8 px
+SEGS = np.array([[[319.5, 10.0], [359.8, 40.0]], [[319.4, 10.0], [359.8, 40.3]]])
+
+
+def test_end_ties_are_ends_on_a_pixel_boundary():
+    assert list(line_ties.end_ties(SEGS)) == [True, False]
+    # within 2^-8 px of the boundary still a tie (a renderer's snap and float32 rounding); 2^-7 px off not
+    assert list(line_ties.end_ties(SEGS + [[[2 ** -9, 0], [0, 0]], [[0, 0], [0, 0.2]]])) == [True, True]
+    assert list(line_ties.end_ties(SEGS[:1] + [[[2 ** -7, 0], [0, 0]]])) == [False]
+
+
+def test_the_lines_of_tied_ends_are_left_out_and_the_others_kept():
+    got = _join(_samples(0, 30), _samples(1, 20))
+    line_ties.drop_end_ties(got, SEGS)
+    # segment 0's 30 samples left out, every array alike; segment 1's 20 kept with their half-pixel offset;
+    # the windows looked at are still counted
+    assert list(got["segment"]) == [1] * 20 and len(got["point"]) == len(got["width"]) == 20
+    assert list(got["offset"]) == [0.5] * 20 and (got["windows"], got["found"]) == (50, 50)
+
+
+def test_a_frame_whose_every_line_ties_keeps_them_all():
+    got = _samples(0, 30)
+    line_ties.drop_end_ties(got, SEGS[:1])
+    assert len(got["offset"]) == 30

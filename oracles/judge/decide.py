@@ -8,7 +8,9 @@ same record fields from its frames; this module alone decides on them:
 - the vertex bound (``max_vertex_error_px`` > ``vertex_bound_px``) and points
   visible to one side only, where vertices were compared;
 - the pixel F1 at 1 px and at 0 px (``pixel_f1_1px``, ``pixel_f1_0px``: the
-  worst frame's), the one-sided pixel balance (a sign test) and the per-edge
+  worst frame's; a renderer's lines read wider than 1 px: F1 at the radius
+  their width allows, ``pixel_f1_radius`` at ``f1_radius_px``,
+  oracles.judge.f1_radius), the one-sided pixel balance (a sign test) and the per-edge
   pixel counts of the lines, sub-pixel ties left out
   (:func:`oracles.judge.metrics.line_failures` on the record's ``lines``); for a
   renderer's lines of a style GL's pixel rule cannot hold (anti-aliased, wide),
@@ -82,9 +84,11 @@ def reasons(rec: dict, tol: Tolerances, error: str | None = None) -> list[str]:
             out.append(f"visible sets differ: {vm['candidate_only']} points shown only by the candidate, "
                        f"{vm['oracle_only']} only by the oracle")
     if rec.get("pixel_f1_0px") is not None:
-        if rec["pixel_f1_1px"] < tol.min_f1_1px:
-            out.append(f"pixel F1@1px {rec['pixel_f1_1px']:.4f} < {tol.min_f1_1px} "
-                       f"(frame {rec['worst_pixel_frame']})")
+        # lines read wider than 1 px: F1 at the radius their width allows (oracles.judge.f1_radius)
+        radius, f1 = rec.get("f1_radius_px", 1), rec.get("pixel_f1_radius", rec["pixel_f1_1px"])
+        if f1 < tol.min_f1_1px:
+            out.append(f"pixel F1@{radius}px {f1:.4f} < {tol.min_f1_1px} (frame {rec.get('pixel_f1_radius_frame', rec['worst_pixel_frame'])}"
+                       + ("; lines read wider than 1 px" if radius > 1 else "") + ")")
         out += pixel_rule_reasons(rec, tol) if rec.get("line_style", {}).get("pixel_rule", True) else []
         out += rec.get("line_style", {}).get("failures", [])
     if rec.get("silhouette_iou") is not None:

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import metrics
+from . import f1_radius, metrics
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
 
@@ -93,6 +93,7 @@ class _CaseFrames:
     def __init__(self):
         self.pixel = {key: [] for key in metrics.PIXEL_SCORE_KEYS}
         self.core_min = {}
+        self.radius = []                   # each frame's F1 at the wider radii (f1_radius)
         self.per_frame, self.lines = [], []
         self.batch = metrics.LineBatch()
         self.drawn_px = 0
@@ -142,6 +143,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
         cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(
             core.shape, fp.cand_idx, np.flatnonzero(core)))
+        acc.radius.append(f1_radius.frame_scores(fp, ps))
         for key, values in acc.pixel.items():
             values.append(ps[key])
         for key in metrics.PIXEL_SCORE_KEYS:
@@ -166,8 +168,10 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     if diagnose:
         faults = diagnose_images(images, segments, camera, [f for _, _, _, f in acc.diag])
     rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
+    f1_radius.apply(rec, style.classify(), acc.radius, numbers)     # F1 at the radius the lines' width allows
     # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
     style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol))
+    rec["line_style"]["f1_radius_px"] = rec["f1_radius_px"]
     rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
     decide(rec, tol, level="frames")
     if diagnose and not faults and rec["verdict"] == "fail":

@@ -65,7 +65,7 @@ The verdict (:meth:`CaseStyle.judge`):
   ``dx, dy``, a warp beyond :data:`oracles.diagnosis.image_diagnose.SCALE_TOL_PX` (binary
   lines: half a pixel more) fails too, and so do ends that stop short or run
   on (``line_end_bias``); the registration's offset and scale faults give way
-  to the measure's. F1@1px holds for every style.
+  to the measure's. F1 holds for every style, at the lines' width (oracles.judge.f1_radius).
 """
 
 from __future__ import annotations
@@ -401,7 +401,7 @@ class CaseStyle:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             ref = measure(_reference(segs, grey.shape, width), segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
-                line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1)
+                line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
             self.reference.append(ref)
         if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
             self.samples = [_halve(x) for x in self.samples]
@@ -593,8 +593,8 @@ def summary_lines(cases: list) -> list[str]:
             by.setdefault((ls["style"], ls["line_rule"]), []).append(ls)
     out = []
     for (style, rule), rows in sorted(by.items()):
-        widths = [r["width_px"] for r in rows]
+        widths, radius = [r["width_px"] for r in rows], max(r.get("f1_radius_px", 1) for r in rows)  # f1_radius
         out.append(f"Line style read: {style} ({len(rows)} case{'s' if len(rows) != 1 else ''}, "
-                   f"{min(widths):.2f}-{max(widths):.2f} px wide, --line-rule {rule}): judged by "
-                   f"{rows[0]['judged_by']}; cannot show {CANNOT_SHOW[style]}")
+                   f"{min(widths):.2f}-{max(widths):.2f} px wide, --line-rule {rule}): judged by {rows[0]['judged_by']}"
+                   f"{f'; F1 at up to {radius} px (the width)' if radius > 1 else ''}; cannot show {CANNOT_SHOW[style]}")
     return out

@@ -151,7 +151,7 @@ def partner_drawn(partner: np.ndarray, frame: np.ndarray, shape: tuple, drawn: n
     return out
 
 
-def fold_ties(samples: dict, band_px: int, end_px: float = TIE_END_PX) -> None:
+def fold_ties(samples: dict, band_px: int, end_px: float = TIE_END_PX, segs: np.ndarray | None = None) -> None:
     """Count either choice at an exact tie of a binary line's band as right, in place: ``samples`` of
     oracles.judge.line_style.measure, on a binary drawing whose lines are ``band_px`` pixels across.
 
@@ -163,6 +163,8 @@ def fold_ties(samples: dict, band_px: int, end_px: float = TIE_END_PX) -> None:
     Such a sample's offset across the line, ``e`` along the minor axis, is moved
     half a pixel towards zero (``e - sign(e) min(|e|, 1/2)``): both choices
     read 0, no bias either way; a line a whole pixel off still reads half a pixel.
+    ``segs``: the frame's oracle segments ``(K, 2, 2)`` (``samples["segment"]``
+    indexes them): the samples of lines whose ends tie are left out (:func:`drop_end_ties`).
     """
     normal, offset, point = samples["normal"], samples["offset"], samples["point"]
     if len(offset) == 0:
@@ -175,3 +177,42 @@ def fold_ties(samples: dict, band_px: int, end_px: float = TIE_END_PX) -> None:
     tie = np.abs(edge - np.rint(edge)) <= (1.0 + slope) * end_px
     e = offset[tie] / across[tie]
     offset[tie] = (e - np.sign(e) * np.minimum(np.abs(e), 0.5)) * across[tie]
+    if segs is not None:
+        drop_end_ties(samples, segs, end_px)
+
+
+def end_ties(segs: np.ndarray, end_px: float = TIE_END_PX) -> np.ndarray:
+    """``(K,)`` bool: which segments ``(K, 2, 2)`` have an end coordinate on a pixel boundary ``k + 1/2``
+    (within ``end_px``, as the ties above)."""
+    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+    return (np.abs(segs - np.floor(segs) - 0.5) <= end_px).any(axis=(1, 2))
+
+
+def drop_end_ties(samples: dict, segs: np.ndarray, end_px: float = TIE_END_PX) -> None:
+    """Leave out, in place, the samples of segments with an end on a pixel boundary (:func:`end_ties`),
+    unless every segment of the frame has one.
+
+    A binary rule that rounds a line's ends to pixel centres (OpenCV's
+    ``cv2.line``, Pillow's) has no right answer for an end coordinate on the
+    boundary ``k + 1/2`` between two pixels: ``k`` and ``k + 1`` are equally
+    near, and a rule that always takes one (OpenCV: upwards) moves every line
+    ending there the same way, by ``(1 - t) / 2`` px along that axis at
+    parameter ``t`` from the end, up to half a pixel. Such a line's centres
+    cannot tell that rounding from a half-pixel offset near the end (a shift
+    is both ends moved), so they are no evidence of where the lines are: the
+    offset is measured on the other lines. Counting either rounding as right
+    on them instead (moving each sample by ``(1 - t) |n_i| / 2`` towards zero)
+    would read a half-pixel offset of those lines as a quarter. What it cannot
+    hide: the other lines keep every sample; a frame whose every line ends on
+    a boundary keeps them all (judged as before: either rounding may fail it).
+    """
+    if len(samples["offset"]) == 0:
+        return
+    tied = end_ties(segs, end_px)
+    if tied.all():
+        return
+    keep = ~tied[samples["segment"]]
+    n = len(keep)
+    for key, value in samples.items():
+        if isinstance(value, np.ndarray) and len(value) == n:
+            samples[key] = value[keep]

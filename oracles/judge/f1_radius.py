@@ -1,0 +1,74 @@
+"""The radius at which a renderer's frames are held to the edge-pixel F1, by the width of the lines read.
+
+F1@1px counts a drawn pixel as right when a pixel of the other image lies
+within 1 px (Chebyshev): right for 1-px lines, whose pixels a correct
+renderer of another rule, or an end snapped to a pixel centre, puts at most
+one pixel from the oracle's. A line ``n`` pixels across (the width the style
+read measured, :class:`oracles.judge.line_style.CaseStyle`, rounded: the pixels a
+binary line draws across it) reaches ``(n - 1) / 2`` pixels past a 1-px
+line on each side, a whole pixel more on one side when ``n`` is even (an even
+width leans one way: :func:`radius_px` rounds up). Its correct pixels then lie
+within ``1 + ceil((n - 1) / 2)`` px of the oracle's 1-px line: the 1 px that
+F1@1px already allows, plus that reach. So a frame read ``wide`` or
+``antialiased`` is held to F1 at that radius; an ``aliased`` frame (1 px) keeps
+F1@1px exactly.
+
+What the wider radius cannot hide: a missing line leaves the oracle's pixels
+with no candidate pixel at any radius (recall falls by its share of the
+pixels), and a line moved by a pixel or more is measured from its centres
+(``pixel_offset``: :meth:`oracles.judge.line_style.CaseStyle.judge`), not from F1.
+
+Each frame's F1 is computed at every radius up to :data:`MAX_RADIUS_PX`
+(only where F1@1px is below 1: at 1 every pixel is within any wider radius),
+since the style is read from the whole case, after its frames.
+"""
+
+from __future__ import annotations
+
+import math
+
+#: The widest radius computed: lines up to 5 px across (``1 + ceil((5 - 1) / 2) = 3``). A wider
+#: line is still held to 3 px (its outer pixels count against it: a stricter F1, never a looser one).
+MAX_RADIUS_PX = 3
+#: The radii computed per frame besides F1@1px.
+RADII = tuple(range(2, MAX_RADIUS_PX + 1))
+
+
+def radius_px(read: dict) -> int:
+    """The F1 radius (px) for a case's style read (``CaseStyle.classify()``: ``style``, ``width_px``).
+
+    ``aliased``: 1 (F1@1px, as for every 1-px line). ``wide`` or ``antialiased``:
+    ``1 + ceil((n - 1) / 2)`` with ``n = round(width_px)`` at least 1 (module
+    docstring), at most :data:`MAX_RADIUS_PX`.
+    """
+    if read.get("style") == "aliased":
+        return 1
+    n = max(int(math.floor(float(read.get("width_px") or 0.0) + 0.5)), 1)
+    return min(1 + math.ceil((n - 1) / 2), MAX_RADIUS_PX)
+
+
+def frame_scores(fp, scores: dict) -> dict:
+    """``{radius: F1}`` of one frame for each of :data:`RADII` (``fp``: its oracles.judge.metrics.FramePixels,
+    ``scores``: its oracles.judge.metrics.pixel_scores at 0 and 1 px)."""
+    from .metrics import pixel_scores
+
+    if scores["f1_1px"] == 1.0:                     # every pixel within 1 px: within any wider radius
+        return {r: 1.0 for r in RADII}
+    wide = pixel_scores(None, None, tols=RADII, pixels=fp)
+    return {r: wide[f"f1_{r}px"] for r in RADII}
+
+
+def apply(rec: dict, read: dict, per_frame: list, frames: list) -> None:
+    """Set the case's F1 radius and its worst frame's F1 there, which oracles.judge.decide.reasons holds to
+    ``min_f1_1px``: ``rec["f1_radius_px"]``, ``rec["pixel_f1_radius"]``, ``rec["pixel_f1_radius_frame"]``.
+
+    ``read``: the case's style (``CaseStyle.classify()``); ``per_frame``: each frame's :func:`frame_scores`,
+    ``frames`` their numbers. At a radius of 1 the F1 is F1@1px itself (``pixel_f1_1px``, its worst frame).
+    """
+    radius = radius_px(read)
+    rec["f1_radius_px"] = radius
+    if radius == 1 or not per_frame:
+        rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"] = rec["pixel_f1_1px"], rec["worst_pixel_frame"]
+        return
+    worst = min(range(len(per_frame)), key=lambda i: per_frame[i][radius])     # the first of the lowest
+    rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"] = float(per_frame[worst][radius]), frames[worst]
