@@ -72,6 +72,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import line_windows
+from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
+
 STYLES = ("aliased", "antialiased", "wide")
 LINE_RULES = ("gl", "geometry")
 
@@ -144,15 +147,6 @@ def _segments(p_model, edges, camera, m) -> np.ndarray:
     return oracle_segments(p_world, edges, camera)
 
 
-def _seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)`` (x and y apart: no (N, K, 2) array)."""
-    abx, aby = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
-    len2 = np.maximum(abx * abx + aby * aby, 1e-300)
-    qx, qy = q[:, 0:1], q[:, 1:2]
-    t = np.clip(((qx - a[:, 0]) * abx + (qy - a[:, 1]) * aby) / len2, 0.0, 1.0)
-    return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
-
-
 def windows(segs: np.ndarray, shape) -> dict:
     """Where :func:`measure` looks along the oracle's segments, clear of junctions: the image's part of it.
 
@@ -160,55 +154,12 @@ def windows(segs: np.ndarray, shape) -> dict:
     serve every image measured on its lines (the candidate's, a reference
     drawing's). Along each segment long enough, at every integer step of its
     major axis :data:`GUARD_PX` clear of its ends and inside the image, a
-    window across it; segment by segment, each in ascending steps. ``rows``,
-    ``cols``: ``(n, 2 PROFILE_RADIUS_PX + 1)`` pixel indices of each window;
-    ``minor``: their coordinate along the minor axis; ``exact``: the exact
-    line's there; ``across``: the unit normal's minor component; ``normal``,
-    ``segment``, ``point``: as :func:`measure` returns them.
+    window across it (:data:`PROFILE_RADIUS_PX` each side); segment by segment,
+    each in ascending steps (oracles.judge.line_windows.windows: ``rows``, ``cols``,
+    ``minor``, ``exact``, ``across``, and ``normal``, ``segment``, ``point`` as
+    :func:`measure` returns them).
     """
-    h, w = shape
-    r = PROFILE_RADIUS_PX
-    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    a, b = segs[:, 0], segs[:, 1]
-    d = b - a
-    length = np.hypot(d[:, 0], d[:, 1])
-    i = np.flatnonzero(length >= 2 * GUARD_PX + 1)
-    a, b, d, length = a[i], b[i], d[i], length[i]
-    major = np.where(np.abs(d[:, 0]) >= np.abs(d[:, 1]), 0, 1)
-    minor = 1 - major
-    k = np.arange(len(i))
-    a_maj, b_maj, d_maj = a[k, major], b[k, major], d[k, major]
-    a_min, d_min = a[k, minor], d[k, minor]
-    guard = GUARD_PX * np.abs(d_maj) / length                # GUARD_PX along the line, on the major axis
-    extent = np.where(major == 0, w, h)
-    start = np.maximum(np.ceil(np.minimum(a_maj, b_maj) + guard), 0)
-    stop = np.minimum(np.floor(np.maximum(a_maj, b_maj) - guard), extent - 1)
-    count = np.maximum(stop - start + 1, 0).astype(np.intp)
-    owner = np.repeat(np.arange(len(i)), count)             # the windows, segment by segment
-    pos = start[owner] + (np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count))
-    minor_exact = a_min[owner] + (pos - a_maj[owner]) * d_min[owner] / d_maj[owner]
-    centre = np.rint(minor_exact)
-    inside = (centre - r >= 0) & (centre + r <= np.where(major == 0, h, w)[owner] - 1)
-    owner, pos, minor_exact, centre = owner[inside], pos[inside], minor_exact[inside], centre[inside]
-    unit = d / length[:, None]
-    normal = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
-    win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
-    cols = np.broadcast_to(pos[:, None], win.shape)
-    horizontal = (major == 0)[owner][:, None]
-    pt = np.empty((len(pos), 2))
-    pt[:, 0] = np.where(horizontal[:, 0], pos, minor_exact)
-    pt[:, 1] = np.where(horizontal[:, 0], minor_exact, pos)
-    out = {"rows": np.where(horizontal, win, cols).astype(np.intp), "cols": np.where(horizontal, cols, win).astype(np.intp),
-           "minor": win, "exact": minor_exact, "across": normal[owner, minor[owner]],
-           "normal": normal[owner], "segment": i[owner], "point": pt}
-    if len(segs) > 1 and len(pos):                      # drop windows near another segment (a junction, a crossing)
-        keep = np.ones(len(pos), bool)
-        for k in range(0, len(keep), 2048):
-            dist = _seg_distance(pt[k:k + 2048], segs[:, 0], segs[:, 1])
-            dist[np.arange(len(dist)), out["segment"][k:k + 2048]] = np.inf
-            keep[k:k + 2048] = dist.min(axis=1) > GUARD_PX
-        out = {k: v[keep] for k, v in out.items()}
-    return out
+    return line_windows.windows(segs, shape, PROFILE_RADIUS_PX, GUARD_PX)
 
 
 def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME, wins: dict | None = None,
@@ -320,14 +271,15 @@ def _off_by_one(fp, ends: np.ndarray) -> dict:
     flat = np.concatenate([c_only, o_only])
     rr, cc = np.divmod(flat, w)
     extra = np.arange(len(flat)) < len(c_only)          # a candidate-only pixel: look in the oracle's, else in the candidate's
-    off1 = np.zeros(len(rr), bool)
-    for dy in (-1, 0, 1):                               # a pixel of the other side among the 8 neighbours
-        for dx in (-1, 0, 1):
-            if dx or dy:
-                y, x = rr + dy, cc + dx
-                inside = (y >= 0) & (y < h) & (x >= 0) & (x < w)
-                for side, sel in ((False, inside & extra), (True, inside & ~extra)):
-                    off1[sel] |= fp.has(y[sel] * w + x[sel], of_candidate=side)
+    # a pixel of the other side among the 8 neighbours: every neighbour looked up at once
+    dy, dx = np.array([-1, -1, -1, 0, 0, 1, 1, 1]), np.array([-1, 0, 1, -1, 1, -1, 0, 1])
+    y, x = rr[:, None] + dy, cc[:, None] + dx
+    inside = (y >= 0) & (y < h) & (x >= 0) & (x < w)
+    near = y * w + x
+    hit = np.zeros(near.shape, bool)
+    hit[extra] = fp.has(near[extra], of_candidate=False)
+    hit[~extra] = fp.has(near[~extra], of_candidate=True)
+    off1 = (hit & inside).any(axis=1)
     at_end = np.zeros(len(rr), bool)
     if len(rr) and len(ends):
         q = np.stack([cc, rr], axis=1).astype(float)
@@ -374,17 +326,26 @@ class CaseStyle:
         ``segs``: the frame's oracle segments (:func:`oracles.diagnosis.image_diagnose.oracle_segments`
         of ``p_model`` moved by ``m``), when the caller has them.
         """
+        out = np.zeros(np.size(grey), bool)
+        out[self.frame_flat(grey, orac, p_model, edges, camera, m, segs)] = True
+        return out.reshape(np.shape(grey))
+
+    def frame_flat(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
+        """:meth:`frame`'s pixels as ascending flat indices ``y W + x`` (the frames judge keeps no image)."""
         from wirecheck.core.projector.clipping import clip_to_image
 
         from . import coverage_pixels, free_ends, line_ties
 
         grey = np.asarray(grey)
-        cand = grey >= 128
-        if grey.dtype == bool:
+        binary_input = grey.dtype == bool
+        if binary_input:
             grey = grey.astype(np.uint8) * 255
         segs = _segments(p_model, edges, camera, m) if segs is None else segs
         self.centre = np.array(camera.principal_point, dtype=float)
-        drawn = grey[grey > 0]
+        nonzero = np.flatnonzero(grey if grey.dtype.kind == "u" else grey > 0)     # one pass: a wireframe draws < 1 %
+        drawn = grey.reshape(-1)[nonzero]
+        # drawn where >= 128 (a bool image compares its True with 128: nothing)
+        cand = nonzero[:0] if binary_input else nonzero[drawn >= 128]
         self.hist += np.bincount(drawn, minlength=256)[:256]
         self.hist[0] += grey.size - len(drawn)
         if len(segs):
@@ -396,7 +357,7 @@ class CaseStyle:
         self.samples.append(got)
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
-            cand = coverage_pixels.drawn(grey)          # grey levels: a thin line's ridge is drawn too
+            cand = np.flatnonzero(coverage_pixels.drawn(grey))    # grey levels: a thin line's ridge is drawn too
         else:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             ref = measure(_reference(segs, grey.shape, width), segs, wins=wins)
