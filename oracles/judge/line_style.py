@@ -236,8 +236,11 @@ def pooled_offset(normal: np.ndarray, offset: np.ndarray):
     return d, determined
 
 
-def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
-    """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width."""
+def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.ndarray:
+    """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width.
+
+    ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
+    """
     from wirecheck.core.projector.clipping import clip_to_image
     from wirecheck.core.projector.raster import line_pixels
 
@@ -246,7 +249,7 @@ def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
     if len(segs) == 0:
         return img
     if width_px < WIDE_MIN_PX:
-        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
+        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h) if clipped is None else clipped
         rr, cc = line_pixels(q0, q1, w, h)
         img[rr, cc] = True
         return img
@@ -348,8 +351,10 @@ class CaseStyle:
         cand = nonzero[:0] if binary_input else nonzero[drawn >= 128]
         self.hist += np.bincount(drawn, minlength=256)[:256]
         self.hist[0] += grey.size - len(drawn)
+        clipped = None
         if len(segs):
-            _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+            clipped = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+            _, q0, q1 = clipped
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
         level = max(int(drawn.max()) if len(drawn) else 0, 1)              # the frame's line level is 1
         wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
@@ -360,7 +365,8 @@ class CaseStyle:
             cand = np.flatnonzero(coverage_pixels.drawn(grey))    # grey levels: a thin line's ridge is drawn too
         else:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
-            ref = measure(_reference(segs, grey.shape, width), segs, wins=wins)
+            same = grey.shape == (camera.height, camera.width)          # the clipping above is the reference's
+            ref = measure(_reference(segs, grey.shape, width, clipped if same else None), segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
                 line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1)
             self.reference.append(ref)
