@@ -135,13 +135,12 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
                                 segs, (job_dir, job))
-        core = render_frame(p_model, edges, camera, m).image >= 128
+        core = _drawn(render_frame(p_model, edges, camera, m).image)
         fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
         style.count_rule(fp, segs)
         ps = metrics.pixel_scores(None, None, pixels=fp)
         # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
-        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(
-            core.shape, fp.cand_idx, np.flatnonzero(core)))
+        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
         for key, values in acc.pixel.items():
             values.append(ps[key])
         for key in metrics.PIXEL_SCORE_KEYS:
@@ -175,6 +174,13 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         rec["faults"] = frames_visibility(rec["faults"], images, segments, camera, len(numbers))
     rec["per_frame"] = acc.per_frame
     return rec, {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
+
+
+def _drawn(image: np.ndarray) -> np.ndarray:
+    """Ascending flat indices of the pixels of a uint8 ``image`` that are >= 128 (one pass over the image)."""
+    flat = image.reshape(-1)
+    nonzero = np.flatnonzero(flat)
+    return nonzero[flat[nonzero] >= 128]
 
 
 def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:

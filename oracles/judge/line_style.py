@@ -321,6 +321,7 @@ class CaseStyle:
         self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
                        "farther": 0}
         self.reference = []                     # measure() of a correct binary drawing of each binary frame
+        self._kept = 0                          # samples in self.samples and self.reference
         self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
@@ -370,9 +371,12 @@ class CaseStyle:
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
                 line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1)
             self.reference.append(ref)
-        if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
+            self._kept += len(ref["offset"])
+        self._kept += len(got["offset"])
+        if self._kept > MAX_SAMPLES_PER_CASE:
             self.samples = [_halve(x) for x in self.samples]
             self.reference = [_halve(x) for x in self.reference]
+            self._kept = sum(len(x["offset"]) for x in self.samples + self.reference)
         return cand
 
     def count_rule(self, fp, segs: np.ndarray) -> None:
