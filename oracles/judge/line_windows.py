@@ -7,6 +7,14 @@ Each window's numbers are found elementwise, so the windows that the image's
 border or a junction drops are dropped first, and the per-window arrays are
 built for the windows kept only (a frame of a few long lines has thousands of
 steps along them; the frames judge finds them once a frame).
+
+The junction test (a window is dropped when another segment comes within the
+guard) is decided for each (window, segment) pair by :func:`seg_distance`'s
+arithmetic, but only for the pairs that can be that close: a window farther
+than the guard from a segment's bounding box is farther from the segment, and
+along a line the windows in a box form one interval, found per pair of
+segments (:func:`_near_pairs`). Segments with coordinates past 1e150 (whose
+squared lengths could overflow to a NaN distance) take every pair.
 """
 
 from __future__ import annotations
@@ -26,24 +34,45 @@ def seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
 
 
-def _near_other(q: np.ndarray, a: np.ndarray, b: np.ndarray, own: np.ndarray, guard: float) -> np.ndarray:
-    """``(N,)`` bool: whether a segment ``a -> b`` other than point ``q``'s own (index ``own``) is within ``guard``.
-
-    The same as ``seg_distance`` (its own segment's column excluded) ``<= guard``, to the bit: the squared
-    distance (no square root) screens the pairs, and only those within a millionth of ``guard`` are decided
-    by :func:`seg_distance`'s own arithmetic on that pair.
-    """
+def _pair_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(N,)`` distance of each point ``q[n]`` to its segment ``a[n] -> b[n]``: :func:`seg_distance`'s
+    arithmetic, element by element, so each pair's value is the same to the bit."""
     abx, aby = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
     len2 = np.maximum(abx * abx + aby * aby, 1e-300)
-    qx, qy = q[:, 0:1], q[:, 1:2]
+    qx, qy = q[:, 0], q[:, 1]
     t = np.clip(((qx - a[:, 0]) * abx + (qy - a[:, 1]) * aby) / len2, 0.0, 1.0)
-    ex, ey = a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy
-    sq = ex * ex + ey * ey
-    sq[np.arange(len(q)), own] = np.inf                      # its own segment
-    pq, pk = np.nonzero(sq <= (guard * (1.0 + 1e-6)) ** 2)    # hypot >= sqrt(sq) (1 - 1e-15): the rest are farther
-    near = np.zeros(len(q), bool)
-    near[pq[np.hypot(ex[pq, pk], ey[pq, pk]) <= guard]] = True
-    return near
+    return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
+
+
+def _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard):
+    """``(window, segment)`` index pairs that may lie within ``guard`` of each other: every pair that does.
+
+    The windows of long segment ``l`` (``segs[i[l]]``) lie on its line at major positions ``start[l] +
+    0, 1, ... count[l] - 1`` (window ``sum(count[:l]) + step``). A point farther than ``guard`` from a
+    segment's bounding box is farther from the segment, so for each (long segment, other segment) pair
+    only the positions whose point falls in the other's box grown by ``guard + 1`` are kept, the interval
+    widened by a step each side (whatever the rounding of the interval's ends).
+    """
+    lo_xy, hi_xy = np.minimum(segs[:, 0], segs[:, 1]) - guard - 1, np.maximum(segs[:, 0], segs[:, 1]) + guard + 1
+    ll, jj = np.nonzero(i[:, None] != np.arange(len(segs))[None])         # (long segment, another segment)
+    k = np.arange(len(i))[ll]
+    maj0, maj1 = lo_xy[jj, major[ll]], hi_xy[jj, major[ll]]
+    min0, min1 = lo_xy[jj, 1 - major[ll]], hi_xy[jj, 1 - major[ll]]
+    slope = (d_min / d_maj)[k]                                           # |slope| <= 1: the major axis
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e0 = a_maj[k] + (min0 - a_min[k]) / slope
+        e1 = a_maj[k] + (min1 - a_min[k]) / slope
+    flat = slope == 0
+    inside = (min0 <= a_min[k]) & (a_min[k] <= min1)
+    lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(e0, e1))
+    hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(e0, e1))
+    first = np.maximum(np.ceil(np.maximum(np.maximum(lo, maj0), start[k]) - 1), start[k])
+    last = np.minimum(np.floor(np.minimum(np.minimum(hi, maj1), start[k] + count[k] - 1) + 1),
+                      start[k] + count[k] - 1)
+    n = np.maximum(last - first + 1, 0).astype(np.intp)
+    base = (np.cumsum(count) - count)[k] + (first - start[k]).astype(np.intp)
+    windows = np.repeat(base, n) + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
+    return windows, np.repeat(jj, n)
 
 
 def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
@@ -88,11 +117,18 @@ def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
     pt[:, 0] = np.where(horizontal, pos, minor_exact)
     pt[:, 1] = np.where(horizontal, minor_exact, pos)
     if len(segs) > 1 and keep.any():                          # drop windows near another segment
-        idx = np.flatnonzero(keep)
-        chunk = max(1, CHUNK_ELEMENTS // len(segs))
-        for c in range(0, len(idx), chunk):
-            sel = idx[c:c + chunk]
-            keep[sel] = ~_near_other(pt[sel], segs[:, 0], segs[:, 1], i[owner[sel]], guard)
+        if np.all(np.abs(segs) < 1e150):                      # squares finite: no distance is NaN
+            win, other = _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard)
+            near = ~(_pair_distance(pt[win], segs[other, 0], segs[other, 1]) > guard)
+            keep[win[near]] = False
+        else:                                                 # every pair (a NaN distance drops the window)
+            idx = np.flatnonzero(keep)
+            chunk = max(1, CHUNK_ELEMENTS // len(segs))
+            for c in range(0, len(idx), chunk):
+                sel = idx[c:c + chunk]
+                dist = seg_distance(pt[sel], segs[:, 0], segs[:, 1])
+                dist[np.arange(len(sel)), i[owner[sel]]] = np.inf         # its own segment
+                keep[sel] = dist.min(axis=1) > guard
     owner, pos, minor_exact, centre, horizontal, pt = (owner[keep], pos[keep], minor_exact[keep], centre[keep],
                                                        horizontal[keep], pt[keep])
     unit = d / length[:, None]
