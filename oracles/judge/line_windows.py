@@ -70,7 +70,7 @@ def _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard)
     last = np.minimum(np.floor(np.minimum(np.minimum(hi, maj1), start[k] + count[k] - 1) + 1),
                       start[k] + count[k] - 1)
     n = np.maximum(last - first + 1, 0).astype(np.intp)
-    base = (np.cumsum(count) - count)[k] + (first - start[k]).astype(np.intp)
+    base = (np.cumsum(count) - count)[k] + (np.where(n > 0, first, start[k]) - start[k]).astype(np.intp)   # n = 0: any
     windows = np.repeat(base, n) + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
     return windows, np.repeat(jj, n)
 
