@@ -177,10 +177,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
 
 
 def _drawn(image: np.ndarray) -> np.ndarray:
-    """Ascending flat indices of the pixels of a uint8 ``image`` that are >= 128 (one pass over the image)."""
-    flat = image.reshape(-1)
-    nonzero = np.flatnonzero(flat)
-    return nonzero[flat[nonzero] >= 128]
+    """Ascending flat indices of the pixels of ``image`` that are >= 128."""
+    return np.flatnonzero(image.reshape(-1) >= 128)
 
 
 def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:

@@ -72,7 +72,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import line_windows
+from . import coverage_pixels, line_ties, line_windows
 from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
 
 STYLES = ("aliased", "antialiased", "wide")
@@ -338,15 +338,13 @@ class CaseStyle:
         """:meth:`frame`'s pixels as ascending flat indices ``y W + x`` (the frames judge keeps no image)."""
         from wirecheck.core.projector.clipping import clip_to_image
 
-        from . import coverage_pixels, free_ends, line_ties
-
         grey = np.asarray(grey)
         binary_input = grey.dtype == bool
         if binary_input:
             grey = grey.astype(np.uint8) * 255
         segs = _segments(p_model, edges, camera, m) if segs is None else segs
         self.centre = np.array(camera.principal_point, dtype=float)
-        nonzero = np.flatnonzero(grey if grey.dtype.kind == "u" else grey > 0)     # one pass: a wireframe draws < 1 %
+        nonzero = np.flatnonzero(grey > 0)              # (numpy finds a bool array's nonzero faster than uint8's)
         drawn = grey.reshape(-1)[nonzero]
         # drawn where >= 128 (a bool image compares its True with 128: nothing)
         cand = nonzero[:0] if binary_input else nonzero[drawn >= 128]
@@ -569,3 +567,6 @@ def summary_lines(cases: list) -> list[str]:
                    f"{min(widths):.2f}-{max(widths):.2f} px wide, --line-rule {rule}): judged by "
                    f"{rows[0]['judged_by']}; cannot show {CANNOT_SHOW[style]}")
     return out
+
+
+from . import free_ends  # noqa: E402  (it reads this module's constants: imported once they are defined)
