@@ -371,9 +371,9 @@ class CaseStyle:
             self.reference.append(ref)
             self._kept += len(ref["offset"])
         self._kept += len(got["offset"])
-        if self._kept > MAX_SAMPLES_PER_CASE:
-            self.samples = [_halve(x) for x in self.samples]
-            self.reference = [_halve(x) for x in self.reference]
+        if self._kept > MAX_SAMPLES_PER_CASE:           # a frame down to one sample keeps it: no copy to make
+            self.samples = [_halve(x) if len(x["offset"]) > 1 else x for x in self.samples]
+            self.reference = [_halve(x) if len(x["offset"]) > 1 else x for x in self.reference]
             self._kept = sum(len(x["offset"]) for x in self.samples + self.reference)
         return cand
 
