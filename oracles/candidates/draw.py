@@ -52,6 +52,11 @@ def clip_depth(p0_world, p1_world, camera, precision: str = "float64", slack: fl
     """
     d0 = opencv_oracle.depth(p0_world, camera)
     d1 = opencv_oracle.depth(p1_world, camera)
+    if np.all((d0 >= camera.near) & (d0 <= camera.far) & (d1 >= camera.near) & (d1 <= camera.far)):
+        # nothing clipped (a NaN depth is not in range: below): the general path's ends, to the bit
+        d = p1_world - p0_world
+        ends = np.stack([p0_world + np.zeros(len(d0))[:, None] * d, p0_world + np.ones(len(d0))[:, None] * d], axis=1)
+        return np.ones(len(d0), bool), ends
     t_in = np.zeros(len(d0))
     t_out = np.ones(len(d0))
     with np.errstate(divide="ignore", invalid="ignore"):

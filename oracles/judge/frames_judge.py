@@ -44,17 +44,17 @@ LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count
 
 def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarray, frame: tuple,
                      segs: np.ndarray | None = None, job=None) -> np.ndarray:
-    """The ``(H, W)`` bool image of the pixels a frame file draws: what the judge compares with the oracle's.
+    """The pixels a frame file draws, as ascending flat indices ``y W + x``: what the judge compares with the oracle's.
 
     Every frame of the frames path goes through here, once: its grey levels
     (:func:`read_frame`) are read by the case's line style
     (oracles.judge.line_style.CaseStyle.frame: the style, line centres and ends
     measured against ``frame`` = ``(p_model, edges, camera, model_matrix)``
     and its oracle segments ``segs``), and the pixels compared are those drawn
-    by the rule (coverage >= 128). ``job``: ``(job_dir, job)``, for
+    by the rule (coverage >= 128; CaseStyle.frame_flat). ``job``: ``(job_dir, job)``, for
     :func:`read_frame`'s listing of a job's problems.
     """
-    return style.frame(read_frame(path, width, height, job), orac, *frame, segs=segs)
+    return style.frame_flat(read_frame(path, width, height, job), orac, *frame, segs=segs)
 
 
 def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
@@ -136,13 +136,12 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
                                 segs, (job_dir, job))
-        core = render_frame(p_model, edges, camera, m).image >= 128
-        fp = metrics.FramePixels(cand, orac)
+        core = _drawn(render_frame(p_model, edges, camera, m).image)
+        fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
         style.count_rule(fp, segs)
         ps = metrics.pixel_scores(None, None, pixels=fp)
         # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
-        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(
-            core.shape, fp.cand_idx, np.flatnonzero(core)))
+        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
         acc.radius.append(f1_radius.frame_scores(fp, ps))
         for key, values in acc.pixel.items():
             values.append(ps[key])
@@ -156,9 +155,9 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         acc.record_lines(acc.batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
         key = (ps["f1_1px"], ps["f1_0px"])
         if acc.worst is None or key < acc.worst[0]:
-            acc.worst = (key, k, cand.copy(), orac.copy())
+            acc.worst = (key, k, _image(cand, orac.shape), orac.copy())
         if i in kept:
-            acc.diag.append((fp.cand_idx, cand.shape, segs,
+            acc.diag.append((fp.cand_idx, orac.shape, segs,
                              oracle_segments(p_world, edges, flipped_camera(camera))))
         del cand, orac, core, fp
     acc.record_lines(acc.batch.flush())
@@ -179,6 +178,11 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         rec["faults"] = frames_visibility(rec["faults"], images, segments, camera, len(numbers))
     rec["per_frame"] = acc.per_frame
     return rec, {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
+
+
+def _drawn(image: np.ndarray) -> np.ndarray:
+    """Ascending flat indices of the pixels of ``image`` that are >= 128."""
+    return np.flatnonzero(image.reshape(-1) >= 128)
 
 
 def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:

@@ -72,6 +72,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import coverage_pixels, line_ties, line_windows
+from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
+
 STYLES = ("aliased", "antialiased", "wide")
 LINE_RULES = ("gl", "geometry")
 
@@ -144,15 +147,6 @@ def _segments(p_model, edges, camera, m) -> np.ndarray:
     return oracle_segments(p_world, edges, camera)
 
 
-def _seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)`` (x and y apart: no (N, K, 2) array)."""
-    abx, aby = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
-    len2 = np.maximum(abx * abx + aby * aby, 1e-300)
-    qx, qy = q[:, 0:1], q[:, 1:2]
-    t = np.clip(((qx - a[:, 0]) * abx + (qy - a[:, 1]) * aby) / len2, 0.0, 1.0)
-    return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
-
-
 def windows(segs: np.ndarray, shape) -> dict:
     """Where :func:`measure` looks along the oracle's segments, clear of junctions: the image's part of it.
 
@@ -160,55 +154,12 @@ def windows(segs: np.ndarray, shape) -> dict:
     serve every image measured on its lines (the candidate's, a reference
     drawing's). Along each segment long enough, at every integer step of its
     major axis :data:`GUARD_PX` clear of its ends and inside the image, a
-    window across it; segment by segment, each in ascending steps. ``rows``,
-    ``cols``: ``(n, 2 PROFILE_RADIUS_PX + 1)`` pixel indices of each window;
-    ``minor``: their coordinate along the minor axis; ``exact``: the exact
-    line's there; ``across``: the unit normal's minor component; ``normal``,
-    ``segment``, ``point``: as :func:`measure` returns them.
+    window across it (:data:`PROFILE_RADIUS_PX` each side); segment by segment,
+    each in ascending steps (oracles.judge.line_windows.windows: ``rows``, ``cols``,
+    ``minor``, ``exact``, ``across``, and ``normal``, ``segment``, ``point`` as
+    :func:`measure` returns them).
     """
-    h, w = shape
-    r = PROFILE_RADIUS_PX
-    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-    a, b = segs[:, 0], segs[:, 1]
-    d = b - a
-    length = np.hypot(d[:, 0], d[:, 1])
-    i = np.flatnonzero(length >= 2 * GUARD_PX + 1)
-    a, b, d, length = a[i], b[i], d[i], length[i]
-    major = np.where(np.abs(d[:, 0]) >= np.abs(d[:, 1]), 0, 1)
-    minor = 1 - major
-    k = np.arange(len(i))
-    a_maj, b_maj, d_maj = a[k, major], b[k, major], d[k, major]
-    a_min, d_min = a[k, minor], d[k, minor]
-    guard = GUARD_PX * np.abs(d_maj) / length                # GUARD_PX along the line, on the major axis
-    extent = np.where(major == 0, w, h)
-    start = np.maximum(np.ceil(np.minimum(a_maj, b_maj) + guard), 0)
-    stop = np.minimum(np.floor(np.maximum(a_maj, b_maj) - guard), extent - 1)
-    count = np.maximum(stop - start + 1, 0).astype(np.intp)
-    owner = np.repeat(np.arange(len(i)), count)             # the windows, segment by segment
-    pos = start[owner] + (np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count))
-    minor_exact = a_min[owner] + (pos - a_maj[owner]) * d_min[owner] / d_maj[owner]
-    centre = np.rint(minor_exact)
-    inside = (centre - r >= 0) & (centre + r <= np.where(major == 0, h, w)[owner] - 1)
-    owner, pos, minor_exact, centre = owner[inside], pos[inside], minor_exact[inside], centre[inside]
-    unit = d / length[:, None]
-    normal = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
-    win = centre[:, None] + np.arange(-r, r + 1)[None]            # (n, 2r + 1) minor coordinates
-    cols = np.broadcast_to(pos[:, None], win.shape)
-    horizontal = (major == 0)[owner][:, None]
-    pt = np.empty((len(pos), 2))
-    pt[:, 0] = np.where(horizontal[:, 0], pos, minor_exact)
-    pt[:, 1] = np.where(horizontal[:, 0], minor_exact, pos)
-    out = {"rows": np.where(horizontal, win, cols).astype(np.intp), "cols": np.where(horizontal, cols, win).astype(np.intp),
-           "minor": win, "exact": minor_exact, "across": normal[owner, minor[owner]],
-           "normal": normal[owner], "segment": i[owner], "point": pt}
-    if len(segs) > 1 and len(pos):                      # drop windows near another segment (a junction, a crossing)
-        keep = np.ones(len(pos), bool)
-        for k in range(0, len(keep), 2048):
-            dist = _seg_distance(pt[k:k + 2048], segs[:, 0], segs[:, 1])
-            dist[np.arange(len(dist)), out["segment"][k:k + 2048]] = np.inf
-            keep[k:k + 2048] = dist.min(axis=1) > GUARD_PX
-        out = {k: v[keep] for k, v in out.items()}
-    return out
+    return line_windows.windows(segs, shape, PROFILE_RADIUS_PX, GUARD_PX)
 
 
 def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME, wins: dict | None = None,
@@ -285,8 +236,11 @@ def pooled_offset(normal: np.ndarray, offset: np.ndarray):
     return d, determined
 
 
-def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
-    """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width."""
+def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.ndarray:
+    """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width.
+
+    ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
+    """
     from wirecheck.core.projector.clipping import clip_to_image
     from wirecheck.core.projector.raster import line_pixels
 
@@ -295,7 +249,7 @@ def _reference(segs: np.ndarray, shape, width_px: float) -> np.ndarray:
     if len(segs) == 0:
         return img
     if width_px < WIDE_MIN_PX:
-        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
+        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h) if clipped is None else clipped
         rr, cc = line_pixels(q0, q1, w, h)
         img[rr, cc] = True
         return img
@@ -320,14 +274,15 @@ def _off_by_one(fp, ends: np.ndarray) -> dict:
     flat = np.concatenate([c_only, o_only])
     rr, cc = np.divmod(flat, w)
     extra = np.arange(len(flat)) < len(c_only)          # a candidate-only pixel: look in the oracle's, else in the candidate's
-    off1 = np.zeros(len(rr), bool)
-    for dy in (-1, 0, 1):                               # a pixel of the other side among the 8 neighbours
-        for dx in (-1, 0, 1):
-            if dx or dy:
-                y, x = rr + dy, cc + dx
-                inside = (y >= 0) & (y < h) & (x >= 0) & (x < w)
-                for side, sel in ((False, inside & extra), (True, inside & ~extra)):
-                    off1[sel] |= fp.has(y[sel] * w + x[sel], of_candidate=side)
+    # a pixel of the other side among the 8 neighbours: every neighbour looked up at once
+    dy, dx = np.array([-1, -1, -1, 0, 0, 1, 1, 1]), np.array([-1, 0, 1, -1, 1, -1, 0, 1])
+    y, x = rr[:, None] + dy, cc[:, None] + dx
+    inside = (y >= 0) & (y < h) & (x >= 0) & (x < w)
+    near = y * w + x
+    hit = np.zeros(near.shape, bool)
+    hit[extra] = fp.has(near[extra], of_candidate=False)
+    hit[~extra] = fp.has(near[~extra], of_candidate=True)
+    off1 = (hit & inside).any(axis=1)
     at_end = np.zeros(len(rr), bool)
     if len(rr) and len(ends):
         q = np.stack([cc, rr], axis=1).astype(float)
@@ -366,6 +321,7 @@ class CaseStyle:
         self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
                        "farther": 0}
         self.reference = []                     # measure() of a correct binary drawing of each binary frame
+        self._kept = 0                          # samples in self.samples and self.reference
         self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
@@ -374,21 +330,30 @@ class CaseStyle:
         ``segs``: the frame's oracle segments (:func:`oracles.diagnosis.image_diagnose.oracle_segments`
         of ``p_model`` moved by ``m``), when the caller has them.
         """
+        out = np.zeros(np.size(grey), bool)
+        out[self.frame_flat(grey, orac, p_model, edges, camera, m, segs)] = True
+        return out.reshape(np.shape(grey))
+
+    def frame_flat(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
+        """:meth:`frame`'s pixels as ascending flat indices ``y W + x`` (the frames judge keeps no image)."""
         from wirecheck.core.projector.clipping import clip_to_image
 
-        from . import coverage_pixels, free_ends, line_ties
-
         grey = np.asarray(grey)
-        cand = grey >= 128
-        if grey.dtype == bool:
+        binary_input = grey.dtype == bool
+        if binary_input:
             grey = grey.astype(np.uint8) * 255
         segs = _segments(p_model, edges, camera, m) if segs is None else segs
         self.centre = np.array(camera.principal_point, dtype=float)
-        drawn = grey[grey > 0]
+        nonzero = np.flatnonzero(grey > 0)              # (numpy finds a bool array's nonzero faster than uint8's)
+        drawn = grey.reshape(-1)[nonzero]
+        # drawn where >= 128 (a bool image compares its True with 128: nothing)
+        cand = nonzero[:0] if binary_input else nonzero[drawn >= 128]
         self.hist += np.bincount(drawn, minlength=256)[:256]
         self.hist[0] += grey.size - len(drawn)
+        clipped = None
         if len(segs):
-            _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+            clipped = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
+            _, q0, q1 = clipped
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
         level = max(int(drawn.max()) if len(drawn) else 0, 1)              # the frame's line level is 1
         wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
@@ -396,16 +361,20 @@ class CaseStyle:
         self.samples.append(got)
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
-            cand = coverage_pixels.drawn(grey)          # grey levels: a thin line's ridge is drawn too
+            cand = np.flatnonzero(coverage_pixels.drawn(grey))    # grey levels: a thin line's ridge is drawn too
         else:
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
-            ref = measure(_reference(segs, grey.shape, width), segs, wins=wins)
+            same = grey.shape == (camera.height, camera.width)          # the clipping above is the reference's
+            ref = measure(_reference(segs, grey.shape, width, clipped if same else None), segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
                 line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
             self.reference.append(ref)
-        if sum(len(x["offset"]) for x in self.samples + self.reference) > MAX_SAMPLES_PER_CASE:
-            self.samples = [_halve(x) for x in self.samples]
-            self.reference = [_halve(x) for x in self.reference]
+            self._kept += len(ref["offset"])
+        self._kept += len(got["offset"])
+        if self._kept > MAX_SAMPLES_PER_CASE:           # a frame down to one sample keeps it: no copy to make
+            self.samples = [_halve(x) if len(x["offset"]) > 1 else x for x in self.samples]
+            self.reference = [_halve(x) if len(x["offset"]) > 1 else x for x in self.reference]
+            self._kept = sum(len(x["offset"]) for x in self.samples + self.reference)
         return cand
 
     def count_rule(self, fp, segs: np.ndarray) -> None:
@@ -598,3 +567,6 @@ def summary_lines(cases: list) -> list[str]:
                    f"{min(widths):.2f}-{max(widths):.2f} px wide, --line-rule {rule}): judged by {rows[0]['judged_by']}"
                    f"{f'; F1 at up to {radius} px (the width)' if radius > 1 else ''}; cannot show {CANNOT_SHOW[style]}")
     return out
+
+
+from . import free_ends  # noqa: E402  (it reads this module's constants: imported once they are defined)
