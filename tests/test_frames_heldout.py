@@ -77,7 +77,7 @@ def test_own_projections_are_the_oracle_lines(jobs, project):
         job = load_job(d)
         frames = list(hd.job_frames(d))
         assert len(frames) == 2
-        for _, v, e, cam, model in frames:
+        for _case, _png, v, e, cam, model in frames:
             p, edges, camera, m = frame_inputs(d, job, cam["scene"], cam["case"], cam["frame"])
             ref = oracle_segments(p @ m[:3, :3].T + m[:3, 3], edges, camera)
             got = project(v, e, cam, model=model)

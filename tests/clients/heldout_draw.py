@@ -27,39 +27,11 @@ line and Bresenham's integer line.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-
-# ---- the job's files ----
-
-def read_obj(path: Path):
-    """The OBJ's ``v`` vertices and ``l`` edges (0-based)."""
-    verts, edges = [], []
-    for line in path.read_text().splitlines():
-        parts = line.split()
-        if parts and parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts and parts[0] == "l":
-            edges.append([int(x) - 1 for x in parts[1:3]])
-    return np.array(verts).reshape(-1, 3), np.array(edges, dtype=int).reshape(-1, 2)
-
-
-def job_frames(job_dir: Path):
-    """Every listed frame: ``(png path, p_model or p_world, edges, camera json, model space?)``."""
-    job = json.loads((job_dir / "job.json").read_text())
-    scenes = {s["name"]: s for s in job["scenes"]}
-    for c in job["cases"]:
-        for rel in c["frames"]:
-            k = int(Path(rel).stem.split("_")[-1])
-            scene = scenes[c["scene"]]
-            model = scene["space"] == "model"
-            obj = scene["obj"] if model else f"scenes/{c['scene']}/frame_{k:04d}.obj"
-            v, e = read_obj(job_dir / obj)
-            cam = json.loads((job_dir / f"cameras/{c['scene']}/{c['case']}/frame_{k:04d}.json").read_text())
-            yield job_dir / rel, v, e, cam, model
+from job_files import job_frames
 
 
 # ---- projections (two routes) ----
@@ -248,7 +220,7 @@ def draw_bresenham(segs, w, h):
 def render(job_dir: Path, draw, project=project_gl, **mistake) -> None:
     """Every listed frame of the job drawn by ``draw(segs, w, h)`` from ``project(..., **mistake)``, as PNG."""
     from PIL import Image
-    for png, v, e, cam, model in job_frames(job_dir):
+    for _case, png, v, e, cam, model in job_frames(job_dir):
         w, h = cam["camera"]["width"], cam["camera"]["height"]
         segs = project(v, e, cam, model=model, **mistake)
         png.parent.mkdir(parents=True, exist_ok=True)

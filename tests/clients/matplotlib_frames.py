@@ -18,21 +18,13 @@ upside down.
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 import numpy as np
 
+from job_files import job_frames
 
-def read_obj(path: Path):
-    verts, edges = [], []
-    for line in path.read_text().splitlines():
-        parts = line.split()
-        if parts and parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts and parts[0] == "l":
-            edges.append([int(x) - 1 for x in parts[1:3]])
-    return np.array(verts).reshape(-1, 3), np.array(edges, dtype=int).reshape(-1, 2)
+
 
 
 def segments(p_world, edges, cam):
@@ -90,19 +82,11 @@ def main(argv=None) -> int:
     ap.add_argument("--mirror-y", action="store_true")
     args = ap.parse_args(argv)
     job_dir = Path(args.job)
-    job = json.loads((job_dir / "job.json").read_text())
-    scenes = {s["name"]: s for s in job["scenes"]}
-    for c in job["cases"]:
-        for rel in c["frames"]:
-            k = int(Path(rel).stem.split("_")[-1])
-            scene = scenes[c["scene"]]
-            obj = scene["obj"] if scene["space"] == "model" else f"scenes/{c['scene']}/frame_{k:04d}.obj"
-            v, e = read_obj(job_dir / obj)
-            cam = json.loads((job_dir / f"cameras/{c['scene']}/{c['case']}/frame_{k:04d}.json").read_text())
-            m = np.array(cam["model_matrix"])
-            p_world = v @ m[:3, :3].T + m[:3, 3] if scene["space"] == "model" else v
-            (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
-            draw(segments(p_world, e, cam), c["width"], c["height"], args.linewidth, args.mirror_y, job_dir / rel)
+    for c, png, v, e, cam, model in job_frames(job_dir):
+        m = np.array(cam["model_matrix"])
+        p_world = v @ m[:3, :3].T + m[:3, 3] if model else v
+        png.parent.mkdir(parents=True, exist_ok=True)
+        draw(segments(p_world, e, cam), c["width"], c["height"], args.linewidth, args.mirror_y, png)
     return 0
 
 

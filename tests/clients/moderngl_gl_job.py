@@ -30,11 +30,12 @@ Typical mistakes, one flag each:
 from __future__ import annotations
 
 import argparse
-import json
 import os
 from pathlib import Path
 
 import numpy as np
+
+from job_files import job_frames
 
 VERTEX_SHADER = """
 #version 330
@@ -50,16 +51,6 @@ void main() { f_color = vec4(1.0); }
 """
 
 
-def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """The OBJ's ``v`` vertices ``(N, 3)`` and ``l`` edges ``(K, 2)``, 0-based."""
-    verts, edges = [], []
-    for line in path.read_text().splitlines():
-        parts = line.split()
-        if parts and parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts and parts[0] == "l":
-            edges.append([int(x) - 1 for x in parts[1:3]])
-    return np.array(verts).reshape(-1, 3), np.array(edges, dtype=int).reshape(-1, 2)
 
 
 def mvp_matrix(cam: dict, width: int, height: int, aspect_h_over_w: bool, half_pixel: bool) -> np.ndarray:
@@ -120,26 +111,17 @@ def main(argv=None) -> int:
     from PIL import Image
 
     job_dir = Path(args.job)
-    job = json.loads((job_dir / "job.json").read_text())
-    scenes = {s["name"]: s for s in job["scenes"]}
     renderer = Renderer()
-    for c in job["cases"]:
+    for c, out, p_model, edges, cam, model in job_frames(job_dir):
         width, height = c["width"], c["height"]
-        for rel in c["frames"]:
-            k = int(Path(rel).stem.split("_")[-1])
-            scene = scenes[c["scene"]]
-            obj = scene["obj"] if scene["space"] == "model" else f"scenes/{c['scene']}/frame_{k:04d}.obj"
-            p_model, edges = read_obj(job_dir / obj)
-            cam = json.loads((job_dir / f"cameras/{c['scene']}/{c['case']}/frame_{k:04d}.json").read_text())
-            if scene["space"] != "model":
-                cam = dict(cam, model_matrix=np.eye(4).tolist())    # world-space vertices per frame
-            mvp = mvp_matrix(cam, width, height, args.aspect_h_over_w, args.half_pixel)
-            pixels = renderer.draw(p_model, edges, mvp, width, height, flip=not args.no_flip)
-            out = job_dir / rel
-            out.parent.mkdir(parents=True, exist_ok=True)
-            tmp = out.with_name(out.name + ".tmp")
-            Image.fromarray(pixels, mode="L").save(tmp, format="PNG")
-            os.replace(tmp, out)
+        if not model:
+            cam = dict(cam, model_matrix=np.eye(4).tolist())    # world-space vertices per frame
+        mvp = mvp_matrix(cam, width, height, args.aspect_h_over_w, args.half_pixel)
+        pixels = renderer.draw(p_model, edges, mvp, width, height, flip=not args.no_flip)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = out.with_name(out.name + ".tmp")
+        Image.fromarray(pixels, mode="L").save(tmp, format="PNG")
+        os.replace(tmp, out)
     renderer.ctx.release()
     return 0
 
