@@ -1,10 +1,11 @@
 """The image rule on hand-built PNGs: every colour type and bit depth, tRNS, alpha, animation (issue 25, item 8).
 
-The PNGs are written here byte by byte (signature, chunks with their CRC, filter-0 scanlines packed at
-the file's bit depth), not by Pillow, so each file is exactly the case it names. The expected pixels
-are derived by hand from the rule (oracles/candidates/png_frame.py): drawn where L x A >= 128 x 255 with the
-samples on 8 bits (1/2/4-bit scaled by 255, 85, 17; 16-bit by their high byte) and a tRNS colour
-transparent at the file's full depth.
+The PNGs are written byte by byte (signature, chunks with their CRC, filter-0 scanlines packed at the
+file's bit depth: tests/fuzz/png_inputs.py's chunk and scanlines), not by Pillow, so each file is
+exactly the case it names. The expected pixels are derived by hand from the rule
+(oracles/candidates/png_frame.py): drawn where L x A >= 128 x 255 with the samples on 8 bits (1/2/4-bit
+scaled by 255, 85, 17; 16-bit by their high byte) and a tRNS colour transparent at the file's full
+depth.
 """
 
 from __future__ import annotations
@@ -14,32 +15,12 @@ import shutil
 import struct
 import zlib
 
-import numpy as np
 import pytest
 
 import helpers
+from fuzz.png_inputs import chunk, scanlines     # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles import cli as crosscheck_cli
 from wirecheck.oracles.candidates.png_frame import FrameProblem, read_png
-
-
-def chunk(kind: bytes, data: bytes) -> bytes:
-    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-
-def scanlines(samples, depth: int) -> bytes:
-    """Rows of samples (each row: width x channels integers) as filter-0 scanlines at ``depth`` bits."""
-    out = b""
-    for row in samples:
-        if depth == 16:
-            data = b"".join(struct.pack(">H", v) for v in row)
-        elif depth == 8:
-            data = bytes(row)
-        else:                                   # pack most significant bits first, pad the last byte
-            bits = "".join(format(v, f"0{depth}b") for v in row)
-            bits += "0" * (-len(bits) % 8)
-            data = bytes(int(bits[i:i + 8], 2) for i in range(0, len(bits), 8))
-        out += b"\0" + data
-    return out
 
 
 def png(samples, colour: int, depth: int, width: int, plte=None, trns: bytes | None = None,

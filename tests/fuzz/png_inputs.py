@@ -22,17 +22,19 @@ _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
 
 
 def chunk(kind: bytes, data: bytes) -> bytes:
+    """A PNG chunk: length, type, data and the CRC of type and data."""
     return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
 
 
-def _scanlines(rows, depth: int) -> bytes:
+def scanlines(rows, depth: int) -> bytes:
+    """Rows of samples (each row: width x channels integers) as filter-0 scanlines at ``depth`` bits."""
     out = b""
     for row in rows:
         if depth == 16:
             data = b"".join(struct.pack(">H", v) for v in row)
         elif depth == 8:
             data = bytes(row)
-        else:
+        else:                                   # pack most significant bits first, pad the last byte
             bits = "".join(format(v, f"0{depth}b") for v in row)
             bits += "0" * (-len(bits) % 8)
             data = bytes(int(bits[i:i + 8], 2) for i in range(0, len(bits), 8))
@@ -67,7 +69,7 @@ def hostile_png(pick, width: int, height: int) -> bytes:
         body += pick.choice([chunk(b"acTL", struct.pack(">II", pick.integer(0, 3), 0)),
                              chunk(b"zzZz", b"\x1b[2J"), chunk(b"XYZW", b"\n"), chunk(b"IHDR", b"\0" * 13),
                              struct.pack(">I", 0xFFFFFFF0) + b"tEXt", chunk(b"tEXt", b"a\0\x1b\n")])
-    data = head + body + chunk(b"IDAT", zlib.compress(_scanlines(rows, depth))) + chunk(b"IEND", b"")
+    data = head + body + chunk(b"IDAT", zlib.compress(scanlines(rows, depth))) + chunk(b"IEND", b"")
     if pick.chance(0.3):
         data = bytearray(data)
         for _ in range(pick.integer(1, 4)):
