@@ -178,7 +178,8 @@ def _walk(frames_dir: Path) -> list[Path]:
             n += 1
             if n > MAX_WALK:
                 raise FramesError([f"{frames_dir}: more than {MAX_WALK:,} files and folders: expected the "
-                                   "job's frames (frames/<scene>/<case>/frame_NNNN.png)"])
+                                   f"job's frames (frames/<scene>/<case>/frame_NNNN.png); the walk was in {folder} "
+                                   "(a link to a folder elsewhere?)"])
             try:
                 is_dir = item.is_dir()
             except OSError:
