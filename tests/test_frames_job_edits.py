@@ -77,6 +77,10 @@ def original(job, *keys):
     # a typo'd or extra key
     (lambda d: d.__setitem__("modle_matrix", d["model_matrix"]), "unknown key 'modle_matrix' (did you mean 'model_matrix'?)"),
     (lambda d: d["camera"].__setitem__("focal", 3.0), "camera: unknown key 'focal'"),
+    # a field of the wrong type, named (before: "TypeError: must be real number, not str"; "camera Truex480")
+    (lambda d: d["camera"].__setitem__("fov_y_deg", "55"), "camera.fov_y_deg '55': expected a number"),
+    (lambda d: d["camera"].__setitem__("width", True), "camera.width True: expected an integer"),
+    (lambda d: d["camera"].__setitem__("up", [0, 1]), "camera.up [0, 1]: expected 3 numbers"),
     # a JSON true is no 1.0
     (lambda d: d["model_matrix"][0].__setitem__(0, True) if d["model_matrix"][0][0] == 1.0 else
      d["model_matrix"][3].__setitem__(3, True), "model_matrix["),

@@ -81,7 +81,32 @@ def camera_keys_problem(cam_json) -> str | None:
     if not isinstance(cam_json.get("camera"), dict):
         return None
     contract = tuple(Camera((0.0, 0.0, 1.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0)).to_dict())
-    return _keys_problem("camera", cam_json["camera"], contract + ("intrinsics",), required=contract)
+    cam = cam_json["camera"]
+    problem = _keys_problem("camera", cam, contract + ("intrinsics",), required=contract)
+    for key, value in cam.items():
+        expected = _CAMERA_TYPES.get(key)
+        if problem is None and expected is not None and not _is_type(value, expected):
+            problem = f"camera.{key} {_short(value)}: expected {expected}"
+    return problem
+
+
+#: What each camera field holds, as export writes it (core.camera.Camera.to_dict).
+_CAMERA_TYPES = {"position": "3 numbers", "forward": "3 numbers", "up": "3 numbers", "fov_y_deg": "a number",
+                 "width": "an integer", "height": "an integer", "near": "a number", "far": "a number",
+                 "projection": "a string", "ortho_height": "a number", "intrinsics": "4 numbers"}
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _is_type(value, expected: str) -> bool:
+    if expected.endswith(" numbers"):
+        n = int(expected.split()[0])
+        return isinstance(value, list) and len(value) == n and all(_is_number(v) for v in value)
+    if expected == "an integer":
+        return _is_number(value) and isinstance(value, int)
+    return _is_number(value) if expected == "a number" else isinstance(value, str)
 
 
 def camera_file_problem(cam_json: dict, camera, model: np.ndarray, job: dict, scene: str, case: str,
