@@ -142,3 +142,19 @@ def test_an_unedited_job_reads_as_exported(blank):
             import shutil
 
             shutil.rmtree(out)
+
+
+@pytest.mark.parametrize("line, needle", [
+    ("f 1 99 3", "'f 1 99 3': expected 'f I J K ...' (3 or more of 1..8)"),
+    ("f 1 2", "'f 1 2': expected 'f I J K ...'"),
+    ("f 1 x 3", "'f 1 x 3': expected 'f I J K ...'"),
+    ("vt 0.5 0.5", "'vt 0.5 0.5': expected 'f I J K ...' (3 or more of 1..8), 'v', 'l' or a '#' comment"),
+])
+def test_an_edited_obj_face_or_record_is_one_line(job, tmp_path, capsys, line, needle):
+    """Faces are not judged, but a renderer may read them (hidden lines): before, any 'f' line or unknown
+    record was skipped and the job judged (correct frames: exit 0)."""
+    obj = job / "scenes/cube.obj"
+    n = len(obj.read_text().splitlines())
+    obj.write_text(obj.read_text() + line + "\n")
+    rc, err = judged(job, tmp_path, capsys)
+    assert_one_line(rc, err, f"{obj}:{n + 1}: {needle}")

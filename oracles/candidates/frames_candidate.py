@@ -257,7 +257,9 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``.
 
     FramesError (file:line) for a record that is not as export writes it: 3
-    finite coordinates, 2 indices of vertices before it.
+    finite coordinates, 2 indices of vertices before it; ``f`` faces (not
+    judged, but a renderer may read them) of 3 or more such indices; nothing
+    but ``v``, ``l``, ``f`` and ``#`` comments.
     """
     verts, edges = [], []
     problem = file_problem(path)
@@ -278,7 +280,14 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
                 edges.append([int(x) - 1 for x in parts[1:]])
                 if len(parts) != 3 or not all(0 <= i < len(verts) for i in edges[-1]):
                     raise ValueError
-        except ValueError:
+            elif parts and not parts[0].startswith("#"):
+                face = [int(x) - 1 for x in parts[1:] if x.lstrip("-").isdigit()] if parts[0] == "f" else []
+                if len(face) < max(3, len(parts) - 1) or not all(0 <= i < len(verts) for i in face):
+                    raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'f I J K ...' (3 or more "
+                                       f"of 1..{len(verts)}), 'v', 'l' or a '#' comment, as 'crosscheck export' wrote"])
+        except ValueError as exc:
+            if isinstance(exc, FramesError):
+                raise
             raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
                                f"(1..{len(verts)}), as 'crosscheck export' wrote"]) from None
     return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
