@@ -32,6 +32,7 @@ import numpy as np
 from . import f1_radius, metrics
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
+from .dim_lines import name_dim_lines
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (image_diagnose.MAX_POINTS_PER_CASE),
@@ -171,6 +172,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
     style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol))
     rec["line_style"]["f1_radius_px"] = rec["f1_radius_px"]
+    rec["faults"] = name_dim_lines(rec["faults"], rec["line_style"], acc.per_frame)   # lines under the 128 rule
     rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
     decide(rec, tol, level="frames")
     if diagnose and not faults and rec["verdict"] == "fail":
