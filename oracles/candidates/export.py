@@ -252,6 +252,8 @@ geometry` judges their geometry only. A line is judged where it is drawn: a
 renderer that moves lines onto pixel centres is held to that move. matplotlib
 does so by default for horizontal and vertical lines (`snap`): draw with
 `snap=False`, or square-on frames read as a `pixel_offset` of up to half a pixel.
+Pillow's ImageDraw truncates float coordinates: give it rounded ones, or its
+lines read as `pixel_offset` (-0.5, -0.5).
 
 """ + short_job_note(job)
 
