@@ -102,6 +102,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     """
     from .candidates.frames_candidate import run_frames
     from .judge.line_style import summary_lines
+    from .reports.compared import what_text
     from .reports.report import console_table, write_report
     from .judge.tolerances import Tolerances
 
@@ -142,6 +143,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
         return _fail(str(exc))
     except OSError as exc:
         return _fail(f"writing {str(run_dir)!r} or the JUnit file failed: {exc}")
+    print(what_text(report))                # what was compared: the first line of every result (docs/pytest.md)
     print(console_table(report["cases"]))
     for line in summary_lines(report["cases"]):
         print(line)

@@ -9,7 +9,8 @@ the difference is visible where the verdict is read: the CLI's output, the Asser
 
 from __future__ import annotations
 
-_LEVEL = {"vertices": "vertices (OpenCV)", "pixels": "pixels (OpenCV and pyrender)"}
+_LEVEL = {"vertices": "vertices (OpenCV)", "pixels": "pixels (OpenCV and pyrender)",
+          "frames": "frames (a renderer's PNGs against pyrender; core's beside it)"}
 
 
 def _n(count: int, word: str, plural: str | None = None) -> str:
@@ -26,7 +27,7 @@ def what_text(report: dict) -> str:
     every = report.get("every", 1) or 1
     per_case = _n(frames, "frame") + " per case" if frames is not None else "frames"
     if every > 1 and frames is not None:
-        per_case += f" (every {every}th checked)"
+        per_case += f" (1 in {every} checked)"
     cases = report.get("cases", [])
     scenes = len({c["scene"] for c in cases})
     cameras = len({c["camera"] for c in cases})
