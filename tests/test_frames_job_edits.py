@@ -158,3 +158,16 @@ def test_an_edited_obj_face_or_record_is_one_line(job, tmp_path, capsys, line, n
     obj.write_text(obj.read_text() + line + "\n")
     rc, err = judged(job, tmp_path, capsys)
     assert_one_line(rc, err, f"{obj}:{n + 1}: {needle}")
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda d: d["K"][1].__setitem__(2, 200.0), "K[1][2] 200.0: expected "),
+    (lambda d: d.__setitem__("t", 0.0), "t 0.0: expected 0.5"),
+])
+def test_an_edit_in_a_later_frame_of_a_case_is_found(job, tmp_path, capsys, edit, needle):
+    """The camera's own fields are computed once a case (the first frame's): a later frame's file is still
+    held to them, and to its own frame number and time (frame 3 of 4: t = 2 / 4)."""
+    cam3 = job / "cameras/cube/on_axis/frame_0003.json"
+    _edit(cam3, edit)
+    rc, err = judged(job, tmp_path, capsys)
+    assert_one_line(rc, err, f"{cam3}: ", needle)

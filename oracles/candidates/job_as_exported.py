@@ -116,14 +116,29 @@ def camera_file_problem(cam_json: dict, camera, model: np.ndarray, job: dict, sc
     ``camera`` and ``model`` are those read from the file; the model matrix must be affine (its last row
     ``[0, 0, 0, 1]``): the oracles use its top three rows, a GL renderer all four.
     """
-    from .export import camera_json
-
     if not np.array_equal(model[3], [0.0, 0.0, 0.0, 1.0]) or any(isinstance(v, bool) for v in cam_json["model_matrix"][3]):
         return (f"model_matrix[3] {[float(v) for v in model[3]]}: expected [0.0, 0.0, 0.0, 1.0] (an affine model "
                 "matrix: the oracles use its top three rows)")
     phase = job["motion"].get("phase", 0.0)
-    expected = camera_json(camera, model, scene, case, k, job["frames"], phase)
-    return _differs("", cam_json, expected)
+    return _differs("", cam_json, _expected(camera, model, scene, case, k, job["frames"], phase))
+
+
+#: The last camera's export JSON: a case's frames share one Camera object (oracles.candidates.frames_candidate
+#: makes it once while the file's ``camera`` is unchanged), so its matrices are computed once a case.
+_LAST: dict = {}
+
+
+def _expected(camera, model, scene: str, case: str, k: int, frames: int, phase: float) -> dict:
+    """:func:`oracles.candidates.export.camera_json` of these arguments; for the camera of the last call, that
+    call's JSON with the fields of the other arguments (frame, time, model matrix, names) replaced: the rest
+    are the camera's alone."""
+    from .export import _rows, camera_json, frame_time
+
+    if _LAST.get("camera") is not camera:
+        _LAST.update(camera=camera, json=camera_json(camera, model, scene, case, k, frames, phase))
+        return _LAST["json"]
+    return {**_LAST["json"], "scene": scene, "case": case, "frame": k, "t": frame_time(k, frames, phase),
+            "model_matrix": _rows(model)}
 
 
 def _differs(where: str, value, expected) -> str | None:
