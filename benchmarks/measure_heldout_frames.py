@@ -35,6 +35,23 @@ from wirecheck.oracles.cli import main  # noqa: E402
 mpl, cv2_line, pillow = hd.draw_matplotlib, hd.draw_cv2, hd.draw_pillow
 GL, LOOKAT = hd.project_gl, hd.project_lookat
 HALF = {"half_pixel": True}
+ASPECT = {"aspect": 1.03}
+
+
+def draw_gl_rule(segs, w, h):
+    """GL's rule: wirecheck core's exact line raster (the pixels pyrender draws for these lines), white on black."""
+    import numpy as np
+
+    from wirecheck.core.projector.clipping import clip_to_image
+    from wirecheck.core.projector.raster import line_pixels
+
+    img = np.zeros((h, w), np.uint8)
+    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+    _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
+    rr, cc = line_pixels(q0, q1, w, h)
+    img[rr, cc] = 255
+    return img
+
 
 #: name -> (drawer, projection, mistake)
 RENDERERS = {
@@ -57,6 +74,15 @@ RENDERERS = {
     "bresenham, FOV of the wrong axis": (hd.draw_bresenham, LOOKAT, {"fov_axis": "x"}),
     "cv2 LINE_8, FOV of the wrong axis": (partial(cv2_line, line_type="LINE_8"), LOOKAT, {"fov_axis": "x"}),
     "cv2 LINE_AA, half pixel": (partial(cv2_line, line_type="LINE_AA"), GL, HALF),
+    # fx 3 % over fy: an aspect mistake drawn by GL's rule and by the rules that round the ends
+    "gl rule (core)": (draw_gl_rule, LOOKAT, {}),
+    "gl rule (core), aspect 1.03": (draw_gl_rule, LOOKAT, ASPECT),
+    "gl rule (core), half pixel": (draw_gl_rule, GL, HALF),
+    "gl rule (core), FOV of the wrong axis": (draw_gl_rule, LOOKAT, {"fov_axis": "x"}),
+    "pillow 1px, FOV of the wrong axis": (pillow, LOOKAT, {"fov_axis": "x"}),
+    "bresenham, aspect 1.03": (hd.draw_bresenham, LOOKAT, ASPECT),
+    "cv2 LINE_8, aspect 1.03": (partial(cv2_line, line_type="LINE_8"), LOOKAT, ASPECT),
+    "pillow 1px, aspect 1.03": (pillow, LOOKAT, ASPECT),
 }
 
 
