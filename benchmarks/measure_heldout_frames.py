@@ -3,14 +3,16 @@
 Exports a job (every bundled scene, the seven cases, frames 1 and 4 of 6), draws
 it with each renderer of tests/clients/heldout_draw.py (Pillow, matplotlib's
 Agg, OpenCV, a Wu and a Bresenham line: drawing code of their own from the
-job's camera contract), correct and with one typical mistake, judges it with
+job's camera contract) and with GL's rule (core's raster, the reference
+aliased rule), correct and with typical mistakes (a half pixel, the FOV of the
+wrong axis, fx 3 % over fy, rows not flipped), judges it with
 ``crosscheck --candidate-frames`` and prints per renderer the verdicts and
 faults counted over the cases, the style read, the width, F1@0px against GL's
 rule, the largest measured centre offset, and the pixel offsets named.
 
     .venv/bin/python benchmarks/measure_heldout_frames.py [OUT] [--only NAME ...] [--cases] [--line-rule geometry]
 
-About 25 s a renderer on one core (10 minutes in all). Not part of CI.
+About 25 s a renderer on one core (15 minutes in all). Not part of CI.
 """
 
 from __future__ import annotations

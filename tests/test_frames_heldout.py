@@ -15,7 +15,7 @@ of the judge's, kept here as ``xfail(strict=True)`` with its measured numbers
 
 Small jobs keep the file near a minute on one core: one case, frames 1 and 4
 of 6 (pyramid / oblique_roll: slanted lines, so an offset shows in x and y);
-the xfails use the case where each was measured to fail.
+the findings use the case where each was measured to fail.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from wirecheck.oracles.cli import main
 sys.path.insert(0, str(Path(__file__).parent / "clients"))
 import heldout_draw as hd  # noqa: E402
 
-# 32 crosscheck runs end to end (~27 s of CPU in all, about a second each)
+# about 40 crosscheck runs end to end (about a second of CPU each)
 pytestmark = pytest.mark.slow
 
 #: Each job: (scene, case); frames 1 and 4 of 6.
