@@ -86,6 +86,11 @@ TARGETS = {
     # module fixture diagnoses ~100 cases); the short job's matrix and the thick lines cover the same names
     "oracles/diagnosis/image_diagnose.py": (_IMAGE_TESTS, None),
     "oracles/diagnosis/image_naming.py": (_IMAGE_TESTS, None),
+    # the aliased rules read and what a fault stands against: its unit tests in test_image_naming.py, then the
+    # held-out cases it decides (cv2 LINE_8 on prism / on_axis, the wrong-axis FOV on prism / wide_fov, aspect)
+    "oracles/diagnosis/rule_read.py": (["tests/test_image_naming.py", "tests/test_frames_heldout.py"],
+                                       "tie_margin or stands_against or centre_line_is_named or prism_wide_fov "
+                                       "or aspect_mistake"),
 }
 
 PER_MUTANT_TIMEOUT_S = 300
