@@ -133,7 +133,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
         seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
         segs = oracle_segments(p_world, edges, camera)             # the lines a correct renderer draws
-        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
+        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m, depth=False)[0]
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
                                 segs, (job_dir, job))
         core = _drawn(render_frame(p_model, edges, camera, m).image)
