@@ -80,6 +80,10 @@ TARGETS = {
                                        "tests/test_frames_candidate.py::test_mirrored_frames_fail_and_are_named",
                                        "tests/test_frames_candidate.py::test_a_case_where_nothing_is_drawn_is_vacuous"],
                                       None),
+    # the frames read ahead on the GL thread: errors at their own frame, the same report, no thread left
+    "oracles/judge/frame_prefetch.py": (["tests/test_frame_prefetch.py",
+                                         "tests/test_frames_candidate.py::test_frames_that_cannot_be_decoded_are_all_listed"],
+                                        None),
     "oracles/judge/line_style.py": (["tests/test_line_style.py"], None),
     "oracles/judge/line_windows.py": (["tests/test_line_windows.py", "tests/test_line_style.py"], None),
     # the image diagnosis: every test file but the 80-s confusion matrix of test_image_diagnosis.py (its
