@@ -104,6 +104,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     from .judge.line_style import summary_lines
     from .reports.compared import what_text
     from .reports.report import console_table, write_report
+    from .reports.report_option import report_line
     from .judge.tolerances import Tolerances
 
     from .config import CLI_DESTS
@@ -134,7 +135,8 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     except InputError as exc:
         return _fail(str(exc))
     try:
-        write_report(run_dir, report, images)
+        if not args.no_report:
+            write_report(run_dir, report, images)
         if args.junit_xml:
             from .reports.junit import write_junit
 
@@ -154,5 +156,5 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "
           f"(F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}); against core: F1@0px >= "
           f"{s['min_core_f1_0px']:.4f}, F1@1px >= {s['min_core_f1_1px']:.4f}")
-    print(f"Report: {run_dir / 'report.json'} (also report.md, report.html)")
+    print(report_line(args, run_dir, "report.json", "report.md, report.html"))
     return 1 if report["verdict"] != "pass" else 0

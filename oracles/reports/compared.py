@@ -39,7 +39,8 @@ def hint_lines(report: dict, failing: list) -> list[str]:
     """``  what to check, NAME: HINT``, once per distinct hint of the faults in ``failing`` cases (oracles.reports.report.fault_hints)."""
     from .report import fault_hints
 
-    return [f"  what to check, {n}: {h}" for n, h in fault_hints(f for c in failing for f in c["faults"])]
+    return [f"  what to check, {n}: {h}" for n, h in fault_hints((f for c in failing for f in c["faults"]),
+                                                                           report.get("level") == "frames")]
 
 
 #: Reasons the CLI prints per failing case; the rest are in report.md (a line a reader can take in).
