@@ -33,3 +33,17 @@ def test_the_console_and_junit_follow_the_reports_level():
     pixels = hint_lines({"level": "pixels"}, [case])
     assert len(frames) == len(pixels) == 1 and "snap=False" in frames[0] and "snap=False" not in pixels[0]
     assert "snap=False" in failure_text(case, frames=True) and "snap=False" not in failure_text(case)
+
+
+def test_the_verdict_line_claims_f1_at_0px_only_where_it_judged():
+    from wirecheck.oracles.frames_cli import f1_0px_clause
+
+    def case(style, rule="gl"):
+        return {"line_style": {"style": style, "line_rule": rule}}
+
+    assert f1_0px_clause([case("aliased")] * 3, 0.98) == "F1@0px >= 0.98"
+    assert f1_0px_clause([case("antialiased"), case("wide")], 0.98) == (
+        "F1@0px reported, not judged: no case is held to GL's pixel rule")
+    assert f1_0px_clause([case("aliased", "geometry")], 0.98).startswith("F1@0px reported, not judged")
+    assert f1_0px_clause([case("aliased"), case("antialiased")], 0.98) == (
+        "F1@0px >= 0.98 in the 1 case held to GL's pixel rule")
