@@ -72,7 +72,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import coverage_pixels, line_ties, line_windows
+from . import coverage_pixels, even_lean, line_ties, line_windows
 from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
 
 STYLES = ("aliased", "antialiased", "wide")
@@ -322,6 +322,7 @@ class CaseStyle:
                        "farther": 0}
         self.reference = []                     # measure() of a correct binary drawing of each binary frame
         self._kept = 0                          # samples in self.samples and self.reference
+        self.drawn_px = np.zeros(2, np.int64)   # binary frames: the candidate's drawn pixels, the oracle's
         self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
@@ -358,11 +359,13 @@ class CaseStyle:
         level = max(int(drawn.max()) if len(drawn) else 0, 1)              # the frame's line level is 1
         wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
         got = measure(grey, segs, wins=wins, level=level)
+        got["edge"] = got["segment"] + len(self.samples) * (len(segs) + 1)    # one key per frame and segment
         self.samples.append(got)
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
             cand = np.flatnonzero(coverage_pixels.drawn(grey))    # grey levels: a thin line's ridge is drawn too
         else:
+            self.drawn_px += (len(cand), int(np.count_nonzero(orac)))      # binary: pixels drawn, the oracle's
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             same = grey.shape == (camera.height, camera.width)          # the clipping above is the reference's
             ref = measure(_reference(segs, grey.shape, width, clipped if same else None), segs, wins=wins)
@@ -394,7 +397,8 @@ class CaseStyle:
         drawn = self.hist[1:]
         n = int(drawn.sum())
         if n == 0:
-            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1}
+            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1,
+                    "band_px": 1, "pixel_ratio": 0.0}
         cum = np.cumsum(drawn)
         level = int(np.searchsorted(cum, LEVEL_PERCENTILE / 100.0 * n)) + 1
         values = np.arange(1, 256)
@@ -407,11 +411,15 @@ class CaseStyle:
             width = coverage / self.length_px if self.length_px > 0 else 0.0
         grey_share = float(grey) / n
         style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
+        ratio = float(self.drawn_px[0] / self.drawn_px[1]) if self.drawn_px[1] else 0.0
+        band = max(int(np.floor(width + 0.5)), 1)
+        if style == "aliased" and ratio >= even_lean.WIDE_PIXEL_RATIO:      # no 1-px line draws this many
+            style, band = "wide", 2
         # coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's step on
         # lines that all sit at one fractional position; that half step is added to the offset's tolerance
         steps = max(int((drawn >= LEVEL_SHARE_MIN * n).sum()), 1)
         return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level,
-                "coverage_steps": steps}
+                "coverage_steps": steps, "band_px": band, "pixel_ratio": round(ratio, 3)}
 
     def _fit(self, samples):
         """``(d (2,), affine)`` over ``samples``: ``d`` the pooled offset (:func:`pooled_offset`), ``affine``
@@ -454,6 +462,13 @@ class CaseStyle:
             return (normal * (aff[0] + (point - self.centre) @ aff[1].T - const)).sum(axis=1)
 
         warp = np.abs(fitted(affine, d) - fitted(ref_affine, ref_d))
+        lean = even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"]) \
+            if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0 else None
+        if lean is not None:                            # an even band: each edge's lean chosen (even_lean)
+            geo["lean"] = {k: lean[k] for k in even_lean.REPORTED}
+            if lean["leaning"]:
+                d, ref_d, affine = lean["offset"], np.zeros(2), fit_lines(normal, lean["corrected"], point, self.centre)
+                warp = np.abs(fitted(affine, d))
         geo.update(offset_px=[float(v) for v in d - ref_d], bias_px=[float(v) for v in ref_d],
                    warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0)
         return geo
