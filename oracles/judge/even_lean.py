@@ -20,27 +20,39 @@ from edge to edge with the order the renderer takes the ends in, which the
 image does not say. Its ends rounded to pixel centres first, a leaning line of
 the ``[e + 1/2 - h, e + 1/2 + h]`` band is pixel for pixel Pillow's on axis-
 aligned lines: a line up to 1.0 px off its exact position (0.5 rounding, 0.5
-lean) and still correct.
+lean) and still correct. Pillow's width 2 draws lines within 30 degrees of an
+axis about 1.2 pixels across: their median width reads 1.0-1.7, so binary
+lines are also read wide where they draw :data:`WIDE_PIXEL_RATIO` times the
+oracle's pixels (:meth:`oracles.judge.line_style.CaseStyle.classify`).
 
-So each edge's centre is known only to one of the three: its measured centres
-less each choice's (:func:`reference_offsets`) give three per-edge residuals,
-and one offset ``d`` for the whole case is fitted with each edge taking the
-choice nearest ``n . d`` (:func:`fit`). What stays sharp: ``d`` is one offset
-for every edge, so a case's lines moved by half a pixel read half a pixel
-wherever their edges lean both ways about the move (an edge leaning with the
-move reads a whole band-step, which no choice at ``d = 0`` explains). What an
-even-width image cannot show: a move of half a pixel along the minor axis of
-edges that all lean the other way is pixel for pixel a correct drawing leaning
-the one way (the ``[e - 1/2 ...]`` and ``[e + 1/2 ...]`` bands of lines half a
-pixel apart are the same pixels); the fit then takes the smaller offset, and
-the centre measure of such a case cannot tell the two apart.
+So each edge's centre is known only up to that choice. Its measured centres
+less each choice's (:func:`reference_offsets`) give three residuals per edge
+(their means over the edge's samples, which average out the band's
+quantisation along it), and one offset ``d`` for the whole case is fitted
+with each edge taking the choice nearest ``n . d`` (:func:`fit`): on a grid of
+``d``, taken only where it explains the edges' means better than ``d = 0``
+(each edge its nearest choice there) by more than the ends' rounding would 99
+times in 100 (:data:`EDGE_NOISE_PX2`, :data:`CHI2_2_P99`, over the case's
+effective number of edges), then refined by least squares with those choices.
 
-The fit is used only where it explains the edges better than the symmetric
-band alone (mean square over the samples lower by :data:`LEAN_GAIN_PX2`): a
-renderer of symmetric even bands, and every odd width, keep the measure of
-:mod:`oracles.judge.line_style` unchanged, and a symmetric band moved half a
-pixel (which a leaning band at every edge would also explain, with ``d = 0``)
-is measured as moved.
+The fit replaces the symmetric band's measure only where it explains the
+edges' means better by :data:`LEAN_GAIN_PX2` (or where the edges are too few
+to test the symmetric band, :data:`MAX_UNTESTED_EDGES`): a renderer of
+symmetric even bands, and every odd width, keep the measure of
+:mod:`oracles.judge.line_style` unchanged, so a symmetric band moved by half
+a pixel (which bands leaning with the move would explain at ``d = 0`` on
+axis-aligned lines only) is still measured as moved, to 0.02 px.
+
+What stays sharp: ``d`` is one offset for every edge, so a leaning renderer's
+lines moved by half a pixel read about half a pixel wherever its edges lean
+both ways about the move (an edge leaning with the move sits a whole pixel
+off, which no choice at ``d = 0`` explains). What an even-width image cannot
+show: a move of half a pixel across edges that all lean against it is pixel
+for pixel a correct drawing leaning the other way (the ``[e - 1/2 ...]`` and
+``[e + 1/2 ...]`` bands of lines half a pixel apart are the same pixels), and
+then the smaller offset is read; with rounded ends (Pillow) a half-pixel move
+reads 0.3-0.9 px (each end moves 0 or 1 px), and a move along lines near an
+axis is absorbed by their leans.
 """
 
 from __future__ import annotations
@@ -60,9 +72,11 @@ EDGE_NOISE_PX2 = 1.0 / 24.0
 #: The 99th percentile of chi-square with 2 degrees of freedom (-2 ln 0.01): what fitting an offset
 #: ``(dx, dy)`` gains on edges of pure noise, in units of that noise over the edges, 1 time in 100.
 CHI2_2_P99 = -2.0 * np.log(0.01)
-#: The leaning fit replaces the symmetric band's when it lowers the mean square residual by this
-#: (px^2): a quarter of the square of the quarter pixel that one leaning edge of a 2-px line leaves
-#: under the symmetric band (0.5 px on the minor axis, times |n_minor| >= 0.71).
+#: The leaning fit replaces the symmetric band's when it lowers the mean square residual of the edges'
+#: means by this (px^2): the square of a quarter pixel (what a leaning edge, 0.5 px on the minor axis
+#: times |n_minor| >= 0.71, leaves under the symmetric band is at least 0.35 px), for a quarter of the
+#: edges. Measured: Pillow 2 px 0.12-0.30 symmetric against 0.02-0.05 leaning; symmetric 2-px bands,
+#: moved or not, 0.000-0.001 against 0.000-0.016.
 LEAN_GAIN_PX2 = 0.25 * 0.25 ** 2
 #: Binary lines drawing this many pixels per pixel of the oracle's 1-px lines are wide whatever the
 #: median across them: a 1-px line of any aliased rule draws one pixel per step of its major axis, as

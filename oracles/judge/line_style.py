@@ -136,7 +136,9 @@ CANNOT_SHOW = {
     "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, not judged; an "
                    "end where lines meet; a line under 0.5 px wide (coverage_pixels: no drawn pixel at a tie)",
     "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other line's "
-            "width covers it); binary: a centre offset under 0.35 px (an even width leans half a pixel)",
+            "width covers it); binary: a centre offset under 0.35 px; an even width (2 px), whose lines may lean "
+            "half a pixel either side edge by edge: a move all its lines lean against, a half-pixel move "
+            "to better than 0.3-0.9 px when the ends are rounded to pixels (oracles.judge.even_lean)",
 }
 
 
