@@ -35,9 +35,12 @@ with each edge taking the choice nearest ``n . d`` (:func:`fit`): on a grid of
 times in 100 (:data:`EDGE_NOISE_PX2`, :data:`CHI2_2_P99`, over the case's
 effective number of edges), then refined by least squares with those choices.
 
-The fit replaces the symmetric band's measure only where it explains the
-edges' means better by :data:`LEAN_GAIN_PX2` (or where the edges are too few
-to test the symmetric band, :data:`MAX_UNTESTED_EDGES`): a renderer of
+The fit (``leaning``) explains the edges' means better than the symmetric band
+by :data:`LEAN_GAIN_PX2` (or the edges are too few to test the symmetric band,
+:data:`MAX_UNTESTED_EDGES`); it replaces the symmetric band's measure only
+where that one fails the case (an offset past the binary lines' 0.35 px or a
+warp past theirs: :meth:`oracles.judge.line_style.CaseStyle.geometry`,
+``geometry["lean"]["used"]``), the lean being the last explanation: a renderer of
 symmetric even bands, and every odd width, keep the measure of
 :mod:`oracles.judge.line_style` unchanged, so a symmetric band moved by half
 a pixel (which bands leaning with the move would explain at ``d = 0`` on

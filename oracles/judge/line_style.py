@@ -467,8 +467,11 @@ class CaseStyle:
         lean = even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"]) \
             if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0 else None
         if lean is not None:                            # an even band: each edge's lean chosen (even_lean)
-            geo["lean"] = {k: lean[k] for k in even_lean.REPORTED}
-            if lean["leaning"]:
+            from ..diagnosis.image_diagnose import SCALE_TOL_PX
+            held = np.max(np.abs(d - ref_d)) <= RULE_OFFSET_MAX_PX and (affine is None or np.percentile(warp, 99)
+                                                                        <= SCALE_TOL_PX + 0.5)   # judge()'s bounds
+            geo["lean"] = {**{k: lean[k] for k in even_lean.REPORTED}, "used": bool(lean["leaning"] and not held)}
+            if geo["lean"]["used"]:                     # the lean explains what the symmetric band cannot
                 d, ref_d, affine = lean["offset"], np.zeros(2), fit_lines(normal, lean["corrected"], point, self.centre)
                 warp = np.abs(fitted(affine, d))
         geo.update(offset_px=[float(v) for v in d - ref_d], bias_px=[float(v) for v in ref_d],
