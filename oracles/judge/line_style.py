@@ -12,7 +12,8 @@ Styles (:func:`classify`, from the images alone, pooled over a case's frames):
 
 - ``aliased``: binary pixels (one level), about one pixel across the line;
 - ``antialiased``: grey levels (coverage), about one pixel across;
-- ``wide``: :data:`WIDE_MIN_PX` or more across (binary or grey), up to ~3 px.
+- ``wide``: :data:`WIDE_MIN_PX` or more across (binary or grey), up to ~3 px; binary lines drawing
+  :data:`oracles.judge.even_lean.WIDE_PIXEL_RATIO` times the oracle's pixels too (2 px at least).
 
 The width is the median coverage across the line over the samples below (a
 1-px aliased line 0.71 to 1, a 1-px antialiased line 1, a 3-px line 3); with too
@@ -39,7 +40,9 @@ fractional position (a cube square-on) sit up to half a pixel off in every corre
 :func:`oracles.diagnosis.image_diagnose.quantisation_bias`; at an exact tie (a band edge on a pixel
 centre) either choice reads 0 (:func:`oracles.judge.line_ties.fold_ties`). Lines that the registration
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
-the windows, are not measured (the centroids would be of stray crossings).
+the windows, are not measured (the centroids would be of stray crossings). Binary lines of an even
+width may lean half a pixel either side, edge by edge: where the symmetric band fails them, each
+edge's lean is fitted with one offset for the case (:mod:`oracles.judge.even_lean`).
 
 Ends (:func:`oracles.judge.free_ends.measure_ends`): each free end's coverage along its line, where it
 falls to half the line's width; the median over a case's free ends is judged
