@@ -69,6 +69,8 @@ RENDERERS = {
     **{f"cv2 {t}": (partial(cv2_line, line_type=t), GL, {}) for t in ("LINE_8", "LINE_4", "LINE_AA")},
     # one typical mistake each
     "pillow 1px, half pixel": (pillow, GL, HALF),
+    "pillow 2px, half pixel": (partial(pillow, width=2), GL, HALF),
+    "pillow 3px, half pixel": (partial(pillow, width=3), GL, HALF),
     "pillow 4x supersampled, half pixel": (hd.draw_pillow_supersampled, GL, HALF),
     "matplotlib aa 1.0px, rows not flipped": (partial(mpl, linewidth_px=1.0), LOOKAT, {"flip_rows": False}),
     "matplotlib aa 1.5px, half pixel": (partial(mpl, linewidth_px=1.5, half_pixel=True), LOOKAT, {}),

@@ -211,6 +211,21 @@ def test_pillow_wide_lines_pass_on_f1_at_their_width(jobs, tmp_path, capsys, wid
     assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["reasons"], c["faults"])
     assert c["pixel_f1_1px"] < 0.999 <= c["pixel_f1_radius"]        # the radius decided: F1@1px alone fails
     assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.35
+    if width == 2:          # each edge's half-pixel lean taken out (oracles.judge.even_lean): measured (0.08, -0.09)
+        assert c["line_style"]["geometry"]["lean"]["leaning"]
+
+
+def test_pillow_2px_half_pixel_is_pixel_offset(jobs, tmp_path, capsys):
+    # Pillow width 2 with the viewport's -0.5 left out: each edge's band leans half a pixel (to the right of
+    # the direction drawn) and its ends are rounded after the move, 0 or 1 px each: the one offset fitted with
+    # each edge's lean (oracles.judge.even_lean) reads (0.63, 0.60), within 0.25 of (0.5, 0.5) (a mean over
+    # this case's 32 ends, each moved 0 or 1 px: SD 0.5 / sqrt(32) = 0.09 per axis, plus the leans' choice);
+    # the same renderer without the mistake passes (test_pillow_wide_lines_pass_on_f1_at_their_width)
+    rc, c = _judge(jobs, tmp_path, "slanted", partial(hd.draw_pillow, width=2), hd.project_gl, half_pixel=True)
+    assert rc == 1 and c["verdict"] == "fail" and c["line_style"]["geometry"]["lean"]["leaning"]
+    (f,) = c["faults"]
+    assert f["name"] == "pixel_offset" and f["measured_by"] == "line centroids", c["faults"]
+    assert f["dx"] == pytest.approx(0.5, abs=0.25) and f["dy"] == pytest.approx(0.5, abs=0.25)
 
 
 def test_cv2_line_8_end_ties_pass_on_geometry(jobs, tmp_path, capsys):
