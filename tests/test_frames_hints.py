@@ -47,3 +47,12 @@ def test_the_verdict_line_claims_f1_at_0px_only_where_it_judged():
     assert f1_0px_clause([case("aliased", "geometry")], 0.98).startswith("F1@0px reported, not judged")
     assert f1_0px_clause([case("aliased"), case("antialiased")], 0.98) == (
         "F1@0px >= 0.98 in the 1 case held to GL's pixel rule")
+
+
+def test_a_faults_list_of_floats_is_written_as_its_numbers():
+    """A per-axis value (``scale=[sx, sy]``) is written as each float is, not as Python's repr of the list."""
+    from wirecheck.oracles.reports.report import fault_text
+
+    text = fault_text([{"name": "unexplained", "scale": [0.622011633928914, 0.8000000000000003]}])
+    # four significant digits, trailing zeros dropped (oracles.reports.fmt.distinct): 0.6220 -> 0.622, 0.8000 -> 0.8
+    assert text == "unexplained(scale=[0.622, 0.8])", text

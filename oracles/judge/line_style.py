@@ -135,7 +135,8 @@ CAN_SHOW = {
             "missing or extra lines, where free ends stop (beyond the cap)",
 }
 CANNOT_SHOW = {
-    "aliased": "nothing the other styles show",
+    "aliased": "one line's own centre to a fraction of a pixel (a 1-px line is a choice of pixels: offsets "
+               "are pooled over the lines)",
     "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, not judged; an "
                    "end where lines meet; a line under 0.5 px wide (coverage_pixels: no drawn pixel at a tie)",
     "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other line's "
@@ -537,7 +538,7 @@ class CaseStyle:
                 faults.append({"name": "pixel_offset", "dx": float(d[0]), "dy": float(d[1]),
                                "uncertainty_px": float(np.max(np.abs(geo["bias_px"]))), "confidence": 1.0,
                                "residual_px": None, "measured_by": "line centroids"})
-                reasons.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {tol_px} "
+                reasons.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {tol_px:.3g} "
                                f"({style} lines, {geo['samples']} samples)")
             end = geo["end_px"]
             if geo["ends_measured"] >= MIN_ENDS and (end < -END_TOL_PX or end > read["width_px"] / 2 + END_TOL_PX):
@@ -551,7 +552,7 @@ class CaseStyle:
                                f"{-END_TOL_PX} to {read['width_px'] / 2 + END_TOL_PX:.2f} ({style} lines)")
             if warped:
                 reasons.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
-                               f"or shear > {warp_tol} ({style} lines)")
+                               f"or shear > {warp_tol:.3g} ({style} lines)")
         rs = self.raster
         if aliased and rs["differing"]:
             out["raster_rule"] = {

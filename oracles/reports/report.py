@@ -113,10 +113,20 @@ def fault_text(faults: list[dict], camera: dict | None = None) -> str:
     nominal = fault_nominals(camera)
     parts = []
     for f in faults:
-        extra = ", ".join(f"{k}={_param(v, nominal.get(k))}" if isinstance(v, float) else f"{k}={v}"
+        extra = ", ".join(f"{k}={_value(v, nominal.get(k))}"
                           for k, v in f.items() if k not in ("name", "hint") and v is not None)   # None: not implied
         parts.append(f"{f['name']}({extra})" if extra else f["name"])
     return "; ".join(parts)
+
+
+def _value(value, nominal: float | None) -> str:
+    """A fault field as text: a float by :func:`_param`, a list or tuple of floats each so (a per-axis
+    ``scale=[0.622, 0.8]``), anything else as it is."""
+    if isinstance(value, float):
+        return _param(value, nominal)
+    if isinstance(value, (list, tuple)) and value and all(isinstance(v, float) for v in value):
+        return "[" + ", ".join(_param(v, nominal) for v in value) + "]"
+    return f"{value}"
 
 
 def _param(value: float, nominal: float | None) -> str:
