@@ -88,10 +88,11 @@ def process_runs(pid: int) -> bool:
 
 
 @contextlib.contextmanager
-def no_block(seconds=5):
-    """Fail (instead of hanging the suite) when the block blocks: opening a FIFO waits for a writer forever."""
+def no_block(seconds=5, error=TimeoutError):
+    """Fail (instead of hanging the suite) when the block blocks: opening a FIFO waits for a writer forever.
+    ``error``: the exception raised then (a BaseException one the code under test cannot catch)."""
     def expire(*_):
-        raise TimeoutError(f"blocked for {seconds} s (a FIFO opened?)")
+        raise error(f"blocked for {seconds} s (a FIFO opened?)")
     old = signal.signal(signal.SIGALRM, expire)
     signal.alarm(seconds)
     try:

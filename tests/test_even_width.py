@@ -13,10 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PIL import Image, ImageDraw
-from test_line_style import _band, _fill, _judge, job_dir  # noqa: F401 - job_dir: the module's fixture
+from test_line_style import _band, _fill, _judge, draw_pillow, job_dir  # noqa: F401 - job_dir: the module's fixture
 
-from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.oracles.judge import even_lean
 from wirecheck.oracles.judge.line_style import RULE_OFFSET_MAX_PX
 
@@ -26,12 +24,7 @@ def draw_symmetric_2px(segs, w, h):
 
 
 def draw_pillow_2px(segs, w, h):
-    im = Image.new("L", (w, h), 0)
-    d = ImageDraw.Draw(im)
-    _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
-    for a, b in zip(q0, q1):
-        d.line([tuple(np.rint(a)), tuple(np.rint(b))], fill=255, width=2)
-    return np.asarray(im)
+    return draw_pillow(segs, w, h, width=2)
 
 
 def _without_longest(draw):

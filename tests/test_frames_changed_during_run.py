@@ -7,9 +7,7 @@ a frame in between. Each test makes that change between the check and the decodi
 
 from __future__ import annotations
 
-import contextlib
 import os
-import signal
 
 import pytest
 from PIL import Image
@@ -28,17 +26,8 @@ class Blocked(BaseException):
     for a frame's problem (helpers.no_block's TimeoutError would be read as one, after the wait)."""
 
 
-@contextlib.contextmanager
 def hang_guard(seconds):
-    def expire(*_):
-        raise Blocked(f"blocked for {seconds} s (a FIFO opened?)")
-    old = signal.signal(signal.SIGALRM, expire)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
+    return no_block(seconds, Blocked)
 
 
 def test_reading_a_fifo_named_like_a_frame_never_blocks(tmp_path):

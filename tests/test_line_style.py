@@ -58,12 +58,12 @@ def draw_wide(segs, w, h):
     return _band(segs, w, h, 1.5, 1)
 
 
-def draw_pillow(segs, w, h):
+def draw_pillow(segs, w, h, width=1):
     im = Image.new("L", (w, h), 0)
     d = ImageDraw.Draw(im)
     _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
     for a, b in zip(q0, q1):
-        d.line([tuple(np.rint(a)), tuple(np.rint(b))], fill=255, width=1)
+        d.line([tuple(np.rint(a)), tuple(np.rint(b))], fill=255, width=width)
     return np.asarray(im)
 
 
