@@ -157,7 +157,7 @@ def windows(segs: np.ndarray, shape) -> dict:
     drawing's). Along each segment long enough, at every integer step of its
     major axis :data:`GUARD_PX` clear of its ends and inside the image, a
     window across it (:data:`PROFILE_RADIUS_PX` each side); segment by segment,
-    each in ascending steps (oracles.judge.line_windows.windows: ``rows``, ``cols``,
+    each in ascending steps (oracles.judge.line_windows.windows: ``flat``,
     ``minor``, ``exact``, ``across``, and ``normal``, ``segment``, ``point`` as
     :func:`measure` returns them).
     """
@@ -180,7 +180,7 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     """
     r = PROFILE_RADIUS_PX
     wins = windows(segs, np.shape(cov)) if wins is None else wins
-    g = cov[wins["rows"], wins["cols"]] / level
+    g = np.reshape(cov, -1)[wins["flat"]] / level
     mass = g.sum(axis=1)
     centroid = (g * wins["minor"]).sum(axis=1) / np.maximum(mass, 1e-300)
     # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
