@@ -189,12 +189,11 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
            "segment": wins["segment"], "point": wins["point"], "mass": mass}
     windows_n = len(out["offset"])
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
-    keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
+    keep = np.flatnonzero((out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5))
+    found = len(keep)
+    if found > limit:                                   # evenly thinned: one gather of each field
+        keep = keep[np.linspace(0, found - 1, limit).round().astype(int)]
     out = {k: v[keep] for k, v in out.items()}
-    found = len(out["offset"])
-    if found > limit:
-        idx = np.linspace(0, found - 1, limit).round().astype(int)
-        out = {k: v[idx] for k, v in out.items()}
     out["windows"], out["found"] = windows_n, found
     return out
 
