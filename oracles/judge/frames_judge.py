@@ -32,7 +32,6 @@ import numpy as np
 from . import f1_radius, metrics
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
-from .sparse_pixels import flat_drawn
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (image_diagnose.MAX_POINTS_PER_CASE),
@@ -138,7 +137,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
                                 segs, (job_dir, job))
         core = _drawn(render_frame(p_model, edges, camera, m).image)
-        fp = metrics.FramePixels.from_indices(orac.shape, cand, flat_drawn(orac))
+        fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
         style.count_rule(fp, segs)
         ps = metrics.pixel_scores(None, None, pixels=fp)
         # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
@@ -183,7 +182,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
 
 def _drawn(image: np.ndarray) -> np.ndarray:
     """Ascending flat indices of the pixels of ``image`` that are >= 128."""
-    return flat_drawn(image, 128)
+    return np.flatnonzero(image.reshape(-1) >= 128)
 
 
 def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:

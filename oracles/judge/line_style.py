@@ -74,7 +74,6 @@ import numpy as np
 
 from . import coverage_pixels, line_ties, line_windows
 from .case_samples import CaseSamples
-from .sparse_pixels import flat_drawn
 from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
 
 STYLES = ("aliased", "antialiased", "wide")
@@ -339,7 +338,7 @@ class CaseStyle:
             grey = grey.astype(np.uint8) * 255
         segs = _segments(p_model, edges, camera, m) if segs is None else segs
         self.centre = np.array(camera.principal_point, dtype=float)
-        nonzero = flat_drawn(grey)                      # the pixels not 0, eight bytes at a time (sparse_pixels)
+        nonzero = np.flatnonzero(grey > 0)              # (numpy finds a bool array's nonzero faster than uint8's)
         drawn = grey.reshape(-1)[nonzero]
         # drawn where >= 128 (a bool image compares its True with 128: nothing)
         cand = nonzero[:0] if binary_input else nonzero[drawn >= 128]
