@@ -3,14 +3,16 @@
 Exports a job (every bundled scene, the seven cases, frames 1 and 4 of 6), draws
 it with each renderer of tests/clients/heldout_draw.py (Pillow, matplotlib's
 Agg, OpenCV, a Wu and a Bresenham line: drawing code of their own from the
-job's camera contract), correct and with one typical mistake, judges it with
+job's camera contract) and with GL's rule (core's raster, the reference
+aliased rule), correct and with typical mistakes (a half pixel, the FOV of the
+wrong axis, fx 3 % over fy, rows not flipped), judges it with
 ``crosscheck --candidate-frames`` and prints per renderer the verdicts and
 faults counted over the cases, the style read, the width, F1@0px against GL's
 rule, the largest measured centre offset, and the pixel offsets named.
 
     .venv/bin/python benchmarks/measure_heldout_frames.py [OUT] [--only NAME ...] [--cases] [--line-rule geometry]
 
-About 25 s a renderer on one core (10 minutes in all). Not part of CI.
+About 25 s a renderer on one core (15 minutes in all). Not part of CI.
 """
 
 from __future__ import annotations
@@ -35,6 +37,23 @@ from wirecheck.oracles.cli import main  # noqa: E402
 mpl, cv2_line, pillow = hd.draw_matplotlib, hd.draw_cv2, hd.draw_pillow
 GL, LOOKAT = hd.project_gl, hd.project_lookat
 HALF = {"half_pixel": True}
+ASPECT = {"aspect": 1.03}
+
+
+def draw_gl_rule(segs, w, h):
+    """GL's rule: wirecheck core's exact line raster (the pixels pyrender draws for these lines), white on black."""
+    import numpy as np
+
+    from wirecheck.core.projector.clipping import clip_to_image
+    from wirecheck.core.projector.raster import line_pixels
+
+    img = np.zeros((h, w), np.uint8)
+    segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
+    _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h)
+    rr, cc = line_pixels(q0, q1, w, h)
+    img[rr, cc] = 255
+    return img
+
 
 #: name -> (drawer, projection, mistake)
 RENDERERS = {
@@ -50,6 +69,8 @@ RENDERERS = {
     **{f"cv2 {t}": (partial(cv2_line, line_type=t), GL, {}) for t in ("LINE_8", "LINE_4", "LINE_AA")},
     # one typical mistake each
     "pillow 1px, half pixel": (pillow, GL, HALF),
+    "pillow 2px, half pixel": (partial(pillow, width=2), GL, HALF),
+    "pillow 3px, half pixel": (partial(pillow, width=3), GL, HALF),
     "pillow 4x supersampled, half pixel": (hd.draw_pillow_supersampled, GL, HALF),
     "matplotlib aa 1.0px, rows not flipped": (partial(mpl, linewidth_px=1.0), LOOKAT, {"flip_rows": False}),
     "matplotlib aa 1.5px, half pixel": (partial(mpl, linewidth_px=1.5, half_pixel=True), LOOKAT, {}),
@@ -57,6 +78,15 @@ RENDERERS = {
     "bresenham, FOV of the wrong axis": (hd.draw_bresenham, LOOKAT, {"fov_axis": "x"}),
     "cv2 LINE_8, FOV of the wrong axis": (partial(cv2_line, line_type="LINE_8"), LOOKAT, {"fov_axis": "x"}),
     "cv2 LINE_AA, half pixel": (partial(cv2_line, line_type="LINE_AA"), GL, HALF),
+    # fx 3 % over fy: an aspect mistake drawn by GL's rule and by the rules that round the ends
+    "gl rule (core)": (draw_gl_rule, LOOKAT, {}),
+    "gl rule (core), aspect 1.03": (draw_gl_rule, LOOKAT, ASPECT),
+    "gl rule (core), half pixel": (draw_gl_rule, GL, HALF),
+    "gl rule (core), FOV of the wrong axis": (draw_gl_rule, LOOKAT, {"fov_axis": "x"}),
+    "pillow 1px, FOV of the wrong axis": (pillow, LOOKAT, {"fov_axis": "x"}),
+    "bresenham, aspect 1.03": (hd.draw_bresenham, LOOKAT, ASPECT),
+    "cv2 LINE_8, aspect 1.03": (partial(cv2_line, line_type="LINE_8"), LOOKAT, ASPECT),
+    "pillow 1px, aspect 1.03": (pillow, LOOKAT, ASPECT),
 }
 
 

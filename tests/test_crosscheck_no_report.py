@@ -56,7 +56,6 @@ def test_no_report_still_writes_the_junit_file(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("clash, named", [(("--report-dir", "r"), "--report-dir"), (("--run", "x"), "--run"),
                                           (("--sweep",), "--sweep"), (("--suite", "extremes"), "--suite"),
-                                          (("--candidate-frames", "job"), "--candidate-frames"),
                                           (("--run", "x", "--report-dir", "r"), "--report-dir, --run")])
 def test_no_report_with_a_report_option_is_one_line_exit_2(tmp_path, monkeypatch, capsys, clash, named):
     monkeypatch.chdir(tmp_path)
@@ -66,3 +65,25 @@ def test_no_report_with_a_report_option_is_one_line_exit_2(tmp_path, monkeypatch
     assert captured.err == (f"crosscheck: error: --no-report with {named}: --no-report writes no report folder; "
                             "expected one or the other (--junit-xml is still written with --no-report)\n")
     assert _listing(tmp_path) == []
+
+
+@pytest.mark.parametrize("drawn, status", [(True, 0),    # core's frames: a correct renderer
+                                           (False, 1)])  # black frames: nothing drawn, a fail
+def test_no_report_judges_a_frames_job_and_writes_only_the_junit_file(tmp_path, monkeypatch, capsys, drawn, status):
+    """A CI gate on a renderer's frames wants the exit status alone: the job is judged, its table and verdict
+    printed, and nothing written but ``--junit-xml`` (the job's own files untouched)."""
+    import helpers
+
+    job = helpers.blank_job(tmp_path / "job")
+    if drawn:
+        helpers.fill_job(job)
+    monkeypatch.chdir(tmp_path)
+    before = _listing(tmp_path)
+    capsys.readouterr()
+    assert cli.main(["--candidate-frames", "job", "--no-report", "--junit-xml", "j.xml"]) == status
+    assert _listing(tmp_path) == sorted(before + ["j.xml"])
+    out = capsys.readouterr().out.splitlines()
+    assert out[-1] == "Report: none written (--no-report)"
+    assert any(line.startswith("PASS:" if drawn else "FAIL:") for line in out)
+    failures = [c for c in ET.parse(tmp_path / "j.xml").getroot().iter("testcase") if c.find("failure") is not None]
+    assert len(failures) == (0 if drawn else 1)

@@ -101,3 +101,10 @@ def test_the_style_note_says_the_radius():
         "Line style read: wide (2 cases, 1.83-3.00 px wide, --line-rule gl): judged by the centres; "
         f"F1 at up to 2 px (the width); cannot show {CANNOT_SHOW['wide']}"]
     assert "F1 at up to" not in summary_lines([case(1.0, 1)])[0]
+
+
+def test_radius_takes_the_band_read_from_the_pixel_count():
+    # binary lines read wide by their pixel count (1.5x the oracle's, band_px 2: oracles.judge.even_lean), with
+    # a median width of 0.99 (Pillow's width 2 near an axis): n = 2 pixels across -> 1 + ceil(1/2) = 2, not 1
+    assert f1_radius.radius_px({"style": "wide", "width_px": 0.99, "band_px": 2}) == 2
+    assert f1_radius.radius_px({"style": "wide", "width_px": 0.99}) == 1

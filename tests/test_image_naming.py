@@ -55,8 +55,9 @@ def test_the_oracles_bias_would_have_named_an_offset(monkeypatch):
     assert np.all(np.abs(oracle_bias) < 0.1) and np.all(np.abs(model_bias - 0.48) < 0.05)
     assert np.max(np.abs(model_bias - oracle_bias)) > OFFSET_TOL_PX
     monkeypatch.setattr(image_diagnose, "quantisation_bias", lambda segs, cam, p=None, d=None: bias(segs, cam))
-    # axis-aligned lines are the same pixels under either aliased rule (rule_bias may read either): GL's here
-    monkeypatch.setattr(image_naming, "rule_bias", lambda *args: ("gl", args[-1]))
+    # axis-aligned lines are the same pixels under either aliased rule (read_rules may read either or both):
+    # GL's alone here
+    monkeypatch.setattr(image_naming, "read_rules", lambda *args: {"gl": args[-1]})
     assert "pixel_offset" in [f["name"] for f in diagnose_images(CAND, SEGS, CAM)]
 
 
@@ -112,3 +113,44 @@ def test_a_swap_about_the_principal_point_is_no_offset():
     swapped = (segs - [CX, CY])[:, :, ::-1] + [CX, CY]
     got = diagnose_images([_draw(swapped)] * 2, [segs] * 2, CAM)
     assert [f["name"] for f in got] == ["axis_swap"], got
+
+
+def test_a_scale_stands_against_every_rule_read():
+    # oracles.diagnosis.rule_read: under the rule that rounds the ends a scale must move the farthest pixel by
+    # more than the tolerance plus half a pixel (0.5 + 0.5 px here). Hand-derived at a reach of 100 px per axis:
+    # scales (1, 1.006) make an aspect of 0.006 x 100 = 0.6 px and move y's farthest pixel by 0.6 px (a FOV);
+    # (1, 1.012): 1.2 px each
+    from wirecheck.oracles.diagnosis.diagnose import scale_faults
+    from wirecheck.oracles.diagnosis.rule_read import standing_scale_faults
+
+    reach, tol = np.array([100.0, 100.0]), 0.5
+    for d, under_gl, under_both in (((1.0, 1.006), ["aspect_mismatch", "fov_mismatch"], []),
+                                    ((1.0, 1.012), ["aspect_mismatch", "fov_mismatch"],
+                                     ["aspect_mismatch", "fov_mismatch"])):
+        named = scale_faults(d[0], d[1], reach, tol, CAM)
+        assert [f["name"] for f in named] == under_gl
+        gl_only = standing_scale_faults(named, np.array(d), reach, tol, CAM, {"gl": np.zeros(2)})
+        assert [f["name"] for f in gl_only] == under_gl
+        for rules in ({"snapped": np.zeros(2)}, {"gl": np.zeros(2), "snapped": np.zeros(2)}):
+            got = standing_scale_faults(named, np.array(d), reach, tol, CAM, rules)
+            assert [f["name"] for f in got] == under_both
+
+
+@pytest.mark.parametrize("gl_cost, snapped_cost, read", [
+    (0.361, 0.368, ["gl", "snapped"]),        # Bresenham's wrong-axis FOV, prism / wide_fov: 2 % apart, a tie
+    (0.374, 0.485, ["gl", "snapped"]),        # LINE_8, pyramid / non_square: 30 %, still a tie (the margin's case)
+    (0.300, 0.401, ["gl"]),                   # 34 % > 1/3: GL's alone
+    (0.401, 0.300, ["snapped"]),              # and the rounded ends' alone
+    (0.300, 0.399, ["gl", "snapped"]),        # 33 % < 1/3: a tie
+])
+def test_two_rules_are_read_within_the_tie_margin(monkeypatch, gl_cost, snapped_cost, read):
+    # read_rules reads one rule only when the other's cost exceeds it by more than RULE_TIE (1/3) of it
+    # (rule_read's docstring: above the largest misread measured, 30 %); the closer rule first
+    from wirecheck.oracles.diagnosis import rule_read
+
+    snapped_bias, gl_bias = np.array([0.2, -0.1]), np.array([0.01, 0.02])
+    monkeypatch.setattr(rule_read, "_costs", lambda *args: (snapped_bias, gl_cost, snapped_cost))
+    got = rule_read.read_rules(None, None, CAM, np.eye(2), np.ones(2), np.zeros(2), gl_bias)
+    assert sorted(got) == sorted(read) and next(iter(got)) == read[0 if gl_cost < snapped_cost else -1]
+    for rule, bias in got.items():
+        np.testing.assert_array_equal(bias, gl_bias if rule == "gl" else snapped_bias)

@@ -51,7 +51,8 @@ def test_grey8_reads_as_pillow_does(tmp_path, mode, interlace, size):
         Image.fromarray(pixels, mode).save(path)           # Pillow's adaptive filters: Sub, Up, Paeth rows
     assert Image.open(path).info.get("interlace", 0) == interlace
     want = np.asarray(Image.open(path).convert("L"))
-    got = _decode_grey8(path, w, h)
+    with open(path, "rb") as fh:
+        got = _decode_grey8(fh, w, h)
     assert got.dtype == np.uint8 and got.shape == (h, w) and np.array_equal(got, want)
     assert np.array_equal(read_grey(path, w, h), want)
 
@@ -59,6 +60,8 @@ def test_grey8_reads_as_pillow_does(tmp_path, mode, interlace, size):
 def test_other_modes_are_left_to_the_general_path(tmp_path):
     path = tmp_path / "f.png"
     Image.fromarray(np.zeros((4, 5, 4), np.uint8), "RGBA").save(path)
-    assert _decode_grey8(path, 5, 4) is None
+    with open(path, "rb") as fh:
+        assert _decode_grey8(fh, 5, 4) is None
     Image.fromarray(np.zeros((4, 5), np.uint8), "L").save(path)
-    assert _decode_grey8(path, 4, 5) is None                # not the size asked for
+    with open(path, "rb") as fh:
+        assert _decode_grey8(fh, 4, 5) is None              # not the size asked for

@@ -248,7 +248,12 @@ lines up to ~3 px wide cannot follow that rule; they are judged by where each
 line's centre lies (to a fraction of a pixel), and the report says which style
 it read. Aliased lines of another rule (Pillow's ImageDraw.line, TinyGL) fail
 the 0-px F1 as `raster_rule`; `crosscheck --candidate-frames DIR --line-rule
-geometry` judges their geometry only.
+geometry` judges their geometry only. A line is judged where it is drawn: a
+renderer that moves lines onto pixel centres is held to that move. matplotlib
+does so by default for horizontal and vertical lines (`snap`): draw with
+`snap=False`, or square-on frames read as a `pixel_offset` of up to half a pixel.
+Pillow's ImageDraw truncates float coordinates: give it rounded ones, or its
+lines read as `pixel_offset` (-0.5, -0.5).
 
 """ + short_job_note(job)
 

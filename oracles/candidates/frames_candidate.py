@@ -22,6 +22,7 @@ import numpy as np
 from wirecheck.core.errors import InputError
 
 from .export import JOB_KIND, JOB_VERSION, frame_name
+from .job_as_exported import camera_file_problem, camera_keys_problem, job_keys_problem
 from .png_frame import FrameProblem, check_png, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
 
 #: Problem lines shown before "... and N more".
@@ -74,11 +75,11 @@ def load_job(job_dir: Path) -> dict:
         raise FramesError([f"{path}: unreadable ({exc}): expected the JSON 'crosscheck export' wrote"]) from None
     if not isinstance(job, dict) or job.get("kind") != JOB_KIND:
         raise FramesError([f"{path}: not a wirecheck frames job (kind {job.get('kind') if isinstance(job, dict) else None!r})"])
-    if job.get("version") != JOB_VERSION:
+    if job.get("version") != JOB_VERSION or not _is_int(job.get("version")):
         raise FramesError([f"{path}: job version {job.get('version')!r}: expected {JOB_VERSION} (export it again)"])
     if not job.get("cases"):
         raise FramesError([f"{path}: the job lists no frames: nothing to judge"])
-    problem = _job_problem(job)
+    problem = job_keys_problem(job) or _job_problem(job)
     if problem is not None:
         raise FramesError([f"{path}: {problem} (export the job again)"])
     return job
@@ -177,7 +178,8 @@ def _walk(frames_dir: Path) -> list[Path]:
             n += 1
             if n > MAX_WALK:
                 raise FramesError([f"{frames_dir}: more than {MAX_WALK:,} files and folders: expected the "
-                                   "job's frames (frames/<scene>/<case>/frame_NNNN.png)"])
+                                   f"job's frames (frames/<scene>/<case>/frame_NNNN.png); the walk was in {folder} "
+                                   "(a link to a folder elsewhere?)"])
             try:
                 is_dir = item.is_dir()
             except OSError:
@@ -255,7 +257,9 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``.
 
     FramesError (file:line) for a record that is not as export writes it: 3
-    finite coordinates, 2 indices of vertices before it.
+    finite coordinates, 2 indices of vertices before it; ``f`` faces (not
+    judged, but a renderer may read them) of 3 or more such indices; nothing
+    but ``v``, ``l``, ``f`` and ``#`` comments.
     """
     verts, edges = [], []
     problem = file_problem(path)
@@ -276,7 +280,14 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
                 edges.append([int(x) - 1 for x in parts[1:]])
                 if len(parts) != 3 or not all(0 <= i < len(verts) for i in edges[-1]):
                     raise ValueError
-        except ValueError:
+            elif parts and not parts[0].startswith("#"):
+                face = [int(x) - 1 for x in parts[1:] if x.lstrip("-").isdigit()] if parts[0] == "f" else []
+                if len(face) < max(3, len(parts) - 1) or not all(0 <= i < len(verts) for i in face):
+                    raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'f I J K ...' (3 or more "
+                                       f"of 1..{len(verts)}), 'v', 'l' or a '#' comment, as 'crosscheck export' wrote"])
+        except ValueError as exc:
+            if isinstance(exc, FramesError):
+                raise
             raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
                                f"(1..{len(verts)}), as 'crosscheck export' wrote"]) from None
     return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
@@ -296,6 +307,13 @@ def _frame_camera(path: Path, cache: dict | None = None):
         raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])
     try:
         cam_json = read_json(path)
+    except (OSError, ValueError, RecursionError) as exc:
+        raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {exc}): expected the camera JSON "
+                           "'crosscheck export' wrote"]) from None
+    problem = camera_keys_problem(cam_json)
+    if problem is not None:
+        raise FramesError([f"{path}: {problem} (export the job again)"])
+    try:
         if cache is not None and cache.get("camera_json") == cam_json["camera"]:
             camera = cache["camera"]
         else:
@@ -309,7 +327,7 @@ def _frame_camera(path: Path, cache: dict | None = None):
         what = f"no {exc}" if isinstance(exc, KeyError) else str(exc)
         raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {what}): expected the camera JSON "
                            "'crosscheck export' wrote"]) from None
-    return camera, m
+    return camera, m, cam_json
 
 
 def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache: dict | None = None):
@@ -331,13 +349,17 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
         raise FramesError([f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
                            f"{row['edges']} (job.json's; the file was changed or cut short)"])
     path = job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}"
-    camera, m = _frame_camera(path, cache)
+    camera, m, cam_json = _frame_camera(path, cache)
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     if (camera.width, camera.height) != (c["width"], c["height"]):     # the frames were read at the job's size
         size = f"{camera.width}x{camera.height}"
         raise FramesError([f"{path}: camera {size[:40]}{'...' if len(size) > 40 else ''}: expected "
                            f"{c['width']}x{c['height']} "
                            f"(job.json's size of {scene} / {case}; export the job again)"])
+    problem = camera_file_problem(cam_json, camera, m, job, scene, case, k)     # as export wrote it, in every form
+    if problem is not None:
+        raise FramesError([f"{path}: {problem} (what 'crosscheck export' writes for this file's camera and "
+                           "model matrix: the file was edited; export the job again)"])
     return p_model, edges, camera, m
 
 

@@ -65,12 +65,42 @@ def file_problem(path: Path) -> str | None:
         return "a broken link" if os.path.islink(path) else "missing"
     except OSError as exc:          # a link loop, a name too long
         return f"unreadable ({escape_controls(exc.strerror or exc)})"
+    return _kind_problem(mode)
+
+
+def _kind_problem(mode: int) -> str | None:
+    """``"a FIFO, not a regular file"`` and the like for a file mode that is not a regular file's; None for one."""
     if stat.S_ISREG(mode):
         return None
     kind = ("a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
             "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else
             "not a file")
     return f"{kind}, not a regular file"
+
+
+def open_frame(path: Path):
+    """``path`` opened for reading, as a binary file, when it is a regular file; FrameProblem otherwise.
+
+    The file is opened without blocking and checked through its descriptor: a
+    frame can be replaced between the job's check and its decoding (a renderer
+    still writing, a FIFO put there), and opening a FIFO by name would wait for
+    a writer forever. Every read of a frame's header and pixels goes through
+    one such file: they see one file, whatever happens to the name meanwhile.
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise FrameProblem("a broken link" if os.path.islink(path) else "missing") from None
+    except OSError as exc:
+        raise FrameProblem(f"unreadable ({escape_controls(exc.strerror or exc)})") from None
+    try:
+        problem = _kind_problem(os.fstat(fd).st_mode)
+        if problem is not None:
+            raise FrameProblem(problem)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
 
 
 def _chunk_name(kind: bytes) -> str:
@@ -150,23 +180,26 @@ def read_header(fh) -> dict:
     return info
 
 
-def _other_format(path: Path) -> str:
+def _other_format(fh) -> str:
     from PIL import Image
 
     try:
-        with Image.open(path) as im:
+        fh.seek(0)
+        with Image.open(fh) as im:
             return f"a {escape_controls(im.format)} image: expected a PNG"
     except Exception:            # noqa: BLE001 - Pillow's many ways to say "not an image"
         return "unreadable as PNG (no PNG signature, nor another image format): expected a PNG"
 
 
-def _decode(path: Path, rawmode: str | None = None):
-    """Pillow's decoding of the pixels; with ``rawmode``, the image's samples unpacked that way instead."""
+def _decode(fh, rawmode: str | None = None):
+    """Pillow's decoding of the pixels of the open file ``fh`` (:func:`open_frame`); with ``rawmode``, the
+    image's samples unpacked that way instead."""
     from PIL import Image
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked before
-        with Image.open(path) as im:
+        fh.seek(0)
+        with Image.open(fh) as im:
             if rawmode is not None:
                 tiles = []
                 for t in im.tile:
@@ -179,9 +212,10 @@ def _decode(path: Path, rawmode: str | None = None):
             return im.mode, np.asarray(im)
 
 
-def _decode_grey8(path: Path, width: int, height: int) -> np.ndarray | None:
-    """An 8-bit grey or RGB frame's luminance ``(H, W)`` uint8, Pillow's decoding and Pillow's RGB -> L
-    (:func:`_luminance`'s); None when Pillow opens it as another mode or size (the general path reads it).
+def _decode_grey8(fh, width: int, height: int) -> np.ndarray | None:
+    """An 8-bit grey or RGB frame's luminance ``(H, W)`` uint8 from the open file ``fh`` (:func:`open_frame`),
+    Pillow's decoding and Pillow's RGB -> L (:func:`_luminance`'s); None when Pillow opens it as another
+    mode or size (the general path reads it).
 
     Pillow decodes an ``L`` frame straight into the array that is returned, and
     an ``RGB`` frame's ``L`` is copied into it (``map_buffer``: Pillow's image
@@ -193,7 +227,8 @@ def _decode_grey8(path: Path, width: int, height: int) -> np.ndarray | None:
     map_buffer = getattr(Image.core, "map_buffer", None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked before
-        with Image.open(path) as im:
+        fh.seek(0)
+        with Image.open(fh) as im:
             if im.mode not in ("L", "RGB") or im.size != (width, height):
                 return None
             if map_buffer is None:                                          # a Pillow without it: copied out
@@ -211,11 +246,11 @@ def _decode_grey8(path: Path, width: int, height: int) -> np.ndarray | None:
             return out
 
 
-def _samples(path: Path, info: dict) -> tuple[np.ndarray, np.ndarray | None]:
+def _samples(fh, info: dict) -> tuple[np.ndarray, np.ndarray | None]:
     """``(samples, alpha8)``: the file's samples at full depth ((H, W) grey/index or (H, W, 3) RGB; for grey +
     alpha and RGBA their 8-bit reduction) and the 8-bit alpha of the types that carry one (None otherwise)."""
     colour, depth = info["colour"], info["depth"]
-    mode, pixels = _decode(path)
+    mode, pixels = _decode(fh)
     if colour == 0:
         if depth == 1:
             return pixels.astype(np.uint16), None
@@ -230,7 +265,7 @@ def _samples(path: Path, info: dict) -> tuple[np.ndarray, np.ndarray | None]:
         if depth == 16:                                # Pillow keeps the high bytes; tRNS needs the low ones
             rgb = rgb << 8
             if info["trns"] is not None:
-                rgb |= _decode(path, "RGB;16L")[1][..., :3].astype(np.uint16)
+                rgb |= _decode(fh, "RGB;16L")[1][..., :3].astype(np.uint16)
         return rgb, None
     # grey + alpha, RGBA: Pillow's 8-bit reduction (the high byte of 16-bit samples); 16-bit grey + alpha
     # comes as RGBA with the grey in R, G and B (its luminance is that grey: Pillow's weights sum to 1)
@@ -264,13 +299,18 @@ def read_png(path: Path, width: int, height: int) -> np.ndarray:
 def check_png(path: Path, width: int, height: int) -> dict:
     """The checks of :func:`read_grey` made before a pixel is decoded (signature, chunks, the camera's size):
     the header's ``{width, height, depth, colour, palette, trns}``; FrameProblem otherwise."""
-    with open(path, "rb") as fh:
-        try:
-            info = read_header(fh)
-        except FrameProblem as exc:
-            if str(exc) == "not a PNG":
-                raise FrameProblem(_other_format(path)) from None
-            raise
+    with open_frame(path) as fh:
+        return _check_header(fh, width, height)
+
+
+def _check_header(fh, width: int, height: int) -> dict:
+    """:func:`check_png` on the open file ``fh``."""
+    try:
+        info = read_header(fh)
+    except FrameProblem as exc:
+        if str(exc) == "not a PNG":
+            raise FrameProblem(_other_format(fh)) from None
+        raise
     if (info["width"], info["height"]) != (width, height):
         raise FrameProblem(f"size {info['width']}x{info['height']}: expected {width}x{height} (the camera's)")
     return info
@@ -285,14 +325,20 @@ def read_grey(path: Path, width: int, height: int) -> np.ndarray:
     camera's size is expected. The size is checked before any pixel is decoded
     (a huge image costs nothing).
     """
-    info = check_png(path, width, height)
+    with open_frame(path) as fh:                 # one file for the header and the pixels
+        info = _check_header(fh, width, height)
+        return _grey(fh, info, width, height)
+
+
+def _grey(fh, info: dict, width: int, height: int) -> np.ndarray:
+    """:func:`read_grey`'s pixels from the open file ``fh`` whose header ``info`` was checked."""
     colour, depth, trns = info["colour"], info["depth"], info["trns"]
     try:
         if trns is None and depth == 8 and colour in (0, 2):    # 8-bit grey or RGB, opaque: the samples' L
-            grey = _decode_grey8(path, width, height)
+            grey = _decode_grey8(fh, width, height)
             if grey is not None:
                 return grey
-        samples, alpha8 = _samples(path, info)
+        samples, alpha8 = _samples(fh, info)
     except FrameProblem:
         raise
     except Exception as exc:     # noqa: BLE001 - a damaged stream (CRC, zlib, truncated): Pillow's message

@@ -20,7 +20,9 @@ reads the faults off the winner, and says what the images cannot decide:
   0.75 FOV fault), which is no ``pixel_offset``. The drawing's aliased rule is
   the one read from the candidate's pixels (:func:`rule_bias`): GL's, or one that
   rounds the ends to pixel centres first (Bresenham, OpenCV's LINE_8), whose
-  rounded ends have a bias of their own.
+  rounded ends have a bias of their own; when the pixels fit both rules' lines
+  alike (:mod:`oracles.diagnosis.rule_read`), the offset must stand against both
+  biases, and a scale against both rules' tolerances.
 * **Confidence of each fault.** ``1 - cost / cost without it``: a permutation
   (or ``ambiguous``) against the identity's fit, a scale against the unit scale
   (``fov_mismatch``) or equal scales (``aspect_mismatch``), an offset against
@@ -38,6 +40,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from .rule_read import read_rules, standing_scale_faults
 
 __all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales", "rule_bias", "rule_off_diagonal"]
 
@@ -101,6 +105,15 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
         else:
             faults += [{"name": n, **common} for n in names]
     scale = scale_faults(float(d[0]), float(d[1]), reach, scale_tol, camera, confidence=0.0, residual_px=residual)
+    rules = {}                                    # the aliased rules the pixels may follow (rule_read), read once
+
+    def read():
+        if not rules:
+            rules.update(read_rules(cand_images, oracle_segs, camera, p, d, b, bias_fn(oracle_segs, camera, p, d)))
+        return rules
+
+    if scale and cand_images is not None:        # a scale the rounded ends' own would explain is no fault
+        scale = standing_scale_faults(scale, d, reach, scale_tol, camera, read())
     for f in scale:
         undo = np.eye(2) if f["name"] == "fov_mismatch" else np.diag([d[1], d[1]])
         f["confidence"] = _confidence(cost, reg.cost(p, undo, b))
@@ -112,13 +125,15 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
         expected = np.array([allowed[np.argmin(np.abs(allowed - b[i]))] for i in range(2)])
     off = b - expected
     bias = bias_fn(oracle_segs, camera, p, d)
-    rule = "gl"
+    rule, read_as = "gl", ["gl"]
     if np.max(np.abs(off - bias)) > offset_tol and cand_images is not None:
-        rule, bias = rule_bias(cand_images, oracle_segs, camera, p, d, b, bias)   # another rule's own bias?
+        # another rule's own bias? The offset stands only against every rule read: the one explaining most
+        read_as = list(read())
+        rule, bias = min(read().items(), key=lambda kv: np.max(np.abs(off - kv[1])))
     if np.max(np.abs(off - bias)) > offset_tol:
         faults.append({"name": "pixel_offset", "confidence": _confidence(cost, reg.cost(p, a, expected + bias)),
                        "residual_px": residual, "dx": float(off[0]), "dy": float(off[1]),
-                       "uncertainty_px": float(np.max(np.abs(bias))), "bias_rule": rule})
+                       "uncertainty_px": float(np.max(np.abs(bias))), "bias_rule": rule, "rules_read": read_as})
     return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
 
 
@@ -216,16 +231,6 @@ def _model_lines(oracle_segs, camera, p, d, shift, snapped: bool) -> list[np.nda
     return out
 
 
-def _lines_cost(cand_images, lines, camera) -> float:
-    """The registration's cost of the candidate's pixels against ``lines`` as they are (no fit)."""
-    from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
-
-    limit = _points_per_frame(len(lines), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
-    reg = _Registration(_frames(cand_images, lines, camera, limit), camera.width, camera.height,
-                        np.array(camera.principal_point))
-    return reg.cost(np.eye(2), np.eye(2), np.zeros(2))
-
-
 #: Shifts (px) about the snapped rule's line position at which its ends are rounded: the fitted offset's
 #: own error (~0.01 px pooled) decides the rounding of ends that fall on a half pixel (an orthographic
 #: view scaled by 4/3 puts many there), so each axis is tried at the position and 0.02 px either side.
@@ -246,14 +251,13 @@ def rule_bias(cand_images, oracle_segs, camera, p, d, b, gl_bias) -> tuple[str, 
     best of :data:`_JITTER`'s positions). The rule
     whose lines the candidate's pixels fit closer (the registration's cost) is
     the one read: a GL-rule renderer with a half-pixel offset lies on its
-    exact lines, so its offset is still measured against GL's bias.
+    exact lines, so its offset is still measured against GL's bias. When the
+    two costs are too close to say, both rules are read
+    (:func:`oracles.diagnosis.rule_read.read_rules`); this is the closer one.
     """
-    snapped_bias = quantisation_bias(oracle_segs, camera, p, d, snapped=True)
-    gl = _lines_cost(cand_images, _model_lines(oracle_segs, camera, p, d, b, False), camera)
     # the renderer's lines are known to the fit's precision; ends at a half pixel round either way under it
-    snapped = min(_lines_cost(cand_images, _model_lines(oracle_segs, camera, p, d, b - snapped_bias + step, True),
-                              camera) for step in _JITTER)
-    return ("snapped", snapped_bias) if snapped < gl else ("gl", np.asarray(gl_bias))
+    rule, bias = next(iter(read_rules(cand_images, oracle_segs, camera, p, d, b, gl_bias).items()))
+    return rule, bias
 
 
 def rule_off_diagonal(cand_images, oracle_segs, camera, fit, a_free, reach, off_diagonal) -> float:
@@ -265,19 +269,21 @@ def rule_off_diagonal(cand_images, oracle_segs, camera, fit, a_free, reach, off_
     finds a shear of its own in them (0.35 px measured on a quarter-turn
     pyramid given a 4/3 FOV, where GL's rule leaves <= 0.04 px). The same
     fit on the model's lines drawn by that rule gives that shear; what is left
-    is the candidate's. Under GL's rule ``off_diagonal`` is returned as it is.
+    is the candidate's. Under GL's rule ``off_diagonal`` is returned as it is;
+    with both rules read (a tie), the smaller of the two: it must stand against both.
     """
     from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
 
     p, a, b = fit
     d = np.diag(a)
-    rule, bias = rule_bias(cand_images, oracle_segs, camera, p, d, b, quantisation_bias(oracle_segs, camera, p, d))
-    if rule == "gl":
+    rules = read_rules(cand_images, oracle_segs, camera, p, d, b, quantisation_bias(oracle_segs, camera, p, d))
+    if "snapped" not in rules:
         return off_diagonal
-    images = _model_images(oracle_segs, camera, p, d, b - bias, snapped=True)
+    images = _model_images(oracle_segs, camera, p, d, b - rules["snapped"], snapped=True)
     limit = _points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
     reg = _Registration(_frames(images, oracle_segs, camera, limit), camera.width, camera.height,
                         np.array(camera.principal_point))
     own, _b, _cost = reg.fit(p, a, b, affine=True)
     left = np.asarray(a_free) - own
-    return float(max(abs(left[0, 1]) * reach[1], abs(left[1, 0]) * reach[0]))
+    snapped = float(max(abs(left[0, 1]) * reach[1], abs(left[1, 0]) * reach[0]))
+    return min(snapped, off_diagonal) if "gl" in rules else snapped     # it stands against every rule read

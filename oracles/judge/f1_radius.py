@@ -38,12 +38,13 @@ def radius_px(read: dict) -> int:
     """The F1 radius (px) for a case's style read (``CaseStyle.classify()``: ``style``, ``width_px``).
 
     ``aliased``: 1 (F1@1px, as for every 1-px line). ``wide`` or ``antialiased``:
-    ``1 + ceil((n - 1) / 2)`` with ``n = round(width_px)`` at least 1 (module
+    ``1 + ceil((n - 1) / 2)`` with ``n = round(width_px)`` at least 1, and at least ``band_px`` where the
+    read has it (lines read wide by their pixel count, not their median width: 2; module
     docstring), at most :data:`MAX_RADIUS_PX`.
     """
     if read.get("style") == "aliased":
         return 1
-    n = max(int(math.floor(float(read.get("width_px") or 0.0) + 0.5)), 1)
+    n = max(int(math.floor(float(read.get("width_px") or 0.0) + 0.5)), int(read.get("band_px") or 1), 1)
     return min(1 + math.ceil((n - 1) / 2), MAX_RADIUS_PX)
 
 

@@ -30,8 +30,10 @@ from pathlib import Path
 import numpy as np
 
 from . import f1_radius, metrics
+from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
+from .dim_lines import name_dim_lines
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (image_diagnose.MAX_POINTS_PER_CASE),
@@ -43,7 +45,7 @@ LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count
 
 
 def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarray, frame: tuple,
-                     segs: np.ndarray | None = None, job=None) -> np.ndarray:
+                     segs: np.ndarray | None = None, job=None, grey: np.ndarray | None = None) -> np.ndarray:
     """The pixels a frame file draws, as ascending flat indices ``y W + x``: what the judge compares with the oracle's.
 
     Every frame of the frames path goes through here, once: its grey levels
@@ -52,9 +54,11 @@ def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarra
     measured against ``frame`` = ``(p_model, edges, camera, model_matrix)``
     and its oracle segments ``segs``), and the pixels compared are those drawn
     by the rule (coverage >= 128; CaseStyle.frame_flat). ``job``: ``(job_dir, job)``, for
-    :func:`read_frame`'s listing of a job's problems.
+    :func:`read_frame`'s listing of a job's problems. ``grey``: the frame's
+    :func:`read_frame` already made (read ahead: oracles.judge.frame_prefetch).
     """
-    return style.frame_flat(read_frame(path, width, height, job), orac, *frame, segs=segs)
+    grey = read_frame(path, width, height, job) if grey is None else grey
+    return style.frame_flat(grey, orac, *frame, segs=segs)
 
 
 def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
@@ -109,6 +113,9 @@ class _CaseFrames:
 def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
     """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
 
+    ``oracles``: the run's oracles.judge.frame_prefetch.FramePrefetch (frames
+    read ahead on its GL thread), or an OracleCache (read in this thread).
+
     ``line_rule``: ``"gl"`` holds aliased 1-px lines to GL's pixel rule,
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
     """
@@ -117,7 +124,6 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     from wirecheck.core.projector.pipeline import render_frame
 
     from ..candidates.draw import oracle_segments as line_segments
-    from ..candidates.frames_candidate import frame_inputs
     from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
     from ..diagnosis.image_visibility import frames_visibility
 
@@ -126,16 +132,19 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     kept = diagnosis_frames(len(numbers)) if diagnose else set()
     acc = _CaseFrames()
     style = CaseStyle(line_rule)
-    camera, cache = None, {}
-    for i, (k, rel) in enumerate(zip(numbers, c["frames"])):
-        p_model, edges, camera, m = frame_inputs(job_dir, job, scene, case, k, cache)
+    camera = None
+    # each frame's inputs, pyrender's drawing and its PNG's grey levels, read ahead on the GL thread
+    # (frame_prefetch: each step's error raised here, at its frame and step)
+    ahead = reader_for(oracles).frames(job_dir, job, c, numbers)
+    for i, ((k, rel), frame) in enumerate(zip(zip(numbers, c["frames"]), ahead)):
+        p_model, edges, camera, m = frame.inputs()
         p_world = p_model @ m[:3, :3].T + m[:3, 3]
         # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
         seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
         segs = oracle_segments(p_world, edges, camera)             # the lines a correct renderer draws
-        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m)[0]
+        orac = frame.oracle()
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
-                                segs, (job_dir, job))
+                                segs, (job_dir, job), grey=frame.grey())
         core = _drawn(render_frame(p_model, edges, camera, m).image)
         fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
         style.count_rule(fp, segs)
@@ -159,7 +168,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         if i in kept:
             acc.diag.append((fp.cand_idx, orac.shape, segs,
                              oracle_segments(p_world, edges, flipped_camera(camera))))
-        del cand, orac, core, fp
+        del cand, orac, core, fp, frame
+    ahead.close()
     acc.record_lines(acc.batch.flush())
     rec = case_record(job, scene, case, camera, acc, len(numbers))
     faults = []
@@ -171,6 +181,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
     style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol))
     rec["line_style"]["f1_radius_px"] = rec["f1_radius_px"]
+    rec["faults"] = name_dim_lines(rec["faults"], rec["line_style"], acc.per_frame)   # lines under the 128 rule
     rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
     decide(rec, tol, level="frames")
     if diagnose and not faults and rec["verdict"] == "fail":
@@ -214,24 +225,23 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     fails the run unless ``allow_vacuous`` (as :mod:`oracles.judge.gate`).
     """
     from ..candidates.frames_candidate import check_frames, load_job
-    from ..references.pyrender_oracle import OracleCache
     from .tolerances import Tolerances
 
     tol = tol or Tolerances()
     t0 = time.perf_counter()
     job = load_job(job_dir)
     check_frames(job_dir, job, decode=False)          # each frame is decoded once, as it is judged
-    oracles = OracleCache()
+    reader = FramePrefetch()            # the GL thread: every oracle call, and the frames read ahead of the judge
     records, images = [], {}
     try:
         for c in job["cases"]:
-            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], oracles, tol, diagnose=diagnose,
+            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], reader, tol, diagnose=diagnose,
                                     line_rule=line_rule)
             records.append(rec)
             images[(c["scene"], c["case"])] = worst
-        gl = oracles.gl_info()
+        gl = reader.call(reader.oracles.gl_info)
     finally:
-        oracles.close()
+        reader.close()
     failed = sum(r["verdict"] == "fail" for r in records)
     vacuous = sum(r["verdict"] == "vacuous" for r in records)
     compared = {"cases": sum(r["verdict"] != "vacuous" for r in records),

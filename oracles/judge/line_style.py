@@ -12,7 +12,8 @@ Styles (:func:`classify`, from the images alone, pooled over a case's frames):
 
 - ``aliased``: binary pixels (one level), about one pixel across the line;
 - ``antialiased``: grey levels (coverage), about one pixel across;
-- ``wide``: :data:`WIDE_MIN_PX` or more across (binary or grey), up to ~3 px.
+- ``wide``: :data:`WIDE_MIN_PX` or more across (binary or grey), up to ~3 px; binary lines drawing
+  :data:`oracles.judge.even_lean.WIDE_PIXEL_RATIO` times the oracle's pixels too (2 px at least).
 
 The width is the median coverage across the line over the samples below (a
 1-px aliased line 0.71 to 1, a 1-px antialiased line 1, a 3-px line 3); with too
@@ -39,7 +40,9 @@ fractional position (a cube square-on) sit up to half a pixel off in every corre
 :func:`oracles.diagnosis.image_diagnose.quantisation_bias`; at an exact tie (a band edge on a pixel
 centre) either choice reads 0 (:func:`oracles.judge.line_ties.fold_ties`). Lines that the registration
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
-the windows, are not measured (the centroids would be of stray crossings).
+the windows, are not measured (the centroids would be of stray crossings). Binary lines of an even
+width may lean half a pixel either side, edge by edge: where the symmetric band fails them, each
+edge's lean is fitted with one offset for the case (:mod:`oracles.judge.even_lean`).
 
 Ends (:func:`oracles.judge.free_ends.measure_ends`): each free end's coverage along its line, where it
 falls to half the line's width; the median over a case's free ends is judged
@@ -72,7 +75,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import coverage_pixels, line_ties, line_windows
+from . import coverage_pixels, even_lean, line_ties, line_windows
 from .case_samples import CaseSamples
 from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
 
@@ -137,7 +140,9 @@ CANNOT_SHOW = {
     "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, not judged; an "
                    "end where lines meet; a line under 0.5 px wide (coverage_pixels: no drawn pixel at a tie)",
     "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other line's "
-            "width covers it); binary: a centre offset under 0.35 px (an even width leans half a pixel)",
+            "width covers it); binary: a centre offset under 0.35 px; an even width (2 px), whose lines may lean "
+            "half a pixel either side edge by edge: a move all its lines lean against, a half-pixel move "
+            "to better than 0.3-0.9 px when the ends are rounded to pixels (oracles.judge.even_lean)",
 }
 
 
@@ -316,6 +321,7 @@ class CaseStyle:
                        "farther": 0}
         self.reference = CaseSamples()          # measure() of a correct binary drawing of each binary frame
         self._kept = 0                          # samples in self.samples and self.reference
+        self.drawn_px = np.zeros(2, np.int64)   # binary frames: the candidate's drawn pixels, the oracle's
         self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
@@ -352,10 +358,12 @@ class CaseStyle:
         level = max(int(drawn.max()) if len(drawn) else 0, 1)              # the frame's line level is 1
         wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
         got = measure(grey, segs, wins=wins, level=level)
+        got["edge"] = got["segment"] + len(self.samples) * (len(segs) + 1)    # one key per frame and segment
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
             cand = np.flatnonzero(coverage_pixels.drawn(grey))    # grey levels: a thin line's ridge is drawn too
         else:
+            self.drawn_px += (len(cand), int(np.count_nonzero(orac)))      # binary: pixels drawn, the oracle's
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             same = grey.shape == (camera.height, camera.width)          # the clipping above is the reference's
             ref = measure(_reference(segs, grey.shape, width, clipped if same else None), segs, wins=wins)
@@ -387,7 +395,8 @@ class CaseStyle:
         drawn = self.hist[1:]
         n = int(drawn.sum())
         if n == 0:
-            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1}
+            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1,
+                    "band_px": 1, "pixel_ratio": 0.0}
         cum = np.cumsum(drawn)
         level = int(np.searchsorted(cum, LEVEL_PERCENTILE / 100.0 * n)) + 1
         values = np.arange(1, 256)
@@ -400,11 +409,15 @@ class CaseStyle:
             width = coverage / self.length_px if self.length_px > 0 else 0.0
         grey_share = float(grey) / n
         style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
+        ratio = float(self.drawn_px[0] / self.drawn_px[1]) if self.drawn_px[1] else 0.0
+        band = max(int(np.floor(width + 0.5)), 1)
+        if style == "aliased" and ratio >= even_lean.WIDE_PIXEL_RATIO:      # no 1-px line draws this many
+            style, band = "wide", 2
         # coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's step on
         # lines that all sit at one fractional position; that half step is added to the offset's tolerance
         steps = max(int((drawn >= LEVEL_SHARE_MIN * n).sum()), 1)
         return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level,
-                "coverage_steps": steps}
+                "coverage_steps": steps, "band_px": band, "pixel_ratio": round(ratio, 3)}
 
     def _fit(self, samples):
         """``(d (2,), affine)`` over ``samples``: ``d`` the pooled offset (:func:`pooled_offset`), ``affine``
@@ -447,6 +460,16 @@ class CaseStyle:
             return (normal * (aff[0] + (point - self.centre) @ aff[1].T - const)).sum(axis=1)
 
         warp = np.abs(fitted(affine, d) - fitted(ref_affine, ref_d))
+        lean = even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"]) \
+            if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0 else None
+        if lean is not None:                            # an even band: each edge's lean chosen (even_lean)
+            from ..diagnosis.image_diagnose import SCALE_TOL_PX
+            held = np.max(np.abs(d - ref_d)) <= RULE_OFFSET_MAX_PX and (affine is None or np.percentile(warp, 99)
+                                                                        <= SCALE_TOL_PX + 0.5)   # judge()'s bounds
+            geo["lean"] = {**{k: lean[k] for k in even_lean.REPORTED}, "used": bool(lean["leaning"] and not held)}
+            if geo["lean"]["used"]:                     # the lean explains what the symmetric band cannot
+                d, ref_d, affine = lean["offset"], np.zeros(2), fit_lines(normal, lean["corrected"], point, self.centre)
+                warp = np.abs(fitted(affine, d))
         geo.update(offset_px=[float(v) for v in d - ref_d], bias_px=[float(v) for v in ref_d],
                    warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0)
         return geo

@@ -339,8 +339,8 @@ class PyrenderOracle:
 
     # ---- rendering -----------------------------------------------------
     def render(self, vertices: np.ndarray, edges: np.ndarray, camera: Camera,
-               model_matrix: np.ndarray | None = None, faces=None, cull: bool = False
-               ) -> tuple[np.ndarray, np.ndarray]:
+               model_matrix: np.ndarray | None = None, faces=None, cull: bool = False,
+               depth: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Render a wireframe.
 
         Parameters
@@ -357,13 +357,18 @@ class PyrenderOracle:
         cull : bool
             Occluding faces single-sided: back faces (clockwise in the window)
             are culled by GL and hide nothing.
+        depth : bool
+            Read the depth buffer back too. False: only the colour buffer's
+            red channel is read (:meth:`_read_line_mask`: the same mask,
+            without pyrender's depth read and float32 linearisation, about
+            half of a 640x480 frame's time on llvmpipe).
 
         Returns
         -------
         colour_mask : (H, W) ndarray of bool, True on line pixels, row 0 on top.
         depth : (H, W) ndarray of float32, camera depth (distance along
             ``forward``) of the nearest fragment, 0 where nothing was drawn
-            (pyrender's convention).
+            (pyrender's convention); None when ``depth`` is False.
         """
         if self._renderer is None:
             raise RuntimeError("PyrenderOracle is closed")
@@ -379,8 +384,46 @@ class PyrenderOracle:
             self.last_bound_px = drawn_bound_px(camera, pose, self._mesh_q, self._mesh_segments)
         if faces is not None and len(faces):
             self._polygon_offset()
-        colour, depth = self._renderer.render(self._scene, pr.RenderFlags.FLAT)
-        return colour[:, :, 0] > 127, np.ascontiguousarray(depth, dtype=np.float32)
+        if not depth:
+            return self._read_line_mask(), None
+        colour, z = self._renderer.render(self._scene, pr.RenderFlags.FLAT)
+        return colour[:, :, 0] > 127, np.ascontiguousarray(z, dtype=np.float32)
+
+    def _read_line_mask(self) -> np.ndarray:
+        """Draw the wireframe scene as ``OffscreenRenderer.render`` does and read back only its red channel.
+
+        The mask is ``red > 127``, row 0 on top, as :meth:`render`'s with depth:
+        GL_RED of the same 8-bit buffer is the red byte pyrender's GL_RGB read
+        gives. On OSMesa pyrender draws into the context's own buffer (read
+        from ``GL_FRONT`` of framebuffer 0, as its ``read_color_buf``); with
+        framebuffer objects its draw framebuffer (single-sample here,
+        :func:`_single_sample`, so it may be read) is read directly, with no
+        blit to the resolve framebuffer and no depth read. PyOpenGL's
+        ``glReadPixels`` packs rows tightly (``GL_PACK_ALIGNMENT`` 1).
+        """
+        from OpenGL import GL
+        pr, off = self._pr, self._renderer
+        inner, platform = off._renderer, off._platform
+        platform.make_current()
+        try:
+            inner.viewport_width, inner.viewport_height = off.viewport_width, off.viewport_height
+            inner.point_size = off.point_size
+            if platform.supports_framebuffers():
+                # pyrender's offscreen pass ends by reading colour and depth: here it reads nothing
+                inner._read_main_framebuffer = lambda scene, flags: None
+                try:
+                    inner.render(self._scene, pr.RenderFlags.FLAT | pr.RenderFlags.OFFSCREEN)
+                finally:
+                    del inner._read_main_framebuffer
+                GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, inner._main_fb_ms)
+            else:
+                inner.render(self._scene, pr.RenderFlags.FLAT)
+                GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, 0)
+                GL.glReadBuffer(GL.GL_FRONT)
+            red = GL.glReadPixels(0, 0, self.width, self.height, GL.GL_RED, GL.GL_UNSIGNED_BYTE)
+        finally:
+            platform.make_uncurrent()
+        return np.frombuffer(red, dtype=np.uint8).reshape(self.height, self.width)[::-1] > 127
 
     def render_faces(self, vertices: np.ndarray, triangles: np.ndarray, camera: Camera,
                      model_matrix: np.ndarray | None = None, cull: bool = False, with_ids: bool = False):

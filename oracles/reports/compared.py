@@ -9,7 +9,8 @@ the difference is visible where the verdict is read: the CLI's output, the Asser
 
 from __future__ import annotations
 
-_LEVEL = {"vertices": "vertices (OpenCV)", "pixels": "pixels (OpenCV and pyrender)"}
+_LEVEL = {"vertices": "vertices (OpenCV)", "pixels": "pixels (OpenCV and pyrender)",
+          "frames": "frames (a renderer's PNGs against pyrender; core's beside it)"}
 
 
 def _n(count: int, word: str, plural: str | None = None) -> str:
@@ -26,7 +27,7 @@ def what_text(report: dict) -> str:
     every = report.get("every", 1) or 1
     per_case = _n(frames, "frame") + " per case" if frames is not None else "frames"
     if every > 1 and frames is not None:
-        per_case += f" (every {every}th checked)"
+        per_case += f" (1 in {every} checked)"
     cases = report.get("cases", [])
     scenes = len({c["scene"] for c in cases})
     cameras = len({c["camera"] for c in cases})
@@ -38,7 +39,8 @@ def hint_lines(report: dict, failing: list) -> list[str]:
     """``  what to check, NAME: HINT``, once per distinct hint of the faults in ``failing`` cases (oracles.reports.report.fault_hints)."""
     from .report import fault_hints
 
-    return [f"  what to check, {n}: {h}" for n, h in fault_hints(f for c in failing for f in c["faults"])]
+    return [f"  what to check, {n}: {h}" for n, h in fault_hints((f for c in failing for f in c["faults"]),
+                                                                           report.get("level") == "frames")]
 
 
 #: Reasons the CLI prints per failing case; the rest are in report.md (a line a reader can take in).

@@ -66,12 +66,13 @@ def failure_message(case: dict) -> str:
     return f"faults: {fault_text(case.get('faults') or [])}; {reasons}"
 
 
-def failure_text(case: dict) -> str:
-    """The failure's body: scene / camera, faults, each reason, and what to check for each fault."""
+def failure_text(case: dict, frames: bool = False) -> str:
+    """The failure's body: scene / camera, faults, each reason, and what to check for each fault (``frames``: a
+    renderer's own frames, report.fault_hints)."""
     lines = [f"{case['scene']} / {case['camera']}: verdict {case['verdict']}",
              f"faults: {fault_text(case.get('faults') or [])}"]
     lines += [f"reason: {r}" for r in case.get("reasons") or []]
-    lines += [f"what to check, {n}: {h}" for n, h in fault_hints(case.get("faults") or [])]
+    lines += [f"what to check, {n}: {h}" for n, h in fault_hints(case.get("faults") or [], frames)]
     return "\n".join(lines) + "\n"
 
 
@@ -102,7 +103,7 @@ def junit_xml(report: dict) -> bytes:
         elif c["verdict"] != "pass":
             kind = ",".join(f["name"] for f in c.get("faults") or []) or c["verdict"]
             failure = ET.SubElement(elem, "failure", {"message": failure_message(c), "type": kind})
-            failure.text = failure_text(c)
+            failure.text = failure_text(c, report.get("level") == "frames")
         if c.get("note"):
             ET.SubElement(elem, "system-out").text = f"note: {c['note']}\n"
     for elem in root.iter():

@@ -64,13 +64,26 @@ FAULT_HINTS = {
 }
 
 
-def fault_hints(faults) -> list[tuple[str, str]]:
+#: What else to check when the pixels are a renderer's own frames (``--candidate-frames``, report level
+#: ``frames``): the drawing library's own choices, which a projector's lines drawn by the harness never have.
+FRAMES_HINTS = {
+    "pixel_offset": "a renderer that snaps lines to pixel centres (matplotlib: draw with snap=False) or truncates "
+                    "float coordinates (Pillow: round them) moves its lines too",
+    "line_end_bias": "a renderer of another aliased line rule: --line-rule geometry judges the geometry only",
+}
+
+
+def fault_hints(faults, frames: bool = False) -> list[tuple[str, str]]:
     """``(name, what to check)`` for each distinct fault of ``faults``, in FAULT_HINTS order: a fault's own
-    ``hint`` (set where its values say more, e.g. a FOV scale of W/H) or its name's."""
+    ``hint`` (set where its values say more, e.g. a FOV scale of W/H) or its name's; ``frames``: a renderer's
+    own frames, each name's FRAMES_HINTS added."""
     seen = {}
     for f in faults:
         if f.get("name") in FAULT_HINTS:
-            seen.setdefault((f["name"], f.get("hint") or FAULT_HINTS[f["name"]]), None)
+            hint = f.get("hint") or FAULT_HINTS[f["name"]]
+            if frames and f["name"] in FRAMES_HINTS:
+                hint += "; " + FRAMES_HINTS[f["name"]]
+            seen.setdefault((f["name"], hint), None)
     return sorted(seen, key=lambda nh: list(FAULT_HINTS).index(nh[0]))
 
 
@@ -350,7 +363,7 @@ def markdown(report: dict, files: set | None = None) -> str:
         out += ["", "## Why cases failed", ""]
         for c in failing:
             out.append(f"- **{c['scene']} / {c['camera']}**: " + "; ".join(c["reasons"]))
-        names = fault_hints(f for c in failing for f in c["faults"])
+        names = fault_hints((f for c in failing for f in c["faults"]), report.get("level") == "frames")
         if names:
             out += ["", "## What to check", ""]
             out += [f"- `{n}`: {h}" for n, h in names]
@@ -410,7 +423,7 @@ def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = 
         parts.append("<h2>Notes</h2><ul>" + "".join(
             f"<li class='note'><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e(note)}</li>" for c, note in notes)
             + "</ul>")
-    names = fault_hints(f for c in report["cases"] for f in c["faults"])
+    names = fault_hints((f for c in report["cases"] for f in c["faults"]), report.get("level") == "frames")
     if names:
         parts.append("<h2>What to check</h2><ul>" + "".join(
             f"<li><code>{e(n)}</code>: {e(h)}</li>" for n, h in names) + "</ul>")

@@ -4,7 +4,9 @@ A plain run writes ``reports/<UTC time>/`` in the working directory by
 default; the console's ``Report:`` line says so and names the option that
 turns it off. The options that only name or shape the report folder
 (``--report-dir``, ``--run``) and the runs whose product is the folder itself
-(``--sweep``, ``--suite``, ``--candidate-frames``) are refused with it;
+(``--sweep``, ``--suite``) are refused with it; a frames job
+(``--candidate-frames``) is judged as any run is: its table, verdict and exit
+status, no folder;
 ``--junit-xml`` is a file of its own and is still written.
 """
 
@@ -20,8 +22,7 @@ def check_no_report(args) -> None:
     if not args.no_report:
         return
     clash = [opt for opt, given in (("--report-dir", args.report_dir is not None), ("--run", args.run is not None),
-                                    ("--sweep", args.sweep), ("--suite", args.suite is not None),
-                                    ("--candidate-frames", args.candidate_frames is not None)) if given]
+                                    ("--sweep", args.sweep), ("--suite", args.suite is not None)) if given]
     if clash:
         raise InputError(f"--no-report with {', '.join(clash)}: --no-report writes no report folder; expected "
                          "one or the other (--junit-xml is still written with --no-report)")

@@ -15,6 +15,7 @@ Both give segments in pixels (x right, y down, integers at pixel centres).
 Each takes the typical mistake it can make: ``half_pixel`` (the viewport
 without its -0.5: lines 0.5 px right and down), ``fov_axis="x"`` (the vertical
 FOV or ortho height taken as the horizontal one: lines W/H larger),
+``aspect=1.03`` (fx 3 % larger than fy: lines wider than they are tall),
 ``flip_rows=False`` (y up: the image upside down).
 
 The drawers take those segments and the image size and return a uint8 grey
@@ -67,8 +68,9 @@ def project_gl(v, edges, cam, model=True, half_pixel=False):
     return np.array(out).reshape(-1, 2, 2)
 
 
-def project_lookat(v, edges, cam, model=True, fov_axis="y", flip_rows=True):
-    """Segments in pixels from the camera fields; ``fov_axis="x"``: the FOV taken as horizontal."""
+def project_lookat(v, edges, cam, model=True, fov_axis="y", flip_rows=True, aspect=1.0):
+    """Segments in pixels from the camera fields; ``fov_axis="x"``: the FOV taken as horizontal;
+    ``aspect``: fx taken as ``aspect`` fy (non-square pixels where the contract has square ones)."""
     c = cam["camera"]
     w, h = c["width"], c["height"]
     m = np.array(cam["model_matrix"]) if model else np.eye(4)
@@ -93,7 +95,7 @@ def project_lookat(v, edges, cam, model=True, fov_axis="y", flip_rows=True):
             continue
         ends = np.array([a + (b - a) * t0, a + (b - a) * t1])
         xy = ends[:, :2] * scale if ortho else ends[:, :2] * scale / ends[:, 2:]
-        out.append(np.c_[cx + xy[:, 0], cy - xy[:, 1] if flip_rows else cy + xy[:, 1]])
+        out.append(np.c_[cx + aspect * xy[:, 0], cy - xy[:, 1] if flip_rows else cy + xy[:, 1]])
     return np.array(out).reshape(-1, 2, 2)
 
 

@@ -41,6 +41,38 @@ def coverage_levels(renderer, scene) -> list:
     return sorted(int(v) for v in np.unique(colour[:, :, 0]))
 
 
+def colour_only_agrees() -> dict:
+    """The oracle's colour-only masks (``render(depth=False)``) against its masks read with depth (pyrender's read).
+
+    The cube from 12 directions, with and without its faces (hidden lines),
+    with face culling, perspective and orthographic, at 61x47 (rows not a
+    multiple of 4 bytes: the read's packing shows) and 640x480.
+    """
+    from wirecheck.core.camera import look_at
+    from wirecheck.core.scene.files import load_scene
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
+
+    cube = load_scene("cube")
+    faces = tuple(tuple(f) for f in cube.faces)
+    out = {"compared": 0, "differ": 0, "drawn": 0}
+    for w, h in ((61, 47), (640, 480)):
+        with PyrenderOracle(w, h) as oracle:
+            for i in range(12):
+                a = 2 * np.pi * i / 12
+                eye = (3.5 * np.cos(a), 1.2 + 0.3 * (i % 3), 3.5 * np.sin(a))
+                cam = look_at(eye, (0, 0, 0), (0, 1, 0), width=w, height=h, near=0.1, far=20,
+                              projection="orthographic" if i % 4 == 3 else "perspective", ortho_height=3.0)
+                for occluders, cull in ((None, False), (faces, False), (faces, True)):
+                    with_depth, _ = oracle.render(cube.vertices, cube.edges, cam, faces=occluders, cull=cull)
+                    colour_only, none = oracle.render(cube.vertices, cube.edges, cam, faces=occluders, cull=cull,
+                                                      depth=False)
+                    out["compared"] += 1
+                    out["differ"] += (none is not None or colour_only.dtype != bool
+                                      or not np.array_equal(colour_only, with_depth))
+                    out["drawn"] += int(with_depth.sum())
+    return out
+
+
 def main() -> int:
     from wirecheck.core.camera import look_at
     from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, gl_available
@@ -68,7 +100,8 @@ def main() -> int:
     raw.delete()
     print(json.dumps({"available": True, "fresh": fresh, "info": info, "levels": levels,
                       "raw_levels": raw_levels, "drawn": int(mask.sum()),
-                      "same_after_close": bool((again == mask).all())}))
+                      "same_after_close": bool((again == mask).all()),
+                      "colour_only": colour_only_agrees()}))
     return 0
 
 

@@ -80,6 +80,10 @@ TARGETS = {
                                        "tests/test_frames_candidate.py::test_mirrored_frames_fail_and_are_named",
                                        "tests/test_frames_candidate.py::test_a_case_where_nothing_is_drawn_is_vacuous"],
                                       None),
+    # the frames read ahead on the GL thread: errors at their own frame, the same report, no thread left
+    "oracles/judge/frame_prefetch.py": (["tests/test_frame_prefetch.py",
+                                         "tests/test_frames_candidate.py::test_frames_that_cannot_be_decoded_are_all_listed"],
+                                        None),
     "oracles/judge/line_style.py": (["tests/test_line_style.py"], None),
     "oracles/judge/line_windows.py": (["tests/test_line_windows.py", "tests/test_line_style.py"], None),
     "oracles/judge/case_samples.py": (["tests/test_case_samples.py", "tests/test_line_style.py"], None),
@@ -87,6 +91,11 @@ TARGETS = {
     # module fixture diagnoses ~100 cases); the short job's matrix and the thick lines cover the same names
     "oracles/diagnosis/image_diagnose.py": (_IMAGE_TESTS, None),
     "oracles/diagnosis/image_naming.py": (_IMAGE_TESTS, None),
+    # the aliased rules read and what a fault stands against: its unit tests in test_image_naming.py, then the
+    # held-out cases it decides (cv2 LINE_8 on prism / on_axis, the wrong-axis FOV on prism / wide_fov, aspect)
+    "oracles/diagnosis/rule_read.py": (["tests/test_image_naming.py", "tests/test_frames_heldout.py"],
+                                       "tie_margin or stands_against or centre_line_is_named or prism_wide_fov "
+                                       "or aspect_mistake"),
 }
 
 PER_MUTANT_TIMEOUT_S = 300

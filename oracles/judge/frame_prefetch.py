@@ -1,0 +1,179 @@
+"""The frames judge's reading ahead: a frame's inputs, its pyrender drawing and its PNG's grey levels, made
+on one worker thread while the judge scores the frames before it.
+
+The judge's own work on frame ``k`` (numpy) and the oracle's drawing of frame
+``k + 1`` (pyrender on OSMesa/EGL: much of it inside the GL library, which
+PyOpenGL's ctypes calls run without the GIL) and the decoding of its PNG
+(zlib, also without the GIL) then overlap, on two cores.
+
+What stays as it was:
+
+- **One GL thread.** A GL context is current on one thread at a time: every
+  GL call of a run (each :class:`~oracles.references.pyrender_oracle.PyrenderOracle`
+  made, every drawing, ``gl_info``, closing them) is made on the worker, in
+  the order it is asked for (a single-thread executor runs its tasks first in,
+  first out).
+- **The same bytes.** Each frame's inputs, drawing and grey levels are
+  computed by the same functions on the same files, one frame after the other,
+  as without the thread; only when they are computed changes.
+- **The same errors, at the same frame.** What a frame's reading raises
+  (a camera file, the oracle, a PNG that cannot be decoded: FramesError,
+  listing every problem of the job as :func:`oracles.judge.frames_judge.read_frame`
+  does) is kept with that frame and raised in the judge's thread when the judge
+  reaches that step of that frame, so frames before it are judged first and
+  the message is the same.
+- **Flat memory.** At most :data:`AHEAD` frames are read ahead of the one
+  being judged (a 640x480 frame: ~0.3 MB of drawing and of grey levels).
+- **Nothing left running.** :meth:`FramePrefetch.close` (``run_frames``' ``finally``,
+  on an error or Ctrl-C too) drops the frames not yet begun, waits for the one
+  being read (milliseconds), closes the oracles on the worker and joins it.
+
+:func:`reader_for` gives judge_case the same reading without a thread when it
+is handed an OracleCache (its callers' older form).
+"""
+
+from __future__ import annotations
+
+import threading
+from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
+
+#: Frames read ahead of the one being judged (each: the oracle's drawing and the PNG's grey levels).
+AHEAD = 2
+
+
+class FrameAhead:
+    """One frame as read ahead: each step's result, or the exception it raised (raised again when asked)."""
+
+    __slots__ = ("_inputs", "_oracle", "_grey")
+
+    def __init__(self, inputs, oracle, grey):
+        self._inputs, self._oracle, self._grey = inputs, oracle, grey
+
+    @staticmethod
+    def _value(step):
+        if isinstance(step, BaseException):
+            raise step
+        return step
+
+    def inputs(self) -> tuple:
+        """``(p_model, edges, camera, model_matrix)`` (oracles.candidates.frames_candidate.frame_inputs)."""
+        return self._value(self._inputs)
+
+    def oracle(self):
+        """pyrender's drawing of the frame: ``(H, W)`` bool, its line pixels."""
+        return self._value(self._oracle)
+
+    def grey(self):
+        """The frame's PNG as grey levels (oracles.judge.frames_judge.read_frame)."""
+        return self._value(self._grey)
+
+
+def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str, cache: dict) -> FrameAhead:
+    """Frame ``k`` of case ``c`` read as the judge reads it, each step's exception kept in its place.
+
+    The steps run in the judge's order: the frame's inputs, pyrender's
+    drawing, the PNG; a step that fails ends the frame's reading (the judge
+    raises it before it would need the next).
+    """
+    from ..candidates.frames_candidate import frame_inputs
+    from .frames_judge import read_frame
+
+    try:
+        inputs = frame_inputs(job_dir, job, c["scene"], c["case"], k, cache)
+    except Exception as exc:      # noqa: BLE001 - raised again in the judge's thread, at this frame
+        return FrameAhead(exc, None, None)
+    p_model, edges, camera, m = inputs
+    try:
+        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m,
+                                                              depth=False)[0]
+    except Exception as exc:      # noqa: BLE001
+        return FrameAhead(inputs, exc, None)
+    try:
+        grey = read_frame(Path(job_dir) / rel, c["width"], c["height"], (job_dir, job))
+    except Exception as exc:      # noqa: BLE001
+        return FrameAhead(inputs, orac, exc)
+    return FrameAhead(inputs, orac, grey)
+
+
+class FramePrefetch:
+    """The frames of a run read :data:`AHEAD` ahead on one worker thread that owns every GL call (module docstring).
+
+    ``oracles``: the run's OracleCache (made here when None); it is used and
+    closed on the worker only. ``threaded=False`` reads each frame in the
+    calling thread when it is asked for (the same results, nothing overlapped).
+    """
+
+    def __init__(self, oracles=None, threaded: bool = True, ahead: int = AHEAD):
+        from ..references.pyrender_oracle import OracleCache
+
+        self.oracles = OracleCache() if oracles is None else oracles
+        self.ahead = int(ahead)
+        self._pool = ThreadPoolExecutor(1, thread_name_prefix="wirecheck-frames") if threaded else None
+        self._pending: set[Future] = set()
+        self._lock = threading.Lock()
+
+    def _submit(self, fn, *args) -> Future:
+        if self._pool is None:
+            f = Future()
+            try:
+                f.set_result(fn(*args))
+            except Exception as exc:      # noqa: BLE001 - as the pool's future would hold it
+                f.set_exception(exc)
+            return f
+        with self._lock:
+            f = self._pool.submit(fn, *args)
+            self._pending.add(f)
+        f.add_done_callback(self._done)
+        return f
+
+    def _done(self, f: Future) -> None:
+        with self._lock:
+            self._pending.discard(f)
+
+    def call(self, fn, *args):
+        """``fn(*args)`` on the GL thread, waited for (``gl_info``)."""
+        return self._submit(fn, *args).result()
+
+    def frames(self, job_dir, job, c: dict, numbers: list):
+        """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead."""
+        cache: dict = {}            # frame_inputs' OBJ and camera, kept over the case (used on the worker only)
+        todo = iter(zip(numbers, c["frames"]))
+        queued: list[Future] = []
+        if self._pool is None:                  # read each frame when it is asked for
+            for k, rel in todo:
+                yield read_ahead(self.oracles, job_dir, job, c, k, rel, cache)
+            return
+        try:
+            while True:
+                while len(queued) <= self.ahead:
+                    nxt = next(todo, None)
+                    if nxt is None:
+                        break
+                    queued.append(self._submit(read_ahead, self.oracles, job_dir, job, c, nxt[0], nxt[1], cache))
+                if not queued:
+                    return
+                yield queued.pop(0).result()
+        finally:
+            for f in queued:                 # the judge stopped early (an error): drop what it will not ask for
+                f.cancel()
+
+    def close(self) -> None:
+        """Drop the frames not begun, close the oracles (on the GL thread) and join it; no thread is left."""
+        if self._pool is None:
+            self.oracles.close()
+            return
+        pool, self._pool = self._pool, None
+        try:
+            with self._lock:
+                pending = list(self._pending)
+            for f in pending:
+                f.cancel()
+            pool.submit(self.oracles.close).result()
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def reader_for(oracles) -> FramePrefetch:
+    """judge_case's reader: ``oracles`` itself when it is a FramePrefetch, else one reading in this thread."""
+    return oracles if isinstance(oracles, FramePrefetch) else FramePrefetch(oracles, threaded=False)
