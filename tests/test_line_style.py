@@ -265,11 +265,10 @@ def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
     style = line_style.CaseStyle()
     for _ in range(8):
         style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
-        assert sum(len(x["offset"]) for x in style.samples + style.reference) <= 600
+        assert style.samples.kept + style.reference.kept <= 600
         # the halved samples hold their own memory: a view (x[::2]) would keep every frame's whole arrays
         # alive, and the case's memory would grow with its frames whatever the samples kept
-        assert all(v.base is None for x in style.samples + style.reference for v in x.values()
-                   if isinstance(v, np.ndarray))
+        assert all(v.base is None for v in style.samples.arrays() + style.reference.arrays())
     rec = {"faults": []}
     style.judge(rec, [], None)
     geo = rec["line_style"]["geometry"]

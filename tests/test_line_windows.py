@@ -79,9 +79,12 @@ def test_windows_are_those_of_the_definition(k):
     assert list(zip(got["segment"].tolist(), pos)) == [(s, p) for s, p, _ in expected]
     # the exact line's minor coordinate: the same formula, float64 both (a few ulps of 250 px)
     assert np.allclose(got["exact"], [e for _, _, e in expected], rtol=0, atol=1e-9)
-    # each window's pixels: 2 r + 1 across the line, centred on the rounded exact line, at the step
-    for key in ("rows", "cols"):
-        assert got[key].shape == (len(expected), 2 * PROFILE_RADIUS_PX + 1)
+    # each window's pixels: 2 r + 1 across the line, centred on the rounded exact line, at the step, as
+    # flat indices y W + x (a horizontal line's window is a column: rows centre - r .. centre + r)
+    r = PROFILE_RADIUS_PX
+    flat = [[(round(e) + o) * W + p if major_of(s) == 0 else p * W + round(e) + o for o in range(-r, r + 1)]
+            for s, p, e in expected]
+    assert got["flat"].shape == (len(expected), 2 * r + 1) and got["flat"].tolist() == flat
 
 
 def test_the_reference_sees_junctions():

@@ -212,6 +212,40 @@ def _decode(fh, rawmode: str | None = None):
             return im.mode, np.asarray(im)
 
 
+def _decode_grey8(fh, width: int, height: int) -> np.ndarray | None:
+    """An 8-bit grey or RGB frame's luminance ``(H, W)`` uint8 from the open file ``fh`` (:func:`open_frame`),
+    Pillow's decoding and Pillow's RGB -> L (:func:`_luminance`'s); None when Pillow opens it as another
+    mode or size (the general path reads it).
+
+    Pillow decodes an ``L`` frame straight into the array that is returned, and
+    an ``RGB`` frame's ``L`` is copied into it (``map_buffer``: Pillow's image
+    memory is the array's): the same pixels as ``np.asarray`` of the decoded
+    image, without its byte-string copies.
+    """
+    from PIL import Image
+
+    map_buffer = getattr(Image.core, "map_buffer", None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked before
+        fh.seek(0)
+        with Image.open(fh) as im:
+            if im.mode not in ("L", "RGB") or im.size != (width, height):
+                return None
+            if map_buffer is None:                                          # a Pillow without it: copied out
+                im.load()
+                return (np.array(im, np.uint8) if im.mode == "L" else
+                        _luminance(np.asarray(im)[..., :3]).astype(np.uint8))
+            out = np.empty((height, width), np.uint8)
+            target = map_buffer(out, (width, height), "raw", 0, ("L", 0, 1))
+            if im.mode == "L":
+                im.im = target                     # decoded into ``out``
+                im.load()
+            else:
+                im.load()
+                target.paste(im.convert("L").im, (0, 0, width, height))
+            return out
+
+
 def _samples(fh, info: dict) -> tuple[np.ndarray, np.ndarray | None]:
     """``(samples, alpha8)``: the file's samples at full depth ((H, W) grey/index or (H, W, 3) RGB; for grey +
     alpha and RGBA their 8-bit reduction) and the 8-bit alpha of the types that carry one (None otherwise)."""
@@ -301,10 +335,9 @@ def _grey(fh, info: dict, width: int, height: int) -> np.ndarray:
     colour, depth, trns = info["colour"], info["depth"], info["trns"]
     try:
         if trns is None and depth == 8 and colour in (0, 2):    # 8-bit grey or RGB, opaque: the samples' L
-            mode, pixels = _decode(fh)
-            if mode in ("L", "RGB") and pixels.shape[:2] == (height, width):
-                return (np.array(pixels, np.uint8) if mode == "L" else
-                        _luminance(pixels[..., :3]).astype(np.uint8))
+            grey = _decode_grey8(fh, width, height)
+            if grey is not None:
+                return grey
         samples, alpha8 = _samples(fh, info)
     except FrameProblem:
         raise

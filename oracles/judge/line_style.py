@@ -76,6 +76,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import coverage_pixels, even_lean, line_ties, line_windows
+from .case_samples import CaseSamples
 from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
 
 STYLES = ("aliased", "antialiased", "wide")
@@ -161,7 +162,7 @@ def windows(segs: np.ndarray, shape) -> dict:
     drawing's). Along each segment long enough, at every integer step of its
     major axis :data:`GUARD_PX` clear of its ends and inside the image, a
     window across it (:data:`PROFILE_RADIUS_PX` each side); segment by segment,
-    each in ascending steps (oracles.judge.line_windows.windows: ``rows``, ``cols``,
+    each in ascending steps (oracles.judge.line_windows.windows: ``flat``,
     ``minor``, ``exact``, ``across``, and ``normal``, ``segment``, ``point`` as
     :func:`measure` returns them).
     """
@@ -184,7 +185,7 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     """
     r = PROFILE_RADIUS_PX
     wins = windows(segs, np.shape(cov)) if wins is None else wins
-    g = cov[wins["rows"], wins["cols"]] / level
+    g = np.reshape(cov, -1)[wins["flat"]] / level
     mass = g.sum(axis=1)
     centroid = (g * wins["minor"]).sum(axis=1) / np.maximum(mass, 1e-300)
     # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
@@ -193,12 +194,11 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
            "segment": wins["segment"], "point": wins["point"], "mass": mass}
     windows_n = len(out["offset"])
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
-    keep = (out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5)
+    keep = np.flatnonzero((out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5))
+    found = len(keep)
+    if found > limit:                                   # evenly thinned: one gather of each field
+        keep = keep[np.linspace(0, found - 1, limit).round().astype(int)]
     out = {k: v[keep] for k, v in out.items()}
-    found = len(out["offset"])
-    if found > limit:
-        idx = np.linspace(0, found - 1, limit).round().astype(int)
-        out = {k: v[idx] for k, v in out.items()}
     out["windows"], out["found"] = windows_n, found
     return out
 
@@ -300,12 +300,6 @@ def _off_by_one(fp, ends: np.ndarray) -> dict:
             "farther": int((~off1).sum())}
 
 
-def _halve(samples: dict) -> dict:
-    """Every other sample of a frame's :func:`measure` (its counts kept), copied: a view would keep the
-    whole of the arrays alive, and a case's memory would grow with its frames."""
-    return {k: (v if np.ndim(v) == 0 else v[::2].copy()) for k, v in samples.items()}
-
-
 class CaseStyle:
     """One case's frames read for style and geometry, frame by frame; then the case judged.
 
@@ -322,11 +316,11 @@ class CaseStyle:
         self.line_rule = line_rule
         self.hist = np.zeros(256, np.int64)
         self.length_px = 0.0
-        self.samples = []                       # measure() of each frame
+        self.samples = CaseSamples()            # measure() of each frame
         self.ends = []                          # measure_ends() of each frame
         self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
                        "farther": 0}
-        self.reference = []                     # measure() of a correct binary drawing of each binary frame
+        self.reference = CaseSamples()          # measure() of a correct binary drawing of each binary frame
         self._kept = 0                          # samples in self.samples and self.reference
         self.drawn_px = np.zeros(2, np.int64)   # binary frames: the candidate's drawn pixels, the oracle's
         self.centre = np.zeros(2)
@@ -366,7 +360,6 @@ class CaseStyle:
         wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
         got = measure(grey, segs, wins=wins, level=level)
         got["edge"] = got["segment"] + len(self.samples) * (len(segs) + 1)    # one key per frame and segment
-        self.samples.append(got)
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
             cand = np.flatnonzero(coverage_pixels.drawn(grey))    # grey levels: a thin line's ridge is drawn too
@@ -377,13 +370,14 @@ class CaseStyle:
             ref = measure(_reference(segs, grey.shape, width, clipped if same else None), segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
                 line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
-            self.reference.append(ref)
+            self.reference.add(ref)
             self._kept += len(ref["offset"])
+        self.samples.add(got)                           # its ties folded (binary frames)
         self._kept += len(got["offset"])
-        if self._kept > MAX_SAMPLES_PER_CASE:           # a frame down to one sample keeps it: no copy to make
-            self.samples = [_halve(x) if len(x["offset"]) > 1 else x for x in self.samples]
-            self.reference = [_halve(x) if len(x["offset"]) > 1 else x for x in self.reference]
-            self._kept = sum(len(x["offset"]) for x in self.samples + self.reference)
+        if self._kept > MAX_SAMPLES_PER_CASE:           # every frame's samples halved (case_samples)
+            self.samples.halve()
+            self.reference.halve()
+            self._kept = self.samples.kept + self.reference.kept
         return cand
 
     def count_rule(self, fp, segs: np.ndarray) -> None:
@@ -395,8 +389,7 @@ class CaseStyle:
     # ---- reading the case
 
     def _pooled(self, key: str, samples=None) -> np.ndarray:
-        samples = self.samples if samples is None else samples
-        return np.concatenate([x[key] for x in samples]) if samples else np.zeros(0)
+        return (self.samples if samples is None else samples).pooled(key)
 
     def classify(self) -> dict:
         """``{"style", "width_px", "grey_share", "level"}`` from the pooled histogram and the samples' widths."""
@@ -445,7 +438,7 @@ class CaseStyle:
         value there less the offset's (fitted values, not the map's parameters: lines of few directions
         fix the values where the lines are, not the map everywhere).
         """
-        windows, found = sum(x["windows"] for x in self.samples), sum(x["found"] for x in self.samples)
+        windows, found = self.samples.counts["windows"], self.samples.counts["found"]
         n = len(self._pooled("offset"))
         ends = np.concatenate(self.ends) if self.ends else np.zeros(0)
         geo = {"samples": n, "windows": windows, "found_share": found / windows if windows else 0.0,

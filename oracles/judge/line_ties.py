@@ -209,7 +209,7 @@ def drop_end_ties(samples: dict, segs: np.ndarray, end_px: float = TIE_END_PX) -
     if len(samples["offset"]) == 0:
         return
     tied = end_ties(segs, end_px)
-    if tied.all():
+    if tied.all() or not tied.any():                    # every segment tied, or none: every sample kept
         return
     keep = ~tied[samples["segment"]]
     n = len(keep)

@@ -59,10 +59,10 @@ def _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard)
     maj0, maj1 = lo_xy[jj, major[ll]], hi_xy[jj, major[ll]]
     min0, min1 = lo_xy[jj, 1 - major[ll]], hi_xy[jj, 1 - major[ll]]
     slope = (d_min / d_maj)[k]                                           # |slope| <= 1: the major axis
-    with np.errstate(divide="ignore", invalid="ignore"):
-        e0 = a_maj[k] + (min0 - a_min[k]) / slope
-        e1 = a_maj[k] + (min1 - a_min[k]) / slope
     flat = slope == 0
+    step = np.where(flat, 1.0, slope)                 # a flat line's e0, e1 are not used (lo, hi below)
+    e0 = a_maj[k] + (min0 - a_min[k]) / step
+    e1 = a_maj[k] + (min1 - a_min[k]) / step
     inside = (min0 <= a_min[k]) & (a_min[k] <= min1)
     lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(e0, e1))
     hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(e0, e1))
@@ -71,7 +71,7 @@ def _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard)
                       start[k] + count[k] - 1)
     n = np.maximum(last - first + 1, 0).astype(np.intp)
     base = (np.cumsum(count) - count)[k] + (np.where(n > 0, first, start[k]) - start[k]).astype(np.intp)   # n = 0: any
-    windows = np.repeat(base, n) + (np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n))
+    windows = np.repeat(base - (np.cumsum(n) - n), n) + np.arange(int(n.sum()))
     return windows, np.repeat(jj, n)
 
 
@@ -83,7 +83,7 @@ def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
     window of ``2 radius + 1`` pixels across it, whose pixels are all inside
     the image and which no other segment comes within ``guard`` of (a
     junction, a crossing); segment by segment, each in ascending steps.
-    ``rows``, ``cols``: ``(n, 2 radius + 1)`` pixel indices of each window;
+    ``flat``: ``(n, 2 radius + 1)`` flat pixel indices ``y W + x`` of each window, across the line;
     ``minor``: their coordinate along the minor axis (float); ``exact``: the
     exact line's there; ``across``: the unit normal's minor component;
     ``normal`` ``(n, 2)``: the unit normal; ``segment``: the window's segment;
@@ -108,7 +108,7 @@ def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
     stop = np.minimum(np.floor(np.maximum(a_maj, b_maj) - along), extent - 1)
     count = np.maximum(stop - start + 1, 0).astype(np.intp)
     owner = np.repeat(np.arange(len(i)), count)               # the windows, segment by segment
-    pos = start[owner] + (np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count))
+    pos = np.repeat(start - (np.cumsum(count) - count), count) + np.arange(len(owner))
     minor_exact = a_min[owner] + (pos - a_maj[owner]) * d_min[owner] / d_maj[owner]
     centre = np.rint(minor_exact)
     horizontal = major[owner] == 0
@@ -132,12 +132,14 @@ def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
     owner, pos, minor_exact, centre, horizontal, pt = (owner[keep], pos[keep], minor_exact[keep], centre[keep],
                                                        horizontal[keep], pt[keep])
     unit = d / length[:, None]
-    normal = np.stack([-unit[:, 1], unit[:, 0]], axis=1)
+    normal = np.empty_like(unit)
+    normal[:, 0], normal[:, 1] = -unit[:, 1], unit[:, 0]
     offsets = np.arange(-r, r + 1)
     win = centre[:, None] + offsets[None]                     # (n, 2r + 1) minor coordinates
-    win_i = centre.astype(np.intp)[:, None] + offsets[None]
-    pos_i = np.broadcast_to(pos.astype(np.intp)[:, None], win_i.shape)
-    hz = horizontal[:, None]
-    return {"rows": np.where(hz, win_i, pos_i), "cols": np.where(hz, pos_i, win_i), "minor": win,
+    # each window's pixels, y W + x: along a row (horizontal line: the window is a column) or a column
+    pos_i, centre_i = pos.astype(np.intp), centre.astype(np.intp)
+    step = np.where(horizontal, w, 1)                         # the flat index's step across the line
+    first = np.where(horizontal, pos_i + (centre_i - r) * w, pos_i * w + centre_i - r)
+    return {"flat": first[:, None] + step[:, None] * np.arange(2 * r + 1)[None], "minor": win,
             "exact": minor_exact, "across": normal[owner, minor[owner]], "normal": normal[owner],
             "segment": i[owner], "point": pt}
