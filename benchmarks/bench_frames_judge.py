@@ -11,7 +11,9 @@ judges it (oracles.judge.frames_judge.run_frames) and reports its peak
 resident memory (``ru_maxrss``) and wall time, and, in the same process and
 on the same frames afterwards, pyrender drawing each frame alone (the
 oracle's share of the judging: ``PyrenderOracle.render``, its context
-already made). The modules the judge uses are imported before the clock
+already made), and, for the longest job, pyrender alone in a fresh
+interpreter of its own (the target's pyrender: its time after the judge, in
+the judge's process, moves with what the judge left in memory). The modules the judge uses are imported before the clock
 starts (an interpreter's start, as pyrender's context is made outside its
 timing); everything else the judging does is timed, the pre-check of every
 frame and the image diagnosis included. Printed: peak RSS of each job and
@@ -163,6 +165,34 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
             "oracle_in_judge_ms_per_frame": round(1e3 * inside["s"] / frames, 2)}
 
 
+def pyrender_alone(path: Path) -> dict:
+    """pyrender drawing the job's frames in a fresh interpreter (as the judge's own run starts): the modules
+    and the context made before the clock (one warm-up render), then ``PyrenderOracle.render`` of every frame,
+    pyrender's full frame (``OffscreenRenderer.render``: colour and depth); then, in a second pass, the
+    colour-only call the judge makes (``depth=False``)."""
+    from wirecheck.oracles.references import pyrender_oracle
+
+    pyrender_oracle.gl_platform()
+    import pyrender  # noqa: F401
+    from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
+
+    job = load_job(path)
+    c = job["cases"][0]
+    inputs = [frame_inputs(path, job, c["scene"], c["case"], int(Path(rel).stem.split("_")[-1]))
+              for rel in c["frames"]]
+    oracle = PyrenderOracle(inputs[0][2].width, inputs[0][2].height)
+    oracle.render(*inputs[0][:3], model_matrix=inputs[0][3])
+    out = {}
+    for key, kwargs in (("pyrender_fresh_ms_per_frame", {}), ("colour_only_fresh_ms_per_frame", {"depth": False})):
+        t = time.perf_counter()
+        for p, e, cam, m in inputs:
+            oracle.render(p, e, cam, model_matrix=m, **kwargs)
+        out[key] = round(1e3 * (time.perf_counter() - t) / len(inputs), 2)
+    oracle.close()
+    return out
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--frames", default="24,720", help="job lengths, comma-separated (default 24,720)")
@@ -170,10 +200,14 @@ def main(argv=None) -> int:
                    help="what the judge compares with (core: the judge's own memory, without pyrender's)")
     p.add_argument("--size", help="image size WxH of the job's camera (default: the case's own, 640x480)")
     p.add_argument("--child", help=argparse.SUPPRESS)
+    p.add_argument("--pyrender-child", help=argparse.SUPPRESS)
     a = p.parse_args(argv)
     size = tuple(int(v) for v in a.size.lower().split("x")) if a.size else None
     if a.child:
         print(json.dumps(judge(Path(a.child), a.oracle)))
+        return 0
+    if a.pyrender_child:
+        print(json.dumps(pyrender_alone(Path(a.pyrender_child))))
         return 0
     lengths = [int(x) for x in a.frames.split(",")]
     print(f"# bench_frames_judge: cube / on_axis, frames {lengths}, {a.size or '640x480'}, judged against "
@@ -186,6 +220,10 @@ def main(argv=None) -> int:
             out = subprocess.run([sys.executable, __file__, "--child", str(job), "--oracle", a.oracle], capture_output=True, text=True,
                                  check=True)
             rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
+            if a.oracle == "pyrender" and n == lengths[-1]:
+                alone = subprocess.run([sys.executable, __file__, "--pyrender-child", str(job)], capture_output=True,
+                                       text=True, check=True)
+                rows[-1].update(json.loads(alone.stdout.strip().splitlines()[-1]))
     # pyrender ms/frame: a fresh oracle drawing the job's frames after the judging; oracle in judge: the
     # oracle's own calls while judging (pyrender's, or core's with --oracle core); the rest is the judge's
     print(f"{'frames':>7} {'verdict':>8} {'peak RSS MB':>12} {'judge ms/frame':>15} {'pyrender ms/frame':>18} "
@@ -198,9 +236,22 @@ def main(argv=None) -> int:
     first, last = rows[0], rows[-1]
     print(f"peak RSS {last['frames']} / {first['frames']} frames: {last['peak_rss_mb'] / first['peak_rss_mb']:.2f} "
           "(target <= 1.5)")
-    print(f"judge / pyrender per frame ({last['frames']} frames): "
-          f"{last['judge_ms_per_frame'] / last['pyrender_ms_per_frame']:.2f} (target <= 1.5)")
-    if last["colour_only_ms_per_frame"]:
+    if "pyrender_fresh_ms_per_frame" in last:
+        # the target's pyrender: a fresh interpreter drawing the same frames, as the judge's run is timed from
+        # one (pyrender's time after the judge, in the judge's process, moves with what the judge left in
+        # memory: 9-13 ms measured on the same frames, so it is printed, not taken)
+        print(f"judge / pyrender per frame ({last['frames']} frames): "
+              f"{last['judge_ms_per_frame'] / last['pyrender_fresh_ms_per_frame']:.2f} (target <= 1.5; pyrender "
+              f"{last['pyrender_fresh_ms_per_frame']:.2f} ms a frame in a fresh process, "
+              f"{last['pyrender_ms_per_frame']:.2f} after the judge in its process)")
+        print(f"judge / pyrender's colour-only drawing per frame ({last['frames']} frames): "
+              f"{last['judge_ms_per_frame'] / last['colour_only_fresh_ms_per_frame']:.2f} "
+              f"({last['colour_only_fresh_ms_per_frame']:.2f} ms a frame in a fresh process: render(depth=False), "
+              "the judge's own call)")
+    else:
+        print(f"judge / pyrender per frame ({last['frames']} frames): "
+              f"{last['judge_ms_per_frame'] / last['pyrender_ms_per_frame']:.2f} (target <= 1.5)")
+    if last["colour_only_ms_per_frame"] and "pyrender_fresh_ms_per_frame" not in last:
         print(f"judge / the oracle's colour-only drawing per frame ({last['frames']} frames): "
               f"{last['judge_ms_per_frame'] / last['colour_only_ms_per_frame']:.2f} "
               f"({last['colour_only_ms_per_frame']:.2f} ms: render(depth=False), the judge's own call)")
