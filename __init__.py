@@ -9,6 +9,8 @@ The public API, importable from the top level::
 
 - :func:`check_projector` / :func:`assert_projector`: crosscheck a projector
   against OpenCV (vertices) and pyrender (pixels).
+- :func:`check_frames` / :func:`assert_frames`: judge a renderer's own frames of a
+  job written by ``crosscheck export`` (``crosscheck --candidate-frames``).
 - :class:`Camera`, :func:`look_at`, :func:`camera_z`: the camera (conventions in
   :mod:`wirecheck.core.conventions`).
 - :func:`load_scene`, :class:`Scene`, :class:`Motion`: scenes and their motion.
@@ -35,6 +37,7 @@ _EXPORTS = {
     "Scene": "core.scene.model", "load_scene": "core.scene.files",
     "Motion": "core.transforms",
     "assert_projector": "oracles.api", "check_projector": "oracles.api",
+    "assert_frames": "oracles.frames_api", "check_frames": "oracles.frames_api",
 }
 
 __all__ = ["__version__", *sorted(_EXPORTS)]

@@ -120,17 +120,10 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
         return _fail(f"--candidate-frames with {', '.join(given)}: the job fixes scenes, cases and frames, and "
                      "its frames are drawn already: expected only --tol-px, --min-f1, --min-f1-0px, --run or --report-dir")
     job_dir = Path(args.candidate_frames)
-    # os.path.realpath: unlike Path.resolve() in 3.11, no RuntimeError for a link loop (judged later)
-    job_real, frames_real, run_real = (Path(os.path.realpath(p)) for p in (job_dir, job_dir / "frames", run_dir))
-    if run_real == job_real or job_real in run_real.parents and (run_real == frames_real
-                                                                 or frames_real in run_real.parents):
-        # the job's own folder or its frames/ (the renderer's files, which a later judgement reads):
-        # never written; a report elsewhere in the job (reports/ when run from inside it) is harmless
-        return _fail(f"report folder {str(run_dir)!r}: the job {str(job_dir)!r} itself or its frames/ "
-                     "(the renderer's files, only read): expected a report folder outside them")
     tol = Tolerances(min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px)
     try:
-        report, images = run_frames(Path(args.candidate_frames), tol=tol, allow_vacuous=args.allow_vacuous,
+        check_report_outside_job(job_dir, run_dir)
+        report, images = run_frames(job_dir, tol=tol, allow_vacuous=args.allow_vacuous,
                                     line_rule=args.line_rule or "gl")
     except InputError as exc:
         return _fail(str(exc))
@@ -158,6 +151,22 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
           f"{s['min_core_f1_0px']:.4f}, F1@1px >= {s['min_core_f1_1px']:.4f}")
     print(report_line(args, run_dir, "report.json", "report.md, report.html"))
     return 1 if report["verdict"] != "pass" else 0
+
+
+def check_report_outside_job(job_dir: Path, run_dir: Path) -> None:
+    """InputError when the report folder ``run_dir`` is the job folder itself or its ``frames/`` (or in it).
+
+    Those hold the renderer's files, which a later judgement reads: never written. A report
+    elsewhere in the job (``reports/`` when run from inside it) is harmless. Shared by
+    ``crosscheck --candidate-frames`` and :func:`wirecheck.oracles.frames_api.check_frames`.
+    """
+    job_dir, run_dir = Path(job_dir), Path(run_dir)
+    # os.path.realpath: unlike Path.resolve() in 3.11, no RuntimeError for a link loop (judged later)
+    job_real, frames_real, run_real = (Path(os.path.realpath(p)) for p in (job_dir, job_dir / "frames", run_dir))
+    if run_real == job_real or job_real in run_real.parents and (run_real == frames_real
+                                                                 or frames_real in run_real.parents):
+        raise InputError(f"report folder {str(run_dir)!r}: the job {str(job_dir)!r} itself or its frames/ "
+                         "(the renderer's files, only read): expected a report folder outside them")
 
 
 def f1_0px_clause(cases: list, min_f1_0px: float) -> str:

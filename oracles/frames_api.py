@@ -1,0 +1,137 @@
+"""A renderer's own frames judged from Python: the twins of :func:`~wirecheck.oracles.api.check_projector`.
+
+    import wirecheck
+
+    def test_my_renderer_draws_the_job():
+        wirecheck.assert_frames("build/job")    # AssertionError naming the fault if not
+
+The job is a folder written by ``crosscheck export`` with the renderer's PNGs under ``frames/``
+(docs/frames.md). The judge is ``crosscheck --candidate-frames DIR``'s own
+(:func:`wirecheck.oracles.candidates.frames_candidate.run_frames`), with its checks of the job
+and of the report folder (:func:`wirecheck.oracles.frames_cli.check_report_outside_job`), so the
+report is the one the command line writes.
+"""
+
+from __future__ import annotations
+
+from .api import _flag, _report_dir, _short, failure_text
+
+
+def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None, min_f1_0px: float | None = None,
+                 allow_vacuous: bool = False, report_dir=None) -> dict:
+    """Judge the frames a renderer drew for a job against pyrender and core; return the report.
+
+    Parameters
+    ----------
+    job_dir : str or Path
+        A job folder written by ``crosscheck export`` (or
+        ``wirecheck.oracles.candidates.export.write_job``), its ``frames/`` drawn.
+    line_rule : {"gl", "geometry"}
+        ``"gl"`` holds aliased 1-px lines to GL's pixel rule (F1@0px); ``"geometry"`` judges where
+        the lines are only (``crosscheck --line-rule``).
+    min_f1, min_f1_0px : float, optional
+        F1 floors at 1 px and 0 px, in [0, 1] (default: those of docs/tolerances.md, as crosscheck's).
+    allow_vacuous : bool
+        Let a case where neither side drew a pixel pass; by default it fails the report.
+    report_dir : str or Path, optional
+        Write report.json, report.md and report.html there with their pictures, the bytes
+        ``crosscheck --candidate-frames DIR --report-dir REPORT_DIR`` writes (timing aside).
+        Default None: nothing is written.
+
+    Returns
+    -------
+    dict
+        The report, as written to report.json: ``verdict``, ``cases`` (each with its ``verdict``,
+        ``faults`` and ``reasons``), ``compared``, ``summary``.
+
+    Raises
+    ------
+    ValueError
+        (:class:`~wirecheck.core.errors.InputError`) the line crosscheck prints for the same input:
+        no job there, a frame missing, of the wrong size or not the job's; a ``line_rule`` other
+        than gl or geometry; an F1 floor that is NaN or outside [0, 1]; a ``report_dir`` that is a
+        file, the job itself or its ``frames/``, or a folder with files wirecheck did not write.
+    TypeError
+        ``allow_vacuous`` not a bool, ``report_dir`` not a path, ``job_dir`` not a path.
+    RuntimeError
+        (:class:`~wirecheck.oracles.references.pyrender_oracle.GLUnavailable`) pyrender's GL
+        cannot draw here: one line naming the missing library and its fix.
+    """
+    import os
+    from pathlib import Path
+
+    from wirecheck.core.errors import InputError
+    from wirecheck.core.outputs.output import check_replaceable, check_report_dir
+
+    from .judge import gate, tolerances
+    from .judge.line_style import LINE_RULES
+
+    if isinstance(job_dir, bool) or not isinstance(job_dir, (str, os.PathLike)):
+        raise TypeError(f"job_dir {_short(job_dir)}: expected a job folder path (str or Path)")
+    job_dir = Path(job_dir)
+    _flag(allow_vacuous, "allow_vacuous")
+    if line_rule not in LINE_RULES:
+        raise InputError(f"line_rule {line_rule!r}: expected one of {', '.join(LINE_RULES)} (gl: aliased 1-px "
+                         "lines held to GL's pixel rule; geometry: where the lines are only)")
+    tol = tolerances.Tolerances(min_f1_1px=tolerances.MIN_F1_1PX if min_f1 is None else min_f1,
+                                min_f1_0px=tolerances.MIN_F1_0PX if min_f1_0px is None else min_f1_0px)
+    gate.check_tolerances(tol)                  # a NaN floor would pass everything
+    run_dir = _report_dir(report_dir)
+    if run_dir is not None:                     # before anything is judged, as crosscheck checks it
+        check_report_dir(run_dir, "report_dir")
+        check_replaceable(run_dir, "report_dir")
+        from .frames_cli import check_report_outside_job
+
+        check_report_outside_job(job_dir, run_dir)
+    report, images = _judge(job_dir, tol, allow_vacuous, line_rule)
+    if run_dir is not None:
+        from .reports.report import write_report
+
+        write_report(run_dir, report, images)
+    return report
+
+
+def _judge(job_dir, tol, allow_vacuous: bool, line_rule: str) -> tuple[dict, dict]:
+    """crosscheck's frames judge on ``job_dir``, after the check that pyrender's GL can draw here."""
+    from .candidates.caller_state import caller_state_kept
+    from .candidates.frames_candidate import run_frames
+    from .references.pyrender_oracle import GLUnavailable, gl_available
+
+    with caller_state_kept():                   # the caller's globals as they were (PYOPENGL_PLATFORM, ...)
+        ok, message = gl_available()
+        if not ok:
+            raise GLUnavailable(message)
+        return run_frames(job_dir, tol=tol, allow_vacuous=allow_vacuous, line_rule=line_rule)
+
+
+def assert_frames(job_dir, **kwargs) -> dict:
+    """:func:`check_frames`, raising AssertionError with the diagnosis unless the verdict is pass.
+
+    Parameters
+    ----------
+    job_dir : str or Path
+        The job folder, its frames drawn.
+    **kwargs
+        Any keyword of :func:`check_frames`.
+
+    Returns
+    -------
+    dict
+        The report, when every case passed.
+
+    Raises
+    ------
+    AssertionError
+        Naming each failing case, its faults and reasons, and what to check
+        (:func:`wirecheck.oracles.api.failure_text`); with ``report_dir``, the report's path last.
+    """
+    __tracebackhide__ = True                     # pytest: the failure points at the caller's line
+    report = check_frames(job_dir, **kwargs)
+    text = failure_text(report)
+    if text is not None:
+        if kwargs.get("report_dir") is not None:
+            from pathlib import Path
+
+            text += f"\n  report: {Path(kwargs['report_dir']) / 'report.html'}"
+        raise AssertionError(text)
+    return report
