@@ -151,11 +151,19 @@ def test_bad_input_raises_the_clis_line(jobs, tmp_path, capsys):
     assert str(exc.value) == _cli_error(capsys, "--candidate-frames", str(undrawn))
     assert "frame_0003.png" in str(exc.value) and "frame_0001.png" not in str(exc.value)
 
+    listing = json.loads((undrawn / "job.json").read_text())   # a job that lists no case: compares nothing
+    listing["cases"] = []
+    (undrawn / "job.json").write_text(json.dumps(listing))
+    with pytest.raises(ValueError) as exc:
+        wirecheck.check_frames(undrawn)
+    assert str(exc.value) == _cli_error(capsys, "--candidate-frames", str(undrawn))
+    assert str(exc.value).endswith("job.json: the job lists no frames: nothing to judge")
+
     # the job and its frames/ hold the renderer's files: refused by the folder check (named as the API names
     # the option, report_dir, as check_projector does), a new folder in frames/ by the job's own check
     for inside, why in ((jobs["good"], "is a frames job holding files a renderer wrote"),
-                        (jobs["good"] / "frames", "report_dir "), (jobs["good"] / "frames" / "rep",
-                                                                  "itself or its frames/")):
+                        (jobs["good"] / "frames", "a directory not written by wirecheck"),
+                        (jobs["good"] / "frames" / "rep", "itself or its frames/")):
         with pytest.raises(ValueError) as exc:
             wirecheck.check_frames(jobs["good"], report_dir=inside)
         cli = _cli_error(capsys, "--candidate-frames", str(jobs["good"]), "--report-dir", str(inside))
