@@ -82,6 +82,49 @@ def test_fit_keeps_a_symmetric_band_moved_half_a_pixel():
     assert not got["leaning"] and got["ms_symmetric"] < 1e-20
 
 
+
+def _axis_edges(leans_h, leans_v, per_edge=10):
+    """Samples of horizontal (normal (0, 1)) and vertical (normal (1, 0)) 2-px bands at whole-pixel
+    coordinates, leaning ``leans_*[k]`` half pixels: there each band's centroid offset is by hand
+    (test_reference_offsets_by_hand's rule) -1/2, 0, +1/2 for the three choices (y = 10: rows 9, 10;
+    9, 10, 11; 10, 11 around 10), so a band leaning ``s`` half pixels has the offset ``s / 2`` exactly."""
+    normal, offset, point, edge = [], [], [], []
+    for k, (n, lean) in enumerate([((0.0, 1.0), s) for s in leans_h] + [((1.0, 0.0), s) for s in leans_v]):
+        along = np.linspace(30.0, 300.0, per_edge)
+        at = np.full(per_edge, 10.0 + 7 * k)
+        normal.append(np.tile(n, (per_edge, 1)))
+        point.append(np.c_[along, at] if n[1] else np.c_[at, along])
+        offset.append(np.full(per_edge, 0.5 * lean))
+        edge.append(np.full(per_edge, k))
+    return tuple(np.concatenate(x) for x in (normal, offset, point, edge))
+
+
+@pytest.mark.parametrize("leaning", [2, 4])
+def test_leaning_wins_past_a_quarter_pixel_squared_for_a_quarter_of_the_edges(leaning):
+    # 20 horizontal and 20 vertical edges: one horizontal edge leaning +1/2 px and one -1/2 px (and as many
+    # vertical ones when 4 lean), the rest symmetric: the leans explain every edge exactly at d = 0 (ms 0);
+    # the symmetric band's offset is 0 (the leans cancel per axis) and leaves 1/2 px on each leaning edge:
+    # ms_symmetric = f / 4 for a share f of leaning edges. The lean is taken past the square of a quarter
+    # pixel on a quarter of the edges (1/64 px^2, even_lean.LEAN_GAIN_PX2's derivation): f = 2/40 leaves
+    # 1/80 < 1/64 (symmetric kept), f = 4/40 leaves 1/40 > 1/64 (leaning)
+    vertical = [1, -1] if leaning == 4 else []
+    got = even_lean.fit(*_axis_edges([1, -1] + [0] * 18, vertical + [0] * (20 - len(vertical))), 2)
+    f = leaning / 40
+    assert got["ms_symmetric"] == pytest.approx(f / 4, abs=1e-12) and got["ms"] == pytest.approx(0.0, abs=1e-12)
+    assert got["edges"] == 40 and got["edges_eff"] == pytest.approx(40.0)
+    assert got["leaning"] == (leaning == 4)
+
+
+@pytest.mark.parametrize("n_edges", [3, 4])
+def test_three_edges_cannot_test_the_symmetric_band(n_edges):
+    # symmetric bands (no lean, no move) fit both ways exactly (ms = ms_symmetric = 0), so only the edges'
+    # count decides: an offset (two numbers) fitted to 3 edges of equal weight leaves one number to test the
+    # symmetric band by, too few (even_lean.MAX_UNTESTED_EDGES), and the lean is used; 4 edges test it
+    got = even_lean.fit(*_axis_edges([0] * (n_edges - n_edges // 2), [0] * (n_edges // 2), per_edge=10), 2)
+    assert got["ms"] == 0.0 == got["ms_symmetric"] and got["edges_eff"] == pytest.approx(n_edges)
+    assert got["leaning"] == (n_edges <= 3)
+
+
 # ---- frames judged end to end ----
 
 DRAWS = [(draw_symmetric_2px, "symmetric"), (draw_pillow_2px, "pillow")]

@@ -123,3 +123,31 @@ def test_reading_ahead_gives_the_report_of_reading_in_turn(filled, monkeypatch):
         del report["timing"]
     assert ahead == in_turn
     assert ahead["compared"]["frames"] == 6 and ahead["verdict"] == "pass"
+
+
+@pytest.mark.parametrize("ahead", [1, 2])
+def test_frames_are_asked_for_ahead_frames_beyond_the_one_judged(monkeypatch, ahead):
+    """While frame k is judged, the worker has been given frames 1 .. k + ahead (the last ones of the case: up
+    to its end) and no more: ``ahead`` frames overlap the judge's work, and memory stays flat."""
+    asked = []
+
+    def read(oracles, job_dir, job, c, k, rel, cache):      # the worker's reading, recorded in its order
+        asked.append(k)
+        return k
+    monkeypatch.setattr(frame_prefetch, "read_ahead", read)
+
+    class Oracles:
+        def close(self):
+            pass
+    reader = frame_prefetch.FramePrefetch(Oracles(), threaded=True, ahead=ahead)
+    try:
+        got, seen = [], []
+        for k in reader.frames("job", {}, {"frames": [f"f{i}.png" for i in range(1, 7)]}, [1, 2, 3, 4, 5, 6]):
+            reader.call(lambda: None)       # first in, first out: every frame asked for before it has been read
+            got.append(k)
+            seen.append(list(asked))
+        assert got == [1, 2, 3, 4, 5, 6]
+        assert seen == [list(range(1, min(k + ahead, 6) + 1)) for k in got]
+    finally:
+        reader.close()
+    assert _workers() == []

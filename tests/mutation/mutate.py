@@ -87,6 +87,11 @@ TARGETS = {
     "oracles/judge/line_style.py": (["tests/test_line_style.py"], None),
     "oracles/judge/line_windows.py": (["tests/test_line_windows.py", "tests/test_line_style.py"], None),
     "oracles/judge/case_samples.py": (["tests/test_case_samples.py", "tests/test_line_style.py"], None),
+    # the even-width lean: its unit tests and 2-px jobs in test_even_width.py, then Pillow's 2-px lines on the
+    # held-out slanted job (a correct one passes leaning, one with the half-pixel mistake is pixel_offset)
+    "oracles/judge/even_lean.py": (["tests/test_even_width.py",
+                                    "tests/test_frames_heldout.py::test_pillow_wide_lines_pass_on_f1_at_their_width[2]",
+                                    "tests/test_frames_heldout.py::test_pillow_2px_half_pixel_is_pixel_offset"], None),
     # the image diagnosis: every test file but the 80-s confusion matrix of test_image_diagnosis.py (its
     # module fixture diagnoses ~100 cases); the short job's matrix and the thick lines cover the same names
     "oracles/diagnosis/image_diagnose.py": (_IMAGE_TESTS, None),
