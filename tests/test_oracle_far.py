@@ -157,3 +157,20 @@ def test_a_bound_that_overflows_is_no_bound_and_beyond_the_limit():
     cam = _camera((0.0, 0.0, 5.0))
     bound = op.frame_bound_px(cam, gl_eye_pose(cam, None, (0.0, 0.0, 0.0)), 1e308)
     assert bound == float("inf") and bound > op.ORACLE_LIMIT_PX
+
+
+@needs_gl
+def test_a_vertex_at_1e300_is_vacuous_and_names_no_fault_from_the_pixels(tmp_path):
+    """A triangle reaching 1e300: the oracle's bound overflows (no finite bound), its pixels are not judged,
+    so no line fault is read from them (before: ``line_pixel_bias`` from the line counts beside the vacuous
+    verdict); the vertices, within core's bound, name nothing either."""
+    import json
+
+    from wirecheck.oracles import cli
+
+    (tmp_path / "big.obj").write_text("v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n")
+    assert cli.main(["--scene", str(tmp_path / "big.obj"), "--frames", "2", "--cases", "on_axis",
+                     "--report-dir", str(tmp_path / "r")]) == 1            # vacuous: a failure of the run
+    (case,) = json.loads((tmp_path / "r" / "report.json").read_text())["cases"]
+    assert case["verdict"] == "vacuous" and case["oracle_precision"] is True
+    assert case["faults"] == []

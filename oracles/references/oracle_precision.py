@@ -194,4 +194,8 @@ def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error,
     vertex_reasons = vertices_only["reasons"] if vertices_only["verdict"] == "fail" else []
     rec["verdict"] = "fail" if vertex_reasons else "vacuous"
     rec["reasons"] = [why] + vertex_reasons
+    from ..diagnosis.diagnose import LINE_FAULTS
+
+    # a line fault is read from the pixels (line counts against the oracle's): those say nothing here
+    rec["faults"] = [f for f in rec.get("faults") or [] if f.get("name") not in LINE_FAULTS]
     rec["oracle_precision"] = True

@@ -319,7 +319,8 @@ def precision_text(report: dict) -> str:
         return f"{p['judged_as']} ({p['source']}" + (f"; returned {', '.join(other)})" if other else ")")
 
     judged = sorted({one(c["precision"]) for c in cases})
-    bounds = [c["vertex_bound_px"] for c in cases]
+    # None: a bound that is not finite (report.json holds no inf: a vertex at 1e300 overflows it)
+    bounds = [float("inf") if c.get("vertex_bound_px") is None else c["vertex_bound_px"] for c in cases]
     lo, hi = min(bounds), max(bounds)
     span = f"{lo:.3g} px" if lo == hi else f"{lo:.3g} to {hi:.3g} px"
     return f"{', '.join(judged)}; vertex bound {span}"
