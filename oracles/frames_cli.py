@@ -145,10 +145,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     for r in report["cases"]:
         if r["verdict"] != "pass":          # failed, or vacuous (compared nothing)
             print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
-    s = report["summary"]
-    print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "
-          f"(F1@1px >= {tol.min_f1_1px}, {f1_0px_clause(report['cases'], tol.min_f1_0px)}); against core: F1@0px >= "
-          f"{s['min_core_f1_0px']:.4f}, F1@1px >= {s['min_core_f1_1px']:.4f}")
+    print("\n" + verdict_line(report, tol))
     print(report_line(args, run_dir, "report.json", "report.md, report.html"))
     return 1 if report["verdict"] != "pass" else 0
 
@@ -167,6 +164,18 @@ def check_report_outside_job(job_dir: Path, run_dir: Path) -> None:
                                                                  or frames_real in run_real.parents):
         raise InputError(f"report folder {str(run_dir)!r}: the job {str(job_dir)!r} itself or its frames/ "
                          "(the renderer's files, only read): expected a report folder outside them")
+
+
+def verdict_line(report: dict, tol) -> str:
+    """The run's last line: the verdict, the thresholds, and the lowest F1 against core ('-' when not a number)."""
+    s = report["summary"]
+
+    def f1(v) -> str:
+        return "-" if v is None else f"{v:.4f}"
+
+    return (f"{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "
+            f"(F1@1px >= {tol.min_f1_1px}, {f1_0px_clause(report['cases'], tol.min_f1_0px)}); against core: F1@0px >= "
+            f"{f1(s['min_core_f1_0px'])}, F1@1px >= {f1(s['min_core_f1_1px'])}")
 
 
 def f1_0px_clause(cases: list, min_f1_0px: float) -> str:

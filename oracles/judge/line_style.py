@@ -579,9 +579,11 @@ def summary_lines(cases: list) -> list[str]:
             by.setdefault((ls["style"], ls["line_rule"]), []).append(ls)
     out = []
     for (style, rule), rows in sorted(by.items()):
-        widths, radius = [r["width_px"] for r in rows], max(r.get("f1_radius_px", 1) for r in rows)  # f1_radius
+        widths = [r["width_px"] for r in rows if r["width_px"] is not None]   # None: not finite, null in report.json
+        radius = max(r.get("f1_radius_px", 1) for r in rows)  # f1_radius
+        wide = f"{min(widths):.2f}-{max(widths):.2f} px wide" if widths else "width -"
         out.append(f"Line style read: {style} ({len(rows)} case{'s' if len(rows) != 1 else ''}, "
-                   f"{min(widths):.2f}-{max(widths):.2f} px wide, --line-rule {rule}): judged by {rows[0]['judged_by']}"
+                   f"{wide}, --line-rule {rule}): judged by {rows[0]['judged_by']}"
                    f"{f'; F1 at up to {radius} px (the width)' if radius > 1 else ''}; cannot show {CANNOT_SHOW[style]}")
     return out
 

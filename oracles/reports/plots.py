@@ -105,7 +105,7 @@ def vertex_error_png(report: dict) -> bytes | None:
         ax.plot(frames, y, dash, color=colour, marker=".", markersize=3, linewidth=1,
                 label=f"{case['scene']} / {case['camera']}")
     tol = report["tolerances"]["vertex_error_px"]
-    if tol > 0:                         # a tolerance of 0 has no place on a log axis
+    if tol is not None and tol > 0:     # a tolerance of 0 has no place on a log axis; None: inf in report.json
         ax.axhline(tol, color="#b00", linewidth=1, linestyle="--")
         ax.text(1.0, tol, f" tolerance {tol:g} px", color="#b00", fontsize=7, va="bottom", ha="right",
                 transform=ax.get_yaxis_transform())

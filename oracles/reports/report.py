@@ -282,6 +282,11 @@ def _worst_text(report: dict) -> str | None:
             "(candidate | oracle | diff; the bar under them is the frame's place in the run)")
 
 
+def _fmt_wall(v, spec: str) -> str:
+    """Wall seconds, '-' when not a finite number (null in report.json)."""
+    return "-" if v is None or not math.isfinite(v) else format(v, spec)
+
+
 def _fmt_ms(v) -> str:
     return "-" if v is None else f"{v:.3g}"
 
@@ -306,7 +311,7 @@ def timing_line(report: dict) -> str:
     if t.get("pixel_stage_ms_per_frame") is not None:
         parts.append(f"pixel stage {_fmt_ms(t.get('pixel_stage_ms_per_frame'))} ms/frame")
     return (f"Level {report.get('level', 'pixels')}: " + ", ".join(parts)
-            + f" ({t.get('jobs', 1)} job(s), {t.get('wall_s', 0.0):.1f} s wall)")
+            + f" ({t.get('jobs', 1)} job(s), {_fmt_wall(t.get('wall_s', 0.0), '.1f')} s wall)")
 
 
 def precision_text(report: dict) -> str:
@@ -445,7 +450,7 @@ def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = 
             "<h2>Time per frame</h2><p>Vertex stage: the candidate's projection and OpenCV; pixel stage: the "
             "candidate's drawing, pyrender and the pixel metrics"
             + (" (not run at level vertices)" if report.get("level") == "vertices" else "")
-            + f". {e(str(timing.get('jobs', 1)))} job(s), {timing.get('wall_s', 0.0):.2f} s wall.</p>"
+            + f". {e(str(timing.get('jobs', 1)))} job(s), {_fmt_wall(timing.get('wall_s', 0.0), '.2f')} s wall.</p>"
             "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in TIMING_HEADER) + "</tr>" + trows + "</table>")
     if "worst.gif" in files and _worst_text(report):
         parts.append(f"<h2>Worst case, every frame</h2><p>{e(_worst_text(report))}: "
