@@ -93,3 +93,12 @@ def test_every_float_field_odd(reports, which, tmp_path):
             except Exception as exc:       # collected: every crash named at once
                 crashes.append(f"{path}={value}: {type(exc).__name__}: {exc}")
     assert not crashes, "\n".join(crashes[:40]) + f"\n({len(crashes)} in all)"
+
+
+def test_dataset_timing_not_measured():
+    """The dataset run's timing line: a null (or inf) time prints as the module's '-' (None) or 'inf', no
+    TypeError; the expected text is written out by hand."""
+    from wirecheck.oracles.datasets.dataset_report import timing_text
+
+    t = {"executor": "local", "workers": 2, "wall_s": None, "startup_s": math.inf, "meshes_per_s": math.nan}
+    assert timing_text({"timing": t}) == "Timing: - s (inf s starting workers), nan meshes/s (local, 2 process(es))"

@@ -81,7 +81,7 @@ def timing_text(report: dict) -> str:
     t = report["timing"]
     where = t["executor"] + (f" {t['scheduler']}" if t.get("scheduler") else f", {t['workers'] or 1} process(es)")
     rate = _num(t.get("meshes_per_s"), ".2f")
-    return (f"Timing: {t['wall_s']:.1f} s ({t['startup_s']:.1f} s starting workers), {rate} meshes/s "
+    return (f"Timing: {_num(t.get('wall_s'), '.1f')} s ({_num(t.get('startup_s'), '.1f')} s starting workers), {rate} meshes/s "
             f"({where})")
 
 
