@@ -356,12 +356,18 @@ def assert_projector(func=None, **kwargs) -> dict:
         Naming each failing case, its faults and reasons, and what to check.
     """
     __tracebackhide__ = True                     # pytest: the failure points at the caller's line
-    report = check_projector(func, **kwargs)
-    text = failure_text(report)
-    if text is not None:
-        if kwargs.get("report_dir") is not None:
-            from pathlib import Path
+    return raise_unless_pass(check_projector(func, **kwargs), kwargs.get("report_dir"))
 
-            text += f"\n  report: {Path(kwargs['report_dir']) / 'report.html'}"
-        raise AssertionError(text)
-    return report
+
+def raise_unless_pass(report: dict, report_dir=None) -> dict:
+    """``report`` when its verdict is pass; else AssertionError with :func:`failure_text` (and, with
+    ``report_dir``, the report's path last): the body of assert_projector and assert_frames."""
+    __tracebackhide__ = True
+    text = failure_text(report)
+    if text is None:
+        return report
+    if report_dir is not None:
+        from pathlib import Path
+
+        text += f"\n  report: {Path(report_dir) / 'report.html'}"
+    raise AssertionError(text)

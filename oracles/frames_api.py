@@ -14,7 +14,7 @@ report is the one the command line writes.
 
 from __future__ import annotations
 
-from .api import _flag, _report_dir, _short, failure_text
+from .api import _flag, _report_dir, _short, raise_unless_pass
 
 
 def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None, min_f1_0px: float | None = None,
@@ -126,12 +126,4 @@ def assert_frames(job_dir, **kwargs) -> dict:
         (:func:`wirecheck.oracles.api.failure_text`); with ``report_dir``, the report's path last.
     """
     __tracebackhide__ = True                     # pytest: the failure points at the caller's line
-    report = check_frames(job_dir, **kwargs)
-    text = failure_text(report)
-    if text is not None:
-        if kwargs.get("report_dir") is not None:
-            from pathlib import Path
-
-            text += f"\n  report: {Path(kwargs['report_dir']) / 'report.html'}"
-        raise AssertionError(text)
-    return report
+    return raise_unless_pass(check_frames(job_dir, **kwargs), kwargs.get("report_dir"))
