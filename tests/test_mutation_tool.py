@@ -64,4 +64,13 @@ def test_every_target_names_a_module_and_tests_that_exist():
         for entry in tests:
             path, _, name = entry.partition("::")
             assert (root / path).is_file(), (module, entry)
-            assert not name or f"def {name}(" in (root / path).read_text(), (module, entry)
+            base, _, param = name.partition("[")
+            assert not name or f"def {base}(" in (root / path).read_text(), (module, entry)
+            if param:           # a parametrised node id: the parameter's id must be collected too
+                import subprocess
+                import sys
+
+                collected = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q",
+                                            "-p", "no:cacheprovider", entry], cwd=root, capture_output=True,
+                                           text=True, timeout=300)
+                assert collected.returncode == 0, (module, entry, collected.stdout[-500:])
