@@ -121,3 +121,41 @@ def fill_job(job_dir, edit=lambda img: img, camera=lambda cam: cam) -> None:
             p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
             (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
             Image.fromarray(edit(render_frame(p, e, camera(cam), m).image.copy())).save(job_dir / rel)
+
+
+def require_renderer(probe: str, what: str) -> None:
+    """Skip (or fail, when WIRECHECK_REQUIRE_EGL=1: .ci/run) where ``python -c probe`` fails: a real
+    renderer (moderngl, VTK) that cannot open its headless context here."""
+    import os
+    import subprocess
+    import sys
+
+    import pytest
+
+    proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
+    if proc.returncode != 0:
+        why = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+        if os.environ.get("WIRECHECK_REQUIRE_EGL") == "1":
+            pytest.fail(f"{what} required (WIRECHECK_REQUIRE_EGL=1) but: {why}")
+        pytest.skip(f"{what} unavailable: {why}")
+
+
+def draw_and_judge(script, job_dir, tmp_path, *args, cases=6, frames=2) -> tuple[int, dict]:
+    """Copy the exported ``job_dir``, draw it with the renderer client ``script`` (``args``: its mistake
+    flags), judge it with ``crosscheck --candidate-frames``; the exit status and report.json, after checking
+    that ``cases`` cases of ``frames`` frames each were compared."""
+    import shutil
+    import subprocess
+    import sys
+
+    from wirecheck.oracles.cli import main
+
+    job = tmp_path / "job"
+    shutil.copytree(job_dir, job)
+    proc = subprocess.run([sys.executable, str(script), str(job), *args], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")])
+    report = json.loads((tmp_path / "rep" / "report.json").read_text())
+    assert len(report["cases"]) == cases and all(c["frames_checked"] == frames for c in report["cases"])
+    return rc, report

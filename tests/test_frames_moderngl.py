@@ -19,15 +19,11 @@ CPU where there is no GPU); skipped without them unless WIRECHECK_REQUIRE_EGL=1
 
 from __future__ import annotations
 
-import json
-import os
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles.cli import main
 
 pytestmark = pytest.mark.slow          # four renderer runs and four judgements (~20 s)
@@ -39,34 +35,16 @@ ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_sq
 PROBE = "import moderngl; moderngl.create_standalone_context(backend='egl').release()"
 
 
-def _require_egl() -> None:
-    """Skip (or fail, when WIRECHECK_REQUIRE_EGL=1) where moderngl cannot open a headless EGL context."""
-    proc = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, timeout=120)
-    if proc.returncode != 0:
-        why = (proc.stderr.strip().splitlines() or ["no output"])[-1]
-        if os.environ.get("WIRECHECK_REQUIRE_EGL") == "1":
-            pytest.fail(f"moderngl on EGL required (WIRECHECK_REQUIRE_EGL=1) but: {why}")
-        pytest.skip(f"moderngl on EGL unavailable: {why}")
-
-
 @pytest.fixture(scope="module")
 def job_dir(tmp_path_factory) -> Path:
-    _require_egl()
+    helpers.require_renderer(PROBE, "moderngl on EGL")
     path = tmp_path_factory.mktemp("moderngl") / "job"
     assert main(["export", str(path)] + ARGS) == 0
     return path
 
 
 def _render_and_judge(job_dir: Path, tmp_path: Path, *mistake: str) -> tuple[int, dict]:
-    job = tmp_path / "job"
-    shutil.copytree(job_dir, job)
-    proc = subprocess.run([sys.executable, str(SCRIPT), str(job), *mistake], capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")])
-    report = json.loads((tmp_path / "rep" / "report.json").read_text())
-    assert len(report["cases"]) == 6 and all(c["frames_checked"] == 2 for c in report["cases"])
-    return rc, report
+    return helpers.draw_and_judge(SCRIPT, job_dir, tmp_path, *mistake)
 
 
 def _by_case(report: dict) -> dict:

@@ -20,16 +20,12 @@ WIRECHECK_REQUIRE_EGL=1 (.ci/run), where that is a failure.
 
 from __future__ import annotations
 
-import json
 import math
-import os
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles.cli import main
 
 pytestmark = pytest.mark.slow          # three renderer runs and three judgements
@@ -42,34 +38,16 @@ PROBE = ("import vtk; w = vtk.vtkRenderWindow(); w.SetOffScreenRendering(1); w.S
          "w.AddRenderer(vtk.vtkRenderer()); w.Render()")
 
 
-def _require_vtk() -> None:
-    """Skip (or fail, when WIRECHECK_REQUIRE_EGL=1) where VTK cannot render offscreen."""
-    proc = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, timeout=120)
-    if proc.returncode != 0:
-        why = (proc.stderr.strip().splitlines() or ["no output"])[-1]
-        if os.environ.get("WIRECHECK_REQUIRE_EGL") == "1":
-            pytest.fail(f"VTK offscreen required (WIRECHECK_REQUIRE_EGL=1) but: {why}")
-        pytest.skip(f"VTK offscreen unavailable: {why}")
-
-
 @pytest.fixture(scope="module")
 def job_dir(tmp_path_factory) -> Path:
-    _require_vtk()
+    helpers.require_renderer(PROBE, "VTK offscreen")
     path = tmp_path_factory.mktemp("vtk") / "job"
     assert main(["export", str(path)] + ARGS) == 0
     return path
 
 
 def _render_and_judge(job_dir: Path, tmp_path: Path, *mistake: str) -> tuple[int, dict]:
-    job = tmp_path / "job"
-    shutil.copytree(job_dir, job)
-    proc = subprocess.run([sys.executable, str(SCRIPT), str(job), *mistake], capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")])
-    report = json.loads((tmp_path / "rep" / "report.json").read_text())
-    assert len(report["cases"]) == 6 and all(c["frames_checked"] == 2 for c in report["cases"])
-    return rc, report
+    return helpers.draw_and_judge(SCRIPT, job_dir, tmp_path, *mistake)
 
 
 def _by_case(report: dict) -> dict:
