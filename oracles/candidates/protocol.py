@@ -89,7 +89,8 @@ def encode_request(request_id: int, p_world: np.ndarray, camera_json: str) -> by
     p_world = np.ascontiguousarray(p_world, dtype=WIRE_DTYPE).reshape(-1, 3)
     line = f'{{"request":{int(request_id)},"n":{len(p_world)},"camera":{camera_json}}}\n'
     out = bytearray(line.encode())
-    out += memoryview(p_world).cast("B")          # one copy of the points, not two
+    if len(p_world):                              # N = 0: the line alone (a view of no bytes cannot be cast)
+        out += memoryview(p_world).cast("B")      # one copy of the points, not two
     return out
 
 
