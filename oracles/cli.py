@@ -127,15 +127,20 @@ def _parse(args):
             ("--candidate-precision", args.candidate_precision is not None),
             ("--allow-vacuous", args.allow_vacuous)) if given]
         if ignored:
+            allowed = ("--level, --gl, --run, --report-dir, --candidate or --candidate-cmd" if args.suite == "spec"
+                       else "--level, --run or --report-dir")
             raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
-                             "bounds are fixed (oracles/extremes/); expected only --level, --run or --report-dir")
+                             f"bounds are fixed (oracles/{args.suite}/); expected only {allowed}")
+        if args.suite == "spec" and core_given:
+            raise InputError(f"--suite spec with {', '.join(core_given)}: the suite judges core in its default "
+                             "settings, or --candidate/--candidate-cmd: expected no --dtype/--clip/--raster")
     if args.sweep and args.allow_vacuous:
         raise InputError("--sweep with --allow-vacuous: the sweep's cases are the bundled scenes and a large mesh, "
                          "which always show something: expected no --allow-vacuous")
     if args.sweep and args.jobs != 1:
         raise InputError(f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
                          "the times compare; expected no --jobs")
-    if (args.sweep or args.suite) and (core_given or external):
+    if (args.sweep or args.suite == "extremes") and (core_given or external):
         what = "--sweep" if args.sweep else f"--suite {args.suite}"
         raise InputError(f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
                          "itself; expected neither --candidate nor --dtype/--clip/--raster")
@@ -163,8 +168,10 @@ def _parse(args):
     mode = RenderMode(style=args.style or "wireframe", hidden_lines=args.hidden_lines, cull=args.cull or "none")
     tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
                      min_iou=args.min_iou, precision=args.candidate_precision)
-    if args.suite:       # fixed cases and bounds (checked above): nothing of a run's inputs applies
+    if args.suite == "extremes":      # fixed cases and bounds (checked above): nothing of a run's inputs applies
         return level, None, None, mode, tol
+    if args.suite == "spec":          # fixed runs and checks; the candidate is core or the one given
+        return level, None, _candidate(args, external), mode, tol
     # the library's one check of what a run compares (oracles.judge.gate), in the CLI's option names
     if args.dataset is not None:      # the meshes are read where they are checked (oracles.datasets.dataset_run)
         inputs = gate.run_settings(args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
@@ -176,13 +183,16 @@ def _parse(args):
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
+    return level, inputs, _candidate(args, external), mode, tol
+
+
+def _candidate(args, external: str | None):
+    """The run's candidate: the program of ``--candidate``/``--candidate-cmd``, started, or core in its settings."""
     if external:
         if getattr(args, "candidate_from", None) is not None:    # before the program runs (docs/pytest.md)
             print(trust_line(*args.candidate_from), file=sys.stderr, flush=True)
-        candidate = external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
-    else:
-        candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
-    return level, inputs, candidate, mode, tol
+        return external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
+    return CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
 
 
 def _executor(args) -> ExecutorSpec:
@@ -328,6 +338,8 @@ def _main(argv=None) -> int:
         return _dataset_main(args, level, inputs, candidate, mode, tol, run_dir)
     if args.sweep:
         return _sweep(args, inputs, level, tol, run_dir)
+    if args.suite == "spec":
+        return _spec_suite(args, candidate, level, run_dir)
     if args.suite:
         return _suite(level, run_dir)
     for scene in inputs.scenes:     # a valid file with nothing in it: said once here, not only in the table
@@ -490,6 +502,37 @@ def _suite(level, run_dir) -> int:
           "within their derived bounds" + (f" (failed: {', '.join(failed)})" if failed else ""))
     print(f"Report: {run_dir / 'extremes.md'} (also extremes.json)")
     return 1 if failed else 0
+
+
+def _spec_suite(args, candidate, level, run_dir) -> int:
+    """``--suite spec`` (oracles.spec): the 24 runs and 7 named checks; spec.json and spec.md; exit 0 or 1."""
+    from wirecheck.core.outputs.output import FrameDir, json_dumps
+
+    from .spec import FRAME_COUNTS, run_spec, spec_console, spec_markdown
+
+    def progress(done, total):
+        print(f"  runs of {FRAME_COUNTS[done - 1]} frames done ({done}/{total})", file=sys.stderr, flush=True)
+
+    result, status = _run_guarded(args, TerminalProgress(None), lambda: run_spec(
+        candidate, level=level, candidate_name=candidate.name, progress=progress))
+    if status is not None:
+        return status
+    result = {"run": args.run, **result}
+    try:
+        run_dir.parent.mkdir(parents=True, exist_ok=True)     # only now: a failed run leaves no folder
+        out = FrameDir(run_dir, "--report-dir")
+        try:
+            out.write("spec.json", json_dumps(result).encode())
+            out.write("spec.md", spec_markdown(result).encode())
+            out.commit()
+        except BaseException:
+            out.abort()
+            raise
+    except OSError as exc:
+        return _error(f"writing {str(run_dir)!r} failed: {exc}")
+    print("\n".join(spec_console(result)))
+    print(f"Report: {run_dir / 'spec.md'} (also spec.json)")
+    return 0 if result["verdict"] == "pass" else 1
 
 
 if __name__ == "__main__":

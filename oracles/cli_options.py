@@ -116,9 +116,11 @@ def build_parser() -> argparse.ArgumentParser:
     mode.add_argument("--sweep", action="store_true",
                       help="every --dtype x --clip x --raster setting of core on the scenes and a large mesh: "
                            "table and Pareto plot of time per frame against accuracy (default: off)")
-    mode.add_argument("--suite", choices=("extremes",), default=None,
+    mode.add_argument("--suite", choices=("extremes", "spec"), default=None,
                       help="extremes: near plane, tiny/huge FOV, extreme aspect, far from the origin, "
-                           "1,000,000-frame periodicity, degenerate and non-finite inputs (default: none)")
+                           "1,000,000-frame periodicity, degenerate and non-finite inputs; spec: the "
+                           "specification's 24-run test matrix and its 7 named checks, of core or --candidate "
+                           "(docs/spec-suite.md) (default: none)")
     p.add_argument("--allow-vacuous", action="store_true", default=False,
                    help="a case that compared nothing (every point clipped, nothing drawn) does not fail the run "
                         "(default: it does)")

@@ -27,6 +27,7 @@ examples:
   crosscheck export job/ ; crosscheck --candidate-frames job/   judge a renderer's own PNGs
   crosscheck --junit-xml out.xml --report-dir reports/ci        for CI
   crosscheck --suite extremes                     numerical extremes; --sweep: speed vs accuracy
+  crosscheck --suite spec --candidate my_proj.py:project   the specification's matrix and checks
 settings also come from [tool.wirecheck] in pyproject.toml (docs/pytest.md); docs: docs/crosscheck.md"""
 
 _ONE_ARGUMENT = re.compile(r"^argument (--[\w-]+)(?:/[^:]*)?: expected one argument$")
