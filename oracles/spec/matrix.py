@@ -73,6 +73,7 @@ def run_matrix(candidate, level: str = "pixels", candidate_name: str = "core", p
         if level == "pixels":
             totals["pixels"] += report["compared"]["pixels"]
         for record in report["cases"]:
+            record.pop("framing")           # the camera is placed by the specification (camera_spec), not framed
             runs.append({"run": f"{record['scene']}/{record['camera']}/{frames}", "frames": frames, **record})
         if progress:
             progress(i + 1, len(FRAME_COUNTS))

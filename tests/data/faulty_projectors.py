@@ -87,3 +87,18 @@ def divides_before_clipping(points, camera):
         out.append([np.nan, np.nan] if not camera.near <= z <= camera.far else
                    [(camera.width - 1) / 2 + f * u, (camera.height - 1) / 2 - f * v])
     return np.array(out, dtype=np.float64).reshape(-1, 2)
+
+
+def clips_at_camera(points, camera):
+    """Clips at the camera (keeps every z > 0), not at the near plane."""
+    px = no_clipping(points, camera)
+    z = (points - camera.position) @ camera.forward
+    px[~((z > 0) & (z <= camera.far))] = np.nan
+    return px
+
+
+def fails_on_empty(points, camera):
+    """Correct, but takes the largest coordinate first: numpy's max of no points raises ValueError."""
+    if np.abs(points).max() > 1e12:
+        raise ValueError("too far")
+    return project(points, camera)
