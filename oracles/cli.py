@@ -508,13 +508,10 @@ def _spec_suite(args, candidate, level, run_dir) -> int:
     """``--suite spec`` (oracles.spec): the 24 runs and 7 named checks; spec.json and spec.md; exit 0 or 1."""
     from wirecheck.core.outputs.output import FrameDir, json_dumps
 
-    from .spec import FRAME_COUNTS, run_spec, spec_console, spec_markdown
-
-    def progress(done, total):
-        print(f"  runs of {FRAME_COUNTS[done - 1]} frames done ({done}/{total})", file=sys.stderr, flush=True)
+    from .spec import run_spec, spec_console, spec_markdown
 
     result, status = _run_guarded(args, TerminalProgress(None), lambda: run_spec(
-        candidate, level=level, candidate_name=candidate.name, progress=progress))
+        candidate, level=level, candidate_name=candidate.name))
     if status is not None:
         return status
     result = {"run": args.run, **result}

@@ -8,7 +8,8 @@ from ..reports.report import console_table, fault_hints, fault_text, gl_text
 
 def _run_rows(result: dict) -> list[dict]:
     """The runs as crosscheck table rows: the camera cell says the distance, FOV and frame count."""
-    return [{**r, "camera": f"{r['camera']}, {r['frames']} frames"} for r in result["runs"]]
+    return [{**r, "camera": f"{r['camera']}, {r['frames']} frame{'' if r['frames'] == 1 else 's'}"}
+            for r in result["runs"]]
 
 
 def _err(v) -> str:
