@@ -71,7 +71,7 @@ from pathlib import Path
 from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
 from wirecheck.core.app.guard import run_cli  # noqa: E402
 from wirecheck.core.limits import check_candidate_timeout
-from wirecheck.core.outputs.output import check_replaceable, check_report_dir
+from wirecheck.core.outputs.output import FrameDir, check_replaceable, check_report_dir, json_dumps
 
 from .judge import gate, tolerances
 from .candidates.isolation import external_candidate
@@ -85,6 +85,7 @@ from .reports.report_option import check_no_report, report_line
 from .reports.compared import hint_lines, reason_text, what_text
 from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import level_for_oracles, run_crosscheck
+from .spec import run_spec, spec_console, spec_markdown
 from .judge.tolerances import Tolerances
 from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
 
@@ -506,10 +507,6 @@ def _suite(level, run_dir) -> int:
 
 def _spec_suite(args, candidate, level, run_dir) -> int:
     """``--suite spec`` (oracles.spec): the 24 runs and 7 named checks; spec.json and spec.md; exit 0 or 1."""
-    from wirecheck.core.outputs.output import FrameDir, json_dumps
-
-    from .spec import run_spec, spec_console, spec_markdown
-
     result, status = _run_guarded(args, TerminalProgress(None), lambda: run_spec(
         candidate, level=level, candidate_name=candidate.name))
     if status is not None:
