@@ -125,13 +125,17 @@ def _parse(args):
             ("--min-f1", args.min_f1 != tolerances.MIN_F1_1PX),
             ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX),
             ("--min-iou", args.min_iou != tolerances.MIN_SILHOUETTE_IOU),
-            ("--candidate-precision", args.candidate_precision is not None),
+            ("--candidate-precision", args.candidate_precision is not None and args.suite != "spec"),
             ("--allow-vacuous", args.allow_vacuous)) if given]
         if ignored:
-            allowed = ("--level, --gl, --run, --report-dir, --candidate or --candidate-cmd" if args.suite == "spec"
+            allowed = ("--level, --gl, --run, --report-dir, --candidate, --candidate-cmd or --candidate-precision"
+                       if args.suite == "spec"
                        else "--level, --run or --report-dir")
             raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
                              f"bounds are fixed (oracles/{args.suite}/); expected only {allowed}")
+        if args.suite == "spec" and args.candidate_precision is not None and not external:
+            raise InputError(f"--suite spec with --candidate-precision {args.candidate_precision} and no --candidate: "
+                             "core says its own precision: expected --candidate or --candidate-cmd with it")
         if args.suite == "spec" and core_given:
             raise InputError(f"--suite spec with {', '.join(core_given)}: the suite judges core in its default "
                              "settings, or --candidate/--candidate-cmd: expected no --dtype/--clip/--raster")
@@ -508,7 +512,7 @@ def _suite(level, run_dir) -> int:
 def _spec_suite(args, candidate, level, run_dir) -> int:
     """``--suite spec`` (oracles.spec): the 24 runs and 7 named checks; spec.json and spec.md; exit 0 or 1."""
     result, status = _run_guarded(args, TerminalProgress(None), lambda: run_spec(
-        candidate, level=level, candidate_name=candidate.name))
+        candidate, level=level, candidate_name=candidate.name, precision=args.candidate_precision))
     if status is not None:
         return status
     result = {"run": args.run, **result}

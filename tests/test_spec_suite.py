@@ -170,6 +170,32 @@ def test_the_correct_user_projector_passes_every_check():
     assert [(c["name"], c["verdict"]) for c in results] == [(n, "pass") for n in CHECKS]
 
 
+def test_float32_candidates_are_held_to_their_precision():
+    glm = DATA / "candidates" / "glm_f32.py"
+    # float32 answers: judged at the float32 bound (~1e-3 px), as the runs judge them
+    assert all(c["verdict"] == "pass" for c in run_checks(load_candidate(f"{glm}:project")))
+    # the same float32 values returned as float64: 3e-5 px off, past the float64 bound, named for what it is
+    # (a float32 near plane, a float32 computation), and passing once declared float32
+    f64_view = load_candidate(f"{glm}:project_f64_view")
+    failed = {c["name"]: c for c in run_checks(f64_view) if c["verdict"] == "fail"}
+    assert set(failed) == {"known_point", "rotation_invariance", "near_plane_depth"}
+    assert [f["name"] for f in failed["known_point"]["faults"]] == ["precision_limited"]
+    assert [f.get("kind") for f in failed["near_plane_depth"]["faults"]] == ["float32_near"]
+    declared = run_checks(f64_view, precision="float32")
+    assert [c["verdict"] for c in declared] == ["pass"] * 7
+    assert 1e-4 < declared[0]["bound_px"] < 1e-2 and declared[0]["error_px"] > 1e-6
+
+
+@pytest.mark.slow
+def test_declared_precision_reaches_the_runs_and_the_checks(tmp_path):
+    rc, result, out, err = _suite(tmp_path, "--level", "vertices", "--candidate-precision", "float32", "--candidate",
+                                  f"{DATA / 'candidates' / 'glm_f32.py'}:project_f64_view")
+    assert rc == 0, out + err
+    assert result["candidate_precision"] == "float32"
+    assert {(r["precision"]["judged_as"], r["precision"]["source"]) for r in result["runs"]} == {("float32", "declared")}
+    assert all(1e-4 < c["bound_px"] < 1e-2 for c in result["checks"][:2])
+
+
 def test_a_suite_that_ran_less_never_passes():
     verdict, why = suite_verdict([], [])
     assert verdict == "fail"
@@ -186,7 +212,7 @@ def test_a_suite_that_ran_less_never_passes():
 @pytest.mark.parametrize("args,needle", [
     (["--frames", "3"], "--suite spec with --frames: "),
     (["--scene", "cube"], "--suite spec with --scene: "),
-    (["--candidate-precision", "float32"], "--suite spec with --candidate-precision: "),
+    (["--candidate-precision", "float32"], "--suite spec with --candidate-precision float32 and no --candidate: "),
     (["--dtype", "float32"], "--suite spec with --dtype: "),
     (["--hidden-lines"], "--hidden-lines with --suite spec: "),
     (["--junit-xml", "x.xml"], "--junit-xml with --suite spec: "),

@@ -48,13 +48,19 @@ def suite_verdict(runs: list, checks: list) -> tuple[str, list[str]]:
     return ("fail" if why else "pass"), why
 
 
-def run_spec(candidate, level: str = "pixels", candidate_name: str = "core", progress=None) -> dict:
+def run_spec(candidate, level: str = "pixels", candidate_name: str = "core", progress=None,
+             precision: str | None = None) -> dict:
     """The whole suite: ``{"suite", "verdict", "why", "candidate", "level", "oracle_gl", "matrix",
-    "summary", "runs", "checks", "timing"}``; only ``"timing"`` varies from run to run."""
+    "summary", "runs", "checks", "timing"}``; only ``"timing"`` varies from run to run.
+
+    ``precision``: the candidate's declared precision (``--candidate-precision``), for the runs' vertex
+    bounds and the checks' alike; default: the dtype it returns.
+    """
     t0 = time.perf_counter()
-    matrix = run_matrix(candidate, level=level, candidate_name=candidate_name, progress=progress)
+    matrix = run_matrix(candidate, level=level, candidate_name=candidate_name, progress=progress,
+                        precision=precision)
     t1 = time.perf_counter()
-    checks = run_checks(candidate)
+    checks = run_checks(candidate, precision=precision)
     runs = matrix["runs"]
     verdict, why = suite_verdict(runs, checks)
     return {
@@ -62,6 +68,7 @@ def run_spec(candidate, level: str = "pixels", candidate_name: str = "core", pro
         "verdict": verdict,
         "why": why,
         "candidate": candidate_name,
+        "candidate_precision": precision,
         "level": level,
         "oracle_gl": matrix["oracle_gl"],
         "matrix": {"scenes": list(SCENES), "camera_z": list(CAMERA_Z), "fov_deg": list(FOVS),

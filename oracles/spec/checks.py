@@ -37,10 +37,10 @@ from wirecheck.core.transforms import Motion   # core's motion: under test for t
 from ..candidates.candidate import CandidateError, call_candidate_precision
 from ..candidates.core_candidate import CoreCandidate
 from ..candidates.draw import draw_candidate
-from ..diagnosis.clip_planes import FLOAT32_PLANE_ROUNDINGS, PLANE_REL_TOL, clip_fault, probe_planes
+from ..diagnosis.clip_planes import FLOAT32_PLANE_ROUNDINGS, PLANE_REL_TOL, clip_fault, depth_slack, probe_planes
 from ..diagnosis.diagnose import diagnose
 from ..judge.cases import Case
-from ..judge.tolerances import EPS, vertex_bound, vertex_scale
+from ..judge.tolerances import EPS, Tolerances, vertex_bound, vertex_scale
 from ..runner import run_crosscheck
 from .matrix import CAMERA, TURNS
 
@@ -63,7 +63,8 @@ def expected_px(x_n, y_n) -> np.ndarray:
 class _Check:
     """One check's outcome, built as it runs."""
 
-    def __init__(self, name: str, kind: str, proves: str):
+    def __init__(self, name: str, declared: str | None, kind: str, proves: str):
+        self.declared = declared          # --candidate-precision: wins over the dtype the candidate returns
         self.out = {"name": name, "kind": kind, "proves": proves, "verdict": "pass", "error_px": None,
                     "bound_px": None, "reasons": [], "faults": [], "expected": {}}
 
@@ -84,10 +85,11 @@ class _Check:
     def call(self, func, points, camera, what: str):
         """``(px, precision)``, or None after failing the check: a crash or a contract violation."""
         try:
-            return call_candidate_precision(func, np.asarray(points, dtype=np.float64).reshape(-1, 3), camera)
+            px, returned = call_candidate_precision(func, np.asarray(points, dtype=np.float64).reshape(-1, 3), camera)
         except CandidateError as exc:
             self.fail(f"{what}: {exc}")
             return None
+        return px, self.declared or returned
 
     def clip_faults(self, func, camera) -> None:
         """Name the candidate's own clipping planes, probed (oracles.diagnosis.clip_planes)."""
@@ -99,6 +101,15 @@ class _Check:
 def _bound(precision: str, points, px, camera) -> float:
     """The crosscheck vertex bound of ``precision`` at these points (module docstring)."""
     return vertex_bound(precision, vertex_scale(points, px, camera))
+
+
+def _named(func, got_px, want_px, camera, precision: str, scale: float, tol_px: float, clipping: bool) -> list:
+    """Faults of ``got_px`` against ``want_px``, named as a crosscheck case names them (oracles.judge.verdict):
+    a float64 answer whose error is float32 rounding is ``precision_limited``; with ``clipping``, a visible set
+    that differs is named by the candidate's own planes, probed."""
+    bound32 = vertex_bound("float32", scale) if precision == "float64" else None
+    planes = probe_planes(func, camera) if clipping else None
+    return diagnose(got_px, want_px, camera, tol_px=tol_px, float32_px=bound32, planes=planes)
 
 
 def _worst(got: np.ndarray, want: np.ndarray) -> tuple[float, int]:
@@ -126,8 +137,8 @@ KNOWN_NORMALISED = np.array([[0.0, 0.0], [1 / 3, 1 / 6], [-1 / 3, 1 / 6], [1 / 3
                              [0.25, -0.125], [0.4, -0.6], [-0.2, 0.4]])
 
 
-def known_point(func) -> dict:
-    check = _Check("known_point", "critical",
+def known_point(func, declared: str | None = None) -> dict:
+    check = _Check("known_point", declared, "critical",
                    "points of known depth (1.5, 3, 6) land on their normalised coordinates (X/z, Y/z): "
                    "the divide, the focal length of the vertical FOV, the principal point and both axes' signs")
     camera = spec_camera()
@@ -147,7 +158,8 @@ def known_point(func) -> dict:
         check.fail(f"point {KNOWN_POINTS[k].tolist()} (depth {D - KNOWN_POINTS[k][2]:g}) projects to "
                    f"{px[k].tolist()}, expected ({x_n:.6g}, {y_n:.6g}) normalised = {want[k].tolist()} px: "
                    f"{err:.3g} px > {bound:.3g} px")
-        check.faults(diagnose(px, want, camera, tol_px=bound, planes=probe_planes(func, camera)))
+        check.faults(_named(func, px, want, camera, precision, vertex_scale(KNOWN_POINTS, want, camera), bound,
+                            clipping=True))
     return check.out
 
 
@@ -171,8 +183,8 @@ def turn(theta: float) -> np.ndarray:
     return r_y @ r_x
 
 
-def rotation_invariance(func) -> dict:
-    check = _Check("rotation_invariance", "critical",
+def rotation_invariance(func, declared: str | None = None) -> dict:
+    check = _Check("rotation_invariance", declared, "critical",
                    "a 360 deg turn returns every vertex to its start: turned in 45 deg steps with the camera "
                    "turned alike, the picture stays the start's at every step (the projector uses the "
                    "camera's orientation, not a fixed one), and the scene turned a full turn alone comes "
@@ -219,7 +231,7 @@ def rotation_invariance(func) -> dict:
         check.fail(f"scene and camera turned {360 * k // ROTATION_STEPS} deg together: corner "
                    f"{UNIT_CUBE[row].tolist()} at {px[row].tolist()}, at rest {px0[row].tolist()}: "
                    f"{worst[0]:.3g} px > {bound:.3g} px (the picture must not change)")
-        check.faults(diagnose(px, px0, camera, tol_px=bound))
+        check.faults(_named(func, px, px0, camera, precision, scale, bound, clipping=False))
     if err_full > bound:
         check.fail(f"after a full turn ({how}) corner {UNIT_CUBE[row_full].tolist()} is at "
                    f"{got[0][row_full].tolist()}, at rest {px0[row_full].tolist()}: {err_full:.3g} px > {bound:.3g} px")
@@ -234,8 +246,8 @@ MONOTONIC_DEPTHS = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 MONOTONIC_XY = ((0.25, 0.25), (-0.5, 0.125))
 
 
-def depth_monotonicity(func) -> dict:
-    check = _Check("depth_monotonicity", "critical",
+def depth_monotonicity(func, declared: str | None = None) -> dict:
+    check = _Check("depth_monotonicity", declared, "critical",
                    "for identical x, y a farther z lands closer to the centre: the distance from the principal "
                    "point is f |(x, y)| / z, halving at each doubling of depth from 0.5 to 64")
     camera = spec_camera()
@@ -280,14 +292,17 @@ ON_EDGE = np.array([[0.5, 0.5, 2.0]])
 
 def _frame(func, points, edges, camera, precision: str) -> np.ndarray:
     """The frame crosscheck judges: core's own pipeline, or the harness's drawing of the candidate's pixels
-    (oracles.candidates.draw: edges clipped in world space, the clipped ends projected by the candidate)."""
+    (oracles.candidates.draw: edges clipped in world space, the clipped ends projected by the candidate and
+    moved inside its own probed planes where those differ from the camera's by float32 rounding, as a run
+    moves them: oracles.diagnosis.clip_planes.depth_slack)."""
     if isinstance(func, CoreCandidate):
         return func.draw(points, edges, camera, np.eye(4))
-    return draw_candidate(func, points, edges, camera, precision)
+    slack, _ = depth_slack(probe_planes(func, camera), camera) if len(edges) else (0.0, None)
+    return draw_candidate(func, points, edges, camera, precision, slack)
 
 
-def clip_safety(func) -> dict:
-    check = _Check("clip_safety", "critical",
+def clip_safety(func, declared: str | None = None) -> dict:
+    check = _Check("clip_safety", declared, "critical",
                    "points behind the camera are not drawn and do not crash the projection: NaN for them and "
                    "for a point on the camera's plane (a divide by zero), the points in front beside them "
                    "unchanged, and an edge that passes behind the camera drawn only in front of it")
@@ -368,8 +383,8 @@ def _near_delta(precision: str) -> float:
     return 2.0 * (PLANE_REL_TOL if precision == "float64" else FLOAT32_PLANE_ROUNDINGS * EPS["float32"])
 
 
-def near_plane_depth(func) -> dict:
-    check = _Check("near_plane_depth", "edge",
+def near_plane_depth(func, declared: str | None = None) -> dict:
+    check = _Check("near_plane_depth", declared, "edge",
                    "the near plane is where clipping starts: a point just inside near is kept, one just "
                    "outside is NaN, one exactly at near may be either (a rounding decides), and none crashes")
     # camera at the origin looking down -Z: depth = -Z exactly, so near is hit to the bit; (x, y) = (0.01,
@@ -399,8 +414,8 @@ def near_plane_depth(func) -> dict:
     return check.out
 
 
-def behind_camera(func) -> dict:
-    check = _Check("behind_camera", "edge",
+def behind_camera(func, declared: str | None = None) -> dict:
+    check = _Check("behind_camera", declared, "edge",
                    "a mesh wholly behind the camera shows nothing: every vertex NaN and an empty frame, "
                    "where through the divide its mirror image would fill the middle of the picture")
     camera = spec_camera()
@@ -434,8 +449,8 @@ def behind_camera(func) -> dict:
 EMPTY = Scene(name="empty_mesh", vertices=np.zeros((0, 3)), edges=np.zeros((0, 2), dtype=np.int64))
 
 
-def empty_mesh(func) -> dict:
-    check = _Check("empty_mesh", "edge",
+def empty_mesh(func, declared: str | None = None) -> dict:
+    check = _Check("empty_mesh", declared, "edge",
                    "an empty mesh is projected without a crash ((0, 3) points -> (0, 2) pixels), draws nothing, "
                    "and a crosscheck of it is vacuous: a gate never passes on nothing")
     camera = spec_camera()
@@ -452,6 +467,7 @@ def empty_mesh(func) -> dict:
             check.fail(f"an empty mesh drew {int(image.sum())} pixels: expected none")
     # the runner on it, at level vertices (nothing to draw): the case compares nothing
     report, _ = run_crosscheck([EMPTY], func, frames=1, level="vertices", turns=TURNS, animation=False,
+                               tol=Tolerances(precision=declared),
                                cases=(Case("z3_fov90", camera),))
     case = report["cases"][0]
     check.out["run"] = {"verdict": report["verdict"], "case_verdict": case["verdict"], "reasons": case["reasons"]}
@@ -468,10 +484,14 @@ CHECK_NAMES = tuple(c.__name__ for c in CHECKS)
 CRITICAL = CHECK_NAMES[:4]
 
 
-def run_checks(func, names=CHECK_NAMES) -> list[dict]:
-    """The named checks of ``func`` (a contract callable; core: a CoreCandidate), in :data:`CHECKS` order."""
+def run_checks(func, names=CHECK_NAMES, precision: str | None = None) -> list[dict]:
+    """The named checks of ``func`` (a contract callable; core: a CoreCandidate), in :data:`CHECKS` order.
+
+    ``precision`` (``--candidate-precision``): what the candidate computes in, when its answers' dtype does
+    not say (oracles.candidates.candidate.case_precision); default: that dtype.
+    """
     by_name = {c.__name__: c for c in CHECKS}
     unknown = [n for n in names if n not in by_name]
     if unknown:
         raise ValueError(f"checks {unknown}: expected some of {', '.join(CHECK_NAMES)}")
-    return [by_name[n](func) for n in CHECK_NAMES if n in names]
+    return [by_name[n](func, precision) for n in CHECK_NAMES if n in names]

@@ -51,20 +51,22 @@ def spec_cases() -> tuple[Case, ...]:
                  for z in CAMERA_Z for fov in FOVS)
 
 
-def run_matrix(candidate, level: str = "pixels", candidate_name: str = "core", progress=None) -> dict:
+def run_matrix(candidate, level: str = "pixels", candidate_name: str = "core", progress=None,
+               precision: str | None = None) -> dict:
     """The 24 runs: ``{"runs": [record...], "compared": totals, "oracle_gl", "seconds"}``.
 
     Each record is a crosscheck case record (oracles.judge.verdict) with
     ``"frames"`` and ``"run"`` (``scene/camera/frames``) added, in matrix order
     (frame count, then scene, then camera). ``progress(done, total)`` after each
-    frame count.
+    frame count. ``precision``: the candidate's declared precision (``--candidate-precision``;
+    default: the dtype it returns).
     """
     scenes = [load_scene(name) for name in SCENES]
     runs, gl, seconds = [], None, 0.0
     totals = {"cases": 0, "frames": 0, "vertices": 0, "pixels": 0 if level == "pixels" else None}
     for i, frames in enumerate(FRAME_COUNTS):
         report, _ = run_crosscheck(scenes, candidate, frames=frames, level=level, turns=TURNS,
-                                   tol=Tolerances(), candidate_name=candidate_name, animation=False,
+                                   tol=Tolerances(precision=precision), candidate_name=candidate_name, animation=False,
                                    cases=spec_cases())
         gl = gl or report["oracle_gl"]
         seconds += report["timing"]["wall_s"]

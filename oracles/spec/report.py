@@ -66,7 +66,9 @@ def spec_markdown(result: dict) -> str:
     """spec.md: the matrix, the runs, each check with what it proves, expected values and reasons."""
     m = result["matrix"]
     lines = [f"## Spec suite: {result['verdict'].upper()}", "",
-             f"Candidate: {result['candidate']}. Level: {result['level']}.",
+             f"Candidate: {result['candidate']}"
+             + (f" (declared {result['candidate_precision']})" if result.get("candidate_precision") else "")
+             + f". Level: {result['level']}.",
              *([f"Oracle GL: {gl_text(result)}."] if gl_text(result) else []), "",
              f"Matrix: scenes {', '.join(m['scenes'])} x camera z {', '.join(f'{z:g}' for z in m['camera_z'])} "
              f"(at (0, 0, z) looking at the origin) x FOV {', '.join(f'{f:g}' for f in m['fov_deg'])} x "
