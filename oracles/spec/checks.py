@@ -253,7 +253,7 @@ def depth_monotonicity(func, declared: str | None = None) -> dict:
     camera = spec_camera()
     points = np.array([[x, y, D - z] for x, y in MONOTONIC_XY for z in MONOTONIC_DEPTHS])
     # expected distance from (cx, cy): f sqrt(x^2 + y^2) / z; the smallest step, between z 32 and 64 of
-    # (-0.5, 0.125), is 240 * 0.515 * (1/32 - 1/64) = 1.9 px, far above any precision's bound
+    # (0.25, 0.25), is 240 * 0.354 * (1/32 - 1/64) = 1.3 px, far above any precision's bound (~1e-3 px)
     radius = [[F90 * math.hypot(x, y) / z for z in MONOTONIC_DEPTHS] for x, y in MONOTONIC_XY]
     check.out["expected"] = {"camera": "z 3, FOV 90", "xy": [list(p) for p in MONOTONIC_XY],
                              "depths": list(MONOTONIC_DEPTHS), "distance_px": radius}
