@@ -9,7 +9,8 @@ by hand below from the conventions (core/conventions.py), never by a projector:
     right = forward x up = (1, 0, 0), so p_cam = (X, Y, D - Z): depth z = D - Z, and
     x_n = X / z,  y_n = Y / z                                 (normalised coordinates)
     x_px = cx + f x_n,  y_px = cy - f y_n,  cx = (W - 1) / 2 = 319.5,  cy = (H - 1) / 2 = 239.5
-    FOV 90 at H = 480:  f = (H / 2) / tan(45 deg) = 240 px
+    FOV 90 at H = 480:  f = (H / 2) / tan(45 deg) = 240 px  (tan(pi / 4) rounds to 1 - 1.1e-16: under
+                                                           1e-13 px at any point here)
 
 Critical (the specification's four): ``known_point``, ``rotation_invariance``,
 ``depth_monotonicity``, ``clip_safety``. Edge cases: ``near_plane_depth``,
