@@ -139,6 +139,9 @@ def test_an_unexplained_cell_says_what_it_is_in_words():
                 "offset": [0.1, 0.2], "rotation_deg": 12.000000000000002, "candidate_only": 0, "oracle_only": 0}
     text = cell(rotation, CAMERA)
     assert text == "unexplained(residual 4.12 px, rotated 12 deg)" and "[" not in text
+    # a fit's float noise is no rotation (the lens projector of tests/data/real_world/opencv_k.py on an
+    # orthographic camera: rotation_deg -3.2e-15)
+    assert cell({**rotation, "rotation_deg": -3.2e-15}) == "unexplained(residual 4.12 px)"
     assert cell({"name": "unexplained", "candidate_pixels": 0, "note": "n"}) == "unexplained(nothing drawn)"
     assert cell({"name": "unexplained", "line_level": 100, "hint": "h"}) == \
         "unexplained(lines at level 100 of 255, none drawn)"

@@ -18,6 +18,10 @@ from .fmt import distinct
 
 #: The longest cell, a fault's or a case's (characters).
 CELL_MAX = 60
+#: The smallest rotation an ``unexplained`` cell names (degrees): 0.01 deg moves a point 500 px from the
+#: centre by 0.09 px, so a fit's float noise (1e-15 deg) or a rotation that small is no part of what is
+#: wrong; the record keeps ``rotation_deg`` whatever it is.
+ROTATION_SHOWN_DEG = 0.01
 #: Significant digits of a number in report.md's full record (a 16-digit matrix entry is 4).
 FULL_DIGITS = 4
 
@@ -73,7 +77,7 @@ def _unexplained(params: dict) -> str:
     parts = []
     if isinstance(n("residual_px"), (int, float)):
         parts.append(f"residual {n('residual_px'):.3g} px")
-    if isinstance(n("rotation_deg"), (int, float)):
+    if isinstance(n("rotation_deg"), (int, float)) and abs(n("rotation_deg")) >= ROTATION_SHOWN_DEG:
         parts.append(f"rotated {n('rotation_deg'):.3g} deg")
     return ", ".join(parts)
 
