@@ -268,6 +268,12 @@ class Fault:
         """What to check: the fault's own ``hint`` (set where its values say more) or its name's."""
         return self.params.get("hint") or self.kind.hint
 
+    def shown(self, limit: int = 2) -> list[tuple[str, str, Any]]:
+        """``(field, label, value)`` of the first ``limit`` of the catalogue's shown fields this fault has
+        (not None): the key numbers of its table cell (formatted by oracles.reports.fault_text.cell)."""
+        return [(key, label, self.params[key]) for key, label in self.kind.shown
+                if self.params.get(key) is not None][:limit]
+
     @property
     def note(self) -> str | None:
         """What the naming step adds about this fault in words (a measured end, a rule), if anything."""

@@ -68,6 +68,7 @@ def test_a_fault_is_its_record_read_through_the_catalogue():
     f = Fault.of(record)
     assert f.as_dict() == record and list(f.as_dict()) == list(record)      # report.json's shape and order
     assert f.family == "scale" and f.hint == "the scale is W/H"              # its own hint first
+    assert f.shown() == [("implied_fov_deg", "fov", 75.2)]                      # None: not implied, not shown
     assert Fault("fov_mismatch").hint == CATALOGUE["fov_mismatch"].hint
     with pytest.raises(dataclasses.FrozenInstanceError):
         f.name = "pixel_offset"

@@ -92,8 +92,7 @@ def cell(fault: dict, camera: dict | None = None, fields: int = 2) -> str:
         text = f"unexplained({what})" if what else "unexplained"
         return text if len(text) <= CELL_MAX else "unexplained"
     nominal = fault_nominals(camera)
-    shown = [(key, label) for key, label in f.kind.shown if f.params.get(key) is not None][:fields]
-    parts = [(f"{label}=" if label else "") + _value(f.params[key], nominal.get(key)) for key, label in shown]
+    parts = [(f"{label}=" if label else "") + _value(value, nominal.get(key)) for key, label, value in f.shown(fields)]
     text = f"{f.name}({', '.join(parts)})" if parts else f.name
     if len(text) > CELL_MAX and fields:
         return cell(fault, camera, fields - 1)
