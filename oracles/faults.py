@@ -34,7 +34,7 @@ __all__ = ["FaultKind", "Fault", "CATALOGUE", "FAMILIES", "NAMES", "kind", "fami
            "ordered", "hint_text", "markdown_table"]
 
 #: The families, each a question about the picture.
-FAMILIES = {
+FAMILIES: Mapping[str, str] = MappingProxyType({
     "orientation": "the picture is turned, mirrored or seen from behind as a whole",
     "ambiguous": "two orientations fit the images equally well",
     "clipping": "the points kept differ from near <= z <= far",
@@ -45,7 +45,7 @@ FAMILIES = {
     "line_rule": "the lines are right but drawn under another rule than GL's",
     "precision": "float32 rounding, not a convention error",
     "unexplained": "no simple image-space fault",
-}
+})
 
 
 @dataclass(frozen=True)
