@@ -382,8 +382,12 @@ def _main(argv=None) -> int:
     for r in records:
         if r["verdict"] != "pass":
             print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
-        elif r.get("note"):
-            print(f"  {r['scene']} / {r['camera']}: {r['note']}")
+    notes = {}                              # a passing case's note, once per text: its cases named together
+    for r in records:
+        if r["verdict"] == "pass" and r.get("note"):
+            notes.setdefault(r["note"], []).append(f"{r['scene']} / {r['camera']}")
+    for note, where in notes.items():
+        print(f"  {', '.join(where)}: {note}")
     for line in hint_lines(report, [r for r in records if r["verdict"] != "pass"]):
         print(line)
     s = report["summary"]

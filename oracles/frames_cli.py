@@ -102,7 +102,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     """
     from .candidates.frames_candidate import run_frames
     from .judge.line_style import summary_lines
-    from .reports.compared import what_text
+    from .reports.compared import hint_lines, what_text
     from .reports.report import console_table, write_report
     from .reports.report_option import report_line
     from .judge.tolerances import Tolerances
@@ -142,9 +142,11 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     print(console_table(report["cases"]))
     for line in summary_lines(report["cases"]):
         print(line)
-    for r in report["cases"]:
-        if r["verdict"] != "pass":          # failed, or vacuous (compared nothing)
-            print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+    failing = [r for r in report["cases"] if r["verdict"] != "pass"]    # failed, or vacuous (compared nothing)
+    for r in failing:
+        print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+    for line in hint_lines(report, failing):    # what to check and each fault kind's note, once
+        print(line)
     print("\n" + verdict_line(report, tol))
     print(report_line(args, run_dir, "report.json", "report.md, report.html"))
     return 1 if report["verdict"] != "pass" else 0

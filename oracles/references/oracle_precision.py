@@ -66,6 +66,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import faults as catalogue
+
 __all__ = ["U32", "CLIP_XY_ROUNDINGS", "CLIP_W_ROUNDINGS", "VIEWPORT_ROUNDINGS", "ORACLE_LIMIT_PX", "mesh_radius", "frame_bound_px",
            "drawn_bound_px",
            "judge_oracle_precision"]
@@ -194,8 +196,6 @@ def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error,
     vertex_reasons = vertices_only["reasons"] if vertices_only["verdict"] == "fail" else []
     rec["verdict"] = "fail" if vertex_reasons else "vacuous"
     rec["reasons"] = [why] + vertex_reasons
-    from ..diagnosis.diagnose import LINE_FAULTS
-
     # a line fault is read from the pixels (line counts against the oracle's): those say nothing here
-    rec["faults"] = [f for f in rec.get("faults") or [] if f.get("name") not in LINE_FAULTS]
+    rec["faults"] = [f for f in rec.get("faults") or [] if catalogue.kind(f["name"]).source != "pixels"]
     rec["oracle_precision"] = True
