@@ -47,6 +47,11 @@ class RequestError(Exception):
         self.status = status
 
 
+#: Headers a request may carry once at most: with two Host headers (a valid one, then another) or two
+#: lengths, a proxy in front and this server could each read a different one (RFC 9112 3.2, 6.3): 400.
+ONE_ONLY = ("Host", "Origin", "Content-Length", "Content-Type")
+
+
 def _reject_constant(name):
     raise ValueError(f"{name} is not JSON; expected a finite number")
 
@@ -129,6 +134,10 @@ def _handler(viewer: Viewer):
             own name resolving to 127.0.0.1: the Host header still says its name)
             or post to it directly (the Origin header says its site).
             """
+            for name in ONE_ONLY:             # which one counts? a proxy and this server may read different ones
+                count = len(self.headers.get_all(name) or ())
+                if count > 1:
+                    raise RequestError(HTTPStatus.BAD_REQUEST, f"{name} given {count} times: expected one")
             port = self.server.server_address[1]
             hosts = (f"127.0.0.1:{port}", f"localhost:{port}")
             host = (self.headers.get("Host") or "").lower()
