@@ -43,25 +43,26 @@ class Limit(NamedTuple):
 #: kind -> Limit. Each is far above any real file of its kind and low enough that reading it
 #: (wholly, into memory, and parsing it in Python) stays within seconds and a few GB.
 LIMITS = {
-    "config": Limit(16 * MiB, "a pyproject.toml or settings file",
-                    "a pyproject.toml is a few KB; tomllib parses 16 MiB in about a second"),
+    "config": Limit(4 * MiB, "a pyproject.toml or settings file",
+                    "a pyproject.toml is a few KB; tomllib took 10 s for 16 MiB (2 busy cores), so about 3 s here"),
     "scene list": Limit(64 * MiB, "a scene list (one mesh path a line)",
                         "a million paths of 60 characters; every line is kept in memory"),
     "scene": Limit(64 * MiB, "a .scene file",
-                   "about a million 'v'/'e' lines parsed in Python; a larger model is a mesh file"),
+                   "about two million 'v'/'e' lines of 30 bytes, parsed in Python; a larger model is a mesh file"),
     "mesh": Limit(2048 * MiB, "a mesh file",
                   "trimesh holds the file and several arrays of it in memory (a 2 GiB binary PLY is "
-                  "about 80 million triangles, far beyond a legible wireframe)"),
+                  "about 100 million triangles at 19 bytes each, far beyond a legible wireframe)"),
     "mesh companion": Limit(2048 * MiB, "a file a mesh names (mtllib, texture, glTF buffer)",
                             "read wholly into memory by trimesh; as large as a mesh"),
     "job": Limit(256 * MiB, "a job.json of 'crosscheck export'",
-                 "export writes about 1 KB a case; read wholly and parsed as JSON"),
+                 "export writes about 40 bytes a frame of a case (its path): 100,000 frames (the limit) of "
+                 "21 cases are 84 MB; read wholly and parsed as JSON"),
     "camera": Limit(1 * MiB, "a camera file of 'crosscheck export'",
-                    "export writes about 2 KB a frame"),
+                    "export writes about 1.5 KB a frame"),
     "job mesh": Limit(2048 * MiB, "an OBJ of 'crosscheck export'", "as a mesh file"),
     "frame": Limit(512 * MiB, "a PNG frame",
-                   "the largest frame, 2^25 pixels of 16-bit RGBA, is 256 MiB unpacked; zlib adds "
-                   "at most 0.03% to that"),
+                   "the largest frame, 2^25 pixels of 16-bit RGBA, is 256 MiB unpacked; deflate adds "
+                   "under 0.1% to data it cannot compress"),
     "candidate": Limit(16 * MiB, "a candidate's Python file", "a module of 300,000 lines; Python compiles it whole"),
 }
 
