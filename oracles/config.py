@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -88,6 +89,15 @@ class Config:
 
             kwargs["oracles"] = LEVEL_ORACLES[self.values["level"]]
         return kwargs
+
+
+def _absolute(path: Path) -> str:
+    """``path`` resolved (links followed); only made absolute where it cannot be (a link loop: Python 3.11 raises
+    RuntimeError), so that the reader of the file names the loop in its one line."""
+    try:
+        return str(path.resolve())
+    except (RuntimeError, OSError):
+        return os.path.abspath(path)
 
 
 def find_pyproject(start: Path) -> Path | None:
@@ -164,7 +174,7 @@ def validate(table: dict, path: Path) -> dict:
                 raise bad(key, value)
             target, func = value.rsplit(":", 1)
             if target.endswith(".py") or "/" in target:
-                target = str((base / target).resolve())
+                target = _absolute(base / target)
             out[key] = f"{target}:{func}"
         elif key == "candidate-cmd":
             if not (isinstance(value, str) and value.strip()):
@@ -189,11 +199,11 @@ def validate(table: dict, path: Path) -> dict:
             scenes = []
             for name in value:
                 if "/" in name or "\\" in name or Path(name).suffix:
-                    scene_path = (base / name).resolve()
+                    scene_path = base / name
                     refused = problem(scene_path, "mesh" if scene_path.suffix.lower() in MESH_SUFFIXES else "scene")
-                    if refused is not None:
+                    if refused is not None:         # before resolve(): a link loop is named, not a RuntimeError
                         raise bad(key, value, f"existing scene files: {str(scene_path)!r} is not a file ({refused})")
-                    scenes.append(str(scene_path))
+                    scenes.append(_absolute(scene_path))
                 elif name in known:
                     scenes.append(name)
                 else:

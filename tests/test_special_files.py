@@ -21,6 +21,7 @@ import pytest
 from helpers import no_block
 from wirecheck.core import user_files
 from wirecheck.core.user_files import LIMITS, Limit, RefusedFile, open_regular, read_regular
+from wirecheck.oracles import cli as crosscheck_cli
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMEOUT_S = 60
@@ -180,3 +181,34 @@ def test_every_kind_has_a_row_in_the_docs_table():
     rows = {line.split("|")[1].strip(" `"): line for line in table.splitlines() if line.startswith("| `")}
     for kind, limit in LIMITS.items():
         assert f"| {limit.size // MiB:,} MiB |" in rows[kind], (kind, rows.get(kind))
+
+
+# ---- paths named in a [tool.wirecheck] table -------------------------------------------------------------
+
+def _crosscheck(argv, capsys):
+    with no_block(30):
+        rc = crosscheck_cli.main(argv)
+    return rc, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("key, name", [("scenes", "loop.scene"), ("candidate", "loop.py")])
+def test_a_link_loop_named_by_the_config_is_one_line(tmp_path, capsys, key, name):
+    """Before: exit 3, "internal error: RuntimeError: Symlink loop" (Path.resolve on Python 3.11)."""
+    (tmp_path / name).symlink_to(tmp_path / name)
+    value = f'["{name}"]' if key == "scenes" else f'"{name}:project"'
+    (tmp_path / "w.toml").write_text(f"[tool.wirecheck]\n{key} = {value}\n")
+    rc, err = _crosscheck(["--config", str(tmp_path / "w.toml"), "--level", "vertices", "--frames", "1",
+                           "--report-dir", str(tmp_path / "rep")], capsys)
+    assert rc == 2 and err.count("\n") == 1, err
+    assert f"{tmp_path / name}" in err and "Too many levels of symbolic links" in err, err
+
+
+def test_a_config_candidate_that_is_a_fifo_is_refused_before_the_line_that_says_it_runs(tmp_path, capsys):
+    """The settings-trust line ("... chose the Python candidate ...; it runs now") is said only for a candidate
+    that will run: before, it came first and the refusal second (two lines for one exit 2)."""
+    os.mkfifo(tmp_path / "cand.py")
+    (tmp_path / "w.toml").write_text('[tool.wirecheck]\ncandidate = "cand.py:project"\n')
+    rc, err = _crosscheck(["--config", str(tmp_path / "w.toml"), "--level", "vertices", "--frames", "1",
+                           "--scene", "cube", "--report-dir", str(tmp_path / "rep")], capsys)
+    assert rc == 2 and err.count("\n") == 1, err
+    assert "cand.py': a FIFO, not a regular file: expected a candidate's Python file" in err, err
