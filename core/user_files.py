@@ -148,16 +148,25 @@ def open_regular(path, kind: str):
 
 
 def read_regular(path, kind: str) -> bytes:
-    """The bytes of ``path`` (:func:`open_regular`); RefusedFile when it grows past the limit while read."""
+    """The bytes of ``path`` (:func:`open_regular`); RefusedFile when it grows past the limit while read.
+
+    Memory is the file's size, not the limit: the first read asks for the size ``fstat`` gives plus one
+    byte (a file that grew, or a ``/proc`` file of size 0, is read on in 1 MiB steps up to the limit).
+    """
     limit = LIMITS[kind].size
+    chunks, total = [], 0
     with open_regular(path, kind) as fh:
+        want = os.fstat(fh.fileno()).st_size + 1
         try:
-            data = fh.read(limit + 1)
+            while chunk := fh.read(min(want, limit + 1 - total)):
+                chunks.append(chunk)
+                total += len(chunk)
+                if total > limit:
+                    raise RefusedFile(path, f"too large (it grew past {limit:,} bytes while read)", kind)
+                want = MiB
         except OSError as exc:                              # EIO, a file on a failing disk
             raise RefusedFile(path, _os_problem(path, exc), kind) from None
-    if len(data) > limit:
-        raise RefusedFile(path, f"too large (it grew past {limit:,} bytes while read)", kind)
-    return data
+    return b"".join(chunks)
 
 
 def read_text(path, kind: str, encoding: str = "utf-8-sig", errors: str = "strict") -> str:
