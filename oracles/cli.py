@@ -74,7 +74,7 @@ from wirecheck.core.limits import check_candidate_timeout
 from wirecheck.core.outputs.output import FrameDir, check_replaceable, check_report_dir, json_dumps
 
 from .judge import gate, tolerances
-from .candidates.isolation import external_candidate
+from .candidates.isolation import check_python_spec, external_candidate
 from .judge.cases import CASE_NAMES
 from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli, trust_line
@@ -195,6 +195,8 @@ def _candidate(args, external: str | None):
     """The run's candidate: the program of ``--candidate``/``--candidate-cmd``, started, or core in its settings."""
     if external:
         if getattr(args, "candidate_from", None) is not None:    # before the program runs (docs/pytest.md)
+            if args.candidate is not None:
+                check_python_spec(args.candidate)      # a file that is refused runs nothing: no line saying it runs
             print(trust_line(*args.candidate_from), file=sys.stderr, flush=True)
         return external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
     return CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})

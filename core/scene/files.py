@@ -28,19 +28,19 @@ import dataclasses
 import io
 import os
 import re
-import stat
 from pathlib import Path
 
 import numpy as np
 
 from ..projector.culling import winding_problem
 from ..errors import InputError, quiet_libraries
-from .mesh_companions import companion_resolver, file_kind, interrupts_kept
+from .mesh_companions import companion_resolver, interrupts_kept
 from .mesh_checks import check_json, check_off, check_ply_counts, check_stl, number as _number, short as _short
 from ..numbers import plain_int
 from ..limits import MAX_FACE_VERTICES, MAX_NAME, check_turns
 from .model import Scene, SceneObject, face_edges, unique_edges
 from ..transforms import Motion
+from ..user_files import expected, open_regular, open_text, problem, read_text
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "scenes"
 #: Example scenes: loadable by name (``--scene orrery``) but not built-ins, so
@@ -159,9 +159,13 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
             if mesh_path.suffix.lower() not in MESH_SUFFIXES:
                 raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected a file ending in "
                                  f"{' '.join(MESH_SUFFIXES)}")
-            if not mesh_path.is_file():
+            refused = problem(mesh_path, "mesh")
+            if refused == "missing":
                 raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected an existing file "
                                  f"({mesh_path} not found)")
+            if refused is not None:
+                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: {mesh_path}: {refused}: expected "
+                                 f"{expected('mesh')}")
             try:
                 cur.mesh = (lineno, load_mesh_file(mesh_path))
             except InputError as exc:
@@ -236,7 +240,7 @@ def _check_name_length(name: str, path) -> None:
 
 def _obj_statements(path: Path):
     """``(line number, tokens, raw line)`` of each OBJ line that holds a statement (comments dropped)."""
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open_text(path, "mesh") as fh:
         for lineno, raw in enumerate(fh, start=1):
             parts = raw.split("#", 1)[0].split()
             if parts:
@@ -279,13 +283,8 @@ def load_mesh_file(path: Path) -> Scene:
     """
     import trimesh  # lazy: only mesh files need it
 
-    try:
-        st = os.stat(path)
-    except OSError as exc:
-        raise InputError(f"{path}: {exc.strerror or exc}: expected a readable mesh file") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise InputError(f"{path} is {file_kind(st.st_mode)}: expected a regular mesh file (never opened: "
-                         "reading it could block forever)")
+    with open_regular(path, "mesh"):   # a FIFO, a device, a folder or a file over the limit: one line, never read
+        pass
     suffix = path.suffix.lower()
     if suffix == ".obj":
         _check_obj(path)      # every 'v' and 'f' line first: errors with file:line, not trimesh's
@@ -296,13 +295,13 @@ def load_mesh_file(path: Path) -> Scene:
     elif suffix == ".gltf":
         check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
     resolver = companion_resolver(path)
-    source = {"file_obj": str(path), "resolver": resolver}
-    if suffix == ".obj":
-        absolute = _obj_absolute_indices(path)
-        if absolute is not None:     # read from memory: no resolver, so trimesh reads no companion
-            source, resolver = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}, None
+    absolute = _obj_absolute_indices(path) if suffix == ".obj" else None
+    if absolute is not None:     # read from memory: no resolver, so trimesh reads no companion
+        source, resolver = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}, None
+    else:       # trimesh reads the file opened here, never the name: a FIFO put there meanwhile cannot block
+        source = {"file_obj": open_regular(path, "mesh"), "file_type": suffix[1:], "resolver": resolver}
     try:
-        with interrupts_kept(), quiet_libraries():  # trimesh logs tracebacks it recovers from; numpy warns
+        with interrupts_kept(), quiet_libraries(), source["file_obj"]:  # trimesh logs tracebacks it recovers from
             loaded = trimesh.load(**source, process=False, maintain_order=True)
     except Exception as exc:  # trimesh raises many types; one line for the user
         _check_refused(path, resolver)
@@ -361,8 +360,8 @@ def _check_refused(path: Path, resolver) -> None:
     """InputError naming the first companion file of ``path`` the resolver refused (a FIFO, a device)."""
     if resolver is not None and resolver.refused:
         name, exc = resolver.refused[0]
-        raise InputError(f"{path}: the file it names {_short(name)} ({exc.path}) is {exc.kind}: expected a "
-                         "regular file (never opened: reading it could block forever)")
+        raise InputError(f"{path}: the file it names {_short(name)} ({exc.path}): {exc.problem}: expected "
+                         f"{expected(exc.kind)}")
 
 
 #: OBJ statements (the Wavefront spec's, free-form geometry included); others are ignored by readers,
@@ -426,7 +425,7 @@ def _obj_absolute_indices(path: Path) -> str | None:
     counts = {"v": 0, "vt": 0, "vn": 0}
     kinds = ("v", "vt", "vn")                   # the fields of 'v/vt/vn'
     lines, changed = [], False
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open_text(path, "mesh") as fh:
         for raw in fh:
             parts = raw.split("#", 1)[0].split()
             if parts and parts[0] in counts:
@@ -505,8 +504,9 @@ def load_scene(name_or_path: str) -> Scene:
                 os.stat(path)         # ELOOP (a symbolic link loop), EACCES: named by the OSError below
             except FileNotFoundError:
                 raise InputError(f"--scene {name_or_path!r}: file not found") from None
-            raise InputError(f"--scene {name_or_path!r}: not a regular file (a device, FIFO or socket): "
-                             "expected a scene file")
+            refused = problem(path, "scene")
+            raise InputError(f"--scene {name_or_path!r}: {refused}: expected a scene or mesh file "
+                             "(never opened: reading it could block forever)")
     except OSError as exc:      # ENAMETOOLONG, ELOOP, EACCES on a folder of the path
         raise InputError(f"--scene {_short(name_or_path)}: {exc.strerror or exc}: expected a readable file") from None
     suffix = path.suffix.lower()
@@ -515,8 +515,8 @@ def load_scene(name_or_path: str) -> Scene:
     if suffix not in (NATIVE_SUFFIX, ".txt"):
         raise InputError(f"{path}: suffix {path.suffix!r}: expected {NATIVE_SUFFIX} or one of {' '.join(MESH_SUFFIXES)}")
     try:
-        text = path.read_text(encoding="utf-8-sig")      # a byte-order mark (Windows editors) is not a tag
-    except (OSError, UnicodeDecodeError) as exc:
+        text = read_text(path, "scene")      # a byte-order mark (Windows editors) is not a tag
+    except UnicodeDecodeError as exc:
         raise InputError(f"{path}: could not be read: {exc}") from None
     scene = parse_scene_text(text, str(path))
     folder = path.resolve().parent

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import importlib.machinery
 import importlib.util
 import inspect
 import sys
@@ -38,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.user_files import expected, problem, read_regular
 
 
 @contextlib.contextmanager
@@ -62,6 +64,15 @@ def _candidate_imports(folder: str | None = None):
         sys.dont_write_bytecode = before
         if added and folder in sys.path:
             sys.path.remove(folder)
+
+
+class _RegularSourceLoader(importlib.machinery.SourceFileLoader):
+    """Python's source loader, reading the candidate's file through core.user_files (never blocking, limited)."""
+
+    def get_data(self, path):
+        if path == self.path:
+            return read_regular(path, "candidate")
+        return super().get_data(path)
 
 
 class _Loaded:
@@ -90,13 +101,17 @@ def load_candidate(spec: str):
     folder = None
     if target.endswith(".py") or "/" in target:
         path = Path(target)
-        if not path.is_file():
+        refused = problem(path, "candidate")
+        if refused == "missing":
             raise InputError(f"--candidate {spec!r}: file {target!r} not found")
+        if refused is not None:         # a FIFO, a device, a folder: never opened (reading it could block forever)
+            raise InputError(f"--candidate {spec!r}: {target}: {refused}: expected {expected('candidate')}")
         mod_name = f"wirecheck_candidate_{path.stem}"
         folder = str(path.resolve().parent)        # like running a script: the candidate's own folder is importable
         try:
             with _candidate_imports(folder):
-                module_spec = importlib.util.spec_from_file_location(mod_name, path)
+                module_spec = importlib.util.spec_from_file_location(mod_name, path,
+                                                                     loader=_RegularSourceLoader(mod_name, str(path)))
                 module = importlib.util.module_from_spec(module_spec)
                 sys.modules[mod_name] = module
                 module_spec.loader.exec_module(module)

@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import collections
 import dataclasses
-import os
 import time
 from pathlib import Path
 
+from wirecheck.core.user_files import expected, problem
 from wirecheck.core.errors import InputError, one_line
 
 from ..judge import gate
@@ -57,9 +57,11 @@ def _load(entry: MeshEntry):
 
     if entry.error is not None:
         raise InputError(entry.error)
-    if not os.path.isfile(entry.path):
-        raise InputError("file not found" if not os.path.lexists(entry.path) else
-                         "not a readable file (a broken link, or not a regular file)")
+    refused = problem(entry.path, "mesh")
+    if refused == "missing":
+        raise InputError("file not found")
+    if refused is not None:
+        raise InputError(f"{refused}: expected {expected('mesh')}")
     try:
         scene = load_mesh_file(Path(entry.path))
     except Exception as exc:         # any reader's failure is this mesh's, never the run's end
