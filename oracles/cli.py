@@ -171,6 +171,9 @@ def _parse(args):
     else:
         inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol,
                                  names=gate.CLI_NAMES)
+    for scene in inputs.scenes:         # read leniently (core.scene.files): one line each, the run goes on
+        for note in scene.load_notes:
+            print(f"crosscheck: warning: {note}", file=sys.stderr)
     if mode.cull == "backface":
         wound = next((sc for sc in inputs.scenes if sc.faces and sc.winding_note), None)
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error

@@ -65,9 +65,16 @@ def _load(entry: MeshEntry):
     except Exception as exc:         # any reader's failure is this mesh's, never the run's end
         text = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
         for path in (entry.path, one_line(entry.path)):        # as the reader wrote it, or made one line
-            text = text.replace(f"{path}: ", "").replace(path, entry.name)
-        raise InputError(text) from None
+            text = text.replace(f"{path}: ", "")
+        raise InputError(_named(text, entry)) from None
     return dataclasses.replace(scene, name=entry.name, source=entry.name)
+
+
+def _named(text: str, entry: MeshEntry) -> str:
+    """``text`` with the mesh's path (as the reader wrote it, or made one line) replaced by its dataset name."""
+    for path in (entry.path, one_line(entry.path)):
+        text = text.replace(path, entry.name)
+    return text
 
 
 def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None) -> tuple[dict, dict, dict | None]:
@@ -91,6 +98,8 @@ def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None) ->
         return record, {"mesh": entry.name, "load_s": time.perf_counter() - t0, "cases": []}, None
     t_load = time.perf_counter() - t0
     record.update(vertices=len(scene.vertices), edges=len(scene.edges), faces=len(scene.faces))
+    if scene.load_notes:           # read leniently (core.scene.files): said in the report, the mesh checked
+        record["warnings"] = [_named(note, entry) for note in scene.load_notes]
     results = [runner.run(scene, case, params) for case in cases]
     rows = [{k: r.record[k] for k in CASE_KEYS if k in r.record} for r in results]
     verdicts = {row["verdict"] for row in rows}
@@ -146,6 +155,9 @@ def summarize(meshes: list[dict], level: str, allow_vacuous: bool, allow_load_er
                "cases": len(records), "cases_failed": sum(1 for r in records if r["verdict"] == "fail"),
                "faults": faults_by_count(meshes), "worst_cases": worst_cases(meshes),
                "errors": [{"mesh": m["mesh"], "error": m["error"]} for m in errors]}
+    warned = [{"mesh": m["mesh"], "warning": w} for m in meshes for w in m.get("warnings", [])]
+    if warned:                        # read leniently, and checked (core.scene.files)
+        summary["warnings"] = warned
     return verdict, compared, summary
 
 
