@@ -141,6 +141,9 @@ def main(argv=None) -> int:
     if args.json:
         Path(args.json).write_text(json.dumps({"machine": info, "runs": rows, "per_mesh_s": per_mesh_s,
                                                "not_passed": not_passed,
+                                               "verdicts": {m["mesh"]: {"verdict": m["verdict"], "cases": [
+                                                   [c["camera"], c["verdict"], [f["name"] for f in c.get("faults", [])]]
+                                                   for c in m.get("cases", [])]} for m in runs["jobs 1"]["meshes"]},
                                                "reports_identical": same, "extrapolated": extrapolated,
                                                "elapsed_s": elapsed}, indent=2))
     return 0 if same else 1

@@ -44,6 +44,10 @@ _NONE = np.iinfo(np.int64).max          # no owner yet (:meth:`_Segments.owners`
 #: this, whatever the drawn length of the segments (a soup of long edges pairs each pixel with
 #: hundreds: 10^8 pairs a frame). 2^19 pairs: ~60 MB of temporaries in _near, ~5 ms of work.
 CHUNK_PAIRS = 1 << 19
+#: :meth:`_Segments.pairs_any` tests each pixel against every segment's box when there are at most
+#: this many (pixel, segment) tests (a frame's few one-sided pixels: ~10 ms), rather than list every
+#: segment in a grid of cells first (~100 ms for 30,000 segments).
+FEW_PAIRS = 1 << 22
 
 #: :func:`frames_count_differences` counts every drawn pixel at once when the frames hold more than
 #: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
@@ -415,6 +419,9 @@ class _Segments:
                 sid = np.arange(int(nn.sum())) + np.repeat(first[lo:hi] - (np.cumsum(nn) - nn), nn)
                 yield self._near(px, sid, pos)
             return
+        if self._cells is None and len(px) * len(self) <= FEW_PAIRS:
+            yield from self._pairs_boxed(px, frame)          # a few pixels: no grid of every segment
+            return
         keys, listed = self._cell_index()
         _, y, x = px.at()
         cell = self._cell
@@ -429,6 +436,21 @@ class _Segments:
             pos = np.repeat(np.arange(lo, hi), nn)
             sid = listed[np.arange(int(nn.sum())) + np.repeat(a[lo:hi] - (np.cumsum(nn) - nn), nn)]
             yield self._near(px, sid, pos)
+
+    def _pairs_boxed(self, px: _Pixels, frame: np.ndarray):
+        """:meth:`pairs_any` by a box test of every pixel against every segment of its frame: the pairs
+        whose pixel centre is within ``radius`` of the segment's box (all those within ``radius`` of the
+        segment), measured. ``frame``: each pixel's."""
+        r = self.radius
+        lo_x, hi_x = np.minimum(self.q0[:, 0], self.q1[:, 0]) - r, np.maximum(self.q0[:, 0], self.q1[:, 0]) + r
+        lo_y, hi_y = np.minimum(self.q0[:, 1], self.q1[:, 1]) - r, np.maximum(self.q0[:, 1], self.q1[:, 1]) + r
+        x, y = px.xy()
+        for lo, hi in _cuts(np.full(len(px), len(self), np.int64), CHUNK_PAIRS):
+            cx, cy = x[lo:hi, None], y[lo:hi, None]
+            inside = ((cx >= lo_x) & (cx <= hi_x) & (cy >= lo_y) & (cy <= hi_y)
+                      & (frame[lo:hi, None] == self.frame[None, :]))
+            pos, sid = np.nonzero(inside)
+            yield self._near(px, sid, pos + lo)
 
     def _cell_index(self) -> tuple[np.ndarray, np.ndarray]:
         """``(keys, sid)``, sorted by key: each segment once per cell it is listed in (:meth:`pairs_any`)."""
