@@ -235,6 +235,8 @@ def main(argv=None) -> int:
     ap.add_argument("--json", default=None, help="also write the rows as JSON to this file")
     ap.add_argument("--plot", default=None, help="the sweep's time and memory against edges as a PNG")
     ap.add_argument("--label", default="", help="a label for this run in the table's title (e.g. before)")
+    ap.add_argument("--baseline", default=None, metavar="JSON",
+                    help="an earlier run's --json (e.g. before a change): its sweep drawn beside this one's in --plot")
     ap.add_argument("--child", nargs=2, metavar=("SIDE", "PATH"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -294,34 +296,44 @@ def main(argv=None) -> int:
     for text, ok in targets:
         print(f"  {verdict(ok)}  {text}")
     if args.plot:
-        plot(rows, args.plot, args.label)
+        baseline = None
+        if args.baseline:
+            data = json.loads(Path(args.baseline).read_text())
+            baseline = (data["machine"].get("label") or "baseline", data["rows"])
+        plot(rows, args.plot, args.label, baseline)
     info["elapsed_s"] = print_end(info, t_start)
     if args.json:
         write_json(args.json, machine=info, rows=rows, targets=[{"target": t, "met": ok} for t, ok in targets])
     return 0
 
 
-def plot(rows: list, png: str, label: str) -> None:
-    """The sweep's pixel stage, process wall time and peak RSS against edges, both sides."""
+def plot(rows: list, png: str, label: str, baseline: tuple | None = None) -> None:
+    """The height fields' (sweep and grid1000k) pixel stage and peak RSS against edges, wirecheck and pyrender (and ``baseline``'s wirecheck)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    sweep = [r for r in rows if r["mesh"].startswith("sweep") and "error" not in r["wirecheck"]
-             and "error" not in r["pyrender"]]
-    e = [r["edges"] for r in sweep]
+    def sweep(rs):
+        return sorted((r for r in rs if (r["mesh"].startswith("sweep") or r["mesh"] == "grid1000k")
+                       and "error" not in r["wirecheck"] and "error" not in r["pyrender"]), key=lambda r: r["edges"])
+
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
-    a.loglog(e, [r["wirecheck"]["pixel_stage_ms"] for r in sweep], "o-", label="wirecheck pixel stage")
-    a.loglog(e, [r["pyrender"]["draw_ms"] for r in sweep], "s--", label="pyrender draw")
+    runs = [(label or "wirecheck", sweep(rows), "o-")] + ([(baseline[0], sweep(baseline[1]), "o:")] if baseline else [])
+    for name, rs, style in runs:
+        e = [r["edges"] for r in rs]
+        a.loglog(e, [r["wirecheck"]["pixel_stage_ms"] for r in rs], style, label=f"wirecheck pixel stage ({name})")
+        b.loglog(e, [r["wirecheck"]["peak_rss"] / 2 ** 20 for r in rs], style, label=f"wirecheck process ({name})")
+    rs = sweep(rows)
+    e = [r["edges"] for r in rs]
+    a.loglog(e, [r["pyrender"]["draw_ms"] for r in rs], "s--", label="pyrender draw")
+    b.loglog(e, [r["pyrender"]["peak_rss"] / 2 ** 20 for r in rs], "s--", label="pyrender process")
     a.set_xlabel("edges")
-    a.set_ylabel("ms per frame")
-    a.legend()
-    b.loglog(e, [r["wirecheck"]["peak_rss"] / 2 ** 20 for r in sweep], "o-", label="wirecheck process")
-    b.loglog(e, [r["pyrender"]["peak_rss"] / 2 ** 20 for r in sweep], "s--", label="pyrender process")
+    a.set_ylabel("ms, one frame")
     b.set_xlabel("edges")
     b.set_ylabel("peak RSS (MiB)")
-    b.legend()
-    fig.suptitle(f"One frame, 640x480, height-field meshes {label}".strip())
+    a.legend(fontsize=8)
+    b.legend(fontsize=8)
+    fig.suptitle("One frame at 640x480, height-field meshes of 10^2 to 1.5x10^6 edges (sweep and grid1000k)")
     fig.tight_layout()
     fig.savefig(png, dpi=80)
     print(f"wrote {png}")

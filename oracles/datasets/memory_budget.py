@@ -10,11 +10,12 @@ estimated from its counts alone (:func:`estimate_bytes`), measured with
 benchmarks/bench_pixel_scale.py (peak RSS of one case, one frame):
 
     mesh                              vertices   edges     faces     peak RSS   estimate
-    50,000 random long triangles      150,000    150,000   50,000    0.62 GiB   0.61 GiB
-    height field of ~1M faces         501,264    1,500,961 999,698   0.96 GiB   1.48 GiB
+    50,000 random long triangles      150,000    150,000   50,000    0.62 GiB   0.60 GiB
+    height field of ~1M faces         501,264    1,500,961 999,698   0.96 GiB   1.43 GiB
 
-(the estimate errs high on large meshes: trimesh's load-time copies are
-counted whole). A mesh whose estimate is over the budget gets verdict
+(the estimate errs high on large meshes, trimesh's load-time copies being
+counted whole, and 0.02 GiB low on the soup, whose long lines fill every
+chunk of pairs). A mesh whose estimate is over the budget gets verdict
 ``"error"`` with one line saying so (oracles.datasets.dataset_run): the run
 goes on, and fails unless ``--allow-load-errors``, as for a file that cannot
 be read.
