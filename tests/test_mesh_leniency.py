@@ -85,3 +85,19 @@ def test_a_dataset_report_says_which_mesh_was_read_leniently(tmp_path):
     assert report["meshes"][0]["verdict"] == "pass" and report["meshes"][0]["edges"] == 6
     assert f"asset.obj: {note}" in out                                      # the console summary
     assert f"| asset.obj | {note} |" in (tmp_path / "r" / "report.md").read_text()
+
+
+def test_renderer_warns_once_and_draws_the_edges(tmp_path, capsys):
+    from wirecheck.core.app import cli as renderer_cli
+
+    mesh = tmp_path / "asset.obj"
+    mesh.write_text(TETRA)
+    out = tmp_path / "out"
+    rc = renderer_cli.main(["--scene", str(mesh), "--frames", "1", "--width", "16", "--height", "8",
+                            "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert [line for line in err.splitlines() if "warning" in line] == [
+        f"renderer: warning: {mesh}:7: 3 faces with fewer than 3 vertex indices (first 'f 2 4'): 2 of two read "
+        "as edges; 1 of one skipped (a point draws nothing)"]
+    assert json.loads((out / "asset-report.json").read_text())["scene"]["edges"] == 6
