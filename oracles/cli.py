@@ -183,6 +183,9 @@ def _parse(args):
     else:
         inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol,
                                  names=gate.CLI_NAMES)
+    for scene in inputs.scenes:         # read leniently (core.scene.files): one line each, the run goes on
+        for note in scene.load_notes:
+            print(f"crosscheck: warning: {note}", file=sys.stderr)
     if mode.cull == "backface":
         wound = next((sc for sc in inputs.scenes if sc.faces and sc.winding_note), None)
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
@@ -238,6 +241,8 @@ def _dataset(args):
     if not folders and not args.scene_list:
         if args.allow_load_errors:
             raise InputError("--allow-load-errors without a dataset: expected --scene DIR or --scene-list FILE")
+        if args.memory_budget is not None:
+            raise InputError("--memory-budget without a dataset: expected --scene DIR or --scene-list FILE")
         return None
     if len(folders) != len(scenes):
         other = next(s for s in scenes if s not in folders)
@@ -433,6 +438,15 @@ def _vertex_limit(report: dict, tol) -> str:
     return f"{tol.vertex_px:g} px" if bounds <= {tol.vertex_px} else "the bound of the candidate's precision"
 
 
+def _memory_budget(gib: float | None):
+    """``--memory-budget GIB`` in bytes ("auto" when not given); InputError unless a number of GiB > 0."""
+    if gib is None:
+        return "auto"
+    if not (math.isfinite(gib) and gib > 0):
+        raise InputError(f"--memory-budget {gib:g}: expected a number of GiB > 0")
+    return int(gib * 2 ** 30)
+
+
 def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
     """A dataset run (oracles.datasets.dataset_run): progress, the report, the summary on stdout."""
     from .datasets.dataset_report import DatasetProgress, console_summary, write_dataset_report
@@ -443,6 +457,7 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
         args.dataset, candidate, frames=inputs.frames, case_names=inputs.case_names, turns=inputs.turns,
         tol=tol, level=level, every=inputs.every, mode=mode, candidate_name=candidate.name,
         allow_vacuous=args.allow_vacuous, allow_load_errors=args.allow_load_errors, executor=args.executor_spec,
+        memory_budget=_memory_budget(args.memory_budget),
         progress=progress.update if progress.active else None))
     if status is not None:
         return status

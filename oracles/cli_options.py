@@ -43,6 +43,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--allow-load-errors", action="store_true", default=False,
                    help="dataset runs: a mesh that cannot be loaded is reported and counted but does not fail "
                         "the run (default: it fails the run)")
+    p.add_argument("--memory-budget", type=plain_float, default=None, metavar="GIB",
+                   help="dataset runs: GiB one mesh may need to be checked; a mesh estimated over it is a load "
+                        "error, and the run goes on (default: half the machine's memory, shared by --jobs)")
     p.add_argument("--frames", type=plain_int, default=None,
                    help="frames of the scene's motion per case (default 24; 12 with --sweep)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} "

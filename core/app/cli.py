@@ -304,6 +304,8 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     if "mp4" in formats and importlib.util.find_spec("av") is None:
         raise InputError("--format mp4: expected the PyAV package (pip install av; it is a dependency of wirecheck)")
     scene = load_scene(a.scene)
+    for note in scene.load_notes:      # read leniently (core.scene.files): one line each, the run goes on
+        print(f"renderer: warning: {note}", file=sys.stderr)
     cull = None if a.cull == "none" else a.cull
     s = Settings(scene, camera, motion, a.frames, a.clip, formats, Path(a.out), a.ascii_cols,
                  dtype=a.dtype, raster=a.raster, ortho_camera=ortho_camera, axes=a.axes, cull=cull,

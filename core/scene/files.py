@@ -247,29 +247,71 @@ def _obj_statements(path: Path):
                 yield lineno, parts, raw
 
 
-def _obj_lines(path: Path) -> list[tuple[int, int]]:
-    """Edges from OBJ ``l`` elements (1-based, possibly negative, 'v/vt' forms)."""
+@dataclasses.dataclass
+class _ShortFaces:
+    """OBJ faces of fewer than 3 vertex indices (trimesh drops them silently): where, how many."""
+
+    first_line: int = 0
+    first_text: str = ""
+    edges: int = 0          # two-index faces, read as edges
+    points: int = 0         # one-index faces, skipped (a point draws nothing)
+
+    def add(self, lineno: int, raw: str, n_indices: int) -> None:
+        if not self.first_line:
+            self.first_line, self.first_text = lineno, raw.strip()
+        if n_indices == 2:
+            self.edges += 1
+        else:
+            self.points += 1
+
+    def note(self, path) -> str | None:
+        """The one warning line (file, first line, counts), or None when every face has 3 indices or more."""
+        n = self.edges + self.points
+        if not n:
+            return None
+        what = "; ".join(part for part in (
+            f"{self.edges} of two read as edges" if self.edges else "",
+            f"{self.points} of one skipped (a point draws nothing)" if self.points else "") if part)
+        return (f"{path}:{self.first_line}: {n} face{'s' * (n != 1)} with fewer than 3 vertex indices "
+                f"(first {_short(self.first_text)}): {what}")
+
+
+def _obj_lines(path: Path, short: _ShortFaces | None = None) -> list[tuple[int, int]]:
+    """Edges from OBJ ``l`` elements and from faces of two indices (1-based, possibly negative, 'v/vt' forms).
+
+    ``short`` counts the faces of fewer than three indices (:class:`_ShortFaces`).
+    """
     n_v = 0
     pairs = []
     for lineno, parts, raw in _obj_statements(path):
         if parts[0] == "v":
             n_v += 1
+        elif parts[0] in ("f", "fo") and len(parts) < 4:
+            if short is not None:
+                short.add(lineno, raw, len(parts) - 1)
+            if len(parts) == 3:             # an edge: its two indices, read as an 'l' element's
+                pairs.append(tuple(_obj_index(path, lineno, tok, n_v, "face") for tok in parts[1:]))
         elif parts[0] == "l":
             if len(parts) < 3:          # a line of one vertex draws nothing
                 raise InputError(f"{path}:{lineno}: line element {_short(raw.strip())}: expected 2 or more "
                                  "vertex indices")
             idx = []
             for tok in parts[1:]:
-                try:
-                    k = int(tok.split("/")[0])
-                except ValueError:
-                    raise InputError(f"{path}:{lineno}: line element index {_short(tok)}: expected an integer") from None
-                k = k - 1 if k > 0 else n_v + k
-                if not 0 <= k < n_v:
-                    raise InputError(f"{path}:{lineno}: line element index {_short(tok)}: expected 1..{n_v}")
-                idx.append(k)
+                idx.append(_obj_index(path, lineno, tok, n_v, "line element"))
             pairs += list(zip(idx[:-1], idx[1:]))
     return pairs
+
+
+def _obj_index(path, lineno: int, tok: str, n_v: int, what: str) -> int:
+    """The 0-based vertex of an OBJ index token (1-based, or negative: back from the ``n_v`` read so far)."""
+    try:
+        k = int(tok.split("/")[0])
+    except ValueError:
+        raise InputError(f"{path}:{lineno}: {what} index {_short(tok)}: expected an integer") from None
+    k = k - 1 if k > 0 else n_v + k
+    if not 0 <= k < n_v:
+        raise InputError(f"{path}:{lineno}: {what} index {_short(tok)}: expected 1..{n_v}")
+    return k
 
 
 def load_mesh_file(path: Path) -> Scene:
@@ -339,8 +381,9 @@ def load_mesh_file(path: Path) -> Scene:
         raise InputError(f"{path}: face {f} has {said}: expected 0..{len(vertices) - 1} "
                          f"(the file has {len(vertices)} vertices)")
     edges = [face_edges(faces)] if len(faces) else []
+    short = _ShortFaces()
     if path.suffix.lower() == ".obj":
-        line_pairs = _obj_lines(path)
+        line_pairs = _obj_lines(path, short)
         if line_pairs:
             if len(vertices) == 0 or max(max(p) for p in line_pairs) >= len(vertices):
                 # trimesh dropped the line-only vertices: read them ourselves
@@ -353,7 +396,8 @@ def load_mesh_file(path: Path) -> Scene:
     faces = tuple(tuple(int(i) for i in f) for f in faces)
     _check_name_length(_safe_stem(path), path)
     return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
-                 faces=faces, source=str(path), winding_note=_winding_note(faces))
+                 faces=faces, source=str(path), winding_note=_winding_note(faces),
+                 load_notes=tuple(n for n in (short.note(path),) if n))
 
 
 def _check_refused(path: Path, resolver) -> None:
@@ -389,8 +433,8 @@ def _check_obj(path: Path) -> None:
                 _number(path, lineno, t, "vertex coordinate")
             n_v += 1
         elif parts[0] in ("f", "fo"):
-            if len(parts) < 4:          # readers drop such a face silently: the user's edges vanish
-                raise InputError(f"{path}:{lineno}: face {_short(raw.strip())}: expected 3 or more vertex indices")
+            if len(parts) < 2:
+                raise InputError(f"{path}:{lineno}: face {_short(raw.strip())}: expected vertex indices")
             for tok in parts[1:]:
                 try:
                     k = int(tok.split("/")[0])
