@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from ..reports.compared import reason_text
-from ..reports.report import console_table, fault_hints, fault_text, gl_text
+from ..reports.fault_text import case_cell, hints
+from ..reports.report import console_table, gl_text
 
 
 def _run_rows(result: dict) -> list[dict]:
@@ -18,7 +19,7 @@ def _err(v) -> str:
 
 def check_rows(result: dict) -> list[list[str]]:
     """``[check, kind, error px, bound px, verdict, faults]`` per named check."""
-    return [[c["name"], c["kind"], _err(c["error_px"]), _err(c["bound_px"]), c["verdict"], fault_text(c["faults"])]
+    return [[c["name"], c["kind"], _err(c["error_px"]), _err(c["bound_px"]), c["verdict"], case_cell(c["faults"])]
             for c in result["checks"]]
 
 
@@ -57,7 +58,7 @@ def spec_console(result: dict) -> list[str]:
         if c["verdict"] != "pass":
             lines.append(f"  {c['name']}: " + reason_text(c["reasons"]))
     faults = [f for r in result["runs"] for f in r["faults"]] + [f for c in result["checks"] for f in c["faults"]]
-    lines += [f"  what to check, {n}: {h}" for n, h in fault_hints(faults)]
+    lines += [f"  what to check, {n}: {h}" for n, h in hints(faults)]
     lines += ["", _verdict_line(result)]
     return lines
 
@@ -81,7 +82,7 @@ def spec_markdown(result: dict) -> str:
         f0, f1 = r.get("pixel_f1_0px"), r.get("pixel_f1_1px")
         lines.append(f"| {r['run']} | {_err(r.get('max_vertex_error_px'))} | "
                      f"{'-' if f0 is None else f'{f0:.4f}'} | {'-' if f1 is None else f'{f1:.4f}'} | "
-                     f"{r['verdict']} | {fault_text(r['faults'])} |")
+                     f"{r['verdict']} | {case_cell(r['faults'])} |")
     lines += ["", "### Named checks", "",
               "| check | kind | error px | bound px | verdict | faults |", "| --- | --- | --- | --- | --- | --- |"]
     lines += [f"| {' | '.join(row)} |" for row in check_rows(result)]
@@ -94,9 +95,8 @@ def spec_markdown(result: dict) -> str:
     if failing:
         lines += ["", "### Runs not passed", ""]
         lines += [f"- {r['run']}: {'; '.join(r['reasons'])}" for r in failing]
-    hints = fault_hints([f for r in result["runs"] for f in r["faults"]] + [f for c in result["checks"]
-                                                                            for f in c["faults"]])
-    if hints:
-        lines += ["", "## What to check", ""] + [f"- `{n}`: {h}" for n, h in hints]
+    what = hints([f for r in result["runs"] for f in r["faults"]] + [f for c in result["checks"] for f in c["faults"]])
+    if what:
+        lines += ["", "## What to check", ""] + [f"- `{n}`: {h}" for n, h in what]
     lines += ["", _verdict_line(result)]
     return "\n".join(lines) + "\n"
