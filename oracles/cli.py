@@ -279,7 +279,7 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
-        if args.unprojector is not None:             # the way back: its own check, its own table
+        if args.unprojector is not None or args.unprojector_cmd is not None:     # the way back: its own table
             from .unprojector_cli import unprojector_main
 
             return unprojector_main(args)

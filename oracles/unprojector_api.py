@@ -29,6 +29,7 @@ from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 
 from .candidates.candidate import load_candidate
+from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, SubprocessCandidate, closing_started
 from .diagnosis.unproject_faults import name_unproject_faults
 from .judge import gate
 from .judge.cases import case_motion, cases_for
@@ -41,8 +42,8 @@ __all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "unp
 UNPROJECT_DEFAULTS = {"frames": 2, "turns": (1.0, 1.0, 0.0), "stride": DEFAULT_STRIDE}
 
 
-def check_unprojector(func, scenes=None, frames: int | None = None, cases=None, turns=None,
-                      stride: int | None = None) -> dict:
+def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=None, turns=None,
+                      stride: int | None = None, *, cmd: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S) -> dict:
     """Judge an unprojector against the exact inverse of the conventions and return the report.
 
     Parameters
@@ -61,6 +62,12 @@ def check_unprojector(func, scenes=None, frames: int | None = None, cases=None, 
         The scenes' spin, full turns about X, Y, Z over the run.
     stride : int
         One sample every ``stride`` pixels each way (>= 1, default 8).
+    cmd : str, optional
+        Instead of ``func``: an unprojector program speaking the candidate protocol's
+        ``unproject`` requests (docs/protocol.md), as a command line; it is started once and ends
+        with the check.
+    timeout_s : float
+        Seconds each request to ``cmd`` may take (default 10).
 
     Returns
     -------
@@ -83,18 +90,26 @@ def check_unprojector(func, scenes=None, frames: int | None = None, cases=None, 
     stride = UNPROJECT_DEFAULTS["stride"] if stride is None else stride
     if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or stride < 1:
         raise InputError(f"stride {stride!r}: expected an integer >= 1 (pixels between samples)")
-    name = func if isinstance(func, str) else getattr(func, "__qualname__", None) or repr(func)
+    if (func is None) == (cmd is None):
+        raise InputError("unprojector: expected one of func (a callable or \"FILE.py:FUNC\") and cmd (a program)")
+    name = cmd if cmd is not None else func if isinstance(func, str) else getattr(func, "__qualname__", None) or repr(func)
     if isinstance(func, str):
         func = load_candidate(func, "unprojector", ("pixels", "depth", "camera"))
-    elif not callable(func):
+    elif func is not None and not callable(func):
         raise TypeError(f"func {func!r}: expected a callable func(pixels, depth, camera) or a \"FILE.py:FUNC\" string")
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns)
     motion = Motion(turns=inputs.turns)
     records = []
-    for scene in inputs.scenes:
-        by_name = {c.name: c for c in cases_for(scene, motion, calibrated=True)}
-        for case_name in inputs.case_names:
-            records.append(_judge_case(func, scene, by_name[case_name], motion, inputs.frames, stride))
+    with closing_started():                      # a program started for the check ends with it
+        if cmd is not None:
+            try:
+                func = SubprocessCandidate.from_command(cmd, timeout_s=timeout_s).unproject
+            except ValueError as exc:
+                raise InputError(f"unprojector command {exc}") from None
+        for scene in inputs.scenes:
+            by_name = {c.name: c for c in cases_for(scene, motion, calibrated=True)}
+            for case_name in inputs.case_names:
+                records.append(_judge_case(func, scene, by_name[case_name], motion, inputs.frames, stride))
     points = sum(r["points"] for r in records)
     if points == 0:
         raise InputError(f"unprojector {name}: no visible surface point in {len(records)} case(s) "
@@ -128,7 +143,9 @@ def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
             record["reasons"].append(f"frame {k}: unprojector {type(exc).__name__}: "
                                      f"{' '.join(str(exc).split())[:200]}")
             continue
-        precision = "float32" if arr.dtype.kind == "f" and arr.dtype.itemsize <= 4 else "float64"
+        told = getattr(getattr(func, "__self__", None), "answer_precision", None)    # a program's own word
+        precision = told() if told is not None else (
+            "float32" if arr.dtype.kind == "f" and arr.dtype.itemsize <= 4 else "float64")
         precisions.add(precision)
         given.append(s)
         got.append(arr.astype(np.float64))

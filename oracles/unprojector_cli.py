@@ -1,4 +1,4 @@
-"""``crosscheck --unprojector FILE.py:FUNC``: an unprojector judged from the command line.
+"""``crosscheck --unprojector FILE.py:FUNC`` (or ``--unprojector-cmd 'COMMAND'``): an unprojector judged.
 
 Parses nothing of its own: :func:`unprojector_main` takes crosscheck's parsed options
 (``--scene``, ``--cases``, ``--frames``, ``--spin``), calls
@@ -24,14 +24,18 @@ DEFAULT_FRAMES = 2
 
 def unprojector_main(args) -> int:
     """Judge ``args.unprojector`` on ``args``' scenes and cases; print the table; return the exit status."""
+    given = "--unprojector" if args.unprojector is not None else "--unprojector-cmd"
     clash = [f"--{name.replace('_', '-')}" for name in OTHER_MODES if getattr(args, name, None)]
+    if args.unprojector is not None and args.unprojector_cmd is not None:
+        clash.append("--unprojector-cmd")
     try:
         if clash:
-            raise InputError(f"--unprojector with {', '.join(clash)}: expected --unprojector alone with "
+            raise InputError(f"{given} with {', '.join(clash)}: expected {given} alone with "
                              "--scene, --cases, --frames and --spin (it writes no report folder)")
         report = check_unprojector(args.unprojector, scenes=args.scene,
                                    frames=args.frames if args.frames is not None else DEFAULT_FRAMES,
-                                   cases=args.cases, turns=args.spin)
+                                   cases=args.cases, turns=args.spin, cmd=args.unprojector_cmd,
+                                   timeout_s=args.candidate_timeout)
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
         return 2

@@ -235,3 +235,41 @@ def test_cli_pass_fail_error():
         assert err.returncode == 2 and err.stdout == "" and len(err.stderr.strip().splitlines()) == 1, err.stderr
     both = crosscheck("--unprojector", f"{SPEC}:correct", "--candidate", f"{SPEC}:correct")
     assert both.returncode == 2 and "--unprojector" in both.stderr
+
+
+# ---------------------------------------------------------------- over the protocol
+
+CLIENT = f"{sys.executable} tests/clients/unproject_client.py"
+
+
+def test_protocol_request_line():
+    from wirecheck.oracles.candidates.protocol import camera_text, encode_request
+
+    cam = camera_z(4.0)
+    rows = np.array([[1.0, 2.0, 3.0]])
+    msg = encode_request(7, rows, camera_text(cam), kind="unproject")
+    line, _, payload = bytes(msg).partition(b"\n")
+    assert line.startswith(b'{"request":7,"kind":"unproject","n":1,"camera":{')
+    assert np.frombuffer(payload, "<f8").tolist() == [1.0, 2.0, 3.0]
+    assert b'"kind"' not in bytes(encode_request(7, rows, camera_text(cam)))      # a projection: unchanged
+
+
+def test_protocol_client(monkeypatch):
+    monkeypatch.chdir(ROOT)
+    r = check_unprojector(cmd=CLIENT, frames=1)
+    assert r["verdict"] == "pass" and r["compared"]["points"] > 10000
+    bad = check_unprojector(cmd=f"{CLIENT} --mistake rows_flipped", scenes=["cube"], frames=1, cases=["oblique_roll"])
+    assert [f["name"] for f in bad["cases"][0]["faults"]] == ["mirror_vertical"]
+    refused = check_unprojector(cmd=f"{CLIENT} --mistake error", scenes=["cube"], frames=1, cases=["on_axis"])
+    assert refused["verdict"] == "fail" and "refused on purpose" in refused["cases"][0]["reasons"][0]
+    with pytest.raises(InputError, match="expected one of func"):
+        check_unprojector(U.correct, cmd=CLIENT)
+
+
+def test_cli_unprojector_cmd():
+    ok = crosscheck("--unprojector-cmd", CLIENT, "--scene", "pyramid", "--frames", "1")
+    assert ok.returncode == 0 and "PASS: 7/7 cases" in ok.stdout, ok.stderr
+    bad = crosscheck("--unprojector-cmd", f"{CLIENT} --mistake rows_flipped", "--scene", "pyramid", "--frames", "1")
+    assert bad.returncode == 1 and "mirror_vertical" in bad.stdout
+    both = crosscheck("--unprojector-cmd", CLIENT, "--unprojector", f"{SPEC}:correct")
+    assert both.returncode == 2 and "--unprojector-cmd" in both.stderr

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..references.convert import opencv_matrices
+from ..references.opencv_oracle import project as cv_project
 from ..references.unproject_reference import cam_points, unproject
 
 __all__ = ["FIT_SLACK", "UNPROJECT_FAULTS", "UNPROJECT_HINTS", "UnprojectFault", "name_unproject_faults"]
@@ -100,8 +101,6 @@ def name_unproject_faults(p_px, depth, camera, cand, bound) -> tuple[list, dict]
 
 def _reproject(x_world, camera) -> np.ndarray:
     """``(N, 3)``: the points' pixels ``u', v'`` (OpenCV's projection, distortion included) and depth ``d'``."""
-    from ..references.opencv_oracle import project as cv_project
-
     r, t, _k = opencv_matrices(camera)
     d = x_world @ r[2] + t[2]
     finite = np.isfinite(x_world).all(axis=1)
