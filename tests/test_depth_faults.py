@@ -6,11 +6,15 @@ camera, with the per-pixel bound of a 24-bit depth buffer (oracles.judge.metrics
 tests/test_depth_reference.py shows pyrender's linearised depth agrees with it within that
 bound. Each candidate is that map written as a renderer with one classic mistake would write
 it (float32, as a float32 ``.npy`` holds it), and must get exactly one name: the mistake's.
+Three mistakes move pixels rather than values, each drawn by core with the mistaken camera:
+rows flipped, the principal point at (W/2, H/2) (half a pixel), K from the FOV taken as the
+horizontal one; the reference's face ids are given (oracles.diagnosis.depth_pixels).
 The confusion matrix over them is printed in the terminal summary and must be diagonal.
 """
 
 from __future__ import annotations
 
+import math
 from collections import Counter
 
 import numpy as np
@@ -56,19 +60,38 @@ def mistakes(r: np.ndarray, camera) -> dict:
     return {name: np.where(r > 0, m, np.nan).astype(np.float32) for name, m in out.items()}
 
 
+def core_depth(scene_name: str, camera, k: int = 2, frames: int = 7):
+    """Core's depth buffer of frame ``k`` through ``camera``: ``(depth (0 where empty), face ids)``."""
+    renderer = SceneRenderer(load_scene(scene_name), Motion(turns=(1.0, 1.0, 0.0)), frames, style="shaded")
+    frame, _ = renderer.render(k, camera)
+    return np.where(np.isfinite(frame.depth_image), frame.depth_image, 0.0), frame.face_ids
+
+
 def frame_depth(scene_name: str, case, k: int = 2, frames: int = 7):
     """Core's depth buffer of frame ``k``: ``(depth (0 where empty), covered, bound)``."""
-    renderer = SceneRenderer(load_scene(scene_name), Motion(turns=(1.0, 1.0, 0.0)), frames, style="shaded")
-    frame, _ = renderer.render(k, case.camera)
-    covered = np.isfinite(frame.depth_image)
-    depth = np.where(covered, frame.depth_image, 0.0)
+    depth, _faces = core_depth(scene_name, case.camera, k, frames)
+    covered = depth > 0
     return depth, covered, depth_bound(depth, covered, case.camera)
 
 
-def judge(cand32: np.ndarray, depth, bound, camera):
+def pixel_mistakes(scene_name: str, camera) -> dict:
+    """The maps a camera mistake draws (core, float32), keyed by the expected name."""
+    depth, _ = core_depth(scene_name, camera)
+    out = {"mirror_vertical": depth[::-1]}                                     # read back bottom row first
+    if camera.projection == "perspective":
+        fx, fy = camera.focal_xy
+        out["pixel_offset"] = core_depth(scene_name, camera.with_intrinsics(fx, fy, camera.width / 2,
+                                                                            camera.height / 2))[0]
+        f_h = (camera.width / 2) / math.tan(math.radians(camera.fov_y_deg) / 2)   # the FOV as the horizontal one
+        out["fov_mismatch"] = core_depth(scene_name, camera.with_intrinsics(f_h, f_h))[0]
+    return {name: np.where(m > 0, m, np.nan).astype(np.float32) for name, m in out.items()}
+
+
+def judge(cand32: np.ndarray, depth, bound, camera, faces=None):
     """The candidate as read from a float32 file (its encoding's bound: eps32 |d|), judged."""
     dm = depth_from_array(cand32, camera.width, camera.height, "candidate", "npy float32", 0.0, EPS32)
-    return name_depth_faults(dm.depth, np.where(depth > 0, depth, np.nan), bound, camera, dm.encoding_bound())
+    return name_depth_faults(dm.depth, np.where(depth > 0, depth, np.nan), bound, camera, dm.encoding_bound(),
+                             faces=faces)
 
 
 @pytest.fixture(scope="module")
@@ -78,8 +101,11 @@ def results():
     for scene_name in SCENES:
         for case in cases_for(load_scene(scene_name)):
             depth, _covered, bound = frame_depth(scene_name, case)
-            for injected, cand in mistakes(depth, case.camera).items():
-                out.append((scene_name, case.name, injected, judge(cand, depth, bound, case.camera), case.camera))
+            faces = core_depth(scene_name, case.camera)[1]
+            maps = {**mistakes(depth, case.camera), **pixel_mistakes(scene_name, case.camera)}
+            for injected, cand in maps.items():
+                out.append((scene_name, case.name, injected, judge(cand, depth, bound, case.camera, faces),
+                            case.camera))
     return out
 
 
@@ -91,21 +117,23 @@ def test_each_mistake_named_alone(results):
     wrong = [(s, c, i, diagnosed(d), d.measured.get("fit_ratios")) for s, c, i, d, _ in results
              if diagnosed(d) != i]
     assert not wrong, wrong
-    assert len(results) == 3 * (7 * 6 + 6)              # the orthographic case has no range mistake
+    # the orthographic case has no range mistake (its rays are all depth), and no K to move
+    assert len(results) == 3 * (6 * 10 + 7)
 
 
 def test_confusion_matrix_is_diagonal(results, summary_section):
     counts = Counter((i, diagnosed(d)) for _, _, i, d, _ in results)
     rows = list(dict.fromkeys(i for _, _, i, _, _ in results))
     cols = list(dict.fromkeys([*rows, *sorted({c for _, c in counts} - set(rows))]))
-    short = {n: n.replace("depth_", "") for n in cols}
+    short = {n: n.replace("depth_", "").replace("mirror_vertical", "mirror_v").replace("_mismatch", "")
+             .replace("pixel_", "px_") for n in cols}
     lines = ["depth faults, core's maps with one mistake each (rows injected, columns named); "
              f"{len(SCENES)} scenes x 7 cases",
              " " * 16 + " ".join(f"{short[c]:>10}" for c in cols)]
     lines += [f"{short[r]:<16}" + " ".join(f"{counts[(r, c)] or '.':>10}" for c in cols) for r in rows]
     summary_section("depth fault confusion matrix", "\n".join(lines))
     assert not {k: v for k, v in counts.items() if k[0] != k[1]}
-    assert set(rows) == set(DEPTH_FAULTS) - {"ambiguous", "unexplained"} | {"pass"}
+    assert set(rows) == set(DEPTH_FAULTS) - {"ambiguous", "unexplained", "mirror_horizontal"} | {"pass"}
 
 
 def test_fitted_numbers_are_the_mistakes(results):
@@ -130,6 +158,14 @@ def test_fitted_numbers_are_the_mistakes(results):
             assert p["format"] == "float16", where
         elif injected == "depth_is_range":
             assert p["stored"] == "range along the ray", where
+        elif injected == "pixel_offset":
+            # cx = W / 2: the map's pixel p shows the reference's p - 0.5; fitted to 0.01 px (measured 0.007)
+            assert p["dx"] == pytest.approx(-0.5, abs=0.01) and p["dy"] == pytest.approx(-0.5, abs=0.01), where
+        elif injected == "fov_mismatch":
+            # f' = (W/2) / tan(fov/2): the scale f / f' is H / W, the implied FOV 2 atan((H/W) tan(fov/2))
+            assert p["scale"] == pytest.approx(cam.height / cam.width, rel=1e-4), where
+            want = math.degrees(2 * math.atan(cam.height / cam.width * math.tan(math.radians(cam.fov_y_deg) / 2)))
+            assert p["implied_fov_y_deg"] == pytest.approx(want, rel=1e-4), where
 
 
 def test_fit_slack_has_room(results):

@@ -21,7 +21,9 @@ A map **passes** when every compared pixel is within its allowance, ``bound + en
 oracles.candidates.depth_map). A model **explains** a failing map when every compared
 pixel's residual ``|c - g(r)|`` is within :attr:`DepthLimits.fit_slack` of the allowance
 carried through the model (``|g'(r)| bound + encoding``, plus the model's own step for
-``depth_precision``). Among the models that explain it the one with the fewest fitted
+``depth_precision``). When none does and the reference's face ids are given, the camera
+mistakes that move pixels rather than values are fitted (oracles.diagnosis.depth_pixels:
+``mirror_vertical``, ``mirror_horizontal``, ``pixel_offset``, ``fov_mismatch``). Among the models that explain it the one with the fewest fitted
 parameters is named, then the closest; when models of two names explain it (a flat surface
 seen square-on: scale and offset alike), ``ambiguous`` with both; none: ``unexplained``,
 with what was measured (``fit_ratios``: each model's worst residual over its allowance).
@@ -33,6 +35,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from .depth_pixels import MAX_OUTSIDE, MIN_INTERIOR, pixel_models, sample
 
 __all__ = ["DEPTH_FAULTS", "DEPTH_HINTS", "DepthDiagnosis", "DepthFault", "DepthLimits", "LIMITS",
            "name_depth_faults", "ray_lengths"]
@@ -62,7 +66,8 @@ LIMITS = DepthLimits()
 
 #: Every name this module gives, in the order of its table.
 DEPTH_FAULTS = ("depth_scale", "depth_offset", "depth_is_range", "depth_reversed", "depth_encoding",
-                "depth_precision", "ambiguous", "unexplained")
+                "depth_precision", "mirror_vertical", "mirror_horizontal", "pixel_offset", "fov_mismatch",
+                "ambiguous", "unexplained")
 
 #: What to check for each name: the usual cause and its fix.
 DEPTH_HINTS = {
@@ -79,6 +84,13 @@ DEPTH_HINTS = {
                       "for window z in [0, 1] (NDC z: z_win = (z + 1) / 2 first; orthographic: d = n + z (f - n))",
     "depth_precision": "depth values are quantised (a float16 or 8-bit target or texture): render and store "
                        "depth as float32, or as a 16-bit PNG with a scale",
+    "mirror_vertical": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
+                       "when reading the buffer back (glReadPixels returns the bottom row first)",
+    "mirror_horizontal": "columns flipped: right = forward x up, and x_px grows to the right",
+    "pixel_offset": "the depth is half a pixel (or more) off: pixel centres are integers, cx = (W - 1) / 2 "
+                    "(W / 2 is the corner convention); a GL projection from K puts cx + 0.5 in it",
+    "fov_mismatch": "the image is scaled about the principal point: fov_y_deg is the vertical FOV, "
+                    "f = (H / 2) / tan(fov_y / 2) (a renderer given it as its horizontal view angle scales by W / H)",
     "ambiguous": "the compared depths fit several of these models alike (a surface at one depth, seen "
                  "square-on): judge more frames, or a view whose depth varies",
     "unexplained": "the depth differs from the reference in no way this diagnosis knows: see what was measured",
@@ -134,7 +146,7 @@ def ray_lengths(camera) -> np.ndarray:
 
 
 def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
-                      limits: DepthLimits = LIMITS) -> DepthDiagnosis:
+                      limits: DepthLimits = LIMITS, faces=None) -> DepthDiagnosis:
     """Judge a depth map against the reference and name what is wrong with it (module docstring).
 
     Parameters
@@ -150,6 +162,10 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
     encoding : (H, W) array_like of float, or float
         The candidate encoding's resolution (oracles.candidates.depth_map.DepthMap.encoding_bound).
     limits : DepthLimits
+    faces : (H, W) array_like of int, optional
+        Which planar face the reference shows at each pixel (-1: none). Given, the camera
+        mistakes that move pixels are fitted too (oracles.diagnosis.depth_pixels:
+        mirror_vertical, mirror_horizontal, pixel_offset, fov_mismatch).
 
     Returns
     -------
@@ -167,9 +183,11 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
                 "reference_px": int(ref_on.sum())}
     if not both.any():
         return DepthDiagnosis("vacuous", (), measured)
+    full_b = np.broadcast_to(np.asarray(bound, dtype=np.float64), cand.shape)
+    full_enc = np.broadcast_to(np.asarray(encoding, dtype=np.float64), cand.shape)
     c, r = cand[both], ref[both]
-    b = np.broadcast_to(np.asarray(bound, dtype=np.float64), cand.shape)[both]
-    enc = np.broadcast_to(np.asarray(encoding, dtype=np.float64), cand.shape)[both]
+    b = full_b[both]
+    enc = full_enc[both]
     err = np.abs(c - r)
     allow = b + enc
     ratio = _ratio(err, allow)
@@ -189,6 +207,10 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
         fit = float(_ratio(np.abs(c - c_hat), np.abs(slope) * b + enc + extra).max())
         if np.isfinite(fit):
             fits.append((n_params, fit, name, params))
+    if faces is not None and not any(f[1] <= limits.fit_slack for f in fits):
+        # no value model explains it: the maps that move pixels (tried only then: they cost a fit each)
+        fits += _pixel_fits(np.where(cand_on, cand, np.nan), np.where(ref_on, ref, np.nan),
+                            np.asarray(faces), full_b, full_enc, camera)
     measured["fit_ratios"] = {}
     for _, fit, name, _ in fits:                # each model's worst residual / allowance (the best of a name's)
         measured["fit_ratios"][name] = min(fit, measured["fit_ratios"].get(name, np.inf))
@@ -203,6 +225,25 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
         measured["fit_ratio"] = fit
         return DepthDiagnosis("fail", (DepthFault(name, params, DEPTH_HINTS[name]),), measured)
     return DepthDiagnosis("fail", (DepthFault("unexplained", {}, DEPTH_HINTS["unexplained"]),), measured)
+
+
+def _pixel_fits(cand, ref, faces, bound, enc, camera) -> list:
+    """``(n_params, fit ratio, name, params)`` of each pixel map that keeps the surfaces on each other."""
+    out = []
+    pts = np.argwhere(np.isfinite(cand))[:, ::-1].astype(np.float64)
+    c = cand[pts[:, 1].astype(int), pts[:, 0].astype(int)]
+    h, w = ref.shape
+    for name, n_params, params, transform in pixel_models(cand, ref, faces, camera):
+        q = transform(pts)
+        depth, inside, outside, _grad = sample(ref, faces, camera, q)
+        if outside.mean() > MAX_OUTSIDE or inside.mean() < MIN_INTERIOR:
+            continue
+        qi = np.clip(np.rint(q[inside]).astype(np.int64), 0, [w - 1, h - 1])
+        allow = bound[qi[:, 1], qi[:, 0]] + enc[pts[inside, 1].astype(int), pts[inside, 0].astype(int)]
+        fit = float(_ratio(np.abs(c[inside] - depth[inside]), allow).max())
+        if np.isfinite(fit):
+            out.append((n_params, fit, name, params))
+    return out
 
 
 def _ratio(err: np.ndarray, allow: np.ndarray) -> np.ndarray:
