@@ -21,7 +21,7 @@ from wirecheck.oracles.judge.cases import case_motion, cases_for
 from wirecheck.oracles.judge.depth_reference import reference_depth
 from wirecheck.oracles.judge.tolerances import MIN_SILHOUETTE_IOU
 
-from test_depth_faults import judge, mistakes
+from test_depth_faults import judge, mistakes, pixel_mistakes
 
 SCENES = ("cube", "prism", "pyramid")
 MOTION = Motion(turns=(1.0, 1.0, 0.0))
@@ -84,13 +84,14 @@ def test_faults_named_against_pyrender_as_against_core(oracles):
     count = 0
     for name, case, core, ref in pairs(oracles):
         depth = np.where(np.isfinite(core), core, 0.0)
-        for injected, cand in mistakes(depth, case.camera).items():
-            d = judge(cand, np.nan_to_num(ref.compared_depth()), ref.bound, case.camera)
+        maps = {**mistakes(depth, case.camera), **pixel_mistakes(name, case.camera)}
+        for injected, cand in maps.items():
+            d = judge(cand, np.nan_to_num(ref.compared_depth()), ref.bound, case.camera, ref.compared_faces())
             got = "pass" if d.passed else "+".join(d.names)
             count += 1
             if got != injected:
                 wrong.append((name, case.name, injected, got, d.measured.get("fit_ratios")))
-    assert count == 3 * (7 * 6 + 6) and not wrong, wrong
+    assert count == 3 * (6 * 10 + 7) and not wrong, wrong
 
 
 def test_wireframe_scene_has_no_depth(oracles):

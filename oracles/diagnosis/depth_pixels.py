@@ -95,6 +95,7 @@ def sample(ref, faces, camera, q):
         val = top + fy * (bottom - top)
         grad = np.column_stack([(w10 - w00) + fy * ((w11 - w01) - (w10 - w00)), bottom - top])
         depth = 1.0 / val if persp else val
+    inside &= np.isfinite(depth)
     return np.where(inside, depth, np.nan), inside, outside, grad
 
 

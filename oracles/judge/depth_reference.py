@@ -48,16 +48,24 @@ class ReferenceDepth:
         Covered pixels beside an occlusion boundary: which surface they show is a rounding decision.
     bound : (H, W) ndarray of float64
         How far a correct depth may be from ``depth`` at each covered pixel.
+    faces : (H, W) ndarray of int64
+        The triangle each pixel shows (-1: none): planar faces, for the mistakes that move
+        pixels (oracles.diagnosis.depth_pixels).
     """
 
     depth: np.ndarray
     covered: np.ndarray
     undecided: np.ndarray
     bound: np.ndarray
+    faces: np.ndarray
 
     def compared_depth(self) -> np.ndarray:
         """``(H, W)`` float64: :attr:`depth` with NaN at the undecided pixels too (what a depth map is judged on)."""
         return np.where(self.undecided, np.nan, self.depth)
+
+    def compared_faces(self) -> np.ndarray:
+        """``(H, W)``: :attr:`faces` with -1 at the undecided pixels too."""
+        return np.where(self.undecided, -1, self.faces)
 
 
 def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, frames: int) -> ReferenceDepth:
@@ -89,7 +97,8 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
     covered, depth, ids = oracle.render_faces(pr_vertices, triangles, cam, model_matrix=pr_pose, with_ids=True)
     bound = depth_bound(depth, covered, cam)
     undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, cam)) & covered
-    return ReferenceDepth(depth=np.where(covered, depth, np.nan), covered=covered, undecided=undecided, bound=bound)
+    return ReferenceDepth(depth=np.where(covered, depth, np.nan), covered=covered, undecided=undecided, bound=bound,
+                          faces=np.where(covered, ids, -1))
 
 
 def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
