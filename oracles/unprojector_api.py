@@ -138,7 +138,7 @@ def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
             if arr.dtype.kind not in "fiu" or arr.shape != (len(s), 3):
                 raise ValueError(f"returned {type(out).__name__} of shape {getattr(arr, 'shape', None)} and dtype "
                                  f"{getattr(arr, 'dtype', None)}: expected an ({len(s)}, 3) float array")
-        except Exception as exc:            # the candidate's failure fails its case, in one line
+        except (Exception, SystemExit) as exc:   # its failure (or its sys.exit) fails its case, in one line
             record["verdict"] = "fail"
             record["reasons"].append(f"frame {k}: unprojector {type(exc).__name__}: "
                                      f"{' '.join(str(exc).split())[:200]}")

@@ -149,7 +149,7 @@ def test_transposed_is_invisible_where_r_is_symmetric():
 
 def test_failing_candidates_fail_their_cases():
     for func, text in ((U.raises, "unprojector RuntimeError: not implemented"),
-                       (U.wrong_shape, "expected an (")):
+                       (U.wrong_shape, "expected an ("), (U.exits, "unprojector SystemExit: 0")):
         r = check_unprojector(func, scenes=["cube"], cases=["on_axis"], frames=1)
         assert r["verdict"] == "fail" and r["cases"][0]["points"] > 0
         assert text in r["cases"][0]["reasons"][0]
@@ -235,6 +235,8 @@ def test_cli_pass_fail_error():
         assert err.returncode == 2 and err.stdout == "" and len(err.stderr.strip().splitlines()) == 1, err.stderr
     both = crosscheck("--unprojector", f"{SPEC}:correct", "--candidate", f"{SPEC}:correct")
     assert both.returncode == 2 and "--unprojector" in both.stderr
+    gone = crosscheck("--unprojector", f"{SPEC}:exits", "--scene", "cube", "--frames", "1", "--cases", "on_axis")
+    assert gone.returncode == 1 and "SystemExit" in gone.stdout
 
 
 # ---------------------------------------------------------------- over the protocol
