@@ -16,7 +16,6 @@ import pytest
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
-from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
 from wirecheck.oracles.judge.cases import case_motion, cases_for
 from wirecheck.oracles.judge.depth_reference import reference_depth
 from wirecheck.oracles.judge.tolerances import MIN_SILHOUETTE_IOU
