@@ -16,8 +16,9 @@ of each frame (oracles.judge.unproject_points) against the exact inverse
 (oracles.references.unproject_reference; OpenCV's undistortion for a camera with a lens),
 each point within ``oracles.judge.tolerances.unproject_bound`` (eps of the answer's precision
 times the point's scale, never under 1e-6 px at its depth). A failing case's fault is named
-by oracles.diagnosis.unproject_faults. The unprojector runs in this process (no isolation,
-unlike a projector).
+by oracles.diagnosis.unproject_faults. A ``"FILE.py:FUNC"`` unprojector runs in its own process
+(the candidate host, oracles.candidates.candidate_host): an ``os._exit`` or a crash fails its
+case; a callable runs in this process.
 """
 
 from __future__ import annotations
@@ -93,8 +94,10 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
     if (func is None) == (cmd is None):
         raise InputError("unprojector: expected one of func (a callable or \"FILE.py:FUNC\") and cmd (a program)")
     name = cmd if cmd is not None else func if isinstance(func, str) else getattr(func, "__qualname__", None) or repr(func)
+    spec = None
     if isinstance(func, str):
-        func = load_candidate(func, "unprojector", ("pixels", "depth", "camera"))
+        load_candidate(func, "unprojector", ("pixels", "depth", "camera"))    # a typo is an input error, here
+        spec, func = func, None
     elif func is not None and not callable(func):
         raise TypeError(f"func {func!r}: expected a callable func(pixels, depth, camera) or a \"FILE.py:FUNC\" string")
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns)
@@ -106,6 +109,8 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
                 func = SubprocessCandidate.from_command(cmd, timeout_s=timeout_s).unproject
             except ValueError as exc:
                 raise InputError(f"unprojector command {exc}") from None
+        elif spec is not None:             # in its own process: os._exit or a crash fails its case, not the run
+            func = SubprocessCandidate.python(spec, timeout_s=timeout_s, unproject=True).unproject
         for scene in inputs.scenes:
             by_name = {c.name: c for c in cases_for(scene, motion, calibrated=True)}
             for case_name in inputs.case_names:

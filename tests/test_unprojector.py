@@ -155,6 +155,10 @@ def test_failing_candidates_fail_their_cases():
         assert text in r["cases"][0]["reasons"][0]
     with pytest.raises(AssertionError, match="mirror_vertical"):
         assert_unprojector(U.rows_flipped, scenes=["cube"], cases=["oblique_roll"], frames=1)
+    # a spec string runs isolated: the same verdicts as the callable, float32 precision carried over the wire
+    assert check_unprojector(f"{SPEC}:correct", scenes=["cube"], frames=1, cases="all")["verdict"] == "pass"
+    r32 = check_unprojector(f"{SPEC}:correct_float32", scenes=["cube"], frames=1)
+    assert r32["verdict"] == "pass" and {c["precision"] for c in r32["cases"]} == {"float32"}
 
 
 def test_never_vacuous():
@@ -237,6 +241,9 @@ def test_cli_pass_fail_error():
     assert both.returncode == 2 and "--unprojector" in both.stderr
     gone = crosscheck("--unprojector", f"{SPEC}:exits", "--scene", "cube", "--frames", "1", "--cases", "on_axis")
     assert gone.returncode == 1 and "SystemExit" in gone.stdout
+    # FILE.py:FUNC runs in its own process: an os._exit(0) fails its case (exit 1), never a pass
+    hard = crosscheck("--unprojector", f"{SPEC}:hard_exit", "--scene", "cube", "--frames", "1", "--cases", "on_axis")
+    assert hard.returncode == 1 and "FAIL: 0/1 cases" in hard.stdout, (hard.stdout, hard.stderr)
 
 
 # ---------------------------------------------------------------- over the protocol

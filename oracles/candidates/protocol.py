@@ -102,9 +102,10 @@ def encode_request(request_id: int, p_world: np.ndarray, camera_json: str, kind:
     return out
 
 
-def encode_reply(p_px: np.ndarray, precision: str = "float64") -> bytes:
-    """One reply: ``{"n": N}`` (with ``"precision": "float32"`` for a float32 answer) and the pixels, float64."""
-    p_px = np.ascontiguousarray(p_px, dtype=WIRE_DTYPE).reshape(-1, 2)
+def encode_reply(p_px: np.ndarray, precision: str = "float64", columns: int = 2) -> bytes:
+    """One reply: ``{"n": N}`` (with ``"precision": "float32"`` for a float32 answer) and the pixels, float64
+    (``columns=3``: an unprojector's world points)."""
+    p_px = np.ascontiguousarray(p_px, dtype=WIRE_DTYPE).reshape(-1, columns)
     head = {"n": len(p_px), **({"precision": precision} if precision != "float64" else {})}
     return json.dumps(head).encode() + b"\n" + p_px.tobytes()
 

@@ -130,11 +130,13 @@ class SubprocessCandidate:
         """A ``FILE.py:FUNC`` / ``MODULE:FUNC`` candidate run isolated, by :mod:`oracles.candidates.candidate_host`.
 
         ``pythonpath``: folders the host puts first on ``sys.path`` (for a
-        ``MODULE:FUNC`` importable only from the caller's path).
+        ``MODULE:FUNC`` importable only from the caller's path). ``unproject=True``: the spec is
+        an unprojector, served for :meth:`unproject`.
         """
         env = (("WIRECHECK_HOST_PATH", os.pathsep.join(pythonpath)),) if pythonpath else ()
-        return cls(argv=(sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", spec), timeout_s=timeout_s,
-                   label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
+        mode = ("--unproject",) if kwargs.pop("unproject", False) else ()
+        return cls(argv=(sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", *mode, spec),
+                   timeout_s=timeout_s, label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
 
     @classmethod
     def fork(cls, func, timeout_s: float = DEFAULT_TIMEOUT_S, label: str = "") -> "SubprocessCandidate":

@@ -107,6 +107,13 @@ def exits(pixels, depth, camera):
     sys.exit(0)
 
 
+def hard_exit(pixels, depth, camera):
+    """Ends its process at once, status 0 (no Python clean-up): run isolated, it fails its case."""
+    import os
+
+    os._exit(0)
+
+
 def wrong_shape(pixels, depth, camera):
     return correct(pixels, depth, camera)[:, :2]
 
