@@ -301,6 +301,10 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
+        if args.unprojector is not None or args.unprojector_cmd is not None:     # the way back: its own table
+            from .unprojector_cli import unprojector_main
+
+            return unprojector_main(args)
         args.candidate_from = next(((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd")
                                     if key in applied), None)
         check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (

@@ -61,6 +61,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.judge.tolerances) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
+    p.add_argument("--unprojector", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
+                   help="judge an unprojector FUNC(pixels, depth, camera) -> world points against the exact "
+                        "inverse of the conventions (docs/depth.md); with --scene, --cases, --frames (2), --spin; "
+                        "no report folder (default: none)")
+    p.add_argument("--unprojector-cmd", default=None, metavar="'COMMAND ARGS'",
+                   help="an unprojector program in any language, over the candidate protocol's unproject requests "
+                        "(docs/protocol.md); each request under --candidate-timeout (default: none)")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
                    help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
                         "(docs/frames.md) (default: none)")
