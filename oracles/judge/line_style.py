@@ -567,7 +567,9 @@ class CaseStyle:
         rounded_fails = self.rule_failures(rounded, tol) if by_rule and rounded is not None else None
         rounded_right = rounded_fails == [] and not moved and not warped and only_rule
         if by_rule:
-            out["rule_read"] = "gl"
+            # the rule read: GL's, unless the rounded ends' explains the pixels and more closely (F1@0px)
+            out["rule_read"] = "rounded" if (rounded_fails == [] and not f0 and not moved and not warped
+                                             and rounded["pixel_f1_0px"] > rec["pixel_f1_0px"]) else "gl"
             if rounded is not None:
                 out["rounded_rule"] = {"pixel_f1_0px": rounded["pixel_f1_0px"], "failures": rounded_fails,
                                        "lines": {k: rounded["lines"][k] for k in ("candidate_only", "oracle_only",
