@@ -589,8 +589,9 @@ class CaseStyle:
                                        "not GL's: check the line rasteriser, not the camera; without --line-rule "
                                        "gl such lines pass"})
         elif self.line_rule == "any" and by_rule and f0 and rounded is not None and only_rule \
-                and rounded["pixel_f1_0px"] > rec["pixel_f1_0px"]:
-            # neither rule draws these pixels, the rounded-ends rule the closer: its limits and its line fault
+                and rec["pixel_f1_0px"] < rounded["pixel_f1_0px"] and rounded["pixel_f1_0px"] >= tol.min_f1_0px:
+            # the pixels are the rounded-ends rule's but for a bias of its one-sided pixels (a dropped end
+            # pixel): that rule's limits and its line fault, as GL's would name them
             out["rule_read"] = "rounded"
             reasons = [r for r in reasons if r not in f0] + rounded_fails
             named = diagnose_lines(rounded["lines"], tol)
