@@ -274,3 +274,16 @@ def test_a_binary_band_centred_on_the_line_measures_no_offset(square_on_job, tmp
     for c in report["cases"]:
         assert c["line_style"]["style"] == "wide" and c["verdict"] == "pass", c["reasons"]
         assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.05, c["line_style"]["geometry"]
+
+
+def test_rule_f1_0px_decides(job_dir, tmp_path):
+    # rule_f1_0px decides whether pixels are read as a correct drawing by the rounded-ends rule (a name, and
+    # with GL's F1@0px floor open the only guard of that reading). Pillow's frames measure F1@0px 1.0 against
+    # it: at rule_f1_0px 1.0 they are read as that rule's (rule_read "rounded"), just above 1.0 they are not
+    # ("gl", whose limits then decide)
+    job = _drawn(job_dir, tmp_path, hd.draw_pillow, "job")
+    report, _ = run_frames(job, tol=Tolerances(min_f1_0px=0.0, rule_f1_0px=1.0))
+    assert all(c["line_style"]["rounded_rule"]["pixel_f1_0px"] == 1.0 for c in report["cases"])
+    assert [c["line_style"]["rule_read"] for c in report["cases"]] == ["rounded"] * 4
+    report, _ = run_frames(job, tol=Tolerances(min_f1_0px=0.0, rule_f1_0px=float(np.nextafter(1.0, 2.0))))
+    assert [c["line_style"]["rule_read"] for c in report["cases"]] == ["gl"] * 4

@@ -589,7 +589,8 @@ class CaseStyle:
                                        "not GL's: check the line rasteriser, not the camera; without --line-rule "
                                        "gl such lines pass"})
         elif self.line_rule == "any" and by_rule and f0 and rounded is not None and only_rule \
-                and rec["pixel_f1_0px"] < rounded["pixel_f1_0px"] and rounded["pixel_f1_0px"] >= tol.min_f1_0px:
+                and rec["pixel_f1_0px"] < rounded["pixel_f1_0px"] \
+                and rounded["pixel_f1_0px"] >= max(tol.min_f1_0px, tol.rule_f1_0px):
             # the pixels are the rounded-ends rule's but for a bias of its one-sided pixels (a dropped end
             # pixel): that rule's limits and its line fault, as GL's would name them
             out["rule_read"] = "rounded"
@@ -621,8 +622,9 @@ class CaseStyle:
         from .metrics import line_failures
 
         out = []
-        if rounded["pixel_f1_0px"] < tol.min_f1_0px:
-            out.append(f"pixel F1@0px {rounded['pixel_f1_0px']:.4f} < {tol.min_f1_0px} against the rounded-ends "
+        floor = max(tol.min_f1_0px, tol.rule_f1_0px)      # a rule is read from its pixels, whatever GL's floor
+        if rounded["pixel_f1_0px"] < floor:
+            out.append(f"pixel F1@0px {rounded['pixel_f1_0px']:.4f} < {floor} against the rounded-ends "
                        "rule too")
         return out + [f"{r} (the rounded-ends rule)" for r in line_failures(rounded["lines"], tol)]
 

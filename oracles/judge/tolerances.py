@@ -400,6 +400,13 @@ END_TOL_PX = 0.5
 #: rounded-ends renderers tried; an end falls that close for 1/16 of ends on an axis, so a dropped end pixel
 #: is still decided at the other ends.
 ROUNDED_END_TIE_PX = 1.0 / 32.0
+#: A renderer's aliased pixels are read as a correct drawing by another rule of the line model
+#: (oracles.judge.line_model, "rounded") only where their F1@0px against that rule's drawing is at least
+#: this (or the run's F1@0px floor, if higher): measured 0.999-1.000 in every case of Pillow, Bresenham and
+#: cv2 LINE_8 (21 bundled cases each); GL's own pixels with each line's last pixel dropped measure 0.83-0.92
+#: against it. Without it a run with --min-f1-0px 0 would read any drawing whose one-sided pixels balance
+#: against the rounded ends' as theirs. 0.98, GL's own F1@0px bound.
+RULE_F1_0PX = 0.98
 
 
 @dataclass
@@ -424,6 +431,7 @@ class Tolerances:
     rule_offset_px: float = RULE_OFFSET_MAX_PX
     end_px: float = END_TOL_PX
     rounded_end_tie_px: float = ROUNDED_END_TIE_PX
+    rule_f1_0px: float = RULE_F1_0PX
 
     def __post_init__(self):
         if self.precision is not None and self.precision not in PRECISIONS:
@@ -444,4 +452,5 @@ class Tolerances:
     def lines_dict(self) -> dict:
         """The frames path's line-geometry limits, as the report's ``tolerances`` adds them."""
         return {"offset_px": self.offset_px, "scale_px": self.scale_px, "rule_offset_px": self.rule_offset_px,
-                "end_px": self.end_px, "rounded_end_tie_px": self.rounded_end_tie_px}
+                "end_px": self.end_px, "rounded_end_tie_px": self.rounded_end_tie_px,
+                "rule_f1_0px": self.rule_f1_0px}
