@@ -10,7 +10,7 @@ wrong axis, fx 3 % over fy, rows not flipped), judges it with
 faults counted over the cases, the style read, the width, F1@0px against GL's
 rule, the largest measured centre offset, and the pixel offsets named.
 
-    .venv/bin/python benchmarks/measure_heldout_frames.py [OUT] [--only NAME ...] [--cases] [--line-rule geometry]
+    .venv/bin/python benchmarks/measure_heldout_frames.py [OUT] [--only NAME ...] [--cases] [--line-rule gl|geometry]
 
 About 25 s a renderer on one core (15 minutes in all). Not part of CI.
 """
@@ -90,14 +90,15 @@ RENDERERS = {
 }
 
 
-def judge(job: Path, out: Path, name: str, line_rule: str = "gl") -> list:
+def judge(job: Path, out: Path, name: str, line_rule: str | None = None) -> list:
     draw, project, mistake = RENDERERS[name]
     d = out / "job"
     shutil.rmtree(out, ignore_errors=True)
     shutil.copytree(job, d)
     hd.render(d, draw, project, **mistake)
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-        main(["--candidate-frames", str(d), "--report-dir", str(out / "rep"), "--line-rule", line_rule])
+        main(["--candidate-frames", str(d), "--report-dir", str(out / "rep")]
+             + (["--line-rule", line_rule] if line_rule else []))
     cases = json.loads((out / "rep" / "report.json").read_text())["cases"]
     shutil.rmtree(out)
     return cases
@@ -135,7 +136,8 @@ def run(argv=None) -> int:
     ap.add_argument("out", nargs="?", help="a folder for the job and the reports (default: a temporary one)")
     ap.add_argument("--only", nargs="+", choices=sorted(RENDERERS), help="these renderers only")
     ap.add_argument("--cases", action="store_true", help="one line per case too")
-    ap.add_argument("--line-rule", choices=("gl", "geometry"), default="gl", help="crosscheck's --line-rule")
+    ap.add_argument("--line-rule", choices=("any", "gl", "geometry"), default=None,
+                    help="crosscheck's --line-rule (default: crosscheck's own, any)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(args.out or tmp)

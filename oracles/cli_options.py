@@ -71,9 +71,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
                    help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
                         "(docs/frames.md) (default: none)")
-    p.add_argument("--line-rule", choices=("gl", "geometry"), default=None,
-                   help="--candidate-frames: gl holds aliased 1-px lines to GL's pixel rule (F1@0px); geometry "
-                        "judges where the lines are only (antialiased and wide lines always are) (default: gl)")
+    p.add_argument("--line-rule", choices=("any", "gl", "geometry"), default=None,
+                   help="--candidate-frames: any holds aliased 1-px lines to a correct drawing by GL's rule or by "
+                        "the rule that rounds the ends to pixel centres (Bresenham, Pillow, cv2.line); gl to GL's "
+                        "pixel rule alone (F1@0px); geometry judges where the lines are only (antialiased and wide "
+                        "lines always are) (default: any)")
     p.add_argument("--level", choices=LEVELS, default=None,
                    help="vertices: OpenCV vertex check only (no drawing, no pyrender); "
                         "pixels: vertices and pyrender pixels (default)")

@@ -154,7 +154,8 @@ _KINDS = (
         "rasterizer's end rule (GL diamond exit: the start pixel is drawn when the start point "
         "is inside its diamond, the end pixel is not drawn when the end point is inside its own)",
         shown=(("end", "end"), ("pixels_per_line", "pixels_per_line"), ("end_px", "end_px")),
-        frames_hint="a renderer of another aliased line rule: --line-rule geometry judges the geometry only"),
+        frames_hint="the pixels lose or gain end pixels against both GL's rule and ends rounded to pixel "
+                    "centres (Bresenham, Pillow), which pass by default; --line-rule geometry judges the geometry only"),
     FaultKind(
         "line_pixel_bias", "line_count", "pixels",
         "the vertices agree but the candidate draws systematically more (or fewer) line pixels "
@@ -165,7 +166,8 @@ _KINDS = (
         "raster_rule", "line_rule", "pixels",
         "the lines are where the oracle's are but their pixels follow another aliased line rule than "
         "GL's (Pillow's, TinyGL's: ends snapped to pixel centres, another choice across the line): check "
-        "the line rasteriser, not the camera; --line-rule geometry judges the geometry only"),
+        "the line rasteriser, not the camera; without --line-rule gl a correct drawing with ends rounded to "
+        "pixel centres passes, and --line-rule geometry judges the geometry only"),
     FaultKind(
         "precision_limited", "precision", "vertices",
         "the error is the size of float32 rounding, not a convention error: compute in "

@@ -17,7 +17,7 @@ from __future__ import annotations
 from .api import _flag, _report_dir, _short, raise_unless_pass
 
 
-def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None, min_f1_0px: float | None = None,
+def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None, min_f1_0px: float | None = None,
                  allow_vacuous: bool = False, report_dir=None) -> dict:
     """Judge the frames a renderer drew for a job against pyrender and core; return the report.
 
@@ -26,9 +26,11 @@ def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None,
     job_dir : str or Path
         A job folder written by ``crosscheck export`` (or
         ``wirecheck.oracles.candidates.export.write_job``), its ``frames/`` drawn.
-    line_rule : {"gl", "geometry"}
-        ``"gl"`` holds aliased 1-px lines to GL's pixel rule (F1@0px); ``"geometry"`` judges where
-        the lines are only (``crosscheck --line-rule``).
+    line_rule : {"any", "gl", "geometry"}
+        ``"any"`` (default) holds aliased 1-px lines to a correct drawing by GL's rule or by the
+        rule that rounds the ends to pixel centres (Bresenham, Pillow, ``cv2.line``); ``"gl"`` to
+        GL's pixel rule alone (F1@0px); ``"geometry"`` judges where the lines are only
+        (``crosscheck --line-rule``).
     min_f1, min_f1_0px : float, optional
         F1 floors at 1 px and 0 px, in [0, 1] (default: those of docs/tolerances.md, as crosscheck's).
     allow_vacuous : bool
@@ -71,8 +73,9 @@ def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None,
     job_dir = Path(job_dir)
     _flag(allow_vacuous, "allow_vacuous")
     if line_rule not in LINE_RULES:
-        raise InputError(f"line_rule {line_rule!r}: expected one of {', '.join(LINE_RULES)} (gl: aliased 1-px "
-                         "lines held to GL's pixel rule; geometry: where the lines are only)")
+        raise InputError(f"line_rule {line_rule!r}: expected one of {', '.join(LINE_RULES)} (any: aliased 1-px "
+                         "lines held to GL's rule or the rounded ends'; gl: to GL's pixel rule; geometry: where "
+                         "the lines are only)")
     tol = tolerances.Tolerances(min_f1_1px=tolerances.MIN_F1_1PX if min_f1 is None else min_f1,
                                 min_f1_0px=tolerances.MIN_F1_0PX if min_f1_0px is None else min_f1_0px)
     gate.check_tolerances(tol)                  # a NaN floor would pass everything

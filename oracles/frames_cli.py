@@ -122,7 +122,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     try:
         check_report_outside_job(job_dir, run_dir)
         report, images = run_frames(job_dir, tol=tol, allow_vacuous=args.allow_vacuous,
-                                    line_rule=args.line_rule or "gl")
+                                    line_rule=args.line_rule or "any")
     except InputError as exc:
         return _fail(str(exc))
     try:
@@ -179,12 +179,16 @@ def verdict_line(report: dict, tol) -> str:
 
 
 def f1_0px_clause(cases: list, min_f1_0px: float) -> str:
-    """The verdict line's F1@0px threshold, said only of the cases it judged: aliased lines held to GL's pixel
-    rule (``--line-rule gl``); antialiased and wide lines, and ``--line-rule geometry``, report F1@0px only."""
-    held = sum(1 for c in cases if not c.get("line_style") or (c["line_style"]["style"] == "aliased"
-                                                               and c["line_style"]["line_rule"] == "gl"))
-    if held == len(cases):
+    """The verdict line's F1@0px threshold, said only of the cases it judged: aliased lines held to a pixel
+    rule (``--line-rule any``: GL's or the rounded ends' read; ``gl``); antialiased and wide lines, and
+    ``--line-rule geometry``, report F1@0px only."""
+    held = [c for c in cases if not c.get("line_style") or (c["line_style"]["style"] == "aliased"
+                                                            and c["line_style"]["line_rule"] in ("gl", "any"))]
+    rounded = sum(1 for c in held if (c.get("line_style") or {}).get("rule_read") == "rounded")
+    which = "GL's pixel rule" if not rounded else "a pixel rule (GL's, or the rounded ends' in " \
+        f"{rounded})"
+    if len(held) == len(cases) and not rounded:
         return f"F1@0px >= {min_f1_0px}"
-    if held == 0:
+    if not held:
         return "F1@0px reported, not judged: no case is held to GL's pixel rule"
-    return f"F1@0px >= {min_f1_0px} in the {held} case{'s' if held != 1 else ''} held to GL's pixel rule"
+    return f"F1@0px >= {min_f1_0px} in the {len(held)} case{'s' if len(held) != 1 else ''} held to {which}"

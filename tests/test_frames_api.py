@@ -63,7 +63,7 @@ def test_core_drawn_frames_pass(jobs):
     assert report["verdict"] == "pass" and case["verdict"] == "pass" and case["faults"] == []
     # the judge compared both listed frames (1 and 4 of 6), not nothing
     assert report["compared"]["frames"] == 2 and report["compared"]["pixels"] > 0
-    assert report["candidate"] == "frames:good" and report["line_rule"] == "gl"
+    assert report["candidate"] == "frames:good" and report["line_rule"] == "any"
 
 
 def test_black_frames_fail_naming_the_fault(jobs):
@@ -177,8 +177,8 @@ def test_bad_input_raises_the_clis_line(jobs, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"line_rule": "pixels"}, "line_rule 'pixels': expected one of gl, geometry"),
-    ({"line_rule": None}, "line_rule None: expected one of gl, geometry"),
+    ({"line_rule": "pixels"}, "line_rule 'pixels': expected one of any, gl, geometry"),
+    ({"line_rule": None}, "line_rule None: expected one of any, gl, geometry"),
     # a NaN floor would pass everything (no comparison with NaN is true); above 1 nothing passes
     ({"min_f1": float("nan")}, "min_f1 nan: expected a number in [0, 1]"),
     ({"min_f1_0px": 1.5}, "min_f1_0px 1.5: expected a number in [0, 1]"),

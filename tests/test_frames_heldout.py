@@ -8,7 +8,8 @@ pixels), OpenCV's ``cv2.line`` (LINE_8, LINE_4, LINE_AA with 4 sub-pixel
 bits), a Xiaolin Wu and a Bresenham line written here. The rule measured
 (guide: a gate never fails correct code, on inputs nobody tuned it to): a
 correct renderer passes, or, aliased by another rule than GL's, is named
-``raster_rule`` and passes ``--line-rule geometry``; one typical mistake per
+``raster_rule`` under ``--line-rule gl`` and passes ``--line-rule geometry`` (and the default
+``any`` when that rule rounds the ends to pixel centres); one typical mistake per
 renderer fails with its own name. A correct renderer that fails is a finding
 of the judge's, kept here as ``xfail(strict=True)`` with its measured numbers
 (docs/frames.md, "Held-out renderers").
@@ -130,6 +131,20 @@ def test_another_aliased_rule_is_raster_rule_and_passes_on_geometry(jobs, tmp_pa
     shutil.rmtree(tmp_path / "job"), shutil.rmtree(tmp_path / "rep")
     rc, c = _judge(jobs, tmp_path, "slanted", draw, project, rule="geometry")
     assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["reasons"], c["faults"])
+
+
+@pytest.mark.parametrize("draw, project", [p[1:] for p in OTHER_RULE], ids=[p[0] for p in OTHER_RULE])
+def test_another_aliased_rule_by_default(jobs, tmp_path, capsys, draw, project):
+    # the default --line-rule any: the rules that round the ends to pixel centres (Pillow, Bresenham, LINE_8)
+    # are correct drawings by the line model's rounded-ends rule and pass (F1@0px against it: 1.0 measured);
+    # LINE_4 (4-connected) is no rule the model draws: it still fails, raster_rule
+    rc, c = _judge(jobs, tmp_path, "slanted", draw, project, rule="any")
+    if getattr(draw, "keywords", {}).get("line_type") == "LINE_4":
+        assert rc == 1 and [f["name"] for f in c["faults"]] == ["raster_rule"], c["faults"]
+        assert c["line_style"]["rounded_rule"]["pixel_f1_0px"] < 0.98
+        return
+    assert rc == 0 and c["faults"] == [] and c["line_style"]["rule_read"] == "rounded", (c["reasons"], c["faults"])
+    assert c["line_style"]["rounded_rule"]["pixel_f1_0px"] >= 0.999 and c["pixel_f1_0px"] < 0.98
 
 
 # ---- one typical mistake per renderer, named ----

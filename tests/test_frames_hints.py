@@ -48,6 +48,10 @@ def test_the_verdict_line_claims_f1_at_0px_only_where_it_judged():
     assert f1_0px_clause([case("aliased", "geometry")], 0.98).startswith("F1@0px reported, not judged")
     assert f1_0px_clause([case("aliased"), case("antialiased")], 0.98) == (
         "F1@0px >= 0.98 in the 1 case held to GL's pixel rule")
+    # --line-rule any: a case read as the rounded ends' is held to that rule's F1@0px, and the line says so
+    rounded = {"line_style": {"style": "aliased", "line_rule": "any", "rule_read": "rounded"}}
+    assert f1_0px_clause([rounded, case("aliased", "any")], 0.98) == (
+        "F1@0px >= 0.98 in the 2 cases held to a pixel rule (GL's, or the rounded ends' in 1)")
 
 
 def test_a_faults_list_of_floats_is_written_as_its_numbers():

@@ -143,18 +143,28 @@ def test_a_small_scale_error_of_antialiased_lines_fails(job_dir, tmp_path, capsy
         assert 0.5 < c["line_style"]["geometry"]["warp_px"] <= 0.8 + 0.05
 
 
-def test_pillow_rule_is_named_raster_rule(job_dir, tmp_path, capsys):
+def test_pillow_rule_passes_by_default_and_is_raster_rule_under_gl(job_dir, tmp_path, capsys):
     job = _fill(job_dir, tmp_path, draw_pillow)
+    # by default (--line-rule any) a correct drawing by the rounded-ends rule passes, with one line saying so
     rc, report = _judge(job, tmp_path)
+    out = capsys.readouterr().out
+    assert rc == 0 and report["line_rule"] == "any", [c["reasons"] for c in report["cases"]]
+    for c in report["cases"]:
+        assert c["line_style"]["rule_read"] == "rounded" and c["faults"] == [] and c["pixel_f1_0px"] < 0.98
+    assert out.count("Line rule read: ends rounded to pixel centres") == 1 and "--line-rule gl holds them" in out
+    # --line-rule gl holds them to GL's: raster_rule, a correct drawing by another rule, no count deficit
+    shutil.rmtree(tmp_path / "rep")
+    rc, report = _judge(job, tmp_path, "--line-rule", "gl")
     assert rc == 1
     for c in report["cases"]:
         assert c["line_style"]["style"] == "aliased"
         assert c["verdict"] == "fail" and c["pixel_f1_1px"] >= 0.999 and c["pixel_f1_0px"] < 0.98
         (f,) = c["faults"]                                  # no rotation, mirror or offset
-        assert f["name"] == "raster_rule", c["faults"]
+        assert f["name"] == "raster_rule" and f["rule"] == "rounded", c["faults"]
         assert f["share_off_by_one_across"] > 0.1 and f["share_farther"] == 0.0
         assert f["share_off_by_one_at_ends"] < f["share_off_by_one_across"]
-        assert "rotation" not in f["note"] and "--line-rule geometry" in f["note"]
+        assert "rotation" not in f["note"] and "--line-rule gl" in f["note"]
+        assert not any("against the oracle's count" in r for r in c["reasons"]), c["reasons"]
     # the user's choice: the geometry only
     shutil.rmtree(tmp_path / "rep")
     rc, report = _judge(job, tmp_path, "--line-rule", "geometry")

@@ -246,9 +246,10 @@ Any: the judge reads it from the frames. A 1-px aliased line (WebGL:
 GL's pixel rule: the 0-px F1 compares pixel for pixel. Anti-aliased lines and
 lines up to ~3 px wide cannot follow that rule; they are judged by where each
 line's centre lies (to a fraction of a pixel), and the report says which style
-it read. Aliased lines of another rule (Pillow's ImageDraw.line, TinyGL) fail
-the 0-px F1 as `raster_rule`; `crosscheck --candidate-frames DIR --line-rule
-geometry` judges their geometry only. A line is judged where it is drawn: a
+it read. Aliased lines that round each end to a pixel centre (Pillow's
+ImageDraw.line, Bresenham, OpenCV's cv2.line) pass when they are a correct
+drawing by that rule, and the report says so; `--line-rule gl` holds them to
+GL's rule (`raster_rule`), `--line-rule geometry` judges the geometry only. A line is judged where it is drawn: a
 renderer that moves lines onto pixel centres is held to that move. matplotlib
 does so by default for horizontal and vertical lines (`snap`): draw with
 `snap=False`, or square-on frames read as a `pixel_offset` of up to half a pixel.

@@ -365,7 +365,7 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
     return p_model, edges, camera, m
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
+def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "any"):
     """One case, judged frame by frame: :func:`oracles.judge.frames_judge.judge_case`."""
     from ..judge.frames_judge import judge_case as judge
 
@@ -373,7 +373,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
 
 
 def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
+               allow_vacuous: bool = False, line_rule: str = "any") -> tuple[dict, dict]:
     """Judge the job's frames: :func:`oracles.judge.frames_judge.run_frames`."""
     from ..judge.frames_judge import run_frames as run
 

@@ -78,6 +78,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..judge import tolerances as _tolerances
 from .image_naming import name_faults, quantisation_bias, restart_scales, rotation_deg, rule_off_diagonal
 from .image_visibility import in_place, visibility_fault
 
@@ -117,17 +118,15 @@ RESIDUAL_MAX_PX = 0.85
 #: view of a centrally symmetric scene) fits several equally well (measured
 #: relative differences below 1e-2), and then no mirror can be seen.
 AMBIGUOUS_RATIO = 0.05
-#: A scale is a fault when it moves some drawn pixel by more than this (px):
-#: a correct renderer's pooled scale is within 5e-4 of 1 (<= 0.05 px at the
-#: tests' reach of ~130 px), a 0.8 FOV factor moves lines by tens of px.
-SCALE_TOL_PX = 0.5
+#: A scale is a fault when it moves some drawn pixel by more than this (px): the default of
+#: Tolerances.scale_px (oracles.judge.tolerances, with its derivation).
+SCALE_TOL_PX = _tolerances.SCALE_TOL_PX
 #: The free affine fit's off-diagonal terms (rotation, shear) are a fault when
 #: they move a pixel by more than this: <= 0.04 px on a correct renderer,
 #: 0.77-1.17 px for a 0.5 degree roll (measured on the tests' cameras).
 ROTATION_TOL_PX = 0.3
-#: An offset is a fault when it exceeds this (px): the pooled fit's offset on
-#: a correct renderer stays within ~0.05 px; a half-pixel convention is 0.5.
-OFFSET_TOL_PX = 0.2
+#: An offset is a fault when it exceeds this (px): the default of Tolerances.offset_px.
+OFFSET_TOL_PX = _tolerances.OFFSET_TOL_PX
 #: The fit pairs a case's candidate pixels with their frame's segments in one
 #: array of (pixels x most segments in a frame) up to this many elements (a
 #: few tens of MB); more (a dense mesh) are paired frame by frame.
@@ -510,7 +509,7 @@ def _in_image(segments, camera) -> int:
     return n
 
 
-def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list[dict]:
+def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=None) -> list[dict]:
     """Name the faults of a renderer from its frames; ``[]`` when its lines are the oracle's.
 
     Parameters
@@ -524,12 +523,17 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
     flipped_segs : sequence of (K, 2, 2) ndarray, optional
         The lines seen by :func:`flipped_camera`; without them ``depth_flip``
         is not considered.
+    tol : oracles.judge.tolerances.Tolerances, optional
+        Its ``scale_px`` and ``offset_px`` name a scale and an offset (default
+        :data:`SCALE_TOL_PX`, :data:`OFFSET_TOL_PX`).
 
     Returns
     -------
     list of dict, primary fault first (precedence: oracles.faults);
     every fault has ``confidence`` and ``residual_px``.
     """
+    scale_tol = SCALE_TOL_PX if tol is None else tol.scale_px
+    offset_tol = OFFSET_TOL_PX if tol is None else tol.offset_px
     cand_images = list(cand_images)
     oracle_segs = list(oracle_segs)
     if len(cand_images) != len(oracle_segs):
@@ -593,8 +597,8 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
                  "rotation_deg": rotation_deg(a_free)}
         matched = fine.matched(p, a, b)         # the lines in place, only the drawn sets differ?
         if in_place(names, np.diag(a), b, off_diagonal, reach, matched,
-                    (SCALE_TOL_PX, OFFSET_TOL_PX, ROTATION_TOL_PX, RESIDUAL_MAX_PX)):
+                    (scale_tol, offset_tol, ROTATION_TOL_PX, RESIDUAL_MAX_PX)):
             fault = visibility_fault(fault, cand_images, oracle_segs, camera, matched)
         return [fault]
-    return name_faults(fine, ranked, plain, camera, oracle_segs, reach, quantisation_bias, SCALE_TOL_PX,
-                       OFFSET_TOL_PX, AMBIGUOUS_RATIO, cost, cand_images)
+    return name_faults(fine, ranked, plain, camera, oracle_segs, reach, quantisation_bias, scale_tol,
+                       offset_tol, AMBIGUOUS_RATIO, cost, cand_images)

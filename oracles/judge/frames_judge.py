@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import f1_radius, metrics
+from . import f1_radius, line_model, metrics
 from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
@@ -103,6 +103,26 @@ class _CaseFrames:
         self.drawn_px = 0
         self.worst = None                  # ((f1_1px, f1_0px), frame, candidate, oracle)
         self.diag = []                     # (KeptImage-like flat indices, shape, segments, flipped)
+        self.rounded_f1 = []               # each frame's F1@0px against the rounded-ends rule (line_model)
+        self.rounded_batch = metrics.LineBatch()
+        self.rounded_lines = []
+
+    def add_rounded(self, k, cand: np.ndarray, segs: np.ndarray, shape: tuple, seg0, seg1, tol) -> None:
+        """Score a frame's drawn pixels ``cand`` (flat) against a correct drawing of ``segs`` by the
+        rounded-ends rule (oracles.judge.line_model), the rule's ties left out of both."""
+        model, ties = line_model.expected(segs, shape, "rounded", tol.rounded_end_tie_px)
+        keep = ~ties.reshape(-1)
+        fp = metrics.FramePixels.from_indices(shape, cand[keep[cand]], np.flatnonzero(model.reshape(-1) & keep))
+        self.rounded_f1.append(float(metrics.pixel_scores(None, None, tols=(0,), pixels=fp)["f1_0px"]))
+        self.rounded_lines.extend(self.rounded_batch.add(k, fp, seg0, seg1))
+
+    def rounded(self) -> dict | None:
+        """The case's pixels against the rounded-ends rule (CaseStyle.judge's ``rounded``), None without frames."""
+        self.rounded_lines.extend(self.rounded_batch.flush())
+        if not self.rounded_f1:
+            return None
+        return {"pixel_f1_0px": min(self.rounded_f1),
+                "lines": metrics.line_summary(self.rounded_lines)}
 
     def record_lines(self, scored: list) -> None:
         for (k, frame_rec), ls in scored:
@@ -110,13 +130,14 @@ class _CaseFrames:
             frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
+def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "any"):
     """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
 
     ``oracles``: the run's oracles.judge.frame_prefetch.FramePrefetch (frames
     read ahead on its GL thread), or an OracleCache (read in this thread).
 
-    ``line_rule``: ``"gl"`` holds aliased 1-px lines to GL's pixel rule,
+    ``line_rule``: ``"any"`` holds aliased 1-px lines to a correct drawing by GL's rule or the
+    rounded-ends rule (oracles.judge.line_model), ``"gl"`` to GL's pixel rule alone,
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
     """
     from .line_style import CaseStyle
@@ -148,6 +169,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         core = _drawn(render_frame(p_model, edges, camera, m).image)
         fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
         style.count_rule(fp, segs)
+        if line_rule != "geometry":
+            acc.add_rounded(k, cand, segs, orac.shape, seg0, seg1, tol)
         ps = metrics.pixel_scores(None, None, pixels=fp)
         # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
         cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
@@ -175,11 +198,11 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     faults = []
     images, segments = [_image(flat, shape) for flat, shape, _, _ in acc.diag], [s for _, _, s, _ in acc.diag]
     if diagnose:
-        faults = diagnose_images(images, segments, camera, [f for _, _, _, f in acc.diag])
+        faults = diagnose_images(images, segments, camera, [f for _, _, _, f in acc.diag], tol=tol)
     rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
     f1_radius.apply(rec, style.classify(), acc.radius, numbers)     # F1 at the radius the lines' width allows
     # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
-    style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol))
+    style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol), rounded=acc.rounded())
     rec["line_style"]["f1_radius_px"] = rec["f1_radius_px"]
     rec["faults"] = name_dim_lines(rec["faults"], rec["line_style"], acc.per_frame)   # lines under the 128 rule
     rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
@@ -214,7 +237,7 @@ def case_record(job: dict, scene: str, case: str, camera, acc: _CaseFrames, chec
 
 
 def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
+               allow_vacuous: bool = False, line_rule: str = "any") -> tuple[dict, dict]:
     """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
 
     Every listed frame is checked first (oracles.candidates.frames_candidate.check_frames:
@@ -248,7 +271,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
                 "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
                 "pixels": sum(r["compared"]["pixels"] for r in records)}
     bad = failed or not compared["frames"] or (not allow_vacuous and (vacuous or not compared["pixels"]))
-    tolerances = tol.to_dict()
+    tolerances = {**tol.to_dict(), **tol.lines_dict()}
     del tolerances["candidate_precision"]                 # no vertex is compared: no precision judged
     report = {
         "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import tolerances as _tolerances
 from .line_style import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX, _seg_distance
 
 #: A segment end is measured when no other segment comes this close to it (px): the profile along the
@@ -22,9 +23,9 @@ FREE_END_PX = GUARD_PX + 4.0
 END_INSIDE_PX = 6.0
 END_REACH_PX = 4.0
 #: An end is short when the line's coverage falls to half before this (px, negative: inside the
-#: segment; a butt end falls at 0, a round or square cap up to half the width past it), long when
-#: it stays above half this far past half the width. A dropped or added pixel moves it by 1.
-END_TOL_PX = 0.5
+#: segment), long when it stays above half this far past half the width: the default of
+#: Tolerances.end_px (oracles.judge.tolerances, with its derivation).
+END_TOL_PX = _tolerances.END_TOL_PX
 #: Ends a case must have measured for their median to be judged.
 MIN_ENDS = 4
 

@@ -76,12 +76,17 @@ from __future__ import annotations
 import numpy as np
 
 from .. import faults as catalogue
-from . import coverage_pixels, even_lean, line_ties, line_windows
+from . import coverage_pixels, even_lean, line_ties, line_windows, tolerances
 from .case_samples import CaseSamples
 from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
 
 STYLES = ("aliased", "antialiased", "wide")
-LINE_RULES = ("gl", "geometry")
+#: ``--line-rule``: ``any`` (the default) holds aliased lines to a correct drawing under GL's rule or under
+#: the rounded-ends rule (oracles.judge.line_model); ``gl`` to GL's alone (another rule's correct drawing
+#: is ``raster_rule``); ``geometry`` judges the lines' centres only.
+LINE_RULES = ("any", "gl", "geometry")
+#: What each rule read from the pixels is, for the report and the summary line.
+RULE_NAMES = {"gl": "GL's diamond exit", "rounded": "ends rounded to pixel centres (Bresenham, Pillow, cv2.line)"}
 
 #: Half the window across a line in which its centroid is taken (px): a 3-px line's half width
 #: (1.5) plus an antialiased fringe (1) plus a pixel of slack for a half-pixel offset.
@@ -125,12 +130,9 @@ PLACEMENT_FAULTS = catalogue.names("orientation")
 MEASURED_FAULTS = catalogue.names("scale", "offset")
 #: The faults a correct drawing under another aliased rule leaves under GL's rule: raster_rule replaces them.
 RULE_FAULTS = catalogue.names("unexplained", "offset", "line_count")
-#: Aliased lines of another rule: the largest pooled centre offset (px) that is still "the geometry is
-#: right". A rule that snaps the ends to pixel centres (Pillow's ImageDraw.line, TinyGL) moves each line
-#: by up to half a pixel; pooled over a case's lines measured 0.00-0.27 px on the bundled scenes and
-#: cases (Pillow), where a half-pixel offset measures 0.50. So an aliased image of another rule cannot
-#: show an offset below this; the registration's pixel_offset (image_diagnose) is kept above it.
-RULE_OFFSET_MAX_PX = 0.35
+#: Aliased lines of another rule, and binary wide lines: the largest pooled centre offset (px) that is
+#: still "the geometry is right": the default of Tolerances.rule_offset_px (oracles.judge.tolerances).
+RULE_OFFSET_MAX_PX = tolerances.RULE_OFFSET_MAX_PX
 
 CAN_SHOW = {
     "aliased": "every pixel: the line rule (GL's or another), the geometry to the pixel, "
@@ -315,7 +317,7 @@ class CaseStyle:
     Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
-    def __init__(self, line_rule: str = "gl"):
+    def __init__(self, line_rule: str = "any"):
         if line_rule not in LINE_RULES:
             raise ValueError(f"line rule {line_rule!r}: expected one of {', '.join(LINE_RULES)}")
         self.line_rule = line_rule
@@ -435,7 +437,7 @@ class CaseStyle:
         d, _ = pooled_offset(normal, offset)
         return d, fit_lines(normal, offset, point, self.centre)
 
-    def geometry(self, read: dict) -> dict:
+    def geometry(self, read: dict, tol=None) -> dict:
         """Where the case's lines are against the oracle's (module docstring), less what a correct drawing shows.
 
         ``offset_px``: the pooled offset. ``warp_px``: how far, along the lines' normals, a scale, rotation
@@ -469,9 +471,9 @@ class CaseStyle:
         lean = even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"]) \
             if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0 else None
         if lean is not None:                            # an even band: each edge's lean chosen (even_lean)
-            from ..diagnosis.image_diagnose import SCALE_TOL_PX
-            held = np.max(np.abs(d - ref_d)) <= RULE_OFFSET_MAX_PX and (affine is None or np.percentile(warp, 99)
-                                                                        <= SCALE_TOL_PX + 0.5)   # judge()'s bounds
+            tol = tolerances.Tolerances() if tol is None else tol
+            held = np.max(np.abs(d - ref_d)) <= tol.rule_offset_px and (affine is None or np.percentile(warp, 99)
+                                                                         <= tol.scale_px + 0.5)   # judge()'s bounds
             geo["lean"] = {**{k: lean[k] for k in even_lean.REPORTED}, "used": bool(lean["leaning"] and not held)}
             if geo["lean"]["used"]:                     # the lean explains what the symmetric band cannot
                 d, ref_d, affine = lean["offset"], np.zeros(2), fit_lines(normal, lean["corrected"], point, self.centre)
@@ -480,31 +482,37 @@ class CaseStyle:
                    warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0)
         return geo
 
-    def judge(self, rec: dict, reasons: list, tol, rule_reasons=None) -> list:
+    def judge(self, rec: dict, reasons: list, tol, rule_reasons=None, rounded=None) -> list:
         """The case's reasons with the style's judgement joined; ``rec`` gains ``line_style`` and faults.
 
         ``reasons``: the case's reasons under every criterion (oracles.judge.decide.reasons);
         ``rule_reasons``: those of GL's pixel rule (F1@0px, the balance, the per-edge
-        counts; default: the F1@0px ones). ``rec["line_style"]`` says whether the
-        pixel rule decides (``pixel_rule``) and the style's own failures
-        (``failures``), which oracles.judge.decide.decide then applies.
+        counts; default: the F1@0px ones). ``rounded``: the same pixels against a correct drawing
+        by the rounded-ends rule (``{"pixel_f1_0px", "lines"}``: the worst frame's F1@0px and the
+        pooled line fields, its ties left out; oracles.judge.line_model), None when not drawn.
+        ``rec["line_style"]`` says whether a pixel rule decides (``pixel_rule``), which rule the
+        pixels were read as (``rule_read``) and the style's own failures (``failures``), which
+        oracles.judge.decide.decide then applies.
         """
-        from ..diagnosis.image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX
-        from .free_ends import END_TOL_PX, MIN_ENDS
+        from ..diagnosis.diagnose import diagnose_lines
+        from .free_ends import MIN_ENDS
 
+        tol = tolerances.Tolerances() if tol is None else tol
         read = self.classify()
-        geo = self.geometry(read)
+        geo = self.geometry(read, tol)
         style = read["style"]
         aliased = style == "aliased"
-        by_rule = aliased and self.line_rule == "gl"
+        by_rule = aliased and self.line_rule in ("gl", "any")
         binary = read["grey_share"] <= GREY_SHARE_MAX
         # binary lines, 1 px or wide, are held to another aliased rule's bound (a wide rule snaps its ends too)
-        tol_px = RULE_OFFSET_MAX_PX if binary else OFFSET_TOL_PX + 0.5 / read["coverage_steps"]
+        tol_px = tol.rule_offset_px if binary else tol.offset_px + 0.5 / read["coverage_steps"]
         out = {**read, "line_rule": self.line_rule,
                "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
                             "the geometry (line centres); F1@0px is reported, not judged",
                "can_show": CAN_SHOW[style], "cannot_show": CANNOT_SHOW[style], "offset_tol_px": tol_px,
                "geometry": geo}
+        if by_rule and self.line_rule == "any":
+            out["judged_by"] = "a correct drawing by GL's rule or by the rounded-ends rule (F1@0px) and the geometry"
         reasons = list(reasons)
         faults = list(rec.get("faults") or [])
         given = list(reasons)
@@ -522,7 +530,7 @@ class CaseStyle:
         moved = placed and off > tol_px
         # binary lines are quantised line by line (up to half a pixel each, which the reference drawing
         # matches only for its own rule): their warp is judged with that half pixel added
-        warp_tol = SCALE_TOL_PX + (0.5 if binary else 0.0)
+        warp_tol = tol.scale_px + (0.5 if binary else 0.0)
         out["warp_tol_px"] = warp_tol
         warped = placed and geo["warp_px"] > warp_tol
         if placed and not by_rule:
@@ -538,7 +546,7 @@ class CaseStyle:
                 reasons.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {tol_px:.3g} "
                                f"({style} lines, {geo['samples']} samples)")
             end = geo["end_px"]
-            if geo["ends_measured"] >= MIN_ENDS and (end < -END_TOL_PX or end > read["width_px"] / 2 + END_TOL_PX):
+            if geo["ends_measured"] >= MIN_ENDS and (end < -tol.end_px or end > read["width_px"] / 2 + tol.end_px):
                 short = end < 0
                 faults.append({"name": "line_end_bias", "end_px": end, "ends_measured": geo["ends_measured"],
                                "confidence": 1.0, "residual_px": None, "measured_by": "line ends",
@@ -546,7 +554,7 @@ class CaseStyle:
                                        f"{'before' if short else 'past'} their ends (median of "
                                        f"{geo['ends_measured']} free ends; a cap may add half the width)"})
                 reasons.append(f"line ends {end:+.2f} px from the segments' ends: expected "
-                               f"{-END_TOL_PX} to {read['width_px'] / 2 + END_TOL_PX:.2f} ({style} lines)")
+                               f"{-tol.end_px} to {read['width_px'] / 2 + tol.end_px:.2f} ({style} lines)")
             if warped:
                 reasons.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
                                f"or shear > {warp_tol:.3g} ({style} lines)")
@@ -557,7 +565,45 @@ class CaseStyle:
                 "share_off_by_one_at_ends": rs["off_by_one_at_ends"] / max(rs["oracle_pixels"], 1),
                 "share_farther": rs["farther"] / max(rs["oracle_pixels"], 1)}
         geometry_right = placed and not moved and not warped
-        if by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0 \
+        # the rounded-ends rule (line_model): the pixels are a correct drawing by it when they miss none of
+        # its pixel limits, the centres are in place, and nothing but GL's pixel rule fails
+        rule_faults = ("unexplained", "pixel_offset", "raster_rule") + COUNT_FAULTS
+        only_rule = bool(f0) and len(f0) == len(reasons) and all(f["name"] in rule_faults for f in faults)
+        rounded_fails = self.rule_failures(rounded, tol) if by_rule and rounded is not None else None
+        rounded_right = rounded_fails == [] and not moved and not warped and only_rule
+        if by_rule:
+            # the rule read: GL's, unless the rounded ends' explains the pixels and more closely (F1@0px)
+            out["rule_read"] = "rounded" if (rounded_fails == [] and not f0 and not moved and not warped
+                                             and rounded["pixel_f1_0px"] > rec["pixel_f1_0px"]) else "gl"
+            if rounded is not None:
+                out["rounded_rule"] = {"pixel_f1_0px": rounded["pixel_f1_0px"], "failures": rounded_fails,
+                                       "lines": {k: rounded["lines"][k] for k in ("candidate_only", "oracle_only",
+                                                                                  "subpixel_ties", "imbalance")}}
+        if rounded_right:
+            out["rule_read"] = "rounded"
+            faults = [f for f in faults if f["name"] not in rule_faults]
+            if self.line_rule == "any":                 # a correct drawing by a rule allowed: GL's limits go
+                reasons = [r for r in reasons if r not in f0]
+            else:                                       # --line-rule gl: another rule's, named; no count deficit
+                reasons = [r for r in reasons if r not in f0] + [
+                    f"the pixels are a correct drawing by another rule than GL's ({RULE_NAMES['rounded']}: "
+                    f"F1@0px {rounded['pixel_f1_0px']:.4f} against it, {rec['pixel_f1_0px']:.4f} against GL's)"]
+                faults.append({"name": "raster_rule", **out.get("raster_rule", {}), "confidence": 1.0,
+                               "offset_px": [float(d[0]), float(d[1])], "residual_px": None, "rule": "rounded",
+                               "note": f"the lines are a correct drawing by another rule ({RULE_NAMES['rounded']}), "
+                                       "not GL's: check the line rasteriser, not the camera; without --line-rule "
+                                       "gl such lines pass"})
+        elif self.line_rule == "any" and by_rule and f0 and rounded is not None and only_rule \
+                and rec["pixel_f1_0px"] < rounded["pixel_f1_0px"] \
+                and rounded["pixel_f1_0px"] >= max(tol.min_f1_0px, tol.rule_f1_0px):
+            # the pixels are the rounded-ends rule's but for a bias of its one-sided pixels (a dropped end
+            # pixel): that rule's limits and its line fault, as GL's would name them
+            out["rule_read"] = "rounded"
+            reasons = [r for r in reasons if r not in f0] + rounded_fails
+            named = diagnose_lines(rounded["lines"], tol)
+            if named and all(f["name"] in COUNT_FAULTS + ("unexplained", "raster_rule") for f in faults):
+                faults = [f for f in faults if f["name"] not in COUNT_FAULTS + ("unexplained", "raster_rule")] + named
+        elif by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0 \
                 and any(r.startswith("pixel F1@0px") for r in f0) \
                 and all(f["name"] in RULE_FAULTS for f in faults):
             faults = [f for f in faults if f["name"] not in RULE_FAULTS]
@@ -568,9 +614,24 @@ class CaseStyle:
                                    "rasteriser (its rule across the line and at the ends), not the camera; "
                                    "--line-rule geometry judges the geometry only"})
         rec["faults"] = catalogue.ordered(faults)
-        out.update(pixel_rule=by_rule, failures=[r for r in reasons if r not in given])
+        # GL's limits decide unless the pixels were read as the rounded ends' under --line-rule any
+        out.update(pixel_rule=by_rule and out.get("rule_read") != "rounded",
+                   failures=[r for r in reasons if r not in given])
         rec["line_style"] = out
         return reasons
+
+    @staticmethod
+    def rule_failures(rounded: dict, tol) -> list[str]:
+        """Why pixels are no correct drawing by the rounded-ends rule: its F1@0px (worst frame) and its line
+        fields' balance and per-edge counts (oracles.judge.metrics.line_failures), as GL's are judged."""
+        from .metrics import line_failures
+
+        out = []
+        floor = max(tol.min_f1_0px, tol.rule_f1_0px)      # a rule is read from its pixels, whatever GL's floor
+        if rounded["pixel_f1_0px"] < floor:
+            out.append(f"pixel F1@0px {rounded['pixel_f1_0px']:.4f} < {floor} against the rounded-ends "
+                       "rule too")
+        return out + [f"{r} (the rounded-ends rule)" for r in line_failures(rounded["lines"], tol)]
 
 
 def summary_lines(cases: list) -> list[str]:
@@ -589,6 +650,11 @@ def summary_lines(cases: list) -> list[str]:
         out.append(f"Line style read: {style} ({len(rows)} case{'s' if len(rows) != 1 else ''}, "
                    f"{wide}, --line-rule {rule}): judged by {rows[0]['judged_by']}"
                    f"{f'; F1 at up to {radius} px (the width)' if radius > 1 else ''}; cannot show {CANNOT_SHOW[style]}")
+    read = [c for c in cases if (c.get("line_style") or {}).get("rule_read") == "rounded"
+            and c["line_style"]["line_rule"] == "any" and c.get("verdict") == "pass"]
+    if read:
+        out.append(f"Line rule read: {RULE_NAMES['rounded']} in {len(read)} case{'s' if len(read) != 1 else ''}, "
+                   "a correct drawing by that rule; --line-rule gl holds them to GL's")
     return out
 
 

@@ -411,6 +411,46 @@ DEPTH_BOUND_TEXT = (f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 /
                     f" + {DEPTH_EPS32:g} eps32 z")
 
 
+# ---- The geometry of a renderer's lines, measured from its frames (oracles.judge.line_style,
+# oracles.diagnosis.image_diagnose): thresholds that decide a verdict or a name on the frames path.
+# They were module constants of those modules; they are Tolerances' fields so a run can set them.
+
+#: An offset is a fault when it exceeds this (px): the image registration's pooled offset on a correct
+#: renderer stays within ~0.05 px (measured, five cameras, 1 px / anti-aliased / 2-px lines), the line
+#: centres' within 0.03 px on anti-aliased lines; a half-pixel convention measures 0.46-0.52. So 0.2, four
+#: times the correct spread and under half the smallest half-pixel reading, parts them. Anti-aliased lines
+#: whose coverage comes in few levels add half a level's step (line_style: 4x MSAA, 0.2 + 0.125).
+OFFSET_TOL_PX = 0.2
+#: A scale (or a rotation, shear: the line centres' warp) is a fault when it moves some drawn pixel by more
+#: than this (px): a correct renderer's pooled scale is within 5e-4 of 1 (<= 0.05 px at ~130 px reach), a
+#: 0.8 FOV factor moves lines by tens of px; lines scaled so that the farthest end moves 0.8 px measure
+#: 0.75-0.8. Binary lines, quantised line by line, add half a pixel (line_style, rule_read).
+SCALE_TOL_PX = 0.5
+#: Binary lines of another aliased rule than GL's, or binary wide lines: the largest pooled centre offset
+#: (px) that is still "the geometry is right". A rule that snaps the ends to pixel centres moves each line
+#: by up to half a pixel: pooled 0.00-0.27 px over the bundled scenes and cases (Pillow, Bresenham;
+#: LINE_8 0.34 on pyramid / near_plane), where a half-pixel offset measures 0.45-0.52. 0.35 parts them.
+RULE_OFFSET_MAX_PX = 0.35
+#: Free line ends (oracles.judge.free_ends): the median end, where the coverage along the line falls to
+#: half its width, must lie within -this and half the width + this (px) of the segments' ends: a butt end
+#: measures 0, a cap up to half the width; a dropped end pixel measures -0.54 to -0.73, an added one 1.25
+#: to 1.51. Half a pixel parts them.
+END_TOL_PX = 0.5
+#: The rounded-ends rule (oracles.judge.line_model, "rounded"): how close to a half pixel (per axis, px)
+#: an end may round either way (the pixels between those roundings are ties, left out of the comparison).
+#: Half a step of OpenCV's cv2.line fixed point (shift=4: 1/16 px), the coarsest grid among the
+#: rounded-ends renderers tried; an end falls that close for 1/16 of ends on an axis, so a dropped end pixel
+#: is still decided at the other ends.
+ROUNDED_END_TIE_PX = 1.0 / 32.0
+#: A renderer's aliased pixels are read as a correct drawing by another rule of the line model
+#: (oracles.judge.line_model, "rounded") only where their F1@0px against that rule's drawing is at least
+#: this (or the run's F1@0px floor, if higher): measured 0.999-1.000 in every case of Pillow, Bresenham and
+#: cv2 LINE_8 (21 bundled cases each); GL's own pixels with each line's last pixel dropped measure 0.83-0.92
+#: against it. Without it a run with --min-f1-0px 0 would read any drawing whose one-sided pixels balance
+#: against the rounded ends' as theirs. 0.98, GL's own F1@0px bound.
+RULE_F1_0PX = 0.98
+
+
 @dataclass
 class Tolerances:
     """The limits a run judges with (defaults: the values above; the CLI's --tol-px, --min-f1, ... override them).
@@ -428,6 +468,12 @@ class Tolerances:
     max_imbalance: float = MAX_IMBALANCE_FRACTION
     max_edge_count_diff: int = MAX_EDGE_COUNT_DIFF
     precision: str | None = None
+    offset_px: float = OFFSET_TOL_PX
+    scale_px: float = SCALE_TOL_PX
+    rule_offset_px: float = RULE_OFFSET_MAX_PX
+    end_px: float = END_TOL_PX
+    rounded_end_tie_px: float = ROUNDED_END_TIE_PX
+    rule_f1_0px: float = RULE_F1_0PX
 
     def __post_init__(self):
         if self.precision is not None and self.precision not in PRECISIONS:
@@ -444,3 +490,9 @@ class Tolerances:
                 "min_pixel_f1_1px": self.min_f1_1px,
                 "min_pixel_f1_0px": self.min_f1_0px, "balance_alpha": self.balance_alpha,
                 "max_imbalance_fraction": self.max_imbalance, "max_edge_count_diff": self.max_edge_count_diff}
+
+    def lines_dict(self) -> dict:
+        """The frames path's line-geometry limits, as the report's ``tolerances`` adds them."""
+        return {"offset_px": self.offset_px, "scale_px": self.scale_px, "rule_offset_px": self.rule_offset_px,
+                "end_px": self.end_px, "rounded_end_tie_px": self.rounded_end_tie_px,
+                "rule_f1_0px": self.rule_f1_0px}
