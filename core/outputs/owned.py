@@ -351,15 +351,10 @@ def _remove_listed(folder: Path) -> None:
             os.rmdir(d)
         except OSError:          # not empty: a file of the user's is in it
             pass
-    if listed is not None:
-        try:
-            with os.scandir(folder) as it:
-                rest = {e.name for e in it}
-        except OSError:
-            return
-        if rest <= {MARKER, TAG}:
-            for name in rest:
-                _unlink_quiet(Path(folder) / name)
+    if listed is not None:                # the listing read above: ours, whatever is left beside it
+        _unlink_quiet(Path(folder) / MARKER)
+    if is_regular(Path(folder) / TAG):
+        _unlink_quiet(Path(folder) / TAG)
     try:
         os.rmdir(folder)
     except OSError:
