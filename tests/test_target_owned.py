@@ -56,10 +56,10 @@ def test_second_run_into_a_held_target_exits_2_at_once(tmp_path, command):
         base = [*CROSSCHECK, "export", str(target), "--cases", "on_axis,oblique_roll"]
         long_cmd, short_cmd = [*base, "--frames", "600"], [*base, "--scene", "cube", "--frames", "1"]
     rc_a, err_a, b, b_s, a_running, pid_a = _second_run_refused(long_cmd, short_cmd, tmp_path / ".t.wirecheck-lock")
-    assert a_running, "run A ended before run B was tried: the test proves nothing"
-    assert rc_a == 0, err_a
     assert b.returncode == 2 and b.stderr.count("\n") == 1, b.stderr
     assert f"being written by another wirecheck run (process {pid_a})" in b.stderr, b.stderr
+    assert a_running, "run A ended before run B was refused: the test proves nothing"
+    assert rc_a == 0, err_a
     if command == "report":
         report = json.loads((target / "report.json").read_text())
         assert report["frames"] == 3000                      # A's report, never B's
@@ -75,9 +75,9 @@ def test_second_renderer_into_a_held_out_exits_2_at_once(tmp_path):
     base = [sys.executable, "-m", "wirecheck.core.app.cli", "--width", "64", "--height", "48", "--out", str(out)]
     rc_a, err_a, b, b_s, a_running, pid_a = _second_run_refused([*base, "--frames", "1500"], [*base, "--frames", "1"],
                                                                 out / LOCK)
+    assert b.returncode == 2 and f"(process {pid_a})" in b.stderr and b.stderr.count("\n") == 1, b.stderr
     assert a_running
     assert rc_a == 0, err_a
-    assert b.returncode == 2 and f"(process {pid_a})" in b.stderr and b.stderr.count("\n") == 1, b.stderr
     assert json.loads((out / "cube-report.json").read_text())["summary"]["frames"] == 1500
 
 
