@@ -33,17 +33,6 @@ def _nest(frames_dir, depth, last_file=None):
     return path
 
 
-def test_rerun_over_a_folder_nested_1100_deep(tmp_path, capsys):
-    out = tmp_path / "out"
-    assert renderer_cli.main([*OPTIONS, "--out", str(out)]) == 0
-    _nest(out / "cube-frames", DEPTH)
-    capsys.readouterr()
-    rc = renderer_cli.main([*OPTIONS, "--out", str(out)])
-    err = capsys.readouterr().err
-    assert rc == 0, err
-    assert sorted(os.listdir(out / "cube-frames")) == [MARKER, "frame_0001.png"]     # the deep folder was ours
-
-
 @pytest.fixture
 def deep_cleanup():
     """Folders to remove bottom up after the test: pytest's own clean-up (shutil.rmtree on Python 3.11)
@@ -51,11 +40,25 @@ def deep_cleanup():
     bottoms = []
     yield bottoms
     for bottom in bottoms:
+        while bottom.name == "d" and not bottom.is_dir():
+            bottom = bottom.parent       # removed by the run, or partly
         for name in os.listdir(bottom):
-            os.unlink(bottom / name)
+            if not (bottom / name).is_dir():
+                os.unlink(bottom / name)
         while bottom.name == "d":
             os.rmdir(bottom)
             bottom = bottom.parent
+
+
+def test_rerun_over_a_folder_nested_1100_deep(tmp_path, capsys, deep_cleanup):
+    out = tmp_path / "out"
+    assert renderer_cli.main([*OPTIONS, "--out", str(out)]) == 0
+    deep_cleanup.append(_nest(out / "cube-frames", DEPTH))
+    capsys.readouterr()
+    rc = renderer_cli.main([*OPTIONS, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert sorted(os.listdir(out / "cube-frames")) == [MARKER, "frame_0001.png"]     # the deep folder was ours
 
 
 def test_users_file_at_the_bottom_of_a_deep_folder_is_found(tmp_path, capsys, deep_cleanup):

@@ -442,6 +442,7 @@ class FrameDir:
         self.final = Path(final)
         self.option = option
         self.tmp = None
+        self.kept = []
         held = _claims.get(os.path.abspath(self.final))
         self._claimed = held is not None
         if held is None:
@@ -460,17 +461,21 @@ class FrameDir:
 
     def _remove_leftovers(self) -> None:
         """Remove the temporaries of killed runs for this ``final`` (ours alone: no live run holds the lock)."""
-        from .owned import TAG, is_leftover, retire
+        from .owned import TAG, is_leftover, listing, retire
 
         prefix = f".{self.final.name}."
         for entry in os.scandir(self.final.parent):
             unique = entry.name[len(prefix):-len(".tmp")]
-            if (entry.name.startswith(prefix) and entry.name.endswith(".tmp") and len(unique) == 8
-                    and unique.replace("_", "").isalnum() and is_leftover(Path(entry.path))):
-                if is_regular(Path(entry.path) / TAG):
+            if not (entry.name.startswith(prefix) and entry.name.endswith(".tmp") and len(unique) == 8
+                    and unique.replace("_", "").isalnum() and entry.is_dir(follow_symlinks=False)):
+                continue
+            if is_regular(Path(entry.path) / TAG):
+                if is_leftover(Path(entry.path)):
                     remove_tree(entry.path)      # being filled when its run was killed: all ours
-                else:
-                    retire(Path(entry.path), self.final)     # an old folder swapped out: by its listing
+            elif listing(Path(entry.path)) is not None:
+                # an old folder swapped out by a run killed before removing it: by its listing; what the user
+                # wrote into it meanwhile goes into the folder in place (core.outputs.owned.retire)
+                self.kept += retire(Path(entry.path), self.final)
 
     def write(self, name: str, data: bytes) -> None:
         (self.tmp / name).write_bytes(data)
@@ -485,10 +490,10 @@ class FrameDir:
         step()                                       # checked: the old folder is checked again after the swap
         seal(self.tmp)
         os.unlink(self.tmp / _TAG)                   # sealed: its listing marks it as ours from here on
-        kept = []
+        kept = self.kept
         if os.path.lexists(self.final) and exchange(self.tmp, self.final):
             swapped, self.tmp = self.tmp, None       # it holds the old folder now: never removed whole
-            kept = retire(swapped, self.final)
+            kept += retire(swapped, self.final)
         elif os.path.lexists(self.final):
             # no exchange here: the old set moves into a new, uniquely named temporary first
             old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
@@ -496,15 +501,15 @@ class FrameDir:
             rename(self.final, old / "old")
             if rename_noreplace(self.tmp, self.final):
                 self.tmp = None
-                kept = retire(old / "old", self.final)
+                kept += retire(old / "old", self.final)
                 os.unlink(old / _TAG)
                 _rmdir_quiet(old)
             else:                                    # a folder appeared in its place meanwhile: both stay
-                kept = [self.final.name, str(old.relative_to(self.final.parent))]
+                kept += [self.final.name, str(old.relative_to(self.final.parent))]
         elif rename_noreplace(self.tmp, self.final):
             self.tmp = None
         else:
-            kept = [self.final.name]                 # a folder appeared in its place meanwhile: it stays
+            kept += [self.final.name]                 # a folder appeared in its place meanwhile: it stays
         self.abort()
         if kept:
             raise InputError(f"{self.option} {str(self.final)!r}: {', '.join(kept[:3])}"
