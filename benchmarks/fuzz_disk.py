@@ -26,8 +26,11 @@ Surfaces (counts per surface in the printed table; docs/reliability.md, round 4)
    symlink, hard link, directory, 70 MB, foreign JSON, a listing naming a folder 1,100 deep.
 4. ``window``: a rerun paused at a random step of its commit (WIRECHECK_PAUSE_AT_STEP) while the "user"
    writes a note into the output folder, edits an output file, or makes a sub-folder with a file.
-5. ``concurrency``: two runs into one target with random lengths, the second started 0-2 s after the
-   first: each exits 0 or 2 naming the other; both may exit 0 only when they did not overlap.
+5. ``concurrency``: two runs into one target with random lengths, the second (B, 1 frame) started 0-2 s
+   after the first (A): each exits 0 or 2 naming the other; a finding when both exit 0 although the lock
+   file named A's pid before B started and A was still running when B ended (A held the target through
+   B's whole run: B must be refused). Both may exit 0 one after the other: B, quicker to start, took the
+   target first and was done before A took it, or A was done before B took it.
 6. ``kills``: kill -9 after rename k of a rerun's commit (every k), then a plain rerun: exit 0, a
    consistent set, no leftovers.
 
@@ -357,27 +360,36 @@ def surface_concurrency(tally, work, rng, n):
         long_frames = rng.choice([200, 800, 2000]) if target != "export" else rng.choice([50, 200])
         delay = rng.uniform(0.0, 2.0)
         box = Path(tempfile.mkdtemp(dir=work))
-        a_argv, out, _ = target_argv(target, box, long_frames)
+        a_argv, out, lock = target_argv(target, box, long_frames)
         b_argv, _, _ = target_argv(target, box, 1)
-        t0 = time.monotonic()
         a = subprocess.Popen(a_argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env())
-        time.sleep(delay)
-        b_start = time.monotonic()
+        held_by_a = False               # A's pid read from the lock file before B started: A held the target
+        deadline = time.monotonic() + delay
+        while time.monotonic() < deadline:
+            try:
+                held_by_a = held_by_a or lock.read_text() == f"wirecheck lock pid {a.pid}\n"
+            except OSError:
+                pass
+            time.sleep(0.005)
         rc_b, err_b, b_s = run(b_argv)
-        b_end = b_start + b_s
+        a_alive = a.poll() is None      # A still running when B ended: A held the target all through B's run
         try:
             err_a = a.communicate(timeout=TIMEOUT_S * 3)[1].decode()
             rc_a = a.returncode
         except subprocess.TimeoutExpired:
             a.kill()
             err_a, rc_a = a.communicate()[1].decode(), "hang"
-        a_end = time.monotonic()
-        overlapped = b_start < a_end and t0 < b_end
-        both = rc_a == 0 and rc_b == 0 and overlapped
+        both = rc_a == 0 and rc_b == 0
+        note = None
+        if both and held_by_a and a_alive:
+            note = "both committed, B started while A held the target"
+            print(f"  FINDING concurrency {target}: {note}", file=sys.stderr)
+        elif both:
+            note = "both exit 0, one after the other"
+        elif rc_b == 2 and held_by_a:
+            note = "B refused while A held the target"
         tally.add("concurrency", rc_a, err_a, 0, int(bool(leftovers(box))))
-        tally.add("concurrency", rc_b, err_b, 0, 0, "both committed while overlapping" if both else None)
-        if both:
-            print(f"  FINDING concurrency {target}: both exit 0 while overlapping", file=sys.stderr)
+        tally.add("concurrency", rc_b, err_b, 0, 0, note)
         shutil.rmtree(box, ignore_errors=True)
 
 
@@ -438,7 +450,7 @@ def main(argv=None) -> int:
                     ("journals", lambda: surface_journals(tally, work)),
                     ("markers", lambda: surface_markers(tally, work)),
                     ("window", lambda: surface_window(tally, work, rng, max(4, int(60 * scale)))),
-                    ("concurrency", lambda: surface_concurrency(tally, work, rng, max(2, int(12 * scale)))),
+                    ("concurrency", lambda: surface_concurrency(tally, work, rng, max(2, int(30 * scale)))),
                     ("kills", lambda: surface_kills(tally, work))]
         for name, go in surfaces:
             if only is None or name in only:
@@ -450,7 +462,7 @@ def main(argv=None) -> int:
     bad = sum(row[k] for row in tally.rows.values() for k in ("tracebacks", "hangs", "odd exits",
                                                              "exit 2 not one line", "user files touched",
                                                              "leftovers", "unexpected exit",
-                                                             "both committed while overlapping",
+                                                             "both committed, B started while A held the target",
                                                              "inconsistent after the rerun"))
     return 1 if bad else 0
 
