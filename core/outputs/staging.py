@@ -212,13 +212,21 @@ def _refuse_if_locked(out: Path, option: str) -> None:
                          "wait for it or use another --out")
 
 
-def _write_json(path: Path, obj: dict) -> None:
-    """``path`` written whole under a temporary name, then renamed into place (a counted move, core.outputs.owned)."""
+def _write_json(path: Path, obj: dict, option: str | None = None) -> None:
+    """``path`` written whole under a temporary name, then renamed into place (a counted move, core.outputs.owned).
+
+    With ``option`` (the journal) nothing at ``path`` is replaced: InputError if a file appeared there since
+    the check."""
     fd, tmp = tempfile.mkstemp(prefix=f"{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(json.dumps(obj, indent=1, sort_keys=True) + "\n")
-        owned.rename(tmp, path)
+        if option is None:
+            owned.rename(tmp, path)
+        elif not owned.rename_noreplace(tmp, path):
+            raise InputError(f"{option} {str(path)!r} appeared while wirecheck was about to move its outputs in: "
+                             "it was kept and nothing was moved; expected no writes into an output folder during "
+                             "a run (move it away and run again)")
     except BaseException:
         if os.path.lexists(tmp):
             os.unlink(tmp)
@@ -390,7 +398,7 @@ class Staging:
                     manifest[name] = sha256(self.tmp / name)
             journal = {"wirecheck_journal": 1, "tmp": self.tmp.name, "names": staged,
                        "folders": sorted(self.folders & set(staged)), "manifest": manifest}
-            _write_json(self.out / JOURNAL, journal)
+            _write_json(self.out / JOURNAL, journal, self.option)
             self._journaled = True           # from here on the next run can finish it: keep the temporaries
             _finish(self.out, journal, self.option, check=False, known=known)
             self.tmp = None
