@@ -30,7 +30,10 @@ Surfaces (counts per surface in the printed table; docs/reliability.md, round 4)
    after the first (A): each exits 0 or 2 naming the other; a finding when both exit 0 although the lock
    file named A's pid before B started and A was still running when B ended (A held the target through
    B's whole run: B must be refused). Both may exit 0 one after the other: B, quicker to start, took the
-   target first and was done before A took it, or A was done before B took it.
+   target first and was done before A took it, or A was done before B took it. Also measured: the
+   share of run A's life (process start to end) during which the lock file named A: a lock that
+   covers only the write covers a sliver of the run; one held from the start covers all but the
+   interpreter's start-up.
 6. ``kills``: kill -9 after rename k of a rerun's commit (every k), then a plain rerun: exit 0, a
    consistent set, no leftovers.
 
@@ -52,6 +55,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections import Counter
 from pathlib import Path
@@ -362,15 +366,24 @@ def surface_concurrency(tally, work, rng, n):
         box = Path(tempfile.mkdtemp(dir=work))
         a_argv, out, lock = target_argv(target, box, long_frames)
         b_argv, _, _ = target_argv(target, box, 1)
+        a_start = time.monotonic()
         a = subprocess.Popen(a_argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env())
-        held_by_a = False               # A's pid read from the lock file before B started: A held the target
-        deadline = time.monotonic() + delay
-        while time.monotonic() < deadline:
-            try:
-                held_by_a = held_by_a or lock.read_text() == f"wirecheck lock pid {a.pid}\n"
-            except OSError:
-                pass
-            time.sleep(0.005)
+        seen = []                       # when the lock file named A's pid (sampled every 5 ms)
+        stop = threading.Event()
+
+        def watch():
+            while not stop.is_set():
+                try:
+                    if lock.read_text() == f"wirecheck lock pid {a.pid}\n":
+                        seen.append(time.monotonic())
+                except OSError:
+                    pass
+                time.sleep(0.005)
+
+        watcher = threading.Thread(target=watch, daemon=True)
+        watcher.start()
+        time.sleep(delay)
+        held_by_a = bool(seen)          # A's pid read from the lock file before B started: A held the target
         rc_b, err_b, b_s = run(b_argv)
         a_alive = a.poll() is None      # A still running when B ended: A held the target all through B's run
         try:
@@ -379,6 +392,11 @@ def surface_concurrency(tally, work, rng, n):
         except subprocess.TimeoutExpired:
             a.kill()
             err_a, rc_a = a.communicate()[1].decode(), "hang"
+        a_end = time.monotonic()
+        stop.set()
+        watcher.join()
+        if rc_a == 0 and seen:          # the share of A's run (process start to end) its lock covered
+            COVERAGE.setdefault(target, []).append((a_end - seen[0]) / (a_end - a_start))
         both = rc_a == 0 and rc_b == 0
         note = None
         if both and held_by_a and a_alive:
@@ -391,6 +409,10 @@ def surface_concurrency(tally, work, rng, n):
         tally.add("concurrency", rc_a, err_a, 0, int(bool(leftovers(box))))
         tally.add("concurrency", rc_b, err_b, 0, 0, note)
         shutil.rmtree(box, ignore_errors=True)
+
+
+#: {target: [share of run A's lifetime during which the lock file named A, ...]} (surface 5)
+COVERAGE: dict = {}
 
 
 KILL_RENAMES = {"renderer": 10, "report": 1, "export": 1}   # of a rerun's commit: tests/test_commit_kill.py
@@ -457,8 +479,10 @@ def main(argv=None) -> int:
                 s0 = time.monotonic()
                 go()
                 print(f"{name}: {dict(tally.rows.get(name, {}))} ({time.monotonic() - s0:.0f} s)", file=sys.stderr)
-    print(json.dumps({"seed": args.seed, "wall_s": round(time.monotonic() - t0), "surfaces": tally.rows}, indent=1,
-                     default=dict))
+    coverage = {t: {"runs": len(v), "median": round(sorted(v)[len(v) // 2], 3), "min": round(min(v), 3)}
+                for t, v in COVERAGE.items()}
+    print(json.dumps({"seed": args.seed, "wall_s": round(time.monotonic() - t0), "surfaces": tally.rows,
+                      "lock_coverage_of_run_a": coverage}, indent=1, default=dict))
     bad = sum(row[k] for row in tally.rows.values() for k in ("tracebacks", "hangs", "odd exits",
                                                              "exit 2 not one line", "user files touched",
                                                              "leftovers", "unexpected exit",
