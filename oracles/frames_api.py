@@ -79,10 +79,14 @@ def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None,
     run_dir = _report_dir(report_dir)
     if run_dir is not None:                     # before anything is judged, as crosscheck checks it
         check_report_dir(run_dir, "report_dir")
+        claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
         from .frames_cli import check_report_outside_job
 
-        check_report_outside_job(job_dir, run_dir)
-        claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
+        try:
+            check_report_outside_job(job_dir, run_dir)
+        except BaseException:
+            release_claim(run_dir)
+            raise
     try:
         report, images = _judge(job_dir, tol, allow_vacuous, line_rule)
         if run_dir is not None:
