@@ -66,6 +66,7 @@ def _assert_one_line(err):
 RENDERER_STEPS = 9
 
 
+@pytest.mark.slow
 def test_renderer_note_written_at_every_step_of_the_commit_is_kept(tmp_path):
     out = tmp_path / "out"
     frames_dir = out / "cube-frames"
@@ -166,6 +167,7 @@ def test_frame_edited_during_the_commit_is_kept_beside_the_new_one(tmp_path, cap
     assert (out / "cube-frames" / "frame_0001.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"   # the new frame
 
 
+@pytest.mark.slow
 def test_report_note_written_while_sealing_is_kept(tmp_path, capsys, monkeypatch):
     target = tmp_path / "r"
     args = ["--report-dir", str(target), "--scene", "cube", "--cases", "on_axis", "--oracles", "opencv",

@@ -81,6 +81,7 @@ def test_second_renderer_into_a_held_out_exits_2_at_once(tmp_path):
     assert json.loads((out / "cube-report.json").read_text())["summary"]["frames"] == 1500
 
 
+@pytest.mark.slow
 def test_claim_is_held_until_release_and_creates_no_folder_for_a_failed_run(tmp_path):
     """In process: a claimed report folder refuses a second claimer; released, its created parents go."""
     from wirecheck.core.errors import InputError
