@@ -33,6 +33,7 @@ from .reports.report import compared_text, not_passed
 from .runner import run_crosscheck
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
 from .judge.tolerances import Tolerances
+from wirecheck.core.outputs.output import claim, release_claim
 
 
 #: check_projector's settings when neither the call nor ``[tool.wirecheck]`` gives them: vertices
@@ -140,13 +141,19 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     directory, logging and signal handlers.
     """
     run_dir = _report_dir(report_dir)
-    report, images = run_check(func, scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns,
-                               allow_vacuous, cmd=cmd, timeout_s=timeout_s, isolate=isolate, precision=precision,
-                               config=config)
     if run_dir is not None:
-        from .reports.report import write_report
+        claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
+    try:
+        report, images = run_check(func, scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns,
+                                   allow_vacuous, cmd=cmd, timeout_s=timeout_s, isolate=isolate,
+                                   precision=precision, config=config)
+        if run_dir is not None:
+            from .reports.report import write_report
 
-        write_report(run_dir, report, images)
+            write_report(run_dir, report, images)
+    finally:
+        if run_dir is not None:
+            release_claim(run_dir)
     return report
 
 

@@ -71,7 +71,7 @@ from pathlib import Path
 from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
 from wirecheck.core.app.guard import run_cli  # noqa: E402
 from wirecheck.core.limits import check_candidate_timeout
-from wirecheck.core.outputs.output import FrameDir, check_replaceable, check_report_dir, json_dumps
+from wirecheck.core.outputs.output import FrameDir, check_report_dir, claim, json_dumps, release_claims
 
 from .judge import gate, tolerances
 from .candidates.isolation import check_python_spec, external_candidate
@@ -290,7 +290,10 @@ def main(argv=None) -> int:
     from .candidates.subprocess_candidate import closing_started
 
     with closing_started():                       # the run's candidate program ends with the run
-        return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/app/guard.py)
+        try:
+            return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/app/guard.py)
+        finally:
+            release_claims()                      # the report folder or job this run held from its start
 
 
 def _main(argv=None) -> int:
@@ -336,7 +339,7 @@ def _main(argv=None) -> int:
     try:
         if not args.no_report:
             check_report_dir(run_dir, run_option)
-            check_replaceable(run_dir, run_option)
+            claim(run_dir, run_option)            # held until the report is in place: one run per folder
     except InputError as exc:
         return _error(str(exc))
     except OSError as exc:
@@ -507,7 +510,6 @@ def _sweep(args, inputs, level, tol, run_dir) -> int:
 
 
 def _suite(level, run_dir) -> int:
-    from wirecheck.core.outputs.output import FrameDir, json_dumps
 
     from .extremes import extremes_markdown, run_extremes
 

@@ -63,7 +63,7 @@ def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None
     from pathlib import Path
 
     from wirecheck.core.errors import InputError
-    from wirecheck.core.outputs.output import check_replaceable, check_report_dir
+    from wirecheck.core.outputs.output import check_report_dir, claim, release_claim
 
     from .judge import gate, tolerances
     from .judge.line_style import LINE_RULES
@@ -82,15 +82,23 @@ def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None
     run_dir = _report_dir(report_dir)
     if run_dir is not None:                     # before anything is judged, as crosscheck checks it
         check_report_dir(run_dir, "report_dir")
-        check_replaceable(run_dir, "report_dir")
+        claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
         from .frames_cli import check_report_outside_job
 
-        check_report_outside_job(job_dir, run_dir)
-    report, images = _judge(job_dir, tol, allow_vacuous, line_rule)
-    if run_dir is not None:
-        from .reports.report import write_report
+        try:
+            check_report_outside_job(job_dir, run_dir)
+        except BaseException:
+            release_claim(run_dir)
+            raise
+    try:
+        report, images = _judge(job_dir, tol, allow_vacuous, line_rule)
+        if run_dir is not None:
+            from .reports.report import write_report
 
-        write_report(run_dir, report, images)
+            write_report(run_dir, report, images)
+    finally:
+        if run_dir is not None:
+            release_claim(run_dir)
     return report
 
 

@@ -47,7 +47,7 @@ def export_main(argv) -> int:
     args = p.parse_args(argv)
     try:
         from wirecheck.core.limits import MAX_FRAMES
-        from wirecheck.core.outputs.output import check_outside_scenes, check_replaceable
+        from wirecheck.core.outputs.output import check_outside_scenes, claim
 
         if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
             raise InputError(f"--frames {args.frames} --every {args.every}: expected --frames in 1..{MAX_FRAMES:,} "
@@ -72,7 +72,7 @@ def export_main(argv) -> int:
             raise InputError(f"export {args.dir!r}: {str(out.parent)!r} is not writable: expected a writable folder")
         # a job in the bundled scenes/ would pass for scenes in later runs (as --out and --report-dir there)
         check_outside_scenes(out, "export DIR", "a job folder elsewhere (e.g. job/)")
-        check_replaceable(out, "export DIR")           # the target first: nothing is built for a refused one
+        claim(out, "export DIR")        # the target first, held to the end: nothing is built for a refused one
         scenes = [load_scene(n) for n in (args.scene or builtin_names())]
         job = write_job(out, scenes, frames=args.frames, every=args.every, case_names=cases,
                         motion=Motion(turns=spin), phase=args.phase)

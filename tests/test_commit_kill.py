@@ -47,9 +47,10 @@ def _renderer_set(out):
     return report["summary"]["frames"], len(pngs), hashes_true
 
 
-# Renames of this commit, counted by hand from core/outputs/staging.py: the journal (1), cube-frames/ (2: the old
-# folder aside, the new one in), cube.gif, cube-report.json, cube-report.txt (1 each), the manifest (1).
-RENDERER_RENAMES = 7
+# Renames of this commit over an earlier set, counted by hand from core/outputs/staging.py (rule 5): the journal
+# (1); cube-frames/, cube.gif, cube-report.json, cube-report.txt (2 each: the old one aside, the new one in); the
+# manifest (1).
+RENDERER_RENAMES = 10
 
 
 def test_renderer_commit_killed_after_every_rename(tmp_path):
@@ -102,3 +103,47 @@ def test_report_and_job_commit_killed_at_its_one_rename(tmp_path, capsys, comman
     assert os.listdir(tmp_path) == ["t"]              # the killed run's temporaries removed
     if command == "export":
         assert _tree(target) == after_kill            # the killed run had put the new job in place whole
+
+
+# Renames of a report folder's or an export job's commit, counted by hand from core/outputs/output.py
+# (FrameDir.commit): a first run moves its folder in (1, RENAME_NOREPLACE); a rerun swaps it with the old one
+# (1, RENAME_EXCHANGE), then removes the old one by its listing (no rename unless a user's file is kept).
+FRAMEDIR_RENAMES = 1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", ["report", "export"])
+@pytest.mark.parametrize("earlier", [False, True], ids=["first_run", "rerun"])
+def test_crosscheck_and_export_killed_after_every_rename(tmp_path, capsys, command, earlier):
+    """Issue 36: kill -9 of crosscheck and crosscheck export after each rename of the commit, on a first run
+    and on a rerun, then a plain rerun: a whole folder of ours in place with the rerun's contents, no
+    temporaries, no lock, and a user's file beside it the same bytes throughout."""
+    target = tmp_path / "t"
+    if command == "report":
+        args = ["--report-dir", str(target), "--scene", "cube", "--cases", "on_axis", "--oracles", "opencv"]
+    else:
+        args = ["export", str(target), "--scene", "cube", "--cases", "on_axis"]
+    (tmp_path / "notes.txt").write_text("the user's")
+    for k in range(1, FRAMEDIR_RENAMES + 2):
+        if earlier:
+            assert crosscheck_cli.main([*args, "--frames", "1"]) == 0
+        killed = _run([sys.executable, "-m", "wirecheck.oracles.cli", *args, "--frames", "2"], kill_at=k)
+        if k <= FRAMEDIR_RENAMES:
+            assert killed.returncode == -signal.SIGKILL, (k, killed.stderr)
+        else:
+            assert killed.returncode == 0, killed.stderr
+        assert foreign(target) is None                          # the old folder or the new one, whole
+        capsys.readouterr()
+        assert crosscheck_cli.main([*args, "--frames", "3"]) == 0, (k, capsys.readouterr().err)
+        assert foreign(target) is None
+        if command == "report":
+            assert json.loads((target / "report.json").read_text())["frames"] == 3
+        else:
+            assert {len(c["frames"]) for c in json.loads((target / "job.json").read_text())["cases"]} == {3}
+        assert sorted(os.listdir(tmp_path)) == ["notes.txt", "t"], (k, os.listdir(tmp_path))
+        assert (tmp_path / "notes.txt").read_text() == "the user's"
+        if not earlier:
+            for entry in os.listdir(tmp_path):
+                if entry == "t":
+                    os.rename(tmp_path / "t", tmp_path / f"gone{k}")   # the next try starts without a folder
+                    os.rename(tmp_path / f"gone{k}", tmp_path / ".." / f"{tmp_path.name}-gone{k}")

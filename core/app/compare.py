@@ -182,17 +182,23 @@ def main_compare(s, z_text: str, fov_text: str) -> int:
     try:
         distances = parse_pair("--compare-z", z_text, 0.0, math.inf)
         fovs = parse_pair("--compare-fov", fov_text, 0.0, 180.0)
-        report, grid = run_compare(s, distances, fovs)
     except InputError as exc:
         print(f"renderer: error: {exc}", file=sys.stderr)
         return 2
-    text = explain(report)
     name = s.scene.name
     from ..outputs.staging import Staging
 
     names = [f"{name}-compare.png", f"{name}-compare.json", f"{name}-compare.txt"]
-    stage = Staging(s.out, names)      # written together, never over a file wirecheck did not write
+    # written together, never over a file wirecheck did not write; --out held from here to the end
+    stage = Staging(s.out, names)
     try:
+        try:
+            report, grid = run_compare(s, distances, fovs)
+        except InputError as exc:
+            stage.abort()
+            print(f"renderer: error: {exc}", file=sys.stderr)
+            return 2
+        text = explain(report)
         stage.path(names[0]).write_bytes(output.png_bytes(grid))
         stage.path(names[1]).write_text(output.json_dumps(report), encoding="utf-8")
         stage.path(names[2]).write_text(text, encoding="utf-8")

@@ -10,7 +10,6 @@ from __future__ import annotations
 import io
 import json
 import os
-import shutil
 import struct
 import tempfile
 import zlib
@@ -20,6 +19,7 @@ import numpy as np
 
 from .owned import MARKER
 from .owned import TAG as _TAG
+from .owned import is_regular, remove_tree
 
 
 def _umask() -> int:
@@ -295,7 +295,7 @@ def check_replaceable(path: Path, option: str) -> None:
     from .owned import ours
 
     path = Path(path)
-    if path.is_dir() and not path.is_symlink() and (path / MARKER).is_file():
+    if path.is_dir() and not path.is_symlink() and is_regular(path / MARKER):
         drawn = _users_frames(path)
         if drawn is not None:
             raise InputError(f"{option} {str(path)!r} is a frames job holding files a renderer wrote ({drawn}): "
@@ -353,17 +353,87 @@ def check_report_dir(path: Path, option: str) -> None:
         raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not writable: expected a writable folder")
 
 
+#: The targets this process holds from its start (:func:`claim`): ``{absolute path: (Lock, folders created)}``.
+_claims: dict = {}
+
+
+def _lock_path(final: Path) -> Path:
+    return final.parent / f".{final.name}.wirecheck-lock"
+
+
+def claim(final: Path, option: str) -> None:
+    """Hold the lock of the output folder ``final`` from now until its :class:`FrameDir` commits or aborts
+    (or :func:`release_claim`): one run owns its target from its start to its end, and a second run into
+    it is refused at once, whichever takes longer. Creates the missing parents (removed again on release
+    while empty), then checks ``final`` (:func:`check_replaceable`)."""
+    from .lockfile import Lock
+
+    final = Path(final)
+    key = os.path.abspath(final)
+    if key in _claims:
+        return
+    created, p = [], final.parent
+    while not os.path.lexists(p) and p != p.parent:
+        created.append(p)
+        p = p.parent
+    made = []
+    try:
+        for folder in reversed(created):
+            try:
+                folder.mkdir()
+            except FileExistsError:
+                continue
+            made.append(folder)
+        _claims[key] = (Lock(_lock_path(final), option, str(final)), made)
+    except BaseException:
+        for folder in reversed(made):
+            _rmdir_quiet(folder)
+        raise
+    try:
+        check_replaceable(final, option)
+    except BaseException:
+        release_claim(final)
+        raise
+
+
+def _rmdir_quiet(folder: Path) -> None:
+    try:
+        folder.rmdir()
+    except OSError:
+        pass
+
+
+def release_claim(final: Path) -> None:
+    """Give back :func:`claim`'s lock of ``final`` (nothing when not held); remove the parents it created
+    if they are empty."""
+    lock, made = _claims.pop(os.path.abspath(final), (None, []))
+    if lock is not None:
+        lock.release()
+    for folder in reversed(made):
+        _rmdir_quiet(folder)
+
+
+def release_claims() -> None:
+    """Give back every target this process claimed (the end of a command)."""
+    for key in list(_claims):
+        release_claim(Path(key))
+
+
 class FrameDir:
     """A directory filled under a temporary name, then put in place of ``final`` by commit().
 
     ``final`` may only be absent, empty, or an earlier output whose listing
     names everything in it (:func:`check_replaceable`). One run writes a
-    given ``final`` at a time (a lock beside it, core.outputs.lockfile). The commit
+    given ``final`` at a time (a lock beside it, core.outputs.lockfile): the
+    lock :func:`claim` took at the run's start, else one taken here. The commit
     is one step where Linux allows: the new folder and the old one swap
     places (``renameat2(RENAME_EXCHANGE)``), so a run killed at any moment
     leaves the old folder or the new one; the temporaries a killed run left
     beside ``final`` (``.<name>.<unique>.tmp``, marked by core.outputs.owned.TAG)
-    are removed by the next run that writes ``final``.
+    are removed by the next run that writes ``final``. The old folder is
+    removed after the swap, by its listing (core.outputs.owned.retire): a
+    file the user wrote into it during the commit is moved into the new one,
+    and :meth:`commit` says so (InputError, exit 2) once the new folder is in place.
     """
 
     def __init__(self, final: Path, option: str = "output"):
@@ -372,8 +442,12 @@ class FrameDir:
         self.final = Path(final)
         self.option = option
         self.tmp = None
-        check_replaceable(self.final, option)
-        self._lock = Lock(self.final.parent / f".{self.final.name}.wirecheck-lock", option, str(self.final))
+        self.kept = []
+        held = _claims.get(os.path.abspath(self.final))
+        self._claimed = held is not None
+        if held is None:
+            check_replaceable(self.final, option)
+        self._lock = held[0] if held is not None else Lock(_lock_path(self.final), option, str(self.final))
         try:
             self._remove_leftovers()
             check_replaceable(self.final, option)        # again, under the lock
@@ -387,42 +461,70 @@ class FrameDir:
 
     def _remove_leftovers(self) -> None:
         """Remove the temporaries of killed runs for this ``final`` (ours alone: no live run holds the lock)."""
-        from .owned import is_leftover
+        from .owned import TAG, is_leftover, listing, retire
 
         prefix = f".{self.final.name}."
         for entry in os.scandir(self.final.parent):
             unique = entry.name[len(prefix):-len(".tmp")]
-            if (entry.name.startswith(prefix) and entry.name.endswith(".tmp") and len(unique) == 8
-                    and unique.replace("_", "").isalnum() and is_leftover(Path(entry.path))):
-                shutil.rmtree(entry.path, ignore_errors=True)
+            if not (entry.name.startswith(prefix) and entry.name.endswith(".tmp") and len(unique) == 8
+                    and unique.replace("_", "").isalnum() and entry.is_dir(follow_symlinks=False)):
+                continue
+            if is_regular(Path(entry.path) / TAG):
+                if is_leftover(Path(entry.path)):
+                    remove_tree(entry.path)      # being filled when its run was killed: all ours
+            elif listing(Path(entry.path)) is not None:
+                # an old folder swapped out by a run killed before removing it: by its listing; what the user
+                # wrote into it meanwhile goes into the folder in place (core.outputs.owned.retire)
+                self.kept += retire(Path(entry.path), self.final)
 
     def write(self, name: str, data: bytes) -> None:
         (self.tmp / name).write_bytes(data)
 
     def commit(self) -> None:
-        from .owned import exchange, rename, seal
+        """Swap the new folder in, then remove the old one by its listing; InputError (after the swap) when
+        a file the user wrote meanwhile was kept (class docstring)."""
+        from ..errors import InputError
+        from .owned import exchange, rename, rename_noreplace, retire, seal, step
 
         check_replaceable(self.final, self.option)   # again: it may have changed meanwhile
+        step()                                       # checked: the old folder is checked again after the swap
         seal(self.tmp)
         os.unlink(self.tmp / _TAG)                   # sealed: its listing marks it as ours from here on
+        kept = self.kept
         if os.path.lexists(self.final) and exchange(self.tmp, self.final):
-            pass                                     # in place: tmp holds the old folder now
+            swapped, self.tmp = self.tmp, None       # it holds the old folder now: never removed whole
+            kept += retire(swapped, self.final)
         elif os.path.lexists(self.final):
             # no exchange here: the old set moves into a new, uniquely named temporary first
             old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
             (old / _TAG).write_bytes(b"")
             rename(self.final, old / "old")
-            rename(self.tmp, self.final)
-            shutil.rmtree(old)
+            if rename_noreplace(self.tmp, self.final):
+                self.tmp = None
+                kept += retire(old / "old", self.final)
+                os.unlink(old / _TAG)
+                _rmdir_quiet(old)
+            else:                                    # a folder appeared in its place meanwhile: both stay
+                kept += [self.final.name, str(old.relative_to(self.final.parent))]
+        elif rename_noreplace(self.tmp, self.final):
+            self.tmp = None
         else:
-            rename(self.tmp, self.final)
+            kept += [self.final.name]                 # a folder appeared in its place meanwhile: it stays
         self.abort()
+        if kept:
+            raise InputError(f"{self.option} {str(self.final)!r}: {', '.join(kept[:3])}"
+                             f"{' ...' if len(kept) > 3 else ''} written or changed during the commit: kept "
+                             "(nothing of it was removed); expected no writes into an output folder while "
+                             "wirecheck replaces it (move them away before the next run)")
 
     def abort(self) -> None:
         if self.tmp is not None:
-            shutil.rmtree(self.tmp, ignore_errors=True)
+            remove_tree(self.tmp)
             self.tmp = None
         if self._lock is not None:
-            self._lock.release()
+            if self._claimed:
+                release_claim(self.final)
+            else:
+                self._lock.release()
             self._lock = None
 
