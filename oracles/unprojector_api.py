@@ -36,8 +36,10 @@ from .judge import gate
 from .judge.cases import case_motion, cases_for
 from .judge.tolerances import unproject_bound
 from .judge.unproject_points import DEFAULT_STRIDE, surface_samples
+from .reports.fault_text import below_table, case_cell, cell
 
-__all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "unprojector_failure_text"]
+__all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "flat_faults",
+           "unprojector_failure_text"]
 
 #: Settings when the call gives none: 2 frames of the scenes' spin per case, one sample every 8 px.
 UNPROJECT_DEFAULTS = {"frames": 2, "turns": (1.0, 1.0, 0.0), "stride": DEFAULT_STRIDE}
@@ -75,7 +77,8 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
     dict
         ``verdict`` ("pass" or "fail"), ``candidate``, ``cases`` (each: ``scene``, ``camera``,
         ``verdict``, ``points``, ``max_error``, ``max_error_ratio``, ``worst`` (frame, pixel),
-        ``precision``, ``faults`` with ``name``, ``params``, ``hint``, and ``reasons``), ``compared``.
+        ``precision``, ``faults`` with ``name``, ``params``, ``hint`` (the catalogue's, oracles.faults, for an
+        unprojector's points) and ``short`` (its table cell), and ``reasons``), ``compared``.
 
     Raises
     ------
@@ -183,23 +186,29 @@ def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
     record["reasons"].append(f"{bad} of {len(err)} points off: max error {err[i]:.3g} > bound {bound[i]:.3g} "
                              f"(frame {int(frame[i])}, pixel ({p_px[i, 0]:.6g}, {p_px[i, 1]:.6g}), depth {depth[i]:.6g})")
     faults, measured = name_unproject_faults(p_px, depth, cam, cand, bound)
-    record["faults"] = [{"name": f.name, "params": f.params, "hint": f.hint, "short": f.short()} for f in faults]
+    record["faults"] = [{"name": f.name, "params": dict(f.params), "hint": f.hint, "short": cell(f.as_dict())}
+                        for f in faults]
     record["measured"] = measured
     return record
 
 
+def flat_faults(case: dict) -> list[dict]:
+    """A case record's faults in the catalogue's record form (``{"name": ..., **params}``), as
+    oracles.reports.fault_text reads them."""
+    return [{"name": f["name"], **f["params"]} for f in case["faults"]]
+
+
 def unprojector_failure_text(report: dict) -> str | None:
-    """The failing cases, their faults, reasons and what to check; None when the verdict is pass."""
+    """The failing cases, their faults (a cell each, oracles.reports.fault_text) and reasons, then what to
+    check once per fault kind; None when the verdict is pass."""
     failing = [c for c in report["cases"] if c["verdict"] != "pass"]
     if not failing:
         return None
     lines = [f"{len(failing)} of {len(report['cases'])} unprojector cases failed for {report['candidate']}:"]
-    hints = {}
     for c in failing:
-        names = ", ".join(f["short"] for f in c["faults"]) or "none named"
-        lines.append(f"  {c['scene']} / {c['camera']}: faults: {names}; " + "; ".join(c["reasons"]))
-        hints.update({f["name"]: f["hint"] for f in c["faults"]})
-    lines += [f"  what to check: {n}: {h}" for n, h in hints.items()]
+        cells = case_cell(flat_faults(c)) if c["faults"] else "none named"
+        lines.append(f"  {c['scene']} / {c['camera']}: faults: {cells}; " + "; ".join(c["reasons"]))
+    lines += below_table([{**c, "faults": flat_faults(c)} for c in failing], source="points")
     comp = report["compared"]
     lines.append(f"  in all: {comp['cases']} cases, {comp['frames']} frames, {comp['points']:,} points compared")
     return "\n".join(lines)

@@ -13,7 +13,8 @@ import sys
 
 from wirecheck.core.errors import InputError
 
-from .unprojector_api import check_unprojector
+from .reports.fault_text import below_table, case_cell
+from .unprojector_api import check_unprojector, flat_faults
 
 #: Options of crosscheck that judge something else and cannot go with --unprojector.
 OTHER_MODES = ("candidate", "candidate_cmd", "candidate_frames", "sweep", "suite", "junit_xml", "report_dir", "run")
@@ -44,21 +45,22 @@ def unprojector_main(args) -> int:
 
 
 def report_lines(report: dict) -> list[str]:
-    """The table (scene, camera, points, max error, error / bound, verdict, faults), what to check, the verdict."""
+    """The table (scene, camera, points, max error, error / bound, verdict, faults: a cell of at most 60
+    characters, oracles.reports.fault_text), each failing case's reasons, what to check once per fault
+    kind, the verdict."""
     rows = [("scene", "camera", "points", "max error", "err/bound", "verdict", "faults")]
-    hints = {}
     for c in report["cases"]:
         err = "-" if c["max_error"] is None else f"{c['max_error']:.2e}"
         ratio = "-" if c["max_error_ratio"] is None else f"{c['max_error_ratio']:.3g}"
-        faults = ", ".join(f["short"] for f in c["faults"]) or ("none" if c["verdict"] == "pass" else "-")
+        faults = case_cell(flat_faults(c)) if c["faults"] else ("none" if c["verdict"] == "pass" else "-")
         rows.append((c["scene"], c["camera"], f"{c['points']:,}", err, ratio, c["verdict"], faults))
-        hints.update({f["name"]: f["hint"] for f in c["faults"]})
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]) - 1)]
     lines = ["  ".join(v.ljust(w) for v, w in zip(r[:-1], widths)) + "  " + r[-1] for r in rows]
     for c in report["cases"]:
         if c["verdict"] != "pass":
             lines.append(f"  {c['scene']} / {c['camera']}: " + "; ".join(c["reasons"]))
-    lines += [f"- `{name}`: {hint}" for name, hint in hints.items()]
+    lines += below_table([{**c, "faults": flat_faults(c)} for c in report["cases"] if c["verdict"] != "pass"],
+                         source="points")
     passed = sum(c["verdict"] == "pass" for c in report["cases"])
     comp = report["compared"]
     lines.append(f"{'PASS' if report['verdict'] == 'pass' else 'FAIL'}: {passed}/{comp['cases']} cases, "

@@ -25,6 +25,7 @@ from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.candidates.depth_map import depth_from_array, read_depth_map
 from wirecheck.oracles.diagnosis.depth_faults import DEPTH_FAULTS, LIMITS, name_depth_faults
+from wirecheck.oracles.faults import CATALOGUE, Fault
 from wirecheck.oracles.judge.cases import cases_for
 from wirecheck.oracles.judge.metrics import depth_bound
 
@@ -119,6 +120,16 @@ def test_each_mistake_named_alone(results):
     assert not wrong, wrong
     # the orthographic case has no range mistake (its rays are all depth), and no K to move
     assert len(results) == 3 * (6 * 10 + 7)
+
+
+def test_named_faults_are_the_catalogues_read_from_depth(results):
+    named = [f for _, _, _, d, _ in results for f in d.faults]
+    assert len(named) == len(results) - 21                     # every mistake named (21 maps are correct)
+    for f in named:
+        assert isinstance(f, Fault) and f.source == "depth" and f.hint == CATALOGUE[f.name].hint_for("depth")
+    # rows flipped: a depth map's hint (the buffer read back bottom row first), not a projector's (y_px = cy - f y / z)
+    flipped = next(d for _, _, i, d, _ in results if i == "mirror_vertical")
+    assert "glReadPixels returns the bottom row first" in flipped.faults[0].hint
 
 
 def test_confusion_matrix_is_diagonal(results, summary_section):

@@ -448,7 +448,9 @@ def test_large_pooled_input_is_fast():
 def confusion(results):
     """rows: injected single fault (by its expected primary name); columns: diagnosed primary."""
     # the vertex faults: the line faults come from the pixels (tests/test_line_gate.py)
-    labels = ["none"] + [n for n in FAULT_ORDER if n not in fault_names(source="pixels") + ("ambiguous",)]   # ambiguous: images only
+    # a projector's names: those read from any source or the vertices (not the lines', a renderer's images'
+    # (ambiguous), a depth map's or an unprojector's)
+    labels = ["none"] + [n for n in FAULT_ORDER if n in fault_names(source="any") + fault_names(source="vertices")]
     counts = Counter()
     for (fault, cam), got in results.items():
         if fault not in SINGLE:

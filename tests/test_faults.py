@@ -2,6 +2,9 @@
 
 - the catalogue holds every name, in the precedence written out here by hand, with the families and
   sources the judge and the references filter by; docs/diagnosis.md's table is the catalogue's;
+- a depth map's and an unprojector's names are the catalogue's too (sources ``depth``, ``points``), a
+  reused pixel name with the hint for where it was read; every name oracles/ writes is in it (an AST
+  scan of records, ``Fault(...)`` calls and the diagnosis' returned models);
 - a cell is the name and its key numbers, at most 60 characters; an ``unexplained`` cell says what
   it is in words, never its matrix; the whole record stays in report.json (rounded in report.md);
 - hints and notes are printed once per fault kind under the table: in real runs (a renderer that
@@ -11,6 +14,7 @@
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 import json
 import re
@@ -20,27 +24,79 @@ import numpy as np
 import pytest
 
 from wirecheck.oracles import faults
+from wirecheck.oracles.diagnosis.depth_faults import DEPTH_FAULTS
+from wirecheck.oracles.diagnosis.unproject_faults import UNPROJECT_FAULTS
 from wirecheck.oracles.faults import CATALOGUE, NAMES, Fault
-from wirecheck.oracles.reports.fault_text import CELL_MAX, case_cell, cell, full_text, notes
+from wirecheck.oracles.reports.fault_text import CELL_MAX, below_table, case_cell, cell, full_text, notes
 
 ROOT = Path(__file__).resolve().parent.parent
 
 # ---------------------------------------------------------------- the catalogue
 
 #: The precedence as docs/diagnosis.md states it: a depth flip hides everything, a swap or a mirror
-#: changes the picture more than a scale, an offset is the smallest effect; then the line faults,
-#: float32 rounding, and what no simple fault explains.
+#: changes the picture more than a scale (a rotation used the wrong way round turns it as a whole),
+#: an offset is the smallest effect; then a depth map's values (their encoding replaces every value,
+#: a float16 step moves them least), the line faults, float32 rounding, and what no simple fault explains.
 PRECEDENCE = ("depth_flip", "clipping_plane", "axis_swap", "ambiguous", "axis_flip", "mirror_horizontal",
-              "mirror_vertical", "aspect_mismatch", "fov_mismatch", "pixel_offset", "distortion_mismatch",
-              "line_end_bias", "line_pixel_bias", "raster_rule", "precision_limited", "unexplained")
+              "mirror_vertical", "rotation_transposed", "aspect_mismatch", "fov_mismatch", "pixel_offset",
+              "distortion_mismatch", "depth_encoding", "depth_reversed", "depth_scale", "depth_is_range",
+              "depth_offset", "depth_precision", "line_end_bias", "line_pixel_bias", "raster_rule",
+              "precision_limited", "unexplained")
+#: The names a depth map's values and an unprojector's points are given (docs/depth.md's tables).
+DEPTH_NAMES = {"depth_scale", "depth_offset", "depth_is_range", "depth_reversed", "depth_encoding",
+               "depth_precision", "mirror_vertical", "mirror_horizontal", "pixel_offset", "fov_mismatch",
+               "ambiguous", "unexplained"}
+POINTS_NAMES = {"pixel_offset", "mirror_vertical", "mirror_horizontal", "fov_mismatch", "depth_is_range",
+                "rotation_transposed", "distortion_mismatch", "ambiguous", "unexplained"}
 
 
 def test_the_catalogue_holds_every_name_in_precedence_order():
     assert NAMES == PRECEDENCE
     assert [CATALOGUE[n].precedence for n in NAMES] == list(range(len(PRECEDENCE)))
     for k in CATALOGUE.values():
-        assert k.family in faults.FAMILIES and k.source in ("any", "vertices", "pixels", "images")
-        assert len(k.hint) > 40, k.name               # a sentence saying what to check
+        assert k.family in faults.FAMILIES and set(k.sources) <= set(faults.SOURCES)
+        assert k.source in ("any", "vertices", "pixels", "images", "depth", "points")
+        for text in [k.hint] + [k.hints[s] for s in k.sources[1:]]:
+            assert len(text) > 40, k.name             # a sentence saying what to check
+
+
+def test_depth_maps_and_unprojectors_are_named_from_the_catalogue():
+    assert set(faults.names(source="depth")) == set(DEPTH_FAULTS) == DEPTH_NAMES
+    assert set(faults.names(source="points")) == set(UNPROJECT_FAULTS) == POINTS_NAMES
+    assert faults.names("depth") == ("depth_encoding", "depth_reversed", "depth_scale", "depth_is_range",
+                                     "depth_offset", "depth_precision")
+    with pytest.raises(KeyError, match="source"):
+        faults.names(source="depths")                  # a typo is an error, not an empty set
+
+
+def test_a_reused_name_has_its_sources_hint():
+    flip = CATALOGUE["mirror_vertical"]
+    assert flip.sources == ("any", "depth", "points")
+    assert flip.hint_for(None) == flip.hint_for("pixels") == flip.hint and "y_px = cy - f y / z" in flip.hint
+    assert "glReadPixels returns the bottom row first" in flip.hint_for("depth")
+    assert "y_cam = -(v - cy) d / fy" in flip.hint_for("points")
+    # read from depth maps first, from points too: each its own hint
+    assert CATALOGUE["depth_is_range"].sources == ("depth", "points")
+    assert "depth = range / |(x_n, y_n, 1)|" in Fault("depth_is_range", source="depth").hint
+    assert "not along the ray" in Fault("depth_is_range", source="points").hint
+    # a name read from one source only keeps its hint; a fault's own hint still comes first
+    assert Fault("depth_scale", {"k": 1000.0}, "depth").hint == CATALOGUE["depth_scale"].hint
+    assert Fault("pixel_offset", {"hint": "own"}, "points").hint == "own"
+    # the source is where it was read, not a field of the record
+    assert Fault("mirror_vertical", {}, "points").as_dict() == {"name": "mirror_vertical"}
+    with pytest.raises(KeyError, match="source"):
+        Fault("mirror_vertical", {}, "unprojector")
+    # the selectors of value-selected hints are no source's name (a source key replaces the hint)
+    for k in CATALOGUE.values():
+        selectors = set(k.hints) - set(k.sources)
+        assert not selectors & set(faults.SOURCES), k.name
+
+
+def test_below_the_table_each_kind_hint_once_for_its_source():
+    cases = [{"scene": "cube", "camera": c, "faults": [{"name": "mirror_vertical"}]} for c in ("a", "b")]
+    assert below_table(cases, source="depth") == [
+        f"  what to check, mirror_vertical: {CATALOGUE['mirror_vertical'].hints['depth']}"]
+    assert below_table(cases) == [f"  what to check, mirror_vertical: {CATALOGUE['mirror_vertical'].hint}"]
 
 
 def test_families_are_the_sets_the_judge_filters_by():
@@ -51,6 +107,9 @@ def test_families_are_the_sets_the_judge_filters_by():
     assert faults.names("scale", "offset") == ("aspect_mismatch", "fov_mismatch", "pixel_offset")
     assert faults.names(source="pixels") == ("line_end_bias", "line_pixel_bias", "raster_rule")
     assert faults.names(source="vertices") == ("clipping_plane", "distortion_mismatch", "precision_limited")
+    # the depth and unprojector names widen none of these sets (rotation_transposed is no orientation of
+    # the picture the judge places: its own family)
+    assert faults.names("rotation") == ("rotation_transposed",)
     with pytest.raises(KeyError, match="families"):
         faults.names("lines")                          # a typo is an error, not an empty set
 
@@ -83,19 +142,48 @@ def test_hint_templates_are_filled_from_the_faults_values():
     assert text.startswith("the frames hold lines, at level 100 of 255") and "under the 128 from which" in text
 
 
-def _produced_names() -> set:
-    """Every fault name the judge, the diagnosis and the references write as a literal ``"name": "..."``."""
-    found = set()
-    for folder in ("judge", "diagnosis", "references"):
-        for path in (ROOT / "oracles" / folder).glob("*.py"):
-            found |= set(re.findall(r'"name": "(\w+)"', path.read_text(encoding="utf-8")))
+def _literal(node) -> str | None:
+    return node.value if isinstance(node, ast.Constant) and isinstance(node.value, str) else None
+
+
+def _produced_names() -> dict:
+    """Every fault name oracles/ writes as a literal, with where: the value of a ``"name"`` key (a fault
+    record), the first argument of ``Fault(...)`` or ``hint_text(...)``, or, in diagnosis/, the first item
+    of a returned or yielded tuple (a name with its params, as the depth and unprojector models give them).
+
+    A regex for ``"name": "..."`` alone missed every name of the depth and unprojector diagnoses: their
+    names travel in such tuples and reach the records through a variable. reports/ is left out: it only
+    reads faults, and its JUnit XML has ``name`` attributes of its own; the tuple rule is kept to
+    diagnosis/, where names are given (elsewhere a returned ``("fail", reasons)`` is no fault).
+    """
+    found: dict = {}
+    for path in sorted((ROOT / "oracles").rglob("*.py")):
+        if path.name == "faults.py" or "reports" in path.relative_to(ROOT / "oracles").parts:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = []
+            if isinstance(node, ast.Dict):
+                names = [_literal(v) for k, v in zip(node.keys, node.values) if k is not None and _literal(k) == "name"]
+            elif isinstance(node, ast.Call):
+                func = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+                if func in ("Fault", "hint_text") and node.args:
+                    names = [_literal(node.args[0])]
+            elif (isinstance(node, (ast.Return, ast.Yield)) and isinstance(node.value, ast.Tuple)
+                  and "diagnosis" in path.parts):
+                items = [node.value, *(e for e in node.value.elts if isinstance(e, ast.Tuple))]
+                names = [_literal(e.elts[0]) for e in items if len(e.elts) >= 2]
+            for name in filter(None, names):
+                found.setdefault(name, []).append(f"{path.relative_to(ROOT)}:{node.lineno}")
     return found
 
 
 def test_every_name_the_code_writes_is_in_the_catalogue():
     produced = _produced_names()
-    assert {"pixel_offset", "raster_rule", "depth_flip", "unexplained", "clipping_plane"} <= produced   # read
-    assert produced <= set(NAMES)
+    # the scan reads each way a name is written: a record's "name", a yielded model, a depth map's own
+    assert {"pixel_offset", "raster_rule", "depth_flip", "unexplained", "clipping_plane", "depth_scale",
+            "depth_encoding", "rotation_transposed", "mirror_vertical"} <= set(produced)
+    outside = {name: where for name, where in produced.items() if name not in NAMES}
+    assert not outside, f"fault names outside oracles.faults.CATALOGUE: {outside}"
 
 
 def test_the_docs_table_is_the_catalogue():

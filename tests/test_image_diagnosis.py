@@ -224,7 +224,8 @@ def confusion(results):
     # of a drawing the harness made itself (oracles.diagnosis.diagnose.diagnose_lines), not this family
     # (nor distortion_mismatch: frames of a distorted camera are not compared, oracles.judge.case;
     # nor precision_limited: float32 rounding is far below a pixel)
-    labels = ["none"] + [n for n in FAULT_ORDER if n not in fault_names(source="pixels") + fault_names(source="vertices")]
+    # (nor a depth map's or an unprojector's own names): those read from any source, and the images' ambiguous
+    labels = ["none"] + [n for n in FAULT_ORDER if n in fault_names(source="any") + fault_names(source="images")]
     counts = Counter()
     for (fault, cam), got in results.items():
         if fault not in SINGLE:

@@ -7,6 +7,7 @@ a float32 one, a GL-style one through inverse(P V), and one classic mistake each
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 from collections import Counter
@@ -22,11 +23,15 @@ from wirecheck.core.scene.files import load_scene
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion
+from wirecheck.oracles.faults import CATALOGUE
 from wirecheck.oracles.judge.cases import CALIBRATED_CASE_NAMES, CASE_NAMES, case_motion, cameras_for, cases_for
 from wirecheck.oracles.judge.metrics import depth_bound
 from wirecheck.oracles.judge.tolerances import unproject_bound
 from wirecheck.oracles.references.opencv_oracle import project as cv_project
 from wirecheck.oracles.references.unproject_reference import unproject
+from wirecheck.oracles.reports.fault_text import CELL_MAX
+from wirecheck.oracles.unprojector_api import unprojector_failure_text
+from wirecheck.oracles.unprojector_cli import report_lines
 
 sys.path.insert(0, str(Path(__file__).parent / "data"))
 import unprojectors as U  # noqa: E402
@@ -244,6 +249,30 @@ def test_cli_pass_fail_error():
     # FILE.py:FUNC runs in its own process: an os._exit(0) fails its case (exit 1), never a pass
     hard = crosscheck("--unprojector", f"{SPEC}:hard_exit", "--scene", "cube", "--frames", "1", "--cases", "on_axis")
     assert hard.returncode == 1 and "FAIL: 0/1 cases" in hard.stdout, (hard.stdout, hard.stderr)
+
+
+def test_faults_are_short_cells_and_each_kind_hint_once():
+    """The assertion's message and the console table show a cell per case (oracles.reports.fault_text,
+    <= 60 characters) and what to check once per fault kind, the catalogue's hint for an unprojector."""
+    report = check_unprojector(U.horizontal_fov, scenes=["cube"], frames=1, cases=["on_axis", "wide_fov",
+                                                                                   "orthographic"])
+    for c in report["cases"]:                     # the record's shape: name, params, hint, short
+        assert [sorted(f) for f in c["faults"]] == [["hint", "name", "params", "short"]]
+        assert type(c["faults"][0]["params"]) is dict
+    text = unprojector_failure_text(report)
+    cells = re.findall(r": faults: (.*?); ", text)
+    # K from the horizontal FOV: f = (W / 2) / tan(fov / 2), so the FOV implied is 2 atan((H / W) tan(fov / 2))
+    cams = {case.name: case.camera for case in cases_for(load_scene("cube"))}
+    implied = [math.degrees(2 * math.atan(c.height / c.width * math.tan(math.radians(c.fov_y_deg) / 2)))
+               for c in (cams["on_axis"], cams["wide_fov"])]
+    # orthographic: that f taken for its pixels per unit; fov_mismatch is fitted on perspective cameras only
+    assert cells == [f"fov_mismatch(fov={implied[0]:.4g})", f"fov_mismatch(fov={implied[1]:.4g})", "unexplained"]
+    table = report_lines(report)
+    assert [line.split()[-1] for line in table[1:4]] == cells and all(len(c) <= CELL_MAX for c in cells)
+    for lines in (text.splitlines(), table):
+        checks = [line for line in lines if line.startswith("  what to check, ")]
+        assert checks == [f"  what to check, fov_mismatch: {CATALOGUE['fov_mismatch'].hints['points']}",
+                          f"  what to check, unexplained: {CATALOGUE['unexplained'].hints['points']}"]
 
 
 # ---------------------------------------------------------------- over the protocol

@@ -28,6 +28,9 @@ parameters is named, then the closest; when models of two names explain it (a fl
 seen square-on: scale and offset alike), ``ambiguous`` with both; none: ``unexplained``,
 with what was measured (``fit_ratios``: each model's worst residual over its allowance).
 Zero pixels compared (a blank map, all NaN, no overlap) is ``vacuous``: never a pass.
+
+Every name is the fault catalogue's (oracles.faults: its ``depth`` source, hints included), and a
+named fault is a :class:`oracles.faults.Fault` read from ``"depth"``.
 """
 
 from __future__ import annotations
@@ -36,10 +39,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import faults as catalogue
+from ..faults import Fault
 from .depth_pixels import MAX_OUTSIDE, MIN_INTERIOR, pixel_models, sample
 
-__all__ = ["DEPTH_FAULTS", "DEPTH_HINTS", "DepthDiagnosis", "DepthFault", "DepthLimits", "LIMITS",
-           "name_depth_faults", "ray_lengths"]
+__all__ = ["DEPTH_FAULTS", "DepthDiagnosis", "DepthLimits", "LIMITS", "name_depth_faults", "ray_lengths"]
 
 
 @dataclass(frozen=True)
@@ -64,61 +68,17 @@ class DepthLimits:
 
 LIMITS = DepthLimits()
 
-#: Every name this module gives, in the order of its table.
-DEPTH_FAULTS = ("depth_scale", "depth_offset", "depth_is_range", "depth_reversed", "depth_encoding",
-                "depth_precision", "mirror_vertical", "mirror_horizontal", "pixel_offset", "fov_mismatch",
-                "ambiguous", "unexplained")
-
-#: What to check for each name: the usual cause and its fix.
-DEPTH_HINTS = {
-    "depth_scale": "depth is a constant factor off: k = 1000 is millimetres read as metres (a 16-bit PNG not "
-                   "divided by its scale; 5000 for TUM files); divide by the scale the file was written with",
-    "depth_offset": "a constant is added: depth measured from the near plane (b = -near) or from a point other "
-                    "than the camera centre; depth is z_cam = dot(p - position, forward)",
-    "depth_is_range": "distance from the eye along the pixel's ray was stored where depth along forward was "
-                      "asked (or the reverse): depth = range / |(x_n, y_n, 1)| with x_n = (x - cx) / fx, "
-                      "y_n = (y - cy) / fy",
-    "depth_reversed": "a reversed-Z buffer (near -> 1, far -> 0) linearised with the standard formula: near and "
-                      "far swap; linearise it as d = n f / (n + z (f - n)), or read 1 - z",
-    "depth_encoding": "the depth buffer's non-linear value was stored: linearise it, d = f n / (f - z (f - n)) "
-                      "for window z in [0, 1] (NDC z: z_win = (z + 1) / 2 first; orthographic: d = n + z (f - n))",
-    "depth_precision": "depth values are quantised (a float16 or 8-bit target or texture): render and store "
-                       "depth as float32, or as a 16-bit PNG with a scale",
-    "mirror_vertical": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
-                       "when reading the buffer back (glReadPixels returns the bottom row first)",
-    "mirror_horizontal": "columns flipped: right = forward x up, and x_px grows to the right",
-    "pixel_offset": "the depth is half a pixel (or more) off: pixel centres are integers, cx = (W - 1) / 2 "
-                    "(W / 2 is the corner convention); a GL projection from K puts cx + 0.5 in it",
-    "fov_mismatch": "the image is scaled about the principal point: fov_y_deg is the vertical FOV, "
-                    "f = (H / 2) / tan(fov_y / 2) (a renderer given it as its horizontal view angle scales by W / H)",
-    "ambiguous": "the compared depths fit several of these models alike (a surface at one depth, seen "
-                 "square-on): judge more frames, or a view whose depth varies",
-    "unexplained": "the depth differs from the reference in no way this diagnosis knows: see what was measured",
-}
-
-
-@dataclass(frozen=True)
-class DepthFault:
-    """A named fault: ``name`` (one of :data:`DEPTH_FAULTS`), what was fitted, what to check."""
-
-    name: str
-    params: dict = field(default_factory=dict)
-    hint: str = ""
-
-    def short(self) -> str:
-        """``name(k=1000)``: the name and its numbers, for one line of a report."""
-        if not self.params:
-            return self.name
-        inner = ", ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.params.items())
-        return f"{self.name}({inner})"
+#: Every name this module gives: the catalogue's names read from depth maps, in precedence order.
+DEPTH_FAULTS = catalogue.names(source="depth")
 
 
 @dataclass(frozen=True)
 class DepthDiagnosis:
-    """The verdict on one depth map: ``"pass"``, ``"fail"`` or ``"vacuous"`` (nothing compared, never a pass)."""
+    """The verdict on one depth map: ``"pass"``, ``"fail"`` or ``"vacuous"`` (nothing compared, never a pass),
+    its ``faults`` (each a :class:`Fault` read from ``"depth"``: its hint is the depth map's) and what was measured."""
 
     verdict: str
-    faults: tuple = ()
+    faults: tuple[Fault, ...] = ()
     measured: dict = field(default_factory=dict)
 
     @property
@@ -218,13 +178,12 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
     names = list(dict.fromkeys(f[2] for f in explained))
     if len(names) > 1:
         # the compared depths do not separate the models (one flat surface square-on: scale and offset alike)
-        return DepthDiagnosis("fail", (DepthFault("ambiguous", {"alternatives": ", ".join(names)},
-                                                  DEPTH_HINTS["ambiguous"]),), measured)
+        return DepthDiagnosis("fail", (Fault("ambiguous", {"alternatives": ", ".join(names)}, "depth"),), measured)
     if explained:
         _, fit, name, params = explained[0]
         measured["fit_ratio"] = fit
-        return DepthDiagnosis("fail", (DepthFault(name, params, DEPTH_HINTS[name]),), measured)
-    return DepthDiagnosis("fail", (DepthFault("unexplained", {}, DEPTH_HINTS["unexplained"]),), measured)
+        return DepthDiagnosis("fail", (Fault(name, params, "depth"),), measured)
+    return DepthDiagnosis("fail", (Fault("unexplained", {}, "depth"),), measured)
 
 
 def _pixel_fits(cand, ref, faces, bound, enc, camera) -> list:

@@ -16,65 +16,37 @@ reprojected by the reference projection (OpenCV's ``projectPoints``; ``u', v'``)
 A fault explains the candidate when every point is within :data:`FIT_SLACK` of its bound
 of the mistaken inverse's point. Two names that both explain it (a view where rows flipped
 is also a transposed rotation) are ``ambiguous``; none: ``unexplained``, with the median
-pixel shift, scale and depth ratio measured.
+pixel shift, scale and depth ratio measured. Every name is the fault catalogue's (oracles.faults:
+its ``points`` source, hints included), and a named fault is a :class:`oracles.faults.Fault` read
+from ``"points"``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import faults as catalogue
+from ..faults import Fault
 from ..references.convert import opencv_matrices
 from ..references.opencv_oracle import project as cv_project
 from ..references.unproject_reference import cam_points, unproject
 
-__all__ = ["FIT_SLACK", "UNPROJECT_FAULTS", "UNPROJECT_HINTS", "UnprojectFault", "name_unproject_faults"]
+__all__ = ["FIT_SLACK", "UNPROJECT_FAULTS", "name_unproject_faults"]
 
 #: A mistaken inverse explains the candidate within this many bounds: its parameters are
 #: medians of reprojected points, each within its own bound, so they move the model by up to
 #: about one bound; doubled for the two sides' roundings: 4.
 FIT_SLACK = 4.0
 
-UNPROJECT_FAULTS = ("pixel_offset", "mirror_vertical", "mirror_horizontal", "fov_mismatch", "depth_is_range",
-                    "rotation_transposed", "distortion_mismatch", "ambiguous", "unexplained")
-
-UNPROJECT_HINTS = {
-    "pixel_offset": "pixel centres are integers: a centred camera has cx = (W - 1) / 2, cy = (H - 1) / 2 "
-                    "(W / 2 is GL's window convention, pixel centres at half-integers: subtract 0.5)",
-    "mirror_vertical": "pixel y grows downward: y_cam = -(v - cy) d / fy (rows are not flipped; OpenCV's camera "
-                       "y is down, the contract's up)",
-    "mirror_horizontal": "pixel x grows to the right: x_cam = (u - cx) d / fx, and right = forward x up",
-    "fov_mismatch": "fov_y_deg is the full vertical FOV: f = (H / 2) / tan(fov_y / 2), the same for x "
-                    "(not (W / 2) / tan(fov / 2))",
-    "depth_is_range": "the depth given is along forward (z_cam), not along the ray: p_cam = d (x_n, y_n, 1), "
-                      "not d (x_n, y_n, 1) / |(x_n, y_n, 1)|",
-    "rotation_transposed": "R maps world to camera (p_cv = R X + t, rows right, -up, forward): the way back is "
-                           "X = R^T (p_cv - t)",
-    "distortion_mismatch": "undo the lens distortion before unprojecting: cv2.undistortPointsIter (the "
-                           "default cv2.undistortPoints stops after 5 iterations, ~4e-3 px off on this lens)",
-    "ambiguous": "the points fit several of these mistakes alike on this view: see the alternatives",
-    "unexplained": "the points differ from the exact inverse in no way this diagnosis knows: see what was "
-                   "measured",
-}
-
-
-@dataclass(frozen=True)
-class UnprojectFault:
-    name: str
-    params: dict = field(default_factory=dict)
-    hint: str = ""
-
-    def short(self) -> str:
-        if not self.params:
-            return self.name
-        inner = ", ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.params.items())
-        return f"{self.name}({inner})"
+#: Every name this module gives: the catalogue's names read from an unprojector's points, in precedence order.
+UNPROJECT_FAULTS = catalogue.names(source="points")
 
 
 def name_unproject_faults(p_px, depth, camera, cand, bound) -> tuple[list, dict]:
-    """``(faults, measured)`` for a candidate whose points ``cand`` ``(N, 3)`` missed their bounds.
+    """``(faults, measured)`` for a candidate whose points ``cand`` ``(N, 3)`` missed their bounds: the
+    faults a list of :class:`Fault` read from ``"points"`` (one: the mistake, ``ambiguous`` or ``unexplained``).
 
     ``p_px`` ``(N, 2)`` and ``depth`` ``(N,)`` are what it was given; ``bound`` ``(N,)`` world
     units (oracles.judge.tolerances.unproject_bound).
@@ -93,10 +65,10 @@ def name_unproject_faults(p_px, depth, camera, cand, bound) -> tuple[list, dict]
     measured["fit_ratios"] = {n: r for n, (r, _) in fits.items()}
     names = [n for n, (r, _) in sorted(fits.items(), key=lambda kv: kv[1][0]) if r <= FIT_SLACK]
     if len(names) > 1:
-        return [UnprojectFault("ambiguous", {"alternatives": ", ".join(names)}, UNPROJECT_HINTS["ambiguous"])], measured
+        return [Fault("ambiguous", {"alternatives": ", ".join(names)}, "points")], measured
     if names:
-        return [UnprojectFault(names[0], fits[names[0]][1], UNPROJECT_HINTS[names[0]])], measured
-    return [UnprojectFault("unexplained", {}, UNPROJECT_HINTS["unexplained"])], measured
+        return [Fault(names[0], fits[names[0]][1], "points")], measured
+    return [Fault("unexplained", {}, "points")], measured
 
 
 def _reproject(x_world, camera) -> np.ndarray:

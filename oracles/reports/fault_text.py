@@ -28,9 +28,10 @@ FULL_DIGITS = 4
 
 def fault_nominals(camera: dict | None) -> dict:
     """The value each fault field would have without the fault (``camera``: a record's ``camera_spec``)."""
-    out = {"scale": 1.0, "scale_x": 1.0, "scale_y": 1.0, "dx": 0.0, "dy": 0.0}
+    out = {"scale": 1.0, "scale_x": 1.0, "scale_y": 1.0, "dx": 0.0, "dy": 0.0, "k": 1.0, "b": 0.0}
     if camera:
         out.update(implied_aspect=camera["width"] / camera["height"], implied_fov_deg=camera["fov_y_deg"],
+                   implied_fov_y_deg=camera["fov_y_deg"],
                    implied_ortho_height=camera["ortho_height"])
         lens = list(camera.get("distortion") or []) + [0.0] * 8            # k1, k2, p1, p2, k3, ...
         out.update(k1=lens[0], k2=lens[1], p1=lens[2], p2=lens[3], k3=lens[4])
@@ -132,12 +133,13 @@ def full_text(faults: list[dict], camera: dict | None = None, digits: int | None
     return "; ".join(parts)
 
 
-def hints(faults: Iterable[dict], frames: bool = False) -> list[tuple[str, str]]:
+def hints(faults: Iterable[dict], frames: bool = False, source: str | None = None) -> list[tuple[str, str]]:
     """``(name, what to check)`` once per distinct hint of ``faults``, in precedence order: a fault's own
-    ``hint`` (set where its values say more, e.g. a FOV scale of W/H) or its name's; ``frames``: a
-    renderer's own frames, each name's ``frames_hint`` added."""
+    ``hint`` (set where its values say more, e.g. a FOV scale of W/H) or its name's, read from ``source``
+    (``"depth"``, ``"points"``: oracles.faults.FaultKind.hint_for); ``frames``: a renderer's own frames,
+    each name's ``frames_hint`` added."""
     seen = {}
-    for f in ordered(Fault.of(x) for x in faults):
+    for f in ordered(Fault.of(x, source) for x in faults):
         hint = f.hint + (f"; {f.kind.frames_hint}" if frames and f.kind.frames_hint else "")
         seen.setdefault((f.name, hint), None)
     return list(seen)
@@ -165,8 +167,9 @@ def notes(cases: list[dict]) -> list[tuple[str, str]]:
     return out
 
 
-def below_table(failing: list[dict], frames: bool = False) -> list[str]:
+def below_table(failing: list[dict], frames: bool = False, source: str | None = None) -> list[str]:
     """The lines under a table (the console's, an AssertionError's): what to check once per fault hint of
-    the ``failing`` cases, then each fault kind's note once."""
-    return ([f"  what to check, {n}: {h}" for n, h in hints((f for c in failing for f in c["faults"]), frames)]
+    the ``failing`` cases (read from ``source``: :func:`hints`), then each fault kind's note once."""
+    return ([f"  what to check, {n}: {h}"
+             for n, h in hints((f for c in failing for f in c["faults"]), frames, source)]
             + [f"  note, {n}: {t}" for n, t in notes(failing)])
