@@ -7,7 +7,7 @@
 
 The job is a folder written by ``crosscheck export`` with the renderer's PNGs under ``frames/``
 (docs/frames.md). The judge is ``crosscheck --candidate-frames DIR``'s own
-(:func:`wirecheck.oracles.candidates.frames_candidate.run_frames`), with its checks of the job
+(:func:`wirecheck.oracles.judge.frames_judge.run_frames`), with its checks of the job
 and of the report folder (:func:`wirecheck.oracles.frames_cli.check_report_outside_job`), so the
 report is the one the command line writes.
 """
@@ -94,7 +94,7 @@ def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None,
 def _judge(job_dir, tol, allow_vacuous: bool, line_rule: str) -> tuple[dict, dict]:
     """crosscheck's frames judge on ``job_dir``, after the check that pyrender's GL can draw here."""
     from .candidates.caller_state import caller_state_kept
-    from .candidates.frames_candidate import run_frames
+    from .judge.frames_judge import run_frames
     from .references.pyrender_oracle import GLUnavailable, gl_available
 
     with caller_state_kept():                   # the caller's globals as they were (PYOPENGL_PLATFORM, ...)

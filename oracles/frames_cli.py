@@ -100,7 +100,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     command line): the project's settings for projector checks, which a job's
     frames do not use, so they are not usage errors here.
     """
-    from .candidates.frames_candidate import run_frames
+    from .judge.frames_judge import run_frames
     from .judge.line_style import summary_lines
     from .reports.compared import what_text
     from .reports.report import console_table, write_report

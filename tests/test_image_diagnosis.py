@@ -262,13 +262,13 @@ def test_a_case_of_many_frames_is_fitted_on_the_points_of_six(fault, monkeypatch
     from wirecheck.oracles.diagnosis import image_diagnose
 
     sizes = []
-    init = image_diagnose._Registration.__init__
+    init = image_diagnose.Registration.__init__
 
     def counting(self, frames, *args):
         init(self, frames, *args)
         sizes.append((len(frames), len(self._cand), len(self._samples)))
 
-    monkeypatch.setattr(image_diagnose._Registration, "__init__", counting)
+    monkeypatch.setattr(image_diagnose.Registration, "__init__", counting)
     cam = CAMERAS["oblique"]
     fn, want = FAULTS[fault]
     sc = load_scene("cube")

@@ -2,7 +2,7 @@
 
     renderer --scene cube --frames 180 --camera-z 4.0 --fov 70
 
-Parses the options into :class:`core.app.run.Settings`, calls
+Parses the options into :class:`core.app.settings.Settings`, calls
 :func:`core.app.run.render_run` and prints. Results go to stdout, errors to stderr
 as one line with exit status 2.
 """
@@ -43,7 +43,7 @@ def _load_numpy_single_threaded() -> None:
 _load_numpy_single_threaded()
 
 from .cli_help import RENDERER_EXAMPLES, usage_hint
-from ..camera import Camera, camera_z, look_at, orthographic_twin
+from ..camera import COEFFICIENT_COUNTS, Camera, camera_z, look_at, orthographic_twin
 from ..projector.clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
 from ..projector.culling import CULL_CHOICES
@@ -55,7 +55,8 @@ from ..outputs.output import check_outside_scenes
 from ..projector.projection import DTYPES
 from ..projector.raster import RASTER_MODES
 from .report import depth_text
-from .run import FORMATS, Settings, output_names, progress_steps, render_run
+from .run import FORMATS, output_names, progress_steps, render_run
+from .settings import Settings
 from ..scene.files import load_scene
 from ..projector.shading import STYLES
 from ..outputs.staging import check_out
@@ -345,7 +346,6 @@ def _numbers(option: str, text: str, counts: tuple) -> tuple:
 
 def _lens_options(a, fov_given: bool) -> dict:
     """``--intrinsics`` and ``--distortion`` as Camera fields; InputError for a combination that ignores them."""
-    from ..projector.distortion import COEFFICIENT_COUNTS
 
     out = {}
     if a.intrinsics is not None:
@@ -419,7 +419,7 @@ def _main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     s = settings_from_args(args)          # InputError: one line, exit 2 (core.app.guard)
     if args.interactive:
-        from .viewer import main_interactive
+        from .viewer_http import main_interactive
 
         return main_interactive(s, args.port)
     if args.compare:

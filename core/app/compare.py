@@ -93,7 +93,7 @@ def measure(image: np.ndarray, row: int) -> dict | None:
 
 
 def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
-    """Render the four views; return (report, 2x2 picture). ``s`` is the run's core.app.run.Settings."""
+    """Render the four views; return (report, 2x2 picture). ``s`` is the run's core.app.settings.Settings."""
     from .compose import picture, side_by_side
 
     from ..scene.model import world_points

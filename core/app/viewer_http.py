@@ -17,13 +17,9 @@ import threading
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
-from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
-from .viewer import _short
-
-if TYPE_CHECKING:
-    from .viewer import Viewer
+from .viewer import LazyOverlay, Viewer, short_repr
 
 STATIC = ("index.html", "viewer.js", "viewer.css")
 #: Largest request body read, in bytes: MAX_OPS ops of ~60 bytes of JSON each is ~15 KiB; 64 KiB
@@ -54,7 +50,7 @@ def _reject_constant(name):
 def _finite_float(text):
     v = float(text)
     if not math.isfinite(v):                           # 1e400 parses to inf
-        raise ValueError(f"number {_short(text)} overflows float64; expected a finite number")
+        raise ValueError(f"number {short_repr(text)} overflows float64; expected a finite number")
     return v
 
 
@@ -78,13 +74,13 @@ def parse_body(raw: bytes) -> tuple[list, bool]:
                                                    'expected an object {"ops": [...], "overlay": bool}')
     unknown = sorted(set(body) - {"ops", "overlay"})
     if unknown:
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: unknown key {_short(unknown[0])}; "
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: unknown key {short_repr(unknown[0])}; "
                                                    "expected ops and overlay")
     ops, overlay = body.get("ops", []), body.get("overlay", False)
     if not isinstance(ops, list):
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: ops {_short(ops)}: expected a list")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: ops {short_repr(ops)}: expected a list")
     if not isinstance(overlay, bool):
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: overlay {_short(overlay)}: expected true or false")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: overlay {short_repr(overlay)}: expected true or false")
     return ops, overlay
 
 
@@ -133,10 +129,10 @@ def _handler(viewer: Viewer):
             hosts = (f"127.0.0.1:{port}", f"localhost:{port}")
             host = (self.headers.get("Host") or "").lower()
             if host not in hosts:
-                raise RequestError(HTTPStatus.FORBIDDEN, f"Host {_short(host)}: expected {' or '.join(hosts)}")
+                raise RequestError(HTTPStatus.FORBIDDEN, f"Host {short_repr(host)}: expected {' or '.join(hosts)}")
             origin = self.headers.get("Origin")
             if origin is not None and origin.lower() not in tuple(f"http://{h}" for h in hosts):
-                raise RequestError(HTTPStatus.FORBIDDEN, f"Origin {_short(origin)}: expected this viewer's page")
+                raise RequestError(HTTPStatus.FORBIDDEN, f"Origin {short_repr(origin)}: expected this viewer's page")
 
         def _path(self) -> str:
             path = urlsplit(self.path).path              # the query string, if any, is ignored
@@ -156,13 +152,13 @@ def _handler(viewer: Viewer):
             elif path == "/api/frame":
                 self._json(viewer.respond())
             else:
-                self._json({"error": f"no such path {_short(path)}"}, 404)
+                self._json({"error": f"no such path {short_repr(path)}"}, 404)
 
         def do_POST(self):
             try:
                 self._check_origin()
                 if self._path() != "/api/frame":
-                    raise RequestError(HTTPStatus.NOT_FOUND, f"no such path {_short(self._path())}")
+                    raise RequestError(HTTPStatus.NOT_FOUND, f"no such path {short_repr(self._path())}")
                 ops, overlay = parse_body(self._read_body())
             except RequestError as exc:
                 return self._refuse(exc)
@@ -173,12 +169,12 @@ def _handler(viewer: Viewer):
             ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
             if ctype != "application/json":             # a cross-site form or text/plain post cannot say this
                 raise RequestError(HTTPStatus.UNSUPPORTED_MEDIA_TYPE,
-                                   f"Content-Type {_short(ctype)}: expected application/json")
+                                   f"Content-Type {short_repr(ctype)}: expected application/json")
             text = self.headers.get("Content-Length")
             if text is None:
                 raise RequestError(HTTPStatus.LENGTH_REQUIRED, "Content-Length: missing; expected the body's size")
             if not (text.isascii() and text.isdigit() and len(text) <= 20):
-                raise RequestError(HTTPStatus.BAD_REQUEST, f"Content-Length {_short(text)}: expected bytes >= 0")
+                raise RequestError(HTTPStatus.BAD_REQUEST, f"Content-Length {short_repr(text)}: expected bytes >= 0")
             n = int(text)
             if n > MAX_BODY_BYTES:
                 raise RequestError(HTTPStatus.REQUEST_ENTITY_TOO_LARGE,
@@ -236,3 +232,26 @@ class Server:
         close = getattr(self.viewer.overlay, "close", None)
         if close is not None:
             close()
+
+
+def main_interactive(s, port: int = 0) -> int:
+    """Serve until Ctrl-C; print the URL. Returns the exit status."""
+    if not 0 <= port <= 65535:
+        print(f"renderer: error: --port {port}: expected 0 (a free port) to 65535", file=sys.stderr)
+        return 2
+    try:
+        server = Server(Viewer(s, overlay=LazyOverlay()), port)
+    except OSError as exc:
+        print(f"renderer: error: --port {port}: cannot listen on 127.0.0.1 ({exc.strerror or exc})", file=sys.stderr)
+        return 2
+    print(f"Viewer: {server.url}  (Ctrl-C stops it)", flush=True)
+    server.start()
+    try:
+        while server.thread.is_alive():
+            server.thread.join(0.2)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
+    print("Viewer stopped.", flush=True)
+    return 0

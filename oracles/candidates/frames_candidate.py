@@ -203,7 +203,7 @@ def check_frames(job_dir: Path, job: dict, decode: bool = True) -> None:
     ``decode=False``: every check but the decoding of the pixels (the files, their PNG headers and
     sizes, the frames of another job): the judge then decodes each frame once, as it judges it, and
     calls this again with ``decode=True`` on a frame it cannot decode, so that the same problems are
-    listed as a full check would list them (oracles.judge.frames_judge.read_frame).
+    listed as a full check would list them (:func:`read_frame`).
     """
     _frames(job_dir, job, keep=False, decode=decode)
 
@@ -363,16 +363,21 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
     return p_model, edges, camera, m
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "gl"):
-    """One case, judged frame by frame: :func:`oracles.judge.frames_judge.judge_case`."""
-    from ..judge.frames_judge import judge_case as judge
+def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
+    """A frame's grey levels (oracles.candidates.png_frame.read_grey), decoded once, as it is judged.
 
-    return judge(job_dir, job, scene, case, oracles, tol, diagnose, line_rule)
-
-
-def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False, line_rule: str = "gl") -> tuple[dict, dict]:
-    """Judge the job's frames: :func:`oracles.judge.frames_judge.run_frames`."""
-    from ..judge.frames_judge import run_frames as run
-
-    return run(job_dir, tol, diagnose, name, allow_vacuous, line_rule)
+    The job's frames were checked before the judging began, all but their
+    pixels' decoding (oracles.candidates.frames_candidate.check_frames with
+    ``decode=False``): a frame that cannot be decoded makes the full check run
+    (``job``: ``(job_dir, job)``), so that every problem of the job is listed,
+    as when the check decodes every frame first; FramesError either way.
+    """
+    try:
+        return read_grey(path, width, height)
+    except FrameProblem as exc:
+        problem = str(exc)
+    except Exception as exc:       # noqa: BLE001 - Pillow's many ways to say "not an image"
+        problem = f"unreadable as PNG ({type(exc).__name__}: {exc})"
+    if job is not None:
+        check_frames(*job)                      # raises, listing every problem of the job
+    raise FramesError([f"{path}: {problem}"])

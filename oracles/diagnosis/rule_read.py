@@ -49,22 +49,22 @@ def _costs(cand_images, oracle_segs, camera, p, d, b):
     GL's model at the fitted offset; the rounded ends' model at the best of the positions the fit cannot
     tell apart (:data:`oracles.diagnosis.image_naming._JITTER`: ends on a half pixel round either way).
     """
-    from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
-    from .image_naming import _JITTER, _model_lines, quantisation_bias
+    from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
+    from .model_lines import JITTER, model_lines, quantisation_bias
 
     snapped_bias = quantisation_bias(oracle_segs, camera, p, d, snapped=True)
-    limit = _points_per_frame(len(cand_images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
+    limit = points_per_frame(len(cand_images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
     nearest = None
 
     def cost(lines):
         nonlocal nearest
-        frames = _frames(cand_images, lines, camera, limit, nearest)
+        frames = frame_samples(cand_images, lines, camera, limit, nearest)
         nearest = [f.nearest for f in frames]              # one distance transform per image, reused
-        reg = _Registration(frames, camera.width, camera.height, np.array(camera.principal_point))
+        reg = Registration(frames, camera.width, camera.height, np.array(camera.principal_point))
         return reg.cost(np.eye(2), np.eye(2), np.zeros(2))
 
-    gl = cost(_model_lines(oracle_segs, camera, p, d, b, False))
-    snapped = min(cost(_model_lines(oracle_segs, camera, p, d, b - snapped_bias + step, True)) for step in _JITTER)
+    gl = cost(model_lines(oracle_segs, camera, p, d, b, False))
+    snapped = min(cost(model_lines(oracle_segs, camera, p, d, b - snapped_bias + step, True)) for step in JITTER)
     return snapped_bias, gl, snapped
 
 

@@ -37,8 +37,7 @@ from .cases import Case
 from ..candidates.core_candidate import CoreCandidate, RenderMode
 from ..candidates.draw import depth_margin, draw_candidate, oracle_segments
 from .tolerances import Tolerances
-from ..references.oracle_precision import judge_oracle_precision
-from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
+from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge, judge_oracle_precision
 
 
 #: The note of a case whose camera has lens distortion, run at level pixels.

@@ -132,7 +132,7 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     samples' offsets less their edge's chosen band's (``d`` plus noise where
     the fit holds; what the affine warp is measured on).
     """
-    from .line_style import MIN_SAMPLES, pooled_offset
+    from .line_profile import MIN_SAMPLES, pooled_offset
 
     if len(offset) < MIN_SAMPLES:
         return None

@@ -18,7 +18,7 @@ What stays as it was:
   as without the thread; only when they are computed changes.
 - **The same errors, at the same frame.** What a frame's reading raises
   (a camera file, the oracle, a PNG that cannot be decoded: FramesError,
-  listing every problem of the job as :func:`oracles.judge.frames_judge.read_frame`
+  listing every problem of the job as :func:`oracles.candidates.frames_candidate.read_frame`
   does) is kept with that frame and raised in the judge's thread when the judge
   reaches that step of that frame, so frames before it are judged first and
   the message is the same.
@@ -65,7 +65,7 @@ class FrameAhead:
         return self._value(self._oracle)
 
     def grey(self):
-        """The frame's PNG as grey levels (oracles.judge.frames_judge.read_frame)."""
+        """The frame's PNG as grey levels (oracles.candidates.frames_candidate.read_frame)."""
         return self._value(self._grey)
 
 
@@ -76,8 +76,7 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str, cache: dict) ->
     drawing, the PNG; a step that fails ends the frame's reading (the judge
     raises it before it would need the next).
     """
-    from ..candidates.frames_candidate import frame_inputs
-    from .frames_judge import read_frame
+    from ..candidates.frames_candidate import frame_inputs, read_frame
 
     try:
         inputs = frame_inputs(job_dir, job, c["scene"], c["case"], k, cache)

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from . import f1_radius, metrics
+from ..candidates.frames_candidate import read_frame
 from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
@@ -59,29 +60,6 @@ def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarra
     """
     grey = read_frame(path, width, height, job) if grey is None else grey
     return style.frame_flat(grey, orac, *frame, segs=segs)
-
-
-def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
-    """A frame's grey levels (oracles.candidates.png_frame.read_grey), decoded once, as it is judged.
-
-    The job's frames were checked before the judging began, all but their
-    pixels' decoding (oracles.candidates.frames_candidate.check_frames with
-    ``decode=False``): a frame that cannot be decoded makes the full check run
-    (``job``: ``(job_dir, job)``), so that every problem of the job is listed,
-    as when the check decodes every frame first; FramesError either way.
-    """
-    from ..candidates.frames_candidate import FramesError, check_frames
-    from ..candidates.png_frame import FrameProblem, read_grey
-
-    try:
-        return read_grey(path, width, height)
-    except FrameProblem as exc:
-        problem = str(exc)
-    except Exception as exc:       # noqa: BLE001 - Pillow's many ways to say "not an image"
-        problem = f"unreadable as PNG ({type(exc).__name__}: {exc})"
-    if job is not None:
-        check_frames(*job)                      # raises, listing every problem of the job
-    raise FramesError([f"{path}: {problem}"])
 
 
 def diagnosis_frames(n: int, limit: int = DIAGNOSIS_FRAMES) -> set:

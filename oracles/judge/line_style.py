@@ -75,19 +75,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import coverage_pixels, even_lean, line_ties, line_windows
+from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
 from .case_samples import CaseSamples
-from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
+from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
+from .line_windows import seg_distance
 
 STYLES = ("aliased", "antialiased", "wide")
 LINE_RULES = ("gl", "geometry")
 
-#: Half the window across a line in which its centroid is taken (px): a 3-px line's half width
-#: (1.5) plus an antialiased fringe (1) plus a pixel of slack for a half-pixel offset.
-PROFILE_RADIUS_PX = 3
-#: A sample is dropped when another segment, or its own segment's end, is this close (px):
-#: the window plus half a pixel, so no other line's pixel enters it.
-GUARD_PX = PROFILE_RADIUS_PX + 1.5
 #: A differing pixel this close to a segment end (px) is counted "at the end".
 END_RADIUS_PX = 1.5
 #: Coverage per unit length from which a line is ``wide``: a 1-px aliased line has at most
@@ -102,17 +97,12 @@ LEVEL_SHARE_MIN = 0.002
 #: The line's level: this percentile of the drawn pixels' values (robust to a few bright
 #: crossings of antialiased lines).
 LEVEL_PERCENTILE = 99
-#: A sample's window must hold this much coverage (in units of a fully covered pixel) to be a
-#: sample of the line: half a pixel's worth, so a missing line is no sample (F1 fails on it).
-MIN_MASS = 0.5
 #: Samples a case keeps per frame (evenly thinned above): thousands of samples pin the pooled
 #: offset far below 0.05 px, and the measure costs about the same whatever the mesh.
 MAX_SAMPLES_PER_FRAME = 4000
 #: ... and per case: past it every frame's samples are halved, so a case's memory stays bounded
 #: whatever its number of frames (the offset is a mean over tens of thousands of samples either way).
 MAX_SAMPLES_PER_CASE = 48_000
-#: Fewer samples than this in a case: the geometry is not measured (too little free line).
-MIN_SAMPLES = 20
 #: The geometry is measured only where at least this share of the windows along the oracle's lines
 #: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
 MIN_FOUND_SHARE = 0.5
@@ -224,24 +214,6 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
     return x[:2], x[2:].reshape(2, 2)
 
 
-def pooled_offset(normal: np.ndarray, offset: np.ndarray):
-    """``(d (2,), determined (2,) bool)``: the least-squares ``d`` with ``n . d = offset``.
-
-    A component the normals do not constrain (every line parallel to it, e.g.
-    only horizontal lines say nothing of ``dx``) is 0 and not determined.
-    """
-    if len(offset) < MIN_SAMPLES:
-        return np.zeros(2), np.zeros(2, bool)
-    nn = normal.T @ normal
-    determined = np.diag(nn) >= 0.05 * len(offset)     # >= 5 % of the samples' weight on that axis
-    d = np.zeros(2)
-    idx = np.flatnonzero(determined)
-    if len(idx):
-        sol, *_ = np.linalg.lstsq(normal[:, idx], offset, rcond=None)
-        d[idx] = sol
-    return d, determined
-
-
 def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.ndarray:
     """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width.
 
@@ -267,7 +239,7 @@ def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.nda
             continue
         yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
         q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
-        near = _seg_distance(q, a[None], b[None])[:, 0] <= half
+        near = seg_distance(q, a[None], b[None])[:, 0] <= half
         img[yy.ravel()[near], xx.ravel()[near]] = True
     return img
 
@@ -587,5 +559,3 @@ def summary_lines(cases: list) -> list[str]:
                    f"{f'; F1 at up to {radius} px (the width)' if radius > 1 else ''}; cannot show {CANNOT_SHOW[style]}")
     return out
 
-
-from . import free_ends  # noqa: E402  (it reads this module's constants: imported once they are defined)

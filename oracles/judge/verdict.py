@@ -16,8 +16,9 @@ import numpy as np
 
 from . import metrics
 from ..candidates.candidate import case_precision
-from ..diagnosis.diagnose import diagnose
+from ..diagnosis.diagnose import LINE_FAULTS, diagnose
 from .decide import decide, line_faults, pixel_fields
+from ..references.oracle_precision import ORACLE_LIMIT_PX
 from .tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
 #: Per-frame fields of a wireframe's line comparison (oracles.judge.metrics.line_scores).
@@ -127,3 +128,32 @@ def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | No
     (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.judge.gate).
     """
     decide(rec, tol, error, points)
+
+
+def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:
+    """Record the case's ``oracle_bound_px``; where it exceeds :data:`ORACLE_LIMIT_PX`, judge without pixels.
+
+    ``rec`` was judged by ``judge`` (oracles.judge.verdict.judge). Beyond the limit
+    the pixel comparison says nothing about the candidate: the case is judged
+    again on its vertices alone, and its verdict is ``"fail"`` only for a
+    vertex failure, else ``"vacuous"`` (fails the run, oracles.judge.gate) with an
+    ``oracle_precision`` reason first, naming the bound and the limit.
+    """
+    if bound_px is None:
+        return
+    rec["oracle_bound_px"] = float(bound_px)
+    rec["oracle_limit_px"] = ORACLE_LIMIT_PX
+    if not bound_px > ORACLE_LIMIT_PX or rec.get("verdict") == "vacuous":
+        return          # within the limit; or nothing was compared, which the case already says
+    vertices_only = {k: v for k, v in rec.items() if k != "lines"}
+    vertices_only.update(pixel_f1_0px=None, pixel_f1_1px=None, silhouette_iou=None,
+                         compared=dict(rec["compared"], pixels=None))
+    judge(vertices_only, tol, error, points=points)
+    why = (f"oracle_precision: the pyrender oracle's own error bound {bound_px:.3g} px exceeds "
+           f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged")
+    vertex_reasons = vertices_only["reasons"] if vertices_only["verdict"] == "fail" else []
+    rec["verdict"] = "fail" if vertex_reasons else "vacuous"
+    rec["reasons"] = [why] + vertex_reasons
+    # a line fault is read from the pixels (line counts against the oracle's): those say nothing here
+    rec["faults"] = [f for f in rec.get("faults") or [] if f.get("name") not in LINE_FAULTS]
+    rec["oracle_precision"] = True

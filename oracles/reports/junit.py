@@ -3,7 +3,7 @@
 One ``<testcase classname=SCENE name=CAMERA>`` per case of the report; a case
 that did not pass gets a ``<failure>`` whose ``message`` is its faults and
 reasons on one line and whose text adds what to check for each fault
-(oracles.reports.report.FAULT_HINTS). Characters XML cannot hold are written as
+(oracles.diagnosis.hints.FAULT_HINTS). Characters XML cannot hold are written as
 escapes (:func:`xml_safe`). A case's ``note`` (what was not compared, and
 why) is its testcase's property ``note`` and its ``<system-out>`` (the part
 most dashboards show). The ``time`` attributes are the only fields that
