@@ -67,7 +67,7 @@ class Motion:
         A constant uniform scale.
     pivot : (3,) tuple of float
         The point the scale and turns are about, model units (crosscheck spins
-        a scene about the centre its cameras are framed on, oracles.judge.cases).
+        a scene about the centre its cameras are framed on, oracles.cases).
 
     The model matrix at run fraction ``t`` in [0, 1) is
     ``T(offset) @ Rz @ Ry @ Rx @ S(scale)`` about the origin, and

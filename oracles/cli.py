@@ -13,7 +13,7 @@ each request under ``--candidate-timeout`` seconds, so a candidate that
 exits, hangs or crashes fails its cases (exit 1) and never ends the run.
 ``--candidate-precision float32|float64`` says what it computes in (default:
 the dtype it returns; core: ``--dtype``): a float32 candidate's vertices are
-held to a bound derived from float32 rounding (oracles/judge/tolerances.py).
+held to a bound derived from float32 rounding (oracles/tolerances.py).
 
 ``--level vertices`` runs the OpenCV vertex check only (no drawing, no
 pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
@@ -27,7 +27,7 @@ offset under the lines), ``--cull backface`` (back faces culled, and their
 edges when no front face owns them; checked against the oracle's own
 front-face test and GL culling) and ``--style shaded`` (core's depth buffer
 against pyrender's filled faces: silhouette IoU and depth error within a
-derived bound, oracles/judge/tolerances.py). A scene without faces is then compared
+derived bound, oracles/tolerances.py). A scene without faces is then compared
 as a plain wireframe, or (shaded) checked for its vertices only, with a note.
 They need the core candidate and the pixel level: with ``--candidate``,
 ``--level vertices``, ``--sweep`` or ``--suite``, and ``--hidden-lines`` with
@@ -42,7 +42,7 @@ dataset: one task per mesh, a mesh that cannot be loaded counted and reported
 (it fails the run unless ``--allow-load-errors``), one summary
 (oracles/datasets/dataset_run.py, docs/datasets.md). ``--executor dask`` runs the
 cases or meshes on a Dask cluster: a local one of ``--jobs`` workers, or
-``--scheduler tcp://HOST:PORT``'s (oracles/datasets/executors.py); same report.
+``--scheduler tcp://HOST:PORT``'s (oracles/executors.py); same report.
 
 ``crosscheck export DIR`` writes a rendering job for any renderer, and
 ``--candidate-frames DIR`` judges the renderer's own frames of it
@@ -73,10 +73,11 @@ from wirecheck.core.app.guard import run_cli  # noqa: E402
 from wirecheck.core.limits import check_candidate_timeout
 from wirecheck.core.outputs.output import check_replaceable, check_report_dir
 
-from .judge import gate, tolerances
+from . import tolerances
+from .judge import gate
 from .candidates.isolation import external_candidate
-from .judge.cases import CASE_NAMES
-from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
+from .cases import CASE_NAMES
+from .executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli, trust_line
 from .reports.junit import check_junit_target, write_junit
 from .candidates.core_candidate import CoreCandidate, RenderMode
@@ -85,7 +86,7 @@ from .reports.report_option import check_no_report, report_line
 from .reports.compared import hint_lines, reason_text, what_text
 from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import level_for_oracles, run_crosscheck
-from .judge.tolerances import Tolerances
+from .tolerances import Tolerances
 from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
 
 ORACLES = ("opencv", "pyrender")

@@ -11,10 +11,10 @@ import argparse
 from wirecheck.core.app.cli_help import CROSSCHECK_EXAMPLES, usage_hint
 from wirecheck.core.app.guard import VersionAction
 
-from .judge import tolerances
-from .judge.cases import ALL_CASE_NAMES, CASE_NAMES
+from . import tolerances
+from .cases import ALL_CASE_NAMES, CASE_NAMES
 from .candidates.core_candidate import CoreCandidate, RenderMode
-from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS
+from .executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS
 from .runner import LEVELS
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S
 
@@ -59,7 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--candidate-precision", choices=tolerances.PRECISIONS, default=None,
-                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.judge.tolerances) "
+                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.tolerances) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",

@@ -14,7 +14,7 @@ report is the one the command line writes.
 
 from __future__ import annotations
 
-from .api import _flag, _report_dir, _short, raise_unless_pass
+from .api import checked_flag, checked_report_dir, short_repr, raise_unless_pass
 
 
 def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None, min_f1_0px: float | None = None,
@@ -63,20 +63,21 @@ def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None,
     from wirecheck.core.errors import InputError
     from wirecheck.core.outputs.output import check_replaceable, check_report_dir
 
-    from .judge import gate, tolerances
+    from . import tolerances
+    from .judge import gate
     from .judge.line_style import LINE_RULES
 
     if isinstance(job_dir, bool) or not isinstance(job_dir, (str, os.PathLike)):
-        raise TypeError(f"job_dir {_short(job_dir)}: expected a job folder path (str or Path)")
+        raise TypeError(f"job_dir {short_repr(job_dir)}: expected a job folder path (str or Path)")
     job_dir = Path(job_dir)
-    _flag(allow_vacuous, "allow_vacuous")
+    checked_flag(allow_vacuous, "allow_vacuous")
     if line_rule not in LINE_RULES:
         raise InputError(f"line_rule {line_rule!r}: expected one of {', '.join(LINE_RULES)} (gl: aliased 1-px "
                          "lines held to GL's pixel rule; geometry: where the lines are only)")
     tol = tolerances.Tolerances(min_f1_1px=tolerances.MIN_F1_1PX if min_f1 is None else min_f1,
                                 min_f1_0px=tolerances.MIN_F1_0PX if min_f1_0px is None else min_f1_0px)
     gate.check_tolerances(tol)                  # a NaN floor would pass everything
-    run_dir = _report_dir(report_dir)
+    run_dir = checked_report_dir(report_dir)
     if run_dir is not None:                     # before anything is judged, as crosscheck checks it
         check_report_dir(run_dir, "report_dir")
         check_replaceable(run_dir, "report_dir")

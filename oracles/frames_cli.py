@@ -15,7 +15,7 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 
-from .judge.cases import ALL_CASE_NAMES, CASE_NAMES
+from .cases import ALL_CASE_NAMES, CASE_NAMES
 
 
 class _Parser(argparse.ArgumentParser):
@@ -105,7 +105,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     from .reports.compared import what_text
     from .reports.report import console_table, write_report
     from .reports.report_option import report_line
-    from .judge.tolerances import Tolerances
+    from .tolerances import Tolerances
 
     from .config import CLI_DESTS
 

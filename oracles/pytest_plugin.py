@@ -161,10 +161,10 @@ class Check:
         self._calls += 1
         error, trace = None, True
         try:
-            from .api import _report_dir
+            from .api import checked_report_dir
 
             settings = dict(settings)
-            run_dir = _report_dir(settings.pop("report_dir", None))   # check_projector's: written pass or fail
+            run_dir = checked_report_dir(settings.pop("report_dir", None))   # check_projector's: written pass or fail
             # the table was read at start-up (rootdir or --wirecheck-config): not again from the cwd
             report, images = run_check(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
             if run_dir is not None:

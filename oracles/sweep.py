@@ -2,7 +2,7 @@
 
 The settings are dtype x clip mode x raster mode (2 x 2 x 3 = 12). Each is run
 on the bundled scenes and on a large mesh (an icosphere) under every case
-camera (oracles/judge/cases.py). The oracles' answers do not depend on the setting,
+camera (oracles/cases.py). The oracles' answers do not depend on the setting,
 so each frame's references are computed once and shared:
 
 * OpenCV's ``projectPoints`` of the frame's world points (vertex reference);
@@ -45,7 +45,7 @@ from wirecheck.core.transforms import Motion
 from .references import faces as oface
 from .judge import metrics
 from .references import opencv_oracle
-from .judge.cases import CASE_NAMES, case_motion, cases_for
+from .cases import CASE_NAMES, case_motion, cases_for
 from .reports.report import gl_text
 
 #: The default setting, the one crosscheck gates on.

@@ -132,13 +132,13 @@ def _expected(camera, model, scene: str, case: str, k: int, frames: int, phase: 
     """:func:`oracles.candidates.export.camera_json` of these arguments; for the camera of the last call, that
     call's JSON with the fields of the other arguments (frame, time, model matrix, names) replaced: the rest
     are the camera's alone."""
-    from .export import _rows, camera_json, frame_time
+    from .export import matrix_rows, camera_json, frame_time
 
     if _LAST.get("camera") is not camera:
         _LAST.update(camera=camera, json=camera_json(camera, model, scene, case, k, frames, phase))
         return _LAST["json"]
     return {**_LAST["json"], "scene": scene, "case": case, "frame": k, "t": frame_time(k, frames, phase),
-            "model_matrix": _rows(model)}
+            "model_matrix": matrix_rows(model)}
 
 
 def _differs(where: str, value, expected) -> str | None:

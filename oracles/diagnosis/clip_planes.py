@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..judge.tolerances import EPS
+from ..tolerances import EPS
 
 __all__ = ["probe_planes", "clip_fault", "depth_slack", "FLOAT32_PLANE_ROUNDINGS", "PLANE_REL_TOL"]
 

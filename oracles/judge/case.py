@@ -9,7 +9,7 @@ Frame ``k`` (1-based, at ``t = (k - 1) / frames``) goes through two stages:
    given no edges, so nothing is drawn), any other candidate called on the
    world points (oracles.candidates.candidate); :func:`vertex_stage` scores them and keeps
    the case's scale for the precision-derived vertex bound
-   (oracles.judge.tolerances.vertex_scale);
+   (oracles.tolerances.vertex_scale);
 2. **pixel stage** (level ``pixels``): the candidate's frame (core's full
    pipeline, or oracles.candidates.draw for another candidate) against pyrender's
    rendering of the same edges, faces or shading (:func:`pixel_stage`).
@@ -29,14 +29,15 @@ from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
 from ..references import faces as oface
-from . import metrics, tolerances
+from . import metrics
+from .. import tolerances
 from ..references import opencv_oracle
 from ..candidates.candidate import CandidateError, call_candidate_precision, case_precision
 from ..references.convert import opencv_matrices
-from .cases import Case
+from ..cases import Case
 from ..candidates.core_candidate import CoreCandidate, RenderMode
 from ..candidates.draw import depth_margin, draw_candidate, oracle_segments
-from .tolerances import Tolerances
+from ..tolerances import Tolerances
 from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge, judge_oracle_precision
 
 
@@ -155,7 +156,7 @@ class TimedCalls:
 
 
 class ScaleBatch:
-    """Frames waiting for :func:`oracles.judge.tolerances.vertex_scale`, measured together.
+    """Frames waiting for :func:`oracles.tolerances.vertex_scale`, measured together.
 
     A frame's scale is the largest of its points' (elementwise), so the
     largest over several frames is the scale of their points together: one

@@ -203,7 +203,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     fails the run unless ``allow_vacuous`` (as :mod:`oracles.judge.gate`).
     """
     from ..candidates.frames_candidate import check_frames, load_job
-    from .tolerances import Tolerances
+    from ..tolerances import Tolerances
 
     tol = tol or Tolerances()
     t0 = time.perf_counter()

@@ -262,8 +262,8 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
 
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
-    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.judge.tolerances)."""
-    from . import tolerances
+    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances)."""
+    from .. import tolerances
     from ..references.pyrender_oracle import depth_step
 
     depth = np.asarray(depth, np.float64)
@@ -476,25 +476,3 @@ def line_summary(frames: list) -> dict:
     return out
 
 
-def line_failures(lines: dict, tol) -> list[str]:
-    """Why a case's pooled line fields (:func:`line_summary`) fail ``tol`` (oracles.judge.tolerances); [] if they pass.
-
-    The balance fails when the sign test rejects symmetry (p < ``tol.balance_alpha``)
-    *and* the net imbalance is more than ``tol.max_imbalance`` of the oracle's
-    pixels, both over the decided one-sided pixels (sub-pixel ties left out,
-    :func:`balance_scores`); the counts fail when some edge in some frame has more than
-    ``tol.max_edge_count_diff`` pixels more or fewer than the oracle's.
-    """
-    out = []
-    frac, p = lines["imbalance_fraction"], lines["balance_p_value"]
-    if p < tol.balance_alpha and abs(frac) > tol.max_imbalance:
-        tc, to = lines["subpixel_ties"]
-        ties = f" (and {tc} + {to} sub-pixel ties, left out)" if tc + to else ""
-        out.append(f"one-sided pixels unbalanced: {lines['candidate_only'] - tc} candidate-only vs "
-                   f"{lines['oracle_only'] - to} oracle-only{ties}, net {frac:+.3%} of the oracle's pixels "
-                   f"(> {tol.max_imbalance:.3%}; sign test p = {p:.2g} < {tol.balance_alpha:g})")
-    if lines["edge_count_max_diff"] > tol.max_edge_count_diff:
-        w = lines["edge_count_worst"]
-        out.append(f"edge {w['edge']} has {w['diff']:+d} pixels against the oracle's count "
-                   f"(allowed +-{tol.max_edge_count_diff}; frame {w['frame']})")
-    return out

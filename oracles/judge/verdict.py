@@ -2,9 +2,9 @@
 
 The verdict is decided by oracles.judge.decide, the one judge of every path (a
 projector's, core's, a renderer's frames). A case fails for every limit of
-oracles.judge.tolerances it misses, each named in a reason: the vertex error, points visible to one side only, the pixel F1 at 1
+oracles.tolerances it misses, each named in a reason: the vertex error, points visible to one side only, the pixel F1 at 1
 and 0 px, the one-sided pixel balance and the per-edge pixel counts of the
-lines (oracles.judge.metrics.line_failures); shaded: regions covered by one side inside the other's silhouette,
+lines (oracles.tolerances.line_failures); shaded: regions covered by one side inside the other's silhouette,
 the silhouette IoU, faces that differ away from their boundaries, the depth
 error beyond its bound. A candidate that fails the contract (oracles.candidates.candidate)
 fails the case with that error.
@@ -19,7 +19,7 @@ from ..candidates.candidate import case_precision
 from ..diagnosis.diagnose import LINE_FAULTS, diagnose
 from .decide import decide, line_faults, pixel_fields
 from ..references.oracle_precision import ORACLE_LIMIT_PX
-from .tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
+from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
 #: Per-frame fields of a wireframe's line comparison (oracles.judge.metrics.line_scores).
 LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
@@ -38,7 +38,7 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
     summary, and a note when there was nothing to compare. ``precision``
     says what the candidate was judged as (declared, or as it returned; core:
     its ``--dtype``) and ``vertex_bound_px`` the bound its vertices were held
-    to (oracles.judge.tolerances.vertex_bound).
+    to (oracles.tolerances.vertex_bound).
     """
     done = len(acc.cand_px)
     rec = {"scene": setup.scene.name, "camera": setup.case.name, "camera_spec": setup.cam.to_dict(),

@@ -53,7 +53,7 @@ plane's; only an edge that GL really clips there divides by ``near``.
 The case's bound is the largest over its frames (the record's
 ``oracle_bound_px``). The line gate's tie zone assumes the oracle's window
 coordinates within ``2^-9`` px of exact (the float32 share of
-oracles.judge.tolerances.TIE_END_PX); a case whose bound exceeds
+oracles.tolerances.TIE_END_PX); a case whose bound exceeds
 :data:`ORACLE_LIMIT_PX` asks for more than the oracle can give, and its
 pixels are not judged: :func:`oracles.judge.verdict.judge_oracle_precision` makes it an
 ``oracle_precision`` case that fails the run without blaming the candidate.
@@ -82,7 +82,7 @@ CLIP_W_ROUNDINGS = 7
 VIEWPORT_ROUNDINGS = 2
 
 #: The oracle's window coordinates must be within this of exact: the float32 share (2^-9 px) of
-#: oracles.judge.tolerances.TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle.
+#: oracles.tolerances.TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle.
 ORACLE_LIMIT_PX = 2.0 ** -9
 
 

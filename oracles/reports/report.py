@@ -277,7 +277,7 @@ def timing_line(report: dict) -> str:
 
 
 def precision_text(report: dict) -> str:
-    """"float32 (returned); vertex bound 1.15e-03 to 2.70e-03 px": what the candidate was judged as (oracles.judge.tolerances)."""
+    """"float32 (returned); vertex bound 1.15e-03 to 2.70e-03 px": what the candidate was judged as (oracles.tolerances)."""
     cases = [c for c in report["cases"] if c.get("precision")]
     if not cases:
         return ""
@@ -330,7 +330,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            f"Drawing: {drawing_text(report)}.", "",
            *([f"Oracle GL: {gl_text(report)}.", ""] if gl_text(report) else []),
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
-           *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.judge.tolerances).", ""]
+           *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.tolerances).", ""]
              if precision_text(report) else []),
            *[x for line in _line_styles(report) for x in (line + ".", "")],
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -450,14 +450,14 @@ def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = 
     return "\n".join(parts)
 
 
-def _finite_or_null(obj):
+def finite_or_null(obj):
     """JSON has no inf or NaN: such values (a candidate's overflow) become null."""
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
     if isinstance(obj, dict):
-        return {k: _finite_or_null(v) for k, v in obj.items()}
+        return {k: finite_or_null(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_finite_or_null(v) for v in obj]
+        return [finite_or_null(v) for v in obj]
     return obj
 
 
@@ -492,7 +492,7 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
             crop, window = crop_image(im["candidate"], im["oracle"])
             out.write(f"img/{stem}-crop.png", png_bytes(crop))
             shown.append((case, stem, crop_caption(window)))
-        report = _finite_or_null(report)
+        report = finite_or_null(report)
         files = set()
         if images.get("animation"):
             out.write("worst.gif", plots.worst_gif(images["animation"]))
