@@ -281,19 +281,19 @@ class Camera:
             p[2, 2], p[2, 3], p[3, 3] = -2.0 / (f - n), -(f + n) / (f - n), 1.0
         return p
 
-    def _replace_lens(self, **changes) -> "Camera":
+    def _replace_lens(self, **changes) -> Camera:
         """``dataclasses.replace`` keeping the pose's vectors to the bit (re-normalising may move an ulp)."""
         cam = replace(self, **changes)
         for name in ("position", "forward", "up", "right"):
             object.__setattr__(cam, name, getattr(self, name))
         return cam
 
-    def with_intrinsics(self, fx: float, fy: float, cx: float | None = None, cy: float | None = None) -> "Camera":
+    def with_intrinsics(self, fx: float, fy: float, cx: float | None = None, cy: float | None = None) -> Camera:
         """This camera (same pose, to the bit) with calibrated intrinsics (``cx, cy`` default: centred)."""
         c0x, c0y = principal_point(self.width, self.height)
         return self._replace_lens(intrinsics=(fx, fy, c0x if cx is None else cx, c0y if cy is None else cy))
 
-    def with_K(self, K) -> "Camera":  # noqa: N802
+    def with_K(self, K) -> Camera:  # noqa: N802
         """This camera with the intrinsics of a ``(3, 3)`` K: no skew, last row ``0 0 1``."""
         k = _numbers("K", K, (3, 3))
         if k[1] != 0 or k[3] != 0 or (k[6], k[7], k[8]) != (0.0, 0.0, 1.0):
@@ -301,7 +301,7 @@ class Camera:
                              "[[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (no skew)")
         return self.with_intrinsics(k[0], k[4], k[2], k[5])
 
-    def with_distortion(self, coefficients) -> "Camera":
+    def with_distortion(self, coefficients) -> Camera:
         """This camera (same pose, to the bit) with OpenCV distortion coefficients (``None``: none)."""
         return self._replace_lens(distortion=coefficients)
 

@@ -288,10 +288,11 @@ def _seconds(timeout_s) -> float:
         raise TypeError(f"timeout_s {short_repr(timeout_s)}: expected a number of seconds > 0")
     from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 
-    if not (math.isfinite(timeout_s) and 0 < timeout_s <= MAX_CANDIDATE_TIMEOUT_S):
+    seconds = float(timeout_s)
+    if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
         raise ValueError(f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0 and at most "
                          f"{MAX_CANDIDATE_TIMEOUT_S:g} (one day)")
-    return float(timeout_s)
+    return seconds
 
 
 def _oracles(oracles) -> tuple:

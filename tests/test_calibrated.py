@@ -10,14 +10,13 @@ off_centre, non_square_pixels (pyrender's IntrinsicsCamera) and distorted
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
 
 from wirecheck.core.projector import clipping
 from wirecheck.core.app import trace
-from wirecheck.core.camera import Camera, camera_z, look_at
+from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.conventions import focal_px
 from wirecheck.core.projector.distortion import distort
 from wirecheck.core.errors import InputError

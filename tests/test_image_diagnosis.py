@@ -26,7 +26,7 @@ from test_diagnosis import format_confusion
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector.projection import project_points
-from wirecheck.core.projector.raster import line_coverage_aa, line_pixels
+from wirecheck.core.projector.raster import line_coverage_aa
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.diagnosis.diagnose import FAULT_ORDER, LINE_FAULTS, VERTEX_ONLY_FAULTS, primary

@@ -22,7 +22,7 @@ from wirecheck.oracles.candidates import protocol
 from wirecheck.oracles import tolerances
 from wirecheck.oracles.api import check_projector, failure_text
 from wirecheck.oracles.candidates.candidate import case_precision, returned_precision
-from wirecheck.oracles.tolerances import EPS, VERTEX_ROUNDINGS, Tolerances, vertex_bound, vertex_scale
+from wirecheck.oracles.tolerances import VERTEX_ROUNDINGS, Tolerances, vertex_bound, vertex_scale
 
 DATA = Path(__file__).parent / "data" / "candidates"
 sys.path.insert(0, str(DATA))

@@ -64,11 +64,11 @@ def parse_body(raw: bytes) -> tuple[list, bool]:
     try:
         body = json.loads(raw.decode("utf-8") or "{}", parse_constant=_reject_constant, parse_float=_finite_float)
     except UnicodeDecodeError as exc:
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: not UTF-8 ({exc.reason} at byte {exc.start})")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: not UTF-8 ({exc.reason} at byte {exc.start})") from exc
     except RecursionError:
-        raise RequestError(HTTPStatus.BAD_REQUEST, "request body: JSON nested too deeply")
+        raise RequestError(HTTPStatus.BAD_REQUEST, "request body: JSON nested too deeply") from None
     except ValueError as exc:                          # JSONDecodeError, our constants, int digit limit
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: {exc}")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: {exc}") from exc
     if not isinstance(body, dict):
         raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: a JSON {type(body).__name__}; "
                                                    'expected an object {"ops": [...], "overlay": bool}')
@@ -221,7 +221,7 @@ class Server:
         host, port = self.httpd.server_address[:2]
         return f"http://{host}:{port}/"
 
-    def start(self) -> "Server":
+    def start(self) -> Server:
         self.thread.start()
         return self
 

@@ -56,7 +56,7 @@ def serve(spec: str, stdin, stdout) -> int:
     try:
         from wirecheck.core.errors import InputError
 
-        from .candidate import CandidateError, call_candidate, load_candidate
+        from .candidate import load_candidate
 
         func = load_candidate(spec)
     except InputError as exc:

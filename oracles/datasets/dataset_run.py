@@ -32,7 +32,7 @@ from pathlib import Path
 from wirecheck.core.errors import InputError, one_line
 
 from ..judge import gate
-from ..candidates.core_candidate import CoreCandidate, RenderMode
+from ..candidates.core_candidate import RenderMode
 from .dataset import Dataset, MeshEntry
 from ..executors import ExecutorSpec, gather_in_order, open_executor
 from ..runner import LEVEL_ORACLES, LEVELS, CaseRunner, overall_ms, RunParams, WORKER_LOCK, worker_init, scene_cases, worker_runner, worst_key

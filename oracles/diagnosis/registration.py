@@ -233,7 +233,9 @@ class Registration:
         if len(self._cand):                                # candidate pixels -> nearest oracle line point
             foot, tangent = self._forward((self._cand - b) @ back.T)
             u = foot @ p.T
-            us.append(u); cs.append(self._cand); ts.append(tangent @ p.T)
+            us.append(u)
+            cs.append(self._cand)
+            ts.append(tangent @ p.T)
             dists.append(np.hypot(*(u @ a.T + b - self._cand).T))
         n_fwd = len(self._cand)
         n_rev = 0

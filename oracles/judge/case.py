@@ -57,7 +57,7 @@ class KeptImage:
     bits: np.ndarray | None = None
 
     @classmethod
-    def of(cls, image: np.ndarray, flat: np.ndarray | None = None) -> "KeptImage":
+    def of(cls, image: np.ndarray, flat: np.ndarray | None = None) -> KeptImage:
         """``image`` kept: as ``flat`` (its drawn pixels' ascending flat indices) when given, else packed."""
         if flat is not None:
             return cls(image.shape, flat=flat)
@@ -193,7 +193,7 @@ class CaseFrames:
     returned: set = field(default_factory=set)          # the precisions of the candidate's answers
     depth_ties: int = 0                                 # points left out by forgive_depth_ties
     scale: float = 0.0                                  # largest tolerances.vertex_scale over the frames
-    scales: "ScaleBatch" = field(default_factory=lambda: ScaleBatch())   # frames waiting for vertex_scale
+    scales: ScaleBatch = field(default_factory=lambda: ScaleBatch())   # frames waiting for vertex_scale
     oracle_px: list = field(default_factory=list)
     frame_errors: list = field(default_factory=list)    # (max error px, frame, worst vertex)
     per_frame: list = field(default_factory=list)       # the record's per_frame items

@@ -41,7 +41,7 @@ class FramePixels:
         self._only = None
 
     @classmethod
-    def from_indices(cls, shape: tuple, cand_idx: np.ndarray, oracle_idx: np.ndarray) -> "FramePixels":
+    def from_indices(cls, shape: tuple, cand_idx: np.ndarray, oracle_idx: np.ndarray) -> FramePixels:
         """The frame whose images draw the ascending flat indices ``cand_idx`` and ``oracle_idx`` (``(H, W)`` ``shape``)."""
         fp = cls.__new__(cls)
         fp.shape = tuple(shape)

@@ -155,7 +155,7 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
 
 
-def _compared(segs: "_Segments", drawn: "_Pixels") -> np.ndarray:
+def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
     """``(S,)`` bool: whether each segment owns a drawn pixel (the pixel at its midpoint, or another near it)."""
     w, h = segs.width, segs.height
     mid = np.floor((segs.q0 + segs.q1) / 2 + 0.5).astype(np.int64)
@@ -176,7 +176,7 @@ def _compared(segs: "_Segments", drawn: "_Pixels") -> np.ndarray:
     return compared
 
 
-def _counts_near(segs: "_Segments", cand: "_Pixels", orac: "_Pixels", near: "_Pixels", every: bool = False):
+def _counts_near(segs: _Segments, cand: _Pixels, orac: _Pixels, near: _Pixels, every: bool = False):
     """``(cc, oc)``, ``(S,)`` each: every segment's count in the candidate's and the oracle's image, over
     the drawn pixels ``near`` only (right for the segments all of whose pixels are among them);
     ``every``: ``near`` is every drawn pixel (paired row by row)."""
@@ -243,7 +243,7 @@ class _Pixels:
         self.stacked, self.width, self.height, self.counts = stacked, width, height, counts
 
     @classmethod
-    def of_frames(cls, per_frame, width: int, height: int) -> "_Pixels":
+    def of_frames(cls, per_frame, width: int, height: int) -> _Pixels:
         """From one ascending flat-index array per frame."""
         per_frame = [np.asarray(p, np.int64).reshape(-1) for p in per_frame]
         counts = np.array([len(p) for p in per_frame], np.int64)
@@ -270,7 +270,7 @@ class _Pixels:
         at = np.minimum(np.searchsorted(self.stacked, stacked), len(self.stacked) - 1)
         return self.stacked[at] == stacked
 
-    def subset(self, pos: np.ndarray) -> "_Pixels":
+    def subset(self, pos: np.ndarray) -> _Pixels:
         """The pixels at ascending positions ``pos``."""
         return _Pixels(self.stacked[pos], self.width, self.height)
 
