@@ -227,7 +227,7 @@ def test_implied_fov_of_horizontal_fov(results, camera_name):
 
 
 def test_scale_hints_only_for_their_ratios(results):
-    """A 0.8 FOV factor is no W/H: the generic hint (report.FAULT_HINTS) stays."""
+    """A 0.8 FOV factor is no W/H: the generic hint (hints.FAULT_HINTS) stays."""
     (fov,) = results[("fov", "axis")]
     assert "hint" not in fov
 

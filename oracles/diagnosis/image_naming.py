@@ -1,6 +1,6 @@
 """Naming a registered picture: from the fitted ``c = d (P o) + b`` to faults (oracles.diagnosis.image_diagnose).
 
-The registration (:mod:`oracles.diagnosis.image_diagnose`) fits every signed axis
+The registration (:mod:`oracles.diagnosis.registration`, driven by oracles.diagnosis.image_diagnose) fits every signed axis
 permutation ``P`` with per-axis scales ``d`` and an offset ``b``; this module
 reads the faults off the winner, and says what the images cannot decide:
 

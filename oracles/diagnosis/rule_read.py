@@ -47,7 +47,7 @@ def _costs(cand_images, oracle_segs, camera, p, d, b):
     """``(snapped bias, GL model's cost, snapped model's cost)`` of the candidate's pixels.
 
     GL's model at the fitted offset; the rounded ends' model at the best of the positions the fit cannot
-    tell apart (:data:`oracles.diagnosis.image_naming._JITTER`: ends on a half pixel round either way).
+    tell apart (:data:`oracles.diagnosis.model_lines.JITTER`: ends on a half pixel round either way).
     """
     from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
     from .model_lines import JITTER, model_lines, quantisation_bias
@@ -72,7 +72,7 @@ def read_rules(cand_images, oracle_segs, camera, p, d, b, gl_bias) -> dict:
     """``{rule: its offset bias}`` for each aliased rule the candidate's pixels may follow, closest first.
 
     ``p, d, b``: the fitted model (signed permutation, per-axis scales, offset); ``gl_bias``: GL's
-    bias for it (:func:`oracles.diagnosis.image_naming.quantisation_bias`). The closer rule is the one
+    bias for it (:func:`oracles.diagnosis.model_lines.quantisation_bias`). The closer rule is the one
     whose model the pixels fit closer (:func:`_costs`), as :func:`oracles.diagnosis.image_naming.rule_bias`
     reads it; the other is read too when its cost is within :data:`RULE_TIE` of the closer one's.
     """

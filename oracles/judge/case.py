@@ -50,7 +50,7 @@ PIXELS_NOT_COMPARED = ("lens distortion: pixels not compared (GL draws straight 
 @dataclass(frozen=True)
 class KeptImage:
     """A bool image kept for worst.gif: its drawn pixels' flat indices (a wireframe: ~1 % of the
-    image, already found by metrics.FramePixels), or its bits packed (a filled silhouette)."""
+    image, already found by frame_pixels.FramePixels), or its bits packed (a filled silhouette)."""
 
     shape: tuple
     flat: np.ndarray | None = None
@@ -398,7 +398,7 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
     """
     p_world, matrices, pr_vertices, pr_pose = geometry
     mode, cam, scene = setup.mode, setup.cam, setup.scene
-    fp = None                                       # the wireframe's drawn pixels (metrics.FramePixels)
+    fp = None                                       # the wireframe's drawn pixels (frame_pixels.FramePixels)
     mirrored = (oface.mirrored_vertices(scene, matrices) if setup.use_faces and mode.cull == "backface"
                 else None)
     if mode.shaded:

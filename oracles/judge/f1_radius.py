@@ -49,7 +49,7 @@ def radius_px(read: dict) -> int:
 
 
 def frame_scores(fp, scores: dict) -> dict:
-    """``{radius: F1}`` of one frame for each of :data:`RADII` (``fp``: its oracles.judge.metrics.FramePixels,
+    """``{radius: F1}`` of one frame for each of :data:`RADII` (``fp``: its oracles.judge.frame_pixels.FramePixels,
     ``scores``: its oracles.judge.metrics.pixel_scores at 0 and 1 px)."""
     from .metrics import pixel_scores
 

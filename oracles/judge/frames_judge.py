@@ -37,7 +37,7 @@ from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reaso
 from .dim_lines import name_dim_lines
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
-#: The diagnosis samples at most 3,600 points a case (image_diagnose.MAX_POINTS_PER_CASE),
+#: The diagnosis samples at most 3,600 points a case (oracles.diagnosis.registration.MAX_POINTS_PER_CASE),
 #: 150 a frame at 24 frames: more frames would add few points each and cost memory.
 DIAGNOSIS_FRAMES = 24
 

@@ -37,7 +37,7 @@ sample's offset. Pooled over every sample of a case's frames:
 For binary styles the same measure on a correct drawing of the same lines (core's GL-like raster
 for aliased lines; pixel centres within half the width for wide ones) is subtracted: lines at one
 fractional position (a cube square-on) sit up to half a pixel off in every correct drawing, as in
-:func:`oracles.diagnosis.image_diagnose.quantisation_bias`; at an exact tie (a band edge on a pixel
+:func:`oracles.diagnosis.model_lines.quantisation_bias`; at an exact tie (a band edge on a pixel
 centre) either choice reads 0 (:func:`oracles.judge.line_ties.fold_ties`). Lines that the registration
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
 the windows, are not measured (the centroids would be of stray crossings). Binary lines of an even
@@ -246,7 +246,7 @@ def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.nda
 
 def _off_by_one(fp, ends: np.ndarray) -> dict:
     """Pixels where the candidate and the oracle differ (``fp``: the frame's
-    oracles.judge.metrics.FramePixels), counted by where they are (module docstring)."""
+    oracles.judge.frame_pixels.FramePixels), counted by where they are (module docstring)."""
     h, w = fp.shape
     c_only, o_only = fp.only()
     flat = np.concatenate([c_only, o_only])
@@ -354,7 +354,7 @@ class CaseStyle:
 
     def count_rule(self, fp, segs: np.ndarray) -> None:
         """Count one frame's differing pixels by where they lie (the raster rule's shares; :func:`_off_by_one`):
-        ``fp`` the frame's oracles.judge.metrics.FramePixels of the pixels :meth:`frame` returned and pyrender's."""
+        ``fp`` the frame's oracles.judge.frame_pixels.FramePixels of the pixels :meth:`frame` returned and pyrender's."""
         counts = _off_by_one(fp, np.asarray(segs, dtype=np.float64).reshape(-1, 2))
         self.raster = {k: v + counts[k] for k, v in self.raster.items()}
 

@@ -122,7 +122,7 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     ----------
     frames : sequence of (p0_px (E, 2), p1_px (E, 2), pixels)
         Each frame's segments and its two images' drawn pixels
-        (oracles.judge.metrics.FramePixels: ``cand_idx``, ``oracle_idx``, ``drawn()``, ``only()``).
+        (oracles.judge.frame_pixels.FramePixels: ``cand_idx``, ``oracle_idx``, ``drawn()``, ``only()``).
 
     Returns
     -------
