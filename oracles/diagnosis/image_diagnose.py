@@ -76,6 +76,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..candidates import draw
 from .image_naming import name_faults, restart_scales, rotation_deg, rule_off_diagonal
 from .model_lines import quantisation_bias
 from .image_visibility import in_place, visibility_fault
@@ -113,23 +114,15 @@ OFFSET_TOL_PX = 0.2
 # ---------------------------------------------------------------- the oracle's lines
 
 def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera) -> np.ndarray:
-    """The lines a correct renderer draws: ``(K, 2, 2)`` pixel segment ends.
+    """The lines a correct renderer draws: ``(K, 2, 2)`` pixel segment ends, of the edges with a part in depth.
 
-    Edges clipped to depth [near, far] in world space (:func:`oracles.candidates.draw.clip_depth`)
-    and projected by OpenCV (:func:`oracles.references.opencv_oracle.project`); not clipped
-    to the image.
+    :func:`oracles.candidates.draw.oracle_segments` (each edge clipped to depth [near, far] in world space,
+    projected by OpenCV; not clipped to the image) in the fit's shape: the two ends stacked, the edges
+    it leaves NaN (nothing in depth) dropped.
     """
-    from ..references import opencv_oracle
-    from ..candidates.draw import clip_depth
-
     edges = np.asarray(edges, dtype=np.intp).reshape(-1, 2)
-    if len(edges) == 0:
-        return np.zeros((0, 2, 2))
-    p_world = np.asarray(p_world, dtype=np.float64)
-    _, ends = clip_depth(p_world[edges[:, 0]], p_world[edges[:, 1]], camera)
-    if len(ends) == 0:
-        return np.zeros((0, 2, 2))
-    px = opencv_oracle.project(ends.reshape(-1, 3), camera).reshape(-1, 2, 2)
+    p0, p1 = draw.oracle_segments(np.asarray(p_world, dtype=np.float64), edges, camera)
+    px = np.stack([p0, p1], axis=1)
     return px[np.isfinite(px).all(axis=(1, 2))]
 
 

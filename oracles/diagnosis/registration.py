@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..segment_geometry import nearest_on_segments
+
 __all__ = ["PERMUTATIONS", "Registration", "frame_samples", "points_per_frame", "register", "segments_in_image"]
 
 
@@ -75,28 +77,6 @@ PERMUTATIONS = {
     ("axis_swap", "mirror_vertical"): _perm(True, 1, -1),
     ("axis_swap", "axis_flip"): _perm(True, -1, -1),
 }
-
-
-def _nearest_on_segments(q: np.ndarray, a: np.ndarray, b: np.ndarray):
-    """For points ``q (N, 2)``: the nearest point on segments ``a -> b (K, 2)``, its distance and segment."""
-    out = np.empty_like(q)
-    dist = np.empty(len(q))
-    which = np.empty(len(q), dtype=np.intp)
-    ab = b - a
-    len2 = np.maximum(ab[:, 0] * ab[:, 0] + ab[:, 1] * ab[:, 1], 1e-300)
-    step = max(1, 2_000_000 // max(len(a), 1))
-    for k in range(0, len(q), step):
-        qx, qy = q[k:k + step, 0:1], q[k:k + step, 1:2]          # (n, 1): against every segment at once
-        t = np.clip(((qx - a[:, 0]) * ab[:, 0] + (qy - a[:, 1]) * ab[:, 1]) / len2, 0.0, 1.0)
-        fx, fy = a[:, 0] + t * ab[:, 0], a[:, 1] + t * ab[:, 1]
-        dx, dy = fx - qx, fy - qy
-        d2 = dx * dx + dy * dy
-        j = np.argmin(d2, axis=1)
-        rows = np.arange(len(qx))
-        out[k:k + step, 0], out[k:k + step, 1] = fx[rows, j], fy[rows, j]
-        dist[k:k + step] = np.sqrt(d2[rows, j])
-        which[k:k + step] = j
-    return out, dist, which
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -193,7 +173,7 @@ class Registration:
         if not self._stacked:
             feet, tangents, start = [], [], 0
             for f in self._fwd_frames:
-                foot, _, j = _nearest_on_segments(q[start:start + len(f.cand)], f.seg_a, f.seg_b)
+                foot, _, j = nearest_on_segments(q[start:start + len(f.cand)], f.seg_a, f.seg_b)
                 feet.append(foot)
                 tangents.append(f.seg_tangents[j])
                 start += len(f.cand)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .line_profile import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX
-from .line_windows import seg_distance
+from ..segment_geometry import seg_distance
 
 #: A segment end is measured when no other segment comes this close to it (px): the profile along the
 #: line (4 px past the end) stays clear of every other line's window.

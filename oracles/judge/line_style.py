@@ -78,7 +78,7 @@ import numpy as np
 from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
 from .case_samples import CaseSamples
 from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
-from .line_windows import seg_distance
+from ..segment_geometry import seg_distance
 
 STYLES = ("aliased", "antialiased", "wide")
 LINE_RULES = ("gl", "geometry")

@@ -33,27 +33,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..segment_geometry import clip_to_box
+
 _EMPTY = np.zeros(0, dtype=np.int64)
 
 #: :func:`frames_count_differences` counts every drawn pixel at once when the frames hold more than
 #: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
 #: looking at midpoints and one-sided pixels first would pair most pixels several times over).
 DENSE = 8
-
-
-def clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-    """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
-    d = p1 - p0
-    # the four boundaries at once: p t <= q for (x >= lo_x, y >= lo_y, x <= hi_x, y <= hi_y)
-    p = np.concatenate([-d, d], axis=1)
-    q = np.concatenate([p0 - lo, hi - p0], axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = q / p
-        keep = np.isfinite(p0 + p1).all(axis=1) & ~((p == 0) & (q < 0)).any(axis=1)
-        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))     # entering: the last boundary
-        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))      # leaving: the first
-    keep &= t0 <= t1
-    return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d
 
 
 def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
@@ -291,7 +278,7 @@ class _Segments:
         edge = np.arange(int(self.counts.sum())) - np.repeat(np.cumsum(self.counts) - self.counts, self.counts)
         p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
         p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
-        keep, q0, q1 = clip_segments(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
+        keep, q0, q1 = clip_to_box(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
         self.q0, self.q1 = q0[keep], q1[keep]
         self.frame, self.edge = frame[keep], edge[keep]
         self.d = self.q1 - self.q0
@@ -457,7 +444,7 @@ def _from_segments(p0_px, p1_px, width: int, height: int, radius: float):
     p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
     p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
     pad = radius + 1.0
-    keep, q0, q1 = clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
+    keep, q0, q1 = clip_to_box(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
     if not keep.any():
         return _EMPTY, _EMPTY, _EMPTY
     q0, q1 = q0[keep], q1[keep]
