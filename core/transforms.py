@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from .limits import check_turns
 
 
 def rotate_x(theta: float) -> np.ndarray:
@@ -81,8 +82,6 @@ class Motion:
     pivot: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        from .limits import check_turns
-
         check_turns(self.turns, "Motion turns")
 
     def model_matrix(self, t: float) -> np.ndarray:

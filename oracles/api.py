@@ -33,6 +33,10 @@ from .reports.report import compared_text, fault_text, not_passed
 from .runner import run_crosscheck
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
 from .tolerances import Tolerances
+from .reports.report import write_report
+from wirecheck.core.errors import InputError
+from .references.pyrender_oracle import GLUnavailable, gl_available
+from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 
 
 #: check_projector's settings when neither the call nor ``[tool.wirecheck]`` gives them: vertices
@@ -144,8 +148,6 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
                                allow_vacuous, cmd=cmd, timeout_s=timeout_s, isolate=isolate, precision=precision,
                                config=config)
     if run_dir is not None:
-        from .reports.report import write_report
-
         write_report(run_dir, report, images)
     return report
 
@@ -155,8 +157,6 @@ def checked_report_dir(report_dir):
     ValueError (InputError) for a path that is a file."""
     import os
     from pathlib import Path
-
-    from wirecheck.core.errors import InputError
 
     if report_dir is None:
         return None
@@ -197,8 +197,6 @@ def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol
     with caller_state_kept(), closing_started():    # the caller's globals as they were; no process left
         name, func = api_candidate(func, cmd, timeout_s, isolate)
         if "pyrender" in oracles:
-            from .references.pyrender_oracle import GLUnavailable, gl_available
-
             ok, message = gl_available()
             if not ok:
                 raise GLUnavailable(message)
@@ -286,8 +284,6 @@ def _seconds(timeout_s) -> float:
 
     if isinstance(timeout_s, bool) or not isinstance(timeout_s, numbers.Real):
         raise TypeError(f"timeout_s {short_repr(timeout_s)}: expected a number of seconds > 0")
-    from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
-
     seconds = float(timeout_s)
     if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
         raise ValueError(f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0 and at most "
@@ -307,8 +303,6 @@ def _oracles(oracles) -> tuple:
 
 def _precision(precision):
     """``precision`` checked: None, "float32" or "float64"; InputError (a ValueError) otherwise."""
-    from wirecheck.core.errors import InputError
-
     if precision is not None and precision not in tolerances.PRECISIONS:
         raise InputError(f"precision {precision!r}: expected one of {', '.join(tolerances.PRECISIONS)} "
                          "(or None: inferred from the dtype the projector returns)")

@@ -35,6 +35,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
+from .tolerances import PRECISIONS
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -173,14 +175,10 @@ def validate(table: dict, path: Path) -> dict:
                 raise bad(key, value)
             out[key] = value
         elif key == "candidate-timeout":
-            from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
-
             if not (number(value) and 0 < value <= MAX_CANDIDATE_TIMEOUT_S):
                 raise bad(key, value)
             out[key] = float(value)
         elif key == "candidate-precision":
-            from .tolerances import PRECISIONS
-
             if value not in PRECISIONS:
                 raise bad(key, value)
             out[key] = value

@@ -15,6 +15,15 @@ report is the one the command line writes.
 from __future__ import annotations
 
 from .api import checked_flag, checked_report_dir, short_repr, raise_unless_pass
+from wirecheck.core.errors import InputError
+from wirecheck.core.outputs.output import check_replaceable, check_report_dir
+from . import tolerances
+from .judge import gate
+from .judge.line_style import LINE_RULES
+from .frames_cli import check_report_outside_job
+from .reports.report import write_report
+from .candidates.caller_state import caller_state_kept
+from .references.pyrender_oracle import GLUnavailable, gl_available
 
 
 def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None, min_f1_0px: float | None = None,
@@ -60,13 +69,6 @@ def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None,
     import os
     from pathlib import Path
 
-    from wirecheck.core.errors import InputError
-    from wirecheck.core.outputs.output import check_replaceable, check_report_dir
-
-    from . import tolerances
-    from .judge import gate
-    from .judge.line_style import LINE_RULES
-
     if isinstance(job_dir, bool) or not isinstance(job_dir, (str, os.PathLike)):
         raise TypeError(f"job_dir {short_repr(job_dir)}: expected a job folder path (str or Path)")
     job_dir = Path(job_dir)
@@ -81,22 +83,16 @@ def check_frames(job_dir, *, line_rule: str = "gl", min_f1: float | None = None,
     if run_dir is not None:                     # before anything is judged, as crosscheck checks it
         check_report_dir(run_dir, "report_dir")
         check_replaceable(run_dir, "report_dir")
-        from .frames_cli import check_report_outside_job
-
         check_report_outside_job(job_dir, run_dir)
     report, images = _judge(job_dir, tol, allow_vacuous, line_rule)
     if run_dir is not None:
-        from .reports.report import write_report
-
         write_report(run_dir, report, images)
     return report
 
 
 def _judge(job_dir, tol, allow_vacuous: bool, line_rule: str) -> tuple[dict, dict]:
     """crosscheck's frames judge on ``job_dir``, after the check that pyrender's GL can draw here."""
-    from .candidates.caller_state import caller_state_kept
     from .judge.frames_judge import run_frames
-    from .references.pyrender_oracle import GLUnavailable, gl_available
 
     with caller_state_kept():                   # the caller's globals as they were (PYOPENGL_PLATFORM, ...)
         ok, message = gl_available()

@@ -16,6 +16,13 @@ from pathlib import Path
 from wirecheck.core.errors import InputError
 
 from .cases import ALL_CASE_NAMES, CASE_NAMES
+from wirecheck.core.scene.files import builtin_names, load_scene
+from wirecheck.core.transforms import Motion
+from wirecheck.core.limits import MAX_FRAMES
+from .judge.line_style import summary_lines
+from .reports.compared import what_text
+from .reports.report_option import report_line
+from .tolerances import Tolerances
 
 
 class _Parser(argparse.ArgumentParser):
@@ -31,9 +38,6 @@ def _fail(message: str) -> int:
 
 def export_main(argv) -> int:
     """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z] [--phase F]``."""
-    from wirecheck.core.scene.files import builtin_names, load_scene
-    from wirecheck.core.transforms import Motion
-
     from .candidates.export import write_job
 
     p = _Parser(prog="crosscheck export",
@@ -50,7 +54,6 @@ def export_main(argv) -> int:
                         "frames (default 0: crosscheck's own poses; 0.3: no frame of --frames 4 is a quarter turn)")
     args = p.parse_args(argv)
     try:
-        from wirecheck.core.limits import MAX_FRAMES
         from wirecheck.core.outputs.output import check_replaceable
 
         if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
@@ -101,11 +104,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     frames do not use, so they are not usage errors here.
     """
     from .judge.frames_judge import run_frames
-    from .judge.line_style import summary_lines
-    from .reports.compared import what_text
     from .reports.report import console_table, write_report
-    from .reports.report_option import report_line
-    from .tolerances import Tolerances
 
     from .config import CLI_DESTS
 

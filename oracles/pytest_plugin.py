@@ -38,6 +38,7 @@ import re
 from pathlib import Path
 
 import pytest
+from wirecheck.core.errors import InputError
 
 _SETTINGS = pytest.StashKey[dict]()
 _CANDIDATE = pytest.StashKey[object]()
@@ -60,8 +61,6 @@ def pytest_addoption(parser):
 
 
 def pytest_configure(config):
-    from wirecheck.core.errors import InputError
-
     from .config import load_config
 
     opt = config.option
@@ -113,8 +112,6 @@ def _write(config, node, index: int, report: dict, images: dict) -> str:
     ``--junitxml`` as a property of the test.
     """
     nodeid = node.nodeid
-    from wirecheck.core.errors import InputError
-
     from .reports.report import write_report
 
     root = Path(config.option.wirecheck_report)

@@ -71,6 +71,10 @@ from .references.convert import model_matrix
 from .candidates.core_candidate import CoreCandidate, RenderMode
 from .executors import ExecutorSpec, gather_in_order, open_executor
 from .tolerances import Tolerances
+from .references.pyrender_oracle import OracleCache, gl_platform
+from wirecheck.core.errors import InputError
+from .cases import CASE_NAMES, cases_for
+from .candidates.candidate import load_candidate
 
 #: Oracle fidelity levels, cheapest first, and the oracles each one runs.
 LEVELS = ("vertices", "pixels")
@@ -120,8 +124,6 @@ class CaseRunner:
     _DUMMY_EDGES = np.array([[0, 1]], dtype=np.intp)
 
     def __init__(self):
-        from .references.pyrender_oracle import OracleCache
-
         self.renderers = OracleCache()
         self.candidates = {}
         self.warm = False
@@ -130,8 +132,6 @@ class CaseRunner:
         if not isinstance(ref, str):
             return ref
         if ref not in self.candidates:
-            from .candidates.candidate import load_candidate
-
             self.candidates[ref] = load_candidate(ref)
         return self.candidates[ref]
 
@@ -191,8 +191,6 @@ def worker_init() -> None:
     global _WORKER_RUNNER
     from multiprocessing.util import Finalize
 
-    from .references.pyrender_oracle import gl_platform
-
     gl_platform()          # the parent's PYOPENGL_PLATFORM (crosscheck --gl), inherited; osmesa if unset
     _WORKER_RUNNER = CaseRunner()
     Finalize(_WORKER_RUNNER, _WORKER_RUNNER.close, exitpriority=10)   # free the GL contexts at exit
@@ -244,10 +242,6 @@ def scene_cases(scene: Scene, case_names, motion: Motion) -> list[Case]:
 
     InputError when no camera fits the scene.
     """
-    from wirecheck.core.errors import InputError
-
-    from .cases import CASE_NAMES, cases_for
-
     try:
         cases = cases_for(scene, motion, calibrated=bool(set(case_names) - set(CASE_NAMES)))
     except InputError as exc:
@@ -307,8 +301,6 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     ``executor`` (:class:`oracles.executors.ExecutorSpec`) sends the cases to
     a Dask cluster instead (same report; ``jobs`` is then the spec's).
     """
-    from wirecheck.core.errors import InputError
-
     if oracles is not None:
         implied = level_for_oracles(oracles)
         if level is not None and level != implied:

@@ -113,3 +113,34 @@ def test_a_private_name_is_found_imported_or_read(copy):
     assert len(uses) == 2
     assert uses[0].startswith("core/projector/pipeline.py:") and uses[0].endswith(": culling._fan")
     assert uses[1].startswith("oracles/frames_api.py:") and uses[1].endswith("from .api import _private_thing")
+
+
+#: The imports of the package's own modules left inside functions, ``(file, module as written)``: each a lazy
+#: load that keeps a light path light. Any other belongs at the top of its module (docs/layout.md, "Layers").
+LAZY = {
+    # loaded by every pytest session where wirecheck is installed: no numpy, OpenCV or report code until a test asks
+    ("oracles/pytest_plugin.py", ".config"), ("oracles/pytest_plugin.py", ".api"),
+    ("oracles/pytest_plugin.py", ".reports.report"), ("oracles/pytest_plugin.py", ".references.pyrender_oracle"),
+    # the candidate's own child process: it loads what the candidate needs, not numpy before the candidate does
+    ("oracles/candidates/candidate_host.py", "wirecheck.core.camera"), ("oracles/candidates/candidate_host.py", "."),
+    ("oracles/candidates/candidate_host.py", ".candidate"),
+    # [tool.wirecheck] is read by the plugin and the CLIs before anything heavy: the names it checks come late
+    ("oracles/config.py", ".runner"), ("oracles/config.py", "wirecheck.core.scene.files"), ("oracles/config.py", ".cases"),
+    ("oracles/config.py", ".datasets.dataset"),
+    ("oracles/api.py", ".config"),                                      # tomllib, only when a config is read
+    # paths of the CLIs a run takes only when asked: the viewer's HTTP server, the sweep, export and JUnit
+    ("core/app/cli.py", ".viewer_http"), ("oracles/cli.py", ".sweep"),
+    ("oracles/frames_cli.py", ".candidates.export"), ("oracles/frames_cli.py", "wirecheck.core.outputs.output"),
+    ("oracles/frames_cli.py", ".judge.frames_judge"), ("oracles/frames_cli.py", ".reports.report"),
+    ("oracles/frames_cli.py", ".config"), ("oracles/frames_cli.py", ".reports.junit"),
+    ("oracles/frames_api.py", ".judge.frames_judge"),                  # its reading-ahead thread pool, on a call
+    ("oracles/candidates/job_as_exported.py", ".export"),              # PNG writing (zlib), on a job check
+    ("oracles/runner.py", ".candidates.subprocess_candidate"),          # subprocess, in the workers only
+    ("oracles/tolerances.py", ".references.convert"),                  # OpenCV and scipy, for the vertex bound only
+}
+
+
+def test_imports_inside_functions_are_only_the_lazy_ones():
+    found = {(i.file, i.module) for i in import_graph.internal_imports(ROOT) if i.in_function}
+    assert found, "no import inside a function found: the scan did not run"   # today's lazy ones exist
+    assert found <= LAZY, sorted(found - LAZY)

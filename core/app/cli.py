@@ -61,6 +61,9 @@ from ..scene.files import load_scene
 from ..projector.shading import STYLES
 from ..outputs.staging import check_out
 from ..transforms import Motion
+from .compare import main_compare
+from .profile import FrameProfiler, profile_table
+from .trace import check_vertex, parse_frames, trace_text, trace_vertex
 
 DESCRIPTION = "renderer: render a scene's motion to wireframe frames with per-frame diagnostics."
 #: --projection: one camera, or "both": perspective left, orthographic right.
@@ -423,8 +426,6 @@ def _main(argv=None) -> int:
 
         return main_interactive(s, args.port)
     if args.compare:
-        from .compare import main_compare
-
         return main_compare(s, args.compare_z, args.compare_fov)
     traces = _traces(args, s)
     width = max(3, len(str(s.frames)))
@@ -445,8 +446,6 @@ def _main(argv=None) -> int:
 
     profiler = None
     if args.profile:
-        from .profile import FrameProfiler
-
         profiler = FrameProfiler()
     try:
         report = render_run(s, log=log, progress=progress, profiler=profiler,
@@ -456,13 +455,9 @@ def _main(argv=None) -> int:
     if s.scene.faces and s.scene.winding_note:       # after the run: an error line is the only line
         print(f"renderer: warning: {s.scene.source}: {s.scene.winding_note}", file=sys.stderr)
     if traces:
-        from .trace import trace_text
-
         for rec in traces:
             print(trace_text(rec, s.camera), end="")
     if profiler is not None:
-        from .profile import profile_table
-
         print(profile_table(report["profile"]), end="")
     paths = report["_paths"]
     if paths["frames"] is not None:
@@ -483,8 +478,6 @@ def _traces(args, s: Settings) -> list[dict]:
         if args.trace_frames is not None:
             raise InputError(f"--trace-frames {args.trace_frames!r} without --trace-vertex: expected --trace-vertex I")
         return []
-    from .trace import check_vertex, parse_frames, trace_vertex
-
     check_vertex(s.scene, args.trace_vertex)
     renderer = s.scene_renderer()
     out = []

@@ -40,6 +40,9 @@ from ..outputs import output
 from ..camera import camera_z
 from ..errors import InputError
 from ..numbers import plain_float
+from .compose import picture, side_by_side
+from ..scene.model import world_points
+from ..outputs.staging import Staging
 
 #: Drawn pixels: at least half coverage (raster "aa"), as the crosscheck's threshold.
 DRAWN = 128
@@ -94,10 +97,6 @@ def measure(image: np.ndarray, row: int) -> dict | None:
 
 def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
     """Render the four views; return (report, 2x2 picture). ``s`` is the run's core.app.settings.Settings."""
-    from .compose import picture, side_by_side
-
-    from ..scene.model import world_points
-
     box = box_of(world_points(s.scene, s.motion, 1, s.frames))        # at rest, with --scale/--translate
     depth = box["z_front"] - box["z_back"]
     if not (depth > 0 and box["half_width"] > 0):      # the widths and their ratio would divide by zero
@@ -188,8 +187,6 @@ def main_compare(s, z_text: str, fov_text: str) -> int:
         return 2
     text = explain(report)
     name = s.scene.name
-    from ..outputs.staging import Staging
-
     names = [f"{name}-compare.png", f"{name}-compare.json", f"{name}-compare.txt"]
     stage = Staging(s.out, names)      # written together, never over a file wirecheck did not write
     try:

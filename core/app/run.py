@@ -22,6 +22,7 @@ from ..outputs.gif import GifWriter
 from .report import frame_record, run_report, summary_text
 from .settings import Settings
 from ..outputs.staging import Staging
+from .motion_plot import plot_png
 
 #: Output formats: frames as PNG and ASCII text, animations as GIF and MP4.
 FORMATS = ("png", "ascii", "gif", "mp4")
@@ -172,8 +173,6 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
             report["vertices_px_file_orthographic"] = sidecar_names[1]
     plot_seconds = None
     if s.plots:
-        from .motion_plot import plot_png
-
         t0 = time.perf_counter()
         cam_text = "perspective (left picture)" if s.ortho_camera is not None else s.camera.projection
         stage.path(f"{name}-plots.png").write_bytes(plot_png(records, f"{name}: {s.frames} frames, {cam_text} camera"))

@@ -59,6 +59,8 @@ from ..camera import Camera, look_at
 from ..errors import InputError
 from ..projector.pipeline import STAGES as PIPELINE_STAGES
 from .profile import FrameProfiler
+from .compose import overlay, picture
+from ..scene.files import builtin_names, example_names
 
 #: Orbit: degrees per CSS pixel of drag.
 DEG_PER_PX = 0.5
@@ -279,8 +281,6 @@ class Viewer:
     # ---- output
     def frame_png(self, v: View, timing: dict | None = None):
         """``(png bytes, Frame, settings)`` of view ``v``: exactly what ``renderer`` writes for its command line."""
-        from .compose import overlay, picture
-
         s = self.settings(v)
         key = (s.style, s.hidden_lines, s.cull)
         if key not in self._renderers:
@@ -301,8 +301,6 @@ class Viewer:
     def command(self, v: View) -> str:
         """The ``renderer`` command line that writes this frame (``frame_<k>.png``), floats exact (repr)."""
         s = self.s
-        from ..scene.files import builtin_names, example_names
-
         scene = s.scene.name if s.scene.name in builtin_names() + example_names() else s.scene.source
         r = lambda xs: ",".join(repr(float(x)) for x in xs)            # noqa: E731 - repr round-trips floats
         # OPTION=VALUE: a value starting with "-" is not taken for an option

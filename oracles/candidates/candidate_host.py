@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import sys
+from wirecheck.core.errors import InputError
 
 
 def _camera(msg: dict):
@@ -54,8 +55,6 @@ def serve(spec: str, stdin, stdout) -> int:
         send(protocol.encode_error(f"expected the header {protocol.HEADER!r}"))
         return 2
     try:
-        from wirecheck.core.errors import InputError
-
         from .candidate import load_candidate
 
         func = load_candidate(spec)

@@ -38,6 +38,8 @@ from wirecheck.core.outputs.output import FrameDir, json_dumps
 
 from ..cases import CASE_NAMES, case_motion, cases_for
 from ..references.convert import camera_to_gl, opencv_matrices
+from wirecheck.core.transforms import Motion
+from ..references.faces import frame_geometry
 
 #: Version of the job format; frames_candidate refuses any other.
 JOB_VERSION = 1
@@ -104,10 +106,6 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
               phase: float = 0.0) -> tuple[dict, dict]:
     """The manifest and the files of a job: ``(job, {relative path: bytes})``; ``phase``: module docstring
     (0: crosscheck's own poses, and job.json without a ``motion.phase``)."""
-    from wirecheck.core.transforms import Motion
-
-    from ..references.faces import frame_geometry
-
     motion = motion or Motion()
     files: dict[str, bytes] = {}
     scene_rows, case_rows = [], []

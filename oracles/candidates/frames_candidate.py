@@ -24,6 +24,9 @@ from wirecheck.core.errors import InputError
 from .export import JOB_KIND, JOB_VERSION, frame_name
 from .job_as_exported import camera_file_problem, camera_keys_problem, job_keys_problem
 from .png_frame import FrameProblem, check_png, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
+from wirecheck.core.limits import MAX_FRAMES, check_image_size
+from wirecheck.core.scene.files import NAME_PATTERN
+from wirecheck.core.camera import Camera
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
@@ -96,9 +99,6 @@ def _job_problem(job: dict) -> str | None:
     so that an edited or damaged one is a usage error naming the field, never a
     crash later or numbers in the report that mean nothing.
     """
-    from wirecheck.core.limits import MAX_FRAMES, check_image_size
-    from wirecheck.core.scene.files import NAME_PATTERN
-
     frames, every = job.get("frames"), job.get("every")
     if not (_is_int(frames) and 1 <= frames <= MAX_FRAMES):
         return f"frames {frames!r}: expected an integer in 1..{MAX_FRAMES}"
@@ -300,8 +300,6 @@ def _frame_camera(path: Path, cache: dict | None = None):
     the same Camera object back (a case's camera is fixed: converted once by
     oracles.references.opencv_oracle, which keeps the last camera by identity).
     """
-    from wirecheck.core.camera import Camera
-
     problem = file_problem(path)
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])

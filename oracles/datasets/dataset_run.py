@@ -37,6 +37,9 @@ from .dataset import Dataset, MeshEntry
 from ..executors import ExecutorSpec, gather_in_order, open_executor
 from ..runner import LEVEL_ORACLES, LEVELS, CaseRunner, overall_ms, RunParams, WORKER_LOCK, worker_init, scene_cases, worker_runner, worst_key
 from ..tolerances import Tolerances
+from wirecheck.core.scene.files import load_mesh_file
+from wirecheck.core.transforms import Motion
+from ..cases import calibrated_cases
 
 #: The fields of a case record kept in a dataset's report (the per-frame detail of
 #: thousands of cases would make report.json hundreds of megabytes; rerun one mesh for it).
@@ -53,8 +56,6 @@ class NothingLoaded(InputError):
 
 def _load(entry: MeshEntry):
     """The mesh as a Scene named by its dataset name; InputError with a one-line reason otherwise."""
-    from wirecheck.core.scene.files import load_mesh_file
-
     if entry.error is not None:
         raise InputError(entry.error)
     if not os.path.isfile(entry.path):
@@ -162,8 +163,6 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     that would compare nothing (oracles.judge.gate.run_settings) and
     :class:`NothingLoaded` when no mesh could be read.
     """
-    from wirecheck.core.transforms import Motion
-
     if level not in LEVELS:
         raise ValueError(f"level {level!r}: expected one of {', '.join(LEVELS)}")
     mode = mode or RenderMode()
@@ -171,8 +170,6 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     executor = executor or ExecutorSpec()
     inputs = gate.run_settings(frames, every, case_names, turns, tol)
     if level == "pixels":
-        from ..cases import calibrated_cases
-
         distorted = {c.name for c in calibrated_cases(1.0) if c.camera.distortion is not None}
         if set(inputs.case_names) <= distorted:      # as oracles.runner.run_crosscheck says it
             raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their "

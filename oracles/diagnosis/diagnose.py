@@ -151,6 +151,7 @@ import numpy as np
 
 from ..tolerances import line_failures
 from .clip_planes import clip_fault
+from .lens_diagnose import distortion_fault
 
 __all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER", "LINE_FAULTS", "VERTEX_ONLY_FAULTS",
            "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
@@ -460,7 +461,6 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     info.update(scale=d.copy(), offset=off.copy(), reach=np.max(np.abs(q), axis=0))
     collapsed = bool(np.any(d * reach <= tol))       # an axis the candidate squashed flat
     if named_max > tol or collapsed:
-        from .lens_diagnose import distortion_fault       # a lens error bends the picture: not affine
         lens = None if mismatches or collapsed else distortion_fault(cand[both], orac[both], camera, tol)
         if lens is not None:
             return [lens]

@@ -83,6 +83,7 @@ from .image_visibility import in_place, visibility_fault
 from .registration import (MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, PAIR_CAP_PX, SCREEN_POINTS_PER_CASE,
                            SCREEN_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame, register,
                            segments_in_image)
+from wirecheck.core.camera import Camera
 
 __all__ = ["diagnose_images", "oracle_segments", "flipped_camera"]
 
@@ -128,8 +129,6 @@ def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera) -> np.ndarra
 
 def flipped_camera(camera):
     """The camera looking backward (forward negated, up kept): what a depth-flipped renderer draws."""
-    from wirecheck.core.camera import Camera
-
     return Camera(position=camera.position, forward=-np.asarray(camera.forward), up=camera.up,
                   fov_y_deg=camera.fov_y_deg, width=camera.width, height=camera.height, near=camera.near,
                   far=camera.far, projection=camera.projection, ortho_height=camera.ortho_height,

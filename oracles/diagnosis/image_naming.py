@@ -44,6 +44,8 @@ import numpy as np
 from .hints import FAULT_HINTS
 from .model_lines import model_images, quantisation_bias
 from .rule_read import read_rules, standing_scale_faults
+from .diagnose import FAULT_ORDER, scale_faults
+from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, PERMUTATIONS, Registration, SCREEN_ITERATIONS, frame_samples, points_per_frame
 
 __all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales", "rule_bias", "rule_off_diagonal"]
 
@@ -90,8 +92,6 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
     ratio, ``residual``: the winner's cost, ``cand_images``: the candidate's frames (the aliased rule read
     from them sets the bias an offset is compared with, :func:`rule_bias`; without them GL's).
     """
-    from .diagnose import FAULT_ORDER, scale_faults
-
     cost, names, p, a, b = ranked[0]
     d = np.diag(a)
     cx, cy = camera.principal_point
@@ -144,8 +144,6 @@ def rotation_deg(a_free: np.ndarray) -> float:
 
 def restart_scales(coarse, fine, ranked: list, camera) -> list:
     """``ranked`` with the identity and the best permutation fitted again from :func:`scale_starts`."""
-    from .registration import PERMUTATIONS, SCREEN_ITERATIONS
-
     screened = []
     for names, p in {(): PERMUTATIONS[()], ranked[0][1]: ranked[0][2]}.items():
         for d0 in scale_starts(camera):
@@ -197,8 +195,6 @@ def rule_off_diagonal(cand_images, oracle_segs, camera, fit, a_free, reach, off_
     is the candidate's. Under GL's rule ``off_diagonal`` is returned as it is;
     with both rules read (a tie), the smaller of the two: it must stand against both.
     """
-    from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
-
     p, a, b = fit
     d = np.diag(a)
     rules = read_rules(cand_images, oracle_segs, camera, p, d, b, quantisation_bias(oracle_segs, camera, p, d))

@@ -9,6 +9,9 @@ Its own module because the naming (oracles.diagnosis.image_naming) and the rule 
 from __future__ import annotations
 
 import numpy as np
+from wirecheck.core.projector.clipping import clip_to_image
+from wirecheck.core.projector import raster
+from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
 
 
 def model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -> list[np.ndarray]:
@@ -18,12 +21,9 @@ def model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -
     ``line_pixels_fast``: Bresenham's, OpenCV's LINE_8, Pillow's 1-px line); otherwise by
     core's exact rule (integer pixel centres, GL's rule on these lines).
     """
-    from wirecheck.core.projector.clipping import clip_to_image
-    from wirecheck.core.projector.raster import line_pixels, line_pixels_fast
-
     centre = np.array(camera.principal_point)
     shift = np.zeros(2) if shift is None else np.asarray(shift, dtype=np.float64)
-    draw = line_pixels_fast if snapped else line_pixels
+    draw = raster.line_pixels_fast if snapped else raster.line_pixels
     images = []
     for segs in oracle_segs:
         segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
@@ -52,8 +52,6 @@ def quantisation_bias(oracle_segs, camera, p=None, d=None, snapped: bool = False
     bias; an offset is a fault only when it differs from it. ``snapped``: drawn
     by the rule that rounds the ends to pixel centres first (:func:`rule_bias`).
     """
-    from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
-
     p = np.eye(2) if p is None else np.asarray(p, dtype=np.float64)
     d = np.ones(2) if d is None else np.asarray(d, dtype=np.float64)
     centre = np.array(camera.principal_point)
@@ -68,8 +66,6 @@ def quantisation_bias(oracle_segs, camera, p=None, d=None, snapped: bool = False
 
 def model_lines(oracle_segs, camera, p, d, shift, snapped: bool) -> list[np.ndarray]:
     """The model's lines moved by ``shift``, clipped to the image; ``snapped``: each end rounded to a pixel centre."""
-    from wirecheck.core.projector.clipping import clip_to_image
-
     centre = np.array(camera.principal_point)
     out = []
     for segs in oracle_segs:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..segment_geometry import nearest_on_segments
+from wirecheck.core.projector.clipping import clip_to_image
 
 __all__ = ["PERMUTATIONS", "Registration", "frame_samples", "points_per_frame", "register", "segments_in_image"]
 
@@ -87,8 +88,6 @@ def _unit(v: np.ndarray) -> np.ndarray:
 def _samples(segs: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """Points every SAMPLE_STEP_PX along the segments, within the image grown by half its size per side,
     and the unit tangent of their segment: ``((M, 2), (M, 2))``."""
-    from wirecheck.core.projector.clipping import clip_to_image
-
     if len(segs) == 0:
         return np.zeros((0, 2)), np.zeros((0, 2))
     shift = np.array([width / 2.0, height / 2.0])

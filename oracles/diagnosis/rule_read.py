@@ -25,6 +25,9 @@ fit closer (the registration's cost), but the two costs are not always far enoug
 from __future__ import annotations
 
 import numpy as np
+from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
+from .model_lines import JITTER, model_lines, quantisation_bias
+from .diagnose import scale_faults
 
 __all__ = ["ROUNDED_END_PX", "RULE_TIE", "read_rules", "standing_scale_faults"]
 
@@ -49,9 +52,6 @@ def _costs(cand_images, oracle_segs, camera, p, d, b):
     GL's model at the fitted offset; the rounded ends' model at the best of the positions the fit cannot
     tell apart (:data:`oracles.diagnosis.model_lines.JITTER`: ends on a half pixel round either way).
     """
-    from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
-    from .model_lines import JITTER, model_lines, quantisation_bias
-
     snapped_bias = quantisation_bias(oracle_segs, camera, p, d, snapped=True)
     limit = points_per_frame(len(cand_images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
     nearest = None
@@ -89,8 +89,6 @@ def standing_scale_faults(faults: list, d, reach, tol: float, camera, rules) -> 
     Under the rule that rounds the ends a scale must move a pixel by more than ``tol`` plus
     :data:`ROUNDED_END_PX`; under GL's, by more than ``tol`` (``faults`` were named so).
     """
-    from .diagnose import scale_faults
-
     if "snapped" not in rules:
         return faults
     loose = {f["name"] for f in scale_faults(float(d[0]), float(d[1]), reach, tol + ROUNDED_END_PX, camera)}

@@ -39,6 +39,7 @@ from ..candidates.core_candidate import CoreCandidate, RenderMode
 from ..candidates.draw import depth_margin, draw_candidate, oracle_segments
 from ..tolerances import Tolerances
 from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge, judge_oracle_precision
+from ..diagnosis import clip_planes
 
 
 #: The note of a case whose camera has lens distortion, run at level pixels.
@@ -123,8 +124,7 @@ class CaseSetup:
         """The candidate's own near and far planes (oracles.diagnosis.clip_planes.probe_planes), probed once; None
         for core (its planes are the camera's by construction) or when the probe cannot run."""
         if not self._probed and not self.is_core:
-            from ..diagnosis.clip_planes import probe_planes
-            self._planes, self._probed = probe_planes(self.timed, self.cam), True
+            self._planes, self._probed = clip_planes.probe_planes(self.timed, self.cam), True
         return self._planes
 
     def draw_slack(self, p_world: np.ndarray) -> float:
@@ -136,8 +136,7 @@ class CaseSetup:
         d0, d1 = depth[self.edges[:, 0]], depth[self.edges[:, 1]]
         crosses = any(((d0 < plane) != (d1 < plane)).any() for plane in (self.cam.near, self.cam.far))
         if crosses:
-            from ..diagnosis.clip_planes import depth_slack
-            self.slack, self.slack_why = depth_slack(self.planes(), self.cam)
+            self.slack, self.slack_why = clip_planes.depth_slack(self.planes(), self.cam)
         return self.slack
 
 

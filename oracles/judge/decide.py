@@ -34,6 +34,7 @@ import numpy as np
 
 from . import gate
 from ..tolerances import Tolerances, line_failures
+from ..diagnosis.diagnose import diagnose_lines
 
 #: The fault of a failing case that no diagnosis explains.
 UNEXPLAINED = {"name": "unexplained"}
@@ -63,8 +64,6 @@ def line_faults(rec: dict, tol: Tolerances, faults: list) -> list:
     """
     if faults or "lines" not in rec:
         return faults
-    from ..diagnosis.diagnose import diagnose_lines
-
     return diagnose_lines(rec["lines"], tol)
 
 

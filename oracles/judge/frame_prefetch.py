@@ -38,6 +38,9 @@ import threading
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
+from ..candidates.frames_candidate import frame_inputs, read_frame
+from ..references.pyrender_oracle import OracleCache
+
 #: Frames read ahead of the one being judged (each: the oracle's drawing and the PNG's grey levels).
 AHEAD = 2
 
@@ -76,8 +79,6 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str, cache: dict) ->
     drawing, the PNG; a step that fails ends the frame's reading (the judge
     raises it before it would need the next).
     """
-    from ..candidates.frames_candidate import frame_inputs, read_frame
-
     try:
         inputs = frame_inputs(job_dir, job, c["scene"], c["case"], k, cache)
     except Exception as exc:      # noqa: BLE001 - raised again in the judge's thread, at this frame
@@ -104,8 +105,6 @@ class FramePrefetch:
     """
 
     def __init__(self, oracles=None, threaded: bool = True, ahead: int = AHEAD):
-        from ..references.pyrender_oracle import OracleCache
-
         self.oracles = OracleCache() if oracles is None else oracles
         self.ahead = int(ahead)
         self._pool = ThreadPoolExecutor(1, thread_name_prefix="wirecheck-frames") if threaded else None

@@ -35,6 +35,13 @@ from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
 from .dim_lines import name_dim_lines
+from .line_style import CaseStyle
+from wirecheck.core.projector import pipeline
+from ..candidates.draw import oracle_segments as line_segments
+from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+from ..diagnosis.image_visibility import frames_visibility
+from ..candidates import frames_candidate
+from ..tolerances import Tolerances
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (oracles.diagnosis.registration.MAX_POINTS_PER_CASE),
@@ -97,14 +104,6 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     ``line_rule``: ``"gl"`` holds aliased 1-px lines to GL's pixel rule,
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
     """
-    from .line_style import CaseStyle
-
-    from wirecheck.core.projector.pipeline import render_frame
-
-    from ..candidates.draw import oracle_segments as line_segments
-    from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
-    from ..diagnosis.image_visibility import frames_visibility
-
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     numbers = [int(Path(rel).stem.split("_")[-1]) for rel in c["frames"]]
     kept = diagnosis_frames(len(numbers)) if diagnose else set()
@@ -123,7 +122,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         orac = frame.oracle()
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
                                 segs, (job_dir, job), grey=frame.grey())
-        core = _drawn(render_frame(p_model, edges, camera, m).image)
+        core = _drawn(pipeline.render_frame(p_model, edges, camera, m).image)
         fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
         style.count_rule(fp, segs)
         ps = metrics.pixel_scores(None, None, pixels=fp)
@@ -202,13 +201,10 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     same FramesError, :func:`read_frame`). A case where neither side drew a pixel is ``"vacuous"`` and
     fails the run unless ``allow_vacuous`` (as :mod:`oracles.judge.gate`).
     """
-    from ..candidates.frames_candidate import check_frames, load_job
-    from ..tolerances import Tolerances
-
     tol = tol or Tolerances()
     t0 = time.perf_counter()
-    job = load_job(job_dir)
-    check_frames(job_dir, job, decode=False)          # each frame is decoded once, as it is judged
+    job = frames_candidate.load_job(job_dir)
+    frames_candidate.check_frames(job_dir, job, decode=False)          # each frame is decoded once, as it is judged
     reader = FramePrefetch()            # the GL thread: every oracle call, and the frames read ahead of the judge
     records, images = [], {}
     try:

@@ -79,6 +79,11 @@ from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
 from .case_samples import CaseSamples
 from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
 from ..segment_geometry import seg_distance
+from ..diagnosis.image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX, oracle_segments
+from wirecheck.core.projector.clipping import clip_to_image
+from wirecheck.core.projector import raster
+from ..diagnosis.diagnose import FAULT_ORDER
+from .free_ends import END_TOL_PX, MIN_ENDS
 
 STYLES = ("aliased", "antialiased", "wide")
 LINE_RULES = ("gl", "geometry")
@@ -138,8 +143,6 @@ CANNOT_SHOW = {
 
 
 def _segments(p_model, edges, camera, m) -> np.ndarray:
-    from ..diagnosis.image_diagnose import oracle_segments
-
     p_world = np.asarray(p_model, dtype=np.float64) @ m[:3, :3].T + m[:3, 3]
     return oracle_segments(p_world, edges, camera)
 
@@ -219,16 +222,13 @@ def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.nda
 
     ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
     """
-    from wirecheck.core.projector.clipping import clip_to_image
-    from wirecheck.core.projector.raster import line_pixels
-
     h, w = shape
     img = np.zeros(shape, bool)
     if len(segs) == 0:
         return img
     if width_px < WIDE_MIN_PX:
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h) if clipped is None else clipped
-        rr, cc = line_pixels(q0, q1, w, h)
+        rr, cc = raster.line_pixels(q0, q1, w, h)
         img[rr, cc] = True
         return img
     half = round(width_px) / 2.0
@@ -309,8 +309,6 @@ class CaseStyle:
 
     def frame_flat(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
         """:meth:`frame`'s pixels as ascending flat indices ``y W + x`` (the frames judge keeps no image)."""
-        from wirecheck.core.projector.clipping import clip_to_image
-
         grey = np.asarray(grey)
         binary_input = grey.dtype == bool
         if binary_input:
@@ -436,7 +434,6 @@ class CaseStyle:
         lean = even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"]) \
             if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0 else None
         if lean is not None:                            # an even band: each edge's lean chosen (even_lean)
-            from ..diagnosis.image_diagnose import SCALE_TOL_PX
             held = np.max(np.abs(d - ref_d)) <= RULE_OFFSET_MAX_PX and (affine is None or np.percentile(warp, 99)
                                                                         <= SCALE_TOL_PX + 0.5)   # judge()'s bounds
             geo["lean"] = {**{k: lean[k] for k in even_lean.REPORTED}, "used": bool(lean["leaning"] and not held)}
@@ -456,10 +453,6 @@ class CaseStyle:
         pixel rule decides (``pixel_rule``) and the style's own failures
         (``failures``), which oracles.judge.decide.decide then applies.
         """
-        from ..diagnosis.diagnose import FAULT_ORDER
-        from ..diagnosis.image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX
-        from .free_ends import END_TOL_PX, MIN_ENDS
-
         read = self.classify()
         geo = self.geometry(read)
         style = read["style"]

@@ -23,6 +23,8 @@ import numpy as np
 from .frame_pixels import FramePixels
 from .line_ends import END_REACH_PX, PLACES, end_attribution, frames_end_places, resolve_ties  # noqa: F401
 from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
+from .. import tolerances
+from ..references.pyrender_oracle import depth_step
 
 
 def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
@@ -263,9 +265,6 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
     """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances)."""
-    from .. import tolerances
-    from ..references.pyrender_oracle import depth_step
-
     depth = np.asarray(depth, np.float64)
     eps32 = float(np.finfo(np.float32).eps)
     return (tolerances.DEPTH_STEPS * depth_step(depth, camera)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import sys
+from wirecheck.core.errors import InputError
 
 #: The OpenGL platforms the oracle draws on (``PYOPENGL_PLATFORM``); the first is the default.
 GL_PLATFORMS = ("osmesa", "egl")
@@ -37,8 +38,6 @@ def select_gl(name: str | None) -> str:
     PyOpenGL was already loaded in this process for another one (it reads the
     variable once, at import).
     """
-    from wirecheck.core.errors import InputError
-
     if name is None:
         return gl_platform()
     if name not in GL_PLATFORMS:

@@ -65,6 +65,7 @@ lines by up to 78 px.
 from __future__ import annotations
 
 import numpy as np
+from .convert import camera_to_gl
 
 __all__ = ["U32", "CLIP_XY_ROUNDINGS", "CLIP_W_ROUNDINGS", "VIEWPORT_ROUNDINGS", "ORACLE_LIMIT_PX", "mesh_radius", "frame_bound_px",
            "drawn_bound_px"]
@@ -102,8 +103,6 @@ def frame_bound_px(camera, eye_pose, radius: float) -> float:
     eye_pose : (4, 4) float64, centred model coordinates to GL eye (oracles.references.convert.gl_eye_pose).
     radius : float, the largest ``|q|`` of the uploaded vertices (:func:`mesh_radius`).
     """
-    from .convert import camera_to_gl
-
     a = np.asarray(eye_pose, dtype=np.float64)
     _view, proj = camera_to_gl(camera)
     with np.errstate(over="ignore", invalid="ignore"):      # an overflow is no bound: inf below
@@ -133,8 +132,6 @@ def drawn_bound_px(camera, eye_pose, q_model, segments) -> float:
     q_model : (N, 3) the uploaded vertices (the float32 offsets from the mesh's centre), as float64.
     segments : (E, 2) int, the vertex indices of each drawn segment (a triangle's three edges for faces).
     """
-    from .convert import camera_to_gl
-
     a = np.asarray(eye_pose, dtype=np.float64)
     q = np.asarray(q_model, dtype=np.float64).reshape(-1, 3)
     seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)

@@ -9,6 +9,8 @@ the difference is visible where the verdict is read: the CLI's output, the Asser
 
 from __future__ import annotations
 
+from .report import fault_hints
+
 _LEVEL = {"vertices": "vertices (OpenCV)", "pixels": "pixels (OpenCV and pyrender)",
           "frames": "frames (a renderer's PNGs against pyrender; core's beside it)"}
 
@@ -37,8 +39,6 @@ def what_text(report: dict) -> str:
 
 def hint_lines(report: dict, failing: list) -> list[str]:
     """``  what to check, NAME: HINT``, once per distinct hint of the faults in ``failing`` cases (oracles.reports.report.fault_hints)."""
-    from .report import fault_hints
-
     return [f"  what to check, {n}: {h}" for n, h in fault_hints((f for c in failing for f in c["faults"]),
                                                                            report.get("level") == "frames")]
 

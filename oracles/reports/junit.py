@@ -24,6 +24,7 @@ from pathlib import Path
 from wirecheck.core.errors import InputError
 
 from .report import fault_hints, fault_text, not_passed
+from wirecheck.core.outputs.output import atomic_write_bytes
 
 #: The root element's name: it marks a file as ours (one we may replace).
 SUITES_NAME = "wirecheck crosscheck"
@@ -141,8 +142,6 @@ def check_junit_target(path: Path, option: str = "--junit-xml") -> None:
 
 def write_junit(path: Path, report: dict) -> Path:
     """Write :func:`junit_xml` to ``path`` atomically (after :func:`check_junit_target`)."""
-    from wirecheck.core.outputs.output import atomic_write_bytes
-
     path = Path(path)
     check_junit_target(path)
     atomic_write_bytes(path, junit_xml(report))

@@ -24,6 +24,9 @@ from .fmt import distinct
 from ..judge.metrics import DIFF_COLOURS, diff_image
 from ..diagnosis.hints import FAULT_HINTS
 from .report_crops import crop_caption, crop_image
+from ..judge.line_style import summary_lines
+from . import plots
+from .points_plot import points_png
 
 
 #: What else to check when the pixels are a renderer's own frames (``--candidate-frames``, report level
@@ -309,8 +312,6 @@ def case_notes(report: dict) -> list[tuple[dict, str]]:
 
 def _line_styles(report: dict) -> list[str]:
     """The line styles read from a renderer's frames (--candidate-frames; oracles.judge.line_style)."""
-    from ..judge.line_style import summary_lines
-
     return summary_lines(report["cases"])
 
 
@@ -468,9 +469,6 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
     ``images["points"]`` (level vertices) worst_points.png;
     the per-frame figures are drawn from the report itself.
     """
-    from . import plots
-    from .points_plot import points_png
-
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
     out = FrameDir(run_dir, "--report-dir")
