@@ -89,15 +89,9 @@ from .runner import level_for_oracles, run_crosscheck
 from .tolerances import Tolerances
 from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
 from wirecheck.core.scene.files import builtin_names, example_names
-from .datasets.dataset import dataset_entries
 from .candidates.subprocess_candidate import closing_started
 from .reports.wall import process_age_s
-from .frames_cli import export_main, frames_main
-from .references.pyrender_oracle import gl_available, select_gl
-from .datasets.dataset_report import DatasetProgress, console_summary, write_dataset_report
-from .datasets.dataset_run import run_dataset
 from wirecheck.core.outputs.output import FrameDir, json_dumps
-from .extremes import extremes_markdown, run_extremes
 
 ORACLES = ("opencv", "pyrender")
 #: Options that configure the core candidate, with their defaults.
@@ -239,6 +233,8 @@ def _dataset(args):
     if other:
         raise InputError(f"a dataset (--scene DIR or --scene-list) with {', '.join(other)}: expected a plain "
                          "crosscheck run over the meshes")
+    from .datasets.dataset import dataset_entries      # --scene DIR / --scene-list only
+
     return dataset_entries(folders, args.scene_list or [])
 
 
@@ -279,6 +275,8 @@ def main(argv=None) -> int:
 def _main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["export"]:                     # crosscheck export DIR: a job for image candidates
+        from .frames_cli import export_main
+
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
@@ -299,6 +297,8 @@ def _main(argv=None) -> int:
     if applied:      # after the checks: on a usage error the error is the only line
         print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
     if level == "pixels":
+        from .references.pyrender_oracle import gl_available, select_gl   # GL chosen before PyOpenGL is imported
+
         try:
             select_gl(args.gl)
         except InputError as exc:
@@ -322,6 +322,8 @@ def _main(argv=None) -> int:
         return _error(f"--line-rule {args.line_rule} without --candidate-frames: a projector's lines are drawn by "
                       "the harness (GL's rule); expected --line-rule only with --candidate-frames DIR")
     if args.candidate_frames is not None:
+        from .frames_cli import frames_main
+
         return frames_main(args, run_dir, from_config=set(applied))
     if getattr(args, "dataset", None) is not None:
         return _dataset_main(args, level, inputs, candidate, mode, tol, run_dir)
@@ -410,6 +412,9 @@ def _vertex_limit(report: dict, tol) -> str:
 
 def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
     """A dataset run (oracles.datasets.dataset_run): progress, the report, the summary on stdout."""
+    from .datasets.dataset_report import DatasetProgress, console_summary, write_dataset_report
+    from .datasets.dataset_run import run_dataset
+
     progress = DatasetProgress(sys.stderr)
     report, status = _run_guarded(args, progress, lambda: run_dataset(
         args.dataset, candidate, frames=inputs.frames, case_names=inputs.case_names, turns=inputs.turns,
@@ -460,6 +465,8 @@ def _sweep(args, inputs, level, tol, run_dir) -> int:
 
 
 def _suite(level, run_dir) -> int:
+    from .extremes import extremes_markdown, run_extremes      # --suite extremes only
+
     result = run_extremes(pyrender=level == "pixels")
     md = extremes_markdown(result)
     try:

@@ -129,7 +129,12 @@ LAZY = {
     ("oracles/config.py", ".datasets.dataset"),
     ("oracles/api.py", ".config"),                                      # tomllib, only when a config is read
     # paths of the CLIs a run takes only when asked: the viewer's HTTP server, the sweep, export and JUnit
-    ("core/app/cli.py", ".viewer_http"), ("oracles/cli.py", ".sweep"),
+    # (crosscheck's subcommands: ~100 ms of its start, measured with -X importtime, for paths taken when asked;
+    # pyrender_oracle: the GL platform is chosen first)
+    ("core/app/cli.py", ".viewer_http"), ("oracles/cli.py", ".sweep"), ("oracles/cli.py", ".extremes"),
+    ("oracles/cli.py", ".datasets.dataset"), ("oracles/cli.py", ".datasets.dataset_report"),
+    ("oracles/cli.py", ".datasets.dataset_run"), ("oracles/cli.py", ".frames_cli"),
+    ("oracles/cli.py", ".references.pyrender_oracle"),
     ("oracles/frames_cli.py", ".candidates.export"), ("oracles/frames_cli.py", "wirecheck.core.outputs.output"),
     ("oracles/frames_cli.py", ".judge.frames_judge"), ("oracles/frames_cli.py", ".reports.report"),
     ("oracles/frames_cli.py", ".config"), ("oracles/frames_cli.py", ".reports.junit"),
