@@ -92,7 +92,7 @@ TARGETS = {
     # moved out of line_windows, segment_pixels and the registration: the distances and the box clipper
     "oracles/segment_geometry.py": (["tests/test_line_windows.py", "tests/test_metrics.py", "tests/test_line_style.py",
                                      "tests/test_image_registration.py"], None),
-    "oracles/judge/line_profile.py": (["tests/test_line_style.py"], None),
+    "oracles/judge/line_profile.py": (["tests/test_line_profile.py", "tests/test_line_style.py"], None),
     "oracles/judge/case_samples.py": (["tests/test_case_samples.py", "tests/test_line_style.py"], None),
     # the even-width lean: its unit tests and 2-px jobs in test_even_width.py, then Pillow's 2-px lines on the
     # held-out slanted job (a correct one passes leaning, one with the half-pixel mistake is pixel_offset)
