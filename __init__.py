@@ -11,6 +11,9 @@ The public API, importable from the top level::
   against OpenCV (vertices) and pyrender (pixels).
 - :func:`check_frames` / :func:`assert_frames`: judge a renderer's own frames of a
   job written by ``crosscheck export`` (``crosscheck --candidate-frames``).
+- :func:`check_unprojector` / :func:`assert_unprojector`: the way back, an
+  unprojector from pixels and depth along ``forward`` to world points, against the
+  exact inverse of the conventions.
 - :class:`Camera`, :func:`look_at`, :func:`camera_z`: the camera (conventions in
   :mod:`wirecheck.core.conventions`).
 - :func:`load_scene`, :class:`Scene`, :class:`Motion`: scenes and their motion.
@@ -39,6 +42,7 @@ _EXPORTS = {
     "Motion": "core.transforms",
     "assert_projector": "oracles.api", "check_projector": "oracles.api",
     "assert_frames": "oracles.frames_api", "check_frames": "oracles.frames_api",
+    "assert_unprojector": "oracles.unprojector_api", "check_unprojector": "oracles.unprojector_api",
 }
 
 __all__ = ["__version__", *sorted(_EXPORTS)]

@@ -17,7 +17,10 @@ makes (:func:`oracles.datasets.dataset_run.run_dataset`) with three executors:
 
 * ``jobs 1``: in this process;
 * ``jobs 2``: a process pool of 2 spawn workers;
-* ``dask 2``: a Dask ``LocalCluster`` of 2 worker processes on 127.0.0.1.
+* ``dask 2``: a Dask ``LocalCluster`` of 2 worker processes on 127.0.0.1;
+* ``cluster`` (with ``--scheduler tcp://HOST:PORT``): a running Dask cluster's
+  workers (the temporary folder must be on a file system they share: set
+  ``TMPDIR`` to it).
 
 Meshes per second count from the moment the workers are ready; a pool's or a
 cluster's start is printed apart (``startup``). The per-mesh cost is the jobs-1
@@ -88,6 +91,9 @@ def main(argv=None) -> int:
     ap.add_argument("--frames", type=int, default=2, help="frames of the motion per case (default 2)")
     ap.add_argument("--cases", default="on_axis,orthographic", help="cameras per mesh (default on_axis,orthographic)")
     ap.add_argument("--json", default=None, help="also write the results as JSON to this file (default: none)")
+    ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                    help="also run on this Dask scheduler's cluster (its workers need the same wirecheck and the "
+                         "dataset's folder at the same path: docs/datasets.md) (default: none)")
     args = ap.parse_args(argv)
     if args.meshes < 2 or args.frames < 1:
         ap.error("expected --meshes >= 2 and --frames >= 1")
@@ -108,8 +114,11 @@ def main(argv=None) -> int:
         dataset = dataset_entries([tmp])
         print(f"{'executor':<8} {'meshes/s':>9} {'speed-up':>9} {'startup s':>10} {'wall s':>8}  verdict", flush=True)
         rows = {}
-        for label, spec in (("jobs 1", ExecutorSpec(jobs=1)), ("jobs 2", ExecutorSpec(jobs=2)),
-                            ("dask 2", ExecutorSpec(kind="dask", jobs=2))):
+        executors = [("jobs 1", ExecutorSpec(jobs=1)), ("jobs 2", ExecutorSpec(jobs=2)),
+                     ("dask 2", ExecutorSpec(kind="dask", jobs=2))]
+        if args.scheduler:
+            executors.append(("cluster", ExecutorSpec(kind="dask", scheduler=args.scheduler)))
+        for label, spec in executors:
             report = runs[label] = run(dataset, spec, args.frames, args.cases)
             t, base = report["timing"], runs["jobs 1"]["timing"]
             r = rows[label] = {"meshes_per_s": t["meshes_per_s"], "startup_s": t["startup_s"], "wall_s": t["wall_s"],
@@ -125,7 +134,7 @@ def main(argv=None) -> int:
         print("not passed (core against the oracles): " + ", ".join(not_passed))
     stripped = [{k: v for k, v in r.items() if k != "timing"} for r in runs.values()]
     same = all(s == stripped[0] for s in stripped)
-    print(f"\nreports apart from timing: {'identical' if same else 'DIFFERENT'} for jobs 1, jobs 2, dask 2")
+    print(f"\nreports apart from timing: {'identical' if same else 'DIFFERENT'} for {', '.join(runs)}")
     eff = rows["dask 2"]["speedup"] / 2
     print(f"\nper-mesh cost (jobs 1): {per_mesh_s * 1e3:.0f} ms; parallel efficiency of dask with 2 workers "
           f"here: {eff:.0%}")
@@ -141,6 +150,9 @@ def main(argv=None) -> int:
     if args.json:
         Path(args.json).write_text(json.dumps({"machine": info, "runs": rows, "per_mesh_s": per_mesh_s,
                                                "not_passed": not_passed,
+                                               "verdicts": {m["mesh"]: {"verdict": m["verdict"], "cases": [
+                                                   [c["camera"], c["verdict"], [f["name"] for f in c.get("faults", [])]]
+                                                   for c in m.get("cases", [])]} for m in runs["jobs 1"]["meshes"]},
                                                "reports_identical": same, "extrapolated": extrapolated,
                                                "elapsed_s": elapsed}, indent=2))
     return 0 if same else 1

@@ -29,7 +29,8 @@ from .judge import gate
 from .candidates.caller_state import caller_state_kept
 from .candidates.isolation import api_candidate
 from .reports.compared import hint_lines, what_text
-from .reports.report import compared_text, fault_text, not_passed
+from .reports.fault_text import case_cell
+from .reports.report import compared_text, not_passed
 from .runner import run_crosscheck
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
 from .tolerances import Tolerances
@@ -323,7 +324,7 @@ def failure_text(report: dict) -> str | None:
     lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
     lines[0] = f"{what_text(report)}\n{lines[0]}"
     for c in failing:          # a vacuous case's reason starts with "vacuous:"
-        lines.append(f"  {c['scene']} / {c['camera']}: faults: {fault_text(c['faults'], c.get('camera_spec'))}; "
+        lines.append(f"  {c['scene']} / {c['camera']}: faults: {case_cell(c['faults'], c.get('camera_spec'))}; "
                      + "; ".join(c["reasons"]))
     lines += hint_lines(report, failing)
     if "compared" in report:

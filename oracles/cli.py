@@ -71,11 +71,11 @@ from pathlib import Path
 from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
 from wirecheck.core.app.guard import run_cli  # noqa: E402
 from wirecheck.core.limits import check_candidate_timeout
-from wirecheck.core.outputs.output import check_replaceable, check_report_dir
+from wirecheck.core.outputs.output import FrameDir, check_replaceable, check_report_dir, json_dumps
 
 from . import tolerances
 from .judge import gate
-from .candidates.isolation import external_candidate
+from .candidates.isolation import check_python_spec, external_candidate
 from .cases import CASE_NAMES
 from .executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli, trust_line
@@ -86,12 +86,12 @@ from .reports.report_option import check_no_report, report_line
 from .reports.compared import hint_lines, reason_text, what_text
 from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import level_for_oracles, run_crosscheck
+from .spec import run_spec, spec_console, spec_markdown
 from .tolerances import Tolerances
 from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
 from wirecheck.core.scene.files import builtin_names, example_names
 from .candidates.subprocess_candidate import closing_started
 from .reports.wall import process_age_s
-from wirecheck.core.outputs.output import FrameDir, json_dumps
 
 ORACLES = ("opencv", "pyrender")
 #: Options that configure the core candidate, with their defaults.
@@ -129,18 +129,27 @@ def _parse(args):
             ("--min-f1", args.min_f1 != tolerances.MIN_F1_1PX),
             ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX),
             ("--min-iou", args.min_iou != tolerances.MIN_SILHOUETTE_IOU),
-            ("--candidate-precision", args.candidate_precision is not None),
+            ("--candidate-precision", args.candidate_precision is not None and args.suite != "spec"),
             ("--allow-vacuous", args.allow_vacuous)) if given]
         if ignored:
+            allowed = ("--level, --gl, --run, --report-dir, --candidate, --candidate-cmd or --candidate-precision"
+                       if args.suite == "spec"
+                       else "--level, --run or --report-dir")
             raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
-                             "bounds are fixed (oracles/extremes/); expected only --level, --run or --report-dir")
+                             f"bounds are fixed (oracles/{args.suite}/); expected only {allowed}")
+        if args.suite == "spec" and args.candidate_precision is not None and not external:
+            raise InputError(f"--suite spec with --candidate-precision {args.candidate_precision} and no --candidate: "
+                             "core says its own precision: expected --candidate or --candidate-cmd with it")
+        if args.suite == "spec" and core_given:
+            raise InputError(f"--suite spec with {', '.join(core_given)}: the suite judges core in its default "
+                             "settings, or --candidate/--candidate-cmd: expected no --dtype/--clip/--raster")
     if args.sweep and args.allow_vacuous:
         raise InputError("--sweep with --allow-vacuous: the sweep's cases are the bundled scenes and a large mesh, "
                          "which always show something: expected no --allow-vacuous")
     if args.sweep and args.jobs != 1:
         raise InputError(f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
                          "the times compare; expected no --jobs")
-    if (args.sweep or args.suite) and (core_given or external):
+    if (args.sweep or args.suite == "extremes") and (core_given or external):
         what = "--sweep" if args.sweep else f"--suite {args.suite}"
         raise InputError(f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
                          "itself; expected neither --candidate nor --dtype/--clip/--raster")
@@ -168,26 +177,36 @@ def _parse(args):
     mode = RenderMode(style=args.style or "wireframe", hidden_lines=args.hidden_lines, cull=args.cull or "none")
     tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
                      min_iou=args.min_iou, precision=args.candidate_precision)
-    if args.suite:       # fixed cases and bounds (checked above): nothing of a run's inputs applies
+    if args.suite == "extremes":      # fixed cases and bounds (checked above): nothing of a run's inputs applies
         return level, None, None, mode, tol
+    if args.suite == "spec":          # fixed runs and checks; the candidate is core or the one given
+        return level, None, _candidate(args, external), mode, tol
     # the library's one check of what a run compares (oracles.judge.gate), in the CLI's option names
     if args.dataset is not None:      # the meshes are read where they are checked (oracles.datasets.dataset_run)
         inputs = gate.run_settings(args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
     else:
         inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol,
                                  names=gate.CLI_NAMES)
+    for scene in inputs.scenes:         # read leniently (core.scene.files): one line each, the run goes on
+        for note in scene.load_notes:
+            print(f"crosscheck: warning: {note}", file=sys.stderr)
     if mode.cull == "backface":
         wound = next((sc for sc in inputs.scenes if sc.faces and sc.winding_note), None)
         if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
             raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
                              "consistently (counter-clockwise seen from outside)")
+    return level, inputs, _candidate(args, external), mode, tol
+
+
+def _candidate(args, external: str | None):
+    """The run's candidate: the program of ``--candidate``/``--candidate-cmd``, started, or core in its settings."""
     if external:
         if getattr(args, "candidate_from", None) is not None:    # before the program runs (docs/pytest.md)
+            if args.candidate is not None:
+                check_python_spec(args.candidate)      # a file that is refused runs nothing: no line saying it runs
             print(trust_line(*args.candidate_from), file=sys.stderr, flush=True)
-        candidate = external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
-    else:
-        candidate = CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
-    return level, inputs, candidate, mode, tol
+        return external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
+    return CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
 
 
 def _executor(args) -> ExecutorSpec:
@@ -222,6 +241,8 @@ def _dataset(args):
     if not folders and not args.scene_list:
         if args.allow_load_errors:
             raise InputError("--allow-load-errors without a dataset: expected --scene DIR or --scene-list FILE")
+        if args.memory_budget is not None:
+            raise InputError("--memory-budget without a dataset: expected --scene DIR or --scene-list FILE")
         return None
     if len(folders) != len(scenes):
         other = next(s for s in scenes if s not in folders)
@@ -280,6 +301,10 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
+        if args.unprojector is not None or args.unprojector_cmd is not None:     # the way back: its own table
+            from .unprojector_cli import unprojector_main
+
+            return unprojector_main(args)
         args.candidate_from = next(((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd")
                                     if key in applied), None)
         check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (
@@ -329,6 +354,8 @@ def _main(argv=None) -> int:
         return _dataset_main(args, level, inputs, candidate, mode, tol, run_dir)
     if args.sweep:
         return _sweep(args, inputs, level, tol, run_dir)
+    if args.suite == "spec":
+        return _spec_suite(args, candidate, level, run_dir)
     if args.suite:
         return _suite(level, run_dir)
     for scene in inputs.scenes:     # a valid file with nothing in it: said once here, not only in the table
@@ -366,8 +393,12 @@ def _main(argv=None) -> int:
     for r in records:
         if r["verdict"] != "pass":
             print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
-        elif r.get("note"):
-            print(f"  {r['scene']} / {r['camera']}: {r['note']}")
+    notes = {}                              # a passing case's note, once per text: its cases named together
+    for r in records:
+        if r["verdict"] == "pass" and r.get("note"):
+            notes.setdefault(r["note"], []).append(f"{r['scene']} / {r['camera']}")
+    for note, where in notes.items():
+        print(f"  {', '.join(where)}: {note}")
     for line in hint_lines(report, [r for r in records if r["verdict"] != "pass"]):
         print(line)
     s = report["summary"]
@@ -410,6 +441,15 @@ def _vertex_limit(report: dict, tol) -> str:
     return f"{tol.vertex_px:g} px" if bounds <= {tol.vertex_px} else "the bound of the candidate's precision"
 
 
+def _memory_budget(gib: float | None):
+    """``--memory-budget GIB`` in bytes ("auto" when not given); InputError unless a number of GiB > 0."""
+    if gib is None:
+        return "auto"
+    if not (math.isfinite(gib) and gib > 0):
+        raise InputError(f"--memory-budget {gib:g}: expected a number of GiB > 0")
+    return int(gib * 2 ** 30)
+
+
 def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
     """A dataset run (oracles.datasets.dataset_run): progress, the report, the summary on stdout."""
     from .datasets.dataset_report import DatasetProgress, console_summary, write_dataset_report
@@ -420,6 +460,7 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
         args.dataset, candidate, frames=inputs.frames, case_names=inputs.case_names, turns=inputs.turns,
         tol=tol, level=level, every=inputs.every, mode=mode, candidate_name=candidate.name,
         allow_vacuous=args.allow_vacuous, allow_load_errors=args.allow_load_errors, executor=args.executor_spec,
+        memory_budget=_memory_budget(args.memory_budget),
         progress=progress.update if progress.active else None))
     if status is not None:
         return status
@@ -488,6 +529,30 @@ def _suite(level, run_dir) -> int:
           "within their derived bounds" + (f" (failed: {', '.join(failed)})" if failed else ""))
     print(f"Report: {run_dir / 'extremes.md'} (also extremes.json)")
     return 1 if failed else 0
+
+
+def _spec_suite(args, candidate, level, run_dir) -> int:
+    """``--suite spec`` (oracles.spec): the 24 runs and 7 named checks; spec.json and spec.md; exit 0 or 1."""
+    result, status = _run_guarded(args, TerminalProgress(None), lambda: run_spec(
+        candidate, level=level, candidate_name=candidate.name, precision=args.candidate_precision))
+    if status is not None:
+        return status
+    result = {"run": args.run, **result}
+    try:
+        run_dir.parent.mkdir(parents=True, exist_ok=True)     # only now: a failed run leaves no folder
+        out = FrameDir(run_dir, "--report-dir")
+        try:
+            out.write("spec.json", json_dumps(result).encode())
+            out.write("spec.md", spec_markdown(result).encode())
+            out.commit()
+        except BaseException:
+            out.abort()
+            raise
+    except OSError as exc:
+        return _error(f"writing {str(run_dir)!r} failed: {exc}")
+    print("\n".join(spec_console(result)))
+    print(f"Report: {run_dir / 'spec.md'} (also spec.json)")
+    return 0 if result["verdict"] == "pass" else 1
 
 
 if __name__ == "__main__":

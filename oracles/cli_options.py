@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import argparse
 
-from wirecheck.core.app.cli_help import CROSSCHECK_EXAMPLES, usage_hint
+from wirecheck.core.app.cli_help import CROSSCHECK_EXAMPLES, OneLineParser
 from wirecheck.core.app.guard import VersionAction
+from wirecheck.core.numbers import plain_float, plain_int
 
 from . import tolerances
 from .cases import ALL_CASE_NAMES, CASE_NAMES
@@ -22,11 +23,6 @@ from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S
 DESCRIPTION = "crosscheck: judge a projector against OpenCV and pyrender (OSMesa or EGL)."
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2
-        self.exit(2, f"{self.prog}: error: {usage_hint(message)}\n")
-
-
 #: Most worker processes --jobs may ask for, on this machine or a local Dask cluster.
 MAX_JOBS = 256
 #: Longest --scheduler-timeout: 1e308 s waited for ever on an address where no scheduler runs.
@@ -34,7 +30,7 @@ MAX_SCHEDULER_TIMEOUT_S = 3600.0
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="crosscheck", description=DESCRIPTION, epilog=CROSSCHECK_EXAMPLES,
+    p = OneLineParser(prog="crosscheck", description=DESCRIPTION, epilog=CROSSCHECK_EXAMPLES,
                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
@@ -47,7 +43,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--allow-load-errors", action="store_true", default=False,
                    help="dataset runs: a mesh that cannot be loaded is reported and counted but does not fail "
                         "the run (default: it fails the run)")
-    p.add_argument("--frames", type=int, default=None,
+    p.add_argument("--memory-budget", type=plain_float, default=None, metavar="GIB",
+                   help="dataset runs: GiB one mesh may need to be checked; a mesh estimated over it is a load "
+                        "error, and the run goes on (default: half the machine's memory, shared by --jobs)")
+    p.add_argument("--frames", type=plain_int, default=None,
                    help="frames of the scene's motion per case (default 24; 12 with --sweep)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} "
                    f"or the groups default, calibrated, all "
@@ -56,12 +55,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the projector to judge (default: core/); run in its own process")
     p.add_argument("--candidate-cmd", default=None, metavar="'COMMAND ARGS'",
                    help="a projector program in any language, spoken to over stdin/stdout (docs/protocol.md) (default: none)")
-    p.add_argument("--candidate-timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
+    p.add_argument("--candidate-timeout", type=plain_float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--candidate-precision", choices=tolerances.PRECISIONS, default=None,
                    help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.tolerances) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
+    p.add_argument("--unprojector", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",
+                   help="judge an unprojector FUNC(pixels, depth, camera) -> world points against the exact "
+                        "inverse of the conventions (docs/depth.md); with --scene, --cases, --frames (2), --spin; "
+                        "no report folder (default: none)")
+    p.add_argument("--unprojector-cmd", default=None, metavar="'COMMAND ARGS'",
+                   help="an unprojector program in any language, over the candidate protocol's unproject requests "
+                        "(docs/protocol.md); each request under --candidate-timeout (default: none)")
     p.add_argument("--candidate-frames", default=None, metavar="DIR",
                    help="judge a renderer's own PNG frames of a job written by 'crosscheck export DIR' "
                         "(docs/frames.md) (default: none)")
@@ -76,9 +82,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--gl", choices=("osmesa", "egl"), default=None,
                    help="the OpenGL platform pyrender draws on (level pixels): osmesa, or egl (Mesa's on the CPU, "
                         "or a GPU's driver) (default: $PYOPENGL_PLATFORM, else osmesa)")
-    p.add_argument("--every", type=int, default=1, metavar="K",
+    p.add_argument("--every", type=plain_int, default=1, metavar="K",
                    help="check frames 1, 1+K, 1+2K, ... of the motion (default 1: every frame)")
-    p.add_argument("--jobs", type=int, default=1, metavar="N",
+    p.add_argument("--jobs", type=plain_int, default=1, metavar="N",
                    help="run the cases in N worker processes (default 1; same report for any N)")
     p.add_argument("--executor", choices=EXECUTORS, default=None,
                    help="local: this process or --jobs worker processes; dask: Dask distributed, a local "
@@ -86,7 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                    help="the Dask scheduler of a cluster (docs/datasets.md); implies --executor dask "
                         "(default: none, a local cluster)")
-    p.add_argument("--scheduler-timeout", type=float, default=DEFAULT_CONNECT_TIMEOUT_S, metavar="SECONDS",
+    p.add_argument("--scheduler-timeout", type=plain_float, default=DEFAULT_CONNECT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds to reach --scheduler and see a worker (default {DEFAULT_CONNECT_TIMEOUT_S:g})")
     p.add_argument("--dtype", choices=CoreCandidate.DTYPES, default=None,
                    help="core candidate only: floating-point type of the pipeline (default float64)")
@@ -104,21 +110,23 @@ def build_parser() -> argparse.ArgumentParser:
                    help="core candidate, level pixels: backface culls back faces and the edges only they own "
                         "(default none)")
     p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames (default 1,1,0)")
-    p.add_argument("--tol-px", type=float, default=tolerances.VERTEX_TOL_PX,
+    p.add_argument("--tol-px", type=plain_float, default=tolerances.VERTEX_TOL_PX,
                    help=f"max vertex error in px (default {tolerances.VERTEX_TOL_PX})")
-    p.add_argument("--min-f1", type=float, default=tolerances.MIN_F1_1PX,
+    p.add_argument("--min-f1", type=plain_float, default=tolerances.MIN_F1_1PX,
                    help=f"min edge-pixel F1 at 1 px (default {tolerances.MIN_F1_1PX})")
-    p.add_argument("--min-f1-0px", type=float, default=tolerances.MIN_F1_0PX,
+    p.add_argument("--min-f1-0px", type=plain_float, default=tolerances.MIN_F1_0PX,
                    help=f"min edge-pixel F1 at 0 px (default {tolerances.MIN_F1_0PX})")
-    p.add_argument("--min-iou", type=float, default=tolerances.MIN_SILHOUETTE_IOU,
+    p.add_argument("--min-iou", type=plain_float, default=tolerances.MIN_SILHOUETTE_IOU,
                    help=f"--style shaded: min silhouette IoU (default {tolerances.MIN_SILHOUETTE_IOU})")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--sweep", action="store_true",
                       help="every --dtype x --clip x --raster setting of core on the scenes and a large mesh: "
                            "table and Pareto plot of time per frame against accuracy (default: off)")
-    mode.add_argument("--suite", choices=("extremes",), default=None,
+    mode.add_argument("--suite", choices=("extremes", "spec"), default=None,
                       help="extremes: near plane, tiny/huge FOV, extreme aspect, far from the origin, "
-                           "1,000,000-frame periodicity, degenerate and non-finite inputs (default: none)")
+                           "1,000,000-frame periodicity, degenerate and non-finite inputs; spec: the "
+                           "specification's 24-run test matrix and its 7 named checks, of core or --candidate "
+                           "(docs/spec-suite.md) (default: none)")
     p.add_argument("--allow-vacuous", action="store_true", default=False,
                    help="a case that compared nothing (every point clipped, nothing drawn) does not fail the run "
                         "(default: it does)")

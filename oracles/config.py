@@ -30,12 +30,14 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
 from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
+from wirecheck.core.user_files import RefusedFile, problem, read_text
 from .tolerances import PRECISIONS
 
 if sys.version_info >= (3, 11):
@@ -91,12 +93,21 @@ class Config:
         return kwargs
 
 
+def _absolute(path: Path) -> str:
+    """``path`` resolved (links followed); only made absolute where it cannot be (a link loop: Python 3.11 raises
+    RuntimeError), so that the reader of the file names the loop in its one line."""
+    try:
+        return str(path.resolve())
+    except (RuntimeError, OSError):
+        return os.path.abspath(path)
+
+
 def find_pyproject(start: Path) -> Path | None:
     """The nearest ``pyproject.toml`` at or above ``start``; None when there is none."""
     start = Path(start).resolve()
     for folder in (start, *start.parents):
         candidate = folder / "pyproject.toml"
-        if candidate.is_file():
+        if candidate.exists():       # a FIFO or folder of that name is refused by load_config, not passed over
             return candidate
     return None
 
@@ -113,16 +124,13 @@ def load_config(path: Path | None = None, start: Path | None = None) -> Config:
     if path is None:
         return Config()
     try:
-        with open(path, "rb") as fh:
-            # a UTF-8 byte-order mark (Windows editors) is not TOML: tomllib's message for it is
-            # "Invalid statement (at line 1, column 1)", which points nowhere useful
-            data = tomllib.loads(fh.read().decode("utf-8-sig"))
-    except FileNotFoundError:
-        raise InputError(f"{path}: file not found: expected a pyproject.toml with a [{TABLE}] table") from None
-    except IsADirectoryError:
-        raise InputError(f"{path} is a directory: expected a pyproject.toml file") from None
-    except OSError as exc:
-        raise InputError(f"{path}: could not be read: {exc}") from None
+        # a UTF-8 byte-order mark (Windows editors) is not TOML: tomllib's message for it is
+        # "Invalid statement (at line 1, column 1)", which points nowhere useful
+        data = tomllib.loads(read_text(path, "config"))
+    except RefusedFile as exc:
+        if exc.problem == "missing":
+            raise InputError(f"{path}: file not found: expected a pyproject.toml with a [{TABLE}] table") from None
+        raise
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
     except RecursionError:           # tomllib recurses per nested array or inline table
@@ -140,7 +148,7 @@ def load_config(path: Path | None = None, start: Path | None = None) -> Config:
 
 def validate(table: dict, path: Path) -> dict:
     """The table's values checked against :data:`KEYS`, paths made absolute; InputError otherwise."""
-    from wirecheck.core.scene.files import builtin_names, example_names
+    from wirecheck.core.scene.files import MESH_SUFFIXES, builtin_names, example_names
 
     from .cases import ALL_CASE_NAMES as CASE_NAMES
 
@@ -168,7 +176,7 @@ def validate(table: dict, path: Path) -> dict:
                 raise bad(key, value)
             target, func = value.rsplit(":", 1)
             if target.endswith(".py") or "/" in target:
-                target = str((base / target).resolve())
+                target = _absolute(base / target)
             out[key] = f"{target}:{func}"
         elif key == "candidate-cmd":
             if not (isinstance(value, str) and value.strip()):
@@ -189,10 +197,11 @@ def validate(table: dict, path: Path) -> dict:
             scenes = []
             for name in value:
                 if "/" in name or "\\" in name or Path(name).suffix:
-                    scene_path = (base / name).resolve()
-                    if not scene_path.is_file():
-                        raise bad(key, value, f"existing scene files: {str(scene_path)!r} is not a file")
-                    scenes.append(str(scene_path))
+                    scene_path = base / name
+                    refused = problem(scene_path, "mesh" if scene_path.suffix.lower() in MESH_SUFFIXES else "scene")
+                    if refused is not None:         # before resolve(): a link loop is named, not a RuntimeError
+                        raise bad(key, value, f"existing scene files: {str(scene_path)!r} is not a file ({refused})")
+                    scenes.append(_absolute(scene_path))
                 elif name in known:
                     scenes.append(name)
                 else:

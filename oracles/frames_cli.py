@@ -7,27 +7,23 @@ Both only parse and call :mod:`oracles.candidates.export` / :mod:`oracles.candid
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import sys
 from pathlib import Path
 
+from wirecheck.core.app.cli_help import OneLineParser
 from wirecheck.core.errors import InputError
+from wirecheck.core.numbers import plain_float, plain_int
 
 from .cases import ALL_CASE_NAMES, CASE_NAMES
 from wirecheck.core.scene.files import builtin_names, load_scene
 from wirecheck.core.transforms import Motion
 from wirecheck.core.limits import MAX_FRAMES
 from .judge.line_style import summary_lines
-from .reports.compared import what_text
+from .reports.compared import hint_lines, what_text
 from .reports.report_option import report_line
 from .tolerances import Tolerances
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2
-        self.exit(2, f"{self.prog}: error: {message}\n")
 
 
 def _fail(message: str) -> int:
@@ -40,21 +36,21 @@ def export_main(argv) -> int:
     """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z] [--phase F]``."""
     from .candidates.export import write_job
 
-    p = _Parser(prog="crosscheck export",
+    p = OneLineParser(prog="crosscheck export",
                 description="write a rendering job (scenes as OBJ, a camera JSON per case and frame, a README) "
                             "for any renderer; judge its frames with crosscheck --candidate-frames DIR")
     p.add_argument("dir", help="the job folder to write (new, empty, or an earlier export)")
     p.add_argument("--scene", action="append", default=None, help="scene name or path; repeatable (default: all)")
-    p.add_argument("--frames", type=int, default=24, help="frames of the motion (default 24)")
-    p.add_argument("--every", type=int, default=1, metavar="K", help="only frames 1, 1+K, ... (default 1)")
+    p.add_argument("--frames", type=plain_int, default=24, help="frames of the motion (default 24)")
+    p.add_argument("--every", type=plain_int, default=1, metavar="K", help="only frames 1, 1+K, ... (default 1)")
     p.add_argument("--cases", default=",".join(CASE_NAMES), help=f"comma-separated subset of: {', '.join(ALL_CASE_NAMES)} (default: {', '.join(CASE_NAMES)})")
     p.add_argument("--spin", default="1,1,0", metavar="X,Y,Z", help="full turns about X, Y, Z over the frames")
-    p.add_argument("--phase", type=float, default=0.0, metavar="F",
+    p.add_argument("--phase", type=plain_float, default=0.0, metavar="F",
                    help="move every frame on by F of a frame's step, 0 <= F < 1: frame k at t = (k - 1 + F) / "
                         "frames (default 0: crosscheck's own poses; 0.3: no frame of --frames 4 is a quarter turn)")
     args = p.parse_args(argv)
     try:
-        from wirecheck.core.outputs.output import check_replaceable
+        from wirecheck.core.outputs.output import check_outside_scenes, check_replaceable
 
         if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
             raise InputError(f"--frames {args.frames} --every {args.every}: expected --frames in 1..{MAX_FRAMES:,} "
@@ -67,7 +63,7 @@ def export_main(argv) -> int:
             raise InputError(f"--cases {args.cases!r}: unknown {', '.join(bad) or '(none)'}; "
                              f"expected some of {', '.join(ALL_CASE_NAMES)}")
         try:
-            spin = tuple(float(x) for x in args.spin.split(","))
+            spin = tuple(plain_float(x) for x in args.spin.split(","))
         except ValueError:
             spin = ()
         if len(spin) != 3 or not all(math.isfinite(x) for x in spin):
@@ -77,6 +73,8 @@ def export_main(argv) -> int:
             raise InputError(f"export {args.dir!r}: its parent folder does not exist")
         if not os.access(out.parent, os.W_OK | os.X_OK):
             raise InputError(f"export {args.dir!r}: {str(out.parent)!r} is not writable: expected a writable folder")
+        # a job in the bundled scenes/ would pass for scenes in later runs (as --out and --report-dir there)
+        check_outside_scenes(out, "export DIR", "a job folder elsewhere (e.g. job/)")
         check_replaceable(out, "export DIR")           # the target first: nothing is built for a refused one
         scenes = [load_scene(n) for n in (args.scene or builtin_names())]
         job = write_job(out, scenes, frames=args.frames, every=args.every, case_names=cases,
@@ -141,9 +139,11 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     print(console_table(report["cases"]))
     for line in summary_lines(report["cases"]):
         print(line)
-    for r in report["cases"]:
-        if r["verdict"] != "pass":          # failed, or vacuous (compared nothing)
-            print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+    failing = [r for r in report["cases"] if r["verdict"] != "pass"]    # failed, or vacuous (compared nothing)
+    for r in failing:
+        print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+    for line in hint_lines(report, failing):    # what to check and each fault kind's note, once
+        print(line)
     print("\n" + verdict_line(report, tol))
     print(report_line(args, run_dir, "report.json", "report.md, report.html"))
     return 1 if report["verdict"] != "pass" else 0

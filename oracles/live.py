@@ -24,7 +24,7 @@ from wirecheck.core.outputs.output import png_bytes
 from .judge import metrics
 from .cases import Case
 from .references.pyrender_oracle import OracleCache, osmesa_available
-from .reports.report import fault_text
+from .reports.fault_text import case_cell
 from .judge.case import run_case
 from .candidates.core_candidate import CoreCandidate, RenderMode
 from .tolerances import Tolerances
@@ -58,7 +58,7 @@ class LiveOverlay:
                "f1_0px": rec.get("pixel_f1_0px"), "f1_1px": rec.get("pixel_f1_1px"),
                "max_vertex_error_px": rec.get("max_vertex_error_px"),
                "faults": [f["name"] for f in rec["faults"]],
-               "faults_text": fault_text(rec["faults"], rec.get("camera_spec")),
+               "faults_text": case_cell(rec["faults"], rec.get("camera_spec")),
                "silhouette_iou": rec.get("silhouette_iou"), "depth_error_ratio": rec.get("depth_error_ratio"),
                "oracle_image": None, "diff_image": None}
         if res.worst_images is not None:

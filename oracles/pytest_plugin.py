@@ -85,21 +85,18 @@ def pytest_configure(config):
 
 
 def report_name(nodeid: str) -> str:
-    """A folder name for a test id: runs of other characters become ``_``.
+    """A folder name for a test id: its letters, digits, ``_``, ``.`` and ``-`` (any run of other
+    characters made ``_``, at most 120 characters kept), then ``-`` and the first 8 hex digits of the
+    SHA-1 of the whole id.
 
-    Only ``/``, ``::`` and brackets are replaced one-to-one; a test id with any
-    other replaced character (``test_x[a b]`` and ``test_x[a_b]`` would share a
-    folder, and the second report replace the first), one ending like a later
-    check's ``-2``, or one too long for a file name gets ``-`` and the first 8
-    hex digits of its SHA-1.
+    The hash makes the name one-to-one with the id, whatever characters two ids differ in
+    (``test[a/b]``, ``test[a::b]``, ``test[a]b]`` and ``test[a b]`` are all ``test_a_b`` before it),
+    keeps it under a file name's 255 bytes, and never ends like a later check's ``-2``.
     """
     import hashlib
 
-    name = re.sub(r"[^A-Za-z0-9_.-]+", "_", nodeid).strip("._-") or "test"
-    plain = re.sub(r"(?:::|[/\[\]])+", "_", nodeid).strip("._-")
-    if name != plain or re.search(r"-[0-9]+$", name) or len(name) > 120:
-        name = name[:120] + "-" + hashlib.sha1(nodeid.encode("utf-8", "surrogatepass")).hexdigest()[:8]
-    return name
+    name = re.sub(r"[^A-Za-z0-9_.-]+", "_", nodeid).strip("._-")[:120] or "test"
+    return name + "-" + hashlib.sha1(nodeid.encode("utf-8", "surrogatepass")).hexdigest()[:8]
 
 
 def _write(config, node, index: int, report: dict, images: dict) -> str:

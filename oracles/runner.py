@@ -263,7 +263,8 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
                    *, level: str | None = None, every: int = 1, jobs: int = 1,
                    candidate_spec: str | None = None, mode: RenderMode | None = None,
                    animation: bool = True, allow_vacuous: bool = False, progress=None,
-                   isolate: bool = False, executor: ExecutorSpec | None = None) -> tuple[dict, dict]:
+                   isolate: bool = False, executor: ExecutorSpec | None = None,
+                   cases: tuple | None = None) -> tuple[dict, dict]:
     """Every scene under every case camera: the report dict and the worst-frame images.
 
     ``level`` is "vertices" (OpenCV only) or "pixels" (OpenCV and pyrender, the
@@ -300,6 +301,11 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     with status 0; the candidate must then be given as ``candidate_spec``.
     ``executor`` (:class:`oracles.executors.ExecutorSpec`) sends the cases to
     a Dask cluster instead (same report; ``jobs`` is then the spec's).
+
+    ``cases``: fixed cameras (:class:`oracles.cases.Case`, distinct names),
+    each scene run under every one of them instead of the cameras framed on it
+    (``case_names`` must then be None; the spec suite, oracles.spec, places its
+    cameras as the specification does).
     """
     if oracles is not None:
         implied = level_for_oracles(oracles)
@@ -322,7 +328,14 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     frames, every = inputs.frames, inputs.every
     motion = Motion(turns=inputs.turns)
     t_run = time.perf_counter()
-    tasks = [(scene, case) for scene in inputs.scenes for case in scene_cases(scene, inputs.case_names, motion)]
+    if cases is not None:
+        names = [case.name for case in cases]
+        if case_names is not None or not names or len(set(names)) != len(names):
+            raise ValueError(f"cases {names}: expected at least one Case, distinct names, and no case_names")
+        tasks = [(scene, case) for scene in inputs.scenes for case in cases]
+    else:
+        tasks = [(scene, case) for scene in inputs.scenes
+                 for case in scene_cases(scene, inputs.case_names, motion)]
     if level == "pixels" and tasks and all(case.camera.distortion is not None for _, case in tasks):
         raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their pixels "
                          "are not compared (GL draws straight lines), so the run would compare no pixel; "

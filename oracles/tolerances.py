@@ -128,6 +128,48 @@ def vertex_bound(precision: str, scale: float, floor: float = VERTEX_TOL_PX) -> 
         return float(floor)
     return max(float(floor), VERTEX_ROUNDINGS * EPS[precision] * float(scale))
 
+# ---------------------------------------------------------------- the unprojector (the way back)
+
+# An unprojector maps a pixel p = (u, v) and a depth d along forward to the world point
+# X = R^T (p_cv - t) (oracles.references.unproject_reference). Its rounding: u - cx rounds
+# values of size |u| + |cx| and the product with d / fx carries that to x_cv; the rotation
+# and the translation round values of size |p_cv| + |C| (C the camera position). So each
+# world coordinate is off by a few eps times
+#
+#     scale = |C| + d (1 + (|u| + |cx|) / fx + (|v| + |cy|) / fy)      (perspective)
+#     scale = |C| + d + (|u| + |cx| + |v| + |cy|) / s                     (orthographic)
+#
+# world units (|.| the largest coordinate). UNPROJECT_ROUNDINGS counts them: about seven
+# per coordinate (subtract, divide, multiply, three products and two sums of the rotation,
+# the translation), on the candidate's side and the reference's: 16. A float32 candidate
+# (its answer float32) is held to eps32, a float64 one to eps64; as for vertices, no bound
+# is below VERTEX_TOL_PX pixels at the point's depth (``d VERTEX_TOL_PX / f``; orthographic
+# ``VERTEX_TOL_PX / s``), so a correct unprojector that inverts the 4x4 GL matrices (worse
+# conditioned than K, R, t) is not failed for that.
+UNPROJECT_ROUNDINGS = 16.0
+
+
+def unproject_bound(p_px, depth, camera, precision: str = "float64", floor_px: float = VERTEX_TOL_PX):
+    """``(N,)`` world-unit bound on ``|X_candidate - X|`` per point (the derivation above).
+
+    ``p_px`` ``(N, 2)`` pixels, ``depth`` ``(N,)`` depths along forward, ``camera`` the contract's.
+    """
+    import numpy as np
+
+    p = np.abs(np.asarray(p_px, dtype=np.float64).reshape(-1, 2))
+    d = np.abs(np.asarray(depth, dtype=np.float64).reshape(-1))
+    k = np.asarray(camera.K, dtype=np.float64)
+    fx, fy, cx, cy = k[0, 0], k[1, 1], abs(k[0, 2]), abs(k[1, 2])
+    c = float(np.abs(np.asarray(camera.position, dtype=np.float64)).max())
+    if camera.projection == "perspective":
+        scale = c + d * (1.0 + (p[:, 0] + cx) / fx + (p[:, 1] + cy) / fy)
+        floor = floor_px * d / max(fx, fy)
+    else:
+        scale = c + d + (p[:, 0] + cx + p[:, 1] + cy) / fx
+        floor = np.full(d.shape, floor_px / fx)
+    return np.maximum(UNPROJECT_ROUNDINGS * EPS[precision] * scale, floor)
+
+
 #: Minimum edge-pixel F1 at 1 px (Chebyshev) against pyrender/OSMesa.
 #: Measured: 1.0 in every one of 1,512 frames (3 scenes x 7 cameras x 72
 #: frames) and in 432 frames of four other cameras (README, "Pixel

@@ -200,6 +200,26 @@ def _block(path, lines, directive_at, first, last, indent, body) -> list[Sample]
                    False, found.get("cwd"), found)]
 
 
+def code_blocks(path: Path, heading: str) -> dict[str, str]:
+    """The fenced code blocks of ``path``'s section ``heading`` (a ``#`` line's text, up to the next heading),
+    by their language tag (``python``, ``toml``; the first block of each), each as its text: a doc's example
+    files, which a test writes into a project and runs (tests/test_docs_samples.py)."""
+    lines = path.read_text(encoding="utf-8").splitlines()
+    start = next(i for i, line in enumerate(lines) if line.lstrip("#").strip() == heading and line.startswith("#"))
+    out: dict[str, str] = {}
+    i = start + 1
+    while i < len(lines) and not lines[i].startswith("#"):
+        m = _FENCE.match(lines[i])
+        if m:
+            j = i + 1
+            while j < len(lines) and not _FENCE.match(lines[j]):
+                j += 1
+            out.setdefault(m.group(3).strip(), "\n".join(lines[i + 1:j]) + "\n")
+            i = j
+        i += 1
+    return out
+
+
 def all_samples() -> list[Sample]:
     return [s for p in doc_files() for s in samples(p)]
 
@@ -322,6 +342,17 @@ class Runner:
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                               timeout=COMMAND_TIMEOUT_S, text=True)
         return done.stdout.splitlines()
+
+    def in_project(self, files: dict[str, str], command: str) -> list[str]:
+        """What ``command`` prints in a fresh folder holding only ``files`` (``{relative path: text}``): a new
+        user's project, which finds wirecheck in this environment and nothing of the checkout (no links)."""
+        work = tempfile.mkdtemp(prefix="wirecheck-project-")
+        self._dirs.append(work)
+        for rel, text in files.items():
+            path = Path(work) / rel
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text, encoding="utf-8")
+        return _shown(self._run_bash(command, work, self._env()), work)
 
     def close(self):
         for d in self._dirs:

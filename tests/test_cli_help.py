@@ -45,8 +45,15 @@ def test_a_negative_value_without_equals_gets_the_hint():
 
 
 def test_renderer_says_so_in_one_line():
-    done = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--distortion", "-0.2,0.05,0,0"],
+    # a value starting with '-' that is no number is still argparse's to refuse
+    done = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--out", "-x"],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 2
-    assert done.stderr.splitlines() == ["renderer: error: argument --distortion: expected one argument (a value "
-                                        "starting with '-' is given with '=': --distortion=-0.2,...)"]
+    assert done.stderr.splitlines() == ["renderer: error: argument --out: expected one argument (a value "
+                                        "starting with '-' is given with '=': --out=-0.2,...)"]
+
+
+def test_a_negative_number_needs_no_equals():
+    # before: "argument --distortion: expected one argument" (argparse takes -0.2,0.05,0,0 for an option)
+    args = renderer_parser().parse_args(["--distortion", "-0.2,0.05,0,0", "--camera-pos", "-1e5,2,3"])
+    assert (args.distortion, args.camera_pos) == ("-0.2,0.05,0,0", "-1e5,2,3")

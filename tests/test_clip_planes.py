@@ -19,7 +19,8 @@ from wirecheck.oracles.diagnosis import clip_planes
 from wirecheck.oracles.diagnosis.clip_planes import clip_fault, depth_slack, probe_planes
 from wirecheck.oracles.diagnosis.diagnose import diagnose
 from wirecheck.oracles.references.opencv_oracle import project as oracle_project
-from wirecheck.oracles.reports.report import fault_hints
+from wirecheck.oracles.faults import hint_text
+from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
 sys.path.insert(0, str(Path(__file__).parent / "data"))
 import gl_float32_matrix  # noqa: E402
@@ -99,7 +100,7 @@ def test_diagnose_names_the_clipping_plane(name):
     if name in EXPECTED_FIT:
         assert got[0]["near_fit"] == pytest.approx(EXPECTED_FIT[name][0], rel=REL, abs=1e-9 * CAM.near)
     hints = dict(fault_hints(got))
-    # the kind's own hint (clip_planes.HINTS), naming the plane at fault; never the rotation advice
+    # the kind's own hint (the catalogue's hints of clipping_plane, oracles.faults), naming the plane at fault; never the rotation advice
     plane = "far" if kind == "far" else "near"
     assert plane in hints["clipping_plane"] and "rotation" not in hints["clipping_plane"]
 
@@ -143,7 +144,7 @@ def test_a_float32_far_plane_is_named_float32_far():
                                                                                                rel=1e-9)
     assert (f["near"], f["far"]) == (CAM_F32_FAR.near, CAM_F32_FAR.far)
     hint = dict(fault_hints(got))["clipping_plane"]
-    assert hint == clip_planes.HINTS["float32_far"] and "far plane went through float32" in hint
+    assert hint == hint_text("clipping_plane", "float32_far") and "far plane went through float32" in hint
 
 
 @pytest.mark.parametrize("name,kind", [("z_positive", "z_positive"), ("none", "none")])
@@ -160,7 +161,7 @@ def test_a_run_names_the_clipping_plane(name, kind):
     assert [(f["name"], f["kind"]) for f in case["faults"]] == [("clipping_plane", kind)], case["faults"]
     # z > 0 keeps points at 1e-9 near, the probe's nearest depth: near_fit 0.0; never clipping: no plane
     assert case["faults"][0]["near_fit"] == (0.0 if kind == "z_positive" else None)
-    assert dict(fault_hints(case["faults"]))["clipping_plane"] == clip_planes.HINTS[kind]
+    assert dict(fault_hints(case["faults"]))["clipping_plane"] == hint_text("clipping_plane", kind)
 
 
 def test_a_broken_probe_is_no_fault():

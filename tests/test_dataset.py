@@ -163,7 +163,7 @@ def _empty_folder(tmp_path):
     (_only_distorted, "cases distorted at level pixels: lens distortion: their pixels are not compared"),
     (_none_loads, "none of the 2 meshes could be loaded (first: a.obj: line 1: vertex 'v 1 2'"),
     (lambda t: ["--scene", "cube", "--scene", t], "--scene 'cube' with a dataset"),
-    (lambda t: ["--scene-list", t / "nope.txt"], "No such file or directory: expected a readable file of paths"),
+    (lambda t: ["--scene-list", t / "nope.txt"], "nope.txt: missing: expected a scene list (one mesh path a line)"),
     (lambda t: ["--allow-load-errors"], "--allow-load-errors without a dataset"),
     (lambda t: ["--scene", t, "--sweep"], "with --sweep: expected a plain crosscheck run over the meshes"),
     (lambda t: ["--scene", t, "--scheduler", "localhost:8786"], "--scheduler 'localhost:8786': expected tcp://"),

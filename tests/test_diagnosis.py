@@ -21,7 +21,8 @@ from wirecheck.core.projector.projection import project_points
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.diagnosis.clip_planes import probe_planes
-from wirecheck.oracles.diagnosis.diagnose import FAULT_ORDER, LINE_FAULTS, diagnose, primary
+from wirecheck.oracles.diagnosis.diagnose import diagnose, primary
+from wirecheck.oracles.faults import NAMES as FAULT_ORDER, names as fault_names
 from wirecheck.oracles.tolerances import vertex_bound, vertex_scale
 
 from diagnosis_faults import (  # the faulty projectors and their cameras
@@ -227,7 +228,7 @@ def test_implied_fov_of_horizontal_fov(results, camera_name):
 
 
 def test_scale_hints_only_for_their_ratios(results):
-    """A 0.8 FOV factor is no W/H: the generic hint (hints.FAULT_HINTS) stays."""
+    """A 0.8 FOV factor is no W/H: the generic hint (the catalogue's, oracles.faults) stays."""
     (fov,) = results[("fov", "axis")]
     assert "hint" not in fov
 
@@ -447,7 +448,7 @@ def test_large_pooled_input_is_fast():
 def confusion(results):
     """rows: injected single fault (by its expected primary name); columns: diagnosed primary."""
     # the vertex faults: the line faults come from the pixels (tests/test_line_gate.py)
-    labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS + ("ambiguous",)]   # ambiguous: images only
+    labels = ["none"] + [n for n in FAULT_ORDER if n not in fault_names(source="pixels") + ("ambiguous",)]   # ambiguous: images only
     counts = Counter()
     for (fault, cam), got in results.items():
         if fault not in SINGLE:

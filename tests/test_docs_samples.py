@@ -14,6 +14,7 @@ After a change of output, regenerate the samples: ``python tests/docs_samples.py
 from __future__ import annotations
 
 import re
+import sys
 import tempfile
 
 import pytest
@@ -48,6 +49,31 @@ def test_the_docs_have_samples_of_each_program():
 def test_sample_is_what_the_program_prints(sample, runner):
     problems = ds.check(sample, runner)
     assert not problems, "\n\n".join(problems)
+
+
+@pytest.mark.slow
+def test_the_readmes_five_line_example_works_as_written_in_a_fresh_project(runner):
+    # the README's test file and pytest setting, verbatim, in a folder of their own (nothing installed:
+    # this environment's wirecheck), with a correct projector written on the contract only
+    blocks = ds.code_blocks(ds.ROOT / "README.md", "Check your own projector in five lines")
+    test_file, config = blocks["python"], blocks["toml"]
+    assert "from my_package import project" in test_file and "pythonpath" in config
+    correct = (ds.ROOT / "tests" / "data" / "user_projector.py").read_text(encoding="utf-8")
+    project = {"my_package/__init__.py": correct, "tests/test_x.py": test_file, "pyproject.toml": config}
+    # PYTHONSAFEPATH: the current folder is not put on the path, as for the `pytest` script (3.11+)
+    pytest = "PYTHONSAFEPATH=1 pytest -q -p no:cacheprovider"
+    out = runner.in_project(project, pytest)
+    assert out and re.fullmatch(r"1 passed in [\d.]+s", out[-1]), "\n".join(out)
+    # the same test fails a principal point at (W/2, H/2), naming the fault: it checks something
+    corner = correct + ("\n_correct = project\n\n\ndef project(points, camera):\n"
+                        "    return _correct(points, camera, cx=camera.width / 2, cy=camera.height / 2)\n")
+    out = runner.in_project({**project, "my_package/__init__.py": corner}, pytest)
+    assert re.fullmatch(r"1 failed in [\d.]+s", out[-1]) and any("pixel_offset(dx=0.5, dy=0.5)" in x for x in out)
+    # and without the setting (nor an install) pytest cannot import the package: what the README says
+    if sys.version_info < (3, 11):
+        return                                        # no PYTHONSAFEPATH: `python -m` adds the folder
+    out = runner.in_project({k: v for k, v in project.items() if k != "pyproject.toml"}, pytest)
+    assert any("No module named 'my_package'" in x for x in out), "\n".join(out)
 
 
 def test_not_run_samples_say_why():

@@ -1,6 +1,6 @@
 """A fault's parameters are printed to what they mean: no float64 rounding digits, no fields that are not implied."""
 
-from wirecheck.oracles.reports.report import fault_text
+from wirecheck.oracles.reports.fault_text import full_text as fault_text
 
 
 def test_a_parameter_one_rounding_from_nominal_prints_as_nominal():

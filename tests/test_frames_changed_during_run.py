@@ -43,7 +43,7 @@ def test_a_folder_or_device_named_like_a_frame_is_named(tmp_path):
     (tmp_path / "d.png").mkdir()
     with pytest.raises(FrameProblem, match="^a folder, not a regular file$"):
         read_grey(tmp_path / "d.png", 4, 4)
-    with no_block(), pytest.raises(FrameProblem, match="^a device, not a regular file$"):
+    with no_block(), pytest.raises(FrameProblem, match="^a character device, not a regular file$"):
         read_grey("/dev/zero", 4, 4)
 
 

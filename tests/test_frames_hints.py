@@ -1,4 +1,4 @@
-"""What to check on a renderer's own frames: the drawing library's own choices (report.FRAMES_HINTS).
+"""What to check on a renderer's own frames: the drawing library's own choices (the catalogue's frames_hint, oracles.faults).
 
 A correct matplotlib renderer that keeps its default snapping, or Pillow given float coordinates, reads as
 ``pixel_offset`` (0.46 px and -0.5 px measured, docs/frames.md); a renderer of another aliased rule can read
@@ -10,21 +10,22 @@ from __future__ import annotations
 
 from wirecheck.oracles.reports.compared import hint_lines
 from wirecheck.oracles.reports.junit import failure_text
-from wirecheck.oracles.reports.report import FAULT_HINTS, fault_hints
+from wirecheck.oracles.faults import CATALOGUE
+from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
 FAULTS = [{"name": "pixel_offset", "dx": 0.46, "dy": 0.46}, {"name": "line_end_bias"}]
 
 
 def test_frames_hints_name_the_drawing_librarys_choices():
     hints = dict(fault_hints(FAULTS, frames=True))
-    assert hints["pixel_offset"].startswith(FAULT_HINTS["pixel_offset"]) and "snap=False" in hints["pixel_offset"]
+    assert hints["pixel_offset"].startswith(CATALOGUE["pixel_offset"].hint) and "snap=False" in hints["pixel_offset"]
     assert "round them" in hints["pixel_offset"]
-    assert hints["line_end_bias"].startswith(FAULT_HINTS["line_end_bias"])
+    assert hints["line_end_bias"].startswith(CATALOGUE["line_end_bias"].hint)
     assert "--line-rule geometry" in hints["line_end_bias"]
 
 
 def test_a_projectors_hints_stay_generic():
-    assert dict(fault_hints(FAULTS)) == {n: FAULT_HINTS[n] for n in ("pixel_offset", "line_end_bias")}
+    assert dict(fault_hints(FAULTS)) == {n: CATALOGUE[n].hint for n in ("pixel_offset", "line_end_bias")}
 
 
 def test_the_console_and_junit_follow_the_reports_level():
@@ -51,8 +52,8 @@ def test_the_verdict_line_claims_f1_at_0px_only_where_it_judged():
 
 def test_a_faults_list_of_floats_is_written_as_its_numbers():
     """A per-axis value (``scale=[sx, sy]``) is written as each float is, not as Python's repr of the list."""
-    from wirecheck.oracles.reports.report import fault_text
+    from wirecheck.oracles.reports.fault_text import full_text
 
-    text = fault_text([{"name": "unexplained", "scale": [0.622011633928914, 0.8000000000000003]}])
+    text = full_text([{"name": "unexplained", "scale": [0.622011633928914, 0.8000000000000003]}])
     # four significant digits, trailing zeros dropped (oracles.reports.fmt.distinct): 0.6220 -> 0.622, 0.8000 -> 0.8
     assert text == "unexplained(scale=[0.622, 0.8])", text

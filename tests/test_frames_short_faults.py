@@ -27,7 +27,7 @@ import pytest
 
 from wirecheck.core.camera import Camera
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.reports.report import fault_hints
+from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
 from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 

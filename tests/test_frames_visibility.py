@@ -27,7 +27,8 @@ from wirecheck.core.camera import Camera
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.reports.report import FAULT_HINTS, fault_hints
+from wirecheck.oracles.faults import CATALOGUE
+from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
 from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 
@@ -112,8 +113,8 @@ def test_a_rolled_camera_keeps_the_rotation_advice(judged):
     names = [f["name"] for f in case["faults"]]
     assert names == ["unexplained"], case["faults"]
     assert "hint" not in case["faults"][0], case["faults"]
-    assert dict(fault_hints(case["faults"]))["unexplained"] == FAULT_HINTS["unexplained"]
-    assert "rotation order" in FAULT_HINTS["unexplained"]
+    assert dict(fault_hints(case["faults"]))["unexplained"] == CATALOGUE["unexplained"].hint
+    assert "rotation order" in CATALOGUE["unexplained"].hint
 
 
 def test_a_line_width_fault_stays_a_line_fault():

@@ -323,7 +323,7 @@ def test_no_progress_when_stderr_is_not_a_terminal(tmp_path, capsys):
 
 def test_fault_numbers_are_printed_distinct_from_their_nominal_values():
     from wirecheck.oracles.reports.fmt import distinct
-    from wirecheck.oracles.reports.report import fault_text
+    from wirecheck.oracles.reports.fault_text import full_text as fault_text
 
     camera = {"width": 640, "height": 480, "fov_y_deg": 60.0, "ortho_height": 3.0}
     faults = [{"name": "aspect_mismatch", "implied_aspect": 1.33264, "scale_x": 1.0005, "scale_y": 1.0},

@@ -650,7 +650,7 @@ def test_scene_symlink_loop_and_fifo_are_named(tmp_path, capsys):
     (tmp_path / "a.obj").symlink_to(tmp_path / "b.obj")
     (tmp_path / "b.obj").symlink_to(tmp_path / "a.obj")
     os.mkfifo(tmp_path / "f.obj")
-    for name, needle in (("a.obj", "Too many levels of symbolic links"), ("f.obj", "not a regular file"),
+    for name, needle in (("a.obj", "Too many levels of symbolic links"), ("f.obj", "a FIFO, not a regular file"),
                          ("missing.obj", "file not found")):          # before: 'file not found' for all three
         rc, _, err = render(["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / "o", capsys)
         assert_one_error_line(rc, err, f"--scene '{tmp_path / name}': {needle}")

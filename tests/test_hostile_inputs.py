@@ -131,7 +131,7 @@ FRAME = "frames/cube/on_axis/frame_0001.png"
 @pytest.mark.parametrize("make, needle", [
     (lambda p: os.mkfifo(p), "a FIFO, not a regular file"),
     (lambda p: p.mkdir(), "a folder, not a regular file"),
-    (lambda p: p.symlink_to("/dev/null"), "a device, not a regular file"),
+    (lambda p: p.symlink_to("/dev/null"), "a character device, not a regular file"),
     (lambda p: p.symlink_to(p.parent / "nowhere.png"), "a broken link"),
 ])
 def test_a_frame_that_is_not_a_regular_file_is_named_so(job, tmp_path, capsys, make, needle):

@@ -29,7 +29,8 @@ from wirecheck.core.projector.projection import project_points
 from wirecheck.core.projector.raster import line_coverage_aa
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles.diagnosis.diagnose import FAULT_ORDER, LINE_FAULTS, VERTEX_ONLY_FAULTS, primary
+from wirecheck.oracles.diagnosis.diagnose import primary
+from wirecheck.oracles.faults import NAMES as FAULT_ORDER, names as fault_names
 from wirecheck.oracles.candidates.draw import clip_depth, draw_candidate
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
 
@@ -161,12 +162,13 @@ def test_expected_names(results, fault, camera_name):
 
 @pytest.mark.parametrize("fault", ["mirror_x", "mirror_y"])
 def test_an_undecidable_mirror_gives_both_names_and_hints(results, fault):
-    from wirecheck.oracles.reports.report import FAULT_HINTS, fault_hints
+    from wirecheck.oracles.faults import CATALOGUE
+    from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
     (amb,) = results[(fault, "ortho_cube")]
     assert sorted(amb["alternatives"]) == ["mirror_horizontal", "mirror_vertical"]
     (hint,) = [h for n, h in fault_hints([amb]) if n == "ambiguous"]
-    assert FAULT_HINTS["mirror_horizontal"] in hint and FAULT_HINTS["mirror_vertical"] in hint
+    assert CATALOGUE["mirror_horizontal"].hint in hint and CATALOGUE["mirror_vertical"].hint in hint
     # the confidence measures the mirror against no mirror (which does not fit), not against the other mirror
     assert amb["confidence"] > 0.5
 
@@ -222,7 +224,7 @@ def confusion(results):
     # of a drawing the harness made itself (oracles.diagnosis.diagnose.diagnose_lines), not this family
     # (nor distortion_mismatch: frames of a distorted camera are not compared, oracles.judge.case;
     # nor precision_limited: float32 rounding is far below a pixel)
-    labels = ["none"] + [n for n in FAULT_ORDER if n not in LINE_FAULTS + VERTEX_ONLY_FAULTS]
+    labels = ["none"] + [n for n in FAULT_ORDER if n not in fault_names(source="pixels") + fault_names(source="vertices")]
     counts = Counter()
     for (fault, cam), got in results.items():
         if fault not in SINGLE:

@@ -22,10 +22,11 @@ from wirecheck.core.projector.projection import project_points
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.cases import case_motion, cases_for
-from wirecheck.oracles.diagnosis.diagnose import FAULT_ORDER, primary
+from wirecheck.oracles.diagnosis.diagnose import primary
+from wirecheck.oracles.faults import NAMES as FAULT_ORDER
 from wirecheck.oracles.candidates.draw import draw_candidate
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
-from wirecheck.oracles.reports.report import fault_hints
+from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
 pytestmark = pytest.mark.slow
 FRAMES = 4

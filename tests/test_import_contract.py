@@ -134,7 +134,7 @@ LAZY = {
     ("core/app/cli.py", ".viewer_http"), ("oracles/cli.py", ".sweep"), ("oracles/cli.py", ".extremes"),
     ("oracles/cli.py", ".datasets.dataset"), ("oracles/cli.py", ".datasets.dataset_report"),
     ("oracles/cli.py", ".datasets.dataset_run"), ("oracles/cli.py", ".frames_cli"),
-    ("oracles/cli.py", ".references.pyrender_oracle"),
+    ("oracles/cli.py", ".references.pyrender_oracle"), ("oracles/cli.py", ".unprojector_cli"),
     ("oracles/frames_cli.py", ".candidates.export"), ("oracles/frames_cli.py", "wirecheck.core.outputs.output"),
     ("oracles/frames_cli.py", ".judge.frames_judge"), ("oracles/frames_cli.py", ".reports.report"),
     ("oracles/frames_cli.py", ".config"), ("oracles/frames_cli.py", ".reports.junit"),

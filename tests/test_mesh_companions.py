@@ -66,8 +66,9 @@ def test_a_fifo_companion_is_refused_by_name_never_opened(tmp_path, kind):
     mesh, companion = COMPANIONS[kind](tmp_path)
     with no_block(10), pytest.raises(InputError) as info:
         load_mesh_file(mesh)
-    assert str(info.value) == (f"{mesh}: the file it names {companion!r} ({tmp_path / companion}) is a FIFO: "
-                               "expected a regular file (never opened: reading it could block forever)")
+    assert str(info.value) == (f"{mesh}: the file it names {companion!r} ({tmp_path / companion}): a FIFO, not a "
+                               "regular file: expected a file a mesh names (mtllib, texture, glTF buffer), a regular "
+                               "file of at most 2,048 MiB (docs/reliability.md)")
 
 
 def test_regular_companions_are_still_read(tmp_path):
@@ -120,7 +121,7 @@ def test_dataset_run_skips_fifos_and_reports_fifo_companions(tmp_path):
     verdicts = {m["mesh"]: m["verdict"] for m in report["meshes"]}
     assert verdicts == {"a.obj": "error", "good.obj": "pass"}
     error = next(m["error"] for m in report["meshes"] if m["mesh"] == "a.obj")
-    assert "the file it names 'm.mtl'" in error and "is a FIFO" in error, error
+    assert "the file it names 'm.mtl'" in error and "a FIFO, not a regular file" in error, error
 
 
 def test_dataset_walk_skips_non_regular_mesh_names_with_stat_only(tmp_path):
@@ -150,13 +151,13 @@ def test_a_signal_while_trimesh_reads_a_companion_ends_the_run(tmp_path, monkeyp
     on, wrote its outputs and exited 0."""
     (tmp_path / "a.obj").write_text("mtllib m.mtl\n" + TRIANGLE)
     (tmp_path / "m.mtl").write_text("newmtl x\nKd 1 0 0\n")
-    real = mesh_companions.read_regular
+    real = mesh_companions.read_companion
 
     def read_and_signal(path):
         os.kill(os.getpid(), sig)           # delivered at the next bytecode: inside trimesh's handler
         return real(path)
 
-    monkeypatch.setattr(mesh_companions, "read_regular", read_and_signal)
+    monkeypatch.setattr(mesh_companions, "read_companion", read_and_signal)
     rc, _, err = run_renderer(["--scene", str(tmp_path / "a.obj"), "--frames", "1"], tmp_path / "out")
     assert rc == code, err
     assert err == (f"renderer: interrupted by {signal.Signals(sig).name}: temporary files removed, "
@@ -173,7 +174,7 @@ def test_sigint_from_outside_during_a_load_ends_the_run(tmp_path):
             "from wirecheck.core.scene import mesh_companions as mc\n"
             "def slow(path):\n"
             "    print('reading', flush=True); time.sleep(60)\n"
-            "mc.read_regular = slow\n"
+            "mc.read_companion = slow\n"
             "from wirecheck.core.app.cli import main\n"
             f"sys.exit(main(['--scene', {str(tmp_path / 'a.obj')!r}, '--frames', '1', "
             f"'--out', {str(tmp_path / 'out')!r}]))\n")

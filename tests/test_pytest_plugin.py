@@ -13,6 +13,11 @@ import pytest
 
 DATA = Path(__file__).parent / "data"
 
+#: The report folders of the user's tests: the id's characters, "-" and the first 8 hex digits of the SHA-1
+#: of "test_user.py::test_mirrored" / "...::test_two_checks" (docs/pytest.md), computed once by hand (hashlib.sha1)
+MIRRORED_DIR = "test_user.py_test_mirrored-674c9e30"
+TWO_CHECKS_DIR = "test_user.py_test_two_checks-8ac2ae87"
+
 MIRRORED = '''
 def mirrored(points, camera):
     px = project(points, camera)
@@ -117,15 +122,15 @@ def test_two_checks(wirecheck):
     result.assert_outcomes(passed=1, failed=2)
     root = project.path / "reports"
     assert sorted(p.name for p in root.iterdir()) == [
-        "test_user.py_test_mirrored", "test_user.py_test_two_checks", "test_user.py_test_two_checks-2"]
-    expected = {"test_user.py_test_mirrored": ("cube", "on_axis"), "test_user.py_test_two_checks": ("cube", "wide_fov"),
-                "test_user.py_test_two_checks-2": ("pyramid", "oblique_roll")}
+        MIRRORED_DIR, TWO_CHECKS_DIR, TWO_CHECKS_DIR + "-2"]
+    expected = {MIRRORED_DIR: ("cube", "on_axis"), TWO_CHECKS_DIR: ("cube", "wide_fov"),
+                TWO_CHECKS_DIR + "-2": ("pyramid", "oblique_roll")}
     for name, (scene, camera) in expected.items():
         report = json.loads((root / name / "report.json").read_text())
         case = report["cases"][0]
         assert (case["scene"], case["camera"], case["faults"][0]["name"]) == (scene, camera, "mirror_horizontal")
         assert (root / name / "report.html").is_file()
-    result.stdout.fnmatch_lines(["E         report: reports/test_user.py_test_mirrored/report.html",
+    result.stdout.fnmatch_lines([f"E         report: reports/{MIRRORED_DIR}/report.html",
                                  "3 report(s) of failing checks under reports"])
 
 
@@ -157,10 +162,49 @@ def test_report_option_on_a_file_is_a_usage_error_and_the_file_is_kept(project):
 
 def test_a_report_folder_not_written_by_wirecheck_is_left_alone(project):
     project.makepyfile(test_user=USER_TESTS)
-    theirs = project.path / "reports" / "test_user.py_test_mirrored"
+    theirs = project.path / "reports" / MIRRORED_DIR
     theirs.mkdir(parents=True)
     (theirs / "keep.txt").write_text("mine\n")
     result = project.runpytest("--wirecheck-report", "reports")
     result.assert_outcomes(passed=1, failed=1)
     result.stdout.fnmatch_lines(["E         report not written: *not written by wirecheck*"])
     assert [p.name for p in theirs.iterdir()] == ["keep.txt"] and (theirs / "keep.txt").read_text() == "mine\n"
+
+
+PUNCTUATION_IDS = ["a/b", "a::b", "a]b", "a[b", "a b", "a+b"]
+
+
+def test_test_ids_that_differ_only_in_punctuation_get_a_report_folder_each(project):
+    """Six failing tests whose ids differ only in punctuation: six folders, each with its own test's report.
+
+    Before, ``/``, ``::`` and brackets were made ``_`` one-to-one with no hash: the first four ids all wrote
+    ``test_user.py_test_shift_a_b`` and each report replaced the one before.
+    """
+    project.makepyfile(test_user=f'''
+import pytest
+from my_projection import project
+
+@pytest.mark.parametrize("shift", [1.0, 2.0, 3.0, 4.0, 5.0, 6.0], ids={PUNCTUATION_IDS!r})
+def test_shift(wirecheck, shift):
+    wirecheck(lambda p, c: project(p, c) + shift, scenes=["cube"], frames=1, cases=["on_axis"])
+''')
+    result = project.runpytest("--wirecheck-report", "reports", "-p", "no:xdist")
+    result.assert_outcomes(failed=6)
+    folders = sorted((project.path / "reports").iterdir())
+    assert len(folders) == 6, [f.name for f in folders]
+    # each shift s moves every vertex by (s, s): the worst vertex error is s * sqrt(2), one folder per test
+    shifts = sorted(round(json.loads((f / "report.json").read_text())["summary"]["max_vertex_error_px"] / 2 ** 0.5, 6)
+                    for f in folders)
+    assert shifts == [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+
+
+def test_report_folder_names_are_one_to_one_and_fit_a_file_name():
+    from wirecheck.oracles.pytest_plugin import report_name
+
+    ids = [f"t.py::test[{p}]" for p in PUNCTUATION_IDS] + ["t.py::test_a_b", "t.py::test[a_b]", "t.py::test[a]-2"]
+    names = [report_name(i) for i in ids]
+    assert len(set(names)) == len(ids), names
+    # "t.py::test[a/b]": its characters with runs of others made "_", "-", then sha1("t.py::test[a/b]")[:8],
+    # computed by hand: hashlib.sha1(b"t.py::test[a/b]").hexdigest()[:8]
+    assert names[0] == "t.py_test_a_b-577e9e1b"
+    assert len(report_name("t.py::test[" + "x" * 300 + "]")) == 120 + 1 + 8       # under NAME_MAX (255 bytes)

@@ -135,7 +135,7 @@ def test_the_fixtures_vertex_report_plots_the_points_where_they_were_projected(p
     pytester.syspathinsert()
     result = pytester.runpytest("--wirecheck-report", "reports")
     result.assert_outcomes(failed=1)
-    out = pytester.path / "reports" / "test_user.py_test_shifted"
+    out = pytester.path / "reports" / "test_user.py_test_shifted-c1fc865c"   # + SHA-1 of the id
     assert "src='worst_points.png'" in (out / "report.html").read_text()
     # the call's own report_dir (check_projector's keyword) holds the same report
     own = pytester.path / "own"

@@ -301,3 +301,61 @@ def test_an_internal_failure_is_one_line_on_stderr_and_the_server_goes_on(server
     assert err == "renderer: viewer: request from 127.0.0.1 failed: RuntimeError: simulated bug\n"
     monkeypatch.undo()
     assert _view(server)["frame"] == 1                               # and the next request is served
+
+
+@pytest.mark.parametrize("method", ["GET", "POST"])
+@pytest.mark.parametrize("second", ["evil.example:80", "OWN", "localhost:OWN_PORT"])
+def test_a_request_with_two_host_headers_is_refused(server, capsys, method, second):
+    """A valid Host, then another (evil, the same one again, the other valid name): 400, which one counts is not
+    guessed. Before: 200 with the frame (http.server reads the first Host only)."""
+    port = server.httpd.server_address[1]
+    own = f"127.0.0.1:{port}"
+    second = {"OWN": own}.get(second, second.replace("OWN_PORT", str(port)))
+    body = b'{"ops": []}' if method == "POST" else b""
+    length = f"Content-Length: {len(body)}\r\n" if method == "POST" else ""
+    head = (f"{method} /api/frame HTTP/1.1\r\nHost: {own}\r\nHost: {second}\r\nContent-Type: application/json\r\n"
+            f"{length}Connection: close\r\n\r\n")
+    got, hdrs, resp = _raw(server, head.encode("latin-1") + body)
+    assert got == 400, resp
+    assert json.loads(resp)["error"] == "Host given 2 times: expected one"
+    assert capsys.readouterr().err == ""
+
+
+def test_a_post_with_two_lengths_is_refused(server):
+    port = server.httpd.server_address[1]
+    body = b'{"ops": []}'
+    head = (f"POST /api/frame HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Type: application/json\r\n"
+            f"Content-Length: {len(body)}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n")
+    got, _, resp = _raw(server, head.encode("latin-1") + body)
+    assert (got, json.loads(resp)["error"]) == (400, "Content-Length given 2 times: expected one")
+
+
+@pytest.mark.parametrize("name, request_text, needle", [
+    # an absolute-form target names another server, whatever the Host says (RFC 9112 3.2.2): before, 200
+    ("absolute target", "POST http://evil.example/api/frame HTTP/1.1\r\nHost: {own}\r\n{body_headers}",
+     "request target 'http://evil.example/api/frame': expected a path starting with /"),
+    # a length and a chunked encoding: a proxy may frame the body by one, this server by the other: before, 200
+    ("length and chunked", "POST /api/frame HTTP/1.1\r\nHost: {own}\r\nTransfer-Encoding: chunked\r\n{body_headers}",
+     "Transfer-Encoding 'chunked': expected a body of Content-Length bytes"),
+    # a header line without a colon ends http.server's header parsing, silently: before, 200
+    ("line without colon", "POST /api/frame HTTP/1.1\r\nHost: {own}\r\n{body_headers_no_end}X y\r\n\r\n",
+     "a malformed header line"),
+], ids=["absolute-target", "length-and-chunked", "line-without-colon"])
+def test_requests_two_parsers_read_differently_are_refused(server, name, request_text, needle):
+    port = server.httpd.server_address[1]
+    body = b'{"ops": []}'
+    rest = f"Content-Type: application/json\r\nContent-Length: {len(body)}\r\nConnection: close\r\n"
+    text = request_text.format(own=f"127.0.0.1:{port}", body_headers=rest + "\r\n", body_headers_no_end=rest)
+    got, _, resp = _raw(server, text.encode("latin-1") + body)
+    assert got == 400 and needle in json.loads(resp)["error"], (got, resp)
+
+
+@pytest.mark.parametrize("line, status", [
+    (b"GET /api/frame\r\n\r\n", 403),                # HTTP/0.9: served as 1.0, then refused for its missing Host
+    (b"POST /api/frame TTP/1.1\r\n\r\n", 400),       # a bad version: http.server's own 400
+], ids=["http-0.9", "bad-version"])
+def test_a_malformed_request_line_gets_a_status_line(server, line, status):
+    """Before, http.server answered a request line it could not parse as HTTP/0.9 would: the body alone,
+    no status line (a client read nothing it could name)."""
+    got, hdrs, resp = _raw(server, line)
+    assert got == status and hdrs["Content-Type"] == "application/json", resp

@@ -42,7 +42,7 @@ def _load_numpy_single_threaded() -> None:
 
 _load_numpy_single_threaded()
 
-from .cli_help import RENDERER_EXAMPLES, usage_hint
+from .cli_help import RENDERER_EXAMPLES, OneLineParser
 from ..camera import COEFFICIENT_COUNTS, Camera, camera_z, look_at, orthographic_twin
 from ..projector.clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
@@ -70,13 +70,6 @@ DESCRIPTION = "renderer: render a scene's motion to wireframe frames with per-fr
 PROJECTION_CHOICES = ("perspective", "orthographic", "both")
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse, but a usage error is one line on stderr and exit status 2."""
-
-    def error(self, message):
-        self.exit(2, f"{self.prog}: error: {usage_hint(message)}\n")
-
-
 def vec3(option: str, text: str) -> tuple[float, float, float]:
     """``"X,Y,Z"`` as three finite floats; InputError naming ``option`` otherwise."""
     parts = text.split(",")
@@ -90,7 +83,7 @@ def vec3(option: str, text: str) -> tuple[float, float, float]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="renderer", description=DESCRIPTION, epilog=RENDERER_EXAMPLES,
+    p = OneLineParser(prog="renderer", description=DESCRIPTION, epilog=RENDERER_EXAMPLES,
                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action=VersionAction, version="%(prog)s (wirecheck) {}",
                    help="print the installed wirecheck version and exit")
@@ -257,6 +250,9 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
         raise InputError(f"--ortho-height {a.ortho_height}: expected a finite number > 0")
     if not (math.isfinite(a.scale) and a.scale != 0):
         raise InputError(f"--scale {a.scale}: expected a finite non-zero number")
+    for option, value in (("--near", a.near), ("--far", a.far)):
+        if not math.isfinite(value):            # the camera's own check names no option
+            raise InputError(f"{option} {value}: expected a finite distance (near > 0 in perspective, far > near)")
     if a.ascii_cols < 1:
         raise InputError(f"--ascii-cols {a.ascii_cols}: expected an integer >= 1")
     formats = tuple(f.strip() for f in a.format.split(","))
@@ -312,6 +308,8 @@ def settings_from_args(a: argparse.Namespace) -> Settings:
     if "mp4" in formats and importlib.util.find_spec("av") is None:
         raise InputError("--format mp4: expected the PyAV package (pip install av; it is a dependency of wirecheck)")
     scene = load_scene(a.scene)
+    for note in scene.load_notes:      # read leniently (core.scene.files): one line each, the run goes on
+        print(f"renderer: warning: {note}", file=sys.stderr)
     cull = None if a.cull == "none" else a.cull
     s = Settings(scene, camera, motion, a.frames, a.clip, formats, Path(a.out), a.ascii_cols,
                  dtype=a.dtype, raster=a.raster, ortho_camera=ortho_camera, axes=a.axes, cull=cull,

@@ -43,6 +43,11 @@ class RequestError(Exception):
         self.status = status
 
 
+#: Headers a request may carry once at most: with two Host headers (a valid one, then another) or two
+#: lengths, a proxy in front and this server could each read a different one (RFC 9112 3.2, 6.3): 400.
+ONE_ONLY = ("Host", "Origin", "Content-Length", "Content-Type")
+
+
 def _reject_constant(name):
     raise ValueError(f"{name} is not JSON; expected a finite number")
 
@@ -89,6 +94,9 @@ def _handler(viewer: Viewer):
         server_version = "wirecheck-viewer"
         timeout = REQUEST_TIMEOUT_S                     # socket timeout: a stalled client frees its thread
 
+        #: a malformed request line is answered with a status line too (http.server's default, HTTP/0.9, has none)
+        default_request_version = "HTTP/1.0"
+
         def log_message(self, fmt, *args):          # quiet: the terminal shows only the URL
             pass
 
@@ -119,12 +127,26 @@ def _handler(viewer: Viewer):
             self._json({"error": str(exc)}, exc.status, headers)
 
         def _check_origin(self) -> None:
-            """403 unless the request names this server (Host) and, if it says, comes from its page (Origin).
+            """403 unless the request names this server (Host) and, if it says, comes from its page (Origin);
+            400 for a request two parsers could read differently (a target that is not a path, a malformed
+            header line, a header of ONE_ONLY given twice, a Transfer-Encoding).
 
             A page on another site can reach 127.0.0.1 through DNS rebinding (its
             own name resolving to 127.0.0.1: the Host header still says its name)
             or post to it directly (the Origin header says its site).
             """
+            if not self.path.startswith("/"):  # absolute-form (http://other.site/...) names another server
+                raise RequestError(HTTPStatus.BAD_REQUEST, f"request target {short_repr(self.path)}: expected a path "
+                                                           "starting with /")
+            if self.headers.defects:           # a header line without a colon: the headers after it were dropped
+                raise RequestError(HTTPStatus.BAD_REQUEST, "a malformed header line: expected 'Name: value' lines")
+            for name in ONE_ONLY:             # which one counts? a proxy and this server may read different ones
+                count = len(self.headers.get_all(name) or ())
+                if count > 1:
+                    raise RequestError(HTTPStatus.BAD_REQUEST, f"{name} given {count} times: expected one")
+            if self.headers.get("Transfer-Encoding") is not None:     # with a Content-Length: request smuggling
+                raise RequestError(HTTPStatus.BAD_REQUEST, f"Transfer-Encoding {short_repr(self.headers['Transfer-Encoding'])}: "
+                                                           "expected a body of Content-Length bytes")
             port = self.server.server_address[1]
             hosts = (f"127.0.0.1:{port}", f"localhost:{port}")
             host = (self.headers.get("Host") or "").lower()

@@ -28,19 +28,19 @@ import dataclasses
 import io
 import os
 import re
-import stat
 from pathlib import Path
 
 import numpy as np
 
 from ..projector.culling import winding_problem
 from ..errors import InputError, quiet_libraries
-from .mesh_companions import companion_resolver, file_kind, interrupts_kept
+from .mesh_companions import companion_resolver, interrupts_kept
 from .mesh_checks import check_json, check_off, check_ply_counts, check_stl, number as _number, short as _short
 from ..numbers import plain_int
 from ..limits import MAX_FACE_VERTICES, MAX_NAME, check_turns
 from .model import Scene, SceneObject, face_edges, unique_edges
 from ..transforms import Motion
+from ..user_files import expected, open_regular, open_text, problem, read_text
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "scenes"
 #: Example scenes: loadable by name (``--scene orrery``) but not built-ins, so
@@ -159,9 +159,13 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
             if mesh_path.suffix.lower() not in MESH_SUFFIXES:
                 raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected a file ending in "
                                  f"{' '.join(MESH_SUFFIXES)}")
-            if not mesh_path.is_file():
+            refused = problem(mesh_path, "mesh")
+            if refused == "missing":
                 raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected an existing file "
                                  f"({mesh_path} not found)")
+            if refused is not None:
+                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: {mesh_path}: {refused}: expected "
+                                 f"{expected('mesh')}")
             try:
                 cur.mesh = (lineno, load_mesh_file(mesh_path))
             except InputError as exc:
@@ -236,36 +240,78 @@ def _check_name_length(name: str, path) -> None:
 
 def _obj_statements(path: Path):
     """``(line number, tokens, raw line)`` of each OBJ line that holds a statement (comments dropped)."""
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open_text(path, "mesh") as fh:
         for lineno, raw in enumerate(fh, start=1):
             parts = raw.split("#", 1)[0].split()
             if parts:
                 yield lineno, parts, raw
 
 
-def _obj_lines(path: Path) -> list[tuple[int, int]]:
-    """Edges from OBJ ``l`` elements (1-based, possibly negative, 'v/vt' forms)."""
+@dataclasses.dataclass
+class _ShortFaces:
+    """OBJ faces of fewer than 3 vertex indices (trimesh drops them silently): where, how many."""
+
+    first_line: int = 0
+    first_text: str = ""
+    edges: int = 0          # two-index faces, read as edges
+    points: int = 0         # one-index faces, skipped (a point draws nothing)
+
+    def add(self, lineno: int, raw: str, n_indices: int) -> None:
+        if not self.first_line:
+            self.first_line, self.first_text = lineno, raw.strip()
+        if n_indices == 2:
+            self.edges += 1
+        else:
+            self.points += 1
+
+    def note(self, path) -> str | None:
+        """The one warning line (file, first line, counts), or None when every face has 3 indices or more."""
+        n = self.edges + self.points
+        if not n:
+            return None
+        what = "; ".join(part for part in (
+            f"{self.edges} of two read as edges" if self.edges else "",
+            f"{self.points} of one skipped (a point draws nothing)" if self.points else "") if part)
+        return (f"{path}:{self.first_line}: {n} face{'s' * (n != 1)} with fewer than 3 vertex indices "
+                f"(first {_short(self.first_text)}): {what}")
+
+
+def _obj_lines(path: Path, short: _ShortFaces | None = None) -> list[tuple[int, int]]:
+    """Edges from OBJ ``l`` elements and from faces of two indices (1-based, possibly negative, 'v/vt' forms).
+
+    ``short`` counts the faces of fewer than three indices (:class:`_ShortFaces`).
+    """
     n_v = 0
     pairs = []
     for lineno, parts, raw in _obj_statements(path):
         if parts[0] == "v":
             n_v += 1
+        elif parts[0] in ("f", "fo") and len(parts) < 4:
+            if short is not None:
+                short.add(lineno, raw, len(parts) - 1)
+            if len(parts) == 3:             # an edge: its two indices, read as an 'l' element's
+                pairs.append(tuple(_obj_index(path, lineno, tok, n_v, "face") for tok in parts[1:]))
         elif parts[0] == "l":
             if len(parts) < 3:          # a line of one vertex draws nothing
                 raise InputError(f"{path}:{lineno}: line element {_short(raw.strip())}: expected 2 or more "
                                  "vertex indices")
             idx = []
             for tok in parts[1:]:
-                try:
-                    k = int(tok.split("/")[0])
-                except ValueError:
-                    raise InputError(f"{path}:{lineno}: line element index {_short(tok)}: expected an integer") from None
-                k = k - 1 if k > 0 else n_v + k
-                if not 0 <= k < n_v:
-                    raise InputError(f"{path}:{lineno}: line element index {_short(tok)}: expected 1..{n_v}")
-                idx.append(k)
+                idx.append(_obj_index(path, lineno, tok, n_v, "line element"))
             pairs += list(zip(idx[:-1], idx[1:]))
     return pairs
+
+
+def _obj_index(path, lineno: int, tok: str, n_v: int, what: str) -> int:
+    """The 0-based vertex of an OBJ index token (1-based, or negative: back from the ``n_v`` read so far)."""
+    try:
+        k = int(tok.split("/")[0])
+    except ValueError:
+        raise InputError(f"{path}:{lineno}: {what} index {_short(tok)}: expected an integer") from None
+    k = k - 1 if k > 0 else n_v + k
+    if not 0 <= k < n_v:
+        raise InputError(f"{path}:{lineno}: {what} index {_short(tok)}: expected 1..{n_v}")
+    return k
 
 
 def load_mesh_file(path: Path) -> Scene:
@@ -279,13 +325,8 @@ def load_mesh_file(path: Path) -> Scene:
     """
     import trimesh  # lazy: only mesh files need it
 
-    try:
-        st = os.stat(path)
-    except OSError as exc:
-        raise InputError(f"{path}: {exc.strerror or exc}: expected a readable mesh file") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise InputError(f"{path} is {file_kind(st.st_mode)}: expected a regular mesh file (never opened: "
-                         "reading it could block forever)")
+    with open_regular(path, "mesh"):   # a FIFO, a device, a folder or a file over the limit: one line, never read
+        pass
     suffix = path.suffix.lower()
     if suffix == ".obj":
         _check_obj(path)      # every 'v' and 'f' line first: errors with file:line, not trimesh's
@@ -296,13 +337,13 @@ def load_mesh_file(path: Path) -> Scene:
     elif suffix == ".gltf":
         check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
     resolver = companion_resolver(path)
-    source = {"file_obj": str(path), "resolver": resolver}
-    if suffix == ".obj":
-        absolute = _obj_absolute_indices(path)
-        if absolute is not None:     # read from memory: no resolver, so trimesh reads no companion
-            source, resolver = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}, None
+    absolute = _obj_absolute_indices(path) if suffix == ".obj" else None
+    if absolute is not None:     # read from memory: no resolver, so trimesh reads no companion
+        source, resolver = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}, None
+    else:       # trimesh reads the file opened here, never the name: a FIFO put there meanwhile cannot block
+        source = {"file_obj": open_regular(path, "mesh"), "file_type": suffix[1:], "resolver": resolver}
     try:
-        with interrupts_kept(), quiet_libraries():  # trimesh logs tracebacks it recovers from; numpy warns
+        with interrupts_kept(), quiet_libraries(), source["file_obj"]:  # trimesh logs tracebacks it recovers from
             loaded = trimesh.load(**source, process=False, maintain_order=True)
     except Exception as exc:  # trimesh raises many types; one line for the user
         _check_refused(path, resolver)
@@ -340,8 +381,9 @@ def load_mesh_file(path: Path) -> Scene:
         raise InputError(f"{path}: face {f} has {said}: expected 0..{len(vertices) - 1} "
                          f"(the file has {len(vertices)} vertices)")
     edges = [face_edges(faces)] if len(faces) else []
+    short = _ShortFaces()
     if path.suffix.lower() == ".obj":
-        line_pairs = _obj_lines(path)
+        line_pairs = _obj_lines(path, short)
         if line_pairs:
             if len(vertices) == 0 or max(max(p) for p in line_pairs) >= len(vertices):
                 # trimesh dropped the line-only vertices: read them ourselves
@@ -354,15 +396,16 @@ def load_mesh_file(path: Path) -> Scene:
     faces = tuple(tuple(int(i) for i in f) for f in faces)
     _check_name_length(_safe_stem(path), path)
     return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
-                 faces=faces, source=str(path), winding_note=_winding_note(faces))
+                 faces=faces, source=str(path), winding_note=_winding_note(faces),
+                 load_notes=tuple(n for n in (short.note(path),) if n))
 
 
 def _check_refused(path: Path, resolver) -> None:
     """InputError naming the first companion file of ``path`` the resolver refused (a FIFO, a device)."""
     if resolver is not None and resolver.refused:
         name, exc = resolver.refused[0]
-        raise InputError(f"{path}: the file it names {_short(name)} ({exc.path}) is {exc.kind}: expected a "
-                         "regular file (never opened: reading it could block forever)")
+        raise InputError(f"{path}: the file it names {_short(name)} ({exc.path}): {exc.problem}: expected "
+                         f"{expected(exc.kind)}")
 
 
 #: OBJ statements (the Wavefront spec's, free-form geometry included); others are ignored by readers,
@@ -390,8 +433,8 @@ def _check_obj(path: Path) -> None:
                 _number(path, lineno, t, "vertex coordinate")
             n_v += 1
         elif parts[0] in ("f", "fo"):
-            if len(parts) < 4:          # readers drop such a face silently: the user's edges vanish
-                raise InputError(f"{path}:{lineno}: face {_short(raw.strip())}: expected 3 or more vertex indices")
+            if len(parts) < 2:
+                raise InputError(f"{path}:{lineno}: face {_short(raw.strip())}: expected vertex indices")
             for tok in parts[1:]:
                 try:
                     k = int(tok.split("/")[0])
@@ -426,7 +469,7 @@ def _obj_absolute_indices(path: Path) -> str | None:
     counts = {"v": 0, "vt": 0, "vn": 0}
     kinds = ("v", "vt", "vn")                   # the fields of 'v/vt/vn'
     lines, changed = [], False
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open_text(path, "mesh") as fh:
         for raw in fh:
             parts = raw.split("#", 1)[0].split()
             if parts and parts[0] in counts:
@@ -505,8 +548,9 @@ def load_scene(name_or_path: str) -> Scene:
                 os.stat(path)         # ELOOP (a symbolic link loop), EACCES: named by the OSError below
             except FileNotFoundError:
                 raise InputError(f"--scene {name_or_path!r}: file not found") from None
-            raise InputError(f"--scene {name_or_path!r}: not a regular file (a device, FIFO or socket): "
-                             "expected a scene file")
+            refused = problem(path, "scene")
+            raise InputError(f"--scene {name_or_path!r}: {refused}: expected a scene or mesh file "
+                             "(never opened: reading it could block forever)")
     except OSError as exc:      # ENAMETOOLONG, ELOOP, EACCES on a folder of the path
         raise InputError(f"--scene {_short(name_or_path)}: {exc.strerror or exc}: expected a readable file") from None
     suffix = path.suffix.lower()
@@ -515,8 +559,8 @@ def load_scene(name_or_path: str) -> Scene:
     if suffix not in (NATIVE_SUFFIX, ".txt"):
         raise InputError(f"{path}: suffix {path.suffix!r}: expected {NATIVE_SUFFIX} or one of {' '.join(MESH_SUFFIXES)}")
     try:
-        text = path.read_text(encoding="utf-8-sig")      # a byte-order mark (Windows editors) is not a tag
-    except (OSError, UnicodeDecodeError) as exc:
+        text = read_text(path, "scene")      # a byte-order mark (Windows editors) is not a tag
+    except UnicodeDecodeError as exc:
         raise InputError(f"{path}: could not be read: {exc}") from None
     scene = parse_scene_text(text, str(path))
     folder = path.resolve().parent

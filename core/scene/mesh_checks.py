@@ -11,16 +11,18 @@ scene-file message uses: :func:`number` (a finite float token) and
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 from ..errors import InputError
 from ..numbers import plain_float
+from ..user_files import open_regular, open_text, read_regular
 
 
 def check_stl(path: Path) -> None:
     """InputError unless ``path`` is a complete binary STL or a well-formed ASCII one (with file:line)."""
-    size = path.stat().st_size
-    with open(path, "rb") as fh:
+    with open_regular(path, "mesh") as fh:
+        size = os.fstat(fh.fileno()).st_size
         data = fh.read(84)
     if size >= 84:
         count = int.from_bytes(data[80:84], "little")
@@ -32,12 +34,12 @@ def check_stl(path: Path) -> None:
                              "bytes a triangle) or an ASCII STL starting with 'solid'")
         raise InputError(f"{path}: {size} bytes, its header declares {count} triangles: expected "
                          f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)")
-    check_ascii_stl(path, path.read_bytes().decode("latin-1"))
+    check_ascii_stl(path, read_regular(path, "mesh").decode("latin-1"))
 
 
 def check_off(path: Path) -> None:
     """InputError (file:line) unless ``path`` is an OFF file: 'OFF', counts, then as many vertices and faces."""
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open_text(path, "mesh") as fh:
         rows = [(n, line.split("#", 1)[0].split()) for n, line in enumerate(fh, start=1)]
     rows = [(n, parts) for n, parts in rows if parts]
     if not rows or rows[0][1][0] not in ("OFF", "COFF"):
@@ -74,7 +76,7 @@ def check_json(path: Path) -> None:
     import json
 
     try:
-        doc = json.loads(path.read_bytes())
+        doc = json.loads(read_regular(path, "mesh"))
     except UnicodeDecodeError as exc:
         raise InputError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start}): expected glTF JSON") from None
     except json.JSONDecodeError as exc:
@@ -124,7 +126,7 @@ def check_ply_counts(path: Path, n_vertices: int, n_faces: int) -> None:
     trimesh reads what is there and drops a short face row silently. Faces may
     be more than declared (polygons split into triangles), never fewer.
     """
-    with open(path, "rb") as fh:
+    with open_regular(path, "mesh") as fh:
         head = fh.read(1 << 16).split(b"end_header", 1)[0].decode("latin-1")
     for lineno, line in enumerate(head.splitlines(), start=1):
         parts = line.split()

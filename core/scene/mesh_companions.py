@@ -5,9 +5,9 @@ A mesh file may name other files: an OBJ's ``mtllib``, a ``.mtl``'s
 through a *resolver*. Its file resolver opens whatever the name points to,
 and reading a FIFO (no writer: forever), ``/dev/zero`` (endless) or a
 terminal blocks the run. :func:`companion_resolver` gives trimesh a resolver
-that opens only regular files: it looks at the path with ``stat`` first, opens
-without blocking (``O_NONBLOCK``, so even a file swapped for a FIFO between the
-check and the open cannot block) and checks the opened file again. A refused
+that opens only regular files (core.user_files: it looks at the path with
+``stat`` first, opens without blocking, so even a file swapped for a FIFO
+between the check and the open cannot block, and checks the opened file again). A refused
 companion is recorded; trimesh swallows the resolver's exception (it catches
 every exception around material loading), so the loader raises afterwards:
 one line naming the companion (``load_mesh_file`` in core.scene.files).
@@ -25,41 +25,14 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
-import stat
 import threading
 from pathlib import Path
 
-_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"), (stat.S_ISDIR, "a folder"))
+from ..user_files import RefusedFile, read_regular
 
-
-def file_kind(mode: int) -> str:
-    """What a non-regular file is, in words (``stat`` mode)."""
-    return next((words for test, words in _KINDS if test(mode)), "not a regular file")
-
-
-def read_regular(path: Path) -> bytes:
-    """The bytes of ``path``, which must be a regular file; OSError otherwise, never blocking.
-
-    Raises ``NotRegularFile`` (an OSError) for a FIFO, device, socket or folder.
-    """
-    st = os.stat(path)
-    if not stat.S_ISREG(st.st_mode):
-        raise NotRegularFile(path, file_kind(st.st_mode))
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
-    with os.fdopen(fd, "rb") as fh:
-        st = os.fstat(fh.fileno())
-        if not stat.S_ISREG(st.st_mode):          # swapped between the stat and the open
-            raise NotRegularFile(path, file_kind(st.st_mode))
-        return fh.read()
-
-
-class NotRegularFile(OSError):
-    """A companion file that is a FIFO, device, socket or folder: never read."""
-
-    def __init__(self, path, kind: str):
-        super().__init__(f"{path} is {kind}")
-        self.path, self.kind = str(path), kind
+def read_companion(path: Path) -> bytes:
+    """The bytes of a companion file: a regular file within its limit (core.user_files); RefusedFile otherwise."""
+    return read_regular(path, "mesh companion")
 
 
 _RESOLVER_CLASS = None
@@ -68,7 +41,7 @@ _RESOLVER_CLASS = None
 def companion_resolver(mesh_path: Path):
     """A trimesh resolver for ``mesh_path``'s companions that refuses non-regular files.
 
-    Its ``refused`` list holds ``(name as written, NotRegularFile)`` for each
+    Its ``refused`` list holds ``(name as written, RefusedFile)`` for each
     companion it would not open.
     """
     global _RESOLVER_CLASS
@@ -92,8 +65,8 @@ def companion_resolver(mesh_path: Path):
                         continue
                     if path.exists():
                         try:
-                            return read_regular(path)
-                        except NotRegularFile as exc:
+                            return read_companion(path)
+                        except RefusedFile as exc:
                             self.refused.append((name, exc))
                             raise
                 self.absolute(name)          # trimesh's message for a name outside the folder

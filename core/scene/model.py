@@ -70,6 +70,8 @@ class Scene:
         The objects in file order; ``()`` means one static object of everything.
     winding_note : str or None
         Why the faces' winding is inconsistent, if it is.
+    load_notes : tuple of str
+        Warning lines: what was read leniently from the file (docs/datasets.md).
     """
 
     name: str
@@ -81,6 +83,9 @@ class Scene:
     objects: tuple = field(default=())
     #: None, or why the faces' winding is inconsistent (core.projector.culling.winding_problem).
     winding_note: str | None = None
+    #: What loading the file read leniently, one warning line each (file:line, what, how many):
+    #: e.g. OBJ faces of two indices read as edges (core.scene.files).
+    load_notes: tuple = ()
 
     def __post_init__(self):
         self.vertices.setflags(write=False)

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import importlib.machinery
 import importlib.util
 import inspect
 import sys
@@ -38,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.user_files import expected, problem, read_regular
 
 
 @contextlib.contextmanager
@@ -64,60 +66,76 @@ def _candidate_imports(folder: str | None = None):
             sys.path.remove(folder)
 
 
+class _RegularSourceLoader(importlib.machinery.SourceFileLoader):
+    """Python's source loader, reading the candidate's file through core.user_files (never blocking, limited)."""
+
+    def get_data(self, path):
+        if path == self.path:
+            return read_regular(path, "candidate")
+        return super().get_data(path)
+
+
 class _Loaded:
     """A candidate :func:`load_candidate` imported: each call inside :func:`_candidate_imports` (its folder)."""
 
     def __init__(self, func, folder: str | None):
         self.func, self.folder = func, folder
 
-    def __call__(self, points, camera):
+    def __call__(self, *args):
         with _candidate_imports(self.folder):
-            return self.func(points, camera)
+            return self.func(*args)
 
     def __repr__(self) -> str:
         return repr(self.func)
 
 
-def load_candidate(spec: str):
+def load_candidate(spec: str, option: str = "--candidate", params: tuple = ("points", "camera")):
     """Resolve ``FILE.py:FUNC`` or ``MODULE:FUNC`` to a callable; InputError otherwise.
 
     The callable calls the candidate as :func:`_candidate_imports` says (its
-    folder importable meanwhile, no bytecode written).
+    folder importable meanwhile, no bytecode written). ``option`` names the option
+    in messages; ``params`` are the contract's arguments (an unprojector's are
+    ``("pixels", "depth", "camera")``).
     """
     if ":" not in spec:
-        raise InputError(f"--candidate {spec!r}: expected FILE.py:FUNC or MODULE:FUNC")
+        raise InputError(f"{option} {spec!r}: expected FILE.py:FUNC or MODULE:FUNC")
     target, func_name = spec.rsplit(":", 1)
     folder = None
     if target.endswith(".py") or "/" in target:
         path = Path(target)
-        if not path.is_file():
-            raise InputError(f"--candidate {spec!r}: file {target!r} not found")
+        refused = problem(path, "candidate")
+        if refused == "missing":
+            raise InputError(f"{option} {spec!r}: file {target!r} not found")
+        if refused is not None:         # a FIFO, a device, a folder: never opened (reading it could block forever)
+            raise InputError(f"{option} {spec!r}: {target}: {refused}: expected {expected('candidate')}")
         mod_name = f"wirecheck_candidate_{path.stem}"
         folder = str(path.resolve().parent)        # like running a script: the candidate's own folder is importable
         try:
             with _candidate_imports(folder):
-                module_spec = importlib.util.spec_from_file_location(mod_name, path)
+                module_spec = importlib.util.spec_from_file_location(mod_name, path,
+                                                                     loader=_RegularSourceLoader(mod_name, str(path)))
                 module = importlib.util.module_from_spec(module_spec)
                 sys.modules[mod_name] = module
                 module_spec.loader.exec_module(module)
         except (Exception, SystemExit) as exc:  # the user's file: report, don't trace back, don't exit
-            raise InputError(f"--candidate {spec!r}: importing {target} failed: "
+            raise InputError(f"{option} {spec!r}: importing {target} failed: "
                              f"{type(exc).__name__}: {exc}") from None
     else:
         try:
             with _candidate_imports():
                 module = importlib.import_module(target)
         except (Exception, SystemExit) as exc:
-            raise InputError(f"--candidate {spec!r}: importing module {target!r} failed: "
+            raise InputError(f"{option} {spec!r}: importing module {target!r} failed: "
                              f"{type(exc).__name__}: {exc}") from None
     func = getattr(module, func_name, None)
     if not callable(func):
-        raise InputError(f"--candidate {spec!r}: {target} has no callable {func_name!r}")
+        raise InputError(f"{option} {spec!r}: {target} has no callable {func_name!r}")
     try:
-        inspect.signature(func).bind(None, None)
+        inspect.signature(func).bind(*(None,) * len(params))
     except TypeError:
-        raise InputError(f"--candidate {spec!r}: {func_name}{inspect.signature(func)} cannot be called as "
-                         f"{func_name}(points, camera): expected the contract FUNC(points, camera)") from None
+        call = f"{func_name}({', '.join(params)})"
+        raise InputError(f"{option} {spec!r}: {func_name}{inspect.signature(func)} cannot be called as "
+                         f"{call}: expected the contract FUNC({', '.join(params)})") from None
     except ValueError:      # builtins without a signature: find out when called
         pass
     return _Loaded(func, folder)

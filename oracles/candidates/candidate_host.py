@@ -43,8 +43,12 @@ def _read_exact(stream, n: int) -> bytes:
     return data
 
 
-def serve(spec: str, stdin, stdout) -> int:
-    """Answer requests on ``stdin``/``stdout`` (binary streams) until stdin closes."""
+def serve(spec: str, stdin, stdout, unproject: bool = False) -> int:
+    """Answer requests on ``stdin``/``stdout`` (binary streams) until stdin closes.
+
+    ``unproject``: ``spec`` is an unprojector ``FUNC(pixels, depth, camera)``, answering requests of
+    kind ``unproject`` (docs/protocol.md).
+    """
     from . import protocol
 
     def send(data: bytes) -> None:
@@ -57,7 +61,8 @@ def serve(spec: str, stdin, stdout) -> int:
     try:
         from .candidate import load_candidate
 
-        func = load_candidate(spec)
+        func = (load_candidate(spec, "unprojector", ("pixels", "depth", "camera")) if unproject
+                else load_candidate(spec))
     except InputError as exc:
         send(protocol.encode_error(str(exc)))
         return 0
@@ -84,6 +89,9 @@ def serve_loaded(func, stdin, send) -> int:
         key = line[line.find(b'"camera"'):]
         if key != camera_key:              # the same camera for a case's requests: built once
             camera_key, camera = key, _camera(request["camera"])
+        if request.get("kind") == "unproject":
+            send(_unprojected(func, p_world, camera))
+            continue
         try:
             p_px, precision = call_candidate_precision(func, p_world, camera)
         except CandidateError as exc:
@@ -95,10 +103,32 @@ def serve_loaded(func, stdin, send) -> int:
         send(protocol.encode_reply(p_px, precision))    # the dtype the function returned, for the harness
 
 
+def _unprojected(func, rows, camera) -> bytes:
+    """The reply to an unproject request: ``func(pixels, depth, camera)``'s ``(N, 3)`` points, or an error line."""
+    import numpy as np
+
+    from . import protocol
+    from .candidate import returned_precision
+
+    try:
+        out = func(rows[:, :2].copy(), rows[:, 2].copy(), camera)
+        arr = np.asarray(out)
+        if arr.dtype.kind not in "fiu" or arr.shape != (len(rows), 3):
+            return protocol.encode_error(f"returned {type(out).__name__} of shape {getattr(arr, 'shape', None)} and "
+                                         f"dtype {arr.dtype}: expected an ({len(rows)}, 3) float array")
+        return protocol.encode_reply(arr.astype(np.float64), returned_precision(out), columns=3)
+    except BaseException as exc:     # SystemExit, KeyboardInterrupt too: this request fails
+        return protocol.encode_error(f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}")
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    unproject = argv[:1] == ["--unproject"]
+    if unproject:
+        argv = argv[1:]
     if len(argv) != 1:
-        print("usage: python -m wirecheck.oracles.candidates.candidate_host FILE.py:FUNC|MODULE:FUNC", file=sys.stderr)
+        print("usage: python -m wirecheck.oracles.candidates.candidate_host [--unproject] FILE.py:FUNC|MODULE:FUNC",
+              file=sys.stderr)
         return 2
     # this process is wirecheck's: nothing the candidate imports, at start-up or inside a call,
     # leaves a __pycache__ folder in the user's folders
@@ -110,7 +140,7 @@ def main(argv=None) -> int:
     protocol_out = os.fdopen(os.dup(1), "wb")        # buffered: a raw write may be partial
     os.dup2(2, 1)
     sys.stdout = sys.stderr
-    return serve(argv[0], sys.stdin.buffer, protocol_out)
+    return serve(argv[0], sys.stdin.buffer, protocol_out, unproject)
 
 
 if __name__ == "__main__":

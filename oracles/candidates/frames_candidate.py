@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.user_files import read_text
 
 from .export import JOB_KIND, JOB_VERSION, frame_name
 from .job_as_exported import camera_file_problem, camera_keys_problem, job_keys_problem
@@ -58,9 +59,10 @@ def _no_duplicate_keys(pairs: list) -> dict:
     return out
 
 
-def read_json(path: Path):
-    """The JSON of a job file (UTF-8, a BOM allowed); ValueError for a key given twice."""
-    return json.loads(Path(path).read_text(encoding="utf-8-sig"), object_pairs_hook=_no_duplicate_keys)
+def read_json(path: Path, kind: str = "job"):
+    """The JSON of a job file (UTF-8, a BOM allowed; ``kind`` "job" or "camera", core.user_files.LIMITS);
+    ValueError for a key given twice, a file that is not regular or over the limit."""
+    return json.loads(read_text(path, kind), object_pairs_hook=_no_duplicate_keys)
 
 
 def load_job(job_dir: Path) -> dict:
@@ -69,7 +71,7 @@ def load_job(job_dir: Path) -> dict:
     if not Path(job_dir).is_dir():
         raise FramesError([f"--candidate-frames {str(job_dir)!r}: not a directory: expected a job folder "
                            "written by 'crosscheck export'"])
-    problem = file_problem(path)
+    problem = file_problem(path, "job")
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected a job folder written by 'crosscheck export'"])
     try:
@@ -262,11 +264,11 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
     but ``v``, ``l``, ``f`` and ``#`` comments.
     """
     verts, edges = [], []
-    problem = file_problem(path)
+    problem = file_problem(path, "job mesh")
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected the OBJ 'crosscheck export' wrote"])
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_text(path, "job mesh", encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise FramesError([f"{path}: unreadable ({exc}): expected the OBJ 'crosscheck export' wrote"]) from None
     for lineno, line in enumerate(text.splitlines(), start=1):
@@ -300,11 +302,11 @@ def _frame_camera(path: Path, cache: dict | None = None):
     the same Camera object back (a case's camera is fixed: converted once by
     oracles.references.opencv_oracle, which keeps the last camera by identity).
     """
-    problem = file_problem(path)
+    problem = file_problem(path, "camera")
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])
     try:
-        cam_json = read_json(path)
+        cam_json = read_json(path, "camera")
     except (OSError, ValueError, RecursionError) as exc:
         raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {exc}): expected the camera JSON "
                            "'crosscheck export' wrote"]) from None

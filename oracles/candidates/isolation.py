@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import sys
 
+from wirecheck.core.user_files import expected, problem
+
 from .candidate import CandidateError
 from .subprocess_candidate import DEFAULT_TIMEOUT_S, CandidateStartRefused, SubprocessCandidate
 from wirecheck.core.errors import InputError
@@ -25,18 +27,16 @@ from .candidate import load_candidate
 
 def check_python_spec(spec: str, option: str = "--candidate") -> None:
     """Usage errors of a ``FILE.py:FUNC`` / ``MODULE:FUNC`` spec found without importing it (InputError)."""
-    from pathlib import Path
 
     if ":" not in spec:
         raise InputError(f"{option} {spec!r}: expected FILE.py:FUNC or MODULE:FUNC")
     target = spec.rsplit(":", 1)[0]
     if target.endswith(".py") or "/" in target:
-        try:
-            found = Path(target).is_file()
-        except OSError as exc:          # e.g. a name too long for the file system
-            raise InputError(f"{option} {spec!r}: file {target[:80]!r}: {exc.strerror or exc}") from None
-        if not found:
+        refused = problem(target, "candidate")          # stat only: a FIFO is never opened
+        if refused == "missing":
             raise InputError(f"{option} {spec!r}: file {target!r} not found")
+        if refused is not None:          # a FIFO, a device, a folder; a name too long for the file system
+            raise InputError(f"{option} {spec!r}: file {target[:80]!r}: {refused}: expected {expected('candidate')}")
 
 
 def importable_spec(func) -> str | None:

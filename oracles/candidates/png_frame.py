@@ -28,12 +28,13 @@ from __future__ import annotations
 
 import os
 import re
-import stat
 import struct
 import warnings
 from pathlib import Path
 
 import numpy as np
+
+from wirecheck.core.user_files import RefusedFile, open_regular, problem
 
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 #: colour type -> (name, channels, allowed bit depths), from the PNG specification (table 11.1)
@@ -53,54 +54,31 @@ def escape_controls(text: str) -> str:
     return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), str(text))
 
 
-def file_problem(path: Path) -> str | None:
-    """Why ``path`` is not a regular file to read, in a phrase (``"missing"``, ``"a FIFO"``, ...); None if it is one.
+def file_problem(path: Path, kind: str = "frame") -> str | None:
+    """Why ``path`` is not a file of a job to read, in a phrase (``"missing"``, ``"a FIFO, not a regular file"``,
+    its size over ``kind``'s limit); None if it is one.
 
-    Checked before any open: opening a FIFO named like a job's file would block
+    Checked before any open (core.user_files): opening a FIFO named like a job's file would block
     the run forever, and a folder or device is no file of a job.
     """
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        return "a broken link" if os.path.islink(path) else "missing"
-    except OSError as exc:          # a link loop, a name too long
-        return f"unreadable ({escape_controls(exc.strerror or exc)})"
-    return _kind_problem(mode)
-
-
-def _kind_problem(mode: int) -> str | None:
-    """``"a FIFO, not a regular file"`` and the like for a file mode that is not a regular file's; None for one."""
-    if stat.S_ISREG(mode):
-        return None
-    kind = ("a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
-            "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else
-            "not a file")
-    return f"{kind}, not a regular file"
+    found = problem(path, kind)
+    return None if found is None else escape_controls(found)
 
 
 def open_frame(path: Path):
     """``path`` opened for reading, as a binary file, when it is a regular file; FrameProblem otherwise.
 
-    The file is opened without blocking and checked through its descriptor: a
-    frame can be replaced between the job's check and its decoding (a renderer
-    still writing, a FIFO put there), and opening a FIFO by name would wait for
-    a writer forever. Every read of a frame's header and pixels goes through
-    one such file: they see one file, whatever happens to the name meanwhile.
+    The file is opened without blocking and checked through its descriptor
+    (core.user_files.open_regular): a frame can be replaced between the job's
+    check and its decoding (a renderer still writing, a FIFO put there), and
+    opening a FIFO by name would wait for a writer forever. Every read of a
+    frame's header and pixels goes through one such file: they see one file,
+    whatever happens to the name meanwhile.
     """
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    except FileNotFoundError:
-        raise FrameProblem("a broken link" if os.path.islink(path) else "missing") from None
-    except OSError as exc:
-        raise FrameProblem(f"unreadable ({escape_controls(exc.strerror or exc)})") from None
-    try:
-        problem = _kind_problem(os.fstat(fd).st_mode)
-        if problem is not None:
-            raise FrameProblem(problem)
-        return os.fdopen(fd, "rb")
-    except BaseException:
-        os.close(fd)
-        raise
+        return open_regular(path, "frame")
+    except RefusedFile as exc:
+        raise FrameProblem(escape_controls(exc.problem)) from None
 
 
 def _chunk_name(kind: bytes) -> str:

@@ -13,6 +13,11 @@ everything is bytes, lines end with ``\\n``, arrays are little-endian float64::
                                                                         NaN, NaN for a clipped point)
                        or  {"error": "one line"}\\n                     (the request fails, the run goes on)
 
+    an unprojector's request (``"kind": "unproject"``; a request without ``kind`` projects):
+    wirecheck -> program   {"request": k, "kind": "unproject", "n": N, "camera": {...}}\\n
+                           then N*3 float64 (x_px, y_px, depth along forward rows)
+    program -> wirecheck   {"n": N}\\n then N*3 float64 (the world points' x, y, z rows)
+
 wirecheck closes the program's stdin when it is done; the program then exits.
 The camera object holds every field of the Python contract (oracles.candidates.candidate)
 and the same camera as matrices, built on the oracle side (oracles.references.convert):
@@ -84,18 +89,24 @@ def camera_text(camera) -> str:
     return json.dumps(camera_message(camera), separators=(",", ":"), allow_nan=False)
 
 
-def encode_request(request_id: int, p_world: np.ndarray, camera_json: str) -> bytearray:
-    """One request: the JSON line (``camera_json`` from :func:`camera_text`) and the points, ``(N, 3)`` float64."""
+def encode_request(request_id: int, p_world: np.ndarray, camera_json: str, kind: str | None = None) -> bytearray:
+    """One request: the JSON line (``camera_json`` from :func:`camera_text`) and the points, ``(N, 3)`` float64.
+
+    ``kind="unproject"``: an unprojector's request, its rows ``(x_px, y_px, depth)``.
+    """
     p_world = np.ascontiguousarray(p_world, dtype=WIRE_DTYPE).reshape(-1, 3)
-    line = f'{{"request":{int(request_id)},"n":{len(p_world)},"camera":{camera_json}}}\n'
+    kind_key = f'"kind":"{kind}",' if kind is not None else ""
+    line = f'{{"request":{int(request_id)},{kind_key}"n":{len(p_world)},"camera":{camera_json}}}\n'
     out = bytearray(line.encode())
-    out += memoryview(p_world).cast("B")          # one copy of the points, not two
+    if len(p_world):                              # N = 0: the line alone (a view of no bytes cannot be cast)
+        out += memoryview(p_world).cast("B")      # one copy of the points, not two
     return out
 
 
-def encode_reply(p_px: np.ndarray, precision: str = "float64") -> bytes:
-    """One reply: ``{"n": N}`` (with ``"precision": "float32"`` for a float32 answer) and the pixels, float64."""
-    p_px = np.ascontiguousarray(p_px, dtype=WIRE_DTYPE).reshape(-1, 2)
+def encode_reply(p_px: np.ndarray, precision: str = "float64", columns: int = 2) -> bytes:
+    """One reply: ``{"n": N}`` (with ``"precision": "float32"`` for a float32 answer) and the pixels, float64
+    (``columns=3``: an unprojector's world points)."""
+    p_px = np.ascontiguousarray(p_px, dtype=WIRE_DTYPE).reshape(-1, columns)
     head = {"n": len(p_px), **({"precision": precision} if precision != "float64" else {})}
     return json.dumps(head).encode() + b"\n" + p_px.tobytes()
 
@@ -160,7 +171,7 @@ def parse_line(line: bytes, what: str) -> dict:
     return obj
 
 
-def reply_length(line: bytes, n_expected: int) -> int:
+def reply_length(line: bytes, n_expected: int, columns: int = 2) -> int:
     """Payload bytes that follow a reply's JSON line; ProtocolError for garbage or a wrong size.
 
     An ``{"error": ...}`` reply raises :class:`CandidateReportedError`.
@@ -179,7 +190,7 @@ def reply_length(line: bytes, n_expected: int) -> int:
         digits = str(n)       # a reply line holds up to MAX_LINE digits: the reason shows the first 24
         digits = digits if len(digits) <= 24 else digits[:24] + "..."
         raise ProtocolError(f"answered {digits} points to a request of {n_expected}: expected {n_expected}")
-    return n * REPLY_POINT_BYTES
+    return n * columns * 8
 
 
 def decode_points(payload, columns: int) -> np.ndarray:

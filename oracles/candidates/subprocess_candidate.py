@@ -130,11 +130,13 @@ class SubprocessCandidate:
         """A ``FILE.py:FUNC`` / ``MODULE:FUNC`` candidate run isolated, by :mod:`oracles.candidates.candidate_host`.
 
         ``pythonpath``: folders the host puts first on ``sys.path`` (for a
-        ``MODULE:FUNC`` importable only from the caller's path).
+        ``MODULE:FUNC`` importable only from the caller's path). ``unproject=True``: the spec is
+        an unprojector, served for :meth:`unproject`.
         """
         env = (("WIRECHECK_HOST_PATH", os.pathsep.join(pythonpath)),) if pythonpath else ()
-        return cls(argv=(sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", spec), timeout_s=timeout_s,
-                   label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
+        mode = ("--unproject",) if kwargs.pop("unproject", False) else ()
+        return cls(argv=(sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", *mode, spec),
+                   timeout_s=timeout_s, label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
 
     @classmethod
     def fork(cls, func, timeout_s: float = DEFAULT_TIMEOUT_S, label: str = "") -> SubprocessCandidate:
@@ -155,6 +157,12 @@ class SubprocessCandidate:
     def __call__(self, points, camera) -> np.ndarray:
         """The candidate contract: ``(N, 3)`` world points to ``(N, 2)`` pixels; CandidateError on any fault."""
         return _live(self).project(np.asarray(points, dtype=np.float64).reshape(-1, 3), camera)
+
+    def unproject(self, pixels, depth, camera) -> np.ndarray:
+        """The unprojector contract over the protocol (a request of kind ``unproject``): ``(N, 3)`` world points."""
+        rows = np.column_stack([np.asarray(pixels, dtype=np.float64).reshape(-1, 2),
+                                np.asarray(depth, dtype=np.float64).reshape(-1)])
+        return _live(self).project(rows, camera, kind="unproject")
 
     def answer_precision(self) -> str:
         """The precision the program's last reply declared (``"float64"`` when it said none; docs/protocol.md)."""
@@ -398,13 +406,16 @@ class _Program:
 
     # ---- requests
 
-    def project(self, p_world: np.ndarray, camera) -> np.ndarray:
+    def project(self, p_world: np.ndarray, camera, kind: str | None = None) -> np.ndarray:
+        """One request: world points to pixels ``(N, 2)``; with ``kind="unproject"``, rows ``(x_px, y_px,
+        depth)`` to world points ``(N, 3)``."""
         self.ensure_started()
         self.requests += 1
         n = len(p_world)
+        columns = 3 if kind == "unproject" else 2
         if self.camera is not camera:          # a case asks with one camera object: its JSON is made once
             self.camera, self.camera_json = camera, protocol.camera_text(camera)
-        payload = protocol.encode_request(self.requests, p_world, self.camera_json)
+        payload = protocol.encode_request(self.requests, p_world, self.camera_json, kind)
         what = f"a request of {n} points"
         header = {}
 
@@ -414,7 +425,7 @@ class _Program:
                 if line_end is None:
                     return None
                 header["line"] = line_end
-                header["end"] = line_end + protocol.reply_length(bytes(buf[:line_end]), n)
+                header["end"] = line_end + protocol.reply_length(bytes(buf[:line_end]), n, columns)
                 header["precision"] = protocol.reply_precision(bytes(buf[:line_end]))
             return header["end"]
 
@@ -436,7 +447,7 @@ class _Program:
             self._kill()
             raise CandidateError(f"candidate {exc} (on {what}); it was killed{self._stderr_hint()}") from None
         with memoryview(self.buf) as view:          # decoded straight from the buffer (one copy)
-            p_px = protocol.decode_points(view[header["line"]:end], 2)
+            p_px = protocol.decode_points(view[header["line"]:end], columns)
         del self.buf[:end]
         self.precision = header["precision"]
         return p_px

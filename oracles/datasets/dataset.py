@@ -39,7 +39,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene.mesh_companions import file_kind
+from wirecheck.core.user_files import RefusedFile, file_kind, read_text
 from wirecheck.core.scene.files import MESH_SUFFIXES
 
 
@@ -153,13 +153,12 @@ def _not_regular(item: os.DirEntry) -> str | None:
 def read_list(list_path: Path) -> list[MeshEntry]:
     """The entries of a scene list; InputError (with FILE:LINE) for a line that names no mesh file."""
     try:
-        text = list_path.read_text(encoding="utf-8-sig")      # a BOM (Windows editors) is not part of line 1
+        text = read_text(list_path, "scene list")      # a BOM (Windows editors) is not part of line 1
     except UnicodeDecodeError as exc:
         raise InputError(f"--scene-list {str(list_path)!r}: not UTF-8 text ({exc.reason} at byte {exc.start}): "
                          "expected one path per line") from None
-    except OSError as exc:
-        raise InputError(f"--scene-list {str(list_path)!r}: {exc.strerror or exc}: expected a readable file "
-                         "of paths, one per line") from None
+    except RefusedFile as exc:      # a FIFO, /dev/zero, a folder, a file over the limit: never read
+        raise InputError(f"--scene-list {exc}") from None
     base = list_path.parent
     entries, lines = [], {}
     for lineno, raw in enumerate(text.splitlines(), start=1):

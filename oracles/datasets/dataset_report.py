@@ -94,6 +94,11 @@ def console_summary(report: dict) -> str:
         lines += [f"  {e['mesh']}: {e['error']}" for e in s["errors"][:CONSOLE_LIST]]
         if len(s["errors"]) > CONSOLE_LIST:
             lines.append(f"  ... and {len(s['errors']) - CONSOLE_LIST} more (report.md)")
+    if s.get("warnings"):
+        lines.append(f"Read leniently ({len(s['warnings'])}):")
+        lines += [f"  {w['mesh']}: {w['warning']}" for w in s["warnings"][:CONSOLE_LIST]]
+        if len(s["warnings"]) > CONSOLE_LIST:
+            lines.append(f"  ... and {len(s['warnings']) - CONSOLE_LIST} more (report.md)")
     bad = [m for m in report["meshes"] if m["verdict"] in ("fail", "vacuous")]
     if bad:
         lines.append(f"Not passed ({len(bad)}):")
@@ -121,6 +126,9 @@ def markdown(report: dict) -> str:
     if s["errors"]:
         out += ["## Could not be loaded", "", "| mesh | error |", "| --- | --- |"]
         out += [f"| {e['mesh']} | {e['error'].replace('|', '/')} |" for e in s["errors"]] + [""]
+    if s.get("warnings"):
+        out += ["## Read leniently", "", "| mesh | warning |", "| --- | --- |"]
+        out += [f"| {w['mesh']} | {w['warning'].replace('|', '/')} |" for w in s["warnings"]] + [""]
     bad = [m for m in report["meshes"] if m["verdict"] in ("fail", "vacuous")]
     if bad:
         out += ["## Not passed", "", "| mesh | verdict | cases not passed |", "| --- | --- | --- |"]

@@ -25,16 +25,17 @@ from __future__ import annotations
 
 import collections
 import dataclasses
-import os
 import time
 from pathlib import Path
 
+from wirecheck.core.user_files import expected, problem
 from wirecheck.core.errors import InputError, one_line
 
 from ..judge import gate
 from ..candidates.core_candidate import RenderMode
 from .dataset import Dataset, MeshEntry
 from ..executors import ExecutorSpec, gather_in_order, open_executor
+from .memory_budget import default_budget, over_budget
 from ..runner import LEVEL_ORACLES, LEVELS, CaseRunner, overall_ms, RunParams, WORKER_LOCK, worker_init, scene_cases, worker_runner, worst_key
 from ..tolerances import Tolerances
 from wirecheck.core.scene.files import load_mesh_file
@@ -58,24 +59,35 @@ def _load(entry: MeshEntry):
     """The mesh as a Scene named by its dataset name; InputError with a one-line reason otherwise."""
     if entry.error is not None:
         raise InputError(entry.error)
-    if not os.path.isfile(entry.path):
-        raise InputError("file not found" if not os.path.lexists(entry.path) else
-                         "not a readable file (a broken link, or not a regular file)")
+    refused = problem(entry.path, "mesh")
+    if refused == "missing":
+        raise InputError("file not found")
+    if refused is not None:
+        raise InputError(f"{refused}: expected {expected('mesh')}")
     try:
         scene = load_mesh_file(Path(entry.path))
     except Exception as exc:         # any reader's failure is this mesh's, never the run's end
         text = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
         for path in (entry.path, one_line(entry.path)):        # as the reader wrote it, or made one line
-            text = text.replace(f"{path}: ", "").replace(path, entry.name)
-        raise InputError(text) from None
+            text = text.replace(f"{path}: ", "")
+        raise InputError(_named(text, entry)) from None
     return dataclasses.replace(scene, name=entry.name, source=entry.name)
 
 
-def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None) -> tuple[dict, dict, dict | None]:
+def _named(text: str, entry: MeshEntry) -> str:
+    """``text`` with the mesh's path (as the reader wrote it, or made one line) replaced by its dataset name."""
+    for path in (entry.path, one_line(entry.path)):
+        text = text.replace(path, entry.name)
+    return text
+
+
+def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None,
+               budget: int | None = None) -> tuple[dict, dict, dict | None]:
     """``(mesh record, timing, oracle GL info or None)`` of one mesh under every case in ``case_names``.
 
     ``runner`` (:class:`oracles.runner._CaseRunner`): None in a worker process
-    (its own runner, made on first use).
+    (its own runner, made on first use). ``budget``: bytes a mesh may need
+    (oracles.datasets.memory_budget); a mesh over it is an error, not checked.
     """
     t0 = time.perf_counter()
     record = {"mesh": entry.name}
@@ -92,6 +104,12 @@ def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None) -> 
         return record, {"mesh": entry.name, "load_s": time.perf_counter() - t0, "cases": []}, None
     t_load = time.perf_counter() - t0
     record.update(vertices=len(scene.vertices), edges=len(scene.edges), faces=len(scene.faces))
+    why = over_budget(len(scene.vertices), len(scene.edges), len(scene.faces), budget)
+    if why is not None:              # one mesh's load error, not the machine's memory
+        record.update(verdict="error", error=why)
+        return record, {"mesh": entry.name, "load_s": t_load, "cases": []}, None
+    if scene.load_notes:           # read leniently (core.scene.files): said in the report, the mesh checked
+        record["warnings"] = [_named(note, entry) for note in scene.load_notes]
     results = [runner.run(scene, case, params) for case in cases]
     rows = [{k: r.record[k] for k in CASE_KEYS if k in r.record} for r in results]
     verdicts = {row["verdict"] for row in rows}
@@ -103,9 +121,10 @@ def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None) -> 
     return record, timing, gl
 
 
-def _worker_check_mesh(entry: MeshEntry, params: RunParams, case_names) -> tuple[dict, dict, dict | None]:
+def _worker_check_mesh(entry: MeshEntry, params: RunParams, case_names,
+                       budget: int | None = None) -> tuple[dict, dict, dict | None]:
     with WORKER_LOCK:
-        return check_mesh(entry, params, case_names, worker_runner())
+        return check_mesh(entry, params, case_names, worker_runner(), budget)
 
 
 def faults_by_count(meshes: list[dict]) -> list[dict]:
@@ -147,6 +166,9 @@ def summarize(meshes: list[dict], level: str, allow_vacuous: bool, allow_load_er
                "cases": len(records), "cases_failed": sum(1 for r in records if r["verdict"] == "fail"),
                "faults": faults_by_count(meshes), "worst_cases": worst_cases(meshes),
                "errors": [{"mesh": m["mesh"], "error": m["error"]} for m in errors]}
+    warned = [{"mesh": m["mesh"], "warning": w} for m in meshes for w in m.get("warnings", [])]
+    if warned:                        # read leniently, and checked (core.scene.files)
+        summary["warnings"] = warned
     return verdict, compared, summary
 
 
@@ -154,14 +176,16 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
                 tol: Tolerances | None = None, level: str = "pixels", every: int = 1,
                 mode: RenderMode | None = None, candidate_name: str = "candidate",
                 allow_vacuous: bool = False, allow_load_errors: bool = False,
-                executor: ExecutorSpec | None = None, progress=None) -> dict:
+                executor: ExecutorSpec | None = None, progress=None, memory_budget="auto") -> dict:
     """Every mesh of ``dataset`` under every case: the report dict (module docstring).
 
     ``candidate`` is as for :func:`oracles.runner.run_crosscheck` (picklable
     when the meshes run in workers). ``progress(meshes_done, meshes)`` is
     called before the first mesh and after each. Raises InputError for inputs
     that would compare nothing (oracles.judge.gate.run_settings) and
-    :class:`NothingLoaded` when no mesh could be read.
+    :class:`NothingLoaded` when no mesh could be read. ``memory_budget``:
+    bytes one mesh may need (oracles.datasets.memory_budget), ``"auto"`` for
+    half the machine's memory shared by the local workers, None for no budget.
     """
     if level not in LEVELS:
         raise ValueError(f"level {level!r}: expected one of {', '.join(LEVELS)}")
@@ -177,6 +201,9 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
                              "pixel; expected level vertices or a case without distortion")
     params = RunParams(frames=inputs.frames, every=inputs.every, level=level, motion=Motion(turns=inputs.turns),
                         tol=tol, candidate=candidate, mode=mode, keep_frames=False)
+    # "auto": the workers on this machine share it (a remote cluster's machines: one worker's share)
+    budget = (default_budget(executor.jobs if executor.scheduler is None else 1) if memory_budget == "auto"
+              else memory_budget)
     entries = list(dataset.entries)
     t_run = time.perf_counter()
     done = 0
@@ -196,12 +223,12 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
             try:
                 results = []
                 for entry in entries:
-                    results.append(check_mesh(entry, params, inputs.case_names, runner))
+                    results.append(check_mesh(entry, params, inputs.case_names, runner, budget))
                     on_result(results[-1])
             finally:
                 runner.close()
         else:
-            items = [(entry, params, inputs.case_names) for entry in entries]
+            items = [(entry, params, inputs.case_names, budget) for entry in entries]
             results = gather_in_order(pool, _worker_check_mesh, items, on_result)
     wall_s = time.perf_counter() - t_run
     meshes = [r[0] for r in results]

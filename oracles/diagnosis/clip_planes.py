@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import faults as catalogue
 from ..tolerances import EPS
 from ..candidates.candidate import CandidateError, call_candidate
 
@@ -138,6 +139,11 @@ def _float32_limit(camera, which: str) -> float:
     return eps if which == "near" else eps * (1.0 + camera.far / camera.near)
 
 
+def _hint(kind: str) -> str:
+    """What to check for a ``clipping_plane`` of ``kind`` (the catalogue's hints, oracles.faults)."""
+    return catalogue.hint_text("clipping_plane", kind)
+
+
 def clip_fault(planes: dict | None, camera) -> dict | None:
     """``clipping_plane`` from :func:`probe_planes`'s answer; None when the planes are the camera's."""
     if planes is None:
@@ -145,12 +151,12 @@ def clip_fault(planes: dict | None, camera) -> dict | None:
     near, far = float(camera.near), float(camera.far)
     fields = {"near_fit": planes["near_fit"], "far_fit": planes["far_fit"], "near": near, "far": far}
     if not planes["front"] and not planes["behind"]:
-        return {"name": "clipping_plane", "kind": "swapped", **fields, "hint": HINTS["swapped"]}
+        return {"name": "clipping_plane", "kind": "swapped", **fields, "hint": _hint("swapped")}
     if not planes["front"]:
         return None                                   # keeps only points behind: a depth flip, named by the pixels
     n_fit, f_fit = planes["near_fit"], planes["far_fit"]
     if n_fit is None or (planes["behind"] and n_fit == 0.0):
-        return {"name": "clipping_plane", "kind": "none", **fields, "near_fit": None, "hint": HINTS["none"]}
+        return {"name": "clipping_plane", "kind": "none", **fields, "near_fit": None, "hint": _hint("none")}
     kind = None
     if abs(_rel(n_fit, near)) > PLANE_REL_TOL:
         if n_fit < PLANE_REL_TOL * near:
@@ -165,23 +171,7 @@ def clip_fault(planes: dict | None, camera) -> dict | None:
         kind = "float32_far" if abs(_rel(f_fit, far)) <= _float32_limit(camera, "far") else "far"
     if kind is None:
         return None
-    return {"name": "clipping_plane", "kind": kind, **fields, "hint": HINTS[kind]}
-
-
-#: What to check, per kind of ``clipping_plane`` (oracles.reports.report.fault_hints).
-HINTS = {
-    "z_positive": "the candidate keeps every point with z > 0: clip at the near plane, near <= z <= far "
-                  "(z = forward . (p - position)), not at the camera",
-    "float32_near": "the near plane went through float32 (a float32 near or GL projection matrix): near_fit "
-                    "is where it clips; build the matrix in float64, or declare float32",
-    "float32_far": "the far plane went through float32 (a float32 GL projection matrix, whose far is "
-                   "ill-conditioned): build the matrix in float64, or declare float32",
-    "near": "the near plane is another value: near_fit is where the candidate clips; use the camera's near",
-    "far": "the far plane is another value (far_fit; None: never clips far): use the camera's far",
-    "none": "the candidate never clips (no NaN, even behind the camera): return NaN unless near <= z <= far",
-    "swapped": "the candidate keeps no depth at all: near and far exchanged in near <= z <= far "
-               "(or the test inverted)",
-}
+    return {"name": "clipping_plane", "kind": kind, **fields, "hint": _hint(kind)}
 
 
 def depth_slack(planes: dict | None, camera) -> tuple[float, str | None]:

@@ -8,7 +8,7 @@ projector clipped the point. A row with any non-finite coordinate counts as
 clipped. The answer is ``[]`` when the candidate agrees: the same points are
 visible to both, and on those the largest coordinate error is ``<= tol_px``.
 Otherwise it is a list of faults, the *primary* fault first (in the order of
-``FAULT_ORDER``), each a dict with ``"name"`` and fields.
+precedence of the catalogue, oracles.faults), each a dict with ``"name"`` and fields.
 
 Method
 ======
@@ -149,28 +149,12 @@ import math
 
 import numpy as np
 
+from .. import faults as catalogue
 from ..tolerances import line_failures
 from .clip_planes import clip_fault
 from .lens_diagnose import distortion_fault
 
-__all__ = ["diagnose", "diagnose_lines", "primary", "FAULT_NAMES", "FAULT_ORDER", "LINE_FAULTS", "VERTEX_ONLY_FAULTS",
-           "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
-
-#: All fault names, in priority order: the first fault of a diagnosis is the
-#: primary one. A depth flip hides everything else; a swap or mirror changes
-#: the picture more than a scale; an offset is the smallest visible effect.
-FAULT_ORDER = ("depth_flip", "clipping_plane", "axis_swap", "ambiguous", "axis_flip", "mirror_horizontal",
-               "mirror_vertical", "aspect_mismatch", "fov_mismatch",
-               "pixel_offset", "distortion_mismatch", "line_end_bias", "line_pixel_bias", "raster_rule",
-               "precision_limited", "unexplained")
-FAULT_NAMES = frozenset(FAULT_ORDER)
-#: The faults named from a wireframe's pixels (:func:`diagnose_lines`; raster_rule: oracles.judge.line_style), not
-#: from its vertices.
-LINE_FAULTS = ("line_end_bias", "line_pixel_bias", "raster_rule")
-#: The faults named from vertices only: frames of a distorted camera are not compared (oracles.judge.case),
-#: float32 rounding (precision_limited) is far below a pixel, and a clipping plane is probed on the
-#: candidate's projector (oracles.diagnosis.clip_planes).
-VERTEX_ONLY_FAULTS = ("clipping_plane", "distortion_mismatch", "precision_limited")
+__all__ = ["diagnose", "diagnose_lines", "primary", "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
 #: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union
@@ -205,7 +189,7 @@ def primary(faults: list[dict]) -> str:
 
 
 def _sorted(faults: list[dict]) -> list[dict]:
-    return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
+    return catalogue.ordered(faults)
 
 
 def _fit_affine(o: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -228,11 +212,6 @@ def _unexplained(**fields) -> dict:
     return {"name": "unexplained", **fields}
 
 
-#: The hint of a scale of (W - 1) / W or (H - 1) / H.
-MINUS_ONE_HINT = ("the scale is (W - 1) / W (or (H - 1) / H): the pixel count minus one was used as the image "
-                  "size (x = (ndc + 1) (W - 1) / 2); use x = (ndc + 1) W / 2 - 0.5")
-
-
 def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> list[dict]:
     """``aspect_mismatch`` and ``fov_mismatch`` from the fitted scales ``sx, sy`` of the pixel axes.
 
@@ -249,21 +228,18 @@ def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> l
                  "implied_aspect": (w / h) * sy / sx, "scale_x": sx, "scale_y": sy}
         if (abs(sx - minus_one["x"]) * reach[0] <= tol or abs(sx / sy - minus_one["x"]) * reach[0] <= tol
                 or abs(sy / sx - minus_one["y"]) * reach[1] <= tol):
-            fault["hint"] = MINUS_ONE_HINT
+            fault["hint"] = catalogue.hint_text("aspect_mismatch", "minus_one")
         elif abs(sx / sy - (w / h) ** 2) * reach[0] <= tol:
-            fault["hint"] = ("implied_aspect is H/W: the aspect was taken the wrong way round (height / width "
-                             "where width / height is expected)")
+            fault["hint"] = catalogue.hint_text("aspect_mismatch", "inverted")
         elif abs(sx / sy - w / h) * reach[0] <= tol or abs(sx / sy - h / w) * reach[0] <= tol:
-            fault["hint"] = ("x is scaled by W/H (or H/W) against y: fx was taken from the width (aspect 1): "
-                             "fx = fy for square pixels")
+            fault["hint"] = catalogue.hint_text("aspect_mismatch", "width")
         faults.append(fault)
     if abs(sy - 1.0) * reach[1] > tol:
         fault = {"name": "fov_mismatch", **fields, "scale": sy, "implied_fov_deg": None, "implied_ortho_height": None}
         if abs(sy - w / h) * reach[1] <= tol or abs(sy - h / w) * reach[1] <= tol:
-            fault["hint"] = ("the scale is W/H (or H/W): you used the horizontal FOV (or the width) where the "
-                             "vertical one is expected: f = (H / 2) / tan(fov_y / 2)")
+            fault["hint"] = catalogue.hint_text("fov_mismatch", "horizontal_fov")
         elif abs(sy - minus_one["y"]) * reach[1] <= tol:
-            fault["hint"] = MINUS_ONE_HINT
+            fault["hint"] = catalogue.hint_text("fov_mismatch", "minus_one")
         if camera.projection == "perspective":
             half = math.tan(math.radians(camera.fov_y_deg) / 2.0)
             fault["implied_fov_deg"] = math.degrees(2.0 * math.atan(half / sy))
@@ -308,11 +284,8 @@ def _advised(fault: dict, tol_px: float) -> dict:
     if fault["name"] != "unexplained" or not fault.get("residual_px", 0.0) <= tol_px:
         return fault
     a, b = fault.get("candidate_only", 0), fault.get("oracle_only", 0)
-    return {**fault, "hint": (
-        f"the pixels agree (residual {fault['residual_px']:.2g} px <= the {tol_px:.2g} px bound); only the "
-        f"visible sets differ: {a} points shown only by the candidate, {b} only by the oracle. Check the "
-        "near/far test (near <= z <= far, z = forward . (p - position)), points behind the camera, and any "
-        "visibility or raster step, not the rotation")}
+    return {**fault, "hint": catalogue.hint_text("unexplained", "visible_sets", residual=fault["residual_px"],
+                                                 tol=tol_px, candidate_only=a, oracle_only=b)}
 
 
 def _diagnose(cand_px, oracle_px, camera, tol_px, float32_px, planes) -> list[dict]:
@@ -337,7 +310,7 @@ def _diagnose(cand_px, oracle_px, camera, tol_px, float32_px, planes) -> list[di
 #: such constants (fx from f and the aspect): 1 eps32; 2 leaves 2x.
 CONSTANT_ROUNDINGS = 2.0
 #: The named faults a float32 constant can fake (mirrors and swaps are exact in any precision).
-_ROUNDABLE = ("aspect_mismatch", "fov_mismatch", "pixel_offset")
+_ROUNDABLE = catalogue.names("scale", "offset")
 
 
 def rounded_constants(faults: list[dict], camera, info: dict, tol_px: float, float32_px: float) -> list[dict]:

@@ -155,7 +155,7 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None) -> list
 
     Returns
     -------
-    list of dict, primary fault first (:data:`oracles.diagnosis.diagnose.FAULT_ORDER`);
+    list of dict, primary fault first (precedence: oracles.faults);
     every fault has ``confidence`` and ``residual_px``.
     """
     cand_images = list(cand_images)

@@ -41,10 +41,10 @@ import math
 
 import numpy as np
 
-from .hints import FAULT_HINTS
+from .. import faults as catalogue
 from .model_lines import model_images, quantisation_bias
 from .rule_read import read_rules, standing_scale_faults
-from .diagnose import FAULT_ORDER, scale_faults
+from .diagnose import scale_faults
 from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, PERMUTATIONS, Registration, SCREEN_ITERATIONS, frame_samples, points_per_frame
 
 __all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales", "rule_bias", "rule_off_diagonal"]
@@ -63,19 +63,15 @@ def scale_starts(camera) -> list[np.ndarray]:
     return out
 
 
-def _hint(name: str) -> str:
-    return FAULT_HINTS.get(name, "")
-
-
 def ambiguous_fault(names: tuple, other: tuple, **common) -> tuple[list[dict], dict]:
     """``(shared faults, ambiguous fault)`` for two permutations' names that fit equally well."""
     shared = [n for n in names if n in other]
     alternatives = ["+".join(n for n in group if n not in shared) or "none" for group in (names, other)]
-    hints = "; ".join(f"if {alt}: {_hint(alt.split('+')[0])}" for alt in alternatives if alt != "none")
+    each = "; ".join(f"if {alt}: {catalogue.kind(alt.split('+')[0]).hint}" for alt in alternatives if alt != "none")
     return ([{"name": n, **common} for n in shared],
             {"name": "ambiguous", **common, "alternatives": alternatives,
-             "hint": f"the images fit {alternatives[0]} and {alternatives[1]} equally well (a symmetric view "
-                     f"cannot tell them apart): {hints}"})
+             "hint": catalogue.hint_text("ambiguous", "alternatives", first=alternatives[0], second=alternatives[1],
+                                         each=each)})
 
 
 def _confidence(cost: float, without: float) -> float:
@@ -134,7 +130,7 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
         faults.append({"name": "pixel_offset", "confidence": _confidence(cost, reg.cost(p, a, expected + bias)),
                        "residual_px": residual, "dx": float(off[0]), "dy": float(off[1]),
                        "uncertainty_px": float(np.max(np.abs(bias))), "bias_rule": rule, "rules_read": read_as})
-    return sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
+    return catalogue.ordered(faults)
 
 
 def rotation_deg(a_free: np.ndarray) -> float:

@@ -23,6 +23,8 @@ import numpy as np
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
 
+from .. import faults as catalogue
+
 __all__ = ["set_difference", "visibility_fault", "in_place", "frames_visibility"]
 
 #: A pixel is on one side only when the other side has no pixel within this distance (px): F1@1px's tolerance.
@@ -89,10 +91,8 @@ def visibility_fault(fault: dict, cand_images, oracle_segs, camera, matched_px: 
              "correct drawing's)")
     return {**fault, "candidate_only_px": cand_only, "oracle_only_px": oracle_only,
             **({} if matched_px is None else {"matched_residual_px": float(matched_px)}),
-            "hint": (f"{where}; only the drawn sets differ: {cand_only} pixels drawn only by the candidate, "
-                     f"{oracle_only} only by the oracle (no pixel of the other within {NEAR_PX:g} px). Check the "
-                     "near/far test (near <= z <= far, z = forward . (p - position)), points behind the camera, "
-                     "and any visibility or raster step, not the rotation")}
+            "hint": catalogue.hint_text("unexplained", "drawn_sets", where=where, candidate_only=cand_only,
+                                        oracle_only=oracle_only, near=NEAR_PX)}
 
 
 def frames_visibility(faults: list, cand_images, oracle_segs, camera, frames_checked: int) -> list:

@@ -102,8 +102,10 @@ class CaseSetup:
         if not mode.plain and not self.is_core and pixels:
             raise ValueError(f"drawing mode {mode.to_dict()}: only the core candidate draws faces")
         self.edges = np.asarray(scene.edges)
-        self.faces = tuple(tuple(int(i) for i in f) for f in scene.faces) or None
-        self.use_faces = pixels and self.faces is not None and not mode.plain
+        self.use_faces = pixels and len(scene.faces) > 0 and not mode.plain
+        # the faces as plain ints where they are drawn; a plain wireframe only asks whether there are any
+        # (converting a million faces costs more than the frame)
+        self.faces = (tuple(tuple(int(i) for i in f) for f in scene.faces) if self.use_faces else scene.faces) or None
         # core is set up as renderer sets it up (core.scene.frames): its own matrices and world points,
         # and, for a multi-object scene, faces re-wound for mirrored objects
         self.core_frames = candidate.scene_frames(scene, motion, frames) if self.is_core else None

@@ -14,6 +14,8 @@ to change (the colour), instead of the image diagnosis' guess.
 
 from __future__ import annotations
 
+from .. import faults as catalogue
+
 #: The coverage from which a pixel counts as drawn (oracles.candidates.png_frame.read_png).
 DRAWN_LEVEL = 128
 
@@ -25,6 +27,4 @@ def name_dim_lines(faults: list, line_style: dict | None, per_frame: list) -> li
     if not 0 < level < DRAWN_LEVEL or any(f.get("candidate_pixels") for f in per_frame):
         return faults
     return [{"name": "unexplained", "line_level": level,
-             "hint": f"the frames hold lines, at level {level} of 255 (luminance x alpha / 255), under the "
-                     f"{DRAWN_LEVEL} from which a pixel counts as drawn: nothing was drawn by the rule. Draw the "
-                     "lines white and opaque (a grey colour or a partial alpha dims them)"}]
+             "hint": catalogue.hint_text("unexplained", "dim_lines", level=level, drawn=DRAWN_LEVEL)}]

@@ -75,6 +75,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import faults as catalogue
 from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
 from .case_samples import CaseSamples
 from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
@@ -82,7 +83,6 @@ from ..segment_geometry import seg_distance
 from ..diagnosis.image_diagnose import OFFSET_TOL_PX, SCALE_TOL_PX, oracle_segments
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
-from ..diagnosis.diagnose import FAULT_ORDER
 from .free_ends import END_TOL_PX, MIN_ENDS
 
 STYLES = ("aliased", "antialiased", "wide")
@@ -111,10 +111,14 @@ MAX_SAMPLES_PER_CASE = 48_000
 #: The geometry is measured only where at least this share of the windows along the oracle's lines
 #: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
 MIN_FOUND_SHARE = 0.5
-#: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
 #: Line faults named from the one-sided pixel counts (oracles.diagnosis.diagnose.diagnose_lines): GL's rule.
-COUNT_FAULTS = ("line_end_bias", "line_pixel_bias")
-PLACEMENT_FAULTS = ("depth_flip", "axis_swap", "axis_flip", "mirror_horizontal", "mirror_vertical")
+COUNT_FAULTS = catalogue.names("line_count")
+#: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
+PLACEMENT_FAULTS = catalogue.names("orientation")
+#: The registration's faults that the line centres, finer over thick or other-rule pixels, replace.
+MEASURED_FAULTS = catalogue.names("scale", "offset")
+#: The faults a correct drawing under another aliased rule leaves under GL's rule: raster_rule replaces them.
+RULE_FAULTS = catalogue.names("unexplained", "offset", "line_count")
 #: Aliased lines of another rule: the largest pooled centre offset (px) that is still "the geometry is
 #: right". A rule that snaps the ends to pixel centres (Pillow's ImageDraw.line, TinyGL) moves each line
 #: by up to half a pixel; pooled over a case's lines measured 0.00-0.27 px on the bundled scenes and
@@ -489,7 +493,7 @@ class CaseStyle:
         if placed and not by_rule:
             # the centres are finer than the registration over thick or other-rule pixels: its offset and
             # scale faults give way to the measure's
-            faults = [f for f in faults if f["name"] not in ("pixel_offset", "fov_mismatch", "aspect_mismatch")
+            faults = [f for f in faults if f["name"] not in MEASURED_FAULTS
                       or warped and f["name"] != "pixel_offset"]
             if moved:
                 faults = [f for f in faults if f["name"] != "unexplained"]
@@ -520,15 +524,15 @@ class CaseStyle:
         geometry_right = placed and not moved and not warped
         if by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0 \
                 and any(r.startswith("pixel F1@0px") for r in f0) \
-                and all(f["name"] in ("unexplained", "pixel_offset") + COUNT_FAULTS for f in faults):
-            faults = [f for f in faults if f["name"] not in ("unexplained", "pixel_offset") + COUNT_FAULTS]
+                and all(f["name"] in RULE_FAULTS for f in faults):
+            faults = [f for f in faults if f["name"] not in RULE_FAULTS]
             faults.append({"name": "raster_rule", **out["raster_rule"], "confidence": 1.0,
                            "offset_px": [float(d[0]), float(d[1])], "residual_px": None,
                            "note": f"the lines are where the oracle's are (centres within {off:.2f} px) but "
                                    "their pixels follow another line rule than GL's: check the line "
                                    "rasteriser (its rule across the line and at the ends), not the camera; "
                                    "--line-rule geometry judges the geometry only"})
-        rec["faults"] = sorted(faults, key=lambda f: FAULT_ORDER.index(f["name"]))
+        rec["faults"] = catalogue.ordered(faults)
         out.update(pixel_rule=by_rule, failures=[r for r in reasons if r not in given])
         rec["line_style"] = out
         return reasons

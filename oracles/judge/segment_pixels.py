@@ -18,7 +18,10 @@ pixels are sorted row-major, so the ones of one row between two columns are
 one slice of them. For each row a segment's grown box spans, the slice runs
 over the columns its part near that row reaches; each pair found is
 measured. For a few pixels, a grid of cells lists the segments near each
-cell instead. The frames of a case are done in one pass: they are stacked
+cell instead. Pairs come in chunks (:data:`CHUNK_PAIRS`) and are folded into
+one nearest segment per pixel as they come, so memory is bounded by the
+image, the segments and the chunk, never by the segments' drawn length
+(a pixel under a soup of long edges is near hundreds of them). The frames of a case are done in one pass: they are stacked
 one above the other, and a segment looks only at its own frame's rows, so no
 pair mixes two frames and each frame's rows are the ones it would get alone;
 distances are measured in the frame's own coordinates, so they are the same
@@ -36,6 +39,17 @@ import numpy as np
 from ..segment_geometry import clip_to_box
 
 _EMPTY = np.zeros(0, dtype=np.int64)
+_NONE = np.iinfo(np.int64).max          # no owner yet (:meth:`_Segments.owners`)
+
+#: Pairs of a segment and a pixel (or rows a run of segments spans) measured at once: the pairing
+#: streams its pairs in chunks of about this many, so that its memory is bounded by the image and
+#: this, whatever the drawn length of the segments (a soup of long edges pairs each pixel with
+#: hundreds: 10^8 pairs a frame). 2^19 pairs: ~60 MB of temporaries in _near, ~5 ms of work.
+CHUNK_PAIRS = 1 << 19
+#: :meth:`_Segments.pairs_any` tests each pixel against every segment's box when there are at most
+#: this many (pixel, segment) tests (a frame's few one-sided pixels: ~10 ms), rather than list every
+#: segment in a grid of cells first (~100 ms for 30,000 segments).
+FEW_PAIRS = 1 << 22
 
 #: :func:`frames_count_differences` counts every drawn pixel at once when the frames hold more than
 #: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
@@ -81,7 +95,7 @@ def frames_neighbourhoods(frames, width: int, height: int, radius: float = 1.0) 
         return []
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius)
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
-    sid, pos = segs.owners(px, *segs.pairs(px))
+    sid, pos = segs.owners(px, segs.pairs(px))
     edge, local, major = segs.rows(px, sid, pos)
     cut = np.searchsorted(pos, np.cumsum(px.counts)[:-1])      # the frames' rows, split
     return list(zip(np.split(edge, cut), np.split(local, cut), np.split(major, cut)))
@@ -133,10 +147,10 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
             compared = (cc > 0) | (oc > 0)
         else:
             compared = _compared(segs, drawn)
-            owners = _unique(segs.owners(one_sided, *segs.pairs_any(one_sided))[0])
+            owners = _unique(segs.owners(one_sided, segs.pairs_any(one_sided))[0])
             cc = oc = np.zeros(len(segs), np.int64)
             if len(owners):
-                cc, oc = _counts_near(segs, cand, orac, drawn.subset(_unique(segs.pairs(drawn, owners)[1])))
+                cc, oc = _counts_near(segs, cand, orac, drawn.subset(segs.near(drawn, owners)))
         diff_all[first_edge[segs.frame[owners]] + segs.edge[owners]] = (cc - oc)[owners]
     n_compared = np.bincount(segs.frame[compared], minlength=len(frames))
     return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
@@ -150,7 +164,7 @@ def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
     mid_stacked = np.where(on, (mid[:, 1] + segs.frame * h) * w + mid[:, 0], -1)
     on &= drawn.has(mid_stacked)
     mids = drawn.subset(_unique(np.searchsorted(drawn.stacked, mid_stacked[on])))
-    m_sid, m_pos = segs.owners(mids, *segs.pairs_any(mids))
+    m_sid, m_pos = segs.owners(mids, segs.pairs_any(mids))
     owner_at = np.full(len(mids), -1, np.int64)
     owner_at[m_pos] = m_sid
     seg_on = np.flatnonzero(on)
@@ -158,8 +172,8 @@ def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
     compared[seg_on] = owner_at[np.searchsorted(mids.stacked, mid_stacked[seg_on])] == seg_on
     rest = np.flatnonzero(~compared)           # the others: the owners of the drawn pixels near them
     if len(rest):
-        near = drawn.subset(_unique(segs.pairs(drawn, rest)[1]))
-        compared[_unique(segs.owners(near, *segs.pairs_any(near))[0])] = True
+        near = drawn.subset(segs.near(drawn, rest))
+        compared[_unique(segs.owners(near, segs.pairs_any(near))[0])] = True
     return compared
 
 
@@ -167,10 +181,22 @@ def _counts_near(segs: _Segments, cand: _Pixels, orac: _Pixels, near: _Pixels, e
     """``(cc, oc)``, ``(S,)`` each: every segment's count in the candidate's and the oracle's image, over
     the drawn pixels ``near`` only (right for the segments all of whose pixels are among them);
     ``every``: ``near`` is every drawn pixel (paired row by row)."""
-    sid, pos = segs.owners(near, *(segs.pairs(near) if every else segs.pairs_any(near)))
+    sid, pos = segs.owners(near, segs.pairs(near) if every else segs.pairs_any(near))
     _, _, major = segs.rows(near, sid, pos)
     in_cand, in_orac = cand.has(near.stacked[pos]), orac.has(near.stacked[pos])
     return tuple(_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac))
+
+
+def _cuts(weights: np.ndarray, limit: int) -> list[tuple[int, int]]:
+    """``[(lo, hi)]``: consecutive ranges of ``weights`` whose sums are at most ``limit`` (an item over
+    ``limit`` alone), covering them all in order."""
+    total = np.cumsum(weights)
+    out, lo, base = [], 0, 0
+    while lo < len(total):
+        hi = max(int(np.searchsorted(total, base + limit, side="right")), lo + 1)
+        out.append((lo, hi))
+        base, lo = int(total[hi - 1]), hi
+    return out
 
 
 def _unique(a: np.ndarray) -> np.ndarray:
@@ -214,7 +240,7 @@ def nearest_segments(frames, width: int, height: int, radius: float, box: tuple)
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius, box=box)
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
     owner = np.full(len(px), -1, np.int64)
-    sid, pos = segs.owners(px, *segs.pairs_any(px))
+    sid, pos = segs.owners(px, segs.pairs_any(px))
     owner[pos] = sid
     return owner, segs.q0, segs.q1, px.at()[0]
 
@@ -228,6 +254,9 @@ class _Pixels:
 
     def __init__(self, stacked: np.ndarray, width: int, height: int, counts: np.ndarray | None = None):
         self.stacked, self.width, self.height, self.counts = stacked, width, height, counts
+        self.frames = len(counts) if counts is not None else 0      # frames stacked (0: not known)
+        self._xy = None                 # (x, y) of every pixel as float64, made on first use (:meth:`xy`)
+        self._rank = None               # :meth:`rank`'s table, made when it pays
 
     @classmethod
     def of_frames(cls, per_frame, width: int, height: int) -> _Pixels:
@@ -249,6 +278,29 @@ class _Pixels:
         frame = row // self.height
         return frame, row - frame * self.height, s - row * self.width
 
+    def xy(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(x, y)``, ``(P,)`` float64 each: every pixel's column and row in its frame (found once)."""
+        if self._xy is None:
+            _, y, x = self.at()
+            self._xy = (x.astype(np.float64), y.astype(np.float64))
+        return self._xy
+
+    def rank(self, stacked: np.ndarray) -> np.ndarray:
+        """``np.searchsorted(self.stacked, stacked)`` for stacked flat indices in ``[0, frames H W]``.
+
+        Many queries (a long segment's rows) look up a table of one entry per
+        pixel of the stacked frames (their count so far, int32: bounded by the
+        images), built once; a few are binary searches.
+        """
+        size = self.frames * self.width * self.height
+        if self._rank is None and size and len(stacked) > size // 4 and size < 2 ** 31:
+            table = np.zeros(size + 1, np.int32)
+            table[self.stacked + 1] = 1
+            self._rank = np.cumsum(table, dtype=np.int32)
+        if self._rank is not None:
+            return self._rank[stacked].astype(np.int64)
+        return np.searchsorted(self.stacked, stacked)
+
     def has(self, stacked: np.ndarray) -> np.ndarray:
         """Whether each stacked flat index is one of these pixels."""
         stacked = np.asarray(stacked, np.int64)
@@ -259,7 +311,9 @@ class _Pixels:
 
     def subset(self, pos: np.ndarray) -> _Pixels:
         """The pixels at ascending positions ``pos``."""
-        return _Pixels(self.stacked[pos], self.width, self.height)
+        out = _Pixels(self.stacked[pos], self.width, self.height)
+        out.frames = self.frames
+        return out
 
 
 class _Segments:
@@ -283,6 +337,9 @@ class _Segments:
         self.frame, self.edge = frame[keep], edge[keep]
         self.d = self.q1 - self.q0
         self.dd = self.d[:, 0] * self.d[:, 0] + self.d[:, 1] * self.d[:, 1]
+        # the columns _near gathers per pair, contiguous (np.take of a 1-D array: the same floats, faster)
+        self._cols = tuple(np.ascontiguousarray(c) for c in (self.q0[:, 0], self.q0[:, 1], self.d[:, 0],
+                                                             self.d[:, 1], self.dd))
         self._cells = None                       # the grid of pairs_any, made on first use
         self._rows = None                        # _rows_spanned, counted on first use
 
@@ -290,24 +347,38 @@ class _Segments:
         return len(self.q0)
 
     def pairs(self, px: _Pixels, which: np.ndarray | None = None):
-        """``(sid, pos, dist)``: each pair of a segment (of ``which``, default all) and a pixel within ``radius``.
+        """``(sid, pos, dist)`` chunks: each pair of a segment (of ``which``, ascending, default all) and a
+        pixel within ``radius``, at most about :data:`CHUNK_PAIRS` pairs a chunk, by ascending segment.
 
         Row by row (:meth:`_spans` of 1-row bands): the pixels of a row
         between two columns are one slice of ``stacked``; each is measured.
+        The segments go in runs spanning at most :data:`CHUNK_PAIRS` rows,
+        and a run's slices in chunks of at most that many pixels (a slice
+        over it alone): memory is bounded whatever the segments' length.
         """
         if which is None:
             which = np.arange(len(self))
         if len(which) == 0 or len(px) == 0:
-            return _EMPTY, _EMPTY, np.zeros(0)
-        seg, row, col_lo, col_hi = self._spans(which, 1)
+            return
         w, h = self.width, self.height
-        # the pixels of one row between two columns are one slice of ``stacked``
-        start = (row + self.frame[seg] * h) * w
-        a = np.searchsorted(px.stacked, start + col_lo)
-        n = np.maximum(np.searchsorted(px.stacked, start + col_hi + 1) - a, 0)
-        sid = np.repeat(seg, n)
-        pos = np.arange(int(n.sum())) + np.repeat(a - (np.cumsum(n) - n), n)
-        return self._near(px, sid, pos)
+        for lo, hi in _cuts(self._rows_of(which), CHUNK_PAIRS):
+            seg, row, col_lo, col_hi = self._spans(which[lo:hi], 1)
+            # the pixels of one row between two columns are one slice of ``stacked``
+            start = (row + self.frame[seg] * h) * w
+            a = px.rank(start + col_lo)
+            n = np.maximum(px.rank(start + col_hi + 1) - a, 0)
+            for s0, s1 in _cuts(n, CHUNK_PAIRS):
+                nn = n[s0:s1]
+                sid = np.repeat(seg[s0:s1], nn)
+                pos = np.arange(int(nn.sum())) + np.repeat(a[s0:s1] - (np.cumsum(nn) - nn), nn)
+                yield self._near(px, sid, pos)
+
+    def near(self, px: _Pixels, which: np.ndarray) -> np.ndarray:
+        """Ascending positions of the pixels within ``radius`` of some segment of ``which`` (ascending)."""
+        hit = np.zeros(len(px), bool)
+        for _sid, pos, _dist in self.pairs(px, which):
+            hit[pos] = True
+        return np.flatnonzero(hit)
 
     def pairs_any(self, px: _Pixels):
         """:meth:`pairs` over all segments, for a subset of the pixels: each against every segment of its
@@ -318,18 +389,26 @@ class _Segments:
         measured against the segments listed in its cell. Cost ~ pixels x
         segments per cell, whatever the segments' total length. The cells'
         side follows the segments' typical length (:meth:`_cell_side`), so a
-        dense mesh's many short segments are not listed together.
+        dense mesh's many short segments are not listed together. Chunks of
+        whole pixels (every pair of a pixel in one chunk), at most about
+        :data:`CHUNK_PAIRS` pairs each.
         """
         if len(px) == 0 or len(self) == 0:
-            return _EMPTY, _EMPTY, np.zeros(0)
+            return
         frame = px.at()[0]
         per_frame = np.bincount(self.frame, minlength=int(frame.max()) + 1)
         n = per_frame[frame]                                 # each pixel against all of its frame's segments
         if self._cells is None and int(n.sum()) <= 4 * (len(px) + len(self)):
-            first = np.cumsum(per_frame) - per_frame         # segments are in frame order
-            pos = np.repeat(np.arange(len(px)), n)
-            sid = np.arange(int(n.sum())) + np.repeat(first[frame] - (np.cumsum(n) - n), n)
-            return self._near(px, sid, pos)
+            first = (np.cumsum(per_frame) - per_frame)[frame]        # segments are in frame order
+            for lo, hi in _cuts(n, CHUNK_PAIRS):
+                nn = n[lo:hi]
+                pos = np.repeat(np.arange(lo, hi), nn)
+                sid = np.arange(int(nn.sum())) + np.repeat(first[lo:hi] - (np.cumsum(nn) - nn), nn)
+                yield self._near(px, sid, pos)
+            return
+        if self._cells is None and len(px) * len(self) <= FEW_PAIRS:
+            yield from self._pairs_boxed(px, frame)          # a few pixels: no grid of every segment
+            return
         keys, listed = self._cell_index()
         _, y, x = px.at()
         cell = self._cell
@@ -337,10 +416,28 @@ class _Segments:
         a = np.searchsorted(keys, key, side="left")
         n = np.searchsorted(keys, key, side="right") - a
         if int(n.sum()) > 2 * (self._rows_spanned() + len(px)):     # crowded cells: row by row is cheaper
-            return self.pairs(px)
-        pos = np.repeat(np.arange(len(px)), n)
-        sid = listed[np.arange(int(n.sum())) + np.repeat(a - (np.cumsum(n) - n), n)]
-        return self._near(px, sid, pos)
+            yield from self.pairs(px)
+            return
+        for lo, hi in _cuts(n, CHUNK_PAIRS):
+            nn = n[lo:hi]
+            pos = np.repeat(np.arange(lo, hi), nn)
+            sid = listed[np.arange(int(nn.sum())) + np.repeat(a[lo:hi] - (np.cumsum(nn) - nn), nn)]
+            yield self._near(px, sid, pos)
+
+    def _pairs_boxed(self, px: _Pixels, frame: np.ndarray):
+        """:meth:`pairs_any` by a box test of every pixel against every segment of its frame: the pairs
+        whose pixel centre is within ``radius`` of the segment's box (all those within ``radius`` of the
+        segment), measured. ``frame``: each pixel's."""
+        r = self.radius
+        lo_x, hi_x = np.minimum(self.q0[:, 0], self.q1[:, 0]) - r, np.maximum(self.q0[:, 0], self.q1[:, 0]) + r
+        lo_y, hi_y = np.minimum(self.q0[:, 1], self.q1[:, 1]) - r, np.maximum(self.q0[:, 1], self.q1[:, 1]) + r
+        x, y = px.xy()
+        for lo, hi in _cuts(np.full(len(px), len(self), np.int64), CHUNK_PAIRS):
+            cx, cy = x[lo:hi, None], y[lo:hi, None]
+            inside = ((cx >= lo_x) & (cx <= hi_x) & (cy >= lo_y) & (cy <= hi_y)
+                      & (frame[lo:hi, None] == self.frame[None, :]))
+            pos, sid = np.nonzero(inside)
+            yield self._near(px, sid, pos + lo)
 
     def _cell_index(self) -> tuple[np.ndarray, np.ndarray]:
         """``(keys, sid)``, sorted by key: each segment once per cell it is listed in (:meth:`pairs_any`)."""
@@ -360,10 +457,15 @@ class _Segments:
     def _rows_spanned(self) -> int:
         """How many (segment, row) slices :meth:`pairs` takes over all segments."""
         if self._rows is None:
-            lo = np.maximum(np.ceil(np.minimum(self.q0[:, 1], self.q1[:, 1]) - self.grow), 0)
-            hi = np.minimum(np.floor(np.maximum(self.q0[:, 1], self.q1[:, 1]) + self.grow), self.height - 1)
-            self._rows = int(np.maximum(hi - lo + 1, 0).sum())
+            self._rows = int(self._rows_of(np.arange(len(self))).sum())
         return self._rows
+
+    def _rows_of(self, which: np.ndarray) -> np.ndarray:
+        """``(len(which),)`` int64: the rows of the frame each segment's grown box spans (:meth:`pairs`' slices)."""
+        y0, y1 = self.q0[which, 1], self.q1[which, 1]
+        lo = np.maximum(np.ceil(np.minimum(y0, y1) - self.grow), 0)
+        hi = np.minimum(np.floor(np.maximum(y0, y1) + self.grow), self.height - 1)
+        return np.maximum(hi - lo + 1, 0).astype(np.int64)
 
     def _cell_side(self) -> int:
         """The grid's cell side (px): the segments' median length, a power of two in [4, 32].
@@ -400,37 +502,37 @@ class _Segments:
 
     def _near(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
         """The pairs ``(sid, pos)`` within ``radius``, with their distances."""
-        q0, d = self.q0, self.d
+        qx, qy, dx, dy, dd = (np.take(c, sid) for c in self._cols)
         # the point of the segment nearest the pixel centre: a + u d, u in [0, 1], in the frame's coordinates
-        _, y, x = px.at(pos)
-        ex, ey = x - q0[sid, 0], y - q0[sid, 1]
-        dx, dy, dd = d[sid, 0], d[sid, 1], self.dd[sid]
+        x, y = px.xy()
+        ex, ey = np.take(x, pos) - qx, np.take(y, pos) - qy
         with np.errstate(divide="ignore", invalid="ignore"):
             u = np.clip(np.where(dd > 0, (ex * dx + ey * dy) / dd, 0.0), 0.0, 1.0)
         dist = np.hypot(ex - u * dx, ey - u * dy)
         near = dist <= self.radius
         return sid[near], pos[near], dist[near]
 
-    def owners(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray, dist: np.ndarray):
-        """``(sid, pos)`` of :meth:`pairs` (over all segments), one per pixel, ascending by pixel.
+    def owners(self, px: _Pixels, chunks):
+        """``(sid, pos)``, one per pixel that has a pair in ``chunks`` (:meth:`pairs` or :meth:`pairs_any`,
+        over all segments), ascending by pixel.
 
         Each pixel goes to its nearest segment only (ties: the lower index),
-        so that one pixel more or less changes one edge's count by at most one;
-        only pixels near several segments need the choice.
+        so that one pixel more or less changes one edge's count by at most one.
+        The chunks are folded into two arrays of one entry per pixel (the
+        nearest distance so far, and its lowest segment): a chunk that brings
+        a pixel nearer replaces its segment, one as near keeps the lower index.
         """
-        several = np.bincount(pos, minlength=len(px))[pos] > 1
-        if several.any():
-            multi = np.flatnonzero(several)
-            order = multi[np.lexsort((sid[multi], dist[multi], pos[multi]))]
-            first = np.ones(len(order), bool)
-            first[1:] = pos[order[1:]] != pos[order[:-1]]
-            chosen = np.concatenate([np.flatnonzero(~several), order[first]])
-            sid, pos = sid[chosen], pos[chosen]
-        # back in pixel order by placing each row at its pixel
-        slot = np.full(len(px), -1, np.int64)
-        slot[pos] = np.arange(len(pos))
-        rows = slot[slot >= 0]
-        return sid[rows], pos[rows]
+        nearest = np.full(len(px), np.inf)
+        owner = np.full(len(px), _NONE, np.int64)
+        for sid, pos, dist in chunks:
+            before = nearest[pos]
+            np.minimum.at(nearest, pos, dist)
+            after = nearest[pos]
+            best = dist == after                        # the pairs at their pixel's nearest distance
+            owner[pos[best & (after < before)]] = _NONE       # nearer than every earlier chunk: theirs go
+            np.minimum.at(owner, pos[best], sid[best])
+        pos = np.flatnonzero(owner != _NONE)
+        return owner[pos], pos
 
     def rows(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
         """``(edge, pixel, major)`` of owner pairs (module docstring), pixels flat in their frames."""

@@ -16,7 +16,8 @@ import numpy as np
 
 from . import metrics
 from ..candidates.candidate import case_precision
-from ..diagnosis.diagnose import LINE_FAULTS, diagnose
+from .. import faults as catalogue
+from ..diagnosis.diagnose import diagnose
 from .decide import decide, line_faults, pixel_fields
 from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
@@ -155,5 +156,5 @@ def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error,
     rec["verdict"] = "fail" if vertex_reasons else "vacuous"
     rec["reasons"] = [why] + vertex_reasons
     # a line fault is read from the pixels (line counts against the oracle's): those say nothing here
-    rec["faults"] = [f for f in rec.get("faults") or [] if f.get("name") not in LINE_FAULTS]
+    rec["faults"] = [f for f in rec.get("faults") or [] if catalogue.kind(f["name"]).source != "pixels"]
     rec["oracle_precision"] = True

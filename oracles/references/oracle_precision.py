@@ -67,6 +67,7 @@ from __future__ import annotations
 import numpy as np
 from .convert import camera_to_gl
 
+
 __all__ = ["U32", "CLIP_XY_ROUNDINGS", "CLIP_W_ROUNDINGS", "VIEWPORT_ROUNDINGS", "ORACLE_LIMIT_PX", "mesh_radius", "frame_bound_px",
            "drawn_bound_px"]
 

@@ -9,7 +9,7 @@ the difference is visible where the verdict is read: the CLI's output, the Asser
 
 from __future__ import annotations
 
-from .report import fault_hints
+from .fault_text import below_table
 
 _LEVEL = {"vertices": "vertices (OpenCV)", "pixels": "pixels (OpenCV and pyrender)",
           "frames": "frames (a renderer's PNGs against pyrender; core's beside it)"}
@@ -38,9 +38,9 @@ def what_text(report: dict) -> str:
 
 
 def hint_lines(report: dict, failing: list) -> list[str]:
-    """``  what to check, NAME: HINT``, once per distinct hint of the faults in ``failing`` cases (oracles.reports.report.fault_hints)."""
-    return [f"  what to check, {n}: {h}" for n, h in fault_hints((f for c in failing for f in c["faults"]),
-                                                                           report.get("level") == "frames")]
+    """``  what to check, NAME: HINT`` once per distinct hint of the faults in ``failing`` cases, then
+    ``  note, NAME: TEXT`` once per fault kind (oracles.reports.fault_text.below_table)."""
+    return below_table(failing, report.get("level") == "frames")
 
 
 #: Reasons the CLI prints per failing case; the rest are in report.md (a line a reader can take in).

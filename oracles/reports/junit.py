@@ -3,7 +3,7 @@
 One ``<testcase classname=SCENE name=CAMERA>`` per case of the report; a case
 that did not pass gets a ``<failure>`` whose ``message`` is its faults and
 reasons on one line and whose text adds what to check for each fault
-(oracles.diagnosis.hints.FAULT_HINTS). Characters XML cannot hold are written as
+(the fault catalogue, oracles.faults). Characters XML cannot hold are written as
 escapes (:func:`xml_safe`). A case's ``note`` (what was not compared, and
 why) is its testcase's property ``note`` and its ``<system-out>`` (the part
 most dashboards show). The ``time`` attributes are the only fields that
@@ -23,8 +23,9 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 
-from .report import fault_hints, fault_text, not_passed
 from wirecheck.core.outputs.output import atomic_write_bytes
+from .fault_text import case_cell, hints, notes
+from .report import not_passed
 
 #: The root element's name: it marks a file as ours (one we may replace).
 SUITES_NAME = "wirecheck crosscheck"
@@ -64,16 +65,17 @@ def _seconds(timing: dict | None) -> float:
 def failure_message(case: dict) -> str:
     """One line: the case's faults, then its reasons."""
     reasons = "; ".join(case.get("reasons") or []) or f"verdict {case['verdict']}"
-    return f"faults: {fault_text(case.get('faults') or [])}; {reasons}"
+    return f"faults: {case_cell(case.get('faults') or [], case.get('camera_spec'))}; {reasons}"
 
 
 def failure_text(case: dict, frames: bool = False) -> str:
     """The failure's body: scene / camera, faults, each reason, and what to check for each fault (``frames``: a
-    renderer's own frames, report.fault_hints)."""
+    renderer's own frames, oracles.reports.fault_text.hints; each fault's note)."""
     lines = [f"{case['scene']} / {case['camera']}: verdict {case['verdict']}",
-             f"faults: {fault_text(case.get('faults') or [])}"]
+             f"faults: {case_cell(case.get('faults') or [], case.get('camera_spec'))}"]
     lines += [f"reason: {r}" for r in case.get("reasons") or []]
-    lines += [f"what to check, {n}: {h}" for n, h in fault_hints(case.get("faults") or [], frames)]
+    lines += [f"what to check, {n}: {h}" for n, h in hints(case.get("faults") or [], frames)]
+    lines += [f"note, {n}: {t}" for n, t in notes([case])]
     return "\n".join(lines) + "\n"
 
 

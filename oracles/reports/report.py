@@ -20,36 +20,12 @@ import numpy as np
 
 from wirecheck.core.outputs.output import FrameDir, json_dumps, png_bytes
 
-from .fmt import distinct
+from .fault_text import FULL_DIGITS, case_cell, full_text, hints, notes
 from ..judge.metrics import DIFF_COLOURS, diff_image
-from ..diagnosis.hints import FAULT_HINTS
 from .report_crops import crop_caption, crop_image
 from ..judge.line_style import summary_lines
 from . import plots
 from .points_plot import points_png
-
-
-#: What else to check when the pixels are a renderer's own frames (``--candidate-frames``, report level
-#: ``frames``): the drawing library's own choices, which a projector's lines drawn by the harness never have.
-FRAMES_HINTS = {
-    "pixel_offset": "a renderer that snaps lines to pixel centres (matplotlib: draw with snap=False) or truncates "
-                    "float coordinates (Pillow: round them) moves its lines too",
-    "line_end_bias": "a renderer of another aliased line rule: --line-rule geometry judges the geometry only",
-}
-
-
-def fault_hints(faults, frames: bool = False) -> list[tuple[str, str]]:
-    """``(name, what to check)`` for each distinct fault of ``faults``, in FAULT_HINTS order: a fault's own
-    ``hint`` (set where its values say more, e.g. a FOV scale of W/H) or its name's; ``frames``: a renderer's
-    own frames, each name's FRAMES_HINTS added."""
-    seen = {}
-    for f in faults:
-        if f.get("name") in FAULT_HINTS:
-            hint = f.get("hint") or FAULT_HINTS[f["name"]]
-            if frames and f["name"] in FRAMES_HINTS:
-                hint += "; " + FRAMES_HINTS[f["name"]]
-            seen.setdefault((f["name"], hint), None)
-    return sorted(seen, key=lambda nh: list(FAULT_HINTS).index(nh[0]))
 
 
 def _fmt_err(v) -> str:
@@ -58,48 +34,6 @@ def _fmt_err(v) -> str:
 
 def _fmt_f1(v) -> str:
     return "-" if v is None else f"{v:.4f}"
-
-
-def fault_nominals(camera: dict | None) -> dict:
-    """The value each fault field would have without the fault (``camera``: a record's ``camera_spec``)."""
-    out = {"scale": 1.0, "scale_x": 1.0, "scale_y": 1.0, "dx": 0.0, "dy": 0.0}
-    if camera:
-        out.update(implied_aspect=camera["width"] / camera["height"], implied_fov_deg=camera["fov_y_deg"],
-                   implied_ortho_height=camera["ortho_height"])
-        lens = list(camera.get("distortion") or []) + [0.0] * 8            # k1, k2, p1, p2, k3, ...
-        out.update(k1=lens[0], k2=lens[1], p1=lens[2], p2=lens[3], k3=lens[4])
-    return out
-
-
-def fault_text(faults: list[dict], camera: dict | None = None) -> str:
-    """Faults in one line; each number with enough digits to differ from its nominal value (oracles.reports.fmt)."""
-    if not faults:
-        return "none"
-    nominal = fault_nominals(camera)
-    parts = []
-    for f in faults:
-        extra = ", ".join(f"{k}={_value(v, nominal.get(k))}"
-                          for k, v in f.items() if k not in ("name", "hint") and v is not None)   # None: not implied
-        parts.append(f"{f['name']}({extra})" if extra else f["name"])
-    return "; ".join(parts)
-
-
-def _value(value, nominal: float | None) -> str:
-    """A fault field as text: a float by :func:`_param`, a list or tuple of floats each so (a per-axis
-    ``scale=[0.622, 0.8]``), anything else as it is."""
-    if isinstance(value, float):
-        return _param(value, nominal)
-    if isinstance(value, (list, tuple)) and value and all(isinstance(v, float) for v in value):
-        return "[" + ", ".join(_param(v, nominal) for v in value) + "]"
-    return f"{value}"
-
-
-def _param(value: float, nominal: float | None) -> str:
-    """A fault's number: digits until it differs from ``nominal``, unless it differs by float64 rounding
-    only (64 eps relative: ``scale_y=0.9999999999999998`` is ``scale_y=1``)."""
-    if nominal is not None and abs(value - nominal) <= 64 * 2.0 ** -52 * max(abs(value), abs(nominal)):
-        return distinct(value)
-    return distinct(value, nominal)
 
 
 def _count(n: int, unit: str) -> str:
@@ -147,9 +81,9 @@ def table_rows(cases: list[dict]) -> list[list[str]]:
     if _is_shaded(cases):
         return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _fmt_f1(c.get("silhouette_iou")),
                  _fmt_err(c.get("depth_max_error")), _fmt_ratio(c.get("depth_error_ratio")), c["verdict"],
-                 fault_text(c["faults"], c.get("camera_spec"))] for c in cases]
+                 case_cell(c["faults"], c.get("camera_spec"))] for c in cases]
     return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _pixel_f1(c, "pixel_f1_0px"),
-             _pixel_f1(c, "pixel_f1_1px"), c["verdict"], fault_text(c["faults"], c.get("camera_spec"))]
+             _pixel_f1(c, "pixel_f1_1px"), c["verdict"], case_cell(c["faults"], c.get("camera_spec"))]
             for c in cases]
 
 
@@ -310,6 +244,17 @@ def case_notes(report: dict) -> list[tuple[dict, str]]:
     return notes
 
 
+def grouped_notes(report: dict) -> list[tuple[str, str]]:
+    """``(where, text)``: each distinct :func:`case_notes` text once, ``where`` the cases that have it
+    (``cube / distorted, pyramid / distorted``), then each fault kind's note once (``where`` its name;
+    oracles.reports.fault_text.notes): the Notes of report.md and report.html."""
+    by: dict[str, list[str]] = {}
+    for c, text in case_notes(report):
+        by.setdefault(text, []).append(f"{c['scene']} / {c['camera']}")
+    return ([(", ".join(where), text) for text, where in by.items()]
+            + [(name, text) for name, text in notes(report["cases"])])
+
+
 def _line_styles(report: dict) -> list[str]:
     """The line styles read from a renderer's frames (--candidate-frames; oracles.judge.line_style)."""
     return summary_lines(report["cases"])
@@ -342,7 +287,9 @@ def markdown(report: dict, files: set | None = None) -> str:
         out += ["", "## Why cases failed", ""]
         for c in failing:
             out.append(f"- **{c['scene']} / {c['camera']}**: " + "; ".join(c["reasons"]))
-        names = fault_hints((f for c in failing for f in c["faults"]), report.get("level") == "frames")
+            if c["faults"]:             # the whole record, rounded (report.json keeps every digit)
+                out.append(f"  - faults: {full_text(c['faults'], c.get('camera_spec'), FULL_DIGITS)}")
+        names = hints((f for c in failing for f in c["faults"]), report.get("level") == "frames")
         if names:
             out += ["", "## What to check", ""]
             out += [f"- `{n}`: {h}" for n, h in names]
@@ -352,10 +299,10 @@ def markdown(report: dict, files: set | None = None) -> str:
         if "worst.gif" in files and _worst_text(report):
             out.append(f"- [worst.gif](worst.gif): the worst case, {_worst_text(report)}")
         out += [f"- [{name}]({name}): {caption}" for name, caption in figures]
-    notes = case_notes(report)
-    if notes:
+    shown_notes = grouped_notes(report)
+    if shown_notes:
         out += ["", "## Notes", ""]
-        out += [f"- {c['scene']} / {c['camera']}: {note}" for c, note in notes]
+        out += [f"- {where}: {note}" for where, note in shown_notes]
     out += ["", "Conventions: see `wirecheck.core.conventions`. Images of the worst frames, and the time per frame "
             "of each stage (vertex, pixel) per case: `report.html` (and `\"timing\"` in `report.json`; "
             "timings are kept out of this file so that it is the same on every run).", ""]
@@ -397,12 +344,11 @@ def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = 
         parts.append("<h2>Why cases failed</h2><ul>" + "".join(
             f"<li><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e('; '.join(c['reasons']))}</li>"
             for c in failing) + "</ul>")
-    notes = case_notes(report)
-    if notes:
+    shown_notes = grouped_notes(report)
+    if shown_notes:
         parts.append("<h2>Notes</h2><ul>" + "".join(
-            f"<li class='note'><b>{e(c['scene'])} / {e(c['camera'])}</b>: {e(note)}</li>" for c, note in notes)
-            + "</ul>")
-    names = fault_hints((f for c in report["cases"] for f in c["faults"]), report.get("level") == "frames")
+            f"<li class='note'><b>{e(where)}</b>: {e(note)}</li>" for where, note in shown_notes) + "</ul>")
+    names = hints((f for c in report["cases"] for f in c["faults"]), report.get("level") == "frames")
     if names:
         parts.append("<h2>What to check</h2><ul>" + "".join(
             f"<li><code>{e(n)}</code>: {e(h)}</li>" for n, h in names) + "</ul>")
@@ -444,8 +390,7 @@ def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = 
         parts.append(
             f"<section><p><b>{e(case['scene'])} / {e(case['camera'])}</b>, frame "
             f"{case.get('worst_pixel_frame')}: {scores}, "
-            f"faults: {e(fault_text(case['faults'], case.get('camera_spec')))}"
-            + (f"; note: {e(case['note'])}" if case.get("note") else "") + "</p>"
+            f"faults: {e(case_cell(case['faults'], case.get('camera_spec')))}</p>"
             f"<div class='row'>{figs}</div></section>")
     parts.append("</body></html>\n")
     return "\n".join(parts)

@@ -1,0 +1,147 @@
+"""A renderer's depth map read from its file: depth along ``forward`` per pixel, NaN where no surface.
+
+Encodings accepted (anything else is refused with one line, InputError):
+
+- ``.npy``: a 2-D float32 (or float64) array, ``(H, W)``, depth in world units;
+- ``.tif`` / ``.tiff``: a 32-bit float TIFF (Pillow's mode ``"F"``), depth in world units;
+- ``.png``: a 16-bit grey PNG (Pillow's mode ``"I;16"``), ``depth = value / scale``;
+  ``scale`` 1000 per world unit by default (millimetres when the unit is the metre,
+  as in BOP, Open3D and RealSense files; TUM's files use 5000).
+
+0, NaN and +inf mean "no surface". A negative depth, a map of the wrong size or of any
+other dtype or mode is refused: depth along ``forward`` is positive in front of the camera
+(:mod:`wirecheck.core.conventions`). Row 0 is the top of the picture, as in every image here.
+
+The encoding's own resolution travels with the map (:attr:`DepthMap.step`,
+:attr:`DepthMap.rel_step`) so a judge can add it to its bound: a 16-bit PNG holds
+depth to ``1 / scale`` (1 mm at scale 1000; a writer that truncates, ``uint16(d * s)``,
+is off by up to one step), a float32 value to one float32 ulp, ``eps32 |d|``
+(round to nearest: half of it, doubled for the renderer's own last rounding).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from wirecheck.core.errors import InputError
+
+__all__ = ["DEFAULT_PNG_SCALE", "DepthMap", "read_depth_map", "depth_from_array"]
+
+#: Values per world unit of a 16-bit PNG depth map unless told otherwise: 1000 (millimetres
+#: per metre), as BOP, Open3D and RealSense write them.
+DEFAULT_PNG_SCALE = 1000.0
+
+_EPS32 = float(np.finfo(np.float32).eps)
+_EPS64 = float(np.finfo(np.float64).eps)
+
+
+@dataclass(frozen=True)
+class DepthMap:
+    """A depth map as read.
+
+    Attributes
+    ----------
+    depth : (H, W) ndarray of float64
+        Depth along ``forward`` in world units; NaN where the file says "no surface".
+    encoding : str
+        What the file held: ``"npy float32"``, ``"tiff float32"``, ``"png uint16 / 1000"``...
+    step : float
+        The encoding's absolute resolution in world units (``1 / scale`` for a PNG, else 0).
+    rel_step : float
+        Its resolution relative to the depth (float32: ``eps32``; a PNG: 0).
+    """
+
+    depth: np.ndarray
+    encoding: str
+    step: float = 0.0
+    rel_step: float = 0.0
+
+    def encoding_bound(self) -> np.ndarray:
+        """``(H, W)`` float64: how far the encoding alone may move a depth, ``step + rel_step |d|`` (0 where none)."""
+        d = np.nan_to_num(self.depth, nan=0.0)
+        return self.step + self.rel_step * np.abs(d)
+
+
+def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCALE) -> DepthMap:
+    """Read a depth map file (module docstring for the encodings).
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.npy``, ``.tif``/``.tiff`` or ``.png`` file.
+    width, height : int
+        The size the map must have (the camera's).
+    scale : float
+        Values per world unit of a 16-bit PNG (finite, > 0).
+
+    Returns
+    -------
+    DepthMap
+
+    Raises
+    ------
+    InputError
+        One line naming the file, what it holds and what was expected: a missing or
+        unreadable file, another suffix, dtype or image mode, a wrong size, a negative depth.
+    """
+    path = Path(path)
+    if not (isinstance(scale, (int, float)) and not isinstance(scale, bool) and math.isfinite(scale) and scale > 0):
+        raise InputError(f"depth scale {scale!r}: expected a finite number of values per unit > 0 (default 1000)")
+    suffix = path.suffix.lower()
+    if suffix not in (".npy", ".png", ".tif", ".tiff"):
+        raise InputError(f"{path}: a {suffix or 'suffix-less'} file: expected a depth map as .npy (float32), "
+                         ".tif (32-bit float) or .png (16-bit)")
+    if not path.is_file():
+        raise InputError(f"{path}: no such file: expected a depth map of {width}x{height}")
+    if suffix == ".npy":
+        try:
+            values = np.load(path, allow_pickle=False)
+        except (OSError, ValueError, EOFError) as exc:
+            raise InputError(f"{path}: not a readable .npy file ({' '.join(str(exc).split())[:120]}): "
+                             "expected a 2-D float32 array") from None
+        if values.dtype not in (np.float32, np.float64):
+            raise InputError(f"{path}: a .npy of {values.dtype}: expected float32 depth in world units "
+                             "(a 16-bit map belongs in a .png with a scale)")
+        encoding, step, rel = f"npy {values.dtype}", 0.0, (_EPS32 if values.dtype == np.float32 else _EPS64)
+        return depth_from_array(values, width, height, str(path), encoding, step, rel)
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as im:
+            mode, fmt = im.mode, im.format
+            values = np.asarray(im) if (mode, suffix) in (("I;16", ".png"), ("F", ".tif"), ("F", ".tiff")) else None
+    except (OSError, UnidentifiedImageError, ValueError) as exc:
+        raise InputError(f"{path}: not a readable image ({' '.join(str(exc).split())[:120]}): expected a "
+                         f"{'16-bit grey PNG' if suffix == '.png' else '32-bit float TIFF'} depth map") from None
+    if values is None:
+        want = "a 16-bit grey PNG (mode I;16)" if suffix == ".png" else "a 32-bit float TIFF (mode F)"
+        raise InputError(f"{path}: a {fmt or 'unknown'} image of mode {mode}: expected {want} depth map")
+    if suffix == ".png":
+        depth = values.astype(np.float64) / float(scale)
+        return depth_from_array(depth, width, height, str(path), f"png uint16 / {scale:g}", 1.0 / float(scale), 0.0)
+    return depth_from_array(values, width, height, str(path), "tiff float32", 0.0, _EPS32)
+
+
+def depth_from_array(values, width: int, height: int, name: str = "depth map", encoding: str = "array",
+                     step: float = 0.0, rel_step: float = 0.0) -> DepthMap:
+    """An ``(H, W)`` array of depths as a :class:`DepthMap`: 0 and non-finite values become NaN.
+
+    Raises InputError (naming ``name``) for another shape or a negative depth.
+    """
+    values = np.asarray(values)
+    if values.shape != (height, width):
+        raise InputError(f"{name}: a depth map of shape {values.shape} ({'x'.join(map(str, values.shape[::-1]))}): "
+                         f"expected {width}x{height} (height {height} rows, width {width} columns)")
+    depth = values.astype(np.float64)
+    with np.errstate(invalid="ignore"):
+        negative = depth < 0
+    if negative.any():
+        r, c = (int(i) for i in np.argwhere(negative)[0])
+        raise InputError(f"{name}: depth {float(depth[r, c])!r} at row {r}, column {c} ({int(negative.sum())} negative "
+                         "in all): expected depth along forward >= 0 (0, NaN or +inf: no surface)")
+    depth[~np.isfinite(depth) | (depth == 0)] = np.nan
+    return DepthMap(depth=depth, encoding=encoding, step=float(step), rel_step=float(rel_step))

@@ -1,0 +1,346 @@
+"""A depth map's faults named from its values against the reference's linear depth.
+
+Over the pixels where both maps show a surface, with ``r`` the reference's depth along
+``forward`` (float64), ``c`` the candidate's and ``rho = |(x_n, y_n, 1)|`` the length of
+the pixel's ray per unit of depth (``x_n = (x - cx) / fx``, ``y_n = (y - cy) / fy``;
+1 under orthographic projection), each fault is a model ``c = g(r)``:
+
+    name              model                                      fitted / reported
+    depth_scale       c = k r                                    k = median(c / r)
+    depth_offset      c = r + b                                  b = median(c - r)
+    depth_is_range    c = rho r   (or c = r / rho: the reverse)  -
+    depth_reversed    1/c = K - 1/r   (orthographic: c = S - r)  K (S); the camera's 1/near + 1/far (near + far)
+    depth_encoding    c = a + b / r   (orthographic: a + b r),   near and far that fit, window [0, 1]
+                      c within [-1, 1]                           or NDC [-1, 1], reversed or not
+    depth_precision   c = r to one float16 ulp (every c a        the step
+                      float16), or to one quantisation step q
+                      (the least gap between c's values)
+
+A map **passes** when every compared pixel is within its allowance, ``bound + encoding``
+(the reference's per-pixel bound and the candidate encoding's own resolution,
+oracles.candidates.depth_map). A model **explains** a failing map when every compared
+pixel's residual ``|c - g(r)|`` is within :attr:`DepthLimits.fit_slack` of the allowance
+carried through the model (``|g'(r)| bound + encoding``, plus the model's own step for
+``depth_precision``). When none does and the reference's face ids are given, the camera
+mistakes that move pixels rather than values are fitted (oracles.diagnosis.depth_pixels:
+``mirror_vertical``, ``mirror_horizontal``, ``pixel_offset``, ``fov_mismatch``). Among the models that explain it the one with the fewest fitted
+parameters is named, then the closest; when models of two names explain it (a flat surface
+seen square-on: scale and offset alike), ``ambiguous`` with both; none: ``unexplained``,
+with what was measured (``fit_ratios``: each model's worst residual over its allowance).
+Zero pixels compared (a blank map, all NaN, no overlap) is ``vacuous``: never a pass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .depth_pixels import MAX_OUTSIDE, MIN_INTERIOR, pixel_models, sample
+
+__all__ = ["DEPTH_FAULTS", "DEPTH_HINTS", "DepthDiagnosis", "DepthFault", "DepthLimits", "LIMITS",
+           "name_depth_faults", "ray_lengths"]
+
+
+@dataclass(frozen=True)
+class DepthLimits:
+    """The thresholds of :func:`name_depth_faults`, each with its derivation."""
+
+    #: A model explains the map when every residual is within this many allowances. A parameter
+    #: fitted (a median) from pixels that each sit within their own bound moves the model by up to
+    #: one bound at another pixel; doubled for the rounding of the stored value against the
+    #: model's float64 one: 4. Measured over core's maps with one mistake each (3 scenes x 7 cases,
+    #: tests/test_depth_faults.py): the named model's worst residual is 0.50 allowances (a float16
+    #: map; 0.09 for the others), the nearest wrong model's 19 (depth_offset on a float16 map).
+    fit_slack: float = 4.0
+    #: Values of a stored encoding (window [0, 1], NDC [-1, 1]) lie within 1 + this of the range:
+    #: float32 rounding of values of size 1 (eps32 = 1.2e-7), with room to spare.
+    encoding_margin: float = 1e-6
+    #: Quantisation steps are whole multiples of the least gap to this relative tolerance: the
+    #: rescaled levels of an 8-bit map (n + k (f - n) / 255) carry float32 rounding of ~1e-7 of
+    #: their size; 1e-3 leaves the gaps of a float32 map of a smooth surface (no common step) out.
+    step_tolerance: float = 1e-3
+
+
+LIMITS = DepthLimits()
+
+#: Every name this module gives, in the order of its table.
+DEPTH_FAULTS = ("depth_scale", "depth_offset", "depth_is_range", "depth_reversed", "depth_encoding",
+                "depth_precision", "mirror_vertical", "mirror_horizontal", "pixel_offset", "fov_mismatch",
+                "ambiguous", "unexplained")
+
+#: What to check for each name: the usual cause and its fix.
+DEPTH_HINTS = {
+    "depth_scale": "depth is a constant factor off: k = 1000 is millimetres read as metres (a 16-bit PNG not "
+                   "divided by its scale; 5000 for TUM files); divide by the scale the file was written with",
+    "depth_offset": "a constant is added: depth measured from the near plane (b = -near) or from a point other "
+                    "than the camera centre; depth is z_cam = dot(p - position, forward)",
+    "depth_is_range": "distance from the eye along the pixel's ray was stored where depth along forward was "
+                      "asked (or the reverse): depth = range / |(x_n, y_n, 1)| with x_n = (x - cx) / fx, "
+                      "y_n = (y - cy) / fy",
+    "depth_reversed": "a reversed-Z buffer (near -> 1, far -> 0) linearised with the standard formula: near and "
+                      "far swap; linearise it as d = n f / (n + z (f - n)), or read 1 - z",
+    "depth_encoding": "the depth buffer's non-linear value was stored: linearise it, d = f n / (f - z (f - n)) "
+                      "for window z in [0, 1] (NDC z: z_win = (z + 1) / 2 first; orthographic: d = n + z (f - n))",
+    "depth_precision": "depth values are quantised (a float16 or 8-bit target or texture): render and store "
+                       "depth as float32, or as a 16-bit PNG with a scale",
+    "mirror_vertical": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
+                       "when reading the buffer back (glReadPixels returns the bottom row first)",
+    "mirror_horizontal": "columns flipped: right = forward x up, and x_px grows to the right",
+    "pixel_offset": "the depth is half a pixel (or more) off: pixel centres are integers, cx = (W - 1) / 2 "
+                    "(W / 2 is the corner convention); a GL projection from K puts cx + 0.5 in it",
+    "fov_mismatch": "the image is scaled about the principal point: fov_y_deg is the vertical FOV, "
+                    "f = (H / 2) / tan(fov_y / 2) (a renderer given it as its horizontal view angle scales by W / H)",
+    "ambiguous": "the compared depths fit several of these models alike (a surface at one depth, seen "
+                 "square-on): judge more frames, or a view whose depth varies",
+    "unexplained": "the depth differs from the reference in no way this diagnosis knows: see what was measured",
+}
+
+
+@dataclass(frozen=True)
+class DepthFault:
+    """A named fault: ``name`` (one of :data:`DEPTH_FAULTS`), what was fitted, what to check."""
+
+    name: str
+    params: dict = field(default_factory=dict)
+    hint: str = ""
+
+    def short(self) -> str:
+        """``name(k=1000)``: the name and its numbers, for one line of a report."""
+        if not self.params:
+            return self.name
+        inner = ", ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.params.items())
+        return f"{self.name}({inner})"
+
+
+@dataclass(frozen=True)
+class DepthDiagnosis:
+    """The verdict on one depth map: ``"pass"``, ``"fail"`` or ``"vacuous"`` (nothing compared, never a pass)."""
+
+    verdict: str
+    faults: tuple = ()
+    measured: dict = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return self.verdict == "pass"
+
+    @property
+    def names(self) -> tuple:
+        return tuple(f.name for f in self.faults)
+
+
+def ray_lengths(camera) -> np.ndarray:
+    """``(H, W)`` float64: ``rho = |(x_n, y_n, 1)|`` per pixel centre (1 everywhere under orthographic projection).
+
+    Range along the pixel's ray is ``rho`` times depth along ``forward`` (pinhole rays: a
+    lens's distortion is not undone).
+    """
+    w, h = int(camera.width), int(camera.height)
+    if camera.projection != "perspective":
+        return np.ones((h, w))
+    k = np.asarray(camera.K, dtype=np.float64)
+    x_n = (np.arange(w, dtype=np.float64) - k[0, 2]) / k[0, 0]
+    y_n = (np.arange(h, dtype=np.float64) - k[1, 2]) / k[1, 1]
+    return np.sqrt(1.0 + x_n[None, :] ** 2 + y_n[:, None] ** 2)
+
+
+def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
+                      limits: DepthLimits = LIMITS, faces=None) -> DepthDiagnosis:
+    """Judge a depth map against the reference and name what is wrong with it (module docstring).
+
+    Parameters
+    ----------
+    candidate : (H, W) array_like of float
+        The map to judge, depth along ``forward``; NaN, inf or 0 where no surface.
+    reference : (H, W) array_like of float
+        The reference's linear depth (float64), NaN, inf or 0 where no surface.
+    bound : (H, W) array_like of float, or float
+        The reference's per-pixel bound (oracles.judge.metrics.depth_bound).
+    camera : core.camera.Camera
+        The frame's camera (rays, near and far).
+    encoding : (H, W) array_like of float, or float
+        The candidate encoding's resolution (oracles.candidates.depth_map.DepthMap.encoding_bound).
+    limits : DepthLimits
+    faces : (H, W) array_like of int, optional
+        Which planar face the reference shows at each pixel (-1: none). Given, the camera
+        mistakes that move pixels are fitted too (oracles.diagnosis.depth_pixels:
+        mirror_vertical, mirror_horizontal, pixel_offset, fov_mismatch).
+
+    Returns
+    -------
+    DepthDiagnosis
+        ``measured`` holds ``compared_px``, ``candidate_px``, ``reference_px``, ``max_error``,
+        ``max_error_ratio`` and ``worst_pixel`` (row, column) when anything was compared.
+    """
+    cand = np.asarray(candidate, dtype=np.float64)
+    ref = np.asarray(reference, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        cand_on = np.isfinite(cand) & (cand != 0)
+        ref_on = np.isfinite(ref) & (ref > 0)
+    both = cand_on & ref_on
+    measured = {"compared_px": int(both.sum()), "candidate_px": int(cand_on.sum()),
+                "reference_px": int(ref_on.sum())}
+    if not both.any():
+        return DepthDiagnosis("vacuous", (), measured)
+    full_b = np.broadcast_to(np.asarray(bound, dtype=np.float64), cand.shape)
+    full_enc = np.broadcast_to(np.asarray(encoding, dtype=np.float64), cand.shape)
+    c, r = cand[both], ref[both]
+    b = full_b[both]
+    enc = full_enc[both]
+    err = np.abs(c - r)
+    allow = b + enc
+    ratio = _ratio(err, allow)
+    worst = int(np.argmax(ratio))
+    rows, cols = np.nonzero(both)
+    measured.update(max_error=float(err.max()), max_error_ratio=float(ratio[worst]),
+                    worst_pixel=[int(rows[worst]), int(cols[worst])],
+                    median_ratio_c_over_r=float(np.median(c / r)), median_c_minus_r=float(np.median(c - r)))
+    if ratio[worst] <= 1.0:
+        return DepthDiagnosis("pass", (), measured)
+    rho = ray_lengths(camera)[both]
+    fits = []                                   # (parameters fitted, max residual / allowance, fault)
+    for n_params, model in _models(c, r, rho, b, enc, camera, limits):
+        if model is None:
+            continue
+        name, params, c_hat, slope, extra = model
+        fit = float(_ratio(np.abs(c - c_hat), np.abs(slope) * b + enc + extra).max())
+        if np.isfinite(fit):
+            fits.append((n_params, fit, name, params))
+    if faces is not None and not any(f[1] <= limits.fit_slack for f in fits):
+        # no value model explains it: the maps that move pixels (tried only then: they cost a fit each)
+        fits += _pixel_fits(np.where(cand_on, cand, np.nan), np.where(ref_on, ref, np.nan),
+                            np.asarray(faces), full_b, full_enc, camera)
+    measured["fit_ratios"] = {}
+    for _, fit, name, _ in fits:                # each model's worst residual / allowance (the best of a name's)
+        measured["fit_ratios"][name] = min(fit, measured["fit_ratios"].get(name, np.inf))
+    explained = sorted((f for f in fits if f[1] <= limits.fit_slack), key=lambda f: (f[0], f[1]))
+    names = list(dict.fromkeys(f[2] for f in explained))
+    if len(names) > 1:
+        # the compared depths do not separate the models (one flat surface square-on: scale and offset alike)
+        return DepthDiagnosis("fail", (DepthFault("ambiguous", {"alternatives": ", ".join(names)},
+                                                  DEPTH_HINTS["ambiguous"]),), measured)
+    if explained:
+        _, fit, name, params = explained[0]
+        measured["fit_ratio"] = fit
+        return DepthDiagnosis("fail", (DepthFault(name, params, DEPTH_HINTS[name]),), measured)
+    return DepthDiagnosis("fail", (DepthFault("unexplained", {}, DEPTH_HINTS["unexplained"]),), measured)
+
+
+def _pixel_fits(cand, ref, faces, bound, enc, camera) -> list:
+    """``(n_params, fit ratio, name, params)`` of each pixel map that keeps the surfaces on each other."""
+    out = []
+    pts = np.argwhere(np.isfinite(cand))[:, ::-1].astype(np.float64)
+    c = cand[pts[:, 1].astype(int), pts[:, 0].astype(int)]
+    h, w = ref.shape
+    for name, n_params, params, transform in pixel_models(cand, ref, faces, camera):
+        q = transform(pts)
+        depth, inside, outside, _grad = sample(ref, faces, camera, q)
+        if outside.mean() > MAX_OUTSIDE or inside.mean() < MIN_INTERIOR:
+            continue
+        qi = np.clip(np.rint(q[inside]).astype(np.int64), 0, [w - 1, h - 1])
+        allow = bound[qi[:, 1], qi[:, 0]] + enc[pts[inside, 1].astype(int), pts[inside, 0].astype(int)]
+        fit = float(_ratio(np.abs(c[inside] - depth[inside]), allow).max())
+        if np.isfinite(fit):
+            out.append((n_params, fit, name, params))
+    return out
+
+
+def _ratio(err: np.ndarray, allow: np.ndarray) -> np.ndarray:
+    """``err / allow``, 0 where both are 0 and inf where only the allowance is."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(err == 0, 0.0, err / allow)
+
+
+def _models(c, r, rho, b, enc, camera, limits):
+    """``(parameters fitted, model or None)`` for each fault of the module's table.
+
+    A model is ``(name, params, c_hat, |g'(r)|, extra allowance)``.
+    """
+    perspective = camera.projection == "perspective"
+    near, far = float(camera.near), float(camera.far)
+    zero = np.zeros_like(c)
+    # depth_is_range: rays alone, nothing fitted (orthographic rays are all depth)
+    if perspective:
+        up = np.abs(c - rho * r).max() <= np.abs(c - r / rho).max()
+        yield 0, ("depth_is_range", {"stored": "range along the ray" if up else "depth / ray length"},
+                  rho * r if up else r / rho, rho if up else 1.0 / rho, zero)
+    # depth_precision: float16 values, or one quantisation step
+    yield 0, _precision(c, r)
+    yield 0, _quantised(c, r, limits)
+    k = float(np.median(c / r))
+    yield 1, ("depth_scale", {"k": k}, k * r, np.full_like(r, k), zero)
+    off = float(np.median(c - r))
+    yield 1, ("depth_offset", {"b": off, "b_over_near": off / near}, r + off, np.ones_like(r), zero)
+    if perspective:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            kk = float(np.median(1.0 / c + 1.0 / r))
+            c_hat = 1.0 / (kk - 1.0 / r)
+        yield 1, ("depth_reversed", {"sum_of_inverses": kk, "camera_1/near+1/far": 1.0 / near + 1.0 / far},
+                  c_hat, c_hat ** 2 / r ** 2, zero)
+    else:
+        s = float(np.median(c + r))
+        yield 1, ("depth_reversed", {"sum": s, "camera_near+far": near + far}, s - r, np.ones_like(r), zero)
+    yield 2, _encoding(c, r, camera, limits)
+
+
+def _precision(c, r):
+    """float16 storage: every value a float16, each within one float16 ulp of the reference."""
+    with np.errstate(over="ignore"):
+        c16 = c.astype(np.float16)
+    if not (np.isfinite(c16).all() and (c16.astype(np.float64) == c).all()):
+        return None
+    ulp = np.spacing(np.abs(r).astype(np.float16)).astype(np.float64)
+    return "depth_precision", {"format": "float16", "step_at_median_depth": float(np.median(ulp))}, r, \
+        np.ones_like(r), ulp
+
+
+def _quantised(c, r, limits):
+    """A uniform quantisation: values on a grid of a least gap ``q``, each within ``q`` of the reference."""
+    levels = np.unique(c)
+    if len(levels) < 2:
+        return None
+    gaps = np.diff(levels)
+    q = float(gaps.min())
+    units = gaps / q
+    if np.abs(units - np.round(units)).max() > limits.step_tolerance:
+        return None
+    return "depth_precision", {"format": "quantised", "step": q, "levels": int(len(levels))}, r, \
+        np.ones_like(r), np.full_like(r, q)
+
+
+def _encoding(c, r, camera, limits):
+    """A stored depth-buffer value: ``c = a + b x`` with ``x = 1/r`` (perspective) or ``r``; near and far read back."""
+    lo, hi = float(c.min()), float(c.max())
+    if lo < -1.0 - limits.encoding_margin or hi > 1.0 + limits.encoding_margin:
+        return None
+    perspective = camera.projection == "perspective"
+    x = 1.0 / r if perspective else r
+    xm, cm = float(x.mean()), float(c.mean())
+    sxx = float(((x - xm) ** 2).sum())
+    if sxx == 0.0:
+        return None
+    slope = float(((x - xm) * (c - cm)).sum()) / sxx
+    a = cm - slope * xm
+    # window z: c(n) = 0, c(f) = 1; NDC: c(n) = -1, c(f) = 1; reversed: the two ends exchanged
+    reversed_z = (slope > 0) if perspective else (slope < 0)
+    at_near, at_far = (1.0, 0.0) if reversed_z else (0.0, 1.0)
+    candidates = {"window [0, 1]": (at_near, at_far)}
+    if not reversed_z:
+        candidates["NDC [-1, 1]"] = (-1.0, 1.0)
+    best = None
+    for kind, (v_near, v_far) in candidates.items():
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if perspective:                                     # v = a + slope / d  ->  d = slope / (v - a)
+                n_fit, f_fit = slope / (v_near - a), slope / (v_far - a)
+            else:                                               # v = a + slope d    ->  d = (v - a) / slope
+                n_fit, f_fit = (v_near - a) / slope, (v_far - a) / slope
+        miss = abs(np.log(abs(n_fit) / camera.near)) + abs(np.log(abs(f_fit) / camera.far)) \
+            if n_fit and f_fit and np.isfinite(n_fit) and np.isfinite(f_fit) else np.inf
+        if best is None or miss < best[0]:
+            best = (miss, kind, float(n_fit), float(f_fit))
+    _, kind, n_fit, f_fit = best
+    c_hat = a + slope * x
+    d_slope = np.abs(slope) / r ** 2 if perspective else np.full_like(r, abs(slope))
+    params = {"stored": kind, "reversed": bool(reversed_z), "near": n_fit, "far": f_fit}
+    return "depth_encoding", params, c_hat, d_slope, np.zeros_like(r)

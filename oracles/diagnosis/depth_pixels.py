@@ -1,0 +1,121 @@
+"""Where a depth map's pixels look: rows flipped, half a pixel off, K from the horizontal FOV.
+
+A map drawn with a camera mistake shows the right surfaces at the wrong pixels: its pixel
+``p`` holds the reference's depth at ``T(p)``. Each mistake is a map ``T``:
+
+    name               T(p)                                  fitted
+    mirror_vertical    (x, H - 1 - y)                        -
+    mirror_horizontal  (W - 1 - x, y)                        -
+    pixel_offset       p + (dx, dy)   (cx = W / 2: -0.5)     dx, dy (Gauss-Newton from the silhouettes' centroids)
+    fov_mismatch       c + s (p - c)  (c the principal point) s (from the silhouettes' spread), perspective
+
+The reference is read at ``T(p)`` by bilinear interpolation of ``w`` (``1 / depth`` under
+perspective, where it is affine in the pixel coordinates on a plane; depth itself under
+orthographic projection) between the four pixel centres around ``T(p)``, used only where the
+four show the same face (``faces``: one id per planar face, -1 where none): there the
+interpolation is exact. A model explains the map when the candidate's surface lands on the
+reference's (at most :data:`MAX_OUTSIDE` of its pixels where all four neighbours are empty),
+at least :data:`MIN_INTERIOR` of them land inside one face, and every one of those is within
+the slack of its allowance (oracles.diagnosis.depth_faults).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["MAX_OUTSIDE", "MIN_INTERIOR", "pixel_models"]
+
+#: Share of the candidate's surface pixels that may land where the reference shows nothing
+#: (all four neighbours empty). Measured, each pixel mistake under its own map: at most 0.32 %
+#: (prism, near_plane: the near plane's clip line); 1 % leaves 3x. This share does not tell the
+#: maps apart (a fitted scale can shrink any surface inside another): the residuals do.
+MAX_OUTSIDE = 0.01
+#: Share that must land inside one face for the residuals to speak for the map (a few-pixel
+#: sliver cannot name a fault): half (measured under the right map: 95 % at least).
+MIN_INTERIOR = 0.5
+#: Gauss-Newton steps of the fitted maps (converged to float rounding in 3 on the bundled cases).
+STEPS = 6
+#: Pixels a fit uses at most (every k-th of the candidate's surface): 4,000 fix two parameters
+#: far below the residuals' scale; the fitted map is then judged on every pixel.
+FIT_PIXELS = 4000
+
+
+def pixel_models(cand, ref, faces, camera):
+    """``(name, n_params, params, T)`` for each map, ``T`` taking ``(N, 2)`` pixels ``(x, y)`` to ``(N, 2)``.
+
+    ``cand``, ``ref``: ``(H, W)`` depths, NaN where no surface; ``faces``: ``(H, W)`` int.
+    """
+    h, w = ref.shape
+    yield "mirror_vertical", 0, {}, lambda p: np.column_stack([p[:, 0], h - 1 - p[:, 1]])
+    yield "mirror_horizontal", 0, {}, lambda p: np.column_stack([w - 1 - p[:, 0], p[:, 1]])
+    c_on, r_on = np.isfinite(cand), np.isfinite(ref)
+    if c_on.sum() < 3 or r_on.sum() < 3:
+        return
+    cy, cx = (np.argwhere(c_on).mean(axis=0))
+    ry, rx = (np.argwhere(r_on).mean(axis=0))
+    d = _fit(cand, ref, faces, camera, np.array([rx - cx, ry - cy]),
+             lambda p, th: p + th, lambda p, th: np.stack([np.eye(2)] * len(p)))
+    if d is not None:
+        yield "pixel_offset", 2, {"dx": float(d[0]), "dy": float(d[1])}, lambda p, d=d: p + d
+    if camera.projection != "perspective":
+        return
+    k = np.asarray(camera.K, dtype=np.float64)
+    c0 = np.array([k[0, 2], k[1, 2]])
+    spread_c = np.sqrt(((np.argwhere(c_on)[:, ::-1] - c0) ** 2).sum(axis=1).mean())
+    spread_r = np.sqrt(((np.argwhere(r_on)[:, ::-1] - c0) ** 2).sum(axis=1).mean())
+    s = _fit(cand, ref, faces, camera, np.array([spread_r / spread_c]),
+             lambda p, th: c0 + th[0] * (p - c0), lambda p, th: (p - c0)[:, :, None])
+    if s is not None:
+        scale = float(s[0])
+        implied = float(np.degrees(2.0 * np.arctan((camera.height / 2.0) / (k[1, 1] / scale))))
+        yield "fov_mismatch", 1, {"scale": scale, "implied_fov_y_deg": implied}, \
+            lambda p, s=scale: c0 + s * (p - c0)
+
+
+def sample(ref, faces, camera, q):
+    """The reference at pixels ``q`` ``(N, 2)``: ``(depth (N,), inside (N,) bool, outside (N,) bool, grad_w (N, 2))``.
+
+    ``inside``: the four neighbours show one face (the value is exact); ``outside``: none of them
+    shows a surface (or ``q`` is off the image); ``grad_w``: the gradient of ``w`` there.
+    """
+    h, w = ref.shape
+    x0 = np.floor(q[:, 0]).astype(np.int64)
+    y0 = np.floor(q[:, 1]).astype(np.int64)
+    on_image = (x0 >= 0) & (y0 >= 0) & (x0 + 1 < w) & (y0 + 1 < h)
+    xs, ys = np.clip(x0, 0, w - 2), np.clip(y0, 0, h - 2)
+    ids = np.stack([faces[ys, xs], faces[ys, xs + 1], faces[ys + 1, xs], faces[ys + 1, xs + 1]], axis=1)
+    inside = on_image & (ids[:, 0] >= 0) & (ids == ids[:, :1]).all(axis=1)
+    outside = ~on_image | (ids < 0).all(axis=1)
+    persp = camera.projection == "perspective"
+    with np.errstate(divide="ignore", invalid="ignore"):
+        wv = 1.0 / ref if persp else ref
+        w00, w10, w01, w11 = wv[ys, xs], wv[ys, xs + 1], wv[ys + 1, xs], wv[ys + 1, xs + 1]
+        fx, fy = q[:, 0] - xs, q[:, 1] - ys
+        top, bottom = w00 + fx * (w10 - w00), w01 + fx * (w11 - w01)
+        val = top + fy * (bottom - top)
+        grad = np.column_stack([(w10 - w00) + fy * ((w11 - w01) - (w10 - w00)), bottom - top])
+        depth = 1.0 / val if persp else val
+    inside &= np.isfinite(depth)
+    return np.where(inside, depth, np.nan), inside, outside, grad
+
+
+def _fit(cand, ref, faces, camera, theta, transform, jac_p):
+    """Gauss-Newton on ``w_cand(p) = w_ref(T(p; theta))`` over the pixels landing inside one face."""
+    pts = np.argwhere(np.isfinite(cand))[:, ::-1].astype(np.float64)
+    pts = pts[::max(1, len(pts) // FIT_PIXELS)]
+    persp = camera.projection == "perspective"
+    wc = 1.0 / cand[pts[:, 1].astype(int), pts[:, 0].astype(int)] if persp else \
+        cand[pts[:, 1].astype(int), pts[:, 0].astype(int)]
+    theta = np.asarray(theta, dtype=np.float64)
+    for _ in range(STEPS):
+        if not np.all(np.isfinite(theta)):
+            return None
+        depth, inside, _outside, grad = sample(ref, faces, camera, transform(pts, theta))
+        if inside.sum() < len(theta) + 1:
+            return None
+        wr = 1.0 / depth[inside] if persp else depth[inside]
+        res = wc[inside] - wr
+        jac = np.einsum("ni,nij->nj", grad[inside], jac_p(pts[inside], theta))
+        step, *_ = np.linalg.lstsq(jac, res, rcond=None)
+        theta = theta + step
+    return theta

@@ -1,0 +1,114 @@
+"""The reference depth of a scene frame: pyrender's depth along ``forward`` per pixel, and its bound.
+
+pyrender draws the frame's faces filled into single-sample buffers
+(:meth:`oracles.references.pyrender_oracle.PyrenderOracle.render_faces`); its 24-bit depth
+buffer is read and made linear in float64 there, perspective and orthographic alike. The
+per-pixel bound is :func:`oracles.judge.metrics.depth_bound` (derived in
+oracles.tolerances: four 24-bit steps, the depth slope over llvmpipe's 1/256 px
+snapping, float32 geometry). Pixels next to an occlusion boundary (a triangle in front of
+another it shares no vertex with: :func:`oracles.judge.metrics.occlusion_boundary`) show
+either surface by each renderer's rounding; their depth is not compared
+(:attr:`ReferenceDepth.undecided`), as in the shaded comparison; nor is the depth of the
+pixels within one pixel of the near or far plane's clip line (a surface at depth within one
+pixel's depth change of the plane): whether their centre is clipped is the same kind of
+rounding decision (measured: prism, near_plane case, 3 pixels where core shows the clipped
+face at the near plane and pyrender the face behind it). The frame's geometry is the oracle side's own
+(oracles.references.faces, scipy matrices), not core's.
+
+A candidate's encoding adds its own step (oracles.candidates.depth_map.DepthMap.encoding_bound);
+oracles.diagnosis.depth_faults judges and names against both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wirecheck.core.scene.model import Scene
+from wirecheck.core.transforms import Motion
+
+from ..references import faces as oface
+from ..cases import Case, case_motion
+from .metrics import depth_bound, depth_slope, occlusion_boundary
+
+__all__ = ["ReferenceDepth", "reference_depth"]
+
+
+@dataclass(frozen=True)
+class ReferenceDepth:
+    """One frame's reference depth.
+
+    Attributes
+    ----------
+    depth : (H, W) ndarray of float64
+        Depth along ``forward`` (world units), NaN where no face covers the pixel centre.
+    covered : (H, W) ndarray of bool
+    undecided : (H, W) ndarray of bool
+        Covered pixels beside an occlusion boundary: which surface they show is a rounding decision.
+    bound : (H, W) ndarray of float64
+        How far a correct depth may be from ``depth`` at each covered pixel.
+    faces : (H, W) ndarray of int64
+        The triangle each pixel shows (-1: none): planar faces, for the mistakes that move
+        pixels (oracles.diagnosis.depth_pixels).
+    """
+
+    depth: np.ndarray
+    covered: np.ndarray
+    undecided: np.ndarray
+    bound: np.ndarray
+    faces: np.ndarray
+
+    def compared_depth(self) -> np.ndarray:
+        """``(H, W)`` float64: :attr:`depth` with NaN at the undecided pixels too (what a depth map is judged on)."""
+        return np.where(self.undecided, np.nan, self.depth)
+
+    def compared_faces(self) -> np.ndarray:
+        """``(H, W)``: :attr:`faces` with -1 at the undecided pixels too."""
+        return np.where(self.undecided, -1, self.faces)
+
+
+def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, frames: int) -> ReferenceDepth:
+    """Frame ``k`` (1-based, of ``frames``) of ``scene`` under ``motion``, through ``case``'s camera.
+
+    Parameters
+    ----------
+    oracle : oracles.references.pyrender_oracle.PyrenderOracle
+        Of the camera's image size.
+    scene : Scene
+        With faces (a wireframe has no depth: ValueError).
+    case : Case
+        The camera and the pivot the run turns about (oracles.cases.case_motion).
+    motion : Motion
+        The run's motion.
+    k, frames : int
+
+    Returns
+    -------
+    ReferenceDepth
+    """
+    if not scene.faces:
+        raise ValueError(f"scene {scene.name!r} has no faces: a wireframe has no depth map")
+    cam = case.camera
+    p_world, matrices, pr_vertices, pr_pose = oface.frame_geometry(scene, case_motion(motion, case),
+                                                                   (k - 1) / frames)
+    tris, _owner = oface.fan(scene.faces)
+    triangles = oface.gl_triangles(tris, oface.mirrored_vertices(scene, matrices))
+    covered, depth, ids = oracle.render_faces(pr_vertices, triangles, cam, model_matrix=pr_pose, with_ids=True)
+    bound = depth_bound(depth, covered, cam)
+    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, cam)) & covered
+    return ReferenceDepth(depth=np.where(covered, depth, np.nan), covered=covered, undecided=undecided, bound=bound,
+                          faces=np.where(covered, ids, -1))
+
+
+def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
+    """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope of near or far."""
+    slope = depth_slope(depth, covered)
+    at_plane = covered & ((np.abs(depth - camera.near) <= slope) | (np.abs(depth - camera.far) <= slope))
+    out = at_plane.copy()
+    h, w = at_plane.shape
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            src = at_plane[max(dy, 0):h + min(dy, 0), max(dx, 0):w + min(dx, 0)]
+            out[max(-dy, 0):h + min(-dy, 0), max(-dx, 0):w + min(-dx, 0)] |= src
+    return out

@@ -1,0 +1,233 @@
+"""The way back, judged: an unprojector from pixels and depth to world points, against the exact inverse.
+
+    from wirecheck import assert_unprojector
+
+    def test_my_unprojector():
+        assert_unprojector(my_unproject)     # AssertionError naming the fault if not
+
+``my_unproject(pixels, depth, camera) -> (N, 3)``: ``pixels`` ``(N, 2)`` float64 in the
+project's pixel convention (x right, y down, integers at pixel centres), ``depth`` ``(N,)``
+float64 along the camera's ``forward`` (``z_cam``, as a depth map holds it), ``camera`` the
+projector contract's (:mod:`wirecheck.oracles.candidates.candidate`: ``K``, ``R``, ``t``,
+``position``, ``forward``, ``up``, ...); it returns the world points, float64 or float32.
+
+Every bundled scene (or those given) under every case camera: the visible surface points
+of each frame (oracles.judge.unproject_points) against the exact inverse
+(oracles.references.unproject_reference; OpenCV's undistortion for a camera with a lens),
+each point within ``oracles.tolerances.unproject_bound`` (eps of the answer's precision
+times the point's scale, never under 1e-6 px at its depth). A failing case's fault is named
+by oracles.diagnosis.unproject_faults. A ``"FILE.py:FUNC"`` unprojector runs in its own process
+(the candidate host, oracles.candidates.candidate_host): an ``os._exit`` or a crash fails its
+case; a callable runs in this process.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wirecheck.core.errors import InputError
+from wirecheck.core.scene.frames import SceneRenderer
+from wirecheck.core.transforms import Motion
+
+from .candidates.candidate import load_candidate
+from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, SubprocessCandidate, closing_started
+from .diagnosis.unproject_faults import name_unproject_faults
+from .judge import gate
+from .cases import case_motion, cases_for
+from .tolerances import unproject_bound
+from .judge.unproject_points import DEFAULT_STRIDE, surface_samples
+
+__all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "unprojector_failure_text"]
+
+#: Settings when the call gives none: 2 frames of the scenes' spin per case, one sample every 8 px.
+UNPROJECT_DEFAULTS = {"frames": 2, "turns": (1.0, 1.0, 0.0), "stride": DEFAULT_STRIDE}
+
+
+def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=None, turns=None,
+                      stride: int | None = None, *, cmd: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S) -> dict:
+    """Judge an unprojector against the exact inverse of the conventions and return the report.
+
+    Parameters
+    ----------
+    func : callable or str
+        ``func(pixels (N, 2), depth (N,), camera) -> (N, 3)`` world points (module docstring),
+        or a ``"FILE.py:FUNC"`` / ``"MODULE:FUNC"`` string.
+    scenes : sequence of str or Scene, optional
+        Names, paths or scenes with faces (default: every bundled scene).
+    frames : int
+        Frames of each scene's motion per case (default 2).
+    cases : sequence of str, optional
+        Names from :data:`wirecheck.oracles.cases.ALL_CASE_NAMES` (default: the default
+        seven; ``"calibrated"`` adds the calibrated ones, the distorted lens included).
+    turns : (3,) tuple of float
+        The scenes' spin, full turns about X, Y, Z over the run.
+    stride : int
+        One sample every ``stride`` pixels each way (>= 1, default 8).
+    cmd : str, optional
+        Instead of ``func``: an unprojector program speaking the candidate protocol's
+        ``unproject`` requests (docs/protocol.md), as a command line; it is started once and ends
+        with the check.
+    timeout_s : float
+        Seconds each request to ``cmd`` may take (default 10).
+
+    Returns
+    -------
+    dict
+        ``verdict`` ("pass" or "fail"), ``candidate``, ``cases`` (each: ``scene``, ``camera``,
+        ``verdict``, ``points``, ``max_error``, ``max_error_ratio``, ``worst`` (frame, pixel),
+        ``precision``, ``faults`` with ``name``, ``params``, ``hint``, and ``reasons``), ``compared``.
+
+    Raises
+    ------
+    ValueError
+        (InputError) Inputs that would compare nothing: an unknown scene or case, ``frames``
+        or ``stride`` < 1, a spec string that does not load, or a run whose scenes give no
+        visible surface point at all (a wireframe has none).
+    TypeError
+        ``func`` neither callable nor a string.
+    """
+    frames = UNPROJECT_DEFAULTS["frames"] if frames is None else frames
+    turns = UNPROJECT_DEFAULTS["turns"] if turns is None else turns
+    stride = UNPROJECT_DEFAULTS["stride"] if stride is None else stride
+    if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or stride < 1:
+        raise InputError(f"stride {stride!r}: expected an integer >= 1 (pixels between samples)")
+    if (func is None) == (cmd is None):
+        raise InputError("unprojector: expected one of func (a callable or \"FILE.py:FUNC\") and cmd (a program)")
+    name = cmd if cmd is not None else func if isinstance(func, str) else getattr(func, "__qualname__", None) or repr(func)
+    spec = None
+    if isinstance(func, str):
+        load_candidate(func, "unprojector", ("pixels", "depth", "camera"))    # a typo is an input error, here
+        spec, func = func, None
+    elif func is not None and not callable(func):
+        raise TypeError(f"func {func!r}: expected a callable func(pixels, depth, camera) or a \"FILE.py:FUNC\" string")
+    inputs = gate.run_inputs(scenes, frames, 1, cases, turns)
+    motion = Motion(turns=inputs.turns)
+    records = []
+    with closing_started():                      # a program started for the check ends with it
+        if cmd is not None:
+            try:
+                func = SubprocessCandidate.from_command(cmd, timeout_s=timeout_s).unproject
+            except ValueError as exc:
+                raise InputError(f"unprojector command {exc}") from None
+        elif spec is not None:             # in its own process: os._exit or a crash fails its case, not the run
+            func = SubprocessCandidate.python(spec, timeout_s=timeout_s, unproject=True).unproject
+        for scene in inputs.scenes:
+            by_name = {c.name: c for c in cases_for(scene, motion, calibrated=True)}
+            for case_name in inputs.case_names:
+                records.append(_judge_case(func, scene, by_name[case_name], motion, inputs.frames, stride))
+    points = sum(r["points"] for r in records)
+    if points == 0:
+        raise InputError(f"unprojector {name}: no visible surface point in {len(records)} case(s) "
+                         "(scenes without faces?): a check that compares nothing is no pass")
+    verdict = "pass" if all(r["verdict"] == "pass" for r in records) else "fail"
+    return {"verdict": verdict, "candidate": name, "cases": records,
+            "compared": {"cases": len(records), "frames": len(records) * inputs.frames, "points": points}}
+
+
+def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
+    """One scene x camera: every frame's samples through ``func``, errors against their bounds, faults."""
+    cam = case.camera
+    record = {"scene": scene.name, "camera": case.name, "verdict": "pass", "points": 0, "max_error": None,
+              "max_error_ratio": None, "worst": None, "precision": None, "faults": [], "reasons": []}
+    renderer = SceneRenderer(scene, case_motion(motion, case), frames, style="shaded") if scene.faces else None
+    given, got, bounds, frame_of = [], [], [], []
+    precisions = set()
+    for k in range(1, frames + 1):
+        s = surface_samples(scene, case, motion, k, frames, stride, renderer) if renderer is not None else None
+        if s is None or len(s) == 0:
+            continue
+        record["points"] += len(s)                   # offered: a candidate that fails them still compared them
+        try:
+            out = func(s.p_px.copy(), s.depth.copy(), cam)
+            arr = np.asarray(out)
+            if arr.dtype.kind not in "fiu" or arr.shape != (len(s), 3):
+                raise ValueError(f"returned {type(out).__name__} of shape {getattr(arr, 'shape', None)} and dtype "
+                                 f"{getattr(arr, 'dtype', None)}: expected an ({len(s)}, 3) float array")
+        except (Exception, SystemExit) as exc:   # its failure (or its sys.exit) fails its case, in one line
+            record["verdict"] = "fail"
+            record["reasons"].append(f"frame {k}: unprojector {type(exc).__name__}: "
+                                     f"{' '.join(str(exc).split())[:200]}")
+            continue
+        told = getattr(getattr(func, "__self__", None), "answer_precision", None)    # a program's own word
+        precision = told() if told is not None else (
+            "float32" if arr.dtype.kind == "f" and arr.dtype.itemsize <= 4 else "float64")
+        precisions.add(precision)
+        given.append(s)
+        got.append(arr.astype(np.float64))
+        bounds.append(unproject_bound(s.p_px, s.depth, cam, precision))
+        frame_of.append(np.full(len(s), k))
+    if record["reasons"]:
+        return record
+    if record["points"] == 0:
+        record["verdict"] = "vacuous"
+        record["reasons"].append("vacuous: no visible surface point in any frame")
+        return record
+    p_px = np.concatenate([s.p_px for s in given])
+    depth = np.concatenate([s.depth for s in given])
+    expected = np.concatenate([s.p_world for s in given])
+    cand = np.concatenate(got)
+    bound = np.concatenate(bounds)
+    frame = np.concatenate(frame_of)
+    with np.errstate(invalid="ignore"):
+        err = np.linalg.norm(cand - expected, axis=1)
+    err = np.where(np.isfinite(err), err, np.inf)
+    ratio = err / bound
+    i = int(np.argmax(ratio))
+    record.update(max_error=float(err[i]), max_error_ratio=float(ratio[i]), bound_at_worst=float(bound[i]),
+                  worst={"frame": int(frame[i]), "pixel": [float(v) for v in p_px[i]], "depth": float(depth[i])},
+                  precision="float32" if "float32" in precisions else "float64")
+    if ratio[i] <= 1.0:
+        return record
+    record["verdict"] = "fail"
+    bad = int((ratio > 1.0).sum())
+    record["reasons"].append(f"{bad} of {len(err)} points off: max error {err[i]:.3g} > bound {bound[i]:.3g} "
+                             f"(frame {int(frame[i])}, pixel ({p_px[i, 0]:.6g}, {p_px[i, 1]:.6g}), depth {depth[i]:.6g})")
+    faults, measured = name_unproject_faults(p_px, depth, cam, cand, bound)
+    record["faults"] = [{"name": f.name, "params": f.params, "hint": f.hint, "short": f.short()} for f in faults]
+    record["measured"] = measured
+    return record
+
+
+def unprojector_failure_text(report: dict) -> str | None:
+    """The failing cases, their faults, reasons and what to check; None when the verdict is pass."""
+    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
+    if not failing:
+        return None
+    lines = [f"{len(failing)} of {len(report['cases'])} unprojector cases failed for {report['candidate']}:"]
+    hints = {}
+    for c in failing:
+        names = ", ".join(f["short"] for f in c["faults"]) or "none named"
+        lines.append(f"  {c['scene']} / {c['camera']}: faults: {names}; " + "; ".join(c["reasons"]))
+        hints.update({f["name"]: f["hint"] for f in c["faults"]})
+    lines += [f"  what to check: {n}: {h}" for n, h in hints.items()]
+    comp = report["compared"]
+    lines.append(f"  in all: {comp['cases']} cases, {comp['frames']} frames, {comp['points']:,} points compared")
+    return "\n".join(lines)
+
+
+def assert_unprojector(func, **kwargs) -> dict:
+    """:func:`check_unprojector`, raising AssertionError with the diagnosis unless the verdict is pass.
+
+    Parameters
+    ----------
+    func : callable or str
+        As for :func:`check_unprojector`.
+    **kwargs
+        Any keyword of :func:`check_unprojector`.
+
+    Returns
+    -------
+    dict
+        The report, when every case passed.
+
+    Raises
+    ------
+    AssertionError
+        Naming each failing case, its faults and reasons, and what to check.
+    """
+    __tracebackhide__ = True
+    report = check_unprojector(func, **kwargs)
+    text = unprojector_failure_text(report)
+    if text is not None:
+        raise AssertionError(text)
+    return report
