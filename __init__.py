@@ -28,6 +28,7 @@ folders ``core/``, ``oracles/`` and ``scenes/`` (``pyproject.toml`` maps them).
 """
 
 from importlib import import_module
+from typing import Any
 
 # Names are imported on first use (PEP 562), so ``import wirecheck.core`` (the
 # renderer) never pays for the oracles' imports (OpenCV, scipy).
@@ -56,7 +57,7 @@ def _version() -> str:
         return "0+unknown"
 
 
-def __getattr__(name):
+def __getattr__(name: str) -> Any:
     if name == "__version__":       # importlib.metadata costs ~40 ms: only when asked
         globals()[name] = _version()
         return globals()[name]
@@ -67,5 +68,5 @@ def __getattr__(name):
     raise AttributeError(f"module 'wirecheck' has no attribute {name!r}")
 
 
-def __dir__():
+def __dir__() -> list[str]:
     return sorted(set(globals()) | set(_EXPORTS))

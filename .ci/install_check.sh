@@ -41,7 +41,7 @@ expect() {
 # has NAME TEXT: the output of run NAME contains TEXT
 has() { grep -qF -- "$2" "$WORK/$1.out" || { tail -40 "$WORK/$1.out" >&2; fail "$1: output lacks '$2'"; }; }
 
-# 1. The wheel: only the wirecheck package, with the bundled scenes.
+# 1. The wheel: only the wirecheck package, with the bundled scenes and py.typed.
 step "building the wheel"
 "$CHECKOUT/.venv/bin/python" -m pip wheel -q --no-deps "$CHECKOUT" -w "$WORK/dist" >&2
 WHEEL="$(ls "$WORK"/dist/wirecheck-*.whl)"
@@ -53,6 +53,8 @@ scenes = sorted(n for n in names if n.endswith(".scene"))
 print(f"install_check: wheel top level {top}, {len(scenes)} scene files", file=sys.stderr)
 assert len(top) == 2 and top[0] == "wirecheck" and top[1].endswith(".dist-info"), f"top level {top}"
 assert {"wirecheck/scenes/cube.scene", "wirecheck/scenes/pyramid.scene"} <= set(scenes), scenes
+# PEP 561: the package's annotations are shipped, for the users' type checkers
+assert "wirecheck/py.typed" in names, "wirecheck/py.typed is not in the wheel (pyproject package-data)"
 EOF
 
 # 2. A new virtualenv outside the checkout: the wheel, its dependencies from

@@ -98,7 +98,7 @@ def main(argv=None) -> int:
     if args.meshes < 2 or args.frames < 1:
         ap.error("expected --meshes >= 2 and --frames >= 1")
     from wirecheck.oracles.datasets.dataset import dataset_entries
-    from wirecheck.oracles.datasets.executors import ExecutorSpec
+    from wirecheck.oracles.executors import ExecutorSpec
 
     t_start = time.perf_counter()
     info = machine_info(meshes=args.meshes, frames=args.frames, cases=args.cases)

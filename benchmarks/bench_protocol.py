@@ -54,7 +54,7 @@ from wirecheck.core.scene.files import builtin_names, load_scene  # noqa: E402
 from wirecheck.core.transforms import Motion  # noqa: E402
 from wirecheck.oracles.references import faces as oface  # noqa: E402
 from wirecheck.oracles.candidates.candidate import call_candidate  # noqa: E402
-from wirecheck.oracles.judge.cases import cameras_for  # noqa: E402
+from wirecheck.oracles.cases import cameras_for  # noqa: E402
 from wirecheck.oracles.candidates.draw import clip_depth  # noqa: E402
 from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate  # noqa: E402
 

@@ -97,7 +97,7 @@ def run(folder: str, frames: int, cases: str, line_pixels=None) -> dict:
     from wirecheck.oracles.candidates.core_candidate import CoreCandidate
     from wirecheck.oracles.datasets.dataset import dataset_entries
     from wirecheck.oracles.datasets.dataset_run import run_dataset
-    from wirecheck.oracles.datasets.executors import ExecutorSpec
+    from wirecheck.oracles.executors import ExecutorSpec
 
     original = raster._line_pixels
     if line_pixels is not None:

@@ -1,4 +1,4 @@
-"""Measure the line gate's statistics (oracles/judge/tolerances.py cites this run).
+"""Measure the line gate's statistics (oracles/tolerances.py cites this run).
 
 For core's exact raster (correct), the drop-last-pixel mutant and an unbiased
 random-end renderer (tests/raster_mutants.py), over the bundled scenes, the

@@ -1,4 +1,4 @@
-"""Measure how far correct float32 projectors are from the float64 oracle (oracles/judge/tolerances.py cites this run).
+"""Measure how far correct float32 projectors are from the float64 oracle (oracles/tolerances.py cites this run).
 
 For five correct float32 projectors -- two glm-style GL pipelines
 (tests/data/candidates/glm_f32.py, tests/data/real_world/glm_gl.py: P V
@@ -7,7 +7,7 @@ premultiplied, GL's clip test), DirectXMath's left-handed one
 float32``, and an OpenCV-style ``K [R | t]`` in float32 -- on the bundled
 scenes (and the orrery example) under every crosscheck case camera: the
 largest vertex error, the largest ``error / (eps32 scale)`` of any point
-(scale: oracles.judge.tolerances, per point), the case bound the harness derives, and
+(scale: oracles.tolerances, per point), the case bound the harness derives, and
 the largest float32 view-depth error over ``eps32 (|X| + |C|)`` (the near-plane
 margin of oracles.candidates.draw).
 
@@ -34,8 +34,8 @@ import glm_gl  # noqa: E402
 from wirecheck.core.scene.files import load_scene  # noqa: E402
 from wirecheck.core.transforms import Motion  # noqa: E402
 from wirecheck.oracles.references import opencv_oracle
-from wirecheck.oracles.judge import tolerances  # noqa: E402
-from wirecheck.oracles.judge.cases import cameras_for  # noqa: E402
+from wirecheck.oracles import tolerances  # noqa: E402
+from wirecheck.oracles.cases import cameras_for  # noqa: E402
 from wirecheck.oracles.references.convert import opencv_matrices  # noqa: E402
 from wirecheck.oracles.candidates.core_candidate import CoreCandidate  # noqa: E402
 from wirecheck.oracles.references.faces import frame_geometry  # noqa: E402

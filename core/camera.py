@@ -167,8 +167,6 @@ class Camera:
 
     def _check_intrinsics(self) -> None:
         """Validate and normalise ``intrinsics`` and ``distortion`` (tuples of floats, or None)."""
-        from .projector.distortion import check_coefficients
-
         if self.intrinsics is not None:
             values = _numbers("intrinsics fx,fy,cx,cy", self.intrinsics, (4,))
             if self.projection != "perspective":
@@ -283,19 +281,19 @@ class Camera:
             p[2, 2], p[2, 3], p[3, 3] = -2.0 / (f - n), -(f + n) / (f - n), 1.0
         return p
 
-    def _replace_lens(self, **changes) -> "Camera":
+    def _replace_lens(self, **changes) -> Camera:
         """``dataclasses.replace`` keeping the pose's vectors to the bit (re-normalising may move an ulp)."""
         cam = replace(self, **changes)
         for name in ("position", "forward", "up", "right"):
             object.__setattr__(cam, name, getattr(self, name))
         return cam
 
-    def with_intrinsics(self, fx: float, fy: float, cx: float | None = None, cy: float | None = None) -> "Camera":
+    def with_intrinsics(self, fx: float, fy: float, cx: float | None = None, cy: float | None = None) -> Camera:
         """This camera (same pose, to the bit) with calibrated intrinsics (``cx, cy`` default: centred)."""
         c0x, c0y = principal_point(self.width, self.height)
         return self._replace_lens(intrinsics=(fx, fy, c0x if cx is None else cx, c0y if cy is None else cy))
 
-    def with_K(self, K) -> "Camera":  # noqa: N802
+    def with_K(self, K) -> Camera:  # noqa: N802
         """This camera with the intrinsics of a ``(3, 3)`` K: no skew, last row ``0 0 1``."""
         k = _numbers("K", K, (3, 3))
         if k[1] != 0 or k[3] != 0 or (k[6], k[7], k[8]) != (0.0, 0.0, 1.0):
@@ -303,7 +301,7 @@ class Camera:
                              "[[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (no skew)")
         return self.with_intrinsics(k[0], k[4], k[2], k[5])
 
-    def with_distortion(self, coefficients) -> "Camera":
+    def with_distortion(self, coefficients) -> Camera:
         """This camera (same pose, to the bit) with OpenCV distortion coefficients (``None``: none)."""
         return self._replace_lens(distortion=coefficients)
 
@@ -393,3 +391,45 @@ def orthographic_twin(camera: Camera, distance: float) -> Camera:
     return Camera(position=camera.position, forward=camera.forward, up=camera.up, fov_y_deg=camera.fov_y_deg,
                   width=camera.width, height=camera.height, near=camera.near, far=camera.far,
                   projection="orthographic", ortho_height=height)
+
+
+#: The lengths OpenCV's ``distCoeffs`` may have that this model covers:
+#: (k1, k2, p1, p2), (..., k3), (..., k3, k4, k5, k6). The thin-prism and tilted
+#: models (12 and 14 numbers) are not modelled.
+COEFFICIENT_COUNTS = (4, 5, 8)
+
+
+#: Largest |coefficient|. Calibrated lenses have |k| up to about 10^2 (rational
+#: models of fisheye-like lenses); 10^4 leaves room for any real lens, while
+#: k r2^3 stays below 1e4 * 1e12 inside the intrinsics' 1e6-side reach
+#: (core.camera), far from float64 overflow.
+MAX_COEFFICIENT = 1e4
+
+
+NAMES = ("k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6")
+
+
+def check_coefficients(coefficients) -> tuple | None:
+    """``coefficients`` as a tuple of floats, ``None`` when absent or all zero; InputError otherwise.
+
+    Parameters
+    ----------
+    coefficients : sequence of float or None
+        ``(k1, k2, p1, p2[, k3[, k4, k5, k6]])``, OpenCV's order.
+    """
+    if coefficients is None:
+        return None
+    try:
+        c = np.asarray(coefficients, dtype=np.float64)
+    except (TypeError, ValueError):
+        c = None
+    if c is None or c.ndim != 1 or len(c) not in COEFFICIENT_COUNTS:
+        raise InputError(f"camera distortion {coefficients!r}: expected 4, 5 or 8 numbers "
+                         "(k1, k2, p1, p2[, k3[, k4, k5, k6]], OpenCV's order)")
+    bad = [f"{n}={v!r}" for n, v in zip(NAMES, c.tolist()) if not (math.isfinite(v) and abs(v) <= MAX_COEFFICIENT)]
+    if bad:
+        raise InputError(f"camera distortion {', '.join(bad)}: expected finite numbers with |value| <= "
+                         f"{MAX_COEFFICIENT:g}")
+    if not c.any():
+        return None
+    return tuple(float(x) for x in c)

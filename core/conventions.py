@@ -103,7 +103,7 @@ Column vectors and 4x4 homogeneous matrices: ``p' = M @ p``. A composite
 same thing, not a row-vector convention. ``compose(A, B, C) == A @ B @ C``
 (C first). The model matrix of a frame is ``T @ R_z @ R_y @ R_x @ S``: scale,
 then rotate about X, then Y, then Z (all about the model origin), then
-translate. A motion with a pivot ``c`` (crosscheck's framing, oracles.judge.cases)
+translate. A motion with a pivot ``c`` (crosscheck's framing, oracles.cases)
 scales and turns about ``c`` instead: ``T(offset + c) @ R_z @ R_y @ R_x @ S @ T(-c)``.
 
 Rotations are right-handed (counter-clockwise when the axis points at the

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from .limits import check_turns
 
 
 def rotate_x(theta: float) -> np.ndarray:
@@ -67,7 +68,7 @@ class Motion:
         A constant uniform scale.
     pivot : (3,) tuple of float
         The point the scale and turns are about, model units (crosscheck spins
-        a scene about the centre its cameras are framed on, oracles.judge.cases).
+        a scene about the centre its cameras are framed on, oracles.cases).
 
     The model matrix at run fraction ``t`` in [0, 1) is
     ``T(offset) @ Rz @ Ry @ Rx @ S(scale)`` about the origin, and
@@ -81,8 +82,6 @@ class Motion:
     pivot: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        from .limits import check_turns
-
         check_turns(self.turns, "Motion turns")
 
     def model_matrix(self, t: float) -> np.ndarray:

@@ -24,7 +24,8 @@ pixels too.
 
 from __future__ import annotations
 
-from .judge import gate, tolerances
+from . import tolerances
+from .judge import gate
 from .candidates.caller_state import caller_state_kept
 from .candidates.isolation import api_candidate
 from .reports.compared import hint_lines, what_text
@@ -32,7 +33,11 @@ from .reports.fault_text import case_cell
 from .reports.report import compared_text, not_passed
 from .runner import run_crosscheck
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
-from .judge.tolerances import Tolerances
+from .tolerances import Tolerances
+from .reports.report import write_report
+from wirecheck.core.errors import InputError
+from .references.pyrender_oracle import GLUnavailable, gl_available
+from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 from wirecheck.core.outputs.output import claim, release_claim
 
 
@@ -70,7 +75,7 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     frames : int
         Frames of each scene's motion per case (>= 1).
     cases : sequence of str, optional
-        Names from :data:`wirecheck.oracles.judge.cases.ALL_CASE_NAMES` (default: the
+        Names from :data:`wirecheck.oracles.cases.ALL_CASE_NAMES` (default: the
         default set ``CASE_NAMES``; the calibrated cases run when named).
     oracles : tuple of {"opencv", "pyrender"}, or str
         ``("opencv",)`` compares vertices only (no OpenGL needed);
@@ -96,7 +101,7 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
         this process (an ``os._exit`` in it then ends your test run).
     precision : {"float32", "float64"}, optional
         What the projector computes in; its vertex bound is derived from it
-        (:func:`wirecheck.oracles.judge.tolerances.vertex_bound`). Default None:
+        (:func:`wirecheck.oracles.tolerances.vertex_bound`). Default None:
         inferred from the dtype it returns (float32 arrays: float32). A
         declared precision wins over the returned dtype: float64 declared and
         float32 returned is judged at float64, and its float32 rounding is
@@ -140,7 +145,7 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     state and print options, ``os.environ``, ``sys.path``, the current
     directory, logging and signal handlers.
     """
-    run_dir = _report_dir(report_dir)
+    run_dir = checked_report_dir(report_dir)
     if run_dir is not None:
         claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
     try:
@@ -148,8 +153,6 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
                                    allow_vacuous, cmd=cmd, timeout_s=timeout_s, isolate=isolate,
                                    precision=precision, config=config)
         if run_dir is not None:
-            from .reports.report import write_report
-
             write_report(run_dir, report, images)
     finally:
         if run_dir is not None:
@@ -157,18 +160,16 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     return report
 
 
-def _report_dir(report_dir):
+def checked_report_dir(report_dir):
     """``report_dir`` as a Path (None: none), checked before anything runs: TypeError for a non-path,
     ValueError (InputError) for a path that is a file."""
     import os
     from pathlib import Path
 
-    from wirecheck.core.errors import InputError
-
     if report_dir is None:
         return None
     if isinstance(report_dir, bool) or not isinstance(report_dir, (str, os.PathLike)):
-        raise TypeError(f"report_dir {_short(report_dir)}: expected a folder path (str or Path), or None")
+        raise TypeError(f"report_dir {short_repr(report_dir)}: expected a folder path (str or Path), or None")
     path = Path(report_dir)
     if path.exists() and not path.is_dir():
         raise InputError(f"report_dir {str(path)!r} is a file: expected a folder for the report")
@@ -194,9 +195,9 @@ def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol
     if func is None and cmd is None:            # the table's candidate, as for the fixture
         func, cmd = settings.get("candidate"), settings.get("candidate_cmd")
     func, cmd = _candidate_args(func, cmd)
-    _flag(allow_vacuous, "allow_vacuous")
+    checked_flag(allow_vacuous, "allow_vacuous")
     if isolate is not None:
-        _flag(isolate, "isolate", "(or None: the default)")
+        checked_flag(isolate, "isolate", "(or None: the default)")
     timeout_s = _seconds(timeout_s)
     oracles = _oracles(oracles)
     tol = Tolerances(tol_px, min_f1, min_f1_0px, precision=_precision(precision))
@@ -204,8 +205,6 @@ def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol
     with caller_state_kept(), closing_started():    # the caller's globals as they were; no process left
         name, func = api_candidate(func, cmd, timeout_s, isolate)
         if "pyrender" in oracles:
-            from .references.pyrender_oracle import GLUnavailable, gl_available
-
             ok, message = gl_available()
             if not ok:
                 raise GLUnavailable(message)
@@ -245,18 +244,18 @@ def _candidate_args(func, cmd):
     if func is None and cmd is None:
         raise ValueError("no candidate: expected func (a callable or \"FILE.py:FUNC\") or cmd (a program)")
     if func is not None and cmd is not None:
-        raise ValueError(f"func {_short(func)} and cmd {_short(cmd)}: expected one candidate, not both")
+        raise ValueError(f"func {short_repr(func)} and cmd {short_repr(cmd)}: expected one candidate, not both")
     if cmd is not None:
         if isinstance(cmd, (str, os.PathLike)):
             return None, os.fspath(cmd)
         argv = list(cmd) if isinstance(cmd, (list, tuple)) else None
         if argv is None or not all(isinstance(a, (str, os.PathLike)) for a in argv):
-            raise TypeError(f"cmd {_short(cmd)}: expected a command line (str) or an argv list of str")
+            raise TypeError(f"cmd {short_repr(cmd)}: expected a command line (str) or an argv list of str")
         return None, [os.fspath(a) for a in argv]
     if isinstance(func, str):
         return func, None
     if not callable(func):
-        raise TypeError(f"func {_short(func)}: expected a callable func(points, camera) or a \"FILE.py:FUNC\" / "
+        raise TypeError(f"func {short_repr(func)}: expected a callable func(points, camera) or a \"FILE.py:FUNC\" / "
                         "\"MODULE:FUNC\" string")
     try:
         signature = inspect.signature(func)
@@ -265,24 +264,24 @@ def _candidate_args(func, cmd):
     try:
         signature.bind(None, None)
     except TypeError:
-        name = getattr(func, "__qualname__", None) or _short(func)
+        name = getattr(func, "__qualname__", None) or short_repr(func)
         raise TypeError(f"func {name}{signature} cannot be called as func(points, camera): expected "
                         "the candidate contract (wirecheck.oracles.candidates.candidate)") from None
     return func, None
 
 
-def _short(value) -> str:
+def short_repr(value) -> str:
     """``repr(value)`` on one line, at most 80 characters."""
     text = " ".join(repr(value).split())
     return text if len(text) <= 80 else text[:77] + "..."
 
 
-def _flag(value, name: str, extra: str = "") -> bool:
+def checked_flag(value, name: str, extra: str = "") -> bool:
     """A bool (numpy's too); TypeError otherwise: ``allow_vacuous="no"`` is truthy and would let nothing pass."""
     import numpy as np
 
     if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{name} {_short(value)}: expected True or False{' ' + extra if extra else ''}")
+        raise TypeError(f"{name} {short_repr(value)}: expected True or False{' ' + extra if extra else ''}")
     return bool(value)
 
 
@@ -292,13 +291,12 @@ def _seconds(timeout_s) -> float:
     import numbers
 
     if isinstance(timeout_s, bool) or not isinstance(timeout_s, numbers.Real):
-        raise TypeError(f"timeout_s {_short(timeout_s)}: expected a number of seconds > 0")
-    from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
-
-    if not (math.isfinite(timeout_s) and 0 < timeout_s <= MAX_CANDIDATE_TIMEOUT_S):
+        raise TypeError(f"timeout_s {short_repr(timeout_s)}: expected a number of seconds > 0")
+    seconds = float(timeout_s)
+    if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
         raise ValueError(f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0 and at most "
                          f"{MAX_CANDIDATE_TIMEOUT_S:g} (one day)")
-    return float(timeout_s)
+    return seconds
 
 
 def _oracles(oracles) -> tuple:
@@ -306,15 +304,13 @@ def _oracles(oracles) -> tuple:
     if isinstance(oracles, str):
         return tuple(o.strip() for o in oracles.split(",") if o.strip())
     if not isinstance(oracles, (list, tuple)) or not all(isinstance(o, str) for o in oracles):
-        raise TypeError(f"oracles {_short(oracles)}: expected a tuple of names among opencv, pyrender "
+        raise TypeError(f"oracles {short_repr(oracles)}: expected a tuple of names among opencv, pyrender "
                         "(\"opencv\": vertices; (\"opencv\", \"pyrender\"): pixels too)")
     return tuple(oracles)
 
 
 def _precision(precision):
     """``precision`` checked: None, "float32" or "float64"; InputError (a ValueError) otherwise."""
-    from wirecheck.core.errors import InputError
-
     if precision is not None and precision not in tolerances.PRECISIONS:
         raise InputError(f"precision {precision!r}: expected one of {', '.join(tolerances.PRECISIONS)} "
                          "(or None: inferred from the dtype the projector returns)")

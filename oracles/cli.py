@@ -13,7 +13,7 @@ each request under ``--candidate-timeout`` seconds, so a candidate that
 exits, hangs or crashes fails its cases (exit 1) and never ends the run.
 ``--candidate-precision float32|float64`` says what it computes in (default:
 the dtype it returns; core: ``--dtype``): a float32 candidate's vertices are
-held to a bound derived from float32 rounding (oracles/judge/tolerances.py).
+held to a bound derived from float32 rounding (oracles/tolerances.py).
 
 ``--level vertices`` runs the OpenCV vertex check only (no drawing, no
 pyrender); ``--level pixels`` (the default) adds the pyrender pixel check.
@@ -27,7 +27,7 @@ offset under the lines), ``--cull backface`` (back faces culled, and their
 edges when no front face owns them; checked against the oracle's own
 front-face test and GL culling) and ``--style shaded`` (core's depth buffer
 against pyrender's filled faces: silhouette IoU and depth error within a
-derived bound, oracles/judge/tolerances.py). A scene without faces is then compared
+derived bound, oracles/tolerances.py). A scene without faces is then compared
 as a plain wireframe, or (shaded) checked for its vertices only, with a note.
 They need the core candidate and the pixel level: with ``--candidate``,
 ``--level vertices``, ``--sweep`` or ``--suite``, and ``--hidden-lines`` with
@@ -42,7 +42,7 @@ dataset: one task per mesh, a mesh that cannot be loaded counted and reported
 (it fails the run unless ``--allow-load-errors``), one summary
 (oracles/datasets/dataset_run.py, docs/datasets.md). ``--executor dask`` runs the
 cases or meshes on a Dask cluster: a local one of ``--jobs`` workers, or
-``--scheduler tcp://HOST:PORT``'s (oracles/datasets/executors.py); same report.
+``--scheduler tcp://HOST:PORT``'s (oracles/executors.py); same report.
 
 ``crosscheck export DIR`` writes a rendering job for any renderer, and
 ``--candidate-frames DIR`` judges the renderer's own frames of it
@@ -73,10 +73,11 @@ from wirecheck.core.app.guard import run_cli  # noqa: E402
 from wirecheck.core.limits import check_candidate_timeout
 from wirecheck.core.outputs.output import FrameDir, check_report_dir, claim, json_dumps, release_claims
 
-from .judge import gate, tolerances
+from . import tolerances
+from .judge import gate
 from .candidates.isolation import check_python_spec, external_candidate
-from .judge.cases import CASE_NAMES
-from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
+from .cases import CASE_NAMES
+from .executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli, trust_line
 from .reports.junit import check_junit_target, write_junit
 from .candidates.core_candidate import CoreCandidate, RenderMode
@@ -86,8 +87,11 @@ from .reports.compared import hint_lines, reason_text, what_text
 from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .runner import level_for_oracles, run_crosscheck
 from .spec import run_spec, spec_console, spec_markdown
-from .judge.tolerances import Tolerances
+from .tolerances import Tolerances
 from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
+from wirecheck.core.scene.files import builtin_names, example_names
+from .candidates.subprocess_candidate import closing_started
+from .reports.wall import process_age_s
 
 ORACLES = ("opencv", "pyrender")
 #: Options that configure the core candidate, with their defaults.
@@ -231,10 +235,6 @@ def _executor(args) -> ExecutorSpec:
 
 def _dataset(args):
     """The dataset of ``--scene DIR`` / ``--scene-list FILE`` (oracles.datasets.dataset), or None for a plain run."""
-    from wirecheck.core.scene.files import builtin_names, example_names
-
-    from .datasets.dataset import dataset_entries
-
     scenes = args.scene or []
     named = set(builtin_names() + example_names())      # a bundled name wins over a folder of that name
     folders = [s for s in scenes if s not in named and Path(s).is_dir()]
@@ -254,6 +254,8 @@ def _dataset(args):
     if other:
         raise InputError(f"a dataset (--scene DIR or --scene-list) with {', '.join(other)}: expected a plain "
                          "crosscheck run over the meshes")
+    from .datasets.dataset import dataset_entries      # --scene DIR / --scene-list only
+
     return dataset_entries(folders, args.scene_list or [])
 
 
@@ -287,8 +289,6 @@ def _external_option(args) -> str | None:
 
 
 def main(argv=None) -> int:
-    from .candidates.subprocess_candidate import closing_started
-
     with closing_started():                       # the run's candidate program ends with the run
         try:
             return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/app/guard.py)
@@ -325,7 +325,7 @@ def _main(argv=None) -> int:
     if applied:      # after the checks: on a usage error the error is the only line
         print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
     if level == "pixels":
-        from .references.pyrender_oracle import gl_available, select_gl
+        from .references.pyrender_oracle import gl_available, select_gl   # GL chosen before PyOpenGL is imported
 
         try:
             select_gl(args.gl)
@@ -412,7 +412,6 @@ def _main(argv=None) -> int:
           f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else ""))
     if precision_text(report):
         print(f"Candidate precision: {precision_text(report)}")
-    from .reports.wall import process_age_s
     print(timing_line(report)[:-1] + f"; {process_age_s():.1f} s in all, with start-up and the report)")
     print(report_line(args, run_dir, "report.json", "report.md, report.html"))
     return 0 if report["verdict"] == "pass" else 1
@@ -510,8 +509,7 @@ def _sweep(args, inputs, level, tol, run_dir) -> int:
 
 
 def _suite(level, run_dir) -> int:
-
-    from .extremes import extremes_markdown, run_extremes
+    from .extremes import extremes_markdown, run_extremes      # --suite extremes only
 
     result = run_extremes(pyrender=level == "pixels")
     md = extremes_markdown(result)

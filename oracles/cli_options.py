@@ -12,10 +12,10 @@ from wirecheck.core.app.cli_help import CROSSCHECK_EXAMPLES, OneLineParser
 from wirecheck.core.app.guard import VersionAction
 from wirecheck.core.numbers import plain_float, plain_int
 
-from .judge import tolerances
-from .judge.cases import ALL_CASE_NAMES, CASE_NAMES
+from . import tolerances
+from .cases import ALL_CASE_NAMES, CASE_NAMES
 from .candidates.core_candidate import CoreCandidate, RenderMode
-from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS
+from .executors import DEFAULT_CONNECT_TIMEOUT_S, EXECUTORS
 from .runner import LEVELS
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S
 
@@ -58,7 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate-timeout", type=plain_float, default=DEFAULT_TIMEOUT_S, metavar="SECONDS",
                    help=f"seconds each request to --candidate/--candidate-cmd may take (default {DEFAULT_TIMEOUT_S:g})")
     p.add_argument("--candidate-precision", choices=tolerances.PRECISIONS, default=None,
-                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.judge.tolerances) "
+                   help="what the candidate computes in; its vertex bound is derived from it (wirecheck.oracles.tolerances) "
                         "(default: from the dtype it returns, float64 over the protocol unless its replies say "
                         "float32; core: --dtype)")
     p.add_argument("--unprojector", default=None, metavar="FILE.py:FUNC|MODULE:FUNC",

@@ -8,7 +8,7 @@
     # candidate-timeout = 10                      # seconds per request to either
     # candidate-precision = "float32"             # what it computes in (default: from the dtype it returns)
     scenes = ["cube", "tests/arm.scene"]   # built-in or example names, or paths relative to this file
-    cases = ["on_axis", "near_plane"]      # a subset of oracles.judge.cases.CASE_NAMES
+    cases = ["on_axis", "near_plane"]      # a subset of oracles.cases.CASE_NAMES
     frames = 8                             # frames of the motion per case
     level = "vertices"                     # or "pixels" (OpenCV and pyrender); or oracles = ["opencv"]
     tol-px = 0.01                          # and min-f1, min-f1-0px: the crosscheck options of that name
@@ -36,7 +36,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 from wirecheck.core.user_files import RefusedFile, problem, read_text
+from .tolerances import PRECISIONS
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -148,7 +150,7 @@ def validate(table: dict, path: Path) -> dict:
     """The table's values checked against :data:`KEYS`, paths made absolute; InputError otherwise."""
     from wirecheck.core.scene.files import MESH_SUFFIXES, builtin_names, example_names
 
-    from .judge.cases import ALL_CASE_NAMES as CASE_NAMES
+    from .cases import ALL_CASE_NAMES as CASE_NAMES
 
     def bad(key, value, expected=None):
         return InputError(f"{path}: [{TABLE}] {key} = {value!r}: expected {expected or KEYS[key]}")
@@ -181,14 +183,10 @@ def validate(table: dict, path: Path) -> dict:
                 raise bad(key, value)
             out[key] = value
         elif key == "candidate-timeout":
-            from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
-
             if not (number(value) and 0 < value <= MAX_CANDIDATE_TIMEOUT_S):
                 raise bad(key, value)
             out[key] = float(value)
         elif key == "candidate-precision":
-            from .judge.tolerances import PRECISIONS
-
             if value not in PRECISIONS:
                 raise bad(key, value)
             out[key] = value

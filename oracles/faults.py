@@ -34,7 +34,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Iterable, Mapping
+from typing import Any
+from collections.abc import Iterable, Mapping
 
 __all__ = ["FaultKind", "Fault", "CATALOGUE", "FAMILIES", "SOURCES", "NAMES", "kind", "family", "names",
            "precedence", "ordered", "hint_text", "markdown_table"]

@@ -7,14 +7,23 @@
 
 The job is a folder written by ``crosscheck export`` with the renderer's PNGs under ``frames/``
 (docs/frames.md). The judge is ``crosscheck --candidate-frames DIR``'s own
-(:func:`wirecheck.oracles.candidates.frames_candidate.run_frames`), with its checks of the job
+(:func:`wirecheck.oracles.judge.frames_judge.run_frames`), with its checks of the job
 and of the report folder (:func:`wirecheck.oracles.frames_cli.check_report_outside_job`), so the
 report is the one the command line writes.
 """
 
 from __future__ import annotations
 
-from .api import _flag, _report_dir, _short, raise_unless_pass
+from .api import checked_flag, checked_report_dir, short_repr, raise_unless_pass
+from wirecheck.core.errors import InputError
+from wirecheck.core.outputs.output import check_report_dir, claim, release_claim
+from . import tolerances
+from .judge import gate
+from .judge.line_style import LINE_RULES
+from .frames_cli import check_report_outside_job
+from .reports.report import write_report
+from .candidates.caller_state import caller_state_kept
+from .references.pyrender_oracle import GLUnavailable, gl_available
 
 
 def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None, min_f1_0px: float | None = None,
@@ -62,16 +71,10 @@ def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None
     import os
     from pathlib import Path
 
-    from wirecheck.core.errors import InputError
-    from wirecheck.core.outputs.output import check_report_dir, claim, release_claim
-
-    from .judge import gate, tolerances
-    from .judge.line_style import LINE_RULES
-
     if isinstance(job_dir, bool) or not isinstance(job_dir, (str, os.PathLike)):
-        raise TypeError(f"job_dir {_short(job_dir)}: expected a job folder path (str or Path)")
+        raise TypeError(f"job_dir {short_repr(job_dir)}: expected a job folder path (str or Path)")
     job_dir = Path(job_dir)
-    _flag(allow_vacuous, "allow_vacuous")
+    checked_flag(allow_vacuous, "allow_vacuous")
     if line_rule not in LINE_RULES:
         raise InputError(f"line_rule {line_rule!r}: expected one of {', '.join(LINE_RULES)} (any: aliased 1-px "
                          "lines held to GL's rule or the rounded ends'; gl: to GL's pixel rule; geometry: where "
@@ -79,12 +82,10 @@ def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None
     tol = tolerances.Tolerances(min_f1_1px=tolerances.MIN_F1_1PX if min_f1 is None else min_f1,
                                 min_f1_0px=tolerances.MIN_F1_0PX if min_f1_0px is None else min_f1_0px)
     gate.check_tolerances(tol)                  # a NaN floor would pass everything
-    run_dir = _report_dir(report_dir)
+    run_dir = checked_report_dir(report_dir)
     if run_dir is not None:                     # before anything is judged, as crosscheck checks it
         check_report_dir(run_dir, "report_dir")
         claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
-        from .frames_cli import check_report_outside_job
-
         try:
             check_report_outside_job(job_dir, run_dir)
         except BaseException:
@@ -93,8 +94,6 @@ def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None
     try:
         report, images = _judge(job_dir, tol, allow_vacuous, line_rule)
         if run_dir is not None:
-            from .reports.report import write_report
-
             write_report(run_dir, report, images)
     finally:
         if run_dir is not None:
@@ -104,9 +103,7 @@ def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None
 
 def _judge(job_dir, tol, allow_vacuous: bool, line_rule: str) -> tuple[dict, dict]:
     """crosscheck's frames judge on ``job_dir``, after the check that pyrender's GL can draw here."""
-    from .candidates.caller_state import caller_state_kept
-    from .candidates.frames_candidate import run_frames
-    from .references.pyrender_oracle import GLUnavailable, gl_available
+    from .judge.frames_judge import run_frames
 
     with caller_state_kept():                   # the caller's globals as they were (PYOPENGL_PLATFORM, ...)
         ok, message = gl_available()

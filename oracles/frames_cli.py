@@ -16,7 +16,14 @@ from wirecheck.core.app.cli_help import OneLineParser
 from wirecheck.core.errors import InputError
 from wirecheck.core.numbers import plain_float, plain_int
 
-from .judge.cases import ALL_CASE_NAMES, CASE_NAMES
+from .cases import ALL_CASE_NAMES, CASE_NAMES
+from wirecheck.core.scene.files import builtin_names, load_scene
+from wirecheck.core.transforms import Motion
+from wirecheck.core.limits import MAX_FRAMES
+from .judge.line_style import summary_lines
+from .reports.compared import hint_lines, what_text
+from .reports.report_option import report_line
+from .tolerances import Tolerances
 
 
 def _fail(message: str) -> int:
@@ -27,9 +34,6 @@ def _fail(message: str) -> int:
 
 def export_main(argv) -> int:
     """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z] [--phase F]``."""
-    from wirecheck.core.scene.files import builtin_names, load_scene
-    from wirecheck.core.transforms import Motion
-
     from .candidates.export import write_job
 
     p = OneLineParser(prog="crosscheck export",
@@ -46,7 +50,6 @@ def export_main(argv) -> int:
                         "frames (default 0: crosscheck's own poses; 0.3: no frame of --frames 4 is a quarter turn)")
     args = p.parse_args(argv)
     try:
-        from wirecheck.core.limits import MAX_FRAMES
         from wirecheck.core.outputs.output import check_outside_scenes, claim
 
         if not (1 <= args.frames <= MAX_FRAMES and args.every >= 1):
@@ -98,12 +101,8 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     command line): the project's settings for projector checks, which a job's
     frames do not use, so they are not usage errors here.
     """
-    from .candidates.frames_candidate import run_frames
-    from .judge.line_style import summary_lines
-    from .reports.compared import hint_lines, what_text
+    from .judge.frames_judge import run_frames
     from .reports.report import console_table, write_report
-    from .reports.report_option import report_line
-    from .judge.tolerances import Tolerances
 
     from .config import CLI_DESTS
 

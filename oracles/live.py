@@ -22,12 +22,12 @@ import numpy as np
 from wirecheck.core.outputs.output import png_bytes
 
 from .judge import metrics
-from .judge.cases import Case
+from .cases import Case
 from .references.pyrender_oracle import OracleCache, osmesa_available
 from .reports.fault_text import case_cell
 from .judge.case import run_case
 from .candidates.core_candidate import CoreCandidate, RenderMode
-from .judge.tolerances import Tolerances
+from .tolerances import Tolerances
 
 
 def _b64_png(image: np.ndarray) -> str:

@@ -38,6 +38,7 @@ import re
 from pathlib import Path
 
 import pytest
+from wirecheck.core.errors import InputError
 
 _SETTINGS = pytest.StashKey[dict]()
 _CANDIDATE = pytest.StashKey[object]()
@@ -60,8 +61,6 @@ def pytest_addoption(parser):
 
 
 def pytest_configure(config):
-    from wirecheck.core.errors import InputError
-
     from .config import load_config
 
     opt = config.option
@@ -110,8 +109,6 @@ def _write(config, node, index: int, report: dict, images: dict) -> str:
     ``--junitxml`` as a property of the test.
     """
     nodeid = node.nodeid
-    from wirecheck.core.errors import InputError
-
     from .reports.report import write_report
 
     root = Path(config.option.wirecheck_report)
@@ -158,10 +155,10 @@ class Check:
         self._calls += 1
         error, trace = None, True
         try:
-            from .api import _report_dir
+            from .api import checked_report_dir
 
             settings = dict(settings)
-            run_dir = _report_dir(settings.pop("report_dir", None))   # check_projector's: written pass or fail
+            run_dir = checked_report_dir(settings.pop("report_dir", None))   # check_projector's: written pass or fail
             # the table was read at start-up (rootdir or --wirecheck-config): not again from the cwd
             report, images = run_check(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
             if run_dir is not None:

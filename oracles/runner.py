@@ -23,7 +23,7 @@ Drawing modes (:class:`RenderMode`, the core candidate only; the pixel level):
 - ``style="shaded"``: core's depth buffer (``Frame.depth_image``) against
   pyrender's rendering of the fan-triangulated faces (flat, no lights:
   coverage and depth only): silhouette IoU, and depth error within a derived
-  bound per pixel (oracles.judge.tolerances, oracles.judge.metrics.shaded_scores). A scene
+  bound per pixel (oracles.tolerances, oracles.judge.metrics.shaded_scores). A scene
   without faces has nothing to shade: only its vertices are checked, with a
   note.
 
@@ -44,7 +44,7 @@ size, cached for the worker's life) and loads a ``FILE.py:FUNC`` candidate
 itself from the spec string. Results are gathered in case order, so the report
 is the same for any number of jobs.
 
-Each scene's cases are framed on it (oracles.judge.cases: the cameras about its
+Each scene's cases are framed on it (oracles.cases: the cameras about its
 framing sphere, the run's turns about the framing centre); each record says
 how (``"framing"``). The report names the GL that drew the oracle's frames
 (``"oracle_gl"``: :meth:`oracles.references.pyrender_oracle.PyrenderOracle.gl_info`;
@@ -66,11 +66,15 @@ from wirecheck.core.transforms import Motion   # parameters only: the oracle's m
 from .judge import gate, metrics
 from .references import opencv_oracle
 from .judge.case import CaseResult, run_case
-from .judge.cases import Case, case_motion
+from .cases import Case, case_motion
 from .references.convert import model_matrix
 from .candidates.core_candidate import CoreCandidate, RenderMode
-from .datasets.executors import ExecutorSpec, gather_in_order, open_executor
-from .judge.tolerances import Tolerances
+from .executors import ExecutorSpec, gather_in_order, open_executor
+from .tolerances import Tolerances
+from .references.pyrender_oracle import OracleCache, gl_platform
+from wirecheck.core.errors import InputError
+from .cases import CASE_NAMES, cases_for
+from .candidates.candidate import load_candidate
 
 #: Oracle fidelity levels, cheapest first, and the oracles each one runs.
 LEVELS = ("vertices", "pixels")
@@ -91,7 +95,7 @@ def level_for_oracles(oracles) -> str:
 # ---------------------------------------------------------------- running cases, here or in workers
 
 @dataclass(frozen=True)
-class _RunParams:
+class RunParams:
     """What every case of a run shares; picklable (sent to workers)."""
 
     frames: int
@@ -105,7 +109,7 @@ class _RunParams:
     keep_points: bool = False   # the worst frame's points of each case, for worst_points.png (level vertices)
 
 
-class _CaseRunner:
+class CaseRunner:
     """Runs cases with cached resources: pyrender oracles by image size, loaded candidates by spec.
 
     One per process: the parent's (``jobs=1``) is closed at the end of the run;
@@ -120,8 +124,6 @@ class _CaseRunner:
     _DUMMY_EDGES = np.array([[0, 1]], dtype=np.intp)
 
     def __init__(self):
-        from .references.pyrender_oracle import OracleCache
-
         self.renderers = OracleCache()
         self.candidates = {}
         self.warm = False
@@ -130,8 +132,6 @@ class _CaseRunner:
         if not isinstance(ref, str):
             return ref
         if ref not in self.candidates:
-            from .candidates.candidate import load_candidate
-
             self.candidates[ref] = load_candidate(ref)
         return self.candidates[ref]
 
@@ -164,7 +164,7 @@ class _CaseRunner:
             metrics.pixel_scores(blank, blank)
         self.warm = True
 
-    def run(self, scene: Scene, case: Case, params: _RunParams) -> CaseResult:
+    def run(self, scene: Scene, case: Case, params: RunParams) -> CaseResult:
         candidate = self.candidate(params.candidate)
         if not self.warm:
             self.warm_up(case.camera, candidate, params.level)
@@ -183,51 +183,49 @@ class _CaseRunner:
         self.renderers.close()
 
 
-_WORKER_RUNNER: _CaseRunner | None = None
-_WORKER_LOCK = threading.Lock()
+_WORKER_RUNNER: CaseRunner | None = None
+WORKER_LOCK = threading.Lock()
 
 
-def _worker_init() -> None:
+def worker_init() -> None:
     global _WORKER_RUNNER
     from multiprocessing.util import Finalize
 
-    from .references.pyrender_oracle import gl_platform
-
     gl_platform()          # the parent's PYOPENGL_PLATFORM (crosscheck --gl), inherited; osmesa if unset
-    _WORKER_RUNNER = _CaseRunner()
+    _WORKER_RUNNER = CaseRunner()
     Finalize(_WORKER_RUNNER, _WORKER_RUNNER.close, exitpriority=10)   # free the GL contexts at exit
 
 
-def worker_runner() -> _CaseRunner:
+def worker_runner() -> CaseRunner:
     """This worker process's runner, made on first use (a Dask worker has no initializer)."""
     if _WORKER_RUNNER is None:
-        _worker_init()
+        worker_init()
     return _WORKER_RUNNER
 
 
-def _worker_run(scene: Scene, case: Case, params: _RunParams) -> CaseResult:
+def _worker_run(scene: Scene, case: Case, params: RunParams) -> CaseResult:
     from .candidates.subprocess_candidate import SubprocessCandidate, close_all_but
 
-    with _WORKER_LOCK:      # a Dask worker may run tasks in several threads: one GL user at a time
+    with WORKER_LOCK:      # a Dask worker may run tasks in several threads: one GL user at a time
         # a worker outlives a run on a Dask cluster: programs of earlier runs' candidates end here
         close_all_but(params.candidate if isinstance(params.candidate, SubprocessCandidate) else None)
         return worker_runner().run(scene, case, params)
 
 
-def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None,
+def _run_tasks(tasks, params: RunParams, jobs: int, on_result=None,
                isolate: bool = False, executor: ExecutorSpec | None = None) -> tuple[list[CaseResult], int]:
     """Results in task order, and the number of worker processes used (0: in this process).
 
     ``on_result(result)`` is called on each result as it is gathered, in task
     order (it may drop what it does not need to keep, e.g. frame images).
     ``isolate``: use a worker even for one job, so that the candidate cannot end this process.
-    ``executor`` (oracles.datasets.executors): where the tasks run (default: ``jobs`` local processes).
+    ``executor`` (oracles.executors): where the tasks run (default: ``jobs`` local processes).
     """
     on_result = on_result or (lambda result: None)
     spec = executor or ExecutorSpec(jobs=jobs)
-    with open_executor(spec, len(tasks), initializer=_worker_init, isolate=isolate) as (pool, workers):
+    with open_executor(spec, len(tasks), initializer=worker_init, isolate=isolate) as (pool, workers):
         if pool is None:
-            runner = _CaseRunner()
+            runner = CaseRunner()
             try:
                 results = []
                 for scene, case in tasks:
@@ -240,14 +238,10 @@ def _run_tasks(tasks, params: _RunParams, jobs: int, on_result=None,
 
 
 def scene_cases(scene: Scene, case_names, motion: Motion) -> list[Case]:
-    """The cases of ``scene`` named in ``case_names`` (framed on the scene, oracles.judge.cases.cases_for).
+    """The cases of ``scene`` named in ``case_names`` (framed on the scene, oracles.cases.cases_for).
 
     InputError when no camera fits the scene.
     """
-    from wirecheck.core.errors import InputError
-
-    from .judge.cases import CASE_NAMES, cases_for
-
     try:
         cases = cases_for(scene, motion, calibrated=bool(set(case_names) - set(CASE_NAMES)))
     except InputError as exc:
@@ -255,7 +249,7 @@ def scene_cases(scene: Scene, case_names, motion: Motion) -> list[Case]:
     return [case for case in cases if case.name in case_names]
 
 
-def _overall_ms(timing_cases: list[dict], key: str):
+def overall_ms(timing_cases: list[dict], key: str):
     """Time per frame over all cases (weighted by the frames each case timed)."""
     rows = [t for t in timing_cases if key in t]
     frames = sum(t["frames_timed"] for t in rows)
@@ -305,16 +299,14 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     worker processes even for ``jobs=1``: a candidate that ends its process
     (``os._exit(0)``) raises BrokenProcessPool here instead of ending the run
     with status 0; the candidate must then be given as ``candidate_spec``.
-    ``executor`` (:class:`oracles.datasets.executors.ExecutorSpec`) sends the cases to
+    ``executor`` (:class:`oracles.executors.ExecutorSpec`) sends the cases to
     a Dask cluster instead (same report; ``jobs`` is then the spec's).
 
-    ``cases``: fixed cameras (:class:`oracles.judge.cases.Case`, distinct names),
+    ``cases``: fixed cameras (:class:`oracles.cases.Case`, distinct names),
     each scene run under every one of them instead of the cameras framed on it
     (``case_names`` must then be None; the spec suite, oracles.spec, places its
     cameras as the specification does).
     """
-    from wirecheck.core.errors import InputError
-
     if oracles is not None:
         implied = level_for_oracles(oracles)
         if level is not None and level != implied:
@@ -351,7 +343,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     is_core = isinstance(candidate, CoreCandidate)
     ref = candidate if is_core or candidate_spec is None else candidate_spec
     keep_frames = animation and level == "pixels"
-    params = _RunParams(frames=frames, every=every, level=level, motion=motion, tol=tol, candidate=ref,
+    params = RunParams(frames=frames, every=every, level=level, motion=motion, tol=tol, candidate=ref,
                         mode=mode, keep_frames=keep_frames, keep_points=level == "vertices")
     worst = _WorstCase(mode)
     n_frames = len(tasks) * inputs.frames_checked
@@ -396,18 +388,18 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     vertex_errs = [r["max_vertex_error_px"] for r in records if r.get("max_vertex_error_px") is not None]
     f1_0 = [r["pixel_f1_0px"] for r in records if r.get("pixel_f1_0px") is not None]
     f1_1 = [r["pixel_f1_1px"] for r in records if r.get("pixel_f1_1px") is not None]
-    timing = {"vertex_stage_ms_per_frame": _overall_ms(timing_cases, "vertex_stage_ms_per_frame")}
+    timing = {"vertex_stage_ms_per_frame": overall_ms(timing_cases, "vertex_stage_ms_per_frame")}
     if level == "pixels":
-        timing["pixel_stage_ms_per_frame"] = _overall_ms(timing_cases, "pixel_stage_ms_per_frame")
+        timing["pixel_stage_ms_per_frame"] = overall_ms(timing_cases, "pixel_stage_ms_per_frame")
     for key in ("candidate_ms_per_frame", "candidate_project_ms_per_frame", "opencv_ms_per_frame",
                 "harness_ms_per_frame", "oracles_ms_per_frame"):
-        timing[key] = _overall_ms(timing_cases, key)
+        timing[key] = overall_ms(timing_cases, key)
     oracles_ms = timing["oracles_ms_per_frame"]
     # issue 12's target is <= 0.15; reported on every run, never gated (a timing)
     timing["harness_overhead_ratio"] = (timing["harness_ms_per_frame"] / oracles_ms) if oracles_ms else None
     if level == "pixels":
         for key in ("candidate_draw_ms_per_frame", "pyrender_ms_per_frame", "pixel_metrics_ms_per_frame"):
-            timing[key] = _overall_ms(timing_cases, key)
+            timing[key] = overall_ms(timing_cases, key)
     timing.update({"executor": executor.kind if executor else "local", "jobs": jobs, "workers": workers, "wall_s": time.perf_counter() - t_run,
                    "cases": timing_cases})
     summary = {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,

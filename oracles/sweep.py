@@ -2,7 +2,7 @@
 
 The settings are dtype x clip mode x raster mode (2 x 2 x 3 = 12). Each is run
 on the bundled scenes and on a large mesh (an icosphere) under every case
-camera (oracles/judge/cases.py). The oracles' answers do not depend on the setting,
+camera (oracles/cases.py). The oracles' answers do not depend on the setting,
 so each frame's references are computed once and shared:
 
 * OpenCV's ``projectPoints`` of the frame's world points (vertex reference);
@@ -45,8 +45,10 @@ from wirecheck.core.transforms import Motion
 from .references import faces as oface
 from .judge import metrics
 from .references import opencv_oracle
-from .judge.cases import CASE_NAMES, case_motion, cases_for
+from .cases import CASE_NAMES, case_motion, cases_for
 from .reports.report import gl_text
+from .references.pyrender_oracle import OracleCache
+from wirecheck.core.outputs.output import FrameDir, json_dumps
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -97,8 +99,6 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     frame_ids = list(range(1, frames + 1, every))
     acc = {s.key: {"err": [], "f1_0": [], "f1_1": [], "t": {"bundled": [], "large": []},
                    "cand_only": 0, "orac_only": 0} for s in settings}
-    from .references.pyrender_oracle import OracleCache
-
     oracles = OracleCache()
     try:
         for group, scene in groups:
@@ -304,8 +304,6 @@ def write_sweep(run_dir, sweep: dict) -> None:
     """``sweep.json`` (timings under each row's ``timing``), ``sweep.md``, ``sweep.html``, ``sweep.png``; atomic."""
     import tempfile
     from pathlib import Path
-
-    from wirecheck.core.outputs.output import FrameDir, json_dumps
 
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)

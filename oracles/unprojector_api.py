@@ -14,7 +14,7 @@ projector contract's (:mod:`wirecheck.oracles.candidates.candidate`: ``K``, ``R`
 Every bundled scene (or those given) under every case camera: the visible surface points
 of each frame (oracles.judge.unproject_points) against the exact inverse
 (oracles.references.unproject_reference; OpenCV's undistortion for a camera with a lens),
-each point within ``oracles.judge.tolerances.unproject_bound`` (eps of the answer's precision
+each point within ``oracles.tolerances.unproject_bound`` (eps of the answer's precision
 times the point's scale, never under 1e-6 px at its depth). A failing case's fault is named
 by oracles.diagnosis.unproject_faults. A ``"FILE.py:FUNC"`` unprojector runs in its own process
 (the candidate host, oracles.candidates.candidate_host): an ``os._exit`` or a crash fails its
@@ -33,8 +33,8 @@ from .candidates.candidate import load_candidate
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, SubprocessCandidate, closing_started
 from .diagnosis.unproject_faults import name_unproject_faults
 from .judge import gate
-from .judge.cases import case_motion, cases_for
-from .judge.tolerances import unproject_bound
+from .cases import case_motion, cases_for
+from .tolerances import unproject_bound
 from .judge.unproject_points import DEFAULT_STRIDE, surface_samples
 from .reports.fault_text import below_table, case_cell, cell
 
@@ -59,7 +59,7 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
     frames : int
         Frames of each scene's motion per case (default 2).
     cases : sequence of str, optional
-        Names from :data:`wirecheck.oracles.judge.cases.ALL_CASE_NAMES` (default: the default
+        Names from :data:`wirecheck.oracles.cases.ALL_CASE_NAMES` (default: the default
         seven; ``"calibrated"`` adds the calibrated ones, the distorted lens included).
     turns : (3,) tuple of float
         The scenes' spin, full turns about X, Y, Z over the run.

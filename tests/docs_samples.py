@@ -49,6 +49,7 @@ import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
+import functools
 
 ROOT = Path(__file__).resolve().parent.parent
 ELISION = "..."
@@ -256,9 +257,8 @@ def matches(expected: list[str], actual: list[str], numbers: bool = False) -> bo
     exp = [ELISION if e.strip() == ELISION else normalise(e, numbers) for e in expected]
     act = [normalise(a, numbers) for a in actual]
     # memoised two-pointer match with the elision as a wildcard over whole lines
-    from functools import lru_cache
 
-    @lru_cache(maxsize=None)
+    @functools.cache
     def ok(i: int, j: int) -> bool:
         if i == len(exp):
             return j == len(act)

@@ -11,7 +11,7 @@ DATA = Path(__file__).parent / "data"
 
 def test_correct_external_projector_passes():
     report = assert_projector(f"{DATA / 'user_projector.py'}:project", scenes=["cube"], frames=3)
-    # float64 on both sides: ~1e-11 px at most (oracles/judge/tolerances.py derivation)
+    # float64 on both sides: ~1e-11 px at most (oracles/tolerances.py derivation)
     assert report["verdict"] == "pass" and report["summary"]["max_vertex_error_px"] < 1e-9
 
 

@@ -10,14 +10,13 @@ off_centre, non_square_pixels (pyrender's IntrinsicsCamera) and distorted
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
 
 from wirecheck.core.projector import clipping
 from wirecheck.core.app import trace
-from wirecheck.core.camera import Camera, camera_z, look_at
+from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.conventions import focal_px
 from wirecheck.core.projector.distortion import distort
 from wirecheck.core.errors import InputError
@@ -279,7 +278,7 @@ def test_crosscheck_calibrated_cases(tmp_path):
 
 
 def LENS_OF_CASES():  # noqa: N802
-    from wirecheck.oracles.judge.cases import DISTORTION
+    from wirecheck.oracles.cases import DISTORTION
     return DISTORTION
 
 
@@ -323,7 +322,7 @@ def test_faults_of_calibrated_candidates_through_crosscheck():
 
 def test_export_calibrated_cases_and_refuses_a_lens(tmp_path):
     from wirecheck.core.scene.files import load_scene
-    from wirecheck.oracles.judge.cases import CASE_NAMES
+    from wirecheck.oracles.cases import CASE_NAMES
     from wirecheck.oracles.candidates.export import build_job
 
     job, files = build_job([load_scene("cube")], frames=2)
@@ -337,7 +336,7 @@ def test_export_calibrated_cases_and_refuses_a_lens(tmp_path):
 
 def test_calibrated_cases_run_only_when_named():
     """The default set is the seven FOV cases: a FOV-only projector's verdicts do not change."""
-    from wirecheck.oracles.judge.cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES, cameras_for
+    from wirecheck.oracles.cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES, cameras_for
     from wirecheck.oracles.judge.gate import resolve_cases
 
     assert CASE_NAMES == ("on_axis", "oblique_roll", "near_plane", "wide_fov", "narrow_fov", "non_square",
@@ -393,7 +392,7 @@ def test_wrappers_that_take_the_cameras_matrices():
     from pathlib import Path
 
     from wirecheck.oracles.api import check_projector
-    from wirecheck.oracles.judge.cases import ALL_CASE_NAMES
+    from wirecheck.oracles.cases import ALL_CASE_NAMES
 
     spec = str(Path(__file__).parent / "data" / "matrix_projectors.py")
     rep = check_projector(f"{spec}:opencv_style", scenes=["cube"], frames=3, cases=list(ALL_CASE_NAMES))

@@ -17,7 +17,7 @@ import pytest
 
 from wirecheck.oracles import cli
 from wirecheck.oracles.references import opencv_oracle
-from wirecheck.oracles.judge.cases import cameras_for
+from wirecheck.oracles.cases import cameras_for
 from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate
 
 from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)

@@ -189,7 +189,7 @@ def test_float32_matrix_projector_keeps_its_clipped_ends():
     (case,) = report["cases"]
     assert case["verdict"] == "pass", case["reasons"]
     assert "line_pixel_bias" not in {f["name"] for f in case["faults"]}
-    planes = probe_planes(gl_float32_matrix.project, wirecheck.oracles.judge.cases.cases_for(_cube(0.9))[2].camera)
+    planes = probe_planes(gl_float32_matrix.project, wirecheck.oracles.cases.cases_for(_cube(0.9))[2].camera)
     assert case["clipped_ends"]["inward_depth"] > 0 and "float32 rounding" in case["clipped_ends"]["reason"]
     assert planes["near_fit"] > case["camera_spec"]["near"]
     # said in report.md's Notes

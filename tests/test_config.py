@@ -158,7 +158,7 @@ def test_crosscheck_config_option_names_the_file(tmp_path, monkeypatch, capsys):
 
 
 def test_suite_and_sweep_leave_the_table_alone(tmp_path, monkeypatch):
-    from wirecheck.oracles.judge.cases import CASE_NAMES
+    from wirecheck.oracles.cases import CASE_NAMES
     from wirecheck.oracles.config import parse_cli
 
     _project(tmp_path, 'candidate = "proj.py:project"\ncases = ["on_axis"]\nframes = 3\n')

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from wirecheck.oracles import cli
-from wirecheck.oracles.judge.cases import CASE_NAMES
+from wirecheck.oracles.cases import CASE_NAMES
 from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
@@ -30,7 +30,7 @@ def test_core_passes_every_case_and_report_has_the_fields(tmp_path, capsys):
     for case in report["cases"]:
         assert CASE_KEYS <= set(case)
         assert case["faults"] == [] and case["verdict"] == "pass"
-        # float64 on both sides: ~1e-11 px is the derived scale (oracles/judge/tolerances.py)
+        # float64 on both sides: ~1e-11 px is the derived scale (oracles/tolerances.py)
         assert case["max_vertex_error_px"] < 1e-9
         assert case["pixel_f1_1px"] == 1.0
     assert set(report["timing"]) >= {"opencv_ms_per_frame", "pyrender_ms_per_frame", "candidate_ms_per_frame"}
@@ -189,7 +189,7 @@ def test_per_frame_errors_and_precision_recall_at_0px(tmp_path):
     assert max(f["max_vertex_error_px"] for f in case["per_frame"]) == case["max_vertex_error_px"]
     assert case["pixel_f1_0px"] == min(f["f1_0px"] for f in case["per_frame"])
     for key in ("pixel_precision_0px", "pixel_recall_0px"):
-        assert 0.98 <= case[key] <= 1.0          # measured >= 0.9958 (oracles/judge/tolerances.py)
+        assert 0.98 <= case[key] <= 1.0          # measured >= 0.9958 (oracles/tolerances.py)
 
 
 def test_empty_scene_is_vacuous_and_fails_unless_allowed(tmp_path):

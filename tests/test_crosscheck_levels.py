@@ -203,7 +203,7 @@ def test_core_candidate_is_a_small_frozen_picklable_dataclass():
 
 def test_core_settings_reach_render_frame(monkeypatch):
     from wirecheck.core.projector import pipeline
-    from wirecheck.oracles.judge.cases import cameras_for
+    from wirecheck.oracles.cases import cameras_for
 
     calls = []
 
@@ -238,7 +238,7 @@ def test_clip_endpoint_reaches_core_and_the_pixel_oracle_sees_it(tmp_path):
                           "--cases", "near_plane,on_axis")
     assert code == 1
     assert report["candidate_settings"] == {"dtype": "float64", "clip": "endpoint", "raster": "exact"}
-    on_axis, near = report["cases"]          # cases run in the order of oracles.judge.cases.CASE_NAMES
+    on_axis, near = report["cases"]          # cases run in the order of oracles.cases.CASE_NAMES
     assert near["max_vertex_error_px"] < 1e-9 and near["pixel_f1_1px"] < 0.9      # measured 0.72
     assert on_axis["verdict"] == "pass" and on_axis["pixel_f1_1px"] == 1.0     # nothing to clip there
 

@@ -1,6 +1,6 @@
 """crosscheck --hidden-lines, --cull backface, --style shaded and scenes of several objects.
 
-Every bound below is the derived one of oracles/judge/tolerances.py (the numbers in
+Every bound below is the derived one of oracles/tolerances.py (the numbers in
 comments are measured, core against pyrender/OSMesa on this machine's llvmpipe).
 """
 
@@ -13,7 +13,7 @@ import pytest
 
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.oracles import cli
-from wirecheck.oracles.judge import tolerances
+from wirecheck.oracles import tolerances
 from wirecheck.oracles.candidates.core_candidate import CoreCandidate, RenderMode
 from wirecheck.oracles.runner import run_crosscheck
 from helpers import run_crosscheck as run

@@ -302,10 +302,10 @@ def dask_scheduler() -> str:
 
     from distributed import LocalCluster
 
-    from wirecheck.oracles.datasets.executors import _environ_kept
+    from wirecheck.oracles.executors import _environ_kept
 
     # the nanny leaves OPENBLAS_NUM_THREADS=1 & co. in this process's environment, for every later
-    # test's subprocess (oracles.datasets.executors._environ_kept): put back once the workers have started
+    # test's subprocess (oracles.executors._environ_kept): put back once the workers have started
     with _environ_kept():
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                dashboard_address=None, silence_logs=logging.CRITICAL)

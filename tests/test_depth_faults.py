@@ -26,7 +26,7 @@ from wirecheck.core.transforms import Motion
 from wirecheck.oracles.candidates.depth_map import depth_from_array, read_depth_map
 from wirecheck.oracles.diagnosis.depth_faults import DEPTH_FAULTS, LIMITS, name_depth_faults
 from wirecheck.oracles.faults import CATALOGUE, Fault
-from wirecheck.oracles.judge.cases import cases_for
+from wirecheck.oracles.cases import cases_for
 from wirecheck.oracles.judge.metrics import depth_bound
 
 SCENES = ("cube", "prism", "pyramid")

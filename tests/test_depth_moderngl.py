@@ -24,7 +24,7 @@ from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.candidates.depth_map import read_depth_map
 from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
-from wirecheck.oracles.judge.cases import case_motion, cases_for
+from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.judge.depth_reference import reference_depth
 
 PROBE = "import moderngl; moderngl.create_standalone_context(backend='egl').release()"

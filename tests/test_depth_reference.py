@@ -3,7 +3,7 @@
 Core's depth buffer (core.projector.zbuffer: linear ``z_cam``, float64) is the reference the
 depth-fault tests use (tests/test_depth_faults.py); here it is held to pyrender's 24-bit
 depth read and made linear in float64, within the per-pixel bound derived in
-oracles.judge.tolerances, on every bundled scene and default case camera, and the named
+oracles.tolerances, on every bundled scene and default case camera, and the named
 faults are the same against either reference. Skipped where OSMesa is missing (the
 ``oracle`` fixtures' rule).
 """
@@ -16,9 +16,9 @@ import pytest
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
-from wirecheck.oracles.judge.cases import case_motion, cases_for
+from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.judge.depth_reference import reference_depth
-from wirecheck.oracles.judge.tolerances import MIN_SILHOUETTE_IOU
+from wirecheck.oracles.tolerances import MIN_SILHOUETTE_IOU
 
 from test_depth_faults import judge, mistakes, pixel_mistakes
 

@@ -23,7 +23,7 @@ from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.diagnosis.clip_planes import probe_planes
 from wirecheck.oracles.diagnosis.diagnose import diagnose, primary
 from wirecheck.oracles.faults import NAMES as FAULT_ORDER, names as fault_names
-from wirecheck.oracles.judge.tolerances import vertex_bound, vertex_scale
+from wirecheck.oracles.tolerances import vertex_bound, vertex_scale
 
 from diagnosis_faults import (  # the faulty projectors and their cameras
     CAMERAS, LENS_PINCUSHION, LENS_CAMERAS, CALIBRATED_CAMERAS, _with, _project, f_none, f_swap, implied_fov,
@@ -95,7 +95,7 @@ def points_for(camera_name):
 
 
 def float32_bound(pts, cam, ref) -> float:
-    """The float32 vertex bound of these points (oracles.judge.tolerances: derived from eps32 and the scene's scale)."""
+    """The float32 vertex bound of these points (oracles.tolerances: derived from eps32 and the scene's scale)."""
     return vertex_bound("float32", vertex_scale(pts, ref, cam), TOL)
 
 

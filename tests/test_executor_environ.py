@@ -1,4 +1,4 @@
-"""oracles.datasets.executors: a local pool's workers start with one BLAS/OpenMP thread each.
+"""oracles.executors: a local pool's workers start with one BLAS/OpenMP thread each.
 
 The pool runs a process per job; OpenBLAS threads in each would spin against
 the other workers. As Dask's nanny does for its workers, the variables are set
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 
-from wirecheck.oracles.datasets.executors import ExecutorSpec, open_executor
+from wirecheck.oracles.executors import ExecutorSpec, open_executor
 
 KEYS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 

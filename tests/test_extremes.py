@@ -20,7 +20,7 @@ from wirecheck.oracles import extremes
 from wirecheck.oracles.extremes import bounds, cases, measure
 from wirecheck.oracles.extremes import EXTREME_CASES, extremes_markdown, run_case, run_extremes
 from wirecheck.oracles.references.pyrender_oracle import osmesa_available
-from wirecheck.oracles.judge.tolerances import MIN_F1_1PX_EXTREMES
+from wirecheck.oracles.tolerances import MIN_F1_1PX_EXTREMES
 
 HAVE_OSMESA = osmesa_available()[0]
 

@@ -15,7 +15,7 @@ from test_line_style import _fill, _judge, draw_wide, job_dir  # noqa: F401 - jo
 
 from wirecheck.oracles.judge import f1_radius
 from wirecheck.oracles.judge.decide import reasons
-from wirecheck.oracles.judge.tolerances import Tolerances
+from wirecheck.oracles.tolerances import Tolerances
 
 
 @pytest.mark.parametrize("style, width, radius", [

@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from wirecheck.core.outputs.frame_writer import ForkedPngWriter, can_fork
+from wirecheck.core.outputs.frame_writer import ForkedPngWriter
 from wirecheck.core.outputs.output import MARKER, is_bilevel, png_bytes
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")

@@ -22,7 +22,7 @@ import pytest
 
 from wirecheck.core.projector import raster
 from wirecheck.core.scene.files import load_scene
-from wirecheck.oracles.judge import tolerances
+from wirecheck.oracles import tolerances
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.judge.frames_judge import diagnosis_frames, run_frames
 from wirecheck.oracles.runner import CoreCandidate, Tolerances, run_crosscheck

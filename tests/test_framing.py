@@ -1,4 +1,4 @@
-"""Case cameras framed on the scene (oracles.judge.cases.framing): a mesh far from the origin fills the image."""
+"""Case cameras framed on the scene (oracles.cases.framing): a mesh far from the origin fills the image."""
 
 import math
 
@@ -10,7 +10,7 @@ from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.references import faces as oface
 from wirecheck.oracles.references import opencv_oracle
-from wirecheck.oracles.judge.cases import case_motion, cases_for, framing
+from wirecheck.oracles.cases import case_motion, cases_for, framing
 from wirecheck.oracles.references.convert import model_matrix
 from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 from helpers import run_crosscheck

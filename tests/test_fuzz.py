@@ -120,9 +120,9 @@ COMPLETE = {
     "binary.stl": b"\0" * 80 + (2).to_bytes(4, "little") + _TRIANGLE * 2,
     "ascii.stl": ("solid s\n" + "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
                   "endloop\nendfacet\nendsolid s\n").encode(),
-    "ascii.ply": ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
-                  "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
-                  "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n").encode(),
+    "ascii.ply": (b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                  b"element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                  b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n"),
     "mesh.off": b"OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
 }
 

@@ -89,7 +89,7 @@ def test_tls_scheduler_without_certificates_is_an_input_error(tmp_path, capsys):
 
 def test_local_dask_cluster_starts_no_more_workers_than_tasks(monkeypatch):
     # --executor dask --jobs 8 for 1 task: 1 worker process, as the local process pool does.
-    from wirecheck.oracles.datasets import executors
+    from wirecheck.oracles import executors
 
     seen = {}
 

@@ -17,7 +17,7 @@ import pytest
 
 from wirecheck.core.camera import look_at
 from wirecheck.core.errors import InputError
-from wirecheck.oracles.judge import cases as cases_mod
+from wirecheck.oracles import cases as cases_mod
 from wirecheck.oracles import cli
 from wirecheck.oracles.judge import gate
 from wirecheck.oracles.api import assert_projector, check_projector

@@ -100,8 +100,8 @@ def test_fixture_without_osmesa_fails_with_one_line_not_a_traceback(tmp_path):
 def test_viewer_overlay_without_osmesa_says_which_library_in_the_page():
     # the viewer's page shows the overlay's error in its banner: the missing library and its fix,
     # not "see the server's stderr" (the browser is often not where the terminal is)
-    code = ("from wirecheck.core.app.viewer import _LazyOverlay\n"
-            "print(_LazyOverlay()(None, None, 1)['error'])\n")
+    code = ("from wirecheck.core.app.viewer import LazyOverlay\n"
+            "print(LazyOverlay()(None, None, 1)['error'])\n")
     done = _run([sys.executable, "-c", code], "OSMesa", cwd=ROOT)
     line = _one_line_with_fix(done.stdout, "libOSMesa cannot be loaded", OSMESA_FIX)
     assert line.startswith("the oracle overlay is not available: libOSMesa"), done.stdout + done.stderr

@@ -66,7 +66,7 @@ def test_arguments_given_in_other_reasonable_forms_work():
     # a Path for one scene, a string for one oracle, numpy arrays of names, a numpy integer of frames
     report = check_projector(project_points, scenes=Path(DATA.parent.parent / "scenes" / "cube.scene"),
                              frames=np.int64(1), cases=np.array(["on_axis"]), oracles="opencv", isolate=False)
-    # float64 on both sides: ~1e-11 px at most (oracles/judge/tolerances.py derivation)
+    # float64 on both sides: ~1e-11 px at most (oracles/tolerances.py derivation)
     assert report["verdict"] == "pass" and report["level"] == "vertices"
     assert report["compared"] == {"cases": 1, "frames": 1, "vertices": 8, "pixels": None}
     assert report["summary"]["max_vertex_error_px"] < 1e-9

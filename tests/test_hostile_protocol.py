@@ -20,7 +20,7 @@ import pytest
 from wirecheck.oracles import cli
 from wirecheck.oracles.candidates import subprocess_candidate
 from wirecheck.oracles.candidates.candidate import CandidateError, call_candidate
-from wirecheck.oracles.judge.cases import cameras_for
+from wirecheck.oracles.cases import cameras_for
 from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate
 
 from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)

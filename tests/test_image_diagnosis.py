@@ -26,7 +26,7 @@ from test_diagnosis import format_confusion
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector.projection import project_points
-from wirecheck.core.projector.raster import line_coverage_aa, line_pixels
+from wirecheck.core.projector.raster import line_coverage_aa
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.diagnosis.diagnose import primary
@@ -265,13 +265,13 @@ def test_a_case_of_many_frames_is_fitted_on_the_points_of_six(fault, monkeypatch
     from wirecheck.oracles.diagnosis import image_diagnose
 
     sizes = []
-    init = image_diagnose._Registration.__init__
+    init = image_diagnose.Registration.__init__
 
     def counting(self, frames, *args):
         init(self, frames, *args)
         sizes.append((len(frames), len(self._cand), len(self._samples)))
 
-    monkeypatch.setattr(image_diagnose._Registration, "__init__", counting)
+    monkeypatch.setattr(image_diagnose.Registration, "__init__", counting)
     cam = CAMERAS["oblique"]
     fn, want = FAULTS[fault]
     sc = load_scene("cube")

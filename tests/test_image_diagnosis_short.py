@@ -21,7 +21,7 @@ from wirecheck.core.camera import Camera
 from wirecheck.core.projector.projection import project_points
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles.judge.cases import case_motion, cases_for
+from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.diagnosis.diagnose import primary
 from wirecheck.oracles.faults import NAMES as FAULT_ORDER
 from wirecheck.oracles.candidates.draw import draw_candidate

@@ -1,4 +1,4 @@
-"""oracles.diagnosis.image_diagnose's correspondences, against a point-by-point reference.
+"""oracles.diagnosis.registration's correspondences, against a point-by-point reference.
 
 The ICP fit pairs every candidate pixel with the nearest point of its own
 frame's oracle lines, and every oracle sample with its frame's nearest drawn
@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from wirecheck.core.camera import Camera
-from wirecheck.oracles.diagnosis import image_diagnose
-from wirecheck.oracles.diagnosis.image_diagnose import PERMUTATIONS, _frames, _Registration
+from wirecheck.oracles.diagnosis import registration
+from wirecheck.oracles.diagnosis.registration import PERMUTATIONS, Registration, frame_samples
 
 W, H = 64, 48
 
@@ -55,16 +55,16 @@ def _point_to_segments(q, seg):
     return best
 
 
-@pytest.mark.parametrize("stack_limit", [image_diagnose.STACK_LIMIT, 0], ids=["stacked", "frame_by_frame"])
+@pytest.mark.parametrize("stack_limit", [registration.STACK_LIMIT, 0], ids=["stacked", "frame_by_frame"])
 @pytest.mark.parametrize("names", [(), ("axis_swap", "mirror_vertical")])
 def test_pairs_are_each_frames_own_nearest(monkeypatch, stack_limit, names):
-    monkeypatch.setattr(image_diagnose, "STACK_LIMIT", stack_limit)
+    monkeypatch.setattr(registration, "STACK_LIMIT", stack_limit)
     rng = np.random.default_rng(7)
     cam = _camera()
     images, segs = _case(rng)
-    frames = _frames(images, segs, cam)
+    frames = frame_samples(images, segs, cam)
     centre = np.array(cam.principal_point)
-    reg = _Registration(frames, W, H, centre)
+    reg = Registration(frames, W, H, centre)
     p = PERMUTATIONS[names]
     a, b = np.diag([1.1, 0.9]), np.array([0.7, -0.4])
     u, c, dist, tangent, n_fwd, n_rev = reg.pairs(p, a, b)
@@ -114,7 +114,7 @@ def test_the_nearest_pixel_map_is_exact_within_the_pairs_reach(where):
     # distance to the nearest drawn pixel wherever that is within the cap plus a rounded sample's
     # 0.71 px (pairs the fit can keep); farther away, the map's pixel is farther than that too
     # (the pair is dropped and the cost capped, whichever pixel it is)
-    from wirecheck.oracles.diagnosis.image_diagnose import PAIR_CAP_PX, _nearest_pixel_map
+    from wirecheck.oracles.diagnosis.registration import PAIR_CAP_PX, _nearest_pixel_map
 
     rng = np.random.default_rng(3)
     img = np.zeros((90, 120), bool)
@@ -145,12 +145,12 @@ def test_oracle_samples_reach_half_the_image_beyond_each_side():
     # is sampled exactly across the grown image, [-0.5 - W/2, W - 0.5 + W/2] (clip_to_image's pixel-edge
     # bounds, shifted), at SAMPLE_STEP_PX = 0.5 px: 2 W / 0.5 steps, 4 W + 1 samples; likewise for H
     horizontal = np.array([[[-10.0 * W, 20.25], [11.0 * W, 20.25]]])
-    pts, tangents = image_diagnose._samples(horizontal, W, H)
+    pts, tangents = registration._samples(horizontal, W, H)
     assert len(pts) == 4 * W + 1
     assert pts[0] == pytest.approx([-0.5 - W / 2, 20.25]) and pts[-1] == pytest.approx([W - 0.5 + W / 2, 20.25])
     assert np.allclose(np.diff(pts[:, 0]), 0.5) and np.allclose(tangents, [1.0, 0.0])
     vertical = np.array([[[30.25, 9.0 * H], [30.25, -12.0 * H]]])        # drawn upward: samples run from the start
-    pts, tangents = image_diagnose._samples(vertical, W, H)
+    pts, tangents = registration._samples(vertical, W, H)
     assert len(pts) == 4 * H + 1
     assert pts[0] == pytest.approx([30.25, H - 0.5 + H / 2]) and pts[-1] == pytest.approx([30.25, -0.5 - H / 2])
     assert np.allclose(tangents, [0.0, -1.0])

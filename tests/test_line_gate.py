@@ -16,7 +16,8 @@ import pytest
 
 from wirecheck.core.projector import raster
 from wirecheck.core.scene.files import load_scene
-from wirecheck.oracles.judge import metrics, tolerances
+from wirecheck.oracles.judge import metrics
+from wirecheck.oracles import tolerances
 from wirecheck.oracles.diagnosis.diagnose import diagnose_lines
 from wirecheck.oracles.runner import CoreCandidate, RenderMode, Tolerances, run_crosscheck
 
@@ -84,14 +85,14 @@ def test_line_failures_and_diagnosis_on_a_summary():
              "edge_count_worst": {"frame": 1, "edge": 0, "diff": -1}, "lines_compared": 300,
              "one_sided_by_place": {"start": [0, 0], "end": [0, 290], "middle": [10, 0], "stray": [0, 0]}}
     # net -280 / 40000 = -0.7 % (> 0.1 %), p ~ 1e-70 (< 1e-3)
-    assert len(metrics.line_failures(lines, tol)) == 1
+    assert len(tolerances.line_failures(lines, tol)) == 1
     (fault,) = diagnose_lines(lines, tol)
     assert fault["name"] == "line_end_bias" and fault["end"] == "last"
     assert fault["pixels_per_line"] == -290 / 300
     middle = {**lines, "one_sided_by_place": {"start": [0, 0], "end": [0, 0], "middle": [10, 290], "stray": [0, 0]}}
     assert diagnose_lines(middle, tol)[0]["name"] == "line_pixel_bias"
     balanced = {**lines, **metrics.balance_scores(150, 150, 40000)}
-    assert metrics.line_failures(balanced, tol) == [] and diagnose_lines(balanced, tol) == []
+    assert tolerances.line_failures(balanced, tol) == [] and diagnose_lines(balanced, tol) == []
 
 
 # ---------------------------------------------------------------- the gate against the mutants

@@ -23,7 +23,7 @@ from wirecheck.oracles.cli import main
 from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 from wirecheck.oracles.judge import line_model
 from wirecheck.oracles.judge.frames_judge import run_frames
-from wirecheck.oracles.judge.tolerances import Tolerances
+from wirecheck.oracles.tolerances import Tolerances
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "clients"))
 import heldout_draw as hd  # noqa: E402

@@ -1,7 +1,7 @@
 """Sub-pixel ties in the line gate (oracles.judge.line_ties): what is excused, and what is not.
 
 Hand-built frames first (expected values worked out in the comments from the
-rule in oracles/judge/tolerances.py: a tie when the segment crosses the pixel's row
+rule in oracles/tolerances.py: a tie when the segment crosses the pixel's row
 within (1 + |m|) TIE_END_PX = (1 + |m|) 2^-8 px of the pixel's edge, and the
 other image drew the pixel across that edge); then crosscheck end to end: the
 generated cylinder that showed the false alarm passes, and lines drawn 1 px
@@ -13,12 +13,13 @@ import pytest
 
 from wirecheck.core.projector import raster
 from wirecheck.core.scene.files import load_scene
-from wirecheck.oracles.judge import line_ties, metrics, tolerances
+from wirecheck.oracles.judge import line_ties, metrics
+from wirecheck.oracles import tolerances
 from wirecheck.oracles.runner import CoreCandidate, run_crosscheck
 
 from raster_mutants import drop_last
 
-E = 2.0 ** -8          # TIE_END_PX: 2^-9 snap + 2^-9 float32 (oracles/judge/tolerances.py)
+E = 2.0 ** -8          # TIE_END_PX: 2^-9 snap + 2^-9 float32 (oracles/tolerances.py)
 
 
 def test_tie_end_px_is_the_derived_value():
@@ -113,7 +114,7 @@ def test_a_shifted_or_thicker_line_is_not_a_tie():
     s = metrics.line_scores(thick, oracle, p0, p1)
     assert (s["candidate_only"], s["oracle_only"], s["subpixel_ties"]) == (21, 0, [0, 0])
     lines = metrics.line_summary([(1, s)])
-    assert lines["imbalance"] == 21 and metrics.line_failures(lines, tolerances.Tolerances())
+    assert lines["imbalance"] == 21 and tolerances.line_failures(lines, tolerances.Tolerances())
 
 
 # ---------------------------------------------------------------- end to end

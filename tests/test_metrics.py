@@ -315,10 +315,10 @@ def _is_end_tie(c, a, b, w, h, end_px=2.0 ** -8):
 
 def _ends_naive(cand, oracle, p0, p1, reach=1.5):
     """end_attribution's definition, pixel by pixel: the nearest segment (clipped to the image's edges)."""
-    from wirecheck.oracles.judge.segment_pixels import clip_segments
+    from wirecheck.oracles.segment_geometry import clip_to_box
 
     h, w = cand.shape
-    ok, q0, q1 = clip_segments(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
+    ok, q0, q1 = clip_to_box(p0, p1, np.array([-0.5, -0.5]), np.array([w - 0.5, h - 0.5]))
     q0, q1 = q0[ok], q1[ok]
     out = {k: [0, 0] for k in ("start", "end", "middle", "stray", "tie")}
     other = (oracle, cand)

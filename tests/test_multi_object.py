@@ -177,7 +177,7 @@ def test_bad_mesh_inside_a_scene_names_both_files(tmp_path):
     with pytest.raises(InputError) as info:
         load_scene(str(p))
     msg = str(info.value)
-    assert msg.startswith(f"{p}:2: mesh 'broken.obj': ") and f"broken.obj:2:" in msg and "'zz'" in msg
+    assert msg.startswith(f"{p}:2: mesh 'broken.obj': ") and "broken.obj:2:" in msg and "'zz'" in msg
 
 
 def test_bad_object_file_through_the_cli(tmp_path):

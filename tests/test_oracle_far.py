@@ -132,10 +132,10 @@ def test_a_case_beyond_the_oracles_precision_is_named_and_does_not_blame_the_can
     from wirecheck.core.scene.files import load_scene
     from wirecheck.core.transforms import Motion
     from wirecheck.oracles.judge.case import run_case
-    from wirecheck.oracles.judge.cases import Case
+    from wirecheck.oracles.cases import Case
     from wirecheck.oracles.candidates.core_candidate import CoreCandidate
     from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
-    from wirecheck.oracles.judge.tolerances import Tolerances
+    from wirecheck.oracles.tolerances import Tolerances
 
     # a 1,400-unit cube seen from 3 units above one face with near 0.01: the nearest drawn point is 0.01
     # deep and the clip magnitudes ~2e3 (703 to the centre + rho 1.2e3), so the w term alone is

@@ -19,10 +19,10 @@ import pytest
 from helpers import run_crosscheck
 from wirecheck.core.camera import look_at
 from wirecheck.oracles.candidates import protocol
-from wirecheck.oracles.judge import tolerances
+from wirecheck.oracles import tolerances
 from wirecheck.oracles.api import check_projector, failure_text
 from wirecheck.oracles.candidates.candidate import case_precision, returned_precision
-from wirecheck.oracles.judge.tolerances import EPS, VERTEX_ROUNDINGS, Tolerances, vertex_bound, vertex_scale
+from wirecheck.oracles.tolerances import VERTEX_ROUNDINGS, Tolerances, vertex_bound, vertex_scale
 
 DATA = Path(__file__).parent / "data" / "candidates"
 sys.path.insert(0, str(DATA))
@@ -60,7 +60,7 @@ def test_declared_precision_wins_over_the_returned_one():
 # ---- the bound -------------------------------------------------------------------------
 
 def test_vertex_bound_by_hand():
-    """One point at the origin seen from (0, 0, 5), fov 60, 640x480: the formula of oracles/judge/tolerances.py by hand."""
+    """One point at the origin seen from (0, 0, 5), fov 60, 640x480: the formula of oracles/tolerances.py by hand."""
     cam = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
     f = 240 / math.tan(math.radians(30))                     # 415.69 px
     # u = 0 (the point is at the principal point (319.5, 239.5)); |X| = 0, |C| = 5, z = 5
@@ -200,7 +200,7 @@ def pixels_available():
 def _near_plane_crossings():
     """The cube's edges under the near_plane case camera, and the camera: some edges cross the near plane."""
     from wirecheck.core.scene.files import load_scene
-    from wirecheck.oracles.judge.cases import cameras_for
+    from wirecheck.oracles.cases import cameras_for
 
     scene = load_scene("cube")
     cam = next(c.camera for c in cameras_for(scene.radius) if c.name == "near_plane")
@@ -266,7 +266,7 @@ def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
     """A vertex on the near plane (to float32 rounding) clipped by the float32 candidate only is not a failure."""
     from wirecheck.core.scene.model import Scene
     from wirecheck.core.scene.files import load_scene
-    from wirecheck.oracles.judge.cases import cameras_for
+    from wirecheck.oracles.cases import cameras_for
 
     cube = load_scene("cube")
     cam = next(c.camera for c in cameras_for(cube.radius) if c.name == "near_plane")

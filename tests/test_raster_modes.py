@@ -29,7 +29,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
-from wirecheck.core.projector.raster import (CHUNK_SEGMENTS, RASTER_MODES, line_coverage_aa, line_pixels, line_pixels_fast,
+from wirecheck.core.projector.raster import (CHUNK_SEGMENTS, RASTER_MODES, line_coverage_aa, line_pixels_fast,
                                    paint_aa)
 from helpers import eight_connected
 

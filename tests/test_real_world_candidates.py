@@ -114,7 +114,7 @@ def test_opencv_k_with_k1_flipped_is_named_with_the_candidates_k1():
         assert (fault["p1"], fault["p2"]) == pytest.approx((coeffs[2], coeffs[3]), abs=1e-9)
 
 
-# ---- float32 candidates (glm, DirectXMath): judged at their precision (oracles/judge/tolerances.py) ----
+# ---- float32 candidates (glm, DirectXMath): judged at their precision (oracles/tolerances.py) ----
 
 ALL_CASES = PERSPECTIVE + ["orthographic"]
 

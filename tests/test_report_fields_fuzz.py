@@ -15,7 +15,7 @@ from wirecheck.oracles.frames_cli import verdict_line
 from wirecheck.oracles.judge.line_style import summary_lines
 from wirecheck.oracles.reports.compared import hint_lines, what_text
 from wirecheck.oracles.reports.junit import junit_xml
-from wirecheck.oracles.judge.tolerances import Tolerances
+from wirecheck.oracles.tolerances import Tolerances
 from wirecheck.oracles.reports.report import _html, console_table, markdown, write_report
 
 from helpers import blank_job

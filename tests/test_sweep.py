@@ -41,7 +41,7 @@ def test_sweep_accuracy_by_setting(small_sweep):
     rows = {r["setting"]: r for r in small_sweep["settings"]}
     assert len(rows) == 12
     assert sum(r["default"] for r in rows.values()) == 1 and rows["float64/clip/exact"]["default"]
-    # float64: the crosscheck tolerance (1e-6 px; its basis is in oracles/judge/tolerances.py).
+    # float64: the crosscheck tolerance (1e-6 px; its basis is in oracles/tolerances.py).
     # float32: each coordinate passes ~6 roundings (rotation: 3 products + 2 sums;
     # translation; divide; f*; cx+) of relative size eps32/2, on pixel values up
     # to ~|x_px| <= 640 (the image) and on the camera-relative coordinates scaled
@@ -54,7 +54,7 @@ def test_sweep_accuracy_by_setting(small_sweep):
             assert r["max_vertex_error_px"] <= 1e-6, key
         else:
             assert 1e-9 < r["max_vertex_error_px"] <= bound32, key
-    # the default setting meets crosscheck's gates (oracles/judge/tolerances.py)
+    # the default setting meets crosscheck's gates (oracles/tolerances.py)
     d = rows["float64/clip/exact"]
     assert d["pixel_f1_1px"] >= 0.999 and d["pixel_f1_0px"] >= 0.98
     # near_plane crosses the near plane: "endpoint" drops the crossing edges that

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from wirecheck.core.projector import raster
-from wirecheck.oracles.judge import line_ends, metrics, tolerances
+from wirecheck.oracles.judge import line_ends, metrics
+from wirecheck.oracles import tolerances
 from wirecheck.oracles.diagnosis.diagnose import diagnose_lines
 
 from raster_mutants import drop_last
@@ -92,7 +93,7 @@ def test_no_line_fault_is_named_on_ties_alone():
              "imbalance_fraction": 0.0, "balance_p_value": 1.0, "edge_count_max_diff": tol.max_edge_count_diff + 4,
              "edge_count_worst": {"frame": 1, "edge": 3, "diff": -(tol.max_edge_count_diff + 4)},
              "lines_compared": 40, "one_sided_by_place": {p: [0, 0] for p in ("start", "end", "middle", "stray")}}
-    assert metrics.line_failures(lines, tol)
+    assert tolerances.line_failures(lines, tol)
     assert diagnose_lines(lines, tol) == []
     # one decided pixel: named again
     lines.update(oracle_only=17, one_sided_by_place={**lines["one_sided_by_place"], "middle": [0, 1]})

@@ -3,7 +3,7 @@
 A line's last pixel ``P`` is drawn when the segment exits ``P``'s diamond
 (``|x - P_x| + |y - P_y| < 1/2``): with the end on the diamond's exit side,
 exactly when ``|E - P|_1 >= 1/2``. The oracle's ends are within TIE_END_PX
-(2^-8 px) per coordinate of exact (oracles/judge/tolerances.py), so
+(2^-8 px) per coordinate of exact (oracles/tolerances.py), so
 ``|E - P|_1`` within ``2 TIE_END_PX = 2^-7`` of 1/2 is the oracle's rounding,
 not the line's (oracles.judge.line_ties.tie_ends). Such a pixel is left out
 of the balance, and the candidate is given the oracle's value there for
@@ -14,7 +14,8 @@ Expected values are worked out by hand in the comments.
 import numpy as np
 import pytest
 
-from wirecheck.oracles.judge import line_ties, metrics, tolerances
+from wirecheck.oracles.judge import line_ties, metrics
+from wirecheck.oracles import tolerances
 
 ZONE = 2 * 2.0 ** -8            # 2 TIE_END_PX: an end moved by 2^-8 per coordinate moves |E - P|_1 by 2^-7
 

@@ -24,9 +24,9 @@ from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.faults import CATALOGUE
-from wirecheck.oracles.judge.cases import CALIBRATED_CASE_NAMES, CASE_NAMES, case_motion, cameras_for, cases_for
+from wirecheck.oracles.cases import CALIBRATED_CASE_NAMES, CASE_NAMES, case_motion, cameras_for, cases_for
 from wirecheck.oracles.judge.metrics import depth_bound
-from wirecheck.oracles.judge.tolerances import unproject_bound
+from wirecheck.oracles.tolerances import unproject_bound
 from wirecheck.oracles.references.opencv_oracle import project as cv_project
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.reports.fault_text import CELL_MAX

@@ -2,7 +2,7 @@
 
     renderer --scene cube --frames 180 --camera-z 4.0 --fov 70
 
-Parses the options into :class:`core.app.run.Settings`, calls
+Parses the options into :class:`core.app.settings.Settings`, calls
 :func:`core.app.run.render_run` and prints. Results go to stdout, errors to stderr
 as one line with exit status 2.
 """
@@ -43,7 +43,7 @@ def _load_numpy_single_threaded() -> None:
 _load_numpy_single_threaded()
 
 from .cli_help import RENDERER_EXAMPLES, OneLineParser
-from ..camera import Camera, camera_z, look_at, orthographic_twin
+from ..camera import COEFFICIENT_COUNTS, Camera, camera_z, look_at, orthographic_twin
 from ..projector.clipping import CLIP_MODES
 from .compose import AXIS_LENGTH
 from ..projector.culling import CULL_CHOICES
@@ -55,11 +55,15 @@ from ..outputs.output import check_outside_scenes
 from ..projector.projection import DTYPES
 from ..projector.raster import RASTER_MODES
 from .report import depth_text
-from .run import FORMATS, Settings, output_names, progress_steps, render_run
+from .run import FORMATS, output_names, progress_steps, render_run
+from .settings import Settings
 from ..scene.files import load_scene
 from ..projector.shading import STYLES
 from ..outputs.staging import check_out
 from ..transforms import Motion
+from .compare import main_compare
+from .profile import FrameProfiler, profile_table
+from .trace import check_vertex, parse_frames, trace_text, trace_vertex
 
 DESCRIPTION = "renderer: render a scene's motion to wireframe frames with per-frame diagnostics."
 #: --projection: one camera, or "both": perspective left, orthographic right.
@@ -343,7 +347,6 @@ def _numbers(option: str, text: str, counts: tuple) -> tuple:
 
 def _lens_options(a, fov_given: bool) -> dict:
     """``--intrinsics`` and ``--distortion`` as Camera fields; InputError for a combination that ignores them."""
-    from ..projector.distortion import COEFFICIENT_COUNTS
 
     out = {}
     if a.intrinsics is not None:
@@ -417,12 +420,10 @@ def _main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     s = settings_from_args(args)          # InputError: one line, exit 2 (core.app.guard)
     if args.interactive:
-        from .viewer import main_interactive
+        from .viewer_http import main_interactive
 
         return main_interactive(s, args.port)
     if args.compare:
-        from .compare import main_compare
-
         return main_compare(s, args.compare_z, args.compare_fov)
     traces = _traces(args, s)
     width = max(3, len(str(s.frames)))
@@ -443,8 +444,6 @@ def _main(argv=None) -> int:
 
     profiler = None
     if args.profile:
-        from .profile import FrameProfiler
-
         profiler = FrameProfiler()
     try:
         report = render_run(s, log=log, progress=progress, profiler=profiler,
@@ -454,13 +453,9 @@ def _main(argv=None) -> int:
     if s.scene.faces and s.scene.winding_note:       # after the run: an error line is the only line
         print(f"renderer: warning: {s.scene.source}: {s.scene.winding_note}", file=sys.stderr)
     if traces:
-        from .trace import trace_text
-
         for rec in traces:
             print(trace_text(rec, s.camera), end="")
     if profiler is not None:
-        from .profile import profile_table
-
         print(profile_table(report["profile"]), end="")
     paths = report["_paths"]
     if paths["frames"] is not None:
@@ -481,8 +476,6 @@ def _traces(args, s: Settings) -> list[dict]:
         if args.trace_frames is not None:
             raise InputError(f"--trace-frames {args.trace_frames!r} without --trace-vertex: expected --trace-vertex I")
         return []
-    from .trace import check_vertex, parse_frames, trace_vertex
-
     check_vertex(s.scene, args.trace_vertex)
     renderer = s.scene_renderer()
     out = []

@@ -40,6 +40,9 @@ from ..outputs import output
 from ..camera import camera_z
 from ..errors import InputError
 from ..numbers import plain_float
+from .compose import picture, side_by_side
+from ..scene.model import world_points
+from ..outputs.staging import Staging
 
 #: Drawn pixels: at least half coverage (raster "aa"), as the crosscheck's threshold.
 DRAWN = 128
@@ -93,11 +96,7 @@ def measure(image: np.ndarray, row: int) -> dict | None:
 
 
 def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
-    """Render the four views; return (report, 2x2 picture). ``s`` is the run's core.app.run.Settings."""
-    from .compose import picture, side_by_side
-
-    from ..scene.model import world_points
-
+    """Render the four views; return (report, 2x2 picture). ``s`` is the run's core.app.settings.Settings."""
     box = box_of(world_points(s.scene, s.motion, 1, s.frames))        # at rest, with --scale/--translate
     depth = box["z_front"] - box["z_back"]
     if not (depth > 0 and box["half_width"] > 0):      # the widths and their ratio would divide by zero
@@ -186,8 +185,6 @@ def main_compare(s, z_text: str, fov_text: str) -> int:
         print(f"renderer: error: {exc}", file=sys.stderr)
         return 2
     name = s.scene.name
-    from ..outputs.staging import Staging
-
     names = [f"{name}-compare.png", f"{name}-compare.json", f"{name}-compare.txt"]
     # written together, never over a file wirecheck did not write; --out held from here to the end
     stage = Staging(s.out, names)

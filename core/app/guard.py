@@ -30,6 +30,7 @@ import tempfile
 import traceback
 
 from ..errors import InputError, one_line, quiet_libraries
+import wirecheck
 
 EXIT_USAGE = 2
 EXIT_INTERNAL = 3
@@ -133,7 +134,5 @@ class VersionAction(argparse._VersionAction):
     """
 
     def __call__(self, parser, namespace, values, option_string=None):
-        import wirecheck
-
         self.version = self.version.format(wirecheck.__version__)
         super().__call__(parser, namespace, values, option_string)

@@ -12,7 +12,7 @@ from .compose import axis_length
 
 if TYPE_CHECKING:
     from ..projector.pipeline import Frame
-    from .run import Settings
+    from .settings import Settings
 
 
 def frame_record(k: int, frame: Frame, sidecar: bool, info: dict | None = None) -> dict:

@@ -11,22 +11,18 @@ from __future__ import annotations
 
 import contextlib
 import time
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from ..outputs import output
-from ..camera import Camera
-from .compose import axis_layers, axis_length, overlay, picture, side_by_side
+from .compose import overlay, picture, side_by_side
 from ..errors import InputError
 from ..outputs.frame_writer import ForkedPngWriter, can_fork
-from ..scene.frames import SceneRenderer
 from ..outputs.gif import GifWriter
 from .report import frame_record, run_report, summary_text
-from ..scene.model import Scene
+from .settings import Settings
 from ..outputs.staging import Staging
-from ..transforms import Motion
+from .motion_plot import plot_png
 
 #: Output formats: frames as PNG and ASCII text, animations as GIF and MP4.
 FORMATS = ("png", "ascii", "gif", "mp4")
@@ -35,48 +31,6 @@ FPS = 30
 #: Above this many vertices the per-frame pixel coordinates go to a binary
 #: sidecar (float64 array, shape (frames, N, 2), NaN where clipped) instead of JSON.
 SIDECAR_VERTICES = 10_000
-
-
-@dataclass
-class Settings:
-    """One renderer run (``renderer``'s options, validated)."""
-
-    scene: Scene
-    camera: Camera
-    motion: Motion
-    frames: int
-    clip: str
-    formats: tuple[str, ...]
-    out: Path
-    ascii_cols: int
-    dtype: str = "float64"
-    raster: str = "exact"
-    ortho_camera: Camera | None = None       # --projection both: the right-hand camera
-    axes: bool = False
-    cull: str | None = None                  # None or "backface"
-    hidden_lines: bool = False
-    style: str = "wireframe"
-    light: tuple | None = None
-    object_culling: bool = True
-    plots: bool = False
-
-    @property
-    def cameras(self) -> tuple[Camera, ...]:
-        return (self.camera,) if self.ortho_camera is None else (self.camera, self.ortho_camera)
-
-    @property
-    def uses_faces(self) -> bool:
-        return self.cull is not None or self.hidden_lines or self.style != "wireframe"
-
-    def axis_layers(self, camera: Camera, frame=None) -> list:
-        """:func:`core.app.compose.axis_layers` of this run (``frame``: depth-tested against its faces)."""
-        return axis_layers(axis_length(self.scene.radius, self.motion.scale), camera, self.clip, self.dtype,
-                           self.raster, frame)
-
-    def scene_renderer(self) -> SceneRenderer:
-        return SceneRenderer(self.scene, self.motion, self.frames, clip=self.clip, dtype=self.dtype,
-                             raster=self.raster, cull=self.cull, hidden_lines=self.hidden_lines,
-                             style=self.style, light=self.light, object_culling=self.object_culling)
 
 
 def progress_steps(s: Settings) -> int:
@@ -219,8 +173,6 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
             report["vertices_px_file_orthographic"] = sidecar_names[1]
     plot_seconds = None
     if s.plots:
-        from .motion_plot import plot_png
-
         t0 = time.perf_counter()
         cam_text = "perspective (left picture)" if s.ortho_camera is not None else s.camera.projection
         stage.path(f"{name}-plots.png").write_bytes(plot_png(records, f"{name}: {s.frames} frames, {cam_text} camera"))

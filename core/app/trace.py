@@ -170,7 +170,7 @@ def _edges(scene, motion, camera, vertex, k, frames, p_cam) -> list[dict]:
             ends_cam = seg[0, 0] + np.array([t0[0], t1[0]])[:, None] * (seg[0, 1] - seg[0, 0])
             # the planes that set the kept range: their crossing is t_enter or t_exit
             cross = {j: dist[0, j] / (dist[0, j] - dist[1, j]) for j in outside if (dist[:, j] < 0).sum() == 1}
-            e["cut_by"] = [PLANE_NAMES[j] for j, tc in cross.items() 
+            e["cut_by"] = [PLANE_NAMES[j] for j, tc in cross.items()
                         if np.isclose(tc, t0[0], rtol=1e-12, atol=0) or np.isclose(tc, t1[0], rtol=1e-12, atol=0)]
             e.update(status="clipped", t=[float(t0[0]), float(t1[0])], ends_camera=ends_cam.tolist(),
                      ends_pixel=cam_to_px(ends_cam, camera).tolist())

@@ -39,7 +39,7 @@ docs/interactive.md.
 
 The oracle overlay (pyrender's frame of the same view, the diff, F1 and the
 vertex error) is an optional callable given to :class:`Viewer`;
-:func:`main_interactive` loads ``wirecheck.oracles.live`` for it on first use
+:class:`LazyOverlay` (given it by core.app.viewer_http.main_interactive) loads ``wirecheck.oracles.live`` on first use
 (core itself never imports the oracles: this is the one optional hook).
 """
 
@@ -59,6 +59,8 @@ from ..camera import Camera, look_at
 from ..errors import InputError
 from ..projector.pipeline import STAGES as PIPELINE_STAGES
 from .profile import FrameProfiler
+from .compose import overlay, picture
+from ..scene.files import builtin_names, example_names
 
 #: Orbit: degrees per CSS pixel of drag.
 DEG_PER_PX = 0.5
@@ -166,7 +168,7 @@ def pan(view: View, dx: float, dy: float, height: int) -> View:
                    target=tuple((np.asarray(view.target) + move).tolist()))
 
 
-def _short(value, limit: int = 60) -> str:
+def short_repr(value, limit: int = 60) -> str:
     """``repr(value)``, cut to ``limit`` characters: an error message echoes hostile input in one short line."""
     r = repr(value)
     return r if len(r) <= limit else r[:limit - 3] + "..."
@@ -179,21 +181,21 @@ def _number(name, text):
     except (TypeError, ValueError, OverflowError):     # OverflowError: an integer beyond float64
         v = math.nan
     if not math.isfinite(v):
-        raise InputError(f"{name} {_short(text)}: expected a finite number")
+        raise InputError(f"{name} {short_repr(text)}: expected a finite number")
     return v
 
 
 def _choice(allowed):
     def parse(name, text):
         if text not in allowed:
-            raise InputError(f"{name} {_short(text)}: expected one of {', '.join(allowed)}")
+            raise InputError(f"{name} {short_repr(text)}: expected one of {', '.join(allowed)}")
         return text
     return parse
 
 
 def _flag(name, value):
     if not isinstance(value, bool):
-        raise InputError(f"{name} {_short(value)}: expected true or false")
+        raise InputError(f"{name} {short_repr(value)}: expected true or false")
     return value
 
 
@@ -229,7 +231,7 @@ class Viewer:
         that would take the camera out of the float64 range is refused.
         """
         if not isinstance(ops, list):
-            raise InputError(f"ops {_short(ops)}: expected a list")
+            raise InputError(f"ops {short_repr(ops)}: expected a list")
         if len(ops) > MAX_OPS:
             raise InputError(f"ops: {len(ops)} in one request; expected at most {MAX_OPS}")
         v = self.view
@@ -238,7 +240,7 @@ class Viewer:
             with np.errstate(all="ignore"):             # an op driving the camera to inf/nan is refused below
                 v = self._apply_one(v, op, h)
             if not np.isfinite([*v.position, *v.target, *v.up]).all():
-                raise InputError(f"op {_short(op)}: the camera would leave the float64 range")
+                raise InputError(f"op {short_repr(op)}: the camera would leave the float64 range")
         self.settings(v)                                # validates camera and mode
         return v
 
@@ -253,17 +255,17 @@ class Viewer:
         elif kind == "set":
             name = op.get("field")
             if not isinstance(name, str) or name not in FIELDS:
-                raise InputError(f"field {_short(name)}: expected one of {', '.join(FIELDS)}")
+                raise InputError(f"field {short_repr(name)}: expected one of {', '.join(FIELDS)}")
             v = replace(v, **{name: FIELDS[name](name, op.get("value"))})
         elif kind == "step":
             n = op.get("n")
             if not isinstance(n, int) or isinstance(n, bool):
-                raise InputError(f"step {_short(n)}: expected an integer")
+                raise InputError(f"step {short_repr(n)}: expected an integer")
             v = replace(v, frame=(v.frame - 1 + n) % self.s.frames + 1)
         elif kind == "reset":
             v = replace(self.start, frame=v.frame)
         else:
-            raise InputError(f"op {_short(op)}: expected orbit, pan, dolly, set, step or reset")
+            raise InputError(f"op {short_repr(op)}: expected orbit, pan, dolly, set, step or reset")
         return v
 
     def settings(self, v: View):
@@ -279,8 +281,6 @@ class Viewer:
     # ---- output
     def frame_png(self, v: View, timing: dict | None = None):
         """``(png bytes, Frame, settings)`` of view ``v``: exactly what ``renderer`` writes for its command line."""
-        from .compose import overlay, picture
-
         s = self.settings(v)
         key = (s.style, s.hidden_lines, s.cull)
         if key not in self._renderers:
@@ -301,8 +301,6 @@ class Viewer:
     def command(self, v: View) -> str:
         """The ``renderer`` command line that writes this frame (``frame_<k>.png``), floats exact (repr)."""
         s = self.s
-        from ..scene.files import builtin_names, example_names
-
         scene = s.scene.name if s.scene.name in builtin_names() + example_names() else s.scene.source
         r = lambda xs: ",".join(repr(float(x)) for x in xs)            # noqa: E731 - repr round-trips floats
         # OPTION=VALUE: a value starting with "-" is not taken for an option
@@ -391,7 +389,7 @@ def _load_overlay():
         return None, why
 
 
-class _LazyOverlay:
+class LazyOverlay:
     """Loads the oracle overlay on its first use (most sessions never turn it on); when it cannot
     load, every request's error says why and how to fix it, in the page's banner."""
 
@@ -411,26 +409,3 @@ class _LazyOverlay:
             self._impl.close()
 
 
-def main_interactive(s, port: int = 0) -> int:
-    """Serve until Ctrl-C; print the URL. Returns the exit status."""
-    if not 0 <= port <= 65535:
-        print(f"renderer: error: --port {port}: expected 0 (a free port) to 65535", file=sys.stderr)
-        return 2
-    try:
-        from .viewer_http import Server
-
-        server = Server(Viewer(s, overlay=_LazyOverlay()), port)
-    except OSError as exc:
-        print(f"renderer: error: --port {port}: cannot listen on 127.0.0.1 ({exc.strerror or exc})", file=sys.stderr)
-        return 2
-    print(f"Viewer: {server.url}  (Ctrl-C stops it)", flush=True)
-    server.start()
-    try:
-        while server.thread.is_alive():
-            server.thread.join(0.2)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        server.stop()
-    print("Viewer stopped.", flush=True)
-    return 0

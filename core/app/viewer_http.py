@@ -17,13 +17,9 @@ import threading
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
-from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
-from .viewer import _short
-
-if TYPE_CHECKING:
-    from .viewer import Viewer
+from .viewer import LazyOverlay, Viewer, short_repr
 
 STATIC = ("index.html", "viewer.js", "viewer.css")
 #: Largest request body read, in bytes: MAX_OPS ops of ~60 bytes of JSON each is ~15 KiB; 64 KiB
@@ -59,7 +55,7 @@ def _reject_constant(name):
 def _finite_float(text):
     v = float(text)
     if not math.isfinite(v):                           # 1e400 parses to inf
-        raise ValueError(f"number {_short(text)} overflows float64; expected a finite number")
+        raise ValueError(f"number {short_repr(text)} overflows float64; expected a finite number")
     return v
 
 
@@ -73,23 +69,23 @@ def parse_body(raw: bytes) -> tuple[list, bool]:
     try:
         body = json.loads(raw.decode("utf-8") or "{}", parse_constant=_reject_constant, parse_float=_finite_float)
     except UnicodeDecodeError as exc:
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: not UTF-8 ({exc.reason} at byte {exc.start})")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: not UTF-8 ({exc.reason} at byte {exc.start})") from exc
     except RecursionError:
-        raise RequestError(HTTPStatus.BAD_REQUEST, "request body: JSON nested too deeply")
+        raise RequestError(HTTPStatus.BAD_REQUEST, "request body: JSON nested too deeply") from None
     except ValueError as exc:                          # JSONDecodeError, our constants, int digit limit
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: {exc}")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: {exc}") from exc
     if not isinstance(body, dict):
         raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: a JSON {type(body).__name__}; "
                                                    'expected an object {"ops": [...], "overlay": bool}')
     unknown = sorted(set(body) - {"ops", "overlay"})
     if unknown:
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: unknown key {_short(unknown[0])}; "
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: unknown key {short_repr(unknown[0])}; "
                                                    "expected ops and overlay")
     ops, overlay = body.get("ops", []), body.get("overlay", False)
     if not isinstance(ops, list):
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: ops {_short(ops)}: expected a list")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: ops {short_repr(ops)}: expected a list")
     if not isinstance(overlay, bool):
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: overlay {_short(overlay)}: expected true or false")
+        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: overlay {short_repr(overlay)}: expected true or false")
     return ops, overlay
 
 
@@ -140,7 +136,7 @@ def _handler(viewer: Viewer):
             or post to it directly (the Origin header says its site).
             """
             if not self.path.startswith("/"):  # absolute-form (http://other.site/...) names another server
-                raise RequestError(HTTPStatus.BAD_REQUEST, f"request target {_short(self.path)}: expected a path "
+                raise RequestError(HTTPStatus.BAD_REQUEST, f"request target {short_repr(self.path)}: expected a path "
                                                            "starting with /")
             if self.headers.defects:           # a header line without a colon: the headers after it were dropped
                 raise RequestError(HTTPStatus.BAD_REQUEST, "a malformed header line: expected 'Name: value' lines")
@@ -149,16 +145,16 @@ def _handler(viewer: Viewer):
                 if count > 1:
                     raise RequestError(HTTPStatus.BAD_REQUEST, f"{name} given {count} times: expected one")
             if self.headers.get("Transfer-Encoding") is not None:     # with a Content-Length: request smuggling
-                raise RequestError(HTTPStatus.BAD_REQUEST, f"Transfer-Encoding {_short(self.headers['Transfer-Encoding'])}: "
+                raise RequestError(HTTPStatus.BAD_REQUEST, f"Transfer-Encoding {short_repr(self.headers['Transfer-Encoding'])}: "
                                                            "expected a body of Content-Length bytes")
             port = self.server.server_address[1]
             hosts = (f"127.0.0.1:{port}", f"localhost:{port}")
             host = (self.headers.get("Host") or "").lower()
             if host not in hosts:
-                raise RequestError(HTTPStatus.FORBIDDEN, f"Host {_short(host)}: expected {' or '.join(hosts)}")
+                raise RequestError(HTTPStatus.FORBIDDEN, f"Host {short_repr(host)}: expected {' or '.join(hosts)}")
             origin = self.headers.get("Origin")
             if origin is not None and origin.lower() not in tuple(f"http://{h}" for h in hosts):
-                raise RequestError(HTTPStatus.FORBIDDEN, f"Origin {_short(origin)}: expected this viewer's page")
+                raise RequestError(HTTPStatus.FORBIDDEN, f"Origin {short_repr(origin)}: expected this viewer's page")
 
         def _path(self) -> str:
             path = urlsplit(self.path).path              # the query string, if any, is ignored
@@ -178,13 +174,13 @@ def _handler(viewer: Viewer):
             elif path == "/api/frame":
                 self._json(viewer.respond())
             else:
-                self._json({"error": f"no such path {_short(path)}"}, 404)
+                self._json({"error": f"no such path {short_repr(path)}"}, 404)
 
         def do_POST(self):
             try:
                 self._check_origin()
                 if self._path() != "/api/frame":
-                    raise RequestError(HTTPStatus.NOT_FOUND, f"no such path {_short(self._path())}")
+                    raise RequestError(HTTPStatus.NOT_FOUND, f"no such path {short_repr(self._path())}")
                 ops, overlay = parse_body(self._read_body())
             except RequestError as exc:
                 return self._refuse(exc)
@@ -195,12 +191,12 @@ def _handler(viewer: Viewer):
             ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
             if ctype != "application/json":             # a cross-site form or text/plain post cannot say this
                 raise RequestError(HTTPStatus.UNSUPPORTED_MEDIA_TYPE,
-                                   f"Content-Type {_short(ctype)}: expected application/json")
+                                   f"Content-Type {short_repr(ctype)}: expected application/json")
             text = self.headers.get("Content-Length")
             if text is None:
                 raise RequestError(HTTPStatus.LENGTH_REQUIRED, "Content-Length: missing; expected the body's size")
             if not (text.isascii() and text.isdigit() and len(text) <= 20):
-                raise RequestError(HTTPStatus.BAD_REQUEST, f"Content-Length {_short(text)}: expected bytes >= 0")
+                raise RequestError(HTTPStatus.BAD_REQUEST, f"Content-Length {short_repr(text)}: expected bytes >= 0")
             n = int(text)
             if n > MAX_BODY_BYTES:
                 raise RequestError(HTTPStatus.REQUEST_ENTITY_TOO_LARGE,
@@ -247,7 +243,7 @@ class Server:
         host, port = self.httpd.server_address[:2]
         return f"http://{host}:{port}/"
 
-    def start(self) -> "Server":
+    def start(self) -> Server:
         self.thread.start()
         return self
 
@@ -258,3 +254,26 @@ class Server:
         close = getattr(self.viewer.overlay, "close", None)
         if close is not None:
             close()
+
+
+def main_interactive(s, port: int = 0) -> int:
+    """Serve until Ctrl-C; print the URL. Returns the exit status."""
+    if not 0 <= port <= 65535:
+        print(f"renderer: error: --port {port}: expected 0 (a free port) to 65535", file=sys.stderr)
+        return 2
+    try:
+        server = Server(Viewer(s, overlay=LazyOverlay()), port)
+    except OSError as exc:
+        print(f"renderer: error: --port {port}: cannot listen on 127.0.0.1 ({exc.strerror or exc})", file=sys.stderr)
+        return 2
+    print(f"Viewer: {server.url}  (Ctrl-C stops it)", flush=True)
+    server.start()
+    try:
+        while server.thread.is_alive():
+            server.thread.join(0.2)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
+    print("Viewer stopped.", flush=True)
+    return 0

@@ -19,7 +19,13 @@ import numpy as np
 
 from .owned import MARKER
 from .owned import TAG as _TAG
-from .owned import is_regular, remove_tree
+from .gif import gif_bytes as encode
+from ..errors import InputError
+from .owned import TAG, exchange, is_leftover, is_regular, listing, ours, remove_tree, rename, rename_noreplace, \
+    retire, seal, step
+from ..scene import files as scene_files
+from ..scene.files import MESH_SUFFIXES, NATIVE_SUFFIX
+from .lockfile import Lock
 
 
 def _umask() -> int:
@@ -152,8 +158,6 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
 
 def gif_bytes(images, fps: float = 30.0, progress=None) -> bytes:
     """An animated GIF of ``images`` as bytes (core.outputs.gif, which also streams to a file)."""
-    from .gif import gif_bytes as encode
-
     return encode(images, fps, progress)
 
 
@@ -291,9 +295,6 @@ def check_replaceable(path: Path, option: str) -> None:
     listing, core.outputs.owned): a user's file inside it is named and nothing is
     replaced. A frames job whose ``frames/`` the renderer has filled says so (:func:`_users_frames`).
     """
-    from ..errors import InputError
-    from .owned import ours
-
     path = Path(path)
     if path.is_dir() and not path.is_symlink() and is_regular(path / MARKER):
         drawn = _users_frames(path)
@@ -311,15 +312,13 @@ def check_replaceable(path: Path, option: str) -> None:
 def check_outside_scenes(path: Path, option: str, expected: str) -> None:
     """InputError when ``path`` is the bundled scenes folder or inside it: outputs there would pass for
     scenes in later runs. ``expected``: what to give instead, for the message."""
-    from ..errors import InputError
-    from ..scene.files import SCENE_DIR
-
     try:
         resolved = Path(path).resolve()
     except (RuntimeError, OSError) as exc:         # a symbolic link loop: Python 3.11 raises RuntimeError
         raise InputError(f"{option} {str(path)!r}: {exc}: expected a folder path") from None
-    if resolved == SCENE_DIR or SCENE_DIR in resolved.parents:
-        raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(SCENE_DIR)!r}: expected {expected}")
+    scenes = scene_files.SCENE_DIR
+    if resolved == scenes or scenes in resolved.parents:
+        raise InputError(f"{option} {str(path)!r} is inside the scenes folder {str(scenes)!r}: expected {expected}")
 
 
 def check_report_dir(path: Path, option: str) -> None:
@@ -330,9 +329,6 @@ def check_report_dir(path: Path, option: str) -> None:
     ``scenes/*.scene``). Nothing is created here: the caller creates the
     parents only when it writes the report, so a failed run leaves no folder.
     """
-    from ..errors import InputError
-    from ..scene.files import MESH_SUFFIXES, NATIVE_SUFFIX
-
     path = Path(path)
     long = next((part for part in path.parts if len(os.fsencode(part)) > 255), None)
     if long is not None:
@@ -366,7 +362,6 @@ def claim(final: Path, option: str) -> None:
     (or :func:`release_claim`): one run owns its target from its start to its end, and a second run into
     it is refused at once, whichever takes longer. Creates the missing parents (removed again on release
     while empty), then checks ``final`` (:func:`check_replaceable`)."""
-    from .lockfile import Lock
 
     final = Path(final)
     key = os.path.abspath(final)
@@ -437,8 +432,6 @@ class FrameDir:
     """
 
     def __init__(self, final: Path, option: str = "output"):
-        from .lockfile import Lock
-
         self.final = Path(final)
         self.option = option
         self.tmp = None
@@ -461,8 +454,6 @@ class FrameDir:
 
     def _remove_leftovers(self) -> None:
         """Remove the temporaries of killed runs for this ``final`` (ours alone: no live run holds the lock)."""
-        from .owned import TAG, is_leftover, listing, retire
-
         prefix = f".{self.final.name}."
         for entry in os.scandir(self.final.parent):
             unique = entry.name[len(prefix):-len(".tmp")]
@@ -483,9 +474,6 @@ class FrameDir:
     def commit(self) -> None:
         """Swap the new folder in, then remove the old one by its listing; InputError (after the swap) when
         a file the user wrote meanwhile was kept (class docstring)."""
-        from ..errors import InputError
-        from .owned import exchange, rename, rename_noreplace, retire, seal, step
-
         check_replaceable(self.final, self.option)   # again: it may have changed meanwhile
         step()                                       # checked: the old folder is checked again after the swap
         seal(self.tmp)

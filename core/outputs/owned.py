@@ -306,7 +306,7 @@ def remove_tree(folder: Path) -> None:
         os.unlink(folder)
         return
     dirs = [folder]
-    for rel, entry in _walk(folder):
+    for _rel, entry in _walk(folder):
         if entry.is_dir(follow_symlinks=False):
             dirs.append(Path(entry.path))
         else:

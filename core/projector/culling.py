@@ -50,7 +50,7 @@ CULL_MODES = (None, "backface")
 CULL_CHOICES = tuple("none" if m is None else m for m in CULL_MODES)
 
 
-def _fan(faces) -> tuple[np.ndarray, np.ndarray]:
+def fan_triangles(faces) -> tuple[np.ndarray, np.ndarray]:
     """``(tris (T, 3) intp, face_of_tri (T,) intp)``: fan from each polygon's first vertex."""
     if isinstance(faces, np.ndarray) and faces.dtype.kind in "iu" and faces.ndim == 2:
         f, k = faces.shape
@@ -69,7 +69,7 @@ def _fan(faces) -> tuple[np.ndarray, np.ndarray]:
             continue
         idx = np.flatnonzero(lengths == k)
         block = np.asarray([faces[i] for i in idx], dtype=np.intp).reshape(-1, int(k))
-        t, f = _fan(block)
+        t, f = fan_triangles(block)
         tris_parts.append(t)
         face_parts.append(idx[f])
     if not tris_parts:
@@ -87,12 +87,12 @@ def triangulate(faces) -> np.ndarray:
     skipped) or an ``(F, k)`` integer array. Triangles come in polygon order and
     keep the polygon's winding. See :func:`face_of_triangle` for the map back.
     """
-    return _fan(faces)[0]
+    return fan_triangles(faces)[0]
 
 
 def face_of_triangle(faces) -> np.ndarray:
     """``(T,) intp``: the polygon index of each triangle of :func:`triangulate`."""
-    return _fan(faces)[1]
+    return fan_triangles(faces)[1]
 
 
 def directed_edges(faces) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

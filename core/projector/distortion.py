@@ -25,52 +25,9 @@ in GL), so frames of a distorted camera are not compared at the pixel level.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from ..errors import InputError
-
-__all__ = ["COEFFICIENT_COUNTS", "MAX_COEFFICIENT", "check_coefficients", "distort"]
-
-#: The lengths OpenCV's ``distCoeffs`` may have that this model covers:
-#: (k1, k2, p1, p2), (..., k3), (..., k3, k4, k5, k6). The thin-prism and tilted
-#: models (12 and 14 numbers) are not modelled.
-COEFFICIENT_COUNTS = (4, 5, 8)
-
-#: Largest |coefficient|. Calibrated lenses have |k| up to about 10^2 (rational
-#: models of fisheye-like lenses); 10^4 leaves room for any real lens, while
-#: k r2^3 stays below 1e4 * 1e12 inside the intrinsics' 1e6-side reach
-#: (core.camera), far from float64 overflow.
-MAX_COEFFICIENT = 1e4
-
-NAMES = ("k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6")
-
-
-def check_coefficients(coefficients) -> tuple | None:
-    """``coefficients`` as a tuple of floats, ``None`` when absent or all zero; InputError otherwise.
-
-    Parameters
-    ----------
-    coefficients : sequence of float or None
-        ``(k1, k2, p1, p2[, k3[, k4, k5, k6]])``, OpenCV's order.
-    """
-    if coefficients is None:
-        return None
-    try:
-        c = np.asarray(coefficients, dtype=np.float64)
-    except (TypeError, ValueError):
-        c = None
-    if c is None or c.ndim != 1 or len(c) not in COEFFICIENT_COUNTS:
-        raise InputError(f"camera distortion {coefficients!r}: expected 4, 5 or 8 numbers "
-                         "(k1, k2, p1, p2[, k3[, k4, k5, k6]], OpenCV's order)")
-    bad = [f"{n}={v!r}" for n, v in zip(NAMES, c.tolist()) if not (math.isfinite(v) and abs(v) <= MAX_COEFFICIENT)]
-    if bad:
-        raise InputError(f"camera distortion {', '.join(bad)}: expected finite numbers with |value| <= "
-                         f"{MAX_COEFFICIENT:g}")
-    if not c.any():
-        return None
-    return tuple(float(x) for x in c)
+__all__ = ["distort"]
 
 
 def distort(p_n: np.ndarray, coefficients: tuple) -> np.ndarray:
@@ -81,7 +38,7 @@ def distort(p_n: np.ndarray, coefficients: tuple) -> np.ndarray:
     p_n : (N, 2) ndarray of float
         ``(x_cam / z_cam, -y_cam / z_cam)``.
     coefficients : tuple of float
-        4, 5 or 8 numbers, as :func:`check_coefficients` returns them.
+        4, 5 or 8 numbers, as :func:`core.camera.check_coefficients` returns them.
 
     Returns
     -------

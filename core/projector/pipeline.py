@@ -300,7 +300,7 @@ def _lap(timing: dict | None, stage: str, t0: float) -> float:
 
 def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: bool) -> dict:
     """Triangulate, cull and (if ``need_depth``) depth-buffer the faces."""
-    tris, tri_face = culling._fan(faces)
+    tris, tri_face = culling.fan_triangles(faces)
     n_faces = len(faces)
     n = len(p_cam)
     if len(tris) and (tris.min() < 0 or tris.max() >= n):

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..camera import Camera
 from ..errors import InputError
+from .distortion import distort
 
 DTYPES = ("float64", "float32")
 
@@ -186,8 +187,6 @@ def cam_to_px(p_cam: np.ndarray, camera: Camera) -> np.ndarray:
 
 def _distorted_px(p_cam: np.ndarray, camera: Camera, f_t, out: np.ndarray) -> np.ndarray:
     """Perspective with lens distortion (core.projector.distortion): ideal normalised, distorted, then pixels."""
-    from .distortion import distort
-
     inv_z = f_t(1.0) / p_cam[:, 2]
     p_n = np.empty(out.shape, dtype=out.dtype)
     np.multiply(p_cam[:, 0], inv_z, out=p_n[:, 0])

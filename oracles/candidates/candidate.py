@@ -15,7 +15,7 @@
   integer coordinates at pixel centres; core/conventions.py), NaN rows for the
   points it clips (depth outside [near, far]).
 
-The candidate's precision (oracles.judge.tolerances.PRECISIONS) is inferred from
+The candidate's precision (oracles.tolerances.PRECISIONS) is inferred from
 the dtype of the array it returns: ``float32`` (or ``float16``) means float32,
 anything else float64. A program over the candidate protocol says it in its
 reply (docs/protocol.md). A precision declared by the user

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import sys
+from wirecheck.core.errors import InputError
 
 
 def _camera(msg: dict):
@@ -58,9 +59,7 @@ def serve(spec: str, stdin, stdout, unproject: bool = False) -> int:
         send(protocol.encode_error(f"expected the header {protocol.HEADER!r}"))
         return 2
     try:
-        from wirecheck.core.errors import InputError
-
-        from .candidate import CandidateError, call_candidate, load_candidate
+        from .candidate import load_candidate
 
         func = (load_candidate(spec, "unprojector", ("pixels", "depth", "camera")) if unproject
                 else load_candidate(spec))

@@ -18,6 +18,9 @@ from wirecheck.core.projector.culling import CULL_CHOICES
 from wirecheck.core.projector.projection import DTYPES
 from wirecheck.core.projector.raster import RASTER_MODES
 from wirecheck.core.projector.shading import STYLES
+from wirecheck.core.projector.projection import localize, project_points
+from wirecheck.core.scene.frames import SceneRenderer
+from wirecheck.core.projector import pipeline
 
 #: A frame of core's pipeline is greyscale with raster "aa": a pixel is drawn from half intensity up.
 DRAWN_THRESHOLD = 128
@@ -85,14 +88,10 @@ class CoreCandidate:
         return {"dtype": self.dtype, "clip": self.clip, "raster": self.raster}
 
     def __call__(self, points, camera):  # the candidate contract, for completeness
-        from wirecheck.core.projector.projection import project_points
-
         return project_points(points, camera, dtype=self.dtype)
 
     def prepare(self, p_model: np.ndarray):
         """Points re-centred and cast once (``core.projector.projection.localize``), as ``renderer`` does."""
-        from wirecheck.core.projector.projection import localize
-
         return localize(p_model, self.dtype)
 
     def scene_frames(self, scene, motion, frames: int):
@@ -102,30 +101,22 @@ class CoreCandidate:
         and model matrix, and its ``faces`` the faces as core draws them, as
         ``renderer`` sets them up.
         """
-        from wirecheck.core.scene.frames import SceneRenderer
-
         return SceneRenderer(scene, motion, frames, clip=self.clip, dtype=self.dtype, raster=self.raster,
                              object_culling=False)
 
     def project(self, points, camera, model_matrix: np.ndarray) -> np.ndarray:
         """Vertex pixels from core's pipeline without drawing: ``render_frame`` given no edges."""
-        from wirecheck.core.projector.pipeline import render_frame
-
         no_edges = np.zeros((0, 2), dtype=np.intp)
-        return render_frame(points, no_edges, camera, model_matrix, self.clip, raster=self.raster).p_px
+        return pipeline.render_frame(points, no_edges, camera, model_matrix, self.clip, raster=self.raster).p_px
 
     def draw(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray) -> np.ndarray:
         """The frame core draws, as a bool image (drawn where the image is >= 128)."""
-        from wirecheck.core.projector.pipeline import render_frame
-
-        frame = render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster)
+        frame = pipeline.render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster)
         return frame.image >= DRAWN_THRESHOLD
 
     def render(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces, mode: RenderMode):
         """core's :class:`~core.projector.pipeline.Frame` in a drawing mode (faces None: the scene has none)."""
-        from wirecheck.core.projector.pipeline import render_frame
-
-        return render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster, faces=faces,
+        return pipeline.render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster, faces=faces,
                             **mode.core_kwargs())
 
     def draw_mode(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces,

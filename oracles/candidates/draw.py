@@ -11,7 +11,7 @@ test decides in its own precision: computed in float32, the end's depth may
 come out a rounding below ``near`` and the candidate rightly clips it, losing
 the whole edge. So each clipped end is moved inside ``[near, far]`` by more
 than the candidate's depth rounding at that point, ``DEPTH_ROUNDINGS eps
-(|X| + |C|)`` (oracles.judge.tolerances; eps of the candidate's precision), and
+(|X| + |C|)`` (oracles.tolerances; eps of the candidate's precision), and
 never less than ``_INWARD`` of the kept segment. A correct candidate at its
 precision then cannot reject it; the end moves by ~1e-6 of a unit in depth
 for float32 (a small fraction of a pixel unless the edge is seen end-on).
@@ -26,7 +26,7 @@ from wirecheck.core.projector.raster import line_pixels
 
 from ..references import opencv_oracle
 from .candidate import call_candidate
-from ..judge.tolerances import DEPTH_ROUNDINGS, EPS
+from ..tolerances import DEPTH_ROUNDINGS, EPS
 
 #: Clipped ends are moved at least this fraction of the kept segment inward
 #: (1e-9 of a segment is far below a pixel for any segment shorter than 1e8 px).

@@ -36,8 +36,10 @@ import numpy as np
 from wirecheck.core.errors import InputError
 from wirecheck.core.outputs.output import FrameDir, json_dumps
 
-from ..judge.cases import CASE_NAMES, case_motion, cases_for
+from ..cases import CASE_NAMES, case_motion, cases_for
 from ..references.convert import camera_to_gl, opencv_matrices
+from wirecheck.core.transforms import Motion
+from ..references.faces import frame_geometry
 
 #: Version of the job format; frames_candidate refuses any other.
 JOB_VERSION = 1
@@ -71,7 +73,7 @@ def frame_name(k: int, ext: str) -> str:
     return f"frame_{k:04d}.{ext}"
 
 
-def _rows(m) -> list:
+def matrix_rows(m) -> list:
     return [[float(x) for x in row] for row in np.asarray(m, dtype=np.float64)]
 
 
@@ -94,9 +96,9 @@ def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames
     view, proj = camera_to_gl(camera)
     return {"scene": scene, "case": case, "frame": k, "t": frame_time(k, frames, phase),
             "camera": camera.to_dict(), "right": [float(x) for x in camera.right],
-            "model_matrix": _rows(model),
-            "K": _rows(kk), "R": _rows(r), "t_cv": [float(x) for x in t],
-            "gl_view": _rows(view), "gl_projection": _rows(proj),
+            "model_matrix": matrix_rows(model),
+            "K": matrix_rows(kk), "R": matrix_rows(r), "t_cv": [float(x) for x in t],
+            "gl_view": matrix_rows(view), "gl_projection": matrix_rows(proj),
             "conventions": "see job.json (conventions); wirecheck.core.conventions states them once"}
 
 
@@ -104,10 +106,6 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
               phase: float = 0.0) -> tuple[dict, dict]:
     """The manifest and the files of a job: ``(job, {relative path: bytes})``; ``phase``: module docstring
     (0: crosscheck's own poses, and job.json without a ``motion.phase``)."""
-    from wirecheck.core.transforms import Motion
-
-    from ..references.faces import frame_geometry
-
     motion = motion or Motion()
     files: dict[str, bytes] = {}
     scene_rows, case_rows = [], []

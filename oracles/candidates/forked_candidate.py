@@ -17,6 +17,7 @@ import time
 
 from . import protocol
 from .processes import die_with_parent
+from .candidate_host import serve_loaded
 
 
 class ForkedChild:
@@ -46,8 +47,6 @@ class ForkedChild:
                 os.dup2(err_w, 1)
                 os.dup2(err_w, 2)
                 sys.stdout = sys.stderr = open(2, "w", buffering=1, closefd=False)
-                from .candidate_host import serve_loaded
-
                 stdin, out = os.fdopen(in_r, "rb"), os.fdopen(out_w, "wb")
 
                 def send(data: bytes) -> None:

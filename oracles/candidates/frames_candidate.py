@@ -25,6 +25,9 @@ from wirecheck.core.user_files import read_text
 from .export import JOB_KIND, JOB_VERSION, frame_name
 from .job_as_exported import camera_file_problem, camera_keys_problem, job_keys_problem
 from .png_frame import FrameProblem, check_png, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
+from wirecheck.core.limits import MAX_FRAMES, check_image_size
+from wirecheck.core.scene.files import NAME_PATTERN
+from wirecheck.core.camera import Camera
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
@@ -98,9 +101,6 @@ def _job_problem(job: dict) -> str | None:
     so that an edited or damaged one is a usage error naming the field, never a
     crash later or numbers in the report that mean nothing.
     """
-    from wirecheck.core.limits import MAX_FRAMES, check_image_size
-    from wirecheck.core.scene.files import NAME_PATTERN
-
     frames, every = job.get("frames"), job.get("every")
     if not (_is_int(frames) and 1 <= frames <= MAX_FRAMES):
         return f"frames {frames!r}: expected an integer in 1..{MAX_FRAMES}"
@@ -205,7 +205,7 @@ def check_frames(job_dir: Path, job: dict, decode: bool = True) -> None:
     ``decode=False``: every check but the decoding of the pixels (the files, their PNG headers and
     sizes, the frames of another job): the judge then decodes each frame once, as it judges it, and
     calls this again with ``decode=True`` on a frame it cannot decode, so that the same problems are
-    listed as a full check would list them (oracles.judge.frames_judge.read_frame).
+    listed as a full check would list them (:func:`read_frame`).
     """
     _frames(job_dir, job, keep=False, decode=decode)
 
@@ -302,8 +302,6 @@ def _frame_camera(path: Path, cache: dict | None = None):
     the same Camera object back (a case's camera is fixed: converted once by
     oracles.references.opencv_oracle, which keeps the last camera by identity).
     """
-    from wirecheck.core.camera import Camera
-
     problem = file_problem(path, "camera")
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected the camera 'crosscheck export' wrote"])
@@ -365,16 +363,21 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
     return p_model, edges, camera, m
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "any"):
-    """One case, judged frame by frame: :func:`oracles.judge.frames_judge.judge_case`."""
-    from ..judge.frames_judge import judge_case as judge
+def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
+    """A frame's grey levels (oracles.candidates.png_frame.read_grey), decoded once, as it is judged.
 
-    return judge(job_dir, job, scene, case, oracles, tol, diagnose, line_rule)
-
-
-def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False, line_rule: str = "any") -> tuple[dict, dict]:
-    """Judge the job's frames: :func:`oracles.judge.frames_judge.run_frames`."""
-    from ..judge.frames_judge import run_frames as run
-
-    return run(job_dir, tol, diagnose, name, allow_vacuous, line_rule)
+    The job's frames were checked before the judging began, all but their
+    pixels' decoding (oracles.candidates.frames_candidate.check_frames with
+    ``decode=False``): a frame that cannot be decoded makes the full check run
+    (``job``: ``(job_dir, job)``), so that every problem of the job is listed,
+    as when the check decodes every frame first; FramesError either way.
+    """
+    try:
+        return read_grey(path, width, height)
+    except FrameProblem as exc:
+        problem = str(exc)
+    except Exception as exc:       # noqa: BLE001 - Pillow's many ways to say "not an image"
+        problem = f"unreadable as PNG ({type(exc).__name__}: {exc})"
+    if job is not None:
+        check_frames(*job)                      # raises, listing every problem of the job
+    raise FramesError([f"{path}: {problem}"])

@@ -21,12 +21,12 @@ from wirecheck.core.user_files import expected, problem
 
 from .candidate import CandidateError
 from .subprocess_candidate import DEFAULT_TIMEOUT_S, CandidateStartRefused, SubprocessCandidate
+from wirecheck.core.errors import InputError
+from .candidate import load_candidate
 
 
 def check_python_spec(spec: str, option: str = "--candidate") -> None:
     """Usage errors of a ``FILE.py:FUNC`` / ``MODULE:FUNC`` spec found without importing it (InputError)."""
-
-    from wirecheck.core.errors import InputError
 
     if ":" not in spec:
         raise InputError(f"{option} {spec!r}: expected FILE.py:FUNC or MODULE:FUNC")
@@ -56,8 +56,6 @@ def started(candidate: SubprocessCandidate, option: str):
     A program that dies, hangs or writes garbage at start-up is *not* a usage
     error: it is returned, and every case then fails with that reason.
     """
-    from wirecheck.core.errors import InputError
-
     try:
         candidate.start()
     except CandidateStartRefused as exc:
@@ -72,8 +70,6 @@ def started(candidate: SubprocessCandidate, option: str):
 def external_candidate(spec: str | None = None, command: str | None = None,
                        timeout_s: float = DEFAULT_TIMEOUT_S) -> SubprocessCandidate:
     """The isolated candidate for ``--candidate SPEC`` or ``--candidate-cmd COMMAND``, started (see :func:`started`)."""
-    from wirecheck.core.errors import InputError
-
     if spec is not None:
         check_python_spec(spec)
         return started(SubprocessCandidate.python(spec, timeout_s), "--candidate")
@@ -86,8 +82,6 @@ def external_candidate(spec: str | None = None, command: str | None = None,
 
 def api_candidate(func=None, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S, isolate: bool | None = None):
     """``(name, candidate)`` for the Python API (oracles.api; its docstring states the isolation rules)."""
-    from wirecheck.core.errors import InputError
-
     if (func is None) == (cmd is None):
         raise ValueError("expected a candidate: func or cmd, not both")
     if cmd is not None:
@@ -101,8 +95,6 @@ def api_candidate(func=None, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S, iso
         return candidate.name, started(candidate, "cmd")
     if isinstance(func, str):
         if isolate is False:
-            from .candidate import load_candidate
-
             return func, load_candidate(func)
         check_python_spec(func)
         return func, started(SubprocessCandidate.python(func, timeout_s), "--candidate")

@@ -19,6 +19,8 @@ import difflib
 import functools
 
 import numpy as np
+from wirecheck.core.scene.files import load_scene
+from wirecheck.core.camera import Camera
 
 #: Relative tolerance of a camera JSON's numbers against export's, of max(1, |expected|): the numbers are
 #: recomputed from the file's own camera (its JSON floats round-trip exactly) by a few dozen float64
@@ -45,8 +47,6 @@ def _keys_problem(where: str, keys, expected, required=None) -> str | None:
 def exported_keys() -> dict:
     """The keys of a job.json export writes: ``{"job", "scene", "case", "motion"}`` -> tuple of keys, from a
     one-frame job of the cube with a phase (so that ``motion.phase`` is there), built in memory."""
-    from wirecheck.core.scene.files import load_scene
-
     from .export import build_job
 
     job, _files = build_job([load_scene("cube")], frames=1, case_names=["on_axis"], phase=0.5)
@@ -74,8 +74,6 @@ def camera_keys_problem(cam_json) -> str | None:
     """Whether a camera JSON is an object whose ``camera`` holds the contract's keys (``intrinsics`` optional,
     as export writes it for a calibrated camera only); None when it does or has no ``camera`` object
     (left to the reading, which names it)."""
-    from wirecheck.core.camera import Camera
-
     if not isinstance(cam_json, dict):
         return f"a JSON {type(cam_json).__name__}: expected the object 'crosscheck export' wrote"
     if not isinstance(cam_json.get("camera"), dict):
@@ -132,13 +130,13 @@ def _expected(camera, model, scene: str, case: str, k: int, frames: int, phase: 
     """:func:`oracles.candidates.export.camera_json` of these arguments; for the camera of the last call, that
     call's JSON with the fields of the other arguments (frame, time, model matrix, names) replaced: the rest
     are the camera's alone."""
-    from .export import _rows, camera_json, frame_time
+    from .export import matrix_rows, camera_json, frame_time
 
     if _LAST.get("camera") is not camera:
         _LAST.update(camera=camera, json=camera_json(camera, model, scene, case, k, frames, phase))
         return _LAST["json"]
     return {**_LAST["json"], "scene": scene, "case": case, "frame": k, "t": frame_time(k, frames, phase),
-            "model_matrix": _rows(model)}
+            "model_matrix": matrix_rows(model)}
 
 
 def _differs(where: str, value, expected) -> str | None:

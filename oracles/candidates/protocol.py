@@ -113,7 +113,7 @@ def encode_reply(p_px: np.ndarray, precision: str = "float64", columns: int = 2)
 
 #: The keys a reply line may hold (an error reply: ``error``, and others are ignored).
 REPLY_KEYS = ("n", "precision")
-#: The values a reply's optional ``precision`` may take (oracles.judge.tolerances.PRECISIONS).
+#: The values a reply's optional ``precision`` may take (oracles.tolerances.PRECISIONS).
 REPLY_PRECISIONS = ("float32", "float64")
 
 

@@ -115,7 +115,7 @@ class SubprocessCandidate:
             raise ValueError(f"timeout_s {self.timeout_s!r}: expected a number of seconds > 0")
 
     @classmethod
-    def from_command(cls, command: str, timeout_s: float = DEFAULT_TIMEOUT_S, **kwargs) -> "SubprocessCandidate":
+    def from_command(cls, command: str, timeout_s: float = DEFAULT_TIMEOUT_S, **kwargs) -> SubprocessCandidate:
         """From a command line, split as a POSIX shell would (``shlex.split``), run without a shell."""
         try:
             argv = tuple(shlex.split(command))
@@ -126,7 +126,7 @@ class SubprocessCandidate:
         return cls(argv=argv, timeout_s=timeout_s, label=kwargs.pop("label", command), **kwargs)
 
     @classmethod
-    def python(cls, spec: str, timeout_s: float = DEFAULT_TIMEOUT_S, pythonpath=(), **kwargs) -> "SubprocessCandidate":
+    def python(cls, spec: str, timeout_s: float = DEFAULT_TIMEOUT_S, pythonpath=(), **kwargs) -> SubprocessCandidate:
         """A ``FILE.py:FUNC`` / ``MODULE:FUNC`` candidate run isolated, by :mod:`oracles.candidates.candidate_host`.
 
         ``pythonpath``: folders the host puts first on ``sys.path`` (for a
@@ -139,7 +139,7 @@ class SubprocessCandidate:
                    timeout_s=timeout_s, label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
 
     @classmethod
-    def fork(cls, func, timeout_s: float = DEFAULT_TIMEOUT_S, label: str = "") -> "SubprocessCandidate":
+    def fork(cls, func, timeout_s: float = DEFAULT_TIMEOUT_S, label: str = "") -> SubprocessCandidate:
         """``func`` run in a forked child process (:class:`ForkedChild`); POSIX only."""
         return cls(argv=("<forked>",), timeout_s=timeout_s, label=label or repr(func), python_spec=label or repr(func),
                    forked=func)
@@ -189,7 +189,7 @@ class SubprocessCandidate:
 _PROGRAMS: dict = {}
 
 
-def _live(spec: SubprocessCandidate) -> "_Program":
+def _live(spec: SubprocessCandidate) -> _Program:
     program = _PROGRAMS.get(spec)
     if program is None:
         program = _PROGRAMS[spec] = _Program(spec)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from wirecheck.core.outputs.output import FrameDir, json_dumps
 
-from ..reports.report import _finite_or_null
+from ..reports.report import finite_or_null
 
 #: Not-passing meshes listed by name on stdout (report.md and report.json list them all).
 CONSOLE_LIST = 20
@@ -148,7 +148,7 @@ def write_dataset_report(run_dir: Path, report: dict) -> Path:
     run_dir.parent.mkdir(parents=True, exist_ok=True)
     out = FrameDir(run_dir, "--report-dir")
     try:
-        report = _finite_or_null(report)
+        report = finite_or_null(report)
         out.write("report.json", json_dumps(report).encode())
         out.write("report.md", markdown(report).encode())
         out.commit()

@@ -1,7 +1,7 @@
 """Check every mesh of a dataset (oracles.datasets.dataset) and sum the run up: meshes passed, worst cases, faults by count.
 
 One task per mesh: the mesh is read where the task runs (a worker of a
-process pool or of a Dask cluster, oracles.datasets.executors), then each case camera
+process pool or of a Dask cluster, oracles.executors), then each case camera
 is run on it as a plain crosscheck runs it (oracles.runner). A mesh that
 cannot be read, or that no camera fits, is a mesh with verdict ``"error"``
 and its one-line reason: it is counted and reported, and the run goes on.
@@ -32,12 +32,15 @@ from wirecheck.core.user_files import expected, problem
 from wirecheck.core.errors import InputError, one_line
 
 from ..judge import gate
-from ..candidates.core_candidate import CoreCandidate, RenderMode
+from ..candidates.core_candidate import RenderMode
 from .dataset import Dataset, MeshEntry
-from .executors import ExecutorSpec, gather_in_order, open_executor
+from ..executors import ExecutorSpec, gather_in_order, open_executor
 from .memory_budget import default_budget, over_budget
-from ..runner import LEVEL_ORACLES, LEVELS, _CaseRunner, _overall_ms, _RunParams, _WORKER_LOCK, _worker_init, scene_cases, worker_runner, worst_key
-from ..judge.tolerances import Tolerances
+from ..runner import LEVEL_ORACLES, LEVELS, CaseRunner, overall_ms, RunParams, WORKER_LOCK, worker_init, scene_cases, worker_runner, worst_key
+from ..tolerances import Tolerances
+from wirecheck.core.scene.files import load_mesh_file
+from wirecheck.core.transforms import Motion
+from ..cases import calibrated_cases
 
 #: The fields of a case record kept in a dataset's report (the per-frame detail of
 #: thousands of cases would make report.json hundreds of megabytes; rerun one mesh for it).
@@ -54,8 +57,6 @@ class NothingLoaded(InputError):
 
 def _load(entry: MeshEntry):
     """The mesh as a Scene named by its dataset name; InputError with a one-line reason otherwise."""
-    from wirecheck.core.scene.files import load_mesh_file
-
     if entry.error is not None:
         raise InputError(entry.error)
     refused = problem(entry.path, "mesh")
@@ -80,7 +81,7 @@ def _named(text: str, entry: MeshEntry) -> str:
     return text
 
 
-def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None,
+def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None,
                budget: int | None = None) -> tuple[dict, dict, dict | None]:
     """``(mesh record, timing, oracle GL info or None)`` of one mesh under every case in ``case_names``.
 
@@ -120,9 +121,9 @@ def check_mesh(entry: MeshEntry, params: _RunParams, case_names, runner=None,
     return record, timing, gl
 
 
-def _worker_check_mesh(entry: MeshEntry, params: _RunParams, case_names,
+def _worker_check_mesh(entry: MeshEntry, params: RunParams, case_names,
                        budget: int | None = None) -> tuple[dict, dict, dict | None]:
-    with _WORKER_LOCK:
+    with WORKER_LOCK:
         return check_mesh(entry, params, case_names, worker_runner(), budget)
 
 
@@ -186,8 +187,6 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     bytes one mesh may need (oracles.datasets.memory_budget), ``"auto"`` for
     half the machine's memory shared by the local workers, None for no budget.
     """
-    from wirecheck.core.transforms import Motion
-
     if level not in LEVELS:
         raise ValueError(f"level {level!r}: expected one of {', '.join(LEVELS)}")
     mode = mode or RenderMode()
@@ -195,14 +194,12 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     executor = executor or ExecutorSpec()
     inputs = gate.run_settings(frames, every, case_names, turns, tol)
     if level == "pixels":
-        from ..judge.cases import calibrated_cases
-
         distorted = {c.name for c in calibrated_cases(1.0) if c.camera.distortion is not None}
         if set(inputs.case_names) <= distorted:      # as oracles.runner.run_crosscheck says it
             raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their "
                              "pixels are not compared (GL draws straight lines), so the run would compare no "
                              "pixel; expected level vertices or a case without distortion")
-    params = _RunParams(frames=inputs.frames, every=inputs.every, level=level, motion=Motion(turns=inputs.turns),
+    params = RunParams(frames=inputs.frames, every=inputs.every, level=level, motion=Motion(turns=inputs.turns),
                         tol=tol, candidate=candidate, mode=mode, keep_frames=False)
     # "auto": the workers on this machine share it (a remote cluster's machines: one worker's share)
     budget = (default_budget(executor.jobs if executor.scheduler is None else 1) if memory_budget == "auto"
@@ -219,10 +216,10 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
 
     if progress:
         progress(0, len(entries))
-    with open_executor(executor, len(entries), initializer=_worker_init) as (pool, workers):
+    with open_executor(executor, len(entries), initializer=worker_init) as (pool, workers):
         startup_s = time.perf_counter() - t_run        # a Dask cluster's start, or nothing
         if pool is None:
-            runner = _CaseRunner()
+            runner = CaseRunner()
             try:
                 results = []
                 for entry in entries:
@@ -277,7 +274,7 @@ def _timing(per_mesh: list[dict], executor: ExecutorSpec, workers: int, wall_s: 
             "oracles_ms_per_frame"]
     if level == "pixels":
         keys += ["pixel_stage_ms_per_frame", "pyrender_ms_per_frame", "pixel_metrics_ms_per_frame"]
-    timing = {k: _overall_ms(cases, k) for k in keys}
+    timing = {k: overall_ms(cases, k) for k in keys}
     oracles_ms, harness_ms = timing["oracles_ms_per_frame"], timing["harness_ms_per_frame"]
     timing["harness_overhead_ratio"] = harness_ms / oracles_ms if oracles_ms and harness_ms is not None else None
     busy_s = sum(m["load_s"] + m.get("check_s", 0.0) for m in per_mesh)

@@ -38,7 +38,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import faults as catalogue
-from ..judge.tolerances import EPS
+from ..tolerances import EPS
+from ..candidates.candidate import CandidateError, call_candidate
 
 __all__ = ["probe_planes", "clip_fault", "depth_slack", "FLOAT32_PLANE_ROUNDINGS", "PLANE_REL_TOL"]
 
@@ -65,11 +66,8 @@ def _axis_points(camera, depth: np.ndarray) -> np.ndarray:
 
 
 def _kept(func, camera, depth: np.ndarray) -> np.ndarray:
-    from ..candidates.candidate import call_candidate
-
     px = call_candidate(func, _axis_points(camera, depth), camera)
     if px.shape != (len(depth), 2):
-        from ..candidates.candidate import CandidateError
         raise CandidateError(f"candidate returned shape {px.shape} for {len(depth)} probe points")
     return np.isfinite(px).all(axis=1)
 
@@ -84,8 +82,6 @@ def probe_planes(func, camera) -> dict | None:
     probe (raises, wrong shape) gives None: the probe is an aid to naming,
     never a reason to fail a case.
     """
-    from ..candidates.candidate import CandidateError
-
     near, far = float(camera.near), float(camera.far)
     if not 0 < near < far < np.inf:
         return None                                   # no positive depth range to probe

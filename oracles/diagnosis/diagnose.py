@@ -87,7 +87,7 @@ unexplained         the named model does not fit (rotation,     residual_px (max
 Precision
 ---------
 ``tol_px`` is the caller's bound for the candidate's precision
-(oracles.judge.tolerances.vertex_bound: 1e-6 px for float64, ~1e-3 px for a
+(oracles.tolerances.vertex_bound: 1e-6 px for float64, ~1e-3 px for a
 float32 candidate on the bundled cases), so steps 3 and 4 fit *through* the
 candidate's rounding noise: a float32 projector with a mirror and a half-pixel
 offset is named ``mirror_vertical`` + ``pixel_offset``, not ``unexplained``.
@@ -150,7 +150,9 @@ import math
 import numpy as np
 
 from .. import faults as catalogue
+from ..tolerances import line_failures
 from .clip_planes import clip_fault
+from .lens_diagnose import distortion_fault
 
 __all__ = ["diagnose", "diagnose_lines", "primary", "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
 
@@ -169,7 +171,7 @@ DEPTH_FLIP_MAX_OVERLAP = 0.01
 #: pixels moves the fitted map by < 1e-10 relative, far below any fault.
 DEGENERATE_RATIO = 1e-6
 
-#: Machine epsilon of float32 (oracles.judge.tolerances.EPS), for :func:`rounded_constants`.
+#: Machine epsilon of float32 (oracles.tolerances.EPS), for :func:`rounded_constants`.
 EPS32 = 2.0 ** -23
 
 
@@ -252,7 +254,7 @@ def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float
     """Name the faults of a candidate projector; ``[]`` when it agrees.
 
     With ``float32_px`` (the float32 rounding bound of these points,
-    oracles.judge.tolerances.vertex_bound; given for a candidate judged at float64)
+    oracles.tolerances.vertex_bound; given for a candidate judged at float64)
     a disagreement at ``tol_px`` that the same diagnosis at ``float32_px``
     explains is named ``precision_limited`` (module docstring). With
     ``planes`` (oracles.diagnosis.clip_planes.probe_planes: the candidate's own near and
@@ -432,7 +434,6 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     info.update(scale=d.copy(), offset=off.copy(), reach=np.max(np.abs(q), axis=0))
     collapsed = bool(np.any(d * reach <= tol))       # an axis the candidate squashed flat
     if named_max > tol or collapsed:
-        from .lens_diagnose import distortion_fault       # a lens error bends the picture: not affine
         lens = None if mismatches or collapsed else distortion_fault(cand[both], orac[both], camera, tol)
         if lens is not None:
             return [lens]
@@ -483,7 +484,7 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     """Name a systematic line-pixel fault from a case's pooled line fields; [] when they pass.
 
     ``lines`` is :func:`oracles.judge.metrics.line_summary`'s output and ``tol`` the
-    run's tolerances; nothing is named unless :func:`oracles.judge.metrics.line_failures`
+    run's tolerances; nothing is named unless :func:`oracles.tolerances.line_failures`
     fails it. The decided one-sided pixels (sub-pixel ties left out, as in the
     balance; ``candidate_only`` and ``oracle_only`` below count these) are
     split by where they lie along the
@@ -497,8 +498,6 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     with the one-sided counts by place. Nothing is named when every one-sided
     pixel is a tie (0 decided on either side).
     """
-    from ..judge.metrics import line_failures
-
     tc, to = lines["subpixel_ties"]
     decided = {"candidate_only": int(lines["candidate_only"] - tc), "oracle_only": int(lines["oracle_only"] - to)}
     if not line_failures(lines, tol) or not (decided["candidate_only"] or decided["oracle_only"]):

@@ -1,6 +1,6 @@
 """Naming a registered picture: from the fitted ``c = d (P o) + b`` to faults (oracles.diagnosis.image_diagnose).
 
-The registration (:mod:`oracles.diagnosis.image_diagnose`) fits every signed axis
+The registration (:mod:`oracles.diagnosis.registration`, driven by oracles.diagnosis.image_diagnose) fits every signed axis
 permutation ``P`` with per-axis scales ``d`` and an offset ``b``; this module
 reads the faults off the winner, and says what the images cannot decide:
 
@@ -42,7 +42,10 @@ import math
 import numpy as np
 
 from .. import faults as catalogue
+from .model_lines import model_images, quantisation_bias
 from .rule_read import read_rules, standing_scale_faults
+from .diagnose import scale_faults
+from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, PERMUTATIONS, Registration, SCREEN_ITERATIONS, frame_samples, points_per_frame
 
 __all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales", "rule_bias", "rule_off_diagonal"]
 
@@ -85,8 +88,6 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
     ratio, ``residual``: the winner's cost, ``cand_images``: the candidate's frames (the aliased rule read
     from them sets the bias an offset is compared with, :func:`rule_bias`; without them GL's).
     """
-    from .diagnose import scale_faults
-
     cost, names, p, a, b = ranked[0]
     d = np.diag(a)
     cx, cy = camera.principal_point
@@ -139,8 +140,6 @@ def rotation_deg(a_free: np.ndarray) -> float:
 
 def restart_scales(coarse, fine, ranked: list, camera) -> list:
     """``ranked`` with the identity and the best permutation fitted again from :func:`scale_starts`."""
-    from .image_diagnose import PERMUTATIONS, SCREEN_ITERATIONS
-
     screened = []
     for names, p in {(): PERMUTATIONS[()], ranked[0][1]: ranked[0][2]}.items():
         for d0 in scale_starts(camera):
@@ -157,81 +156,6 @@ def restart_scales(coarse, fine, ranked: list, camera) -> list:
     return sorted(out.values(), key=lambda r: r[0])
 
 
-def _model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -> list[np.ndarray]:
-    """The fitted model's lines (``u -> d (p u)`` about the principal point, then ``+ shift``) drawn aliased.
-
-    ``snapped``: by the rule that rounds each end to a pixel centre first (core's
-    ``line_pixels_fast``: Bresenham's, OpenCV's LINE_8, Pillow's 1-px line); otherwise by
-    core's exact rule (integer pixel centres, GL's rule on these lines).
-    """
-    from wirecheck.core.projector.clipping import clip_to_image
-    from wirecheck.core.projector.raster import line_pixels, line_pixels_fast
-
-    centre = np.array(camera.principal_point)
-    shift = np.zeros(2) if shift is None else np.asarray(shift, dtype=np.float64)
-    draw = line_pixels_fast if snapped else line_pixels
-    images = []
-    for segs in oracle_segs:
-        segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-        segs = ((segs - centre) @ p.T) * d + centre + shift      # the model's lines (identity: the oracle's)
-        img = np.zeros((camera.height, camera.width), bool)
-        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
-        rr, cc = draw(q0, q1, camera.width, camera.height)
-        img[rr, cc] = True
-        images.append(img)
-    return images
-
-
-def quantisation_bias(oracle_segs, camera, p=None, d=None, snapped: bool = False) -> np.ndarray:
-    """The offset this fit finds for a *correct* aliased drawing of these lines: ``(2,)`` px.
-
-    With ``p`` and ``d`` (a signed axis permutation and per-axis scales), of
-    the lines mapped by ``u -> d (p u)`` about the principal point: the bias of
-    a fitted model's own lines (oracles.diagnosis.image_naming).
-
-    Pixel centres sit up to half a pixel from a line; over slanted lines at
-    every fractional position this averages out (< 0.05 px measured), but lines
-    that are all axis-aligned at one fractional position (a cube square-on,
-    nearly orthographic) are drawn half a pixel off in one direction, and no
-    image can tell that from an offset. The oracle's own lines drawn by core's
-    rasteriser (integer pixel centres, like GL's rule on these lines) give that
-    bias; an offset is a fault only when it differs from it. ``snapped``: drawn
-    by the rule that rounds the ends to pixel centres first (:func:`rule_bias`).
-    """
-    from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
-
-    p = np.eye(2) if p is None else np.asarray(p, dtype=np.float64)
-    d = np.ones(2) if d is None else np.asarray(d, dtype=np.float64)
-    centre = np.array(camera.principal_point)
-    images = _model_images(oracle_segs, camera, p, d, snapped=snapped)
-    limit = _points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)    # as diagnose_images
-    reg = _Registration(_frames(images, oracle_segs, camera, limit), camera.width, camera.height, centre)
-    if not any(len(f.cand) for f in reg.frames):
-        return np.zeros(2)
-    _a, b, _cost = reg.fit(p, np.diag(d), np.zeros(2))
-    return b
-
-
-def _model_lines(oracle_segs, camera, p, d, shift, snapped: bool) -> list[np.ndarray]:
-    """The model's lines moved by ``shift``, clipped to the image; ``snapped``: each end rounded to a pixel centre."""
-    from wirecheck.core.projector.clipping import clip_to_image
-
-    centre = np.array(camera.principal_point)
-    out = []
-    for segs in oracle_segs:
-        segs = ((np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2) - centre) @ p.T) * d + centre + shift
-        _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
-        q = np.stack([q0, q1], axis=1)
-        out.append(np.floor(q + 0.5) if snapped else q)
-    return out
-
-
-#: Shifts (px) about the snapped rule's line position at which its ends are rounded: the fitted offset's
-#: own error (~0.01 px pooled) decides the rounding of ends that fall on a half pixel (an orthographic
-#: view scaled by 4/3 puts many there), so each axis is tried at the position and 0.02 px either side.
-_JITTER = [np.array([sx, sy]) for sx in (-0.02, 0.0, 0.02) for sy in (-0.02, 0.0, 0.02)]
-
-
 def rule_bias(cand_images, oracle_segs, camera, p, d, b, gl_bias) -> tuple[str, np.ndarray]:
     """``(rule read, its bias)``: which aliased rule drew the candidate's lines, GL's or ends snapped.
 
@@ -243,7 +167,7 @@ def rule_bias(cand_images, oracle_segs, camera, p, d, b, gl_bias) -> tuple[str, 
     put them (offset ``b``); the snapped rule's, the model's lines moved by
     ``b`` less that rule's bias with their ends rounded to pixel centres (the
     segments such a renderer steps along, whatever its tie-breaking; the
-    best of :data:`_JITTER`'s positions). The rule
+    best of :data:`JITTER`'s positions). The rule
     whose lines the candidate's pixels fit closer (the registration's cost) is
     the one read: a GL-rule renderer with a half-pixel offset lies on its
     exact lines, so its offset is still measured against GL's bias. When the
@@ -267,16 +191,14 @@ def rule_off_diagonal(cand_images, oracle_segs, camera, fit, a_free, reach, off_
     is the candidate's. Under GL's rule ``off_diagonal`` is returned as it is;
     with both rules read (a tie), the smaller of the two: it must stand against both.
     """
-    from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
-
     p, a, b = fit
     d = np.diag(a)
     rules = read_rules(cand_images, oracle_segs, camera, p, d, b, quantisation_bias(oracle_segs, camera, p, d))
     if "snapped" not in rules:
         return off_diagonal
-    images = _model_images(oracle_segs, camera, p, d, b - rules["snapped"], snapped=True)
-    limit = _points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
-    reg = _Registration(_frames(images, oracle_segs, camera, limit), camera.width, camera.height,
+    images = model_images(oracle_segs, camera, p, d, b - rules["snapped"], snapped=True)
+    limit = points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
+    reg = Registration(frame_samples(images, oracle_segs, camera, limit), camera.width, camera.height,
                         np.array(camera.principal_point))
     own, _b, _cost = reg.fit(p, a, b, affine=True)
     left = np.asarray(a_free) - own

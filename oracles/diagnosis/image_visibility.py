@@ -20,6 +20,8 @@ rasteriser from the exact segments) with no drawn pixel within 1 px.
 from __future__ import annotations
 
 import numpy as np
+from wirecheck.core.projector.clipping import clip_to_image
+from wirecheck.core.projector import raster
 
 from .. import faults as catalogue
 
@@ -30,14 +32,11 @@ NEAR_PX = 1.0
 
 
 def _oracle_image(segs, camera) -> np.ndarray:
-    from wirecheck.core.projector.clipping import clip_to_image
-    from wirecheck.core.projector.raster import line_pixels
-
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
     img = np.zeros((camera.height, camera.width), bool)
     if len(segs):
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
-        rr, cc = line_pixels(q0, q1, camera.width, camera.height)
+        rr, cc = raster.line_pixels(q0, q1, camera.width, camera.height)
         img[rr, cc] = True
     return img
 

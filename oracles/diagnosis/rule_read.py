@@ -25,6 +25,9 @@ fit closer (the registration's cost), but the two costs are not always far enoug
 from __future__ import annotations
 
 import numpy as np
+from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
+from .model_lines import JITTER, model_lines, quantisation_bias
+from .diagnose import scale_faults
 
 __all__ = ["ROUNDED_END_PX", "RULE_TIE", "read_rules", "standing_scale_faults"]
 
@@ -47,24 +50,21 @@ def _costs(cand_images, oracle_segs, camera, p, d, b):
     """``(snapped bias, GL model's cost, snapped model's cost)`` of the candidate's pixels.
 
     GL's model at the fitted offset; the rounded ends' model at the best of the positions the fit cannot
-    tell apart (:data:`oracles.diagnosis.image_naming._JITTER`: ends on a half pixel round either way).
+    tell apart (:data:`oracles.diagnosis.model_lines.JITTER`: ends on a half pixel round either way).
     """
-    from .image_diagnose import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, _frames, _points_per_frame, _Registration
-    from .image_naming import _JITTER, _model_lines, quantisation_bias
-
     snapped_bias = quantisation_bias(oracle_segs, camera, p, d, snapped=True)
-    limit = _points_per_frame(len(cand_images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
+    limit = points_per_frame(len(cand_images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
     nearest = None
 
     def cost(lines):
         nonlocal nearest
-        frames = _frames(cand_images, lines, camera, limit, nearest)
+        frames = frame_samples(cand_images, lines, camera, limit, nearest)
         nearest = [f.nearest for f in frames]              # one distance transform per image, reused
-        reg = _Registration(frames, camera.width, camera.height, np.array(camera.principal_point))
+        reg = Registration(frames, camera.width, camera.height, np.array(camera.principal_point))
         return reg.cost(np.eye(2), np.eye(2), np.zeros(2))
 
-    gl = cost(_model_lines(oracle_segs, camera, p, d, b, False))
-    snapped = min(cost(_model_lines(oracle_segs, camera, p, d, b - snapped_bias + step, True)) for step in _JITTER)
+    gl = cost(model_lines(oracle_segs, camera, p, d, b, False))
+    snapped = min(cost(model_lines(oracle_segs, camera, p, d, b - snapped_bias + step, True)) for step in JITTER)
     return snapped_bias, gl, snapped
 
 
@@ -72,7 +72,7 @@ def read_rules(cand_images, oracle_segs, camera, p, d, b, gl_bias) -> dict:
     """``{rule: its offset bias}`` for each aliased rule the candidate's pixels may follow, closest first.
 
     ``p, d, b``: the fitted model (signed permutation, per-axis scales, offset); ``gl_bias``: GL's
-    bias for it (:func:`oracles.diagnosis.image_naming.quantisation_bias`). The closer rule is the one
+    bias for it (:func:`oracles.diagnosis.model_lines.quantisation_bias`). The closer rule is the one
     whose model the pixels fit closer (:func:`_costs`), as :func:`oracles.diagnosis.image_naming.rule_bias`
     reads it; the other is read too when its cost is within :data:`RULE_TIE` of the closer one's.
     """
@@ -89,8 +89,6 @@ def standing_scale_faults(faults: list, d, reach, tol: float, camera, rules) -> 
     Under the rule that rounds the ends a scale must move a pixel by more than ``tol`` plus
     :data:`ROUNDED_END_PX`; under GL's, by more than ``tol`` (``faults`` were named so).
     """
-    from .diagnose import scale_faults
-
     if "snapped" not in rules:
         return faults
     loose = {f["name"] for f in scale_faults(float(d[0]), float(d[1]), reach, tol + ROUNDED_END_PX, camera)}

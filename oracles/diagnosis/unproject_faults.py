@@ -49,7 +49,7 @@ def name_unproject_faults(p_px, depth, camera, cand, bound) -> tuple[list, dict]
     faults a list of :class:`Fault` read from ``"points"`` (one: the mistake, ``ambiguous`` or ``unexplained``).
 
     ``p_px`` ``(N, 2)`` and ``depth`` ``(N,)`` are what it was given; ``bound`` ``(N,)`` world
-    units (oracles.judge.tolerances.unproject_bound).
+    units (oracles.tolerances.unproject_bound).
     """
     p = np.asarray(p_px, dtype=np.float64).reshape(-1, 2)
     d = np.asarray(depth, dtype=np.float64).reshape(-1)

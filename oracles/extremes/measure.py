@@ -16,6 +16,7 @@ from ..judge import metrics
 from ..references import opencv_oracle
 from .bounds import EPS, EPS64, camera_error, near_band, opencv_camera_error, pixel_bound
 from .reference import LD, reference_project, reference_world
+from ..references.pyrender_oracle import OracleCache, osmesa_available
 
 
 def err_px(a_px, ref_px) -> np.ndarray:
@@ -114,8 +115,6 @@ class Pyrender:
     """One PyrenderOracle per image size (pyrender_oracle.OracleCache), or a note saying why none."""
 
     def __init__(self, enabled: bool):
-        from ..references.pyrender_oracle import OracleCache
-
         self.oracles = OracleCache()
         self.gl = None
         self.note = None
@@ -123,7 +122,6 @@ class Pyrender:
         if not enabled:
             self.note = "pyrender disabled (run_extremes(pyrender=False))"
             return
-        from ..references.pyrender_oracle import osmesa_available
         ok, msg = osmesa_available()
         if not ok:
             self.enabled, self.note = False, f"pyrender unavailable: {msg}"

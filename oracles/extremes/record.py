@@ -8,7 +8,7 @@ import numpy as np
 
 from wirecheck.core.projector.projection import DTYPES
 
-from ..judge.tolerances import MIN_F1_1PX_EXTREMES
+from ..tolerances import MIN_F1_1PX_EXTREMES
 from .measure import within
 
 #: The stats a record keeps, as :func:`measure.measure` names them.

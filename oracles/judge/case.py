@@ -9,7 +9,7 @@ Frame ``k`` (1-based, at ``t = (k - 1) / frames``) goes through two stages:
    given no edges, so nothing is drawn), any other candidate called on the
    world points (oracles.candidates.candidate); :func:`vertex_stage` scores them and keeps
    the case's scale for the precision-derived vertex bound
-   (oracles.judge.tolerances.vertex_scale);
+   (oracles.tolerances.vertex_scale);
 2. **pixel stage** (level ``pixels``): the candidate's frame (core's full
    pipeline, or oracles.candidates.draw for another candidate) against pyrender's
    rendering of the same edges, faces or shading (:func:`pixel_stage`).
@@ -29,16 +29,17 @@ from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
 
 from ..references import faces as oface
-from . import metrics, tolerances
+from . import metrics
+from .. import tolerances
 from ..references import opencv_oracle
 from ..candidates.candidate import CandidateError, call_candidate_precision, case_precision
 from ..references.convert import opencv_matrices
-from .cases import Case
+from ..cases import Case
 from ..candidates.core_candidate import CoreCandidate, RenderMode
 from ..candidates.draw import depth_margin, draw_candidate, oracle_segments
-from .tolerances import Tolerances
-from ..references.oracle_precision import judge_oracle_precision
-from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
+from ..tolerances import Tolerances
+from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge, judge_oracle_precision
+from ..diagnosis import clip_planes
 
 
 #: The note of a case whose camera has lens distortion, run at level pixels.
@@ -50,14 +51,14 @@ PIXELS_NOT_COMPARED = ("lens distortion: pixels not compared (GL draws straight 
 @dataclass(frozen=True)
 class KeptImage:
     """A bool image kept for worst.gif: its drawn pixels' flat indices (a wireframe: ~1 % of the
-    image, already found by metrics.FramePixels), or its bits packed (a filled silhouette)."""
+    image, already found by frame_pixels.FramePixels), or its bits packed (a filled silhouette)."""
 
     shape: tuple
     flat: np.ndarray | None = None
     bits: np.ndarray | None = None
 
     @classmethod
-    def of(cls, image: np.ndarray, flat: np.ndarray | None = None) -> "KeptImage":
+    def of(cls, image: np.ndarray, flat: np.ndarray | None = None) -> KeptImage:
         """``image`` kept: as ``flat`` (its drawn pixels' ascending flat indices) when given, else packed."""
         if flat is not None:
             return cls(image.shape, flat=flat)
@@ -125,8 +126,7 @@ class CaseSetup:
         """The candidate's own near and far planes (oracles.diagnosis.clip_planes.probe_planes), probed once; None
         for core (its planes are the camera's by construction) or when the probe cannot run."""
         if not self._probed and not self.is_core:
-            from ..diagnosis.clip_planes import probe_planes
-            self._planes, self._probed = probe_planes(self.timed, self.cam), True
+            self._planes, self._probed = clip_planes.probe_planes(self.timed, self.cam), True
         return self._planes
 
     def draw_slack(self, p_world: np.ndarray) -> float:
@@ -138,8 +138,7 @@ class CaseSetup:
         d0, d1 = depth[self.edges[:, 0]], depth[self.edges[:, 1]]
         crosses = any(((d0 < plane) != (d1 < plane)).any() for plane in (self.cam.near, self.cam.far))
         if crosses:
-            from ..diagnosis.clip_planes import depth_slack
-            self.slack, self.slack_why = depth_slack(self.planes(), self.cam)
+            self.slack, self.slack_why = clip_planes.depth_slack(self.planes(), self.cam)
         return self.slack
 
 
@@ -158,7 +157,7 @@ class TimedCalls:
 
 
 class ScaleBatch:
-    """Frames waiting for :func:`oracles.judge.tolerances.vertex_scale`, measured together.
+    """Frames waiting for :func:`oracles.tolerances.vertex_scale`, measured together.
 
     A frame's scale is the largest of its points' (elementwise), so the
     largest over several frames is the scale of their points together: one
@@ -195,7 +194,7 @@ class CaseFrames:
     returned: set = field(default_factory=set)          # the precisions of the candidate's answers
     depth_ties: int = 0                                 # points left out by forgive_depth_ties
     scale: float = 0.0                                  # largest tolerances.vertex_scale over the frames
-    scales: "ScaleBatch" = field(default_factory=lambda: ScaleBatch())   # frames waiting for vertex_scale
+    scales: ScaleBatch = field(default_factory=lambda: ScaleBatch())   # frames waiting for vertex_scale
     oracle_px: list = field(default_factory=list)
     frame_errors: list = field(default_factory=list)    # (max error px, frame, worst vertex)
     per_frame: list = field(default_factory=list)       # the record's per_frame items
@@ -400,7 +399,7 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
     """
     p_world, matrices, pr_vertices, pr_pose = geometry
     mode, cam, scene = setup.mode, setup.cam, setup.scene
-    fp = None                                       # the wireframe's drawn pixels (metrics.FramePixels)
+    fp = None                                       # the wireframe's drawn pixels (frame_pixels.FramePixels)
     mirrored = (oface.mirrored_vertices(scene, matrices) if setup.use_faces and mode.cull == "backface"
                 else None)
     if mode.shaded:

@@ -12,7 +12,7 @@ same record fields from its frames; this module alone decides on them:
   their width allows, ``pixel_f1_radius`` at ``f1_radius_px``,
   oracles.judge.f1_radius), the one-sided pixel balance (a sign test) and the per-edge
   pixel counts of the lines, sub-pixel ties left out
-  (:func:`oracles.judge.metrics.line_failures` on the record's ``lines``); for a
+  (:func:`oracles.tolerances.line_failures` on the record's ``lines``); for a
   renderer's lines of a style GL's pixel rule cannot hold (anti-aliased, wide),
   the line centres, ends and warp measured from its images instead
   (``line_style``, oracles.judge.line_style);
@@ -32,8 +32,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import gate, metrics
-from .tolerances import Tolerances
+from . import gate
+from ..tolerances import Tolerances, line_failures
+from ..diagnosis.diagnose import diagnose_lines
 
 #: The fault of a failing case that no diagnosis explains.
 UNEXPLAINED = {"name": "unexplained"}
@@ -63,8 +64,6 @@ def line_faults(rec: dict, tol: Tolerances, faults: list) -> list:
     """
     if faults or "lines" not in rec:
         return faults
-    from ..diagnosis.diagnose import diagnose_lines
-
     return diagnose_lines(rec["lines"], tol)
 
 
@@ -108,7 +107,7 @@ def pixel_rule_reasons(rec: dict, tol: Tolerances) -> list[str]:
     if rec["pixel_f1_0px"] < tol.min_f1_0px:
         out.append(f"pixel F1@0px {rec['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
     if "lines" in rec:
-        out += metrics.line_failures(rec["lines"], tol)
+        out += line_failures(rec["lines"], tol)
     return out
 
 

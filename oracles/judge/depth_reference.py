@@ -4,7 +4,7 @@ pyrender draws the frame's faces filled into single-sample buffers
 (:meth:`oracles.references.pyrender_oracle.PyrenderOracle.render_faces`); its 24-bit depth
 buffer is read and made linear in float64 there, perspective and orthographic alike. The
 per-pixel bound is :func:`oracles.judge.metrics.depth_bound` (derived in
-oracles.judge.tolerances: four 24-bit steps, the depth slope over llvmpipe's 1/256 px
+oracles.tolerances: four 24-bit steps, the depth slope over llvmpipe's 1/256 px
 snapping, float32 geometry). Pixels next to an occlusion boundary (a triangle in front of
 another it shares no vertex with: :func:`oracles.judge.metrics.occlusion_boundary`) show
 either surface by each renderer's rounding; their depth is not compared
@@ -29,7 +29,7 @@ from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion
 
 from ..references import faces as oface
-from .cases import Case, case_motion
+from ..cases import Case, case_motion
 from .metrics import depth_bound, depth_slope, occlusion_boundary
 
 __all__ = ["ReferenceDepth", "reference_depth"]
@@ -78,7 +78,7 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
     scene : Scene
         With faces (a wireframe has no depth: ValueError).
     case : Case
-        The camera and the pivot the run turns about (oracles.judge.cases.case_motion).
+        The camera and the pivot the run turns about (oracles.cases.case_motion).
     motion : Motion
         The run's motion.
     k, frames : int

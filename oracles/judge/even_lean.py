@@ -61,6 +61,7 @@ axis is absorbed by their leans.
 from __future__ import annotations
 
 import numpy as np
+from .line_profile import MIN_SAMPLES, pooled_offset
 
 #: How far (px, along the minor axis) an even band may lean off the exact line: half a pixel.
 LEAN_PX = 0.5
@@ -132,8 +133,6 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     samples' offsets less their edge's chosen band's (``d`` plus noise where
     the fit holds; what the affine warp is measured on).
     """
-    from .line_style import MIN_SAMPLES, pooled_offset
-
     if len(offset) < MIN_SAMPLES:
         return None
     refs = reference_offsets(normal, point, band_px)

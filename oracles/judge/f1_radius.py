@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import math
 
+from .metrics import pixel_scores
+
 #: The widest radius computed: lines up to 5 px across (``1 + ceil((5 - 1) / 2) = 3``). A wider
 #: line is still held to 3 px (its outer pixels count against it: a stricter F1, never a looser one).
 MAX_RADIUS_PX = 3
@@ -49,10 +51,8 @@ def radius_px(read: dict) -> int:
 
 
 def frame_scores(fp, scores: dict) -> dict:
-    """``{radius: F1}`` of one frame for each of :data:`RADII` (``fp``: its oracles.judge.metrics.FramePixels,
+    """``{radius: F1}`` of one frame for each of :data:`RADII` (``fp``: its oracles.judge.frame_pixels.FramePixels,
     ``scores``: its oracles.judge.metrics.pixel_scores at 0 and 1 px)."""
-    from .metrics import pixel_scores
-
     if scores["f1_1px"] == 1.0:                     # every pixel within 1 px: within any wider radius
         return {r: 1.0 for r in RADII}
     wide = pixel_scores(None, None, tols=RADII, pixels=fp)

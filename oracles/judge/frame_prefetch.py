@@ -18,7 +18,7 @@ What stays as it was:
   as without the thread; only when they are computed changes.
 - **The same errors, at the same frame.** What a frame's reading raises
   (a camera file, the oracle, a PNG that cannot be decoded: FramesError,
-  listing every problem of the job as :func:`oracles.judge.frames_judge.read_frame`
+  listing every problem of the job as :func:`oracles.candidates.frames_candidate.read_frame`
   does) is kept with that frame and raised in the judge's thread when the judge
   reaches that step of that frame, so frames before it are judged first and
   the message is the same.
@@ -37,6 +37,9 @@ from __future__ import annotations
 import threading
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
+
+from ..candidates.frames_candidate import frame_inputs, read_frame
+from ..references.pyrender_oracle import OracleCache
 
 #: Frames read ahead of the one being judged (each: the oracle's drawing and the PNG's grey levels).
 AHEAD = 2
@@ -65,7 +68,7 @@ class FrameAhead:
         return self._value(self._oracle)
 
     def grey(self):
-        """The frame's PNG as grey levels (oracles.judge.frames_judge.read_frame)."""
+        """The frame's PNG as grey levels (oracles.candidates.frames_candidate.read_frame)."""
         return self._value(self._grey)
 
 
@@ -76,9 +79,6 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str, cache: dict) ->
     drawing, the PNG; a step that fails ends the frame's reading (the judge
     raises it before it would need the next).
     """
-    from ..candidates.frames_candidate import frame_inputs
-    from .frames_judge import read_frame
-
     try:
         inputs = frame_inputs(job_dir, job, c["scene"], c["case"], k, cache)
     except Exception as exc:      # noqa: BLE001 - raised again in the judge's thread, at this frame
@@ -105,8 +105,6 @@ class FramePrefetch:
     """
 
     def __init__(self, oracles=None, threaded: bool = True, ahead: int = AHEAD):
-        from ..references.pyrender_oracle import OracleCache
-
         self.oracles = OracleCache() if oracles is None else oracles
         self.ahead = int(ahead)
         self._pool = ThreadPoolExecutor(1, thread_name_prefix="wirecheck-frames") if threaded else None

@@ -30,13 +30,21 @@ from pathlib import Path
 import numpy as np
 
 from . import f1_radius, line_model, metrics
+from ..candidates.frames_candidate import read_frame
 from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
 from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
 from .dim_lines import name_dim_lines
+from .line_style import CaseStyle
+from wirecheck.core.projector import pipeline
+from ..candidates.draw import oracle_segments as line_segments
+from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+from ..diagnosis.image_visibility import frames_visibility
+from ..candidates import frames_candidate
+from ..tolerances import Tolerances
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
-#: The diagnosis samples at most 3,600 points a case (image_diagnose.MAX_POINTS_PER_CASE),
+#: The diagnosis samples at most 3,600 points a case (oracles.diagnosis.registration.MAX_POINTS_PER_CASE),
 #: 150 a frame at 24 frames: more frames would add few points each and cost memory.
 DIAGNOSIS_FRAMES = 24
 
@@ -59,29 +67,6 @@ def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarra
     """
     grey = read_frame(path, width, height, job) if grey is None else grey
     return style.frame_flat(grey, orac, *frame, segs=segs)
-
-
-def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
-    """A frame's grey levels (oracles.candidates.png_frame.read_grey), decoded once, as it is judged.
-
-    The job's frames were checked before the judging began, all but their
-    pixels' decoding (oracles.candidates.frames_candidate.check_frames with
-    ``decode=False``): a frame that cannot be decoded makes the full check run
-    (``job``: ``(job_dir, job)``), so that every problem of the job is listed,
-    as when the check decodes every frame first; FramesError either way.
-    """
-    from ..candidates.frames_candidate import FramesError, check_frames
-    from ..candidates.png_frame import FrameProblem, read_grey
-
-    try:
-        return read_grey(path, width, height)
-    except FrameProblem as exc:
-        problem = str(exc)
-    except Exception as exc:       # noqa: BLE001 - Pillow's many ways to say "not an image"
-        problem = f"unreadable as PNG ({type(exc).__name__}: {exc})"
-    if job is not None:
-        check_frames(*job)                      # raises, listing every problem of the job
-    raise FramesError([f"{path}: {problem}"])
 
 
 def diagnosis_frames(n: int, limit: int = DIAGNOSIS_FRAMES) -> set:
@@ -140,14 +125,6 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     rounded-ends rule (oracles.judge.line_model), ``"gl"`` to GL's pixel rule alone,
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
     """
-    from .line_style import CaseStyle
-
-    from wirecheck.core.projector.pipeline import render_frame
-
-    from ..candidates.draw import oracle_segments as line_segments
-    from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
-    from ..diagnosis.image_visibility import frames_visibility
-
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     numbers = [int(Path(rel).stem.split("_")[-1]) for rel in c["frames"]]
     kept = diagnosis_frames(len(numbers)) if diagnose else set()
@@ -166,7 +143,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         orac = frame.oracle()
         cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
                                 segs, (job_dir, job), grey=frame.grey())
-        core = _drawn(render_frame(p_model, edges, camera, m).image)
+        core = _drawn(pipeline.render_frame(p_model, edges, camera, m).image)
         fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
         style.count_rule(fp, segs)
         if line_rule != "geometry":
@@ -247,13 +224,10 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     same FramesError, :func:`read_frame`). A case where neither side drew a pixel is ``"vacuous"`` and
     fails the run unless ``allow_vacuous`` (as :mod:`oracles.judge.gate`).
     """
-    from ..candidates.frames_candidate import check_frames, load_job
-    from .tolerances import Tolerances
-
     tol = tol or Tolerances()
     t0 = time.perf_counter()
-    job = load_job(job_dir)
-    check_frames(job_dir, job, decode=False)          # each frame is decoded once, as it is judged
+    job = frames_candidate.load_job(job_dir)
+    frames_candidate.check_frames(job_dir, job, decode=False)          # each frame is decoded once, as it is judged
     reader = FramePrefetch()            # the GL thread: every oracle call, and the frames read ahead of the judge
     records, images = [], {}
     try:

@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import tolerances as _tolerances
-from .line_style import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX, _seg_distance
+from .. import tolerances as _tolerances
+from .line_profile import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX
+from ..segment_geometry import seg_distance
 
 #: A segment end is measured when no other segment comes this close to it (px): the profile along the
 #: line (4 px past the end) stays clear of every other line's window.
@@ -24,7 +25,7 @@ END_INSIDE_PX = 6.0
 END_REACH_PX = 4.0
 #: An end is short when the line's coverage falls to half before this (px, negative: inside the
 #: segment), long when it stays above half this far past half the width: the default of
-#: Tolerances.end_px (oracles.judge.tolerances, with its derivation).
+#: Tolerances.end_px (oracles.tolerances, with its derivation).
 END_TOL_PX = _tolerances.END_TOL_PX
 #: Ends a case must have measured for their median to be judged.
 MIN_ENDS = 4
@@ -76,7 +77,7 @@ def measure_ends(cov: np.ndarray, segs: np.ndarray, level: float = 1.0) -> np.nd
     free = ((margin <= end[:, 0]) & (end[:, 0] <= w - 1 - margin)
             & (margin <= end[:, 1]) & (end[:, 1] <= h - 1 - margin))
     if len(segs) > 1 and free.any():
-        dist = _seg_distance(end, segs[:, 0], segs[:, 1])
+        dist = seg_distance(end, segs[:, 0], segs[:, 1])
         dist[np.arange(len(end)), seg] = np.inf                 # its own segment
         free &= dist.min(axis=1) > FREE_END_PX
     end, out_dir, normal = end[free], out_dir[free], normal[free]

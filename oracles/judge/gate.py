@@ -36,7 +36,7 @@ from wirecheck.core.scene import files as scene_files
 from wirecheck.core.scene.model import Scene
 from wirecheck.core.scene.files import builtin_names, load_scene
 
-from .cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES
+from ..cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES
 
 #: How each input is called in messages: by the Python API, and by the ``crosscheck`` CLI.
 API_NAMES = {"scenes": "scenes", "frames": "frames", "every": "every", "cases": "cases", "turns": "turns",

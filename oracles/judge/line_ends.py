@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import line_ties
+from .frame_pixels import FramePixels
 from .segment_pixels import nearest_segments
 
 #: A one-sided pixel within this distance (px) of a segment's start or end counts as at that end.
@@ -49,8 +50,6 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
     the segment leaves the pixel's diamond). Returns
     ``{place: [candidate_only, oracle_only]}``.
     """
-    from .metrics import FramePixels
-
     return frames_end_places([(FramePixels(cand, oracle), p0_px, p1_px)])[0]
 
 
@@ -105,7 +104,7 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
 
 
 def resolve_ties(fp, ties: tuple):
-    """The frame's pixels (oracles.judge.metrics.FramePixels) with the candidate given the oracle's value at its ties.
+    """The frame's pixels (oracles.judge.frame_pixels.FramePixels) with the candidate given the oracle's value at its ties.
 
     ``ties``: ``(candidate_only, oracle_only)`` flat indices of the tie pixels
     (:func:`frames_end_places`' ``tie_pixels``). The candidate's tie pixels the
@@ -113,8 +112,6 @@ def resolve_ties(fp, ties: tuple):
     candidate did not draw are put in: both images then agree at every tie,
     and differ at the decided pixels only. ``fp`` itself when there is no tie.
     """
-    from .metrics import FramePixels
-
     cand_ties, oracle_ties = ties
     if not len(cand_ties) and not len(oracle_ties):
         return fp

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tolerances import ROUNDED_END_TIE_PX
+from ..tolerances import ROUNDED_END_TIE_PX
 
 __all__ = ["RULES", "END_TIE_PX", "rounded_pixels", "rounded_ties", "expected", "band_pixels",
            "run_centroid_offset"]
@@ -51,7 +51,7 @@ __all__ = ["RULES", "END_TIE_PX", "rounded_pixels", "rounded_ties", "expected", 
 RULES = ("gl", "rounded")
 
 #: How close to a half pixel (px, per axis) a rounded-rule end may be rounded either way: the default of
-#: Tolerances.rounded_end_tie_px (oracles.judge.tolerances, with its derivation).
+#: Tolerances.rounded_end_tie_px (oracles.tolerances, with its derivation).
 END_TIE_PX = ROUNDED_END_TIE_PX
 
 

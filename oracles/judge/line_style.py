@@ -37,7 +37,7 @@ sample's offset. Pooled over every sample of a case's frames:
 For binary styles the same measure on a correct drawing of the same lines (core's GL-like raster
 for aliased lines; pixel centres within half the width for wide ones) is subtracted: lines at one
 fractional position (a cube square-on) sit up to half a pixel off in every correct drawing, as in
-:func:`oracles.diagnosis.image_diagnose.quantisation_bias`; at an exact tie (a band edge on a pixel
+:func:`oracles.diagnosis.model_lines.quantisation_bias`; at an exact tie (a band edge on a pixel
 centre) either choice reads 0 (:func:`oracles.judge.line_ties.fold_ties`). Lines that the registration
 finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
 the windows, are not measured (the centroids would be of stray crossings). Binary lines of an even
@@ -76,9 +76,16 @@ from __future__ import annotations
 import numpy as np
 
 from .. import faults as catalogue
-from . import coverage_pixels, even_lean, line_ties, line_windows, tolerances
+from .. import tolerances
+from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
+from ..diagnosis.diagnose import diagnose_lines
 from .case_samples import CaseSamples
-from .line_windows import seg_distance as _seg_distance  # noqa: F401 (free_ends, _reference)
+from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
+from ..segment_geometry import seg_distance
+from ..diagnosis.image_diagnose import oracle_segments
+from wirecheck.core.projector.clipping import clip_to_image
+from wirecheck.core.projector import raster
+from .free_ends import MIN_ENDS
 
 STYLES = ("aliased", "antialiased", "wide")
 #: ``--line-rule``: ``any`` (the default) holds aliased lines to a correct drawing under GL's rule or under
@@ -88,12 +95,6 @@ LINE_RULES = ("any", "gl", "geometry")
 #: What each rule read from the pixels is, for the report and the summary line.
 RULE_NAMES = {"gl": "GL's diamond exit", "rounded": "ends rounded to pixel centres (Bresenham, Pillow, cv2.line)"}
 
-#: Half the window across a line in which its centroid is taken (px): a 3-px line's half width
-#: (1.5) plus an antialiased fringe (1) plus a pixel of slack for a half-pixel offset.
-PROFILE_RADIUS_PX = 3
-#: A sample is dropped when another segment, or its own segment's end, is this close (px):
-#: the window plus half a pixel, so no other line's pixel enters it.
-GUARD_PX = PROFILE_RADIUS_PX + 1.5
 #: A differing pixel this close to a segment end (px) is counted "at the end".
 END_RADIUS_PX = 1.5
 #: Coverage per unit length from which a line is ``wide``: a 1-px aliased line has at most
@@ -108,17 +109,12 @@ LEVEL_SHARE_MIN = 0.002
 #: The line's level: this percentile of the drawn pixels' values (robust to a few bright
 #: crossings of antialiased lines).
 LEVEL_PERCENTILE = 99
-#: A sample's window must hold this much coverage (in units of a fully covered pixel) to be a
-#: sample of the line: half a pixel's worth, so a missing line is no sample (F1 fails on it).
-MIN_MASS = 0.5
 #: Samples a case keeps per frame (evenly thinned above): thousands of samples pin the pooled
 #: offset far below 0.05 px, and the measure costs about the same whatever the mesh.
 MAX_SAMPLES_PER_FRAME = 4000
 #: ... and per case: past it every frame's samples are halved, so a case's memory stays bounded
 #: whatever its number of frames (the offset is a mean over tens of thousands of samples either way).
 MAX_SAMPLES_PER_CASE = 48_000
-#: Fewer samples than this in a case: the geometry is not measured (too little free line).
-MIN_SAMPLES = 20
 #: The geometry is measured only where at least this share of the windows along the oracle's lines
 #: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
 MIN_FOUND_SHARE = 0.5
@@ -131,7 +127,7 @@ MEASURED_FAULTS = catalogue.names("scale", "offset")
 #: The faults a correct drawing under another aliased rule leaves under GL's rule: raster_rule replaces them.
 RULE_FAULTS = catalogue.names("unexplained", "offset", "line_count")
 #: Aliased lines of another rule, and binary wide lines: the largest pooled centre offset (px) that is
-#: still "the geometry is right": the default of Tolerances.rule_offset_px (oracles.judge.tolerances).
+#: still "the geometry is right": the default of Tolerances.rule_offset_px (oracles.tolerances).
 RULE_OFFSET_MAX_PX = tolerances.RULE_OFFSET_MAX_PX
 
 CAN_SHOW = {
@@ -155,8 +151,6 @@ CANNOT_SHOW = {
 
 
 def _segments(p_model, edges, camera, m) -> np.ndarray:
-    from ..diagnosis.image_diagnose import oracle_segments
-
     p_world = np.asarray(p_model, dtype=np.float64) @ m[:3, :3].T + m[:3, 3]
     return oracle_segments(p_world, edges, camera)
 
@@ -231,39 +225,18 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
     return x[:2], x[2:].reshape(2, 2)
 
 
-def pooled_offset(normal: np.ndarray, offset: np.ndarray):
-    """``(d (2,), determined (2,) bool)``: the least-squares ``d`` with ``n . d = offset``.
-
-    A component the normals do not constrain (every line parallel to it, e.g.
-    only horizontal lines say nothing of ``dx``) is 0 and not determined.
-    """
-    if len(offset) < MIN_SAMPLES:
-        return np.zeros(2), np.zeros(2, bool)
-    nn = normal.T @ normal
-    determined = np.diag(nn) >= 0.05 * len(offset)     # >= 5 % of the samples' weight on that axis
-    d = np.zeros(2)
-    idx = np.flatnonzero(determined)
-    if len(idx):
-        sol, *_ = np.linalg.lstsq(normal[:, idx], offset, rcond=None)
-        d[idx] = sol
-    return d, determined
-
-
 def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.ndarray:
     """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width.
 
     ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
     """
-    from wirecheck.core.projector.clipping import clip_to_image
-    from wirecheck.core.projector.raster import line_pixels
-
     h, w = shape
     img = np.zeros(shape, bool)
     if len(segs) == 0:
         return img
     if width_px < WIDE_MIN_PX:
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h) if clipped is None else clipped
-        rr, cc = line_pixels(q0, q1, w, h)
+        rr, cc = raster.line_pixels(q0, q1, w, h)
         img[rr, cc] = True
         return img
     half = round(width_px) / 2.0
@@ -274,14 +247,14 @@ def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.nda
             continue
         yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
         q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
-        near = _seg_distance(q, a[None], b[None])[:, 0] <= half
+        near = seg_distance(q, a[None], b[None])[:, 0] <= half
         img[yy.ravel()[near], xx.ravel()[near]] = True
     return img
 
 
 def _off_by_one(fp, ends: np.ndarray) -> dict:
     """Pixels where the candidate and the oracle differ (``fp``: the frame's
-    oracles.judge.metrics.FramePixels), counted by where they are (module docstring)."""
+    oracles.judge.frame_pixels.FramePixels), counted by where they are (module docstring)."""
     h, w = fp.shape
     c_only, o_only = fp.only()
     flat = np.concatenate([c_only, o_only])
@@ -344,8 +317,6 @@ class CaseStyle:
 
     def frame_flat(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
         """:meth:`frame`'s pixels as ascending flat indices ``y W + x`` (the frames judge keeps no image)."""
-        from wirecheck.core.projector.clipping import clip_to_image
-
         grey = np.asarray(grey)
         binary_input = grey.dtype == bool
         if binary_input:
@@ -389,7 +360,7 @@ class CaseStyle:
 
     def count_rule(self, fp, segs: np.ndarray) -> None:
         """Count one frame's differing pixels by where they lie (the raster rule's shares; :func:`_off_by_one`):
-        ``fp`` the frame's oracles.judge.metrics.FramePixels of the pixels :meth:`frame` returned and pyrender's."""
+        ``fp`` the frame's oracles.judge.frame_pixels.FramePixels of the pixels :meth:`frame` returned and pyrender's."""
         counts = _off_by_one(fp, np.asarray(segs, dtype=np.float64).reshape(-1, 2))
         self.raster = {k: v + counts[k] for k, v in self.raster.items()}
 
@@ -494,9 +465,6 @@ class CaseStyle:
         pixels were read as (``rule_read``) and the style's own failures (``failures``), which
         oracles.judge.decide.decide then applies.
         """
-        from ..diagnosis.diagnose import diagnose_lines
-        from .free_ends import MIN_ENDS
-
         tol = tolerances.Tolerances() if tol is None else tol
         read = self.classify()
         geo = self.geometry(read, tol)
@@ -657,5 +625,3 @@ def summary_lines(cases: list) -> list[str]:
                    "a correct drawing by that rule; --line-rule gl holds them to GL's")
     return out
 
-
-from . import free_ends  # noqa: E402  (it reads this module's constants: imported once they are defined)

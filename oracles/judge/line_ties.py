@@ -19,7 +19,7 @@ candidate, so the line gate counts it apart (``subpixel_ties``) and leaves it
 out of the balance sign test (oracles.judge.metrics.line_summary).
 
 ``eps`` for a segment of minor/major slope ``m`` is ``(1 + |m|) TIE_END_PX``
-(oracles.judge.tolerances, with its derivation): each end may move by
+(oracles.tolerances, with its derivation): each end may move by
 ``TIE_END_PX`` per coordinate, which moves the crossing by at most that
 times ``1 + |m|``.
 
@@ -57,7 +57,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tolerances import TIE_END_PX
+from ..tolerances import TIE_END_PX
 
 
 def tie_crossings(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray,

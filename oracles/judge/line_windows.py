@@ -9,7 +9,7 @@ built for the windows kept only (a frame of a few long lines has thousands of
 steps along them; the frames judge finds them once a frame).
 
 The junction test (a window is dropped when another segment comes within the
-guard) is decided for each (window, segment) pair by :func:`seg_distance`'s
+guard) is decided for each (window, segment) pair by :func:`oracles.segment_geometry.seg_distance`'s
 arithmetic, but only for the pairs that can be that close: a window farther
 than the guard from a segment's bounding box is farther from the segment, and
 along a line the windows in a box form one interval, found per pair of
@@ -21,27 +21,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..segment_geometry import pair_distance, seg_distance
+
 #: Points whose distances to every segment are found at once (the ``(n, K)`` temporaries stay small).
 CHUNK_ELEMENTS = 1 << 16
-
-
-def seg_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(N, K)`` distance of points ``q (N, 2)`` to segments ``a -> b (K, 2)`` (x and y apart: no (N, K, 2) array)."""
-    abx, aby = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
-    len2 = np.maximum(abx * abx + aby * aby, 1e-300)
-    qx, qy = q[:, 0:1], q[:, 1:2]
-    t = np.clip(((qx - a[:, 0]) * abx + (qy - a[:, 1]) * aby) / len2, 0.0, 1.0)
-    return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
-
-
-def _pair_distance(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(N,)`` distance of each point ``q[n]`` to its segment ``a[n] -> b[n]``: :func:`seg_distance`'s
-    arithmetic, element by element, so each pair's value is the same to the bit."""
-    abx, aby = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
-    len2 = np.maximum(abx * abx + aby * aby, 1e-300)
-    qx, qy = q[:, 0], q[:, 1]
-    t = np.clip(((qx - a[:, 0]) * abx + (qy - a[:, 1]) * aby) / len2, 0.0, 1.0)
-    return np.hypot(a[:, 0] + t * abx - qx, a[:, 1] + t * aby - qy)
 
 
 def _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard):
@@ -119,7 +102,7 @@ def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
     if len(segs) > 1 and keep.any():                          # drop windows near another segment
         if np.all(np.abs(segs) < 1e150):                      # squares finite: no distance is NaN
             win, other = _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard)
-            near = ~(_pair_distance(pt[win], segs[other, 0], segs[other, 1]) > guard)
+            near = ~(pair_distance(pt[win], segs[other, 0], segs[other, 1]) > guard)
             keep[win[near]] = False
         else:                                                 # every pair (a NaN distance drops the window)
             idx = np.flatnonzero(keep)

@@ -20,8 +20,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .frame_pixels import FramePixels
 from .line_ends import END_REACH_PX, PLACES, end_attribution, frames_end_places, resolve_ties  # noqa: F401
 from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
+from .. import tolerances
+from ..references.pyrender_oracle import depth_step
 
 
 def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
@@ -77,106 +80,6 @@ def vertex_errors_frames(cand_frames: list, oracle_frames: list) -> list[dict]:
                           "max_px": float(mx[j]), "mean_px": float(mean[j]), "rms_px": float(rms[j]),
                           "worst_index": int(k[j])}
     return [r if r is not None else vertex_errors(c, o) for r, c, o in zip(out, cand_frames, oracle_frames)]
-
-
-class FramePixels:
-    """The drawn pixels of a candidate frame and the oracle's, found once and shared by one frame's metrics.
-
-    A wireframe covers under 1 % of an image, so each image is scanned once
-    (``np.flatnonzero``) and every metric after that (:func:`pixel_scores`,
-    :func:`line_scores`) works on the drawn pixels' indices: lookups, not
-    passes over the whole image. The images themselves are not kept, so a
-    case can hold its frames' pixels until it scores their lines together
-    (:class:`LineBatch`).
-
-    Attributes
-    ----------
-    shape : (H, W)
-    cand_idx, oracle_idx : (Nc,), (No,) ndarray of intp
-        Flat indices ``y W + x`` of each image's drawn pixels, ascending (row-major).
-    cand_in_oracle, oracle_in_cand : (Nc,), (No,) ndarray of bool
-        Whether each drawn pixel is drawn in the other image too.
-    """
-
-    def __init__(self, cand: np.ndarray, oracle: np.ndarray):
-        cand = np.asarray(cand, bool)
-        oracle = np.asarray(oracle, bool)
-        if cand.shape != oracle.shape:
-            raise ValueError(f"image shapes differ: {cand.shape} vs {oracle.shape}")
-        self.shape = cand.shape
-        self.cand_idx = np.flatnonzero(cand)
-        self.oracle_idx = np.flatnonzero(oracle)
-        self.cand_in_oracle = oracle.reshape(-1)[self.cand_idx]
-        self.oracle_in_cand = cand.reshape(-1)[self.oracle_idx]
-        self._only = None
-
-    @classmethod
-    def from_indices(cls, shape: tuple, cand_idx: np.ndarray, oracle_idx: np.ndarray) -> "FramePixels":
-        """The frame whose images draw the ascending flat indices ``cand_idx`` and ``oracle_idx`` (``(H, W)`` ``shape``)."""
-        fp = cls.__new__(cls)
-        fp.shape = tuple(shape)
-        fp.cand_idx, fp.oracle_idx = cand_idx, oracle_idx
-        fp.cand_in_oracle = fp.has(cand_idx, of_candidate=False)       # a binary search each: no sort
-        fp.oracle_in_cand = fp.has(oracle_idx, of_candidate=True)
-        fp._only = None
-        return fp
-
-    @property
-    def both(self) -> int:
-        """Pixels drawn by both images."""
-        return int(np.count_nonzero(self.cand_in_oracle))
-
-    @property
-    def identical(self) -> bool:
-        """Whether the two images draw the same pixels."""
-        return len(self.cand_idx) == len(self.oracle_idx) == self.both
-
-    def only(self) -> tuple[np.ndarray, np.ndarray]:
-        """Flat indices of the candidate-only and the oracle-only pixels, ascending (found once)."""
-        if self._only is None:
-            self._only = (self.cand_idx[~self.cand_in_oracle], self.oracle_idx[~self.oracle_in_cand])
-        return self._only
-
-    def drawn(self) -> np.ndarray:
-        """Flat indices of the pixels drawn by either image, ascending."""
-        if self.identical:
-            return self.cand_idx
-        return np.sort(np.concatenate([self.cand_idx, self.oracle_idx[~self.oracle_in_cand]]))
-
-    def has(self, flat: np.ndarray, of_candidate: bool = True) -> np.ndarray:
-        """``(K,)`` bool: whether the candidate's (else the oracle's) image draws each flat index."""
-        idx = self.cand_idx if of_candidate else self.oracle_idx
-        flat = np.asarray(flat, np.int64)
-        if len(idx) == 0:
-            return np.zeros(flat.shape, bool)
-        at = np.minimum(np.searchsorted(idx, flat), len(idx) - 1)
-        return idx[at] == flat
-
-    def within(self, tol: int, of_candidate: bool = True) -> np.ndarray:
-        """For each drawn pixel of one image (row-major): is a pixel of the other within ``tol`` (Chebyshev)?
-
-        ``of_candidate``: the candidate's pixels against the oracle's (else the
-        reverse). A pixel both draw is within any ``tol``; for the others, the
-        ``(2 tol + 1)^2`` pixels around each are looked up among the other
-        image's (outside the image counts as not drawn).
-        """
-        inside = self.cand_in_oracle if of_candidate else self.oracle_in_cand
-        if tol == 0:
-            return inside
-        idx = self.cand_idx if of_candidate else self.oracle_idx
-        out = inside.copy()
-        rest = np.flatnonzero(~inside)
-        if len(rest) == 0:
-            return out
-        h, w = self.shape
-        rows, cols = np.divmod(idx[rest], w)
-        offs = np.arange(-tol, tol + 1)
-        ry = (rows[:, None, None] + offs[None, :, None]).repeat(len(offs), axis=2)
-        cx = (cols[:, None, None] + offs[None, None, :]).repeat(len(offs), axis=1)
-        valid = (ry >= 0) & (ry < h) & (cx >= 0) & (cx < w)
-        found = self.has(np.where(valid, ry * w + cx, -1).reshape(len(rest), -1), not of_candidate)
-        out[rest] = (found & valid.reshape(len(rest), -1)).any(axis=1)
-        return out
 
 
 def _within(mask_from: np.ndarray, mask_to: np.ndarray, tol: int) -> np.ndarray:
@@ -361,10 +264,7 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
 
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
-    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.judge.tolerances)."""
-    from . import tolerances
-    from ..references.pyrender_oracle import depth_step
-
+    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances)."""
     depth = np.asarray(depth, np.float64)
     eps32 = float(np.finfo(np.float32).eps)
     return (tolerances.DEPTH_STEPS * depth_step(depth, camera)
@@ -575,25 +475,3 @@ def line_summary(frames: list) -> dict:
     return out
 
 
-def line_failures(lines: dict, tol) -> list[str]:
-    """Why a case's pooled line fields (:func:`line_summary`) fail ``tol`` (oracles.judge.tolerances); [] if they pass.
-
-    The balance fails when the sign test rejects symmetry (p < ``tol.balance_alpha``)
-    *and* the net imbalance is more than ``tol.max_imbalance`` of the oracle's
-    pixels, both over the decided one-sided pixels (sub-pixel ties left out,
-    :func:`balance_scores`); the counts fail when some edge in some frame has more than
-    ``tol.max_edge_count_diff`` pixels more or fewer than the oracle's.
-    """
-    out = []
-    frac, p = lines["imbalance_fraction"], lines["balance_p_value"]
-    if p < tol.balance_alpha and abs(frac) > tol.max_imbalance:
-        tc, to = lines["subpixel_ties"]
-        ties = f" (and {tc} + {to} sub-pixel ties, left out)" if tc + to else ""
-        out.append(f"one-sided pixels unbalanced: {lines['candidate_only'] - tc} candidate-only vs "
-                   f"{lines['oracle_only'] - to} oracle-only{ties}, net {frac:+.3%} of the oracle's pixels "
-                   f"(> {tol.max_imbalance:.3%}; sign test p = {p:.2g} < {tol.balance_alpha:g})")
-    if lines["edge_count_max_diff"] > tol.max_edge_count_diff:
-        w = lines["edge_count_worst"]
-        out.append(f"edge {w['edge']} has {w['diff']:+d} pixels against the oracle's count "
-                   f"(allowed +-{tol.max_edge_count_diff}; frame {w['frame']})")
-    return out

@@ -36,6 +36,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..segment_geometry import clip_to_box
+
 _EMPTY = np.zeros(0, dtype=np.int64)
 _NONE = np.iinfo(np.int64).max          # no owner yet (:meth:`_Segments.owners`)
 
@@ -53,21 +55,6 @@ FEW_PAIRS = 1 << 22
 #: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
 #: looking at midpoints and one-sided pixels first would pair most pixels several times over).
 DENSE = 8
-
-
-def clip_segments(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-    """Liang-Barsky: the parts of segments ``p0 -> p1`` inside the box ``[lo, hi]``: ``(kept, q0, q1)``."""
-    d = p1 - p0
-    # the four boundaries at once: p t <= q for (x >= lo_x, y >= lo_y, x <= hi_x, y <= hi_y)
-    p = np.concatenate([-d, d], axis=1)
-    q = np.concatenate([p0 - lo, hi - p0], axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = q / p
-        keep = np.isfinite(p0 + p1).all(axis=1) & ~((p == 0) & (q < 0)).any(axis=1)
-        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))     # entering: the last boundary
-        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))      # leaving: the first
-    keep &= t0 <= t1
-    return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d
 
 
 def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
@@ -136,7 +123,7 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     ----------
     frames : sequence of (p0_px (E, 2), p1_px (E, 2), pixels)
         Each frame's segments and its two images' drawn pixels
-        (oracles.judge.metrics.FramePixels: ``cand_idx``, ``oracle_idx``, ``drawn()``, ``only()``).
+        (oracles.judge.frame_pixels.FramePixels: ``cand_idx``, ``oracle_idx``, ``drawn()``, ``only()``).
 
     Returns
     -------
@@ -169,7 +156,7 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
 
 
-def _compared(segs: "_Segments", drawn: "_Pixels") -> np.ndarray:
+def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
     """``(S,)`` bool: whether each segment owns a drawn pixel (the pixel at its midpoint, or another near it)."""
     w, h = segs.width, segs.height
     mid = np.floor((segs.q0 + segs.q1) / 2 + 0.5).astype(np.int64)
@@ -190,7 +177,7 @@ def _compared(segs: "_Segments", drawn: "_Pixels") -> np.ndarray:
     return compared
 
 
-def _counts_near(segs: "_Segments", cand: "_Pixels", orac: "_Pixels", near: "_Pixels", every: bool = False):
+def _counts_near(segs: _Segments, cand: _Pixels, orac: _Pixels, near: _Pixels, every: bool = False):
     """``(cc, oc)``, ``(S,)`` each: every segment's count in the candidate's and the oracle's image, over
     the drawn pixels ``near`` only (right for the segments all of whose pixels are among them);
     ``every``: ``near`` is every drawn pixel (paired row by row)."""
@@ -272,7 +259,7 @@ class _Pixels:
         self._rank = None               # :meth:`rank`'s table, made when it pays
 
     @classmethod
-    def of_frames(cls, per_frame, width: int, height: int) -> "_Pixels":
+    def of_frames(cls, per_frame, width: int, height: int) -> _Pixels:
         """From one ascending flat-index array per frame."""
         per_frame = [np.asarray(p, np.int64).reshape(-1) for p in per_frame]
         counts = np.array([len(p) for p in per_frame], np.int64)
@@ -322,7 +309,7 @@ class _Pixels:
         at = np.minimum(np.searchsorted(self.stacked, stacked), len(self.stacked) - 1)
         return self.stacked[at] == stacked
 
-    def subset(self, pos: np.ndarray) -> "_Pixels":
+    def subset(self, pos: np.ndarray) -> _Pixels:
         """The pixels at ascending positions ``pos``."""
         out = _Pixels(self.stacked[pos], self.width, self.height)
         out.frames = self.frames
@@ -345,7 +332,7 @@ class _Segments:
         edge = np.arange(int(self.counts.sum())) - np.repeat(np.cumsum(self.counts) - self.counts, self.counts)
         p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
         p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
-        keep, q0, q1 = clip_segments(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
+        keep, q0, q1 = clip_to_box(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
         self.q0, self.q1 = q0[keep], q1[keep]
         self.frame, self.edge = frame[keep], edge[keep]
         self.d = self.q1 - self.q0
@@ -559,7 +546,7 @@ def _from_segments(p0_px, p1_px, width: int, height: int, radius: float):
     p0 = np.asarray(p0_px, np.float64).reshape(-1, 2)
     p1 = np.asarray(p1_px, np.float64).reshape(-1, 2)
     pad = radius + 1.0
-    keep, q0, q1 = clip_segments(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
+    keep, q0, q1 = clip_to_box(p0, p1, np.array([-pad, -pad]), np.array([width - 1 + pad, height - 1 + pad]))
     if not keep.any():
         return _EMPTY, _EMPTY, _EMPTY
     q0, q1 = q0[keep], q1[keep]

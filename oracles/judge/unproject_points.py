@@ -22,7 +22,7 @@ from wirecheck.core.transforms import Motion
 
 from ..references.opencv_oracle import project as cv_project
 from ..references.unproject_reference import unproject
-from .cases import Case, case_motion
+from ..cases import Case, case_motion
 
 __all__ = ["DEFAULT_STRIDE", "Samples", "surface_samples"]
 

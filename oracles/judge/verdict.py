@@ -2,9 +2,9 @@
 
 The verdict is decided by oracles.judge.decide, the one judge of every path (a
 projector's, core's, a renderer's frames). A case fails for every limit of
-oracles.judge.tolerances it misses, each named in a reason: the vertex error, points visible to one side only, the pixel F1 at 1
+oracles.tolerances it misses, each named in a reason: the vertex error, points visible to one side only, the pixel F1 at 1
 and 0 px, the one-sided pixel balance and the per-edge pixel counts of the
-lines (oracles.judge.metrics.line_failures); shaded: regions covered by one side inside the other's silhouette,
+lines (oracles.tolerances.line_failures); shaded: regions covered by one side inside the other's silhouette,
 the silhouette IoU, faces that differ away from their boundaries, the depth
 error beyond its bound. A candidate that fails the contract (oracles.candidates.candidate)
 fails the case with that error.
@@ -16,9 +16,11 @@ import numpy as np
 
 from . import metrics
 from ..candidates.candidate import case_precision
+from .. import faults as catalogue
 from ..diagnosis.diagnose import diagnose
 from .decide import decide, line_faults, pixel_fields
-from .tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
+from ..references.oracle_precision import ORACLE_LIMIT_PX
+from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
 #: Per-frame fields of a wireframe's line comparison (oracles.judge.metrics.line_scores).
 LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
@@ -37,7 +39,7 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
     summary, and a note when there was nothing to compare. ``precision``
     says what the candidate was judged as (declared, or as it returned; core:
     its ``--dtype``) and ``vertex_bound_px`` the bound its vertices were held
-    to (oracles.judge.tolerances.vertex_bound).
+    to (oracles.tolerances.vertex_bound).
     """
     done = len(acc.cand_px)
     rec = {"scene": setup.scene.name, "camera": setup.case.name, "camera_spec": setup.cam.to_dict(),
@@ -127,3 +129,32 @@ def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | No
     (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.judge.gate).
     """
     decide(rec, tol, error, points)
+
+
+def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:
+    """Record the case's ``oracle_bound_px``; where it exceeds :data:`ORACLE_LIMIT_PX`, judge without pixels.
+
+    ``rec`` was judged by ``judge`` (oracles.judge.verdict.judge). Beyond the limit
+    the pixel comparison says nothing about the candidate: the case is judged
+    again on its vertices alone, and its verdict is ``"fail"`` only for a
+    vertex failure, else ``"vacuous"`` (fails the run, oracles.judge.gate) with an
+    ``oracle_precision`` reason first, naming the bound and the limit.
+    """
+    if bound_px is None:
+        return
+    rec["oracle_bound_px"] = float(bound_px)
+    rec["oracle_limit_px"] = ORACLE_LIMIT_PX
+    if not bound_px > ORACLE_LIMIT_PX or rec.get("verdict") == "vacuous":
+        return          # within the limit; or nothing was compared, which the case already says
+    vertices_only = {k: v for k, v in rec.items() if k != "lines"}
+    vertices_only.update(pixel_f1_0px=None, pixel_f1_1px=None, silhouette_iou=None,
+                         compared=dict(rec["compared"], pixels=None))
+    judge(vertices_only, tol, error, points=points)
+    why = (f"oracle_precision: the pyrender oracle's own error bound {bound_px:.3g} px exceeds "
+           f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged")
+    vertex_reasons = vertices_only["reasons"] if vertices_only["verdict"] == "fail" else []
+    rec["verdict"] = "fail" if vertex_reasons else "vacuous"
+    rec["reasons"] = [why] + vertex_reasons
+    # a line fault is read from the pixels (line counts against the oracle's): those say nothing here
+    rec["faults"] = [f for f in rec.get("faults") or [] if catalogue.kind(f["name"]).source != "pixels"]
+    rec["oracle_precision"] = True

@@ -4,7 +4,7 @@ what to install when it does not.
 ``PYOPENGL_PLATFORM`` is ``osmesa`` (the default, set here when unset) or
 ``egl`` (Mesa's EGL on the CPU, or a vendor's driver on a GPU);
 :func:`select_gl` sets it (``crosscheck --gl``). It must be chosen before
-PyOpenGL is imported. :func:`gl_available` says in one line what is missing
+PyOpenGL is imported. :func:`gl_library_problem` (and pyrender_oracle.gl_available) says in one line what is missing
 and its fix (never ``pip install pyrender2`` for a missing system library).
 """
 
@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import sys
+from wirecheck.core.errors import InputError
 
 #: The OpenGL platforms the oracle draws on (``PYOPENGL_PLATFORM``); the first is the default.
 GL_PLATFORMS = ("osmesa", "egl")
@@ -20,7 +21,7 @@ class GLUnavailable(RuntimeError):
     """The pixel oracle cannot draw here: the message is one line naming the missing piece and its fix."""
 
 
-_INSTALL_HINT = {"osmesa": "apt-get install -y libosmesa6",
+INSTALL_HINT = {"osmesa": "apt-get install -y libosmesa6",
                  "egl": "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri"}
 
 
@@ -37,8 +38,6 @@ def select_gl(name: str | None) -> str:
     PyOpenGL was already loaded in this process for another one (it reads the
     variable once, at import).
     """
-    from wirecheck.core.errors import InputError
-
     if name is None:
         return gl_platform()
     if name not in GL_PLATFORMS:
@@ -51,49 +50,29 @@ def select_gl(name: str | None) -> str:
     return name
 
 
-_EGL_CHECKED: dict[str, tuple[bool, str]] = {}
+def gl_library_problem(platform: str) -> str | None:
+    """One line saying why pyrender cannot draw on ``platform`` (with the install hint); None when it may.
 
-
-def gl_available() -> tuple[bool, str]:
-    """Whether pyrender can render offscreen here on :func:`gl_platform`.
-
-    OSMesa: libOSMesa loads. EGL: a 1x1 context can be created and made
-    current (the only reliable test: libEGL may load with no usable device),
-    checked once per process.
-
-    Returns
-    -------
-    ok : bool
-    message : str, one line; with an install hint when the library cannot load.
+    The platform must be one of :data:`GL_PLATFORMS`, its GL library must load
+    and pyrender must import. On EGL that is not enough (libEGL may load with no
+    usable device): :func:`oracles.references.pyrender_oracle.gl_available` then
+    makes a 1x1 context.
     """
-    platform = gl_platform()
     if platform not in GL_PLATFORMS:
-        return False, (f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on "
-                       f"{' or '.join(repr(p) for p in GL_PLATFORMS)}")
+        return (f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on "
+                f"{' or '.join(repr(p) for p in GL_PLATFORMS)}")
     missing = _missing_gl_library(platform)
     if missing is not None:
-        return False, missing
+        return missing
     try:
         import pyrender  # noqa: F401
     except Exception as exc:
         if "glGetError" in str(exc) or str(exc).startswith("Library "):   # a GL library PyOpenGL could not load
-            return False, (f"OpenGL's library cannot be loaded on {platform} ({type(exc).__name__}: {exc}); "
-                           f"install it with: {_INSTALL_HINT[platform]}")
-        return False, (f"pyrender cannot be imported ({type(exc).__name__}: {exc}); "
-                       "install it with: pip install 'pyrender2>=0.2,<1'")
-    if platform == "osmesa":
-        return True, "OSMesa available"
-    if platform not in _EGL_CHECKED:
-        try:
-            from .pyrender_oracle import PyrenderOracle
-
-            PyrenderOracle(1, 1).close()
-            _EGL_CHECKED[platform] = (True, "EGL available")
-        except Exception as exc:  # RuntimeError, OSError, ImportError, GLError: no usable EGL
-            msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
-            _EGL_CHECKED[platform] = (False, f"no EGL context can be created ({msg}); "
-                                             f"install it with: {_INSTALL_HINT['egl']}")
-    return _EGL_CHECKED[platform]
+            return (f"OpenGL's library cannot be loaded on {platform} ({type(exc).__name__}: {exc}); "
+                    f"install it with: {INSTALL_HINT[platform]}")
+        return (f"pyrender cannot be imported ({type(exc).__name__}: {exc}); "
+                "install it with: pip install 'pyrender2>=0.2,<1'")
+    return None
 
 
 def _missing_gl_library(platform: str) -> str | None:
@@ -102,7 +81,7 @@ def _missing_gl_library(platform: str) -> str | None:
     PyOpenGL leaves a missing library None and pyrender's import then fails with ``'NoneType' object
     has no attribute 'glGetError'``: so libOSMesa (with ``OSMesaCreateContextAttribs``, Mesa >= 11.2),
     or libEGL and libGL, are looked at here, before pyrender is imported."""
-    hint = _INSTALL_HINT[platform]
+    hint = INSTALL_HINT[platform]
     try:
         from OpenGL import platform as gl_platform_module
         loaded = gl_platform_module.PLATFORM
@@ -136,8 +115,3 @@ def _loaded(platform_object, name: str):
         return getattr(platform_object, name)
     except Exception:  # ImportError, OSError: PyOpenGL's lazy properties raise on some versions
         return None
-
-
-def osmesa_available() -> tuple[bool, str]:
-    """:func:`gl_available` (the older name, from when OSMesa was the only platform)."""
-    return gl_available()

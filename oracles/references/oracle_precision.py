@@ -53,9 +53,9 @@ plane's; only an edge that GL really clips there divides by ``near``.
 The case's bound is the largest over its frames (the record's
 ``oracle_bound_px``). The line gate's tie zone assumes the oracle's window
 coordinates within ``2^-9`` px of exact (the float32 share of
-oracles.judge.tolerances.TIE_END_PX); a case whose bound exceeds
+oracles.tolerances.TIE_END_PX); a case whose bound exceeds
 :data:`ORACLE_LIMIT_PX` asks for more than the oracle can give, and its
-pixels are not judged: :func:`judge_oracle_precision` makes it an
+pixels are not judged: :func:`oracles.judge.verdict.judge_oracle_precision` makes it an
 ``oracle_precision`` case that fails the run without blaming the candidate.
 On the bundled scenes the bound is ~1e-4 to 1e-3 px, wherever the scene is
 put; before the re-centring a mesh 1e5 from the origin moved the oracle's
@@ -65,12 +65,11 @@ lines by up to 78 px.
 from __future__ import annotations
 
 import numpy as np
+from .convert import camera_to_gl
 
-from .. import faults as catalogue
 
 __all__ = ["U32", "CLIP_XY_ROUNDINGS", "CLIP_W_ROUNDINGS", "VIEWPORT_ROUNDINGS", "ORACLE_LIMIT_PX", "mesh_radius", "frame_bound_px",
-           "drawn_bound_px",
-           "judge_oracle_precision"]
+           "drawn_bound_px"]
 
 #: float32's unit roundoff (half its epsilon): one rounding moves a value v by at most U32 |v|.
 U32 = 2.0 ** -24
@@ -85,7 +84,7 @@ CLIP_W_ROUNDINGS = 7
 VIEWPORT_ROUNDINGS = 2
 
 #: The oracle's window coordinates must be within this of exact: the float32 share (2^-9 px) of
-#: oracles.judge.tolerances.TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle.
+#: oracles.tolerances.TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle.
 ORACLE_LIMIT_PX = 2.0 ** -9
 
 
@@ -105,8 +104,6 @@ def frame_bound_px(camera, eye_pose, radius: float) -> float:
     eye_pose : (4, 4) float64, centred model coordinates to GL eye (oracles.references.convert.gl_eye_pose).
     radius : float, the largest ``|q|`` of the uploaded vertices (:func:`mesh_radius`).
     """
-    from .convert import camera_to_gl
-
     a = np.asarray(eye_pose, dtype=np.float64)
     _view, proj = camera_to_gl(camera)
     with np.errstate(over="ignore", invalid="ignore"):      # an overflow is no bound: inf below
@@ -136,8 +133,6 @@ def drawn_bound_px(camera, eye_pose, q_model, segments) -> float:
     q_model : (N, 3) the uploaded vertices (the float32 offsets from the mesh's centre), as float64.
     segments : (E, 2) int, the vertex indices of each drawn segment (a triangle's three edges for faces).
     """
-    from .convert import camera_to_gl
-
     a = np.asarray(eye_pose, dtype=np.float64)
     q = np.asarray(q_model, dtype=np.float64).reshape(-1, 3)
     seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
@@ -172,30 +167,3 @@ def drawn_bound_px(camera, eye_pose, q_model, segments) -> float:
     return float(both.max(initial=0.0)) + viewport
 
 
-def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:
-    """Record the case's ``oracle_bound_px``; where it exceeds :data:`ORACLE_LIMIT_PX`, judge without pixels.
-
-    ``rec`` was judged by ``judge`` (oracles.judge.verdict.judge). Beyond the limit
-    the pixel comparison says nothing about the candidate: the case is judged
-    again on its vertices alone, and its verdict is ``"fail"`` only for a
-    vertex failure, else ``"vacuous"`` (fails the run, oracles.judge.gate) with an
-    ``oracle_precision`` reason first, naming the bound and the limit.
-    """
-    if bound_px is None:
-        return
-    rec["oracle_bound_px"] = float(bound_px)
-    rec["oracle_limit_px"] = ORACLE_LIMIT_PX
-    if not bound_px > ORACLE_LIMIT_PX or rec.get("verdict") == "vacuous":
-        return          # within the limit; or nothing was compared, which the case already says
-    vertices_only = {k: v for k, v in rec.items() if k != "lines"}
-    vertices_only.update(pixel_f1_0px=None, pixel_f1_1px=None, silhouette_iou=None,
-                         compared=dict(rec["compared"], pixels=None))
-    judge(vertices_only, tol, error, points=points)
-    why = (f"oracle_precision: the pyrender oracle's own error bound {bound_px:.3g} px exceeds "
-           f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged")
-    vertex_reasons = vertices_only["reasons"] if vertices_only["verdict"] == "fail" else []
-    rec["verdict"] = "fail" if vertex_reasons else "vacuous"
-    rec["reasons"] = [why] + vertex_reasons
-    # a line fault is read from the pixels (line counts against the oracle's): those say nothing here
-    rec["faults"] = [f for f in rec.get("faults") or [] if catalogue.kind(f["name"]).source != "pixels"]
-    rec["oracle_precision"] = True

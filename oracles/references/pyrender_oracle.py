@@ -57,7 +57,7 @@ import numpy as np
 from wirecheck.core.camera import Camera
 
 from .convert import camera_to_pyrender, centre_of, gl_eye_pose
-from .gl_platform import GL_PLATFORMS, GLUnavailable, gl_available, gl_platform, osmesa_available, select_gl
+from .gl_platform import GL_PLATFORMS, INSTALL_HINT, GLUnavailable, gl_library_problem, gl_platform, select_gl
 from .oracle_precision import drawn_bound_px
 from .pyrender_programs import stabilise_program_cache
 
@@ -510,6 +510,43 @@ class PyrenderOracle:
         self._renderer._platform.make_current()
         GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
         GL.glPolygonOffset(1.0, 1.0)
+
+
+_EGL_CHECKED: dict[str, tuple[bool, str]] = {}
+
+
+def gl_available() -> tuple[bool, str]:
+    """Whether pyrender can render offscreen here on :func:`gl_platform`.
+
+    OSMesa: libOSMesa loads. EGL: a 1x1 context can be created and made
+    current (the only reliable test: libEGL may load with no usable device),
+    checked once per process.
+
+    Returns
+    -------
+    ok : bool
+    message : str, one line; with an install hint when the library cannot load.
+    """
+    platform = gl_platform()
+    problem = gl_library_problem(platform)
+    if problem is not None:
+        return False, problem
+    if platform == "osmesa":
+        return True, "OSMesa available"
+    if platform not in _EGL_CHECKED:
+        try:
+            PyrenderOracle(1, 1).close()
+            _EGL_CHECKED[platform] = (True, "EGL available")
+        except Exception as exc:  # RuntimeError, OSError, ImportError, GLError: no usable EGL
+            msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
+            _EGL_CHECKED[platform] = (False, f"no EGL context can be created ({msg}); "
+                                             f"install it with: {INSTALL_HINT['egl']}")
+    return _EGL_CHECKED[platform]
+
+
+def osmesa_available() -> tuple[bool, str]:
+    """:func:`gl_available` (the older name, from when OSMesa was the only platform)."""
+    return gl_available()
 
 
 class OracleCache:

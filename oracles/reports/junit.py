@@ -23,6 +23,7 @@ from pathlib import Path
 
 from wirecheck.core.errors import InputError
 
+from wirecheck.core.outputs.output import atomic_write_bytes
 from .fault_text import case_cell, hints, notes
 from .report import not_passed
 
@@ -143,8 +144,6 @@ def check_junit_target(path: Path, option: str = "--junit-xml") -> None:
 
 def write_junit(path: Path, report: dict) -> Path:
     """Write :func:`junit_xml` to ``path`` atomically (after :func:`check_junit_target`)."""
-    from wirecheck.core.outputs.output import atomic_write_bytes
-
     path = Path(path)
     check_junit_target(path)
     atomic_write_bytes(path, junit_xml(report))

@@ -30,7 +30,7 @@ STRIP_PX = 3
 MINOR_TICKS_MAX_DECADES = 2.0
 
 
-def _figure(rows: int):
+def new_figure(rows: int):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -39,7 +39,7 @@ def _figure(rows: int):
     return fig
 
 
-def _png(fig) -> bytes:
+def figure_png(fig) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", metadata={"Software": None})
     return buf.getvalue()
@@ -97,7 +97,7 @@ def vertex_error_png(report: dict) -> bytes | None:
     cases = [c for c in report["cases"] if c.get("per_frame")]
     if not any(f.get("max_vertex_error_px") is not None for c in cases for f in c["per_frame"]):
         return None                 # no vertex compared (a renderer's frames): no figure of nothing
-    fig = _figure(1)
+    fig = new_figure(1)
     ax = fig.add_subplot(1, 1, 1)
     for case, (colour, dash) in zip(cases, _styles(len(cases))):
         frames, values = _series(case, "max_vertex_error_px")
@@ -117,7 +117,7 @@ def vertex_error_png(report: dict) -> bytes | None:
     ax.grid(True, which="major", alpha=0.3)
     _legend(ax, len(cases))
     fig.tight_layout()
-    return _png(fig)
+    return figure_png(fig)
 
 
 def pixel_png(report: dict) -> bytes | None:
@@ -133,7 +133,7 @@ def pixel_png(report: dict) -> bytes | None:
               else [("f1_0px", "F1@0px", report["tolerances"].get("min_pixel_f1_0px"), False)])
     if not any(f.get(panels[0][0]) is not None for c in cases for f in c["per_frame"]):
         return None
-    fig = _figure(len(panels))
+    fig = new_figure(len(panels))
     styles = _styles(len(cases))
     for row, (key, label, limit, log) in enumerate(panels):
         ax = fig.add_subplot(len(panels), 1, row + 1)
@@ -156,7 +156,7 @@ def pixel_png(report: dict) -> bytes | None:
             ax.set_title(f"{label} against pyrender, per frame", fontsize=10)
             _legend(ax, len(cases))
     fig.tight_layout()
-    return _png(fig)
+    return figure_png(fig)
 
 
 def _panel_indices(cand: np.ndarray, orac: np.ndarray) -> np.ndarray:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..judge.metrics import DIFF_COLOURS
-from .plots import _figure, _png
+from .plots import new_figure, figure_png
 
 #: The plot shows the image and OpenCV's points, with this share of the span as margin; a
 #: candidate point far outside (a broken projector's 1e30) is left out rather than shrinking the rest.
@@ -41,7 +41,7 @@ def points_png(points: dict) -> bytes:
 
     cand, orac = np.asarray(points["candidate"], float), np.asarray(points["oracle"], float)
     w, h = points["size"]
-    fig = _figure(2)                              # 10 x 6.4 in: a 4:3 image with its title and legend
+    fig = new_figure(2)                              # 10 x 6.4 in: a 4:3 image with its title and legend
     ax = fig.add_subplot(1, 1, 1)
     ax.add_patch(Rectangle((0, 0), w, h, fill=False, edgecolor="#888", linewidth=1, linestyle="--"))
     o_ok, c_ok = np.isfinite(orac).all(axis=1), np.isfinite(cand).all(axis=1)
@@ -68,4 +68,4 @@ def points_png(points: dict) -> bytes:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax.grid(True, alpha=0.2)
     fig.tight_layout()
-    return _png(fig)
+    return figure_png(fig)

@@ -23,6 +23,9 @@ from wirecheck.core.outputs.output import FrameDir, json_dumps, png_bytes
 from .fault_text import FULL_DIGITS, case_cell, full_text, hints, notes
 from ..judge.metrics import DIFF_COLOURS, diff_image
 from .report_crops import crop_caption, crop_image
+from ..judge.line_style import summary_lines
+from . import plots
+from .points_plot import points_png
 
 
 def _fmt_err(v) -> str:
@@ -211,7 +214,7 @@ def timing_line(report: dict) -> str:
 
 
 def precision_text(report: dict) -> str:
-    """"float32 (returned); vertex bound 1.15e-03 to 2.70e-03 px": what the candidate was judged as (oracles.judge.tolerances)."""
+    """"float32 (returned); vertex bound 1.15e-03 to 2.70e-03 px": what the candidate was judged as (oracles.tolerances)."""
     cases = [c for c in report["cases"] if c.get("precision")]
     if not cases:
         return ""
@@ -254,8 +257,6 @@ def grouped_notes(report: dict) -> list[tuple[str, str]]:
 
 def _line_styles(report: dict) -> list[str]:
     """The line styles read from a renderer's frames (--candidate-frames; oracles.judge.line_style)."""
-    from ..judge.line_style import summary_lines
-
     return summary_lines(report["cases"])
 
 
@@ -275,7 +276,7 @@ def markdown(report: dict, files: set | None = None) -> str:
            f"Drawing: {drawing_text(report)}.", "",
            *([f"Oracle GL: {gl_text(report)}.", ""] if gl_text(report) else []),
            "Tolerances: " + ", ".join(f"{k} = {v}" for k, v in report["tolerances"].items()), "",
-           *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.judge.tolerances).", ""]
+           *([f"Candidate precision: {precision_text(report)} (wirecheck.oracles.tolerances).", ""]
              if precision_text(report) else []),
            *[x for line in _line_styles(report) for x in (line + ".", "")],
            "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -395,14 +396,14 @@ def _html(report: dict, shown: list[tuple[dict, str, str]], files: set | None = 
     return "\n".join(parts)
 
 
-def _finite_or_null(obj):
+def finite_or_null(obj):
     """JSON has no inf or NaN: such values (a candidate's overflow) become null."""
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
     if isinstance(obj, dict):
-        return {k: _finite_or_null(v) for k, v in obj.items()}
+        return {k: finite_or_null(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_finite_or_null(v) for v in obj]
+        return [finite_or_null(v) for v in obj]
     return obj
 
 
@@ -413,9 +414,6 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
     ``images["points"]`` (level vertices) worst_points.png;
     the per-frame figures are drawn from the report itself.
     """
-    from . import plots
-    from .points_plot import points_png
-
     run_dir = Path(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
     out = FrameDir(run_dir, "--report-dir")
@@ -437,7 +435,7 @@ def write_report(run_dir: Path, report: dict, images: dict, worst_n: int = 6) ->
             crop, window = crop_image(im["candidate"], im["oracle"])
             out.write(f"img/{stem}-crop.png", png_bytes(crop))
             shown.append((case, stem, crop_caption(window)))
-        report = _finite_or_null(report)
+        report = finite_or_null(report)
         files = set()
         if images.get("animation"):
             out.write("worst.gif", plots.worst_gif(images["animation"]))

@@ -21,7 +21,7 @@ by oracles.diagnosis against the hand-derived pixels, or the candidate's own
 clipping planes probed) and ``expected`` (the derived values, for the report).
 
 A pixel bound is the crosscheck vertex bound of the candidate's precision at
-the check's points (oracles.judge.tolerances.vertex_bound: 1e-6 px in float64,
+the check's points (oracles.tolerances.vertex_bound: 1e-6 px in float64,
 ~1e-3 px in float32), so a check never holds a candidate tighter than the runs do.
 """
 
@@ -40,8 +40,8 @@ from ..candidates.core_candidate import CoreCandidate
 from ..candidates.draw import draw_candidate
 from ..diagnosis.clip_planes import FLOAT32_PLANE_ROUNDINGS, PLANE_REL_TOL, clip_fault, depth_slack, probe_planes
 from ..diagnosis.diagnose import diagnose
-from ..judge.cases import Case
-from ..judge.tolerances import EPS, Tolerances, vertex_bound, vertex_scale
+from ..cases import Case
+from ..tolerances import EPS, Tolerances, vertex_bound, vertex_scale
 from ..runner import run_crosscheck
 from .matrix import CAMERA, TURNS
 

@@ -21,8 +21,8 @@ from __future__ import annotations
 from wirecheck.core.camera import look_at
 from wirecheck.core.scene.files import load_scene
 
-from ..judge.cases import Case
-from ..judge.tolerances import Tolerances
+from ..cases import Case
+from ..tolerances import Tolerances
 from ..runner import run_crosscheck
 
 #: The specification's scenes (A, B), its camera distances, FOVs (degrees, vertical) and frame counts.

@@ -12,7 +12,7 @@ import numpy as np
 
 def gl_strings_of_a_fresh_context() -> dict:
     """glGetString of a plain pyrender OffscreenRenderer's context (not the oracle's code)."""
-    import pyrender
+    import pyrender  # noqa: F401  (PyOpenGL imported through pyrender first, as the oracle does)
     from OpenGL import GL
 
     r = plain_renderer(8, 8)

@@ -64,6 +64,9 @@ TARGETS = {
     "core/camera.py": (["tests/test_conventions.py", "tests/test_projection.py", "tests/test_scene.py"], None),
     "core/transforms.py": (["tests/test_transforms.py", "tests/test_conventions.py"], None),
     "oracles/judge/metrics.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
+    # FramePixels (moved out of metrics) and line_failures (moved into tolerances): the same tests as before
+    "oracles/judge/frame_pixels.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
+    "oracles/tolerances.py": (["tests/test_line_gate.py", "tests/test_precision.py"], None),
     "oracles/diagnosis/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
     "oracles/judge/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
                            "decides or note or empty_scene or faceless or visibility or core_case_fields "
@@ -86,6 +89,10 @@ TARGETS = {
                                         None),
     "oracles/judge/line_style.py": (["tests/test_line_style.py"], None),
     "oracles/judge/line_windows.py": (["tests/test_line_windows.py", "tests/test_line_style.py"], None),
+    # moved out of line_windows, segment_pixels and the registration: the distances and the box clipper
+    "oracles/segment_geometry.py": (["tests/test_line_windows.py", "tests/test_metrics.py", "tests/test_line_style.py",
+                                     "tests/test_image_registration.py"], None),
+    "oracles/judge/line_profile.py": (["tests/test_line_profile.py", "tests/test_line_style.py"], None),
     "oracles/judge/case_samples.py": (["tests/test_case_samples.py", "tests/test_line_style.py"], None),
     # the even-width lean: its unit tests and 2-px jobs in test_even_width.py, then Pillow's 2-px lines on the
     # held-out slanted job (a correct one passes leaning, one with the half-pixel mistake is pixel_offset)
@@ -96,6 +103,9 @@ TARGETS = {
     # module fixture diagnoses ~100 cases); the short job's matrix and the thick lines cover the same names
     "oracles/diagnosis/image_diagnose.py": (_IMAGE_TESTS, None),
     "oracles/diagnosis/image_naming.py": (_IMAGE_TESTS, None),
+    # split out of image_diagnose / image_naming (issue 34's import cycles): the fit and the model's lines
+    "oracles/diagnosis/registration.py": (_IMAGE_TESTS, None),
+    "oracles/diagnosis/model_lines.py": (_IMAGE_TESTS, None),
     # the aliased rules read and what a fault stands against: its unit tests in test_image_naming.py, then the
     # held-out cases it decides (cv2 LINE_8 on prism / on_axis, the wrong-axis FOV on prism / wide_fov, aspect)
     "oracles/diagnosis/rule_read.py": (["tests/test_image_naming.py", "tests/test_frames_heldout.py"],

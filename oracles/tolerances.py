@@ -91,7 +91,7 @@ def vertex_scale(p_world, p_px, camera, matrices=None) -> float:
     """
     import numpy as np
 
-    from ..references.convert import opencv_matrices
+    from .references.convert import opencv_matrices
 
     p_world = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
     p_px = np.asarray(p_px, dtype=np.float64).reshape(-1, 2)
@@ -496,3 +496,26 @@ class Tolerances:
         return {"offset_px": self.offset_px, "scale_px": self.scale_px, "rule_offset_px": self.rule_offset_px,
                 "end_px": self.end_px, "rounded_end_tie_px": self.rounded_end_tie_px,
                 "rule_f1_0px": self.rule_f1_0px}
+
+def line_failures(lines: dict, tol) -> list[str]:
+    """Why a case's pooled line fields (oracles.judge.metrics.line_summary) fail ``tol``; [] if they pass.
+
+    The balance fails when the sign test rejects symmetry (p < ``tol.balance_alpha``)
+    *and* the net imbalance is more than ``tol.max_imbalance`` of the oracle's
+    pixels, both over the decided one-sided pixels (sub-pixel ties left out,
+    oracles.judge.metrics.balance_scores); the counts fail when some edge in some frame has more than
+    ``tol.max_edge_count_diff`` pixels more or fewer than the oracle's.
+    """
+    out = []
+    frac, p = lines["imbalance_fraction"], lines["balance_p_value"]
+    if p < tol.balance_alpha and abs(frac) > tol.max_imbalance:
+        tc, to = lines["subpixel_ties"]
+        ties = f" (and {tc} + {to} sub-pixel ties, left out)" if tc + to else ""
+        out.append(f"one-sided pixels unbalanced: {lines['candidate_only'] - tc} candidate-only vs "
+                   f"{lines['oracle_only'] - to} oracle-only{ties}, net {frac:+.3%} of the oracle's pixels "
+                   f"(> {tol.max_imbalance:.3%}; sign test p = {p:.2g} < {tol.balance_alpha:g})")
+    if lines["edge_count_max_diff"] > tol.max_edge_count_diff:
+        w = lines["edge_count_worst"]
+        out.append(f"edge {w['edge']} has {w['diff']:+d} pixels against the oracle's count "
+                   f"(allowed +-{tol.max_edge_count_diff}; frame {w['frame']})")
+    return out
