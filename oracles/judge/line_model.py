@@ -42,6 +42,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from wirecheck.core.projector.clipping import clip_to_image
+from wirecheck.core.projector.raster import line_pixels
+
 from ..tolerances import ROUNDED_END_TIE_PX
 
 __all__ = ["RULES", "END_TIE_PX", "rounded_pixels", "rounded_ties", "expected", "band_pixels",
@@ -109,8 +112,6 @@ def _clip(segs_px: np.ndarray, shape):
     the whole line and drops the pixels outside does; only ends farther out are cut (and rounded either
     way: :func:`rounded_ties`), which bounds the work whatever the segment.
     """
-    from wirecheck.core.projector.clipping import clip_to_image
-
     h, w = shape
     g = float(max(h, w))
     segs_px = np.asarray(segs_px, dtype=np.float64).reshape(-1, 2, 2)
@@ -186,8 +187,6 @@ def rounded_ties(segs_px: np.ndarray, shape, end_tie_px: float = END_TIE_PX) -> 
     lies within ``end_tie_px`` of a half pixel on an axis, or outside the image (then any of the pixels
     around where the line crosses the image's border grown by :data:`CLIP_MARGINS_PX`, or the end itself).
     """
-    from wirecheck.core.projector.clipping import clip_to_image
-
     q0, q1, _, _ = _clip(segs_px, shape)
     ties = np.zeros(shape, bool)
     if not len(q0):
@@ -236,8 +235,6 @@ def expected(segs_px: np.ndarray, shape, rule: str = "gl", end_tie_px: float = E
         raise ValueError(f"rule {rule!r}: expected one of {', '.join(RULES)}")
     drawn = np.zeros(shape, bool)
     if rule == "gl":
-        from wirecheck.core.projector.raster import line_pixels
-
         q0, q1, _, _ = _clip(segs_px, shape)
         rr, cc = line_pixels(q0, q1, shape[1], shape[0])
         drawn[rr, cc] = True

@@ -591,15 +591,13 @@ class CaseStyle:
     @staticmethod
     def rule_failures(rounded: dict, tol) -> list[str]:
         """Why pixels are no correct drawing by the rounded-ends rule: its F1@0px (worst frame) and its line
-        fields' balance and per-edge counts (oracles.judge.metrics.line_failures), as GL's are judged."""
-        from .metrics import line_failures
-
+        fields' balance and per-edge counts (oracles.tolerances.line_failures), as GL's are judged."""
         out = []
         floor = max(tol.min_f1_0px, tol.rule_f1_0px)      # a rule is read from its pixels, whatever GL's floor
         if rounded["pixel_f1_0px"] < floor:
             out.append(f"pixel F1@0px {rounded['pixel_f1_0px']:.4f} < {floor} against the rounded-ends "
                        "rule too")
-        return out + [f"{r} (the rounded-ends rule)" for r in line_failures(rounded["lines"], tol)]
+        return out + [f"{r} (the rounded-ends rule)" for r in tolerances.line_failures(rounded["lines"], tol)]
 
 
 def summary_lines(cases: list) -> list[str]:
