@@ -76,6 +76,7 @@ from wirecheck.core.outputs.output import FrameDir, check_replaceable, check_rep
 from .judge import gate, tolerances
 from .candidates.isolation import check_python_spec, external_candidate
 from .judge.cases import CASE_NAMES
+from .datasets.memory_budget import gib_bytes
 from .datasets.executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli, trust_line
 from .reports.junit import check_junit_target, write_junit
@@ -448,7 +449,7 @@ def _memory_budget(gib: float | None):
         return "auto"
     if not (math.isfinite(gib) and gib > 0):
         raise InputError(f"--memory-budget {gib:g}: expected a number of GiB > 0")
-    return int(gib * 2 ** 30)
+    return gib_bytes(gib)           # exact: 1e300 GiB is a budget too large to matter, not inf
 
 
 def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
