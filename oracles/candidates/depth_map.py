@@ -2,13 +2,15 @@
 
 Encodings accepted (anything else is refused with one line, InputError):
 
-- ``.npy``: a 2-D float32 (or float64) array, ``(H, W)``, depth in world units;
+- ``.npy``: a 2-D float32 (or float64) array, ``(H, W)``, either byte order, depth in world units
+  (its header checked before its data is used; never a pickle);
 - ``.tif`` / ``.tiff``: a 32-bit float TIFF (Pillow's mode ``"F"``), depth in world units;
 - ``.png``: a 16-bit grey PNG (Pillow's mode ``"I;16"``), ``depth = value / scale``;
   ``scale`` 1000 per world unit by default (millimetres when the unit is the metre,
   as in BOP, Open3D and RealSense files; TUM's files use 5000).
 
-0, NaN and +inf mean "no surface". A negative depth, a map of the wrong size or of any
+0, NaN and +inf mean "no surface". The file is read through core.user_files (kind
+``"depth map"``: a regular file of at most 512 MiB). A negative depth, a map of the wrong size or of any
 other dtype or mode is refused: depth along ``forward`` is positive in front of the camera
 (:mod:`wirecheck.core.conventions`). Row 0 is the top of the picture, as in every image here.
 
