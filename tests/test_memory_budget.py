@@ -75,6 +75,7 @@ def test_a_budget_without_a_dataset_is_refused(tmp_path):
     assert code == 2 and "--memory-budget without a dataset" in err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("value, budget_bytes", [
     ("1e300", int(1e300) * 2 ** 30),      # int(float) is the float's exact integer value; 2^30 B a GiB
     ("1e-300", 0),                        # 1e-300 GiB is 1.07e-291 bytes: 0 whole bytes
