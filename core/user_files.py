@@ -63,6 +63,9 @@ LIMITS = {
     "frame": Limit(512 * MiB, "a PNG frame",
                    "the largest frame, 2^25 pixels of 16-bit RGBA, is 256 MiB unpacked; deflate adds "
                    "under 0.1% to data it cannot compress"),
+    "depth map": Limit(512 * MiB, "a depth map (.npy, .tif, .png)",
+                       "the largest frame's depth, 2^25 pixels of float64, is 256 MiB; a TIFF or .npy adds its "
+                       "header only"),
     "candidate": Limit(16 * MiB, "a candidate's Python file", "a module of 300,000 lines; Python compiles it whole"),
 }
 

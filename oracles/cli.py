@@ -77,6 +77,7 @@ from . import tolerances
 from .judge import gate
 from .candidates.isolation import check_python_spec, external_candidate
 from .cases import CASE_NAMES
+from .datasets.memory_budget import gib_bytes
 from .executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .config import parse_cli, trust_line
 from .reports.junit import check_junit_target, write_junit
@@ -450,7 +451,7 @@ def _memory_budget(gib: float | None):
         return "auto"
     if not (math.isfinite(gib) and gib > 0):
         raise InputError(f"--memory-budget {gib:g}: expected a number of GiB > 0")
-    return int(gib * 2 ** 30)
+    return gib_bytes(gib)           # exact: 1e300 GiB is a budget too large to matter, not inf
 
 
 def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:

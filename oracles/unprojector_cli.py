@@ -12,6 +12,7 @@ from __future__ import annotations
 import sys
 
 from wirecheck.core.errors import InputError
+from wirecheck.core.limits import check_candidate_timeout
 
 from .reports.fault_text import below_table, case_cell
 from .unprojector_api import check_unprojector, flat_faults
@@ -33,6 +34,7 @@ def unprojector_main(args) -> int:
         if clash:
             raise InputError(f"{given} with {', '.join(clash)}: expected {given} alone with "
                              "--scene, --cases, --frames and --spin (it writes no report folder)")
+        check_candidate_timeout(args.candidate_timeout, "--candidate-timeout")     # as for --candidate
         report = check_unprojector(args.unprojector, scenes=args.scene,
                                    frames=args.frames if args.frames is not None else DEFAULT_FRAMES,
                                    cases=args.cases, turns=args.spin, cmd=args.unprojector_cmd,

@@ -309,3 +309,22 @@ def test_a_long_test_id_gets_a_folder_name_the_file_system_takes(tmp_path):
     names = [report_name(f"t.py::test[{c * 300}]") for c in "xy"]
     assert [len(n) for n in names] == [129, 129] and names[0] != names[1]
     (tmp_path / names[0]).mkdir()           # before: OSError "File name too long", "report not written"
+
+
+def test_an_empty_list_answers_an_empty_request():
+    # a list-of-lists projector (accepted above) answers no points with [], shape (0,): it was refused
+    # ("returned shape (0,): expected (0, 2)"), so the spec suite's empty_mesh check failed a correct
+    # candidate (found by benchmarks/fuzz_round5.py). [] for no points is (0, 2); for 8 points it is still refused.
+    from wirecheck.core.camera import camera_z
+    from wirecheck.oracles.candidates.candidate import CandidateError, call_candidate_precision
+    from wirecheck.oracles.spec import run_checks
+
+    def as_list(p, c):
+        return project_points(p, c).tolist()
+
+    px, precision = call_candidate_precision(as_list, np.zeros((0, 3)), camera_z(4.0))
+    assert px.shape == (0, 2) and px.dtype == np.float64 and precision == "float64"
+    with pytest.raises(CandidateError, match=r"returned shape \(0,\): expected \(8, 2\)"):
+        call_candidate_precision(lambda p, c: [], np.zeros((8, 3)), camera_z(4.0))
+    (empty,) = run_checks(as_list, names=("empty_mesh",))
+    assert empty["verdict"] == "pass", empty["reasons"]

@@ -73,3 +73,26 @@ def test_a_budget_that_is_not_a_size_is_one_line_exit_2(folder, tmp_path, value,
 def test_a_budget_without_a_dataset_is_refused(tmp_path):
     code, _, err = _cli(["--scene", "cube", "--memory-budget", "1", "--report-dir", tmp_path / "r"])
     assert code == 2 and "--memory-budget without a dataset" in err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("value, budget_bytes", [
+    ("1e300", int(1e300) * 2 ** 30),      # int(float) is the float's exact integer value; 2^30 B a GiB
+    ("1e-300", 0),                        # 1e-300 GiB is 1.07e-291 bytes: 0 whole bytes
+], ids=["1e300", "1e-300"])
+def test_a_huge_or_tiny_budget_is_a_budget(folder, tmp_path, value, budget_bytes):
+    # 1e300 GiB: int(1e300 * 2^30) was int(inf), an OverflowError (exit 3, internal error); the budget is the
+    # float 1e300 times 2^30 exactly, so every mesh fits. 1e-300 GiB: every mesh is over it, the run compared nothing.
+    from wirecheck.oracles.datasets.memory_budget import gib_bytes
+
+    assert gib_bytes(float(value)) == budget_bytes
+    code, _, err = _cli(["--scene", folder, "--frames", "1", "--cases", "on_axis", "--memory-budget", value,
+                         "--report-dir", tmp_path / "r"])
+    assert "Traceback" not in err and "internal error" not in err
+    if value == "1e-300":                 # no mesh checked: nothing compared, an input error, no report
+        assert code == 2 and "none of the 2 meshes could be loaded" in err and len(err.splitlines()) == 1
+        assert not (tmp_path / "r").exists()
+        return
+    assert code == 0, err
+    report = json.loads((tmp_path / "r" / "report.json").read_text())
+    assert report["summary"]["load_errors"] == 0 and report["summary"]["passed"] == 2

@@ -228,3 +228,26 @@ def test_options_the_suite_cannot_honour_are_one_line(tmp_path, args, needle):
 def test_a_request_of_no_points_is_its_line_alone():
     # docs/protocol.md: N may be 0; the request is then the JSON line and no bytes of points
     assert bytes(encode_request(1, np.zeros((0, 3)), "{}")) == b'{"request":1,"n":0,"camera":{}}\n'
+
+
+def _strict(text: str):
+    """spec.json parsed as strict JSON: NaN, Infinity and -Infinity are not JSON."""
+    def refuse(name):
+        raise ValueError(f"{name} in spec.json")
+    return json.loads(text, parse_constant=refuse)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("func", ["nan_everywhere", "far_off"])
+def test_a_nan_or_inf_candidate_fails_with_a_report(tmp_path, func):
+    # found by benchmarks/fuzz_round5.py: a candidate answering NaN (or 1e300, whose distances overflow) made
+    # known_point's error_px inf and its pixels NaN; writing spec.json raised ValueError (exit 3, "internal
+    # error", no report). Such values are null in spec.json (as in report.json) and the suite fails.
+    rc, result, out, err = _suite(tmp_path, "--level", "vertices", "--candidate", f"{FAULTY}:{func}")
+    assert rc == 1 and "internal error" not in err, err
+    result = _strict((tmp_path / "run" / "spec.json").read_text())
+    assert result["verdict"] == "fail" and result["summary"]["runs_passed"] == 0
+    known = result["checks"][0]
+    assert known["name"] == "known_point" and known["verdict"] == "fail" and known["reasons"]
+    assert known["error_px"] is None          # inf for NaN (checks._worst), null in JSON
+    assert "FAIL: 0/24 runs" in out

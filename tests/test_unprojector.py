@@ -311,3 +311,16 @@ def test_cli_unprojector_cmd():
     assert bad.returncode == 1 and "mirror_vertical" in bad.stdout
     both = crosscheck("--unprojector-cmd", CLIENT, "--unprojector", f"{SPEC}:correct")
     assert both.returncode == 2 and "--unprojector-cmd" in both.stderr
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf", "1e9"])
+def test_cli_hostile_candidate_timeout(value, capsys):
+    # --candidate-timeout 0 with --unprojector reached SubprocessCandidate's ValueError: exit 3, "internal
+    # error" (found by benchmarks/fuzz_round5.py); checked as for --candidate: one line, exit 2
+    from wirecheck.oracles import cli
+
+    code = cli.main(["--unprojector", f"{SPEC}:correct", "--scene", "cube", "--cases", "on_axis", "--frames", "1",
+                     "--candidate-timeout", value])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert err.startswith(f"crosscheck: error: --candidate-timeout {float(value)}: expected a number of seconds > 0")

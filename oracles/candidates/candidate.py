@@ -218,6 +218,8 @@ def call_candidate_precision(func, points: np.ndarray, camera) -> tuple[np.ndarr
     told = getattr(func, "answer_precision", None)
     precision = told() if callable(told) else returned_precision(out)
     out = _as_pixels(out)
+    if len(points) == 0 and out.shape == (0,):     # [] from a list-of-lists projector: no points, no pixels
+        out = out.reshape(0, 2)
     if out.shape != (len(points), 2):
         raise CandidateError(f"candidate returned shape {out.shape}: expected ({len(points)}, 2)")
     infinite = np.isinf(out).any(axis=1)

@@ -24,6 +24,7 @@ be read.
 from __future__ import annotations
 
 import os
+from fractions import Fraction
 
 GIB = 2 ** 30
 
@@ -42,6 +43,11 @@ EDGE_BYTES = 400
 FACE_BYTES = 300
 #: The default budget's share of the machine's memory, split between the workers that check meshes at once.
 DEFAULT_SHARE = 0.5
+
+
+def gib_bytes(gib: float) -> int:
+    """``gib`` GiB (finite, >= 0) in whole bytes, exactly: ``int(gib * 2**30)`` overflows to inf above ~1.7e299 GiB."""
+    return int(Fraction(gib) * GIB)
 
 
 def estimate_bytes(vertices: int, edges: int, faces: int) -> int:

@@ -21,7 +21,7 @@ import time
 
 from .checks import CHECK_NAMES, CRITICAL, run_checks
 from .matrix import CAMERA_Z, FOVS, FRAME_COUNTS, RUNS, SCENES, TURNS, run_matrix, spec_cases
-from .report import spec_console, spec_markdown
+from .report import finite_or_null, spec_console, spec_markdown
 
 __all__ = ["run_spec", "suite_verdict", "spec_markdown", "spec_console", "run_checks", "run_matrix",
            "spec_cases", "CHECK_NAMES", "CRITICAL", "RUNS", "SCENES", "CAMERA_Z", "FOVS", "FRAME_COUNTS"]
@@ -63,7 +63,7 @@ def run_spec(candidate, level: str = "pixels", candidate_name: str = "core", pro
     checks = run_checks(candidate, precision=precision)
     runs = matrix["runs"]
     verdict, why = suite_verdict(runs, checks)
-    return {
+    return finite_or_null({                 # JSON-ready: a NaN or overflowing candidate's values are null
         "suite": "spec",
         "verdict": verdict,
         "why": why,
@@ -79,4 +79,4 @@ def run_spec(candidate, level: str = "pixels", candidate_name: str = "core", pro
         "runs": runs,
         "checks": checks,
         "timing": {"matrix_s": t1 - t0, "runs_wall_s": matrix["seconds"], "checks_s": time.perf_counter() - t1},
-    }
+    })

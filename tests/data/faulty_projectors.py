@@ -102,3 +102,13 @@ def fails_on_empty(points, camera):
     if np.abs(points).max() > 1e12:
         raise ValueError("too far")
     return project(points, camera)
+
+
+def nan_everywhere(points, camera):
+    """NaN for every point, in front of the camera or not: every check that compares a pixel fails."""
+    return np.full((len(points), 2), np.nan)
+
+
+def far_off(points, camera):
+    """1e300 px for every point: finite, but its distances to the right pixels overflow to inf."""
+    return np.full((len(points), 2), 1e300)
