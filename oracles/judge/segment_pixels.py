@@ -68,10 +68,14 @@ GROW_PX = 1e-6
 
 #: The radii (px) within which :meth:`_Segments.nearest` looks first, in turn, before ``radius``: a
 #: pixel with a segment within one of them has its nearest there, and is not paired with the farther
-#: ones. A drawn pixel is within 1/2 of the line that drew it (the diamond rule), and in a dense mesh
-#: or a soup within 1/4 of some line nearly always (93-99 % of the benchmark's drawn pixels), while
-#: ``radius`` = 1 pairs each with 2-4 times as many segments.
-LEVELS = (0.25, 0.5)
+#: ones. A drawn pixel is within 1/2 of the line that drew it (the diamond rule): within 1/2, a drawn
+#: pixel of the benchmark's meshes is paired with 35-50 % of the segments within 1.
+LEVELS = (0.5,)
+#: ... and where the segments' rows outnumber the pixels by more than :data:`CROWDED` (a soup of long
+#: edges: ~700 segments within 1 px of each drawn pixel, 95 % of the pixels with one within 1/8, which
+#: pairs each with 12 % of them): 1/8 first.
+CROWDED_LEVELS = (0.125, 0.5)
+CROWDED = 64
 #: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
 #: (fewer: one search costs less than the calls of several).
 LEVEL_PIXELS = 1024
@@ -397,6 +401,7 @@ class _Segments:
                                                              self.d[:, 1], self.dd))
         self._cells = None                       # the grid of pairs_any, made on first use
         self._rows = None                        # _rows_spanned, counted on first use
+        self._y = None                           # _y_range, found on first use
 
     def __len__(self) -> int:
         return len(self.q0)
@@ -418,7 +423,10 @@ class _Segments:
         else :meth:`pairs_any`). The same ``(sid, pos)`` as one search within
         ``radius``.
         """
-        levels = [r for r in LEVELS if r < self.radius] if len(px) >= LEVEL_PIXELS else []
+        levels = []
+        if len(px) >= LEVEL_PIXELS:
+            crowded = self._rows_spanned() > CROWDED * len(px)
+            levels = [r for r in (CROWDED_LEVELS if crowded else LEVELS) if r < self.radius]
         sid_parts, pos_parts = [], []
         rest = None                                   # positions in px still without an owner (None: all)
         for k, r in enumerate(levels + [self.radius]):
@@ -520,7 +528,7 @@ class _Segments:
         """:meth:`pairs_any` by a box test of every pixel against every segment of its frame: the pairs
         whose pixel centre is within ``radius`` of the segment's box (all those within ``radius`` of the
         segment), measured. ``frame``: each pixel's."""
-        r = self.radius
+        r = self.grow                   # radius and the margin of :data:`GROW_PX`
         lo_x, hi_x = np.minimum(self.q0[:, 0], self.q1[:, 0]) - r, np.maximum(self.q0[:, 0], self.q1[:, 0]) + r
         lo_y, hi_y = np.minimum(self.q0[:, 1], self.q1[:, 1]) - r, np.maximum(self.q0[:, 1], self.q1[:, 1]) + r
         x, y = px.xy()
@@ -554,9 +562,9 @@ class _Segments:
 
     def _rows_of(self, which: np.ndarray) -> np.ndarray:
         """``(len(which),)`` int64: the rows of the frame each segment's grown box spans (:meth:`pairs`' slices)."""
-        y0, y1 = self.q0[which, 1], self.q1[which, 1]
-        lo = np.maximum(np.ceil(np.minimum(y0, y1) - self.grow), 0)
-        hi = np.minimum(np.floor(np.maximum(y0, y1) + self.grow), self.height - 1)
+        y_lo, y_hi = self._y_range()
+        lo = np.maximum(np.ceil(y_lo[which] - self.grow), 0)
+        hi = np.minimum(np.floor(y_hi[which] + self.grow), self.height - 1)
         return np.maximum(hi - lo + 1, 0).astype(np.int64)
 
     def _cell_side(self) -> int:
@@ -575,22 +583,45 @@ class _Segments:
         of the frame only), the columns its part within ``grow`` of the band reaches, grown, clipped to the
         frame (a pixel centre within ``radius`` of the segment in those rows is in those columns: the
         nearest point is within ``radius`` in y, so in that part, and within ``radius`` in x)."""
-        q0, q1, d, grow, w, h = self.q0, self.q1, self.d, self.grow, self.width, self.height
-        b_lo = np.maximum(np.ceil(np.minimum(q0[which, 1], q1[which, 1]) - grow), 0).astype(np.int64) // band
-        b_hi = np.minimum(np.floor(np.maximum(q0[which, 1], q1[which, 1]) + grow), h - 1).astype(np.int64) // band
+        grow, w, h = self.grow, self.width, self.height
+        qx, qy, dx, dy = self._cols[:4]
+        y_lo, y_hi = self._y_range()
+        b_lo = np.maximum(np.ceil(y_lo[which] - grow), 0).astype(np.int64) // band
+        b_hi = np.minimum(np.floor(y_hi[which] + grow), h - 1).astype(np.int64) // band
         n = np.maximum(b_hi - b_lo + 1, 0)
         seg = np.repeat(which, n)
-        b = np.repeat(b_lo, n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
-        top, bottom = b * band - grow, b * band + (band - 1) + grow
-        dy = d[seg, 1]
+        b = np.arange(int(n.sum())) + np.repeat(b_lo - (np.cumsum(n) - n), n)
+        seg_dy = np.take(dy, seg)
+        # t of the band's top and bottom (+ 2 grow + band - 1) along each segment; a flat one: all of it
+        rel = b * band - grow
+        rel -= np.take(qy, seg)
         with np.errstate(divide="ignore", invalid="ignore"):
-            ta = np.where(dy != 0, (top - q0[seg, 1]) / dy, 0.0)
-            tb = np.where(dy != 0, (bottom - q0[seg, 1]) / dy, 1.0)
-        xa = q0[seg, 0] + np.clip(np.minimum(ta, tb), 0.0, 1.0) * d[seg, 0]
-        xb = q0[seg, 0] + np.clip(np.maximum(ta, tb), 0.0, 1.0) * d[seg, 0]
-        col_lo = np.maximum(np.ceil(np.minimum(xa, xb) - grow), 0).astype(np.int64)
-        col_hi = np.minimum(np.floor(np.maximum(xa, xb) + grow), w - 1).astype(np.int64)
+            ta = rel / seg_dy
+            rel += (band - 1) + 2 * grow
+            tb = np.divide(rel, seg_dy, out=rel)
+        t_lo, t_hi = np.minimum(ta, tb), np.maximum(ta, tb, out=ta)
+        flat = seg_dy == 0
+        if flat.any():
+            t_lo[flat], t_hi[flat] = 0.0, 1.0
+        seg_qx, seg_dx = np.take(qx, seg), np.take(dx, seg)
+        xa = np.clip(t_lo, 0.0, 1.0, out=t_lo)
+        xa *= seg_dx
+        xa += seg_qx
+        xb = np.clip(t_hi, 0.0, 1.0, out=t_hi)
+        xb *= seg_dx
+        xb += seg_qx
+        lo, hi = np.minimum(xa, xb), np.maximum(xa, xb, out=xb)
+        lo -= grow
+        hi += grow
+        col_lo = np.maximum(np.ceil(lo, out=lo), 0).astype(np.int64)
+        col_hi = np.minimum(np.floor(hi, out=hi), w - 1).astype(np.int64)
         return seg, b, col_lo, col_hi
+
+    def _y_range(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(y_lo, y_hi)``, ``(S,)`` each: the lower and upper y of each segment (found once)."""
+        if self._y is None:
+            self._y = (np.minimum(self.q0[:, 1], self.q1[:, 1]), np.maximum(self.q0[:, 1], self.q1[:, 1]))
+        return self._y
 
     def _near(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
         """The pairs ``(sid, pos)`` within ``radius``, with their distances."""
