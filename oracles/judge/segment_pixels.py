@@ -242,8 +242,10 @@ def _counts_near(segs: "_Segments", cand: "_Pixels", orac: "_Pixels", near: "_Pi
     ``every``: ``near`` is every drawn pixel (paired row by row)."""
     sid, pos = segs.nearest(near, every)
     _, _, major = segs.rows(near, sid, pos)
-    in_cand, in_orac = cand.has(near.stacked[pos]), orac.has(near.stacked[pos])
-    return tuple(_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac))
+    cc = _distinct_per_segment(sid, major, len(segs), cand.has(near.stacked[pos]))
+    if np.array_equal(cand.stacked, orac.stacked):          # the frames agree (ties resolved): once
+        return cc, cc
+    return cc, _distinct_per_segment(sid, major, len(segs), orac.has(near.stacked[pos]))
 
 
 def _cuts(weights: np.ndarray, limit: int) -> list[tuple[int, int]]:
@@ -266,8 +268,9 @@ def _unique(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int) -> np.ndarray:
-    """``(n_segments,)``: the number of distinct ``major`` values of each segment's rows."""
+def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int, kept: np.ndarray) -> np.ndarray:
+    """``(n_segments,)``: the number of distinct ``major`` values of each segment's rows where ``kept``."""
+    sid, major = sid[kept], major[kept]
     span = int(major.max()) + 1 if len(major) else 1
     keys = _unique(sid * span + major)
     return np.bincount(keys // span, minlength=n_segments)
