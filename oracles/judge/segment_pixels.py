@@ -21,7 +21,11 @@ measured. For a few pixels, a grid of cells lists the segments near each
 cell instead. Pairs come in chunks (:data:`CHUNK_PAIRS`) and are folded into
 one nearest segment per pixel as they come, so memory is bounded by the
 image, the segments and the chunk, never by the segments' drawn length
-(a pixel under a soup of long edges is near hundreds of them). The frames of a case are done in one pass: they are stacked
+(a pixel under a soup of long edges is near hundreds of them). A pixel's
+nearest segment is looked for within 1/2 px first (1/8 where the segments
+crowd the pixels), and within ``radius`` only for the pixels with none that
+near (:meth:`_Segments.nearest`): a drawn pixel is within 1/2 of the line
+that drew it, and most of its pairs within 1 are farther. The frames of a case are done in one pass: they are stacked
 one above the other, and a segment looks only at its own frame's rows, so no
 pair mixes two frames and each frame's rows are the ones it would get alone;
 distances are measured in the frame's own coordinates, so they are the same
