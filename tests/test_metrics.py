@@ -174,15 +174,18 @@ def test_edge_neighbourhoods_of_drawn_pixels_equal_the_definition(seed, density)
 
 
 @pytest.mark.parametrize("seed", range(4))
-@pytest.mark.parametrize("levels", ["radius only", "1/2 first", "1/8 and 1/2 first"])
+@pytest.mark.parametrize("levels", ["radius only", "1/2 first", "1/8 and 1/2 first", "1/2 first, no table"])
 def test_nearest_looked_for_near_first_equals_the_definition(monkeypatch, seed, levels):
     """segment_pixels looks within 1/2 px (a soup: 1/8, then 1/2) before the radius, for many pixels:
     forced here on a small image, where random pixels lie at every distance from the segments (some
-    nearest within 1/8, some only between 1/2 and 1, some farther)."""
+    nearest within 1/8, some only between 1/2 and 1, some farther). The pixels left after a radius
+    are paired with the segments whose boxes hold one (a summed-area table), or without the table
+    with every segment."""
     from wirecheck.oracles.judge import segment_pixels
     from wirecheck.oracles.judge.metrics import edge_neighbourhoods
 
     monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 10 ** 9 if levels == "radius only" else 0)
+    monkeypatch.setattr(segment_pixels, "TABLE_CELLS", 0 if levels.endswith("no table") else 1 << 23)
     monkeypatch.setattr(segment_pixels, "CROWDED", 0 if levels.startswith("1/8") else 10 ** 9)
     rng = np.random.default_rng(40 + seed)
     w, h = 40, 30

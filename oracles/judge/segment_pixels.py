@@ -80,6 +80,10 @@ LEVELS = (0.5,)
 #: pairs each with 12 % of them): 1/8 first.
 CROWDED_LEVELS = (0.125, 0.5)
 CROWDED = 64
+#: :meth:`_Segments.boxes_holding`'s summed-area table of the pixels is made up to this many cells (frames
+#: x (H + 1) x (W + 1), int32: 32 MiB); over it, the pixels left after a first radius are paired by
+#: :meth:`_Segments.pairs_any`.
+TABLE_CELLS = 1 << 23
 #: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
 #: (fewer: one search costs less than the calls of several).
 LEVEL_PIXELS = 1024
@@ -439,7 +443,12 @@ class _Segments:
         for k, r in enumerate(levels + [self.radius]):
             segs = self.within(r) if r != self.radius else self
             sub = px if rest is None else px.subset(rest)
-            sid, pos = segs.owners(sub, segs.pairs(sub) if every and k == 0 else segs.pairs_any(sub))
+            if k == 0:
+                chunks = segs.pairs(sub) if every else segs.pairs_any(sub)
+            else:                          # the rest: only the segments whose boxes hold one of them
+                which = segs.boxes_holding(sub)
+                chunks = segs.pairs_any(sub) if which is None else segs.pairs(sub, which)
+            sid, pos = segs.owners(sub, chunks)
             sid_parts.append(sid)
             pos_parts.append(pos if rest is None else rest[pos])
             found = np.zeros(len(sub), bool)
@@ -452,6 +461,32 @@ class _Segments:
         pos = np.concatenate(pos_parts)
         order = np.argsort(pos, kind="stable")
         return np.concatenate(sid_parts)[order], pos[order]
+
+    def boxes_holding(self, px: _Pixels) -> np.ndarray | None:
+        """Ascending indices of the segments whose box grown by ``grow`` holds one of the pixels ``px`` (all
+        that can pair with them), from a summed-area table of the pixels per frame; None when that table
+        would be over :data:`TABLE_CELLS` cells."""
+        n_frames = int(self.frame.max()) + 1 if len(self) else 0
+        w, h = self.width, self.height
+        if len(self) == 0 or n_frames * (h + 1) * (w + 1) > TABLE_CELLS:
+            return None
+        frame, y, x = px.at()
+        table = np.zeros((n_frames, h + 1, w + 1), np.int32)
+        keep = frame < n_frames
+        table[frame[keep], y[keep] + 1, x[keep] + 1] = 1
+        table = table.cumsum(axis=1, dtype=np.int32).cumsum(axis=2, dtype=np.int32)
+        y_lo, y_hi = self._y_range()
+        x_lo = np.minimum(self.q0[:, 0], self.q1[:, 0])
+        x_hi = np.maximum(self.q0[:, 0], self.q1[:, 0])
+        # the box's columns and rows (pixel centres on integers), clipped to the frame: [c0, c1] x [r0, r1]
+        c0 = np.clip(np.ceil(x_lo - self.grow), 0, w).astype(np.int64)
+        c1 = np.clip(np.floor(x_hi + self.grow), -1, w - 1).astype(np.int64) + 1
+        r0 = np.clip(np.ceil(y_lo - self.grow), 0, h).astype(np.int64)
+        r1 = np.clip(np.floor(y_hi + self.grow), -1, h - 1).astype(np.int64) + 1
+        c1, r1 = np.maximum(c1, c0), np.maximum(r1, r0)          # an empty box: no pixel
+        f = self.frame
+        inside = table[f, r1, c1] - table[f, r0, c1] - table[f, r1, c0] + table[f, r0, c0]
+        return np.flatnonzero(inside > 0)
 
     def pairs(self, px: _Pixels, which: np.ndarray | None = None):
         """``(sid, pos, dist)`` chunks: each pair of a segment (of ``which``, ascending, default all) and a
