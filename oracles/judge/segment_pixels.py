@@ -474,7 +474,8 @@ class _Segments:
         table = np.zeros((n_frames, h + 1, w + 1), np.int32)
         keep = frame < n_frames
         table[frame[keep], y[keep] + 1, x[keep] + 1] = 1
-        table = table.cumsum(axis=1, dtype=np.int32).cumsum(axis=2, dtype=np.int32)
+        np.cumsum(table, axis=1, out=table)               # in place: the table is all the memory it takes
+        np.cumsum(table, axis=2, out=table)
         y_lo, y_hi = self._y_range()
         x_lo = np.minimum(self.q0[:, 0], self.q1[:, 0])
         x_hi = np.maximum(self.q0[:, 0], self.q1[:, 0])
