@@ -173,6 +173,50 @@ def test_edge_neighbourhoods_of_drawn_pixels_equal_the_definition(seed, density)
     assert got[1].tolist() == sorted(got[1].tolist())     # one row per pixel, in pixel order
 
 
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("levels", ["radius only", "1/2 first", "1/8 and 1/2 first", "1/2 first, no table"])
+def test_nearest_looked_for_near_first_equals_the_definition(monkeypatch, seed, levels):
+    """segment_pixels looks within 1/2 px (a soup: 1/8, then 1/2) before the radius, for many pixels:
+    forced here on a small image, where random pixels lie at every distance from the segments (some
+    nearest within 1/8, some only between 1/2 and 1, some farther). The pixels left after a radius
+    are paired with the segments whose boxes hold one (a summed-area table), or without the table
+    with every segment."""
+    from wirecheck.oracles.judge import segment_pixels
+    from wirecheck.oracles.judge.metrics import edge_neighbourhoods
+
+    monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 10 ** 9 if levels == "radius only" else 0)
+    monkeypatch.setattr(segment_pixels, "TABLE_CELLS", 0 if levels.endswith("no table") else 1 << 23)
+    monkeypatch.setattr(segment_pixels, "CROWDED", 0 if levels.startswith("1/8") else 10 ** 9)
+    rng = np.random.default_rng(40 + seed)
+    w, h = 40, 30
+    p0 = rng.uniform(-3, 43, (25, 2))
+    p1 = p0 + rng.normal(0, 8, (25, 2))
+    pixels = np.flatnonzero(rng.random(w * h) < 0.5)
+    got = edge_neighbourhoods(p0, p1, w, h, pixels=pixels)
+    assert list(zip(*(a.tolist() for a in got))) == _neighbourhoods_naive(p0, p1, w, h, pixels)
+
+
+@pytest.mark.parametrize("levels", ["radius only", "1/2 first", "1/8 and 1/2 first"])
+def test_nearest_beyond_half_a_pixel_and_tied(monkeypatch, levels):
+    """Two horizontal segments 1.5 px apart, y = 4.25 (edge 0) and 5.75 (edge 1), x 0..20: row 4 is 1/4
+    from edge 0, row 6 1/4 from edge 1, row 5 3/4 from both (a tie beyond every first radius: edge 0,
+    the lower index), rows 3 and 7 1.25 from the nearer (no edge within 1)."""
+    from wirecheck.oracles.judge import segment_pixels
+    from wirecheck.oracles.judge.metrics import edge_neighbourhoods
+
+    monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 10 ** 9 if levels == "radius only" else 0)
+    monkeypatch.setattr(segment_pixels, "CROWDED", 0 if levels.startswith("1/8") else 10 ** 9)
+    w, h = 24, 12
+    p0, p1 = np.array([[0.0, 4.25], [0.0, 5.75]]), np.array([[20.0, 4.25], [20.0, 5.75]])
+    pixels = np.arange(3 * w, 8 * w)                       # rows 3..7, every column
+    edge, pixel, major = (a.tolist() for a in edge_neighbourhoods(p0, p1, w, h, pixels=pixels))
+    # within 1 of a segment: x from 0 to 20 only (x = 21 is hypot(1, 1/4) = 1.03 from the nearer end)
+    expected = [(0, 4 * w + x) for x in range(21)] + [(0, 5 * w + x) for x in range(21)] \
+        + [(1, 6 * w + x) for x in range(21)]
+    assert list(zip(edge, pixel)) == expected
+    assert major == [p % w for p in pixel]                 # horizontal: the column
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_frames_neighbourhoods_give_each_frame_its_own_rows(seed):
     """Frames paired in one pass (stacked with a gap) get the definition's rows, frame by frame.

@@ -28,6 +28,7 @@ import dataclasses
 import io
 import os
 import re
+from itertools import chain
 from pathlib import Path
 
 import numpy as np
@@ -393,10 +394,13 @@ def load_mesh_file(path: Path) -> Scene:
         bad = np.argwhere(~np.isfinite(vertices))[0]
         raise InputError(f"{path}: vertex {bad[0]} has {vertices[bad[0]].tolist()}: expected finite coordinates")
     all_edges = np.concatenate(edges) if edges else np.zeros((0, 2), dtype=np.intp)
-    faces = tuple(tuple(int(i) for i in f) for f in faces)
+    # the Scene's faces are tuples of Python ints; the winding is checked on the array (the same edges)
+    winding = winding_problem(faces) if len(faces) else None
+    faces = tuple(chain.from_iterable(map(tuple, faces[k:k + 65536].tolist())        # a block at a time:
+                                      for k in range(0, len(faces), 65536)))           # no list of all rows
     _check_name_length(_safe_stem(path), path)
     return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
-                 faces=faces, source=str(path), winding_note=_winding_note(faces),
+                 faces=faces, source=str(path), winding_note=winding,
                  load_notes=tuple(n for n in (short.note(path),) if n))
 
 

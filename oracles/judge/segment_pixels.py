@@ -21,7 +21,11 @@ measured. For a few pixels, a grid of cells lists the segments near each
 cell instead. Pairs come in chunks (:data:`CHUNK_PAIRS`) and are folded into
 one nearest segment per pixel as they come, so memory is bounded by the
 image, the segments and the chunk, never by the segments' drawn length
-(a pixel under a soup of long edges is near hundreds of them). The frames of a case are done in one pass: they are stacked
+(a pixel under a soup of long edges is near hundreds of them). A pixel's
+nearest segment is looked for within 1/2 px first (1/8 where the segments
+crowd the pixels), and within ``radius`` only for the pixels with none that
+near (:meth:`_Segments.nearest`): a drawn pixel is within 1/2 of the line
+that drew it, and most of its pairs within 1 are farther. The frames of a case are done in one pass: they are stacked
 one above the other, and a segment looks only at its own frame's rows, so no
 pair mixes two frames and each frame's rows are the ones it would get alone;
 distances are measured in the frame's own coordinates, so they are the same
@@ -33,6 +37,8 @@ gives the rows themselves.
 """
 
 from __future__ import annotations
+
+import copy
 
 import numpy as np
 
@@ -55,6 +61,30 @@ FEW_PAIRS = 1 << 22
 #: one segment per this many drawn pixels (a dense mesh: most segments a few pixels long, where
 #: looking at midpoints and one-sided pixels first would pair most pixels several times over).
 DENSE = 8
+
+#: How far (px) past ``radius`` the boxes and row spans that list candidate pairs reach: a margin for
+#: the rounding of the spans' arithmetic and of the distance itself (each ~1e-12 px on coordinates of
+#: at most ~10^4 px, the frame's grown box), so that every pair whose computed distance is within
+#: ``radius`` is listed; a pair listed beyond it is measured and dropped.
+GROW_PX = 1e-6
+
+#: The radii (px) within which :meth:`_Segments.nearest` looks first, in turn, before ``radius``: a
+#: pixel with a segment within one of them has its nearest there, and is not paired with the farther
+#: ones. A drawn pixel is within 1/2 of the line that drew it (the diamond rule): within 1/2, a drawn
+#: pixel of the benchmark's meshes is paired with 35-50 % of the segments within 1.
+LEVELS = (0.5,)
+#: ... and where the segments' rows outnumber the pixels by more than :data:`CROWDED` (a soup of long
+#: edges: ~700 segments within 1 px of each drawn pixel, 95 % of the pixels with one within 1/8, which
+#: pairs each with 12 % of them): 1/8 first.
+CROWDED_LEVELS = (0.125, 0.5)
+CROWDED = 64
+#: :meth:`_Segments.boxes_holding`'s summed-area table of the pixels is made up to this many cells (frames
+#: x (H + 1) x (W + 1), int32: 32 MiB); over it, the pixels left after a first radius are paired by
+#: :meth:`_Segments.pairs_any`.
+TABLE_CELLS = 1 << 23
+#: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
+#: (fewer: one search costs less than the calls of several).
+LEVEL_PIXELS = 1024
 
 
 def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
@@ -95,7 +125,7 @@ def frames_neighbourhoods(frames, width: int, height: int, radius: float = 1.0) 
         return []
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius)
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
-    sid, pos = segs.owners(px, segs.pairs(px))
+    sid, pos = segs.nearest(px, every=True)
     edge, local, major = segs.rows(px, sid, pos)
     cut = np.searchsorted(pos, np.cumsum(px.counts)[:-1])      # the frames' rows, split
     return list(zip(np.split(edge, cut), np.split(local, cut), np.split(major, cut)))
@@ -147,7 +177,7 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
             compared = (cc > 0) | (oc > 0)
         else:
             compared = _compared(segs, drawn)
-            owners = _unique(segs.owners(one_sided, segs.pairs_any(one_sided))[0])
+            owners = _unique(segs.nearest(one_sided)[0])
             cc = oc = np.zeros(len(segs), np.int64)
             if len(owners):
                 cc, oc = _counts_near(segs, cand, orac, drawn.subset(segs.near(drawn, owners)))
@@ -164,7 +194,7 @@ def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
     mid_stacked = np.where(on, (mid[:, 1] + segs.frame * h) * w + mid[:, 0], -1)
     on &= drawn.has(mid_stacked)
     mids = drawn.subset(_unique(np.searchsorted(drawn.stacked, mid_stacked[on])))
-    m_sid, m_pos = segs.owners(mids, segs.pairs_any(mids))
+    m_sid, m_pos = segs.nearest(mids)
     owner_at = np.full(len(mids), -1, np.int64)
     owner_at[m_pos] = m_sid
     seg_on = np.flatnonzero(on)
@@ -173,7 +203,7 @@ def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
     rest = np.flatnonzero(~compared)           # the others: the owners of the drawn pixels near them
     if len(rest):
         near = drawn.subset(segs.near(drawn, rest))
-        compared[_unique(segs.owners(near, segs.pairs_any(near))[0])] = True
+        compared[_unique(segs.nearest(near)[0])] = True
     return compared
 
 
@@ -181,10 +211,12 @@ def _counts_near(segs: _Segments, cand: _Pixels, orac: _Pixels, near: _Pixels, e
     """``(cc, oc)``, ``(S,)`` each: every segment's count in the candidate's and the oracle's image, over
     the drawn pixels ``near`` only (right for the segments all of whose pixels are among them);
     ``every``: ``near`` is every drawn pixel (paired row by row)."""
-    sid, pos = segs.owners(near, segs.pairs(near) if every else segs.pairs_any(near))
+    sid, pos = segs.nearest(near, every)
     _, _, major = segs.rows(near, sid, pos)
-    in_cand, in_orac = cand.has(near.stacked[pos]), orac.has(near.stacked[pos])
-    return tuple(_distinct_per_segment(sid[m], major[m], len(segs)) for m in (in_cand, in_orac))
+    cc = _distinct_per_segment(sid, major, len(segs), cand.has(near.stacked[pos]))
+    if np.array_equal(cand.stacked, orac.stacked):          # the frames agree (ties resolved): once
+        return cc, cc
+    return cc, _distinct_per_segment(sid, major, len(segs), orac.has(near.stacked[pos]))
 
 
 def _cuts(weights: np.ndarray, limit: int) -> list[tuple[int, int]]:
@@ -207,8 +239,9 @@ def _unique(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int) -> np.ndarray:
-    """``(n_segments,)``: the number of distinct ``major`` values of each segment's rows."""
+def _distinct_per_segment(sid: np.ndarray, major: np.ndarray, n_segments: int, kept: np.ndarray) -> np.ndarray:
+    """``(n_segments,)``: the number of distinct ``major`` values of each segment's rows where ``kept``."""
+    sid, major = sid[kept], major[kept]
     span = int(major.max()) + 1 if len(major) else 1
     keys = _unique(sid * span + major)
     return np.bincount(keys // span, minlength=n_segments)
@@ -240,7 +273,7 @@ def nearest_segments(frames, width: int, height: int, radius: float, box: tuple)
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius, box=box)
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
     owner = np.full(len(px), -1, np.int64)
-    sid, pos = segs.owners(px, segs.pairs_any(px))
+    sid, pos = segs.nearest(px)
     owner[pos] = sid
     return owner, segs.q0, segs.q1, px.at()[0]
 
@@ -324,7 +357,7 @@ class _Segments:
         self.width, self.height, self.radius = width, height, radius
         pad = radius + 1.0
         lo, hi = box if box is not None else ((-pad, -pad), (width - 1 + pad, height - 1 + pad))
-        self.grow = radius + 0.5            # each box is grown by a further 1/2 px, against rounding
+        self.grow = radius + GROW_PX        # each box is grown a little further, against rounding
         p0 = [np.asarray(a, np.float64).reshape(-1, 2) for a, _ in per_frame]
         p1 = [np.asarray(b, np.float64).reshape(-1, 2) for _, b in per_frame]
         self.counts = np.array([len(a) for a in p0], np.int64)
@@ -342,9 +375,82 @@ class _Segments:
                                                              self.d[:, 1], self.dd))
         self._cells = None                       # the grid of pairs_any, made on first use
         self._rows = None                        # _rows_spanned, counted on first use
+        self._y = None                           # _y_range, found on first use
 
     def __len__(self) -> int:
         return len(self.q0)
+
+    def within(self, radius: float) -> _Segments:
+        """These segments, pairing within ``radius`` (the arrays shared; the grid and row counts its own)."""
+        out = copy.copy(self)
+        out.radius, out.grow = radius, radius + GROW_PX
+        out._cells = out._rows = None
+        return out
+
+    def nearest(self, px: _Pixels, every: bool = False):
+        """:meth:`owners` of the pixels ``px`` over all segments, looking within :data:`LEVELS` first.
+
+        The pixels with a pair within a level's radius have their nearest
+        segment among those pairs (every segment as near, ties included, is
+        one of them); only the others are paired within the next radius.
+        ``every``: ``px`` is every drawn pixel (paired row by row, :meth:`pairs`;
+        else :meth:`pairs_any`). The same ``(sid, pos)`` as one search within
+        ``radius``.
+        """
+        levels = []
+        if len(px) >= LEVEL_PIXELS:
+            crowded = self._rows_spanned() > CROWDED * len(px)
+            levels = [r for r in (CROWDED_LEVELS if crowded else LEVELS) if r < self.radius]
+        sid_parts, pos_parts = [], []
+        rest = None                                   # positions in px still without an owner (None: all)
+        for k, r in enumerate(levels + [self.radius]):
+            segs = self.within(r) if r != self.radius else self
+            sub = px if rest is None else px.subset(rest)
+            if k == 0:
+                chunks = segs.pairs(sub) if every else segs.pairs_any(sub)
+            else:                          # the rest: only the segments whose boxes hold one of them
+                which = segs.boxes_holding(sub)
+                chunks = segs.pairs_any(sub) if which is None else segs.pairs(sub, which)
+            sid, pos = segs.owners(sub, chunks)
+            sid_parts.append(sid)
+            pos_parts.append(pos if rest is None else rest[pos])
+            found = np.zeros(len(sub), bool)
+            found[pos] = True
+            rest = np.flatnonzero(~found) if rest is None else rest[~found]
+            if len(rest) == 0:
+                break
+        if len(sid_parts) == 1:
+            return sid_parts[0], pos_parts[0]
+        pos = np.concatenate(pos_parts)
+        order = np.argsort(pos, kind="stable")
+        return np.concatenate(sid_parts)[order], pos[order]
+
+    def boxes_holding(self, px: _Pixels) -> np.ndarray | None:
+        """Ascending indices of the segments whose box grown by ``grow`` holds one of the pixels ``px`` (all
+        that can pair with them), from a summed-area table of the pixels per frame; None when that table
+        would be over :data:`TABLE_CELLS` cells."""
+        n_frames = int(self.frame.max()) + 1 if len(self) else 0
+        w, h = self.width, self.height
+        if len(self) == 0 or n_frames * (h + 1) * (w + 1) > TABLE_CELLS:
+            return None
+        frame, y, x = px.at()
+        table = np.zeros((n_frames, h + 1, w + 1), np.int32)
+        keep = frame < n_frames
+        table[frame[keep], y[keep] + 1, x[keep] + 1] = 1
+        np.cumsum(table, axis=1, out=table)               # in place: the table is all the memory it takes
+        np.cumsum(table, axis=2, out=table)
+        y_lo, y_hi = self._y_range()
+        x_lo = np.minimum(self.q0[:, 0], self.q1[:, 0])
+        x_hi = np.maximum(self.q0[:, 0], self.q1[:, 0])
+        # the box's columns and rows (pixel centres on integers), clipped to the frame: [c0, c1] x [r0, r1]
+        c0 = np.clip(np.ceil(x_lo - self.grow), 0, w).astype(np.int64)
+        c1 = np.clip(np.floor(x_hi + self.grow), -1, w - 1).astype(np.int64) + 1
+        r0 = np.clip(np.ceil(y_lo - self.grow), 0, h).astype(np.int64)
+        r1 = np.clip(np.floor(y_hi + self.grow), -1, h - 1).astype(np.int64) + 1
+        c1, r1 = np.maximum(c1, c0), np.maximum(r1, r0)          # an empty box: no pixel
+        f = self.frame
+        inside = table[f, r1, c1] - table[f, r0, c1] - table[f, r1, c0] + table[f, r0, c0]
+        return np.flatnonzero(inside > 0)
 
     def pairs(self, px: _Pixels, which: np.ndarray | None = None):
         """``(sid, pos, dist)`` chunks: each pair of a segment (of ``which``, ascending, default all) and a
@@ -428,7 +534,7 @@ class _Segments:
         """:meth:`pairs_any` by a box test of every pixel against every segment of its frame: the pairs
         whose pixel centre is within ``radius`` of the segment's box (all those within ``radius`` of the
         segment), measured. ``frame``: each pixel's."""
-        r = self.radius
+        r = self.grow                   # radius and the margin of :data:`GROW_PX`
         lo_x, hi_x = np.minimum(self.q0[:, 0], self.q1[:, 0]) - r, np.maximum(self.q0[:, 0], self.q1[:, 0]) + r
         lo_y, hi_y = np.minimum(self.q0[:, 1], self.q1[:, 1]) - r, np.maximum(self.q0[:, 1], self.q1[:, 1]) + r
         x, y = px.xy()
@@ -462,9 +568,9 @@ class _Segments:
 
     def _rows_of(self, which: np.ndarray) -> np.ndarray:
         """``(len(which),)`` int64: the rows of the frame each segment's grown box spans (:meth:`pairs`' slices)."""
-        y0, y1 = self.q0[which, 1], self.q1[which, 1]
-        lo = np.maximum(np.ceil(np.minimum(y0, y1) - self.grow), 0)
-        hi = np.minimum(np.floor(np.maximum(y0, y1) + self.grow), self.height - 1)
+        y_lo, y_hi = self._y_range()
+        lo = np.maximum(np.ceil(y_lo[which] - self.grow), 0)
+        hi = np.minimum(np.floor(y_hi[which] + self.grow), self.height - 1)
         return np.maximum(hi - lo + 1, 0).astype(np.int64)
 
     def _cell_side(self) -> int:
@@ -483,22 +589,45 @@ class _Segments:
         of the frame only), the columns its part within ``grow`` of the band reaches, grown, clipped to the
         frame (a pixel centre within ``radius`` of the segment in those rows is in those columns: the
         nearest point is within ``radius`` in y, so in that part, and within ``radius`` in x)."""
-        q0, q1, d, grow, w, h = self.q0, self.q1, self.d, self.grow, self.width, self.height
-        b_lo = np.maximum(np.ceil(np.minimum(q0[which, 1], q1[which, 1]) - grow), 0).astype(np.int64) // band
-        b_hi = np.minimum(np.floor(np.maximum(q0[which, 1], q1[which, 1]) + grow), h - 1).astype(np.int64) // band
+        grow, w, h = self.grow, self.width, self.height
+        qx, qy, dx, dy = self._cols[:4]
+        y_lo, y_hi = self._y_range()
+        b_lo = np.maximum(np.ceil(y_lo[which] - grow), 0).astype(np.int64) // band
+        b_hi = np.minimum(np.floor(y_hi[which] + grow), h - 1).astype(np.int64) // band
         n = np.maximum(b_hi - b_lo + 1, 0)
         seg = np.repeat(which, n)
-        b = np.repeat(b_lo, n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
-        top, bottom = b * band - grow, b * band + (band - 1) + grow
-        dy = d[seg, 1]
+        b = np.arange(int(n.sum())) + np.repeat(b_lo - (np.cumsum(n) - n), n)
+        seg_dy = np.take(dy, seg)
+        # t of the band's top and bottom (+ 2 grow + band - 1) along each segment; a flat one: all of it
+        rel = b * band - grow
+        rel -= np.take(qy, seg)
         with np.errstate(divide="ignore", invalid="ignore"):
-            ta = np.where(dy != 0, (top - q0[seg, 1]) / dy, 0.0)
-            tb = np.where(dy != 0, (bottom - q0[seg, 1]) / dy, 1.0)
-        xa = q0[seg, 0] + np.clip(np.minimum(ta, tb), 0.0, 1.0) * d[seg, 0]
-        xb = q0[seg, 0] + np.clip(np.maximum(ta, tb), 0.0, 1.0) * d[seg, 0]
-        col_lo = np.maximum(np.ceil(np.minimum(xa, xb) - grow), 0).astype(np.int64)
-        col_hi = np.minimum(np.floor(np.maximum(xa, xb) + grow), w - 1).astype(np.int64)
+            ta = rel / seg_dy
+            rel += (band - 1) + 2 * grow
+            tb = np.divide(rel, seg_dy, out=rel)
+        t_lo, t_hi = np.minimum(ta, tb), np.maximum(ta, tb, out=ta)
+        flat = seg_dy == 0
+        if flat.any():
+            t_lo[flat], t_hi[flat] = 0.0, 1.0
+        seg_qx, seg_dx = np.take(qx, seg), np.take(dx, seg)
+        xa = np.clip(t_lo, 0.0, 1.0, out=t_lo)
+        xa *= seg_dx
+        xa += seg_qx
+        xb = np.clip(t_hi, 0.0, 1.0, out=t_hi)
+        xb *= seg_dx
+        xb += seg_qx
+        lo, hi = np.minimum(xa, xb), np.maximum(xa, xb, out=xb)
+        lo -= grow
+        hi += grow
+        col_lo = np.maximum(np.ceil(lo, out=lo), 0).astype(np.int64)
+        col_hi = np.minimum(np.floor(hi, out=hi), w - 1).astype(np.int64)
         return seg, b, col_lo, col_hi
+
+    def _y_range(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(y_lo, y_hi)``, ``(S,)`` each: the lower and upper y of each segment (found once)."""
+        if self._y is None:
+            self._y = (np.minimum(self.q0[:, 1], self.q1[:, 1]), np.maximum(self.q0[:, 1], self.q1[:, 1]))
+        return self._y
 
     def _near(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
         """The pairs ``(sid, pos)`` within ``radius``, with their distances."""
