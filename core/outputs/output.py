@@ -21,8 +21,9 @@ from .owned import MARKER
 from .owned import TAG as _TAG
 from .gif import gif_bytes as encode
 from ..errors import InputError
+from . import owned
 from .owned import TAG, exchange, is_leftover, is_regular, listing, ours, remove_tree, rename, rename_noreplace, \
-    retire, seal, step
+    retire, step
 from ..scene import files as scene_files
 from ..scene.files import MESH_SUFFIXES, NATIVE_SUFFIX
 from .lockfile import Lock
@@ -476,7 +477,7 @@ class FrameDir:
         a file the user wrote meanwhile was kept (class docstring)."""
         check_replaceable(self.final, self.option)   # again: it may have changed meanwhile
         step()                                       # checked: the old folder is checked again after the swap
-        seal(self.tmp)
+        owned.seal(self.tmp)                         # read off its module: tests pause a commit there
         os.unlink(self.tmp / _TAG)                   # sealed: its listing marks it as ours from here on
         kept = self.kept
         if os.path.lexists(self.final) and exchange(self.tmp, self.final):
