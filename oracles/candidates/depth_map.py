@@ -126,6 +126,8 @@ def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCA
                 if size != (width, height):
                     raise InputError(_shape_text(str(path), size[::-1], width, height))
                 values = np.asarray(im)
+    except InputError:                          # our own line above (InputError is a ValueError): as it is
+        raise
     except (OSError, UnidentifiedImageError, ValueError, Image.DecompressionBombError,
             Image.DecompressionBombWarning) as exc:
         raise InputError(f"{path}: not a readable image ({' '.join(str(exc).split())[:120]}): expected {want} "
