@@ -163,3 +163,14 @@ def test_big_endian_and_fortran_float32_are_float32(tmp_path):
     for name in ("b.npy", "f.npy"):
         dm = read_depth_map(tmp_path / name, 3, 2)
         assert np.array_equal(dm.depth, values) and dm.encoding == "npy float32" and dm.rel_step == EPS32
+
+
+def test_npy_of_an_unknown_version_says_so_once(tmp_path):
+    # a .npy whose magic says version 3.0: refused by the reader's own version check, whose line is the
+    # one the user reads (not wrapped again as "not a readable .npy file (...: not a readable .npy ...)"
+    # and cut: InputError is a ValueError, which the header parser's handler also catches)
+    data = bytearray(_npy_bytes(b"{'descr': '<f4', 'fortran_order': False, 'shape': (6, 8), }", b"\0" * 192))
+    data[6:8] = b"\x03\x00"
+    (tmp_path / "d.npy").write_bytes(bytes(data))
+    text = _refused(tmp_path / "d.npy", 8, 6)
+    assert "format version 3.0, expected 1.0 or 2.0" in text and text.count("not a readable .npy") == 1, text

@@ -156,6 +156,8 @@ def _npy_map(data: bytes, path: Path, width: int, height: int) -> DepthMap:
             refuse(f"format version {version[0]}.{version[1]}, expected 1.0 or 2.0")
         read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
         shape, fortran, dtype = read_header(fh)
+    except InputError:                          # refuse()'s own line (InputError is a ValueError): as it is
+        raise
     except _NPY_HEADER_ERRORS as exc:
         refuse(str(exc) or type(exc).__name__)
     if dtype.kind != "f" or dtype.itemsize not in (4, 8):
