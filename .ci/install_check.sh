@@ -153,7 +153,9 @@ has pytest ">       wirecheck(mirrored)"
 if grep -E "site-packages/wirecheck/.*\.py:[0-9]+" "$WORK/pytest.out" | grep -v '^#\|^import \|code object' >&2; then
     fail "pytest: the failure shows wirecheck's own frames (lines above)"
 fi
-[ -f "$P/wc-reports/tests_test_projection.py_test_mirrored_projector_is_caught/report.json" ] \
+# the folder: the test id made a name, then 8 hex digits of the id's SHA-1 (docs/pytest.md), computed here
+id_hash=$(printf '%s' "tests/test_projection.py::test_mirrored_projector_is_caught" | sha1sum | cut -c1-8)
+[ -f "$P/wc-reports/tests_test_projection.py_test_mirrored_projector_is_caught-$id_hash/report.json" ] \
     || fail "pytest --wirecheck-report: no report for the failing test under $P/wc-reports"
 expect 0 pytest-pass "$VENV/bin/pytest" -q -p no:cacheprovider -k matches_the_references
 has pytest-pass "1 passed, 1 deselected"
