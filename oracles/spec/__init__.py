@@ -21,7 +21,8 @@ import time
 
 from .checks import CHECK_NAMES, CRITICAL, run_checks
 from .matrix import CAMERA_Z, FOVS, FRAME_COUNTS, RUNS, SCENES, TURNS, run_matrix, spec_cases
-from .report import finite_or_null, spec_console, spec_markdown
+from ..reports.report import finite_or_null
+from .report import spec_console, spec_markdown
 
 __all__ = ["run_spec", "suite_verdict", "spec_markdown", "spec_console", "run_checks", "run_matrix",
            "spec_cases", "CHECK_NAMES", "CRITICAL", "RUNS", "SCENES", "CAMERA_Z", "FOVS", "FRAME_COUNTS"]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 
 from ..reports.compared import reason_text
 from ..reports.fault_text import case_cell, hints
@@ -13,18 +12,6 @@ def _run_rows(result: dict) -> list[dict]:
     """The runs as crosscheck table rows: the camera cell says the distance, FOV and frame count."""
     return [{**r, "camera": f"{r['camera']}, {r['frames']} frame{'' if r['frames'] == 1 else 's'}"}
             for r in result["runs"]]
-
-
-def finite_or_null(obj):
-    """``obj`` with every inf and NaN float made None: strict JSON (spec.json) has neither, and a candidate
-    that answers NaN or overflows puts them in the checks' records (error_px inf, its pixels NaN)."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: finite_or_null(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [finite_or_null(v) for v in obj]
-    return obj
 
 
 def _err(v) -> str:
