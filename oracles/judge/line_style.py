@@ -225,10 +225,18 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
     return x[:2], x[2:].reshape(2, 2)
 
 
-def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.ndarray:
+def _reference(segs: np.ndarray, shape, width_px: float, clipped=None, drawn: int | None = None) -> np.ndarray:
     """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width.
 
     ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
+    ``drawn``: the candidate's count of drawn pixels in the frame. A wide band's half-width is then
+    the one whose band holds that many pixel centres (between the ``drawn``-th nearest centre's distance
+    and the next's), not the measured width rounded: a binary band of half-width h centred on the line is
+    every centre within h of it, and where every line sits at one fractional position (square-on) the
+    widths h that give the same centres span up to a pixel, so the width read from the counts (2 for a
+    1.5 px band at some positions) does not say which h drew them. Any h between the two distances draws
+    the candidate's count exactly when its band is centred on the line, whose offset then reads 0; a band
+    moved off the line holds other centres and reads the move. Without ``drawn``: the width rounded.
     """
     h, w = shape
     img = np.zeros(shape, bool)
@@ -240,16 +248,24 @@ def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.nda
         img[rr, cc] = True
         return img
     half = round(width_px) / 2.0
+    reach = max(half, width_px / 2.0) + 1.0 if drawn is not None else half
+    dist = np.full(shape, np.inf)
     for a, b in segs:
-        lo = np.maximum(np.floor(np.minimum(a, b) - half), 0).astype(int)
-        hi = np.minimum(np.ceil(np.maximum(a, b) + half), [w - 1, h - 1]).astype(int)
+        lo = np.maximum(np.floor(np.minimum(a, b) - reach), 0).astype(int)
+        hi = np.minimum(np.ceil(np.maximum(a, b) + reach), [w - 1, h - 1]).astype(int)
         if np.any(hi < lo):
             continue
         yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
         q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
-        near = seg_distance(q, a[None], b[None])[:, 0] <= half
-        img[yy.ravel()[near], xx.ravel()[near]] = True
-    return img
+        d = seg_distance(q, a[None], b[None])[:, 0].reshape(yy.shape)
+        window = dist[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
+        np.minimum(window, d, out=window)
+    if drawn is not None and drawn > 0:
+        near = np.sort(dist[dist <= reach])
+        if len(near) >= drawn:
+            nxt = near[drawn] if len(near) > drawn else reach
+            half = (near[drawn - 1] + nxt) / 2.0
+    return dist <= half
 
 
 def _off_by_one(fp, ends: np.ndarray) -> dict:
@@ -345,7 +361,8 @@ class CaseStyle:
             self.drawn_px += (len(cand), int(np.count_nonzero(orac)))      # binary: pixels drawn, the oracle's
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             same = grey.shape == (camera.height, camera.width)          # the clipping above is the reference's
-            ref = measure(_reference(segs, grey.shape, width, clipped if same else None), segs, wins=wins)
+            ref = measure(_reference(segs, grey.shape, width, clipped if same else None, drawn=len(cand)),
+                          segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
                 line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
             self.reference.add(ref)
