@@ -77,11 +77,10 @@ import numpy as np
 
 from .. import faults as catalogue
 from .. import tolerances
-from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
+from . import coverage_pixels, even_lean, free_ends, line_model, line_ties, line_windows
 from ..diagnosis.diagnose import diagnose_lines
 from .case_samples import CaseSamples
 from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
-from ..segment_geometry import seg_distance
 from ..diagnosis.image_diagnose import oracle_segments
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
@@ -225,47 +224,22 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
     return x[:2], x[2:].reshape(2, 2)
 
 
-def _reference(segs: np.ndarray, shape, width_px: float, clipped=None, drawn: int | None = None) -> np.ndarray:
-    """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width.
+def _reference(segs: np.ndarray, shape, width_px: float, clipped=None, drawn: int = 0) -> np.ndarray:
+    """A correct binary drawing of ``segs``: core's raster (1 px), or a band centred on them holding the
+    candidate's ``drawn`` pixels (oracles.judge.line_model.band_holding; ``drawn`` 0: the width rounded).
 
     ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
-    ``drawn``: the candidate's count of drawn pixels in the frame. A wide band's half-width is then
-    the one whose band holds that many pixel centres (between the ``drawn``-th nearest centre's distance
-    and the next's), not the measured width rounded: a binary band of half-width h centred on the line is
-    every centre within h of it, and where every line sits at one fractional position (square-on) the
-    widths h that give the same centres span up to a pixel, so the width read from the counts (2 for a
-    1.5 px band at some positions) does not say which h drew them. Any h between the two distances draws
-    the candidate's count exactly when its band is centred on the line, whose offset then reads 0; a band
-    moved off the line holds other centres and reads the move. Without ``drawn``: the width rounded.
     """
     h, w = shape
-    img = np.zeros(shape, bool)
     if len(segs) == 0:
-        return img
+        return np.zeros(shape, bool)
     if width_px < WIDE_MIN_PX:
+        img = np.zeros(shape, bool)
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h) if clipped is None else clipped
         rr, cc = raster.line_pixels(q0, q1, w, h)
         img[rr, cc] = True
         return img
-    half = round(width_px) / 2.0
-    reach = max(half, width_px / 2.0) + 1.0 if drawn is not None else half
-    dist = np.full(shape, np.inf)
-    for a, b in segs:
-        lo = np.maximum(np.floor(np.minimum(a, b) - reach), 0).astype(int)
-        hi = np.minimum(np.ceil(np.maximum(a, b) + reach), [w - 1, h - 1]).astype(int)
-        if np.any(hi < lo):
-            continue
-        yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
-        q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
-        d = seg_distance(q, a[None], b[None])[:, 0].reshape(yy.shape)
-        window = dist[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
-        np.minimum(window, d, out=window)
-    if drawn is not None and drawn > 0:
-        near = np.sort(dist[dist <= reach])
-        if len(near) >= drawn:
-            nxt = near[drawn] if len(near) > drawn else reach
-            half = (near[drawn - 1] + nxt) / 2.0
-    return dist <= half
+    return line_model.band_holding(segs, shape, drawn, width_px)
 
 
 def _off_by_one(fp, ends: np.ndarray) -> dict:
