@@ -34,6 +34,7 @@ PROBE = ("import vtk; w = vtk.vtkRenderWindow(); w.SetOffScreenRendering(1); w.S
          "w.AddRenderer(vtk.vtkRenderer()); w.Render()")
 MOTION = Motion(turns=(1.0, 1.0, 0.0))
 MISTAKES = ("correct", "zbuffer", "no_flip", "horizontal_fov")
+pytestmark = pytest.mark.slow          # 21 pyrender frames and a renderer process (15-30 s here)
 
 
 @pytest.fixture(scope="module")
