@@ -38,6 +38,14 @@ from pathlib import Path
 
 import numpy as np
 
+from wirecheck.core.scene.files import load_scene
+from wirecheck.core.transforms import Motion
+from wirecheck.oracles.cases import case_motion, cases_for
+from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
+from wirecheck.oracles.judge.depth_reference import reference_depth
+from wirecheck.oracles.references import faces as oface
+from wirecheck.oracles.references.convert import centre_of, gl_eye_pose
+
 ROOT = Path(__file__).resolve().parents[1]
 
 VERTEX_RUNS = [("core, default cases", ["--cases", "default"]),
@@ -155,14 +163,7 @@ def _line(label: str, t: dict) -> str:
 def measure_depth() -> None:
     import cv2
 
-    from wirecheck.core.scene.files import load_scene
-    from wirecheck.core.transforms import Motion
-    from wirecheck.oracles.cases import case_motion, cases_for
-    from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
-    from wirecheck.oracles.judge.depth_reference import reference_depth
-    from wirecheck.oracles.references import faces as oface
-    from wirecheck.oracles.references.convert import centre_of, gl_eye_pose
-    from wirecheck.oracles.references.pyrender_oracle import OracleCache, osmesa_available
+    from wirecheck.oracles.references.pyrender_oracle import OracleCache, osmesa_available   # GL: lazily
 
     ok, msg = osmesa_available()
     if not ok:
