@@ -362,3 +362,16 @@ def test_pyrender_object_ids_where_objects_hide_each_other(summary_section):
             n += 1
     summary_section("fill rule: object ids", f"{n} views of 3 overlapping objects: ids equal pyrender's at "
                     f"{decided_ids} decided pixels; {id_ties} id ties")
+
+
+def test_docs_depth_picture_is_what_coverage_gives():
+    # docs/depth.md, "Filled frames: the fill rule and ties": the right triangle's two 5 x 5 pictures
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "depth.md").read_text()
+    lines = text[text.index("inside        ties\n"):].splitlines()[1:6]
+    inside, ties = coverage([[[0, 0], [4, 0], [0, 4]]], (5, 5))
+    for row, line in enumerate(lines):
+        cells = line.split()
+        assert cells[:5] == ["*" if v else "." for v in inside[row]], line
+        assert cells[5:10] == ["t" if v else "." for v in ties[row]], line
