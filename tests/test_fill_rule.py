@@ -271,6 +271,7 @@ def _face_objects(scene) -> np.ndarray:
 FRAMES = 2      # 6 scenes x 7 cameras x 2 frames: 84 frames
 
 
+@pytest.mark.slow
 def test_core_shaded_frames_differ_from_the_reference_only_at_ties(summary_section):
     decided_diff, tie_diff, ties_px, ref_px, n = 0, 0, 0, 0, 0
     for label, scene, cam, (p_world, _m, pr_vertices, pr_pose) in _scene_frames(FRAMES):
