@@ -243,6 +243,12 @@ def test_the_tie_distance_is_the_tolerances():
         tolerances.DEPTH_STEPS, tolerances.DEPTH_SNAP_PX, tolerances.DEPTH_EPS32)
 
 
+def test_face_objects_of_another_length_are_refused():
+    cam = _camera()
+    with pytest.raises(ValueError, match="1 entries for 2 faces"):
+        silhouette(np.eye(4, 3), [(0, 1, 2), (1, 2, 3)], cam, (48, 64), face_objects=[0])
+
+
 def test_a_distorted_camera_is_refused():
     cam = _camera(distortion=(0.1, 0.0, 0.0, 0.0, 0.0), intrinsics=(40.0, 40.0, 31.5, 23.5))
     with pytest.raises(ValueError, match="distorted"):

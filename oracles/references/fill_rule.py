@@ -382,6 +382,8 @@ def silhouette(p_world, faces, camera, shape, face_objects=None,
     object_ids : (H, W) int64, the object of the nearest face at each covered centre,
         :data:`NO_OBJECT` where none, :data:`ID_TIE` where two objects are within depth bounds.
     """
+    if face_objects is not None and len(face_objects) != len(faces):
+        raise ValueError(f"face_objects has {len(face_objects)} entries for {len(faces)} faces: expected one per face")
     tris_px, tri_z, owner = project_clipped(p_world, faces, camera)
     shape = (int(shape[0]), int(shape[1]))
     is_open = open_edges(tris_px)
