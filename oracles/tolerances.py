@@ -369,6 +369,48 @@ MIN_SILHOUETTE_IOU = 0.995
 #: boundary pixels are 20 % of its area.
 MIN_IOU_UNION_PX = 400
 
+# ---- Filled frames under GL's fill rule (oracles.references.fill_rule, oracles.judge.silhouette)
+#
+# The reference covers a pixel when its centre is inside a triangle, computed exactly in
+# float64; a renderer first moves each vertex, per coordinate, by its snap to the sub-pixel
+# grid and its float32 rounding: at most TIE_END_PX (above: 2^-9 + 2^-9 px while the frame's
+# scale is at most 4,096 px; GL's minimum of 4 sub-pixel bits would be 2^-5, see below). A
+# vertex moved by at most TIE_END_PX per coordinate moves by at most sqrt(2) TIE_END_PX, and
+# every point of an edge, a weighted mean of its ends, by at most as much: a centre farther
+# than that from every edge the renderer could move is decided as the reference decides it.
+# Centres within it of an open edge (the silhouette's contour, a mesh border, a near-plane
+# cut; not an edge that triangles on both its sides share, whose shared ends move together)
+# are ties, where either answer is correct.
+#
+# So a correct rasteriser (float32 vertices, >= 8 sub-pixel bits, GL's fill rule) differs
+# from the reference only at ties, and any decided disagreement is an error: the longest run
+# of decided disagreements allowed (the largest 8-connected set of pixels missing or added,
+# oracles.judge.silhouette) is 0. The run is what is reported: a one-pixel band missing along
+# an edge of L px is a run of about L, which IoU hides on a large silhouette (IoU = 1 - L/A:
+# 0.9967 for one edge of a 300 x 300 square, above MIN_SILHOUETTE_IOU). A renderer with
+# coarser snapping (GL allows 4 sub-pixel bits: a vertex may move by 1/32 px) flips centres
+# up to ~0.05 px from an edge, isolated pixels and runs along near-axis-aligned edges: loosen
+# max_silhouette_run_px for it. Scales above 4,096 px make the float32 term larger than 2^-9:
+# with FILL_TIE_PX a centre may then count as decided where a renderer is undecided (a false
+# alarm, never a hidden fault); fill_tie_bound(vertex_scale(...)) widens the zone for such a frame.
+
+#: How far a renderer may move a vertex before deciding coverage (px, Euclidean; derivation above).
+FILL_TIE_PX = 2.0 ** 0.5 * TIE_END_PX
+#: The largest 8-connected set of decided pixels missing or added that passes (derivation above).
+MAX_SILHOUETTE_RUN_PX = 0
+
+
+def fill_tie_bound(scale: float) -> float:
+    """The tie distance (px) for a frame of ``scale`` (:func:`vertex_scale`): FILL_TIE_PX up to 4,096 px.
+
+    ``sqrt(2) (2^-(SUBPIXEL_BITS + 1) + max(2^-9, VERTEX_ROUNDINGS eps32 scale))``: the snap's half
+    step and the float32 rounding of a vertex at that scale, never below the 2^-9 that FILL_TIE_PX
+    assumes (derivation above).
+    """
+    rounding = max(2.0 ** -9, VERTEX_ROUNDINGS * EPS["float32"] * float(scale))
+    return 2.0 ** 0.5 * (2.0 ** -(SUBPIXEL_BITS + 1) + rounding)
+
+
 #: The shaded depth comparison: |z_candidate - z_pyrender| at a pixel covered
 #: by both and not on either silhouette (eroded by 1 px) nor beside an occlusion
 #: boundary (oracles.judge.metrics.occlusion_boundary) must be at most
@@ -474,6 +516,8 @@ class Tolerances:
     end_px: float = END_TOL_PX
     rounded_end_tie_px: float = ROUNDED_END_TIE_PX
     rule_f1_0px: float = RULE_F1_0PX
+    fill_tie_px: float = FILL_TIE_PX
+    max_silhouette_run_px: int = MAX_SILHOUETTE_RUN_PX
 
     def __post_init__(self):
         if self.precision is not None and self.precision not in PRECISIONS:
