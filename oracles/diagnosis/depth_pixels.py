@@ -54,7 +54,7 @@ def pixel_models(cand, ref, faces, camera):
     cy, cx = (np.argwhere(c_on).mean(axis=0))
     ry, rx = (np.argwhere(r_on).mean(axis=0))
     d = _fit(cand, ref, faces, camera, np.array([rx - cx, ry - cy]),
-             lambda p, th: p + th, lambda p, th: np.stack([np.eye(2)] * len(p)))
+             lambda p, th: p + th, lambda p, th: np.broadcast_to(np.eye(2), (len(p), 2, 2)))
     if d is not None:
         yield "pixel_offset", 2, {"dx": float(d[0]), "dy": float(d[1])}, lambda p, d=d: p + d
     if camera.projection != "perspective":
@@ -83,13 +83,15 @@ def sample(ref, faces, camera, q):
     y0 = np.floor(q[:, 1]).astype(np.int64)
     on_image = (x0 >= 0) & (y0 >= 0) & (x0 + 1 < w) & (y0 + 1 < h)
     xs, ys = np.clip(x0, 0, w - 2), np.clip(y0, 0, h - 2)
-    ids = np.stack([faces[ys, xs], faces[ys, xs + 1], faces[ys + 1, xs], faces[ys + 1, xs + 1]], axis=1)
-    inside = on_image & (ids[:, 0] >= 0) & (ids == ids[:, :1]).all(axis=1)
-    outside = ~on_image | (ids < 0).all(axis=1)
+    i00, i10, i01, i11 = faces[ys, xs], faces[ys, xs + 1], faces[ys + 1, xs], faces[ys + 1, xs + 1]
+    inside = on_image & (i00 >= 0) & (i10 == i00) & (i01 == i00) & (i11 == i00)
+    outside = ~on_image | ((i00 < 0) & (i10 < 0) & (i01 < 0) & (i11 < 0))
     persp = camera.projection == "perspective"
     with np.errstate(divide="ignore", invalid="ignore"):
-        wv = 1.0 / ref if persp else ref
-        w00, w10, w01, w11 = wv[ys, xs], wv[ys, xs + 1], wv[ys + 1, xs], wv[ys + 1, xs + 1]
+        # the four neighbours' w, taken from ``ref`` at those pixels only (not 1 / ref over the whole image)
+        w00, w10, w01, w11 = ref[ys, xs], ref[ys, xs + 1], ref[ys + 1, xs], ref[ys + 1, xs + 1]
+        if persp:
+            w00, w10, w01, w11 = 1.0 / w00, 1.0 / w10, 1.0 / w01, 1.0 / w11
         fx, fy = q[:, 0] - xs, q[:, 1] - ys
         top, bottom = w00 + fx * (w10 - w00), w01 + fx * (w11 - w01)
         val = top + fy * (bottom - top)

@@ -174,7 +174,11 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
         if not m.any():
             continue
         a, b = triangles[ids[m]], triangles[other[m]]
-        apart = ~(a[:, :, None] == b[:, None, :]).any(axis=(1, 2))
+        shared = np.zeros(len(a), bool)
+        for i in range(3):                               # nine 1-D comparisons: no (n, 3, 3) temporary
+            for j in range(3):
+                shared |= a[:, i] == b[:, j]
+        apart = ~shared
         hit = np.zeros(ids.shape, bool)
         hit[m] = apart                                   # this pixel, whose neighbour (dy, dx) is apart
         out |= hit | _shifted(hit, -dy, -dx, False)      # and that neighbour
