@@ -35,6 +35,8 @@ from .runner import run_crosscheck
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
 from .tolerances import Tolerances
 from .reports.report import write_report
+from .reports.fmt import short_repr
+from .reports.report_option import checked_report_dir
 from wirecheck.core.errors import InputError
 from .references.pyrender_oracle import GLUnavailable, gl_available
 from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
@@ -160,22 +162,6 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     return report
 
 
-def checked_report_dir(report_dir):
-    """``report_dir`` as a Path (None: none), checked before anything runs: TypeError for a non-path,
-    ValueError (InputError) for a path that is a file."""
-    import os
-    from pathlib import Path
-
-    if report_dir is None:
-        return None
-    if isinstance(report_dir, bool) or not isinstance(report_dir, (str, os.PathLike)):
-        raise TypeError(f"report_dir {short_repr(report_dir)}: expected a folder path (str or Path), or None")
-    path = Path(report_dir)
-    if path.exists() and not path.is_dir():
-        raise InputError(f"report_dir {str(path)!r} is a file: expected a folder for the report")
-    return path
-
-
 def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol_px=None, min_f1=None,
               min_f1_0px=None, turns=None, allow_vacuous=False, *, cmd=None, timeout_s=None, isolate=None,
               precision=None, config=None) -> tuple[dict, dict]:
@@ -268,12 +254,6 @@ def _candidate_args(func, cmd):
         raise TypeError(f"func {name}{signature} cannot be called as func(points, camera): expected "
                         "the candidate contract (wirecheck.oracles.candidates.candidate)") from None
     return func, None
-
-
-def short_repr(value) -> str:
-    """``repr(value)`` on one line, at most 80 characters."""
-    text = " ".join(repr(value).split())
-    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def checked_flag(value, name: str, extra: str = "") -> bool:

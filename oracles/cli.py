@@ -305,14 +305,15 @@ def _main(argv=None) -> int:
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
-        if args.unprojector is not None or args.unprojector_cmd is not None:     # the way back: its own table
-            from .unprojector_cli import unprojector_main
-
-            return unprojector_main(args)
         args.candidate_from = next(((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd")
                                     if key in applied), None)
         check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (
             "scene", "scene_list", "candidate_frames", "report_dir", "junit_xml", "config"))
+        if args.unprojector is not None or args.unprojector_cmd is not None:     # the way back: its own report
+            from .unprojector_cli import unprojector_main
+
+            check_no_report(args)
+            return unprojector_main(args, *_run_dir(args))
         if args.junit_xml and (args.sweep or args.suite):
             raise InputError(f"--junit-xml with {'--sweep' if args.sweep else '--suite ' + args.suite}: "
                              "expected it in a plain crosscheck run (one test case per scene x camera)")

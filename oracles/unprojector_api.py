@@ -23,10 +23,14 @@ case; a callable runs in this process.
 
 from __future__ import annotations
 
+import time
+from pathlib import Path
+
 import numpy as np
 
 from wirecheck.core.errors import InputError
 from wirecheck.core.scene.frames import SceneRenderer
+from wirecheck.core.outputs.output import claim, release_claim
 from wirecheck.core.transforms import Motion
 
 from .candidates.candidate import load_candidate
@@ -37,6 +41,8 @@ from .cases import case_motion, cases_for
 from .tolerances import unproject_bound
 from .judge.unproject_points import DEFAULT_STRIDE, surface_samples
 from .reports.fault_text import below_table, case_cell, cell
+from .reports.report_option import checked_report_dir
+from .reports.unprojector_report import failing, flat_faults, write_unprojector_report
 
 __all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "flat_faults",
            "unprojector_failure_text"]
@@ -46,7 +52,8 @@ UNPROJECT_DEFAULTS = {"frames": 2, "turns": (1.0, 1.0, 0.0), "stride": DEFAULT_S
 
 
 def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=None, turns=None,
-                      stride: int | None = None, *, cmd: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S) -> dict:
+                      stride: int | None = None, *, cmd: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S,
+                      report_dir=None) -> dict:
     """Judge an unprojector against the exact inverse of the conventions and return the report.
 
     Parameters
@@ -71,6 +78,10 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
         with the check.
     timeout_s : float
         Seconds each request to ``cmd`` may take (default 10).
+    report_dir : str or Path, optional
+        Write report.json and report.md there, pass or fail, as ``crosscheck --unprojector
+        --report-dir`` does (oracles.reports.unprojector_report). A folder wirecheck did not write
+        is never replaced (ValueError, before anything runs). Default None: nothing is written.
 
     Returns
     -------
@@ -78,17 +89,36 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
         ``verdict`` ("pass" or "fail"), ``candidate``, ``cases`` (each: ``scene``, ``camera``,
         ``verdict``, ``points``, ``max_error``, ``max_error_ratio``, ``worst`` (frame, pixel),
         ``precision``, ``faults`` with ``name``, ``params``, ``hint`` (the catalogue's, oracles.faults, for an
-        unprojector's points) and ``short`` (its table cell), and ``reasons``), ``compared``.
+        unprojector's points) and ``short`` (its table cell), and ``reasons``), ``compared``,
+        ``settings`` (``scenes``, ``cases``, ``frames``, ``turns``, ``stride``) and ``timing``
+        (``wall_s``, and each case's ``ms_per_frame``: the only values that differ between runs).
 
     Raises
     ------
     ValueError
         (InputError) Inputs that would compare nothing: an unknown scene or case, ``frames``
         or ``stride`` < 1, a spec string that does not load, or a run whose scenes give no
-        visible surface point at all (a wireframe has none).
+        visible surface point at all (a wireframe has none); a ``report_dir`` that is a file or
+        holds anything wirecheck did not write.
     TypeError
-        ``func`` neither callable nor a string.
+        ``func`` neither callable nor a string, ``report_dir`` not a path.
     """
+    run_dir = checked_report_dir(report_dir)
+    if run_dir is not None:
+        claim(run_dir, "report_dir")            # checked and held before anything runs: one run per folder
+    try:
+        report = _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s)
+        if run_dir is not None:
+            write_unprojector_report(run_dir, report, "report_dir")
+    finally:
+        if run_dir is not None:
+            release_claim(run_dir)
+    return report
+
+
+def _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s) -> dict:
+    """:func:`check_unprojector` without its report folder."""
+    started = time.perf_counter()
     frames = UNPROJECT_DEFAULTS["frames"] if frames is None else frames
     turns = UNPROJECT_DEFAULTS["turns"] if turns is None else turns
     stride = UNPROJECT_DEFAULTS["stride"] if stride is None else stride
@@ -105,7 +135,7 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
         raise TypeError(f"func {func!r}: expected a callable func(pixels, depth, camera) or a \"FILE.py:FUNC\" string")
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns)
     motion = Motion(turns=inputs.turns)
-    records = []
+    records, case_ms = [], []
     with closing_started():                      # a program started for the check ends with it
         if cmd is not None:
             try:
@@ -117,14 +147,22 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
         for scene in inputs.scenes:
             by_name = {c.name: c for c in cases_for(scene, motion, calibrated=True)}
             for case_name in inputs.case_names:
+                case_started = time.perf_counter()
                 records.append(_judge_case(func, scene, by_name[case_name], motion, inputs.frames, stride))
+                case_ms.append((time.perf_counter() - case_started) * 1000.0 / inputs.frames)
     points = sum(r["points"] for r in records)
     if points == 0:
         raise InputError(f"unprojector {name}: no visible surface point in {len(records)} case(s) "
                          "(scenes without faces?): a check that compares nothing is no pass")
     verdict = "pass" if all(r["verdict"] == "pass" for r in records) else "fail"
+    settings = {"scenes": [s.name for s in inputs.scenes], "cases": list(inputs.case_names), "frames": inputs.frames,
+                "turns": [float(t) for t in inputs.turns], "stride": int(stride)}
+    timing = {"wall_s": time.perf_counter() - started,
+              "cases": [{"scene": r["scene"], "camera": r["camera"], "ms_per_frame": ms}
+                        for r, ms in zip(records, case_ms)]}
     return {"verdict": verdict, "candidate": name, "cases": records,
-            "compared": {"cases": len(records), "frames": len(records) * inputs.frames, "points": points}}
+            "compared": {"cases": len(records), "frames": len(records) * inputs.frames, "points": points},
+            "settings": settings, "timing": timing}
 
 
 def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
@@ -192,23 +230,17 @@ def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
     return record
 
 
-def flat_faults(case: dict) -> list[dict]:
-    """A case record's faults in the catalogue's record form (``{"name": ..., **params}``), as
-    oracles.reports.fault_text reads them."""
-    return [{"name": f["name"], **f["params"]} for f in case["faults"]]
-
-
 def unprojector_failure_text(report: dict) -> str | None:
     """The failing cases, their faults (a cell each, oracles.reports.fault_text) and reasons, then what to
     check once per fault kind; None when the verdict is pass."""
-    failing = [c for c in report["cases"] if c["verdict"] != "pass"]
-    if not failing:
+    bad = failing(report)
+    if not bad:
         return None
-    lines = [f"{len(failing)} of {len(report['cases'])} unprojector cases failed for {report['candidate']}:"]
-    for c in failing:
-        cells = case_cell(flat_faults(c)) if c["faults"] else "none named"
+    lines = [f"{len(bad)} of {len(report['cases'])} unprojector cases failed for {report['candidate']}:"]
+    for c in bad:
+        cells = case_cell(c["faults"]) if c["faults"] else "none named"
         lines.append(f"  {c['scene']} / {c['camera']}: faults: {cells}; " + "; ".join(c["reasons"]))
-    lines += below_table([{**c, "faults": flat_faults(c)} for c in failing], source="points")
+    lines += below_table(bad, source="points")
     comp = report["compared"]
     lines.append(f"  in all: {comp['cases']} cases, {comp['frames']} frames, {comp['points']:,} points compared")
     return "\n".join(lines)
@@ -238,5 +270,7 @@ def assert_unprojector(func, **kwargs) -> dict:
     report = check_unprojector(func, **kwargs)
     text = unprojector_failure_text(report)
     if text is not None:
+        if kwargs.get("report_dir") is not None:
+            text += f"\n  report: {Path(kwargs['report_dir']) / 'report.md'}"
         raise AssertionError(text)
     return report

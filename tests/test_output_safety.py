@@ -1,5 +1,7 @@
 """Outputs never destroy what wirecheck did not write; reruns replace earlier outputs."""
 
+from pathlib import Path
+
 import pytest
 
 from wirecheck.core.app import cli as renderer_cli
@@ -126,8 +128,15 @@ def _export(job):
     return crosscheck_cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "2"])
 
 
+def _unprojector_report(rep):
+    spec = Path(__file__).parent / "data" / "unprojectors.py"
+    return crosscheck_cli.main(["--unprojector", f"{spec}:correct", "--report-dir", str(rep), "--scene", "cube",
+                                "--cases", "on_axis", "--frames", "1"])
+
+
 #: (the command, the folder of ours it wrote, where in it the user's things go)
-KINDS = {"renderer": (_render_out, "cube-frames"), "report": (_report, "."), "export": (_export, ".")}
+KINDS = {"renderer": (_render_out, "cube-frames"), "report": (_report, "."), "export": (_export, "."),
+         "unprojector_report": (_unprojector_report, ".")}
 
 
 def _plant(folder, how):

@@ -31,7 +31,7 @@ from wirecheck.oracles.references.opencv_oracle import project as cv_project
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.reports.fault_text import CELL_MAX
 from wirecheck.oracles.unprojector_api import unprojector_failure_text
-from wirecheck.oracles.unprojector_cli import report_lines
+from wirecheck.oracles.reports.unprojector_report import console_lines
 
 sys.path.insert(0, str(Path(__file__).parent / "data"))
 import unprojectors as U  # noqa: E402
@@ -228,8 +228,10 @@ def test_depth_map_back_onto_the_mesh():
 # ---------------------------------------------------------------- the CLI
 
 def crosscheck(*args):
-    return subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", *args], cwd=ROOT, capture_output=True,
-                          text=True, timeout=300)
+    """crosscheck in a process of its own; --no-report: no reports/<UTC time>/ folder in the repository
+    (the report folder: tests/test_unprojector_report.py)."""
+    return subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", *args, "--no-report"], cwd=ROOT,
+                          capture_output=True, text=True, timeout=300)
 
 
 def test_cli_pass_fail_error():
@@ -267,7 +269,7 @@ def test_faults_are_short_cells_and_each_kind_hint_once():
                for c in (cams["on_axis"], cams["wide_fov"])]
     # orthographic: that f taken for its pixels per unit; fov_mismatch is fitted on perspective cameras only
     assert cells == [f"fov_mismatch(fov={implied[0]:.4g})", f"fov_mismatch(fov={implied[1]:.4g})", "unexplained"]
-    table = report_lines(report)
+    table = console_lines(report)
     assert [line.split()[-1] for line in table[1:4]] == cells and all(len(c) <= CELL_MAX for c in cells)
     for lines in (text.splitlines(), table):
         checks = [line for line in lines if line.startswith("  what to check, ")]

@@ -51,20 +51,21 @@ def pixel_models(cand, ref, faces, camera):
     c_on, r_on = np.isfinite(cand), np.isfinite(ref)
     if c_on.sum() < 3 or r_on.sum() < 3:
         return
-    cy, cx = (np.argwhere(c_on).mean(axis=0))
-    ry, rx = (np.argwhere(r_on).mean(axis=0))
+    c_rows_cols, r_rows_cols = np.argwhere(c_on), np.argwhere(r_on)      # once, for every fit below
+    cy, cx = c_rows_cols.mean(axis=0)
+    ry, rx = r_rows_cols.mean(axis=0)
     d = _fit(cand, ref, faces, camera, np.array([rx - cx, ry - cy]),
-             lambda p, th: p + th, lambda p, th: np.stack([np.eye(2)] * len(p)))
+             lambda p, th: p + th, lambda p, th: np.broadcast_to(np.eye(2), (len(p), 2, 2)), c_rows_cols)
     if d is not None:
         yield "pixel_offset", 2, {"dx": float(d[0]), "dy": float(d[1])}, lambda p, d=d: p + d
     if camera.projection != "perspective":
         return
     k = np.asarray(camera.K, dtype=np.float64)
     c0 = np.array([k[0, 2], k[1, 2]])
-    spread_c = np.sqrt(((np.argwhere(c_on)[:, ::-1] - c0) ** 2).sum(axis=1).mean())
-    spread_r = np.sqrt(((np.argwhere(r_on)[:, ::-1] - c0) ** 2).sum(axis=1).mean())
+    spread_c = np.sqrt(((c_rows_cols[:, ::-1] - c0) ** 2).sum(axis=1).mean())
+    spread_r = np.sqrt(((r_rows_cols[:, ::-1] - c0) ** 2).sum(axis=1).mean())
     s = _fit(cand, ref, faces, camera, np.array([spread_r / spread_c]),
-             lambda p, th: c0 + th[0] * (p - c0), lambda p, th: (p - c0)[:, :, None])
+             lambda p, th: c0 + th[0] * (p - c0), lambda p, th: (p - c0)[:, :, None], c_rows_cols)
     if s is not None:
         scale = float(s[0])
         implied = float(np.degrees(2.0 * np.arctan((camera.height / 2.0) / (k[1, 1] / scale))))
@@ -83,13 +84,15 @@ def sample(ref, faces, camera, q):
     y0 = np.floor(q[:, 1]).astype(np.int64)
     on_image = (x0 >= 0) & (y0 >= 0) & (x0 + 1 < w) & (y0 + 1 < h)
     xs, ys = np.clip(x0, 0, w - 2), np.clip(y0, 0, h - 2)
-    ids = np.stack([faces[ys, xs], faces[ys, xs + 1], faces[ys + 1, xs], faces[ys + 1, xs + 1]], axis=1)
-    inside = on_image & (ids[:, 0] >= 0) & (ids == ids[:, :1]).all(axis=1)
-    outside = ~on_image | (ids < 0).all(axis=1)
+    i00, i10, i01, i11 = faces[ys, xs], faces[ys, xs + 1], faces[ys + 1, xs], faces[ys + 1, xs + 1]
+    inside = on_image & (i00 >= 0) & (i10 == i00) & (i01 == i00) & (i11 == i00)
+    outside = ~on_image | ((i00 < 0) & (i10 < 0) & (i01 < 0) & (i11 < 0))
     persp = camera.projection == "perspective"
     with np.errstate(divide="ignore", invalid="ignore"):
-        wv = 1.0 / ref if persp else ref
-        w00, w10, w01, w11 = wv[ys, xs], wv[ys, xs + 1], wv[ys + 1, xs], wv[ys + 1, xs + 1]
+        # the four neighbours' w, taken from ``ref`` at those pixels only (not 1 / ref over the whole image)
+        w00, w10, w01, w11 = ref[ys, xs], ref[ys, xs + 1], ref[ys + 1, xs], ref[ys + 1, xs + 1]
+        if persp:
+            w00, w10, w01, w11 = 1.0 / w00, 1.0 / w10, 1.0 / w01, 1.0 / w11
         fx, fy = q[:, 0] - xs, q[:, 1] - ys
         top, bottom = w00 + fx * (w10 - w00), w01 + fx * (w11 - w01)
         val = top + fy * (bottom - top)
@@ -99,9 +102,10 @@ def sample(ref, faces, camera, q):
     return np.where(inside, depth, np.nan), inside, outside, grad
 
 
-def _fit(cand, ref, faces, camera, theta, transform, jac_p):
-    """Gauss-Newton on ``w_cand(p) = w_ref(T(p; theta))`` over the pixels landing inside one face."""
-    pts = np.argwhere(np.isfinite(cand))[:, ::-1].astype(np.float64)
+def _fit(cand, ref, faces, camera, theta, transform, jac_p, c_rows_cols):
+    """Gauss-Newton on ``w_cand(p) = w_ref(T(p; theta))`` over the pixels landing inside one face
+    (``c_rows_cols``: ``np.argwhere`` of the candidate's surface pixels)."""
+    pts = c_rows_cols[:, ::-1].astype(np.float64)
     pts = pts[::max(1, len(pts) // FIT_PIXELS)]
     persp = camera.projection == "perspective"
     wc = 1.0 / cand[pts[:, 1].astype(int), pts[:, 0].astype(int)] if persp else \

@@ -95,15 +95,16 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
     tris, _owner = oface.fan(scene.faces)
     triangles = oface.gl_triangles(tris, oface.mirrored_vertices(scene, matrices))
     covered, depth, ids = oracle.render_faces(pr_vertices, triangles, cam, model_matrix=pr_pose, with_ids=True)
-    bound = depth_bound(depth, covered, cam)
-    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, cam)) & covered
+    slope = depth_slope(depth, covered)                     # once, for the bound and the clip planes' pixels
+    bound = depth_bound(depth, covered, cam, slope)
+    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, cam, slope)) & covered
     return ReferenceDepth(depth=np.where(covered, depth, np.nan), covered=covered, undecided=undecided, bound=bound,
                           faces=np.where(covered, ids, -1))
 
 
-def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
-    """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope of near or far."""
-    slope = depth_slope(depth, covered)
+def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:
+    """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope (``slope``,
+    oracles.judge.metrics.depth_slope) of near or far."""
     at_plane = covered & ((np.abs(depth - camera.near) <= slope) | (np.abs(depth - camera.far) <= slope))
     out = at_plane.copy()
     h, w = at_plane.shape

@@ -174,7 +174,11 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
         if not m.any():
             continue
         a, b = triangles[ids[m]], triangles[other[m]]
-        apart = ~(a[:, :, None] == b[:, None, :]).any(axis=(1, 2))
+        shared = np.zeros(len(a), bool)
+        for i in range(3):                               # nine 1-D comparisons: no (n, 3, 3) temporary
+            for j in range(3):
+                shared |= a[:, i] == b[:, j]
+        apart = ~shared
         hit = np.zeros(ids.shape, bool)
         hit[m] = apart                                   # this pixel, whose neighbour (dy, dx) is apart
         out |= hit | _shifted(hit, -dy, -dx, False)      # and that neighbour
@@ -263,12 +267,13 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
     return np.nan_to_num(slope, nan=0.0)
 
 
-def depth_bound(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
-    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances)."""
+def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray | None = None) -> np.ndarray:
+    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances);
+    ``slope``: :func:`depth_slope` of ``depth`` and ``covered`` when the caller has it already."""
     depth = np.asarray(depth, np.float64)
     eps32 = float(np.finfo(np.float32).eps)
     return (tolerances.DEPTH_STEPS * depth_step(depth, camera)
-            + tolerances.DEPTH_SNAP_PX * depth_slope(depth, covered)
+            + tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
             + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth))
 
 

@@ -23,19 +23,32 @@ is written again here from them, in float64 world space.
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 
 from .convert import camera_basis, model_matrix
 
 
 def fan(faces) -> tuple[np.ndarray, np.ndarray]:
-    """``(triangles (T, 3) int64, owner (T,) int64)``: each polygon fanned from its first vertex."""
-    tris, owner = [], []
-    for i, f in enumerate(faces):
-        for k in range(1, len(f) - 1):
-            tris.append((f[0], f[k], f[k + 1]))
-            owner.append(i)
-    return np.asarray(tris, dtype=np.int64).reshape(-1, 3), np.asarray(owner, dtype=np.int64)
+    """``(triangles (T, 3) int64, owner (T,) int64)``: each polygon fanned from its first vertex.
+
+    Polygon ``i`` of ``n`` corners gives ``(f[0], f[k], f[k + 1])`` for ``k = 1 .. n - 2``, in that
+    order, polygon after polygon; one of fewer than 3 corners gives none. ``faces``: a sequence of index
+    sequences, or an ``(F, n)`` array.
+    """
+    if isinstance(faces, np.ndarray) and faces.ndim == 2:
+        lengths = np.full(len(faces), faces.shape[1], dtype=np.int64)
+        flat = faces.astype(np.int64).ravel()
+    else:
+        lengths = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+        flat = np.fromiter(chain.from_iterable(faces), dtype=np.int64, count=int(lengths.sum()))
+    per = np.maximum(lengths - 2, 0)                          # triangles of each polygon
+    owner = np.repeat(np.arange(len(lengths), dtype=np.int64), per)
+    k = np.arange(len(owner), dtype=np.int64) - np.repeat(np.cumsum(per) - per, per) + 1    # 1 .. n - 2
+    first = (np.cumsum(lengths) - lengths)[owner]             # where each polygon starts in ``flat``
+    tris = np.stack([flat[first], flat[first + k], flat[first + k + 1]], axis=1)
+    return tris.reshape(-1, 3), owner
 
 
 def object_matrices(scene, run_turns, t: float, pivot=(0.0, 0.0, 0.0)) -> list[np.ndarray]:

@@ -209,7 +209,8 @@ class PyrenderOracle:
         self._mesh_faces = None
         self._mesh_centre = np.zeros(3)                       # of the uploaded vertices (float64)
         self._mesh_q, self._mesh_segments = np.zeros((0, 3)), np.zeros((0, 2), np.int64)   # what GL draws
-        self.last_bound_px = 0.0      # oracle_precision.drawn_bound_px of the last frame drawn
+        self._bound_of = None         # drawn_bound_px's arguments for the last frame drawn (last_bound_px)
+        self._last_bound_px = 0.0
         self._cam_node = None
         self._cam_key = None
         # render_faces: a scene of its own, so that alternating with render() rebuilds nothing
@@ -292,6 +293,17 @@ class PyrenderOracle:
                                       mode=pr.constants.GLTF.TRIANGLES, material=black))
         if prims:
             self._mesh_node = self._scene.add(pr.Mesh(prims))
+
+    @property
+    def last_bound_px(self) -> float:
+        """oracle_precision.drawn_bound_px of the last frame drawn (0 when nothing was drawn): worked out when
+        first asked for (a depth reference never asks: 0.19 s a frame on a 20k-face mesh), from the
+        camera, pose and geometry of that frame, which a later frame does not change (each is replaced,
+        never edited in place)."""
+        if self._bound_of is not None:
+            self._last_bound_px = drawn_bound_px(*self._bound_of)
+            self._bound_of = None
+        return self._last_bound_px
 
     def _set_camera(self, camera: Camera, faces_scene: bool = False) -> None:
         if (camera.width, camera.height) != (self.width, self.height):
@@ -377,11 +389,11 @@ class PyrenderOracle:
         edges = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
         self._set_mesh(vertices, edges, faces, bool(cull))
         self._set_camera(camera)
-        self.last_bound_px = 0.0
+        self._bound_of, self._last_bound_px = None, 0.0
         if self._mesh_node is not None:
             pose = gl_eye_pose(camera, model_matrix, self._mesh_centre)
             self._scene.set_pose(self._mesh_node, pose)
-            self.last_bound_px = drawn_bound_px(camera, pose, self._mesh_q, self._mesh_segments)
+            self._bound_of = (camera, pose, self._mesh_q, self._mesh_segments)
         if faces is not None and len(faces):
             self._polygon_offset()
         if not depth:
@@ -453,11 +465,11 @@ class PyrenderOracle:
             raise ValueError(f"{len(triangles)} triangles: the id image holds at most 2^24 - 2")
         self._set_faces(vertices, triangles, bool(cull))
         self._set_camera(camera, faces_scene=True)
-        self.last_bound_px = 0.0
+        self._bound_of, self._last_bound_px = None, 0.0
         if self._fmesh_node is not None:
             pose = gl_eye_pose(camera, model_matrix, self._fmesh_centre)
             self._fscene.set_pose(self._fmesh_node, pose)
-            self.last_bound_px = drawn_bound_px(camera, pose, self._fmesh_q, self._fmesh_segments)
+            self._bound_of = (camera, pose, self._fmesh_q, self._fmesh_segments)
         self._no_polygon_offset()
         colour, _pyrender_depth = self._renderer.render(self._fscene, pr.RenderFlags.FLAT)
         z_win = self._read_window_depth()

@@ -31,3 +31,9 @@ def distinct(value: float, reference: float | None = None, digits: int = 4) -> s
         if text != f"{float(reference):.{n}g}":
             return text
     return repr(value)
+
+
+def short_repr(value) -> str:
+    """``repr(value)`` on one line, at most 80 characters (an argument named in an error message)."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 80 else text[:77] + "..."

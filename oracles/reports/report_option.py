@@ -12,9 +12,12 @@ status, no folder;
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
+
+from .fmt import short_repr
 
 
 def check_no_report(args) -> None:
@@ -40,3 +43,17 @@ def report_line(args, run_dir: Path, main: str, also: str) -> str:
     if args.report_dir is None and args.run is None:
         return where + "; --no-report writes none)"
     return where + ")"
+
+
+def checked_report_dir(report_dir):
+    """``report_dir`` as a Path (None: none), checked before anything runs: TypeError for a non-path,
+    ValueError (InputError) for a path that is a file (the API's ``report_dir=``: check_projector's,
+    check_frames', check_unprojector's)."""
+    if report_dir is None:
+        return None
+    if isinstance(report_dir, bool) or not isinstance(report_dir, (str, os.PathLike)):
+        raise TypeError(f"report_dir {short_repr(report_dir)}: expected a folder path (str or Path), or None")
+    path = Path(report_dir)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"report_dir {str(path)!r} is a file: expected a folder for the report")
+    return path
