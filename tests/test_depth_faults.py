@@ -244,3 +244,19 @@ def test_unexplained_says_what_was_measured():
     assert d.names == ("unexplained",)
     assert d.measured["max_error_ratio"] > 1 and d.measured["compared_px"] == int(covered.sum())
     assert set(d.measured["fit_ratios"]) >= {"depth_scale", "depth_offset", "depth_is_range", "depth_reversed"}
+
+
+def test_a_flipped_map_is_not_reversed_z_by_chance():
+    # pyramid / on_axis at the spin's start (frame 1 of 3: no rotation), rows flipped. Its planar faces'
+    # 1/depth flipped fits 1/c + 1/r = 0.43 to 0.07 allowances, a reversed-Z map with a sum of inverses
+    # unrelated to the camera's (1/near + 1/far = 5.83): named depth_reversed while that sum was fitted.
+    # Reversed-Z swaps the camera's own near and far, so the model holds the sum to the camera's
+    case = next(c for c in cases_for(load_scene("pyramid")) if c.name == "on_axis")
+    depth, faces = core_depth("pyramid", case.camera, k=1, frames=3)
+    bound = depth_bound(depth, depth > 0, case.camera)
+    flipped = np.where(depth > 0, depth, np.nan)[::-1].astype(np.float32)
+    d = judge(flipped, depth, bound, case.camera, faces)
+    assert d.verdict == "fail"
+    named = [f.name for f in d.faults]
+    assert "depth_reversed" not in named and "depth_reversed" not in str(d.faults[0].params.get("alternatives"))
+    assert "mirror_vertical" in named or "mirror_vertical" in d.faults[0].params.get("alternatives", ""), d.faults

@@ -9,7 +9,7 @@ the pixel's ray per unit of depth (``x_n = (x - cx) / fx``, ``y_n = (y - cy) / f
     depth_scale       c = k r                                    k = median(c / r)
     depth_offset      c = r + b                                  b = median(c - r)
     depth_is_range    c = rho r   (or c = r / rho: the reverse)  -
-    depth_reversed    1/c = K - 1/r   (orthographic: c = S - r)  K (S); the camera's 1/near + 1/far (near + far)
+    depth_reversed    1/c = K - 1/r   (orthographic: c = S - r)  K = the camera's 1/near + 1/far (S = near + far); the median fitted K (S)
     depth_encoding    c = a + b / r   (orthographic: a + b r),   near and far that fit, window [0, 1]
                       c within [-1, 1]                           or NDC [-1, 1], reversed or not
     depth_precision   c = r to one float16 ulp (every c a        the step
@@ -231,15 +231,21 @@ def _models(c, r, rho, b, enc, camera, limits):
     yield 1, ("depth_scale", {"k": k}, k * r, np.full_like(r, k), zero)
     off = float(np.median(c - r))
     yield 1, ("depth_offset", {"b": off, "b_over_near": off / near}, r + off, np.ones_like(r), zero)
+    # depth_reversed: reversed-Z read back by the standard formula swaps the camera's own near and far, so
+    # the model is the camera's (nothing fitted): 1/c = (1/near + 1/far) - 1/r (orthographic c = near + far
+    # - r). The median sum is reported beside it. A free sum would fit other maps by chance: a pyramid seen
+    # head-on with its rows flipped fits 1/c + 1/r = 0.43 (the camera's 5.83) to 0.07 allowances
     if perspective:
+        k_cam = 1.0 / near + 1.0 / far
         with np.errstate(divide="ignore", invalid="ignore"):
             kk = float(np.median(1.0 / c + 1.0 / r))
-            c_hat = 1.0 / (kk - 1.0 / r)
-        yield 1, ("depth_reversed", {"sum_of_inverses": kk, "camera_1/near+1/far": 1.0 / near + 1.0 / far},
+            c_hat = 1.0 / (k_cam - 1.0 / r)
+        yield 0, ("depth_reversed", {"sum_of_inverses": kk, "camera_1/near+1/far": k_cam},
                   c_hat, c_hat ** 2 / r ** 2, zero)
     else:
         s = float(np.median(c + r))
-        yield 1, ("depth_reversed", {"sum": s, "camera_near+far": near + far}, s - r, np.ones_like(r), zero)
+        yield 0, ("depth_reversed", {"sum": s, "camera_near+far": near + far}, near + far - r, np.ones_like(r),
+                  zero)
     yield 2, _encoding(c, r, camera, limits)
 
 
