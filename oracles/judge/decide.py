@@ -92,7 +92,48 @@ def reasons(rec: dict, tol: Tolerances, error: str | None = None) -> list[str]:
         out += rec.get("line_style", {}).get("failures", [])
     if rec.get("silhouette_iou") is not None:
         out += _shaded_reasons(rec, tol)
+    if "depth_map" in rec:
+        out += depth_map_reasons(rec["depth_map"], tol)
+    if "filled" in rec:
+        out += filled_reasons(rec["filled"], tol)
     return out
+
+
+def _surface_reasons(f: dict, tol: Tolerances, what: str) -> list[str]:
+    """Blank frames, holes and extra surface of a case's depth maps or filled frames (``what``)."""
+    out = []
+    if f["blank_frames"]:
+        shown = ", ".join(map(str, f["blank_frames"][:5])) + (", ..." if len(f["blank_frames"]) > 5 else "")
+        out.append(f"{what} blank where the reference shows a surface (frame{'s' if len(f['blank_frames']) > 1 else ''}"
+                   f" {shown}): nothing compared there")
+    if f["holes_px"] > tol.max_surface_holes_px:
+        out.append(f"{what}: {f['holes_px']} pixels of the reference's surface left empty away from its "
+                   f"silhouette's boundary (> {tol.max_surface_holes_px}; most in frame {f['holes_worst_frame']})")
+    if f["extra_px"] > tol.max_surface_extra_px:
+        out.append(f"{what}: {f['extra_px']} pixels of surface where the reference has none, away from its "
+                   f"silhouette's boundary (> {tol.max_surface_extra_px}; most in frame {f['extra_worst_frame']})")
+    return out
+
+
+def depth_map_reasons(d: dict, tol: Tolerances) -> list[str]:
+    """The limits a case's depth maps miss (``record["depth_map"]``, oracles.judge.depth_frames)."""
+    out = []
+    if d["max_error_ratio"] is not None and d["max_error_ratio"] > tol.max_depth_error_ratio:
+        r, c = d["worst_pixel"]
+        out.append(f"depth error {d['max_error']:.3g} is {d['max_error_ratio']:.3g} x its bound "
+                   f"(> {tol.max_depth_error_ratio:g}; frame {d['worst_frame']}, row {r}, column {c})")
+    if d["reference_px"] and not d["compared_px"]:
+        out.append(f"depth maps compare nothing: no pixel shows a surface on both sides "
+                   f"({d['reference_px']} reference pixels): never a pass")
+    return out + _surface_reasons(d, tol, "depth map")
+
+
+def filled_reasons(f: dict, tol: Tolerances) -> list[str]:
+    """The limits a case's filled frames miss (``record["filled"]``, oracles.judge.filled_frames)."""
+    out = []
+    if f["min_iou"] is not None and f["min_iou"] < tol.min_iou:
+        out.append(f"filled silhouette IoU {f['min_iou']:.4f} < {tol.min_iou} (frame {f['iou_worst_frame']})")
+    return out + _surface_reasons(f, tol, "filled frame")
 
 
 def pixel_rule_reasons(rec: dict, tol: Tolerances) -> list[str]:
