@@ -18,10 +18,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from helpers import run_crosscheck          # tests/ is on sys.path (rootdir conftest)
-from wirecheck.core.projector.pipeline import render_frame
+from clients.core_depth_job import MISTAKES, render_job    # tests/ is on sys.path (rootdir conftest)
+from helpers import run_crosscheck
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.candidates.frames_candidate import frame_faces, frame_inputs, load_job
+from wirecheck.oracles.candidates.frames_candidate import load_job
 from wirecheck.oracles.judge.surfaces import surface_mismatch
 
 # frames 1, 4, 7 of 7, moved on by 0.3 of a step (no quarter-turn pose: a flipped cube is not the cube),
@@ -34,42 +34,10 @@ def export(path: Path, *extra) -> Path:
     return path
 
 
-def core_depth(job_dir: Path, job: dict, c: dict, k: int):
-    """Core's depth buffer of frame ``k`` from the job's files: ``(depth, 0 where no face; camera)``."""
-    p, e, cam, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
-    z = render_frame(p, e, cam, m, faces=frame_faces(job_dir, job, c["scene"], k), style="shaded").depth_image
-    return np.where(np.isfinite(z), z, 0.0), cam
-
-
-def window_depth(z: np.ndarray, cam) -> np.ndarray:
-    """The GL depth buffer's value glDepthRange [0, 1] would store for linear depth ``z`` (0: none)."""
-    n, f = cam.near, cam.far
-    with np.errstate(divide="ignore", invalid="ignore"):
-        w = f * (z - n) / ((f - n) * z) if cam.projection == "perspective" else (z - n) / (f - n)
-    return np.where(z > 0, w, 0.0)
-
-
-def fill(job_dir: Path, mistake=lambda z, cam: z, fmt: str = "npy", filled=lambda covered: covered) -> Path:
-    """Write every listed depth map (``mistake`` applied to core's linear depth) and filled frame."""
-    job = load_job(job_dir)
-    for c in job["cases"]:
-        for i, k in enumerate(job["frame_numbers"]):
-            z, cam = core_depth(job_dir, job, c, k)
-            for rel in c["frames"][i:i + 1]:
-                (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
-                p, e, cam_, m = frame_inputs(job_dir, job, c["scene"], c["case"], k)
-                Image.fromarray(render_frame(p, e, cam_, m).image).save(job_dir / rel)
-            for rel in c.get("filled", [])[i:i + 1]:
-                (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
-                Image.fromarray(np.where(filled(z > 0), 200, 0).astype(np.uint8)).save(job_dir / rel)
-            for rel in c.get("depth", [])[i:i + 1]:
-                path = job_dir / rel
-                path.parent.mkdir(parents=True, exist_ok=True)
-                d = mistake(z, cam)
-                if fmt == "npy":
-                    np.save(path, d.astype(np.float32))
-                else:                                       # png16 at scale 1000, rounded as BOP writes it
-                    Image.fromarray(np.rint(d * 1000.0).astype(np.uint16)).save(path)
+def fill(job_dir: Path, mistake=MISTAKES["none"], filled=lambda covered: covered) -> Path:
+    """Every file the job lists, drawn by core (tests/clients/core_depth_job.py: the job's files read without
+    wirecheck's reader), its depth maps made by ``mistake(z, camera)`` from core's linear depth."""
+    render_job(job_dir, mistake, filled)
     return job_dir
 
 
@@ -96,8 +64,7 @@ def test_core_depth_as_float32_npy_passes(depth_job, tmp_path, capsys):
 
 
 def test_core_depth_as_png16_at_scale_1000_passes(tmp_path, capsys):
-    job = fill(export(tmp_path / "job", "--outputs", "depth", "--depth-format", "png16", "--depth-scale", "1000"),
-               fmt="png16")
+    job = fill(export(tmp_path / "job", "--outputs", "depth", "--depth-format", "png16", "--depth-scale", "1000"))
     code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
     assert code == 0, capsys.readouterr().out
     assert {c["depth_map"]["encoding"] for c in report["cases"]} == {"png uint16 / 1000"}
@@ -107,17 +74,13 @@ def test_core_depth_as_png16_at_scale_1000_passes(tmp_path, capsys):
     assert 0.4e-3 < worst <= 0.5e-3 + 1e-4
 
 
-def _flip_rows(z, cam):
-    return z[::-1]
-
-
 @pytest.mark.parametrize("mistake, expected", [
-    (window_depth, "depth_encoding"),                   # the z-buffer's [0, 1] value stored as depth
-    (lambda z, cam: z * 1000.0, "depth_scale"),         # millimetres written where metres were asked for
-    (_flip_rows, "mirror_vertical"),                    # GL's bottom row written first
-], ids=["zbuffer", "x1000", "rows_flipped"])
+    ("zbuffer", "depth_encoding"),              # the z-buffer's [0, 1] value stored as depth
+    ("x1000", "depth_scale"),                   # millimetres written where world units were asked for
+    ("rows_flipped", "mirror_vertical"),        # GL's bottom row written first
+])
 def test_a_mistaken_depth_map_fails_with_its_name(depth_job, tmp_path, capsys, mistake, expected):
-    job = fill(copy(depth_job, tmp_path), mistake)
+    job = fill(copy(depth_job, tmp_path), MISTAKES[mistake])
     code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
     out = capsys.readouterr().out
     assert code == 1, out
@@ -160,6 +123,14 @@ def test_a_hole_inside_the_surface_fails(depth_job, tmp_path):
     for case in report["cases"]:
         assert case["depth_map"]["holes_px"] == 9 * 3 and case["depth_map"]["extra_px"] == 0
         assert any("left empty" in r for r in case["reasons"])
+
+
+def test_core_depth_as_float_tiff_passes(tmp_path, capsys):
+    job = fill(export(tmp_path / "job", "--outputs", "depth", "--depth-format", "tiff"))
+    assert load_job(job)["cases"][0]["depth"][0].endswith("/depth_0001.tif")
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
+    assert code == 0, capsys.readouterr().out
+    assert {c["depth_map"]["encoding"] for c in report["cases"]} == {"tiff float32"}
 
 
 def _one_line(capsys, *needles):
@@ -284,3 +255,15 @@ def test_surface_mismatch_counts_away_from_the_boundary():
     assert not holes.any() and extra.sum() == 81 - 36 and not extra[1:7, 1:7].any()
     full = np.ones((3, 3), bool)              # the image's edge is no boundary: a covered picture's every pixel
     assert surface_mismatch(np.zeros_like(full), full)[0].all()
+
+
+def test_assert_frames_names_the_depth_fault(depth_job, tmp_path):
+    """The Python API judges a depth job by the same judge: a correct one passes, one x1000 is named."""
+    from wirecheck import assert_frames, check_frames
+
+    job = fill(copy(depth_job, tmp_path))
+    report = check_frames(job)
+    assert report["verdict"] == "pass" and all("depth_map" in c for c in report["cases"])
+    fill(job, MISTAKES["x1000"])
+    with pytest.raises(AssertionError, match=r"depth_scale\(k=1000"):
+        assert_frames(job)
