@@ -369,6 +369,37 @@ MIN_SILHOUETTE_IOU = 0.995
 #: boundary pixels are 20 % of its area.
 MIN_IOU_UNION_PX = 400
 
+# ---- Filled frames under GL's fill rule (oracles.references.fill_rule, oracles.judge.silhouette)
+#
+# The reference covers a pixel when its centre is inside a triangle, computed exactly in
+# float64; a renderer first moves each vertex, per coordinate, by its snap to the sub-pixel
+# grid and its float32 rounding: at most TIE_END_PX (above: 2^-9 + 2^-9 px while the frame's
+# scale is at most 4,096 px; GL's minimum of 4 sub-pixel bits would be 2^-5, see below). A
+# vertex moved by at most TIE_END_PX per coordinate moves by at most sqrt(2) TIE_END_PX, and
+# every point of an edge, a weighted mean of its ends, by at most as much: a centre farther
+# than that from every edge the renderer could move is decided as the reference decides it.
+# Centres within it of an open edge (the silhouette's contour, a mesh border, a near-plane
+# cut; not an edge that triangles on both its sides share, whose shared ends move together)
+# are ties, where either answer is correct.
+#
+# So a correct rasteriser (float32 vertices, >= 8 sub-pixel bits, GL's fill rule) differs
+# from the reference only at ties, and any decided disagreement is an error: the longest run
+# of decided disagreements allowed (the largest 8-connected set of pixels missing or added,
+# oracles.judge.silhouette) is 0. The run is what is reported: a one-pixel band missing along
+# an edge of L px is a run of about L, which IoU hides on a large silhouette (IoU = 1 - L/A:
+# 0.9967 for one edge of a 300 x 300 square, above MIN_SILHOUETTE_IOU). A renderer with
+# coarser snapping (GL allows 4 sub-pixel bits: a vertex may move by 1/32 px) flips centres
+# up to ~0.05 px from an edge, isolated pixels and runs along near-axis-aligned edges: loosen
+# max_silhouette_run_px for it. Scales above 4,096 px make the float32 term larger than 2^-9:
+# a centre may then count as decided where such a renderer is undecided (a false alarm, never
+# a hidden fault), as for lines.
+
+#: How far a renderer may move a vertex before deciding coverage (px, Euclidean; derivation above).
+FILL_TIE_PX = 2.0 ** 0.5 * TIE_END_PX
+#: The largest 8-connected set of decided pixels missing or added that passes (derivation above).
+MAX_SILHOUETTE_RUN_PX = 0
+
+
 #: The shaded depth comparison: |z_candidate - z_pyrender| at a pixel covered
 #: by both and not on either silhouette (eroded by 1 px) nor beside an occlusion
 #: boundary (oracles.judge.metrics.occlusion_boundary) must be at most
@@ -421,12 +452,13 @@ DEPTH_BOUND_TEXT = (f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 /
 #: case (core's depth against pyrender's measured 0.59 of it at most, docs/depth.md), so 1: the depth
 #: diagnosis' own pass rule (oracles.diagnosis.depth_faults).
 MAX_DEPTH_ERROR_RATIO = 1.0
-#: Reference surface a depth map or filled frame leaves empty (holes), and surface it shows where the
-#: reference has none (extra), counted away from the reference silhouette's boundary: a pixel whose eight
-#: neighbours are all covered (all uncovered) by the reference has its centre more than half a pixel from
-#: any silhouette edge, far beyond the 1/256 px snapping that decides a boundary pixel (MIN_SILHOUETTE_IOU's
-#: derivation), so a correct renderer leaves none: 0. Core's depth buffer and filled faces, drawn from a
-#: job's own files, measured 0 and 0 (tests/test_depth_jobs.py).
+#: Reference surface a depth map leaves empty (holes), and surface it shows where the reference has none
+#: (extra), counted away from the reference silhouette's boundary: a pixel whose eight neighbours are all
+#: covered (all uncovered) by the reference has its centre more than half a pixel from any silhouette
+#: edge, far beyond the 1/256 px snapping that decides a boundary pixel (MIN_SILHOUETTE_IOU's derivation),
+#: so a correct renderer leaves none: 0. Core's depth buffer, drawn from a job's own files, measured 0 and
+#: 0 (tests/test_depth_jobs.py). (Filled frames are held to the fill rule's decided pixels instead:
+#: MAX_SILHOUETTE_RUN_PX below.)
 MAX_SURFACE_HOLES_PX = 0
 MAX_SURFACE_EXTRA_PX = 0
 
@@ -497,6 +529,8 @@ class Tolerances:
     max_depth_error_ratio: float = MAX_DEPTH_ERROR_RATIO
     max_surface_holes_px: int = MAX_SURFACE_HOLES_PX
     max_surface_extra_px: int = MAX_SURFACE_EXTRA_PX
+    fill_tie_px: float = FILL_TIE_PX
+    max_silhouette_run_px: int = MAX_SILHOUETTE_RUN_PX
 
     def __post_init__(self):
         if self.precision is not None and self.precision not in PRECISIONS:
@@ -519,7 +553,8 @@ class Tolerances:
         return {"max_depth_error_ratio": self.max_depth_error_ratio, "depth_error": DEPTH_BOUND_TEXT
                 + " + the map's encoding step", "max_surface_holes_px": self.max_surface_holes_px,
                 "max_surface_extra_px": self.max_surface_extra_px, "min_silhouette_iou": self.min_iou,
-                "min_iou_union_px": MIN_IOU_UNION_PX}
+                "min_iou_union_px": MIN_IOU_UNION_PX, "fill_tie_px": self.fill_tie_px,
+                "max_silhouette_run_px": self.max_silhouette_run_px}
 
     def lines_dict(self) -> dict:
         """The frames path's line-geometry limits, as the report's ``tolerances`` adds them."""

@@ -1,0 +1,399 @@
+r"""Filled silhouettes under GL's fill rule, with the pixel centres that no renderer decides (ties).
+
+Pixel convention (core.conventions): x right, y down, integer coordinates are pixel centres.
+Written here from the rule, in float64, sharing no code with core's rasterizer.
+
+The fill rule
+=============
+A pixel is covered when its centre is inside a triangle. With the triangle oriented so that
+the edge functions ``E(p) = (Q - P) x (p - P) = (Qx - Px)(py - Py) - (Qy - Py)(px - Px)`` of
+its edges ``P -> Q`` are positive inside, a centre is inside when every ``E > 0``, or
+``E == 0`` on a **top** edge (horizontal, ``Qx > Px``: the interior below it) or a **left**
+edge (``Qy < Py``: the interior to its right). Zero-area triangles cover nothing::
+
+    (0,0) top   (4,0)        the right triangle (0,0), (4,0), (0,4): centres on the top
+      * * * * o              edge (y = 0) and the left edge (x = 0) are in, those on the
+      * * * o                hypotenuse x + y = 4 are out; every centre on an edge is a tie
+      * * o
+      * o                    * covered   o on the hypotenuse, not covered
+      o
+
+Ties
+====
+A renderer rounds each vertex before it decides (GL snaps to 1/256 px after float32
+arithmetic): each vertex may move by ``tie_px`` (Euclidean), so every point of an edge moves
+by at most ``tie_px``, and a centre farther than that from every edge is decided as here. A
+centre within ``tie_px`` of an **open** edge is a tie (either answer is correct) unless some
+triangle holds it farther than ``tie_px`` from all of that triangle's edges. An edge is
+*closed* when triangles on both of its sides share it (the same two end points, in the
+image, to the bit): those triangles' shared ends move together, so no centre near it can fall
+into a crack and the union of the two covers it whatever the rounding; every other edge
+(the silhouette's contour, an open mesh's border, a near-plane cut, a T-junction) is open.
+
+``tie_px`` is :data:`GL_TIE_PX` unless given: ``sqrt(2) x oracles.tolerances.TIE_END_PX``
+(the per-coordinate move of a GL vertex, derived there) as a distance.
+
+Object ids (:func:`silhouette`): at each covered centre, the object of the nearest triangle
+(depth along ``forward``: ``1/z`` is linear in the image under perspective, ``z`` under
+orthographic). Where the two nearest objects' depths are within their depth bounds
+(:func:`depth_bound`), the pixel's id is :data:`ID_TIE` (either object is correct).
+
+Work is vectorised over batches of triangles whose bounding boxes (clipped to the image, grown
+by ``tie_px``) fit the same power-of-two box, so it scales with the area the triangles cover.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .convert import camera_basis, intrinsics
+from .faces import fan
+from .pyrender_oracle import depth_step
+
+__all__ = ["GL_TIE_PX", "ID_TIE", "NO_OBJECT", "coverage", "silhouette", "project_clipped", "open_edges",
+           "depth_bound"]
+
+#: How far a GL renderer may move a vertex before deciding coverage (px, Euclidean):
+#: sqrt(2) x oracles.tolerances.TIE_END_PX = sqrt(2) x (2^-9 snap + 2^-9 float32), derived there.
+GL_TIE_PX = math.sqrt(2.0) * 2.0 ** -8
+
+#: ``object_ids`` where no triangle covers the pixel centre.
+NO_OBJECT = -1
+#: ``object_ids`` where the two nearest objects are within their depth bounds (either is correct).
+ID_TIE = -2
+
+# Depth bound of a GL depth test (oracles.tolerances, "The shaded depth comparison", derives
+# these three; a test checks that they are the same numbers): steps of the 24-bit buffer,
+# the 1/256-px snap times the depth slope, float32 roundings of z.
+_DEPTH_STEPS = 4.0
+_DEPTH_SNAP_PX = 1.0 / 256.0
+_DEPTH_EPS32 = 16.0
+_EPS32 = 2.0 ** -23
+
+#: Bounding-box samples per batch (~12 float64 temporaries of this length: ~50 MB).
+_CHUNK = 1 << 19
+
+
+def depth_bound(z: np.ndarray, slope: np.ndarray, camera) -> np.ndarray:
+    """How far a GL depth test may be off at camera depth ``z`` with depth slope ``slope`` (per px).
+
+    ``4 step(z) + slope / 256 + 16 eps32 z`` (oracles.tolerances, DEPTH_STEPS, DEPTH_SNAP_PX,
+    DEPTH_EPS32); ``step`` is one level of a 24-bit buffer (pyrender_oracle.depth_step).
+    """
+    z = np.asarray(z, dtype=np.float64)
+    return _DEPTH_STEPS * depth_step(z, camera) + _DEPTH_SNAP_PX * slope + _DEPTH_EPS32 * _EPS32 * z
+
+
+def _edge_keys(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each triangle edge ``k`` (``v_k -> v_k+1``) as ``(key (3T, 4), flip (3T,) bool, third (3T, 2))``.
+
+    The key is the edge's two ends in (x, y) order, so that both triangles of a shared edge get
+    the same key; ``third`` is the opposite vertex.
+    """
+    p = tris_px + 0.0                                    # -0.0 -> 0.0: equal keys compare equal
+    a = p.reshape(-1, 2)                                 # v0, v1, v2 of each triangle
+    b = np.roll(p, -1, axis=1).reshape(-1, 2)            # v1, v2, v0
+    third = np.roll(p, -2, axis=1).reshape(-1, 2)        # v2, v0, v1
+    flip = (b[:, 0] < a[:, 0]) | ((b[:, 0] == a[:, 0]) & (b[:, 1] < a[:, 1]))
+    lo = np.where(flip[:, None], b, a)
+    hi = np.where(flip[:, None], a, b)
+    return np.concatenate([lo, hi], axis=1), flip, third
+
+
+def open_edges(tris_px) -> np.ndarray:
+    """``(T, 3) bool``: edge ``k`` (``v_k -> v_k+1``) of each triangle is open (module docstring).
+
+    Closed: some triangle with the same two end points has its third vertex strictly on one side
+    of the edge's line and some other strictly on the other.
+    """
+    tris_px = np.asarray(tris_px, dtype=np.float64).reshape(-1, 3, 2)
+    if len(tris_px) == 0:
+        return np.zeros((0, 3), dtype=bool)
+    key, _flip, third = _edge_keys(tris_px)
+    d = key[:, 2:] - key[:, :2]
+    side = np.sign(d[:, 0] * (third[:, 1] - key[:, 1]) - d[:, 1] * (third[:, 0] - key[:, 0]))
+    order = np.lexsort((key[:, 3], key[:, 2], key[:, 1], key[:, 0]))
+    ks = key[order]
+    new = np.ones(len(ks), dtype=bool)
+    new[1:] = (ks[1:] != ks[:-1]).any(axis=1)
+    group = np.cumsum(new) - 1
+    pos = np.bincount(group, weights=(side[order] > 0), minlength=group[-1] + 1) > 0
+    neg = np.bincount(group, weights=(side[order] < 0), minlength=group[-1] + 1) > 0
+    closed = np.empty(len(key), dtype=bool)
+    closed[order] = (pos & neg)[group]
+    return ~closed.reshape(-1, 3)
+
+
+def _orient(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Triangles turned so that their edge functions are positive inside, their doubled areas, which turned."""
+    a, b, c = tris_px[:, 0], tris_px[:, 1], tris_px[:, 2]
+    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    out = tris_px.copy()
+    neg = area2 < 0
+    out[neg, 1], out[neg, 2] = tris_px[neg, 2], tris_px[neg, 1]
+    return out, np.abs(area2), neg
+
+
+class _Buffers:
+    """The per-pixel results of one pass, flat over ``H x W``."""
+
+    def __init__(self, shape, depth: bool):
+        n = shape[0] * shape[1]
+        self.inside = np.zeros(n, dtype=bool)
+        self.near_open = np.zeros(n, dtype=bool)
+        self.robust = np.zeros(n, dtype=bool)
+        self.z = np.full(n, np.inf) if depth else None
+        self.slope = np.zeros(n) if depth else None
+
+
+def _raster(tris_px: np.ndarray, is_open: np.ndarray, shape, tie_px: float,
+            tri_z: np.ndarray | None = None, perspective: bool = True) -> _Buffers:
+    """One pass over the triangles: coverage, centres near open edges, centres held robustly (and depth)."""
+    height, width = int(shape[0]), int(shape[1])
+    out = _Buffers((height, width), tri_z is not None)
+    if len(tris_px) == 0 or height == 0 or width == 0:
+        return out
+    # is_open follows the caller's vertex order; orient, and carry the open flags along with
+    # the edges (swapping v1 and v2 reverses the triangle: edges 0, 1, 2 become 2, 1, 0)
+    tris, area2, swapped = _orient(tris_px)
+    is_open = np.where(swapped[:, None], is_open[:, ::-1], is_open)
+    if tri_z is not None:
+        tri_z = np.where(swapped[:, None], tri_z[:, [0, 2, 1]], tri_z)
+    lo = np.floor(tris.min(axis=1) - tie_px)
+    hi = np.ceil(tris.max(axis=1) + tie_px)
+    x0 = np.clip(lo[:, 0], 0, width - 1)
+    y0 = np.clip(lo[:, 1], 0, height - 1)
+    x1 = np.clip(hi[:, 0], 0, width - 1)
+    y1 = np.clip(hi[:, 1], 0, height - 1)
+    finite = np.isfinite(tris).all(axis=(1, 2))
+    seen = finite & (hi[:, 0] >= 0) & (lo[:, 0] <= width - 1) & (hi[:, 1] >= 0) & (lo[:, 1] <= height - 1)
+    idx = np.flatnonzero(seen)
+    bw = (x1[idx] - x0[idx] + 1).astype(np.int64)
+    bh = (y1[idx] - y0[idx] + 1).astype(np.int64)
+    # buckets: boxes of the same power-of-two size (at most 4x the work of exact boxes)
+    kw = np.ceil(np.log2(bw)).astype(np.int64)
+    kh = np.ceil(np.log2(bh)).astype(np.int64)
+    bucket = kw * 64 + kh
+    for b in np.unique(bucket):
+        members = idx[bucket == b]
+        gw, gh = 1 << int(b // 64), 1 << int(b % 64)
+        per = max(1, _CHUNK // (gw * gh))
+        for s in range(0, len(members), per):
+            t = members[s:s + per]
+            _batch(out, tris[t], area2[t], is_open[t], x0[t], y0[t], x1[t], y1[t], gw, gh, width, tie_px,
+                   None if tri_z is None else tri_z[t], perspective)
+    return out
+
+
+def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, tie_px, tri_z, perspective):
+    oy, ox = np.divmod(np.arange(gw * gh), gw)
+    px = x0[:, None] + ox[None, :]                                   # (n, gw gh) centres, float
+    py = y0[:, None] + oy[None, :]
+    valid = (px <= x1[:, None]) & (py <= y1[:, None])
+    inside = valid & (area2 > 0)[:, None]
+    min_dist = np.full(px.shape, np.inf)
+    near_open = np.zeros(px.shape, dtype=bool)
+    for k in range(3):
+        p, q = tris[:, k], tris[:, (k + 1) % 3]
+        dx, dy = (q[:, 0] - p[:, 0])[:, None], (q[:, 1] - p[:, 1])[:, None]
+        rx, ry = px - p[:, 0:1], py - p[:, 1:2]
+        e = dx * ry - dy * rx
+        top_left = (dy < 0) | ((dy == 0) & (dx > 0))
+        inside &= (e > 0) | ((e == 0) & top_left)
+        length2 = dx * dx + dy * dy
+        with np.errstate(invalid="ignore", divide="ignore"):
+            line_dist = np.abs(e) / np.sqrt(length2)
+            t = np.clip((rx * dx + ry * dy) / length2, 0.0, 1.0)
+        t = np.where(length2 > 0, t, 0.0)
+        seg_dist = np.hypot(rx - t * dx, ry - t * dy)
+        min_dist = np.minimum(min_dist, np.where(length2 > 0, line_dist, 0.0))
+        near_open |= is_open[:, k:k + 1] & (seg_dist <= tie_px)
+    flat = (py * width + px).astype(np.int64)
+    near_open &= valid
+    out.inside[flat[inside]] = True
+    out.near_open[flat[near_open]] = True
+    robust = inside & (min_dist > tie_px)
+    out.robust[flat[robust]] = True
+    if tri_z is None or not inside.any():
+        return
+    # depth at the centres: w = 1/z (perspective) or z (orthographic) on the plane through the vertices
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+    w = 1.0 / tri_z if perspective else tri_z
+    det = area2                                                      # > 0 where inside
+    e1, e2 = b - a, c - a
+    dw1, dw2 = (w[:, 1] - w[:, 0]), (w[:, 2] - w[:, 0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        gx = (dw1 * e2[:, 1] - dw2 * e1[:, 1]) / det
+        gy = (dw2 * e1[:, 0] - dw1 * e2[:, 0]) / det
+    wp = w[:, 0:1] + gx[:, None] * (px - a[:, 0:1]) + gy[:, None] * (py - a[:, 1:2])
+    if perspective:
+        z = 1.0 / wp
+        slope = z * z * (np.abs(gx) + np.abs(gy))[:, None]           # |dz/dx| + |dz/dy| = z^2 |dw|
+    else:
+        z = wp
+        slope = np.broadcast_to((np.abs(gx) + np.abs(gy))[:, None], z.shape)
+    cells, zs, ss = flat[inside], z[inside], slope[inside]
+    order = np.lexsort((zs, cells))                                  # nearest first within each pixel
+    cells, zs, ss = cells[order], zs[order], ss[order]
+    first = np.ones(len(cells), dtype=bool)
+    first[1:] = cells[1:] != cells[:-1]
+    cells, zs, ss = cells[first], zs[first], ss[first]
+    nearer = zs < out.z[cells]
+    out.z[cells[nearer]] = zs[nearer]
+    out.slope[cells[nearer]] = ss[nearer]
+
+
+def coverage(tris_px, shape, tie_px: float = GL_TIE_PX, is_open=None) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel centres covered by triangles under GL's fill rule, and the ties (module docstring).
+
+    Parameters
+    ----------
+    tris_px : (T, 3, 2) array_like
+        Triangles in pixel coordinates (x right, y down, integers at pixel centres), float64.
+    shape : (H, W)
+    tie_px : float
+        How far a renderer may move a vertex before it decides (px); 0 leaves only the
+        centres exactly on an open edge as ties.
+    is_open : (T, 3) bool, optional
+        Which edges (``v_k -> v_k+1``) are open; :func:`open_edges` of ``tris_px`` if None.
+
+    Returns
+    -------
+    inside : (H, W) bool, the centre is in some triangle.
+    ties : (H, W) bool, a renderer may answer either way there.
+    """
+    tris_px = np.asarray(tris_px, dtype=np.float64).reshape(-1, 3, 2)
+    if is_open is None:
+        is_open = open_edges(tris_px)
+    buf = _raster(tris_px, np.asarray(is_open, dtype=bool).reshape(-1, 3), shape, float(tie_px))
+    shape = (int(shape[0]), int(shape[1]))
+    return buf.inside.reshape(shape), (buf.near_open & ~buf.robust).reshape(shape)
+
+
+def _clip_polygon(poly: np.ndarray, z_min: float, z_max: float) -> np.ndarray:
+    """A convex polygon (k, 3) in camera space cut to ``z_min <= z <= z_max`` (Sutherland-Hodgman).
+
+    A cut point on an edge is computed from the edge's ends in a fixed order (the end inside
+    first), so two triangles sharing the edge get the same point to the bit.
+    """
+    for plane, sign in ((z_min, 1.0), (z_max, -1.0)):      # keep sign (z - plane) >= 0
+        if len(poly) == 0:
+            break
+        out = []
+        for i in range(len(poly)):
+            p, q = poly[i], poly[(i + 1) % len(poly)]
+            p_in, q_in = bool(sign * (p[2] - plane) >= 0), bool(sign * (q[2] - plane) >= 0)
+            if p_in:
+                out.append(p)
+            if p_in != q_in:
+                a, b = (p, q) if p_in else (q, p)
+                t = (plane - a[2]) / (b[2] - a[2])
+                cut = a + t * (b - a)
+                cut[2] = plane
+                out.append(cut)
+        poly = np.asarray(out, dtype=np.float64).reshape(-1, 3)
+    return poly
+
+
+def project_clipped(p_world, faces, camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The faces as image triangles: ``(tris_px (T, 3, 2), tri_z (T, 3), owner (T,))``.
+
+    Polygons are fanned from their first vertex (oracles.references.faces.fan), every face
+    kept (back faces too: a silhouette is all faces), cut to ``near <= z <= far`` in camera
+    space before the divide (a cut triangle is fanned again), then projected by the
+    conventions (perspective ``x = cx + fx x/z, y = cy - fy y/z``; orthographic with
+    ``s = H / ortho_height`` and the centred principal point). ``owner`` is the face of each.
+    """
+    if getattr(camera, "distortion", None) is not None:
+        raise ValueError("a distorted camera's silhouette is curved: no fill-rule reference for it")
+    p_world = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
+    right, up, forward = camera_basis(camera)
+    world_to_cam = np.stack([right, up, forward])
+    p_cam = (p_world - np.asarray(camera.position, dtype=np.float64)) @ world_to_cam.T
+    tris, owner = fan(faces)
+    tri_cam = p_cam[tris]                                              # (T, 3, 3)
+    z = tri_cam[:, :, 2]
+    near, far = float(camera.near), float(camera.far)
+    whole = ((z >= near) & (z <= far)).all(axis=1)
+    gone = (z < near).all(axis=1) | (z > far).all(axis=1)
+    parts, part_owner = [tri_cam[whole]], [owner[whole]]
+    for i in np.flatnonzero(~whole & ~gone):
+        poly = _clip_polygon(tri_cam[i], near, far)
+        if len(poly) >= 3:
+            parts.append(np.stack([np.stack([poly[0], poly[k], poly[k + 1]]) for k in range(1, len(poly) - 1)]))
+            part_owner.append(np.full(len(poly) - 2, owner[i]))
+    tri_cam = np.concatenate(parts).reshape(-1, 3, 3)
+    owner = np.concatenate(part_owner).astype(np.int64)
+    x, y, zc = tri_cam[..., 0], tri_cam[..., 1], tri_cam[..., 2]
+    if camera.projection == "perspective":
+        fx, fy, cx, cy = intrinsics(camera)
+        tris_px = np.stack([cx + fx * x / zc, cy - fy * y / zc], axis=-1)
+    else:
+        s = camera.height / camera.ortho_height
+        cx, cy = (camera.width - 1) / 2.0, (camera.height - 1) / 2.0
+        tris_px = np.stack([cx + s * x, cy - s * y], axis=-1)
+    return tris_px, zc, owner
+
+
+def silhouette(p_world, faces, camera, shape, face_objects=None,
+               tie_px: float = GL_TIE_PX) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A frame's reference silhouette: ``(inside, ties, object_ids)``, each ``(H, W)``.
+
+    Parameters
+    ----------
+    p_world : (N, 3) array_like
+        World points of the frame (after each object's matrix).
+    faces : sequence of index tuples
+        Polygons (any winding: back faces count).
+    camera : core.camera.Camera
+        Without distortion (ValueError otherwise).
+    shape : (H, W)
+    face_objects : (F,) int, optional
+        The object of each face (0, 1, ...); all faces one object (id 0) if None.
+    tie_px : float
+        As in :func:`coverage`.
+
+    Returns
+    -------
+    inside : (H, W) bool
+    ties : (H, W) bool
+    object_ids : (H, W) int64, the object of the nearest face at each covered centre,
+        :data:`NO_OBJECT` where none, :data:`ID_TIE` where two objects are within depth bounds.
+    """
+    tris_px, tri_z, owner = project_clipped(p_world, faces, camera)
+    shape = (int(shape[0]), int(shape[1]))
+    is_open = open_edges(tris_px)
+    buf = _raster(tris_px, is_open, shape, float(tie_px))
+    inside = buf.inside.reshape(shape)
+    ties = (buf.near_open & ~buf.robust).reshape(shape)
+    ids = np.where(buf.inside, 0, NO_OBJECT).astype(np.int64)
+    if face_objects is not None and len(owner):
+        tri_object = np.asarray(face_objects, dtype=np.int64).reshape(-1)[owner]
+        objects = np.unique(tri_object)
+        if len(objects) > 1:
+            perspective = camera.projection == "perspective"
+            n = shape[0] * shape[1]
+            z1, b1, z2, b2 = np.full(n, np.inf), np.zeros(n), np.full(n, np.inf), np.zeros(n)
+            best = np.full(n, NO_OBJECT, dtype=np.int64)
+            for o in objects:
+                t = tri_object == o
+                one = _raster(tris_px[t], is_open[t], shape, float(tie_px), tri_z[t], perspective)
+                seen = np.isfinite(one.z)
+                bound = np.zeros(n)
+                bound[seen] = depth_bound(one.z[seen], one.slope[seen], camera)
+                first = one.z < z1
+                second = ~first & (one.z < z2)
+                z2 = np.where(first, z1, np.where(second, one.z, z2))
+                b2 = np.where(first, b1, np.where(second, bound, b2))
+                z1 = np.where(first, one.z, z1)
+                b1 = np.where(first, bound, b1)
+                best = np.where(first, o, best)
+            ids = np.where(buf.inside, best, NO_OBJECT)
+            with np.errstate(invalid="ignore"):                      # inf - inf where one object or none
+                tie = buf.inside & np.isfinite(z2) & (z2 - z1 <= b1 + b2)
+            ids[tie] = ID_TIE
+        elif len(objects) == 1:
+            ids = np.where(buf.inside, objects[0], NO_OBJECT).astype(np.int64)
+    return inside, ties, ids.reshape(shape)
