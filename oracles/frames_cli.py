@@ -187,11 +187,11 @@ def verdict_line(report: dict, tol) -> str:
     outputs = report.get("outputs", ["wireframe"])
     limits = [f"F1@1px >= {tol.min_f1_1px}, {f1_0px_clause(report['cases'], tol.min_f1_0px)}"] \
         if "wireframe" in outputs else []
-    limits += [f"filled IoU >= {tol.min_iou}"] if "filled" in outputs else []
-    limits += [f"depth error <= {tol.max_depth_error_ratio:g} x its bound"] if "depth" in outputs else []
-    if "filled" in outputs or "depth" in outputs:
-        limits.append(f"holes <= {tol.max_surface_holes_px}, extra <= {tol.max_surface_extra_px} px away from the "
-                      "silhouette's boundary")
+    limits += [f"filled IoU >= {tol.min_iou}, runs of decided pixels missing or added <= "
+               f"{tol.max_silhouette_run_px}"] if "filled" in outputs else []
+    limits += [f"depth error <= {tol.max_depth_error_ratio:g} x its bound, holes <= {tol.max_surface_holes_px}, "
+               f"extra <= {tol.max_surface_extra_px} px away from the silhouette's boundary"] \
+        if "depth" in outputs else []
     core = (f"; against core: F1@0px >= {f1(s['min_core_f1_0px'])}, F1@1px >= {f1(s['min_core_f1_1px'])}"
             if "wireframe" in outputs else "")
     return (f"{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "

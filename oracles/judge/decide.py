@@ -99,20 +99,13 @@ def reasons(rec: dict, tol: Tolerances, error: str | None = None) -> list[str]:
     return out
 
 
-def _surface_reasons(f: dict, tol: Tolerances, what: str) -> list[str]:
-    """Blank frames, holes and extra surface of a case's depth maps or filled frames (``what``)."""
-    out = []
-    if f["blank_frames"]:
-        shown = ", ".join(map(str, f["blank_frames"][:5])) + (", ..." if len(f["blank_frames"]) > 5 else "")
-        out.append(f"{what} blank where the reference shows a surface (frame{'s' if len(f['blank_frames']) > 1 else ''}"
-                   f" {shown}): nothing compared there")
-    if f["holes_px"] > tol.max_surface_holes_px:
-        out.append(f"{what}: {f['holes_px']} pixels of the reference's surface left empty away from its "
-                   f"silhouette's boundary (> {tol.max_surface_holes_px}; most in frame {f['holes_worst_frame']})")
-    if f["extra_px"] > tol.max_surface_extra_px:
-        out.append(f"{what}: {f['extra_px']} pixels of surface where the reference has none, away from its "
-                   f"silhouette's boundary (> {tol.max_surface_extra_px}; most in frame {f['extra_worst_frame']})")
-    return out
+def _blank(frames: list, what: str) -> list[str]:
+    """The reason of a case whose ``what`` (depth maps, filled frames) are blank in ``frames``; [] if none."""
+    if not frames:
+        return []
+    shown = ", ".join(map(str, frames[:5])) + (", ..." if len(frames) > 5 else "")
+    return [f"{what} blank where the reference shows a surface (frame{'s' if len(frames) > 1 else ''} {shown}): "
+            "nothing compared there"]
 
 
 def depth_map_reasons(d: dict, tol: Tolerances) -> list[str]:
@@ -125,15 +118,28 @@ def depth_map_reasons(d: dict, tol: Tolerances) -> list[str]:
     if d["reference_px"] and not d["compared_px"]:
         out.append(f"depth maps compare nothing: no pixel shows a surface on both sides "
                    f"({d['reference_px']} reference pixels): never a pass")
-    return out + _surface_reasons(d, tol, "depth map")
+    out += _blank(d["blank_frames"], "depth map")
+    if d["holes_px"] > tol.max_surface_holes_px:
+        out.append(f"depth map: {d['holes_px']} pixels of the reference's surface left empty away from its "
+                   f"silhouette's boundary (> {tol.max_surface_holes_px}; most in frame {d['holes_worst_frame']})")
+    if d["extra_px"] > tol.max_surface_extra_px:
+        out.append(f"depth map: {d['extra_px']} pixels of surface where the reference has none, away from its "
+                   f"silhouette's boundary (> {tol.max_surface_extra_px}; most in frame {d['extra_worst_frame']})")
+    return out
 
 
 def filled_reasons(f: dict, tol: Tolerances) -> list[str]:
-    """The limits a case's filled frames miss (``record["filled"]``, oracles.judge.filled_frames)."""
-    out = []
+    """The limits a case's filled frames miss (``record["filled"]``, oracles.judge.filled_frames): blank frames,
+    the longest run of decided pixels missing or added (oracles.judge.silhouette), the IoU."""
+    out = _blank(f["blank_frames"], "filled frame")
+    if f["longest_run_px"] > tol.max_silhouette_run_px:
+        r, c = f["run_at"]
+        out.append(f"filled silhouette: {f['longest_run_px']} decided pixels missing or added in one run (frame "
+                   f"{f['run_frame']}, row {r}, column {c}; > {tol.max_silhouette_run_px}); {f['holes_px']} holes, "
+                   f"{f['extra_px']} extra in all")
     if f["min_iou"] is not None and f["min_iou"] < tol.min_iou:
         out.append(f"filled silhouette IoU {f['min_iou']:.4f} < {tol.min_iou} (frame {f['iou_worst_frame']})")
-    return out + _surface_reasons(f, tol, "filled frame")
+    return out
 
 
 def pixel_rule_reasons(rec: dict, tol: Tolerances) -> list[str]:

@@ -74,9 +74,9 @@ class FrameAhead:
         return self._value(self._grey)
 
     def faces(self):
-        """pyrender's drawing of the frame's faces, ``(covered, depth, ids, triangles)``
-        (PyrenderOracle.render_faces with ids, of the OBJ's faces fanned: ``triangles`` (T, 3)); None when the
-        job asks for no filled frame nor depth map."""
+        """pyrender's drawing of the frame's faces, ``(covered, depth, ids, triangles, faces)``
+        (PyrenderOracle.render_faces with ids, of the OBJ's ``faces`` fanned: ``triangles`` (T, 3)); None when
+        the job asks for no filled frame nor depth map."""
         return self._value(self._faces)
 
 
@@ -108,10 +108,11 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: d
     if not set(job_outputs(job)) & {"filled", "depth"}:
         return FrameAhead(inputs, orac, grey)
     try:
-        tris, _owner = fan(frame_faces(job_dir, job, c["scene"], k, cache))
+        polygons = frame_faces(job_dir, job, c["scene"], k, cache)
+        tris, _owner = fan(polygons)
         drawn = oracles.get(camera.width, camera.height).render_faces(p_model, tris, camera, model_matrix=m,
                                                                       with_ids=True)
-        faces = (*drawn, tris)
+        faces = (*drawn, tris, polygons)
     except Exception as exc:      # noqa: BLE001
         faces = exc
     return FrameAhead(inputs, orac, grey, faces)

@@ -141,7 +141,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     outputs = job_outputs(job)
     wire = "wireframe" in outputs
     depth = DepthFrames(job) if "depth" in outputs else None         # each frame's depth map (depth_frames)
-    filled = FilledFrames() if "filled" in outputs else None          # each frame's filled PNG (filled_frames)
+    filled = FilledFrames(tol.fill_tie_px) if "filled" in outputs else None     # each filled PNG (filled_frames)
     kept = diagnosis_frames(len(numbers)) if diagnose and wire else set()
     acc = _CaseFrames()
     style = CaseStyle(line_rule)
@@ -155,12 +155,13 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
             _wireframe(acc, style, Path(job_dir) / c["frames"][i], c, k, frame, (p_model, edges, camera, m),
                        (job_dir, job), tol, line_rule, i in kept)
         if depth or filled:
-            covered, z, ids, tris = frame.faces()          # pyrender's faces: the surface's reference
+            covered, z, ids, tris, polygons = frame.faces()     # pyrender's faces: the depth maps' reference
             if depth:
                 rec_k = depth.add(k, Path(job_dir) / c["depth"][i], camera, from_render(covered, z, ids, tris, camera))
                 acc.drawn_px += rec_k["union_px"]
-            if filled:
-                rec_k = filled.add(k, Path(job_dir) / c["filled"][i], covered, (job_dir, job))
+            if filled:                                          # the fill rule's silhouette (filled_frames)
+                rec_k = filled.add(k, Path(job_dir) / c["filled"][i], p_model @ m[:3, :3].T + m[:3, 3], polygons,
+                                   camera, (job_dir, job))
                 acc.drawn_px += rec_k["union_px"]
         del frame
     ahead.close()

@@ -1,10 +1,10 @@
 """Two surfaces' pixels compared away from a silhouette's boundary: holes and extra surface.
 
-A renderer's depth map (oracles.judge.depth_frames) and its filled frame
-(oracles.judge.filled_frames) each show a surface at some pixels; the
-reference (pyrender's faces) covers others. Where they differ on the
-reference silhouette's boundary, the difference is a rounding decision; away
-from it, it is a fault.
+A renderer's depth map (oracles.judge.depth_frames) shows a surface at some
+pixels; the reference (pyrender's faces) covers others. Where they differ on
+the reference silhouette's boundary, the difference is a rounding decision;
+away from it, it is a fault. (A filled frame is held to the fill rule's
+decided pixels instead: oracles.judge.silhouette.)
 """
 
 from __future__ import annotations
