@@ -69,7 +69,7 @@ def test_core_depth_as_png16_at_scale_1000_passes(tmp_path, capsys):
     assert code == 0, capsys.readouterr().out
     assert {c["depth_map"]["encoding"] for c in report["cases"]} == {"png uint16 / 1000"}
     # rounded to 1 mm: the error is half the 1 mm step plus core's own difference from pyrender (at most
-    # 4.7e-5 on these frames as float32 .npy, the test above): within 0.5e-3 + 1e-4, and the step shows
+    # 2.9e-5 on these frames as float32 .npy, the test above): within 0.5e-3 + 1e-4, and the step shows
     worst = max(c["depth_map"]["max_error"] for c in report["cases"])
     assert 0.4e-3 < worst <= 0.5e-3 + 1e-4
 
