@@ -52,10 +52,10 @@ def export_main(argv) -> int:
     p.add_argument("--outputs", default="wireframe", metavar="LIST",
                    help="what the renderer writes per frame, comma-separated: wireframe, filled, depth "
                         "(default wireframe; e.g. wireframe,depth or filled,depth)")
-    p.add_argument("--depth-format", default="npy", choices=("npy", "png16", "tiff"),
+    p.add_argument("--depth-format", default=None, choices=("npy", "png16", "tiff"),
                    help="the depth maps' file: npy (float32), png16 (16-bit PNG, --depth-scale values per "
                         "world unit) or tiff (32-bit float) (default npy)")
-    p.add_argument("--depth-scale", type=plain_float, default=1000.0, metavar="S",
+    p.add_argument("--depth-scale", type=plain_float, default=None, metavar="S",
                    help="values per world unit of a png16 depth map (default 1000: millimetres per metre)")
     args = p.parse_args(argv)
     try:
@@ -77,7 +77,15 @@ def export_main(argv) -> int:
             spin = ()
         if len(spin) != 3 or not all(math.isfinite(x) for x in spin):
             raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
-        outputs = check_outputs(args.outputs, args.depth_format, args.depth_scale)
+        depth_format = args.depth_format or "npy"
+        depth_scale = 1000.0 if args.depth_scale is None else args.depth_scale
+        outputs = check_outputs(args.outputs, depth_format, depth_scale)
+        if args.depth_format is not None and "depth" not in outputs:
+            raise InputError(f"--depth-format {args.depth_format} with --outputs {args.outputs!r}: expected "
+                             "--outputs with depth (the format is the depth maps')")
+        if args.depth_scale is not None and depth_format != "png16":
+            raise InputError(f"--depth-scale {args.depth_scale!r} with --depth-format {depth_format}: expected "
+                             "--depth-format png16 (a scale is a 16-bit PNG's; float maps hold world units)")
         out = Path(args.dir)
         if not out.parent.is_dir():
             raise InputError(f"export {args.dir!r}: its parent folder does not exist")
@@ -89,7 +97,7 @@ def export_main(argv) -> int:
         scenes = [load_scene(n) for n in (args.scene or builtin_names())]
         job = write_job(out, scenes, frames=args.frames, every=args.every, case_names=cases,
                         motion=Motion(turns=spin), phase=args.phase, outputs=outputs,
-                        depth_format=args.depth_format, depth_scale=args.depth_scale)
+                        depth_format=depth_format, depth_scale=depth_scale)
     except InputError as exc:
         return _fail(str(exc))
     except OSError as exc:

@@ -263,6 +263,8 @@ def test_the_readme_says_what_to_write(tmp_path):
     (["--outputs", "depth,depth"], "one given twice"),
     (["--outputs", "depth", "--depth-format", "png16", "--depth-scale", "0"], "--depth-scale 0"),
     (["--outputs", "depth", "--depth-format", "png16", "--depth-scale", "nan"], "--depth-scale nan"),
+    (["--outputs", "depth", "--depth-scale", "1000"], "expected --depth-format png16"),
+    (["--outputs", "filled", "--depth-format", "npy"], "expected --outputs with depth"),
 ])
 def test_export_refuses_bad_outputs(tmp_path, capsys, args, needle):
     assert main(["export", str(tmp_path / "job"), *ARGS, *args]) == 2

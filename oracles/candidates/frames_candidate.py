@@ -1,7 +1,8 @@
 """``crosscheck --candidate-frames DIR``: a renderer's frames job, read and checked.
 
 ``DIR`` is a job written by :mod:`oracles.candidates.export` with the renderer's PNGs
-under ``frames/``. This module reads and checks the job (its manifest, OBJ,
+under ``frames/`` (and, for a job that asks for them, its filled frames and depth maps
+there too: job.json's ``filled`` and ``depth`` of each case). This module reads and checks the job (its manifest, OBJ,
 cameras and frames); :mod:`oracles.judge.frames_judge` judges the frames, one at a
 time, by the one judge of every path (:mod:`oracles.judge.decide`).
 

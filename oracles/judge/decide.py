@@ -17,6 +17,9 @@ same record fields from its frames; this module alone decides on them:
   the line centres, ends and warp measured from its images instead
   (``line_style``, oracles.judge.line_style);
 - the shaded limits (regions inside a silhouette, IoU, faces, depth);
+- a renderer's depth maps and filled frames (``depth_map``, ``filled``:
+  oracles.judge.depth_frames, filled_frames): depth error over its bound, holes and
+  extra surface, blank frames, the silhouette's longest run and IoU;
 - the gate (:mod:`oracles.judge.gate`): a case that misses no limit but compared
   nothing is ``"vacuous"``;
 - the ``unexplained`` rule: a case that fails without a candidate error and

@@ -101,15 +101,15 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
 def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: np.ndarray, camera) -> ReferenceDepth:
     """The :class:`ReferenceDepth` of pyrender's drawing of a frame's faces (``render_faces(..., with_ids=True)``
     of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels."""
-    bound = depth_bound(depth, covered, camera)
-    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera)) & covered
+    slope = depth_slope(depth, covered)
+    bound = depth_bound(depth, covered, camera, slope)
+    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope)) & covered
     return ReferenceDepth(depth=np.where(covered, depth, np.nan), covered=covered, undecided=undecided, bound=bound,
                           faces=np.where(covered, ids, -1))
 
 
-def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
-    """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope of near or far."""
-    slope = depth_slope(depth, covered)
+def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:
+    """Pixels within one pixel (8 neighbours) of one whose depth is within its depth ``slope`` of near or far."""
     at_plane = covered & ((np.abs(depth - camera.near) <= slope) | (np.abs(depth - camera.far) <= slope))
     out = at_plane.copy()
     h, w = at_plane.shape

@@ -15,6 +15,14 @@ images (oracles.diagnosis.image_diagnose); when those name nothing, from the lin
 (``line_end_bias``, ``line_pixel_bias``: oracles.judge.decide.line_faults). The
 verdict is oracles.judge.decide.decide's, at level ``frames`` (no vertex compared).
 
+A job that asks for depth maps or filled frames (``outputs``, oracles.candidates.export)
+has them measured in the same frame loop: pyrender draws the frame's faces (on the
+GL thread, read ahead), each depth map is read and judged against that depth
+(oracles.judge.depth_frames), each filled frame against the fill rule's
+silhouette (oracles.judge.filled_frames); their fields join the case's record
+(``depth_map``, ``filled``) and the one verdict. Without wireframes, no line
+field is measured and no worst-frame images are kept.
+
 Frames are streamed: a frame's images are dropped once it is scored, so
 memory does not grow with the job. What is kept per case: the worst frame's
 two images (for report.md's picture), at most :data:`DIAGNOSIS_FRAMES`
@@ -135,6 +143,9 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     ``line_rule``: ``"any"`` holds aliased 1-px lines to a correct drawing by GL's rule or the
     rounded-ends rule (oracles.judge.line_model), ``"gl"`` to GL's pixel rule alone,
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
+
+    Each frame's wireframe, depth map and filled frame, as the job asks for them (module
+    docstring); the worst images are None for a job without wireframes.
     """
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     numbers = job["frame_numbers"]

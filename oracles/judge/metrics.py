@@ -254,21 +254,28 @@ def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_dep
 
 
 def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
-    """Largest |depth change| to a covered 4-neighbour, per pixel (0 where none)."""
+    """Largest |depth change| to a covered 4-neighbour, per pixel (0 where none).
+
+    Each neighbouring pair's change is taken once, across columns then rows, and given to both
+    pixels of the pair (``fmax`` keeps 0 where the change is NaN: a pixel not covered); an infinite
+    change is the largest float, as ``nan_to_num`` made it."""
     d = np.where(covered, np.asarray(depth, np.float64), np.nan)
     slope = np.zeros(d.shape)
-    for dy, dx in ((0, 1), (0, -1), (1, 0), (-1, 0)):
-        with np.errstate(invalid="ignore"):
-            slope = np.fmax(slope, np.abs(_shifted(d, dy, dx, np.nan) - d))
-    return np.nan_to_num(slope, nan=0.0)
+    with np.errstate(invalid="ignore"):
+        for change, first, second in ((np.abs(d[:, 1:] - d[:, :-1]), np.s_[:, :-1], np.s_[:, 1:]),
+                                      (np.abs(d[1:] - d[:-1]), np.s_[:-1], np.s_[1:])):
+            np.fmax(slope[first], change, out=slope[first])
+            np.fmax(slope[second], change, out=slope[second])
+    return np.minimum(slope, np.finfo(np.float64).max, out=slope)      # an infinite change: the largest float
 
 
-def depth_bound(depth: np.ndarray, covered: np.ndarray, camera) -> np.ndarray:
-    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances)."""
+def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray | None = None) -> np.ndarray:
+    """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances);
+    ``slope``: :func:`depth_slope` of these, when the caller has it."""
     depth = np.asarray(depth, np.float64)
     eps32 = float(np.finfo(np.float32).eps)
     return (tolerances.DEPTH_STEPS * depth_step(depth, camera)
-            + tolerances.DEPTH_SNAP_PX * depth_slope(depth, covered)
+            + tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
             + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth))
 
 
