@@ -15,6 +15,7 @@ job). Each problem is one line of :class:`FramesError` (exit 2).
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 
@@ -329,7 +330,7 @@ def read_obj(path: Path, with_faces: bool = False) -> tuple:
         try:
             if parts and parts[0] == "v":
                 verts.append([float(x) for x in parts[1:]])
-                if len(parts) != 4 or not np.all(np.isfinite(verts[-1])):
+                if len(parts) != 4 or not all(map(math.isfinite, verts[-1])):
                     raise ValueError
             elif parts and parts[0] == "l":
                 edges.append([int(x) - 1 for x in parts[1:]])
@@ -397,7 +398,9 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
     if cache is not None and cache.get("obj") == obj:
         p_model, edges = cache["mesh"]
     else:
-        p_model, edges = read_obj(obj)
+        p_model, edges, faces = read_obj(obj, with_faces=True)
+        if cache is not None:               # the faces of the file just read, for frame_faces
+            cache.update(faces_obj=obj, faces=faces)
         if cache is not None and row["space"] == "model":
             cache.update(obj=obj, mesh=(p_model, edges))
     if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
@@ -420,17 +423,19 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
 
 def frame_faces(job_dir: Path, job: dict, scene: str, k: int, cache: dict | None = None) -> list:
     """The ``f`` records of frame ``k``'s OBJ (0-based index tuples): the faces a filled frame or a depth map
-    shows. ``cache``: as :func:`frame_inputs`', the faces of a model-space scene read once."""
+    shows. ``cache``: as :func:`frame_inputs`' (which keeps the faces of the OBJ it read last): each OBJ
+    read once."""
     row = next(s for s in job["scenes"] if s["name"] == scene)
     obj = Path(job_dir) / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
     if cache is not None and cache.get("faces_obj") == obj:
-        return cache["faces"]
-    _v, _e, faces = read_obj(obj, with_faces=True)
+        faces = cache["faces"]
+    else:
+        _v, _e, faces = read_obj(obj, with_faces=True)
+        if cache is not None:
+            cache.update(faces_obj=obj, faces=faces)
     if row["space"] == "model" and len(faces) != row.get("faces"):
         raise FramesError([f"{obj}: {len(faces)} faces: expected {row.get('faces')} (job.json's; the file was "
                            "changed or cut short)"])
-    if cache is not None and row["space"] == "model":
-        cache.update(faces_obj=obj, faces=faces)
     return faces
 
 

@@ -109,7 +109,9 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: d
         return FrameAhead(inputs, orac, grey)
     try:
         polygons = frame_faces(job_dir, job, c["scene"], k, cache)
-        tris, _owner = fan(polygons)
+        if cache.get("fanned") is not polygons:             # a model-space scene's faces: fanned once a case
+            cache.update(fanned=polygons, tris=fan(polygons)[0])
+        tris = cache["tris"]
         drawn = oracles.get(camera.width, camera.height).render_faces(p_model, tris, camera, model_matrix=m,
                                                                       with_ids=True)
         faces = (*drawn, tris, polygons)
