@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from clients.core_depth_job import MISTAKES, render_job    # tests/ is on sys.path (rootdir conftest)
 from helpers import run_crosscheck
