@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from clients.core_depth_job import MISTAKES, render_job    # tests/ is on sys.path (rootdir conftest)
+from clients.core_depth_job import CAMERA_MISTAKES, MISTAKES, render_job    # tests/ is on sys.path (rootdir conftest)
 from helpers import run_crosscheck
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.candidates.frames_candidate import load_job
@@ -87,6 +87,34 @@ def test_a_mistaken_depth_map_fails_with_its_name(depth_job, tmp_path, capsys, m
         assert case["verdict"] == "fail"
         assert [f["name"] for f in case["faults"]] == [expected], (case["camera"], case["faults"])
     assert expected in out
+
+
+@pytest.fixture(scope="module")
+def perspective_job(tmp_path_factory) -> Path:
+    """A perspective camera alone: an orthographic camera has no K to get wrong."""
+    path = tmp_path_factory.mktemp("persp") / "job"
+    assert main(["export", str(path), *ARGS[:3], "oblique_roll", *ARGS[4:], "--outputs", "depth"]) == 0
+    return path
+
+
+@pytest.mark.parametrize("mistake, expected", [
+    ("half_pixel", "pixel_offset"),             # cx = W / 2 for (W - 1) / 2: the map moved by half a pixel
+    ("fov_horizontal", "fov_mismatch"),         # K from the FOV taken as the horizontal one
+])
+def test_a_camera_mistake_in_a_depth_map_is_named(perspective_job, tmp_path, mistake, expected):
+    job = copy(perspective_job, tmp_path)
+    render_job(job, camera=CAMERA_MISTAKES[mistake])
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
+    assert code == 1
+    (case,) = report["cases"]
+    assert [f["name"] for f in case["faults"]] == [expected], case["faults"]
+    fault = case["faults"][0]
+    # the mistakes' own numbers (docs/depth.md: fitted within 0.01 px, the scale within 1e-4): half a pixel
+    # each way, read back where the reference is sampled (T(p) = p + d: d = -0.5); the focal length H / W
+    if expected == "pixel_offset":
+        assert abs(fault["dx"] + 0.5) < 0.01 and abs(fault["dy"] + 0.5) < 0.01, fault
+    else:
+        assert abs(fault["scale"] - case["camera_spec"]["height"] / case["camera_spec"]["width"]) < 1e-4, fault
 
 
 def test_a_blank_map_fails(depth_job, tmp_path, capsys):

@@ -6,13 +6,15 @@ Reads ``job.json``, the OBJ files (``v``, ``l``, ``f``) and each frame's camera 
 not wirecheck's job reader: the judge's own reader is what is tested) and draws every file the job lists
 (``frames``, ``filled``, ``depth`` of each case) with core's renderer (``style="shaded"``: core's depth
 buffer, linear ``z_cam``), written in the job's ``depth_encoding``. ``--mistake`` writes the depth maps
-with one classic mistake (:data:`MISTAKES`), for the tests and docs/depth.md's sample.
+with one classic mistake (:data:`MISTAKES`: of the values; :data:`CAMERA_MISTAKES`: of a perspective camera's
+K, the faces drawn through it), for the tests and docs/depth.md's sample.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -54,6 +56,22 @@ MISTAKES = {
 }
 
 
+def _half_pixel(cam: Camera) -> Camera:
+    """The principal point at (W / 2, H / 2) instead of ((W - 1) / 2, (H - 1) / 2)."""
+    fx, fy = cam.focal_xy
+    return cam.with_intrinsics(fx, fy, cam.width / 2, cam.height / 2)
+
+
+def _fov_horizontal(cam: Camera) -> Camera:
+    """K from the FOV taken as the horizontal one: f = (W / 2) / tan(fov / 2) on both axes."""
+    f = (cam.width / 2) / math.tan(math.radians(cam.fov_y_deg) / 2)
+    return cam.with_intrinsics(f, f)
+
+
+#: Camera mistakes ``--mistake`` draws the depth maps with (perspective cameras only: the others draw as asked).
+CAMERA_MISTAKES = {"half_pixel": _half_pixel, "fov_horizontal": _fov_horizontal}
+
+
 def frames(job_dir: Path):
     """Every frame of the job: ``(case row, index in its lists, camera, p_model, edges, faces, model_matrix)``."""
     job = json.loads((job_dir / "job.json").read_text())
@@ -67,14 +85,16 @@ def frames(job_dir: Path):
             yield c, i, Camera(**cam_json["camera"]), v, e, f, np.array(cam_json["model_matrix"])
 
 
-def render_job(job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered) -> None:
+def render_job(job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered, camera=None) -> None:
     """Write every file the job lists (module docstring); ``mistake(z, camera)`` makes each depth map from core's
-    depth, ``filled(covered)`` each filled frame's surface from core's."""
+    depth, ``filled(covered)`` each filled frame's surface from core's; ``camera`` (one of
+    :data:`CAMERA_MISTAKES`) changes a perspective camera before the faces are drawn."""
     job_dir = Path(job_dir)
     job = json.loads((job_dir / "job.json").read_text())
     enc = job.get("depth_encoding") or {}
     for c, i, cam, v, e, f, m in frames(job_dir):
-        frame = render_frame(v, e, cam, m, faces=f, style="shaded")
+        drawn = camera(cam) if camera is not None and cam.projection == "perspective" else cam
+        frame = render_frame(v, e, drawn, m, faces=f, style="shaded")
         z = np.where(np.isfinite(frame.depth_image), frame.depth_image, 0.0)
         for key, write in (("frames", lambda p: Image.fromarray(render_frame(v, e, cam, m).image).save(p)),
                            ("filled", lambda p: Image.fromarray(np.where(filled(z > 0), 200, 0).astype(np.uint8))
@@ -97,9 +117,9 @@ def _save_depth(path: Path, d: np.ndarray, enc: dict) -> None:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("job")
-    p.add_argument("--mistake", choices=sorted(MISTAKES), default="none")
+    p.add_argument("--mistake", choices=sorted(MISTAKES) + sorted(CAMERA_MISTAKES), default="none")
     args = p.parse_args(argv)
-    render_job(Path(args.job), MISTAKES[args.mistake])
+    render_job(Path(args.job), MISTAKES.get(args.mistake, MISTAKES["none"]), camera=CAMERA_MISTAKES.get(args.mistake))
     return 0
 
 
