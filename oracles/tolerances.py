@@ -461,6 +461,12 @@ MAX_DEPTH_ERROR_RATIO = 1.0
 #: MAX_SILHOUETTE_RUN_PX below.)
 MAX_SURFACE_HOLES_PX = 0
 MAX_SURFACE_EXTRA_PX = 0
+#: A filled frame of several objects: decided pixels whose grey level reads as another object than the
+#: fill rule's nearest (oracles.judge.filled_frames.object_id_misses). The reference leaves out the pixels
+#: where two objects' depths are within their depth bounds (fill_rule.ID_TIE: either is correct) and the
+#: coverage ties, so a correct renderer shows the reference's object everywhere else: 0 (measured: pyrender's
+#: ids equal the reference's at every decided pixel of 3 views of 3 overlapping objects, tests/test_fill_rule.py).
+MAX_OBJECT_ID_PX = 0
 
 
 # ---- The geometry of a renderer's lines, measured from its frames (oracles.judge.line_style,
@@ -529,6 +535,7 @@ class Tolerances:
     max_depth_error_ratio: float = MAX_DEPTH_ERROR_RATIO
     max_surface_holes_px: int = MAX_SURFACE_HOLES_PX
     max_surface_extra_px: int = MAX_SURFACE_EXTRA_PX
+    max_object_id_px: int = MAX_OBJECT_ID_PX
     fill_tie_px: float = FILL_TIE_PX
     max_silhouette_run_px: int = MAX_SILHOUETTE_RUN_PX
 
@@ -554,7 +561,7 @@ class Tolerances:
                 + " + the map's encoding step", "max_surface_holes_px": self.max_surface_holes_px,
                 "max_surface_extra_px": self.max_surface_extra_px, "min_silhouette_iou": self.min_iou,
                 "min_iou_union_px": MIN_IOU_UNION_PX, "fill_tie_px": self.fill_tie_px,
-                "max_silhouette_run_px": self.max_silhouette_run_px}
+                "max_silhouette_run_px": self.max_silhouette_run_px, "max_object_id_px": self.max_object_id_px}
 
     def lines_dict(self) -> dict:
         """The frames path's line-geometry limits, as the report's ``tolerances`` adds them."""

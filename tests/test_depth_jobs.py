@@ -325,3 +325,35 @@ def test_assert_frames_names_the_depth_fault(depth_job, tmp_path):
     fill(job, MISTAKES["x1000"])
     with pytest.raises(AssertionError, match=r"depth_scale\(k=1000"):
         assert_frames(job)
+
+
+ORRERY = str(Path(__file__).parents[1] / "scenes" / "examples" / "orrery.scene")
+
+
+@pytest.fixture(scope="module")
+def orrery_job(tmp_path_factory) -> Path:
+    """Three moving objects (scenes/examples/orrery.scene): a world-space OBJ per frame, one id per object."""
+    path = tmp_path_factory.mktemp("orrery") / "job"
+    assert main(["export", str(path), "--scene", ORRERY, *ARGS[2:], "--outputs", "filled,depth"]) == 0
+    return path
+
+
+def test_several_objects_ids_and_depth(orrery_job, tmp_path):
+    """Core's levels 1, 2, 3 per object pass, as do the ids permuted (ids are labels); one level for every
+    object fails on the pixels of the objects that are not the level's most frequent."""
+    assert json.loads((orrery_job / "job.json").read_text())["scenes"][0]["objects"] == [8, 5, 6]
+    job = copy(orrery_job, tmp_path)
+    render_job(job)
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job), name="ids")
+    assert code == 0, [c["reasons"] for c in report["cases"]]
+    assert all(c["filled"]["object_id_px"] == 0 and c["depth_map"]["compared_px"] > 0 for c in report["cases"])
+    render_job(job, object_ids=lambda o: 2 - o)
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job), name="permuted")
+    assert code == 0
+    render_job(job, object_ids=np.zeros_like)
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job), name="one_id")
+    assert code == 1
+    for case in report["cases"]:
+        assert case["filled"]["object_id_px"] > 0 and case["filled"]["longest_run_px"] == 0
+        assert any("another object's id" in r for r in case["reasons"])
+

@@ -190,7 +190,10 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
         scene_rows.append({"name": scene.name, "space": "model" if single else "world per frame",
                            "obj": f"scenes/{scene.name}.obj" if single else f"scenes/{scene.name}/frame_NNNN.obj",
                            "vertices": int(len(scene.vertices)), "edges": int(len(scene.edges)),
-                           "faces": len(faces)})
+                           "faces": len(faces),
+                           # the objects' vertex counts, in the OBJ's order: a face is its first vertex's object
+                           **({} if plain else {"objects": [int(o.vertex_stop - o.vertex_start)
+                                                            for o in scene.objects]})})
         cases = cases_for(scene, motion, calibrated=True)
         scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
         geometry = {}

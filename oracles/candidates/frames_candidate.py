@@ -141,6 +141,11 @@ def _job_problem(job: dict) -> str | None:
         if r.get("space") == "model" and not all(_is_int(r.get(k)) and r[k] >= 0 for k in ("vertices", "edges", "faces")):
             return (f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}, faces "
                     f"{r.get('faces')!r}: expected counts")
+        objects = r.get("objects")
+        if "outputs" in job and not (isinstance(objects, list) and objects and all(_is_int(n) and n > 0 for n in objects)
+                                     and sum(objects) == r.get("vertices")):
+            return (f"scene {name!r}: objects {str(objects)[:60]}: expected each object's vertex count (> 0), "
+                    f"{r.get('vertices')!r} in all")
     if not (isinstance(cases, list) and all(isinstance(c, dict) for c in cases)):
         return "cases: expected a list of the job's cases"
     pairs = set()
@@ -437,6 +442,15 @@ def frame_faces(job_dir: Path, job: dict, scene: str, k: int, cache: dict | None
         raise FramesError([f"{obj}: {len(faces)} faces: expected {row.get('faces')} (job.json's; the file was "
                            "changed or cut short)"])
     return faces
+
+
+def face_objects(job: dict, scene: str, faces: list) -> np.ndarray:
+    """``(F,)`` int64: the object (0, 1, ... in job.json's ``objects`` of the scene) of each face, that of its
+    first vertex (an object's faces index its own vertices)."""
+    row = next(s for s in job["scenes"] if s["name"] == scene)
+    stops = np.cumsum(row["objects"])
+    first = np.fromiter((f[0] for f in faces), dtype=np.int64, count=len(faces))
+    return np.searchsorted(stops, first, side="right")
 
 
 def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:

@@ -53,7 +53,8 @@ def exported_keys() -> dict:
     full, _files = build_job([load_scene("cube")], frames=1, case_names=["on_axis"], phase=0.5,
                              outputs=("wireframe", "filled", "depth"))
     return {"job": tuple(job), "scene": tuple(job["scenes"][0]), "case": tuple(job["cases"][0]),
-            "motion": tuple(job["motion"]), "outputs_job": tuple(full), "outputs_case": tuple(full["cases"][0])}
+            "motion": tuple(job["motion"]), "outputs_job": tuple(full), "outputs_case": tuple(full["cases"][0]),
+            "outputs_scene": tuple(full["scenes"][0])}
 
 
 def job_keys_problem(job: dict) -> str | None:
@@ -69,7 +70,7 @@ def job_keys_problem(job: dict) -> str | None:
         problem = _keys_problem("motion", job["motion"], keys["motion"], required=("turns",))
     for what in ("scene", "case"):
         rows = job.get(what + "s")
-        expected = keys["outputs_case"] if what == "case" and outputs else keys[what]
+        expected = keys[f"outputs_{what}"] if outputs else keys[what]
         for i, row in enumerate(rows if isinstance(rows, list) else []):
             if problem is None and isinstance(row, dict):
                 problem = _keys_problem(f"{what}s[{i}]", row, expected)

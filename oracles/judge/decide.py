@@ -142,6 +142,9 @@ def filled_reasons(f: dict, tol: Tolerances) -> list[str]:
                    f"{f['extra_px']} extra in all")
     if f["min_iou"] is not None and f["min_iou"] < tol.min_iou:
         out.append(f"filled silhouette IoU {f['min_iou']:.4f} < {tol.min_iou} (frame {f['iou_worst_frame']})")
+    if f.get("object_id_px") is not None and f["object_id_px"] > tol.max_object_id_px:
+        out.append(f"filled frames: {f['object_id_px']} decided pixels show another object's id than the "
+                   f"reference's (> {tol.max_object_id_px}; most in frame {f['object_id_worst_frame']})")
     return out
 
 

@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from . import f1_radius, line_model, metrics
-from ..candidates.frames_candidate import read_frame
+from ..candidates.frames_candidate import face_objects, read_frame
 from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
 from .decide import decide, depth_map_reasons, line_faults, pixel_fields, pixel_rule_reasons, reasons
@@ -172,7 +172,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
                 acc.drawn_px += rec_k["union_px"]
             if filled:                                          # the fill rule's silhouette (filled_frames)
                 rec_k = filled.add(k, Path(job_dir) / c["filled"][i], p_model @ m[:3, :3].T + m[:3, 3], polygons,
-                                   camera, (job_dir, job))
+                                   camera, (job_dir, job), face_objects(job, scene, polygons))
                 acc.drawn_px += rec_k["union_px"]
         del frame
     ahead.close()

@@ -85,19 +85,27 @@ def frames(job_dir: Path):
             yield c, i, Camera(**cam_json["camera"]), v, e, f, np.array(cam_json["model_matrix"])
 
 
-def render_job(job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered, camera=None) -> None:
+def render_job(job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered, camera=None,
+               object_ids=lambda objects: objects) -> None:
     """Write every file the job lists (module docstring); ``mistake(z, camera)`` makes each depth map from core's
     depth, ``filled(covered)`` each filled frame's surface from core's; ``camera`` (one of
-    :data:`CAMERA_MISTAKES`) changes a perspective camera before the faces are drawn."""
+    :data:`CAMERA_MISTAKES`) changes a perspective camera before the faces are drawn. A filled frame of a
+    scene of several objects (job.json's ``objects``: vertex counts) holds grey level ``1 + object_ids(o)``
+    where core shows object ``o``; of one object, 200."""
     job_dir = Path(job_dir)
     job = json.loads((job_dir / "job.json").read_text())
     enc = job.get("depth_encoding") or {}
+    counts = {s["name"]: s.get("objects", [s["vertices"]]) for s in job["scenes"]}
     for c, i, cam, v, e, f, m in frames(job_dir):
         drawn = camera(cam) if camera is not None and cam.projection == "perspective" else cam
         frame = render_frame(v, e, drawn, m, faces=f, style="shaded")
         z = np.where(np.isfinite(frame.depth_image), frame.depth_image, 0.0)
+        stops = np.cumsum(counts[c["scene"]])
+        face_object = np.searchsorted(stops, [face[0] for face in f], side="right")
+        seen = np.where(frame.face_ids >= 0, face_object[np.maximum(frame.face_ids, 0)], -1)
+        level = np.where(seen >= 0, 1 + object_ids(seen), 0) if len(stops) > 1 else np.full(z.shape, 200)
         for key, write in (("frames", lambda p: Image.fromarray(render_frame(v, e, cam, m).image).save(p)),
-                           ("filled", lambda p: Image.fromarray(np.where(filled(z > 0), 200, 0).astype(np.uint8))
+                           ("filled", lambda p: Image.fromarray(np.where(filled(z > 0), level, 0).astype(np.uint8))
                             .save(p)),
                            ("depth", lambda p: _save_depth(p, mistake(z, cam), enc))):
             for rel in (c.get(key) or [])[i:i + 1]:
