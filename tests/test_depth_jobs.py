@@ -204,6 +204,17 @@ def test_a_hand_edited_encoding_is_exit_2(depth_job, tmp_path, capsys, encoding,
     _one_line(capsys, "job.json", needle)
 
 
+def test_hand_edited_objects_are_exit_2(depth_job, tmp_path, capsys):
+    job = fill(copy(depth_job, tmp_path))
+    data = json.loads((job / "job.json").read_text())
+    data["scenes"][0]["objects"] = [4, 3]                  # the cube has 8 vertices
+    (job / "job.json").write_text(json.dumps(data))
+    capsys.readouterr()
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
+    assert code == 2 and report is None
+    _one_line(capsys, "job.json", "objects [4, 3]", "8 in all")
+
+
 def test_a_map_under_another_suffix_than_asked_is_exit_2(depth_job, tmp_path, capsys):
     """The job asks for .npy: a .png beside it is not the job's (and the .npy is missing)."""
     job = fill(copy(depth_job, tmp_path))

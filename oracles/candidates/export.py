@@ -349,7 +349,9 @@ def outputs_readme(job: dict) -> str:
         files.append(f"- `frames/<scene>/<case>/frame_NNNN.png`: the wireframe. {job['image']}. Any line style: "
                      "the judge reads it from the frames (a wireframe-only job's README says how).")
     if "filled" in outputs:
-        files.append(f"- `frames/<scene>/<case>/filled_NNNN.png`: the filled frame. {job['filled_image']}.")
+        files.append(f"- `frames/<scene>/<case>/filled_NNNN.png`: the filled frame. {job['filled_image']} "
+                     "(job.json's `objects` of each scene: its objects' vertex counts, in the OBJ's order; a face "
+                     "belongs to its first vertex's object).")
     if "depth" in outputs:
         ext = DEPTH_FORMATS[enc["format"]]
         what = DEPTH_FORMAT_TEXT[enc["format"]].format(scale=enc["scale"] or 0.0)
