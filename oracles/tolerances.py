@@ -391,13 +391,24 @@ MIN_IOU_UNION_PX = 400
 # coarser snapping (GL allows 4 sub-pixel bits: a vertex may move by 1/32 px) flips centres
 # up to ~0.05 px from an edge, isolated pixels and runs along near-axis-aligned edges: loosen
 # max_silhouette_run_px for it. Scales above 4,096 px make the float32 term larger than 2^-9:
-# a centre may then count as decided where such a renderer is undecided (a false alarm, never
-# a hidden fault), as for lines.
+# with FILL_TIE_PX a centre may then count as decided where a renderer is undecided (a false
+# alarm, never a hidden fault); fill_tie_bound(vertex_scale(...)) widens the zone for such a frame.
 
 #: How far a renderer may move a vertex before deciding coverage (px, Euclidean; derivation above).
 FILL_TIE_PX = 2.0 ** 0.5 * TIE_END_PX
 #: The largest 8-connected set of decided pixels missing or added that passes (derivation above).
 MAX_SILHOUETTE_RUN_PX = 0
+
+
+def fill_tie_bound(scale: float) -> float:
+    """The tie distance (px) for a frame of ``scale`` (:func:`vertex_scale`): FILL_TIE_PX up to 4,096 px.
+
+    ``sqrt(2) (2^-(SUBPIXEL_BITS + 1) + max(2^-9, VERTEX_ROUNDINGS eps32 scale))``: the snap's half
+    step and the float32 rounding of a vertex at that scale, never below the 2^-9 that FILL_TIE_PX
+    assumes (derivation above).
+    """
+    rounding = max(2.0 ** -9, VERTEX_ROUNDINGS * EPS["float32"] * float(scale))
+    return 2.0 ** 0.5 * (2.0 ** -(SUBPIXEL_BITS + 1) + rounding)
 
 
 #: The shaded depth comparison: |z_candidate - z_pyrender| at a pixel covered

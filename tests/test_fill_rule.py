@@ -243,6 +243,12 @@ def test_the_tie_distance_is_the_tolerances():
         tolerances.DEPTH_STEPS, tolerances.DEPTH_SNAP_PX, tolerances.DEPTH_EPS32)
 
 
+def test_face_objects_of_another_length_are_refused():
+    cam = _camera()
+    with pytest.raises(ValueError, match="1 entries for 2 faces"):
+        silhouette(np.eye(4, 3), [(0, 1, 2), (1, 2, 3)], cam, (48, 64), face_objects=[0])
+
+
 def test_a_distorted_camera_is_refused():
     cam = _camera(distortion=(0.1, 0.0, 0.0, 0.0, 0.0), intrinsics=(40.0, 40.0, 31.5, 23.5))
     with pytest.raises(ValueError, match="distorted"):
@@ -271,6 +277,7 @@ def _face_objects(scene) -> np.ndarray:
 FRAMES = 2      # 6 scenes x 7 cameras x 2 frames: 84 frames
 
 
+@pytest.mark.slow
 def test_core_shaded_frames_differ_from_the_reference_only_at_ties(summary_section):
     decided_diff, tie_diff, ties_px, ref_px, n = 0, 0, 0, 0, 0
     for label, scene, cam, (p_world, _m, pr_vertices, pr_pose) in _scene_frames(FRAMES):
@@ -362,3 +369,16 @@ def test_pyrender_object_ids_where_objects_hide_each_other(summary_section):
             n += 1
     summary_section("fill rule: object ids", f"{n} views of 3 overlapping objects: ids equal pyrender's at "
                     f"{decided_ids} decided pixels; {id_ties} id ties")
+
+
+def test_docs_depth_picture_is_what_coverage_gives():
+    # docs/depth.md, "Filled frames: the fill rule and ties": the right triangle's two 5 x 5 pictures
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "depth.md").read_text()
+    lines = text[text.index("inside        ties\n"):].splitlines()[1:6]
+    inside, ties = coverage([[[0, 0], [4, 0], [0, 4]]], (5, 5))
+    for row, line in enumerate(lines):
+        cells = line.split()
+        assert cells[:5] == ["*" if v else "." for v in inside[row]], line
+        assert cells[5:10] == ["t" if v else "." for v in ties[row]], line

@@ -135,9 +135,17 @@ def test_band_pixels_symmetric_and_leaning():
     assert band[:, 4].tolist() == [False, True, True, False, False, False]
 
 
-@pytest.mark.parametrize("e, n, expected", [(0.3, 1, -0.3), (0.3, 2, 0.2), (0.7, 2, -0.2), (2.0, 3, 0.0),
-                                            (0.4, 3, -0.4)])
-def test_run_centroid_offset(e, n, expected):
-    # n = 1 at 0.3: pixel 0, -0.3; n = 2 at 0.3: pixels 0, 1 (mean 0.5), +0.2; at 0.7 the same run, -0.2;
-    # n = 3 at 2.0: 1, 2, 3 (mean 2), 0; at 0.4: -1, 0, 1, -0.4
-    assert lm.run_centroid_offset(np.array([e]), np.array([n]))[0] == pytest.approx(expected)
+def test_band_holding_the_candidates_count():
+    # a horizontal line at y = 2.3 over columns 1..8 (10 x 6): centre distances 0.3 (row 2), 0.7 (row 3),
+    # 1.3 (row 1), 1.7 (row 4) in each column, and more past the ends (round caps)
+    segs = np.array([[[1.0, 2.3], [8.0, 2.3]]])
+    # 16 centres: the 8 columns' rows 2 and 3 (every centre within 0.7; the 17th nearest is a cap's,
+    # column 0 or 9 on row 2, sqrt(1 + 0.09) = 1.04 away) -> h = 0.87, rows 2 and 3 exactly
+    band = lm.band_holding(segs, (6, 10), 16, 1.5)
+    assert band.sum() == 16 and band[2:4, 1:9].all()
+    # 8 centres: row 2 alone (0.3; the 9th is 0.7) -> the 1-px band, whatever width was read
+    band = lm.band_holding(segs, (6, 10), 8, 2.0)
+    assert band.sum() == 8 and band[2, 1:9].all()
+    # no count: the width rounded, 3 -> within 1.5: rows 1-3 of columns 1..8 (24) and each cap's rows 2
+    # and 3 (1.04, sqrt(1 + 0.49) = 1.22; row 1's is sqrt(1 + 1.69) = 1.64 away): 28
+    assert lm.band_holding(segs, (6, 10), 0, 3.0).sum() == 28

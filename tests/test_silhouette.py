@@ -212,3 +212,12 @@ def test_scores_are_frozen():
     assert isinstance(s, SilhouetteScores)
     with pytest.raises(AttributeError):
         s.iou = 0.0
+
+
+def test_the_tie_distance_grows_with_the_frame_scale_past_4096_px():
+    from wirecheck.oracles import tolerances
+
+    # up to 4,096 px the float32 rounding (4 eps32 scale) is within the 2^-9 FILL_TIE_PX assumes
+    assert tolerances.fill_tie_bound(0.0) == tolerances.fill_tie_bound(4096.0) == tolerances.FILL_TIE_PX
+    # at 2^16 px: 4 x 2^-23 x 2^16 = 2^-5 of rounding, plus the 2^-9 snap, times sqrt 2
+    assert tolerances.fill_tie_bound(2.0 ** 16) == pytest.approx(math.sqrt(2) * (2 ** -9 + 2 ** -5), rel=1e-15)

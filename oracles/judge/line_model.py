@@ -47,8 +47,8 @@ from wirecheck.core.projector.raster import line_pixels
 
 from ..tolerances import ROUNDED_END_TIE_PX
 
-__all__ = ["RULES", "END_TIE_PX", "rounded_pixels", "rounded_ties", "expected", "band_pixels",
-           "run_centroid_offset"]
+__all__ = ["RULES", "END_TIE_PX", "rounded_pixels", "rounded_ties", "expected", "band_distances",
+           "band_pixels", "band_holding"]
 
 #: The aliased rules the model draws (module docstring).
 RULES = ("gl", "rounded")
@@ -244,40 +244,54 @@ def expected(segs_px: np.ndarray, shape, rule: str = "gl", end_tie_px: float = E
     return drawn, rounded_ties(segs_px, shape, end_tie_px)
 
 
-def band_pixels(segs_px: np.ndarray, shape, width_px: float, lean_px: float = 0.0) -> np.ndarray:
-    """``(H, W)`` bool: the pixel centres within ``width_px / 2`` of each segment, moved ``lean_px`` along
-    its left normal ``(dy, -dx) / |d|`` (a binary band of width ``w``; 0: symmetric). Distances are to the
-    segment (an end's cap is round)."""
+def band_distances(segs_px: np.ndarray, shape, reach_px: float, lean_px: float = 0.0) -> np.ndarray:
+    """``(H, W)`` float: each pixel centre's distance to the nearest segment, where it is within ``reach_px``
+    (beyond: inf); each segment moved ``lean_px`` along its left normal ``(dy, -dx) / |d|``. Distances are
+    to the segment (an end's cap is round)."""
     h, w = shape
-    img = np.zeros(shape, bool)
-    half = width_px / 2.0
+    dist = np.full(shape, np.inf)
     for a, b in np.asarray(segs_px, dtype=np.float64).reshape(-1, 2, 2):
         d = b - a
         length = float(np.hypot(*d))
         normal = np.array([d[1], -d[0]]) / length if length > 0 else np.zeros(2)
         a, b = a + lean_px * normal, b + lean_px * normal
-        lo = np.maximum(np.floor(np.minimum(a, b) - half), 0).astype(int)
-        hi = np.minimum(np.ceil(np.maximum(a, b) + half), [w - 1, h - 1]).astype(int)
+        lo = np.maximum(np.floor(np.minimum(a, b) - reach_px), 0).astype(int)
+        hi = np.minimum(np.ceil(np.maximum(a, b) + reach_px), [w - 1, h - 1]).astype(int)
         if np.any(hi < lo):
             continue
         yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
         q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
         t = np.clip(((q - a) @ d) / max(length * length, 1e-300), 0.0, 1.0)
-        near = np.hypot(*(q - (a + t[:, None] * d)).T) <= half
-        img[yy.ravel()[near], xx.ravel()[near]] = True
-    return img
+        near = np.hypot(*(q - (a + t[:, None] * d)).T).reshape(yy.shape)
+        window = dist[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
+        np.minimum(window, near, out=window)
+    return dist
 
 
-def run_centroid_offset(exact_minor: np.ndarray, n_px: np.ndarray) -> np.ndarray:
-    """``(M,)`` float: where a correct run of ``n_px`` binary pixels across a line centres, less the line.
+def band_pixels(segs_px: np.ndarray, shape, width_px: float, lean_px: float = 0.0) -> np.ndarray:
+    """``(H, W)`` bool: the pixel centres within ``width_px / 2`` of each segment, moved ``lean_px`` along
+    its left normal ``(dy, -dx) / |d|`` (a binary band of width ``w``; 0: symmetric). Distances are to the
+    segment (an end's cap is round)."""
+    return band_distances(segs_px, shape, width_px / 2.0, lean_px) <= width_px / 2.0
 
-    Of the runs of ``n`` consecutive pixel centres along the minor axis, a drawing centred on the line at
-    minor coordinate ``e`` takes the one whose mean is nearest ``e``: mean ``round(e - (n - 1) / 2) + (n -
-    1) / 2``. Its offset from ``e`` lies in ``[-1/2, 1/2]`` and is 0 on average over ``e``; a band of any
-    width centred on the line measures exactly this, so subtracting it reads such a band at 0. At an
-    exact tie (``e - (n - 1) / 2`` on a half) the run below is taken (``+1/2``; :mod:`oracles.judge.line_ties`
-    folds either choice to 0).
+
+def band_holding(segs_px: np.ndarray, shape, count: int, width_px: float) -> np.ndarray:
+    """``(H, W)`` bool: the binary band around the segments that holds ``count`` pixel centres.
+
+    A band of half-width ``h`` centred on the lines is every centre within ``h`` of them. Where the lines
+    sit at one fractional position (square-on), bands of widths up to a pixel apart hold the same centres,
+    so a width read from pixel counts (2 for a 1.5 px band at some positions) does not say which ``h``
+    drew them. Of the bands centred on the lines, the one holding ``count`` centres (``h`` halfway between
+    the ``count``-th nearest centre's distance and the next's, searched within ``width_px / 2 + 1`` px) is
+    the drawing a renderer centred on them made with that many pixels: its centres are the candidate's
+    when the candidate's band is centred, and a band moved off the lines holds other centres. Where fewer
+    than ``count`` centres lie within reach, or ``count`` < 1: the band of ``width_px`` rounded.
     """
-    e = np.asarray(exact_minor, dtype=np.float64)
-    half = (np.maximum(np.asarray(n_px), 1) - 1) / 2.0
-    return np.floor(e - half + 0.5) + half - e
+    half = round(width_px) / 2.0
+    reach = max(half, width_px / 2.0) + 1.0
+    dist = band_distances(segs_px, shape, reach)
+    if count >= 1:
+        near = np.sort(dist[dist <= reach])
+        if len(near) >= count:
+            half = (near[count - 1] + (near[count] if len(near) > count else reach)) / 2.0
+    return dist <= half

@@ -77,11 +77,10 @@ import numpy as np
 
 from .. import faults as catalogue
 from .. import tolerances
-from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
+from . import coverage_pixels, even_lean, free_ends, line_model, line_ties, line_windows
 from ..diagnosis.diagnose import diagnose_lines
 from .case_samples import CaseSamples
 from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
-from ..segment_geometry import seg_distance
 from ..diagnosis.image_diagnose import oracle_segments
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
@@ -225,31 +224,22 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
     return x[:2], x[2:].reshape(2, 2)
 
 
-def _reference(segs: np.ndarray, shape, width_px: float, clipped=None) -> np.ndarray:
-    """A correct binary drawing of ``segs``: core's raster (1 px) or pixel centres within half the width.
+def _reference(segs: np.ndarray, shape, width_px: float, clipped=None, drawn: int = 0) -> np.ndarray:
+    """A correct binary drawing of ``segs``: core's raster (1 px), or a band centred on them holding the
+    candidate's ``drawn`` pixels (oracles.judge.line_model.band_holding; ``drawn`` 0: the width rounded).
 
     ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
     """
     h, w = shape
-    img = np.zeros(shape, bool)
     if len(segs) == 0:
-        return img
+        return np.zeros(shape, bool)
     if width_px < WIDE_MIN_PX:
+        img = np.zeros(shape, bool)
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h) if clipped is None else clipped
         rr, cc = raster.line_pixels(q0, q1, w, h)
         img[rr, cc] = True
         return img
-    half = round(width_px) / 2.0
-    for a, b in segs:
-        lo = np.maximum(np.floor(np.minimum(a, b) - half), 0).astype(int)
-        hi = np.minimum(np.ceil(np.maximum(a, b) + half), [w - 1, h - 1]).astype(int)
-        if np.any(hi < lo):
-            continue
-        yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
-        q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
-        near = seg_distance(q, a[None], b[None])[:, 0] <= half
-        img[yy.ravel()[near], xx.ravel()[near]] = True
-    return img
+    return line_model.band_holding(segs, shape, drawn, width_px)
 
 
 def _off_by_one(fp, ends: np.ndarray) -> dict:
@@ -345,7 +335,8 @@ class CaseStyle:
             self.drawn_px += (len(cand), int(np.count_nonzero(orac)))      # binary: pixels drawn, the oracle's
             width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
             same = grey.shape == (camera.height, camera.width)          # the clipping above is the reference's
-            ref = measure(_reference(segs, grey.shape, width, clipped if same else None), segs, wins=wins)
+            ref = measure(_reference(segs, grey.shape, width, clipped if same else None, drawn=len(cand)),
+                          segs, wins=wins)
             for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
                 line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
             self.reference.add(ref)

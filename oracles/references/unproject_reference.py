@@ -12,7 +12,8 @@ built from the camera's own vectors, not from core), in float64::
 
 (``u, v`` in pixel-centre coordinates, core.conventions.) A camera with lens distortion
 has its pixels undistorted first by OpenCV's ``cv2.undistortPointsIter`` to the normalised
-``(x_cv / z, y_cv / z)`` (:func:`undistort`), iterated to :data:`UNDISTORT_EPS`.
+``(x_cv / z, y_cv / z)`` (:func:`undistort`), iterated to :data:`UNDISTORT_EPS` (OpenCV 5 has no
+``undistortPointsIter``: the same iteration is ``cv2.undistortPoints(..., criteria=)`` there).
 """
 
 from __future__ import annotations
@@ -40,7 +41,10 @@ def undistort(p_px: np.ndarray, camera) -> np.ndarray:
     if len(pts) == 0:
         return np.zeros((0, 2))
     criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, UNDISTORT_ITERATIONS, UNDISTORT_EPS)
-    out = cv2.undistortPointsIter(pts, k, distortion_coefficients(camera), None, None, criteria)
+    if hasattr(cv2, "undistortPointsIter"):        # OpenCV 4's name for undistortPoints with a criterion
+        out = cv2.undistortPointsIter(pts, k, distortion_coefficients(camera), None, None, criteria)
+    else:                                           # OpenCV 5 folded it in (equal to the last bit: docs/depth.md)
+        out = cv2.undistortPoints(pts, k, distortion_coefficients(camera), R=None, P=None, criteria=criteria)
     return out.reshape(-1, 2)
 
 

@@ -20,8 +20,12 @@ def _normalised(pixels, camera, cx=None, cy=None, fx=None, fy=None):
         return (pixels[:, 0] - cx) / fx, (pixels[:, 1] - cy) / fy
     if camera.distortion is not None:
         criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
-        xy = cv2.undistortPointsIter(pixels.reshape(-1, 1, 2), k, np.array(camera.distortion), None, None,
-                                     criteria).reshape(-1, 2)
+        if hasattr(cv2, "undistortPointsIter"):
+            xy = cv2.undistortPointsIter(pixels.reshape(-1, 1, 2), k, np.array(camera.distortion), None, None,
+                                         criteria).reshape(-1, 2)
+        else:                       # OpenCV 5: undistortPoints takes the criterion itself
+            xy = cv2.undistortPoints(pixels.reshape(-1, 1, 2), k, np.array(camera.distortion), R=None, P=None,
+                                     criteria=criteria).reshape(-1, 2)
         return xy[:, 0], xy[:, 1]
     return (pixels[:, 0] - cx) / fx, (pixels[:, 1] - cy) / fy
 
