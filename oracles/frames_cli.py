@@ -33,8 +33,9 @@ def _fail(message: str) -> int:
 
 
 def export_main(argv) -> int:
-    """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z] [--phase F]``."""
-    from .candidates.export import write_job
+    """``crosscheck export DIR [--scene S]... [--frames N] [--every K] [--cases A,B] [--spin X,Y,Z] [--phase F]
+    [--outputs wireframe,filled,depth] [--depth-format npy|png16|tiff] [--depth-scale S]``."""
+    from .candidates.export import check_outputs, write_job
 
     p = OneLineParser(prog="crosscheck export",
                 description="write a rendering job (scenes as OBJ, a camera JSON per case and frame, a README) "
@@ -48,6 +49,14 @@ def export_main(argv) -> int:
     p.add_argument("--phase", type=plain_float, default=0.0, metavar="F",
                    help="move every frame on by F of a frame's step, 0 <= F < 1: frame k at t = (k - 1 + F) / "
                         "frames (default 0: crosscheck's own poses; 0.3: no frame of --frames 4 is a quarter turn)")
+    p.add_argument("--outputs", default="wireframe", metavar="LIST",
+                   help="what the renderer writes per frame, comma-separated: wireframe, filled, depth "
+                        "(default wireframe; e.g. wireframe,depth or filled,depth)")
+    p.add_argument("--depth-format", default=None, choices=("npy", "png16", "tiff"),
+                   help="the depth maps' file: npy (float32), png16 (16-bit PNG, --depth-scale values per "
+                        "world unit) or tiff (32-bit float) (default npy)")
+    p.add_argument("--depth-scale", type=plain_float, default=None, metavar="S",
+                   help="values per world unit of a png16 depth map (default 1000: millimetres per metre)")
     args = p.parse_args(argv)
     try:
         from wirecheck.core.outputs.output import check_outside_scenes, claim
@@ -68,6 +77,15 @@ def export_main(argv) -> int:
             spin = ()
         if len(spin) != 3 or not all(math.isfinite(x) for x in spin):
             raise InputError(f"--spin {args.spin!r}: expected three finite numbers X,Y,Z")
+        depth_format = args.depth_format or "npy"
+        depth_scale = 1000.0 if args.depth_scale is None else args.depth_scale
+        outputs = check_outputs(args.outputs, depth_format, depth_scale)
+        if args.depth_format is not None and "depth" not in outputs:
+            raise InputError(f"--depth-format {args.depth_format} with --outputs {args.outputs!r}: expected "
+                             "--outputs with depth (the format is the depth maps')")
+        if args.depth_scale is not None and depth_format != "png16":
+            raise InputError(f"--depth-scale {args.depth_scale!r} with --depth-format {depth_format}: expected "
+                             "--depth-format png16 (a scale is a 16-bit PNG's; float maps hold world units)")
         out = Path(args.dir)
         if not out.parent.is_dir():
             raise InputError(f"export {args.dir!r}: its parent folder does not exist")
@@ -78,13 +96,15 @@ def export_main(argv) -> int:
         claim(out, "export DIR")        # the target first, held to the end: nothing is built for a refused one
         scenes = [load_scene(n) for n in (args.scene or builtin_names())]
         job = write_job(out, scenes, frames=args.frames, every=args.every, case_names=cases,
-                        motion=Motion(turns=spin), phase=args.phase)
+                        motion=Motion(turns=spin), phase=args.phase, outputs=outputs,
+                        depth_format=depth_format, depth_scale=depth_scale)
     except InputError as exc:
         return _fail(str(exc))
     except OSError as exc:
         return _fail(f"export {args.dir!r}: cannot write there ({exc})")
-    n = sum(len(c["frames"]) for c in job["cases"])
-    print(f"Job: {out} ({len(job['cases'])} cases, {n} frames to draw; see {out / 'README.md'})")
+    n = len(job["cases"]) * len(job["frame_numbers"])
+    asked = "" if outputs == ("wireframe",) else f" ({', '.join(outputs)} each)"
+    print(f"Job: {out} ({len(job['cases'])} cases, {n} frames to draw{asked}; see {out / 'README.md'})")
     print(f"Then: crosscheck --candidate-frames {out}")
     return 0
 
@@ -172,9 +192,18 @@ def verdict_line(report: dict, tol) -> str:
     def f1(v) -> str:
         return "-" if v is None else f"{v:.4f}"
 
+    outputs = report.get("outputs", ["wireframe"])
+    limits = [f"F1@1px >= {tol.min_f1_1px}, {f1_0px_clause(report['cases'], tol.min_f1_0px)}"] \
+        if "wireframe" in outputs else []
+    limits += [f"filled IoU >= {tol.min_iou}, runs of decided pixels missing or added <= "
+               f"{tol.max_silhouette_run_px}"] if "filled" in outputs else []
+    limits += [f"depth error <= {tol.max_depth_error_ratio:g} x its bound, holes <= {tol.max_surface_holes_px}, "
+               f"extra <= {tol.max_surface_extra_px} px away from the silhouette's boundary"] \
+        if "depth" in outputs else []
+    core = (f"; against core: F1@0px >= {f1(s['min_core_f1_0px'])}, F1@1px >= {f1(s['min_core_f1_1px'])}"
+            if "wireframe" in outputs else "")
     return (f"{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "
-            f"(F1@1px >= {tol.min_f1_1px}, {f1_0px_clause(report['cases'], tol.min_f1_0px)}); against core: F1@0px >= "
-            f"{f1(s['min_core_f1_0px'])}, F1@1px >= {f1(s['min_core_f1_1px'])}")
+            f"({', '.join(limits)}){core}")
 
 
 def f1_0px_clause(cases: list, min_f1_0px: float) -> str:

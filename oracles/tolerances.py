@@ -453,6 +453,33 @@ DEPTH_BOUND_TEXT = (f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 /
                     f" + {DEPTH_EPS32:g} eps32 z")
 
 
+# ---- A renderer's depth maps and filled frames (crosscheck export --outputs ...,depth,filled), judged by the
+# frames judge (oracles.judge.depth_frames, oracles.judge.filled_frames) against pyrender's faces.
+
+#: A depth map's value at a pixel where both it and the reference show a decided surface must lie within
+#: this many allowances of the reference's, the allowance being the reference's per-pixel bound (DEPTH_STEPS
+#: above: the 24-bit buffer, llvmpipe's snapping, float32 geometry) plus the map's encoding step (one
+#: float32 ulp, or 1 / scale for a 16-bit PNG: oracles.candidates.depth_map). The bound is already a worst
+#: case (core's depth against pyrender's measured 0.59 of it at most, docs/depth.md), so 1: the depth
+#: diagnosis' own pass rule (oracles.diagnosis.depth_faults).
+MAX_DEPTH_ERROR_RATIO = 1.0
+#: Reference surface a depth map leaves empty (holes), and surface it shows where the reference has none
+#: (extra), counted away from the reference silhouette's boundary: a pixel whose eight neighbours are all
+#: covered (all uncovered) by the reference has its centre more than half a pixel from any silhouette
+#: edge, far beyond the 1/256 px snapping that decides a boundary pixel (MIN_SILHOUETTE_IOU's derivation),
+#: so a correct renderer leaves none: 0. Core's depth buffer, drawn from a job's own files, measured 0 and
+#: 0 (tests/test_depth_jobs.py). (Filled frames are held to the fill rule's decided pixels instead:
+#: MAX_SILHOUETTE_RUN_PX below.)
+MAX_SURFACE_HOLES_PX = 0
+MAX_SURFACE_EXTRA_PX = 0
+#: A filled frame of several objects: decided pixels whose grey level reads as another object than the
+#: fill rule's nearest (oracles.judge.filled_frames.object_id_misses). The reference leaves out the pixels
+#: where two objects' depths are within their depth bounds (fill_rule.ID_TIE: either is correct) and the
+#: coverage ties, so a correct renderer shows the reference's object everywhere else: 0 (measured: pyrender's
+#: ids equal the reference's at every decided pixel of 3 views of 3 overlapping objects, tests/test_fill_rule.py).
+MAX_OBJECT_ID_PX = 0
+
+
 # ---- The geometry of a renderer's lines, measured from its frames (oracles.judge.line_style,
 # oracles.diagnosis.image_diagnose): thresholds that decide a verdict or a name on the frames path.
 # They were module constants of those modules; they are Tolerances' fields so a run can set them.
@@ -516,6 +543,10 @@ class Tolerances:
     end_px: float = END_TOL_PX
     rounded_end_tie_px: float = ROUNDED_END_TIE_PX
     rule_f1_0px: float = RULE_F1_0PX
+    max_depth_error_ratio: float = MAX_DEPTH_ERROR_RATIO
+    max_surface_holes_px: int = MAX_SURFACE_HOLES_PX
+    max_surface_extra_px: int = MAX_SURFACE_EXTRA_PX
+    max_object_id_px: int = MAX_OBJECT_ID_PX
     fill_tie_px: float = FILL_TIE_PX
     max_silhouette_run_px: int = MAX_SILHOUETTE_RUN_PX
 
@@ -534,6 +565,14 @@ class Tolerances:
                 "min_pixel_f1_1px": self.min_f1_1px,
                 "min_pixel_f1_0px": self.min_f1_0px, "balance_alpha": self.balance_alpha,
                 "max_imbalance_fraction": self.max_imbalance, "max_edge_count_diff": self.max_edge_count_diff}
+
+    def surfaces_dict(self) -> dict:
+        """The limits of a job's depth maps and filled frames, as the report's ``tolerances`` adds them."""
+        return {"max_depth_error_ratio": self.max_depth_error_ratio, "depth_error": DEPTH_BOUND_TEXT
+                + " + the map's encoding step", "max_surface_holes_px": self.max_surface_holes_px,
+                "max_surface_extra_px": self.max_surface_extra_px, "min_silhouette_iou": self.min_iou,
+                "min_iou_union_px": MIN_IOU_UNION_PX, "fill_tie_px": self.fill_tie_px,
+                "max_silhouette_run_px": self.max_silhouette_run_px, "max_object_id_px": self.max_object_id_px}
 
     def lines_dict(self) -> dict:
         """The frames path's line-geometry limits, as the report's ``tolerances`` adds them."""

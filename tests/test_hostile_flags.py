@@ -82,6 +82,7 @@ EXPORT_FLAGS = [
     ("--every", "-inf", [], "invalid int value"),
     ("--phase", "-1e5", [], "expected a number in [0, 1)"),
     ("--spin", "-inf,0,0", [], "expected three finite numbers X,Y,Z"),
+    ("--depth-scale", "-1e3", [], "expected a finite number of values per world unit > 0"),
 ]
 
 

@@ -71,8 +71,7 @@ class DepthMap:
 
     def encoding_bound(self) -> np.ndarray:
         """``(H, W)`` float64: how far the encoding alone may move a depth, ``step + rel_step |d|`` (0 where none)."""
-        d = np.nan_to_num(self.depth, nan=0.0)
-        return self.step + self.rel_step * np.abs(d)
+        return self.step + self.rel_step * np.where(np.isnan(self.depth), 0.0, np.abs(self.depth))
 
 
 def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCALE) -> DepthMap:

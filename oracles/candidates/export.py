@@ -8,6 +8,15 @@ The job is a folder::
     DIR/scenes/<scene>/frame_0001.obj    instead, for a scene of several moving objects: world space per frame
     DIR/cameras/<scene>/<case>/frame_0001.json   the camera and model matrix of one frame
     DIR/frames/<scene>/<case>/frame_0001.png     written by the renderer (not by export)
+    DIR/frames/<scene>/<case>/filled_0001.png    the same, for a job asking for filled frames
+    DIR/frames/<scene>/<case>/depth_0001.npy     the same, for a job asking for depth maps (.npy, .png, .tif)
+
+A job asks for ``outputs`` (:data:`OUTPUTS`): wireframes (the default, and the only
+output of a job.json without an ``outputs`` key), filled frames, depth maps, or any
+of them together. A job that asks for more than wireframes lists, per case, its
+``depth`` and ``filled`` files beside ``frames`` (empty when wireframes are not
+asked for) and states the depth maps' ``depth_encoding``: format
+(:data:`DEPTH_FORMATS`) and, for a 16-bit PNG, its scale in values per world unit.
 
 A frame's JSON holds the camera in every form a renderer may want: the
 fields of the candidate contract (:mod:`oracles.candidates.candidate`), OpenCV's ``K, R,
@@ -29,6 +38,7 @@ the scene at oblique poses; its frames are then not crosscheck's own. ``oracles.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -66,11 +76,47 @@ IMAGE_RULE = {
                  "1-px aliased (held to GL's pixel rule), or anti-aliased, or up to ~3 px wide (judged by where "
                  "the lines' centres are); a pixel's luminance over black (luminance x alpha / 255) is its "
                  "coverage, and it counts as drawn when >= 128 (a transparent pixel is not drawn)",
+    "filled": "PNG, the camera's width x height, black background, every face's visible part filled in any "
+              "non-black colour (a pixel shows a surface when its centre is inside a face, as GL fills "
+              "triangles; it counts as filled when its luminance x alpha / 255 is 1 or more); with several "
+              "objects one id per object, as a grey level (1, 2, ...); no lines, no shading needed",
+    "depth": "the camera's width x height, row 0 at the top, each pixel the depth along the camera's forward "
+             "(z_cam: not the distance along the ray, not the GL depth buffer's [0, 1] value) of the nearest "
+             "visible face at the pixel centre, in world units; 0, NaN or +inf where no face is seen",
 }
 
 
-def frame_name(k: int, ext: str) -> str:
-    return f"frame_{k:04d}.{ext}"
+#: What a job may ask a renderer to write per frame, in the order job.json lists them.
+OUTPUTS = ("wireframe", "filled", "depth")
+#: Depth map formats a job may ask for: the file's suffix (oracles.candidates.depth_map reads each).
+DEPTH_FORMATS = {"npy": "npy", "png16": "png", "tiff": "tif"}
+#: What each depth format holds, for the README.
+DEPTH_FORMAT_TEXT = {
+    "npy": "a 2-D float32 NumPy array (`numpy.save`), shape (height, width), depth in world units",
+    "png16": "a 16-bit grey PNG, each value `round(depth x scale)` (scale {scale:g} per world unit), "
+             "values up to 65535",
+    "tiff": "a 32-bit float TIFF (one channel, Pillow's mode F), depth in world units",
+}
+
+
+def frame_name(k: int, ext: str, kind: str = "frame") -> str:
+    """A frame's file name: ``frame_0001.png`` (``kind``: ``"frame"``, ``"depth"``, ``"filled"``)."""
+    return f"{kind}_{k:04d}.{ext}"
+
+
+def output_files(scene: str, case: str, checked, outputs, depth_format: str = "npy") -> dict:
+    """The files a case's renderer writes, per output: ``{"frames": [...], "filled": [...], "depth": [...]}``
+    (``frames``: the wireframes; a list is empty when its output is not asked for)."""
+    where = f"frames/{scene}/{case}"
+    ext = DEPTH_FORMATS[depth_format]
+    return {"frames": [f"{where}/{frame_name(k, 'png')}" for k in checked] if "wireframe" in outputs else [],
+            "filled": [f"{where}/{frame_name(k, 'png', 'filled')}" for k in checked] if "filled" in outputs else [],
+            "depth": [f"{where}/{frame_name(k, ext, 'depth')}" for k in checked] if "depth" in outputs else []}
+
+
+def job_outputs(job: dict) -> tuple:
+    """What a (checked) job asks for: its ``outputs``, wireframes alone when it has none."""
+    return tuple(job.get("outputs", ("wireframe",)))
 
 
 def matrix_rows(m) -> list:
@@ -102,10 +148,34 @@ def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames
             "conventions": "see job.json (conventions); wirecheck.core.conventions states them once"}
 
 
+def check_outputs(outputs, depth_format: str = "npy", depth_scale: float = 1000.0) -> tuple:
+    """``outputs`` (a list or a comma-separated string) in :data:`OUTPUTS` order; InputError naming the
+    option for an unknown or repeated output, a depth format not in :data:`DEPTH_FORMATS`, or a PNG scale
+    that is not a finite number > 0 with 65535 / scale finite."""
+    given = [o.strip() for o in outputs.split(",")] if isinstance(outputs, str) else list(outputs)
+    bad = [o for o in given if o not in OUTPUTS]
+    if bad or not given or len(set(given)) != len(given):
+        why = f"unknown {', '.join(map(repr, bad))}" if bad else ("none given" if not given else "one given twice")
+        raise InputError(f"--outputs {','.join(map(str, given))!r}: {why}: expected one or more of "
+                         f"{', '.join(OUTPUTS)}, each once (e.g. wireframe,depth)")
+    if depth_format not in DEPTH_FORMATS:
+        raise InputError(f"--depth-format {depth_format!r}: expected one of {', '.join(DEPTH_FORMATS)}")
+    if not (isinstance(depth_scale, (int, float)) and not isinstance(depth_scale, bool)
+            and math.isfinite(depth_scale) and depth_scale > 0 and math.isfinite(65535.0 / depth_scale)):
+        raise InputError(f"--depth-scale {depth_scale!r}: expected a finite number of values per world unit > 0 "
+                         "(1000: millimetres per metre)")
+    return tuple(o for o in OUTPUTS if o in given)
+
+
 def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=None,
-              phase: float = 0.0) -> tuple[dict, dict]:
+              phase: float = 0.0, outputs=("wireframe",), depth_format: str = "npy",
+              depth_scale: float = 1000.0) -> tuple[dict, dict]:
     """The manifest and the files of a job: ``(job, {relative path: bytes})``; ``phase``: module docstring
-    (0: crosscheck's own poses, and job.json without a ``motion.phase``)."""
+    (0: crosscheck's own poses, and job.json without a ``motion.phase``). ``outputs``: what the renderer
+    writes (:data:`OUTPUTS`; wireframes alone: job.json as before, without ``outputs``); ``depth_format``
+    and ``depth_scale`` (values per world unit of a 16-bit PNG): its depth maps' encoding."""
+    outputs = check_outputs(outputs, depth_format, depth_scale)
+    plain = outputs == ("wireframe",)
     motion = motion or Motion()
     files: dict[str, bytes] = {}
     scene_rows, case_rows = [], []
@@ -120,7 +190,10 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
         scene_rows.append({"name": scene.name, "space": "model" if single else "world per frame",
                            "obj": f"scenes/{scene.name}.obj" if single else f"scenes/{scene.name}/frame_NNNN.obj",
                            "vertices": int(len(scene.vertices)), "edges": int(len(scene.edges)),
-                           "faces": len(faces)})
+                           "faces": len(faces),
+                           # the objects' vertex counts, in the OBJ's order: a face is its first vertex's object
+                           **({} if plain else {"objects": [int(o.vertex_stop - o.vertex_start)
+                                                            for o in scene.objects]})})
         cases = cases_for(scene, motion, calibrated=True)
         scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
         geometry = {}
@@ -139,14 +212,19 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
             for k in checked:
                 files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
                     camera_json(case.camera, geometry[k], scene.name, case.name, k, frames, phase)).encode()
+            written = output_files(scene.name, case.name, checked, outputs, depth_format)
             case_rows.append({"scene": scene.name, "case": case.name, "width": case.camera.width,
-                              "height": case.camera.height,
-                              "frames": [f"frames/{scene.name}/{case.name}/{frame_name(k, 'png')}" for k in checked]})
+                              "height": case.camera.height, "frames": written["frames"],
+                              **({} if plain else {"filled": written["filled"], "depth": written["depth"]})})
     job = {"kind": JOB_KIND, "version": JOB_VERSION, "style": "wireframe", "frames": frames, "every": every,
            "frame_numbers": checked,
            "motion": {"turns": list(motion.turns), **({"phase": float(phase)} if phase else {})},
            "image": IMAGE_RULE["wireframe"], "conventions": CONVENTIONS,
            "scenes": scene_rows, "cases": case_rows}
+    if not plain:
+        job.update(outputs=list(outputs), filled_image=IMAGE_RULE["filled"], depth_image=IMAGE_RULE["depth"],
+                   depth_encoding={"format": depth_format,
+                                   "scale": float(depth_scale) if depth_format == "png16" else None})
     files["job.json"] = json_dumps(job).encode()
     files["README.md"] = readme(job).encode()
     return job, files
@@ -199,6 +277,8 @@ image), more frames, or a number of frames that is not a multiple of 4 (e.g.
 
 
 def readme(job: dict) -> str:
+    if job_outputs(job) != ("wireframe",):
+        return outputs_readme(job)
     n_frames = sum(len(c["frames"]) for c in job["cases"])
     first = job["cases"][0]
     return f"""# A wirecheck rendering job
@@ -257,10 +337,79 @@ lines read as `pixel_offset` (-0.5, -0.5).
 """ + short_job_note(job)
 
 
+def outputs_readme(job: dict) -> str:
+    """The README of a job asking for filled frames or depth maps (beside wireframes or instead of them)."""
+    outputs = job_outputs(job)
+    first = job["cases"][0]
+    n = len(job["frame_numbers"])
+    enc = job["depth_encoding"]
+    asked = {"wireframe": "wireframes", "filled": "filled frames", "depth": "depth maps"}
+    files = []
+    if "wireframe" in outputs:
+        files.append(f"- `frames/<scene>/<case>/frame_NNNN.png`: the wireframe. {job['image']}. Any line style: "
+                     "the judge reads it from the frames (a wireframe-only job's README says how).")
+    if "filled" in outputs:
+        files.append(f"- `frames/<scene>/<case>/filled_NNNN.png`: the filled frame. {job['filled_image']} "
+                     "(job.json's `objects` of each scene: its objects' vertex counts, in the OBJ's order; a face "
+                     "belongs to its first vertex's object).")
+    if "depth" in outputs:
+        ext = DEPTH_FORMATS[enc["format"]]
+        what = DEPTH_FORMAT_TEXT[enc["format"]].format(scale=enc["scale"] or 0.0)
+        files.append(f"- `frames/<scene>/<case>/depth_NNNN.{ext}`: the depth map, {what}; "
+                     f"{job['depth_image']}.")
+    listed = next(c for c in (first["frames"], first["filled"], first["depth"]) if c)
+    return f"""# A wirecheck rendering job
+
+Render every frame listed below with your renderer, writing its
+{', '.join(asked[o] for o in outputs)}, then run
+
+    crosscheck --candidate-frames THIS_FOLDER
+
+to have them judged against pyrender (OpenGL): wireframes as a wireframe job's
+(edge-pixel F1, line balance and counts); filled frames by their silhouette
+against the faces GL fills (IoU, pixels one side fills away from the other's
+boundary); depth maps against pyrender's depth made linear in float64, each
+pixel within its bound (24-bit depth steps, the encoding's own step), the
+surface the map leaves empty (holes) and the surface it shows where the
+reference has none (extra) counted; and, when something is off, the name of
+the fault (a stored z-buffer, range for depth, a scale such as millimetres
+read as metres, an offset, reversed-Z, half floats, rows flipped, a
+half-pixel principal point, K from the horizontal FOV).
+
+## What to render
+
+- {len(job['cases'])} cases (a scene under a camera), {n} frame{'s' if n != 1 else ''} each.
+- Scenes: `scenes/<scene>.obj` (model space: `v` vertices, `l` edges, `f`
+  faces, 1-based). Wireframes draw the `l` edges; filled frames and depth
+  maps render the `f` faces (both sides: no back-face culling).
+- Cameras: `cameras/<scene>/<case>/frame_NNNN.json` gives the camera as
+  position/forward/up/fov_y_deg/width/height/near/far/projection/ortho_height,
+  as OpenCV `K`, `R`, `t_cv`, and as OpenGL `gl_view` and `gl_projection`, and
+  the frame's `model_matrix` (p_world = model_matrix @ [v, 1]). Matrices are
+  rows, for column vectors. The conventions are in `job.json` (`conventions`).
+- Clip at the near and far planes (depth along `forward` in [near, far]).
+
+## What to write, and where
+
+Every file below, for every frame number of the camera files, at its
+camera's size (e.g. `{listed[0]}`, {first['width']} x {first['height']});
+job.json lists each one (`frames`, `filled`, `depth` of each case):
+
+{chr(10).join(files)}
+
+A missing file, one of the wrong size or of another encoding is an input
+error (exit 2), never a pass; so is a file under `frames/` that job.json does
+not list.
+
+""" + short_job_note(job)
+
+
 def write_job(out_dir: Path, scenes, frames: int = 24, every: int = 1, case_names=None, motion=None,
-              phase: float = 0.0) -> dict:
+              phase: float = 0.0, outputs=("wireframe",), depth_format: str = "npy",
+              depth_scale: float = 1000.0) -> dict:
     """Write the job to ``out_dir`` atomically (a temporary folder renamed over it); the manifest."""
-    job, files = build_job(scenes, frames=frames, every=every, case_names=case_names, motion=motion, phase=phase)
+    job, files = build_job(scenes, frames=frames, every=every, case_names=case_names, motion=motion, phase=phase,
+                           outputs=outputs, depth_format=depth_format, depth_scale=depth_scale)
     out_dir = Path(out_dir)
     out = FrameDir(out_dir, "export DIR")
     try:

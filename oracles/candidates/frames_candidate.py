@@ -1,7 +1,8 @@
 """``crosscheck --candidate-frames DIR``: a renderer's frames job, read and checked.
 
 ``DIR`` is a job written by :mod:`oracles.candidates.export` with the renderer's PNGs
-under ``frames/``. This module reads and checks the job (its manifest, OBJ,
+under ``frames/`` (and, for a job that asks for them, its filled frames and depth maps
+there too: job.json's ``filled`` and ``depth`` of each case). This module reads and checks the job (its manifest, OBJ,
 cameras and frames); :mod:`oracles.judge.frames_judge` judges the frames, one at a
 time, by the one judge of every path (:mod:`oracles.judge.decide`).
 
@@ -14,6 +15,7 @@ job). Each problem is one line of :class:`FramesError` (exit 2).
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 
@@ -22,8 +24,9 @@ import numpy as np
 from wirecheck.core.errors import InputError
 from wirecheck.core.user_files import read_text
 
-from .export import JOB_KIND, JOB_VERSION, frame_name
+from .export import DEPTH_FORMATS, JOB_KIND, JOB_VERSION, OUTPUTS, frame_name, job_outputs, output_files
 from .job_as_exported import camera_file_problem, camera_keys_problem, job_keys_problem
+from .depth_map import DEFAULT_PNG_SCALE, read_depth_map
 from .png_frame import FrameProblem, check_png, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
 from wirecheck.core.limits import MAX_FRAMES, check_image_size
 from wirecheck.core.scene.files import NAME_PATTERN
@@ -118,6 +121,10 @@ def _job_problem(job: dict) -> str | None:
         return f"motion.phase {phase!r}: expected a number in [0, 1) (crosscheck export --phase)"
     if job.get("style") != "wireframe":
         return f"style {job.get('style')!r}: expected 'wireframe' (the frames judged are wireframes)"
+    problem = _outputs_problem(job)
+    if problem is not None:
+        return problem
+    outputs = job_outputs(job)
     scenes, cases = job.get("scenes"), job.get("cases")
     if not (isinstance(scenes, list) and scenes and all(isinstance(r, dict) for r in scenes)):
         return "scenes: expected a list of the job's scenes"
@@ -131,8 +138,14 @@ def _job_problem(job: dict) -> str | None:
         if expected.get(r.get("space")) != obj:
             return (f"scene {name!r}: space {r.get('space')!r}, obj {obj!r}: expected space 'model' with "
                     f"obj {expected['model']!r}, or 'world per frame' with {expected['world per frame']!r}")
-        if r.get("space") == "model" and not all(_is_int(r.get(k)) and r[k] >= 0 for k in ("vertices", "edges")):
-            return f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}: expected counts"
+        if r.get("space") == "model" and not all(_is_int(r.get(k)) and r[k] >= 0 for k in ("vertices", "edges", "faces")):
+            return (f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}, faces "
+                    f"{r.get('faces')!r}: expected counts")
+        objects = r.get("objects")
+        if "outputs" in job and not (isinstance(objects, list) and objects and all(_is_int(n) and n > 0 for n in objects)
+                                     and sum(objects) == r.get("vertices")):
+            return (f"scene {name!r}: objects {str(objects)[:60]}: expected each object's vertex count (> 0), "
+                    f"{r.get('vertices')!r} in all")
     if not (isinstance(cases, list) and all(isinstance(c, dict) for c in cases)):
         return "cases: expected a list of the job's cases"
     pairs = set()
@@ -149,10 +162,42 @@ def _job_problem(job: dict) -> str | None:
             check_image_size(w, h, f"case {scene} / {case}: width x height")
         except InputError as exc:
             return str(exc)
-        listed = [f"frames/{scene}/{case}/{frame_name(k, 'png')}" for k in checked]
-        if c.get("frames") != listed:
-            return (f"case {scene} / {case}: frames {str(c.get('frames'))[:80]}: expected "
-                    f"frames/{scene}/{case}/frame_NNNN.png for each of frame_numbers")
+        written = output_files(scene, case, checked, outputs, (job.get("depth_encoding") or {}).get("format", "npy"))
+        for key in ("frames", "filled", "depth") if "outputs" in job else ("frames",):
+            if c.get(key) != written[key]:
+                pattern = (f"frames/{scene}/{case}/{Path(written[key][0]).stem.split('_')[0]}_NNNN"
+                           f"{Path(written[key][0]).suffix} for each of frame_numbers" if written[key]
+                           else "[] (the job's outputs do not ask for them)")
+                return f"case {scene} / {case}: {key} {str(c.get(key))[:80]}: expected {pattern}"
+    return None
+
+
+def _outputs_problem(job: dict) -> str | None:
+    """What in a job's ``outputs`` and ``depth_encoding`` is not as export writes them; None if all is
+    (a job without ``outputs`` asks for wireframes alone)."""
+    if "outputs" not in job:
+        return None
+    outputs = job["outputs"]
+    if not (isinstance(outputs, list) and outputs and all(isinstance(o, str) for o in outputs)
+            and outputs == [o for o in OUTPUTS if o in outputs]):
+        return (f"outputs {str(outputs)[:60]}: expected some of {', '.join(map(repr, OUTPUTS))}, each once, "
+                "in that order")
+    if outputs == ["wireframe"]:
+        return "outputs ['wireframe']: expected no 'outputs' key for a job of wireframes alone"
+    enc = job.get("depth_encoding")
+    fmt = enc.get("format") if isinstance(enc, dict) else None
+    if not (isinstance(enc, dict) and set(enc) == {"format", "scale"} and isinstance(fmt, str)
+            and fmt in DEPTH_FORMATS):
+        return (f"depth_encoding {str(enc)[:60]}: expected {{'format': one of {', '.join(DEPTH_FORMATS)}, "
+                "'scale': ...}")
+    scale = enc["scale"]
+    if fmt == "png16":
+        if not (isinstance(scale, (int, float)) and not isinstance(scale, bool) and np.isfinite(scale)
+                and scale > 0 and np.isfinite(65535.0 / scale)):
+            return (f"depth_encoding.scale {scale!r}: expected a finite number of values per world unit > 0 "
+                    "(crosscheck export --depth-scale; 1000: millimetres per metre)")
+    elif scale is not None:
+        return f"depth_encoding.scale {scale!r} with format {fmt!r}: expected null (a scale is a 16-bit PNG's)"
     return None
 
 
@@ -221,7 +266,7 @@ def _frames(job_dir: Path, job: dict, keep: bool, decode: bool = True) -> dict:
     if not found:
         raise FramesError([f"{frames_dir}: empty: expected the renderer's frames "
                            "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
-    listed = {f for c in job["cases"] for f in c["frames"]}
+    listed = {f for c in job["cases"] for f in case_files(c)}
     if not found & listed:
         example = sorted(found)[0]
         raise FramesError([f"{frames_dir}: none of its {len(found)} files is a frame of this job "
@@ -229,24 +274,31 @@ def _frames(job_dir: Path, job: dict, keep: bool, decode: bool = True) -> dict:
     problems = [f"{job_dir / rel}: not a frame of this job (expected only the files job.json lists)"
                 for rel in sorted(found - listed)]
     out = {}
+    scale = (job.get("depth_encoding") or {}).get("scale") or DEFAULT_PNG_SCALE
     for c in job["cases"]:
         images = []
-        for rel in c["frames"]:
+        for rel in case_files(c):
             path = job_dir / rel
             k = int(Path(rel).stem.split("_")[-1])
-            problem = file_problem(path)
+            problem = file_problem(path, "depth map" if rel in c.get("depth", ()) else "frame")
             if problem is not None:
                 problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
                 continue
             try:
+                if rel in c.get("depth", ()):       # its size and encoding, read as the judge will read it
+                    if decode:
+                        read_depth_map(path, c["width"], c["height"], scale)
+                    continue
                 if not decode:
                     check_png(path, c["width"], c["height"])
                     continue
                 image = read_grey(path, c["width"], c["height"])
-                if keep:
+                if keep and rel in c["frames"]:
                     images.append((k, image))
             except FrameProblem as exc:
                 problems.append(f"{path}: {exc}")
+            except InputError as exc:               # read_depth_map's line names the file
+                problems.append(str(exc))
             except Exception as exc:       # Pillow's many ways to say "not an image"
                 problems.append(f"{path}: unreadable as PNG ({type(exc).__name__}: {exc})")
         out[(c["scene"], c["case"])] = images
@@ -255,15 +307,22 @@ def _frames(job_dir: Path, job: dict, keep: bool, decode: bool = True) -> dict:
     return out
 
 
-def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``.
+def case_files(c: dict) -> list:
+    """Every file a case's renderer writes (job.json's ``frames``, ``filled``, ``depth``), frame by frame."""
+    lists = [c[key] for key in ("frames", "filled", "depth") if c.get(key)]
+    return [rel for group in zip(*lists) for rel in group]
+
+
+def read_obj(path: Path, with_faces: bool = False) -> tuple:
+    """The ``v`` and ``l`` records of an OBJ export wrote: ``(vertices (N, 3), edges (E, 2) 0-based)``;
+    ``with_faces``: ``(vertices, edges, faces)``, each face a tuple of 0-based indices.
 
     FramesError (file:line) for a record that is not as export writes it: 3
     finite coordinates, 2 indices of vertices before it; ``f`` faces (not
     judged, but a renderer may read them) of 3 or more such indices; nothing
     but ``v``, ``l``, ``f`` and ``#`` comments.
     """
-    verts, edges = [], []
+    verts, edges, faces = [], [], []
     problem = file_problem(path, "job mesh")
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected the OBJ 'crosscheck export' wrote"])
@@ -276,7 +335,7 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
         try:
             if parts and parts[0] == "v":
                 verts.append([float(x) for x in parts[1:]])
-                if len(parts) != 4 or not np.all(np.isfinite(verts[-1])):
+                if len(parts) != 4 or not all(map(math.isfinite, verts[-1])):
                     raise ValueError
             elif parts and parts[0] == "l":
                 edges.append([int(x) - 1 for x in parts[1:]])
@@ -287,12 +346,14 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
                 if len(face) < max(3, len(parts) - 1) or not all(0 <= i < len(verts) for i in face):
                     raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'f I J K ...' (3 or more "
                                        f"of 1..{len(verts)}), 'v', 'l' or a '#' comment, as 'crosscheck export' wrote"])
+                faces.append(tuple(face))
         except ValueError as exc:
             if isinstance(exc, FramesError):
                 raise
             raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
                                f"(1..{len(verts)}), as 'crosscheck export' wrote"]) from None
-    return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
+    out = np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
+    return (*out, faces) if with_faces else out
 
 
 def _frame_camera(path: Path, cache: dict | None = None):
@@ -342,7 +403,9 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
     if cache is not None and cache.get("obj") == obj:
         p_model, edges = cache["mesh"]
     else:
-        p_model, edges = read_obj(obj)
+        p_model, edges, faces = read_obj(obj, with_faces=True)
+        if cache is not None:               # the faces of the file just read, for frame_faces
+            cache.update(faces_obj=obj, faces=faces)
         if cache is not None and row["space"] == "model":
             cache.update(obj=obj, mesh=(p_model, edges))
     if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
@@ -361,6 +424,33 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
         raise FramesError([f"{path}: {problem} (what 'crosscheck export' writes for this file's camera and "
                            "model matrix: the file was edited; export the job again)"])
     return p_model, edges, camera, m
+
+
+def frame_faces(job_dir: Path, job: dict, scene: str, k: int, cache: dict | None = None) -> list:
+    """The ``f`` records of frame ``k``'s OBJ (0-based index tuples): the faces a filled frame or a depth map
+    shows. ``cache``: as :func:`frame_inputs`' (which keeps the faces of the OBJ it read last): each OBJ
+    read once."""
+    row = next(s for s in job["scenes"] if s["name"] == scene)
+    obj = Path(job_dir) / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
+    if cache is not None and cache.get("faces_obj") == obj:
+        faces = cache["faces"]
+    else:
+        _v, _e, faces = read_obj(obj, with_faces=True)
+        if cache is not None:
+            cache.update(faces_obj=obj, faces=faces)
+    if row["space"] == "model" and len(faces) != row.get("faces"):
+        raise FramesError([f"{obj}: {len(faces)} faces: expected {row.get('faces')} (job.json's; the file was "
+                           "changed or cut short)"])
+    return faces
+
+
+def face_objects(job: dict, scene: str, faces: list) -> np.ndarray:
+    """``(F,)`` int64: the object (0, 1, ... in job.json's ``objects`` of the scene) of each face, that of its
+    first vertex (an object's faces index its own vertices)."""
+    row = next(s for s in job["scenes"] if s["name"] == scene)
+    stops = np.cumsum(row["objects"])
+    first = np.fromiter((f[0] for f in faces), dtype=np.int64, count=len(faces))
+    return np.searchsorted(stops, first, side="right")
 
 
 def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:

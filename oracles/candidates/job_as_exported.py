@@ -50,23 +50,30 @@ def exported_keys() -> dict:
     from .export import build_job
 
     job, _files = build_job([load_scene("cube")], frames=1, case_names=["on_axis"], phase=0.5)
+    full, _files = build_job([load_scene("cube")], frames=1, case_names=["on_axis"], phase=0.5,
+                             outputs=("wireframe", "filled", "depth"))
     return {"job": tuple(job), "scene": tuple(job["scenes"][0]), "case": tuple(job["cases"][0]),
-            "motion": tuple(job["motion"])}
+            "motion": tuple(job["motion"]), "outputs_job": tuple(full), "outputs_case": tuple(full["cases"][0]),
+            "outputs_scene": tuple(full["scenes"][0])}
 
 
 def job_keys_problem(job: dict) -> str | None:
     """What key of a ``job.json`` (top level, ``motion``, each scene and case row) is not export's; None if none.
 
-    ``motion.phase`` may be absent (export writes it only for a phase other than 0)."""
+    ``motion.phase`` may be absent (export writes it only for a phase other than 0). A job with
+    ``outputs`` (filled frames, depth maps: oracles.candidates.export.OUTPUTS) holds the keys export
+    writes for one, every case its ``filled`` and ``depth`` lists; a job without holds none of them."""
     keys = exported_keys()
-    problem = _keys_problem("", job, keys["job"])
+    outputs = "outputs" in job
+    problem = _keys_problem("", job, keys["outputs_job" if outputs else "job"])
     if problem is None and isinstance(job.get("motion"), dict):
         problem = _keys_problem("motion", job["motion"], keys["motion"], required=("turns",))
     for what in ("scene", "case"):
         rows = job.get(what + "s")
+        expected = keys[f"outputs_{what}"] if outputs else keys[what]
         for i, row in enumerate(rows if isinstance(rows, list) else []):
             if problem is None and isinstance(row, dict):
-                problem = _keys_problem(f"{what}s[{i}]", row, keys[what])
+                problem = _keys_problem(f"{what}s[{i}]", row, expected)
     return problem
 
 

@@ -17,6 +17,9 @@ same record fields from its frames; this module alone decides on them:
   the line centres, ends and warp measured from its images instead
   (``line_style``, oracles.judge.line_style);
 - the shaded limits (regions inside a silhouette, IoU, faces, depth);
+- a renderer's depth maps and filled frames (``depth_map``, ``filled``:
+  oracles.judge.depth_frames, filled_frames): depth error over its bound, holes and
+  extra surface, blank frames, the silhouette's longest run and IoU;
 - the gate (:mod:`oracles.judge.gate`): a case that misses no limit but compared
   nothing is ``"vacuous"``;
 - the ``unexplained`` rule: a case that fails without a candidate error and
@@ -92,6 +95,56 @@ def reasons(rec: dict, tol: Tolerances, error: str | None = None) -> list[str]:
         out += rec.get("line_style", {}).get("failures", [])
     if rec.get("silhouette_iou") is not None:
         out += _shaded_reasons(rec, tol)
+    if "depth_map" in rec:
+        out += depth_map_reasons(rec["depth_map"], tol)
+    if "filled" in rec:
+        out += filled_reasons(rec["filled"], tol)
+    return out
+
+
+def _blank(frames: list, what: str) -> list[str]:
+    """The reason of a case whose ``what`` (depth maps, filled frames) are blank in ``frames``; [] if none."""
+    if not frames:
+        return []
+    shown = ", ".join(map(str, frames[:5])) + (", ..." if len(frames) > 5 else "")
+    return [f"{what} blank where the reference shows a surface (frame{'s' if len(frames) > 1 else ''} {shown}): "
+            "nothing compared there"]
+
+
+def depth_map_reasons(d: dict, tol: Tolerances) -> list[str]:
+    """The limits a case's depth maps miss (``record["depth_map"]``, oracles.judge.depth_frames)."""
+    out = []
+    if d["max_error_ratio"] is not None and d["max_error_ratio"] > tol.max_depth_error_ratio:
+        r, c = d["worst_pixel"]
+        out.append(f"depth error {d['max_error']:.3g} is {d['max_error_ratio']:.3g} x its bound "
+                   f"(> {tol.max_depth_error_ratio:g}; frame {d['worst_frame']}, row {r}, column {c})")
+    if d["reference_px"] and not d["compared_px"]:
+        out.append(f"depth maps compare nothing: no pixel shows a surface on both sides "
+                   f"({d['reference_px']} reference pixels): never a pass")
+    out += _blank(d["blank_frames"], "depth map")
+    if d["holes_px"] > tol.max_surface_holes_px:
+        out.append(f"depth map: {d['holes_px']} pixels of the reference's surface left empty away from its "
+                   f"silhouette's boundary (> {tol.max_surface_holes_px}; most in frame {d['holes_worst_frame']})")
+    if d["extra_px"] > tol.max_surface_extra_px:
+        out.append(f"depth map: {d['extra_px']} pixels of surface where the reference has none, away from its "
+                   f"silhouette's boundary (> {tol.max_surface_extra_px}; most in frame {d['extra_worst_frame']})")
+    return out
+
+
+def filled_reasons(f: dict, tol: Tolerances) -> list[str]:
+    """The limits a case's filled frames miss (``record["filled"]``, oracles.judge.filled_frames): blank frames,
+    the longest run of decided pixels missing or added (oracles.judge.silhouette), the IoU."""
+    out = _blank(f["blank_frames"], "filled frame")
+    if f["longest_run_px"] > tol.max_silhouette_run_px:
+        r, c = f["run_at"]
+        out.append(f"filled silhouette: {f['longest_run_px']} decided pixels missing or added in one run (frame "
+                   f"{f['run_frame']}, row {r}, column {c}; > {tol.max_silhouette_run_px}); {f['holes_px']} holes, "
+                   f"{f['extra_px']} extra in all")
+    if f["min_iou"] is not None and f["min_iou"] < tol.min_iou:
+        out.append(f"filled silhouette IoU {f['min_iou']:.4f} < {tol.min_iou} (frame {f['iou_worst_frame']})")
+    if f.get("object_id_px") is not None and f["object_id_px"] > tol.max_object_id_px:
+        out.append(f"filled frames: {f['object_id_px']} decided pixels show another object's id than the "
+                   f"reference's (> {tol.max_object_id_px}; most in frame {f['object_id_worst_frame']})")
     return out
 
 

@@ -32,7 +32,7 @@ from ..references import faces as oface
 from ..cases import Case, case_motion
 from .metrics import depth_bound, depth_slope, occlusion_boundary
 
-__all__ = ["ReferenceDepth", "reference_depth"]
+__all__ = ["ReferenceDepth", "from_render", "reference_depth"]
 
 
 @dataclass(frozen=True)
@@ -95,9 +95,15 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
     tris, _owner = oface.fan(scene.faces)
     triangles = oface.gl_triangles(tris, oface.mirrored_vertices(scene, matrices))
     covered, depth, ids = oracle.render_faces(pr_vertices, triangles, cam, model_matrix=pr_pose, with_ids=True)
-    slope = depth_slope(depth, covered)                     # once, for the bound and the clip planes' pixels
-    bound = depth_bound(depth, covered, cam, slope)
-    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, cam, slope)) & covered
+    return from_render(covered, depth, ids, tris, cam)
+
+
+def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: np.ndarray, camera) -> ReferenceDepth:
+    """The :class:`ReferenceDepth` of pyrender's drawing of a frame's faces (``render_faces(..., with_ids=True)``
+    of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels."""
+    slope = depth_slope(depth, covered)
+    bound = depth_bound(depth, covered, camera, slope)
+    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope)) & covered
     return ReferenceDepth(depth=np.where(covered, depth, np.nan), covered=covered, undecided=undecided, bound=bound,
                           faces=np.where(covered, ids, -1))
 

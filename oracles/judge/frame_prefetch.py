@@ -38,7 +38,9 @@ import threading
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
-from ..candidates.frames_candidate import frame_inputs, read_frame
+from ..candidates.export import job_outputs
+from ..candidates.frames_candidate import frame_faces, frame_inputs, read_frame
+from ..references.faces import fan
 from ..references.pyrender_oracle import OracleCache
 
 #: Frames read ahead of the one being judged (each: the oracle's drawing and the PNG's grey levels).
@@ -48,10 +50,10 @@ AHEAD = 2
 class FrameAhead:
     """One frame as read ahead: each step's result, or the exception it raised (raised again when asked)."""
 
-    __slots__ = ("_inputs", "_oracle", "_grey")
+    __slots__ = ("_inputs", "_oracle", "_grey", "_faces")
 
-    def __init__(self, inputs, oracle, grey):
-        self._inputs, self._oracle, self._grey = inputs, oracle, grey
+    def __init__(self, inputs, oracle, grey, faces=None):
+        self._inputs, self._oracle, self._grey, self._faces = inputs, oracle, grey, faces
 
     @staticmethod
     def _value(step):
@@ -64,19 +66,27 @@ class FrameAhead:
         return self._value(self._inputs)
 
     def oracle(self):
-        """pyrender's drawing of the frame: ``(H, W)`` bool, its line pixels."""
+        """pyrender's drawing of the frame: ``(H, W)`` bool, its line pixels (None: the job asks for no wireframe)."""
         return self._value(self._oracle)
 
     def grey(self):
-        """The frame's PNG as grey levels (oracles.candidates.frames_candidate.read_frame)."""
+        """The frame's PNG as grey levels (oracles.candidates.frames_candidate.read_frame; None: no wireframe)."""
         return self._value(self._grey)
 
+    def faces(self):
+        """pyrender's drawing of the frame's faces, ``(covered, depth, ids, triangles, faces)``
+        (PyrenderOracle.render_faces with ids, of the OBJ's ``faces`` fanned: ``triangles`` (T, 3)); None when
+        the job asks for no filled frame nor depth map."""
+        return self._value(self._faces)
 
-def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str, cache: dict) -> FrameAhead:
+
+def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: dict) -> FrameAhead:
     """Frame ``k`` of case ``c`` read as the judge reads it, each step's exception kept in its place.
 
     The steps run in the judge's order: the frame's inputs, pyrender's
-    drawing, the PNG; a step that fails ends the frame's reading (the judge
+    drawing, the PNG (``rel``: the wireframe's, None when the job asks for no
+    wireframe), then pyrender's drawing of the faces when the job asks for filled
+    frames or depth maps; a step that fails ends the frame's reading (the judge
     raises it before it would need the next).
     """
     try:
@@ -84,16 +94,30 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str, cache: dict) ->
     except Exception as exc:      # noqa: BLE001 - raised again in the judge's thread, at this frame
         return FrameAhead(exc, None, None)
     p_model, edges, camera, m = inputs
+    orac = grey = None
+    if rel is not None:
+        try:
+            orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m,
+                                                                  depth=False)[0]
+        except Exception as exc:      # noqa: BLE001
+            return FrameAhead(inputs, exc, None)
+        try:
+            grey = read_frame(Path(job_dir) / rel, c["width"], c["height"], (job_dir, job))
+        except Exception as exc:      # noqa: BLE001
+            return FrameAhead(inputs, orac, exc)
+    if not set(job_outputs(job)) & {"filled", "depth"}:
+        return FrameAhead(inputs, orac, grey)
     try:
-        orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m,
-                                                              depth=False)[0]
+        polygons = frame_faces(job_dir, job, c["scene"], k, cache)
+        if cache.get("fanned") is not polygons:             # a model-space scene's faces: fanned once a case
+            cache.update(fanned=polygons, tris=fan(polygons)[0])
+        tris = cache["tris"]
+        drawn = oracles.get(camera.width, camera.height).render_faces(p_model, tris, camera, model_matrix=m,
+                                                                      with_ids=True)
+        faces = (*drawn, tris, polygons)
     except Exception as exc:      # noqa: BLE001
-        return FrameAhead(inputs, exc, None)
-    try:
-        grey = read_frame(Path(job_dir) / rel, c["width"], c["height"], (job_dir, job))
-    except Exception as exc:      # noqa: BLE001
-        return FrameAhead(inputs, orac, exc)
-    return FrameAhead(inputs, orac, grey)
+        faces = exc
+    return FrameAhead(inputs, orac, grey, faces)
 
 
 class FramePrefetch:
@@ -136,7 +160,7 @@ class FramePrefetch:
     def frames(self, job_dir, job, c: dict, numbers: list):
         """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead."""
         cache: dict = {}            # frame_inputs' OBJ and camera, kept over the case (used on the worker only)
-        todo = iter(zip(numbers, c["frames"]))
+        todo = iter(zip(numbers, c["frames"] or [None] * len(numbers)))      # no wireframe asked: no PNG
         queued: list[Future] = []
         if self._pool is None:                  # read each frame when it is asked for
             for k, rel in todo:

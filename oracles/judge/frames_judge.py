@@ -15,6 +15,14 @@ images (oracles.diagnosis.image_diagnose); when those name nothing, from the lin
 (``line_end_bias``, ``line_pixel_bias``: oracles.judge.decide.line_faults). The
 verdict is oracles.judge.decide.decide's, at level ``frames`` (no vertex compared).
 
+A job that asks for depth maps or filled frames (``outputs``, oracles.candidates.export)
+has them measured in the same frame loop: pyrender draws the frame's faces (on the
+GL thread, read ahead), each depth map is read and judged against that depth
+(oracles.judge.depth_frames), each filled frame against the fill rule's
+silhouette (oracles.judge.filled_frames); their fields join the case's record
+(``depth_map``, ``filled``) and the one verdict. Without wireframes, no line
+field is measured and no worst-frame images are kept.
+
 Frames are streamed: a frame's images are dropped once it is scored, so
 memory does not grow with the job. What is kept per case: the worst frame's
 two images (for report.md's picture), at most :data:`DIAGNOSIS_FRAMES`
@@ -30,18 +38,22 @@ from pathlib import Path
 import numpy as np
 
 from . import f1_radius, line_model, metrics
-from ..candidates.frames_candidate import read_frame
+from ..candidates.frames_candidate import face_objects, read_frame
 from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
-from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
+from .decide import decide, depth_map_reasons, line_faults, pixel_fields, pixel_rule_reasons, reasons
+from .depth_frames import DepthFrames
+from .depth_reference import from_render
 from .dim_lines import name_dim_lines
+from .filled_frames import FilledFrames
 from .line_style import CaseStyle
 from wirecheck.core.projector import pipeline
 from ..candidates.draw import oracle_segments as line_segments
 from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
 from ..diagnosis.image_visibility import frames_visibility
 from ..candidates import frames_candidate
-from ..tolerances import Tolerances
+from ..candidates.export import job_outputs
+from ..tolerances import MIN_IOU_UNION_PX, Tolerances
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (oracles.diagnosis.registration.MAX_POINTS_PER_CASE),
@@ -91,6 +103,7 @@ class _CaseFrames:
         self.rounded_f1 = []               # each frame's F1@0px against the rounded-ends rule (line_model)
         self.rounded_batch = metrics.LineBatch()
         self.rounded_lines = []
+        self.named = False                 # whether the image diagnosis named a fault
 
     def add_rounded(self, k, cand: np.ndarray, segs: np.ndarray, shape: tuple, seg0, seg1, tol) -> None:
         """Score a frame's drawn pixels ``cand`` (flat) against a correct drawing of ``segs`` by the
@@ -109,6 +122,12 @@ class _CaseFrames:
         return {"pixel_f1_0px": min(self.rounded_f1),
                 "lines": metrics.line_summary(self.rounded_lines)}
 
+    def visibility_inputs(self) -> tuple[list, list, list]:
+        """The kept frames' ``(drawn images, oracle segments, the flipped camera's segments)``, for the image
+        diagnosis and the visibility advice."""
+        images = [_image(flat, shape) for flat, shape, _, _ in self.diag]
+        return images, [s for _, _, s, _ in self.diag], [f for _, _, _, f in self.diag]
+
     def record_lines(self, scored: list) -> None:
         for (k, frame_rec), ls in scored:
             self.lines.append((k, ls))
@@ -124,70 +143,123 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     ``line_rule``: ``"any"`` holds aliased 1-px lines to a correct drawing by GL's rule or the
     rounded-ends rule (oracles.judge.line_model), ``"gl"`` to GL's pixel rule alone,
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
+
+    Each frame's wireframe, depth map and filled frame, as the job asks for them (module
+    docstring); the worst images are None for a job without wireframes.
     """
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
-    numbers = [int(Path(rel).stem.split("_")[-1]) for rel in c["frames"]]
-    kept = diagnosis_frames(len(numbers)) if diagnose else set()
+    numbers = job["frame_numbers"]
+    outputs = job_outputs(job)
+    wire = "wireframe" in outputs
+    depth = DepthFrames(job) if "depth" in outputs else None         # each frame's depth map (depth_frames)
+    filled = FilledFrames(tol.fill_tie_px) if "filled" in outputs else None     # each filled PNG (filled_frames)
+    kept = diagnosis_frames(len(numbers)) if diagnose and wire else set()
     acc = _CaseFrames()
     style = CaseStyle(line_rule)
     camera = None
     # each frame's inputs, pyrender's drawing and its PNG's grey levels, read ahead on the GL thread
     # (frame_prefetch: each step's error raised here, at its frame and step)
     ahead = reader_for(oracles).frames(job_dir, job, c, numbers)
-    for i, ((k, rel), frame) in enumerate(zip(zip(numbers, c["frames"]), ahead)):
+    for i, (k, frame) in enumerate(zip(numbers, ahead)):
         p_model, edges, camera, m = frame.inputs()
-        p_world = p_model @ m[:3, :3].T + m[:3, 3]
-        # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
-        seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
-        segs = oracle_segments(p_world, edges, camera)             # the lines a correct renderer draws
-        orac = frame.oracle()
-        cand = candidate_pixels(Path(job_dir) / rel, c["width"], c["height"], style, orac, (p_model, edges, camera, m),
-                                segs, (job_dir, job), grey=frame.grey())
-        core = _drawn(pipeline.render_frame(p_model, edges, camera, m).image)
-        fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
-        style.count_rule(fp, segs)
-        if line_rule != "geometry":
-            acc.add_rounded(k, cand, segs, orac.shape, seg0, seg1, tol)
-        ps = metrics.pixel_scores(None, None, pixels=fp)
-        # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
-        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
-        acc.radius.append(f1_radius.frame_scores(fp, ps))
-        for key, values in acc.pixel.items():
-            values.append(ps[key])
-        for key in metrics.PIXEL_SCORE_KEYS:
-            acc.core_min[key] = min(acc.core_min.get(key, 1.0), float(cs[key]))
-        acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
-        frame_rec = {"frame": k, "f1_0px": ps["f1_0px"], "f1_1px": ps["f1_1px"],
-                     "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"],
-                     "candidate_pixels": ps["candidate_pixels"], "oracle_pixels": ps["oracle_pixels"]}
-        acc.per_frame.append(frame_rec)
-        acc.record_lines(acc.batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
-        key = (ps["f1_1px"], ps["f1_0px"])
-        if acc.worst is None or key < acc.worst[0]:
-            acc.worst = (key, k, _image(cand, orac.shape), orac.copy())
-        if i in kept:
-            acc.diag.append((fp.cand_idx, orac.shape, segs,
-                             oracle_segments(p_world, edges, flipped_camera(camera))))
-        del cand, orac, core, fp, frame
+        if wire:
+            _wireframe(acc, style, Path(job_dir) / c["frames"][i], c, k, frame, (p_model, edges, camera, m),
+                       (job_dir, job), tol, line_rule, i in kept)
+        if depth or filled:
+            covered, z, ids, tris, polygons = frame.faces()     # pyrender's faces: the depth maps' reference
+            if depth:
+                rec_k = depth.add(k, Path(job_dir) / c["depth"][i], camera, from_render(covered, z, ids, tris, camera))
+                acc.drawn_px += rec_k["union_px"]
+            if filled:                                          # the fill rule's silhouette (filled_frames)
+                rec_k = filled.add(k, Path(job_dir) / c["filled"][i], p_model @ m[:3, :3].T + m[:3, 3], polygons,
+                                   camera, (job_dir, job), face_objects(job, scene, polygons))
+                acc.drawn_px += rec_k["union_px"]
+        del frame
     ahead.close()
+    if wire:
+        rec, worst = _wireframe_record(acc, style, job, scene, case, camera, numbers, tol, diagnose, line_rule)
+    else:
+        rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
+               "frames_checked": len(numbers), "max_vertex_error_px": None, "faults": []}
+        worst = None
+    faults = rec["faults"]
+    if depth:
+        rec["depth_map"] = depth.fields()
+        faults = faults + (depth.faults() if depth_map_reasons(rec["depth_map"], tol) else [])
+    if filled:
+        rec["filled"] = filled.fields(MIN_IOU_UNION_PX)
+    rec["faults"] = faults
+    rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
+    decide(rec, tol, level="frames")
+    if wire and diagnose and not acc.named and rec["verdict"] == "fail" and _wireframe_fails(rec, tol):
+        # the images fit the oracle's lines (nothing named from them) and the case fails: which sets differ?
+        images, segments, _flipped = acc.visibility_inputs()
+        rec["faults"] = frames_visibility(rec["faults"], images, segments, camera, len(numbers))
+    rec["per_frame"] = acc.per_frame
+    return rec, worst
+
+
+def _wireframe_fails(rec: dict, tol) -> bool:
+    """Whether the case's wireframes miss a limit of their own (not only its depth maps or filled frames)."""
+    if "depth_map" not in rec and "filled" not in rec:
+        return True
+    return bool(reasons({k: v for k, v in rec.items() if k not in ("depth_map", "filled")}, tol))
+
+
+def _wireframe(acc: _CaseFrames, style, path: Path, c: dict, k: int, frame, inputs: tuple, job, tol, line_rule: str,
+               keep: bool) -> None:
+    """Frame ``k``'s wireframe PNG (``path``) scored into ``acc`` (``frame``: its FrameAhead; ``inputs``:
+    ``(p_model, edges, camera, model_matrix)``; ``keep``: its drawn pixels kept for the image diagnosis)."""
+    p_model, edges, camera, m = inputs
+    p_world = p_model @ m[:3, :3].T + m[:3, 3]
+    # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
+    seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
+    segs = oracle_segments(p_world, edges, camera)             # the lines a correct renderer draws
+    orac = frame.oracle()
+    cand = candidate_pixels(path, c["width"], c["height"], style, orac, inputs, segs, job, grey=frame.grey())
+    core = _drawn(pipeline.render_frame(p_model, edges, camera, m).image)
+    fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
+    style.count_rule(fp, segs)
+    if line_rule != "geometry":
+        acc.add_rounded(k, cand, segs, orac.shape, seg0, seg1, tol)
+    ps = metrics.pixel_scores(None, None, pixels=fp)
+    # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
+    cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
+    acc.radius.append(f1_radius.frame_scores(fp, ps))
+    for key, values in acc.pixel.items():
+        values.append(ps[key])
+    for key in metrics.PIXEL_SCORE_KEYS:
+        acc.core_min[key] = min(acc.core_min.get(key, 1.0), float(cs[key]))
+    acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
+    frame_rec = {"frame": k, "f1_0px": ps["f1_0px"], "f1_1px": ps["f1_1px"],
+                 "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"],
+                 "candidate_pixels": ps["candidate_pixels"], "oracle_pixels": ps["oracle_pixels"]}
+    acc.per_frame.append(frame_rec)
+    acc.record_lines(acc.batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
+    key = (ps["f1_1px"], ps["f1_0px"])
+    if acc.worst is None or key < acc.worst[0]:
+        acc.worst = (key, k, _image(cand, orac.shape), orac.copy())
+    if keep:
+        acc.diag.append((fp.cand_idx, orac.shape, segs, oracle_segments(p_world, edges, flipped_camera(camera))))
+
+
+def _wireframe_record(acc: _CaseFrames, style, job: dict, scene: str, case: str, camera, numbers: list, tol,
+                      diagnose: bool, line_rule: str) -> tuple[dict, dict]:
+    """The case's record from its wireframes' scores (before any depth or filled field, and the verdict), and
+    the worst frame's images; ``acc.named``: whether the images named a fault."""
     acc.record_lines(acc.batch.flush())
     rec = case_record(job, scene, case, camera, acc, len(numbers))
     faults = []
-    images, segments = [_image(flat, shape) for flat, shape, _, _ in acc.diag], [s for _, _, s, _ in acc.diag]
     if diagnose:
-        faults = diagnose_images(images, segments, camera, [f for _, _, _, f in acc.diag], tol=tol)
+        images, segments, flipped = acc.visibility_inputs()
+        faults = diagnose_images(images, segments, camera, flipped, tol=tol)
+    acc.named = bool(faults)
     rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
     f1_radius.apply(rec, style.classify(), acc.radius, numbers)     # F1 at the radius the lines' width allows
     # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
     style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol), rounded=acc.rounded())
     rec["line_style"]["f1_radius_px"] = rec["f1_radius_px"]
     rec["faults"] = name_dim_lines(rec["faults"], rec["line_style"], acc.per_frame)   # lines under the 128 rule
-    rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
-    decide(rec, tol, level="frames")
-    if diagnose and not faults and rec["verdict"] == "fail":
-        # the images fit the oracle's lines (nothing named from them) and the case fails: which sets differ?
-        rec["faults"] = frames_visibility(rec["faults"], images, segments, camera, len(numbers))
-    rec["per_frame"] = acc.per_frame
     return rec, {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
 
 
@@ -235,7 +307,8 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
             rec, worst = judge_case(job_dir, job, c["scene"], c["case"], reader, tol, diagnose=diagnose,
                                     line_rule=line_rule)
             records.append(rec)
-            images[(c["scene"], c["case"])] = worst
+            if worst is not None:           # a job without wireframes: no line images to show
+                images[(c["scene"], c["case"])] = worst
         gl = reader.call(reader.oracles.gl_info)
     finally:
         reader.close()
@@ -245,8 +318,13 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
                 "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
                 "pixels": sum(r["compared"]["pixels"] for r in records)}
     bad = failed or not compared["frames"] or (not allow_vacuous and (vacuous or not compared["pixels"]))
-    tolerances = {**tol.to_dict(), **tol.lines_dict()}
+    outputs = job_outputs(job)
+    tolerances = {**tol.to_dict(), **tol.lines_dict(), **(tol.surfaces_dict() if outputs != ("wireframe",) else {})}
     del tolerances["candidate_precision"]                 # no vertex is compared: no precision judged
+
+    def lowest(key, sub=None):          # over the cases with wireframes (None: the job asks for none)
+        values = [(r[sub] if sub else r)[key] for r in records if "pixel_f1_0px" in r]
+        return min(values) if values else None
     report = {
         "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",
         "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
@@ -256,13 +334,14 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
         "motion": job["motion"],
         "tolerances": tolerances,
         "allow_vacuous": allow_vacuous, "line_rule": line_rule, "compared": compared,
+        **({} if outputs == ("wireframe",) else {"outputs": list(outputs), "depth_encoding": job["depth_encoding"]}),
         "summary": {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
                     "vacuous": vacuous,
                     "max_vertex_error_px": None,
-                    "min_pixel_f1_0px": min(r["pixel_f1_0px"] for r in records),
-                    "min_pixel_f1_1px": min(r["pixel_f1_1px"] for r in records),
-                    "min_core_f1_0px": min(r["core"]["f1_0px"] for r in records),
-                    "min_core_f1_1px": min(r["core"]["f1_1px"] for r in records)},
+                    "min_pixel_f1_0px": lowest("pixel_f1_0px"),
+                    "min_pixel_f1_1px": lowest("pixel_f1_1px"),
+                    "min_core_f1_0px": lowest("f1_0px", "core"),
+                    "min_core_f1_1px": lowest("f1_1px", "core")},
         "cases": records,
         "timing": {"wall_s": time.perf_counter() - t0},
     }

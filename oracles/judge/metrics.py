@@ -258,13 +258,19 @@ def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_dep
 
 
 def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
-    """Largest |depth change| to a covered 4-neighbour, per pixel (0 where none)."""
+    """Largest |depth change| to a covered 4-neighbour, per pixel (0 where none).
+
+    Each neighbouring pair's change is taken once, across columns then rows, and given to both
+    pixels of the pair (``fmax`` keeps 0 where the change is NaN: a pixel not covered); an infinite
+    change is the largest float, as ``nan_to_num`` made it."""
     d = np.where(covered, np.asarray(depth, np.float64), np.nan)
     slope = np.zeros(d.shape)
-    for dy, dx in ((0, 1), (0, -1), (1, 0), (-1, 0)):
-        with np.errstate(invalid="ignore"):
-            slope = np.fmax(slope, np.abs(_shifted(d, dy, dx, np.nan) - d))
-    return np.nan_to_num(slope, nan=0.0)
+    with np.errstate(invalid="ignore"):
+        for change, first, second in ((np.abs(d[:, 1:] - d[:, :-1]), np.s_[:, :-1], np.s_[:, 1:]),
+                                      (np.abs(d[1:] - d[:-1]), np.s_[:-1], np.s_[1:])):
+            np.fmax(slope[first], change, out=slope[first])
+            np.fmax(slope[second], change, out=slope[second])
+    return np.minimum(slope, np.finfo(np.float64).max, out=slope)      # an infinite change: the largest float
 
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray | None = None) -> np.ndarray:

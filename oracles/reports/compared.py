@@ -33,7 +33,13 @@ def what_text(report: dict) -> str:
     cases = report.get("cases", [])
     scenes = len({c["scene"] for c in cases})
     cameras = len({c["camera"] for c in cases})
-    return (f"Compared: level {_LEVEL.get(level, level)}, {per_case}, {_n(len(cases), 'case')} "
+    what = _LEVEL.get(level, level)
+    outputs = report.get("outputs")
+    if level == "frames" and outputs:           # a job asking for filled frames or depth maps
+        named = {"wireframe": "wireframes", "filled": "filled frames", "depth": "depth maps"}
+        what = (f"frames (a renderer's {', '.join(named[o] for o in outputs)} against pyrender"
+                + ("; core's wireframes beside it)" if "wireframe" in outputs else ")"))
+    return (f"Compared: level {what}, {per_case}, {_n(len(cases), 'case')} "
             f"({_n(scenes, 'scene')} x {_n(cameras, 'camera')})")
 
 

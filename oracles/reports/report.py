@@ -77,7 +77,25 @@ def _pixel_f1(case: dict, key: str) -> str:
     return "-" if (case.get("compared") or {}).get("pixels") == 0 else _fmt_f1(case.get(key))
 
 
+def _has_surfaces(cases: list[dict]) -> bool:
+    """Whether a frames job's cases hold depth maps or filled frames (oracles.judge.depth_frames, filled_frames)."""
+    return any("depth_map" in c or "filled" in c for c in cases)
+
+
+def _surface_count(case: dict, key: str) -> str:
+    """Holes or extra pixels of a case's depth maps and filled frames, summed; "-" when it has neither."""
+    parts = [case[k][key] for k in ("depth_map", "filled") if k in case]
+    return f"{sum(parts):,}" if parts else "-"
+
+
 def table_rows(cases: list[dict]) -> list[list[str]]:
+    if _has_surfaces(cases):
+        return [[c["scene"], c["camera"], _pixel_f1(c, "pixel_f1_0px") if "pixel_f1_0px" in c else "-",
+                 _pixel_f1(c, "pixel_f1_1px") if "pixel_f1_1px" in c else "-",
+                 _fmt_f1((c.get("filled") or {}).get("min_iou")),
+                 _fmt_ratio((c.get("depth_map") or {}).get("max_error_ratio")),
+                 _surface_count(c, "holes_px"), _surface_count(c, "extra_px"), c["verdict"],
+                 case_cell(c["faults"], c.get("camera_spec"))] for c in cases]
     if _is_shaded(cases):
         return [[c["scene"], c["camera"], _fmt_err(c.get("max_vertex_error_px")), _fmt_f1(c.get("silhouette_iou")),
                  _fmt_err(c.get("depth_max_error")), _fmt_ratio(c.get("depth_error_ratio")), c["verdict"],
@@ -92,7 +110,13 @@ SHADED_HEADER = ["scene", "camera", "max vertex err (px)", "silhouette IoU", "ma
                  "verdict", "faults"]
 
 
+SURFACES_HEADER = ["scene", "camera", "F1@0px", "F1@1px", "filled IoU", "depth err / bound", "holes", "extra",
+                   "verdict", "faults"]
+
+
 def header(cases: list[dict]) -> list[str]:
+    if _has_surfaces(cases):
+        return SURFACES_HEADER
     return SHADED_HEADER if _is_shaded(cases) else HEADER
 
 
