@@ -82,6 +82,14 @@ CROWDED = 64
 #: x (H + 1) x (W + 1), int32: 32 MiB); over it, the pixels left after a first radius are paired by
 #: :meth:`_Segments.pairs_any`.
 TABLE_CELLS = 1 << 23
+#: :func:`nearest_segments` first keeps only the segments whose unclipped boxes, grown by its radius and
+#: :data:`REACH_MARGIN_PX`, hold one of the pixels (a frame's few one-sided pixels among 10^4 - 10^5
+#: segments: clipping and pairing every segment cost ~10 ms), when the frames hold at least this many.
+FEW_SEGMENTS = 4096
+#: A clipped end is ``p0 + t (p1 - p0)``, ``t`` in [0, 1]: within ~1e-12 px of the segment's box on
+#: coordinates of ~10^4 px; a whole pixel of margin keeps every segment that can pair (the pairs are
+#: measured after).
+REACH_MARGIN_PX = 1.0
 #: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
 #: (fewer: one search costs less than the calls of several).
 LEVEL_PIXELS = 1024
@@ -266,16 +274,59 @@ def nearest_segments(frames, width: int, height: int, radius: float, box: tuple)
         one's nearest segment within ``radius`` (ties: the lower index), -1
         where none is that near.
     q0, q1 : (K, 2) float64
-        The kept segments of all frames, clipped, frame after frame.
+        The kept segments of all frames, clipped, frame after frame (from :data:`FEW_SEGMENTS`
+        segments on, only those whose boxes reach one of the pixels: the others own none).
     frame : (sum P,) int64
         Each pixel's frame.
     """
+    frames = [(np.asarray(p0, np.float64).reshape(-1, 2), np.asarray(p1, np.float64).reshape(-1, 2), pixels)
+              for p0, p1, pixels in frames]
+    if sum(len(p0) for p0, _, _ in frames) >= FEW_SEGMENTS:      # only the segments that can reach a pixel
+        frames = [(p0[k], p1[k], pixels) for (p0, p1, pixels), k in
+                  zip(frames, _reaching([(p0, p1, pixels) for p0, p1, pixels in frames], width, height,
+                                        radius + REACH_MARGIN_PX))]
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius, box=box)
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
     owner = np.full(len(px), -1, np.int64)
     sid, pos = segs.nearest(px)
     owner[pos] = sid
     return owner, segs.q0, segs.q1, px.at()[0]
+
+
+def _reaching(frames, width: int, height: int, reach: float, cell: int = 8) -> list[np.ndarray]:
+    """For each frame ``(p0 (E, 2), p1 (E, 2), pixels)``: ``(E,)`` bool, True for every segment whose box (of
+    its ends, unclipped) grown by ``reach`` holds one of the frame's pixels (and for some others: the boxes
+    are widened to whole square cells of ``cell`` px, a summed-area table of the cells holding pixels);
+    False for non-finite rows, which clipping drops."""
+    out = []
+    nx, ny = -(-width // cell), -(-height // cell)
+    for p0, p1, pixels in frames:
+        pixels = np.asarray(pixels, np.int64).reshape(-1)
+        hit = np.zeros(len(p0), bool)
+        if len(pixels) and len(p0):
+            table = np.zeros((ny + 1, nx + 1), np.int32)
+            table[pixels // width // cell + 1, pixels % width // cell + 1] = 1
+            np.cumsum(table, axis=0, out=table)
+            np.cumsum(table, axis=1, out=table)
+            with np.errstate(invalid="ignore", over="ignore"):
+                total = p0 + p1                    # clip_to_box keeps only the rows where this is finite
+                finite = np.isfinite(total[:, 0]) & np.isfinite(total[:, 1])
+                ends = []
+                for k, n in ((0, nx), (1, ny)):
+                    a, b = np.where(finite, p0[:, k], 0.0), np.where(finite, p1[:, k], 0.0)
+                    lo, hi = np.minimum(a, b), np.maximum(a, b)
+                    lo -= reach
+                    hi += reach
+                    lo /= cell
+                    hi /= cell
+                    # x in [lo, hi] has its cell x // cell in [floor(lo / cell), floor(hi / cell)]: [first, stop)
+                    first = np.clip(np.floor(lo), 0, n).astype(np.int64)
+                    stop = np.maximum(np.clip(np.floor(hi) + 1, 0, n).astype(np.int64), first)
+                    ends += [first, stop]
+            c0, c1, r0, r1 = ends
+            hit = ((table[r1, c1] - table[r0, c1] - table[r1, c0] + table[r0, c0]) > 0) & finite
+        out.append(hit)
+    return out
 
 
 class _Pixels:
