@@ -54,9 +54,9 @@ class FramePixels:
     def exchanged(self, cand_out: np.ndarray, cand_in: np.ndarray) -> FramePixels | None:
         """The frame with the candidate's ``cand_out`` taken out and ``cand_in`` put in, or None.
 
-        ``cand_out``: candidate-only pixels, ``cand_in``: oracle-only pixels (ascending
-        flat indices each; None when they are not). The same frame as
-        ``from_indices`` of the changed candidate pixels gives, found by a merge:
+        ``cand_out``: candidate-only pixels, ``cand_in``: oracle-only pixels, ascending
+        flat indices each; None (the caller builds the frame anew) when they are
+        not. The same frame as ``from_indices`` of the changed candidate pixels gives, found by a merge:
         the pixels the other image draws change only at those places (a
         candidate-only pixel is in no oracle lookup; an oracle-only one put in is
         drawn by both), so no lookup over all the pixels is made again.
