@@ -470,7 +470,7 @@ class _Segments:
         """
         levels = []
         if len(px) >= LEVEL_PIXELS:
-            crowded = self._rows_spanned() > CROWDED * len(px)
+            crowded = self._crowded(CROWDED * len(px))
             levels = [r for r in (CROWDED_LEVELS if crowded else LEVELS) if r < self.radius]
         sid_parts, pos_parts = [], []
         rest = None                                   # positions in px still without an owner (None: all)
@@ -630,6 +630,13 @@ class _Segments:
             order = np.argsort(keys, kind="stable")
             self._cells = (keys[order], sid[order])
         return self._cells
+
+    def _crowded(self, limit: int) -> bool:
+        """Whether :meth:`_rows_spanned` is over ``limit``; without counting them when a bound says not: a
+        segment's grown box spans at most ``|dy| + 2 grow + 1`` rows."""
+        if self._rows is None and float(np.abs(self._cols[3]).sum()) + len(self) * (2 * self.grow + 1) <= limit:
+            return False
+        return self._rows_spanned() > limit
 
     def _rows_spanned(self) -> int:
         """How many (segment, row) slices :meth:`pairs` takes over all segments."""
