@@ -146,6 +146,7 @@ class CaseRunner:
             if camera.distortion is not None:          # GL has no lens; the shaders do not depend on it
                 camera = camera.with_distortion(None)
             oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera)   # compiles the shaders
+            oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera, depth=False)   # the pixel stage's read
             if mode is not None and mode.shaded:
                 oracle.render_faces(*self._DUMMY_TRIANGLE, camera)         # and the id shader
         return oracle

@@ -76,7 +76,14 @@ def clip_to_box(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
     """
     p0, p1 = np.asarray(p0, np.float64), np.asarray(p1, np.float64)
     d = p1 - p0
-    inside = ((p0 > lo + INSIDE_PX) & (p0 < hi - INSIDE_PX) & (p1 > lo + INSIDE_PX) & (p1 < hi - INSIDE_PX)).all(axis=1)
+    inside = np.ones(len(p0), bool)
+    columns = p0.shape[1] if p0.ndim == 2 else 0
+    lo_in = np.broadcast_to(np.asarray(lo, np.float64) + INSIDE_PX, (columns,))
+    hi_in = np.broadcast_to(np.asarray(hi, np.float64) - INSIDE_PX, (columns,))
+    for k in range(columns):                         # column by column: no reduction over the rows' 2 values
+        for q in (p0[:, k], p1[:, k]):
+            inside &= q > lo_in[k]
+            inside &= q < hi_in[k]
     if inside.all():
         return inside, p0 + 0.0 * d, p0 + d
     with np.errstate(invalid="ignore"):             # rows not inside are overwritten below

@@ -388,8 +388,14 @@ def _ends_naive(cand, oracle, p0, p1, reach=1.5):
 
 
 @pytest.mark.parametrize("seed", range(8))
-def test_end_attribution_equals_the_definition(seed):
+@pytest.mark.parametrize("prefilter", [False, True], ids=["all-segments", "reaching-only"])
+def test_end_attribution_equals_the_definition(monkeypatch, seed, prefilter):
+    # reaching-only: segment_pixels.nearest_segments keeps only the segments whose boxes (whole cells of
+    # 8 px) reach a one-sided pixel, forced here on 9 segments (by default from 4096 on)
+    from wirecheck.oracles.judge import segment_pixels
     from wirecheck.oracles.judge.metrics import end_attribution
+
+    monkeypatch.setattr(segment_pixels, "FEW_SEGMENTS", 0 if prefilter else 10 ** 9)
 
     rng = np.random.default_rng(200 + seed)
     w, h = 30, 20
@@ -401,9 +407,13 @@ def test_end_attribution_equals_the_definition(seed):
     assert end_attribution(cand, oracle, p0, p1) == _ends_naive(cand, oracle, p0, p1)
 
 
-def test_end_attribution_equals_the_definition_at_ties():
+@pytest.mark.parametrize("prefilter", [False, True], ids=["all-segments", "reaching-only"])
+def test_end_attribution_equals_the_definition_at_ties(monkeypatch, prefilter):
     # segment ends on the half-pixel grid: many rows are crossed exactly at a pixel's edge (sub-pixel ties)
+    from wirecheck.oracles.judge import segment_pixels
     from wirecheck.oracles.judge.metrics import end_attribution
+
+    monkeypatch.setattr(segment_pixels, "FEW_SEGMENTS", 0 if prefilter else 10 ** 9)
 
     ties = 0
     for seed in range(8):
@@ -433,3 +443,27 @@ def test_vertex_errors_frames_equal_frame_by_frame():
     got = vertex_errors_frames(cand, orac)
     assert json.dumps(got) == json.dumps([vertex_errors(c, o) for c, o in zip(cand, orac)])
     assert got[2]["oracle_only"] == 1 and got[5]["candidate_only"] == 1 and got[7]["max_px"] == float("inf")
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_resolve_ties_by_a_merge_equals_the_pixels_looked_up_again(seed):
+    """line_ends.resolve_ties moves the tie pixels by a merge (FramePixels.exchanged); the frame it gives
+    equals FramePixels.from_indices of the changed candidate pixels (binary searches over every pixel),
+    array for array; pixels that are not one-sided are refused (None)."""
+    from wirecheck.oracles.judge.frame_pixels import FramePixels
+    from wirecheck.oracles.judge.line_ends import resolve_ties
+
+    rng = np.random.default_rng(500 + seed)
+    h, w = 20, 30
+    fp = FramePixels(rng.random((h, w)) < 0.3, rng.random((h, w)) < 0.3)
+    c_only, o_only = fp.only()
+    c_ties = np.sort(rng.choice(c_only, len(c_only) // 2, replace=False))
+    o_ties = np.sort(rng.choice(o_only, len(o_only) // 3, replace=False))
+    got = resolve_ties(fp, (c_ties, o_ties))
+    want_cand = np.union1d(np.setdiff1d(fp.cand_idx, c_ties), o_ties)
+    want = FramePixels.from_indices(fp.shape, want_cand, fp.oracle_idx)
+    for name in ("cand_idx", "oracle_idx", "cand_in_oracle", "oracle_in_cand"):
+        np.testing.assert_array_equal(getattr(got, name), getattr(want, name), err_msg=name)
+    assert got.only()[0].tolist() == np.setdiff1d(c_only, c_ties).tolist()
+    both = fp.cand_idx[fp.cand_in_oracle][:1]                        # drawn by both: no tie of one side
+    assert fp.exchanged(both, o_ties[:0]) is None and fp.exchanged(c_ties[:0], both) is None

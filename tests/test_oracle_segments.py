@@ -62,3 +62,19 @@ def test_given_pixels_serve_only_whole_edges():
 def test_no_edges():
     p0, p1 = oracle_segments(P_WORLD, np.zeros((0, 2), np.int64), CAM, opencv_oracle.project(P_WORLD, CAM))
     assert p0.shape == p1.shape == (0, 2)
+
+
+def test_every_edge_whole_takes_the_given_rows_into_new_arrays():
+    """Every edge in [near, far] (edge 0 both ways, and vertex 3 to vertex 0): each end is its vertex's
+    given row, in arrays of their own (the caller blanks culled edges in them; the given pixels stay)."""
+    p_px = opencv_oracle.project(P_WORLD, CAM)
+    marked = p_px.copy()
+    marked[np.isfinite(marked)] += 1000.0
+    kept = marked.copy()
+    edges = np.array([[0, 1], [1, 0], [3, 0]])
+    p0, p1 = oracle_segments(P_WORLD, edges, CAM, marked)
+    np.testing.assert_array_equal(p0, marked[[0, 1, 3]])
+    np.testing.assert_array_equal(p1, marked[[1, 0, 0]])
+    assert p0.dtype == p1.dtype == np.float64 and p0.shape == p1.shape == (3, 2)
+    p0[0] = p1[0] = np.nan
+    np.testing.assert_array_equal(marked, kept)

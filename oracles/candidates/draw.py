@@ -116,6 +116,9 @@ def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera,
     if p_px is not None:
         seen = np.isfinite(p_px).all(axis=1)          # project's NaN rows: depth outside [near, far]
         whole = seen[edges[:, 0]] & seen[edges[:, 1]]
+        if whole.all():                                 # every edge in [near, far]: its ends, gathered
+            return (np.take(np.asarray(p_px, np.float64), edges[:, 0], axis=0),
+                    np.take(np.asarray(p_px, np.float64), edges[:, 1], axis=0))
         p0[whole], p1[whole] = p_px[edges[whole, 0]], p_px[edges[whole, 1]]
         cut = ~whole
         if not cut.any():

@@ -438,8 +438,10 @@ def pixel_stage(setup: CaseSetup, acc: CaseFrames, k: int, frame_rec: dict, geom
         if setup.use_faces and mode.hidden_lines:
             occluders = oface.gl_polygons(setup.faces, mirrored)
         t0 = acc.add("pmetric", t0)      # the oracle's segments and the edges to draw: harness, not pyrender
+        # the colour only (the mask pyrender's colour-and-depth read gives, without the depth's read back and
+        # linearisation: tests/test_oracle_gl.py)
         orac_img, _depth = pyrender_oracle.render(pr_vertices, draw_edges, cam, model_matrix=pr_pose,
-                                                  faces=occluders, cull=mode.cull == "backface")
+                                                  faces=occluders, cull=mode.cull == "backface", depth=False)
         t1 = acc.add("pr", t0)
         acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(pyrender_oracle, "last_bound_px", 0.0))
         fp = metrics.FramePixels(cand_img, orac_img)                     # one scan of each image

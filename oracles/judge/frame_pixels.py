@@ -51,6 +51,43 @@ class FramePixels:
         fp._only = None
         return fp
 
+    def exchanged(self, cand_out: np.ndarray, cand_in: np.ndarray) -> FramePixels | None:
+        """The frame with the candidate's ``cand_out`` taken out and ``cand_in`` put in, or None.
+
+        ``cand_out``: candidate-only pixels, ``cand_in``: oracle-only pixels, ascending
+        flat indices each; None (the caller builds the frame anew) when they are
+        not. The same frame as ``from_indices`` of the changed candidate pixels gives, found by a merge:
+        the pixels the other image draws change only at those places (a
+        candidate-only pixel is in no oracle lookup; an oracle-only one put in is
+        drawn by both), so no lookup over all the pixels is made again.
+        """
+        cand_out = np.asarray(cand_out, np.int64).reshape(-1)
+        cand_in = np.asarray(cand_in, np.int64).reshape(-1)
+        at_out = np.searchsorted(self.cand_idx, cand_out)
+        at_in = np.searchsorted(self.oracle_idx, cand_in)
+        only_c, only_o = ~self.cand_in_oracle, ~self.oracle_in_cand
+        if (len(cand_out) and (np.any(at_out >= len(self.cand_idx))
+                               or np.any(self.cand_idx[np.minimum(at_out, len(self.cand_idx) - 1)] != cand_out)
+                               or not only_c[at_out].all() or np.any(np.diff(cand_out) <= 0))):
+            return None
+        if (len(cand_in) and (np.any(at_in >= len(self.oracle_idx))
+                              or np.any(self.oracle_idx[np.minimum(at_in, len(self.oracle_idx) - 1)] != cand_in)
+                              or not only_o[at_in].all() or np.any(np.diff(cand_in) <= 0))):
+            return None
+        keep = np.ones(len(self.cand_idx), bool)
+        keep[at_out] = False
+        kept, kept_in = self.cand_idx[keep], self.cand_in_oracle[keep]
+        where = np.searchsorted(kept, cand_in)
+        fp = FramePixels.__new__(FramePixels)
+        fp.shape = self.shape
+        fp.cand_idx = np.insert(kept, where, cand_in.astype(kept.dtype))
+        fp.oracle_idx = self.oracle_idx
+        fp.cand_in_oracle = np.insert(kept_in, where, True)
+        fp.oracle_in_cand = self.oracle_in_cand.copy()
+        fp.oracle_in_cand[at_in] = True
+        fp._only = None
+        return fp
+
     @property
     def both(self) -> int:
         """Pixels drawn by both images."""

@@ -115,6 +115,9 @@ def resolve_ties(fp, ties: tuple):
     cand_ties, oracle_ties = ties
     if not len(cand_ties) and not len(oracle_ties):
         return fp
+    swapped = fp.exchanged(cand_ties, oracle_ties)                 # ties found by frames_end_places: a merge
+    if swapped is not None:
+        return swapped
     kept = fp.cand_idx[~np.isin(fp.cand_idx, cand_ties, assume_unique=True)]
     cand_idx = np.union1d(kept, oracle_ties).astype(fp.cand_idx.dtype)
     return FramePixels.from_indices(fp.shape, cand_idx, fp.oracle_idx)

@@ -82,6 +82,14 @@ CROWDED = 64
 #: x (H + 1) x (W + 1), int32: 32 MiB); over it, the pixels left after a first radius are paired by
 #: :meth:`_Segments.pairs_any`.
 TABLE_CELLS = 1 << 23
+#: :func:`nearest_segments` first keeps only the segments whose unclipped boxes, grown by its radius and
+#: :data:`REACH_MARGIN_PX`, hold one of the pixels (a frame's few one-sided pixels among 10^4 - 10^5
+#: segments: clipping and pairing every segment cost ~10 ms), when the frames hold at least this many.
+FEW_SEGMENTS = 4096
+#: A clipped end is ``p0 + t (p1 - p0)``, ``t`` in [0, 1]: within ~1e-12 px of the segment's box on
+#: coordinates of ~10^4 px; a whole pixel of margin keeps every segment that can pair (the pairs are
+#: measured after).
+REACH_MARGIN_PX = 1.0
 #: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
 #: (fewer: one search costs less than the calls of several).
 LEVEL_PIXELS = 1024
@@ -145,6 +153,10 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
       drawn pixel: most do at the pixel nearest their midpoint, and only the
       rest are looked for among the drawn pixels near them.
 
+    On a dense mesh (:data:`DENSE`) every drawn pixel's owner is found in one
+    pass instead: the compared edges are the owners, and the counts are taken
+    over the rows of the owners of one-sided pixels only.
+
     The results equal the full count over every drawn pixel
     (:func:`frames_neighbourhoods` and oracles.judge.metrics.edge_counts), for a
     fraction of the work when the frames mostly agree.
@@ -172,9 +184,16 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     compared = np.zeros(len(segs), bool)
     if len(segs) and len(drawn):
         if len(segs) * DENSE > len(drawn):          # a dense mesh: one pass over every drawn pixel is cheaper
-            owners = np.arange(len(segs))
-            cc, oc = _counts_near(segs, cand, orac, drawn, every=True)
-            compared = (cc > 0) | (oc > 0)
+            sid, pos = segs.nearest(drawn, every=True)
+            compared[sid] = True                    # every drawn pixel is drawn by one image at least
+            # only the owners of one-sided pixels can count differently: their rows alone are counted
+            mine = np.zeros(len(segs), bool)
+            mine[sid[one_sided.has(drawn.stacked[pos])]] = True
+            owners = np.flatnonzero(mine)
+            cc = oc = np.zeros(len(segs), np.int64)
+            if len(owners):
+                keep = mine[sid]
+                cc, oc = _counts_of(segs, cand, orac, drawn, sid[keep], pos[keep])
         else:
             compared = _compared(segs, drawn)
             owners = _unique(segs.nearest(one_sided)[0])
@@ -212,6 +231,11 @@ def _counts_near(segs: _Segments, cand: _Pixels, orac: _Pixels, near: _Pixels, e
     the drawn pixels ``near`` only (right for the segments all of whose pixels are among them);
     ``every``: ``near`` is every drawn pixel (paired row by row)."""
     sid, pos = segs.nearest(near, every)
+    return _counts_of(segs, cand, orac, near, sid, pos)
+
+
+def _counts_of(segs: _Segments, cand: _Pixels, orac: _Pixels, near: _Pixels, sid: np.ndarray, pos: np.ndarray):
+    """:func:`_counts_near` given the owner ``sid`` of the pixels at positions ``pos`` of ``near``."""
     _, _, major = segs.rows(near, sid, pos)
     cc = _distinct_per_segment(sid, major, len(segs), cand.has(near.stacked[pos]))
     if np.array_equal(cand.stacked, orac.stacked):          # the frames agree (ties resolved): once
@@ -266,16 +290,59 @@ def nearest_segments(frames, width: int, height: int, radius: float, box: tuple)
         one's nearest segment within ``radius`` (ties: the lower index), -1
         where none is that near.
     q0, q1 : (K, 2) float64
-        The kept segments of all frames, clipped, frame after frame.
+        The kept segments of all frames, clipped, frame after frame (from :data:`FEW_SEGMENTS`
+        segments on, only those whose boxes reach one of the pixels: the others own none).
     frame : (sum P,) int64
         Each pixel's frame.
     """
+    frames = [(np.asarray(p0, np.float64).reshape(-1, 2), np.asarray(p1, np.float64).reshape(-1, 2), pixels)
+              for p0, p1, pixels in frames]
+    if sum(len(p0) for p0, _, _ in frames) >= FEW_SEGMENTS:      # only the segments that can reach a pixel
+        frames = [(p0[k], p1[k], pixels) for (p0, p1, pixels), k in
+                  zip(frames, _reaching([(p0, p1, pixels) for p0, p1, pixels in frames], width, height,
+                                        radius + REACH_MARGIN_PX))]
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius, box=box)
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
     owner = np.full(len(px), -1, np.int64)
     sid, pos = segs.nearest(px)
     owner[pos] = sid
     return owner, segs.q0, segs.q1, px.at()[0]
+
+
+def _reaching(frames, width: int, height: int, reach: float, cell: int = 8) -> list[np.ndarray]:
+    """For each frame ``(p0 (E, 2), p1 (E, 2), pixels)``: ``(E,)`` bool, True for every segment whose box (of
+    its ends, unclipped) grown by ``reach`` holds one of the frame's pixels (and for some others: the boxes
+    are widened to whole square cells of ``cell`` px, a summed-area table of the cells holding pixels);
+    False for non-finite rows, which clipping drops."""
+    out = []
+    nx, ny = -(-width // cell), -(-height // cell)
+    for p0, p1, pixels in frames:
+        pixels = np.asarray(pixels, np.int64).reshape(-1)
+        hit = np.zeros(len(p0), bool)
+        if len(pixels) and len(p0):
+            table = np.zeros((ny + 1, nx + 1), np.int32)
+            table[pixels // width // cell + 1, pixels % width // cell + 1] = 1
+            np.cumsum(table, axis=0, out=table)
+            np.cumsum(table, axis=1, out=table)
+            with np.errstate(invalid="ignore", over="ignore"):
+                total = p0 + p1                    # clip_to_box keeps only the rows where this is finite
+                finite = np.isfinite(total[:, 0]) & np.isfinite(total[:, 1])
+                ends = []
+                for k, n in ((0, nx), (1, ny)):
+                    a, b = np.where(finite, p0[:, k], 0.0), np.where(finite, p1[:, k], 0.0)
+                    lo, hi = np.minimum(a, b), np.maximum(a, b)
+                    lo -= reach
+                    hi += reach
+                    lo /= cell
+                    hi /= cell
+                    # x in [lo, hi] has its cell x // cell in [floor(lo / cell), floor(hi / cell)]: [first, stop)
+                    first = np.clip(np.floor(lo), 0, n).astype(np.int64)
+                    stop = np.maximum(np.clip(np.floor(hi) + 1, 0, n).astype(np.int64), first)
+                    ends += [first, stop]
+            c0, c1, r0, r1 = ends
+            hit = ((table[r1, c1] - table[r0, c1] - table[r1, c0] + table[r0, c0]) > 0) & finite
+        out.append(hit)
+    return out
 
 
 class _Pixels:
@@ -366,13 +433,17 @@ class _Segments:
         p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
         p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
         keep, q0, q1 = clip_to_box(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
-        self.q0, self.q1 = q0[keep], q1[keep]
-        self.frame, self.edge = frame[keep], edge[keep]
+        if keep.all():                           # every segment reaches the box: no copies
+            self.q0, self.q1, self.frame, self.edge = q0, q1, frame, edge
+        else:
+            self.q0, self.q1 = q0[keep], q1[keep]
+            self.frame, self.edge = frame[keep], edge[keep]
         self.d = self.q1 - self.q0
-        self.dd = self.d[:, 0] * self.d[:, 0] + self.d[:, 1] * self.d[:, 1]
         # the columns _near gathers per pair, contiguous (np.take of a 1-D array: the same floats, faster)
-        self._cols = tuple(np.ascontiguousarray(c) for c in (self.q0[:, 0], self.q0[:, 1], self.d[:, 0],
-                                                             self.d[:, 1], self.dd))
+        dx, dy = np.ascontiguousarray(self.d[:, 0]), np.ascontiguousarray(self.d[:, 1])
+        self.dd = dx * dx + dy * dy
+        self._cols = (np.ascontiguousarray(self.q0[:, 0]), np.ascontiguousarray(self.q0[:, 1]), dx, dy, self.dd)
+        self._points = bool((self.dd == 0).any())          # a segment of no length (_near's u is 0 for it)
         self._cells = None                       # the grid of pairs_any, made on first use
         self._rows = None                        # _rows_spanned, counted on first use
         self._y = None                           # _y_range, found on first use
@@ -399,7 +470,7 @@ class _Segments:
         """
         levels = []
         if len(px) >= LEVEL_PIXELS:
-            crowded = self._rows_spanned() > CROWDED * len(px)
+            crowded = self._crowded(CROWDED * len(px))
             levels = [r for r in (CROWDED_LEVELS if crowded else LEVELS) if r < self.radius]
         sid_parts, pos_parts = [], []
         rest = None                                   # positions in px still without an owner (None: all)
@@ -560,6 +631,13 @@ class _Segments:
             self._cells = (keys[order], sid[order])
         return self._cells
 
+    def _crowded(self, limit: int) -> bool:
+        """Whether :meth:`_rows_spanned` is over ``limit``; without counting them when a bound says not: a
+        segment's grown box spans at most ``|dy| + 2 grow + 1`` rows."""
+        if self._rows is None and float(np.abs(self._cols[3]).sum()) + len(self) * (2 * self.grow + 1) <= limit:
+            return False
+        return self._rows_spanned() > limit
+
     def _rows_spanned(self) -> int:
         """How many (segment, row) slices :meth:`pairs` takes over all segments."""
         if self._rows is None:
@@ -633,11 +711,22 @@ class _Segments:
         """The pairs ``(sid, pos)`` within ``radius``, with their distances."""
         qx, qy, dx, dy, dd = (np.take(c, sid) for c in self._cols)
         # the point of the segment nearest the pixel centre: a + u d, u in [0, 1], in the frame's coordinates
+        # (in place, each float as ``clip(where(dd > 0, (ex dx + ey dy) / dd, 0), 0, 1)`` and
+        # ``hypot(ex - u dx, ey - u dy)`` give it)
         x, y = px.xy()
-        ex, ey = np.take(x, pos) - qx, np.take(y, pos) - qy
+        ex, ey = np.take(x, pos), np.take(y, pos)
+        ex -= qx
+        ey -= qy
+        u = np.multiply(ex, dx, out=qx)
+        u += np.multiply(ey, dy, out=qy)
         with np.errstate(divide="ignore", invalid="ignore"):
-            u = np.clip(np.where(dd > 0, (ex * dx + ey * dy) / dd, 0.0), 0.0, 1.0)
-        dist = np.hypot(ex - u * dx, ey - u * dy)
+            u /= dd
+        if self._points:
+            u[dd == 0] = 0.0
+        np.clip(u, 0.0, 1.0, out=u)
+        ex -= np.multiply(u, dx, out=dx)
+        ey -= np.multiply(u, dy, out=dy)
+        dist = np.hypot(ex, ey, out=ex)
         near = dist <= self.radius
         return sid[near], pos[near], dist[near]
 
