@@ -12,9 +12,10 @@ A map drawn with a camera mistake shows the right surfaces at the wrong pixels: 
 The reference is read at ``T(p)`` by bilinear interpolation of ``w`` (``1 / depth`` under
 perspective, where it is affine in the pixel coordinates on a plane; depth itself under
 orthographic projection) between the four pixel centres around ``T(p)``, used only where the
-four show the same face (``faces``: one id per planar face, -1 where none): there the
+four show the same face (``faces``: one id per planar face, -1 where none, :data:`UNDECIDED_FACE`
+where which face shows is a rounding decision): there the
 interpolation is exact. A model explains the map when the candidate's surface lands on the
-reference's (at most :data:`MAX_OUTSIDE` of its pixels where all four neighbours are empty),
+reference's (at most :data:`MAX_OUTSIDE` of its pixels where all four neighbours show no surface),
 at least :data:`MIN_INTERIOR` of them land inside one face, and every one of those is within
 the slack of its allowance (oracles.diagnosis.depth_faults).
 """
@@ -23,8 +24,11 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MAX_OUTSIDE", "MIN_INTERIOR", "pixel_models"]
+__all__ = ["MAX_OUTSIDE", "MIN_INTERIOR", "UNDECIDED_FACE", "pixel_models"]
 
+#: The face id of a pixel that shows a surface whose face is a rounding decision (beside an occlusion edge or a
+#: clip plane's line): neither sampled (not inside one face) nor empty (not outside).
+UNDECIDED_FACE = -2
 #: Share of the candidate's surface pixels that may land where the reference shows nothing
 #: (all four neighbours empty). Measured, each pixel mistake under its own map: at most 0.32 %
 #: (prism, near_plane: the near plane's clip line); 1 % leaves 3x. This share does not tell the
@@ -86,7 +90,9 @@ def sample(ref, faces, camera, q):
     xs, ys = np.clip(x0, 0, w - 2), np.clip(y0, 0, h - 2)
     i00, i10, i01, i11 = faces[ys, xs], faces[ys, xs + 1], faces[ys + 1, xs], faces[ys + 1, xs + 1]
     inside = on_image & (i00 >= 0) & (i10 == i00) & (i01 == i00) & (i11 == i00)
-    outside = ~on_image | ((i00 < 0) & (i10 < 0) & (i01 < 0) & (i11 < 0))
+    # no surface at any of the four (-1); an undecided pixel (-2: a surface, which one a rounding decision) is
+    # neither inside nor outside
+    outside = ~on_image | ((i00 == -1) & (i10 == -1) & (i01 == -1) & (i11 == -1))
     persp = camera.projection == "perspective"
     with np.errstate(divide="ignore", invalid="ignore"):
         # the four neighbours' w, taken from ``ref`` at those pixels only (not 1 / ref over the whole image)

@@ -30,6 +30,7 @@ from wirecheck.core.transforms import Motion
 
 from ..references import faces as oface
 from ..cases import Case, case_motion
+from ..diagnosis.depth_pixels import UNDECIDED_FACE
 from .metrics import depth_bound, depth_slope, occlusion_boundary
 
 __all__ = ["ReferenceDepth", "from_render", "reference_depth"]
@@ -64,8 +65,10 @@ class ReferenceDepth:
         return np.where(self.undecided, np.nan, self.depth)
 
     def compared_faces(self) -> np.ndarray:
-        """``(H, W)``: :attr:`faces` with -1 at the undecided pixels too."""
-        return np.where(self.undecided, -1, self.faces)
+        """``(H, W)``: :attr:`faces` with :data:`UNDECIDED_FACE` (-2) at the undecided pixels: a surface is there,
+        which one is a rounding decision (oracles.diagnosis.depth_pixels neither samples it nor counts a pixel
+        landing there as landing on nothing)."""
+        return np.where(self.undecided, UNDECIDED_FACE, self.faces)
 
 
 def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, frames: int) -> ReferenceDepth:
