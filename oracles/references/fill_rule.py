@@ -229,13 +229,12 @@ def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, t
         in_half |= e > 0
         inside &= in_half
         reach = tie_px * np.sqrt(dx * dx + dy * dy)                  # |e| / length <= tie_px, undivided
-        np.abs(e, out=e)
-        far_from_edges &= e > reach.reshape(tri)
+        far_from_edges &= e > reach.reshape(tri)                     # inside it: e >= 0, so |e| > reach
         # near an open edge (few triangles have one): within tie_px of its line, then of the segment itself
         rows = np.flatnonzero(is_open[:, k])
         if len(rows) == 0:
             continue
-        ii, r, c = np.nonzero((e.transpose(tri_major)[rows] <= reach[rows, None, None])
+        ii, r, c = np.nonzero((np.abs(e.transpose(tri_major)[rows]) <= reach[rows, None, None])
                              & valid.transpose(tri_major)[rows])
         if len(ii):
             ii = rows[ii]
@@ -252,7 +251,7 @@ def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, t
     out.robust[cell[far_from_edges].astype(np.int64)] = True
     if tri_z is None or not inside.any():
         return
-    rows, r, cols = np.nonzero(inside.transpose(tri_major))                    # covered, triangle by triangle, row-major
+    rows, r, cols = np.nonzero(inside.transpose(tri_major))          # covered, triangle by triangle, row-major
     cells = _cells(x0, y0, width, rows, r, cols)
     # depth at the centres: w = 1/z (perspective) or z (orthographic) on the plane through the vertices
     a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
