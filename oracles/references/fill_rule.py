@@ -226,10 +226,11 @@ def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, t
         dx, dy = q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]
         e = dx.reshape(tri) * (py - p[:, 1].reshape(tri)) - dy.reshape(tri) * (px - p[:, 0].reshape(tri))
         top_left = (dy < 0) | ((dy == 0) & (dx > 0))
-        in_half = e == 0                                             # E > 0, or E == 0 on a top or left edge
-        in_half &= top_left.reshape(tri)
-        in_half |= e > 0
-        inside &= in_half
+        inside &= e >= 0                                             # E > 0, or E == 0 on a top or left edge:
+        on_line = e == 0                                             # E == 0 is rare off axis-aligned edges
+        if on_line.any():
+            on_line &= ~top_left.reshape(tri)
+            inside &= ~on_line
         reach = tie_px * np.sqrt(dx * dx + dy * dy)                  # |e| / length <= tie_px, undivided
         far_from_edges &= e > reach.reshape(tri)                     # inside it: e >= 0, so |e| > reach
         # near an open edge (few triangles have one): within tie_px of its line, then of the segment itself
