@@ -453,3 +453,38 @@ def test_coverage_equals_a_naive_pass_bit_for_bit(count, size, shape, step, tie_
         assert want_inside.any() and want_ties.any() and is_open.any() and not is_open.all()
         np.testing.assert_array_equal(inside, want_inside)
         np.testing.assert_array_equal(ties, want_ties)
+
+
+def _naive_open_edges(tris_px):
+    """Edge ``k`` of each triangle is closed when the triangles with the same two end points (as floats:
+    -0.0 == 0.0, NaN equal to nothing) have third vertices strictly on both sides of its line."""
+    tris = np.asarray(tris_px, dtype=np.float64)
+    p = tris.reshape(-1, 2)                             # edge k runs p -> q, opposite third
+    q = np.roll(tris, -1, axis=1).reshape(-1, 2)
+    third = np.roll(tris, -2, axis=1).reshape(-1, 2)
+
+    def equal(a, b):
+        return (a[:, None] == b[None]).all(axis=2)
+
+    same = (equal(p, p) & equal(q, q)) | (equal(p, q) & equal(q, p))
+    d = q - p
+    side = np.sign(d[:, None, 0] * (third[None, :, 1] - p[:, None, 1])
+                   - d[:, None, 1] * (third[None, :, 0] - p[:, None, 0]))      # edge i's line, edge j's third
+    closed = (same & (side > 0)).any(axis=1) & (same & (side < 0)).any(axis=1)
+    return ~closed.reshape(-1, 3)
+
+
+def test_open_edges_equal_a_naive_pairing():
+    rng = np.random.default_rng(7)
+    tris = _snapped_soup(rng, 300, 3.0, (40, 56), 0.25)
+    tris[::7] *= -1.0                                   # -0.0 corners where a corner was 0.0
+    # an edge (0, 0) -> (0, 4) shared across, written with 0.0 in one triangle and -0.0 in the other: closed
+    tris = np.concatenate([tris, [[[0.0, 0.0], [0.0, 4.0], [-3.0, 2.0]], [[-0.0, 4.0], [-0.0, -0.0], [3.0, 2.0]]]])
+    want = _naive_open_edges(tris)
+    assert want.any() and not want.all()
+    assert not want[-2, 0] and not want[-1, 0]
+    np.testing.assert_array_equal(open_edges(tris), want)
+    # NaN corners equal nothing: the edges through one are open, even between triangles that share it
+    nan_pair = np.array([[[0.0, 0.0], [np.nan, 4.0], [-3.0, 2.0]], [[np.nan, 4.0], [0.0, 0.0], [3.0, 2.0]]])
+    np.testing.assert_array_equal(open_edges(nan_pair), _naive_open_edges(nan_pair))
+    assert open_edges(nan_pair)[:, :2].all()
