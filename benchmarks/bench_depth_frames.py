@@ -1,7 +1,10 @@
 """A job's depth maps (and filled frames) judged: the judge's time per frame against pyrender drawing it.
 
     .venv/bin/python benchmarks/bench_depth_frames.py                          # the cube, 12 frames, depth
-    .venv/bin/python benchmarks/bench_depth_frames.py --scene icosphere --outputs filled,depth --frames 24
+    .venv/bin/python benchmarks/bench_depth_frames.py --scene ICOSPHERE.obj --outputs filled,depth --frames 24
+
+(``--scene`` takes a built-in name or a mesh file: README's icosphere(4) is
+``trimesh.creation.icosphere(subdivisions=4).export('ICOSPHERE.obj')``.)
 
 A job is exported (one scene, case ``oblique_roll``, every frame checked, ``--outputs``) and drawn by
 core (tests/clients/core_depth_job.py: a correct renderer). In this process, its imports done and

@@ -382,3 +382,109 @@ def test_docs_depth_picture_is_what_coverage_gives():
         cells = line.split()
         assert cells[:5] == ["*" if v else "." for v in inside[row]], line
         assert cells[5:10] == ["t" if v else "." for v in ties[row]], line
+
+
+# ---- the batched pass against a naive one: every triangle over the whole image ----------------
+
+def _naive_coverage(tris_px, is_open, shape, tie_px):
+    """``(inside, ties)`` by the module docstring's rule, one triangle at a time over every centre.
+
+    Written from the rule, not from the batched pass: each triangle turned so that its edge functions
+    ``E = (Qx - Px)(py - Py) - (Qy - Py)(px - Px)`` are positive inside (its open flags carried with
+    its edges), a centre inside when every ``E > 0`` or ``E == 0`` on a top or left edge; near an open
+    edge when within tie_px of its line (``|E| <= tie_px |PQ|``) and of the segment; held robustly
+    when inside and ``|E| > tie_px |PQ|`` for all three edges. Ties: near an open edge, held by none.
+    """
+    height, width = shape
+    py, px = np.mgrid[0:height, 0:width].astype(np.float64)
+    inside = np.zeros(shape, dtype=bool)
+    near_open = np.zeros(shape, dtype=bool)
+    robust = np.zeros(shape, dtype=bool)
+    for tri, opened in zip(np.asarray(tris_px, dtype=np.float64), is_open):
+        a, b, c = tri
+        area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+        if area2 < 0:                                   # v1 <-> v2: edges 0, 1, 2 become 2, 1, 0
+            tri, opened = np.stack([a, c, b]), opened[::-1]
+        tri_in = np.full(shape, area2 != 0)
+        tri_far = tri_in.copy()
+        for k in range(3):
+            p, q = tri[k], tri[(k + 1) % 3]
+            dx, dy = q[0] - p[0], q[1] - p[1]
+            e = dx * (py - p[1]) - dy * (px - p[0])
+            top_left = dy < 0 or (dy == 0 and dx > 0)
+            tri_in &= (e > 0) | ((e == 0) & top_left)
+            reach = tie_px * math.sqrt(dx * dx + dy * dy)
+            tri_far &= np.abs(e) > reach
+            if opened[k]:
+                rx, ry = px - p[0], py - p[1]
+                length2 = dx * dx + dy * dy
+                t = np.clip((rx * dx + ry * dy) / length2, 0.0, 1.0) if length2 > 0 else np.zeros(shape)
+                near_open |= (np.abs(e) <= reach) & (np.hypot(rx - t * dx, ry - t * dy) <= tie_px)
+        inside |= tri_in
+        robust |= tri_in & tri_far
+    return inside, near_open & ~robust
+
+
+def _snapped_soup(rng, count, size, shape, step):
+    """``count`` triangles of about ``size`` px with corners on a ``step``-px grid (centres fall on edges: E == 0,
+    ties), half of them in strips sharing edges (closed edges), in and partly out of the image."""
+    height, width = shape
+    corner = rng.uniform([0, 0], [width, height], size=(count, 1, 2))
+    tris = np.round((corner + rng.uniform(-size, size, size=(count, 3, 2))) / step) * step
+    half = count // 2
+    tris[1:half:2, 0] = tris[0:half - 1:2, 1]           # each odd triangle shares its neighbour's edge v1 -> v2
+    tris[1:half:2, 1] = tris[0:half - 1:2, 2]
+    return tris
+
+
+@pytest.mark.parametrize("count, size, shape, step", [
+    (600, 3.0, (40, 56), 0.25),     # many small boxes: the triangle axis the longest (innermost)
+    (4, 40.0, (48, 64), 1.0),       # few large boxes: the column axis the longest
+    (60, 12.0, (33, 45), 0.5),
+])
+@pytest.mark.parametrize("tie_px", [GL_TIE_PX, 0.3])
+def test_coverage_equals_a_naive_pass_bit_for_bit(count, size, shape, step, tie_px):
+    rng = np.random.default_rng(count)
+    for _ in range(3):
+        tris = _snapped_soup(rng, count, size, shape, step)
+        is_open = open_edges(tris)
+        inside, ties = coverage(tris, shape, tie_px=tie_px)
+        want_inside, want_ties = _naive_coverage(tris, is_open, shape, tie_px)
+        assert want_inside.any() and want_ties.any() and is_open.any() and not is_open.all()
+        np.testing.assert_array_equal(inside, want_inside)
+        np.testing.assert_array_equal(ties, want_ties)
+
+
+def _naive_open_edges(tris_px):
+    """Edge ``k`` of each triangle is closed when the triangles with the same two end points (as floats:
+    -0.0 == 0.0, NaN equal to nothing) have third vertices strictly on both sides of its line."""
+    tris = np.asarray(tris_px, dtype=np.float64)
+    p = tris.reshape(-1, 2)                             # edge k runs p -> q, opposite third
+    q = np.roll(tris, -1, axis=1).reshape(-1, 2)
+    third = np.roll(tris, -2, axis=1).reshape(-1, 2)
+
+    def equal(a, b):
+        return (a[:, None] == b[None]).all(axis=2)
+
+    same = (equal(p, p) & equal(q, q)) | (equal(p, q) & equal(q, p))
+    d = q - p
+    side = np.sign(d[:, None, 0] * (third[None, :, 1] - p[:, None, 1])
+                   - d[:, None, 1] * (third[None, :, 0] - p[:, None, 0]))      # edge i's line, edge j's third
+    closed = (same & (side > 0)).any(axis=1) & (same & (side < 0)).any(axis=1)
+    return ~closed.reshape(-1, 3)
+
+
+def test_open_edges_equal_a_naive_pairing():
+    rng = np.random.default_rng(7)
+    tris = _snapped_soup(rng, 300, 3.0, (40, 56), 0.25)
+    tris[::7] *= -1.0                                   # -0.0 corners where a corner was 0.0
+    # an edge (0, 0) -> (0, 4) shared across, written with 0.0 in one triangle and -0.0 in the other: closed
+    tris = np.concatenate([tris, [[[0.0, 0.0], [0.0, 4.0], [-3.0, 2.0]], [[-0.0, 4.0], [-0.0, -0.0], [3.0, 2.0]]]])
+    want = _naive_open_edges(tris)
+    assert want.any() and not want.all()
+    assert not want[-2, 0] and not want[-1, 0]
+    np.testing.assert_array_equal(open_edges(tris), want)
+    # NaN corners equal nothing: the edges through one are open, even between triangles that share it
+    nan_pair = np.array([[[0.0, 0.0], [np.nan, 4.0], [-3.0, 2.0]], [[np.nan, 4.0], [0.0, 0.0], [3.0, 2.0]]])
+    np.testing.assert_array_equal(open_edges(nan_pair), _naive_open_edges(nan_pair))
+    assert open_edges(nan_pair)[:, :2].all()

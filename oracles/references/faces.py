@@ -41,7 +41,7 @@ def fan(faces) -> tuple[np.ndarray, np.ndarray]:
         lengths = np.full(len(faces), faces.shape[1], dtype=np.int64)
         flat = faces.astype(np.int64).ravel()
     else:
-        lengths = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+        lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
         flat = np.fromiter(chain.from_iterable(faces), dtype=np.int64, count=int(lengths.sum()))
     per = np.maximum(lengths - 2, 0)                          # triangles of each polygon
     owner = np.repeat(np.arange(len(lengths), dtype=np.int64), per)
