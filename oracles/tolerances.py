@@ -497,6 +497,40 @@ class Tolerances:
                 "end_px": self.end_px, "rounded_end_tie_px": self.rounded_end_tie_px,
                 "rule_f1_0px": self.rule_f1_0px}
 
+@dataclass(frozen=True)
+class NamingThresholds:
+    """The frames path's thresholds that decide a verdict or a name but are not a run's to set (no CLI option):
+    read by oracles.judge.decide and oracles.judge.name_faults, each with its reason. They were module
+    constants of line_style, free_ends, dim_lines and image_visibility; their values are unchanged.
+    """
+
+    #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
+    #: (oracles.candidates.png_frame). Lines whose level is above 0 and under it drew nothing by the rule:
+    #: named ``unexplained`` (dim lines), not the image diagnosis' ``depth_flip``.
+    drawn_level: int = 128
+    #: A case's lines are binary (aliased) when at most this share of the drawn pixels is an intermediate grey
+    #: (between 1/8 and 7/8 of the level): antialiased lines have a third or more (4x4 supersampled 1-px
+    #: lines measured 0.6-0.8). Binary lines are held to ``rule_offset_px`` and a warp half a pixel looser.
+    grey_share_max: float = 0.05
+    #: Binary lines are quantised line by line (up to half a pixel each, which a reference drawing matches
+    #: only for its own rule): their warp is held to ``Tolerances.scale_px`` plus this half pixel (px).
+    binary_warp_px: float = 0.5
+    #: The line centres are measured (and may name ``pixel_offset``) only where at least this share of the
+    #: windows along the oracle's lines holds a line: a correct renderer nearly all, lines mirrored or
+    #: scaled away few.
+    min_found_share: float = 0.5
+    #: Free ends a case must have measured for their median to be judged (one stray end cannot decide).
+    min_ends: int = 4
+    #: A ``line_pixel_bias`` whose one-sided pixels are mostly whole pieces of line is a visibility
+    #: difference: at least this share of its decided one-sided pixels (per frame) lie farther than 1 px from
+    #: the other side (a line drawn too thick or too thin never leaves a pixel that far).
+    visibility_share: float = 0.5
+
+
+#: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults).
+NAMING = NamingThresholds()
+
+
 def line_failures(lines: dict, tol) -> list[str]:
     """Why a case's pooled line fields (oracles.judge.metrics.line_summary) fail ``tol``; [] if they pass.
 

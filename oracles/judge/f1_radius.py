@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 
+from .evidence import Radius
 from .metrics import pixel_scores
 
 #: The widest radius computed: lines up to 5 px across (``1 + ceil((5 - 1) / 2) = 3``). A wider
@@ -59,17 +60,14 @@ def frame_scores(fp, scores: dict) -> dict:
     return {r: wide[f"f1_{r}px"] for r in RADII}
 
 
-def apply(rec: dict, read: dict, per_frame: list, frames: list) -> None:
-    """Set the case's F1 radius and its worst frame's F1 there, which oracles.judge.decide.reasons holds to
-    ``min_f1_1px``: ``rec["f1_radius_px"]``, ``rec["pixel_f1_radius"]``, ``rec["pixel_f1_radius_frame"]``.
+def radius_read(read: dict, per_frame: list, frames: list, f1_1px: float, worst_frame) -> Radius:
+    """The case's F1 radius and its worst frame's F1 there, which oracles.judge.decide holds to ``min_f1_1px``.
 
     ``read``: the case's style (``CaseStyle.classify()``); ``per_frame``: each frame's :func:`frame_scores`,
-    ``frames`` their numbers. At a radius of 1 the F1 is F1@1px itself (``pixel_f1_1px``, its worst frame).
+    ``frames`` their numbers. At a radius of 1 the F1 is F1@1px itself (``f1_1px``, its ``worst_frame``).
     """
     radius = radius_px(read)
-    rec["f1_radius_px"] = radius
     if radius == 1 or not per_frame:
-        rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"] = rec["pixel_f1_1px"], rec["worst_pixel_frame"]
-        return
+        return Radius(radius, f1_1px, worst_frame)
     worst = min(range(len(per_frame)), key=lambda i: per_frame[i][radius])     # the first of the lowest
-    rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"] = float(per_frame[worst][radius]), frames[worst]
+    return Radius(radius, float(per_frame[worst][radius]), frames[worst])

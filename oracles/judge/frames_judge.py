@@ -10,10 +10,10 @@ its frames: edge-pixel F1 at 0 and 1 px (oracles.judge.metrics.pixel_scores), an
 the line scores against the oracle's segments (oracles.judge.metrics.line_scores:
 one-sided pixels and their balance, per-edge counts, where the one-sided
 pixels lie, sub-pixel ties), the segments known from the job's camera and
-scene (oracles.candidates.draw.oracle_segments). The case's faults are named from the
-images (oracles.diagnosis.image_diagnose); when those name nothing, from the lines
-(``line_end_bias``, ``line_pixel_bias``: oracles.judge.decide.line_faults). The
-verdict is oracles.judge.decide.decide's, at level ``frames`` (no vertex compared).
+scene (oracles.candidates.draw.oracle_segments). After the frames, the case's measurements are frozen
+(:func:`case_evidence`: oracles.judge.evidence), its verdict decided from them (oracles.judge.decide.decide,
+at level ``frames``: no vertex compared), its faults named from both (oracles.judge.name_faults: the images'
+names, else the lines'), and its record built once (:func:`case_record`).
 
 Frames are streamed: a frame's images are dropped once it is scored, so
 memory does not grow with the job. What is kept per case: the worst frame's
@@ -25,22 +25,26 @@ its samples are capped per case anyway), and a per-frame record of numbers.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from . import f1_radius, line_model, metrics
+from . import f1_radius, gate, line_model, metrics
 from ..candidates.frames_candidate import read_frame
 from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
-from .decide import decide, line_faults, pixel_fields, pixel_rule_reasons, reasons
-from .dim_lines import name_dim_lines
-from .line_style import CaseStyle
+from .decide import decide, pixel_fields
+from .evidence import CaseEvidence, Visibility
+from .line_style import CaseStyle, style_record
+from .name_faults import name_faults, wants_visibility
 from wirecheck.core.projector import pipeline
 from ..candidates.draw import oracle_segments as line_segments
 from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
-from ..diagnosis.image_visibility import frames_visibility
+from ..diagnosis.diagnose import diagnose_lines
+from ..diagnosis.image_visibility import set_difference
 from ..candidates import frames_candidate
+from ..faults import Fault
 from ..tolerances import Tolerances
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
@@ -171,23 +175,19 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         del cand, orac, core, fp, frame
     ahead.close()
     acc.record_lines(acc.batch.flush())
-    rec = case_record(job, scene, case, camera, acc, len(numbers))
-    faults = []
     images, segments = [_image(flat, shape) for flat, shape, _, _ in acc.diag], [s for _, _, s, _ in acc.diag]
+    diagnosed = ()
     if diagnose:
-        faults = diagnose_images(images, segments, camera, [f for _, _, _, f in acc.diag], tol=tol)
-    rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
-    f1_radius.apply(rec, style.classify(), acc.radius, numbers)     # F1 at the radius the lines' width allows
-    # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
-    style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol), rounded=acc.rounded())
-    rec["line_style"]["f1_radius_px"] = rec["f1_radius_px"]
-    rec["faults"] = name_dim_lines(rec["faults"], rec["line_style"], acc.per_frame)   # lines under the 128 rule
-    rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
-    decide(rec, tol, level="frames")
-    if diagnose and not faults and rec["verdict"] == "fail":
+        diagnosed = tuple(Fault.of(f) for f in diagnose_images(images, segments, camera,
+                                                                [f for _, _, _, f in acc.diag], tol=tol))
+    ev = case_evidence(acc, style, numbers, diagnosed, tol)
+    verdict = decide(ev, tol)
+    names = name_faults(ev, verdict, tol)
+    if diagnose and images and wants_visibility(names, ev, verdict):
         # the images fit the oracle's lines (nothing named from them) and the case fails: which sets differ?
-        rec["faults"] = frames_visibility(rec["faults"], images, segments, camera, len(numbers))
-    rec["per_frame"] = acc.per_frame
+        ev = replace(ev, visibility=Visibility(*set_difference(images, segments, camera), len(images), len(numbers)))
+        names = name_faults(ev, verdict, tol)
+    rec = case_record(job, scene, case, camera, ev, verdict, names, acc)
     return rec, {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
 
 
@@ -202,14 +202,35 @@ def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:
     return out.reshape(shape)
 
 
-def case_record(job: dict, scene: str, case: str, camera, acc: _CaseFrames, checked: int) -> dict:
-    """A case's fields (before faults and verdict) from its frames' scores."""
+def case_evidence(acc: _CaseFrames, style: CaseStyle, numbers: list, diagnosed: tuple, tol) -> CaseEvidence:
+    """What a case's frames measured, frozen (oracles.judge.evidence): its pixel scores, lines, F1 radius,
+    the diagnosis's faults (``diagnosed``), GL's line faults, the style read and what was compared."""
+    pixels = pixel_fields(acc.pixel, acc.worst[1])
+    lines = metrics.line_summary(acc.lines)
+    line_named = tuple(Fault.of(f) for f in diagnose_lines(lines, tol))
+    radius = f1_radius.radius_read(style.classify(), acc.radius, numbers, pixels["pixel_f1_1px"],
+                                   pixels["worst_pixel_frame"])
+    return CaseEvidence(level="frames", compared={"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px},
+                        frames_checked=len(numbers), pixels=pixels, lines=lines, radius=radius,
+                        image_faults=diagnosed, line_faults=line_named,
+                        style=style.read(diagnosed or line_named, tol, acc.rounded()),
+                        drew_pixels=any(f["candidate_pixels"] for f in acc.per_frame))
+
+
+def case_record(job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple,
+                acc: _CaseFrames) -> dict:
+    """A case's record (its entry in report.json's ``cases``), built once from its evidence, verdict and names;
+    beside them core's second opinion (never deciding) and the per-frame numbers (``acc``)."""
     rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
-           "frames_checked": checked, "max_vertex_error_px": None}
-    rec.update(pixel_fields(acc.pixel, acc.worst[1]))
-    rec["core"] = {f"{k}": acc.core_min[k] for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
-                                                        "precision_1px", "recall_1px")}
-    rec["lines"] = metrics.line_summary(acc.lines)
+           "frames_checked": ev.frames_checked, "max_vertex_error_px": None, **ev.pixels,
+           "core": {k: acc.core_min[k] for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
+                                                  "precision_1px", "recall_1px")},
+           "lines": dict(ev.lines), "faults": [f.as_dict() for f in names],
+           "f1_radius_px": ev.radius.radius_px, "pixel_f1_radius": ev.radius.f1,
+           "pixel_f1_radius_frame": ev.radius.frame,
+           "line_style": style_record(ev.style, verdict.style, ev.radius.radius_px),
+           "compared": dict(ev.compared), "verdict": verdict.verdict, "reasons": list(verdict.reasons),
+           "per_frame": acc.per_frame}
     return rec
 
 
@@ -244,11 +265,10 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     compared = {"cases": sum(r["verdict"] != "vacuous" for r in records),
                 "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
                 "pixels": sum(r["compared"]["pixels"] for r in records)}
-    bad = failed or not compared["frames"] or (not allow_vacuous and (vacuous or not compared["pixels"]))
     tolerances = {**tol.to_dict(), **tol.lines_dict()}
     del tolerances["candidate_precision"]                 # no vertex is compared: no precision judged
     report = {
-        "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",
+        "tool": "wirecheck crosscheck", "verdict": gate.run_verdict(records, compared, "frames", allow_vacuous),
         "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
         "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
         "oracle_gl": gl,

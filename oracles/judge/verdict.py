@@ -19,6 +19,9 @@ from ..candidates.candidate import case_precision
 from .. import faults as catalogue
 from ..diagnosis.diagnose import diagnose
 from .decide import decide, line_faults, pixel_fields
+from .evidence import CaseEvidence
+from .name_faults import name_faults
+from ..faults import Fault
 from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
@@ -122,13 +125,39 @@ def shaded_summary(shaded: list, worst) -> dict:
     return out
 
 
+#: A projector case's vertex and shaded fields, as its evidence holds them (oracles.judge.evidence).
+VERTEX_KEYS = ("max_vertex_error_px", "vertex_bound_px", "worst_vertex", "precision", "visibility_mismatch")
+SHADED_KEYS = ("silhouette_iou", "silhouette_iou_gated", "silhouette_mismatch_inside", "face_disagreements_inside",
+               "depth_error_ratio", "depth_max_error", "depth_error_bound", "depth_worst_frame", "worst_pixel_frame")
+PIXEL_KEYS = ("pixel_f1_0px", "pixel_f1_1px", "worst_pixel_frame")
+
+
+def record_evidence(rec: dict, error: str | None = None, points: int | None = None) -> CaseEvidence:
+    """A projector case's record (:func:`case_record`) as frozen evidence: its vertex, pixel, line and shaded
+    fields, the faults the diagnosis named (line faults among them), what it compared, at level ``"vertices"``
+    when no pixel was compared, else ``"pixels"``."""
+    return CaseEvidence(
+        level="vertices" if rec["compared"]["pixels"] is None else "pixels", compared=rec["compared"],
+        frames_checked=rec["frames_checked"], pixels={k: rec[k] for k in PIXEL_KEYS if k in rec},
+        lines=rec.get("lines"), vertices={k: rec[k] for k in VERTEX_KEYS if k in rec},
+        shaded={k: rec[k] for k in SHADED_KEYS if k in rec} if "silhouette_iou" in rec else None,
+        image_faults=tuple(Fault.of(f) for f in rec.get("faults") or []), error=error, points=points)
+
+
 def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | None = None) -> None:
-    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed): :func:`oracles.judge.decide.decide`.
+    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed; oracles.judge.decide.decide),
+    and ``rec["faults"]`` to the names (oracles.judge.name_faults) where they add one: a failure nothing
+    explains is ``unexplained``.
 
     "fail" when a limit is missed; else "vacuous" when the case compared nothing
     (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.judge.gate).
     """
-    decide(rec, tol, error, points)
+    ev = record_evidence(rec, error, points)
+    verdict = decide(ev, tol)
+    names = name_faults(ev, verdict, tol)
+    if names and not ev.image_faults:
+        rec["faults"] = [f.as_dict() for f in names]
+    rec["verdict"], rec["reasons"] = verdict.verdict, list(verdict.reasons)
 
 
 def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:

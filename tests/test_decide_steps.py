@@ -1,0 +1,270 @@
+"""The three pure steps of a case's judgement on hand-made evidence: oracles.judge.evidence (frozen),
+oracles.judge.decide.decide (each limit just met and just missed, the bound taken from its Tolerances or
+NAMING field) and oracles.judge.name_faults.name_faults (the precedence table: of two candidate names, the
+table's winner).
+
+Every input below is written by hand (no frame drawn, nothing measured by the code under test); "just
+missed" is the next float past the bound (math.nextafter), so a limit compared with >= instead of > (or the
+reverse), or a bound taken from another field, fails here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from wirecheck.oracles.faults import Fault
+from wirecheck.oracles.judge.decide import Verdict, decide
+from wirecheck.oracles.judge.evidence import CaseEvidence, Radius, StyleRead, Visibility
+from wirecheck.oracles.judge.name_faults import PRECEDENCE, name_faults
+from wirecheck.oracles.tolerances import NAMING, Tolerances
+
+TOL = Tolerances()
+UP = math.inf
+
+#: Line fields that pass every line limit (balanced, no per-edge deficit).
+LINES_OK = {"imbalance_fraction": 0.0, "balance_p_value": 1.0, "subpixel_ties": [0, 0], "candidate_only": 0,
+            "oracle_only": 0, "edge_count_max_diff": 0, "edge_count_worst": None, "imbalance": 0,
+            "lines_compared": 12, "one_sided_by_place": {"start": [0, 0], "end": [0, 0], "middle": [0, 0]}}
+COMPARED = {"frames": 2, "vertices": 0, "pixels": 500}
+RASTER_NONE = {"oracle_pixels": 400, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0, "farther": 0}
+
+
+def _geometry(dx=0.0, warp=0.0, end=0.0, ends=6):
+    return {"samples": 900, "windows": 100, "found_share": 1.0, "offset_px": [dx, 0.0], "bias_px": [0.0, 0.0],
+            "warp_px": warp, "ends_measured": ends, "end_px": end}
+
+
+def _style(style="antialiased", grey_share=0.4, steps=4, width=1.0, line_rule="any", rounded=None,
+           raster=RASTER_NONE, placed=True, **geo):
+    read = {"style": style, "width_px": width, "grey_share": grey_share, "level": 255, "coverage_steps": steps,
+            "band_px": max(round(width), 1), "pixel_ratio": 1.0}
+    return StyleRead(line_rule, read, _geometry(**geo), raster, rounded, (), placed)
+
+
+def _evidence(f1_0=1.0, f1_1=1.0, style=None, **kw):
+    return CaseEvidence(level="frames", compared=kw.pop("compared", COMPARED), frames_checked=2,
+                        pixels={"pixel_f1_0px": f1_0, "pixel_f1_1px": f1_1, "worst_pixel_frame": 3},
+                        lines=kw.pop("lines", LINES_OK), style=style, **kw)
+
+
+def _names(ev, tol=TOL):
+    return [f.name for f in name_faults(ev, decide(ev, tol), tol)]
+
+
+# ---------------------------------------------------------------- evidence is frozen
+
+def test_evidence_is_frozen():
+    ev = _evidence(style=_style())
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        ev.pixels = {}
+    with pytest.raises(TypeError):                      # its mappings are read-only views
+        ev.pixels["pixel_f1_0px"] = 0.0
+    with pytest.raises(TypeError):
+        ev.style.geometry["offset_px"] = [9.0, 9.0]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        decide(ev, TOL).verdict = "pass"
+
+
+def test_evidence_copies_what_it_is_given():
+    pixels = {"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 3}
+    ev = CaseEvidence(level="frames", compared=COMPARED, frames_checked=2, pixels=pixels)
+    pixels["pixel_f1_0px"] = 0.0                        # the caller's dict changed afterwards: not the evidence
+    assert ev.pixels["pixel_f1_0px"] == 1.0 and decide(ev, TOL).verdict == "pass"
+
+
+# ---------------------------------------------------------------- decide: each limit, just met and just missed
+
+def test_f1_at_one_pixel_decides_at_min_f1_1px():
+    assert decide(_evidence(f1_1=TOL.min_f1_1px), TOL).verdict == "pass"
+    v = decide(_evidence(f1_1=math.nextafter(TOL.min_f1_1px, -UP)), TOL)
+    assert v.verdict == "fail" and v.reasons[0].startswith("pixel F1@1px")
+
+
+def test_f1_at_the_radius_decides_not_f1_at_one_pixel():
+    # lines read 3 px wide: the F1 at radius 2 is held to min_f1_1px; F1@1px beside it does not decide
+    wide = dict(f1_1=0.5, radius=Radius(2, TOL.min_f1_1px, 4))
+    assert decide(_evidence(**wide), TOL).verdict == "pass"
+    v = decide(_evidence(f1_1=0.5, radius=Radius(2, math.nextafter(TOL.min_f1_1px, -UP), 4)), TOL)
+    assert v.reasons == (f"pixel F1@2px {math.nextafter(TOL.min_f1_1px, -UP):.4f} < {TOL.min_f1_1px} "
+                         "(frame 4; lines read wider than 1 px)",)
+
+
+def test_f1_at_zero_pixels_decides_at_min_f1_0px():
+    assert decide(_evidence(f1_0=TOL.min_f1_0px), TOL).verdict == "pass"
+    v = decide(_evidence(f1_0=math.nextafter(TOL.min_f1_0px, -UP)), TOL)
+    assert v.verdict == "fail" and v.reasons[0].startswith("pixel F1@0px")
+
+
+def test_edge_counts_decide_at_max_edge_count_diff():
+    worst = {"edge": 3, "diff": -TOL.max_edge_count_diff - 1, "frame": 2}
+    at = dict(LINES_OK, edge_count_max_diff=TOL.max_edge_count_diff, edge_count_worst=worst)
+    past = dict(LINES_OK, edge_count_max_diff=TOL.max_edge_count_diff + 1, edge_count_worst=worst)
+    assert decide(_evidence(lines=at), TOL).verdict == "pass"
+    assert decide(_evidence(lines=past), TOL).reasons[0].startswith("edge 3 has -4 pixels")
+
+
+def test_grey_lines_offset_decides_at_offset_px_plus_half_a_coverage_step():
+    # antialiased lines in 4 coverage steps: offset_px + 0.5 / 4 (Tolerances.offset_px, line_style's rule)
+    bound = TOL.offset_px + 0.5 / 4
+    assert decide(_evidence(style=_style(dx=bound)), TOL).verdict == "pass"
+    v = decide(_evidence(style=_style(dx=math.nextafter(bound, UP))), TOL)
+    assert v.verdict == "fail" and v.reasons[0].startswith("line centres offset by")
+    assert v.style.moved and not v.style.warped
+
+
+def test_binary_wide_lines_offset_decides_at_rule_offset_px():
+    binary = dict(style="wide", grey_share=NAMING.grey_share_max, width=3.0)
+    assert decide(_evidence(style=_style(dx=-TOL.rule_offset_px, **binary)), TOL).verdict == "pass"
+    assert decide(_evidence(style=_style(dx=-math.nextafter(TOL.rule_offset_px, UP), **binary)), TOL).verdict \
+        == "fail"
+    # a grey share just past NAMING.grey_share_max is grey: the tighter offset_px bound holds it
+    grey = dict(binary, grey_share=math.nextafter(NAMING.grey_share_max, UP))
+    assert decide(_evidence(style=_style(dx=TOL.rule_offset_px, **grey)), TOL).verdict == "fail"
+
+
+def test_warp_decides_at_scale_px_and_binary_lines_half_a_pixel_more():
+    assert decide(_evidence(style=_style(warp=TOL.scale_px)), TOL).verdict == "pass"
+    assert decide(_evidence(style=_style(warp=math.nextafter(TOL.scale_px, UP))), TOL).reasons[0] \
+        .startswith("line centres moved by up to")
+    binary = dict(style="wide", grey_share=0.0, width=3.0)
+    bound = TOL.scale_px + NAMING.binary_warp_px
+    assert decide(_evidence(style=_style(warp=bound, **binary)), TOL).verdict == "pass"
+    assert decide(_evidence(style=_style(warp=math.nextafter(bound, UP), **binary)), TOL).verdict == "fail"
+
+
+def test_free_ends_decide_at_end_px_and_half_the_width_past_it():
+    assert decide(_evidence(style=_style(end=-TOL.end_px)), TOL).verdict == "pass"
+    assert decide(_evidence(style=_style(end=math.nextafter(-TOL.end_px, -UP))), TOL).reasons[0] \
+        .startswith("line ends -0.50 px")
+    far = 3.0 / 2 + TOL.end_px                           # a 3-px line's cap reaches half its width
+    assert decide(_evidence(style=_style(end=far, width=3.0, style="wide")), TOL).verdict == "pass"
+    assert decide(_evidence(style=_style(end=math.nextafter(far, UP), width=3.0, style="wide")), TOL).verdict \
+        == "fail"
+    # fewer free ends than NAMING.min_ends: their median does not decide
+    short = math.nextafter(-TOL.end_px, -UP)
+    assert decide(_evidence(style=_style(end=short, ends=NAMING.min_ends - 1)), TOL).verdict == "pass"
+    assert decide(_evidence(style=_style(end=short, ends=NAMING.min_ends)), TOL).verdict == "fail"
+
+
+def test_unplaced_lines_are_not_held_to_their_centres():
+    # the registration found the lines mirrored (not placed): their centroid offset says nothing
+    assert decide(_evidence(style=_style(dx=5.0, placed=False)), TOL).verdict == "pass"
+
+
+def _aliased(rounded_f1, line_rule):
+    rounded = {"pixel_f1_0px": rounded_f1, "lines": LINES_OK}
+    return _style(style="aliased", grey_share=0.0, line_rule=line_rule, rounded=rounded,
+                  raster=dict(RASTER_NONE, differing=8, off_by_one_at_ends=8))
+
+
+@pytest.mark.parametrize("line_rule", ["any", "gl"])
+def test_the_rounded_ends_rule_is_read_from_rule_f1_0px(line_rule):
+    # aliased pixels 0.9 against GL's rule (< min_f1_0px), rule_f1_0px against the rounded ends': a correct
+    # drawing by that rule (passes under any; named raster_rule under gl); just under it: GL's limit decides
+    ok = _evidence(f1_0=0.9, style=_aliased(TOL.rule_f1_0px, line_rule))
+    v = decide(ok, TOL)
+    assert v.style.rule_read == "rounded" and v.style.rounded_case == "correct" and not v.style.pixel_rule
+    if line_rule == "any":
+        assert v.verdict == "pass" and _names(ok) == []
+    else:
+        assert v.verdict == "fail" and v.reasons[0].startswith("the pixels are a correct drawing by another rule")
+        assert _names(ok) == ["raster_rule"]
+    under = _evidence(f1_0=0.9, style=_aliased(math.nextafter(TOL.rule_f1_0px, -UP), line_rule))
+    v = decide(under, TOL)
+    assert v.verdict == "fail" and v.style.rule_read == "gl" and v.style.pixel_rule
+    assert v.reasons[0] == f"pixel F1@0px 0.9000 < {TOL.min_f1_0px}"
+
+
+def test_a_biased_rounded_drawing_is_judged_by_that_rule_from_rule_f1_0px():
+    # --line-rule any: pixels the rounded ends' (F1@0px rule_f1_0px against it) but for a dropped end pixel
+    # (an edge 4 pixels short): that rule's limits and its line fault, not GL's; just under rule_f1_0px GL's
+    # limits decide, and lines where the oracle's are, off by one pixel only, are raster_rule
+    worst = {"edge": 1, "diff": -(TOL.max_edge_count_diff + 1), "frame": 2}
+    short = dict(LINES_OK, edge_count_max_diff=TOL.max_edge_count_diff + 1, edge_count_worst=worst)
+    end_fault = (Fault("line_end_bias", {"end": "last", "pixels_per_line": -1.0}),)
+
+    def ev(rounded_f1):
+        s = dataclasses.replace(_aliased(rounded_f1, "any"), rounded={"pixel_f1_0px": rounded_f1, "lines": short},
+                                rounded_faults=end_fault)
+        return _evidence(f1_0=0.9, style=s)
+    v = decide(ev(TOL.rule_f1_0px), TOL)
+    assert v.style.rounded_case == "biased" and v.reasons == (
+        "edge 1 has -4 pixels against the oracle's count (allowed +-3; frame 2) (the rounded-ends rule)",)
+    assert _names(ev(TOL.rule_f1_0px)) == ["line_end_bias"]
+    below = ev(math.nextafter(TOL.rule_f1_0px, -UP))
+    assert decide(below, TOL).style.rounded_case is None and _names(below) == ["raster_rule"]
+
+
+def test_a_case_that_compared_no_pixel_is_vacuous():
+    ev = _evidence(compared={"frames": 2, "vertices": 0, "pixels": 0})
+    assert decide(ev, TOL) == Verdict("vacuous", ("vacuous: neither side drew a pixel in any of the 2 checked "
+                                                  "frames: nothing compared",))
+
+
+def test_the_vertex_bound_decides_on_the_projector_path():
+    def ev(err):
+        return CaseEvidence(level="vertices", compared={"frames": 1, "vertices": 8, "pixels": None},
+                            frames_checked=1, vertices={"max_vertex_error_px": err, "vertex_bound_px": 1e-6,
+                                                        "worst_vertex": {"frame": 1, "vertex": 2}})
+    assert decide(ev(1e-6), TOL).verdict == "pass"
+    assert decide(ev(math.nextafter(1e-6, UP)), TOL).reasons == (
+        "max vertex error 1e-06 px > 1e-06 px (float64 bound; frame 1, vertex 2)",)
+
+
+# ---------------------------------------------------------------- name_faults: the precedence table
+
+def test_the_diagnosis_wins_over_the_line_counts():
+    ev = _evidence(f1_0=0.5, image_faults=(Fault("fov_mismatch", {"implied_fov_deg": 40.0}),),
+                   line_faults=(Fault("line_end_bias", {"end": "last"}),))
+    assert _names(ev) == ["fov_mismatch"]
+    assert _names(dataclasses.replace(ev, image_faults=())) == ["line_end_bias"]
+
+
+def test_the_line_centres_win_over_the_registrations_offset():
+    # antialiased lines moved: the registration's pixel_offset gives way to the centres' own
+    moved = math.nextafter(TOL.offset_px + 0.5 / 4, UP)
+    ev = _evidence(style=_style(dx=moved), image_faults=(Fault("pixel_offset", {"dx": 0.4, "dy": 0.0}),))
+    (f,) = name_faults(ev, decide(ev, TOL), TOL)
+    assert (f.name, f.params["dx"], f.params["measured_by"]) == ("pixel_offset", moved, "line centroids")
+    # a warp beyond its bound keeps the registration's scale fault beside the measure
+    warped = _evidence(style=_style(warp=2.0), image_faults=(Fault("fov_mismatch", {"implied_fov_deg": 40.0}),))
+    assert _names(warped) == ["fov_mismatch"]
+    assert _names(dataclasses.replace(warped, style=_style(warp=0.0))) == []
+
+
+def test_dim_lines_win_over_the_images():
+    ev = _evidence(f1_0=0.0, f1_1=0.0, style=_style(), image_faults=(Fault("depth_flip"),), drew_pixels=False)
+    lvl = NAMING.drawn_level - 1
+    ev = dataclasses.replace(ev, style=dataclasses.replace(ev.style, read={**ev.style.read, "level": lvl}))
+    (f,) = name_faults(ev, decide(ev, TOL), TOL)
+    assert f.name == "unexplained" and f.params["line_level"] == lvl
+    at_level = dataclasses.replace(ev.style, read={**ev.style.read, "level": NAMING.drawn_level})
+    assert _names(dataclasses.replace(ev, style=at_level)) == ["depth_flip"]
+
+
+def test_unexplained_only_when_failing_and_nothing_named():
+    assert _names(_evidence(f1_0=0.5)) == ["unexplained"]
+    assert _names(_evidence()) == []
+    assert _names(_evidence(f1_0=0.5, error="candidate raised ValueError")) == []
+
+
+def test_visibility_rewrites_the_unexplained_where_the_images_name_nothing():
+    ev = _evidence(f1_0=0.5, visibility=Visibility(40, 0, 2, 2))
+    (f,) = name_faults(ev, decide(ev, TOL), TOL)
+    assert (f.name, f.params["candidate_only_px"], f.params["oracle_only_px"]) == ("unexplained", 40, 0)
+    # a line_pixel_bias made of whole pieces of line (40 far pixels of 60 decided, >= visibility_share) too
+    bias = Fault("line_pixel_bias", {"candidate_only": 60, "oracle_only": 0})
+    far = dataclasses.replace(ev, line_faults=(bias,))
+    assert [(f.name, f.params.get("line_fault")) for f in name_faults(far, decide(far, TOL), TOL)] == \
+        [("unexplained", "line_pixel_bias")]
+    near = dataclasses.replace(far, visibility=Visibility(29, 0, 2, 2))   # 29 < 0.5 x 60: a line width
+    assert _names(near) == ["line_pixel_bias"]
+
+
+def test_the_table_lists_every_step_once_in_order():
+    steps = [r.step for r in PRECEDENCE]
+    assert steps == ["diagnosis", "line_centres", "line_rule", "dim_lines", "unexplained", "visibility"]
+    assert all(r.why for r in PRECEDENCE)
