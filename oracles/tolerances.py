@@ -501,7 +501,7 @@ class Tolerances:
 class NamingThresholds:
     """The frames path's thresholds that decide a verdict or a name but are not a run's to set (no CLI option):
     read by oracles.judge.decide and oracles.judge.name_faults, each with its reason. They were module
-    constants of line_style, free_ends, dim_lines and image_visibility; their values are unchanged.
+    constants of line_style, free_ends, f1_radius, dim_lines and image_visibility; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
@@ -521,6 +521,13 @@ class NamingThresholds:
     min_found_share: float = 0.5
     #: Free ends a case must have measured for their median to be judged (one stray end cannot decide).
     min_ends: int = 4
+    #: Coverage across a line (px) from which it is ``wide`` (line_style): a 1-px aliased line has at most
+    #: sqrt(2) = 1.41 pixels per unit length (diagonal), a 2-px line 2; 1.75 parts them. Wide lines are
+    #: judged by their centres and F1 at their radius, not by GL's pixel rule.
+    wide_min_px: float = 1.75
+    #: The widest F1 radius (px, oracles.judge.f1_radius): lines up to 5 px across (1 + ceil((5 - 1) / 2) = 3).
+    #: A wider line is still held to 3 px (its outer pixels count against it: a stricter F1, never a looser one).
+    max_radius_px: int = 3
     #: A ``line_pixel_bias`` whose one-sided pixels are mostly whole pieces of line is a visibility
     #: difference: at least this share of its decided one-sided pixels (per frame) lie farther than 1 px from
     #: the other side (a line drawn too thick or too thin never leaves a pixel that far).

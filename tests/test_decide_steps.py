@@ -214,6 +214,26 @@ def test_the_vertex_bound_decides_on_the_projector_path():
         "max vertex error 1e-06 px > 1e-06 px (float64 bound; frame 1, vertex 2)",)
 
 
+def test_past_the_oracles_precision_limit_the_pixels_are_set_aside():
+    # ORACLE_LIMIT_PX (oracles.references.oracle_precision): at the limit the pixels are judged; just past it
+    # they are set aside, the case judged on its vertices alone (vacuous here: they agree), the pixel-read
+    # line fault goes and the reasons the pixels gave stay on record
+    from wirecheck.oracles.references.oracle_precision import ORACLE_LIMIT_PX
+
+    def ev(bound):
+        return CaseEvidence(level="pixels", compared={"frames": 1, "vertices": 8, "pixels": 300}, frames_checked=1,
+                            pixels={"pixel_f1_0px": 0.5, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
+                            vertices={"max_vertex_error_px": 0.0, "vertex_bound_px": 1e-6,
+                                      "worst_vertex": {"frame": 1, "vertex": 0}},
+                            line_faults=(Fault("line_pixel_bias", {"candidate_only": 9, "oracle_only": 0}),),
+                            oracle_bound_px=bound)
+    at = decide(ev(ORACLE_LIMIT_PX), TOL)
+    assert at.verdict == "fail" and at.set_aside is None and _names(ev(ORACLE_LIMIT_PX)) == ["line_pixel_bias"]
+    past = decide(ev(math.nextafter(ORACLE_LIMIT_PX, UP)), TOL)
+    assert past.verdict == "vacuous" and past.reasons[0].startswith("oracle_precision: the pyrender oracle's")
+    assert past.set_aside == at.reasons and _names(ev(math.nextafter(ORACLE_LIMIT_PX, UP))) == []
+
+
 # ---------------------------------------------------------------- name_faults: the precedence table
 
 def test_the_diagnosis_wins_over_the_line_counts():
@@ -266,5 +286,6 @@ def test_visibility_rewrites_the_unexplained_where_the_images_name_nothing():
 
 def test_the_table_lists_every_step_once_in_order():
     steps = [r.step for r in PRECEDENCE]
-    assert steps == ["diagnosis", "line_centres", "line_rule", "dim_lines", "unexplained", "visibility"]
+    assert steps == ["diagnosis", "line_centres", "line_rule", "dim_lines", "unexplained", "visibility",
+                     "oracle_precision"]
     assert all(r.why for r in PRECEDENCE)

@@ -13,7 +13,9 @@ missed, one reason each:
   ``--line-rule any`` (:func:`judge_style`);
 - a renderer's line centres, ends and warp against their bounds (:func:`judge_style`);
 - the shaded limits (regions inside a silhouette, IoU, faces, depth);
-- the gate (:mod:`oracles.judge.gate`): a case that misses no limit but compared nothing is ``"vacuous"``.
+- the gate (:mod:`oracles.judge.gate`): a case that misses no limit but compared nothing is ``"vacuous"``;
+- the oracle's own precision: past ``ORACLE_LIMIT_PX`` (oracles.references.oracle_precision) the pixels are
+  set aside and the case is judged on its vertices alone.
 
 The names are :func:`oracles.judge.name_faults.name_faults`'s, from the same evidence and this verdict.
 :func:`pixel_fields` and :func:`line_faults` are the measurements both paths collect alike.
@@ -21,15 +23,20 @@ The names are :func:`oracles.judge.name_faults.name_faults`'s, from the same evi
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from . import gate
-from .evidence import CaseEvidence
+from .evidence import CaseEvidence, Radius, StyleRead
+from ..faults import Fault
 from .. import faults as catalogue
 from ..tolerances import NAMING, Tolerances, line_failures
 from ..diagnosis.diagnose import diagnose_lines
+from ..references.oracle_precision import ORACLE_LIMIT_PX
 
 __all__ = ["Verdict", "StyleJudgement", "decide", "judge_style", "gl_rule_reasons", "rounded_rule_failures",
            "pixel_fields", "line_faults", "RULE_FAULTS", "ROUNDED_RULE_NAME"]
@@ -73,9 +80,13 @@ class StyleJudgement:
 class Verdict:
     """A case's verdict (``"pass"``, ``"fail"``, ``"vacuous"``), its reasons, and the style's judgement."""
 
+
     verdict: str
     reasons: tuple[str, ...]
     style: StyleJudgement | None = None
+    #: The reasons the case had with its pixels, set aside because the pyrender oracle's own error bound
+    #: exceeds ORACLE_LIMIT_PX (its pixels then say nothing of the candidate); None: the pixels were judged.
+    set_aside: tuple[str, ...] | None = None
 
 
 def pixel_fields(pixel: dict, worst_frame) -> dict:
@@ -117,10 +128,10 @@ def _vertex_reasons(v, tol: Tolerances) -> list[str]:
     return out
 
 
-def _radius_reasons(ev: CaseEvidence, tol: Tolerances) -> list[str]:
-    """F1 at the radius the lines' width allows (oracles.judge.f1_radius), held to ``min_f1_1px``."""
-    px = ev.pixels
-    radius, f1, frame = ((ev.radius.radius_px, ev.radius.f1, ev.radius.frame) if ev.radius is not None
+def _radius_reasons(px: Mapping[str, Any], r: Radius | None, tol: Tolerances) -> list[str]:
+    """F1 at the radius the lines' width allows (``r``, oracles.judge.f1_radius; None: F1@1px of the pixel
+    fields ``px``), held to ``min_f1_1px``."""
+    radius, f1, frame = ((r.radius_px, r.f1, r.frame) if r is not None
                          else (1, px["pixel_f1_1px"], px["worst_pixel_frame"]))
     if f1 < tol.min_f1_1px:
         return [f"pixel F1@{radius}px {f1:.4f} < {tol.min_f1_1px} (frame {frame}"
@@ -128,13 +139,14 @@ def _radius_reasons(ev: CaseEvidence, tol: Tolerances) -> list[str]:
     return []
 
 
-def gl_rule_reasons(ev: CaseEvidence, tol: Tolerances) -> list[str]:
-    """The limits of GL's pixel rule the case misses: F1@0px, the balance, the per-edge counts."""
+def gl_rule_reasons(px: Mapping[str, Any], lines: Mapping[str, Any] | None, tol: Tolerances) -> list[str]:
+    """The limits of GL's pixel rule the case misses: F1@0px (of the pixel fields ``px``), the balance and the
+    per-edge counts (of the ``lines``)."""
     out = []
-    if ev.pixels["pixel_f1_0px"] < tol.min_f1_0px:
-        out.append(f"pixel F1@0px {ev.pixels['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
-    if ev.lines is not None:
-        out += line_failures(ev.lines, tol)
+    if px["pixel_f1_0px"] < tol.min_f1_0px:
+        out.append(f"pixel F1@0px {px['pixel_f1_0px']:.4f} < {tol.min_f1_0px}")
+    if lines is not None:
+        out += line_failures(dict(lines), tol)
     return out
 
 
@@ -150,8 +162,12 @@ def rounded_rule_failures(rounded, tol: Tolerances) -> list[str]:
     return out + [f"{r} (the rounded-ends rule)" for r in line_failures(rounded["lines"], tol)]
 
 
-def judge_style(ev: CaseEvidence, tol: Tolerances, gl_reasons: list[str], radius_reasons: list[str]) -> StyleJudgement:
-    """The style read (``ev.style``) held to ``tol``: the centres' bounds and the rule read (:class:`StyleJudgement`).
+def judge_style(s: StyleRead, pf0: float, diagnosed: tuple[Fault, ...], tol: Tolerances, gl_reasons: list[str],
+                radius_reasons: list[str]) -> StyleJudgement:
+    """The style read ``s`` held to ``tol``: the centres' bounds and the rule read (:class:`StyleJudgement`).
+
+    ``pf0``: the case's F1@0px against GL's rule; ``diagnosed``: what the diagnosis named
+    (CaseEvidence.diagnosed); ``gl_reasons``, ``radius_reasons``: GL's limits and the F1 radius's missed.
 
     Binary lines (1 px or wide) are held to ``rule_offset_px`` (another aliased rule's, or a wide rule's,
     snapped ends), grey lines to ``offset_px`` plus half a coverage step; the warp to ``scale_px``, binary
@@ -162,8 +178,7 @@ def judge_style(ev: CaseEvidence, tol: Tolerances, gl_reasons: list[str], radius
     then go, under ``gl`` a reason says which rule was read. Under ``any``, pixels that are the rounded-ends
     rule's but for a bias of its one-sided pixels are judged by that rule's limits instead of GL's.
     """
-    s = ev.style
-    read, geo = s.read, s.geometry
+    read, geo, rounded = s.read, s.geometry, s.rounded
     binary = read["grey_share"] <= NAMING.grey_share_max
     offset_tol = tol.rule_offset_px if binary else tol.offset_px + 0.5 / read["coverage_steps"]
     warp_tol = tol.scale_px + (NAMING.binary_warp_px if binary else 0.0)
@@ -185,24 +200,26 @@ def judge_style(ev: CaseEvidence, tol: Tolerances, gl_reasons: list[str], radius
             failures.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
                             f"or shear > {warp_tol:.3g} ({s.style} lines)")
     only_gl = bool(gl_reasons) and not radius_reasons
-    only_rule = only_gl and all(f.name in RULE_FAULTS for f in ev.diagnosed)
-    rounded_failures = tuple(rounded_rule_failures(s.rounded, tol)) if s.by_rule and s.rounded is not None \
-        else None
-    rule_read = rounded_case = None
-    pf0 = ev.pixels["pixel_f1_0px"]
-    if s.by_rule:
-        rule_read = "rounded" if (rounded_failures == () and not gl_reasons and not moved and not warped
-                                  and s.rounded["pixel_f1_0px"] > pf0) else "gl"
-    if rounded_failures == () and not moved and not warped and only_rule:
-        rule_read, rounded_case = "rounded", "correct"
-        if s.line_rule == "gl":                         # another rule's correct drawing, named; no count deficit
-            failures.append(f"the pixels are a correct drawing by another rule than GL's ({ROUNDED_RULE_NAME}: "
-                            f"F1@0px {s.rounded['pixel_f1_0px']:.4f} against it, {pf0:.4f} against GL's)")
-    elif (s.line_rule == "any" and s.by_rule and only_rule and pf0 < s.rounded["pixel_f1_0px"]
-          and s.rounded["pixel_f1_0px"] >= max(tol.min_f1_0px, tol.rule_f1_0px)):
-        # the rounded-ends rule's pixels but for a bias of its one-sided pixels (a dropped end pixel)
-        rule_read, rounded_case = "rounded", "biased"
-        failures += rounded_failures
+    only_rule = only_gl and all(f.name in RULE_FAULTS for f in diagnosed)
+    rule_read: str | None = None
+    rounded_case: str | None = None
+    rounded_failures: tuple[str, ...] | None = None
+    if s.by_rule and rounded is not None:
+        rounded_failures = tuple(rounded_rule_failures(rounded, tol))
+        rf0 = rounded["pixel_f1_0px"]
+        rule_read = "rounded" if (not rounded_failures and not gl_reasons and not moved and not warped
+                                  and rf0 > pf0) else "gl"
+        if not rounded_failures and not moved and not warped and only_rule:
+            rule_read, rounded_case = "rounded", "correct"
+            if s.line_rule == "gl":                     # another rule's correct drawing, named; no count deficit
+                failures.append(f"the pixels are a correct drawing by another rule than GL's ({ROUNDED_RULE_NAME}: "
+                                f"F1@0px {rf0:.4f} against it, {pf0:.4f} against GL's)")
+        elif s.line_rule == "any" and only_rule and pf0 < rf0 and rf0 >= max(tol.min_f1_0px, tol.rule_f1_0px):
+            # the rounded-ends rule's pixels but for a bias of its one-sided pixels (a dropped end pixel)
+            rule_read, rounded_case = "rounded", "biased"
+            failures += rounded_failures
+    elif s.by_rule:
+        rule_read = "gl"
     return StyleJudgement(offset_tol, warp_tol, moved, warped, end_out, rounded_failures, rule_read, rounded_case,
                           pixel_rule=s.by_rule and rule_read != "rounded", gl_reasons=tuple(gl_reasons),
                           only_gl=only_gl, failures=tuple(failures))
@@ -234,14 +251,29 @@ def decide(ev: CaseEvidence, tol: Tolerances) -> Verdict:
         why += _vertex_reasons(ev.vertices, tol)
     style = None
     if ev.pixels is not None and ev.pixels.get("pixel_f1_0px") is not None:
-        radius = _radius_reasons(ev, tol)
-        gl = gl_rule_reasons(ev, tol)
+        radius = _radius_reasons(ev.pixels, ev.radius, tol)
+        gl = gl_rule_reasons(ev.pixels, ev.lines, tol)
         why += radius
         if ev.style is not None:
-            style = judge_style(ev, tol, gl, radius)
+            style = judge_style(ev.style, ev.pixels["pixel_f1_0px"], ev.diagnosed, tol, gl, radius)
         why += gl if style is None or style.pixel_rule else []
         why += list(style.failures) if style is not None else []
     if ev.shaded is not None and ev.shaded.get("silhouette_iou") is not None:
         why += _shaded_reasons(ev.shaded, tol)
-    verdict, reasons = gate.case_verdict(ev.compared, why, ev.level, ev.points)
+    verdict, reasons = gate.case_verdict(dict(ev.compared), why, ev.level, ev.points)
+    if ev.oracle_bound_px is not None and ev.oracle_bound_px > ORACLE_LIMIT_PX and verdict != "vacuous":
+        return _vertices_only(ev, tol, tuple(reasons), style)
     return Verdict(verdict, tuple(reasons), style)
+
+
+def _vertices_only(ev: CaseEvidence, tol: Tolerances, reasons: tuple, style) -> Verdict:
+    """Past the oracle's precision limit the pixels say nothing of the candidate: the case judged on its
+    vertices alone, ``"fail"`` only for a vertex failure (or the candidate's error), else ``"vacuous"`` (which
+    fails the run, oracles.judge.gate), with an ``oracle_precision`` reason first."""
+    vertices = dataclasses.replace(ev, level="vertices", pixels=None, lines=None, shaded=None, style=None,
+                                   compared={**ev.compared, "pixels": None}, oracle_bound_px=None)
+    alone = decide(vertices, tol)
+    why = (f"oracle_precision: the pyrender oracle's own error bound {ev.oracle_bound_px:.3g} px exceeds "
+           f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged")
+    vertex_reasons = alone.reasons if alone.verdict == "fail" else ()
+    return Verdict("fail" if vertex_reasons else "vacuous", (why,) + vertex_reasons, style, set_aside=reasons)

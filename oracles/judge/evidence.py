@@ -60,7 +60,10 @@ class StyleRead:
     @property
     def offset_px(self) -> tuple[float, float]:
         """The pooled centre offset ``(dx, dy)`` (px) where the centres were measured, else (0, 0)."""
-        return tuple(float(v) for v in self.geometry["offset_px"]) if self.placed else (0.0, 0.0)
+        if not self.placed:
+            return (0.0, 0.0)
+        dx, dy = self.geometry["offset_px"]
+        return (float(dx), float(dy))
 
     @property
     def raster_shares(self) -> dict:
@@ -108,7 +111,8 @@ class CaseEvidence:
     diagnosis named from the vertices or the images; ``line_faults``: those GL's line counts name;
     ``style``: the style read (a renderer's frames); ``drew_pixels``: some frame drew a pixel by the 128
     rule; ``visibility``: the sets that differ (measured only where the names ask for it); ``error``:
-    the candidate's error; ``points``: the scene's vertex count.
+    the candidate's error; ``points``: the scene's vertex count; ``oracle_bound_px``: the pyrender oracle's own
+    error bound where pixels were drawn (oracles.references.oracle_precision).
     """
 
     level: str
@@ -126,6 +130,7 @@ class CaseEvidence:
     visibility: Visibility | None = None
     error: str | None = None
     points: int | None = None
+    oracle_bound_px: float | None = None
 
     def __post_init__(self):
         for name in ("compared", "pixels", "lines", "vertices", "shaded"):

@@ -28,11 +28,11 @@ from __future__ import annotations
 import math
 
 from .evidence import Radius
+from ..tolerances import NAMING
 from .metrics import pixel_scores
 
-#: The widest radius computed: lines up to 5 px across (``1 + ceil((5 - 1) / 2) = 3``). A wider
-#: line is still held to 3 px (its outer pixels count against it: a stricter F1, never a looser one).
-MAX_RADIUS_PX = 3
+#: The widest radius computed: oracles.tolerances.NAMING.max_radius_px (3: lines up to 5 px across; its reason there).
+MAX_RADIUS_PX = NAMING.max_radius_px
 #: The radii computed per frame besides F1@1px.
 RADII = tuple(range(2, MAX_RADIUS_PX + 1))
 

@@ -100,9 +100,8 @@ RULE_NAMES = {"gl": "GL's diamond exit", "rounded": ROUNDED_RULE_NAME}
 
 #: A differing pixel this close to a segment end (px) is counted "at the end".
 END_RADIUS_PX = 1.5
-#: Coverage per unit length from which a line is ``wide``: a 1-px aliased line has at most
-#: sqrt(2) = 1.41 pixels per unit length (diagonal), a 2-px line 2.
-WIDE_MIN_PX = 1.75
+#: Coverage per unit length from which a line is ``wide``: oracles.tolerances.NAMING.wide_min_px (its reason there).
+WIDE_MIN_PX = tolerances.NAMING.wide_min_px
 #: A case is binary (aliased) when at most this share of its drawn pixels is an intermediate
 #: grey (between 1/8 and 7/8 of the line's level): antialiased lines have a third or more
 #: (measured: 4x4 supersampled 1-px lines 0.6-0.8).

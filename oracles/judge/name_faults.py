@@ -55,6 +55,9 @@ PRECEDENCE = (
                "where the images fit the oracle's lines (nothing named from them) and the case fails, an "
                "unexplained, or a line_pixel_bias made of whole pieces of line, becomes the visible sets that "
                "differ"),
+    Precedence("oracle_precision", ("line_count",),
+               "past the oracle's precision limit its pixels say nothing of the candidate: every name read from "
+               "the drawn lines (source 'pixels' in the catalogue) goes"),
 )
 
 
@@ -137,7 +140,8 @@ def _dim_lines(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
 
 
 def _unexplained(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
-    if verdict.reasons and not ev.error and not faults:
+    why = verdict.reasons if verdict.set_aside is None else verdict.set_aside
+    if why and not ev.error and not faults:
         return [Fault("unexplained")]
     return faults
 
@@ -151,8 +155,15 @@ def _visibility(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
     return [Fault.of(f) for f in named]
 
 
+def _oracle_precision(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
+    if verdict.set_aside is None:
+        return faults
+    return [f for f in faults if f.kind.source != "pixels"]
+
+
 _STEPS = {"diagnosis": _diagnosis, "line_centres": _line_centres, "line_rule": _line_rule,
-          "dim_lines": _dim_lines, "unexplained": _unexplained, "visibility": _visibility}
+          "dim_lines": _dim_lines, "unexplained": _unexplained, "visibility": _visibility,
+          "oracle_precision": _oracle_precision}
 
 
 def wants_visibility(faults, ev: CaseEvidence, verdict: Verdict) -> bool:
