@@ -521,6 +521,10 @@ class NamingThresholds:
     min_found_share: float = 0.5
     #: Free ends a case must have measured for their median to be judged (one stray end cannot decide).
     min_ends: int = 4
+    #: A grey value is one of the lines' coverage levels when at least this share of the drawn pixels has it
+    #: (line_style): coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's
+    #: step, which grey lines' offset bound adds (offset_px + 0.5 / levels).
+    level_share_min: float = 0.002
     #: Coverage across a line (px) from which it is ``wide`` (line_style): a 1-px aliased line has at most
     #: sqrt(2) = 1.41 pixels per unit length (diagonal), a 2-px line 2; 1.75 parts them. Wide lines are
     #: judged by their centres and F1 at their radius, not by GL's pixel rule.

@@ -106,8 +106,9 @@ WIDE_MIN_PX = tolerances.NAMING.wide_min_px
 #: grey (between 1/8 and 7/8 of the line's level): antialiased lines have a third or more
 #: (measured: 4x4 supersampled 1-px lines 0.6-0.8).
 GREY_SHARE_MAX = tolerances.NAMING.grey_share_max
-#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it.
-LEVEL_SHARE_MIN = 0.002
+#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it:
+#: oracles.tolerances.NAMING.level_share_min.
+LEVEL_SHARE_MIN = tolerances.NAMING.level_share_min
 #: The line's level: this percentile of the drawn pixels' values (robust to a few bright
 #: crossings of antialiased lines).
 LEVEL_PERCENTILE = 99
