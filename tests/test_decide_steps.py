@@ -198,6 +198,26 @@ def test_a_biased_rounded_drawing_is_judged_by_that_rule_from_rule_f1_0px():
     assert decide(below, TOL).style.rounded_case is None and _names(below) == ["raster_rule"]
 
 
+def test_the_rounded_rule_is_read_only_where_the_diagnosis_names_no_camera_fault():
+    # a rule fault named (pixel_offset: a rule's snapped ends move lines) leaves the read; a camera fault does not
+    def ev(fault):
+        return _evidence(f1_0=0.9, style=_aliased(1.0, "any"), image_faults=(fault,))
+    rule = ev(Fault("pixel_offset", {"dx": 0.3, "dy": 0.0}))
+    assert decide(rule, TOL).verdict == "pass" and _names(rule) == []
+    camera = ev(Fault("fov_mismatch", {"implied_fov_deg": 40.0}))
+    assert decide(camera, TOL).style.rounded_case is None and _names(camera) == ["fov_mismatch"]
+
+
+def test_pixels_that_pass_gl_are_read_as_the_rule_that_fits_them_more_closely():
+    # GL's limits met (F1@0px at its floor or more): the rule read is the rounded ends' only where its F1@0px
+    # is higher than GL's, never at a tie
+    def read(f1_gl, f1_rounded):
+        return decide(_evidence(f1_0=f1_gl, style=_aliased(f1_rounded, "any")), TOL).style.rule_read
+    assert read(TOL.min_f1_0px, 1.0) == "rounded"
+    assert read(1.0, 1.0) == "gl"
+    assert read(0.99, 0.99) == "gl"
+
+
 def test_a_case_that_compared_no_pixel_is_vacuous():
     ev = _evidence(compared={"frames": 2, "vertices": 0, "pixels": 0})
     assert decide(ev, TOL) == Verdict("vacuous", ("vacuous: neither side drew a pixel in any of the 2 checked "
@@ -248,11 +268,79 @@ def test_the_line_centres_win_over_the_registrations_offset():
     moved = math.nextafter(TOL.offset_px + 0.5 / 4, UP)
     ev = _evidence(style=_style(dx=moved), image_faults=(Fault("pixel_offset", {"dx": 0.4, "dy": 0.0}),))
     (f,) = name_faults(ev, decide(ev, TOL), TOL)
-    assert (f.name, f.params["dx"], f.params["measured_by"]) == ("pixel_offset", moved, "line centroids")
+    assert f.as_dict() == {"name": "pixel_offset", "dx": moved, "dy": 0.0, "uncertainty_px": 0.0, "confidence": 1.0,
+                           "residual_px": None, "measured_by": "line centroids"}
     # a warp beyond its bound keeps the registration's scale fault beside the measure
     warped = _evidence(style=_style(warp=2.0), image_faults=(Fault("fov_mismatch", {"implied_fov_deg": 40.0}),))
     assert _names(warped) == ["fov_mismatch"]
     assert _names(dataclasses.replace(warped, style=_style(warp=0.0))) == []
+
+
+def test_ends_past_their_bound_are_line_end_bias_with_their_median():
+    short = math.nextafter(-TOL.end_px, -UP)
+    ev = _evidence(style=_style(end=short))
+    assert decide(ev, TOL).reasons == (f"line ends {short:+.2f} px from the segments' ends: expected "
+                                       f"{-TOL.end_px} to {0.5 + TOL.end_px:.2f} (antialiased lines)",)
+    (f,) = name_faults(ev, decide(ev, TOL), TOL)
+    assert f.as_dict() == {"name": "line_end_bias", "end_px": short, "ends_measured": 6, "confidence": 1.0,
+                           "residual_px": None, "measured_by": "line ends",
+                           "note": "the lines stop 0.50 px before their ends (median of 6 free ends; a cap may add "
+                                   "half the width)"}
+
+
+def test_the_biased_rounded_rules_line_fault_replaces_only_count_faults():
+    # --line-rule any, pixels the rounded ends' but biased (test above): its line fault replaces GL's count
+    # faults and an unexplained; a pixel_offset the diagnosis named stays, and with no rounded line fault GL's
+    # count fault stays
+    worst = {"edge": 1, "diff": -(TOL.max_edge_count_diff + 1), "frame": 2}
+    short = dict(LINES_OK, edge_count_max_diff=TOL.max_edge_count_diff + 1, edge_count_worst=worst)
+    rounded_end = (Fault("line_end_bias", {"end": "last", "pixels_per_line": -1.0}),)
+
+    def names(diagnosed, rounded_faults):
+        s = dataclasses.replace(_aliased(TOL.rule_f1_0px, "any"), rounded={"pixel_f1_0px": TOL.rule_f1_0px,
+                                                                            "lines": short},
+                                rounded_faults=rounded_faults)
+        return _names(_evidence(f1_0=0.9, style=s, line_faults=diagnosed))
+    gl_bias = (Fault("line_pixel_bias", {"candidate_only": 0, "oracle_only": 30}),)
+    assert names(gl_bias, rounded_end) == ["line_end_bias"]
+    assert names(gl_bias, ()) == ["line_pixel_bias"]
+    offset = (Fault("pixel_offset", {"dx": 0.1, "dy": 0.0}),)
+    assert names(offset, rounded_end) == ["pixel_offset"]
+
+
+def test_gl_limits_and_the_radius_both_missed_are_no_rule_read():
+    # F1 at the radius missed too: the pixels are not read as the rounded ends' (only GL's limits may fail
+    # for that), and GL's F1@0px still decides
+    ev = _evidence(f1_0=0.9, f1_1=math.nextafter(TOL.min_f1_1px, -UP), style=_aliased(1.0, "any"))
+    v = decide(ev, TOL)
+    assert v.style.rounded_case is None and v.style.pixel_rule
+    assert [r.split(" <")[0] for r in v.reasons] == ["pixel F1@1px 0.9990", "pixel F1@0px 0.9000"]
+
+
+def test_no_pixel_fields_no_style_judgement_and_no_names_from_it():
+    ev = CaseEvidence(level="frames", compared=COMPARED, frames_checked=2, style=_style(dx=5.0))
+    v = decide(ev, TOL)
+    assert v == Verdict("pass", ()) and name_faults(ev, v, TOL) == ()
+
+
+def test_raster_shares_by_hand():
+    counts = {"oracle_pixels": 200, "differing": 10, "off_by_one_across": 4, "off_by_one_at_ends": 4, "farther": 2}
+    s = _style(style="aliased", grey_share=0.0, raster=counts)
+    assert s.raster_shares == {"share_off_by_one_across": 0.02, "share_off_by_one_at_ends": 0.02,
+                               "share_farther": 0.01}
+    assert _style(style="aliased", grey_share=0.0, raster=dict(counts, oracle_pixels=0)).raster_shares == \
+        {"share_off_by_one_across": 4.0, "share_off_by_one_at_ends": 4.0, "share_farther": 2.0}
+    assert _style(style="aliased", grey_share=0.0, raster=dict(counts, differing=0)).raster_shares == {}
+    assert _style(style="antialiased", raster=counts).raster_shares == {}
+
+
+def test_the_offset_of_unplaced_lines_is_none_of_theirs():
+    assert _style(dx=0.3).offset_px == (0.3, 0.0)
+    assert _style(dx=0.3, placed=False).offset_px == (0.0, 0.0)
+    # a correct drawing by the rounded ends under gl: raster_rule carries the placed offset, else (0, 0)
+    s = dataclasses.replace(_aliased(1.0, "gl"), placed=False)
+    (f,) = name_faults(_evidence(f1_0=0.9, style=s), decide(_evidence(f1_0=0.9, style=s), TOL), TOL)
+    assert (f.name, f.params["offset_px"], f.params["rule"]) == ("raster_rule", [0.0, 0.0], "rounded")
 
 
 def test_dim_lines_win_over_the_images():

@@ -102,7 +102,7 @@ class CaseEvidence:
     """One case's measurements (module docstring).
 
     ``level``: what the case compared (oracles.judge.gate: ``"vertices"``, ``"pixels"``, ``"frames"``);
-    ``compared``: frames, vertices, pixels; ``pixels``: the pixel fields (oracles.judge.decide.pixel_fields:
+    ``compared``: frames, vertices, pixels; ``frames_checked``: the frames judged (0: no vertex is judged); ``pixels``: the pixel fields (oracles.judge.decide.pixel_fields:
     ``pixel_f1_0px``... ``worst_pixel_frame``; None: no pixel compared); ``lines``: the pooled line
     fields against GL's rule (oracles.judge.metrics.line_summary; None without lines); ``radius``: the F1
     radius (None: 1 px, F1@1px); ``vertices``: the vertex fields (``max_vertex_error_px``,
@@ -117,7 +117,7 @@ class CaseEvidence:
 
     level: str
     compared: Mapping[str, Any]
-    frames_checked: int = 0
+    frames_checked: int
     pixels: Mapping[str, Any] | None = None
     lines: Mapping[str, Any] | None = None
     radius: Radius | None = None

@@ -61,8 +61,8 @@ PRECEDENCE = (
 )
 
 
-def _count_faults() -> tuple[str, ...]:
-    return catalogue.names("line_count")
+#: The line faults of one-sided pixel counts (line_end_bias, line_pixel_bias).
+COUNT_FAULTS = catalogue.names("line_count")
 
 
 def _diagnosis(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
@@ -73,7 +73,7 @@ def _line_centres(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault
     s, j = ev.style, verdict.style
     if s is None or j is None or s.by_rule:
         return faults
-    faults = [f for f in faults if f.name not in _count_faults() or "measured_by" in f.params]
+    faults = [f for f in faults if f.name not in COUNT_FAULTS]          # GL's counts: no rule holds these lines
     if not s.placed:
         return faults
     measured = catalogue.names("scale", "offset")
@@ -111,7 +111,7 @@ def _line_rule(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
                         "not GL's: check the line rasteriser, not the camera; without --line-rule "
                         "gl such lines pass"}))
     elif j.rounded_case == "biased":
-        gives_way = _count_faults() + ("unexplained", "raster_rule")
+        gives_way = COUNT_FAULTS + ("unexplained", "raster_rule")
         if s.rounded_faults and all(f.name in gives_way for f in faults):
             faults = [f for f in faults if f.name not in gives_way] + list(s.rounded_faults)
     elif (s.by_rule and j.only_gl and s.placed and not j.moved and not j.warped and s.raster["farther"] == 0
