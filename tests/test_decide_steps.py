@@ -154,10 +154,10 @@ def test_unplaced_lines_are_not_held_to_their_centres():
     assert decide(_evidence(style=_style(dx=5.0, placed=False)), TOL).verdict == "pass"
 
 
-def _aliased(rounded_f1, line_rule):
+def _aliased(rounded_f1, line_rule, **geo):
     rounded = {"pixel_f1_0px": rounded_f1, "lines": LINES_OK}
     return _style(style="aliased", grey_share=0.0, line_rule=line_rule, rounded=rounded,
-                  raster=dict(RASTER_NONE, differing=8, off_by_one_at_ends=8))
+                  raster=dict(RASTER_NONE, differing=8, off_by_one_at_ends=8), **geo)
 
 
 @pytest.mark.parametrize("line_rule", ["any", "gl"])
@@ -218,6 +218,35 @@ def test_pixels_that_pass_gl_are_read_as_the_rule_that_fits_them_more_closely():
     assert read(0.99, 0.99) == "gl"
 
 
+def test_raster_rule_records_by_hand():
+    # 8 of the oracle's 400 pixels off by one at the ends; the centres 0.1 px off in x (placed, not moved)
+    def record(rounded_f1):
+        ev = _evidence(f1_0=0.9, style=_aliased(rounded_f1, "gl", dx=0.1))
+        (f,) = name_faults(ev, decide(ev, TOL), TOL)
+        return f.as_dict()
+    shares = {"share_off_by_one_across": 0.0, "share_off_by_one_at_ends": 0.02, "share_farther": 0.0}
+    rounded = record(1.0)                               # a correct drawing by the rounded ends, under gl
+    assert {k: v for k, v in rounded.items() if k != "note"} == {
+        "name": "raster_rule", **shares, "confidence": 1.0, "offset_px": [0.1, 0.0], "residual_px": None,
+        "rule": "rounded"}
+    other = record(math.nextafter(TOL.rule_f1_0px, -UP))    # not the rounded ends': another rule, GL-placed
+    assert {k: v for k, v in other.items() if k != "note"} == {
+        "name": "raster_rule", **shares, "confidence": 1.0, "offset_px": [0.1, 0.0], "residual_px": None}
+    assert other["note"].startswith("the lines are where the oracle's are (centres within 0.10 px)")
+
+
+def test_a_biased_rounded_read_needs_the_rounded_rule_to_fit_more_closely_than_gls():
+    # GL's per-edge counts fail, the rounded ends' too, both F1@0px 0.99: a tie is no rounded read (GL decides)
+    worst = {"edge": 1, "diff": -(TOL.max_edge_count_diff + 1), "frame": 2}
+    short = dict(LINES_OK, edge_count_max_diff=TOL.max_edge_count_diff + 1, edge_count_worst=worst)
+
+    def case(rounded_f1):
+        s = dataclasses.replace(_aliased(rounded_f1, "any"), rounded={"pixel_f1_0px": rounded_f1, "lines": short})
+        return decide(_evidence(f1_0=0.99, style=s, lines=short), TOL).style
+    assert case(0.99).rounded_case is None and case(0.99).pixel_rule
+    assert case(math.nextafter(0.99, UP)).rounded_case == "biased"
+
+
 def test_a_case_that_compared_no_pixel_is_vacuous():
     ev = _evidence(compared={"frames": 2, "vertices": 0, "pixels": 0})
     assert decide(ev, TOL) == Verdict("vacuous", ("vacuous: neither side drew a pixel in any of the 2 checked "
@@ -252,6 +281,12 @@ def test_past_the_oracles_precision_limit_the_pixels_are_set_aside():
     past = decide(ev(math.nextafter(ORACLE_LIMIT_PX, UP)), TOL)
     assert past.verdict == "vacuous" and past.reasons[0].startswith("oracle_precision: the pyrender oracle's")
     assert past.set_aside == at.reasons and _names(ev(math.nextafter(ORACLE_LIMIT_PX, UP))) == []
+    # a vertex failure still fails the case, after the oracle_precision reason
+    wrong = dataclasses.replace(ev(math.nextafter(ORACLE_LIMIT_PX, UP)), vertices={
+        "max_vertex_error_px": 0.5, "vertex_bound_px": 1e-6, "worst_vertex": {"frame": 1, "vertex": 0}})
+    v = decide(wrong, TOL)
+    assert v.verdict == "fail" and v.reasons[1:] == ("max vertex error 0.5 px > 1e-06 px (float64 bound; frame 1, "
+                                                     "vertex 0)",)
 
 
 # ---------------------------------------------------------------- name_faults: the precedence table
@@ -351,6 +386,9 @@ def test_dim_lines_win_over_the_images():
     assert f.name == "unexplained" and f.params["line_level"] == lvl
     at_level = dataclasses.replace(ev.style, read={**ev.style.read, "level": NAMING.drawn_level})
     assert _names(dataclasses.replace(ev, style=at_level)) == ["depth_flip"]
+    for nothing in (0, None):                           # no line at all (level 0 or unread): the images' name
+        dark = dataclasses.replace(ev.style, read={**ev.style.read, "level": nothing})
+        assert _names(dataclasses.replace(ev, style=dark)) == ["depth_flip"]
 
 
 def test_unexplained_only_when_failing_and_nothing_named():

@@ -16,7 +16,7 @@ F1@1px exactly.
 What the wider radius cannot hide: a missing line leaves the oracle's pixels
 with no candidate pixel at any radius (recall falls by its share of the
 pixels), and a line moved by a pixel or more is measured from its centres
-(``pixel_offset``: :meth:`oracles.judge.line_style.CaseStyle.judge`), not from F1.
+(``pixel_offset``: oracles.judge.decide.judge_style, oracles.judge.name_faults), not from F1.
 
 Each frame's F1 is computed at every radius up to :data:`MAX_RADIUS_PX`
 (only where F1@1px is below 1: at 1 every pixel is within any wider radius),

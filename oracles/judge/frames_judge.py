@@ -106,7 +106,7 @@ class _CaseFrames:
         self.rounded_lines.extend(self.rounded_batch.add(k, fp, seg0, seg1))
 
     def rounded(self) -> dict | None:
-        """The case's pixels against the rounded-ends rule (CaseStyle.judge's ``rounded``), None without frames."""
+        """The case's pixels against the rounded-ends rule (CaseStyle.read's ``rounded``), None without frames."""
         self.rounded_lines.extend(self.rounded_batch.flush())
         if not self.rounded_f1:
             return None
