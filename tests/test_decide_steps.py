@@ -380,10 +380,13 @@ def test_the_offset_of_unplaced_lines_is_none_of_theirs():
 
 def test_dim_lines_win_over_the_images():
     ev = _evidence(f1_0=0.0, f1_1=0.0, style=_style(), image_faults=(Fault("depth_flip"),), drew_pixels=False)
-    lvl = NAMING.drawn_level - 1
-    ev = dataclasses.replace(ev, style=dataclasses.replace(ev.style, read={**ev.style.read, "level": lvl}))
-    (f,) = name_faults(ev, decide(ev, TOL), TOL)
-    assert f.name == "unexplained" and f.params["line_level"] == lvl
+    for lvl in (1, NAMING.drawn_level - 1):             # the dimmest line there is, and the brightest under 128
+        dim = dataclasses.replace(ev, style=dataclasses.replace(ev.style, read={**ev.style.read, "level": lvl}))
+        (f,) = name_faults(dim, decide(dim, TOL), TOL)
+        assert f.name == "unexplained" and f.params["line_level"] == lvl
+    # some frame drew a pixel by the rule: the lines are not all too dim, the images' name stands
+    drew = dataclasses.replace(dim, drew_pixels=True)
+    assert _names(drew) == ["depth_flip"]
     at_level = dataclasses.replace(ev.style, read={**ev.style.read, "level": NAMING.drawn_level})
     assert _names(dataclasses.replace(ev, style=at_level)) == ["depth_flip"]
     for nothing in (0, None):                           # no line at all (level 0 or unread): the images' name
