@@ -529,6 +529,10 @@ class NamingThresholds:
     #: sqrt(2) = 1.41 pixels per unit length (diagonal), a 2-px line 2; 1.75 parts them. Wide lines are
     #: judged by their centres and F1 at their radius, not by GL's pixel rule.
     wide_min_px: float = 1.75
+    #: Binary lines drawing this many pixels per pixel of the oracle's 1-px lines are wide whatever the median
+    #: across them (line_style, even_lean): a 1-px line of any aliased rule draws one pixel per step of its
+    #: major axis (the ratio 1, give or take its ends); Pillow's width 2 measured 1.85-2.1 on the bundled job.
+    wide_pixel_ratio: float = 1.5
     #: The widest F1 radius (px, oracles.judge.f1_radius): lines up to 5 px across (1 + ceil((5 - 1) / 2) = 3).
     #: A wider line is still held to 3 px (its outer pixels count against it: a stricter F1, never a looser one).
     max_radius_px: int = 3

@@ -24,6 +24,7 @@ from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
 
 from .. import faults as catalogue
+from ..tolerances import NAMING
 
 __all__ = ["set_difference", "visibility_fault", "in_place", "frames_visibility", "visibility_names"]
 
@@ -109,7 +110,7 @@ def frames_visibility(faults: list, cand_images, oracle_segs, camera, frames_che
 
 
 def visibility_names(faults: list, counts: tuple[int, int], frames_diagnosed: int, frames_checked: int,
-                     share: float = 0.5) -> list:
+                     share: float = NAMING.visibility_share) -> list:
     """:func:`frames_visibility` on the sets already counted (``counts``: :func:`set_difference` over
     ``frames_diagnosed`` frames): a bare ``unexplained`` gets the advice; a ``line_pixel_bias`` becomes it when
     at least ``share`` of its decided one-sided pixels, per frame, lie farther than :data:`NEAR_PX` from the

@@ -173,11 +173,9 @@ def wants_visibility(faults, ev: CaseEvidence, verdict: Verdict) -> bool:
             and faults[0].name in ("unexplained", "line_pixel_bias"))
 
 
-def name_faults(ev: CaseEvidence, verdict: Verdict, tol: Tolerances, upto: str | None = None) -> tuple[Fault, ...]:
-    """The case's faults, by :data:`PRECEDENCE`'s steps in order (``upto``: stop after that step)."""
+def name_faults(ev: CaseEvidence, verdict: Verdict, tol: Tolerances) -> tuple[Fault, ...]:
+    """The case's faults, by :data:`PRECEDENCE`'s steps in order, each given what the earlier ones named."""
     faults: list[Fault] = []
     for rule in PRECEDENCE:
         faults = _STEPS[rule.step](faults, ev, verdict, tol)
-        if rule.step == upto:
-            break
     return tuple(faults)
