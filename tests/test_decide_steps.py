@@ -323,6 +323,13 @@ def test_ends_past_their_bound_are_line_end_bias_with_their_median():
                                    "half the width)"}
 
 
+def test_ends_that_run_on_are_said_to_run_on():
+    # a 0.5-px antialiased line whose ends run 0.8 px on (past 0.25 + end_px): named, and said to run on
+    ev = _evidence(style=_style(end=0.8, width=0.5))
+    (f,) = name_faults(ev, decide(ev, TOL), TOL)
+    assert f.name == "line_end_bias" and f.params["note"].startswith("the lines run on 0.80 px past their ends")
+
+
 def test_the_biased_rounded_rules_line_fault_replaces_only_count_faults():
     # --line-rule any, pixels the rounded ends' but biased (test above): its line fault replaces GL's count
     # faults and an unexplained; a pixel_offset the diagnosis named stays, and with no rounded line fault GL's
