@@ -111,8 +111,17 @@ def test_grey_lines_offset_decides_at_offset_px_plus_half_a_coverage_step():
     bound = TOL.offset_px + 0.5 / 4
     assert decide(_evidence(style=_style(dx=bound)), TOL).verdict == "pass"
     v = decide(_evidence(style=_style(dx=math.nextafter(bound, UP))), TOL)
-    assert v.verdict == "fail" and v.reasons[0].startswith("line centres offset by")
+    assert v.verdict == "fail" and v.reasons == (f"line centres offset by (0.33, 0.00) px > {bound:.3g} "
+                                                 "(antialiased lines, 900 samples)",)
     assert v.style.moved and not v.style.warped
+
+
+def test_aliased_lines_held_to_gl_are_not_held_to_their_centres():
+    # aliased lines under --line-rule gl: GL's pixel rule decides (here met), the centres' offset is measured
+    # (moved) but adds no reason of its own
+    v = decide(_evidence(style=_style(style="aliased", grey_share=0.0, line_rule="gl", dx=0.5, warp=2.0,
+                                      end=-2.0)), TOL)
+    assert v.style.moved and v.style.warped and v.style.end_out and v == Verdict("pass", (), v.style)
 
 
 def test_binary_wide_lines_offset_decides_at_rule_offset_px():
