@@ -580,6 +580,55 @@ class Tolerances:
                 "end_px": self.end_px, "rounded_end_tie_px": self.rounded_end_tie_px,
                 "rule_f1_0px": self.rule_f1_0px}
 
+@dataclass(frozen=True)
+class NamingThresholds:
+    """The frames path's thresholds that decide a verdict or a name but are not a run's to set (no CLI option):
+    read by oracles.judge.decide and oracles.judge.name_faults, each with its reason. They were module
+    constants of line_style, free_ends, f1_radius, dim_lines and image_visibility; their values are unchanged.
+    """
+
+    #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
+    #: (oracles.candidates.png_frame). Lines whose level is above 0 and under it drew nothing by the rule:
+    #: named ``unexplained`` (dim lines), not the image diagnosis' ``depth_flip``.
+    drawn_level: int = 128
+    #: A case's lines are binary (aliased) when at most this share of the drawn pixels is an intermediate grey
+    #: (between 1/8 and 7/8 of the level): antialiased lines have a third or more (4x4 supersampled 1-px
+    #: lines measured 0.6-0.8). Binary lines are held to ``rule_offset_px`` and a warp half a pixel looser.
+    grey_share_max: float = 0.05
+    #: Binary lines are quantised line by line (up to half a pixel each, which a reference drawing matches
+    #: only for its own rule): their warp is held to ``Tolerances.scale_px`` plus this half pixel (px).
+    binary_warp_px: float = 0.5
+    #: The line centres are measured (and may name ``pixel_offset``) only where at least this share of the
+    #: windows along the oracle's lines holds a line: a correct renderer nearly all, lines mirrored or
+    #: scaled away few.
+    min_found_share: float = 0.5
+    #: Free ends a case must have measured for their median to be judged (one stray end cannot decide).
+    min_ends: int = 4
+    #: A grey value is one of the lines' coverage levels when at least this share of the drawn pixels has it
+    #: (line_style): coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's
+    #: step, which grey lines' offset bound adds (offset_px + 0.5 / levels).
+    level_share_min: float = 0.002
+    #: Coverage across a line (px) from which it is ``wide`` (line_style): a 1-px aliased line has at most
+    #: sqrt(2) = 1.41 pixels per unit length (diagonal), a 2-px line 2; 1.75 parts them. Wide lines are
+    #: judged by their centres and F1 at their radius, not by GL's pixel rule.
+    wide_min_px: float = 1.75
+    #: Binary lines drawing this many pixels per pixel of the oracle's 1-px lines are wide whatever the median
+    #: across them (line_style, even_lean): a 1-px line of any aliased rule draws one pixel per step of its
+    #: major axis (the ratio 1, give or take its ends); Pillow's width 2 measured 1.85-2.1 on the bundled job.
+    wide_pixel_ratio: float = 1.5
+    #: The widest F1 radius (px, oracles.judge.f1_radius): lines up to 5 px across (1 + ceil((5 - 1) / 2) = 3).
+    #: A wider line is still held to 3 px (its outer pixels count against it: a stricter F1, never a looser one).
+    max_radius_px: int = 3
+    #: A ``line_pixel_bias`` whose one-sided pixels are mostly whole pieces of line is a visibility
+    #: difference: at least this share of its decided one-sided pixels (per frame) lie farther than 1 px from
+    #: the other side (a line drawn too thick or too thin never leaves a pixel that far).
+    visibility_share: float = 0.5
+
+
+#: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults).
+NAMING = NamingThresholds()
+
+
 def line_failures(lines: dict, tol) -> list[str]:
     """Why a case's pooled line fields (oracles.judge.metrics.line_summary) fail ``tol``; [] if they pass.
 

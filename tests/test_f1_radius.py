@@ -14,7 +14,8 @@ import pytest
 from test_line_style import _fill, _judge, draw_wide, job_dir  # noqa: F401 - job_dir: the module's fixture
 
 from wirecheck.oracles.judge import f1_radius
-from wirecheck.oracles.judge.decide import reasons
+from wirecheck.oracles.judge.decide import decide
+from wirecheck.oracles.judge.evidence import CaseEvidence, Radius
 from wirecheck.oracles.tolerances import Tolerances
 
 
@@ -32,30 +33,27 @@ def test_radius_from_the_width_read(style, width, radius):
     assert f1_radius.radius_px({"style": style, "width_px": width}) == radius
 
 
-def _rec(f1_1px: float, radius: int, f1_radius: float) -> dict:
-    return {"frames_checked": 2, "pixel_f1_0px": 1.0, "pixel_f1_1px": f1_1px, "worst_pixel_frame": 1,
-            "f1_radius_px": radius, "pixel_f1_radius": f1_radius, "pixel_f1_radius_frame": 4,
-            "line_style": {"pixel_rule": False, "failures": []}}
+def _reasons(f1_1px: float, radius: int, f1_radius: float, frame: int = 4) -> list:
+    ev = CaseEvidence(level="frames", compared={"frames": 2, "vertices": 0, "pixels": 100}, frames_checked=2,
+                      pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": f1_1px, "worst_pixel_frame": 1},
+                      radius=Radius(radius, f1_radius, frame))
+    return list(decide(ev, Tolerances()).reasons)
 
 
 def test_the_f1_at_the_radius_alone_decides():
     # by hand: the gate's bound 0.999 applies to the F1 at the case's radius, not to F1@1px beside it
-    tol = Tolerances()
-    assert reasons(_rec(0.995, 2, 0.9995), tol) == []
-    assert reasons(_rec(1.0, 2, 0.998), tol) == ["pixel F1@2px 0.9980 < 0.999 (frame 4; lines read wider than 1 px)"]
+    assert _reasons(0.995, 2, 0.9995) == []
+    assert _reasons(1.0, 2, 0.998) == ["pixel F1@2px 0.9980 < 0.999 (frame 4; lines read wider than 1 px)"]
     # an aliased case (radius 1): F1@1px itself, its worst frame, as before
-    rec = _rec(0.998, 1, 0.998)
-    rec["pixel_f1_radius_frame"] = 1
-    assert reasons(rec, tol) == ["pixel F1@1px 0.9980 < 0.999 (frame 1)"]
+    assert _reasons(0.998, 1, 0.998, frame=1) == ["pixel F1@1px 0.9980 < 0.999 (frame 1)"]
 
 
-def test_apply_takes_the_worst_frame_at_the_radius():
-    rec = {"pixel_f1_1px": 0.99, "worst_pixel_frame": 4}
+def test_radius_read_takes_the_worst_frame_at_the_radius():
     per_frame = [{2: 0.9991, 3: 1.0}, {2: 0.9993, 3: 1.0}]
-    f1_radius.apply(rec, {"style": "wide", "width_px": 3.0}, per_frame, [1, 4])
-    assert (rec["f1_radius_px"], rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"]) == (2, 0.9991, 1)
-    f1_radius.apply(rec, {"style": "aliased", "width_px": 1.0}, per_frame, [1, 4])
-    assert (rec["f1_radius_px"], rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"]) == (1, 0.99, 4)
+    assert f1_radius.radius_read({"style": "wide", "width_px": 3.0}, per_frame, [1, 4], 0.99, 4) == \
+        Radius(2, 0.9991, 1)
+    assert f1_radius.radius_read({"style": "aliased", "width_px": 1.0}, per_frame, [1, 4], 0.99, 4) == \
+        Radius(1, 0.99, 4)
 
 
 def _without_longest(segs, w, h):

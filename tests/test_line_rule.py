@@ -23,6 +23,10 @@ from wirecheck.oracles.cli import main
 from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 from wirecheck.oracles.judge import line_model
 from wirecheck.oracles.judge.frames_judge import run_frames
+from wirecheck.oracles.judge.decide import decide
+from wirecheck.oracles.judge.evidence import CaseEvidence
+from wirecheck.oracles.judge.line_style import style_record
+from wirecheck.oracles.judge.name_faults import name_faults
 from wirecheck.oracles.tolerances import Tolerances
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "clients"))
@@ -32,6 +36,17 @@ from test_line_style import draw_antialiased  # noqa: E402
 # oblique views: the lines slant, so every frame shows both offset components; 6 frames each, so that a
 # pixel dropped at each line's end (hidden at the vertices where another line covers it) is seen often enough
 ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6"]
+
+
+def _judged(style, tol=None):
+    """A CaseStyle's frames judged alone: pixels that agree (F1 1.0), only the style's own limits deciding;
+    ``(verdict, fault names, line_style record)`` (oracles.judge.decide, name_faults, line_style.style_record)."""
+    tol = Tolerances() if tol is None else tol
+    ev = CaseEvidence(level="frames", compared={"frames": 1, "vertices": 0, "pixels": 1}, frames_checked=1,
+                      pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
+                      style=style.read((), tol))
+    verdict = decide(ev, tol)
+    return verdict, [f.name for f in name_faults(ev, verdict, tol)], style_record(ev.style, verdict.style, 1)
 
 
 @pytest.fixture(scope="module")
@@ -226,14 +241,12 @@ def test_end_px_decides():
     def judged(end_px):
         style = CaseStyle()
         style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
-        rec = {"faults": []}
-        style.judge(rec, [], Tolerances(end_px=end_px))
-        return rec
+        return _judged(style, Tolerances(end_px=end_px))
 
-    end = judged(5.0)["line_style"]["geometry"]["end_px"]
+    end = judged(5.0)[2]["geometry"]["end_px"]
     assert -0.8 < end < -0.5
-    assert judged(-end + 0.02)["faults"] == []
-    assert [f["name"] for f in judged(-end - 0.02)["faults"]] == ["line_end_bias"]
+    assert judged(-end + 0.02)[1] == []
+    assert judged(-end - 0.02)[1] == ["line_end_bias"]
 
 
 def test_rounded_end_tie_px_decides():

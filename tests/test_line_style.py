@@ -25,11 +25,27 @@ from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX
 from wirecheck.oracles.judge.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset
+from wirecheck.oracles.judge.decide import decide
+from wirecheck.oracles.judge.evidence import CaseEvidence
+from wirecheck.oracles.judge.line_style import style_record
+from wirecheck.oracles.judge.name_faults import name_faults
+from wirecheck.oracles.tolerances import Tolerances
 
 # oblique views: the lines slant, so every frame shows both offset components
 ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6",
         "--every", "3"]
 
+
+
+def _judged(style, tol=None):
+    """A CaseStyle's frames judged alone: pixels that agree (F1 1.0), only the style's own limits deciding;
+    ``(verdict, fault names, line_style record)`` (oracles.judge.decide, name_faults, line_style.style_record)."""
+    tol = Tolerances() if tol is None else tol
+    ev = CaseEvidence(level="frames", compared={"frames": 1, "vertices": 0, "pixels": 1}, frames_checked=1,
+                      pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
+                      style=style.read((), tol))
+    verdict = decide(ev, tol)
+    return verdict, [f.name for f in name_faults(ev, verdict, tol)], style_record(ev.style, verdict.style, 1)
 
 def _band(segs, w, h, half, ss):
     """Coverage (uint8) of lines of half-width ``half`` px: pixels' ``ss x ss`` sub-centres within it."""
@@ -251,13 +267,12 @@ def test_a_dropped_or_extra_end_is_named(short_px, named):
     drawn = np.stack([segs[:, 0] + short_px * u, segs[:, 1] - short_px * u], axis=1)
     style = CaseStyle()
     style.frame(draw_antialiased(drawn, 220, 140), np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
-    rec = {"faults": []}
-    reasons = style.judge(rec, [], None)
-    geo = rec["line_style"]["geometry"]
-    assert rec["line_style"]["style"] == "antialiased" and geo["ends_measured"] == 6
+    verdict, names, line_style = _judged(style)
+    geo = line_style["geometry"]
+    assert line_style["style"] == "antialiased" and geo["ends_measured"] == 6
     assert geo["end_px"] == pytest.approx(0.37 - short_px, abs=0.15)
-    assert [f["name"] for f in rec["faults"]] == (["line_end_bias"] if named else [])
-    assert any("line ends" in r for r in reasons) == named
+    assert names == (["line_end_bias"] if named else [])
+    assert any("line ends" in r for r in verdict.reasons) == named
 
 
 def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
@@ -279,10 +294,9 @@ def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
         # the halved samples hold their own memory: a view (x[::2]) would keep every frame's whole arrays
         # alive, and the case's memory would grow with its frames whatever the samples kept
         assert all(v.base is None for v in style.samples.arrays() + style.reference.arrays())
-    rec = {"faults": []}
-    style.judge(rec, [], None)
-    geo = rec["line_style"]["geometry"]
-    assert geo["found_share"] == 1.0 and max(map(abs, geo["offset_px"])) < 0.05 and rec["faults"] == []
+    _, names, line_style = _judged(style)
+    geo = line_style["geometry"]
+    assert geo["found_share"] == 1.0 and max(map(abs, geo["offset_px"])) < 0.05 and names == []
 
 
 @pytest.mark.parametrize("row", [0, -1], ids=["first_row", "last_row"])

@@ -24,8 +24,9 @@ from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
 
 from .. import faults as catalogue
+from ..tolerances import NAMING
 
-__all__ = ["set_difference", "visibility_fault", "in_place", "frames_visibility"]
+__all__ = ["set_difference", "visibility_fault", "in_place", "frames_visibility", "visibility_names"]
 
 #: A pixel is on one side only when the other side has no pixel within this distance (px): F1@1px's tolerance.
 NEAR_PX = 1.0
@@ -99,19 +100,26 @@ def frames_visibility(faults: list, cand_images, oracle_segs, camera, frames_che
     """A frames case's ``faults`` when its images fit the oracle's lines (nothing named from them).
 
     A bare ``unexplained`` (oracles.judge.decide's) gets the visibility advice. A ``line_pixel_bias`` whose
-    one-sided pixels are mostly whole pieces of line (at least half of its decided one-sided pixels, per
-    frame, lie farther than :data:`NEAR_PX` from the other side: a line drawn too thick or too thin never
-    leaves a pixel that far) is a visibility difference, not a line width: it becomes that ``unexplained``,
-    the line fault's name kept under ``line_fault``. ``cand_images``, ``oracle_segs``: the diagnosed frames (of the
-    case's ``frames_checked``).
+    one-sided pixels are mostly whole pieces of line becomes that ``unexplained`` (:func:`visibility_names`).
+    ``cand_images``, ``oracle_segs``: the diagnosed frames (of the case's ``frames_checked``).
     """
     if len(faults) != 1 or not len(cand_images) or faults[0]["name"] not in ("unexplained", "line_pixel_bias"):
         return faults
     counts = set_difference(cand_images, oracle_segs, camera)
+    return visibility_names(faults, counts, len(cand_images), frames_checked)
+
+
+def visibility_names(faults: list, counts: tuple[int, int], frames_diagnosed: int, frames_checked: int,
+                     share: float = NAMING.visibility_share) -> list:
+    """:func:`frames_visibility` on the sets already counted (``counts``: :func:`set_difference` over
+    ``frames_diagnosed`` frames): a bare ``unexplained`` gets the advice; a ``line_pixel_bias`` becomes it when
+    at least ``share`` of its decided one-sided pixels, per frame, lie farther than :data:`NEAR_PX` from the
+    other side (a line drawn too thick or too thin never leaves a pixel that far), its name kept under
+    ``line_fault`` (oracles.tolerances.NamingThresholds.visibility_share)."""
     if faults[0]["name"] == "unexplained":
-        return [visibility_fault(faults[0], cand_images, oracle_segs, camera, None, counts)]
+        return [visibility_fault(faults[0], None, None, None, None, counts)]
     decided = faults[0]["candidate_only"] + faults[0]["oracle_only"]
-    if sum(counts) * frames_checked < 0.5 * decided * len(cand_images):
+    if sum(counts) * frames_checked < share * decided * frames_diagnosed:
         return faults
-    return [visibility_fault({"name": "unexplained", "line_fault": faults[0]["name"]}, cand_images, oracle_segs, camera,
-                             None, counts)]
+    return [visibility_fault({"name": "unexplained", "line_fault": faults[0]["name"]}, None, None, None, None,
+                             counts)]

@@ -38,7 +38,7 @@ from ..cases import Case
 from ..candidates.core_candidate import CoreCandidate, RenderMode
 from ..candidates.draw import depth_margin, draw_candidate, oracle_segments
 from ..tolerances import Tolerances
-from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge, judge_oracle_precision
+from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
 from ..diagnosis import clip_planes
 
 
@@ -282,9 +282,8 @@ def run_case(scene: Scene, case: Case, frames: int, candidate, motion: Motion,
         rec["clipped_ends"] = {"inward_depth": setup.slack, "reason": setup.slack_why}
     if setup.pixels_skipped:
         rec["note"] = PIXELS_NOT_COMPARED
-    judge(rec, tol, acc.error, points=len(scene.vertices))
-    judge_oracle_precision(rec, acc.oracle_bound_px if setup.pixels else None, judge, tol, acc.error,
-                           len(scene.vertices))
+    judge(rec, tol, acc.error, points=len(scene.vertices),
+          oracle_bound_px=acc.oracle_bound_px if setup.pixels else None)
     rec["per_frame"] = acc.per_frame
     images = None
     if acc.worst is not None:

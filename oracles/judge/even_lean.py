@@ -62,6 +62,7 @@ from __future__ import annotations
 
 import numpy as np
 from .line_profile import MIN_SAMPLES, pooled_offset
+from ..tolerances import NAMING
 
 #: How far (px, along the minor axis) an even band may lean off the exact line: half a pixel.
 LEAN_PX = 0.5
@@ -86,8 +87,8 @@ LEAN_GAIN_PX2 = 0.25 * 0.25 ** 2
 #: median across them: a 1-px line of any aliased rule draws one pixel per step of its major axis, as
 #: GL's does (the ratio 1, give or take its ends). Pillow's width 2 draws its lines within 30 degrees
 #: of an axis about 1.2 pixels across (half a pixel off, leaning), the others 2-3: a median of 1.0-1.7
-#: on slanted views and 1.85-2.1 times the oracle's pixels (measured on the bundled job).
-WIDE_PIXEL_RATIO = 1.5
+#: on slanted views and 1.85-2.1 times the oracle's pixels (measured on the bundled job): NAMING.wide_pixel_ratio.
+WIDE_PIXEL_RATIO = NAMING.wide_pixel_ratio
 #: Cases with at most this many edges' worth of samples cannot test the symmetric band: its offset
 #: (two numbers) fits two edges exactly and leaves a third one number to check, so the leaning fit
 #: (the smaller offset, by the lean's ambiguity) is used there.

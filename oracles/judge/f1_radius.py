@@ -16,7 +16,7 @@ F1@1px exactly.
 What the wider radius cannot hide: a missing line leaves the oracle's pixels
 with no candidate pixel at any radius (recall falls by its share of the
 pixels), and a line moved by a pixel or more is measured from its centres
-(``pixel_offset``: :meth:`oracles.judge.line_style.CaseStyle.judge`), not from F1.
+(``pixel_offset``: oracles.judge.decide.judge_style, oracles.judge.name_faults), not from F1.
 
 Each frame's F1 is computed at every radius up to :data:`MAX_RADIUS_PX`
 (only where F1@1px is below 1: at 1 every pixel is within any wider radius),
@@ -27,11 +27,12 @@ from __future__ import annotations
 
 import math
 
+from .evidence import Radius
+from ..tolerances import NAMING
 from .metrics import pixel_scores
 
-#: The widest radius computed: lines up to 5 px across (``1 + ceil((5 - 1) / 2) = 3``). A wider
-#: line is still held to 3 px (its outer pixels count against it: a stricter F1, never a looser one).
-MAX_RADIUS_PX = 3
+#: The widest radius computed: oracles.tolerances.NAMING.max_radius_px (3: lines up to 5 px across; its reason there).
+MAX_RADIUS_PX = NAMING.max_radius_px
 #: The radii computed per frame besides F1@1px.
 RADII = tuple(range(2, MAX_RADIUS_PX + 1))
 
@@ -59,17 +60,14 @@ def frame_scores(fp, scores: dict) -> dict:
     return {r: wide[f"f1_{r}px"] for r in RADII}
 
 
-def apply(rec: dict, read: dict, per_frame: list, frames: list) -> None:
-    """Set the case's F1 radius and its worst frame's F1 there, which oracles.judge.decide.reasons holds to
-    ``min_f1_1px``: ``rec["f1_radius_px"]``, ``rec["pixel_f1_radius"]``, ``rec["pixel_f1_radius_frame"]``.
+def radius_read(read: dict, per_frame: list, frames: list, f1_1px: float, worst_frame) -> Radius:
+    """The case's F1 radius and its worst frame's F1 there, which oracles.judge.decide holds to ``min_f1_1px``.
 
     ``read``: the case's style (``CaseStyle.classify()``); ``per_frame``: each frame's :func:`frame_scores`,
-    ``frames`` their numbers. At a radius of 1 the F1 is F1@1px itself (``pixel_f1_1px``, its worst frame).
+    ``frames`` their numbers. At a radius of 1 the F1 is F1@1px itself (``f1_1px``, its ``worst_frame``).
     """
     radius = radius_px(read)
-    rec["f1_radius_px"] = radius
     if radius == 1 or not per_frame:
-        rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"] = rec["pixel_f1_1px"], rec["worst_pixel_frame"]
-        return
+        return Radius(radius, f1_1px, worst_frame)
     worst = min(range(len(per_frame)), key=lambda i: per_frame[i][radius])     # the first of the lowest
-    rec["pixel_f1_radius"], rec["pixel_f1_radius_frame"] = float(per_frame[worst][radius]), frames[worst]
+    return Radius(radius, float(per_frame[worst][radius]), frames[worst])

@@ -10,10 +10,10 @@ its frames: edge-pixel F1 at 0 and 1 px (oracles.judge.metrics.pixel_scores), an
 the line scores against the oracle's segments (oracles.judge.metrics.line_scores:
 one-sided pixels and their balance, per-edge counts, where the one-sided
 pixels lie, sub-pixel ties), the segments known from the job's camera and
-scene (oracles.candidates.draw.oracle_segments). The case's faults are named from the
-images (oracles.diagnosis.image_diagnose); when those name nothing, from the lines
-(``line_end_bias``, ``line_pixel_bias``: oracles.judge.decide.line_faults). The
-verdict is oracles.judge.decide.decide's, at level ``frames`` (no vertex compared).
+scene (oracles.candidates.draw.oracle_segments). After the frames, the case's measurements are frozen
+(:func:`case_evidence`: oracles.judge.evidence), its verdict decided from them (oracles.judge.decide.decide,
+at level ``frames``: no vertex compared), its faults named from both (oracles.judge.name_faults: the images'
+names, else the lines'), and its record built once (:func:`case_record`).
 
 A job that asks for depth maps or filled frames (``outputs``, oracles.candidates.export)
 has them measured in the same frame loop: pyrender draws the frame's faces (on the
@@ -37,22 +37,28 @@ from pathlib import Path
 
 import numpy as np
 
-from . import f1_radius, line_model, metrics
+from collections.abc import Mapping
+from dataclasses import replace
+
+from . import f1_radius, gate, line_model, metrics
 from ..candidates.frames_candidate import face_objects, read_frame
 from .frame_prefetch import FramePrefetch, reader_for
 from ..references import opencv_oracle
-from .decide import decide, depth_map_reasons, line_faults, pixel_fields, pixel_rule_reasons, reasons
+from .decide import decide, pixel_fields
 from .depth_frames import DepthFrames
 from .depth_reference import from_render
-from .dim_lines import name_dim_lines
+from .evidence import CaseEvidence, Visibility
 from .filled_frames import FilledFrames
-from .line_style import CaseStyle
+from .line_style import CaseStyle, style_record
+from .name_faults import name_faults, wants_visibility
 from wirecheck.core.projector import pipeline
 from ..candidates.draw import oracle_segments as line_segments
 from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
-from ..diagnosis.image_visibility import frames_visibility
+from ..diagnosis.diagnose import diagnose_lines
+from ..diagnosis.image_visibility import set_difference
 from ..candidates import frames_candidate
 from ..candidates.export import job_outputs
+from ..faults import Fault
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
@@ -103,7 +109,6 @@ class _CaseFrames:
         self.rounded_f1 = []               # each frame's F1@0px against the rounded-ends rule (line_model)
         self.rounded_batch = metrics.LineBatch()
         self.rounded_lines = []
-        self.named = False                 # whether the image diagnosis named a fault
 
     def add_rounded(self, k, cand: np.ndarray, segs: np.ndarray, shape: tuple, seg0, seg1, tol) -> None:
         """Score a frame's drawn pixels ``cand`` (flat) against a correct drawing of ``segs`` by the
@@ -176,34 +181,32 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
                 acc.drawn_px += rec_k["union_px"]
         del frame
     ahead.close()
+    diagnosed, images, segments = (), [], []
     if wire:
-        rec, worst = _wireframe_record(acc, style, job, scene, case, camera, numbers, tol, diagnose, line_rule)
-    else:
-        rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
-               "frames_checked": len(numbers), "max_vertex_error_px": None, "faults": []}
-        worst = None
-    faults = rec["faults"]
-    if depth:
-        rec["depth_map"] = depth.fields()
-        faults = faults + (depth.faults() if depth_map_reasons(rec["depth_map"], tol) else [])
-    if filled:
-        rec["filled"] = filled.fields(MIN_IOU_UNION_PX)
-    rec["faults"] = faults
-    rec["compared"] = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
-    decide(rec, tol, level="frames")
-    if wire and diagnose and not acc.named and rec["verdict"] == "fail" and _wireframe_fails(rec, tol):
+        acc.record_lines(acc.batch.flush())
+        images, segments, flipped = acc.visibility_inputs()
+        if diagnose:
+            diagnosed = tuple(Fault.of(f) for f in diagnose_images(images, segments, camera, flipped, tol=tol))
+    ev = case_evidence(acc, style if wire else None, numbers, diagnosed, tol,
+                       depth_map=depth.fields() if depth else None,
+                       filled=filled.fields(MIN_IOU_UNION_PX) if filled else None,
+                       depth_faults=tuple(Fault.of(f) for f in depth.faults()) if depth else ())
+    verdict = decide(ev, tol)
+    names = name_faults(ev, verdict, tol)
+    if diagnose and images and wants_visibility(names, ev, verdict) and _wireframe_fails(ev, tol):
         # the images fit the oracle's lines (nothing named from them) and the case fails: which sets differ?
-        images, segments, _flipped = acc.visibility_inputs()
-        rec["faults"] = frames_visibility(rec["faults"], images, segments, camera, len(numbers))
-    rec["per_frame"] = acc.per_frame
+        ev = replace(ev, visibility=Visibility(*set_difference(images, segments, camera), len(images), len(numbers)))
+        names = name_faults(ev, verdict, tol)
+    rec = case_record(job, scene, case, camera, ev, verdict, names, acc)
+    worst = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]} if wire else None
     return rec, worst
 
 
-def _wireframe_fails(rec: dict, tol) -> bool:
+def _wireframe_fails(ev: CaseEvidence, tol) -> bool:
     """Whether the case's wireframes miss a limit of their own (not only its depth maps or filled frames)."""
-    if "depth_map" not in rec and "filled" not in rec:
+    if ev.depth_map is None and ev.filled is None:
         return True
-    return bool(reasons({k: v for k, v in rec.items() if k not in ("depth_map", "filled")}, tol))
+    return decide(replace(ev, depth_map=None, filled=None), tol).verdict == "fail"
 
 
 def _wireframe(acc: _CaseFrames, style, path: Path, c: dict, k: int, frame, inputs: tuple, job, tol, line_rule: str,
@@ -243,26 +246,6 @@ def _wireframe(acc: _CaseFrames, style, path: Path, c: dict, k: int, frame, inpu
         acc.diag.append((fp.cand_idx, orac.shape, segs, oracle_segments(p_world, edges, flipped_camera(camera))))
 
 
-def _wireframe_record(acc: _CaseFrames, style, job: dict, scene: str, case: str, camera, numbers: list, tol,
-                      diagnose: bool, line_rule: str) -> tuple[dict, dict]:
-    """The case's record from its wireframes' scores (before any depth or filled field, and the verdict), and
-    the worst frame's images; ``acc.named``: whether the images named a fault."""
-    acc.record_lines(acc.batch.flush())
-    rec = case_record(job, scene, case, camera, acc, len(numbers))
-    faults = []
-    if diagnose:
-        images, segments, flipped = acc.visibility_inputs()
-        faults = diagnose_images(images, segments, camera, flipped, tol=tol)
-    acc.named = bool(faults)
-    rec["faults"] = line_faults(rec, tol, faults)      # a line fault only when the images name none
-    f1_radius.apply(rec, style.classify(), acc.radius, numbers)     # F1 at the radius the lines' width allows
-    # the style read from the images: whether GL's pixel rule decides, and the geometry's own failures
-    style.judge(rec, reasons(rec, tol), tol, rule_reasons=pixel_rule_reasons(rec, tol), rounded=acc.rounded())
-    rec["line_style"]["f1_radius_px"] = rec["f1_radius_px"]
-    rec["faults"] = name_dim_lines(rec["faults"], rec["line_style"], acc.per_frame)   # lines under the 128 rule
-    return rec, {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
-
-
 def _drawn(image: np.ndarray) -> np.ndarray:
     """Ascending flat indices of the pixels of ``image`` that are >= 128."""
     return np.flatnonzero(image.reshape(-1) >= 128)
@@ -274,15 +257,59 @@ def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:
     return out.reshape(shape)
 
 
-def case_record(job: dict, scene: str, case: str, camera, acc: _CaseFrames, checked: int) -> dict:
-    """A case's fields (before faults and verdict) from its frames' scores."""
+def case_evidence(acc: _CaseFrames, style: CaseStyle | None, numbers: list, diagnosed: tuple, tol,
+                  depth_map=None, filled=None, depth_faults: tuple = ()) -> CaseEvidence:
+    """What a case's frames measured, frozen (oracles.judge.evidence): its pixel scores, lines, F1 radius,
+    the diagnosis's faults (``diagnosed``), GL's line faults, the style read and what was compared; its depth
+    maps' and filled frames' fields and the depth maps' faults. ``style`` None: the job asks for no
+    wireframe (no pixel or line field)."""
+    compared = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
+    surfaces = {"depth_map": depth_map, "filled": filled, "depth_faults": depth_faults}
+    if style is None:
+        return CaseEvidence(level="frames", compared=compared, frames_checked=len(numbers), **surfaces)
+    pixels = pixel_fields(acc.pixel, acc.worst[1])
+    lines = metrics.line_summary(acc.lines)
+    line_named = tuple(Fault.of(f) for f in diagnose_lines(lines, tol))
+    radius = f1_radius.radius_read(style.classify(), acc.radius, numbers, pixels["pixel_f1_1px"],
+                                   pixels["worst_pixel_frame"])
+    return CaseEvidence(level="frames", compared=compared,
+                        frames_checked=len(numbers), pixels=pixels, lines=lines, radius=radius,
+                        image_faults=diagnosed, line_faults=line_named,
+                        style=style.read(diagnosed or line_named, tol, acc.rounded()),
+                        drew_pixels=any(f["candidate_pixels"] for f in acc.per_frame), **surfaces)
+
+
+def case_record(job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple,
+                acc: _CaseFrames) -> dict:
+    """A case's record (its entry in report.json's ``cases``), built once from its evidence, verdict and names;
+    beside them core's second opinion (never deciding) and the per-frame numbers (``acc``)."""
     rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
-           "frames_checked": checked, "max_vertex_error_px": None}
-    rec.update(pixel_fields(acc.pixel, acc.worst[1]))
-    rec["core"] = {f"{k}": acc.core_min[k] for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
-                                                        "precision_1px", "recall_1px")}
-    rec["lines"] = metrics.line_summary(acc.lines)
+           "frames_checked": ev.frames_checked, "max_vertex_error_px": None}
+    if ev.pixels is not None:
+        rec.update({**ev.pixels,
+                    "core": {k: acc.core_min[k] for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
+                                                          "precision_1px", "recall_1px")},
+                    "lines": dict(ev.lines)})
+    rec["faults"] = [f.as_dict() for f in names]
+    if ev.pixels is not None:
+        rec.update({"f1_radius_px": ev.radius.radius_px, "pixel_f1_radius": ev.radius.f1,
+                    "pixel_f1_radius_frame": ev.radius.frame,
+                    "line_style": style_record(ev.style, verdict.style, ev.radius.radius_px)})
+    for key in ("depth_map", "filled"):
+        if getattr(ev, key) is not None:
+            rec[key] = _plain(getattr(ev, key))
+    rec.update({"compared": dict(ev.compared), "verdict": verdict.verdict, "reasons": list(verdict.reasons),
+                "per_frame": acc.per_frame})
     return rec
+
+
+def _plain(value):
+    """``value`` with every read-only mapping made a dict again (report.json's record)."""
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return type(value)(_plain(v) for v in value)
+    return value
 
 
 def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
@@ -317,7 +344,6 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     compared = {"cases": sum(r["verdict"] != "vacuous" for r in records),
                 "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
                 "pixels": sum(r["compared"]["pixels"] for r in records)}
-    bad = failed or not compared["frames"] or (not allow_vacuous and (vacuous or not compared["pixels"]))
     outputs = job_outputs(job)
     tolerances = {**tol.to_dict(), **tol.lines_dict(), **(tol.surfaces_dict() if outputs != ("wireframe",) else {})}
     del tolerances["candidate_precision"]                 # no vertex is compared: no precision judged
@@ -326,7 +352,7 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
         values = [(r[sub] if sub else r)[key] for r in records if "pixel_f1_0px" in r]
         return min(values) if values else None
     report = {
-        "tool": "wirecheck crosscheck", "verdict": "fail" if bad else "pass",
+        "tool": "wirecheck crosscheck", "verdict": gate.run_verdict(records, compared, "frames", allow_vacuous),
         "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
         "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
         "oracle_gl": gl,

@@ -27,8 +27,8 @@ END_REACH_PX = 4.0
 #: segment), long when it stays above half this far past half the width: the default of
 #: Tolerances.end_px (oracles.tolerances, with its derivation).
 END_TOL_PX = _tolerances.END_TOL_PX
-#: Ends a case must have measured for their median to be judged.
-MIN_ENDS = 4
+#: Ends a case must have measured for their median to be judged: oracles.tolerances.NAMING.min_ends.
+MIN_ENDS = _tolerances.NAMING.min_ends
 
 
 def _bilinear(cov: np.ndarray, q: np.ndarray, level: float = 1.0) -> np.ndarray:

@@ -14,7 +14,8 @@ Three checks, each made here and nowhere else:
 3. **After the run** (:func:`run_verdict`): ``"pass"`` only when no case
    failed, the run compared at least one frame, and -- unless vacuous results
    are allowed (``allow_vacuous`` / ``--allow-vacuous``) -- no case is vacuous
-   and the run compared vertices (and pixels, at level pixels).
+   and the run compared vertices (and pixels, at level pixels; pixels only,
+   at level frames: a renderer's frames compare no vertex).
 
 What was compared is counted per case (``record["compared"]``) and for the run
 (:func:`compared_totals`, ``report["compared"]``): cases, frames, vertices
@@ -227,7 +228,8 @@ def run_verdict(records: list, compared: dict, level: str, allow_vacuous: bool =
     """``"pass"`` only when the run compared something and no case failed (module docstring)."""
     if not records or compared["frames"] == 0 or any(r["verdict"] == "fail" for r in records):
         return "fail"
-    if not allow_vacuous and (any(r["verdict"] == "vacuous" for r in records) or compared["vertices"] == 0
-                              or (level == "pixels" and not compared["pixels"])):
+    if not allow_vacuous and (any(r["verdict"] == "vacuous" for r in records)
+                              or (level != "frames" and compared["vertices"] == 0)
+                              or (level in ("pixels", "frames") and not compared["pixels"])):
         return "fail"
     return "pass"

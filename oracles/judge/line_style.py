@@ -53,7 +53,8 @@ differ are counted; one with a pixel of the other side among its 8 neighbours
 is "off by one", at an end when within :data:`END_RADIUS_PX` of a segment end,
 across the line otherwise.
 
-The verdict (:meth:`CaseStyle.judge`):
+What the read decides (:meth:`CaseStyle.read` returns it; oracles.judge.decide.judge_style holds it to
+the tolerances, oracles.judge.name_faults names it):
 
 - ``aliased`` with ``line_rule="gl"`` (default): F1@0px holds, as before.
   When F1@0px alone fails, the lines are measured in place (offset within
@@ -84,7 +85,9 @@ from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, po
 from ..diagnosis.image_diagnose import oracle_segments
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
-from .free_ends import MIN_ENDS
+from .decide import ROUNDED_RULE_NAME
+from .evidence import StyleRead
+from ..faults import Fault
 
 STYLES = ("aliased", "antialiased", "wide")
 #: ``--line-rule``: ``any`` (the default) holds aliased lines to a correct drawing under GL's rule or under
@@ -92,19 +95,19 @@ STYLES = ("aliased", "antialiased", "wide")
 #: is ``raster_rule``); ``geometry`` judges the lines' centres only.
 LINE_RULES = ("any", "gl", "geometry")
 #: What each rule read from the pixels is, for the report and the summary line.
-RULE_NAMES = {"gl": "GL's diamond exit", "rounded": "ends rounded to pixel centres (Bresenham, Pillow, cv2.line)"}
+RULE_NAMES = {"gl": "GL's diamond exit", "rounded": ROUNDED_RULE_NAME}
 
 #: A differing pixel this close to a segment end (px) is counted "at the end".
 END_RADIUS_PX = 1.5
-#: Coverage per unit length from which a line is ``wide``: a 1-px aliased line has at most
-#: sqrt(2) = 1.41 pixels per unit length (diagonal), a 2-px line 2.
-WIDE_MIN_PX = 1.75
+#: Coverage per unit length from which a line is ``wide``: oracles.tolerances.NAMING.wide_min_px (its reason there).
+WIDE_MIN_PX = tolerances.NAMING.wide_min_px
 #: A case is binary (aliased) when at most this share of its drawn pixels is an intermediate
 #: grey (between 1/8 and 7/8 of the line's level): antialiased lines have a third or more
 #: (measured: 4x4 supersampled 1-px lines 0.6-0.8).
-GREY_SHARE_MAX = 0.05
-#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it.
-LEVEL_SHARE_MIN = 0.002
+GREY_SHARE_MAX = tolerances.NAMING.grey_share_max
+#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it:
+#: oracles.tolerances.NAMING.level_share_min.
+LEVEL_SHARE_MIN = tolerances.NAMING.level_share_min
 #: The line's level: this percentile of the drawn pixels' values (robust to a few bright
 #: crossings of antialiased lines).
 LEVEL_PERCENTILE = 99
@@ -116,15 +119,9 @@ MAX_SAMPLES_PER_FRAME = 4000
 MAX_SAMPLES_PER_CASE = 48_000
 #: The geometry is measured only where at least this share of the windows along the oracle's lines
 #: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
-MIN_FOUND_SHARE = 0.5
-#: Line faults named from the one-sided pixel counts (oracles.diagnosis.diagnose.diagnose_lines): GL's rule.
-COUNT_FAULTS = catalogue.names("line_count")
+MIN_FOUND_SHARE = tolerances.NAMING.min_found_share
 #: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
 PLACEMENT_FAULTS = catalogue.names("orientation")
-#: The registration's faults that the line centres, finer over thick or other-rule pixels, replace.
-MEASURED_FAULTS = catalogue.names("scale", "offset")
-#: The faults a correct drawing under another aliased rule leaves under GL's rule: raster_rule replaces them.
-RULE_FAULTS = catalogue.names("unexplained", "offset", "line_count")
 #: Aliased lines of another rule, and binary wide lines: the largest pooled centre offset (px) that is
 #: still "the geometry is right": the default of Tolerances.rule_offset_px (oracles.tolerances).
 RULE_OFFSET_MAX_PX = tolerances.RULE_OFFSET_MAX_PX
@@ -435,7 +432,7 @@ class CaseStyle:
         if lean is not None:                            # an even band: each edge's lean chosen (even_lean)
             tol = tolerances.Tolerances() if tol is None else tol
             held = np.max(np.abs(d - ref_d)) <= tol.rule_offset_px and (affine is None or np.percentile(warp, 99)
-                                                                         <= tol.scale_px + 0.5)   # judge()'s bounds
+                                                                         <= tol.scale_px + tolerances.NAMING.binary_warp_px)   # decide's bounds
             geo["lean"] = {**{k: lean[k] for k in even_lean.REPORTED}, "used": bool(lean["leaning"] and not held)}
             if geo["lean"]["used"]:                     # the lean explains what the symmetric band cannot
                 d, ref_d, affine = lean["offset"], np.zeros(2), fit_lines(normal, lean["corrected"], point, self.centre)
@@ -444,151 +441,50 @@ class CaseStyle:
                    warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0)
         return geo
 
-    def judge(self, rec: dict, reasons: list, tol, rule_reasons=None, rounded=None) -> list:
-        """The case's reasons with the style's judgement joined; ``rec`` gains ``line_style`` and faults.
+    def read(self, diagnosed, tol=None, rounded=None) -> StyleRead:
+        """The case's lines read (:class:`oracles.judge.evidence.StyleRead`): their style, geometry, raster
+        counts and, for aliased lines, the same pixels against the rounded-ends rule; nothing judged here
+        (oracles.judge.decide.judge_style holds them to the tolerances, oracles.judge.name_faults names them).
 
-        ``reasons``: the case's reasons under every criterion (oracles.judge.decide.reasons);
-        ``rule_reasons``: those of GL's pixel rule (F1@0px, the balance, the per-edge
-        counts; default: the F1@0px ones). ``rounded``: the same pixels against a correct drawing
-        by the rounded-ends rule (``{"pixel_f1_0px", "lines"}``: the worst frame's F1@0px and the
-        pooled line fields, its ties left out; oracles.judge.line_model), None when not drawn.
-        ``rec["line_style"]`` says whether a pixel rule decides (``pixel_rule``), which rule the
-        pixels were read as (``rule_read``) and the style's own failures (``failures``), which
-        oracles.judge.decide.decide then applies.
+        ``diagnosed``: what the diagnosis named (oracles.faults.Fault records): lines it finds mirrored or
+        swapped are not measured (a centroid of what lies near the oracle's lines would be of stray
+        crossings). ``rounded``: the pixels against a correct drawing by the rounded-ends rule
+        (``{"pixel_f1_0px", "lines"}``: the worst frame's F1@0px and the pooled line fields, its ties left
+        out; oracles.judge.line_model), None when not drawn.
         """
         tol = tolerances.Tolerances() if tol is None else tol
         read = self.classify()
         geo = self.geometry(read, tol)
-        style = read["style"]
-        aliased = style == "aliased"
-        by_rule = aliased and self.line_rule in ("gl", "any")
-        binary = read["grey_share"] <= GREY_SHARE_MAX
-        # binary lines, 1 px or wide, are held to another aliased rule's bound (a wide rule snaps its ends too)
-        tol_px = tol.rule_offset_px if binary else tol.offset_px + 0.5 / read["coverage_steps"]
-        out = {**read, "line_rule": self.line_rule,
-               "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
-                            "the geometry (line centres); F1@0px is reported, not judged",
-               "can_show": CAN_SHOW[style], "cannot_show": CANNOT_SHOW[style], "offset_tol_px": tol_px,
-               "geometry": geo}
-        if by_rule and self.line_rule == "any":
-            out["judged_by"] = "a correct drawing by GL's rule or by the rounded-ends rule (F1@0px) and the geometry"
-        reasons = list(reasons)
-        faults = list(rec.get("faults") or [])
-        given = list(reasons)
-        f0 = [r for r in reasons if (r in rule_reasons if rule_reasons is not None else r.startswith("pixel F1@0px"))]
-        if not by_rule:
-            reasons = [r for r in reasons if r not in f0]
-            # the counts' line faults are GL's rule too: lines of another style are judged by their ends instead
-            faults = [f for f in faults if f["name"] not in COUNT_FAULTS or "measured_by" in f]
-        # lines mirrored or swapped, or mostly away from the oracle's, are not measured: a centroid of what
-        # lies near the oracle's lines would be of stray crossings; the registration's faults stand
         placed = (geo["offset_px"] is not None and geo["found_share"] >= MIN_FOUND_SHARE
-                  and not any(f["name"] in PLACEMENT_FAULTS for f in faults))
-        d = np.array(geo["offset_px"]) if placed else np.zeros(2)
-        off = float(np.max(np.abs(d)))
-        moved = placed and off > tol_px
-        # binary lines are quantised line by line (up to half a pixel each, which the reference drawing
-        # matches only for its own rule): their warp is judged with that half pixel added
-        warp_tol = tol.scale_px + (0.5 if binary else 0.0)
-        out["warp_tol_px"] = warp_tol
-        warped = placed and geo["warp_px"] > warp_tol
-        if placed and not by_rule:
-            # the centres are finer than the registration over thick or other-rule pixels: its offset and
-            # scale faults give way to the measure's
-            faults = [f for f in faults if f["name"] not in MEASURED_FAULTS
-                      or warped and f["name"] != "pixel_offset"]
-            if moved:
-                faults = [f for f in faults if f["name"] != "unexplained"]
-                faults.append({"name": "pixel_offset", "dx": float(d[0]), "dy": float(d[1]),
-                               "uncertainty_px": float(np.max(np.abs(geo["bias_px"]))), "confidence": 1.0,
-                               "residual_px": None, "measured_by": "line centroids"})
-                reasons.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {tol_px:.3g} "
-                               f"({style} lines, {geo['samples']} samples)")
-            end = geo["end_px"]
-            if geo["ends_measured"] >= MIN_ENDS and (end < -tol.end_px or end > read["width_px"] / 2 + tol.end_px):
-                short = end < 0
-                faults.append({"name": "line_end_bias", "end_px": end, "ends_measured": geo["ends_measured"],
-                               "confidence": 1.0, "residual_px": None, "measured_by": "line ends",
-                               "note": f"the lines {'stop' if short else 'run on'} {abs(end):.2f} px "
-                                       f"{'before' if short else 'past'} their ends (median of "
-                                       f"{geo['ends_measured']} free ends; a cap may add half the width)"})
-                reasons.append(f"line ends {end:+.2f} px from the segments' ends: expected "
-                               f"{-tol.end_px} to {read['width_px'] / 2 + tol.end_px:.2f} ({style} lines)")
-            if warped:
-                reasons.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
-                               f"or shear > {warp_tol:.3g} ({style} lines)")
-        rs = self.raster
-        if aliased and rs["differing"]:
-            out["raster_rule"] = {
-                "share_off_by_one_across": rs["off_by_one_across"] / max(rs["oracle_pixels"], 1),
-                "share_off_by_one_at_ends": rs["off_by_one_at_ends"] / max(rs["oracle_pixels"], 1),
-                "share_farther": rs["farther"] / max(rs["oracle_pixels"], 1)}
-        geometry_right = placed and not moved and not warped
-        # the rounded-ends rule (line_model): the pixels are a correct drawing by it when they miss none of
-        # its pixel limits, the centres are in place, and nothing but GL's pixel rule fails
-        rule_faults = ("unexplained", "pixel_offset", "raster_rule") + COUNT_FAULTS
-        only_rule = bool(f0) and len(f0) == len(reasons) and all(f["name"] in rule_faults for f in faults)
-        rounded_fails = self.rule_failures(rounded, tol) if by_rule and rounded is not None else None
-        rounded_right = rounded_fails == [] and not moved and not warped and only_rule
-        if by_rule:
-            # the rule read: GL's, unless the rounded ends' explains the pixels and more closely (F1@0px)
-            out["rule_read"] = "rounded" if (rounded_fails == [] and not f0 and not moved and not warped
-                                             and rounded["pixel_f1_0px"] > rec["pixel_f1_0px"]) else "gl"
-            if rounded is not None:
-                out["rounded_rule"] = {"pixel_f1_0px": rounded["pixel_f1_0px"], "failures": rounded_fails,
-                                       "lines": {k: rounded["lines"][k] for k in ("candidate_only", "oracle_only",
-                                                                                  "subpixel_ties", "imbalance")}}
-        if rounded_right:
-            out["rule_read"] = "rounded"
-            faults = [f for f in faults if f["name"] not in rule_faults]
-            if self.line_rule == "any":                 # a correct drawing by a rule allowed: GL's limits go
-                reasons = [r for r in reasons if r not in f0]
-            else:                                       # --line-rule gl: another rule's, named; no count deficit
-                reasons = [r for r in reasons if r not in f0] + [
-                    f"the pixels are a correct drawing by another rule than GL's ({RULE_NAMES['rounded']}: "
-                    f"F1@0px {rounded['pixel_f1_0px']:.4f} against it, {rec['pixel_f1_0px']:.4f} against GL's)"]
-                faults.append({"name": "raster_rule", **out.get("raster_rule", {}), "confidence": 1.0,
-                               "offset_px": [float(d[0]), float(d[1])], "residual_px": None, "rule": "rounded",
-                               "note": f"the lines are a correct drawing by another rule ({RULE_NAMES['rounded']}), "
-                                       "not GL's: check the line rasteriser, not the camera; without --line-rule "
-                                       "gl such lines pass"})
-        elif self.line_rule == "any" and by_rule and f0 and rounded is not None and only_rule \
-                and rec["pixel_f1_0px"] < rounded["pixel_f1_0px"] \
-                and rounded["pixel_f1_0px"] >= max(tol.min_f1_0px, tol.rule_f1_0px):
-            # the pixels are the rounded-ends rule's but for a bias of its one-sided pixels (a dropped end
-            # pixel): that rule's limits and its line fault, as GL's would name them
-            out["rule_read"] = "rounded"
-            reasons = [r for r in reasons if r not in f0] + rounded_fails
-            named = diagnose_lines(rounded["lines"], tol)
-            if named and all(f["name"] in COUNT_FAULTS + ("unexplained", "raster_rule") for f in faults):
-                faults = [f for f in faults if f["name"] not in COUNT_FAULTS + ("unexplained", "raster_rule")] + named
-        elif by_rule and f0 and len(f0) == len(reasons) and geometry_right and rs["farther"] == 0 \
-                and any(r.startswith("pixel F1@0px") for r in f0) \
-                and all(f["name"] in RULE_FAULTS for f in faults):
-            faults = [f for f in faults if f["name"] not in RULE_FAULTS]
-            faults.append({"name": "raster_rule", **out["raster_rule"], "confidence": 1.0,
-                           "offset_px": [float(d[0]), float(d[1])], "residual_px": None,
-                           "note": f"the lines are where the oracle's are (centres within {off:.2f} px) but "
-                                   "their pixels follow another line rule than GL's: check the line "
-                                   "rasteriser (its rule across the line and at the ends), not the camera; "
-                                   "--line-rule geometry judges the geometry only"})
-        rec["faults"] = catalogue.ordered(faults)
-        # GL's limits decide unless the pixels were read as the rounded ends' under --line-rule any
-        out.update(pixel_rule=by_rule and out.get("rule_read") != "rounded",
-                   failures=[r for r in reasons if r not in given])
-        rec["line_style"] = out
-        return reasons
+                  and not any(f.name in PLACEMENT_FAULTS for f in diagnosed))
+        by_rule = read["style"] == "aliased" and self.line_rule in ("gl", "any")
+        rounded_faults = tuple(Fault.of(f) for f in diagnose_lines(rounded["lines"], tol)) \
+            if by_rule and rounded is not None else ()
+        return StyleRead(self.line_rule, read, geo, dict(self.raster), rounded, rounded_faults, placed)
 
-    @staticmethod
-    def rule_failures(rounded: dict, tol) -> list[str]:
-        """Why pixels are no correct drawing by the rounded-ends rule: its F1@0px (worst frame) and its line
-        fields' balance and per-edge counts (oracles.tolerances.line_failures), as GL's are judged."""
-        out = []
-        floor = max(tol.min_f1_0px, tol.rule_f1_0px)      # a rule is read from its pixels, whatever GL's floor
-        if rounded["pixel_f1_0px"] < floor:
-            out.append(f"pixel F1@0px {rounded['pixel_f1_0px']:.4f} < {floor} against the rounded-ends "
-                       "rule too")
-        return out + [f"{r} (the rounded-ends rule)" for r in tolerances.line_failures(rounded["lines"], tol)]
+
+def style_record(s: StyleRead, j, radius_px: int) -> dict:
+    """A case's ``line_style`` field (report.json): the style read ``s`` and its judgement ``j``
+    (oracles.judge.decide.StyleJudgement), with what the style can and cannot show and the F1 radius."""
+    by_rule = s.by_rule
+    out = {**s.read, "line_rule": s.line_rule,
+           "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
+                        "the geometry (line centres); F1@0px is reported, not judged",
+           "can_show": CAN_SHOW[s.style], "cannot_show": CANNOT_SHOW[s.style], "offset_tol_px": j.offset_tol_px,
+           "geometry": dict(s.geometry)}
+    if by_rule and s.line_rule == "any":
+        out["judged_by"] = "a correct drawing by GL's rule or by the rounded-ends rule (F1@0px) and the geometry"
+    out["warp_tol_px"] = j.warp_tol_px
+    if s.raster_shares:
+        out["raster_rule"] = s.raster_shares
+    if by_rule:
+        out["rule_read"] = j.rule_read
+        if s.rounded is not None:
+            out["rounded_rule"] = {"pixel_f1_0px": s.rounded["pixel_f1_0px"], "failures": list(j.rounded_failures),
+                                   "lines": {k: s.rounded["lines"][k] for k in ("candidate_only", "oracle_only",
+                                                                                  "subpixel_ties", "imbalance")}}
+    out.update(pixel_rule=j.pixel_rule, failures=list(j.failures), f1_radius_px=radius_px)
+    return out
 
 
 def summary_lines(cases: list) -> list[str]:

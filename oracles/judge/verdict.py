@@ -16,9 +16,11 @@ import numpy as np
 
 from . import metrics
 from ..candidates.candidate import case_precision
-from .. import faults as catalogue
 from ..diagnosis.diagnose import diagnose
 from .decide import decide, line_faults, pixel_fields
+from .evidence import CaseEvidence
+from .name_faults import name_faults
+from ..faults import Fault
 from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 
@@ -122,39 +124,47 @@ def shaded_summary(shaded: list, worst) -> dict:
     return out
 
 
-def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | None = None) -> None:
-    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed): :func:`oracles.judge.decide.decide`.
+#: A projector case's vertex and shaded fields, as its evidence holds them (oracles.judge.evidence).
+VERTEX_KEYS = ("max_vertex_error_px", "vertex_bound_px", "worst_vertex", "precision", "visibility_mismatch")
+SHADED_KEYS = ("silhouette_iou", "silhouette_iou_gated", "silhouette_mismatch_inside", "face_disagreements_inside",
+               "depth_error_ratio", "depth_max_error", "depth_error_bound", "depth_worst_frame", "worst_pixel_frame")
+PIXEL_KEYS = ("pixel_f1_0px", "pixel_f1_1px", "worst_pixel_frame")
+
+
+def record_evidence(rec: dict, error: str | None = None, points: int | None = None,
+                    oracle_bound_px: float | None = None) -> CaseEvidence:
+    """A projector case's record (:func:`case_record`) as frozen evidence: its vertex, pixel, line and shaded
+    fields, the faults the diagnosis named (line faults among them), what it compared, at level ``"vertices"``
+    when no pixel was compared, else ``"pixels"``."""
+    return CaseEvidence(
+        level="vertices" if rec["compared"]["pixels"] is None else "pixels", compared=rec["compared"],
+        frames_checked=rec["frames_checked"], pixels={k: rec[k] for k in PIXEL_KEYS if k in rec},
+        lines=rec.get("lines"), vertices={k: rec[k] for k in VERTEX_KEYS if k in rec},
+        shaded={k: rec[k] for k in SHADED_KEYS if k in rec} if "silhouette_iou" in rec else None,
+        image_faults=tuple(Fault.of(f) for f in rec.get("faults") or []), error=error, points=points,
+        oracle_bound_px=oracle_bound_px)
+
+
+def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | None = None,
+          oracle_bound_px: float | None = None) -> None:
+    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed; oracles.judge.decide.decide),
+    and ``rec["faults"]`` to the names (oracles.judge.name_faults) where they change: a failure nothing
+    explains is ``unexplained``; past the oracle's precision limit the names read from pixels go.
 
     "fail" when a limit is missed; else "vacuous" when the case compared nothing
     (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.judge.gate).
+    ``oracle_bound_px``: the pyrender oracle's own error bound where pixels were drawn, recorded as
+    ``oracle_bound_px`` beside ``oracle_limit_px``; past the limit the case is judged on its vertices alone
+    (``oracle_precision``: True).
     """
-    decide(rec, tol, error, points)
-
-
-def judge_oracle_precision(rec: dict, bound_px: float | None, judge, tol, error, points) -> None:
-    """Record the case's ``oracle_bound_px``; where it exceeds :data:`ORACLE_LIMIT_PX`, judge without pixels.
-
-    ``rec`` was judged by ``judge`` (oracles.judge.verdict.judge). Beyond the limit
-    the pixel comparison says nothing about the candidate: the case is judged
-    again on its vertices alone, and its verdict is ``"fail"`` only for a
-    vertex failure, else ``"vacuous"`` (fails the run, oracles.judge.gate) with an
-    ``oracle_precision`` reason first, naming the bound and the limit.
-    """
-    if bound_px is None:
-        return
-    rec["oracle_bound_px"] = float(bound_px)
-    rec["oracle_limit_px"] = ORACLE_LIMIT_PX
-    if not bound_px > ORACLE_LIMIT_PX or rec.get("verdict") == "vacuous":
-        return          # within the limit; or nothing was compared, which the case already says
-    vertices_only = {k: v for k, v in rec.items() if k != "lines"}
-    vertices_only.update(pixel_f1_0px=None, pixel_f1_1px=None, silhouette_iou=None,
-                         compared=dict(rec["compared"], pixels=None))
-    judge(vertices_only, tol, error, points=points)
-    why = (f"oracle_precision: the pyrender oracle's own error bound {bound_px:.3g} px exceeds "
-           f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged")
-    vertex_reasons = vertices_only["reasons"] if vertices_only["verdict"] == "fail" else []
-    rec["verdict"] = "fail" if vertex_reasons else "vacuous"
-    rec["reasons"] = [why] + vertex_reasons
-    # a line fault is read from the pixels (line counts against the oracle's): those say nothing here
-    rec["faults"] = [f for f in rec.get("faults") or [] if catalogue.kind(f["name"]).source != "pixels"]
-    rec["oracle_precision"] = True
+    ev = record_evidence(rec, error, points, oracle_bound_px)
+    verdict = decide(ev, tol)
+    names = [f.as_dict() for f in name_faults(ev, verdict, tol)]
+    if names != rec.get("faults", []):
+        rec["faults"] = names
+    rec["verdict"], rec["reasons"] = verdict.verdict, list(verdict.reasons)
+    if oracle_bound_px is not None:
+        rec["oracle_bound_px"] = float(oracle_bound_px)
+        rec["oracle_limit_px"] = ORACLE_LIMIT_PX
+    if verdict.set_aside is not None:
+        rec["oracle_precision"] = True

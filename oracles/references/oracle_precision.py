@@ -55,7 +55,7 @@ The case's bound is the largest over its frames (the record's
 coordinates within ``2^-9`` px of exact (the float32 share of
 oracles.tolerances.TIE_END_PX); a case whose bound exceeds
 :data:`ORACLE_LIMIT_PX` asks for more than the oracle can give, and its
-pixels are not judged: :func:`oracles.judge.verdict.judge_oracle_precision` makes it an
+pixels are not judged: :func:`oracles.judge.decide.decide` makes it an
 ``oracle_precision`` case that fails the run without blaming the candidate.
 On the bundled scenes the bound is ~1e-4 to 1e-3 px, wherever the scene is
 put; before the re-centring a mesh 1e5 from the origin moved the oracle's

@@ -72,10 +72,14 @@ TARGETS = {
                            "decides or note or empty_scene or faceless or visibility or core_case_fields "
                            "or shaded_summary"),
     "oracles/references/convert.py": (["tests/test_oracle_convert.py"], None),
-    "oracles/judge/decide.py": (["tests/test_frames_judge.py", "tests/test_line_gate.py", "tests/test_crosscheck.py",
-                          "tests/test_crosscheck_styles.py", "tests/test_gate.py"],
-                         "decides or note or empty_scene or faceless or visibility or line_end_bias or exact or geometric "
-                         "or vacuous"),
+    "oracles/judge/decide.py": (["tests/test_decide_steps.py", "tests/test_f1_radius.py::test_the_f1_at_the_radius_alone_decides",
+                                 "tests/test_oracle_far.py", "tests/test_frames_judge.py", "tests/test_line_gate.py"],
+                                "steps or radius or oracle or decides or vacuous or line_end_bias or exact"),
+    # the pure steps (issue 34): decide and name_faults on hand-made evidence first (seconds), then the paths
+    # that collect it: the F1 radius by hand, the oracle's precision limit, dim lines and the visible sets
+    "oracles/judge/evidence.py": (["tests/test_decide_steps.py"], None),
+    "oracles/judge/name_faults.py": (["tests/test_decide_steps.py", "tests/test_oracle_far.py",
+                                      "tests/test_frames_dim_lines.py", "tests/test_frames_visibility.py"], None),
     # the frames path: its judge (run_frames, judge_case) is exercised by test_frames_judge.py (each threshold
     # deciding on PNG frames) and by the run_frames cases of test_frames_candidate.py (pass, named fault, vacuous)
     "oracles/judge/frames_judge.py": (["tests/test_frames_judge.py",
