@@ -34,9 +34,10 @@ Counted over all frames together (the parameters are shared: one camera mistake)
 and its ``miss_ratio`` is misses over the reference's boundary pixels (decided covered pixels
 with an uncovered 4-neighbour in the image: the silhouette's length in pixels). A model **explains** the
 frames when ``miss_ratio <= ALLOWANCE`` (derivation at :data:`ALLOWANCE`). Among the models that
-explain, the fewest parameters win, then the fewest misses; the identity explaining with no miss
-names nothing (a correct frame, or a mistake that moves no decided pixel: a symmetric silhouette
-under its mirror); two names explaining with as few parameters are ``ambiguous`` (a silhouette
+explain, the fewest parameters win, then the fewest misses; the identity with no miss names
+nothing (a correct frame, or a mistake that moves no decided pixel: a symmetric silhouette under
+its mirror), with a few misses within the allowance ``unexplained`` (in place: no camera mistake
+moves them; a rasteriser's own rule); two names explaining with as few parameters are ``ambiguous`` (a silhouette
 symmetric about the vertical axis shows ``mirror_vertical`` and ``axis_flip`` alike); nothing
 explaining is ``unexplained``, with every model's ``miss_ratio`` (``fit_ratios``).
 
