@@ -242,3 +242,32 @@ def test_names_are_the_catalogues():
     assert set(SILHOUETTE_FAULTS) == {"depth_flip", "axis_swap", "ambiguous", "axis_flip", "mirror_horizontal",
                                       "mirror_vertical", "aspect_mismatch", "fov_mismatch", "pixel_offset",
                                       "unexplained"}
+
+
+def test_a_square_frame_transposed_is_an_axis_swap():
+    """On a square image with the centred principal point, x and y exchanged is the array transposed."""
+    scene = load_scene("prism")
+    case = cases_for(scene, MOTION)[1]
+    cam = Camera(position=case.camera.position, forward=case.camera.forward, up=case.camera.up,
+                 fov_y_deg=case.camera.fov_y_deg, width=480, height=480, near=case.camera.near, far=case.camera.far)
+    p_world, _m, pr_vertices, pose = oface.frame_geometry(scene, case_motion(MOTION, case), 2 / 7)
+    inside, ties, _ = silhouette(p_world, scene.faces, cam, (cam.height, cam.width))
+    cand = core_covered(pr_vertices, scene, cam, pose).T
+    (fault,) = name_silhouette_faults([SilhouetteFrame(cand, inside, ties, cam, p_world, scene.faces)])
+    assert fault.name == "axis_swap", dict(fault.params)
+
+
+def test_a_few_stray_pixels_in_place_are_unexplained_not_a_camera_mistake():
+    """Three decided pixels flipped deep inside the silhouette: no camera mistake moves them (3 misses of ~700
+    boundary pixels are within every fitted model's allowance, but the identity is the simplest)."""
+    scene = load_scene("prism")
+    case = cases_for(scene, MOTION)[1]
+    cam = case.camera
+    p_world, _m, pr_vertices, pose = oface.frame_geometry(scene, case_motion(MOTION, case), 2 / 7)
+    inside, ties, _ = silhouette(p_world, scene.faces, cam, (cam.height, cam.width))
+    cand = core_covered(pr_vertices, scene, cam, pose).copy()
+    rows, cols = np.nonzero(inside & ~ties)
+    mid = len(rows) // 2
+    cand[rows[mid - 1:mid + 2], cols[mid - 1:mid + 2]] = False
+    (fault,) = name_silhouette_faults([SilhouetteFrame(cand, inside, ties, cam, p_world, scene.faces)])
+    assert fault.name == "unexplained" and "3 decided pixels differ" in fault.note
