@@ -11,7 +11,8 @@ an unprojector's names included. An entry says
   list of name strings (:data:`FAMILIES`);
 - ``source``: where it is read (:data:`SOURCES`: ``any``; ``vertices`` only; ``pixels``: the
   drawn lines; ``images``: a renderer's frames only; ``depth``: a depth map's values; ``points``:
-  an unprojector's world points); a name read from other sources too has a hint keyed by each of
+  an unprojector's world points; ``silhouettes``: a filled frame's covered pixels); a name read from other
+  sources too has a hint keyed by each of
   them in ``hints`` (``mirror_vertical``'s ``depth`` and ``points`` hints), its :attr:`FaultKind.sources`;
 - ``shown``: the fields a table cell may show, with their labels ("": the value alone), of which a
   cell shows the first two a fault has (oracles.reports.fault_text; the full record is report.json's);
@@ -64,6 +65,7 @@ SOURCES: Mapping[str, str] = MappingProxyType({
     "images": "a renderer's frames only",
     "depth": "depth maps",
     "points": "unprojectors",
+    "silhouettes": "filled frames",
 })
 
 
@@ -134,7 +136,10 @@ _KINDS = (
                             "them apart): {each}",
             "depth": "the compared depths fit several of these models alike (a surface at one depth, seen "
                      "square-on): judge more frames, or a view whose depth varies",
-            "points": "the points fit several of these mistakes alike on this view: see the alternatives"})),
+            "points": "the points fit several of these mistakes alike on this view: see the alternatives",
+            "silhouettes": "the silhouettes fit several of these camera mistakes alike (a silhouette symmetric "
+                           "about an axis looks the same mirrored): see the alternatives, or judge a view that "
+                           "is not symmetric"})),
     FaultKind(
         "axis_flip", "orientation", "any",
         "the picture is turned 180 degrees: x and y are both negated (e.g. right and up "
@@ -145,7 +150,9 @@ _KINDS = (
         "and x_px = cx + f x / z",
         hints=MappingProxyType({
             "depth": "columns flipped: right = forward x up, and x_px grows to the right",
-            "points": "pixel x grows to the right: x_cam = (u - cx) d / fx, and right = forward x up"})),
+            "points": "pixel x grows to the right: x_cam = (u - cx) d / fx, and right = forward x up",
+            "silhouettes": "columns flipped: right = forward x up, x_px = cx + f x / z (a texture or buffer "
+                           "read back with its u axis reversed mirrors it too)"})),
     FaultKind(
         "mirror_vertical", "orientation", "any",
         "the picture is upside down: pixel y grows downward, so y_px = cy - f y / z",
@@ -153,7 +160,9 @@ _KINDS = (
             "depth": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
                      "when reading the buffer back (glReadPixels returns the bottom row first)",
             "points": "pixel y grows downward: y_cam = -(v - cy) d / fy (rows are not flipped; OpenCV's camera "
-                      "y is down, the contract's up)"})),
+                      "y is down, the contract's up)",
+            "silhouettes": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
+                           "when reading the frame back (glReadPixels returns the bottom row first)"})),
     FaultKind(
         "rotation_transposed", "rotation", "points",
         "R maps world to camera (p_cv = R X + t, rows right, -up, forward): the way back is "
@@ -183,7 +192,10 @@ _KINDS = (
                      "f = (H / 2) / tan(fov_y / 2) (a renderer given it as its horizontal view angle scales by "
                      "W / H)",
             "points": "fov_y_deg is the full vertical FOV: f = (H / 2) / tan(fov_y / 2), the same for x "
-                      "(not (W / 2) / tan(fov / 2))"})),
+                      "(not (W / 2) / tan(fov / 2))",
+            "silhouettes": "the silhouette is scaled about the principal point (scale: a candidate pixel shows "
+                           "the reference's at c + scale (p - c)): f = (H / 2) / tan(fov_y / 2) with the vertical "
+                           "FOV (a renderer given it as its horizontal view angle scales by H / W)"})),
     FaultKind(
         "pixel_offset", "offset", "any",
         "a constant shift: integer pixel coordinates are pixel centres and the principal "
@@ -195,7 +207,10 @@ _KINDS = (
             "depth": "the depth is half a pixel (or more) off: pixel centres are integers, cx = (W - 1) / 2 "
                      "(W / 2 is the corner convention); a GL projection from K puts cx + 0.5 in it",
             "points": "pixel centres are integers: a centred camera has cx = (W - 1) / 2, cy = (H - 1) / 2 "
-                      "(W / 2 is GL's window convention, pixel centres at half-integers: subtract 0.5)"})),
+                      "(W / 2 is GL's window convention, pixel centres at half-integers: subtract 0.5)",
+            "silhouettes": "the silhouette is shifted (a candidate pixel p shows the reference's p + (dx, dy)): "
+                           "pixel centres are integers, cx = (W - 1) / 2 (W / 2 gives -0.5); a GL projection "
+                           "built from K puts cx + 0.5 in it"})),
     FaultKind(
         "distortion_mismatch", "lens", "vertices",
         "the lens distortion differs from the camera's (kind: ignored, k1's sign, or a "
@@ -281,6 +296,9 @@ _KINDS = (
                          "lines white and opaque (a grey colour or a partial alpha dims them)",
             "depth": "the depth differs from the reference in no way this diagnosis knows: see what was measured "
                      "(fit_ratios: each model's worst residual over its allowance)",
+            "silhouettes": "the silhouette differs from the reference in no way this diagnosis knows (a roll, a "
+                           "wrong pose, missing faces): see what was measured (fit_ratios: each camera mistake's "
+                           "missed pixels per boundary pixel)",
             "points": "the points differ from the exact inverse in no way this diagnosis knows: see what was "
                       "measured (the median pixel shift, scale and depth ratio)"})),
 )

@@ -431,7 +431,7 @@ def test_visibility_rewrites_the_unexplained_where_the_images_name_nothing():
 
 def test_the_table_lists_every_step_once_in_order():
     steps = [r.step for r in PRECEDENCE]
-    assert steps == ["diagnosis", "line_centres", "line_rule", "dim_lines", "depth_maps", "unexplained",
+    assert steps == ["diagnosis", "line_centres", "line_rule", "dim_lines", "surfaces", "unexplained",
                      "visibility", "oracle_precision"]
     assert all(r.why for r in PRECEDENCE)
 

@@ -259,6 +259,13 @@ def test_filled_frames_flipped_or_blank_fail(filled_job, tmp_path):
     code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job), name="flipped")
     assert code == 1
     assert all(c["filled"]["min_iou"] < 0.995 and c["filled"]["extra_px"] > 0 for c in report["cases"])
+    # named from the silhouettes (oracles.diagnosis.silhouette_faults): the rows written bottom first. An
+    # orthographic cube's silhouette is centrally symmetric (a parallel projection of a centrally symmetric
+    # solid), so its rows flipped are its columns flipped: ambiguous between the two mirrors
+    named = {c["camera"]: c["faults"] for c in report["cases"]}
+    assert [f["name"] for f in named["oblique_roll"]] == ["mirror_vertical"]
+    (f,) = named["orthographic"]
+    assert f["name"] == "ambiguous" and f["alternatives"] == "mirror_horizontal, mirror_vertical"
     fill(job, filled=np.zeros_like)
     code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job), name="blank")
     assert code == 1

@@ -55,7 +55,7 @@ def test_the_catalogue_holds_every_name_in_precedence_order():
     assert [CATALOGUE[n].precedence for n in NAMES] == list(range(len(PRECEDENCE)))
     for k in CATALOGUE.values():
         assert k.family in faults.FAMILIES and set(k.sources) <= set(faults.SOURCES)
-        assert k.source in ("any", "vertices", "pixels", "images", "depth", "points")
+        assert k.source in ("any", "vertices", "pixels", "images", "depth", "points")   # silhouettes: hints only
         for text in [k.hint] + [k.hints[s] for s in k.sources[1:]]:
             assert len(text) > 40, k.name             # a sentence saying what to check
 
@@ -71,10 +71,11 @@ def test_depth_maps_and_unprojectors_are_named_from_the_catalogue():
 
 def test_a_reused_name_has_its_sources_hint():
     flip = CATALOGUE["mirror_vertical"]
-    assert flip.sources == ("any", "depth", "points")
+    assert flip.sources == ("any", "depth", "points", "silhouettes")
     assert flip.hint_for(None) == flip.hint_for("pixels") == flip.hint and "y_px = cy - f y / z" in flip.hint
     assert "glReadPixels returns the bottom row first" in flip.hint_for("depth")
     assert "y_cam = -(v - cy) d / fy" in flip.hint_for("points")
+    assert "flip the rows once when reading the frame back" in flip.hint_for("silhouettes")
     # read from depth maps first, from points too: each its own hint
     assert CATALOGUE["depth_is_range"].sources == ("depth", "points")
     assert "depth = range / |(x_n, y_n, 1)|" in Fault("depth_is_range", source="depth").hint

@@ -114,7 +114,9 @@ class CaseEvidence:
     the candidate's error; ``points``: the scene's vertex count; ``oracle_bound_px``: the pyrender oracle's own
     error bound where pixels were drawn (oracles.references.oracle_precision); ``depth_map``, ``filled``: a
     renderer's depth maps' and filled frames' fields (oracles.judge.depth_frames, filled_frames; None: the job
-    asks for none); ``depth_faults``: what its failing depth maps' values name (oracles.diagnosis.depth_faults).
+    asks for none); ``depth_faults``: what its failing depth maps' values name (oracles.diagnosis.depth_faults);
+    ``filled_faults``: the camera mistake its failing filled frames' silhouettes show
+    (oracles.diagnosis.silhouette_faults).
     """
 
     level: str
@@ -136,6 +138,7 @@ class CaseEvidence:
     depth_map: Mapping[str, Any] | None = None
     filled: Mapping[str, Any] | None = None
     depth_faults: tuple[Fault, ...] = ()
+    filled_faults: tuple[Fault, ...] = ()
 
     def __post_init__(self):
         for name in ("compared", "pixels", "lines", "vertices", "shaded", "depth_map", "filled"):
@@ -143,6 +146,7 @@ class CaseEvidence:
         object.__setattr__(self, "image_faults", tuple(self.image_faults))
         object.__setattr__(self, "line_faults", tuple(self.line_faults))
         object.__setattr__(self, "depth_faults", tuple(self.depth_faults))
+        object.__setattr__(self, "filled_faults", tuple(self.filled_faults))
 
     @property
     def diagnosed(self) -> tuple[Fault, ...]:

@@ -27,16 +27,24 @@ from pathlib import Path
 import numpy as np
 
 from ..candidates.frames_candidate import read_frame
+from ..diagnosis.silhouette_faults import SilhouetteFrame, name_silhouette_faults
 from ..references.fill_rule import silhouette
 from .silhouette import score_silhouette
 
 
+#: Failing filled frames of a case kept for naming (oracles.diagnosis.silhouette_faults fits one camera mistake
+#: to them together; a fit costs about half a second a frame at 640x480, up to 3 s where the border cuts it).
+NAMED_FRAMES = 2
+
+
 class FilledFrames:
-    """A case's filled frames, measured one frame at a time (module docstring); nothing kept but numbers."""
+    """A case's filled frames, measured one frame at a time (module docstring); nothing kept but numbers, and
+    the first :data:`NAMED_FRAMES` frames with a decided pixel off (their masks, for :meth:`faults`)."""
 
     def __init__(self, tie_px: float):
         self.tie_px = float(tie_px)
         self.frames = []
+        self.failing: list[SilhouetteFrame] = []
 
     def add(self, k: int, path: Path, p_world: np.ndarray, faces, camera, job=None, objects=None) -> dict:
         """Frame ``k``'s filled PNG at ``path`` against the fill-rule silhouette of ``faces`` (index tuples into
@@ -57,7 +65,13 @@ class FilledFrames:
                "reference_decided_px": int((inside & ~ties).sum()),
                "object_id_px": object_id_misses(grey, shown & ~ties, ids) if several else None}
         self.frames.append(rec)
+        if (s.holes or s.extra) and not s.vacuous and len(self.failing) < NAMED_FRAMES:
+            self.failing.append(SilhouetteFrame(shown, inside, ties, camera, p_world, tuple(faces)))
         return rec
+
+    def faults(self) -> tuple:
+        """The camera mistake the case's failing frames show (oracles.diagnosis.silhouette_faults), or ()."""
+        return name_silhouette_faults(self.failing) if self.failing else ()
 
     def fields(self, min_union_px: int) -> dict:
         """The case's ``filled`` record: the lowest IoU among frames of at least ``min_union_px`` decided pixels

@@ -190,7 +190,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     ev = case_evidence(acc, style if wire else None, numbers, diagnosed, tol,
                        depth_map=depth.fields() if depth else None,
                        filled=filled.fields(MIN_IOU_UNION_PX) if filled else None,
-                       depth_faults=tuple(Fault.of(f) for f in depth.faults()) if depth else ())
+                       depth_faults=tuple(Fault.of(f) for f in depth.faults()) if depth else (),
+                       filled_faults=filled.faults() if filled else ())
     verdict = decide(ev, tol)
     names = name_faults(ev, verdict, tol)
     if diagnose and images and wants_visibility(names, ev, verdict) and _wireframe_fails(ev, tol):
@@ -258,13 +259,13 @@ def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:
 
 
 def case_evidence(acc: _CaseFrames, style: CaseStyle | None, numbers: list, diagnosed: tuple, tol,
-                  depth_map=None, filled=None, depth_faults: tuple = ()) -> CaseEvidence:
+                  depth_map=None, filled=None, depth_faults: tuple = (), filled_faults: tuple = ()) -> CaseEvidence:
     """What a case's frames measured, frozen (oracles.judge.evidence): its pixel scores, lines, F1 radius,
     the diagnosis's faults (``diagnosed``), GL's line faults, the style read and what was compared; its depth
-    maps' and filled frames' fields and the depth maps' faults. ``style`` None: the job asks for no
+    maps' and filled frames' fields and the faults their values and silhouettes name. ``style`` None: the job asks for no
     wireframe (no pixel or line field)."""
     compared = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
-    surfaces = {"depth_map": depth_map, "filled": filled, "depth_faults": depth_faults}
+    surfaces = {"depth_map": depth_map, "filled": filled, "depth_faults": depth_faults, "filled_faults": filled_faults}
     if style is None:
         return CaseEvidence(level="frames", compared=compared, frames_checked=len(numbers), **surfaces)
     pixels = pixel_fields(acc.pixel, acc.worst[1])

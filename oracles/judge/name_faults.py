@@ -15,7 +15,7 @@ from .. import faults as catalogue
 from ..faults import Fault
 from ..tolerances import NAMING, Tolerances
 from ..diagnosis.image_visibility import visibility_names
-from .decide import RULE_FAULTS, ROUNDED_RULE_NAME, Verdict, depth_map_reasons
+from .decide import RULE_FAULTS, ROUNDED_RULE_NAME, Verdict, depth_map_reasons, filled_reasons
 from .evidence import CaseEvidence
 
 __all__ = ["Precedence", "PRECEDENCE", "name_faults", "wants_visibility"]
@@ -48,9 +48,10 @@ PRECEDENCE = (
     Precedence("dim_lines", tuple(catalogue.FAMILIES),
                "lines under the 128 level drew nothing by the rule: unexplained with their level replaces every "
                "name the images gave (a camera looking backward would be the wrong advice)"),
-    Precedence("depth_maps", (),
-               "a renderer's depth maps whose limits are missed add the faults their values name "
-               "(oracles.diagnosis.depth_faults); the lines' names stand beside them, each read from its own frames"),
+    Precedence("surfaces", (),
+               "a renderer's depth maps and filled frames whose limits are missed add the faults their values "
+               "(oracles.diagnosis.depth_faults) and silhouettes (oracles.diagnosis.silhouette_faults) name; the "
+               "lines' names stand beside them, each read from its own frames"),
     Precedence("unexplained", (),
                "a failing case that no step named (and no candidate error explains) is unexplained, never "
                "'no fault'"),
@@ -142,10 +143,13 @@ def _dim_lines(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
         "unexplained", "dim_lines", level=level, drawn=NAMING.drawn_level)})]
 
 
-def _depth_maps(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
-    if ev.depth_map is None or not ev.depth_faults or not depth_map_reasons(ev.depth_map, tol):
-        return faults
-    return faults + [f for f in ev.depth_faults if f not in faults]
+def _surfaces(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
+    out = list(faults)
+    if ev.depth_map is not None and depth_map_reasons(ev.depth_map, tol):
+        out += [f for f in ev.depth_faults if f not in out]
+    if ev.filled is not None and filled_reasons(ev.filled, tol):
+        out += [f for f in ev.filled_faults if f not in out]
+    return out
 
 
 def _unexplained(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
@@ -171,7 +175,7 @@ def _oracle_precision(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[F
 
 
 _STEPS = {"diagnosis": _diagnosis, "line_centres": _line_centres, "line_rule": _line_rule,
-          "dim_lines": _dim_lines, "depth_maps": _depth_maps, "unexplained": _unexplained, "visibility": _visibility,
+          "dim_lines": _dim_lines, "surfaces": _surfaces, "unexplained": _unexplained, "visibility": _visibility,
           "oracle_precision": _oracle_precision}
 
 
