@@ -414,6 +414,11 @@ def test_unexplained_only_when_failing_and_nothing_named():
     assert _names(_evidence(f1_0=0.5)) == ["unexplained"]
     assert _names(_evidence()) == []
     assert _names(_evidence(f1_0=0.5, error="candidate raised ValueError")) == []
+    # a passing case whose image registration fitted nothing (the diagnosis's own unexplained: Pillow's
+    # 2- and 3-px lines on 4 of the held-out cases) has nothing to explain: no name; a failing one keeps it
+    unfit = (Fault("unexplained"),)
+    assert _names(_evidence(image_faults=unfit)) == []
+    assert _names(_evidence(f1_0=0.5, image_faults=unfit)) == ["unexplained"]
 
 
 def test_visibility_rewrites_the_unexplained_where_the_images_name_nothing():

@@ -52,9 +52,9 @@ PRECEDENCE = (
                "a renderer's depth maps and filled frames whose limits are missed add the faults their values "
                "(oracles.diagnosis.depth_faults) and silhouettes (oracles.diagnosis.silhouette_faults) name; the "
                "lines' names stand beside them, each read from its own frames"),
-    Precedence("unexplained", (),
+    Precedence("unexplained", ("unexplained",),
                "a failing case that no step named (and no candidate error explains) is unexplained, never "
-               "'no fault'"),
+               "'no fault'; a passing case has nothing to explain: an unexplained the diagnosis gave goes"),
     Precedence("visibility", ("unexplained", "line_pixel_bias"),
                "where the images fit the oracle's lines (nothing named from them) and the case fails, an "
                "unexplained, or a line_pixel_bias made of whole pieces of line, becomes the visible sets that "
@@ -153,6 +153,8 @@ def _surfaces(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
 
 
 def _unexplained(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
+    if verdict.verdict == "pass":
+        return [f for f in faults if f.name != "unexplained"]
     why = verdict.reasons if verdict.set_aside is None else verdict.set_aside
     if why and not ev.error and not faults:
         return [Fault("unexplained")]
