@@ -62,7 +62,7 @@ def markdown(report: dict) -> str:
     turns = ", ".join(f"{t:g}" for t in settings["turns"])
     out = [f"# crosscheck unprojector report{run}: {report['verdict'].upper()}", "",
            f"Unprojector: `{report['candidate']}`. Reference: the exact inverse of the conventions from K, R, t "
-           "(oracles/references/unproject_reference.py; OpenCV's undistortPointsIter for a lens).", "",
+           "(wirecheck.oracles.references.unproject_reference; OpenCV's undistortPointsIter for a lens).", "",
            f"Checked: scenes {', '.join(settings['scenes'])}; cameras {', '.join(settings['cases'])}; "
            f"{settings['frames']} frame(s) of the scenes' spin (turns {turns}) per case; the visible surface "
            f"points of each frame, one every {settings['stride']} px each way.", "",
