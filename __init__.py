@@ -33,16 +33,23 @@ from typing import Any
 # Names are imported on first use (PEP 562), so ``import wirecheck.core`` (the
 # renderer) never pays for the oracles' imports (OpenCV, scipy).
 _EXPORTS = {
-    "Camera": "core.camera", "camera_z": "core.camera", "look_at": "core.camera",
+    "Camera": "core.camera",
+    "camera_z": "core.camera",
+    "look_at": "core.camera",
     "InputError": "core.errors",
-    "Frame": "core.projector.pipeline", "render_frame": "core.projector.pipeline",
+    "Frame": "core.projector.pipeline",
+    "render_frame": "core.projector.pipeline",
     "project_points": "core.projector.projection",
     "SceneRenderer": "core.scene.frames",
-    "Scene": "core.scene.model", "load_scene": "core.scene.files",
+    "Scene": "core.scene.model",
+    "load_scene": "core.scene.files",
     "Motion": "core.transforms",
-    "assert_projector": "oracles.api", "check_projector": "oracles.api",
-    "assert_frames": "oracles.frames_api", "check_frames": "oracles.frames_api",
-    "assert_unprojector": "oracles.unprojector_api", "check_unprojector": "oracles.unprojector_api",
+    "assert_projector": "oracles.api",
+    "check_projector": "oracles.api",
+    "assert_frames": "oracles.frames_api",
+    "check_frames": "oracles.frames_api",
+    "assert_unprojector": "oracles.unprojector_api",
+    "check_unprojector": "oracles.unprojector_api",
 }
 
 __all__ = ["__version__", *sorted(_EXPORTS)]
@@ -58,7 +65,7 @@ def _version() -> str:
 
 
 def __getattr__(name: str) -> Any:
-    if name == "__version__":       # importlib.metadata costs ~40 ms: only when asked
+    if name == "__version__":  # importlib.metadata costs ~40 ms: only when asked
         globals()[name] = _version()
         return globals()[name]
     if name in _EXPORTS:

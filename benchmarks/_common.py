@@ -61,10 +61,18 @@ def print_machine(title: str, info: dict, libraries: str | None = None) -> None:
     """The benchmark's title and three lines about the machine (``libraries`` replaces the default line)."""
     ram = f"RAM {info['mem_total_gib']:.1f} GiB" if info.get("mem_total_gib") else "RAM ?"
     print(title)
-    print(f"  cpu: {info['cpu_model'] or '?'}; cpu_count={info['cpu_count']}, usable={info['cpus_usable']}, "
-          f"{ram}; load average at start {' '.join(info['loadavg_start'] or [])}")
-    print("  " + (libraries or f"python {info['python']}, numpy {info['numpy']}, cv2 {info['cv2']} "
-                  f"(threads {info['cv2_threads']}), trimesh {info['trimesh']}"))
+    print(
+        f"  cpu: {info['cpu_model'] or '?'}; cpu_count={info['cpu_count']}, usable={info['cpus_usable']}, "
+        f"{ram}; load average at start {' '.join(info['loadavg_start'] or [])}"
+    )
+    print(
+        "  "
+        + (
+            libraries
+            or f"python {info['python']}, numpy {info['numpy']}, cv2 {info['cv2']} "
+            f"(threads {info['cv2_threads']}), trimesh {info['trimesh']}"
+        )
+    )
     print(f"  {info['platform']}")
 
 
@@ -104,5 +112,5 @@ def write_json(path, **payload) -> None:
 
 
 def verdict(ok: bool, miss: str = "FAIL") -> str:
-    """"PASS", or ``miss`` for a target not met."""
+    """ "PASS", or ``miss`` for a target not met."""
     return "PASS" if ok else miss

@@ -46,8 +46,8 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
 
     from clients.core_depth_job import render_job
-    from wirecheck.oracles.cli import main as crosscheck
     from wirecheck.oracles.candidates.frames_candidate import frame_faces, frame_inputs, load_job
+    from wirecheck.oracles.cli import main as crosscheck
     from wirecheck.oracles.judge.depth_frames import DepthFrames
     from wirecheck.oracles.judge.depth_reference import from_render
     from wirecheck.oracles.judge.frames_judge import run_frames
@@ -58,15 +58,30 @@ def main(argv=None) -> int:
     tmp = Path(tempfile.mkdtemp(prefix="bench-depth-"))
     try:
         job_dir = tmp / "job"
-        assert crosscheck(["export", str(job_dir), "--scene", args.scene, "--cases", "oblique_roll", "--frames",
-                           str(args.frames), "--outputs", args.outputs]) == 0
+        assert (
+            crosscheck(
+                [
+                    "export",
+                    str(job_dir),
+                    "--scene",
+                    args.scene,
+                    "--cases",
+                    "oblique_roll",
+                    "--frames",
+                    str(args.frames),
+                    "--outputs",
+                    args.outputs,
+                ]
+            )
+            == 0
+        )
         render_job(job_dir)
         job = load_job(job_dir)
         c = job["cases"][0]
         n = len(job["frame_numbers"])
         inputs = [frame_inputs(job_dir, job, c["scene"], c["case"], k) for k in job["frame_numbers"]]
         tris = [fan(frame_faces(job_dir, job, c["scene"], k))[0] for k in job["frame_numbers"]]
-        run_frames(job_dir)                                 # warm: pyrender's context, its programs, imports
+        run_frames(job_dir)  # warm: pyrender's context, its programs, imports
         t0 = time.perf_counter()
         report, _ = run_frames(job_dir)
         judge = (time.perf_counter() - t0) / n
@@ -74,7 +89,7 @@ def main(argv=None) -> int:
         oracles = OracleCache()
         cam = inputs[0][2]
         oracle = oracles.get(cam.width, cam.height)
-        oracle.render_faces(inputs[0][0], tris[0], cam, model_matrix=inputs[0][3], with_ids=True)   # warm
+        oracle.render_faces(inputs[0][0], tris[0], cam, model_matrix=inputs[0][3], with_ids=True)  # warm
         drawn = []
         t0 = time.perf_counter()
         for (p_model, _e, camera, m), t in zip(inputs, tris):
@@ -86,8 +101,9 @@ def main(argv=None) -> int:
             depth = DepthFrames(job)
             t0 = time.perf_counter()
             for i, ((_p, _e, camera, _m), (covered, z, ids), t) in enumerate(zip(inputs, drawn, tris)):
-                depth.add(job["frame_numbers"][i], job_dir / c["depth"][i], camera,
-                          from_render(covered, z, ids, t, camera))
+                depth.add(
+                    job["frame_numbers"][i], job_dir / c["depth"][i], camera, from_render(covered, z, ids, t, camera)
+                )
             own = (time.perf_counter() - t0) / n
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -97,8 +113,10 @@ def main(argv=None) -> int:
     if own is not None:
         print(f"  depth own work (read + judge)  {own * 1e3:8.1f} ms a frame")
     print(f"  judge / pyrender: {judge / pyrender:.2f} (target <= 2)")
-    print(f"  load average before {' '.join(load_before or ['?'])}, after {' '.join(loadavg() or ['?'])} "
-          "(2 cores, shared)")
+    print(
+        f"  load average before {' '.join(load_before or ['?'])}, after {' '.join(loadavg() or ['?'])} "
+        "(2 cores, shared)"
+    )
     return 0
 
 

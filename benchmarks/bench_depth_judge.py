@@ -56,7 +56,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-
 from _common import loadavg, machine_info, print_end, print_machine  # noqa: E402
 
 #: The issue's targets.
@@ -68,7 +67,6 @@ MESHES = {"ico20k": 5, "ico82k": 6}
 def load_scenes(names, folder: Path):
     """Bundled names as they are; ``ico*`` written as binary PLY into ``folder`` and read back."""
     import trimesh
-
     from wirecheck.core.scene.files import load_scene
 
     out = []
@@ -89,7 +87,6 @@ class UserRender:
     def __init__(self, scene, camera):
         import pyrender
         import trimesh
-
         from wirecheck.oracles.references import faces as oface
         from wirecheck.oracles.references.convert import camera_to_pyrender
 
@@ -101,14 +98,14 @@ class UserRender:
         pose, cam = camera_to_pyrender(camera)
         self.scene.add(cam, pose=pose)
         self.scene.add(pyrender.DirectionalLight(intensity=3.0), pose=pose)
-        self.renderer.render(self.scene)                   # shaders compiled, the mesh uploaded: warm
+        self.renderer.render(self.scene)  # shaders compiled, the mesh uploaded: warm
 
     def frame_s(self, model_matrix) -> float:
         self.scene.set_pose(self.node, model_matrix)
         t0 = time.perf_counter()
         colour, depth = self.renderer.render(self.scene)
         elapsed = time.perf_counter() - t0
-        assert colour.shape[:2] == depth.shape and (depth > 0).any()       # it drew the mesh
+        assert colour.shape[:2] == depth.shape and (depth > 0).any()  # it drew the mesh
         return elapsed
 
     def close(self):
@@ -167,13 +164,13 @@ def timing_rows(scenes, case_names, frames: int, folder: Path, repeat: int) -> l
         for case in (c for c in cases_for(scene, motion) if c.name in case_names):
             cam = case.camera
             oracle = oracles.setdefault((cam.width, cam.height), PyrenderOracle(cam.width, cam.height))
-            judge_frame(oracle, scene, case, motion, 1, frames, folder)        # warm: the mesh uploaded once
+            judge_frame(oracle, scene, case, motion, 1, frames, folder)  # warm: the mesh uploaded once
             user = UserRender(scene, cam)
             per = []
             for k in range(1, frames + 1):
                 _p_world, _m, _v, pose = oface.frame_geometry(scene, case_motion(motion, case), (k - 1) / frames)
                 render_s, times = float("inf"), {}
-                for _ in range(repeat):          # best of ``repeat``, each side: the machine's load moves both
+                for _ in range(repeat):  # best of ``repeat``, each side: the machine's load moves both
                     render_s = min(render_s, user.frame_s(pose))
                     got, names = judge_frame(oracle, scene, case, motion, k, frames, folder)
                     times = {key: min(v, times.get(key, float("inf"))) for key, v in got.items()}
@@ -183,13 +180,23 @@ def timing_rows(scenes, case_names, frames: int, folder: Path, repeat: int) -> l
             render = statistics.median(r for r, _, _ in per)
             base = med["read"] + med["reference"]
             ratio_pass = statistics.median((t["read"] + t["reference"] + t["name_pass"]) / r for r, t, _ in per)
-            ratio_worst = statistics.median((t["read"] + t["reference"] + max(t["name_x1000"], t["name_flipped"])) / r
-                                            for r, t, _ in per)
-            rows.append({"scene": scene.name, "faces": len(scene.faces), "camera": case.name, "frames": frames,
-                         "pyrender_ms": 1e3 * render, **{f"{k}_ms": 1e3 * v for k, v in med.items()},
-                         "judged_pass_ms": 1e3 * (base + med["name_pass"]),
-                         "ratio_pass": ratio_pass, "ratio_worst": ratio_worst,
-                         "names": sorted({n for _, _, ns in per for n in [f"{k}={v}" for k, v in ns.items()]})})
+            ratio_worst = statistics.median(
+                (t["read"] + t["reference"] + max(t["name_x1000"], t["name_flipped"])) / r for r, t, _ in per
+            )
+            rows.append(
+                {
+                    "scene": scene.name,
+                    "faces": len(scene.faces),
+                    "camera": case.name,
+                    "frames": frames,
+                    "pyrender_ms": 1e3 * render,
+                    **{f"{k}_ms": 1e3 * v for k, v in med.items()},
+                    "judged_pass_ms": 1e3 * (base + med["name_pass"]),
+                    "ratio_pass": ratio_pass,
+                    "ratio_worst": ratio_worst,
+                    "names": sorted({n for _, _, ns in per for n in [f"{k}={v}" for k, v in ns.items()]}),
+                }
+            )
     for oracle in oracles.values():
         oracle.close()
     return rows
@@ -204,7 +211,7 @@ def memory_rows(scene, counts, folder: Path) -> list[dict]:
     motion = Motion(turns=(1.0, 1.0, 0.0))
     case = next(c for c in cases_for(scene, motion) if c.name == "on_axis")
     oracle = PyrenderOracle(case.camera.width, case.camera.height)
-    judge_frame(oracle, scene, case, motion, 1, 1, folder, maps=("flipped", "pass"))     # warm
+    judge_frame(oracle, scene, case, motion, 1, 1, folder, maps=("flipped", "pass"))  # warm
     rows = []
     tracemalloc.start()
     for n in counts:
@@ -213,12 +220,20 @@ def memory_rows(scene, counts, folder: Path) -> list[dict]:
         t0 = time.perf_counter()
         # frames 2 .. n + 1 of one spin of max(counts) + 1 frames (frame 1, the spin's start, is symmetric:
         # its flipped map passes without the pixel models): what a run keeps of each frame, its names
-        kept = [judge_frame(oracle, scene, case, motion, k, max(counts) + 1, folder, maps=("flipped", "pass"))[1]
-                for k in range(2, n + 2)]
+        kept = [
+            judge_frame(oracle, scene, case, motion, k, max(counts) + 1, folder, maps=("flipped", "pass"))[1]
+            for k in range(2, n + 2)
+        ]
         peak = tracemalloc.get_traced_memory()[1] - held
-        rows.append({"frames": n, "traced_peak_mib": peak / 2**20, "seconds": time.perf_counter() - t0,
-                     "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-                     "names": sorted({f"{k}={v}" for d in kept for k, v in d.items()})})
+        rows.append(
+            {
+                "frames": n,
+                "traced_peak_mib": peak / 2**20,
+                "seconds": time.perf_counter() - t0,
+                "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+                "names": sorted({f"{k}={v}" for d in kept for k, v in d.items()}),
+            }
+        )
     tracemalloc.stop()
     oracle.close()
     return rows
@@ -228,8 +243,13 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--quick", action="store_true", help="ico20k only, on_axis, 3 frames")
     p.add_argument("--json", metavar="PATH", help="write the numbers there")
-    p.add_argument("--repeat", type=int, default=3, metavar="R",
-                   help="each frame rendered and judged R times, the best time of each side kept (default 3)")
+    p.add_argument(
+        "--repeat",
+        type=int,
+        default=3,
+        metavar="R",
+        help="each frame rendered and judged R times, the best time of each side kept (default 3)",
+    )
     args = p.parse_args(argv)
     t_start = time.perf_counter()
     info = machine_info(quick=args.quick)
@@ -241,14 +261,41 @@ def main(argv=None) -> int:
         folder = Path(tmp)
         scenes = load_scenes(names, folder)
         rows = timing_rows(scenes, case_names, frames, folder, args.repeat)
-        print(f"\nPer frame (median over {frames} frames of each side's best of {args.repeat}; ms): pyrender = "
-              "renderer.render(scene), colour and depth, warm; judged = read + reference + naming")
-        head = ("scene", "faces", "camera", "pyrender", "read", "reference", "name ok", "name x1000",
-                "name flip", "judged ok", "/pyrender ok", "/pyrender worst")
-        table = [head] + [(r["scene"], f"{r['faces']:,}", r["camera"], f"{r['pyrender_ms']:.1f}", f"{r['read_ms']:.1f}",
-                           f"{r['reference_ms']:.1f}", f"{r['name_pass_ms']:.1f}", f"{r['name_x1000_ms']:.1f}",
-                           f"{r['name_flipped_ms']:.1f}", f"{r['judged_pass_ms']:.1f}", f"{r['ratio_pass']:.2f}",
-                           f"{r['ratio_worst']:.2f}") for r in rows]
+        print(
+            f"\nPer frame (median over {frames} frames of each side's best of {args.repeat}; ms): pyrender = "
+            "renderer.render(scene), colour and depth, warm; judged = read + reference + naming"
+        )
+        head = (
+            "scene",
+            "faces",
+            "camera",
+            "pyrender",
+            "read",
+            "reference",
+            "name ok",
+            "name x1000",
+            "name flip",
+            "judged ok",
+            "/pyrender ok",
+            "/pyrender worst",
+        )
+        table = [head] + [
+            (
+                r["scene"],
+                f"{r['faces']:,}",
+                r["camera"],
+                f"{r['pyrender_ms']:.1f}",
+                f"{r['read_ms']:.1f}",
+                f"{r['reference_ms']:.1f}",
+                f"{r['name_pass_ms']:.1f}",
+                f"{r['name_x1000_ms']:.1f}",
+                f"{r['name_flipped_ms']:.1f}",
+                f"{r['judged_pass_ms']:.1f}",
+                f"{r['ratio_pass']:.2f}",
+                f"{r['ratio_worst']:.2f}",
+            )
+            for r in rows
+        ]
         widths = [max(len(t[i]) for t in table) for i in range(len(head))]
         for t in table:
             print("  " + "  ".join(v.rjust(w) for v, w in zip(t, widths)))
@@ -256,19 +303,27 @@ def main(argv=None) -> int:
             print(f"  {r['scene']} / {r['camera']}: named {', '.join(r['names'])}")
         worst = max(r["ratio_worst"] for r in rows)
         worst_ok = max(r["ratio_pass"] for r in rows)
-        print(f"\nTime target (judged within {TIME_TARGET:g}x pyrender's render): correct maps at most "
-              f"{worst_ok:.2f}x, faulty maps at most {worst:.2f}x: "
-              f"{'PASS' if max(worst, worst_ok) <= TIME_TARGET else 'FAIL'}")
+        print(
+            f"\nTime target (judged within {TIME_TARGET:g}x pyrender's render): correct maps at most "
+            f"{worst_ok:.2f}x, faulty maps at most {worst:.2f}x: "
+            f"{'PASS' if max(worst, worst_ok) <= TIME_TARGET else 'FAIL'}"
+        )
         mem_scene = next(s for s in scenes if s.name == "ico20k")
         mem = memory_rows(mem_scene, (1, 10, 50), folder)
-    print(f"\nMemory over a run of n frames (ico20k / on_axis, the flipped map named each frame; "
-          f"load {' '.join(loadavg() or [])}):")
+    print(
+        f"\nMemory over a run of n frames (ico20k / on_axis, the flipped map named each frame; "
+        f"load {' '.join(loadavg() or [])}):"
+    )
     for r in mem:
-        print(f"  {r['frames']:>3} frames: traced peak {r['traced_peak_mib']:.1f} MiB above the start, "
-              f"process peak RSS {r['peak_rss_mib']:.0f} MiB, {r['seconds']:.1f} s ({', '.join(r['names'])})")
+        print(
+            f"  {r['frames']:>3} frames: traced peak {r['traced_peak_mib']:.1f} MiB above the start, "
+            f"process peak RSS {r['peak_rss_mib']:.0f} MiB, {r['seconds']:.1f} s ({', '.join(r['names'])})"
+        )
     growth = mem[-1]["traced_peak_mib"] / mem[0]["traced_peak_mib"]
-    print(f"Memory target (50 frames' traced peak within {MEMORY_TARGET:g}x 1 frame's): {growth:.2f}x: "
-          f"{'PASS' if growth <= MEMORY_TARGET else 'FAIL'}")
+    print(
+        f"Memory target (50 frames' traced peak within {MEMORY_TARGET:g}x 1 frame's): {growth:.2f}x: "
+        f"{'PASS' if growth <= MEMORY_TARGET else 'FAIL'}"
+    )
     print_end(info, t_start)
     if args.json:
         Path(args.json).write_text(json.dumps({"machine": info, "frames": rows, "memory": mem}, indent=1) + "\n")

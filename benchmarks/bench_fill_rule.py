@@ -41,7 +41,6 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
     import trimesh
-
     from wirecheck.core.camera import look_at
     from wirecheck.oracles.references.fill_rule import silhouette
     from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
@@ -62,8 +61,10 @@ def main(argv=None) -> int:
             t_sil = _best(lambda: silhouette(v, faces, cam, shape), args.repeat)
             t_two = _best(lambda: silhouette(v, faces, cam, shape, halves), args.repeat)
             t_pr = _best(lambda: oracle.render_faces(v, f, cam, cull=False, with_ids=True), args.repeat)
-            print(f"{name:8s} {len(f):9d} {t_sil * 1e3:9.0f}ms {t_two * 1e3:8.0f}ms {t_pr * 1e3:7.0f}ms "
-                  f"{t_sil / t_pr:6.2f}")
+            print(
+                f"{name:8s} {len(f):9d} {t_sil * 1e3:9.0f}ms {t_two * 1e3:8.0f}ms {t_pr * 1e3:7.0f}ms "
+                f"{t_sil / t_pr:6.2f}"
+            )
     return 0
 
 

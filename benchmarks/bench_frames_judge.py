@@ -71,10 +71,9 @@ def make_job(path: Path, frames: int, size: tuple | None = None) -> None:
     """Export a job of ``frames`` frames (every one checked; ``size``: ``(W, H)`` of its images) and draw them
     with core."""
     from PIL import Image
-
     from wirecheck.core.projector.pipeline import render_frame
-    from wirecheck.oracles.cli import main
     from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
+    from wirecheck.oracles.cli import main
 
     assert main(["export", str(path), "--scene", "cube", "--cases", "on_axis", "--frames", str(frames)]) == 0
     if size is not None:
@@ -108,13 +107,12 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     import cv2  # noqa: F401  (the modules the judging imports, before the clock: an interpreter's start)
     import scipy.ndimage  # noqa: F401
     import scipy.spatial.transform  # noqa: F401
-
     import wirecheck.oracles.diagnosis.image_diagnose  # noqa: F401
     import wirecheck.oracles.judge.decide  # noqa: F401
     import wirecheck.oracles.judge.line_style  # noqa: F401
     from wirecheck.oracles.references import pyrender_oracle
 
-    pyrender_oracle.gl_platform()               # the GL platform chosen before pyrender is imported
+    pyrender_oracle.gl_platform()  # the GL platform chosen before pyrender is imported
     import pyrender  # noqa: F401
     from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
     from wirecheck.oracles.judge.frames_judge import run_frames
@@ -123,7 +121,7 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     if oracle_name == "core":
         pyrender_oracle.OracleCache.get = lambda self, w, h: CoreOracle()
         pyrender_oracle.OracleCache.gl_info = lambda self: None
-    inside = {"s": 0.0}                        # the oracle's seconds inside the judge
+    inside = {"s": 0.0}  # the oracle's seconds inside the judge
     render = (CoreOracle if oracle_name == "core" else PyrenderOracle).render
 
     def timed(self, *args, **kwargs):
@@ -132,6 +130,7 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
             return render(self, *args, **kwargs)
         finally:
             inside["s"] += time.perf_counter() - t
+
     (CoreOracle if oracle_name == "core" else PyrenderOracle).render = timed
 
     t0 = time.perf_counter()
@@ -142,14 +141,14 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
     (CoreOracle if oracle_name == "core" else PyrenderOracle).render = render
     job = load_job(path)
     c = job["cases"][0]
-    colour_only = "depth" in inspect.signature(render).parameters     # PyrenderOracle.render(depth=False)
+    colour_only = "depth" in inspect.signature(render).parameters  # PyrenderOracle.render(depth=False)
     oracle, seconds, seconds_colour = None, 0.0, 0.0
     for rel in c["frames"]:
         k = int(Path(rel).stem.split("_")[-1])
         p, e, cam, m = frame_inputs(path, job, c["scene"], c["case"], k)
         if oracle is None:
             oracle = PyrenderOracle(cam.width, cam.height)
-            oracle.render(p, e, cam, model_matrix=m)           # the context made, as in the judge
+            oracle.render(p, e, cam, model_matrix=m)  # the context made, as in the judge
         t = time.perf_counter()
         oracle.render(p, e, cam, model_matrix=m)
         seconds += time.perf_counter() - t
@@ -158,11 +157,16 @@ def judge(path: Path, oracle_name: str = "pyrender") -> dict:
             oracle.render(p, e, cam, model_matrix=m, depth=False)
             seconds_colour += time.perf_counter() - t
     oracle.close()
-    return {"frames": frames, "verdict": report["verdict"], "peak_rss_mb": round(peak, 1),
-            "judge_s": round(wall, 2), "judge_ms_per_frame": round(1e3 * wall / frames, 2),
-            "pyrender_ms_per_frame": round(1e3 * seconds / frames, 2),
-            "colour_only_ms_per_frame": round(1e3 * seconds_colour / frames, 2) if colour_only else None,
-            "oracle_in_judge_ms_per_frame": round(1e3 * inside["s"] / frames, 2)}
+    return {
+        "frames": frames,
+        "verdict": report["verdict"],
+        "peak_rss_mb": round(peak, 1),
+        "judge_s": round(wall, 2),
+        "judge_ms_per_frame": round(1e3 * wall / frames, 2),
+        "pyrender_ms_per_frame": round(1e3 * seconds / frames, 2),
+        "colour_only_ms_per_frame": round(1e3 * seconds_colour / frames, 2) if colour_only else None,
+        "oracle_in_judge_ms_per_frame": round(1e3 * inside["s"] / frames, 2),
+    }
 
 
 def pyrender_alone(path: Path) -> dict:
@@ -179,8 +183,7 @@ def pyrender_alone(path: Path) -> dict:
 
     job = load_job(path)
     c = job["cases"][0]
-    inputs = [frame_inputs(path, job, c["scene"], c["case"], int(Path(rel).stem.split("_")[-1]))
-              for rel in c["frames"]]
+    inputs = [frame_inputs(path, job, c["scene"], c["case"], int(Path(rel).stem.split("_")[-1])) for rel in c["frames"]]
     oracle = PyrenderOracle(inputs[0][2].width, inputs[0][2].height)
     oracle.render(*inputs[0][:3], model_matrix=inputs[0][3])
     out = {}
@@ -196,8 +199,12 @@ def pyrender_alone(path: Path) -> dict:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--frames", default="24,720", help="job lengths, comma-separated (default 24,720)")
-    p.add_argument("--oracle", choices=("pyrender", "core"), default="pyrender",
-                   help="what the judge compares with (core: the judge's own memory, without pyrender's)")
+    p.add_argument(
+        "--oracle",
+        choices=("pyrender", "core"),
+        default="pyrender",
+        help="what the judge compares with (core: the judge's own memory, without pyrender's)",
+    )
     p.add_argument("--size", help="image size WxH of the job's camera (default: the case's own, 640x480)")
     p.add_argument("--child", help=argparse.SUPPRESS)
     p.add_argument("--pyrender-child", help=argparse.SUPPRESS)
@@ -210,51 +217,72 @@ def main(argv=None) -> int:
         print(json.dumps(pyrender_alone(Path(a.pyrender_child))))
         return 0
     lengths = [int(x) for x in a.frames.split(",")]
-    print(f"# bench_frames_judge: cube / on_axis, frames {lengths}, {a.size or '640x480'}, judged against "
-          f"{a.oracle}; load at start {loadavg()}")
+    print(
+        f"# bench_frames_judge: cube / on_axis, frames {lengths}, {a.size or '640x480'}, judged against "
+        f"{a.oracle}; load at start {loadavg()}"
+    )
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in lengths:
             job = Path(tmp) / f"job{n}"
             make_job(job, n, size)
-            out = subprocess.run([sys.executable, __file__, "--child", str(job), "--oracle", a.oracle], capture_output=True, text=True,
-                                 check=True)
+            out = subprocess.run(
+                [sys.executable, __file__, "--child", str(job), "--oracle", a.oracle],
+                capture_output=True,
+                text=True,
+                check=True,
+            )
             rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
             if a.oracle == "pyrender" and n == lengths[-1]:
-                alone = subprocess.run([sys.executable, __file__, "--pyrender-child", str(job)], capture_output=True,
-                                       text=True, check=True)
+                alone = subprocess.run(
+                    [sys.executable, __file__, "--pyrender-child", str(job)], capture_output=True, text=True, check=True
+                )
                 rows[-1].update(json.loads(alone.stdout.strip().splitlines()[-1]))
     # pyrender ms/frame: a fresh oracle drawing the job's frames after the judging; oracle in judge: the
     # oracle's own calls while judging (pyrender's, or core's with --oracle core); the rest is the judge's
-    print(f"{'frames':>7} {'verdict':>8} {'peak RSS MB':>12} {'judge ms/frame':>15} {'pyrender ms/frame':>18} "
-          f"{'judge/pyrender':>15} {'oracle in judge':>16} {'rest/pyrender':>14}")
+    print(
+        f"{'frames':>7} {'verdict':>8} {'peak RSS MB':>12} {'judge ms/frame':>15} {'pyrender ms/frame':>18} "
+        f"{'judge/pyrender':>15} {'oracle in judge':>16} {'rest/pyrender':>14}"
+    )
     for r in rows:
         rest = r["judge_ms_per_frame"] - r["oracle_in_judge_ms_per_frame"]
-        print(f"{r['frames']:>7} {r['verdict']:>8} {r['peak_rss_mb']:>12.1f} {r['judge_ms_per_frame']:>15.2f} "
-              f"{r['pyrender_ms_per_frame']:>18.2f} {r['judge_ms_per_frame'] / r['pyrender_ms_per_frame']:>15.2f} "
-              f"{r['oracle_in_judge_ms_per_frame']:>16.2f} {rest / r['pyrender_ms_per_frame']:>14.2f}")
+        print(
+            f"{r['frames']:>7} {r['verdict']:>8} {r['peak_rss_mb']:>12.1f} {r['judge_ms_per_frame']:>15.2f} "
+            f"{r['pyrender_ms_per_frame']:>18.2f} {r['judge_ms_per_frame'] / r['pyrender_ms_per_frame']:>15.2f} "
+            f"{r['oracle_in_judge_ms_per_frame']:>16.2f} {rest / r['pyrender_ms_per_frame']:>14.2f}"
+        )
     first, last = rows[0], rows[-1]
-    print(f"peak RSS {last['frames']} / {first['frames']} frames: {last['peak_rss_mb'] / first['peak_rss_mb']:.2f} "
-          "(target <= 1.5)")
+    print(
+        f"peak RSS {last['frames']} / {first['frames']} frames: {last['peak_rss_mb'] / first['peak_rss_mb']:.2f} "
+        "(target <= 1.5)"
+    )
     if "pyrender_fresh_ms_per_frame" in last:
         # the target's pyrender: a fresh interpreter drawing the same frames, as the judge's run is timed from
         # one (pyrender's time after the judge, in the judge's process, moves with what the judge left in
         # memory: 9-13 ms measured on the same frames, so it is printed, not taken)
-        print(f"judge / pyrender per frame ({last['frames']} frames): "
-              f"{last['judge_ms_per_frame'] / last['pyrender_fresh_ms_per_frame']:.2f} (target <= 1.5; pyrender "
-              f"{last['pyrender_fresh_ms_per_frame']:.2f} ms a frame in a fresh process, "
-              f"{last['pyrender_ms_per_frame']:.2f} after the judge in its process)")
-        print(f"judge / pyrender's colour-only drawing per frame ({last['frames']} frames): "
-              f"{last['judge_ms_per_frame'] / last['colour_only_fresh_ms_per_frame']:.2f} "
-              f"({last['colour_only_fresh_ms_per_frame']:.2f} ms a frame in a fresh process: render(depth=False), "
-              "the judge's own call)")
+        print(
+            f"judge / pyrender per frame ({last['frames']} frames): "
+            f"{last['judge_ms_per_frame'] / last['pyrender_fresh_ms_per_frame']:.2f} (target <= 1.5; pyrender "
+            f"{last['pyrender_fresh_ms_per_frame']:.2f} ms a frame in a fresh process, "
+            f"{last['pyrender_ms_per_frame']:.2f} after the judge in its process)"
+        )
+        print(
+            f"judge / pyrender's colour-only drawing per frame ({last['frames']} frames): "
+            f"{last['judge_ms_per_frame'] / last['colour_only_fresh_ms_per_frame']:.2f} "
+            f"({last['colour_only_fresh_ms_per_frame']:.2f} ms a frame in a fresh process: render(depth=False), "
+            "the judge's own call)"
+        )
     else:
-        print(f"judge / pyrender per frame ({last['frames']} frames): "
-              f"{last['judge_ms_per_frame'] / last['pyrender_ms_per_frame']:.2f} (target <= 1.5)")
+        print(
+            f"judge / pyrender per frame ({last['frames']} frames): "
+            f"{last['judge_ms_per_frame'] / last['pyrender_ms_per_frame']:.2f} (target <= 1.5)"
+        )
     if last["colour_only_ms_per_frame"] and "pyrender_fresh_ms_per_frame" not in last:
-        print(f"judge / the oracle's colour-only drawing per frame ({last['frames']} frames): "
-              f"{last['judge_ms_per_frame'] / last['colour_only_ms_per_frame']:.2f} "
-              f"({last['colour_only_ms_per_frame']:.2f} ms: render(depth=False), the judge's own call)")
+        print(
+            f"judge / the oracle's colour-only drawing per frame ({last['frames']} frames): "
+            f"{last['judge_ms_per_frame'] / last['colour_only_ms_per_frame']:.2f} "
+            f"({last['colour_only_ms_per_frame']:.2f} ms: render(depth=False), the judge's own call)"
+        )
     print(f"# load at end {loadavg()}")
     return 0
 

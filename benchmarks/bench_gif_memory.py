@@ -23,10 +23,10 @@ import time
 
 def encode(mode: str, frames: int) -> dict:
     from wirecheck.core.app.compose import picture
+    from wirecheck.core.camera import camera_z
     from wirecheck.core.scene.frames import SceneRenderer
     from wirecheck.core.scene.model import load_scene
     from wirecheck.core.transforms import Motion
-    from wirecheck.core.camera import camera_z
 
     cam = camera_z(4.0, fov_y_deg=60.0, width=640, height=480)
     renderer = SceneRenderer(load_scene("cube"), Motion(), frames)
@@ -43,12 +43,15 @@ def encode(mode: str, frames: int) -> dict:
     else:
         from PIL import Image
 
-        pics = [Image.fromarray(im).convert("P") for im in images]      # the old code kept every frame
-        pics[0].save(buf, format="GIF", save_all=True, append_images=pics[1:], duration=33, loop=0,
-                     optimize=False)
-    return {"mode": mode, "frames": frames, "seconds": round(time.perf_counter() - t0, 2),
-            "gif_bytes": len(buf.getvalue()),
-            "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)}
+        pics = [Image.fromarray(im).convert("P") for im in images]  # the old code kept every frame
+        pics[0].save(buf, format="GIF", save_all=True, append_images=pics[1:], duration=33, loop=0, optimize=False)
+    return {
+        "mode": mode,
+        "frames": frames,
+        "seconds": round(time.perf_counter() - t0, 2),
+        "gif_bytes": len(buf.getvalue()),
+        "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
+    }
 
 
 def main(argv=None) -> int:
@@ -62,8 +65,12 @@ def main(argv=None) -> int:
     rows = []
     for frames in sorted({max(1, a.frames // 10), a.frames}):
         for mode in ("pillow", "stream"):
-            out = subprocess.run([sys.executable, __file__, "--child", mode, "--frames", str(frames)],
-                                 capture_output=True, text=True, check=True)
+            out = subprocess.run(
+                [sys.executable, __file__, "--child", mode, "--frames", str(frames)],
+                capture_output=True,
+                text=True,
+                check=True,
+            )
             rows.append(json.loads(out.stdout))
     print("| encoder | frames | peak RSS (MB) | GIF (KB) | encode + render (s) |")
     print("|---|---:|---:|---:|---:|")

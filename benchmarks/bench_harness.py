@@ -39,14 +39,16 @@ from _common import machine_info, print_end, print_machine  # noqa: E402
 TARGET = 0.15
 
 #: (module attribute to wrap, label): the harness's parts, timed in this process only
-PARTS = (("wirecheck.oracles.judge.case:oface.frame_geometry", "oracle-side geometry (scipy model matrix)"),
-         ("wirecheck.oracles.judge.case:oracle_segments", "oracle's segments (depth clip + OpenCV of the ends)"),
-         ("wirecheck.oracles.judge.metrics:vertex_errors_frames", "vertex metrics (errors, scale; per case)"),
-         ("wirecheck.oracles.judge.case:ScaleBatch.flush", "vertex metrics (errors, scale; per case)"),
-         ("wirecheck.oracles.judge.metrics:FramePixels.__init__", "pixel metrics (scan + F1)"),
-         ("wirecheck.oracles.judge.metrics:pixel_scores", "pixel metrics (scan + F1)"),
-         ("wirecheck.oracles.judge.metrics:LineBatch.add", "line metrics (batched per case)"),
-         ("wirecheck.oracles.judge.metrics:LineBatch.flush", "line metrics (batched per case)"))
+PARTS = (
+    ("wirecheck.oracles.judge.case:oface.frame_geometry", "oracle-side geometry (scipy model matrix)"),
+    ("wirecheck.oracles.judge.case:oracle_segments", "oracle's segments (depth clip + OpenCV of the ends)"),
+    ("wirecheck.oracles.judge.metrics:vertex_errors_frames", "vertex metrics (errors, scale; per case)"),
+    ("wirecheck.oracles.judge.case:ScaleBatch.flush", "vertex metrics (errors, scale; per case)"),
+    ("wirecheck.oracles.judge.metrics:FramePixels.__init__", "pixel metrics (scan + F1)"),
+    ("wirecheck.oracles.judge.metrics:pixel_scores", "pixel metrics (scan + F1)"),
+    ("wirecheck.oracles.judge.metrics:LineBatch.add", "line metrics (batched per case)"),
+    ("wirecheck.oracles.judge.metrics:LineBatch.flush", "line metrics (batched per case)"),
+)
 LABELS = tuple(dict.fromkeys(label for _, label in PARTS))
 
 
@@ -65,7 +67,7 @@ def _wrap(spec: str, seconds: dict, label: str) -> None:
     inner = getattr(owner, name)
 
     def timed(*args, **kwargs):
-        if label in _ACTIVE:                 # called inside another timed part of the same label
+        if label in _ACTIVE:  # called inside another timed part of the same label
             return inner(*args, **kwargs)
         _ACTIVE.add(label)
         t = time.perf_counter()
@@ -89,8 +91,9 @@ def run_once(frames: int, seconds: dict, scene_args: list | None = None) -> dict
             code = cli.main([*(scene_args or []), "--frames", str(frames), "--report-dir", str(Path(tmp) / "run")])
         wall = time.perf_counter() - t
         if code != 0:
-            raise SystemExit(f"bench_harness: crosscheck exited {code} on {scene_args or 'the bundled scenes'} "
-                             "(expected 0)")
+            raise SystemExit(
+                f"bench_harness: crosscheck exited {code} on {scene_args or 'the bundled scenes'} (expected 0)"
+            )
         report = json.loads((Path(tmp) / "run" / "report.json").read_text())
     timing = report["timing"]
     n = sum(c["frames_timed"] for c in timing["cases"])
@@ -105,9 +108,12 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=3, help="crosscheck runs (default 3)")
     ap.add_argument("--quick", action="store_true", help="8 frames per case instead of 24")
     ap.add_argument("--json", type=Path, help="also write the results here")
-    ap.add_argument("--scene", metavar="PATH",
-                    help="a mesh or scene file instead of the bundled scenes (e.g. a dense mesh: the target is "
-                         "set for the bundled scenes)")
+    ap.add_argument(
+        "--scene",
+        metavar="PATH",
+        help="a mesh or scene file instead of the bundled scenes (e.g. a dense mesh: the target is "
+        "set for the bundled scenes)",
+    )
     ap.add_argument("--cases", help="crosscheck --cases (default: crosscheck's)")
     args = ap.parse_args(argv)
     if args.repeats < 1:
@@ -123,8 +129,14 @@ def main(argv=None) -> int:
     scene_args = (["--scene", args.scene] if args.scene else []) + (["--cases", args.cases] if args.cases else [])
     runs = [run_once(frames, seconds, scene_args) for _ in range(args.repeats)]
 
-    keys = ("harness_ms_per_frame", "oracles_ms_per_frame", "opencv_ms_per_frame", "pyrender_ms_per_frame",
-            "candidate_ms_per_frame", "harness_overhead_ratio")
+    keys = (
+        "harness_ms_per_frame",
+        "oracles_ms_per_frame",
+        "opencv_ms_per_frame",
+        "pyrender_ms_per_frame",
+        "candidate_ms_per_frame",
+        "harness_overhead_ratio",
+    )
     print(f"\n{'run':>4}  " + "  ".join(f"{k.replace('_ms_per_frame', ' ms/frame'):>22}" for k in keys))
     for i, r in enumerate(runs, 1):
         print(f"{i:>4}  " + "  ".join(f"{r['timing'][k]:>22.4f}" for k in keys))
@@ -134,20 +146,34 @@ def main(argv=None) -> int:
     print("\nharness, by part (ms/frame, median over runs; timers added by this benchmark):")
     for label in LABELS:
         print(f"  {label:55s} {statistics.median(r['parts_ms_per_frame'][label] for r in runs):8.3f}")
-    print(f"  {'(the rest: bookkeeping, images kept for the report)':55s} "
-          f"{med['harness_ms_per_frame'] - sum(statistics.median(r['parts_ms_per_frame'][l] for r in runs) for l in LABELS):8.3f}")
+    print(
+        f"  {'(the rest: bookkeeping, images kept for the report)':55s} "
+        f"{med['harness_ms_per_frame'] - sum(statistics.median(r['parts_ms_per_frame'][l] for r in runs) for l in LABELS):8.3f}"
+    )
 
     run_s = statistics.median(r["run_s"] for r in runs)
     wall_s = statistics.median(r["wall_s"] for r in runs)
-    print(f"\nper run, outside the per-frame ratio: {wall_s - run_s:.2f} s of {wall_s:.2f} s "
-          "(validating inputs, writing report.json/.md/.html and the plots)")
+    print(
+        f"\nper run, outside the per-frame ratio: {wall_s - run_s:.2f} s of {wall_s:.2f} s "
+        "(validating inputs, writing report.json/.md/.html and the plots)"
+    )
     ratio = med["harness_overhead_ratio"]
     print(f"\nharness_overhead_ratio {ratio:.3f} (target <= {TARGET}: {'met' if ratio <= TARGET else 'NOT met'})")
     print_end(info, t_start)
     if args.json:
-        args.json.write_text(json.dumps({"machine": info, "median": med, "runs": [
-            {k: v for k, v in r.items() if k != "timing"} | {"timing": {k: r["timing"][k] for k in keys}}
-            for r in runs]}, indent=1))
+        args.json.write_text(
+            json.dumps(
+                {
+                    "machine": info,
+                    "median": med,
+                    "runs": [
+                        {k: v for k, v in r.items() if k != "timing"} | {"timing": {k: r["timing"][k] for k in keys}}
+                        for r in runs
+                    ],
+                },
+                indent=1,
+            )
+        )
     return 0
 
 

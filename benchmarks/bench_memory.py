@@ -82,24 +82,36 @@ def main(argv=None) -> int:
     t_start = time.perf_counter()
     info = machine_info(frames=args.frames, cases=args.cases, as_shipped=args.as_shipped)
     print_machine("bench_memory: peak RSS of a dataset run at 40 and 320 meshes (core candidate, level pixels)", info)
-    print(f"  {len(cases)} cameras ({args.cases}) x {args.frames} frames per mesh; "
-          f"{'pyrender program cache as shipped' if args.as_shipped else 'program cache keyed by context address'}\n")
+    print(
+        f"  {len(cases)} cameras ({args.cases}) x {args.frames} frames per mesh; "
+        f"{'pyrender program cache as shipped' if args.as_shipped else 'program cache keyed by context address'}\n"
+    )
     print(f"{'meshes':>7} {'frames':>7} {'peak MB':>9} {'wall s':>8}  verdict", flush=True)
     rows = {}
     for n in SIZES:
         r = rows[n] = run_size(n, args.frames, cases, args.as_shipped)
-        print(f"{n:>7} {n * len(cases) * args.frames:>7} {r['peak_rss_mb']:>9.1f} {r['wall_s']:>8.1f}  "
-              f"{r['verdict']} ({r['passed']}/{n})", flush=True)
+        print(
+            f"{n:>7} {n * len(cases) * args.frames:>7} {r['peak_rss_mb']:>9.1f} {r['wall_s']:>8.1f}  "
+            f"{r['verdict']} ({r['passed']}/{n})",
+            flush=True,
+        )
     ratio = rows[SIZES[1]]["peak_rss_mb"] / rows[SIZES[0]]["peak_rss_mb"]
-    grow = (rows[SIZES[1]]["peak_rss_mb"] - rows[SIZES[0]]["peak_rss_mb"]) / ((SIZES[1] - SIZES[0]) * len(cases)
-                                                                              * args.frames)
+    grow = (rows[SIZES[1]]["peak_rss_mb"] - rows[SIZES[0]]["peak_rss_mb"]) / (
+        (SIZES[1] - SIZES[0]) * len(cases) * args.frames
+    )
     ok = ratio <= TARGET_RATIO
-    print(f"\npeak ratio {SIZES[1]}/{SIZES[0]}: {ratio:.2f}x (target <= {TARGET_RATIO}x: {'met' if ok else 'MISSED'}); "
-          f"growth {grow * 1e3:.1f} kB per extra frame")
+    print(
+        f"\npeak ratio {SIZES[1]}/{SIZES[0]}: {ratio:.2f}x (target <= {TARGET_RATIO}x: {'met' if ok else 'MISSED'}); "
+        f"growth {grow * 1e3:.1f} kB per extra frame"
+    )
     elapsed = print_end(info, t_start)
     if args.json:
-        Path(args.json).write_text(json.dumps({"machine": info, "runs": rows, "ratio": ratio,
-                                               "growth_mb_per_frame": grow, "elapsed_s": elapsed}, indent=2))
+        Path(args.json).write_text(
+            json.dumps(
+                {"machine": info, "runs": rows, "ratio": ratio, "growth_mb_per_frame": grow, "elapsed_s": elapsed},
+                indent=2,
+            )
+        )
     return 0 if ok else 1
 
 

@@ -60,12 +60,12 @@ ROOT = Path(__file__).resolve().parent.parent
 HERE = Path(__file__).resolve().parent
 
 SEED = 37
-WIDTH, HEIGHT = 640, 480          # the on_axis case's image
-GIB = 2 ** 30
-SOUP_TIME_RATIO = 3.0             # wirecheck's process <= 3x pyrender's (soup, sphere)
-SOUP_RSS_GIB = 1.0                # ... and under 1 GiB
-MESH_STAGE_RATIO = 2.0            # pixel stage per frame <= 2x pyrender's draw (20k-60k faces)
-MILLION_RSS_GIB = 1.5             # a 1M-face mesh's peak RSS
+WIDTH, HEIGHT = 640, 480  # the on_axis case's image
+GIB = 2**30
+SOUP_TIME_RATIO = 3.0  # wirecheck's process <= 3x pyrender's (soup, sphere)
+SOUP_RSS_GIB = 1.0  # ... and under 1 GiB
+MESH_STAGE_RATIO = 2.0  # pixel stage per frame <= 2x pyrender's draw (20k-60k faces)
+MILLION_RSS_GIB = 1.5  # a 1M-face mesh's peak RSS
 
 
 # ---------------------------------------------------------------- meshes
@@ -144,10 +144,17 @@ def child_wirecheck(path: str, t_start: float) -> dict:
     t_case = time.perf_counter() - t0
     case = report["cases"][0]
     tm = report["timing"]
-    return {"load_s": t_load, "case_s": t_case, "verdict": case.get("verdict"),
-            "pixel_stage_ms": tm.get("pixel_stage_ms_per_frame"), "pixel_metrics_ms": tm.get("pixel_metrics_ms_per_frame"),
-            "pyrender_in_ms": tm.get("pyrender_ms_per_frame"), "draw_ms": tm.get("candidate_draw_ms_per_frame"),
-            "wall_s": time.perf_counter() - t_start, "peak_rss": peak_rss_bytes()}
+    return {
+        "load_s": t_load,
+        "case_s": t_case,
+        "verdict": case.get("verdict"),
+        "pixel_stage_ms": tm.get("pixel_stage_ms_per_frame"),
+        "pixel_metrics_ms": tm.get("pixel_metrics_ms_per_frame"),
+        "pyrender_in_ms": tm.get("pyrender_ms_per_frame"),
+        "draw_ms": tm.get("candidate_draw_ms_per_frame"),
+        "wall_s": time.perf_counter() - t_start,
+        "peak_rss": peak_rss_bytes(),
+    }
 
 
 def child_pyrender(path: str, t_start: float) -> dict:
@@ -162,14 +169,19 @@ def child_pyrender(path: str, t_start: float) -> dict:
     renderer = pyrender.OffscreenRenderer(WIDTH, HEIGHT)
     scene = pyrender.Scene(bg_color=[0, 0, 0, 1], ambient_light=[0, 0, 0])
     white = pyrender.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0])
-    warm = pyrender.Primitive(positions=np.array([[0, 0, 0], [1, 1, 0]], np.float32),
-                              indices=np.array([[0, 1]], np.uint32), mode=pyrender.constants.GLTF.LINES, material=white)
+    warm = pyrender.Primitive(
+        positions=np.array([[0, 0, 0], [1, 1, 0]], np.float32),
+        indices=np.array([[0, 1]], np.uint32),
+        mode=pyrender.constants.GLTF.LINES,
+        material=white,
+    )
     warm_node = scene.add(pyrender.Mesh([warm]))
     pose = np.eye(4)
     pose[2, 3] = 3.0
-    cam_node = scene.add(pyrender.PerspectiveCamera(yfov=math.radians(60), aspectRatio=WIDTH / HEIGHT,
-                                                    znear=0.05, zfar=10.0), pose=pose)
-    renderer.render(scene, flags=pyrender.RenderFlags.FLAT)        # the shaders compiled, as wirecheck's warm-up
+    cam_node = scene.add(
+        pyrender.PerspectiveCamera(yfov=math.radians(60), aspectRatio=WIDTH / HEIGHT, znear=0.05, zfar=10.0), pose=pose
+    )
+    renderer.render(scene, flags=pyrender.RenderFlags.FLAT)  # the shaders compiled, as wirecheck's warm-up
     t0 = time.perf_counter()
     mesh = trimesh.load(path, process=False)
     v = np.asarray(mesh.vertices, np.float64)
@@ -178,31 +190,47 @@ def child_pyrender(path: str, t_start: float) -> dict:
     edges = mesh.edges_unique.astype(np.uint32)
     load = time.perf_counter() - t0
     scene.remove_node(warm_node)
-    prim = pyrender.Primitive(positions=(v - centre).astype(np.float32), indices=edges,
-                              mode=pyrender.constants.GLTF.LINES, material=white)
+    prim = pyrender.Primitive(
+        positions=(v - centre).astype(np.float32), indices=edges, mode=pyrender.constants.GLTF.LINES, material=white
+    )
     scene.add(pyrender.Mesh([prim]))
     pose[2, 3] = 3.0 * radius
     scene.remove_node(cam_node)
-    scene.add(pyrender.PerspectiveCamera(yfov=math.radians(60), aspectRatio=WIDTH / HEIGHT,
-                                         znear=0.05 * radius, zfar=10 * radius), pose=pose)
+    scene.add(
+        pyrender.PerspectiveCamera(
+            yfov=math.radians(60), aspectRatio=WIDTH / HEIGHT, znear=0.05 * radius, zfar=10 * radius
+        ),
+        pose=pose,
+    )
     t0 = time.perf_counter()
-    color, _ = renderer.render(scene, flags=pyrender.RenderFlags.FLAT)   # the mesh uploaded and drawn
+    color, _ = renderer.render(scene, flags=pyrender.RenderFlags.FLAT)  # the mesh uploaded and drawn
     draw = time.perf_counter() - t0
     t0 = time.perf_counter()
-    renderer.render(scene, flags=pyrender.RenderFlags.FLAT)              # a frame of a run: drawn only
+    renderer.render(scene, flags=pyrender.RenderFlags.FLAT)  # a frame of a run: drawn only
     redraw = time.perf_counter() - t0
     drawn = int((color[:, :, 0] > 0).sum())
     renderer.delete()
-    return {"load_s": load, "draw_ms": 1e3 * draw, "redraw_ms": 1e3 * redraw, "drawn_px": drawn,
-            "wall_s": time.perf_counter() - t_start, "peak_rss": peak_rss_bytes()}
+    return {
+        "load_s": load,
+        "draw_ms": 1e3 * draw,
+        "redraw_ms": 1e3 * redraw,
+        "drawn_px": drawn,
+        "wall_s": time.perf_counter() - t_start,
+        "peak_rss": peak_rss_bytes(),
+    }
 
 
 def measure(side: str, path: Path, timeout: float) -> dict:
     """One fresh interpreter measuring ``side`` on ``path``; its JSON line, or ``{"error": ...}``."""
     t0 = time.perf_counter()
     try:
-        proc = subprocess.run([sys.executable, str(Path(__file__)), "--child", side, str(path)], cwd=ROOT,
-                              capture_output=True, text=True, timeout=timeout)
+        proc = subprocess.run(
+            [sys.executable, str(Path(__file__)), "--child", side, str(path)],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
     except subprocess.TimeoutExpired:
         return {"error": f"over {timeout:.0f} s"}
     wall = time.perf_counter() - t0
@@ -210,7 +238,7 @@ def measure(side: str, path: Path, timeout: float) -> dict:
     if proc.returncode != 0 or not lines:
         return {"error": (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1][:160]}
     out = json.loads(lines[-1])
-    out["process_s"] = wall            # the process as the parent saw it: start-up and imports included
+    out["process_s"] = wall  # the process as the parent saw it: start-up and imports included
     return out
 
 
@@ -235,8 +263,12 @@ def main(argv=None) -> int:
     ap.add_argument("--json", default=None, help="also write the rows as JSON to this file")
     ap.add_argument("--plot", default=None, help="the sweep's time and memory against edges as a PNG")
     ap.add_argument("--label", default="", help="a label for this run in the table's title (e.g. before)")
-    ap.add_argument("--baseline", default=None, metavar="JSON",
-                    help="an earlier run's --json (e.g. before a change): its sweep drawn beside this one's in --plot")
+    ap.add_argument(
+        "--baseline",
+        default=None,
+        metavar="JSON",
+        help="an earlier run's --json (e.g. before a change): its sweep drawn beside this one's in --plot",
+    )
     ap.add_argument("--child", nargs=2, metavar=("SIDE", "PATH"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -259,18 +291,22 @@ def main(argv=None) -> int:
             pr = measure("pyrender", path, args.timeout)
             rows.append({"mesh": name, "faces": n_faces, "edges": n_edges, "wirecheck": wc, "pyrender": pr})
             print(f"  {name}: done", flush=True)
-    header = (f"{'mesh':<11} {'faces':>9} {'edges':>9} | {'load s':>7} {'stage ms':>9} {'metrics ms':>10} "
-              f"{'wall s':>7} {'RSS GiB':>7} {'verdict':>7} | {'pr draw ms':>10} {'pr wall s':>9} {'pr GiB':>6} "
-              f"| {'stage/draw':>10} {'wall/wall':>9}")
+    header = (
+        f"{'mesh':<11} {'faces':>9} {'edges':>9} | {'load s':>7} {'stage ms':>9} {'metrics ms':>10} "
+        f"{'wall s':>7} {'RSS GiB':>7} {'verdict':>7} | {'pr draw ms':>10} {'pr wall s':>9} {'pr GiB':>6} "
+        f"| {'stage/draw':>10} {'wall/wall':>9}"
+    )
 
     def fmt(r):
         wc, pr = r["wirecheck"], r["pyrender"]
-        if "error" in wc or "error" in pr:       # a side that failed or ran out of time: what it said
+        if "error" in wc or "error" in pr:  # a side that failed or ran out of time: what it said
             return f"{r['mesh']:<11} {r['faces']:>9} {r['edges']:>9} | wirecheck: {wc.get('error', 'ok')}; pyrender: {pr.get('error', 'ok')}"
-        return (f"{r['mesh']:<11} {r['faces']:>9} {r['edges']:>9} | {wc['load_s']:>7.2f} {wc['pixel_stage_ms']:>9.1f} "
-                f"{wc['pixel_metrics_ms']:>10.1f} {wc['process_s']:>7.2f} {gib(wc['peak_rss']):>7} {wc['verdict']:>7} | "
-                f"{pr['draw_ms']:>10.1f} {pr['process_s']:>9.2f} {gib(pr['peak_rss']):>6} | "
-                f"{wc['pixel_stage_ms'] / pr['draw_ms']:>10.2f} {wc['process_s'] / pr['process_s']:>9.2f}")
+        return (
+            f"{r['mesh']:<11} {r['faces']:>9} {r['edges']:>9} | {wc['load_s']:>7.2f} {wc['pixel_stage_ms']:>9.1f} "
+            f"{wc['pixel_metrics_ms']:>10.1f} {wc['process_s']:>7.2f} {gib(wc['peak_rss']):>7} {wc['verdict']:>7} | "
+            f"{pr['draw_ms']:>10.1f} {pr['process_s']:>9.2f} {gib(pr['peak_rss']):>6} | "
+            f"{wc['pixel_stage_ms'] / pr['draw_ms']:>10.2f} {wc['process_s'] / pr['process_s']:>9.2f}"
+        )
 
     print()
     print_table("One frame (on_axis, 640x480), each side in a fresh process", header, [fmt(r) for r in rows])
@@ -280,19 +316,31 @@ def main(argv=None) -> int:
         if name in by:
             wc, pr = by[name]["wirecheck"], by[name]["pyrender"]
             ratio = wc["process_s"] / pr["process_s"]
-            targets.append((f"{name}: process {ratio:.2f}x pyrender's (<= {SOUP_TIME_RATIO:g}x), peak "
-                            f"{gib(wc['peak_rss'])} GiB (< {SOUP_RSS_GIB:g})",
-                            ratio <= SOUP_TIME_RATIO and wc["peak_rss"] < SOUP_RSS_GIB * GIB))
+            targets.append(
+                (
+                    f"{name}: process {ratio:.2f}x pyrender's (<= {SOUP_TIME_RATIO:g}x), peak "
+                    f"{gib(wc['peak_rss'])} GiB (< {SOUP_RSS_GIB:g})",
+                    ratio <= SOUP_TIME_RATIO and wc["peak_rss"] < SOUP_RSS_GIB * GIB,
+                )
+            )
     for name in ("ico20k", "grid40k", "grid60k"):
         if name in by:
             wc, pr = by[name]["wirecheck"], by[name]["pyrender"]
             ratio = wc["pixel_stage_ms"] / pr["draw_ms"]
-            targets.append((f"{name}: pixel stage {ratio:.2f}x pyrender's draw (<= {MESH_STAGE_RATIO:g}x)",
-                            ratio <= MESH_STAGE_RATIO))
+            targets.append(
+                (
+                    f"{name}: pixel stage {ratio:.2f}x pyrender's draw (<= {MESH_STAGE_RATIO:g}x)",
+                    ratio <= MESH_STAGE_RATIO,
+                )
+            )
     if "grid1000k" in by:
         wc = by["grid1000k"]["wirecheck"]
-        targets.append((f"grid1000k ({by['grid1000k']['faces']} faces): peak {gib(wc['peak_rss'])} GiB "
-                        f"(< {MILLION_RSS_GIB:g})", wc["peak_rss"] < MILLION_RSS_GIB * GIB))
+        targets.append(
+            (
+                f"grid1000k ({by['grid1000k']['faces']} faces): peak {gib(wc['peak_rss'])} GiB (< {MILLION_RSS_GIB:g})",
+                wc["peak_rss"] < MILLION_RSS_GIB * GIB,
+            )
+        )
     for text, ok in targets:
         print(f"  {verdict(ok)}  {text}")
     if args.plot:
@@ -310,23 +358,32 @@ def main(argv=None) -> int:
 def plot(rows: list, png: str, label: str, baseline: tuple | None = None) -> None:
     """The height fields' (sweep and grid1000k) pixel stage and peak RSS against edges, wirecheck and pyrender (and ``baseline``'s wirecheck)."""
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     def sweep(rs):
-        return sorted((r for r in rs if (r["mesh"].startswith("sweep") or r["mesh"] == "grid1000k")
-                       and "error" not in r["wirecheck"] and "error" not in r["pyrender"]), key=lambda r: r["edges"])
+        return sorted(
+            (
+                r
+                for r in rs
+                if (r["mesh"].startswith("sweep") or r["mesh"] == "grid1000k")
+                and "error" not in r["wirecheck"]
+                and "error" not in r["pyrender"]
+            ),
+            key=lambda r: r["edges"],
+        )
 
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
     runs = [(label or "wirecheck", sweep(rows), "o-")] + ([(baseline[0], sweep(baseline[1]), "o:")] if baseline else [])
     for name, rs, style in runs:
         e = [r["edges"] for r in rs]
         a.loglog(e, [r["wirecheck"]["pixel_stage_ms"] for r in rs], style, label=f"wirecheck pixel stage ({name})")
-        b.loglog(e, [r["wirecheck"]["peak_rss"] / 2 ** 20 for r in rs], style, label=f"wirecheck process ({name})")
+        b.loglog(e, [r["wirecheck"]["peak_rss"] / 2**20 for r in rs], style, label=f"wirecheck process ({name})")
     rs = sweep(rows)
     e = [r["edges"] for r in rs]
     a.loglog(e, [r["pyrender"]["draw_ms"] for r in rs], "s--", label="pyrender draw")
-    b.loglog(e, [r["pyrender"]["peak_rss"] / 2 ** 20 for r in rs], "s--", label="pyrender process")
+    b.loglog(e, [r["pyrender"]["peak_rss"] / 2**20 for r in rs], "s--", label="pyrender process")
     a.set_xlabel("edges")
     a.set_ylabel("ms, one frame")
     b.set_xlabel("edges")

@@ -31,9 +31,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from wirecheck.core.camera import look_at  # noqa: E402
 from wirecheck.core.projector.projection import project_points  # noqa: E402
+from wirecheck.oracles.extremes import reference_project  # noqa: E402
 from wirecheck.oracles.references import opencv_oracle  # noqa: E402
 from wirecheck.oracles.references.convert import camera_to_opencv  # noqa: E402
-from wirecheck.oracles.extremes import reference_project  # noqa: E402
 
 
 def reference(p_world, camera):
@@ -67,8 +67,13 @@ def opencv_f32(p_world, camera):
     vis = ~np.isnan(opencv_oracle.project(p_world, camera)[:, 0])
     out = np.full((len(p_world), 2), np.nan)
     if vis.any():
-        px, _ = cv2.projectPoints(np.asarray(p_world[vis], np.float32), rvec.astype(np.float32),
-                                  tvec.astype(np.float32), k.astype(np.float32), None)
+        px, _ = cv2.projectPoints(
+            np.asarray(p_world[vis], np.float32),
+            rvec.astype(np.float32),
+            tvec.astype(np.float32),
+            k.astype(np.float32),
+            None,
+        )
         out[vis] = px.reshape(-1, 2)
     return out
 
@@ -82,18 +87,33 @@ def cases(rng):
     n = 40_962
     unit = sphere(n, 1.0, rng)
     yield "baseline: unit sphere at 4", unit, look_at((0.3, 0.4, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=60)
-    yield "huge coords: radius 1e6 at 4e6", unit * 1e6, look_at((0.3e6, 0.4e6, 4e6), (0, 0, 0), (0, 1, 0),
-                                                                   fov_y_deg=60, near=1.0, far=1e8)
-    yield "offset origin: unit sphere at x=1e7", unit + [1e7, 0, 0], look_at((1e7 + 0.3, 0.4, 4), (1e7, 0, 0),
-                                                                            (0, 1, 0), fov_y_deg=60)
-    yield "far: unit sphere at 1e8, camera 4 away", unit + [1e8, 0, 0], look_at((1e8 + 0.3, 0.4, 4), (1e8, 0, 0),
-                                                                                (0, 1, 0), fov_y_deg=60)
-    yield "tiny fov: 0.01 deg at 1e4", unit, look_at((0, 0, 1e4), (0, 0, 0), (0, 1, 0), fov_y_deg=0.01,
-                                                      near=1.0, far=2e4)
+    yield (
+        "huge coords: radius 1e6 at 4e6",
+        unit * 1e6,
+        look_at((0.3e6, 0.4e6, 4e6), (0, 0, 0), (0, 1, 0), fov_y_deg=60, near=1.0, far=1e8),
+    )
+    yield (
+        "offset origin: unit sphere at x=1e7",
+        unit + [1e7, 0, 0],
+        look_at((1e7 + 0.3, 0.4, 4), (1e7, 0, 0), (0, 1, 0), fov_y_deg=60),
+    )
+    yield (
+        "far: unit sphere at 1e8, camera 4 away",
+        unit + [1e8, 0, 0],
+        look_at((1e8 + 0.3, 0.4, 4), (1e8, 0, 0), (0, 1, 0), fov_y_deg=60),
+    )
+    yield (
+        "tiny fov: 0.01 deg at 1e4",
+        unit,
+        look_at((0, 0, 1e4), (0, 0, 0), (0, 1, 0), fov_y_deg=0.01, near=1.0, far=2e4),
+    )
     yield "huge fov: 179 deg at 4", unit, look_at((0, 0, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=179.0)
-    near_pts = unit * [1, 1, 0] + [0, 0, 4 - 0.1 * (1 + 1e-9)]   # a disc 1e-10 in front of the near plane
-    yield "near plane: depth = near (1 + 1e-9)", near_pts, look_at((0, 0, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=60,
-                                                                   near=0.1)
+    near_pts = unit * [1, 1, 0] + [0, 0, 4 - 0.1 * (1 + 1e-9)]  # a disc 1e-10 in front of the near plane
+    yield (
+        "near plane: depth = near (1 + 1e-9)",
+        near_pts,
+        look_at((0, 0, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=60, near=0.1),
+    )
 
 
 def timed(fn, *args, reps=7):
@@ -125,12 +145,24 @@ def main(argv=None) -> int:
     for name, p_world, cam in cases(rng):
         ref = reference(p_world, cam)
         _, t_ref = timed(opencv_oracle.project, p_world, cam)
-        for impl, fn in (("ours f64", project_points), ("ours f32", project_f32), ("naive f32", naive_f32),
-                         ("opencv f64", opencv_oracle.project), ("opencv f32", opencv_f32)):
+        for impl, fn in (
+            ("ours f64", project_points),
+            ("ours f32", project_f32),
+            ("naive f32", naive_f32),
+            ("opencv f64", opencv_oracle.project),
+            ("opencv f32", opencv_f32),
+        ):
             px, t = timed(fn, p_world, cam)
             err, mismatch = max_err(px, ref)
-            rows.append({"case": name, "impl": impl, "max_error_px": err, "visibility_mismatches": mismatch,
-                         "timing": {"ms_per_call": 1e3 * t, "reference_ms_per_call": 1e3 * t_ref}})
+            rows.append(
+                {
+                    "case": name,
+                    "impl": impl,
+                    "max_error_px": err,
+                    "visibility_mismatches": mismatch,
+                    "timing": {"ms_per_call": 1e3 * t, "reference_ms_per_call": 1e3 * t_ref},
+                }
+            )
             print(f"{name:<38} {impl:<11} {err:>11.3g} {mismatch:>9d} {1e3 * t:>8.3f} {t / t_ref:>10.2f}")
         print()
     print("vis. diff: points whose clipped/visible status differs from the reference;")

@@ -48,15 +48,14 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
-
 from wirecheck.core.projector.projection import project_points  # noqa: E402
 from wirecheck.core.scene.files import builtin_names, load_scene  # noqa: E402
 from wirecheck.core.transforms import Motion  # noqa: E402
-from wirecheck.oracles.references import faces as oface  # noqa: E402
 from wirecheck.oracles.candidates.candidate import call_candidate  # noqa: E402
-from wirecheck.oracles.cases import cameras_for  # noqa: E402
 from wirecheck.oracles.candidates.draw import clip_depth  # noqa: E402
 from wirecheck.oracles.candidates.subprocess_candidate import SubprocessCandidate  # noqa: E402
+from wirecheck.oracles.cases import cameras_for  # noqa: E402
+from wirecheck.oracles.references import faces as oface  # noqa: E402
 
 
 def _median_time(fn, repeats: int) -> float:
@@ -69,8 +68,10 @@ def _median_time(fn, repeats: int) -> float:
 
 
 def candidates(workdir: Path) -> dict:
-    out = {"in-process": project_points,
-           "python-host": SubprocessCandidate.python("wirecheck.core.projector.projection:project_points", timeout_s=120)}
+    out = {
+        "in-process": project_points,
+        "python-host": SubprocessCandidate.python("wirecheck.core.projector.projection:project_points", timeout_s=120),
+    }
     null = workdir / "null_projector.py"
     null.write_text("import numpy as np\ndef null(p, c):\n    return np.zeros((len(p), 2))\n")
     out["null"] = lambda p, c: np.zeros((len(p), 2))
@@ -82,7 +83,9 @@ def candidates(workdir: Path) -> dict:
         out["c"] = SubprocessCandidate(argv=(str(exe),), timeout_s=120)
     node = shutil.which("node")
     if node and (ROOT / "tests/clients/three/node_modules/three").is_dir():
-        out["three.js"] = SubprocessCandidate(argv=(node, str(ROOT / "tests/clients/three/candidate.mjs")), timeout_s=120)
+        out["three.js"] = SubprocessCandidate(
+            argv=(node, str(ROOT / "tests/clients/three/candidate.mjs")), timeout_s=120
+        )
     return out
 
 
@@ -107,14 +110,16 @@ def run(quick: bool) -> dict:
         requests = frame_requests()
         cam_1m = cameras_for(1.0)[1].camera
         p_1m = np.random.default_rng(0).uniform(-1, 1, (1_000_000, 3))
-        for func in cands.values():               # start the programs (and warm numpy) outside the timing
+        for func in cands.values():  # start the programs (and warm numpy) outside the timing
             call_candidate(func, requests[0][0], requests[0][2])
         gc.disable()
         try:
             result = {}
             for name, func in cands.items():
-                per_pair = [_median_time(lambda: (call_candidate(func, pv, cam), call_candidate(func, pe, cam)),
-                                         repeats) for pv, pe, cam in requests]
+                per_pair = [
+                    _median_time(lambda: (call_candidate(func, pv, cam), call_candidate(func, pe, cam)), repeats)
+                    for pv, pe, cam in requests
+                ]
                 t_1m = _median_time(lambda: call_candidate(func, p_1m, cam_1m), max(3, repeats // 6))
                 result[name] = {"frame_ms": 1e3 * statistics.median(per_pair), "1M_ms": 1e3 * t_1m}
         finally:
@@ -138,8 +143,10 @@ def main(argv=None) -> int:
     print(f"candidate protocol cost ({out['pairs']} scene/case frames, median of {out['repeats']} repeats)")
     print(f"{'candidate':<12} {'ms/frame':>9} {'overhead':>9} {'1M pts ms':>10} {'overhead':>9}")
     for name, r in out["results"].items():
-        print(f"{name:<12} {r['frame_ms']:9.3f} {r['frame_overhead_ms']:+9.3f} {r['1M_ms']:10.1f} "
-              f"{r['1M_overhead_ms']:+9.1f}")
+        print(
+            f"{name:<12} {r['frame_ms']:9.3f} {r['frame_overhead_ms']:+9.3f} {r['1M_ms']:10.1f} "
+            f"{r['1M_overhead_ms']:+9.1f}"
+        )
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=2) + "\n")
     return 0

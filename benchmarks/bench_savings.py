@@ -49,24 +49,23 @@ import tempfile
 import time
 from pathlib import Path
 
-os.environ["PYOPENGL_PLATFORM"] = "osmesa"        # before anything imports pyrender / OpenGL
+os.environ["PYOPENGL_PLATFORM"] = "osmesa"  # before anything imports pyrender / OpenGL
 
 import numpy as np
 import trimesh
-
 from _common import print_end, print_machine, print_table, write_json
 from bench_scale import OpenBLAS, bench_group, blas_info, fast_unique_edges
-from wirecheck.core.projector import clipping, raster
 from wirecheck.core.camera import camera_z
+from wirecheck.core.projector import clipping, raster
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import cam_to_px, localize, model_to_cam
-from wirecheck.core.scene.model import Scene
 from wirecheck.core.scene.files import load_scene
+from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 640, 480
 FRAMES = 180
-NOISE_FLOOR = 0.05        # faces / no faces: "identical" when the ratio is within 5 % (or the measured noise)
+NOISE_FLOOR = 0.05  # faces / no faces: "identical" when the ratio is within 5 % (or the measured noise)
 
 
 def make_camera():
@@ -110,7 +109,7 @@ def depth_stage(rr, cc, count, z0, z1, height, width) -> np.ndarray:
     t = (k / np.maximum(count - 1, 1)[seg]).astype(np.float32)
     inv0 = (1.0 / z0).astype(np.float32)[seg]
     inv1 = (1.0 / z1).astype(np.float32)[seg]
-    z = 1.0 / (inv0 + t * (inv1 - inv0))                     # perspective-correct along the segment
+    z = 1.0 / (inv0 + t * (inv1 - inv0))  # perspective-correct along the segment
     zbuf = np.full((height, width), np.inf, dtype=np.float32)
     np.minimum.at(zbuf, (rr, cc), z)
     keep = z <= zbuf[rr, cc]
@@ -132,6 +131,7 @@ class PyrenderScenes:
     def __init__(self, vertices, edges, faces, camera):
         import pyrender
         from wirecheck.oracles.references.convert import camera_to_pyrender
+
         self.pr = pyrender
         self.renderer = pyrender.OffscreenRenderer(camera.width, camera.height)
         pose, cam = camera_to_pyrender(camera)
@@ -140,12 +140,15 @@ class PyrenderScenes:
         black = pyrender.MetallicRoughnessMaterial(baseColorFactor=[0.0, 0.0, 0.0, 1.0], doubleSided=True)
 
         def lines():
-            return pyrender.Primitive(positions=pos, indices=edges.astype(np.uint32),
-                                      mode=pyrender.constants.GLTF.LINES, material=white)
+            return pyrender.Primitive(
+                positions=pos, indices=edges.astype(np.uint32), mode=pyrender.constants.GLTF.LINES, material=white
+            )
 
         def tris():
-            return pyrender.Primitive(positions=pos, indices=faces.astype(np.uint32),
-                                      mode=pyrender.constants.GLTF.TRIANGLES, material=black)
+            return pyrender.Primitive(
+                positions=pos, indices=faces.astype(np.uint32), mode=pyrender.constants.GLTF.TRIANGLES, material=black
+            )
+
         self.scenes, self.nodes = {}, {}
         for name, prims in (("flat", [lines()]), ("lit", [lines()]), ("faces", [lines(), tris()])):
             sc = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
@@ -157,9 +160,10 @@ class PyrenderScenes:
 
     def render(self, name, model_matrix):
         from OpenGL import GL
+
         pr = self.pr
         self.scenes[name].set_pose(self.nodes[name], model_matrix)
-        if name == "faces":                       # as PyrenderOracle._polygon_offset
+        if name == "faces":  # as PyrenderOracle._polygon_offset
             self.renderer._platform.make_current()
             GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
             GL.glPolygonOffset(1.0, 1.0)
@@ -180,9 +184,11 @@ def main(argv=None) -> int:
     ap.add_argument("--json", metavar="PATH", help="also write the results as JSON to PATH")
     args = ap.parse_args(argv)
     t_start = time.perf_counter()
-    cfg = ({"budget_s": 0.15, "rounds": 2, "max_passes": 10, "poses": 4, "load_subdiv": 6, "load_repeats": 2}
-           if args.quick else
-           {"budget_s": 0.8, "rounds": 3, "max_passes": 50, "poses": 8, "load_subdiv": 7, "load_repeats": 3})
+    cfg = (
+        {"budget_s": 0.15, "rounds": 2, "max_passes": 10, "poses": 4, "load_subdiv": 6, "load_repeats": 2}
+        if args.quick
+        else {"budget_s": 0.8, "rounds": 3, "max_passes": 50, "poses": 8, "load_subdiv": 7, "load_repeats": 3}
+    )
     blas = OpenBLAS()
     info = blas_info(blas)
     camera = make_camera()
@@ -195,11 +201,18 @@ def main(argv=None) -> int:
     faces = np.asarray(mesh.faces, dtype=np.intp)
     e = fast_unique_edges(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), len(v))
 
-    print_machine("wirecheck savings benchmark: what the skipped stages would cost", info, libraries=(
-        f"python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}), "
-        f"cv2 {info['cv2']}, trimesh {info['trimesh']}"))
-    print(f"  icosphere(6): {len(v):,} V, {len(e):,} E, {len(faces):,} F; camera_z(4.0, fov_y_deg=70) "
-          f"{WIDTH}x{HEIGHT}; {n_poses} Motion() poses; mode {'quick' if args.quick else 'full'}")
+    print_machine(
+        "wirecheck savings benchmark: what the skipped stages would cost",
+        info,
+        libraries=(
+            f"python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}), "
+            f"cv2 {info['cv2']}, trimesh {info['trimesh']}"
+        ),
+    )
+    print(
+        f"  icosphere(6): {len(v):,} V, {len(e):,} E, {len(faces):,} F; camera_z(4.0, fov_y_deg=70) "
+        f"{WIDTH}x{HEIGHT}; {n_poses} Motion() poses; mode {'quick' if args.quick else 'full'}"
+    )
     print(flush=True)
 
     bg = dict(n_poses=n_poses, budget_s=cfg["budget_s"], rounds=cfg["rounds"], max_passes=cfg["max_passes"])
@@ -212,24 +225,40 @@ def main(argv=None) -> int:
     pts_p = localize(scene_plain.vertices)
     p_cams = [model_to_cam(pts_p, m, camera) for m in mats]
     front = face_stage(p_cams[0], faces)
-    t_faces = bench_group({
-        "scene_with_faces": lambda i: render_frame(pts_f, scene_faces.edges, camera, mats[i]),
-        "scene_without_faces": lambda i: render_frame(pts_p, scene_plain.edges, camera, mats[i]),
-        "face_stage": lambda i: face_stage(p_cams[i], faces),
-    }, **bg)
+    t_faces = bench_group(
+        {
+            "scene_with_faces": lambda i: render_frame(pts_f, scene_faces.edges, camera, mats[i]),
+            "scene_without_faces": lambda i: render_frame(pts_p, scene_plain.edges, camera, mats[i]),
+            "face_stage": lambda i: face_stage(p_cams[i], faces),
+        },
+        **bg,
+    )
     with_f = t_faces["scene_with_faces"]["median_ms"]
     without_f = t_faces["scene_without_faces"]["median_ms"]
     face_ms = t_faces["face_stage"]["median_ms"]
     ratio_faces = with_f / without_f
-    noise = max(abs(t_faces[k]["median_ms"] - t_faces[k]["min_ms"]) / t_faces[k]["median_ms"]
-                for k in ("scene_with_faces", "scene_without_faces"))
+    noise = max(
+        abs(t_faces[k]["median_ms"] - t_faces[k]["min_ms"]) / t_faces[k]["median_ms"]
+        for k in ("scene_with_faces", "scene_without_faces")
+    )
     identical = abs(ratio_faces - 1.0) <= max(NOISE_FLOOR, noise)
-    details["faces"] = {"timings": t_faces, "ratio_with_over_without": ratio_faces, "noise": noise,
-                        "identical_within_noise": identical, "front_facing_fraction_pose0": float(front.mean())}
-    rows.append({"stage": "faces: normals + back-face test", "skipped_ms": face_ms, "run_ms": with_f,
-                 "note": f"scene with faces {ms(with_f)} ms vs without {ms(without_f)} ms "
-                         f"(ratio {ratio_faces:.3f}: {'identical' if identical else 'NOT identical'} within noise "
-                         f"{max(NOISE_FLOOR, noise):.0%}); front-facing {front.mean():.1%} of faces"})
+    details["faces"] = {
+        "timings": t_faces,
+        "ratio_with_over_without": ratio_faces,
+        "noise": noise,
+        "identical_within_noise": identical,
+        "front_facing_fraction_pose0": float(front.mean()),
+    }
+    rows.append(
+        {
+            "stage": "faces: normals + back-face test",
+            "skipped_ms": face_ms,
+            "run_ms": with_f,
+            "note": f"scene with faces {ms(with_f)} ms vs without {ms(without_f)} ms "
+            f"(ratio {ratio_faces:.3f}: {'identical' if identical else 'NOT identical'} within noise "
+            f"{max(NOISE_FLOOR, noise):.0%}); front-facing {front.mean():.1%} of faces",
+        }
+    )
 
     # ---- 2. depth buffer (raster "fast")
     frames = [render_frame(pts_p, e, camera, m, raster="fast") for m in mats]
@@ -238,31 +267,45 @@ def main(argv=None) -> int:
         q0 = round_half_up(np.take(f.p_px, e[:, 0], axis=0))
         q1 = round_half_up(np.take(f.p_px, e[:, 1], axis=0))
         count = np.abs(q1 - q0).max(axis=1) + 1
-        rr, cc = raster.line_pixels_fast(np.take(f.p_px, e[:, 0], axis=0), np.take(f.p_px, e[:, 1], axis=0),
-                                         WIDTH, HEIGHT)
+        rr, cc = raster.line_pixels_fast(
+            np.take(f.p_px, e[:, 0], axis=0), np.take(f.p_px, e[:, 1], axis=0), WIDTH, HEIGHT
+        )
         prep.append((rr, cc, count, pc[e[:, 0], 2], pc[e[:, 1], 2]))
     depth_ok = all(len(p[0]) == int(p[2].sum()) for p in prep)
     if depth_ok:
         # the z-buffered image equals the plain one for a wireframe (lines never hide lines)
-        same = all(np.array_equal(depth_stage(*p, HEIGHT, WIDTH), plain_paint(p[0], p[1], HEIGHT, WIDTH))
-                   for p in prep[:1])
-        t_depth = bench_group({
-            "frame_fast": lambda i: render_frame(pts_p, e, camera, mats[i], raster="fast"),
-            "plain_paint": lambda i: plain_paint(prep[i][0], prep[i][1], HEIGHT, WIDTH),
-            "zbuffer_paint": lambda i: depth_stage(*prep[i], HEIGHT, WIDTH),
-        }, **bg)
+        same = all(
+            np.array_equal(depth_stage(*p, HEIGHT, WIDTH), plain_paint(p[0], p[1], HEIGHT, WIDTH)) for p in prep[:1]
+        )
+        t_depth = bench_group(
+            {
+                "frame_fast": lambda i: render_frame(pts_p, e, camera, mats[i], raster="fast"),
+                "plain_paint": lambda i: plain_paint(prep[i][0], prep[i][1], HEIGHT, WIDTH),
+                "zbuffer_paint": lambda i: depth_stage(*prep[i], HEIGHT, WIDTH),
+            },
+            **bg,
+        )
         extra = t_depth["zbuffer_paint"]["median_ms"] - t_depth["plain_paint"]["median_ms"]
-        details["depth_buffer"] = {"timings": t_depth, "extra_ms": extra, "pixels_pose0": int(len(prep[0][0])),
-                                   "zbuffer_image_equals_plain": same}
-        rows.append({"stage": "depth buffer (z-test line pixels)", "skipped_ms": extra,
-                     "run_ms": t_depth["frame_fast"]["median_ms"],
-                     "note": f"raster fast; z-buffered paint {ms(t_depth['zbuffer_paint']['median_ms'])} ms vs plain "
-                             f"paint {ms(t_depth['plain_paint']['median_ms'])} ms, {len(prep[0][0]):,} px; "
-                             f"same image: {same}"})
+        details["depth_buffer"] = {
+            "timings": t_depth,
+            "extra_ms": extra,
+            "pixels_pose0": int(len(prep[0][0])),
+            "zbuffer_image_equals_plain": same,
+        }
+        rows.append(
+            {
+                "stage": "depth buffer (z-test line pixels)",
+                "skipped_ms": extra,
+                "run_ms": t_depth["frame_fast"]["median_ms"],
+                "note": f"raster fast; z-buffered paint {ms(t_depth['zbuffer_paint']['median_ms'])} ms vs plain "
+                f"paint {ms(t_depth['plain_paint']['median_ms'])} ms, {len(prep[0][0]):,} px; "
+                f"same image: {same}",
+            }
+        )
     else:
         details["depth_buffer"] = {"skipped": "line_pixels_fast dropped pixels: per-pixel segment ids unknown"}
         print("  depth buffer row skipped: the fast raster's pixel count does not match its segments")
-    frames = prep = None        # free them (the lambdas above are done)
+    frames = prep = None  # free them (the lambdas above are done)
 
     # ---- 3. clipping: only the edges with an end outside, vs every edge through the clip stage
     # render_frame clips only edges with an end out of [near, far] or off the image: on this mesh
@@ -280,52 +323,80 @@ def main(argv=None) -> int:
         return clipping.clip_to_image(seg_px[:, 0], seg_px[:, 1], WIDTH, HEIGHT)
 
     on_image = all(bool(clip_all(i)[0].all()) for i in range(n_poses))
-    t_clip = bench_group({
-        "render_frame": lambda i: render_frame(pts_p, e, camera, mats[i]),
-        "clip_every_edge": clip_all,
-    }, **bg)
+    t_clip = bench_group(
+        {
+            "render_frame": lambda i: render_frame(pts_p, e, camera, mats[i]),
+            "clip_every_edge": clip_all,
+        },
+        **bg,
+    )
     p_cams = None
     details["clipping"] = {"timings": t_clip, "every_edge_kept_whole_all_poses": on_image}
-    rows.append({"stage": "clipping every edge (6 planes + image)", "skipped_ms": t_clip["clip_every_edge"]["median_ms"],
-                 "run_ms": t_clip["render_frame"]["median_ms"],
-                 "note": f"clip stage on all {len(e):,} edges {ms(t_clip['clip_every_edge']['median_ms'])} ms, "
-                         f"whole frame {ms(t_clip['render_frame']['median_ms'])} ms; every edge inside (nothing to "
-                         f"clip) in every pose: {on_image}"})
+    rows.append(
+        {
+            "stage": "clipping every edge (6 planes + image)",
+            "skipped_ms": t_clip["clip_every_edge"]["median_ms"],
+            "run_ms": t_clip["render_frame"]["median_ms"],
+            "note": f"clip stage on all {len(e):,} edges {ms(t_clip['clip_every_edge']['median_ms'])} ms, "
+            f"whole frame {ms(t_clip['render_frame']['median_ms'])} ms; every edge inside (nothing to "
+            f"clip) in every pose: {on_image}",
+        }
+    )
     print(f"  core rows done ({time.perf_counter() - t_start:.1f} s)", flush=True)
 
     # ---- 4. pyrender
     pyr = None
     try:
         from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available
+
         ok, msg = osmesa_available()
     except Exception as exc:  # noqa: BLE001
         ok, msg = False, f"{type(exc).__name__}: {exc}"
     if ok:
         pyr = PyrenderScenes(v, e, faces, camera)
         masks = {name: pyr.render(name, mats[0])[0] for name in ("flat", "lit", "faces")}
-        t_pyr = bench_group({name: (lambda i, name=name: pyr.render(name, mats[i]))
-                             for name in ("flat", "lit", "faces")},
-                            n_poses=n_poses, budget_s=cfg["budget_s"], rounds=cfg["rounds"],
-                            max_passes=cfg["max_passes"])
+        t_pyr = bench_group(
+            {name: (lambda i, name=name: pyr.render(name, mats[i])) for name in ("flat", "lit", "faces")},
+            n_poses=n_poses,
+            budget_s=cfg["budget_s"],
+            rounds=cfg["rounds"],
+            max_passes=cfg["max_passes"],
+        )
         pyr.close()
         with PyrenderOracle(WIDTH, HEIGHT) as oracle:
             m_or, _ = oracle.render(v, e, camera, mats[0])
-            t_or = bench_group({"oracle_flat": lambda i: oracle.render(v, e, camera, mats[i])},
-                               n_poses=n_poses, budget_s=cfg["budget_s"], rounds=cfg["rounds"],
-                               max_passes=cfg["max_passes"])
+            t_or = bench_group(
+                {"oracle_flat": lambda i: oracle.render(v, e, camera, mats[i])},
+                n_poses=n_poses,
+                budget_s=cfg["budget_s"],
+                rounds=cfg["rounds"],
+                max_passes=cfg["max_passes"],
+            )
         flat = t_pyr["flat"]["median_ms"]
-        details["pyrender"] = {"timings": {**t_pyr, **t_or},
-                               "pixels_pose0": {k: int(m.sum()) for k, m in masks.items()},
-                               "flat_equals_oracle_pose0": bool(np.array_equal(masks["flat"], m_or))}
-        rows.append({"stage": "pyrender: light + lit shader", "skipped_ms": t_pyr["lit"]["median_ms"] - flat,
-                     "run_ms": flat,
-                     "note": f"DirectionalLight, default flags {ms(t_pyr['lit']['median_ms'])} ms vs FLAT "
-                             f"{ms(flat)} ms (oracle class {ms(t_or['oracle_flat']['median_ms'])} ms; "
-                             f"same pixels as the oracle: {details['pyrender']['flat_equals_oracle_pose0']})"})
-        rows.append({"stage": "pyrender: faces as occluders", "skipped_ms": t_pyr["faces"]["median_ms"] - flat,
-                     "run_ms": flat,
-                     "note": f"{len(faces):,} black triangles, FLAT {ms(t_pyr['faces']['median_ms'])} ms; line "
-                             f"pixels {masks['flat'].sum():,} -> {masks['faces'].sum():,} (hidden lines removed)"})
+        details["pyrender"] = {
+            "timings": {**t_pyr, **t_or},
+            "pixels_pose0": {k: int(m.sum()) for k, m in masks.items()},
+            "flat_equals_oracle_pose0": bool(np.array_equal(masks["flat"], m_or)),
+        }
+        rows.append(
+            {
+                "stage": "pyrender: light + lit shader",
+                "skipped_ms": t_pyr["lit"]["median_ms"] - flat,
+                "run_ms": flat,
+                "note": f"DirectionalLight, default flags {ms(t_pyr['lit']['median_ms'])} ms vs FLAT "
+                f"{ms(flat)} ms (oracle class {ms(t_or['oracle_flat']['median_ms'])} ms; "
+                f"same pixels as the oracle: {details['pyrender']['flat_equals_oracle_pose0']})",
+            }
+        )
+        rows.append(
+            {
+                "stage": "pyrender: faces as occluders",
+                "skipped_ms": t_pyr["faces"]["median_ms"] - flat,
+                "run_ms": flat,
+                "note": f"{len(faces):,} black triangles, FLAT {ms(t_pyr['faces']['median_ms'])} ms; line "
+                f"pixels {masks['flat'].sum():,} -> {masks['faces'].sum():,} (hidden lines removed)",
+            }
+        )
     else:
         details["pyrender"] = {"skipped": msg}
         print(f"  pyrender rows skipped: {msg}")
@@ -340,7 +411,7 @@ def main(argv=None) -> int:
         t_load = {"process_true": [], "process_false": [], "core_load_scene": []}
         for r in range(cfg["load_repeats"]):
             order = ["process_false", "process_true", "core_load_scene"]
-            for name in (order if r % 2 == 0 else order[::-1]):
+            for name in order if r % 2 == 0 else order[::-1]:
                 t0 = time.perf_counter()
                 if name == "core_load_scene":
                     sc = load_scene(str(path))
@@ -349,15 +420,27 @@ def main(argv=None) -> int:
                 t_load[name].append(time.perf_counter() - t0)
         n_loaded = (len(loaded.vertices), len(loaded.faces))
     load_med = {k: float(np.median(x)) * 1e3 for k, x in t_load.items()}
-    details["loading"] = {"file": f"icosphere({cfg['load_subdiv']}) binary PLY", "file_mib": size_mib,
-                          "vertices": len(big.vertices), "faces": len(big.faces), "median_ms": load_med,
-                          "all_ms": {k: [t * 1e3 for t in x] for k, x in t_load.items()},
-                          "core_scene_edges": int(len(sc.edges)), "loaded_last": list(map(int, n_loaded)),
-                          "core_uses": "process=False, maintain_order=True"}
-    rows.append({"stage": "load: trimesh process=True", "skipped_ms": load_med["process_true"] - load_med["process_false"],
-                 "run_ms": load_med["process_false"], "per": "load",
-                 "note": f"{len(big.vertices):,} V PLY ({size_mib:.1f} MiB), once per run; core uses process=False; "
-                         f"core.scene.files.load_scene total {ms(load_med['core_load_scene'])} ms"})
+    details["loading"] = {
+        "file": f"icosphere({cfg['load_subdiv']}) binary PLY",
+        "file_mib": size_mib,
+        "vertices": len(big.vertices),
+        "faces": len(big.faces),
+        "median_ms": load_med,
+        "all_ms": {k: [t * 1e3 for t in x] for k, x in t_load.items()},
+        "core_scene_edges": int(len(sc.edges)),
+        "loaded_last": list(map(int, n_loaded)),
+        "core_uses": "process=False, maintain_order=True",
+    }
+    rows.append(
+        {
+            "stage": "load: trimesh process=True",
+            "skipped_ms": load_med["process_true"] - load_med["process_false"],
+            "run_ms": load_med["process_false"],
+            "per": "load",
+            "note": f"{len(big.vertices):,} V PLY ({size_mib:.1f} MiB), once per run; core uses process=False; "
+            f"core.scene.files.load_scene total {ms(load_med['core_load_scene'])} ms",
+        }
+    )
 
     # ---- table
     print()
@@ -367,15 +450,24 @@ def main(argv=None) -> int:
         r["saving"] = r["skipped_ms"] / (r["run_ms"] + r["skipped_ms"]) if r["run_ms"] + r["skipped_ms"] > 0 else 0.0
         per = " (per load)" if r.get("per") == "load" else ""
         lines.append(f"{r['stage']:<36} {ms(r['skipped_ms']):>15} {ms(r['run_ms']):>12} {r['saving']:>7.1%}{per}")
-    print_table("skipped cost = what the stage would add; run cost = what runs now; "
-                "saving = skipped / (run + skipped)", hdr, lines)
+    print_table(
+        "skipped cost = what the stage would add; run cost = what runs now; saving = skipped / (run + skipped)",
+        hdr,
+        lines,
+    )
     for r in rows:
         print(f"  {r['stage']}: {r['note']}")
     elapsed = print_end(info, t_start)
 
     if args.json:
-        config = {"width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
-                  "mesh": "icosphere(6)", "quick": args.quick, **cfg}
+        config = {
+            "width": WIDTH,
+            "height": HEIGHT,
+            "camera": "camera_z(4.0, fov_y_deg=70)",
+            "mesh": "icosphere(6)",
+            "quick": args.quick,
+            **cfg,
+        }
         write_json(args.json, machine=info, config=config, rows=rows, details=details, elapsed_s=elapsed)
     return 0
 

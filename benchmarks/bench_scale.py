@@ -75,24 +75,23 @@ ROOT = Path(__file__).resolve().parent.parent
 import cv2
 import numpy as np
 import trimesh
-
 from _common import fmt_ms, machine_info, print_end, print_machine, print_table, verdict, write_json
-from wirecheck.core.projector import raster
 from wirecheck.core.camera import camera_z
+from wirecheck.core.projector import raster
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import cam_to_px, depth_mask, localize, model_to_cam
-from wirecheck.core.scene.model import unique_edges
 from wirecheck.core.scene.files import load_scene
+from wirecheck.core.scene.model import unique_edges
 from wirecheck.core.transforms import Motion
 
 WIDTH, HEIGHT = 1280, 960
-FRAMES = 180                     # Motion() period; poses are frames of it
-PROJ_SPEEDUP_TARGET = 5.0        # ours f64 >= 5x faster than cv2.projectPoints at 1M points
-AGREE_TARGET_PX = 1e-9           # max |ours f64 - cv2.projectPoints|
-RASTER_RATIO_TARGET = 2.0        # ours raster <= 2x cv2.polylines at the largest size
-SLOPE_LIMIT = 1.15               # log-log slope of time vs V + E (1 = linear)
-RSS_GROWTH_LIMIT_MIB = 8.0       # RSS after the last frame - after frame 10
-TRACED_GROWTH_LIMIT_KIB = 64.0   # tracemalloc current after the last frame - after frame 10
+FRAMES = 180  # Motion() period; poses are frames of it
+PROJ_SPEEDUP_TARGET = 5.0  # ours f64 >= 5x faster than cv2.projectPoints at 1M points
+AGREE_TARGET_PX = 1e-9  # max |ours f64 - cv2.projectPoints|
+RASTER_RATIO_TARGET = 2.0  # ours raster <= 2x cv2.polylines at the largest size
+SLOPE_LIMIT = 1.15  # log-log slope of time vs V + E (1 = linear)
+RSS_GROWTH_LIMIT_MIB = 8.0  # RSS after the last frame - after frame 10
+TRACED_GROWTH_LIMIT_KIB = 64.0  # tracemalloc current after the last frame - after frame 10
 
 
 # ---------------------------------------------------------------- meshes
@@ -113,7 +112,7 @@ def icosphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
     v = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
     f = np.asarray(mesh.faces, dtype=np.int64)
     e = fast_unique_edges(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), len(v))
-    if subdivisions <= 5:         # same set as core's own unique_edges
+    if subdivisions <= 5:  # same set as core's own unique_edges
         assert np.array_equal(e, unique_edges(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)))
     return v, e
 
@@ -123,8 +122,12 @@ def grid(n: int) -> tuple[np.ndarray, np.ndarray]:
     x, y = np.meshgrid(u, u)
     v = np.stack([x.ravel(), y.ravel(), 0.1 * np.sin(3 * x.ravel()) * np.cos(3 * y.ravel())], axis=1)
     idx = np.arange(n * n, dtype=np.intp).reshape(n, n)
-    e = np.concatenate([np.stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()], axis=1),
-                        np.stack([idx[:-1, :].ravel(), idx[1:, :].ravel()], axis=1)])
+    e = np.concatenate(
+        [
+            np.stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()], axis=1),
+            np.stack([idx[:-1, :].ravel(), idx[1:, :].ravel()], axis=1),
+        ]
+    )
     return np.ascontiguousarray(v), e
 
 
@@ -136,8 +139,16 @@ def mesh_list(quick: bool) -> list[tuple[str, str, object]]:
     else:
         ico = tuple(range(9))
         grids = (3, 10, 32, 100, 316, 1000)
-    out = [("cube", "cube", lambda: (np.ascontiguousarray(load_scene("cube").vertices, dtype=np.float64),
-                                     np.asarray(load_scene("cube").edges, dtype=np.intp)))]
+    out = [
+        (
+            "cube",
+            "cube",
+            lambda: (
+                np.ascontiguousarray(load_scene("cube").vertices, dtype=np.float64),
+                np.asarray(load_scene("cube").edges, dtype=np.intp),
+            ),
+        )
+    ]
     out += [(f"ico{s}", "icosphere", (lambda s=s: icosphere(s))) for s in ico]
     out += [(f"grid{n}", "grid", (lambda n=n: grid(n))) for n in grids]
     return out
@@ -155,9 +166,11 @@ class OpenBLAS:
                 lib = ctypes.CDLL(path)
             except OSError:
                 continue
-            for s_name, g_name in (("scipy_openblas_set_num_threads64_", "scipy_openblas_get_num_threads64_"),
-                                   ("openblas_set_num_threads64_", "openblas_get_num_threads64_"),
-                                   ("openblas_set_num_threads", "openblas_get_num_threads")):
+            for s_name, g_name in (
+                ("scipy_openblas_set_num_threads64_", "scipy_openblas_get_num_threads64_"),
+                ("openblas_set_num_threads64_", "openblas_get_num_threads64_"),
+                ("openblas_set_num_threads", "openblas_get_num_threads"),
+            ):
                 if hasattr(lib, s_name) and hasattr(lib, g_name):
                     self.set, self.get = getattr(lib, s_name), getattr(lib, g_name)
                     self.set.argtypes = [ctypes.c_int]
@@ -177,7 +190,7 @@ def ours_project(points, m, camera) -> np.ndarray:
     """render_frame's projection, line for line: model-view, depth test, pixels, float64."""
     p_cam = model_to_cam(points, m, camera)
     visible = depth_mask(p_cam, camera)
-    if visible.all():                      # as render_frame: no gather/scatter when all are visible
+    if visible.all():  # as render_frame: no gather/scatter when all are visible
         p_px = cam_to_px(p_cam, camera)
     else:
         p_px = np.full((len(points), 2), np.nan, dtype=p_cam.dtype)
@@ -243,14 +256,20 @@ def bench_group(impls: dict, n_poses: int, budget_s: float, rounds: int, max_pas
         times = {name: [] for name in impls}
         order = list(impls)
         for r in range(rounds):
-            for name in (order if r % 2 == 0 else order[::-1]):
+            for name in order if r % 2 == 0 else order[::-1]:
                 times[name] += time_calls(impls[name], poses, passes[name])
     finally:
         if gc_was_on:
             gc.enable()
-    return {name: {"median_ms": float(np.median(t)) * 1e3, "min_ms": float(np.min(t)) * 1e3,
-                   "p90_ms": float(np.percentile(t, 90)) * 1e3, "calls": len(t)}
-            for name, t in times.items()}
+    return {
+        name: {
+            "median_ms": float(np.median(t)) * 1e3,
+            "min_ms": float(np.min(t)) * 1e3,
+            "p90_ms": float(np.percentile(t, 90)) * 1e3,
+            "calls": len(t),
+        }
+        for name, t in times.items()
+    }
 
 
 def slope(xs, ys) -> float | None:
@@ -273,8 +292,9 @@ def bench_mesh(name, family, v, e, camera, matrices, cfg, blas) -> dict:
 
     # ---- checks, outside the timing: fast path, agreement
     px = [ours_project(lp64, m, camera) for m in mats]
-    on = [np.all((p[:, 0] >= -0.5) & (p[:, 0] <= WIDTH - 0.5) & (p[:, 1] >= -0.5) & (p[:, 1] <= HEIGHT - 0.5))
-          for p in px]
+    on = [
+        np.all((p[:, 0] >= -0.5) & (p[:, 0] <= WIDTH - 0.5) & (p[:, 1] >= -0.5) & (p[:, 1] <= HEIGHT - 0.5)) for p in px
+    ]
     res["poses_through_clipping"] = int(sum(not o for o in on))
     d64 = d32 = dxf = 0.0
     for m, p in zip(mats, px):
@@ -287,7 +307,7 @@ def bench_mesh(name, family, v, e, camera, matrices, cfg, blas) -> dict:
 
     big = n_v >= 1_000_000
     budget = cfg["budget_s"]
-    rounds = cfg["rounds"] if not big else min(cfg["rounds"], 2)      # 1M: 2 rounds of 2 poses
+    rounds = cfg["rounds"] if not big else min(cfg["rounds"], 2)  # 1M: 2 rounds of 2 poses
     max_passes = cfg["max_passes"]
 
     # ---- projection
@@ -306,6 +326,7 @@ def bench_mesh(name, family, v, e, camera, matrices, cfg, blas) -> dict:
                 return ours_project(lp64, mats[i], camera)
             finally:
                 blas.set(default_threads)
+
         proj["ours_f64_1thr"] = one_thread
     res["projection"] = bench_group(proj, n_poses, budget, rounds, max_passes)
 
@@ -348,8 +369,13 @@ def bench_mesh(name, family, v, e, camera, matrices, cfg, blas) -> dict:
             cv2.polylines(img, segs8[i], False, 255, 1, cv2.LINE_AA, 8)
             return img
 
-        rast = {"ours_exact": r_exact, "ours_fast": r_fast, "ours_aa": r_aa,
-                "cv2_LINE_8": cv_l8, "cv2_LINE_8_shift8": cv_l8s8}
+        rast = {
+            "ours_exact": r_exact,
+            "ours_fast": r_fast,
+            "ours_aa": r_aa,
+            "cv2_LINE_8": cv_l8,
+            "cv2_LINE_8_shift8": cv_l8s8,
+        }
         if cfg["cv_aa"]:
             rast["cv2_LINE_AA_shift8"] = cv_aa
         res["raster"] = bench_group(rast, n_poses, budget, rounds, max_passes)
@@ -362,8 +388,11 @@ def bench_mesh(name, family, v, e, camera, matrices, cfg, blas) -> dict:
         def iou(a, b):
             u = int((a | b).sum())
             return int((a & b).sum()) / u if u else 1.0
+
         res["raster_pixels_pose0"] = {
-            "ours_exact": int(a_ex.sum()), "cv2_LINE_8": int(b8.sum()), "cv2_LINE_8_shift8": int(b8s.sum()),
+            "ours_exact": int(a_ex.sum()),
+            "cv2_LINE_8": int(b8.sum()),
+            "cv2_LINE_8_shift8": int(b8s.sum()),
             "iou_exact_vs_cv2_shift8": iou(a_ex, b8s),
             "iou_fast_vs_cv2_LINE_8": iou(a_fast, b8),
         }
@@ -437,17 +466,25 @@ def memory_child(spec: dict) -> dict:
     v, e = grid(spec["grid"])
     lp = localize(v, "float64")
     k = cv_intrinsics(camera)
-    out = {"impl": impl, "mesh": f"grid{spec['grid']}", "vertices": len(v), "edges": len(e),
-           "input_mib": (v.nbytes + e.nbytes) / 2**20, "raster": spec.get("raster", "exact")}
+    out = {
+        "impl": impl,
+        "mesh": f"grid{spec['grid']}",
+        "vertices": len(v),
+        "edges": len(e),
+        "input_mib": (v.nbytes + e.nbytes) / 2**20,
+        "raster": spec.get("raster", "exact"),
+    }
     gc.collect()
     out["hwm_setup_mib"] = hwm_mib()
     out["hwm_reset"] = reset_hwm()
     out["rss_setup_mib"] = rss_mib()
 
     if impl == "ours":
+
         def frame(m):
             return render_frame(lp, e, camera, m, raster=out["raster"]).image
     else:
+
         def frame(m):
             pts = np.rint(cv_project(v, m, camera, k)).astype(np.int32)
             img = np.zeros((HEIGHT, WIDTH), np.uint8)
@@ -474,7 +511,7 @@ def memory_child(spec: dict) -> dict:
             else:
                 mark = {}
             gc.collect()
-            hwm = hwm_mib()                 # before malloc_trim, which does not lower it anyway
+            hwm = hwm_mib()  # before malloc_trim, which does not lower it anyway
             malloc_trim()
             mark.update({"rss_mib": rss_mib(), "hwm_mib": hwm})
             if trace:
@@ -503,20 +540,30 @@ def run_child(spec: dict) -> dict:
 # ---------------------------------------------------------------- machine
 def blas_info(blas: OpenBLAS) -> dict:
     """:func:`_common.machine_info` with OpenBLAS's thread count and the BLAS environment variables."""
-    return machine_info(openblas_threads=blas.threads(),
-                        blas_env={k: os.environ[k] for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
-                                                             "MKL_NUM_THREADS") if k in os.environ})
+    return machine_info(
+        openblas_threads=blas.threads(),
+        blas_env={
+            k: os.environ[k] for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS") if k in os.environ
+        },
+    )
 
 
 # ---------------------------------------------------------------- main
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--quick", action="store_true",
-                    help="fewer meshes, poses and repeats; at 1M vertices no raster row and only the exact frame")
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="fewer meshes, poses and repeats; at 1M vertices no raster row and only the exact frame",
+    )
     ap.add_argument("--json", metavar="PATH", help="also write the results as JSON to PATH")
-    ap.add_argument("--growth-grid", type=int, metavar="N",
-                    help="grid size n (n x n vertices) of the 200-frame growth test (default 316, --quick 224; "
-                         "1000 = 1M vertices, about 4 minutes)")
+    ap.add_argument(
+        "--growth-grid",
+        type=int,
+        metavar="N",
+        help="grid size n (n x n vertices) of the 200-frame growth test (default 316, --quick 224; "
+        "1000 = 1M vertices, about 4 minutes)",
+    )
     ap.add_argument("--memory-child", metavar="SPEC", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.memory_child:
@@ -525,13 +572,41 @@ def main(argv=None) -> int:
 
     t_start = time.perf_counter()
     blas = OpenBLAS()
-    cfg = ({"budget_s": 0.04, "rounds": 3, "max_passes": 25, "poses_small": 4, "poses_100k": 2, "poses_1m": 1, "skip_1m_raster": True,
-            "skip_1m_frame": False, "frame_1m_exact_only": True, "cv_aa": False, "frame_aa": False,
-            "growth": {"grid": 224, "frames": 200}, "peak": {"grid": 1000, "frames": 2}, "cv_peak": False}
-           if args.quick else
-           {"budget_s": 0.25, "rounds": 3, "max_passes": 200, "poses_small": 8, "poses_100k": 4, "poses_1m": 2, "skip_1m_raster": False,
-            "skip_1m_frame": False, "frame_1m_exact_only": False, "cv_aa": True, "frame_aa": True,
-            "growth": {"grid": 316, "frames": 200}, "peak": {"grid": 1000, "frames": 3}, "cv_peak": True})
+    cfg = (
+        {
+            "budget_s": 0.04,
+            "rounds": 3,
+            "max_passes": 25,
+            "poses_small": 4,
+            "poses_100k": 2,
+            "poses_1m": 1,
+            "skip_1m_raster": True,
+            "skip_1m_frame": False,
+            "frame_1m_exact_only": True,
+            "cv_aa": False,
+            "frame_aa": False,
+            "growth": {"grid": 224, "frames": 200},
+            "peak": {"grid": 1000, "frames": 2},
+            "cv_peak": False,
+        }
+        if args.quick
+        else {
+            "budget_s": 0.25,
+            "rounds": 3,
+            "max_passes": 200,
+            "poses_small": 8,
+            "poses_100k": 4,
+            "poses_1m": 2,
+            "skip_1m_raster": False,
+            "skip_1m_frame": False,
+            "frame_1m_exact_only": False,
+            "cv_aa": True,
+            "frame_aa": True,
+            "growth": {"grid": 316, "frames": 200},
+            "peak": {"grid": 1000, "frames": 3},
+            "cv_peak": True,
+        }
+    )
     if args.growth_grid:
         cfg["growth"]["grid"] = args.growth_grid
     camera = make_camera()
@@ -539,23 +614,31 @@ def main(argv=None) -> int:
     matrices = [motion.frame_matrix(i, FRAMES) for i in range(1, FRAMES + 1)]
     info = blas_info(blas)
 
-    print_machine("wirecheck scale benchmark", info, libraries=(
-        f"python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}"
-        f"{', env ' + str(info['blas_env']) if info['blas_env'] else ''}), cv2 {info['cv2']} "
-        f"(threads {info['cv2_threads']}), trimesh {info['trimesh']}"))
+    print_machine(
+        "wirecheck scale benchmark",
+        info,
+        libraries=(
+            f"python {info['python']}, numpy {info['numpy']} (OpenBLAS threads {info['openblas_threads']}"
+            f"{', env ' + str(info['blas_env']) if info['blas_env'] else ''}), cv2 {info['cv2']} "
+            f"(threads {info['cv2_threads']}), trimesh {info['trimesh']}"
+        ),
+    )
     print(f"  camera_z(4.0, fov_y_deg=70) {WIDTH}x{HEIGHT}, Motion() poses; raster modes: exact, fast, aa")
-    print(f"  mode: {'quick' if args.quick else 'full'}; per implementation and mesh: {cfg['rounds']} rounds, "
-          f"passes over the poses from a {cfg['budget_s']:g} s budget (max {cfg['max_passes']})")
+    print(
+        f"  mode: {'quick' if args.quick else 'full'}; per implementation and mesh: {cfg['rounds']} rounds, "
+        f"passes over the poses from a {cfg['budget_s']:g} s budget (max {cfg['max_passes']})"
+    )
     print(flush=True)
 
     # Memory first, in child processes: on Linux a child's ru_maxrss can start at
     # the parent's RSS, so the parent should still be small.
     mem = {"ours_peak": run_child({"impl": "ours", "grid": cfg["peak"]["grid"], "frames": cfg["peak"]["frames"]})}
     if cfg["cv_peak"]:
-        mem["opencv_peak"] = run_child({"impl": "opencv", "grid": cfg["peak"]["grid"],
-                                        "frames": cfg["peak"]["frames"], "trace": False})
+        mem["opencv_peak"] = run_child(
+            {"impl": "opencv", "grid": cfg["peak"]["grid"], "frames": cfg["peak"]["frames"], "trace": False}
+        )
     mem["ours_growth"] = run_child({"impl": "ours", "grid": cfg["growth"]["grid"], "frames": cfg["growth"]["frames"]})
-    for child in mem.values():   # JSON turned the checkpoint keys into strings
+    for child in mem.values():  # JSON turned the checkpoint keys into strings
         child["marks"] = {int(i): mk for i, mk in child["marks"].items()}
     print(f"  memory children done ({time.perf_counter() - t_start:.1f} s)", flush=True)
 
@@ -567,32 +650,59 @@ def main(argv=None) -> int:
         res["bench_s"] = time.perf_counter() - t0
         results.append(res)
         p = res["projection"]
-        print(f"  {name:<9} V={len(v):>9,} E={len(e):>9,}  proj f64 {fmt_ms(p['ours_f64']['median_ms'])} ms, "
-              f"cv2 {fmt_ms(p['cv2_projectPoints']['median_ms'])} ms  ({res['bench_s']:.1f} s)", flush=True)
+        print(
+            f"  {name:<9} V={len(v):>9,} E={len(e):>9,}  proj f64 {fmt_ms(p['ours_f64']['median_ms'])} ms, "
+            f"cv2 {fmt_ms(p['cv2_projectPoints']['median_ms'])} ms  ({res['bench_s']:.1f} s)",
+            flush=True,
+        )
         del v, e
         gc.collect()
     print()
 
     # ---- tables
-    proj_cols = [("ours_f64", "f64"), ("ours_f64_1thr", "f64 1thr"), ("ours_f32", "f32"),
-                 ("cv2_projectPoints", "cv2.pP"), ("cv2_transform", "cv2.xf")]
-    hdr = (f"{'mesh':<9} {'V':>9} {'E':>9} | " + " ".join(f"{h:>9}" for _, h in proj_cols)
-           + f" | {'pP/f64':>7} {'max|d| f64':>10} {'f32':>8} {'cv2.xf':>8}")
+    proj_cols = [
+        ("ours_f64", "f64"),
+        ("ours_f64_1thr", "f64 1thr"),
+        ("ours_f32", "f32"),
+        ("cv2_projectPoints", "cv2.pP"),
+        ("cv2_transform", "cv2.xf"),
+    ]
+    hdr = (
+        f"{'mesh':<9} {'V':>9} {'E':>9} | "
+        + " ".join(f"{h:>9}" for _, h in proj_cols)
+        + f" | {'pP/f64':>7} {'max|d| f64':>10} {'f32':>8} {'cv2.xf':>8}"
+    )
     rows = []
     for r in results:
         p = r["projection"]
         cells = " ".join(f"{fmt_ms(p[c]['median_ms']) if c in p else '-':>9}" for c, _ in proj_cols)
         d = r["max_abs_diff_px"]
-        rows.append(f"{r['name']:<9} {r['vertices']:>9,} {r['edges']:>9,} | {cells} | "
-                    f"{p['cv2_projectPoints']['median_ms'] / p['ours_f64']['median_ms']:>7.2f} "
-                    f"{d['ours_f64']:>10.1e} {d['ours_f32']:>8.1e} {d['cv2_transform']:>8.1e}")
-    print_table("projection, model space -> (N, 2) pixels, median ms per call (pP = cv2.projectPoints, "
-                "xf = cv2.transform + convertPointsFromHomogeneous; max|d| = px vs cv2.pP)", hdr, rows)
+        rows.append(
+            f"{r['name']:<9} {r['vertices']:>9,} {r['edges']:>9,} | {cells} | "
+            f"{p['cv2_projectPoints']['median_ms'] / p['ours_f64']['median_ms']:>7.2f} "
+            f"{d['ours_f64']:>10.1e} {d['ours_f32']:>8.1e} {d['cv2_transform']:>8.1e}"
+        )
+    print_table(
+        "projection, model space -> (N, 2) pixels, median ms per call (pP = cv2.projectPoints, "
+        "xf = cv2.transform + convertPointsFromHomogeneous; max|d| = px vs cv2.pP)",
+        hdr,
+        rows,
+    )
 
-    rast_cols = [("ours_exact", "exact"), ("ours_fast", "fast"), ("ours_aa", "aa"),
-                 ("cv2_LINE_8", "cv2 L8"), ("cv2_LINE_8_shift8", "cv2 L8 s8"), ("cv2_LINE_AA_shift8", "cv2 AA s8")]
-    hdr = (f"{'mesh':<9} {'E':>9} | " + " ".join(f"{h:>9}" for _, h in rast_cols)
-           + f" | {'fast/L8':>7} {'exact/s8':>8} {'aa/AA':>6}")
+    rast_cols = [
+        ("ours_exact", "exact"),
+        ("ours_fast", "fast"),
+        ("ours_aa", "aa"),
+        ("cv2_LINE_8", "cv2 L8"),
+        ("cv2_LINE_8_shift8", "cv2 L8 s8"),
+        ("cv2_LINE_AA_shift8", "cv2 AA s8"),
+    ]
+    hdr = (
+        f"{'mesh':<9} {'E':>9} | "
+        + " ".join(f"{h:>9}" for _, h in rast_cols)
+        + f" | {'fast/L8':>7} {'exact/s8':>8} {'aa/AA':>6}"
+    )
+
     def raster_row(r):
         if "raster" not in r:
             return f"{r['name']:<9} {r['edges']:>9,} | (skipped in --quick)"
@@ -601,31 +711,45 @@ def main(argv=None) -> int:
 
         def ratio(a, b):
             return f"{q[a]['median_ms'] / q[b]['median_ms']:.2f}" if a in q and b in q else "-"
-        return (f"{r['name']:<9} {r['edges']:>9,} | {cells} | {ratio('ours_fast', 'cv2_LINE_8'):>7} "
-                f"{ratio('ours_exact', 'cv2_LINE_8_shift8'):>8} {ratio('ours_aa', 'cv2_LINE_AA_shift8'):>6}")
-    print_table(f"raster, pixel ends -> ({HEIGHT}, {WIDTH}) uint8 image incl. np.zeros, median ms per call "
-                "(L8 = cv2.polylines LINE_8 on rounded ends, s8 = shift=8 ends in 1/256 px)",
-                hdr, [raster_row(r) for r in results])
+
+        return (
+            f"{r['name']:<9} {r['edges']:>9,} | {cells} | {ratio('ours_fast', 'cv2_LINE_8'):>7} "
+            f"{ratio('ours_exact', 'cv2_LINE_8_shift8'):>8} {ratio('ours_aa', 'cv2_LINE_AA_shift8'):>6}"
+        )
+
+    print_table(
+        f"raster, pixel ends -> ({HEIGHT}, {WIDTH}) uint8 image incl. np.zeros, median ms per call "
+        "(L8 = cv2.polylines LINE_8 on rounded ends, s8 = shift=8 ends in 1/256 px)",
+        hdr,
+        [raster_row(r) for r in results],
+    )
 
     frame_cols = [("render_frame_exact", "exact"), ("render_frame_fast", "fast"), ("render_frame_aa", "aa")]
     hdr = f"{'mesh':<9} {'V+E':>10} | " + " ".join(f"{h:>9}" for _, h in frame_cols) + " | clip poses"
+
     def frame_row(r):
         if "frame" not in r:
             return f"{r['name']:<9} {r['vertices'] + r['edges']:>10,} | (skipped in --quick)"
         f = r["frame"]
         cells = " ".join(f"{fmt_ms(f[c]['median_ms']) if c in f else '-':>9}" for c, _ in frame_cols)
-        return (f"{r['name']:<9} {r['vertices'] + r['edges']:>10,} | {cells} | "
-                f"{r['poses_through_clipping']}/{r['poses']}")
-    print_table("whole frame, render_frame(LocalPoints, ...), median ms per call",
-                hdr, [frame_row(r) for r in results])
+        return (
+            f"{r['name']:<9} {r['vertices'] + r['edges']:>10,} | {cells} | {r['poses_through_clipping']}/{r['poses']}"
+        )
+
+    print_table("whole frame, render_frame(LocalPoints, ...), median ms per call", hdr, [frame_row(r) for r in results])
 
     # ---- slopes
     slopes = {}
     big = [r for r in results if r["vertices"] >= 10_000]
-    stage_impls = ([("projection", c) for c, _ in proj_cols] + [("raster", c) for c, _ in rast_cols]
-                   + [("frame", c) for c, _ in frame_cols])
-    print("log-log slope of median time against V + E, meshes with >= 10,000 vertices "
-          f"(all / icospheres / grids; PASS when the 'all' slope <= {SLOPE_LIMIT})")
+    stage_impls = (
+        [("projection", c) for c, _ in proj_cols]
+        + [("raster", c) for c, _ in rast_cols]
+        + [("frame", c) for c, _ in frame_cols]
+    )
+    print(
+        "log-log slope of median time against V + E, meshes with >= 10,000 vertices "
+        f"(all / icospheres / grids; PASS when the 'all' slope <= {SLOPE_LIMIT})"
+    )
     for stage, impl in stage_impls:
         row = {}
         for fam in ("all", "icosphere", "grid"):
@@ -636,24 +760,32 @@ def main(argv=None) -> int:
             continue
         slopes[f"{stage}.{impl}"] = row
         tag = verdict(row["all"] <= SLOPE_LIMIT) if impl.startswith(("ours", "render")) else "(ref)"
-        print(f"  {stage:<10} {impl:<20} {row['all']:6.3f} / "
-              f"{row['icosphere'] if row['icosphere'] is not None else float('nan'):6.3f} / "
-              f"{row['grid'] if row['grid'] is not None else float('nan'):6.3f}   "
-              f"(n={row['all_n']})  {tag}")
+        print(
+            f"  {stage:<10} {impl:<20} {row['all']:6.3f} / "
+            f"{row['icosphere'] if row['icosphere'] is not None else float('nan'):6.3f} / "
+            f"{row['grid'] if row['grid'] is not None else float('nan'):6.3f}   "
+            f"(n={row['all_n']})  {tag}"
+        )
     # the exact frame over the whole range, 8 .. 10^6 vertices: the fixed cost of a
     # call (~0.2 ms) dominates the small meshes, so this slope is below the one above;
     # linear means no size at which the cost per element grows
     full = [r for r in results if "frame" in r and "render_frame_exact" in r["frame"]]
     xs = [r["vertices"] + r["edges"] for r in full]
     ys = [r["frame"]["render_frame_exact"]["median_ms"] for r in full]
-    slopes["frame.render_frame_exact.whole_range"] = {"all": slope(xs, ys), "all_n": len(full),
-                                                      "vertices": [min(r["vertices"] for r in full),
-                                                                   max(r["vertices"] for r in full)]}
+    slopes["frame.render_frame_exact.whole_range"] = {
+        "all": slope(xs, ys),
+        "all_n": len(full),
+        "vertices": [min(r["vertices"] for r in full), max(r["vertices"] for r in full)],
+    }
     row = slopes["frame.render_frame_exact.whole_range"]
-    print(f"  frame      render_frame_exact, all {row['all_n']} meshes, {row['vertices'][0]:,} .. "
-          f"{row['vertices'][1]:,} vertices: slope {row['all']:.3f}  {verdict(row['all'] <= SLOPE_LIMIT)}")
-    print("  cost per vertex + edge, exact frame: " + ", ".join(
-        f"{r['name']} {y * 1e6 / x:.0f} ns" for r, x, y in sorted(zip(full, xs, ys), key=lambda t: t[1])))
+    print(
+        f"  frame      render_frame_exact, all {row['all_n']} meshes, {row['vertices'][0]:,} .. "
+        f"{row['vertices'][1]:,} vertices: slope {row['all']:.3f}  {verdict(row['all'] <= SLOPE_LIMIT)}"
+    )
+    print(
+        "  cost per vertex + edge, exact frame: "
+        + ", ".join(f"{r['name']} {y * 1e6 / x:.0f} ns" for r, x, y in sorted(zip(full, xs, ys), key=lambda t: t[1]))
+    )
     print(flush=True)
 
     # ---- memory (measured first, see above)
@@ -662,30 +794,44 @@ def main(argv=None) -> int:
         if key not in mem:
             continue
         pk = mem[key]
-        who = ("ours, render_frame exact" if key == "ours_peak"
-               else "opencv, projectPoints + rint + gather + polylines LINE_8")
-        traced = (f"; tracemalloc peak of frame 1 {pk['traced_peak_frame1_mib']:.0f} MiB"
-                  if "traced_peak_frame1_mib" in pk else "; tracemalloc does not see OpenCV's buffers")
-        print(f"  {who}: {pk['mesh']} ({pk['vertices']:,} V, {pk['edges']:,} E; inputs {pk['input_mib']:.0f} MiB), "
-              f"{pk['frames']} frames: peak RSS {pk['hwm_mib']:.0f} MiB = {pk['rss_setup_mib']:.0f} MiB after setup "
-              f"+ {pk['hwm_mib'] - pk['rss_setup_mib']:.0f} MiB for the frames (ru_maxrss {pk['maxrss_mib']:.0f} MiB)"
-              f"{traced}")
+        who = (
+            "ours, render_frame exact"
+            if key == "ours_peak"
+            else "opencv, projectPoints + rint + gather + polylines LINE_8"
+        )
+        traced = (
+            f"; tracemalloc peak of frame 1 {pk['traced_peak_frame1_mib']:.0f} MiB"
+            if "traced_peak_frame1_mib" in pk
+            else "; tracemalloc does not see OpenCV's buffers"
+        )
+        print(
+            f"  {who}: {pk['mesh']} ({pk['vertices']:,} V, {pk['edges']:,} E; inputs {pk['input_mib']:.0f} MiB), "
+            f"{pk['frames']} frames: peak RSS {pk['hwm_mib']:.0f} MiB = {pk['rss_setup_mib']:.0f} MiB after setup "
+            f"+ {pk['hwm_mib'] - pk['rss_setup_mib']:.0f} MiB for the frames (ru_maxrss {pk['maxrss_mib']:.0f} MiB)"
+            f"{traced}"
+        )
     growth = mem["ours_growth"]
     g = cfg["growth"]
     m10, mlast = growth["marks"][10], growth["marks"][g["frames"]]
     d_rss = mlast["rss_mib"] - m10["rss_mib"]
     d_tr = mlast["traced_current_kib"] - m10["traced_current_kib"]
     d_tr_raw = mlast["traced_current_before_collect_kib"] - m10["traced_current_before_collect_kib"]
-    print(f"  ours, {growth['mesh']} ({growth['vertices']:,} V, {growth['edges']:,} E), {g['frames']} frames in "
-          f"{growth['seconds']:.1f} s (tracemalloc on); frame results dropped each frame; RSS read after "
-          "gc.collect() and malloc_trim(0):")
+    print(
+        f"  ours, {growth['mesh']} ({growth['vertices']:,} V, {growth['edges']:,} E), {g['frames']} frames in "
+        f"{growth['seconds']:.1f} s (tracemalloc on); frame results dropped each frame; RSS read after "
+        "gc.collect() and malloc_trim(0):"
+    )
     for i, mk in growth["marks"].items():
-        print(f"    after frame {int(i):>3}: RSS {mk['rss_mib']:8.1f} MiB, peak RSS {mk['hwm_mib']:8.1f} MiB, "
-              f"tracemalloc current {mk['traced_current_kib']:9.1f} KiB "
-              f"(before gc.collect {mk['traced_current_before_collect_kib']:9.1f} KiB)")
-    print(f"    growth frame 10 -> {g['frames']}: RSS {d_rss:+.2f} MiB (peak RSS {mlast['hwm_mib'] - m10['hwm_mib']:+.2f} MiB), "
-          f"tracemalloc {d_tr:+.2f} KiB after gc.collect() "
-          f"({d_tr_raw:+.2f} KiB before it: CPython free lists, bounded)")
+        print(
+            f"    after frame {int(i):>3}: RSS {mk['rss_mib']:8.1f} MiB, peak RSS {mk['hwm_mib']:8.1f} MiB, "
+            f"tracemalloc current {mk['traced_current_kib']:9.1f} KiB "
+            f"(before gc.collect {mk['traced_current_before_collect_kib']:9.1f} KiB)"
+        )
+    print(
+        f"    growth frame 10 -> {g['frames']}: RSS {d_rss:+.2f} MiB (peak RSS {mlast['hwm_mib'] - m10['hwm_mib']:+.2f} MiB), "
+        f"tracemalloc {d_tr:+.2f} KiB after gc.collect() "
+        f"({d_tr_raw:+.2f} KiB before it: CPython free lists, bounded)"
+    )
     print()
 
     # ---- targets
@@ -693,41 +839,71 @@ def main(argv=None) -> int:
     r1m = one_m[-1]
     p1m = r1m["projection"]
     speedup = p1m["cv2_projectPoints"]["median_ms"] / p1m["ours_f64"]["median_ms"]
-    speedup_1thr = (p1m["cv2_projectPoints"]["median_ms"] / p1m["ours_f64_1thr"]["median_ms"]
-                    if "ours_f64_1thr" in p1m else None)
+    speedup_1thr = (
+        p1m["cv2_projectPoints"]["median_ms"] / p1m["ours_f64_1thr"]["median_ms"] if "ours_f64_1thr" in p1m else None
+    )
     agree_1m = r1m["max_abs_diff_px"]["ours_f64"]
     agree_all = max(r["max_abs_diff_px"]["ours_f64"] for r in results)
     rast_big = [r for r in results if "raster" in r][-1]
     q = rast_big["raster"]
     targets = [
-        {"name": f"projection {r1m['name']} f64 >= {PROJ_SPEEDUP_TARGET:g}x faster than cv2.projectPoints",
-         "ours_ms": p1m["ours_f64"]["median_ms"], "cv2_ms": p1m["cv2_projectPoints"]["median_ms"],
-         "speedup": speedup, "pass": speedup >= PROJ_SPEEDUP_TARGET},
-        {"name": f"projection {r1m['name']} f64 agrees with cv2.projectPoints within {AGREE_TARGET_PX:g} px",
-         "max_abs_diff_px": agree_1m, "max_abs_diff_px_all_sizes": agree_all, "pass": agree_1m <= AGREE_TARGET_PX},
+        {
+            "name": f"projection {r1m['name']} f64 >= {PROJ_SPEEDUP_TARGET:g}x faster than cv2.projectPoints",
+            "ours_ms": p1m["ours_f64"]["median_ms"],
+            "cv2_ms": p1m["cv2_projectPoints"]["median_ms"],
+            "speedup": speedup,
+            "pass": speedup >= PROJ_SPEEDUP_TARGET,
+        },
+        {
+            "name": f"projection {r1m['name']} f64 agrees with cv2.projectPoints within {AGREE_TARGET_PX:g} px",
+            "max_abs_diff_px": agree_1m,
+            "max_abs_diff_px_all_sizes": agree_all,
+            "pass": agree_1m <= AGREE_TARGET_PX,
+        },
     ]
     if speedup_1thr is not None:
-        targets.append({"name": "(info) same with OpenBLAS at 1 thread",
-                        "ours_ms": p1m["ours_f64_1thr"]["median_ms"], "speedup": speedup_1thr,
-                        "pass": speedup_1thr >= PROJ_SPEEDUP_TARGET, "info": True})
-    for ours, cv, label in (("ours_fast", "cv2_LINE_8", "fast vs cv2.polylines LINE_8 (rounded ends)"),
-                            ("ours_exact", "cv2_LINE_8_shift8", "exact vs cv2.polylines LINE_8 shift=8"),
-                            ("ours_exact", "cv2_LINE_8", "exact vs cv2.polylines LINE_8 (rounded ends)")):
+        targets.append(
+            {
+                "name": "(info) same with OpenBLAS at 1 thread",
+                "ours_ms": p1m["ours_f64_1thr"]["median_ms"],
+                "speedup": speedup_1thr,
+                "pass": speedup_1thr >= PROJ_SPEEDUP_TARGET,
+                "info": True,
+            }
+        )
+    for ours, cv, label in (
+        ("ours_fast", "cv2_LINE_8", "fast vs cv2.polylines LINE_8 (rounded ends)"),
+        ("ours_exact", "cv2_LINE_8_shift8", "exact vs cv2.polylines LINE_8 shift=8"),
+        ("ours_exact", "cv2_LINE_8", "exact vs cv2.polylines LINE_8 (rounded ends)"),
+    ):
         if ours in q and cv in q:
             ratio = q[ours]["median_ms"] / q[cv]["median_ms"]
-            targets.append({"name": f"raster {rast_big['name']} {label} <= {RASTER_RATIO_TARGET:g}x",
-                            "ours_ms": q[ours]["median_ms"], "cv2_ms": q[cv]["median_ms"], "ratio": ratio,
-                            "pass": ratio <= RASTER_RATIO_TARGET})
+            targets.append(
+                {
+                    "name": f"raster {rast_big['name']} {label} <= {RASTER_RATIO_TARGET:g}x",
+                    "ours_ms": q[ours]["median_ms"],
+                    "cv2_ms": q[cv]["median_ms"],
+                    "ratio": ratio,
+                    "pass": ratio <= RASTER_RATIO_TARGET,
+                }
+            )
     for key, row in slopes.items():
         impl = key.split(".", 1)[1]
         if impl.startswith(("ours", "render")):
-            targets.append({"name": f"slope {key} <= {SLOPE_LIMIT}", "slope": row["all"],
-                            "pass": row["all"] <= SLOPE_LIMIT})
-    targets.append({"name": f"no growth over {g['frames']} frames of {growth['mesh']}: RSS < {RSS_GROWTH_LIMIT_MIB:g} MiB, "
-                            f"tracemalloc < {TRACED_GROWTH_LIMIT_KIB:g} KiB",
-                    "rss_growth_mib": d_rss, "peak_rss_growth_mib": mlast["hwm_mib"] - m10["hwm_mib"],
-                    "traced_growth_kib": d_tr, "traced_growth_before_collect_kib": d_tr_raw,
-                    "pass": d_rss < RSS_GROWTH_LIMIT_MIB and d_tr < TRACED_GROWTH_LIMIT_KIB})
+            targets.append(
+                {"name": f"slope {key} <= {SLOPE_LIMIT}", "slope": row["all"], "pass": row["all"] <= SLOPE_LIMIT}
+            )
+    targets.append(
+        {
+            "name": f"no growth over {g['frames']} frames of {growth['mesh']}: RSS < {RSS_GROWTH_LIMIT_MIB:g} MiB, "
+            f"tracemalloc < {TRACED_GROWTH_LIMIT_KIB:g} KiB",
+            "rss_growth_mib": d_rss,
+            "peak_rss_growth_mib": mlast["hwm_mib"] - m10["hwm_mib"],
+            "traced_growth_kib": d_tr,
+            "traced_growth_before_collect_kib": d_tr_raw,
+            "pass": d_rss < RSS_GROWTH_LIMIT_MIB and d_tr < TRACED_GROWTH_LIMIT_KIB,
+        }
+    )
 
     print("targets:")
     for t in targets:
@@ -749,11 +925,25 @@ def main(argv=None) -> int:
     elapsed = print_end(info, t_start)
 
     if args.json:
-        config = {"width": WIDTH, "height": HEIGHT, "camera": "camera_z(4.0, fov_y_deg=70)",
-                  "motion": "Motion(), frames of 180", "quick": args.quick, **cfg,
-                  "statistic": "median per-call time over rounds x passes x poses"}
-        write_json(args.json, machine=info, config=config, results=results, slopes=slopes, memory=mem,
-                   targets=targets, elapsed_s=elapsed)
+        config = {
+            "width": WIDTH,
+            "height": HEIGHT,
+            "camera": "camera_z(4.0, fov_y_deg=70)",
+            "motion": "Motion(), frames of 180",
+            "quick": args.quick,
+            **cfg,
+            "statistic": "median per-call time over rounds x passes x poses",
+        }
+        write_json(
+            args.json,
+            machine=info,
+            config=config,
+            results=results,
+            slopes=slopes,
+            memory=mem,
+            targets=targets,
+            elapsed_s=elapsed,
+        )
     return 0
 
 

@@ -50,13 +50,26 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     ours, peer = [], []
     with tempfile.TemporaryDirectory() as tmp:
-        ours_cmd = [sys.executable, "-m", "wirecheck.core.app.cli", "--scene", "cube", "--frames", str(args.frames),
-                    "--camera-z", "4.0", "--fov", "70", "--out", f"{tmp}/ours"]
+        ours_cmd = [
+            sys.executable,
+            "-m",
+            "wirecheck.core.app.cli",
+            "--scene",
+            "cube",
+            "--frames",
+            str(args.frames),
+            "--camera-z",
+            "4.0",
+            "--fov",
+            "70",
+            "--out",
+            f"{tmp}/ours",
+        ]
         peer_cmd = [sys.executable, str(HERE / "peer_seed_pyrender.py"), f"{tmp}/peer", "--frames", str(args.frames)]
-        wall(ours_cmd), wall(peer_cmd)                 # untimed: bytecode written, files cached
+        wall(ours_cmd), wall(peer_cmd)  # untimed: bytecode written, files cached
         for r in range(args.repeats):
             pair = [(ours, ours_cmd), (peer, peer_cmd)]
-            for times, cmd in (pair if r % 2 == 0 else pair[::-1]):
+            for times, cmd in pair if r % 2 == 0 else pair[::-1]:
                 times.append(wall(cmd))
     o, p = statistics.median(ours), statistics.median(peer)
     ratio = o / p

@@ -54,7 +54,6 @@ for p in (ROOT, ROOT / "tests", Path(__file__).resolve().parent):
         sys.path.insert(0, str(p))
 
 import numpy as np  # noqa: E402
-
 from _common import machine_info, print_end, print_machine  # noqa: E402
 from specificity_dataset import make_dataset  # noqa: E402
 
@@ -80,6 +79,7 @@ def _shifted(dx: float):
 
     def line_pixels(p0, p1, w, h):
         return _LINE_PIXELS(np.asarray(p0, np.float64) + dx, np.asarray(p1, np.float64) + dx, w, h)
+
     return line_pixels
 
 
@@ -87,8 +87,9 @@ def mutant(name: str):
     """The replacement of ``core.projector.raster._line_pixels`` called ``name`` (module docstring)."""
     from raster_mutants import drop_last
 
-    return {"drop_end": lambda: drop_last, "biased_rule": lambda: _shifted(0.25),
-            "half_pixel": lambda: _shifted(0.5)}[name]()
+    return {"drop_end": lambda: drop_last, "biased_rule": lambda: _shifted(0.25), "half_pixel": lambda: _shifted(0.5)}[
+        name
+    ]()
 
 
 def run(folder: str, frames: int, cases: str, line_pixels=None) -> dict:
@@ -103,16 +104,28 @@ def run(folder: str, frames: int, cases: str, line_pixels=None) -> dict:
     if line_pixels is not None:
         raster._line_pixels = line_pixels
     try:
-        return run_dataset(dataset_entries([folder]), CoreCandidate(), frames=frames, case_names=cases,
-                           candidate_name="core", executor=ExecutorSpec(jobs=1), allow_load_errors=True)
+        return run_dataset(
+            dataset_entries([folder]),
+            CoreCandidate(),
+            frames=frames,
+            case_names=cases,
+            candidate_name="core",
+            executor=ExecutorSpec(jobs=1),
+            allow_load_errors=True,
+        )
     finally:
         raster._line_pixels = original
 
 
 def case_rows(report: dict) -> dict:
     """``{mesh name: [case verdicts and reasons]}`` of a dataset report."""
-    return {m["mesh"]: [(c["camera"], c["verdict"], c.get("reasons", []), [f["name"] for f in c.get("faults", [])])
-                        for c in m.get("cases", [])] for m in report["meshes"]}
+    return {
+        m["mesh"]: [
+            (c["camera"], c["verdict"], c.get("reasons", []), [f["name"] for f in c.get("faults", [])])
+            for c in m.get("cases", [])
+        ]
+        for m in report["meshes"]
+    }
 
 
 def tally(rows: dict, names) -> dict:
@@ -120,17 +133,23 @@ def tally(rows: dict, names) -> dict:
     (e.g. ``oracle_precision``: no false fail of the candidate, but the gate's run does not pass on them),
     and meshes with a failed case and with a failed or vacuous one."""
     cases = [c for name in names for c in rows[name]]
-    return {"cases": len(cases), "cases_failed": sum(c[1] == "fail" for c in cases),
-            "cases_vacuous": sum(c[1] == "vacuous" for c in cases), "meshes": len(names),
-            "meshes_failed": sum(any(c[1] == "fail" for c in rows[name]) for name in names),
-            "meshes_not_passed": sum(any(c[1] in ("fail", "vacuous") for c in rows[name]) for name in names)}
+    return {
+        "cases": len(cases),
+        "cases_failed": sum(c[1] == "fail" for c in cases),
+        "cases_vacuous": sum(c[1] == "vacuous" for c in cases),
+        "meshes": len(names),
+        "meshes_failed": sum(any(c[1] == "fail" for c in rows[name]) for name in names),
+        "meshes_not_passed": sum(any(c[1] in ("fail", "vacuous") for c in rows[name]) for name in names),
+    }
 
 
 def rate_line(label: str, k: int, n: int, unit: str) -> str:
     lo, hi = clopper_pearson(k, n)
-    three = f"; rule of three {3e3 / n:.2f}" if k == 0 and n else ""       # one-sided 95 % bound for 0 of n
-    return (f"  {label:<6} {k:>4} / {n:<5} {unit}: {1e3 * k / max(n, 1):7.2f} per 1,000 "
-            f"(95 % CI {1e3 * lo:.2f} .. {1e3 * hi:.2f}{three})")
+    three = f"; rule of three {3e3 / n:.2f}" if k == 0 and n else ""  # one-sided 95 % bound for 0 of n
+    return (
+        f"  {label:<6} {k:>4} / {n:<5} {unit}: {1e3 * k / max(n, 1):7.2f} per 1,000 "
+        f"(95 % CI {1e3 * lo:.2f} .. {1e3 * hi:.2f}{three})"
+    )
 
 
 def main(argv=None) -> int:
@@ -139,10 +158,15 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=27, help="the dataset's seed (default 27)")
     ap.add_argument("--frames", type=int, default=8, help="frames of the motion per case (default 8)")
     ap.add_argument("--cases", default=ALL_CASES, help="cameras per mesh (default: the 7 default cases)")
-    ap.add_argument("--mutants", default=",".join(MUTANTS), help=f"mutants to run (default {','.join(MUTANTS)}; "
-                    "'' for none)")
-    ap.add_argument("--mutant-meshes", type=int, default=None,
-                    help="run the mutants on the first N near meshes only (default: all near ones)")
+    ap.add_argument(
+        "--mutants", default=",".join(MUTANTS), help=f"mutants to run (default {','.join(MUTANTS)}; '' for none)"
+    )
+    ap.add_argument(
+        "--mutant-meshes",
+        type=int,
+        default=None,
+        help="run the mutants on the first N near meshes only (default: all near ones)",
+    )
     ap.add_argument("--skip-core", action="store_true", help="run the mutants only (core's numbers from another run)")
     ap.add_argument("--quick", action="store_true", help="14 meshes, 2 cases (on_axis, orthographic) x 2 frames")
     ap.add_argument("--json", default=None, help="also write the results as JSON to this file")
@@ -154,17 +178,21 @@ def main(argv=None) -> int:
         ap.error(f"expected --meshes >= 1, --frames >= 1 and mutants among {', '.join(MUTANTS)}")
     n_mut = min(args.meshes, args.mutant_meshes or args.meshes)
     t_start = time.perf_counter()
-    info = machine_info(meshes=args.meshes, seed=args.seed, frames=args.frames, cases=args.cases,
-                        mutants=mutants, mutant_meshes=n_mut)
+    info = machine_info(
+        meshes=args.meshes, seed=args.seed, frames=args.frames, cases=args.cases, mutants=mutants, mutant_meshes=n_mut
+    )
     print_machine("bench_specificity: false fails of core and the mutants' detection on a generated dataset", info)
     out = {"machine": info}
     with tempfile.TemporaryDirectory(prefix="bench_specificity.") as tmp:
         t0 = time.perf_counter()
         made = make_dataset(Path(tmp), args.meshes, args.seed)
         far = {m.name for m in made if m.far}
-        print(f"  dataset: {len(made)} meshes ({len(far)} far), {min(m.vertices for m in made)}.."
-              f"{max(m.vertices for m in made)} vertices, written in {time.perf_counter() - t0:.1f} s; "
-              f"{args.frames} frames x {len(args.cases.split(','))} cases per mesh\n", flush=True)
+        print(
+            f"  dataset: {len(made)} meshes ({len(far)} far), {min(m.vertices for m in made)}.."
+            f"{max(m.vertices for m in made)} vertices, written in {time.perf_counter() - t0:.1f} s; "
+            f"{args.frames} frames x {len(args.cases.split(','))} cases per mesh\n",
+            flush=True,
+        )
         t0 = time.perf_counter()
         rows = {} if args.skip_core else case_rows(run(tmp, args.frames, args.cases))
         core_s = time.perf_counter() - t0
@@ -178,24 +206,33 @@ def main(argv=None) -> int:
             print(rate_line(label, k, n, "cases failed") + f"; {t['meshes_failed']}/{t['meshes']} meshes")
             if v:
                 print(rate_line("", k + v, n, "failed or vacuous") + f"; {t['meshes_not_passed']}/{t['meshes']} meshes")
-            result[label] = dict(t, per_1000=1e3 * k / max(n, 1),
-                                 ci95_per_1000=[1e3 * x for x in clopper_pearson(k, n)],
-                                 not_passed_per_1000=1e3 * (k + v) / max(n, 1),
-                                 not_passed_ci95_per_1000=[1e3 * x for x in clopper_pearson(k + v, n)])
+            result[label] = dict(
+                t,
+                per_1000=1e3 * k / max(n, 1),
+                ci95_per_1000=[1e3 * x for x in clopper_pearson(k, n)],
+                not_passed_per_1000=1e3 * (k + v) / max(n, 1),
+                not_passed_ci95_per_1000=[1e3 * x for x in clopper_pearson(k + v, n)],
+            )
         errors = [name for name, cs in rows.items() if not cs]
         if errors:
             print(f"  could not be checked: {', '.join(errors)}")
         failed = [(name, c) for name in sorted(rows) for c in rows[name] if c[1] in ("fail", "vacuous")]
         for name, (camera, _v, reasons, faults) in failed:
-            print(f"    {name} / {camera}{' (far)' if name in far else ''} [{_v}]: {'; '.join(reasons)}"
-                  f"{' [' + ', '.join(faults) + ']' if faults else ''}")
-        out["core"] = {"seconds": core_s, "rates": result,
-                       "failed": [{"mesh": n, "camera": c[0], "verdict": c[1], "reasons": c[2], "faults": c[3]}
-                                                        for n, c in failed]}
+            print(
+                f"    {name} / {camera}{' (far)' if name in far else ''} [{_v}]: {'; '.join(reasons)}"
+                f"{' [' + ', '.join(faults) + ']' if faults else ''}"
+            )
+        out["core"] = {
+            "seconds": core_s,
+            "rates": result,
+            "failed": [
+                {"mesh": n, "camera": c[0], "verdict": c[1], "reasons": c[2], "faults": c[3]} for n, c in failed
+            ],
+        }
         if mutants:
             sub = Path(tmp) / "mutants"
             sub.mkdir()
-            chosen = [m for m in made if not m.far][:n_mut]       # a far mesh fails with core itself today
+            chosen = [m for m in made if not m.far][:n_mut]  # a far mesh fails with core itself today
             for m in chosen:
                 (sub / m.name).write_bytes((Path(tmp) / m.name).read_bytes())
             print(f"\nmutants (on the first {len(chosen)} near meshes; caught = at least one failed case):")
@@ -209,11 +246,20 @@ def main(argv=None) -> int:
                 k = sum(c[1] == "fail" for c in cases)
                 lo, hi = clopper_pearson(caught, len(mrows))
                 missed = [n for n, cs in mrows.items() if not any(c[1] == "fail" for c in cs)]
-                print(f"  {name:<12} caught on {caught}/{len(mrows)} meshes ({100 * caught / max(len(mrows), 1):.1f} %,"
-                      f" 95 % CI {100 * lo:.1f} .. {100 * hi:.1f} %), {k}/{len(cases)} cases failed ({sec:.0f} s)"
-                      + (f"; missed: {', '.join(missed)}" if missed else ""), flush=True)
-                out["mutants"][name] = {"meshes": len(mrows), "meshes_caught": caught, "cases": len(cases),
-                                        "cases_failed": k, "missed": missed, "seconds": sec}
+                print(
+                    f"  {name:<12} caught on {caught}/{len(mrows)} meshes ({100 * caught / max(len(mrows), 1):.1f} %,"
+                    f" 95 % CI {100 * lo:.1f} .. {100 * hi:.1f} %), {k}/{len(cases)} cases failed ({sec:.0f} s)"
+                    + (f"; missed: {', '.join(missed)}" if missed else ""),
+                    flush=True,
+                )
+                out["mutants"][name] = {
+                    "meshes": len(mrows),
+                    "meshes_caught": caught,
+                    "cases": len(cases),
+                    "cases_failed": k,
+                    "missed": missed,
+                    "seconds": sec,
+                }
     out["elapsed_s"] = print_end(info, t_start)
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=2))

@@ -28,7 +28,6 @@ import urllib.request
 from pathlib import Path
 
 import numpy as np
-
 from wirecheck.core.app.cli import build_parser, settings_from_args
 from wirecheck.core.app.viewer import STAGES, Viewer
 from wirecheck.core.app.viewer_http import Server
@@ -37,18 +36,22 @@ MODES = {"wireframe": [], "hidden-lines": ["--hidden-lines"], "shaded": ["--styl
 
 
 def _post(url: str, ops) -> dict:
-    req = urllib.request.Request(url + "api/frame", data=json.dumps({"ops": ops}).encode(),
-                                 headers={"Content-Type": "application/json"})
+    req = urllib.request.Request(
+        url + "api/frame", data=json.dumps({"ops": ops}).encode(), headers={"Content-Type": "application/json"}
+    )
     with urllib.request.urlopen(req, timeout=60) as r:
         return json.loads(r.read())
 
 
 def run(scene: str, mode_args, frames: int, out: Path) -> dict:
-    s = settings_from_args(build_parser().parse_args(["--scene", scene, "--camera-z", "4", "--frames", "180",
-                                                      "--out", str(out)] + mode_args))
+    s = settings_from_args(
+        build_parser().parse_args(
+            ["--scene", scene, "--camera-z", "4", "--frames", "180", "--out", str(out)] + mode_args
+        )
+    )
     server = Server(Viewer(s)).start()
     try:
-        _post(server.url, [])                                   # warm-up: caches, first PNG
+        _post(server.url, [])  # warm-up: caches, first PNG
         rts = []
         for _ in range(frames):
             t0 = time.perf_counter()
@@ -58,8 +61,12 @@ def run(scene: str, mode_args, frames: int, out: Path) -> dict:
     finally:
         server.stop()
     rts = np.array(rts)
-    return {"fps": 1e3 / rts.mean(), "p50": float(np.percentile(rts, 50)), "p95": float(np.percentile(rts, 95)),
-            "stages_p50": {k: prof[k]["p50_ms"] for k in STAGES}}
+    return {
+        "fps": 1e3 / rts.mean(),
+        "p50": float(np.percentile(rts, 50)),
+        "p95": float(np.percentile(rts, 95)),
+        "stages_p50": {k: prof[k]["p50_ms"] for k in STAGES},
+    }
 
 
 def main(argv=None) -> int:

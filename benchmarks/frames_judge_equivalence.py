@@ -29,10 +29,32 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 GEOMETRY = {"a_core", "a_aa", "a_pillow", "a_gl_half", "b_core", "b_wide", "b_aa_half", "b_short", "c96_aa"}
-A = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square,orthographic", "--frames", "6",
-     "--every", "3"]
-B = ["--scene", "prism", "--scene", "cube", "--cases", "on_axis,wide_fov,near_plane,off_centre", "--frames", "8",
-     "--every", "2", "--phase", "0.3"]
+A = [
+    "--scene",
+    "cube",
+    "--scene",
+    "pyramid",
+    "--cases",
+    "oblique_roll,non_square,orthographic",
+    "--frames",
+    "6",
+    "--every",
+    "3",
+]
+B = [
+    "--scene",
+    "prism",
+    "--scene",
+    "cube",
+    "--cases",
+    "on_axis,wide_fov,near_plane,off_centre",
+    "--frames",
+    "8",
+    "--every",
+    "2",
+    "--phase",
+    "0.3",
+]
 C = ["--scene", "cube", "--cases", "on_axis", "--frames", "96"]
 
 
@@ -43,7 +65,6 @@ def make_jobs(out: Path) -> None:
     sys.path[:0] = [str(ROOT / "tests")]
     from raster_mutants import drop_last
     from test_line_style import draw_antialiased, draw_pillow, draw_wide
-
     from wirecheck.core.projector import raster
     from wirecheck.core.projector.clipping import clip_to_image
     from wirecheck.core.projector.pipeline import render_frame
@@ -78,8 +99,9 @@ def make_jobs(out: Path) -> None:
         return img
 
     def styled(draw, shift=(0, 0)):
-        return lambda p, e, cam, m: draw(oracle_segments(p @ m[:3, :3].T + m[:3, 3], e, cam) + np.asarray(shift),
-                                         cam.width, cam.height)
+        return lambda p, e, cam, m: draw(
+            oracle_segments(p @ m[:3, :3].T + m[:3, 3], e, cam) + np.asarray(shift), cam.width, cam.height
+        )
 
     def stray(*x):
         img = core(*x)
@@ -102,8 +124,13 @@ def make_jobs(out: Path) -> None:
             raster._line_pixels = original
     grey = lambda img: np.stack([img, img // 2, img], -1)
     each(export("a_rgb", A), core, lambda img, p: Image.fromarray(grey(img)).save(p))
-    each(export("a_rgba", A), core, lambda img, p: Image.fromarray(
-        np.stack([img, img, img, np.where(img > 0, 255, 0).astype(np.uint8)], -1)).save(p))
+    each(
+        export("a_rgba", A),
+        core,
+        lambda img, p: Image.fromarray(np.stack([img, img, img, np.where(img > 0, 255, 0).astype(np.uint8)], -1)).save(
+            p
+        ),
+    )
     each(export("a_grey16", A), core, lambda img, p: Image.fromarray(img.astype(np.uint16) * 257).save(p))
     each(export("a_la", A), core, lambda img, p: Image.fromarray(np.stack([img, img], -1), "LA").save(p))
     each(export("a_pal", A), core, lambda img, p: Image.fromarray(img).convert("P").save(p))
@@ -149,7 +176,7 @@ def compare(a: Path, b: Path) -> int:
             x, y = (d / rel).read_bytes(), (e / rel).read_bytes()
             if rel.name == "report.json":
                 x, y = _timeless(json.loads(x)), _timeless(json.loads(y))
-            elif rel.name == ".wirecheck-output":          # the files' hashes, report.json's (timing) left out
+            elif rel.name == ".wirecheck-output":  # the files' hashes, report.json's (timing) left out
                 x, y = json.loads(x), json.loads(y)
                 x["files"].pop("report.json", None)
                 y["files"].pop("report.json", None)

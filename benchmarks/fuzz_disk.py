@@ -88,10 +88,28 @@ def target_argv(kind, box, frames):
     if kind == "renderer":
         return [*RENDER, "--frames", str(frames), "--out", str(box / "out")], box / "out", box / "out" / LOCK
     if kind == "report":
-        return ([*CROSS, "--report-dir", str(box / "r"), "--scene", "cube", "--cases", "on_axis", "--oracles",
-                 "opencv", "--frames", str(frames)], box / "r", box / ".r.wirecheck-lock")
-    return ([*CROSS, "export", str(box / "j"), "--scene", "cube", "--cases", "on_axis", "--frames", str(frames)],
-            box / "j", box / ".j.wirecheck-lock")
+        return (
+            [
+                *CROSS,
+                "--report-dir",
+                str(box / "r"),
+                "--scene",
+                "cube",
+                "--cases",
+                "on_axis",
+                "--oracles",
+                "opencv",
+                "--frames",
+                str(frames),
+            ],
+            box / "r",
+            box / ".r.wirecheck-lock",
+        )
+    return (
+        [*CROSS, "export", str(box / "j"), "--scene", "cube", "--cases", "on_axis", "--frames", str(frames)],
+        box / "j",
+        box / ".j.wirecheck-lock",
+    )
 
 
 def snapshot(box):
@@ -142,10 +160,17 @@ class Tally:
         row["leftovers"] += left
         if note:
             row[note] += 1
-        if touched or left or rc not in (0, 2) or "Traceback" in (err or "") or (
-                rc == 2 and (err or "").count("\n") != 1):
-            print(f"  FINDING {surface}: rc={rc} touched={touched} left={left}: {(err or '').strip()[:300]}",
-                  file=sys.stderr)
+        if (
+            touched
+            or left
+            or rc not in (0, 2)
+            or "Traceback" in (err or "")
+            or (rc == 2 and (err or "").count("\n") != 1)
+        ):
+            print(
+                f"  FINDING {surface}: rc={rc} touched={touched} left={left}: {(err or '').strip()[:300]}",
+                file=sys.stderr,
+            )
 
 
 def plant(path, kind, user):
@@ -196,8 +221,11 @@ def surface_locks(tally, work):
             if sock is not None:
                 sock.close()
             after = snapshot(box)
-            touched = sum(1 for k, v in before.items() if after.get(k) != v and not (kind == "stale"
-                                                                                      and k == str(lock.relative_to(box))))
+            touched = sum(
+                1
+                for k, v in before.items()
+                if after.get(k) != v and not (kind == "stale" and k == str(lock.relative_to(box)))
+            )
             expected = 0 if kind == "stale" else 2
             left = int(kind == "stale" and bool(leftovers(box)))
             tally.add("locks", rc, err, touched, left, None if rc == expected else "unexpected exit")
@@ -205,8 +233,20 @@ def surface_locks(tally, work):
 
 
 def surface_journals(tally, work):
-    kinds = ["fifo", "symlink", "hard_link", "empty", "not_json", "huge", "users_file", "untagged_tmp",
-             "folders_int", "names_str", "tmp_outside", "bad_hash"]
+    kinds = [
+        "fifo",
+        "symlink",
+        "hard_link",
+        "empty",
+        "not_json",
+        "huge",
+        "users_file",
+        "untagged_tmp",
+        "folders_int",
+        "names_str",
+        "tmp_outside",
+        "bad_hash",
+    ]
     for kind in kinds:
         box = Path(tempfile.mkdtemp(dir=work))
         user = box / "thesis.tex"
@@ -215,8 +255,13 @@ def surface_journals(tally, work):
         out.mkdir()
         (out / "thesis.tex").write_bytes(USERS)
         path = out / JOURNAL
-        base = {"wirecheck_journal": 1, "tmp": ".wirecheck-abc123.tmp", "names": ["cube-report.txt"],
-                "folders": [], "manifest": {}}
+        base = {
+            "wirecheck_journal": 1,
+            "tmp": ".wirecheck-abc123.tmp",
+            "names": ["cube-report.txt"],
+            "folders": [],
+            "manifest": {},
+        }
         tmp = out / base["tmp"]
         if kind in ("users_file", "folders_int", "names_str", "tmp_outside", "bad_hash"):
             tmp.mkdir()
@@ -285,7 +330,7 @@ def surface_markers(tally, work):
         touched = 0
         if kind == "deep_user":
             touched = int(not (p / "note.txt").is_file())
-            while p != out / "cube-frames":          # iterative clean-up (shutil.rmtree recurses on 3.11)
+            while p != out / "cube-frames":  # iterative clean-up (shutil.rmtree recurses on 3.11)
                 for name in os.listdir(p):
                     if not (p / name).is_dir():
                         os.unlink(p / name)
@@ -317,8 +362,12 @@ def surface_window(tally, work, rng, n):
         folder = out / "cube-frames" if target == "renderer" else out
         argv2 = [a if a != "1" or argv[i - 1] != "--frames" else "2" for i, a in enumerate(argv)]
         pause = box / "pause"
-        proc = subprocess.Popen(argv2, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                                env=env(WIRECHECK_PAUSE_AT_STEP=step, WIRECHECK_PAUSE_FILE=pause))
+        proc = subprocess.Popen(
+            argv2,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            env=env(WIRECHECK_PAUSE_AT_STEP=step, WIRECHECK_PAUSE_FILE=pause),
+        )
         written = None
         deadline = time.monotonic() + TIMEOUT_S
         while proc.poll() is None and time.monotonic() < deadline:
@@ -327,8 +376,11 @@ def surface_window(tally, work, rng, n):
                 if action == "note":
                     written = ("note.txt", b"a note")
                 elif action == "edit":
-                    name = "frame_0001.png" if target == "renderer" else ("report.md" if target == "report"
-                                                                           else "README.md")
+                    name = (
+                        "frame_0001.png"
+                        if target == "renderer"
+                        else ("report.md" if target == "report" else "README.md")
+                    )
                     written = (name, b"edited by the user")
                 else:
                     (folder / "mine").mkdir(exist_ok=True)
@@ -368,7 +420,7 @@ def surface_concurrency(tally, work, rng, n):
         b_argv, _, _ = target_argv(target, box, 1)
         a_start = time.monotonic()
         a = subprocess.Popen(a_argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env())
-        seen = []                       # when the lock file named A's pid (sampled every 5 ms)
+        seen = []  # when the lock file named A's pid (sampled every 5 ms)
         stop = threading.Event()
 
         def watch():
@@ -383,9 +435,9 @@ def surface_concurrency(tally, work, rng, n):
         watcher = threading.Thread(target=watch, daemon=True)
         watcher.start()
         time.sleep(delay)
-        held_by_a = bool(seen)          # A's pid read from the lock file before B started: A held the target
+        held_by_a = bool(seen)  # A's pid read from the lock file before B started: A held the target
         rc_b, err_b, b_s = run(b_argv)
-        a_alive = a.poll() is None      # A still running when B ended: A held the target all through B's run
+        a_alive = a.poll() is None  # A still running when B ended: A held the target all through B's run
         try:
             err_a = a.communicate(timeout=TIMEOUT_S * 3)[1].decode()
             rc_a = a.returncode
@@ -395,7 +447,7 @@ def surface_concurrency(tally, work, rng, n):
         a_end = time.monotonic()
         stop.set()
         watcher.join()
-        if rc_a == 0 and seen:          # the share of A's run (process start to end) its lock covered
+        if rc_a == 0 and seen:  # the share of A's run (process start to end) its lock covered
             COVERAGE.setdefault(target, []).append((a_end - seen[0]) / (a_end - a_start))
         both = rc_a == 0 and rc_b == 0
         note = None
@@ -415,7 +467,7 @@ def surface_concurrency(tally, work, rng, n):
 COVERAGE: dict = {}
 
 
-KILL_RENAMES = {"renderer": 10, "report": 1, "export": 1}   # of a rerun's commit: tests/test_commit_kill.py
+KILL_RENAMES = {"renderer": 10, "report": 1, "export": 1}  # of a rerun's commit: tests/test_commit_kill.py
 
 
 def surface_kills(tally, work):
@@ -435,8 +487,14 @@ def surface_kills(tally, work):
             rc, err, _ = run(argv3)
             consistent = rc == 0 and _consistent(target, out, 3)
             touched = int((box / "thesis.tex").read_bytes() != USERS)
-            tally.add("kills", rc, err, touched, int(bool(leftovers(box))),
-                      None if consistent and rc_k == want else "inconsistent after the rerun")
+            tally.add(
+                "kills",
+                rc,
+                err,
+                touched,
+                int(bool(leftovers(box))),
+                None if consistent and rc_k == want else "inconsistent after the rerun",
+            )
             shutil.rmtree(box, ignore_errors=True)
 
 
@@ -468,26 +526,50 @@ def main(argv=None) -> int:
     t0 = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="fuzz_disk.") as work:
         work = Path(work)
-        surfaces = [("locks", lambda: surface_locks(tally, work)),
-                    ("journals", lambda: surface_journals(tally, work)),
-                    ("markers", lambda: surface_markers(tally, work)),
-                    ("window", lambda: surface_window(tally, work, rng, max(4, int(60 * scale)))),
-                    ("concurrency", lambda: surface_concurrency(tally, work, rng, max(2, int(30 * scale)))),
-                    ("kills", lambda: surface_kills(tally, work))]
+        surfaces = [
+            ("locks", lambda: surface_locks(tally, work)),
+            ("journals", lambda: surface_journals(tally, work)),
+            ("markers", lambda: surface_markers(tally, work)),
+            ("window", lambda: surface_window(tally, work, rng, max(4, int(60 * scale)))),
+            ("concurrency", lambda: surface_concurrency(tally, work, rng, max(2, int(30 * scale)))),
+            ("kills", lambda: surface_kills(tally, work)),
+        ]
         for name, go in surfaces:
             if only is None or name in only:
                 s0 = time.monotonic()
                 go()
                 print(f"{name}: {dict(tally.rows.get(name, {}))} ({time.monotonic() - s0:.0f} s)", file=sys.stderr)
-    coverage = {t: {"runs": len(v), "median": round(sorted(v)[len(v) // 2], 3), "min": round(min(v), 3)}
-                for t, v in COVERAGE.items()}
-    print(json.dumps({"seed": args.seed, "wall_s": round(time.monotonic() - t0), "surfaces": tally.rows,
-                      "lock_coverage_of_run_a": coverage}, indent=1, default=dict))
-    bad = sum(row[k] for row in tally.rows.values() for k in ("tracebacks", "hangs", "odd exits",
-                                                             "exit 2 not one line", "user files touched",
-                                                             "leftovers", "unexpected exit",
-                                                             "both committed, B started while A held the target",
-                                                             "inconsistent after the rerun"))
+    coverage = {
+        t: {"runs": len(v), "median": round(sorted(v)[len(v) // 2], 3), "min": round(min(v), 3)}
+        for t, v in COVERAGE.items()
+    }
+    print(
+        json.dumps(
+            {
+                "seed": args.seed,
+                "wall_s": round(time.monotonic() - t0),
+                "surfaces": tally.rows,
+                "lock_coverage_of_run_a": coverage,
+            },
+            indent=1,
+            default=dict,
+        )
+    )
+    bad = sum(
+        row[k]
+        for row in tally.rows.values()
+        for k in (
+            "tracebacks",
+            "hangs",
+            "odd exits",
+            "exit 2 not one line",
+            "user files touched",
+            "leftovers",
+            "unexpected exit",
+            "both committed, B started while A held the target",
+            "inconsistent after the rerun",
+        )
+    )
     return 1 if bad else 0
 
 

@@ -69,6 +69,7 @@ def _alarm(signum, frame):
 
 # ---- special files --------------------------------------------------------------------------------------
 
+
 def make_special(kind: str, path: Path, spare: Path | None = None) -> None:
     """``path`` made into a special file of ``kind`` (links for the devices: the name keeps its suffix);
     ``spare``: where a link's FIFO goes (default: beside the link)."""
@@ -81,7 +82,7 @@ def make_special(kind: str, path: Path, spare: Path | None = None) -> None:
     elif kind == "socket":
         s = socket.socket(socket.AF_UNIX)
         s.bind(str(path))
-        s.close()                     # the socket file stays
+        s.close()  # the socket file stays
     elif kind == "dangling_link":
         path.symlink_to(path.parent / "nowhere")
     elif kind == "link_loop":
@@ -97,8 +98,18 @@ def make_special(kind: str, path: Path, spare: Path | None = None) -> None:
         raise ValueError(kind)
 
 
-KINDS = ("fifo", "dev_zero", "dev_urandom", "dev_null", "folder", "socket", "dangling_link", "link_loop",
-         "link_to_fifo", "sparse_64GiB")
+KINDS = (
+    "fifo",
+    "dev_zero",
+    "dev_urandom",
+    "dev_null",
+    "folder",
+    "socket",
+    "dangling_link",
+    "link_loop",
+    "link_to_fifo",
+    "sparse_64GiB",
+)
 
 
 def _job(box: Path) -> Path:
@@ -129,6 +140,7 @@ def file_inputs():
         def build(box, kind):
             make_special(kind, box / f"x{suffix}")
             return ["--scene", str(box / f"x{suffix}")]
+
         return build
 
     for suffix in (".scene", ".obj", ".ply", ".stl", ".off", ".glb", ".gltf"):
@@ -147,32 +159,41 @@ def file_inputs():
     def obj_texture(box, kind):
         make_special(kind, box / "tex.png")
         (box / "m.mtl").write_text("newmtl x\nKd 1 1 1\nmap_Kd tex.png\n")
-        (box / "a.obj").write_text("mtllib m.mtl\nusemtl x\nvt 0 0\nvt 1 0\nvt 0 1\n"
-                                   "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/2 3/3\n")
+        (box / "a.obj").write_text(
+            "mtllib m.mtl\nusemtl x\nvt 0 0\nvt 1 0\nvt 0 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/2 3/3\n"
+        )
         return ["--scene", str(box / "a.obj")]
 
     def gltf_buffer(box, kind):
         make_special(kind, box / "buf.bin")
-        doc = {"asset": {"version": "2.0"}, "buffers": [{"uri": "buf.bin", "byteLength": 36}],
-               "bufferViews": [{"buffer": 0, "byteLength": 36}],
-               "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                              "min": [0, 0, 0], "max": [1, 1, 0]}],
-               "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-               "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}
+        doc = {
+            "asset": {"version": "2.0"},
+            "buffers": [{"uri": "buf.bin", "byteLength": 36}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}
+            ],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "nodes": [{"mesh": 0}],
+            "scenes": [{"nodes": [0]}],
+            "scene": 0,
+        }
         (box / "a.gltf").write_text(json.dumps(doc))
         return ["--scene", str(box / "a.gltf")]
 
-    out += [("renderer: a .scene's mesh line", "renderer", scene_mesh_line),
-            ("renderer: an OBJ's mtllib", "renderer", obj_mtllib),
-            ("renderer: a material's map_Kd", "renderer", obj_texture),
-            ("renderer: a glTF buffer", "renderer", gltf_buffer)]
+    out += [
+        ("renderer: a .scene's mesh line", "renderer", scene_mesh_line),
+        ("renderer: an OBJ's mtllib", "renderer", obj_mtllib),
+        ("renderer: a material's map_Kd", "renderer", obj_texture),
+        ("renderer: a glTF buffer", "renderer", gltf_buffer),
+    ]
 
     def config(box, kind):
         make_special(kind, box / "w.toml")
         return ["--config", str(box / "w.toml"), *QUICK, "--scene", "cube"]
 
     def pyproject(box, kind):
-        make_special(kind, box / "pyproject.toml")          # found in the working folder (box)
+        make_special(kind, box / "pyproject.toml")  # found in the working folder (box)
         return [*QUICK, "--scene", "cube"]
 
     def config_scene(box, kind):
@@ -216,29 +237,45 @@ def file_inputs():
     def frames_file(rel):
         def build(box, kind):
             job = _job(box)
-            _replace(job / rel, kind, box)          # a link's FIFO outside the job: not a stray file of it
+            _replace(job / rel, kind, box)  # a link's FIFO outside the job: not a stray file of it
             return ["--candidate-frames", str(job)]
+
         return build
 
-    out += [("crosscheck --config", "crosscheck", config),
-            ("crosscheck: pyproject.toml found", "crosscheck", pyproject),
-            ("crosscheck: a config's scenes path", "crosscheck", config_scene),
-            ("crosscheck: a config's candidate path", "crosscheck", config_candidate),
-            ("crosscheck --scene-list", "crosscheck", scene_list),
-            ("crosscheck: a --scene-list line", "crosscheck", scene_list_line),
-            ("crosscheck --scene DIR", "crosscheck", scene_dir),
-            ("crosscheck --scene X.obj", "crosscheck", scene_file),
-            ("crosscheck --candidate FILE.py", "crosscheck", candidate),
-            ("crosscheck --candidate-frames DIR", "crosscheck", frames_job_dir)]
-    for rel in ("job.json", "cameras/cube/on_axis/frame_0001.json", "scenes/cube.obj",
-                "frames/cube/on_axis/frame_0001.png"):
+    out += [
+        ("crosscheck --config", "crosscheck", config),
+        ("crosscheck: pyproject.toml found", "crosscheck", pyproject),
+        ("crosscheck: a config's scenes path", "crosscheck", config_scene),
+        ("crosscheck: a config's candidate path", "crosscheck", config_candidate),
+        ("crosscheck --scene-list", "crosscheck", scene_list),
+        ("crosscheck: a --scene-list line", "crosscheck", scene_list_line),
+        ("crosscheck --scene DIR", "crosscheck", scene_dir),
+        ("crosscheck --scene X.obj", "crosscheck", scene_file),
+        ("crosscheck --candidate FILE.py", "crosscheck", candidate),
+        ("crosscheck --candidate-frames DIR", "crosscheck", frames_job_dir),
+    ]
+    for rel in (
+        "job.json",
+        "cameras/cube/on_axis/frame_0001.json",
+        "scenes/cube.obj",
+        "frames/cube/on_axis/frame_0001.png",
+    ):
         out.append((f"crosscheck --candidate-frames: {rel}", "crosscheck", frames_file(rel)))
 
     def export_scene(suffix):
         def build(box, kind):
             make_special(kind, box / f"x{suffix}")
-            return ["export", str(box / "out"), "--scene", str(box / f"x{suffix}"), "--cases", "on_axis",
-                    "--frames", "1"]
+            return [
+                "export",
+                str(box / "out"),
+                "--scene",
+                str(box / f"x{suffix}"),
+                "--cases",
+                "on_axis",
+                "--frames",
+                "1",
+            ]
+
         return build
 
     def export_target(box, kind):
@@ -257,16 +294,21 @@ def file_inputs():
         make_special(kind, box / "j.xml")
         return [*QUICK, "--scene", "cube", "--junit-xml", str(box / "j.xml")]
 
-    out += [("renderer --out", "renderer out", renderer_out),
-            ("crosscheck --report-dir", "crosscheck out", report_dir),
-            ("crosscheck --junit-xml", "crosscheck", junit)]
-    out += [("crosscheck export --scene X.scene", "crosscheck", export_scene(".scene")),
-            ("crosscheck export --scene X.obj", "crosscheck", export_scene(".obj")),
-            ("crosscheck export DIR", "crosscheck", export_target)]
+    out += [
+        ("renderer --out", "renderer out", renderer_out),
+        ("crosscheck --report-dir", "crosscheck out", report_dir),
+        ("crosscheck --junit-xml", "crosscheck", junit),
+    ]
+    out += [
+        ("crosscheck export --scene X.scene", "crosscheck", export_scene(".scene")),
+        ("crosscheck export --scene X.obj", "crosscheck", export_scene(".obj")),
+        ("crosscheck export DIR", "crosscheck", export_target),
+    ]
     return out
 
 
 # ---- the contract ---------------------------------------------------------------------------------------
+
 
 def snapshot(box: Path) -> dict:
     """Every path under ``box``: its kind and, for a regular file up to 16 MiB, its SHA-256 (nothing else opened)."""
@@ -301,7 +343,7 @@ def run_one(main, argv: list[str], box: Path, output: Path | None) -> dict:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 rc = main(argv)
-            except SystemExit as exc:                   # argparse
+            except SystemExit as exc:  # argparse
                 rc = exc.code if isinstance(exc.code, int) else 2
     except Hang:
         rc = None
@@ -324,8 +366,11 @@ def run_one(main, argv: list[str], box: Path, output: Path | None) -> dict:
     if "expected one argument" in stderr:
         found.append("a negative value read as an option")
     after = snapshot(box)
-    if any(p not in after or after[p] != before[p] for p in before
-           if before[p][0] != "dir" and not (rc in (0, 1) and output is not None and _under(box / p, output))):
+    if any(
+        p not in after or after[p] != before[p]
+        for p in before
+        if before[p][0] != "dir" and not (rc in (0, 1) and output is not None and _under(box / p, output))
+    ):
         found.append("user files touched")
     new = [p for p in after if p not in before]
     if rc not in (0, 1) and new:
@@ -342,9 +387,13 @@ def _under(path: Path, folder: Path) -> bool:
 def _tally(results: list[dict]) -> dict:
     codes = collections.Counter("hang" if r["rc"] is None else r["rc"] for r in results)
     found = collections.Counter(f for r in results for f in set(r["found"]))
-    return {"inputs": len(results), "exit_codes": {str(k): v for k, v in sorted(codes.items(), key=str)},
-            "findings": dict(found), "slowest_s": max((r["seconds"] for r in results), default=0),
-            "examples": [r for r in results if r["found"]][:10]}
+    return {
+        "inputs": len(results),
+        "exit_codes": {str(k): v for k, v in sorted(codes.items(), key=str)},
+        "findings": dict(found),
+        "slowest_s": max((r["seconds"] for r in results), default=0),
+        "examples": [r for r in results if r["found"]][:10],
+    }
 
 
 def fuzz_files() -> dict:
@@ -357,7 +406,7 @@ def fuzz_files() -> dict:
             with tempfile.TemporaryDirectory(prefix="wirecheck-r4-") as d:
                 box = Path(d)
                 argv = build(box, kind)
-                if cli == "renderer out":                   # the special file is the output folder
+                if cli == "renderer out":  # the special file is the output folder
                     argv += ["--frames", "1", "--width", "32", "--height", "24"]
                     output = box / "o"
                 elif cli == "crosscheck out":
@@ -373,41 +422,87 @@ def fuzz_files() -> dict:
                 r = run_one(renderer.main if cli.startswith("renderer") else crosscheck.main, argv, box, output)
                 r.update(input=f"{name} <- {kind}", argv=argv)
                 results.append(r)
-                print(f"  {r['rc']} {r['seconds']:6.2f}s {name} <- {kind}: {r['stderr'].strip()[:150]}",
-                      file=sys.stderr, flush=True)
+                print(
+                    f"  {r['rc']} {r['seconds']:6.2f}s {name} <- {kind}: {r['stderr'].strip()[:150]}",
+                    file=sys.stderr,
+                    flush=True,
+                )
     return _tally(results) | {"surface": "files", "special kinds": len(KINDS), "places": len(file_inputs())}
 
 
 # ---- numeric flags --------------------------------------------------------------------------------------
 
-SCALARS = ["-inf", "inf", "nan", "-nan", "-1e5", "1e400", "-0", "-1", "0", "1e308", str(2 ** 63), "\u0664"]
+SCALARS = ["-inf", "inf", "nan", "-nan", "-1e5", "1e400", "-0", "-1", "0", "1e308", str(2**63), "\u0664"]
 VECTORS = ["-inf,0,0", "nan,1,1", "-1e5,0,0", "1e400,0,0", "-1,-2,-3", "-0,-0,-0", "1,2", "-1,2,3,4"]
 
-RENDERER_SCALAR = ["--frames", "--camera-z", "--fov", "--near", "--far", "--width", "--height", "--ortho-height",
-                   "--scale", "--ascii-cols", "--trace-vertex", "--port"]
-RENDERER_VECTOR = ["--camera-pos", "--look-at", "--up", "--spin", "--translate", "--light", "--intrinsics",
-                   "--distortion", "--trace-frames", "--compare-z", "--compare-fov"]
-CROSSCHECK_SCALAR = ["--frames", "--candidate-timeout", "--every", "--jobs", "--scheduler-timeout", "--tol-px",
-                     "--min-f1", "--min-f1-0px", "--min-iou"]
+RENDERER_SCALAR = [
+    "--frames",
+    "--camera-z",
+    "--fov",
+    "--near",
+    "--far",
+    "--width",
+    "--height",
+    "--ortho-height",
+    "--scale",
+    "--ascii-cols",
+    "--trace-vertex",
+    "--port",
+]
+RENDERER_VECTOR = [
+    "--camera-pos",
+    "--look-at",
+    "--up",
+    "--spin",
+    "--translate",
+    "--light",
+    "--intrinsics",
+    "--distortion",
+    "--trace-frames",
+    "--compare-z",
+    "--compare-fov",
+]
+CROSSCHECK_SCALAR = [
+    "--frames",
+    "--candidate-timeout",
+    "--every",
+    "--jobs",
+    "--scheduler-timeout",
+    "--tol-px",
+    "--min-f1",
+    "--min-f1-0px",
+    "--min-iou",
+]
 CROSSCHECK_VECTOR = ["--spin"]
 EXPORT_SCALAR = ["--frames", "--every", "--phase"]
 EXPORT_VECTOR = ["--spin"]
 
 #: what a flag needs beside it to be read at all
-NEEDS = {"--ortho-height": ["--projection", "orthographic"], "--look-at": ["--camera-pos", "3,2,4"],
-         "--up": ["--camera-pos", "3,2,4"], "--light": ["--style", "shaded"],
-         "--trace-frames": ["--trace-vertex", "0"], "--compare-z": ["--compare"], "--compare-fov": ["--compare"],
-         "--port": ["--interactive"], "--min-iou": ["--level", "pixels"], "--min-f1": ["--level", "pixels"],
-         "--min-f1-0px": ["--level", "pixels"], "--scheduler-timeout": ["--executor", "dask"],
-         "--candidate-timeout": ["--candidate-cmd", "true"]}
+NEEDS = {
+    "--ortho-height": ["--projection", "orthographic"],
+    "--look-at": ["--camera-pos", "3,2,4"],
+    "--up": ["--camera-pos", "3,2,4"],
+    "--light": ["--style", "shaded"],
+    "--trace-frames": ["--trace-vertex", "0"],
+    "--compare-z": ["--compare"],
+    "--compare-fov": ["--compare"],
+    "--port": ["--interactive"],
+    "--min-iou": ["--level", "pixels"],
+    "--min-f1": ["--level", "pixels"],
+    "--min-f1-0px": ["--level", "pixels"],
+    "--scheduler-timeout": ["--executor", "dask"],
+    "--candidate-timeout": ["--candidate-cmd", "true"],
+}
 
 
 def flag_inputs():
     """``(cli, flag, value)`` for every numeric flag and hostile value."""
     out = []
-    for cli, scalars, vectors in (("renderer", RENDERER_SCALAR, RENDERER_VECTOR),
-                                  ("crosscheck", CROSSCHECK_SCALAR, CROSSCHECK_VECTOR),
-                                  ("export", EXPORT_SCALAR, EXPORT_VECTOR)):
+    for cli, scalars, vectors in (
+        ("renderer", RENDERER_SCALAR, RENDERER_VECTOR),
+        ("crosscheck", CROSSCHECK_SCALAR, CROSSCHECK_VECTOR),
+        ("export", EXPORT_SCALAR, EXPORT_VECTOR),
+    ):
         out += [(cli, f, v) for f in scalars for v in SCALARS]
         out += [(cli, f, v) for f in vectors for v in VECTORS + ["-inf", "nan"]]
     return out
@@ -424,26 +519,55 @@ def fuzz_flags() -> dict:
             extra = NEEDS.get(flag, [])
             if cli == "renderer":
                 if flag == "--port" and value in ("0", "-0"):
-                    continue                                # a real viewer serving until killed
-                argv = ["--scene", "cube", "--frames", "1", "--width", "32", "--height", "24", "--format", "png",
-                        "--out", str(box / "out"), *extra, flag, value]
+                    continue  # a real viewer serving until killed
+                argv = [
+                    "--scene",
+                    "cube",
+                    "--frames",
+                    "1",
+                    "--width",
+                    "32",
+                    "--height",
+                    "24",
+                    "--format",
+                    "png",
+                    "--out",
+                    str(box / "out"),
+                    *extra,
+                    flag,
+                    value,
+                ]
                 main, output = renderer.main, box / "out"
             elif cli == "crosscheck":
                 argv = ["--scene", "cube", *QUICK, "--report-dir", str(box / "rep"), *extra, flag, value]
                 main, output = crosscheck.main, box / "rep"
             else:
-                argv = ["export", str(box / "job"), "--scene", "cube", "--cases", "on_axis", "--frames", "1",
-                        flag, value]
+                argv = [
+                    "export",
+                    str(box / "job"),
+                    "--scene",
+                    "cube",
+                    "--cases",
+                    "on_axis",
+                    "--frames",
+                    "1",
+                    flag,
+                    value,
+                ]
                 main, output = crosscheck.main, box / "job"
             r = run_one(main, argv, box, output)
             r.update(input=f"{cli} {flag} {value}", argv=argv)
             results.append(r)
-            print(f"  {r['rc']} {r['seconds']:6.2f}s {cli} {flag} {value}: {r['stderr'].strip()[:150]}",
-                  file=sys.stderr, flush=True)
+            print(
+                f"  {r['rc']} {r['seconds']:6.2f}s {cli} {flag} {value}: {r['stderr'].strip()[:150]}",
+                file=sys.stderr,
+                flush=True,
+            )
     return _tally(results) | {"surface": "flags"}
 
 
 # ---- viewer requests ------------------------------------------------------------------------------------
+
 
 def viewer_requests(port: int, rng: random.Random) -> list[tuple[str, bytes, bool]]:
     """``(name, raw request, may_be_200)``: may_be_200 for what the viewer's own page could send."""
@@ -454,28 +578,57 @@ def viewer_requests(port: int, rng: random.Random) -> list[tuple[str, bytes, boo
         head = f"POST {target} {version}\r\n" + "".join(f"{k}: {v}\r\n" for k, v in headers)
         return head.encode("latin-1") + b"\r\n" + data
 
-    good = [("Host", own), ("Content-Type", "application/json"), ("Content-Length", str(len(body))),
-            ("Connection", "close")]
-    out = [("good POST", post(good), True),
-           ("good GET", f"GET /api/frame HTTP/1.1\r\nHost: {own}\r\nConnection: close\r\n\r\n".encode(), True)]
+    good = [
+        ("Host", own),
+        ("Content-Type", "application/json"),
+        ("Content-Length", str(len(body))),
+        ("Connection", "close"),
+    ]
+    out = [
+        ("good POST", post(good), True),
+        ("good GET", f"GET /api/frame HTTP/1.1\r\nHost: {own}\r\nConnection: close\r\n\r\n".encode(), True),
+    ]
     for name in ("Host", "Origin", "Content-Type", "Content-Length"):
-        value = {"Host": own, "Origin": f"http://{own}", "Content-Type": "application/json",
-                 "Content-Length": str(len(body))}[name]
+        value = {
+            "Host": own,
+            "Origin": f"http://{own}",
+            "Content-Type": "application/json",
+            "Content-Length": str(len(body)),
+        }[name]
         for second in (value, "evil.example:80", other if name == "Host" else "0"):
             headers = [h for h in good if h[0] != name] + [(name, value), (name, second)]
             out.append((f"two {name} ({value}, {second})", post(headers), False))
             headers = [h for h in good if h[0] != name] + [(name, value), (name.lower(), second)]
             out.append((f"two {name}, the second lower-case", post(headers), False))
-    for host in ("", " ", f"{own} ", f"{own}.", f"127.0.0.1.:{port}", f"{own}@evil", "127.0.0.1",
-                 f"[::1]:{port}", f"127.0.0.1:{port + 1}", "evil.example", own.upper(), f"0x7f000001:{port}",
-                 f"{own}\x00evil", f"127.0.0.1:0{port}"):
+    for host in (
+        "",
+        " ",
+        f"{own} ",
+        f"{own}.",
+        f"127.0.0.1.:{port}",
+        f"{own}@evil",
+        "127.0.0.1",
+        f"[::1]:{port}",
+        f"127.0.0.1:{port + 1}",
+        "evil.example",
+        own.upper(),
+        f"0x7f000001:{port}",
+        f"{own}\x00evil",
+        f"127.0.0.1:0{port}",
+    ):
         headers = [h for h in good if h[0] != "Host"] + [("Host", host)]
         out.append((f"Host {host!r}", post(headers), host in (own, own.upper())))
     out += [
         ("no Host", post([h for h in good if h[0] != "Host"]), False),
         ("absolute-form target", post(good, target="http://evil.example/api/frame"), False),
-        ("chunked body", post([h for h in good if h[0] != "Content-Length"] + [("Transfer-Encoding", "chunked")],
-                              data=b"%x\r\n" % len(body) + body + b"\r\n0\r\n\r\n"), False),
+        (
+            "chunked body",
+            post(
+                [h for h in good if h[0] != "Content-Length"] + [("Transfer-Encoding", "chunked")],
+                data=b"%x\r\n" % len(body) + body + b"\r\n0\r\n\r\n",
+            ),
+            False,
+        ),
         ("length and chunked", post(good + [("Transfer-Encoding", "chunked")]), False),
         ("HTTP/0.9", b"GET /api/frame\r\n\r\n", False),
         ("HTTP/2.0 line", post(good, version="HTTP/2.0"), False),
@@ -487,7 +640,7 @@ def viewer_requests(port: int, rng: random.Random) -> list[tuple[str, bytes, boo
         ("length +5", post([h for h in good if h[0] != "Content-Length"] + [("Content-Length", "+5")]), False),
         ("Origin null", post(good + [("Origin", "null")]), False),
     ]
-    for i in range(60):                                  # random byte mutations of the good POST
+    for i in range(60):  # random byte mutations of the good POST
         raw = bytearray(post(good))
         for _ in range(rng.randint(1, 4)):
             k = rng.randrange(len(raw))
@@ -526,8 +679,11 @@ def fuzz_viewer(seed: int) -> dict:
 
     codes, found, examples = collections.Counter(), collections.Counter(), []
     with tempfile.TemporaryDirectory(prefix="wirecheck-r4-") as d:
-        settings = settings_from_args(build_parser().parse_args(
-            ["--frames", "6", "--width", "64", "--height", "48", "--out", str(Path(d) / "out")]))
+        settings = settings_from_args(
+            build_parser().parse_args(
+                ["--frames", "6", "--width", "64", "--height", "48", "--out", str(Path(d) / "out")]
+            )
+        )
         err = io.StringIO()
         with contextlib.redirect_stderr(err):
             srv = Server(Viewer(settings)).start()
@@ -546,7 +702,7 @@ def fuzz_viewer(seed: int) -> dict:
                         problems.append("answers without a status line")
                     if status == 200 and not may_be_200:
                         problems.append("200 to a hostile request")
-                    if isinstance(status, int) and status >= 500 and status not in (501, 505):   # http.server's own
+                    if isinstance(status, int) and status >= 500 and status not in (501, 505):  # http.server's own
                         problems.append("5xx")
                     if _send(port, good) != 200:
                         problems.append("server stopped answering")
@@ -560,8 +716,13 @@ def fuzz_viewer(seed: int) -> dict:
                         examples.append({"input": name, "status": status, "found": problems})
             finally:
                 srv.stop()
-    return {"surface": "viewer", "inputs": len(requests), "statuses": {str(k): v for k, v in sorted(codes.items(), key=str)},
-            "findings": dict(found), "examples": examples}
+    return {
+        "surface": "viewer",
+        "inputs": len(requests),
+        "statuses": {str(k): v for k, v in sorted(codes.items(), key=str)},
+        "findings": dict(found),
+        "examples": examples,
+    }
 
 
 def main(argv=None) -> int:
@@ -571,8 +732,12 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=36)
     p.add_argument("--json", default=None, help="also write the counts here")
     p.add_argument("--timeout", type=int, default=TIMEOUT_S, help="seconds an input may run (default 60)")
-    p.add_argument("--memory-gb", type=float, default=8.0,
-                   help="address-space limit of this process (default 8: a reader of /dev/zero fails, not the machine)")
+    p.add_argument(
+        "--memory-gb",
+        type=float,
+        default=8.0,
+        help="address-space limit of this process (default 8: a reader of /dev/zero fails, not the machine)",
+    )
     a = p.parse_args(argv)
     TIMEOUT_S = a.timeout
     limit = int(a.memory_gb * (1 << 30))
@@ -582,7 +747,7 @@ def main(argv=None) -> int:
     signal.signal(signal.SIGALRM, _alarm)
     results = []
     t0 = time.perf_counter()
-    for surface in (("files", "flags", "viewer") if a.surface == "all" else (a.surface,)):
+    for surface in ("files", "flags", "viewer") if a.surface == "all" else (a.surface,):
         t = time.perf_counter()
         r = fuzz_files() if surface == "files" else fuzz_flags() if surface == "flags" else fuzz_viewer(a.seed)
         r["seconds"] = round(time.perf_counter() - t)

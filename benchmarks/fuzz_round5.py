@@ -59,7 +59,7 @@ QUICK_UNPROJECT = ["--scene", "cube", "--cases", "on_axis", "--frames", "1"]
 
 # ---- hostile projectors and unprojectors (written into each input's in/ folder) ------------------------
 
-CANDIDATES = '''
+CANDIDATES = """
 import os, sys, time
 import numpy as np
 sys.path.insert(0, TESTS_DATA)
@@ -113,9 +113,9 @@ def nan_on_empty(points, camera):
 def prints(points, camera):
     print("x" * 100000)
     return _ok(points, camera)
-'''
+"""
 
-UNPROJECTORS = '''
+UNPROJECTORS = """
 import os, sys, time
 import numpy as np
 
@@ -198,12 +198,12 @@ def raises_recursion(pixels, depth, camera):
     return raises_recursion(pixels, depth, camera)
 def not_callable_two(pixels, camera):
     return pixels
-'''
+"""
 
 # Unprojectors a correct judge may pass (their answers are right, whatever their container).
 UNPROJECT_MAY_PASS = {"correct", "as_list", "ints", "matrix", "object_array", "prints", "generator"}
 
-PEER = r'''
+PEER = r"""
 import json, sys, time
 import numpy as np
 mode = sys.argv[1]
@@ -272,19 +272,41 @@ while True:
         sys.stderr.write("noise\n" * 200000); sys.stderr.flush()
         stdout.write(json.dumps({"n": n}).encode() + b"\n" + body)
     stdout.flush()
-'''
-PEER_MODES = ("garbage_header", "no_newline_header", "silent", "exit_at_once", "garbage_reply", "short_reply",
-              "short_then_exit", "huge_n", "huge_n_exit", "negative_n", "float_n", "string_n", "bool_n", "wrong_n",
-              "nan_bytes", "endless_line", "json_list", "huge_error", "error_not_string", "extra_bytes",
-              "nan_json", "deep_json", "exit_mid", "stderr_flood")
+"""
+PEER_MODES = (
+    "garbage_header",
+    "no_newline_header",
+    "silent",
+    "exit_at_once",
+    "garbage_reply",
+    "short_reply",
+    "short_then_exit",
+    "huge_n",
+    "huge_n_exit",
+    "negative_n",
+    "float_n",
+    "string_n",
+    "bool_n",
+    "wrong_n",
+    "nan_bytes",
+    "endless_line",
+    "json_list",
+    "huge_error",
+    "error_not_string",
+    "extra_bytes",
+    "nan_json",
+    "deep_json",
+    "exit_mid",
+    "stderr_flood",
+)
 
 
 # ---- drivers run in the input's subprocess ------------------------------------------------------------
 
+
 def depth_driver(path: str, width: int, height: int, scale) -> int:
     """read_depth_map on one file: 0 and a summary, 2 and one line (InputError), 4 an invalid map accepted."""
     import numpy as np
-
     from wirecheck.core.errors import InputError
     from wirecheck.oracles.candidates.depth_map import read_depth_map
 
@@ -295,14 +317,21 @@ def depth_driver(path: str, width: int, height: int, scale) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     d = m.depth
-    ok = (isinstance(d, np.ndarray) and d.dtype == np.float64 and d.shape == (height, width)
-          and bool(np.all(np.isnan(d) | (np.isfinite(d) & (d > 0))))
-          and all(isinstance(v, float) and np.isfinite(v) and v >= 0 for v in (m.step, m.rel_step))
-          and bool(np.all(np.isfinite(m.encoding_bound()))))
+    ok = (
+        isinstance(d, np.ndarray)
+        and d.dtype == np.float64
+        and d.shape == (height, width)
+        and bool(np.all(np.isnan(d) | (np.isfinite(d) & (d > 0))))
+        and all(isinstance(v, float) and np.isfinite(v) and v >= 0 for v in (m.step, m.rel_step))
+        and bool(np.all(np.isfinite(m.encoding_bound())))
+    )
     print(f"read {m.encoding}: {int(np.isfinite(d).sum())} surface pixels, step {m.step!r}, rel {m.rel_step!r}")
     if not ok:
-        print(f"invalid map accepted: dtype {d.dtype}, shape {d.shape}, min {np.nanmin(d) if np.isfinite(d).any() else None}, "
-              f"step {m.step!r}, rel_step {m.rel_step!r}", file=sys.stderr)
+        print(
+            f"invalid map accepted: dtype {d.dtype}, shape {d.shape}, min {np.nanmin(d) if np.isfinite(d).any() else None}, "
+            f"step {m.step!r}, rel_step {m.rel_step!r}",
+            file=sys.stderr,
+        )
         return 4
     return 0
 
@@ -330,12 +359,13 @@ def unproject_api_driver(file: str, func: str) -> int:
 
 # ---- inputs ---------------------------------------------------------------------------------------------
 
+
 class Input:
     """One hostile input: argv built in its box, whether exit 0 is allowed, its timeout."""
 
     def __init__(self, surface, name, build, may_pass=False, timeout=TIMEOUT_S, must_pass=False):
         self.surface, self.name, self.build, self.may_pass, self.timeout = surface, name, build, may_pass, timeout
-        self.must_pass = must_pass          # a correct candidate in another container: failing it is a bug
+        self.must_pass = must_pass  # a correct candidate in another container: failing it is a bug
 
 
 def spec_inputs():
@@ -345,22 +375,73 @@ def spec_inputs():
     def cand(func, extra=()):
         def build(box):
             (box / "in" / "cands.py").write_text(CANDIDATES.replace("TESTS_DATA", repr(str(ROOT / "tests" / "data"))))
-            wait = "0.5" if func == "hang" else "10"       # a correct one's first request waits for its start-up
-            return CROSSCHECK + base + ["--candidate", f"{box / 'in' / 'cands.py'}:{func}", "--candidate-timeout", wait,
-                                        "--report-dir", str(box / "out" / "rep")] + list(extra)
+            wait = "0.5" if func == "hang" else "10"  # a correct one's first request waits for its start-up
+            return (
+                CROSSCHECK
+                + base
+                + [
+                    "--candidate",
+                    f"{box / 'in' / 'cands.py'}:{func}",
+                    "--candidate-timeout",
+                    wait,
+                    "--report-dir",
+                    str(box / "out" / "rep"),
+                ]
+                + list(extra)
+            )
+
         return build
 
-    for func in ("correct", "hang", "hard_exit", "sys_exit", "kill_self", "nan", "inf", "huge", "shape_n3",
-                 "shape_2n", "flat", "none", "as_list", "generator", "float16", "strings", "complex_",
-                 "raises_on_empty", "nan_on_empty", "prints"):
+    for func in (
+        "correct",
+        "hang",
+        "hard_exit",
+        "sys_exit",
+        "kill_self",
+        "nan",
+        "inf",
+        "huge",
+        "shape_n3",
+        "shape_2n",
+        "flat",
+        "none",
+        "as_list",
+        "generator",
+        "float16",
+        "strings",
+        "complex_",
+        "raises_on_empty",
+        "nan_on_empty",
+        "prints",
+    ):
         ok = func in ("correct", "as_list", "prints")
-        out.append(Input("spec", f"--candidate {func}", cand(func), may_pass=ok, must_pass=ok,
-                         timeout=120 if func == "hang" else TIMEOUT_S))
+        out.append(
+            Input(
+                "spec",
+                f"--candidate {func}",
+                cand(func),
+                may_pass=ok,
+                must_pass=ok,
+                timeout=120 if func == "hang" else TIMEOUT_S,
+            )
+        )
     for prec in ("float32", "float64"):
-        out.append(Input("spec", f"--candidate float16 --candidate-precision {prec}",
-                         cand("float16", ["--candidate-precision", prec])))
-        out.append(Input("spec", f"--candidate correct --candidate-precision {prec}",
-                         cand("correct", ["--candidate-precision", prec]), may_pass=True, must_pass=True))
+        out.append(
+            Input(
+                "spec",
+                f"--candidate float16 --candidate-precision {prec}",
+                cand("float16", ["--candidate-precision", prec]),
+            )
+        )
+        out.append(
+            Input(
+                "spec",
+                f"--candidate correct --candidate-precision {prec}",
+                cand("correct", ["--candidate-precision", prec]),
+                may_pass=True,
+                must_pass=True,
+            )
+        )
 
     def combo(extra, with_cand=False):
         def build(box):
@@ -370,44 +451,118 @@ def spec_inputs():
             if with_cand:
                 argv += ["--candidate", f"{box / 'in' / 'cands.py'}:correct"]
             return argv + [a.replace("IN", str(box / "in")) for a in extra]
+
         return build
 
     combos = [
-        ["--candidate-precision", "float32"], ["--candidate-precision", "float16"], ["--candidate-precision", ""],
-        ["--unprojector", "IN/unp.py:correct"], ["--unprojector-cmd", "true"], ["--sweep"], ["--scene", "cube"],
-        ["--frames", "0"], ["--frames", "3"], ["--cases", "on_axis"], ["--candidate-frames", "IN"],
-        ["--candidate-cmd", "IN/nothing-here"], ["--candidate-cmd", "'unbalanced"], ["--candidate-cmd", ""],
-        ["--candidate-cmd", "false"], ["--candidate", "IN/cands.py:missing"], ["--candidate", "IN/cands.py"],
-        ["--candidate", "IN/cands.py:correct", "--candidate-cmd", "true"], ["--no-report"],
-        ["--run", "../../escape"], ["--memory-budget", "1"], ["--every", "0"], ["--oracles", "nothing"],
-        ["--candidate-timeout", "0"], ["--candidate-timeout", "nan"], ["--candidate-timeout", "-1"],
-        ["--suite", "spec"], ["--allow-vacuous"], ["--level", "pixels", "--gl", "nonsense"],
+        ["--candidate-precision", "float32"],
+        ["--candidate-precision", "float16"],
+        ["--candidate-precision", ""],
+        ["--unprojector", "IN/unp.py:correct"],
+        ["--unprojector-cmd", "true"],
+        ["--sweep"],
+        ["--scene", "cube"],
+        ["--frames", "0"],
+        ["--frames", "3"],
+        ["--cases", "on_axis"],
+        ["--candidate-frames", "IN"],
+        ["--candidate-cmd", "IN/nothing-here"],
+        ["--candidate-cmd", "'unbalanced"],
+        ["--candidate-cmd", ""],
+        ["--candidate-cmd", "false"],
+        ["--candidate", "IN/cands.py:missing"],
+        ["--candidate", "IN/cands.py"],
+        ["--candidate", "IN/cands.py:correct", "--candidate-cmd", "true"],
+        ["--no-report"],
+        ["--run", "../../escape"],
+        ["--memory-budget", "1"],
+        ["--every", "0"],
+        ["--oracles", "nothing"],
+        ["--candidate-timeout", "0"],
+        ["--candidate-timeout", "nan"],
+        ["--candidate-timeout", "-1"],
+        ["--suite", "spec"],
+        ["--allow-vacuous"],
+        ["--level", "pixels", "--gl", "nonsense"],
     ]
     for extra in combos:
-        out.append(Input("spec", "spec " + " ".join(extra), combo(extra), may_pass=True))   # core: a real pass
+        out.append(Input("spec", "spec " + " ".join(extra), combo(extra), may_pass=True))  # core: a real pass
     for mode in ("silent", "garbage_reply", "exit_at_once", "nan_bytes", "huge_n", "short_then_exit"):
+
         def build(box, mode=mode):
             (box / "in" / "peer.py").write_text(PEER)
-            return CROSSCHECK + base + ["--candidate-cmd", f"{PY} {box / 'in' / 'peer.py'} {mode}",
-                                        "--candidate-timeout", "0.5", "--report-dir", str(box / "out" / "rep")]
+            return (
+                CROSSCHECK
+                + base
+                + [
+                    "--candidate-cmd",
+                    f"{PY} {box / 'in' / 'peer.py'} {mode}",
+                    "--candidate-timeout",
+                    "0.5",
+                    "--report-dir",
+                    str(box / "out" / "rep"),
+                ]
+            )
+
         out.append(Input("spec", f"--candidate-cmd peer {mode}", build, timeout=120))
-    out.append(Input("spec", "spec --candidate correct --candidate-precision float32 --candidate-cmd true",
-                     combo(["--candidate-cmd", "true"], with_cand=True), may_pass=True))
+    out.append(
+        Input(
+            "spec",
+            "spec --candidate correct --candidate-precision float32 --candidate-cmd true",
+            combo(["--candidate-cmd", "true"], with_cand=True),
+            may_pass=True,
+        )
+    )
     return out
 
 
 def unproject_inputs():
     out = []
-    funcs = ("correct", "hang", "hard_exit", "sys_exit", "kill_self", "nan", "inf", "neg_inf", "huge", "nan_one",
-             "float16", "as_list", "none", "n2", "n4", "transposed_shape", "generator", "strings", "complex_",
-             "bools", "ints", "int_huge", "uint64", "zeros", "scalar", "masked", "matrix", "object_array",
-             "mutates_input", "prints", "raises_base", "raises_recursion", "not_callable_two")
+    funcs = (
+        "correct",
+        "hang",
+        "hard_exit",
+        "sys_exit",
+        "kill_self",
+        "nan",
+        "inf",
+        "neg_inf",
+        "huge",
+        "nan_one",
+        "float16",
+        "as_list",
+        "none",
+        "n2",
+        "n4",
+        "transposed_shape",
+        "generator",
+        "strings",
+        "complex_",
+        "bools",
+        "ints",
+        "int_huge",
+        "uint64",
+        "zeros",
+        "scalar",
+        "masked",
+        "matrix",
+        "object_array",
+        "mutates_input",
+        "prints",
+        "raises_base",
+        "raises_recursion",
+        "not_callable_two",
+    )
 
     def cli(func):
         def build(box):
             (box / "in" / "unp.py").write_text(UNPROJECTORS)
-            return CROSSCHECK + ["--unprojector", f"{box / 'in' / 'unp.py'}:{func}", "--candidate-timeout", "2"] \
+            return (
+                CROSSCHECK
+                + ["--unprojector", f"{box / 'in' / 'unp.py'}:{func}", "--candidate-timeout", "2"]
                 + QUICK_UNPROJECT
+            )
+
         return build
 
     def api(func):
@@ -415,6 +570,7 @@ def unproject_inputs():
             (box / "in" / "unp.py").write_text(UNPROJECTORS)
             (box / "in" / "wire.scene").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\ne 0 1\ne 1 2\n")
             return [PY, __file__, "--unproject-api", str(box / "in" / "unp.py"), func]
+
         return build
 
     for func in funcs:
@@ -422,25 +578,55 @@ def unproject_inputs():
         may = func in UNPROJECT_MAY_PASS and func != "ints"
         must = func in ("correct", "as_list", "matrix", "prints")
         out.append(Input("unproject", f"--unprojector {func}", cli(func), may_pass=may, must_pass=must))
-        if func not in ("hang", "hard_exit", "kill_self", "raises_base"):   # in process: they end the caller, by design
+        if func not in ("hang", "hard_exit", "kill_self", "raises_base"):  # in process: they end the caller, by design
             out.append(Input("unproject", f"check_unprojector({func})", api(func), may_pass=may, must_pass=must))
     out.append(Input("unproject", "check_unprojector zero points (a wireframe scene)", api("ZERO_POINTS")))
 
     def zero_cli(box):
         (box / "in" / "unp.py").write_text(UNPROJECTORS)
         (box / "in" / "wire.scene").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\ne 0 1\ne 1 2\n")
-        return CROSSCHECK + ["--unprojector", f"{box / 'in' / 'unp.py'}:correct", "--scene",
-                             str(box / "in" / "wire.scene"), "--cases", "on_axis", "--frames", "1"]
+        return CROSSCHECK + [
+            "--unprojector",
+            f"{box / 'in' / 'unp.py'}:correct",
+            "--scene",
+            str(box / "in" / "wire.scene"),
+            "--cases",
+            "on_axis",
+            "--frames",
+            "1",
+        ]
+
     out.append(Input("unproject", "--unprojector zero points (a wireframe scene)", zero_cli))
-    for extra in (["--frames", "0"], ["--cases", ""], ["--cases", "nonsense"], ["--spin", "nan,0,0"],
-                  ["--spin", "1e308,1e308,1e308"], ["--scene", "nonexistent"], ["--sweep"], ["--suite", "spec"],
-                  ["--junit-xml", "OUT/j.xml"], ["--candidate-timeout", "0"], ["--unprojector-cmd", "true"]):
+    for extra in (
+        ["--frames", "0"],
+        ["--cases", ""],
+        ["--cases", "nonsense"],
+        ["--spin", "nan,0,0"],
+        ["--spin", "1e308,1e308,1e308"],
+        ["--scene", "nonexistent"],
+        ["--sweep"],
+        ["--suite", "spec"],
+        ["--junit-xml", "OUT/j.xml"],
+        ["--candidate-timeout", "0"],
+        ["--unprojector-cmd", "true"],
+    ):
+
         def build(box, extra=extra):
             (box / "in" / "unp.py").write_text(UNPROJECTORS)
-            return CROSSCHECK + ["--unprojector", f"{box / 'in' / 'unp.py'}:correct", "--scene", "cube",
-                                 "--cases", "on_axis"] + [a.replace("OUT", str(box / "out")) for a in extra]
-        out.append(Input("unproject", "--unprojector correct " + " ".join(extra), build,
-                         may_pass=extra[0] in ("--spin",) and extra[1].startswith("1e")))
+            return (
+                CROSSCHECK
+                + ["--unprojector", f"{box / 'in' / 'unp.py'}:correct", "--scene", "cube", "--cases", "on_axis"]
+                + [a.replace("OUT", str(box / "out")) for a in extra]
+            )
+
+        out.append(
+            Input(
+                "unproject",
+                "--unprojector correct " + " ".join(extra),
+                build,
+                may_pass=extra[0] in ("--spin",) and extra[1].startswith("1e"),
+            )
+        )
     return out
 
 
@@ -448,13 +634,29 @@ def peer_inputs():
     out = []
     for mode in PEER_MODES:
         for flag in ("--unprojector-cmd", "--candidate-cmd"):
+
             def build(box, mode=mode, flag=flag):
                 (box / "in" / "peer.py").write_text(PEER)
                 cmd = f"{PY} {box / 'in' / 'peer.py'} {mode}"
                 if flag == "--unprojector-cmd":
                     return CROSSCHECK + [flag, cmd, "--candidate-timeout", "2"] + QUICK_UNPROJECT
-                return CROSSCHECK + [flag, cmd, "--candidate-timeout", "2", "--level", "vertices", "--scene", "cube",
-                                     "--cases", "on_axis", "--frames", "1", "--report-dir", str(box / "out" / "rep")]
+                return CROSSCHECK + [
+                    flag,
+                    cmd,
+                    "--candidate-timeout",
+                    "2",
+                    "--level",
+                    "vertices",
+                    "--scene",
+                    "cube",
+                    "--cases",
+                    "on_axis",
+                    "--frames",
+                    "1",
+                    "--report-dir",
+                    str(box / "out" / "rep"),
+                ]
+
             out.append(Input("peer", f"{flag} peer {mode}", build))
     return out
 
@@ -477,6 +679,7 @@ def depth_inputs(seed: int):
         def build(box):
             path = make(box / "in")
             return [PY, __file__, "--depth-one", str(path), str(size[0]), str(size[1]), "s:" + scale]
+
         out.append(Input("depth", name, build, may_pass=may_pass, timeout=60))
 
     good = np.linspace(0.5, 3.0, W * H).reshape(H, W)
@@ -485,11 +688,35 @@ def depth_inputs(seed: int):
         def make(d):
             np.save(d / name, arr, **kw)
             return d / name
+
         return make
 
-    for dt in ("float32", "float64", "float16", "longdouble", "int8", "uint8", "int16", "uint16", "int32", "uint32",
-               "int64", "uint64", "bool", "complex64", "complex128", ">f4", ">f8", "<f4", "U3", "S3", "m8[s]", "M8[s]",
-               "V8", [("a", "<f4"), ("b", "<f4")]):
+    for dt in (
+        "float32",
+        "float64",
+        "float16",
+        "longdouble",
+        "int8",
+        "uint8",
+        "int16",
+        "uint16",
+        "int32",
+        "uint32",
+        "int64",
+        "uint64",
+        "bool",
+        "complex64",
+        "complex128",
+        ">f4",
+        ">f8",
+        "<f4",
+        "U3",
+        "S3",
+        "m8[s]",
+        "M8[s]",
+        "V8",
+        [("a", "<f4"), ("b", "<f4")],
+    ):
         dname = dt if isinstance(dt, str) else "structured"
         try:
             arr = good.astype(dt)
@@ -511,17 +738,27 @@ def depth_inputs(seed: int):
         class Evil:
             def __reduce__(self):
                 return (open, (str(marker), "w"))
+
         arr = np.empty((H, W), dtype=object)
         arr[0, 0] = Evil()
         with open(d / "d.npy", "wb") as fh:
             np.lib.format.write_array(fh, arr, allow_pickle=True)
         return d / "d.npy"
+
     add(".npy object array (a pickle that writes a file)", pickle_bomb)
     add(".npy object array of floats", npy_of(good.astype(object), allow_pickle=True))
     for name, header, body in [
         ("truncated body", b"{'descr': '<f4', 'fortran_order': False, 'shape': (6, 8), }", b"\0" * 17),
-        ("header claims 2^40 x 2^40", b"{'descr': '<f4', 'fortran_order': False, 'shape': (1099511627776, 1099511627776), }", b""),
-        ("header claims (6, 8) of 2^40-byte void", b"{'descr': '|V1099511627776', 'fortran_order': False, 'shape': (6, 8), }", b""),
+        (
+            "header claims 2^40 x 2^40",
+            b"{'descr': '<f4', 'fortran_order': False, 'shape': (1099511627776, 1099511627776), }",
+            b"",
+        ),
+        (
+            "header claims (6, 8) of 2^40-byte void",
+            b"{'descr': '|V1099511627776', 'fortran_order': False, 'shape': (6, 8), }",
+            b"",
+        ),
         ("negative shape", b"{'descr': '<f4', 'fortran_order': False, 'shape': (-6, -8), }", b""),
         ("header not a dict", b"[1, 2, 3]", b""),
         ("header code", b"__import__('os').system('touch PWNED2')", b""),
@@ -531,26 +768,32 @@ def depth_inputs(seed: int):
         ("extra key", b"{'descr': '<f4', 'fortran_order': False, 'shape': (6, 8), 'x': 1}", b"\0" * 192),
         ("float shape", b"{'descr': '<f4', 'fortran_order': False, 'shape': (6.0, 8.0), }", b"\0" * 192),
     ]:
+
         def make(d, header=header, body=body):
             _npy(d / "d.npy", header, body)
             return d / "d.npy"
+
         add(f".npy {name}", make)
 
-    def big_header(d):                                  # version 2: a 4-byte header length of 2^31
-        (d / "d.npy").write_bytes(b"\x93NUMPY\x02\x00" + (2 ** 31).to_bytes(4, "little") + b"{")
+    def big_header(d):  # version 2: a 4-byte header length of 2^31
+        (d / "d.npy").write_bytes(b"\x93NUMPY\x02\x00" + (2**31).to_bytes(4, "little") + b"{")
         return d / "d.npy"
+
     add(".npy header length 2^31 (v2)", big_header)
 
     def not_npy(d):
         (d / "d.npy").write_bytes(b"\x93NUMPX" + b"\0" * 100)
         return d / "d.npy"
+
     add(".npy bad magic", not_npy)
 
     def empty_file(d, suffix):
         def make(dd):
             (dd / f"d{suffix}").write_bytes(b"")
             return dd / f"d{suffix}"
+
         return make
+
     for suffix in (".npy", ".png", ".tif"):
         add(f"empty {suffix}", empty_file(None, suffix))
 
@@ -560,32 +803,46 @@ def depth_inputs(seed: int):
     def mutated(k):
         def make(d):
             import io
+
             buf = io.BytesIO()
             np.save(buf, good.astype(np.float32))
             data = bytearray(buf.getvalue())
             r = random.Random(seed * 1000 + k)
             for _ in range(r.randint(1, 6)):
-                i = r.randrange(0, 128)                   # the magic and the header
+                i = r.randrange(0, 128)  # the magic and the header
                 data[i] = r.randrange(256)
             (d / "d.npy").write_bytes(bytes(data))
             return d / "d.npy"
+
         return make
+
     for k in range(12):
-        add(f".npy header mutation {k} (seed {seed})", mutated(k), may_pass=True)   # may still be a valid map
+        add(f".npy header mutation {k} (seed {seed})", mutated(k), may_pass=True)  # may still be a valid map
     del rng, valid_npy
 
     # values
-    for name, val in (("negative", -1.0), ("nan", np.nan), ("+inf", np.inf), ("-inf", -np.inf),
-                      ("subnormal", 1e-310), ("float32 subnormal", 1e-40), ("-0.0", -0.0), ("1e38", 1e38),
-                      ("float64 1e300", 1e300)):
+    for name, val in (
+        ("negative", -1.0),
+        ("nan", np.nan),
+        ("+inf", np.inf),
+        ("-inf", -np.inf),
+        ("subnormal", 1e-310),
+        ("float32 subnormal", 1e-40),
+        ("-0.0", -0.0),
+        ("1e38", 1e38),
+        ("float64 1e300", 1e300),
+    ):
         arr = good.copy()
         arr[2, 3] = val
         dt = np.float32 if name in ("float32 subnormal", "1e38") else np.float64
-        add(f".npy value {name}", npy_of(arr.astype(dt)),
-            may_pass=name in ("nan", "+inf", "subnormal", "float32 subnormal", "-0.0", "1e38", "float64 1e300"))
+        add(
+            f".npy value {name}",
+            npy_of(arr.astype(dt)),
+            may_pass=name in ("nan", "+inf", "subnormal", "float32 subnormal", "-0.0", "1e38", "float64 1e300"),
+        )
     add(".npy all NaN", npy_of(np.full((H, W), np.nan, np.float32)), may_pass=True)
     add(".npy wrong size", npy_of(good.astype(np.float32)), size=(W + 1, H))
-    add(".npy huge size asked", npy_of(good.astype(np.float32)), size=(2 ** 31, 2 ** 31))
+    add(".npy huge size asked", npy_of(good.astype(np.float32)), size=(2**31, 2**31))
     add(".npy negative size asked", npy_of(good.astype(np.float32)), size=(-8, -6))
 
     # images
@@ -607,18 +864,21 @@ def depth_inputs(seed: int):
                 im = Image.new(mode, (W, H))
             im.save(d / f"d{suffix}", **save)
             return d / f"d{suffix}"
+
         return make
 
     for mode in ("F", "I", "I;16", "L", "LA", "P", "PA", "RGB", "RGBA", "CMYK", "1", "YCbCr", "LAB", "HSV", "I;16B"):
         for suffix in (".tif", ".png"):
-            ok = (mode, suffix) in (("F", ".tif"), ("I;16", ".png"), ("I;16B", ".png"))   # a PNG is big-endian
+            ok = (mode, suffix) in (("F", ".tif"), ("I;16", ".png"), ("I;16B", ".png"))  # a PNG is big-endian
+
             def safe(d, mode=mode, suffix=suffix):
                 try:
                     return img(mode, suffix)(d)
-                except (OSError, ValueError, KeyError):       # Pillow cannot write it: write a stub
+                except (OSError, ValueError, KeyError):  # Pillow cannot write it: write a stub
                     p = d / f"d{suffix}"
                     p.write_bytes(b"")
                     return p
+
             add(f"{suffix} mode {mode}", safe, may_pass=ok)
     for comp in ("tiff_lzw", "tiff_deflate", "packbits", "tiff_adobe_deflate"):
         add(f".tif F {comp}", img("F", ".tif", compression=comp), may_pass=True)
@@ -634,8 +894,11 @@ def depth_inputs(seed: int):
         def make(d):
             channels = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}.get(color_type, 1)
             row = (w * channels * bit_depth + 7) // 8
-            raw = idat if idat is not None else b"".join(b"\0" + bytes(range(row)) [:row].ljust(row, b"\1")
-                                                         for _ in range(h))
+            raw = (
+                idat
+                if idat is not None
+                else b"".join(b"\0" + bytes(range(row))[:row].ljust(row, b"\1") for _ in range(h))
+            )
             data = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, bit_depth, color_type, 0, 0, 0))
             if palette:
                 data += chunk(b"PLTE", bytes(range(48)))
@@ -646,23 +909,61 @@ def depth_inputs(seed: int):
                 data = data[: len(data) - 9]
             (d / "d.png").write_bytes(data)
             return d / "d.png"
+
         return make
 
-    for bd, ct in ((1, 0), (2, 0), (4, 0), (8, 0), (16, 0), (16, 2), (16, 4), (16, 6), (8, 3), (4, 3), (16, 3),
-                   (3, 0), (0, 0), (32, 0), (16, 1), (16, 5)):
-        add(f".png hand-written bit depth {bd} colour type {ct}", png_raw(bd, ct, palette=ct == 3), may_pass=(bd, ct) == (16, 0))
+    for bd, ct in (
+        (1, 0),
+        (2, 0),
+        (4, 0),
+        (8, 0),
+        (16, 0),
+        (16, 2),
+        (16, 4),
+        (16, 6),
+        (8, 3),
+        (4, 3),
+        (16, 3),
+        (3, 0),
+        (0, 0),
+        (32, 0),
+        (16, 1),
+        (16, 5),
+    ):
+        add(
+            f".png hand-written bit depth {bd} colour type {ct}",
+            png_raw(bd, ct, palette=ct == 3),
+            may_pass=(bd, ct) == (16, 0),
+        )
     add(".png 16-bit truncated", png_raw(16, 0, trunc=True))
     add(".png 16-bit IDAT short", png_raw(16, 0, idat=b"\0\1\2"))
-    add(".png 16-bit 2^31 x 1", png_raw(16, 0, w=2 ** 31 - 1, h=1, idat=b"\0"))
+    add(".png 16-bit 2^31 x 1", png_raw(16, 0, w=2**31 - 1, h=1, idat=b"\0"))
     add(".png 16-bit 100000 x 100000 (decompression bomb)", png_raw(16, 0, w=100000, h=100000, idat=b"\0"))
     add(".png 16-bit 0 x 0", png_raw(16, 0, w=0, h=0, idat=b""))
-    add(".png 16-bit values all zero", png_raw(16, 0, idat=b"".join(b"\0" + b"\0" * 16 for _ in range(H))),
-        may_pass=True)
-    for name, scale in (("0", "0"), ("-1", "-1"), ("inf", "Infinity"), ("nan", "NaN"), ("-inf", "-Infinity"),
-                        ("1e-320 (subnormal)", "1e-320"), ("1e-300", "1e-300"), ("1e308", "1e308"), ("true", "true"),
-                        ("string", "\"1000\""), ("list", "[1000]"), ("null", "null"), ("2^70", str(2 ** 70)),
-                        ("5000", "5000")):
-        add(f".png scale {name}", img("I;16", ".png"), scale=scale, may_pass=name in ("5000", "1e308", "2^70", "1e-300"))
+    add(
+        ".png 16-bit values all zero",
+        png_raw(16, 0, idat=b"".join(b"\0" + b"\0" * 16 for _ in range(H))),
+        may_pass=True,
+    )
+    for name, scale in (
+        ("0", "0"),
+        ("-1", "-1"),
+        ("inf", "Infinity"),
+        ("nan", "NaN"),
+        ("-inf", "-Infinity"),
+        ("1e-320 (subnormal)", "1e-320"),
+        ("1e-300", "1e-300"),
+        ("1e308", "1e308"),
+        ("true", "true"),
+        ("string", '"1000"'),
+        ("list", "[1000]"),
+        ("null", "null"),
+        ("2^70", str(2**70)),
+        ("5000", "5000"),
+    ):
+        add(
+            f".png scale {name}", img("I;16", ".png"), scale=scale, may_pass=name in ("5000", "1e308", "2^70", "1e-300")
+        )
         if name in ("0", "nan", "1e-320 (subnormal)"):
             add(f".npy scale {name}", npy_of(good.astype(np.float32)), scale=scale)
 
@@ -689,28 +990,43 @@ def depth_inputs(seed: int):
                 np.save(p, good.astype(np.float32)) if suffix == ".npy" else img("I;16", ".png")(d)
                 os.chmod(p if suffix == ".npy" else d / "d.png", 0)
             return p
+
         return make
-    for kind in ("fifo", "dev_zero", "dev_urandom", "dev_null", "folder", "sparse_64GiB", "link_loop", "dangling",
-                 "missing", "unreadable"):
+
+    for kind in (
+        "fifo",
+        "dev_zero",
+        "dev_urandom",
+        "dev_null",
+        "folder",
+        "sparse_64GiB",
+        "link_loop",
+        "dangling",
+        "missing",
+        "unreadable",
+    ):
         for suffix in (".npy", ".png", ".tif"):
             if kind == "unreadable" and suffix == ".tif":
                 continue
             add(f"{suffix} {kind}", special(kind, suffix), may_pass=kind == "unreadable" and os.geteuid() == 0)
 
-    def sparse_npy_valid_header(d):                 # a real header, then 64 GiB of holes
+    def sparse_npy_valid_header(d):  # a real header, then 64 GiB of holes
         p = d / "d.npy"
         _npy(p, b"{'descr': '<f4', 'fortran_order': False, 'shape': (131072, 131072), }")
         with open(p, "r+b") as fh:
             fh.truncate(SPARSE_BYTES + 128)
         return p
+
     add(".npy sparse 64 GiB with a valid header", sparse_npy_valid_header, size=(131072, 131072))
     add(".npy sparse 64 GiB header, small size asked", sparse_npy_valid_header)
     for suffix in (".exr", ".jpg", "", ".NPY", ".npy.gz"):
+
         def make(d, suffix=suffix):
             p = d / f"d{suffix}" if suffix else d / "d"
             np.save(d / "x.npy", good.astype(np.float32))
             os.replace(d / "x.npy", p)
             return p
+
         add(f"suffix '{suffix}'", make, may_pass=suffix == ".NPY")
     return out
 
@@ -718,34 +1034,104 @@ def depth_inputs(seed: int):
 def budget_inputs():
     out = []
     obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n"
-    for val in ("0", "-1", "nan", "-nan", "inf", "-inf", "1e300", "1e-300", "5e-324", "1e-9", "0.5", "abc", "",
-                "1e400", "0x10", "1_0", "١", "2", "-0"):
+    for val in (
+        "0",
+        "-1",
+        "nan",
+        "-nan",
+        "inf",
+        "-inf",
+        "1e300",
+        "1e-300",
+        "5e-324",
+        "1e-9",
+        "0.5",
+        "abc",
+        "",
+        "1e400",
+        "0x10",
+        "1_0",
+        "١",
+        "2",
+        "-0",
+    ):
+
         def build(box, val=val):
             (box / "in" / "ds").mkdir()
             (box / "in" / "ds" / "a.obj").write_text(obj)
-            return CROSSCHECK + ["--scene", str(box / "in" / "ds"), "--level", "vertices", "--frames", "1",
-                                 "--cases", "on_axis", "--report-dir", str(box / "out" / "rep"),
-                                 "--memory-budget", val]
+            return CROSSCHECK + [
+                "--scene",
+                str(box / "in" / "ds"),
+                "--level",
+                "vertices",
+                "--frames",
+                "1",
+                "--cases",
+                "on_axis",
+                "--report-dir",
+                str(box / "out" / "rep"),
+                "--memory-budget",
+                val,
+            ]
+
         out.append(Input("budget", f"--memory-budget {val!r}", build, may_pass=val in ("1e300", "2", "0.5", "inf")))
     for extra in (["--scene", "cube"], []):
+
         def build(box, extra=extra):
-            return CROSSCHECK + extra + ["--level", "vertices", "--frames", "1", "--cases", "on_axis",
-                                         "--report-dir", str(box / "out" / "rep"), "--memory-budget", "1"]
+            return (
+                CROSSCHECK
+                + extra
+                + [
+                    "--level",
+                    "vertices",
+                    "--frames",
+                    "1",
+                    "--cases",
+                    "on_axis",
+                    "--report-dir",
+                    str(box / "out" / "rep"),
+                    "--memory-budget",
+                    "1",
+                ]
+            )
+
         out.append(Input("budget", "--memory-budget without a dataset " + " ".join(extra), build))
 
     def empty_ds(box):
         (box / "in" / "ds").mkdir()
-        return CROSSCHECK + ["--scene", str(box / "in" / "ds"), "--level", "vertices", "--report-dir",
-                             str(box / "out" / "rep"), "--memory-budget", "1"]
+        return CROSSCHECK + [
+            "--scene",
+            str(box / "in" / "ds"),
+            "--level",
+            "vertices",
+            "--report-dir",
+            str(box / "out" / "rep"),
+            "--memory-budget",
+            "1",
+        ]
+
     out.append(Input("budget", "--memory-budget 1 on an empty folder", empty_ds))
 
     def all_over(box):
         (box / "in" / "ds").mkdir()
         (box / "in" / "ds" / "a.obj").write_text(obj)
         (box / "in" / "ds" / "b.obj").write_text(obj)
-        return CROSSCHECK + ["--scene", str(box / "in" / "ds"), "--level", "vertices", "--frames", "1",
-                             "--cases", "on_axis", "--report-dir", str(box / "out" / "rep"),
-                             "--memory-budget", "1e-6", "--allow-load-errors"]
+        return CROSSCHECK + [
+            "--scene",
+            str(box / "in" / "ds"),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--cases",
+            "on_axis",
+            "--report-dir",
+            str(box / "out" / "rep"),
+            "--memory-budget",
+            "1e-6",
+            "--allow-load-errors",
+        ]
+
     out.append(Input("budget", "--memory-budget 1e-6 --allow-load-errors: every mesh over it", all_over))
     return out
 
@@ -778,7 +1164,10 @@ OBJ_BODIES = {
     "v with 2 coordinates": "v 0 0\nv 1 0\nv 0 1\nf 1 2 3\n",
     "v 1e308": "v 1e308 0 0\nv -1e308 0 0\nv 0 1e308 0\nf 1 2 3\n",
     "degenerate face (all same point)": "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n",
-    "f with 10000 indices": "".join(f"v {i} {i % 7} 0\n" for i in range(10000)) + "f " + " ".join(str(i + 1) for i in range(10000)) + "\n",
+    "f with 10000 indices": "".join(f"v {i} {i % 7} 0\n" for i in range(10000))
+    + "f "
+    + " ".join(str(i + 1) for i in range(10000))
+    + "\n",
     "NUL bytes": "v 0 0 0\nv 1 0 0\x00\nv 0 1 0\nf 1 2 3\n",
     "not UTF-8": "v 0 0 0\nv 1 0 0\nv 0 1 0\n\xff\xfe\nf 1 2 3\n",
     "p points only": "v 0 0 0\nv 1 0 0\np 1 2\n",
@@ -792,23 +1181,54 @@ def obj_inputs():
     out = []
     for name, body in OBJ_BODIES.items():
         for tool in ("crosscheck", "renderer"):
+
             def build(box, body=body, tool=tool):
                 p = box / "in" / "m.obj"
                 p.write_bytes(body.encode("utf-8", "surrogateescape") if "\xff" not in body else body.encode("latin-1"))
                 if tool == "crosscheck":
-                    return CROSSCHECK + ["--scene", str(p), "--level", "vertices", "--frames", "1", "--cases",
-                                         "on_axis", "--report-dir", str(box / "out" / "rep")]
-                return RENDERER + ["--scene", str(p), "--frames", "1", "--width", "64", "--height", "48",
-                                   "--out", str(box / "out" / "f.png")]
-            out.append(Input("obj", f"{tool} {name}", build, may_pass=name not in OBJ_MAY_NOT_PASS or tool == "renderer"))
+                    return CROSSCHECK + [
+                        "--scene",
+                        str(p),
+                        "--level",
+                        "vertices",
+                        "--frames",
+                        "1",
+                        "--cases",
+                        "on_axis",
+                        "--report-dir",
+                        str(box / "out" / "rep"),
+                    ]
+                return RENDERER + [
+                    "--scene",
+                    str(p),
+                    "--frames",
+                    "1",
+                    "--width",
+                    "64",
+                    "--height",
+                    "48",
+                    "--out",
+                    str(box / "out" / "f.png"),
+                ]
+
+            out.append(
+                Input("obj", f"{tool} {name}", build, may_pass=name not in OBJ_MAY_NOT_PASS or tool == "renderer")
+            )
     return out
 
 
-SURFACES = {"spec": spec_inputs, "unproject": unproject_inputs, "peer": peer_inputs, "depth": depth_inputs,
-            "budget": budget_inputs, "obj": obj_inputs}
+SURFACES = {
+    "spec": spec_inputs,
+    "unproject": unproject_inputs,
+    "peer": peer_inputs,
+    "depth": depth_inputs,
+    "budget": budget_inputs,
+    "obj": obj_inputs,
+}
 
 
 # ---- running and checking -------------------------------------------------------------------------------
+
 
 def snapshot(folder: Path) -> dict:
     """Every path under ``folder``: a regular file's SHA-256, else its kind (a special file is never opened)."""
@@ -820,8 +1240,11 @@ def snapshot(folder: Path) -> dict:
             continue
         if stat.S_ISREG(st.st_mode):
             try:
-                out[str(p)] = hashlib.sha256(p.read_bytes()).hexdigest() if st.st_size < (1 << 26) else \
-                    f"size {st.st_size} mtime {st.st_mtime_ns}"
+                out[str(p)] = (
+                    hashlib.sha256(p.read_bytes()).hexdigest()
+                    if st.st_size < (1 << 26)
+                    else f"size {st.st_size} mtime {st.st_mtime_ns}"
+                )
             except OSError:
                 out[str(p)] = f"unreadable {st.st_mtime_ns}"
         else:
@@ -837,8 +1260,15 @@ def run_one(inp: Input, work: Path) -> dict:
     before = snapshot(box / "in")
     env = dict(os.environ, PYTHONWARNINGS="default")
     t0 = time.monotonic()
-    proc = subprocess.Popen(argv, cwd=box / "in", stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            stdin=subprocess.DEVNULL, env=env, start_new_session=True)
+    proc = subprocess.Popen(
+        argv,
+        cwd=box / "in",
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        env=env,
+        start_new_session=True,
+    )
     try:
         stdout, stderr = proc.communicate(timeout=inp.timeout)
         rc = proc.returncode
@@ -853,23 +1283,48 @@ def run_one(inp: Input, work: Path) -> dict:
     touched = sorted(k for k in before if after.get(k) != before[k])
     leftovers = []
     for p in sorted((box / "out").rglob("*")):
-        if rc not in (0, 1) or ".tmp" in p.name or p.name == "PWNED" or (
-                p.name.startswith(".") and not p.name.startswith(".wirecheck")):   # an output folder's own marker
+        if (
+            rc not in (0, 1)
+            or ".tmp" in p.name
+            or p.name == "PWNED"
+            or (p.name.startswith(".") and not p.name.startswith(".wirecheck"))
+        ):  # an output folder's own marker
             leftovers.append(str(p.relative_to(box)))
     for p in (box / "in").rglob("*"):
-        if str(p) not in before and p.name not in ("__pycache__",) and "__pycache__" not in str(p) \
-                and not str(p.relative_to(box / "in")).startswith("reports"):
+        if (
+            str(p) not in before
+            and p.name not in ("__pycache__",)
+            and "__pycache__" not in str(p)
+            and not str(p.relative_to(box / "in")).startswith("reports")
+        ):
             leftovers.append(str(p.relative_to(box)))
-    rec = {"surface": inp.surface, "name": inp.name, "rc": rc, "wall_s": round(wall, 2),
-           "traceback": "Traceback" in err or rc == 3, "hang": rc == "hang",
-           "not_one_line": rc == 2 and len(lines) != 1, "touched": touched, "leftovers": leftovers,
-           "pass_on_nothing": rc == 0 and not inp.may_pass, "bad_result": rc == 4,
-           "correct_failed": inp.must_pass and rc != 0,
-           "stderr": err[-600:] if (rc not in (0, 1) or "Traceback" in err) else err[-200:],
-           "stdout_tail": stdout.decode("utf-8", "replace")[-300:]}
-    rec["problem"] = bool(rec["traceback"] or rec["hang"] or rec["not_one_line"] or touched or leftovers
-                          or rec["pass_on_nothing"] or rec["bad_result"] or rec["correct_failed"]
-                          or rc not in (0, 1, 2))
+    rec = {
+        "surface": inp.surface,
+        "name": inp.name,
+        "rc": rc,
+        "wall_s": round(wall, 2),
+        "traceback": "Traceback" in err or rc == 3,
+        "hang": rc == "hang",
+        "not_one_line": rc == 2 and len(lines) != 1,
+        "touched": touched,
+        "leftovers": leftovers,
+        "pass_on_nothing": rc == 0 and not inp.may_pass,
+        "bad_result": rc == 4,
+        "correct_failed": inp.must_pass and rc != 0,
+        "stderr": err[-600:] if (rc not in (0, 1) or "Traceback" in err) else err[-200:],
+        "stdout_tail": stdout.decode("utf-8", "replace")[-300:],
+    }
+    rec["problem"] = bool(
+        rec["traceback"]
+        or rec["hang"]
+        or rec["not_one_line"]
+        or touched
+        or leftovers
+        or rec["pass_on_nothing"]
+        or rec["bad_result"]
+        or rec["correct_failed"]
+        or rc not in (0, 1, 2)
+    )
     return rec
 
 
@@ -919,11 +1374,14 @@ def main(argv=None) -> int:
             rec = run_one(inp, Path(work))
             records.append(rec)
             if rec["problem"]:
-                print(f"[{k}/{len(inputs)}] PROBLEM {inp.surface}: {inp.name}: rc {rec['rc']}: "
-                      f"{' | '.join(rec['stderr'].strip().splitlines()[-3:])[:400]}"
-                      f"{' touched ' + str(rec['touched']) if rec['touched'] else ''}"
-                      f"{' leftovers ' + str(rec['leftovers'][:3]) if rec['leftovers'] else ''}", flush=True)
-        for root, dirs, _ in os.walk(work):                 # the unreadable inputs, made removable
+                print(
+                    f"[{k}/{len(inputs)}] PROBLEM {inp.surface}: {inp.name}: rc {rec['rc']}: "
+                    f"{' | '.join(rec['stderr'].strip().splitlines()[-3:])[:400]}"
+                    f"{' touched ' + str(rec['touched']) if rec['touched'] else ''}"
+                    f"{' leftovers ' + str(rec['leftovers'][:3]) if rec['leftovers'] else ''}",
+                    flush=True,
+                )
+        for root, dirs, _ in os.walk(work):  # the unreadable inputs, made removable
             for d in dirs:
                 os.chmod(os.path.join(root, d), 0o755)
             for f in os.listdir(root):

@@ -35,7 +35,7 @@ class InternalImport:
 
     file: str
     line: int
-    module: str            # as written: ".judge.metrics", "wirecheck.core.errors"
+    module: str  # as written: ".judge.metrics", "wirecheck.core.errors"
     names: tuple[str, ...]
     in_function: bool
 
@@ -60,8 +60,15 @@ def internal_imports(root: Path) -> list[InternalImport]:
             for child in ast.iter_child_nodes(node):
                 inner = in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
                 if isinstance(child, ast.ImportFrom) and (child.level or (child.module or "").startswith(PACKAGE)):
-                    out.append(InternalImport(rel, child.lineno, "." * child.level + (child.module or ""),
-                                              tuple(a.name for a in child.names), in_function))
+                    out.append(
+                        InternalImport(
+                            rel,
+                            child.lineno,
+                            "." * child.level + (child.module or ""),
+                            tuple(a.name for a in child.names),
+                            in_function,
+                        )
+                    )
                 elif isinstance(child, ast.Import):
                     for alias in child.names:
                         if alias.name == PACKAGE or alias.name.startswith(PACKAGE + "."):
@@ -78,21 +85,26 @@ def private_name_uses(root: Path) -> list[str]:
     for path in package_files(root):
         rel = str(path.relative_to(root))
         tree = ast.parse(path.read_text(), filename=rel)
-        modules = set()                                  # internal modules bound to a name here
+        modules = set()  # internal modules bound to a name here
         for node in ast.walk(tree):
             if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith(PACKAGE)):
                 for alias in node.names:
                     if _is_private(alias.name):
-                        found.append(f"{rel}:{node.lineno}: from {'.' * node.level}{node.module or ''} "
-                                     f"import {alias.name}")
+                        found.append(
+                            f"{rel}:{node.lineno}: from {'.' * node.level}{node.module or ''} import {alias.name}"
+                        )
                     modules.add(alias.asname or alias.name)
             elif isinstance(node, ast.Import):
                 for alias in node.names:
                     if alias.name.startswith(PACKAGE):
                         modules.add(alias.asname or alias.name.split(".")[0])
         for node in ast.walk(tree):
-            if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in modules
-                    and _is_private(node.attr)):
+            if (
+                isinstance(node, ast.Attribute)
+                and isinstance(node.value, ast.Name)
+                and node.value.id in modules
+                and _is_private(node.attr)
+            ):
                 found.append(f"{rel}:{node.lineno}: {node.value.id}.{node.attr}")
     return sorted(found)
 
@@ -134,8 +146,9 @@ def import_cycles(root: Path) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         os.symlink(Path(root).resolve(), Path(tmp) / PACKAGE)
         env = dict(os.environ, PYTHONPATH=tmp)
-        done = subprocess.run([sys.executable, "-c", _CYCLES, PACKAGE], env=env, cwd=tmp, capture_output=True,
-                              text=True, timeout=300)
+        done = subprocess.run(
+            [sys.executable, "-c", _CYCLES, PACKAGE], env=env, cwd=tmp, capture_output=True, text=True, timeout=300
+        )
     if done.returncode != 0:
         raise RuntimeError(f"grimp on {root}: {done.stderr.strip().splitlines()[-1:]}")
     return json.loads(done.stdout)
@@ -144,9 +157,15 @@ def import_cycles(root: Path) -> dict:
 def measure(root: Path) -> dict:
     imports = internal_imports(root)
     graph = import_cycles(root)
-    return {"tree": str(root), "modules": graph["modules"], "internal_imports": len(imports),
-            "inside_functions": sum(i.in_function for i in imports), "private_names": len(private_name_uses(root)),
-            "cycles": len(graph["cycles"]), "modules_in_cycles": sum(len(c) for c in graph["cycles"])}
+    return {
+        "tree": str(root),
+        "modules": graph["modules"],
+        "internal_imports": len(imports),
+        "inside_functions": sum(i.in_function for i in imports),
+        "private_names": len(private_name_uses(root)),
+        "cycles": len(graph["cycles"]),
+        "modules_in_cycles": sum(len(c) for c in graph["cycles"]),
+    }
 
 
 def main(argv=None) -> int:
@@ -156,9 +175,11 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     for tree in args.trees:
         m = measure(Path(tree))
-        print(f"{m['tree']}: {m['modules']} modules; {m['internal_imports']} internal imports, "
-              f"{m['inside_functions']} inside functions; {m['private_names']} private names of other modules; "
-              f"{m['cycles']} import cycles ({m['modules_in_cycles']} modules)")
+        print(
+            f"{m['tree']}: {m['modules']} modules; {m['internal_imports']} internal imports, "
+            f"{m['inside_functions']} inside functions; {m['private_names']} private names of other modules; "
+            f"{m['cycles']} import cycles ({m['modules_in_cycles']} modules)"
+        )
         if args.list:
             for cycle in import_cycles(Path(tree))["cycles"]:
                 print("  cycle:", " ".join(c.removeprefix(PACKAGE + ".") for c in cycle))

@@ -19,7 +19,6 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-
 from wirecheck.core.projector import pipeline
 from wirecheck.core.scene.files import builtin_names, example_names, load_scene
 from wirecheck.core.transforms import Motion
@@ -32,11 +31,11 @@ from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     frames = int(argv[0]) if argv else 4
-    zones = [0.0, 2 ** -12, 2 ** -10, 2 ** -9, 2 ** -8, fill_rule.GL_TIE_PX, 2 ** -6]
+    zones = [0.0, 2**-12, 2**-10, 2**-9, 2**-8, fill_rule.GL_TIE_PX, 2**-6]
     names = list(builtin_names()) + [f"scenes/examples/{n}.scene" for n in example_names()]
     oracles = {}
     motion0 = Motion(turns=(1.0, 1.0, 0.0))
-    res = {z: [0, 0, 0] for z in zones}        # pyrender's decided differences, core's, ties
+    res = {z: [0, 0, 0] for z in zones}  # pyrender's decided differences, core's, ties
     n_frames, ref_px = 0, 0
     try:
         for name in names:
@@ -50,15 +49,19 @@ def main(argv=None) -> int:
                 for k in range(frames):
                     p_world, _m, pr_vertices, pr_pose = oface.frame_geometry(scene, motion, k / frames)
                     gl, _depth = oracles[key].render_faces(pr_vertices, tris, cam, model_matrix=pr_pose, cull=False)
-                    frame = pipeline.render_frame(pr_vertices, scene.edges, cam,
-                                                  np.eye(4) if pr_pose is None else pr_pose,
-                                                  faces=scene.faces, style="shaded")
+                    frame = pipeline.render_frame(
+                        pr_vertices,
+                        scene.edges,
+                        cam,
+                        np.eye(4) if pr_pose is None else pr_pose,
+                        faces=scene.faces,
+                        style="shaded",
+                    )
                     core = np.isfinite(frame.depth_image)
                     tris_px, _z, _ = fill_rule.project_clipped(p_world, scene.faces, cam)
                     is_open = fill_rule.open_edges(tris_px)
                     for z in zones:
-                        inside, ties = fill_rule.coverage(tris_px, (cam.height, cam.width), tie_px=z,
-                                                          is_open=is_open)
+                        inside, ties = fill_rule.coverage(tris_px, (cam.height, cam.width), tie_px=z, is_open=is_open)
                         res[z][0] += int(((gl != inside) & ~ties).sum())
                         res[z][1] += int(((core != inside) & ~ties).sum())
                         res[z][2] += int(ties.sum())
@@ -69,8 +72,10 @@ def main(argv=None) -> int:
             o.close()
     print(f"{n_frames} frames, {ref_px} reference pixels")
     for z in zones:
-        print(f"tie zone {z:.6f} px: pyrender differs at {res[z][0]} decided pixels, core at {res[z][1]}; "
-              f"{res[z][2]} ties")
+        print(
+            f"tie zone {z:.6f} px: pyrender differs at {res[z][0]} decided pixels, core at {res[z][1]}; "
+            f"{res[z][2]} ties"
+        )
     return 0
 
 

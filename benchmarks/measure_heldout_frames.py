@@ -31,7 +31,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "clients"))
 
 import heldout_draw as hd  # noqa: E402
-
 from wirecheck.oracles.cli import main  # noqa: E402
 
 mpl, cv2_line, pillow = hd.draw_matplotlib, hd.draw_cv2, hd.draw_pillow
@@ -43,7 +42,6 @@ ASPECT = {"aspect": 1.03}
 def draw_gl_rule(segs, w, h):
     """GL's rule: wirecheck core's exact line raster (the pixels pyrender draws for these lines), white on black."""
     import numpy as np
-
     from wirecheck.core.projector.clipping import clip_to_image
     from wirecheck.core.projector.raster import line_pixels
 
@@ -62,8 +60,10 @@ RENDERERS = {
     "pillow 3px": (partial(pillow, width=3), GL, {}),
     "pillow 4x supersampled": (hd.draw_pillow_supersampled, GL, {}),
     **{f"matplotlib aa {w}px": (partial(mpl, linewidth_px=w), LOOKAT, {}) for w in (0.5, 1.0, 1.5, 2.0)},
-    **{f"matplotlib aliased {w}px": (partial(mpl, linewidth_px=w, antialiased=False), LOOKAT, {})
-       for w in (0.5, 1.0, 1.5, 2.0)},
+    **{
+        f"matplotlib aliased {w}px": (partial(mpl, linewidth_px=w, antialiased=False), LOOKAT, {})
+        for w in (0.5, 1.0, 1.5, 2.0)
+    },
     "wu": (hd.draw_wu, GL, {}),
     "bresenham": (hd.draw_bresenham, LOOKAT, {}),
     **{f"cv2 {t}": (partial(cv2_line, line_type=t), GL, {}) for t in ("LINE_8", "LINE_4", "LINE_AA")},
@@ -97,8 +97,10 @@ def judge(job: Path, out: Path, name: str, line_rule: str | None = None) -> list
     shutil.copytree(job, d)
     hd.render(d, draw, project, **mistake)
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-        main(["--candidate-frames", str(d), "--report-dir", str(out / "rep")]
-             + (["--line-rule", line_rule] if line_rule else []))
+        main(
+            ["--candidate-frames", str(d), "--report-dir", str(out / "rep")]
+            + (["--line-rule", line_rule] if line_rule else [])
+        )
     cases = json.loads((out / "rep" / "report.json").read_text())["cases"]
     shutil.rmtree(out)
     return cases
@@ -121,13 +123,19 @@ def summary(name: str, cases: list, per_case: bool) -> str:
             offs.append(max(map(abs, off)))
         named += [(f["dx"], f["dy"]) for f in c["faults"] if f["name"] == "pixel_offset"]
         if per_case:
-            lines.append(f"    {c['scene']:8s} {c['camera']:13s} {c['verdict']:4s} F1@1px {c['pixel_f1_1px']:.4f} "
-                         f"F1@0px {c['pixel_f1_0px']:.4f} {ls['style']} offset {off} {names}")
-    head = (f"{name}: {dict(verdicts)}; style {dict(styles)}, width {min(widths):.2f}-{max(widths):.2f}, "
-            f"F1@0px {min(f1_0):.2f}-{max(f1_0):.2f}, max |offset| {max(offs, default=float('nan')):.3f}")
+            lines.append(
+                f"    {c['scene']:8s} {c['camera']:13s} {c['verdict']:4s} F1@1px {c['pixel_f1_1px']:.4f} "
+                f"F1@0px {c['pixel_f1_0px']:.4f} {ls['style']} offset {off} {names}"
+            )
+    head = (
+        f"{name}: {dict(verdicts)}; style {dict(styles)}, width {min(widths):.2f}-{max(widths):.2f}, "
+        f"F1@0px {min(f1_0):.2f}-{max(f1_0):.2f}, max |offset| {max(offs, default=float('nan')):.3f}"
+    )
     if named:
-        head += (f"; pixel_offset dx {min(p[0] for p in named):.2f}..{max(p[0] for p in named):.2f} "
-                 f"dy {min(p[1] for p in named):.2f}..{max(p[1] for p in named):.2f}")
+        head += (
+            f"; pixel_offset dx {min(p[0] for p in named):.2f}..{max(p[0] for p in named):.2f} "
+            f"dy {min(p[1] for p in named):.2f}..{max(p[1] for p in named):.2f}"
+        )
     return "\n".join([head] + lines)
 
 
@@ -136,8 +144,12 @@ def run(argv=None) -> int:
     ap.add_argument("out", nargs="?", help="a folder for the job and the reports (default: a temporary one)")
     ap.add_argument("--only", nargs="+", choices=sorted(RENDERERS), help="these renderers only")
     ap.add_argument("--cases", action="store_true", help="one line per case too")
-    ap.add_argument("--line-rule", choices=("any", "gl", "geometry"), default=None,
-                    help="crosscheck's --line-rule (default: crosscheck's own, any)")
+    ap.add_argument(
+        "--line-rule",
+        choices=("any", "gl", "geometry"),
+        default=None,
+        help="crosscheck's --line-rule (default: crosscheck's own, any)",
+    )
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(args.out or tmp)

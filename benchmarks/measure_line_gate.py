@@ -25,7 +25,6 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from raster_mutants import drop_last, random_ends  # noqa: E402
-
 from wirecheck.core.projector import raster  # noqa: E402
 from wirecheck.core.scene.files import load_scene, parse_scene_text  # noqa: E402
 from wirecheck.oracles.runner import CoreCandidate, RenderMode, run_crosscheck  # noqa: E402
@@ -43,8 +42,11 @@ def random_scenes(n: int = 5, seed: int = 16) -> list:
             i, j = (int(x) for x in rng.integers(0, nv, 2))
             if i != j:
                 edges.add((min(i, j), max(i, j)))
-        text = (f"name random{s}\n" + "".join(f"v {a:.6f} {b:.6f} {c:.6f}\n" for a, b, c in v)
-                + "".join(f"e {i} {j}\n" for i, j in sorted(edges)))
+        text = (
+            f"name random{s}\n"
+            + "".join(f"v {a:.6f} {b:.6f} {c:.6f}\n" for a, b, c in v)
+            + "".join(f"e {i} {j}\n" for i, j in sorted(edges))
+        )
         out.append(parse_scene_text(text))
     return out
 
@@ -61,7 +63,7 @@ def summarise(label: str, report: dict) -> str:
     cnt = max(x["edge_count_max_diff"] for x in lines)
     passed = sum(x["verdict"] == "pass" for x in cases)
     ends = sum(1 for x in cases if x["faults"] and x["faults"][0]["name"] == "line_end_bias")
-    return (f"| {label} | {passed}/{len(cases)} | {c} | {o} | {tc} + {to} | {frac:.2e} | {p:.2g} | {cnt} | {ends} |")
+    return f"| {label} | {passed}/{len(cases)} | {c} | {o} | {tc} + {to} | {frac:.2e} | {p:.2g} | {cnt} | {ends} |"
 
 
 def main(argv=None) -> int:
@@ -69,11 +71,16 @@ def main(argv=None) -> int:
     ap.add_argument("--frames", type=int, default=24)
     args = ap.parse_args(argv)
     bundled = [load_scene(n) for n in ("cube", "pyramid", "prism")]
-    sets = [("bundled", bundled, None), ("orrery", [load_scene("orrery")], None),
-            ("hidden+cull", bundled + [load_scene("orrery")], RenderMode(hidden_lines=True, cull="backface")),
-            ("random", random_scenes(), None)]
-    print("| scenes, raster | passed | cand-only | oracle-only | of them ties | max abs net/oracle px | min p | "
-          "max edge count diff | line_end_bias |")
+    sets = [
+        ("bundled", bundled, None),
+        ("orrery", [load_scene("orrery")], None),
+        ("hidden+cull", bundled + [load_scene("orrery")], RenderMode(hidden_lines=True, cull="backface")),
+        ("random", random_scenes(), None),
+    ]
+    print(
+        "| scenes, raster | passed | cand-only | oracle-only | of them ties | max abs net/oracle px | min p | "
+        "max edge count diff | line_end_bias |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     original = raster._line_pixels
     for raster_name, fn in (("correct", original), ("drop last", drop_last), ("random ends", random_ends)):

@@ -30,14 +30,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "data" / 
 import d3d_lh  # noqa: E402
 import glm_f32  # noqa: E402
 import glm_gl  # noqa: E402
-
 from wirecheck.core.scene.files import load_scene  # noqa: E402
 from wirecheck.core.transforms import Motion  # noqa: E402
-from wirecheck.oracles.references import opencv_oracle
 from wirecheck.oracles import tolerances  # noqa: E402
-from wirecheck.oracles.cases import cameras_for  # noqa: E402
-from wirecheck.oracles.references.convert import opencv_matrices  # noqa: E402
 from wirecheck.oracles.candidates.core_candidate import CoreCandidate  # noqa: E402
+from wirecheck.oracles.cases import cameras_for  # noqa: E402
+from wirecheck.oracles.references import opencv_oracle
+from wirecheck.oracles.references.convert import opencv_matrices  # noqa: E402
 from wirecheck.oracles.references.faces import frame_geometry  # noqa: E402
 
 EPS32 = tolerances.EPS["float32"]
@@ -66,8 +65,12 @@ def main(argv=None) -> int:
     core32 = CoreCandidate(dtype="float32")
     worst = {"glm": 0.0, "glm_gl": 0.0, "d3d": 0.0, "core": 0.0, "kcv": 0.0}
     depth_ratio = 0.0
-    print(f"{'scene':<8} {'case':<13} {'bound px':>9} | max err px: "
-          + " ".join(f"{k:>8}" for k in worst) + " | err/(eps scale): " + " ".join(f"{k:>6}" for k in worst))
+    print(
+        f"{'scene':<8} {'case':<13} {'bound px':>9} | max err px: "
+        + " ".join(f"{k:>8}" for k in worst)
+        + " | err/(eps scale): "
+        + " ".join(f"{k:>6}" for k in worst)
+    )
     for name in ("cube", "pyramid", "prism", "orrery"):
         scene = load_scene(name)
         for case in cameras_for(scene.radius):
@@ -80,14 +83,17 @@ def main(argv=None) -> int:
                 p_world = frame_geometry(scene, motion, (f - 1) / args.frames)[0]
                 orac = opencv_oracle.project(p_world, cam)
                 points, m_core = frames.geometry(f)
-                cands = {"glm": glm_f32.project(p_world, cam).astype(np.float64),
-                         "glm_gl": glm_gl.project(p_world, cam).astype(np.float64),
-                         "d3d": d3d_lh.project(p_world, cam).astype(np.float64),
-                         "core": core32.project(points, cam, m_core),
-                         "kcv": kcv_f32(p_world, cam).astype(np.float64)}
+                cands = {
+                    "glm": glm_f32.project(p_world, cam).astype(np.float64),
+                    "glm_gl": glm_gl.project(p_world, cam).astype(np.float64),
+                    "d3d": d3d_lh.project(p_world, cam).astype(np.float64),
+                    "core": core32.project(points, cam, m_core),
+                    "kcv": kcv_f32(p_world, cam).astype(np.float64),
+                }
                 seen = np.isfinite(orac).all(axis=1)
-                per_point = np.array([tolerances.vertex_scale(p_world[i:i + 1], orac[i:i + 1], cam)
-                                      for i in np.flatnonzero(seen)])
+                per_point = np.array(
+                    [tolerances.vertex_scale(p_world[i : i + 1], orac[i : i + 1], cam) for i in np.flatnonzero(seen)]
+                )
                 scale_max = max(scale_max, per_point.max(initial=0.0))
                 for key, c in cands.items():
                     both = seen & np.isfinite(c).all(axis=1)
@@ -97,8 +103,9 @@ def main(argv=None) -> int:
                     ratios[key] = max(ratios[key], float((e / (EPS32 * sc)).max(initial=0.0)))
                 # float32 view depth (glm's) against the float64 depth
                 eye = np.asarray(cam.position, np.float32)
-                view = glm_f32.look_at_rh(eye, eye + np.asarray(cam.forward, np.float32),
-                                          np.asarray(cam.up, np.float32))
+                view = glm_f32.look_at_rh(
+                    eye, eye + np.asarray(cam.forward, np.float32), np.asarray(cam.up, np.float32)
+                )
                 p32 = np.asarray(p_world, np.float32)
                 d32 = -(p32 @ view[2, :3] + view[2, 3])
                 d64 = opencv_oracle.depth(p_world, cam)
@@ -107,10 +114,17 @@ def main(argv=None) -> int:
             bound = tolerances.vertex_bound("float32", scale_max)
             for key in worst:
                 worst[key] = max(worst[key], ratios[key])
-            print(f"{name:<8} {case.name:<13} {bound:9.2e} | {'':11} " + " ".join(f"{errs[k]:8.1e}" for k in worst)
-                  + f" | {'':16} " + " ".join(f"{ratios[k]:6.2f}" for k in worst))
-    print("largest error / (eps32 scale): " + ", ".join(f"{k} {v:.2f}" for k, v in worst.items())
-          + f"; largest float32 depth error / (eps32 (|X|+|C|)): {depth_ratio:.2f}")
+            print(
+                f"{name:<8} {case.name:<13} {bound:9.2e} | {'':11} "
+                + " ".join(f"{errs[k]:8.1e}" for k in worst)
+                + f" | {'':16} "
+                + " ".join(f"{ratios[k]:6.2f}" for k in worst)
+            )
+    print(
+        "largest error / (eps32 scale): "
+        + ", ".join(f"{k} {v:.2f}" for k, v in worst.items())
+        + f"; largest float32 depth error / (eps32 (|X|+|C|)): {depth_ratio:.2f}"
+    )
     return 0
 
 

@@ -36,11 +36,13 @@ def judge(job: Path, out: Path, flags: list) -> list:
     d = out / "job"
     shutil.rmtree(out, ignore_errors=True)
     shutil.copytree(job, d)
-    drawn = subprocess.run([sys.executable, str(CLIENT), str(d), *flags], cwd=CLIENT.parent,
-                           capture_output=True, text=True)
+    drawn = subprocess.run(
+        [sys.executable, str(CLIENT), str(d), *flags], cwd=CLIENT.parent, capture_output=True, text=True
+    )
     if drawn.returncode != 0:
-        raise SystemExit(f"vtk_frames.py {' '.join(flags)} exited {drawn.returncode}: "
-                         f"{drawn.stderr.strip().splitlines()[-1:]}")
+        raise SystemExit(
+            f"vtk_frames.py {' '.join(flags)} exited {drawn.returncode}: {drawn.stderr.strip().splitlines()[-1:]}"
+        )
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         main(["--candidate-frames", str(d), "--report-dir", str(out / "rep")])
     return json.loads((out / "rep" / "report.json").read_text())["cases"]

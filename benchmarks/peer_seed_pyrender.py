@@ -24,8 +24,9 @@ import pyrender  # noqa: E402
 from PIL import Image  # noqa: E402
 
 CUBE = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], np.float32)
-EDGES = np.array([[a, b] for a in range(8) for b in range(a + 1, 8)
-                  if np.abs(CUBE[a] - CUBE[b]).sum() == 2], np.uint32)          # the 12 unit-step pairs
+EDGES = np.array(
+    [[a, b] for a in range(8) for b in range(a + 1, 8) if np.abs(CUBE[a] - CUBE[b]).sum() == 2], np.uint32
+)  # the 12 unit-step pairs
 
 
 def rotation(t: float) -> np.ndarray:
@@ -44,8 +45,9 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     white = pyrender.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0])
-    mesh = pyrender.Mesh([pyrender.Primitive(positions=CUBE, indices=EDGES, mode=pyrender.constants.GLTF.LINES,
-                                             material=white)])
+    mesh = pyrender.Mesh(
+        [pyrender.Primitive(positions=CUBE, indices=EDGES, mode=pyrender.constants.GLTF.LINES, material=white)]
+    )
     scene = pyrender.Scene(bg_color=[0, 0, 0, 1], ambient_light=[0, 0, 0])
     node = scene.add(mesh)
     pose = np.eye(4)

@@ -68,17 +68,34 @@ def _primitive(rng, i):
         ("icosahedron", lambda: trimesh.creation.icosahedron()),
         ("icosphere", lambda: trimesh.creation.icosphere(subdivisions=int(rng.integers(0, 4)))),
         ("uv_sphere", lambda: trimesh.creation.uv_sphere(count=[int(rng.integers(4, 33))] * 2)),
-        ("capsule", lambda: trimesh.creation.capsule(height=rng.uniform(0.2, 1.5), radius=0.4,
-                                                     count=[int(rng.integers(4, 25))] * 2)),
-        ("torus", lambda: trimesh.creation.torus(major_radius=1.0, minor_radius=rng.uniform(0.1, 0.5),
-                                                 major_sections=int(rng.integers(3, 49)),
-                                                 minor_sections=int(rng.integers(3, 17)))),
-        ("annulus", lambda: trimesh.creation.annulus(r_min=rng.uniform(0.1, 0.8), r_max=1.0,
-                                                     height=rng.uniform(0.05, 1.0),
-                                                     sections=int(rng.integers(3, 65)))),
-        ("revolve", lambda: trimesh.creation.revolve(
-            np.column_stack([rng.uniform(0.1, 1.0, 6), np.sort(rng.uniform(-1, 1, 6))]),
-            sections=int(rng.integers(3, 49)))),
+        (
+            "capsule",
+            lambda: trimesh.creation.capsule(
+                height=rng.uniform(0.2, 1.5), radius=0.4, count=[int(rng.integers(4, 25))] * 2
+            ),
+        ),
+        (
+            "torus",
+            lambda: trimesh.creation.torus(
+                major_radius=1.0,
+                minor_radius=rng.uniform(0.1, 0.5),
+                major_sections=int(rng.integers(3, 49)),
+                minor_sections=int(rng.integers(3, 17)),
+            ),
+        ),
+        (
+            "annulus",
+            lambda: trimesh.creation.annulus(
+                r_min=rng.uniform(0.1, 0.8), r_max=1.0, height=rng.uniform(0.05, 1.0), sections=int(rng.integers(3, 65))
+            ),
+        ),
+        (
+            "revolve",
+            lambda: trimesh.creation.revolve(
+                np.column_stack([rng.uniform(0.1, 1.0, 6), np.sort(rng.uniform(-1, 1, 6))]),
+                sections=int(rng.integers(3, 49)),
+            ),
+        ),
     ]
     name, make = makers[k % len(makers)]
     return make(), name
@@ -99,7 +116,7 @@ def _extrusion(rng, i):
     angle = np.sort(rng.uniform(0, 2 * np.pi, n))
     radius = rng.uniform(0.3, 1.0, n)
     ring = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
-    vertices = np.vstack([[0.0, 0.0], ring])                  # star-shaped about its centre: a fan triangulates it
+    vertices = np.vstack([[0.0, 0.0], ring])  # star-shaped about its centre: a fan triangulates it
     faces = np.array([[0, 1 + j, 1 + (j + 1) % n] for j in range(n)])
     return trimesh.creation.extrude_triangulation(vertices, faces, height=rng.uniform(0.05, 1.5)), f"{n}-gon"
 
@@ -124,7 +141,7 @@ def _grid(rng, i):
     nx, ny = (int(v) for v in rng.integers(2, 25, 2))
     u, v = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, 1, ny + 1), indexing="ij")
     bent = bool(rng.integers(0, 2))
-    if bent:                                    # rolled about the y axis: rows of collinear edges, bent columns
+    if bent:  # rolled about the y axis: rows of collinear edges, bent columns
         a = u * rng.uniform(0.5, 3.0)
         xyz = np.stack([np.sin(a), v, 1.0 - np.cos(a)], axis=-1)
     else:
@@ -146,7 +163,7 @@ def make_mesh(i: int, seed: int):
     else:
         mesh, detail = {"extrusion": _extrusion, "hull": _hull, "plate": _plate, "grid": _grid}[kind](rng, i)
     mesh.apply_translation(-mesh.bounds.mean(axis=0))
-    mesh.apply_transform(_rotation(rng))                      # two in three turned, one in three axis-aligned
+    mesh.apply_transform(_rotation(rng))  # two in three turned, one in three axis-aligned
     extent = float(np.max(mesh.extents)) or 1.0
     size = float(10 ** rng.uniform(*SCALE_EXP))
     mesh.apply_scale(size / extent)

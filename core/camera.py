@@ -122,15 +122,16 @@ class Camera:
         up = _vec3("up", self.up)
         if not np.any(forward):
             raise InputError("camera forward: expected a non-zero direction (is the camera at the look-at point?)")
-        forward = forward / np.abs(forward).max()   # scale first: norm() of 1e-200 underflows to 0
+        forward = forward / np.abs(forward).max()  # scale first: norm() of 1e-200 underflows to 0
         forward = forward / np.linalg.norm(forward)
         if np.any(up):
-            up = up / np.abs(up).max()              # likewise for a tiny up
+            up = up / np.abs(up).max()  # likewise for a tiny up
         right = np.cross(forward, up)
         nr = np.linalg.norm(right)
         if nr < _DEGENERATE_CROSS * max(np.linalg.norm(up), 1e-300):
             raise InputError(
-                f"camera up {up.tolist()}: expected a direction not parallel to forward {forward.tolist()}")
+                f"camera up {up.tolist()}: expected a direction not parallel to forward {forward.tolist()}"
+            )
         right = right / nr
         up = np.cross(right, forward)  # re-orthogonalised, unit by construction
         object.__setattr__(self, "position", position)
@@ -141,8 +142,11 @@ class Camera:
             a.setflags(write=False)
         if self.projection not in PROJECTIONS:
             raise InputError(f"camera projection {self.projection!r}: expected one of {', '.join(PROJECTIONS)}")
-        if not (isinstance(self.width, (int, np.integer)) and isinstance(self.height, (int, np.integer))) \
-                or self.width < 1 or self.height < 1:
+        if (
+            not (isinstance(self.width, (int, np.integer)) and isinstance(self.height, (int, np.integer)))
+            or self.width < 1
+            or self.height < 1
+        ):
             raise InputError(f"camera size {self.width}x{self.height}: expected positive integers")
         if self.projection == "perspective" and not (0.0 < float(self.fov_y_deg) < 180.0):
             raise InputError(f"camera fov {self.fov_y_deg!r}: expected degrees in (0, 180)")
@@ -152,44 +156,53 @@ class Camera:
             raise InputError(f"camera near {self.near!r}: expected > 0 for a perspective camera")
         if not self.far > self.near:
             raise InputError(f"camera far {self.far!r}: expected > near ({self.near!r})")
-        if not (math.isfinite(self.ortho_height) and self.ortho_height > 0):   # also perspective: it is reported
+        if not (math.isfinite(self.ortho_height) and self.ortho_height > 0):  # also perspective: it is reported
             raise InputError(f"camera ortho-height {self.ortho_height!r}: expected a finite number > 0")
         self._check_intrinsics()
         # A positive but tiny fov or ortho-height passes the range checks yet makes the
         # focal length / pixel scale overflow to inf: say so here, not later as a
         # "vertex projects beyond the float64 range".
         if self.projection == "perspective" and not math.isfinite(self.focal_px):
-            raise InputError(f"camera fov {self.fov_y_deg!r}: focal length (H/2)/tan(fov/2) overflows float64; "
-                             "expected a larger fov")
+            raise InputError(
+                f"camera fov {self.fov_y_deg!r}: focal length (H/2)/tan(fov/2) overflows float64; expected a larger fov"
+            )
         if self.projection == "orthographic" and not math.isfinite(self.height / self.ortho_height):
-            raise InputError(f"camera ortho-height {self.ortho_height!r}: pixel scale H/ortho-height overflows "
-                             "float64; expected a larger ortho-height")
+            raise InputError(
+                f"camera ortho-height {self.ortho_height!r}: pixel scale H/ortho-height overflows "
+                "float64; expected a larger ortho-height"
+            )
 
     def _check_intrinsics(self) -> None:
         """Validate and normalise ``intrinsics`` and ``distortion`` (tuples of floats, or None)."""
         if self.intrinsics is not None:
             values = _numbers("intrinsics fx,fy,cx,cy", self.intrinsics, (4,))
             if self.projection != "perspective":
-                raise InputError(f"camera intrinsics {list(values)}: expected a perspective camera "
-                                 f"(got {self.projection})")
+                raise InputError(
+                    f"camera intrinsics {list(values)}: expected a perspective camera (got {self.projection})"
+                )
             fx, fy, cx, cy = values
             if not (fx > 0 and fy > 0):
                 raise InputError(f"camera intrinsics fx={fx!r}, fy={fy!r}: expected focal lengths > 0 (pixels)")
             limit = _MAX_INTRINSIC * max(self.width, self.height)
             if max(fx, fy, abs(cx), abs(cy)) > limit:
-                raise InputError(f"camera intrinsics {list(values)}: expected |fx|, |fy|, |cx|, |cy| <= "
-                                 f"{limit:g} ({_MAX_INTRINSIC:g} x the larger image side)")
+                raise InputError(
+                    f"camera intrinsics {list(values)}: expected |fx|, |fy|, |cx|, |cy| <= "
+                    f"{limit:g} ({_MAX_INTRINSIC:g} x the larger image side)"
+                )
             if min(fx, fy) < max(self.width, self.height) / _MAX_INTRINSIC:
-                raise InputError(f"camera intrinsics fx={fx!r}, fy={fy!r}: expected focal lengths >= "
-                                 f"{max(self.width, self.height) / _MAX_INTRINSIC:g} px (the larger image "
-                                 f"side / {_MAX_INTRINSIC:g}: a field of view under 180 degrees by a margin)")
+                raise InputError(
+                    f"camera intrinsics fx={fx!r}, fy={fy!r}: expected focal lengths >= "
+                    f"{max(self.width, self.height) / _MAX_INTRINSIC:g} px (the larger image "
+                    f"side / {_MAX_INTRINSIC:g}: a field of view under 180 degrees by a margin)"
+                )
             object.__setattr__(self, "intrinsics", values)
             object.__setattr__(self, "fov_y_deg", math.degrees(2.0 * math.atan((self.height / 2.0) / fy)))
         if self.distortion is not None:
             coeffs = check_coefficients(self.distortion)
             if coeffs is not None and self.projection != "perspective":
-                raise InputError(f"camera distortion {list(coeffs)}: expected a perspective camera "
-                                 f"(got {self.projection})")
+                raise InputError(
+                    f"camera distortion {list(coeffs)}: expected a perspective camera (got {self.projection})"
+                )
             object.__setattr__(self, "distortion", coeffs)
 
     # ---- derived quantities (see core.conventions) -------------------------
@@ -297,8 +310,10 @@ class Camera:
         """This camera with the intrinsics of a ``(3, 3)`` K: no skew, last row ``0 0 1``."""
         k = _numbers("K", K, (3, 3))
         if k[1] != 0 or k[3] != 0 or (k[6], k[7], k[8]) != (0.0, 0.0, 1.0):
-            raise InputError(f"camera K {[list(k[i:i + 3]) for i in (0, 3, 6)]}: expected "
-                             "[[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (no skew)")
+            raise InputError(
+                f"camera K {[list(k[i : i + 3]) for i in (0, 3, 6)]}: expected "
+                "[[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (no skew)"
+            )
         return self.with_intrinsics(k[0], k[4], k[2], k[5])
 
     def with_distortion(self, coefficients) -> Camera:
@@ -358,8 +373,10 @@ def look_at(position, target, up=(0.0, 1.0, 0.0), **kwargs) -> Camera:
     position = _vec3("position", position)
     target = _vec3("look-at", target)
     forward = target - position
-    if not np.any(forward):                     # exact test: norm() underflows to 0 below ~1e-160
-        raise InputError(f"camera position {position.tolist()}: expected a point different from look-at {target.tolist()}")
+    if not np.any(forward):  # exact test: norm() underflows to 0 below ~1e-160
+        raise InputError(
+            f"camera position {position.tolist()}: expected a point different from look-at {target.tolist()}"
+        )
     return Camera(position=position, forward=forward, up=_vec3("up", up), **kwargs)
 
 
@@ -388,9 +405,18 @@ def orthographic_twin(camera: Camera, distance: float) -> Camera:
     pixels in both pictures (nearer things are bigger only in perspective).
     """
     height = 2.0 * distance * math.tan(math.radians(camera.fov_y_deg) / 2.0)
-    return Camera(position=camera.position, forward=camera.forward, up=camera.up, fov_y_deg=camera.fov_y_deg,
-                  width=camera.width, height=camera.height, near=camera.near, far=camera.far,
-                  projection="orthographic", ortho_height=height)
+    return Camera(
+        position=camera.position,
+        forward=camera.forward,
+        up=camera.up,
+        fov_y_deg=camera.fov_y_deg,
+        width=camera.width,
+        height=camera.height,
+        near=camera.near,
+        far=camera.far,
+        projection="orthographic",
+        ortho_height=height,
+    )
 
 
 #: The lengths OpenCV's ``distCoeffs`` may have that this model covers:
@@ -424,12 +450,15 @@ def check_coefficients(coefficients) -> tuple | None:
     except (TypeError, ValueError):
         c = None
     if c is None or c.ndim != 1 or len(c) not in COEFFICIENT_COUNTS:
-        raise InputError(f"camera distortion {coefficients!r}: expected 4, 5 or 8 numbers "
-                         "(k1, k2, p1, p2[, k3[, k4, k5, k6]], OpenCV's order)")
+        raise InputError(
+            f"camera distortion {coefficients!r}: expected 4, 5 or 8 numbers "
+            "(k1, k2, p1, p2[, k3[, k4, k5, k6]], OpenCV's order)"
+        )
     bad = [f"{n}={v!r}" for n, v in zip(NAMES, c.tolist()) if not (math.isfinite(v) and abs(v) <= MAX_COEFFICIENT)]
     if bad:
-        raise InputError(f"camera distortion {', '.join(bad)}: expected finite numbers with |value| <= "
-                         f"{MAX_COEFFICIENT:g}")
+        raise InputError(
+            f"camera distortion {', '.join(bad)}: expected finite numbers with |value| <= {MAX_COEFFICIENT:g}"
+        )
     if not c.any():
         return None
     return tuple(float(x) for x in c)

@@ -73,5 +73,7 @@ def check_not_empty(options) -> None:
     """
     for option, value in options:
         if value == "" or (isinstance(value, list) and "" in value):
-            raise InputError(f"{option} '': expected a name or path (an empty value, often an unset shell "
-                             "variable, would silently mean the working directory or the default)")
+            raise InputError(
+                f"{option} '': expected a name or path (an empty value, often an unset shell "
+                "variable, would silently mean the working directory or the default)"
+            )

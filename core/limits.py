@@ -24,7 +24,7 @@ MAX_SIDE = 16384
 #: 8192 x 4096). --hidden-lines and --style shaded need about 28 bytes per
 #: pixel (depth buffer, face ids, masks; measured: 3000 x 3000 peaks 226 MB
 #: above 1000 x 1000), so the largest frame stays under 1 GB of memory.
-MAX_PIXELS = 2 ** 25
+MAX_PIXELS = 2**25
 
 #: Largest seconds a candidate's request may take (crosscheck --candidate-timeout, [tool.wirecheck],
 #: check_projector's timeout_s): one day. The wait is a ``poll`` whose timeout, in milliseconds, is a C int
@@ -34,7 +34,7 @@ MAX_CANDIDATE_TIMEOUT_S = 86_400.0
 #: Largest |turns| of a spin. Beyond 2^53 a float64 holds no fraction of a
 #: turn (every frame would be at phase 0), and (frame - 1) * turns must stay
 #: finite for the phase computation (core.transforms.Motion.frame_matrix).
-MAX_TURNS = 2.0 ** 53
+MAX_TURNS = 2.0**53
 
 #: Largest number of vertices of one polygon (a ``f`` line of a .scene).
 #: Larger polygons are a mesh: give it as a mesh file (triangulated faces).
@@ -51,24 +51,32 @@ def check_image_size(width: int, height: int, option: str, sides: int = 1) -> No
     if width < 1 or height < 1:
         raise InputError(f"{option} {width}x{height}: expected positive integers")
     if width > MAX_SIDE or height > MAX_SIDE:
-        raise InputError(f"{option} {width}x{height}: expected at most {MAX_SIDE} pixels a side "
-                         "(the largest viewport OpenGL drivers render; wirecheck.core.limits)")
+        raise InputError(
+            f"{option} {width}x{height}: expected at most {MAX_SIDE} pixels a side "
+            "(the largest viewport OpenGL drivers render; wirecheck.core.limits)"
+        )
     if width * height > MAX_PIXELS:
-        raise InputError(f"{option} {width}x{height}: {width * height:,} pixels: expected at most "
-                         f"{MAX_PIXELS:,} (about 1 GB of buffers with --hidden-lines; wirecheck.core.limits)")
+        raise InputError(
+            f"{option} {width}x{height}: {width * height:,} pixels: expected at most "
+            f"{MAX_PIXELS:,} (about 1 GB of buffers with --hidden-lines; wirecheck.core.limits)"
+        )
 
 
 def check_turns(turns, what: str) -> tuple:
     """``turns`` unchanged; InputError naming ``what`` when one is not finite or exceeds MAX_TURNS."""
     for t in turns:
         if not (math.isfinite(t) and abs(t) <= MAX_TURNS):
-            raise InputError(f"{what} {' '.join(f'{v:g}' for v in turns)}: expected turns with |t| <= 2^53 "
-                             "(a float64 holds no fraction of a turn beyond; wirecheck.core.limits)")
+            raise InputError(
+                f"{what} {' '.join(f'{v:g}' for v in turns)}: expected turns with |t| <= 2^53 "
+                "(a float64 holds no fraction of a turn beyond; wirecheck.core.limits)"
+            )
     return tuple(turns)
 
 
 def check_candidate_timeout(seconds: float, option: str) -> None:
     """InputError unless ``seconds`` is finite, > 0 and at most MAX_CANDIDATE_TIMEOUT_S."""
     if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
-        raise InputError(f"{option} {seconds}: expected a number of seconds > 0 and at most "
-                         f"{MAX_CANDIDATE_TIMEOUT_S:.0f} (one day; wirecheck.core.limits)")
+        raise InputError(
+            f"{option} {seconds}: expected a number of seconds > 0 and at most "
+            f"{MAX_CANDIDATE_TIMEOUT_S:.0f} (one day; wirecheck.core.limits)"
+        )

@@ -25,5 +25,5 @@ def plain_float(text: str) -> float:
     return float(_check(text, "float"))
 
 
-plain_int.__name__ = "int"          # argparse's message: "invalid int value: '4_000'"
+plain_int.__name__ = "int"  # argparse's message: "invalid int value: '4_000'"
 plain_float.__name__ = "float"

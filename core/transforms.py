@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
 from .limits import check_turns
 
 
@@ -103,8 +104,14 @@ class Motion:
 
     def _matrix(self, phases) -> np.ndarray:
         ax, ay, az = (2.0 * math.pi * p for p in phases)
-        if not any(float(p) for p in self.pivot):      # about the origin: no T(pivot) factors at all
+        if not any(float(p) for p in self.pivot):  # about the origin: no T(pivot) factors at all
             return compose(translate(self.offset), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale))
         to_pivot = tuple(float(o) + float(p) for o, p in zip(self.offset, self.pivot))
-        return compose(translate(to_pivot), rotate_z(az), rotate_y(ay), rotate_x(ax), scale(self.scale),
-                       translate(tuple(-float(p) for p in self.pivot)))
+        return compose(
+            translate(to_pivot),
+            rotate_z(az),
+            rotate_y(ay),
+            rotate_x(ax),
+            scale(self.scale),
+            translate(tuple(-float(p) for p in self.pivot)),
+        )

@@ -43,34 +43,61 @@ class Limit(NamedTuple):
 #: kind -> Limit. Each is far above any real file of its kind and low enough that reading it
 #: (wholly, into memory, and parsing it in Python) stays within seconds and a few GB.
 LIMITS = {
-    "config": Limit(4 * MiB, "a pyproject.toml or settings file",
-                    "a pyproject.toml is a few KB; tomllib took 10 s for 16 MiB (2 busy cores), so about 3 s here"),
-    "scene list": Limit(64 * MiB, "a scene list (one mesh path a line)",
-                        "a million paths of 60 characters; every line is kept in memory"),
-    "scene": Limit(64 * MiB, "a .scene file",
-                   "about two million 'v'/'e' lines of 30 bytes, parsed in Python; a larger model is a mesh file"),
-    "mesh": Limit(2048 * MiB, "a mesh file",
-                  "trimesh holds the file and several arrays of it in memory (a 2 GiB binary PLY is "
-                  "about 100 million triangles at 19 bytes each, far beyond a legible wireframe)"),
-    "mesh companion": Limit(2048 * MiB, "a file a mesh names (mtllib, texture, glTF buffer)",
-                            "read wholly into memory by trimesh; as large as a mesh"),
-    "job": Limit(256 * MiB, "a job.json of 'crosscheck export'",
-                 "export writes about 40 bytes a frame of a case (its path): 100,000 frames (the limit) of "
-                 "21 cases are 84 MB; read wholly and parsed as JSON"),
-    "camera": Limit(1 * MiB, "a camera file of 'crosscheck export'",
-                    "export writes about 1.5 KB a frame"),
+    "config": Limit(
+        4 * MiB,
+        "a pyproject.toml or settings file",
+        "a pyproject.toml is a few KB; tomllib took 10 s for 16 MiB (2 busy cores), so about 3 s here",
+    ),
+    "scene list": Limit(
+        64 * MiB,
+        "a scene list (one mesh path a line)",
+        "a million paths of 60 characters; every line is kept in memory",
+    ),
+    "scene": Limit(
+        64 * MiB,
+        "a .scene file",
+        "about two million 'v'/'e' lines of 30 bytes, parsed in Python; a larger model is a mesh file",
+    ),
+    "mesh": Limit(
+        2048 * MiB,
+        "a mesh file",
+        "trimesh holds the file and several arrays of it in memory (a 2 GiB binary PLY is "
+        "about 100 million triangles at 19 bytes each, far beyond a legible wireframe)",
+    ),
+    "mesh companion": Limit(
+        2048 * MiB,
+        "a file a mesh names (mtllib, texture, glTF buffer)",
+        "read wholly into memory by trimesh; as large as a mesh",
+    ),
+    "job": Limit(
+        256 * MiB,
+        "a job.json of 'crosscheck export'",
+        "export writes about 40 bytes a frame of a case (its path): 100,000 frames (the limit) of "
+        "21 cases are 84 MB; read wholly and parsed as JSON",
+    ),
+    "camera": Limit(1 * MiB, "a camera file of 'crosscheck export'", "export writes about 1.5 KB a frame"),
     "job mesh": Limit(2048 * MiB, "an OBJ of 'crosscheck export'", "as a mesh file"),
-    "frame": Limit(512 * MiB, "a PNG frame",
-                   "the largest frame, 2^25 pixels of 16-bit RGBA, is 256 MiB unpacked; deflate adds "
-                   "under 0.1% to data it cannot compress"),
-    "depth map": Limit(512 * MiB, "a depth map (.npy, .tif, .png)",
-                       "the largest frame's depth, 2^25 pixels of float64, is 256 MiB; a TIFF or .npy adds its "
-                       "header only"),
+    "frame": Limit(
+        512 * MiB,
+        "a PNG frame",
+        "the largest frame, 2^25 pixels of 16-bit RGBA, is 256 MiB unpacked; deflate adds "
+        "under 0.1% to data it cannot compress",
+    ),
+    "depth map": Limit(
+        512 * MiB,
+        "a depth map (.npy, .tif, .png)",
+        "the largest frame's depth, 2^25 pixels of float64, is 256 MiB; a TIFF or .npy adds its header only",
+    ),
     "candidate": Limit(16 * MiB, "a candidate's Python file", "a module of 300,000 lines; Python compiles it whole"),
 }
 
-_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"), (stat.S_ISDIR, "a folder"))
+_KINDS = (
+    (stat.S_ISFIFO, "a FIFO"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISDIR, "a folder"),
+)
 _FLAGS = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_CLOEXEC", 0)
 
 
@@ -121,7 +148,7 @@ def problem(path, kind: str) -> str | None:
     """Why ``path`` would be refused as a ``kind`` (from ``stat`` alone, nothing opened); None when it would not."""
     try:
         st = os.stat(path)
-    except (OSError, ValueError) as exc:          # ValueError: a NUL in the name
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
         return _os_problem(path, exc) if isinstance(exc, OSError) else "a name holding a NUL character"
     return _problem(st.st_mode, st.st_size, kind)
 
@@ -141,7 +168,7 @@ def open_regular(path, kind: str):
         raise RefusedFile(path, _os_problem(path, exc), kind) from None
     try:
         st = os.fstat(fd)
-        why = _problem(st.st_mode, st.st_size, kind)       # replaced between the stat and the open
+        why = _problem(st.st_mode, st.st_size, kind)  # replaced between the stat and the open
         if why is not None:
             raise RefusedFile(path, why, kind)
         return os.fdopen(fd, "rb")
@@ -167,7 +194,7 @@ def read_regular(path, kind: str) -> bytes:
                 if total > limit:
                     raise RefusedFile(path, f"too large (it grew past {limit:,} bytes while read)", kind)
                 want = MiB
-        except OSError as exc:                              # EIO, a file on a failing disk
+        except OSError as exc:  # EIO, a file on a failing disk
             raise RefusedFile(path, _os_problem(path, exc), kind) from None
     return b"".join(chunks)
 
@@ -193,5 +220,15 @@ def is_regular(path) -> bool:
         return False
 
 
-__all__ = ["LIMITS", "RefusedFile", "expected", "file_kind", "is_regular", "open_regular", "open_text",
-           "problem", "read_regular", "read_text"]
+__all__ = [
+    "LIMITS",
+    "RefusedFile",
+    "expected",
+    "file_kind",
+    "is_regular",
+    "open_regular",
+    "open_text",
+    "problem",
+    "read_regular",
+    "read_text",
+]

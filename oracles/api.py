@@ -24,39 +24,57 @@ pixels too.
 
 from __future__ import annotations
 
-from . import tolerances
-from .judge import gate
-from .candidates.caller_state import caller_state_kept
-from .candidates.isolation import api_candidate
-from .reports.compared import hint_lines, what_text
-from .reports.fault_text import case_cell
-from .reports.report import compared_text, not_passed
-from .runner import run_crosscheck
-from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
-from .tolerances import Tolerances
-from .reports.report import write_report
-from .reports.fmt import short_repr
-from .reports.report_option import checked_report_dir
 from wirecheck.core.errors import InputError
-from .references.pyrender_oracle import GLUnavailable, gl_available
 from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 from wirecheck.core.outputs.output import claim, release_claim
 
+from . import tolerances
+from .candidates.caller_state import caller_state_kept
+from .candidates.isolation import api_candidate
+from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
+from .judge import gate
+from .references.pyrender_oracle import GLUnavailable, gl_available
+from .reports.compared import hint_lines, what_text
+from .reports.fault_text import case_cell
+from .reports.fmt import short_repr
+from .reports.report import compared_text, not_passed, write_report
+from .reports.report_option import checked_report_dir
+from .runner import run_crosscheck
+from .tolerances import Tolerances
 
 #: check_projector's settings when neither the call nor ``[tool.wirecheck]`` gives them: vertices
 #: (OpenCV only, no OpenGL) over 8 frames, quick enough for a unit test; crosscheck's own are
 #: pixels over 24 frames (docs/pytest.md, "Two questions, two sets of defaults").
-API_DEFAULTS = {"frames": 8, "oracles": ("opencv",), "tol_px": tolerances.VERTEX_TOL_PX,
-                "min_f1": tolerances.MIN_F1_1PX, "min_f1_0px": tolerances.MIN_F1_0PX,
-                "turns": (1.0, 1.0, 0.0), "timeout_s": DEFAULT_TIMEOUT_S}
+API_DEFAULTS = {
+    "frames": 8,
+    "oracles": ("opencv",),
+    "tol_px": tolerances.VERTEX_TOL_PX,
+    "min_f1": tolerances.MIN_F1_1PX,
+    "min_f1_0px": tolerances.MIN_F1_0PX,
+    "turns": (1.0, 1.0, 0.0),
+    "timeout_s": DEFAULT_TIMEOUT_S,
+}
 
 
-def check_projector(func=None, scenes=None, frames: int | None = None, cases=None, oracles=None,
-                    tol_px: float | None = None, min_f1: float | None = None,
-                    min_f1_0px: float | None = None, turns=None,
-                    allow_vacuous: bool = False, *, cmd=None, timeout_s: float | None = None,
-                    isolate: bool | None = None, precision: str | None = None, config=None,
-                    report_dir=None) -> dict:
+def check_projector(
+    func=None,
+    scenes=None,
+    frames: int | None = None,
+    cases=None,
+    oracles=None,
+    tol_px: float | None = None,
+    min_f1: float | None = None,
+    min_f1_0px: float | None = None,
+    turns=None,
+    allow_vacuous: bool = False,
+    *,
+    cmd=None,
+    timeout_s: float | None = None,
+    isolate: bool | None = None,
+    precision: str | None = None,
+    config=None,
+    report_dir=None,
+) -> dict:
     """Crosscheck a projector against OpenCV (and pyrender) and return the report.
 
     A setting not given (None) comes from ``[tool.wirecheck]`` in the nearest ``pyproject.toml``
@@ -149,11 +167,25 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     """
     run_dir = checked_report_dir(report_dir)
     if run_dir is not None:
-        claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
+        claim(run_dir, "report_dir")  # held until the report is in place: one run per folder
     try:
-        report, images = run_check(func, scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns,
-                                   allow_vacuous, cmd=cmd, timeout_s=timeout_s, isolate=isolate,
-                                   precision=precision, config=config)
+        report, images = run_check(
+            func,
+            scenes,
+            frames,
+            cases,
+            oracles,
+            tol_px,
+            min_f1,
+            min_f1_0px,
+            turns,
+            allow_vacuous,
+            cmd=cmd,
+            timeout_s=timeout_s,
+            isolate=isolate,
+            precision=precision,
+            config=config,
+        )
         if run_dir is not None:
             write_report(run_dir, report, images)
     finally:
@@ -162,9 +194,24 @@ def check_projector(func=None, scenes=None, frames: int | None = None, cases=Non
     return report
 
 
-def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol_px=None, min_f1=None,
-              min_f1_0px=None, turns=None, allow_vacuous=False, *, cmd=None, timeout_s=None, isolate=None,
-              precision=None, config=None) -> tuple[dict, dict]:
+def run_check(
+    func=None,
+    scenes=None,
+    frames=None,
+    cases=None,
+    oracles=None,
+    tol_px=None,
+    min_f1=None,
+    min_f1_0px=None,
+    turns=None,
+    allow_vacuous=False,
+    *,
+    cmd=None,
+    timeout_s=None,
+    isolate=None,
+    precision=None,
+    config=None,
+) -> tuple[dict, dict]:
     """:func:`check_projector`'s work: the report and its pictures' data.
 
     The second value is what :func:`wirecheck.oracles.reports.report.write_report` draws: the
@@ -172,13 +219,23 @@ def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol
     worst_points.png) at level vertices; the ``wirecheck`` fixture's ``--wirecheck-report``
     writes them, so its reports show what crosscheck's show.
     """
-    given = {"scenes": scenes, "frames": frames, "cases": cases, "oracles": oracles, "tol_px": tol_px,
-             "min_f1": min_f1, "min_f1_0px": min_f1_0px, "turns": turns, "timeout_s": timeout_s,
-             "precision": precision}
+    given = {
+        "scenes": scenes,
+        "frames": frames,
+        "cases": cases,
+        "oracles": oracles,
+        "tol_px": tol_px,
+        "min_f1": min_f1,
+        "min_f1_0px": min_f1_0px,
+        "turns": turns,
+        "timeout_s": timeout_s,
+        "precision": precision,
+    }
     settings = settings_for(given, config)
     scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns, timeout_s, precision = (
-        settings.get(k) for k in given)
-    if func is None and cmd is None:            # the table's candidate, as for the fixture
+        settings.get(k) for k in given
+    )
+    if func is None and cmd is None:  # the table's candidate, as for the fixture
         func, cmd = settings.get("candidate"), settings.get("candidate_cmd")
     func, cmd = _candidate_args(func, cmd)
     checked_flag(allow_vacuous, "allow_vacuous")
@@ -187,17 +244,25 @@ def run_check(func=None, scenes=None, frames=None, cases=None, oracles=None, tol
     timeout_s = _seconds(timeout_s)
     oracles = _oracles(oracles)
     tol = Tolerances(tol_px, min_f1, min_f1_0px, precision=_precision(precision))
-    inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)    # before any OpenGL set-up
-    with caller_state_kept(), closing_started():    # the caller's globals as they were; no process left
+    inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)  # before any OpenGL set-up
+    with caller_state_kept(), closing_started():  # the caller's globals as they were; no process left
         name, func = api_candidate(func, cmd, timeout_s, isolate)
         if "pyrender" in oracles:
             ok, message = gl_available()
             if not ok:
                 raise GLUnavailable(message)
-        report, images = run_crosscheck(inputs.scenes, func, frames=inputs.frames, case_names=inputs.case_names,
-                                         oracles=oracles, turns=inputs.turns, tol=tol, candidate_name=name,
-                                         allow_vacuous=allow_vacuous)
-    return {"run": None, **report}, images        # report.json's fields: "run" is crosscheck's --run name
+        report, images = run_crosscheck(
+            inputs.scenes,
+            func,
+            frames=inputs.frames,
+            case_names=inputs.case_names,
+            oracles=oracles,
+            turns=inputs.turns,
+            tol=tol,
+            candidate_name=name,
+            allow_vacuous=allow_vacuous,
+        )
+    return {"run": None, **report}, images  # report.json's fields: "run" is crosscheck's --run name
 
 
 def settings_for(given: dict, config=None) -> dict:
@@ -228,7 +293,7 @@ def _candidate_args(func, cmd):
     import os
 
     if func is None and cmd is None:
-        raise ValueError("no candidate: expected func (a callable or \"FILE.py:FUNC\") or cmd (a program)")
+        raise ValueError('no candidate: expected func (a callable or "FILE.py:FUNC") or cmd (a program)')
     if func is not None and cmd is not None:
         raise ValueError(f"func {short_repr(func)} and cmd {short_repr(cmd)}: expected one candidate, not both")
     if cmd is not None:
@@ -241,18 +306,22 @@ def _candidate_args(func, cmd):
     if isinstance(func, str):
         return func, None
     if not callable(func):
-        raise TypeError(f"func {short_repr(func)}: expected a callable func(points, camera) or a \"FILE.py:FUNC\" / "
-                        "\"MODULE:FUNC\" string")
+        raise TypeError(
+            f'func {short_repr(func)}: expected a callable func(points, camera) or a "FILE.py:FUNC" / '
+            '"MODULE:FUNC" string'
+        )
     try:
         signature = inspect.signature(func)
-    except (TypeError, ValueError):          # builtins and C callables without one: found out when called
+    except (TypeError, ValueError):  # builtins and C callables without one: found out when called
         return func, None
     try:
         signature.bind(None, None)
     except TypeError:
         name = getattr(func, "__qualname__", None) or short_repr(func)
-        raise TypeError(f"func {name}{signature} cannot be called as func(points, camera): expected "
-                        "the candidate contract (wirecheck.oracles.candidates.candidate)") from None
+        raise TypeError(
+            f"func {name}{signature} cannot be called as func(points, camera): expected "
+            "the candidate contract (wirecheck.oracles.candidates.candidate)"
+        ) from None
     return func, None
 
 
@@ -274,8 +343,10 @@ def _seconds(timeout_s) -> float:
         raise TypeError(f"timeout_s {short_repr(timeout_s)}: expected a number of seconds > 0")
     seconds = float(timeout_s)
     if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
-        raise ValueError(f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0 and at most "
-                         f"{MAX_CANDIDATE_TIMEOUT_S:g} (one day)")
+        raise ValueError(
+            f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0 and at most "
+            f"{MAX_CANDIDATE_TIMEOUT_S:g} (one day)"
+        )
     return seconds
 
 
@@ -284,16 +355,20 @@ def _oracles(oracles) -> tuple:
     if isinstance(oracles, str):
         return tuple(o.strip() for o in oracles.split(",") if o.strip())
     if not isinstance(oracles, (list, tuple)) or not all(isinstance(o, str) for o in oracles):
-        raise TypeError(f"oracles {short_repr(oracles)}: expected a tuple of names among opencv, pyrender "
-                        "(\"opencv\": vertices; (\"opencv\", \"pyrender\"): pixels too)")
+        raise TypeError(
+            f"oracles {short_repr(oracles)}: expected a tuple of names among opencv, pyrender "
+            '("opencv": vertices; ("opencv", "pyrender"): pixels too)'
+        )
     return tuple(oracles)
 
 
 def _precision(precision):
     """``precision`` checked: None, "float32" or "float64"; InputError (a ValueError) otherwise."""
     if precision is not None and precision not in tolerances.PRECISIONS:
-        raise InputError(f"precision {precision!r}: expected one of {', '.join(tolerances.PRECISIONS)} "
-                         "(or None: inferred from the dtype the projector returns)")
+        raise InputError(
+            f"precision {precision!r}: expected one of {', '.join(tolerances.PRECISIONS)} "
+            "(or None: inferred from the dtype the projector returns)"
+        )
     return precision
 
 
@@ -306,13 +381,16 @@ def failure_text(report: dict) -> str | None:
     if not failing:
         if report["verdict"] == "pass":
             return None
-        return (f"crosscheck of {report['candidate']}: verdict {report['verdict']} with no failing case"
-                + (f" ({compared_text(report)})" if "compared" in report else ""))
+        return f"crosscheck of {report['candidate']}: verdict {report['verdict']} with no failing case" + (
+            f" ({compared_text(report)})" if "compared" in report else ""
+        )
     lines = [f"{len(failing)} of {len(report['cases'])} crosscheck cases failed for {report['candidate']}:"]
     lines[0] = f"{what_text(report)}\n{lines[0]}"
-    for c in failing:          # a vacuous case's reason starts with "vacuous:"
-        lines.append(f"  {c['scene']} / {c['camera']}: faults: {case_cell(c['faults'], c.get('camera_spec'))}; "
-                     + "; ".join(c["reasons"]))
+    for c in failing:  # a vacuous case's reason starts with "vacuous:"
+        lines.append(
+            f"  {c['scene']} / {c['camera']}: faults: {case_cell(c['faults'], c.get('camera_spec'))}; "
+            + "; ".join(c["reasons"])
+        )
     lines += hint_lines(report, failing)
     if "compared" in report:
         lines.append(f"  in all: {compared_text(report)}")
@@ -339,7 +417,7 @@ def assert_projector(func=None, **kwargs) -> dict:
     AssertionError
         Naming each failing case, its faults and reasons, and what to check.
     """
-    __tracebackhide__ = True                     # pytest: the failure points at the caller's line
+    __tracebackhide__ = True  # pytest: the failure points at the caller's line
     return raise_unless_pass(check_projector(func, **kwargs), kwargs.get("report_dir"))
 
 

@@ -43,7 +43,6 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-
 from wirecheck.core.camera import Camera, look_at
 from wirecheck.core.scene.model import Scene, radius_about
 from wirecheck.core.transforms import Motion
@@ -73,8 +72,11 @@ class Case:
 
     def framing(self) -> dict:
         """The case's framing, for reports: ``{"centre", "radius", "pivot"}``."""
-        return {"centre": [float(x) for x in self.centre], "radius": float(self.radius),
-                "pivot": [float(x) for x in self.pivot]}
+        return {
+            "centre": [float(x) for x in self.centre],
+            "radius": float(self.radius),
+            "pivot": [float(x) for x in self.pivot],
+        }
 
 
 def cameras_for(radius: float, centre=ORIGIN, pivot=ORIGIN, calibrated: bool = False) -> list[Case]:
@@ -94,18 +96,51 @@ def cameras_for(radius: float, centre=ORIGIN, pivot=ORIGIN, calibrated: bool = F
     framed = {"pivot": tuple(float(x) for x in pivot), "centre": (cx, cy, cz), "radius": float(r)}
     return [
         Case("on_axis", look_at(at(0, 0, 3 * r), o, (0, 1, 0), fov_y_deg=60, near=0.1 * r, far=10 * r), **framed),
-        Case("oblique_roll", look_at(at(2 * r, 1.5 * r, 2.5 * r), o, (0.3, 1.0, 0.2), fov_y_deg=55,
-                                     near=0.1 * r, far=10 * r), **framed),
-        Case("near_plane", look_at(at(0.1 * r, 0.15 * r, 0.75 * r), at(0, 0, -r), (0, 1, 0), fov_y_deg=90,
-                                   near=0.35 * r, far=10 * r), **framed),
-        Case("wide_fov", look_at(at(0.2 * r, 0.3 * r, 1.4 * r), o, (0, 1, 0), fov_y_deg=120, near=0.05 * r,
-                                 far=10 * r), **framed),
-        Case("narrow_fov", look_at(at(0.5 * r, 1.0 * r, 25 * r), o, (0, 1, 0), fov_y_deg=8, near=r, far=50 * r),
-             **framed),
-        Case("non_square", look_at(at(-2 * r, 1.0 * r, 2.5 * r), o, (0, 1, 0), fov_y_deg=50, width=320, height=480,
-                                   near=0.1 * r, far=10 * r), **framed),
-        Case("orthographic", look_at(at(2 * r, 2 * r, 3 * r), o, (0, 1, 0), projection="orthographic",
-                                     ortho_height=3 * r, near=0.1 * r, far=10 * r), **framed),
+        Case(
+            "oblique_roll",
+            look_at(at(2 * r, 1.5 * r, 2.5 * r), o, (0.3, 1.0, 0.2), fov_y_deg=55, near=0.1 * r, far=10 * r),
+            **framed,
+        ),
+        Case(
+            "near_plane",
+            look_at(at(0.1 * r, 0.15 * r, 0.75 * r), at(0, 0, -r), (0, 1, 0), fov_y_deg=90, near=0.35 * r, far=10 * r),
+            **framed,
+        ),
+        Case(
+            "wide_fov",
+            look_at(at(0.2 * r, 0.3 * r, 1.4 * r), o, (0, 1, 0), fov_y_deg=120, near=0.05 * r, far=10 * r),
+            **framed,
+        ),
+        Case(
+            "narrow_fov", look_at(at(0.5 * r, 1.0 * r, 25 * r), o, (0, 1, 0), fov_y_deg=8, near=r, far=50 * r), **framed
+        ),
+        Case(
+            "non_square",
+            look_at(
+                at(-2 * r, 1.0 * r, 2.5 * r),
+                o,
+                (0, 1, 0),
+                fov_y_deg=50,
+                width=320,
+                height=480,
+                near=0.1 * r,
+                far=10 * r,
+            ),
+            **framed,
+        ),
+        Case(
+            "orthographic",
+            look_at(
+                at(2 * r, 2 * r, 3 * r),
+                o,
+                (0, 1, 0),
+                projection="orthographic",
+                ortho_height=3 * r,
+                near=0.1 * r,
+                far=10 * r,
+            ),
+            **framed,
+        ),
     ] + (calibrated_cases(r, o, framed) if calibrated else [])
 
 
@@ -125,12 +160,38 @@ def calibrated_cases(r: float, o=ORIGIN, framed: dict | None = None) -> list[Cas
         return tuple(c + d * r for c, d in zip(o, offset))
 
     return [
-        Case("off_centre", look_at(at((-1.5, 1.0, 2.6)), o, (0, 1, 0), near=0.1 * r, far=10 * r,
-                                   intrinsics=(460.0, 460.0, 319.5 + 70.0, 239.5 - 45.0)), **framed),
-        Case("non_square_pixels", look_at(at((1.2, -0.8, 2.8)), o, (0, 1, 0), near=0.1 * r, far=10 * r,
-                                          intrinsics=(520.0, 400.0, 319.5, 239.5)), **framed),
-        Case("distorted", look_at(at((0.4, 0.6, 2.6)), o, (0, 1, 0), near=0.1 * r, far=10 * r,
-                                  intrinsics=(470.0, 465.0, 325.2, 236.8), distortion=DISTORTION), **framed),
+        Case(
+            "off_centre",
+            look_at(
+                at((-1.5, 1.0, 2.6)),
+                o,
+                (0, 1, 0),
+                near=0.1 * r,
+                far=10 * r,
+                intrinsics=(460.0, 460.0, 319.5 + 70.0, 239.5 - 45.0),
+            ),
+            **framed,
+        ),
+        Case(
+            "non_square_pixels",
+            look_at(
+                at((1.2, -0.8, 2.8)), o, (0, 1, 0), near=0.1 * r, far=10 * r, intrinsics=(520.0, 400.0, 319.5, 239.5)
+            ),
+            **framed,
+        ),
+        Case(
+            "distorted",
+            look_at(
+                at((0.4, 0.6, 2.6)),
+                o,
+                (0, 1, 0),
+                near=0.1 * r,
+                far=10 * r,
+                intrinsics=(470.0, 465.0, 325.2, 236.8),
+                distortion=DISTORTION,
+            ),
+            **framed,
+        ),
     ]
 
 
@@ -150,11 +211,11 @@ def centred_sphere(scene: Scene) -> tuple[np.ndarray, float, bool]:
         lo, hi = v.min(axis=0), v.max(axis=0)
         c = 0.5 * lo + 0.5 * hi
         return c, radius_about(v, c), bool(np.all(lo <= 0.0) and np.all(hi >= 0.0))
-    parts = []          # (points (K, 3) or None, centre (3,), sphere radius)
+    parts = []  # (points (K, 3) or None, centre (3,), sphere radius)
     for o in scene.objects:
         if o.vertex_count == 0:
             continue
-        m, v = o.motion, scene.vertices[o.vertex_start:o.vertex_stop]
+        m, v = o.motion, scene.vertices[o.vertex_start : o.vertex_stop]
         off = np.asarray(m.offset, dtype=np.float64)
         if not any(float(t) for t in m.turns):
             parts.append((off + float(m.scale) * v, off, 0.0))
@@ -214,5 +275,17 @@ def case_table() -> str:
     return __doc__.split("\n\n", 2)[2].split("\n\n", 1)[0].strip()
 
 
-__all__ = ["Case", "cameras_for", "cases_for", "case_motion", "framing", "centred_sphere", "calibrated_cases",
-           "CASE_NAMES", "CALIBRATED_CASE_NAMES", "ALL_CASE_NAMES", "DISTORTION", "REFRAME_RATIO"]
+__all__ = [
+    "Case",
+    "cameras_for",
+    "cases_for",
+    "case_motion",
+    "framing",
+    "centred_sphere",
+    "calibrated_cases",
+    "CASE_NAMES",
+    "CALIBRATED_CASE_NAMES",
+    "ALL_CASE_NAMES",
+    "DISTORTION",
+    "REFRAME_RATIO",
+]

@@ -59,7 +59,7 @@ from __future__ import annotations
 
 from wirecheck.core.app.startup import interrupts_from_start
 
-interrupts_from_start("crosscheck")    # first: Ctrl-C while the imports below run is one line, no traceback
+interrupts_from_start("crosscheck")  # first: Ctrl-C while the imports below run is one line, no traceback
 
 import math  # noqa: E402
 import re
@@ -68,31 +68,31 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
-from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
 from wirecheck.core.app.guard import run_cli  # noqa: E402
+from wirecheck.core.errors import InputError, check_not_empty  # noqa: E402
 from wirecheck.core.limits import check_candidate_timeout
 from wirecheck.core.outputs.output import FrameDir, check_report_dir, claim, json_dumps, release_claims
+from wirecheck.core.scene.files import builtin_names, example_names
 
 from . import tolerances
-from .judge import gate
+from .candidates.core_candidate import CoreCandidate, RenderMode
 from .candidates.isolation import check_python_spec, external_candidate
+from .candidates.subprocess_candidate import closing_started
 from .cases import CASE_NAMES
+from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
+from .config import parse_cli, trust_line
 from .datasets.memory_budget import gib_bytes
 from .executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
-from .config import parse_cli, trust_line
-from .reports.junit import check_junit_target, write_junit
-from .candidates.core_candidate import CoreCandidate, RenderMode
-from .reports.progress import TerminalProgress
-from .reports.report_option import check_no_report, report_line
+from .judge import gate
 from .reports.compared import hint_lines, reason_text, what_text
+from .reports.junit import check_junit_target, write_junit
+from .reports.progress import TerminalProgress
 from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
+from .reports.report_option import check_no_report, report_line
+from .reports.wall import process_age_s
 from .runner import level_for_oracles, run_crosscheck
 from .spec import run_spec, spec_console, spec_markdown
 from .tolerances import Tolerances
-from .cli_options import MAX_JOBS, MAX_SCHEDULER_TIMEOUT_S, build_parser  # noqa: F401 (build_parser: the CLI's parser)
-from wirecheck.core.scene.files import builtin_names, example_names
-from .candidates.subprocess_candidate import closing_started
-from .reports.wall import process_age_s
 
 ORACLES = ("opencv", "pyrender")
 #: Options that configure the core candidate, with their defaults.
@@ -117,94 +117,141 @@ def _parse(args):
             raise InputError(f"--oracles {args.oracles!r}: expected opencv among them (vertices are always checked)")
         implied = level_for_oracles(oracles)
         if args.level is not None and args.level != implied:
-            raise InputError(f"--oracles {args.oracles!r} means --level {implied}, which contradicts "
-                             f"--level {args.level}: give only --level")
+            raise InputError(
+                f"--oracles {args.oracles!r} means --level {implied}, which contradicts "
+                f"--level {args.level}: give only --level"
+            )
         level = implied
     core_given = [f"--{k}" for k in CORE_OPTIONS if getattr(args, k) is not None]
     external = _external_option(args)
     if args.suite:
-        ignored = [opt for opt, given in (
-            ("--scene", args.scene is not None), ("--frames", args.frames != 24), ("--every", args.every != 1),
-            ("--cases", args.cases != ",".join(CASE_NAMES)), ("--spin", args.spin != "1,1,0"),
-            ("--jobs", args.jobs != 1), ("--tol-px", args.tol_px != tolerances.VERTEX_TOL_PX),
-            ("--min-f1", args.min_f1 != tolerances.MIN_F1_1PX),
-            ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX),
-            ("--min-iou", args.min_iou != tolerances.MIN_SILHOUETTE_IOU),
-            ("--candidate-precision", args.candidate_precision is not None and args.suite != "spec"),
-            ("--allow-vacuous", args.allow_vacuous)) if given]
+        ignored = [
+            opt
+            for opt, given in (
+                ("--scene", args.scene is not None),
+                ("--frames", args.frames != 24),
+                ("--every", args.every != 1),
+                ("--cases", args.cases != ",".join(CASE_NAMES)),
+                ("--spin", args.spin != "1,1,0"),
+                ("--jobs", args.jobs != 1),
+                ("--tol-px", args.tol_px != tolerances.VERTEX_TOL_PX),
+                ("--min-f1", args.min_f1 != tolerances.MIN_F1_1PX),
+                ("--min-f1-0px", args.min_f1_0px != tolerances.MIN_F1_0PX),
+                ("--min-iou", args.min_iou != tolerances.MIN_SILHOUETTE_IOU),
+                ("--candidate-precision", args.candidate_precision is not None and args.suite != "spec"),
+                ("--allow-vacuous", args.allow_vacuous),
+            )
+            if given
+        ]
         if ignored:
-            allowed = ("--level, --gl, --run, --report-dir, --candidate, --candidate-cmd or --candidate-precision"
-                       if args.suite == "spec"
-                       else "--level, --run or --report-dir")
-            raise InputError(f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
-                             f"bounds are fixed (oracles/{args.suite}/); expected only {allowed}")
+            allowed = (
+                "--level, --gl, --run, --report-dir, --candidate, --candidate-cmd or --candidate-precision"
+                if args.suite == "spec"
+                else "--level, --run or --report-dir"
+            )
+            raise InputError(
+                f"--suite {args.suite} with {', '.join(ignored)}: the suite's cases, frames and "
+                f"bounds are fixed (oracles/{args.suite}/); expected only {allowed}"
+            )
         if args.suite == "spec" and args.candidate_precision is not None and not external:
-            raise InputError(f"--suite spec with --candidate-precision {args.candidate_precision} and no --candidate: "
-                             "core says its own precision: expected --candidate or --candidate-cmd with it")
+            raise InputError(
+                f"--suite spec with --candidate-precision {args.candidate_precision} and no --candidate: "
+                "core says its own precision: expected --candidate or --candidate-cmd with it"
+            )
         if args.suite == "spec" and core_given:
-            raise InputError(f"--suite spec with {', '.join(core_given)}: the suite judges core in its default "
-                             "settings, or --candidate/--candidate-cmd: expected no --dtype/--clip/--raster")
+            raise InputError(
+                f"--suite spec with {', '.join(core_given)}: the suite judges core in its default "
+                "settings, or --candidate/--candidate-cmd: expected no --dtype/--clip/--raster"
+            )
     if args.sweep and args.allow_vacuous:
-        raise InputError("--sweep with --allow-vacuous: the sweep's cases are the bundled scenes and a large mesh, "
-                         "which always show something: expected no --allow-vacuous")
+        raise InputError(
+            "--sweep with --allow-vacuous: the sweep's cases are the bundled scenes and a large mesh, "
+            "which always show something: expected no --allow-vacuous"
+        )
     if args.sweep and args.jobs != 1:
-        raise InputError(f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
-                         "the times compare; expected no --jobs")
+        raise InputError(
+            f"--sweep with --jobs {args.jobs}: the sweep times every setting on one process so "
+            "the times compare; expected no --jobs"
+        )
     if (args.sweep or args.suite == "extremes") and (core_given or external):
         what = "--sweep" if args.sweep else f"--suite {args.suite}"
-        raise InputError(f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
-                         "itself; expected neither --candidate nor --dtype/--clip/--raster")
+        raise InputError(
+            f"{what} with {', '.join(core_given) or '--candidate'}: {what} runs core's settings "
+            "itself; expected neither --candidate nor --dtype/--clip/--raster"
+        )
     if args.sweep and args.candidate_precision is not None:
-        raise InputError(f"--sweep with --candidate-precision {args.candidate_precision}: the sweep runs each core "
-                         "--dtype at its own precision: expected no --candidate-precision")
+        raise InputError(
+            f"--sweep with --candidate-precision {args.candidate_precision}: the sweep runs each core "
+            "--dtype at its own precision: expected no --candidate-precision"
+        )
     if external and core_given:
-        raise InputError(f"{', '.join(core_given)}: settings of the core candidate, not of {external}: "
-                         "expected them without it")
-    mode_given = [opt for opt, given in (("--style", args.style is not None), ("--hidden-lines", args.hidden_lines),
-                                         ("--cull", args.cull is not None)) if given]
+        raise InputError(
+            f"{', '.join(core_given)}: settings of the core candidate, not of {external}: expected them without it"
+        )
+    mode_given = [
+        opt
+        for opt, given in (
+            ("--style", args.style is not None),
+            ("--hidden-lines", args.hidden_lines),
+            ("--cull", args.cull is not None),
+        )
+        if given
+    ]
     if mode_given:
         what = ", ".join(mode_given)
         if args.sweep or args.suite:
-            raise InputError(f"{what} with {'--sweep' if args.sweep else '--suite ' + args.suite}: expected "
-                             "the drawing options in a plain crosscheck run only")
+            raise InputError(
+                f"{what} with {'--sweep' if args.sweep else '--suite ' + args.suite}: expected "
+                "the drawing options in a plain crosscheck run only"
+            )
         if external:
-            raise InputError(f"{what}: drawing modes of the core candidate; {external} only "
-                             "projects points: expected them without it")
+            raise InputError(
+                f"{what}: drawing modes of the core candidate; {external} only "
+                "projects points: expected them without it"
+            )
         if level != "pixels":
-            raise InputError(f"{what} with --level {level}: faces are drawn and compared at the pixel level "
-                             "only: expected --level pixels (the default)")
+            raise InputError(
+                f"{what} with --level {level}: faces are drawn and compared at the pixel level "
+                "only: expected --level pixels (the default)"
+            )
         if args.style == "shaded" and args.hidden_lines:
             raise InputError("--hidden-lines with --style shaded: a shaded frame has no lines: expected one of them")
     mode = RenderMode(style=args.style or "wireframe", hidden_lines=args.hidden_lines, cull=args.cull or "none")
-    tol = Tolerances(vertex_px=args.tol_px, min_f1_1px=args.min_f1, min_f1_0px=args.min_f1_0px,
-                     min_iou=args.min_iou, precision=args.candidate_precision)
-    if args.suite == "extremes":      # fixed cases and bounds (checked above): nothing of a run's inputs applies
+    tol = Tolerances(
+        vertex_px=args.tol_px,
+        min_f1_1px=args.min_f1,
+        min_f1_0px=args.min_f1_0px,
+        min_iou=args.min_iou,
+        precision=args.candidate_precision,
+    )
+    if args.suite == "extremes":  # fixed cases and bounds (checked above): nothing of a run's inputs applies
         return level, None, None, mode, tol
-    if args.suite == "spec":          # fixed runs and checks; the candidate is core or the one given
+    if args.suite == "spec":  # fixed runs and checks; the candidate is core or the one given
         return level, None, _candidate(args, external), mode, tol
     # the library's one check of what a run compares (oracles.judge.gate), in the CLI's option names
-    if args.dataset is not None:      # the meshes are read where they are checked (oracles.datasets.dataset_run)
+    if args.dataset is not None:  # the meshes are read where they are checked (oracles.datasets.dataset_run)
         inputs = gate.run_settings(args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
     else:
-        inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol,
-                                 names=gate.CLI_NAMES)
-    for scene in inputs.scenes:         # read leniently (core.scene.files): one line each, the run goes on
+        inputs = gate.run_inputs(args.scene, args.frames, args.every, args.cases, args.spin, tol, names=gate.CLI_NAMES)
+    for scene in inputs.scenes:  # read leniently (core.scene.files): one line each, the run goes on
         for note in scene.load_notes:
             print(f"crosscheck: warning: {note}", file=sys.stderr)
     if mode.cull == "backface":
         wound = next((sc for sc in inputs.scenes if sc.faces and sc.winding_note), None)
-        if wound is not None:         # as renderer: culling needs one winding; both sides would share the error
-            raise InputError(f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
-                             "consistently (counter-clockwise seen from outside)")
+        if wound is not None:  # as renderer: culling needs one winding; both sides would share the error
+            raise InputError(
+                f"--cull backface: {wound.source}: {wound.winding_note}: expected faces wound "
+                "consistently (counter-clockwise seen from outside)"
+            )
     return level, inputs, _candidate(args, external), mode, tol
 
 
 def _candidate(args, external: str | None):
     """The run's candidate: the program of ``--candidate``/``--candidate-cmd``, started, or core in its settings."""
     if external:
-        if getattr(args, "candidate_from", None) is not None:    # before the program runs (docs/pytest.md)
+        if getattr(args, "candidate_from", None) is not None:  # before the program runs (docs/pytest.md)
             if args.candidate is not None:
-                check_python_spec(args.candidate)      # a file that is refused runs nothing: no line saying it runs
+                check_python_spec(args.candidate)  # a file that is refused runs nothing: no line saying it runs
             print(trust_line(*args.candidate_from), file=sys.stderr, flush=True)
         return external_candidate(args.candidate, args.candidate_cmd, args.candidate_timeout)
     return CoreCandidate(**{k: getattr(args, k) or v for k, v in CORE_OPTIONS.items()})
@@ -215,29 +262,36 @@ def _executor(args) -> ExecutorSpec:
     kind = args.executor or ("dask" if args.scheduler is not None else "local")
     if args.scheduler is not None:
         if kind != "dask":
-            raise InputError(f"--scheduler {args.scheduler!r} with --executor {kind}: a scheduler is Dask's: "
-                             "expected --executor dask (or no --executor)")
+            raise InputError(
+                f"--scheduler {args.scheduler!r} with --executor {kind}: a scheduler is Dask's: "
+                "expected --executor dask (or no --executor)"
+            )
         if args.jobs != 1:
-            raise InputError(f"--jobs {args.jobs} with --scheduler: the cluster's workers are those started with "
-                             "'dask worker': expected no --jobs")
+            raise InputError(
+                f"--jobs {args.jobs} with --scheduler: the cluster's workers are those started with "
+                "'dask worker': expected no --jobs"
+            )
         check_scheduler_address(args.scheduler)
     if not (math.isfinite(args.scheduler_timeout) and 0 < args.scheduler_timeout <= MAX_SCHEDULER_TIMEOUT_S):
-        raise InputError(f"--scheduler-timeout {args.scheduler_timeout:g}: expected a number of seconds > 0 and "
-                         f"<= {MAX_SCHEDULER_TIMEOUT_S:g}")
+        raise InputError(
+            f"--scheduler-timeout {args.scheduler_timeout:g}: expected a number of seconds > 0 and "
+            f"<= {MAX_SCHEDULER_TIMEOUT_S:g}"
+        )
     if args.scheduler is None and args.scheduler_timeout != DEFAULT_CONNECT_TIMEOUT_S:
-        raise InputError(f"--scheduler-timeout {args.scheduler_timeout:g} without --scheduler: it bounds reaching "
-                         "a cluster's scheduler: expected --scheduler tcp://HOST:PORT")
+        raise InputError(
+            f"--scheduler-timeout {args.scheduler_timeout:g} without --scheduler: it bounds reaching "
+            "a cluster's scheduler: expected --scheduler tcp://HOST:PORT"
+        )
     if kind == "dask" and (args.sweep or args.suite or args.candidate_frames is not None):
         what = "--sweep" if args.sweep else f"--suite {args.suite}" if args.suite else "--candidate-frames"
         raise InputError(f"--executor dask with {what}: expected it in a plain crosscheck run or a dataset run")
-    return ExecutorSpec(kind=kind, jobs=args.jobs, scheduler=args.scheduler,
-                        connect_timeout_s=args.scheduler_timeout)
+    return ExecutorSpec(kind=kind, jobs=args.jobs, scheduler=args.scheduler, connect_timeout_s=args.scheduler_timeout)
 
 
 def _dataset(args):
     """The dataset of ``--scene DIR`` / ``--scene-list FILE`` (oracles.datasets.dataset), or None for a plain run."""
     scenes = args.scene or []
-    named = set(builtin_names() + example_names())      # a bundled name wins over a folder of that name
+    named = set(builtin_names() + example_names())  # a bundled name wins over a folder of that name
     folders = [s for s in scenes if s not in named and Path(s).is_dir()]
     if not folders and not args.scene_list:
         if args.allow_load_errors:
@@ -247,26 +301,41 @@ def _dataset(args):
         return None
     if len(folders) != len(scenes):
         other = next(s for s in scenes if s not in folders)
-        raise InputError(f"--scene {other!r} with a dataset (--scene DIR or --scene-list): expected only folders "
-                         "and lists (put single mesh files in a --scene-list)")
-    other = [opt for opt, given in (("--sweep", args.sweep), ("--suite", args.suite),
-                                    ("--candidate-frames", args.candidate_frames is not None),
-                                    ("--junit-xml", args.junit_xml is not None)) if given]
+        raise InputError(
+            f"--scene {other!r} with a dataset (--scene DIR or --scene-list): expected only folders "
+            "and lists (put single mesh files in a --scene-list)"
+        )
+    other = [
+        opt
+        for opt, given in (
+            ("--sweep", args.sweep),
+            ("--suite", args.suite),
+            ("--candidate-frames", args.candidate_frames is not None),
+            ("--junit-xml", args.junit_xml is not None),
+        )
+        if given
+    ]
     if other:
-        raise InputError(f"a dataset (--scene DIR or --scene-list) with {', '.join(other)}: expected a plain "
-                         "crosscheck run over the meshes")
-    from .datasets.dataset import dataset_entries      # --scene DIR / --scene-list only
+        raise InputError(
+            f"a dataset (--scene DIR or --scene-list) with {', '.join(other)}: expected a plain "
+            "crosscheck run over the meshes"
+        )
+    from .datasets.dataset import dataset_entries  # --scene DIR / --scene-list only
 
     return dataset_entries(folders, args.scene_list or [])
 
 
 def _run_dir(args) -> tuple[Path, str]:
     """The report folder: DIR/RUN, DIR alone, or reports/RUN; and the option to name in errors."""
-    run = args.run if args.run is not None else (
-        None if args.report_dir else datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S"))
+    run = (
+        args.run
+        if args.run is not None
+        else (None if args.report_dir else datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S"))
+    )
     if run is not None and not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", run):
-        raise InputError(f"--run {run!r}: expected a name of letters, digits, '_', '.', '-' "
-                         "(no '/', not starting with '.')")
+        raise InputError(
+            f"--run {run!r}: expected a name of letters, digits, '_', '.', '-' (no '/', not starting with '.')"
+        )
     if args.report_dir:
         return (Path(args.report_dir) / run, "--run") if run is not None else (Path(args.report_dir), "--report-dir")
     return Path("reports") / run, "--run"
@@ -281,42 +350,48 @@ def _error(text: str) -> int:
 def _external_option(args) -> str | None:
     """``--candidate 'X'`` or ``--candidate-cmd 'X'`` as given (None: core); InputError for both or a bad timeout."""
     if args.candidate is not None and args.candidate_cmd is not None:
-        raise InputError(f"--candidate {args.candidate!r} with --candidate-cmd {args.candidate_cmd!r}: "
-                         "expected one candidate")
+        raise InputError(
+            f"--candidate {args.candidate!r} with --candidate-cmd {args.candidate_cmd!r}: expected one candidate"
+        )
     check_candidate_timeout(args.candidate_timeout, "--candidate-timeout")
-    if args.candidate is not None:            # '' too: an empty candidate is an error, never core
+    if args.candidate is not None:  # '' too: an empty candidate is an error, never core
         return f"--candidate {args.candidate!r}"
     return f"--candidate-cmd {args.candidate_cmd!r}" if args.candidate_cmd is not None else None
 
 
 def main(argv=None) -> int:
-    with closing_started():                       # the run's candidate program ends with the run
+    with closing_started():  # the run's candidate program ends with the run
         try:
-            return run_cli("crosscheck", _main, argv)     # one line on stderr whatever happens (core/app/guard.py)
+            return run_cli("crosscheck", _main, argv)  # one line on stderr whatever happens (core/app/guard.py)
         finally:
-            release_claims()                      # the report folder or job this run held from its start
+            release_claims()  # the report folder or job this run held from its start
 
 
 def _main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] == ["export"]:                     # crosscheck export DIR: a job for image candidates
+    if argv[:1] == ["export"]:  # crosscheck export DIR: a job for image candidates
         from .frames_cli import export_main
 
         return export_main(argv[1:])
     try:
         args, config, applied = parse_cli(build_parser(), argv)
-        args.candidate_from = next(((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd")
-                                    if key in applied), None)
-        check_not_empty((f"--{d.replace('_', '-')}", getattr(args, d)) for d in (
-            "scene", "scene_list", "candidate_frames", "report_dir", "junit_xml", "config"))
-        if args.unprojector is not None or args.unprojector_cmd is not None:     # the way back: its own report
+        args.candidate_from = next(
+            ((config.path, key, config.values[key]) for key in ("candidate", "candidate-cmd") if key in applied), None
+        )
+        check_not_empty(
+            (f"--{d.replace('_', '-')}", getattr(args, d))
+            for d in ("scene", "scene_list", "candidate_frames", "report_dir", "junit_xml", "config")
+        )
+        if args.unprojector is not None or args.unprojector_cmd is not None:  # the way back: its own report
             from .unprojector_cli import unprojector_main
 
             check_no_report(args)
             return unprojector_main(args, *_run_dir(args))
         if args.junit_xml and (args.sweep or args.suite):
-            raise InputError(f"--junit-xml with {'--sweep' if args.sweep else '--suite ' + args.suite}: "
-                             "expected it in a plain crosscheck run (one test case per scene x camera)")
+            raise InputError(
+                f"--junit-xml with {'--sweep' if args.sweep else '--suite ' + args.suite}: "
+                "expected it in a plain crosscheck run (one test case per scene x camera)"
+            )
         if args.junit_xml:
             check_junit_target(Path(args.junit_xml))
         check_no_report(args)
@@ -324,10 +399,10 @@ def _main(argv=None) -> int:
         run_dir, run_option = _run_dir(args)
     except InputError as exc:
         return _error(str(exc))
-    if applied:      # after the checks: on a usage error the error is the only line
+    if applied:  # after the checks: on a usage error the error is the only line
         print(f"crosscheck: settings from {config.path} [tool.wirecheck]: {', '.join(applied)}", file=sys.stderr)
     if level == "pixels":
-        from .references.pyrender_oracle import gl_available, select_gl   # GL chosen before PyOpenGL is imported
+        from .references.pyrender_oracle import gl_available, select_gl  # GL chosen before PyOpenGL is imported
 
         try:
             select_gl(args.gl)
@@ -341,16 +416,17 @@ def _main(argv=None) -> int:
     try:
         if not args.no_report:
             check_report_dir(run_dir, run_option)
-            claim(run_dir, run_option)            # held until the report is in place: one run per folder
+            claim(run_dir, run_option)  # held until the report is in place: one run per folder
     except InputError as exc:
         return _error(str(exc))
     except OSError as exc:
-        return _error(f"--report-dir {str(run_dir)!r}: cannot write there ({exc}): "
-                      "expected a writable directory")
+        return _error(f"--report-dir {str(run_dir)!r}: cannot write there ({exc}): expected a writable directory")
 
     if args.line_rule is not None and args.candidate_frames is None:
-        return _error(f"--line-rule {args.line_rule} without --candidate-frames: a projector's lines are drawn by "
-                      "the harness (GL's rule); expected --line-rule only with --candidate-frames DIR")
+        return _error(
+            f"--line-rule {args.line_rule} without --candidate-frames: a projector's lines are drawn by "
+            "the harness (GL's rule); expected --line-rule only with --candidate-frames DIR"
+        )
     if args.candidate_frames is not None:
         from .frames_cli import frames_main
 
@@ -363,18 +439,35 @@ def _main(argv=None) -> int:
         return _spec_suite(args, candidate, level, run_dir)
     if args.suite:
         return _suite(level, run_dir)
-    for scene in inputs.scenes:     # a valid file with nothing in it: said once here, not only in the table
+    for scene in inputs.scenes:  # a valid file with nothing in it: said once here, not only in the table
         if len(scene.vertices) == 0:
-            print(f"crosscheck: {scene.source}: no vertices: every case of scene {scene.name!r} compares nothing "
-                  f"(vacuous: {'allowed by --allow-vacuous' if args.allow_vacuous else 'the run fails'})",
-                  file=sys.stderr)
+            print(
+                f"crosscheck: {scene.source}: no vertices: every case of scene {scene.name!r} compares nothing "
+                f"(vacuous: {'allowed by --allow-vacuous' if args.allow_vacuous else 'the run fails'})",
+                file=sys.stderr,
+            )
     progress = TerminalProgress(sys.stderr)
     # an external candidate runs in its own process already (oracles.candidates.isolation): no worker needed
-    result, status = _run_guarded(args, progress, lambda: run_crosscheck(
-        inputs.scenes, candidate, frames=inputs.frames, case_names=inputs.case_names, level=level,
-        turns=inputs.turns, tol=tol, every=inputs.every, jobs=args.jobs, candidate_name=candidate.name,
-        mode=mode, allow_vacuous=args.allow_vacuous, progress=progress.update if progress.active else None,
-        executor=args.executor_spec))
+    result, status = _run_guarded(
+        args,
+        progress,
+        lambda: run_crosscheck(
+            inputs.scenes,
+            candidate,
+            frames=inputs.frames,
+            case_names=inputs.case_names,
+            level=level,
+            turns=inputs.turns,
+            tol=tol,
+            every=inputs.every,
+            jobs=args.jobs,
+            candidate_name=candidate.name,
+            mode=mode,
+            allow_vacuous=args.allow_vacuous,
+            progress=progress.update if progress.active else None,
+            executor=args.executor_spec,
+        ),
+    )
     if status is not None:
         return status
     report, images = result
@@ -382,7 +475,7 @@ def _main(argv=None) -> int:
     records = report["cases"]
     try:
         if not args.no_report:
-            run_dir.parent.mkdir(parents=True, exist_ok=True)     # only now: a failed run leaves no folder
+            run_dir.parent.mkdir(parents=True, exist_ok=True)  # only now: a failed run leaves no folder
             write_report(run_dir, report, images)
     except OSError as exc:
         return _error(f"writing {str(run_dir)!r} failed: {exc}")
@@ -398,7 +491,7 @@ def _main(argv=None) -> int:
     for r in records:
         if r["verdict"] != "pass":
             print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
-    notes = {}                              # a passing case's note, once per text: its cases named together
+    notes = {}  # a passing case's note, once per text: its cases named together
     for r in records:
         if r["verdict"] == "pass" and r.get("note"):
             notes.setdefault(r["note"], []).append(f"{r['scene']} / {r['camera']}")
@@ -407,11 +500,16 @@ def _main(argv=None) -> int:
     for line in hint_lines(report, [r for r in records if r["verdict"] != "pass"]):
         print(line)
     s = report["summary"]
-    limits = (f"silhouette IoU >= {tol.min_iou}, depth error <= its bound" if mode.shaded
-              else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}")
+    limits = (
+        f"silhouette IoU >= {tol.min_iou}, depth error <= its bound"
+        if mode.shaded
+        else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}"
+    )
     vacuous = vacuous_text(report)
-    print(f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases, {compared_text(report)} "
-          f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else ""))
+    print(
+        f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases, {compared_text(report)} "
+        f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else "")
+    )
     if precision_text(report):
         print(f"Candidate precision: {precision_text(report)}")
     print(timing_line(report)[:-1] + f"; {process_age_s():.1f} s in all, with start-up and the report)")
@@ -452,7 +550,7 @@ def _memory_budget(gib: float | None):
         return "auto"
     if not (math.isfinite(gib) and gib > 0):
         raise InputError(f"--memory-budget {gib:g}: expected a number of GiB > 0")
-    return gib_bytes(gib)           # exact: 1e300 GiB is a budget too large to matter, not inf
+    return gib_bytes(gib)  # exact: 1e300 GiB is a budget too large to matter, not inf
 
 
 def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
@@ -461,15 +559,30 @@ def _dataset_main(args, level, inputs, candidate, mode, tol, run_dir) -> int:
     from .datasets.dataset_run import run_dataset
 
     progress = DatasetProgress(sys.stderr)
-    report, status = _run_guarded(args, progress, lambda: run_dataset(
-        args.dataset, candidate, frames=inputs.frames, case_names=inputs.case_names, turns=inputs.turns,
-        tol=tol, level=level, every=inputs.every, mode=mode, candidate_name=candidate.name,
-        allow_vacuous=args.allow_vacuous, allow_load_errors=args.allow_load_errors, executor=args.executor_spec,
-        memory_budget=_memory_budget(args.memory_budget),
-        progress=progress.update if progress.active else None))
+    report, status = _run_guarded(
+        args,
+        progress,
+        lambda: run_dataset(
+            args.dataset,
+            candidate,
+            frames=inputs.frames,
+            case_names=inputs.case_names,
+            turns=inputs.turns,
+            tol=tol,
+            level=level,
+            every=inputs.every,
+            mode=mode,
+            candidate_name=candidate.name,
+            allow_vacuous=args.allow_vacuous,
+            allow_load_errors=args.allow_load_errors,
+            executor=args.executor_spec,
+            memory_budget=_memory_budget(args.memory_budget),
+            progress=progress.update if progress.active else None,
+        ),
+    )
     if status is not None:
         return status
-    if args.dataset.skipped_line() is not None:     # FIFOs, devices: never opened (oracles.datasets.dataset)
+    if args.dataset.skipped_line() is not None:  # FIFOs, devices: never opened (oracles.datasets.dataset)
         print(f"crosscheck: {args.dataset.skipped_line()}", file=sys.stderr)
     report = {"run": args.run, **report}
     try:
@@ -488,13 +601,23 @@ def _sweep(args, inputs, level, tol, run_dir) -> int:
     def progress(text):
         print(f"  {text}", file=sys.stderr, flush=True)
 
-    print(f"Sweep: 12 settings x {len(inputs.scenes)} scenes + a large mesh x {len(inputs.case_names)} cameras, "
-          f"{inputs.frames_checked} frames each", file=sys.stderr)
+    print(
+        f"Sweep: 12 settings x {len(inputs.scenes)} scenes + a large mesh x {len(inputs.case_names)} cameras, "
+        f"{inputs.frames_checked} frames each",
+        file=sys.stderr,
+    )
     try:
         run_dir.parent.mkdir(parents=True, exist_ok=True)
-        result = run_sweep(list(inputs.scenes), frames=inputs.frames, every=inputs.every,
-                           case_names=list(inputs.case_names), turns=inputs.turns, large=large_mesh(),
-                           pyrender=level == "pixels", progress=progress)
+        result = run_sweep(
+            list(inputs.scenes),
+            frames=inputs.frames,
+            every=inputs.every,
+            case_names=list(inputs.case_names),
+            turns=inputs.turns,
+            large=large_mesh(),
+            pyrender=level == "pixels",
+            progress=progress,
+        )
         write_sweep(run_dir, result)
     except InputError as exc:
         return _error(str(exc))
@@ -511,7 +634,7 @@ def _sweep(args, inputs, level, tol, run_dir) -> int:
 
 
 def _suite(level, run_dir) -> int:
-    from .extremes import extremes_markdown, run_extremes      # --suite extremes only
+    from .extremes import extremes_markdown, run_extremes  # --suite extremes only
 
     result = run_extremes(pyrender=level == "pixels")
     md = extremes_markdown(result)
@@ -527,24 +650,29 @@ def _suite(level, run_dir) -> int:
             raise
     except OSError as exc:
         return _error(f"writing {str(run_dir)!r} failed: {exc}")
-    print(md.split("\n\n- **", 1)[0].rstrip())   # the table; derivations and notes are in extremes.md
+    print(md.split("\n\n- **", 1)[0].rstrip())  # the table; derivations and notes are in extremes.md
     print(f"(the bounds' derivations and each case's notes: {run_dir / 'extremes.md'})\n")
     failed = [c["name"] for c in result["cases"] if c["verdict"] != "pass"]
-    print(f"{result['verdict'].upper()}: {len(result['cases']) - len(failed)}/{len(result['cases'])} extreme cases "
-          "within their derived bounds" + (f" (failed: {', '.join(failed)})" if failed else ""))
+    print(
+        f"{result['verdict'].upper()}: {len(result['cases']) - len(failed)}/{len(result['cases'])} extreme cases "
+        "within their derived bounds" + (f" (failed: {', '.join(failed)})" if failed else "")
+    )
     print(f"Report: {run_dir / 'extremes.md'} (also extremes.json)")
     return 1 if failed else 0
 
 
 def _spec_suite(args, candidate, level, run_dir) -> int:
     """``--suite spec`` (oracles.spec): the 24 runs and 7 named checks; spec.json and spec.md; exit 0 or 1."""
-    result, status = _run_guarded(args, TerminalProgress(None), lambda: run_spec(
-        candidate, level=level, candidate_name=candidate.name, precision=args.candidate_precision))
+    result, status = _run_guarded(
+        args,
+        TerminalProgress(None),
+        lambda: run_spec(candidate, level=level, candidate_name=candidate.name, precision=args.candidate_precision),
+    )
     if status is not None:
         return status
     result = {"run": args.run, **result}
     try:
-        run_dir.parent.mkdir(parents=True, exist_ok=True)     # only now: a failed run leaves no folder
+        run_dir.parent.mkdir(parents=True, exist_ok=True)  # only now: a failed run leaves no folder
         out = FrameDir(run_dir, "--report-dir")
         try:
             out.write("spec.json", json_dumps(result).encode())

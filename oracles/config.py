@@ -38,6 +38,7 @@ from pathlib import Path
 from wirecheck.core.errors import InputError
 from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 from wirecheck.core.user_files import RefusedFile, problem, read_text
+
 from .tolerances import PRECISIONS
 
 if sys.version_info >= (3, 11):
@@ -65,9 +66,17 @@ KEYS = {
 }
 
 #: Keyword of oracles.api.check_projector for each key (``level``/``oracles`` become ``oracles``).
-API_KEYWORDS = {"scenes": "scenes", "cases": "cases", "frames": "frames", "tol-px": "tol_px",
-                "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "turns", "candidate-timeout": "timeout_s",
-                "candidate-precision": "precision"}
+API_KEYWORDS = {
+    "scenes": "scenes",
+    "cases": "cases",
+    "frames": "frames",
+    "tol-px": "tol_px",
+    "min-f1": "min_f1",
+    "min-f1-0px": "min_f1_0px",
+    "spin": "turns",
+    "candidate-timeout": "timeout_s",
+    "candidate-precision": "precision",
+}
 
 
 @dataclass(frozen=True)
@@ -107,7 +116,7 @@ def find_pyproject(start: Path) -> Path | None:
     start = Path(start).resolve()
     for folder in (start, *start.parents):
         candidate = folder / "pyproject.toml"
-        if candidate.exists():       # a FIFO or folder of that name is refused by load_config, not passed over
+        if candidate.exists():  # a FIFO or folder of that name is refused by load_config, not passed over
             return candidate
     return None
 
@@ -133,9 +142,11 @@ def load_config(path: Path | None = None, start: Path | None = None) -> Config:
         raise
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
-    except RecursionError:           # tomllib recurses per nested array or inline table
-        raise InputError(f"{path}: not valid TOML here: arrays or tables nested too deep for the "
-                         "reader: expected the settings of docs (a few levels at most)") from None
+    except RecursionError:  # tomllib recurses per nested array or inline table
+        raise InputError(
+            f"{path}: not valid TOML here: arrays or tables nested too deep for the "
+            "reader: expected the settings of docs (a few levels at most)"
+        ) from None
     table = data.get("tool", {}).get("wirecheck") if isinstance(data.get("tool"), dict) else None
     if table is None:
         if explicit:
@@ -168,8 +179,13 @@ def validate(table: dict, path: Path) -> dict:
             close = difflib.get_close_matches(key, KEYS, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise InputError(f"{path}: [{TABLE}] unknown key {key!r}{hint}: expected some of {', '.join(KEYS)}")
-        if "\x00" in (value if isinstance(value, str) else "".join(v for v in value if isinstance(v, str))
-                       if isinstance(value, list) else ""):
+        if "\x00" in (
+            value
+            if isinstance(value, str)
+            else "".join(v for v in value if isinstance(v, str))
+            if isinstance(value, list)
+            else ""
+        ):
             raise bad(key, value, "text without a NUL character (no file name or command holds one)")
         if key == "candidate":
             if not isinstance(value, str) or ":" not in value:
@@ -199,20 +215,27 @@ def validate(table: dict, path: Path) -> dict:
                 if "/" in name or "\\" in name or Path(name).suffix:
                     scene_path = base / name
                     refused = problem(scene_path, "mesh" if scene_path.suffix.lower() in MESH_SUFFIXES else "scene")
-                    if refused is not None:         # before resolve(): a link loop is named, not a RuntimeError
+                    if refused is not None:  # before resolve(): a link loop is named, not a RuntimeError
                         raise bad(key, value, f"existing scene files: {str(scene_path)!r} is not a file ({refused})")
                     scenes.append(_absolute(scene_path))
                 elif name in known:
                     scenes.append(name)
                 else:
-                    raise bad(key, value, f"built-in or example scenes ({', '.join(sorted(known))}) or "
-                                          f"paths: {name!r} is neither")
+                    raise bad(
+                        key,
+                        value,
+                        f"built-in or example scenes ({', '.join(sorted(known))}) or paths: {name!r} is neither",
+                    )
             out[key] = scenes
         elif key == "cases":
             unknown = [c for c in value if c not in CASE_NAMES] if strings(value) else None
             if unknown is None or unknown:
-                raise bad(key, value, f"a non-empty list of some of {', '.join(CASE_NAMES)}"
-                                      + (f" ({', '.join(map(repr, unknown))} unknown)" if unknown else ""))
+                raise bad(
+                    key,
+                    value,
+                    f"a non-empty list of some of {', '.join(CASE_NAMES)}"
+                    + (f" ({', '.join(map(repr, unknown))} unknown)" if unknown else ""),
+                )
             out[key] = list(value)
         elif key == "frames":
             if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
@@ -252,10 +275,20 @@ def validate(table: dict, path: Path) -> dict:
 
 
 #: crosscheck's argparse destination for each key.
-CLI_DESTS = {"candidate": "candidate", "candidate-cmd": "candidate_cmd", "candidate-timeout": "candidate_timeout",
-             "candidate-precision": "candidate_precision",
-             "scenes": "scene", "cases": "cases", "frames": "frames", "level": "level",
-             "tol-px": "tol_px", "min-f1": "min_f1", "min-f1-0px": "min_f1_0px", "spin": "spin"}
+CLI_DESTS = {
+    "candidate": "candidate",
+    "candidate-cmd": "candidate_cmd",
+    "candidate-timeout": "candidate_timeout",
+    "candidate-precision": "candidate_precision",
+    "scenes": "scene",
+    "cases": "cases",
+    "frames": "frames",
+    "level": "level",
+    "tol-px": "tol_px",
+    "min-f1": "min_f1",
+    "min-f1-0px": "min_f1_0px",
+    "spin": "spin",
+}
 
 
 def _cli_value(key: str, value):
@@ -278,9 +311,11 @@ def trust_line(path: Path, key: str, value: str) -> str:
     from .datasets.dataset import printable
 
     what = "program" if key == "candidate-cmd" else "Python candidate (its file is imported and run)"
-    return (f"crosscheck: {printable(str(path))} [{TABLE}] chose the {what}: {key} = {printable(repr(value))}; "
-            "it runs now with your permissions (as pytest runs a conftest.py): give --candidate, --candidate-cmd "
-            "or --config FILE to choose otherwise")
+    return (
+        f"crosscheck: {printable(str(path))} [{TABLE}] chose the {what}: {key} = {printable(repr(value))}; "
+        "it runs now with your permissions (as pytest runs a conftest.py): give --candidate, --candidate-cmd "
+        "or --config FILE to choose otherwise"
+    )
 
 
 class _Unset:
@@ -300,7 +335,7 @@ def parse_cli(parser, argv=None):
     import argparse
 
     unset = _Unset()
-    dests = [d for d in (*CLI_DESTS.values(), "oracles") if d != "scene"]   # append actions need a list
+    dests = [d for d in (*CLI_DESTS.values(), "oracles") if d != "scene"]  # append actions need a list
     args = parser.parse_args(argv, namespace=argparse.Namespace(**{d: unset for d in dests}))
     given = {d for d in dests if getattr(args, d) is not unset} | ({"scene"} if args.scene is not None else set())
     for d in dests:
@@ -314,7 +349,7 @@ def parse_cli(parser, argv=None):
         dest = CLI_DESTS[key]
         picked = key in ("candidate", "candidate-cmd") and (args.sweep or {"candidate", "candidate_cmd"} & given)
         if dest in given or (key == "level" and "oracles" in given) or picked:
-            continue                  # a candidate on the command line replaces the table's, of either kind
+            continue  # a candidate on the command line replaces the table's, of either kind
         setattr(args, dest, _cli_value(key, value))
         applied.append(key)
     return args, config, applied

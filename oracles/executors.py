@@ -70,8 +70,10 @@ def check_scheduler_address(address: str, option: str = "--scheduler") -> str:
     """``address`` when it is ``tcp://HOST:PORT`` (or ``tls://``) with a port in 1..65535; InputError otherwise."""
     m = _ADDRESS.fullmatch(address or "")
     if not m or not 1 <= int(m.group(3)) <= 65535:
-        raise InputError(f"{option} {address!r}: expected tcp://HOST:PORT (the address 'dask scheduler' "
-                         "prints, e.g. tcp://10.0.0.5:8786)")
+        raise InputError(
+            f"{option} {address!r}: expected tcp://HOST:PORT (the address 'dask scheduler' "
+            "prints, e.g. tcp://10.0.0.5:8786)"
+        )
     return address
 
 
@@ -142,13 +144,20 @@ def _dask_client(spec: ExecutorSpec, n_workers: int | None = None):
     """
     try:
         from distributed import Client, LocalCluster
-    except ImportError as exc:       # pragma: no cover - a dependency in pyproject.toml
-        raise InputError(f"--executor dask: {exc}: expected the 'distributed' package (pip install distributed)") \
-            from None
+    except ImportError as exc:  # pragma: no cover - a dependency in pyproject.toml
+        raise InputError(
+            f"--executor dask: {exc}: expected the 'distributed' package (pip install distributed)"
+        ) from None
     with _quiet_dask(), _environ_kept():
         if spec.scheduler is None:
-            cluster = LocalCluster(n_workers=n_workers or spec.jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                   dashboard_address=None, silence_logs=logging.CRITICAL)
+            cluster = LocalCluster(
+                n_workers=n_workers or spec.jobs,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=logging.CRITICAL,
+            )
             try:
                 client = Client(cluster)
             except BaseException:
@@ -159,23 +168,29 @@ def _dask_client(spec: ExecutorSpec, n_workers: int | None = None):
             try:
                 client = Client(spec.scheduler, timeout=spec.connect_timeout_s)
             except (OSError, TimeoutError) as exc:
-                raise InputError(f"--scheduler {spec.scheduler}: no Dask scheduler answered within "
-                                 f"{spec.connect_timeout_s:g} s ({type(exc).__name__}): expected a running "
-                                 "'dask scheduler' at that address") from None
+                raise InputError(
+                    f"--scheduler {spec.scheduler}: no Dask scheduler answered within "
+                    f"{spec.connect_timeout_s:g} s ({type(exc).__name__}): expected a running "
+                    "'dask scheduler' at that address"
+                ) from None
             except TypeError as exc:
                 if not spec.scheduler.startswith("tls://"):
                     raise
                 # distributed wants an ssl.SSLContext from the Dask config's TLS settings
-                raise InputError(f"--scheduler {spec.scheduler}: TLS without certificates ({exc}): expected the "
-                                 "Dask config's distributed.comm.tls settings, or a tcp:// address") from None
+                raise InputError(
+                    f"--scheduler {spec.scheduler}: TLS without certificates ({exc}): expected the "
+                    "Dask config's distributed.comm.tls settings, or a tcp:// address"
+                ) from None
         try:
             if spec.scheduler is not None:
                 try:
                     client.wait_for_workers(1, timeout=spec.connect_timeout_s)
                 except (OSError, TimeoutError):
-                    raise InputError(f"--scheduler {spec.scheduler}: the scheduler has no worker after "
-                                     f"{spec.connect_timeout_s:g} s: expected 'dask worker {spec.scheduler}' "
-                                     "running on at least one machine with wirecheck installed") from None
+                    raise InputError(
+                        f"--scheduler {spec.scheduler}: the scheduler has no worker after "
+                        f"{spec.connect_timeout_s:g} s: expected 'dask worker {spec.scheduler}' "
+                        "running on at least one machine with wirecheck installed"
+                    ) from None
             yield client
         finally:
             client.close()
@@ -203,15 +218,17 @@ def heap_for_arrays() -> bool:
         libc = ctypes.CDLL("libc.so.6")
     except OSError:
         return False
-    m_trim_threshold, m_mmap_threshold = -1, -3           # glibc's <malloc.h>
+    m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's <malloc.h>
     return bool(libc.mallopt(m_mmap_threshold, 32 * 2**20)) and bool(libc.mallopt(m_trim_threshold, 64 * 2**20))
 
 
 def dask_failure(exc: BaseException) -> str:
     """One line for a task that failed on a Dask worker (a worker died, or lacks wirecheck)."""
     text = " ".join(str(exc).split())[:300]
-    return (f"a Dask task failed ({type(exc).__name__}: {text}): every worker needs the same wirecheck "
-            "installed as this machine, and the mesh files at the same paths (docs/datasets.md)")
+    return (
+        f"a Dask task failed ({type(exc).__name__}: {text}): every worker needs the same wirecheck "
+        "installed as this machine, and the mesh files at the same paths (docs/datasets.md)"
+    )
 
 
 def dask_workers(client) -> int:
@@ -232,7 +249,7 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
         with _dask_client(spec, min(spec.jobs, max(n_tasks, 1))) as client:
             client.run(heap_for_arrays)
             if initializer is not None:
-                client.run(initializer)          # on every worker, before the first task
+                client.run(initializer)  # on every worker, before the first task
             yield client.get_executor(), dask_workers(client)
         return
     workers = min(spec.jobs, n_tasks)
@@ -245,8 +262,9 @@ def open_executor(spec: ExecutorSpec, n_tasks: int, initializer=None, isolate: b
     workers = max(workers, 1)
     ctx = multiprocessing.get_context("spawn")
     barrier = ctx.Barrier(workers)
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_pool_init,
-                             initargs=(initializer, barrier)) as pool:
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=ctx, initializer=_pool_init, initargs=(initializer, barrier)
+    ) as pool:
         try:
             # start every worker now (the pool starts one per task submitted while none is idle, and each
             # waits for the others): the run's time then counts tasks, not interpreters starting
@@ -266,8 +284,8 @@ def _stop_workers(pool) -> None:
     timeout (a hung candidate: 10 s by default). A worker's candidate program dies with it
     (oracles.candidates.subprocess_candidate: it is killed when its parent ends).
     """
-    processes = list((getattr(pool, "_processes", None) or {}).values())     # CPython's pid -> Process
-    pool.shutdown(wait=False, cancel_futures=True)                           # (which forgets them)
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # CPython's pid -> Process
+    pool.shutdown(wait=False, cancel_futures=True)  # (which forgets them)
     for proc in processes:
         proc.terminate()
     for proc in processes:

@@ -33,45 +33,63 @@ names, cells and hints is :func:`markdown_table` (tests/test_faults.py).
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
-from collections.abc import Iterable, Mapping
 
-__all__ = ["FaultKind", "Fault", "CATALOGUE", "FAMILIES", "SOURCES", "NAMES", "kind", "family", "names",
-           "precedence", "ordered", "hint_text", "markdown_table"]
+__all__ = [
+    "FaultKind",
+    "Fault",
+    "CATALOGUE",
+    "FAMILIES",
+    "SOURCES",
+    "NAMES",
+    "kind",
+    "family",
+    "names",
+    "precedence",
+    "ordered",
+    "hint_text",
+    "markdown_table",
+]
 
 #: The families, each a question about the picture.
-FAMILIES: Mapping[str, str] = MappingProxyType({
-    "orientation": "the picture is turned, mirrored or seen from behind as a whole",
-    "ambiguous": "two orientations fit the images equally well",
-    "clipping": "the points kept differ from near <= z <= far",
-    "scale": "the focal length or the aspect",
-    "offset": "a constant shift",
-    "lens": "the lens distortion",
-    "line_count": "the drawn lines gain or lose pixels (GL's rule, counted against the oracle's)",
-    "line_rule": "the lines are right but drawn under another rule than GL's",
-    "precision": "float32 rounding, not a convention error",
-    "depth": "a depth map's values: their unit, origin, ray, direction, encoding or precision",
-    "rotation": "the world-to-camera rotation applied the wrong way round on the way back",
-    "unexplained": "no simple image-space fault",
-})
+FAMILIES: Mapping[str, str] = MappingProxyType(
+    {
+        "orientation": "the picture is turned, mirrored or seen from behind as a whole",
+        "ambiguous": "two orientations fit the images equally well",
+        "clipping": "the points kept differ from near <= z <= far",
+        "scale": "the focal length or the aspect",
+        "offset": "a constant shift",
+        "lens": "the lens distortion",
+        "line_count": "the drawn lines gain or lose pixels (GL's rule, counted against the oracle's)",
+        "line_rule": "the lines are right but drawn under another rule than GL's",
+        "precision": "float32 rounding, not a convention error",
+        "depth": "a depth map's values: their unit, origin, ray, direction, encoding or precision",
+        "rotation": "the world-to-camera rotation applied the wrong way round on the way back",
+        "unexplained": "no simple image-space fault",
+    }
+)
 
 #: Where a fault is read, each with the words docs/diagnosis.md's table uses for its own hint.
-SOURCES: Mapping[str, str] = MappingProxyType({
-    "any": "vertices or pixels",
-    "vertices": "the projected vertices only",
-    "pixels": "the drawn lines",
-    "images": "a renderer's frames only",
-    "depth": "depth maps",
-    "points": "unprojectors",
-    "silhouettes": "filled frames",
-})
+SOURCES: Mapping[str, str] = MappingProxyType(
+    {
+        "any": "vertices or pixels",
+        "vertices": "the projected vertices only",
+        "pixels": "the drawn lines",
+        "images": "a renderer's frames only",
+        "depth": "depth maps",
+        "points": "unprojectors",
+        "silhouettes": "filled frames",
+    }
+)
 
 
 @dataclass(frozen=True)
 class FaultKind:
     """One name of the catalogue: what it is about, what a cell shows, what to check."""
+
     name: str
     family: str
     source: str
@@ -96,211 +114,306 @@ class FaultKind:
         return self.hints[source] if source in self.sources and source in self.hints else self.hint
 
 
-_MINUS_ONE = ("the scale is (W - 1) / W (or (H - 1) / H): the pixel count minus one was used as the image "
-              "size (x = (ndc + 1) (W - 1) / 2); use x = (ndc + 1) W / 2 - 0.5")
+_MINUS_ONE = (
+    "the scale is (W - 1) / W (or (H - 1) / H): the pixel count minus one was used as the image "
+    "size (x = (ndc + 1) (W - 1) / 2); use x = (ndc + 1) W / 2 - 0.5"
+)
 _NEAR_FAR = "Check the near/far test (near <= z <= far, z = forward . (p - position)), points behind the camera, "
 
 _KINDS = (
     FaultKind(
-        "depth_flip", "orientation", "any",
-        "the camera looks backward: depth must be positive in front, z = forward . (p - position)"),
+        "depth_flip",
+        "orientation",
+        "any",
+        "the camera looks backward: depth must be positive in front, z = forward . (p - position)",
+    ),
     FaultKind(
-        "clipping_plane", "clipping", "vertices",
+        "clipping_plane",
+        "clipping",
+        "vertices",
         "the points kept differ from near <= z <= far (z = forward . (p - position)): kind and "
         "near_fit/far_fit say where the candidate clips (z_positive: at z > 0, not near; "
         "float32_near: near rounded to float32; none: never; swapped: near and far exchanged)",
         shown=(("kind", ""),),
-        hints=MappingProxyType({
-            "z_positive": "the candidate keeps every point with z > 0: clip at the near plane, near <= z <= far "
-                          "(z = forward . (p - position)), not at the camera",
-            "float32_near": "the near plane went through float32 (a float32 near or GL projection matrix): "
-                            "near_fit is where it clips; build the matrix in float64, or declare float32",
-            "float32_far": "the far plane went through float32 (a float32 GL projection matrix, whose far is "
-                           "ill-conditioned): build the matrix in float64, or declare float32",
-            "near": "the near plane is another value: near_fit is where the candidate clips; use the camera's near",
-            "far": "the far plane is another value (far_fit; None: never clips far): use the camera's far",
-            "none": "the candidate never clips (no NaN, even behind the camera): return NaN unless "
-                    "near <= z <= far",
-            "swapped": "the candidate keeps no depth at all: near and far exchanged in near <= z <= far "
-                       "(or the test inverted)"})),
+        hints=MappingProxyType(
+            {
+                "z_positive": "the candidate keeps every point with z > 0: clip at the near plane, near <= z <= far "
+                "(z = forward . (p - position)), not at the camera",
+                "float32_near": "the near plane went through float32 (a float32 near or GL projection matrix): "
+                "near_fit is where it clips; build the matrix in float64, or declare float32",
+                "float32_far": "the far plane went through float32 (a float32 GL projection matrix, whose far is "
+                "ill-conditioned): build the matrix in float64, or declare float32",
+                "near": "the near plane is another value: near_fit is where the candidate clips; use the camera's near",
+                "far": "the far plane is another value (far_fit; None: never clips far): use the camera's far",
+                "none": "the candidate never clips (no NaN, even behind the camera): return NaN unless "
+                "near <= z <= far",
+                "swapped": "the candidate keeps no depth at all: near and far exchanged in near <= z <= far "
+                "(or the test inverted)",
+            }
+        ),
+    ),
+    FaultKind("axis_swap", "orientation", "any", "x and y are exchanged: return columns [x, y], not [row, col]"),
     FaultKind(
-        "axis_swap", "orientation", "any",
-        "x and y are exchanged: return columns [x, y], not [row, col]"),
-    FaultKind(
-        "ambiguous", "ambiguous", "images",
+        "ambiguous",
+        "ambiguous",
+        "images",
         "the images fit two faults equally well (a symmetric view cannot tell them apart): "
         "check both, see alternatives",
         shown=(("alternatives", ""),),
-        hints=MappingProxyType({
-            "alternatives": "the images fit {first} and {second} equally well (a symmetric view cannot tell "
-                            "them apart): {each}",
-            "depth": "the compared depths fit several of these models alike (a surface at one depth, seen "
-                     "square-on): judge more frames, or a view whose depth varies",
-            "points": "the points fit several of these mistakes alike on this view: see the alternatives",
-            "silhouettes": "the silhouettes fit several of these camera mistakes alike (a silhouette symmetric "
-                           "about an axis looks the same mirrored): see the alternatives, or judge a view that "
-                           "is not symmetric"})),
+        hints=MappingProxyType(
+            {
+                "alternatives": "the images fit {first} and {second} equally well (a symmetric view cannot tell "
+                "them apart): {each}",
+                "depth": "the compared depths fit several of these models alike (a surface at one depth, seen "
+                "square-on): judge more frames, or a view whose depth varies",
+                "points": "the points fit several of these mistakes alike on this view: see the alternatives",
+                "silhouettes": "the silhouettes fit several of these camera mistakes alike (a silhouette symmetric "
+                "about an axis looks the same mirrored): see the alternatives, or judge a view that "
+                "is not symmetric",
+            }
+        ),
+    ),
     FaultKind(
-        "axis_flip", "orientation", "any",
+        "axis_flip",
+        "orientation",
+        "any",
         "the picture is turned 180 degrees: x and y are both negated (e.g. right and up "
-        "both negated in the world-to-camera rotation)"),
+        "both negated in the world-to-camera rotation)",
+    ),
     FaultKind(
-        "mirror_horizontal", "orientation", "any",
-        "left and right are exchanged: check right = forward x up (not up x forward) "
-        "and x_px = cx + f x / z",
-        hints=MappingProxyType({
-            "depth": "columns flipped: right = forward x up, and x_px grows to the right",
-            "points": "pixel x grows to the right: x_cam = (u - cx) d / fx, and right = forward x up",
-            "silhouettes": "columns flipped: right = forward x up, x_px = cx + f x / z (a texture or buffer "
-                           "read back with its u axis reversed mirrors it too)"})),
+        "mirror_horizontal",
+        "orientation",
+        "any",
+        "left and right are exchanged: check right = forward x up (not up x forward) and x_px = cx + f x / z",
+        hints=MappingProxyType(
+            {
+                "depth": "columns flipped: right = forward x up, and x_px grows to the right",
+                "points": "pixel x grows to the right: x_cam = (u - cx) d / fx, and right = forward x up",
+                "silhouettes": "columns flipped: right = forward x up, x_px = cx + f x / z (a texture or buffer "
+                "read back with its u axis reversed mirrors it too)",
+            }
+        ),
+    ),
     FaultKind(
-        "mirror_vertical", "orientation", "any",
+        "mirror_vertical",
+        "orientation",
+        "any",
         "the picture is upside down: pixel y grows downward, so y_px = cy - f y / z",
-        hints=MappingProxyType({
-            "depth": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
-                     "when reading the buffer back (glReadPixels returns the bottom row first)",
-            "points": "pixel y grows downward: y_cam = -(v - cy) d / fy (rows are not flipped; OpenCV's camera "
-                      "y is down, the contract's up)",
-            "silhouettes": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
-                           "when reading the frame back (glReadPixels returns the bottom row first)"})),
+        hints=MappingProxyType(
+            {
+                "depth": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
+                "when reading the buffer back (glReadPixels returns the bottom row first)",
+                "points": "pixel y grows downward: y_cam = -(v - cy) d / fy (rows are not flipped; OpenCV's camera "
+                "y is down, the contract's up)",
+                "silhouettes": "rows flipped: GL's window y is up, an image's row 0 is the top: flip the rows once "
+                "when reading the frame back (glReadPixels returns the bottom row first)",
+            }
+        ),
+    ),
     FaultKind(
-        "rotation_transposed", "rotation", "points",
-        "R maps world to camera (p_cv = R X + t, rows right, -up, forward): the way back is "
-        "X = R^T (p_cv - t)",
-        shown=(("form", ""),)),
+        "rotation_transposed",
+        "rotation",
+        "points",
+        "R maps world to camera (p_cv = R X + t, rows right, -up, forward): the way back is X = R^T (p_cv - t)",
+        shown=(("form", ""),),
+    ),
     FaultKind(
-        "aspect_mismatch", "scale", "any",
+        "aspect_mismatch",
+        "scale",
+        "any",
         "x and y are scaled differently: use one focal length for both axes (square "
         "pixels); implied_aspect is the width/height ratio that was used",
         shown=(("implied_aspect", "aspect"),),
-        hints=MappingProxyType({
-            "minus_one": _MINUS_ONE,
-            "inverted": "implied_aspect is H/W: the aspect was taken the wrong way round (height / width "
-                        "where width / height is expected)",
-            "width": "x is scaled by W/H (or H/W) against y: fx was taken from the width (aspect 1): "
-                     "fx = fy for square pixels"})),
+        hints=MappingProxyType(
+            {
+                "minus_one": _MINUS_ONE,
+                "inverted": "implied_aspect is H/W: the aspect was taken the wrong way round (height / width "
+                "where width / height is expected)",
+                "width": "x is scaled by W/H (or H/W) against y: fx was taken from the width (aspect 1): "
+                "fx = fy for square pixels",
+            }
+        ),
+    ),
     FaultKind(
-        "fov_mismatch", "scale", "any",
+        "fov_mismatch",
+        "scale",
+        "any",
         "the focal length is off: f = (H / 2) / tan(fov_y / 2) with the vertical FOV in "
         "radians; implied_fov_deg is the FOV that was used",
         shown=(("implied_fov_deg", "fov"), ("implied_ortho_height", "ortho_height"), ("implied_fov_y_deg", "fov")),
-        hints=MappingProxyType({
-            "horizontal_fov": "the scale is W/H (or H/W): you used the horizontal FOV (or the width) where the "
-                              "vertical one is expected: f = (H / 2) / tan(fov_y / 2)",
-            "minus_one": _MINUS_ONE,
-            "depth": "the image is scaled about the principal point: fov_y_deg is the vertical FOV, "
-                     "f = (H / 2) / tan(fov_y / 2) (a renderer given it as its horizontal view angle scales by "
-                     "W / H)",
-            "points": "fov_y_deg is the full vertical FOV: f = (H / 2) / tan(fov_y / 2), the same for x "
-                      "(not (W / 2) / tan(fov / 2))",
-            "silhouettes": "the silhouette is scaled about the principal point (scale: a candidate pixel shows "
-                           "the reference's at c + scale (p - c)): f = (H / 2) / tan(fov_y / 2) with the vertical "
-                           "FOV (a renderer given it as its horizontal view angle scales by H / W)"})),
+        hints=MappingProxyType(
+            {
+                "horizontal_fov": "the scale is W/H (or H/W): you used the horizontal FOV (or the width) where the "
+                "vertical one is expected: f = (H / 2) / tan(fov_y / 2)",
+                "minus_one": _MINUS_ONE,
+                "depth": "the image is scaled about the principal point: fov_y_deg is the vertical FOV, "
+                "f = (H / 2) / tan(fov_y / 2) (a renderer given it as its horizontal view angle scales by "
+                "W / H)",
+                "points": "fov_y_deg is the full vertical FOV: f = (H / 2) / tan(fov_y / 2), the same for x "
+                "(not (W / 2) / tan(fov / 2))",
+                "silhouettes": "the silhouette is scaled about the principal point (scale: a candidate pixel shows "
+                "the reference's at c + scale (p - c)): f = (H / 2) / tan(fov_y / 2) with the vertical "
+                "FOV (a renderer given it as its horizontal view angle scales by H / W)",
+            }
+        ),
+    ),
     FaultKind(
-        "pixel_offset", "offset", "any",
+        "pixel_offset",
+        "offset",
+        "any",
         "a constant shift: integer pixel coordinates are pixel centres and the principal "
         "point is ((W - 1) / 2, (H - 1) / 2); 0.5 is the pixel-corner convention",
         shown=(("dx", "dx"), ("dy", "dy")),
         frames_hint="a renderer that snaps lines to pixel centres (matplotlib: draw with snap=False) or truncates "
-                    "float coordinates (Pillow: round them) moves its lines too",
-        hints=MappingProxyType({
-            "depth": "the depth is half a pixel (or more) off: pixel centres are integers, cx = (W - 1) / 2 "
-                     "(W / 2 is the corner convention); a GL projection from K puts cx + 0.5 in it",
-            "points": "pixel centres are integers: a centred camera has cx = (W - 1) / 2, cy = (H - 1) / 2 "
-                      "(W / 2 is GL's window convention, pixel centres at half-integers: subtract 0.5)",
-            "silhouettes": "the silhouette is shifted (a candidate pixel p shows the reference's p + (dx, dy)): "
-                           "pixel centres are integers, cx = (W - 1) / 2 (W / 2 gives -0.5); a GL projection "
-                           "built from K puts cx + 0.5 in it"})),
+        "float coordinates (Pillow: round them) moves its lines too",
+        hints=MappingProxyType(
+            {
+                "depth": "the depth is half a pixel (or more) off: pixel centres are integers, cx = (W - 1) / 2 "
+                "(W / 2 is the corner convention); a GL projection from K puts cx + 0.5 in it",
+                "points": "pixel centres are integers: a centred camera has cx = (W - 1) / 2, cy = (H - 1) / 2 "
+                "(W / 2 is GL's window convention, pixel centres at half-integers: subtract 0.5)",
+                "silhouettes": "the silhouette is shifted (a candidate pixel p shows the reference's p + (dx, dy)): "
+                "pixel centres are integers, cx = (W - 1) / 2 (W / 2 gives -0.5); a GL projection "
+                "built from K puts cx + 0.5 in it",
+            }
+        ),
+    ),
     FaultKind(
-        "distortion_mismatch", "lens", "vertices",
+        "distortion_mismatch",
+        "lens",
+        "vertices",
         "the lens distortion differs from the camera's (kind: ignored, k1's sign, or a "
         "coefficient's size): apply OpenCV's model to x/z, y/z with y down, before K: "
         "r2 = x^2 + y^2, x (1 + k1 r2 + k2 r2^2 + k3 r2^3) + 2 p1 x y + p2 (r2 + 2 x^2)",
         shown=(("kind", ""), ("radial_error_px", "error_px")),
-        hints=MappingProxyType({
-            "points": "undo the lens distortion before unprojecting: cv2.undistortPointsIter (the "
-                      "default cv2.undistortPoints stops after 5 iterations, ~4e-3 px off on this lens)"})),
+        hints=MappingProxyType(
+            {
+                "points": "undo the lens distortion before unprojecting: cv2.undistortPointsIter (the "
+                "default cv2.undistortPoints stops after 5 iterations, ~4e-3 px off on this lens)"
+            }
+        ),
+    ),
     FaultKind(
-        "depth_encoding", "depth", "depth",
+        "depth_encoding",
+        "depth",
+        "depth",
         "the depth buffer's non-linear value was stored: linearise it, d = f n / (f - z (f - n)) for window "
         "z in [0, 1] (NDC z: z_win = (z + 1) / 2 first; orthographic: d = n + z (f - n))",
-        shown=(("near", "near"), ("far", "far"))),
+        shown=(("near", "near"), ("far", "far")),
+    ),
     FaultKind(
-        "depth_reversed", "depth", "depth",
+        "depth_reversed",
+        "depth",
+        "depth",
         "a reversed-Z buffer (near -> 1, far -> 0) linearised with the standard formula: near and far swap; "
         "linearise it as d = n f / (n + z (f - n)), or read 1 - z",
-        shown=(("sum_of_inverses", "1/n+1/f"), ("sum", "n+f"))),
+        shown=(("sum_of_inverses", "1/n+1/f"), ("sum", "n+f")),
+    ),
     FaultKind(
-        "depth_scale", "depth", "depth",
+        "depth_scale",
+        "depth",
+        "depth",
         "depth is a constant factor off: k = 1000 is millimetres read as metres (a 16-bit PNG not divided by "
         "its scale; 5000 for TUM files); divide by the scale the file was written with",
-        shown=(("k", "k"),)),
+        shown=(("k", "k"),),
+    ),
     FaultKind(
-        "depth_is_range", "depth", "depth",
+        "depth_is_range",
+        "depth",
+        "depth",
         "distance from the eye along the pixel's ray was stored where depth along forward was asked (or the "
         "reverse): depth = range / |(x_n, y_n, 1)| with x_n = (x - cx) / fx, y_n = (y - cy) / fy",
         shown=(("stored", ""),),
-        hints=MappingProxyType({
-            "points": "the depth given is along forward (z_cam), not along the ray: p_cam = d (x_n, y_n, 1), "
-                      "not d (x_n, y_n, 1) / |(x_n, y_n, 1)|"})),
+        hints=MappingProxyType(
+            {
+                "points": "the depth given is along forward (z_cam), not along the ray: p_cam = d (x_n, y_n, 1), "
+                "not d (x_n, y_n, 1) / |(x_n, y_n, 1)|"
+            }
+        ),
+    ),
     FaultKind(
-        "depth_offset", "depth", "depth",
+        "depth_offset",
+        "depth",
+        "depth",
         "a constant is added: depth measured from the near plane (b = -near) or from a point other than the "
         "camera centre; depth is z_cam = dot(p - position, forward)",
-        shown=(("b", "b"), ("b_over_near", "b/near"))),
+        shown=(("b", "b"), ("b_over_near", "b/near")),
+    ),
     FaultKind(
-        "depth_precision", "depth", "depth",
+        "depth_precision",
+        "depth",
+        "depth",
         "depth values are quantised (a float16 or 8-bit target or texture): render and store depth as "
         "float32, or as a 16-bit PNG with a scale",
-        shown=(("format", ""), ("step", "step"))),
+        shown=(("format", ""), ("step", "step")),
+    ),
     FaultKind(
-        "line_end_bias", "line_count", "pixels",
+        "line_end_bias",
+        "line_count",
+        "pixels",
         "the vertices agree but the lines lose (or gain) pixels at one end: check the "
         "rasterizer's end rule (GL diamond exit: the start pixel is drawn when the start point "
         "is inside its diamond, the end pixel is not drawn when the end point is inside its own)",
         shown=(("end", "end"), ("pixels_per_line", "pixels_per_line"), ("end_px", "end_px")),
         frames_hint="the pixels lose or gain end pixels against both GL's rule and ends rounded to pixel "
-                    "centres (Bresenham, Pillow), which pass by default; --line-rule geometry judges the geometry only"),
+        "centres (Bresenham, Pillow), which pass by default; --line-rule geometry judges the geometry only",
+    ),
     FaultKind(
-        "line_pixel_bias", "line_count", "pixels",
+        "line_pixel_bias",
+        "line_count",
+        "pixels",
         "the vertices agree but the candidate draws systematically more (or fewer) line pixels "
         "than the oracle along the lines: check the line width (1 px) and the rounding of the "
         "minor coordinate (nearest pixel centre)",
-        shown=(("candidate_only", "candidate_only"), ("oracle_only", "oracle_only"))),
+        shown=(("candidate_only", "candidate_only"), ("oracle_only", "oracle_only")),
+    ),
     FaultKind(
-        "raster_rule", "line_rule", "pixels",
+        "raster_rule",
+        "line_rule",
+        "pixels",
         "the lines are where the oracle's are but their pixels follow another aliased line rule than "
         "GL's (Pillow's, TinyGL's: ends snapped to pixel centres, another choice across the line): check "
         "the line rasteriser, not the camera; without --line-rule gl a correct drawing with ends rounded to "
-        "pixel centres passes, and --line-rule geometry judges the geometry only"),
+        "pixel centres passes, and --line-rule geometry judges the geometry only",
+    ),
     FaultKind(
-        "precision_limited", "precision", "vertices",
+        "precision_limited",
+        "precision",
+        "vertices",
         "the error is the size of float32 rounding, not a convention error: compute in "
         "float64 or declare float32 (--candidate-precision float32)",
-        shown=(("residual_px", "residual_px"),)),
+        shown=(("residual_px", "residual_px"),),
+    ),
     FaultKind(
-        "unexplained", "unexplained", "any",
+        "unexplained",
+        "unexplained",
+        "any",
         "not a simple image-space fault: check the rotation order, a transposed "
         "world-to-camera matrix, the up vector (roll) and the near/far test",
         cell="which kind, in a few words (nothing drawn, the sets that differ, the residual and rotation)",
-        hints=MappingProxyType({
-            "visible_sets": "the pixels agree (residual {residual:.2g} px <= the {tol:.2g} px bound); only the "
-                            "visible sets differ: {candidate_only} points shown only by the candidate, "
-                            "{oracle_only} only by the oracle. " + _NEAR_FAR + "and any visibility or raster "
-                            "step, not the rotation",
-            "drawn_sets": "{where}; only the drawn sets differ: {candidate_only} pixels drawn only by the candidate, "
-                          "{oracle_only} only by the oracle (no pixel of the other within {near:g} px). "
-                          + _NEAR_FAR + "and any visibility or raster step, not the rotation",
-            "dim_lines": "the frames hold lines, at level {level} of 255 (luminance x alpha / 255), under the "
-                         "{drawn} from which a pixel counts as drawn: nothing was drawn by the rule. Draw the "
-                         "lines white and opaque (a grey colour or a partial alpha dims them)",
-            "depth": "the depth differs from the reference in no way this diagnosis knows: see what was measured "
-                     "(fit_ratios: each model's worst residual over its allowance)",
-            "silhouettes": "the silhouette differs from the reference in no way this diagnosis knows (a roll, a "
-                           "wrong pose, missing faces): see what was measured (fit_ratios: each camera mistake's "
-                           "missed pixels per boundary pixel)",
-            "points": "the points differ from the exact inverse in no way this diagnosis knows: see what was "
-                      "measured (the median pixel shift, scale and depth ratio)"})),
+        hints=MappingProxyType(
+            {
+                "visible_sets": "the pixels agree (residual {residual:.2g} px <= the {tol:.2g} px bound); only the "
+                "visible sets differ: {candidate_only} points shown only by the candidate, "
+                "{oracle_only} only by the oracle. " + _NEAR_FAR + "and any visibility or raster "
+                "step, not the rotation",
+                "drawn_sets": "{where}; only the drawn sets differ: {candidate_only} pixels drawn only by the candidate, "
+                "{oracle_only} only by the oracle (no pixel of the other within {near:g} px). "
+                + _NEAR_FAR
+                + "and any visibility or raster step, not the rotation",
+                "dim_lines": "the frames hold lines, at level {level} of 255 (luminance x alpha / 255), under the "
+                "{drawn} from which a pixel counts as drawn: nothing was drawn by the rule. Draw the "
+                "lines white and opaque (a grey colour or a partial alpha dims them)",
+                "depth": "the depth differs from the reference in no way this diagnosis knows: see what was measured "
+                "(fit_ratios: each model's worst residual over its allowance)",
+                "silhouettes": "the silhouette differs from the reference in no way this diagnosis knows (a roll, a "
+                "wrong pose, missing faces): see what was measured (fit_ratios: each camera mistake's "
+                "missed pixels per boundary pixel)",
+                "points": "the points differ from the exact inverse in no way this diagnosis knows: see what was "
+                "measured (the median pixel shift, scale and depth ratio)",
+            }
+        ),
+    ),
 )
 
 #: Every fault name's entry, in precedence order (the primary fault first).
@@ -330,8 +443,9 @@ def names(*families: str, source: str | None = None) -> tuple[str, ...]:
         raise KeyError(f"families {sorted(unknown)}: expected among {', '.join(FAMILIES)}")
     if source is not None and source not in SOURCES:
         raise KeyError(f"source {source!r}: expected one of {', '.join(SOURCES)}")
-    return tuple(k.name for k in _KINDS if (not families or k.family in families)
-                 and (source is None or source in k.sources))
+    return tuple(
+        k.name for k in _KINDS if (not families or k.family in families) and (source is None or source in k.sources)
+    )
 
 
 def precedence(name: str) -> int:
@@ -354,12 +468,13 @@ class Fault:
     a per-fault ``hint`` or ``note`` among them), read through the catalogue; ``source``: where it was
     read when that selects its hint (``"depth"``, ``"points"``: :meth:`FaultKind.hint_for`), not part
     of the record."""
+
     name: str
     params: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     source: str | None = None
 
     def __post_init__(self):
-        kind(self.name)                                     # a name outside the catalogue is a bug
+        kind(self.name)  # a name outside the catalogue is a bug
         if self.source is not None and self.source not in SOURCES:
             raise KeyError(f"source {self.source!r}: expected one of {', '.join(SOURCES)}")
         object.__setattr__(self, "params", MappingProxyType(dict(self.params)))
@@ -393,8 +508,9 @@ class Fault:
     def shown(self, limit: int = 2) -> list[tuple[str, str, Any]]:
         """``(field, label, value)`` of the first ``limit`` of the catalogue's shown fields this fault has
         (not None): the key numbers of its table cell (formatted by oracles.reports.fault_text.cell)."""
-        return [(key, label, self.params[key]) for key, label in self.kind.shown
-                if self.params.get(key) is not None][:limit]
+        return [(key, label, self.params[key]) for key, label in self.kind.shown if self.params.get(key) is not None][
+            :limit
+        ]
 
     @property
     def note(self) -> str | None:

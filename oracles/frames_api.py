@@ -14,20 +14,28 @@ report is the one the command line writes.
 
 from __future__ import annotations
 
-from .api import checked_flag, checked_report_dir, short_repr, raise_unless_pass
 from wirecheck.core.errors import InputError
 from wirecheck.core.outputs.output import check_report_dir, claim, release_claim
+
 from . import tolerances
+from .api import checked_flag, checked_report_dir, raise_unless_pass, short_repr
+from .candidates.caller_state import caller_state_kept
+from .frames_cli import check_report_outside_job
 from .judge import gate
 from .judge.line_style import LINE_RULES
-from .frames_cli import check_report_outside_job
-from .reports.report import write_report
-from .candidates.caller_state import caller_state_kept
 from .references.pyrender_oracle import GLUnavailable, gl_available
+from .reports.report import write_report
 
 
-def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None, min_f1_0px: float | None = None,
-                 allow_vacuous: bool = False, report_dir=None) -> dict:
+def check_frames(
+    job_dir,
+    *,
+    line_rule: str = "any",
+    min_f1: float | None = None,
+    min_f1_0px: float | None = None,
+    allow_vacuous: bool = False,
+    report_dir=None,
+) -> dict:
     """Judge the frames a renderer drew for a job against pyrender and core; return the report.
 
     Parameters
@@ -76,16 +84,20 @@ def check_frames(job_dir, *, line_rule: str = "any", min_f1: float | None = None
     job_dir = Path(job_dir)
     checked_flag(allow_vacuous, "allow_vacuous")
     if line_rule not in LINE_RULES:
-        raise InputError(f"line_rule {line_rule!r}: expected one of {', '.join(LINE_RULES)} (any: aliased 1-px "
-                         "lines held to GL's rule or the rounded ends'; gl: to GL's pixel rule; geometry: where "
-                         "the lines are only)")
-    tol = tolerances.Tolerances(min_f1_1px=tolerances.MIN_F1_1PX if min_f1 is None else min_f1,
-                                min_f1_0px=tolerances.MIN_F1_0PX if min_f1_0px is None else min_f1_0px)
-    gate.check_tolerances(tol)                  # a NaN floor would pass everything
+        raise InputError(
+            f"line_rule {line_rule!r}: expected one of {', '.join(LINE_RULES)} (any: aliased 1-px "
+            "lines held to GL's rule or the rounded ends'; gl: to GL's pixel rule; geometry: where "
+            "the lines are only)"
+        )
+    tol = tolerances.Tolerances(
+        min_f1_1px=tolerances.MIN_F1_1PX if min_f1 is None else min_f1,
+        min_f1_0px=tolerances.MIN_F1_0PX if min_f1_0px is None else min_f1_0px,
+    )
+    gate.check_tolerances(tol)  # a NaN floor would pass everything
     run_dir = checked_report_dir(report_dir)
-    if run_dir is not None:                     # before anything is judged, as crosscheck checks it
+    if run_dir is not None:  # before anything is judged, as crosscheck checks it
         check_report_dir(run_dir, "report_dir")
-        claim(run_dir, "report_dir")            # held until the report is in place: one run per folder
+        claim(run_dir, "report_dir")  # held until the report is in place: one run per folder
         try:
             check_report_outside_job(job_dir, run_dir)
         except BaseException:
@@ -105,7 +117,7 @@ def _judge(job_dir, tol, allow_vacuous: bool, line_rule: str) -> tuple[dict, dic
     """crosscheck's frames judge on ``job_dir``, after the check that pyrender's GL can draw here."""
     from .judge.frames_judge import run_frames
 
-    with caller_state_kept():                   # the caller's globals as they were (PYOPENGL_PLATFORM, ...)
+    with caller_state_kept():  # the caller's globals as they were (PYOPENGL_PLATFORM, ...)
         ok, message = gl_available()
         if not ok:
             raise GLUnavailable(message)
@@ -133,5 +145,5 @@ def assert_frames(job_dir, **kwargs) -> dict:
         Naming each failing case, its faults and reasons, and what to check
         (:func:`wirecheck.oracles.api.failure_text`); with ``report_dir``, the report's path last.
     """
-    __tracebackhide__ = True                     # pytest: the failure points at the caller's line
+    __tracebackhide__ = True  # pytest: the failure points at the caller's line
     return raise_unless_pass(check_frames(job_dir, **kwargs), kwargs.get("report_dir"))

@@ -18,15 +18,14 @@ import base64
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-
 from wirecheck.core.outputs.output import png_bytes
 
-from .judge import metrics
+from .candidates.core_candidate import CoreCandidate, RenderMode
 from .cases import Case
+from .judge import metrics
+from .judge.case import run_case
 from .references.pyrender_oracle import OracleCache, osmesa_available
 from .reports.fault_text import case_cell
-from .judge.case import run_case
-from .candidates.core_candidate import CoreCandidate, RenderMode
 from .tolerances import Tolerances
 
 
@@ -50,17 +49,34 @@ class LiveOverlay:
     def _run(self, s, camera, frame: int) -> dict:
         mode = RenderMode(style=s.style, hidden_lines=s.hidden_lines, cull=s.cull or "none")
         cand = CoreCandidate(dtype=s.dtype, clip=s.clip, raster=s.raster)
-        res = run_case(s.scene, Case("interactive", camera), s.frames, cand, s.motion, Tolerances(),
-                       pyrender_oracle=self._cache.get(camera.width, camera.height), want_images=True,
-                       every=s.frames, mode=mode, first=frame)
+        res = run_case(
+            s.scene,
+            Case("interactive", camera),
+            s.frames,
+            cand,
+            s.motion,
+            Tolerances(),
+            pyrender_oracle=self._cache.get(camera.width, camera.height),
+            want_images=True,
+            every=s.frames,
+            mode=mode,
+            first=frame,
+        )
         rec = res.record
-        out = {"frame": frame, "verdict": rec["verdict"], "reasons": rec["reasons"],
-               "f1_0px": rec.get("pixel_f1_0px"), "f1_1px": rec.get("pixel_f1_1px"),
-               "max_vertex_error_px": rec.get("max_vertex_error_px"),
-               "faults": [f["name"] for f in rec["faults"]],
-               "faults_text": case_cell(rec["faults"], rec.get("camera_spec")),
-               "silhouette_iou": rec.get("silhouette_iou"), "depth_error_ratio": rec.get("depth_error_ratio"),
-               "oracle_image": None, "diff_image": None}
+        out = {
+            "frame": frame,
+            "verdict": rec["verdict"],
+            "reasons": rec["reasons"],
+            "f1_0px": rec.get("pixel_f1_0px"),
+            "f1_1px": rec.get("pixel_f1_1px"),
+            "max_vertex_error_px": rec.get("max_vertex_error_px"),
+            "faults": [f["name"] for f in rec["faults"]],
+            "faults_text": case_cell(rec["faults"], rec.get("camera_spec")),
+            "silhouette_iou": rec.get("silhouette_iou"),
+            "depth_error_ratio": rec.get("depth_error_ratio"),
+            "oracle_image": None,
+            "diff_image": None,
+        }
         if res.worst_images is not None:
             cand_img, orac_img = res.worst_images["candidate"], res.worst_images["oracle"]
             out["oracle_image"] = _b64_png(np.where(orac_img, 255, 0).astype(np.uint8))

@@ -47,17 +47,32 @@ _CMD = pytest.StashKey[object]()
 
 def pytest_addoption(parser):
     group = parser.getgroup("wirecheck", "wirecheck: crosscheck a projector (the wirecheck fixture)")
-    group.addoption("--wirecheck-report", metavar="DIR", default=None,
-                    help="write the report (report.json, report.md, report.html) of every failing wirecheck "
-                         "check to DIR/<test id> (default: no reports)")
-    group.addoption("--wirecheck-frames", metavar="N", type=int, default=None,
-                    help="frames per case, over [tool.wirecheck] frames (default: the table's, else 8)")
-    group.addoption("--wirecheck-level", choices=("vertices", "pixels"), default=None,
-                    help="vertices: OpenCV only; pixels: OpenCV and pyrender (default: the table's, "
-                         "else vertices)")
-    group.addoption("--wirecheck-config", metavar="FILE", default=None,
-                    help="read [tool.wirecheck] from FILE (default: the nearest pyproject.toml at or above "
-                         "the rootdir)")
+    group.addoption(
+        "--wirecheck-report",
+        metavar="DIR",
+        default=None,
+        help="write the report (report.json, report.md, report.html) of every failing wirecheck "
+        "check to DIR/<test id> (default: no reports)",
+    )
+    group.addoption(
+        "--wirecheck-frames",
+        metavar="N",
+        type=int,
+        default=None,
+        help="frames per case, over [tool.wirecheck] frames (default: the table's, else 8)",
+    )
+    group.addoption(
+        "--wirecheck-level",
+        choices=("vertices", "pixels"),
+        default=None,
+        help="vertices: OpenCV only; pixels: OpenCV and pyrender (default: the table's, else vertices)",
+    )
+    group.addoption(
+        "--wirecheck-config",
+        metavar="FILE",
+        default=None,
+        help="read [tool.wirecheck] from FILE (default: the nearest pyproject.toml at or above the rootdir)",
+    )
 
 
 def pytest_configure(config):
@@ -148,31 +163,34 @@ class Check:
         config = self._config
         projector = projector if projector is not None else config.stash[_CANDIDATE]
         if projector is None and "cmd" not in settings and config.stash[_CMD] is not None:
-            settings = {"cmd": config.stash[_CMD], **settings}      # the table's program
+            settings = {"cmd": config.stash[_CMD], **settings}  # the table's program
         if projector is None and "cmd" not in settings:
-            pytest.fail("wirecheck(): no projector: expected wirecheck(func) or candidate = \"FILE.py:FUNC\" "
-                        "in [tool.wirecheck]", pytrace=False)
+            pytest.fail(
+                'wirecheck(): no projector: expected wirecheck(func) or candidate = "FILE.py:FUNC" in [tool.wirecheck]',
+                pytrace=False,
+            )
         self._calls += 1
         error, trace = None, True
         try:
             from .api import checked_report_dir
 
             settings = dict(settings)
-            run_dir = checked_report_dir(settings.pop("report_dir", None))   # check_projector's: written pass or fail
+            run_dir = checked_report_dir(settings.pop("report_dir", None))  # check_projector's: written pass or fail
             # the table was read at start-up (rootdir or --wirecheck-config): not again from the cwd
             report, images = run_check(projector, **{"config": False, **config.stash[_SETTINGS], **settings})
             if run_dir is not None:
                 from .reports.report import write_report
 
                 write_report(run_dir, report, images)
-        except (ValueError, TypeError) as exc:   # InputError is a ValueError: a bad setting or projector spec
+        except (ValueError, TypeError) as exc:  # InputError is a ValueError: a bad setting or projector spec
             error = f"wirecheck: {type(exc).__name__}: {exc}"
         except RuntimeError as exc:
             from .references.pyrender_oracle import GLUnavailable
+
             if not isinstance(exc, GLUnavailable):
                 raise
-            error, trace = f"wirecheck: {exc}", False   # the missing GL library and its fix: one line
-        if error is not None:                     # outside the except: no chained harness traceback
+            error, trace = f"wirecheck: {exc}", False  # the missing GL library and its fix: one line
+        if error is not None:  # outside the except: no chained harness traceback
             pytest.fail(error, pytrace=trace)
         text = failure_text(report)
         if text is not None:
@@ -195,9 +213,17 @@ def wirecheck(request) -> Check:
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
     # from the tests' reports, not this process's state: under pytest-xdist the checks ran in workers
-    written = sorted({value for reports in terminalreporter.stats.values() for r in reports
-                      for name, value in getattr(r, "user_properties", ()) if name == "wirecheck_report"})
+    written = sorted(
+        {
+            value
+            for reports in terminalreporter.stats.values()
+            for r in reports
+            for name, value in getattr(r, "user_properties", ())
+            if name == "wirecheck_report"
+        }
+    )
     if written:
         terminalreporter.write_sep("-", "wirecheck")
-        terminalreporter.write_line(f"{len(written)} report(s) of failing checks under "
-                                    f"{config.option.wirecheck_report}")
+        terminalreporter.write_line(
+            f"{len(written)} report(s) of failing checks under {config.option.wirecheck_report}"
+        )

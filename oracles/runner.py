@@ -59,22 +59,20 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-
-from wirecheck.core.scene.model import Scene
-from wirecheck.core.transforms import Motion   # parameters only: the oracle's matrix is convert.model_matrix
-
-from .judge import gate, metrics
-from .references import opencv_oracle
-from .judge.case import CaseResult, run_case
-from .cases import Case, case_motion
-from .references.convert import model_matrix
-from .candidates.core_candidate import CoreCandidate, RenderMode
-from .executors import ExecutorSpec, gather_in_order, open_executor
-from .tolerances import Tolerances
-from .references.pyrender_oracle import OracleCache, gl_platform
 from wirecheck.core.errors import InputError
-from .cases import CASE_NAMES, cases_for
+from wirecheck.core.scene.model import Scene
+from wirecheck.core.transforms import Motion  # parameters only: the oracle's matrix is convert.model_matrix
+
 from .candidates.candidate import load_candidate
+from .candidates.core_candidate import CoreCandidate, RenderMode
+from .cases import CASE_NAMES, Case, case_motion, cases_for
+from .executors import ExecutorSpec, gather_in_order, open_executor
+from .judge import gate, metrics
+from .judge.case import CaseResult, run_case
+from .references import opencv_oracle
+from .references.convert import model_matrix
+from .references.pyrender_oracle import OracleCache, gl_platform
+from .tolerances import Tolerances
 
 #: Oracle fidelity levels, cheapest first, and the oracles each one runs.
 LEVELS = ("vertices", "pixels")
@@ -94,6 +92,7 @@ def level_for_oracles(oracles) -> str:
 
 # ---------------------------------------------------------------- running cases, here or in workers
 
+
 @dataclass(frozen=True)
 class RunParams:
     """What every case of a run shares; picklable (sent to workers)."""
@@ -103,10 +102,10 @@ class RunParams:
     level: str
     motion: Motion
     tol: Tolerances
-    candidate: object        # a picklable callable (CoreCandidate), or a "FILE.py:FUNC" spec string
+    candidate: object  # a picklable callable (CoreCandidate), or a "FILE.py:FUNC" spec string
     mode: RenderMode = RenderMode()
-    keep_frames: bool = False   # every checked frame's images, for worst.gif
-    keep_points: bool = False   # the worst frame's points of each case, for worst_points.png (level vertices)
+    keep_frames: bool = False  # every checked frame's images, for worst.gif
+    keep_points: bool = False  # the worst frame's points of each case, for worst_points.png (level vertices)
 
 
 class CaseRunner:
@@ -135,20 +134,22 @@ class CaseRunner:
             self.candidates[ref] = load_candidate(ref)
         return self.candidates[ref]
 
-    _DUMMY_TRIANGLE = (np.array([[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.0, 0.5, 0.0]]),
-                       np.array([[0, 1, 2]], dtype=np.int64))
+    _DUMMY_TRIANGLE = (
+        np.array([[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.0, 0.5, 0.0]]),
+        np.array([[0, 1, 2]], dtype=np.int64),
+    )
 
     def renderer(self, camera, mode: RenderMode | None = None):
         size = (camera.width, camera.height)
         new = size not in self.renderers
         oracle = self.renderers.get(*size)
         if new:
-            if camera.distortion is not None:          # GL has no lens; the shaders do not depend on it
+            if camera.distortion is not None:  # GL has no lens; the shaders do not depend on it
                 camera = camera.with_distortion(None)
-            oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera)   # compiles the shaders
-            oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera, depth=False)   # the pixel stage's read
+            oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera)  # compiles the shaders
+            oracle.render(self._DUMMY_POINTS, self._DUMMY_EDGES, camera, depth=False)  # the pixel stage's read
             if mode is not None and mode.shaded:
-                oracle.render_faces(*self._DUMMY_TRIANGLE, camera)         # and the id shader
+                oracle.render_faces(*self._DUMMY_TRIANGLE, camera)  # and the id shader
         return oracle
 
     def warm_up(self, camera, candidate, level: str) -> None:
@@ -170,13 +171,23 @@ class CaseRunner:
         if not self.warm:
             self.warm_up(case.camera, candidate, params.level)
         pyr = self.renderer(case.camera, params.mode) if params.level == "pixels" else None
-        result = run_case(scene, case, params.frames, candidate, case_motion(params.motion, case),
-                          params.tol, pyrender_oracle=pyr, every=params.every, mode=params.mode,
-                          keep_frames=params.keep_frames, keep_points=params.keep_points)
+        result = run_case(
+            scene,
+            case,
+            params.frames,
+            candidate,
+            case_motion(params.motion, case),
+            params.tol,
+            pyrender_oracle=pyr,
+            every=params.every,
+            mode=params.mode,
+            keep_frames=params.keep_frames,
+            keep_points=params.keep_points,
+        )
         result.record["framing"] = case.framing()
         result.gl_info = pyr.gl_info() if pyr is not None else None
         stderr = candidate.take_stderr() if hasattr(candidate, "take_stderr") else ""
-        if stderr:          # an isolated candidate's stderr during this case (oracles.candidates.subprocess_candidate)
+        if stderr:  # an isolated candidate's stderr during this case (oracles.candidates.subprocess_candidate)
             result.record["candidate_stderr"] = stderr
         return result
 
@@ -192,9 +203,9 @@ def worker_init() -> None:
     global _WORKER_RUNNER
     from multiprocessing.util import Finalize
 
-    gl_platform()          # the parent's PYOPENGL_PLATFORM (crosscheck --gl), inherited; osmesa if unset
+    gl_platform()  # the parent's PYOPENGL_PLATFORM (crosscheck --gl), inherited; osmesa if unset
     _WORKER_RUNNER = CaseRunner()
-    Finalize(_WORKER_RUNNER, _WORKER_RUNNER.close, exitpriority=10)   # free the GL contexts at exit
+    Finalize(_WORKER_RUNNER, _WORKER_RUNNER.close, exitpriority=10)  # free the GL contexts at exit
 
 
 def worker_runner() -> CaseRunner:
@@ -207,14 +218,15 @@ def worker_runner() -> CaseRunner:
 def _worker_run(scene: Scene, case: Case, params: RunParams) -> CaseResult:
     from .candidates.subprocess_candidate import SubprocessCandidate, close_all_but
 
-    with WORKER_LOCK:      # a Dask worker may run tasks in several threads: one GL user at a time
+    with WORKER_LOCK:  # a Dask worker may run tasks in several threads: one GL user at a time
         # a worker outlives a run on a Dask cluster: programs of earlier runs' candidates end here
         close_all_but(params.candidate if isinstance(params.candidate, SubprocessCandidate) else None)
         return worker_runner().run(scene, case, params)
 
 
-def _run_tasks(tasks, params: RunParams, jobs: int, on_result=None,
-               isolate: bool = False, executor: ExecutorSpec | None = None) -> tuple[list[CaseResult], int]:
+def _run_tasks(
+    tasks, params: RunParams, jobs: int, on_result=None, isolate: bool = False, executor: ExecutorSpec | None = None
+) -> tuple[list[CaseResult], int]:
     """Results in task order, and the number of worker processes used (0: in this process).
 
     ``on_result(result)`` is called on each result as it is gathered, in task
@@ -259,13 +271,28 @@ def overall_ms(timing_cases: list[dict], key: str):
     return sum(t[key] * t["frames_timed"] for t in rows) / frames if frames else 0.0
 
 
-def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles=None,
-                   turns=(1.0, 1.0, 0.0), tol: Tolerances | None = None, candidate_name: str = "candidate",
-                   *, level: str | None = None, every: int = 1, jobs: int = 1,
-                   candidate_spec: str | None = None, mode: RenderMode | None = None,
-                   animation: bool = True, allow_vacuous: bool = False, progress=None,
-                   isolate: bool = False, executor: ExecutorSpec | None = None,
-                   cases: tuple | None = None) -> tuple[dict, dict]:
+def run_crosscheck(
+    scenes,
+    candidate,
+    frames: int = 24,
+    case_names=None,
+    oracles=None,
+    turns=(1.0, 1.0, 0.0),
+    tol: Tolerances | None = None,
+    candidate_name: str = "candidate",
+    *,
+    level: str | None = None,
+    every: int = 1,
+    jobs: int = 1,
+    candidate_spec: str | None = None,
+    mode: RenderMode | None = None,
+    animation: bool = True,
+    allow_vacuous: bool = False,
+    progress=None,
+    isolate: bool = False,
+    executor: ExecutorSpec | None = None,
+    cases: tuple | None = None,
+) -> tuple[dict, dict]:
     """Every scene under every case camera: the report dict and the worst-frame images.
 
     ``level`` is "vertices" (OpenCV only) or "pixels" (OpenCV and pyrender, the
@@ -335,22 +362,32 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
             raise ValueError(f"cases {names}: expected at least one Case, distinct names, and no case_names")
         tasks = [(scene, case) for scene in inputs.scenes for case in cases]
     else:
-        tasks = [(scene, case) for scene in inputs.scenes
-                 for case in scene_cases(scene, inputs.case_names, motion)]
+        tasks = [(scene, case) for scene in inputs.scenes for case in scene_cases(scene, inputs.case_names, motion)]
     if level == "pixels" and tasks and all(case.camera.distortion is not None for _, case in tasks):
-        raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their pixels "
-                         "are not compared (GL draws straight lines), so the run would compare no pixel; "
-                         "expected level vertices or a case without distortion")
+        raise InputError(
+            f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their pixels "
+            "are not compared (GL draws straight lines), so the run would compare no pixel; "
+            "expected level vertices or a case without distortion"
+        )
     is_core = isinstance(candidate, CoreCandidate)
     ref = candidate if is_core or candidate_spec is None else candidate_spec
     keep_frames = animation and level == "pixels"
-    params = RunParams(frames=frames, every=every, level=level, motion=motion, tol=tol, candidate=ref,
-                        mode=mode, keep_frames=keep_frames, keep_points=level == "vertices")
+    params = RunParams(
+        frames=frames,
+        every=every,
+        level=level,
+        motion=motion,
+        tol=tol,
+        candidate=ref,
+        mode=mode,
+        keep_frames=keep_frames,
+        keep_points=level == "vertices",
+    )
     worst = _WorstCase(mode)
     n_frames = len(tasks) * inputs.frames_checked
     cases_done = 0
 
-    worst_points = []        # the case with the largest vertex error so far (inf included); ties: the first
+    worst_points = []  # the case with the largest vertex error so far (inf included); ties: the first
 
     def on_result(result: CaseResult) -> None:
         nonlocal cases_done
@@ -359,7 +396,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
         if result.worst_points is not None:
             if not worst_points or _points_error(result.worst_points) > _points_error(worst_points[0]):
                 worst_points[:] = [result.worst_points]
-            result.worst_points = None          # kept once, not per case
+            result.worst_points = None  # kept once, not per case
         cases_done += 1
         if progress:
             progress(cases_done, len(tasks), cases_done * inputs.frames_checked, n_frames)
@@ -369,7 +406,7 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     results, workers = _run_tasks(tasks, params, jobs, on_result=on_result, isolate=isolate, executor=executor)
 
     records, images, timing_cases = [], {}, []
-    gl = next((r.gl_info for r in results if r.gl_info is not None), None)   # one driver per machine
+    gl = next((r.gl_info for r in results if r.gl_info is not None), None)  # one driver per machine
     for (scene, case), result in zip(tasks, results):
         records.append(result.record)
         timing_cases.append({"scene": scene.name, "camera": case.name, **result.timing})
@@ -381,8 +418,12 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     worst_case = None
     if worst.result is not None:
         images["animation"] = worst.animation()
-        worst_case = {"scene": images["animation"]["scene"], "camera": images["animation"]["camera"],
-                      "frames_checked": len(images["animation"]["frames"]), "animation": "worst.gif"}
+        worst_case = {
+            "scene": images["animation"]["scene"],
+            "camera": images["animation"]["camera"],
+            "frames_checked": len(images["animation"]["frames"]),
+            "animation": "worst.gif",
+        }
     failed = sum(1 for r in records if r["verdict"] == "fail")
     vacuous = sum(1 for r in records if r["verdict"] == "vacuous")
     compared = gate.compared_totals(records, level)
@@ -392,8 +433,13 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     timing = {"vertex_stage_ms_per_frame": overall_ms(timing_cases, "vertex_stage_ms_per_frame")}
     if level == "pixels":
         timing["pixel_stage_ms_per_frame"] = overall_ms(timing_cases, "pixel_stage_ms_per_frame")
-    for key in ("candidate_ms_per_frame", "candidate_project_ms_per_frame", "opencv_ms_per_frame",
-                "harness_ms_per_frame", "oracles_ms_per_frame"):
+    for key in (
+        "candidate_ms_per_frame",
+        "candidate_project_ms_per_frame",
+        "opencv_ms_per_frame",
+        "harness_ms_per_frame",
+        "oracles_ms_per_frame",
+    ):
         timing[key] = overall_ms(timing_cases, key)
     oracles_ms = timing["oracles_ms_per_frame"]
     # issue 12's target is <= 0.15; reported on every run, never gated (a timing)
@@ -401,20 +447,35 @@ def run_crosscheck(scenes, candidate, frames: int = 24, case_names=None, oracles
     if level == "pixels":
         for key in ("candidate_draw_ms_per_frame", "pyrender_ms_per_frame", "pixel_metrics_ms_per_frame"):
             timing[key] = overall_ms(timing_cases, key)
-    timing.update({"executor": executor.kind if executor else "local", "jobs": jobs, "workers": workers, "wall_s": time.perf_counter() - t_run,
-                   "cases": timing_cases})
-    summary = {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
-               "vacuous": vacuous,
-               "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
-               "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
-               "min_pixel_f1_1px": min(f1_1) if f1_1 else None}
+    timing.update(
+        {
+            "executor": executor.kind if executor else "local",
+            "jobs": jobs,
+            "workers": workers,
+            "wall_s": time.perf_counter() - t_run,
+            "cases": timing_cases,
+        }
+    )
+    summary = {
+        "cases": len(records),
+        "passed": len(records) - failed - vacuous,
+        "failed": failed,
+        "vacuous": vacuous,
+        "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
+        "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
+        "min_pixel_f1_1px": min(f1_1) if f1_1 else None,
+    }
     if mode.shaded and level == "pixels":
         ious = [r["silhouette_iou"] for r in records if r.get("silhouette_iou") is not None]
         derr = [r["depth_max_error"] for r in records if r.get("depth_max_error") is not None]
         ratio = [r["depth_error_ratio"] for r in records if r.get("depth_error_ratio") is not None]
-        summary.update({"min_silhouette_iou": min(ious) if ious else None,
-                        "max_depth_error": max(derr) if derr else None,
-                        "max_depth_error_ratio": max(ratio) if ratio else None})
+        summary.update(
+            {
+                "min_silhouette_iou": min(ious) if ious else None,
+                "max_depth_error": max(derr) if derr else None,
+                "max_depth_error_ratio": max(ratio) if ratio else None,
+            }
+        )
     report = {
         "tool": "wirecheck crosscheck",
         "verdict": gate.run_verdict(records, compared, level, allow_vacuous),
@@ -469,7 +530,7 @@ class _WorstCase:
             result.frame_images = None
             return
         key = worst_key(result.record)
-        if self.result is None or key < self.key:      # ties: the first case in order stays
+        if self.result is None or key < self.key:  # ties: the first case in order stays
             if self.result is not None:
                 self.result.frame_images = None
             self.result, self.key = result, key
@@ -479,6 +540,11 @@ class _WorstCase:
     def animation(self) -> dict:
         rec = self.result.record
         frames = self.result.frame_images
-        return {"scene": rec["scene"], "camera": rec["camera"], "frames": [k for k, _, _ in frames],
-                "candidate": [c.image() for _, c, _ in frames], "oracle": [o.image() for _, _, o in frames],
-                "shaded": self.mode.shaded}
+        return {
+            "scene": rec["scene"],
+            "camera": rec["camera"],
+            "frames": [k for k, _, _ in frames],
+            "candidate": [c.image() for _, c, _ in frames],
+            "oracle": [o.image() for _, _, o in frames],
+            "shaded": self.mode.shaded,
+        }

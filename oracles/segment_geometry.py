@@ -48,16 +48,16 @@ def nearest_on_segments(q: np.ndarray, a: np.ndarray, b: np.ndarray):
     len2 = np.maximum(ab[:, 0] * ab[:, 0] + ab[:, 1] * ab[:, 1], 1e-300)
     step = max(1, 2_000_000 // max(len(a), 1))
     for k in range(0, len(q), step):
-        qx, qy = q[k:k + step, 0:1], q[k:k + step, 1:2]          # (n, 1): against every segment at once
+        qx, qy = q[k : k + step, 0:1], q[k : k + step, 1:2]  # (n, 1): against every segment at once
         t = np.clip(((qx - a[:, 0]) * ab[:, 0] + (qy - a[:, 1]) * ab[:, 1]) / len2, 0.0, 1.0)
         fx, fy = a[:, 0] + t * ab[:, 0], a[:, 1] + t * ab[:, 1]
         dx, dy = fx - qx, fy - qy
         d2 = dx * dx + dy * dy
         j = np.argmin(d2, axis=1)
         rows = np.arange(len(qx))
-        out[k:k + step, 0], out[k:k + step, 1] = fx[rows, j], fy[rows, j]
-        dist[k:k + step] = np.sqrt(d2[rows, j])
-        which[k:k + step] = j
+        out[k : k + step, 0], out[k : k + step, 1] = fx[rows, j], fy[rows, j]
+        dist[k : k + step] = np.sqrt(d2[rows, j])
+        which[k : k + step] = j
     return out, dist, which
 
 
@@ -80,13 +80,13 @@ def clip_to_box(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray):
     columns = p0.shape[1] if p0.ndim == 2 else 0
     lo_in = np.broadcast_to(np.asarray(lo, np.float64) + INSIDE_PX, (columns,))
     hi_in = np.broadcast_to(np.asarray(hi, np.float64) - INSIDE_PX, (columns,))
-    for k in range(columns):                         # column by column: no reduction over the rows' 2 values
+    for k in range(columns):  # column by column: no reduction over the rows' 2 values
         for q in (p0[:, k], p1[:, k]):
             inside &= q > lo_in[k]
             inside &= q < hi_in[k]
     if inside.all():
         return inside, p0 + 0.0 * d, p0 + d
-    with np.errstate(invalid="ignore"):             # rows not inside are overwritten below
+    with np.errstate(invalid="ignore"):  # rows not inside are overwritten below
         keep, q0, q1 = inside.copy(), p0 + 0.0 * d, p0 + d
     rest = np.flatnonzero(~inside)
     keep[rest], q0[rest], q1[rest] = _clip_ratios(p0[rest], p1[rest], lo, hi)
@@ -102,7 +102,7 @@ def _clip_ratios(p0: np.ndarray, p1: np.ndarray, lo: np.ndarray, hi: np.ndarray)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = q / p
         keep = np.isfinite(p0 + p1).all(axis=1) & ~((p == 0) & (q < 0)).any(axis=1)
-        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))     # entering: the last boundary
-        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))      # leaving: the first
+        t0 = np.maximum(0.0, np.where(p < 0, r, -np.inf).max(axis=1))  # entering: the last boundary
+        t1 = np.minimum(1.0, np.where(p > 0, r, np.inf).min(axis=1))  # leaving: the first
     keep &= t0 <= t1
     return keep, p0 + t0[:, None] * d, p0 + t1[:, None] * d

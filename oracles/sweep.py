@@ -33,22 +33,21 @@ import time
 from collections import namedtuple
 
 import numpy as np
-
+from wirecheck.core.outputs.output import FrameDir, json_dumps
 from wirecheck.core.projector.clipping import CLIP_MODES
-from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import DTYPES
 from wirecheck.core.projector.raster import RASTER_MODES
+from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.scene.model import Scene, face_edges, unique_edges
 from wirecheck.core.transforms import Motion
 
-from .references import faces as oface
-from .judge import metrics
-from .references import opencv_oracle
 from .cases import CASE_NAMES, case_motion, cases_for
-from .reports.report import gl_text
+from .judge import metrics
+from .references import faces as oface
+from .references import opencv_oracle
 from .references.pyrender_oracle import OracleCache
-from wirecheck.core.outputs.output import FrameDir, json_dumps
+from .reports.report import gl_text
 
 #: The default setting, the one crosscheck gates on.
 DEFAULT = ("float64", "clip", "exact")
@@ -73,12 +72,17 @@ def large_mesh(subdivisions: int = 5) -> Scene:
     mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
     faces = np.asarray(mesh.faces)
     edges = unique_edges(face_edges(faces))
-    return Scene(name=f"icosphere{subdivisions}", vertices=np.array(mesh.vertices, dtype=np.float64),
-                 edges=edges, source=f"trimesh.creation.icosphere(subdivisions={subdivisions})")
+    return Scene(
+        name=f"icosphere{subdivisions}",
+        vertices=np.array(mesh.vertices, dtype=np.float64),
+        edges=edges,
+        source=f"trimesh.creation.icosphere(subdivisions={subdivisions})",
+    )
 
 
 def _pareto(rows: list[dict]) -> None:
     """Mark rows on the front of (time on the large mesh, vertex error, -F1@0px)."""
+
     def cost(r):
         return (r["timing"]["ms_per_frame_large"], r["max_vertex_error_px"], -r["pixel_f1_0px"])
 
@@ -86,32 +90,46 @@ def _pareto(rows: list[dict]) -> None:
         c = cost(r)
         r["timing"]["pareto"] = not any(
             all(a <= b for a, b in zip(cost(o), c)) and any(a < b for a, b in zip(cost(o), c))
-            for o in rows if o is not r)
+            for o in rows
+            if o is not r
+        )
 
 
-def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=None,
-              turns=(1.0, 1.0, 0.0), large: Scene | None = None, pyrender: bool = True,
-              repeats: int = 3, progress=None) -> dict:
+def run_sweep(
+    scenes: list[Scene],
+    frames: int = 12,
+    every: int = 1,
+    case_names=None,
+    turns=(1.0, 1.0, 0.0),
+    large: Scene | None = None,
+    pyrender: bool = True,
+    repeats: int = 3,
+    progress=None,
+) -> dict:
     """Run every setting; return the sweep report (see the module docstring)."""
     settings = all_settings()
     groups = [("bundled", s) for s in scenes] + ([("large", large)] if large is not None else [])
     motion = Motion(turns=tuple(float(x) for x in turns))
     frame_ids = list(range(1, frames + 1, every))
-    acc = {s.key: {"err": [], "f1_0": [], "f1_1": [], "t": {"bundled": [], "large": []},
-                   "cand_only": 0, "orac_only": 0} for s in settings}
+    acc = {
+        s.key: {"err": [], "f1_0": [], "f1_1": [], "t": {"bundled": [], "large": []}, "cand_only": 0, "orac_only": 0}
+        for s in settings
+    }
     oracles = OracleCache()
     try:
         for group, scene in groups:
             edges = np.asarray(scene.edges)
             cases = cases_for(scene, motion, calibrated=True)
-            scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
-            core = {d: SceneRenderer(scene, scene_motion, frames, dtype=d) for d in DTYPES}   # as renderer sets frames up
+            scene_motion = case_motion(motion, cases[0])  # one framing, one pivot per scene
+            core = {
+                d: SceneRenderer(scene, scene_motion, frames, dtype=d) for d in DTYPES
+            }  # as renderer sets frames up
             for case in cases:
                 if case.name not in (CASE_NAMES if case_names is None else case_names):
                     continue
                 cam = case.camera
                 pyr = None
-                if pyrender and cam.distortion is None:      # a lens: vertices only (oracles.judge.case)
+                if pyrender and cam.distortion is None:  # a lens: vertices only (oracles.judge.case)
                     pyr = oracles.get(cam.width, cam.height)
                 for k in frame_ids:
                     p_world, _, pr_vertices, pr_pose = oface.frame_geometry(scene, scene_motion, (k - 1) / frames)
@@ -144,29 +162,41 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
     rows = []
     for s in settings:
         a = acc[s.key]
-        row = {"setting": s.key, "dtype": s.dtype, "clip": s.clip, "raster": s.raster,
-               "default": (s.dtype, s.clip, s.raster) == DEFAULT,
-               "max_vertex_error_px": max(a["err"]) if a["err"] else None,
-               "visibility_mismatches": a["cand_only"] + a["orac_only"],
-               "pixel_f1_0px": min(a["f1_0"]) if a["f1_0"] else None,
-               "pixel_f1_1px": min(a["f1_1"]) if a["f1_1"] else None,
-               "pixel_f1_0px_mean": float(np.mean(a["f1_0"])) if a["f1_0"] else None,
-               "pixel_f1_1px_mean": float(np.mean(a["f1_1"])) if a["f1_1"] else None,
-               "timing": {"ms_per_frame_bundled": 1e3 * statistics.median(a["t"]["bundled"])
-                          if a["t"]["bundled"] else None,
-                          "ms_per_frame_large": 1e3 * statistics.median(a["t"]["large"])
-                          if a["t"]["large"] else None}}
+        row = {
+            "setting": s.key,
+            "dtype": s.dtype,
+            "clip": s.clip,
+            "raster": s.raster,
+            "default": (s.dtype, s.clip, s.raster) == DEFAULT,
+            "max_vertex_error_px": max(a["err"]) if a["err"] else None,
+            "visibility_mismatches": a["cand_only"] + a["orac_only"],
+            "pixel_f1_0px": min(a["f1_0"]) if a["f1_0"] else None,
+            "pixel_f1_1px": min(a["f1_1"]) if a["f1_1"] else None,
+            "pixel_f1_0px_mean": float(np.mean(a["f1_0"])) if a["f1_0"] else None,
+            "pixel_f1_1px_mean": float(np.mean(a["f1_1"])) if a["f1_1"] else None,
+            "timing": {
+                "ms_per_frame_bundled": 1e3 * statistics.median(a["t"]["bundled"]) if a["t"]["bundled"] else None,
+                "ms_per_frame_large": 1e3 * statistics.median(a["t"]["large"]) if a["t"]["large"] else None,
+            },
+        }
         rows.append(row)
     if pyrender and large is not None:
         _pareto(rows)
     return {
         "tool": "wirecheck crosscheck --sweep",
         "scenes": [s.name for s in scenes],
-        "large_mesh": None if large is None else {"name": large.name, "source": large.source,
-                                                  "vertices": int(len(large.vertices)),
-                                                  "edges": int(len(large.edges))},
+        "large_mesh": None
+        if large is None
+        else {
+            "name": large.name,
+            "source": large.source,
+            "vertices": int(len(large.vertices)),
+            "edges": int(len(large.edges)),
+        },
         "cases": list(case_names) if case_names is not None else list(CASE_NAMES),
-        "frames": frames, "every": every, "frames_checked": len(frame_ids),
+        "frames": frames,
+        "every": every,
+        "frames_checked": len(frame_ids),
         "motion": {"turns": list(motion.turns)},
         "oracles": ["opencv"] + (["pyrender"] if pyrender else []),
         "oracle_gl": gl,
@@ -176,6 +206,7 @@ def run_sweep(scenes: list[Scene], frames: int = 12, every: int = 1, case_names=
 
 
 # ---- output ------------------------------------------------------------------
+
 
 def _e(v) -> str:
     return "-" if v is None else f"{v:.2g}"
@@ -191,28 +222,39 @@ def _ms(v) -> str:
 
 def markdown_table(sweep: dict) -> str:
     big = sweep["large_mesh"]
-    head = ("| setting (dtype/clip/raster) | ms/frame bundled | ms/frame "
-            f"{big['name'] if big else 'large'} | max vertex error px | F1@0px min | F1@1px min | Pareto |")
+    head = (
+        "| setting (dtype/clip/raster) | ms/frame bundled | ms/frame "
+        f"{big['name'] if big else 'large'} | max vertex error px | F1@0px min | F1@1px min | Pareto |"
+    )
     lines = [head, "|---|---:|---:|---:|---:|---:|:---:|"]
     for r in sweep["settings"]:
         name = f"**{r['setting']}** (default)" if r["default"] else r["setting"]
         t = r["timing"]
-        lines.append(f"| {name} | {_ms(t['ms_per_frame_bundled'])} | {_ms(t['ms_per_frame_large'])} | "
-                     f"{_e(r['max_vertex_error_px'])} | {_f(r['pixel_f1_0px'])} | {_f(r['pixel_f1_1px'])} | "
-                     f"{'yes' if t.get('pareto') else ''} |")
+        lines.append(
+            f"| {name} | {_ms(t['ms_per_frame_bundled'])} | {_ms(t['ms_per_frame_large'])} | "
+            f"{_e(r['max_vertex_error_px'])} | {_f(r['pixel_f1_0px'])} | {_f(r['pixel_f1_1px'])} | "
+            f"{'yes' if t.get('pareto') else ''} |"
+        )
     return "\n".join(lines) + "\n"
 
 
 def markdown(sweep: dict) -> str:
     big = sweep["large_mesh"]
-    out = ["# wirecheck speed/accuracy sweep", "",
-           f"Scenes: {', '.join(sweep['scenes'])}"
-           + (f"; large mesh: {big['name']} ({big['vertices']:,} vertices, {big['edges']:,} edges)" if big else ""),
-           f"Cases: {', '.join(sweep['cases'])}; frames {sweep['frames_checked']} of {sweep['frames']} "
-           f"(every {sweep['every']}); oracles: {', '.join(sweep['oracles'])}.",
-           f"Timing: {sweep['timing_method']}.", "",
-           *([f"Oracle GL: {gl_text(sweep)}.", ""] if gl_text(sweep) else []),
-           markdown_table(sweep), "", "![Pareto plot](sweep.png)", ""]
+    out = [
+        "# wirecheck speed/accuracy sweep",
+        "",
+        f"Scenes: {', '.join(sweep['scenes'])}"
+        + (f"; large mesh: {big['name']} ({big['vertices']:,} vertices, {big['edges']:,} edges)" if big else ""),
+        f"Cases: {', '.join(sweep['cases'])}; frames {sweep['frames_checked']} of {sweep['frames']} "
+        f"(every {sweep['every']}); oracles: {', '.join(sweep['oracles'])}.",
+        f"Timing: {sweep['timing_method']}.",
+        "",
+        *([f"Oracle GL: {gl_text(sweep)}.", ""] if gl_text(sweep) else []),
+        markdown_table(sweep),
+        "",
+        "![Pareto plot](sweep.png)",
+        "",
+    ]
     return "\n".join(out)
 
 
@@ -233,8 +275,10 @@ def plot_png(sweep: dict, path) -> None:
     markers = {"exact": "o", "fast": "s", "aa": "^"}
     colours = {"float64": "tab:blue", "float32": "tab:orange"}
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), dpi=100)
-    panels = [("max_vertex_error_px", "max vertex error vs OpenCV (px, log)", True),
-              ("pixel_f1_0px", "edge-pixel F1@0px vs pyrender (min over frames)", False)]
+    panels = [
+        ("max_vertex_error_px", "max vertex error vs OpenCV (px, log)", True),
+        ("pixel_f1_0px", "edge-pixel F1@0px vs pyrender (min over frames)", False),
+    ]
     for ax, (key, ylabel, log) in zip(axes, panels):
         pts = []
         for r in rows:
@@ -244,15 +288,27 @@ def plot_png(sweep: dict, path) -> None:
             if log:
                 y = max(y, 1e-16)
             hollow = r["clip"] == "endpoint"
-            ax.scatter([x], [y], marker=markers[r["raster"]], s=60,
-                       facecolors="none" if hollow else colours[r["dtype"]],
-                       edgecolors=colours[r["dtype"]], linewidths=1.5, zorder=3)
+            ax.scatter(
+                [x],
+                [y],
+                marker=markers[r["raster"]],
+                s=60,
+                facecolors="none" if hollow else colours[r["dtype"]],
+                edgecolors=colours[r["dtype"]],
+                linewidths=1.5,
+                zorder=3,
+            )
             pts.append((x, y, r))
         # This panel's own 2-D front: no other point is as fast and as good on this metric.
         better = (lambda a, b: a <= b) if log else (lambda a, b: a >= b)
-        front = sorted((p for p in pts if not any(
-            o[0] <= p[0] and better(o[1], p[1]) and (o[0] < p[0] or o[1] != p[1]) for o in pts)),
-            key=lambda p: p[0])
+        front = sorted(
+            (
+                p
+                for p in pts
+                if not any(o[0] <= p[0] and better(o[1], p[1]) and (o[0] < p[0] or o[1] != p[1]) for o in pts)
+            ),
+            key=lambda p: p[0],
+        )
         if front:
             ax.step([p[0] for p in front], [p[1] for p in front], "k--", where="post", lw=0.8, zorder=2)
         for x, y, r in pts:
@@ -265,10 +321,14 @@ def plot_png(sweep: dict, path) -> None:
         ax.grid(True, alpha=0.3)
     from matplotlib.lines import Line2D
 
-    legend = ([Line2D([], [], marker=m, ls="", color="grey", label=f"raster {k}") for k, m in markers.items()]
-              + [Line2D([], [], marker="o", ls="", color=c, label=k) for k, c in colours.items()]
-              + [Line2D([], [], marker="o", ls="", mfc="none", color="grey", label="clip endpoint"),
-                 Line2D([], [], ls="--", color="k", label="Pareto front")])
+    legend = (
+        [Line2D([], [], marker=m, ls="", color="grey", label=f"raster {k}") for k, m in markers.items()]
+        + [Line2D([], [], marker="o", ls="", color=c, label=k) for k, c in colours.items()]
+        + [
+            Line2D([], [], marker="o", ls="", mfc="none", color="grey", label="clip endpoint"),
+            Line2D([], [], ls="--", color="k", label="Pareto front"),
+        ]
+    )
     axes[1].legend(handles=legend, fontsize=8, loc="lower right")
     fig.suptitle("wirecheck: speed against accuracy, every dtype x clip x raster setting")
     fig.tight_layout()
@@ -282,22 +342,40 @@ def html(sweep: dict) -> str:
     rows = []
     for r in sweep["settings"]:
         t = r["timing"]
-        rows.append("<tr>" + "".join(f"<td>{_h.escape(str(v))}</td>" for v in (
-            r["setting"] + (" (default)" if r["default"] else ""), _ms(t["ms_per_frame_bundled"]),
-            _ms(t["ms_per_frame_large"]), _e(r["max_vertex_error_px"]), _f(r["pixel_f1_0px"]),
-            _f(r["pixel_f1_1px"]), "yes" if t.get("pareto") else "")) + "</tr>")
+        rows.append(
+            "<tr>"
+            + "".join(
+                f"<td>{_h.escape(str(v))}</td>"
+                for v in (
+                    r["setting"] + (" (default)" if r["default"] else ""),
+                    _ms(t["ms_per_frame_bundled"]),
+                    _ms(t["ms_per_frame_large"]),
+                    _e(r["max_vertex_error_px"]),
+                    _f(r["pixel_f1_0px"]),
+                    _f(r["pixel_f1_1px"]),
+                    "yes" if t.get("pareto") else "",
+                )
+            )
+            + "</tr>"
+        )
     big = sweep["large_mesh"]
-    return ("<!doctype html><meta charset='utf-8'><title>wirecheck sweep</title>"
-            "<style>body{font-family:sans-serif;margin:2em}td,th{padding:2px 8px;text-align:right}"
-            "td:first-child{text-align:left}</style>"
-            "<h1>wirecheck speed/accuracy sweep</h1>"
-            f"<p>Scenes: {_h.escape(', '.join(sweep['scenes']))}"
-            + (f"; large mesh: {_h.escape(big['name'])} ({big['vertices']:,} vertices, {big['edges']:,} edges)"
-               if big else "")
-            + f". Cases: {_h.escape(', '.join(sweep['cases']))}. Frames checked: {sweep['frames_checked']}.</p>"
-            "<table><tr><th>setting</th><th>ms/frame bundled</th><th>ms/frame large</th>"
-            "<th>max vertex error px</th><th>F1@0px min</th><th>F1@1px min</th><th>Pareto</th></tr>"
-            + "".join(rows) + "</table><p><img src='sweep.png' alt='Pareto plot'></p>\n")
+    return (
+        "<!doctype html><meta charset='utf-8'><title>wirecheck sweep</title>"
+        "<style>body{font-family:sans-serif;margin:2em}td,th{padding:2px 8px;text-align:right}"
+        "td:first-child{text-align:left}</style>"
+        "<h1>wirecheck speed/accuracy sweep</h1>"
+        f"<p>Scenes: {_h.escape(', '.join(sweep['scenes']))}"
+        + (
+            f"; large mesh: {_h.escape(big['name'])} ({big['vertices']:,} vertices, {big['edges']:,} edges)"
+            if big
+            else ""
+        )
+        + f". Cases: {_h.escape(', '.join(sweep['cases']))}. Frames checked: {sweep['frames_checked']}.</p>"
+        "<table><tr><th>setting</th><th>ms/frame bundled</th><th>ms/frame large</th>"
+        "<th>max vertex error px</th><th>F1@0px min</th><th>F1@1px min</th><th>Pareto</th></tr>"
+        + "".join(rows)
+        + "</table><p><img src='sweep.png' alt='Pareto plot'></p>\n"
+    )
 
 
 def write_sweep(run_dir, sweep: dict) -> None:
@@ -326,7 +404,7 @@ def default_failures(sweep: dict, vertex_px: float, min_f1_1px: float, min_f1_0p
     """Why the default setting is out of tolerance (empty when it is within)."""
     d = next(r for r in sweep["settings"] if r["default"])
     reasons = []
-    if d["max_vertex_error_px"] is None:        # a gate never passes on nothing (oracles.judge.gate)
+    if d["max_vertex_error_px"] is None:  # a gate never passes on nothing (oracles.judge.gate)
         reasons.append("no vertex was compared (every point clipped in every case)")
     if d["max_vertex_error_px"] is not None and d["max_vertex_error_px"] > vertex_px:
         reasons.append(f"max vertex error {d['max_vertex_error_px']:.3g} px > {vertex_px:g}")

@@ -23,7 +23,7 @@ VERTEX_TOL_PX = 1e-6
 PRECISIONS = ("float32", "float64")
 
 #: Machine epsilon (the spacing of floats at 1.0) of each precision.
-EPS = {"float32": 2.0 ** -23, "float64": 2.0 ** -52}
+EPS = {"float32": 2.0**-23, "float64": 2.0**-52}
 
 # A candidate that computes in float32 (glm, PyTorch3D, a GL shader) is off
 # from the float64 oracle by its own rounding, which 1e-6 px cannot absorb.
@@ -127,6 +127,7 @@ def vertex_bound(precision: str, scale: float, floor: float = VERTEX_TOL_PX) -> 
     if precision == "float64" and float(floor) != VERTEX_TOL_PX:
         return float(floor)
     return max(float(floor), VERTEX_ROUNDINGS * EPS[precision] * float(scale))
+
 
 # ---------------------------------------------------------------- the unprojector (the way back)
 
@@ -328,7 +329,7 @@ SUBPIXEL_BITS = 8
 
 #: How far a renderer may move a segment's end before deciding, per coordinate (px): the snap's
 #: half step 2^-(SUBPIXEL_BITS + 1) plus 2^-9 of float32 rounding (derivation above).
-TIE_END_PX = 2.0 ** -(SUBPIXEL_BITS + 1) + 2.0 ** -9
+TIE_END_PX = 2.0 ** -(SUBPIXEL_BITS + 1) + 2.0**-9
 
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)
@@ -395,7 +396,7 @@ MIN_IOU_UNION_PX = 400
 # alarm, never a hidden fault); fill_tie_bound(vertex_scale(...)) widens the zone for such a frame.
 
 #: How far a renderer may move a vertex before deciding coverage (px, Euclidean; derivation above).
-FILL_TIE_PX = 2.0 ** 0.5 * TIE_END_PX
+FILL_TIE_PX = 2.0**0.5 * TIE_END_PX
 #: The largest 8-connected set of decided pixels missing or added that passes (derivation above).
 MAX_SILHOUETTE_RUN_PX = 0
 
@@ -407,8 +408,8 @@ def fill_tie_bound(scale: float) -> float:
     step and the float32 rounding of a vertex at that scale, never below the 2^-9 that FILL_TIE_PX
     assumes (derivation above).
     """
-    rounding = max(2.0 ** -9, VERTEX_ROUNDINGS * EPS["float32"] * float(scale))
-    return 2.0 ** 0.5 * (2.0 ** -(SUBPIXEL_BITS + 1) + rounding)
+    rounding = max(2.0**-9, VERTEX_ROUNDINGS * EPS["float32"] * float(scale))
+    return 2.0**0.5 * (2.0 ** -(SUBPIXEL_BITS + 1) + rounding)
 
 
 #: The shaded depth comparison: |z_candidate - z_pyrender| at a pixel covered
@@ -449,8 +450,9 @@ DEPTH_EPS32 = 16.0
 
 
 #: The shaded depth bound, as stated in the report.
-DEPTH_BOUND_TEXT = (f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 / DEPTH_SNAP_PX:g}"
-                    f" + {DEPTH_EPS32:g} eps32 z")
+DEPTH_BOUND_TEXT = (
+    f"per pixel, {DEPTH_STEPS:g} depth-buffer steps + slope/{1 / DEPTH_SNAP_PX:g} + {DEPTH_EPS32:g} eps32 z"
+)
 
 
 # ---- A renderer's depth maps and filled frames (crosscheck export --outputs ...,depth,filled), judged by the
@@ -552,33 +554,55 @@ class Tolerances:
 
     def __post_init__(self):
         if self.precision is not None and self.precision not in PRECISIONS:
-            raise ValueError(f"precision {self.precision!r}: expected one of {', '.join(PRECISIONS)} (or None: "
-                             "inferred from the candidate's answers)")
+            raise ValueError(
+                f"precision {self.precision!r}: expected one of {', '.join(PRECISIONS)} (or None: "
+                "inferred from the candidate's answers)"
+            )
 
     def to_dict(self, shaded: bool = False) -> dict:
         """The report's ``tolerances`` field."""
         if shaded:
-            return {"vertex_error_px": self.vertex_px, "candidate_precision": self.precision,
-                    "min_silhouette_iou": self.min_iou,
-                    "depth_error": DEPTH_BOUND_TEXT}
-        return {"vertex_error_px": self.vertex_px, "candidate_precision": self.precision,
-                "min_pixel_f1_1px": self.min_f1_1px,
-                "min_pixel_f1_0px": self.min_f1_0px, "balance_alpha": self.balance_alpha,
-                "max_imbalance_fraction": self.max_imbalance, "max_edge_count_diff": self.max_edge_count_diff}
+            return {
+                "vertex_error_px": self.vertex_px,
+                "candidate_precision": self.precision,
+                "min_silhouette_iou": self.min_iou,
+                "depth_error": DEPTH_BOUND_TEXT,
+            }
+        return {
+            "vertex_error_px": self.vertex_px,
+            "candidate_precision": self.precision,
+            "min_pixel_f1_1px": self.min_f1_1px,
+            "min_pixel_f1_0px": self.min_f1_0px,
+            "balance_alpha": self.balance_alpha,
+            "max_imbalance_fraction": self.max_imbalance,
+            "max_edge_count_diff": self.max_edge_count_diff,
+        }
 
     def surfaces_dict(self) -> dict:
         """The limits of a job's depth maps and filled frames, as the report's ``tolerances`` adds them."""
-        return {"max_depth_error_ratio": self.max_depth_error_ratio, "depth_error": DEPTH_BOUND_TEXT
-                + " + the map's encoding step", "max_surface_holes_px": self.max_surface_holes_px,
-                "max_surface_extra_px": self.max_surface_extra_px, "min_silhouette_iou": self.min_iou,
-                "min_iou_union_px": MIN_IOU_UNION_PX, "fill_tie_px": self.fill_tie_px,
-                "max_silhouette_run_px": self.max_silhouette_run_px, "max_object_id_px": self.max_object_id_px}
+        return {
+            "max_depth_error_ratio": self.max_depth_error_ratio,
+            "depth_error": DEPTH_BOUND_TEXT + " + the map's encoding step",
+            "max_surface_holes_px": self.max_surface_holes_px,
+            "max_surface_extra_px": self.max_surface_extra_px,
+            "min_silhouette_iou": self.min_iou,
+            "min_iou_union_px": MIN_IOU_UNION_PX,
+            "fill_tie_px": self.fill_tie_px,
+            "max_silhouette_run_px": self.max_silhouette_run_px,
+            "max_object_id_px": self.max_object_id_px,
+        }
 
     def lines_dict(self) -> dict:
         """The frames path's line-geometry limits, as the report's ``tolerances`` adds them."""
-        return {"offset_px": self.offset_px, "scale_px": self.scale_px, "rule_offset_px": self.rule_offset_px,
-                "end_px": self.end_px, "rounded_end_tie_px": self.rounded_end_tie_px,
-                "rule_f1_0px": self.rule_f1_0px}
+        return {
+            "offset_px": self.offset_px,
+            "scale_px": self.scale_px,
+            "rule_offset_px": self.rule_offset_px,
+            "end_px": self.end_px,
+            "rounded_end_tie_px": self.rounded_end_tie_px,
+            "rule_f1_0px": self.rule_f1_0px,
+        }
+
 
 @dataclass(frozen=True)
 class NamingThresholds:
@@ -643,11 +667,15 @@ def line_failures(lines: dict, tol) -> list[str]:
     if p < tol.balance_alpha and abs(frac) > tol.max_imbalance:
         tc, to = lines["subpixel_ties"]
         ties = f" (and {tc} + {to} sub-pixel ties, left out)" if tc + to else ""
-        out.append(f"one-sided pixels unbalanced: {lines['candidate_only'] - tc} candidate-only vs "
-                   f"{lines['oracle_only'] - to} oracle-only{ties}, net {frac:+.3%} of the oracle's pixels "
-                   f"(> {tol.max_imbalance:.3%}; sign test p = {p:.2g} < {tol.balance_alpha:g})")
+        out.append(
+            f"one-sided pixels unbalanced: {lines['candidate_only'] - tc} candidate-only vs "
+            f"{lines['oracle_only'] - to} oracle-only{ties}, net {frac:+.3%} of the oracle's pixels "
+            f"(> {tol.max_imbalance:.3%}; sign test p = {p:.2g} < {tol.balance_alpha:g})"
+        )
     if lines["edge_count_max_diff"] > tol.max_edge_count_diff:
         w = lines["edge_count_worst"]
-        out.append(f"edge {w['edge']} has {w['diff']:+d} pixels against the oracle's count "
-                   f"(allowed +-{tol.max_edge_count_diff}; frame {w['frame']})")
+        out.append(
+            f"edge {w['edge']} has {w['diff']:+d} pixels against the oracle's count "
+            f"(allowed +-{tol.max_edge_count_diff}; frame {w['frame']})"
+        )
     return out

@@ -27,33 +27,40 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.outputs.output import claim, release_claim
+from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 
 from .candidates.candidate import load_candidate
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, SubprocessCandidate, closing_started
+from .cases import case_motion, cases_for
 from .diagnosis.unproject_faults import name_unproject_faults
 from .judge import gate
-from .cases import case_motion, cases_for
-from .tolerances import unproject_bound
 from .judge.unproject_points import DEFAULT_STRIDE, surface_samples
 from .reports.fault_text import below_table, case_cell, cell
 from .reports.report_option import checked_report_dir
 from .reports.unprojector_report import failing, flat_faults, write_unprojector_report
+from .tolerances import unproject_bound
 
-__all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "flat_faults",
-           "unprojector_failure_text"]
+__all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "flat_faults", "unprojector_failure_text"]
 
 #: Settings when the call gives none: 2 frames of the scenes' spin per case, one sample every 8 px.
 UNPROJECT_DEFAULTS = {"frames": 2, "turns": (1.0, 1.0, 0.0), "stride": DEFAULT_STRIDE}
 
 
-def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=None, turns=None,
-                      stride: int | None = None, *, cmd: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S,
-                      report_dir=None) -> dict:
+def check_unprojector(
+    func=None,
+    scenes=None,
+    frames: int | None = None,
+    cases=None,
+    turns=None,
+    stride: int | None = None,
+    *,
+    cmd: str | None = None,
+    timeout_s: float = DEFAULT_TIMEOUT_S,
+    report_dir=None,
+) -> dict:
     """Judge an unprojector against the exact inverse of the conventions and return the report.
 
     Parameters
@@ -105,7 +112,7 @@ def check_unprojector(func=None, scenes=None, frames: int | None = None, cases=N
     """
     run_dir = checked_report_dir(report_dir)
     if run_dir is not None:
-        claim(run_dir, "report_dir")            # checked and held before anything runs: one run per folder
+        claim(run_dir, "report_dir")  # checked and held before anything runs: one run per folder
     try:
         report = _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s)
         if run_dir is not None:
@@ -125,24 +132,26 @@ def _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s) -> dict:
     if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or stride < 1:
         raise InputError(f"stride {stride!r}: expected an integer >= 1 (pixels between samples)")
     if (func is None) == (cmd is None):
-        raise InputError("unprojector: expected one of func (a callable or \"FILE.py:FUNC\") and cmd (a program)")
-    name = cmd if cmd is not None else func if isinstance(func, str) else getattr(func, "__qualname__", None) or repr(func)
+        raise InputError('unprojector: expected one of func (a callable or "FILE.py:FUNC") and cmd (a program)')
+    name = (
+        cmd if cmd is not None else func if isinstance(func, str) else getattr(func, "__qualname__", None) or repr(func)
+    )
     spec = None
     if isinstance(func, str):
-        load_candidate(func, "unprojector", ("pixels", "depth", "camera"))    # a typo is an input error, here
+        load_candidate(func, "unprojector", ("pixels", "depth", "camera"))  # a typo is an input error, here
         spec, func = func, None
     elif func is not None and not callable(func):
-        raise TypeError(f"func {func!r}: expected a callable func(pixels, depth, camera) or a \"FILE.py:FUNC\" string")
+        raise TypeError(f'func {func!r}: expected a callable func(pixels, depth, camera) or a "FILE.py:FUNC" string')
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns)
     motion = Motion(turns=inputs.turns)
     records, case_ms = [], []
-    with closing_started():                      # a program started for the check ends with it
+    with closing_started():  # a program started for the check ends with it
         if cmd is not None:
             try:
                 func = SubprocessCandidate.from_command(cmd, timeout_s=timeout_s).unproject
             except ValueError as exc:
                 raise InputError(f"unprojector command {exc}") from None
-        elif spec is not None:             # in its own process: os._exit or a crash fails its case, not the run
+        elif spec is not None:  # in its own process: os._exit or a crash fails its case, not the run
             func = SubprocessCandidate.python(spec, timeout_s=timeout_s, unproject=True).unproject
         for scene in inputs.scenes:
             by_name = {c.name: c for c in cases_for(scene, motion, calibrated=True)}
@@ -152,24 +161,47 @@ def _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s) -> dict:
                 case_ms.append((time.perf_counter() - case_started) * 1000.0 / inputs.frames)
     points = sum(r["points"] for r in records)
     if points == 0:
-        raise InputError(f"unprojector {name}: no visible surface point in {len(records)} case(s) "
-                         "(scenes without faces?): a check that compares nothing is no pass")
+        raise InputError(
+            f"unprojector {name}: no visible surface point in {len(records)} case(s) "
+            "(scenes without faces?): a check that compares nothing is no pass"
+        )
     verdict = "pass" if all(r["verdict"] == "pass" for r in records) else "fail"
-    settings = {"scenes": [s.name for s in inputs.scenes], "cases": list(inputs.case_names), "frames": inputs.frames,
-                "turns": [float(t) for t in inputs.turns], "stride": int(stride)}
-    timing = {"wall_s": time.perf_counter() - started,
-              "cases": [{"scene": r["scene"], "camera": r["camera"], "ms_per_frame": ms}
-                        for r, ms in zip(records, case_ms)]}
-    return {"verdict": verdict, "candidate": name, "cases": records,
-            "compared": {"cases": len(records), "frames": len(records) * inputs.frames, "points": points},
-            "settings": settings, "timing": timing}
+    settings = {
+        "scenes": [s.name for s in inputs.scenes],
+        "cases": list(inputs.case_names),
+        "frames": inputs.frames,
+        "turns": [float(t) for t in inputs.turns],
+        "stride": int(stride),
+    }
+    timing = {
+        "wall_s": time.perf_counter() - started,
+        "cases": [{"scene": r["scene"], "camera": r["camera"], "ms_per_frame": ms} for r, ms in zip(records, case_ms)],
+    }
+    return {
+        "verdict": verdict,
+        "candidate": name,
+        "cases": records,
+        "compared": {"cases": len(records), "frames": len(records) * inputs.frames, "points": points},
+        "settings": settings,
+        "timing": timing,
+    }
 
 
 def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
     """One scene x camera: every frame's samples through ``func``, errors against their bounds, faults."""
     cam = case.camera
-    record = {"scene": scene.name, "camera": case.name, "verdict": "pass", "points": 0, "max_error": None,
-              "max_error_ratio": None, "worst": None, "precision": None, "faults": [], "reasons": []}
+    record = {
+        "scene": scene.name,
+        "camera": case.name,
+        "verdict": "pass",
+        "points": 0,
+        "max_error": None,
+        "max_error_ratio": None,
+        "worst": None,
+        "precision": None,
+        "faults": [],
+        "reasons": [],
+    }
     renderer = SceneRenderer(scene, case_motion(motion, case), frames, style="shaded") if scene.faces else None
     given, got, bounds, frame_of = [], [], [], []
     precisions = set()
@@ -177,21 +209,25 @@ def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
         s = surface_samples(scene, case, motion, k, frames, stride, renderer) if renderer is not None else None
         if s is None or len(s) == 0:
             continue
-        record["points"] += len(s)                   # offered: a candidate that fails them still compared them
+        record["points"] += len(s)  # offered: a candidate that fails them still compared them
         try:
             out = func(s.p_px.copy(), s.depth.copy(), cam)
             arr = np.asarray(out)
             if arr.dtype.kind not in "fiu" or arr.shape != (len(s), 3):
-                raise ValueError(f"returned {type(out).__name__} of shape {getattr(arr, 'shape', None)} and dtype "
-                                 f"{getattr(arr, 'dtype', None)}: expected an ({len(s)}, 3) float array")
-        except (Exception, SystemExit) as exc:   # its failure (or its sys.exit) fails its case, in one line
+                raise ValueError(
+                    f"returned {type(out).__name__} of shape {getattr(arr, 'shape', None)} and dtype "
+                    f"{getattr(arr, 'dtype', None)}: expected an ({len(s)}, 3) float array"
+                )
+        except (Exception, SystemExit) as exc:  # its failure (or its sys.exit) fails its case, in one line
             record["verdict"] = "fail"
-            record["reasons"].append(f"frame {k}: unprojector {type(exc).__name__}: "
-                                     f"{' '.join(str(exc).split())[:200]}")
+            record["reasons"].append(f"frame {k}: unprojector {type(exc).__name__}: {' '.join(str(exc).split())[:200]}")
             continue
-        told = getattr(getattr(func, "__self__", None), "answer_precision", None)    # a program's own word
-        precision = told() if told is not None else (
-            "float32" if arr.dtype.kind == "f" and arr.dtype.itemsize <= 4 else "float64")
+        told = getattr(getattr(func, "__self__", None), "answer_precision", None)  # a program's own word
+        precision = (
+            told()
+            if told is not None
+            else ("float32" if arr.dtype.kind == "f" and arr.dtype.itemsize <= 4 else "float64")
+        )
         precisions.add(precision)
         given.append(s)
         got.append(arr.astype(np.float64))
@@ -214,18 +250,25 @@ def _judge_case(func, scene, case, motion, frames: int, stride: int) -> dict:
     err = np.where(np.isfinite(err), err, np.inf)
     ratio = err / bound
     i = int(np.argmax(ratio))
-    record.update(max_error=float(err[i]), max_error_ratio=float(ratio[i]), bound_at_worst=float(bound[i]),
-                  worst={"frame": int(frame[i]), "pixel": [float(v) for v in p_px[i]], "depth": float(depth[i])},
-                  precision="float32" if "float32" in precisions else "float64")
+    record.update(
+        max_error=float(err[i]),
+        max_error_ratio=float(ratio[i]),
+        bound_at_worst=float(bound[i]),
+        worst={"frame": int(frame[i]), "pixel": [float(v) for v in p_px[i]], "depth": float(depth[i])},
+        precision="float32" if "float32" in precisions else "float64",
+    )
     if ratio[i] <= 1.0:
         return record
     record["verdict"] = "fail"
     bad = int((ratio > 1.0).sum())
-    record["reasons"].append(f"{bad} of {len(err)} points off: max error {err[i]:.3g} > bound {bound[i]:.3g} "
-                             f"(frame {int(frame[i])}, pixel ({p_px[i, 0]:.6g}, {p_px[i, 1]:.6g}), depth {depth[i]:.6g})")
+    record["reasons"].append(
+        f"{bad} of {len(err)} points off: max error {err[i]:.3g} > bound {bound[i]:.3g} "
+        f"(frame {int(frame[i])}, pixel ({p_px[i, 0]:.6g}, {p_px[i, 1]:.6g}), depth {depth[i]:.6g})"
+    )
     faults, measured = name_unproject_faults(p_px, depth, cam, cand, bound)
-    record["faults"] = [{"name": f.name, "params": dict(f.params), "hint": f.hint, "short": cell(f.as_dict())}
-                        for f in faults]
+    record["faults"] = [
+        {"name": f.name, "params": dict(f.params), "hint": f.hint, "short": cell(f.as_dict())} for f in faults
+    ]
     record["measured"] = measured
     return record
 

@@ -38,24 +38,34 @@ def unprojector_main(args, run_dir: Path, run_option: str) -> int:
         clash.append("--unprojector-cmd")
     try:
         if clash:
-            raise InputError(f"{given} with {', '.join(clash)}: expected {given} alone with --scene, --cases, "
-                             "--frames, --spin and the report folder's --report-dir, --run or --no-report")
-        check_candidate_timeout(args.candidate_timeout, "--candidate-timeout")     # as for --candidate
+            raise InputError(
+                f"{given} with {', '.join(clash)}: expected {given} alone with --scene, --cases, "
+                "--frames, --spin and the report folder's --report-dir, --run or --no-report"
+            )
+        check_candidate_timeout(args.candidate_timeout, "--candidate-timeout")  # as for --candidate
         if not args.no_report:
             check_report_dir(run_dir, run_option)
-            claim(run_dir, run_option)            # held until the report is in place: one run per folder
-        report = check_unprojector(args.unprojector, scenes=args.scene,
-                                   frames=args.frames if args.frames is not None else DEFAULT_FRAMES,
-                                   cases=args.cases, turns=args.spin, cmd=args.unprojector_cmd,
-                                   timeout_s=args.candidate_timeout)
+            claim(run_dir, run_option)  # held until the report is in place: one run per folder
+        report = check_unprojector(
+            args.unprojector,
+            scenes=args.scene,
+            frames=args.frames if args.frames is not None else DEFAULT_FRAMES,
+            cases=args.cases,
+            turns=args.spin,
+            cmd=args.unprojector_cmd,
+            timeout_s=args.candidate_timeout,
+        )
         if not args.no_report:
             write_unprojector_report(run_dir, {"run": args.run, **report}, run_option)
     except InputError as exc:
         print(f"crosscheck: error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:
-        print(f"crosscheck: error: {run_option} {str(run_dir)!r}: cannot write there ({exc}): "
-              "expected a writable directory", file=sys.stderr)
+        print(
+            f"crosscheck: error: {run_option} {str(run_dir)!r}: cannot write there ({exc}): "
+            "expected a writable directory",
+            file=sys.stderr,
+        )
         return 2
     print("\n".join(console_lines(report)))
     print(report_line(args, run_dir, "report.md", "report.json"))

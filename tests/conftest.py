@@ -42,8 +42,8 @@ import numpy.fft  # noqa: E402, F401
 # tests/test_pytest_plugin.py runs a user's pytest on a small project
 pytest_plugins = ["pytester"]
 
-_SECTION = "wirecheck_summary_section"      # the user_properties key of a summary block
-_SECTIONS: list[tuple[str, str]] = []       # gathered in the process that prints the summary
+_SECTION = "wirecheck_summary_section"  # the user_properties key of a summary block
+_SECTIONS: list[tuple[str, str]] = []  # gathered in the process that prints the summary
 
 
 @pytest.fixture

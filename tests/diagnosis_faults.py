@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from wirecheck.core.camera import Camera, look_at
 from wirecheck.core.conventions import focal_px
 from wirecheck.core.transforms import rotate_z
@@ -21,8 +20,9 @@ CAMERAS = {
     "oblique": look_at((3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), fov_y_deg=60, width=640, height=480),
     "tall": look_at((-1, 2, 6), (0.2, 0, 0), (0.1, 1, -0.2), fov_y_deg=50, width=320, height=480),
     "wide": look_at((0.5, 0.8, 3.2), (0, 0, 0), (0, 1, 0), fov_y_deg=110, width=640, height=480),
-    "ortho": look_at((2, 3, 5), (0, 0, 0), (0.2, 1, 0), width=400, height=300,
-                     projection="orthographic", ortho_height=5.0),
+    "ortho": look_at(
+        (2, 3, 5), (0, 0, 0), (0.2, 1, 0), width=400, height=300, projection="orthographic", ortho_height=5.0
+    ),
     # camera at the centre of the points: some in front, some behind
     "inside": look_at((0, 0, 0), (0.1, 0.2, -1), (0, 1, 0), fov_y_deg=90, width=640, height=480),
     # the same, with near and far inside the points' depths (|p| <= ~3.5): both planes cut some
@@ -36,45 +36,74 @@ CAMERAS = {
 # where both lenses are still monotonic (no fold-over).
 LENS_BARREL = (-0.22, 0.06, 0.0012, -0.0009, -0.008)
 LENS_PINCUSHION = (0.15, -0.04, -0.002, 0.0015)
-CAMERAS.update({
-    "k_offc": look_at((3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), width=640, height=480,
-                      intrinsics=(520.0, 520.0, 360.25, 210.5)),
-    "k_aniso": look_at((-1, 2, 6), (0.2, 0, 0), (0.1, 1, -0.2), width=320, height=480,
-                       intrinsics=(700.0, 560.0, 150.0, 250.0)),
-    "k_barrel": look_at((0.5, 0.8, 4.0), (0, 0, 0), (0, 1, 0), width=640, height=480,
-                        intrinsics=(470.0, 465.0, 325.2, 236.8), distortion=LENS_BARREL),
-    "k_pincushion": look_at((-2.5, 1.5, 3.0), (0, 0, 0), (0, 1, 0), width=640, height=480,
-                            intrinsics=(560.0, 540.0, 300.0, 250.0), distortion=LENS_PINCUSHION),
-})
+CAMERAS.update(
+    {
+        "k_offc": look_at(
+            (3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), width=640, height=480, intrinsics=(520.0, 520.0, 360.25, 210.5)
+        ),
+        "k_aniso": look_at(
+            (-1, 2, 6), (0.2, 0, 0), (0.1, 1, -0.2), width=320, height=480, intrinsics=(700.0, 560.0, 150.0, 250.0)
+        ),
+        "k_barrel": look_at(
+            (0.5, 0.8, 4.0),
+            (0, 0, 0),
+            (0, 1, 0),
+            width=640,
+            height=480,
+            intrinsics=(470.0, 465.0, 325.2, 236.8),
+            distortion=LENS_BARREL,
+        ),
+        "k_pincushion": look_at(
+            (-2.5, 1.5, 3.0),
+            (0, 0, 0),
+            (0, 1, 0),
+            width=640,
+            height=480,
+            intrinsics=(560.0, 540.0, 300.0, 250.0),
+            distortion=LENS_PINCUSHION,
+        ),
+    }
+)
 LENS_CAMERAS = ("k_barrel", "k_pincushion")
 CALIBRATED_CAMERAS = ("k_offc", "k_aniso") + LENS_CAMERAS
 
 
 def _with(camera: Camera, **changes) -> Camera:
-    kw = dict(position=camera.position, forward=camera.forward, up=camera.up, fov_y_deg=camera.fov_y_deg,
-              width=camera.width, height=camera.height, near=camera.near, far=camera.far,
-              projection=camera.projection, ortho_height=camera.ortho_height,
-              intrinsics=camera.intrinsics, distortion=camera.distortion)
+    kw = dict(
+        position=camera.position,
+        forward=camera.forward,
+        up=camera.up,
+        fov_y_deg=camera.fov_y_deg,
+        width=camera.width,
+        height=camera.height,
+        near=camera.near,
+        far=camera.far,
+        projection=camera.projection,
+        ortho_height=camera.ortho_height,
+        intrinsics=camera.intrinsics,
+        distortion=camera.distortion,
+    )
     kw.update(changes)
     return Camera(**kw)
 
 
 # ---- a re-implementation of the projector with knobs for the faults -----------
 
+
 def naive_distort(x, y, coeffs):
     """OpenCV's distortion (its documentation's formula), written out term by term; y down."""
     k1, k2, p1, p2, k3, k4, k5, k6 = tuple(coeffs) + (0.0,) * (8 - len(coeffs))
-    r2 = x ** 2 + y ** 2
-    radial = (1 + k1 * r2 + k2 * r2 ** 2 + k3 * r2 ** 3) / (1 + k4 * r2 + k5 * r2 ** 2 + k6 * r2 ** 3)
-    return (x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x ** 2),
-            y * radial + p1 * (r2 + 2 * y ** 2) + 2 * p2 * x * y)
+    r2 = x**2 + y**2
+    radial = (1 + k1 * r2 + k2 * r2**2 + k3 * r2**3) / (1 + k4 * r2 + k5 * r2**2 + k6 * r2**3)
+    return (x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x**2), y * radial + p1 * (r2 + 2 * y**2) + 2 * p2 * x * y)
 
 
 _LENS = "the camera's"
 
 
-def _project(p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None, dist=_LENS,
-             dtype=np.float64, keep=None):
+def _project(
+    p_world, camera, *, rotation=None, fx=None, fy=None, cx=None, cy=None, dist=_LENS, dtype=np.float64, keep=None
+):
     """core.projector.projection.project_points, with the rotation, focal lengths (or
     ortho scales), principal point, lens distortion and depth test (``keep(z, camera)``)
     replaceable; every value in ``dtype`` (float32: the float32 twin of a fault)."""
@@ -156,7 +185,7 @@ def implied_fov(cam):
 
 def f_fov(p, cam, dtype=np.float64):
     s = _scale_for(cam, implied_fov(cam))
-    if cam.calibrated:                        # both focal lengths scaled alike: fx/fy kept
+    if cam.calibrated:  # both focal lengths scaled alike: fx/fy kept
         fx, fy = cam.focal_xy
         return _project(p, cam, fx=fx * s / fy, fy=s, dtype=dtype)
     return _project(p, cam, fx=s, fy=s, dtype=dtype)
@@ -301,5 +330,9 @@ SINGLE = [k for k in FAULTS if k not in ("swap_mirror", "fov_aspect", "fov_offse
 #: Faults of the depth test, on the "clip" camera only (its near and far planes cut the points).
 CLIP_FAULTS = ("clip_z_positive", "clip_none", "clip_swapped")
 #: Faults that need a calibrated camera: fx != fy, or a lens.
-CALIBRATED_FAULTS = {"fxfy_swap": ("k_aniso", "k_barrel", "k_pincushion"),
-                     "lens_ignored": LENS_CAMERAS, "k1_sign": LENS_CAMERAS, "k2_wrong": LENS_CAMERAS}
+CALIBRATED_FAULTS = {
+    "fxfy_swap": ("k_aniso", "k_barrel", "k_pincushion"),
+    "lens_ignored": LENS_CAMERAS,
+    "k1_sign": LENS_CAMERAS,
+    "k2_wrong": LENS_CAMERAS,
+}

@@ -41,6 +41,7 @@ and after each elision stay the same in number) and the comment lines before it.
 from __future__ import annotations
 
 import difflib
+import functools
 import os
 import re
 import shutil
@@ -49,7 +50,6 @@ import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-import functools
 
 ROOT = Path(__file__).resolve().parent.parent
 ELISION = "..."
@@ -65,6 +65,7 @@ USER_PROJECT = "/home/me/myproj"
 @dataclass
 class Command:
     """One ``$`` line (or a ``command:`` directive) and the output the doc shows for it."""
+
     text: str
     expected: list[str]
 
@@ -72,10 +73,11 @@ class Command:
 @dataclass
 class Sample:
     """One block of a doc: where it is, its commands, and how it is run."""
+
     path: Path
-    first: int            # 0-based index of the block's first content line
-    last: int             # 0-based index one past its last content line
-    indent: str           # the prefix every content line carries ("" fenced, "    " indented)
+    first: int  # 0-based index of the block's first content line
+    last: int  # 0-based index one past its last content line
+    indent: str  # the prefix every content line carries ("" fenced, "    " indented)
     commands: list[Command]
     not_run: str | None = None
     hidden_command: bool = False  # the command is in a `command:` directive, not in the block
@@ -144,8 +146,10 @@ def unbalanced_fences(path: Path) -> list[str]:
         if open_at is None:
             open_at = number
         elif m.group(3).strip():
-            problems.append(f"{_rel(path)}:{number}: a fence with a language "
-                            f"({m.group(3).strip()}) inside the block opened at line {open_at}")
+            problems.append(
+                f"{_rel(path)}:{number}: a fence with a language "
+                f"({m.group(3).strip()}) inside the block opened at line {open_at}"
+            )
             open_at = number
         else:
             open_at = None
@@ -165,12 +169,11 @@ def samples(path: Path) -> list[Sample]:
             j = i + 1
             while j < len(lines) and not _FENCE.match(lines[j]):
                 j += 1
-            body = lines[i + 1:j]
+            body = lines[i + 1 : j]
             out += _block(path, lines, i, i + 1, j, "", body)
             i = j + 1
             continue
-        if lines[i].startswith("    $ ") and (i == 0 or not lines[i - 1].strip()
-                                               or _DIRECTIVE.match(lines[i - 1])):
+        if lines[i].startswith("    $ ") and (i == 0 or not lines[i - 1].strip() or _DIRECTIVE.match(lines[i - 1])):
             j = i
             while j < len(lines) and (lines[j].startswith("    ") or not lines[j].strip()):
                 j += 1
@@ -189,15 +192,14 @@ def _block(path, lines, directive_at, first, last, indent, body) -> list[Sample]
     starts_with_command = bool(body) and body[0].startswith("$ ")
     if "command" in found:
         commands = [Command(found["command"], list(body))]
-        return [Sample(path, first, last, indent, commands, found.get("not run"), True,
-                       found.get("cwd"), found)]
+        return [Sample(path, first, last, indent, commands, found.get("not run"), True, found.get("cwd"), found)]
     if not starts_with_command:
         if "not run" in found:
-            return [Sample(path, first, last, indent, [], found["not run"], False,
-                           found.get("cwd"), found)]
+            return [Sample(path, first, last, indent, [], found["not run"], False, found.get("cwd"), found)]
         return []
-    return [Sample(path, first, last, indent, _split_commands(body), found.get("not run"),
-                   False, found.get("cwd"), found)]
+    return [
+        Sample(path, first, last, indent, _split_commands(body), found.get("not run"), False, found.get("cwd"), found)
+    ]
 
 
 def code_blocks(path: Path, heading: str) -> dict[str, str]:
@@ -214,7 +216,7 @@ def code_blocks(path: Path, heading: str) -> dict[str, str]:
             j = i + 1
             while j < len(lines) and not _FENCE.match(lines[j]):
                 j += 1
-            out.setdefault(m.group(3).strip(), "\n".join(lines[i + 1:j]) + "\n")
+            out.setdefault(m.group(3).strip(), "\n".join(lines[i + 1 : j]) + "\n")
             i = j
         i += 1
     return out
@@ -247,7 +249,7 @@ def normalise(line: str, numbers: bool = False) -> str:
     """
     for pattern, repl in _NORMALISE:
         line = pattern.sub(repl, line)
-    if numbers:                        # and the columns' widths, which follow the numbers'
+    if numbers:  # and the columns' widths, which follow the numbers'
         line = re.sub(r"\s+", " ", _DECIMAL.sub("<n>", line))
     return line.rstrip()
 
@@ -270,12 +272,20 @@ def matches(expected: list[str], actual: list[str], numbers: bool = False) -> bo
 
 
 def diff(expected: list[str], actual: list[str], numbers: bool = False) -> str:
-    return "\n".join(difflib.unified_diff(
-        [normalise(e, numbers) for e in expected], [normalise(a, numbers) for a in actual],
-        "doc", "program", lineterm="", n=2))
+    return "\n".join(
+        difflib.unified_diff(
+            [normalise(e, numbers) for e in expected],
+            [normalise(a, numbers) for a in actual],
+            "doc",
+            "program",
+            lineterm="",
+            n=2,
+        )
+    )
 
 
 # -- running ---------------------------------------------------------------------------------
+
 
 class Runner:
     """Runs commands in one temporary folder each, remembering outputs (one run serves every
@@ -310,10 +320,10 @@ class Runner:
     def _env() -> dict:
         env = dict(os.environ)
         env["PATH"] = f"{ROOT / '.venv' / 'bin'}{os.pathsep}{env.get('PATH', '')}"
-        env["COLUMNS"] = "80"             # argparse and pytest wrap to the terminal's width
+        env["COLUMNS"] = "80"  # argparse and pytest wrap to the terminal's width
         env.pop("PYTEST_ADDOPTS", None)
         env.pop("PYTEST_XDIST_WORKER", None)
-        for name in ("CI", "BUILD_NUMBER"):   # pytest prints its summary lines whole under CI: a user's terminal
+        for name in ("CI", "BUILD_NUMBER"):  # pytest prints its summary lines whole under CI: a user's terminal
             env.pop(name, None)
         env["PYTHONDONTWRITEBYTECODE"] = "1"
         return env
@@ -323,8 +333,9 @@ class Runner:
         self._dirs.append(work)
         self._folders[(command, cwd)] = work
         if cwd:
-            shutil.copytree(ROOT / cwd, work, dirs_exist_ok=True,
-                            ignore=shutil.ignore_patterns("__pycache__", ".pytest_cache"))
+            shutil.copytree(
+                ROOT / cwd, work, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__", ".pytest_cache")
+            )
         for name in (".venv", "tests", "scenes"):
             if not os.path.exists(os.path.join(work, name)):
                 os.symlink(ROOT / name, os.path.join(work, name))
@@ -338,9 +349,16 @@ class Runner:
     def _run_bash(command: str, work: str, env: dict) -> list[str]:
         # `pytest` is the environment's (the venv has no pytest script of its own)
         script = f'pytest() {{ "{ROOT / ".venv" / "bin" / "python"}" -m pytest "$@"; }}\n{command}'
-        done = subprocess.run(["bash", "-c", script], cwd=work, env=env, stdin=subprocess.DEVNULL,
-                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                              timeout=COMMAND_TIMEOUT_S, text=True)
+        done = subprocess.run(
+            ["bash", "-c", script],
+            cwd=work,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            timeout=COMMAND_TIMEOUT_S,
+            text=True,
+        )
         return done.stdout.splitlines()
 
     def in_project(self, files: dict[str, str], command: str) -> list[str]:
@@ -378,8 +396,15 @@ _PLAIN_CLI = re.compile(r"^(?:\.venv/bin/)?(crosscheck|renderer)(?: [A-Za-z0-9_.
 _MAINS = {"crosscheck": "wirecheck.oracles.cli", "renderer": "wirecheck.core.app.cli"}
 #: Imported once here before the first fork, so that no run pays for them again; none of them
 #: loads OpenGL (a fork must pick its GL platform itself, as a new process does).
-_WARM = ("numpy", "scipy.spatial.transform", "cv2", "matplotlib.figure", "matplotlib.backends.backend_agg",
-         "PIL.Image", *_MAINS.values())
+_WARM = (
+    "numpy",
+    "scipy.spatial.transform",
+    "cv2",
+    "matplotlib.figure",
+    "matplotlib.backends.backend_agg",
+    "PIL.Image",
+    *_MAINS.values(),
+)
 
 
 def _warm_up() -> None:
@@ -389,7 +414,7 @@ def _warm_up() -> None:
     try:
         for name in _WARM:
             importlib.import_module(name)
-    finally:                             # cv2's import adds to LD_LIBRARY_PATH: this process's is kept
+    finally:  # cv2's import adds to LD_LIBRARY_PATH: this process's is kept
         for name in set(os.environ) - set(environ):
             del os.environ[name]
         for name, value in environ.items():
@@ -413,7 +438,7 @@ def _run_forked(program: str, args: list[str], work: str, env: dict) -> list[str
     _warm_up()
     read_end, write_end = os.pipe()
     pid = os.fork()
-    if pid == 0:                                        # the child: never returns
+    if pid == 0:  # the child: never returns
         code = 3
         try:
             os.close(read_end)
@@ -428,14 +453,15 @@ def _run_forked(program: str, args: list[str], work: str, env: dict) -> list[str
                 signal.signal(sig, signal.default_int_handler if sig == signal.SIGINT else signal.SIG_DFL)
             sys.stdin = open(0, closefd=False)
             sys.stdout = io.TextIOWrapper(open(1, "wb", closefd=False), encoding="utf-8")
-            sys.stderr = io.TextIOWrapper(open(2, "wb", closefd=False), encoding="utf-8",
-                                          errors="backslashreplace", line_buffering=True)
+            sys.stderr = io.TextIOWrapper(
+                open(2, "wb", closefd=False), encoding="utf-8", errors="backslashreplace", line_buffering=True
+            )
             sys.__stdin__, sys.__stdout__, sys.__stderr__ = sys.stdin, sys.stdout, sys.stderr
             sys.argv = [str(ROOT / ".venv" / "bin" / program), *args]
-            atexit._clear()                         # this process's handlers are not the program's
+            atexit._clear()  # this process's handlers are not the program's
             module = importlib.import_module(_MAINS[program])
             candidates = sys.modules.get("wirecheck.oracles.candidates.subprocess_candidate")
-            if candidates is not None:              # its handler was registered before the fork
+            if candidates is not None:  # its handler was registered before the fork
                 atexit.register(candidates._close_all)
             try:
                 code = module.main()
@@ -444,7 +470,7 @@ def _run_forked(program: str, args: list[str], work: str, env: dict) -> list[str
             atexit._run_exitfuncs()
             sys.stdout.flush()
             sys.stderr.flush()
-        except BaseException:                       # noqa: BLE001 - shown as the run's output
+        except BaseException:  # noqa: BLE001 - shown as the run's output
             import traceback
 
             traceback.print_exc()
@@ -457,7 +483,7 @@ def _run_forked(program: str, args: list[str], work: str, env: dict) -> list[str
 
     chunks, deadline = [], time.monotonic() + COMMAND_TIMEOUT_S
     with open(read_end, "rb", buffering=0) as pipe:
-        while True:                                     # as subprocess.run(timeout=...): a hung run is an error
+        while True:  # as subprocess.run(timeout=...): a hung run is an error
             ready, _, _ = select.select([pipe], [], [], max(0.0, deadline - time.monotonic()))
             if not ready:
                 os.kill(pid, signal.SIGKILL)
@@ -477,13 +503,16 @@ def check(sample: Sample, runner: Runner) -> list[str]:
     for c in sample.commands:
         actual = runner.output(c.text, sample.cwd)
         if not matches(c.expected, actual, sample.numbers):
-            problems.append(f"{sample.where}: `$ {c.text}` prints something else than the doc "
-                            f"(regenerate: python tests/docs_samples.py --update)\n"
-                            f"{diff(c.expected, actual, sample.numbers)}")
+            problems.append(
+                f"{sample.where}: `$ {c.text}` prints something else than the doc "
+                f"(regenerate: python tests/docs_samples.py --update)\n"
+                f"{diff(c.expected, actual, sample.numbers)}"
+            )
     return problems
 
 
 # -- regenerating ----------------------------------------------------------------------------
+
 
 def reshape(expected: list[str], actual: list[str], numbers: bool = False) -> list[str]:
     """``actual`` cut to the shape of ``expected``: each ``...`` of the doc kept, with as many
@@ -523,7 +552,7 @@ def reshape(expected: list[str], actual: list[str], numbers: bool = False) -> li
         pos = max(pos, hi)
     out: list[str] = []
     for k, (lo, hi) in enumerate(spans):
-        if k and lo > spans[k - 1][1]:        # something is hidden here: keep the elision
+        if k and lo > spans[k - 1][1]:  # something is hidden here: keep the elision
             out.append(elisions[k - 1])
         out += actual[lo:hi]
     return out
@@ -573,7 +602,7 @@ def update(paths: list[Path] | None = None, runner: Runner | None = None) -> lis
     for path in paths or doc_files():
         lines = path.read_text(encoding="utf-8").splitlines()
         blocks = [s for s in samples(path) if s.not_run is None and s.commands]
-        for s in reversed(blocks):            # from the bottom, so line numbers stay valid
+        for s in reversed(blocks):  # from the bottom, so line numbers stay valid
             body = []
             for c in s.commands:
                 new = reshape(c.expected, runner.output(c.text, s.cwd), s.numbers)
@@ -583,8 +612,8 @@ def update(paths: list[Path] | None = None, runner: Runner | None = None) -> lis
                 if c is not s.commands[-1]:
                     body.append("")
             new_lines = [(s.indent + b) if b else "" for b in body]
-            if new_lines != lines[s.first:s.last]:
-                lines[s.first:s.last] = new_lines
+            if new_lines != lines[s.first : s.last]:
+                lines[s.first : s.last] = new_lines
                 changed.append(s.where)
         text = "\n".join(lines) + "\n"
         if text != path.read_text(encoding="utf-8"):
@@ -594,6 +623,7 @@ def update(paths: list[Path] | None = None, runner: Runner | None = None) -> lis
 
 def main(argv=None) -> int:
     import argparse
+
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--update", action="store_true", help="rewrite the sample blocks from real runs")
@@ -614,8 +644,7 @@ def main(argv=None) -> int:
             for where in update(paths, runner):
                 print(f"updated {where}")
             return 0
-        problems = [m for p in paths for s in samples(p) if s.not_run is None
-                    for m in check(s, runner)]
+        problems = [m for p in paths for s in samples(p) if s.not_run is None for m in check(s, runner)]
         problems += [m for p in paths for m in unbalanced_fences(p)]
         print("\n\n".join(problems) or "every sample agrees")
         return 1 if problems else 0

@@ -17,7 +17,7 @@ def run_renderer(args, out) -> tuple[int, str, str]:
     with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
         try:
             rc = main(list(args) + ["--out", str(out)])
-        except SystemExit as exc:       # argparse usage errors
+        except SystemExit as exc:  # argparse usage errors
             rc = exc.code
     return rc, o.getvalue(), e.getvalue()
 
@@ -53,7 +53,7 @@ def eight_connected(pixels) -> bool:
 def assert_help_states_defaults(parser) -> None:
     """Every option of ``parser`` but -h/--version has help naming its default; no reStructuredText in --help."""
     for action in parser._actions:
-        if action.dest not in ("help", "version"):          # -h and --version take no value
+        if action.dest not in ("help", "version"):  # -h and --version take no value
             assert action.help and "default" in action.help, action.option_strings
     text = parser.format_help()
     assert "``" not in text and ":func:" not in text and ":mod:" not in text
@@ -63,11 +63,9 @@ def blank_job(job):
     """Export a frames job of cube / on_axis, frames 1 and 3 of 4, into ``job`` and fill it with black
     640x480 PNGs (a renderer that drew nothing: judged, it fails); returns ``job``."""
     from PIL import Image
-
     from wirecheck.oracles import cli
 
-    assert cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "4",
-                     "--every", "2"]) == 0
+    assert cli.main(["export", str(job), "--scene", "cube", "--cases", "on_axis", "--frames", "4", "--every", "2"]) == 0
     (job / "frames/cube/on_axis").mkdir(parents=True)
     for k in (1, 3):
         Image.new("L", (640, 480)).save(job / f"frames/cube/on_axis/frame_{k:04d}.png")
@@ -86,13 +84,14 @@ def process_runs(pid: int) -> bool:
     return state != "Z"
 
 
-
 @contextlib.contextmanager
 def no_block(seconds=5, error=TimeoutError):
     """Fail (instead of hanging the suite) when the block blocks: opening a FIFO waits for a writer forever.
     ``error``: the exception raised then (a BaseException one the code under test cannot catch)."""
+
     def expire(*_):
         raise error(f"blocked for {seconds} s (a FIFO opened?)")
+
     old = signal.signal(signal.SIGALRM, expire)
     signal.alarm(seconds)
     try:
@@ -109,7 +108,6 @@ def fill_job(job_dir, edit=lambda img: img, camera=lambda cam: cam) -> None:
     from pathlib import Path
 
     from PIL import Image
-
     from wirecheck.core.projector.pipeline import render_frame
     from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 
@@ -152,8 +150,7 @@ def draw_and_judge(script, job_dir, tmp_path, *args, cases=6, frames=2) -> tuple
 
     job = tmp_path / "job"
     shutil.copytree(job_dir, job)
-    proc = subprocess.run([sys.executable, str(script), str(job), *args], capture_output=True, text=True,
-                          timeout=300)
+    proc = subprocess.run([sys.executable, str(script), str(job), *args], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
     rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")])
     report = json.loads((tmp_path / "rep" / "report.json").read_text())

@@ -11,13 +11,12 @@ whose outcome the rule fixes and does the arithmetic in another order.
 """
 
 import numpy as np
-
 from wirecheck.core.projector.raster import SUBPIXEL, major_minor
 
 
 def candidates_reference(p0_px, p1_px, width, height):
     x_major, a0, a1, b0, b1 = major_minor(p0_px, p1_px)
-    travel = np.where(a1 >= a0, 1.0, -1.0)            # direction along the major axis
+    travel = np.where(a1 >= a0, 1.0, -1.0)  # direction along the major axis
     lo = np.floor(np.minimum(a0, a1)).astype(np.intp)  # candidate major coordinates lo..hi
     hi = np.ceil(np.maximum(a0, a1)).astype(np.intp)
     n = hi - lo + 1
@@ -31,16 +30,19 @@ def candidates_reference(p0_px, p1_px, width, height):
     ib0, ib1 = (np.round(v * SUBPIXEL).astype(np.int64) for v in (b0, b1))
     den = ia1 - ia0
     sign = np.where(den < 0, -1, 1)
-    den_s = np.where(den == 0, 1, den * sign)[seg]                # > 0
+    den_s = np.where(den == 0, 1, den * sign)[seg]  # > 0
     num = sign[seg] * (ib0[seg] * den[seg] + (i * int(SUBPIXEL) - ia0[seg]) * (ib1 - ib0)[seg])
-    num = np.where(den[seg] == 0, ib0[seg], num)                 # zero length: b = b0
-    unit = int(SUBPIXEL) * den_s                                 # b = num / unit pixels
+    num = np.where(den[seg] == 0, ib0[seg], num)  # zero length: b = b0
+    unit = int(SUBPIXEL) * den_s  # b = num / unit pixels
     xm = x_major[seg]
-    j = np.where(xm, (2 * num + unit) // (2 * unit),             # floor(b + 1/2): halves to +y
-                 -((unit - 2 * num) // (2 * unit)))              # ceil(b - 1/2):  halves to -x
-    e = (num - j * unit) / unit                                  # offset from the pixel centre, [-1/2, 1/2]
+    j = np.where(
+        xm,
+        (2 * num + unit) // (2 * unit),  # floor(b + 1/2): halves to +y
+        -((unit - 2 * num) // (2 * unit)),
+    )  # ceil(b - 1/2):  halves to -x
+    e = (num - j * unit) / unit  # offset from the pixel centre, [-1/2, 1/2]
     s = travel[seg]
-    m = slope[seg] * s                                 # minor change per unit of travel, |m| <= 1
+    m = slope[seg] * s  # minor change per unit of travel, |m| <= 1
     # distance u >= 0 along travel to where the line leaves the diamond:
     # |u| + |e + m u| <= 1/2  <=>  u (1 + m) <= 1/2 - e  and  u (1 - m) <= 1/2 + e
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -9,7 +9,6 @@ import time
 from pathlib import Path
 
 import pytest
-
 from wirecheck import assert_projector, check_projector
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -19,11 +18,12 @@ MIRRORED = str(ROOT / "tests" / "data" / "faulty_projectors.py") + ":mirrored"
 
 @pytest.fixture
 def project(tmp_path, monkeypatch):
-    (tmp_path / "pyproject.toml").write_text('[tool.wirecheck]\nscenes = ["cube"]\ncases = ["on_axis"]\n'
-                                             'frames = 2\n', encoding="utf-8")
+    (tmp_path / "pyproject.toml").write_text(
+        '[tool.wirecheck]\nscenes = ["cube"]\ncases = ["on_axis"]\nframes = 2\n', encoding="utf-8"
+    )
     sub = tmp_path / "tests"
     sub.mkdir()
-    monkeypatch.chdir(sub)              # the nearest pyproject.toml at or above the working directory
+    monkeypatch.chdir(sub)  # the nearest pyproject.toml at or above the working directory
     return tmp_path
 
 
@@ -34,7 +34,7 @@ def _cases(report):
 def test_the_table_chooses_scenes_cases_and_frames(project):
     report = check_projector(GOOD)
     assert _cases(report) == [("cube", "on_axis")] and report["frames"] == 2
-    assert report["compared"]["frames"] == 2          # 1 case x 2 frames
+    assert report["compared"]["frames"] == 2  # 1 case x 2 frames
 
 
 def test_a_keyword_wins_over_the_table(project):
@@ -44,7 +44,7 @@ def test_a_keyword_wins_over_the_table(project):
 
 def test_config_false_ignores_the_table(project):
     report = check_projector(GOOD, config=False, scenes=["cube"], frames=1)
-    assert len(report["cases"]) == 7                  # the seven default case cameras, not the table's one
+    assert len(report["cases"]) == 7  # the seven default case cameras, not the table's one
 
 
 def test_a_bad_table_is_a_value_error_naming_the_file(project):
@@ -64,21 +64,46 @@ def test_the_failure_starts_with_what_was_compared(project):
 def test_pytest_shows_the_callers_line_not_wirecheck_source(project):
     (project / "tests" / "test_p.py").write_text(
         f"from wirecheck import assert_projector\n\ndef test_p():\n    assert_projector({MIRRORED!r})\n",
-        encoding="utf-8")
-    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "test_p.py"],
-                          cwd=project / "tests", capture_output=True, text=True, timeout=180)
+        encoding="utf-8",
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "test_p.py"],
+        cwd=project / "tests",
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
     assert done.returncode == 1
-    assert ">       assert_projector(" in done.stdout            # the test's own line
+    assert ">       assert_projector(" in done.stdout  # the test's own line
     assert "check_projector(func, **kwargs)" not in done.stdout  # wirecheck's frame hidden
     assert "E       AssertionError: Compared: level vertices (OpenCV), 2 frames per case" in done.stdout
 
 
 def test_cli_says_what_it_compared_and_each_hint_once(tmp_path):
     started = time.monotonic()
-    done = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", MIRRORED, "--scene", "cube",
-                           "--cases", "on_axis,oblique_roll", "--level", "vertices", "--frames", "2",
-                           "--report-dir", str(tmp_path / "r")], cwd=tmp_path, capture_output=True, text=True,
-                          timeout=180)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.oracles.cli",
+            "--candidate",
+            MIRRORED,
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis,oblique_roll",
+            "--level",
+            "vertices",
+            "--frames",
+            "2",
+            "--report-dir",
+            str(tmp_path / "r"),
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
     assert done.returncode == 1, done.stderr
     lines = done.stdout.splitlines()
     assert lines[0] == "Compared: level vertices (OpenCV), 2 frames per case, 2 cases (1 scene x 2 cameras)"
@@ -89,7 +114,7 @@ def test_cli_says_what_it_compared_and_each_hint_once(tmp_path):
     m = re.search(r"\(1 job\(s\), ([\d.]+) s wall; ([\d.]+) s in all, with start-up and the report\)", done.stdout)
     assert m, done.stdout
     cases_wall, in_all = float(m.group(1)), float(m.group(2))
-    assert cases_wall + 0.1 < in_all <= time.monotonic() - started + 0.05   # 0.05: the one-decimal rounding
+    assert cases_wall + 0.1 < in_all <= time.monotonic() - started + 0.05  # 0.05: the one-decimal rounding
 
 
 def test_the_returned_report_has_the_fields_of_report_json(tmp_path):

@@ -12,15 +12,14 @@ import math
 
 import numpy as np
 import pytest
+from helpers import run_renderer
 from numpy.testing import assert_array_equal
 from PIL import Image
-
 from wirecheck.core.camera import camera_z
 from wirecheck.core.projector.pipeline import draw_segments, render_frame
-from helpers import run_renderer
 
 F60 = 240.0 * math.sqrt(3.0)
-END = 319.5 + F60 * 1.2 * math.sqrt(3.0) / 4          # 535.5
+END = 319.5 + F60 * 1.2 * math.sqrt(3.0) / 4  # 535.5
 
 
 def red_columns(path):
@@ -38,14 +37,14 @@ def run(args, out):
 def test_x_axis_is_hidden_behind_the_front_face(tmp_path, mode):
     run(["--frames", "2", "--spin", "0,0,0", "--camera-z", "4", "--axes"] + mode, tmp_path)
     cols = red_columns(tmp_path / "cube-frames" / "frame_0001.png")
-    assert cols.min() == 459                      # first pixel centre right of 458.06
-    assert abs(cols.max() - END) <= 1.0           # the axis' end pixel, within the raster's 1 px
+    assert cols.min() == 459  # first pixel centre right of 458.06
+    assert abs(cols.max() - END) <= 1.0  # the axis' end pixel, within the raster's 1 px
 
 
 def test_without_faces_the_axes_are_drawn_over_everything(tmp_path):
     run(["--frames", "2", "--spin", "0,0,0", "--camera-z", "4", "--axes"], tmp_path)
     cols = red_columns(tmp_path / "cube-frames" / "frame_0001.png")
-    assert cols.min() in (319, 320)               # from the origin's pixel, 319.5
+    assert cols.min() in (319, 320)  # from the origin's pixel, 319.5
 
 
 def test_draw_segments_without_occluders_draws_as_the_pipeline_draws_an_edge():
@@ -56,7 +55,7 @@ def test_draw_segments_without_occluders_draws_as_the_pipeline_draws_an_edge():
     want = render_frame(p, edges, cam, np.eye(4)).image
     seg_cam = (p @ cam.world_to_cam[:3, :3].T + cam.world_to_cam[:3, 3])[edges]
     assert_array_equal(draw_segments(seg_cam, cam), want)
-    assert (want > 0).sum() > 100                  # something was drawn
+    assert (want > 0).sum() > 100  # something was drawn
 
 
 def test_endpoint_clip_drops_an_axis_with_a_clipped_end(tmp_path):
@@ -66,6 +65,10 @@ def test_endpoint_clip_drops_an_axis_with_a_clipped_end(tmp_path):
     cam = ["--frames", "2", "--spin", "0,0,0", "--camera-pos", "1.5,1,3", "--near", "2", "--axes", "--hidden-lines"]
     run(cam + ["--clip", "endpoint"], tmp_path / "e")
     run(cam, tmp_path / "c")
-    blue = [(np.asarray(Image.open(tmp_path / d / "cube-frames" / "frame_0001.png").convert("RGB"))
-             == (0, 0, 255)).all(axis=2).sum() for d in ("e", "c")]
+    blue = [
+        (np.asarray(Image.open(tmp_path / d / "cube-frames" / "frame_0001.png").convert("RGB")) == (0, 0, 255))
+        .all(axis=2)
+        .sum()
+        for d in ("e", "c")
+    ]
     assert blue[0] == 0 and blue[1] > 10

@@ -10,16 +10,14 @@ off_centre, non_square_pixels (pyrender's IntrinsicsCamera) and distorted
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
-
-from wirecheck.core.projector import clipping
 from wirecheck.core.app import trace
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.conventions import focal_px
-from wirecheck.core.projector.distortion import distort
 from wirecheck.core.errors import InputError
+from wirecheck.core.projector import clipping
+from wirecheck.core.projector.distortion import distort
 from wirecheck.core.projector.projection import cam_to_px, project_points, unproject, world_to_cam
 from wirecheck.oracles.references import convert, opencv_oracle
 
@@ -31,9 +29,9 @@ RATIONAL = (0.3, -0.05, -0.001, 0.002, 0.01, 0.25, -0.03, 0.005)
 def naive_distort(x, y, c):
     """OpenCV's documented model, term by term (y down)."""
     k1, k2, p1, p2, k3, k4, k5, k6 = tuple(c) + (0.0,) * (8 - len(c))
-    r2 = x ** 2 + y ** 2
-    radial = (1 + k1 * r2 + k2 * r2 ** 2 + k3 * r2 ** 3) / (1 + k4 * r2 + k5 * r2 ** 2 + k6 * r2 ** 3)
-    return x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x ** 2), y * radial + p1 * (r2 + 2 * y ** 2) + 2 * p2 * x * y
+    r2 = x**2 + y**2
+    radial = (1 + k1 * r2 + k2 * r2**2 + k3 * r2**3) / (1 + k4 * r2 + k5 * r2**2 + k6 * r2**3)
+    return x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x**2), y * radial + p1 * (r2 + 2 * y**2) + 2 * p2 * x * y
 
 
 def random_cameras(n, seed, lens_every=2):
@@ -42,17 +40,37 @@ def random_cameras(n, seed, lens_every=2):
     out = []
     for i in range(n):
         w, h = int(rng.integers(64, 1024)), int(rng.integers(64, 1024))
-        intr = (rng.uniform(0.3, 3) * w, rng.uniform(0.3, 3) * h, rng.uniform(-0.2, 1.2) * w, rng.uniform(-0.2, 1.2) * h)
+        intr = (
+            rng.uniform(0.3, 3) * w,
+            rng.uniform(0.3, 3) * h,
+            rng.uniform(-0.2, 1.2) * w,
+            rng.uniform(-0.2, 1.2) * h,
+        )
         lens = None
         if lens_every and i % lens_every == 0:
             lens = tuple(rng.uniform(-0.3, 0.3, 2)) + tuple(rng.uniform(-0.01, 0.01, 2)) + (rng.uniform(-0.05, 0.05),)
         target = rng.uniform(-0.5, 0.5, 3)
-        out.append((look_at(rng.uniform(-5, 5, 3), target, (0, 1, 0), width=w, height=h, near=0.1, far=100,
-                            intrinsics=intr, distortion=lens), target))
+        out.append(
+            (
+                look_at(
+                    rng.uniform(-5, 5, 3),
+                    target,
+                    (0, 1, 0),
+                    width=w,
+                    height=h,
+                    near=0.1,
+                    far=100,
+                    intrinsics=intr,
+                    distortion=lens,
+                ),
+                target,
+            )
+        )
     return out
 
 
 # ---- the convention, pinned ------------------------------------------------------
+
 
 def test_fov_camera_k_is_unchanged():
     """A FOV camera's K is f_px of its FOV on both axes and the centred principal point, exactly."""
@@ -116,10 +134,11 @@ def test_unproject_calibrated_and_refuses_a_lens():
 
 # ---- clipping and the GL-style clip matrix -----------------------------------------
 
+
 def test_side_planes_follow_fx_fy_cx_cy():
     """A point unprojected onto each image edge lies on its side plane; a pixel beyond is outside."""
     cam = look_at((1, 2, 5), (0, 0, 0), width=320, height=200, intrinsics=(500.0, 300.0, 40.0, 170.0))
-    planes = clipping.frustum_planes(cam)[2:]                    # left, right, top, bottom
+    planes = clipping.frustum_planes(cam)[2:]  # left, right, top, bottom
     edges = [(-0.5, 100.0), (319.5, 100.0), (160.0, -0.5), (160.0, 199.5)]
     beyond = [(-0.6, 100.0), (319.6, 100.0), (160.0, -0.6), (160.0, 199.6)]
     z = 3.0
@@ -130,7 +149,7 @@ def test_side_planes_follow_fx_fy_cx_cy():
             p_cam = np.array([(x - cx) * z / fx, -(y - cy) * z / fy, z])
             d = plane[:3] @ p_cam + plane[3]
             if want is None:
-                assert d < 0                                     # 0.1 px outside: d ~ -0.3, far from noise
+                assert d < 0  # 0.1 px outside: d ~ -0.3, far from noise
             else:
                 # plane terms ~ f x ~ 1e3 x 3: a few roundings, 16 eps x 3e3
                 assert abs(d) <= 16 * EPS * 3e3
@@ -160,10 +179,18 @@ def test_clip_matrix_of_a_fov_camera_has_no_offset_terms():
 # ---- the contract's matrices and the oracle's conversions ------------------------
 
 CALIBRATED = {
-    "offc": look_at((3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), width=640, height=480,
-                    intrinsics=(520.0, 520.0, 360.25, 210.5)),
-    "aniso": look_at((-1, 2, 6), (0.2, 0, 0), (0.1, 1, -0.2), width=320, height=480,
-                     intrinsics=(700.0, 560.0, 150.0, 250.0), distortion=LENS),
+    "offc": look_at(
+        (3, 2, 4), (0, 0, 0), (0.3, 1, 0.1), width=640, height=480, intrinsics=(520.0, 520.0, 360.25, 210.5)
+    ),
+    "aniso": look_at(
+        (-1, 2, 6),
+        (0.2, 0, 0),
+        (0.1, 1, -0.2),
+        width=320,
+        height=480,
+        intrinsics=(700.0, 560.0, 150.0, 250.0),
+        distortion=LENS,
+    ),
 }
 
 
@@ -173,15 +200,16 @@ def test_contract_matrices_match_the_oracle_side(name):
     cam = CALIBRATED[name]
     r, t, k = convert.opencv_matrices(cam)
     view, proj = convert.camera_to_gl(cam)
-    np.testing.assert_array_equal(cam.K, k)                   # the same numbers, no arithmetic
+    np.testing.assert_array_equal(cam.K, k)  # the same numbers, no arithmetic
     # rows of unit vectors: equal up to the re-normalisation's ulp; t and view's
     # translation are R @ position (|position| <= 7): 8 eps x 7
     np.testing.assert_allclose(cam.R, r, rtol=0, atol=8 * EPS)
     np.testing.assert_allclose(cam.t, t, rtol=0, atol=8 * EPS * 7)
     np.testing.assert_allclose(cam.view_matrix, view, rtol=0, atol=8 * EPS * 7)
     np.testing.assert_allclose(cam.projection_matrix, proj, rtol=0, atol=4 * EPS)
-    np.testing.assert_array_equal(convert.distortion_coefficients(cam),
-                                  np.zeros(5) if cam.distortion is None else cam.distortion)
+    np.testing.assert_array_equal(
+        convert.distortion_coefficients(cam), np.zeros(5) if cam.distortion is None else cam.distortion
+    )
 
 
 def test_gl_matrices_give_the_pixels_of_projectpoints():
@@ -197,12 +225,12 @@ def test_gl_matrices_give_the_pixels_of_projectpoints():
 
 
 def test_pyrender_intrinsics_camera_and_round_trip():
-    cam = CALIBRATED["offc"]           # (convert imports pyrender on OSMesa: PYOPENGL_PLATFORM first)
+    cam = CALIBRATED["offc"]  # (convert imports pyrender on OSMesa: PYOPENGL_PLATFORM first)
     pose, pcam = convert.camera_to_pyrender(cam)
     # pyrender measures cx, cy from the pixel corner: + 0.5, exact for these values
     assert (pcam.fx, pcam.fy, pcam.cx, pcam.cy) == (520.0, 520.0, 360.75, 211.0)
     back = convert.pyrender_pose_to_camera(pose, pcam, cam.width, cam.height)
-    assert back.intrinsics == cam.intrinsics                   # - 0.5 undoes + 0.5 exactly
+    assert back.intrinsics == cam.intrinsics  # - 0.5 undoes + 0.5 exactly
     with pytest.raises(ValueError, match="lens distortion"):
         convert.camera_to_pyrender(CALIBRATED["aniso"])
 
@@ -223,19 +251,23 @@ def test_protocol_camera_and_host_rebuild():
 
 # ---- hostile input ------------------------------------------------------------------
 
-@pytest.mark.parametrize("kwargs,match", [
-    (dict(intrinsics=(500.0, 500.0, 320.0)), "intrinsics fx,fy,cx,cy: expected 4 numbers"),
-    (dict(intrinsics=(500.0, float("nan"), 320.0, 240.0)), "expected finite numbers"),
-    (dict(intrinsics=(-500.0, 500.0, 320.0, 240.0)), "expected focal lengths > 0"),
-    (dict(intrinsics=(1e300, 500.0, 320.0, 240.0)), r"expected \|fx\|"),
-    (dict(intrinsics=(1e-300, 500.0, 320.0, 240.0)), "expected focal lengths >="),
-    (dict(intrinsics="abcd"), "expected 4 numbers"),
-    (dict(intrinsics=(500.0, 500.0, 320.0, 240.0), projection="orthographic"), "expected a perspective camera"),
-    (dict(distortion=(0.1, 0.2, 0.3)), "expected 4, 5 or 8 numbers"),
-    (dict(distortion=(0.1, float("inf"), 0.0, 0.0)), "k2=inf"),
-    (dict(distortion=(1e9, 0.0, 0.0, 0.0)), "k1=1000000000.0"),
-    (dict(distortion=(0.1, 0.0, 0.0, 0.0), projection="orthographic"), "expected a perspective camera"),
-])
+
+@pytest.mark.parametrize(
+    "kwargs,match",
+    [
+        (dict(intrinsics=(500.0, 500.0, 320.0)), "intrinsics fx,fy,cx,cy: expected 4 numbers"),
+        (dict(intrinsics=(500.0, float("nan"), 320.0, 240.0)), "expected finite numbers"),
+        (dict(intrinsics=(-500.0, 500.0, 320.0, 240.0)), "expected focal lengths > 0"),
+        (dict(intrinsics=(1e300, 500.0, 320.0, 240.0)), r"expected \|fx\|"),
+        (dict(intrinsics=(1e-300, 500.0, 320.0, 240.0)), "expected focal lengths >="),
+        (dict(intrinsics="abcd"), "expected 4 numbers"),
+        (dict(intrinsics=(500.0, 500.0, 320.0, 240.0), projection="orthographic"), "expected a perspective camera"),
+        (dict(distortion=(0.1, 0.2, 0.3)), "expected 4, 5 or 8 numbers"),
+        (dict(distortion=(0.1, float("inf"), 0.0, 0.0)), "k2=inf"),
+        (dict(distortion=(1e9, 0.0, 0.0, 0.0)), "k1=1000000000.0"),
+        (dict(distortion=(0.1, 0.0, 0.0, 0.0), projection="orthographic"), "expected a perspective camera"),
+    ],
+)
 def test_hostile_camera_input(kwargs, match):
     with pytest.raises(InputError, match=match):
         look_at((0, 0, 4), (0, 0, 0), **kwargs)
@@ -251,17 +283,26 @@ def test_with_k_refuses_skew_and_all_zero_lens_is_none():
 
 # ---- the crosscheck cases -------------------------------------------------------------
 
+
 def test_crosscheck_calibrated_cases(tmp_path):
     """core against pyrender's IntrinsicsCamera and cv2.projectPoints; the lens case by its vertices."""
     from helpers import run_crosscheck
-
     from wirecheck.oracles.judge.case import PIXELS_NOT_COMPARED
     from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
     if not osmesa_available()[0]:
         pytest.skip("no OSMesa")
-    code, report, _ = run_crosscheck(tmp_path, "--scene", "cube", "--scene", "prism", "--frames", "6",
-                                     "--cases", "off_centre,non_square_pixels,distorted")
+    code, report, _ = run_crosscheck(
+        tmp_path,
+        "--scene",
+        "cube",
+        "--scene",
+        "prism",
+        "--frames",
+        "6",
+        "--cases",
+        "off_centre,non_square_pixels,distorted",
+    )
     assert code == 0 and report["verdict"] == "pass"
     by = {(c["scene"], c["camera"]): c for c in report["cases"]}
     for scene in ("cube", "prism"):
@@ -279,6 +320,7 @@ def test_crosscheck_calibrated_cases(tmp_path):
 
 def LENS_OF_CASES():  # noqa: N802
     from wirecheck.oracles.cases import DISTORTION
+
     return DISTORTION
 
 
@@ -291,8 +333,9 @@ def test_only_distorted_cases_at_level_pixels_is_refused(tmp_path):
 
     err = io.StringIO()
     with contextlib.redirect_stderr(err):
-        code = cli.main(["--report-dir", str(tmp_path / "r"), "--scene", "cube", "--frames", "2",
-                         "--cases", "distorted"])
+        code = cli.main(
+            ["--report-dir", str(tmp_path / "r"), "--scene", "cube", "--frames", "2", "--cases", "distorted"]
+        )
     assert code == 2 and "lens distortion" in err.getvalue() and len(err.getvalue().strip().splitlines()) == 1
     assert not (tmp_path / "r").exists()
 
@@ -308,8 +351,7 @@ def test_faults_of_calibrated_candidates_through_crosscheck():
     def no_lens(points, camera):
         return project_points(points, camera.with_distortion(None))
 
-    rep = check_projector(pp_off, scenes=["cube"], frames=3, cases=["off_centre", "non_square_pixels"],
-                          isolate=False)
+    rep = check_projector(pp_off, scenes=["cube"], frames=3, cases=["off_centre", "non_square_pixels"], isolate=False)
     for c in rep["cases"]:
         (f,) = c["faults"]
         # an exactly representable shift of pixels <= 640: the fit recovers it to ~1e-12 px
@@ -322,11 +364,11 @@ def test_faults_of_calibrated_candidates_through_crosscheck():
 
 def test_export_calibrated_cases_and_refuses_a_lens(tmp_path):
     from wirecheck.core.scene.files import load_scene
-    from wirecheck.oracles.cases import CASE_NAMES
     from wirecheck.oracles.candidates.export import build_job
+    from wirecheck.oracles.cases import CASE_NAMES
 
     job, files = build_job([load_scene("cube")], frames=2)
-    assert [c["case"] for c in job["cases"]] == list(CASE_NAMES)              # the default set, unchanged
+    assert [c["case"] for c in job["cases"]] == list(CASE_NAMES)  # the default set, unchanged
     job, files = build_job([load_scene("cube")], frames=2, case_names=["off_centre"])
     cam = __import__("json").loads(files["cameras/cube/off_centre/frame_0001.json"])
     assert cam["camera"]["intrinsics"] == [460.0, 460.0, 389.5, 194.5] and cam["K"][0][2] == 389.5
@@ -339,8 +381,15 @@ def test_calibrated_cases_run_only_when_named():
     from wirecheck.oracles.cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES, cameras_for
     from wirecheck.oracles.judge.gate import resolve_cases
 
-    assert CASE_NAMES == ("on_axis", "oblique_roll", "near_plane", "wide_fov", "narrow_fov", "non_square",
-                          "orthographic")
+    assert CASE_NAMES == (
+        "on_axis",
+        "oblique_roll",
+        "near_plane",
+        "wide_fov",
+        "narrow_fov",
+        "non_square",
+        "orthographic",
+    )
     assert CALIBRATED_CASE_NAMES == ("off_centre", "non_square_pixels", "distorted")
     assert resolve_cases(None) == CASE_NAMES and [c.name for c in cameras_for(2.0)] == list(CASE_NAMES)
     assert resolve_cases("distorted,on_axis") == ("on_axis", "distorted")
@@ -349,27 +398,31 @@ def test_calibrated_cases_run_only_when_named():
 
 # ---- renderer flags ---------------------------------------------------------------------
 
-@pytest.mark.parametrize("args,match", [
-    (["--intrinsics", "500,400,300"], "--intrinsics '500,400,300': expected 4 finite numbers"),
-    (["--intrinsics=-5,400,300,200"], "expected focal lengths > 0"),
-    (["--intrinsics", "500,400,nan,200"], "expected 4 finite numbers"),
-    (["--intrinsics", "500,400,300,200", "--fov", "50"], "--fov and --intrinsics: expected one of them"),
-    (["--intrinsics", "500,400,300,200", "--projection", "both"], "expected --projection perspective"),
-    (["--distortion", "0.1,0,0"], "expected 4 or 5 or 8 finite numbers"),
-    (["--distortion", "1e9,0,0,0"], r"k1=1000000000.0: expected finite numbers with \|value\| <= 10000"),
-    (["--distortion", "0.1,0,0,0", "--hidden-lines"], "faces do not; expected a wireframe"),
-    (["--distortion", "0.1,0,0,0", "--compare"], "its cameras are set by FOV"),
-])
+
+@pytest.mark.parametrize(
+    "args,match",
+    [
+        (["--intrinsics", "500,400,300"], "--intrinsics '500,400,300': expected 4 finite numbers"),
+        (["--intrinsics=-5,400,300,200"], "expected focal lengths > 0"),
+        (["--intrinsics", "500,400,nan,200"], "expected 4 finite numbers"),
+        (["--intrinsics", "500,400,300,200", "--fov", "50"], "--fov and --intrinsics: expected one of them"),
+        (["--intrinsics", "500,400,300,200", "--projection", "both"], "expected --projection perspective"),
+        (["--distortion", "0.1,0,0"], "expected 4 or 5 or 8 finite numbers"),
+        (["--distortion", "1e9,0,0,0"], r"k1=1000000000.0: expected finite numbers with \|value\| <= 10000"),
+        (["--distortion", "0.1,0,0,0", "--hidden-lines"], "faces do not; expected a wireframe"),
+        (["--distortion", "0.1,0,0,0", "--compare"], "its cameras are set by FOV"),
+    ],
+)
 def test_renderer_lens_flags_hostile(tmp_path, args, match):
     import re
 
     from helpers import run_renderer
 
     out = tmp_path / "out"
-    frames = [] if "--compare" in args else ["--frames", "2"]      # --compare refuses --frames (it renders at rest)
+    frames = [] if "--compare" in args else ["--frames", "2"]  # --compare refuses --frames (it renders at rest)
     rc, _, err = run_renderer([*frames, *args], out)
     assert rc == 2 and len(err.strip().splitlines()) == 1 and re.search(match, err), err
-    assert not out.exists()                                    # nothing written
+    assert not out.exists()  # nothing written
 
 
 def test_renderer_centred_intrinsics_draw_the_fov_frames(tmp_path):
@@ -378,8 +431,9 @@ def test_renderer_centred_intrinsics_draw_the_fov_frames(tmp_path):
 
     f = focal_px(60.0, 480)
     rc1, _, _ = run_renderer(["--frames", "3", "--format", "png"], tmp_path / "fov")
-    rc2, _, _ = run_renderer(["--frames", "3", "--format", "png", f"--intrinsics={f!r},{f!r},319.5,239.5"],
-                             tmp_path / "k")
+    rc2, _, _ = run_renderer(
+        ["--frames", "3", "--format", "png", f"--intrinsics={f!r},{f!r},319.5,239.5"], tmp_path / "k"
+    )
     assert rc1 == rc2 == 0
     a = sorted((tmp_path / "fov" / "cube-frames").glob("*.png"))
     b = sorted((tmp_path / "k" / "cube-frames").glob("*.png"))

@@ -10,32 +10,53 @@ import sys
 from pathlib import Path
 
 import pytest
-
+from helpers import process_runs  # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles import cli
-
-from helpers import process_runs          # tests/ is on sys.path (rootdir conftest)
 
 ROOT = Path(__file__).parent.parent
 
 #: (name, candidate source, a phrase the case's reason must hold)
 HOSTILE = [
-    ("os_exit_0_in_call", "import os\ndef f(p, c):\n    os._exit(0)\n",
-     "candidate exited with status 0 during a request of 8 points"),
-    ("os_exit_0_at_import", "import os\nos._exit(0)\ndef f(p, c):\n    return p[:, :2]\n",
-     "candidate exited with status 0 at start-up, before answering the protocol header"),
+    (
+        "os_exit_0_in_call",
+        "import os\ndef f(p, c):\n    os._exit(0)\n",
+        "candidate exited with status 0 during a request of 8 points",
+    ),
+    (
+        "os_exit_0_at_import",
+        "import os\nos._exit(0)\ndef f(p, c):\n    return p[:, :2]\n",
+        "candidate exited with status 0 at start-up, before answering the protocol header",
+    ),
     ("os_exit_3", "import os\ndef f(p, c):\n    os._exit(3)\n", "candidate exited with status 3 during"),
     ("keyboard_interrupt", "def f(p, c):\n    raise KeyboardInterrupt\n", "candidate raised KeyboardInterrupt"),
     ("generator_exit", "def f(p, c):\n    raise GeneratorExit('bye')\n", "candidate raised GeneratorExit: bye"),
-    ("segfault", "import ctypes\ndef f(p, c):\n    ctypes.string_at(0)\n",
-     "candidate was killed by signal SIGSEGV during a request of 8 points"),
-    ("huge_int", "def f(p, c):\n    return [[10**400, 0]] * len(p)\n",
-     "candidate returned list that is not an array of floats (OverflowError"),
-    ("array_raises", "class A:\n    def __array__(self, *a, **k):\n        raise RuntimeError('no array')\n"
-                     "def f(p, c):\n    return A()\n", "(RuntimeError: no array)"),
-    ("float_raises", "class F:\n    def __float__(self):\n        raise ValueError('no float')\n"
-                     "def f(p, c):\n    return [[F(), F()] for _ in p]\n", "(ValueError: no float)"),
-    ("complex", "import numpy as np\ndef f(p, c):\n    return np.zeros((len(p), 2)) + 1j\n",
-     "candidate returned complex numbers (complex128)"),
+    (
+        "segfault",
+        "import ctypes\ndef f(p, c):\n    ctypes.string_at(0)\n",
+        "candidate was killed by signal SIGSEGV during a request of 8 points",
+    ),
+    (
+        "huge_int",
+        "def f(p, c):\n    return [[10**400, 0]] * len(p)\n",
+        "candidate returned list that is not an array of floats (OverflowError",
+    ),
+    (
+        "array_raises",
+        "class A:\n    def __array__(self, *a, **k):\n        raise RuntimeError('no array')\n"
+        "def f(p, c):\n    return A()\n",
+        "(RuntimeError: no array)",
+    ),
+    (
+        "float_raises",
+        "class F:\n    def __float__(self):\n        raise ValueError('no float')\n"
+        "def f(p, c):\n    return [[F(), F()] for _ in p]\n",
+        "(ValueError: no float)",
+    ),
+    (
+        "complex",
+        "import numpy as np\ndef f(p, c):\n    return np.zeros((len(p), 2)) + 1j\n",
+        "candidate returned complex numbers (complex128)",
+    ),
 ]
 
 
@@ -43,8 +64,23 @@ def _crosscheck(tmp_path, source, *extra):
     cand = tmp_path / "hostile.py"
     cand.write_text(source)
     out = tmp_path / "report"
-    code = cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--cases", "on_axis,orthographic",
-                     "--frames", "2", "--level", "vertices", "--report-dir", str(out), *extra])
+    code = cli.main(
+        [
+            "--candidate",
+            f"{cand}:f",
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis,orthographic",
+            "--frames",
+            "2",
+            "--level",
+            "vertices",
+            "--report-dir",
+            str(out),
+            *extra,
+        ]
+    )
     return code, json.loads((out / "report.json").read_text())
 
 
@@ -63,14 +99,18 @@ def test_hostile_candidate_fails_every_case_with_its_reason(tmp_path, capsys, na
 def test_hang_times_out_and_the_next_case_gets_a_fresh_process(tmp_path, capsys):
     # the first process ever started sleeps; later ones (after the kill) answer correctly
     flag = tmp_path / "started-once"
-    source = (f"import time, pathlib\nfrom wirecheck.core.projector.projection import project_points\n"
-              f"FIRST = not pathlib.Path({str(flag)!r}).exists()\npathlib.Path({str(flag)!r}).touch()\n"
-              "def f(p, c):\n    if FIRST:\n        time.sleep(60)\n    return project_points(p, c)\n")
+    source = (
+        f"import time, pathlib\nfrom wirecheck.core.projector.projection import project_points\n"
+        f"FIRST = not pathlib.Path({str(flag)!r}).exists()\npathlib.Path({str(flag)!r}).touch()\n"
+        "def f(p, c):\n    if FIRST:\n        time.sleep(60)\n    return project_points(p, c)\n"
+    )
     code, report = _crosscheck(tmp_path, source, "--candidate-timeout", "0.5")
     first, second = report["cases"]
     assert code == 1
-    assert first["reasons"] == ["frame 1: candidate timed out after 0.5 s on a request of 8 points; it was "
-                                "killed (and is started again for the next case)"]
+    assert first["reasons"] == [
+        "frame 1: candidate timed out after 0.5 s on a request of 8 points; it was "
+        "killed (and is started again for the next case)"
+    ]
     assert second["verdict"] == "pass" and second["max_vertex_error_px"] < 1e-9
 
 
@@ -82,10 +122,29 @@ def test_os_exit_0_as_a_real_process_exits_1_with_a_report(tmp_path):
     # (pixel_f1 is None at either level); the pixel level would only load pyrender for nothing.
     # Two cases: the second one's candidate is a fresh host after the first one's exit (each
     # further case would only start one more Python for the same check)
-    proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", f"{cand}:f",
-                           "--scene", "cube", "--frames", "1", "--cases", "on_axis,orthographic",
-                           "--level", "vertices", "--report-dir", str(tmp_path / "r")],
-                          capture_output=True, text=True, cwd=ROOT, timeout=300)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.oracles.cli",
+            "--candidate",
+            f"{cand}:f",
+            "--scene",
+            "cube",
+            "--frames",
+            "1",
+            "--cases",
+            "on_axis,orthographic",
+            "--level",
+            "vertices",
+            "--report-dir",
+            str(tmp_path / "r"),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+    )
     assert proc.returncode == 1 and proc.stderr == ""
     report = json.loads((tmp_path / "r" / "report.json").read_text())
     assert report["summary"]["failed"] == report["summary"]["cases"] == 2
@@ -93,9 +152,11 @@ def test_os_exit_0_as_a_real_process_exits_1_with_a_report(tmp_path):
 
 
 def test_candidate_stderr_and_prints_go_into_the_report_not_the_protocol(tmp_path):
-    source = ("import sys\nfrom wirecheck.core.projector.projection import project_points\nprint('loaded')\n"
-              "def f(p, c):\n    print('stdout of f')\n    print('stderr of f', file=sys.stderr)\n"
-              "    return project_points(p, c)\n")
+    source = (
+        "import sys\nfrom wirecheck.core.projector.projection import project_points\nprint('loaded')\n"
+        "def f(p, c):\n    print('stdout of f')\n    print('stderr of f', file=sys.stderr)\n"
+        "    return project_points(p, c)\n"
+    )
     code, report = _crosscheck(tmp_path, source)
     assert code == 0
     # frames 1 and 2 of on_axis: one call each (vertex level); the import's print lands in the first case
@@ -122,20 +183,29 @@ def test_a_candidate_hanging_at_import_fails_every_case_and_is_started_once(tmp_
     code, report = _crosscheck(tmp_path, source, "--candidate-timeout", "0.3")
     assert code == 1
     for case in report["cases"]:
-        assert case["reasons"] == ["frame 1: candidate did not answer the protocol header within 2.5 s "
-                                   "(start-up); it was killed"]
-    assert starts.read_text() == "start\n"       # not started again for the second case
+        assert case["reasons"] == [
+            "frame 1: candidate did not answer the protocol header within 2.5 s (start-up); it was killed"
+        ]
+    assert starts.read_text() == "start\n"  # not started again for the second case
 
 
-LAZY = "def f(p, c):\n    import helper\n    return helper.g(p)\n"       # imports its sibling inside a call
+LAZY = "def f(p, c):\n    import helper\n    return helper.g(p)\n"  # imports its sibling inside a call
 
 
 RUNS, IMPORT_FAILS = "def f(p, c):\n    return p[:, :2] * 0.0\n", "raise ImportError('at import')\n"
 
 
-@pytest.mark.parametrize("isolated,source,code", [
-    (True, RUNS, 1), (True, IMPORT_FAILS, 2), (True, LAZY, 1), (False, RUNS, 1), (False, IMPORT_FAILS, 2),
-], ids=["host-runs", "host-import_fails", "host-imports_in_a_call", "in_process-runs", "in_process-import_fails"])
+@pytest.mark.parametrize(
+    "isolated,source,code",
+    [
+        (True, RUNS, 1),
+        (True, IMPORT_FAILS, 2),
+        (True, LAZY, 1),
+        (False, RUNS, 1),
+        (False, IMPORT_FAILS, 2),
+    ],
+    ids=["host-runs", "host-import_fails", "host-imports_in_a_call", "in_process-runs", "in_process-import_fails"],
+)
 def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, isolated, source, code):
     # Python writes __pycache__/NAME.cpython-3X.pyc beside a module it imports unless told not to;
     # the candidate's folder is the user's, and wirecheck changes nothing it did not write. With
@@ -150,19 +220,33 @@ def test_the_candidates_folder_gets_no_bytecode_files(tmp_path, monkeypatch, iso
     (folder / "proj.py").write_text(source)
     (folder / "helper.py").write_text("def g(p):\n    return p[:, :2] * 0.0\n")
     if isolated:
-        got = cli.main(["--candidate", f"{folder / 'proj.py'}:f", "--scene", "cube", "--cases", "on_axis",
-                        "--frames", "1", "--level", "vertices", "--report-dir", str(tmp_path / "rep")])
+        got = cli.main(
+            [
+                "--candidate",
+                f"{folder / 'proj.py'}:f",
+                "--scene",
+                "cube",
+                "--cases",
+                "on_axis",
+                "--frames",
+                "1",
+                "--level",
+                "vertices",
+                "--report-dir",
+                str(tmp_path / "rep"),
+            ]
+        )
         assert got == code
     elif code == 2:
         with pytest.raises(Exception, match="at import"):
-            api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
-                                isolate=False)
+            api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1, isolate=False)
     else:
-        report = api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
-                                     isolate=False)
+        report = api.check_projector(
+            f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1, isolate=False
+        )
         assert report["verdict"] == "fail"
     assert sorted(p.name for p in folder.rglob("*")) == ["helper.py", "proj.py"]
-    assert sys.dont_write_bytecode is False                   # set back after the import
+    assert sys.dont_write_bytecode is False  # set back after the import
 
 
 def test_an_in_process_candidate_leaves_the_callers_imports_as_they_were(tmp_path, monkeypatch):
@@ -178,20 +262,24 @@ def test_an_in_process_candidate_leaves_the_callers_imports_as_they_were(tmp_pat
     monkeypatch.setattr(sys, "dont_write_bytecode", False)
     monkeypatch.setattr(sys, "path", list(sys.path))
     path_before = list(sys.path)
-    sibling = f"sibling_{uuid.uuid4().hex}"             # not yet in sys.modules: really imported here
+    sibling = f"sibling_{uuid.uuid4().hex}"  # not yet in sys.modules: really imported here
     folder = tmp_path / "user"
     folder.mkdir()
     (folder / "proj.py").write_text(f"def f(p, c):\n    import {sibling}\n    return {sibling}.g(p, c)\n")
-    (folder / f"{sibling}.py").write_text("from wirecheck.core.projector.projection import project_points\n"
-                                          "def g(p, c):\n    return project_points(p, c)\n")
+    (folder / f"{sibling}.py").write_text(
+        "from wirecheck.core.projector.projection import project_points\n"
+        "def g(p, c):\n    return project_points(p, c)\n"
+    )
     try:
-        report = api.check_projector(f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1,
-                                     isolate=False)
+        report = api.check_projector(
+            f"{folder / 'proj.py'}:f", scenes=["cube"], cases=["on_axis"], frames=1, isolate=False
+        )
     finally:
         sys.modules.pop(sibling, None)
-    assert report["verdict"] == "pass"                      # core's projection, reached through the sibling
+    assert report["verdict"] == "pass"  # core's projection, reached through the sibling
     assert sorted(p.name for p in folder.rglob("*")) == sorted(["proj.py", f"{sibling}.py"])
     assert sys.path == path_before and sys.dont_write_bytecode is False
+
 
 @pytest.mark.parametrize("how", ["cli", "api_file", "api_callable", "api_cmd"])
 def test_a_candidates_process_ends_with_its_run(tmp_path, how):
@@ -202,26 +290,51 @@ def test_a_candidates_process_ends_with_its_run(tmp_path, how):
     from wirecheck.oracles import api
 
     pids = tmp_path / "pids"
-    source = (f"import os\nwith open({str(pids)!r}, 'a') as fh:\n    fh.write(f'{{os.getpid()}}\\n')\n"
-              "def f(p, c):\n    return p[:, :2] * 0.0\n")
+    source = (
+        f"import os\nwith open({str(pids)!r}, 'a') as fh:\n    fh.write(f'{{os.getpid()}}\\n')\n"
+        "def f(p, c):\n    return p[:, :2] * 0.0\n"
+    )
     cand = tmp_path / "proj.py"
     cand.write_text(source)
     args = dict(scenes=["cube"], cases=["on_axis"], frames=1)
     if how == "cli":
-        assert cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--cases", "on_axis", "--frames", "1",
-                         "--level", "vertices", "--report-dir", str(tmp_path / "rep")]) == 1
+        assert (
+            cli.main(
+                [
+                    "--candidate",
+                    f"{cand}:f",
+                    "--scene",
+                    "cube",
+                    "--cases",
+                    "on_axis",
+                    "--frames",
+                    "1",
+                    "--level",
+                    "vertices",
+                    "--report-dir",
+                    str(tmp_path / "rep"),
+                ]
+            )
+            == 1
+        )
     elif how == "api_file":
         assert api.check_projector(f"{cand}:f", **args)["verdict"] == "fail"
     elif how == "api_callable":
-        def closure(p, c):                       # not importable by another process: run in a fork
+
+        def closure(p, c):  # not importable by another process: run in a fork
             pids.open("a").write(f"{os.getpid()}\n")
             return p[:, :2] * 0.0
+
         assert api.check_projector(closure, **args)["verdict"] == "fail"
     else:
-        assert api.check_projector(cmd=[sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", f"{cand}:f"],
-                                   **args)["verdict"] == "fail"
+        assert (
+            api.check_projector(
+                cmd=[sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", f"{cand}:f"], **args
+            )["verdict"]
+            == "fail"
+        )
     started = {int(x) for x in pids.read_text().split()} - {os.getpid()}
-    assert len(started) == 1, started                      # one program, started once for the run
+    assert len(started) == 1, started  # one program, started once for the run
     assert not process_runs(started.pop())
 
 
@@ -238,19 +351,24 @@ def test_what_a_candidate_started_ends_with_its_run(tmp_path, how):
     cand.write_text("def f(p, c):\n    return p[:, :2] * 0.0\n")
     args = dict(scenes=["cube"], cases=["on_axis"], frames=1)
     if how == "cmd_shell":
-        cmd = (f"sleep 300 & echo $! > {pid_file}; "
-               f"exec {sys.executable} -m wirecheck.oracles.candidates.candidate_host {cand}:f")
+        cmd = (
+            f"sleep 300 & echo $! > {pid_file}; "
+            f"exec {sys.executable} -m wirecheck.oracles.candidates.candidate_host {cand}:f"
+        )
         assert api.check_projector(cmd=["sh", "-c", cmd], **args)["verdict"] == "fail"
     else:
-        def closure(p, c):                       # run in a fork; starts a child there, once
+
+        def closure(p, c):  # run in a fork; starts a child there, once
             import subprocess
 
             if not pid_file.exists():
                 pid_file.write_text(str(subprocess.Popen(["sleep", "300"]).pid))
             return p[:, :2] * 0.0
+
         assert api.check_projector(closure, **args)["verdict"] == "fail"
     child = int(pid_file.read_text())
     assert child != os.getpid() and not process_runs(child)
+
 
 def test_the_candidate_host_loads_no_oracle_library(tmp_path):
     # The host starts once per run (per worker): what it imports is start-up time of every
@@ -259,14 +377,33 @@ def test_the_candidate_host_loads_no_oracle_library(tmp_path):
     # the modules of the process it is called in.
     seen = tmp_path / "modules.json"
     cand = tmp_path / "proj.py"
-    cand.write_text(f"import json, sys\ndef f(p, c):\n    with open({str(seen)!r}, 'w') as fh:\n"
-                    "        json.dump(sorted(sys.modules), fh)\n    return p[:, :2] * 0.0\n")
-    assert cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--cases", "on_axis", "--frames", "1",
-                     "--level", "vertices", "--report-dir", str(tmp_path / "rep")]) == 1
+    cand.write_text(
+        f"import json, sys\ndef f(p, c):\n    with open({str(seen)!r}, 'w') as fh:\n"
+        "        json.dump(sorted(sys.modules), fh)\n    return p[:, :2] * 0.0\n"
+    )
+    assert (
+        cli.main(
+            [
+                "--candidate",
+                f"{cand}:f",
+                "--scene",
+                "cube",
+                "--cases",
+                "on_axis",
+                "--frames",
+                "1",
+                "--level",
+                "vertices",
+                "--report-dir",
+                str(tmp_path / "rep"),
+            ]
+        )
+        == 1
+    )
     modules = json.loads(seen.read_text())
     heavy = ("scipy", "cv2", "pyrender", "trimesh", "matplotlib", "OpenGL")
     assert [m for m in modules if m.split(".")[0] in heavy] == []
-    assert "wirecheck.oracles.candidates.protocol" in modules and "numpy" in modules   # the host's own modules are seen
+    assert "wirecheck.oracles.candidates.protocol" in modules and "numpy" in modules  # the host's own modules are seen
 
 
 def test_a_forked_candidates_imports_write_no_bytecode_files(tmp_path, monkeypatch):
@@ -282,15 +419,16 @@ def test_a_forked_candidates_imports_write_no_bytecode_files(tmp_path, monkeypat
     def closure(p, c):
         sys.path.insert(0, str(folder))
         import fork_helper
+
         return fork_helper.g(p)
 
     assert api.check_projector(closure, scenes=["cube"], cases=["on_axis"], frames=1)["verdict"] == "fail"
-    assert "fork_helper" not in sys.modules                   # imported in the child only
+    assert "fork_helper" not in sys.modules  # imported in the child only
     assert sorted(p.name for p in folder.rglob("*")) == ["fork_helper.py"]
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("sig", ["SIGINT"])       # SIGTERM takes the same path (core.app.guard: both unwind alike)
+@pytest.mark.parametrize("sig", ["SIGINT"])  # SIGTERM takes the same path (core.app.guard: both unwind alike)
 def test_an_interrupted_run_with_workers_does_not_wait_for_hung_candidates(tmp_path, sig):
     # Both workers' candidates hang in a call (each writes its pid first); the run gets SIGINT
     # (sent to crosscheck's process only, as a CI runner's cancel does). The pool's own
@@ -302,23 +440,47 @@ def test_an_interrupted_run_with_workers_does_not_wait_for_hung_candidates(tmp_p
     called = tmp_path / "called"
     called.mkdir()
     cand = tmp_path / "hang.py"
-    cand.write_text(f"import os, time\ndef f(p, c):\n    open(os.path.join({str(called)!r}, str(os.getpid())), 'w').close()\n"
-                    "    time.sleep(600)\n")
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate", f"{cand}:f", "--scene", "cube",
-                             "--cases", "on_axis,orthographic", "--frames", "1", "--level", "vertices", "--jobs", "2",
-                             "--candidate-timeout", "60", "--report-dir", str(tmp_path / "rep")],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    cand.write_text(
+        f"import os, time\ndef f(p, c):\n    open(os.path.join({str(called)!r}, str(os.getpid())), 'w').close()\n"
+        "    time.sleep(600)\n"
+    )
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.oracles.cli",
+            "--candidate",
+            f"{cand}:f",
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis,orthographic",
+            "--frames",
+            "1",
+            "--level",
+            "vertices",
+            "--jobs",
+            "2",
+            "--candidate-timeout",
+            "60",
+            "--report-dir",
+            str(tmp_path / "rep"),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 60
     while len(list(called.iterdir())) < 2 and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.05)
     hosts = [int(p.name) for p in called.iterdir()]
-    assert len(hosts) == 2, proc.poll()                      # both workers are inside a hung call
+    assert len(hosts) == 2, proc.poll()  # both workers are inside a hung call
     t0 = time.monotonic()
     proc.send_signal(getattr(signal, sig))
     _out, err = proc.communicate(timeout=60)
     assert time.monotonic() - t0 < 20, err
     assert proc.returncode == 128 + getattr(signal, sig) and "Traceback" not in err
-    deadline = time.monotonic() + 5                          # the hosts die with their workers (SIGKILL)
+    deadline = time.monotonic() + 5  # the hosts die with their workers (SIGKILL)
     while any(process_runs(pid) for pid in hosts) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert not any(process_runs(pid) for pid in hosts)

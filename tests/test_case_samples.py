@@ -10,13 +10,17 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles.judge.case_samples import CaseSamples
 
 
 def _frame(rng, n):
-    return {"offset": rng.normal(size=n), "normal": rng.normal(size=(n, 2)), "segment": rng.integers(0, 9, n),
-            "windows": n + 3, "found": n}
+    return {
+        "offset": rng.normal(size=n),
+        "normal": rng.normal(size=(n, 2)),
+        "segment": rng.integers(0, 9, n),
+        "windows": n + 3,
+        "found": n,
+    }
 
 
 @pytest.mark.parametrize("seed", range(6))

@@ -44,20 +44,20 @@ def steps() -> list[dict]:
 
 
 def step_running(program: list[str]) -> list[str]:
-    found = [argv for s in steps() for argv in commands(s) if argv[:len(program)] == program]
+    found = [argv for s in steps() for argv in commands(s) if argv[: len(program)] == program]
     assert len(found) == 1, f"expected one step running {' '.join(program)}, found {found}"
     return found[0]
 
 
 def test_structure_triggers_python_and_set_up():
     wf = workflow()
-    on = wf.get("on", wf.get(True))            # YAML 1.1 reads a bare `on` key as True
+    on = wf.get("on", wf.get(True))  # YAML 1.1 reads a bare `on` key as True
     assert set(on) == {"push", "pull_request"}
     uses = [s["uses"].split("@")[0] for s in steps() if "uses" in s]
     assert uses == ["actions/checkout", "actions/setup-python", "actions/upload-artifact"]
     python = next(s for s in steps() if s.get("uses", "").startswith("actions/setup-python"))["with"]
     major, minor = map(int, python["python-version"].split("."))
-    assert (major, minor) >= (3, 10)           # pyproject.toml: requires-python >= 3.10
+    assert (major, minor) >= (3, 10)  # pyproject.toml: requires-python >= 3.10
     assert step_running(["sudo", "apt-get", "install"]) == ["sudo", "apt-get", "install", "-y", "libosmesa6"]
     install = step_running(["python", "-m", "pip", "install", "$WIRECHECK"])
     assert any(a.startswith("pytest") for a in install)
@@ -65,11 +65,15 @@ def test_structure_triggers_python_and_set_up():
 
 
 def _user_project(pytester, projector: str):
-    pytester.makepyfile(user_projector=(DATA / "user_projector.py").read_text()
-                        + "\n\ndef mirrored(points, camera):\n    px = project(points, camera)\n"
-                          "    px[:, 0] = (camera.width - 1) - px[:, 0]\n    return px\n")
-    pytester.makepyprojecttoml(f'[tool.wirecheck]\ncandidate = "user_projector.py:{projector}"\n'
-                               'scenes = ["cube"]\ncases = ["on_axis", "orthographic"]\nframes = 2\n')
+    pytester.makepyfile(
+        user_projector=(DATA / "user_projector.py").read_text()
+        + "\n\ndef mirrored(points, camera):\n    px = project(points, camera)\n"
+        "    px[:, 0] = (camera.width - 1) - px[:, 0]\n    return px\n"
+    )
+    pytester.makepyprojecttoml(
+        f'[tool.wirecheck]\ncandidate = "user_projector.py:{projector}"\n'
+        'scenes = ["cube"]\ncases = ["on_axis", "orthographic"]\nframes = 2\n'
+    )
     pytester.makepyfile(test_user="def test_projector(wirecheck):\n    wirecheck()\n")
     pytester.syspathinsert()
 
@@ -85,7 +89,7 @@ def test_the_steps_commands_run_and_write_what_the_upload_keeps(pytester, projec
     run_crosscheck = step_running(["crosscheck"])
     assert cli.main(run_crosscheck[1:]) == code
     junit = ET.parse(pytester.path / run_crosscheck[run_crosscheck.index("--junit-xml") + 1]).getroot()
-    assert (junit.get("tests"), junit.get("failures")) == ("2", "0" if code == 0 else "2")   # cube x 2 cameras
+    assert (junit.get("tests"), junit.get("failures")) == ("2", "0" if code == 0 else "2")  # cube x 2 cameras
     upload = next(s for s in steps() if s.get("uses", "").startswith("actions/upload-artifact"))
     kept = [p for p in upload["with"]["path"].split() if p]
     written = [p for p in kept if (pytester.path / p).exists()]

@@ -6,7 +6,6 @@ import subprocess
 import sys
 
 import pytest
-
 from wirecheck.core.app.cli import build_parser as renderer_parser
 from wirecheck.core.app.cli_help import CROSSCHECK_EXAMPLES, RENDERER_EXAMPLES, usage_hint
 from wirecheck.oracles.cli import build_parser as crosscheck_parser
@@ -23,16 +22,18 @@ def _example_commands(text, program):
     return out
 
 
-@pytest.mark.parametrize("program, text, parser", [("renderer", RENDERER_EXAMPLES, renderer_parser),
-                                                   ("crosscheck", CROSSCHECK_EXAMPLES, crosscheck_parser)])
+@pytest.mark.parametrize(
+    "program, text, parser",
+    [("renderer", RENDERER_EXAMPLES, renderer_parser), ("crosscheck", CROSSCHECK_EXAMPLES, crosscheck_parser)],
+)
 def test_every_example_parses(program, text, parser, capsys):
     commands = _example_commands(text, program)
     assert len(commands) >= 6
     for command in commands:
         argv = shlex.split(command)[1:]
-        if argv[:1] == ["export"]:          # crosscheck's export subcommand has its own parser
+        if argv[:1] == ["export"]:  # crosscheck's export subcommand has its own parser
             continue
-        parser().parse_args(argv)           # a usage error would SystemExit(2) here
+        parser().parse_args(argv)  # a usage error would SystemExit(2) here
     assert text.splitlines()[0] == "examples:"
     assert parser().format_help().rstrip().endswith(text.splitlines()[-1])
 
@@ -40,17 +41,21 @@ def test_every_example_parses(program, text, parser, capsys):
 def test_a_negative_value_without_equals_gets_the_hint():
     assert usage_hint("argument --distortion: expected one argument") == (
         "argument --distortion: expected one argument (a value starting with '-' is given with '=': "
-        "--distortion=-0.2,...)")
+        "--distortion=-0.2,...)"
+    )
     assert usage_hint("argument --fov: invalid float value: 'x'") == "argument --fov: invalid float value: 'x'"
 
 
 def test_renderer_says_so_in_one_line():
     # a value starting with '-' that is no number is still argparse's to refuse
-    done = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--out", "-x"],
-                          capture_output=True, text=True, timeout=60)
+    done = subprocess.run(
+        [sys.executable, "-m", "wirecheck.core.app.cli", "--out", "-x"], capture_output=True, text=True, timeout=60
+    )
     assert done.returncode == 2
-    assert done.stderr.splitlines() == ["renderer: error: argument --out: expected one argument (a value "
-                                        "starting with '-' is given with '=': --out=-0.2,...)"]
+    assert done.stderr.splitlines() == [
+        "renderer: error: argument --out: expected one argument (a value "
+        "starting with '-' is given with '=': --out=-0.2,...)"
+    ]
 
 
 def test_a_negative_number_needs_no_equals():

@@ -10,7 +10,6 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-
 from wirecheck.core.camera import camera_z
 from wirecheck.core.projector.clipping import apply_clip, clip_segments, frustum_planes
 from wirecheck.core.projector.pipeline import render_frame
@@ -37,7 +36,7 @@ def world(p_cam):
 
 def render(p_cam, edges, camera=None, clip_mode="clip"):
     camera = camera or cam()
-    with np.errstate(all="raise"):   # any overflow / invalid op outside clip_segments raises
+    with np.errstate(all="raise"):  # any overflow / invalid op outside clip_segments raises
         return render_frame(world(p_cam), np.asarray(edges, dtype=np.intp).reshape(-1, 2), camera, np.eye(4), clip_mode)
 
 
@@ -99,8 +98,8 @@ def test_case5_disjoint_pieces_dropped():
 
 
 def test_point_on_plane_is_inside():
-    assert clip1([0, 0, 1], [5, 0, 1]) == (True, 0.0, 1.0)      # lying on the plane: drawn
-    assert clip1([0, 0, 1], [0, 0, 2]) == (True, 0.0, 1.0)      # one end on it
+    assert clip1([0, 0, 1], [5, 0, 1]) == (True, 0.0, 1.0)  # lying on the plane: drawn
+    assert clip1([0, 0, 1], [0, 0, 2]) == (True, 0.0, 1.0)  # one end on it
 
 
 def test_nan_segment_dropped():
@@ -108,8 +107,9 @@ def test_nan_segment_dropped():
 
 
 def test_vectorised_cases_together():
-    segs = np.array([[[0, 0, 2], [0, 0, 3]], [[0, 0, 0], [0, 0, -1]], [[0, 0, 0], [0, 0, 2]], [[0, 0, 2], [0, 0, 0]]],
-                    dtype=float)
+    segs = np.array(
+        [[[0, 0, 2], [0, 0, 3]], [[0, 0, 0], [0, 0, -1]], [[0, 0, 0], [0, 0, 2]], [[0, 0, 2], [0, 0, 0]]], dtype=float
+    )
     kept, t0, t1 = clip_segments(segs, Z_GE_1)
     assert_array_equal(kept, [True, False, True, True])
     out = apply_clip(segs, kept, t0, t1)
@@ -118,6 +118,7 @@ def test_vectorised_cases_together():
 
 # ---- frustum planes ----------------------------------------------------------------
 
+
 @pytest.mark.parametrize("projection", ["perspective", "orthographic"])
 @pytest.mark.parametrize("guard", [0.0, 3.0])
 def test_side_planes_pass_through_image_border(projection, guard):
@@ -125,7 +126,7 @@ def test_side_planes_pass_through_image_border(projection, guard):
     planes = frustum_planes(c, guard_px=guard)
     assert_array_equal(planes[:2], [[0, 0, 1, -1.0], [0, 0, -1, 100.0]])
     z = 7.0
-    s = F / z if projection == "perspective" else H / 4.0     # pixels per camera unit at depth z
+    s = F / z if projection == "perspective" else H / 4.0  # pixels per camera unit at depth z
     g = guard
     # border points (x_px, y_px) -> camera (x, y, z) with x = (x_px - cx)/s, y = (cy - y_px)/s
     border = {2: (-0.5 - g, CY), 3: (W - 0.5 + g, CY), 4: (CX, -0.5 - g), 5: (CX, H - 0.5 + g)}
@@ -140,6 +141,7 @@ def test_side_planes_pass_through_image_border(projection, guard):
 
 
 # ---- near plane --------------------------------------------------------------------
+
 
 def test_near_crossing_edge_clipped_exactly_at_near():
     c = cam()
@@ -177,7 +179,7 @@ def test_near_crossing_edge_drawn_up_to_near_plane():
 
 def test_point_exactly_on_near_plane_is_visible_and_edge_on_near_plane_is_drawn():
     fr = render(EDGE_ON_NEAR, [[0, 1]])
-    assert_array_equal(fr.depth, [1.0, 1.0])           # 10 - 9 = 1 exactly
+    assert_array_equal(fr.depth, [1.0, 1.0])  # 10 - 9 = 1 exactly
     assert fr.visible.all()
     # x: 319.5 - 240*0.301 = 247.26 ... 319.5 + 240*0.401 = 415.74; y: 239.5 + 16.8 = 256.3
     assert_allclose(fr.p_px, [[247.26, 256.3], [415.74, 256.3]], rtol=0, atol=8 * EPS * 416)
@@ -200,9 +202,9 @@ def test_clip_modes_endpoint_drops_edge_clip_keeps_part():
     edges = [[0, 1], [2, 3]]
     clip = render(p, edges, clip_mode="clip")
     endpoint = render(p, edges, clip_mode="endpoint")
-    crossing = raster_image([((328.3, 233.9), (345.9, 222.7))])   # see test above
+    crossing = raster_image([((328.3, 233.9), (345.9, 222.7))])  # see test above
     on_near = raster_image([((247.26, 256.3), (415.74, 256.3))])
-    assert np.count_nonzero(crossing) >= 17      # the run 328..346 less at most both ends
+    assert np.count_nonzero(crossing) >= 17  # the run 328..346 less at most both ends
     # clip: both edges (disjoint rows: 223..234 and 256); endpoint: only the one with both ends visible
     assert np.count_nonzero(clip.image) == np.count_nonzero(crossing) + np.count_nonzero(on_near)
     assert np.count_nonzero(endpoint.image) == np.count_nonzero(on_near)
@@ -213,6 +215,7 @@ def test_clip_modes_endpoint_drops_edge_clip_keeps_part():
 
 
 # ---- behind the camera ---------------------------------------------------------------
+
 
 def test_camera_inside_cube_no_inf_nan_pixels_only_expected_ones():
     """camera_z(0.5), fov 70: the z = -1 face is 1.5 in front, the z = +1 face 0.5 behind."""
@@ -233,8 +236,16 @@ def test_camera_inside_cube_no_inf_nan_pixels_only_expected_ones():
     # The edges along z run from each corner away from the centre at 45 degrees in
     # pixels (|x_cam| = |y_cam|, so x_px - cx = +-(y_px - cy)) and are cut by rows
     # y = -0.5 / 479.5 (H < W), at x = cx +- (cy + 0.5) = 559.5 / 79.5.
-    segs = [((L, T), (R, T)), ((R, T), (R, B)), ((R, B), (L, B)), ((L, B), (L, T)),
-            ((R, T), (559.5, -0.5)), ((L, T), (79.5, -0.5)), ((R, B), (559.5, 479.5)), ((L, B), (79.5, 479.5))]
+    segs = [
+        ((L, T), (R, T)),
+        ((R, T), (R, B)),
+        ((R, B), (L, B)),
+        ((L, B), (L, T)),
+        ((R, T), (559.5, -0.5)),
+        ((L, T), (79.5, -0.5)),
+        ((R, B), (559.5, 479.5)),
+        ((L, B), (79.5, 479.5)),
+    ]
     assert_array_equal(fr.image, raster_image(segs))
     # rule-independent: the square's sides are drawn between the corners' pixels
     assert fr.image[11, 92:548].all() and fr.image[468, 92:548].all()
@@ -287,7 +298,7 @@ def test_huge_segment_renders_one_row_to_right_border():
     fr = render([[0.0, 0.3, 5.0], [1e12, 0.3, 5.0]], [[0, 1]])
     assert_array_equal(fr.image, raster_image([((319.5, 225.1), (639.5, 225.1))]))
     assert fr.image[225, 320:639].all() and np.count_nonzero(fr.image) == np.count_nonzero(fr.image[225])
-    assert fr.visible.all()                     # far off-image but within near..far
+    assert fr.visible.all()  # far off-image but within near..far
     assert_allclose(fr.p_px[1, 0], CX + F * 1e12 / 5, rtol=4 * EPS)
 
 
@@ -306,7 +317,7 @@ def test_huge_diagonal_renders_within_bounds():
 def test_segment_entirely_outside_one_side_draws_nothing():
     fr = render([[1e12, 0.3, 5.0], [1e12, -0.3, 6.0], [0.0, 0.0, -5.0], [0.1, 0.1, -1e12]], [[0, 1], [2, 3]])
     assert not fr.image.any()
-    assert fr.visible_vertices == 2     # the first two are in [near, far], just off-image
+    assert fr.visible_vertices == 2  # the first two are in [near, far], just off-image
 
 
 def test_far_plane_clips():
@@ -321,7 +332,7 @@ def test_far_plane_clips():
     fr = render(seg[0], [[0, 1]])
     assert fr.clipped_edges == 1
     assert_array_equal(fr.image, raster_image([((331.5, 227.5), (319.74, 239.26))]))
-    assert np.count_nonzero(fr.image) >= 11     # |331.5 - 319.74| ~ 11.8 px along x
+    assert np.count_nonzero(fr.image) >= 11  # |331.5 - 319.74| ~ 11.8 px along x
 
 
 # ---- precision of the clipped ends at extreme coordinates ------------------------------
@@ -351,19 +362,23 @@ def test_clipped_ends_never_have_nonpositive_depth(p0, p1):
     kept, t0, t1 = clip_segments(seg, frustum_planes(c))
     ends = apply_clip(seg, kept, t0, t1, (c.near, c.far)).reshape(-1, 3)
     assert np.all(ends[:, 2] > 0), ends
-    with np.errstate(all="raise"):       # cam_to_px must never divide by z <= 0
+    with np.errstate(all="raise"):  # cam_to_px must never divide by z <= 0
         fr = render_frame(world([p0, p1]), np.array([[0, 1]]), c, np.eye(4))
     assert np.all(np.isfinite(fr.p_px[fr.visible]))
 
 
 # ---- the last guard: clip_to_image --------------------------------------------------
 
-@pytest.mark.parametrize("p1, want", [
-    ((10.0, 100.0), (10.0, 29.5)),      # down: stops at the bottom edge, y = H - 1/2
-    ((10.0, -100.0), (10.0, -0.5)),     # up: the top edge, y = -1/2
-    ((100.0, 5.0), (19.5, 5.0)),        # right: x = W - 1/2
-    ((-100.0, 5.0), (-0.5, 5.0)),       # left: x = -1/2
-])
+
+@pytest.mark.parametrize(
+    "p1, want",
+    [
+        ((10.0, 100.0), (10.0, 29.5)),  # down: stops at the bottom edge, y = H - 1/2
+        ((10.0, -100.0), (10.0, -0.5)),  # up: the top edge, y = -1/2
+        ((100.0, 5.0), (19.5, 5.0)),  # right: x = W - 1/2
+        ((-100.0, 5.0), (-0.5, 5.0)),  # left: x = -1/2
+    ],
+)
 def test_clip_to_image_stops_at_each_image_edge(p1, want):
     from wirecheck.core.projector.clipping import clip_to_image
 
@@ -371,7 +386,7 @@ def test_clip_to_image_stops_at_each_image_edge(p1, want):
     kept, q0, q1 = clip_to_image(np.array([[10.0, 5.0]]), np.array([p1]), 20, 30)
     assert kept.tolist() == [True]
     assert_array_equal(q0, [[10.0, 5.0]])
-    assert_allclose(q1, [want], rtol=0, atol=1e-12)      # t = (edge - 5) / 95 etc.: one rounding of ~100
+    assert_allclose(q1, [want], rtol=0, atol=1e-12)  # t = (edge - 5) / 95 etc.: one rounding of ~100
 
 
 def test_clip_to_image_moves_a_start_outside_onto_the_edge():

@@ -14,7 +14,6 @@ import subprocess
 import sys
 
 import pytest
-
 from wirecheck.core.app import cli as renderer_cli
 from wirecheck.core.outputs.owned import MARKER, foreign, sha256
 from wirecheck.core.outputs.staging import JOURNAL, LOCK, MANIFEST
@@ -60,7 +59,7 @@ def test_renderer_commit_killed_after_every_rename(tmp_path):
     (out / "notes.txt").write_text("the user's")
     inconsistent = 0
     for k in range(1, RENDERER_RENAMES + 2):
-        old, frames = frames, 5 - frames              # 3 frames, then 2, then 3, ...: each run changes the set
+        old, frames = frames, 5 - frames  # 3 frames, then 2, then 3, ...: each run changes the set
         killed = _run([*RENDER, "--frames", str(frames), "--out", str(out)], kill_at=k)
         if k <= RENDERER_RENAMES:
             assert killed.returncode == -signal.SIGKILL, (k, killed.stderr)
@@ -68,7 +67,7 @@ def test_renderer_commit_killed_after_every_rename(tmp_path):
             # the old set, the new one, or a journal the next run finishes
             assert state in ((old, old, True), (frames, frames, True), "journal"), (k, state)
         else:
-            assert killed.returncode == 0, killed.stderr        # k past the last rename: the commit is whole
+            assert killed.returncode == 0, killed.stderr  # k past the last rename: the commit is whole
         assert (out / "notes.txt").read_text() == "the user's"
         assert _render(frames, out) == 0, k
         inconsistent += _renderer_set(out) != (frames, frames, True)
@@ -79,8 +78,9 @@ def test_renderer_commit_killed_after_every_rename(tmp_path):
 
 
 def _tree(folder):
-    return sorted((str(p.relative_to(folder)), p.is_file() and p.read_bytes()) for p in folder.rglob("*")
-                  if p.name != MARKER)
+    return sorted(
+        (str(p.relative_to(folder)), p.is_file() and p.read_bytes()) for p in folder.rglob("*") if p.name != MARKER
+    )
 
 
 @pytest.mark.parametrize("command", ["report", "export"])
@@ -95,14 +95,14 @@ def test_report_and_job_commit_killed_at_its_one_rename(tmp_path, capsys, comman
     assert crosscheck_cli.main([*args, "--frames", "1"]) == 0
     killed = _run([sys.executable, "-m", "wirecheck.oracles.cli", *args, "--frames", "2"], kill_at=1)
     assert killed.returncode == -signal.SIGKILL, killed.stderr
-    assert foreign(target) is None                    # a whole folder of ours in place
+    assert foreign(target) is None  # a whole folder of ours in place
     leftover = [n for n in os.listdir(tmp_path) if n != "t"]
-    assert len(leftover) == 2                         # the old folder and the lock file, both hidden
+    assert len(leftover) == 2  # the old folder and the lock file, both hidden
     after_kill = _tree(target)
     assert crosscheck_cli.main([*args, "--frames", "2"]) == 0, capsys.readouterr().err
-    assert os.listdir(tmp_path) == ["t"]              # the killed run's temporaries removed
+    assert os.listdir(tmp_path) == ["t"]  # the killed run's temporaries removed
     if command == "export":
-        assert _tree(target) == after_kill            # the killed run had put the new job in place whole
+        assert _tree(target) == after_kill  # the killed run had put the new job in place whole
 
 
 # Renames of a report folder's or an export job's commit, counted by hand from core/outputs/output.py
@@ -132,7 +132,7 @@ def test_crosscheck_and_export_killed_after_every_rename(tmp_path, capsys, comma
             assert killed.returncode == -signal.SIGKILL, (k, killed.stderr)
         else:
             assert killed.returncode == 0, killed.stderr
-        assert foreign(target) is None                          # the old folder or the new one, whole
+        assert foreign(target) is None  # the old folder or the new one, whole
         capsys.readouterr()
         assert crosscheck_cli.main([*args, "--frames", "3"]) == 0, (k, capsys.readouterr().err)
         assert foreign(target) is None
@@ -145,5 +145,5 @@ def test_crosscheck_and_export_killed_after_every_rename(tmp_path, capsys, comma
         if not earlier:
             for entry in os.listdir(tmp_path):
                 if entry == "t":
-                    os.rename(tmp_path / "t", tmp_path / f"gone{k}")   # the next try starts without a folder
+                    os.rename(tmp_path / "t", tmp_path / f"gone{k}")  # the next try starts without a folder
                     os.rename(tmp_path / f"gone{k}", tmp_path / ".." / f"{tmp_path.name}-gone{k}")

@@ -16,7 +16,6 @@ import sys
 import time
 
 import pytest
-
 from wirecheck.core.app import cli as renderer_cli
 from wirecheck.core.outputs import owned
 from wirecheck.core.outputs.owned import MARKER
@@ -35,8 +34,12 @@ def _env(**extra):
 
 def _paused_run(cmd, step, pause_file, act):
     """Run ``cmd`` paused at commit step ``step``; ``act()`` while it waits. Whether it paused, rc, stderr."""
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            env=_env(WIRECHECK_PAUSE_AT_STEP=str(step), WIRECHECK_PAUSE_FILE=str(pause_file)))
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        env=_env(WIRECHECK_PAUSE_AT_STEP=str(step), WIRECHECK_PAUSE_FILE=str(pause_file)),
+    )
     paused = False
     deadline = time.monotonic() + 120
     while proc.poll() is None and time.monotonic() < deadline:
@@ -74,32 +77,34 @@ def test_renderer_note_written_at_every_step_of_the_commit_is_kept(tmp_path):
     steps, outcomes = 0, {}
     for step in range(1, RENDERER_STEPS + 3):
         assert subprocess.run([*cmd, "--frames", "2"], env=_env(), capture_output=True).returncode == 0
-        paused, rc, err = _paused_run([*cmd, "--frames", "3"], step, tmp_path / "pause", lambda: _write_note(frames_dir))
+        paused, rc, err = _paused_run(
+            [*cmd, "--frames", "3"], step, tmp_path / "pause", lambda: _write_note(frames_dir)
+        )
         if not paused:
-            assert rc == 0, err                    # past the last step: a plain run
+            assert rc == 0, err  # past the last step: a plain run
             break
         steps += 1
-        assert (frames_dir / "note.txt").read_bytes() == NOTE, (step, err)     # never removed, where it was put
+        assert (frames_dir / "note.txt").read_bytes() == NOTE, (step, err)  # never removed, where it was put
         if rc == 2:
             _assert_one_line(err)
             assert "note.txt" in err or "appeared" in err, err
         else:
-            assert rc == 0 and err == "", (step, err)     # written into the new folder: nothing to remove
-        if os.path.exists(out / JOURNAL):         # the folder was put where the new one goes: the commit waits
+            assert rc == 0 and err == "", (step, err)  # written into the new folder: nothing to remove
+        if os.path.exists(out / JOURNAL):  # the folder was put where the new one goes: the commit waits
             assert rc == 2 and "appeared" in err, err
             os.rename(frames_dir, tmp_path / "moved-away")
             assert subprocess.run([*cmd, "--frames", "3"], env=_env(), capture_output=True).returncode == 0
             assert (tmp_path / "moved-away" / "note.txt").read_bytes() == NOTE
         else:
             pngs = sorted(n for n in os.listdir(frames_dir) if n.endswith(".png"))
-            assert pngs == ["frame_0001.png", "frame_0002.png", "frame_0003.png"], (step, pngs)   # the new set
-            os.unlink(frames_dir / "note.txt")        # the user moves it away; the next step starts clean
+            assert pngs == ["frame_0001.png", "frame_0002.png", "frame_0003.png"], (step, pngs)  # the new set
+            os.unlink(frames_dir / "note.txt")  # the user moves it away; the next step starts clean
         outcomes[step] = rc
         assert sorted(n for n in os.listdir(out) if n.endswith(".tmp") or n in (LOCK, JOURNAL)) == [], step
     assert steps == RENDERER_STEPS, outcomes
     # written into the old folder (after the check, before the swap): kept in the new one, said, exit 2
     assert outcomes[1] == outcomes[2] == 2, outcomes
-    assert outcomes[RENDERER_STEPS] == 0, outcomes          # written into the new folder: nothing to say
+    assert outcomes[RENDERER_STEPS] == 0, outcomes  # written into the new folder: nothing to say
 
 
 @pytest.mark.slow
@@ -112,7 +117,7 @@ def test_report_and_job_note_written_at_every_step_is_kept(tmp_path, command):
         args = ["export", str(target), "--scene", "cube", "--cases", "on_axis"]
     cmd = [sys.executable, "-m", "wirecheck.oracles.cli", *args]
     outcomes = {}
-    for step in (1, 2, 3):              # the check (1), the exchange (2); 3: past the last step
+    for step in (1, 2, 3):  # the check (1), the exchange (2); 3: past the last step
         assert subprocess.run([*cmd, "--frames", "1"], env=_env(), capture_output=True).returncode == 0
         paused, rc, err = _paused_run([*cmd, "--frames", "2"], step, tmp_path / "pause", lambda: _write_note(target))
         if not paused:
@@ -122,10 +127,10 @@ def test_report_and_job_note_written_at_every_step_is_kept(tmp_path, command):
         if rc == 2:
             _assert_one_line(err)
             assert "note.txt" in err and "kept" in err, err
-        assert owned.listing(target) is not None and "note.txt" not in owned.listing(target)[0]   # the new folder
+        assert owned.listing(target) is not None and "note.txt" not in owned.listing(target)[0]  # the new folder
         outcomes[step] = rc
         os.unlink(target / "note.txt")
-        assert sorted(os.listdir(tmp_path)) == ["t"], os.listdir(tmp_path)       # no temporaries, no lock
+        assert sorted(os.listdir(tmp_path)) == ["t"], os.listdir(tmp_path)  # no temporaries, no lock
     assert outcomes == {1: 2, 2: 0}
 
 
@@ -136,7 +141,7 @@ def test_note_written_while_the_frames_are_hashed_is_kept(tmp_path, capsys, monk
     seal = owned.seal
 
     def seal_and_write(folder):
-        _write_note(out / "cube-frames")           # the user, while wirecheck hashes its new frames
+        _write_note(out / "cube-frames")  # the user, while wirecheck hashes its new frames
         seal(folder)
 
     monkeypatch.setattr(owned, "seal", seal_and_write)
@@ -145,7 +150,7 @@ def test_note_written_while_the_frames_are_hashed_is_kept(tmp_path, capsys, monk
     err = capsys.readouterr().err
     assert (out / "cube-frames" / "note.txt").read_bytes() == NOTE
     assert rc == 2 and err.count("\n") == 1 and "note.txt" in err and "kept" in err, err
-    assert (out / "cube-frames" / "frame_0003.png").is_file()        # the new set is in place, whole
+    assert (out / "cube-frames" / "frame_0003.png").is_file()  # the new set is in place, whole
     assert owned.foreign(out / "cube-frames") == "note.txt (a file not written by wirecheck)"
 
 
@@ -164,14 +169,24 @@ def test_frame_edited_during_the_commit_is_kept_beside_the_new_one(tmp_path, cap
     err = capsys.readouterr().err
     assert rc == 2 and "frame_0001.png.kept" in err, err
     assert (out / "cube-frames" / "frame_0001.png.kept").read_bytes() == b"edited by the user"
-    assert (out / "cube-frames" / "frame_0001.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"   # the new frame
+    assert (out / "cube-frames" / "frame_0001.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"  # the new frame
 
 
 @pytest.mark.slow
 def test_report_note_written_while_sealing_is_kept(tmp_path, capsys, monkeypatch):
     target = tmp_path / "r"
-    args = ["--report-dir", str(target), "--scene", "cube", "--cases", "on_axis", "--oracles", "opencv",
-            "--frames", "1"]
+    args = [
+        "--report-dir",
+        str(target),
+        "--scene",
+        "cube",
+        "--cases",
+        "on_axis",
+        "--oracles",
+        "opencv",
+        "--frames",
+        "1",
+    ]
     assert crosscheck_cli.main(args) == 0
     seal = owned.seal
 

@@ -10,15 +10,14 @@ import math
 
 import numpy as np
 import pytest
-from PIL import Image
-
-from wirecheck.core.app.compare import crossings
 from helpers import run_renderer as run
+from PIL import Image
+from wirecheck.core.app.compare import crossings
 
 
 def test_crossings_are_run_centres():
     img = np.zeros((3, 12), np.uint8)
-    img[1, [1, 2, 5, 9, 10, 11]] = 255          # runs [1,2], [5], [9,11]
+    img[1, [1, 2, 5, 9, 10, 11]] = 255  # runs [1,2], [5], [9,11]
     assert crossings(img, 1) == [1.5, 5.0, 10.0]
     assert crossings(img, 0) == []
 
@@ -43,7 +42,7 @@ def test_widths_ratios_and_compression_against_the_formulas(compared):
         # each crossing is a drawn pixel within 0.5 px of the true line: widths within 1 px
         assert abs(m["front_width_px"] - w_front) <= 1.0
         assert abs(m["back_width_px"] - w_back) <= 1.0
-        ratio = (d + 1) / (d - 1)                     # 2 at D = 3, 1.4 at D = 6
+        ratio = (d + 1) / (d - 1)  # 2 at D = 3, 1.4 at D = 6
         assert v["predicted"]["ratio"] == pytest.approx(ratio)
         # error propagation of the 1-px bound through wf / wb
         assert abs(m["ratio"] - ratio) <= (1 + ratio) / (w_back - 1)
@@ -57,7 +56,7 @@ def test_widths_ratios_and_compression_against_the_formulas(compared):
 def test_picture_and_text(compared):
     out, stdout, _ = compared
     img = np.asarray(Image.open(out / "cube-compare.png"))
-    assert img.shape == (2 * 480 + 1, 2 * 640 + 1)               # 2x2 panels, 1-px grey separators
+    assert img.shape == (2 * 480 + 1, 2 * 640 + 1)  # 2x2 panels, 1-px grey separators
     assert (img[480] == 128).all() and (img[:, 640] == 128).all()
     # the top-left panel (D = 3, FOV 60) has the largest cube: more drawn pixels than the bottom-right
     assert (img[:480, :640] >= 128).sum() > 2 * (img[481:, 641:] >= 128).sum()
@@ -65,22 +64,28 @@ def test_picture_and_text(compared):
     assert (out / "cube-compare.txt").read_text() == stdout.split("Picture:")[0]
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["--compare", "--compare-z", "3"], "--compare-z '3': expected two numbers"),
-    (["--compare", "--compare-z", "0.5,6"], "--compare-z 0.5: the scene's front (z = 1)"),
-    (["--compare", "--compare-fov", "60,180"], "--compare-fov '60,180'"),
-    (["--compare", "--compare-z", "nan,3"], "--compare-z 'nan,3'"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--compare", "--compare-z", "3"], "--compare-z '3': expected two numbers"),
+        (["--compare", "--compare-z", "0.5,6"], "--compare-z 0.5: the scene's front (z = 1)"),
+        (["--compare", "--compare-fov", "60,180"], "--compare-fov '60,180'"),
+        (["--compare", "--compare-z", "nan,3"], "--compare-z 'nan,3'"),
+    ],
+)
 def test_bad_compare_input(tmp_path, args, needle):
     rc, _, err = run(args, tmp_path)
     assert rc == 2 and needle in err and err.count("\n") == 1
     assert not (tmp_path / "cube-compare.png").exists()
 
 
-@pytest.mark.parametrize("verts, what", [
-    ("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n", "flat in z"),     # no depth: front width = back width
-    ("v 0 -1 -1\nv 0 1 -1\nv 0 1 1\nv 0 -1 1\n", "flat in x"),     # no width: nothing to measure
-])
+@pytest.mark.parametrize(
+    "verts, what",
+    [
+        ("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n", "flat in z"),  # no depth: front width = back width
+        ("v 0 -1 -1\nv 0 1 -1\nv 0 1 1\nv 0 -1 1\n", "flat in x"),  # no width: nothing to measure
+    ],
+)
 def test_compare_on_a_scene_without_width_or_depth_is_one_error_line(tmp_path, verts, what):
     # Found by the renderer fuzz: such a scene divided by zero (exit 3) in the predicted widths.
     mesh = tmp_path / "flat.obj"

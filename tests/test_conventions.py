@@ -11,7 +11,6 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.conventions import PIXEL_CENTRE_OFFSET, focal_px, principal_point
 from wirecheck.core.projector.projection import project_points, world_to_cam
@@ -42,9 +41,10 @@ def cam(D=4.0, **kw):
 
 # ---- screen orientation ------------------------------------------------------
 
+
 def test_plus_x_shows_on_the_right():
     c = cam()
-    (x, y), = project_points([[1.0, 0.0, 0.0]], c)
+    ((x, y),) = project_points([[1.0, 0.0, 0.0]], c)
     # p_cam = (1, 0, 4): x_px = cx + f/4 (> cx), y_px = cy.
     assert x > CX
     assert_allclose([x, y], [CX + F / 4.0, CY], rtol=0, atol=PX_TOL)
@@ -52,7 +52,7 @@ def test_plus_x_shows_on_the_right():
 
 def test_plus_y_shows_up():
     c = cam()
-    (x, y), = project_points([[0.0, 1.0, 0.0]], c)
+    ((x, y),) = project_points([[0.0, 1.0, 0.0]], c)
     # p_cam = (0, 1, 4): y_px = cy - f/4 (< cy: pixel rows grow downward).
     assert y < CY
     assert_allclose([x, y], [CX, CY - F / 4.0], rtol=0, atol=PX_TOL)
@@ -71,8 +71,8 @@ def test_right_is_forward_cross_up_looking_down_plus_z():
     c = look_at((0, 0, 0), (0, 0, 1), (0, 1, 0))
     assert_array_equal(c.right, [-1.0, 0.0, 0.0])
     # so a world point at +X shows on the LEFT of this camera
-    (x, _), = project_points([[1.0, 0.0, 5.0]], c)
-    assert x < CX              # look_at's defaults are 640 x 480 too
+    ((x, _),) = project_points([[1.0, 0.0, 5.0]], c)
+    assert x < CX  # look_at's defaults are 640 x 480 too
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -98,6 +98,7 @@ def test_world_to_cam_rows_are_right_up_forward():
 
 # ---- depth -------------------------------------------------------------------
 
+
 def test_depth_positive_in_front_negative_behind():
     c = cam(D=4.0, near=0.1)
     p_cam = world_to_cam(np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 5.0]]), c)
@@ -109,6 +110,7 @@ def test_depth_positive_in_front_negative_behind():
 
 
 # ---- pixel centres -------------------------------------------------------------
+
 
 @pytest.mark.parametrize("w,h,expected", [(640, 480, (319.5, 239.5)), (5, 3, (2.0, 1.0)), (1, 1, (0.0, 0.0))])
 def test_principal_point_is_image_centre_in_pixel_centre_coordinates(w, h, expected):
@@ -132,6 +134,7 @@ def test_gl_pixel_centre_offset_is_half():
 
 # ---- field of view -------------------------------------------------------------
 
+
 def test_focal_length_formula():
     # f = (H/2)/tan(fov/2); fov 90 -> f = 240 / tan(45 deg) = 240 (tan(pi/4) is
     # 1 - 1.1e-16 in float64, so f = 240 * (1 + 1.1e-16): tolerance 2 ulp of 240)
@@ -144,14 +147,13 @@ def test_focal_length_formula():
 @pytest.mark.parametrize("w,h", [(640, 480), (320, 240), (100, 300)])
 def test_vertical_fov_is_edge_to_edge(fov, w, h):
     c = cam(D=10.0, fov_y_deg=fov, width=w, height=h, far=1000.0)
-    z = 5.0                                  # depth of the test points
+    z = 5.0  # depth of the test points
     ty = math.tan(math.radians(fov) / 2.0)
-    tx = (w / h) * ty                        # horizontal half-FOV tangent
+    tx = (w / h) * ty  # horizontal half-FOV tangent
     # world z = D - z_cam. Top edge of the vertical FOV: y/z = tan(fov/2) ->
     # y_px = cy - f*ty = (H-1)/2 - H/2 = -0.5 (top edge of row 0).
     # Bottom: H - 0.5. Right: x/z = (W/H) ty -> x_px = (W-1)/2 + W/2 = W - 0.5.
-    pts = [[0.0, z * ty, 10.0 - z], [0.0, -z * ty, 10.0 - z],
-           [z * tx, 0.0, 10.0 - z], [-z * tx, 0.0, 10.0 - z]]
+    pts = [[0.0, z * ty, 10.0 - z], [0.0, -z * ty, 10.0 - z], [z * tx, 0.0, 10.0 - z], [-z * tx, 0.0, 10.0 - z]]
     px = project_points(pts, c)
     cx, cy = (w - 1) / 2, (h - 1) / 2
     expected = [[cx, -0.5], [cx, h - 0.5], [w - 0.5, cy], [-0.5, cy]]
@@ -160,13 +162,17 @@ def test_vertical_fov_is_edge_to_edge(fov, w, h):
 
 # ---- rotations and matrix order ----------------------------------------------
 
+
 # |cos(pi/2)| in float64 is 6.1e-17 < EPS: a 90-degree rotation of a unit
 # vector is exact up to EPS per component.
-@pytest.mark.parametrize("rot,src,dst", [
-    (rotate_z, [1, 0, 0], [0, 1, 0]),   # +X -> +Y
-    (rotate_x, [0, 1, 0], [0, 0, 1]),   # +Y -> +Z
-    (rotate_y, [0, 0, 1], [1, 0, 0]),   # +Z -> +X
-])
+@pytest.mark.parametrize(
+    "rot,src,dst",
+    [
+        (rotate_z, [1, 0, 0], [0, 1, 0]),  # +X -> +Y
+        (rotate_x, [0, 1, 0], [0, 0, 1]),  # +Y -> +Z
+        (rotate_y, [0, 0, 1], [1, 0, 0]),  # +Z -> +X
+    ],
+)
 def test_rotations_are_right_handed(rot, src, dst):
     assert_allclose(apply(rot(math.pi / 2), [src])[0], dst, rtol=0, atol=EPS)
 
@@ -175,7 +181,7 @@ def test_rotate_z_90_shows_counter_clockwise_on_screen():
     # camera_z looks down -Z, so +Z points at the viewer: rotate_z(90) turns the
     # point (1,0,0) (right of centre) to (0,1,0) (above centre) on screen.
     c = cam(D=4.0)
-    (x, y), = project_points(apply(rotate_z(math.pi / 2), [[1.0, 0.0, 0.0]]), c)
+    ((x, y),) = project_points(apply(rotate_z(math.pi / 2), [[1.0, 0.0, 0.0]]), c)
     # x_cam = cos(pi/2) = 6e-17: x_px - cx = f * 6e-17 / 4 ~ 5e-15
     assert_allclose([x, y], [CX, CY - F / 4.0], rtol=0, atol=PX_TOL)
 
@@ -222,7 +228,7 @@ def test_orthographic_scale_that_overflows_is_refused():
 
     with pytest.raises(InputError, match="ortho-height"):
         cam(projection="orthographic", ortho_height=1e-320)
-    cam(projection="orthographic", ortho_height=1e-300)       # 4.8e302: finite, accepted
+    cam(projection="orthographic", ortho_height=1e-300)  # 4.8e302: finite, accepted
 
 
 def test_calibrated_intrinsics_fx_on_columns_cx_added():

@@ -3,7 +3,6 @@
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.projection import project_points
 from wirecheck.oracles.references import opencv_oracle
@@ -27,9 +26,18 @@ def test_core_matches_opencv(seed, fov, width, height, distance, ortho):
     up = rng.normal(size=3)
     if np.linalg.norm(np.cross(position, up)) < 1e-3 * np.linalg.norm(position) * np.linalg.norm(up):
         up = np.cross(position, [1.0, 0.0, 0.0]) + [0.0, 0.0, 1.0]
-    cam = look_at(position, (0, 0, 0), up, fov_y_deg=fov, width=width, height=height,
-                  near=0.01 * distance, far=3 * distance,
-                  projection="orthographic" if ortho else "perspective", ortho_height=distance)
+    cam = look_at(
+        position,
+        (0, 0, 0),
+        up,
+        fov_y_deg=fov,
+        width=width,
+        height=height,
+        near=0.01 * distance,
+        far=3 * distance,
+        projection="orthographic" if ortho else "perspective",
+        ortho_height=distance,
+    )
     pts = rng.uniform(-1, 1, (200, 3)) * distance
     ours = project_points(pts, cam)
     ref = opencv_oracle.project(pts, cam)

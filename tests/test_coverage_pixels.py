@@ -7,7 +7,6 @@ pixels it falls between (0.25 of 255 = 63.75, rounded down).
 """
 
 import numpy as np
-
 from wirecheck.oracles.judge import coverage_pixels
 
 

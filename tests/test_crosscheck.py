@@ -5,21 +5,29 @@ import sys
 from pathlib import Path
 
 import pytest
-
+from helpers import run_crosscheck as run
 from wirecheck.oracles import cli
 from wirecheck.oracles.cases import CASE_NAMES
-from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
 USER = DATA / "user_projector.py"
 FAULTY = DATA / "faulty_projectors.py"
-CASE_KEYS = {"scene", "camera", "frames", "max_vertex_error_px", "mean_vertex_error_px",
-             "pixel_f1_0px", "pixel_f1_1px", "faults", "verdict"}
+CASE_KEYS = {
+    "scene",
+    "camera",
+    "frames",
+    "max_vertex_error_px",
+    "mean_vertex_error_px",
+    "pixel_f1_0px",
+    "pixel_f1_1px",
+    "faults",
+    "verdict",
+}
 
 
 @pytest.fixture(autouse=True)
 def _data_on_path(monkeypatch):
-    monkeypatch.syspath_prepend(str(DATA))   # faulty_projectors imports user_projector
+    monkeypatch.syspath_prepend(str(DATA))  # faulty_projectors imports user_projector
 
 
 def test_core_passes_every_case_and_report_has_the_fields(tmp_path, capsys):
@@ -45,7 +53,8 @@ def test_core_passes_every_case_and_report_has_the_fields(tmp_path, capsys):
 def test_report_is_deterministic_apart_from_timing(tmp_path):
     _, a, out_a = run(tmp_path, "--scene", "pyramid", "--frames", "3", "--cases", "on_axis,near_plane", name="a")
     _, b, out_b = run(tmp_path, "--scene", "pyramid", "--frames", "3", "--cases", "on_axis,near_plane", name="b")
-    a.pop("timing"); b.pop("timing")
+    a.pop("timing")
+    b.pop("timing")
     assert a == b
     assert (out_a / "report.md").read_bytes() == (out_b / "report.md").read_bytes()
 
@@ -66,12 +75,21 @@ def test_half_pixel_offset_is_diagnosed(tmp_path):
         # that still tells 0.5 from any other offset.
         assert case["faults"][0]["dx"] == pytest.approx(0.5, abs=1e-9)
         assert case["faults"][0]["dy"] == pytest.approx(0.5, abs=1e-9)
-        assert case["max_vertex_error_px"] == pytest.approx(0.5 * 2 ** 0.5, abs=1e-9)
+        assert case["max_vertex_error_px"] == pytest.approx(0.5 * 2**0.5, abs=1e-9)
 
 
 def test_mirror_is_diagnosed_and_fails_pixels_too(tmp_path):
-    code, report, _ = run(tmp_path, "--candidate", f"{FAULTY}:mirrored", "--scene", "cube", "--frames", "3",
-                          "--cases", "oblique_roll,non_square")
+    code, report, _ = run(
+        tmp_path,
+        "--candidate",
+        f"{FAULTY}:mirrored",
+        "--scene",
+        "cube",
+        "--frames",
+        "3",
+        "--cases",
+        "oblique_roll,non_square",
+    )
     assert code == 1
     for case in report["cases"]:
         assert [f["name"] for f in case["faults"]] == ["mirror_horizontal"]
@@ -80,28 +98,32 @@ def test_mirror_is_diagnosed_and_fails_pixels_too(tmp_path):
 
 @pytest.mark.parametrize("func, needle", [("crashes", "ZeroDivisionError"), ("wrong_shape", "shape")])
 def test_broken_candidate_fails_with_reason(tmp_path, func, needle):
-    code, report, _ = run(tmp_path, "--candidate", f"{FAULTY}:{func}", "--scene", "cube", "--frames", "2",
-                          "--cases", "on_axis")
+    code, report, _ = run(
+        tmp_path, "--candidate", f"{FAULTY}:{func}", "--scene", "cube", "--frames", "2", "--cases", "on_axis"
+    )
     assert code == 1
     assert needle in report["cases"][0]["reasons"][0]
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["--frames", "0"], "--frames 0"),
-    (["--scene", "nope"], "'nope'"),
-    (["--candidate", "missing.py:f"], "not found"),
-    (["--candidate", f"{USER}:nothere"], "nothere"),
-    (["--candidate", "nocolon"], "FILE.py:FUNC"),
-    (["--oracles", "opencv,blender"], "--oracles"),
-    (["--cases", "on_axis,upside_down"], "upside_down"),
-    (["--min-f1", "1.5"], "--min-f1"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--frames", "0"], "--frames 0"),
+        (["--scene", "nope"], "'nope'"),
+        (["--candidate", "missing.py:f"], "not found"),
+        (["--candidate", f"{USER}:nothere"], "nothere"),
+        (["--candidate", "nocolon"], "FILE.py:FUNC"),
+        (["--oracles", "opencv,blender"], "--oracles"),
+        (["--cases", "on_axis,upside_down"], "upside_down"),
+        (["--min-f1", "1.5"], "--min-f1"),
+    ],
+)
 def test_usage_errors_exit_2_with_one_line(tmp_path, capsys, args, needle):
     code = cli.main(["--report-dir", str(tmp_path / "r"), *args])
     err = capsys.readouterr().err
     assert code == 2
     assert err.count("\n") == 1 and needle in err and "Traceback" not in err
-    assert not (tmp_path / "r").exists()          # no half-written report
+    assert not (tmp_path / "r").exists()  # no half-written report
 
 
 def test_missing_osmesa_exits_2_unless_opencv_only(tmp_path, capsys, monkeypatch):
@@ -128,22 +150,39 @@ def test_tolerance_override_turns_pass_into_fail(tmp_path):
 @pytest.mark.slow
 def test_subprocess_prints_table_and_path(tmp_path):
     out = tmp_path / "sub"
-    proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--scene", "cube", "--frames", "2",
-                           "--cases", "on_axis", "--report-dir", str(out)],
-                          capture_output=True, text=True, cwd=Path(__file__).parent.parent)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.oracles.cli",
+            "--scene",
+            "cube",
+            "--frames",
+            "2",
+            "--cases",
+            "on_axis",
+            "--report-dir",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=Path(__file__).parent.parent,
+    )
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr == ""
     # first what was compared (oracles.reports.compared), then the table
-    assert proc.stdout.splitlines()[0] == ("Compared: level pixels (OpenCV and pyrender), 2 frames per case, "
-                                           "1 case (1 scene x 1 camera)")
+    assert proc.stdout.splitlines()[0] == (
+        "Compared: level pixels (OpenCV and pyrender), 2 frames per case, 1 case (1 scene x 1 camera)"
+    )
     assert proc.stdout.splitlines()[1].split()[:2] == ["scene", "camera"]
     assert proc.stdout.rstrip().endswith("(also report.md, report.html)")
     assert (out / "report.json").is_file()
 
 
 def test_failing_report_says_what_to_check(tmp_path):
-    _, _, out = run(tmp_path, "--candidate", f"{FAULTY}:mirrored", "--scene", "cube", "--frames", "2",
-                    "--cases", "oblique_roll")
+    _, _, out = run(
+        tmp_path, "--candidate", f"{FAULTY}:mirrored", "--scene", "cube", "--frames", "2", "--cases", "oblique_roll"
+    )
     md = (out / "report.md").read_text()
     assert "## What to check" in md and "`mirror_horizontal`: left and right are exchanged" in md
 
@@ -168,18 +207,20 @@ def test_candidate_with_wrong_signature_is_a_usage_error(tmp_path, capsys):
 
 def test_candidate_exiting_during_the_run_fails_not_passes(tmp_path):
     cand = _write(tmp_path, "def f(p, c):\n    raise SystemExit(0)\n")
-    code, report, _ = run(tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", "--frames", "1",
-                          "--cases", "on_axis")
+    code, report, _ = run(
+        tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", "--frames", "1", "--cases", "on_axis"
+    )
     assert code == 1 and "SystemExit" in report["cases"][0]["reasons"][0]
 
 
 def test_infinite_output_is_a_contract_violation(tmp_path, capsys):
     cand = _write(tmp_path, "import numpy as np\ndef f(p, c):\n    return np.full((len(p), 2), np.inf)\n")
-    code, report, _ = run(tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", "--frames", "1",
-                          "--cases", "on_axis")
+    code, report, _ = run(
+        tmp_path, "--candidate", f"{cand}:f", "--scene", "cube", "--frames", "1", "--cases", "on_axis"
+    )
     assert code == 1
     assert "expected finite pixel coordinates" in report["cases"][0]["reasons"][0]
-    assert "expected finite pixel coordinates" in capsys.readouterr().out   # reasons on the console too
+    assert "expected finite pixel coordinates" in capsys.readouterr().out  # reasons on the console too
 
 
 def test_per_frame_errors_and_precision_recall_at_0px(tmp_path):
@@ -189,7 +230,7 @@ def test_per_frame_errors_and_precision_recall_at_0px(tmp_path):
     assert max(f["max_vertex_error_px"] for f in case["per_frame"]) == case["max_vertex_error_px"]
     assert case["pixel_f1_0px"] == min(f["f1_0px"] for f in case["per_frame"])
     for key in ("pixel_precision_0px", "pixel_recall_0px"):
-        assert 0.98 <= case[key] <= 1.0          # measured >= 0.9958 (oracles/tolerances.py)
+        assert 0.98 <= case[key] <= 1.0  # measured >= 0.9958 (oracles/tolerances.py)
 
 
 def test_empty_scene_is_vacuous_and_fails_unless_allowed(tmp_path):
@@ -201,6 +242,7 @@ def test_empty_scene_is_vacuous_and_fails_unless_allowed(tmp_path):
     assert case["verdict"] == "vacuous" and case["max_vertex_error_px"] is None
     assert case["reasons"] == ["vacuous: the scene has no vertices: nothing compared"]
     assert report["compared"] == {"cases": 0, "frames": 1, "vertices": 0, "pixels": 0}
-    code, report, _ = run(tmp_path, "--scene", str(empty), "--frames", "1", "--cases", "on_axis",
-                          "--allow-vacuous", name="allowed")
+    code, report, _ = run(
+        tmp_path, "--scene", str(empty), "--frames", "1", "--cases", "on_axis", "--allow-vacuous", name="allowed"
+    )
     assert code == 0 and report["verdict"] == "pass" and report["cases"][0]["verdict"] == "vacuous"

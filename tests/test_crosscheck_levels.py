@@ -7,18 +7,23 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
+from helpers import run_crosscheck as run
 from wirecheck.oracles import cli
 from wirecheck.oracles.candidates.core_candidate import CoreCandidate
-from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
 USER = DATA / "user_projector.py"
 PIXEL_KEYS = {"f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px"}
-VERTEX_KEYS = ("max_vertex_error_px", "mean_vertex_error_px", "rms_vertex_error_px", "worst_vertex",
-               "visible_points", "visibility_mismatch", "faults", "verdict")
-
-
+VERTEX_KEYS = (
+    "max_vertex_error_px",
+    "mean_vertex_error_px",
+    "rms_vertex_error_px",
+    "worst_vertex",
+    "visible_points",
+    "visibility_mismatch",
+    "faults",
+    "verdict",
+)
 
 
 def without_timing(out: Path) -> str:
@@ -28,6 +33,7 @@ def without_timing(out: Path) -> str:
 
 
 # ---------------------------------------------------------------- --level
+
 
 def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeypatch):
     from wirecheck.core.projector import raster
@@ -43,8 +49,9 @@ def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeyp
     monkeypatch.setattr(pyrender_oracle.PyrenderOracle, "__init__", forbidden)
     monkeypatch.setattr(raster, "line_pixels", forbidden)
     monkeypatch.setattr(case_module, "draw_candidate", forbidden)
-    code, report, out = run(tmp_path, "--level", "vertices", "--scene", "cube", "--frames", "3",
-                            "--cases", "on_axis,near_plane")
+    code, report, out = run(
+        tmp_path, "--level", "vertices", "--scene", "cube", "--frames", "3", "--cases", "on_axis,near_plane"
+    )
     assert code == 0
     assert report["level"] == "vertices" and report["oracles"] == ["opencv"]
     for case in report["cases"]:
@@ -62,8 +69,20 @@ def test_vertices_level_draws_nothing_and_never_loads_pyrender(tmp_path, monkeyp
     assert "Level: vertices" in (out / "report.md").read_text()
     assert "nothing is drawn at level vertices" in (out / "report.html").read_text()
     # an external candidate is not drawn either (draw_candidate raises above)
-    code, report, _ = run(tmp_path, "--level", "vertices", "--candidate", f"{USER}:project", "--scene", "prism",
-                          "--frames", "2", "--cases", "near_plane", name="ext")
+    code, report, _ = run(
+        tmp_path,
+        "--level",
+        "vertices",
+        "--candidate",
+        f"{USER}:project",
+        "--scene",
+        "prism",
+        "--frames",
+        "2",
+        "--cases",
+        "near_plane",
+        name="ext",
+    )
     assert code == 0 and report["cases"][0]["pixel_f1_1px"] is None
 
 
@@ -75,7 +94,9 @@ def test_vertex_results_are_the_same_at_both_levels(tmp_path):
     assert p["level"] == "pixels" and p["oracles"] == ["opencv", "pyrender"]
     for cv, cp in zip(v["cases"], p["cases"], strict=True):
         assert {k: cv[k] for k in VERTEX_KEYS} == {k: cp[k] for k in VERTEX_KEYS}
-        assert [f["max_vertex_error_px"] for f in cv["per_frame"]] == [f["max_vertex_error_px"] for f in cp["per_frame"]]
+        assert [f["max_vertex_error_px"] for f in cv["per_frame"]] == [
+            f["max_vertex_error_px"] for f in cp["per_frame"]
+        ]
         assert cp["pixel_f1_1px"] == 1.0
     timing = p["timing"]
     for t in [timing, *timing["cases"]]:
@@ -84,22 +105,29 @@ def test_vertex_results_are_the_same_at_both_levels(tmp_path):
         # them and the candidate (vertex stage = harness part + opencv + candidate projection)
         assert t["oracles_ms_per_frame"] == pytest.approx(t["opencv_ms_per_frame"] + t["pyrender_ms_per_frame"])
         assert t["harness_ms_per_frame"] == pytest.approx(
-            t["vertex_stage_ms_per_frame"] + t["pixel_stage_ms_per_frame"] - t["oracles_ms_per_frame"]
-            - t["candidate_project_ms_per_frame"] - t["candidate_draw_ms_per_frame"])
-    assert timing["harness_overhead_ratio"] == pytest.approx(timing["harness_ms_per_frame"]
-                                                             / timing["oracles_ms_per_frame"])
+            t["vertex_stage_ms_per_frame"]
+            + t["pixel_stage_ms_per_frame"]
+            - t["oracles_ms_per_frame"]
+            - t["candidate_project_ms_per_frame"]
+            - t["candidate_draw_ms_per_frame"]
+        )
+    assert timing["harness_overhead_ratio"] == pytest.approx(
+        timing["harness_ms_per_frame"] / timing["oracles_ms_per_frame"]
+    )
     html = (out_p / "report.html").read_text()
     assert "Time per frame" in html and "pixel stage (ms/frame)" in html
 
 
 @pytest.mark.parametrize("oracles, level", [("opencv", "vertices"), ("opencv,pyrender", "pixels")])
 def test_oracles_is_an_alias_of_level(tmp_path, oracles, level):
-    code, report, _ = run(tmp_path, "--oracles", oracles, "--level", level, "--scene", "cube", "--frames", "1",
-                          "--cases", "on_axis")
+    code, report, _ = run(
+        tmp_path, "--oracles", oracles, "--level", level, "--scene", "cube", "--frames", "1", "--cases", "on_axis"
+    )
     assert code == 0 and report["level"] == level
 
 
 # ---------------------------------------------------------------- --every
+
 
 def test_every_3_over_7_frames_checks_1_4_7_at_their_own_times(tmp_path):
     args = ("--level", "vertices", "--scene", "cube", "--frames", "7", "--cases", "oblique_roll")
@@ -119,6 +147,7 @@ def test_every_3_over_7_frames_checks_1_4_7_at_their_own_times(tmp_path):
 
 # ---------------------------------------------------------------- --jobs
 
+
 @pytest.mark.slow
 def test_jobs_2_gives_the_report_of_jobs_1(tmp_path):
     args = ("--scene", "cube", "--scene", "pyramid", "--frames", "3", "--cases", "on_axis,near_plane")
@@ -127,10 +156,15 @@ def test_jobs_2_gives_the_report_of_jobs_1(tmp_path):
     assert code1 == code2 == 0
     assert r1["timing"]["workers"] == 0 and r2["timing"]["workers"] == 2 and r2["timing"]["jobs"] == 2
     assert [(c["scene"], c["camera"]) for c in r2["cases"]] == [
-        ("cube", "on_axis"), ("cube", "near_plane"), ("pyramid", "on_axis"), ("pyramid", "near_plane")]
+        ("cube", "on_axis"),
+        ("cube", "near_plane"),
+        ("pyramid", "on_axis"),
+        ("pyramid", "near_plane"),
+    ]
     assert [(t["scene"], t["camera"]) for t in r2["timing"]["cases"]] == [
-        (c["scene"], c["camera"]) for c in r2["cases"]]
-    assert without_timing(out1) == without_timing(out2)            # byte for byte, apart from timing
+        (c["scene"], c["camera"]) for c in r2["cases"]
+    ]
+    assert without_timing(out1) == without_timing(out2)  # byte for byte, apart from timing
     assert (out1 / "report.md").read_bytes() == (out2 / "report.md").read_bytes()
     imgs = sorted(p.name for p in (out1 / "img").iterdir())
     # 4 worst frames x (candidate, oracle, diff, and the enlarged crop of the worst disagreement)
@@ -142,8 +176,16 @@ def test_jobs_2_gives_the_report_of_jobs_1(tmp_path):
 @pytest.mark.slow
 def test_file_candidate_runs_in_workers(tmp_path):
     # a faulty projector from a file outside sys.path: each worker starts its own candidate host
-    args = ("--candidate", f"{USER}:project_corner", "--scene", "prism", "--frames", "2",
-            "--cases", "oblique_roll,non_square,orthographic")
+    args = (
+        "--candidate",
+        f"{USER}:project_corner",
+        "--scene",
+        "prism",
+        "--frames",
+        "2",
+        "--cases",
+        "oblique_roll,non_square,orthographic",
+    )
     code1, _, out1 = run(tmp_path, *args, name="j1")
     code2, r2, out2 = run(tmp_path, *args, "--jobs", "2", name="j2")
     assert code1 == code2 == 1
@@ -155,33 +197,38 @@ def test_file_candidate_runs_in_workers(tmp_path):
 
 
 def test_more_jobs_than_cases_is_fine(tmp_path):
-    code, report, _ = run(tmp_path, "--level", "vertices", "--scene", "cube", "--frames", "1",
-                          "--cases", "on_axis", "--jobs", "4")
+    code, report, _ = run(
+        tmp_path, "--level", "vertices", "--scene", "cube", "--frames", "1", "--cases", "on_axis", "--jobs", "4"
+    )
     assert code == 0 and len(report["cases"]) == 1 and report["timing"]["jobs"] == 4
 
 
 # ---------------------------------------------------------------- usage errors
 
-@pytest.mark.parametrize("args, needle", [
-    (["--every", "0"], "--every 0"),
-    (["--every", "-2"], "--every -2"),
-    (["--every", "x"], "--every"),
-    (["--jobs", "0"], "--jobs 0"),
-    (["--jobs", "2.5"], "--jobs"),
-    (["--level", "voxels"], "--level"),
-    (["--level", "vertices", "--oracles", "opencv,pyrender"], "contradicts --level vertices"),
-    (["--level", "pixels", "--oracles", "opencv"], "contradicts --level pixels"),
-    (["--oracles", "pyrender"], "--oracles"),
-    (["--dtype", "float16"], "--dtype"),
-    (["--clip", "none"], "--clip"),
-    (["--raster", "smooth"], "--raster"),
-    (["--dtype", "float32", "--candidate", f"{USER}:project"], "--dtype"),
-    (["--clip", "clip", "--raster", "aa", "--candidate", f"{USER}:project"], "--clip, --raster"),
-])
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--every", "0"], "--every 0"),
+        (["--every", "-2"], "--every -2"),
+        (["--every", "x"], "--every"),
+        (["--jobs", "0"], "--jobs 0"),
+        (["--jobs", "2.5"], "--jobs"),
+        (["--level", "voxels"], "--level"),
+        (["--level", "vertices", "--oracles", "opencv,pyrender"], "contradicts --level vertices"),
+        (["--level", "pixels", "--oracles", "opencv"], "contradicts --level pixels"),
+        (["--oracles", "pyrender"], "--oracles"),
+        (["--dtype", "float16"], "--dtype"),
+        (["--clip", "none"], "--clip"),
+        (["--raster", "smooth"], "--raster"),
+        (["--dtype", "float32", "--candidate", f"{USER}:project"], "--dtype"),
+        (["--clip", "clip", "--raster", "aa", "--candidate", f"{USER}:project"], "--clip, --raster"),
+    ],
+)
 def test_bad_values_exit_2_with_one_line(tmp_path, capsys, args, needle):
     try:
         code = cli.main(["--report-dir", str(tmp_path / "r"), "--scene", "cube", *args])
-    except SystemExit as exc:         # argparse's own checks (types, choices) exit from parse_args
+    except SystemExit as exc:  # argparse's own checks (types, choices) exit from parse_args
         code = exc.code
     err = capsys.readouterr().err
     assert code == 2
@@ -190,6 +237,7 @@ def test_bad_values_exit_2_with_one_line(tmp_path, capsys, args, needle):
 
 
 # ---------------------------------------------------------------- the core candidate's settings
+
 
 def test_core_candidate_is_a_small_frozen_picklable_dataclass():
     c = CoreCandidate(dtype="float32", clip="endpoint", raster="aa")
@@ -210,7 +258,7 @@ def test_core_settings_reach_render_frame(monkeypatch):
     def fake_render_frame(p_model, edges, camera, model_matrix, clip_mode="clip", **kw):
         calls.append((clip_mode, kw))
         image = np.zeros((camera.height, camera.width), np.uint8)
-        image[0, :3] = (127, 128, 255)                   # "aa" coverage: drawn from 128 up
+        image[0, :3] = (127, 128, 255)  # "aa" coverage: drawn from 128 up
 
         class F:
             pass
@@ -225,7 +273,7 @@ def test_core_settings_reach_render_frame(monkeypatch):
     CoreCandidate().project(CoreCandidate().prepare(pts), cam, np.eye(4))
     cand = CoreCandidate(dtype="float32", clip="endpoint", raster="aa")
     prepared = cand.prepare(pts)
-    assert prepared.dtype == np.float32                  # the dtype reaches core through localize()
+    assert prepared.dtype == np.float32  # the dtype reaches core through localize()
     img = cand.draw(prepared, edges, cam, np.eye(4))
     assert calls[0] == ("clip", {"raster": "exact"})
     assert calls[1] == ("endpoint", {"raster": "aa"})
@@ -234,13 +282,14 @@ def test_core_settings_reach_render_frame(monkeypatch):
 
 def test_clip_endpoint_reaches_core_and_the_pixel_oracle_sees_it(tmp_path):
     # near_plane: edges cross the near plane; "endpoint" drops them where pyrender clips them
-    code, report, _ = run(tmp_path, "--clip", "endpoint", "--scene", "cube", "--frames", "4",
-                          "--cases", "near_plane,on_axis")
+    code, report, _ = run(
+        tmp_path, "--clip", "endpoint", "--scene", "cube", "--frames", "4", "--cases", "near_plane,on_axis"
+    )
     assert code == 1
     assert report["candidate_settings"] == {"dtype": "float64", "clip": "endpoint", "raster": "exact"}
-    on_axis, near = report["cases"]          # cases run in the order of oracles.cases.CASE_NAMES
-    assert near["max_vertex_error_px"] < 1e-9 and near["pixel_f1_1px"] < 0.9      # measured 0.72
-    assert on_axis["verdict"] == "pass" and on_axis["pixel_f1_1px"] == 1.0     # nothing to clip there
+    on_axis, near = report["cases"]  # cases run in the order of oracles.cases.CASE_NAMES
+    assert near["max_vertex_error_px"] < 1e-9 and near["pixel_f1_1px"] < 0.9  # measured 0.72
+    assert on_axis["verdict"] == "pass" and on_axis["pixel_f1_1px"] == 1.0  # nothing to clip there
 
 
 def test_default_settings_are_recorded(tmp_path):
@@ -250,8 +299,9 @@ def test_default_settings_are_recorded(tmp_path):
 
 
 def test_float32_reaches_core(tmp_path):
-    code, report, _ = run(tmp_path, "--level", "vertices", "--dtype", "float32", "--scene", "cube",
-                          "--frames", "2", "--cases", "on_axis")
+    code, report, _ = run(
+        tmp_path, "--level", "vertices", "--dtype", "float32", "--scene", "cube", "--frames", "2", "--cases", "on_axis"
+    )
     err = report["cases"][0]["max_vertex_error_px"]
     # float64 gives ~1e-13 px; float32 rounding shows at ~1e-5 px (eps 6e-8 x 640 px)
     assert 1e-9 < err < 1e-2, err
@@ -260,9 +310,10 @@ def test_float32_reaches_core(tmp_path):
 
 @pytest.mark.parametrize("raster", ["fast", "aa"])
 def test_other_rasters_are_drawn_and_judged(tmp_path, raster):
-    code, report, _ = run(tmp_path, "--raster", raster, "--scene", "cube", "--frames", "2",
-                          "--cases", "on_axis,oblique_roll")
+    code, report, _ = run(
+        tmp_path, "--raster", raster, "--scene", "cube", "--frames", "2", "--cases", "on_axis,oblique_roll"
+    )
     assert report["candidate_settings"]["raster"] == raster
     for case in report["cases"]:
-        assert case["max_vertex_error_px"] < 1e-9          # the rasterizer changes pixels, not vertices
+        assert case["max_vertex_error_px"] < 1e-9  # the rasterizer changes pixels, not vertices
         assert case["pixel_f1_1px"] > 0.9, (raster, case["pixel_f1_1px"])

@@ -9,12 +9,11 @@ import json
 import os
 
 import pytest
-
 from wirecheck.core.app import cli as renderer_cli
 from wirecheck.core.outputs.owned import MARKER
 
 OPTIONS = ["--width", "32", "--height", "24", "--frames", "1"]
-DEPTH = 1100            # past Python's default recursion limit of 1000
+DEPTH = 1100  # past Python's default recursion limit of 1000
 
 
 def _nest(frames_dir, depth, last_file=None):
@@ -41,7 +40,7 @@ def deep_cleanup():
     yield bottoms
     for bottom in bottoms:
         while bottom.name == "d" and not bottom.is_dir():
-            bottom = bottom.parent       # removed by the run, or partly
+            bottom = bottom.parent  # removed by the run, or partly
         for name in os.listdir(bottom):
             if not (bottom / name).is_dir():
                 os.unlink(bottom / name)
@@ -58,7 +57,7 @@ def test_rerun_over_a_folder_nested_1100_deep(tmp_path, capsys, deep_cleanup):
     rc = renderer_cli.main([*OPTIONS, "--out", str(out)])
     err = capsys.readouterr().err
     assert rc == 0, err
-    assert sorted(os.listdir(out / "cube-frames")) == [MARKER, "frame_0001.png"]     # the deep folder was ours
+    assert sorted(os.listdir(out / "cube-frames")) == [MARKER, "frame_0001.png"]  # the deep folder was ours
 
 
 def test_users_file_at_the_bottom_of_a_deep_folder_is_found(tmp_path, capsys, deep_cleanup):

@@ -19,14 +19,13 @@ from collections import Counter
 
 import numpy as np
 import pytest
-
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.candidates.depth_map import depth_from_array, read_depth_map
+from wirecheck.oracles.cases import cases_for
 from wirecheck.oracles.diagnosis.depth_faults import DEPTH_FAULTS, LIMITS, name_depth_faults
 from wirecheck.oracles.faults import CATALOGUE, Fault
-from wirecheck.oracles.cases import cases_for
 from wirecheck.oracles.judge.metrics import depth_bound
 
 SCENES = ("cube", "prism", "pyramid")
@@ -45,18 +44,18 @@ def mistakes(r: np.ndarray, camera) -> dict:
     n, f = camera.near, camera.far
     persp = camera.projection == "perspective"
     with np.errstate(divide="ignore", invalid="ignore"):
-        z_win = f * (r - n) / ((f - n) * r) if persp else (r - n) / (f - n)          # glDepthRange [0, 1]
+        z_win = f * (r - n) / ((f - n) * r) if persp else (r - n) / (f - n)  # glDepthRange [0, 1]
         # reversed-Z (near -> 1, far -> 0) read back with the standard linearisation d = fn / (f - z (f - n))
         reversed_lin = f * n / (f - (1.0 - z_win) * (f - n)) if persp else n + (1.0 - z_win) * (f - n)
     out = {
         "pass": r,
-        "depth_encoding": np.clip(z_win, 0.0, 1.0),              # a value at exactly near is 0: no surface
-        "depth_scale": r * 1000.0,                                # millimetres read as metres
-        "depth_offset": r + n,                                    # measured from one near plane behind
+        "depth_encoding": np.clip(z_win, 0.0, 1.0),  # a value at exactly near is 0: no surface
+        "depth_scale": r * 1000.0,  # millimetres read as metres
+        "depth_offset": r + n,  # measured from one near plane behind
         "depth_reversed": reversed_lin,
-        "depth_precision": r.astype(np.float16),                  # a half-float target
+        "depth_precision": r.astype(np.float16),  # a half-float target
     }
-    if persp:                                                     # orthographic rays are all depth: no mistake
+    if persp:  # orthographic rays are all depth: no mistake
         out["depth_is_range"] = r * rays(camera)
     return {name: np.where(r > 0, m, np.nan).astype(np.float32) for name, m in out.items()}
 
@@ -78,12 +77,13 @@ def frame_depth(scene_name: str, case, k: int = 2, frames: int = 7):
 def pixel_mistakes(scene_name: str, camera) -> dict:
     """The maps a camera mistake draws (core, float32), keyed by the expected name."""
     depth, _ = core_depth(scene_name, camera)
-    out = {"mirror_vertical": depth[::-1]}                                     # read back bottom row first
+    out = {"mirror_vertical": depth[::-1]}  # read back bottom row first
     if camera.projection == "perspective":
         fx, fy = camera.focal_xy
-        out["pixel_offset"] = core_depth(scene_name, camera.with_intrinsics(fx, fy, camera.width / 2,
-                                                                            camera.height / 2))[0]
-        f_h = (camera.width / 2) / math.tan(math.radians(camera.fov_y_deg) / 2)   # the FOV as the horizontal one
+        out["pixel_offset"] = core_depth(
+            scene_name, camera.with_intrinsics(fx, fy, camera.width / 2, camera.height / 2)
+        )[0]
+        f_h = (camera.width / 2) / math.tan(math.radians(camera.fov_y_deg) / 2)  # the FOV as the horizontal one
         out["fov_mismatch"] = core_depth(scene_name, camera.with_intrinsics(f_h, f_h))[0]
     return {name: np.where(m > 0, m, np.nan).astype(np.float32) for name, m in out.items()}
 
@@ -91,8 +91,9 @@ def pixel_mistakes(scene_name: str, camera) -> dict:
 def judge(cand32: np.ndarray, depth, bound, camera, faces=None):
     """The candidate as read from a float32 file (its encoding's bound: eps32 |d|), judged."""
     dm = depth_from_array(cand32, camera.width, camera.height, "candidate", "npy float32", 0.0, EPS32)
-    return name_depth_faults(dm.depth, np.where(depth > 0, depth, np.nan), bound, camera, dm.encoding_bound(),
-                             faces=faces)
+    return name_depth_faults(
+        dm.depth, np.where(depth > 0, depth, np.nan), bound, camera, dm.encoding_bound(), faces=faces
+    )
 
 
 @pytest.fixture(scope="module")
@@ -105,8 +106,9 @@ def results():
             faces = core_depth(scene_name, case.camera)[1]
             maps = {**mistakes(depth, case.camera), **pixel_mistakes(scene_name, case.camera)}
             for injected, cand in maps.items():
-                out.append((scene_name, case.name, injected, judge(cand, depth, bound, case.camera, faces),
-                            case.camera))
+                out.append(
+                    (scene_name, case.name, injected, judge(cand, depth, bound, case.camera, faces), case.camera)
+                )
     return out
 
 
@@ -115,8 +117,7 @@ def diagnosed(d) -> str:
 
 
 def test_each_mistake_named_alone(results):
-    wrong = [(s, c, i, diagnosed(d), d.measured.get("fit_ratios")) for s, c, i, d, _ in results
-             if diagnosed(d) != i]
+    wrong = [(s, c, i, diagnosed(d), d.measured.get("fit_ratios")) for s, c, i, d, _ in results if diagnosed(d) != i]
     assert not wrong, wrong
     # the orthographic case has no range mistake (its rays are all depth), and no K to move
     assert len(results) == 3 * (6 * 10 + 7)
@@ -124,7 +125,7 @@ def test_each_mistake_named_alone(results):
 
 def test_named_faults_are_the_catalogues_read_from_depth(results):
     named = [f for _, _, _, d, _ in results for f in d.faults]
-    assert len(named) == len(results) - 21                     # every mistake named (21 maps are correct)
+    assert len(named) == len(results) - 21  # every mistake named (21 maps are correct)
     for f in named:
         assert isinstance(f, Fault) and f.source == "depth" and f.hint == CATALOGUE[f.name].hint_for("depth")
     # rows flipped: a depth map's hint (the buffer read back bottom row first), not a projector's (y_px = cy - f y / z)
@@ -136,11 +137,18 @@ def test_confusion_matrix_is_diagonal(results, summary_section):
     counts = Counter((i, diagnosed(d)) for _, _, i, d, _ in results)
     rows = list(dict.fromkeys(i for _, _, i, _, _ in results))
     cols = list(dict.fromkeys([*rows, *sorted({c for _, c in counts} - set(rows))]))
-    short = {n: n.replace("depth_", "").replace("mirror_vertical", "mirror_v").replace("_mismatch", "")
-             .replace("pixel_", "px_") for n in cols}
-    lines = ["depth faults, core's maps with one mistake each (rows injected, columns named); "
-             f"{len(SCENES)} scenes x 7 cases",
-             " " * 16 + " ".join(f"{short[c]:>10}" for c in cols)]
+    short = {
+        n: n.replace("depth_", "")
+        .replace("mirror_vertical", "mirror_v")
+        .replace("_mismatch", "")
+        .replace("pixel_", "px_")
+        for n in cols
+    }
+    lines = [
+        "depth faults, core's maps with one mistake each (rows injected, columns named); "
+        f"{len(SCENES)} scenes x 7 cases",
+        " " * 16 + " ".join(f"{short[c]:>10}" for c in cols),
+    ]
     lines += [f"{short[r]:<16}" + " ".join(f"{counts[(r, c)] or '.':>10}" for c in cols) for r in rows]
     summary_section("depth fault confusion matrix", "\n".join(lines))
     assert not {k: v for k, v in counts.items() if k[0] != k[1]}
@@ -152,18 +160,23 @@ def test_fitted_numbers_are_the_mistakes(results):
         p = d.faults[0].params if d.faults else {}
         where = (scene_name, case_name, injected, p)
         if injected == "depth_scale":
-            assert p["k"] == pytest.approx(1000.0, rel=4 * EPS32), where       # float32 rounding of the stored value
+            assert p["k"] == pytest.approx(1000.0, rel=4 * EPS32), where  # float32 rounding of the stored value
         elif injected == "depth_offset":
-            assert p["b"] == pytest.approx(cam.near, rel=1e-5), where           # within the bound's 1e-5 of depth
+            assert p["b"] == pytest.approx(cam.near, rel=1e-5), where  # within the bound's 1e-5 of depth
             assert p["b_over_near"] == pytest.approx(1.0, rel=1e-5), where
         elif injected == "depth_encoding":
             assert p["stored"] == "window [0, 1]" and not p["reversed"], where
             # near and far read back from float32 window depths: 1e-3 relative (the values near 1 keep
             # ~7 digits, and far is read from their distance to 1)
-            assert p["near"] == pytest.approx(cam.near, rel=1e-3) and p["far"] == pytest.approx(cam.far, rel=1e-3), where
+            assert p["near"] == pytest.approx(cam.near, rel=1e-3) and p["far"] == pytest.approx(cam.far, rel=1e-3), (
+                where
+            )
         elif injected == "depth_reversed":
-            key, want = (("sum_of_inverses", 1 / cam.near + 1 / cam.far) if cam.projection == "perspective"
-                         else ("sum", cam.near + cam.far))
+            key, want = (
+                ("sum_of_inverses", 1 / cam.near + 1 / cam.far)
+                if cam.projection == "perspective"
+                else ("sum", cam.near + cam.far)
+            )
             assert p[key] == pytest.approx(want, rel=1e-5), where
         elif injected == "depth_precision":
             assert p["format"] == "float16", where
@@ -187,14 +200,14 @@ def test_fit_slack_has_room(results):
         ratios = d.measured["fit_ratios"]
         assert ratios[injected] <= 0.5 * LIMITS.fit_slack, (injected, ratios)
         others = [v for name, v in ratios.items() if name != injected]
-        assert min(others) > 4 * LIMITS.fit_slack, (injected, ratios)     # measured: 19 (offset, float16 map)
+        assert min(others) > 4 * LIMITS.fit_slack, (injected, ratios)  # measured: 19 (offset, float16 map)
 
 
 def test_ambiguous_when_one_depth(tmp_path):
     """Frame 1 of the cube on axis shows one face square-on: every pixel at depth 2r, scale and offset alike."""
     case = cases_for(load_scene("cube"))[0]
     depth, covered, bound = frame_depth("cube", case, k=1)
-    assert np.ptp(depth[covered]) < 1e-12 * depth[covered].max()        # one depth: the premise
+    assert np.ptp(depth[covered]) < 1e-12 * depth[covered].max()  # one depth: the premise
     d = judge(mistakes(depth, case.camera)["depth_scale"], depth, bound, case.camera)
     assert d.names == ("ambiguous",)
     assert set(d.faults[0].params["alternatives"].split(", ")) >= {"depth_scale", "depth_offset"}
@@ -227,8 +240,12 @@ def test_never_vacuous():
     depth, covered, bound = frame_depth("cube", case)
     ref = np.where(covered, depth, np.nan)
     cam = case.camera
-    for cand in (np.full(depth.shape, np.nan), np.zeros(depth.shape), np.full(depth.shape, np.inf),
-                 np.where(covered, np.nan, 5.0)):                      # surface only where the reference has none
+    for cand in (
+        np.full(depth.shape, np.nan),
+        np.zeros(depth.shape),
+        np.full(depth.shape, np.inf),
+        np.where(covered, np.nan, 5.0),
+    ):  # surface only where the reference has none
         d = name_depth_faults(cand, ref, bound, cam)
         assert d.verdict == "vacuous" and not d.passed and d.measured["compared_px"] == 0
     # a blank reference too
@@ -238,9 +255,10 @@ def test_never_vacuous():
 def test_unexplained_says_what_was_measured():
     case = cases_for(load_scene("cube"))[1]
     depth, covered, bound = frame_depth("cube", case)
-    noise = np.random.default_rng(7).normal(0.0, 0.01, depth.shape)        # 1% noise: no model's shape
-    d = name_depth_faults(np.where(covered, depth * (1 + noise), np.nan), np.where(covered, depth, np.nan), bound,
-                          case.camera)
+    noise = np.random.default_rng(7).normal(0.0, 0.01, depth.shape)  # 1% noise: no model's shape
+    d = name_depth_faults(
+        np.where(covered, depth * (1 + noise), np.nan), np.where(covered, depth, np.nan), bound, case.camera
+    )
     assert d.names == ("unexplained",)
     assert d.measured["max_error_ratio"] > 1 and d.measured["compared_px"] == int(covered.sum())
     assert set(d.measured["fit_ratios"]) >= {"depth_scale", "depth_offset", "depth_is_range", "depth_reversed"}

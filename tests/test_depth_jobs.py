@@ -16,11 +16,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from clients.core_depth_job import CAMERA_MISTAKES, MISTAKES, render_job    # tests/ is on sys.path (rootdir conftest)
+from clients.core_depth_job import CAMERA_MISTAKES, MISTAKES, render_job  # tests/ is on sys.path (rootdir conftest)
 from helpers import run_crosscheck
-from wirecheck.oracles.cli import main
 from wirecheck.oracles.candidates.frames_candidate import load_job
+from wirecheck.oracles.cli import main
 from wirecheck.oracles.judge.surfaces import surface_mismatch
 
 # frames 1, 4, 7 of 7, moved on by 0.3 of a step (no quarter-turn pose: a flipped cube is not the cube),
@@ -73,11 +72,14 @@ def test_core_depth_as_png16_at_scale_1000_passes(tmp_path, capsys):
     assert 0.4e-3 < worst <= 0.5e-3 + 1e-4
 
 
-@pytest.mark.parametrize("mistake, expected", [
-    ("zbuffer", "depth_encoding"),              # the z-buffer's [0, 1] value stored as depth
-    ("x1000", "depth_scale"),                   # millimetres written where world units were asked for
-    ("rows_flipped", "mirror_vertical"),        # GL's bottom row written first
-])
+@pytest.mark.parametrize(
+    "mistake, expected",
+    [
+        ("zbuffer", "depth_encoding"),  # the z-buffer's [0, 1] value stored as depth
+        ("x1000", "depth_scale"),  # millimetres written where world units were asked for
+        ("rows_flipped", "mirror_vertical"),  # GL's bottom row written first
+    ],
+)
 def test_a_mistaken_depth_map_fails_with_its_name(depth_job, tmp_path, capsys, mistake, expected):
     job = fill(copy(depth_job, tmp_path), MISTAKES[mistake])
     code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
@@ -97,10 +99,13 @@ def perspective_job(tmp_path_factory) -> Path:
     return path
 
 
-@pytest.mark.parametrize("mistake, expected", [
-    ("half_pixel", "pixel_offset"),             # cx = W / 2 for (W - 1) / 2: the map moved by half a pixel
-    ("fov_horizontal", "fov_mismatch"),         # K from the FOV taken as the horizontal one
-])
+@pytest.mark.parametrize(
+    "mistake, expected",
+    [
+        ("half_pixel", "pixel_offset"),  # cx = W / 2 for (W - 1) / 2: the map moved by half a pixel
+        ("fov_horizontal", "fov_mismatch"),  # K from the FOV taken as the horizontal one
+    ],
+)
 def test_a_camera_mistake_in_a_depth_map_is_named(perspective_job, tmp_path, mistake, expected):
     job = copy(perspective_job, tmp_path)
     render_job(job, camera=CAMERA_MISTAKES[mistake])
@@ -136,12 +141,13 @@ def test_an_all_nan_map_fails(depth_job, tmp_path):
 def test_a_hole_inside_the_surface_fails(depth_job, tmp_path):
     """A 3x3 patch of no surface in the middle of a face: 9 holes a frame (the patch and its neighbours are
     covered by the reference: away from any boundary), nothing else."""
+
     def hole(z, cam):
         out = z.copy()
         rows, cols = np.nonzero(z > 0)
         r, c = int(np.median(rows)), int(np.median(cols))
-        assert (z[r - 2:r + 3, c - 2:c + 3] > 0).all()      # the patch and its ring on the surface
-        out[r - 1:r + 2, c - 1:c + 2] = 0.0
+        assert (z[r - 2 : r + 3, c - 2 : c + 3] > 0).all()  # the patch and its ring on the surface
+        out[r - 1 : r + 2, c - 1 : c + 2] = 0.0
         return out
 
     job = fill(copy(depth_job, tmp_path), hole)
@@ -188,11 +194,14 @@ def test_a_missing_map_is_exit_2(depth_job, tmp_path, capsys):
     _one_line(capsys, str(path), "missing")
 
 
-@pytest.mark.parametrize("encoding, needle", [
-    ({"format": "exr", "scale": None}, "depth_encoding"),
-    ({"format": "png16", "scale": 0}, "depth_encoding.scale 0"),
-    ({"format": "npy", "scale": 1000.0}, "expected null"),
-])
+@pytest.mark.parametrize(
+    "encoding, needle",
+    [
+        ({"format": "exr", "scale": None}, "depth_encoding"),
+        ({"format": "png16", "scale": 0}, "depth_encoding.scale 0"),
+        ({"format": "npy", "scale": 1000.0}, "expected null"),
+    ],
+)
 def test_a_hand_edited_encoding_is_exit_2(depth_job, tmp_path, capsys, encoding, needle):
     job = fill(copy(depth_job, tmp_path))
     data = json.loads((job / "job.json").read_text())
@@ -207,7 +216,7 @@ def test_a_hand_edited_encoding_is_exit_2(depth_job, tmp_path, capsys, encoding,
 def test_hand_edited_objects_are_exit_2(depth_job, tmp_path, capsys):
     job = fill(copy(depth_job, tmp_path))
     data = json.loads((job / "job.json").read_text())
-    data["scenes"][0]["objects"] = [4, 3]                  # the cube has 8 vertices
+    data["scenes"][0]["objects"] = [4, 3]  # the cube has 8 vertices
     (job / "job.json").write_text(json.dumps(data))
     capsys.readouterr()
     code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
@@ -231,7 +240,10 @@ def test_wireframes_filled_frames_and_depth_together(tmp_path, capsys):
     job = fill(export(tmp_path / "job", "--outputs", "depth,wireframe,filled"))
     listed = load_job(job)["cases"][0]
     assert [Path(p).name for p in listed["frames"] + listed["filled"] + listed["depth"]][::3] == [
-        "frame_0001.png", "filled_0001.png", "depth_0001.npy"]
+        "frame_0001.png",
+        "filled_0001.png",
+        "depth_0001.npy",
+    ]
     code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
     assert code == 0, capsys.readouterr().out
     for case in report["cases"]:
@@ -244,7 +256,7 @@ def drop_top(covered: np.ndarray) -> np.ndarray:
     along the silhouette's upper left edge."""
     out = covered.copy()
     cols = np.flatnonzero(covered.any(axis=0))
-    cols = cols[:len(cols) // 2]
+    cols = cols[: len(cols) // 2]
     out[covered.argmax(axis=0)[cols], cols] = False
     return out
 
@@ -284,7 +296,7 @@ def test_a_one_pixel_band_missing_along_an_edge_fails(filled_job, tmp_path):
         f = case["filled"]
         assert f["longest_run_px"] >= 50 and f["extra_px"] == 0, f
         assert any("in one run" in r for r in case["reasons"])
-    assert min(c["filled"]["min_iou"] for c in report["cases"]) >= 0.995      # IoU alone would pass
+    assert min(c["filled"]["min_iou"] for c in report["cases"]) >= 0.995  # IoU alone would pass
 
 
 def test_a_default_export_is_a_wireframe_job_as_before(tmp_path):
@@ -303,14 +315,17 @@ def test_the_readme_says_what_to_write(tmp_path):
     assert json.loads((job / "job.json").read_text())["depth_encoding"] == {"format": "png16", "scale": 5000.0}
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["--outputs", "depth,normals"], "unknown 'normals'"),
-    (["--outputs", "depth,depth"], "one given twice"),
-    (["--outputs", "depth", "--depth-format", "png16", "--depth-scale", "0"], "--depth-scale 0"),
-    (["--outputs", "depth", "--depth-format", "png16", "--depth-scale", "nan"], "--depth-scale nan"),
-    (["--outputs", "depth", "--depth-scale", "1000"], "expected --depth-format png16"),
-    (["--outputs", "filled", "--depth-format", "npy"], "expected --outputs with depth"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--outputs", "depth,normals"], "unknown 'normals'"),
+        (["--outputs", "depth,depth"], "one given twice"),
+        (["--outputs", "depth", "--depth-format", "png16", "--depth-scale", "0"], "--depth-scale 0"),
+        (["--outputs", "depth", "--depth-format", "png16", "--depth-scale", "nan"], "--depth-scale nan"),
+        (["--outputs", "depth", "--depth-scale", "1000"], "expected --depth-format png16"),
+        (["--outputs", "filled", "--depth-format", "npy"], "expected --outputs with depth"),
+    ],
+)
 def test_export_refuses_bad_outputs(tmp_path, capsys, args, needle):
     assert main(["export", str(tmp_path / "job"), *ARGS, *args]) == 2
     _one_line(capsys, needle)
@@ -323,13 +338,13 @@ def test_surface_mismatch_counts_away_from_the_boundary():
     those outside rows/columns 1..6."""
     covered = np.zeros((9, 9), bool)
     covered[2:6, 2:6] = True
-    shown = np.zeros_like(covered)            # nothing shown: every interior pixel is a hole
+    shown = np.zeros_like(covered)  # nothing shown: every interior pixel is a hole
     holes, extra = surface_mismatch(shown, covered)
     assert holes.sum() == 4 and holes[3:5, 3:5].all() and not extra.any()
-    shown = np.ones_like(covered)             # everything shown: the extra pixels are the far ring
+    shown = np.ones_like(covered)  # everything shown: the extra pixels are the far ring
     holes, extra = surface_mismatch(shown, covered)
     assert not holes.any() and extra.sum() == 81 - 36 and not extra[1:7, 1:7].any()
-    full = np.ones((3, 3), bool)              # the image's edge is no boundary: a covered picture's every pixel
+    full = np.ones((3, 3), bool)  # the image's edge is no boundary: a covered picture's every pixel
     assert surface_mismatch(np.zeros_like(full), full)[0].all()
 
 
@@ -374,4 +389,3 @@ def test_several_objects_ids_and_depth(orrery_job, tmp_path):
     for case in report["cases"]:
         assert case["filled"]["object_id_px"] > 0 and case["filled"]["longest_run_px"] == 0
         assert any("another object's id" in r for r in case["reasons"])
-

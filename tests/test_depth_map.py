@@ -9,7 +9,6 @@ import zlib
 import numpy as np
 import pytest
 from PIL import Image
-
 from wirecheck.core.errors import InputError
 from wirecheck.oracles.candidates.depth_map import read_depth_map
 
@@ -24,15 +23,15 @@ def test_npy_float32(tmp_path):
     assert np.array_equal(np.isnan(dm.depth), [[True, False, True], [True, False, False]])
     assert dm.depth[0, 1] == 1.5 and dm.depth[1, 1] == 2.25 and dm.depth.dtype == np.float64
     assert (dm.encoding, dm.step, dm.rel_step) == ("npy float32", 0.0, EPS32)
-    assert dm.encoding_bound()[1, 2] == pytest.approx(3.0 * EPS32)       # one float32 ulp of depth 3 (2 ulps at 2^1)
+    assert dm.encoding_bound()[1, 2] == pytest.approx(3.0 * EPS32)  # one float32 ulp of depth 3 (2 ulps at 2^1)
 
 
 def test_png_16bit_scale(tmp_path):
     Image.fromarray(np.array([[0, 1000, 65535]], dtype=np.uint16)).save(tmp_path / "d.png")
     dm = read_depth_map(tmp_path / "d.png", 3, 1)
     assert np.isnan(dm.depth[0, 0]) and dm.depth[0, 1] == 1.0 and dm.depth[0, 2] == 65.535
-    assert dm.step == 1e-3 and np.array_equal(dm.encoding_bound(), [[1e-3, 1e-3, 1e-3]])   # 1 mm at 1000 per unit
-    dm = read_depth_map(tmp_path / "d.png", 3, 1, scale=5000)                           # TUM's scale
+    assert dm.step == 1e-3 and np.array_equal(dm.encoding_bound(), [[1e-3, 1e-3, 1e-3]])  # 1 mm at 1000 per unit
+    dm = read_depth_map(tmp_path / "d.png", 3, 1, scale=5000)  # TUM's scale
     assert dm.depth[0, 1] == 0.2 and dm.step == 2e-4
 
 
@@ -42,22 +41,29 @@ def test_tiff_float32(tmp_path):
     assert np.isnan(dm.depth[0, 0]) and dm.depth[0, 1] == 1.25 and dm.encoding == "tiff float32"
 
 
-@pytest.mark.parametrize("make, expect", [
-    (lambda p: np.save(p / "d.npy", np.zeros((2, 3), np.uint16)), "a .npy of uint16: expected float32"),
-    (lambda p: np.save(p / "d.npy", np.zeros((2, 3), np.float16)), "a .npy of float16: expected float32"),
-    (lambda p: np.save(p / "d.npy", np.zeros((3, 2), np.float32)), "expected 3x2"),
-    (lambda p: np.save(p / "d.npy", np.zeros((2, 3, 1), np.float32)), "expected 3x2"),
-    (lambda p: np.save(p / "d.npy", np.array([[1, 1, 1], [1, -0.5, 1]], np.float32)),
-     "depth -0.5 at row 1, column 1 (1 negative in all)"),
-    (lambda p: np.save(p / "d.npy", np.array([[1, 1, 1], [1, -np.inf, 1]], np.float32)), "depth -inf at row 1"),
-    (lambda p: Image.fromarray(np.zeros((2, 3), np.uint8)).save(p / "d.png"), "a PNG image of mode L: expected a "
-                                                                               "16-bit grey PNG"),
-    (lambda p: Image.fromarray(np.zeros((2, 3, 3), np.uint8)).save(p / "d.png"), "mode RGB"),
-    (lambda p: Image.fromarray(np.zeros((2, 3), np.int32)).save(p / "d.tif"), "mode I: expected a 32-bit float"),
-    (lambda p: (p / "d.png").write_bytes(b"not a png"), "not a readable image"),
-    (lambda p: (p / "d.npy").write_bytes(b"not a npy"), "not a readable .npy"),
-    (lambda p: (p / "d.exr").write_bytes(b"x"), "a .exr file: expected a depth map as .npy"),
-])
+@pytest.mark.parametrize(
+    "make, expect",
+    [
+        (lambda p: np.save(p / "d.npy", np.zeros((2, 3), np.uint16)), "a .npy of uint16: expected float32"),
+        (lambda p: np.save(p / "d.npy", np.zeros((2, 3), np.float16)), "a .npy of float16: expected float32"),
+        (lambda p: np.save(p / "d.npy", np.zeros((3, 2), np.float32)), "expected 3x2"),
+        (lambda p: np.save(p / "d.npy", np.zeros((2, 3, 1), np.float32)), "expected 3x2"),
+        (
+            lambda p: np.save(p / "d.npy", np.array([[1, 1, 1], [1, -0.5, 1]], np.float32)),
+            "depth -0.5 at row 1, column 1 (1 negative in all)",
+        ),
+        (lambda p: np.save(p / "d.npy", np.array([[1, 1, 1], [1, -np.inf, 1]], np.float32)), "depth -inf at row 1"),
+        (
+            lambda p: Image.fromarray(np.zeros((2, 3), np.uint8)).save(p / "d.png"),
+            "a PNG image of mode L: expected a 16-bit grey PNG",
+        ),
+        (lambda p: Image.fromarray(np.zeros((2, 3, 3), np.uint8)).save(p / "d.png"), "mode RGB"),
+        (lambda p: Image.fromarray(np.zeros((2, 3), np.int32)).save(p / "d.tif"), "mode I: expected a 32-bit float"),
+        (lambda p: (p / "d.png").write_bytes(b"not a png"), "not a readable image"),
+        (lambda p: (p / "d.npy").write_bytes(b"not a npy"), "not a readable .npy"),
+        (lambda p: (p / "d.exr").write_bytes(b"x"), "a .exr file: expected a depth map as .npy"),
+    ],
+)
 def test_refused_with_one_line(tmp_path, make, expect):
     make(tmp_path)
     path = next(tmp_path.iterdir())
@@ -78,6 +84,7 @@ def test_missing_file_and_bad_scale(tmp_path):
 
 # ---- hostile files (benchmarks/fuzz_round5.py, docs/reliability.md "Round 5") ----------------------------
 
+
 def _npy_bytes(header: bytes, body: bytes = b"") -> bytes:
     """A version 1.0 .npy file with this header dict text, padded as numpy pads it (to 64 bytes)."""
     magic = b"\x93NUMPY\x01\x00"
@@ -94,16 +101,23 @@ def _refused(path, *args, **kwargs) -> str:
     return text
 
 
-@pytest.mark.parametrize("header, body, expect", [
-    # numpy's header parser: OverflowError computing the count of a shape of a 4,000-digit number
-    (b"{'descr': '<f4', 'fortran_order': False, 'shape': (" + b"9" * 4000 + b", 8), }", b"", "expected 8x6"),
-    # tokenize.TokenError from an unclosed bracket (found by a random byte of the header, seed 5)
-    (b"{'descr': '<f4', 'fortran_order': False, 'shape': ((6, 8), }", b"\0" * 192, "not a readable .npy"),
-    # a body shorter than the header's shape
-    (b"{'descr': '<f4', 'fortran_order': False, 'shape': (6, 8), }", b"\0" * 17, "17 bytes of data after the header"),
-    # an object array's header: refused by its dtype, the pickle after it never loaded
-    (b"{'descr': '|O', 'fortran_order': False, 'shape': (6, 8), }", b"\x80\x04N.", "a .npy of object"),
-])
+@pytest.mark.parametrize(
+    "header, body, expect",
+    [
+        # numpy's header parser: OverflowError computing the count of a shape of a 4,000-digit number
+        (b"{'descr': '<f4', 'fortran_order': False, 'shape': (" + b"9" * 4000 + b", 8), }", b"", "expected 8x6"),
+        # tokenize.TokenError from an unclosed bracket (found by a random byte of the header, seed 5)
+        (b"{'descr': '<f4', 'fortran_order': False, 'shape': ((6, 8), }", b"\0" * 192, "not a readable .npy"),
+        # a body shorter than the header's shape
+        (
+            b"{'descr': '<f4', 'fortran_order': False, 'shape': (6, 8), }",
+            b"\0" * 17,
+            "17 bytes of data after the header",
+        ),
+        # an object array's header: refused by its dtype, the pickle after it never loaded
+        (b"{'descr': '|O', 'fortran_order': False, 'shape': (6, 8), }", b"\x80\x04N.", "a .npy of object"),
+    ],
+)
 def test_hostile_npy_header_is_one_line(tmp_path, header, body, expect):
     (tmp_path / "d.npy").write_bytes(_npy_bytes(header, body))
     assert expect in _refused(tmp_path / "d.npy", 8, 6)
@@ -130,8 +144,10 @@ def test_png_decompression_bomb_is_one_line(tmp_path):
 
     def chunk(kind, data):
         return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-    (tmp_path / "d.png").write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0"))
-                                     + chunk(b"IEND", b""))
+
+    (tmp_path / "d.png").write_bytes(
+        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0")) + chunk(b"IEND", b"")
+    )
     assert "not a readable image" in _refused(tmp_path / "d.png", 8, 6)
 
 
@@ -145,7 +161,7 @@ def test_scale_whose_step_overflows_is_refused(tmp_path):
     # a whole map silently empty. 65535 / scale must be finite.
     Image.fromarray(np.full((2, 3), 1000, np.uint16)).save(tmp_path / "d.png")
     assert "depth scale 1e-320" in _refused(tmp_path / "d.png", 3, 2, scale=1e-320)
-    assert read_depth_map(tmp_path / "d.png", 3, 2, scale=1e-300).depth[0, 0] == 1000 / 1e-300   # finite: read
+    assert read_depth_map(tmp_path / "d.png", 3, 2, scale=1e-300).depth[0, 0] == 1000 / 1e-300  # finite: read
 
 
 @pytest.mark.parametrize("width, height", [(0, 0), (0, 6), (-8, -6), (8.0, 6), (True, 6)])

@@ -12,15 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
+from test_depth_faults import judge, mistakes, pixel_mistakes
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.judge.depth_reference import reference_depth
 from wirecheck.oracles.tolerances import MIN_SILHOUETTE_IOU
-
-from test_depth_faults import judge, mistakes, pixel_mistakes
 
 SCENES = ("cube", "prism", "pyramid")
 MOTION = Motion(turns=(1.0, 1.0, 0.0))
@@ -57,13 +55,13 @@ def test_core_depth_within_the_bound_of_pyrenders(oracles):
         iou = (on & ref.covered).sum() / (on | ref.covered).sum()
         assert iou >= MIN_SILHOUETTE_IOU, (name, case.name, iou)
         both = on & ref.covered & ~ref.undecided
-        assert ref.undecided.sum() < 0.01 * ref.covered.sum()     # few left out (occlusion edges only)
+        assert ref.undecided.sum() < 0.01 * ref.covered.sum()  # few left out (occlusion edges only)
         ratio = np.abs(core[both] - ref.depth[both]) / ref.bound[both]
         worst.append(float(ratio.max()))
         assert ratio.max() <= 1.0, (name, case.name, ratio.max())
     # measured: the largest error is 0.59 of the bound (cube, near_plane); 3,833 of 1,242,850 covered
     # pixels left out (occlusion edges and the near plane's clip line)
-    assert len(worst) == 21 and max(worst) > 0                  # compared, and not trivially equal
+    assert len(worst) == 21 and max(worst) > 0  # compared, and not trivially equal
 
 
 def test_orthographic_reference_is_linear(oracles):
@@ -73,7 +71,7 @@ def test_orthographic_reference_is_linear(oracles):
     ref = reference_depth(oracles.get(640, 480), scene, case, MOTION, 2, FRAMES)
     cam = case.camera
     # hand-derived: every depth is near + (a whole number of steps)
-    steps = (ref.depth[ref.covered] - cam.near) / ((cam.far - cam.near) / (2 ** 24 - 1))
+    steps = (ref.depth[ref.covered] - cam.near) / ((cam.far - cam.near) / (2**24 - 1))
     assert np.abs(steps - np.round(steps)).max() < 1e-3
 
 

@@ -18,10 +18,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import numpy as np
 import pytest
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
@@ -30,11 +29,13 @@ from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
 from wirecheck.oracles.judge.depth_reference import reference_depth
 
-PROBE = ("import vtk; w = vtk.vtkRenderWindow(); w.SetOffScreenRendering(1); w.SetSize(8, 8); "
-         "w.AddRenderer(vtk.vtkRenderer()); w.Render()")
+PROBE = (
+    "import vtk; w = vtk.vtkRenderWindow(); w.SetOffScreenRendering(1); w.SetSize(8, 8); "
+    "w.AddRenderer(vtk.vtkRenderer()); w.Render()"
+)
 MOTION = Motion(turns=(1.0, 1.0, 0.0))
 MISTAKES = ("correct", "zbuffer", "no_flip", "horizontal_fov")
-pytestmark = pytest.mark.slow          # 21 pyrender frames and a renderer process (15-30 s here)
+pytestmark = pytest.mark.slow  # 21 pyrender frames and a renderer process (15-30 s here)
 
 
 @pytest.fixture(scope="module")
@@ -55,22 +56,33 @@ def judged(tmp_path_factory):
             for case in cases_for(scene):
                 cam = case.camera
                 refs.append((name, case, reference_depth(cache.get(cam.width, cam.height), scene, case, MOTION, 2, 7)))
-                np.savez(folder / f"{name}-{case.name}.npz", triangles=fan,
-                         p_world=SceneRenderer(scene, case_motion(MOTION, case), 7).world_points(2),
-                         position=cam.position, forward=cam.forward, up=cam.up, fov_y_deg=cam.fov_y_deg,
-                         ortho_height=cam.ortho_height, width=cam.width, height=cam.height, near=cam.near,
-                         far=cam.far, projection=cam.projection)
+                np.savez(
+                    folder / f"{name}-{case.name}.npz",
+                    triangles=fan,
+                    p_world=SceneRenderer(scene, case_motion(MOTION, case), 7).world_points(2),
+                    position=cam.position,
+                    forward=cam.forward,
+                    up=cam.up,
+                    fov_y_deg=cam.fov_y_deg,
+                    ortho_height=cam.ortho_height,
+                    width=cam.width,
+                    height=cam.height,
+                    near=cam.near,
+                    far=cam.far,
+                    projection=cam.projection,
+                )
     finally:
         cache.close()
     client = Path(__file__).parent / "clients" / "vtk_depth.py"
-    subprocess.run([sys.executable, str(client), str(folder)], check=True, timeout=300)    # the renderer, as users run it
+    subprocess.run([sys.executable, str(client), str(folder)], check=True, timeout=300)  # the renderer, as users run it
     out = []
     for name, case, ref in refs:
         cam = case.camera
         for mistake in MISTAKES:
             depth = read_depth_map(folder / f"{name}-{case.name}.{mistake}.npy", cam.width, cam.height)
-            d = name_depth_faults(depth.depth, ref.compared_depth(), ref.bound, cam, depth.encoding_bound(),
-                                  faces=ref.compared_faces())
+            d = name_depth_faults(
+                depth.depth, ref.compared_depth(), ref.bound, cam, depth.encoding_bound(), faces=ref.compared_faces()
+            )
             out.append((name, case.name, None if mistake == "correct" else mistake, d, cam))
     return out
 
@@ -103,7 +115,7 @@ def test_horizontal_view_angle_is_fov_mismatch(judged):
     rows = [(name, case, d, cam) for name, case, mistake, d, cam in judged if mistake == "horizontal_fov"]
     assert len(rows) == 21
     for name, case, d, cam in rows:
-        if cam.projection == "orthographic":            # a parallel projection has no view angle
+        if cam.projection == "orthographic":  # a parallel projection has no view angle
             assert d.verdict == "pass", (name, case, d.names)
             continue
         assert d.names == ("fov_mismatch",), (name, case, d.names)

@@ -15,25 +15,40 @@ from collections import Counter
 
 import numpy as np
 import pytest
-
+from diagnosis_faults import (  # the faulty projectors and their cameras
+    CALIBRATED_CAMERAS,
+    CALIBRATED_FAULTS,
+    CAMERAS,
+    CLIP_FAULTS,
+    FAULTS,
+    LENS_CAMERAS,
+    LENS_PINCUSHION,
+    PP_SHIFT,
+    SINGLE,
+    _lens_with,
+    _project,
+    _with,
+    f_depth_flip,
+    f_fov_offset,
+    f_none,
+    f_swap,
+    implied_fov,
+)
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.projection import project_points
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
 from wirecheck.oracles.diagnosis.clip_planes import probe_planes
 from wirecheck.oracles.diagnosis.diagnose import diagnose, primary
-from wirecheck.oracles.faults import NAMES as FAULT_ORDER, names as fault_names
+from wirecheck.oracles.faults import NAMES as FAULT_ORDER
+from wirecheck.oracles.faults import names as fault_names
 from wirecheck.oracles.tolerances import vertex_bound, vertex_scale
-
-from diagnosis_faults import (  # the faulty projectors and their cameras
-    CAMERAS, LENS_PINCUSHION, LENS_CAMERAS, CALIBRATED_CAMERAS, _with, _project, f_none, f_swap, implied_fov,
-    f_fov_offset, f_depth_flip, PP_SHIFT, _lens_with, FAULTS, SINGLE, CLIP_FAULTS, CALIBRATED_FAULTS,
-)
 
 try:
     from wirecheck.oracles.references.opencv_oracle import project as oracle_project
+
     ORACLE = "opencv"
-except ImportError:                                   # pragma: no cover - fallback only
+except ImportError:  # pragma: no cover - fallback only
     oracle_project = project_points
     ORACLE = "core"
 
@@ -59,6 +74,7 @@ SCENES = ("cube", "pyramid", "prism")
 
 # ---- points -----------------------------------------------------------------
 
+
 def pooled_points(motion: Motion = Motion(), frames: int = FRAMES) -> np.ndarray:
     """World points of all bundled scenes over all frames of a run, stacked."""
     out = []
@@ -77,16 +93,21 @@ POINTS_AROUND = pooled_points(Motion(turns=(1.0, 2.0, 1.0), scale=2.0))
 # non-empty); "transposed" is invisible on the "axis" camera (its rotation
 # diag(1, 1, -1) is its own transpose), tested separately below.
 MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
-CASES = [(f, c) for f in FAULTS for c in MAIN_CAMERAS
-         if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS and f not in CLIP_FAULTS
-         # the ortho camera's constants (scale 300/5 = 60, cx 199.5, cy 149.5) are exact in float32
-         and not (f == "float32_k" and c == "ortho")]
+CASES = [
+    (f, c)
+    for f in FAULTS
+    for c in MAIN_CAMERAS
+    if not (f == "transposed" and c == "axis")
+    and f not in CALIBRATED_FAULTS
+    and f not in CLIP_FAULTS
+    # the ortho camera's constants (scale 300/5 = 60, cx 199.5, cy 149.5) are exact in float32
+    and not (f == "float32_k" and c == "ortho")
+]
 CASES += [("none", "inside"), ("depth_flip", "inside"), ("roll", "inside")]
 CASES += [(f, "clip") for f in ("none", "depth_flip") + CLIP_FAULTS]
 # calibrated cameras: the faults of a principal point, of fx/fy and of the lens, and
 # the unexplained ones, which a lens profile must not absorb
-CASES += [(f, c) for f in ("none", "pp_offset", "fov", "depth_flip", "roll", "transposed")
-          for c in CALIBRATED_CAMERAS]
+CASES += [(f, c) for f in ("none", "pp_offset", "fov", "depth_flip", "roll", "transposed") for c in CALIBRATED_CAMERAS]
 CASES += [(f, c) for f, cams in CALIBRATED_FAULTS.items() for c in cams]
 
 
@@ -130,13 +151,14 @@ def results32():
 
 # ---- the exact set of names per pair ---------------------------------------
 
+
 @pytest.mark.parametrize("fault,camera_name", CASES)
 def test_expected_names(results, fault, camera_name):
     got = results[(fault, camera_name)]
     names = [d["name"] for d in got]
     assert set(names) == FAULTS[fault][1], got
     assert len(names) == len(set(names))
-    assert names == sorted(names, key=FAULT_ORDER.index)          # primary first
+    assert names == sorted(names, key=FAULT_ORDER.index)  # primary first
 
 
 @pytest.mark.parametrize("fault,camera_name", CASES32)
@@ -191,6 +213,7 @@ def test_transposed_rotation_invisible_on_axis():
 
 # ---- the numbers -------------------------------------------------------------
 
+
 @pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
 def test_implied_fov(results, camera_name):
     cam = CAMERAS[camera_name]
@@ -239,8 +262,9 @@ def test_pixel_count_minus_one_hint(camera_name):
     cam = CAMERAS[camera_name]
     fx, fy = cam.focal_xy
     w, h = cam.width, cam.height
-    got = diagnose(_project(POINTS, cam, fx=fx * (w - 1) / w, fy=fy * (h - 1) / h), oracle_project(POINTS, cam),
-                   cam, tol_px=TOL)
+    got = diagnose(
+        _project(POINTS, cam, fx=fx * (w - 1) / w, fy=fy * (h - 1) / h), oracle_project(POINTS, cam), cam, tol_px=TOL
+    )
     faults = {f["name"]: f for f in got}
     assert set(faults) == {"aspect_mismatch", "fov_mismatch"}
     assert "pixel count minus one" in faults["aspect_mismatch"]["hint"]
@@ -255,8 +279,13 @@ def test_float32_aspect_is_precision_limited():
     a32 = float(np.float32(cam.width / cam.height))
     fy = cam.focal_xy[1]
     ref = oracle_project(POINTS, cam)
-    got = diagnose(_project(POINTS, cam, fx=fy * (cam.width / cam.height) / a32), ref, cam, tol_px=TOL,
-                   float32_px=float32_bound(POINTS, cam, ref))
+    got = diagnose(
+        _project(POINTS, cam, fx=fy * (cam.width / cam.height) / a32),
+        ref,
+        cam,
+        tol_px=TOL,
+        float32_px=float32_bound(POINTS, cam, ref),
+    )
     assert [(f["name"], f.get("kind")) for f in got] == [("precision_limited", "float32_constants")], got
     # the fitted scale is (W/H) / a32 to ~3.5e-14 relative (budget above)
     assert got[0]["scale_x"] / got[0]["scale_y"] == pytest.approx((cam.width / cam.height) / a32, rel=1e-12)
@@ -341,8 +370,11 @@ def test_fxfy_swap_scales(results, camera_name):
 
 
 LENS_KINDS = {"lens_ignored": "ignored", "k1_sign": "k1_sign", "k2_wrong": "magnitude"}
-LENS_OF = {"lens_ignored": lambda cam: (0.0, 0.0, 0.0, 0.0), "k1_sign": lambda cam: _lens_with(cam, 0, -1.0),
-           "k2_wrong": lambda cam: _lens_with(cam, 1, 2.0)}
+LENS_OF = {
+    "lens_ignored": lambda cam: (0.0, 0.0, 0.0, 0.0),
+    "k1_sign": lambda cam: _lens_with(cam, 0, -1.0),
+    "k2_wrong": lambda cam: _lens_with(cam, 1, 2.0),
+}
 
 
 @pytest.mark.parametrize("camera_name", LENS_CAMERAS)
@@ -366,7 +398,7 @@ def test_lens_added_to_a_camera_without_one():
     cam = CAMERAS["k_offc"]
     (got,) = diagnose(_project(POINTS, cam, dist=LENS_PINCUSHION), oracle_project(POINTS, cam), cam, tol_px=TOL)
     assert (got["name"], got["kind"]) == ("distortion_mismatch", "added")
-    assert got["k1"] == pytest.approx(LENS_PINCUSHION[0], abs=1e-9)       # bound as above
+    assert got["k1"] == pytest.approx(LENS_PINCUSHION[0], abs=1e-9)  # bound as above
 
 
 def test_unexplained_fields(results):
@@ -376,7 +408,7 @@ def test_unexplained_fields(results):
     # exactly an image rotation, so its affine residual is only the pixel noise
     # (measured 1.1e-13 px) << TOL.
     assert u["residual_px"] > TOL
-    assert u["affine_residual_px"] < TOL                 # a roll is an image rotation...
+    assert u["affine_residual_px"] < TOL  # a roll is an image rotation...
     # ...of the roll angle (y down). rotation_deg = atan2(A10 - A01, A00 + A11):
     # entries of A off by <= 3.5e-14 (budget above), so the angle by ~1e-13 rad
     # = 6e-12 deg (measured 9e-15); 1e-9 deg leaves ~150x margin (was 1e-6).
@@ -389,6 +421,7 @@ def test_unexplained_fields(results):
 
 
 # ---- degenerate inputs -------------------------------------------------------
+
 
 def test_degenerate_inputs():
     cam = CAMERAS["axis"]
@@ -445,6 +478,7 @@ def test_large_pooled_input_is_fast():
 
 # ---- confusion matrix --------------------------------------------------------
 
+
 def confusion(results):
     """rows: injected single fault (by its expected primary name); columns: diagnosed primary."""
     # the vertex faults: the line faults come from the pixels (tests/test_line_gate.py)
@@ -463,12 +497,19 @@ def confusion(results):
 
 
 def format_confusion(labels, rows, counts):
-    short = {n: n.replace("mirror_horizontal", "mirr_h").replace("mirror_vertical", "mirr_v")
-             .replace("_mismatch", "").replace("pixel_", "").replace("unexplained", "unexpl")
-             for n in labels}
+    short = {
+        n: n.replace("mirror_horizontal", "mirr_h")
+        .replace("mirror_vertical", "mirr_v")
+        .replace("_mismatch", "")
+        .replace("pixel_", "")
+        .replace("unexplained", "unexpl")
+        for n in labels
+    }
     width = max(len(r) for r in rows) + 1
-    lines = [f"confusion matrix (oracle: {ORACLE}; rows injected, columns diagnosed primary)",
-             " " * width + " ".join(f"{short[c]:>8}" for c in labels)]
+    lines = [
+        f"confusion matrix (oracle: {ORACLE}; rows injected, columns diagnosed primary)",
+        " " * width + " ".join(f"{short[c]:>8}" for c in labels),
+    ]
     for r in rows:
         lines.append(f"{r:<{width}}" + " ".join(f"{counts[(r, c)] or '.':>8}" for c in labels))
     return "\n".join(lines)
@@ -480,13 +521,15 @@ def test_confusion_matrix_is_diagonal(results, summary_section):
     summary_section("diagnosis confusion matrix", format_confusion(labels, rows, counts))
     off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
     assert not off, off
-    assert set(rows) == set(labels)                      # every fault name was injected
+    assert set(rows) == set(labels)  # every fault name was injected
 
 
 def test_float32_confusion_matrix_is_diagonal(results32, summary_section):
     labels, rows, counts = confusion(results32)
-    summary_section("diagnosis confusion matrix, float32 twins (judged at the float32 bound)",
-                    format_confusion(labels, rows, counts))
+    summary_section(
+        "diagnosis confusion matrix, float32 twins (judged at the float32 bound)",
+        format_confusion(labels, rows, counts),
+    )
     off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
     assert not off, off
-    assert set(rows) == set(labels) - {"precision_limited"}   # every fault but the float64-only one
+    assert set(rows) == set(labels) - {"precision_limited"}  # every fault but the float64-only one

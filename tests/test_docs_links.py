@@ -14,8 +14,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 #: Pages other branches are writing; links to them are allowed until they land. Empty this
 #: set when they are merged (an entry whose file exists is an error, so it cannot go stale).
-PENDING = {
-}
+PENDING = {}
 
 #: Pages whose README link is written by the lead at merge (helpers do not edit README.md);
 #: docs/index.md links them meanwhile. Remove an entry when README.md links it.
@@ -43,8 +42,7 @@ def prose_lines(text: str):
 
 def links(path: Path) -> list[tuple[int, str]]:
     """``(line_number, target)`` of every Markdown link and image in ``path``."""
-    return [(n, m.group(1)) for n, line in prose_lines(path.read_text(encoding="utf-8"))
-            for m in _LINK.finditer(line)]
+    return [(n, m.group(1)) for n, line in prose_lines(path.read_text(encoding="utf-8")) for m in _LINK.finditer(line)]
 
 
 def slug(heading: str) -> str:
@@ -75,7 +73,7 @@ def broken_links(path: Path, root: Path = ROOT, pending=frozenset(PENDING)) -> l
     """
     problems = []
     for number, target in links(path):
-        if re.match(r"[a-z][a-z0-9+.-]*:", target):            # http:, https:, mailto:
+        if re.match(r"[a-z][a-z0-9+.-]*:", target):  # http:, https:, mailto:
             continue
         file_part, _, fragment = target.partition("#")
         dest = (path.parent / file_part).resolve() if file_part else path
@@ -124,11 +122,20 @@ def test_checker_finds_broken_links(tmp_path):
     # anchor, one link inside code (ignored), one external link (ignored).
     page = tmp_path / "page.md"
     (tmp_path / "there.md").write_text("# Here it is\n", encoding="utf-8")
-    page.write_text("# Top\n\n[ok](there.md) [gone](missing.png) ![img](there.md#nope)\n"
-                    "[self](#top) [good](there.md#here-it-is) `[x](code.md)` [web](https://example.org)\n"
-                    "```\n[fenced](fenced.md)\n```\n", encoding="utf-8")
-    assert [t for _, t in links(page)] == ["there.md", "missing.png", "there.md#nope", "#top",
-                                           "there.md#here-it-is", "https://example.org"]
+    page.write_text(
+        "# Top\n\n[ok](there.md) [gone](missing.png) ![img](there.md#nope)\n"
+        "[self](#top) [good](there.md#here-it-is) `[x](code.md)` [web](https://example.org)\n"
+        "```\n[fenced](fenced.md)\n```\n",
+        encoding="utf-8",
+    )
+    assert [t for _, t in links(page)] == [
+        "there.md",
+        "missing.png",
+        "there.md#nope",
+        "#top",
+        "there.md#here-it-is",
+        "https://example.org",
+    ]
     assert anchors(page) == {"top"}
     assert slug("`crosscheck`: what it says") == "crosscheck-what-it-says"
     problems = broken_links(page, root=tmp_path, pending=frozenset())

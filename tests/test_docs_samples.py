@@ -17,9 +17,8 @@ import re
 import sys
 import tempfile
 
-import pytest
-
 import docs_samples as ds
+import pytest
 
 SAMPLES = [s for s in ds.all_samples() if s.not_run is None]
 
@@ -65,13 +64,15 @@ def test_the_readmes_five_line_example_works_as_written_in_a_fresh_project(runne
     out = runner.in_project(project, pytest)
     assert out and re.fullmatch(r"1 passed in [\d.]+s", out[-1]), "\n".join(out)
     # the same test fails a principal point at (W/2, H/2), naming the fault: it checks something
-    corner = correct + ("\n_correct = project\n\n\ndef project(points, camera):\n"
-                        "    return _correct(points, camera, cx=camera.width / 2, cy=camera.height / 2)\n")
+    corner = correct + (
+        "\n_correct = project\n\n\ndef project(points, camera):\n"
+        "    return _correct(points, camera, cx=camera.width / 2, cy=camera.height / 2)\n"
+    )
     out = runner.in_project({**project, "my_package/__init__.py": corner}, pytest)
     assert re.fullmatch(r"1 failed in [\d.]+s", out[-1]) and any("pixel_offset(dx=0.5, dy=0.5)" in x for x in out)
     # and without the setting (nor an install) pytest cannot import the package: what the README says
     if sys.version_info < (3, 11):
-        return                                        # no PYTHONSAFEPATH: `python -m` adds the folder
+        return  # no PYTHONSAFEPATH: `python -m` adds the folder
     out = runner.in_project({k: v for k, v in project.items() if k != "pyproject.toml"}, pytest)
     assert any("No module named 'my_package'" in x for x in out), "\n".join(out)
 
@@ -84,12 +85,13 @@ def test_not_run_samples_say_why():
 
 # -- the comparison itself (hand-made outputs: no program run) --------------------------------
 
+
 def test_an_edited_number_is_a_difference():
     doc = ["PASS: 21/21 cases, 504 frames", "Level pixels: vertex stage 1.59 ms/frame (11.9 s wall)"]
     run = ["PASS: 21/21 cases, 504 frames", "Level pixels: vertex stage 4.27 ms/frame (42.7 s wall)"]
-    assert ds.matches(doc, run)                       # times differ: normalised
-    assert not ds.matches(["PASS: 20/21 cases, 504 frames", doc[1]], run)   # a count does not
-    assert not ds.matches(doc, run + ["Candidate precision: float64"])        # a line more
+    assert ds.matches(doc, run)  # times differ: normalised
+    assert not ds.matches(["PASS: 20/21 cases, 504 frames", doc[1]], run)  # a count does not
+    assert not ds.matches(doc, run + ["Candidate precision: float64"])  # a line more
 
 
 def test_elision_stands_for_any_lines_and_only_where_it_is():
@@ -97,41 +99,69 @@ def test_elision_stands_for_any_lines_and_only_where_it_is():
     assert ds.matches(["head", "...", "", "FAIL: 0/7", "Report: reports/20261121-193000/report.json"], run)
     assert ds.matches(["head", "a", "b", "c", "...", "FAIL: 0/7", "..."], run)
     assert not ds.matches(["head", "...", "FAIL: 0/6", "..."], run)
-    assert not ds.matches(["a", "..."], run)          # the head is compared from the first line
+    assert not ds.matches(["a", "..."], run)  # the head is compared from the first line
 
 
 def test_update_keeps_the_shape_of_a_block():
-    doc = ["scene camera", "cube on_axis 1", "...", "  cube / on_axis: reason", "  ...", "",
-           "FAIL: 0/7 cases", "Report: reports/20261121-193000/report.json"]
-    run = ["scene camera", "cube on_axis 1", "cube oblique 2", "cube wide 3",
-           "  cube / on_axis: reason (float64 bound)", "  cube / oblique: reason", "",
-           "FAIL: 0/7 cases", "Candidate precision: float64", "Report: reports/20261127-042124/report.json"]
+    doc = [
+        "scene camera",
+        "cube on_axis 1",
+        "...",
+        "  cube / on_axis: reason",
+        "  ...",
+        "",
+        "FAIL: 0/7 cases",
+        "Report: reports/20261121-193000/report.json",
+    ]
+    run = [
+        "scene camera",
+        "cube on_axis 1",
+        "cube oblique 2",
+        "cube wide 3",
+        "  cube / on_axis: reason (float64 bound)",
+        "  cube / oblique: reason",
+        "",
+        "FAIL: 0/7 cases",
+        "Candidate precision: float64",
+        "Report: reports/20261127-042124/report.json",
+    ]
     assert ds.reshape(doc, run) == [
-        "scene camera", "cube on_axis 1", "...", "  cube / on_axis: reason (float64 bound)",
-        "  ...", "", "FAIL: 0/7 cases", "Candidate precision: float64",
-        "Report: reports/20261127-042124/report.json"]
+        "scene camera",
+        "cube on_axis 1",
+        "...",
+        "  cube / on_axis: reason (float64 bound)",
+        "  ...",
+        "",
+        "FAIL: 0/7 cases",
+        "Candidate precision: float64",
+        "Report: reports/20261127-042124/report.json",
+    ]
     assert ds.matches(ds.reshape(doc, run), run)
 
 
 def test_update_then_check_round_trips(tmp_path):
     doc = tmp_path / "page.md"
-    doc.write_text("Intro\n\n```\n$ printf 'a\\nb\\nc\\nd\\n'\na\n...\nd\nold line\n```\n\n"
-                   "    $ echo 'took 1.5 s'\n    took 9.9 s\n", encoding="utf-8")
+    doc.write_text(
+        "Intro\n\n```\n$ printf 'a\\nb\\nc\\nd\\n'\na\n...\nd\nold line\n```\n\n"
+        "    $ echo 'took 1.5 s'\n    took 9.9 s\n",
+        encoding="utf-8",
+    )
     runner = ds.Runner()
     try:
         (first, second) = ds.samples(doc)
-        assert ds.check(first, runner)                # "old line" is not printed
-        assert not ds.check(second, runner)           # a time: normalised
+        assert ds.check(first, runner)  # "old line" is not printed
+        assert not ds.check(second, runner)  # a time: normalised
         ds.update([doc], runner)
         assert doc.read_text(encoding="utf-8") == (
-            "Intro\n\n```\n$ printf 'a\\nb\\nc\\nd\\n'\na\n...\nd\n```\n\n"
-            "    $ echo 'took 1.5 s'\n    took 1.5 s\n")
+            "Intro\n\n```\n$ printf 'a\\nb\\nc\\nd\\n'\na\n...\nd\n```\n\n    $ echo 'took 1.5 s'\n    took 1.5 s\n"
+        )
         assert not any(ds.check(s, runner) for s in ds.samples(doc))
     finally:
         runner.close()
 
 
 # -- option tables --------------------------------------------------------------------------
+
 
 def _table_options(path):
     """Every ``--option`` in the first column of the Markdown tables of ``path``."""
@@ -144,8 +174,7 @@ def _table_options(path):
 
 
 def _parser_options(parser):
-    return {s for a in parser._actions for s in a.option_strings
-            if s.startswith("--") and s != "--help"}
+    return {s for a in parser._actions for s in a.option_strings if s.startswith("--") and s != "--help"}
 
 
 @pytest.mark.parametrize("program", ["renderer", "crosscheck"])
@@ -156,12 +185,13 @@ def test_option_table_is_the_parser(program):
         from wirecheck.oracles.cli import build_parser
     documented = _table_options(ds.ROOT / "docs" / f"{program}.md")
     real = _parser_options(build_parser())
-    assert "--version" in real and len(real) > 20      # the parser was read
+    assert "--version" in real and len(real) > 20  # the parser was read
     assert not real - documented, f"options of {program} missing from docs/{program}.md's table"
     assert not documented - real, f"docs/{program}.md documents options {program} does not have"
 
 
 # -- fences ---------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("path", ds.doc_files(), ids=lambda p: p.name)
 def test_fences_are_balanced(path):
@@ -187,9 +217,11 @@ def test_every_cwd_directive_names_a_folder_of_the_repository():
 
 # -- running: a fork of this process prints what a new process prints -------------------------
 
-FORKED = ["renderer --scene cube --frames 2 --camera-z 4.0 --trace-vertex 6 --trace-frames 1",   # stdout
-          "renderer --camera-pos 0,4,0",                   # one stderr line, exit 2
-          "crosscheck --scene cube --level vertices --frames 1 --cases on_axis --no-report"]
+FORKED = [
+    "renderer --scene cube --frames 2 --camera-z 4.0 --trace-vertex 6 --trace-frames 1",  # stdout
+    "renderer --camera-pos 0,4,0",  # one stderr line, exit 2
+    "crosscheck --scene cube --level vertices --frames 1 --cases on_axis --no-report",
+]
 
 
 @pytest.mark.parametrize("command", FORKED)
@@ -198,7 +230,7 @@ def test_a_forked_command_prints_what_bash_running_it_prints(command, tmp_path):
     env = ds.Runner._env()
     forked = ds._run_forked(command.split()[0], command.split()[1:], str(tmp_path), env)
     bash = ds.Runner._run_bash(command, str(tmp_path), env)
-    assert forked and ds.matches(bash, forked)             # times normalised, every other character the same
+    assert forked and ds.matches(bash, forked)  # times normalised, every other character the same
 
 
 def test_a_report_excerpt_reads_the_folder_of_the_run_it_follows():
@@ -207,11 +239,12 @@ def test_a_report_excerpt_reads_the_folder_of_the_run_it_follows():
         first = "renderer --scene cube --frames 2 --camera-z 4.0"
         shown = runner.output(first)
         listing = runner.output(f"{first} >/dev/null; ls -A | sort")
-        again = runner._run_bash(f"{first} >/dev/null; ls -A | sort", tempfile.mkdtemp(dir=runner._dirs[0]),
-                                 runner._env())
+        again = runner._run_bash(
+            f"{first} >/dev/null; ls -A | sort", tempfile.mkdtemp(dir=runner._dirs[0]), runner._env()
+        )
     finally:
         runner.close()
-    assert shown and len(runner._cache) == 2 and len(runner._folders) == 1     # the renderer ran once
+    assert shown and len(runner._cache) == 2 and len(runner._folders) == 1  # the renderer ran once
     # what the renderer wrote, as a run of the whole line in an empty folder lists it (less the links)
     assert [n for n in listing if n not in (".venv", "scenes", "tests")] == again and again
 

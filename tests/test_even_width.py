@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from test_line_style import _band, _fill, _judge, draw_pillow, job_dir  # noqa: F401 - job_dir: the module's fixture
-
 from wirecheck.oracles.judge import even_lean
 from wirecheck.oracles.judge.line_style import RULE_OFFSET_MAX_PX
 
@@ -31,10 +30,12 @@ def _without_longest(draw):
     def drawn(segs, w, h):
         longest = int(np.argmax(np.hypot(*(segs[:, 1] - segs[:, 0]).T)))
         return draw(np.delete(segs, longest, axis=0), w, h)
+
     return drawn
 
 
 # ---- the three bands, by hand ----
+
 
 def test_reference_offsets_by_hand():
     # a horizontal line (normal (0, 1)) at y = 10.3 and 10.7, 2 px: the whole rows in [y + s - 1, y + s + 1]
@@ -80,7 +81,6 @@ def test_fit_keeps_a_symmetric_band_moved_half_a_pixel():
     # used (they would explain the lines near the axes at d = 0)
     got = even_lean.fit(*_edges((0.5, 0.5), [0] * 12), 2)
     assert not got["leaning"] and got["ms_symmetric"] < 1e-20
-
 
 
 def _axis_edges(leans_h, leans_v, per_edge=10):

@@ -18,7 +18,7 @@ KEYS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 def test_pool_workers_get_one_blas_thread_and_the_caller_keeps_its_environment(monkeypatch):
     for key in KEYS:
         monkeypatch.delenv(key, raising=False)
-    monkeypatch.setenv("OMP_NUM_THREADS", "3")             # the caller's choice wins
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")  # the caller's choice wins
     with open_executor(ExecutorSpec("local", jobs=2), n_tasks=2) as (pool, workers):
         assert workers == 2
         seen = [pool.submit(os.getenv, key).result() for key in KEYS for _ in range(2)]

@@ -6,7 +6,6 @@ import os
 import shutil
 
 import pytest
-
 from wirecheck.core.scene.files import SCENE_DIR
 from wirecheck.oracles import cli as crosscheck_cli
 
@@ -26,7 +25,7 @@ def _tree(folder):
 def job_name():
     name = f"wirecheck-test-export-{os.getpid()}"
     yield name
-    for folder in (SCENE_DIR, SCENE_DIR / "examples"):     # before the fix the job was written there: remove it
+    for folder in (SCENE_DIR, SCENE_DIR / "examples"):  # before the fix the job was written there: remove it
         shutil.rmtree(folder / name, ignore_errors=True)
 
 
@@ -41,6 +40,8 @@ def test_export_into_the_bundled_scenes_is_refused(tmp_path, capsys, job_name, w
     rc = crosscheck_cli.main(["export", str(target), "--scene", "cube", "--cases", "on_axis", "--frames", "1"])
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1, err
-    assert err == (f"crosscheck: error: export DIR {str(target)!r} is inside the scenes folder {str(SCENE_DIR)!r}: "
-                   "expected a job folder elsewhere (e.g. job/)\n")
+    assert err == (
+        f"crosscheck: error: export DIR {str(target)!r} is inside the scenes folder {str(SCENE_DIR)!r}: "
+        "expected a job folder elsewhere (e.g. job/)\n"
+    )
     assert _tree(SCENE_DIR) == before

@@ -15,18 +15,17 @@ import json
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles import extremes
-from wirecheck.oracles.extremes import bounds, cases, measure
-from wirecheck.oracles.extremes import EXTREME_CASES, extremes_markdown, run_case, run_extremes
+from wirecheck.oracles.extremes import EXTREME_CASES, bounds, cases, extremes_markdown, measure, run_case, run_extremes
 from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 from wirecheck.oracles.tolerances import MIN_F1_1PX_EXTREMES
 
 HAVE_OSMESA = osmesa_available()[0]
 
 # The reference needs a long double wider than float64 (x87 80-bit on x86-64 Linux).
-pytestmark = pytest.mark.skipif(not extremes.REFERENCE_EXTENDED,
-                                reason="np.longdouble is plain float64 here: no extended-precision reference")
+pytestmark = pytest.mark.skipif(
+    not extremes.REFERENCE_EXTENDED, reason="np.longdouble is plain float64 here: no extended-precision reference"
+)
 
 
 @pytest.fixture(scope="module")
@@ -61,9 +60,9 @@ def test_suite_runs_without_pyrender(suite_without_pyrender):
     assert res["pyrender"] is False
     for c in res["cases"]:
         assert c["pyrender"] is None and c["pyrender_note"], c["name"]
-    json.dumps(res, allow_nan=False)           # strict JSON: no NaN / inf anywhere
+    json.dumps(res, allow_nan=False)  # strict JSON: no NaN / inf anywhere
     md = extremes_markdown(res)
-    assert md.count("\n| ") == len(EXTREME_CASES) + 2     # header, rule, one row per case
+    assert md.count("\n| ") == len(EXTREME_CASES) + 2  # header, rule, one row per case
     for name in EXTREME_CASES:
         assert f"| {name} |" in md and f"**{name}**" in md
 
@@ -82,8 +81,19 @@ def test_report_prints_every_derivation(suite_without_pyrender):
         c = next(r for r in res["cases"] if r["name"] == case.__name__)
         assert c["bound_derivation"] == bounds.derivation(case) and c["bound_derivation"], c["name"]
         assert f"Bound: {c['bound_derivation']}" in md
-        named = [b for b in ("camera_error", "pixel_bound", "focal_condition", "near_band", "clipped_end_bounds",
-                             "motion_matrix_error", "orthonormality_error") if b in c["bound_derivation"]]
+        named = [
+            b
+            for b in (
+                "camera_error",
+                "pixel_bound",
+                "focal_condition",
+                "near_band",
+                "clipped_end_bounds",
+                "motion_matrix_error",
+                "orthonormality_error",
+            )
+            if b in c["bound_derivation"]
+        ]
         assert named, c["name"]
         assert all(f"- **{b}**: " in md for b in named), (c["name"], named)
 
@@ -93,9 +103,17 @@ def test_results_are_deterministic(suite_without_pyrender):
     again = run_case("near_grazing", pyrender=False)
     first = next(c for c in suite_without_pyrender["cases"] if c["name"] == "near_grazing")
     assert json.dumps(again, sort_keys=True) == json.dumps(first, sort_keys=True)
-    assert set(suite_without_pyrender) == {"suite", "verdict", "pyrender", "oracle_gl", "reference", "bounds",
-                                           "cases", "timing"}
-    assert suite_without_pyrender["oracle_gl"] is None        # no GL drew anything
+    assert set(suite_without_pyrender) == {
+        "suite",
+        "verdict",
+        "pyrender",
+        "oracle_gl",
+        "reference",
+        "bounds",
+        "cases",
+        "timing",
+    }
+    assert suite_without_pyrender["oracle_gl"] is None  # no GL drew anything
 
 
 def test_bounds_are_not_vacuous(suite_without_pyrender):
@@ -148,9 +166,24 @@ def test_reference_is_independent_of_core_basis():
     from wirecheck.core.camera import look_at
 
     cam = look_at((3, 2, 4), (0, 0, 0), (0.3, 1.0, 0.1), fov_y_deg=55)
-    liar = SimpleNamespace(**{k: getattr(cam, k) for k in (
-        "position", "forward", "up", "fov_y_deg", "width", "height", "near", "far", "projection",
-        "ortho_height")}, right=-cam.right)
+    liar = SimpleNamespace(
+        **{
+            k: getattr(cam, k)
+            for k in (
+                "position",
+                "forward",
+                "up",
+                "fov_y_deg",
+                "width",
+                "height",
+                "near",
+                "far",
+                "projection",
+                "ortho_height",
+            )
+        },
+        right=-cam.right,
+    )
     pts = np.random.default_rng(3).uniform(-1, 1, (20, 3))
     a = extremes.reference_project(pts, cam)[1]
     b = extremes.reference_project(pts, liar)[1]

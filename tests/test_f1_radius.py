@@ -12,31 +12,44 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from test_line_style import _fill, _judge, draw_wide, job_dir  # noqa: F401 - job_dir: the module's fixture
-
 from wirecheck.oracles.judge import f1_radius
 from wirecheck.oracles.judge.decide import decide
 from wirecheck.oracles.judge.evidence import CaseEvidence, Radius
 from wirecheck.oracles.tolerances import Tolerances
 
 
-@pytest.mark.parametrize("style, width, radius", [
-    # aliased: 1-px lines, F1@1px whatever the width measured (0.71-1 across a 1-px line)
-    ("aliased", 1.0, 1), ("aliased", 0.71, 1),
-    # antialiased 1-px lines: n = 1, no reach past a 1-px line: 1; a 1.5-px one rounds to n = 2
-    ("antialiased", 1.0, 1), ("antialiased", 1.41, 1), ("antialiased", 1.5, 2),
-    # wide: n = 2 -> 1 + ceil(1/2) = 2; n = 3 -> 1 + 1 = 2; n = 4 -> 1 + ceil(3/2) = 3; n = 5 -> 3
-    ("wide", 1.83, 2), ("wide", 3.0, 2), ("wide", 3.24, 2), ("wide", 4.0, 3), ("wide", 5.0, 3),
-    # past 5 px the radius stays MAX_RADIUS_PX = 3 (stricter for the line, never looser)
-    ("wide", 9.0, 3),
-])
+@pytest.mark.parametrize(
+    "style, width, radius",
+    [
+        # aliased: 1-px lines, F1@1px whatever the width measured (0.71-1 across a 1-px line)
+        ("aliased", 1.0, 1),
+        ("aliased", 0.71, 1),
+        # antialiased 1-px lines: n = 1, no reach past a 1-px line: 1; a 1.5-px one rounds to n = 2
+        ("antialiased", 1.0, 1),
+        ("antialiased", 1.41, 1),
+        ("antialiased", 1.5, 2),
+        # wide: n = 2 -> 1 + ceil(1/2) = 2; n = 3 -> 1 + 1 = 2; n = 4 -> 1 + ceil(3/2) = 3; n = 5 -> 3
+        ("wide", 1.83, 2),
+        ("wide", 3.0, 2),
+        ("wide", 3.24, 2),
+        ("wide", 4.0, 3),
+        ("wide", 5.0, 3),
+        # past 5 px the radius stays MAX_RADIUS_PX = 3 (stricter for the line, never looser)
+        ("wide", 9.0, 3),
+    ],
+)
 def test_radius_from_the_width_read(style, width, radius):
     assert f1_radius.radius_px({"style": style, "width_px": width}) == radius
 
 
 def _reasons(f1_1px: float, radius: int, f1_radius: float, frame: int = 4) -> list:
-    ev = CaseEvidence(level="frames", compared={"frames": 2, "vertices": 0, "pixels": 100}, frames_checked=2,
-                      pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": f1_1px, "worst_pixel_frame": 1},
-                      radius=Radius(radius, f1_radius, frame))
+    ev = CaseEvidence(
+        level="frames",
+        compared={"frames": 2, "vertices": 0, "pixels": 100},
+        frames_checked=2,
+        pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": f1_1px, "worst_pixel_frame": 1},
+        radius=Radius(radius, f1_radius, frame),
+    )
     return list(decide(ev, Tolerances()).reasons)
 
 
@@ -50,10 +63,10 @@ def test_the_f1_at_the_radius_alone_decides():
 
 def test_radius_read_takes_the_worst_frame_at_the_radius():
     per_frame = [{2: 0.9991, 3: 1.0}, {2: 0.9993, 3: 1.0}]
-    assert f1_radius.radius_read({"style": "wide", "width_px": 3.0}, per_frame, [1, 4], 0.99, 4) == \
-        Radius(2, 0.9991, 1)
-    assert f1_radius.radius_read({"style": "aliased", "width_px": 1.0}, per_frame, [1, 4], 0.99, 4) == \
-        Radius(1, 0.99, 4)
+    assert f1_radius.radius_read({"style": "wide", "width_px": 3.0}, per_frame, [1, 4], 0.99, 4) == Radius(2, 0.9991, 1)
+    assert f1_radius.radius_read({"style": "aliased", "width_px": 1.0}, per_frame, [1, 4], 0.99, 4) == Radius(
+        1, 0.99, 4
+    )
 
 
 def _without_longest(segs, w, h):
@@ -92,12 +105,20 @@ def test_the_style_note_says_the_radius():
     from wirecheck.oracles.judge.line_style import CANNOT_SHOW, summary_lines
 
     def case(width, radius):
-        return {"line_style": {"style": "wide", "line_rule": "gl", "width_px": width, "judged_by": "the centres",
-                               "f1_radius_px": radius}}
+        return {
+            "line_style": {
+                "style": "wide",
+                "line_rule": "gl",
+                "width_px": width,
+                "judged_by": "the centres",
+                "f1_radius_px": radius,
+            }
+        }
 
     assert summary_lines([case(1.83, 2), case(3.0, 2)]) == [
         "Line style read: wide (2 cases, 1.83-3.00 px wide, --line-rule gl): judged by the centres; "
-        f"F1 at up to 2 px (the width); cannot show {CANNOT_SHOW['wide']}"]
+        f"F1 at up to 2 px (the width); cannot show {CANNOT_SHOW['wide']}"
+    ]
     assert "F1 at up to" not in summary_lines([case(1.0, 1)])[0]
 
 

@@ -9,12 +9,11 @@ import sys
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.projector.culling import backface_keep, degenerate
 from wirecheck.core.projector.pipeline import render_frame
-from wirecheck.core.scene.model import oriented_faces
 from wirecheck.core.scene.files import load_scene, parse_scene_text
+from wirecheck.core.scene.model import oriented_faces
 from wirecheck.core.transforms import Motion, scale
 
 
@@ -23,11 +22,14 @@ def _cli(module, args, tmp_path):
     return proc.returncode, proc.stdout, proc.stderr
 
 
-@pytest.mark.parametrize("args,needle", [
-    (["--axes", "--scale", "1e308"], "--axes with --scale"),
-    (["--style", "shaded", "--hidden-lines"], "--hidden-lines with --style shaded"),
-    (["--projection", "both", "--ortho-height", "40"], "--ortho-height 40.0 with --projection both"),
-])
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["--axes", "--scale", "1e308"], "--axes with --scale"),
+        (["--style", "shaded", "--hidden-lines"], "--hidden-lines with --style shaded"),
+        (["--projection", "both", "--ortho-height", "40"], "--ortho-height 40.0 with --projection both"),
+    ],
+)
 def test_renderer_rejects_contradictory_or_overflowing_options(args, needle, tmp_path):
     rc, out, err = _cli("wirecheck.core.app.cli", ["--frames", "2", "--out", str(tmp_path / "o"), *args], tmp_path)
     assert rc == 2 and needle in err and len(err.strip().splitlines()) == 1
@@ -38,16 +40,22 @@ def test_renderer_rejects_contradictory_or_overflowing_options(args, needle, tmp
 def test_light_direction_of_any_finite_magnitude_works(light, tmp_path):
     # a direction: only its sign pattern and ratios matter; it is scaled by its
     # largest component before normalising, so neither overflows nor underflows
-    rc, out, err = _cli("wirecheck.core.app.cli", ["--frames", "1", "--style", "shaded", "--light", light,
-                                     "--out", str(tmp_path / "o")], tmp_path)
+    rc, out, err = _cli(
+        "wirecheck.core.app.cli",
+        ["--frames", "1", "--style", "shaded", "--light", light, "--out", str(tmp_path / "o")],
+        tmp_path,
+    )
     assert rc == 0, err
 
 
-@pytest.mark.parametrize("args,needle", [
-    (["--suite", "extremes", "--frames", "3"], "--suite extremes with --frames"),
-    (["--suite", "extremes", "--scene", "cube"], "--suite extremes with --scene"),
-    (["--sweep", "--jobs", "2"], "--sweep with --jobs 2"),
-])
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["--suite", "extremes", "--frames", "3"], "--suite extremes with --frames"),
+        (["--suite", "extremes", "--scene", "cube"], "--suite extremes with --scene"),
+        (["--sweep", "--jobs", "2"], "--sweep with --jobs 2"),
+    ],
+)
 def test_crosscheck_rejects_options_a_mode_would_ignore(args, needle, tmp_path):
     rc, out, err = _cli("wirecheck.oracles.cli", [*args, "--report-dir", str(tmp_path / "r")], tmp_path)
     assert rc == 2 and needle in err and len(err.strip().splitlines()) == 1
@@ -60,11 +68,9 @@ def test_zero_area_face_is_culled_and_covers_nothing_in_every_frame():
     cam = look_at((2.0, 1.5, 2.5), (0.0, 0.0, 0.0))
     m = Motion()
     for k in range(1, 9):
-        fr = render_frame(scene.vertices, scene.edges, cam, m.frame_matrix(k, 8), faces=scene.faces,
-                          cull="backface")
+        fr = render_frame(scene.vertices, scene.edges, cam, m.frame_matrix(k, 8), faces=scene.faces, cull="backface")
         assert fr.faces_culled == 1 and not fr.image.any()
-        sh = render_frame(scene.vertices, scene.edges, cam, m.frame_matrix(k, 8), faces=scene.faces,
-                          style="shaded")
+        sh = render_frame(scene.vertices, scene.edges, cam, m.frame_matrix(k, 8), faces=scene.faces, style="shaded")
         assert not sh.image.any() and np.isinf(sh.depth_image).all()
     tri = np.array([[[0, 0, 5.0], [1, 0, 5.0], [2, 0, 5.0]]])
     assert degenerate(tri).all() and not backface_keep(tri, "perspective").any()

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles.references.faces import fan
 
 
@@ -22,13 +21,22 @@ def naive_fan(faces):
 RNG = np.random.default_rng(35)
 
 
-@pytest.mark.parametrize("faces", [
-    (), ((0, 1, 2),), ((0, 1),), ((4,),),
-    ((0, 1, 2, 3, 4), (5, 6), (7, 8, 9), (1, 2, 3, 4)),                  # mixed, a 2-gon in between
-    tuple(tuple(int(v) for v in RNG.integers(0, 100, RNG.integers(0, 8))) for _ in range(300)),
-    RNG.integers(0, 100, (50, 4)), RNG.integers(0, 100, (50, 3)), np.zeros((0, 3), np.int64),
-    np.zeros((5, 2), np.int64),
-], ids=["none", "one", "segment", "point", "mixed", "random", "quads", "triangles", "empty_array", "pairs"])
+@pytest.mark.parametrize(
+    "faces",
+    [
+        (),
+        ((0, 1, 2),),
+        ((0, 1),),
+        ((4,),),
+        ((0, 1, 2, 3, 4), (5, 6), (7, 8, 9), (1, 2, 3, 4)),  # mixed, a 2-gon in between
+        tuple(tuple(int(v) for v in RNG.integers(0, 100, RNG.integers(0, 8))) for _ in range(300)),
+        RNG.integers(0, 100, (50, 4)),
+        RNG.integers(0, 100, (50, 3)),
+        np.zeros((0, 3), np.int64),
+        np.zeros((5, 2), np.int64),
+    ],
+    ids=["none", "one", "segment", "point", "mixed", "random", "quads", "triangles", "empty_array", "pairs"],
+)
 def test_fan_is_the_loop(faces):
     tris, owner = fan(faces)
     want_tris, want_owner = naive_fan(faces)

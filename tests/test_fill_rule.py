@@ -11,7 +11,6 @@ import math
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import Camera, look_at
 from wirecheck.core.projector import pipeline
 from wirecheck.core.scene.files import builtin_names, example_names, load_scene
@@ -22,8 +21,8 @@ from wirecheck.oracles.references import faces as oface
 from wirecheck.oracles.references import fill_rule
 from wirecheck.oracles.references.fill_rule import GL_TIE_PX, ID_TIE, NO_OBJECT, coverage, open_edges, silhouette
 
-
 # ---- a naive reference: one ray per pixel centre, Moller-Trumbore, in camera space -------------
+
 
 def _ray_cast(tri_cam: np.ndarray, camera: Camera) -> np.ndarray:
     """(H, W) bool: the ray through each pixel centre hits some triangle at near <= z <= far."""
@@ -66,6 +65,7 @@ def _camera(**kw) -> Camera:
 
 
 # ---- hand-derived coverage ---------------------------------------------------------------------
+
 
 def test_right_triangle_top_left_rule_and_ties_on_every_edge():
     # (0,0), (4,0), (0,4): the top edge y = 0 and the left edge x = 0 own their centres, the
@@ -118,17 +118,17 @@ def test_a_centre_within_the_tie_distance_of_an_edge_is_a_tie():
     # a vertical edge at x = 2 + d: the centres of column 2 are d px from it
     for d, tie in ((0.5 * GL_TIE_PX, True), (0.99 * GL_TIE_PX, True), (1.01 * GL_TIE_PX, False), (0.3, False)):
         x_edge = 2.0 + d
-        tris = [[[x_edge, -20.0], [x_edge, 25.0], [-30.0, 2.0]]]      # other edges far away
+        tris = [[[x_edge, -20.0], [x_edge, 25.0], [-30.0, 2.0]]]  # other edges far away
         inside, ties = coverage(tris, (5, 5))
         assert ties[:, 2].all() == tie and ties[:, 2].any() == tie, d
-        np.testing.assert_array_equal(inside[:, :3], True)      # x = 2 < x_edge: inside
+        np.testing.assert_array_equal(inside[:, :3], True)  # x = 2 < x_edge: inside
         assert not inside[:, 3:].any()
 
 
 def test_tie_px_zero_leaves_only_centres_on_an_open_edge():
     inside, ties = coverage([[[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]]], (6, 6), tie_px=0.0)
     y, x = np.mgrid[0:6, 0:6]
-    assert ties.sum() == 5 + 5 + 5 - 3      # three edges of 5 centres, the corners counted once
+    assert ties.sum() == 5 + 5 + 5 - 3  # three edges of 5 centres, the corners counted once
 
 
 def test_zero_area_triangle_covers_nothing_but_its_centres_are_ties():
@@ -146,19 +146,27 @@ def test_a_centre_near_an_open_edge_but_deep_inside_another_triangle_is_decided(
     inside, ties = coverage([big, small], (20, 20))
     assert inside.all() and not ties.any()
     _, ties_small = coverage([small], (20, 20))
-    assert ties_small.sum() == 12                                   # alone, its edges' centres are ties
+    assert ties_small.sum() == 12  # alone, its edges' centres are ties
 
 
 def test_open_edges_closed_only_between_triangles_on_both_sides():
-    tris = np.array([[[0, 0], [4, 0], [0, 4]],      # shares (4,0)-(0,4) with the next, on the other side
-                     [[4, 0], [4, 4], [0, 4]],
-                     [[0, 0], [4, 0], [2, -3]],     # shares (0,0)-(4,0) with the first, other side
-                     [[0, 0], [2, 2], [0, 4]]],     # shares no edge ((0,0)-(0,4) is not an edge above)
-                    dtype=np.float64)
-    expected = np.array([[False, False, True],       # edges v0v1, v1v2, v2v0
-                         [True, True, False],
-                         [False, True, True],
-                         [True, True, True]])
+    tris = np.array(
+        [
+            [[0, 0], [4, 0], [0, 4]],  # shares (4,0)-(0,4) with the next, on the other side
+            [[4, 0], [4, 4], [0, 4]],
+            [[0, 0], [4, 0], [2, -3]],  # shares (0,0)-(4,0) with the first, other side
+            [[0, 0], [2, 2], [0, 4]],
+        ],  # shares no edge ((0,0)-(0,4) is not an edge above)
+        dtype=np.float64,
+    )
+    expected = np.array(
+        [
+            [False, False, True],  # edges v0v1, v1v2, v2v0
+            [True, True, False],
+            [False, True, True],
+            [True, True, True],
+        ]
+    )
     np.testing.assert_array_equal(open_edges(tris), expected)
     # a fold: two triangles sharing an edge with both third vertices on one side keep it open
     fold = np.array([[[0, 0], [4, 0], [2, 3]], [[0, 0], [4, 0], [1, 1]]], dtype=np.float64)
@@ -176,30 +184,30 @@ def test_a_shared_edge_through_centres_leaves_no_crack_and_no_tie():
     assert inside[np.arange(7, 14), np.arange(7, 14)].all() and inside[np.arange(7, 14), np.arange(13, 6, -1)].all()
     assert not ties[5:16, 10].any() and not ties[10, 5:16].any()
     assert not ties[np.arange(7, 14), np.arange(7, 14)].any()
-    assert ties[10, 4] and ties[4, 10] and ties[6, 6]           # rim vertices, on open edges
+    assert ties[10, 4] and ties[4, 10] and ties[6, 6]  # rim vertices, on open edges
 
 
 # ---- the scene path: projection, near-plane cut, object ids -----------------------------------
+
 
 @pytest.mark.parametrize("projection", ["perspective", "orthographic"])
 def test_triangles_crossing_the_near_plane_match_a_ray_caster(projection):
     rng = np.random.default_rng(35)
     cam = _camera(near=1.0, far=8.0, fov_y_deg=70.0, projection=projection, ortho_height=4.0)
-    tri_cam = rng.uniform([-3, -2.5, -1.0], [3, 2.5, 10.0], size=(12, 3, 3))   # many cross near or far
-    tri_cam[0] = [[-1.5, -1.0, -2.0], [2.0, -1.2, 3.0], [0.0, 1.5, 3.0]]       # one vertex behind the eye
+    tri_cam = rng.uniform([-3, -2.5, -1.0], [3, 2.5, 10.0], size=(12, 3, 3))  # many cross near or far
+    tri_cam[0] = [[-1.5, -1.0, -2.0], [2.0, -1.2, 3.0], [0.0, 1.5, 3.0]]  # one vertex behind the eye
     faces = [tuple(range(3 * i, 3 * i + 3)) for i in range(len(tri_cam))]
     inside, ties, _ = silhouette(_cam_to_world(tri_cam.reshape(-1, 3)), faces, cam, (cam.height, cam.width))
     expected = _ray_cast(tri_cam, cam)
     decided = ~ties
     assert decided.sum() > 0.95 * decided.size
     np.testing.assert_array_equal(inside[decided], expected[decided])
-    assert 0.1 * inside.size < inside.sum() < 0.95 * inside.size       # the frame says something
+    assert 0.1 * inside.size < inside.sum() < 0.95 * inside.size  # the frame says something
 
 
 def test_a_triangle_wholly_behind_or_beyond_is_not_drawn():
     cam = _camera(near=1.0, far=5.0)
-    tri_cam = np.array([[[-1, -1, 0.5], [1, -1, 0.5], [0, 1, 0.9]],
-                        [[-1, -1, 6.0], [1, -1, 6.0], [0, 1, 7.0]]])
+    tri_cam = np.array([[[-1, -1, 0.5], [1, -1, 0.5], [0, 1, 0.9]], [[-1, -1, 6.0], [1, -1, 6.0], [0, 1, 7.0]]])
     inside, ties, ids = silhouette(_cam_to_world(tri_cam.reshape(-1, 3)), [(0, 1, 2), (3, 4, 5)], cam, (48, 64))
     assert not inside.any() and not ties.any() and (ids == NO_OBJECT).all()
 
@@ -217,14 +225,21 @@ def test_nearest_object_owns_the_pixel_and_equal_depths_are_id_ties():
     def cam_square(xa, xb, z):
         # pixel x -> x_cam = (x - cx) z / f
         cx = (64 - 1) / 2
-        return np.array([[(xa - cx) * z / f, -1.0, z], [(xb - cx) * z / f, -1.0, z],
-                         [(xb - cx) * z / f, 1.0, z], [(xa - cx) * z / f, 1.0, z]])
+        return np.array(
+            [
+                [(xa - cx) * z / f, -1.0, z],
+                [(xb - cx) * z / f, -1.0, z],
+                [(xb - cx) * z / f, 1.0, z],
+                [(xa - cx) * z / f, 1.0, z],
+            ]
+        )
+
     pts = np.concatenate([cam_square(10.3, 40.3, 4.0), cam_square(30.3, 55.3, 2.0)])
     faces = [(0, 1, 2, 3), (4, 5, 6, 7)]
     inside, ties, ids = silhouette(_cam_to_world(pts), faces, cam, (48, 64), face_objects=[0, 1])
     row = 24
-    np.testing.assert_array_equal(ids[row, 11:31], 0)           # columns 11..30: object 0 only
-    np.testing.assert_array_equal(ids[row, 31:56], 1)           # 31..55: object 1 in front
+    np.testing.assert_array_equal(ids[row, 11:31], 0)  # columns 11..30: object 0 only
+    np.testing.assert_array_equal(ids[row, 31:56], 1)  # 31..55: object 1 in front
     assert (ids[row, :11] == NO_OBJECT).all() and (ids[row, 56:] == NO_OBJECT).all()
     # the same square twice, as two objects at one depth: every covered pixel an id tie
     pts2 = np.concatenate([cam_square(10.3, 40.3, 4.0), cam_square(10.3, 40.3, 4.0)])
@@ -240,7 +255,10 @@ def test_the_tie_distance_is_the_tolerances():
     # fill_rule may not import the tolerances (they sit above the references): the same numbers
     assert GL_TIE_PX == tolerances.FILL_TIE_PX == tolerances.Tolerances().fill_tie_px
     assert (fill_rule._DEPTH_STEPS, fill_rule._DEPTH_SNAP_PX, fill_rule._DEPTH_EPS32) == (
-        tolerances.DEPTH_STEPS, tolerances.DEPTH_SNAP_PX, tolerances.DEPTH_EPS32)
+        tolerances.DEPTH_STEPS,
+        tolerances.DEPTH_SNAP_PX,
+        tolerances.DEPTH_EPS32,
+    )
 
 
 def test_face_objects_of_another_length_are_refused():
@@ -256,6 +274,7 @@ def test_a_distorted_camera_is_refused():
 
 
 # ---- the bundled scenes: pyrender and core differ from the reference only at ties -------------
+
 
 def _scene_frames(frames: int):
     """Every bundled scene x default case camera x ``frames`` frames: (label, scene, camera, geometry)."""
@@ -274,7 +293,7 @@ def _face_objects(scene) -> np.ndarray:
     return np.searchsorted(starts, [f[0] for f in scene.faces], side="right") - 1
 
 
-FRAMES = 2      # 6 scenes x 7 cameras x 2 frames: 84 frames
+FRAMES = 2  # 6 scenes x 7 cameras x 2 frames: 84 frames
 
 
 @pytest.mark.slow
@@ -282,8 +301,9 @@ def test_core_shaded_frames_differ_from_the_reference_only_at_ties(summary_secti
     decided_diff, tie_diff, ties_px, ref_px, n = 0, 0, 0, 0, 0
     for label, scene, cam, (p_world, _m, pr_vertices, pr_pose) in _scene_frames(FRAMES):
         inside, ties, _ = silhouette(p_world, scene.faces, cam, (cam.height, cam.width))
-        frame = pipeline.render_frame(pr_vertices, scene.edges, cam, np.eye(4) if pr_pose is None else pr_pose,
-                                      faces=scene.faces, style="shaded")
+        frame = pipeline.render_frame(
+            pr_vertices, scene.edges, cam, np.eye(4) if pr_pose is None else pr_pose, faces=scene.faces, style="shaded"
+        )
         core = np.isfinite(frame.depth_image)
         assert not ((core != inside) & ~ties).any(), label
         decided_diff += int(((core != inside) & ~ties).sum())
@@ -292,8 +312,11 @@ def test_core_shaded_frames_differ_from_the_reference_only_at_ties(summary_secti
         ref_px += int(inside.sum())
         n += 1
     assert n == 6 * 7 * FRAMES and ref_px > 0
-    summary_section("fill rule: core --style shaded", f"{n} frames, {ref_px} reference pixels, {ties_px} ties; "
-                    f"core differs at {decided_diff} decided pixels, {tie_diff} ties")
+    summary_section(
+        "fill rule: core --style shaded",
+        f"{n} frames, {ref_px} reference pixels, {ties_px} ties; "
+        f"core differs at {decided_diff} decided pixels, {tie_diff} ties",
+    )
 
 
 @pytest.mark.slow
@@ -313,8 +336,9 @@ def test_pyrender_silhouettes_and_object_ids_differ_from_the_reference_only_at_t
             key = (cam.width, cam.height)
             if key not in oracles:
                 oracles[key] = PyrenderOracle(*key)
-            covered, _depth, tri_ids = oracles[key].render_faces(pr_vertices, tris, cam, model_matrix=pr_pose,
-                                                                 cull=False, with_ids=True)
+            covered, _depth, tri_ids = oracles[key].render_faces(
+                pr_vertices, tris, cam, model_matrix=pr_pose, cull=False, with_ids=True
+            )
             gl_ids = np.where(tri_ids >= 0, objects[owner[np.maximum(tri_ids, 0)]], NO_OBJECT)
             assert not ((covered != inside) & ~ties).any(), label
             both = covered & inside & ~ties & (ids != ID_TIE)
@@ -328,8 +352,11 @@ def test_pyrender_silhouettes_and_object_ids_differ_from_the_reference_only_at_t
         for o in oracles.values():
             o.close()
     assert n == 6 * 7 * FRAMES and id_px > 0
-    summary_section("fill rule: pyrender", f"{n} frames, {ref_px} reference pixels, {ties_px} ties; pyrender "
-                    f"differs at 0 decided pixels, {tie_diff} ties; object ids equal at {id_px} decided pixels")
+    summary_section(
+        "fill rule: pyrender",
+        f"{n} frames, {ref_px} reference pixels, {ties_px} ties; pyrender "
+        f"differs at 0 decided pixels, {tie_diff} ties; object ids equal at {id_px} decided pixels",
+    )
 
 
 @pytest.mark.slow
@@ -342,9 +369,11 @@ def test_pyrender_object_ids_where_objects_hide_each_other(summary_section):
     if not ok:
         pytest.skip(msg)
     trimesh = pytest.importorskip("trimesh")
-    parts = [trimesh.creation.icosphere(subdivisions=3),
-             trimesh.creation.icosphere(subdivisions=2, radius=0.6),
-             trimesh.creation.box(extents=(0.5, 0.4, 0.3))]
+    parts = [
+        trimesh.creation.icosphere(subdivisions=3),
+        trimesh.creation.icosphere(subdivisions=2, radius=0.6),
+        trimesh.creation.box(extents=(0.5, 0.4, 0.3)),
+    ]
     offsets = [(0.0, 0.0, 0.0), (0.9, 0.35, 0.5), (-0.4, -0.2, 1.4)]
     vertices, faces, objects, start = [], [], [], 0
     for i, (m, off) in enumerate(zip(parts, offsets)):
@@ -363,12 +392,14 @@ def test_pyrender_object_ids_where_objects_hide_each_other(summary_section):
             assert not ((covered != inside) & ~ties).any()
             both = covered & inside & ~ties & (ids != ID_TIE)
             assert (gl_ids[both] == ids[both]).all(), position
-            assert len(np.unique(ids[both])) == 3                  # all three objects seen
+            assert len(np.unique(ids[both])) == 3  # all three objects seen
             decided_ids += int(both.sum())
             id_ties += int((ids == ID_TIE).sum())
             n += 1
-    summary_section("fill rule: object ids", f"{n} views of 3 overlapping objects: ids equal pyrender's at "
-                    f"{decided_ids} decided pixels; {id_ties} id ties")
+    summary_section(
+        "fill rule: object ids",
+        f"{n} views of 3 overlapping objects: ids equal pyrender's at {decided_ids} decided pixels; {id_ties} id ties",
+    )
 
 
 def test_docs_depth_picture_is_what_coverage_gives():
@@ -376,7 +407,7 @@ def test_docs_depth_picture_is_what_coverage_gives():
     from pathlib import Path
 
     text = (Path(__file__).resolve().parents[1] / "docs" / "depth.md").read_text()
-    lines = text[text.index("inside        ties\n"):].splitlines()[1:6]
+    lines = text[text.index("inside        ties\n") :].splitlines()[1:6]
     inside, ties = coverage([[[0, 0], [4, 0], [0, 4]]], (5, 5))
     for row, line in enumerate(lines):
         cells = line.split()
@@ -385,6 +416,7 @@ def test_docs_depth_picture_is_what_coverage_gives():
 
 
 # ---- the batched pass against a naive one: every triangle over the whole image ----------------
+
 
 def _naive_coverage(tris_px, is_open, shape, tie_px):
     """``(inside, ties)`` by the module docstring's rule, one triangle at a time over every centre.
@@ -403,7 +435,7 @@ def _naive_coverage(tris_px, is_open, shape, tie_px):
     for tri, opened in zip(np.asarray(tris_px, dtype=np.float64), is_open):
         a, b, c = tri
         area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-        if area2 < 0:                                   # v1 <-> v2: edges 0, 1, 2 become 2, 1, 0
+        if area2 < 0:  # v1 <-> v2: edges 0, 1, 2 become 2, 1, 0
             tri, opened = np.stack([a, c, b]), opened[::-1]
         tri_in = np.full(shape, area2 != 0)
         tri_far = tri_in.copy()
@@ -432,16 +464,19 @@ def _snapped_soup(rng, count, size, shape, step):
     corner = rng.uniform([0, 0], [width, height], size=(count, 1, 2))
     tris = np.round((corner + rng.uniform(-size, size, size=(count, 3, 2))) / step) * step
     half = count // 2
-    tris[1:half:2, 0] = tris[0:half - 1:2, 1]           # each odd triangle shares its neighbour's edge v1 -> v2
-    tris[1:half:2, 1] = tris[0:half - 1:2, 2]
+    tris[1:half:2, 0] = tris[0 : half - 1 : 2, 1]  # each odd triangle shares its neighbour's edge v1 -> v2
+    tris[1:half:2, 1] = tris[0 : half - 1 : 2, 2]
     return tris
 
 
-@pytest.mark.parametrize("count, size, shape, step", [
-    (600, 3.0, (40, 56), 0.25),     # many small boxes: the triangle axis the longest (innermost)
-    (4, 40.0, (48, 64), 1.0),       # few large boxes: the column axis the longest
-    (60, 12.0, (33, 45), 0.5),
-])
+@pytest.mark.parametrize(
+    "count, size, shape, step",
+    [
+        (600, 3.0, (40, 56), 0.25),  # many small boxes: the triangle axis the longest (innermost)
+        (4, 40.0, (48, 64), 1.0),  # few large boxes: the column axis the longest
+        (60, 12.0, (33, 45), 0.5),
+    ],
+)
 @pytest.mark.parametrize("tie_px", [GL_TIE_PX, 0.3])
 def test_coverage_equals_a_naive_pass_bit_for_bit(count, size, shape, step, tie_px):
     rng = np.random.default_rng(count)
@@ -459,7 +494,7 @@ def _naive_open_edges(tris_px):
     """Edge ``k`` of each triangle is closed when the triangles with the same two end points (as floats:
     -0.0 == 0.0, NaN equal to nothing) have third vertices strictly on both sides of its line."""
     tris = np.asarray(tris_px, dtype=np.float64)
-    p = tris.reshape(-1, 2)                             # edge k runs p -> q, opposite third
+    p = tris.reshape(-1, 2)  # edge k runs p -> q, opposite third
     q = np.roll(tris, -1, axis=1).reshape(-1, 2)
     third = np.roll(tris, -2, axis=1).reshape(-1, 2)
 
@@ -468,8 +503,9 @@ def _naive_open_edges(tris_px):
 
     same = (equal(p, p) & equal(q, q)) | (equal(p, q) & equal(q, p))
     d = q - p
-    side = np.sign(d[:, None, 0] * (third[None, :, 1] - p[:, None, 1])
-                   - d[:, None, 1] * (third[None, :, 0] - p[:, None, 0]))      # edge i's line, edge j's third
+    side = np.sign(
+        d[:, None, 0] * (third[None, :, 1] - p[:, None, 1]) - d[:, None, 1] * (third[None, :, 0] - p[:, None, 0])
+    )  # edge i's line, edge j's third
     closed = (same & (side > 0)).any(axis=1) & (same & (side < 0)).any(axis=1)
     return ~closed.reshape(-1, 3)
 
@@ -477,7 +513,7 @@ def _naive_open_edges(tris_px):
 def test_open_edges_equal_a_naive_pairing():
     rng = np.random.default_rng(7)
     tris = _snapped_soup(rng, 300, 3.0, (40, 56), 0.25)
-    tris[::7] *= -1.0                                   # -0.0 corners where a corner was 0.0
+    tris[::7] *= -1.0  # -0.0 corners where a corner was 0.0
     # an edge (0, 0) -> (0, 4) shared across, written with 0.0 in one triangle and -0.0 in the other: closed
     tris = np.concatenate([tris, [[[0.0, 0.0], [0.0, 4.0], [-3.0, 2.0]], [[-0.0, 4.0], [-0.0, -0.0], [3.0, 2.0]]]])
     want = _naive_open_edges(tris)

@@ -15,12 +15,11 @@ import threading
 from pathlib import Path
 
 import pytest
-
-from wirecheck.oracles.cli import main
+from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles.candidates.frames_candidate import FramesError, check_frames, load_job
+from wirecheck.oracles.cli import main
 from wirecheck.oracles.judge import frame_prefetch, frames_judge
 from wirecheck.oracles.judge.frames_judge import run_frames
-from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 
 # one case of 6 frames: frame 4 is read ahead (frame_prefetch.AHEAD = 2) while frames 2 and 3 are judged
 ARGS = ["--scene", "cube", "--cases", "on_axis", "--frames", "6"]
@@ -41,8 +40,8 @@ def damaged(filled, tmp_path) -> Path:
     d = tmp_path / "job"
     shutil.copytree(filled, d)
     data = bytearray((d / BAD).read_bytes())
-    at = data.index(b"IDAT") + 4 + 2                  # past the zlib header
-    data[at:at + 16] = bytes(16)
+    at = data.index(b"IDAT") + 4 + 2  # past the zlib header
+    data[at : at + 16] = bytes(16)
     (d / BAD).write_bytes(bytes(data))
     return d
 
@@ -58,12 +57,12 @@ def _count_judged(monkeypatch) -> list:
     def counted(path, *args, **kwargs):
         judged.append(Path(path).name)
         return real(path, *args, **kwargs)
+
     monkeypatch.setattr(frames_judge, "candidate_pixels", counted)
     return judged
 
 
-def test_an_undecodable_frame_read_ahead_raises_at_its_own_frame_with_the_full_checks_message(damaged,
-                                                                                               monkeypatch):
+def test_an_undecodable_frame_read_ahead_raises_at_its_own_frame_with_the_full_checks_message(damaged, monkeypatch):
     # the expected message: the full check's (every frame decoded), independent of the judge and its thread
     with pytest.raises(FramesError) as full:
         check_frames(damaged, load_job(damaged), decode=True)
@@ -100,13 +99,15 @@ def test_an_interrupt_in_the_judges_thread_stops_the_worker(filled, monkeypatch)
         if len(calls) == 2:
             raise KeyboardInterrupt
         return real(*args, **kwargs)
+
     monkeypatch.setattr(frames_judge, "candidate_pixels", interrupted)
     closed = []
     real_close = frame_prefetch.FramePrefetch.close
 
     def close(self):
         real_close(self)
-        closed.append(self.oracles._by_size == {})         # every context released
+        closed.append(self.oracles._by_size == {})  # every context released
+
     monkeypatch.setattr(frame_prefetch.FramePrefetch, "close", close)
     with pytest.raises(KeyboardInterrupt):
         run_frames(filled, diagnose=False)
@@ -131,19 +132,21 @@ def test_frames_are_asked_for_ahead_frames_beyond_the_one_judged(monkeypatch, ah
     to its end) and no more: ``ahead`` frames overlap the judge's work, and memory stays flat."""
     asked = []
 
-    def read(oracles, job_dir, job, c, k, rel, cache):      # the worker's reading, recorded in its order
+    def read(oracles, job_dir, job, c, k, rel, cache):  # the worker's reading, recorded in its order
         asked.append(k)
         return k
+
     monkeypatch.setattr(frame_prefetch, "read_ahead", read)
 
     class Oracles:
         def close(self):
             pass
+
     reader = frame_prefetch.FramePrefetch(Oracles(), threaded=True, ahead=ahead)
     try:
         got, seen = [], []
         for k in reader.frames("job", {}, {"frames": [f"f{i}.png" for i in range(1, 7)]}, [1, 2, 3, 4, 5, 6]):
-            reader.call(lambda: None)       # first in, first out: every frame asked for before it has been read
+            reader.call(lambda: None)  # first in, first out: every frame asked for before it has been read
             got.append(k)
             seen.append(list(asked))
         assert got == [1, 2, 3, 4, 5, 6]

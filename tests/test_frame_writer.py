@@ -9,7 +9,6 @@ import sys
 
 import numpy as np
 import pytest
-
 from wirecheck.core.outputs.frame_writer import ForkedPngWriter
 from wirecheck.core.outputs.output import MARKER, is_bilevel, png_bytes
 
@@ -20,14 +19,14 @@ def _images() -> list[np.ndarray]:
     """Bilevel frames (even and odd widths, one empty), an 8-bit grey one and an RGB one."""
     rng = np.random.default_rng(7)
     out = [rng.choice(np.array([0, 255], np.uint8), size=shape) for shape in [(48, 64), (5, 13), (1, 1), (0, 0)]]
-    out.append(rng.integers(0, 256, size=(9, 11), dtype=np.uint8))          # aa-like grey: Pillow, in the parent
-    out.append(rng.integers(0, 256, size=(6, 7, 3), dtype=np.uint8))        # RGB (--axes)
+    out.append(rng.integers(0, 256, size=(9, 11), dtype=np.uint8))  # aa-like grey: Pillow, in the parent
+    out.append(rng.integers(0, 256, size=(6, 7, 3), dtype=np.uint8))  # RGB (--axes)
     return out
 
 
 def test_files_are_the_in_line_encoders_bytes(tmp_path):
     images = _images()
-    assert [is_bilevel(im) for im in images] == [True] * 4 + [False] * 2     # both paths are taken
+    assert [is_bilevel(im) for im in images] == [True] * 4 + [False] * 2  # both paths are taken
     with ForkedPngWriter() as writer:
         for k, im in enumerate(images):
             writer.put(tmp_path / f"frame_{k}.png", im)
@@ -49,20 +48,22 @@ def test_leaving_on_an_error_waits_for_the_child_and_keeps_the_callers_error(tmp
             writer.put(tmp_path / "a.png", np.zeros((8, 8), np.uint8))
             pid = writer._pid
             raise KeyError("the caller's")
-    with pytest.raises(ChildProcessError):         # reaped: no zombie left behind
+    with pytest.raises(ChildProcessError):  # reaped: no zombie left behind
         os.waitpid(pid, os.WNOHANG)
-    assert (tmp_path / "a.png").read_bytes() == png_bytes(np.zeros((8, 8), np.uint8))   # queued before: written
+    assert (tmp_path / "a.png").read_bytes() == png_bytes(np.zeros((8, 8), np.uint8))  # queued before: written
 
 
 def test_no_fork_with_other_threads_few_frames_or_one_cpu():
     """In a fresh interpreter (this one may hold other threads: pytest-xdist's)."""
-    code = ("import os, threading\n"
-            "from wirecheck.core.outputs.frame_writer import MIN_FRAMES, can_fork\n"
-            "alone = can_fork(MIN_FRAMES), can_fork(MIN_FRAMES - 1)\n"
-            "stop = threading.Event(); t = threading.Thread(target=stop.wait); t.start()\n"
-            "threaded = can_fork(10_000)\n"
-            "stop.set(); t.join()\n"
-            "print(*alone, threaded, len(os.sched_getaffinity(0)) >= 2)\n")
+    code = (
+        "import os, threading\n"
+        "from wirecheck.core.outputs.frame_writer import MIN_FRAMES, can_fork\n"
+        "alone = can_fork(MIN_FRAMES), can_fork(MIN_FRAMES - 1)\n"
+        "stop = threading.Event(); t = threading.Thread(target=stop.wait); t.start()\n"
+        "threaded = can_fork(10_000)\n"
+        "stop.set(); t.join()\n"
+        "print(*alone, threaded, len(os.sched_getaffinity(0)) >= 2)\n"
+    )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     at_min, below_min, threaded, two_cpus = done.stdout.split()
@@ -72,8 +73,20 @@ def test_no_fork_with_other_threads_few_frames_or_one_cpu():
 @pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="one CPU: frames are written in line")
 def test_renderer_frames_from_the_child_equal_the_in_line_ones(tmp_path):
     """The seed command's path (frames >= MIN_FRAMES, two CPUs) against --profile's (always in line)."""
+
     def frames(out, *extra):
-        cmd = [sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "40", "--fov", "70", "--out", str(out), *extra]
+        cmd = [
+            sys.executable,
+            "-m",
+            "wirecheck.core.app.cli",
+            "--frames",
+            "40",
+            "--fov",
+            "70",
+            "--out",
+            str(out),
+            *extra,
+        ]
         assert subprocess.run(cmd, capture_output=True).returncode == 0
         d = out / "cube-frames"
         return {n: (d / n).read_bytes() for n in sorted(os.listdir(d)) if n != MARKER}

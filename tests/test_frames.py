@@ -3,11 +3,10 @@
 import doctest
 
 import numpy as np
-from numpy.testing import assert_array_equal
-
 import wirecheck
-from wirecheck.core.scene import frames
+from numpy.testing import assert_array_equal
 from wirecheck.core.camera import look_at
+from wirecheck.core.scene import frames
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.references import opencv_oracle
@@ -60,4 +59,4 @@ def test_object_culling_changes_neither_picture_nor_counts():
         assert i_on["clipped_edges"] == i_off["clipped_edges"]
         assert i_off["objects_culled"] is None
         culled += i_on["objects_culled"]
-    assert culled > 0          # the camera does leave objects out, so the check compares something
+    assert culled > 0  # the camera does leave objects out, so the check compares something

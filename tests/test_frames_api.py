@@ -17,10 +17,9 @@ import sys
 from pathlib import Path
 
 import pytest
-from PIL import Image
-
 import wirecheck
 from helpers import blank_job, fill_job  # tests/ is on sys.path (rootdir conftest)
+from PIL import Image
 from wirecheck.oracles.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -41,8 +40,23 @@ def jobs(tmp_path_factory) -> dict:
     out = {}
     for name, camera in (("good", lambda cam: cam), ("half", _half_pixel)):
         out[name] = base / name
-        assert main(["export", str(out[name]), "--scene", "pyramid", "--cases", "oblique_roll",
-                     "--frames", "6", "--every", "3"]) == 0
+        assert (
+            main(
+                [
+                    "export",
+                    str(out[name]),
+                    "--scene",
+                    "pyramid",
+                    "--cases",
+                    "oblique_roll",
+                    "--frames",
+                    "6",
+                    "--every",
+                    "3",
+                ]
+            )
+            == 0
+        )
         fill_job(out[name], camera=camera)
     out["black"] = blank_job(base / "black")
     return out
@@ -54,7 +68,7 @@ def _cli_error(capsys, *args) -> str:
     assert main(list(args)) == 2
     err = capsys.readouterr().err.splitlines()
     assert err and all(line.startswith("crosscheck: error: ") for line in err), err
-    return "\n".join(line[len("crosscheck: error: "):] for line in err)
+    return "\n".join(line[len("crosscheck: error: ") :] for line in err)
 
 
 def test_core_drawn_frames_pass(jobs):
@@ -70,7 +84,7 @@ def test_black_frames_fail_naming_the_fault(jobs):
     with pytest.raises(AssertionError) as exc:
         wirecheck.assert_frames(jobs["black"])
     text = str(exc.value)
-    report = wirecheck.check_frames(jobs["black"])        # the same judge, not raising
+    report = wirecheck.check_frames(jobs["black"])  # the same judge, not raising
     (case,) = report["cases"]
     assert report["verdict"] == "fail" and case["faults"], case
     names = [f["name"] for f in case["faults"]]
@@ -104,13 +118,14 @@ def test_report_dir_is_the_clis_report_byte_for_byte(jobs, tmp_path, job, rule):
     else:
         wirecheck.assert_frames(jobs[job], line_rule=rule, report_dir=api_dir)
     assert main(["--candidate-frames", str(jobs[job]), "--line-rule", rule, "--report-dir", str(cli_dir)]) == (
-        1 if job == "half" else 0)
+        1 if job == "half" else 0
+    )
     files = sorted(p.relative_to(api_dir) for p in api_dir.rglob("*") if p.is_file())
     assert files == sorted(p.relative_to(cli_dir) for p in cli_dir.rglob("*") if p.is_file())
     assert {Path("report.json"), Path("report.md"), Path("report.html")} <= set(files)
     for rel in files:
         a, c = (api_dir / rel).read_bytes(), (cli_dir / rel).read_bytes()
-        if rel == Path("report.json"):          # the judge's wall time: its own field, differs run to run
+        if rel == Path("report.json"):  # the judge's wall time: its own field, differs run to run
             a, c = (json.loads(x) for x in (a, c))
             assert a.pop("timing").keys() == c.pop("timing").keys()
             assert a["line_rule"] == rule
@@ -134,22 +149,20 @@ def test_bad_input_raises_the_clis_line(jobs, tmp_path, capsys):
     assert str(exc.value) == _cli_error(capsys, "--candidate-frames", str(missing))
     assert "not a directory: expected a job folder written by 'crosscheck export'" in str(exc.value)
 
-    undrawn = tmp_path / "undrawn"              # exported, no frame drawn
-    assert main(["export", str(undrawn), "--scene", "cube", "--cases", "on_axis", "--frames", "4",
-                 "--every", "2"]) == 0
+    undrawn = tmp_path / "undrawn"  # exported, no frame drawn
+    assert main(["export", str(undrawn), "--scene", "cube", "--cases", "on_axis", "--frames", "4", "--every", "2"]) == 0
     with pytest.raises(ValueError) as exc:
         wirecheck.check_frames(undrawn)
-    assert str(exc.value) == _cli_error(capsys, "--candidate-frames", str(undrawn), "--report-dir",
-                                        str(tmp_path / "r"))
+    assert str(exc.value) == _cli_error(capsys, "--candidate-frames", str(undrawn), "--report-dir", str(tmp_path / "r"))
     assert "frames: empty: expected the renderer's frames" in str(exc.value)
-    (undrawn / "frames/cube/on_axis").mkdir(parents=True)      # frame 1 drawn, frame 3 missing
+    (undrawn / "frames/cube/on_axis").mkdir(parents=True)  # frame 1 drawn, frame 3 missing
     Image.new("L", (640, 480)).save(undrawn / "frames/cube/on_axis/frame_0001.png")
     with pytest.raises(ValueError) as exc:
         wirecheck.check_frames(undrawn)
     assert str(exc.value) == _cli_error(capsys, "--candidate-frames", str(undrawn))
     assert "frame_0003.png" in str(exc.value) and "frame_0001.png" not in str(exc.value)
 
-    listing = json.loads((undrawn / "job.json").read_text())   # a job that lists no case: compares nothing
+    listing = json.loads((undrawn / "job.json").read_text())  # a job that lists no case: compares nothing
     listing["cases"] = []
     (undrawn / "job.json").write_text(json.dumps(listing))
     with pytest.raises(ValueError) as exc:
@@ -159,9 +172,11 @@ def test_bad_input_raises_the_clis_line(jobs, tmp_path, capsys):
 
     # the job and its frames/ hold the renderer's files: refused by the folder check (named as the API names
     # the option, report_dir, as check_projector does), a new folder in frames/ by the job's own check
-    for inside, why in ((jobs["good"], "is a frames job holding files a renderer wrote"),
-                        (jobs["good"] / "frames", "a directory not written by wirecheck"),
-                        (jobs["good"] / "frames" / "rep", "itself or its frames/")):
+    for inside, why in (
+        (jobs["good"], "is a frames job holding files a renderer wrote"),
+        (jobs["good"] / "frames", "a directory not written by wirecheck"),
+        (jobs["good"] / "frames" / "rep", "itself or its frames/"),
+    ):
         with pytest.raises(ValueError) as exc:
             wirecheck.check_frames(jobs["good"], report_dir=inside)
         cli = _cli_error(capsys, "--candidate-frames", str(jobs["good"]), "--report-dir", str(inside))
@@ -176,23 +191,29 @@ def test_bad_input_raises_the_clis_line(jobs, tmp_path, capsys):
     assert a_file.read_text() == "mine\n"
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"line_rule": "pixels"}, "line_rule 'pixels': expected one of any, gl, geometry"),
-    ({"line_rule": None}, "line_rule None: expected one of any, gl, geometry"),
-    # a NaN floor would pass everything (no comparison with NaN is true); above 1 nothing passes
-    ({"min_f1": float("nan")}, "min_f1 nan: expected a number in [0, 1]"),
-    ({"min_f1_0px": 1.5}, "min_f1_0px 1.5: expected a number in [0, 1]"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"line_rule": "pixels"}, "line_rule 'pixels': expected one of any, gl, geometry"),
+        ({"line_rule": None}, "line_rule None: expected one of any, gl, geometry"),
+        # a NaN floor would pass everything (no comparison with NaN is true); above 1 nothing passes
+        ({"min_f1": float("nan")}, "min_f1 nan: expected a number in [0, 1]"),
+        ({"min_f1_0px": 1.5}, "min_f1_0px 1.5: expected a number in [0, 1]"),
+    ],
+)
 def test_bad_arguments_raise_value_error_naming_them(jobs, kwargs, message):
     with pytest.raises(ValueError) as exc:
         wirecheck.check_frames(jobs["good"], **kwargs)
     assert str(exc.value).startswith(message)
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"allow_vacuous": "no"}, "allow_vacuous 'no': expected True or False"),
-    ({"report_dir": 3}, "report_dir 3: expected a folder path"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"allow_vacuous": "no"}, "allow_vacuous 'no': expected True or False"),
+        ({"report_dir": 3}, "report_dir 3: expected a folder path"),
+    ],
+)
 def test_wrong_kinds_raise_type_error(jobs, kwargs, message):
     with pytest.raises(TypeError, match=re.escape(message)):
         wirecheck.check_frames(jobs["good"], **kwargs)
@@ -211,16 +232,23 @@ def test_the_docs_example_runs(tmp_path, monkeypatch, draws):
     # my_renderer: core's drawing of the job (tests/helpers.py fill_job), or black frames
     work = tmp_path / "work"
     work.mkdir()
-    draw = "helpers.fill_job(job)" if draws == "core" else (
-        "from PIL import Image\n"
-        "for c in json.loads((job / 'job.json').read_text())['cases']:\n"
-        "    for rel in c['frames']:\n"
-        "        (job / rel).parent.mkdir(parents=True, exist_ok=True)\n"
-        "        Image.new('L', (c['width'], c['height'])).save(job / rel)\n")
+    draw = (
+        "helpers.fill_job(job)"
+        if draws == "core"
+        else (
+            "from PIL import Image\n"
+            "for c in json.loads((job / 'job.json').read_text())['cases']:\n"
+            "    for rel in c['frames']:\n"
+            "        (job / rel).parent.mkdir(parents=True, exist_ok=True)\n"
+            "        Image.new('L', (c['width'], c['height'])).save(job / rel)\n"
+        )
+    )
     renderer = work / "my_renderer"
-    renderer.write_text(f"#!{sys.executable}\nimport json, sys\nfrom pathlib import Path\n"
-                        f"sys.path.insert(0, {str(ROOT / 'tests')!r})\nimport helpers\n"
-                        f"job = Path(sys.argv[1])\n{draw}\n")
+    renderer.write_text(
+        f"#!{sys.executable}\nimport json, sys\nfrom pathlib import Path\n"
+        f"sys.path.insert(0, {str(ROOT / 'tests')!r})\nimport helpers\n"
+        f"job = Path(sys.argv[1])\n{draw}\n"
+    )
     renderer.chmod(0o755)
     monkeypatch.chdir(work)
     monkeypatch.setenv("PATH", f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}")

@@ -17,14 +17,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 from PIL import Image
-
 from wirecheck.core.scene.files import load_scene
-from wirecheck.oracles.references import opencv_oracle
-from wirecheck.oracles.cli import main
 from wirecheck.oracles.candidates.export import build_job
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job, read_obj
-from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
+from wirecheck.oracles.cli import main
+from wirecheck.oracles.references import opencv_oracle
 
 ARGS = ["--scene", "cube", "--cases", "on_axis,non_square,orthographic", "--frames", "6", "--every", "3"]
 
@@ -49,13 +48,19 @@ def filled(job_dir, tmp_path) -> Path:
 
 # ---- the job ----------------------------------------------------------------
 
+
 def test_job_lists_every_case_and_frame(job_dir):
     job = json.loads((job_dir / "job.json").read_text())
-    assert [(c["scene"], c["case"]) for c in job["cases"]] == [("cube", "on_axis"), ("cube", "non_square"),
-                                                              ("cube", "orthographic")]
+    assert [(c["scene"], c["case"]) for c in job["cases"]] == [
+        ("cube", "on_axis"),
+        ("cube", "non_square"),
+        ("cube", "orthographic"),
+    ]
     assert job["frame_numbers"] == [1, 4]
-    assert job["cases"][1]["frames"] == ["frames/cube/non_square/frame_0001.png",
-                                         "frames/cube/non_square/frame_0004.png"]
+    assert job["cases"][1]["frames"] == [
+        "frames/cube/non_square/frame_0001.png",
+        "frames/cube/non_square/frame_0004.png",
+    ]
     assert (job["cases"][1]["width"], job["cases"][1]["height"]) == (320, 480)
     readme = (job_dir / "README.md").read_text()
     assert "frames/<scene>/<case>/frame_NNNN.png" in readme and "antialias: false" in readme
@@ -65,7 +70,7 @@ def test_job_lists_every_case_and_frame(job_dir):
 def test_obj_is_the_scene(job_dir):
     v, e = read_obj(job_dir / "scenes" / "cube.obj")
     scene = load_scene("cube")
-    assert np.array_equal(v, scene.vertices)          # repr() floats: exact round trip
+    assert np.array_equal(v, scene.vertices)  # repr() floats: exact round trip
     assert np.array_equal(e, np.asarray(scene.edges))
 
 
@@ -84,16 +89,17 @@ def test_camera_json_reproduces_opencv_pixels(job_dir, case):
     if cam_json["camera"]["projection"] == "perspective":
         uvw = p_cv @ k.T
         pinhole = uvw[:, :2] / uvw[:, 2:]
-    else:                                               # K is affine: [u, v] = K[:2, :2] p_cv[:2] + K[:2, 2]
+    else:  # K is affine: [u, v] = K[:2, :2] p_cv[:2] + K[:2, 2]
         pinhole = p_cv[:, :2] @ k[:2, :2].T + k[:2, 2]
     np.testing.assert_allclose(pinhole, want, atol=1e-9)
     w, h = cam_json["camera"]["width"], cam_json["camera"]["height"]
-    clip = np.c_[p_world, np.ones(len(p_world))] @ (np.array(cam_json["gl_projection"])
-                                                   @ np.array(cam_json["gl_view"])).T
+    clip = (
+        np.c_[p_world, np.ones(len(p_world))] @ (np.array(cam_json["gl_projection"]) @ np.array(cam_json["gl_view"])).T
+    )
     ndc = clip[:, :3] / clip[:, 3:]
     gl_px = np.c_[(ndc[:, 0] + 1) * w / 2 - 0.5, h - (ndc[:, 1] + 1) * h / 2 - 0.5]
     np.testing.assert_allclose(gl_px, want, atol=1e-9)
-    assert np.all(np.abs(ndc[:, 2]) <= 1)              # inside near/far: the cube is within the frustum
+    assert np.all(np.abs(ndc[:, 2]) <= 1)  # inside near/far: the cube is within the frustum
 
 
 def test_export_is_deterministic(tmp_path):
@@ -114,6 +120,7 @@ def test_export_refuses_a_foreign_folder(tmp_path, capsys):
 
 # ---- judging frames -----------------------------------------------------------
 
+
 def test_core_frames_pass(filled, tmp_path, capsys):
     rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")])
     out = capsys.readouterr().out
@@ -126,7 +133,7 @@ def test_core_frames_pass(filled, tmp_path, capsys):
         assert c["pixel_f1_1px"] >= 0.999 and c["faults"] == []
         assert c["frames_checked"] == 2
     assert (tmp_path / "rep" / "report.html").is_file() and (tmp_path / "rep" / "pixels.png").is_file()
-    assert not (tmp_path / "rep" / "vertex_error.png").exists()     # no vertex was compared
+    assert not (tmp_path / "rep" / "vertex_error.png").exists()  # no vertex was compared
 
 
 def test_mirrored_frames_fail_and_are_named(filled, tmp_path, capsys):
@@ -148,7 +155,7 @@ def _judge(job: Path, tmp_path, capsys):
     rc = main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "rep")])
     err = capsys.readouterr().err
     assert "Traceback" not in err
-    assert not (tmp_path / "rep").exists()                # nothing written on an input error
+    assert not (tmp_path / "rep").exists()  # nothing written on an input error
     return rc, err.strip().splitlines()
 
 
@@ -173,8 +180,8 @@ def test_wrong_size_and_unreadable(filled, tmp_path, capsys):
 def _damage_pixels(path: Path) -> None:
     """Zero 16 bytes of the first IDAT's data: the header and size stay right, the pixels cannot be decoded."""
     data = bytearray(path.read_bytes())
-    at = data.index(b"IDAT") + 4 + 2                  # past the zlib header
-    data[at:at + 16] = bytes(16)
+    at = data.index(b"IDAT") + 4 + 2  # past the zlib header
+    data[at : at + 16] = bytes(16)
     path.write_bytes(bytes(data))
 
 
@@ -231,7 +238,12 @@ def test_not_a_job(tmp_path, capsys):
 
 
 def test_options_the_job_fixes_are_usage_errors(filled, tmp_path, capsys):
-    for extra in (["--scene", "cube"], ["--frames", "3"], ["--candidate", "wirecheck.core.projector.projection:project_points"], ["--cases", "on_axis"]):
+    for extra in (
+        ["--scene", "cube"],
+        ["--frames", "3"],
+        ["--candidate", "wirecheck.core.projector.projection:project_points"],
+        ["--cases", "on_axis"],
+    ):
         rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep")] + extra)
         err = capsys.readouterr().err
         assert rc == 2 and "the job fixes scenes, cases and frames" in err, (extra, err)
@@ -264,8 +276,18 @@ def test_project_settings_do_not_apply_to_frames_and_junit_is_written(filled, tm
     cfg = tmp_path / "pyproject.toml"
     cfg.write_text('[tool.wirecheck]\nscenes = ["pyramid"]\ncases = ["on_axis"]\nframes = 3\n')
     junit = tmp_path / "frames.xml"
-    rc = main(["--candidate-frames", str(filled), "--report-dir", str(tmp_path / "rep"), "--config", str(cfg),
-               "--junit-xml", str(junit)])
+    rc = main(
+        [
+            "--candidate-frames",
+            str(filled),
+            "--report-dir",
+            str(tmp_path / "rep"),
+            "--config",
+            str(cfg),
+            "--junit-xml",
+            str(junit),
+        ]
+    )
     assert rc == 0, capsys.readouterr().err
     import xml.etree.ElementTree as ET
 

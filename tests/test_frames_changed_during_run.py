@@ -9,11 +9,10 @@ from __future__ import annotations
 
 import os
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import pytest
-from PIL import Image
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from helpers import no_block
+from PIL import Image
 from wirecheck.oracles import cli as crosscheck_cli
 from wirecheck.oracles.candidates import frames_candidate
 from wirecheck.oracles.candidates.png_frame import FrameProblem, check_png, read_grey
@@ -60,18 +59,22 @@ def _swap_after_check(monkeypatch, job, swap):
         real(job_dir, job_dict, decode)
         if not decode:
             swap(job / FRAME)
+
     monkeypatch.setattr(frames_candidate, "check_frames", check_then_swap)
 
 
-@pytest.mark.parametrize("swap, needle", [
-    (lambda p: (p.unlink(), os.mkfifo(p)), "a FIFO, not a regular file (frame 3 of cube / on_axis)"),
-    (lambda p: p.write_bytes(p.read_bytes()[:60]), "truncated"),
-    (lambda p: Image.new("L", (64, 48)).save(p), "size 64x48: expected 640x480 (the camera's)"),
-])
+@pytest.mark.parametrize(
+    "swap, needle",
+    [
+        (lambda p: (p.unlink(), os.mkfifo(p)), "a FIFO, not a regular file (frame 3 of cube / on_axis)"),
+        (lambda p: p.write_bytes(p.read_bytes()[:60]), "truncated"),
+        (lambda p: Image.new("L", (64, 48)).save(p), "size 64x48: expected 640x480 (the camera's)"),
+    ],
+)
 def test_a_frame_changed_after_the_check_is_one_line(job, tmp_path, capsys, monkeypatch, swap, needle):
     """Before (the FIFO): the run blocked forever in the decoding's open()."""
     _swap_after_check(monkeypatch, job, swap)
-    with hang_guard(120):                   # the judging of the job's first frame takes a few seconds
+    with hang_guard(120):  # the judging of the job's first frame takes a few seconds
         rc = crosscheck_cli.main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "r")])
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1 and err.startswith(f"crosscheck: error: {job / FRAME}: "), err

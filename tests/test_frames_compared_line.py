@@ -6,7 +6,7 @@ The blank job is cube / on_axis, frames 1 and 3 of 4 (``--frames 4 --every 2``):
 
 from __future__ import annotations
 
-import helpers                          # tests/ is on sys.path (rootdir conftest)
+import helpers  # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles import cli as crosscheck_cli
 
 
@@ -15,5 +15,7 @@ def test_the_first_line_says_what_was_compared(tmp_path, capsys):
     capsys.readouterr()
     assert crosscheck_cli.main(["--candidate-frames", str(job), "--report-dir", str(tmp_path / "r")]) == 1
     first = capsys.readouterr().out.splitlines()[0]
-    assert first == ("Compared: level frames (a renderer's PNGs against pyrender; core's beside it), 4 frames per "
-                     "case (1 in 2 checked), 1 case (1 scene x 1 camera)"), first
+    assert first == (
+        "Compared: level frames (a renderer's PNGs against pyrender; core's beside it), 4 frames per "
+        "case (1 in 2 checked), 1 case (1 scene x 1 camera)"
+    ), first

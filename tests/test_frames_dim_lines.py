@@ -9,11 +9,10 @@ from __future__ import annotations
 
 import json
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import numpy as np
 import pytest
 from PIL import Image
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles import cli as crosscheck_cli
 
 

@@ -29,7 +29,6 @@ from functools import partial
 from pathlib import Path
 
 import pytest
-
 from wirecheck.oracles.cli import main
 
 sys.path.insert(0, str(Path(__file__).parent / "clients"))
@@ -39,9 +38,14 @@ import heldout_draw as hd  # noqa: E402
 pytestmark = pytest.mark.slow
 
 #: Each job: (scene, case); frames 1 and 4 of 6.
-JOBS = {"slanted": ("pyramid", "oblique_roll"), "centre_line": ("prism", "on_axis"),
-        "square_on": ("cube", "narrow_fov"), "rolled_cube": ("cube", "oblique_roll"),
-        "ortho_pyramid": ("pyramid", "orthographic"), "wide_prism": ("prism", "wide_fov")}
+JOBS = {
+    "slanted": ("pyramid", "oblique_roll"),
+    "centre_line": ("prism", "on_axis"),
+    "square_on": ("cube", "narrow_fov"),
+    "rolled_cube": ("cube", "oblique_roll"),
+    "ortho_pyramid": ("pyramid", "orthographic"),
+    "wide_prism": ("prism", "wide_fov"),
+}
 
 
 @pytest.fixture(scope="module")
@@ -61,7 +65,7 @@ def _judge(jobs, tmp_path, job, draw, project=hd.project_gl, rule="gl", **mistak
     hd.render(d, draw, project, **mistake)
     rc = main(["--candidate-frames", str(d), "--report-dir", str(tmp_path / "rep"), "--line-rule", rule])
     (case,) = json.loads((tmp_path / "rep" / "report.json").read_text())["cases"]
-    assert case["frames_checked"] == 2                  # both frames judged: not a pass on nothing
+    assert case["frames_checked"] == 2  # both frames judged: not a pass on nothing
     return rc, case
 
 
@@ -127,7 +131,7 @@ def test_another_aliased_rule_is_raster_rule_and_passes_on_geometry(jobs, tmp_pa
     assert rc == 1 and c["line_style"]["style"] == "aliased"
     (f,) = c["faults"]
     assert f["name"] == "raster_rule" and f["share_farther"] == 0.0, c["faults"]
-    assert c["pixel_f1_1px"] >= 0.999 and c["pixel_f1_0px"] < 0.98      # F1@0px alone failed
+    assert c["pixel_f1_1px"] >= 0.999 and c["pixel_f1_0px"] < 0.98  # F1@0px alone failed
     shutil.rmtree(tmp_path / "job"), shutil.rmtree(tmp_path / "rep")
     rc, c = _judge(jobs, tmp_path, "slanted", draw, project, rule="geometry")
     assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["reasons"], c["faults"])
@@ -156,8 +160,13 @@ MISTAKES = [
     ("wu_half_pixel", hd.draw_wu, hd.project_gl, HALF, (0.5, 0.5)),
     ("cv2_LINE_AA_half_pixel", partial(cv2_line, line_type="LINE_AA"), hd.project_gl, HALF, (0.5, 0.5)),
     # matplotlib's display pixels without the +0.5 of a pixel's centre: 0.5 px left and up
-    ("matplotlib_aa_1.5px_half_pixel", partial(mpl, linewidth_px=1.5, half_pixel=True), hd.project_lookat, {},
-     (-0.5, -0.5)),
+    (
+        "matplotlib_aa_1.5px_half_pixel",
+        partial(mpl, linewidth_px=1.5, half_pixel=True),
+        hd.project_lookat,
+        {},
+        (-0.5, -0.5),
+    ),
 ]
 
 
@@ -172,19 +181,49 @@ def test_half_pixel_mistake_is_pixel_offset_measured(jobs, tmp_path, capsys, dra
 
 
 NAMED = [
-    ("matplotlib_aa_1.0px_rows_not_flipped", partial(mpl, linewidth_px=1.0), hd.project_lookat,
-     {"flip_rows": False}, "slanted", "mirror_vertical"),
+    (
+        "matplotlib_aa_1.0px_rows_not_flipped",
+        partial(mpl, linewidth_px=1.0),
+        hd.project_lookat,
+        {"flip_rows": False},
+        "slanted",
+        "mirror_vertical",
+    ),
     # square-on (cube / narrow_fov): the FOV alone is named; on pyramid / oblique_roll see the findings
-    ("bresenham_fov_of_the_wrong_axis", hd.draw_bresenham, hd.project_lookat, {"fov_axis": "x"}, "square_on",
-     "fov_mismatch"),
-    ("cv2_LINE_8_fov_of_the_wrong_axis", partial(cv2_line, line_type="LINE_8"), hd.project_lookat,
-     {"fov_axis": "x"}, "square_on", "fov_mismatch"),
+    (
+        "bresenham_fov_of_the_wrong_axis",
+        hd.draw_bresenham,
+        hd.project_lookat,
+        {"fov_axis": "x"},
+        "square_on",
+        "fov_mismatch",
+    ),
+    (
+        "cv2_LINE_8_fov_of_the_wrong_axis",
+        partial(cv2_line, line_type="LINE_8"),
+        hd.project_lookat,
+        {"fov_axis": "x"},
+        "square_on",
+        "fov_mismatch",
+    ),
     # where the scaled lines' ends, rounded to pixel centres, sit 0.19-0.25 px off on average (the rule's own
     # bias): the FOV alone, no pixel_offset beside it (issue 24 item 4 for an aliased rule other than GL's)
-    ("bresenham_fov_of_the_wrong_axis_rolled_cube", hd.draw_bresenham, hd.project_lookat, {"fov_axis": "x"},
-     "rolled_cube", "fov_mismatch"),
-    ("cv2_LINE_8_fov_of_the_wrong_axis_ortho_pyramid", partial(cv2_line, line_type="LINE_8"), hd.project_lookat,
-     {"fov_axis": "x"}, "ortho_pyramid", "fov_mismatch"),
+    (
+        "bresenham_fov_of_the_wrong_axis_rolled_cube",
+        hd.draw_bresenham,
+        hd.project_lookat,
+        {"fov_axis": "x"},
+        "rolled_cube",
+        "fov_mismatch",
+    ),
+    (
+        "cv2_LINE_8_fov_of_the_wrong_axis_ortho_pyramid",
+        partial(cv2_line, line_type="LINE_8"),
+        hd.project_lookat,
+        {"fov_axis": "x"},
+        "ortho_pyramid",
+        "fov_mismatch",
+    ),
 ]
 
 
@@ -215,6 +254,7 @@ def test_typical_mistake_is_named(jobs, tmp_path, capsys, draw, project, mistake
 
 # ---- findings: correct renderers the judge fails (measured; docs/frames.md, "Held-out renderers") ----
 
+
 @pytest.mark.parametrize("width", [2, 3])
 def test_pillow_wide_lines_pass_on_f1_at_their_width(jobs, tmp_path, capsys, width):
     # Pillow's wide lines: ends snapped to pixel centres and an asymmetric even width; their centres within
@@ -224,9 +264,9 @@ def test_pillow_wide_lines_pass_on_f1_at_their_width(jobs, tmp_path, capsys, wid
     rc, c = _judge(jobs, tmp_path, "slanted", partial(hd.draw_pillow, width=width), hd.project_gl)
     assert c["line_style"]["style"] == "wide" and c["f1_radius_px"] == 2 == c["line_style"]["f1_radius_px"]
     assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["reasons"], c["faults"])
-    assert c["pixel_f1_1px"] < 0.999 <= c["pixel_f1_radius"]        # the radius decided: F1@1px alone fails
+    assert c["pixel_f1_1px"] < 0.999 <= c["pixel_f1_radius"]  # the radius decided: F1@1px alone fails
     assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.35
-    if width == 2:          # each edge's half-pixel lean taken out (oracles.judge.even_lean): measured (0.08, -0.09)
+    if width == 2:  # each edge's half-pixel lean taken out (oracles.judge.even_lean): measured (0.08, -0.09)
         assert c["line_style"]["geometry"]["lean"]["leaning"]
 
 
@@ -249,8 +289,7 @@ def test_cv2_line_8_end_ties_pass_on_geometry(jobs, tmp_path, capsys):
     # pixel_offset. A line with an end on a pixel boundary cannot tell that rounding from an offset, so its
     # samples are left out (line_ties.drop_end_ties): measured on the other lines (780 of 1994 samples),
     # (0.00, 0.00) px, no fault, under --line-rule geometry
-    rc, c = _judge(jobs, tmp_path, "centre_line", partial(cv2_line, line_type="LINE_8"), hd.project_gl,
-                   rule="geometry")
+    rc, c = _judge(jobs, tmp_path, "centre_line", partial(cv2_line, line_type="LINE_8"), hd.project_gl, rule="geometry")
     assert c["line_style"]["style"] == "aliased"
     assert rc == 0 and c["verdict"] == "pass" and c["faults"] == [], (c["faults"], c["line_style"]["geometry"])
     assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.35
@@ -271,7 +310,6 @@ def test_cv2_line_8_centre_line_is_named_raster_rule(jobs, tmp_path, capsys):
 def draw_gl_rule(segs, w, h):
     """GL's rule: wirecheck core's exact raster (the pixels pyrender draws for these lines), white on black."""
     import numpy as np
-
     from wirecheck.core.projector.clipping import clip_to_image
     from wirecheck.core.projector.raster import line_pixels
 
@@ -282,8 +320,11 @@ def draw_gl_rule(segs, w, h):
     return img
 
 
-ASPECT = [("gl_rule", draw_gl_rule), ("cv2_LINE_8", partial(cv2_line, line_type="LINE_8")),
-          ("bresenham", hd.draw_bresenham)]
+ASPECT = [
+    ("gl_rule", draw_gl_rule),
+    ("cv2_LINE_8", partial(cv2_line, line_type="LINE_8")),
+    ("bresenham", hd.draw_bresenham),
+]
 
 
 @pytest.mark.parametrize("job", ["centre_line", "slanted"])
@@ -352,8 +393,11 @@ def test_pillow_half_pixel_is_pixel_offset_against_its_rules_bias(jobs, tmp_path
     assert f["dx"] == pytest.approx(0.5, abs=0.25) and f["dy"] == pytest.approx(0.5, abs=0.25)
 
 
-@pytest.mark.parametrize("draw", [hd.draw_bresenham, partial(cv2_line, line_type="LINE_8"), hd.draw_pillow],
-                         ids=["bresenham", "cv2_LINE_8", "pillow_1px"])
+@pytest.mark.parametrize(
+    "draw",
+    [hd.draw_bresenham, partial(cv2_line, line_type="LINE_8"), hd.draw_pillow],
+    ids=["bresenham", "cv2_LINE_8", "pillow_1px"],
+)
 def test_fov_of_the_wrong_axis_on_prism_wide_fov_is_the_fov_alone(jobs, tmp_path, capsys, draw):
     # the wrong-axis FOV drawn by a rule that rounds the ends, prism / wide_fov: the registration's offset
     # (0.02, 0.19) px is over GL's bias (-0.01, -0.02) by 0.21 (> 0.2) and within the rounded ends' own

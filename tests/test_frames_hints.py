@@ -8,10 +8,10 @@ harness, which has none of them, so its hints stay the generic ones.
 
 from __future__ import annotations
 
-from wirecheck.oracles.reports.compared import hint_lines
-from wirecheck.oracles.reports.junit import failure_text
 from wirecheck.oracles.faults import CATALOGUE
+from wirecheck.oracles.reports.compared import hint_lines
 from wirecheck.oracles.reports.fault_text import hints as fault_hints
+from wirecheck.oracles.reports.junit import failure_text
 
 FAULTS = [{"name": "pixel_offset", "dx": 0.46, "dy": 0.46}, {"name": "line_end_bias"}]
 
@@ -44,14 +44,17 @@ def test_the_verdict_line_claims_f1_at_0px_only_where_it_judged():
 
     assert f1_0px_clause([case("aliased")] * 3, 0.98) == "F1@0px >= 0.98"
     assert f1_0px_clause([case("antialiased"), case("wide")], 0.98) == (
-        "F1@0px reported, not judged: no case is held to GL's pixel rule")
+        "F1@0px reported, not judged: no case is held to GL's pixel rule"
+    )
     assert f1_0px_clause([case("aliased", "geometry")], 0.98).startswith("F1@0px reported, not judged")
     assert f1_0px_clause([case("aliased"), case("antialiased")], 0.98) == (
-        "F1@0px >= 0.98 in the 1 case held to GL's pixel rule")
+        "F1@0px >= 0.98 in the 1 case held to GL's pixel rule"
+    )
     # --line-rule any: a case read as the rounded ends' is held to that rule's F1@0px, and the line says so
     rounded = {"line_style": {"style": "aliased", "line_rule": "any", "rule_read": "rounded"}}
     assert f1_0px_clause([rounded, case("aliased", "any")], 0.98) == (
-        "F1@0px >= 0.98 in the 2 cases held to a pixel rule (GL's, or the rounded ends' in 1)")
+        "F1@0px >= 0.98 in the 2 cases held to a pixel rule (GL's, or the rounded ends' in 1)"
+    )
 
 
 def test_a_faults_list_of_floats_is_written_as_its_numbers():

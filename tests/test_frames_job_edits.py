@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import json
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import pytest
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles import cli as crosscheck_cli
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 
@@ -62,29 +61,41 @@ def original(job, *keys):
     return value
 
 
-@pytest.mark.parametrize("edit, needle", [
-    # K, R, t_cv, the GL matrices, right: what a renderer draws from; the judge draws from "camera"
-    (lambda d: d["K"][0].__setitem__(0, 400.0), "K[0][0] 400.0: expected "),
-    (lambda d: d["gl_projection"][0].__setitem__(0, 2.0), "gl_projection[0][0] 2.0: expected "),
-    (lambda d: d["R"].reverse(), "R[0][0] "),
-    (lambda d: d["t_cv"].__setitem__(2, 7.0), "t_cv[2] 7.0: expected "),
-    # the contract's fields: one missing is not the default's business
-    (lambda d: d["camera"].pop("near"), "camera: no 'near': expected "),
-    (lambda d: d["camera"].__setitem__("fov_y_deg", 50.0), "K[0][0] "),
-    # a camera file copied over another frame's
-    (lambda d: d.__setitem__("frame", 3), "frame 3: expected 1"),
-    (lambda d: d.__setitem__("case", "oblique_roll"), "case 'oblique_roll': expected 'on_axis'"),
-    # a typo'd or extra key
-    (lambda d: d.__setitem__("modle_matrix", d["model_matrix"]), "unknown key 'modle_matrix' (did you mean 'model_matrix'?)"),
-    (lambda d: d["camera"].__setitem__("focal", 3.0), "camera: unknown key 'focal'"),
-    # a field of the wrong type, named (before: "TypeError: must be real number, not str"; "camera Truex480")
-    (lambda d: d["camera"].__setitem__("fov_y_deg", "55"), "camera.fov_y_deg '55': expected a number"),
-    (lambda d: d["camera"].__setitem__("width", True), "camera.width True: expected an integer"),
-    (lambda d: d["camera"].__setitem__("up", [0, 1]), "camera.up [0, 1]: expected 3 numbers"),
-    # a JSON true is no 1.0
-    (lambda d: d["model_matrix"][0].__setitem__(0, True) if d["model_matrix"][0][0] == 1.0 else
-     d["model_matrix"][3].__setitem__(3, True), "model_matrix["),
-])
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        # K, R, t_cv, the GL matrices, right: what a renderer draws from; the judge draws from "camera"
+        (lambda d: d["K"][0].__setitem__(0, 400.0), "K[0][0] 400.0: expected "),
+        (lambda d: d["gl_projection"][0].__setitem__(0, 2.0), "gl_projection[0][0] 2.0: expected "),
+        (lambda d: d["R"].reverse(), "R[0][0] "),
+        (lambda d: d["t_cv"].__setitem__(2, 7.0), "t_cv[2] 7.0: expected "),
+        # the contract's fields: one missing is not the default's business
+        (lambda d: d["camera"].pop("near"), "camera: no 'near': expected "),
+        (lambda d: d["camera"].__setitem__("fov_y_deg", 50.0), "K[0][0] "),
+        # a camera file copied over another frame's
+        (lambda d: d.__setitem__("frame", 3), "frame 3: expected 1"),
+        (lambda d: d.__setitem__("case", "oblique_roll"), "case 'oblique_roll': expected 'on_axis'"),
+        # a typo'd or extra key
+        (
+            lambda d: d.__setitem__("modle_matrix", d["model_matrix"]),
+            "unknown key 'modle_matrix' (did you mean 'model_matrix'?)",
+        ),
+        (lambda d: d["camera"].__setitem__("focal", 3.0), "camera: unknown key 'focal'"),
+        # a field of the wrong type, named (before: "TypeError: must be real number, not str"; "camera Truex480")
+        (lambda d: d["camera"].__setitem__("fov_y_deg", "55"), "camera.fov_y_deg '55': expected a number"),
+        (lambda d: d["camera"].__setitem__("width", True), "camera.width True: expected an integer"),
+        (lambda d: d["camera"].__setitem__("up", [0, 1]), "camera.up [0, 1]: expected 3 numbers"),
+        # a JSON true is no 1.0
+        (
+            lambda d: (
+                d["model_matrix"][0].__setitem__(0, True)
+                if d["model_matrix"][0][0] == 1.0
+                else d["model_matrix"][3].__setitem__(3, True)
+            ),
+            "model_matrix[",
+        ),
+    ],
+)
 def test_an_edited_camera_json_is_one_line(job, tmp_path, capsys, edit, needle):
     _edit(job / CAM, edit)
     rc, err = judged(job, tmp_path, capsys)
@@ -106,14 +117,17 @@ def test_a_model_matrix_that_is_not_affine_is_refused(job, tmp_path, capsys):
     assert_one_line(rc, err, f"{job / CAM}: model_matrix[3] [0.0, 0.0, 1.0, 0.0]: expected [0.0, 0.0, 0.0, 1.0]")
 
 
-@pytest.mark.parametrize("edit, needle", [
-    (lambda d: d.__setitem__("evrey", 2), "unknown key 'evrey' (did you mean 'every'?)"),
-    (lambda d: d.pop("conventions"), "no 'conventions'"),
-    (lambda d: d["cases"][0].__setitem__("widht", 640), "cases[0]: unknown key 'widht' (did you mean 'width'?)"),
-    (lambda d: d["scenes"][0].__setitem__("colour", "red"), "scenes[0]: unknown key 'colour'"),
-    (lambda d: d["motion"].__setitem__("phse", 0.3), "motion: unknown key 'phse' (did you mean 'phase'?)"),
-    (lambda d: d.__setitem__("version", 1.0), "version 1.0: expected 1"),
-])
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (lambda d: d.__setitem__("evrey", 2), "unknown key 'evrey' (did you mean 'every'?)"),
+        (lambda d: d.pop("conventions"), "no 'conventions'"),
+        (lambda d: d["cases"][0].__setitem__("widht", 640), "cases[0]: unknown key 'widht' (did you mean 'width'?)"),
+        (lambda d: d["scenes"][0].__setitem__("colour", "red"), "scenes[0]: unknown key 'colour'"),
+        (lambda d: d["motion"].__setitem__("phse", 0.3), "motion: unknown key 'phse' (did you mean 'phase'?)"),
+        (lambda d: d.__setitem__("version", 1.0), "version 1.0: expected 1"),
+    ],
+)
 def test_an_edited_job_json_is_one_line(job, tmp_path, capsys, edit, needle):
     _edit(job / "job.json", edit)
     rc, err = judged(job, tmp_path, capsys)
@@ -129,10 +143,11 @@ def test_an_unedited_job_reads_as_exported(blank):
     from wirecheck.oracles import cli
 
     with tempfile.TemporaryDirectory() as tmp:
-        for args in (["--scene", "cube", "--cases", "orthographic,non_square", "--frames", "3", "--phase", "0.3"],
-                     ["--scene", "pyramid", "--cases", "off_centre,non_square_pixels", "--frames", "2"],
-                     ["--scene", ORRERY, "--cases", "near_plane", "--frames", "4", "--every", "3",
-                      "--spin", "0.25,1,3"]):
+        for args in (
+            ["--scene", "cube", "--cases", "orthographic,non_square", "--frames", "3", "--phase", "0.3"],
+            ["--scene", "pyramid", "--cases", "off_centre,non_square_pixels", "--frames", "2"],
+            ["--scene", ORRERY, "--cases", "near_plane", "--frames", "4", "--every", "3", "--spin", "0.25,1,3"],
+        ):
             out = Path(tmp) / "j"
             assert cli.main(["export", str(out), *args]) == 0
             job = load_job(out)
@@ -144,12 +159,15 @@ def test_an_unedited_job_reads_as_exported(blank):
             shutil.rmtree(out)
 
 
-@pytest.mark.parametrize("line, needle", [
-    ("f 1 99 3", "'f 1 99 3': expected 'f I J K ...' (3 or more of 1..8)"),
-    ("f 1 2", "'f 1 2': expected 'f I J K ...'"),
-    ("f 1 x 3", "'f 1 x 3': expected 'f I J K ...'"),
-    ("vt 0.5 0.5", "'vt 0.5 0.5': expected 'f I J K ...' (3 or more of 1..8), 'v', 'l' or a '#' comment"),
-])
+@pytest.mark.parametrize(
+    "line, needle",
+    [
+        ("f 1 99 3", "'f 1 99 3': expected 'f I J K ...' (3 or more of 1..8)"),
+        ("f 1 2", "'f 1 2': expected 'f I J K ...'"),
+        ("f 1 x 3", "'f 1 x 3': expected 'f I J K ...'"),
+        ("vt 0.5 0.5", "'vt 0.5 0.5': expected 'f I J K ...' (3 or more of 1..8), 'v', 'l' or a '#' comment"),
+    ],
+)
 def test_an_edited_obj_face_or_record_is_one_line(job, tmp_path, capsys, line, needle):
     """Faces are not judged, but a renderer may read them (hidden lines): before, any 'f' line or unknown
     record was skipped and the job judged (correct frames: exit 0)."""
@@ -160,10 +178,13 @@ def test_an_edited_obj_face_or_record_is_one_line(job, tmp_path, capsys, line, n
     assert_one_line(rc, err, f"{obj}:{n + 1}: {needle}")
 
 
-@pytest.mark.parametrize("edit, needle", [
-    (lambda d: d["K"][1].__setitem__(2, 200.0), "K[1][2] 200.0: expected "),
-    (lambda d: d.__setitem__("t", 0.0), "t 0.0: expected 0.5"),
-])
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        (lambda d: d["K"][1].__setitem__(2, 200.0), "K[1][2] 200.0: expected "),
+        (lambda d: d.__setitem__("t", 0.0), "t 0.0: expected 0.5"),
+    ],
+)
 def test_an_edit_in_a_later_frame_of_a_case_is_found(job, tmp_path, capsys, edit, needle):
     """The camera's own fields are computed once a case (the first frame's): a later frame's file is still
     held to them, and to its own frame number and time (frame 3 of 4: t = 2 / 4)."""

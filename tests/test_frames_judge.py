@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
+from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
+from raster_mutants import drop_last
 from wirecheck.core.projector import raster
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles import tolerances
@@ -27,16 +28,20 @@ from wirecheck.oracles.cli import main
 from wirecheck.oracles.judge.frames_judge import diagnosis_frames, run_frames
 from wirecheck.oracles.runner import CoreCandidate, Tolerances, run_crosscheck
 
-from raster_mutants import drop_last
-from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
-
 # frames 1 and 4 of 6 (the cube square-on and half a turn on), seen by an oblique camera and an orthographic one
 ARGS = ["--scene", "cube", "--cases", "oblique_roll,orthographic", "--frames", "6", "--every", "3"]
 
 # Every other criterion switched off so that only the one under test can decide
 # (as tests/test_line_gate.OPEN): F1 floors 0, balance alpha 0 (p < 0 never), counts of any size.
-OPEN = Tolerances(vertex_px=1.0, min_f1_1px=0.0, min_f1_0px=0.0, min_iou=0.0, balance_alpha=0.0,
-                  max_imbalance=1.0, max_edge_count_diff=10 ** 6)
+OPEN = Tolerances(
+    vertex_px=1.0,
+    min_f1_1px=0.0,
+    min_f1_0px=0.0,
+    min_iou=0.0,
+    balance_alpha=0.0,
+    max_imbalance=1.0,
+    max_edge_count_diff=10**6,
+)
 
 
 @pytest.fixture(scope="module")
@@ -69,9 +74,11 @@ def short(job_dir, tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def stray(job_dir, tmp_path_factory) -> Path:
     """Core's frames and pixel (0, 0), far from every line (F1@1px < 1, nothing else changes but balance)."""
+
     def edit(img):
         img[0, 0] = 255
         return img
+
     return _filled(job_dir, tmp_path_factory.mktemp("stray"), edit)
 
 
@@ -93,7 +100,6 @@ def test_compared_counts_and_the_worst_frame(exact):
     """``compared``: the frames, no vertex, and the pixels drawn by either side (the gate's "nothing
     compared"); the worst frame's images are that frame's."""
     from PIL import Image
-
     from wirecheck.oracles.candidates.frames_candidate import load_job
 
     report, images = run_frames(exact)
@@ -107,8 +113,9 @@ def test_compared_counts_and_the_worst_frame(exact):
         rel = listed["frames"][[f["frame"] for f in per].index(worst)]
         assert np.array_equal(im["candidate"], np.asarray(Image.open(exact / rel).convert("L")) >= 128)
         # the candidate's count, read here from its PNGs by the frames rule (drawn where grey >= 128)
-        assert [f["candidate_pixels"] for f in per] == \
-            [int((np.asarray(Image.open(exact / rel).convert("L")) >= 128).sum()) for rel in listed["frames"]]
+        assert [f["candidate_pixels"] for f in per] == [
+            int((np.asarray(Image.open(exact / rel).convert("L")) >= 128).sum()) for rel in listed["frames"]
+        ]
         # |A u B| lies in [max(|A|, |B|), |A| + |B|), the upper end open as the two sides share pixels
         # (core's exact lines against the oracle's: F1@0px near 1)
         low = sum(max(f["candidate_pixels"], f["oracle_pixels"]) for f in per)
@@ -159,8 +166,14 @@ def test_a_geometric_fault_is_named_before_the_lines(mirrored):
 def test_both_paths_count_the_same_one_sided_pixels(monkeypatch, short):
     """The projector path on core (rasterizer patched alike) against the frames path on core's PNGs."""
     monkeypatch.setattr(raster, "_line_pixels", drop_last)
-    projector, _ = run_crosscheck([load_scene("cube")], CoreCandidate(), frames=6, every=3,
-                                  case_names=["oblique_roll", "orthographic"], animation=False)
+    projector, _ = run_crosscheck(
+        [load_scene("cube")],
+        CoreCandidate(),
+        frames=6,
+        every=3,
+        case_names=["oblique_roll", "orthographic"],
+        animation=False,
+    )
     frames, _ = run_frames(short)
     keys = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "one_sided_by_place")
     for p, f in zip(projector["cases"], frames["cases"]):
@@ -170,6 +183,7 @@ def test_both_paths_count_the_same_one_sided_pixels(monkeypatch, short):
 
 
 # ---------------------------------------------------------------- each threshold decides, on the frames path
+
 
 def _decides(job, field, at, past, prefix, base=OPEN):
     """``field`` = ``at`` passes, ``field`` = ``past`` fails, with exactly the one reason ``prefix``."""
@@ -191,7 +205,7 @@ def _lowest(job, key):
 
 def test_min_f1_1px_decides_on_frames(stray):
     f1 = _lowest(stray, "pixel_f1_1px")
-    assert 0.99 < f1 < 1.0                  # one stray pixel among ~1,000
+    assert 0.99 < f1 < 1.0  # one stray pixel among ~1,000
     failed = _decides(stray, "min_f1_1px", f1, np.nextafter(f1, 2.0), "pixel F1@1px")
     # the geometry is right (nothing named from the images) and the line gate is off: a failure
     # nothing explains is `unexplained`, never "no fault" (oracles.judge.decide.decide); its advice says
@@ -206,7 +220,7 @@ def test_min_f1_1px_decides_on_frames(stray):
 
 def test_min_f1_0px_decides_on_frames(short):
     f1 = _lowest(short, "pixel_f1_0px")
-    assert 0.98 < f1 < 1.0                  # ~8 end pixels among ~1,000
+    assert 0.98 < f1 < 1.0  # ~8 end pixels among ~1,000
     _decides(short, "min_f1_0px", f1, np.nextafter(f1, 2.0), "pixel F1@0px")
 
 
@@ -214,20 +228,32 @@ def test_balance_decides_on_frames(short):
     report, _ = run_frames(short, tol=OPEN)
     fracs = [abs(c["lines"]["imbalance_fraction"]) for c in report["cases"]]
     ps = [c["lines"]["balance_p_value"] for c in report["cases"]]
-    assert min(fracs) > 2e-3 and max(ps) < 1e-3     # ~8 of ~1,000 pixels a frame, all one-sided one way
+    assert min(fracs) > 2e-3 and max(ps) < 1e-3  # ~8 of ~1,000 pixels a frame, all one-sided one way
     # the net fraction alone (alpha 1: every p rejects symmetry): allowed up to the largest case's, then
     # just below the smallest case's
-    _decides(short, "max_imbalance", max(fracs), np.nextafter(min(fracs), 0.0), "one-sided pixels unbalanced",
-             base=replace(OPEN, balance_alpha=1.0))
+    _decides(
+        short,
+        "max_imbalance",
+        max(fracs),
+        np.nextafter(min(fracs), 0.0),
+        "one-sided pixels unbalanced",
+        base=replace(OPEN, balance_alpha=1.0),
+    )
     # the sign test alone (any net fraction too much): alpha 0 never rejects, just above the largest p does
-    _decides(short, "balance_alpha", 0.0, np.nextafter(max(ps), 2.0), "one-sided pixels unbalanced",
-             base=replace(OPEN, max_imbalance=0.0))
+    _decides(
+        short,
+        "balance_alpha",
+        0.0,
+        np.nextafter(max(ps), 2.0),
+        "one-sided pixels unbalanced",
+        base=replace(OPEN, max_imbalance=0.0),
+    )
 
 
 def test_edge_count_decides_on_frames(short):
     report, _ = run_frames(short, tol=OPEN)
     worst = max(c["lines"]["edge_count_max_diff"] for c in report["cases"])
-    assert worst >= 1                       # a line one pixel short
+    assert worst >= 1  # a line one pixel short
     _decides(short, "max_edge_count_diff", worst, worst - 1, "edge ")
 
 
@@ -266,8 +292,10 @@ def _core_frames(files: dict, job: dict, scene) -> dict:
         out[c["case"]] = []
         for k in job["frame_numbers"]:
             cj = json.loads(files[f"cameras/{scene.name}/{c['case']}/frame_{k:04d}.json"])
-            out[c["case"]].append(render_frame(scene.vertices, scene.edges, Camera(**cj["camera"]),
-                                               np.asarray(cj["model_matrix"])).image >= 128)
+            out[c["case"]].append(
+                render_frame(scene.vertices, scene.edges, Camera(**cj["camera"]), np.asarray(cj["model_matrix"])).image
+                >= 128
+            )
     return out
 
 

@@ -21,17 +21,26 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import pytest
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles.cli import main
 
-pytestmark = pytest.mark.slow          # four renderer runs and four judgements (~20 s)
+pytestmark = pytest.mark.slow  # four renderer runs and four judgements (~20 s)
 
 SCRIPT = Path(__file__).parent / "clients" / "moderngl_gl_job.py"
 # cube and pyramid, three cases (4:3 oblique with roll, portrait 2:3, orthographic), frames 1 and 4 of 6
-ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square,orthographic",
-        "--frames", "6", "--every", "3"]
+ARGS = [
+    "--scene",
+    "cube",
+    "--scene",
+    "pyramid",
+    "--cases",
+    "oblique_roll,non_square,orthographic",
+    "--frames",
+    "6",
+    "--every",
+    "3",
+]
 PROBE = "import moderngl; moderngl.create_standalone_context(backend='egl').release()"
 
 
@@ -94,7 +103,7 @@ def test_moderngl_half_pixel_offset_is_named_with_its_offset(job_dir, tmp_path):
     assert rc == 1
     for key, c in _by_case(report).items():
         assert c["verdict"] == "fail" and [f["name"] for f in c["faults"]] == ["pixel_offset"], (key, c["faults"])
-        assert c["pixel_f1_1px"] >= 0.99           # the same lines, half a pixel away: a 0-px fault only
+        assert c["pixel_f1_1px"] >= 0.99  # the same lines, half a pixel away: a 0-px fault only
         fault = c["faults"][0]
         # +0.5 px right and down. Aliased 1-px lines quantise the fitted offset (docs/frames.md: 0.46-0.52
         # for a half-pixel offset of core's lines); 0.1 px is half of OFFSET_TOL_PX (0.2), so an offset this

@@ -11,9 +11,8 @@ from __future__ import annotations
 
 import json
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import numpy as np
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles import cli as crosscheck_cli
 
 

@@ -24,14 +24,12 @@ import math
 import shutil
 
 import pytest
-
+from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 from wirecheck.core.camera import Camera
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
-from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
-
-pytestmark = pytest.mark.slow          # two exports, four drawings and judgements (~25 s)
+pytestmark = pytest.mark.slow  # two exports, four drawings and judgements (~25 s)
 
 JOBS = {"frames4": ["--frames", "4"], "every12": ["--every", "12"]}
 CASES = "oblique_roll,narrow_fov"
@@ -41,9 +39,17 @@ FOV_SCALE = 0.75
 def _fov_075(cam: Camera) -> Camera:
     """The camera with fx, fy scaled by 0.75 about the principal point (the horizontal FOV given as vertical)."""
     fx, fy = cam.focal_xy
-    return Camera(position=cam.position, forward=cam.forward, up=cam.up, fov_y_deg=cam.fov_y_deg, width=cam.width,
-                  height=cam.height, near=cam.near, far=cam.far,
-                  intrinsics=(fx * FOV_SCALE, fy * FOV_SCALE, *cam.principal_point))
+    return Camera(
+        position=cam.position,
+        forward=cam.forward,
+        up=cam.up,
+        fov_y_deg=cam.fov_y_deg,
+        width=cam.width,
+        height=cam.height,
+        near=cam.near,
+        far=cam.far,
+        intrinsics=(fx * FOV_SCALE, fy * FOV_SCALE, *cam.principal_point),
+    )
 
 
 FAULTS = {"fov": {"camera": _fov_075}, "flip_rows": {"edit": lambda img: img[::-1].copy()}}

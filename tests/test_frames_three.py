@@ -30,10 +30,9 @@ import subprocess
 from pathlib import Path
 
 import pytest
-
 from wirecheck.oracles.cli import main
 
-pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
+pytestmark = pytest.mark.slow  # an expensive module fixture (tests/conftest.py runs such files first)
 
 TESTS = Path(__file__).parent
 SCRIPT = TESTS / "browser" / "frames_three.mjs"
@@ -62,9 +61,13 @@ def _draw(job: Path, *flags: str) -> None:
     left a 2-3 MB wirecheck-chromium-* profile in the system temporary folder)."""
     profiles = job.parent / "profiles"
     profiles.mkdir(exist_ok=True)
-    proc = subprocess.run(["node", str(SCRIPT), str(job), str(THREE), *flags], capture_output=True, text=True,
-                          timeout=300, env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM,
-                                                WIRECHECK_PROFILE_PARENT=str(profiles)))
+    proc = subprocess.run(
+        ["node", str(SCRIPT), str(job), str(THREE), *flags],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM, WIRECHECK_PROFILE_PARENT=str(profiles)),
+    )
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert sorted(p.name for p in profiles.iterdir()) == [], "Chromium's profile was left behind"
 
@@ -95,7 +98,7 @@ def test_three_js_frames_are_judged_by_their_own_pixels(judged):
     # the edge three.js (SwiftShader) does not draw: pixels only the oracle has
     worst = next(f for f in dropped["per_frame"] if f["frame"] == 13)
     assert worst["f1_1px"] < 0.95 and worst["oracle_pixels"] - worst["candidate_pixels"] > 150
-    assert rc == 1                                  # so the run fails, by that case and the 0-px bound
+    assert rc == 1  # so the run fails, by that case and the 0-px bound
 
 
 def test_three_js_has_no_named_fault(judged):
@@ -111,13 +114,20 @@ def test_three_js_has_no_named_fault(judged):
     assert named.pop(("cube", "narrow_fov")) in ([], ["unexplained"], ["line_pixel_bias"], ["raster_rule"])
     # SwiftShader's line rule is not Mesa's: where it differs, a raster fault (raster_rule, or the
     # one-sided counts' line_pixel_bias where F1@0px itself holds), never a convention fault
-    odd = {key: names for key, names in named.items()
-           if names not in ([], ["unexplained"], ["raster_rule"], ["line_pixel_bias"])}
+    odd = {
+        key: names
+        for key, names in named.items()
+        if names not in ([], ["unexplained"], ["raster_rule"], ["line_pixel_bias"])
+    }
     assert not odd, odd
     # a case failing by F1@0px alone (SwiftShader's line rule, not Mesa's) is named for its rule
     for c in report["cases"]:
         if c["reasons"] and all(r.startswith("pixel F1@0px") for r in c["reasons"]):
-            assert named.get((c["scene"], c["camera"]), ["raster_rule"]) == ["raster_rule"], (c["scene"], c["camera"], c["faults"])
+            assert named.get((c["scene"], c["camera"]), ["raster_rule"]) == ["raster_rule"], (
+                c["scene"],
+                c["camera"],
+                c["faults"],
+            )
 
 
 def test_a_mirrored_three_js_frame_set_is_named(judged, tmp_path):
@@ -131,8 +141,9 @@ def test_a_mirrored_three_js_frame_set_is_named(judged, tmp_path):
         ImageOps.flip(Image.open(png)).save(png)
     # judge a single oblique case by a job of its own: export it, copy its frames
     one = tmp_path / "one"
-    assert main(["export", str(one), "--scene", "cube", "--cases", "oblique_roll", "--frames", "24",
-                 "--every", "12"]) == 0
+    assert (
+        main(["export", str(one), "--scene", "cube", "--cases", "oblique_roll", "--frames", "24", "--every", "12"]) == 0
+    )
     shutil.rmtree(one / "frames")
     (one / "frames" / "cube").mkdir(parents=True)
     shutil.copytree(bad / "frames" / "cube" / "oblique_roll", one / "frames" / "cube" / "oblique_roll")
@@ -155,4 +166,4 @@ def test_three_js_antialiased_frames_pass(tmp_path):
         assert c["line_style"]["style"] == "antialiased" and c["faults"] == []
         # measured: centres within 0.1 px of the oracle's lines (0.095 at most, cube / orthographic)
         assert max(map(abs, c["line_style"]["geometry"]["offset_px"])) < 0.15
-    assert min(c["pixel_f1_0px"] for c in report["cases"]) < 0.98      # GL's rule would have failed them
+    assert min(c["pixel_f1_0px"] for c in report["cases"]) < 0.98  # GL's rule would have failed them

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 from scipy.ndimage import distance_transform_edt
-
 from wirecheck.core.camera import Camera
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
@@ -30,19 +30,26 @@ from wirecheck.oracles.cli import main
 from wirecheck.oracles.faults import CATALOGUE
 from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
-from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
-
-pytestmark = pytest.mark.slow          # one export, three drawings and judgements (~15 s)
+pytestmark = pytest.mark.slow  # one export, three drawings and judgements (~15 s)
 
 
 def _camera(near_factor=1.0, roll_deg=0.0):
     def edit(cam: Camera) -> Camera:
         f, up = np.asarray(cam.forward, float), np.asarray(cam.up, float)
         f = f / np.linalg.norm(f)
-        t = math.radians(roll_deg)                        # Rodrigues: up turned about the forward axis
+        t = math.radians(roll_deg)  # Rodrigues: up turned about the forward axis
         up = up * math.cos(t) + np.cross(f, up) * math.sin(t) + f * np.dot(f, up) * (1 - math.cos(t))
-        return Camera(position=cam.position, forward=cam.forward, up=tuple(up), fov_y_deg=cam.fov_y_deg,
-                      width=cam.width, height=cam.height, near=cam.near * near_factor, far=cam.far)
+        return Camera(
+            position=cam.position,
+            forward=cam.forward,
+            up=tuple(up),
+            fov_y_deg=cam.fov_y_deg,
+            width=cam.width,
+            height=cam.height,
+            near=cam.near * near_factor,
+            far=cam.far,
+        )
+
     return edit
 
 
@@ -93,7 +100,7 @@ def test_a_near_plane_too_far_is_a_visibility_question(judged, mistake):
     # diagnosis draws the oracle's OpenCV segments with core's rasteriser: a few tie pixels either way
     # (a line end on a pixel boundary), 2 % of the count
     assert fault["oracle_only_px"] == pytest.approx(_missing_px(job_dir, MISTAKES[mistake]), rel=0.02), fault
-    (name, hint), = fault_hints(case["faults"])
+    ((name, hint),) = fault_hints(case["faults"])
     assert "near/far test" in hint and "rotation order" not in hint, hint
     # near x 1.5: the images name nothing; the one-sided line pixels would be line_pixel_bias ("check the line
     # width"), but they are whole pieces of line
@@ -126,13 +133,13 @@ def test_a_line_width_fault_stays_a_line_fault():
     cam = Camera(position=(0, 0, 0), forward=(0, 0, -1), up=(0, 1, 0), width=64, height=48)
     segs = np.array([[[10, 10], [50, 10]], [[50, 10], [50, 40]], [[50, 40], [10, 40]], [[10, 40], [10, 10]]], float)
     exact = np.zeros((48, 64), bool)
-    exact[10, 10:51] = exact[40, 10:51] = exact[10:41, 10] = exact[10:41, 50] = True    # the square's pixels
+    exact[10, 10:51] = exact[40, 10:51] = exact[10:41, 10] = exact[10:41, 50] = True  # the square's pixels
     thick = exact.copy()
     thick[:, 1:] |= exact[:, :-1]
     width_fault = {"name": "line_pixel_bias", "candidate_only": int((thick & ~exact).sum()), "oracle_only": 0}
     assert frames_visibility([width_fault], [thick], [segs], cam, 1) == [width_fault]
     cut = exact.copy()
-    cut[40, 10:31] = False                             # 21 pixels of the bottom line missing
+    cut[40, 10:31] = False  # 21 pixels of the bottom line missing
     piece_fault = {"name": "line_pixel_bias", "candidate_only": 0, "oracle_only": 21}
     (got,) = frames_visibility([piece_fault], [cut], [segs], cam, 1)
     # 19 of them beyond 1 px: (40, 30) is 1 px from the kept (40, 31), (40, 10) 1 px from the kept (39, 10);

@@ -23,19 +23,30 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import pytest
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles.cli import main
 
-pytestmark = pytest.mark.slow          # three renderer runs and three judgements
+pytestmark = pytest.mark.slow  # three renderer runs and three judgements
 
 SCRIPT = Path(__file__).parent / "clients" / "vtk_frames.py"
 # cube and pyramid, three cases (4:3 oblique with roll, portrait 2:3, orthographic), frames 1 and 4 of 6
-ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square,orthographic",
-        "--frames", "6", "--every", "3"]
-PROBE = ("import vtk; w = vtk.vtkRenderWindow(); w.SetOffScreenRendering(1); w.SetSize(8, 8); "
-         "w.AddRenderer(vtk.vtkRenderer()); w.Render()")
+ARGS = [
+    "--scene",
+    "cube",
+    "--scene",
+    "pyramid",
+    "--cases",
+    "oblique_roll,non_square,orthographic",
+    "--frames",
+    "6",
+    "--every",
+    "3",
+]
+PROBE = (
+    "import vtk; w = vtk.vtkRenderWindow(); w.SetOffScreenRendering(1); w.SetSize(8, 8); "
+    "w.AddRenderer(vtk.vtkRenderer()); w.Render()"
+)
 
 
 @pytest.fixture(scope="module")
@@ -71,15 +82,16 @@ def test_vtk_horizontal_view_angle_is_a_fov_mismatch(job_dir, tmp_path):
     rc, report = _render_and_judge(job_dir, tmp_path, "--mistake", "horizontal_fov")
     assert rc == 1
     for key, c in _by_case(report).items():
-        if key[1] == "orthographic":      # parallel projection: VTK's view angle is not used
+        if key[1] == "orthographic":  # parallel projection: VTK's view angle is not used
             assert c["verdict"] == "pass", (key, c["faults"])
             continue
         assert c["verdict"] == "fail" and [f["name"] for f in c["faults"]] == ["fov_mismatch"], (key, c["faults"])
         spec = c["camera_spec"]
         # the angle taken as horizontal: tan(v/2) = tan(fov/2) H / W, the FOV the image implies (to 0.5 deg,
         # a 1 % scale at these FOVs, far inside the 25-50 % of the mistake)
-        expected = math.degrees(2 * math.atan(math.tan(math.radians(spec["fov_y_deg"]) / 2)
-                                              * spec["height"] / spec["width"]))
+        expected = math.degrees(
+            2 * math.atan(math.tan(math.radians(spec["fov_y_deg"]) / 2) * spec["height"] / spec["width"])
+        )
         assert c["faults"][0]["implied_fov_deg"] == pytest.approx(expected, abs=0.5), (key, c["faults"][0])
 
 

@@ -7,9 +7,8 @@ user could not tell which link to remove. Before: no path but ``frames/`` in the
 
 from __future__ import annotations
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import pytest
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles.candidates import frames_candidate
 from wirecheck.oracles.candidates.frames_candidate import FramesError, load_frames, load_job
 
@@ -21,7 +20,7 @@ def test_the_walk_bound_names_the_folder_it_was_in(tmp_path, monkeypatch):
     for i in range(8):
         (big / "deep" / f"f{i}").write_bytes(b"")
     (job / "frames/cube/on_axis/out").symlink_to(big)
-    monkeypatch.setattr(frames_candidate, "MAX_WALK", 5)      # the job's 4 entries (cube, on_axis, 2 frames) and the link
+    monkeypatch.setattr(frames_candidate, "MAX_WALK", 5)  # the job's 4 entries (cube, on_axis, 2 frames) and the link
     # the link's first entry (deep) passes the bound: the line names the folder walked, the link
     with pytest.raises(FramesError) as info:
         load_frames(job, load_job(job))

@@ -4,20 +4,19 @@ import math
 
 import numpy as np
 import pytest
-
-from wirecheck.core.scene.model import Scene, SceneObject
+from helpers import run_crosscheck
 from wirecheck.core.scene.files import load_scene
+from wirecheck.core.scene.model import Scene, SceneObject
 from wirecheck.core.transforms import Motion, apply
+from wirecheck.oracles.cases import case_motion, cases_for, framing
 from wirecheck.oracles.references import faces as oface
 from wirecheck.oracles.references import opencv_oracle
-from wirecheck.oracles.cases import case_motion, cases_for, framing
 from wirecheck.oracles.references.convert import model_matrix
 from wirecheck.oracles.references.pyrender_oracle import osmesa_available
-from helpers import run_crosscheck
 
-HALF = 50.0                                  # the box's half-size
-FAR = np.array([900.0, -400.0, 300.0])       # where its centre is
-CUBE = load_scene("cube")                    # corners (+-1, +-1, +-1)
+HALF = 50.0  # the box's half-size
+FAR = np.array([900.0, -400.0, 300.0])  # where its centre is
+CUBE = load_scene("cube")  # corners (+-1, +-1, +-1)
 
 _OK, _WHY = osmesa_available()
 needs_osmesa = pytest.mark.skipif(not _OK, reason=f"pyrender/OSMesa unavailable: {_WHY}")
@@ -89,7 +88,12 @@ def test_crosscheck_of_the_off_centre_box_passes_comparing_its_lines(tmp_path):
 def test_every_bundled_scene_keeps_the_origin_framing():
     # hand values: the cube's and pyramid's corners are at sqrt(3), the prism's at sqrt(2);
     # the orrery's bound is |planet offset| 2.5 + scale 0.5 * sqrt(3) (core.scene.model.Scene.radius)
-    expected = {"cube": math.sqrt(3), "pyramid": math.sqrt(3), "prism": math.sqrt(2), "orrery": 2.5 + 0.5 * math.sqrt(3)}
+    expected = {
+        "cube": math.sqrt(3),
+        "pyramid": math.sqrt(3),
+        "prism": math.sqrt(2),
+        "orrery": 2.5 + 0.5 * math.sqrt(3),
+    }
     for name, r in expected.items():
         centre, radius, pivot = framing(load_scene(name))
         assert centre == pivot == (0.0, 0.0, 0.0), name
@@ -102,8 +106,10 @@ def _moving_far_scene() -> Scene:
     v = np.concatenate([CUBE.vertices * 10.0, CUBE.vertices * 5.0 + [0.0, 40.0, 0.0]])
     edges = np.concatenate([CUBE.edges, CUBE.edges + len(CUBE.vertices)])
     n = len(CUBE.vertices)
-    objects = (SceneObject("spinner", 0, n, Motion(turns=(0.0, 2.0, 1.0), offset=(2000.0, 100.0, -50.0), scale=2.0)),
-               SceneObject("still", n, 2 * n, Motion(turns=(0.0, 0.0, 0.0), offset=(2060.0, 0.0, 0.0), scale=1.0)))
+    objects = (
+        SceneObject("spinner", 0, n, Motion(turns=(0.0, 2.0, 1.0), offset=(2000.0, 100.0, -50.0), scale=2.0)),
+        SceneObject("still", n, 2 * n, Motion(turns=(0.0, 0.0, 0.0), offset=(2060.0, 0.0, 0.0), scale=1.0)),
+    )
     return Scene("far_pair", v, edges, (), source="test", objects=objects)
 
 
@@ -117,7 +123,7 @@ def test_the_framing_sphere_holds_the_scene_in_every_frame(make):
     """
     scene = make()
     centre, radius, pivot = framing(scene)
-    assert pivot != (0.0, 0.0, 0.0)                      # both are away from the origin: reframed
+    assert pivot != (0.0, 0.0, 0.0)  # both are away from the origin: reframed
     case = cases_for(scene)[0]
     motion = case_motion(Motion(turns=(1.0, 1.0, 0.0)), case)
     worst = 0.0

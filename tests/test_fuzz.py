@@ -10,14 +10,22 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from fuzz.contract import (
+    SCENE_TEXTS,
+    HypothesisPick,
+    Pick,
+    crosscheck_argv,
+    make_scene_arg,
+    mutate_text,
+    outside_box,
+    renderer_argv,
+    run_cli,
+)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
-from fuzz.contract import (SCENE_TEXTS, HypothesisPick, Pick, crosscheck_argv, make_scene_arg, mutate_text, outside_box,
-                           renderer_argv, run_cli)
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene.model import Scene
 from wirecheck.core.scene.files import load_scene, parse_scene_text
+from wirecheck.core.scene.model import Scene
 
 SLOW = settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck))
 
@@ -56,7 +64,7 @@ def test_mesh_loader_gives_a_scene_or_one_line(data):
             scene = load_scene(arg)
         except InputError as exc:
             assert "\n" not in str(exc)
-        except OSError:                     # names the CLIs turn into one line (too long, not a folder)
+        except OSError:  # names the CLIs turn into one line (too long, not a folder)
             pass
         else:
             assert len(scene.edges) == 0 or scene.edges.max() < len(scene.vertices)
@@ -103,13 +111,16 @@ def test_generated_inputs_stay_inside_their_folder(earlier):
                 argv = make(Pick(random.Random(f"inside-{cli}-{i}")), box, earlier)
                 assert outside_box(argv, box) == [], (cli, i, argv)
                 values.update(v for o, v in zip(argv, argv[1:]) if o == "--scene" and not v.startswith(d))
-        assert {"in", "nosuch"} <= values, values       # the relative values are still drawn
+        assert {"in", "nosuch"} <= values, values  # the relative values are still drawn
 
 
 def test_outside_box_sees_parent_and_root(tmp_path):
     """The check itself: the two values the generator used to draw are outside; the box's own folders are not."""
     assert outside_box(["--scene", "..", "--out", "/", "--report-dir", "in/../..", "--cases", "/x"], tmp_path) == [
-        "--scene ..", "--out /", "--report-dir in/../.."]
+        "--scene ..",
+        "--out /",
+        "--report-dir in/../..",
+    ]
     assert outside_box(["--scene", ".", "--scene", str(tmp_path / "in" / ".."), "--out", "out"], tmp_path) == []
 
 
@@ -118,11 +129,15 @@ def test_outside_box_sees_parent_and_root(tmp_path):
 _TRIANGLE = np.array([[0, 0, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes() + b"\0\0"
 COMPLETE = {
     "binary.stl": b"\0" * 80 + (2).to_bytes(4, "little") + _TRIANGLE * 2,
-    "ascii.stl": ("solid s\n" + "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-                  "endloop\nendfacet\nendsolid s\n").encode(),
-    "ascii.ply": (b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
-                  b"element face 2\nproperty list uchar int vertex_indices\nend_header\n"
-                  b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n"),
+    "ascii.stl": (
+        "solid s\n" + "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\nendsolid s\n"
+    ).encode(),
+    "ascii.ply": (
+        b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+        b"element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+        b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n"
+    ),
     "mesh.off": b"OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n",
 }
 
@@ -141,7 +156,7 @@ def test_a_truncated_mesh_file_is_refused_or_read_whole(name, data):
             scene = load_scene(str(part))
         except InputError as exc:
             assert "\n" not in str(exc) and str(exc).startswith(str(part))
-        else:   # only a cut in the last line's name or newline leaves the mesh whole
+        else:  # only a cut in the last line's name or newline leaves the mesh whole
             assert (scene.vertices.tolist(), scene.faces) == (full.vertices.tolist(), full.faces), cut
 
 

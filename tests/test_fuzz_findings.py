@@ -4,7 +4,6 @@ import json
 import os
 
 import pytest
-
 from wirecheck.oracles import cli
 
 OBJ = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
@@ -35,7 +34,7 @@ def test_dataset_with_non_utf8_file_and_folder_names(tmp_path, capsys):
     assert code == 0, capsys.readouterr().err
     report = json.loads((out / "report.json").read_text(encoding="utf-8"))
     assert [m["mesh"] for m in report["meshes"]] == ["bad\\xff.obj", "dir\\xfd/y.obj"]
-    assert (report["summary"]["passed"], report["summary"]["cases"]) == (2, 14)      # 7 cameras each, both loaded
+    assert (report["summary"]["passed"], report["summary"]["cases"]) == (2, 14)  # 7 cameras each, both loaded
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "bad\\xff.obj" in md and "dir\\xfd/y.obj" in md
 
@@ -46,8 +45,20 @@ def test_two_inputs_naming_one_mesh_name_it_printably(tmp_path, capsys):
     data = tmp_path / "data"
     data.mkdir()
     _bytes_path(data, b"bad\xff.obj")
-    code = cli.main(["--report-dir", str(tmp_path / "run"), "--level", "vertices", "--frames", "1",
-                     "--scene", str(data), "--scene", str(data)])
+    code = cli.main(
+        [
+            "--report-dir",
+            str(tmp_path / "run"),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--scene",
+            str(data),
+            "--scene",
+            str(data),
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "two meshes named" in err
     assert "bad\\xff.obj" in err and "\udcff" not in err
@@ -61,18 +72,37 @@ def _error_line(capsys, argv) -> str:
     return err
 
 
-@pytest.mark.parametrize("extra, message", [
-    # a local Dask cluster of 99999 workers never started (killed after 200 s, a RuntimeError from
-    # distributed on the way)
-    (["--executor", "dask", "--jobs", "99999"], "--jobs 99999: expected at most 256 worker processes"),
-    (["--jobs", "257"], "--jobs 257: expected at most 256 worker processes"),
-    # 1e308 s: waited for ever on an address where nothing listens
-    (["--scheduler", "tcp://127.0.0.1:1", "--scheduler-timeout", "1e308"],
-     "--scheduler-timeout 1e+308: expected a number of seconds > 0 and <= 3600"),
-])
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        # a local Dask cluster of 99999 workers never started (killed after 200 s, a RuntimeError from
+        # distributed on the way)
+        (["--executor", "dask", "--jobs", "99999"], "--jobs 99999: expected at most 256 worker processes"),
+        (["--jobs", "257"], "--jobs 257: expected at most 256 worker processes"),
+        # 1e308 s: waited for ever on an address where nothing listens
+        (
+            ["--scheduler", "tcp://127.0.0.1:1", "--scheduler-timeout", "1e308"],
+            "--scheduler-timeout 1e+308: expected a number of seconds > 0 and <= 3600",
+        ),
+    ],
+)
 def test_executor_bounds(tmp_path, capsys, extra, message):
-    err = _error_line(capsys, ["--report-dir", str(tmp_path / "run"), "--level", "vertices", "--frames", "1",
-                               "--scene", "cube", "--cases", "on_axis", *extra])
+    err = _error_line(
+        capsys,
+        [
+            "--report-dir",
+            str(tmp_path / "run"),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            *extra,
+        ],
+    )
     assert message in err and not (tmp_path / "run").exists()
 
 
@@ -80,9 +110,25 @@ def test_tls_scheduler_without_certificates_is_an_input_error(tmp_path, capsys):
     # tls:// passes the address check; distributed then raised a TypeError (no ssl_context), reported
     # as "a Dask task failed ... every worker needs the same wirecheck": not the cause.
     pytest.importorskip("distributed")
-    err = _error_line(capsys, ["--report-dir", str(tmp_path / "run"), "--level", "vertices", "--frames", "1",
-                               "--scene", "cube", "--cases", "on_axis", "--scheduler", "tls://127.0.0.1:1",
-                               "--scheduler-timeout", "1"])
+    err = _error_line(
+        capsys,
+        [
+            "--report-dir",
+            str(tmp_path / "run"),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            "--scheduler",
+            "tls://127.0.0.1:1",
+            "--scheduler-timeout",
+            "1",
+        ],
+    )
     assert "--scheduler tls://127.0.0.1:1: TLS without certificates" in err and "Dask task failed" not in err
     assert not (tmp_path / "run").exists()
 

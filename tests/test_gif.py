@@ -4,7 +4,6 @@ import io
 
 import numpy as np
 from PIL import Image, ImageSequence
-
 from wirecheck.core.outputs.gif import GifWriter, gif_bytes
 
 
@@ -24,8 +23,8 @@ def moving_square(n, h=40, w=50, rgb=False):
     out = []
     for k in range(n):
         im = np.zeros((h, w), np.uint8)
-        im[5 + k:15 + k, 10 + 2 * k:22 + 2 * k] = 255
-        im[0, 0] = 128                               # a grey that must survive the palette
+        im[5 + k : 15 + k, 10 + 2 * k : 22 + 2 * k] = 255
+        im[0, 0] = 128  # a grey that must survive the palette
         out.append(np.stack([im, im // 2, 255 - im], axis=2) if rgb else im)
     return out
 
@@ -35,13 +34,13 @@ def test_grey_frames_decode_exactly():
     frames, durations = decoded(gif_bytes(images, fps=30))
     assert len(frames) == 6
     for got, want in zip(frames, images):
-        np.testing.assert_array_equal(got[:, :, 0], want)     # grey: R = G = B = the value
+        np.testing.assert_array_equal(got[:, :, 0], want)  # grey: R = G = B = the value
         np.testing.assert_array_equal(got[:, :, 2], want)
-    assert durations == [30] * 6        # int(33 ms / 10) = 3 hundredths, as Pillow writes 30 fps
+    assert durations == [30] * 6  # int(33 ms / 10) = 3 hundredths, as Pillow writes 30 fps
 
 
 def test_rgb_frames_decode_exactly():
-    images = moving_square(4, rgb=True)      # 4 exact colours per frame: the adaptive palette holds them
+    images = moving_square(4, rgb=True)  # 4 exact colours per frame: the adaptive palette holds them
     frames, _ = decoded(gif_bytes(images))
     assert len(frames) == 4
     for got, want in zip(frames, images):
@@ -52,7 +51,7 @@ def test_equal_neighbours_merge_with_summed_delay():
     a, b = moving_square(2)
     frames, durations = decoded(gif_bytes([a, a, a, b, b]))
     assert len(frames) == 2
-    assert durations == [90, 60]          # int(3 x 33 / 10) = 9, int(2 x 33 / 10) = 6 hundredths
+    assert durations == [90, 60]  # int(3 x 33 / 10) = 9, int(2 x 33 / 10) = 6 hundredths
     np.testing.assert_array_equal(frames[1][:, :, 0], b)
 
 

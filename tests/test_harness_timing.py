@@ -11,7 +11,6 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent / "data"))
 from user_projector import project  # noqa: E402
-
 from wirecheck.oracles.api import check_projector  # noqa: E402
 
 SLEEP_S = 0.15
@@ -23,8 +22,9 @@ def slow_project(points, camera):
 
 
 def test_an_external_candidates_calls_are_its_time_and_the_harness_drawing_is_harness():
-    report = check_projector(slow_project, scenes=["cube"], frames=2, cases=["on_axis"],
-                             oracles=("opencv", "pyrender"), isolate=False)
+    report = check_projector(
+        slow_project, scenes=["cube"], frames=2, cases=["on_axis"], oracles=("opencv", "pyrender"), isolate=False
+    )
     t = report["timing"]
     sleep_ms = 1e3 * SLEEP_S
     # one call for the vertices and one for the clipped segment ends of the drawing, per frame:

@@ -4,27 +4,25 @@ Each test is one finding of the fuzzing that filed the issue.
 """
 
 import json
-import shutil
 import os
+import shutil
 import signal
 import subprocess
 import sys
 import time
 
+import helpers
 import numpy as np
 import pytest
-
+from fuzz.contract import glb_bytes  # tests/ is on sys.path (rootdir conftest)
 from wirecheck.core.app import cli as renderer_cli
 from wirecheck.core.app import run as core_run
 from wirecheck.core.errors import InputError, one_line
 from wirecheck.core.limits import MAX_FACE_VERTICES, MAX_FRAMES, MAX_SIDE
 from wirecheck.core.outputs.output import MARKER
-from wirecheck.core.scene.files import SCENE_DIR, parse_scene_text
 from wirecheck.core.outputs.staging import LOCK, MANIFEST
+from wirecheck.core.scene.files import SCENE_DIR, parse_scene_text
 from wirecheck.oracles import cli as crosscheck_cli
-
-import helpers
-from fuzz.contract import glb_bytes     # tests/ is on sys.path (rootdir conftest)
 
 
 def render(args, out, capsys):
@@ -35,7 +33,9 @@ def render(args, out, capsys):
 
 def assert_one_error_line(rc, err, *needles):
     assert rc == 2, err
-    assert err.count("\n") == 1 and err.endswith("\n") and err.startswith(("renderer: error: ", "crosscheck: error: ")), err
+    assert (
+        err.count("\n") == 1 and err.endswith("\n") and err.startswith(("renderer: error: ", "crosscheck: error: "))
+    ), err
     assert "Traceback" not in err and "Warning" not in err
     for n in needles:
         assert n in err, (n, err)
@@ -48,11 +48,12 @@ def tree(folder):
 
 # ---- one error path ----------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("value", ["nan", "inf", "-1", "0"])
 def test_ortho_height_not_finite_with_perspective(tmp_path, capsys, value):
     rc, _, err = render(["--frames", "2", "--ortho-height", value], tmp_path / "o", capsys)
     assert_one_error_line(rc, err, f"--ortho-height {float(value)}")
-    assert not (tmp_path / "o").exists()          # no cube-frames/ left behind (nor the folder)
+    assert not (tmp_path / "o").exists()  # no cube-frames/ left behind (nor the folder)
 
 
 def test_huge_spin_option(tmp_path, capsys):
@@ -69,8 +70,8 @@ def test_huge_spin_in_scene_file(tmp_path, capsys):
 
 def test_spin_limit_is_2_to_the_53(tmp_path, capsys):
     # 2^53 turns is accepted (every frame at phase 0: an integer), one ulp of 2^53 more is not
-    assert render(["--frames", "3", "--spin", f"{2.0 ** 53:.17g},0,0"], tmp_path / "a", capsys)[0] == 0
-    rc, _, err = render(["--frames", "3", "--spin", f"{2.0 ** 53 + 2:.17g},0,0"], tmp_path / "b", capsys)
+    assert render(["--frames", "3", "--spin", f"{2.0**53:.17g},0,0"], tmp_path / "a", capsys)[0] == 0
+    rc, _, err = render(["--frames", "3", "--spin", f"{2.0**53 + 2:.17g},0,0"], tmp_path / "b", capsys)
     assert_one_error_line(rc, err, "--spin")
 
 
@@ -88,16 +89,28 @@ def test_long_scene_path(tmp_path, capsys):
 
 
 def test_long_candidate_path(tmp_path, capsys):
-    rc = crosscheck_cli.main(["--candidate", str(tmp_path / ("c" * 300)) + ".py:f", "--scene", "cube",
-                              "--level", "vertices", "--report-dir", str(tmp_path / "r")])
+    rc = crosscheck_cli.main(
+        [
+            "--candidate",
+            str(tmp_path / ("c" * 300)) + ".py:f",
+            "--scene",
+            "cube",
+            "--level",
+            "vertices",
+            "--report-dir",
+            str(tmp_path / "r"),
+        ]
+    )
     assert_one_error_line(rc, capsys.readouterr().err)
     assert not (tmp_path / "r").exists()
 
 
 def _bad_ply(path):
-    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                    "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n")
+    path.write_text(
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"
+    )
 
 
 def _bad_glb(path):
@@ -118,9 +131,11 @@ def test_a_face_index_beyond_32_bits_is_not_reported_as_another_number(tmp_path,
     # trimesh stores PLY indices as int32: 2**31 + 2 and 2**32 + 1 are both read as -2**31. The
     # message must not pass that number off as the file's: it says what happened instead.
     mesh = tmp_path / "m.ply"
-    mesh.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                    f"0 0 0\n1 0 0\n0 1 0\n3 0 1 {index}\n")
+    mesh.write_text(
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        f"0 0 0\n1 0 0\n0 1 0\n3 0 1 {index}\n"
+    )
     rc, _, err = render(["--frames", "1", "--scene", str(mesh)], tmp_path / "o", capsys)
     assert_one_error_line(rc, err, f"{mesh}: face 0 has a vertex index beyond 32-bit integers")
 
@@ -130,19 +145,33 @@ def test_a_face_index_beyond_32_bits_is_not_reported_as_another_number(tmp_path,
 def test_face_index_out_of_range_crosscheck(tmp_path, capsys, make, suffix, level):
     mesh = tmp_path / f"m{suffix}"
     make(mesh)
-    rc = crosscheck_cli.main(["--scene", str(mesh), "--level", level, "--frames", "1", "--cases", "on_axis",
-                              "--report-dir", str(tmp_path / "r")])
+    rc = crosscheck_cli.main(
+        [
+            "--scene",
+            str(mesh),
+            "--level",
+            level,
+            "--frames",
+            "1",
+            "--cases",
+            "on_axis",
+            "--report-dir",
+            str(tmp_path / "r"),
+        ]
+    )
     assert_one_error_line(rc, capsys.readouterr().err, "vertex index 7")
     assert not (tmp_path / "r").exists()
 
 
 def test_ascii_stl_with_bad_facet_normal_is_quiet(tmp_path, capsys):
     stl = tmp_path / "n.stl"
-    stl.write_text("solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-                   "endloop\nendfacet\nendsolid x\n")
+    stl.write_text(
+        "solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\nendsolid x\n"
+    )
     rc, out, err = render(["--frames", "1", "--scene", str(stl)], tmp_path / "o", capsys)
-    assert (rc, err) == (0, "")                   # trimesh's logged traceback is kept off stderr
-    assert "(3 vertices, 3 edges)" in out         # the triangle itself is read: the normals are unused
+    assert (rc, err) == (0, "")  # trimesh's logged traceback is kept off stderr
+    assert "(3 vertices, 3 edges)" in out  # the triangle itself is read: the normals are unused
 
 
 def test_float32_tiny_fov_is_one_line_without_warnings(tmp_path, capsys):
@@ -152,10 +181,12 @@ def test_float32_tiny_fov_is_one_line_without_warnings(tmp_path, capsys):
 
 def test_stl_with_nan_vertex_is_one_line(tmp_path, capsys):
     stl = tmp_path / "nan.stl"
-    stl.write_text("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\nvertex 1 0 0\nvertex 0 1 0\n"
-                   "endloop\nendfacet\nendsolid x\n")
+    stl.write_text(
+        "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\nendsolid x\n"
+    )
     rc, _, err = render(["--frames", "1", "--scene", str(stl)], tmp_path / "o", capsys)
-    assert_one_error_line(rc, err, f"{stl}:4: vertex coordinate 'nan': expected a finite number")   # its line
+    assert_one_error_line(rc, err, f"{stl}:4: vertex coordinate 'nan': expected a finite number")  # its line
 
 
 def test_winding_warning_never_precedes_an_error(tmp_path, capsys):
@@ -176,19 +207,35 @@ def test_winding_warning_still_shown_on_success(tmp_path, capsys):
 
 
 def test_message_with_newlines_is_one_line():
-    assert str(InputError("--candidate 'x.py:f': importing x.py failed: ImportError: a\nb\n  c")) == \
-        "--candidate 'x.py:f': importing x.py failed: ImportError: a | b | c"
+    assert (
+        str(InputError("--candidate 'x.py:f': importing x.py failed: ImportError: a\nb\n  c"))
+        == "--candidate 'x.py:f': importing x.py failed: ImportError: a | b | c"
+    )
     assert one_line("no break") == "no break"
 
 
 def test_candidate_import_error_with_newline(tmp_path, capsys):
     cand = tmp_path / "cand.py"
     cand.write_text("raise ImportError('first line\\nsecond line')\n")
-    crosscheck_cli.main(["--candidate", f"{cand}:f", "--scene", "cube", "--level", "vertices", "--frames", "1",
-                         "--cases", "on_axis", "--report-dir", str(tmp_path / "r")])
+    crosscheck_cli.main(
+        [
+            "--candidate",
+            f"{cand}:f",
+            "--scene",
+            "cube",
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--cases",
+            "on_axis",
+            "--report-dir",
+            str(tmp_path / "r"),
+        ]
+    )
     err = capsys.readouterr().err
     assert "Traceback" not in err
-    if err:                                  # refused at load: one line holding both lines of the message
+    if err:  # refused at load: one line holding both lines of the message
         assert err.count("\n") == 1 and "first line | second line" in err
 
 
@@ -198,14 +245,17 @@ def test_non_utf8_mesh_files_are_read(tmp_path, capsys):
     rc, out, err = render(["--frames", "1", "--scene", str(obj)], tmp_path / "o", capsys)
     assert (rc, err) == (0, "") and "(3 vertices, 3 edges)" in out
     stl = tmp_path / "latin.stl"
-    stl.write_bytes("solid caf\xe9\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-                    "endloop\nendfacet\nendsolid caf\xe9\n".encode("latin-1"))
+    stl.write_bytes(
+        "solid caf\xe9\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\nendsolid caf\xe9\n".encode("latin-1")
+    )
     rc, out, err = render(["--frames", "1", "--scene", str(stl)], tmp_path / "o2", capsys)
     assert "charset_normalizer" not in err and "Traceback" not in err
     assert (rc, err) == (0, "") and "(3 vertices, 3 edges)" in out
 
 
 # ---- limits --------------------------------------------------------------------------------------
+
 
 def test_image_size_limit(tmp_path, capsys):
     rc, _, err = render(["--width", "100000", "--height", "100000"], tmp_path / "o", capsys)
@@ -224,10 +274,11 @@ def test_polygon_size_limit(tmp_path):
     text = "".join(f"v {np.cos(t)} {np.sin(t)} 0\n" for t in np.linspace(0, 6, n)) + "f " + " ".join(map(str, range(n)))
     with pytest.raises(InputError, match=f"s.scene:{n + 1}: face of {n} indices: expected at most"):
         parse_scene_text(text, "s.scene")
-    parse_scene_text(text.rsplit(" ", 1)[0], "s.scene")     # MAX_FACE_VERTICES indices: accepted
+    parse_scene_text(text.rsplit(" ", 1)[0], "s.scene")  # MAX_FACE_VERTICES indices: accepted
 
 
 # ---- the guard: a bug is exit 3 and a log, never a traceback -----------------------------------
+
 
 def test_internal_error_renderer(tmp_path, capsys, monkeypatch):
     def boom(*a, **k):
@@ -255,6 +306,7 @@ def test_internal_error_crosscheck(tmp_path, capsys, monkeypatch):
 
 
 # ---- never destroy what wirecheck did not write -------------------------------------------------
+
 
 def test_user_folder_named_like_the_old_backup_survives(tmp_path, capsys):
     out = tmp_path / "out"
@@ -322,7 +374,7 @@ def test_report_json_as_a_directory_leaves_nothing(tmp_path, capsys):
     (out / "cube-report.json" / "x").write_text("mine")
     rc, _, err = render(["--frames", "2", "--format", "png,gif"], out, capsys)
     assert_one_error_line(rc, err, "cube-report.json")
-    assert tree(out) == ["cube-report.json", "cube-report.json/x"]      # no cube-frames/, no cube.gif
+    assert tree(out) == ["cube-report.json", "cube-report.json/x"]  # no cube-frames/, no cube.gif
 
 
 def test_failed_run_removes_the_folders_it_created(tmp_path, capsys, monkeypatch):
@@ -335,17 +387,18 @@ def test_failed_run_removes_the_folders_it_created(tmp_path, capsys, monkeypatch
 
     monkeypatch.setattr(core_run, "_check_overflow", fail_in_frame_3)
     rc, _, _ = render(["--frames", "5", "--format", "png,gif,mp4"], tmp_path / "a" / "b", capsys)
-    assert rc == 2 and tree(tmp_path) == []                       # a/ and a/b/ were the run's: gone
+    assert rc == 2 and tree(tmp_path) == []  # a/ and a/b/ were the run's: gone
     (tmp_path / "kept").mkdir()
     rc, _, _ = render(["--frames", "5", "--format", "png,gif,mp4"], tmp_path / "kept", capsys)
-    assert rc == 2 and tree(tmp_path) == ["kept"]                 # the user's folder stays, empty
+    assert rc == 2 and tree(tmp_path) == ["kept"]  # the user's folder stays, empty
 
 
 @pytest.mark.parametrize("where", ["in_scenes", "named_like_a_scene"])
 def test_report_dir_never_shadows_a_scene(tmp_path, capsys, where):
     target = SCENE_DIR / "evil.scene" if where == "in_scenes" else tmp_path / "evil.scene"
-    rc = crosscheck_cli.main(["--report-dir", str(target), "--scene", "cube", "--level", "vertices",
-                              "--frames", "1", "--cases", "on_axis"])
+    rc = crosscheck_cli.main(
+        ["--report-dir", str(target), "--scene", "cube", "--level", "vertices", "--frames", "1", "--cases", "on_axis"]
+    )
     assert_one_error_line(rc, capsys.readouterr().err, "--report-dir")
     assert not target.exists()
 
@@ -357,12 +410,14 @@ def test_failed_crosscheck_creates_no_report_parent(tmp_path, capsys):
 
 # ---- one writer at a time ------------------------------------------------------------------------
 
-_HOLD = ("import fcntl, os, sys, time\n"
-         "fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)\n"
-         "fcntl.flock(fd, fcntl.LOCK_EX)\n"
-         "os.write(fd, b'wirecheck lock pid %d\\n' % os.getpid())\n"
-         "print('held', flush=True)\n"
-         "time.sleep(60)\n")
+_HOLD = (
+    "import fcntl, os, sys, time\n"
+    "fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)\n"
+    "fcntl.flock(fd, fcntl.LOCK_EX)\n"
+    "os.write(fd, b'wirecheck lock pid %d\\n' % os.getpid())\n"
+    "print('held', flush=True)\n"
+    "time.sleep(60)\n"
+)
 
 
 def test_a_held_lock_is_refused_until_its_process_dies(tmp_path, capsys):
@@ -379,7 +434,7 @@ def test_a_held_lock_is_refused_until_its_process_dies(tmp_path, capsys):
         holder.kill()
         holder.wait()
         holder.stdout.close()
-    assert render(["--frames", "1"], out, capsys)[0] == 0          # killed: no lock left to block
+    assert render(["--frames", "1"], out, capsys)[0] == 0  # killed: no lock left to block
     assert not (out / LOCK).exists()
 
 
@@ -416,8 +471,10 @@ def test_two_renderers_on_one_out_never_mix(tmp_path):
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "wirecheck.core.app.cli", "--width", "64", "--height", "48", "--out", str(out)]
     for pair in range(4):
-        procs = [subprocess.Popen([*cmd, "--frames", str(n)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-                 for n in (20 + pair, 27 + pair)]
+        procs = [
+            subprocess.Popen([*cmd, "--frames", str(n)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            for n in (20 + pair, 27 + pair)
+        ]
         results = [(p.wait(), p.stderr.read().decode()) for p in procs]
         for p in procs:
             p.stdout.close()
@@ -433,27 +490,48 @@ def test_two_renderers_on_one_out_never_mix(tmp_path):
 
 # ---- killed: nothing half-written ------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_killed_run_leaves_nothing(tmp_path, sig):
     out = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2000", "--verbose",
-                             "--format", "png,gif", "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.core.app.cli",
+            "--frames",
+            "2000",
+            "--verbose",
+            "--format",
+            "png,gif",
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     for _ in range(3):
-        proc.stdout.readline()                 # "Scene: ...", frames 1 and 2: it is writing
+        proc.stdout.readline()  # "Scene: ...", frames 1 and 2: it is writing
     proc.send_signal(sig)
     err = proc.communicate(timeout=60)[1].decode()
     assert proc.returncode == 128 + sig and "Traceback" not in err and err.count("\n") == 1
-    assert not out.exists()                    # the run created out/: removed with its temporaries
+    assert not out.exists()  # the run created out/: removed with its temporaries
 
 
 def test_killed_rerun_keeps_the_earlier_output(tmp_path):
     out = tmp_path / "out"
-    assert subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2", "--out", str(out)],
-                          capture_output=True).returncode == 0
+    assert (
+        subprocess.run(
+            [sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2", "--out", str(out)], capture_output=True
+        ).returncode
+        == 0
+    )
     before = {n: (out / n).read_bytes() for n in ("cube-report.json", "cube-report.txt")}
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2000", "--verbose",
-                             "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "2000", "--verbose", "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     for _ in range(3):
         proc.stdout.readline()
     time.sleep(0.2)
@@ -470,24 +548,44 @@ def test_api_mesh_loading_is_quiet_too(tmp_path):
     In a fresh interpreter: pytest's own log capture would hide the traceback.
     """
     stl = tmp_path / "n.stl"
-    stl.write_text("solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-                   "endloop\nendfacet\nendsolid x\n")
-    proc = subprocess.run([sys.executable, "-c", "import sys; from wirecheck import load_scene; "
-                           "print(len(load_scene(sys.argv[1]).vertices))", str(stl)], capture_output=True, text=True)
+    stl.write_text(
+        "solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\nendsolid x\n"
+    )
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from wirecheck import load_scene; print(len(load_scene(sys.argv[1]).vertices))",
+            str(stl),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert (proc.stdout, proc.stderr) == ("3\n", "")
 
 
 @pytest.mark.slow
 def test_crosscheck_users_old_folder_survives_a_report_replace(tmp_path, capsys):
-    args = ["--report-dir", str(tmp_path / "r"), "--scene", "cube", "--cases", "on_axis", "--level", "vertices",
-            "--frames", "1"]
+    args = [
+        "--report-dir",
+        str(tmp_path / "r"),
+        "--scene",
+        "cube",
+        "--cases",
+        "on_axis",
+        "--level",
+        "vertices",
+        "--frames",
+        "1",
+    ]
     assert crosscheck_cli.main(args) == 0
     mine = tmp_path / ".r.old"
     mine.mkdir()
     (mine / "keep.txt").write_text("mine")
     assert crosscheck_cli.main(args) == 0
     assert (mine / "keep.txt").read_text() == "mine"
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".r.old", "r"]       # no other leftovers
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".r.old", "r"]  # no other leftovers
 
 
 def test_settings_line_from_the_config_never_precedes_an_error(tmp_path, capsys, monkeypatch):
@@ -502,38 +600,66 @@ def test_trace_with_a_far_plane_near_the_float64_limit(tmp_path, capsys):
     rc, out, err = render(["--frames", "1", "--trace-vertex", "0", "--far", "1e308"], tmp_path / "o", capsys)
     assert (rc, err) == (0, "")
     trace = json.loads((tmp_path / "o" / "cube-report.json").read_text())["trace"][0]
-    assert trace["clip"][2] is None and trace["clip"][3] == trace["depth"]      # w = z_cam, finite
+    assert trace["clip"][2] is None and trace["clip"][3] == trace["depth"]  # w = z_cam, finite
     assert "overflow" in out
 
 
 def test_crosscheck_frame_count_limit(tmp_path, capsys):
-    rc = crosscheck_cli.main(["--frames", "100000000000000000000", "--scene", "cube", "--level", "vertices",
-                              "--report-dir", str(tmp_path / "r")])
+    rc = crosscheck_cli.main(
+        [
+            "--frames",
+            "100000000000000000000",
+            "--scene",
+            "cube",
+            "--level",
+            "vertices",
+            "--report-dir",
+            str(tmp_path / "r"),
+        ]
+    )
     assert_one_error_line(rc, capsys.readouterr().err, f"1..{MAX_FRAMES:,}")
 
 
 def test_run_under_report_dir_never_creates_a_scene_named_folder(tmp_path, capsys):
     target = tmp_path / "evil.scene"
-    rc = crosscheck_cli.main(["--report-dir", str(target), "--run", "r1", "--scene", "cube", "--level", "vertices",
-                              "--frames", "1", "--cases", "on_axis"])
+    rc = crosscheck_cli.main(
+        [
+            "--report-dir",
+            str(target),
+            "--run",
+            "r1",
+            "--scene",
+            "cube",
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--cases",
+            "on_axis",
+        ]
+    )
     assert_one_error_line(rc, capsys.readouterr().err, "evil.scene")
     assert not target.exists()
 
 
 def test_run_name_too_long_leaves_no_reports_folder(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    rc = crosscheck_cli.main(["--run", "x" * 300, "--scene", "cube", "--level", "vertices", "--frames", "1",
-                              "--cases", "on_axis"])
+    rc = crosscheck_cli.main(
+        ["--run", "x" * 300, "--scene", "cube", "--level", "vertices", "--frames", "1", "--cases", "on_axis"]
+    )
     assert_one_error_line(rc, capsys.readouterr().err, "300 characters")
     assert tree(tmp_path) == []
 
 
 # ---- a mesh file named on the command line: unparsable is a usage error, empty says so ------------
 
-PLY_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-            "element face 1\nproperty list uchar int vertex_indices\nend_header\n")
-ASCII_STL = ("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
-             "endsolid s\n")
+PLY_HEAD = (
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+)
+ASCII_STL = (
+    "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n"
+)
 
 
 def _binary_stl(count: int, triangles: int) -> bytes:
@@ -543,60 +669,107 @@ def _binary_stl(count: int, triangles: int) -> bytes:
 
 def crosscheck_file(path, tmp_path, capsys, *extra):
     """crosscheck --scene PATH at level vertices, one frame, one case: (rc, stdout, stderr)."""
-    rc = crosscheck_cli.main(["--scene", str(path), "--level", "vertices", "--frames", "1", "--cases", "on_axis",
-                              "--report-dir", str(tmp_path / "r"), *extra])
+    rc = crosscheck_cli.main(
+        [
+            "--scene",
+            str(path),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--cases",
+            "on_axis",
+            "--report-dir",
+            str(tmp_path / "r"),
+            *extra,
+        ]
+    )
     cap = capsys.readouterr()
     return rc, cap.out, cap.err
 
 
-@pytest.mark.parametrize("name, data, needle", [
-    # binary data renamed .obj: before, an empty scene, exit 1 'vacuous' with nothing on stderr
-    ("garbage.obj", b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\xff\xfe", "garbage.obj:1: "),
-    ("faces_only.obj", b"f 1 2 3\n", "faces_only.obj:1: face index '3': the file has no vertices"),
-    ("negative.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "negative.obj:4: face index '-4': expected a 1-based index or -1..-3"),
-    ("zero.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "zero.obj:4: face index '0': expected a 1-based index or -1..-3"),
-    ("huge.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", "huge.obj:4: face index '9999"),
-    ("empty.stl", b"", "empty.stl: 0 bytes: expected a binary STL"),
-    ("truncated.stl", _binary_stl(5, 2), "truncated.stl: 184 bytes, its header declares 5 triangles: expected "
-                                         "84 + 50 x 5 = 334 bytes"),
-    ("billion.stl", _binary_stl(10**9, 1), "billion.stl: 134 bytes, its header declares 1000000000 triangles"),
-    ("cut.stl", ASCII_STL[:64].encode(), "cut.stl:5: the file ends inside a facet"),       # after 2 vertices
-    ("cut_vertex.stl", ASCII_STL[:70].encode(), "cut_vertex.stl:6: 'vertex': expected 'vertex X Y Z'"),
-    ("noend.stl", ASCII_STL[:-len("endsolid s\n")].encode(), "noend.stl:8: the file ends without endsolid"),
-    ("foreign.stl", b"solid s\nfacet normal 0 0 1\nbogus line\n", "foreign.stl:3: 'bogus line': expected an ASCII STL"),
-    ("two.stl", ASCII_STL.replace("vertex 0 1 0\n", "").encode(), "two.stl:7: endfacet after 2 vertices"),
-    # before: read as 3 vertices without faces, as no vertices, as no faces; the rest without a line
-    ("header.off", b"NOTOFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n", "header.off:1: 'NOTOFF': expected the header 'OFF'"),
-    ("negative.off", b"OFF\n-3 0 0\n", "negative.off:2: counts '-3 0 0': expected 'VERTICES FACES EDGES'"),
-    ("noface.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n",
-     "noface.off:2: 3 vertices and 1 faces declared, 3 lines follow: expected a complete file"),
-    ("index.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "index.off:6: face '3 0 1 9': expected"),
-    ("empty.off", b"", "empty.off:1: '(empty)': expected the header 'OFF'"),
-    # before: "could not be read as GLTF: FileNotFoundError: model.gltf", naming a file that is not there
-    ("broken.gltf", b'{"asset": ', "broken.gltf:1:11: not JSON (Expecting value): expected glTF JSON"),
-    ("array.gltf", b"[1, 2]", "array.gltf: a JSON list: expected a glTF object"),
-    ("few_vertices.ply", (PLY_HEAD + "0 0 0\n1 0 0\n").encode(),
-     "few_vertices.ply:3: 'element vertex 3', but 2 vertices were read"),
-    ("few_faces.ply", (PLY_HEAD + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n").encode(),   # a short row: trimesh drops it
-     "few_faces.ply:7: 'element face 1', but 0 faces were read"),
-])
+@pytest.mark.parametrize(
+    "name, data, needle",
+    [
+        # binary data renamed .obj: before, an empty scene, exit 1 'vacuous' with nothing on stderr
+        ("garbage.obj", b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\xff\xfe", "garbage.obj:1: "),
+        ("faces_only.obj", b"f 1 2 3\n", "faces_only.obj:1: face index '3': the file has no vertices"),
+        (
+            "negative.obj",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n",
+            "negative.obj:4: face index '-4': expected a 1-based index or -1..-3",
+        ),
+        (
+            "zero.obj",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
+            "zero.obj:4: face index '0': expected a 1-based index or -1..-3",
+        ),
+        ("huge.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", "huge.obj:4: face index '9999"),
+        ("empty.stl", b"", "empty.stl: 0 bytes: expected a binary STL"),
+        (
+            "truncated.stl",
+            _binary_stl(5, 2),
+            "truncated.stl: 184 bytes, its header declares 5 triangles: expected 84 + 50 x 5 = 334 bytes",
+        ),
+        ("billion.stl", _binary_stl(10**9, 1), "billion.stl: 134 bytes, its header declares 1000000000 triangles"),
+        ("cut.stl", ASCII_STL[:64].encode(), "cut.stl:5: the file ends inside a facet"),  # after 2 vertices
+        ("cut_vertex.stl", ASCII_STL[:70].encode(), "cut_vertex.stl:6: 'vertex': expected 'vertex X Y Z'"),
+        ("noend.stl", ASCII_STL[: -len("endsolid s\n")].encode(), "noend.stl:8: the file ends without endsolid"),
+        (
+            "foreign.stl",
+            b"solid s\nfacet normal 0 0 1\nbogus line\n",
+            "foreign.stl:3: 'bogus line': expected an ASCII STL",
+        ),
+        ("two.stl", ASCII_STL.replace("vertex 0 1 0\n", "").encode(), "two.stl:7: endfacet after 2 vertices"),
+        # before: read as 3 vertices without faces, as no vertices, as no faces; the rest without a line
+        ("header.off", b"NOTOFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n", "header.off:1: 'NOTOFF': expected the header 'OFF'"),
+        ("negative.off", b"OFF\n-3 0 0\n", "negative.off:2: counts '-3 0 0': expected 'VERTICES FACES EDGES'"),
+        (
+            "noface.off",
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n",
+            "noface.off:2: 3 vertices and 1 faces declared, 3 lines follow: expected a complete file",
+        ),
+        ("index.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "index.off:6: face '3 0 1 9': expected"),
+        ("empty.off", b"", "empty.off:1: '(empty)': expected the header 'OFF'"),
+        # before: "could not be read as GLTF: FileNotFoundError: model.gltf", naming a file that is not there
+        ("broken.gltf", b'{"asset": ', "broken.gltf:1:11: not JSON (Expecting value): expected glTF JSON"),
+        ("array.gltf", b"[1, 2]", "array.gltf: a JSON list: expected a glTF object"),
+        (
+            "few_vertices.ply",
+            (PLY_HEAD + "0 0 0\n1 0 0\n").encode(),
+            "few_vertices.ply:3: 'element vertex 3', but 2 vertices were read",
+        ),
+        (
+            "few_faces.ply",
+            (PLY_HEAD + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n").encode(),  # a short row: trimesh drops it
+            "few_faces.ply:7: 'element face 1', but 0 faces were read",
+        ),
+    ],
+)
 def test_unparsable_mesh_file_is_a_usage_error(tmp_path, capsys, name, data, needle):
     mesh = tmp_path / name
     mesh.write_bytes(data)
     rc, out, err = crosscheck_file(mesh, tmp_path, capsys)
     assert_one_error_line(rc, err, f"{tmp_path}/{needle}")
-    assert out == "" and not (tmp_path / "r").exists()          # no report of a run that never started
+    assert out == "" and not (tmp_path / "r").exists()  # no report of a run that never started
 
 
-@pytest.mark.parametrize("name, text", [("empty.obj", ""), ("groups.obj", "# exported\no thing\ng part\n"),
-                                        ("empty.stl", "solid s\nendsolid s\n"), ("empty.scene", "# none\n")])
+@pytest.mark.parametrize(
+    "name, text",
+    [
+        ("empty.obj", ""),
+        ("groups.obj", "# exported\no thing\ng part\n"),
+        ("empty.stl", "solid s\nendsolid s\n"),
+        ("empty.scene", "# none\n"),
+    ],
+)
 def test_valid_empty_file_is_vacuous_and_says_so_on_stderr(tmp_path, capsys, name, text):
     mesh = tmp_path / name
     mesh.write_text(text)
     stem = name.split(".")[0]
     line = f"crosscheck: {mesh}: no vertices: every case of scene {stem!r} compares nothing (vacuous: %s)\n"
     rc, _, err = crosscheck_file(mesh, tmp_path, capsys)
-    assert (rc, err) == (1, line % "the run fails")              # a gate never passes on nothing
+    assert (rc, err) == (1, line % "the run fails")  # a gate never passes on nothing
     rc, _, err = crosscheck_file(mesh, tmp_path, capsys, "--allow-vacuous", "--run", "allowed")
     assert (rc, err) == (0, line % "allowed by --allow-vacuous")
 
@@ -604,23 +777,31 @@ def test_valid_empty_file_is_vacuous_and_says_so_on_stderr(tmp_path, capsys, nam
 def test_loadable_meshes_are_still_read(tmp_path, capsys):
     """The checks above refuse nothing valid: a quad PLY (split into 2 triangles), negative OBJ indices,
     a binary STL whose header starts with 'solid', an OFF quad with its counts on the header line and a colour."""
-    (tmp_path / "quad.ply").write_text(PLY_HEAD.replace("vertex 3", "vertex 4") + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
-                                       "4 0 1 2 3\n")
+    (tmp_path / "quad.ply").write_text(
+        PLY_HEAD.replace("vertex 3", "vertex 4") + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"
+    )
     (tmp_path / "rel.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n")
     (tmp_path / "c.off").write_text("# a comment\nOFF 4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 255 0 0\n")
     tri = np.array([[0, 0, 1], [0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes() + b"\0\0"
     (tmp_path / "b.stl").write_bytes(b"solid but binary".ljust(80, b" ") + (1).to_bytes(4, "little") + tri)
-    for name, counts in (("quad.ply", "(4 vertices, 5 edges)"), ("rel.obj", "(3 vertices, 3 edges)"),
-                         ("b.stl", "(3 vertices, 3 edges)"), ("c.off", "(4 vertices, 5 edges)")):
-        rc, out, err = render(["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / name.replace(".", "_"),
-                              capsys)
+    for name, counts in (
+        ("quad.ply", "(4 vertices, 5 edges)"),
+        ("rel.obj", "(3 vertices, 3 edges)"),
+        ("b.stl", "(3 vertices, 3 edges)"),
+        ("c.off", "(4 vertices, 5 edges)"),
+    ):
+        rc, out, err = render(
+            ["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / name.replace(".", "_"), capsys
+        )
         assert (rc, err) == (0, "") and counts in out, name
 
 
 # ---- option values that would silently mean something else --------------------------------------
 
-@pytest.mark.parametrize("option", ["--scene", "--scene-list", "--report-dir", "--junit-xml", "--config",
-                                    "--candidate-frames"])
+
+@pytest.mark.parametrize(
+    "option", ["--scene", "--scene-list", "--report-dir", "--junit-xml", "--config", "--candidate-frames"]
+)
 def test_empty_path_option_is_a_usage_error(tmp_path, capsys, monkeypatch, option):
     # before: --scene '' ran the working directory as a dataset, --junit-xml '' wrote no XML,
     # --report-dir '' / --config '' fell back to their defaults
@@ -632,7 +813,7 @@ def test_empty_path_option_is_a_usage_error(tmp_path, capsys, monkeypatch, optio
 
 
 def test_renderer_empty_out_is_a_usage_error(tmp_path, capsys, monkeypatch):
-    monkeypatch.chdir(tmp_path)                   # before: frames and reports written into the working directory
+    monkeypatch.chdir(tmp_path)  # before: frames and reports written into the working directory
     rc = renderer_cli.main(["--frames", "1", "--format", "ascii", "--out", ""])
     assert_one_error_line(rc, capsys.readouterr().err, "renderer: error: --out '': expected a name or path")
     assert tree(tmp_path) == []
@@ -641,22 +822,27 @@ def test_renderer_empty_out_is_a_usage_error(tmp_path, capsys, monkeypatch):
 def test_report_dir_through_a_symlink_loop_is_a_usage_error(tmp_path, capsys):
     (tmp_path / "a").symlink_to(tmp_path / "b")
     (tmp_path / "b").symlink_to(tmp_path / "a")
-    rc = crosscheck_cli.main(["--level", "vertices", "--frames", "1", "--cases", "on_axis",
-                              "--report-dir", str(tmp_path / "a")])
-    assert_one_error_line(rc, capsys.readouterr().err, f"--report-dir '{tmp_path}/a': Symlink loop")   # was exit 3
+    rc = crosscheck_cli.main(
+        ["--level", "vertices", "--frames", "1", "--cases", "on_axis", "--report-dir", str(tmp_path / "a")]
+    )
+    assert_one_error_line(rc, capsys.readouterr().err, f"--report-dir '{tmp_path}/a': Symlink loop")  # was exit 3
 
 
 def test_scene_symlink_loop_and_fifo_are_named(tmp_path, capsys):
     (tmp_path / "a.obj").symlink_to(tmp_path / "b.obj")
     (tmp_path / "b.obj").symlink_to(tmp_path / "a.obj")
     os.mkfifo(tmp_path / "f.obj")
-    for name, needle in (("a.obj", "Too many levels of symbolic links"), ("f.obj", "a FIFO, not a regular file"),
-                         ("missing.obj", "file not found")):          # before: 'file not found' for all three
+    for name, needle in (
+        ("a.obj", "Too many levels of symbolic links"),
+        ("f.obj", "a FIFO, not a regular file"),
+        ("missing.obj", "file not found"),
+    ):  # before: 'file not found' for all three
         rc, _, err = render(["--frames", "1", "--scene", str(tmp_path / name)], tmp_path / "o", capsys)
         assert_one_error_line(rc, err, f"--scene '{tmp_path / name}': {needle}")
 
 
 # ---- a frames job (crosscheck export DIR) edited or damaged by hand --------------------------------
+
 
 @pytest.fixture(scope="module")
 def blank_job(tmp_path_factory):
@@ -672,25 +858,31 @@ def _set(*path_value):
         for key in path[:-1]:
             node = node[key]
         node[path[-1]] = value
+
     return edit
 
 
-@pytest.mark.parametrize("edit, needle", [
-    # before: exit 3 (a traceback in a log) for these three ...
-    (_set("every", 0), "job.json: every 0: expected an integer in 1..frames (4)"),
-    (_set("scenes", []), "job.json: scenes: expected a list of the job's scenes"),
-    (_set("cases", 0, "scene", "sphere"), "job.json: case 'sphere' / 'on_axis': expected a scene of 'scenes'"),
-    # ... and exit 1 with the value copied into the report, or the file read from elsewhere, for these
-    (_set("frames", "x"), "job.json: frames 'x': expected an integer in 1..100000"),
-    (_set("frames", True), "job.json: frames True: expected an integer"),
-    (_set("frame_numbers", []), "job.json: frame_numbers []: expected 1, 1+every, ... up to frames"),
-    (_set("motion", "turns", [float("nan"), 0, 0]), "job.json: motion.turns [nan, 0, 0]: expected three finite"),
-    (_set("style", "shaded"), "job.json: style 'shaded': expected 'wireframe'"),
-    (_set("scenes", 0, "obj", "/etc/passwd"), "job.json: scene 'cube': space 'model', obj '/etc/passwd': expected"),
-    (_set("cases", 0, "width", 0), "job.json: case cube / on_axis: width x height 0x480: expected positive"),
-    (_set("cases", 0, "frames", ["../../x.png", "frames/cube/on_axis/frame_0003.png"]),
-     "job.json: case cube / on_axis: frames ['../../x.png'"),
-])
+@pytest.mark.parametrize(
+    "edit, needle",
+    [
+        # before: exit 3 (a traceback in a log) for these three ...
+        (_set("every", 0), "job.json: every 0: expected an integer in 1..frames (4)"),
+        (_set("scenes", []), "job.json: scenes: expected a list of the job's scenes"),
+        (_set("cases", 0, "scene", "sphere"), "job.json: case 'sphere' / 'on_axis': expected a scene of 'scenes'"),
+        # ... and exit 1 with the value copied into the report, or the file read from elsewhere, for these
+        (_set("frames", "x"), "job.json: frames 'x': expected an integer in 1..100000"),
+        (_set("frames", True), "job.json: frames True: expected an integer"),
+        (_set("frame_numbers", []), "job.json: frame_numbers []: expected 1, 1+every, ... up to frames"),
+        (_set("motion", "turns", [float("nan"), 0, 0]), "job.json: motion.turns [nan, 0, 0]: expected three finite"),
+        (_set("style", "shaded"), "job.json: style 'shaded': expected 'wireframe'"),
+        (_set("scenes", 0, "obj", "/etc/passwd"), "job.json: scene 'cube': space 'model', obj '/etc/passwd': expected"),
+        (_set("cases", 0, "width", 0), "job.json: case cube / on_axis: width x height 0x480: expected positive"),
+        (
+            _set("cases", 0, "frames", ["../../x.png", "frames/cube/on_axis/frame_0003.png"]),
+            "job.json: case cube / on_axis: frames ['../../x.png'",
+        ),
+    ],
+)
 def test_edited_job_json_is_one_line_exit_2(blank_job, tmp_path, capsys, edit, needle):
     job_dir = tmp_path / "job"
     shutil.copytree(blank_job, job_dir)
@@ -702,16 +894,35 @@ def test_edited_job_json_is_one_line_exit_2(blank_job, tmp_path, capsys, edit, n
     assert not (tmp_path / "r").exists()
 
 
-@pytest.mark.parametrize("rel, data, needle", [
-    # before: exit 3 for each (UnicodeDecodeError, JSONDecodeError, KeyError), exit 1 for the empty OBJ
-    ("scenes/cube.obj", b"\xff\0garbage", "scenes/cube.obj: unreadable ('utf-8' codec"),
-    ("scenes/cube.obj", b"", "scenes/cube.obj: 0 vertices, 0 edges: expected 8 and 12"),
-    ("scenes/cube.obj", b"v 0 0 0\nl 1 2\n", "scenes/cube.obj:2: 'l 1 2': expected 'v X Y Z' (finite) or 'l I J' (1..1)"),
-    ("scenes/cube.obj", b"v 0 nan 0\n", "scenes/cube.obj:1: 'v 0 nan 0': expected 'v X Y Z' (finite)"),
-    ("cameras/cube/on_axis/frame_0001.json", b"{", "cameras/cube/on_axis/frame_0001.json: unreadable (JSONDecodeError: "),
-    ("cameras/cube/on_axis/frame_0001.json", b"{}", "cameras/cube/on_axis/frame_0001.json: unreadable (KeyError: no 'camera')"),
-    ("cameras/cube/on_axis/frame_0001.json", b'{"camera": {"width": 3}}', "cameras/cube/on_axis/frame_0001.json: camera: no 'position': expected position, forward, "),
-])
+@pytest.mark.parametrize(
+    "rel, data, needle",
+    [
+        # before: exit 3 for each (UnicodeDecodeError, JSONDecodeError, KeyError), exit 1 for the empty OBJ
+        ("scenes/cube.obj", b"\xff\0garbage", "scenes/cube.obj: unreadable ('utf-8' codec"),
+        ("scenes/cube.obj", b"", "scenes/cube.obj: 0 vertices, 0 edges: expected 8 and 12"),
+        (
+            "scenes/cube.obj",
+            b"v 0 0 0\nl 1 2\n",
+            "scenes/cube.obj:2: 'l 1 2': expected 'v X Y Z' (finite) or 'l I J' (1..1)",
+        ),
+        ("scenes/cube.obj", b"v 0 nan 0\n", "scenes/cube.obj:1: 'v 0 nan 0': expected 'v X Y Z' (finite)"),
+        (
+            "cameras/cube/on_axis/frame_0001.json",
+            b"{",
+            "cameras/cube/on_axis/frame_0001.json: unreadable (JSONDecodeError: ",
+        ),
+        (
+            "cameras/cube/on_axis/frame_0001.json",
+            b"{}",
+            "cameras/cube/on_axis/frame_0001.json: unreadable (KeyError: no 'camera')",
+        ),
+        (
+            "cameras/cube/on_axis/frame_0001.json",
+            b'{"camera": {"width": 3}}',
+            "cameras/cube/on_axis/frame_0001.json: camera: no 'position': expected position, forward, ",
+        ),
+    ],
+)
 def test_damaged_job_file_is_one_line_exit_2(blank_job, tmp_path, capsys, rel, data, needle):
     job_dir = tmp_path / "job"
     shutil.copytree(blank_job, job_dir)

@@ -9,7 +9,6 @@ translation) or refuses it in one line naming the flag, the value and what it ex
 import json
 
 import pytest
-
 from wirecheck.core.app import cli as renderer_cli
 from wirecheck.core.app.cli_help import attach_negative_values
 from wirecheck.oracles import cli as crosscheck_cli
@@ -26,17 +25,34 @@ def run(main, argv, capsys):
 
 def test_export_phase_minus_inf_names_the_flag_and_what_it_expects(tmp_path, capsys):
     # before: "crosscheck export: error: argument --phase: expected one argument"
-    rc, _, err = run(crosscheck_cli.main, ["export", str(tmp_path / "job"), "--scene", "cube", "--phase", "-inf"],
-                     capsys)
-    assert (rc, err) == (2, "crosscheck: error: --phase -inf: expected a number in [0, 1) (a share of a frame's "
-                            "step)\n")
+    rc, _, err = run(
+        crosscheck_cli.main, ["export", str(tmp_path / "job"), "--scene", "cube", "--phase", "-inf"], capsys
+    )
+    assert (rc, err) == (
+        2,
+        "crosscheck: error: --phase -inf: expected a number in [0, 1) (a share of a frame's step)\n",
+    )
     assert not (tmp_path / "job").exists()
 
 
 def test_a_negative_exponent_value_reaches_its_option(tmp_path, capsys):
     """``--spin -2e0,1,0``: the job's motion is what was given (before: "expected one argument")."""
-    rc, _, err = run(crosscheck_cli.main, ["export", str(tmp_path / "job"), "--scene", "cube", "--cases", "on_axis",
-                                           "--frames", "1", "--spin", "-2e0,1,0"], capsys)
+    rc, _, err = run(
+        crosscheck_cli.main,
+        [
+            "export",
+            str(tmp_path / "job"),
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            "--frames",
+            "1",
+            "--spin",
+            "-2e0,1,0",
+        ],
+        capsys,
+    )
     assert rc == 0, err
     assert json.loads((tmp_path / "job" / "job.json").read_text())["motion"]["turns"] == [-2.0, 1.0, 0.0]
 
@@ -105,8 +121,21 @@ def test_renderer_numeric_flag_given_a_hostile_negative_value(tmp_path, capsys, 
 
 @pytest.mark.parametrize("flag, value, extra, needle", CROSSCHECK_FLAGS, ids=_ids(CROSSCHECK_FLAGS))
 def test_crosscheck_numeric_flag_given_a_hostile_negative_value(tmp_path, capsys, flag, value, extra, needle):
-    argv = ["--scene", "cube", "--level", "vertices", "--frames", "1", "--cases", "on_axis",
-            "--report-dir", str(tmp_path / "rep"), *extra, flag, value]
+    argv = [
+        "--scene",
+        "cube",
+        "--level",
+        "vertices",
+        "--frames",
+        "1",
+        "--cases",
+        "on_axis",
+        "--report-dir",
+        str(tmp_path / "rep"),
+        *extra,
+        flag,
+        value,
+    ]
     rc, _, err = run(crosscheck_cli.main, argv, capsys)
     _check_refused(rc, err, flag, value, needle)
     assert not (tmp_path / "rep").exists()
@@ -126,17 +155,20 @@ def test_a_unicode_digit_is_refused_by_crosscheck_as_by_renderer(capsys):
     assert rc == 2 and "argument --frames: invalid int value" in err, err
 
 
-@pytest.mark.parametrize("argv, expected", [
-    (["--phase", "-inf"], ["--phase=-inf"]),
-    (["--spin", "-1,2,3", "--frames", "4"], ["--spin=-1,2,3", "--frames", "4"]),
-    (["--far", "-1e5"], ["--far=-1e5"]),
-    (["--near", "-.5"], ["--near=-.5"]),
-    (["--x", "-NaN"], ["--x=-NaN"]),
-    (["--scene", "-h"], ["--scene", "-h"]),              # an option, not a number: argparse's to judge
-    (["-h", "-1"], ["-h", "-1"]),                        # after a short option: argparse's own rule
-    (["--a=1", "-1"], ["--a=1", "-1"]),                  # the option has its value already
-    (["--", "--a", "-1"], ["--", "--a", "-1"]),          # nothing after "--" is an option
-    (["export", "-1"], ["export", "-1"]),                # a positional that looks like a number
-])
+@pytest.mark.parametrize(
+    "argv, expected",
+    [
+        (["--phase", "-inf"], ["--phase=-inf"]),
+        (["--spin", "-1,2,3", "--frames", "4"], ["--spin=-1,2,3", "--frames", "4"]),
+        (["--far", "-1e5"], ["--far=-1e5"]),
+        (["--near", "-.5"], ["--near=-.5"]),
+        (["--x", "-NaN"], ["--x=-NaN"]),
+        (["--scene", "-h"], ["--scene", "-h"]),  # an option, not a number: argparse's to judge
+        (["-h", "-1"], ["-h", "-1"]),  # after a short option: argparse's own rule
+        (["--a=1", "-1"], ["--a=1", "-1"]),  # the option has its value already
+        (["--", "--a", "-1"], ["--", "--a", "-1"]),  # nothing after "--" is an option
+        (["export", "-1"], ["export", "-1"]),  # a positional that looks like a number
+    ],
+)
 def test_attach_negative_values(argv, expected):
     assert attach_negative_values(argv) == expected

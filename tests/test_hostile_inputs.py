@@ -13,15 +13,20 @@ import json
 import os
 import shutil
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import numpy as np
 import pytest
-from PIL import Image
-
-from wirecheck.oracles import cli as crosscheck_cli
-from wirecheck.oracles.candidates.frames_candidate import FrameProblem, FramesError, frame_inputs, load_frames, load_job, read_png
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 from helpers import no_block  # tests/ is on sys.path (rootdir conftest)
+from PIL import Image
+from wirecheck.oracles import cli as crosscheck_cli
+from wirecheck.oracles.candidates.frames_candidate import (
+    FrameProblem,
+    FramesError,
+    frame_inputs,
+    load_frames,
+    load_job,
+    read_png,
+)
 
 
 def assert_one_error_line(rc, err, *needles):
@@ -33,6 +38,7 @@ def assert_one_error_line(rc, err, *needles):
 
 
 # ---- one frame PNG: what is read as drawn ------------------------------------------------------
+
 
 def _png(tmp_path, array, mode=None, **save):
     path = tmp_path / "f.png"
@@ -54,9 +60,9 @@ def test_alpha_is_composited_over_the_black_background(tmp_path):
     rgba = np.zeros((1, 5, 4), np.uint8)
     rgba[..., :3] = 255
     rgba[0, :, 3] = [0, 127, 128, 255, 0]
-    rgba[0, 4] = [0, 0, 0, 255]                         # opaque black: not drawn
+    rgba[0, 4] = [0, 0, 0, 255]  # opaque black: not drawn
     assert read_png(_png(tmp_path, rgba, "RGBA"), 5, 1).tolist() == [[False, False, True, True, False]]
-    la = np.array([[[255, 0], [255, 255], [100, 255]]], np.uint8)      # grey 100 < 128 even opaque
+    la = np.array([[[255, 0], [255, 255], [100, 255]]], np.uint8)  # grey 100 < 128 even opaque
     assert read_png(_png(tmp_path, la, "LA"), 3, 1).tolist() == [[False, True, False]]
 
 
@@ -104,6 +110,7 @@ def test_an_animated_png_is_refused(tmp_path):
 
 # ---- a job on disk -----------------------------------------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def blank_job(tmp_path_factory):
     """cube / on_axis, frames 1 and 3 of 4, black 640x480 PNGs (judged: exit 1, tests/test_hostile.py)."""
@@ -128,12 +135,15 @@ def judge(job, tmp_path, capsys):
 FRAME = "frames/cube/on_axis/frame_0001.png"
 
 
-@pytest.mark.parametrize("make, needle", [
-    (lambda p: os.mkfifo(p), "a FIFO, not a regular file"),
-    (lambda p: p.mkdir(), "a folder, not a regular file"),
-    (lambda p: p.symlink_to("/dev/null"), "a character device, not a regular file"),
-    (lambda p: p.symlink_to(p.parent / "nowhere.png"), "a broken link"),
-])
+@pytest.mark.parametrize(
+    "make, needle",
+    [
+        (lambda p: os.mkfifo(p), "a FIFO, not a regular file"),
+        (lambda p: p.mkdir(), "a folder, not a regular file"),
+        (lambda p: p.symlink_to("/dev/null"), "a character device, not a regular file"),
+        (lambda p: p.symlink_to(p.parent / "nowhere.png"), "a broken link"),
+    ],
+)
 def test_a_frame_that_is_not_a_regular_file_is_named_so(job, tmp_path, capsys, make, needle):
     """Before: each read 'missing', which sends the user looking for a file that is there."""
     (job / FRAME).unlink()
@@ -142,11 +152,14 @@ def test_a_frame_that_is_not_a_regular_file_is_named_so(job, tmp_path, capsys, m
     assert_one_error_line(rc, err, f"{job / FRAME}: {needle} (frame 1 of cube / on_axis)")
 
 
-@pytest.mark.parametrize("rel, needle", [
-    ("cameras/cube/on_axis/frame_0001.json", "a FIFO, not a regular file: expected the camera"),
-    ("scenes/cube.obj", "a FIFO, not a regular file: expected the OBJ"),
-    ("job.json", "a FIFO, not a regular file: expected a job folder"),
-])
+@pytest.mark.parametrize(
+    "rel, needle",
+    [
+        ("cameras/cube/on_axis/frame_0001.json", "a FIFO, not a regular file: expected the camera"),
+        ("scenes/cube.obj", "a FIFO, not a regular file: expected the OBJ"),
+        ("job.json", "a FIFO, not a regular file: expected a job folder"),
+    ],
+)
 def test_a_fifo_in_place_of_a_job_file_never_blocks(job, tmp_path, capsys, rel, needle):
     """Before: the run opened the FIFO and waited for a writer forever."""
     (job / rel).unlink()
@@ -159,7 +172,7 @@ def test_frames_folder_that_is_a_link_loop(job, tmp_path, capsys):
     shutil.rmtree(job / "frames")
     (job / "frames").symlink_to(job / "loop")
     (job / "loop").symlink_to(job / "frames")
-    rc, err = judge(job, tmp_path, capsys)          # before: "frames: missing"
+    rc, err = judge(job, tmp_path, capsys)  # before: "frames: missing"
     assert_one_error_line(rc, err, f"{job / 'frames'}: unreadable (Too many levels of symbolic links)")
 
 
@@ -214,7 +227,7 @@ def test_a_camera_width_beyond_64_bits_is_one_line(job, tmp_path, capsys):
     """Before: exit 3 (OverflowError: Python int too large to convert to C long) when GL was asked for it."""
     path = job / "cameras/cube/on_axis/frame_0001.json"
     cam = json.loads(path.read_text())
-    cam["camera"]["width"] = 10 ** 400
+    cam["camera"]["width"] = 10**400
     path.write_text(json.dumps(cam))
     rc, err = judge(job, tmp_path, capsys)
     assert_one_error_line(rc, err, f"{path}: camera 1{'0' * 39}...: expected 640x480 (job.json's size")
@@ -226,8 +239,8 @@ def test_a_key_given_twice_is_refused_and_a_bom_is_read(job, tmp_path, capsys):
     (job / "job.json").write_text('{"every": 1,' + text.lstrip()[1:])
     rc, err = judge(job, tmp_path, capsys)
     assert_one_error_line(rc, err, "job.json: unreadable (key 'every' given twice)")
-    (job / "job.json").write_bytes(b"\xef\xbb\xbf" + text.encode())      # a Windows editor's BOM
-    assert load_job(job)["every"] == 2                                     # before: "Unexpected UTF-8 BOM"
+    (job / "job.json").write_bytes(b"\xef\xbb\xbf" + text.encode())  # a Windows editor's BOM
+    assert load_job(job)["every"] == 2  # before: "Unexpected UTF-8 BOM"
 
 
 def test_frame_inputs_of_the_blank_job_are_as_exported(blank_job):
@@ -241,22 +254,27 @@ def test_frame_inputs_of_the_blank_job_are_as_exported(blank_job):
 
 # ---- the job is read, never written ------------------------------------------------------------
 
+
 def _tree(folder):
     return sorted((str(p.relative_to(folder)), p.is_file() and p.read_bytes()) for p in folder.rglob("*"))
 
 
-@pytest.mark.parametrize("argv", [
-    lambda job, tmp: ["--candidate-frames", str(job), "--report-dir", str(job)],
-    lambda job, tmp: ["--level", "vertices", "--frames", "1", "--cases", "on_axis", "--report-dir", str(job)],
-    lambda job, tmp: ["export", str(job), "--scene", "cube", "--cases", "on_axis"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        lambda job, tmp: ["--candidate-frames", str(job), "--report-dir", str(job)],
+        lambda job, tmp: ["--level", "vertices", "--frames", "1", "--cases", "on_axis", "--report-dir", str(job)],
+        lambda job, tmp: ["export", str(job), "--scene", "cube", "--cases", "on_axis"],
+    ],
+)
 def test_a_job_with_drawn_frames_is_never_replaced(job, tmp_path, capsys, argv):
     """The job carries wirecheck's output marker (export wrote it), but frames/ holds the renderer's files.
     Before: each command replaced the whole job by its own output, deleting the renderer's frames."""
     before = _tree(job)
     rc = crosscheck_cli.main(argv(job, tmp_path))
-    assert_one_error_line(rc, capsys.readouterr().err,
-                          f"'{job}' is a frames job holding files a renderer wrote (frames/cube)")
+    assert_one_error_line(
+        rc, capsys.readouterr().err, f"'{job}' is a frames job holding files a renderer wrote (frames/cube)"
+    )
     assert _tree(job) == before
 
 
@@ -265,11 +283,12 @@ def test_a_report_in_the_frames_folder_is_refused(job, tmp_path, capsys, monkeyp
     A report elsewhere in the job (reports/RUN when run from inside it) is harmless and still written."""
     before = _tree(job)
     rc = crosscheck_cli.main(["--candidate-frames", str(job), "--report-dir", str(job / "frames/new")])
-    assert_one_error_line(rc, capsys.readouterr().err,
-                          f"report folder '{job / 'frames/new'}': the job '{job}' itself or its frames/")
+    assert_one_error_line(
+        rc, capsys.readouterr().err, f"report folder '{job / 'frames/new'}': the job '{job}' itself or its frames/"
+    )
     assert _tree(job) == before
     monkeypatch.chdir(job)
-    assert crosscheck_cli.main(["--candidate-frames", ".", "--run", "r"]) == 1      # black frames: a fail
+    assert crosscheck_cli.main(["--candidate-frames", ".", "--run", "r"]) == 1  # black frames: a fail
     assert (job / "reports/r/report.json").is_file()
 
 
@@ -294,8 +313,10 @@ def test_a_scene_list_with_a_bom_and_crlf_lines(tmp_path):
     (tmp_path / "b.obj").write_text(TRI)
     (tmp_path / "set.txt").write_bytes(b"\xef\xbb\xbfa.obj\r\n\r\n  # comment\r\nb.obj\r\n")
     entries = read_list(tmp_path / "set.txt")
-    assert [(e.name, e.path) for e in entries] == [("a.obj", str(tmp_path / "a.obj")),
-                                                  ("b.obj", str(tmp_path / "b.obj"))]
+    assert [(e.name, e.path) for e in entries] == [
+        ("a.obj", str(tmp_path / "a.obj")),
+        ("b.obj", str(tmp_path / "b.obj")),
+    ]
 
 
 def test_a_mesh_listed_again_through_a_link_is_refused(tmp_path):
@@ -314,20 +335,33 @@ def test_control_characters_in_mesh_names_are_escaped(tmp_path, capsys):
     """Linux file names may hold a newline, a tab or an ESC. Before, they went raw into stdout and the reports:
     a name split a summary line in two, and '\\x1b[31m' recoloured the user's terminal."""
     (tmp_path / "d").mkdir()
-    (tmp_path / "d/a\nb.obj").write_text("v 1\n")                 # unreadable: named in 'Could not be loaded'
+    (tmp_path / "d/a\nb.obj").write_text("v 1\n")  # unreadable: named in 'Could not be loaded'
     (tmp_path / "d/ok.obj").write_text(TRI)
     (tmp_path / "d/c\x1b[31m.obj").write_text(TRI)
-    rc = crosscheck_cli.main(["--scene", str(tmp_path / "d"), "--level", "vertices", "--frames", "1",
-                              "--cases", "on_axis", "--report-dir", str(tmp_path / "r")])
+    rc = crosscheck_cli.main(
+        [
+            "--scene",
+            str(tmp_path / "d"),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--cases",
+            "on_axis",
+            "--report-dir",
+            str(tmp_path / "r"),
+        ]
+    )
     out = capsys.readouterr().out
     assert rc == 1 and "\x1b" not in out
-    assert "  a\\nb.obj: line 1: vertex 'v 1': expected 'v X Y Z' (3 numbers)\n" in out      # path stripped
+    assert "  a\\nb.obj: line 1: vertex 'v 1': expected 'v X Y Z' (3 numbers)\n" in out  # path stripped
     assert "  c\\x1b[31m.obj / on_axis: pass" in out
     report = json.loads((tmp_path / "r" / "report.json").read_text())
     assert sorted(m["mesh"] for m in report["meshes"]) == ["a\\nb.obj", "c\\x1b[31m.obj", "ok.obj"]
 
 
 # ---- [tool.wirecheck] in pyproject.toml --------------------------------------------------------
+
 
 def test_pyproject_nested_too_deep_is_one_line(tmp_path):
     """Before: exit 3 (RecursionError from tomllib)."""

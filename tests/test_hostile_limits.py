@@ -12,13 +12,11 @@ import os
 import shutil
 import time
 
+import helpers  # tests/ is on sys.path (rootdir conftest)
 import pytest
-
 from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S as MAX_TIMEOUT_S
 from wirecheck.core.limits import MAX_FRAMES
 from wirecheck.oracles import cli as crosscheck_cli
-
-import helpers                          # tests/ is on sys.path (rootdir conftest)
 
 
 def one_line(rc, err, *needles):
@@ -34,23 +32,25 @@ VERTICES = ["--scene", "cube", "--cases", "on_axis", "--frames", "1", "--level",
 @pytest.mark.parametrize("seconds", ["3e6", "86400.5", "1e308"])
 def test_a_candidate_timeout_past_a_day_is_a_usage_error(tmp_path, capsys, seconds):
     """Before: exit 3, OverflowError ('timeout is too large') from poll, whose millisecond timeout is a C int."""
-    rc = crosscheck_cli.main([*VERTICES, "--report-dir", str(tmp_path / "r"), "--candidate-cmd", "true",
-                              "--candidate-timeout", seconds])
+    rc = crosscheck_cli.main(
+        [*VERTICES, "--report-dir", str(tmp_path / "r"), "--candidate-cmd", "true", "--candidate-timeout", seconds]
+    )
     one_line(rc, capsys.readouterr().err, "--candidate-timeout", "at most 86400")
     assert not (tmp_path / "r").exists()
 
 
 def test_the_largest_timeout_is_accepted():
     # the bound itself: 86400 s = 86,400,000 ms, under the C int poll takes (2^31 - 1 = 2,147,483,647 ms)
-    assert MAX_TIMEOUT_S * 1000 < 2 ** 31 - 1
+    assert MAX_TIMEOUT_S * 1000 < 2**31 - 1
 
 
 def test_a_candidate_timeout_past_a_day_in_pyproject(tmp_path, capsys, monkeypatch):
     (tmp_path / "pyproject.toml").write_text("[tool.wirecheck]\ncandidate-timeout = 3e6\n")
     monkeypatch.chdir(tmp_path)
     rc = crosscheck_cli.main([*VERTICES, "--report-dir", str(tmp_path / "r")])
-    one_line(rc, capsys.readouterr().err, "pyproject.toml: [tool.wirecheck] candidate-timeout = 3000000.0",
-             "at most 86400")
+    one_line(
+        rc, capsys.readouterr().err, "pyproject.toml: [tool.wirecheck] candidate-timeout = 3000000.0", "at most 86400"
+    )
     assert not (tmp_path / "r").exists()
 
 
@@ -106,9 +106,10 @@ def test_junit_into_an_unwritable_folder_is_found_before_the_report(tmp_path, ca
     assert not (tmp_path / "r").exists() and not os.path.exists(f"{folder}/j.xml")
 
 
-@pytest.mark.parametrize("key, value", [("candidate-cmd", '"echo a\\u0000b"'),
-                                        ("scenes", '["cu\\u0000be"]'),
-                                        ("candidate", '"x.py:f\\u0000"')])
+@pytest.mark.parametrize(
+    "key, value",
+    [("candidate-cmd", '"echo a\\u0000b"'), ("scenes", '["cu\\u0000be"]'), ("candidate", '"x.py:f\\u0000"')],
+)
 def test_a_nul_in_a_config_value_is_one_line(tmp_path, capsys, monkeypatch, key, value):
     """Before (candidate-cmd): exit 3, ValueError 'embedded null byte' when the command was started."""
     (tmp_path / "pyproject.toml").write_text(f"[tool.wirecheck]\n{key} = {value}\n")
@@ -135,6 +136,9 @@ def test_the_api_timeout_has_the_same_limit():
     """check_projector(timeout_s=3e6) reached the same poll as the CLI: OverflowError in the middle of a run."""
     from wirecheck.oracles.api import check_projector
 
-    with pytest.raises(ValueError, match=r"timeout_s 3000000.0: expected a finite number of seconds > 0 and at "
-                                         r"most 86400 \(one day\)"):
+    with pytest.raises(
+        ValueError,
+        match=r"timeout_s 3000000.0: expected a finite number of seconds > 0 and at "
+        r"most 86400 \(one day\)",
+    ):
         check_projector(cmd="true", timeout_s=3e6)

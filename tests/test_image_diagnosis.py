@@ -19,25 +19,24 @@ from collections import Counter
 
 import numpy as np
 import pytest
-
 from diagnosis_faults import CALIBRATED_FAULTS, CAMERAS, CLIP_FAULTS, FAULTS, FOV_FACTOR, SINGLE, implied_fov
 from test_diagnosis import format_confusion
-
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector.projection import project_points
 from wirecheck.core.projector.raster import line_coverage_aa
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
-from wirecheck.oracles.diagnosis.diagnose import primary
-from wirecheck.oracles.faults import NAMES as FAULT_ORDER, names as fault_names
 from wirecheck.oracles.candidates.draw import clip_depth, draw_candidate
+from wirecheck.oracles.diagnosis.diagnose import primary
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+from wirecheck.oracles.faults import NAMES as FAULT_ORDER
+from wirecheck.oracles.faults import names as fault_names
 
-pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
+pytestmark = pytest.mark.slow  # an expensive module fixture (tests/conftest.py runs such files first)
 
 SCENES = ("cube", "pyramid", "prism")
-FRAMES = (2, 7)                       # of 12: two poses per scene, six images per case
+FRAMES = (2, 7)  # of 12: two poses per scene, six images per case
 MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
 # Every single fault on every camera ("transposed" is invisible on "axis", as in
 # test_diagnosis); the combinations on two cameras; the camera inside the scene
@@ -46,16 +45,25 @@ MAIN_CAMERAS = ("axis", "oblique", "tall", "wide", "ortho")
 # float32_arith, float32 rounding of ~1e-5 px: a vertex-level fault a drawing cannot show.)
 # Nor float32_k (float32 constants, ~1e-5 px) nor the depth-test faults (CLIP_FAULTS: probed on the
 # projector, oracles.diagnosis.clip_planes).
-CASES = [(f, c) for f in SINGLE for c in MAIN_CAMERAS
-         if not (f == "transposed" and c == "axis") and f not in CALIBRATED_FAULTS
-         and f not in ("float32_arith", "float32_k") + CLIP_FAULTS]
+CASES = [
+    (f, c)
+    for f in SINGLE
+    for c in MAIN_CAMERAS
+    if not (f == "transposed" and c == "axis")
+    and f not in CALIBRATED_FAULTS
+    and f not in ("float32_arith", "float32_k") + CLIP_FAULTS
+]
 CASES += [(f, c) for f in ("swap_mirror", "fov_aspect", "fov_offset") for c in ("oblique", "tall")]
 CASES += [(f, "inside") for f in ("none", "depth_flip", "roll")]
 # A view the images cannot decide a mirror on: the cube alone, centred, orthographic (its picture is
 # centrally symmetric, so a left-right mirror is also an up-down one: both fit, the identity does not)
 CASES += [(f, "ortho_cube") for f in ("none", "mirror_x", "mirror_y")]
-IMAGE_CAMERAS = {**CAMERAS, "ortho_cube": look_at((2, 3, 5), (0, 0, 0), (0.2, 1, 0), width=400, height=300,
-                                                  projection="orthographic", ortho_height=5.0)}
+IMAGE_CAMERAS = {
+    **CAMERAS,
+    "ortho_cube": look_at(
+        (2, 3, 5), (0, 0, 0), (0.2, 1, 0), width=400, height=300, projection="orthographic", ortho_height=5.0
+    ),
+}
 #: The names a case expects where they are not its fault's (test_diagnosis.FAULTS).
 EXPECTED = {("mirror_x", "ortho_cube"): {"ambiguous"}, ("mirror_y", "ortho_cube"): {"ambiguous"}}
 
@@ -93,7 +101,7 @@ def draw_wide(fn, p_world, edges, cam, width_px=2.0):
     """A GL-style wide line: pixels whose centre lies within width/2 of the segment (naive distance)."""
     q0, q1 = _segments_px(fn, p_world, edges, cam)
     img = np.zeros((cam.height, cam.width), bool)
-    yy, xx = np.mgrid[0:cam.height, 0:cam.width]
+    yy, xx = np.mgrid[0 : cam.height, 0 : cam.width]
     pts = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
     for a, b in zip(q0, q1):
         lo = np.floor(np.minimum(a, b) - width_px).astype(int)
@@ -112,7 +120,7 @@ def diagnose_fault(fault, camera_name, draw=draw_candidate):
     fn, _ = FAULTS[fault]
     images, segs, flipped = [], [], []
     for p_world, edges in _scene_frames(camera_name):
-        if fault == "depth_flip":           # the renderer's camera looks backward, clipping included
+        if fault == "depth_flip":  # the renderer's camera looks backward, clipping included
             images.append(draw(project_points, p_world, edges, flipped_camera(cam)))
         else:
             images.append(draw(fn, p_world, edges, cam))
@@ -242,12 +250,12 @@ def test_confusion_matrix_is_diagonal(results, summary_section):
     summary_section("image diagnosis confusion matrix", text)
     off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
     assert not off, off
-    assert set(rows) == set(labels)                      # every fault name was injected
+    assert set(rows) == set(labels)  # every fault name was injected
 
 
 def test_blank_candidate_is_a_depth_flip_only_when_the_backward_view_is_empty():
     cam = CAMERAS["axis"]
-    (p_world, edges), = list(_scene_frames("axis"))[:1]
+    ((p_world, edges),) = list(_scene_frames("axis"))[:1]
     blank = [np.zeros((cam.height, cam.width), bool)]
     segs = [oracle_segments(p_world, edges, cam)]
     assert primary(diagnose_images(blank, segs, cam, [np.zeros((0, 2, 2))])) == "depth_flip"
@@ -282,7 +290,7 @@ def test_a_case_of_many_frames_is_fitted_on_the_points_of_six(fault, monkeypatch
         segs.append(oracle_segments(p_world, np.asarray(sc.edges), cam))
     got = diagnose_images(images, segs, cam)
     assert {f["name"] for f in got} == want, got
-    fine, coarse = sizes[0], sizes[1]                   # the fit's and the screening's registrations
+    fine, coarse = sizes[0], sizes[1]  # the fit's and the screening's registrations
     assert fine[0] == 24 and 24 * 100 < fine[1] <= image_diagnose.MAX_POINTS_PER_CASE
     assert 24 * 100 < fine[2] <= image_diagnose.MAX_POINTS_PER_CASE
     assert coarse[1] <= image_diagnose.SCREEN_POINTS_PER_CASE and coarse[2] <= image_diagnose.SCREEN_POINTS_PER_CASE

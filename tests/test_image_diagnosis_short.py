@@ -14,18 +14,16 @@ from collections import Counter
 
 import numpy as np
 import pytest
-
 from test_diagnosis import format_confusion
-
 from wirecheck.core.camera import Camera
 from wirecheck.core.projector.projection import project_points
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion, apply
+from wirecheck.oracles.candidates.draw import draw_candidate
 from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.diagnosis.diagnose import primary
-from wirecheck.oracles.faults import NAMES as FAULT_ORDER
-from wirecheck.oracles.candidates.draw import draw_candidate
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+from wirecheck.oracles.faults import NAMES as FAULT_ORDER
 from wirecheck.oracles.reports.fault_text import hints as fault_hints
 
 pytestmark = pytest.mark.slow
@@ -36,8 +34,17 @@ def _scaled(cam, sx, sy, dx=0.0, dy=0.0):
     """The camera with fx, fy scaled (perspective) and the principal point moved by (dx, dy)."""
     fx, fy = cam.focal_xy
     cx, cy = cam.principal_point
-    return Camera(position=cam.position, forward=cam.forward, up=cam.up, fov_y_deg=cam.fov_y_deg, width=cam.width,
-                  height=cam.height, near=cam.near, far=cam.far, intrinsics=(fx * sx, fy * sy, cx + dx, cy + dy))
+    return Camera(
+        position=cam.position,
+        forward=cam.forward,
+        up=cam.up,
+        fov_y_deg=cam.fov_y_deg,
+        width=cam.width,
+        height=cam.height,
+        near=cam.near,
+        far=cam.far,
+        intrinsics=(fx * sx, fy * sy, cx + dx, cy + dy),
+    )
 
 
 # (scene, case, fault, parameters) -> expected names. fov 0.75: VTK given the horizontal FOV of a
@@ -116,8 +123,9 @@ def test_short_job_confusion_matrix_is_diagonal(short_results, summary_section):
         want = SHORT[key]
         counts[("none" if not want else min(want, key=FAULT_ORDER.index), primary(got))] += 1
     rows = [r for r in labels if any(counts[(r, c)] for c in labels)]
-    text = format_confusion(labels, rows, counts).replace("confusion matrix (oracle",
-                                                           f"images only, {FRAMES} frames (oracle lines")
+    text = format_confusion(labels, rows, counts).replace(
+        "confusion matrix (oracle", f"images only, {FRAMES} frames (oracle lines"
+    )
     summary_section("image diagnosis confusion matrix, short jobs", text)
     off = {k: v for k, v in counts.items() if k[0] != k[1] and v}
     assert not off, off

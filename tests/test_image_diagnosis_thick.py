@@ -8,16 +8,15 @@ can run it beside that file's long module fixture.
 from __future__ import annotations
 
 import pytest
-
 from test_image_diagnosis import MAIN_CAMERAS, diagnose_fault, draw_aa, draw_wide
-
 from wirecheck.oracles.diagnosis.diagnose import primary
 from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX
 
-pytestmark = pytest.mark.slow          # ~1 s per diagnosis of six images
+pytestmark = pytest.mark.slow  # ~1 s per diagnosis of six images
 
 
 # ---- drawings other than 1-px aliased lines: no false faults -----------------
+
 
 @pytest.mark.parametrize("draw", [draw_aa, draw_wide], ids=["antialiased", "2px"])
 @pytest.mark.parametrize("camera_name", MAIN_CAMERAS)
@@ -33,5 +32,5 @@ def test_thick_lines_keep_their_faults(draw):
     assert primary(diagnose_fault("mirror_x", "oblique", draw=draw)) == "mirror_horizontal"
     (f,) = diagnose_fault("offset", "oblique", draw=draw)
     assert f["name"] == "pixel_offset"
-    assert f["dy"] == pytest.approx(0.5, abs=0.06)                 # measured 0.46-0.52 through thick lines
-    assert OFFSET_TOL_PX < 0.5 - 0.06                    # so the offset could not hide under the tolerance
+    assert f["dy"] == pytest.approx(0.5, abs=0.06)  # measured 0.46-0.52 through thick lines
+    assert OFFSET_TOL_PX < 0.5 - 0.06  # so the offset could not hide under the tolerance

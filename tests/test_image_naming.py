@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.raster import line_pixels
 from wirecheck.oracles.diagnosis import image_diagnose, image_naming
@@ -20,7 +19,7 @@ from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX, diagnose_i
 CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
 CX, CY = CAM.principal_point
 SCALE = 0.75
-pytestmark = pytest.mark.slow          # two image diagnoses, ~5 s each
+pytestmark = pytest.mark.slow  # two image diagnoses, ~5 s each
 
 
 def _rectangle(right, left, bottom, top):
@@ -93,8 +92,7 @@ def test_scale_starts_are_the_convention_mistakes_ratios():
         return sorted({tuple(round(float(v), 12) for v in d) for d in scale_starts(camera)})
 
     def expected(ratios):
-        return sorted({tuple(round(v, 12) for v in d)
-                       for r in ratios for d in ((r, r), (r, 1.0), (1.0, r))})
+        return sorted({tuple(round(v, 12) for v in d) for r in ratios for d in ((r, r), (r, 1.0), (1.0, r))})
 
     mistakes = [4 / 3, 3 / 4, 16 / 9, 9 / 16, 2.0, 0.5]
     # a 16:9 camera's W/H and H/W are among the mistakes: nothing more
@@ -124,9 +122,10 @@ def test_a_scale_stands_against_every_rule_read():
     from wirecheck.oracles.diagnosis.rule_read import standing_scale_faults
 
     reach, tol = np.array([100.0, 100.0]), 0.5
-    for d, under_gl, under_both in (((1.0, 1.006), ["aspect_mismatch", "fov_mismatch"], []),
-                                    ((1.0, 1.012), ["aspect_mismatch", "fov_mismatch"],
-                                     ["aspect_mismatch", "fov_mismatch"])):
+    for d, under_gl, under_both in (
+        ((1.0, 1.006), ["aspect_mismatch", "fov_mismatch"], []),
+        ((1.0, 1.012), ["aspect_mismatch", "fov_mismatch"], ["aspect_mismatch", "fov_mismatch"]),
+    ):
         named = scale_faults(d[0], d[1], reach, tol, CAM)
         assert [f["name"] for f in named] == under_gl
         gl_only = standing_scale_faults(named, np.array(d), reach, tol, CAM, {"gl": np.zeros(2)})
@@ -136,13 +135,16 @@ def test_a_scale_stands_against_every_rule_read():
             assert [f["name"] for f in got] == under_both
 
 
-@pytest.mark.parametrize("gl_cost, snapped_cost, read", [
-    (0.361, 0.368, ["gl", "snapped"]),        # Bresenham's wrong-axis FOV, prism / wide_fov: 2 % apart, a tie
-    (0.374, 0.485, ["gl", "snapped"]),        # LINE_8, pyramid / non_square: 30 %, still a tie (the margin's case)
-    (0.300, 0.401, ["gl"]),                   # 34 % > 1/3: GL's alone
-    (0.401, 0.300, ["snapped"]),              # and the rounded ends' alone
-    (0.300, 0.399, ["gl", "snapped"]),        # 33 % < 1/3: a tie
-])
+@pytest.mark.parametrize(
+    "gl_cost, snapped_cost, read",
+    [
+        (0.361, 0.368, ["gl", "snapped"]),  # Bresenham's wrong-axis FOV, prism / wide_fov: 2 % apart, a tie
+        (0.374, 0.485, ["gl", "snapped"]),  # LINE_8, pyramid / non_square: 30 %, still a tie (the margin's case)
+        (0.300, 0.401, ["gl"]),  # 34 % > 1/3: GL's alone
+        (0.401, 0.300, ["snapped"]),  # and the rounded ends' alone
+        (0.300, 0.399, ["gl", "snapped"]),  # 33 % < 1/3: a tie
+    ],
+)
 def test_two_rules_are_read_within_the_tie_margin(monkeypatch, gl_cost, snapped_cost, read):
     # read_rules reads one rule only when the other's cost exceeds it by more than RULE_TIE (1/3) of it
     # (rule_read's docstring: above the largest misread measured, 30 %); the closer rule first

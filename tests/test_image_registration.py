@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import Camera
 from wirecheck.oracles.diagnosis import registration
 from wirecheck.oracles.diagnosis.registration import PERMUTATIONS, Registration, frame_samples
@@ -21,8 +20,9 @@ W, H = 64, 48
 
 
 def _camera():
-    return Camera(position=(0.0, 0.0, 5.0), forward=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0), fov_y_deg=60.0,
-                  width=W, height=H)
+    return Camera(
+        position=(0.0, 0.0, 5.0), forward=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0), fov_y_deg=60.0, width=W, height=H
+    )
 
 
 def _case(rng):
@@ -81,7 +81,7 @@ def test_pairs_are_each_frames_own_nearest(monkeypatch, stack_limit, names):
             want_u.append(p @ foot)
             want_c.append(cpx)
             want_t.append(p @ f.seg_tangents[k])
-    assert n_fwd == len(want_u) == 130                     # frames 0 and 2; frame 1 drew nothing
+    assert n_fwd == len(want_u) == 130  # frames 0 and 2; frame 1 drew nothing
     # float64 arithmetic on coordinates below ~100 px: 1e-9 px is ~1e5 ulps of slack, far below a pixel
     np.testing.assert_allclose(u[:n_fwd], want_u, atol=1e-9)
     np.testing.assert_array_equal(c[:n_fwd], want_c)
@@ -94,7 +94,7 @@ def test_pairs_are_each_frames_own_nearest(monkeypatch, stack_limit, names):
     for f, img in zip(frames, images):
         if not (len(f.samples) and len(f.cand)):
             continue
-        drawn = np.argwhere(img)[:, ::-1] - centre          # (col, row) - centre
+        drawn = np.argwhere(img)[:, ::-1] - centre  # (col, row) - centre
         for s in f.samples:
             t = a @ (p @ s) + b
             col, row = np.round(t + centre)
@@ -118,9 +118,13 @@ def test_the_nearest_pixel_map_is_exact_within_the_pairs_reach(where):
 
     rng = np.random.default_rng(3)
     img = np.zeros((90, 120), bool)
-    boxes = {"corner": [(0, 12, 0, 15)], "middle": [(40, 50, 50, 64)],
-             "two_clusters": [(5, 12, 8, 20), (70, 85, 90, 118)], "everywhere": [(0, 90, 0, 120)]}[where]
-    density = 0.02 if where == "everywhere" else 0.2     # ~200 drawn pixels everywhere: a small brute force
+    boxes = {
+        "corner": [(0, 12, 0, 15)],
+        "middle": [(40, 50, 50, 64)],
+        "two_clusters": [(5, 12, 8, 20), (70, 85, 90, 118)],
+        "everywhere": [(0, 90, 0, 120)],
+    }[where]
+    density = 0.02 if where == "everywhere" else 0.2  # ~200 drawn pixels everywhere: a small brute force
     for r0, r1, c0, c1 in boxes:
         img[r0:r1, c0:c1] = rng.random((r1 - r0, c1 - c0)) < density
     rr, cc = np.nonzero(img)
@@ -130,11 +134,11 @@ def test_the_nearest_pixel_map_is_exact_within_the_pairs_reach(where):
     drawn = np.stack([rr, cc], axis=1).astype(float)
     d_true = np.min(np.hypot(q[:, None, 0] - drawn[None, :, 0], q[:, None, 1] - drawn[None, :, 1]), axis=1)
     d_map = np.hypot(q[:, 0] - near // 120, q[:, 1] - near % 120)
-    assert img.ravel()[near].all()                              # always a drawn pixel
+    assert img.ravel()[near].all()  # always a drawn pixel
     reach = PAIR_CAP_PX + np.sqrt(0.5)
     inside = d_true <= reach
-    assert inside.sum() > 300                                  # both parts are checked on many pixels
-    assert (~inside).sum() > 500 or where == "everywhere"      # (everywhere: the box is the whole image)
+    assert inside.sum() > 300  # both parts are checked on many pixels
+    assert (~inside).sum() > 500 or where == "everywhere"  # (everywhere: the box is the whole image)
     np.testing.assert_array_equal(d_map[inside], d_true[inside])
     assert np.all(d_map[~inside] > reach)
 
@@ -149,7 +153,7 @@ def test_oracle_samples_reach_half_the_image_beyond_each_side():
     assert len(pts) == 4 * W + 1
     assert pts[0] == pytest.approx([-0.5 - W / 2, 20.25]) and pts[-1] == pytest.approx([W - 0.5 + W / 2, 20.25])
     assert np.allclose(np.diff(pts[:, 0]), 0.5) and np.allclose(tangents, [1.0, 0.0])
-    vertical = np.array([[[30.25, 9.0 * H], [30.25, -12.0 * H]]])        # drawn upward: samples run from the start
+    vertical = np.array([[[30.25, 9.0 * H], [30.25, -12.0 * H]]])  # drawn upward: samples run from the start
     pts, tangents = registration._samples(vertical, W, H)
     assert len(pts) == 4 * H + 1
     assert pts[0] == pytest.approx([30.25, H - 0.5 + H / 2]) and pts[-1] == pytest.approx([30.25, -0.5 - H / 2])

@@ -13,7 +13,6 @@ import json
 import os
 
 import pytest
-
 from wirecheck.core.app import cli as renderer_cli
 from wirecheck.core.outputs.owned import TAG
 from wirecheck.core.outputs.staging import JOURNAL
@@ -29,8 +28,13 @@ def _render(out, capsys):
 
 
 def _journal(out, **fields):
-    data = {"wirecheck_journal": 1, "tmp": ".wirecheck-abc123.tmp", "names": ["cube-report.txt"],
-            "folders": [], "manifest": {}}
+    data = {
+        "wirecheck_journal": 1,
+        "tmp": ".wirecheck-abc123.tmp",
+        "names": ["cube-report.txt"],
+        "folders": [],
+        "manifest": {},
+    }
     data.update(fields)
     (out / JOURNAL).write_text(json.dumps(data))
     return (out / JOURNAL).read_bytes()
@@ -40,10 +44,10 @@ def _assert_refused(out, capsys, journal_bytes):
     rc, err = _render(out, capsys)
     assert rc == 2 and err.count("\n") == 1 and "Traceback" not in err, err
     assert JOURNAL in err and "delete" in err and str(out / JOURNAL) in err, err
-    assert (out / JOURNAL).read_bytes() == journal_bytes          # left in place
+    assert (out / JOURNAL).read_bytes() == journal_bytes  # left in place
     assert not (out / "cube-report.json").exists()
-    os.unlink(out / JOURNAL)                                      # what the message says to do
-    assert _render(out, capsys)[0] == 0                           # then the next run works
+    os.unlink(out / JOURNAL)  # what the message says to do
+    assert _render(out, capsys)[0] == 0  # then the next run works
 
 
 def test_journal_naming_a_users_file_never_replaces_it(tmp_path, capsys):
@@ -54,7 +58,7 @@ def test_journal_naming_a_users_file_never_replaces_it(tmp_path, capsys):
     tmp.mkdir()
     (tmp / TAG).write_bytes(b"")
     (tmp / "thesis.tex").write_bytes(b"replaced!\n")
-    digest = hashlib.sha256(THESIS).hexdigest()                 # its true hash: a manifest would trust it
+    digest = hashlib.sha256(THESIS).hexdigest()  # its true hash: a manifest would trust it
     journal = _journal(out, names=["thesis.tex"], manifest={"thesis.tex": digest})
     _assert_refused(out, capsys, journal)
     assert (out / "thesis.tex").read_bytes() == THESIS
@@ -63,7 +67,7 @@ def test_journal_naming_a_users_file_never_replaces_it(tmp_path, capsys):
 def test_journal_naming_an_untagged_folder_never_deletes_it(tmp_path, capsys):
     out = tmp_path / "out"
     out.mkdir()
-    users = out / ".wirecheck-mydata.tmp"                         # named like a temporary, no staging tag
+    users = out / ".wirecheck-mydata.tmp"  # named like a temporary, no staging tag
     users.mkdir()
     (users / "data.csv").write_bytes(b"1,2,3\n")
     journal = _journal(out, tmp=users.name, names=["cube-report.txt"])
@@ -71,9 +75,18 @@ def test_journal_naming_an_untagged_folder_never_deletes_it(tmp_path, capsys):
     assert (users / "data.csv").read_bytes() == b"1,2,3\n"
 
 
-@pytest.mark.parametrize("fields", [{"folders": 5}, {"names": "cube-report.txt"}, {"manifest": {"a": "x"}},
-                                    {"tmp": "../elsewhere"}, {"names": ["../../etc"]}, {"manifest": []}],
-                         ids=["folders_int", "names_str", "hash_bad", "tmp_outside", "name_outside", "manifest_list"])
+@pytest.mark.parametrize(
+    "fields",
+    [
+        {"folders": 5},
+        {"names": "cube-report.txt"},
+        {"manifest": {"a": "x"}},
+        {"tmp": "../elsewhere"},
+        {"names": ["../../etc"]},
+        {"manifest": []},
+    ],
+    ids=["folders_int", "names_str", "hash_bad", "tmp_outside", "name_outside", "manifest_list"],
+)
 def test_malformed_journal_is_one_line_and_kept(tmp_path, capsys, fields):
     out = tmp_path / "out"
     out.mkdir()

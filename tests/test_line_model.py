@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles.judge import line_model as lm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "clients"))
@@ -32,7 +31,7 @@ def test_horizontal_line_draws_both_rounded_ends():
 
 
 def test_vertical_and_reversed_lines():
-    drawn, _ = _image([[[3.0, 6.4], [3.0, 0.6]]], (8, 5))      # rounds to (3, 6) -> (3, 1)
+    drawn, _ = _image([[[3.0, 6.4], [3.0, 0.6]]], (8, 5))  # rounds to (3, 6) -> (3, 1)
     expected = np.zeros((8, 5), bool)
     expected[1:7, 3] = True
     assert (drawn == expected).all()
@@ -72,13 +71,17 @@ def _cv2(a, b, shape):
     import cv2
 
     img = np.zeros(shape, np.uint8)
-    cv2.line(img, tuple(int(v) for v in np.floor(a + 0.5)), tuple(int(v) for v in np.floor(b + 0.5)), 255, 1,
-             cv2.LINE_8)
+    cv2.line(
+        img, tuple(int(v) for v in np.floor(a + 0.5)), tuple(int(v) for v in np.floor(b + 0.5)), 255, 1, cv2.LINE_8
+    )
     return img > 0
 
 
-@pytest.mark.parametrize("draw", [_pillow, _cv2, lambda a, b, s: hd.draw_bresenham(np.array([[a, b]]), s[1], s[0]) > 0],
-                         ids=["pillow", "cv2_line_8", "bresenham"])
+@pytest.mark.parametrize(
+    "draw",
+    [_pillow, _cv2, lambda a, b, s: hd.draw_bresenham(np.array([[a, b]]), s[1], s[0]) > 0],
+    ids=["pillow", "cv2_line_8", "bresenham"],
+)
 def test_independent_rounded_drawers_agree_outside_the_ties(draw):
     # 300 random segments inside a 80x90 image: every pixel of Pillow's, OpenCV's LINE_8 and a textbook
     # Bresenham is the model's, and back, except at the model's ties (measured: 0 of ~11,000 pixels differ)

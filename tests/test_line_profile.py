@@ -8,10 +8,9 @@ neither fitted nor determined; fewer than 20 samples (the documented minimum) me
 from __future__ import annotations
 
 import numpy as np
-
 from wirecheck.oracles.judge.line_profile import pooled_offset
 
-D = np.array([0.25, -0.125])          # exact in binary: the fit gives it back to rounding (lstsq, ~1e-16)
+D = np.array([0.25, -0.125])  # exact in binary: the fit gives it back to rounding (lstsq, ~1e-16)
 
 
 def _samples(n_x: int, n_y: int) -> tuple[np.ndarray, np.ndarray]:

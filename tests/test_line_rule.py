@@ -17,14 +17,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PIL import Image
-
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 from wirecheck.oracles.judge import line_model
-from wirecheck.oracles.judge.frames_judge import run_frames
 from wirecheck.oracles.judge.decide import decide
 from wirecheck.oracles.judge.evidence import CaseEvidence
+from wirecheck.oracles.judge.frames_judge import run_frames
 from wirecheck.oracles.judge.line_style import style_record
 from wirecheck.oracles.judge.name_faults import name_faults
 from wirecheck.oracles.tolerances import Tolerances
@@ -42,9 +41,13 @@ def _judged(style, tol=None):
     """A CaseStyle's frames judged alone: pixels that agree (F1 1.0), only the style's own limits deciding;
     ``(verdict, fault names, line_style record)`` (oracles.judge.decide, name_faults, line_style.style_record)."""
     tol = Tolerances() if tol is None else tol
-    ev = CaseEvidence(level="frames", compared={"frames": 1, "vertices": 0, "pixels": 1}, frames_checked=1,
-                      pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
-                      style=style.read((), tol))
+    ev = CaseEvidence(
+        level="frames",
+        compared={"frames": 1, "vertices": 0, "pixels": 1},
+        frames_checked=1,
+        pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
+        style=style.read((), tol),
+    )
     verdict = decide(ev, tol)
     return verdict, [f.name for f in name_faults(ev, verdict, tol)], style_record(ev.style, verdict.style, 1)
 
@@ -102,11 +105,15 @@ def _unlit_border(draw):
         img[[0, -1], :] = 0
         img[:, [0, -1]] = 0
         return img
+
     return drawn
 
 
-@pytest.mark.parametrize("draw", [hd.draw_pillow, hd.draw_bresenham, _unlit_border(hd.draw_pillow)],
-                         ids=["pillow", "bresenham", "pillow_border_unlit"])
+@pytest.mark.parametrize(
+    "draw",
+    [hd.draw_pillow, hd.draw_bresenham, _unlit_border(hd.draw_pillow)],
+    ids=["pillow", "bresenham", "pillow_border_unlit"],
+)
 def test_a_correct_rounded_ends_renderer_passes_by_default(job_dir, tmp_path, capsys, draw):
     job = _drawn(job_dir, tmp_path, draw, "job")
     for extra in ((), ("--min-f1-0px", "0")):
@@ -175,6 +182,7 @@ def test_gl_frames_with_an_unlit_border_pass(job_dir, tmp_path, capsys):
 
 # ---- each threshold moved into Tolerances decides: just inside the measured value passes, just outside fails
 
+
 def _verdicts(job: Path, tol: Tolerances) -> list[str]:
     report, _ = run_frames(job, tol=tol)
     return [c["verdict"] for c in report["cases"]]
@@ -187,7 +195,7 @@ def test_offset_px_decides(job_dir, tmp_path):
     report, _ = run_frames(job, tol=Tolerances(offset_px=1.0))
     offs = [max(map(abs, c["line_style"]["geometry"]["offset_px"])) for c in report["cases"]]
     assert all(o == pytest.approx(0.3, abs=0.05) for o in offs), offs
-    steps = report["cases"][0]["line_style"]["coverage_steps"]   # the half level step added to the limit
+    steps = report["cases"][0]["line_style"]["coverage_steps"]  # the half level step added to the limit
     extra = 0.5 / steps
     assert _verdicts(job, Tolerances(offset_px=max(offs) - extra + 0.02)) == ["pass"] * 4
     assert _verdicts(job, Tolerances(offset_px=min(offs) - extra - 0.02)) == ["fail"] * 4
@@ -201,10 +209,14 @@ def test_rule_offset_px_decides(job_dir, tmp_path):
     report, _ = run_frames(job, tol=Tolerances(rule_offset_px=1.0), line_rule="geometry")
     offs = [max(map(abs, c["line_style"]["geometry"]["offset_px"])) for c in report["cases"]]
     assert all(0.1 < o < 0.6 for o in offs), offs
-    assert [c["verdict"] for c in run_frames(job, tol=Tolerances(rule_offset_px=max(offs) + 0.02),
-                                             line_rule="geometry")[0]["cases"]] == ["pass"] * 4
-    assert [c["verdict"] for c in run_frames(job, tol=Tolerances(rule_offset_px=min(offs) - 0.02),
-                                             line_rule="geometry")[0]["cases"]] == ["fail"] * 4
+    assert [
+        c["verdict"]
+        for c in run_frames(job, tol=Tolerances(rule_offset_px=max(offs) + 0.02), line_rule="geometry")[0]["cases"]
+    ] == ["pass"] * 4
+    assert [
+        c["verdict"]
+        for c in run_frames(job, tol=Tolerances(rule_offset_px=min(offs) - 0.02), line_rule="geometry")[0]["cases"]
+    ] == ["fail"] * 4
 
 
 def test_scale_px_decides(job_dir, tmp_path):
@@ -229,10 +241,25 @@ def test_end_px_decides():
     from wirecheck.core.camera import Camera
     from wirecheck.oracles.judge.line_style import CaseStyle
 
-    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
-                 projection="orthographic", ortho_height=140.0)
-    p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0],
-                  [40.0, 40.0, 0.0], [80.3, -40.7, 0.0]])
+    cam = Camera(
+        position=[0.0, 0.0, 10.0],
+        forward=[0.0, 0.0, -1.0],
+        up=[0.0, 1.0, 0.0],
+        width=220,
+        height=140,
+        projection="orthographic",
+        ortho_height=140.0,
+    )
+    p = np.array(
+        [
+            [-90.0, 50.0, 0.0],
+            [10.0, 13.0, 0.0],
+            [-80.0, -30.0, 0.0],
+            [-70.0, 20.0, 0.0],
+            [40.0, 40.0, 0.0],
+            [80.3, -40.7, 0.0],
+        ]
+    )
     edges = np.array([[0, 1], [2, 3], [4, 5]])
     segs = oracle_segments(p, edges, cam)
     u = (segs[:, 1] - segs[:, 0]) / np.hypot(*(segs[:, 1] - segs[:, 0]).T)[:, None]
@@ -263,8 +290,25 @@ def test_rounded_end_tie_px_decides():
 def square_on_job(tmp_path_factory) -> Path:
     # cube / narrow_fov: nearly orthographic and square-on, every line at one fractional position
     path = tmp_path_factory.mktemp("square") / "job"
-    assert main(["export", str(path), "--scene", "cube", "--scene", "pyramid", "--cases", "narrow_fov,oblique_roll",
-                 "--frames", "6", "--every", "3"]) == 0
+    assert (
+        main(
+            [
+                "export",
+                str(path),
+                "--scene",
+                "cube",
+                "--scene",
+                "pyramid",
+                "--cases",
+                "narrow_fov,oblique_roll",
+                "--frames",
+                "6",
+                "--every",
+                "3",
+            ]
+        )
+        == 0
+    )
     return path
 
 

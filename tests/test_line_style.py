@@ -18,46 +18,46 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PIL import Image, ImageDraw
-
 from wirecheck.core.projector.clipping import clip_to_image
-from wirecheck.oracles.cli import main
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job, read_grey
-from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
-from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX
-from wirecheck.oracles.judge.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset
+from wirecheck.oracles.cli import main
+from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX, oracle_segments
 from wirecheck.oracles.judge.decide import decide
 from wirecheck.oracles.judge.evidence import CaseEvidence
-from wirecheck.oracles.judge.line_style import style_record
+from wirecheck.oracles.judge.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset, style_record
 from wirecheck.oracles.judge.name_faults import name_faults
 from wirecheck.oracles.tolerances import Tolerances
 
 # oblique views: the lines slant, so every frame shows both offset components
-ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6",
-        "--every", "3"]
-
+ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6", "--every", "3"]
 
 
 def _judged(style, tol=None):
     """A CaseStyle's frames judged alone: pixels that agree (F1 1.0), only the style's own limits deciding;
     ``(verdict, fault names, line_style record)`` (oracles.judge.decide, name_faults, line_style.style_record)."""
     tol = Tolerances() if tol is None else tol
-    ev = CaseEvidence(level="frames", compared={"frames": 1, "vertices": 0, "pixels": 1}, frames_checked=1,
-                      pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
-                      style=style.read((), tol))
+    ev = CaseEvidence(
+        level="frames",
+        compared={"frames": 1, "vertices": 0, "pixels": 1},
+        frames_checked=1,
+        pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
+        style=style.read((), tol),
+    )
     verdict = decide(ev, tol)
     return verdict, [f.name for f in name_faults(ev, verdict, tol)], style_record(ev.style, verdict.style, 1)
+
 
 def _band(segs, w, h, half, ss):
     """Coverage (uint8) of lines of half-width ``half`` px: pixels' ``ss x ss`` sub-centres within it."""
     hi_w, hi_h = w * ss, h * ss
     acc = np.zeros((hi_h, hi_w), bool)
     for a, b in segs:
-        a, b = (a + 0.5) * ss - 0.5, (b + 0.5) * ss - 0.5         # pixel centres at integers, in sub-pixels
+        a, b = (a + 0.5) * ss - 0.5, (b + 0.5) * ss - 0.5  # pixel centres at integers, in sub-pixels
         lo = np.maximum(np.floor(np.minimum(a, b) - half * ss - 1), 0).astype(int)
         top = np.minimum(np.ceil(np.maximum(a, b) + half * ss + 1), [hi_w - 1, hi_h - 1]).astype(int)
         if np.any(top < lo):
             continue
-        yy, xx = np.mgrid[lo[1]:top[1] + 1, lo[0]:top[0] + 1]
+        yy, xx = np.mgrid[lo[1] : top[1] + 1, lo[0] : top[0] + 1]
         q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
         ab = b - a
         t = np.clip(((q - a) @ ab) / max(ab @ ab, 1e-300), 0.0, 1.0)
@@ -109,8 +109,9 @@ def _judge(job: Path, tmp_path: Path, *extra) -> tuple[int, dict]:
     return rc, json.loads((tmp_path / "rep" / "report.json").read_text())
 
 
-@pytest.mark.parametrize("draw, style", [(draw_antialiased, "antialiased"), (draw_wide, "wide")],
-                         ids=["antialiased", "3px"])
+@pytest.mark.parametrize(
+    "draw, style", [(draw_antialiased, "antialiased"), (draw_wide, "wide")], ids=["antialiased", "3px"]
+)
 def test_correct_antialiased_and_wide_lines_pass(job_dir, tmp_path, capsys, draw, style):
     rc, report = _judge(_fill(job_dir, tmp_path, draw), tmp_path)
     out = capsys.readouterr().out
@@ -147,7 +148,7 @@ def test_a_small_scale_error_of_antialiased_lines_fails(job_dir, tmp_path, capsy
     # the lines scaled about the principal point so that the farthest end moves 0.8 px: within F1@1px's
     # 1 px, so only the measured centres can fail it (0.8 > SCALE_TOL_PX, 0.5)
     def scaled(segs, w, h):
-        c = np.array([(w - 1) / 2.0, (h - 1) / 2.0])       # the principal point of the job's centred cameras
+        c = np.array([(w - 1) / 2.0, (h - 1) / 2.0])  # the principal point of the job's centred cameras
         reach = np.max(np.hypot(*(segs.reshape(-1, 2) - c).T))
         return draw_antialiased(c + (segs - c) * (1.0 + 0.8 / reach), w, h)
 
@@ -175,7 +176,7 @@ def test_pillow_rule_passes_by_default_and_is_raster_rule_under_gl(job_dir, tmp_
     for c in report["cases"]:
         assert c["line_style"]["style"] == "aliased"
         assert c["verdict"] == "fail" and c["pixel_f1_1px"] >= 0.999 and c["pixel_f1_0px"] < 0.98
-        (f,) = c["faults"]                                  # no rotation, mirror or offset
+        (f,) = c["faults"]  # no rotation, mirror or offset
         assert f["name"] == "raster_rule" and f["rule"] == "rounded", c["faults"]
         assert f["share_off_by_one_across"] > 0.1 and f["share_farther"] == 0.0
         assert f["share_off_by_one_at_ends"] < f["share_off_by_one_across"]
@@ -227,7 +228,7 @@ def test_measure_recovers_a_known_offset():
 def test_read_grey_keeps_coverage_and_the_rule(tmp_path):
     rgba = np.zeros((1, 4, 4), np.uint8)
     rgba[0, :, :3] = 255
-    rgba[0, :, 3] = [0, 100, 129, 255]             # white at alpha 100: 255 * 100 / 255 = 100
+    rgba[0, :, 3] = [0, 100, 129, 255]  # white at alpha 100: 255 * 100 / 255 = 100
     path = tmp_path / "f.png"
     Image.fromarray(rgba, "RGBA").save(path)
     assert read_grey(path, 4, 1).tolist() == [[0, 100, 129, 255]]
@@ -241,14 +242,16 @@ def test_read_grey_keeps_coverage_and_the_rule(tmp_path):
 
 
 def test_line_rule_needs_frames(tmp_path, capsys):
-    rc = main(["--line-rule", "geometry", "--scene", "cube", "--level", "vertices",
-               "--report-dir", str(tmp_path / "rep")])
+    rc = main(
+        ["--line-rule", "geometry", "--scene", "cube", "--level", "vertices", "--report-dir", str(tmp_path / "rep")]
+    )
     err = capsys.readouterr().err
     assert rc == 2 and "--line-rule geometry without --candidate-frames" in err and err.count("\n") == 1
 
 
-@pytest.mark.parametrize("short_px, named", [(0.0, False), (1.0, True), (-1.0, True)],
-                         ids=["correct", "dropped", "extra"])
+@pytest.mark.parametrize(
+    "short_px, named", [(0.0, False), (1.0, True), (-1.0, True)], ids=["correct", "dropped", "extra"]
+)
 def test_a_dropped_or_extra_end_is_named(short_px, named):
     # three separate lines (six free ends) seen by an orthographic camera at 1 px per unit, drawn
     # antialiased (round caps of radius 0.5: the cap's chord is half the width 0.43 px past the end;
@@ -257,10 +260,25 @@ def test_a_dropped_or_extra_end_is_named(short_px, named):
     from wirecheck.core.camera import Camera
     from wirecheck.oracles.judge.line_style import CaseStyle
 
-    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
-                 projection="orthographic", ortho_height=140.0)
-    p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0],
-                  [40.0, 40.0, 0.0], [80.3, -40.7, 0.0]])
+    cam = Camera(
+        position=[0.0, 0.0, 10.0],
+        forward=[0.0, 0.0, -1.0],
+        up=[0.0, 1.0, 0.0],
+        width=220,
+        height=140,
+        projection="orthographic",
+        ortho_height=140.0,
+    )
+    p = np.array(
+        [
+            [-90.0, 50.0, 0.0],
+            [10.0, 13.0, 0.0],
+            [-80.0, -30.0, 0.0],
+            [-70.0, 20.0, 0.0],
+            [40.0, 40.0, 0.0],
+            [80.3, -40.7, 0.0],
+        ]
+    )
     edges = np.array([[0, 1], [2, 3], [4, 5]])
     segs = oracle_segments(p, edges, cam)
     u = (segs[:, 1] - segs[:, 0]) / np.hypot(*(segs[:, 1] - segs[:, 0]).T)[:, None]
@@ -282,8 +300,15 @@ def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
     from wirecheck.oracles.judge import line_style
 
     monkeypatch.setattr(line_style, "MAX_SAMPLES_PER_CASE", 600)
-    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
-                 projection="orthographic", ortho_height=140.0)
+    cam = Camera(
+        position=[0.0, 0.0, 10.0],
+        forward=[0.0, 0.0, -1.0],
+        up=[0.0, 1.0, 0.0],
+        width=220,
+        height=140,
+        projection="orthographic",
+        ortho_height=140.0,
+    )
     p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0]])
     edges = np.array([[0, 1], [2, 3]])
     image = draw_antialiased(oracle_segments(p, edges, cam), 220, 140)
@@ -314,12 +339,11 @@ def test_off_by_one_pixels_at_the_image_border(row):
     cand = np.zeros((h, w), bool)
     orac[row, 0:4] = True
     cand[inner, 0:5] = True
-    ends = np.array([[0.0, row % h], [4.0, row % h]])           # the segment's ends (x, y)
+    ends = np.array([[0.0, row % h], [4.0, row % h]])  # the segment's ends (x, y)
     got = _off_by_one(FramePixels(cand, orac), ends)
     # at the ends: within END_RADIUS_PX = 1.5 px of (0, row): (0, row), (1, row), (0, inner), (1, inner); of (4, row):
     # (3, row), (3, inner), (4, inner): 7 of the 9, the other 2 ((2, row), (2, inner)) across
-    assert got == {"oracle_pixels": 4, "differing": 9, "off_by_one_across": 2, "off_by_one_at_ends": 7,
-                   "farther": 0}
+    assert got == {"oracle_pixels": 4, "differing": 9, "off_by_one_across": 2, "off_by_one_at_ends": 7, "farther": 0}
 
 
 def test_only_binary_frames_get_a_reference_drawing():
@@ -330,13 +354,20 @@ def test_only_binary_frames_get_a_reference_drawing():
     from wirecheck.core.camera import Camera
     from wirecheck.oracles.judge import line_style
 
-    cam = Camera(position=[0.0, 0.0, 10.0], forward=[0.0, 0.0, -1.0], up=[0.0, 1.0, 0.0], width=220, height=140,
-                 projection="orthographic", ortho_height=140.0)
+    cam = Camera(
+        position=[0.0, 0.0, 10.0],
+        forward=[0.0, 0.0, -1.0],
+        up=[0.0, 1.0, 0.0],
+        width=220,
+        height=140,
+        projection="orthographic",
+        ortho_height=140.0,
+    )
     p = np.array([[-90.0, 50.0, 0.0], [10.0, 13.0, 0.0], [-80.0, -30.0, 0.0], [-70.0, 20.0, 0.0]])
     edges = np.array([[0, 1], [2, 3]])
     grey = draw_antialiased(oracle_segments(p, edges, cam), 220, 140)
     drawn = grey[grey > 0]
-    assert np.mean((drawn > 255 / 8) & (drawn < 255 * 7 / 8)) > 0.3          # the frame is grey
+    assert np.mean((drawn > 255 / 8) & (drawn < 255 * 7 / 8)) > 0.3  # the frame is grey
     binary = np.where(grey >= 128, 255, 0).astype(np.uint8)
     for image, references in ((grey, 0), (binary, 2)):
         style = line_style.CaseStyle()
@@ -355,11 +386,16 @@ def test_summary_lines_one_per_style_and_rule():
         return {"line_style": {"style": style, "line_rule": rule, "width_px": width, "judged_by": judged_by}}
 
     by_centres = "the geometry (line centres); F1@0px is reported, not judged"
-    cases = [case("antialiased", "gl", 1.02, by_centres), {"faults": []},
-             case("aliased", "geometry", 1.0, by_centres), case("antialiased", "gl", 0.98, by_centres)]
+    cases = [
+        case("antialiased", "gl", 1.02, by_centres),
+        {"faults": []},
+        case("aliased", "geometry", 1.0, by_centres),
+        case("antialiased", "gl", 0.98, by_centres),
+    ]
     assert summary_lines(cases) == [
         f"Line style read: aliased (1 case, 1.00-1.00 px wide, --line-rule geometry): judged by {by_centres}; "
         f"cannot show {CANNOT_SHOW['aliased']}",
         f"Line style read: antialiased (2 cases, 0.98-1.02 px wide, --line-rule gl): judged by {by_centres}; "
-        f"cannot show {CANNOT_SHOW['antialiased']}"]
+        f"cannot show {CANNOT_SHOW['antialiased']}",
+    ]
     assert summary_lines([{"faults": []}]) == []

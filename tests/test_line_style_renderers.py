@@ -17,11 +17,9 @@ import sys
 from pathlib import Path
 
 import pytest
-
+from test_line_style import ARGS
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.diagnosis.diagnose import primary
-
-from test_line_style import ARGS
 
 pytest.importorskip("matplotlib")
 SCRIPT = Path(__file__).parent / "clients" / "matplotlib_frames.py"
@@ -71,7 +69,7 @@ def _require_egl():
     moderngl = pytest.importorskip("moderngl")
     try:
         moderngl.create_standalone_context(backend="egl").release()
-    except Exception as exc:        # no EGL display or driver: nothing to draw with
+    except Exception as exc:  # no EGL display or driver: nothing to draw with
         pytest.skip(f"moderngl has no EGL context here: {exc}")
 
 
@@ -90,9 +88,9 @@ def test_moderngl_correct_setup_passes(job_dir, tmp_path, capsys, samples, style
     assert rc == 0, capsys.readouterr().out
     for c in report["cases"]:
         assert c["line_style"]["style"] == style and c["faults"] == []
-        if style == "aliased":          # GL's rule, as the oracle's (Mesa): pixel for pixel (measured >= 0.999)
+        if style == "aliased":  # GL's rule, as the oracle's (Mesa): pixel for pixel (measured >= 0.999)
             assert c["pixel_f1_0px"] >= 0.98
-        else:                           # 4x MSAA: coverage in quarters; GL's rule would fail it
+        else:  # 4x MSAA: coverage in quarters; GL's rule would fail it
             assert c["line_style"]["coverage_steps"] == 4 and c["pixel_f1_0px"] < 0.98
 
 

@@ -10,7 +10,6 @@ measured as before.
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles.judge import line_style, line_ties
 
 H, W = 64, 640
@@ -24,7 +23,7 @@ def _vertical(x_exact, cols, y0=56.0, y1=8.0):
     img[:, cols] = 1.0
     segs = np.array([[[x_exact, y0], [x_exact, y1]]])
     got = line_style.measure(img, segs)
-    assert len(got["offset"]) >= 30                 # 48 rows less the guard at each end: a real sample
+    assert len(got["offset"]) >= 30  # 48 rows less the guard at each end: a real sample
     line_ties.fold_ties(got, len(cols))
     return got["offset"]
 
@@ -58,16 +57,26 @@ def test_an_even_width_ties_on_a_pixel_centre():
 
 # ---- ties at a segment's ends (oracles.judge.line_ties.drop_end_ties) ----
 
+
 def _samples(segment, n):
     """``n`` hand-built samples of segment index ``segment`` (offsets 0.5: a half-pixel offset)."""
-    return {"offset": np.full(n, 0.5), "normal": np.tile([1.0, 0.0], (n, 1)), "point": np.zeros((n, 2)),
-            "width": np.ones(n), "mass": np.ones(n), "segment": np.full(n, segment, np.intp), "windows": n,
-            "found": n}
+    return {
+        "offset": np.full(n, 0.5),
+        "normal": np.tile([1.0, 0.0], (n, 1)),
+        "point": np.zeros((n, 2)),
+        "width": np.ones(n),
+        "mass": np.ones(n),
+        "segment": np.full(n, segment, np.intp),
+        "windows": n,
+        "found": n,
+    }
 
 
 def _join(*parts):
-    return {k: (np.concatenate([p[k] for p in parts]) if isinstance(parts[0][k], np.ndarray)
-                else sum(p[k] for p in parts)) for k in parts[0]}
+    return {
+        k: (np.concatenate([p[k] for p in parts]) if isinstance(parts[0][k], np.ndarray) else sum(p[k] for p in parts))
+        for k in parts[0]
+    }
 
 
 # segment 0 ends at x = 319.5 (a boundary: columns 319 and 320 equally near); segment 1 nowhere near one:
@@ -78,8 +87,8 @@ SEGS = np.array([[[319.5, 10.0], [359.8, 40.0]], [[319.4, 10.0], [359.8, 40.3]]]
 def test_end_ties_are_ends_on_a_pixel_boundary():
     assert list(line_ties.end_ties(SEGS)) == [True, False]
     # within 2^-8 px of the boundary still a tie (a renderer's snap and float32 rounding); 2^-7 px off not
-    assert list(line_ties.end_ties(SEGS + [[[2 ** -9, 0], [0, 0]], [[0, 0], [0, 0.2]]])) == [True, True]
-    assert list(line_ties.end_ties(SEGS[:1] + [[[2 ** -7, 0], [0, 0]]])) == [False]
+    assert list(line_ties.end_ties(SEGS + [[[2**-9, 0], [0, 0]], [[0, 0], [0, 0.2]]])) == [True, True]
+    assert list(line_ties.end_ties(SEGS[:1] + [[[2**-7, 0], [0, 0]]])) == [False]
 
 
 def test_the_lines_of_tied_ends_are_left_out_and_the_others_kept():

@@ -10,16 +10,14 @@ thicker, shifted, or short at one end are still named.
 
 import numpy as np
 import pytest
-
+from raster_mutants import drop_last
 from wirecheck.core.projector import raster
 from wirecheck.core.scene.files import load_scene
-from wirecheck.oracles.judge import line_ties, metrics
 from wirecheck.oracles import tolerances
+from wirecheck.oracles.judge import line_ties, metrics
 from wirecheck.oracles.runner import CoreCandidate, run_crosscheck
 
-from raster_mutants import drop_last
-
-E = 2.0 ** -8          # TIE_END_PX: 2^-9 snap + 2^-9 float32 (oracles/tolerances.py)
+E = 2.0**-8  # TIE_END_PX: 2^-9 snap + 2^-9 float32 (oracles/tolerances.py)
 
 
 def test_tie_end_px_is_the_derived_value():
@@ -28,11 +26,12 @@ def test_tie_end_px_is_the_derived_value():
 
 # ---------------------------------------------------------------- hand-built frames
 
+
 def vertical(x_line, h=8, w=8):
     """A vertical segment x = ``x_line`` from row 0 to row h - 2, and the oracle's pixels of it (column 3)."""
     p0, p1 = np.array([[x_line, 0.0]]), np.array([[x_line, h - 2.0]])
     img = np.zeros((h, w), bool)
-    img[: h - 1, 3] = True                          # rows 0..6: the crossing rounds to column 3
+    img[: h - 1, 3] = True  # rows 0..6: the crossing rounds to column 3
     return p0, p1, img
 
 
@@ -76,20 +75,20 @@ def test_the_tie_zone_grows_with_the_slope(slope):
     # a segment from (x0, 0) to (x0 + 4 slope, 4) crosses row 0 at x0; the zone there is
     # (1 + slope) 2^-8: 2^-8 for a vertical line, 1.5 x 2^-8 at slope 1/2 (all binary fractions: exact)
     zone = (1 + slope) * E
-    q = np.array([[4.0, 0.0]])                       # the pixel right of the edge x = 3.5
-    for gap, tie in ((zone, True), (zone + 2.0 ** -12, False), (1.5 * E, slope == 0.5)):
+    q = np.array([[4.0, 0.0]])  # the pixel right of the edge x = 3.5
+    for gap, tie in ((zone, True), (zone + 2.0**-12, False), (1.5 * E, slope == 0.5)):
         a = np.array([[3.5 - gap, 0.0]])
         b = a + [4 * slope, 4.0]
         got, partner = line_ties.tie_crossings(q, a, b)
         assert got.tolist() == [tie], (slope, gap)
         if tie:
-            assert partner.tolist() == [[3, 0]]     # the pixel left of that edge
+            assert partner.tolist() == [[3, 0]]  # the pixel left of that edge
 
 
 def test_x_major_segments_tie_across_columns():
     # a horizontal segment y = 2.5 + 1e-4 from x = 0 to 6: it crosses each column 1e-4 below the edge
     # between rows 2 and 3 (<= 2^-8): pixel (x, 3) is a tie whose partner is (x, 2); (x, 1) is not
-    q = np.array([[1.0, 3.0], [1.0, 2.0], [1.0, 1.0], [7.0, 3.0]])   # the last: past the segment's end
+    q = np.array([[1.0, 3.0], [1.0, 2.0], [1.0, 1.0], [7.0, 3.0]])  # the last: past the segment's end
     a, b = np.array([[0.0, 2.5001]] * 4), np.array([[6.0, 2.5001]] * 4)
     tie, partner = line_ties.tie_crossings(q, a, b)
     assert tie.tolist() == [True, True, False, False]
@@ -119,6 +118,7 @@ def test_a_shifted_or_thicker_line_is_not_a_tie():
 
 # ---------------------------------------------------------------- end to end
 
+
 def cylinder_0014(folder):
     """benchmarks/bench_dataset.py's mesh 0014.stl (seed 12): a 24-sided cylinder, r 41.18, h 62.60."""
     import trimesh
@@ -126,7 +126,7 @@ def cylinder_0014(folder):
     mesh = trimesh.creation.cylinder(radius=41.17821687301166, height=62.60102649438868, sections=24)
     mesh.apply_translation(-mesh.bounds.mean(axis=0))
     path = folder / "0014.stl"
-    mesh.export(path)                                # float32 vertices, as the dataset's file
+    mesh.export(path)  # float32 vertices, as the dataset's file
     return load_scene(str(path))
 
 
@@ -138,6 +138,7 @@ def test_generated_cylinder_ties_pass(tmp_path, monkeypatch):
     def run():
         report, _ = run_crosscheck([scene], CoreCandidate(), frames=2, case_names=["on_axis"], animation=False)
         return report["cases"][0]
+
     case = run()
     lines = case["lines"]
     assert case["verdict"] == "pass", case["reasons"]
@@ -184,17 +185,16 @@ def test_thicker_and_shifted_lines_are_still_named():
         # cube), under 1/16 of the one-sided pixels leaves a 4x margin
         n = lines["candidate_only"] + lines["oracle_only"]
         assert sum(lines["subpixel_ties"]) <= n / 16, (cls, lines)
-        if cls is ThickCore:           # one-sided on the candidate's side: the balance names it
+        if cls is ThickCore:  # one-sided on the candidate's side: the balance names it
             assert case["faults"][0]["name"] == "line_pixel_bias"
             assert any(r.startswith("one-sided pixels unbalanced") for r in case["reasons"])
-        else:                          # balanced in count; F1 at 0 px fails it
+        else:  # balanced in count; F1 at 0 px fails it
             assert any(r.startswith("pixel F1@0px") for r in case["reasons"]), case["reasons"]
 
 
 def test_dropped_last_pixel_is_not_excused(monkeypatch):
     monkeypatch.setattr(raster, "_line_pixels", drop_last)
-    report, _ = run_crosscheck([load_scene("cube")], CoreCandidate(), frames=6, case_names=["on_axis"],
-                               animation=False)
+    report, _ = run_crosscheck([load_scene("cube")], CoreCandidate(), frames=6, case_names=["on_axis"], animation=False)
     case = report["cases"][0]
     lines = case["lines"]
     # a dropped end pixel has no partner drawn across a tie edge: it stays decided

@@ -14,7 +14,6 @@ import math
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles.judge.line_style import GUARD_PX, PROFILE_RADIUS_PX, windows
 
 W, H = 220, 140
@@ -58,12 +57,25 @@ def _segment_sets():
     for n in (1, 2, 3, 5, 8, 12, 20):
         for _ in range(4):
             segs = rng.uniform(-40, 260, (n, 2, 2))
-            segs[: n // 2] = np.round(segs[: n // 2] * 2) / 2             # half pixels: lines meet, run side by side
+            segs[: n // 2] = np.round(segs[: n // 2] * 2) / 2  # half pixels: lines meet, run side by side
             sets.append(segs)
     # a square's frame, lines 4 and 5 px apart (one pair nearer than GUARD_PX = 4.5, one farther), a crossing
-    sets.append(np.array([[[20, 20], [200, 20]], [[200, 20], [200, 120]], [[200, 120], [20, 120]],
-                          [[20, 120], [20, 20]], [[30, 60], [190, 60]], [[30, 64], [190, 64]], [[30, 90], [190, 90]],
-                          [[30, 95], [190, 95]], [[60, 30], [150, 110]]], dtype=float))
+    sets.append(
+        np.array(
+            [
+                [[20, 20], [200, 20]],
+                [[200, 20], [200, 120]],
+                [[200, 120], [20, 120]],
+                [[20, 120], [20, 20]],
+                [[30, 60], [190, 60]],
+                [[30, 64], [190, 64]],
+                [[30, 90], [190, 90]],
+                [[30, 95], [190, 95]],
+                [[60, 30], [150, 110]],
+            ],
+            dtype=float,
+        )
+    )
     # a segment past 1e150 px (its squared length overflows: every distance to it is NaN, which drops the window)
     sets.append(np.array([[[-1e200, 60], [1e200, 60]], [[20, 63], [200, 63]], [[20, 100], [200, 100]]]))
     return sets
@@ -82,8 +94,10 @@ def test_windows_are_those_of_the_definition(k):
     # each window's pixels: 2 r + 1 across the line, centred on the rounded exact line, at the step, as
     # flat indices y W + x (a horizontal line's window is a column: rows centre - r .. centre + r)
     r = PROFILE_RADIUS_PX
-    flat = [[(round(e) + o) * W + p if major_of(s) == 0 else p * W + round(e) + o for o in range(-r, r + 1)]
-            for s, p, e in expected]
+    flat = [
+        [(round(e) + o) * W + p if major_of(s) == 0 else p * W + round(e) + o for o in range(-r, r + 1)]
+        for s, p, e in expected
+    ]
     assert got["flat"].shape == (len(expected), 2 * r + 1) and got["flat"].tolist() == flat
 
 

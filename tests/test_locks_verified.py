@@ -14,7 +14,6 @@ import subprocess
 import sys
 
 import pytest
-
 from wirecheck.core.outputs.staging import LOCK
 
 RENDER = [sys.executable, "-m", "wirecheck.core.app.cli", "--width", "32", "--height", "24", "--frames", "1"]
@@ -66,10 +65,33 @@ def _target(tmp_path, command):
         out.mkdir()
         return [*RENDER, "--out", str(out)], out / LOCK
     if command == "report":
-        return ([*CROSSCHECK, "--report-dir", str(tmp_path / "r"), "--scene", "cube", "--cases", "on_axis",
-                 "--oracles", "opencv", "--frames", "1"], tmp_path / ".r.wirecheck-lock")
-    return [*CROSSCHECK, "export", str(tmp_path / "j"), "--scene", "cube", "--cases", "on_axis",
-            "--frames", "1"], tmp_path / ".j.wirecheck-lock"
+        return (
+            [
+                *CROSSCHECK,
+                "--report-dir",
+                str(tmp_path / "r"),
+                "--scene",
+                "cube",
+                "--cases",
+                "on_axis",
+                "--oracles",
+                "opencv",
+                "--frames",
+                "1",
+            ],
+            tmp_path / ".r.wirecheck-lock",
+        )
+    return [
+        *CROSSCHECK,
+        "export",
+        str(tmp_path / "j"),
+        "--scene",
+        "cube",
+        "--cases",
+        "on_axis",
+        "--frames",
+        "1",
+    ], tmp_path / ".j.wirecheck-lock"
 
 
 def _check_refused(tmp_path, command, kind):
@@ -83,10 +105,10 @@ def _check_refused(tmp_path, command, kind):
         assert run.returncode == 2, (kind, run.returncode, run.stderr)
         assert run.stderr.count("\n") == 1 and "Traceback" not in run.stderr, run.stderr
         assert str(lock) in run.stderr and "remove or rename it" in run.stderr, run.stderr
-        assert _state(lock) == before                      # not written, not removed, not replaced
-        assert user.read_bytes() == USERS                  # nothing written through a link
+        assert _state(lock) == before  # not written, not removed, not replaced
+        assert user.read_bytes() == USERS  # nothing written through a link
         outputs = [n for n in os.listdir(lock.parent) if n not in (lock.name, "thesis.tex", "out")]
-        assert outputs == [], outputs                      # nothing else written
+        assert outputs == [], outputs  # nothing else written
     finally:
         if sock is not None:
             sock.close()
@@ -128,7 +150,7 @@ def test_lock_file_is_never_seen_without_its_content(tmp_path):
         assert path.read_bytes() == f"wirecheck lock pid {os.getpid()}\n".encode()
         assert os.stat(path).st_nlink == 1
         assert holder(path) == f"process {os.getpid()}"
-        assert sorted(os.listdir(tmp_path)) == [LOCK]      # no temporary left beside it
+        assert sorted(os.listdir(tmp_path)) == [LOCK]  # no temporary left beside it
     finally:
         lock.release()
     assert os.listdir(tmp_path) == []

@@ -30,5 +30,5 @@ def test_no_string_a_user_can_read_names_a_module_by_its_path():
                 strings += 1
                 if PATH_NAME.search(node.value):
                     offenders.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value[:80]!r}")
-    assert strings > 1000                      # the sources were read
+    assert strings > 1000  # the sources were read
     assert not offenders, "\n".join(offenders)

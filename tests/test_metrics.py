@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles.judge.metrics import diff_image, pixel_scores, vertex_errors
 
 
@@ -20,8 +19,10 @@ def test_vertex_errors_hand_values():
 def test_pixel_scores_shifted_line():
     # a 10-px horizontal line vs the same line one row down: nothing matches
     # exactly, everything matches within 1 px (Chebyshev)
-    a = np.zeros((8, 12), bool); a[3, 1:11] = True
-    b = np.zeros((8, 12), bool); b[4, 1:11] = True
+    a = np.zeros((8, 12), bool)
+    a[3, 1:11] = True
+    b = np.zeros((8, 12), bool)
+    b[4, 1:11] = True
     s = pixel_scores(a, b)
     assert s["f1_0px"] == 0.0
     assert s["f1_1px"] == 1.0
@@ -30,8 +31,11 @@ def test_pixel_scores_shifted_line():
 def test_pixel_scores_partial():
     # candidate draws 10 px, oracle 8 of them plus 2 elsewhere (far away):
     # P@0 = 8/10, R@0 = 8/10 -> F1 = 0.8
-    a = np.zeros((20, 20), bool); a[2, 0:10] = True
-    b = np.zeros((20, 20), bool); b[2, 0:8] = True; b[15, 15:17] = True
+    a = np.zeros((20, 20), bool)
+    a[2, 0:10] = True
+    b = np.zeros((20, 20), bool)
+    b[2, 0:8] = True
+    b[15, 15:17] = True
     s = pixel_scores(a, b)
     assert s["precision_0px"] == 0.8 and s["recall_0px"] == 0.8
     assert s["f1_0px"] == pytest.approx(0.8, abs=1e-15)
@@ -42,9 +46,10 @@ def test_pixel_scores_partial():
 
 def test_pixel_scores_blank_images():
     z = np.zeros((4, 4), bool)
-    one = z.copy(); one[1, 1] = True
-    assert pixel_scores(z, z)["f1_0px"] == 1.0           # both blank: agree
-    assert pixel_scores(one, z)["f1_1px"] == 0.0         # one blank: disagree
+    one = z.copy()
+    one[1, 1] = True
+    assert pixel_scores(z, z)["f1_0px"] == 1.0  # both blank: agree
+    assert pixel_scores(one, z)["f1_1px"] == 0.0  # one blank: disagree
     assert pixel_scores(z, one)["f1_1px"] == 0.0
 
 
@@ -52,9 +57,9 @@ def test_diff_image_colours():
     a = np.array([[1, 1, 0, 0]], bool)
     b = np.array([[1, 0, 1, 0]], bool)
     d = diff_image(a, b)
-    assert d[0, 0].tolist() == [255, 255, 255]     # both
-    assert d[0, 1].tolist() == [255, 70, 70]       # candidate only: red
-    assert d[0, 2].tolist() == [60, 170, 255]      # oracle only: blue
+    assert d[0, 0].tolist() == [255, 255, 255]  # both
+    assert d[0, 1].tolist() == [255, 70, 70]  # candidate only: red
+    assert d[0, 2].tolist() == [60, 170, 255]  # oracle only: blue
     assert d[0, 3].tolist() == [0, 0, 0]
 
 
@@ -110,16 +115,21 @@ def test_occlusion_boundary_marks_both_sides_of_triangles_sharing_no_vertex():
     tris = np.array([[0, 1, 2], [3, 4, 5]])
     ids = np.array([[1, 1, 0, 0]])
     assert occlusion_boundary(ids, tris).tolist() == [[False, True, True, False]]
-    shared = np.array([[0, 1, 2], [2, 3, 4]])            # sharing vertex 2: depth is continuous
+    shared = np.array([[0, 1, 2], [2, 3, 4]])  # sharing vertex 2: depth is continuous
     assert not occlusion_boundary(ids, shared).any()
-    assert not occlusion_boundary(np.array([[-1, 0, 0, -1]]), tris).any()     # -1: no triangle
+    assert not occlusion_boundary(np.array([[-1, 0, 0, -1]]), tris).any()  # -1: no triangle
 
 
 def _within_naive(mask_from, mask_to, tol):
     """The definition, pixel by pixel: a True of mask_to in the (2 tol + 1)^2 window, clipped to the image."""
     h, w = mask_to.shape
-    return np.array([mask_to[max(r - tol, 0):r + tol + 1, max(c - tol, 0):c + tol + 1].any()
-                     for r, c in zip(*np.nonzero(mask_from))], bool)
+    return np.array(
+        [
+            mask_to[max(r - tol, 0) : r + tol + 1, max(c - tol, 0) : c + tol + 1].any()
+            for r, c in zip(*np.nonzero(mask_from))
+        ],
+        bool,
+    )
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -130,7 +140,7 @@ def test_one_pixel_match_on_drawn_pixels_equals_the_definition(seed):
     h, w = rng.integers(1, 30, 2)
     a = rng.random((h, w)) < rng.uniform(0, 0.5)
     b = rng.random((h, w)) < rng.uniform(0, 0.2)
-    b[0, :] |= rng.random(w) < 0.5                  # lines along the border: the window is clipped there
+    b[0, :] |= rng.random(w) < 0.5  # lines along the border: the window is clipped there
     for tol in (0, 1, 2):
         np.testing.assert_array_equal(_within(a, b, tol), _within_naive(a, b, tol))
 
@@ -165,12 +175,12 @@ def test_edge_neighbourhoods_of_drawn_pixels_equal_the_definition(seed, density)
     w, h = 36, 24
     p0 = rng.uniform(-3, 39, (10, 2))
     p1 = p0 + rng.normal(0, 12, (10, 2))
-    p1[2] = p0[2] + 0.3                                   # a very short segment
-    p0[5] = np.nan                                        # an edge not drawn
+    p1[2] = p0[2] + 0.3  # a very short segment
+    p0[5] = np.nan  # an edge not drawn
     pixels = np.flatnonzero(rng.random(w * h) < density)
     got = edge_neighbourhoods(p0, p1, w, h, pixels=pixels)
     assert list(zip(*(a.tolist() for a in got))) == _neighbourhoods_naive(p0, p1, w, h, pixels)
-    assert got[1].tolist() == sorted(got[1].tolist())     # one row per pixel, in pixel order
+    assert got[1].tolist() == sorted(got[1].tolist())  # one row per pixel, in pixel order
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -184,9 +194,9 @@ def test_nearest_looked_for_near_first_equals_the_definition(monkeypatch, seed, 
     from wirecheck.oracles.judge import segment_pixels
     from wirecheck.oracles.judge.metrics import edge_neighbourhoods
 
-    monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 10 ** 9 if levels == "radius only" else 0)
+    monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 10**9 if levels == "radius only" else 0)
     monkeypatch.setattr(segment_pixels, "TABLE_CELLS", 0 if levels.endswith("no table") else 1 << 23)
-    monkeypatch.setattr(segment_pixels, "CROWDED", 0 if levels.startswith("1/8") else 10 ** 9)
+    monkeypatch.setattr(segment_pixels, "CROWDED", 0 if levels.startswith("1/8") else 10**9)
     rng = np.random.default_rng(40 + seed)
     w, h = 40, 30
     p0 = rng.uniform(-3, 43, (25, 2))
@@ -204,17 +214,18 @@ def test_nearest_beyond_half_a_pixel_and_tied(monkeypatch, levels):
     from wirecheck.oracles.judge import segment_pixels
     from wirecheck.oracles.judge.metrics import edge_neighbourhoods
 
-    monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 10 ** 9 if levels == "radius only" else 0)
-    monkeypatch.setattr(segment_pixels, "CROWDED", 0 if levels.startswith("1/8") else 10 ** 9)
+    monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 10**9 if levels == "radius only" else 0)
+    monkeypatch.setattr(segment_pixels, "CROWDED", 0 if levels.startswith("1/8") else 10**9)
     w, h = 24, 12
     p0, p1 = np.array([[0.0, 4.25], [0.0, 5.75]]), np.array([[20.0, 4.25], [20.0, 5.75]])
-    pixels = np.arange(3 * w, 8 * w)                       # rows 3..7, every column
+    pixels = np.arange(3 * w, 8 * w)  # rows 3..7, every column
     edge, pixel, major = (a.tolist() for a in edge_neighbourhoods(p0, p1, w, h, pixels=pixels))
     # within 1 of a segment: x from 0 to 20 only (x = 21 is hypot(1, 1/4) = 1.03 from the nearer end)
-    expected = [(0, 4 * w + x) for x in range(21)] + [(0, 5 * w + x) for x in range(21)] \
-        + [(1, 6 * w + x) for x in range(21)]
+    expected = (
+        [(0, 4 * w + x) for x in range(21)] + [(0, 5 * w + x) for x in range(21)] + [(1, 6 * w + x) for x in range(21)]
+    )
     assert list(zip(edge, pixel)) == expected
-    assert major == [p % w for p in pixel]                 # horizontal: the column
+    assert major == [p % w for p in pixel]  # horizontal: the column
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -233,9 +244,9 @@ def test_frames_neighbourhoods_give_each_frame_its_own_rows(seed):
     for _ in range(int(rng.integers(2, 6))):
         n = int(rng.integers(0, 8))
         p0 = rng.uniform(-4, 34, (n, 2))
-        p1 = np.column_stack([rng.uniform(-4, 34, n), rng.choice([-3.5, 15.5], n)])   # through top or bottom
+        p1 = np.column_stack([rng.uniform(-4, 34, n), rng.choice([-3.5, 15.5], n)])  # through top or bottom
         if n > 1:
-            p1[1, 1] = p0[1, 1]                              # horizontal
+            p1[1, 1] = p0[1, 1]  # horizontal
         frames.append((p0, p1, np.flatnonzero(rng.random(w * h) < rng.uniform(0.05, 0.7))))
     got = frames_neighbourhoods(frames, w, h)
     assert len(got) == len(frames)
@@ -264,7 +275,7 @@ def test_line_batch_scores_as_frame_by_frame(dense):
         cand, orac = rng.random((h, w)) < 0.1, rng.random((h, w)) < 0.1
         frames.append((k, cand, orac, p0, p1))
     alone = [line_scores(c, o, p0, p1) for _, c, o, p0, p1 in frames]
-    for limit in (1, 50, 1 << 20):                       # every frame alone, a few together, all together
+    for limit in (1, 50, 1 << 20):  # every frame alone, a few together, all together
         batch, got = LineBatch(limit=limit), []
         for k, c, o, p0, p1 in frames:
             got += batch.add(k, FramePixels(c, o), p0, p1)
@@ -299,7 +310,7 @@ def test_line_batch_counts_by_hand():
     short = scores["short"]
     assert (short["edges_compared"], short["edge_count_worst_edge"], short["edge_count_worst_diff"]) == (2, 2, -1)
     assert short["edge_count_diff_sum"] == -1
-    assert scores["short"] == line_scores(cand, oracle, p0, p1)      # the full count over every drawn pixel
+    assert scores["short"] == line_scores(cand, oracle, p0, p1)  # the full count over every drawn pixel
 
 
 def test_line_scores_with_nothing_drawn_near_an_edge_on_screen():
@@ -316,13 +327,13 @@ def test_kept_image_gives_the_image_back(how):
     from wirecheck.oracles.judge.case import KeptImage
 
     image = np.zeros((5, 7), bool)
-    image[0, 0] = image[4, 6] = image[2, 3] = True        # the corners and the middle
+    image[0, 0] = image[4, 6] = image[2, 3] = True  # the corners and the middle
     kept = KeptImage.of(image, np.flatnonzero(image) if how == "flat" else None)
     assert (kept.flat is not None) == (how == "flat")
     np.testing.assert_array_equal(kept.image(), image)
 
 
-def _is_tie(c, a, b, other, end_px=2.0 ** -8):
+def _is_tie(c, a, b, other, end_px=2.0**-8):
     """oracles.judge.line_ties' rule for one pixel ``c`` of segment ``a -> b``, written out per axis (y-major first)."""
     d = b - a
     for major in (1, 0):
@@ -341,7 +352,7 @@ def _is_tie(c, a, b, other, end_px=2.0 ** -8):
     return False
 
 
-def _is_end_tie(c, a, b, w, h, end_px=2.0 ** -8):
+def _is_end_tie(c, a, b, w, h, end_px=2.0**-8):
     """oracles.judge.line_ties' end rule for one pixel ``c`` of segment ``a -> b``, end by end: | |E - c|_1 - 1/2 |
     within 2 end_px, on the diamond's exit side (L1 distance growing along b - a), not an end on the border."""
     d, zone = b - a, 2 * end_px
@@ -395,14 +406,14 @@ def test_end_attribution_equals_the_definition(monkeypatch, seed, prefilter):
     from wirecheck.oracles.judge import segment_pixels
     from wirecheck.oracles.judge.metrics import end_attribution
 
-    monkeypatch.setattr(segment_pixels, "FEW_SEGMENTS", 0 if prefilter else 10 ** 9)
+    monkeypatch.setattr(segment_pixels, "FEW_SEGMENTS", 0 if prefilter else 10**9)
 
     rng = np.random.default_rng(200 + seed)
     w, h = 30, 20
     p0 = rng.uniform(-5, 35, (9, 2))
     p1 = p0 + rng.normal(0, 8, (9, 2))
-    p1[3] = p0[3]                                       # a point
-    p0[4] = np.nan                                      # not drawn
+    p1[3] = p0[3]  # a point
+    p0[4] = np.nan  # not drawn
     cand, oracle = rng.random((h, w)) < 0.15, rng.random((h, w)) < 0.15
     assert end_attribution(cand, oracle, p0, p1) == _ends_naive(cand, oracle, p0, p1)
 
@@ -413,7 +424,7 @@ def test_end_attribution_equals_the_definition_at_ties(monkeypatch, prefilter):
     from wirecheck.oracles.judge import segment_pixels
     from wirecheck.oracles.judge.metrics import end_attribution
 
-    monkeypatch.setattr(segment_pixels, "FEW_SEGMENTS", 0 if prefilter else 10 ** 9)
+    monkeypatch.setattr(segment_pixels, "FEW_SEGMENTS", 0 if prefilter else 10**9)
 
     ties = 0
     for seed in range(8):
@@ -425,7 +436,7 @@ def test_end_attribution_equals_the_definition_at_ties(monkeypatch, prefilter):
         got = end_attribution(cand, oracle, p0, p1)
         assert got == _ends_naive(cand, oracle, p0, p1)
         ties += sum(got["tie"])
-    assert ties > 0                                     # the tie rule was exercised
+    assert ties > 0  # the tie rule was exercised
 
 
 def test_vertex_errors_frames_equal_frame_by_frame():
@@ -437,9 +448,9 @@ def test_vertex_errors_frames_equal_frame_by_frame():
     rng = np.random.default_rng(9)
     cand = [rng.normal(300, 200, (13, 2)) for _ in range(10)]
     orac = [c + rng.normal(0, 1e-3, c.shape) for c in cand]
-    cand[2][4] = np.nan                                  # clipped by the candidate only: shown by the oracle only
-    orac[5][0] = np.nan                                  # clipped by the oracle only: shown by the candidate only
-    cand[7][3, 1] = np.inf                               # a broken answer
+    cand[2][4] = np.nan  # clipped by the candidate only: shown by the oracle only
+    orac[5][0] = np.nan  # clipped by the oracle only: shown by the candidate only
+    cand[7][3, 1] = np.inf  # a broken answer
     got = vertex_errors_frames(cand, orac)
     assert json.dumps(got) == json.dumps([vertex_errors(c, o) for c, o in zip(cand, orac)])
     assert got[2]["oracle_only"] == 1 and got[5]["candidate_only"] == 1 and got[7]["max_px"] == float("inf")
@@ -465,5 +476,5 @@ def test_resolve_ties_by_a_merge_equals_the_pixels_looked_up_again(seed):
     for name in ("cand_idx", "oracle_idx", "cand_in_oracle", "oracle_in_cand"):
         np.testing.assert_array_equal(getattr(got, name), getattr(want, name), err_msg=name)
     assert got.only()[0].tolist() == np.setdiff1d(c_only, c_ties).tolist()
-    both = fp.cand_idx[fp.cand_in_oracle][:1]                        # drawn by both: no tie of one side
+    both = fp.cand_idx[fp.cand_in_oracle][:1]  # drawn by both: no tie of one side
     assert fp.exchanged(both, o_ties[:0]) is None and fp.exchanged(c_ties[:0], both) is None

@@ -14,12 +14,11 @@ import hashlib
 
 import numpy as np
 import pytest
-
 from wirecheck.core.outputs.output import MP4_OPTIONS, mp4_bytes
 
 pytest.importorskip("av")
 
-M_PERTURB = -6          # glibc malloc.h
+M_PERTURB = -6  # glibc malloc.h
 
 
 def _mallopt():
@@ -37,8 +36,8 @@ def wireframe_frames(h, w, n, rgb=False):
     for i in range(n):
         im = np.zeros((h, w), np.uint8)
         for k in range(12):
-            im[int((h - 1) * (0.5 + 0.45 * np.sin(0.3 * i + k))), w // 10:w * 9 // 10] = 255
-            im[h // 10:h * 9 // 10, int((w - 1) * (0.5 + 0.45 * np.cos(0.2 * i + 1.7 * k)))] = 255
+            im[int((h - 1) * (0.5 + 0.45 * np.sin(0.3 * i + k))), w // 10 : w * 9 // 10] = 255
+            im[h // 10 : h * 9 // 10, int((w - 1) * (0.5 + 0.45 * np.cos(0.2 * i + 1.7 * k)))] = 255
         out.append(np.stack([im, np.roll(im, 3, axis=1), im // 2], axis=2) if rgb else im)
     return out
 
@@ -55,7 +54,7 @@ def test_mp4_bytes_do_not_depend_on_heap_contents(h, w, n, rgb):
             assert mallopt(M_PERTURB, pattern) == 1
             digests.add(hashlib.sha256(mp4_bytes(frames)).hexdigest())
     finally:
-        mallopt(M_PERTURB, 0)        # back to glibc's default: no filling
+        mallopt(M_PERTURB, 0)  # back to glibc's default: no filling
     assert len(digests) == 1
 
 
@@ -64,7 +63,7 @@ def test_mp4_encoder_settings_written_in_the_file():
     # carries no library version string (fflags=+bitexact).
     data = mp4_bytes(wireframe_frames(62, 82, 3))
     start = data.index(b"x264 - core")
-    options = data[start:data.index(b"\0", start)].decode("ascii").split(" options: ")[1].split()
+    options = data[start : data.index(b"\0", start)].decode("ascii").split(" options: ")[1].split()
     assert {"threads=1", "lookahead_threads=1", "sliced_threads=0", "mbtree=0"} <= set(options)
     assert MP4_OPTIONS["x264-params"] == "mbtree=0"
     assert b"Lavf" not in data

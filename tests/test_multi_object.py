@@ -2,16 +2,16 @@
 
 import json
 from pathlib import Path
+
 import numpy as np
 import pytest
+from helpers import run_renderer as run
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
-
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene.model import object_matrix, SceneObject, world_points
-from wirecheck.core.scene.files import builtin_names, example_names, load_scene, parse_scene_text, SCENE_DIR
+from wirecheck.core.scene.files import SCENE_DIR, builtin_names, example_names, load_scene, parse_scene_text
+from wirecheck.core.scene.model import SceneObject, object_matrix, world_points
 from wirecheck.core.transforms import Motion
-from helpers import run_renderer as run
 
 EPS = np.finfo(np.float64).eps
 
@@ -35,6 +35,7 @@ def reference_parse(text):
 
 
 # ---- old files are one static object, arrays unchanged ------------------------------------
+
 
 @pytest.mark.parametrize("name", builtin_names())
 def test_builtin_scenes_parse_to_the_same_arrays(name):
@@ -108,8 +109,12 @@ def test_world_points_hand_derived():
     p = world_points(s, run_motion, 2, 4)
     want = [[0, 0, -1], [0, 1, 0], [0, 2, -3], [2, 0, -3], [0, 0, -1]]
     assert_allclose(p, want, rtol=0, atol=8 * EPS * 3)
-    assert_allclose(object_matrix(s.objects[1], run_motion, 2, 4),
-                    run_motion.frame_matrix(2, 4) @ s.objects[1].motion.frame_matrix(2, 4), rtol=0, atol=0)
+    assert_allclose(
+        object_matrix(s.objects[1], run_motion, 2, 4),
+        run_motion.frame_matrix(2, 4) @ s.objects[1].motion.frame_matrix(2, 4),
+        rtol=0,
+        atol=0,
+    )
     # frame 1 is the rest pose of everything: only b's scale and offset apply
     assert_array_equal(world_points(s, run_motion, 1, 4), [[1, 0, 0], [0, 1, 0], [5, 0, 0], [3, 0, 2], [3, 2, 0]])
 
@@ -141,8 +146,12 @@ def test_mesh_object_relative_to_the_scene_file(tmp_path):
 
 BAD = [
     ("unknown keyword", "object a\nv 0 0 0\nrotate 1 0 0\n", 3, "'rotate'"),
-    ("index out of range within an object", "object a\nv 0 0 0\nv 1 0 0\nobject b\nv 0 0 0\nv 1 1 1\ne 0 2\n",
-     7, "index 2"),
+    (
+        "index out of range within an object",
+        "object a\nv 0 0 0\nv 1 0 0\nobject b\nv 0 0 0\nv 1 1 1\ne 0 2\n",
+        7,
+        "index 2",
+    ),
     ("duplicate object name", "object a\nv 0 0 0\nobject b\nobject a\n", 4, "'a'"),
     ("name clash with the implicit object", "name s\nv 0 0 0\nobject s\nv 1 1 1\n", 3, "'s'"),
     ("non-finite translate", "object a\ntranslate 0 inf 0\n", 2, "'inf'"),
@@ -185,7 +194,10 @@ def test_bad_object_file_through_the_cli(tmp_path):
     p.write_text("object a\nv 0 0 0\nobject a\n")
     rc, out, err = run(["--scene", str(p), "--frames", "1"], tmp_path / "out")
     assert (rc, out) == (2, "")
-    assert err == f"renderer: error: {p}:3: object 'a': expected a new name (line 1 already starts an object of that name)\n"
+    assert (
+        err
+        == f"renderer: error: {p}:3: object 'a': expected a new name (line 1 already starts an object of that name)\n"
+    )
 
 
 # ---- the renderer with several objects ------------------------------------------------------
@@ -211,8 +223,22 @@ def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
     # radius sqrt 3) is entirely behind the near plane (z_cam = 4 - 10 +- 1.74 < 0.1); 'aside' at
     # x = 40, depth 4: the image's right edge is at x = 4 tan(30) 4/3 = 3.08, so it is outside the
     # right plane by far more than its radius. Only 'front' can be drawn.
-    args = ["--scene", str(scene), "--frames", "3", "--camera-z", "4", "--width", "160", "--height", "120",
-            "--spin", "0,0,0", "--format", "png,ascii"] + extra
+    args = [
+        "--scene",
+        str(scene),
+        "--frames",
+        "3",
+        "--camera-z",
+        "4",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--spin",
+        "0,0,0",
+        "--format",
+        "png,ascii",
+    ] + extra
     rc1, out1, err1 = run(args, tmp_path / "on")
     rc2, out2, err2 = run(args + ["--no-object-culling"], tmp_path / "off")
     assert (rc1, err1, rc2, err2) == (0, "", 0, "")
@@ -227,7 +253,7 @@ def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
             fa, fb = a.pop("faces_culled"), b.pop("faces_culled")
             assert fa <= fb <= fa + 12
             assert a["faces_total"] == 18
-        assert a == b                          # every other count (and vertex pixel) is the same
+        assert a == b  # every other count (and vertex pixel) is the same
         # 'behind' has 8 vertices at depth < near; its 12 edges are all clipped
         assert (a["clipped"], a["clipped_edges"]) == (8, 12)
     assert on["summary"]["objects_culled"] == 6
@@ -237,7 +263,9 @@ def test_object_culling_counts_and_never_changes_the_picture(tmp_path, extra):
         assert_array_equal(im_on, im_off)
         assert im_on.any()
         txt = f"frame_{k:04d}.txt"
-        assert (tmp_path / "on" / "three-frames" / txt).read_bytes() == (tmp_path / "off" / "three-frames" / txt).read_bytes()
+        assert (tmp_path / "on" / "three-frames" / txt).read_bytes() == (
+            tmp_path / "off" / "three-frames" / txt
+        ).read_bytes()
 
 
 def test_multi_object_frame_matches_world_points(tmp_path):
@@ -246,7 +274,8 @@ def test_multi_object_frame_matches_world_points(tmp_path):
     # core, by scipy (oracles.references.faces) and projected by cv2.projectPoints. Two float64
     # pipelines: ~20 roundings of values <= 640 px, ~3e-12; 1e-9 px leaves margin.
     from wirecheck.core.camera import camera_z
-    from wirecheck.oracles.references import faces as oface, opencv_oracle
+    from wirecheck.oracles.references import faces as oface
+    from wirecheck.oracles.references import opencv_oracle
 
     rc, _, err = run(["--scene", "orrery", "--frames", "4", "--camera-z", "8", "--spin", "0,1,0"], tmp_path)
     assert (rc, err) == (0, "")
@@ -262,7 +291,7 @@ def test_multi_object_frame_matches_world_points(tmp_path):
 
 # ---- winding and faces ---------------------------------------------------------------------
 
-BAD_WINDING = CUBE_V + CUBE_FACES.replace("f 1 2 6 5", "f 5 6 2 1")     # one face flipped
+BAD_WINDING = CUBE_V + CUBE_FACES.replace("f 1 2 6 5", "f 5 6 2 1")  # one face flipped
 
 
 def test_inconsistent_winding_warns_and_refuses_backface_culling(tmp_path):
@@ -280,7 +309,7 @@ def test_inconsistent_winding_warns_and_refuses_backface_culling(tmp_path):
 
 @pytest.mark.parametrize("flag", [["--hidden-lines"], ["--style", "shaded"], ["--cull", "backface"]])
 def test_face_options_need_faces(tmp_path, flag):
-    wire = tmp_path / "wire.scene"                      # edges only: a wireframe with no faces
+    wire = tmp_path / "wire.scene"  # edges only: a wireframe with no faces
     wire.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\ne 0 1\ne 1 2\n")
     rc, out, err = run(["--scene", str(wire), "--frames", "1"] + flag, tmp_path / "o")
     assert (rc, out) == (2, "")
@@ -297,8 +326,9 @@ def test_cull_and_hidden_lines_fields(tmp_path):
     # is on the outer side of its plane. Front (z = +1, camera z 4 > 1): kept. Back (z = -1):
     # culled. Side x = +1: the camera's x = 0 < 1, inner side: culled; likewise the other 3
     # sides. So 6 faces, 5 culled.
-    rc, out, err = run(["--scene", "cube", "--frames", "1", "--spin", "0,0,0", "--cull", "backface",
-                        "--hidden-lines"], tmp_path)
+    rc, out, err = run(
+        ["--scene", "cube", "--frames", "1", "--spin", "0,0,0", "--cull", "backface", "--hidden-lines"], tmp_path
+    )
     assert (rc, err) == (0, "")
     fr = json.loads((tmp_path / "cube-report.json").read_text())["frames"][0]
     assert (fr["faces_total"], fr["faces_culled"]) == (6, 5)
@@ -318,19 +348,34 @@ def test_mirrored_object_is_culled_like_its_oracle(tmp_path, capsys):
 
     cube = (Path(__file__).resolve().parent.parent / "scenes" / "cube.scene").read_text()
     body = "\n".join(line for line in cube.splitlines() if line.split("#")[0].strip().startswith(("v", "f")))
-    text = (f"object a\ntranslate -1.5 0 0\nscale 0.5\n{body}\n"
-            f"object b\ntranslate 1.5 0 0\nscale -0.5\nspin 0 1 0\n{body}\n")
+    text = (
+        f"object a\ntranslate -1.5 0 0\nscale 0.5\n{body}\n"
+        f"object b\ntranslate 1.5 0 0\nscale -0.5\nspin 0 1 0\n{body}\n"
+    )
     path = tmp_path / "mirror.scene"
     path.write_text(text)
-    from wirecheck.core.scene.model import oriented_faces
     from wirecheck.core.scene.files import load_scene
+    from wirecheck.core.scene.model import oriented_faces
     from wirecheck.core.transforms import Motion
 
     scene = load_scene(str(path))
     faces = oriented_faces(scene, Motion())
     n_a = len(scene.faces) // 2
-    assert faces[:n_a] == scene.faces[:n_a]                             # a: unchanged
-    assert faces[n_a:] == tuple(tuple(reversed(f)) for f in scene.faces[n_a:])   # b: re-wound
-    rc = main(["--scene", str(path), "--cases", "on_axis,oblique_roll", "--frames", "3", "--cull", "backface",
-               "--hidden-lines", "--report-dir", str(tmp_path / "rep")])
+    assert faces[:n_a] == scene.faces[:n_a]  # a: unchanged
+    assert faces[n_a:] == tuple(tuple(reversed(f)) for f in scene.faces[n_a:])  # b: re-wound
+    rc = main(
+        [
+            "--scene",
+            str(path),
+            "--cases",
+            "on_axis,oblique_roll",
+            "--frames",
+            "3",
+            "--cull",
+            "backface",
+            "--hidden-lines",
+            "--report-dir",
+            str(tmp_path / "rep"),
+        ]
+    )
     assert rc == 0, capsys.readouterr().out

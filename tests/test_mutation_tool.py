@@ -12,7 +12,7 @@ MUTATION = Path(__file__).resolve().parent / "mutation"
 def _mutate():
     spec = importlib.util.spec_from_file_location("mutate_tool", MUTATION / "mutate.py")
     module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module              # its dataclasses look their module up there
+    sys.modules[spec.name] = module  # its dataclasses look their module up there
     spec.loader.exec_module(module)
     return module
 
@@ -20,11 +20,21 @@ def _mutate():
 def test_only_with_an_unknown_id_is_exit_2_and_writes_nothing(tmp_path, capsys):
     committed = hashlib.sha256((MUTATION / "report.md").read_bytes()).hexdigest()
     report = tmp_path / "report.md"
-    rc = _mutate().main(["--module", "core/projector/clipping.py", "--only", "core/projector/clipping.py:1:1:nosuch",
-                         "--report", str(report)])
+    rc = _mutate().main(
+        [
+            "--module",
+            "core/projector/clipping.py",
+            "--only",
+            "core/projector/clipping.py:1:1:nosuch",
+            "--report",
+            str(report),
+        ]
+    )
     err = capsys.readouterr().err
-    assert rc == 2 and err == ("mutate: error: --only 'core/projector/clipping.py:1:1:nosuch': no mutant of core/projector/clipping.py "
-                               "has this id: expected one that --list prints (MODULE:LINE:COL:CHANGE)\n")
+    assert rc == 2 and err == (
+        "mutate: error: --only 'core/projector/clipping.py:1:1:nosuch': no mutant of core/projector/clipping.py "
+        "has this id: expected one that --list prints (MODULE:LINE:COL:CHANGE)\n"
+    )
     assert not report.exists()
     assert hashlib.sha256((MUTATION / "report.md").read_bytes()).hexdigest() == committed
 
@@ -48,7 +58,7 @@ def test_the_mutant_ids_in_the_docs_name_mutants_that_exist():
     import re
 
     shown = re.findall(r"--only '([^']+)'", (MUTATION.parent.parent / "docs" / "testing.md").read_text())
-    assert shown                                          # the page was read
+    assert shown  # the page was read
     mutate = _mutate()
     for mutant in shown:
         module = mutant.split(":")[0]
@@ -66,11 +76,15 @@ def test_every_target_names_a_module_and_tests_that_exist():
             assert (root / path).is_file(), (module, entry)
             base, _, param = name.partition("[")
             assert not name or f"def {base}(" in (root / path).read_text(), (module, entry)
-            if param:           # a parametrised node id: the parameter's id must be collected too
+            if param:  # a parametrised node id: the parameter's id must be collected too
                 import subprocess
                 import sys
 
-                collected = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q",
-                                            "-p", "no:cacheprovider", entry], cwd=root, capture_output=True,
-                                           text=True, timeout=300)
+                collected = subprocess.run(
+                    [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", entry],
+                    cwd=root,
+                    capture_output=True,
+                    text=True,
+                    timeout=300,
+                )
                 assert collected.returncode == 0, (module, entry, collected.stdout[-500:])

@@ -4,7 +4,6 @@ import math
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.references import convert
@@ -13,12 +12,28 @@ EPS = np.finfo(np.float64).eps
 
 CAMERAS = {
     "camera_z": camera_z(4.0, fov_y_deg=90.0, width=640, height=480, near=1.0, far=10.0),
-    "oblique_roll": look_at((3.0, -2.0, 5.0), (0.3, 0.1, -0.2), up=(0.4, 1.0, 0.3),
-                            fov_y_deg=47.5, width=320, height=200, near=0.25, far=50.0),
-    "looking_down": look_at((0.5, 6.0, 0.2), (0.0, 0.0, 0.0), up=(0.0, 0.0, -1.0),
-                            fov_y_deg=30.0, width=101, height=77),
-    "ortho_oblique": look_at((4.0, 3.0, -4.0), (0.0, 0.5, 0.0), up=(0.2, 1.0, 0.0),
-                             projection="orthographic", ortho_height=3.5, width=160, height=90),
+    "oblique_roll": look_at(
+        (3.0, -2.0, 5.0),
+        (0.3, 0.1, -0.2),
+        up=(0.4, 1.0, 0.3),
+        fov_y_deg=47.5,
+        width=320,
+        height=200,
+        near=0.25,
+        far=50.0,
+    ),
+    "looking_down": look_at(
+        (0.5, 6.0, 0.2), (0.0, 0.0, 0.0), up=(0.0, 0.0, -1.0), fov_y_deg=30.0, width=101, height=77
+    ),
+    "ortho_oblique": look_at(
+        (4.0, 3.0, -4.0),
+        (0.0, 0.5, 0.0),
+        up=(0.2, 1.0, 0.0),
+        projection="orthographic",
+        ortho_height=3.5,
+        width=160,
+        height=90,
+    ),
 }
 
 
@@ -59,8 +74,7 @@ def test_opencv_orthographic_affine_k():
 def test_opencv_round_trip(name):
     cam = CAMERAS[name]
     rvec, tvec, k = convert.camera_to_opencv(cam)
-    back = convert.opencv_to_camera(rvec, tvec, k, cam.width, cam.height, cam.near, cam.far,
-                                    projection=cam.projection)
+    back = convert.opencv_to_camera(rvec, tvec, k, cam.width, cam.height, cam.near, cam.far, projection=cam.projection)
     tol_dir = _rodrigues_tol(rvec, 1.0)
     tol_pos = _rodrigues_tol(rvec, np.abs(cam.position).max())
     np.testing.assert_allclose(back.position, cam.position, rtol=0, atol=tol_pos)
@@ -79,12 +93,12 @@ def test_opencv_round_trip(name):
 def test_opencv_to_camera_rejects_foreign_k():
     rvec, tvec, k = convert.camera_to_opencv(CAMERAS["camera_z"])
     skewed = k.copy()
-    skewed[0, 1] = 0.5                               # skew: no camera of ours has it
+    skewed[0, 1] = 0.5  # skew: no camera of ours has it
     with pytest.raises(ValueError, match="skew"):
         convert.opencv_to_camera(rvec, tvec, skewed, 640, 480, 1.0, 10.0)
     rvec, tvec, k = convert.camera_to_opencv(CAMERAS["ortho_oblique"])
     k = k.copy()
-    k[0, 2] += 3.0                                   # orthographic cameras stay centred
+    k[0, 2] += 3.0  # orthographic cameras stay centred
     with pytest.raises(ValueError, match="principal point"):
         convert.opencv_to_camera(rvec, tvec, k, 160, 90, 1.0, 10.0, projection="orthographic")
 
@@ -92,7 +106,7 @@ def test_opencv_to_camera_rejects_foreign_k():
 def test_opencv_to_camera_off_centre_k_is_calibrated():
     rvec, tvec, k = convert.camera_to_opencv(CAMERAS["camera_z"])
     k = k.copy()
-    k[0, 2] += 3.0                                   # off-centre principal point
+    k[0, 2] += 3.0  # off-centre principal point
     cam = convert.opencv_to_camera(rvec, tvec, k, 640, 480, 1.0, 10.0, dist=(0.1, 0.0, 0.0, 0.0))
     # the K entries are carried over as they are: exact
     assert cam.intrinsics == (k[0, 0], k[1, 1], 322.5, 239.5)
@@ -127,7 +141,7 @@ def test_pyrender_hand_values_camera_z():
 def test_pyrender_orthographic_magnification():
     cam = CAMERAS["ortho_oblique"]
     _, pcam = convert.camera_to_pyrender(cam)
-    assert pcam.ymag == 3.5 / 2                      # halving is exact
+    assert pcam.ymag == 3.5 / 2  # halving is exact
     # xmag = ymag * W / H: the same two roundings in the same order as the
     # expected value, so equal; rel = 1 ulp in case pyrender re-rounds it.
     assert pcam.xmag == pytest.approx(3.5 / 2 * 160 / 90, rel=EPS)
@@ -140,7 +154,7 @@ def test_pyrender_round_trip(name):
     # The pose holds the camera's own unit vectors: no arithmetic, so the only
     # error is Camera re-normalising them (a few ulp).
     np.testing.assert_allclose(pose[:3, :3].T @ pose[:3, :3], np.eye(3), rtol=0, atol=8 * EPS)
-    assert np.linalg.det(pose[:3, :3]) == pytest.approx(1.0, abs=8 * EPS)   # right-handed
+    assert np.linalg.det(pose[:3, :3]) == pytest.approx(1.0, abs=8 * EPS)  # right-handed
     back = convert.pyrender_pose_to_camera(pose, pcam, cam.width, cam.height)
     np.testing.assert_allclose(back.position, cam.position, rtol=0, atol=0)
     for attr in ("forward", "up", "right"):
@@ -150,7 +164,7 @@ def test_pyrender_round_trip(name):
         # fov -> f -> fov through tan and atan: a few ulp of the angle (as above).
         assert back.fov_y_deg == pytest.approx(cam.fov_y_deg, rel=8 * EPS)
     else:
-        assert back.ortho_height == cam.ortho_height      # x / 2 then x 2: exact
+        assert back.ortho_height == cam.ortho_height  # x / 2 then x 2: exact
 
 
 MOTIONS = [
@@ -192,7 +206,7 @@ def test_model_matrix_memo_gives_each_caller_its_own_matrix():
     first = convert.model_matrix((0.0, 0.0, 1.0), (1.0, 2.0, 3.0), 1.0, 0.25)
     first[:] = 0.0
     again = convert.model_matrix((0.0, 0.0, 1.0), (1.0, 2.0, 3.0), 1.0, 0.25)
-    np.testing.assert_array_equal(again[:3, 3], [1.0, 2.0, 3.0])      # the offset, copied exactly
+    np.testing.assert_array_equal(again[:3, 3], [1.0, 2.0, 3.0])  # the offset, copied exactly
     # -0.0 and 0.0 compare equal but are different inputs: each gets its own translation's sign
     neg = convert.model_matrix((0.0, 0.0, 0.0), (-0.0, 0.0, 0.0), 1.0, 0.0)
     pos = convert.model_matrix((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 1.0, 0.0)
@@ -200,6 +214,7 @@ def test_model_matrix_memo_gives_each_caller_its_own_matrix():
 
 
 # ---- OpenGL matrices (the candidate protocol's view_matrix / projection_matrix)
+
 
 def test_gl_hand_values_camera_z():
     # camera_z: at (0, 0, 4) looking down -Z, up +Y: GL eye space is world space shifted by -4 in z
@@ -209,8 +224,7 @@ def test_gl_hand_values_camera_z():
     np.testing.assert_array_equal(view, expected_view)
     # fov 90: f = 1 / tan(45 deg) = 1 (to 1 ulp); aspect 640/480; near 1, far 10
     g = 1.0 / math.tan(math.radians(45.0))
-    expected = np.array([[g * 480 / 640, 0, 0, 0], [0, g, 0, 0],
-                         [0, 0, -11.0 / 9.0, -20.0 / 9.0], [0, 0, -1.0, 0]])
+    expected = np.array([[g * 480 / 640, 0, 0, 0], [0, g, 0, 0], [0, 0, -11.0 / 9.0, -20.0 / 9.0], [0, 0, -1.0, 0]])
     np.testing.assert_allclose(proj, expected, rtol=4 * EPS, atol=0)
 
 

@@ -16,11 +16,10 @@ import sys
 from pathlib import Path
 
 import pytest
-
+from helpers import run_crosscheck
 from wirecheck.core.errors import InputError
 from wirecheck.oracles import cli
 from wirecheck.oracles.references.pyrender_oracle import osmesa_available, select_gl
-from helpers import run_crosscheck
 
 PROBE = Path(__file__).parent / "data" / "gl_probe.py"
 REQUIRED = {"egl": os.environ.get("WIRECHECK_REQUIRE_EGL") == "1"}
@@ -36,8 +35,7 @@ def _env(platform: str) -> dict:
 @functools.cache
 def _probe_answer(platform: str) -> dict:
     """gl_probe.py's JSON on ``platform``, run once per test process (an interpreter that loads pyrender: ~1.5 s)."""
-    proc = subprocess.run([sys.executable, str(PROBE)], env=_env(platform), capture_output=True, text=True,
-                          timeout=120)
+    proc = subprocess.run([sys.executable, str(PROBE)], env=_env(platform), capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout)
 
@@ -107,8 +105,9 @@ def test_every_report_names_the_oracle_gl(tmp_path):
     """report.json, report.md, report.html and the JUnit properties carry what the context says (not a constant)."""
     fresh = probe("osmesa")["fresh"]
     xml = tmp_path / "junit.xml"
-    code, report, out = run_crosscheck(tmp_path, "--scene", "cube", "--frames", "1", "--cases", "on_axis",
-                                       "--junit-xml", str(xml))
+    code, report, out = run_crosscheck(
+        tmp_path, "--scene", "cube", "--frames", "1", "--cases", "on_axis", "--junit-xml", str(xml)
+    )
     assert code == 0
     gl = report["oracle_gl"]
     assert gl == {"platform": "osmesa", **fresh, "samples": 0}
@@ -121,8 +120,9 @@ def test_every_report_names_the_oracle_gl(tmp_path):
 
 @needs_osmesa
 def test_no_gl_is_named_where_none_drew(tmp_path):
-    code, report, out = run_crosscheck(tmp_path, "--scene", "cube", "--frames", "1", "--cases", "on_axis",
-                                       "--level", "vertices")
+    code, report, out = run_crosscheck(
+        tmp_path, "--scene", "cube", "--frames", "1", "--cases", "on_axis", "--level", "vertices"
+    )
     assert code == 0 and report["oracle_gl"] is None
     assert "Oracle GL" not in (out / "report.md").read_text()
 
@@ -132,10 +132,25 @@ def test_crosscheck_on_egl_passes_and_says_egl(tmp_path):
     """The bundled cube through ``crosscheck --gl egl``: every case passes at F1@1px = 1, drawn by EGL."""
     probe("egl")
     out = tmp_path / "r"
-    proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--gl", "egl", "--scene", "cube",
-                           "--frames", "2", "--report-dir", str(out)],
-                          env={k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"},
-                          capture_output=True, text=True, timeout=600)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.oracles.cli",
+            "--gl",
+            "egl",
+            "--scene",
+            "cube",
+            "--frames",
+            "2",
+            "--report-dir",
+            str(out),
+        ],
+        env={k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert proc.returncode == 0, proc.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert report["oracle_gl"]["platform"] == "egl" and report["oracle_gl"]["samples"] == 0
@@ -144,8 +159,7 @@ def test_crosscheck_on_egl_passes_and_says_egl(tmp_path):
 
 
 def test_gl_options_that_cannot_apply_are_usage_errors(tmp_path, capsys):
-    assert cli.main(["--gl", "egl", "--level", "vertices", "--scene", "cube", "--report-dir",
-                     str(tmp_path / "v")]) == 2
+    assert cli.main(["--gl", "egl", "--level", "vertices", "--scene", "cube", "--report-dir", str(tmp_path / "v")]) == 2
     assert "--gl egl with --level vertices" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exc:
         cli.main(["--gl", "glx", "--scene", "cube"])
@@ -166,9 +180,25 @@ def test_no_usable_egl_is_one_line_with_the_install_hint(tmp_path):
     out = tmp_path / "r"
     env = {**os.environ, "__EGL_VENDOR_LIBRARY_FILENAMES": str(tmp_path / "no-vendor.json")}
     env.pop("PYOPENGL_PLATFORM", None)
-    proc = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--gl", "egl", "--scene", "cube",
-                           "--frames", "1", "--report-dir", str(out)], env=env, capture_output=True, text=True,
-                          timeout=120)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.oracles.cli",
+            "--gl",
+            "egl",
+            "--scene",
+            "cube",
+            "--frames",
+            "1",
+            "--report-dir",
+            str(out),
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "no EGL context can be created" in lines[0]

@@ -20,10 +20,8 @@ import os
 
 import numpy as np
 import pytest
-
-from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available
-
 from wirecheck.core.camera import Camera
+from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available
 
 _OK, _WHY = osmesa_available()
 needs_gl = pytest.mark.skipif(not _OK, reason=f"pyrender/OSMesa unavailable: {_WHY}")
@@ -34,7 +32,7 @@ MAX_GROWTH_MB_PER_FRAME = 0.05
 
 def rss_mb() -> float:
     with open("/proc/self/statm") as fh:
-        return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2 ** 20
+        return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
 TETRA = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
@@ -43,8 +41,16 @@ TETRA_FACES = ((0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3))
 
 
 def _camera(w=64, h=48):
-    return Camera(position=(3.0, 2.0, 4.0), forward=(-3.0, -2.0, -4.0), up=(0.0, 1.0, 0.0), width=w, height=h,
-                  near=0.1, far=100.0, fov_y_deg=45.0)
+    return Camera(
+        position=(3.0, 2.0, 4.0),
+        forward=(-3.0, -2.0, -4.0),
+        up=(0.0, 1.0, 0.0),
+        width=w,
+        height=h,
+        near=0.1,
+        far=100.0,
+        fov_y_deg=45.0,
+    )
 
 
 def _pose(k: int) -> np.ndarray:
@@ -58,7 +64,8 @@ def _pose(k: int) -> np.ndarray:
 def test_a_thousand_oracle_frames_grow_memory_by_less_than_0_05_mb_each():
     cam = _camera()
     with PyrenderOracle(cam.width, cam.height) as oracle:
-        def frame(k):       # the three kinds of frame a case draws: lines, hidden lines, filled triangles
+
+        def frame(k):  # the three kinds of frame a case draws: lines, hidden lines, filled triangles
             if k % 3 == 0:
                 return oracle.render(TETRA, TETRA_EDGES, cam, model_matrix=_pose(k))[0]
             if k % 3 == 1:
@@ -71,7 +78,7 @@ def test_a_thousand_oracle_frames_grow_memory_by_less_than_0_05_mb_each():
         before = rss_mb()
         drawn = sum(int(frame(k).sum() > 0) for k in range(60, 1060))
         growth = (rss_mb() - before) / 1000
-        assert drawn == 1000                                  # every frame drew the tetrahedron
+        assert drawn == 1000  # every frame drew the tetrahedron
         # one program per shader variant for the oracle's life, not one per frame
         assert len(oracle._renderer._renderer._program_cache._program_cache) == programs
     assert growth < MAX_GROWTH_MB_PER_FRAME, f"{growth:.3f} MB per frame"
@@ -83,15 +90,17 @@ def test_the_viewer_overlay_grows_memory_by_less_than_0_05_mb_a_request(tmp_path
     from wirecheck.core.app.viewer import Viewer
     from wirecheck.oracles.live import LiveOverlay
 
-    s = settings_from_args(build_parser().parse_args(["--frames", "10", "--width", "96", "--height", "72",
-                                                      "--out", str(tmp_path / "out")]))
+    s = settings_from_args(
+        build_parser().parse_args(["--frames", "10", "--width", "96", "--height", "72", "--out", str(tmp_path / "out")])
+    )
     overlay = LiveOverlay()
     try:
         viewer = Viewer(s, overlay=overlay)
 
         def request(k):
-            return viewer.respond([{"op": "orbit", "dx": 7, "dy": 3}, {"op": "step", "n": 1}],
-                                  want_overlay=True)["overlay"]
+            return viewer.respond([{"op": "orbit", "dx": 7, "dy": 3}, {"op": "step", "n": 1}], want_overlay=True)[
+                "overlay"
+            ]
 
         for k in range(30):
             request(k)
@@ -100,5 +109,5 @@ def test_the_viewer_overlay_grows_memory_by_less_than_0_05_mb_a_request(tmp_path
         growth = (rss_mb() - before) / 300
     finally:
         overlay.close()
-    assert verdicts == ["pass"] * 300                        # a real comparison each time: core agrees
+    assert verdicts == ["pass"] * 300  # a real comparison each time: core agrees
     assert growth < MAX_GROWTH_MB_PER_FRAME, f"{growth:.3f} MB per request"

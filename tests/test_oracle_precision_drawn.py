@@ -20,7 +20,6 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import Camera
 from wirecheck.oracles.references import oracle_precision as op
 from wirecheck.oracles.references.convert import camera_to_gl, centre_of, gl_eye_pose
@@ -34,15 +33,28 @@ def cone(sections=23, across=0.1):
     ring = np.column_stack([0.36 * np.cos(ang), 0.36 * np.sin(ang), np.full(sections, -0.3)])
     v = np.vstack([[0.0, 0.0, 0.3], [0.0, 0.0, -0.3], ring]) * (across / 0.72)
     k = np.arange(sections) + 2
-    edges = np.concatenate([np.column_stack([np.zeros(sections, int), k]), np.column_stack([np.ones(sections, int), k]),
-                            np.column_stack([k, np.roll(k, -1)])])
+    edges = np.concatenate(
+        [
+            np.column_stack([np.zeros(sections, int), k]),
+            np.column_stack([np.ones(sections, int), k]),
+            np.column_stack([k, np.roll(k, -1)]),
+        ]
+    )
     return v, edges
 
 
 def wide_camera(position, near):
     # as the wide_fov case: fov 120 deg, 320 x 240
-    return Camera(position=position, forward=tuple(-np.asarray(position) / np.linalg.norm(position)),
-                  up=(0.0, 1.0, 0.0), width=320, height=240, near=near, far=10.0, fov_y_deg=120.0)
+    return Camera(
+        position=position,
+        forward=tuple(-np.asarray(position) / np.linalg.norm(position)),
+        up=(0.0, 1.0, 0.0),
+        width=320,
+        height=240,
+        near=near,
+        far=10.0,
+        fov_y_deg=120.0,
+    )
 
 
 def _clip_f32(q, pose, proj):
@@ -57,12 +69,12 @@ def _segment_window(ca, cb, width, height, one):
     ``one`` is 1 in the arithmetic used (``np.float32(1)`` or ``Fraction(1)``). Returns the window
     ``[x, y]`` of the drawn ends (None when the segment is wholly behind the near plane).
     """
-    da, db = ca[2] + ca[3], cb[2] + cb[3]            # distance inside the near plane, clip units
+    da, db = ca[2] + ca[3], cb[2] + cb[3]  # distance inside the near plane, clip units
     if da < 0 and db < 0:
         return None
     ends = []
     for c, d, other, d_other in ((ca, da, cb, db), (cb, db, ca, da)):
-        if d < 0:                                     # clipped: the point of the segment on the plane
+        if d < 0:  # clipped: the point of the segment on the plane
             s = d / (d - d_other)
             c = [c[k] + s * (other[k] - c[k]) for k in range(4)]
         half_w, half_h = one * width / 2, one * height / 2
@@ -103,13 +115,13 @@ def test_a_cone_close_to_a_wide_camera_is_bounded_by_its_edges_depths():
     v, edges = cone()
     cam = wide_camera(tuple(np.array([0.2, 0.3, 1.4]) / np.linalg.norm([0.2, 0.3, 1.4]) * 0.07), near=0.004)
     errs, bounds, pose, q = _errors_and_bounds(v, edges, cam)
-    assert len(errs) == len(edges)                        # nothing clipped: every edge in front of near
+    assert len(errs) == len(edges)  # nothing clipped: every edge in front of near
     sphere = op.frame_bound_px(cam, pose, op.mesh_radius(q))
     frame = op.drawn_bound_px(cam, pose, q, edges)
     assert sphere > op.ORACLE_LIMIT_PX >= frame == bounds.max()
     # each edge's float32 error within its own bound (measured: the largest error/bound 0.11)
     assert (errs <= bounds).all(), (errs / bounds).max()
-    assert errs.max() > 0                                 # the float32 model does round: the test can fail
+    assert errs.max() > 0  # the float32 model does round: the test can fail
 
 
 def test_edges_clipped_at_the_near_plane_are_bounded_there():
@@ -121,7 +133,7 @@ def test_edges_clipped_at_the_near_plane_are_bounded_there():
     lin, t = pose[:3, :3], pose[:3, 3]
     depth = -(q @ lin[2] + t[2])
     clipped = [(depth[i] < cam.near) != (depth[j] < cam.near) for i, j in edges if max(depth[i], depth[j]) >= cam.near]
-    assert 0 < sum(clipped) < len(clipped)                # some edges clipped, some not: both kinds checked
+    assert 0 < sum(clipped) < len(clipped)  # some edges clipped, some not: both kinds checked
     assert (errs <= bounds).all(), (errs / bounds).max()
     in_front = np.array(clipped) == 0
     assert bounds[~in_front].min() > bounds[in_front].min()
@@ -135,8 +147,16 @@ def test_random_segments_near_a_wide_camera_stay_within_their_bounds(seed):
     v = rng.uniform(-0.1, 0.1, (120, 3)) + (0.0, 0.0, -0.12)
     edges = rng.integers(0, len(v), (150, 2))
     edges = edges[edges[:, 0] != edges[:, 1]]
-    cam = Camera(position=(0.0, 0.0, 0.0), forward=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0), width=320, height=240,
-                 near=0.03, far=10.0, fov_y_deg=120.0)
+    cam = Camera(
+        position=(0.0, 0.0, 0.0),
+        forward=(0.0, 0.0, -1.0),
+        up=(0.0, 1.0, 0.0),
+        width=320,
+        height=240,
+        near=0.03,
+        far=10.0,
+        fov_y_deg=120.0,
+    )
     errs, bounds, pose, q = _errors_and_bounds(v, edges, cam)
     assert len(errs) > 100
     assert (errs <= bounds).all(), (errs / bounds).max()
@@ -150,11 +170,19 @@ def test_the_drawn_bound_by_hand_and_never_above_the_spheres():
     # Per-vertex term magnitudes |q_j|: (0, 0, 2) and (1, 0, 4); the larger: mag = (1, 0, 4).
     # m_clip x = 0.75 * 1 (P02 = 0 for a centred camera), y = 0, w = 4; nearer end depth 2:
     # x: u 160 (10 * 0.75 + 7 * 4) / 2 + 2 u 320;  y: u 120 (0 + 28) / 2 + 2 u 240
-    u = 2.0 ** -24
+    u = 2.0**-24
     bx = u * 160 * (7.5 + 28) / 2 + 2 * u * 320
     by = u * 120 * 28 / 2 + 2 * u * 240
-    cam = Camera(position=(0.0, 0.0, 0.0), forward=(0.0, 0.0, -1.0), up=(0.0, 1.0, 0.0), width=320, height=240,
-                 near=0.1, far=100.0, fov_y_deg=90.0)
+    cam = Camera(
+        position=(0.0, 0.0, 0.0),
+        forward=(0.0, 0.0, -1.0),
+        up=(0.0, 1.0, 0.0),
+        width=320,
+        height=240,
+        near=0.1,
+        far=100.0,
+        fov_y_deg=90.0,
+    )
     q = np.array([[0.0, 0.0, -2.0], [1.0, 0.0, -4.0]])
     assert op.drawn_bound_px(cam, np.eye(4), q, [[0, 1]]) == pytest.approx(max(bx, by), rel=1e-12)
     # the sphere's bound of the same points is larger: it takes every point as large and as near as any
@@ -164,4 +192,5 @@ def test_the_drawn_bound_by_hand_and_never_above_the_spheres():
     assert op.drawn_bound_px(cam, np.eye(4), q2, [[0, 1], [2, 3]]) == pytest.approx(max(bx, by), rel=1e-12)
     # one that crosses it divides by near, 0.1 instead of 2; its mag (0, 0, 2): x: u 160 (0 + 7 * 2) / 0.1 + 2 u 320
     assert op.drawn_bound_px(cam, np.eye(4), q2, [[0, 1], [0, 2]]) == pytest.approx(
-        u * 160 * 14 / 0.1 + 2 * u * 320, rel=1e-12)
+        u * 160 * 14 / 0.1 + 2 * u * 320, rel=1e-12
+    )

@@ -8,19 +8,24 @@ integers, core.conventions), so a point (x, y, -z) lands on
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import look_at
-from wirecheck.oracles.references import opencv_oracle
 from wirecheck.oracles.candidates.draw import oracle_segments
+from wirecheck.oracles.references import opencv_oracle
 
 CAM = look_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), fov_y_deg=90.0, width=640, height=480, near=1.0, far=10.0)
 
-P_WORLD = np.array([
-    [1.0, 0.0, -2.0], [-1.0, 0.5, -4.0],      # edge 0: both ends inside [near, far]
-    [0.5, 0.0, -0.5], [0.5, 0.0, -3.0],       # edge 1: first end in front of near: cut at depth 1
-    [0.0, 0.0, -0.2], [1.0, 1.0, -0.5],       # edge 2: both in front of near: nothing left
-    [2.0, 0.0, -20.0], [2.0, 0.0, -5.0],      # edge 3: first end beyond far: cut at depth 10
-])
+P_WORLD = np.array(
+    [
+        [1.0, 0.0, -2.0],
+        [-1.0, 0.5, -4.0],  # edge 0: both ends inside [near, far]
+        [0.5, 0.0, -0.5],
+        [0.5, 0.0, -3.0],  # edge 1: first end in front of near: cut at depth 1
+        [0.0, 0.0, -0.2],
+        [1.0, 1.0, -0.5],  # edge 2: both in front of near: nothing left
+        [2.0, 0.0, -20.0],
+        [2.0, 0.0, -5.0],  # edge 3: first end beyond far: cut at depth 10
+    ]
+)
 EDGES = np.array([[0, 1], [2, 3], [4, 5], [6, 7]])
 
 #: by hand from the module docstring's formula; NaN: nothing of the edge in [near, far]
@@ -50,7 +55,7 @@ def test_given_pixels_serve_only_whole_edges():
     """Edges with both ends in [near, far] take the given rows as they are; cut edges are projected anew."""
     p_px = opencv_oracle.project(P_WORLD, CAM)
     marked = p_px.copy()
-    marked[np.isfinite(marked)] += 1000.0         # a shift no projection of these points gives
+    marked[np.isfinite(marked)] += 1000.0  # a shift no projection of these points gives
     p0, p1 = oracle_segments(P_WORLD, EDGES, CAM, marked)
     np.testing.assert_array_equal(p0[0], marked[0])
     np.testing.assert_array_equal(p1[0], marked[1])

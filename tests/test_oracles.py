@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import project_points
@@ -25,11 +24,16 @@ PX_TOL = 16 * EPS * 640
 
 # ---- OpenCV oracle ------------------------------------------------------
 
+
 def test_opencv_hand_values():
-    p_world = np.array([[1.0, 1.0, 0.0],      # depth 4: (319.5 + 60, 239.5 - 60)
-                        [2.0, -1.0, 2.0],     # depth 2: (319.5 + 240, 239.5 + 120)
-                        [0.0, 0.0, -6.0],     # depth 10 = far: the centre
-                        [-3.0, 0.5, 3.0]])    # depth 1 = near: (319.5 - 720, 239.5 - 120)
+    p_world = np.array(
+        [
+            [1.0, 1.0, 0.0],  # depth 4: (319.5 + 60, 239.5 - 60)
+            [2.0, -1.0, 2.0],  # depth 2: (319.5 + 240, 239.5 + 120)
+            [0.0, 0.0, -6.0],  # depth 10 = far: the centre
+            [-3.0, 0.5, 3.0],
+        ]
+    )  # depth 1 = near: (319.5 - 720, 239.5 - 120)
     expected = [[379.5, 179.5], [559.5, 359.5], [319.5, 239.5], [-400.5, 119.5]]
     np.testing.assert_allclose(opencv_oracle.project(p_world, CAM), expected, rtol=0, atol=PX_TOL)
     np.testing.assert_array_equal(opencv_oracle.depth(p_world, CAM), [4.0, 2.0, 10.0, 1.0])
@@ -38,14 +42,19 @@ def test_opencv_hand_values():
 def test_opencv_masks_outside_near_far():
     import cv2
     from wirecheck.oracles.references.convert import camera_to_opencv
-    p_world = np.array([[1.0, 1.0, 8.0],          # behind the camera (depth -4)
-                        [0.0, 0.0, 4.0],          # at the camera (depth 0)
-                        [0.0, 0.0, 3.0],          # exactly on near (depth 1): visible
-                        [0.0, 0.0, np.nextafter(3.0, 4.0)],   # depth 1 - 4.4e-16: before near
-                        [0.0, 0.0, -6.0],         # exactly on far: visible
-                        # depth = 1 ulp of 10 beyond far (z = 4 - that is exact;
-                        # 1 ulp of z = -6 would round back to depth 10)
-                        [0.0, 0.0, 4.0 - np.nextafter(10.0, 11.0)]])
+
+    p_world = np.array(
+        [
+            [1.0, 1.0, 8.0],  # behind the camera (depth -4)
+            [0.0, 0.0, 4.0],  # at the camera (depth 0)
+            [0.0, 0.0, 3.0],  # exactly on near (depth 1): visible
+            [0.0, 0.0, np.nextafter(3.0, 4.0)],  # depth 1 - 4.4e-16: before near
+            [0.0, 0.0, -6.0],  # exactly on far: visible
+            # depth = 1 ulp of 10 beyond far (z = 4 - that is exact;
+            # 1 ulp of z = -6 would round back to depth 10)
+            [0.0, 0.0, 4.0 - np.nextafter(10.0, 11.0)],
+        ]
+    )
     p_px = opencv_oracle.project(p_world, CAM)
     assert np.isnan(p_px[[0, 1, 3, 5]]).all()
     np.testing.assert_allclose(p_px[[2, 4]], [[319.5, 239.5], [319.5, 239.5]], rtol=0, atol=PX_TOL)
@@ -62,8 +71,7 @@ def test_opencv_empty():
 
 
 def test_opencv_orthographic_hand_values():
-    cam = camera_z(4.0, projection="orthographic", ortho_height=2.0, width=640, height=480,
-                   near=0.5, far=10.0)
+    cam = camera_z(4.0, projection="orthographic", ortho_height=2.0, width=640, height=480, near=0.5, far=10.0)
     # s = 480 / 2 = 240 px per unit, independent of depth
     p_world = np.array([[1.0, 1.0, 0.0], [1.0, 1.0, -5.0], [0.5, -0.25, 3.5], [0.0, 0.0, 3.6]])
     expected = [[559.5, -0.5], [559.5, -0.5], [439.5, 299.5], [np.nan, np.nan]]
@@ -73,8 +81,16 @@ def test_opencv_orthographic_hand_values():
 def test_opencv_agrees_with_core_oblique():
     # Not a hand value, a cross-check of two independent codes on a rolled,
     # oblique camera; pixel coordinates up to ~1e3 -> 64 eps * 1e3 px.
-    cam = look_at((3.0, -2.0, 5.0), (0.3, 0.1, -0.2), up=(0.4, 1.0, 0.3), fov_y_deg=47.5,
-                  width=320, height=200, near=0.25, far=50.0)
+    cam = look_at(
+        (3.0, -2.0, 5.0),
+        (0.3, 0.1, -0.2),
+        up=(0.4, 1.0, 0.3),
+        fov_y_deg=47.5,
+        width=320,
+        height=200,
+        near=0.25,
+        far=50.0,
+    )
     p_world = np.random.default_rng(7).uniform(-2, 2, size=(200, 3))
     ours, theirs = project_points(p_world, cam), opencv_oracle.project(p_world, cam)
     np.testing.assert_array_equal(np.isnan(ours), np.isnan(theirs))
@@ -93,7 +109,7 @@ def _dilate(mask):
     p = np.pad(mask, 1)
     for dy in range(3):
         for dx in range(3):
-            out |= p[dy:dy + mask.shape[0], dx:dx + mask.shape[1]]
+            out |= p[dy : dy + mask.shape[0], dx : dx + mask.shape[1]]
     return out
 
 
@@ -119,8 +135,17 @@ def test_pyrender_empty_edges_blank(oracle):
 
 @needs_osmesa
 def test_pyrender_orthographic_lines_follow_closed_form(oracle):
-    cam = look_at((2.0, 1.5, 3.0), (0.0, 0.0, 0.0), up=(0.2, 1.0, 0.0), projection="orthographic",
-                  ortho_height=3.0, width=640, height=480, near=0.5, far=20.0)
+    cam = look_at(
+        (2.0, 1.5, 3.0),
+        (0.0, 0.0, 0.0),
+        up=(0.2, 1.0, 0.0),
+        projection="orthographic",
+        ortho_height=3.0,
+        width=640,
+        height=480,
+        near=0.5,
+        far=20.0,
+    )
     p_world = np.array([[-1.0, -0.7, 0.2], [1.1, 0.4, -0.3], [0.3, 1.2, 0.9], [-0.2, -1.1, -0.8]])
     edges = np.array([[0, 1], [2, 3], [0, 2]])
     p_px = opencv_oracle.project(p_world, cam)
@@ -146,8 +171,7 @@ def test_pyrender_depth_readback(oracle):
     # row ties: y_px = 239.5 - 240 y / depth.
     #   y = 0.31 at depth 3:  239.5 - 24.8      = 214.7   -> row 215
     #   y = -0.5 at depth 7:  239.5 + 17.142857 = 256.64  -> row 257
-    p_world = np.array([[-1.0, 0.31, 1.0], [1.0, 0.31, 1.0],
-                        [-1.0, -0.5, -3.0], [1.0, -0.5, -3.0]])
+    p_world = np.array([[-1.0, 0.31, 1.0], [1.0, 0.31, 1.0], [-1.0, -0.5, -3.0], [1.0, -0.5, -3.0]])
     mask, depth = oracle.render(p_world, np.array([[0, 1], [2, 3]]), CAM)
     col = 320
     assert list(np.nonzero(mask[:, col])[0]) == [215, 257]
@@ -156,20 +180,18 @@ def test_pyrender_depth_readback(oracle):
     # / (2 far near) = depth^2 * 9 / 20 here (~2.6e-6 at depth 7); plus float32
     # rounding of the result (a few eps32 relative).
     for row, d in ((215, 3.0), (257, 7.0)):
-        tol = d * d * (10.0 - 1.0) / (2 * 10.0 * 1.0) * 2.0 ** -23 + 4 * EPS32 * d
+        tol = d * d * (10.0 - 1.0) / (2 * 10.0 * 1.0) * 2.0**-23 + 4 * EPS32 * d
         assert depth[row, col] == pytest.approx(d, abs=tol)
-        assert np.abs(depth[row][mask[row]] - d).max() <= tol     # the whole line
-    assert not depth[~mask].any()                                 # 0 where nothing drawn
+        assert np.abs(depth[row][mask[row]] - d).max() <= tol  # the whole line
+    assert not depth[~mask].any()  # 0 where nothing drawn
 
 
 def _cube_frames():
     w, h = 640, 480
     cams = {
         "front": camera_z(5.0, width=w, height=h),
-        "oblique_roll": look_at((3.0, 2.5, 5.0), (0, 0, 0), up=(0.3, 1.0, 0.1), fov_y_deg=50.0,
-                                width=w, height=h),
-        "ortho": look_at((4.0, 3.0, 4.0), (0, 0, 0), projection="orthographic", ortho_height=4.0,
-                         width=w, height=h),
+        "oblique_roll": look_at((3.0, 2.5, 5.0), (0, 0, 0), up=(0.3, 1.0, 0.1), fov_y_deg=50.0, width=w, height=h),
+        "ortho": look_at((4.0, 3.0, 4.0), (0, 0, 0), projection="orthographic", ortho_height=4.0, width=w, height=h),
     }
     for name, cam in cams.items():
         for k in (1, 4, 7, 11):
@@ -183,7 +205,7 @@ def test_pyrender_cube_matches_core_within_1px(oracle, cam, k):
     m = Motion().frame_matrix(k, 12)
     gl, _ = oracle.render(scene.vertices, scene.edges, cam, model_matrix=m)
     ours = render_frame(scene.vertices, scene.edges, cam, m).image > 0
-    assert gl.sum() > 500 and ours.sum() > 500          # the cube is in view
+    assert gl.sum() > 500 and ours.sum() > 500  # the cube is in view
     # recall@1px: every oracle pixel has a core pixel in its 3x3 neighbourhood;
     # precision@1px: the converse. Both must be exactly 1.
     assert (gl & ~_dilate(ours)).sum() == 0
@@ -210,7 +232,7 @@ def test_pyrender_faces_hide_back_edges(oracle):
     # 24-bit depth buffer (2^-24 of window z) plus 1 unit of quantisation;
     # one unit is depth^2 (far - near) / (far near) 2^-24 = 16 * 999 * 2^-24
     # ~ 9.5e-6 at depth 4 (near 0.1, far 100). Allow 4 units.
-    unit = 16.0 * (100.0 - 0.1) / (100.0 * 0.1) * 2.0 ** -24
+    unit = 16.0 * (100.0 - 0.1) / (100.0 * 0.1) * 2.0**-24
     assert depth[240, 320] == pytest.approx(4.0, abs=4 * unit)
 
 
@@ -224,18 +246,22 @@ def test_opencv_oracle_conversion_cache_follows_the_camera():
     from wirecheck.oracles.references import opencv_oracle
 
     pts = np.array([[0.3, -0.2, 0.1], [-0.5, 0.4, -0.3]])
-    cams = [look_at((0, 0, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=60),
-            look_at((3, 1, 2), (0, 0, 0), (0, 1, 0), fov_y_deg=40, width=320, height=240)]
+    cams = [
+        look_at((0, 0, 4), (0, 0, 0), (0, 1, 0), fov_y_deg=60),
+        look_at((3, 1, 2), (0, 0, 0), (0, 1, 0), fov_y_deg=40, width=320, height=240),
+    ]
 
     def by_hand(cam):
         fwd = -np.asarray(cam.position) / np.linalg.norm(cam.position)
-        right = np.cross(fwd, (0, 1, 0)); right /= np.linalg.norm(right)
+        right = np.cross(fwd, (0, 1, 0))
+        right /= np.linalg.norm(right)
         up = np.cross(right, fwd)
         r = np.stack([right, -up, fwd])
         f = (cam.height / 2) / np.tan(np.radians(cam.fov_y_deg) / 2)
         k = np.array([[f, 0, (cam.width - 1) / 2], [0, f, (cam.height - 1) / 2], [0, 0, 1]])
-        out, _ = cv2.projectPoints(pts.reshape(-1, 1, 3), Rotation.from_matrix(r).as_rotvec(),
-                                   -r @ np.asarray(cam.position), k, np.zeros(5))
+        out, _ = cv2.projectPoints(
+            pts.reshape(-1, 1, 3), Rotation.from_matrix(r).as_rotvec(), -r @ np.asarray(cam.position), k, np.zeros(5)
+        )
         return out.reshape(-1, 2)
 
     for cam in cams + cams[::-1] + cams:
@@ -270,7 +296,7 @@ def test_closing_the_oracle_frees_its_context_without_a_full_collection(monkeypa
     collections = []
     monkeypatch.setattr(gc, "collect", lambda *a: collections.append(a) or 0)
     first.close()
-    assert collections == []                                # no full collection
+    assert collections == []  # no full collection
     # pyrender's order: GL objects, then the context (the platform's __del__ may destroy it again)
     assert freed[:2] == ["delete", "delete_context"]
     assert renderer._platform is None and renderer._renderer is None

@@ -3,7 +3,6 @@
 from pathlib import Path
 
 import pytest
-
 from wirecheck.core.app import cli as renderer_cli
 from wirecheck.core.outputs.output import MARKER
 from wirecheck.oracles import cli as crosscheck_cli
@@ -14,7 +13,7 @@ def test_rerun_replaces_earlier_frames(tmp_path):
     assert renderer_cli.main(args) == 0
     assert renderer_cli.main(["--frames", "2", "--out", str(tmp_path)]) == 0
     frames = sorted(p.name for p in (tmp_path / "cube-frames").iterdir() if p.name != MARKER)
-    assert frames == ["frame_0001.png", "frame_0002.png"]      # the third is gone: a fresh set
+    assert frames == ["frame_0001.png", "frame_0002.png"]  # the third is gone: a fresh set
 
 
 def test_renderer_refuses_a_foreign_frames_dir(tmp_path, capsys):
@@ -36,11 +35,12 @@ def test_crosscheck_refuses_to_replace_user_paths(tmp_path, capsys, make):
     else:
         target.mkdir()
         (target / "important.txt").write_text("keep")
-    code = crosscheck_cli.main(["--report-dir", str(target), "--scene", "cube", "--cases", "on_axis",
-                                "--frames", "1", "--oracles", "opencv"])
+    code = crosscheck_cli.main(
+        ["--report-dir", str(target), "--scene", "cube", "--cases", "on_axis", "--frames", "1", "--oracles", "opencv"]
+    )
     assert code == 2 and capsys.readouterr().err.count("\n") == 1
     assert (target.read_text() if make == "file" else (target / "important.txt").read_text()) == "keep"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["target"]      # no hidden leftovers
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["target"]  # no hidden leftovers
 
 
 def test_crosscheck_replaces_its_own_earlier_report(tmp_path):
@@ -56,10 +56,13 @@ def test_run_name_cannot_leave_reports(run, capsys):
     assert "--run" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("text, needle", [
-    ("name ../../escape\nv 0 0 0\n", "name '../../escape'"),
-    ("name a/b\nv 0 0 0\n", "name 'a/b'"),
-])
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        ("name ../../escape\nv 0 0 0\n", "name '../../escape'"),
+        ("name a/b\nv 0 0 0\n", "name 'a/b'"),
+    ],
+)
 def test_scene_name_cannot_leave_out_dir(tmp_path, capsys, text, needle):
     scene = tmp_path / "s.scene"
     scene.write_text(text)
@@ -90,16 +93,20 @@ def test_closed_stdout_exits_quietly(tmp_path):
     import sys
 
     # `renderer | head -1`: the reader goes away after the first line
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "3", "--out", str(tmp_path)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "wirecheck.core.app.cli", "--frames", "3", "--out", str(tmp_path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     proc.stdout.readline()
     proc.stdout.close()
     err = proc.stderr.read().decode()
     proc.wait()
-    assert "Traceback" not in err and proc.returncode in (0, 141)   # 0 if it finished before the close
+    assert "Traceback" not in err and proc.returncode in (0, 141)  # 0 if it finished before the close
 
 
 # ---- a user's file inside a folder wirecheck wrote (issue 25, item 1) ----------------------------------
+
 
 def _snapshot(folder):
     """Every path under ``folder`` with its bytes (None for a folder, the target for a link)."""
@@ -110,8 +117,7 @@ def _snapshot(folder):
         for n in ds + fs:
             p = os.path.join(d, n)
             rel = os.path.relpath(p, folder)
-            out[rel] = (os.readlink(p) if os.path.islink(p) else None if os.path.isdir(p)
-                        else open(p, "rb").read())
+            out[rel] = os.readlink(p) if os.path.islink(p) else None if os.path.isdir(p) else open(p, "rb").read()
     return out
 
 
@@ -120,8 +126,9 @@ def _render_out(out):
 
 
 def _report(rep):
-    return crosscheck_cli.main(["--report-dir", str(rep), "--scene", "cube", "--cases", "on_axis",
-                                "--frames", "1", "--oracles", "opencv"])
+    return crosscheck_cli.main(
+        ["--report-dir", str(rep), "--scene", "cube", "--cases", "on_axis", "--frames", "1", "--oracles", "opencv"]
+    )
 
 
 def _export(job):
@@ -130,13 +137,29 @@ def _export(job):
 
 def _unprojector_report(rep):
     spec = Path(__file__).parent / "data" / "unprojectors.py"
-    return crosscheck_cli.main(["--unprojector", f"{spec}:correct", "--report-dir", str(rep), "--scene", "cube",
-                                "--cases", "on_axis", "--frames", "1"])
+    return crosscheck_cli.main(
+        [
+            "--unprojector",
+            f"{spec}:correct",
+            "--report-dir",
+            str(rep),
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            "--frames",
+            "1",
+        ]
+    )
 
 
 #: (the command, the folder of ours it wrote, where in it the user's things go)
-KINDS = {"renderer": (_render_out, "cube-frames"), "report": (_report, "."), "export": (_export, "."),
-         "unprojector_report": (_unprojector_report, ".")}
+KINDS = {
+    "renderer": (_render_out, "cube-frames"),
+    "report": (_report, "."),
+    "export": (_export, "."),
+    "unprojector_report": (_unprojector_report, "."),
+}
 
 
 def _plant(folder, how):
@@ -146,11 +169,11 @@ def _plant(folder, how):
     if how == "file":
         (folder / "analysis.md").write_text("my notes")
         return "analysis.md"
-    if how == "nested":                  # into a sub-folder wirecheck made (a report's img/, a job's cameras/)
+    if how == "nested":  # into a sub-folder wirecheck made (a report's img/, a job's cameras/)
         sub = next((p for p in sorted(folder.rglob("*")) if p.is_dir() and not p.name.startswith(".")), folder)
         (sub / "render.sh").write_text("#!/bin/sh\n")
         return str((sub / "render.sh").relative_to(folder))
-    if how == "edited":                  # a file of ours, changed since: the user's now
+    if how == "edited":  # a file of ours, changed since: the user's now
         mine = next(p for p in sorted(folder.rglob("*")) if p.is_file() and not p.name.startswith("."))
         mine.write_bytes(mine.read_bytes() + b"edited")
         return str(mine.relative_to(folder))
@@ -178,7 +201,7 @@ def test_a_users_thing_inside_a_folder_of_ours_is_never_touched(tmp_path, capsys
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err, err
     assert name.rstrip("/") in err and "nothing was changed" in err, err
-    assert _snapshot(tmp_path) == before                 # every byte, every name: no leftovers either
+    assert _snapshot(tmp_path) == before  # every byte, every name: no leftovers either
 
 
 @pytest.mark.parametrize("kind", sorted(KINDS))
@@ -190,7 +213,7 @@ def test_a_rerun_over_our_own_folder_still_replaces_it(tmp_path, kind):
     first = _snapshot(target)
     assert command(target) == 0
     assert sorted(_snapshot(target)) == sorted(first)
-    assert [p.name for p in tmp_path.iterdir()] == ["t"]         # no temporaries, no lock left beside it
+    assert [p.name for p in tmp_path.iterdir()] == ["t"]  # no temporaries, no lock left beside it
 
 
 def test_a_legacy_empty_marker_lists_nothing(tmp_path, capsys):

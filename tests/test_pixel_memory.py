@@ -11,11 +11,10 @@ import tracemalloc
 
 import numpy as np
 import pytest
-
 from wirecheck.oracles.judge import metrics, segment_pixels
 
-W, H = 200, 150          # the image
-EDGES = 3000             # segments across it: ~100 px each, 3,000 x ~100 x ~5 = 1.5M pixel pairs
+W, H = 200, 150  # the image
+EDGES = 3000  # segments across it: ~100 px each, 3,000 x ~100 x ~5 = 1.5M pixel pairs
 
 
 def _soup(seed: int = 37):
@@ -75,11 +74,14 @@ def test_chunked_pairing_gives_the_same_scores(monkeypatch):
     assert _frame_metrics(p0, p1, cand, orac) == whole
 
 
-@pytest.mark.parametrize("limit, weights, cuts", [
-    (5, [2, 2, 2, 2], [(0, 2), (2, 4)]),
-    (5, [9, 1, 1], [(0, 1), (1, 3)]),            # an item over the limit goes alone
-    (5, [], []),
-    (3, [1, 1, 1, 1, 1, 1, 1], [(0, 3), (3, 6), (6, 7)]),
-])
+@pytest.mark.parametrize(
+    "limit, weights, cuts",
+    [
+        (5, [2, 2, 2, 2], [(0, 2), (2, 4)]),
+        (5, [9, 1, 1], [(0, 1), (1, 3)]),  # an item over the limit goes alone
+        (5, [], []),
+        (3, [1, 1, 1, 1, 1, 1, 1], [(0, 3), (3, 6), (6, 7)]),
+    ],
+)
 def test_cuts(limit, weights, cuts):
     assert segment_pixels._cuts(np.array(weights, np.int64), limit) == cuts

@@ -7,7 +7,6 @@ import cv2
 import numpy as np
 import pytest
 from PIL import Image
-
 from wirecheck.core.outputs.output import png_bytes
 
 
@@ -18,7 +17,7 @@ def _line_drawing(h, w, seed):
     return img
 
 
-@pytest.mark.parametrize("h, w", [(480, 640), (7, 13), (1, 1), (3, 9), (5, 8)])   # widths not a multiple of 8 too
+@pytest.mark.parametrize("h, w", [(480, 640), (7, 13), (1, 1), (3, 9), (5, 8)])  # widths not a multiple of 8 too
 def test_bilevel_frame_is_lossless_for_pillow_and_opencv(h, w):
     img = _line_drawing(h, w, seed=h * 1000 + w)
     data = png_bytes(img)
@@ -33,7 +32,7 @@ def test_bilevel_frame_is_lossless_for_pillow_and_opencv(h, w):
 
 def test_grey_levels_keep_8_bit_grey():
     img = _line_drawing(20, 30, seed=1)
-    img[3, 4] = 128                                      # one anti-aliased coverage level
+    img[3, 4] = 128  # one anti-aliased coverage level
     data = png_bytes(img)
     assert struct.unpack(">IIBB", data[16:26]) == (30, 20, 8, 0)
     np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(data))), img)

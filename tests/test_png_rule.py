@@ -15,16 +15,16 @@ import shutil
 import struct
 import zlib
 
-import pytest
-
 import helpers
-from fuzz.png_inputs import chunk, scanlines     # tests/ is on sys.path (rootdir conftest)
+import pytest
+from fuzz.png_inputs import chunk, scanlines  # tests/ is on sys.path (rootdir conftest)
 from wirecheck.oracles import cli as crosscheck_cli
 from wirecheck.oracles.candidates.png_frame import FrameProblem, read_png
 
 
-def png(samples, colour: int, depth: int, width: int, plte=None, trns: bytes | None = None,
-        before_idat: bytes = b"") -> bytes:
+def png(
+    samples, colour: int, depth: int, width: int, plte=None, trns: bytes | None = None, before_idat: bytes = b""
+) -> bytes:
     height = len(samples)
     out = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, depth, colour, 0, 0, 0))
     if plte is not None:
@@ -58,37 +58,100 @@ CASES = {
     # 16-bit grey: high byte >= 128 from 32768; tRNS compares all 16 bits (65534 is not 65535)
     "L16": ([0, 32767, 32768, W16], 0, 16, 4, None, None, [F, F, T, T]),
     "L16 tRNS white": ([0, 32768, W16 - 1, W16], 0, 16, 4, None, grey_key(W16), [F, T, T, F]),
-    "L16 white, tRNS white": ([W16] * 4, 0, 16, 4, None, grey_key(W16), [F] * 4),    # the issue's picture
+    "L16 white, tRNS white": ([W16] * 4, 0, 16, 4, None, grey_key(W16), [F] * 4),  # the issue's picture
     # grey + alpha: 255 x A >= 128 x 255 iff A >= 128; a grey of 127 never (127 x 255 < 128 x 255)
     "LA8": ([255, 127, 255, 128, 127, 255, 128, 255], 4, 8, 4, None, None, [F, T, F, T]),
     "LA16": ([W16, 127 * 257, W16, 32768, 32767, W16, 32768, W16], 4, 16, 4, None, None, [F, T, F, T]),
     # RGB: white L=255, red L = 0.299 x 255 = 76 (< 128), green L = 0.587 x 255 = 150 (>= 128), black 0
     "RGB8": ([255, 255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 0], 2, 8, 4, None, None, [T, F, T, F]),
-    "RGB8 tRNS white": ([255, 255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 0], 2, 8, 4, None, rgb_key(255, 255, 255),
-                        [F, F, T, F]),
+    "RGB8 tRNS white": (
+        [255, 255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 0],
+        2,
+        8,
+        4,
+        None,
+        rgb_key(255, 255, 255),
+        [F, F, T, F],
+    ),
     "RGB16": ([W16, W16, W16, 32767, 32767, 32767, 0, W16, 0, W16, 0, 0], 2, 16, 4, None, None, [T, F, T, F]),
     # 16-bit RGB tRNS: only the exact 16-bit triple is transparent; one differing low byte is opaque white
-    "RGB16 tRNS white": ([W16, W16, W16, W16, W16, W16 - 1, 0, W16, 0, W16 - 256, W16, W16], 2, 16, 4, None,
-                         rgb_key(W16, W16, W16), [F, T, T, T]),
+    "RGB16 tRNS white": (
+        [W16, W16, W16, W16, W16, W16 - 1, 0, W16, 0, W16 - 256, W16, W16],
+        2,
+        16,
+        4,
+        None,
+        rgb_key(W16, W16, W16),
+        [F, T, T, T],
+    ),
     # RGBA: white at alpha 128 drawn, 127 not; opaque green drawn, opaque red not
-    "RGBA8": ([255, 255, 255, 128, 255, 255, 255, 127, 0, 255, 0, 255, 255, 0, 0, 255], 6, 8, 4, None, None,
-              [T, F, T, F]),
-    "RGBA16": ([W16, W16, W16, 32768, W16, W16, W16, 32767, 0, W16, 0, W16, W16, 0, 0, W16], 6, 16, 4, None, None,
-               [T, F, T, F]),
+    "RGBA8": (
+        [255, 255, 255, 128, 255, 255, 255, 127, 0, 255, 0, 255, 255, 0, 0, 255],
+        6,
+        8,
+        4,
+        None,
+        None,
+        [T, F, T, F],
+    ),
+    "RGBA16": (
+        [W16, W16, W16, 32768, W16, W16, W16, 32767, 0, W16, 0, W16, W16, 0, 0, W16],
+        6,
+        16,
+        4,
+        None,
+        None,
+        [T, F, T, F],
+    ),
     # palette: colour by entry; tRNS gives entries' alphas (255 beyond those listed)
     "P1": ([0, 1], 3, 1, 2, [(0, 0, 0), (255, 255, 255)], None, [F, T]),
     "P1 tRNS": ([0, 1], 3, 1, 2, [(0, 0, 0), (255, 255, 255)], bytes([255, 0]), [F, F]),
     "P2": ([0, 1, 2, 3], 3, 2, 4, [(0, 0, 0), (255, 255, 255), (0, 255, 0), (255, 0, 0)], None, [F, T, T, F]),
-    "P2 tRNS": ([0, 1, 2, 3], 3, 2, 4, [(0, 0, 0), (255, 255, 255), (0, 255, 0), (255, 0, 0)], bytes([0, 127]),
-                [F, F, T, F]),
-    "P4": ([0, 1, 15, 2], 3, 4, 4, [(0, 0, 0), (255, 255, 255)] + [(0, 0, 0)] * 13 + [(255, 255, 255)], None,
-           [F, T, T, F]),
-    "P4 tRNS": ([0, 1, 15, 2], 3, 4, 4, [(0, 0, 0), (255, 255, 255)] + [(0, 0, 0)] * 13 + [(255, 255, 255)],
-                bytes([255, 128]), [F, T, T, F]),
-    "P8": ([0, 1, 200, 2], 3, 8, 4, [(0, 0, 0), (255, 255, 255), (0, 255, 0)] + [(255, 255, 255)] * 198, None,
-           [F, T, T, T]),
-    "P8 tRNS": ([0, 1, 200, 2], 3, 8, 4, [(0, 0, 0), (255, 255, 255), (0, 255, 0)] + [(255, 255, 255)] * 198,
-                bytes([0, 0, 128]), [F, F, T, F]),     # green (L 150) at alpha 128: 150 x 128 < 128 x 255
+    "P2 tRNS": (
+        [0, 1, 2, 3],
+        3,
+        2,
+        4,
+        [(0, 0, 0), (255, 255, 255), (0, 255, 0), (255, 0, 0)],
+        bytes([0, 127]),
+        [F, F, T, F],
+    ),
+    "P4": (
+        [0, 1, 15, 2],
+        3,
+        4,
+        4,
+        [(0, 0, 0), (255, 255, 255)] + [(0, 0, 0)] * 13 + [(255, 255, 255)],
+        None,
+        [F, T, T, F],
+    ),
+    "P4 tRNS": (
+        [0, 1, 15, 2],
+        3,
+        4,
+        4,
+        [(0, 0, 0), (255, 255, 255)] + [(0, 0, 0)] * 13 + [(255, 255, 255)],
+        bytes([255, 128]),
+        [F, T, T, F],
+    ),
+    "P8": (
+        [0, 1, 200, 2],
+        3,
+        8,
+        4,
+        [(0, 0, 0), (255, 255, 255), (0, 255, 0)] + [(255, 255, 255)] * 198,
+        None,
+        [F, T, T, T],
+    ),
+    "P8 tRNS": (
+        [0, 1, 200, 2],
+        3,
+        8,
+        4,
+        [(0, 0, 0), (255, 255, 255), (0, 255, 0)] + [(255, 255, 255)] * 198,
+        bytes([0, 0, 128]),
+        [F, F, T, F],
+    ),  # green (L 150) at alpha 128: 150 x 128 < 128 x 255
 }
 
 
@@ -119,14 +182,17 @@ def test_an_animated_png_is_refused_by_its_actl(tmp_path, frames):
     assert str(info.value) == f"an animated PNG of {frames} {plural}: expected one still image (it has an acTL chunk)"
 
 
-@pytest.mark.parametrize("build, needle", [
-    (lambda: png([[0, 5]], 3, 8, 2, plte=[(0, 0, 0), (9, 9, 9)]), "palette index 5 beyond its 2 entries"),
-    (lambda: png([[0, 1]], 3, 8, 2), "a palette image without a PLTE chunk"),
-    (lambda: png([[0, 1]], 0, 8, 2, trns=b"\0"), "tRNS of 1 bytes in a grey image: expected 2"),
-    (lambda: png([[0, 1, 0, 1]], 4, 8, 2, trns=grey_key(1)), "a tRNS chunk in a grey + alpha image"),
-    (lambda: png([[0, 1]], 2, 4, 2), "colour type 2 with bit depth 4: expected one the PNG specification allows"),
-    (lambda: png([[0, 1]], 0, 8, 2, before_idat=chunk(b"ZZ\x1bZ", b"")), "unknown critical chunk"),
-])
+@pytest.mark.parametrize(
+    "build, needle",
+    [
+        (lambda: png([[0, 5]], 3, 8, 2, plte=[(0, 0, 0), (9, 9, 9)]), "palette index 5 beyond its 2 entries"),
+        (lambda: png([[0, 1]], 3, 8, 2), "a palette image without a PLTE chunk"),
+        (lambda: png([[0, 1]], 0, 8, 2, trns=b"\0"), "tRNS of 1 bytes in a grey image: expected 2"),
+        (lambda: png([[0, 1, 0, 1]], 4, 8, 2, trns=grey_key(1)), "a tRNS chunk in a grey + alpha image"),
+        (lambda: png([[0, 1]], 2, 4, 2), "colour type 2 with bit depth 4: expected one the PNG specification allows"),
+        (lambda: png([[0, 1]], 0, 8, 2, before_idat=chunk(b"ZZ\x1bZ", b"")), "unknown critical chunk"),
+    ],
+)
 def test_malformed_pngs_are_one_phrase(tmp_path, build, needle):
     path = tmp_path / "f.png"
     path.write_bytes(build())

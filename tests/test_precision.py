@@ -15,12 +15,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from helpers import run_crosscheck
 from wirecheck.core.camera import look_at
-from wirecheck.oracles.candidates import protocol
 from wirecheck.oracles import tolerances
 from wirecheck.oracles.api import check_projector, failure_text
+from wirecheck.oracles.candidates import protocol
 from wirecheck.oracles.candidates.candidate import case_precision, returned_precision
 from wirecheck.oracles.tolerances import VERTEX_ROUNDINGS, Tolerances, vertex_bound, vertex_scale
 
@@ -39,18 +38,19 @@ def names(case: dict) -> list[str]:
 
 # ---- the precision: inferred, declared ------------------------------------------------
 
+
 def test_returned_precision_is_the_answer_dtype():
     assert returned_precision(np.zeros((2, 2), np.float32)) == "float32"
     assert returned_precision(np.zeros((2, 2), np.float16)) == "float32"
     assert returned_precision(np.zeros((2, 2), np.float64)) == "float64"
-    assert returned_precision([[1.0, 2.0]]) == "float64"               # a list has no dtype: the wire's float64
+    assert returned_precision([[1.0, 2.0]]) == "float64"  # a list has no dtype: the wire's float64
     assert returned_precision(np.zeros((2, 2), np.int64)) == "float64"
 
 
 def test_declared_precision_wins_over_the_returned_one():
     assert case_precision("float64", {"float32"}) == ("float64", "declared")
     assert case_precision("float32", {"float64"}) == ("float32", "declared")
-    assert case_precision(None, {"float64", "float32"}) == ("float32", "returned")   # the coarser one seen
+    assert case_precision(None, {"float64", "float32"}) == ("float32", "returned")  # the coarser one seen
     assert case_precision(None, {"float64"}) == ("float64", "returned")
     assert case_precision(None, set()) == ("float64", "default")
     with pytest.raises(ValueError, match="float16"):
@@ -59,21 +59,22 @@ def test_declared_precision_wins_over_the_returned_one():
 
 # ---- the bound -------------------------------------------------------------------------
 
+
 def test_vertex_bound_by_hand():
     """One point at the origin seen from (0, 0, 5), fov 60, 640x480: the formula of oracles/tolerances.py by hand."""
     cam = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
-    f = 240 / math.tan(math.radians(30))                     # 415.69 px
+    f = 240 / math.tan(math.radians(30))  # 415.69 px
     # u = 0 (the point is at the principal point (319.5, 239.5)); |X| = 0, |C| = 5, z = 5
     scale = f * 5 / 5 + (319.5 + 239.5) + (640 + 480)
     got = vertex_scale(np.zeros((1, 3)), np.array([[319.5, 239.5]]), cam)
     # the same few float64 operations in another order: equal to ~1e-13 relative
     assert got == pytest.approx(scale, rel=1e-12)
-    assert vertex_bound("float32", got) == pytest.approx(VERTEX_ROUNDINGS * 2.0 ** -23 * scale, rel=1e-12)
+    assert vertex_bound("float32", got) == pytest.approx(VERTEX_ROUNDINGS * 2.0**-23 * scale, rel=1e-12)
     # float64: the floor (--tol-px) is the bound, 1e6 x VERTEX_ROUNDINGS eps64 scale ~ 1.9e-12 px; 0 stays 0
     assert vertex_bound("float64", got) == tolerances.VERTEX_TOL_PX
     assert vertex_bound("float64", got, floor=0.0) == 0.0
-    assert vertex_bound("float32", got, floor=1.0) == 1.0          # a larger --tol-px wins
-    assert vertex_scale(np.zeros((1, 3)), np.full((1, 2), np.nan), cam) == 0.0        # nothing visible
+    assert vertex_bound("float32", got, floor=1.0) == 1.0  # a larger --tol-px wins
+    assert vertex_scale(np.zeros((1, 3)), np.full((1, 2), np.nan), cam) == 0.0  # nothing visible
 
 
 def test_float32_bound_sits_between_the_noise_and_the_smallest_fault():
@@ -85,6 +86,7 @@ def test_float32_bound_sits_between_the_noise_and_the_smallest_fault():
 
 
 # ---- verdicts and faults at the vertex level ----------------------------------------
+
 
 def test_correct_float32_projector_passes_every_case():
     report = check_projector(glm_f32.project, isolate=False, frames=4)
@@ -134,11 +136,12 @@ def test_declared_float32_loosens_a_float64_candidate():
     from wirecheck.core.projector.projection import project_points
 
     def off_by_1e5(points, camera):
-        return project_points(points, camera) + 1e-5          # 10x the float64 floor, ~100x below the float32 bound
+        return project_points(points, camera) + 1e-5  # 10x the float64 floor, ~100x below the float32 bound
 
     assert check_projector(off_by_1e5, isolate=False, frames=2, scenes=["cube"])["verdict"] == "fail"
-    assert check_projector(off_by_1e5, isolate=False, frames=2, scenes=["cube"],
-                           precision="float32")["verdict"] == "pass"
+    assert (
+        check_projector(off_by_1e5, isolate=False, frames=2, scenes=["cube"], precision="float32")["verdict"] == "pass"
+    )
 
 
 def test_precision_travels_over_the_protocol():
@@ -149,9 +152,11 @@ def test_precision_travels_over_the_protocol():
 
 
 def test_reply_precision_field():
-    assert json.loads(protocol.encode_reply(np.zeros((1, 2)), "float32").split(b"\n")[0]) == \
-        {"n": 1, "precision": "float32"}
-    assert protocol.encode_reply(np.zeros((1, 2))).split(b"\n")[0] == b'{"n": 1}'     # float64: as before
+    assert json.loads(protocol.encode_reply(np.zeros((1, 2)), "float32").split(b"\n")[0]) == {
+        "n": 1,
+        "precision": "float32",
+    }
+    assert protocol.encode_reply(np.zeros((1, 2))).split(b"\n")[0] == b'{"n": 1}'  # float64: as before
     assert protocol.reply_precision(b'{"n": 1}\n') == "float64"
     with pytest.raises(protocol.ProtocolError, match="precision"):
         protocol.reply_precision(b'{"n": 1, "precision": "float16"}\n')
@@ -164,6 +169,7 @@ def test_api_rejects_an_unknown_precision():
 
 # ---- the CLI ---------------------------------------------------------------------------
 
+
 def test_cli_core_float32_passes_and_reports_its_precision(tmp_path, capsys):
     code, report, run_dir = run_crosscheck(tmp_path, "--dtype", "float32", "--level", "vertices", "--frames", "2")
     out = capsys.readouterr().out
@@ -174,12 +180,25 @@ def test_cli_core_float32_passes_and_reports_its_precision(tmp_path, capsys):
 
 
 def test_cli_declared_precision(tmp_path, capsys):
-    code, report, _ = run_crosscheck(tmp_path, "--candidate", GLM + ":project", "--candidate-precision", "float64",
-                                     "--level", "vertices", "--frames", "2", "--scene", "cube", "--cases", "on_axis")
+    code, report, _ = run_crosscheck(
+        tmp_path,
+        "--candidate",
+        GLM + ":project",
+        "--candidate-precision",
+        "float64",
+        "--level",
+        "vertices",
+        "--frames",
+        "2",
+        "--scene",
+        "cube",
+        "--cases",
+        "on_axis",
+    )
     out = capsys.readouterr().out
     assert code == 1, out
     assert "precision_limited" in out and "float64 (declared; returned float32)" in out
-    with pytest.raises(SystemExit) as exc:           # argparse: one line, exit 2
+    with pytest.raises(SystemExit) as exc:  # argparse: one line, exit 2
         run_crosscheck(tmp_path, "--candidate-precision", "half", name="bad")
     assert exc.value.code == 2
     err = capsys.readouterr().err
@@ -187,6 +206,7 @@ def test_cli_declared_precision(tmp_path, capsys):
 
 
 # ---- the pixel level: near-plane ends ----------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def pixels_available():
@@ -221,7 +241,7 @@ def test_clipped_ends_survive_a_float32_depth_test(monkeypatch):
     p0, p1, cam = _near_plane_crossings()
     d0, d1 = opencv_oracle.depth(p0, cam), opencv_oracle.depth(p1, cam)
     crossing = int(np.sum((d0 < cam.near) != (d1 < cam.near)))
-    assert crossing >= 3                                      # the case does cross the near plane
+    assert crossing >= 3  # the case does cross the near plane
     _, ends = draw.clip_depth(p0, p1, cam, "float32")
     assert _float32_near_rejects(ends, cam) == 0
     # the old nudge (1e-9 of the segment, below float32 resolution) loses ends to the float32 test
@@ -239,15 +259,16 @@ def test_correct_float32_projector_passes_every_case_at_the_pixel_level(pixels_a
 def test_old_near_plane_nudge_fails_a_correct_float32_projector(pixels_available, monkeypatch):
     """Break on purpose: the 1e-9 nudge alone drops near-plane edges of a correct float32 projector
     (neither the precision's depth margin nor the probed planes' slack, oracles.diagnosis.clip_planes)."""
-    from wirecheck.oracles.diagnosis import clip_planes
     from wirecheck.oracles.candidates import draw
+    from wirecheck.oracles.diagnosis import clip_planes
 
     monkeypatch.setattr(draw, "depth_margin", lambda p, camera, precision: np.zeros(len(p)))
     monkeypatch.setattr(clip_planes, "depth_slack", lambda planes, camera: (0.0, None))
-    report = check_projector(glm_f32.project, isolate=False, frames=2, oracles=("opencv", "pyrender"),
-                             cases=["near_plane"])
+    report = check_projector(
+        glm_f32.project, isolate=False, frames=2, oracles=("opencv", "pyrender"), cases=["near_plane"]
+    )
     assert report["verdict"] == "fail"
-    assert all(c["pixel_f1_1px"] < 0.9 for c in report["cases"])      # measured 0.59-0.82
+    assert all(c["pixel_f1_1px"] < 0.9 for c in report["cases"])  # measured 0.59-0.82
 
 
 def test_config_key_candidate_precision(tmp_path):
@@ -264,8 +285,8 @@ def test_config_key_candidate_precision(tmp_path):
 
 def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
     """A vertex on the near plane (to float32 rounding) clipped by the float32 candidate only is not a failure."""
-    from wirecheck.core.scene.model import Scene
     from wirecheck.core.scene.files import load_scene
+    from wirecheck.core.scene.model import Scene
     from wirecheck.oracles.cases import cameras_for
 
     cube = load_scene("cube")
@@ -278,7 +299,7 @@ def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
 
     def clips_the_tie(points, camera):
         out = glm_f32.project(points, camera)
-        out[np.all(np.abs(points - tie) < 1e-12, axis=1)] = np.nan     # its rounding went the other way
+        out[np.all(np.abs(points - tie) < 1e-12, axis=1)] = np.nan  # its rounding went the other way
         return out
 
     kwargs = dict(isolate=False, scenes=[scene], frames=1, cases=["near_plane"], turns=(0, 0, 0))
@@ -293,8 +314,8 @@ def test_a_point_on_the_near_plane_may_go_either_way_in_float32():
 def test_scale_batch_is_the_largest_frame_scale(limit):
     """A case measures its frames' vertex scales together (oracles.judge.case.ScaleBatch): the largest of
     the frames' own scales, whether it measures each frame alone, a few together or all at the end."""
-    from wirecheck.oracles.references import opencv_oracle
     from wirecheck.oracles.judge.case import ScaleBatch
+    from wirecheck.oracles.references import opencv_oracle
 
     rng = np.random.default_rng(11)
     cam = look_at((0.0, 1.0, 6.0), (0.0, 0.0, 0.0), fov_y_deg=60.0, width=320, height=240, near=0.5, far=40.0)
@@ -312,6 +333,6 @@ def test_float64_bound_is_its_own_rounding_where_that_exceeds_the_floor():
     # Scale 1e4 px (an ordinary scene): 8.9e-12 px, five orders under the 1e-6 floor: the floor.
     # Scale 1e12 px (a 1e-2 mesh 5e4 from the origin, seen from 0.1 away): 8.9e-4 px, the bound.
     assert vertex_bound("float64", 1e4) == tolerances.VERTEX_TOL_PX
-    assert vertex_bound("float64", 1e12) == pytest.approx(4 * 2.0 ** -52 * 1e12, rel=1e-15)
-    assert vertex_bound("float64", 1e12, floor=0.0) == 0.0      # --tol-px 0: any error fails
-    assert vertex_bound("float64", 1e12, floor=1e-9) == 1e-9    # a --tol-px given is the bound
+    assert vertex_bound("float64", 1e12) == pytest.approx(4 * 2.0**-52 * 1e12, rel=1e-15)
+    assert vertex_bound("float64", 1e12, floor=0.0) == 0.0  # --tol-px 0: any error fails
+    assert vertex_bound("float64", 1e12, floor=1e-9) == 1e-9  # a --tol-px given is the bound

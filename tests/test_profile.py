@@ -4,24 +4,22 @@ import json
 
 import numpy as np
 import pytest
+from helpers import run_renderer as run
 from numpy.testing import assert_array_equal
-
-from wirecheck.core.camera import camera_z
-from wirecheck.core.projector.pipeline import STAGES as PIPELINE_STAGES, render_frame
 from wirecheck.core.app.profile import STAGES, FrameProfiler, profile_table
+from wirecheck.core.camera import camera_z
+from wirecheck.core.projector.pipeline import STAGES as PIPELINE_STAGES
+from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
-from helpers import run_renderer as run
 
-
-MODES = {"wireframe": {}, "hidden": {"hidden_lines": True}, "cull": {"cull": "backface"},
-         "shaded": {"style": "shaded"}}
+MODES = {"wireframe": {}, "hidden": {"hidden_lines": True}, "cull": {"cull": "backface"}, "shaded": {"style": "shaded"}}
 
 
 @pytest.mark.parametrize("mode", MODES)
 def test_timing_changes_no_pixel_and_times_the_stages_that_ran(mode):
     cube = load_scene("cube")
-    cam = camera_z(2.5, near=1.2)                   # the near plane cuts the cube: the clip stage runs
+    cam = camera_z(2.5, near=1.2)  # the near plane cuts the cube: the clip stage runs
     m = Motion().frame_matrix(7, 24)
     kw = dict(faces=cube.faces, **MODES[mode]) if MODES[mode] else {}
     plain = render_frame(cube.vertices, cube.edges, cam, m, **kw)
@@ -29,8 +27,12 @@ def test_timing_changes_no_pixel_and_times_the_stages_that_ran(mode):
     timed = render_frame(cube.vertices, cube.edges, cam, m, timing=timing, **kw)
     assert_array_equal(timed.image, plain.image)
     assert_array_equal(timed.p_px, plain.p_px)
-    ran = {"wireframe": {"transform", "faces", "clip", "raster"}, "hidden": {"transform", "faces", "clip", "raster"},
-           "cull": {"transform", "faces", "clip", "raster"}, "shaded": {"transform", "faces", "shading"}}[mode]
+    ran = {
+        "wireframe": {"transform", "faces", "clip", "raster"},
+        "hidden": {"transform", "faces", "clip", "raster"},
+        "cull": {"transform", "faces", "clip", "raster"},
+        "shaded": {"transform", "faces", "shading"},
+    }[mode]
     assert set(timing) == ran
     assert set(timing) <= set(PIPELINE_STAGES)
     assert all(v > 0 for v in timing.values())
@@ -41,7 +43,7 @@ def test_timing_accumulates_over_calls(monkeypatch):
     # ticks whatever the machine's load, so three frames' must be three times one's
     from wirecheck.core.projector import pipeline
 
-    ticks = iter(range(10 ** 6))
+    ticks = iter(range(10**6))
     monkeypatch.setattr(pipeline, "_clock", lambda: float(next(ticks)))
     cube = load_scene("cube")
     timing = {}
@@ -84,7 +86,7 @@ def test_profiler_window_keeps_the_last_frames():
         prof.begin()
         prof.add("a", ms * 1e-3)
         prof.end(total=ms * 1e-3)
-    assert prof.summary()["stages"]["a"]["mean_ms"] == pytest.approx(2.5)   # frames 2 and 3
+    assert prof.summary()["stages"]["a"]["mean_ms"] == pytest.approx(2.5)  # frames 2 and 3
 
 
 def test_renderer_profile_table_and_report(tmp_path):

@@ -13,7 +13,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
-
 from wirecheck.core.camera import Camera, camera_z, look_at
 from wirecheck.core.projector.projection import cam_to_px, depth_mask, project_points, world_to_cam
 from wirecheck.core.transforms import apply, rotate_y, rotate_z
@@ -23,6 +22,7 @@ SQRT2, SQRT3, SQRT6 = math.sqrt(2.0), math.sqrt(3.0), math.sqrt(6.0)
 
 
 # ---- naive reference ---------------------------------------------------------------
+
 
 def _sub(a, b):
     return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -47,8 +47,9 @@ def naive_basis(pos, target, up):
     return right, _cross(right, fwd), fwd
 
 
-def naive_project(points, pos, target, up, fov_y_deg, width, height, near, far,
-                  projection="perspective", ortho_height=2.0):
+def naive_project(
+    points, pos, target, up, fov_y_deg, width, height, near, far, projection="perspective", ortho_height=2.0
+):
     """Per-point loop: returns a list of (x_px, y_px) or (nan, nan), and the camera coords."""
     right, upv, fwd = naive_basis(pos, target, up)
     cx, cy = (width - 1) / 2.0, (height - 1) / 2.0
@@ -101,6 +102,7 @@ def random_camera_and_points(rng, n=200, near=0.1, far=100.0):
 
 # ---- the seed's thinking exercise --------------------------------------------------
 
+
 def seed_camera():
     # Camera at the origin looking down +Z, up +Y, 640x480, fov_y 120 deg:
     # forward = +Z, right = forward x up = (+Z) x (+Y) = -X, up = +Y,
@@ -129,8 +131,7 @@ def test_seed_points_rotated_45_about_y_pixels():
     # point 2: x/z = -9/7, y/z = sqrt2/7
     #   x_px = 319.5 - 720 sqrt3/7                                  ~ 141.35
     #   y_px = 239.5 - 80 sqrt6/7                                   ~ 211.51
-    expected = [[319.5 - 400 / SQRT3, 239.5 - 80 * SQRT6 / 3],
-                [319.5 - 720 * SQRT3 / 7, 239.5 - 80 * SQRT6 / 7]]
+    expected = [[319.5 - 400 / SQRT3, 239.5 - 80 * SQRT6 / 3], [319.5 - 720 * SQRT3 / 7, 239.5 - 80 * SQRT6 / 7]]
     # x/z carries ~6 EPS relative error, times f|x/z| <= 240, plus cx + ...: 6 EPS * 320 ~ 4e-13
     assert_allclose(px, expected, rtol=0, atol=1e-12)
 
@@ -165,6 +166,7 @@ def test_perspective_shrink_by_depth_ratio_unrotated():
 
 # ---- naive reference on random input -----------------------------------------------
 
+
 @pytest.mark.parametrize("seed", range(20))
 def test_project_points_matches_naive_reference(seed):
     rng = np.random.default_rng(seed)
@@ -176,7 +178,7 @@ def test_project_points_matches_naive_reference(seed):
     want, cams, f = naive_project(pts.tolist(), pos.tolist(), target.tolist(), up.tolist(), fov, w, h, 0.1, 100.0)
     assert_array_equal(np.isnan(got), np.isnan(want))
     vis = ~np.isnan(want[:, 0])
-    assert vis.sum() > 10 and (~vis).sum() > 0   # both branches exercised
+    assert vis.sum() > 10 and (~vis).sum() > 0  # both branches exercised
     tol = px_tolerance(cams[vis], pts[vis], pos, f, w)
     assert np.all(np.abs(got[vis] - want[vis]) <= tol[:, None])
 
@@ -186,14 +188,14 @@ def test_project_points_matches_naive_reference(seed):
 def test_single_point_matches_formula_hypothesis(x, y, z):
     # camera_z(D=0 is invalid) -> camera at (0,0,200) looking at origin: p_cam = (x, y, 200 - z_w)
     c = camera_z(200.0, fov_y_deg=60.0, width=640, height=480, near=0.1, far=100.0)
-    (xp, yp), = project_points([[x, y, 200.0 - z]], c)
+    ((xp, yp),) = project_points([[x, y, 200.0 - z]], c)
     f = 240.0 * SQRT3
     # 200 - (200 - z) may differ from z by ulp(200)/2 = 1.4e-14 absolute: relative
     # 1.4e-14/z <= 1.4e-13 at z = 0.1; the pixel offset f|x|/z <= 416*50/0.1 = 2e5,
     # so tol = 2e5 * (1.4e-14/z_rel + 6 EPS) -> bound computed per point:
     off_x, off_y = f * x / z, f * y / z
     rel = 1.5e-14 / z + 6 * EPS
-    if 200.0 - (200.0 - z) < 0.1:   # rounding pushed the depth below near: clipped
+    if 200.0 - (200.0 - z) < 0.1:  # rounding pushed the depth below near: clipped
         assert math.isnan(xp)
         return
     assert abs(xp - (319.5 + off_x)) <= abs(off_x) * rel + 4 * EPS * 320
@@ -201,6 +203,7 @@ def test_single_point_matches_formula_hypothesis(x, y, z):
 
 
 # ---- orthographic ------------------------------------------------------------------
+
 
 def test_orthographic_scale_is_height_over_ortho_height():
     c = camera_z(10.0, projection="orthographic", ortho_height=4.0, width=640, height=480, near=0.1, far=100.0)
@@ -215,11 +218,13 @@ def test_orthographic_scale_is_height_over_ortho_height():
 def test_orthographic_matches_naive():
     rng = np.random.default_rng(7)
     pos, target, up, pts = random_camera_and_points(rng, near=-5.0, far=50.0)
-    c = look_at(pos, target, up, projection="orthographic", ortho_height=3.0, width=320, height=200,
-                near=-5.0, far=50.0)
+    c = look_at(
+        pos, target, up, projection="orthographic", ortho_height=3.0, width=320, height=200, near=-5.0, far=50.0
+    )
     got = project_points(pts, c)
-    want, cams, _ = naive_project(pts.tolist(), pos.tolist(), target.tolist(), up.tolist(), 60.0, 320, 200,
-                                  -5.0, 50.0, "orthographic", 3.0)
+    want, cams, _ = naive_project(
+        pts.tolist(), pos.tolist(), target.tolist(), up.tolist(), 60.0, 320, 200, -5.0, 50.0, "orthographic", 3.0
+    )
     assert_array_equal(np.isnan(got), np.isnan(want))
     vis = ~np.isnan(want[:, 0])
     # s = 200/3 ~ 67; camera coordinates err <= 8 EPS (|p| + |pos|) <= 8 EPS * 300 = 5.3e-13;
@@ -229,14 +234,15 @@ def test_orthographic_matches_naive():
 
 # ---- depth -------------------------------------------------------------------------
 
+
 def test_depth_monotonicity():
     c = camera_z(10.0, fov_y_deg=60.0, near=0.5, far=100.0)
-    cx, cy = CX, CY                                 # 640 x 480 (camera_z's default)
-    f = 240.0 * SQRT3                               # (480 / 2) / tan(30 deg)
-    zw = np.linspace(9.5, -80.0, 60)              # depth D - z from 0.5 to 90, increasing
+    cx, cy = CX, CY  # 640 x 480 (camera_z's default)
+    f = 240.0 * SQRT3  # (480 / 2) / tan(30 deg)
+    zw = np.linspace(9.5, -80.0, 60)  # depth D - z from 0.5 to 90, increasing
     pts = np.column_stack([np.ones_like(zw), np.ones_like(zw), zw])
     depth = world_to_cam(pts, c)[:, 2]
-    assert_array_equal(depth, 10.0 - zw)           # translation by exact 10, signs exact
+    assert_array_equal(depth, 10.0 - zw)  # translation by exact 10, signs exact
     assert np.all(np.diff(depth) > 0)
     px = project_points(pts, c)
     off = px[:, 0] - cx
@@ -254,9 +260,9 @@ def test_rotation_about_optical_axis_keeps_distance_to_principal_point(deg):
     # a circle of radius f/4 about (cx, cy), counter-clockwise on screen:
     # (cx + r cos theta, cy - r sin theta).
     c = camera_z(4.0, fov_y_deg=70.0)
-    cx, cy = CX, CY                                 # 640 x 480 (camera_z's default)
+    cx, cy = CX, CY  # 640 x 480 (camera_z's default)
     th = math.radians(deg)
-    (x, y), = project_points(apply(rotate_z(th), [[1.0, 0.0, 0.0]]), c)
+    ((x, y),) = project_points(apply(rotate_z(th), [[1.0, 0.0, 0.0]]), c)
     r = 240.0 / math.tan(math.radians(35.0)) / 4.0  # f = (480 / 2) / tan(70 deg / 2), at depth 4
     # cos/sin rounding EPS times r ~ 86, plus cx rounding: 4 EPS * 320
     assert_allclose([x, y], [cx + r * math.cos(th), cy - r * math.sin(th)], rtol=0, atol=4 * EPS * 320)
@@ -264,15 +270,18 @@ def test_rotation_about_optical_axis_keeps_distance_to_principal_point(deg):
 
 # ---- visibility ----------------------------------------------------------------------
 
+
 def test_visibility_near_and_far_inclusive():
     c = camera_z(10.0, near=1.0, far=20.0)
     # p_cam z = 10 - z_world, exact for these values
-    pts = [[0.1, 0.1, 9.0],        # z = near exactly: visible
-           [0.1, 0.1, 9.5],        # z = 0.5 < near: clipped
-           [0.1, 0.1, -10.0],      # z = far exactly: visible
-           [0.1, 0.1, -10.5],      # z = 20.5 > far: clipped
-           [0.1, 0.1, 10.0],       # z = 0: clipped (never divided by)
-           [0.1, 0.1, 11.0]]       # behind: clipped
+    pts = [
+        [0.1, 0.1, 9.0],  # z = near exactly: visible
+        [0.1, 0.1, 9.5],  # z = 0.5 < near: clipped
+        [0.1, 0.1, -10.0],  # z = far exactly: visible
+        [0.1, 0.1, -10.5],  # z = 20.5 > far: clipped
+        [0.1, 0.1, 10.0],  # z = 0: clipped (never divided by)
+        [0.1, 0.1, 11.0],
+    ]  # behind: clipped
     px = project_points(pts, c)
     assert_array_equal(np.isnan(px).all(axis=1), [False, True, False, True, True, True])
     assert_array_equal(np.isnan(px).any(axis=1), np.isnan(px).all(axis=1))
@@ -285,6 +294,7 @@ def test_project_points_accepts_empty_input():
 
 
 # ---- extremes ----------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("fov", [1e-3, 179.9])
 @pytest.mark.parametrize("seed", range(3))
@@ -306,8 +316,9 @@ def test_extreme_fov_finite_and_matching_naive(fov, seed):
 def test_coordinate_scales(s):
     # camera at the origin looking down +Z: p_cam = (-x, y, z) exactly; perspective is
     # scale invariant: pixels of s*P equal pixels of P.
-    c = Camera(position=(0, 0, 0), forward=(0, 0, 1), up=(0, 1, 0), fov_y_deg=60.0, width=640, height=480,
-               near=1e-7, far=1e8)
+    c = Camera(
+        position=(0, 0, 0), forward=(0, 0, 1), up=(0, 1, 0), fov_y_deg=60.0, width=640, height=480, near=1e-7, far=1e8
+    )
     rng = np.random.default_rng(5)
     p = np.column_stack([rng.uniform(-1, 1, (50, 2)), rng.uniform(1, 10, 50)])
     base = project_points(p, c)
@@ -328,6 +339,7 @@ def test_cam_to_px_perspective_formula_direct():
 
 
 # ---- localize: far-off models are re-centred ------------------------------------------
+
 
 def test_localize_recentres_a_model_far_from_its_origin():
     from wirecheck.core.projector.projection import localize
@@ -350,9 +362,9 @@ def test_float32_pixels_are_the_plain_float32_expressions():
     # every operation rounded to float32. The naive float32 numpy expressions give the same bits.
     from wirecheck.core.camera import camera_z
 
-    c = camera_z(4.0, fov_y_deg=60.0)                    # 640 x 480
+    c = camera_z(4.0, fov_y_deg=60.0)  # 640 x 480
     p = np.random.default_rng(3).uniform([-2, -2, 0.5], [2, 2, 9], size=(200, 3)).astype(np.float32)
-    f32 = np.float32(240.0 * SQRT3)                      # (480 / 2) / tan(30 deg), rounded to float32
+    f32 = np.float32(240.0 * SQRT3)  # (480 / 2) / tan(30 deg), rounded to float32
     inv_z = np.float32(1.0) / p[:, 2]
     want_x = (p[:, 0] * f32) * inv_z + np.float32(CX)
     want_y = np.float32(CY) - (p[:, 1] * f32) * inv_z

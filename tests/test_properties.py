@@ -27,19 +27,28 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import project_points, unproject
 from wirecheck.core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z
+from wirecheck.oracles.extremes import (
+    EPS,
+    EPS64,
+    LD,
+    REFERENCE_EXTENDED,
+    camera_error,
+    opencv_camera_error,
+    pixel_bound,
+    reference_project,
+    reference_world,
+)
 from wirecheck.oracles.references import opencv_oracle
 from wirecheck.oracles.references.convert import model_matrix as scipy_model_matrix
-from wirecheck.oracles.extremes import (EPS, EPS64, LD, REFERENCE_EXTENDED, camera_error, opencv_camera_error,
-                              pixel_bound, reference_project, reference_world)
 
 # The bounds are evaluated at a long-double reference: it must be wider than float64.
-needs_extended = pytest.mark.skipif(not REFERENCE_EXTENDED,
-                                    reason="np.longdouble is plain float64 here: no extended-precision reference")
+needs_extended = pytest.mark.skipif(
+    not REFERENCE_EXTENDED, reason="np.longdouble is plain float64 here: no extended-precision reference"
+)
 
 DTYPE = st.sampled_from(["float64", "float32"])
 
@@ -51,9 +60,18 @@ def random_camera(rng, fov, width, height, distance, ortho, target):
     fwd = np.asarray(target) - position
     if np.linalg.norm(np.cross(fwd, up)) < 1e-3 * np.linalg.norm(fwd) * np.linalg.norm(up):
         up = np.cross(fwd, [1.0, 0.0, 0.0]) + [0.0, 0.0, 1.0]
-    return look_at(position, target, up, fov_y_deg=fov, width=width, height=height,
-                   near=0.01 * distance, far=3 * distance,
-                   projection="orthographic" if ortho else "perspective", ortho_height=distance)
+    return look_at(
+        position,
+        target,
+        up,
+        fov_y_deg=fov,
+        width=width,
+        height=height,
+        near=0.01 * distance,
+        far=3 * distance,
+        projection="orthographic" if ortho else "perspective",
+        ortho_height=distance,
+    )
 
 
 def near_band(ref_cam, camera, e, eps):
@@ -77,13 +95,15 @@ def assert_agrees_with_opencv(cand_px, p_world, camera, e_core, eps_core, ref):
     both = vis_c & vis_o
     if not both.any():
         return
-    bound = (pixel_bound(ref_cam, ref_px, camera, e_core, eps_core)
-             + pixel_bound(ref_cam, ref_px, camera, e_cv, EPS64))[both]
+    bound = (
+        pixel_bound(ref_cam, ref_px, camera, e_core, eps_core) + pixel_bound(ref_cam, ref_px, camera, e_cv, EPS64)
+    )[both]
     err = np.hypot(*(cand_px[both] - cv_px[both]).T)
     assert np.all(err <= bound), float((err / bound).max())
 
 
 # ---- 1a: project_points (world path), both dtypes, points possibly far from the origin ----
+
 
 @needs_extended
 @settings(max_examples=120, deadline=None)
@@ -99,7 +119,7 @@ def assert_agrees_with_opencv(cand_px, p_world, camera, e_core, eps_core, ref):
 )
 def test_project_points_matches_opencv(seed, fov, width, height, distance, far_away, ortho, dtype):
     rng = np.random.default_rng(seed)
-    target = far_away * rng.normal(size=3) / math.sqrt(3)       # the scene may sit ~1e8 from the origin
+    target = far_away * rng.normal(size=3) / math.sqrt(3)  # the scene may sit ~1e8 from the origin
     cam = random_camera(rng, fov, width, height, distance, ortho, target)
     pts = target + rng.uniform(-1, 1, (200, 3)) * distance
     ref = reference_project(pts, cam)
@@ -112,6 +132,7 @@ def test_project_points_matches_opencv(seed, fov, width, height, distance, far_a
 
 
 # ---- 1b: render_frame's model-view path with a random model matrix, both dtypes ----
+
 
 @needs_extended
 @settings(max_examples=120, deadline=None)
@@ -146,6 +167,7 @@ def test_render_frame_model_view_matches_opencv(seed, fov, size, radius, far_awa
 
 # ---- 2: project then unproject at the known depth ----
 
+
 @needs_extended
 @settings(max_examples=150, deadline=None)
 @given(
@@ -167,7 +189,7 @@ def test_unproject_inverts_project(seed, fov, width, height, distance, far_away,
     vis = ~np.isnan(px[:, 0]) & ref_vis
     if not vis.any():
         return
-    z = ref_cam[vis, 2].astype(np.float64)                 # the known depth (exact to u |z|)
+    z = ref_cam[vis, 2].astype(np.float64)  # the known depth (exact to u |z|)
     back = unproject(px[vis], z, cam)
     # Derivation. Projection leaves the pixel within B_px (pixel_bound). Unprojection
     # maps a pixel error to a lateral one times k = z / f (orthographic: 1 / s); its
@@ -181,8 +203,11 @@ def test_unproject_inverts_project(seed, fov, width, height, distance, far_away,
     k = z / cam.focal_px if cam.projection == "perspective" else np.full_like(z, cam.ortho_height / cam.height)
     cx, cy = cam.principal_point
     p_cam_norm = np.linalg.norm(ref_cam[vis].astype(float), axis=1)
-    bound = 2 * (k * (b_px + EPS64 * (np.abs(px[vis]).sum(axis=1) + cx + cy)) + 5 * EPS64 * p_cam_norm
-                 + EPS64 * (np.linalg.norm(pts[vis], axis=1) + np.linalg.norm(cam.position)))
+    bound = 2 * (
+        k * (b_px + EPS64 * (np.abs(px[vis]).sum(axis=1) + cx + cy))
+        + 5 * EPS64 * p_cam_norm
+        + EPS64 * (np.linalg.norm(pts[vis], axis=1) + np.linalg.norm(cam.position))
+    )
     err = np.linalg.norm(back - pts[vis], axis=1)
     assert np.all(err <= bound), float((err / bound).max())
 
@@ -209,9 +234,13 @@ def defect(a):
 
 
 @settings(max_examples=100, deadline=None)
-@given(factors=st.lists(st.tuples(st.sampled_from("xyz"),
-                                  st.one_of(st.floats(-7.0, 7.0), st.floats(-1e4, 1e4))),
-                        min_size=1, max_size=200))
+@given(
+    factors=st.lists(
+        st.tuples(st.sampled_from("xyz"), st.one_of(st.floats(-7.0, 7.0), st.floats(-1e4, 1e4))),
+        min_size=1,
+        max_size=200,
+    )
+)
 def test_composed_rotations_stay_orthonormal(factors):
     r = compose(*(ROT[axis](angle) for axis, angle in factors))
     n = len(factors)
@@ -223,7 +252,7 @@ def test_composed_rotations_stay_orthonormal(factors):
 
 @settings(max_examples=100, deadline=None)
 @given(
-    turns=st.tuples(*[st.integers(-10**6, 10**6)] * 3),
+    turns=st.tuples(*[st.integers(-(10**6), 10**6)] * 3),
     frames=st.integers(1, 10**7),
     ks=st.lists(st.integers(1, 10**7), min_size=1, max_size=50),
 )

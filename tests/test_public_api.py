@@ -4,7 +4,6 @@ import doctest
 import inspect
 
 import pytest
-
 import wirecheck
 from wirecheck.core import camera
 from wirecheck.core.projector import projection
@@ -34,7 +33,7 @@ def test_exported_names_have_numpydoc_sections(name):
 @pytest.mark.parametrize("module", [camera, projection], ids=lambda m: m.__name__)
 def test_docstring_examples_run(module):
     result = doctest.testmod(module)
-    assert result.attempted > 0 and result.failed == 0     # attempted: a module without examples fails
+    assert result.attempted > 0 and result.failed == 0  # attempted: a module without examples fails
 
 
 def test_version_is_the_installed_distributions():

@@ -18,14 +18,14 @@ DATA = Path(__file__).parent / "data"
 MIRRORED_DIR = "test_user.py_test_mirrored-674c9e30"
 TWO_CHECKS_DIR = "test_user.py_test_two_checks-8ac2ae87"
 
-MIRRORED = '''
+MIRRORED = """
 def mirrored(points, camera):
     px = project(points, camera)
     px[:, 0] = (camera.width - 1) - px[:, 0]
     return px
-'''
+"""
 
-USER_TESTS = '''
+USER_TESTS = """
 from my_projection import project, mirrored
 
 
@@ -36,7 +36,7 @@ def test_good(wirecheck):
 
 def test_mirrored(wirecheck):
     wirecheck(mirrored, scenes=["cube"], frames=2, cases=["on_axis"])
-'''
+"""
 
 
 @pytest.fixture
@@ -58,22 +58,27 @@ def test_pass_and_fail_with_the_fault_and_without_harness_frames(project):
     result.assert_outcomes(passed=1, failed=1)
     out = result.stdout.str()
     # the user's own line is the traceback, then the diagnosis
-    result.stdout.fnmatch_lines([
-        ">       wirecheck(mirrored, scenes=[[]\"cube\"[]], frames=2, cases=[[]\"on_axis\"[]])",
-        "E       Failed: Compared: level vertices (OpenCV), 2 frames per case, 1 case (1 scene x 1 camera)",
-        "E       1 of 1 crosscheck cases failed for mirrored:",
-        "E         cube / on_axis: faults: mirror_horizontal; max vertex error * px > 1e-06 px *",
-        "E         what to check, mirror_horizontal: left and right are exchanged*",
-        "test_user.py:10: Failed",
-    ])
+    result.stdout.fnmatch_lines(
+        [
+            '>       wirecheck(mirrored, scenes=[[]"cube"[]], frames=2, cases=[[]"on_axis"[]])',
+            "E       Failed: Compared: level vertices (OpenCV), 2 frames per case, 1 case (1 scene x 1 camera)",
+            "E       1 of 1 crosscheck cases failed for mirrored:",
+            "E         cube / on_axis: faults: mirror_horizontal; max vertex error * px > 1e-06 px *",
+            "E         what to check, mirror_horizontal: left and right are exchanged*",
+            "test_user.py:10: Failed",
+        ]
+    )
     for harness in ("pytest_plugin.py", "oracles/api.py", "oracles/runner.py", "During handling"):
         assert harness not in out
 
 
 def test_settings_come_from_the_table_then_the_command_line_then_the_call(project):
-    project.makepyprojecttoml('[tool.wirecheck]\ncandidate = "my_projection.py:project"\nscenes = ["prism"]\n'
-                              'cases = ["near_plane", "wide_fov"]\nframes = 2\nlevel = "vertices"\n')
-    project.makepyfile(test_user='''
+    project.makepyprojecttoml(
+        '[tool.wirecheck]\ncandidate = "my_projection.py:project"\nscenes = ["prism"]\n'
+        'cases = ["near_plane", "wide_fov"]\nframes = 2\nlevel = "vertices"\n'
+    )
+    project.makepyfile(
+        test_user="""
 def test_table(wirecheck, request):
     report = wirecheck()                 # the table's candidate, scenes, cases
     frames = request.config.getoption("wirecheck_frames") or 2
@@ -84,16 +89,20 @@ def test_table(wirecheck, request):
 def test_call_wins(wirecheck):
     report = wirecheck(frames=4, cases=["orthographic"])
     assert report["frames"] == 4 and [c["camera"] for c in report["cases"]] == ["orthographic"]
-''')
+"""
+    )
     project.runpytest().assert_outcomes(passed=2)
     project.runpytest("--wirecheck-frames", "3").assert_outcomes(passed=2)
 
 
-@pytest.mark.parametrize("table, needle", [
-    ("frame = 2\n", "unknown key 'frame' (did you mean 'frames'?)"),
-    ("cases = []\n", "cases = []: expected a non-empty list"),
-    ("frames = 0\n", "frames = 0: expected an integer >= 1"),
-])
+@pytest.mark.parametrize(
+    "table, needle",
+    [
+        ("frame = 2\n", "unknown key 'frame' (did you mean 'frames'?)"),
+        ("cases = []\n", "cases = []: expected a non-empty list"),
+        ("frames = 0\n", "frames = 0: expected an integer >= 1"),
+    ],
+)
 def test_a_bad_table_is_a_usage_error_before_any_test(project, table, needle):
     path = project.makepyprojecttoml("[tool.wirecheck]\n" + table)
     project.makepyfile(test_user=USER_TESTS)
@@ -109,7 +118,9 @@ def test_zero_frames_on_the_command_line_is_a_usage_error(project):
 
 
 def test_report_option_writes_the_report_of_each_failing_check(project):
-    project.makepyfile(test_user=USER_TESTS + '''
+    project.makepyfile(
+        test_user=USER_TESTS
+        + """
 
 def test_two_checks(wirecheck):
     try:
@@ -117,21 +128,25 @@ def test_two_checks(wirecheck):
     except BaseException:
         pass
     wirecheck(mirrored, scenes=["pyramid"], frames=2, cases=["oblique_roll"])
-''')
+"""
+    )
     result = project.runpytest("--wirecheck-report", "reports")
     result.assert_outcomes(passed=1, failed=2)
     root = project.path / "reports"
-    assert sorted(p.name for p in root.iterdir()) == [
-        MIRRORED_DIR, TWO_CHECKS_DIR, TWO_CHECKS_DIR + "-2"]
-    expected = {MIRRORED_DIR: ("cube", "on_axis"), TWO_CHECKS_DIR: ("cube", "wide_fov"),
-                TWO_CHECKS_DIR + "-2": ("pyramid", "oblique_roll")}
+    assert sorted(p.name for p in root.iterdir()) == [MIRRORED_DIR, TWO_CHECKS_DIR, TWO_CHECKS_DIR + "-2"]
+    expected = {
+        MIRRORED_DIR: ("cube", "on_axis"),
+        TWO_CHECKS_DIR: ("cube", "wide_fov"),
+        TWO_CHECKS_DIR + "-2": ("pyramid", "oblique_roll"),
+    }
     for name, (scene, camera) in expected.items():
         report = json.loads((root / name / "report.json").read_text())
         case = report["cases"][0]
         assert (case["scene"], case["camera"], case["faults"][0]["name"]) == (scene, camera, "mirror_horizontal")
         assert (root / name / "report.html").is_file()
-    result.stdout.fnmatch_lines([f"E         report: reports/{MIRRORED_DIR}/report.html",
-                                 "3 report(s) of failing checks under reports"])
+    result.stdout.fnmatch_lines(
+        [f"E         report: reports/{MIRRORED_DIR}/report.html", "3 report(s) of failing checks under reports"]
+    )
 
 
 def test_no_projector_anywhere_fails_the_test(project):
@@ -147,8 +162,10 @@ def test_a_report_that_did_not_pass_is_never_silent():
     # hand-made reports: the fixture fails whenever failure_text is not None
     case = {"scene": "cube", "camera": "on_axis", "verdict": "pass", "faults": [], "reasons": []}
     assert failure_text({"candidate": "f", "verdict": "pass", "cases": [case]}) is None
-    assert failure_text({"candidate": "f", "verdict": "fail", "cases": [case]}) == \
-        "crosscheck of f: verdict fail with no failing case"
+    assert (
+        failure_text({"candidate": "f", "verdict": "fail", "cases": [case]})
+        == "crosscheck of f: verdict fail with no failing case"
+    )
     assert failure_text({"candidate": "f", "verdict": "fail", "cases": []}) is not None
 
 
@@ -180,21 +197,25 @@ def test_test_ids_that_differ_only_in_punctuation_get_a_report_folder_each(proje
     Before, ``/``, ``::`` and brackets were made ``_`` one-to-one with no hash: the first four ids all wrote
     ``test_user.py_test_shift_a_b`` and each report replaced the one before.
     """
-    project.makepyfile(test_user=f'''
+    project.makepyfile(
+        test_user=f"""
 import pytest
 from my_projection import project
 
 @pytest.mark.parametrize("shift", [1.0, 2.0, 3.0, 4.0, 5.0, 6.0], ids={PUNCTUATION_IDS!r})
 def test_shift(wirecheck, shift):
     wirecheck(lambda p, c: project(p, c) + shift, scenes=["cube"], frames=1, cases=["on_axis"])
-''')
+"""
+    )
     result = project.runpytest("--wirecheck-report", "reports", "-p", "no:xdist")
     result.assert_outcomes(failed=6)
     folders = sorted((project.path / "reports").iterdir())
     assert len(folders) == 6, [f.name for f in folders]
     # each shift s moves every vertex by (s, s): the worst vertex error is s * sqrt(2), one folder per test
-    shifts = sorted(round(json.loads((f / "report.json").read_text())["summary"]["max_vertex_error_px"] / 2 ** 0.5, 6)
-                    for f in folders)
+    shifts = sorted(
+        round(json.loads((f / "report.json").read_text())["summary"]["max_vertex_error_px"] / 2**0.5, 6)
+        for f in folders
+    )
     assert shifts == [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
 
 
@@ -207,4 +228,4 @@ def test_report_folder_names_are_one_to_one_and_fit_a_file_name():
     # "t.py::test[a/b]": its characters with runs of others made "_", "-", then sha1("t.py::test[a/b]")[:8],
     # computed by hand: hashlib.sha1(b"t.py::test[a/b]").hexdigest()[:8]
     assert names[0] == "t.py_test_a_b-577e9e1b"
-    assert len(report_name("t.py::test[" + "x" * 300 + "]")) == 120 + 1 + 8       # under NAME_MAX (255 bytes)
+    assert len(report_name("t.py::test[" + "x" * 300 + "]")) == 120 + 1 + 8  # under NAME_MAX (255 bytes)

@@ -21,13 +21,12 @@ import math
 
 import numpy as np
 import pytest
+from helpers import eight_connected
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
-
 from wirecheck.core.projector import raster
 from wirecheck.core.projector.raster import SUBPIXEL, line_pixels
-from helpers import eight_connected
 
 W, H = 12, 10
 
@@ -52,8 +51,8 @@ def blank():
 
 # ---- naive reference -----------------------------------------------------------------
 
-T_TIE = 1e-9   # parameter-space tie band: ends are on a 1/256 grid, lengths <= 100 px,
-               # so genuine non-ties differ from 0/1 by >= (1/256)^2/100 ~ 1.5e-7 >> 1e-9
+T_TIE = 1e-9  # parameter-space tie band: ends are on a 1/256 grid, lengths <= 100 px,
+# so genuine non-ties differ from 0/1 by >= (1/256)^2/100 ~ 1.5e-7 >> 1e-9
 
 
 def naive_diamond_exit(p0, p1, w, h):
@@ -80,20 +79,21 @@ def naive_diamond_exit(p0, p1, w, h):
                 elif b < 0:
                     empty = True
             if empty or t_hi < t_lo - T_TIE:
-                continue                                   # misses the diamond
+                continue  # misses the diamond
             tm = 0.5 * (t_lo + t_hi)
             l1_mid = abs(x0 + tm * dx - c) + abs(y0 + tm * dy - r)
             if t_hi - t_lo <= T_TIE or l1_mid >= 0.5 - 1e-12:
-                ambiguous.add((r, c))                      # touches only the boundary: a tie
+                ambiguous.add((r, c))  # touches only the boundary: a tie
                 continue
             if abs(t_hi) <= T_TIE or abs(t_hi - 1) <= T_TIE:
-                ambiguous.add((r, c))                      # exits exactly at an end
+                ambiguous.add((r, c))  # exits exactly at an end
             elif 0 < t_hi <= 1:
                 drawn.add((r, c))
     return drawn, ambiguous
 
 
 # ---- one test per geometric case --------------------------------------------------------
+
 
 def test_horizontal():
     # centres (2,3) -> (7,3): start pixel drawn, end pixel not: cols 2..6 of row 3
@@ -277,8 +277,9 @@ def outside_diamonds(x, y, margin=2 / 256):
 # an end point off every diamond: integer + offsets with |fx|, |fy| in [0.26, 0.5], so
 # |fx| + |fy| >= 0.52 > 0.5 + 2/256 (snapping moves each coordinate by <= 1/512)
 off = st.tuples(st.floats(0.26, 0.5), st.sampled_from((-1, 1)))
-corner_point = st.builds(lambda i, j, fx, fy: (i + fx[0] * fx[1], j + fy[0] * fy[1]),
-                         st.integers(-3, 43), st.integers(-3, 33), off, off)
+corner_point = st.builds(
+    lambda i, j, fx, fy: (i + fx[0] * fx[1], j + fy[0] * fy[1]), st.integers(-3, 43), st.integers(-3, 33), off, off
+)
 
 
 @settings(max_examples=300, deadline=None)

@@ -25,13 +25,11 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from helpers import eight_connected
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
-
-from wirecheck.core.projector.raster import (CHUNK_SEGMENTS, RASTER_MODES, line_coverage_aa, line_pixels_fast,
-                                   paint_aa)
-from helpers import eight_connected
+from wirecheck.core.projector.raster import CHUNK_SEGMENTS, RASTER_MODES, line_coverage_aa, line_pixels_fast, paint_aa
 
 W, H = 12, 10
 EPS = np.finfo(np.float64).eps
@@ -78,16 +76,17 @@ def test_raster_modes():
 
 # ---- fast: one test per geometric case --------------------------------------------------
 
+
 def test_fast_horizontal_includes_both_ends():
     exp = blank()
-    exp[3, 2:8] = 1                                   # cols 2..7: 7 - 2 + 1 = 6 pixels
+    exp[3, 2:8] = 1  # cols 2..7: 7 - 2 + 1 = 6 pixels
     assert_array_equal(fast_img((2, 3), (7, 3)), exp)
     assert_array_equal(fast_img((7, 3), (2, 3)), exp)
 
 
 def test_fast_vertical():
     exp = blank()
-    exp[1:7, 4] = 1                                   # rows 1..6
+    exp[1:7, 4] = 1  # rows 1..6
     assert_array_equal(fast_img((4, 1), (4, 6)), exp)
 
 
@@ -167,12 +166,13 @@ def test_fast_several_segments_at_once_is_union_of_single_calls():
 
 # ---- aa: one test per geometric case ---------------------------------------------------
 
+
 def test_aa_horizontal_between_centres():
     # (2,3) -> (7,3): cols 2..7; the end pixels are half covered along x
     # (g = 2.5 - 2 = 0.5 and 7 - 6.5 = 0.5), b = 3 exactly: one pixel per column
     assert aa_dict((2, 3), (7, 3)) == {(3, 2): 0.5, (3, 3): 1.0, (3, 4): 1.0, (3, 5): 1.0, (3, 6): 1.0, (3, 7): 0.5}
     exp = blank()
-    exp[3, 2:8] = [128, 255, 255, 255, 255, 128]   # floor(255 * 0.5 + 0.5) = 128
+    exp[3, 2:8] = [128, 255, 255, 255, 255, 128]  # floor(255 * 0.5 + 0.5) = 128
     assert_array_equal(aa_img((2, 3), (7, 3)), exp)
 
 
@@ -196,10 +196,14 @@ def test_aa_shallow_line_with_ties():
     # (0,0) -> (4,1): y = x/4 at cols 0..4: 0, .25, .5, .75, 1 (the module doctest)
     assert aa_dict((0, 0), (4, 1), 5, 2) == {
         (0, 0): 0.5,
-        (0, 1): 0.75, (1, 1): 0.25,
-        (0, 2): 0.5, (1, 2): 0.5,          # a tie: both halves, both drawn when thresholded
-        (0, 3): 0.25, (1, 3): 0.75,
-        (1, 4): 0.5}
+        (0, 1): 0.75,
+        (1, 1): 0.25,
+        (0, 2): 0.5,
+        (1, 2): 0.5,  # a tie: both halves, both drawn when thresholded
+        (0, 3): 0.25,
+        (1, 3): 0.75,
+        (1, 4): 0.5,
+    }
     img = aa_img((0, 0), (4, 1), 5, 2)
     assert_array_equal(img, [[128, 191, 128, 64, 0], [0, 64, 128, 191, 128]])
 
@@ -260,6 +264,7 @@ def test_paint_aa_rounding_and_threshold():
 
 # ---- references ----------------------------------------------------------------------------
 
+
 def round_half_up(v):
     return math.floor(Fraction(v) + Fraction(1, 2))
 
@@ -311,15 +316,19 @@ def aa_reference(p0, p1):
 
 PW, PH = 40, 30
 coord = st.floats(-5.0, 45.0, allow_nan=False, allow_infinity=False)
-inside_x = st.floats(-0.49, PW - 0.51)          # rounds to a column 0..PW-1
+inside_x = st.floats(-0.49, PW - 0.51)  # rounds to a column 0..PW-1
 inside_y = st.floats(-0.49, PH - 0.51)
 # halves and quarters make exact ties and exact rounding halves common
 grid_coord = st.integers(-20, 180).map(lambda k: k / 4)
 
 
 @settings(max_examples=300, deadline=None)
-@given(x0=st.one_of(coord, grid_coord), y0=st.one_of(coord, grid_coord),
-       x1=st.one_of(coord, grid_coord), y1=st.one_of(coord, grid_coord))
+@given(
+    x0=st.one_of(coord, grid_coord),
+    y0=st.one_of(coord, grid_coord),
+    x1=st.one_of(coord, grid_coord),
+    y1=st.one_of(coord, grid_coord),
+)
 def test_fast_matches_naive(x0, y0, x1, y1):
     assert fast_set((x0, y0), (x1, y1), PW, PH) == naive_fast((x0, y0), (x1, y1), PW, PH)
 
@@ -338,8 +347,12 @@ def test_fast_in_image_count_ends_connectivity(x0, y0, x1, y1):
 
 
 @settings(max_examples=300, deadline=None)
-@given(x0=st.one_of(coord, grid_coord), y0=st.one_of(coord, grid_coord),
-       x1=st.one_of(coord, grid_coord), y1=st.one_of(coord, grid_coord))
+@given(
+    x0=st.one_of(coord, grid_coord),
+    y0=st.one_of(coord, grid_coord),
+    x1=st.one_of(coord, grid_coord),
+    y1=st.one_of(coord, grid_coord),
+)
 def test_fast_symmetric_under_reversal(x0, y0, x1, y1):
     # the tie rule depends on b(i) only, and b(i) is the same point in both directions
     assert fast_set((x0, y0), (x1, y1), PW, PH) == fast_set((x1, y1), (x0, y0), PW, PH)
@@ -364,8 +377,7 @@ def test_fast_pixels_within_half_pixel_chebyshev_of_rounded_segment(x0, y0, x1, 
 
 
 @settings(max_examples=200, deadline=None)
-@given(x0=grid_coord, y0=grid_coord, x1=grid_coord, y1=grid_coord,
-       ox=st.integers(0, 20), oy=st.integers(0, 20))
+@given(x0=grid_coord, y0=grid_coord, x1=grid_coord, y1=grid_coord, ox=st.integers(0, 20), oy=st.integers(0, 20))
 def test_fast_out_of_bounds_dropping_equals_cropping_a_larger_canvas(x0, y0, x1, y1, ox, oy):
     # floor(v + 1/2) commutes with whole-pixel shifts (quarters keep v + ox exact)
     small = fast_set((x0, y0), (x1, y1), PW, PH)
@@ -379,12 +391,13 @@ def test_fast_batches_equal_one_call_per_segment():
     p0 = rng.uniform(-5, 45, size=(m, 2))
     p1 = p0 + rng.uniform(-6, 6, size=(m, 2))
     rr, cc = line_pixels_fast(p0, p1, PW, PH)
-    per = [line_pixels_fast(p0[k:k + 1], p1[k:k + 1], PW, PH) for k in range(m)]
+    per = [line_pixels_fast(p0[k : k + 1], p1[k : k + 1], PW, PH) for k in range(m)]
     assert_array_equal(rr, np.concatenate([p[0] for p in per]))
     assert_array_equal(cc, np.concatenate([p[1] for p in per]))
 
 
 # ---- fast against cv2.line (LINE_8) ------------------------------------------------------
+
 
 def test_fast_against_cv2_line(summary_section):
     """cv2.line LINE_8 on integer ends: same count, same ends, and the same pixels up to
@@ -409,14 +422,16 @@ def test_fast_against_cv2_line(summary_section):
         assert len(ours) == len(theirs)
         assert {(p0[1], p0[0]), (p1[1], p1[0])} <= ours & theirs
         assert theirs == naive_fast(p0.tolist(), p1.tolist(), w, h, cv2_ties=True)
-        f1 = len(ours & theirs) / len(ours)            # equal sizes: F1 = precision = recall
+        f1 = len(ours & theirs) / len(ours)  # equal sizes: F1 = precision = recall
         assert f1 > 0.5
         f1s.append(f1)
         identical += ours == theirs
     f1s = np.array(f1s)
-    summary_section("fast raster vs cv2.line LINE_8 (integer ends, 64x48)",
-                    f"{n_seg} segments: identical {identical} ({identical / n_seg:.1%}), "
-                    f"F1@0 mean {f1s.mean():.4f} min {f1s.min():.4f}")
+    summary_section(
+        "fast raster vs cv2.line LINE_8 (integer ends, 64x48)",
+        f"{n_seg} segments: identical {identical} ({identical / n_seg:.1%}), "
+        f"F1@0 mean {f1s.mean():.4f} min {f1s.min():.4f}",
+    )
 
 
 # ---- aa: properties ----------------------------------------------------------------------
@@ -429,12 +444,13 @@ int_x = st.floats(1.0, PW - 2.0)
 int_y = st.floats(1.0, PH - 2.0)
 grid_x = st.integers(4, 4 * (PW - 2)).map(lambda k: k / 4)
 grid_y = st.integers(4, 4 * (PH - 2)).map(lambda k: k / 4)
-TIE_BAND = Fraction(1, 10**9)     # b is computed in floats (error ~1e-14 px here)
+TIE_BAND = Fraction(1, 10**9)  # b is computed in floats (error ~1e-14 px here)
 
 
 @settings(max_examples=200, deadline=None)
-@given(x0=st.one_of(int_x, grid_x), y0=st.one_of(int_y, grid_y),
-       x1=st.one_of(int_x, grid_x), y1=st.one_of(int_y, grid_y))
+@given(
+    x0=st.one_of(int_x, grid_x), y0=st.one_of(int_y, grid_y), x1=st.one_of(int_x, grid_x), y1=st.one_of(int_y, grid_y)
+)
 def test_aa_weights_threshold_and_total(x0, y0, x1, y1):
     got = aa_dict((x0, y0), (x1, y1), PW, PH)
     x_major, cols = aa_reference((x0, y0), (x1, y1))
@@ -457,9 +473,9 @@ def test_aa_weights_threshold_and_total(x0, y0, x1, y1):
             if g == 1:
                 assert drawn
         elif g == 1:
-            assert drawn == {near}           # interior: the nearest pixel, and only it
+            assert drawn == {near}  # interior: the nearest pixel, and only it
         else:
-            assert drawn <= {near}           # end pixel: g < 1 may drop it
+            assert drawn <= {near}  # end pixel: g < 1 may drop it
     # total coverage = sum of g = a_hi - a_lo (telescoping). Tolerance: each column's
     # pair is within 4 eps of g (above), and the float sum of 2 n_cols terms, partial
     # sums <= 2 n_cols, adds <= 2 n_cols * (2 n_cols) eps in the worst (sequential) case.
@@ -472,7 +488,7 @@ def test_aa_weights_threshold_and_total(x0, y0, x1, y1):
 @given(x0=coord, y0=coord, x1=coord, y1=coord)
 def test_aa_symmetric_under_reversal_and_thresholds_like_paint(x0, y0, x1, y1):
     fwd = aa_dict((x0, y0), (x1, y1), PW, PH)
-    assert fwd == aa_dict((x1, y1), (x0, y0), PW, PH)      # computed from the lower end: bit-equal
+    assert fwd == aa_dict((x1, y1), (x0, y0), PW, PH)  # computed from the lower end: bit-equal
     img = aa_img((x0, y0), (x1, y1), PW, PH)
     drawn = {(r, c) for r, c in zip(*(a.tolist() for a in np.nonzero(img >= 128)))}
     assert drawn == {k for k, v in fwd.items() if v >= 0.5}
@@ -482,7 +498,7 @@ def test_aa_long_interior_segment_total_coverage():
     # a 30-px x-major segment: columns 5..35, coverage sums to 30.0 up to the bound above
     got = aa_dict((5.3, 7.1), (35.3, 19.4), PW, PH)
     n_cols = 31
-    assert sum(got.values()) == pytest.approx(30.0, abs=(4 * n_cols + 4 * n_cols ** 2) * EPS)
+    assert sum(got.values()) == pytest.approx(30.0, abs=(4 * n_cols + 4 * n_cols**2) * EPS)
 
 
 def test_aa_batches_equal_one_call_per_segment():
@@ -491,12 +507,12 @@ def test_aa_batches_equal_one_call_per_segment():
     p0 = rng.uniform(-5, 45, size=(m, 2))
     p1 = p0 + rng.uniform(-6, 6, size=(m, 2))
     got = line_coverage_aa(p0, p1, PW, PH)
-    per = [line_coverage_aa(p0[k:k + 1], p1[k:k + 1], PW, PH) for k in range(m)]
+    per = [line_coverage_aa(p0[k : k + 1], p1[k : k + 1], PW, PH) for k in range(m)]
     for a, k in zip(got, range(3)):
         assert_array_equal(a, np.concatenate([p[k] for p in per]))
 
 
-@pytest.mark.parametrize("n", [50, 5000])     # 50*8 < 40*30: sparse path; 5000*8 >= 1200: dense path
+@pytest.mark.parametrize("n", [50, 5000])  # 50*8 < 40*30: sparse path; 5000*8 >= 1200: dense path
 def test_paint_aa_both_accumulation_paths_equal_an_in_order_reference(n):
     # np.add.at sums in input order, as bincount does on both paths: bit-identical.
     rng = np.random.default_rng(n)

@@ -16,9 +16,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
-
-from wirecheck.core.projector import raster
 from raster_reference import candidates_reference
+from wirecheck.core.projector import raster
 
 W, H = 40, 30
 
@@ -67,9 +66,10 @@ def test_a_batch_equals_reference_and_the_single_segment_calls(segs):
     got, want = both(p0, p1, W, H)
     assert_same(got, want)
     # segment after segment: the batch is the concatenation of one call per segment
-    per = [raster.line_pixels(p0[m:m + 1], p1[m:m + 1], W, H) for m in range(len(p0))]
-    assert_same(raster.line_pixels(p0, p1, W, H),
-                (np.concatenate([p[0] for p in per]), np.concatenate([p[1] for p in per])))
+    per = [raster.line_pixels(p0[m : m + 1], p1[m : m + 1], W, H) for m in range(len(p0))]
+    assert_same(
+        raster.line_pixels(p0, p1, W, H), (np.concatenate([p[0] for p in per]), np.concatenate([p[1] for p in per]))
+    )
 
 
 # Far ends: 2^23 grid units is 32,768 px; beyond it core computes in int64. The offset
@@ -114,11 +114,11 @@ def test_chunked_batches_equal_one_batch(monkeypatch, chunk):
     rng = np.random.default_rng(5)
     p0 = rng.uniform(-5, 45, size=(50, 2))
     p1 = p0 + rng.uniform(-6, 6, size=(50, 2))
-    p1[::9] = p0[::9]                                       # zero length
+    p1[::9] = p0[::9]  # zero length
     whole = raster.line_pixels(p0, p1, W, H)
     monkeypatch.setattr(raster, "CHUNK_SEGMENTS", chunk)
     assert_same(raster.line_pixels(p0, p1, W, H), whole)
-    assert len(whole[0]) > 50                               # not an empty comparison
+    assert len(whole[0]) > 50  # not an empty comparison
 
 
 def test_icosphere_frame_segments_equal_reference():
@@ -127,6 +127,7 @@ def test_icosphere_frame_segments_equal_reference():
     from wirecheck.core.camera import camera_z
     from wirecheck.core.projector.pipeline import render_frame
     from wirecheck.core.transforms import Motion
+
     ico = trimesh.creation.icosphere(subdivisions=6)
     e = np.asarray(ico.edges_unique)
     cam = camera_z(4.0, fov_y_deg=70, width=640, height=480)

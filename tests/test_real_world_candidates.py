@@ -5,13 +5,13 @@ Ray Tracing in One Weekend, the pygame tutorials, an OpenCV-style calibrated cam
 The expected verdicts and fault parameters below are derived by hand from those
 formulas, in the comments; none comes from wirecheck.
 """
+
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
 import pytest
-
 import wirecheck
 
 sys.path.insert(0, str(Path(__file__).parent / "data" / "real_world"))
@@ -92,9 +92,12 @@ def _lens_faults(func):
     assert report["verdict"] == "fail"
     for case in report["cases"]:
         if case["camera"] != "distorted":
-            assert case["verdict"] == "pass", case["camera"]   # no lens there: nothing to get wrong
-    return [(case["camera_spec"]["distortion"], _faults(case)["distortion_mismatch"])
-            for case in report["cases"] if case["camera"] == "distorted"]
+            assert case["verdict"] == "pass", case["camera"]  # no lens there: nothing to get wrong
+    return [
+        (case["camera_spec"]["distortion"], _faults(case)["distortion_mismatch"])
+        for case in report["cases"]
+        if case["camera"] == "distorted"
+    ]
 
 
 def test_opencv_k_without_the_lens_is_distortion_ignored():

@@ -14,18 +14,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import run_renderer as run
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
-
-from wirecheck.core.outputs.output import MARKER
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.errors import InputError
-from helpers import run_renderer as run
+from wirecheck.core.outputs.output import MARKER
 
 EPS = np.finfo(np.float64).eps
 SEED_ARGS = ["--scene", "cube", "--frames", "180", "--camera-z", "4.0", "--fov", "70"]
 CUBE = [(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1), (-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)]
-F70 = 240.0 / math.tan(math.radians(35.0))      # f = (H/2)/tan(fov/2) = 342.7555
+F70 = 240.0 / math.tan(math.radians(35.0))  # f = (H/2)/tan(fov/2) = 342.7555
 
 
 def naive_depth_range(k, frames, turns=(1.0, 1.0, 0.0), d=4.0):
@@ -34,17 +33,19 @@ def naive_depth_range(k, frames, turns=(1.0, 1.0, 0.0), d=4.0):
     ax, ay = 2 * math.pi * t * turns[0], 2 * math.pi * t * turns[1]
     depths = []
     for x, y, z in CUBE:
-        z1 = math.sin(ax) * y + math.cos(ax) * z          # only z matters for depth
+        z1 = math.sin(ax) * y + math.cos(ax) * z  # only z matters for depth
         z2 = -math.sin(ay) * x + math.cos(ay) * z1
         depths.append(d - z2)
     return min(depths), max(depths)
 
 
 def seed_expected_stdout(out):
-    lines = ["Scene: cube (8 vertices, 12 edges)",
-             # rest pose: depths 4 - 1 = 3 and 4 + 1 = 5
-             "Frame 001: visible_vertices=8 clipped=0 depth=[3.00, 5.00]"]
-    for k in (90, 180):   # frames >= 180 print 1, frames // 2, frames
+    lines = [
+        "Scene: cube (8 vertices, 12 edges)",
+        # rest pose: depths 4 - 1 = 3 and 4 + 1 = 5
+        "Frame 001: visible_vertices=8 clipped=0 depth=[3.00, 5.00]",
+    ]
+    for k in (90, 180):  # frames >= 180 print 1, frames // 2, frames
         lo, hi = naive_depth_range(k, 180)
         lines.append(f"Frame {k:03d}: visible_vertices=8 clipped=0 depth=[{lo:.2f}, {hi:.2f}]")
     lines += [f"Exported frames: {out}/cube-frames/", f"Summary: {out}/cube-report.txt"]
@@ -59,6 +60,7 @@ def seed_run(tmp_path_factory):
 
 
 # ---- the seed command ----------------------------------------------------------------
+
 
 def test_seed_command_prints_six_lines(seed_run):
     out, rc, stdout, stderr = seed_run
@@ -106,12 +108,21 @@ def test_seed_json_frame_one_hand_derived(seed_run):
 
 def test_seed_json_drawing_defaults_and_objects(seed_run):
     rep = json.loads((seed_run[0] / "cube-report.json").read_text())
-    assert rep["drawing"] == {"projection": "perspective", "axes": False, "axis_length": None, "cull": None,
-                              "hidden_lines": False, "style": "wireframe", "light": None, "object_culling": True}
-    assert rep["scene"]["objects"] == [{"name": "cube", "vertices": 8, "spin": [0.0, 0.0, 0.0],
-                                        "translate": [0.0, 0.0, 0.0], "scale": 1.0}]
+    assert rep["drawing"] == {
+        "projection": "perspective",
+        "axes": False,
+        "axis_length": None,
+        "cull": None,
+        "hidden_lines": False,
+        "style": "wireframe",
+        "light": None,
+        "object_culling": True,
+    }
+    assert rep["scene"]["objects"] == [
+        {"name": "cube", "vertices": 8, "spin": [0.0, 0.0, 0.0], "translate": [0.0, 0.0, 0.0], "scale": 1.0}
+    ]
     assert "camera_orthographic" not in rep and "objects_culled" not in rep["summary"]
-    assert not (seed_run[0] / "cube-plots.png").exists()          # --plots is off by default
+    assert not (seed_run[0] / "cube-plots.png").exists()  # --plots is off by default
 
 
 @pytest.mark.parametrize("k", [2, 46, 90, 135, 180])
@@ -165,6 +176,7 @@ def test_subprocess_entry_point(tmp_path):
 
 # ---- image orientation ---------------------------------------------------------------
 
+
 def test_png_row_zero_is_top(tmp_path):
     # pyramid at rest, camera_z(4), fov 70: apex (0,1,0) at depth 4 -> y = 239.5 - f/4 =
     # 153.81 (the TOP of the drawing), front base corners (+-1,-1,1) at depth 3 ->
@@ -179,6 +191,7 @@ def test_png_row_zero_is_top(tmp_path):
 
 
 # ---- bad input ---------------------------------------------------------------------------
+
 
 def bad_cases(tmp):
     bad_scene = tmp / "bad.scene"
@@ -196,12 +209,22 @@ def bad_cases(tmp):
         (["--camera-pos", "0,5,0", "--look-at", "0,0,0", "--up", "0,1,0"], ["up [0.0, 1.0, 0.0]", "parallel"]),
         (["--camera-pos", "1,2,3", "--look-at", "1,2,3"], ["[1.0, 2.0, 3.0]", "look-at"]),
         (["--camera-z", "0"], ["--camera-z 0.0"]),
-        (["--frames", "abc"], ["'abc'"]),                      # argparse: SystemExit(2)
+        (["--frames", "abc"], ["'abc'"]),  # argparse: SystemExit(2)
     ], a_file
 
 
-BAD_IDS = ["malformed-scene", "unknown-scene", "fov0", "fov180", "fov-5", "frames0", "up-parallel",
-           "at-look-at", "camera-z0", "frames-not-int"]
+BAD_IDS = [
+    "malformed-scene",
+    "unknown-scene",
+    "fov0",
+    "fov180",
+    "fov-5",
+    "frames0",
+    "up-parallel",
+    "at-look-at",
+    "camera-z0",
+    "frames-not-int",
+]
 
 
 @pytest.mark.parametrize("i", range(len(BAD_IDS)), ids=BAD_IDS)
@@ -218,7 +241,7 @@ def test_bad_input_one_line_exit_2_nothing_written(tmp_path, i):
     for n in needles:
         assert n in lines[0]
     assert "Traceback" not in stderr
-    assert not out.exists()          # all checks happen before the output dir is touched
+    assert not out.exists()  # all checks happen before the output dir is touched
 
 
 def test_unwritable_out_under_a_regular_file(tmp_path):
@@ -234,8 +257,12 @@ def test_unwritable_out_under_a_regular_file(tmp_path):
 
 def test_bad_input_subprocess_no_traceback(tmp_path):
     # the same contract through a real process (stderr must be exactly one line)
-    proc = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", "--fov", "0", "--out", str(tmp_path / "o")],
-                          capture_output=True, text=True, timeout=60)
+    proc = subprocess.run(
+        [sys.executable, "-m", "wirecheck.core.app.cli", "--fov", "0", "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert (proc.returncode, proc.stdout) == (2, "")
     assert proc.stderr == "renderer: error: --fov 0.0: expected degrees in (0, 180)\n"
 
@@ -251,7 +278,7 @@ NONFINITE_ARGS = [
     (["--fov", "inf"], ["--fov", "inf"]),
     (["--fov", "nan"], ["--fov", "nan"]),
     (["--camera-z", "nan"], ["--camera-z", "nan"]),
-    (["--camera-z=-inf"], ["--camera-z", "inf"]),   # "--camera-z -inf": argparse takes -inf for an option
+    (["--camera-z=-inf"], ["--camera-z", "inf"]),  # "--camera-z -inf": argparse takes -inf for an option
     (["--near", "nan"], ["near", "nan"]),
     (["--far", "inf"], ["far", "inf"]),
     (["--projection", "orthographic", "--ortho-height", "nan"], ["ortho-height", "nan"]),
@@ -302,15 +329,22 @@ def test_nonfinite_input_subprocess_no_traceback(tmp_path):
     # the same contract through real processes: a NaN camera argument and a NaN vertex in a file
     fname, text, line, token = NONFINITE_SCENES[0]
     (tmp_path / fname).write_text(text)
-    for args, needles in ((["--camera-pos", "nan,0,4"], ["--camera-pos", "nan"]),
-                          (["--scene", str(tmp_path / fname)], [f"{tmp_path / fname}:{line}:", token])):
-        proc = subprocess.run([sys.executable, "-m", "wirecheck.core.app.cli", *args, "--frames", "2",
-                               "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
+    for args, needles in (
+        (["--camera-pos", "nan,0,4"], ["--camera-pos", "nan"]),
+        (["--scene", str(tmp_path / fname)], [f"{tmp_path / fname}:{line}:", token]),
+    ):
+        proc = subprocess.run(
+            [sys.executable, "-m", "wirecheck.core.app.cli", *args, "--frames", "2", "--out", str(tmp_path / "o")],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert_one_error_line(proc.returncode, proc.stdout, proc.stderr, needles)
 
 
-@pytest.mark.parametrize("up", [(0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1e-3, 0.0)],
-                         ids=["parallel", "anti-parallel", "parallel-scaled"])
+@pytest.mark.parametrize(
+    "up", [(0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (0.0, 1e-3, 0.0)], ids=["parallel", "anti-parallel", "parallel-scaled"]
+)
 def test_look_at_rejects_up_parallel_to_forward(up):
     # |forward x up| = 0 < 1e-9 |up| (core/camera.py): InputError, no other exception type
     with pytest.raises(InputError, match="parallel"):
@@ -326,6 +360,7 @@ def test_look_at_up_1e_minus_6_off_forward_is_orthonormal():
 
 
 # ---- empty mesh ------------------------------------------------------------------------
+
 
 def test_empty_mesh_renders_blank_frames(tmp_path):
     scene = tmp_path / "empty.scene"
@@ -354,6 +389,7 @@ def test_empty_mesh_renders_blank_frames(tmp_path):
 
 # ---- clip modes through the CLI ------------------------------------------------------------
 
+
 def test_clip_mode_endpoint_draws_subset_of_clip(tmp_path):
     # camera inside the cube (z = 0.5): the 4 edges along z cross the near plane.
     common = ["--scene", "cube", "--frames", "1", "--camera-z", "0.5", "--fov", "70"]
@@ -378,16 +414,17 @@ def test_clip_mode_endpoint_draws_subset_of_clip(tmp_path):
 
 # ---- sidecar -----------------------------------------------------------------------------
 
+
 def test_sidecar_for_large_scene(tmp_path):
     trimesh = pytest.importorskip("trimesh")
-    ico = trimesh.creation.icosphere(subdivisions=5)          # 10 * 4^5 + 2 = 10242 vertices
+    ico = trimesh.creation.icosphere(subdivisions=5)  # 10 * 4^5 + 2 = 10242 vertices
     path = tmp_path / "ico.ply"
     ico.export(path)
     out = tmp_path / "out"
     rc, stdout, stderr = run(["--scene", str(path), "--frames", "2"], out)
     assert (rc, stderr) == (0, "")
-    n = 10 * 4 ** 5 + 2
-    assert stdout.splitlines()[0] == f"Scene: ico ({n} vertices, {3 * n - 6} edges)"   # Euler: E = 3V - 6
+    n = 10 * 4**5 + 2
+    assert stdout.splitlines()[0] == f"Scene: ico ({n} vertices, {3 * n - 6} edges)"  # Euler: E = 3V - 6
     rep = json.loads((out / "ico-report.json").read_text())
     assert rep["vertices_px_file"] == "ico-vertices_px.npy"
     assert all("vertices_px" not in fr for fr in rep["frames"])
@@ -396,7 +433,7 @@ def test_sidecar_for_large_scene(tmp_path):
     cam = camera_z(4.0, fov_y_deg=60.0, width=640, height=480, near=0.1, far=100.0)
     # the PLY holds the coordinates as float32: read them back (independently of core)
     v = np.asarray(trimesh.load(path, process=False).vertices, dtype=np.float64)
-    assert_allclose(v, ico.vertices, rtol=0, atol=1.2e-7)     # float32 eps 1.2e-7 x |v| = 1
+    assert_allclose(v, ico.vertices, rtol=0, atol=1.2e-7)  # float32 eps 1.2e-7 x |v| = 1
     # frame 1 is the rest pose; frame 2 uses the default spin (1,1,0) at t = 1/2.
     # The reference is independent of core: scipy's model matrix and
     # cv2.projectPoints (oracles/). Two float64 pipelines with different
@@ -414,6 +451,7 @@ def test_sidecar_for_large_scene(tmp_path):
 
 # ---- finite but extreme scene coordinates ------------------------------------------------
 
+
 def test_huge_finite_vertex_is_not_a_crash(tmp_path):
     """A scene the parser accepts (all coordinates finite) must not end in a traceback.
 
@@ -425,7 +463,7 @@ def test_huge_finite_vertex_is_not_a_crash(tmp_path):
     out = tmp_path / "out"
     try:
         rc, stdout, stderr = run(["--scene", str(scene), "--frames", "1", "--fov", "70"], out)
-    except Exception as exc:            # noqa: BLE001 - the failure being tested for
+    except Exception as exc:  # noqa: BLE001 - the failure being tested for
         pytest.fail(f"renderer raised {type(exc).__name__}: {exc}")
     assert "Traceback" not in stderr
     if rc == 2:
@@ -433,12 +471,13 @@ def test_huge_finite_vertex_is_not_a_crash(tmp_path):
         assert not (out / "huge-report.json").exists()
     else:
         assert rc == 0
-        rep = json.loads((out / "huge-report.json").read_text())     # strict JSON parsed back
+        rep = json.loads((out / "huge-report.json").read_text())  # strict JSON parsed back
         for xy in rep["frames"][0]["vertices_px"]:
             assert xy is None or all(math.isfinite(v) for v in xy)
 
 
 # ---- --help and the progress bar ---------------------------------------------------
+
 
 def test_every_option_has_help_with_its_default_and_no_markup():
     from helpers import assert_help_states_defaults

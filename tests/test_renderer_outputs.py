@@ -5,20 +5,20 @@ import math
 
 import numpy as np
 import pytest
+from helpers import run_renderer as run
 from numpy.testing import assert_array_equal
 from PIL import Image
-
 from wirecheck.core.app.compose import SEPARATOR_GREY
 from wirecheck.core.outputs.output import pad_even
-from helpers import run_renderer as run
 
 
 def frame(out, scene, k=1):
     im = Image.open(out / f"{scene}-frames" / f"frame_{k:04d}.png")
-    return np.asarray(im.convert("L") if im.mode == "1" else im)     # bilevel frames as 0/255
+    return np.asarray(im.convert("L") if im.mode == "1" else im)  # bilevel frames as 0/255
 
 
 # ---- --axes ---------------------------------------------------------------------------------
+
 
 def test_axes_colours_and_directions(tmp_path):
     # Camera at (0, 0, 4) looking at the origin, up +Y, 201 x 151 (odd, so the principal point
@@ -27,18 +27,34 @@ def test_axes_colours_and_directions(tmp_path):
     # x = 100 + f 2.078 / 4 = 167.95 on row 75, Y up to y = 75 - 67.95 = 7.05 in column 100,
     # Z points at the camera and projects to the centre alone (a zero-length line).
     # Diamond-exit: the start pixel is drawn, the end pixel (its diamond holds the end) is not.
-    rc, _, err = run(["--scene", "cube", "--frames", "1", "--spin", "0,0,0", "--width", "201",
-                      "--height", "151", "--camera-z", "4", "--axes"], tmp_path)
+    rc, _, err = run(
+        [
+            "--scene",
+            "cube",
+            "--frames",
+            "1",
+            "--spin",
+            "0,0,0",
+            "--width",
+            "201",
+            "--height",
+            "151",
+            "--camera-z",
+            "4",
+            "--axes",
+        ],
+        tmp_path,
+    )
     assert (rc, err) == (0, "")
     img = frame(tmp_path, "cube")
     assert img.shape == (151, 201, 3)
     red = np.argwhere((img == (255, 0, 0)).all(axis=2))
     green = np.argwhere((img == (0, 255, 0)).all(axis=2))
-    assert set(red[:, 0].tolist()) == {75}                      # on the centre row ...
-    assert red[:, 1].min() == 101 and red[:, 1].max() == 167     # ... right of the centre (100 is Y's)
+    assert set(red[:, 0].tolist()) == {75}  # on the centre row ...
+    assert red[:, 1].min() == 101 and red[:, 1].max() == 167  # ... right of the centre (100 is Y's)
     assert len(red) == 67
-    assert set(green[:, 1].tolist()) == {100}                   # in the centre column ...
-    assert green[:, 0].min() == 8 and green[:, 0].max() == 75    # ... above the centre
+    assert set(green[:, 1].tolist()) == {100}  # in the centre column ...
+    assert green[:, 0].min() == 8 and green[:, 0].max() == 75  # ... above the centre
     assert len(green) == 68
     assert not (img == (0, 0, 255)).all(axis=2).any()
     # the rest of the picture is the grey wireframe: every other pixel has r = g = b
@@ -62,9 +78,28 @@ def test_axes_are_clipped_like_edges(tmp_path):
     # to (40 - 0.3 f, 30 + 0.3 f) = (24.15, 45.85) and the visible part runs from there to the
     # lower left, off the image. Unclipped, the part behind the camera would mirror to the
     # upper right of the centre.
-    rc, _, err = run(["--scene", "cube", "--frames", "1", "--spin", "0,0,0", "--camera-pos", "0.3,0.3,1",
-                      "--look-at", "0.3,0.3,0", "--width", "81", "--height", "61", "--axes",
-                      "--format", "png,ascii"], tmp_path)
+    rc, _, err = run(
+        [
+            "--scene",
+            "cube",
+            "--frames",
+            "1",
+            "--spin",
+            "0,0,0",
+            "--camera-pos",
+            "0.3,0.3,1",
+            "--look-at",
+            "0.3,0.3,0",
+            "--width",
+            "81",
+            "--height",
+            "61",
+            "--axes",
+            "--format",
+            "png,ascii",
+        ],
+        tmp_path,
+    )
     assert (rc, err) == (0, "")
     blue = np.argwhere((frame(tmp_path, "cube") == (0, 0, 255)).all(axis=2))
     assert len(blue) >= 10
@@ -74,6 +109,7 @@ def test_axes_are_clipped_like_edges(tmp_path):
 
 # ---- animations ----------------------------------------------------------------------------
 
+
 def test_mp4_frame_count_size_and_determinism(tmp_path):
     av = pytest.importorskip("av")
     args = ["--scene", "cube", "--frames", "6", "--width", "161", "--height", "121", "--format", "mp4"]
@@ -81,14 +117,14 @@ def test_mp4_frame_count_size_and_determinism(tmp_path):
     assert (rc, err) == (0, "")
     path = tmp_path / "a" / "cube.mp4"
     assert f"Animation: {path}" in out
-    assert not (tmp_path / "a" / "cube-frames").exists()       # mp4 alone writes no frame files
+    assert not (tmp_path / "a" / "cube-frames").exists()  # mp4 alone writes no frame files
     with av.open(str(path)) as c:
         frames = [f.to_ndarray(format="gray") for f in c.decode(video=0)]
     # 161 x 121 is odd both ways: padded (not scaled) to 162 x 122 for yuv420p
     assert len(frames) == 6 and frames[0].shape == (122, 162)
-    assert frames[0][121].max() <= 16 and frames[0][:, 161].max() <= 16   # the padding stays black (H.264 noise)
+    assert frames[0][121].max() <= 16 and frames[0][:, 161].max() <= 16  # the padding stays black (H.264 noise)
     assert run(args, tmp_path / "b")[0] == 0
-    assert (tmp_path / "b" / "cube.mp4").read_bytes() == path.read_bytes()     # (heap patterns: test_mp4_determinism)
+    assert (tmp_path / "b" / "cube.mp4").read_bytes() == path.read_bytes()  # (heap patterns: test_mp4_determinism)
     assert not [p for p in (tmp_path / "a").iterdir() if p.name.endswith(".tmp")]
 
 
@@ -102,14 +138,17 @@ def test_pad_even_pads_without_scaling():
 
 
 def test_gif_frame_count(tmp_path):
-    rc, _, _ = run(["--scene", "pyramid", "--frames", "5", "--width", "80", "--height", "60", "--format", "gif",
-                    "--axes"], tmp_path)
+    rc, _, _ = run(
+        ["--scene", "pyramid", "--frames", "5", "--width", "80", "--height", "60", "--format", "gif", "--axes"],
+        tmp_path,
+    )
     assert rc == 0
     with Image.open(tmp_path / "pyramid.gif") as g:
         assert g.n_frames == 5 and g.size == (80, 60)
 
 
 # ---- plots -----------------------------------------------------------------------------------
+
 
 def test_plots_png_size_and_determinism(tmp_path):
     pytest.importorskip("matplotlib")
@@ -119,7 +158,7 @@ def test_plots_png_size_and_determinism(tmp_path):
     path = tmp_path / "a" / "cube-plots.png"
     assert f"Plots: {path}" in out
     with Image.open(path) as im:
-        assert im.size == (900, 650)                           # FIGSIZE 9 x 6.5 in at 100 dpi
+        assert im.size == (900, 650)  # FIGSIZE 9 x 6.5 in at 100 dpi
     run(args, tmp_path / "b")
     assert (tmp_path / "b" / "cube-plots.png").read_bytes() == path.read_bytes()
     # off by default: no plot, no "Plots:" line
@@ -129,10 +168,11 @@ def test_plots_png_size_and_determinism(tmp_path):
 
 # ---- --projection both ------------------------------------------------------------------------
 
+
 def half_extents(img, w):
     """(col span, row span) of the drawn pixels of the left and the right picture."""
     out = []
-    for half in (img[:, :w], img[:, w + 1:]):
+    for half in (img[:, :w], img[:, w + 1 :]):
         rows, cols = np.nonzero(half)
         out.append((cols.max() - cols.min(), rows.max() - rows.min()))
     return out
@@ -146,9 +186,27 @@ def test_projection_both_side_by_side(tmp_path):
     sq = tmp_path / "sq.scene"
     sq.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 0 1 2 3\n")
     w, h = 161, 121
-    rc, _, err = run(["--scene", str(sq), "--frames", "2", "--spin", "0,0,0", "--camera-z", "4",
-                      "--width", str(w), "--height", str(h), "--projection", "both", "--format", "png,gif"],
-                     tmp_path)
+    rc, _, err = run(
+        [
+            "--scene",
+            str(sq),
+            "--frames",
+            "2",
+            "--spin",
+            "0,0,0",
+            "--camera-z",
+            "4",
+            "--width",
+            str(w),
+            "--height",
+            str(h),
+            "--projection",
+            "both",
+            "--format",
+            "png,gif",
+        ],
+        tmp_path,
+    )
     assert (rc, err) == (0, "")
     img = frame(tmp_path, "sq")
     assert img.shape == (h, 2 * w + 1)
@@ -179,8 +237,25 @@ def test_projection_both_cube_nearer_than_look_at_is_bigger_in_perspective(tmp_p
     # perspective (the outline), but 2 s = 52.39 px in the orthographic half, where front and
     # back faces coincide.
     w, h = 161, 121
-    rc, _, _ = run(["--scene", "cube", "--frames", "1", "--spin", "0,0,0", "--camera-z", "4", "--width", str(w),
-                    "--height", str(h), "--projection", "both"], tmp_path)
+    rc, _, _ = run(
+        [
+            "--scene",
+            "cube",
+            "--frames",
+            "1",
+            "--spin",
+            "0,0,0",
+            "--camera-z",
+            "4",
+            "--width",
+            str(w),
+            "--height",
+            str(h),
+            "--projection",
+            "both",
+        ],
+        tmp_path,
+    )
     assert rc == 0
     (pc, _), (oc, _) = half_extents(frame(tmp_path, "cube"), w)
     f = 60.5 / math.tan(math.radians(30))
@@ -190,24 +265,58 @@ def test_projection_both_cube_nearer_than_look_at_is_bigger_in_perspective(tmp_p
 def test_projection_both_with_axes_and_mp4(tmp_path):
     av = pytest.importorskip("av")
     w, h = 64, 48
-    rc, _, err = run(["--scene", "orrery", "--frames", "3", "--camera-z", "8", "--width", str(w), "--height", str(h),
-                      "--projection", "both", "--axes", "--format", "png,mp4"], tmp_path)
+    rc, _, err = run(
+        [
+            "--scene",
+            "orrery",
+            "--frames",
+            "3",
+            "--camera-z",
+            "8",
+            "--width",
+            str(w),
+            "--height",
+            str(h),
+            "--projection",
+            "both",
+            "--axes",
+            "--format",
+            "png,mp4",
+        ],
+        tmp_path,
+    )
     assert (rc, err) == (0, "")
     img = frame(tmp_path, "orrery")
     assert img.shape == (h, 2 * w + 1, 3)
     assert (img[:, w] == SEPARATOR_GREY).all()
-    for half in (img[:, :w], img[:, w + 1:]):                    # both pictures have their axes
+    for half in (img[:, :w], img[:, w + 1 :]):  # both pictures have their axes
         assert (half == (255, 0, 0)).all(axis=2).any() and (half == (0, 255, 0)).all(axis=2).any()
     with av.open(str(tmp_path / "orrery.mp4")) as c:
         frames = list(c.decode(video=0))
-    assert len(frames) == 3 and (frames[0].width, frames[0].height) == (2 * w + 2, h)   # 129 -> 130
+    assert len(frames) == 3 and (frames[0].width, frames[0].height) == (2 * w + 2, h)  # 129 -> 130
 
 
 # ---- shaded style through the CLI -----------------------------------------------------------
 
+
 def test_shaded_style_writes_grey_faces(tmp_path):
-    rc, out, err = run(["--scene", "cube", "--frames", "1", "--width", "64", "--height", "48", "--style", "shaded",
-                        "--light", "0,0,-1"], tmp_path)
+    rc, out, err = run(
+        [
+            "--scene",
+            "cube",
+            "--frames",
+            "1",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--style",
+            "shaded",
+            "--light",
+            "0,0,-1",
+        ],
+        tmp_path,
+    )
     assert (rc, err) == (0, "")
     img = frame(tmp_path, "cube")
     assert img.ndim == 2 and img.any()

@@ -7,7 +7,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PIL import Image
-
 from wirecheck.oracles.judge.metrics import DIFF_COLOURS
 from wirecheck.oracles.reports.report_crops import CROP_PX, SCALE, crop_image, worst_window
 
@@ -37,24 +36,40 @@ def test_the_crop_is_the_diff_enlarged_pixel_for_pixel():
     # image pixel (y 100, x 200) is crop pixel (38, 0): the SCALE x SCALE block at rows 228..233
     red = np.array(DIFF_COLOURS["candidate_only"], np.uint8)
     blue = np.array(DIFF_COLOURS["oracle_only"], np.uint8)
-    assert (img[(100 - y0) * SCALE:(101 - y0) * SCALE, 0:SCALE] == red).all()
-    assert (img[(101 - y0) * SCALE:(102 - y0) * SCALE, 0:SCALE] == blue).all()
-    assert (img[:(100 - y0) * SCALE] == 0).all()            # nothing drawn above the pair
+    assert (img[(100 - y0) * SCALE : (101 - y0) * SCALE, 0:SCALE] == red).all()
+    assert (img[(101 - y0) * SCALE : (102 - y0) * SCALE, 0:SCALE] == blue).all()
+    assert (img[: (100 - y0) * SCALE] == 0).all()  # nothing drawn above the pair
 
 
 def test_frames_that_agree_give_an_empty_window():
     a = np.zeros((30, 50), bool)
     a[5, 5:20] = True
-    assert worst_window(a, a) == (0, 0, 0)                   # image smaller than the window: clamped
+    assert worst_window(a, a) == (0, 0, 0)  # image smaller than the window: clamped
 
 
 @pytest.mark.slow
 def test_report_html_shows_the_crop_of_a_half_pixel_offset(tmp_path):
     run = tmp_path / "r"
-    done = subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", "--candidate",
-                           str(ROOT / "tests/data/user_projector.py") + ":project_corner", "--scene", "cube",
-                           "--cases", "on_axis", "--frames", "1", "--report-dir", str(run)],
-                          capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "wirecheck.oracles.cli",
+            "--candidate",
+            str(ROOT / "tests/data/user_projector.py") + ":project_corner",
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            "--frames",
+            "1",
+            "--report-dir",
+            str(run),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 1, done.stderr
     html = (run / "report.html").read_text()
     assert "img/cube-on_axis-crop.png" in html and "diff, 6x: x " in html

@@ -4,21 +4,19 @@ NaN; report.json/md/html, JUnit, the console table, the first lines and the line
 without an exception. Integer counts are left alone: they are counted, never measured, and never inf."""
 
 import copy
-import shutil
 import json
 import math
+import shutil
 
 import pytest
-
+from helpers import blank_job
 from wirecheck.oracles import cli
 from wirecheck.oracles.frames_cli import verdict_line
 from wirecheck.oracles.judge.line_style import summary_lines
 from wirecheck.oracles.reports.compared import hint_lines, what_text
 from wirecheck.oracles.reports.junit import junit_xml
-from wirecheck.oracles.tolerances import Tolerances
 from wirecheck.oracles.reports.report import _html, console_table, markdown, write_report
-
-from helpers import blank_job
+from wirecheck.oracles.tolerances import Tolerances
 
 ODD = (None, math.inf, math.nan)
 #: Fields that are null in a real report but never numbers (a run name, settings, a command, a precision name).
@@ -33,7 +31,7 @@ def _paths(obj, path=()):
         yield path
     elif isinstance(obj, dict):
         for k, v in obj.items():
-            if k != "timing" or path:                    # timings: wall-clock numbers, fuzzed below anyway
+            if k != "timing" or path:  # timings: wall-clock numbers, fuzzed below anyway
                 yield from _paths(v, path + (k,))
     elif isinstance(obj, list):
         for i, v in enumerate(obj[:1] if path and path[-1] == "per_frame" else obj):
@@ -60,7 +58,7 @@ def _write_all(report, tmp_path, files: bool):
     _html(report, [], set())
     junit_xml(report)
     console_table(report["cases"])
-    markdown(report, set())          # direct too: a caller that did not null inf/NaN first
+    markdown(report, set())  # direct too: a caller that did not null inf/NaN first
     what_text(report)
     hint_lines(report, failing)
     summary_lines(report["cases"])
@@ -72,8 +70,23 @@ def _write_all(report, tmp_path, files: bool):
 def reports(tmp_path_factory):
     """A failing projector's report (pixels level) and a blank renderer's frames report."""
     base = tmp_path_factory.mktemp("fuzz")
-    assert cli.main(["--scene", "cube", "--frames", "2", "--cases", "on_axis,oblique_roll", "--candidate",
-                     "tests/data/user_projector.py:project_corner", "--report-dir", str(base / "p")]) == 1
+    assert (
+        cli.main(
+            [
+                "--scene",
+                "cube",
+                "--frames",
+                "2",
+                "--cases",
+                "on_axis,oblique_roll",
+                "--candidate",
+                "tests/data/user_projector.py:project_corner",
+                "--report-dir",
+                str(base / "p"),
+            ]
+        )
+        == 1
+    )
     job = blank_job(base / "job")
     assert cli.main(["--candidate-frames", str(job), "--report-dir", str(base / "f")]) == 1
     return [json.loads((base / d / "report.json").read_text()) for d in ("p", "f")]
@@ -82,15 +95,14 @@ def reports(tmp_path_factory):
 @pytest.mark.parametrize("which", [0, 1], ids=["projector", "frames"])
 def test_every_float_field_odd(reports, which, tmp_path):
     report = reports[which]
-    paths = list(_paths(report)) + [("timing", k) for k, v in report.get("timing", {}).items()
-                                    if isinstance(v, float)]
-    assert len(paths) > 40                    # the fuzz reaches the case fields, not just the top level
+    paths = list(_paths(report)) + [("timing", k) for k, v in report.get("timing", {}).items() if isinstance(v, float)]
+    assert len(paths) > 40  # the fuzz reaches the case fields, not just the top level
     crashes = []
     for path in paths:
         for value in ODD:
             try:
                 _write_all(_with(report, path, value), tmp_path, files=value is None)
-            except Exception as exc:       # collected: every crash named at once
+            except Exception as exc:  # collected: every crash named at once
                 crashes.append(f"{path}={value}: {type(exc).__name__}: {exc}")
     assert not crashes, "\n".join(crashes[:40]) + f"\n({len(crashes)} in all)"
 

@@ -6,7 +6,6 @@ import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
 
 import pytest
-
 from wirecheck.oracles.judge.case import PIXELS_NOT_COMPARED
 from wirecheck.oracles.reports.junit import junit_xml
 from wirecheck.oracles.reports.report import _html, markdown
@@ -56,8 +55,20 @@ def test_distorted_case_note_in_html_and_junit(tmp_path):
     from wirecheck.oracles import cli
 
     out, xml_path = tmp_path / "run", tmp_path / "junit.xml"
-    code = cli.main(["--report-dir", str(out), "--junit-xml", str(xml_path), "--scene", "cube",
-                     "--cases", "on_axis,distorted", "--frames", "2"])
+    code = cli.main(
+        [
+            "--report-dir",
+            str(out),
+            "--junit-xml",
+            str(xml_path),
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis,distorted",
+            "--frames",
+            "2",
+        ]
+    )
     assert code == 0
     report = json.loads((out / "report.json").read_text())
     assert [c.get("note") for c in report["cases"]] == [None, PIXELS_NOT_COMPARED]
@@ -66,7 +77,8 @@ def test_distorted_case_note_in_html_and_junit(tmp_path):
     assert f"cube / distorted: {PIXELS_NOT_COMPARED}" in items
     assert not [i for i in items if i.startswith("cube / on_axis")]
     assert junit_notes(xml_path.read_bytes()) == {
-        ("cube", "distorted"): (PIXELS_NOT_COMPARED, f"note: {PIXELS_NOT_COMPARED}\n")}
+        ("cube", "distorted"): (PIXELS_NOT_COMPARED, f"note: {PIXELS_NOT_COMPARED}\n")
+    }
 
 
 @pytest.fixture(scope="module")
@@ -75,8 +87,12 @@ def one_case_report(tmp_path_factory):
     from wirecheck.oracles import cli
 
     out = tmp_path_factory.mktemp("notes") / "run"
-    assert cli.main(["--report-dir", str(out), "--level", "vertices", "--scene", "cube", "--cases", "on_axis",
-                     "--frames", "1"]) == 0
+    assert (
+        cli.main(
+            ["--report-dir", str(out), "--level", "vertices", "--scene", "cube", "--cases", "on_axis", "--frames", "1"]
+        )
+        == 0
+    )
     return json.loads((out / "report.json").read_text())
 
 
@@ -92,7 +108,7 @@ def test_note_is_escaped_in_html_and_junit(one_case_report):
     report = _report(one_case_report, note)
     items, tags = html_items(_html(report, []))
     assert f"cube / on_axis: {note}" in items
-    assert "script" not in tags and tags.count("b") == 1    # the <b> of "cube / on_axis", none from the note
+    assert "script" not in tags and tags.count("b") == 1  # the <b> of "cube / on_axis", none from the note
     assert junit_notes(junit_xml(report)) == {("cube", "on_axis"): (note, f"note: {note}\n")}
     assert f"- cube / on_axis: {note}" in markdown(report)
 

@@ -6,15 +6,14 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from helpers import run_crosscheck as run
 from PIL import Image
-
 from wirecheck.oracles.candidates.core_candidate import CoreCandidate
 from wirecheck.oracles.judge.metrics import DIFF_COLOURS
 from wirecheck.oracles.runner import run_crosscheck
-from helpers import run_crosscheck as run
 
 DATA = Path(__file__).parent / "data"
-CORNER = f"{DATA / 'user_projector.py'}:project_corner"   # principal point at (W/2, H/2): off by (+0.5, +0.5)
+CORNER = f"{DATA / 'user_projector.py'}:project_corner"  # principal point at (W/2, H/2): off by (+0.5, +0.5)
 #: float64 pixels of a 640 x 480 image are exact to ~1e-13 px; 1e-9 px leaves room and still tells 0.5 apart
 EPS_PX = 1e-9
 
@@ -26,11 +25,21 @@ def _cube():
 
 
 def test_vertex_report_shows_the_worst_points_deterministically(tmp_path):
-    args = ("--candidate", CORNER, "--scene", "cube", "--frames", "2", "--cases", "on_axis,oblique_roll",
-            "--level", "vertices")
+    args = (
+        "--candidate",
+        CORNER,
+        "--scene",
+        "cube",
+        "--frames",
+        "2",
+        "--cases",
+        "on_axis,oblique_roll",
+        "--level",
+        "vertices",
+    )
     code, report, a = run(tmp_path, *args, name="a")
     _, _, b = run(tmp_path, *args, name="b")
-    assert code == 1 and report["level"] == "vertices"          # the offset fails the 1e-6 px tolerance
+    assert code == 1 and report["level"] == "vertices"  # the offset fails the 1e-6 px tolerance
     assert (a / "worst_points.png").read_bytes() == (b / "worst_points.png").read_bytes()
     png = Image.open(a / "worst_points.png")
     assert png.format == "PNG" and "Software" not in png.info
@@ -51,20 +60,25 @@ def test_the_points_are_the_frame_of_the_worst_vertex():
         from user_projector import project_corner
     finally:
         sys.path.remove(str(DATA))
-    report, images = run_crosscheck([_cube()], project_corner, frames=2, case_names=["on_axis"],
-                                    level="vertices", candidate_name="corner")
+    report, images = run_crosscheck(
+        [_cube()], project_corner, frames=2, case_names=["on_axis"], level="vertices", candidate_name="corner"
+    )
     points = images["points"]
     cand, orac = points["candidate"], points["oracle"]
     shown = np.isfinite(cand).all(axis=1) & np.isfinite(orac).all(axis=1)
-    assert shown.sum() == 8                                       # the cube's 8 corners, all in view
+    assert shown.sum() == 8  # the cube's 8 corners, all in view
     # hand-derived: cx = W/2 against OpenCV's (W-1)/2, and the same for y: every point (+0.5, +0.5)
     assert np.abs(cand[shown] - orac[shown] - 0.5).max() < EPS_PX
     assert abs(points["error_px"] - math.sqrt(0.5)) < EPS_PX
     v = points["vertex"]
     assert abs(math.hypot(*(cand[v] - orac[v])) - points["error_px"]) < EPS_PX
     worst = report["cases"][0]["worst_vertex"]
-    assert (points["scene"], points["camera"], points["frame"], v) == ("cube", "on_axis", worst["frame"],
-                                                                       worst["vertex"])
+    assert (points["scene"], points["camera"], points["frame"], v) == (
+        "cube",
+        "on_axis",
+        worst["frame"],
+        worst["vertex"],
+    )
     assert points["size"] == (640, 480)
 
 
@@ -72,9 +86,13 @@ def test_the_case_with_the_largest_vertex_error_is_shown():
     # float32: each case's error is its own rounding, so the cases differ; measured once: oblique_roll
     # 2.0e-5, wide_fov 2.3e-5, orthographic 2.1e-5 px, the largest in the middle of the run's order (so
     # neither "the first" nor "the last" case passes this test)
-    report, images = run_crosscheck([_cube()], CoreCandidate(dtype="float32"), frames=3,
-                                    case_names=["oblique_roll", "orthographic", "wide_fov"],
-                                    level="vertices")
+    report, images = run_crosscheck(
+        [_cube()],
+        CoreCandidate(dtype="float32"),
+        frames=3,
+        case_names=["oblique_roll", "orthographic", "wide_fov"],
+        level="vertices",
+    )
     errors = {(c["scene"], c["camera"]): c["max_vertex_error_px"] for c in report["cases"]}
     assert len(set(errors.values())) == 3 and max(errors, key=errors.get) == ("cube", "wide_fov")
     points = images["points"]
@@ -98,7 +116,7 @@ def test_a_pixel_report_has_no_points_figure(tmp_path):
 #: has a sign in y: a plot drawn with y up would put the crosses 100 px the wrong way.
 SHIFT_PX = (16.0, -100.0)
 
-SHIFTED = f'''
+SHIFTED = f"""
 import json
 import numpy as np
 from my_projection import project
@@ -113,7 +131,7 @@ def shifted(points, camera):
 
 def test_shifted(wirecheck):
     wirecheck(shifted, scenes=["cube"], frames=1, cases=["on_axis"], report_dir="own")
-'''
+"""
 
 
 def _blobs(rgb: np.ndarray, colour: tuple) -> np.ndarray:
@@ -135,7 +153,7 @@ def test_the_fixtures_vertex_report_plots_the_points_where_they_were_projected(p
     pytester.syspathinsert()
     result = pytester.runpytest("--wirecheck-report", "reports")
     result.assert_outcomes(failed=1)
-    out = pytester.path / "reports" / "test_user.py_test_shifted-c1fc865c"   # + SHA-1 of the id
+    out = pytester.path / "reports" / "test_user.py_test_shifted-c1fc865c"  # + SHA-1 of the id
     assert "src='worst_points.png'" in (out / "report.html").read_text()
     # the call's own report_dir (check_projector's keyword) holds the same report
     own = pytester.path / "own"
@@ -169,7 +187,7 @@ def test_the_fixtures_vertex_report_plots_the_points_where_they_were_projected(p
 
     for marks, p_px in ((crosses, p_cand), (circles, p_orac)):
         d = np.linalg.norm(marks[:, None, :] - placed(p_px)[None, :, :], axis=2)
-        assert d.min(axis=0).max() < 1.5 and d.min(axis=1).max() < 1.5     # each point has its mark, and back
+        assert d.min(axis=0).max() < 1.5 and d.min(axis=1).max() < 1.5  # each point has its mark, and back
 
 
 def test_the_api_writes_the_same_picture_as_crosscheck(tmp_path):
@@ -193,7 +211,6 @@ def test_the_api_writes_the_same_picture_as_crosscheck(tmp_path):
 
 def test_a_report_dir_that_is_not_a_folder_is_refused_before_the_run(tmp_path):
     import pytest
-
     from wirecheck import check_projector
 
     mine = tmp_path / "notes.txt"

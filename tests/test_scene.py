@@ -3,10 +3,9 @@
 import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
-
 from wirecheck.core.errors import InputError
-from wirecheck.core.scene.model import unique_edges
 from wirecheck.core.scene.files import builtin_names, load_scene, parse_scene_text
+from wirecheck.core.scene.model import unique_edges
 
 CUBE_CORNERS = [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]]
 
@@ -34,7 +33,7 @@ def test_cube_geometry():
 
 def test_pyramid_and_prism_geometry():
     p = load_scene("pyramid")
-    assert_array_equal(p.vertices[4], [0, 1, 0])                    # apex
+    assert_array_equal(p.vertices[4], [0, 1, 0])  # apex
     assert sorted(map(tuple, p.edges.tolist())) == [(0, 1), (0, 3), (0, 4), (1, 2), (1, 4), (2, 3), (2, 4), (3, 4)]
     q = load_scene("prism")
     # circumradius 1 triangle at z = -1 and z = +1: |(x, y)| = 1 for all 6 vertices
@@ -142,6 +141,7 @@ def test_scene_arrays_are_read_only():
 
 # ---- mesh files ------------------------------------------------------------------------
 
+
 def test_obj_line_elements_become_edges(tmp_path):
     p = tmp_path / "lines.obj"
     # l 1 2 3 -> (0,1) (1,2); l -1 -4 -> relative: last vertex (3) to first (0)
@@ -209,6 +209,7 @@ def test_corrupt_mesh_file_is_input_error(tmp_path):
 
 
 # ---- objects (tests/test_multi_object.py has the rest) -----------------------------------
+
 
 def test_example_scene_by_name_and_in_the_unknown_message():
     s = load_scene("orrery")

@@ -6,13 +6,13 @@ import math
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.shading import DEFAULT_AMBIENT, default_light_dir, face_intensity, shade
 
-CUBE_V = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
-                   [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
+CUBE_V = np.array(
+    [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float
+)
 CUBE_F = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (3, 7, 6, 2), (0, 4, 7, 3), (1, 2, 6, 5)]
 CUBE_E = np.array(sorted({tuple(sorted((f[k], f[(k + 1) % 4]))) for f in CUBE_F for k in range(4)}))
 
@@ -41,7 +41,7 @@ def test_shaded_cube_face_has_the_exact_lambert_level():
     for deg in (0.0, 30.0, 60.0, 75.0):
         light = np.array([math.sin(math.radians(deg)), 0.0, -math.cos(math.radians(deg))])
         fr = render_frame(CUBE_V, CUBE_E, cam, np.eye(4), faces=CUBE_F, style="shaded", light_dir=light)
-        cos = math.cos(math.radians(deg))     # front face normal (0, 0, 1) . (-light)
+        cos = math.cos(math.radians(deg))  # front face normal (0, 0, 1) . (-light)
         expected = _level(DEFAULT_AMBIENT + (1 - DEFAULT_AMBIENT) * cos)
         front = fr.face_ids == 1
         assert front.sum() > 5000
@@ -60,7 +60,7 @@ def test_default_light_comes_from_the_cameras_upper_left():
     assert d @ cam.forward > 0 and d @ cam.right > 0 and d @ cam.up < 0
     fr = render_frame(CUBE_V, CUBE_E, cam, np.eye(4), faces=CUBE_F, style="shaded")
     lv = {f: set(np.unique(fr.image[fr.face_ids == f])) for f in (1, 3, 5)}
-    assert all(len(v) == 1 for v in lv.values())                # flat: one level per face
+    assert all(len(v) == 1 for v in lv.values())  # flat: one level per face
     assert fr.faces_visible == 3
     # the top face (+y) faces the upper light more than the right face (+x) does
     assert lv[3].pop() > lv[5].pop()
@@ -98,25 +98,37 @@ def test_shaded_silhouette_against_pyrender(projection, pyrender_renderer, summa
     (tests/test_zbuffer.py). Bound asserted: IoU >= 0.999.
     """
     import pyrender
+
     trimesh = pytest.importorskip("trimesh")
 
     from wirecheck.oracles.references.convert import camera_to_pyrender
+
     ico = trimesh.creation.icosphere(subdivisions=3)
     v, f = np.asarray(ico.vertices), np.asarray(ico.faces)
-    cam = look_at((2.5, 1.8, 3.3), (0.0, 0.0, 0.0), near=0.5, far=20.0, projection=projection,
-                  ortho_height=3.0)
-    fr = render_frame(v, np.asarray(ico.edges_unique), cam, np.eye(4), faces=[tuple(t) for t in f],
-                      style="shaded")
+    cam = look_at((2.5, 1.8, 3.3), (0.0, 0.0, 0.0), near=0.5, far=20.0, projection=projection, ortho_height=3.0)
+    fr = render_frame(v, np.asarray(ico.edges_unique), cam, np.eye(4), faces=[tuple(t) for t in f], style="shaded")
     scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
     mat = pyrender.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=True)
-    scene.add(pyrender.Mesh([pyrender.Primitive(positions=v.astype(np.float32), indices=f.astype(np.uint32),
-                                                mode=pyrender.constants.GLTF.TRIANGLES, material=mat)]))
+    scene.add(
+        pyrender.Mesh(
+            [
+                pyrender.Primitive(
+                    positions=v.astype(np.float32),
+                    indices=f.astype(np.uint32),
+                    mode=pyrender.constants.GLTF.TRIANGLES,
+                    material=mat,
+                )
+            ]
+        )
+    )
     pose, pc = camera_to_pyrender(cam)
     scene.add(pc, pose=pose)
     colour, _ = pyrender_renderer.render(scene, pyrender.RenderFlags.FLAT)
     theirs = colour[:, :, 0] > 127
-    ours = fr.image > 0                            # every face gets >= ambient 38 > 0
+    ours = fr.image > 0  # every face gets >= ambient 38 > 0
     iou = (ours & theirs).sum() / (ours | theirs).sum()
-    summary_section(f"shaded silhouette vs pyrender ({projection})",
-                    f"IoU {iou:.6f}, {int((ours ^ theirs).sum())} px differ of {int(ours.sum())}")
+    summary_section(
+        f"shaded silhouette vs pyrender ({projection})",
+        f"IoU {iou:.6f}, {int((ours ^ theirs).sum())} px differ of {int(ours.sum())}",
+    )
     assert iou >= 0.999

@@ -11,7 +11,6 @@ from collections import deque
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import look_at
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles.judge.silhouette import SilhouetteScores, largest_run, score_silhouette
@@ -51,10 +50,11 @@ def _square(x0, y0, side, shape=(480, 640)):
 
 # ---- the boundary measure ----------------------------------------------------------------------
 
+
 def test_largest_run_counts_8_connected_pixels():
     m = np.zeros((8, 9), dtype=bool)
-    m[np.arange(6), np.arange(6) + 2] = True     # a staircase: one run of 6 (diagonal neighbours)
-    m[0, 8] = m[1, 8] = True                      # a run of 2 at the border: no wrap-around to row 2, column 0
+    m[np.arange(6), np.arange(6) + 2] = True  # a staircase: one run of 6 (diagonal neighbours)
+    m[0, 8] = m[1, 8] = True  # a run of 2 at the border: no wrap-around to row 2, column 0
     m[2, 0] = True
     size, at = largest_run(m)
     assert size == 6 and m[at] and at[1] == at[0] + 2
@@ -69,7 +69,7 @@ def test_largest_run_agrees_with_a_breadth_first_search():
     # a long snake (the worst case for label propagation) is one run
     snake = np.zeros((41, 41), dtype=bool)
     snake[::2, :] = True
-    for row in range(1, 41, 2):                   # joined at alternate ends
+    for row in range(1, 41, 2):  # joined at alternate ends
         snake[row, 40 if row % 4 == 1 else 0] = True
     assert largest_run(snake)[0] == _bfs_largest(snake) == snake.sum()
 
@@ -103,8 +103,9 @@ def test_a_half_pixel_shift_fails():
     cam = look_at((2.0, 1.5, 2.5), (0.0, 0.0, 0.0), (0.3, 1.0, 0.2), fov_y_deg=55, near=0.1, far=10.0)
     f = (cam.height / 2) / math.tan(math.radians(cam.fov_y_deg) / 2)
     cx, cy = (cam.width - 1) / 2, (cam.height - 1) / 2
-    shifted = look_at((2.0, 1.5, 2.5), (0.0, 0.0, 0.0), (0.3, 1.0, 0.2), near=0.1, far=10.0,
-                      intrinsics=(f, f, cx + 0.5, cy))
+    shifted = look_at(
+        (2.0, 1.5, 2.5), (0.0, 0.0, 0.0), (0.3, 1.0, 0.2), near=0.1, far=10.0, intrinsics=(f, f, cx + 0.5, cy)
+    )
     ref, ties, _ = silhouette(scene.vertices, scene.faces, cam, (cam.height, cam.width))
     cand, _, _ = silhouette(scene.vertices, scene.faces, shifted, (cam.height, cam.width))
     s = score_silhouette(cand, ref, ties)
@@ -114,8 +115,7 @@ def test_a_half_pixel_shift_fails():
     assert s.iou > TOL.min_iou
     assert not s.passed(TOL) and "in one run" in s.failures(TOL)[0]
     # ... and the very same camera given by its intrinsics passes: the shift is the fault
-    same = look_at((2.0, 1.5, 2.5), (0.0, 0.0, 0.0), (0.3, 1.0, 0.2), near=0.1, far=10.0,
-                   intrinsics=(f, f, cx, cy))
+    same = look_at((2.0, 1.5, 2.5), (0.0, 0.0, 0.0), (0.3, 1.0, 0.2), near=0.1, far=10.0, intrinsics=(f, f, cx, cy))
     cand, _, _ = silhouette(scene.vertices, scene.faces, same, (cam.height, cam.width))
     s = score_silhouette(cand, ref, ties)
     assert s.passed(TOL) and s.iou == 1.0 and s.longest_run_px == 0
@@ -124,7 +124,7 @@ def test_a_half_pixel_shift_fails():
 def test_disagreements_at_ties_do_not_count():
     # the right triangle of test_fill_rule: every centre on its edges is a tie
     ref, ties = coverage([[[2, 2], [40, 2], [2, 40]]], (48, 48))
-    cand = ref ^ ties                                   # every tie answered the other way
+    cand = ref ^ ties  # every tie answered the other way
     s = score_silhouette(cand, ref, ties)
     assert ties.sum() == 3 * 38 and s.ties_px == 3 * 38
     assert (s.holes, s.extra, s.longest_run_px, s.iou) == (0, 0, 0, 1.0)
@@ -134,9 +134,9 @@ def test_disagreements_at_ties_do_not_count():
 def test_holes_and_extra_are_counted_and_scattered_pixels_make_short_runs():
     ref, ties = _square(10.3, 10.3, 40.0, shape=(64, 64))
     cand = ref.copy()
-    cand[20, 20:23] = False                             # a hole of 3 in a row
-    cand[30, 30] = False                                # and one alone
-    cand[60, 5] = cand[60, 60] = True                   # two extra, apart
+    cand[20, 20:23] = False  # a hole of 3 in a row
+    cand[30, 30] = False  # and one alone
+    cand[60, 5] = cand[60, 60] = True  # two extra, apart
     s = score_silhouette(cand, ref, ties)
     assert (s.holes, s.extra, s.longest_run_px) == (4, 2, 3)
     assert s.run_at == (20, 20)
@@ -149,10 +149,10 @@ def test_holes_and_extra_are_counted_and_scattered_pixels_make_short_runs():
 
 
 def test_iou_limit_applies_from_the_union_floor_up():
-    ref, ties = _square(10.3, 10.3, 40.0, shape=(64, 64))   # 1600 px, above MIN_IOU_UNION_PX
+    ref, ties = _square(10.3, 10.3, 40.0, shape=(64, 64))  # 1600 px, above MIN_IOU_UNION_PX
     cand = ref.copy()
-    cand[11:21, 11:51] = False                              # 400 holes: IoU 0.75
-    loose = Tolerances(max_silhouette_run_px=10 ** 6)
+    cand[11:21, 11:51] = False  # 400 holes: IoU 0.75
+    loose = Tolerances(max_silhouette_run_px=10**6)
     s = score_silhouette(cand, ref, ties)
     assert s.iou == pytest.approx(0.75) and not s.passed(loose)
     assert "IoU 0.750000 below 0.995" in s.failures(loose)[0]
@@ -167,7 +167,7 @@ def test_iou_limit_applies_from_the_union_floor_up():
 
 # ---- never vacuous -----------------------------------------------------------------------------
 
-VERY_LOOSE = Tolerances(max_silhouette_run_px=10 ** 9, min_iou=0.0)
+VERY_LOOSE = Tolerances(max_silhouette_run_px=10**9, min_iou=0.0)
 
 
 def test_a_blank_candidate_never_passes():
@@ -192,7 +192,7 @@ def test_nothing_decided_never_passes():
 
 
 def test_a_reference_covered_only_at_ties_never_passes():
-    ref, ties = coverage([[[2, 2], [3, 2], [2, 3]]], (8, 8))    # a half-pixel triangle: its centres on edges
+    ref, ties = coverage([[[2, 2], [3, 2], [2, 3]]], (8, 8))  # a half-pixel triangle: its centres on edges
     assert ref.any() and not (ref & ~ties).any()
     s = score_silhouette(ref, ref, ties)
     assert "reference covers no decided pixel" in s.vacuous and not s.passed(VERY_LOOSE)
@@ -220,4 +220,4 @@ def test_the_tie_distance_grows_with_the_frame_scale_past_4096_px():
     # up to 4,096 px the float32 rounding (4 eps32 scale) is within the 2^-9 FILL_TIE_PX assumes
     assert tolerances.fill_tie_bound(0.0) == tolerances.fill_tie_bound(4096.0) == tolerances.FILL_TIE_PX
     # at 2^16 px: 4 x 2^-23 x 2^16 = 2^-5 of rounding, plus the 2^-9 snap, times sqrt 2
-    assert tolerances.fill_tie_bound(2.0 ** 16) == pytest.approx(math.sqrt(2) * (2 ** -9 + 2 ** -5), rel=1e-15)
+    assert tolerances.fill_tie_bound(2.0**16) == pytest.approx(math.sqrt(2) * (2**-9 + 2**-5), rel=1e-15)

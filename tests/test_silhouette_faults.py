@@ -26,15 +26,18 @@ from collections import Counter
 
 import numpy as np
 import pytest
-
 from wirecheck.core.camera import Camera
 from wirecheck.core.projector import pipeline
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.diagnosis import silhouette_faults
-from wirecheck.oracles.diagnosis.silhouette_faults import (ALLOWANCE, SILHOUETTE_FAULTS, SilhouetteFrame,
-                                                           name_silhouette_faults)
+from wirecheck.oracles.diagnosis.silhouette_faults import (
+    ALLOWANCE,
+    SILHOUETTE_FAULTS,
+    SilhouetteFrame,
+    name_silhouette_faults,
+)
 from wirecheck.oracles.faults import CATALOGUE, Fault
 from wirecheck.oracles.references import faces as oface
 from wirecheck.oracles.references.fill_rule import silhouette
@@ -43,8 +46,17 @@ SCENES = ("cube", "prism", "pyramid")
 MOTION = Motion(turns=(1.0, 1.0, 0.0))
 #: The cells where the mistake cannot be seen (module docstring): (scene, case, injected) -> named.
 INVISIBLE = {
-    **{("cube", "near_plane", m): "pass" for m in ("mirror_vertical", "mirror_horizontal", "axis_flip",
-                                                      "pixel_offset", "fov_mismatch", "aspect_mismatch")},
+    **{
+        ("cube", "near_plane", m): "pass"
+        for m in (
+            "mirror_vertical",
+            "mirror_horizontal",
+            "axis_flip",
+            "pixel_offset",
+            "fov_mismatch",
+            "aspect_mismatch",
+        )
+    },
     ("cube", "orthographic", "mirror_vertical"): "ambiguous",
     ("cube", "orthographic", "mirror_horizontal"): "ambiguous",
     ("cube", "orthographic", "axis_flip"): "pass",
@@ -53,31 +65,47 @@ INVISIBLE = {
 
 def core_covered(pr_vertices, scene, camera, pose) -> np.ndarray:
     """Core's shaded frame through ``camera``: ``(H, W)`` bool, covered where its depth buffer holds a surface."""
-    frame = pipeline.render_frame(pr_vertices, scene.edges, camera, np.eye(4) if pose is None else pose,
-                                  faces=scene.faces, style="shaded")
+    frame = pipeline.render_frame(
+        pr_vertices, scene.edges, camera, np.eye(4) if pose is None else pose, faces=scene.faces, style="shaded"
+    )
     return np.isfinite(frame.depth_image)
 
 
 def turned(camera) -> Camera:
     """The camera with ``up`` negated (so ``right`` too): the picture turned 180 degrees about the centre."""
-    return Camera(position=camera.position, forward=camera.forward, up=-np.asarray(camera.up),
-                  fov_y_deg=camera.fov_y_deg, width=camera.width, height=camera.height, near=camera.near,
-                  far=camera.far, projection=camera.projection, ortho_height=camera.ortho_height)
+    return Camera(
+        position=camera.position,
+        forward=camera.forward,
+        up=-np.asarray(camera.up),
+        fov_y_deg=camera.fov_y_deg,
+        width=camera.width,
+        height=camera.height,
+        near=camera.near,
+        far=camera.far,
+        projection=camera.projection,
+        ortho_height=camera.ortho_height,
+    )
 
 
 def mistakes(scene, camera, pr_vertices, pose) -> dict:
     """The candidate's covered pixels under each mistake, keyed by the expected name ("pass": none)."""
     good = core_covered(pr_vertices, scene, camera, pose)
-    out = {"pass": good, "mirror_vertical": good[::-1], "mirror_horizontal": good[:, ::-1],
-           "axis_flip": core_covered(pr_vertices, scene, turned(camera), pose)}
+    out = {
+        "pass": good,
+        "mirror_vertical": good[::-1],
+        "mirror_horizontal": good[:, ::-1],
+        "axis_flip": core_covered(pr_vertices, scene, turned(camera), pose),
+    }
     if camera.projection == "perspective":
         fx, fy = camera.focal_xy
-        out["pixel_offset"] = core_covered(pr_vertices, scene, camera.with_intrinsics(
-            fx, fy, camera.width / 2, camera.height / 2), pose)
+        out["pixel_offset"] = core_covered(
+            pr_vertices, scene, camera.with_intrinsics(fx, fy, camera.width / 2, camera.height / 2), pose
+        )
         f_h = (camera.width / 2) / math.tan(math.radians(camera.fov_y_deg) / 2)
         out["fov_mismatch"] = core_covered(pr_vertices, scene, camera.with_intrinsics(f_h, f_h), pose)
-        out["aspect_mismatch"] = core_covered(pr_vertices, scene, camera.with_intrinsics(
-            fy * camera.width / camera.height, fy), pose)
+        out["aspect_mismatch"] = core_covered(
+            pr_vertices, scene, camera.with_intrinsics(fy * camera.width / camera.height, fy), pose
+        )
     return out
 
 
@@ -103,8 +131,11 @@ def named(faults) -> str:
 
 @pytest.mark.slow
 def test_each_mistake_named_alone(results):
-    wrong = [(s, c, i, named(f), [dict(x.params) for x in f]) for s, c, i, f, _ in results
-             if named(f) != INVISIBLE.get((s, c, i), i)]
+    wrong = [
+        (s, c, i, named(f), [dict(x.params) for x in f])
+        for s, c, i, f, _ in results
+        if named(f) != INVISIBLE.get((s, c, i), i)
+    ]
     assert not wrong, wrong
     # 3 scenes x (6 perspective cases x 7 + orthographic x 4)
     assert len(results) == 3 * (6 * 7 + 4)
@@ -115,11 +146,18 @@ def test_confusion_matrix_is_diagonal_but_for_the_invisible(results, summary_sec
     counts = Counter((i, named(f)) for _, _, i, f, _ in results)
     rows = list(dict.fromkeys(i for _, _, i, _, _ in results))
     cols = list(dict.fromkeys([*rows, *sorted({c for _, c in counts} - set(rows))]))
-    short = {n: n.replace("mirror_horizontal", "mirror_h").replace("mirror_vertical", "mirror_v")
-             .replace("_mismatch", "").replace("pixel_", "px_") for n in cols}
-    lines = ["silhouette faults, core's filled frames with one mistake each (rows injected, columns named); "
-             f"{len(SCENES)} scenes x 7 cases",
-             " " * 12 + " ".join(f"{short[c]:>10}" for c in cols)]
+    short = {
+        n: n.replace("mirror_horizontal", "mirror_h")
+        .replace("mirror_vertical", "mirror_v")
+        .replace("_mismatch", "")
+        .replace("pixel_", "px_")
+        for n in cols
+    }
+    lines = [
+        "silhouette faults, core's filled frames with one mistake each (rows injected, columns named); "
+        f"{len(SCENES)} scenes x 7 cases",
+        " " * 12 + " ".join(f"{short[c]:>10}" for c in cols),
+    ]
     lines += [f"{short[r]:<12}" + " ".join(f"{counts[(r, c)] or '.':>10}" for c in cols) for r in rows]
     summary_section("silhouette fault confusion matrix", "\n".join(lines))
     off = Counter((i, named(f)) for s, c, i, f, _ in results if named(f) != i)
@@ -137,8 +175,11 @@ def test_fitted_numbers_are_the_mistakes(results):
             continue
         p = faults[0].params
         where = (scene_name, case_name, injected, dict(p))
-        assert faults[0].source == "silhouettes" and faults[0].hint == CATALOGUE[injected].hint_for("silhouettes") \
-            or injected == "fov_mismatch", where
+        assert (
+            faults[0].source == "silhouettes"
+            and faults[0].hint == CATALOGUE[injected].hint_for("silhouettes")
+            or injected == "fov_mismatch"
+        ), where
         if injected == "pixel_offset":
             # cx = W / 2: a candidate pixel p shows the reference's p - 0.5. The centroid of a mask is
             # quantised by the pixels it adds or drops along the edge: measured within 0.025 px, except at
@@ -171,9 +212,12 @@ def test_allowance_has_room(results, summary_section):
         for k, v in ratios.items():
             if k != injected and not (injected == "fov_mismatch" and k == "aspect_mismatch"):
                 nearest_other = min(nearest_other, (v, (s, c, injected, k)))
-    summary_section("silhouette fault allowance", f"named model's worst miss ratio {worst_named:.4f}, nearest "
-                    f"other model's {nearest_other[0]:.3f} {nearest_other[1]}; allowance {ALLOWANCE}")
-    assert worst_named <= 0.5 * ALLOWANCE, worst_named          # measured 0.0063
+    summary_section(
+        "silhouette fault allowance",
+        f"named model's worst miss ratio {worst_named:.4f}, nearest "
+        f"other model's {nearest_other[0]:.3f} {nearest_other[1]}; allowance {ALLOWANCE}",
+    )
+    assert worst_named <= 0.5 * ALLOWANCE, worst_named  # measured 0.0063
     # measured 0.285 (pyramid wide_fov, a half-pixel shift against a scale per axis): 5.7 allowances
     assert nearest_other[0] >= 4 * ALLOWANCE, nearest_other
 
@@ -186,8 +230,7 @@ def test_a_correct_frame_names_nothing_and_a_blank_one_is_unexplained():
     inside, ties, _ = silhouette(p_world, scene.faces, cam, (cam.height, cam.width))
     good = core_covered(pr_vertices, scene, cam, pose)
     assert name_silhouette_faults([SilhouetteFrame(good, inside, ties, cam, p_world, scene.faces)]) == ()
-    (blank,) = name_silhouette_faults([SilhouetteFrame(np.zeros_like(good), inside, ties, cam, p_world,
-                                                       scene.faces)])
+    (blank,) = name_silhouette_faults([SilhouetteFrame(np.zeros_like(good), inside, ties, cam, p_world, scene.faces)])
     assert blank.name == "unexplained" and "blank" in blank.note
     with pytest.raises(ValueError, match="no frame"):
         name_silhouette_faults([])
@@ -206,14 +249,31 @@ def test_a_rolled_camera_is_unexplained_with_what_was_measured():
     right, up = np.asarray(cam.right, dtype=float), np.asarray(cam.up, dtype=float)
     up_cam = up - np.dot(up, cam.forward) * np.asarray(cam.forward) / np.dot(cam.forward, cam.forward)
     up_cam /= np.linalg.norm(up_cam)
-    rolled = Camera(position=cam.position, forward=cam.forward, up=math.cos(a) * up_cam + math.sin(a) * right,
-                    fov_y_deg=cam.fov_y_deg, width=cam.width, height=cam.height, near=cam.near, far=cam.far)
+    rolled = Camera(
+        position=cam.position,
+        forward=cam.forward,
+        up=math.cos(a) * up_cam + math.sin(a) * right,
+        fov_y_deg=cam.fov_y_deg,
+        width=cam.width,
+        height=cam.height,
+        near=cam.near,
+        far=cam.far,
+    )
     cand = core_covered(pr_vertices, scene, rolled, pose)
     (fault,) = name_silhouette_faults([SilhouetteFrame(cand, inside, ties, cam, p_world, scene.faces)])
     assert fault.name == "unexplained" and fault.source == "silhouettes"
     assert min(fault.params["fit_ratios"].values()) > ALLOWANCE
-    assert set(fault.params["fit_ratios"]) == {"none", "depth_flip", "axis_swap", "axis_flip", "mirror_horizontal",
-                                               "mirror_vertical", "fov_mismatch", "pixel_offset", "aspect_mismatch"}
+    assert set(fault.params["fit_ratios"]) == {
+        "none",
+        "depth_flip",
+        "axis_swap",
+        "axis_flip",
+        "mirror_horizontal",
+        "mirror_vertical",
+        "fov_mismatch",
+        "pixel_offset",
+        "aspect_mismatch",
+    }
 
 
 def test_two_frames_share_one_fit():
@@ -238,18 +298,35 @@ def test_names_are_the_catalogues():
     for name in ("mirror_vertical", "pixel_offset", "fov_mismatch", "ambiguous", "unexplained"):
         assert "silhouettes" in CATALOGUE[name].sources
     assert "glReadPixels" in Fault("mirror_vertical", {}, "silhouettes").hint
-    assert silhouette_faults.ALLOWANCE < 0.5                     # below a half-pixel shift's ~0.5 per boundary px
-    assert set(SILHOUETTE_FAULTS) == {"depth_flip", "axis_swap", "ambiguous", "axis_flip", "mirror_horizontal",
-                                      "mirror_vertical", "aspect_mismatch", "fov_mismatch", "pixel_offset",
-                                      "unexplained"}
+    assert silhouette_faults.ALLOWANCE < 0.5  # below a half-pixel shift's ~0.5 per boundary px
+    assert set(SILHOUETTE_FAULTS) == {
+        "depth_flip",
+        "axis_swap",
+        "ambiguous",
+        "axis_flip",
+        "mirror_horizontal",
+        "mirror_vertical",
+        "aspect_mismatch",
+        "fov_mismatch",
+        "pixel_offset",
+        "unexplained",
+    }
 
 
 def test_a_square_frame_transposed_is_an_axis_swap():
     """On a square image with the centred principal point, x and y exchanged is the array transposed."""
     scene = load_scene("prism")
     case = cases_for(scene, MOTION)[1]
-    cam = Camera(position=case.camera.position, forward=case.camera.forward, up=case.camera.up,
-                 fov_y_deg=case.camera.fov_y_deg, width=480, height=480, near=case.camera.near, far=case.camera.far)
+    cam = Camera(
+        position=case.camera.position,
+        forward=case.camera.forward,
+        up=case.camera.up,
+        fov_y_deg=case.camera.fov_y_deg,
+        width=480,
+        height=480,
+        near=case.camera.near,
+        far=case.camera.far,
+    )
     p_world, _m, pr_vertices, pose = oface.frame_geometry(scene, case_motion(MOTION, case), 2 / 7)
     inside, ties, _ = silhouette(p_world, scene.faces, cam, (cam.height, cam.width))
     cand = core_covered(pr_vertices, scene, cam, pose).T
@@ -268,6 +345,6 @@ def test_a_few_stray_pixels_in_place_are_unexplained_not_a_camera_mistake():
     cand = core_covered(pr_vertices, scene, cam, pose).copy()
     rows, cols = np.nonzero(inside & ~ties)
     mid = len(rows) // 2
-    cand[rows[mid - 1:mid + 2], cols[mid - 1:mid + 2]] = False
+    cand[rows[mid - 1 : mid + 2], cols[mid - 1 : mid + 2]] = False
     (fault,) = name_silhouette_faults([SilhouetteFrame(cand, inside, ties, cam, p_world, scene.faces)])
     assert fault.name == "unexplained" and "3 decided pixels differ" in fault.note

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles import cli
 from wirecheck.oracles.candidates.candidate import load_candidate
@@ -30,8 +29,15 @@ FAULTY = DATA / "faulty_projectors.py"
 SCENES = ("unit_cube", "offset_pyramid")
 CAMERAS = ("z3_fov60", "z3_fov90", "z6_fov60", "z6_fov90")
 FRAME_COUNTS = (1, 30, 180)
-CHECKS = ["known_point", "rotation_invariance", "depth_monotonicity", "clip_safety",
-          "near_plane_depth", "behind_camera", "empty_mesh"]
+CHECKS = [
+    "known_point",
+    "rotation_invariance",
+    "depth_monotonicity",
+    "clip_safety",
+    "near_plane_depth",
+    "behind_camera",
+    "empty_mesh",
+]
 CRITICAL = CHECKS[:4]
 
 
@@ -41,7 +47,7 @@ def _suite(tmp_path, *args, name="run"):
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:
             rc = cli.main(["--suite", "spec", "--report-dir", str(tmp_path / name), *args])
-        except SystemExit as exc:       # argparse usage errors
+        except SystemExit as exc:  # argparse usage errors
             rc = exc.code
     path = tmp_path / name / "spec.json"
     return rc, (json.loads(path.read_text()) if path.exists() else None), out.getvalue(), err.getvalue()
@@ -102,19 +108,22 @@ def test_the_scenes_are_the_specifications():
     assert len(cube.edges) == 12
     pyramid = load_scene("offset_pyramid")
     text = (Path(__file__).parents[1] / "scenes" / "examples" / "offset_pyramid.scene").read_text()
-    assert re.search(r"^translate 0\.5 0\.25 -0\.5$", text, re.M)       # the translation, stated in the file
+    assert re.search(r"^translate 0\.5 0\.25 -0\.5$", text, re.M)  # the translation, stated in the file
     (obj,) = pyramid.objects
     assert obj.motion.offset == (0.5, 0.25, -0.5) and obj.motion.turns == (0.0, 0.0, 0.0)
     assert len(pyramid.vertices) == 5 and len(pyramid.edges) == 8
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("func,fault,check,runs_pass", [
-    ("mirrored", "mirror_horizontal", "known_point", False),
-    ("horizontal_fov", "fov_mismatch", "known_point", False),
-    # no point of the matrix is ever behind the camera: only the named checks can see the missing clip
-    ("no_clipping", "clipping_plane", "clip_safety", True),
-])
+@pytest.mark.parametrize(
+    "func,fault,check,runs_pass",
+    [
+        ("mirrored", "mirror_horizontal", "known_point", False),
+        ("horizontal_fov", "fov_mismatch", "known_point", False),
+        # no point of the matrix is ever behind the camera: only the named checks can see the missing clip
+        ("no_clipping", "clipping_plane", "clip_safety", True),
+    ],
+)
 def test_classic_mistakes_fail_with_their_names(tmp_path, func, fault, check, runs_pass):
     rc, result, out, err = _suite(tmp_path, "--level", "vertices", "--candidate", f"{FAULTY}:{func}")
     assert rc == 1, err
@@ -124,8 +133,9 @@ def test_classic_mistakes_fail_with_their_names(tmp_path, func, fault, check, ru
     if runs_pass:
         assert all(r["verdict"] == "pass" for r in runs)
     else:
-        assert all(r["verdict"] == "fail" and r["faults"][0]["name"] == fault for r in runs), \
-            [(r["run"], r["faults"]) for r in runs]
+        assert all(r["verdict"] == "fail" and r["faults"][0]["name"] == fault for r in runs), [
+            (r["run"], r["faults"]) for r in runs
+        ]
     failed = {c["name"]: c for c in result["checks"] if c["verdict"] == "fail"}
     assert check in failed and [f["name"] for f in failed[check]["faults"]] == [fault]
     if func == "horizontal_fov":
@@ -140,12 +150,15 @@ def test_classic_mistakes_fail_with_their_names(tmp_path, func, fault, check, ru
     assert f"what to check, {fault}:" in out
 
 
-@pytest.mark.parametrize("func,check", [
-    ("mirrored", "known_point"),                           # x negated about cx
-    ("fixed_orientation", "rotation_invariance"),          # ignores forward/up: right only on the -Z axis
-    ("depth_clamped", "depth_monotonicity"),               # divides by min(z, 10)
-    ("divides_before_clipping", "clip_safety"),            # ZeroDivisionError on the camera's plane
-])
+@pytest.mark.parametrize(
+    "func,check",
+    [
+        ("mirrored", "known_point"),  # x negated about cx
+        ("fixed_orientation", "rotation_invariance"),  # ignores forward/up: right only on the -Z axis
+        ("depth_clamped", "depth_monotonicity"),  # divides by min(z, 10)
+        ("divides_before_clipping", "clip_safety"),  # ZeroDivisionError on the camera's plane
+    ],
+)
 def test_each_critical_check_fails_alone_against_its_broken_projector(func, check):
     results = run_checks(load_candidate(f"{FAULTY}:{func}"))
     assert [c["name"] for c in results] == CHECKS
@@ -154,10 +167,13 @@ def test_each_critical_check_fails_alone_against_its_broken_projector(func, chec
     assert failed["reasons"]
 
 
-@pytest.mark.parametrize("func,check,fault", [
-    ("clips_at_camera", "near_plane_depth", "z_positive"),   # keeps 0 < z < near
-    ("fails_on_empty", "empty_mesh", None),                  # np.max of no points raises
-])
+@pytest.mark.parametrize(
+    "func,check,fault",
+    [
+        ("clips_at_camera", "near_plane_depth", "z_positive"),  # keeps 0 < z < near
+        ("fails_on_empty", "empty_mesh", None),  # np.max of no points raises
+    ],
+)
 def test_edge_cases_fail_against_their_mistakes(func, check, fault):
     results = run_checks(load_candidate(f"{FAULTY}:{func}"))
     assert [c["name"] for c in results if c["verdict"] == "fail"] == [check]
@@ -188,18 +204,30 @@ def test_float32_candidates_are_held_to_their_precision():
 
 @pytest.mark.slow
 def test_declared_precision_reaches_the_runs_and_the_checks(tmp_path):
-    rc, result, out, err = _suite(tmp_path, "--level", "vertices", "--candidate-precision", "float32", "--candidate",
-                                  f"{DATA / 'candidates' / 'glm_f32.py'}:project_f64_view")
+    rc, result, out, err = _suite(
+        tmp_path,
+        "--level",
+        "vertices",
+        "--candidate-precision",
+        "float32",
+        "--candidate",
+        f"{DATA / 'candidates' / 'glm_f32.py'}:project_f64_view",
+    )
     assert rc == 0, out + err
     assert result["candidate_precision"] == "float32"
-    assert {(r["precision"]["judged_as"], r["precision"]["source"]) for r in result["runs"]} == {("float32", "declared")}
+    assert {(r["precision"]["judged_as"], r["precision"]["source"]) for r in result["runs"]} == {
+        ("float32", "declared")
+    }
     assert all(1e-4 < c["bound_px"] < 1e-2 for c in result["checks"][:2])
 
 
 def test_a_suite_that_ran_less_never_passes():
     verdict, why = suite_verdict([], [])
     assert verdict == "fail"
-    assert why == ["0 runs compared: expected the matrix's 24", "0 named checks run: expected the 7 of the specification"]
+    assert why == [
+        "0 runs compared: expected the matrix's 24",
+        "0 named checks run: expected the 7 of the specification",
+    ]
     runs = [{"run": f"r{i}", "verdict": "pass"} for i in range(24)]
     checks = [{"name": n, "verdict": "pass"} for n in CHECKS]
     assert suite_verdict(runs, checks) == ("pass", [])
@@ -209,15 +237,18 @@ def test_a_suite_that_ran_less_never_passes():
     assert suite_verdict(vacuous, checks) == ("fail", ["1 runs not passed: r23"])
 
 
-@pytest.mark.parametrize("args,needle", [
-    (["--frames", "3"], "--suite spec with --frames: "),
-    (["--scene", "cube"], "--suite spec with --scene: "),
-    (["--candidate-precision", "float32"], "--suite spec with --candidate-precision float32 and no --candidate: "),
-    (["--dtype", "float32"], "--suite spec with --dtype: "),
-    (["--hidden-lines"], "--hidden-lines with --suite spec: "),
-    (["--junit-xml", "x.xml"], "--junit-xml with --suite spec: "),
-    (["--candidate", "nowhere.py:f"], "--candidate 'nowhere.py:f': file 'nowhere.py' not found"),
-])
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["--frames", "3"], "--suite spec with --frames: "),
+        (["--scene", "cube"], "--suite spec with --scene: "),
+        (["--candidate-precision", "float32"], "--suite spec with --candidate-precision float32 and no --candidate: "),
+        (["--dtype", "float32"], "--suite spec with --dtype: "),
+        (["--hidden-lines"], "--hidden-lines with --suite spec: "),
+        (["--junit-xml", "x.xml"], "--junit-xml with --suite spec: "),
+        (["--candidate", "nowhere.py:f"], "--candidate 'nowhere.py:f': file 'nowhere.py' not found"),
+    ],
+)
 def test_options_the_suite_cannot_honour_are_one_line(tmp_path, args, needle):
     rc, result, out, err = _suite(tmp_path, *args)
     assert rc == 2 and out == ""
@@ -232,8 +263,10 @@ def test_a_request_of_no_points_is_its_line_alone():
 
 def _strict(text: str):
     """spec.json parsed as strict JSON: NaN, Infinity and -Infinity are not JSON."""
+
     def refuse(name):
         raise ValueError(f"{name} in spec.json")
+
     return json.loads(text, parse_constant=refuse)
 
 
@@ -249,5 +282,5 @@ def test_a_nan_or_inf_candidate_fails_with_a_report(tmp_path, func):
     assert result["verdict"] == "fail" and result["summary"]["runs_passed"] == 0
     known = result["checks"][0]
     assert known["name"] == "known_point" and known["verdict"] == "fail" and known["reasons"]
-    assert known["error_px"] is None          # inf for NaN (checks._worst), null in JSON
+    assert known["error_px"] is None  # inf for NaN (checks._worst), null in JSON
     assert "FAIL: 0/24 runs" in out

@@ -17,7 +17,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from helpers import no_block
 from wirecheck.core import user_files
 from wirecheck.core.user_files import LIMITS, Limit, RefusedFile, open_regular, read_regular
@@ -36,8 +35,14 @@ def run_cli(program: str, args: list[str], cwd: Path) -> tuple[int | None, str]:
     """``(exit status, stderr)`` of the console script; status None when it ran past TIMEOUT_S (killed)."""
     code = f"import sys; from {program} import main; sys.exit(main(sys.argv[1:]))"
     try:
-        done = subprocess.run([sys.executable, "-c", code, *args], cwd=cwd, capture_output=True, text=True,
-                              timeout=TIMEOUT_S, preexec_fn=_limited)
+        done = subprocess.run(
+            [sys.executable, "-c", code, *args],
+            cwd=cwd,
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT_S,
+            preexec_fn=_limited,
+        )
     except subprocess.TimeoutExpired:
         return None, "(killed after 60 s: it blocked)"
     return done.returncode, done.stderr
@@ -57,6 +62,7 @@ def _link(target: str):
     def make(path: Path) -> Path:
         path.symlink_to(target)
         return path
+
     return make
 
 
@@ -65,32 +71,92 @@ def _sparse(size: int):
         with open(path, "wb") as fh:
             fh.truncate(size)
         return path
+
     return make
 
 
 #: (id, program, file name, maker, argv given the file, what the line says)
 CASES = [
-    ("config FIFO", CROSSCHECK, "w.toml", _fifo, lambda f: ["--config", str(f), *QUICK],
-     "a FIFO, not a regular file: expected a pyproject.toml or settings file"),
-    ("config /dev/zero", CROSSCHECK, "w.toml", _link("/dev/zero"), lambda f: ["--config", str(f), *QUICK],
-     "a character device, not a regular file: expected a pyproject.toml or settings file"),
-    ("config /dev/urandom", CROSSCHECK, "w.toml", _link("/dev/urandom"), lambda f: ["--config", str(f), *QUICK],
-     "a character device, not a regular file: expected a pyproject.toml or settings file"),
-    ("config 5 MiB", CROSSCHECK, "w.toml", _sparse(5 * MiB), lambda f: ["--config", str(f), *QUICK],
-     f"too large ({5 * MiB:,} bytes): expected a pyproject.toml or settings file, a regular file of at most 4 MiB"),
-    ("pyproject.toml FIFO found", CROSSCHECK, "pyproject.toml", _fifo, lambda f: QUICK,
-     "pyproject.toml: a FIFO, not a regular file"),
-    ("scene list FIFO", CROSSCHECK, "list.txt", _fifo, lambda f: ["--scene-list", str(f), "--level", "vertices"],
-     "a FIFO, not a regular file: expected a scene list (one mesh path a line)"),
-    ("scene list /dev/zero", CROSSCHECK, "list.txt", _link("/dev/zero"),
-     lambda f: ["--scene-list", str(f), "--level", "vertices"],
-     "a character device, not a regular file: expected a scene list (one mesh path a line)"),
-    ("candidate FIFO", CROSSCHECK, "cand.py", _fifo, lambda f: ["--candidate", f"{f}:project", *QUICK],
-     "a FIFO, not a regular file: expected a candidate's Python file"),
-    (".scene 100 GiB", RENDERER, "big.scene", _sparse(100 << 30), lambda f: ["--scene", str(f), "--frames", "1"],
-     f"too large ({100 << 30:,} bytes): expected a .scene file, a regular file of at most 64 MiB"),
-    ("mesh /dev/urandom", RENDERER, "m.obj", _link("/dev/urandom"), lambda f: ["--scene", str(f), "--frames", "1"],
-     "a character device, not a regular file"),
+    (
+        "config FIFO",
+        CROSSCHECK,
+        "w.toml",
+        _fifo,
+        lambda f: ["--config", str(f), *QUICK],
+        "a FIFO, not a regular file: expected a pyproject.toml or settings file",
+    ),
+    (
+        "config /dev/zero",
+        CROSSCHECK,
+        "w.toml",
+        _link("/dev/zero"),
+        lambda f: ["--config", str(f), *QUICK],
+        "a character device, not a regular file: expected a pyproject.toml or settings file",
+    ),
+    (
+        "config /dev/urandom",
+        CROSSCHECK,
+        "w.toml",
+        _link("/dev/urandom"),
+        lambda f: ["--config", str(f), *QUICK],
+        "a character device, not a regular file: expected a pyproject.toml or settings file",
+    ),
+    (
+        "config 5 MiB",
+        CROSSCHECK,
+        "w.toml",
+        _sparse(5 * MiB),
+        lambda f: ["--config", str(f), *QUICK],
+        f"too large ({5 * MiB:,} bytes): expected a pyproject.toml or settings file, a regular file of at most 4 MiB",
+    ),
+    (
+        "pyproject.toml FIFO found",
+        CROSSCHECK,
+        "pyproject.toml",
+        _fifo,
+        lambda f: QUICK,
+        "pyproject.toml: a FIFO, not a regular file",
+    ),
+    (
+        "scene list FIFO",
+        CROSSCHECK,
+        "list.txt",
+        _fifo,
+        lambda f: ["--scene-list", str(f), "--level", "vertices"],
+        "a FIFO, not a regular file: expected a scene list (one mesh path a line)",
+    ),
+    (
+        "scene list /dev/zero",
+        CROSSCHECK,
+        "list.txt",
+        _link("/dev/zero"),
+        lambda f: ["--scene-list", str(f), "--level", "vertices"],
+        "a character device, not a regular file: expected a scene list (one mesh path a line)",
+    ),
+    (
+        "candidate FIFO",
+        CROSSCHECK,
+        "cand.py",
+        _fifo,
+        lambda f: ["--candidate", f"{f}:project", *QUICK],
+        "a FIFO, not a regular file: expected a candidate's Python file",
+    ),
+    (
+        ".scene 100 GiB",
+        RENDERER,
+        "big.scene",
+        _sparse(100 << 30),
+        lambda f: ["--scene", str(f), "--frames", "1"],
+        f"too large ({100 << 30:,} bytes): expected a .scene file, a regular file of at most 64 MiB",
+    ),
+    (
+        "mesh /dev/urandom",
+        RENDERER,
+        "m.obj",
+        _link("/dev/urandom"),
+        lambda f: ["--scene", str(f), "--frames", "1"],
+        "a character device, not a regular file",
+    ),
 ]
 
 
@@ -111,15 +177,19 @@ def test_a_special_file_is_one_line_and_exit_2(tmp_path, program, name, make, ar
 def test_the_config_fifo_line_in_full(tmp_path):
     fifo = _fifo(tmp_path / "w.toml")
     rc, err = run_cli(CROSSCHECK, ["--config", str(fifo), *QUICK], tmp_path)
-    assert (rc, err) == (2, f"crosscheck: error: {fifo}: a FIFO, not a regular file: expected a pyproject.toml or "
-                            "settings file, a regular file of at most 4 MiB (docs/reliability.md)\n")
+    assert (rc, err) == (
+        2,
+        f"crosscheck: error: {fifo}: a FIFO, not a regular file: expected a pyproject.toml or "
+        "settings file, a regular file of at most 4 MiB (docs/reliability.md)\n",
+    )
 
 
 # ---- core.user_files itself ------------------------------------------------------------------------------
 
+
 def test_a_regular_file_and_a_link_to_one_are_read(tmp_path):
     (tmp_path / "a.txt").write_bytes(b"abc\n")
-    (tmp_path / "l.txt").symlink_to(tmp_path / "a.txt")        # a link in a user's input is normal: followed
+    (tmp_path / "l.txt").symlink_to(tmp_path / "a.txt")  # a link in a user's input is normal: followed
     assert read_regular(tmp_path / "a.txt", "config") == read_regular(tmp_path / "l.txt", "config") == b"abc\n"
 
 
@@ -130,23 +200,29 @@ def _socket(path: Path) -> Path:
     return path
 
 
-@pytest.mark.parametrize("make, problem", [
-    (_fifo, "a FIFO, not a regular file"),
-    (_link("/dev/zero"), "a character device, not a regular file"),
-    (_link("/dev/null"), "a character device, not a regular file"),
-    (lambda p: (p.mkdir(), p)[1], "a folder, not a regular file"),
-    (_socket, "a socket, not a regular file"),
-    (lambda p: (p.symlink_to(p.parent / "nowhere"), p)[1], "a broken link"),
-    (lambda p: p, "missing"),
-    (lambda p: (p.symlink_to(p), p)[1], "unreadable (Too many levels of symbolic links)"),
-], ids=["fifo", "dev-zero", "dev-null", "folder", "socket", "broken-link", "missing", "link-loop"])
+@pytest.mark.parametrize(
+    "make, problem",
+    [
+        (_fifo, "a FIFO, not a regular file"),
+        (_link("/dev/zero"), "a character device, not a regular file"),
+        (_link("/dev/null"), "a character device, not a regular file"),
+        (lambda p: (p.mkdir(), p)[1], "a folder, not a regular file"),
+        (_socket, "a socket, not a regular file"),
+        (lambda p: (p.symlink_to(p.parent / "nowhere"), p)[1], "a broken link"),
+        (lambda p: p, "missing"),
+        (lambda p: (p.symlink_to(p), p)[1], "unreadable (Too many levels of symbolic links)"),
+    ],
+    ids=["fifo", "dev-zero", "dev-null", "folder", "socket", "broken-link", "missing", "link-loop"],
+)
 def test_what_is_refused_and_how_it_is_named(tmp_path, make, problem):
     path = make(tmp_path / "x")
     with no_block(10), pytest.raises(RefusedFile) as info:
         read_regular(path, "scene list")
     assert info.value.problem == problem
-    assert str(info.value) == (f"{path}: {problem}: expected a scene list (one mesh path a line), a regular file "
-                               "of at most 64 MiB (docs/reliability.md)")
+    assert str(info.value) == (
+        f"{path}: {problem}: expected a scene list (one mesh path a line), a regular file "
+        "of at most 64 MiB (docs/reliability.md)"
+    )
 
 
 def test_the_limit_is_the_largest_size_read(tmp_path):
@@ -163,7 +239,7 @@ def test_a_fifo_swapped_in_after_the_stat_is_refused_through_its_descriptor(tmp_
     """The name is a regular file when looked at, a FIFO when opened: the open does not block (O_NONBLOCK)
     and the descriptor's own fstat refuses it."""
     fifo = _fifo(tmp_path / "f")
-    monkeypatch.setattr(user_files, "problem", lambda path, kind: None)       # the stat saw a regular file
+    monkeypatch.setattr(user_files, "problem", lambda path, kind: None)  # the stat saw a regular file
     with no_block(10), pytest.raises(RefusedFile, match="a FIFO, not a regular file"):
         open_regular(fifo, "frame")
 
@@ -177,13 +253,14 @@ def test_a_file_that_grows_past_the_limit_while_read_is_refused(monkeypatch):
 
 def test_every_kind_has_a_row_in_the_docs_table():
     text = (ROOT / "docs" / "reliability.md").read_text(encoding="utf-8")
-    table = text[text.index("### Files wirecheck reads"):]
+    table = text[text.index("### Files wirecheck reads") :]
     rows = {line.split("|")[1].strip(" `"): line for line in table.splitlines() if line.startswith("| `")}
     for kind, limit in LIMITS.items():
         assert f"| {limit.size // MiB:,} MiB |" in rows[kind], (kind, rows.get(kind))
 
 
 # ---- paths named in a [tool.wirecheck] table -------------------------------------------------------------
+
 
 def _crosscheck(argv, capsys):
     with no_block(30):
@@ -197,8 +274,19 @@ def test_a_link_loop_named_by_the_config_is_one_line(tmp_path, capsys, key, name
     (tmp_path / name).symlink_to(tmp_path / name)
     value = f'["{name}"]' if key == "scenes" else f'"{name}:project"'
     (tmp_path / "w.toml").write_text(f"[tool.wirecheck]\n{key} = {value}\n")
-    rc, err = _crosscheck(["--config", str(tmp_path / "w.toml"), "--level", "vertices", "--frames", "1",
-                           "--report-dir", str(tmp_path / "rep")], capsys)
+    rc, err = _crosscheck(
+        [
+            "--config",
+            str(tmp_path / "w.toml"),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--report-dir",
+            str(tmp_path / "rep"),
+        ],
+        capsys,
+    )
     assert rc == 2 and err.count("\n") == 1, err
     assert f"{tmp_path / name}" in err and "Too many levels of symbolic links" in err, err
 
@@ -208,7 +296,20 @@ def test_a_config_candidate_that_is_a_fifo_is_refused_before_the_line_that_says_
     that will run: before, it came first and the refusal second (two lines for one exit 2)."""
     os.mkfifo(tmp_path / "cand.py")
     (tmp_path / "w.toml").write_text('[tool.wirecheck]\ncandidate = "cand.py:project"\n')
-    rc, err = _crosscheck(["--config", str(tmp_path / "w.toml"), "--level", "vertices", "--frames", "1",
-                           "--scene", "cube", "--report-dir", str(tmp_path / "rep")], capsys)
+    rc, err = _crosscheck(
+        [
+            "--config",
+            str(tmp_path / "w.toml"),
+            "--level",
+            "vertices",
+            "--frames",
+            "1",
+            "--scene",
+            "cube",
+            "--report-dir",
+            str(tmp_path / "rep"),
+        ],
+        capsys,
+    )
     assert rc == 2 and err.count("\n") == 1, err
     assert "cand.py': a FIFO, not a regular file: expected a candidate's Python file" in err, err

@@ -14,9 +14,10 @@ import specificity_dataset as sd  # noqa: E402
 
 
 def test_the_dataset_is_seeded_and_varied(tmp_path):
-    n = len(sd.KINDS) * len(sd.SUFFIXES)                   # 35: the format changes every len(KINDS) meshes
+    n = len(sd.KINDS) * len(sd.SUFFIXES)  # 35: the format changes every len(KINDS) meshes
     a, b = tmp_path / "a", tmp_path / "b"
-    a.mkdir(); b.mkdir()
+    a.mkdir()
+    b.mkdir()
     made = sd.make_dataset(a, n)
     assert sd.make_dataset(b, n) == made
     assert all((a / m.name).read_bytes() == (b / m.name).read_bytes() for m in made)
@@ -27,11 +28,12 @@ def test_the_dataset_is_seeded_and_varied(tmp_path):
     # coordinate of the bounds centre within R, its norm within sqrt(3) R = 1.5 size; and the float32
     # rounding of the coordinates in STL/GLB: 2^-24 relative, 2^-23 with the centre's own rounding
     import trimesh
+
     far = [m for m in made if m.far]
-    assert len(far) == n // sd.FAR_EVERY                   # meshes 3, 7, ..., 31
+    assert len(far) == n // sd.FAR_EVERY  # meshes 3, 7, ..., 31
     for m in made:
         centre = trimesh.load(a / m.name, force="mesh").bounds.mean(axis=0)
-        assert abs(np.linalg.norm(centre) - m.offset) <= 1.5 * m.size + 2.0 ** -23 * m.offset, m
+        assert abs(np.linalg.norm(centre) - m.offset) <= 1.5 * m.size + 2.0**-23 * m.offset, m
         assert (m.offset == 0.0) or 1e3 <= m.offset <= 1e5
 
 
@@ -51,10 +53,18 @@ def test_clopper_pearson_by_hand():
 def test_tally_counts_vacuous_cases_apart_from_false_fails():
     # an oracle_precision case is "vacuous": no false fail of the candidate, but the gate's run does not pass,
     # so the benchmark must count it (hand-made rows: mesh a fails one case, b is vacuous once, c passes)
-    rows = {"a": [("on_axis", "fail", ["x"], []), ("wide_fov", "pass", [], [])],
-            "b": [("on_axis", "vacuous", ["oracle_precision: ..."], []), ("wide_fov", "vacuous", ["..."], [])],
-            "c": [("on_axis", "pass", [], []), ("wide_fov", "pass", [], [])]}
+    rows = {
+        "a": [("on_axis", "fail", ["x"], []), ("wide_fov", "pass", [], [])],
+        "b": [("on_axis", "vacuous", ["oracle_precision: ..."], []), ("wide_fov", "vacuous", ["..."], [])],
+        "c": [("on_axis", "pass", [], []), ("wide_fov", "pass", [], [])],
+    }
     t = bench_specificity.tally(rows, ["a", "b", "c"])
-    assert t == {"cases": 6, "cases_failed": 1, "cases_vacuous": 2, "meshes": 3, "meshes_failed": 1,
-                 "meshes_not_passed": 2}
+    assert t == {
+        "cases": 6,
+        "cases_failed": 1,
+        "cases_vacuous": 2,
+        "meshes": 3,
+        "meshes_failed": 1,
+        "meshes_not_passed": 2,
+    }
     assert bench_specificity.tally(rows, ["c"])["meshes_not_passed"] == 0

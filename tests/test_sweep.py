@@ -9,7 +9,6 @@ import json
 
 import numpy as np
 import pytest
-
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles import sweep
 from wirecheck.oracles.references.pyrender_oracle import osmesa_available
@@ -26,8 +25,9 @@ def _strip_timing(report):
 
 @pytest.fixture(scope="module")
 def small_sweep():
-    return sweep.run_sweep([load_scene("cube")], frames=2, case_names=["on_axis", "near_plane"],
-                           large=sweep.large_mesh(1), repeats=1)
+    return sweep.run_sweep(
+        [load_scene("cube")], frames=2, case_names=["on_axis", "near_plane"], large=sweep.large_mesh(1), repeats=1
+    )
 
 
 def test_all_twelve_settings_once():
@@ -68,20 +68,22 @@ def test_sweep_accuracy_by_setting(small_sweep):
 
 @needs_osmesa
 def test_sweep_is_deterministic_apart_from_timing(small_sweep):
-    again = sweep.run_sweep([load_scene("cube")], frames=2, case_names=["on_axis", "near_plane"],
-                            large=sweep.large_mesh(1), repeats=1)
+    again = sweep.run_sweep(
+        [load_scene("cube")], frames=2, case_names=["on_axis", "near_plane"], large=sweep.large_mesh(1), repeats=1
+    )
     assert json.dumps(_strip_timing(again), sort_keys=True) == json.dumps(_strip_timing(small_sweep), sort_keys=True)
 
 
 def test_pareto_front_by_hand():
     def row(name, ms, err, f1):
-        return {"setting": name, "max_vertex_error_px": err, "pixel_f1_0px": f1,
-                "timing": {"ms_per_frame_large": ms}}
+        return {"setting": name, "max_vertex_error_px": err, "pixel_f1_0px": f1, "timing": {"ms_per_frame_large": ms}}
 
-    rows = [row("a", 1.0, 1e-3, 0.9),    # fastest: on the front
-            row("b", 2.0, 1e-12, 0.99),  # most accurate: on the front
-            row("c", 2.5, 1e-12, 0.98),  # slower and worse F1 than b: dominated
-            row("d", 1.0, 1e-3, 0.8)]    # same time and error as a, worse F1: dominated
+    rows = [
+        row("a", 1.0, 1e-3, 0.9),  # fastest: on the front
+        row("b", 2.0, 1e-12, 0.99),  # most accurate: on the front
+        row("c", 2.5, 1e-12, 0.98),  # slower and worse F1 than b: dominated
+        row("d", 1.0, 1e-3, 0.8),
+    ]  # same time and error as a, worse F1: dominated
     sweep._pareto(rows)
     assert [r["timing"]["pareto"] for r in rows] == [True, True, False, False]
 
@@ -93,9 +95,9 @@ def test_plot_and_markdown(small_sweep, tmp_path):
     from PIL import Image
 
     with Image.open(path) as im:
-        assert im.size == (1100, 420)          # figsize (11, 4.2) at dpi 100
+        assert im.size == (1100, 420)  # figsize (11, 4.2) at dpi 100
         px = np.asarray(im.convert("L"))
-    assert (px < 128).mean() > 0.001           # something was drawn, not a blank canvas
+    assert (px < 128).mean() > 0.001  # something was drawn, not a blank canvas
     md = sweep.markdown(small_sweep)
     rows = [ln for ln in md.splitlines() if ln.startswith("| ") and ("float64/" in ln or "float32/" in ln)]
     assert len(rows) == 12 and "| **float64/clip/exact** (default) |" in md
@@ -105,23 +107,42 @@ def test_cli_sweep_writes_table_and_plot(tmp_path, capsys):
     from wirecheck.oracles.cli import main
 
     out = tmp_path / "sw"
-    rc = main(["--sweep", "--level", "vertices", "--scene", "cube", "--cases", "on_axis", "--frames", "2",
-               "--report-dir", str(out)])
+    rc = main(
+        [
+            "--sweep",
+            "--level",
+            "vertices",
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            "--frames",
+            "2",
+            "--report-dir",
+            str(out),
+        ]
+    )
     assert rc == 0
-    assert sorted(p.name for p in out.iterdir()) == [".wirecheck-output", "sweep.html", "sweep.json",
-                                                      "sweep.md", "sweep.png"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".wirecheck-output",
+        "sweep.html",
+        "sweep.json",
+        "sweep.md",
+        "sweep.png",
+    ]
     data = json.loads((out / "sweep.json").read_text())
     assert len(data["settings"]) == 12 and data["oracles"] == ["opencv"]
     assert data["frames_checked"] == 2
     assert "PASS: the default setting" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("extra", [["--candidate", "tests/data/user_projector.py:project"], ["--dtype", "float32"],
-                                   ["--suite", "extremes"]])
+@pytest.mark.parametrize(
+    "extra", [["--candidate", "tests/data/user_projector.py:project"], ["--dtype", "float32"], ["--suite", "extremes"]]
+)
 def test_cli_sweep_rejects_candidate_settings_and_suite(extra, tmp_path, capsys):
     from wirecheck.oracles.cli import main
 
-    with pytest.raises(SystemExit) as exc:    # argparse: --suite and --sweep are exclusive
+    with pytest.raises(SystemExit) as exc:  # argparse: --suite and --sweep are exclusive
         rc = main(["--sweep", *extra, "--report-dir", str(tmp_path / "x")])
         raise SystemExit(rc)
     assert exc.value.code == 2
@@ -145,10 +166,10 @@ def test_sweep_composes_each_objects_motion():
     motion = Motion()
     from wirecheck.oracles.references.faces import frame_geometry
 
-    ref = frame_geometry(orrery, motion, 2 / 8)[0]                      # frame 3 of 8: t = 2/8
+    ref = frame_geometry(orrery, motion, 2 / 8)[0]  # frame 3 of 8: t = 2/8
     # scipy's composition equals core's to rounding (entries ~3, a few eps each)
     np.testing.assert_allclose(ref, world_points(orrery, motion, 3, 8), rtol=0, atol=1e-12)
-    naive = orrery.vertices @ motion.frame_matrix(3, 8)[:3, :3].T     # object motion ignored
+    naive = orrery.vertices @ motion.frame_matrix(3, 8)[:3, :3].T  # object motion ignored
     assert np.abs(ref - naive).max() > 1.0
     result = sweep.run_sweep([orrery], frames=2, case_names=["oblique_roll"], repeats=1)
     d = next(r for r in result["settings"] if r["default"])

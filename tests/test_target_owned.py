@@ -14,7 +14,6 @@ import sys
 import time
 
 import pytest
-
 from wirecheck.core.outputs.staging import LOCK
 
 CROSSCHECK = [sys.executable, "-m", "wirecheck.oracles.cli"]
@@ -49,8 +48,17 @@ def _second_run_refused(long_cmd, short_cmd, lock):
 def test_second_run_into_a_held_target_exits_2_at_once(tmp_path, command):
     target = tmp_path / "t"
     if command == "report":
-        base = [*CROSSCHECK, "--report-dir", str(target), "--scene", "cube", "--cases", "on_axis",
-                "--oracles", "opencv"]
+        base = [
+            *CROSSCHECK,
+            "--report-dir",
+            str(target),
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            "--oracles",
+            "opencv",
+        ]
         long_cmd, short_cmd = [*base, "--frames", "3000"], [*base, "--frames", "1"]
     else:
         base = [*CROSSCHECK, "export", str(target), "--cases", "on_axis,oblique_roll"]
@@ -62,19 +70,20 @@ def test_second_run_into_a_held_target_exits_2_at_once(tmp_path, command):
     assert rc_a == 0, err_a
     if command == "report":
         report = json.loads((target / "report.json").read_text())
-        assert report["frames"] == 3000                      # A's report, never B's
+        assert report["frames"] == 3000  # A's report, never B's
     else:
         job = json.loads((target / "job.json").read_text())
         assert max(len(c["frames"]) for c in job["cases"]) == 600
-    assert sorted(os.listdir(tmp_path)) == ["t"]             # no lock, no temporaries
+    assert sorted(os.listdir(tmp_path)) == ["t"]  # no lock, no temporaries
 
 
 @pytest.mark.slow
 def test_second_renderer_into_a_held_out_exits_2_at_once(tmp_path):
     out = tmp_path / "out"
     base = [sys.executable, "-m", "wirecheck.core.app.cli", "--width", "64", "--height", "48", "--out", str(out)]
-    rc_a, err_a, b, b_s, a_running, pid_a = _second_run_refused([*base, "--frames", "1500"], [*base, "--frames", "1"],
-                                                                out / LOCK)
+    rc_a, err_a, b, b_s, a_running, pid_a = _second_run_refused(
+        [*base, "--frames", "1500"], [*base, "--frames", "1"], out / LOCK
+    )
     assert b.returncode == 2 and f"(process {pid_a})" in b.stderr and b.stderr.count("\n") == 1, b.stderr
     assert a_running
     assert rc_a == 0, err_a
@@ -91,13 +100,29 @@ def test_claim_is_held_until_release_and_creates_no_folder_for_a_failed_run(tmp_
     claim(target, "--report-dir")
     try:
         assert sorted(os.listdir(tmp_path / "a" / "b")) == [".report.wirecheck-lock"]
-        other = subprocess.run([*CROSSCHECK, "--report-dir", str(target), "--scene", "cube", "--cases", "on_axis",
-                                "--oracles", "opencv", "--frames", "1"], capture_output=True, text=True, timeout=120)
+        other = subprocess.run(
+            [
+                *CROSSCHECK,
+                "--report-dir",
+                str(target),
+                "--scene",
+                "cube",
+                "--cases",
+                "on_axis",
+                "--oracles",
+                "opencv",
+                "--frames",
+                "1",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert other.returncode == 2 and f"(process {os.getpid()})" in other.stderr, other.stderr
     finally:
         release_claim(target)
-    assert os.listdir(tmp_path) == []                           # the parents it made are gone with it
-    with pytest.raises(InputError):                             # the claim checks the target as before
+    assert os.listdir(tmp_path) == []  # the parents it made are gone with it
+    with pytest.raises(InputError):  # the claim checks the target as before
         (tmp_path / "r").mkdir()
         (tmp_path / "r" / "mine.txt").write_text("x")
         claim(tmp_path / "r", "--report-dir")

@@ -10,13 +10,11 @@ every line's end pixel, which the tie handling must not excuse.
 
 import numpy as np
 import pytest
-
+from raster_mutants import drop_last
 from wirecheck.core.projector import raster
-from wirecheck.oracles.judge import line_ends, metrics
 from wirecheck.oracles import tolerances
 from wirecheck.oracles.diagnosis.diagnose import diagnose_lines
-
-from raster_mutants import drop_last
+from wirecheck.oracles.judge import line_ends, metrics
 
 
 def two_columns():
@@ -63,13 +61,13 @@ def test_a_decided_pixel_still_counts():
     # F1 = 2 (12/14) / (1 + 12/14) = 24/26
     assert s["tie_resolved"]["f1_0px"] == pytest.approx(24 / 26, abs=1e-15)
     assert s["tie_resolved"]["recall_0px"] == pytest.approx(12 / 14, abs=1e-15)
-    assert s["edge_count_max_diff"] == 1            # row 5 lost by both edges: -1 each
+    assert s["edge_count_max_diff"] == 1  # row 5 lost by both edges: -1 each
 
 
 def test_resolve_ties_gives_the_candidate_the_oracles_value():
     p0, p1, oracle = two_columns()
     cand = oracle.copy()
-    cand[3, 3], cand[3, 2] = False, True            # (2, 3) is not beside a tie edge of edge 0: decided
+    cand[3, 3], cand[3, 2] = False, True  # (2, 3) is not beside a tie edge of edge 0: decided
     fp = metrics.FramePixels(cand, oracle)
     ties = []
     line_ends.frames_end_places([(fp, p0, p1)], ties)
@@ -89,10 +87,18 @@ def test_no_line_fault_is_named_on_ties_alone():
     # beyond the limit as the counts before ties were undecided there gave: the limit may
     # fail the case, but no line fault is named on undecided pixels
     tol = tolerances.Tolerances()
-    lines = {"candidate_only": 0, "oracle_only": 16, "subpixel_ties": [0, 16], "imbalance": 0,
-             "imbalance_fraction": 0.0, "balance_p_value": 1.0, "edge_count_max_diff": tol.max_edge_count_diff + 4,
-             "edge_count_worst": {"frame": 1, "edge": 3, "diff": -(tol.max_edge_count_diff + 4)},
-             "lines_compared": 40, "one_sided_by_place": {p: [0, 0] for p in ("start", "end", "middle", "stray")}}
+    lines = {
+        "candidate_only": 0,
+        "oracle_only": 16,
+        "subpixel_ties": [0, 16],
+        "imbalance": 0,
+        "imbalance_fraction": 0.0,
+        "balance_p_value": 1.0,
+        "edge_count_max_diff": tol.max_edge_count_diff + 4,
+        "edge_count_worst": {"frame": 1, "edge": 3, "diff": -(tol.max_edge_count_diff + 4)},
+        "lines_compared": 40,
+        "one_sided_by_place": {p: [0, 0] for p in ("start", "end", "middle", "stray")},
+    }
     assert tolerances.line_failures(lines, tol)
     assert diagnose_lines(lines, tol) == []
     # one decided pixel: named again
@@ -102,6 +108,7 @@ def test_no_line_fault_is_named_on_ties_alone():
 
 # ---------------------------------------------------------------- end to end: generated meshes
 
+
 def cone_59(folder):
     """benchmarks/specificity_dataset.py's mesh 9 (seed 27): a 59-section cone 0.0116 across, axis along z, STL."""
     import trimesh
@@ -110,7 +117,7 @@ def cone_59(folder):
     mesh.apply_translation(-mesh.bounds.mean(axis=0))
     mesh.apply_scale(0.011606563388891019 / float(np.max(mesh.extents)))
     path = folder / "cone59.stl"
-    mesh.export(path)                                # float32 vertices, as the dataset's file
+    mesh.export(path)  # float32 vertices, as the dataset's file
     return path
 
 
@@ -118,8 +125,9 @@ def check(path, frames=2, cases=("on_axis",)):
     from wirecheck.core.scene.files import load_scene
     from wirecheck.oracles.runner import CoreCandidate, run_crosscheck
 
-    report, _ = run_crosscheck([load_scene(str(path))], CoreCandidate(), frames=frames, case_names=list(cases),
-                               animation=False)
+    report, _ = run_crosscheck(
+        [load_scene(str(path))], CoreCandidate(), frames=frames, case_names=list(cases), animation=False
+    )
     return report["cases"]
 
 
@@ -135,6 +143,7 @@ def dataset_mesh(i, suffix):
         path = folder / f"{i:04d}{suffix}"
         make_mesh(i, 27)[0].export(path)
         return path
+
     return make
 
 
@@ -151,9 +160,9 @@ def test_generated_ties_pass_and_a_dropped_end_pixel_still_fails(name, tmp_path,
     for case in check(path, frames, cases):
         lines = case["lines"]
         assert case["verdict"] == "pass", (case["camera"], case["reasons"])
-        assert lines["edge_count_max_diff"] <= 1            # measured: 0 (cone59), 1 (cylinder53)
+        assert lines["edge_count_max_diff"] <= 1  # measured: 0 (cone59), 1 (cylinder53)
         assert sum(lines["subpixel_ties"]) > 0
-        if name == "cone59":      # every one-sided pixel a tie (14 vs 4): the candidate is the oracle
+        if name == "cone59":  # every one-sided pixel a tie (14 vs 4): the candidate is the oracle
             assert lines["subpixel_ties"] == [lines["candidate_only"], lines["oracle_only"]]
             assert case["pixel_f1_0px"] == 1.0 and lines["edge_count_max_diff"] == 0
     # the same meshes with every line's last pixel dropped (tests/raster_mutants.py): still failed, and
@@ -165,6 +174,7 @@ def test_generated_ties_pass_and_a_dropped_end_pixel_still_fails(name, tmp_path,
 
 
 # ---------------------------------------------------------------- the issue's tie reproducers
+
 
 def cylinder_on_axis(sections, turn_deg):
     """A cylinder (radius 0.5, height 1, trimesh's: axis z, each cap a fan of spokes from its centre) turned
@@ -180,12 +190,14 @@ def cylinder_on_axis(sections, turn_deg):
         path = folder / f"cylinder{sections}.obj"
         mesh.export(path)
         return path
+
     return make
 
 
 @pytest.mark.parametrize("sections, turn_deg", [(3, 10.0), (21, 0.0)])
-def test_cylinders_seen_down_their_axis_tie_pass_and_a_dropped_end_pixel_still_fails(sections, turn_deg, tmp_path,
-                                                                                     monkeypatch):
+def test_cylinders_seen_down_their_axis_tie_pass_and_a_dropped_end_pixel_still_fails(
+    sections, turn_deg, tmp_path, monkeypatch
+):
     # measured (OSMesa llvmpipe, 4 frames): 3 sections turned 10 deg, 7 vs 7 one-sided pixels; 21 sections,
     # 4 vs 7; every one of them a sub-pixel tie. (At 0, 30, 60 deg the 3-sided cylinder's rays lie on a pixel
     # row or column through the image centre exactly, which both rasterizers decide alike: no tie.) Four
@@ -195,8 +207,8 @@ def test_cylinders_seen_down_their_axis_tie_pass_and_a_dropped_end_pixel_still_f
     lines = case["lines"]
     assert case["verdict"] == "pass", case["reasons"]
     assert sum(lines["subpixel_ties"]) > 0
-    assert lines["subpixel_ties"] == [lines["candidate_only"], lines["oracle_only"]]    # every one a tie
-    assert case["pixel_f1_0px"] == 1.0 and lines["edge_count_max_diff"] == 0           # the oracle's value there
+    assert lines["subpixel_ties"] == [lines["candidate_only"], lines["oracle_only"]]  # every one a tie
+    assert case["pixel_f1_0px"] == 1.0 and lines["edge_count_max_diff"] == 0  # the oracle's value there
     # every line's last pixel dropped (tests/raster_mutants.py): the ties hide none of it
     # (measured: 0 vs 26 decided one-sided pixels besides 7 + 7 ties, p = 3e-8, for 3 sections)
     monkeypatch.setattr(raster, "_line_pixels", drop_last)

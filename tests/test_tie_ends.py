@@ -13,11 +13,10 @@ Expected values are worked out by hand in the comments.
 
 import numpy as np
 import pytest
-
-from wirecheck.oracles.judge import line_ties, metrics
 from wirecheck.oracles import tolerances
+from wirecheck.oracles.judge import line_ties, metrics
 
-ZONE = 2 * 2.0 ** -8            # 2 TIE_END_PX: an end moved by 2^-8 per coordinate moves |E - P|_1 by 2^-7
+ZONE = 2 * 2.0**-8  # 2 TIE_END_PX: an end moved by 2^-8 per coordinate moves |E - P|_1 by 2^-7
 
 
 def vertical(y_end, h=10, w=8):
@@ -38,37 +37,43 @@ def test_tie_end_zone_is_twice_tie_end_px():
     assert tolerances.TIE_END_PX * 2 == ZONE
 
 
-@pytest.mark.parametrize("y_end, oracle_last, cand_last, side", [
-    (5.3 + 0.9 * ZONE, 5, 4, "oracle"),      # end 0.9 zone past the exit: the oracle drew row 5, the candidate not
-    (5.3 - 0.9 * ZONE, 4, 5, "candidate"),   # end 0.9 zone before it: the oracle stopped at row 4, the candidate not
-])
+@pytest.mark.parametrize(
+    "y_end, oracle_last, cand_last, side",
+    [
+        (5.3 + 0.9 * ZONE, 5, 4, "oracle"),  # end 0.9 zone past the exit: the oracle drew row 5, the candidate not
+        (5.3 - 0.9 * ZONE, 4, 5, "candidate"),  # end 0.9 zone before it: the oracle stopped at row 4, the candidate not
+    ],
+)
 def test_an_end_within_the_zone_is_a_tie_in_every_criterion(y_end, oracle_last, cand_last, side):
     p0, p1 = vertical(y_end)
     cand, oracle = column(cand_last), column(oracle_last)
     s = metrics.line_scores(cand, oracle, p0, p1)
     one = [1, 0] if side == "candidate" else [0, 1]
     assert [s["candidate_only"], s["oracle_only"]] == one
-    assert s["subpixel_ties"] == one                                  # the balance: left out as a tie
+    assert s["subpixel_ties"] == one  # the balance: left out as a tie
     assert s["ends"] == {"start": [0, 0], "end": [0, 0], "middle": [0, 0], "stray": [0, 0]}
     # F1@0px as drawn: 5 shared pixels of 5 and 6 -> P R with one side 5/6 -> F1 = 2 (5/6) / (1 + 5/6) = 10/11
     assert metrics.pixel_scores(cand, oracle)["f1_0px"] == pytest.approx(10 / 11, abs=1e-15)
     assert s["tie_resolved"] == {"f1_0px": 1.0, "precision_0px": 1.0, "recall_0px": 1.0}
-    assert s["edge_count_max_diff"] == 0                              # the raw count differs by 1 (next test)
+    assert s["edge_count_max_diff"] == 0  # the raw count differs by 1 (next test)
     summary = metrics.line_summary([(1, s)])
     assert summary["subpixel_ties"] == one and summary["imbalance"] == 0 and summary["balance_p_value"] == 1.0
 
 
-@pytest.mark.parametrize("y_end, oracle_last, cand_last", [
-    (5.3 + 1.1 * ZONE, 5, 4),      # just outside the zone: the oracle's row 5 is the line's, the candidate lost it
-    (5.3 + 0.1, 5, 4),
-])
+@pytest.mark.parametrize(
+    "y_end, oracle_last, cand_last",
+    [
+        (5.3 + 1.1 * ZONE, 5, 4),  # just outside the zone: the oracle's row 5 is the line's, the candidate lost it
+        (5.3 + 0.1, 5, 4),
+    ],
+)
 def test_an_end_outside_the_zone_stays_decided(y_end, oracle_last, cand_last):
     p0, p1 = vertical(y_end)
     cand, oracle = column(cand_last), column(oracle_last)
     s = metrics.line_scores(cand, oracle, p0, p1)
     assert (s["oracle_only"], s["subpixel_ties"]) == (1, [0, 0])
-    assert s["ends"]["end"] == [0, 1]                                  # decided, at the line's end
-    assert s["tie_resolved"] is None                                   # no tie: F1@0px as drawn, 10/11
+    assert s["ends"]["end"] == [0, 1]  # decided, at the line's end
+    assert s["tie_resolved"] is None  # no tie: F1@0px as drawn, 10/11
     assert s["edge_count_max_diff"] == 1
 
 
@@ -101,5 +106,6 @@ def test_an_end_at_the_image_border_decides_nothing():
     assert (s["oracle_only"], s["subpixel_ties"]) == (1, [0, 0])
     # without the border (box None), the cut end would have been taken for a tie
     assert line_ties.tie_ends(np.array([[3.0, 0.0]]), p0, np.array([[3.0, -0.5]]))[0]
-    assert not line_ties.tie_ends(np.array([[3.0, 0.0]]), p0, np.array([[3.0, -0.5]]),
-                                  box=((-0.5, -0.5), (7.5, 9.5)))[0]
+    assert not line_ties.tie_ends(np.array([[3.0, 0.0]]), p0, np.array([[3.0, -0.5]]), box=((-0.5, -0.5), (7.5, 9.5)))[
+        0
+    ]

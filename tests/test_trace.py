@@ -10,13 +10,12 @@ import math
 
 import numpy as np
 import pytest
+from helpers import run_renderer as run
 from numpy.testing import assert_allclose
-
+from wirecheck.core.app.trace import clip_matrix, ndc_to_px, trace_vertex
 from wirecheck.core.camera import camera_z, look_at
 from wirecheck.core.scene.files import load_scene
-from wirecheck.core.app.trace import clip_matrix, ndc_to_px, trace_vertex
 from wirecheck.core.transforms import Motion
-from helpers import run_renderer as run
 
 F60 = 240.0 * math.sqrt(3.0)
 # float64 arithmetic on values of size ~500 with a handful of operations: 1e-9 is
@@ -26,17 +25,17 @@ TOL = 1e-9
 
 def test_rest_pose_every_space_by_hand():
     cube = load_scene("cube")
-    cam = camera_z(4.0)                                   # at (0, 0, 4), forward -Z: p_cam = (x, y, 4 - z)
+    cam = camera_z(4.0)  # at (0, 0, 4), forward -Z: p_cam = (x, y, 4 - z)
     rec = trace_vertex(cube, Motion(), cam, 6, 1, 180)
     n, f = 0.1, 100.0
     assert rec["model"] == [1.0, 1.0, 1.0]
-    assert rec["world"] == [1.0, 1.0, 1.0]                # frame 1 is the rest pose
+    assert rec["world"] == [1.0, 1.0, 1.0]  # frame 1 is the rest pose
     assert_allclose(rec["camera"], [1.0, 1.0, 3.0], atol=TOL)
-    z_clip = (f + n) / (f - n) * 3.0 - 2 * f * n / (f - n)   # = 2.805806
+    z_clip = (f + n) / (f - n) * 3.0 - 2 * f * n / (f - n)  # = 2.805806
     assert_allclose(rec["clip"], [2 * F60 / 640, 2 * F60 / 480, z_clip, 3.0], atol=TOL)
     assert_allclose(rec["clip"][:2], [1.2990381056766578, math.sqrt(3.0)], atol=TOL)
     assert_allclose(rec["ndc"], [F60 / 3 / 320, F60 / 3 / 240, z_clip / 3.0], atol=TOL)
-    assert_allclose(rec["pixel"], [319.5 + F60 / 3, 239.5 - F60 / 3], atol=TOL)   # (458.0641, 100.9359)
+    assert_allclose(rec["pixel"], [319.5 + F60 / 3, 239.5 - F60 / 3], atol=TOL)  # (458.0641, 100.9359)
     assert_allclose(rec["pixel_from_ndc"], rec["pixel"], atol=TOL)
     assert rec["visible"] and rec["on_image"]
     assert sorted(tuple(e["edge"]) for e in rec["edges"]) == [(6, 2), (6, 5), (6, 7)]
@@ -70,25 +69,31 @@ def test_near_plane_clipping_by_hand():
     assert next(e for e in rec["edges"] if e["edge"] == [6, 7])["status"] == "dropped"
 
 
-@pytest.mark.parametrize("cam", [
-    look_at((2.0, 1.5, 2.5), (0, 0, 0), (0.3, 1.0, 0.2), fov_y_deg=55, width=320, height=480, near=0.5, far=9.0),
-    look_at((2.0, 2.0, 3.0), (0, 0, 0), projection="orthographic", ortho_height=3.0, near=0.5, far=9.0),
-])
+@pytest.mark.parametrize(
+    "cam",
+    [
+        look_at((2.0, 1.5, 2.5), (0, 0, 0), (0.3, 1.0, 0.2), fov_y_deg=55, width=320, height=480, near=0.5, far=9.0),
+        look_at((2.0, 2.0, 3.0), (0, 0, 0), projection="orthographic", ortho_height=3.0, near=0.5, far=9.0),
+    ],
+)
 def test_clip_matrix_agrees_with_core_projection(cam):
     """The GL-form clip matrix, divided and mapped to pixels, lands on core's pixels (both projections)."""
     cube = load_scene("cube")
     for i in range(8):
         rec = trace_vertex(cube, Motion(), cam, i, 3, 10)
         assert_allclose(rec["pixel_from_ndc"], rec["pixel"], atol=TOL * 10)
-        assert -1.0 <= rec["ndc"][2] <= 1.0                # inside [near, far]
+        assert -1.0 <= rec["ndc"][2] <= 1.0  # inside [near, far]
     # boundary values: z_ndc = -1 on the near plane, +1 on the far plane
     p = clip_matrix(cam)
     for z, want in ((cam.near, -1.0), (cam.far, 1.0)):
         c = p @ [0.0, 0.0, z, 1.0]
         assert c[2] / c[3] == pytest.approx(want, abs=1e-12)
     # NDC corners are the image's outer edges
-    assert_allclose(ndc_to_px(np.array([[-1.0, 1.0, 0.0], [1.0, -1.0, 0.0]]), cam),
-                    [[-0.5, -0.5], [cam.width - 0.5, cam.height - 0.5]], atol=TOL)
+    assert_allclose(
+        ndc_to_px(np.array([[-1.0, 1.0, 0.0], [1.0, -1.0, 0.0]]), cam),
+        [[-0.5, -0.5], [cam.width - 0.5, cam.height - 0.5]],
+        atol=TOL,
+    )
 
 
 def test_cli_prints_and_reports_the_trace(tmp_path):
@@ -109,13 +114,16 @@ def test_default_trace_frames_are_first_middle_last(tmp_path):
     assert [t["frame"] for t in report["trace"]] == [1, 90, 180]
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["--trace-vertex", "8"], "--trace-vertex 8: scene 'cube' has 8 vertices: expected an index in [0, 7]"),
-    (["--trace-vertex", "-1"], "--trace-vertex -1: scene 'cube' has 8 vertices"),
-    (["--trace-vertex", "0", "--trace-frames", "0,3"], "--trace-frames '0,3': expected comma-separated"),
-    (["--trace-vertex", "0", "--trace-frames", "x"], "--trace-frames 'x'"),
-    (["--trace-frames", "1"], "without --trace-vertex"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["--trace-vertex", "8"], "--trace-vertex 8: scene 'cube' has 8 vertices: expected an index in [0, 7]"),
+        (["--trace-vertex", "-1"], "--trace-vertex -1: scene 'cube' has 8 vertices"),
+        (["--trace-vertex", "0", "--trace-frames", "0,3"], "--trace-frames '0,3': expected comma-separated"),
+        (["--trace-vertex", "0", "--trace-frames", "x"], "--trace-frames 'x'"),
+        (["--trace-frames", "1"], "without --trace-vertex"),
+    ],
+)
 def test_bad_trace_input_is_one_line_and_exit_2(tmp_path, args, needle):
     rc, out, err = run(["--frames", "5"] + args, tmp_path / "o")
     assert rc == 2

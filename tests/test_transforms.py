@@ -9,7 +9,6 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-
 from wirecheck.core.transforms import Motion, apply, compose, rotate_x, rotate_y, rotate_z, scale, translate
 
 EPS = np.finfo(np.float64).eps  # 2.2e-16
@@ -92,6 +91,7 @@ def test_compose_translate_rotate_hand_computed():
 
 # ---- Motion ----------------------------------------------------------------------
 
+
 def test_frame_one_is_rest_pose_identity():
     m = Motion()
     assert_array_equal(m.frame_matrix(1, 180), np.eye(4))  # bitwise: angles are exactly 0
@@ -120,8 +120,10 @@ def test_frame_and_frame_one_period_later_are_bit_identical_over_a_million_frame
     assert not np.array_equal(m.frame_matrix(k, 1_000_000), m.frame_matrix(k + 1000, 1_000_000))
 
 
-@pytest.mark.parametrize("turns,frames,k", [((2, 2, 0), 180, 91), ((3, 0, 0), 3, 2), ((6, 3, 0), 180, 61),
-                                            ((1, 1, 0), 2, 2), ((4, 0, 2), 8, 3)])
+@pytest.mark.parametrize(
+    "turns,frames,k",
+    [((2, 2, 0), 180, 91), ((3, 0, 0), 3, 2), ((6, 3, 0), 180, 61), ((1, 1, 0), 2, 2), ((4, 0, 2), 8, 3)],
+)
 def test_whole_turns_return_bitwise_to_frame_one(turns, frames, k):
     # turns=(2,2,0), frames=180, frame 91: t = 90/180 = 0.5, 2*0.5 = 1 whole turn on
     # each axis; (3,0,0), 3, frame 2: t = 1/3, 3t = 1.0 in float64; (6,3,0), 180, frame

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from wirecheck import assert_unprojector, check_unprojector
 from wirecheck.core.camera import camera_z
 from wirecheck.core.errors import InputError
@@ -23,15 +22,15 @@ from wirecheck.core.scene.files import load_scene
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion
+from wirecheck.oracles.cases import CALIBRATED_CASE_NAMES, CASE_NAMES, cameras_for, case_motion, cases_for
 from wirecheck.oracles.faults import CATALOGUE
-from wirecheck.oracles.cases import CALIBRATED_CASE_NAMES, CASE_NAMES, case_motion, cameras_for, cases_for
 from wirecheck.oracles.judge.metrics import depth_bound
-from wirecheck.oracles.tolerances import unproject_bound
 from wirecheck.oracles.references.opencv_oracle import project as cv_project
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.reports.fault_text import CELL_MAX
-from wirecheck.oracles.unprojector_api import unprojector_failure_text
 from wirecheck.oracles.reports.unprojector_report import console_lines
+from wirecheck.oracles.tolerances import unproject_bound
+from wirecheck.oracles.unprojector_api import unprojector_failure_text
 
 sys.path.insert(0, str(Path(__file__).parent / "data"))
 import unprojectors as U  # noqa: E402
@@ -43,12 +42,13 @@ EPS = np.finfo(np.float64).eps
 
 # ---------------------------------------------------------------- the reference inverse
 
+
 def test_reference_hand_values():
-    cam = camera_z(4.0, width=640, height=480, fov_y_deg=90)      # f = 240 px, centre (319.5, 239.5)
+    cam = camera_z(4.0, width=640, height=480, fov_y_deg=90)  # f = 240 px, centre (319.5, 239.5)
     # the centre at depth 4 is the origin; 240 px right of it at depth 2 is 2 * 240 / 240 = 2 units right
     x = unproject([[319.5, 239.5], [559.5, 239.5], [319.5, 479.5]], [4.0, 2.0, 2.0], cam)
     assert np.allclose(x, [[0, 0, 0], [2, 0, 2], [0, -2, 2]], atol=8 * EPS * 4)
-    ortho = camera_z(4.0, width=640, height=480, projection="orthographic", ortho_height=2.0)   # 240 px per unit
+    ortho = camera_z(4.0, width=640, height=480, projection="orthographic", ortho_height=2.0)  # 240 px per unit
     x = unproject([[559.5, 239.5]], [4.0], ortho)
     assert np.allclose(x, [[1.0, 0.0, 0.0]], atol=8 * EPS * 4)
 
@@ -70,6 +70,7 @@ def test_reference_inverts_projectpoints(case):
 
 # ---------------------------------------------------------------- the check
 
+
 @pytest.fixture(scope="module")
 def correct_report():
     return check_unprojector(U.correct, cases="all")
@@ -88,8 +89,7 @@ def test_float32_and_gl_style_pass():
     r = check_unprojector(U.correct_float32)
     assert r["verdict"] == "pass" and {c["precision"] for c in r["cases"]} == {"float32"}
     # the same float32 answers handed back as float64 are held to float64's bound, and fail
-    as64 = check_unprojector(lambda p, d, c: U.correct_float32(p, d, c).astype(np.float64), scenes=["cube"],
-                             frames=1)
+    as64 = check_unprojector(lambda p, d, c: U.correct_float32(p, d, c).astype(np.float64), scenes=["cube"], frames=1)
     assert as64["verdict"] == "fail"
     # inverse(P V) on NDC: worse conditioned than K, R, t; within the 1e-6 px floor
     assert check_unprojector(U.gl_unproject)["verdict"] == "pass"
@@ -122,8 +122,10 @@ def test_each_mistake_named_alone(mistake_reports, summary_section):
             counts[(expected, got)] += 1
     names = [e for _, _, e in MISTAKES]
     cols = names + sorted({g for _, g in counts} - set(names))
-    lines = ["unprojector mistakes (rows injected, columns named), 3 scenes, 1 frame each",
-             " " * 20 + " ".join(f"{n[:12]:>12}" for n in cols)]
+    lines = [
+        "unprojector mistakes (rows injected, columns named), 3 scenes, 1 frame each",
+        " " * 20 + " ".join(f"{n[:12]:>12}" for n in cols),
+    ]
     lines += [f"{r:<20}" + " ".join(f"{counts[(r, c)] or '.':>12}" for c in cols) for r in names]
     summary_section("unprojector confusion matrix", "\n".join(lines))
     assert not {k: v for k, v in counts.items() if k[0] != k[1]}, counts
@@ -153,8 +155,11 @@ def test_transposed_is_invisible_where_r_is_symmetric():
 
 
 def test_failing_candidates_fail_their_cases():
-    for func, text in ((U.raises, "unprojector RuntimeError: not implemented"),
-                       (U.wrong_shape, "expected an ("), (U.exits, "unprojector SystemExit: 0")):
+    for func, text in (
+        (U.raises, "unprojector RuntimeError: not implemented"),
+        (U.wrong_shape, "expected an ("),
+        (U.exits, "unprojector SystemExit: 0"),
+    ):
         r = check_unprojector(func, scenes=["cube"], cases=["on_axis"], frames=1)
         assert r["verdict"] == "fail" and r["cases"][0]["points"] > 0
         assert text in r["cases"][0]["reasons"][0]
@@ -168,7 +173,7 @@ def test_failing_candidates_fail_their_cases():
 
 def test_never_vacuous():
     cube = load_scene("cube")
-    bare = Scene(name="bare", vertices=cube.vertices, edges=cube.edges)          # a wireframe: no surface
+    bare = Scene(name="bare", vertices=cube.vertices, edges=cube.edges)  # a wireframe: no surface
     with pytest.raises(InputError, match="compares nothing is no pass"):
         check_unprojector(U.correct, scenes=[bare])
     for bad in ({"frames": 0}, {"cases": ["nope"]}, {"stride": 0}):
@@ -181,6 +186,7 @@ def test_never_vacuous():
 
 
 # ---------------------------------------------------------------- the round trip
+
 
 def mesh_distance_ratios(unproject_func) -> list:
     """Core's depth map of frame 2 of 7 of each scene and default case, every 50th covered pixel
@@ -210,8 +216,11 @@ def mesh_distance_ratios(unproject_func) -> list:
                 closest = trimesh.triangles.closest_point(np.repeat(tri[None], len(x), axis=0), x)
                 dist = np.minimum(dist, np.linalg.norm(closest - x, axis=1))
             k = cam.K
-            rho = (np.hypot(np.hypot((p_px[:, 0] - k[0, 2]) / k[0, 0], (p_px[:, 1] - k[1, 2]) / k[1, 1]), 1.0)
-                   if cam.projection == "perspective" else 1.0)
+            rho = (
+                np.hypot(np.hypot((p_px[:, 0] - k[0, 2]) / k[0, 0], (p_px[:, 1] - k[1, 2]) / k[1, 1]), 1.0)
+                if cam.projection == "perspective"
+                else 1.0
+            )
             bound = rho * depth_bound(frame.depth_image, covered, cam)[rows, cols] + unproject_bound(p_px, d, cam)
             out.append((name, case.name, float((dist / bound).max())))
     return out
@@ -220,18 +229,24 @@ def mesh_distance_ratios(unproject_func) -> list:
 def test_depth_map_back_onto_the_mesh():
     ratios = mesh_distance_ratios(U.correct)
     assert len(ratios) == 21 and all(r <= 1.0 for _, _, r in ratios), ratios
-    assert max(r for _, _, r in ratios) > 0             # measured: 0.021 at most
+    assert max(r for _, _, r in ratios) > 0  # measured: 0.021 at most
     # a half-pixel unprojector misses the mesh somewhere in every case (measured: 18 to 278 bounds)
     assert all(r > 1.0 for _, _, r in mesh_distance_ratios(U.half_pixel))
 
 
 # ---------------------------------------------------------------- the CLI
 
+
 def crosscheck(*args):
     """crosscheck in a process of its own; --no-report: no reports/<UTC time>/ folder in the repository
     (the report folder: tests/test_unprojector_report.py)."""
-    return subprocess.run([sys.executable, "-m", "wirecheck.oracles.cli", *args, "--no-report"], cwd=ROOT,
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "wirecheck.oracles.cli", *args, "--no-report"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 def test_cli_pass_fail_error():
@@ -240,7 +255,7 @@ def test_cli_pass_fail_error():
     assert "PASS: 7/7 cases" in ok.stdout and "points compared" in ok.stdout
     bad = crosscheck("--unprojector", f"{SPEC}:rows_flipped", "--scene", "cube", "--frames", "1")
     assert bad.returncode == 1 and "mirror_vertical" in bad.stdout and "FAIL: 0/7 cases" in bad.stdout
-    assert "rows are not flipped" in bad.stdout                        # what to check
+    assert "rows are not flipped" in bad.stdout  # what to check
     for args in ([f"{SPEC}:nope"], ["nofile.py:f"], [f"{SPEC}:correct", "--cases", "nope"]):
         err = crosscheck("--unprojector", *args, "--scene", "cube")
         assert err.returncode == 2 and err.stdout == "" and len(err.stderr.strip().splitlines()) == 1, err.stderr
@@ -256,25 +271,30 @@ def test_cli_pass_fail_error():
 def test_faults_are_short_cells_and_each_kind_hint_once():
     """The assertion's message and the console table show a cell per case (oracles.reports.fault_text,
     <= 60 characters) and what to check once per fault kind, the catalogue's hint for an unprojector."""
-    report = check_unprojector(U.horizontal_fov, scenes=["cube"], frames=1, cases=["on_axis", "wide_fov",
-                                                                                   "orthographic"])
-    for c in report["cases"]:                     # the record's shape: name, params, hint, short
+    report = check_unprojector(
+        U.horizontal_fov, scenes=["cube"], frames=1, cases=["on_axis", "wide_fov", "orthographic"]
+    )
+    for c in report["cases"]:  # the record's shape: name, params, hint, short
         assert [sorted(f) for f in c["faults"]] == [["hint", "name", "params", "short"]]
         assert type(c["faults"][0]["params"]) is dict
     text = unprojector_failure_text(report)
     cells = re.findall(r": faults: (.*?); ", text)
     # K from the horizontal FOV: f = (W / 2) / tan(fov / 2), so the FOV implied is 2 atan((H / W) tan(fov / 2))
     cams = {case.name: case.camera for case in cases_for(load_scene("cube"))}
-    implied = [math.degrees(2 * math.atan(c.height / c.width * math.tan(math.radians(c.fov_y_deg) / 2)))
-               for c in (cams["on_axis"], cams["wide_fov"])]
+    implied = [
+        math.degrees(2 * math.atan(c.height / c.width * math.tan(math.radians(c.fov_y_deg) / 2)))
+        for c in (cams["on_axis"], cams["wide_fov"])
+    ]
     # orthographic: that f taken for its pixels per unit; fov_mismatch is fitted on perspective cameras only
     assert cells == [f"fov_mismatch(fov={implied[0]:.4g})", f"fov_mismatch(fov={implied[1]:.4g})", "unexplained"]
     table = console_lines(report)
     assert [line.split()[-1] for line in table[1:4]] == cells and all(len(c) <= CELL_MAX for c in cells)
     for lines in (text.splitlines(), table):
         checks = [line for line in lines if line.startswith("  what to check, ")]
-        assert checks == [f"  what to check, fov_mismatch: {CATALOGUE['fov_mismatch'].hints['points']}",
-                          f"  what to check, unexplained: {CATALOGUE['unexplained'].hints['points']}"]
+        assert checks == [
+            f"  what to check, fov_mismatch: {CATALOGUE['fov_mismatch'].hints['points']}",
+            f"  what to check, unexplained: {CATALOGUE['unexplained'].hints['points']}",
+        ]
 
 
 # ---------------------------------------------------------------- over the protocol
@@ -291,7 +311,7 @@ def test_protocol_request_line():
     line, _, payload = bytes(msg).partition(b"\n")
     assert line.startswith(b'{"request":7,"kind":"unproject","n":1,"camera":{')
     assert np.frombuffer(payload, "<f8").tolist() == [1.0, 2.0, 3.0]
-    assert b'"kind"' not in bytes(encode_request(7, rows, camera_text(cam)))      # a projection: unchanged
+    assert b'"kind"' not in bytes(encode_request(7, rows, camera_text(cam)))  # a projection: unchanged
 
 
 def test_protocol_client(monkeypatch):
@@ -321,8 +341,20 @@ def test_cli_hostile_candidate_timeout(value, capsys):
     # error" (found by benchmarks/fuzz_round5.py); checked as for --candidate: one line, exit 2
     from wirecheck.oracles import cli
 
-    code = cli.main(["--unprojector", f"{SPEC}:correct", "--scene", "cube", "--cases", "on_axis", "--frames", "1",
-                     "--candidate-timeout", value])
+    code = cli.main(
+        [
+            "--unprojector",
+            f"{SPEC}:correct",
+            "--scene",
+            "cube",
+            "--cases",
+            "on_axis",
+            "--frames",
+            "1",
+            "--candidate-timeout",
+            value,
+        ]
+    )
     out, err = capsys.readouterr()
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
     assert err.startswith(f"crosscheck: error: --candidate-timeout {float(value)}: expected a number of seconds > 0")

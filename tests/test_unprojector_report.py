@@ -17,7 +17,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from wirecheck import assert_unprojector, check_unprojector
 from wirecheck.core.errors import InputError
 from wirecheck.core.outputs.output import MARKER
@@ -43,33 +42,56 @@ def _files(folder: Path) -> dict:
     for d, ds, fs in os.walk(folder):
         for n in ds + fs:
             p = os.path.join(d, n)
-            out[os.path.relpath(p, folder)] = (None if os.path.isdir(p) else "fifo" if stat.S_ISFIFO(os.lstat(p).st_mode)
-                                               else open(p, "rb").read())
+            out[os.path.relpath(p, folder)] = (
+                None if os.path.isdir(p) else "fifo" if stat.S_ISFIFO(os.lstat(p).st_mode) else open(p, "rb").read()
+            )
     return out
 
 
 def test_report_json_holds_the_returned_report(tmp_path):
-    report = check_unprojector(U.horizontal_fov, scenes=["cube"], frames=1, cases=["on_axis", "wide_fov"],
-                               report_dir=tmp_path / "r")
+    report = check_unprojector(
+        U.horizontal_fov, scenes=["cube"], frames=1, cases=["on_axis", "wide_fov"], report_dir=tmp_path / "r"
+    )
     assert sorted(p.name for p in (tmp_path / "r").iterdir()) == sorted([MARKER, "report.json", "report.md"])
     written = json.loads((tmp_path / "r" / "report.json").read_text())
     assert report["verdict"] == "fail" and len(report["cases"]) == 2
     # every number read back as it was returned: json keeps a float's 17 digits, so == is exact
-    assert written["compared"] == report["compared"] == {"cases": 2, "frames": 2,
-                                                         "points": sum(c["points"] for c in report["cases"])}
+    assert (
+        written["compared"]
+        == report["compared"]
+        == {"cases": 2, "frames": 2, "points": sum(c["points"] for c in report["cases"])}
+    )
     for got, case in zip(written["cases"], report["cases"]):
-        for key in ("scene", "camera", "verdict", "points", "max_error", "max_error_ratio", "bound_at_worst",
-                    "worst", "precision", "reasons", "measured"):
+        for key in (
+            "scene",
+            "camera",
+            "verdict",
+            "points",
+            "max_error",
+            "max_error_ratio",
+            "bound_at_worst",
+            "worst",
+            "precision",
+            "reasons",
+            "measured",
+        ):
             assert got[key] == case[key], key
         assert got["faults"] == case["faults"] and got["faults"][0]["name"] == "fov_mismatch"
-    assert written["settings"] == {"scenes": ["cube"], "cases": ["on_axis", "wide_fov"], "frames": 1,
-                                   "turns": [1.0, 1.0, 0.0], "stride": 8}
+    assert written["settings"] == {
+        "scenes": ["cube"],
+        "cases": ["on_axis", "wide_fov"],
+        "frames": 1,
+        "turns": [1.0, 1.0, 0.0],
+        "stride": 8,
+    }
     assert written["timing"]["wall_s"] == report["timing"]["wall_s"] > 0
     md = (tmp_path / "r" / "report.md").read_text()
     # the table's rows: one per case, the error and ratio as the console prints them
     for case in report["cases"]:
-        row = (f"| cube | {case['camera']} | {case['points']:,} | {case['max_error']:.2e} | "
-               f"{case['max_error_ratio']:.3g} | fail | {case['faults'][0]['short']} |")
+        row = (
+            f"| cube | {case['camera']} | {case['points']:,} | {case['max_error']:.2e} | "
+            f"{case['max_error_ratio']:.3g} | fail | {case['faults'][0]['short']} |"
+        )
         assert row in md.splitlines(), row
     # two cases with fov_mismatch: what to check once, the catalogue's hint for an unprojector's points
     hint = f"- `fov_mismatch`: {CATALOGUE['fov_mismatch'].hints['points']}"
@@ -97,13 +119,16 @@ def test_run_and_no_report(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert _run("--run", "r1") == 1
     assert json.loads((tmp_path / "reports" / "r1" / "report.json").read_text())["run"] == "r1"
-    assert (tmp_path / "reports" / "r1" / "report.md").read_text().startswith(
-        "# crosscheck unprojector report (r1): FAIL\n")
+    assert (
+        (tmp_path / "reports" / "r1" / "report.md")
+        .read_text()
+        .startswith("# crosscheck unprojector report (r1): FAIL\n")
+    )
     capsys.readouterr()
     assert _run("--no-report") == 1
     assert capsys.readouterr().out.rstrip().splitlines()[-1] == "Report: none written (--no-report)"
     assert sorted(os.listdir(tmp_path)) == ["reports"] and os.listdir(tmp_path / "reports") == ["r1"]
-    assert _run() == 1                                        # the default: reports/<UTC time>/
+    assert _run() == 1  # the default: reports/<UTC time>/
     (made,) = set(os.listdir(tmp_path / "reports")) - {"r1"}
     assert len(made) == len("20261207-040000") and (tmp_path / "reports" / made / "report.md").is_file()
     capsys.readouterr()
@@ -151,7 +176,7 @@ def test_a_folder_not_written_by_wirecheck_is_refused(tmp_path, capsys, make):
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and err.startswith("crosscheck: error: --report-dir ")
     assert f"--report-dir {str(target)!r}" in err and needle in err and "nothing was changed" in err, err
-    assert _files(tmp_path) == before                     # every byte, every name: nothing added or removed
+    assert _files(tmp_path) == before  # every byte, every name: nothing added or removed
 
 
 def test_api_refuses_before_running(tmp_path):
@@ -171,14 +196,15 @@ def test_api_refuses_before_running(tmp_path):
         check_unprojector(spy, scenes=["cube"], frames=1, cases=["on_axis"], report_dir=3)
     assert calls == [] and (tmp_path / "t" / "notes.txt").read_text() == "mine"
     assert (tmp_path / "f").read_text() == "mine"
-    assert sorted(os.listdir(tmp_path)) == ["f", "t"]         # no lock or temporary left beside them
+    assert sorted(os.listdir(tmp_path)) == ["f", "t"]  # no lock or temporary left beside them
 
 
 def test_assert_unprojector_names_its_report(tmp_path):
     with pytest.raises(AssertionError) as info:
         assert_unprojector(U.rows_flipped, scenes=["cube"], frames=1, cases=["on_axis"], report_dir=tmp_path / "r")
     assert str(info.value).splitlines()[-1] == f"  report: {tmp_path / 'r' / 'report.md'}"
-    assert json.loads((tmp_path / "r" / "report.json").read_text())["cases"][0]["faults"][0]["name"] == \
-        "mirror_vertical"
+    assert (
+        json.loads((tmp_path / "r" / "report.json").read_text())["cases"][0]["faults"][0]["name"] == "mirror_vertical"
+    )
     report = assert_unprojector(U.correct, scenes=["cube"], frames=1, cases=["on_axis"], report_dir=tmp_path / "r")
     assert json.loads((tmp_path / "r" / "report.json").read_text())["verdict"] == report["verdict"] == "pass"

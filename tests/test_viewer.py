@@ -24,15 +24,14 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
-
-from wirecheck.core.camera import look_at
 from wirecheck.core.app.cli import build_parser, main, settings_from_args
+from wirecheck.core.app.viewer import DOLLY_PER_UNIT, View, Viewer, dolly, orbit, pan
+from wirecheck.core.app.viewer_http import Server
+from wirecheck.core.camera import look_at
 from wirecheck.core.outputs.output import png_bytes
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import project_points
 from wirecheck.core.transforms import Motion
-from wirecheck.core.app.viewer import DOLLY_PER_UNIT, View, Viewer, dolly, orbit, pan
-from wirecheck.core.app.viewer_http import Server
 
 F60 = 240.0 * math.sqrt(3.0)
 # a few float64 rotations of values ~4: 1e-12 is ~10^3 eps x scale
@@ -44,28 +43,34 @@ def settings(tmp_path, *args):
 
 
 def start_view(**kw):
-    base = dict(position=(0.0, 0.0, 4.0), target=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0), fov=60.0, near=0.1,
-                far=100.0, ortho_height=4.0)
+    base = dict(
+        position=(0.0, 0.0, 4.0),
+        target=(0.0, 0.0, 0.0),
+        up=(0.0, 1.0, 0.0),
+        fov=60.0,
+        near=0.1,
+        far=100.0,
+        ortho_height=4.0,
+    )
     base.update(kw)
     return View(**base)
 
 
 def test_orbit_left_drag_turns_the_camera_90_degrees_about_up():
-    v = orbit(start_view(), -180.0, 0.0)             # 180 px x 0.5 deg/px, drag left: camera to +X
+    v = orbit(start_view(), -180.0, 0.0)  # 180 px x 0.5 deg/px, drag left: camera to +X
     assert_allclose(v.position, (4.0, 0.0, 0.0), atol=TOL)
     assert_allclose(v.up, (0.0, 1.0, 0.0), atol=TOL)
     cam = v.camera(640, 480)
     assert_allclose(cam.right, (0.0, 0.0, -1.0), atol=TOL)
     # vertex (1, 1, 1): p_cam = (right, up, forward) . (p - position) = (-1, 1, 3)
-    assert_allclose(project_points(np.array([[1.0, 1.0, 1.0]]), cam)[0],
-                    (319.5 - F60 / 3, 239.5 - F60 / 3), atol=1e-9)
+    assert_allclose(project_points(np.array([[1.0, 1.0, 1.0]]), cam)[0], (319.5 - F60 / 3, 239.5 - F60 / 3), atol=1e-9)
 
 
 def test_orbit_down_drag_raises_the_camera_and_turns_up_with_it():
-    v = orbit(start_view(), 0.0, 180.0)              # drag down 90 deg: camera over the top
+    v = orbit(start_view(), 0.0, 180.0)  # drag down 90 deg: camera over the top
     assert_allclose(v.position, (0.0, 4.0, 0.0), atol=TOL)
     assert_allclose(v.up, (0.0, 0.0, -1.0), atol=TOL)
-    v2 = orbit(v, 0.0, 180.0)                        # past the pole: no degenerate up
+    v2 = orbit(v, 0.0, 180.0)  # past the pole: no degenerate up
     assert_allclose(v2.position, (0.0, 0.0, -4.0), atol=TOL)
     assert_allclose(v2.up, (0.0, -1.0, 0.0), atol=TOL)
 
@@ -94,20 +99,28 @@ def test_frame_is_core_render_frame_byte_for_byte(tmp_path):
     v = viewer.view
     cam = look_at(v.position, v.target, v.up, fov_y_deg=60.0, near=0.1, far=100.0)
     cube = s.scene
-    frame = render_frame(cube.vertices, cube.edges, cam, Motion().frame_matrix(5, 12), faces=cube.faces,
-                         hidden_lines=True)
+    frame = render_frame(
+        cube.vertices, cube.edges, cam, Motion().frame_matrix(5, 12), faces=cube.faces, hidden_lines=True
+    )
     png = base64.b64decode(resp["image"])
     assert png == png_bytes(frame.image)
-    assert_array_equal(np.asarray(Image.open(io.BytesIO(png)).convert("L")), frame.image)   # bilevel PNG: 0/255
+    assert_array_equal(np.asarray(Image.open(io.BytesIO(png)).convert("L")), frame.image)  # bilevel PNG: 0/255
     assert resp["vertices_px"][6] == frame.p_px[6].tolist()
 
 
 def test_the_printed_command_line_writes_the_same_png(tmp_path):
     s = settings(tmp_path, "--frames", "8", "--scene", "prism")
     viewer = Viewer(s)
-    resp = viewer.respond([{"op": "orbit", "dx": 71, "dy": 40}, {"op": "dolly", "delta": -130},
-                           {"op": "pan", "dx": 12, "dy": -9}, {"op": "set", "field": "axes", "value": True},
-                           {"op": "set", "field": "cull", "value": True}, {"op": "step", "n": 2}])
+    resp = viewer.respond(
+        [
+            {"op": "orbit", "dx": 71, "dy": 40},
+            {"op": "dolly", "delta": -130},
+            {"op": "pan", "dx": 12, "dy": -9},
+            {"op": "set", "field": "axes", "value": True},
+            {"op": "set", "field": "cull", "value": True},
+            {"op": "step", "n": 2},
+        ]
+    )
     assert resp["error"] is None
     cmd, comment = resp["command"].split("   # ")
     args = shlex.split(cmd)[1:]
@@ -118,24 +131,29 @@ def test_the_printed_command_line_writes_the_same_png(tmp_path):
     assert (out / "prism-frames" / "frame_0003.png").read_bytes() == base64.b64decode(resp["image"])
 
 
-@pytest.mark.parametrize("ops, needle", [
-    ([{"op": "set", "field": "fov", "value": "NaN"}], "fov 'NaN': expected a finite number"),
-    ([{"op": "set", "field": "near", "value": "500"}], "expected > near"),
-    ([{"op": "set", "field": "fov", "value": "180"}], "camera fov 180.0"),
-    ([{"op": "set", "field": "style", "value": "shaded"}, {"op": "set", "field": "hidden_lines", "value": True}],
-     "hidden lines with style shaded"),
-    ([{"op": "set", "field": "colour", "value": "red"}], "field 'colour'"),
-    ([{"op": "warp"}], "expected orbit, pan, dolly"),
-    ([{"op": "orbit", "dx": "x", "dy": 0}], "dx 'x'"),
-    ([{"op": "step", "n": 1.5}], "step 1.5"),
-    ("orbit", "ops 'orbit': expected a list"),
-])
+@pytest.mark.parametrize(
+    "ops, needle",
+    [
+        ([{"op": "set", "field": "fov", "value": "NaN"}], "fov 'NaN': expected a finite number"),
+        ([{"op": "set", "field": "near", "value": "500"}], "expected > near"),
+        ([{"op": "set", "field": "fov", "value": "180"}], "camera fov 180.0"),
+        (
+            [{"op": "set", "field": "style", "value": "shaded"}, {"op": "set", "field": "hidden_lines", "value": True}],
+            "hidden lines with style shaded",
+        ),
+        ([{"op": "set", "field": "colour", "value": "red"}], "field 'colour'"),
+        ([{"op": "warp"}], "expected orbit, pan, dolly"),
+        ([{"op": "orbit", "dx": "x", "dy": 0}], "dx 'x'"),
+        ([{"op": "step", "n": 1.5}], "step 1.5"),
+        ("orbit", "ops 'orbit': expected a list"),
+    ],
+)
 def test_bad_input_is_a_message_and_the_view_stays(tmp_path, ops, needle):
     viewer = Viewer(settings(tmp_path, "--frames", "6"))
     before = viewer.respond([{"op": "orbit", "dx": 10, "dy": 0}])
     resp = viewer.respond(ops)
     assert needle in resp["error"]
-    assert resp["view"] == before["view"]                        # nothing half-applied
+    assert resp["view"] == before["view"]  # nothing half-applied
     assert resp["image"] == before["image"]
 
 
@@ -170,7 +188,7 @@ def test_http_api_and_clean_stop(tmp_path):
         with pytest.raises(urllib.error.HTTPError) as exc:
             _get(url + "etc/passwd")
         assert exc.value.code == 404
-        assert json.loads(_get(url + "api/frame")[2])["error"] is None      # still serving
+        assert json.loads(_get(url + "api/frame")[2])["error"] is None  # still serving
     finally:
         server.stop()
     assert not server.thread.is_alive()
@@ -180,13 +198,16 @@ def test_http_api_and_clean_stop(tmp_path):
 
 
 def test_overlay_f1_equals_metrics_computed_independently(tmp_path):
-    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle, osmesa_available   # sets PYOPENGL_PLATFORM first
     from wirecheck.oracles.judge import metrics
-    from wirecheck.oracles.references import opencv_oracle
     from wirecheck.oracles.live import LiveOverlay
+    from wirecheck.oracles.references import opencv_oracle
+    from wirecheck.oracles.references.pyrender_oracle import (
+        PyrenderOracle,
+        osmesa_available,
+    )  # sets PYOPENGL_PLATFORM first
 
     ok, why = osmesa_available()
-    assert ok, why                                           # .ci/setup.sh installs libOSMesa
+    assert ok, why  # .ci/setup.sh installs libOSMesa
     s = settings(tmp_path, "--frames", "10")
     overlay = LiveOverlay()
     try:
@@ -207,20 +228,26 @@ def test_overlay_f1_equals_metrics_computed_independently(tmp_path):
     # F1@0px is over the decided pixels: at a sub-pixel tie the candidate takes the oracle's value
     # (metrics.line_scores' tie_resolved, on OpenCV's segments of the frame)
     from wirecheck.oracles.candidates.draw import oracle_segments
+
     ls = metrics.line_scores(core_img, oracle_img, *oracle_segments(p_world, cube.edges, cam))
     assert ov["f1_0px"] == (ls["tie_resolved"] or ps)["f1_0px"] and ov["f1_1px"] == ps["f1_1px"]
-    assert 0.5 < ps["f1_0px"] <= ov["f1_0px"] <= 1.0         # a real comparison: both drew the cube
+    assert 0.5 < ps["f1_0px"] <= ov["f1_0px"] <= 1.0  # a real comparison: both drew the cube
     err = np.hypot(*(project_points(p_world, cam) - opencv_oracle.project(p_world, cam)).T).max()
     assert ov["max_vertex_error_px"] == pytest.approx(err, abs=1e-9)
     assert ov["verdict"] == "pass" and ov["faults"] == []
     diff = np.asarray(Image.open(io.BytesIO(base64.b64decode(ov["diff_image"]))))
-    assert (diff == 255).all(axis=2).sum() == (core_img & oracle_img).sum()   # white: both drew
+    assert (diff == 255).all(axis=2).sum() == (core_img & oracle_img).sum()  # white: both drew
 
 
 def test_interactive_cli_serves_and_stops_on_ctrl_c(tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen([sys.executable, "-m", "wirecheck.core.app.cli", "--interactive", "--frames", "4"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=env)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "wirecheck.core.app.cli", "--interactive", "--frames", "4"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         line = proc.stdout.readline()
         assert line.startswith("Viewer: http://127.0.0.1:"), line + proc.stderr.read()
@@ -238,5 +265,5 @@ def test_interactive_cli_serves_and_stops_on_ctrl_c(tmp_path):
 def test_bad_port_is_exit_2(tmp_path):
     e = io.StringIO()
     with contextlib.redirect_stderr(e):
-        rc = main(["--interactive", "--port", "70000"])       # no --out: --interactive writes nothing
+        rc = main(["--interactive", "--port", "70000"])  # no --out: --interactive writes nothing
     assert rc == 2 and "--port 70000" in e.getvalue() and e.getvalue().count("\n") == 1

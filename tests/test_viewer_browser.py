@@ -22,20 +22,19 @@ from pathlib import Path
 
 import pytest
 from numpy.testing import assert_allclose
-
-from wirecheck.core.camera import look_at
 from wirecheck.core.app.cli import build_parser, settings_from_args
-from wirecheck.core.projector.pipeline import render_frame
-from wirecheck.core.transforms import Motion
 from wirecheck.core.app.viewer import DOLLY_PER_UNIT, STAGES, Viewer
 from wirecheck.core.app.viewer_http import Server
+from wirecheck.core.camera import look_at
+from wirecheck.core.projector.pipeline import render_frame
+from wirecheck.core.transforms import Motion
 
-pytestmark = pytest.mark.slow          # an expensive module fixture (tests/conftest.py runs such files first)
+pytestmark = pytest.mark.slow  # an expensive module fixture (tests/conftest.py runs such files first)
 
 BROWSER_DIR = Path(__file__).parent / "browser"
 CHROMIUM = os.environ.get("WIRECHECK_CHROMIUM", "/usr/bin/chromium")
 F60 = 240.0 * math.sqrt(3.0)
-TOL = 1e-9        # a few dozen float64 rotations/scalings of values ~5: far below any sign or axis error
+TOL = 1e-9  # a few dozen float64 rotations/scalings of values ~5: far below any sign or axis error
 
 
 def _missing() -> str | None:
@@ -72,8 +71,8 @@ def session(tmp_path_factory):
         if os.environ.get("WIRECHECK_REQUIRE_BROWSER") == "1":
             pytest.fail(f"browser test required (WIRECHECK_REQUIRE_BROWSER=1) but {why}")
         pytest.skip(f"browser test skipped: {why}")
-    from wirecheck.oracles.references.pyrender_oracle import osmesa_available   # sets PYOPENGL_PLATFORM first
     from wirecheck.oracles.live import LiveOverlay
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available  # sets PYOPENGL_PLATFORM first
 
     ok, why = osmesa_available()
     assert ok, why
@@ -82,12 +81,16 @@ def session(tmp_path_factory):
     overlay = _SlowFirst(LiveOverlay())
     server = Server(Viewer(s, overlay=overlay)).start()
     out = tmp / "session.json"
-    profiles = tmp / "profiles"            # Chromium's profile goes here, not into the system temporary folder
+    profiles = tmp / "profiles"  # Chromium's profile goes here, not into the system temporary folder
     profiles.mkdir()
     try:
-        proc = subprocess.run(["node", str(BROWSER_DIR / "viewer_session.mjs"), server.url, str(out)],
-                              capture_output=True, text=True, timeout=180,
-                              env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM, WIRECHECK_PROFILE_PARENT=str(profiles)))
+        proc = subprocess.run(
+            ["node", str(BROWSER_DIR / "viewer_session.mjs"), server.url, str(out)],
+            capture_output=True,
+            text=True,
+            timeout=180,
+            env=dict(os.environ, WIRECHECK_CHROMIUM=CHROMIUM, WIRECHECK_PROFILE_PARENT=str(profiles)),
+        )
     finally:
         server.stop()
     assert proc.returncode == 0, proc.stderr[-3000:]
@@ -129,8 +132,8 @@ def test_wheel_dollies_and_shift_drag_pans(session):
 
 
 def test_overlay_f1_matches_independent_metrics_for_that_view(session):
-    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
     from wirecheck.oracles.judge import metrics
+    from wirecheck.oracles.references.pyrender_oracle import PyrenderOracle
 
     ov = session["overlay"]
     v = session["by"]["pan"]["json"]["view"]
@@ -143,7 +146,7 @@ def test_overlay_f1_matches_independent_metrics_for_that_view(session):
     ps = metrics.pixel_scores(core_img, oracle_img)
     assert ov["f1_0px"] == ps["f1_0px"] and ov["f1_1px"] == ps["f1_1px"]
     assert ov["verdict"] == "pass" and ov["faults"] == []
-    assert session["diffSrc"] > 100                        # the diff picture was shown
+    assert session["diffSrc"] > 100  # the diff picture was shown
 
 
 def test_modes_bad_input_and_motion(session):
@@ -177,5 +180,5 @@ def test_rough_edges_loading_banner_controls_reset_reload(session):
     by = session["by"]
     assert by["played"]["json"]["frame"] > 2
     start = by["start"]["json"]["view"]
-    assert by["reset"]["json"]["view"] == start and by["reset"]["json"]["frame"] == 1    # frame reset too
+    assert by["reset"]["json"]["view"] == start and by["reset"]["json"]["frame"] == 1  # frame reset too
     assert by["reload"]["json"]["view"] == start and session["overlayAfterReload"] is False

@@ -17,12 +17,12 @@ import threading
 import warnings
 
 import pytest
-from hypothesis import HealthCheck, given, settings as hsettings
+import wirecheck.core.app.viewer_http as viewer_http_mod
+from hypothesis import HealthCheck, given
+from hypothesis import settings as hsettings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from PIL import Image
-
-import wirecheck.core.app.viewer_http as viewer_http_mod
 from wirecheck.core.app.cli import build_parser, settings_from_args
 from wirecheck.core.app.viewer import FIELDS, MAX_OPS, View, Viewer
 from wirecheck.core.app.viewer_http import MAX_BODY_BYTES, Server
@@ -52,7 +52,7 @@ def _raw(srv, data: bytes, timeout: float = 5.0):
     with socket.create_connection(("127.0.0.1", port), timeout=timeout) as c:
         try:
             c.sendall(data)
-        except OSError:                          # refused before the whole request was sent
+        except OSError:  # refused before the whole request was sent
             pass
         out = b""
         while chunk := c.recv(65536):
@@ -87,37 +87,40 @@ def _view(srv):
     return json.loads(body)["view"]
 
 
-NESTED = b"[" * 30000 + b"]" * 30000            # 60 KB: under MAX_BODY_BYTES, deeper than the recursion limit
+NESTED = b"[" * 30000 + b"]" * 30000  # 60 KB: under MAX_BODY_BYTES, deeper than the recursion limit
 
 
-@pytest.mark.parametrize("body, length, headers, status, needle", [
-    (b'{"ops": []}', None, {}, 411, "Content-Length: missing"),
-    (b'{"ops": []}', "-1", {}, 400, "Content-Length '-1'"),
-    (b'{"ops": []}', "abc", {}, 400, "Content-Length 'abc'"),
-    (b'{"ops": []}', "99999999999999", {}, 413, f"at most {MAX_BODY_BYTES} bytes"),
-    (b" " * (MAX_BODY_BYTES + 1), "auto", {}, 413, f"at most {MAX_BODY_BYTES} bytes"),
-    (b'{"ops": "\xff"}', "auto", {}, 400, "not UTF-8"),
-    (b"{not json", "auto", {}, 400, "request body: Expecting property name"),
-    (b"[1, 2]", "auto", {}, 400, "a JSON list; expected an object"),
-    (NESTED, "auto", {}, 400, "JSON nested too deeply"),
-    (b'{"ops": [{"op": "orbit", "dx": NaN, "dy": 0}]}', "auto", {}, 400, "NaN is not JSON"),
-    (b'{"ops": [{"op": "dolly", "delta": -Infinity}]}', "auto", {}, 400, "-Infinity is not JSON"),
-    (b'{"ops": [{"op": "dolly", "delta": 1e400}]}', "auto", {}, 400, "'1e400' overflows float64"),
-    (b'{"ops": {"op": "reset"}}', "auto", {}, 400, "ops {'op': 'reset'}: expected a list"),
-    (b'{"ops": [], "overlay": "no"}', "auto", {}, 400, "overlay 'no': expected true or false"),
-    (b'{"op": []}', "auto", {}, 400, "unknown key 'op'"),
-    (b'{"ops": []}', "auto", {"Content-Type": "text/plain"}, 415, "expected application/json"),
-    (b'{"ops": []}', "auto", {"Host": "evil.example:80"}, 403, "Host 'evil.example:80'"),
-    (b'{"ops": []}', "auto", {"Host": None}, 403, "Host ''"),
-    (b'{"ops": []}', "auto", {"Origin": "http://evil.example"}, 403, "Origin 'http://evil.example'"),
-])
+@pytest.mark.parametrize(
+    "body, length, headers, status, needle",
+    [
+        (b'{"ops": []}', None, {}, 411, "Content-Length: missing"),
+        (b'{"ops": []}', "-1", {}, 400, "Content-Length '-1'"),
+        (b'{"ops": []}', "abc", {}, 400, "Content-Length 'abc'"),
+        (b'{"ops": []}', "99999999999999", {}, 413, f"at most {MAX_BODY_BYTES} bytes"),
+        (b" " * (MAX_BODY_BYTES + 1), "auto", {}, 413, f"at most {MAX_BODY_BYTES} bytes"),
+        (b'{"ops": "\xff"}', "auto", {}, 400, "not UTF-8"),
+        (b"{not json", "auto", {}, 400, "request body: Expecting property name"),
+        (b"[1, 2]", "auto", {}, 400, "a JSON list; expected an object"),
+        (NESTED, "auto", {}, 400, "JSON nested too deeply"),
+        (b'{"ops": [{"op": "orbit", "dx": NaN, "dy": 0}]}', "auto", {}, 400, "NaN is not JSON"),
+        (b'{"ops": [{"op": "dolly", "delta": -Infinity}]}', "auto", {}, 400, "-Infinity is not JSON"),
+        (b'{"ops": [{"op": "dolly", "delta": 1e400}]}', "auto", {}, 400, "'1e400' overflows float64"),
+        (b'{"ops": {"op": "reset"}}', "auto", {}, 400, "ops {'op': 'reset'}: expected a list"),
+        (b'{"ops": [], "overlay": "no"}', "auto", {}, 400, "overlay 'no': expected true or false"),
+        (b'{"op": []}', "auto", {}, 400, "unknown key 'op'"),
+        (b'{"ops": []}', "auto", {"Content-Type": "text/plain"}, 415, "expected application/json"),
+        (b'{"ops": []}', "auto", {"Host": "evil.example:80"}, 403, "Host 'evil.example:80'"),
+        (b'{"ops": []}', "auto", {"Host": None}, 403, "Host ''"),
+        (b'{"ops": []}', "auto", {"Origin": "http://evil.example"}, 403, "Origin 'http://evil.example'"),
+    ],
+)
 def test_a_bad_request_is_a_4xx_json_error_and_the_view_stays(server, capsys, body, length, headers, status, needle):
     before = json.loads(_post(server, {"ops": [{"op": "orbit", "dx": 10, "dy": 0}]})[2])["view"]
     got, hdrs, resp = _request(server, body=body, length=length, headers=headers)
     assert got == status, resp
     assert hdrs["Content-Type"] == "application/json" and needle in json.loads(resp)["error"]
-    assert _view(server) == before                                   # still serving, nothing applied
-    assert capsys.readouterr().err == ""                             # no traceback on the terminal
+    assert _view(server) == before  # still serving, nothing applied
+    assert capsys.readouterr().err == ""  # no traceback on the terminal
 
 
 def test_a_body_shorter_than_its_length_is_dropped_after_the_timeout(tmp_path, monkeypatch, capsys):
@@ -127,8 +130,8 @@ def test_a_body_shorter_than_its_length_is_dropped_after_the_timeout(tmp_path, m
     try:
         status, _, resp = _request(srv, body=b'{"ops": []}', length="100")
         assert status == 400 and "fewer bytes arrived than Content-Length 100" in json.loads(resp)["error"]
-        status, _, _ = _raw(srv, b"GET /api/fr")                     # a request line that never ends
-        assert status is None                                        # closed, not held
+        status, _, _ = _raw(srv, b"GET /api/fr")  # a request line that never ends
+        assert status is None  # closed, not held
         assert _view(srv)["frame"] == 1
     finally:
         srv.stop()
@@ -143,23 +146,26 @@ def test_a_legal_origin_and_localhost_are_served(server):
     assert _view(server)["frame"] == 3
 
 
-@pytest.mark.parametrize("ops, needle", [
-    ([{"op": "orbit", "dx": 10 ** 400, "dy": 0}], "dx 1000000000000"),            # int beyond float64
-    ([{"op": "orbit", "dx": True, "dy": 0}], "dx True: expected a finite number"),
-    ([{"op": "set", "field": ["fov"], "value": 1}], "field ['fov']"),             # unhashable
-    ([{"op": "dolly", "delta": 1e6}], "dolly 1000000.0"),                        # exp(1000): overflow
-    ([{"op": "dolly", "delta": -1e6}], "dolly -1000000.0"),                      # exp(-1000) = 0: zero distance
-    # distance 4 e^700 ~ 4e304, a pixel ~ 1e303: a pan of 1e10 px overflows to inf
-    ([{"op": "dolly", "delta": 7e5}, {"op": "pan", "dx": 1e10, "dy": 0}], "leave the float64 range"),
-    # a pan to ~1e306: the 4 units between camera and look-at point are below the spacing of floats there
-    ([{"op": "pan", "dx": 1e308, "dy": 1e308}], "expected a point different from look-at"),
-    ([{"op": "set", "field": "fov", "value": 0}], "camera fov 0.0"),
-    ([{"op": "set", "field": "fov", "value": 180}], "camera fov 180.0"),
-    ([{"op": "set", "field": "near", "value": 0}], "camera near 0.0"),
-    ([{"op": "set", "field": "far", "value": "inf"}], "far 'inf': expected a finite number"),
-    ([{"op": "step", "n": 10 ** 30}, {"op": "set", "field": "fov", "value": None}], "fov None"),
-    ([{"op": "reset"}] * (MAX_OPS + 1), f"{MAX_OPS + 1} in one request; expected at most {MAX_OPS}"),
-])
+@pytest.mark.parametrize(
+    "ops, needle",
+    [
+        ([{"op": "orbit", "dx": 10**400, "dy": 0}], "dx 1000000000000"),  # int beyond float64
+        ([{"op": "orbit", "dx": True, "dy": 0}], "dx True: expected a finite number"),
+        ([{"op": "set", "field": ["fov"], "value": 1}], "field ['fov']"),  # unhashable
+        ([{"op": "dolly", "delta": 1e6}], "dolly 1000000.0"),  # exp(1000): overflow
+        ([{"op": "dolly", "delta": -1e6}], "dolly -1000000.0"),  # exp(-1000) = 0: zero distance
+        # distance 4 e^700 ~ 4e304, a pixel ~ 1e303: a pan of 1e10 px overflows to inf
+        ([{"op": "dolly", "delta": 7e5}, {"op": "pan", "dx": 1e10, "dy": 0}], "leave the float64 range"),
+        # a pan to ~1e306: the 4 units between camera and look-at point are below the spacing of floats there
+        ([{"op": "pan", "dx": 1e308, "dy": 1e308}], "expected a point different from look-at"),
+        ([{"op": "set", "field": "fov", "value": 0}], "camera fov 0.0"),
+        ([{"op": "set", "field": "fov", "value": 180}], "camera fov 180.0"),
+        ([{"op": "set", "field": "near", "value": 0}], "camera near 0.0"),
+        ([{"op": "set", "field": "far", "value": "inf"}], "far 'inf': expected a finite number"),
+        ([{"op": "step", "n": 10**30}, {"op": "set", "field": "fov", "value": None}], "fov None"),
+        ([{"op": "reset"}] * (MAX_OPS + 1), f"{MAX_OPS + 1} in one request; expected at most {MAX_OPS}"),
+    ],
+)
 def test_a_bad_op_is_an_error_with_the_last_good_frame(server, capsys, ops, needle):
     before = json.loads(_post(server, {"ops": [{"op": "orbit", "dx": 10, "dy": 0}]})[2])
     status, _, resp = _post(server, {"ops": ops})
@@ -180,17 +186,20 @@ def test_max_ops_ops_are_applied(server):
     assert_allclose(json.loads(resp)["view"]["position"], (4 * math.sin(a), 0.0, 4 * math.cos(a)), atol=1e-10)
 
 
-@pytest.mark.parametrize("method, path, status, needle", [
-    ("GET", "/../../etc/passwd", 404, "no such path '/../../etc/passwd'"),
-    ("GET", "/%2e%2e/viewer.js", 404, "no such path '/%2e%2e/viewer.js'"),
-    ("GET", "/core/viewer.py", 404, "no such path"),
-    ("GET", "/" + "a" * 70000, 414, "Request-URI Too Long"),
-    ("HEAD", "/", 405, ""),
-    ("PUT", "/api/frame", 405, "method PUT: expected GET or POST"),
-    ("DELETE", "/index.html", 405, "method DELETE"),
-    ("OPTIONS", "/api/frame", 405, "method OPTIONS"),        # no CORS preflight answer: cross-site JSON POSTs stop here
-    ("BREW", "/", 501, "Unsupported method ('BREW')"),
-])
+@pytest.mark.parametrize(
+    "method, path, status, needle",
+    [
+        ("GET", "/../../etc/passwd", 404, "no such path '/../../etc/passwd'"),
+        ("GET", "/%2e%2e/viewer.js", 404, "no such path '/%2e%2e/viewer.js'"),
+        ("GET", "/core/viewer.py", 404, "no such path"),
+        ("GET", "/" + "a" * 70000, 414, "Request-URI Too Long"),
+        ("HEAD", "/", 405, ""),
+        ("PUT", "/api/frame", 405, "method PUT: expected GET or POST"),
+        ("DELETE", "/index.html", 405, "method DELETE"),
+        ("OPTIONS", "/api/frame", 405, "method OPTIONS"),  # no CORS preflight answer: cross-site JSON POSTs stop here
+        ("BREW", "/", 501, "Unsupported method ('BREW')"),
+    ],
+)
 def test_paths_and_methods(server, capsys, method, path, status, needle):
     got, hdrs, resp = _request(server, method=method, path=path, length=None)
     assert got == status
@@ -228,7 +237,7 @@ def test_concurrent_requests_get_consistent_frames(tmp_path):
         try:
             barrier.wait()
             answers.append(json.loads(_post(srv, {"ops": [{"op": "orbit", "dx": -2, "dy": 0}]})[2]))
-        except Exception as exc:                 # collected: an assert in a thread would be lost
+        except Exception as exc:  # collected: an assert in a thread would be lost
             errors.append(exc)
 
     threads = [threading.Thread(target=client) for _ in range(n)]
@@ -247,22 +256,44 @@ def test_concurrent_requests_get_consistent_frames(tmp_path):
         x, _, z = a["view"]["position"]
         k = math.degrees(math.atan2(x, z))
         degrees.append(round(k))
-        assert abs(k - round(k)) < 1e-9                      # whole degrees: k orbits, not a torn mix
-        png, _, _ = ref.frame_png(View(**{**a["view"], "position": tuple(a["view"]["position"]),
-                                          "target": tuple(a["view"]["target"]), "up": tuple(a["view"]["up"])}))
-        assert base64.b64decode(a["image"]) == png            # the frame is the view's own
+        assert abs(k - round(k)) < 1e-9  # whole degrees: k orbits, not a torn mix
+        png, _, _ = ref.frame_png(
+            View(
+                **{
+                    **a["view"],
+                    "position": tuple(a["view"]["position"]),
+                    "target": tuple(a["view"]["target"]),
+                    "up": tuple(a["view"]["up"]),
+                }
+            )
+        )
+        assert base64.b64decode(a["image"]) == png  # the frame is the view's own
     assert sorted(degrees) == list(range(1, n + 1))
 
 
-_num = st.one_of(st.floats(), st.integers(), st.booleans(), st.none(), st.text(max_size=6),
-                 st.sampled_from([1e-300, 5e-324, 1e300, 180, 179.99999999999997, "1e400", "nan", [], {}]))
+_num = st.one_of(
+    st.floats(),
+    st.integers(),
+    st.booleans(),
+    st.none(),
+    st.text(max_size=6),
+    st.sampled_from([1e-300, 5e-324, 1e300, 180, 179.99999999999997, "1e400", "nan", [], {}]),
+)
 _op = st.one_of(
     st.fixed_dictionaries({"op": st.sampled_from(["orbit", "pan"]), "dx": _num, "dy": _num}),
     st.fixed_dictionaries({"op": st.just("dolly"), "delta": _num}),
-    st.fixed_dictionaries({"op": st.just("set"), "field": st.one_of(st.sampled_from(list(FIELDS)), _num),
-                           "value": st.one_of(_num, st.sampled_from(["orthographic", "shaded", True, False]))}),
+    st.fixed_dictionaries(
+        {
+            "op": st.just("set"),
+            "field": st.one_of(st.sampled_from(list(FIELDS)), _num),
+            "value": st.one_of(_num, st.sampled_from(["orthographic", "shaded", True, False])),
+        }
+    ),
     st.fixed_dictionaries({"op": st.just("step"), "n": _num}),
-    st.just({"op": "reset"}), _num, st.fixed_dictionaries({"op": _num}))
+    st.just({"op": "reset"}),
+    _num,
+    st.fixed_dictionaries({"op": _num}),
+)
 
 
 def test_any_ops_give_a_frame_or_an_error_with_the_view_kept(tmp_path):
@@ -296,11 +327,11 @@ def test_an_internal_failure_is_one_line_on_stderr_and_the_server_goes_on(server
 
     monkeypatch.setattr(server.viewer, "frame_png", broken)
     status, _, _ = _post(server, {"ops": []})
-    assert status is None and len(calls) == 1                       # the connection closed, unanswered
+    assert status is None and len(calls) == 1  # the connection closed, unanswered
     err = capsys.readouterr().err
     assert err == "renderer: viewer: request from 127.0.0.1 failed: RuntimeError: simulated bug\n"
     monkeypatch.undo()
-    assert _view(server)["frame"] == 1                               # and the next request is served
+    assert _view(server)["frame"] == 1  # and the next request is served
 
 
 @pytest.mark.parametrize("method", ["GET", "POST"])
@@ -313,8 +344,10 @@ def test_a_request_with_two_host_headers_is_refused(server, capsys, method, seco
     second = {"OWN": own}.get(second, second.replace("OWN_PORT", str(port)))
     body = b'{"ops": []}' if method == "POST" else b""
     length = f"Content-Length: {len(body)}\r\n" if method == "POST" else ""
-    head = (f"{method} /api/frame HTTP/1.1\r\nHost: {own}\r\nHost: {second}\r\nContent-Type: application/json\r\n"
-            f"{length}Connection: close\r\n\r\n")
+    head = (
+        f"{method} /api/frame HTTP/1.1\r\nHost: {own}\r\nHost: {second}\r\nContent-Type: application/json\r\n"
+        f"{length}Connection: close\r\n\r\n"
+    )
     got, hdrs, resp = _raw(server, head.encode("latin-1") + body)
     assert got == 400, resp
     assert json.loads(resp)["error"] == "Host given 2 times: expected one"
@@ -324,23 +357,38 @@ def test_a_request_with_two_host_headers_is_refused(server, capsys, method, seco
 def test_a_post_with_two_lengths_is_refused(server):
     port = server.httpd.server_address[1]
     body = b'{"ops": []}'
-    head = (f"POST /api/frame HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Type: application/json\r\n"
-            f"Content-Length: {len(body)}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n")
+    head = (
+        f"POST /api/frame HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nContent-Type: application/json\r\n"
+        f"Content-Length: {len(body)}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
+    )
     got, _, resp = _raw(server, head.encode("latin-1") + body)
     assert (got, json.loads(resp)["error"]) == (400, "Content-Length given 2 times: expected one")
 
 
-@pytest.mark.parametrize("name, request_text, needle", [
-    # an absolute-form target names another server, whatever the Host says (RFC 9112 3.2.2): before, 200
-    ("absolute target", "POST http://evil.example/api/frame HTTP/1.1\r\nHost: {own}\r\n{body_headers}",
-     "request target 'http://evil.example/api/frame': expected a path starting with /"),
-    # a length and a chunked encoding: a proxy may frame the body by one, this server by the other: before, 200
-    ("length and chunked", "POST /api/frame HTTP/1.1\r\nHost: {own}\r\nTransfer-Encoding: chunked\r\n{body_headers}",
-     "Transfer-Encoding 'chunked': expected a body of Content-Length bytes"),
-    # a header line without a colon ends http.server's header parsing, silently: before, 200
-    ("line without colon", "POST /api/frame HTTP/1.1\r\nHost: {own}\r\n{body_headers_no_end}X y\r\n\r\n",
-     "a malformed header line"),
-], ids=["absolute-target", "length-and-chunked", "line-without-colon"])
+@pytest.mark.parametrize(
+    "name, request_text, needle",
+    [
+        # an absolute-form target names another server, whatever the Host says (RFC 9112 3.2.2): before, 200
+        (
+            "absolute target",
+            "POST http://evil.example/api/frame HTTP/1.1\r\nHost: {own}\r\n{body_headers}",
+            "request target 'http://evil.example/api/frame': expected a path starting with /",
+        ),
+        # a length and a chunked encoding: a proxy may frame the body by one, this server by the other: before, 200
+        (
+            "length and chunked",
+            "POST /api/frame HTTP/1.1\r\nHost: {own}\r\nTransfer-Encoding: chunked\r\n{body_headers}",
+            "Transfer-Encoding 'chunked': expected a body of Content-Length bytes",
+        ),
+        # a header line without a colon ends http.server's header parsing, silently: before, 200
+        (
+            "line without colon",
+            "POST /api/frame HTTP/1.1\r\nHost: {own}\r\n{body_headers_no_end}X y\r\n\r\n",
+            "a malformed header line",
+        ),
+    ],
+    ids=["absolute-target", "length-and-chunked", "line-without-colon"],
+)
 def test_requests_two_parsers_read_differently_are_refused(server, name, request_text, needle):
     port = server.httpd.server_address[1]
     body = b'{"ops": []}'
@@ -350,10 +398,14 @@ def test_requests_two_parsers_read_differently_are_refused(server, name, request
     assert got == 400 and needle in json.loads(resp)["error"], (got, resp)
 
 
-@pytest.mark.parametrize("line, status", [
-    (b"GET /api/frame\r\n\r\n", 403),                # HTTP/0.9: served as 1.0, then refused for its missing Host
-    (b"POST /api/frame TTP/1.1\r\n\r\n", 400),       # a bad version: http.server's own 400
-], ids=["http-0.9", "bad-version"])
+@pytest.mark.parametrize(
+    "line, status",
+    [
+        (b"GET /api/frame\r\n\r\n", 403),  # HTTP/0.9: served as 1.0, then refused for its missing Host
+        (b"POST /api/frame TTP/1.1\r\n\r\n", 400),  # a bad version: http.server's own 400
+    ],
+    ids=["http-0.9", "bad-version"],
+)
 def test_a_malformed_request_line_gets_a_status_line(server, line, status):
     """Before, http.server answered a request line it could not parse as HTTP/0.9 would: the body alone,
     no status line (a client read nothing it could name)."""

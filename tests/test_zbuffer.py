@@ -11,22 +11,23 @@ import time
 
 import numpy as np
 import pytest
-
-from wirecheck.core.projector import zbuffer
 from wirecheck.core.camera import look_at
-from wirecheck.core.projector.projection import unproject, world_to_cam
+from wirecheck.core.projector import zbuffer
 from wirecheck.core.projector.clipping import clip_triangles_near
+from wirecheck.core.projector.projection import unproject, world_to_cam
 from wirecheck.core.projector.zbuffer import project_triangles, rasterize_triangles
 
 EPS32 = float(np.finfo(np.float32).eps)
 
 
 def _raster(tri_px, z, w, h, projection="perspective"):
-    return rasterize_triangles(np.asarray(tri_px, float).reshape(-1, 3, 2),
-                               np.asarray(z, float).reshape(-1, 3), w, h, projection)
+    return rasterize_triangles(
+        np.asarray(tri_px, float).reshape(-1, 3, 2), np.asarray(z, float).reshape(-1, 3), w, h, projection
+    )
 
 
 # ---- hand-derived cases -------------------------------------------------------
+
 
 def test_single_triangle_top_left_rule_on_exact_ties():
     # Vertices on pixel centres (1, 1), (5, 1), (1, 5): the top edge y = 1 and the
@@ -72,7 +73,7 @@ def test_two_overlapping_triangles_nearest_wins_ties_go_to_the_lower_index():
     d, f = _raster([big, small], [[5.0] * 3, [2.0] * 3], 24, 24)
     y, x = np.mgrid[0:24, 0:24]
     in_small = (x >= 2) & (y >= 2) & (x + y < 10)
-    in_big = (x + y < 20)
+    in_big = x + y < 20
     assert np.array_equal(f == 1, in_small)
     assert np.array_equal(f == 0, in_big & ~in_small)
     assert np.all(d[in_small] == 2.0) and np.all(d[in_big & ~in_small] == 5.0)
@@ -99,8 +100,8 @@ def _plane_depth_along_rays(p_cam_tri, camera, rr, cc):
         f = (camera.height / 2.0) / math.tan(math.radians(camera.fov_y_deg) / 2.0)
         x1 = (px[:, 0] - cx) / f
         y1 = -(px[:, 1] - cy) / f
-        d = np.stack([x1, y1, np.ones_like(x1)], 1)          # ray direction with z = 1
-        return (n @ a) / (d @ n)                             # t = depth
+        d = np.stack([x1, y1, np.ones_like(x1)], 1)  # ray direction with z = 1
+        return (n @ a) / (d @ n)  # t = depth
     s = camera.height / camera.ortho_height
     x = (px[:, 0] - cx) / s
     y = -(px[:, 1] - cy) / s
@@ -110,9 +111,17 @@ def _plane_depth_along_rays(p_cam_tri, camera, rr, cc):
 @pytest.mark.parametrize("projection", ["perspective", "orthographic"])
 def test_depth_is_the_plane_depth_at_pixel_centres(projection):
     """Perspective-correct: 1/z interpolated in screen space is exactly the plane's depth."""
-    cam = look_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), width=64, height=48, near=0.1, far=100.0,
-                  projection=projection, ortho_height=6.0)
-    tri_cam = np.array([[[-2.0, -1.5, 3.0], [2.5, -1.0, 9.0], [0.0, 2.0, 5.0]]])   # strongly tilted
+    cam = look_at(
+        (0.0, 0.0, 0.0),
+        (0.0, 0.0, -1.0),
+        width=64,
+        height=48,
+        near=0.1,
+        far=100.0,
+        projection=projection,
+        ortho_height=6.0,
+    )
+    tri_cam = np.array([[[-2.0, -1.5, 3.0], [2.5, -1.0, 9.0], [0.0, 2.0, 5.0]]])  # strongly tilted
     tri_px, tri_z, src = project_triangles(tri_cam, cam)
     depth, face = rasterize_triangles(tri_px, tri_z, 64, 48, projection)
     rr, cc = np.nonzero(face >= 0)
@@ -127,6 +136,7 @@ def test_depth_is_the_plane_depth_at_pixel_centres(projection):
 
 
 # ---- brute-force reference ----------------------------------------------------
+
 
 def _reference(tri_px, tri_z, w, h):
     """Per triangle, per pixel, in integers (1/256 px units): the documented rules verbatim."""
@@ -167,11 +177,11 @@ def test_matches_a_brute_force_reference_including_ties():
     n = 300
     c = rng.uniform([0, 0], [w, h], size=(n, 1, 2))
     tri = c + rng.normal(scale=5, size=(n, 3, 2))
-    tri[:100] = np.round(tri[:100])                    # on pixel centres: exact ties
-    tri[100:150] = np.round(tri[100:150] * 2) / 2      # on half-integers
-    tri[150:170, 2] = tri[150:170, 1]                  # degenerate
+    tri[:100] = np.round(tri[:100])  # on pixel centres: exact ties
+    tri[100:150] = np.round(tri[100:150] * 2) / 2  # on half-integers
+    tri[150:170, 2] = tri[150:170, 1]  # degenerate
     z = rng.uniform(1, 10, size=(n, 3))
-    z[:100] = z[:100, :1]                              # flat, to make depth ties between triangles rare but not absent
+    z[:100] = z[:100, :1]  # flat, to make depth ties between triangles rare but not absent
     depth, face = rasterize_triangles(tri, z, w, h)
     ref_d, ref_f = _reference(tri, z, w, h)
     assert np.array_equal(np.isinf(depth), np.isinf(ref_d))
@@ -187,7 +197,7 @@ def test_batches_and_row_slabs_do_not_change_the_result(monkeypatch):
     ico = trimesh.creation.icosphere(subdivisions=3)
     cam = look_at((2.0, 1.5, 2.5), (0.0, 0.0, 0.0), width=160, height=120)
     tri_px, tri_z, _ = project_triangles(world_to_cam(np.asarray(ico.vertices), cam)[np.asarray(ico.faces)], cam)
-    big = np.array([[[-50.0, -40.0], [400.0, 10.0], [30.0, 300.0]]])      # larger than a small batch
+    big = np.array([[[-50.0, -40.0], [400.0, 10.0], [30.0, 300.0]]])  # larger than a small batch
     tri_px = np.concatenate([tri_px, big])
     tri_z = np.concatenate([tri_z, [[5.0, 5.0, 5.0]]])
     d1, f1 = rasterize_triangles(tri_px, tri_z, 160, 120)
@@ -197,23 +207,33 @@ def test_batches_and_row_slabs_do_not_change_the_result(monkeypatch):
 
 
 def test_non_finite_and_off_image_triangles_are_skipped():
-    tri = np.array([[[1, 1], [5, 1], [1, 5]], [[np.nan, 1], [5, 1], [1, 5]],
-                    [[1e300, 1], [np.inf, 1], [1, 5]], [[-50, -50], [-40, -50], [-50, -40]]], float)
+    tri = np.array(
+        [
+            [[1, 1], [5, 1], [1, 5]],
+            [[np.nan, 1], [5, 1], [1, 5]],
+            [[1e300, 1], [np.inf, 1], [1, 5]],
+            [[-50, -50], [-40, -50], [-50, -40]],
+        ],
+        float,
+    )
     d, f = rasterize_triangles(tri, np.ones((4, 3)), 8, 8)
     assert set(np.unique(f)) == {-1, 0}
 
 
 # ---- clipping ---------------------------------------------------------------
 
+
 def test_clip_near_counts_winding_and_exact_plane():
-    tri = np.array([
-        [[0, 0, 2.0], [1, 0, 2.0], [0, 1, 2.0]],           # inside: kept as is
-        [[0, 0, 0.5], [1, 0, 0.5], [0, 1, 0.5]],           # before near: dropped
-        [[0, 0, 2.0], [1, 0, 0.5], [0, 1, 0.5]],           # one inside: one triangle
-        [[0, 0, 0.5], [1, 0, 2.0], [0, 1, 2.0]],           # two inside: two triangles
-        [[0, 0, 1.0], [1, 0, 1.0], [0, 1, 0.9]],           # only an edge on the plane: zero area, dropped
-        [[0, 0, 1.0], [1, 0, 1.5], [0, 1, 0.9]],           # a vertex on the plane: one triangle
-    ])
+    tri = np.array(
+        [
+            [[0, 0, 2.0], [1, 0, 2.0], [0, 1, 2.0]],  # inside: kept as is
+            [[0, 0, 0.5], [1, 0, 0.5], [0, 1, 0.5]],  # before near: dropped
+            [[0, 0, 2.0], [1, 0, 0.5], [0, 1, 0.5]],  # one inside: one triangle
+            [[0, 0, 0.5], [1, 0, 2.0], [0, 1, 2.0]],  # two inside: two triangles
+            [[0, 0, 1.0], [1, 0, 1.0], [0, 1, 0.9]],  # only an edge on the plane: zero area, dropped
+            [[0, 0, 1.0], [1, 0, 1.5], [0, 1, 0.9]],  # a vertex on the plane: one triangle
+        ]
+    )
     out, src = clip_triangles_near(tri, 1.0)
     assert src.tolist() == [0, 2, 3, 3, 5]
     assert np.all(out[..., 2] >= 1.0)
@@ -256,36 +276,50 @@ def test_huge_projected_coordinates_are_guard_band_clipped():
 
 # ---- speed ------------------------------------------------------------------
 
+
 def test_100k_triangles_at_640x480_cover_the_image(summary_section):
     # Its time is printed, not asserted: speed lives in benchmarks/ (bench_scale), not in timed tests.
     trimesh = pytest.importorskip("trimesh")
-    ico = trimesh.creation.icosphere(subdivisions=6)                  # 81920 triangles
+    ico = trimesh.creation.icosphere(subdivisions=6)  # 81920 triangles
     faces = np.asarray(ico.faces)
     faces = np.concatenate([faces, faces[: 100_000 - len(faces)]])  # 100k (some drawn twice)
-    cam = look_at((1.5, 1.25, 1.55), (0.0, 0.0, 0.0), near=0.1, far=100.0)   # fills most of the image
+    cam = look_at((1.5, 1.25, 1.55), (0.0, 0.0, 0.0), near=0.1, far=100.0)  # fills most of the image
     tri_px, tri_z, _ = project_triangles(world_to_cam(np.asarray(ico.vertices), cam)[faces], cam)
     best = np.inf
     for _ in range(3):
         t0 = time.perf_counter()
         _, face = rasterize_triangles(tri_px, tri_z, 640, 480)
         best = min(best, time.perf_counter() - t0)
-    summary_section("zbuffer speed", f"rasterize_triangles: {len(faces)} triangles at 640x480, "
-                    f"{int((face >= 0).sum())} pixels covered: {best * 1e3:.0f} ms (best of 3)")
+    summary_section(
+        "zbuffer speed",
+        f"rasterize_triangles: {len(faces)} triangles at 640x480, "
+        f"{int((face >= 0).sum())} pixels covered: {best * 1e3:.0f} ms (best of 3)",
+    )
     assert (face >= 0).sum() > 100_000
 
 
 # ---- against pyrender ---------------------------------------------------------
 
+
 def _pyrender_faces(vertices, triangles, camera, renderer):
     """White flat faces (double sided) with pyrender: (covered mask, linear depth, 0 = empty)."""
     import pyrender
-
     from wirecheck.oracles.references.convert import camera_to_pyrender
+
     scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
     mat = pyrender.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=True)
-    scene.add(pyrender.Mesh([pyrender.Primitive(positions=vertices.astype(np.float32),
-                                                indices=triangles.astype(np.uint32),
-                                                mode=pyrender.constants.GLTF.TRIANGLES, material=mat)]))
+    scene.add(
+        pyrender.Mesh(
+            [
+                pyrender.Primitive(
+                    positions=vertices.astype(np.float32),
+                    indices=triangles.astype(np.uint32),
+                    mode=pyrender.constants.GLTF.TRIANGLES,
+                    material=mat,
+                )
+            ]
+        )
+    )
     pose, cam = camera_to_pyrender(camera)
     scene.add(cam, pose=pose)
     colour, depth = renderer.render(scene, pyrender.RenderFlags.FLAT)
@@ -301,18 +335,20 @@ def _pyrender_faces(vertices, triangles, camera, renderer):
 
 def _meshes():
     trimesh = pytest.importorskip("trimesh")
-    return {"cube": trimesh.creation.box(extents=(2.0, 2.0, 2.0)),
-            "icosphere": trimesh.creation.icosphere(subdivisions=3)}
+    return {
+        "cube": trimesh.creation.box(extents=(2.0, 2.0, 2.0)),
+        "icosphere": trimesh.creation.icosphere(subdivisions=3),
+    }
 
 
 @pytest.mark.parametrize("projection", ["perspective", "orthographic"])
 @pytest.mark.parametrize("name", ["cube", "icosphere"])
 def test_against_pyrender(name, projection, pyrender_renderer, summary_section):
     from scipy import ndimage
+
     mesh = _meshes()[name]
     v, tris = np.asarray(mesh.vertices, float), np.asarray(mesh.faces)
-    cam = look_at((3.0, 2.2, 4.1), (0.1, -0.2, 0.0), near=0.5, far=20.0, projection=projection,
-                  ortho_height=4.0)
+    cam = look_at((3.0, 2.2, 4.1), (0.1, -0.2, 0.0), near=0.5, far=20.0, projection=projection, ortho_height=4.0)
     tri_px, tri_z, src = project_triangles(world_to_cam(v, cam)[tris], cam)
     depth, face = rasterize_triangles(tri_px, tri_z, 640, 480, projection)
     g = zbuffer.triangle_gradients(tri_px, tri_z, projection)
@@ -350,17 +386,19 @@ def test_against_pyrender(name, projection, pyrender_renderer, summary_section):
     z = depth[both]
     n, f = cam.near, cam.far
     if projection == "perspective":
-        u = 2.0 ** -24 * (f - n) * z ** 2 / (f * n)
-        slope = np.abs(g[face[both]]).sum(axis=1) * z ** 2            # |dz/dx| + |dz/dy| = z^2 |d(1/z)|
+        u = 2.0**-24 * (f - n) * z**2 / (f * n)
+        slope = np.abs(g[face[both]]).sum(axis=1) * z**2  # |dz/dx| + |dz/dy| = z^2 |d(1/z)|
     else:
-        u = np.full_like(z, 2.0 ** -24 * (f - n))
+        u = np.full_like(z, 2.0**-24 * (f - n))
         slope = np.abs(g[face[both]]).sum(axis=1)
     bound = 4 * u + EPS32 * (640 + 480) * slope
     err = np.abs(z - their_depth[both])
     ratio = float((err / bound).max())
-    summary_section(f"zbuffer vs pyrender: {name} {projection}",
-                    f"silhouette IoU {iou:.6f} ({xor} of {outline} outline px differ); "
-                    f"depth max error {err.max():.3g} (max {err.max() / u.max():.2f} u), "
-                    f"max error / bound = {ratio:.2f} over {both.sum()} px")
+    summary_section(
+        f"zbuffer vs pyrender: {name} {projection}",
+        f"silhouette IoU {iou:.6f} ({xor} of {outline} outline px differ); "
+        f"depth max error {err.max():.3g} (max {err.max() / u.max():.2f} u), "
+        f"max error / bound = {ratio:.2f} over {both.sum()} px",
+    )
     assert both.sum() > 10_000
     assert ratio <= 1.0

@@ -82,5 +82,4 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {usage_hint(message)}\n")
 
     def parse_known_args(self, args=None, namespace=None):
-        return super().parse_known_args(attach_negative_values(list(sys.argv[1:] if args is None else args)),
-                                        namespace)
+        return super().parse_known_args(attach_negative_values(list(sys.argv[1:] if args is None else args)), namespace)

@@ -36,13 +36,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..outputs import output
 from ..camera import camera_z
 from ..errors import InputError
 from ..numbers import plain_float
-from .compose import picture, side_by_side
-from ..scene.model import world_points
+from ..outputs import output
 from ..outputs.staging import Staging
+from ..scene.model import world_points
+from .compose import picture, side_by_side
 
 #: Drawn pixels: at least half coverage (raster "aa"), as the crosscheck's threshold.
 DRAWN = 128
@@ -72,8 +72,11 @@ def crossings(image: np.ndarray, row: int) -> list[float]:
 def box_of(vertices: np.ndarray) -> dict:
     """Half-width (x) and front/back z of the scene's bounding box at rest."""
     v = np.asarray(vertices, dtype=np.float64)
-    return {"half_width": float(max(abs(v[:, 0].min()), abs(v[:, 0].max()))),
-            "z_front": float(v[:, 2].max()), "z_back": float(v[:, 2].min())}
+    return {
+        "half_width": float(max(abs(v[:, 0].min()), abs(v[:, 0].max()))),
+        "z_front": float(v[:, 2].max()),
+        "z_back": float(v[:, 2].min()),
+    }
 
 
 def predicted(distance: float, fov: float, height: int, box: dict) -> dict:
@@ -81,8 +84,12 @@ def predicted(distance: float, fov: float, height: int, box: dict) -> dict:
     f = (height / 2.0) / math.tan(math.radians(fov) / 2.0)
     a, zf, zb = box["half_width"], box["z_front"], box["z_back"]
     w_front, w_back = 2 * f * a / (distance - zf), 2 * f * a / (distance - zb)
-    return {"front_width_px": w_front, "back_width_px": w_back, "ratio": w_front / w_back,
-            "depth_compression": (w_front - w_back) / 2 / (zf - zb) / (w_front / (2 * a))}
+    return {
+        "front_width_px": w_front,
+        "back_width_px": w_back,
+        "ratio": w_front / w_back,
+        "depth_compression": (w_front - w_back) / 2 / (zf - zb) / (w_front / (2 * a)),
+    }
 
 
 def measure(image: np.ndarray, row: int) -> dict | None:
@@ -91,29 +98,38 @@ def measure(image: np.ndarray, row: int) -> dict | None:
     if len(xs) != 4:
         return None
     w_front, w_back = xs[3] - xs[0], xs[2] - xs[1]
-    return {"crossings_px": xs, "front_width_px": w_front, "back_width_px": w_back,
-            "ratio": w_front / w_back if w_back > 0 else None}
+    return {
+        "crossings_px": xs,
+        "front_width_px": w_front,
+        "back_width_px": w_back,
+        "ratio": w_front / w_back if w_back > 0 else None,
+    }
 
 
 def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
     """Render the four views; return (report, 2x2 picture). ``s`` is the run's core.app.settings.Settings."""
-    box = box_of(world_points(s.scene, s.motion, 1, s.frames))        # at rest, with --scale/--translate
+    box = box_of(world_points(s.scene, s.motion, 1, s.frames))  # at rest, with --scale/--translate
     depth = box["z_front"] - box["z_back"]
-    if not (depth > 0 and box["half_width"] > 0):      # the widths and their ratio would divide by zero
-        raise InputError(f"--compare: scene {s.scene.name!r} at rest spans x up to {box['half_width']:g} and z from "
-                         f"{box['z_back']:g} to {box['z_front']:g}: expected a scene with width in x and depth in z "
-                         "(the comparison measures its front and back widths)")
+    if not (depth > 0 and box["half_width"] > 0):  # the widths and their ratio would divide by zero
+        raise InputError(
+            f"--compare: scene {s.scene.name!r} at rest spans x up to {box['half_width']:g} and z from "
+            f"{box['z_back']:g} to {box['z_front']:g}: expected a scene with width in x and depth in z "
+            "(the comparison measures its front and back widths)"
+        )
     for d in distances:
         if not d - box["z_front"] > s.camera.near:
-            raise InputError(f"--compare-z {d:g}: the scene's front (z = {box['z_front']:g}) must be beyond the "
-                             f"near plane ({s.camera.near:g}): expected distances > {box['z_front'] + s.camera.near:g}")
-    row = int(round((s.camera.height - 1) / 2.0 + 0.5))      # the row just below the centre line cy
+            raise InputError(
+                f"--compare-z {d:g}: the scene's front (z = {box['z_front']:g}) must be beyond the "
+                f"near plane ({s.camera.near:g}): expected distances > {box['z_front'] + s.camera.near:g}"
+            )
+    row = int(round((s.camera.height - 1) / 2.0 + 0.5))  # the row just below the centre line cy
     views, rows = [], []
     for d in distances:
         pics = []
         for fov in fovs:
-            cam = camera_z(d, fov_y_deg=fov, width=s.camera.width, height=s.camera.height,
-                           near=s.camera.near, far=s.camera.far)
+            cam = camera_z(
+                d, fov_y_deg=fov, width=s.camera.width, height=s.camera.height, near=s.camera.near, far=s.camera.far
+            )
             frame, _ = replace(s, camera=cam, ortho_camera=None).scene_renderer().render(1, cam)
             img = picture(frame, s.style)
             pics.append(img)
@@ -122,19 +138,28 @@ def run_compare(s, distances, fovs) -> tuple[dict, np.ndarray]:
             v = {"camera_z": d, "fov_y_deg": fov, "focal_px": cam.focal_px, "measured": m, "predicted": p}
             if m is not None and depth > 0 and m["front_width_px"] > 0:
                 a = box["half_width"]
-                v["measured"]["depth_compression"] = ((m["front_width_px"] - m["back_width_px"]) / 2 / depth
-                                                      / (m["front_width_px"] / (2 * a)))
+                v["measured"]["depth_compression"] = (
+                    (m["front_width_px"] - m["back_width_px"]) / 2 / depth / (m["front_width_px"] / (2 * a))
+                )
             views.append(v)
         rows.append(side_by_side(*pics))
     sep = np.full((1,) + rows[0].shape[1:], 128, dtype=np.uint8)
     grid = np.concatenate([rows[0], sep, rows[1]], axis=0)
-    report = {"scene": s.scene.name, "box": box, "row_measured": row, "distances": list(distances),
-              "fovs": list(fovs), "views": views,
-              "fov_scale_predicted": math.tan(math.radians(fovs[0]) / 2) / math.tan(math.radians(fovs[1]) / 2)}
+    report = {
+        "scene": s.scene.name,
+        "box": box,
+        "row_measured": row,
+        "distances": list(distances),
+        "fovs": list(fovs),
+        "views": views,
+        "fov_scale_predicted": math.tan(math.radians(fovs[0]) / 2) / math.tan(math.radians(fovs[1]) / 2),
+    }
     by = {(v["camera_z"], v["fov_y_deg"]): v for v in views}
     if all(v["measured"] for v in views):
-        report["fov_scale_measured"] = (by[(distances[0], fovs[1])]["measured"]["front_width_px"]
-                                        / by[(distances[0], fovs[0])]["measured"]["front_width_px"])
+        report["fov_scale_measured"] = (
+            by[(distances[0], fovs[1])]["measured"]["front_width_px"]
+            / by[(distances[0], fovs[0])]["measured"]["front_width_px"]
+        )
     return report, grid
 
 
@@ -142,35 +167,43 @@ def explain(report: dict) -> str:
     """The comparison in words, with the measured and predicted numbers."""
     box, views = report["box"], report["views"]
     (d1, d2), (f1, f2) = report["distances"], report["fovs"]
-    lines = [f"Compare: {report['scene']} at rest, camera on +Z at {d1:g} and {d2:g}, FOV {f1:g} and {f2:g} "
-             f"(picture: rows camera_z {d1:g}, {d2:g}; columns FOV {f1:g}, {f2:g})",
-             f"Box: half-width {box['half_width']:g}, front z = {box['z_front']:g}, back z = {box['z_back']:g}; "
-             f"widths measured on row {report['row_measured']}",
-             "",
-             f"{'camera_z':>8} {'fov':>5} {'front px':>17} {'back px':>17} {'front/back':>19} {'depth compr.':>19}",
-             f"{'':>8} {'':>5} {'meas.':>8} {'pred.':>8} {'meas.':>8} {'pred.':>8} {'meas.':>9} {'pred.':>9} "
-             f"{'meas.':>9} {'pred.':>9}"]
+    lines = [
+        f"Compare: {report['scene']} at rest, camera on +Z at {d1:g} and {d2:g}, FOV {f1:g} and {f2:g} "
+        f"(picture: rows camera_z {d1:g}, {d2:g}; columns FOV {f1:g}, {f2:g})",
+        f"Box: half-width {box['half_width']:g}, front z = {box['z_front']:g}, back z = {box['z_back']:g}; "
+        f"widths measured on row {report['row_measured']}",
+        "",
+        f"{'camera_z':>8} {'fov':>5} {'front px':>17} {'back px':>17} {'front/back':>19} {'depth compr.':>19}",
+        f"{'':>8} {'':>5} {'meas.':>8} {'pred.':>8} {'meas.':>8} {'pred.':>8} {'meas.':>9} {'pred.':>9} "
+        f"{'meas.':>9} {'pred.':>9}",
+    ]
     for v in views:
         m, p = v["measured"], v["predicted"]
         if m is None:
-            lines.append(f"{v['camera_z']:>8g} {v['fov_y_deg']:>5g}  not measurable: the centre row does not cross "
-                         "four vertical edges (the measurement needs a box seen on axis)")
+            lines.append(
+                f"{v['camera_z']:>8g} {v['fov_y_deg']:>5g}  not measurable: the centre row does not cross "
+                "four vertical edges (the measurement needs a box seen on axis)"
+            )
             continue
-        lines.append(f"{v['camera_z']:>8g} {v['fov_y_deg']:>5g} {m['front_width_px']:>8.1f} {p['front_width_px']:>8.1f} "
-                     f"{m['back_width_px']:>8.1f} {p['back_width_px']:>8.1f} {m['ratio']:>9.3f} {p['ratio']:>9.3f} "
-                     f"{m['depth_compression']:>9.3f} {p['depth_compression']:>9.3f}")
-    lines += ["",
-              f"Distance: the front face is nearer than the back by {box['z_front'] - box['z_back']:g}; at "
-              f"D = {d1:g} that is a large part of the distance, so the front face shows "
-              f"{views[0]['predicted']['ratio']:.3f}x the back's width ((D - z_back)/(D - z_front)); at D = {d2:g} "
-              f"only {views[2]['predicted']['ratio']:.3f}x. The nearer camera exaggerates depth (the receding edges "
-              f"span {views[0]['predicted']['depth_compression']:.3f} px per unit of depth for each px per unit of "
-              f"front width, against {views[2]['predicted']['depth_compression']:.3f} at D = {d2:g}): the farther "
-              "picture is flatter, closer to an orthographic one (ratio 1, compression 0).",
-              f"FOV: a wider FOV shortens the focal length, so everything shrinks by tan({f1:g}/2)/tan({f2:g}/2) = "
-              f"{report['fov_scale_predicted']:.4f}"
-              + (f" (measured {report['fov_scale_measured']:.4f})" if "fov_scale_measured" in report else "")
-              + "; the ratios do not change: FOV zooms, distance changes the perspective."]
+        lines.append(
+            f"{v['camera_z']:>8g} {v['fov_y_deg']:>5g} {m['front_width_px']:>8.1f} {p['front_width_px']:>8.1f} "
+            f"{m['back_width_px']:>8.1f} {p['back_width_px']:>8.1f} {m['ratio']:>9.3f} {p['ratio']:>9.3f} "
+            f"{m['depth_compression']:>9.3f} {p['depth_compression']:>9.3f}"
+        )
+    lines += [
+        "",
+        f"Distance: the front face is nearer than the back by {box['z_front'] - box['z_back']:g}; at "
+        f"D = {d1:g} that is a large part of the distance, so the front face shows "
+        f"{views[0]['predicted']['ratio']:.3f}x the back's width ((D - z_back)/(D - z_front)); at D = {d2:g} "
+        f"only {views[2]['predicted']['ratio']:.3f}x. The nearer camera exaggerates depth (the receding edges "
+        f"span {views[0]['predicted']['depth_compression']:.3f} px per unit of depth for each px per unit of "
+        f"front width, against {views[2]['predicted']['depth_compression']:.3f} at D = {d2:g}): the farther "
+        "picture is flatter, closer to an orthographic one (ratio 1, compression 0).",
+        f"FOV: a wider FOV shortens the focal length, so everything shrinks by tan({f1:g}/2)/tan({f2:g}/2) = "
+        f"{report['fov_scale_predicted']:.4f}"
+        + (f" (measured {report['fov_scale_measured']:.4f})" if "fov_scale_measured" in report else "")
+        + "; the ratios do not change: FOV zooms, distance changes the perspective.",
+    ]
     return "\n".join(lines) + "\n"
 
 

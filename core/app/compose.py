@@ -38,8 +38,9 @@ def axis_length(radius: float, scale: float) -> float:
     return AXIS_LENGTH * (r if r > 0 and math.isfinite(r) else 1.0)
 
 
-def axis_layers(length: float, camera: Camera, clip: str, dtype: str, raster: str, frame: Frame | None = None
-                ) -> list[tuple[tuple[int, int, int], np.ndarray]]:
+def axis_layers(
+    length: float, camera: Camera, clip: str, dtype: str, raster: str, frame: Frame | None = None
+) -> list[tuple[tuple[int, int, int], np.ndarray]]:
     """``[(rgb, coverage (H, W) uint8)]`` for the X, Y, Z axes of ``length`` from the origin.
 
     Each axis is one edge through core's pipeline, so it is clipped and
@@ -52,12 +53,12 @@ def axis_layers(length: float, camera: Camera, clip: str, dtype: str, raster: st
     """
     points = np.array([[0.0, 0.0, 0.0], [length, 0.0, 0.0], [0.0, length, 0.0], [0.0, 0.0, length]])
     if frame is not None and frame.tri_ids is not None:
-        p_cam = world_to_cam(points, camera)                          # camera
+        p_cam = world_to_cam(points, camera)  # camera
         layers = []
         for i, (_, rgb) in enumerate(AXIS_COLOURS, start=1):
             seg_cam = p_cam[[0, i]][None]
             if clip == "endpoint" and not ((camera.near <= seg_cam[0, :, 2]) & (seg_cam[0, :, 2] <= camera.far)).all():
-                seg_cam = seg_cam[:0]                                 # clip "endpoint": a clipped end drops the edge
+                seg_cam = seg_cam[:0]  # clip "endpoint": a clipped end drops the edge
             layers.append((rgb, draw_segments(seg_cam, camera, raster, occluders=frame)))
         return layers
     layers = []

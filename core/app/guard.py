@@ -29,8 +29,9 @@ import sys
 import tempfile
 import traceback
 
-from ..errors import InputError, one_line, quiet_libraries
 import wirecheck
+
+from ..errors import InputError, one_line, quiet_libraries
 
 EXIT_USAGE = 2
 EXIT_INTERNAL = 3
@@ -80,8 +81,9 @@ def run_cli(prog: str, body, argv=None) -> int:
         with quiet_libraries() as messages:
             return body(argv)
     except Interrupted as exc:
-        print(f"{prog}: interrupted by {exc}: temporary files removed, earlier outputs left as they were",
-              file=sys.stderr)
+        print(
+            f"{prog}: interrupted by {exc}: temporary files removed, earlier outputs left as they were", file=sys.stderr
+        )
         return 128 + exc.signum
     except KeyboardInterrupt:
         print(f"{prog}: interrupted: temporary files removed, earlier outputs left as they were", file=sys.stderr)
@@ -93,18 +95,21 @@ def run_cli(prog: str, body, argv=None) -> int:
         except (OSError, ValueError):
             pass
         return 141
-    except Exception as exc:       # noqa: BLE001 - the guard: nothing gets past as a traceback
+    except Exception as exc:  # noqa: BLE001 - the guard: nothing gets past as a traceback
         line = error_line(prog, exc)
         if line is not None:
             print(line, file=sys.stderr)
             return EXIT_USAGE
         log = write_log(prog, exc, messages)
-        print(f"{prog}: internal error: {type(exc).__name__}: {one_line(exc)[:200]} (a bug in wirecheck, "
-              f"not in your input; the traceback is in {log}; please report it)", file=sys.stderr)
+        print(
+            f"{prog}: internal error: {type(exc).__name__}: {one_line(exc)[:200]} (a bug in wirecheck, "
+            f"not in your input; the traceback is in {log}; please report it)",
+            file=sys.stderr,
+        )
         return EXIT_INTERNAL
     finally:
-        for sig, old in handlers.items():       # interrupts_from_start's exit is over once the run has been
-            if getattr(old, "wirecheck_starting", False):                          # (outputs may exist)
+        for sig, old in handlers.items():  # interrupts_from_start's exit is over once the run has been
+            if getattr(old, "wirecheck_starting", False):  # (outputs may exist)
                 old = signal.default_int_handler if sig == signal.SIGINT else signal.SIG_DFL
             signal.signal(sig, old)
 

@@ -85,13 +85,16 @@ class FrameProfiler:
         if n == 0:
             return out
         keys = self.stages + ("other", "total")
-        table = np.array([[f[k] for k in keys] for f in self.frames])          # (n, stages + 2) ms
+        table = np.array([[f[k] for k in keys] for f in self.frames])  # (n, stages + 2) ms
         sum_total = float(table[:, -1].sum())
         for j, key in enumerate(keys):
             col = table[:, j]
-            out["stages"][key] = {"mean_ms": float(col.mean()), "p50_ms": float(np.percentile(col, 50)),
-                                  "p95_ms": float(np.percentile(col, 95)),
-                                  "share": float(col.sum() / sum_total) if sum_total > 0 else None}
+            out["stages"][key] = {
+                "mean_ms": float(col.mean()),
+                "p50_ms": float(np.percentile(col, 50)),
+                "p95_ms": float(np.percentile(col, 95)),
+                "share": float(col.sum() / sum_total) if sum_total > 0 else None,
+            }
         mean_total = out["stages"]["total"]["mean_ms"]
         out["fps"] = 1e3 / mean_total if mean_total > 0 else None
         return out
@@ -99,9 +102,10 @@ class FrameProfiler:
 
 def profile_table(summary: dict) -> str:
     """The summary as a text table: one row per stage, then other and total."""
-    lines = [f"Profile: {summary['frames']} frames"
-             + (f", {summary['fps']:.1f} frames/s" if summary["fps"] else ""),
-             f"{'stage':<10} {'mean ms':>9} {'p50 ms':>9} {'p95 ms':>9} {'share':>7}"]
+    lines = [
+        f"Profile: {summary['frames']} frames" + (f", {summary['fps']:.1f} frames/s" if summary["fps"] else ""),
+        f"{'stage':<10} {'mean ms':>9} {'p50 ms':>9} {'p95 ms':>9} {'share':>7}",
+    ]
     for name, st in summary["stages"].items():
         share = "-" if st["share"] is None else f"{100 * st['share']:.1f}%"
         lines.append(f"{name:<10} {st['mean_ms']:>9.3f} {st['p50_ms']:>9.3f} {st['p95_ms']:>9.3f} {share:>7}")

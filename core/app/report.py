@@ -42,8 +42,9 @@ def frame_record(k: int, frame: Frame, sidecar: bool, info: dict | None = None) 
         if key in info:
             rec[key] = None if info[key] is None else int(info[key])
     if not sidecar:
-        rec["vertices_px"] = [None if not v else [float(x), float(y)]
-                              for (x, y), v in zip(frame.p_px.tolist(), frame.visible.tolist())]
+        rec["vertices_px"] = [
+            None if not v else [float(x), float(y)] for (x, y), v in zip(frame.p_px.tolist(), frame.visible.tolist())
+        ]
     return rec
 
 
@@ -57,10 +58,23 @@ def run_report(s: Settings, records: list[dict]) -> dict:
     """The report dict of a run: scene, cameras, motion, settings, summary and the frame ``records``."""
     sc = s.scene
     depths = [(r["min_depth"], r["max_depth"]) for r in records if r["min_depth"] is not None]
-    scene = {"name": sc.name, "source": sc.source, "vertices": int(len(sc.vertices)),
-             "edges": int(len(sc.edges)), "faces": len(sc.faces),
-             "objects": [{"name": o.name, "vertices": o.vertex_count, "spin": list(o.motion.turns),
-                          "translate": list(o.motion.offset), "scale": o.motion.scale} for o in sc.objects]}
+    scene = {
+        "name": sc.name,
+        "source": sc.source,
+        "vertices": int(len(sc.vertices)),
+        "edges": int(len(sc.edges)),
+        "faces": len(sc.faces),
+        "objects": [
+            {
+                "name": o.name,
+                "vertices": o.vertex_count,
+                "spin": list(o.motion.turns),
+                "translate": list(o.motion.offset),
+                "scale": o.motion.scale,
+            }
+            for o in sc.objects
+        ],
+    }
     if sc.faces:
         scene["winding_note"] = sc.winding_note
     summary = {
@@ -71,32 +85,48 @@ def run_report(s: Settings, records: list[dict]) -> dict:
     }
     for key in ("objects_culled", "faces_culled", "hidden_pixels"):
         if records and key in records[0]:
-            summary[key] = sum(r[key] or 0 for r in records)       # total over the run
+            summary[key] = sum(r[key] or 0 for r in records)  # total over the run
     report = {
         "scene": scene,
         "camera": s.camera.to_dict(),
     }
     if s.ortho_camera is not None:
         report["camera_orthographic"] = s.ortho_camera.to_dict()
-    report.update({
-        "motion": {"turns": list(s.motion.turns), "translate": list(s.motion.offset),
-                   "scale": s.motion.scale, "frames": s.frames},
-        "clip": s.clip,
-        "dtype": s.dtype,
-        "raster": s.raster,
-        "drawing": {"projection": "both" if s.ortho_camera is not None else s.camera.projection,
-                    "axes": s.axes, "axis_length": axis_length(s.scene.radius, s.motion.scale) if s.axes else None,
-                    "cull": s.cull, "hidden_lines": s.hidden_lines, "style": s.style,
-                    "light": None if s.light is None else list(s.light), "object_culling": s.object_culling},
-        "summary": summary,
-        "frames": records,
-    })
+    report.update(
+        {
+            "motion": {
+                "turns": list(s.motion.turns),
+                "translate": list(s.motion.offset),
+                "scale": s.motion.scale,
+                "frames": s.frames,
+            },
+            "clip": s.clip,
+            "dtype": s.dtype,
+            "raster": s.raster,
+            "drawing": {
+                "projection": "both" if s.ortho_camera is not None else s.camera.projection,
+                "axes": s.axes,
+                "axis_length": axis_length(s.scene.radius, s.motion.scale) if s.axes else None,
+                "cull": s.cull,
+                "hidden_lines": s.hidden_lines,
+                "style": s.style,
+                "light": None if s.light is None else list(s.light),
+                "object_culling": s.object_culling,
+            },
+            "summary": summary,
+            "frames": records,
+        }
+    )
     return report
 
 
 #: Optional per-frame columns of the text report: (key, header).
-_EXTRA_COLUMNS = (("objects_culled", "objects_culled"), ("faces_total", "faces"),
-                  ("faces_culled", "faces_culled"), ("hidden_pixels", "hidden_pixels"))
+_EXTRA_COLUMNS = (
+    ("objects_culled", "objects_culled"),
+    ("faces_total", "faces"),
+    ("faces_culled", "faces_culled"),
+    ("hidden_pixels", "hidden_pixels"),
+)
 
 
 def summary_text(report: dict, render_seconds: float, wall_seconds: float, plot_seconds=None) -> str:
@@ -106,11 +136,17 @@ def summary_text(report: dict, render_seconds: float, wall_seconds: float, plot_
         f"Scene: {sc['name']} ({sc['vertices']} vertices, {sc['edges']} edges) from {sc['source']}",
     ]
     if len(sc["objects"]) > 1:
-        lines.append(f"Objects: {len(sc['objects'])}: " + ", ".join(
-            f"{o['name']} ({o['vertices']} vertices, spin {o['spin']}, translate {o['translate']}, "
-            f"scale {o['scale']})" for o in sc["objects"]))
-    cams = [("Camera", cam)] + ([("Right camera", report["camera_orthographic"])]
-                                if "camera_orthographic" in report else [])
+        lines.append(
+            f"Objects: {len(sc['objects'])}: "
+            + ", ".join(
+                f"{o['name']} ({o['vertices']} vertices, spin {o['spin']}, translate {o['translate']}, "
+                f"scale {o['scale']})"
+                for o in sc["objects"]
+            )
+        )
+    cams = [("Camera", cam)] + (
+        [("Right camera", report["camera_orthographic"])] if "camera_orthographic" in report else []
+    )
     for label, c in cams:
         pad = " " * len(label)
         lines += [
@@ -129,8 +165,8 @@ def summary_text(report: dict, render_seconds: float, wall_seconds: float, plot_
         f"hidden_lines={'on' if dr['hidden_lines'] else 'off'} style={dr['style']}"
         + (f" light={dr['light']}" if dr["light"] else ""),
         f"Frames: {sm['frames']} ({sm['frames_with_clipping']} with clipping)",
-        "Depth over the run: " + ("none visible" if sm["min_depth"] is None
-                                  else f"[{sm['min_depth']:.4f}, {sm['max_depth']:.4f}]"),
+        "Depth over the run: "
+        + ("none visible" if sm["min_depth"] is None else f"[{sm['min_depth']:.4f}, {sm['max_depth']:.4f}]"),
     ]
     for key in ("objects_culled", "faces_culled", "hidden_pixels"):
         if key in sm:
@@ -142,12 +178,17 @@ def summary_text(report: dict, render_seconds: float, wall_seconds: float, plot_
         dmin = "-" if r["min_depth"] is None else f"{r['min_depth']:.4f}"
         dmax = "-" if r["max_depth"] is None else f"{r['max_depth']:.4f}"
         cells = "".join(f"  {'-' if r[k] is None else r[k]:>{len(h)}}" for k, h in extra)
-        lines.append(f"{r['frame']:>5}  {r['visible_vertices']:>7}  {r['clipped']:>7}  {r['clipped_edges']:>13}  "
-                     f"{dmin:>9}  {dmax:>9}{cells}")
-    lines += ["", "Timing (varies run to run; everything above is deterministic):",
-              f"  projection + raster: {1e3 * render_seconds / max(sm['frames'], 1):.3f} ms/frame"
-              + (" (both cameras)" if "camera_orthographic" in report else ""),
-              f"  wall time incl. export: {wall_seconds:.3f} s"]
+        lines.append(
+            f"{r['frame']:>5}  {r['visible_vertices']:>7}  {r['clipped']:>7}  {r['clipped_edges']:>13}  "
+            f"{dmin:>9}  {dmax:>9}{cells}"
+        )
+    lines += [
+        "",
+        "Timing (varies run to run; everything above is deterministic):",
+        f"  projection + raster: {1e3 * render_seconds / max(sm['frames'], 1):.3f} ms/frame"
+        + (" (both cameras)" if "camera_orthographic" in report else ""),
+        f"  wall time incl. export: {wall_seconds:.3f} s",
+    ]
     if plot_seconds is not None:
         lines.append(f"  plots (matplotlib): {plot_seconds:.3f} s")
     return "\n".join(lines) + "\n"

@@ -14,15 +14,15 @@ import time
 
 import numpy as np
 
-from ..outputs import output
-from .compose import overlay, picture, side_by_side
 from ..errors import InputError
+from ..outputs import output
 from ..outputs.frame_writer import ForkedPngWriter, can_fork
 from ..outputs.gif import GifWriter
+from ..outputs.staging import Staging
+from .compose import overlay, picture, side_by_side
+from .motion_plot import plot_png
 from .report import frame_record, run_report, summary_text
 from .settings import Settings
-from ..outputs.staging import Staging
-from .motion_plot import plot_png
 
 #: Output formats: frames as PNG and ASCII text, animations as GIF and MP4.
 FORMATS = ("png", "ascii", "gif", "mp4")
@@ -48,7 +48,7 @@ def output_names(s: Settings) -> list[str]:
     names = [f"{name}-frames/"] if ("png" in s.formats or "ascii" in s.formats) else []
     names += [f"{name}.{fmt}" for fmt in ("gif", "mp4") if fmt in s.formats]
     if len(s.scene.vertices) > SIDECAR_VERTICES:
-        names += [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"][:len(s.cameras)]
+        names += [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"][: len(s.cameras)]
     if s.plots:
         names.append(f"{name}-plots.png")
     return names + [f"{name}-report.json", f"{name}-report.txt"]
@@ -87,7 +87,7 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
         (frames_dir / output.MARKER).write_bytes(b"")
     records = []
     sidecar_names = [f"{name}-vertices_px.npy", f"{name}-vertices_px-orthographic.npy"]
-    all_px = [None for _ in s.cameras]       # the sidecars, filled frame by frame (memory flat in the frame count)
+    all_px = [None for _ in s.cameras]  # the sidecars, filled frame by frame (memory flat in the frame count)
     t_start = time.perf_counter()
     render_seconds = 0.0
     renderer = s.scene_renderer()
@@ -101,8 +101,9 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
         if "mp4" in s.formats:
             mp4 = output.Mp4Writer(files.enter_context(open(stage.path(f"{name}.mp4"), "wb")), FPS)
         if "gif" in s.formats:
-            gif = GifWriter(files.enter_context(open(stage.path(f"{name}.gif"), "wb")), FPS,
-                            progress=lambda: step("gif"))
+            gif = GifWriter(
+                files.enter_context(open(stage.path(f"{name}.gif"), "wb")), FPS, progress=lambda: step("gif")
+            )
         for k in range(1, s.frames + 1):
             if profiler is not None:
                 profiler.begin()
@@ -114,17 +115,22 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
                 render_seconds += t - t0
                 _check_overflow(s, frame, k)
                 img = picture(frame, s.style)
-                if layers and frame.tri_ids is not None:          # faces in a depth buffer: axes depth-tested
+                if layers and frame.tri_ids is not None:  # faces in a depth buffer: axes depth-tested
                     pictures.append(overlay(img, s.axis_layers(cam, frame)))
                 else:
                     pictures.append(overlay(img, layers[c]) if layers else img)
                 recs.append(frame_record(k, frame, sidecar, info))
                 if sidecar:
-                    if all_px[c] is None:           # the bytes np.save writes, one frame at a time
+                    if all_px[c] is None:  # the bytes np.save writes, one frame at a time
                         all_px[c] = files.enter_context(open(stage.path(sidecar_names[c]), "wb"))
-                        np.lib.format.write_array_header_1_0(all_px[c], {
-                            "descr": np.lib.format.dtype_to_descr(frame.p_px.dtype), "fortran_order": False,
-                            "shape": (s.frames, *frame.p_px.shape)})
+                        np.lib.format.write_array_header_1_0(
+                            all_px[c],
+                            {
+                                "descr": np.lib.format.dtype_to_descr(frame.p_px.dtype),
+                                "fortran_order": False,
+                                "shape": (s.frames, *frame.p_px.shape),
+                            },
+                        )
                     all_px[c].write(np.ascontiguousarray(frame.p_px).tobytes())
                 if c == 0:
                     first = (frame, info)
@@ -135,8 +141,10 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
                 rec["orthographic"] = {key: v for key, v in recs[1].items() if key != "frame"}
             image = pictures[0] if len(pictures) == 1 else side_by_side(*pictures)
             t = lap("compose", t)
-            for fmt, encode in (("png", output.png_bytes), ("ascii", lambda im: output.ascii_frame(
-                    im, s.ascii_cols).encode())):
+            for fmt, encode in (
+                ("png", output.png_bytes),
+                ("ascii", lambda im: output.ascii_frame(im, s.ascii_cols).encode()),
+            ):
                 if fmt == "png" and png_writer is not None:
                     png_writer.put(frames_dir / f"frame_{k:04d}.png", image)
                 elif frames_dir is not None and fmt in s.formats:
@@ -179,14 +187,18 @@ def _render_into(s: Settings, stage: Staging, log, step, profiler, extra) -> dic
         plot_seconds = time.perf_counter() - t0
     stage.path(f"{name}-report.json").write_text(output.json_dumps(report), encoding="utf-8")
     wall = time.perf_counter() - t_start
-    stage.path(f"{name}-report.txt").write_text(summary_text(report, render_seconds, wall, plot_seconds),
-                                                encoding="utf-8", errors="backslashreplace")   # a non-UTF-8 path
+    stage.path(f"{name}-report.txt").write_text(
+        summary_text(report, render_seconds, wall, plot_seconds), encoding="utf-8", errors="backslashreplace"
+    )  # a non-UTF-8 path
     out = s.out
-    report["_paths"] = {"frames": out / f"{name}-frames" if frames_dir else None,
-                        "json": out / f"{name}-report.json", "txt": out / f"{name}-report.txt",
-                        "gif": out / f"{name}.gif" if gif is not None else None,
-                        "mp4": out / f"{name}.mp4" if mp4 is not None else None,
-                        "plots": out / f"{name}-plots.png" if s.plots else None}
+    report["_paths"] = {
+        "frames": out / f"{name}-frames" if frames_dir else None,
+        "json": out / f"{name}-report.json",
+        "txt": out / f"{name}-report.txt",
+        "gif": out / f"{name}.gif" if gif is not None else None,
+        "mp4": out / f"{name}.mp4" if mp4 is not None else None,
+        "plots": out / f"{name}-plots.png" if s.plots else None,
+    }
     return report
 
 
@@ -197,4 +209,5 @@ def _check_overflow(s: Settings, frame, k: int) -> None:
         raise InputError(
             f"{s.scene.source}: vertex {i} {s.scene.vertices[i].tolist()} projects beyond the {s.dtype} "
             f"range in frame {k}: expected coordinates whose pixel position fits in a {s.dtype} "
-            f"(|f * x / z| < {float(np.finfo(s.dtype).max):.2g})")
+            f"(|f * x / z| < {float(np.finfo(s.dtype).max):.2g})"
+        )

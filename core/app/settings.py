@@ -29,9 +29,9 @@ class Settings:
     ascii_cols: int
     dtype: str = "float64"
     raster: str = "exact"
-    ortho_camera: Camera | None = None       # --projection both: the right-hand camera
+    ortho_camera: Camera | None = None  # --projection both: the right-hand camera
     axes: bool = False
-    cull: str | None = None                  # None or "backface"
+    cull: str | None = None  # None or "backface"
     hidden_lines: bool = False
     style: str = "wireframe"
     light: tuple | None = None
@@ -48,10 +48,21 @@ class Settings:
 
     def axis_layers(self, camera: Camera, frame=None) -> list:
         """:func:`core.app.compose.axis_layers` of this run (``frame``: depth-tested against its faces)."""
-        return axis_layers(axis_length(self.scene.radius, self.motion.scale), camera, self.clip, self.dtype,
-                           self.raster, frame)
+        return axis_layers(
+            axis_length(self.scene.radius, self.motion.scale), camera, self.clip, self.dtype, self.raster, frame
+        )
 
     def scene_renderer(self) -> SceneRenderer:
-        return SceneRenderer(self.scene, self.motion, self.frames, clip=self.clip, dtype=self.dtype,
-                             raster=self.raster, cull=self.cull, hidden_lines=self.hidden_lines,
-                             style=self.style, light=self.light, object_culling=self.object_culling)
+        return SceneRenderer(
+            self.scene,
+            self.motion,
+            self.frames,
+            clip=self.clip,
+            dtype=self.dtype,
+            raster=self.raster,
+            cull=self.cull,
+            hidden_lines=self.hidden_lines,
+            style=self.style,
+            light=self.light,
+            object_culling=self.object_culling,
+        )

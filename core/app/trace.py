@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..projector import clipping
 from ..camera import Camera
 from ..errors import InputError
 from ..numbers import plain_int
+from ..projector import clipping
 from ..projector.projection import cam_to_px, world_to_cam
 from ..scene.model import Scene, object_matrix
 from ..transforms import Motion, apply
@@ -89,8 +89,10 @@ def model_matrix_of(scene: Scene, motion: Motion, vertex: int, k: int, frames: i
 
 def check_vertex(scene: Scene, vertex: int) -> None:
     if not 0 <= vertex < len(scene.vertices):
-        raise InputError(f"--trace-vertex {vertex}: scene {scene.name!r} has {len(scene.vertices)} vertices: "
-                         f"expected an index in [0, {len(scene.vertices) - 1}]")
+        raise InputError(
+            f"--trace-vertex {vertex}: scene {scene.name!r} has {len(scene.vertices)} vertices: "
+            f"expected an index in [0, {len(scene.vertices) - 1}]"
+        )
 
 
 def parse_frames(text: str | None, frames: int) -> list[int]:
@@ -106,8 +108,9 @@ def parse_frames(text: str | None, frames: int) -> list[int]:
     return sorted(set(ks))
 
 
-def trace_vertex(scene: Scene, motion: Motion, camera: Camera, vertex: int, k: int, frames: int,
-                 p_px_drawn=None) -> dict:
+def trace_vertex(
+    scene: Scene, motion: Motion, camera: Camera, vertex: int, k: int, frames: int, p_px_drawn=None
+) -> dict:
     """The vertex's coordinates in every space, its visibility and its edges' clipping, in frame ``k``.
 
     ``p_px_drawn`` is the pixel the pipeline drew for it (``Frame.p_px[vertex]``),
@@ -116,25 +119,34 @@ def trace_vertex(scene: Scene, motion: Motion, camera: Camera, vertex: int, k: i
     check_vertex(scene, vertex)
     m = model_matrix_of(scene, motion, vertex, k, frames)
     p_model = np.asarray(scene.vertices[vertex], dtype=np.float64)
-    p_world = apply(m, p_model)[0]                                       # world
-    p_cam = world_to_cam(p_world[None], camera)[0]                       # camera
-    p_clip = clip_matrix(camera) @ np.append(p_cam, 1.0)                 # clip (homogeneous)
+    p_world = apply(m, p_model)[0]  # world
+    p_cam = world_to_cam(p_world[None], camera)[0]  # camera
+    p_clip = clip_matrix(camera) @ np.append(p_cam, 1.0)  # clip (homogeneous)
     visible = bool(camera.near <= p_cam[2] <= camera.far)
-    p_ndc = p_clip[:3] / p_clip[3] if visible else None                  # NDC (only in front: w > 0)
+    p_ndc = p_clip[:3] / p_clip[3] if visible else None  # NDC (only in front: w > 0)
     if p_px_drawn is not None:
         p_px = None if not np.all(np.isfinite(p_px_drawn)) else np.asarray(p_px_drawn, dtype=np.float64)
     else:
-        p_px = cam_to_px(p_cam[None], camera)[0] if visible else None   # pixels
-    on_image = bool(p_px is not None and -0.5 <= p_px[0] <= camera.width - 0.5
-                    and -0.5 <= p_px[1] <= camera.height - 0.5)
-    rec = {"frame": k, "t": (k - 1) / frames, "vertex": vertex,
-           "model": p_model.tolist(), "world": p_world.tolist(), "camera": p_cam.tolist(),
-           "depth": float(p_cam[2]), "clip": _floats(p_clip),
-           "ndc": None if p_ndc is None else _floats(p_ndc),
-           "pixel": None if p_px is None else p_px.tolist(),
-           "pixel_from_ndc": None if p_ndc is None else _floats(ndc_to_px(p_ndc, camera)),
-           "visible": visible, "on_image": on_image,
-           "edges": _edges(scene, motion, camera, vertex, k, frames, p_cam)}
+        p_px = cam_to_px(p_cam[None], camera)[0] if visible else None  # pixels
+    on_image = bool(
+        p_px is not None and -0.5 <= p_px[0] <= camera.width - 0.5 and -0.5 <= p_px[1] <= camera.height - 0.5
+    )
+    rec = {
+        "frame": k,
+        "t": (k - 1) / frames,
+        "vertex": vertex,
+        "model": p_model.tolist(),
+        "world": p_world.tolist(),
+        "camera": p_cam.tolist(),
+        "depth": float(p_cam[2]),
+        "clip": _floats(p_clip),
+        "ndc": None if p_ndc is None else _floats(p_ndc),
+        "pixel": None if p_px is None else p_px.tolist(),
+        "pixel_from_ndc": None if p_ndc is None else _floats(ndc_to_px(p_ndc, camera)),
+        "visible": visible,
+        "on_image": on_image,
+        "edges": _edges(scene, motion, camera, vertex, k, frames, p_cam),
+    }
     return rec
 
 
@@ -157,9 +169,9 @@ def _edges(scene, motion, camera, vertex, k, frames, p_cam) -> list[dict]:
         other = int(b if a == vertex else a)
         m_o = model_matrix_of(scene, motion, other, k, frames)
         q_cam = world_to_cam(apply(m_o, scene.vertices[other]), camera)[0]
-        seg = np.stack([p_cam, q_cam])[None]                             # camera, (1, 2, 3)
+        seg = np.stack([p_cam, q_cam])[None]  # camera, (1, 2, 3)
         kept, t0, t1 = clipping.clip_segments(seg, planes)
-        dist = seg[0] @ planes[:, :3].T + planes[:, 3]                   # (2 ends, 6 planes) signed distances
+        dist = seg[0] @ planes[:, :3].T + planes[:, 3]  # (2 ends, 6 planes) signed distances
         outside = [j for j in range(len(planes)) if (dist[:, j] < 0).any()]
         e = {"edge": [vertex, other], "ends_outside": [PLANE_NAMES[j] for j in outside]}
         if not kept[0]:
@@ -170,10 +182,17 @@ def _edges(scene, motion, camera, vertex, k, frames, p_cam) -> list[dict]:
             ends_cam = seg[0, 0] + np.array([t0[0], t1[0]])[:, None] * (seg[0, 1] - seg[0, 0])
             # the planes that set the kept range: their crossing is t_enter or t_exit
             cross = {j: dist[0, j] / (dist[0, j] - dist[1, j]) for j in outside if (dist[:, j] < 0).sum() == 1}
-            e["cut_by"] = [PLANE_NAMES[j] for j, tc in cross.items()
-                        if np.isclose(tc, t0[0], rtol=1e-12, atol=0) or np.isclose(tc, t1[0], rtol=1e-12, atol=0)]
-            e.update(status="clipped", t=[float(t0[0]), float(t1[0])], ends_camera=ends_cam.tolist(),
-                     ends_pixel=cam_to_px(ends_cam, camera).tolist())
+            e["cut_by"] = [
+                PLANE_NAMES[j]
+                for j, tc in cross.items()
+                if np.isclose(tc, t0[0], rtol=1e-12, atol=0) or np.isclose(tc, t1[0], rtol=1e-12, atol=0)
+            ]
+            e.update(
+                status="clipped",
+                t=[float(t0[0]), float(t1[0])],
+                ends_camera=ends_cam.tolist(),
+                ends_pixel=cam_to_px(ends_cam, camera).tolist(),
+            )
         out.append(e)
     return out
 
@@ -184,25 +203,35 @@ def _fmt(v, digits=6) -> str:
 
 def trace_text(rec: dict, camera: Camera) -> str:
     """The trace of one frame as the lines ``renderer`` prints."""
-    lines = [f"Trace: vertex {rec['vertex']}, frame {rec['frame']} (t = {rec['t']:.6f})",
-             f"  model   {_fmt(rec['model'])}",
-             f"  world   {_fmt(rec['world'])}   after the model matrix",
-             f"  camera  {_fmt(rec['camera'])}   depth z_cam = {rec['depth']:.6f}",
-             f"  clip    {_fmt(rec['clip'])}   homogeneous, before the divide"]
+    lines = [
+        f"Trace: vertex {rec['vertex']}, frame {rec['frame']} (t = {rec['t']:.6f})",
+        f"  model   {_fmt(rec['model'])}",
+        f"  world   {_fmt(rec['world'])}   after the model matrix",
+        f"  camera  {_fmt(rec['camera'])}   depth z_cam = {rec['depth']:.6f}",
+        f"  clip    {_fmt(rec['clip'])}   homogeneous, before the divide",
+    ]
     if rec["ndc"] is None:
-        lines.append(f"  ndc     -   (clipped: z_cam {rec['depth']:.6g} outside [near {camera.near:g}, "
-                     f"far {camera.far:g}]; never divided)")
+        lines.append(
+            f"  ndc     -   (clipped: z_cam {rec['depth']:.6g} outside [near {camera.near:g}, "
+            f"far {camera.far:g}]; never divided)"
+        )
     else:
         lines.append(f"  ndc     {_fmt(rec['ndc'])}")
-    lines.append("  pixel   " + ("-" if rec["pixel"] is None else
-                                  f"{_fmt(rec['pixel'], 4)}   {'on' if rec['on_image'] else 'off'} the image"))
-    lines.append(f"  visible: {'yes' if rec['visible'] else 'no'} (near {camera.near:g} <= z_cam <= far {camera.far:g})")
+    lines.append(
+        "  pixel   "
+        + ("-" if rec["pixel"] is None else f"{_fmt(rec['pixel'], 4)}   {'on' if rec['on_image'] else 'off'} the image")
+    )
+    lines.append(
+        f"  visible: {'yes' if rec['visible'] else 'no'} (near {camera.near:g} <= z_cam <= far {camera.far:g})"
+    )
     for e in rec["edges"]:
         a, b = e["edge"]
         text = f"  edge {a}-{b}: {e['status']}"
         if e["status"] == "clipped":
-            text += (f" by {', '.join(e['cut_by'])}: kept t in [{e['t'][0]:.6f}, {e['t'][1]:.6f}], "
-                     f"ends at px {_fmt(e['ends_pixel'][0], 3)} and {_fmt(e['ends_pixel'][1], 3)}")
+            text += (
+                f" by {', '.join(e['cut_by'])}: kept t in [{e['t'][0]:.6f}, {e['t'][1]:.6f}], "
+                f"ends at px {_fmt(e['ends_pixel'][0], 3)} and {_fmt(e['ends_pixel'][1], 3)}"
+            )
         elif e["status"] == "dropped":
             text += f" (ends outside {', '.join(e['ends_outside'])})"
         lines.append(text)

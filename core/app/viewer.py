@@ -54,13 +54,13 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from ..outputs import output
 from ..camera import Camera, look_at
 from ..errors import InputError
+from ..outputs import output
 from ..projector.pipeline import STAGES as PIPELINE_STAGES
-from .profile import FrameProfiler
-from .compose import overlay, picture
 from ..scene.files import builtin_names, example_names
+from .compose import overlay, picture
+from .profile import FrameProfiler
 
 #: Orbit: degrees per CSS pixel of drag.
 DEG_PER_PX = 0.5
@@ -97,8 +97,18 @@ class View:
     frame: int = 1
 
     def camera(self, width: int, height: int) -> Camera:
-        return look_at(self.position, self.target, self.up, fov_y_deg=self.fov, width=width, height=height,
-                       near=self.near, far=self.far, projection=self.projection, ortho_height=self.ortho_height)
+        return look_at(
+            self.position,
+            self.target,
+            self.up,
+            fov_y_deg=self.fov,
+            width=width,
+            height=height,
+            near=self.near,
+            far=self.far,
+            projection=self.projection,
+            ortho_height=self.ortho_height,
+        )
 
 
 def view_of(s) -> View:
@@ -106,10 +116,20 @@ def view_of(s) -> View:
     c = s.camera
     d = _look_distance(s)
     target = tuple(float(v) for v in c.position + d * c.forward)
-    return View(position=tuple(float(v) for v in c.position), target=target, up=tuple(float(v) for v in c.up),
-                fov=float(c.fov_y_deg), near=float(c.near), far=float(c.far), ortho_height=float(c.ortho_height),
-                projection=c.projection, style=s.style, hidden_lines=s.hidden_lines, cull=s.cull is not None,
-                axes=s.axes)
+    return View(
+        position=tuple(float(v) for v in c.position),
+        target=target,
+        up=tuple(float(v) for v in c.up),
+        fov=float(c.fov_y_deg),
+        near=float(c.near),
+        far=float(c.far),
+        ortho_height=float(c.ortho_height),
+        projection=c.projection,
+        style=s.style,
+        hidden_lines=s.hidden_lines,
+        cull=s.cull is not None,
+        axes=s.axes,
+    )
 
 
 def _look_distance(s) -> float:
@@ -143,9 +163,9 @@ def dolly(view: View, delta: float) -> View:
     tgt = np.asarray(view.target, dtype=np.float64)
     try:
         scale = math.exp(delta * DOLLY_PER_UNIT)
-    except OverflowError:                               # delta > ~7e5: beyond float64
+    except OverflowError:  # delta > ~7e5: beyond float64
         scale = math.inf
-    with np.errstate(all="ignore"):                     # inf, nan or 0 from an extreme delta: refused below
+    with np.errstate(all="ignore"):  # inf, nan or 0 from an extreme delta: refused below
         offset = (np.asarray(view.position, dtype=np.float64) - tgt) * scale
     if not (math.isfinite(scale) and np.isfinite(offset).all() and np.any(offset)):
         raise InputError(f"dolly {delta!r}: the camera would reach the look-at point or infinity")
@@ -164,21 +184,24 @@ def pan(view: View, dx: float, dy: float, height: int) -> View:
     """Move camera and look-at point so the look-at plane follows the mouse by ``(dx, dy)`` px."""
     cam = look_at(view.position, view.target, view.up)
     move = (-dx * cam.right + dy * cam.up) * pixel_size(view, height)
-    return replace(view, position=tuple((np.asarray(view.position) + move).tolist()),
-                   target=tuple((np.asarray(view.target) + move).tolist()))
+    return replace(
+        view,
+        position=tuple((np.asarray(view.position) + move).tolist()),
+        target=tuple((np.asarray(view.target) + move).tolist()),
+    )
 
 
 def short_repr(value, limit: int = 60) -> str:
     """``repr(value)``, cut to ``limit`` characters: an error message echoes hostile input in one short line."""
     r = repr(value)
-    return r if len(r) <= limit else r[:limit - 3] + "..."
+    return r if len(r) <= limit else r[: limit - 3] + "..."
 
 
 def _number(name, text):
     """A finite float from a JSON number or a typed string (``"61.5"``); InputError otherwise."""
     try:
         v = math.nan if isinstance(text, bool) else float(text)
-    except (TypeError, ValueError, OverflowError):     # OverflowError: an integer beyond float64
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer beyond float64
         v = math.nan
     if not math.isfinite(v):
         raise InputError(f"{name} {short_repr(text)}: expected a finite number")
@@ -190,6 +213,7 @@ def _choice(allowed):
         if text not in allowed:
             raise InputError(f"{name} {short_repr(text)}: expected one of {', '.join(allowed)}")
         return text
+
     return parse
 
 
@@ -200,9 +224,17 @@ def _flag(name, value):
 
 
 #: Fields the page may set, with their parsers.
-FIELDS = {"fov": _number, "near": _number, "far": _number, "ortho_height": _number,
-          "projection": _choice(("perspective", "orthographic")), "style": _choice(("wireframe", "shaded")),
-          "hidden_lines": _flag, "cull": _flag, "axes": _flag}
+FIELDS = {
+    "fov": _number,
+    "near": _number,
+    "far": _number,
+    "ortho_height": _number,
+    "projection": _choice(("perspective", "orthographic")),
+    "style": _choice(("wireframe", "shaded")),
+    "hidden_lines": _flag,
+    "cull": _flag,
+    "axes": _flag,
+}
 
 
 class Viewer:
@@ -237,11 +269,11 @@ class Viewer:
         v = self.view
         h = self.s.camera.height
         for op in ops:
-            with np.errstate(all="ignore"):             # an op driving the camera to inf/nan is refused below
+            with np.errstate(all="ignore"):  # an op driving the camera to inf/nan is refused below
                 v = self._apply_one(v, op, h)
             if not np.isfinite([*v.position, *v.target, *v.up]).all():
                 raise InputError(f"op {short_repr(op)}: the camera would leave the float64 range")
-        self.settings(v)                                # validates camera and mode
+        self.settings(v)  # validates camera and mode
         return v
 
     def _apply_one(self, v: View, op, h: int) -> View:
@@ -275,8 +307,16 @@ class Viewer:
             raise InputError("hidden lines with style shaded: a shaded frame draws no lines; expected one of them")
         if (v.style == "shaded" or v.hidden_lines or v.cull) and not self.s.scene.faces:
             raise InputError(f"scene {self.s.scene.name!r} has no faces: hidden lines, culling and shading need faces")
-        return replace(self.s, camera=cam, ortho_camera=None, style=v.style, hidden_lines=v.hidden_lines,
-                       cull="backface" if v.cull else None, axes=v.axes, light=self.s.light if v.style == "shaded" else None)
+        return replace(
+            self.s,
+            camera=cam,
+            ortho_camera=None,
+            style=v.style,
+            hidden_lines=v.hidden_lines,
+            cull="backface" if v.cull else None,
+            axes=v.axes,
+            light=self.s.light if v.style == "shaded" else None,
+        )
 
     # ---- output
     def frame_png(self, v: View, timing: dict | None = None):
@@ -284,7 +324,7 @@ class Viewer:
         s = self.settings(v)
         key = (s.style, s.hidden_lines, s.cull)
         if key not in self._renderers:
-            self._renderers[key] = s.scene_renderer()             # the renderer's own frame set-up
+            self._renderers[key] = s.scene_renderer()  # the renderer's own frame set-up
         frame, _ = self._renderers[key].render(v.frame, s.camera, timing=timing)
         t1 = time.perf_counter()
         img = picture(frame, s.style)
@@ -302,11 +342,21 @@ class Viewer:
         """The ``renderer`` command line that writes this frame (``frame_<k>.png``), floats exact (repr)."""
         s = self.s
         scene = s.scene.name if s.scene.name in builtin_names() + example_names() else s.scene.source
-        r = lambda xs: ",".join(repr(float(x)) for x in xs)            # noqa: E731 - repr round-trips floats
+        r = lambda xs: ",".join(repr(float(x)) for x in xs)  # noqa: E731 - repr round-trips floats
         # OPTION=VALUE: a value starting with "-" is not taken for an option
-        args = ["renderer", "--scene", scene, "--frames", str(s.frames),
-                f"--camera-pos={r(v.position)}", f"--look-at={r(v.target)}", f"--up={r(v.up)}",
-                f"--fov={v.fov!r}", f"--near={v.near!r}", f"--far={v.far!r}"]
+        args = [
+            "renderer",
+            "--scene",
+            scene,
+            "--frames",
+            str(s.frames),
+            f"--camera-pos={r(v.position)}",
+            f"--look-at={r(v.target)}",
+            f"--up={r(v.up)}",
+            f"--fov={v.fov!r}",
+            f"--near={v.near!r}",
+            f"--far={v.far!r}",
+        ]
         if (s.camera.width, s.camera.height) != (640, 480):
             args += ["--width", str(s.camera.width), "--height", str(s.camera.height)]
         if v.projection == "orthographic":
@@ -318,8 +368,11 @@ class Viewer:
             args += [f"--translate={r(m.offset)}"]
         if m.scale != 1.0:
             args += [f"--scale={m.scale!r}"]
-        for opt, val, default in (("--clip", s.clip, "clip"), ("--dtype", s.dtype, "float64"),
-                                  ("--raster", s.raster, "exact")):
+        for opt, val, default in (
+            ("--clip", s.clip, "clip"),
+            ("--dtype", s.dtype, "float64"),
+            ("--raster", s.raster, "exact"),
+        ):
             if val != default:
                 args += [opt, val]
         if v.hidden_lines:
@@ -354,17 +407,40 @@ class Viewer:
             rec = self.profiler.end()
             cam = s.camera
             n = min(SHOWN_VERTICES, len(frame.p_px))
-            out = {"error": error, "view": asdict(v), "frames": s.frames,
-                   "camera": {k: cam.to_dict()[k] for k in ("position", "forward", "up", "fov_y_deg", "near", "far",
-                                                              "projection", "ortho_height", "width", "height")},
-                   "command": self.command(v), "image": image,
-                   "vertices_px": [None if not vis else [float(x), float(y)]
-                                   for (x, y), vis in zip(frame.p_px[:n].tolist(), frame.visible[:n].tolist())],
-                   "timing_ms": rec, "profile": self.profiler.summary(), "overlay": None, "overlay_ms": 0.0}
+            out = {
+                "error": error,
+                "view": asdict(v),
+                "frames": s.frames,
+                "camera": {
+                    k: cam.to_dict()[k]
+                    for k in (
+                        "position",
+                        "forward",
+                        "up",
+                        "fov_y_deg",
+                        "near",
+                        "far",
+                        "projection",
+                        "ortho_height",
+                        "width",
+                        "height",
+                    )
+                },
+                "command": self.command(v),
+                "image": image,
+                "vertices_px": [
+                    None if not vis else [float(x), float(y)]
+                    for (x, y), vis in zip(frame.p_px[:n].tolist(), frame.visible[:n].tolist())
+                ],
+                "timing_ms": rec,
+                "profile": self.profiler.summary(),
+                "overlay": None,
+                "overlay_ms": 0.0,
+            }
             if want_overlay:
                 t0 = time.perf_counter()
                 out["overlay"] = self._overlay(s, v)
-                out["overlay_ms"] = 1e3 * (time.perf_counter() - t0)      # crosscheck of the view, not the frame
+                out["overlay_ms"] = 1e3 * (time.perf_counter() - t0)  # crosscheck of the view, not the frame
             return out
 
     def _overlay(self, s, v: View) -> dict:
@@ -372,7 +448,7 @@ class Viewer:
             return {"error": "the oracle overlay is not available (wirecheck.oracles could not be loaded)"}
         try:
             return self.overlay(s, s.camera, v.frame)
-        except Exception as exc:                        # an oracle failure is shown, not fatal
+        except Exception as exc:  # an oracle failure is shown, not fatal
             return {"error": f"oracle overlay failed: {type(exc).__name__}: {exc}"}
 
 
@@ -383,7 +459,7 @@ def _load_overlay():
         from importlib import import_module
 
         return import_module("wirecheck.oracles.live").LiveOverlay(), None
-    except Exception as exc:                             # e.g. no libOSMesa: the viewer runs without it
+    except Exception as exc:  # e.g. no libOSMesa: the viewer runs without it
         why = " ".join(str(exc).split()) or type(exc).__name__
         print(f"renderer: warning: oracle overlay unavailable: {why}", file=sys.stderr)
         return None, why
@@ -407,5 +483,3 @@ class LazyOverlay:
     def close(self):
         if self._impl is not None:
             self._impl.close()
-
-

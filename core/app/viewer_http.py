@@ -34,7 +34,6 @@ REQUEST_TIMEOUT_S = 10.0
 POLL_S = 0.05
 
 
-
 class RequestError(Exception):
     """A request the server refuses: ``status`` (a 4xx :class:`http.HTTPStatus`) and a one-line message."""
 
@@ -54,7 +53,7 @@ def _reject_constant(name):
 
 def _finite_float(text):
     v = float(text)
-    if not math.isfinite(v):                           # 1e400 parses to inf
+    if not math.isfinite(v):  # 1e400 parses to inf
         raise ValueError(f"number {short_repr(text)} overflows float64; expected a finite number")
     return v
 
@@ -69,35 +68,42 @@ def parse_body(raw: bytes) -> tuple[list, bool]:
     try:
         body = json.loads(raw.decode("utf-8") or "{}", parse_constant=_reject_constant, parse_float=_finite_float)
     except UnicodeDecodeError as exc:
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: not UTF-8 ({exc.reason} at byte {exc.start})") from exc
+        raise RequestError(
+            HTTPStatus.BAD_REQUEST, f"request body: not UTF-8 ({exc.reason} at byte {exc.start})"
+        ) from exc
     except RecursionError:
         raise RequestError(HTTPStatus.BAD_REQUEST, "request body: JSON nested too deeply") from None
-    except ValueError as exc:                          # JSONDecodeError, our constants, int digit limit
+    except ValueError as exc:  # JSONDecodeError, our constants, int digit limit
         raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: {exc}") from exc
     if not isinstance(body, dict):
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: a JSON {type(body).__name__}; "
-                                                   'expected an object {"ops": [...], "overlay": bool}')
+        raise RequestError(
+            HTTPStatus.BAD_REQUEST,
+            f'request body: a JSON {type(body).__name__}; expected an object {{"ops": [...], "overlay": bool}}',
+        )
     unknown = sorted(set(body) - {"ops", "overlay"})
     if unknown:
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: unknown key {short_repr(unknown[0])}; "
-                                                   "expected ops and overlay")
+        raise RequestError(
+            HTTPStatus.BAD_REQUEST, f"request body: unknown key {short_repr(unknown[0])}; expected ops and overlay"
+        )
     ops, overlay = body.get("ops", []), body.get("overlay", False)
     if not isinstance(ops, list):
         raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: ops {short_repr(ops)}: expected a list")
     if not isinstance(overlay, bool):
-        raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: overlay {short_repr(overlay)}: expected true or false")
+        raise RequestError(
+            HTTPStatus.BAD_REQUEST, f"request body: overlay {short_repr(overlay)}: expected true or false"
+        )
     return ops, overlay
 
 
 def _handler(viewer: Viewer):
     class Handler(BaseHTTPRequestHandler):
         server_version = "wirecheck-viewer"
-        timeout = REQUEST_TIMEOUT_S                     # socket timeout: a stalled client frees its thread
+        timeout = REQUEST_TIMEOUT_S  # socket timeout: a stalled client frees its thread
 
         #: a malformed request line is answered with a status line too (http.server's default, HTTP/0.9, has none)
         default_request_version = "HTTP/1.0"
 
-        def log_message(self, fmt, *args):          # quiet: the terminal shows only the URL
+        def log_message(self, fmt, *args):  # quiet: the terminal shows only the URL
             pass
 
         def _send(self, code: int, body: bytes, ctype: str, headers=()) -> None:
@@ -111,7 +117,7 @@ def _handler(viewer: Viewer):
                 self.end_headers()
                 if self.command != "HEAD":
                     self.wfile.write(body)
-            except (ConnectionError, TimeoutError):     # the client went away: nobody to answer
+            except (ConnectionError, TimeoutError):  # the client went away: nobody to answer
                 self.close_connection = True
 
         def _json(self, obj, code=200, headers=()):
@@ -123,7 +129,7 @@ def _handler(viewer: Viewer):
             self._json({"error": message or HTTPStatus(code).phrase}, code)
 
         def _refuse(self, exc: RequestError, headers=()):
-            self.close_connection = True                # the unread rest of a refused body must not be parsed
+            self.close_connection = True  # the unread rest of a refused body must not be parsed
             self._json({"error": str(exc)}, exc.status, headers)
 
         def _check_origin(self) -> None:
@@ -136,17 +142,21 @@ def _handler(viewer: Viewer):
             or post to it directly (the Origin header says its site).
             """
             if not self.path.startswith("/"):  # absolute-form (http://other.site/...) names another server
-                raise RequestError(HTTPStatus.BAD_REQUEST, f"request target {short_repr(self.path)}: expected a path "
-                                                           "starting with /")
-            if self.headers.defects:           # a header line without a colon: the headers after it were dropped
+                raise RequestError(
+                    HTTPStatus.BAD_REQUEST, f"request target {short_repr(self.path)}: expected a path starting with /"
+                )
+            if self.headers.defects:  # a header line without a colon: the headers after it were dropped
                 raise RequestError(HTTPStatus.BAD_REQUEST, "a malformed header line: expected 'Name: value' lines")
-            for name in ONE_ONLY:             # which one counts? a proxy and this server may read different ones
+            for name in ONE_ONLY:  # which one counts? a proxy and this server may read different ones
                 count = len(self.headers.get_all(name) or ())
                 if count > 1:
                     raise RequestError(HTTPStatus.BAD_REQUEST, f"{name} given {count} times: expected one")
-            if self.headers.get("Transfer-Encoding") is not None:     # with a Content-Length: request smuggling
-                raise RequestError(HTTPStatus.BAD_REQUEST, f"Transfer-Encoding {short_repr(self.headers['Transfer-Encoding'])}: "
-                                                           "expected a body of Content-Length bytes")
+            if self.headers.get("Transfer-Encoding") is not None:  # with a Content-Length: request smuggling
+                raise RequestError(
+                    HTTPStatus.BAD_REQUEST,
+                    f"Transfer-Encoding {short_repr(self.headers['Transfer-Encoding'])}: "
+                    "expected a body of Content-Length bytes",
+                )
             port = self.server.server_address[1]
             hosts = (f"127.0.0.1:{port}", f"localhost:{port}")
             host = (self.headers.get("Host") or "").lower()
@@ -157,7 +167,7 @@ def _handler(viewer: Viewer):
                 raise RequestError(HTTPStatus.FORBIDDEN, f"Origin {short_repr(origin)}: expected this viewer's page")
 
         def _path(self) -> str:
-            path = urlsplit(self.path).path              # the query string, if any, is ignored
+            path = urlsplit(self.path).path  # the query string, if any, is ignored
             return "/index.html" if path == "/" else path
 
         def do_GET(self):
@@ -189,9 +199,10 @@ def _handler(viewer: Viewer):
         def _read_body(self) -> bytes:
             """The body, at most MAX_BODY_BYTES; RequestError for a missing, bad or too large length, or a stall."""
             ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
-            if ctype != "application/json":             # a cross-site form or text/plain post cannot say this
-                raise RequestError(HTTPStatus.UNSUPPORTED_MEDIA_TYPE,
-                                   f"Content-Type {short_repr(ctype)}: expected application/json")
+            if ctype != "application/json":  # a cross-site form or text/plain post cannot say this
+                raise RequestError(
+                    HTTPStatus.UNSUPPORTED_MEDIA_TYPE, f"Content-Type {short_repr(ctype)}: expected application/json"
+                )
             text = self.headers.get("Content-Length")
             if text is None:
                 raise RequestError(HTTPStatus.LENGTH_REQUIRED, "Content-Length: missing; expected the body's size")
@@ -199,20 +210,25 @@ def _handler(viewer: Viewer):
                 raise RequestError(HTTPStatus.BAD_REQUEST, f"Content-Length {short_repr(text)}: expected bytes >= 0")
             n = int(text)
             if n > MAX_BODY_BYTES:
-                raise RequestError(HTTPStatus.REQUEST_ENTITY_TOO_LARGE,
-                                   f"Content-Length {n}: expected at most {MAX_BODY_BYTES} bytes")
+                raise RequestError(
+                    HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"Content-Length {n}: expected at most {MAX_BODY_BYTES} bytes"
+                )
             try:
                 raw = self.rfile.read(n)
-            except (ConnectionError, TimeoutError):        # the socket timeout: REQUEST_TIMEOUT_S
+            except (ConnectionError, TimeoutError):  # the socket timeout: REQUEST_TIMEOUT_S
                 raw = b""
             if len(raw) != n:
-                raise RequestError(HTTPStatus.BAD_REQUEST, f"request body: fewer bytes arrived than Content-Length "
-                                                           f"{n} within {REQUEST_TIMEOUT_S:g} s")
+                raise RequestError(
+                    HTTPStatus.BAD_REQUEST,
+                    f"request body: fewer bytes arrived than Content-Length {n} within {REQUEST_TIMEOUT_S:g} s",
+                )
             return raw
 
         def _no_method(self):
-            self._refuse(RequestError(HTTPStatus.METHOD_NOT_ALLOWED, f"method {self.command}: expected GET or POST"),
-                         headers=(("Allow", "GET, POST"),))
+            self._refuse(
+                RequestError(HTTPStatus.METHOD_NOT_ALLOWED, f"method {self.command}: expected GET or POST"),
+                headers=(("Allow", "GET, POST"),),
+            )
 
         do_HEAD = do_PUT = do_DELETE = do_PATCH = do_OPTIONS = _no_method
 
@@ -225,8 +241,9 @@ class _HTTPServer(ThreadingHTTPServer):
     def handle_error(self, request, client_address):
         """A request that failed past the handler's checks: one line on stderr, not a traceback."""
         exc = sys.exc_info()[1]
-        print(f"renderer: viewer: request from {client_address[0]} failed: {type(exc).__name__}: {exc}",
-              file=sys.stderr)
+        print(
+            f"renderer: viewer: request from {client_address[0]} failed: {type(exc).__name__}: {exc}", file=sys.stderr
+        )
 
 
 class Server:
@@ -235,8 +252,9 @@ class Server:
     def __init__(self, viewer: Viewer, port: int = 0, host: str = "127.0.0.1"):
         self.httpd = _HTTPServer((host, port), _handler(viewer))
         self.viewer = viewer
-        self.thread = threading.Thread(target=self.httpd.serve_forever, kwargs={"poll_interval": POLL_S},
-                                       name="wirecheck-viewer", daemon=True)
+        self.thread = threading.Thread(
+            target=self.httpd.serve_forever, kwargs={"poll_interval": POLL_S}, name="wirecheck-viewer", daemon=True
+        )
 
     @property
     def url(self) -> str:

@@ -36,7 +36,7 @@ from .output import bilevel_png_from_rows, bilevel_rows, is_bilevel, png_bytes, 
 #: Fewer frames than this are written in line: forking costs a few ms.
 MIN_FRAMES = 32
 
-_HEADER = struct.Struct(">IIII")      # width, height, length of the path, length of the scanlines
+_HEADER = struct.Struct(">IIII")  # width, height, length of the path, length of the scanlines
 
 
 def can_fork(frames: int) -> bool:
@@ -50,7 +50,7 @@ def can_fork(frames: int) -> bool:
         return False
     try:
         cpus = len(os.sched_getaffinity(0))
-    except AttributeError:          # not Linux
+    except AttributeError:  # not Linux
         cpus = os.cpu_count() or 1
     return cpus >= 2
 
@@ -67,7 +67,7 @@ class ForkedPngWriter:
         to_child, self._pipe = os.pipe()
         errors, self._child_errors = os.pipe()
         pid = os.fork()
-        if pid == 0:                                        # the child: never returns
+        if pid == 0:  # the child: never returns
             os.close(self._pipe)
             os.close(errors)
             _child(to_child, self._child_errors)
@@ -85,7 +85,7 @@ class ForkedPngWriter:
         h, w = image.shape
         try:
             write_all(self._pipe, _HEADER.pack(w, h, len(name), len(rows)) + name + rows)
-        except BrokenPipeError:                             # the child stopped: say why
+        except BrokenPipeError:  # the child stopped: say why
             self._finish()
             raise RuntimeError("frame writer process ended early") from None
 
@@ -116,10 +116,10 @@ class ForkedPngWriter:
     def __exit__(self, exc_type, exc, tb):
         if exc_type is None:
             self._finish()
-        elif self._pid is not None:                         # already failing: wait, keep the first error
+        elif self._pid is not None:  # already failing: wait, keep the first error
             try:
                 self._finish()
-            except Exception:                               # noqa: BLE001 - the caller's error comes first
+            except Exception:  # noqa: BLE001 - the caller's error comes first
                 pass
         return False
 
@@ -128,7 +128,7 @@ def _child(source: int, errors: int) -> None:
     """Read frames from ``source`` until it ends, write each; the first error goes to ``errors``; exit."""
     report = b""
     try:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)        # Ctrl-C: the parent stops, the pipe ends
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent stops, the pipe ends
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         with os.fdopen(source, "rb") as pipe:
             while header := pipe.read(_HEADER.size):
@@ -139,9 +139,13 @@ def _child(source: int, errors: int) -> None:
                     raise EOFError("frame cut short")
                 write_file(path, bilevel_png_from_rows(rows, w, h))
     except OSError as exc:
-        report = b"OSError\0" + "\0".join((str(exc.errno or 0), exc.strerror or str(exc),
-                                           os.fsdecode(exc.filename) if exc.filename else "")).encode()
-    except BaseException as exc:                            # noqa: BLE001 - reported to the parent
+        report = (
+            b"OSError\0"
+            + "\0".join(
+                (str(exc.errno or 0), exc.strerror or str(exc), os.fsdecode(exc.filename) if exc.filename else "")
+            ).encode()
+        )
+    except BaseException as exc:  # noqa: BLE001 - reported to the parent
         report = f"{type(exc).__name__}: {exc}".encode()
     finally:
         try:

@@ -37,8 +37,8 @@ class GifWriter:
     def __init__(self, fh, fps: float = 30.0, progress=None):
         self.fh, self.ms = fh, int(round(1000.0 / fps))
         self.tick = progress or (lambda: None)
-        self.prev = None                  # the last distinct frame
-        self.pending = None               # (descriptor + data bytes) of prev, written when its delay is known
+        self.prev = None  # the last distinct frame
+        self.pending = None  # (descriptor + data bytes) of prev, written when its delay is known
         self.pending_ms = 0
         self.frames_written = 0
 
@@ -108,9 +108,9 @@ def _single_frame_parts(gif: bytes) -> tuple[bytes, int, bytes]:
     pos, table, bits = 13, b"", 0
     if packed & 0x80:
         bits = packed & 7
-        table = gif[pos:pos + 3 * 2 ** (bits + 1)]
+        table = gif[pos : pos + 3 * 2 ** (bits + 1)]
         pos += len(table)
-    while gif[pos] == 0x21:                     # extensions: skip their sub-blocks
+    while gif[pos] == 0x21:  # extensions: skip their sub-blocks
         pos += 2
         while gif[pos]:
             pos += gif[pos] + 1
@@ -119,15 +119,15 @@ def _single_frame_parts(gif: bytes) -> tuple[bytes, int, bytes]:
         raise ValueError("unexpected block in Pillow's GIF")
     ipacked = gif[pos + 9]
     pos += 10
-    if ipacked & 0x80:                          # a local table overrides the global one
+    if ipacked & 0x80:  # a local table overrides the global one
         bits = ipacked & 7
-        table = gif[pos:pos + 3 * 2 ** (bits + 1)]
+        table = gif[pos : pos + 3 * 2 ** (bits + 1)]
         pos += len(table)
     start = pos
-    pos += 1                                    # LZW minimum code size
+    pos += 1  # LZW minimum code size
     while gif[pos]:
         pos += gif[pos] + 1
-    return table, bits, gif[start:pos + 1]
+    return table, bits, gif[start : pos + 1]
 
 
 def gif_bytes(images, fps: float = 30.0, progress=None) -> bytes:

@@ -53,9 +53,14 @@ def what_is(fd: int) -> str | None:
 
 
 def _kind(mode: int) -> str:
-    for test, name in ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISDIR, "a folder"), (stat.S_ISSOCK, "a socket"),
-                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-                       (stat.S_ISLNK, "a symbolic link")):
+    for test, name in (
+        (stat.S_ISFIFO, "a FIFO"),
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISLNK, "a symbolic link"),
+    ):
         if test(mode):
             return name
     return "not a regular file"
@@ -67,9 +72,11 @@ def _pid(fd: int) -> str:
 
 
 def _refusal(option: str, what: str, path: Path, kind: str) -> InputError:
-    return InputError(f"{option} {what!r}: {str(path)!r} is {kind}, not a lock of wirecheck's: nothing was "
-                      "changed; expected wirecheck's own lock file or none there (remove or rename it if no "
-                      "wirecheck run is writing there)")
+    return InputError(
+        f"{option} {what!r}: {str(path)!r} is {kind}, not a lock of wirecheck's: nothing was "
+        "changed; expected wirecheck's own lock file or none there (remove or rename it if no "
+        "wirecheck run is writing there)"
+    )
 
 
 def _open_existing(path: Path, option: str, what: str) -> int | None:
@@ -81,9 +88,11 @@ def _open_existing(path: Path, option: str, what: str) -> int | None:
     except OSError as exc:
         kind = {errno.ELOOP: "a symbolic link", errno.ENXIO: "a socket"}.get(exc.errno)
         if kind is None:
-            raise InputError(f"{option} {what!r}: cannot open {str(path)!r} ({exc.strerror}): expected wirecheck's "
-                             "own lock file or none there (remove or rename it if no wirecheck run is writing "
-                             "there)") from None
+            raise InputError(
+                f"{option} {what!r}: cannot open {str(path)!r} ({exc.strerror}): expected wirecheck's "
+                "own lock file or none there (remove or rename it if no wirecheck run is writing "
+                "there)"
+            ) from None
         raise _refusal(option, what, path, kind) from None
 
 
@@ -92,12 +101,14 @@ def _create_locked(path: Path, option: str, what: str) -> int | None:
     try:
         fd, tmp = tempfile.mkstemp(prefix=f"{path.name}.", suffix=".tmp", dir=path.parent)
     except OSError as exc:
-        raise InputError(f"{option} {what!r}: cannot create {path.name} there ({exc.strerror}): "
-                         "expected a writable folder and a shorter name") from None
+        raise InputError(
+            f"{option} {what!r}: cannot create {path.name} there ({exc.strerror}): "
+            "expected a writable folder and a shorter name"
+        ) from None
     try:
         os.write(fd, f"{PREFIX}{os.getpid()}\n".encode())
         os.fchmod(fd, 0o644)
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)       # a new file: nobody else has it
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # a new file: nobody else has it
         if not rename_noreplace(tmp, path, counted=False):
             os.unlink(tmp)
             os.close(fd)
@@ -123,7 +134,7 @@ class Lock:
                 return
             fd = _open_existing(self.path, option, what)
             if fd is None:
-                continue                                      # released and removed meanwhile: try again
+                continue  # released and removed meanwhile: try again
             try:
                 kind = what_is(fd)
                 if kind is not None:
@@ -133,8 +144,10 @@ class Lock:
                 except BlockingIOError:
                     pid = _pid(fd)
                     who = f" (process {pid})" if pid else ""
-                    raise InputError(f"{option} {what!r} is being written by another wirecheck run{who}: "
-                                     "expected one run per output at a time; wait for it or write elsewhere") from None
+                    raise InputError(
+                        f"{option} {what!r} is being written by another wirecheck run{who}: "
+                        "expected one run per output at a time; wait for it or write elsewhere"
+                    ) from None
                 # a lock of ours that nobody holds: its process is gone. Removed under its own lock, if still there
                 if _same(fd, self.path) and what_is(fd) is None:
                     os.unlink(self.path)
@@ -145,7 +158,7 @@ class Lock:
     def release(self) -> None:
         if self.fd is None:
             return
-        if _same(self.fd, self.path):        # still ours and still locked: nobody else can hold it now
+        if _same(self.fd, self.path):  # still ours and still locked: nobody else can hold it now
             os.unlink(self.path)
         os.close(self.fd)
         self.fd = None
@@ -178,4 +191,4 @@ def holder(path: Path) -> str | None:
             return f"process {pid}" if pid else ""
         return None
     finally:
-        os.close(fd)      # drops the probe's shared lock, if taken
+        os.close(fd)  # drops the probe's shared lock, if taken

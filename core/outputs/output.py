@@ -17,16 +17,27 @@ from pathlib import Path
 
 import numpy as np
 
-from .owned import MARKER
-from .owned import TAG as _TAG
-from .gif import gif_bytes as encode
 from ..errors import InputError
-from . import owned
-from .owned import TAG, exchange, is_leftover, is_regular, listing, ours, remove_tree, rename, rename_noreplace, \
-    retire, step
 from ..scene import files as scene_files
 from ..scene.files import MESH_SUFFIXES, NATIVE_SUFFIX
+from . import owned
+from .gif import gif_bytes as encode
 from .lockfile import Lock
+from .owned import (
+    MARKER,
+    TAG,
+    exchange,
+    is_leftover,
+    is_regular,
+    listing,
+    ours,
+    remove_tree,
+    rename,
+    rename_noreplace,
+    retire,
+    step,
+)
+from .owned import TAG as _TAG
 
 
 def _umask() -> int:
@@ -41,7 +52,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())   # mkstemp makes 0600; give the usual mode
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -62,7 +73,7 @@ def write_all(fd: int, data: bytes) -> None:
     """Every byte of ``data`` to the file descriptor ``fd`` (``os.write`` may write fewer)."""
     view = memoryview(data)
     while view:
-        view = view[os.write(fd, view):]
+        view = view[os.write(fd, view) :]
 
 
 def atomic_write_text(path: Path, text: str) -> None:
@@ -120,7 +131,7 @@ def bilevel_rows(image: np.ndarray) -> bytes:
     ``(H, W)`` image in, ``H * (ceil(W / 8) + 1)`` bytes out (what IDAT compresses).
     """
     h, w = image.shape
-    rows = np.zeros((h, (w + 7) // 8 + 1), np.uint8)          # column 0: the row's filter byte (0, None)
+    rows = np.zeros((h, (w + 7) // 8 + 1), np.uint8)  # column 0: the row's filter byte (0, None)
     on = image >= 128
     # most significant bit = leftmost pixel; rows of whole bytes pack as one run (~3x quicker than axis=1)
     rows[:, 1:] = np.packbits(on.reshape(-1)).reshape(h, w // 8) if w % 8 == 0 else np.packbits(on, axis=1)
@@ -129,9 +140,13 @@ def bilevel_rows(image: np.ndarray) -> bytes:
 
 def bilevel_png_from_rows(rows: bytes, width: int, height: int) -> bytes:
     """The 1-bit greyscale PNG of :func:`bilevel_rows`' scanlines of a ``width x height`` image."""
-    header = struct.pack(">IIBBBBB", width, height, 1, 0, 0, 0, 0)    # bit depth 1, colour type 0 (grey)
-    return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", header)
-            + _png_chunk(b"IDAT", zlib.compress(rows, BILEVEL_ZLIB_LEVEL)) + _png_chunk(b"IEND", b""))
+    header = struct.pack(">IIBBBBB", width, height, 1, 0, 0, 0, 0)  # bit depth 1, colour type 0 (grey)
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + _png_chunk(b"IHDR", header)
+        + _png_chunk(b"IDAT", zlib.compress(rows, BILEVEL_ZLIB_LEVEL))
+        + _png_chunk(b"IEND", b"")
+    )
 
 
 def _png_chunk(kind: bytes, data: bytes) -> bytes:
@@ -144,14 +159,14 @@ def ascii_frame(image: np.ndarray, cols: int = 80) -> str:
     Character cells are about twice as tall as wide, so a cell covers
     ``W / cols`` pixels across and twice that down.
     """
-    if image.ndim == 3:                          # RGB (--axes): a cell is drawn when any channel is
+    if image.ndim == 3:  # RGB (--axes): a cell is drawn when any channel is
         image = np.maximum(np.maximum(image[:, :, 0], image[:, :, 1]), image[:, :, 2])
     h, w = image.shape[:2]
     cols = max(1, min(cols, w))
     rows = max(1, min(h, int(round(cols * h / w / 2.0))))
     c_edges = (np.arange(cols) * w) // cols
     r_edges = (np.arange(rows) * h) // rows
-    on = (image >= 128).astype(np.int32)         # drawn: 255, or aa coverage >= 1/2
+    on = (image >= 128).astype(np.int32)  # drawn: 255, or aa coverage >= 1/2
     cells = np.add.reduceat(np.add.reduceat(on, r_edges, axis=0), c_edges, axis=1) > 0
     lines = ["".join("#" if v else "." for v in row) for row in cells]
     return "\n".join(lines) + "\n"
@@ -228,7 +243,7 @@ class Mp4Writer:
             st = self.container.add_stream(MP4_CODEC, rate=self.fps, options=dict(MP4_OPTIONS))
             st.width, st.height = im.shape[1], im.shape[0]
             st.pix_fmt = "yuv420p"
-            st.codec_context.thread_count = 1          # deterministic bytes (MP4_OPTIONS)
+            st.codec_context.thread_count = 1  # deterministic bytes (MP4_OPTIONS)
             st.codec_context.thread_type = "NONE"
             self.stream, self.size = st, im.shape[:2]
         if im.shape[:2] != self.size:
@@ -254,7 +269,7 @@ class Mp4Writer:
     def abort(self) -> None:
         try:
             self.container.close()
-        except Exception:       # noqa: BLE001 - cleaning up after another error
+        except Exception:  # noqa: BLE001 - cleaning up after another error
             pass
         if self.final is not None and os.path.exists(self.tmp):
             os.unlink(self.tmp)
@@ -300,14 +315,18 @@ def check_replaceable(path: Path, option: str) -> None:
     if path.is_dir() and not path.is_symlink() and is_regular(path / MARKER):
         drawn = _users_frames(path)
         if drawn is not None:
-            raise InputError(f"{option} {str(path)!r} is a frames job holding files a renderer wrote ({drawn}): "
-                             "expected a new path or an earlier wirecheck output (nothing was changed; "
-                             "move the frames away first)")
+            raise InputError(
+                f"{option} {str(path)!r} is a frames job holding files a renderer wrote ({drawn}): "
+                "expected a new path or an earlier wirecheck output (nothing was changed; "
+                "move the frames away first)"
+            )
     why = ours(path)
     if why is None:
         return
-    raise InputError(f"{option} {str(path)!r} is {why}: expected a new path or an earlier wirecheck "
-                     "output (nothing was changed; move it away first)")
+    raise InputError(
+        f"{option} {str(path)!r} is {why}: expected a new path or an earlier wirecheck "
+        "output (nothing was changed; move it away first)"
+    )
 
 
 def check_outside_scenes(path: Path, option: str, expected: str) -> None:
@@ -315,7 +334,7 @@ def check_outside_scenes(path: Path, option: str, expected: str) -> None:
     scenes in later runs. ``expected``: what to give instead, for the message."""
     try:
         resolved = Path(path).resolve()
-    except (RuntimeError, OSError) as exc:         # a symbolic link loop: Python 3.11 raises RuntimeError
+    except (RuntimeError, OSError) as exc:  # a symbolic link loop: Python 3.11 raises RuntimeError
         raise InputError(f"{option} {str(path)!r}: {exc}: expected a folder path") from None
     scenes = scene_files.SCENE_DIR
     if resolved == scenes or scenes in resolved.parents:
@@ -333,16 +352,20 @@ def check_report_dir(path: Path, option: str) -> None:
     path = Path(path)
     long = next((part for part in path.parts if len(os.fsencode(part)) > 255), None)
     if long is not None:
-        raise InputError(f"{option} {str(path)[:60]!r}...: a name of {len(long)} characters: expected at most 255 "
-                         "bytes per folder name")
+        raise InputError(
+            f"{option} {str(path)[:60]!r}...: a name of {len(long)} characters: expected at most 255 "
+            "bytes per folder name"
+        )
     parent = path.parent
     while not parent.exists() and not parent.is_symlink() and parent != parent.parent:
         parent = parent.parent
-    created = path.relative_to(parent).parts          # the folders a report would create
+    created = path.relative_to(parent).parts  # the folders a report would create
     named = next((p for p in created if Path(p).suffix.lower() in (NATIVE_SUFFIX, ".txt", *MESH_SUFFIXES)), None)
     if named is not None:
-        raise InputError(f"{option} {str(path)!r}: a folder named like a scene file ({named}) would be "
-                         "taken for a scene by later runs: expected another name")
+        raise InputError(
+            f"{option} {str(path)!r}: a folder named like a scene file ({named}) would be "
+            "taken for a scene by later runs: expected another name"
+        )
     check_outside_scenes(path, option, "a report folder elsewhere (reports/ by default)")
     if not parent.is_dir():
         raise InputError(f"{option} {str(path)!r}: {str(parent)!r} is not a directory: expected a folder path")
@@ -444,7 +467,7 @@ class FrameDir:
         self._lock = held[0] if held is not None else Lock(_lock_path(self.final), option, str(self.final))
         try:
             self._remove_leftovers()
-            check_replaceable(self.final, option)        # again, under the lock
+            check_replaceable(self.final, option)  # again, under the lock
             self.tmp = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.", suffix=".tmp", dir=self.final.parent))
             (self.tmp / _TAG).write_bytes(b"")
             os.chmod(self.tmp, 0o777 & ~_umask())
@@ -457,13 +480,18 @@ class FrameDir:
         """Remove the temporaries of killed runs for this ``final`` (ours alone: no live run holds the lock)."""
         prefix = f".{self.final.name}."
         for entry in os.scandir(self.final.parent):
-            unique = entry.name[len(prefix):-len(".tmp")]
-            if not (entry.name.startswith(prefix) and entry.name.endswith(".tmp") and len(unique) == 8
-                    and unique.replace("_", "").isalnum() and entry.is_dir(follow_symlinks=False)):
+            unique = entry.name[len(prefix) : -len(".tmp")]
+            if not (
+                entry.name.startswith(prefix)
+                and entry.name.endswith(".tmp")
+                and len(unique) == 8
+                and unique.replace("_", "").isalnum()
+                and entry.is_dir(follow_symlinks=False)
+            ):
                 continue
             if is_regular(Path(entry.path) / TAG):
                 if is_leftover(Path(entry.path)):
-                    remove_tree(entry.path)      # being filled when its run was killed: all ours
+                    remove_tree(entry.path)  # being filled when its run was killed: all ours
             elif listing(Path(entry.path)) is not None:
                 # an old folder swapped out by a run killed before removing it: by its listing; what the user
                 # wrote into it meanwhile goes into the folder in place (core.outputs.owned.retire)
@@ -475,13 +503,13 @@ class FrameDir:
     def commit(self) -> None:
         """Swap the new folder in, then remove the old one by its listing; InputError (after the swap) when
         a file the user wrote meanwhile was kept (class docstring)."""
-        check_replaceable(self.final, self.option)   # again: it may have changed meanwhile
-        step()                                       # checked: the old folder is checked again after the swap
-        owned.seal(self.tmp)                         # read off its module: tests pause a commit there
-        os.unlink(self.tmp / _TAG)                   # sealed: its listing marks it as ours from here on
+        check_replaceable(self.final, self.option)  # again: it may have changed meanwhile
+        step()  # checked: the old folder is checked again after the swap
+        owned.seal(self.tmp)  # read off its module: tests pause a commit there
+        os.unlink(self.tmp / _TAG)  # sealed: its listing marks it as ours from here on
         kept = self.kept
         if os.path.lexists(self.final) and exchange(self.tmp, self.final):
-            swapped, self.tmp = self.tmp, None       # it holds the old folder now: never removed whole
+            swapped, self.tmp = self.tmp, None  # it holds the old folder now: never removed whole
             kept += retire(swapped, self.final)
         elif os.path.lexists(self.final):
             # no exchange here: the old set moves into a new, uniquely named temporary first
@@ -493,18 +521,20 @@ class FrameDir:
                 kept += retire(old / "old", self.final)
                 os.unlink(old / _TAG)
                 _rmdir_quiet(old)
-            else:                                    # a folder appeared in its place meanwhile: both stay
+            else:  # a folder appeared in its place meanwhile: both stay
                 kept += [self.final.name, str(old.relative_to(self.final.parent))]
         elif rename_noreplace(self.tmp, self.final):
             self.tmp = None
         else:
-            kept += [self.final.name]                 # a folder appeared in its place meanwhile: it stays
+            kept += [self.final.name]  # a folder appeared in its place meanwhile: it stays
         self.abort()
         if kept:
-            raise InputError(f"{self.option} {str(self.final)!r}: {', '.join(kept[:3])}"
-                             f"{' ...' if len(kept) > 3 else ''} written or changed during the commit: kept "
-                             "(nothing of it was removed); expected no writes into an output folder while "
-                             "wirecheck replaces it (move them away before the next run)")
+            raise InputError(
+                f"{self.option} {str(self.final)!r}: {', '.join(kept[:3])}"
+                f"{' ...' if len(kept) > 3 else ''} written or changed during the commit: kept "
+                "(nothing of it was removed); expected no writes into an output folder while "
+                "wirecheck replaces it (move them away before the next run)"
+            )
 
     def abort(self) -> None:
         if self.tmp is not None:
@@ -516,4 +546,3 @@ class FrameDir:
             else:
                 self._lock.release()
             self._lock = None
-

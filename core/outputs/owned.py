@@ -141,10 +141,10 @@ def listing(folder: Path) -> tuple[dict, set] | None:
     """``({file: sha256}, {folder})`` from ``folder``'s MARKER; None when there is no marker of ours."""
     try:
         text = read_regular(Path(folder) / MARKER, MAX_MARKER_BYTES).decode("utf-8")
-    except (ValueError, OSError):        # UnicodeDecodeError is a ValueError
+    except (ValueError, OSError):  # UnicodeDecodeError is a ValueError
         return None
     if text == "":
-        return {}, set()            # an earlier wirecheck's empty marker: lists nothing
+        return {}, set()  # an earlier wirecheck's empty marker: lists nothing
     try:
         data = json.loads(text)
         files, folders = data["files"], data["folders"]
@@ -311,7 +311,7 @@ def remove_tree(folder: Path) -> None:
             dirs.append(Path(entry.path))
         else:
             _unlink_quiet(entry.path)
-    for d in reversed(dirs):            # children before parents
+    for d in reversed(dirs):  # children before parents
         try:
             os.rmdir(d)
         except FileNotFoundError:
@@ -341,17 +341,21 @@ def _remove_listed(folder: Path) -> None:
                 continue
             try:
                 st = os.fstat(fd)
-                if (stat.S_ISREG(st.st_mode) and st.st_nlink == 1 and hash_fd(fd) == files[rel]
-                        and os.path.samestat(st, os.lstat(entry.path))):
+                if (
+                    stat.S_ISREG(st.st_mode)
+                    and st.st_nlink == 1
+                    and hash_fd(fd) == files[rel]
+                    and os.path.samestat(st, os.lstat(entry.path))
+                ):
                     os.unlink(entry.path)
             finally:
                 os.close(fd)
     for d in reversed(dirs):
         try:
             os.rmdir(d)
-        except OSError:          # not empty: a file of the user's is in it
+        except OSError:  # not empty: a file of the user's is in it
             pass
-    if listed is not None:                # the listing read above: ours, whatever is left beside it
+    if listed is not None:  # the listing read above: ours, whatever is left beside it
         _unlink_quiet(Path(folder) / MARKER)
     if is_regular(Path(folder) / TAG):
         _unlink_quiet(Path(folder) / TAG)
@@ -372,7 +376,7 @@ def retire(old: Path, live: Path) -> list[str]:
     _remove_listed(old)
     if not os.path.lexists(old):
         return []
-    if not os.path.lexists(live):            # the folder in place is gone: the old one goes back whole
+    if not os.path.lexists(live):  # the folder in place is gone: the old one goes back whole
         if rename_noreplace(old, live):
             return [live.name]
     kept = []
@@ -392,7 +396,7 @@ def retire(old: Path, live: Path) -> list[str]:
                 free = target.with_name(f"{target.name}.kept{n if n > 1 else ''}")
                 n += 1
             kept.append(f"{live.name}/{free.relative_to(live)}")
-    remove_tree(old)                          # empty folders only, now
+    remove_tree(old)  # empty folders only, now
     return kept
 
 

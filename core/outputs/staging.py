@@ -49,8 +49,8 @@ import stat
 import tempfile
 from pathlib import Path
 
-from . import owned
 from ..errors import InputError
+from . import owned
 from .lockfile import Lock, holder
 from .owned import MARKER, TAG, is_dir_here, is_regular, read_regular, remove_tree, retire, sha256
 
@@ -81,8 +81,10 @@ def _read_json(path: Path, key: str, option: str) -> dict | None:
             raise ValueError("not ours")
         return data
     except (OSError, ValueError, KeyError, TypeError, AttributeError, UnicodeDecodeError):
-        raise InputError(f"{option} {str(path.parent)!r}: {path.name} there was not written by wirecheck: expected "
-                         "an output folder of wirecheck's or a new one (nothing was changed; move it away)") from None
+        raise InputError(
+            f"{option} {str(path.parent)!r}: {path.name} there was not written by wirecheck: expected "
+            "an output folder of wirecheck's or a new one (nothing was changed; move it away)"
+        ) from None
 
 
 def read_manifest(out: Path, option: str) -> dict:
@@ -91,8 +93,10 @@ def read_manifest(out: Path, option: str) -> dict:
     if data is None:
         return {}
     if not isinstance(data.get("files"), dict):
-        raise InputError(f"{option} {str(out)!r}: {MANIFEST} there was not written by wirecheck: expected an "
-                         "output folder of wirecheck's or a new one (nothing was changed; move it away)")
+        raise InputError(
+            f"{option} {str(out)!r}: {MANIFEST} there was not written by wirecheck: expected an "
+            "output folder of wirecheck's or a new one (nothing was changed; move it away)"
+        )
     return {str(k): str(v) for k, v in data["files"].items()}
 
 
@@ -103,16 +107,23 @@ def _journal_fault(data, out: Path, names) -> str | None:
     tmp, listed, folders, manifest = (data.get(k) for k in ("tmp", "names", "folders", "manifest"))
     if not (isinstance(tmp, str) and _TMP.fullmatch(tmp)):
         return "its temporary folder is not named .wirecheck-<unique>.tmp"
-    if not (isinstance(listed, list) and all(isinstance(n, str) and n and "/" not in n and not n.startswith(".")
-                                             for n in listed)):
+    if not (
+        isinstance(listed, list)
+        and all(isinstance(n, str) and n and "/" not in n and not n.startswith(".") for n in listed)
+    ):
         return "'names' is not a list of output names"
     other = next((n for n in listed if names is not None and n not in names), None)
     if other is not None:
         return f"it names {other!r}, not an output of this run"
     if not (isinstance(folders, list) and all(isinstance(f, str) and f in listed for f in folders)):
         return "'folders' is not a list of the names it moves"
-    if not (isinstance(manifest, dict) and all(isinstance(k, str) and k and "/" not in k and isinstance(v, str)
-                                               and _HEX64.fullmatch(v) for k, v in manifest.items())):
+    if not (
+        isinstance(manifest, dict)
+        and all(
+            isinstance(k, str) and k and "/" not in k and isinstance(v, str) and _HEX64.fullmatch(v)
+            for k, v in manifest.items()
+        )
+    ):
         return "'manifest' is not a list of names and SHA-256 hashes"
     if not is_dir_here(out / tmp):
         return f"its temporary folder {tmp} is not there"
@@ -129,13 +140,15 @@ def _read_journal(out: Path, option: str, names=None) -> dict | None:
     try:
         data = json.loads(read_regular(path, MAX_JSON_BYTES).decode("utf-8"))
         why = _journal_fault(data, Path(out), names)
-    except ValueError as exc:          # not readable, not UTF-8, not JSON
+    except ValueError as exc:  # not readable, not UTF-8, not JSON
         why = str(exc) if str(exc)[:2] in ("a ", "no") else "not a journal of wirecheck's"
     if why is not None:
-        raise InputError(f"{option} {str(out)!r}: {JOURNAL} there cannot be finished ({why}): nothing was "
-                         "changed; expected a journal naming only this run's outputs and its own temporary "
-                         "folder (rerun the command that was stopped there to finish its commit, or delete "
-                         f"{str(path)!r} if no wirecheck run was stopped there)")
+        raise InputError(
+            f"{option} {str(out)!r}: {JOURNAL} there cannot be finished ({why}): nothing was "
+            "changed; expected a journal naming only this run's outputs and its own temporary "
+            "folder (rerun the command that was stopped there to finish its commit, or delete "
+            f"{str(path)!r} if no wirecheck run was stopped there)"
+        )
     return data
 
 
@@ -169,8 +182,10 @@ def check_replaceable(out: Path, name: str, known: dict, option: str, folder: bo
         return
     else:
         kind = "a file not written by wirecheck" if name not in known else "a file changed since wirecheck wrote it"
-    raise InputError(f"{option} {str(path)!r} is {kind}: expected a new path or an earlier wirecheck output "
-                     "(nothing was changed; move it away first)")
+    raise InputError(
+        f"{option} {str(path)!r} is {kind}: expected a new path or an earlier wirecheck output "
+        "(nothing was changed; move it away first)"
+    )
 
 
 def check_out(out: Path, names, option: str = "--out", _locked: bool = False) -> None:
@@ -200,16 +215,18 @@ def check_out(out: Path, names, option: str = "--out", _locked: bool = False) ->
             check_replaceable(out, name, known, option, name in folders)
     except InputError:
         if not _locked:
-            _refuse_if_locked(out, option)     # another run moving its outputs in: say that instead
+            _refuse_if_locked(out, option)  # another run moving its outputs in: say that instead
         raise
 
 
 def _refuse_if_locked(out: Path, option: str) -> None:
     who = holder(out / LOCK)
     if who is not None:
-        raise InputError(f"{option} {str(out)!r} is being written by another wirecheck run"
-                         f"{f' ({who})' if who else ''}: expected one run per output folder at a time; "
-                         "wait for it or use another --out")
+        raise InputError(
+            f"{option} {str(out)!r} is being written by another wirecheck run"
+            f"{f' ({who})' if who else ''}: expected one run per output folder at a time; "
+            "wait for it or use another --out"
+        )
 
 
 def _write_json(path: Path, obj: dict, option: str | None = None) -> None:
@@ -224,9 +241,11 @@ def _write_json(path: Path, obj: dict, option: str | None = None) -> None:
         if option is None:
             owned.rename(tmp, path)
         elif not owned.rename_noreplace(tmp, path):
-            raise InputError(f"{option} {str(path)!r} appeared while wirecheck was about to move its outputs in: "
-                             "it was kept and nothing was moved; expected no writes into an output folder during "
-                             "a run (move it away and run again)")
+            raise InputError(
+                f"{option} {str(path)!r} appeared while wirecheck was about to move its outputs in: "
+                "it was kept and nothing was moved; expected no writes into an output folder during "
+                "a run (move it away and run again)"
+            )
     except BaseException:
         if os.path.lexists(tmp):
             os.unlink(tmp)
@@ -246,9 +265,11 @@ def _move_in(out: Path, tmp: Path, names, option: str) -> None:
         if os.path.lexists(dst) and not os.path.lexists(tmp / f".old-{name}"):
             owned.rename(dst, tmp / f".old-{name}")
         if not owned.rename_noreplace(src, dst):
-            raise InputError(f"{option} {str(dst)!r} appeared while wirecheck moved its outputs in: it was kept; "
-                             f"expected no writes into {str(out)!r} during a run (move it away and run again to "
-                             "finish the commit)")
+            raise InputError(
+                f"{option} {str(dst)!r} appeared while wirecheck moved its outputs in: it was kept; "
+                f"expected no writes into {str(out)!r} during a run (move it away and run again to "
+                "finish the commit)"
+            )
 
 
 def _retire_file(old: Path, live: Path, known: set) -> list[str]:
@@ -261,8 +282,12 @@ def _retire_file(old: Path, live: Path, known: set) -> list[str]:
     if fd is not None:
         try:
             st = os.fstat(fd)
-            ours = (stat.S_ISREG(st.st_mode) and st.st_nlink == 1 and owned.hash_fd(fd) in known
-                    and os.path.samestat(st, os.lstat(old)))
+            ours = (
+                stat.S_ISREG(st.st_mode)
+                and st.st_nlink == 1
+                and owned.hash_fd(fd) in known
+                and os.path.samestat(st, os.lstat(old))
+            )
         finally:
             os.close(fd)
         if ours:
@@ -312,10 +337,12 @@ def _finish(out: Path, journal: dict, option: str, check: bool = True, known: di
     (out / JOURNAL).unlink()
     remove_tree(tmp)
     if kept:
-        raise InputError(f"{option} {str(out)!r}: {', '.join(kept[:3])}{' ...' if len(kept) > 3 else ''} "
-                         f"({len(kept)} file{'s' if len(kept) > 1 else ''}) written or changed during the commit: "
-                         "kept beside the new outputs, which are in place; expected no writes into an output "
-                         "folder while wirecheck replaces it (move them away before the next run)")
+        raise InputError(
+            f"{option} {str(out)!r}: {', '.join(kept[:3])}{' ...' if len(kept) > 3 else ''} "
+            f"({len(kept)} file{'s' if len(kept) > 1 else ''}) written or changed during the commit: "
+            "kept beside the new outputs, which are in place; expected no writes into an output "
+            "folder while wirecheck replaces it (move them away before the next run)"
+        )
 
 
 def _recover(out: Path, option: str, names=None) -> None:
@@ -329,7 +356,7 @@ def _recover(out: Path, option: str, names=None) -> None:
                 remove_tree(entry.path)
             else:
                 try:
-                    os.rmdir(entry.path)      # killed between its creation and its tag: empty
+                    os.rmdir(entry.path)  # killed between its creation and its tag: empty
                 except OSError:
                     pass
         elif entry.is_file(follow_symlinks=False) and _TMP_FILE.fullmatch(entry.name):
@@ -371,7 +398,7 @@ class Staging:
         for folder in reversed(missing):
             try:
                 folder.mkdir()
-            except FileExistsError:      # another run made it meanwhile: not ours to remove
+            except FileExistsError:  # another run made it meanwhile: not ours to remove
                 continue
             self.created.append(folder)
 
@@ -382,30 +409,35 @@ class Staging:
     def commit(self) -> None:
         """Check every target, then move every staged output into place under a journal (rule 3)."""
         blocked = {signal.SIGINT, signal.SIGTERM}
-        signal.pthread_sigmask(signal.SIG_BLOCK, blocked)    # the moves finish together: no mixed set
+        signal.pthread_sigmask(signal.SIG_BLOCK, blocked)  # the moves finish together: no mixed set
         try:
             known = _known(self.out, self.option, self.names)
             manifest = read_manifest(self.out, self.option)
             staged = [n for n in self.names if os.path.lexists(self.tmp / n)]
-            for name in staged:              # every target, before the first move
+            for name in staged:  # every target, before the first move
                 check_replaceable(self.out, name, known, self.option, name in self.folders)
-            owned.step()                     # checked: what is removed is checked again after the moves (rule 5)
+            owned.step()  # checked: what is removed is checked again after the moves (rule 5)
             for name in staged:
                 if name in self.folders:
                     owned.seal(self.tmp / name)
                     manifest.pop(name, None)
                 else:
                     manifest[name] = sha256(self.tmp / name)
-            journal = {"wirecheck_journal": 1, "tmp": self.tmp.name, "names": staged,
-                       "folders": sorted(self.folders & set(staged)), "manifest": manifest}
+            journal = {
+                "wirecheck_journal": 1,
+                "tmp": self.tmp.name,
+                "names": staged,
+                "folders": sorted(self.folders & set(staged)),
+                "manifest": manifest,
+            }
             _write_json(self.out / JOURNAL, journal, self.option)
-            self._journaled = True           # from here on the next run can finish it: keep the temporaries
+            self._journaled = True  # from here on the next run can finish it: keep the temporaries
             _finish(self.out, journal, self.option, check=False, known=known)
             self.tmp = None
-            self.created = []                # the outputs live there now
+            self.created = []  # the outputs live there now
         finally:
             self.abort()
-            signal.pthread_sigmask(signal.SIG_UNBLOCK, blocked)     # a pending signal is raised here
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, blocked)  # a pending signal is raised here
 
     def abort(self) -> None:
         """Remove the temporaries (unless a journal names them), the lock, and the folders this run created."""

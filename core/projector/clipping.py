@@ -47,18 +47,16 @@ def frustum_planes(camera: Camera, guard_px: float = 0.0, sides: bool = True) ->
     planes = [[0.0, 0.0, 1.0, -camera.near], [0.0, 0.0, -1.0, camera.far]]
     if sides:
         cx, cy = camera.principal_point
-        left = cx + 0.5 + guard_px               # pixels from cx to the left edge
+        left = cx + 0.5 + guard_px  # pixels from cx to the left edge
         right = camera.width - 0.5 + guard_px - cx
         top = cy + 0.5 + guard_px
         bottom = camera.height - 0.5 + guard_px - cy
         if camera.projection == "perspective":
-            fx, fy = camera.focal_xy          # a distorted camera: the undistorted frustum (core.projector.distortion)
-            planes += [[fx, 0.0, left, 0.0], [-fx, 0.0, right, 0.0],
-                       [0.0, -fy, top, 0.0], [0.0, fy, bottom, 0.0]]
+            fx, fy = camera.focal_xy  # a distorted camera: the undistorted frustum (core.projector.distortion)
+            planes += [[fx, 0.0, left, 0.0], [-fx, 0.0, right, 0.0], [0.0, -fy, top, 0.0], [0.0, fy, bottom, 0.0]]
         else:
             s = camera.height / camera.ortho_height
-            planes += [[s, 0.0, 0.0, left], [-s, 0.0, 0.0, right],
-                       [0.0, -s, 0.0, top], [0.0, s, 0.0, bottom]]
+            planes += [[s, 0.0, 0.0, left], [-s, 0.0, 0.0, right], [0.0, -s, 0.0, top], [0.0, s, 0.0, bottom]]
     return np.asarray(planes, dtype=np.float64)
 
 
@@ -71,28 +69,33 @@ def clip_segments(seg_cam: np.ndarray, planes: np.ndarray) -> tuple[np.ndarray, 
     p0 = seg_cam[:, 0, :]
     p1 = seg_cam[:, 1, :]
     m = len(seg_cam)
-    t_enter = np.zeros(m, dtype=seg_cam.dtype)       # in the run's dtype (float32 or float64)
+    t_enter = np.zeros(m, dtype=seg_cam.dtype)  # in the run's dtype (float32 or float64)
     t_exit = np.ones(m, dtype=seg_cam.dtype)
     kept = np.ones(m, dtype=bool)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # inf/NaN are handled below
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inf/NaN are handled below
         for n_x, n_y, n_z, d in planes:
             d0 = n_x * p0[:, 0] + n_y * p0[:, 1] + n_z * p0[:, 2] + d
             d1 = n_x * p1[:, 0] + n_y * p1[:, 1] + n_z * p1[:, 2] + d
             out0 = d0 < 0
             out1 = d1 < 0
-            kept &= ~(out0 & out1)                          # case 2
+            kept &= ~(out0 & out1)  # case 2
             t_cross = d0 / (d0 - d1)
-            enter = out0 & ~out1                            # case 3
+            enter = out0 & ~out1  # case 3
             t_enter = np.where(enter, np.maximum(t_enter, t_cross), t_enter)
-            leave = ~out0 & out1                            # case 4
+            leave = ~out0 & out1  # case 4
             t_exit = np.where(leave, np.minimum(t_exit, t_cross), t_exit)
-            kept &= ~(np.isnan(d0) | np.isnan(d1))          # NaN input: dropped
-    kept &= t_enter <= t_exit                               # case 5
+            kept &= ~(np.isnan(d0) | np.isnan(d1))  # NaN input: dropped
+    kept &= t_enter <= t_exit  # case 5
     return kept, t_enter, t_exit
 
 
-def apply_clip(seg_cam: np.ndarray, kept: np.ndarray, t_enter: np.ndarray, t_exit: np.ndarray,
-               depth_range: tuple[float, float] | None = None) -> np.ndarray:
+def apply_clip(
+    seg_cam: np.ndarray,
+    kept: np.ndarray,
+    t_enter: np.ndarray,
+    t_exit: np.ndarray,
+    depth_range: tuple[float, float] | None = None,
+) -> np.ndarray:
     """The kept parts of the segments, ``(K, 2, 3)``.
 
     ``p0 + t (p1 - p0)`` loses about ``eps * |p|`` of absolute precision: at
@@ -119,14 +122,15 @@ def clip_edges(seg_cam: np.ndarray, camera: Camera) -> tuple[np.ndarray, ...]:
     """
     planes = frustum_planes(camera).astype(seg_cam.dtype)
     kept, t0, t1 = clip_segments(seg_cam, planes)
-    seg_cam = apply_clip(seg_cam, kept, t0, t1, (camera.near, camera.far))       # camera, inside the frustum
-    seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)         # pixels
+    seg_cam = apply_clip(seg_cam, kept, t0, t1, (camera.near, camera.far))  # camera, inside the frustum
+    seg_px = cam_to_px(seg_cam.reshape(-1, 3), camera).reshape(-1, 2, 2)  # pixels
     on, p0_px, p1_px = clip_to_image(seg_px[:, 0], seg_px[:, 1], camera.width, camera.height)
     return seg_cam, seg_px, on, p0_px, p1_px
 
 
-def clip_to_image(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def clip_to_image(
+    p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Liang-Barsky in pixel space against [-0.5, W - 0.5] x [-0.5, H - 0.5].
 
     A last guard before rasterizing: whatever precision the 3D clip lost, the
@@ -141,7 +145,7 @@ def clip_to_image(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
         for axis, lo, hi in ((0, -0.5, width - 0.5), (1, -0.5, height - 0.5)):
             for p, q in ((-d[:, axis], p0_px[:, axis] - lo), (d[:, axis], hi - p0_px[:, axis])):
                 parallel = p == 0
-                kept &= ~(parallel & (q < 0))                   # parallel and outside
+                kept &= ~(parallel & (q < 0))  # parallel and outside
                 r = q / p
                 t0 = np.where(~parallel & (p < 0), np.maximum(t0, r), t0)
                 t1 = np.where(~parallel & (p > 0), np.minimum(t1, r), t1)
@@ -153,8 +157,10 @@ def clip_to_image(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
 
 # ---- triangles ----------------------------------------------------------------
 
-def clip_triangles(tri_cam: np.ndarray, planes, src: np.ndarray | None = None,
-                   snap_z: list | None = None) -> tuple[np.ndarray, np.ndarray]:
+
+def clip_triangles(
+    tri_cam: np.ndarray, planes, src: np.ndarray | None = None, snap_z: list | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Clip ``(T, 3, 3)`` camera-space triangles against half-spaces ``n . p + d >= 0``.
 
     Sutherland-Hodgman, one plane at a time; per plane a triangle gives 0
@@ -193,7 +199,7 @@ def clip_triangles(tri_cam: np.ndarray, planes, src: np.ndarray | None = None,
 
 
 def _clip_plane(tri, src, n, d, z_new):
-    dist = tri @ n + d                                   # (T, 3)
+    dist = tri @ n + d  # (T, 3)
     inside = dist >= 0
     count = inside.sum(axis=1)
     if count.min(initial=3) == 3:
@@ -220,20 +226,19 @@ def _clip_plane(tri, src, n, d, z_new):
 
     # A piece with a vertex on the plane (distance 0) that would repeat that
     # vertex has zero area and is not emitted.
-    one = count == 1                                     # A inside, B and C outside
+    one = count == 1  # A inside, B and C outside
     if one.any():
         t, dd = rotated(one, np.argmax(inside[one], axis=1))
         a, b, c = t[:, 0], t[:, 1], t[:, 2]
-        keep = dd[:, 0] > 0                              # A on the plane: nothing left
-        out_tri.append(np.stack([a, cut(a, dd[:, 0], b, dd[:, 1]),
-                                 cut(a, dd[:, 0], c, dd[:, 2])], axis=1)[keep])
+        keep = dd[:, 0] > 0  # A on the plane: nothing left
+        out_tri.append(np.stack([a, cut(a, dd[:, 0], b, dd[:, 1]), cut(a, dd[:, 0], c, dd[:, 2])], axis=1)[keep])
         out_src.append(src[one][keep])
-    two = count == 2                                     # O outside, B and C inside
+    two = count == 2  # O outside, B and C inside
     if two.any():
         t, dd = rotated(two, np.argmin(inside[two], axis=1))
         o, b, c = t[:, 0], t[:, 1], t[:, 2]
-        p_ob = cut(b, dd[:, 1], o, dd[:, 0])             # == b when b is on the plane
-        p_co = cut(c, dd[:, 2], o, dd[:, 0])             # == c when c is on the plane
+        p_ob = cut(b, dd[:, 1], o, dd[:, 0])  # == b when b is on the plane
+        p_co = cut(c, dd[:, 2], o, dd[:, 0])  # == c when c is on the plane
         k1, k2 = dd[:, 1] > 0, dd[:, 2] > 0
         out_tri.append(np.stack([p_ob, b, c], axis=1)[k1])
         out_tri.append(np.stack([p_ob, c, p_co], axis=1)[k2])
@@ -241,8 +246,7 @@ def _clip_plane(tri, src, n, d, z_new):
     return np.concatenate(out_tri), np.concatenate(out_src)
 
 
-def clip_triangles_near(tri_cam: np.ndarray, near: float, far: float | None = None
-                        ) -> tuple[np.ndarray, np.ndarray]:
+def clip_triangles_near(tri_cam: np.ndarray, near: float, far: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Clip triangles to ``z >= near`` (and ``z <= far`` when given); see :func:`clip_triangles`.
 
     Returns ``(tri (T', 3, 3), src (T',))``; new vertices lie exactly on the plane.

@@ -41,8 +41,16 @@ import numpy as np
 from ..camera import Camera
 from .clipping import frustum_planes
 
-__all__ = ["CULL_MODES", "CULL_CHOICES", "triangulate", "face_of_triangle", "directed_edges",
-           "winding_problem", "backface_keep", "sphere_outside_frustum"]
+__all__ = [
+    "CULL_MODES",
+    "CULL_CHOICES",
+    "triangulate",
+    "face_of_triangle",
+    "directed_edges",
+    "winding_problem",
+    "backface_keep",
+    "sphere_outside_frustum",
+]
 
 #: Back-face culling of render_frame: None (off) or "backface".
 CULL_MODES = (None, "backface")
@@ -76,7 +84,7 @@ def fan_triangles(faces) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros((0, 3), dtype=np.intp), np.zeros(0, dtype=np.intp)
     tris = np.concatenate(tris_parts)
     face_of = np.concatenate(face_parts)
-    order = np.argsort(face_of, kind="stable")          # triangles in polygon order
+    order = np.argsort(face_of, kind="stable")  # triangles in polygon order
     return tris[order], face_of[order]
 
 
@@ -111,8 +119,7 @@ def directed_edges(faces) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
     face_id = np.repeat(np.arange(len(lengths)), lengths)
     starts = np.cumsum(lengths) - lengths
     pos = np.arange(len(flat)) - np.repeat(starts, lengths)
-    nxt = np.where(pos + 1 < np.repeat(lengths, lengths), np.arange(len(flat)) + 1,
-                   np.repeat(starts, lengths))
+    nxt = np.where(pos + 1 < np.repeat(lengths, lengths), np.arange(len(flat)) + 1, np.repeat(starts, lengths))
     return flat, flat[nxt], face_id, pos
 
 
@@ -130,7 +137,7 @@ def winding_problem(faces) -> str | None:
     i, j, face_id, pos = i[keep], j[keep], face_id[keep], pos[keep]
     if len(i) == 0:
         return None
-    order = np.lexsort((pos, face_id, j, i))           # by edge, then face, then position
+    order = np.lexsort((pos, face_id, j, i))  # by edge, then face, then position
     i, j, face_id, pos = i[order], j[order], face_id[order], pos[order]
     same = (i[1:] == i[:-1]) & (j[1:] == j[:-1])
     if not same.any():
@@ -138,8 +145,8 @@ def winding_problem(faces) -> str | None:
     # group start (first use of each directed edge) for every element
     new_group = np.concatenate([[True], ~same])
     first = np.maximum.accumulate(np.where(new_group, np.arange(len(i)), 0))
-    dup = np.flatnonzero(~new_group)                   # later uses of an already used edge
-    k = dup[np.lexsort((pos[dup], face_id[dup]))[0]]   # smallest later face, then position
+    dup = np.flatnonzero(~new_group)  # later uses of an already used edge
+    k = dup[np.lexsort((pos[dup], face_id[dup]))[0]]  # smallest later face, then position
     a, b = int(face_id[first[k]]), int(face_id[k])
     edge = f"{int(i[k])}->{int(j[k])}"
     if a == b:
@@ -203,10 +210,10 @@ def backface_keep(tri_cam: np.ndarray, projection: str, mirrored: bool = False) 
     with np.errstate(over="ignore", invalid="ignore"):
         if projection == "perspective":
             a = _unit_scale(tri_cam[:, 0])
-            s = np.einsum("ij,ij->i", n_cc, a)                 # dot(n_cc, p_cam) = -dot(n_world, view)
+            s = np.einsum("ij,ij->i", n_cc, a)  # dot(n_cc, p_cam) = -dot(n_world, view)
             tol = ORIENTATION_EPS * np.linalg.norm(n_cc, axis=1) * np.linalg.norm(a, axis=1)
         else:
-            s = n_cc[:, 2]                                       # n_cc . (0, 0, 1) = -dot(n_world, forward)
+            s = n_cc[:, 2]  # n_cc . (0, 0, 1) = -dot(n_world, forward)
             tol = ORIENTATION_EPS * np.linalg.norm(n_cc, axis=1)
     # Edge-on (|s| within rounding of 0) and zero-area faces are culled: their sign is noise.
     keep = s < -tol if mirrored else s > tol
@@ -224,7 +231,7 @@ def sphere_outside_frustum(center_world, radius: float, camera: Camera) -> bool:
     """
     c = np.asarray(center_world, dtype=np.float64).reshape(3)
     r_cam = np.stack([camera.right, camera.up, camera.forward])
-    c_cam = r_cam @ (c - camera.position)                  # camera-relative, as everywhere
+    c_cam = r_cam @ (c - camera.position)  # camera-relative, as everywhere
     planes = frustum_planes(camera)
     dist = (planes[:, :3] @ c_cam + planes[:, 3]) / np.linalg.norm(planes[:, :3], axis=1)
     return bool(np.any(dist < -float(radius)))

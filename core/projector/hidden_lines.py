@@ -26,12 +26,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import raster
 from ..camera import Camera
+from . import raster
 from .raster import round_half_up, snap_subpixel
 
 #: Resolution of a 24-bit window depth buffer (GL's ``r`` in glPolygonOffset).
-DEPTH_UNIT = 2.0 ** -24
+DEPTH_UNIT = 2.0**-24
 #: Slope factor of the line-vs-face bias per raster mode (module docstring):
 #: "exact" pixels are within 1/2 px of their line (minor axis), as GL's, so
 #: glPolygonOffset's factor 1 covers them; "fast" (ends rounded to pixels) and
@@ -41,8 +41,9 @@ DEPTH_UNIT = 2.0 ** -24
 SLOPE_FACTOR = {"exact": 1.0, "fast": 2.0, "aa": 2.0}
 
 
-def line_samples(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int, mode: str = "exact"
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+def line_samples(
+    p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int, mode: str = "exact"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """core.projector.raster's pixels of ``M`` segments, with the segment of each pixel.
 
     Returns ``(seg, rr, cc, weight)``: ``weight`` is None except for mode "aa".
@@ -112,8 +113,16 @@ def line_samples(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int, 
     return seg, rr, cc, weight
 
 
-def line_sample_depth(seg: np.ndarray, rr: np.ndarray, cc: np.ndarray, a_px: np.ndarray,
-                      b_px: np.ndarray, z_a: np.ndarray, z_b: np.ndarray, projection: str) -> np.ndarray:
+def line_sample_depth(
+    seg: np.ndarray,
+    rr: np.ndarray,
+    cc: np.ndarray,
+    a_px: np.ndarray,
+    b_px: np.ndarray,
+    z_a: np.ndarray,
+    z_b: np.ndarray,
+    projection: str,
+) -> np.ndarray:
     """Depth of each line pixel on its segment ``a -> b`` (module docstring).
 
     ``t`` is the pixel centre's coordinate along the segment's major axis (x
@@ -152,8 +161,20 @@ def occlusion_bias(z_buf: np.ndarray, grad: np.ndarray, camera: Camera, factor: 
     return g + DEPTH_UNIT * (far - near)
 
 
-def visible_line_samples(seg, rr, cc, a_px, b_px, z_a, z_b, depth: np.ndarray, face: np.ndarray,
-                         grad: np.ndarray, camera: Camera, slope_factor: float = 1.0) -> np.ndarray:
+def visible_line_samples(
+    seg,
+    rr,
+    cc,
+    a_px,
+    b_px,
+    z_a,
+    z_b,
+    depth: np.ndarray,
+    face: np.ndarray,
+    grad: np.ndarray,
+    camera: Camera,
+    slope_factor: float = 1.0,
+) -> np.ndarray:
     """``(K,) bool``: line pixels not hidden by the depth buffer (``z_line <= z_buf + bias``).
 
     ``slope_factor`` multiplies the slope term of the bias (:data:`SLOPE_FACTOR`).

@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import clipping, culling, raster, shading, zbuffer
 from ..camera import Camera
+from . import clipping, culling, raster, shading, zbuffer
 from .clipping import CLIP_MODES
 from .culling import CULL_MODES
 from .hidden_lines import SLOPE_FACTOR, line_samples, visible_line_samples
@@ -125,11 +125,23 @@ class Frame:
         return int(len(np.unique(ids)))
 
 
-def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.ndarray,
-                 clip_mode: str = "clip", *, dtype=None, raster: str = "exact",
-                 faces=None, cull: str | None = None, hidden_lines: bool = False,
-                 style: str = "wireframe", light_dir=None,
-                 ambient: float = shading.DEFAULT_AMBIENT, timing: dict | None = None) -> Frame:
+def render_frame(
+    p_model,
+    edges: np.ndarray,
+    camera: Camera,
+    model_matrix: np.ndarray,
+    clip_mode: str = "clip",
+    *,
+    dtype=None,
+    raster: str = "exact",
+    faces=None,
+    cull: str | None = None,
+    hidden_lines: bool = False,
+    style: str = "wireframe",
+    light_dir=None,
+    ambient: float = shading.DEFAULT_AMBIENT,
+    timing: dict | None = None,
+) -> Frame:
     """Project and draw one frame of a mesh's edges (and, optionally, its faces).
 
     Parameters
@@ -201,15 +213,15 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
         points = localize(p_model, "float64" if dtype is None else dtype)
     n = len(points)
     edges = np.asarray(edges).reshape(-1, 2)
-    p_cam = model_to_cam(points, model_matrix, camera)              # camera (model-view, camera-relative)
-    visible = depth_mask(p_cam, camera)                             # near <= z <= far
+    p_cam = model_to_cam(points, model_matrix, camera)  # camera (model-view, camera-relative)
+    visible = depth_mask(p_cam, camera)  # near <= z <= far
     all_visible = bool(visible.all())
-    if all_visible:                                                 # the usual case: no gather/scatter
-        p_px = cam_to_px(p_cam, camera)                             # pixels
+    if all_visible:  # the usual case: no gather/scatter
+        p_px = cam_to_px(p_cam, camera)  # pixels
     else:
         p_px = np.full((n, 2), np.nan, dtype=p_cam.dtype)
         if visible.any():
-            p_px[visible] = cam_to_px(p_cam[visible], camera)      # pixels
+            p_px[visible] = cam_to_px(p_cam[visible], camera)  # pixels
     ends_visible = visible[edges[:, 0]] & visible[edges[:, 1]] if len(edges) else np.zeros(0, bool)
     # Depth is affine along an edge, so near/far leave an edge whole exactly when
     # both ends are in [near, far]: every other edge is cut or dropped by them.
@@ -234,7 +246,7 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
         tri_face_buf, grad = fs.get("tri_buf"), fs.get("grad")
         if tri_face_buf is not None:
             extra.update(tri_ids=tri_face_buf, tri_grad=grad)
-    elif hidden_lines or shaded_style:                              # no faces: an empty depth buffer
+    elif hidden_lines or shaded_style:  # no faces: an empty depth buffer
         depth_image = np.full((camera.height, camera.width), np.inf)
         face_ids = np.full((camera.height, camera.width), -1, dtype=np.int32)
     if depth_image is not None:
@@ -244,16 +256,21 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
     if shaded_style:
         normals = fs["normals_world"] if use_faces else np.zeros((0, 3))
         light = shading.default_light_dir(camera) if light_dir is None else light_dir
-        image = shading.shade(face_ids, normals, light, ambient)     # shaded
+        image = shading.shade(face_ids, normals, light, ambient)  # shaded
         extra["shaded"] = image
         _lap(timing, "shading", t)
-        return Frame(image=image, p_px=p_px.astype(np.float64, copy=False),
-                     depth=p_cam[:, 2].astype(np.float64), visible=visible,
-                     clipped_edges=clipped_edges, **extra)
+        return Frame(
+            image=image,
+            p_px=p_px.astype(np.float64, copy=False),
+            depth=p_cam[:, 2].astype(np.float64),
+            visible=visible,
+            clipped_edges=clipped_edges,
+            **extra,
+        )
 
     image = np.zeros((camera.height, camera.width), dtype=np.uint8)
     if len(edges):
-        inside = visible & _inside_image(p_px, camera)             # per vertex: in depth range, on the image
+        inside = visible & _inside_image(p_px, camera)  # per vertex: in depth range, on the image
         # Only edges with an end outside need clipping; the rest are drawn
         # straight from the vertex pixels (np.take gathers rows of an (N, 2)
         # array ~10x faster than p_px[idx]). Usually that is every edge.
@@ -266,24 +283,32 @@ def render_frame(p_model, edges: np.ndarray, camera: Camera, model_matrix: np.nd
         if not direct.all():
             c_edges = edges[~direct]
             if clip_mode == "endpoint":
-                c_edges = c_edges[ends_visible[~direct]]            # drop edges with a failing end
+                c_edges = c_edges[ends_visible[~direct]]  # drop edges with a failing end
             # camera (clipped to the frustum), pixels, and pixels cut to the image
             seg_cam, seg_px, on, c0_px, c1_px = clipping.clip_edges(p_cam[c_edges], camera)
             seg0_px = np.concatenate([seg0_px, c0_px])
             seg1_px = np.concatenate([seg1_px, c1_px])
             if hidden_lines:
-                ends = tuple(np.concatenate([a, b]) for a, b in zip(
-                    ends, (seg_px[on, 0], seg_px[on, 1], seg_cam[on, 0, 2], seg_cam[on, 1, 2])))
+                ends = tuple(
+                    np.concatenate([a, b])
+                    for a, b in zip(ends, (seg_px[on, 0], seg_px[on, 1], seg_cam[on, 0, 2], seg_cam[on, 1, 2]))
+                )
         t = _lap(timing, "clip", t)
         if hidden_lines and tri_face_buf is not None and (tri_face_buf >= 0).any():
-            extra["hidden_pixels"] = _paint_visible(image, seg0_px, seg1_px, ends, raster,
-                                                    depth_image, tri_face_buf, grad, camera)
+            extra["hidden_pixels"] = _paint_visible(
+                image, seg0_px, seg1_px, ends, raster, depth_image, tri_face_buf, grad, camera
+            )
         else:
-            _paint(image, seg0_px, seg1_px, raster)                 # painted
+            _paint(image, seg0_px, seg1_px, raster)  # painted
         _lap(timing, "raster", t)
-    return Frame(image=image, p_px=p_px.astype(np.float64, copy=False),
-                 depth=p_cam[:, 2].astype(np.float64), visible=visible, clipped_edges=clipped_edges,
-                 **extra)
+    return Frame(
+        image=image,
+        p_px=p_px.astype(np.float64, copy=False),
+        depth=p_cam[:, 2].astype(np.float64),
+        visible=visible,
+        clipped_edges=clipped_edges,
+        **extra,
+    )
 
 
 _clock = time.perf_counter
@@ -306,7 +331,7 @@ def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: b
     if len(tris) and (tris.min() < 0 or tris.max() >= n):
         bad = int(tris.max()) if tris.max() >= n else int(tris.min())
         raise ValueError(f"faces: vertex index {bad} out of range for {n} vertices")
-    tri_cam = p_cam.astype(np.float64, copy=False)[tris]           # camera, (T, 3, 3)
+    tri_cam = p_cam.astype(np.float64, copy=False)[tris]  # camera, (T, 3, 3)
     # the sign of the determinant from slogdet: det() of a scale of 1e-110 underflows to -0.0
     mirrored = bool(np.linalg.slogdet(np.asarray(model_matrix, dtype=np.float64)[:3, :3])[0] < 0)
     out = {"faces_culled": 0, "face_kept": None}
@@ -319,7 +344,7 @@ def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: b
         out["face_kept"] = face_kept
         kept_idx = np.flatnonzero(keep_tri)
     else:
-        kept_idx = np.flatnonzero(~culling.degenerate(tri_cam))         # zero-area faces cover nothing
+        kept_idx = np.flatnonzero(~culling.degenerate(tri_cam))  # zero-area faces cover nothing
     if not need_depth:
         return out
     # Outward normals (for shading): sum of fan cross products = the polygon's
@@ -330,15 +355,16 @@ def _faces_stage(p_cam, faces, camera: Camera, model_matrix, cull, need_depth: b
         np.add.at(n_cc, tri_face, culling.triangle_cross_cam(tri_cam))
     r_cam = np.stack([camera.right, camera.up, camera.forward])
     out["normals_world"] = (-1.0 if not mirrored else 1.0) * (n_cc @ r_cam)
-    tri_px, tri_z, src = zbuffer.project_triangles(tri_cam[kept_idx], camera)   # pixels (clipped)
-    depth, tri_buf = zbuffer.rasterize_triangles(tri_px, tri_z, camera.width, camera.height,
-                                                 camera.projection)            # depth buffer
-    poly_of = tri_face[kept_idx][src]                                          # clipped tri -> polygon
+    tri_px, tri_z, src = zbuffer.project_triangles(tri_cam[kept_idx], camera)  # pixels (clipped)
+    depth, tri_buf = zbuffer.rasterize_triangles(
+        tri_px, tri_z, camera.width, camera.height, camera.projection
+    )  # depth buffer
+    poly_of = tri_face[kept_idx][src]  # clipped tri -> polygon
     out["depth"] = depth
     out["tri_buf"] = tri_buf
     if len(poly_of):
         out["face_ids"] = np.where(tri_buf >= 0, poly_of[np.maximum(tri_buf, 0)], -1).astype(np.int32)
-    else:                                   # every face culled or clipped away: nothing covered
+    else:  # every face culled or clipped away: nothing covered
         out["face_ids"] = np.full(tri_buf.shape, -1, dtype=np.int32)
     out["grad"] = zbuffer.triangle_gradients(tri_px, tri_z, camera.projection)
     return out
@@ -367,7 +393,7 @@ def _paint_visible(image, seg0_px, seg1_px, ends, mode, depth, tri_buf, grad, ca
     shown = np.unique(rr[vis] * w + cc[vis])
     if mode == "aa":
         if vis.all():
-            _paint(image, seg0_px, seg1_px, mode)               # bit-identical to the plain wireframe
+            _paint(image, seg0_px, seg1_px, mode)  # bit-identical to the plain wireframe
         else:
             image[...] = raster.paint_aa(rr[vis], cc[vis], weight[vis], w, h)
     else:
@@ -382,14 +408,15 @@ def _paint(image: np.ndarray, seg0_px: np.ndarray, seg1_px: np.ndarray, mode: st
         rr, cc = fn(seg0_px, seg1_px, w, h)
         flat = rr * w
         flat += cc
-        image.reshape(-1)[flat] = 255       # a view (image is a fresh np.zeros); half the time of image[rr, cc]
+        image.reshape(-1)[flat] = 255  # a view (image is a fresh np.zeros); half the time of image[rr, cc]
     else:
         rr, cc, weight = raster.line_coverage_aa(seg0_px, seg1_px, w, h)
         image[...] = raster.paint_aa(rr, cc, weight, w, h)
 
 
-def draw_segments(seg_cam: np.ndarray, camera: Camera, raster: str = "exact", occluders: Frame | None = None
-                  ) -> np.ndarray:
+def draw_segments(
+    seg_cam: np.ndarray, camera: Camera, raster: str = "exact", occluders: Frame | None = None
+) -> np.ndarray:
     """``(H, W) uint8``: camera-space segments ``(M, 2, 3)`` clipped and drawn as edges are.
 
     With ``occluders`` (a Frame rendered with ``hidden_lines`` or style

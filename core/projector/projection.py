@@ -55,8 +55,8 @@ def resolve_dtype(dtype) -> np.dtype:
 class LocalPoints:
     """A scene's vertices prepared for one dtype: ``p_model = origin + p_local``."""
 
-    origin: np.ndarray      # (3,) float64
-    p_local: np.ndarray     # (N, 3) in the run's dtype
+    origin: np.ndarray  # (3,) float64
+    p_local: np.ndarray  # (N, 3) in the run's dtype
 
     @property
     def dtype(self) -> np.dtype:
@@ -74,7 +74,7 @@ def localize(p_model: np.ndarray, dtype="float64") -> LocalPoints:
     finite = np.isfinite(p_model).all(axis=1)
     if finite.any():
         lo, hi = p_model[finite].min(axis=0), p_model[finite].max(axis=0)
-        centre = 0.5 * lo + 0.5 * hi               # halves first: no overflow near 1e308
+        centre = 0.5 * lo + 0.5 * hi  # halves first: no overflow near 1e308
         half_extent = 0.5 * hi - 0.5 * lo
         # Far from its own origin: farther (on some axis) than the object's largest half-extent.
         if np.abs(centre).max() > half_extent.max():
@@ -91,7 +91,7 @@ def model_view(model_matrix: np.ndarray, camera: Camera, origin=None) -> tuple[n
     r_cam = np.stack([camera.right, camera.up, camera.forward])
     a = model_matrix[:3, :3]
     t_world = model_matrix[:3, 3] if origin is None else a @ origin + model_matrix[:3, 3]
-    return r_cam @ a, r_cam @ (t_world - camera.position)       # subtract first, then rotate
+    return r_cam @ a, r_cam @ (t_world - camera.position)  # subtract first, then rotate
 
 
 #: Rows per block of :func:`model_to_cam`: 64k rows x 3 x 8 bytes = 1.5 MB, inside L2/L3.
@@ -114,8 +114,8 @@ def model_to_cam(points: LocalPoints, model_matrix: np.ndarray, camera: Camera) 
     p = points.p_local
     out = np.empty((len(p), 3), dtype=dt)
     for start in range(0, len(p), BLOCK_ROWS):
-        blk = p[start:start + BLOCK_ROWS]
-        o = out[start:start + BLOCK_ROWS]
+        blk = p[start : start + BLOCK_ROWS]
+        o = out[start : start + BLOCK_ROWS]
         x, y, z = blk[:, 0], blk[:, 1], blk[:, 2]
         for i in range(3):
             oi = o[:, i]
@@ -190,7 +190,7 @@ def _distorted_px(p_cam: np.ndarray, camera: Camera, f_t, out: np.ndarray) -> np
     inv_z = f_t(1.0) / p_cam[:, 2]
     p_n = np.empty(out.shape, dtype=out.dtype)
     np.multiply(p_cam[:, 0], inv_z, out=p_n[:, 0])
-    np.multiply(p_cam[:, 1], -inv_z, out=p_n[:, 1])        # OpenCV's y is down
+    np.multiply(p_cam[:, 1], -inv_z, out=p_n[:, 1])  # OpenCV's y is down
     p_d = distort(p_n, camera.distortion)
     fx, fy = (f_t(f) for f in camera.focal_xy)
     cx, cy = (f_t(c) for c in camera.principal_point)

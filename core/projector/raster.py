@@ -104,11 +104,10 @@ CHUNK_SEGMENTS = 8192
 #: and faster than int64 division) when every end is within this many grid
 #: units (1/256 px) of the origin: 2^23 units = 32,768 px. Then every product
 #: and sum in :func:`_line_pixels` stays below 2^51. Farther ends take int64.
-_FLOAT_GRID_LIMIT = 2.0 ** 23
+_FLOAT_GRID_LIMIT = 2.0**23
 
 
-def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
-                ) -> tuple[np.ndarray, np.ndarray]:
+def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """Pixels of ``M`` segments from ``p0_px[m]`` to ``p1_px[m]``.
 
     Parameters
@@ -130,9 +129,12 @@ def line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     if len(p0_px) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
-    parts = [_line_pixels(snap_subpixel(p0_px[k:k + CHUNK_SEGMENTS]), snap_subpixel(p1_px[k:k + CHUNK_SEGMENTS]),
-                          width, height)
-             for k in range(0, len(p0_px), CHUNK_SEGMENTS)]
+    parts = [
+        _line_pixels(
+            snap_subpixel(p0_px[k : k + CHUNK_SEGMENTS]), snap_subpixel(p1_px[k : k + CHUNK_SEGMENTS]), width, height
+        )
+        for k in range(0, len(p0_px), CHUNK_SEGMENTS)
+    ]
     if len(parts) == 1:
         return parts[0]
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
@@ -162,8 +164,7 @@ def _floor_div_int(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a // b
 
 
-def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`line_pixels` of a non-empty batch of already snapped end points.
 
     All in the segment's *travel* coordinate ``I = s i`` (``s = +1`` when the
@@ -188,9 +189,9 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
       float operations of the rule as stated, and the pixels between are
       generated without a test.
     """
-    g0 = p0_px * SUBPIXEL                       # grid units: exact integers (the ends are snapped)
+    g0 = p0_px * SUBPIXEL  # grid units: exact integers (the ends are snapped)
     g1 = p1_px * SUBPIXEL
-    if (min(g0.min(), g1.min()) >= -_FLOAT_GRID_LIMIT and max(g0.max(), g1.max()) <= _FLOAT_GRID_LIMIT):
+    if min(g0.min(), g1.min()) >= -_FLOAT_GRID_LIMIT and max(g0.max(), g1.max()) <= _FLOAT_GRID_LIMIT:
         floor_div, one = _floor_div_float, 1.0
     else:
         g0, g1 = g0.astype(np.int64), g1.astype(np.int64)
@@ -198,16 +199,16 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     d = g1 - g0
     ad = np.abs(d)
     x_major = ad[:, 0] > ad[:, 1]
-    da = np.where(x_major, d[:, 0], d[:, 1])               # major and minor change, grid units
+    da = np.where(x_major, d[:, 0], d[:, 1])  # major and minor change, grid units
     db = np.where(x_major, d[:, 1], d[:, 0])
     ga0 = np.where(x_major, g0[:, 0], g0[:, 1])
     gb0 = np.where(x_major, g0[:, 1], g0[:, 0])
-    s = np.where(da >= 0, one, -one)                        # direction of travel along the major axis
+    s = np.where(da >= 0, one, -one)  # direction of travel along the major axis
     den = np.abs(da)
-    ta0 = s * ga0                                           # the ends in travel coordinates, grid units
+    ta0 = s * ga0  # the ends in travel coordinates, grid units
     ta1 = ta0 + den
-    np.maximum(den, one, out=den)                           # zero length: db = 0 too, any den > 0 will do
-    t = np.where(x_major, one, -one)                        # rounding side: +1 halves to +y, -1 halves to -x
+    np.maximum(den, one, out=den)  # zero length: db = 0 too, any den > 0 will do
+    t = np.where(x_major, one, -one)  # rounding side: +1 halves to +y, -1 halves to -x
     # The diamond's exit (_exit_travel) divides by 1 + t m and 1 - t m, with
     # m = db / den: the rule's float slope times s (the same quotient, rounded once).
     tm = db / den
@@ -239,7 +240,7 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     seg = np.repeat(np.arange(len(count)), count)
     i = np.arange(len(seg), dtype=p0.dtype)
     i += i_lo[seg]
-    dp *= s                                                 # P as a function of i
+    dp *= s  # P as a function of i
     j = floor_div(p0[seg] + dp[seg] * i, q[seg])
     j *= t[seg]
     i = i.astype(np.intp)
@@ -248,7 +249,7 @@ def _line_pixels(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
     cc = np.where(xm, i, j)
     rr = np.where(xm, j, i)
     if len(rr) == 0 or (rr.min() >= 0 and cc.min() >= 0 and rr.max() < height and cc.max() < width):
-        return rr, cc                                   # the usual case: skip the mask and two gathers
+        return rr, cc  # the usual case: skip the mask and two gathers
     inside = (cc >= 0) & (cc < width) & (rr >= 0) & (rr < height)
     return rr[inside], cc[inside]
 
@@ -276,28 +277,28 @@ def _exit_travel(i, p0, dp, q, unit, d1, d2, floor_div) -> np.ndarray:
 
 
 def _as_ends(p0_px, p1_px) -> tuple[np.ndarray, np.ndarray]:
-    return (np.asarray(p0_px, dtype=np.float64).reshape(-1, 2),
-            np.asarray(p1_px, dtype=np.float64).reshape(-1, 2))
+    return (np.asarray(p0_px, dtype=np.float64).reshape(-1, 2), np.asarray(p1_px, dtype=np.float64).reshape(-1, 2))
 
 
 def _batched(fn, p0: np.ndarray, p1: np.ndarray, width: int, height: int) -> tuple:
     """``fn`` over batches of :data:`CHUNK_SEGMENTS` segments, results concatenated."""
     if len(p0) <= CHUNK_SEGMENTS:
         return fn(p0, p1, width, height)
-    parts = [fn(p0[k:k + CHUNK_SEGMENTS], p1[k:k + CHUNK_SEGMENTS], width, height)
-             for k in range(0, len(p0), CHUNK_SEGMENTS)]
+    parts = [
+        fn(p0[k : k + CHUNK_SEGMENTS], p1[k : k + CHUNK_SEGMENTS], width, height)
+        for k in range(0, len(p0), CHUNK_SEGMENTS)
+    ]
     return tuple(np.concatenate(arrays) for arrays in zip(*parts))
 
 
 def _keep_inside(rr: np.ndarray, cc: np.ndarray, width: int, height: int, *extra: np.ndarray) -> tuple:
     inside = (cc >= 0) & (cc < width) & (rr >= 0) & (rr < height)
-    if inside.all():                                   # the usual case: skip the gathers
+    if inside.all():  # the usual case: skip the gathers
         return (rr, cc) + extra
     return (rr[inside], cc[inside]) + tuple(e[inside] for e in extra)
 
 
-def line_pixels_fast(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def line_pixels_fast(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """Pixels of ``M`` segments by integer DDA (raster mode "fast", module docstring).
 
     Ends are rounded to pixel centres with ``floor(v + 1/2)``; the line between
@@ -311,22 +312,22 @@ def line_pixels_fast(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: i
     if len(p0) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
-    return _batched(_line_pixels_fast, round_half_up(p0).astype(np.int64), round_half_up(p1).astype(np.int64),
-                    width, height)
+    return _batched(
+        _line_pixels_fast, round_half_up(p0).astype(np.int64), round_half_up(p1).astype(np.int64), width, height
+    )
 
 
 def round_half_up(v: np.ndarray) -> np.ndarray:
     """``floor(v + 1/2)`` (float64), exactly: ``v + 0.5`` itself can round up (0.49999999999999994 + 0.5 == 1.0)."""
     r = np.floor(v)
-    return r + (v - r >= 0.5)                              # v - floor(v) is exact
+    return r + (v - r >= 0.5)  # v - floor(v) is exact
 
 
-def _line_pixels_fast(q0: np.ndarray, q1: np.ndarray, width: int, height: int
-                      ) -> tuple[np.ndarray, np.ndarray]:
+def _line_pixels_fast(q0: np.ndarray, q1: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`line_pixels_fast` of a non-empty batch of rounded (int64) end points."""
     d = q1 - q0
     x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])
-    n = np.maximum(np.abs(d[:, 0]), np.abs(d[:, 1]))     # steps; n + 1 pixels
+    n = np.maximum(np.abs(d[:, 0]), np.abs(d[:, 1]))  # steps; n + 1 pixels
     # After k steps: major = a0 + s k, minor = b0 + t q(k) with
     #   q(k) = floor((2 k db' + n) / (2 n)),
     # x-major: db' = dy, t = +1 (floor(b + 1/2): halves to +y);
@@ -339,7 +340,7 @@ def _line_pixels_fast(q0: np.ndarray, q1: np.ndarray, width: int, height: int
     mx = np.where(x_major, 0, -1)
     my = np.where(x_major, 1, 0)
     two_db = 2 * np.where(x_major, d[:, 1], -d[:, 0])
-    two_n = 2 * np.maximum(n, 1)                          # n = 0: k = 0 only, q = 0
+    two_n = 2 * np.maximum(n, 1)  # n = 0: k = 0 only, q = 0
     count = n + 1
     k = np.arange(int(count.sum()), dtype=np.int64) - np.repeat(np.cumsum(count) - count, count)
     q = (k * np.repeat(two_db, count) + np.repeat(n, count)) // np.repeat(two_n, count)
@@ -348,8 +349,9 @@ def _line_pixels_fast(q0: np.ndarray, q1: np.ndarray, width: int, height: int
     return _keep_inside(rr.astype(np.intp, copy=False), cc.astype(np.intp, copy=False), width, height)
 
 
-def line_coverage_aa(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def line_coverage_aa(
+    p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Anti-aliased coverage of ``M`` segments, Xiaolin Wu's rule (raster mode "aa").
 
     At each integer major coordinate ``i`` the segment reaches, the pixels
@@ -380,8 +382,9 @@ def line_coverage_aa(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: i
     return _batched(_line_coverage_aa, p0, p1, width, height)
 
 
-def _line_coverage_aa(p0: np.ndarray, p1: np.ndarray, width: int, height: int
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _line_coverage_aa(
+    p0: np.ndarray, p1: np.ndarray, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`line_coverage_aa` of a non-empty batch."""
     x_major, a0, a1, b0, b1 = major_minor(p0, p1)
     # Work from the end with the smaller major coordinate, so that a reversed
@@ -391,20 +394,20 @@ def _line_coverage_aa(p0: np.ndarray, p1: np.ndarray, width: int, height: int
     b_lo, b_hi = np.where(swap, b1, b0), np.where(swap, b0, b1)
     da = a_hi - a_lo
     with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.where(da > 0, (b_hi - b_lo) / da, 0.0)    # |slope| <= 1
+        slope = np.where(da > 0, (b_hi - b_lo) / da, 0.0)  # |slope| <= 1
     # pixels lo..hi: those whose interval [i - 1/2, i + 1/2] overlaps [a_lo, a_hi]
     # in more than a point (an end on a pixel boundary does not reach past it)
-    lo = round_half_up(a_lo).astype(np.int64)     # floor(a_lo + 1/2)
+    lo = round_half_up(a_lo).astype(np.int64)  # floor(a_lo + 1/2)
     hi = -round_half_up(-a_hi).astype(np.int64)  # ceil(a_hi - 1/2)
     count = np.maximum(hi - lo + 1, 0)
     seg = np.repeat(np.arange(len(count)), count)
     i = lo[seg] + (np.arange(int(count.sum()), dtype=np.int64) - np.repeat(np.cumsum(count) - count, count))
     fi = i.astype(np.float64)
     al, ah = a_lo[seg], a_hi[seg]
-    g = np.minimum(ah, fi + 0.5) - np.maximum(al, fi - 0.5)   # 1 exactly inside: (i + 1/2) - (i - 1/2)
-    b = b_lo[seg] + (fi - al) * slope[seg]                    # the line's minor coordinate at i
+    g = np.minimum(ah, fi + 0.5) - np.maximum(al, fi - 0.5)  # 1 exactly inside: (i + 1/2) - (i - 1/2)
+    b = b_lo[seg] + (fi - al) * slope[seg]  # the line's minor coordinate at i
     jf = np.floor(b)
-    f = b - jf                                                # exact (the fraction bits of b)
+    f = b - jf  # exact (the fraction bits of b)
     # the pair (floor(b), floor(b) + 1) of each major step, side by side
     major = np.repeat(i, 2)
     minor = np.stack([jf, jf + 1.0], axis=1).ravel().astype(np.int64)

@@ -47,7 +47,7 @@ def face_intensity(normals_world: np.ndarray, light_dir_world, ambient: float = 
     light = np.asarray(light_dir_world, dtype=np.float64).reshape(3)
     big = np.abs(light).max()
     if np.isfinite(big) and big > 0:
-        light = light / big                      # a direction: scaled first, so norm() cannot over/underflow
+        light = light / big  # a direction: scaled first, so norm() cannot over/underflow
     norm_l = np.linalg.norm(light)
     if not (np.isfinite(norm_l) and norm_l > 0):
         raise ValueError(f"light_dir {light.tolist()}: expected a finite non-zero direction")
@@ -57,8 +57,9 @@ def face_intensity(normals_world: np.ndarray, light_dir_world, ambient: float = 
     return ambient + (1.0 - ambient) * np.clip(cos, 0.0, 1.0)
 
 
-def shade(face_ids: np.ndarray, normals_world: np.ndarray, light_dir_world,
-          ambient: float = DEFAULT_AMBIENT) -> np.ndarray:
+def shade(
+    face_ids: np.ndarray, normals_world: np.ndarray, light_dir_world, ambient: float = DEFAULT_AMBIENT
+) -> np.ndarray:
     """``(H, W) uint8`` flat-shaded image of a face-id buffer.
 
     Parameters
@@ -75,5 +76,5 @@ def shade(face_ids: np.ndarray, normals_world: np.ndarray, light_dir_world,
         raise ValueError(f"ambient {ambient!r}: expected a value in [0, 1]")
     face_ids = np.asarray(face_ids)
     level = np.floor(255.0 * face_intensity(normals_world, light_dir_world, ambient) + 0.5)
-    lut = np.concatenate([[0], level]).astype(np.uint8)    # id -1 -> 0
+    lut = np.concatenate([[0], level]).astype(np.uint8)  # id -1 -> 0
     return lut[face_ids + 1]

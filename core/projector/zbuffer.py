@@ -62,11 +62,10 @@ __all__ = ["CHUNK_SAMPLES", "GUARD_PX", "project_triangles", "rasterize_triangle
 CHUNK_SAMPLES = 1 << 19
 #: Side planes for triangles reaching far off the image, in pixels beyond the edges.
 GUARD_PX = 4096.0
-_E_STEP = 1.0 / (SUBPIXEL * SUBPIXEL)     # edge functions are multiples of 2^-16
+_E_STEP = 1.0 / (SUBPIXEL * SUBPIXEL)  # edge functions are multiples of 2^-16
 
 
-def project_triangles(tri_cam: np.ndarray, camera: Camera
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def project_triangles(tri_cam: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Clip to [near, far] (and the guard band if needed), then project.
 
     Returns ``(tri_px (T', 3, 2), tri_z (T', 3), src (T',))`` in float64.
@@ -76,8 +75,9 @@ def project_triangles(tri_cam: np.ndarray, camera: Camera
     lo_x, hi_x = -0.5 - GUARD_PX, camera.width - 0.5 + GUARD_PX
     lo_y, hi_y = -0.5 - GUARD_PX, camera.height - 0.5 + GUARD_PX
     with np.errstate(invalid="ignore"):
-        off = ~((tri_px[..., 0] >= lo_x) & (tri_px[..., 0] <= hi_x)
-                & (tri_px[..., 1] >= lo_y) & (tri_px[..., 1] <= hi_y)).all(axis=1)
+        off = ~(
+            (tri_px[..., 0] >= lo_x) & (tri_px[..., 0] <= hi_x) & (tri_px[..., 1] >= lo_y) & (tri_px[..., 1] <= hi_y)
+        ).all(axis=1)
     if off.any():
         # Only the triangles reaching beyond the guard band: clipping moves
         # nothing inside the image, and the common case pays nothing.
@@ -94,6 +94,7 @@ def project_triangles(tri_cam: np.ndarray, camera: Camera
 
 # ---- triangle setup ---------------------------------------------------------
 
+
 class _Setup:
     """Snapped, oriented triangles with their edge functions (module docstring)."""
 
@@ -106,7 +107,7 @@ class _Setup:
             px = snap_subpixel(raw)
             z = np.where(ok[:, None], z, 1.0)
             area2 = _area2(px)
-        flip = area2 < 0                                  # make E > 0 inside
+        flip = area2 < 0  # make E > 0 inside
         px = np.where(flip[:, None, None], px[:, [0, 2, 1]], px)
         raw = np.where(flip[:, None, None], raw[:, [0, 2, 1]], raw)
         z = np.where(flip[:, None], z[:, [0, 2, 1]], z)
@@ -117,11 +118,11 @@ class _Setup:
         # edge k is opposite vertex k: (b -> c), (c -> a), (a -> b)
         p = px[:, [1, 2, 0]]
         q = px[:, [2, 0, 1]]
-        self.p = p                                         # (T, 3, 2) edge start
-        self.dx = q[..., 0] - p[..., 0]                    # (T, 3)
+        self.p = p  # (T, 3, 2) edge start
+        self.dx = q[..., 0] - p[..., 0]  # (T, 3)
         self.dy = q[..., 1] - p[..., 1]
         top_left = (self.dy < 0) | ((self.dy == 0) & (self.dx > 0))
-        self.thr = np.where(top_left, 0.0, _E_STEP)        # E >= thr  <=>  covered by this edge
+        self.thr = np.where(top_left, 0.0, _E_STEP)  # E >= thr  <=>  covered by this edge
         # Depth plane: the value interpolated linearly in screen space (1/z under
         # perspective, z otherwise) through the *unsnapped* vertices, as llvmpipe
         # does (snapping is for coverage only; measured: snapped planes differ from
@@ -142,7 +143,7 @@ class _Setup:
         self.ok = ok_plane
         self.gx = np.where(ok_plane, gx, 0.0)
         self.gy = np.where(ok_plane, gy, 0.0)
-        self.anchor = a                                    # value w0 at vertex a
+        self.anchor = a  # value w0 at vertex a
         self.w0 = w[:, 0]
 
     def gradients(self) -> np.ndarray:
@@ -164,8 +165,9 @@ def triangle_gradients(tri_px: np.ndarray, tri_z: np.ndarray, projection: str) -
     return _Setup(tri_px, tri_z, projection).gradients()
 
 
-def rasterize_triangles(tri_px: np.ndarray, tri_z: np.ndarray, width: int, height: int,
-                        projection: str = "perspective") -> tuple[np.ndarray, np.ndarray]:
+def rasterize_triangles(
+    tri_px: np.ndarray, tri_z: np.ndarray, width: int, height: int, projection: str = "perspective"
+) -> tuple[np.ndarray, np.ndarray]:
     """Depth-buffer ``T`` projected triangles (module docstring for the rules).
 
     Parameters
@@ -214,8 +216,9 @@ def rasterize_triangles(tri_px: np.ndarray, tri_z: np.ndarray, width: int, heigh
     while start < len(count):
         base = ends[start] - count[start]
         stop = max(int(np.searchsorted(ends, base + CHUNK_SAMPLES, side="right")), start + 1)
-        _raster_batch(s, tri_id[start:stop], x0[start:stop], y0[start:stop], bw[start:stop],
-                      bh[start:stop], width, depth, face)
+        _raster_batch(
+            s, tri_id[start:stop], x0[start:stop], y0[start:stop], bw[start:stop], bh[start:stop], width, depth, face
+        )
         start = stop
     return depth.reshape(height, width), face.reshape(height, width)
 
@@ -231,7 +234,7 @@ def _raster_batch(s: _Setup, tri, x0, y0, bw, bh, width, depth, face) -> None:
     t = tri[r_t]
     fx0 = x0[r_t].astype(np.float64)
     fy = y.astype(np.float64)
-    n_i = bw[r_t]                                     # i in [0, n_i - 1]
+    n_i = bw[r_t]  # i in [0, n_i - 1]
     lo = np.zeros(rows, dtype=np.int64)
     hi = n_i - 1
     for edge in range(3):
@@ -240,7 +243,7 @@ def _raster_batch(s: _Setup, tri, x0, y0, bw, bh, width, depth, face) -> None:
         # E_row - thr: covered by this edge  <=>  rest + a i >= 0   (exact)
         rest = dx * (fy - s.p[t, edge, 1]) + a * (fx0 - s.p[t, edge, 0]) - s.thr[t, edge]
         with np.errstate(divide="ignore", invalid="ignore"):
-            q = -rest / a                             # rounded; fixed up exactly below
+            q = -rest / a  # rounded; fixed up exactly below
         pos, neg = a > 0, a < 0
         # a > 0: i >= q
         c = np.clip(np.ceil(np.where(pos, q, 0.0)), 0, n_i).astype(np.int64)
@@ -269,9 +272,9 @@ def _raster_batch(s: _Setup, tri, x0, y0, bw, bh, width, depth, face) -> None:
     old_z = depth[pix]
     old_f = face[pix]
     np.minimum.at(depth, pix, z)
-    win = z == depth[pix]                 # at the new minimum (possibly tied with the old one)
+    win = z == depth[pix]  # at the new minimum (possibly tied with the old one)
     if not win.any():
         return
     pw = pix[win]
     face[pw] = np.where(old_z[win] == z[win], old_f[win], np.iinfo(np.int32).max)
-    np.minimum.at(face, pw, ts[win])      # ties: the lower triangle index
+    np.minimum.at(face, pw, ts[win])  # ties: the lower triangle index

@@ -33,15 +33,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..projector.culling import winding_problem
 from ..errors import InputError, quiet_libraries
-from .mesh_companions import companion_resolver, interrupts_kept
-from .mesh_checks import check_json, check_off, check_ply_counts, check_stl, number as _number, short as _short
-from ..numbers import plain_int
 from ..limits import MAX_FACE_VERTICES, MAX_NAME, check_turns
-from .model import Scene, SceneObject, face_edges, unique_edges
+from ..numbers import plain_int
+from ..projector.culling import winding_problem
 from ..transforms import Motion
 from ..user_files import expected, open_regular, open_text, problem, read_text
+from .mesh_checks import check_json, check_off, check_ply_counts, check_stl
+from .mesh_checks import number as _number
+from .mesh_checks import short as _short
+from .mesh_companions import companion_resolver, interrupts_kept
+from .model import Scene, SceneObject, face_edges, unique_edges
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "scenes"
 #: Example scenes: loadable by name (``--scene orrery``) but not built-ins, so
@@ -65,8 +67,10 @@ def _index(path, lineno, token, what, n_vertices, where="the scene has"):
     except ValueError:
         raise InputError(f"{path}:{lineno}: {what} index {_short(token)}: expected an integer") from None
     if not 0 <= value < n_vertices:
-        raise InputError(f"{path}:{lineno}: {what} index {value}: expected 0..{n_vertices - 1} "
-                         f"({where} {n_vertices} vertices so far)")
+        raise InputError(
+            f"{path}:{lineno}: {what} index {value}: expected 0..{n_vertices - 1} "
+            f"({where} {n_vertices} vertices so far)"
+        )
     return value
 
 
@@ -81,9 +85,9 @@ class _Obj:
     def __init__(self, name, lineno):
         self.name, self.lineno = name, lineno
         self.vertices, self.edges, self.faces = [], [], []
-        self.mesh = None                      # (lineno, Scene) of a 'mesh' line
-        self.geometry_line = None             # first v/e/f line
-        self.motion = {}                      # keyword -> (lineno, value)
+        self.mesh = None  # (lineno, Scene) of a 'mesh' line
+        self.geometry_line = None  # first v/e/f line
+        self.motion = {}  # keyword -> (lineno, value)
 
     def touched(self) -> bool:
         return bool(self.vertices or self.edges or self.faces or self.mesh or self.motion)
@@ -92,14 +96,15 @@ class _Obj:
 _MOTION_KEYS = {"translate": "offset", "scale": "scale", "spin": "turns"}
 
 
-def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
-                     base_dir: str | os.PathLike | None = None) -> Scene:
+def parse_scene_text(
+    text: str, path: str = "<string>", name: str | None = None, base_dir: str | os.PathLike | None = None
+) -> Scene:
     """Parse the text format. ``base_dir`` (default: the directory of ``path``) resolves ``mesh`` paths."""
     base = Path(base_dir) if base_dir is not None else Path(path).parent
     implicit = _Obj(None, 0)
     objs = [implicit]
     cur = implicit
-    single = True                 # no 'object' line yet: messages speak of "the scene"
+    single = True  # no 'object' line yet: messages speak of "the scene"
     # lines end at "\n" (and "\r\n") only, as editors count them: str.splitlines() would also end one at
     # U+2028, U+0085, \x0c, \x1c..\x1e, turning the rest of a comment into a statement
     for lineno, raw in enumerate(text.split("\n"), start=1):
@@ -110,99 +115,131 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
         where = "the scene has" if single else f"object {cur.name!r} has"
         if tag == "name":
             if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
-                raise InputError(f"{path}:{lineno}: name {_short(' '.join(fields))}: expected one word of letters, "
-                                 "digits, '_', '.', '-' (it names output files)")
+                raise InputError(
+                    f"{path}:{lineno}: name {_short(' '.join(fields))}: expected one word of letters, "
+                    "digits, '_', '.', '-' (it names output files)"
+                )
             name = fields[0]
         elif tag in ("v", "e", "f"):
             if cur.mesh is not None:
-                raise InputError(f"{path}:{lineno}: {_short(line)}: expected no v/e/f lines in an object that takes "
-                                 f"its geometry from 'mesh' (line {cur.mesh[0]}); start a new 'object' first")
+                raise InputError(
+                    f"{path}:{lineno}: {_short(line)}: expected no v/e/f lines in an object that takes "
+                    f"its geometry from 'mesh' (line {cur.mesh[0]}); start a new 'object' first"
+                )
             cur.geometry_line = cur.geometry_line or lineno
             if tag == "v":
                 if len(fields) != 3:
-                    raise InputError(f"{path}:{lineno}: vertex {_short(line)}: expected 'v X Y Z' (3 numbers), "
-                                     f"got {len(fields)}")
+                    raise InputError(
+                        f"{path}:{lineno}: vertex {_short(line)}: expected 'v X Y Z' (3 numbers), got {len(fields)}"
+                    )
                 cur.vertices.append([_number(path, lineno, t, "vertex coordinate") for t in fields])
             elif tag == "e":
                 if len(fields) != 2:
-                    raise InputError(f"{path}:{lineno}: edge {_short(line)}: expected 'e I J' (2 indices), got {len(fields)}")
+                    raise InputError(
+                        f"{path}:{lineno}: edge {_short(line)}: expected 'e I J' (2 indices), got {len(fields)}"
+                    )
                 cur.edges.append([_index(path, lineno, t, "edge", len(cur.vertices), where) for t in fields])
             else:
                 if len(fields) < 3:
-                    raise InputError(f"{path}:{lineno}: face {_short(line)}: expected 'f I J K ...' (3 or more indices), "
-                                     f"got {len(fields)}")
+                    raise InputError(
+                        f"{path}:{lineno}: face {_short(line)}: expected 'f I J K ...' (3 or more indices), "
+                        f"got {len(fields)}"
+                    )
                 if len(fields) > MAX_FACE_VERTICES:
-                    raise InputError(f"{path}:{lineno}: face of {len(fields)} indices: expected at most "
-                                     f"{MAX_FACE_VERTICES} (a larger surface is a mesh: give it as a mesh file)")
+                    raise InputError(
+                        f"{path}:{lineno}: face of {len(fields)} indices: expected at most "
+                        f"{MAX_FACE_VERTICES} (a larger surface is a mesh: give it as a mesh file)"
+                    )
                 cur.faces.append(tuple(_index(path, lineno, t, "face", len(cur.vertices), where) for t in fields))
         elif tag == "object":
             if len(fields) != 1 or not NAME_PATTERN.fullmatch(fields[0]):
-                raise InputError(f"{path}:{lineno}: object {_short(' '.join(fields))}: expected 'object NAME', one word "
-                                 "of letters, digits, '_', '.', '-'")
+                raise InputError(
+                    f"{path}:{lineno}: object {_short(' '.join(fields))}: expected 'object NAME', one word "
+                    "of letters, digits, '_', '.', '-'"
+                )
             dup = next((o for o in objs[1:] if o.name == fields[0]), None)
             if dup is not None:
-                raise InputError(f"{path}:{lineno}: object {_short(fields[0])}: expected a new name (line {dup.lineno} "
-                                 "already starts an object of that name)")
+                raise InputError(
+                    f"{path}:{lineno}: object {_short(fields[0])}: expected a new name (line {dup.lineno} "
+                    "already starts an object of that name)"
+                )
             cur = _Obj(fields[0], lineno)
             objs.append(cur)
             single = False
         elif tag == "mesh":
             if len(fields) != 1:
-                raise InputError(f"{path}:{lineno}: mesh {_short(' '.join(fields))}: expected 'mesh PATH' "
-                                 "(one path without spaces, relative to the scene file)")
+                raise InputError(
+                    f"{path}:{lineno}: mesh {_short(' '.join(fields))}: expected 'mesh PATH' "
+                    "(one path without spaces, relative to the scene file)"
+                )
             if cur.mesh is not None or cur.geometry_line is not None:
                 first = cur.mesh[0] if cur.mesh is not None else cur.geometry_line
-                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected one source of geometry per "
-                                 f"object (line {first} already gives it); start a new 'object' first")
+                raise InputError(
+                    f"{path}:{lineno}: mesh {_short(fields[0])}: expected one source of geometry per "
+                    f"object (line {first} already gives it); start a new 'object' first"
+                )
             mesh_path = Path(fields[0])
             if not mesh_path.is_absolute():
                 mesh_path = base / mesh_path
             if mesh_path.suffix.lower() not in MESH_SUFFIXES:
-                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected a file ending in "
-                                 f"{' '.join(MESH_SUFFIXES)}")
+                raise InputError(
+                    f"{path}:{lineno}: mesh {_short(fields[0])}: expected a file ending in {' '.join(MESH_SUFFIXES)}"
+                )
             refused = problem(mesh_path, "mesh")
             if refused == "missing":
-                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: expected an existing file "
-                                 f"({mesh_path} not found)")
+                raise InputError(
+                    f"{path}:{lineno}: mesh {_short(fields[0])}: expected an existing file ({mesh_path} not found)"
+                )
             if refused is not None:
-                raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: {mesh_path}: {refused}: expected "
-                                 f"{expected('mesh')}")
+                raise InputError(
+                    f"{path}:{lineno}: mesh {_short(fields[0])}: {mesh_path}: {refused}: expected {expected('mesh')}"
+                )
             try:
                 cur.mesh = (lineno, load_mesh_file(mesh_path))
             except InputError as exc:
                 raise InputError(f"{path}:{lineno}: mesh {_short(fields[0])}: {exc}") from None
         elif tag in _MOTION_KEYS:
             if tag in cur.motion:
-                raise InputError(f"{path}:{lineno}: {tag} {_short(' '.join(fields))}: expected one '{tag}' per object "
-                                 f"(line {cur.motion[tag][0]} already gives it)")
+                raise InputError(
+                    f"{path}:{lineno}: {tag} {_short(' '.join(fields))}: expected one '{tag}' per object "
+                    f"(line {cur.motion[tag][0]} already gives it)"
+                )
             if tag == "scale":
                 if len(fields) != 1:
-                    raise InputError(f"{path}:{lineno}: scale {_short(' '.join(fields))}: expected 'scale S' (1 number)")
+                    raise InputError(
+                        f"{path}:{lineno}: scale {_short(' '.join(fields))}: expected 'scale S' (1 number)"
+                    )
                 s = _number(path, lineno, fields[0], "scale")
                 if s == 0.0:
                     raise InputError(f"{path}:{lineno}: scale {_short(fields[0])}: expected a non-zero number")
                 cur.motion[tag] = (lineno, s)
             else:
                 if len(fields) != 3:
-                    raise InputError(f"{path}:{lineno}: {tag} {_short(' '.join(fields))}: expected '{tag} X Y Z' "
-                                     f"(3 numbers), got {len(fields)}")
+                    raise InputError(
+                        f"{path}:{lineno}: {tag} {_short(' '.join(fields))}: expected '{tag} X Y Z' "
+                        f"(3 numbers), got {len(fields)}"
+                    )
                 values = tuple(_number(path, lineno, t, tag) for t in fields)
                 if tag == "spin":
                     check_turns(values, f"{path}:{lineno}: spin")
                 cur.motion[tag] = (lineno, values)
         else:
-            raise InputError(f"{path}:{lineno}: {_short(tag)}: expected a line starting with 'v', 'e', 'f', 'name', "
-                             "'object', 'mesh', 'translate', 'scale', 'spin' or '#'")
+            raise InputError(
+                f"{path}:{lineno}: {_short(tag)}: expected a line starting with 'v', 'e', 'f', 'name', "
+                "'object', 'mesh', 'translate', 'scale', 'spin' or '#'"
+            )
     scene_name = name or _safe_stem(path)
     _check_name_length(scene_name, path)
     if len(objs) > 1 and not implicit.touched():
-        objs = objs[1:]                           # nothing before the first 'object'
+        objs = objs[1:]  # nothing before the first 'object'
     implicit.name = scene_name
     if len(objs) > 1 and objs[0] is implicit:
         dup = next((o for o in objs[1:] if o.name == scene_name), None)
         if dup is not None:
-            raise InputError(f"{path}:{dup.lineno}: object {dup.name!r}: expected a name other than the scene's "
-                             "(the lines before the first 'object' form an object named after the scene)")
+            raise InputError(
+                f"{path}:{dup.lineno}: object {dup.name!r}: expected a name other than the scene's "
+                "(the lines before the first 'object' form an object named after the scene)"
+            )
     vertices, edges, faces, objects = [], [], [], []
     n = 0
     for o in objs:
@@ -235,8 +272,10 @@ def parse_scene_text(text: str, path: str = "<string>", name: str | None = None,
 
 def _check_name_length(name: str, path) -> None:
     if len(name) > MAX_NAME:
-        raise InputError(f"{path}: scene name {name[:40]!r}... of {len(name)} characters: expected at most "
-                         f"{MAX_NAME} (it names output files; give a shorter 'name' line or file name)")
+        raise InputError(
+            f"{path}: scene name {name[:40]!r}... of {len(name)} characters: expected at most "
+            f"{MAX_NAME} (it names output files; give a shorter 'name' line or file name)"
+        )
 
 
 def _obj_statements(path: Path):
@@ -254,8 +293,8 @@ class _ShortFaces:
 
     first_line: int = 0
     first_text: str = ""
-    edges: int = 0          # two-index faces, read as edges
-    points: int = 0         # one-index faces, skipped (a point draws nothing)
+    edges: int = 0  # two-index faces, read as edges
+    points: int = 0  # one-index faces, skipped (a point draws nothing)
 
     def add(self, lineno: int, raw: str, n_indices: int) -> None:
         if not self.first_line:
@@ -270,11 +309,18 @@ class _ShortFaces:
         n = self.edges + self.points
         if not n:
             return None
-        what = "; ".join(part for part in (
-            f"{self.edges} of two read as edges" if self.edges else "",
-            f"{self.points} of one skipped (a point draws nothing)" if self.points else "") if part)
-        return (f"{path}:{self.first_line}: {n} face{'s' * (n != 1)} with fewer than 3 vertex indices "
-                f"(first {_short(self.first_text)}): {what}")
+        what = "; ".join(
+            part
+            for part in (
+                f"{self.edges} of two read as edges" if self.edges else "",
+                f"{self.points} of one skipped (a point draws nothing)" if self.points else "",
+            )
+            if part
+        )
+        return (
+            f"{path}:{self.first_line}: {n} face{'s' * (n != 1)} with fewer than 3 vertex indices "
+            f"(first {_short(self.first_text)}): {what}"
+        )
 
 
 def _obj_lines(path: Path, short: _ShortFaces | None = None) -> list[tuple[int, int]]:
@@ -290,12 +336,13 @@ def _obj_lines(path: Path, short: _ShortFaces | None = None) -> list[tuple[int, 
         elif parts[0] in ("f", "fo") and len(parts) < 4:
             if short is not None:
                 short.add(lineno, raw, len(parts) - 1)
-            if len(parts) == 3:             # an edge: its two indices, read as an 'l' element's
+            if len(parts) == 3:  # an edge: its two indices, read as an 'l' element's
                 pairs.append(tuple(_obj_index(path, lineno, tok, n_v, "face") for tok in parts[1:]))
         elif parts[0] == "l":
-            if len(parts) < 3:          # a line of one vertex draws nothing
-                raise InputError(f"{path}:{lineno}: line element {_short(raw.strip())}: expected 2 or more "
-                                 "vertex indices")
+            if len(parts) < 3:  # a line of one vertex draws nothing
+                raise InputError(
+                    f"{path}:{lineno}: line element {_short(raw.strip())}: expected 2 or more vertex indices"
+                )
             idx = []
             for tok in parts[1:]:
                 idx.append(_obj_index(path, lineno, tok, n_v, "line element"))
@@ -326,30 +373,31 @@ def load_mesh_file(path: Path) -> Scene:
     """
     import trimesh  # lazy: only mesh files need it
 
-    with open_regular(path, "mesh"):   # a FIFO, a device, a folder or a file over the limit: one line, never read
+    with open_regular(path, "mesh"):  # a FIFO, a device, a folder or a file over the limit: one line, never read
         pass
     suffix = path.suffix.lower()
     if suffix == ".obj":
-        _check_obj(path)      # every 'v' and 'f' line first: errors with file:line, not trimesh's
+        _check_obj(path)  # every 'v' and 'f' line first: errors with file:line, not trimesh's
     elif suffix == ".stl":
-        check_stl(path)      # trimesh reads a truncated or foreign STL as an empty mesh, silently
+        check_stl(path)  # trimesh reads a truncated or foreign STL as an empty mesh, silently
     elif suffix == ".off":
-        check_off(path)      # trimesh takes any first line for 'OFF' and reads a short face list as none
+        check_off(path)  # trimesh takes any first line for 'OFF' and reads a short face list as none
     elif suffix == ".gltf":
-        check_json(path)     # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
+        check_json(path)  # trimesh's message for broken JSON is "FileNotFoundError: model.gltf"
     resolver = companion_resolver(path)
     absolute = _obj_absolute_indices(path) if suffix == ".obj" else None
-    if absolute is not None:     # read from memory: no resolver, so trimesh reads no companion
+    if absolute is not None:  # read from memory: no resolver, so trimesh reads no companion
         source, resolver = {"file_obj": io.BytesIO(absolute.encode("utf-8")), "file_type": "obj"}, None
-    else:       # trimesh reads the file opened here, never the name: a FIFO put there meanwhile cannot block
+    else:  # trimesh reads the file opened here, never the name: a FIFO put there meanwhile cannot block
         source = {"file_obj": open_regular(path, "mesh"), "file_type": suffix[1:], "resolver": resolver}
     try:
         with interrupts_kept(), quiet_libraries(), source["file_obj"]:  # trimesh logs tracebacks it recovers from
             loaded = trimesh.load(**source, process=False, maintain_order=True)
     except Exception as exc:  # trimesh raises many types; one line for the user
         _check_refused(path, resolver)
-        raise InputError(f"{path}: could not be read as {path.suffix[1:].upper()}: "
-                         f"{type(exc).__name__}: {exc}") from None
+        raise InputError(
+            f"{path}: could not be read as {path.suffix[1:].upper()}: {type(exc).__name__}: {exc}"
+        ) from None
     _check_refused(path, resolver)
     if isinstance(loaded, trimesh.Scene):
         loaded = loaded.to_geometry() if hasattr(loaded, "to_geometry") else loaded.dump(concatenate=True)
@@ -377,10 +425,14 @@ def load_mesh_file(path: Path) -> Scene:
         f, k = (int(i) for i in np.argwhere(bad)[0])
         value = int(faces[f, k])
         # the readers store indices as 32-bit integers: one beyond that range is read as -2**31
-        said = (f"a vertex index beyond 32-bit integers (read as {value})" if value in (-2 ** 31, 2 ** 31 - 1)
-                else f"vertex index {value}")
-        raise InputError(f"{path}: face {f} has {said}: expected 0..{len(vertices) - 1} "
-                         f"(the file has {len(vertices)} vertices)")
+        said = (
+            f"a vertex index beyond 32-bit integers (read as {value})"
+            if value in (-(2**31), 2**31 - 1)
+            else f"vertex index {value}"
+        )
+        raise InputError(
+            f"{path}: face {f} has {said}: expected 0..{len(vertices) - 1} (the file has {len(vertices)} vertices)"
+        )
     edges = [face_edges(faces)] if len(faces) else []
     short = _ShortFaces()
     if path.suffix.lower() == ".obj":
@@ -396,27 +448,39 @@ def load_mesh_file(path: Path) -> Scene:
     all_edges = np.concatenate(edges) if edges else np.zeros((0, 2), dtype=np.intp)
     # the Scene's faces are tuples of Python ints; the winding is checked on the array (the same edges)
     winding = winding_problem(faces) if len(faces) else None
-    faces = tuple(chain.from_iterable(map(tuple, faces[k:k + 65536].tolist())        # a block at a time:
-                                      for k in range(0, len(faces), 65536)))           # no list of all rows
+    faces = tuple(
+        chain.from_iterable(
+            map(tuple, faces[k : k + 65536].tolist())  # a block at a time:
+            for k in range(0, len(faces), 65536)
+        )
+    )  # no list of all rows
     _check_name_length(_safe_stem(path), path)
-    return Scene(name=_safe_stem(path), vertices=vertices, edges=unique_edges(all_edges),
-                 faces=faces, source=str(path), winding_note=winding,
-                 load_notes=tuple(n for n in (short.note(path),) if n))
+    return Scene(
+        name=_safe_stem(path),
+        vertices=vertices,
+        edges=unique_edges(all_edges),
+        faces=faces,
+        source=str(path),
+        winding_note=winding,
+        load_notes=tuple(n for n in (short.note(path),) if n),
+    )
 
 
 def _check_refused(path: Path, resolver) -> None:
     """InputError naming the first companion file of ``path`` the resolver refused (a FIFO, a device)."""
     if resolver is not None and resolver.refused:
         name, exc = resolver.refused[0]
-        raise InputError(f"{path}: the file it names {_short(name)} ({exc.path}): {exc.problem}: expected "
-                         f"{expected(exc.kind)}")
+        raise InputError(
+            f"{path}: the file it names {_short(name)} ({exc.path}): {exc.problem}: expected {expected(exc.kind)}"
+        )
 
 
 #: OBJ statements (the Wavefront spec's, free-form geometry included); others are ignored by readers,
 #: so a file without vertices is only "empty" when every line is one of these.
 OBJ_KEYWORDS = frozenset(
     "v vt vn vp f fo l p o g s mg mtllib usemtl usemap maplib lod bevel c_interp d_interp shadow_obj "
-    "trace_obj ctech stech cstype deg bmat step curv curv2 surf parm trim hole scrv sp end con call csh".split())
+    "trace_obj ctech stech cstype deg bmat step curv curv2 surf parm trim hole scrv sp end con call csh".split()
+)
 
 
 def _check_obj(path: Path) -> None:
@@ -428,7 +492,7 @@ def _check_obj(path: Path) -> None:
     lines are not OBJ statements (binary data, another format renamed) is not
     an empty mesh: its first such line is named.
     """
-    n_v, foreign, beyond = 0, None, None          # beyond: (index, line, token) of the largest 1-based index
+    n_v, foreign, beyond = 0, None, None  # beyond: (index, line, token) of the largest 1-based index
     for lineno, parts, raw in _obj_statements(path):
         if parts[0] == "v":
             if len(parts) < 4:
@@ -445,21 +509,29 @@ def _check_obj(path: Path) -> None:
                 except ValueError:
                     raise InputError(f"{path}:{lineno}: face index {_short(tok)}: expected an integer") from None
                 if k == 0 or n_v + k < 0:
-                    raise InputError(f"{path}:{lineno}: face index {_short(tok)}: expected a 1-based index or "
-                                     f"-1..-{n_v} (counting back over the {n_v} vertices before this line)")
+                    raise InputError(
+                        f"{path}:{lineno}: face index {_short(tok)}: expected a 1-based index or "
+                        f"-1..-{n_v} (counting back over the {n_v} vertices before this line)"
+                    )
                 if beyond is None or k > beyond[0]:
                     beyond = (k, lineno, tok)
         elif parts[0] not in OBJ_KEYWORDS and foreign is None:
             foreign = (lineno, raw.strip())
     if beyond is not None and beyond[0] > n_v:
         k, lineno, tok = beyond
-        raise InputError(f"{path}:{lineno}: face index {_short(tok)}: " + (
-            f"expected 1..{n_v} (the file has {n_v} vertices)" if n_v else
-            "the file has no vertices ('v X Y Z' lines): expected some"))
+        raise InputError(
+            f"{path}:{lineno}: face index {_short(tok)}: "
+            + (
+                f"expected 1..{n_v} (the file has {n_v} vertices)"
+                if n_v
+                else "the file has no vertices ('v X Y Z' lines): expected some"
+            )
+        )
     if n_v == 0 and foreign is not None:
         lineno, text = foreign
-        raise InputError(f"{path}:{lineno}: {_short(text)}: expected an OBJ statement (v, f, l, o, g, ...); "
-                         "no vertex in the file")
+        raise InputError(
+            f"{path}:{lineno}: {_short(text)}: expected an OBJ statement (v, f, l, o, g, ...); no vertex in the file"
+        )
 
 
 def _obj_absolute_indices(path: Path) -> str | None:
@@ -471,7 +543,7 @@ def _obj_absolute_indices(path: Path) -> str | None:
     fails on 'f -3/1 ...' and 'f -3//1 ...'.
     """
     counts = {"v": 0, "vt": 0, "vn": 0}
-    kinds = ("v", "vt", "vn")                   # the fields of 'v/vt/vn'
+    kinds = ("v", "vt", "vn")  # the fields of 'v/vt/vn'
     lines, changed = [], False
     with open_text(path, "mesh") as fh:
         for raw in fh:
@@ -542,28 +614,34 @@ def load_scene(name_or_path: str) -> Scene:
                 path = candidate
                 break
         else:
-            raise InputError(f"--scene {name_or_path!r}: expected a built-in scene "
-                             f"({', '.join(builtin_names() + example_names())}) or a file path")
+            raise InputError(
+                f"--scene {name_or_path!r}: expected a built-in scene "
+                f"({', '.join(builtin_names() + example_names())}) or a file path"
+            )
     try:
         if path.is_dir():
             raise InputError(f"--scene {name_or_path!r} is a directory: expected a scene file")
         if not path.is_file():
             try:
-                os.stat(path)         # ELOOP (a symbolic link loop), EACCES: named by the OSError below
+                os.stat(path)  # ELOOP (a symbolic link loop), EACCES: named by the OSError below
             except FileNotFoundError:
                 raise InputError(f"--scene {name_or_path!r}: file not found") from None
             refused = problem(path, "scene")
-            raise InputError(f"--scene {name_or_path!r}: {refused}: expected a scene or mesh file "
-                             "(never opened: reading it could block forever)")
-    except OSError as exc:      # ENAMETOOLONG, ELOOP, EACCES on a folder of the path
+            raise InputError(
+                f"--scene {name_or_path!r}: {refused}: expected a scene or mesh file "
+                "(never opened: reading it could block forever)"
+            )
+    except OSError as exc:  # ENAMETOOLONG, ELOOP, EACCES on a folder of the path
         raise InputError(f"--scene {_short(name_or_path)}: {exc.strerror or exc}: expected a readable file") from None
     suffix = path.suffix.lower()
     if suffix in MESH_SUFFIXES:
         return load_mesh_file(path)
     if suffix not in (NATIVE_SUFFIX, ".txt"):
-        raise InputError(f"{path}: suffix {path.suffix!r}: expected {NATIVE_SUFFIX} or one of {' '.join(MESH_SUFFIXES)}")
+        raise InputError(
+            f"{path}: suffix {path.suffix!r}: expected {NATIVE_SUFFIX} or one of {' '.join(MESH_SUFFIXES)}"
+        )
     try:
-        text = read_text(path, "scene")      # a byte-order mark (Windows editors) is not a tag
+        text = read_text(path, "scene")  # a byte-order mark (Windows editors) is not a tag
     except UnicodeDecodeError as exc:
         raise InputError(f"{path}: could not be read: {exc}") from None
     scene = parse_scene_text(text, str(path))

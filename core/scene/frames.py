@@ -33,12 +33,12 @@ import time
 import numpy as np
 
 from ..camera import Camera
-from ..projector.culling import sphere_outside_frustum
 from ..errors import InputError
+from ..projector.culling import sphere_outside_frustum
 from ..projector.pipeline import Frame, render_frame
 from ..projector.projection import LocalPoints, localize
-from .model import Scene, object_matrix, object_spheres, oriented_faces, world_points
 from ..transforms import Motion, apply
+from .model import Scene, object_matrix, object_spheres, oriented_faces, world_points
 
 #: The model matrix of a frame drawn from world points.
 IDENTITY = np.eye(4)
@@ -74,10 +74,21 @@ class SceneRenderer:
     ((480, 640), (8, 2), 0)
     """
 
-    def __init__(self, scene: Scene, motion: Motion, frames: int, *, clip: str = "clip",
-                 dtype: str = "float64", raster: str = "exact", cull: str | None = None,
-                 hidden_lines: bool = False, style: str = "wireframe", light=None,
-                 object_culling: bool = True):
+    def __init__(
+        self,
+        scene: Scene,
+        motion: Motion,
+        frames: int,
+        *,
+        clip: str = "clip",
+        dtype: str = "float64",
+        raster: str = "exact",
+        cull: str | None = None,
+        hidden_lines: bool = False,
+        style: str = "wireframe",
+        light=None,
+        object_culling: bool = True,
+    ):
         self.scene, self.motion, self.frames = scene, motion, frames
         self.clip, self.dtype, self.raster = clip, dtype, raster
         self.cull, self.hidden_lines, self.style, self.light = cull, hidden_lines, style, light
@@ -110,12 +121,27 @@ class SceneRenderer:
             return self.points, self.motion.frame_matrix(k, self.frames)
         return localize(self.world_points(k), self.dtype), IDENTITY
 
-    def draw(self, points: LocalPoints, model_matrix: np.ndarray, camera: Camera,
-             edges: np.ndarray | None = None, faces=None, timing: dict | None = None) -> Frame:
+    def draw(
+        self,
+        points: LocalPoints,
+        model_matrix: np.ndarray,
+        camera: Camera,
+        edges: np.ndarray | None = None,
+        faces=None,
+        timing: dict | None = None,
+    ) -> Frame:
         """One :func:`render_frame` call with this renderer's settings (default: all edges and faces)."""
         edges = self.scene.edges if edges is None else edges
-        return render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster, timing=timing,
-                            **self._face_kwargs(self.faces if faces is None else faces))
+        return render_frame(
+            points,
+            edges,
+            camera,
+            model_matrix,
+            self.clip,
+            raster=self.raster,
+            timing=timing,
+            **self._face_kwargs(self.faces if faces is None else faces),
+        )
 
     def project(self, points: LocalPoints, model_matrix: np.ndarray, camera: Camera) -> np.ndarray:
         """``(N, 2)`` vertex pixels, NaN where clipped: the pipeline given no edges, so nothing is drawn."""
@@ -182,20 +208,21 @@ class SceneRenderer:
             raise InputError(
                 f"{scene.source}: vertex {i - obj.vertex_start} of object {obj.name!r} "
                 f"{scene.vertices[i].tolist()} moves beyond the float64 range in frame {k}: expected "
-                f"coordinates whose world position (after the object's and the run's scale) fits in a float64")
+                f"coordinates whose world position (after the object's and the run's scale) fits in a float64"
+            )
 
     def _culled_objects(self, k: int, camera: Camera) -> list[int]:
         out = []
         for i, (obj, (centre, radius)) in enumerate(zip(self.scene.objects, self._spheres)):
             if obj.vertex_count == 0:
-                continue                      # nothing to draw: not counted as culled
+                continue  # nothing to draw: not counted as culled
             m = object_matrix(obj, self.motion, k, self.frames)
             c_world = apply(m, centre)[0]
             r_world = radius * abs(self.motion.scale * obj.motion.scale)
             # widen by far more than the rounding of apply() (a few eps of |c| + r)
             r_world += 1e-9 * (float(np.abs(c_world).max()) + r_world)
             if np.all(np.isfinite(c_world)) and math.isfinite(r_world):
-                with np.errstate(all="ignore"):            # near-overflow coordinates: no warnings
+                with np.errstate(all="ignore"):  # near-overflow coordinates: no warnings
                     if sphere_outside_frustum(c_world, r_world, camera):
                         out.append(i)
         return out
@@ -205,7 +232,7 @@ class SceneRenderer:
         if dropped_edges is not None and len(dropped_edges):
             whole = frame.visible[dropped_edges[:, 0]] & frame.visible[dropped_edges[:, 1]]
             info["clipped_edges"] += int(len(dropped_edges) - whole.sum())
-        if not self.single:                   # None: object culling off
+        if not self.single:  # None: object culling off
             info["objects_culled"] = n_culled if self.object_culling else None
         if self.uses_faces:
             info["faces_total"] = len(self.scene.faces)

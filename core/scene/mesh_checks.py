@@ -27,13 +27,17 @@ def check_stl(path: Path) -> None:
     if size >= 84:
         count = int.from_bytes(data[80:84], "little")
         if size == 84 + 50 * count:
-            return                                        # binary, even when the header starts with 'solid'
+            return  # binary, even when the header starts with 'solid'
     if not data.lstrip()[:5].lower() == b"solid":
         if size < 84:
-            raise InputError(f"{path}: {size} bytes: expected a binary STL (an 84-byte header, then 50 "
-                             "bytes a triangle) or an ASCII STL starting with 'solid'")
-        raise InputError(f"{path}: {size} bytes, its header declares {count} triangles: expected "
-                         f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)")
+            raise InputError(
+                f"{path}: {size} bytes: expected a binary STL (an 84-byte header, then 50 "
+                "bytes a triangle) or an ASCII STL starting with 'solid'"
+            )
+        raise InputError(
+            f"{path}: {size} bytes, its header declares {count} triangles: expected "
+            f"84 + 50 x {count} = {84 + 50 * count} bytes of binary STL (truncated, or not an STL)"
+        )
     check_ascii_stl(path, read_regular(path, "mesh").decode("latin-1"))
 
 
@@ -46,29 +50,33 @@ def check_off(path: Path) -> None:
         n, parts = rows[0] if rows else (1, ["(empty)"])
         raise InputError(f"{path}:{n}: {short(' '.join(parts))}: expected the header 'OFF' (or 'COFF')")
     head_n, head = rows[0]
-    if len(head) == 1:                                    # the counts on the next line
+    if len(head) == 1:  # the counts on the next line
         rows = rows[1:]
         head_n, head = rows[0] if rows else (head_n, [])
         head = ["OFF", *head]
     counts = head[1:4]
     if len(counts) < 2 or not all(t.isdigit() for t in counts):
-        raise InputError(f"{path}:{head_n}: counts {short(' '.join(head[1:]))}: expected 'VERTICES FACES EDGES' "
-                         "(integers >= 0)")
+        raise InputError(
+            f"{path}:{head_n}: counts {short(' '.join(head[1:]))}: expected 'VERTICES FACES EDGES' (integers >= 0)"
+        )
     n_v, n_f = int(counts[0]), int(counts[1])
     body = rows[1:]
     if len(body) < n_v + n_f:
-        raise InputError(f"{path}:{head_n}: {n_v} vertices and {n_f} faces declared, {len(body)} lines follow: "
-                         "expected a complete file (truncated?)")
+        raise InputError(
+            f"{path}:{head_n}: {n_v} vertices and {n_f} faces declared, {len(body)} lines follow: "
+            "expected a complete file (truncated?)"
+        )
     for n, parts in body[:n_v]:
         if len(parts) < 3:
             raise InputError(f"{path}:{n}: vertex {short(' '.join(parts))}: expected 'X Y Z'")
         for t in parts[:3]:
             number(path, n, t, "vertex coordinate")
-    for n, parts in body[n_v:n_v + n_f]:
+    for n, parts in body[n_v : n_v + n_f]:
         size = int(parts[0]) if parts[0].isdigit() else -1
-        if size < 3 or len(parts) < size + 1 or not all(t.isdigit() and int(t) < n_v for t in parts[1:size + 1]):
-            raise InputError(f"{path}:{n}: face {short(' '.join(parts))}: expected 'N I1 ... IN', N >= 3, "
-                             f"indices 0..{n_v - 1}")
+        if size < 3 or len(parts) < size + 1 or not all(t.isdigit() and int(t) < n_v for t in parts[1 : size + 1]):
+            raise InputError(
+                f"{path}:{n}: face {short(' '.join(parts))}: expected 'N I1 ... IN', N >= 3, indices 0..{n_v - 1}"
+            )
 
 
 def check_json(path: Path) -> None:
@@ -82,7 +90,7 @@ def check_json(path: Path) -> None:
     except json.JSONDecodeError as exc:
         raise InputError(f"{path}:{exc.lineno}:{exc.colno}: not JSON ({exc.msg}): expected glTF JSON") from None
     if not isinstance(doc, dict):
-        raise InputError(f"{path}: a JSON {type(doc).__name__}: expected a glTF object ({{\"asset\": ...}})")
+        raise InputError(f'{path}: a JSON {type(doc).__name__}: expected a glTF object ({{"asset": ...}})')
 
 
 _STL_TOKENS = frozenset(("solid", "facet", "outer", "vertex", "endloop", "endfacet", "endsolid"))
@@ -97,8 +105,10 @@ def check_ascii_stl(path: Path, text: str) -> None:
             continue
         tag = parts[0].lower()
         if tag not in _STL_TOKENS:
-            raise InputError(f"{path}:{lineno}: {short(raw.strip())}: expected an ASCII STL statement "
-                             "(solid, facet normal, outer loop, vertex X Y Z, endloop, endfacet, endsolid)")
+            raise InputError(
+                f"{path}:{lineno}: {short(raw.strip())}: expected an ASCII STL statement "
+                "(solid, facet normal, outer loop, vertex X Y Z, endloop, endfacet, endsolid)"
+            )
         if tag == "vertex":
             if len(parts) != 4 or not in_facet:
                 raise InputError(f"{path}:{lineno}: {short(raw.strip())}: expected 'vertex X Y Z' inside a facet")
@@ -111,13 +121,14 @@ def check_ascii_stl(path: Path, text: str) -> None:
             in_facet, vertices = True, 0
         elif tag == "endfacet":
             if not in_facet or vertices != 3:
-                raise InputError(f"{path}:{lineno}: endfacet after {vertices} vertices: expected a facet of "
-                                 "3 vertices")
+                raise InputError(f"{path}:{lineno}: endfacet after {vertices} vertices: expected a facet of 3 vertices")
             in_facet = False
         last = tag
     if in_facet or last != "endsolid":
-        raise InputError(f"{path}:{lineno}: the file ends {'inside a facet' if in_facet else 'without endsolid'}: "
-                         "expected a complete ASCII STL (truncated?)")
+        raise InputError(
+            f"{path}:{lineno}: the file ends {'inside a facet' if in_facet else 'without endsolid'}: "
+            "expected a complete ASCII STL (truncated?)"
+        )
 
 
 def check_ply_counts(path: Path, n_vertices: int, n_faces: int) -> None:
@@ -133,9 +144,10 @@ def check_ply_counts(path: Path, n_vertices: int, n_faces: int) -> None:
         if parts[:1] == ["element"] and len(parts) == 3 and parts[2].isdigit() and parts[1] in ("vertex", "face"):
             declared, read = int(parts[2]), n_vertices if parts[1] == "vertex" else n_faces
             if read < declared or (parts[1] == "vertex" and read != declared):
-                raise InputError(f"{path}:{lineno}: {line.strip()!r}, but {read} {'vertices' if parts[1] == 'vertex' else 'faces'} were read: expected "
-                                 "a complete file (truncated?)")
-
+                raise InputError(
+                    f"{path}:{lineno}: {line.strip()!r}, but {read} {'vertices' if parts[1] == 'vertex' else 'faces'} were read: expected "
+                    "a complete file (truncated?)"
+                )
 
 
 def number(path, lineno, token, what):
@@ -146,7 +158,6 @@ def number(path, lineno, token, what):
     if not math.isfinite(value):
         raise InputError(f"{path}:{lineno}: {what} {short(token)}: expected a finite number")
     return value
-
 
 
 def short(text: str) -> str:

@@ -30,6 +30,7 @@ from pathlib import Path
 
 from ..user_files import RefusedFile, read_regular
 
+
 def read_companion(path: Path) -> bytes:
     """The bytes of a companion file: a regular file within its limit (core.user_files); RefusedFile otherwise."""
     return read_regular(path, "mesh companion")
@@ -69,10 +70,10 @@ def companion_resolver(mesh_path: Path):
                         except RefusedFile as exc:
                             self.refused.append((name, exc))
                             raise
-                self.absolute(name)          # trimesh's message for a name outside the folder
+                self.absolute(name)  # trimesh's message for a name outside the folder
                 raise FileNotFoundError(name)
 
-            def keys(self):                   # a listing of the whole folder is never needed here
+            def keys(self):  # a listing of the whole folder is never needed here
                 return iter(())
 
         _RESOLVER_CLASS = RegularFileResolver
@@ -96,7 +97,7 @@ def interrupts_kept():
     saved = {}
     for sig in (signal.SIGINT, signal.SIGTERM):
         old = signal.getsignal(sig)
-        if not callable(old):               # SIG_DFL (the kernel ends the process) or SIG_IGN
+        if not callable(old):  # SIG_DFL (the kernel ends the process) or SIG_IGN
             continue
 
         def handler(signum, frame, old=old):

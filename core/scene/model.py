@@ -30,8 +30,11 @@ STATIC = Motion(turns=(0.0, 0.0, 0.0), offset=(0.0, 0.0, 0.0), scale=1.0)
 
 def is_static(motion: Motion) -> bool:
     """True when ``motion`` is the identity in every frame."""
-    return (all(float(t) == 0.0 for t in motion.turns) and all(float(o) == 0.0 for o in motion.offset)
-            and float(motion.scale) == 1.0)
+    return (
+        all(float(t) == 0.0 for t in motion.turns)
+        and all(float(o) == 0.0 for o in motion.offset)
+        and float(motion.scale) == 1.0
+    )
 
 
 @dataclass(frozen=True)
@@ -75,9 +78,9 @@ class Scene:
     """
 
     name: str
-    vertices: np.ndarray                     # (N, 3) float64, p_model
-    edges: np.ndarray                        # (E, 2) intp, unique, i < j
-    faces: tuple = field(default=())         # tuple of index tuples (polygons)
+    vertices: np.ndarray  # (N, 3) float64, p_model
+    edges: np.ndarray  # (E, 2) intp, unique, i < j
+    faces: tuple = field(default=())  # tuple of index tuples (polygons)
     source: str = ""
     #: The objects, in file order; () when built by hand means one static object of everything.
     objects: tuple = field(default=())
@@ -96,8 +99,12 @@ class Scene:
     @property
     def is_single_static(self) -> bool:
         """One object with the identity motion: a frame's model matrix is the run's alone."""
-        return (len(self.objects) == 1 and is_static(self.objects[0].motion)
-                and self.objects[0].vertex_start == 0 and self.objects[0].vertex_stop == len(self.vertices))
+        return (
+            len(self.objects) == 1
+            and is_static(self.objects[0].motion)
+            and self.objects[0].vertex_start == 0
+            and self.objects[0].vertex_stop == len(self.vertices)
+        )
 
     @property
     def radius(self) -> float:
@@ -114,15 +121,17 @@ class Scene:
         for o in self.objects:
             if o.vertex_count == 0:
                 continue
-            r = _radius(self.vertices[o.vertex_start:o.vertex_stop])
+            r = _radius(self.vertices[o.vertex_start : o.vertex_stop])
             best = max(best, _radius(np.asarray([o.motion.offset], dtype=np.float64)) + abs(o.motion.scale) * r)
         return best
 
     def object_edge_ranges(self) -> list[tuple[int, int]]:
         """``(start, stop)`` rows of ``edges`` of each object (edges are sorted, objects' vertices contiguous)."""
         first = self.edges[:, 0] if len(self.edges) else np.zeros(0, dtype=np.intp)
-        return [(int(np.searchsorted(first, o.vertex_start)), int(np.searchsorted(first, o.vertex_stop)))
-                for o in self.objects]
+        return [
+            (int(np.searchsorted(first, o.vertex_start)), int(np.searchsorted(first, o.vertex_stop)))
+            for o in self.objects
+        ]
 
     def object_face_ranges(self) -> list[tuple[int, int]]:
         """``(start, stop)`` items of ``faces`` of each object (faces are kept in object order)."""
@@ -143,7 +152,7 @@ def radius_about(points: np.ndarray, centre) -> float:
 def _radius(vertices: np.ndarray) -> float:
     if len(vertices) == 0:
         return 0.0
-    big = float(np.abs(vertices).max())       # scale first: squares of 1e155 overflow
+    big = float(np.abs(vertices).max())  # scale first: squares of 1e155 overflow
     if big == 0.0:
         return 0.0
     return big * float(np.sqrt(((vertices / big) ** 2).sum(axis=1).max()))
@@ -199,7 +208,7 @@ def object_spheres(scene: Scene) -> list[tuple[np.ndarray, float]]:
     """
     out = []
     for o in scene.objects:
-        v = scene.vertices[o.vertex_start:o.vertex_stop]
+        v = scene.vertices[o.vertex_start : o.vertex_stop]
         if len(v) == 0:
             out.append((np.zeros(3), -1.0))
             continue

@@ -37,7 +37,6 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-
 from wirecheck.core.errors import InputError
 from wirecheck.core.user_files import expected, problem, read_regular
 
@@ -106,27 +105,28 @@ def load_candidate(spec: str, option: str = "--candidate", params: tuple = ("poi
         refused = problem(path, "candidate")
         if refused == "missing":
             raise InputError(f"{option} {spec!r}: file {target!r} not found")
-        if refused is not None:         # a FIFO, a device, a folder: never opened (reading it could block forever)
+        if refused is not None:  # a FIFO, a device, a folder: never opened (reading it could block forever)
             raise InputError(f"{option} {spec!r}: {target}: {refused}: expected {expected('candidate')}")
         mod_name = f"wirecheck_candidate_{path.stem}"
-        folder = str(path.resolve().parent)        # like running a script: the candidate's own folder is importable
+        folder = str(path.resolve().parent)  # like running a script: the candidate's own folder is importable
         try:
             with _candidate_imports(folder):
-                module_spec = importlib.util.spec_from_file_location(mod_name, path,
-                                                                     loader=_RegularSourceLoader(mod_name, str(path)))
+                module_spec = importlib.util.spec_from_file_location(
+                    mod_name, path, loader=_RegularSourceLoader(mod_name, str(path))
+                )
                 module = importlib.util.module_from_spec(module_spec)
                 sys.modules[mod_name] = module
                 module_spec.loader.exec_module(module)
         except (Exception, SystemExit) as exc:  # the user's file: report, don't trace back, don't exit
-            raise InputError(f"{option} {spec!r}: importing {target} failed: "
-                             f"{type(exc).__name__}: {exc}") from None
+            raise InputError(f"{option} {spec!r}: importing {target} failed: {type(exc).__name__}: {exc}") from None
     else:
         try:
             with _candidate_imports():
                 module = importlib.import_module(target)
         except (Exception, SystemExit) as exc:
-            raise InputError(f"{option} {spec!r}: importing module {target!r} failed: "
-                             f"{type(exc).__name__}: {exc}") from None
+            raise InputError(
+                f"{option} {spec!r}: importing module {target!r} failed: {type(exc).__name__}: {exc}"
+            ) from None
     func = getattr(module, func_name, None)
     if not callable(func):
         raise InputError(f"{option} {spec!r}: {target} has no callable {func_name!r}")
@@ -134,9 +134,11 @@ def load_candidate(spec: str, option: str = "--candidate", params: tuple = ("poi
         inspect.signature(func).bind(*(None,) * len(params))
     except TypeError:
         call = f"{func_name}({', '.join(params)})"
-        raise InputError(f"{option} {spec!r}: {func_name}{inspect.signature(func)} cannot be called as "
-                         f"{call}: expected the contract FUNC({', '.join(params)})") from None
-    except ValueError:      # builtins without a signature: find out when called
+        raise InputError(
+            f"{option} {spec!r}: {func_name}{inspect.signature(func)} cannot be called as "
+            f"{call}: expected the contract FUNC({', '.join(params)})"
+        ) from None
+    except ValueError:  # builtins without a signature: find out when called
         pass
     return _Loaded(func, folder)
 
@@ -163,18 +165,23 @@ def _as_pixels(out) -> np.ndarray:
             warnings.simplefilter("error")
             arr = np.asarray(out)
             if arr.dtype.kind == "c":
-                raise CandidateError(f"candidate returned complex numbers ({arr.dtype}): expected an (N, 2) "
-                                     "real float array")
-            if arr.dtype.kind in "bUSMmV":     # would cast to numbers that are not pixels (True: 1.0, "3": 3.0)
-                raise CandidateError(f"candidate returned an array of {arr.dtype} ({_KINDS[arr.dtype.kind]}): "
-                                     "expected an (N, 2) float array")
+                raise CandidateError(
+                    f"candidate returned complex numbers ({arr.dtype}): expected an (N, 2) real float array"
+                )
+            if arr.dtype.kind in "bUSMmV":  # would cast to numbers that are not pixels (True: 1.0, "3": 3.0)
+                raise CandidateError(
+                    f"candidate returned an array of {arr.dtype} ({_KINDS[arr.dtype.kind]}): "
+                    "expected an (N, 2) float array"
+                )
             return arr.astype(np.float64)
     except CandidateError:
         raise
-    except Exception as exc:   # OverflowError, a raising __array__/__float__, ragged lists, warnings
-        raise CandidateError(f"candidate returned {what} that is not an array of floats "
-                             f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}): "
-                             "expected an (N, 2) float array") from exc
+    except Exception as exc:  # OverflowError, a raising __array__/__float__, ragged lists, warnings
+        raise CandidateError(
+            f"candidate returned {what} that is not an array of floats "
+            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}): "
+            "expected an (N, 2) float array"
+        ) from exc
 
 
 def returned_precision(out) -> str:
@@ -211,25 +218,29 @@ def call_candidate_precision(func, points: np.ndarray, camera) -> tuple[np.ndarr
     """
     try:
         out = func(np.array(points, dtype=np.float64, copy=True), camera)
-    except CandidateError:                   # an isolated candidate's own one-line reason
+    except CandidateError:  # an isolated candidate's own one-line reason
         raise
-    except (Exception, SystemExit) as exc:   # a candidate must not end the run (nor pass CI by exiting 0)
+    except (Exception, SystemExit) as exc:  # a candidate must not end the run (nor pass CI by exiting 0)
         raise CandidateError(f"candidate raised {type(exc).__name__}: {exc}") from exc
     told = getattr(func, "answer_precision", None)
     precision = told() if callable(told) else returned_precision(out)
     out = _as_pixels(out)
-    if len(points) == 0 and out.shape == (0,):     # [] from a list-of-lists projector: no points, no pixels
+    if len(points) == 0 and out.shape == (0,):  # [] from a list-of-lists projector: no points, no pixels
         out = out.reshape(0, 2)
     if out.shape != (len(points), 2):
         raise CandidateError(f"candidate returned shape {out.shape}: expected ({len(points)}, 2)")
     infinite = np.isinf(out).any(axis=1)
     if infinite.any():
         k = int(np.flatnonzero(infinite)[0])
-        raise CandidateError(f"candidate returned {out[k].tolist()} for point {k} {np.asarray(points)[k].tolist()}: "
-                             "expected finite pixel coordinates, or NaN for a clipped point")
+        raise CandidateError(
+            f"candidate returned {out[k].tolist()} for point {k} {np.asarray(points)[k].tolist()}: "
+            "expected finite pixel coordinates, or NaN for a clipped point"
+        )
     half = np.isnan(out).any(axis=1) & ~np.isnan(out).all(axis=1)
     if half.any():
         k = int(np.flatnonzero(half)[0])
-        raise CandidateError(f"candidate returned {out[k].tolist()} for point {k}: expected both coordinates "
-                             "NaN (clipped) or both finite")
+        raise CandidateError(
+            f"candidate returned {out[k].tolist()} for point {k}: expected both coordinates "
+            "NaN (clipped) or both finite"
+        )
     return out, precision

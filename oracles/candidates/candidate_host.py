@@ -16,20 +16,30 @@ from __future__ import annotations
 
 import os
 import sys
+
 from wirecheck.core.errors import InputError
 
 
 def _camera(msg: dict):
     """The contract's Camera with exactly the vectors of the message (no re-normalising)."""
     import numpy as np
-
     from wirecheck.core.camera import Camera
 
     vec = {k: np.array(msg[k], dtype=np.float64) for k in ("position", "forward", "up", "right")}
-    cam = Camera(position=vec["position"], forward=vec["forward"], up=vec["up"], fov_y_deg=msg["fov_y_deg"],
-                 width=msg["width"], height=msg["height"], near=msg["near"], far=msg["far"],
-                 projection=msg["projection"], ortho_height=msg["ortho_height"],
-                 intrinsics=msg.get("intrinsics"), distortion=msg.get("distortion"))
+    cam = Camera(
+        position=vec["position"],
+        forward=vec["forward"],
+        up=vec["up"],
+        fov_y_deg=msg["fov_y_deg"],
+        width=msg["width"],
+        height=msg["height"],
+        near=msg["near"],
+        far=msg["far"],
+        projection=msg["projection"],
+        ortho_height=msg["ortho_height"],
+        intrinsics=msg.get("intrinsics"),
+        distortion=msg.get("distortion"),
+    )
     for k, v in vec.items():
         v.setflags(write=False)
         object.__setattr__(cam, k, v)
@@ -61,12 +71,11 @@ def serve(spec: str, stdin, stdout, unproject: bool = False) -> int:
     try:
         from .candidate import load_candidate
 
-        func = (load_candidate(spec, "unprojector", ("pixels", "depth", "camera")) if unproject
-                else load_candidate(spec))
+        func = load_candidate(spec, "unprojector", ("pixels", "depth", "camera")) if unproject else load_candidate(spec)
     except InputError as exc:
         send(protocol.encode_error(str(exc)))
         return 0
-    except BaseException as exc:        # KeyboardInterrupt, GeneratorExit at import: refuse, in one line
+    except BaseException as exc:  # KeyboardInterrupt, GeneratorExit at import: refuse, in one line
         send(protocol.encode_error(f"--candidate {spec!r}: importing failed: {type(exc).__name__}: {exc}"))
         return 0
     send(protocol.HEADER)
@@ -86,8 +95,8 @@ def serve_loaded(func, stdin, send) -> int:
         request = protocol.parse_line(line, "a request")
         n = int(request["n"])
         p_world = protocol.decode_points(_read_exact(stdin, n * protocol.REQUEST_POINT_BYTES), 3)
-        key = line[line.find(b'"camera"'):]
-        if key != camera_key:              # the same camera for a case's requests: built once
+        key = line[line.find(b'"camera"') :]
+        if key != camera_key:  # the same camera for a case's requests: built once
             camera_key, camera = key, _camera(request["camera"])
         if request.get("kind") == "unproject":
             send(_unprojected(func, p_world, camera))
@@ -97,10 +106,10 @@ def serve_loaded(func, stdin, send) -> int:
         except CandidateError as exc:
             send(protocol.encode_error(str(exc)))
             continue
-        except BaseException as exc:     # KeyboardInterrupt, GeneratorExit: this request fails
+        except BaseException as exc:  # KeyboardInterrupt, GeneratorExit: this request fails
             send(protocol.encode_error(f"candidate raised {type(exc).__name__}: {exc}"))
             continue
-        send(protocol.encode_reply(p_px, precision))    # the dtype the function returned, for the harness
+        send(protocol.encode_reply(p_px, precision))  # the dtype the function returned, for the harness
 
 
 def _unprojected(func, rows, camera) -> bytes:
@@ -114,10 +123,12 @@ def _unprojected(func, rows, camera) -> bytes:
         out = func(rows[:, :2].copy(), rows[:, 2].copy(), camera)
         arr = np.asarray(out)
         if arr.dtype.kind not in "fiu" or arr.shape != (len(rows), 3):
-            return protocol.encode_error(f"returned {type(out).__name__} of shape {getattr(arr, 'shape', None)} and "
-                                         f"dtype {arr.dtype}: expected an ({len(rows)}, 3) float array")
+            return protocol.encode_error(
+                f"returned {type(out).__name__} of shape {getattr(arr, 'shape', None)} and "
+                f"dtype {arr.dtype}: expected an ({len(rows)}, 3) float array"
+            )
         return protocol.encode_reply(arr.astype(np.float64), returned_precision(out), columns=3)
-    except BaseException as exc:     # SystemExit, KeyboardInterrupt too: this request fails
+    except BaseException as exc:  # SystemExit, KeyboardInterrupt too: this request fails
         return protocol.encode_error(f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}")
 
 
@@ -127,8 +138,10 @@ def main(argv=None) -> int:
     if unproject:
         argv = argv[1:]
     if len(argv) != 1:
-        print("usage: python -m wirecheck.oracles.candidates.candidate_host [--unproject] FILE.py:FUNC|MODULE:FUNC",
-              file=sys.stderr)
+        print(
+            "usage: python -m wirecheck.oracles.candidates.candidate_host [--unproject] FILE.py:FUNC|MODULE:FUNC",
+            file=sys.stderr,
+        )
         return 2
     # this process is wirecheck's: nothing the candidate imports, at start-up or inside a call,
     # leaves a __pycache__ folder in the user's folders
@@ -137,7 +150,7 @@ def main(argv=None) -> int:
     if extra:
         sys.path[:0] = [p for p in extra.split(os.pathsep) if p]
     # the protocol keeps the real stdout; the candidate's prints (Python or C) go to stderr
-    protocol_out = os.fdopen(os.dup(1), "wb")        # buffered: a raw write may be partial
+    protocol_out = os.fdopen(os.dup(1), "wb")  # buffered: a raw write may be partial
     os.dup2(2, 1)
     sys.stdout = sys.stderr
     return serve(argv[0], sys.stdin.buffer, protocol_out, unproject)

@@ -12,15 +12,13 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-
+from wirecheck.core.projector import pipeline
 from wirecheck.core.projector.clipping import CLIP_MODES
 from wirecheck.core.projector.culling import CULL_CHOICES
-from wirecheck.core.projector.projection import DTYPES
+from wirecheck.core.projector.projection import DTYPES, localize, project_points
 from wirecheck.core.projector.raster import RASTER_MODES
 from wirecheck.core.projector.shading import STYLES
-from wirecheck.core.projector.projection import localize, project_points
 from wirecheck.core.scene.frames import SceneRenderer
-from wirecheck.core.projector import pipeline
 
 #: A frame of core's pipeline is greyscale with raster "aa": a pixel is drawn from half intensity up.
 DRAWN_THRESHOLD = 128
@@ -34,7 +32,7 @@ class RenderMode:
     hidden_lines: bool = False
     cull: str = "none"
 
-    STYLES: ClassVar[tuple] = STYLES              # core's own lists
+    STYLES: ClassVar[tuple] = STYLES  # core's own lists
     CULLS: ClassVar[tuple] = CULL_CHOICES
 
     def __post_init__(self):
@@ -58,8 +56,11 @@ class RenderMode:
 
     def core_kwargs(self) -> dict:
         """Keywords of :func:`core.projector.pipeline.render_frame`."""
-        return {"style": self.style, "hidden_lines": self.hidden_lines,
-                "cull": None if self.cull == "none" else self.cull}
+        return {
+            "style": self.style,
+            "hidden_lines": self.hidden_lines,
+            "cull": None if self.cull == "none" else self.cull,
+        }
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,7 @@ class CoreCandidate:
     raster: str = "exact"
 
     name: ClassVar[str] = "core"
-    DTYPES: ClassVar[tuple] = DTYPES              # core's own lists, so the two cannot drift apart
+    DTYPES: ClassVar[tuple] = DTYPES  # core's own lists, so the two cannot drift apart
     CLIPS: ClassVar[tuple] = CLIP_MODES
     RASTERS: ClassVar[tuple] = RASTER_MODES
 
@@ -101,8 +102,9 @@ class CoreCandidate:
         and model matrix, and its ``faces`` the faces as core draws them, as
         ``renderer`` sets them up.
         """
-        return SceneRenderer(scene, motion, frames, clip=self.clip, dtype=self.dtype, raster=self.raster,
-                             object_culling=False)
+        return SceneRenderer(
+            scene, motion, frames, clip=self.clip, dtype=self.dtype, raster=self.raster, object_culling=False
+        )
 
     def project(self, points, camera, model_matrix: np.ndarray) -> np.ndarray:
         """Vertex pixels from core's pipeline without drawing: ``render_frame`` given no edges."""
@@ -116,16 +118,17 @@ class CoreCandidate:
 
     def render(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces, mode: RenderMode):
         """core's :class:`~core.projector.pipeline.Frame` in a drawing mode (faces None: the scene has none)."""
-        return pipeline.render_frame(points, edges, camera, model_matrix, self.clip, raster=self.raster, faces=faces,
-                            **mode.core_kwargs())
+        return pipeline.render_frame(
+            points, edges, camera, model_matrix, self.clip, raster=self.raster, faces=faces, **mode.core_kwargs()
+        )
 
-    def draw_mode(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces,
-                  mode: RenderMode) -> np.ndarray:
+    def draw_mode(
+        self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces, mode: RenderMode
+    ) -> np.ndarray:
         """The frame core draws with hidden lines and/or culling, as a bool image."""
         return self.render(points, edges, camera, model_matrix, faces, mode).image >= DRAWN_THRESHOLD
 
-    def shade(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces,
-              mode: RenderMode) -> np.ndarray:
+    def shade(self, points, edges: np.ndarray, camera, model_matrix: np.ndarray, faces, mode: RenderMode) -> np.ndarray:
         """core's depth buffer of a shaded frame: ``(H, W)`` linear camera depth, +inf where empty.
 
         The polygon shown at each pixel (-1: none) is kept in ``self.last_face_ids``.

@@ -32,7 +32,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
 from wirecheck.core.errors import InputError
 from wirecheck.core.user_files import read_regular
 
@@ -99,17 +98,26 @@ def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCA
     """
     path = Path(path)
     _check_size(width, height)
-    if not (isinstance(scale, (int, float)) and not isinstance(scale, bool) and math.isfinite(scale) and scale > 0
-            and math.isfinite(_PNG_MAX / scale)):
-        raise InputError(f"depth scale {scale!r}: expected a finite number of values per unit > 0 (default 1000) "
-                         f"with {_PNG_MAX:g} / scale finite")
+    if not (
+        isinstance(scale, (int, float))
+        and not isinstance(scale, bool)
+        and math.isfinite(scale)
+        and scale > 0
+        and math.isfinite(_PNG_MAX / scale)
+    ):
+        raise InputError(
+            f"depth scale {scale!r}: expected a finite number of values per unit > 0 (default 1000) "
+            f"with {_PNG_MAX:g} / scale finite"
+        )
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".png", ".tif", ".tiff"):
-        raise InputError(f"{path}: a {suffix or 'suffix-less'} file: expected a depth map as .npy (float32), "
-                         ".tif (32-bit float) or .png (16-bit)")
+        raise InputError(
+            f"{path}: a {suffix or 'suffix-less'} file: expected a depth map as .npy (float32), "
+            ".tif (32-bit float) or .png (16-bit)"
+        )
     if not os.path.lexists(path):
         raise InputError(f"{path}: no such file: expected a depth map of {width}x{height}")
-    data = read_regular(path, "depth map")       # a FIFO, a device, a folder or a huge file: one line, nothing read
+    data = read_regular(path, "depth map")  # a FIFO, a device, a folder or a huge file: one line, nothing read
     if suffix == ".npy":
         return _npy_map(data, path, width, height)
     from PIL import Image, UnidentifiedImageError
@@ -117,7 +125,7 @@ def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCA
     want = "a 16-bit grey PNG (mode I;16)" if suffix == ".png" else "a 32-bit float TIFF (mode F)"
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("error", Image.DecompressionBombWarning)     # its size is checked below
+            warnings.simplefilter("error", Image.DecompressionBombWarning)  # its size is checked below
             with Image.open(io.BytesIO(data)) as im:
                 mode, fmt, size = im.mode, im.format, im.size
                 if (mode, suffix) not in (("I;16", ".png"), ("F", ".tif"), ("F", ".tiff")):
@@ -125,12 +133,18 @@ def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCA
                 if size != (width, height):
                     raise InputError(_shape_text(str(path), size[::-1], width, height))
                 values = np.asarray(im)
-    except InputError:                          # our own line above (InputError is a ValueError): as it is
+    except InputError:  # our own line above (InputError is a ValueError): as it is
         raise
-    except (OSError, UnidentifiedImageError, ValueError, Image.DecompressionBombError,
-            Image.DecompressionBombWarning) as exc:
-        raise InputError(f"{path}: not a readable image ({' '.join(str(exc).split())[:120]}): expected {want} "
-                         "depth map") from None
+    except (
+        OSError,
+        UnidentifiedImageError,
+        ValueError,
+        Image.DecompressionBombError,
+        Image.DecompressionBombWarning,
+    ) as exc:
+        raise InputError(
+            f"{path}: not a readable image ({' '.join(str(exc).split())[:120]}): expected {want} depth map"
+        ) from None
     if suffix == ".png":
         depth = values.astype(np.float64) / float(scale)
         return depth_from_array(depth, width, height, str(path), f"png uint16 / {scale:g}", 1.0 / float(scale), 0.0)
@@ -138,16 +152,27 @@ def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCA
 
 
 #: What numpy's .npy header parser may raise on a hostile header (it evaluates a Python literal).
-_NPY_HEADER_ERRORS = (ValueError, SyntaxError, TypeError, OverflowError, MemoryError, RecursionError,
-                      EOFError, tokenize.TokenError)
+_NPY_HEADER_ERRORS = (
+    ValueError,
+    SyntaxError,
+    TypeError,
+    OverflowError,
+    MemoryError,
+    RecursionError,
+    EOFError,
+    tokenize.TokenError,
+)
 
 
 def _npy_map(data: bytes, path: Path, width: int, height: int) -> DepthMap:
     """A ``.npy`` file's bytes as a depth map: its header checked (a float dtype, the camera's shape)
     before any of its body is used; no pickle, whatever the header says."""
+
     def refuse(why: str):
-        raise InputError(f"{path}: not a readable .npy file ({' '.join(why.split())[:120]}): "
-                         "expected a 2-D float32 array")
+        raise InputError(
+            f"{path}: not a readable .npy file ({' '.join(why.split())[:120]}): expected a 2-D float32 array"
+        )
+
     fh = io.BytesIO(data)
     try:
         version = np.lib.format.read_magic(fh)
@@ -155,13 +180,15 @@ def _npy_map(data: bytes, path: Path, width: int, height: int) -> DepthMap:
             refuse(f"format version {version[0]}.{version[1]}, expected 1.0 or 2.0")
         read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
         shape, fortran, dtype = read_header(fh)
-    except InputError:                          # refuse()'s own line (InputError is a ValueError): as it is
+    except InputError:  # refuse()'s own line (InputError is a ValueError): as it is
         raise
     except _NPY_HEADER_ERRORS as exc:
         refuse(str(exc) or type(exc).__name__)
     if dtype.kind != "f" or dtype.itemsize not in (4, 8):
-        raise InputError(f"{path}: a .npy of {dtype}: expected float32 depth in world units "
-                         "(a 16-bit map belongs in a .png with a scale)")
+        raise InputError(
+            f"{path}: a .npy of {dtype}: expected float32 depth in world units "
+            "(a 16-bit map belongs in a .png with a scale)"
+        )
     if tuple(shape) != (height, width):
         raise InputError(_shape_text(str(path), tuple(shape), width, height))
     start, need = fh.tell(), height * width * dtype.itemsize
@@ -181,12 +208,21 @@ def _check_size(width, height) -> None:
 
 
 def _shape_text(name: str, shape: tuple, width: int, height: int) -> str:
-    return (f"{name}: a depth map of shape {shape} ({'x'.join(map(str, shape[::-1]))}): "
-            f"expected {width}x{height} (height {height} rows, width {width} columns)")
+    return (
+        f"{name}: a depth map of shape {shape} ({'x'.join(map(str, shape[::-1]))}): "
+        f"expected {width}x{height} (height {height} rows, width {width} columns)"
+    )
 
 
-def depth_from_array(values, width: int, height: int, name: str = "depth map", encoding: str = "array",
-                     step: float = 0.0, rel_step: float = 0.0) -> DepthMap:
+def depth_from_array(
+    values,
+    width: int,
+    height: int,
+    name: str = "depth map",
+    encoding: str = "array",
+    step: float = 0.0,
+    rel_step: float = 0.0,
+) -> DepthMap:
     """An ``(H, W)`` array of depths as a :class:`DepthMap`: 0 and non-finite values become NaN.
 
     Raises InputError (naming ``name``) for another shape or a negative depth.
@@ -200,7 +236,9 @@ def depth_from_array(values, width: int, height: int, name: str = "depth map", e
         negative = depth < 0
     if negative.any():
         r, c = (int(i) for i in np.argwhere(negative)[0])
-        raise InputError(f"{name}: depth {float(depth[r, c])!r} at row {r}, column {c} ({int(negative.sum())} negative "
-                         "in all): expected depth along forward >= 0 (0, NaN or +inf: no surface)")
+        raise InputError(
+            f"{name}: depth {float(depth[r, c])!r} at row {r}, column {c} ({int(negative.sum())} negative "
+            "in all): expected depth along forward >= 0 (0, NaN or +inf: no surface)"
+        )
     depth[~np.isfinite(depth) | (depth == 0)] = np.nan
     return DepthMap(depth=depth, encoding=encoding, step=float(step), rel_step=float(rel_step))

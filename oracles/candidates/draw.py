@@ -20,13 +20,12 @@ for float32 (a small fraction of a pixel unless the edge is seen end-on).
 from __future__ import annotations
 
 import numpy as np
-
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector.raster import line_pixels
 
 from ..references import opencv_oracle
-from .candidate import call_candidate
 from ..tolerances import DEPTH_ROUNDINGS, EPS
+from .candidate import call_candidate
 
 #: Clipped ends are moved at least this fraction of the kept segment inward
 #: (1e-9 of a segment is far below a pixel for any segment shorter than 1e8 px).
@@ -61,18 +60,20 @@ def clip_depth(p0_world, p1_world, camera, precision: str = "float64", slack: fl
     t_out = np.ones(len(d0))
     with np.errstate(divide="ignore", invalid="ignore"):
         for plane, sign in ((camera.near, 1.0), (camera.far, -1.0)):
-            s0 = sign * (d0 - plane)          # >= 0 inside
+            s0 = sign * (d0 - plane)  # >= 0 inside
             s1 = sign * (d1 - plane)
             t = s0 / (s0 - s1)
             t_in = np.where((s0 < 0) & (s1 >= 0), np.maximum(t_in, t), t_in)
             t_out = np.where((s0 >= 0) & (s1 < 0), np.minimum(t_out, t), t_out)
-            t_in = np.where((s0 < 0) & (s1 < 0), 2.0, t_in)   # both outside: drop
+            t_in = np.where((s0 < 0) & (s1 < 0), 2.0, t_in)  # both outside: drop
     kept = t_in <= t_out
     span = (t_out - t_in)[kept]
     d = (p1_world - p0_world)[kept]
-    margin = np.maximum(np.maximum(depth_margin(p0_world[kept], camera, precision),
-                                   depth_margin(p1_world[kept], camera, precision)), slack)
-    with np.errstate(divide="ignore", invalid="ignore"):   # depth constant along it: never clipped, never moved
+    margin = np.maximum(
+        np.maximum(depth_margin(p0_world[kept], camera, precision), depth_margin(p1_world[kept], camera, precision)),
+        slack,
+    )
+    with np.errstate(divide="ignore", invalid="ignore"):  # depth constant along it: never clipped, never moved
         margin_t = margin / np.abs(d1 - d0)[kept]
     inward = np.clip(margin_t, _INWARD * span, _MAX_INWARD * span)
     a = t_in[kept] + np.where(t_in[kept] > 0, inward, 0.0)
@@ -81,8 +82,9 @@ def clip_depth(p0_world, p1_world, camera, precision: str = "float64", slack: fl
     return kept, ends
 
 
-def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera, precision: str = "float64",
-                   slack: float = 0.0) -> np.ndarray:
+def draw_candidate(
+    func, p_world: np.ndarray, edges: np.ndarray, camera, precision: str = "float64", slack: float = 0.0
+) -> np.ndarray:
     """``(H, W)`` bool image of the candidate's wireframe (``precision``: the candidate's, and ``slack``:
     its probed planes' depth offset, for the clipped ends; :func:`clip_depth`)."""
     image = np.zeros((camera.height, camera.width), bool)
@@ -98,8 +100,9 @@ def draw_candidate(func, p_world: np.ndarray, edges: np.ndarray, camera, precisi
     return image
 
 
-def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera,
-                    p_px: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def oracle_segments(
+    p_world: np.ndarray, edges: np.ndarray, camera, p_px: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """``(E, 2)`` twice: each edge's ends in pixels by OpenCV, clipped to [near, far] in depth; NaN if none left.
 
     The oracle's float64 picture of where each line lies, for attributing
@@ -114,11 +117,13 @@ def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera,
         return p0, p1
     cut = np.ones(len(edges), bool)
     if p_px is not None:
-        seen = np.isfinite(p_px).all(axis=1)          # project's NaN rows: depth outside [near, far]
+        seen = np.isfinite(p_px).all(axis=1)  # project's NaN rows: depth outside [near, far]
         whole = seen[edges[:, 0]] & seen[edges[:, 1]]
-        if whole.all():                                 # every edge in [near, far]: its ends, gathered
-            return (np.take(np.asarray(p_px, np.float64), edges[:, 0], axis=0),
-                    np.take(np.asarray(p_px, np.float64), edges[:, 1], axis=0))
+        if whole.all():  # every edge in [near, far]: its ends, gathered
+            return (
+                np.take(np.asarray(p_px, np.float64), edges[:, 0], axis=0),
+                np.take(np.asarray(p_px, np.float64), edges[:, 1], axis=0),
+            )
         p0[whole], p1[whole] = p_px[edges[whole, 0]], p_px[edges[whole, 1]]
         cut = ~whole
         if not cut.any():

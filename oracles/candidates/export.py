@@ -42,13 +42,12 @@ import math
 from pathlib import Path
 
 import numpy as np
-
 from wirecheck.core.errors import InputError
 from wirecheck.core.outputs.output import FrameDir, json_dumps
+from wirecheck.core.transforms import Motion
 
 from ..cases import CASE_NAMES, case_motion, cases_for
 from ..references.convert import camera_to_gl, opencv_matrices
-from wirecheck.core.transforms import Motion
 from ..references.faces import frame_geometry
 
 #: Version of the job format; frames_candidate refuses any other.
@@ -59,8 +58,8 @@ CONVENTIONS = {
     "statement": "wirecheck.core.conventions states these once; summarised here for the renderer",
     "world": "right-handed; camera right = forward x up",
     "pixels": "x right (columns), y down (rows), origin top-left; integer coordinates are pixel centres: "
-              "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2) unless the camera has "
-              "intrinsics [fx, fy, cx, cy] (then K and gl_projection hold them)",
+    "pixel (0, 0) covers [-0.5, 0.5]^2; principal point ((W-1)/2, (H-1)/2) unless the camera has "
+    "intrinsics [fx, fy, cx, cy] (then K and gl_projection hold them)",
     "fov": "fov_y_deg is the vertical field of view, edge to edge of the image",
     "orthographic": "ortho_height world units are visible vertically (edge to edge)",
     "clipping": "a point is drawn when its depth along forward is in [near, far]; edges are clipped there",
@@ -68,21 +67,21 @@ CONVENTIONS = {
     "model_matrix": "p_world = model_matrix @ [p_model, 1] (the OBJ's v are p_model)",
     "opencv": "p_cv = R @ p_world + t; [u, v, 1] ~ K @ p_cv (perspective); u, v are our pixel coordinates",
     "opengl": "p_clip = gl_projection @ gl_view @ [p_world, 1]; x_win = (x_ndc + 1) W / 2, "
-              "y_win = (y_ndc + 1) H / 2 (y up, corner origin); our x_px = x_win - 0.5, y_px = H - y_win - 0.5",
+    "y_win = (y_ndc + 1) H / 2 (y up, corner origin); our x_px = x_win - 0.5, y_px = H - y_win - 0.5",
 }
 
 IMAGE_RULE = {
     "wireframe": "PNG, the camera's width x height, black background, every visible edge as a white line: "
-                 "1-px aliased (held to GL's pixel rule), or anti-aliased, or up to ~3 px wide (judged by where "
-                 "the lines' centres are); a pixel's luminance over black (luminance x alpha / 255) is its "
-                 "coverage, and it counts as drawn when >= 128 (a transparent pixel is not drawn)",
+    "1-px aliased (held to GL's pixel rule), or anti-aliased, or up to ~3 px wide (judged by where "
+    "the lines' centres are); a pixel's luminance over black (luminance x alpha / 255) is its "
+    "coverage, and it counts as drawn when >= 128 (a transparent pixel is not drawn)",
     "filled": "PNG, the camera's width x height, black background, every face's visible part filled in any "
-              "non-black colour (a pixel shows a surface when its centre is inside a face, as GL fills "
-              "triangles; it counts as filled when its luminance x alpha / 255 is 1 or more); with several "
-              "objects one id per object, as a grey level (1, 2, ...); no lines, no shading needed",
+    "non-black colour (a pixel shows a surface when its centre is inside a face, as GL fills "
+    "triangles; it counts as filled when its luminance x alpha / 255 is 1 or more); with several "
+    "objects one id per object, as a grey level (1, 2, ...); no lines, no shading needed",
     "depth": "the camera's width x height, row 0 at the top, each pixel the depth along the camera's forward "
-             "(z_cam: not the distance along the ray, not the GL depth buffer's [0, 1] value) of the nearest "
-             "visible face at the pixel centre, in world units; 0, NaN or +inf where no face is seen",
+    "(z_cam: not the distance along the ray, not the GL depth buffer's [0, 1] value) of the nearest "
+    "visible face at the pixel centre, in world units; 0, NaN or +inf where no face is seen",
 }
 
 
@@ -94,7 +93,7 @@ DEPTH_FORMATS = {"npy": "npy", "png16": "png", "tiff": "tif"}
 DEPTH_FORMAT_TEXT = {
     "npy": "a 2-D float32 NumPy array (`numpy.save`), shape (height, width), depth in world units",
     "png16": "a 16-bit grey PNG, each value `round(depth x scale)` (scale {scale:g} per world unit), "
-             "values up to 65535",
+    "values up to 65535",
     "tiff": "a 32-bit float TIFF (one channel, Pillow's mode F), depth in world units",
 }
 
@@ -109,9 +108,11 @@ def output_files(scene: str, case: str, checked, outputs, depth_format: str = "n
     (``frames``: the wireframes; a list is empty when its output is not asked for)."""
     where = f"frames/{scene}/{case}"
     ext = DEPTH_FORMATS[depth_format]
-    return {"frames": [f"{where}/{frame_name(k, 'png')}" for k in checked] if "wireframe" in outputs else [],
-            "filled": [f"{where}/{frame_name(k, 'png', 'filled')}" for k in checked] if "filled" in outputs else [],
-            "depth": [f"{where}/{frame_name(k, ext, 'depth')}" for k in checked] if "depth" in outputs else []}
+    return {
+        "frames": [f"{where}/{frame_name(k, 'png')}" for k in checked] if "wireframe" in outputs else [],
+        "filled": [f"{where}/{frame_name(k, 'png', 'filled')}" for k in checked] if "filled" in outputs else [],
+        "depth": [f"{where}/{frame_name(k, ext, 'depth')}" for k in checked] if "depth" in outputs else [],
+    }
 
 
 def job_outputs(job: dict) -> tuple:
@@ -140,12 +141,21 @@ def camera_json(camera, model: np.ndarray, scene: str, case: str, k: int, frames
     """Everything a renderer needs to draw frame ``k`` of one case."""
     r, t, kk = opencv_matrices(camera)
     view, proj = camera_to_gl(camera)
-    return {"scene": scene, "case": case, "frame": k, "t": frame_time(k, frames, phase),
-            "camera": camera.to_dict(), "right": [float(x) for x in camera.right],
-            "model_matrix": matrix_rows(model),
-            "K": matrix_rows(kk), "R": matrix_rows(r), "t_cv": [float(x) for x in t],
-            "gl_view": matrix_rows(view), "gl_projection": matrix_rows(proj),
-            "conventions": "see job.json (conventions); wirecheck.core.conventions states them once"}
+    return {
+        "scene": scene,
+        "case": case,
+        "frame": k,
+        "t": frame_time(k, frames, phase),
+        "camera": camera.to_dict(),
+        "right": [float(x) for x in camera.right],
+        "model_matrix": matrix_rows(model),
+        "K": matrix_rows(kk),
+        "R": matrix_rows(r),
+        "t_cv": [float(x) for x in t],
+        "gl_view": matrix_rows(view),
+        "gl_projection": matrix_rows(proj),
+        "conventions": "see job.json (conventions); wirecheck.core.conventions states them once",
+    }
 
 
 def check_outputs(outputs, depth_format: str = "npy", depth_scale: float = 1000.0) -> tuple:
@@ -156,20 +166,37 @@ def check_outputs(outputs, depth_format: str = "npy", depth_scale: float = 1000.
     bad = [o for o in given if o not in OUTPUTS]
     if bad or not given or len(set(given)) != len(given):
         why = f"unknown {', '.join(map(repr, bad))}" if bad else ("none given" if not given else "one given twice")
-        raise InputError(f"--outputs {','.join(map(str, given))!r}: {why}: expected one or more of "
-                         f"{', '.join(OUTPUTS)}, each once (e.g. wireframe,depth)")
+        raise InputError(
+            f"--outputs {','.join(map(str, given))!r}: {why}: expected one or more of "
+            f"{', '.join(OUTPUTS)}, each once (e.g. wireframe,depth)"
+        )
     if depth_format not in DEPTH_FORMATS:
         raise InputError(f"--depth-format {depth_format!r}: expected one of {', '.join(DEPTH_FORMATS)}")
-    if not (isinstance(depth_scale, (int, float)) and not isinstance(depth_scale, bool)
-            and math.isfinite(depth_scale) and depth_scale > 0 and math.isfinite(65535.0 / depth_scale)):
-        raise InputError(f"--depth-scale {depth_scale!r}: expected a finite number of values per world unit > 0 "
-                         "(1000: millimetres per metre)")
+    if not (
+        isinstance(depth_scale, (int, float))
+        and not isinstance(depth_scale, bool)
+        and math.isfinite(depth_scale)
+        and depth_scale > 0
+        and math.isfinite(65535.0 / depth_scale)
+    ):
+        raise InputError(
+            f"--depth-scale {depth_scale!r}: expected a finite number of values per world unit > 0 "
+            "(1000: millimetres per metre)"
+        )
     return tuple(o for o in OUTPUTS if o in given)
 
 
-def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=None,
-              phase: float = 0.0, outputs=("wireframe",), depth_format: str = "npy",
-              depth_scale: float = 1000.0) -> tuple[dict, dict]:
+def build_job(
+    scenes,
+    frames: int = 24,
+    every: int = 1,
+    case_names=None,
+    motion=None,
+    phase: float = 0.0,
+    outputs=("wireframe",),
+    depth_format: str = "npy",
+    depth_scale: float = 1000.0,
+) -> tuple[dict, dict]:
     """The manifest and the files of a job: ``(job, {relative path: bytes})``; ``phase``: module docstring
     (0: crosscheck's own poses, and job.json without a ``motion.phase``). ``outputs``: what the renderer
     writes (:data:`OUTPUTS`; wireframes alone: job.json as before, without ``outputs``); ``depth_format``
@@ -185,46 +212,74 @@ def build_job(scenes, frames: int = 24, every: int = 1, case_names=None, motion=
         faces = [tuple(int(i) for i in f) for f in scene.faces]
         if single:
             path = f"scenes/{scene.name}.obj"
-            files[path] = _obj_text(scene.vertices, scene.edges, faces,
-                                    f"{scene.name}: model space; each frame's JSON has its model_matrix").encode()
-        scene_rows.append({"name": scene.name, "space": "model" if single else "world per frame",
-                           "obj": f"scenes/{scene.name}.obj" if single else f"scenes/{scene.name}/frame_NNNN.obj",
-                           "vertices": int(len(scene.vertices)), "edges": int(len(scene.edges)),
-                           "faces": len(faces),
-                           # the objects' vertex counts, in the OBJ's order: a face is its first vertex's object
-                           **({} if plain else {"objects": [int(o.vertex_stop - o.vertex_start)
-                                                            for o in scene.objects]})})
+            files[path] = _obj_text(
+                scene.vertices, scene.edges, faces, f"{scene.name}: model space; each frame's JSON has its model_matrix"
+            ).encode()
+        scene_rows.append(
+            {
+                "name": scene.name,
+                "space": "model" if single else "world per frame",
+                "obj": f"scenes/{scene.name}.obj" if single else f"scenes/{scene.name}/frame_NNNN.obj",
+                "vertices": int(len(scene.vertices)),
+                "edges": int(len(scene.edges)),
+                "faces": len(faces),
+                # the objects' vertex counts, in the OBJ's order: a face is its first vertex's object
+                **({} if plain else {"objects": [int(o.vertex_stop - o.vertex_start) for o in scene.objects]}),
+            }
+        )
         cases = cases_for(scene, motion, calibrated=True)
-        scene_motion = case_motion(motion, cases[0])       # one framing, one pivot per scene
+        scene_motion = case_motion(motion, cases[0])  # one framing, one pivot per scene
         geometry = {}
         for k in checked:
             p_world, _m, _pr_vertices, pose = frame_geometry(scene, scene_motion, frame_time(k, frames, phase))
             geometry[k] = pose if single else np.eye(4)
             if not single:
                 files[f"scenes/{scene.name}/{frame_name(k, 'obj')}"] = _obj_text(
-                    p_world, scene.edges, faces, f"{scene.name} frame {k}: world space").encode()
+                    p_world, scene.edges, faces, f"{scene.name} frame {k}: world space"
+                ).encode()
         for case in cases:
             if case.name not in (CASE_NAMES if case_names is None else case_names):
                 continue
-            if case.camera.distortion is not None:      # frames are judged by pixels: not for a lens (oracles.judge.case)
-                raise InputError(f"--cases {case.name}: lens distortion: a frames job is judged by its pixels, "
-                                 "which GL cannot draw through a lens; expected cases without distortion")
+            if case.camera.distortion is not None:  # frames are judged by pixels: not for a lens (oracles.judge.case)
+                raise InputError(
+                    f"--cases {case.name}: lens distortion: a frames job is judged by its pixels, "
+                    "which GL cannot draw through a lens; expected cases without distortion"
+                )
             for k in checked:
                 files[f"cameras/{scene.name}/{case.name}/{frame_name(k, 'json')}"] = json_dumps(
-                    camera_json(case.camera, geometry[k], scene.name, case.name, k, frames, phase)).encode()
+                    camera_json(case.camera, geometry[k], scene.name, case.name, k, frames, phase)
+                ).encode()
             written = output_files(scene.name, case.name, checked, outputs, depth_format)
-            case_rows.append({"scene": scene.name, "case": case.name, "width": case.camera.width,
-                              "height": case.camera.height, "frames": written["frames"],
-                              **({} if plain else {"filled": written["filled"], "depth": written["depth"]})})
-    job = {"kind": JOB_KIND, "version": JOB_VERSION, "style": "wireframe", "frames": frames, "every": every,
-           "frame_numbers": checked,
-           "motion": {"turns": list(motion.turns), **({"phase": float(phase)} if phase else {})},
-           "image": IMAGE_RULE["wireframe"], "conventions": CONVENTIONS,
-           "scenes": scene_rows, "cases": case_rows}
+            case_rows.append(
+                {
+                    "scene": scene.name,
+                    "case": case.name,
+                    "width": case.camera.width,
+                    "height": case.camera.height,
+                    "frames": written["frames"],
+                    **({} if plain else {"filled": written["filled"], "depth": written["depth"]}),
+                }
+            )
+    job = {
+        "kind": JOB_KIND,
+        "version": JOB_VERSION,
+        "style": "wireframe",
+        "frames": frames,
+        "every": every,
+        "frame_numbers": checked,
+        "motion": {"turns": list(motion.turns), **({"phase": float(phase)} if phase else {})},
+        "image": IMAGE_RULE["wireframe"],
+        "conventions": CONVENTIONS,
+        "scenes": scene_rows,
+        "cases": case_rows,
+    }
     if not plain:
-        job.update(outputs=list(outputs), filled_image=IMAGE_RULE["filled"], depth_image=IMAGE_RULE["depth"],
-                   depth_encoding={"format": depth_format,
-                                   "scale": float(depth_scale) if depth_format == "png16" else None})
+        job.update(
+            outputs=list(outputs),
+            filled_image=IMAGE_RULE["filled"],
+            depth_image=IMAGE_RULE["depth"],
+            depth_encoding={"format": depth_format, "scale": float(depth_scale) if depth_format == "png16" else None},
+        )
     files["job.json"] = json_dumps(job).encode()
     files["README.md"] = readme(job).encode()
     return job, files
@@ -249,7 +304,7 @@ def short_job_note(job: dict) -> str:
     n = len(job["frame_numbers"])
     text = f"""## What this job cannot reveal
 
-The verdict rests on the {n} frame{'s' if n != 1 else ''} listed per case, and on nothing between them: a
+The verdict rests on the {n} frame{"s" if n != 1 else ""} listed per case, and on nothing between them: a
 fault that shows only at other poses (a line crossing the near plane, an edge
 leaving the picture at some angle) goes unseen. The faults are named from at
 most 24 of a case's frames (evenly spaced)."""
@@ -258,13 +313,13 @@ most 24 of a case's frames (evenly spaced)."""
         text += f"""
 
 Every frame is moved on by {phase:g} of a frame's step (`--phase {phase:g}`): frame `k` is
-drawn at `t = (k - 1 + {phase:g}) / {job['frames']}` of the motion, not at crosscheck's own `(k - 1) / {job['frames']}`."""
+drawn at `t = (k - 1 + {phase:g}) / {job["frames"]}` of the motion, not at crosscheck's own `(k - 1) / {job["frames"]}`."""
     if quarter_turn_frames(job):
         shown = ", ".join(str(k) for k in job["frame_numbers"][:6]) + (", ..." if n > 6 else "")
         text += f"""
 
 **Every frame of this job is a quarter-turn pose** (frames {shown} of
-{job['frames']}, spin {','.join(f'{t:g}' for t in job['motion']['turns'])}): a cube is seen square-on in each, a
+{job["frames"]}, spin {",".join(f"{t:g}" for t in job["motion"]["turns"])}): a cube is seen square-on in each, a
 picture that a mirror, an axis swap or flip, a transposed rotation, a wrong
 rotation order or a camera looking backward can map onto itself, so such
 faults may draw the very pixels a correct renderer draws and pass. Export
@@ -296,9 +351,9 @@ depth flip, lines short or long at an end).
 
 ## What to draw
 
-{job['image']}.
+{job["image"]}.
 
-- {len(job['cases'])} cases (a scene under a camera), {n_frames} frames in all.
+- {len(job["cases"])} cases (a scene under a camera), {n_frames} frames in all.
 - Scenes: `scenes/<scene>.obj` (model space: `v` vertices, `l` edges, `f`
   faces, 1-based). Draw the `l` edges (a line per edge); the faces are for
   shaded renderers and for hidden lines, which this job does not ask for.
@@ -313,7 +368,7 @@ depth flip, lines short or long at an end).
 ## Where to write
 
 `frames/<scene>/<case>/frame_NNNN.png`, the same numbers as the camera files,
-e.g. `{first['frames'][0]}` ({first['width']} x {first['height']}). Every
+e.g. `{first["frames"][0]}` ({first["width"]} x {first["height"]}). Every
 listed frame must be there, at its camera's size: one still PNG (8- or
 16-bit grey, RGB, RGBA or palette; no JPEG renamed, no animated PNG).
 
@@ -346,22 +401,25 @@ def outputs_readme(job: dict) -> str:
     asked = {"wireframe": "wireframes", "filled": "filled frames", "depth": "depth maps"}
     files = []
     if "wireframe" in outputs:
-        files.append(f"- `frames/<scene>/<case>/frame_NNNN.png`: the wireframe. {job['image']}. Any line style: "
-                     "the judge reads it from the frames (a wireframe-only job's README says how).")
+        files.append(
+            f"- `frames/<scene>/<case>/frame_NNNN.png`: the wireframe. {job['image']}. Any line style: "
+            "the judge reads it from the frames (a wireframe-only job's README says how)."
+        )
     if "filled" in outputs:
-        files.append(f"- `frames/<scene>/<case>/filled_NNNN.png`: the filled frame. {job['filled_image']} "
-                     "(job.json's `objects` of each scene: its objects' vertex counts, in the OBJ's order; a face "
-                     "belongs to its first vertex's object).")
+        files.append(
+            f"- `frames/<scene>/<case>/filled_NNNN.png`: the filled frame. {job['filled_image']} "
+            "(job.json's `objects` of each scene: its objects' vertex counts, in the OBJ's order; a face "
+            "belongs to its first vertex's object)."
+        )
     if "depth" in outputs:
         ext = DEPTH_FORMATS[enc["format"]]
         what = DEPTH_FORMAT_TEXT[enc["format"]].format(scale=enc["scale"] or 0.0)
-        files.append(f"- `frames/<scene>/<case>/depth_NNNN.{ext}`: the depth map, {what}; "
-                     f"{job['depth_image']}.")
+        files.append(f"- `frames/<scene>/<case>/depth_NNNN.{ext}`: the depth map, {what}; {job['depth_image']}.")
     listed = next(c for c in (first["frames"], first["filled"], first["depth"]) if c)
     return f"""# A wirecheck rendering job
 
 Render every frame listed below with your renderer, writing its
-{', '.join(asked[o] for o in outputs)}, then run
+{", ".join(asked[o] for o in outputs)}, then run
 
     crosscheck --candidate-frames THIS_FOLDER
 
@@ -378,7 +436,7 @@ half-pixel principal point, K from the horizontal FOV).
 
 ## What to render
 
-- {len(job['cases'])} cases (a scene under a camera), {n} frame{'s' if n != 1 else ''} each.
+- {len(job["cases"])} cases (a scene under a camera), {n} frame{"s" if n != 1 else ""} each.
 - Scenes: `scenes/<scene>.obj` (model space: `v` vertices, `l` edges, `f`
   faces, 1-based). Wireframes draw the `l` edges; filled frames and depth
   maps render the `f` faces (both sides: no back-face culling).
@@ -392,7 +450,7 @@ half-pixel principal point, K from the horizontal FOV).
 ## What to write, and where
 
 Every file below, for every frame number of the camera files, at its
-camera's size (e.g. `{listed[0]}`, {first['width']} x {first['height']});
+camera's size (e.g. `{listed[0]}`, {first["width"]} x {first["height"]});
 job.json lists each one (`frames`, `filled`, `depth` of each case):
 
 {chr(10).join(files)}
@@ -404,12 +462,30 @@ not list.
 """ + short_job_note(job)
 
 
-def write_job(out_dir: Path, scenes, frames: int = 24, every: int = 1, case_names=None, motion=None,
-              phase: float = 0.0, outputs=("wireframe",), depth_format: str = "npy",
-              depth_scale: float = 1000.0) -> dict:
+def write_job(
+    out_dir: Path,
+    scenes,
+    frames: int = 24,
+    every: int = 1,
+    case_names=None,
+    motion=None,
+    phase: float = 0.0,
+    outputs=("wireframe",),
+    depth_format: str = "npy",
+    depth_scale: float = 1000.0,
+) -> dict:
     """Write the job to ``out_dir`` atomically (a temporary folder renamed over it); the manifest."""
-    job, files = build_job(scenes, frames=frames, every=every, case_names=case_names, motion=motion, phase=phase,
-                           outputs=outputs, depth_format=depth_format, depth_scale=depth_scale)
+    job, files = build_job(
+        scenes,
+        frames=frames,
+        every=every,
+        case_names=case_names,
+        motion=motion,
+        phase=phase,
+        outputs=outputs,
+        depth_format=depth_format,
+        depth_scale=depth_scale,
+    )
     out_dir = Path(out_dir)
     out = FrameDir(out_dir, "export DIR")
     try:

@@ -16,8 +16,8 @@ import sys
 import time
 
 from . import protocol
-from .processes import die_with_parent
 from .candidate_host import serve_loaded
+from .processes import die_with_parent
 
 
 class ForkedChild:
@@ -36,12 +36,12 @@ class ForkedChild:
         out_r, out_w = os.pipe()
         err_r, err_w = os.pipe()
         pid = os.fork()
-        if pid == 0:                                   # the child
+        if pid == 0:  # the child
             code = 1
             try:
                 os.setsid()
                 die_with_parent()
-                sys.dont_write_bytecode = True         # as the candidate host: no __pycache__ from its imports
+                sys.dont_write_bytecode = True  # as the candidate host: no __pycache__ from its imports
                 for fd in (in_w, out_r, err_r, *close_fds):
                     os.close(fd)
                 os.dup2(err_w, 1)
@@ -59,7 +59,7 @@ class ForkedChild:
                 else:
                     send(protocol.encode_error(f"expected the header {protocol.HEADER!r}"))
                     code = 2
-            except BaseException:                      # noqa: BLE001 - the child must never return
+            except BaseException:  # noqa: BLE001 - the child must never return
                 code = 1
             finally:
                 os._exit(code)

@@ -20,17 +20,16 @@ import os
 from pathlib import Path
 
 import numpy as np
-
+from wirecheck.core.camera import Camera
 from wirecheck.core.errors import InputError
-from wirecheck.core.user_files import read_text
-
-from .export import DEPTH_FORMATS, JOB_KIND, JOB_VERSION, OUTPUTS, frame_name, job_outputs, output_files
-from .job_as_exported import camera_file_problem, camera_keys_problem, job_keys_problem
-from .depth_map import DEFAULT_PNG_SCALE, read_depth_map
-from .png_frame import FrameProblem, check_png, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
 from wirecheck.core.limits import MAX_FRAMES, check_image_size
 from wirecheck.core.scene.files import NAME_PATTERN
-from wirecheck.core.camera import Camera
+from wirecheck.core.user_files import read_text
+
+from .depth_map import DEFAULT_PNG_SCALE, read_depth_map
+from .export import DEPTH_FORMATS, JOB_KIND, JOB_VERSION, OUTPUTS, frame_name, job_outputs, output_files
+from .job_as_exported import camera_file_problem, camera_keys_problem, job_keys_problem
+from .png_frame import FrameProblem, check_png, escape_controls, file_problem, read_grey, read_png  # noqa: F401 (read_png re-exported)
 
 #: Problem lines shown before "... and N more".
 MAX_LINES = 20
@@ -43,12 +42,12 @@ class FramesError(InputError):
     """The job or its frames cannot be judged: one line per problem."""
 
     def __init__(self, problems: list[str]):
-        self.problems = problems = [escape_controls(p) for p in problems]    # a file name may hold an ESC
+        self.problems = problems = [escape_controls(p) for p in problems]  # a file name may hold an ESC
         shown = problems[:MAX_LINES]
         more = len(problems) - len(shown)
         super().__init__("\n".join(shown + ([f"... and {more} more"] if more else [])))
 
-    def __str__(self) -> str:       # one line per problem, kept apart (InputError joins lines into one)
+    def __str__(self) -> str:  # one line per problem, kept apart (InputError joins lines into one)
         return Exception.__str__(self)
 
 
@@ -72,17 +71,23 @@ def load_job(job_dir: Path) -> dict:
     """The manifest ``DIR/job.json``, checked; FramesError otherwise."""
     path = Path(job_dir) / "job.json"
     if not Path(job_dir).is_dir():
-        raise FramesError([f"--candidate-frames {str(job_dir)!r}: not a directory: expected a job folder "
-                           "written by 'crosscheck export'"])
+        raise FramesError(
+            [
+                f"--candidate-frames {str(job_dir)!r}: not a directory: expected a job folder "
+                "written by 'crosscheck export'"
+            ]
+        )
     problem = file_problem(path, "job")
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected a job folder written by 'crosscheck export'"])
     try:
         job = read_json(path)
-    except (OSError, ValueError, RecursionError) as exc:        # RecursionError: arrays nested 100,000 deep
+    except (OSError, ValueError, RecursionError) as exc:  # RecursionError: arrays nested 100,000 deep
         raise FramesError([f"{path}: unreadable ({exc}): expected the JSON 'crosscheck export' wrote"]) from None
     if not isinstance(job, dict) or job.get("kind") != JOB_KIND:
-        raise FramesError([f"{path}: not a wirecheck frames job (kind {job.get('kind') if isinstance(job, dict) else None!r})"])
+        raise FramesError(
+            [f"{path}: not a wirecheck frames job (kind {job.get('kind') if isinstance(job, dict) else None!r})"]
+        )
     if job.get("version") != JOB_VERSION or not _is_int(job.get("version")):
         raise FramesError([f"{path}: job version {job.get('version')!r}: expected {JOB_VERSION} (export it again)"])
     if not job.get("cases"):
@@ -113,8 +118,11 @@ def _job_problem(job: dict) -> str | None:
     if job.get("frame_numbers") != checked:
         return f"frame_numbers {str(job.get('frame_numbers'))[:60]}: expected 1, 1+every, ... up to frames"
     turns = (job.get("motion") or {}).get("turns") if isinstance(job.get("motion"), dict) else None
-    if not (isinstance(turns, list) and len(turns) == 3
-            and all(isinstance(t, (int, float)) and not isinstance(t, bool) and np.isfinite(t) for t in turns)):
+    if not (
+        isinstance(turns, list)
+        and len(turns) == 3
+        and all(isinstance(t, (int, float)) and not isinstance(t, bool) and np.isfinite(t) for t in turns)
+    ):
         return f"motion.turns {turns!r}: expected three finite numbers"
     phase = job["motion"].get("phase", 0.0)
     if not (isinstance(phase, (int, float)) and not isinstance(phase, bool) and 0.0 <= phase < 1.0):
@@ -136,24 +144,40 @@ def _job_problem(job: dict) -> str | None:
         names.add(name)
         expected = {"model": f"scenes/{name}.obj", "world per frame": f"scenes/{name}/frame_NNNN.obj"}
         if expected.get(r.get("space")) != obj:
-            return (f"scene {name!r}: space {r.get('space')!r}, obj {obj!r}: expected space 'model' with "
-                    f"obj {expected['model']!r}, or 'world per frame' with {expected['world per frame']!r}")
-        if r.get("space") == "model" and not all(_is_int(r.get(k)) and r[k] >= 0 for k in ("vertices", "edges", "faces")):
-            return (f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}, faces "
-                    f"{r.get('faces')!r}: expected counts")
+            return (
+                f"scene {name!r}: space {r.get('space')!r}, obj {obj!r}: expected space 'model' with "
+                f"obj {expected['model']!r}, or 'world per frame' with {expected['world per frame']!r}"
+            )
+        if r.get("space") == "model" and not all(
+            _is_int(r.get(k)) and r[k] >= 0 for k in ("vertices", "edges", "faces")
+        ):
+            return (
+                f"scene {name!r}: vertices {r.get('vertices')!r}, edges {r.get('edges')!r}, faces "
+                f"{r.get('faces')!r}: expected counts"
+            )
         objects = r.get("objects")
-        if "outputs" in job and not (isinstance(objects, list) and objects and all(_is_int(n) and n > 0 for n in objects)
-                                     and sum(objects) == r.get("vertices")):
-            return (f"scene {name!r}: objects {str(objects)[:60]}: expected each object's vertex count (> 0), "
-                    f"{r.get('vertices')!r} in all")
+        if "outputs" in job and not (
+            isinstance(objects, list)
+            and objects
+            and all(_is_int(n) and n > 0 for n in objects)
+            and sum(objects) == r.get("vertices")
+        ):
+            return (
+                f"scene {name!r}: objects {str(objects)[:60]}: expected each object's vertex count (> 0), "
+                f"{r.get('vertices')!r} in all"
+            )
     if not (isinstance(cases, list) and all(isinstance(c, dict) for c in cases)):
         return "cases: expected a list of the job's cases"
     pairs = set()
     for c in cases:
         scene, case, w, h = c.get("scene"), c.get("case"), c.get("width"), c.get("height")
-        if not isinstance(scene, str) or scene not in names or not (isinstance(case, str) and NAME_PATTERN.fullmatch(case)):
+        if (
+            not isinstance(scene, str)
+            or scene not in names
+            or not (isinstance(case, str) and NAME_PATTERN.fullmatch(case))
+        ):
             return f"case {scene!r} / {case!r}: expected a scene of 'scenes' and a case name"
-        if (scene, case) in pairs:      # judged twice, it would count twice in the summary
+        if (scene, case) in pairs:  # judged twice, it would count twice in the summary
             return f"case {scene} / {case}: listed twice: expected each case once"
         pairs.add((scene, case))
         if not (_is_int(w) and _is_int(h)):
@@ -165,9 +189,12 @@ def _job_problem(job: dict) -> str | None:
         written = output_files(scene, case, checked, outputs, (job.get("depth_encoding") or {}).get("format", "npy"))
         for key in ("frames", "filled", "depth") if "outputs" in job else ("frames",):
             if c.get(key) != written[key]:
-                pattern = (f"frames/{scene}/{case}/{Path(written[key][0]).stem.split('_')[0]}_NNNN"
-                           f"{Path(written[key][0]).suffix} for each of frame_numbers" if written[key]
-                           else "[] (the job's outputs do not ask for them)")
+                pattern = (
+                    f"frames/{scene}/{case}/{Path(written[key][0]).stem.split('_')[0]}_NNNN"
+                    f"{Path(written[key][0]).suffix} for each of frame_numbers"
+                    if written[key]
+                    else "[] (the job's outputs do not ask for them)"
+                )
                 return f"case {scene} / {case}: {key} {str(c.get(key))[:80]}: expected {pattern}"
     return None
 
@@ -178,24 +205,36 @@ def _outputs_problem(job: dict) -> str | None:
     if "outputs" not in job:
         return None
     outputs = job["outputs"]
-    if not (isinstance(outputs, list) and outputs and all(isinstance(o, str) for o in outputs)
-            and outputs == [o for o in OUTPUTS if o in outputs]):
-        return (f"outputs {str(outputs)[:60]}: expected some of {', '.join(map(repr, OUTPUTS))}, each once, "
-                "in that order")
+    if not (
+        isinstance(outputs, list)
+        and outputs
+        and all(isinstance(o, str) for o in outputs)
+        and outputs == [o for o in OUTPUTS if o in outputs]
+    ):
+        return (
+            f"outputs {str(outputs)[:60]}: expected some of {', '.join(map(repr, OUTPUTS))}, each once, in that order"
+        )
     if outputs == ["wireframe"]:
         return "outputs ['wireframe']: expected no 'outputs' key for a job of wireframes alone"
     enc = job.get("depth_encoding")
     fmt = enc.get("format") if isinstance(enc, dict) else None
-    if not (isinstance(enc, dict) and set(enc) == {"format", "scale"} and isinstance(fmt, str)
-            and fmt in DEPTH_FORMATS):
-        return (f"depth_encoding {str(enc)[:60]}: expected {{'format': one of {', '.join(DEPTH_FORMATS)}, "
-                "'scale': ...}")
+    if not (
+        isinstance(enc, dict) and set(enc) == {"format", "scale"} and isinstance(fmt, str) and fmt in DEPTH_FORMATS
+    ):
+        return f"depth_encoding {str(enc)[:60]}: expected {{'format': one of {', '.join(DEPTH_FORMATS)}, 'scale': ...}}"
     scale = enc["scale"]
     if fmt == "png16":
-        if not (isinstance(scale, (int, float)) and not isinstance(scale, bool) and np.isfinite(scale)
-                and scale > 0 and np.isfinite(65535.0 / scale)):
-            return (f"depth_encoding.scale {scale!r}: expected a finite number of values per world unit > 0 "
-                    "(crosscheck export --depth-scale; 1000: millimetres per metre)")
+        if not (
+            isinstance(scale, (int, float))
+            and not isinstance(scale, bool)
+            and np.isfinite(scale)
+            and scale > 0
+            and np.isfinite(65535.0 / scale)
+        ):
+            return (
+                f"depth_encoding.scale {scale!r}: expected a finite number of values per world unit > 0 "
+                "(crosscheck export --depth-scale; 1000: millimetres per metre)"
+            )
     elif scale is not None:
         return f"depth_encoding.scale {scale!r} with format {fmt!r}: expected null (a scale is a 16-bit PNG's)"
     return None
@@ -224,9 +263,13 @@ def _walk(frames_dir: Path) -> list[Path]:
         for item in items:
             n += 1
             if n > MAX_WALK:
-                raise FramesError([f"{frames_dir}: more than {MAX_WALK:,} files and folders: expected the "
-                                   f"job's frames (frames/<scene>/<case>/frame_NNNN.png); the walk was in {folder} "
-                                   "(a link to a folder elsewhere?)"])
+                raise FramesError(
+                    [
+                        f"{frames_dir}: more than {MAX_WALK:,} files and folders: expected the "
+                        f"job's frames (frames/<scene>/<case>/frame_NNNN.png); the walk was in {folder} "
+                        "(a link to a folder elsewhere?)"
+                    ]
+                )
             try:
                 is_dir = item.is_dir()
             except OSError:
@@ -260,19 +303,33 @@ def _frames(job_dir: Path, job: dict, keep: bool, decode: bool = True) -> dict:
     frames_dir = job_dir / "frames"
     if not frames_dir.is_dir():
         problem = file_problem(frames_dir)
-        raise FramesError([f"{frames_dir}: {problem or 'a file, not a folder'}: the renderer's frames go there "
-                           "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
+        raise FramesError(
+            [
+                f"{frames_dir}: {problem or 'a file, not a folder'}: the renderer's frames go there "
+                "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"
+            ]
+        )
     found = {p.relative_to(job_dir).as_posix() for p in _walk(frames_dir)}
     if not found:
-        raise FramesError([f"{frames_dir}: empty: expected the renderer's frames "
-                           "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"])
+        raise FramesError(
+            [
+                f"{frames_dir}: empty: expected the renderer's frames "
+                "(frames/<scene>/<case>/frame_NNNN.png; see README.md)"
+            ]
+        )
     listed = {f for c in job["cases"] for f in case_files(c)}
     if not found & listed:
         example = sorted(found)[0]
-        raise FramesError([f"{frames_dir}: none of its {len(found)} files is a frame of this job "
-                           f"(e.g. {example}; expected e.g. {sorted(listed)[0]}): frames of another job?"])
-    problems = [f"{job_dir / rel}: not a frame of this job (expected only the files job.json lists)"
-                for rel in sorted(found - listed)]
+        raise FramesError(
+            [
+                f"{frames_dir}: none of its {len(found)} files is a frame of this job "
+                f"(e.g. {example}; expected e.g. {sorted(listed)[0]}): frames of another job?"
+            ]
+        )
+    problems = [
+        f"{job_dir / rel}: not a frame of this job (expected only the files job.json lists)"
+        for rel in sorted(found - listed)
+    ]
     out = {}
     scale = (job.get("depth_encoding") or {}).get("scale") or DEFAULT_PNG_SCALE
     for c in job["cases"]:
@@ -285,7 +342,7 @@ def _frames(job_dir: Path, job: dict, keep: bool, decode: bool = True) -> dict:
                 problems.append(f"{path}: {problem} (frame {k} of {c['scene']} / {c['case']})")
                 continue
             try:
-                if rel in c.get("depth", ()):       # its size and encoding, read as the judge will read it
+                if rel in c.get("depth", ()):  # its size and encoding, read as the judge will read it
                     if decode:
                         read_depth_map(path, c["width"], c["height"], scale)
                     continue
@@ -297,9 +354,9 @@ def _frames(job_dir: Path, job: dict, keep: bool, decode: bool = True) -> dict:
                     images.append((k, image))
             except FrameProblem as exc:
                 problems.append(f"{path}: {exc}")
-            except InputError as exc:               # read_depth_map's line names the file
+            except InputError as exc:  # read_depth_map's line names the file
                 problems.append(str(exc))
-            except Exception as exc:       # Pillow's many ways to say "not an image"
+            except Exception as exc:  # Pillow's many ways to say "not an image"
                 problems.append(f"{path}: unreadable as PNG ({type(exc).__name__}: {exc})")
         out[(c["scene"], c["case"])] = images
     if problems:
@@ -344,14 +401,22 @@ def read_obj(path: Path, with_faces: bool = False) -> tuple:
             elif parts and not parts[0].startswith("#"):
                 face = [int(x) - 1 for x in parts[1:] if x.lstrip("-").isdigit()] if parts[0] == "f" else []
                 if len(face) < max(3, len(parts) - 1) or not all(0 <= i < len(verts) for i in face):
-                    raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'f I J K ...' (3 or more "
-                                       f"of 1..{len(verts)}), 'v', 'l' or a '#' comment, as 'crosscheck export' wrote"])
+                    raise FramesError(
+                        [
+                            f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'f I J K ...' (3 or more "
+                            f"of 1..{len(verts)}), 'v', 'l' or a '#' comment, as 'crosscheck export' wrote"
+                        ]
+                    )
                 faces.append(tuple(face))
         except ValueError as exc:
             if isinstance(exc, FramesError):
                 raise
-            raise FramesError([f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
-                               f"(1..{len(verts)}), as 'crosscheck export' wrote"]) from None
+            raise FramesError(
+                [
+                    f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
+                    f"(1..{len(verts)}), as 'crosscheck export' wrote"
+                ]
+            ) from None
     out = np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
     return (*out, faces) if with_faces else out
 
@@ -369,8 +434,9 @@ def _frame_camera(path: Path, cache: dict | None = None):
     try:
         cam_json = read_json(path, "camera")
     except (OSError, ValueError, RecursionError) as exc:
-        raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {exc}): expected the camera JSON "
-                           "'crosscheck export' wrote"]) from None
+        raise FramesError(
+            [f"{path}: unreadable ({type(exc).__name__}: {exc}): expected the camera JSON 'crosscheck export' wrote"]
+        ) from None
     problem = camera_keys_problem(cam_json)
     if problem is not None:
         raise FramesError([f"{path}: {problem} (export the job again)"])
@@ -386,8 +452,9 @@ def _frame_camera(path: Path, cache: dict | None = None):
             raise ValueError(f"model_matrix of shape {m.shape}: expected 4x4 finite numbers")
     except (OSError, ValueError, KeyError, TypeError, AttributeError, OverflowError, RecursionError) as exc:
         what = f"no {exc}" if isinstance(exc, KeyError) else str(exc)
-        raise FramesError([f"{path}: unreadable ({type(exc).__name__}: {what}): expected the camera JSON "
-                           "'crosscheck export' wrote"]) from None
+        raise FramesError(
+            [f"{path}: unreadable ({type(exc).__name__}: {what}): expected the camera JSON 'crosscheck export' wrote"]
+        ) from None
     return camera, m, cam_json
 
 
@@ -398,31 +465,43 @@ def frame_inputs(job_dir: Path, job: dict, scene: str, case: str, k: int, cache:
     OBJ (model space) is then read once, and an unchanged camera made once.
     """
     job_dir = Path(job_dir)
-    row = next(s for s in job["scenes"] if s["name"] == scene)       # load_job checked it is there
+    row = next(s for s in job["scenes"] if s["name"] == scene)  # load_job checked it is there
     obj = job_dir / (row["obj"] if row["space"] == "model" else f"scenes/{scene}/{frame_name(k, 'obj')}")
     if cache is not None and cache.get("obj") == obj:
         p_model, edges = cache["mesh"]
     else:
         p_model, edges, faces = read_obj(obj, with_faces=True)
-        if cache is not None:               # the faces of the file just read, for frame_faces
+        if cache is not None:  # the faces of the file just read, for frame_faces
             cache.update(faces_obj=obj, faces=faces)
         if cache is not None and row["space"] == "model":
             cache.update(obj=obj, mesh=(p_model, edges))
     if row["space"] == "model" and (len(p_model), len(edges)) != (row["vertices"], row["edges"]):
-        raise FramesError([f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
-                           f"{row['edges']} (job.json's; the file was changed or cut short)"])
+        raise FramesError(
+            [
+                f"{obj}: {len(p_model)} vertices, {len(edges)} edges: expected {row['vertices']} and "
+                f"{row['edges']} (job.json's; the file was changed or cut short)"
+            ]
+        )
     path = job_dir / f"cameras/{scene}/{case}/{frame_name(k, 'json')}"
     camera, m, cam_json = _frame_camera(path, cache)
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
-    if (camera.width, camera.height) != (c["width"], c["height"]):     # the frames were read at the job's size
+    if (camera.width, camera.height) != (c["width"], c["height"]):  # the frames were read at the job's size
         size = f"{camera.width}x{camera.height}"
-        raise FramesError([f"{path}: camera {size[:40]}{'...' if len(size) > 40 else ''}: expected "
-                           f"{c['width']}x{c['height']} "
-                           f"(job.json's size of {scene} / {case}; export the job again)"])
-    problem = camera_file_problem(cam_json, camera, m, job, scene, case, k)     # as export wrote it, in every form
+        raise FramesError(
+            [
+                f"{path}: camera {size[:40]}{'...' if len(size) > 40 else ''}: expected "
+                f"{c['width']}x{c['height']} "
+                f"(job.json's size of {scene} / {case}; export the job again)"
+            ]
+        )
+    problem = camera_file_problem(cam_json, camera, m, job, scene, case, k)  # as export wrote it, in every form
     if problem is not None:
-        raise FramesError([f"{path}: {problem} (what 'crosscheck export' writes for this file's camera and "
-                           "model matrix: the file was edited; export the job again)"])
+        raise FramesError(
+            [
+                f"{path}: {problem} (what 'crosscheck export' writes for this file's camera and "
+                "model matrix: the file was edited; export the job again)"
+            ]
+        )
     return p_model, edges, camera, m
 
 
@@ -439,8 +518,9 @@ def frame_faces(job_dir: Path, job: dict, scene: str, k: int, cache: dict | None
         if cache is not None:
             cache.update(faces_obj=obj, faces=faces)
     if row["space"] == "model" and len(faces) != row.get("faces"):
-        raise FramesError([f"{obj}: {len(faces)} faces: expected {row.get('faces')} (job.json's; the file was "
-                           "changed or cut short)"])
+        raise FramesError(
+            [f"{obj}: {len(faces)} faces: expected {row.get('faces')} (job.json's; the file was changed or cut short)"]
+        )
     return faces
 
 
@@ -466,8 +546,8 @@ def read_frame(path: Path, width: int, height: int, job=None) -> np.ndarray:
         return read_grey(path, width, height)
     except FrameProblem as exc:
         problem = str(exc)
-    except Exception as exc:       # noqa: BLE001 - Pillow's many ways to say "not an image"
+    except Exception as exc:  # noqa: BLE001 - Pillow's many ways to say "not an image"
         problem = f"unreadable as PNG ({type(exc).__name__}: {exc})"
     if job is not None:
-        check_frames(*job)                      # raises, listing every problem of the job
+        check_frames(*job)  # raises, listing every problem of the job
     raise FramesError([f"{path}: {problem}"])

@@ -17,12 +17,11 @@ from __future__ import annotations
 
 import sys
 
+from wirecheck.core.errors import InputError
 from wirecheck.core.user_files import expected, problem
 
-from .candidate import CandidateError
+from .candidate import CandidateError, load_candidate
 from .subprocess_candidate import DEFAULT_TIMEOUT_S, CandidateStartRefused, SubprocessCandidate
-from wirecheck.core.errors import InputError
-from .candidate import load_candidate
 
 
 def check_python_spec(spec: str, option: str = "--candidate") -> None:
@@ -32,10 +31,10 @@ def check_python_spec(spec: str, option: str = "--candidate") -> None:
         raise InputError(f"{option} {spec!r}: expected FILE.py:FUNC or MODULE:FUNC")
     target = spec.rsplit(":", 1)[0]
     if target.endswith(".py") or "/" in target:
-        refused = problem(target, "candidate")          # stat only: a FIFO is never opened
+        refused = problem(target, "candidate")  # stat only: a FIFO is never opened
         if refused == "missing":
             raise InputError(f"{option} {spec!r}: file {target!r} not found")
-        if refused is not None:          # a FIFO, a device, a folder; a name too long for the file system
+        if refused is not None:  # a FIFO, a device, a folder; a name too long for the file system
             raise InputError(f"{option} {spec!r}: file {target[:80]!r}: {refused}: expected {expected('candidate')}")
 
 
@@ -67,8 +66,9 @@ def started(candidate: SubprocessCandidate, option: str):
     return candidate
 
 
-def external_candidate(spec: str | None = None, command: str | None = None,
-                       timeout_s: float = DEFAULT_TIMEOUT_S) -> SubprocessCandidate:
+def external_candidate(
+    spec: str | None = None, command: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S
+) -> SubprocessCandidate:
     """The isolated candidate for ``--candidate SPEC`` or ``--candidate-cmd COMMAND``, started (see :func:`started`)."""
     if spec is not None:
         check_python_spec(spec)
@@ -88,8 +88,11 @@ def api_candidate(func=None, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S, iso
         if isolate is False:
             raise ValueError("isolate=False with cmd: a program always runs in its own process")
         try:
-            candidate = (SubprocessCandidate.from_command(cmd, timeout_s) if isinstance(cmd, str)
-                         else SubprocessCandidate(argv=tuple(cmd), timeout_s=timeout_s))
+            candidate = (
+                SubprocessCandidate.from_command(cmd, timeout_s)
+                if isinstance(cmd, str)
+                else SubprocessCandidate(argv=tuple(cmd), timeout_s=timeout_s)
+            )
         except ValueError as exc:
             raise InputError(f"cmd {exc}") from None
         return candidate.name, started(candidate, "cmd")
@@ -107,8 +110,10 @@ def api_candidate(func=None, cmd=None, timeout_s: float = DEFAULT_TIMEOUT_S, iso
 
         if not hasattr(os, "fork"):
             if isolate:
-                raise ValueError(f"isolate=True: {name} cannot be imported by another process (expected a "
-                                 "module-level function of an importable module) and this system cannot fork")
+                raise ValueError(
+                    f"isolate=True: {name} cannot be imported by another process (expected a "
+                    "module-level function of an importable module) and this system cannot fork"
+                )
             return name, func
         return name, started(SubprocessCandidate.fork(func, timeout_s, label=name), "func")
     path = tuple(p for p in sys.path if isinstance(p, str))

@@ -19,8 +19,8 @@ import difflib
 import functools
 
 import numpy as np
-from wirecheck.core.scene.files import load_scene
 from wirecheck.core.camera import Camera
+from wirecheck.core.scene.files import load_scene
 
 #: Relative tolerance of a camera JSON's numbers against export's, of max(1, |expected|): the numbers are
 #: recomputed from the file's own camera (its JSON floats round-trip exactly) by a few dozen float64
@@ -50,11 +50,18 @@ def exported_keys() -> dict:
     from .export import build_job
 
     job, _files = build_job([load_scene("cube")], frames=1, case_names=["on_axis"], phase=0.5)
-    full, _files = build_job([load_scene("cube")], frames=1, case_names=["on_axis"], phase=0.5,
-                             outputs=("wireframe", "filled", "depth"))
-    return {"job": tuple(job), "scene": tuple(job["scenes"][0]), "case": tuple(job["cases"][0]),
-            "motion": tuple(job["motion"]), "outputs_job": tuple(full), "outputs_case": tuple(full["cases"][0]),
-            "outputs_scene": tuple(full["scenes"][0])}
+    full, _files = build_job(
+        [load_scene("cube")], frames=1, case_names=["on_axis"], phase=0.5, outputs=("wireframe", "filled", "depth")
+    )
+    return {
+        "job": tuple(job),
+        "scene": tuple(job["scenes"][0]),
+        "case": tuple(job["cases"][0]),
+        "motion": tuple(job["motion"]),
+        "outputs_job": tuple(full),
+        "outputs_case": tuple(full["cases"][0]),
+        "outputs_scene": tuple(full["scenes"][0]),
+    }
 
 
 def job_keys_problem(job: dict) -> str | None:
@@ -96,9 +103,19 @@ def camera_keys_problem(cam_json) -> str | None:
 
 
 #: What each camera field holds, as export writes it (core.camera.Camera.to_dict).
-_CAMERA_TYPES = {"position": "3 numbers", "forward": "3 numbers", "up": "3 numbers", "fov_y_deg": "a number",
-                 "width": "an integer", "height": "an integer", "near": "a number", "far": "a number",
-                 "projection": "a string", "ortho_height": "a number", "intrinsics": "4 numbers"}
+_CAMERA_TYPES = {
+    "position": "3 numbers",
+    "forward": "3 numbers",
+    "up": "3 numbers",
+    "fov_y_deg": "a number",
+    "width": "an integer",
+    "height": "an integer",
+    "near": "a number",
+    "far": "a number",
+    "projection": "a string",
+    "ortho_height": "a number",
+    "intrinsics": "4 numbers",
+}
 
 
 def _is_number(value) -> bool:
@@ -114,16 +131,21 @@ def _is_type(value, expected: str) -> bool:
     return _is_number(value) if expected == "a number" else isinstance(value, str)
 
 
-def camera_file_problem(cam_json: dict, camera, model: np.ndarray, job: dict, scene: str, case: str,
-                        k: int) -> str | None:
+def camera_file_problem(
+    cam_json: dict, camera, model: np.ndarray, job: dict, scene: str, case: str, k: int
+) -> str | None:
     """How a frame's camera JSON differs from what export writes for its camera and model matrix; None if not.
 
     ``camera`` and ``model`` are those read from the file; the model matrix must be affine (its last row
     ``[0, 0, 0, 1]``): the oracles use its top three rows, a GL renderer all four.
     """
-    if not np.array_equal(model[3], [0.0, 0.0, 0.0, 1.0]) or any(isinstance(v, bool) for v in cam_json["model_matrix"][3]):
-        return (f"model_matrix[3] {[float(v) for v in model[3]]}: expected [0.0, 0.0, 0.0, 1.0] (an affine model "
-                "matrix: the oracles use its top three rows)")
+    if not np.array_equal(model[3], [0.0, 0.0, 0.0, 1.0]) or any(
+        isinstance(v, bool) for v in cam_json["model_matrix"][3]
+    ):
+        return (
+            f"model_matrix[3] {[float(v) for v in model[3]]}: expected [0.0, 0.0, 0.0, 1.0] (an affine model "
+            "matrix: the oracles use its top three rows)"
+        )
     phase = job["motion"].get("phase", 0.0)
     return _differs("", cam_json, _expected(camera, model, scene, case, k, job["frames"], phase))
 
@@ -137,13 +159,19 @@ def _expected(camera, model, scene: str, case: str, k: int, frames: int, phase: 
     """:func:`oracles.candidates.export.camera_json` of these arguments; for the camera of the last call, that
     call's JSON with the fields of the other arguments (frame, time, model matrix, names) replaced: the rest
     are the camera's alone."""
-    from .export import matrix_rows, camera_json, frame_time
+    from .export import camera_json, frame_time, matrix_rows
 
     if _LAST.get("camera") is not camera:
         _LAST.update(camera=camera, json=camera_json(camera, model, scene, case, k, frames, phase))
         return _LAST["json"]
-    return {**_LAST["json"], "scene": scene, "case": case, "frame": k, "t": frame_time(k, frames, phase),
-            "model_matrix": matrix_rows(model)}
+    return {
+        **_LAST["json"],
+        "scene": scene,
+        "case": case,
+        "frame": k,
+        "t": frame_time(k, frames, phase),
+        "model_matrix": matrix_rows(model),
+    }
 
 
 def _differs(where: str, value, expected) -> str | None:
@@ -166,7 +194,7 @@ def _differs(where: str, value, expected) -> str | None:
     if isinstance(expected, (int, float)) and not isinstance(expected, bool):
         number = isinstance(value, (int, float)) and not isinstance(value, bool)
         if isinstance(expected, int) and not isinstance(value, int):
-            number = False                      # a count or a size: an integer, as export writes it
+            number = False  # a count or a size: an integer, as export writes it
         if number and abs(value - expected) <= REL_TOL * max(1.0, abs(expected)):
             return None
         return f"{where} {_short(value)}: expected {expected!r}"

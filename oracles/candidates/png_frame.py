@@ -33,13 +33,17 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-
 from wirecheck.core.user_files import RefusedFile, open_regular, problem
 
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 #: colour type -> (name, channels, allowed bit depths), from the PNG specification (table 11.1)
-COLOUR_TYPES = {0: ("grey", 1, (1, 2, 4, 8, 16)), 2: ("RGB", 3, (8, 16)), 3: ("palette", 1, (1, 2, 4, 8)),
-                4: ("grey + alpha", 2, (8, 16)), 6: ("RGBA", 4, (8, 16))}
+COLOUR_TYPES = {
+    0: ("grey", 1, (1, 2, 4, 8, 16)),
+    2: ("RGB", 3, (8, 16)),
+    3: ("palette", 1, (1, 2, 4, 8)),
+    4: ("grey + alpha", 2, (8, 16)),
+    6: ("RGBA", 4, (8, 16)),
+}
 #: Chunks read before the first IDAT: a file holding more before its pixels is no frame.
 MAX_HEADER_CHUNKS = 1000
 _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
@@ -89,7 +93,7 @@ def read_header(fh) -> dict:
     """The chunks before the first IDAT: ``{width, height, depth, colour, palette, trns}``; FrameProblem otherwise."""
     head = fh.read(8)
     if head != SIGNATURE:
-        raise FrameProblem("not a PNG")                 # named by the caller (another format, or none)
+        raise FrameProblem("not a PNG")  # named by the caller (another format, or none)
     info = {"palette": None, "trns": None}
     for n in range(MAX_HEADER_CHUNKS):
         raw = fh.read(8)
@@ -97,7 +101,7 @@ def read_header(fh) -> dict:
             raise FrameProblem("truncated before its image data: expected IDAT chunks")
         length, kind = struct.unpack(">I4s", raw)
         name = _chunk_name(kind)
-        if length > 2 ** 31 - 1:
+        if length > 2**31 - 1:
             raise FrameProblem(f"chunk {name} of {length} bytes: expected at most 2^31 - 1 (a damaged file)")
         if n == 0 and kind != b"IHDR":
             raise FrameProblem(f"first chunk {name}: expected IHDR")
@@ -107,11 +111,13 @@ def read_header(fh) -> dict:
             data = fh.read(length)
             if len(data) < length:
                 raise FrameProblem(f"truncated in its {name} chunk")
-            fh.seek(4, os.SEEK_CUR)                     # the CRC: Pillow checks it when it decodes
+            fh.seek(4, os.SEEK_CUR)  # the CRC: Pillow checks it when it decodes
         else:
             if kind[:1].isupper() and kind not in (b"IEND",):
-                raise FrameProblem(f"an unknown critical chunk {name} before the image data: expected IHDR, "
-                                   "PLTE, tRNS or ancillary chunks (a damaged file or another format)")
+                raise FrameProblem(
+                    f"an unknown critical chunk {name} before the image data: expected IHDR, "
+                    "PLTE, tRNS or ancillary chunks (a damaged file or another format)"
+                )
             fh.seek(length + 4, os.SEEK_CUR)
             continue
         if kind == b"IHDR":
@@ -120,16 +126,22 @@ def read_header(fh) -> dict:
             w, h, depth, colour, compression, filtering, interlace = struct.unpack(">IIBBBBB", data)
             if colour not in COLOUR_TYPES or depth not in COLOUR_TYPES[colour][2]:
                 allowed = "; ".join(f"{c} ({v[0]}): {', '.join(map(str, v[2]))}" for c, v in COLOUR_TYPES.items())
-                raise FrameProblem(f"colour type {colour} with bit depth {depth}: expected one the PNG "
-                                   f"specification allows ({allowed})")
+                raise FrameProblem(
+                    f"colour type {colour} with bit depth {depth}: expected one the PNG "
+                    f"specification allows ({allowed})"
+                )
             if (compression, filtering) != (0, 0) or interlace not in (0, 1):
-                raise FrameProblem(f"IHDR compression {compression}, filter {filtering}, interlace {interlace}: "
-                                   "expected 0, 0 and 0 or 1")
+                raise FrameProblem(
+                    f"IHDR compression {compression}, filter {filtering}, interlace {interlace}: "
+                    "expected 0, 0 and 0 or 1"
+                )
             info.update(width=w, height=h, depth=depth, colour=colour)
         elif kind == b"acTL":
             frames = struct.unpack(">I", data[:4])[0] if length >= 4 else 0
-            raise FrameProblem(f"an animated PNG of {frames} frame{'' if frames == 1 else 's'}: expected one still "
-                               "image (it has an acTL chunk)")
+            raise FrameProblem(
+                f"an animated PNG of {frames} frame{'' if frames == 1 else 's'}: expected one still "
+                "image (it has an acTL chunk)"
+            )
         elif kind == b"PLTE":
             if length % 3 or not 3 <= length <= 768:
                 raise FrameProblem(f"PLTE of {length} bytes: expected 1 to 256 RGB entries (3 bytes each)")
@@ -142,17 +154,20 @@ def read_header(fh) -> dict:
     if colour == 3:
         if info["palette"] is None:
             raise FrameProblem("a palette image without a PLTE chunk")
-        if len(info["palette"]) > 2 ** depth:
-            raise FrameProblem(f"a palette of {len(info['palette'])} entries for {depth}-bit indices: expected at "
-                               f"most {2 ** depth}")
+        if len(info["palette"]) > 2**depth:
+            raise FrameProblem(
+                f"a palette of {len(info['palette'])} entries for {depth}-bit indices: expected at most {2**depth}"
+            )
     trns = info["trns"]
     if trns is not None:
         expected = {0: 2, 2: 6}.get(colour)
         if colour in (4, 6):
             raise FrameProblem(f"a tRNS chunk in a {COLOUR_TYPES[colour][0]} image: expected none (it has alpha)")
         if colour == 3 and len(trns) > len(info["palette"]):
-            raise FrameProblem(f"tRNS of {len(trns)} alphas for a palette of {len(info['palette'])} entries: "
-                               "expected at most one per entry")
+            raise FrameProblem(
+                f"tRNS of {len(trns)} alphas for a palette of {len(info['palette'])} entries: "
+                "expected at most one per entry"
+            )
         if expected is not None and len(trns) != expected:
             raise FrameProblem(f"tRNS of {len(trns)} bytes in a {COLOUR_TYPES[colour][0]} image: expected {expected}")
     return info
@@ -165,7 +180,7 @@ def _other_format(fh) -> str:
         fh.seek(0)
         with Image.open(fh) as im:
             return f"a {escape_controls(im.format)} image: expected a PNG"
-    except Exception:            # noqa: BLE001 - Pillow's many ways to say "not an image"
+    except Exception:  # noqa: BLE001 - Pillow's many ways to say "not an image"
         return "unreadable as PNG (no PNG signature, nor another image format): expected a PNG"
 
 
@@ -175,7 +190,7 @@ def _decode(fh, rawmode: str | None = None):
     from PIL import Image
 
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked before
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)  # the size is checked before
         fh.seek(0)
         with Image.open(fh) as im:
             if rawmode is not None:
@@ -204,19 +219,20 @@ def _decode_grey8(fh, width: int, height: int) -> np.ndarray | None:
 
     map_buffer = getattr(Image.core, "map_buffer", None)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", Image.DecompressionBombWarning)     # the size is checked before
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)  # the size is checked before
         fh.seek(0)
         with Image.open(fh) as im:
             if im.mode not in ("L", "RGB") or im.size != (width, height):
                 return None
-            if map_buffer is None:                                          # a Pillow without it: copied out
+            if map_buffer is None:  # a Pillow without it: copied out
                 im.load()
-                return (np.array(im, np.uint8) if im.mode == "L" else
-                        _luminance(np.asarray(im)[..., :3]).astype(np.uint8))
+                return (
+                    np.array(im, np.uint8) if im.mode == "L" else _luminance(np.asarray(im)[..., :3]).astype(np.uint8)
+                )
             out = np.empty((height, width), np.uint8)
             target = map_buffer(out, (width, height), "raw", 0, ("L", 0, 1))
             if im.mode == "L":
-                im.im = target                     # decoded into ``out``
+                im.im = target  # decoded into ``out``
                 im.load()
             else:
                 im.load()
@@ -233,14 +249,14 @@ def _samples(fh, info: dict) -> tuple[np.ndarray, np.ndarray | None]:
         if depth == 1:
             return pixels.astype(np.uint16), None
         if depth in (2, 4):
-            scale = 255 // (2 ** depth - 1)            # Pillow unpacks 2/4-bit grey scaled to 0..255
+            scale = 255 // (2**depth - 1)  # Pillow unpacks 2/4-bit grey scaled to 0..255
             return (pixels // scale).astype(np.uint16), None
-        return pixels.astype(np.uint16), None          # 8 bits (L), 16 bits (I;16: the full samples)
+        return pixels.astype(np.uint16), None  # 8 bits (L), 16 bits (I;16: the full samples)
     if colour == 3:
-        return pixels.astype(np.uint16), None          # palette indices (P)
+        return pixels.astype(np.uint16), None  # palette indices (P)
     if colour == 2:
         rgb = pixels[..., :3].astype(np.uint16)
-        if depth == 16:                                # Pillow keeps the high bytes; tRNS needs the low ones
+        if depth == 16:  # Pillow keeps the high bytes; tRNS needs the low ones
             rgb = rgb << 8
             if info["trns"] is not None:
                 rgb |= _decode(fh, "RGB;16L")[1][..., :3].astype(np.uint16)
@@ -258,15 +274,14 @@ def _to8(samples: np.ndarray, depth: int) -> np.ndarray:
     """Samples of ``depth`` bits on 8 bits: low depths scaled up exactly, 16 bits by their high byte."""
     if depth == 16:
         return (samples >> 8).astype(np.uint8)
-    return (samples.astype(np.uint16) * (255 // (2 ** depth - 1))).astype(np.uint8)
+    return (samples.astype(np.uint16) * (255 // (2**depth - 1))).astype(np.uint8)
 
 
 def _luminance(rgb8: np.ndarray) -> np.ndarray:
     """Pillow's RGB -> L (ITU-R 601-2), the luminance the rule has always used."""
     from PIL import Image
 
-    return np.asarray(Image.fromarray(np.ascontiguousarray(rgb8, dtype=np.uint8), "RGB").convert("L"),
-                      dtype=np.uint16)
+    return np.asarray(Image.fromarray(np.ascontiguousarray(rgb8, dtype=np.uint8), "RGB").convert("L"), dtype=np.uint16)
 
 
 def read_png(path: Path, width: int, height: int) -> np.ndarray:
@@ -303,7 +318,7 @@ def read_grey(path: Path, width: int, height: int) -> np.ndarray:
     camera's size is expected. The size is checked before any pixel is decoded
     (a huge image costs nothing).
     """
-    with open_frame(path) as fh:                 # one file for the header and the pixels
+    with open_frame(path) as fh:  # one file for the header and the pixels
         info = _check_header(fh, width, height)
         return _grey(fh, info, width, height)
 
@@ -312,14 +327,14 @@ def _grey(fh, info: dict, width: int, height: int) -> np.ndarray:
     """:func:`read_grey`'s pixels from the open file ``fh`` whose header ``info`` was checked."""
     colour, depth, trns = info["colour"], info["depth"], info["trns"]
     try:
-        if trns is None and depth == 8 and colour in (0, 2):    # 8-bit grey or RGB, opaque: the samples' L
+        if trns is None and depth == 8 and colour in (0, 2):  # 8-bit grey or RGB, opaque: the samples' L
             grey = _decode_grey8(fh, width, height)
             if grey is not None:
                 return grey
         samples, alpha8 = _samples(fh, info)
     except FrameProblem:
         raise
-    except Exception as exc:     # noqa: BLE001 - a damaged stream (CRC, zlib, truncated): Pillow's message
+    except Exception as exc:  # noqa: BLE001 - a damaged stream (CRC, zlib, truncated): Pillow's message
         raise FrameProblem(f"unreadable as PNG ({type(exc).__name__}: {escape_controls(exc)[:200]})") from None
     if samples.shape[:2] != (height, width):
         raise FrameProblem(f"decoded to {samples.shape[1]}x{samples.shape[0]}: expected {width}x{height}")
@@ -329,18 +344,17 @@ def _grey(fh, info: dict, width: int, height: int) -> np.ndarray:
             raise FrameProblem(f"palette index {int(samples.max())} beyond its {n} entries: expected 0..{n - 1}")
         alphas = np.full(n, 255, np.uint16)
         if trns is not None:
-            alphas[:len(trns)] = np.frombuffer(trns, np.uint8)
+            alphas[: len(trns)] = np.frombuffer(trns, np.uint8)
         grey = _luminance(palette[samples])
         alpha = alphas[samples]
     elif colour in (0, 2):
-        grey = (_to8(samples, depth).astype(np.uint16) if colour == 0 else
-                _luminance(_to8(samples, depth)))
+        grey = _to8(samples, depth).astype(np.uint16) if colour == 0 else _luminance(_to8(samples, depth))
         alpha = np.full(samples.shape[:2], 255, np.uint16)
-        if trns is not None:                   # one transparent colour, at the samples' full depth
+        if trns is not None:  # one transparent colour, at the samples' full depth
             key = np.array(struct.unpack(">" + "H" * (len(trns) // 2), trns), np.uint16)
             hit = samples == key[0] if colour == 0 else np.all(samples == key, axis=-1)
             alpha[hit] = 0
     else:
         grey = samples.astype(np.uint16) if samples.ndim == 2 else _luminance(samples)
         alpha = alpha8
-    return (grey.astype(np.uint32) * alpha // 255).astype(np.uint8)    # 0 where transparent
+    return (grey.astype(np.uint32) * alpha // 255).astype(np.uint8)  # 0 where transparent

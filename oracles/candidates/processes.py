@@ -26,7 +26,7 @@ def die_with_parent() -> None:
     try:
         import ctypes
 
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)    # PR_SET_PDEATHSIG
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except (OSError, AttributeError):
         pass
 
@@ -44,7 +44,7 @@ def await_group_end(pgid: int) -> None:
         try:
             os.killpg(pgid, 0)
         except (ProcessLookupError, PermissionError):
-            return                     # no member at all: the usual case, at the cost of one call
+            return  # no member at all: the usual case, at the cost of one call
         if not groupruns(pgid):
             return
         time.sleep(0.001)
@@ -53,9 +53,11 @@ def await_group_end(pgid: int) -> None:
 def pipe_ends(proc) -> dict:
     """``{pipe inode: access mode}`` of the program's ends of its three pipes (read stdin, write stdout, stderr)."""
     try:
-        return {os.fstat(proc.stdin.fileno()).st_ino: os.O_RDONLY,
-                os.fstat(proc.stdout.fileno()).st_ino: os.O_WRONLY,
-                os.fstat(proc.stderr.fileno()).st_ino: os.O_WRONLY}
+        return {
+            os.fstat(proc.stdin.fileno()).st_ino: os.O_RDONLY,
+            os.fstat(proc.stdout.fileno()).st_ino: os.O_WRONLY,
+            os.fstat(proc.stderr.fileno()).st_ino: os.O_WRONLY,
+        }
     except (OSError, ValueError):
         return {}
 

@@ -72,15 +72,24 @@ def camera_message(camera) -> dict:
         return [_json_number(x) for x in np.asarray(v, dtype=np.float64).reshape(-1)]
 
     return {
-        "position": vec(camera.position), "forward": vec(camera.forward), "up": vec(camera.up),
-        "right": vec(camera.right), "fov_y_deg": _json_number(camera.fov_y_deg),
-        "width": int(camera.width), "height": int(camera.height),
-        "near": _json_number(camera.near), "far": _json_number(camera.far),
-        "projection": camera.projection, "ortho_height": _json_number(camera.ortho_height),
+        "position": vec(camera.position),
+        "forward": vec(camera.forward),
+        "up": vec(camera.up),
+        "right": vec(camera.right),
+        "fov_y_deg": _json_number(camera.fov_y_deg),
+        "width": int(camera.width),
+        "height": int(camera.height),
+        "near": _json_number(camera.near),
+        "far": _json_number(camera.far),
+        "projection": camera.projection,
+        "ortho_height": _json_number(camera.ortho_height),
         "intrinsics": None if camera.intrinsics is None else vec(camera.intrinsics),
         "distortion": None if camera.distortion is None else vec(camera.distortion),
-        "K": rows(k), "R": rows(r_cv), "t": vec(t_cv),
-        "view_matrix": rows(view), "projection_matrix": rows(proj),
+        "K": rows(k),
+        "R": rows(r_cv),
+        "t": vec(t_cv),
+        "view_matrix": rows(view),
+        "projection_matrix": rows(proj),
     }
 
 
@@ -98,8 +107,8 @@ def encode_request(request_id: int, p_world: np.ndarray, camera_json: str, kind:
     kind_key = f'"kind":"{kind}",' if kind is not None else ""
     line = f'{{"request":{int(request_id)},{kind_key}"n":{len(p_world)},"camera":{camera_json}}}\n'
     out = bytearray(line.encode())
-    if len(p_world):                              # N = 0: the line alone (a view of no bytes cannot be cast)
-        out += memoryview(p_world).cast("B")      # one copy of the points, not two
+    if len(p_world):  # N = 0: the line alone (a view of no bytes cannot be cast)
+        out += memoryview(p_world).cast("B")  # one copy of the points, not two
     return out
 
 
@@ -122,8 +131,9 @@ def reply_precision(line: bytes) -> str:
     obj = parse_line(line, "a reply")
     precision = obj.get("precision", "float64")
     if precision not in REPLY_PRECISIONS:
-        raise ProtocolError(f"wrote the reply {shown(line)}: expected \"precision\" to be one of "
-                            f"{', '.join(REPLY_PRECISIONS)}")
+        raise ProtocolError(
+            f'wrote the reply {shown(line)}: expected "precision" to be one of {", ".join(REPLY_PRECISIONS)}'
+        )
     return precision
 
 
@@ -162,9 +172,10 @@ def parse_line(line: bytes, what: str) -> dict:
     try:
         obj = json.loads(line.decode("utf-8"), object_pairs_hook=_unique_keys)
     except _DuplicateKey as exc:
-        raise ProtocolError(f"wrote {shown(line)} instead of {what}: the key {shown(str(exc))} twice "
-                            "(expected each key once)") from None
-    except (UnicodeDecodeError, ValueError, RecursionError):   # RecursionError: arrays nested too deep
+        raise ProtocolError(
+            f"wrote {shown(line)} instead of {what}: the key {shown(str(exc))} twice (expected each key once)"
+        ) from None
+    except (UnicodeDecodeError, ValueError, RecursionError):  # RecursionError: arrays nested too deep
         raise ProtocolError(f"wrote garbage instead of {what}: {shown(line)} (expected one JSON line)") from None
     if not isinstance(obj, dict):
         raise ProtocolError(f"wrote {shown(line)} instead of {what}: expected a JSON object")
@@ -180,14 +191,16 @@ def reply_length(line: bytes, n_expected: int, columns: int = 2) -> int:
     if "error" in obj:
         raise CandidateReportedError(error_text(obj["error"]))
     unknown = sorted(set(obj) - set(REPLY_KEYS))
-    if unknown:      # an echo of the request ({"request":..,"n":N,...}) must not pass for a reply
-        raise ProtocolError(f"wrote the reply {shown(line)}: the key {shown(unknown[0], 30)} is not one of a "
-                            f"reply's ({', '.join(REPLY_KEYS)})")
+    if unknown:  # an echo of the request ({"request":..,"n":N,...}) must not pass for a reply
+        raise ProtocolError(
+            f"wrote the reply {shown(line)}: the key {shown(unknown[0], 30)} is not one of a "
+            f"reply's ({', '.join(REPLY_KEYS)})"
+        )
     n = obj.get("n")
     if not isinstance(n, int) or isinstance(n, bool):
-        raise ProtocolError(f"wrote the reply {shown(line)}: expected {{\"n\": {n_expected}}} or {{\"error\": ...}}")
+        raise ProtocolError(f'wrote the reply {shown(line)}: expected {{"n": {n_expected}}} or {{"error": ...}}')
     if n != n_expected:
-        digits = str(n)       # a reply line holds up to MAX_LINE digits: the reason shows the first 24
+        digits = str(n)  # a reply line holds up to MAX_LINE digits: the reason shows the first 24
         digits = digits if len(digits) <= 24 else digits[:24] + "..."
         raise ProtocolError(f"answered {digits} points to a request of {n_expected}: expected {n_expected}")
     return n * columns * 8
@@ -210,6 +223,6 @@ def check_hello(line: bytes) -> None:
         obj = parse_line(line, "the header")
         if "error" in obj:
             raise CandidateReportedError(error_text(obj["error"]))
-    if re.fullmatch(rb"wirecheck-candidate [0-9]{1,9}\n", line):      # another version, byte for byte
+    if re.fullmatch(rb"wirecheck-candidate [0-9]{1,9}\n", line):  # another version, byte for byte
         raise ProtocolError(f"speaks {line.decode().strip()!r}: this wirecheck speaks {HEADER.decode().strip()!r}")
     raise ProtocolError(f"answered the header with {shown(line)}: expected {HEADER!r}")

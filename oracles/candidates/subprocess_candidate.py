@@ -51,9 +51,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import protocol
+from .candidate import CandidateError
 from .forked_candidate import ForkedChild
 from .processes import await_group_end, die_with_parent, kill_pipe_holders, pipe_ends
-from .candidate import CandidateError
 
 #: Default seconds a request may take (issue 15: a hang fails the case, not the run).
 DEFAULT_TIMEOUT_S = 10.0
@@ -135,14 +135,25 @@ class SubprocessCandidate:
         """
         env = (("WIRECHECK_HOST_PATH", os.pathsep.join(pythonpath)),) if pythonpath else ()
         mode = ("--unproject",) if kwargs.pop("unproject", False) else ()
-        return cls(argv=(sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", *mode, spec),
-                   timeout_s=timeout_s, label=kwargs.pop("label", spec), env=env, python_spec=spec, **kwargs)
+        return cls(
+            argv=(sys.executable, "-m", "wirecheck.oracles.candidates.candidate_host", *mode, spec),
+            timeout_s=timeout_s,
+            label=kwargs.pop("label", spec),
+            env=env,
+            python_spec=spec,
+            **kwargs,
+        )
 
     @classmethod
     def fork(cls, func, timeout_s: float = DEFAULT_TIMEOUT_S, label: str = "") -> SubprocessCandidate:
         """``func`` run in a forked child process (:class:`ForkedChild`); POSIX only."""
-        return cls(argv=("<forked>",), timeout_s=timeout_s, label=label or repr(func), python_spec=label or repr(func),
-                   forked=func)
+        return cls(
+            argv=("<forked>",),
+            timeout_s=timeout_s,
+            label=label or repr(func),
+            python_spec=label or repr(func),
+            forked=func,
+        )
 
     @property
     def name(self) -> str:
@@ -150,9 +161,12 @@ class SubprocessCandidate:
 
     def settings(self) -> dict:
         """For the report: how the candidate ran."""
-        return {"isolation": "subprocess", "protocol": protocol.VERSION,
-                "command": list(self.argv) if self.python_spec is None else None,
-                "timeout_s": self.timeout_s}
+        return {
+            "isolation": "subprocess",
+            "protocol": protocol.VERSION,
+            "command": list(self.argv) if self.python_spec is None else None,
+            "timeout_s": self.timeout_s,
+        }
 
     def __call__(self, points, camera) -> np.ndarray:
         """The candidate contract: ``(N, 3)`` world points to ``(N, 2)`` pixels; CandidateError on any fault."""
@@ -160,8 +174,9 @@ class SubprocessCandidate:
 
     def unproject(self, pixels, depth, camera) -> np.ndarray:
         """The unprojector contract over the protocol (a request of kind ``unproject``): ``(N, 3)`` world points."""
-        rows = np.column_stack([np.asarray(pixels, dtype=np.float64).reshape(-1, 2),
-                                np.asarray(depth, dtype=np.float64).reshape(-1)])
+        rows = np.column_stack(
+            [np.asarray(pixels, dtype=np.float64).reshape(-1, 2), np.asarray(depth, dtype=np.float64).reshape(-1)]
+        )
         return _live(self).project(rows, camera, kind="unproject")
 
     def answer_precision(self) -> str:
@@ -232,8 +247,13 @@ def _close_all() -> None:
 def _live_pipe_fds() -> list:
     """This process's ends of every live program's pipes: a fork closes them, or a program would never see
     EOF on its stdin while the fork lives (its close would wait out ``_EXIT_GRACE_S``, then kill it)."""
-    return [f.fileno() for program in _PROGRAMS.values() if program.proc is not None
-            for f in (program.proc.stdin, program.proc.stdout, program.proc.stderr) if not f.closed]
+    return [
+        f.fileno()
+        for program in _PROGRAMS.values()
+        if program.proc is not None
+        for f in (program.proc.stdin, program.proc.stdout, program.proc.stderr)
+        if not f.closed
+    ]
 
 
 class _Died(Exception):
@@ -269,8 +289,10 @@ def _status_text(returncode) -> str:
 def _early(sent: int, total: int) -> str:
     """The reason for a reply (an error reply too) that came before the request was all written: the
     program would read the rest as its next request."""
-    return (f"answered before reading the whole request ({sent} of {total} bytes had reached its stdin): "
-            "expected the reply after the request")
+    return (
+        f"answered before reading the whole request ({sent} of {total} bytes had reached its stdin): "
+        "expected the reply after the request"
+    )
 
 
 class _Program:
@@ -279,13 +301,13 @@ class _Program:
     def __init__(self, spec: SubprocessCandidate):
         self.spec = spec
         self.proc = None
-        self.start_error = None        # sticky: (exception class, message)
+        self.start_error = None  # sticky: (exception class, message)
         self.buf = bytearray()
         self.requests = 0
         self.camera = self.camera_json = None
-        self.precision = "float64"         # what the last reply declared
-        self.err = bytearray()             # the program's stderr not yet taken (its tail)
-        self.err_cut = 0                   # bytes dropped from its front since the last take
+        self.precision = "float64"  # what the last reply declared
+        self.err = bytearray()  # the program's stderr not yet taken (its tail)
+        self.err_cut = 0  # bytes dropped from its front since the last take
 
     # ---- life cycle
 
@@ -309,9 +331,16 @@ class _Program:
             if spec.forked is not None:
                 proc = ForkedChild(spec.forked, _live_pipe_fds())
             else:
-                proc = subprocess.Popen(spec.argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                        stderr=subprocess.PIPE, env=env, start_new_session=True, bufsize=0,
-                                        preexec_fn=die_with_parent)
+                proc = subprocess.Popen(
+                    spec.argv,
+                    stdin=subprocess.PIPE,
+                    stdout=subprocess.PIPE,
+                    stderr=subprocess.PIPE,
+                    env=env,
+                    start_new_session=True,
+                    bufsize=0,
+                    preexec_fn=die_with_parent,
+                )
         except OSError as exc:
             raise CandidateStartRefused(f"cannot start {spec.argv[0]!r}: {exc.strerror or exc}") from None
         self.proc = proc
@@ -323,20 +352,25 @@ class _Program:
 
                 fcntl.fcntl(f.fileno(), fcntl.F_SETPIPE_SZ, _CHUNK)
             except (ImportError, AttributeError, OSError):
-                pass                       # a smaller pipe only costs speed
+                pass  # a smaller pipe only costs speed
         limit = spec.start_timeout_s or max(spec.timeout_s, MIN_START_TIMEOUT_S)
         what = "at start-up, before answering the protocol header"
         try:
-            end = self._exchange(protocol.HEADER, self._line_end, limit,
-                                 f"candidate did not answer the protocol header within {limit:g} s "
-                                 "(start-up); it was killed", what)
+            end = self._exchange(
+                protocol.HEADER,
+                self._line_end,
+                limit,
+                f"candidate did not answer the protocol header within {limit:g} s (start-up); it was killed",
+                what,
+            )
             line = bytes(self.buf[:end])
             del self.buf[:end]
             protocol.check_hello(line)
         except protocol.CandidateReportedError as exc:
             self._kill()
-            raise CandidateStartRefused(str(exc) if spec.python_spec else f"candidate refused to start: {exc}") \
-                from None
+            raise CandidateStartRefused(
+                str(exc) if spec.python_spec else f"candidate refused to start: {exc}"
+            ) from None
         except protocol.ProtocolError as exc:
             self._kill()
             raise CandidateError(f"candidate {exc}{self._stderr_hint()}") from None
@@ -366,7 +400,7 @@ class _Program:
     @staticmethod
     def _killpg(proc) -> None:
         try:
-            os.killpg(proc.pid, signal.SIGKILL)     # the program and anything it started
+            os.killpg(proc.pid, signal.SIGKILL)  # the program and anything it started
         except (ProcessLookupError, PermissionError):
             try:
                 proc.kill()
@@ -381,7 +415,7 @@ class _Program:
         proc.wait()
         await_group_end(proc.pid)
         kill_pipe_holders(pipe_ends(proc))
-        self._drain_stderr(proc)            # all it wrote is in the pipe now
+        self._drain_stderr(proc)  # all it wrote is in the pipe now
         for f in (proc.stdin, proc.stdout, proc.stderr):
             try:
                 f.close()
@@ -401,7 +435,7 @@ class _Program:
         except subprocess.TimeoutExpired:
             self._kill()
             return f"closed its {pipe} but went on running (it was killed)"
-        self._kill()           # closes the pipes; the group may hold children
+        self._kill()  # closes the pipes; the group may hold children
         return _status_text(proc.returncode)
 
     # ---- requests
@@ -413,7 +447,7 @@ class _Program:
         self.requests += 1
         n = len(p_world)
         columns = 3 if kind == "unproject" else 2
-        if self.camera is not camera:          # a case asks with one camera object: its JSON is made once
+        if self.camera is not camera:  # a case asks with one camera object: its JSON is made once
             self.camera, self.camera_json = camera, protocol.camera_text(camera)
         payload = protocol.encode_request(self.requests, p_world, self.camera_json, kind)
         what = f"a request of {n} points"
@@ -432,22 +466,28 @@ class _Program:
         try:
             self._read_pending()
             if self.buf:
-                raise protocol.ProtocolError(f"wrote {len(self.buf)} bytes outside a reply: "
-                                             f"{protocol.shown(bytes(self.buf))}")
-            end = self._exchange(payload, reply_end, self.spec.timeout_s,
-                                 f"candidate timed out after {self.spec.timeout_s:g} s on {what}{{progress}}; "
-                                 "it was killed "
-                                 "(and is started again for the next case)", f"during {what}")
+                raise protocol.ProtocolError(
+                    f"wrote {len(self.buf)} bytes outside a reply: {protocol.shown(bytes(self.buf))}"
+                )
+            end = self._exchange(
+                payload,
+                reply_end,
+                self.spec.timeout_s,
+                f"candidate timed out after {self.spec.timeout_s:g} s on {what}{{progress}}; "
+                "it was killed "
+                "(and is started again for the next case)",
+                f"during {what}",
+            )
         except protocol.CandidateReportedError as exc:
-            del self.buf[:header["line"]]
+            del self.buf[: header["line"]]
             if self.spec.python_spec:
                 raise CandidateError(str(exc)) from None
             raise CandidateError(f"candidate reported an error: {exc}") from None
         except protocol.ProtocolError as exc:
             self._kill()
             raise CandidateError(f"candidate {exc} (on {what}); it was killed{self._stderr_hint()}") from None
-        with memoryview(self.buf) as view:          # decoded straight from the buffer (one copy)
-            p_px = protocol.decode_points(view[header["line"]:end], columns)
+        with memoryview(self.buf) as view:  # decoded straight from the buffer (one copy)
+            p_px = protocol.decode_points(view[header["line"] : end], columns)
         del self.buf[:end]
         self.precision = header["precision"]
         return p_px
@@ -470,8 +510,10 @@ class _Program:
         if i >= 0:
             return i + 1
         if len(buf) >= protocol.MAX_LINE:
-            raise protocol.ProtocolError(f"wrote {protocol.shown(bytes(buf))} with no newline in its first "
-                                         f"{protocol.MAX_LINE} bytes: expected a JSON line")
+            raise protocol.ProtocolError(
+                f"wrote {protocol.shown(bytes(buf))} with no newline in its first "
+                f"{protocol.MAX_LINE} bytes: expected a JSON line"
+            )
         return None
 
     def _transfer(self, payload: bytes, end_of, deadline: float) -> int:
@@ -498,9 +540,9 @@ class _Program:
                         raise protocol.ProtocolError(_early(sent, len(payload))) from None
                     raise
                 if end is not None and len(self.buf) >= end:
-                    if sent < len(payload):       # its answer cannot depend on bytes it never got
+                    if sent < len(payload):  # its answer cannot depend on bytes it never got
                         raise protocol.ProtocolError(_early(sent, len(payload)))
-                    self._drain_stderr(proc)      # what it wrote before replying
+                    self._drain_stderr(proc)  # what it wrote before replying
                     return end
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
@@ -508,10 +550,10 @@ class _Program:
                 for key, _ in sel.select(remaining):
                     if key.fd == e:
                         if not self._drain_stderr(proc):
-                            sel.unregister(e)       # closed: the program may live on without it
+                            sel.unregister(e)  # closed: the program may live on without it
                     elif key.fd == w:
                         try:
-                            sent += os.write(w, view[sent:sent + _CHUNK])
+                            sent += os.write(w, view[sent : sent + _CHUNK])
                         except BlockingIOError:
                             continue
                         except (BrokenPipeError, ConnectionResetError):
@@ -536,7 +578,7 @@ class _Program:
             chunk = os.read(self.proc.stdout.fileno(), protocol.MAX_LINE)
         except (BlockingIOError, OSError):
             return
-        self.buf += chunk          # b"" (EOF) too: the exchange then finds it
+        self.buf += chunk  # b"" (EOF) too: the exchange then finds it
 
     # ---- stderr
 

@@ -39,8 +39,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.user_files import RefusedFile, file_kind, read_text
 from wirecheck.core.scene.files import MESH_SUFFIXES
+from wirecheck.core.user_files import RefusedFile, file_kind, read_text
 
 
 @dataclass(frozen=True)
@@ -57,10 +57,10 @@ class MeshEntry:
 class Dataset:
     """The meshes to check, sorted by name, and what the walk saw besides them."""
 
-    entries: tuple          # of MeshEntry
-    sources: tuple          # the folders and lists given, as given
-    other_files: int = 0    # files without a mesh suffix, ignored
-    skipped: tuple = ()     # (name, what it is) of each mesh-named FIFO, device or socket: never opened
+    entries: tuple  # of MeshEntry
+    sources: tuple  # the folders and lists given, as given
+    other_files: int = 0  # files without a mesh suffix, ignored
+    skipped: tuple = ()  # (name, what it is) of each mesh-named FIFO, device or socket: never opened
 
     def to_dict(self) -> dict:
         out = {"sources": list(self.sources), "meshes": len(self.entries), "other_files": self.other_files}
@@ -74,8 +74,7 @@ class Dataset:
             return None
         named = ", ".join(f"{name} ({kind})" for name, kind in self.skipped[:5])
         more = f" and {len(self.skipped) - 5} more" if len(self.skipped) > 5 else ""
-        return (f"skipped {len(self.skipped)} mesh-named file(s) that are not regular files, never opened: "
-                f"{named}{more}")
+        return f"skipped {len(self.skipped)} mesh-named file(s) that are not regular files, never opened: {named}{more}"
 
 
 #: Control characters (C0, DEL, C1): legal in a Linux file name, but a newline would split a
@@ -110,20 +109,21 @@ def walk_folder(root: Path, skipped: list | None = None) -> tuple[list[MeshEntry
         try:
             st = folder.stat()
             key = (st.st_dev, st.st_ino)
-            if key in seen:           # a link loop, or a second link to a folder already walked
+            if key in seen:  # a link loop, or a second link to a folder already walked
                 continue
             seen.add(key)
             with os.scandir(folder) as it:
                 items = sorted(it, key=lambda e: e.name)
         except OSError as exc:
-            entries.append(MeshEntry(name=rel or ".", path=str(folder),
-                                     error=f"folder could not be read: {exc.strerror or exc}"))
+            entries.append(
+                MeshEntry(name=rel or ".", path=str(folder), error=f"folder could not be read: {exc.strerror or exc}")
+            )
             continue
         folders = []
         for item in items:
             item_rel = f"{rel}/{item.name}" if rel else item.name
             try:
-                is_dir = item.is_dir()        # follows links
+                is_dir = item.is_dir()  # follows links
             except OSError:
                 is_dir = False
             if is_dir:
@@ -137,14 +137,14 @@ def walk_folder(root: Path, skipped: list | None = None) -> tuple[list[MeshEntry
                 entries.append(MeshEntry(name=item_rel, path=os.path.abspath(item.path)))
             else:
                 other += 1
-        stack += reversed(folders)            # the first in name order is walked first
+        stack += reversed(folders)  # the first in name order is walked first
     return entries, other
 
 
 def _not_regular(item: os.DirEntry) -> str | None:
     """What ``item`` is when it exists and is not a regular file (links followed); None otherwise."""
     try:
-        mode = item.stat().st_mode          # follows links; a broken link is the loader's "file not found"
+        mode = item.stat().st_mode  # follows links; a broken link is the loader's "file not found"
     except OSError:
         return None
     return None if stat.S_ISREG(mode) else file_kind(mode)
@@ -153,11 +153,13 @@ def _not_regular(item: os.DirEntry) -> str | None:
 def read_list(list_path: Path) -> list[MeshEntry]:
     """The entries of a scene list; InputError (with FILE:LINE) for a line that names no mesh file."""
     try:
-        text = read_text(list_path, "scene list")      # a BOM (Windows editors) is not part of line 1
+        text = read_text(list_path, "scene list")  # a BOM (Windows editors) is not part of line 1
     except UnicodeDecodeError as exc:
-        raise InputError(f"--scene-list {str(list_path)!r}: not UTF-8 text ({exc.reason} at byte {exc.start}): "
-                         "expected one path per line") from None
-    except RefusedFile as exc:      # a FIFO, /dev/zero, a folder, a file over the limit: never read
+        raise InputError(
+            f"--scene-list {str(list_path)!r}: not UTF-8 text ({exc.reason} at byte {exc.start}): "
+            "expected one path per line"
+        ) from None
+    except RefusedFile as exc:  # a FIFO, /dev/zero, a folder, a file over the limit: never read
         raise InputError(f"--scene-list {exc}") from None
     base = list_path.parent
     entries, lines = [], {}
@@ -168,14 +170,18 @@ def read_list(list_path: Path) -> list[MeshEntry]:
         if "\0" in line:
             raise InputError(f"{list_path}:{lineno}: a NUL character: expected a path")
         if not is_mesh_file(line):
-            raise InputError(f"{list_path}:{lineno}: {line!r}: expected a mesh file ending in "
-                             f"{' '.join(MESH_SUFFIXES)} (folders go in --scene DIR)")
+            raise InputError(
+                f"{list_path}:{lineno}: {line!r}: expected a mesh file ending in "
+                f"{' '.join(MESH_SUFFIXES)} (folders go in --scene DIR)"
+            )
         path = Path(line) if Path(line).is_absolute() else base / line
         key = os.path.normpath(os.path.abspath(path))
-        same = os.path.realpath(key)            # a link to a mesh already listed is that mesh
+        same = os.path.realpath(key)  # a link to a mesh already listed is that mesh
         if same in lines:
-            raise InputError(f"{list_path}:{lineno}: {line!r}: listed twice (line {lines[same]}"
-                             f"{'' if same == key else ', through a link'}): expected each mesh once")
+            raise InputError(
+                f"{list_path}:{lineno}: {line!r}: listed twice (line {lines[same]}"
+                f"{'' if same == key else ', through a link'}): expected each mesh once"
+            )
         lines[same] = lineno
         entries.append(MeshEntry(name=os.path.normpath(line), path=key))
     return entries
@@ -196,11 +202,13 @@ def dataset_entries(folders=(), lists=()) -> Dataset:
         found, n_other = walk_folder(root, skipped)
         if not found:
             odd = len(skipped) - n_skipped
-            raise InputError(f"--scene {str(folder)!r}: no mesh files in this folder "
-                             f"(looked for {' '.join(MESH_SUFFIXES)}; {n_other} other files"
-                             f"{f', {odd} mesh-named files that are not regular files' if odd else ''}): "
-                             "nothing to check")
-        if len(folders) > 1:      # several folders may each hold a 0001.obj: name them by folder too
+            raise InputError(
+                f"--scene {str(folder)!r}: no mesh files in this folder "
+                f"(looked for {' '.join(MESH_SUFFIXES)}; {n_other} other files"
+                f"{f', {odd} mesh-named files that are not regular files' if odd else ''}): "
+                "nothing to check"
+            )
+        if len(folders) > 1:  # several folders may each hold a 0001.obj: name them by folder too
             prefix = str(folder).rstrip("/\\") or "/"
             found = [MeshEntry(f"{prefix}/{e.name}", e.path, e.error) for e in found]
         entries += found
@@ -208,8 +216,9 @@ def dataset_entries(folders=(), lists=()) -> Dataset:
     for lst in lists:
         found = read_list(Path(lst))
         if not found:
-            raise InputError(f"--scene-list {str(lst)!r}: no paths in this list (only blank lines and "
-                             "comments): nothing to check")
+            raise InputError(
+                f"--scene-list {str(lst)!r}: no paths in this list (only blank lines and comments): nothing to check"
+            )
         entries += found
     if not entries:
         raise InputError("no dataset given: expected --scene DIR or --scene-list FILE")
@@ -219,7 +228,13 @@ def dataset_entries(folders=(), lists=()) -> Dataset:
     entries.sort(key=lambda e: e.name)
     for a, b in zip(entries, entries[1:]):
         if a.name == b.name:
-            raise InputError(f"two meshes named {a.name!r} ({printable(a.path)}, {printable(b.path)}): the report "
-                             "names meshes by their path under the folder or in the list: expected each name once")
-    return Dataset(entries=tuple(entries), sources=tuple(printable(str(s)) for s in (*folders, *lists)),
-                   other_files=other, skipped=tuple(skipped))
+            raise InputError(
+                f"two meshes named {a.name!r} ({printable(a.path)}, {printable(b.path)}): the report "
+                "names meshes by their path under the folder or in the list: expected each name once"
+            )
+    return Dataset(
+        entries=tuple(entries),
+        sources=tuple(printable(str(s)) for s in (*folders, *lists)),
+        other_files=other,
+        skipped=tuple(skipped),
+    )

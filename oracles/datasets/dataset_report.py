@@ -32,8 +32,9 @@ class DatasetProgress:
         if self.bar is None:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=total, file=self.stream, unit="mesh", desc="crosscheck", leave=False,
-                            dynamic_ncols=True)
+            self.bar = tqdm(
+                total=total, file=self.stream, unit="mesh", desc="crosscheck", leave=False, dynamic_ncols=True
+            )
         self.bar.n = done
         self.bar.refresh()
 
@@ -71,18 +72,22 @@ def headline(report: dict) -> str:
         allowed = ", allowed" if report.get("allow_load_errors") else ""
         extra.append(f"{s['load_errors']} could not be loaded{allowed}")
     c = report["compared"]
-    return (f"{report['verdict'].upper()}: {s['passed']}/{s['meshes']} meshes passed"
-            + (f" ({'; '.join(extra)})" if extra else "")
-            + f"; {s['cases']:,} cases, {c['frames']:,} frames compared ({len(report['cameras'])} cameras x "
-              f"{report['frames_checked']} frames per mesh)")
+    return (
+        f"{report['verdict'].upper()}: {s['passed']}/{s['meshes']} meshes passed"
+        + (f" ({'; '.join(extra)})" if extra else "")
+        + f"; {s['cases']:,} cases, {c['frames']:,} frames compared ({len(report['cameras'])} cameras x "
+        f"{report['frames_checked']} frames per mesh)"
+    )
 
 
 def timing_text(report: dict) -> str:
     t = report["timing"]
     where = t["executor"] + (f" {t['scheduler']}" if t.get("scheduler") else f", {t['workers'] or 1} process(es)")
     rate = _num(t.get("meshes_per_s"), ".2f")
-    return (f"Timing: {_num(t.get('wall_s'), '.1f')} s ({_num(t.get('startup_s'), '.1f')} s starting workers), {rate} meshes/s "
-            f"({where})")
+    return (
+        f"Timing: {_num(t.get('wall_s'), '.1f')} s ({_num(t.get('startup_s'), '.1f')} s starting workers), {rate} meshes/s "
+        f"({where})"
+    )
 
 
 def console_summary(report: dict) -> str:
@@ -111,8 +116,9 @@ def console_summary(report: dict) -> str:
         lines.append("Worst cases:")
         lines += [f"  {case_line(c)}" for c in s["worst_cases"]]
     if s["faults"]:
-        lines.append("Faults: " + ", ".join(f"{f['fault']} {f['cases']} cases ({f['meshes']} meshes)"
-                                            for f in s["faults"]))
+        lines.append(
+            "Faults: " + ", ".join(f"{f['fault']} {f['cases']} cases ({f['meshes']} meshes)" for f in s["faults"])
+        )
     lines += ["", headline(report), timing_text(report)]
     return "\n".join(lines)
 
@@ -120,9 +126,15 @@ def console_summary(report: dict) -> str:
 def markdown(report: dict) -> str:
     """report.md: the headline, load errors, every mesh not passed, the worst cases and the faults."""
     s = report["summary"]
-    out = [f"# crosscheck dataset: {report.get('run') or ''}".rstrip(), "", headline(report), "",
-           f"Candidate: `{report['candidate']}`; level {report['level']}; sources: "
-           + ", ".join(f"`{src}`" for src in report["dataset"]["sources"]), ""]
+    out = [
+        f"# crosscheck dataset: {report.get('run') or ''}".rstrip(),
+        "",
+        headline(report),
+        "",
+        f"Candidate: `{report['candidate']}`; level {report['level']}; sources: "
+        + ", ".join(f"`{src}`" for src in report["dataset"]["sources"]),
+        "",
+    ]
     if s["errors"]:
         out += ["## Could not be loaded", "", "| mesh | error |", "| --- | --- |"]
         out += [f"| {e['mesh']} | {e['error'].replace('|', '/')} |" for e in s["errors"]] + [""]
@@ -132,8 +144,12 @@ def markdown(report: dict) -> str:
     bad = [m for m in report["meshes"] if m["verdict"] in ("fail", "vacuous")]
     if bad:
         out += ["## Not passed", "", "| mesh | verdict | cases not passed |", "| --- | --- | --- |"]
-        out += [f"| {m['mesh']} | {m['verdict']} | "
-                + ", ".join(c["camera"] for c in m["cases"] if c["verdict"] != "pass") + " |" for m in bad] + [""]
+        out += [
+            f"| {m['mesh']} | {m['verdict']} | "
+            + ", ".join(c["camera"] for c in m["cases"] if c["verdict"] != "pass")
+            + " |"
+            for m in bad
+        ] + [""]
     if s["worst_cases"]:
         out += ["## Worst cases", ""] + [f"- {case_line(c)}" for c in s["worst_cases"]] + [""]
     if s["faults"]:

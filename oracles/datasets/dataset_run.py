@@ -28,25 +28,51 @@ import dataclasses
 import time
 from pathlib import Path
 
-from wirecheck.core.user_files import expected, problem
 from wirecheck.core.errors import InputError, one_line
-
-from ..judge import gate
-from ..candidates.core_candidate import RenderMode
-from .dataset import Dataset, MeshEntry
-from ..executors import ExecutorSpec, gather_in_order, open_executor
-from .memory_budget import default_budget, over_budget
-from ..runner import LEVEL_ORACLES, LEVELS, CaseRunner, overall_ms, RunParams, WORKER_LOCK, worker_init, scene_cases, worker_runner, worst_key
-from ..tolerances import Tolerances
 from wirecheck.core.scene.files import load_mesh_file
 from wirecheck.core.transforms import Motion
+from wirecheck.core.user_files import expected, problem
+
+from ..candidates.core_candidate import RenderMode
 from ..cases import calibrated_cases
+from ..executors import ExecutorSpec, gather_in_order, open_executor
+from ..judge import gate
+from ..runner import (
+    LEVEL_ORACLES,
+    LEVELS,
+    WORKER_LOCK,
+    CaseRunner,
+    RunParams,
+    overall_ms,
+    scene_cases,
+    worker_init,
+    worker_runner,
+    worst_key,
+)
+from ..tolerances import Tolerances
+from .dataset import Dataset, MeshEntry
+from .memory_budget import default_budget, over_budget
 
 #: The fields of a case record kept in a dataset's report (the per-frame detail of
 #: thousands of cases would make report.json hundreds of megabytes; rerun one mesh for it).
-CASE_KEYS = ("scene", "camera", "verdict", "reasons", "faults", "max_vertex_error_px", "mean_vertex_error_px",
-             "pixel_f1_0px", "pixel_f1_1px", "silhouette_iou", "depth_max_error", "depth_error_ratio",
-             "visible_points", "compared", "note", "candidate_stderr")
+CASE_KEYS = (
+    "scene",
+    "camera",
+    "verdict",
+    "reasons",
+    "faults",
+    "max_vertex_error_px",
+    "mean_vertex_error_px",
+    "pixel_f1_0px",
+    "pixel_f1_1px",
+    "silhouette_iou",
+    "depth_max_error",
+    "depth_error_ratio",
+    "visible_points",
+    "compared",
+    "note",
+    "candidate_stderr",
+)
 #: How many cases the summary names as the worst.
 WORST_N = 10
 
@@ -66,9 +92,9 @@ def _load(entry: MeshEntry):
         raise InputError(f"{refused}: expected {expected('mesh')}")
     try:
         scene = load_mesh_file(Path(entry.path))
-    except Exception as exc:         # any reader's failure is this mesh's, never the run's end
+    except Exception as exc:  # any reader's failure is this mesh's, never the run's end
         text = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
-        for path in (entry.path, one_line(entry.path)):        # as the reader wrote it, or made one line
+        for path in (entry.path, one_line(entry.path)):  # as the reader wrote it, or made one line
             text = text.replace(f"{path}: ", "")
         raise InputError(_named(text, entry)) from None
     return dataclasses.replace(scene, name=entry.name, source=entry.name)
@@ -81,8 +107,9 @@ def _named(text: str, entry: MeshEntry) -> str:
     return text
 
 
-def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None,
-               budget: int | None = None) -> tuple[dict, dict, dict | None]:
+def check_mesh(
+    entry: MeshEntry, params: RunParams, case_names, runner=None, budget: int | None = None
+) -> tuple[dict, dict, dict | None]:
     """``(mesh record, timing, oracle GL info or None)`` of one mesh under every case in ``case_names``.
 
     ``runner`` (:class:`oracles.runner._CaseRunner`): None in a worker process
@@ -96,8 +123,8 @@ def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None,
         cases = scene_cases(scene, case_names, params.motion)
     except InputError as exc:
         text = str(exc)
-        if text.startswith(f"{entry.name}:"):    # "NAME: why" or "NAME:LINE: why": the record names the mesh
-            rest = text[len(entry.name) + 1:]
+        if text.startswith(f"{entry.name}:"):  # "NAME: why" or "NAME:LINE: why": the record names the mesh
+            rest = text[len(entry.name) + 1 :]
             line, sep, why = rest.partition(": ")
             text = f"line {line}: {why}" if sep and line.isdigit() else rest.lstrip()
         record.update(verdict="error", error=text)
@@ -105,24 +132,29 @@ def check_mesh(entry: MeshEntry, params: RunParams, case_names, runner=None,
     t_load = time.perf_counter() - t0
     record.update(vertices=len(scene.vertices), edges=len(scene.edges), faces=len(scene.faces))
     why = over_budget(len(scene.vertices), len(scene.edges), len(scene.faces), budget)
-    if why is not None:              # one mesh's load error, not the machine's memory
+    if why is not None:  # one mesh's load error, not the machine's memory
         record.update(verdict="error", error=why)
         return record, {"mesh": entry.name, "load_s": t_load, "cases": []}, None
-    if scene.load_notes:           # read leniently (core.scene.files): said in the report, the mesh checked
+    if scene.load_notes:  # read leniently (core.scene.files): said in the report, the mesh checked
         record["warnings"] = [_named(note, entry) for note in scene.load_notes]
     results = [runner.run(scene, case, params) for case in cases]
     rows = [{k: r.record[k] for k in CASE_KEYS if k in r.record} for r in results]
     verdicts = {row["verdict"] for row in rows}
     record["verdict"] = "fail" if "fail" in verdicts else "vacuous" if "vacuous" in verdicts else "pass"
     record["cases"] = rows
-    timing = {"mesh": entry.name, "load_s": t_load, "check_s": time.perf_counter() - t0 - t_load,
-              "cases": [{"camera": case.name, **r.timing} for case, r in zip(cases, results)]}
+    timing = {
+        "mesh": entry.name,
+        "load_s": t_load,
+        "check_s": time.perf_counter() - t0 - t_load,
+        "cases": [{"camera": case.name, **r.timing} for case, r in zip(cases, results)],
+    }
     gl = next((r.gl_info for r in results if getattr(r, "gl_info", None) is not None), None)
     return record, timing, gl
 
 
-def _worker_check_mesh(entry: MeshEntry, params: RunParams, case_names,
-                       budget: int | None = None) -> tuple[dict, dict, dict | None]:
+def _worker_check_mesh(
+    entry: MeshEntry, params: RunParams, case_names, budget: int | None = None
+) -> tuple[dict, dict, dict | None]:
     with WORKER_LOCK:
         return check_mesh(entry, params, case_names, worker_runner(), budget)
 
@@ -134,8 +166,10 @@ def faults_by_count(meshes: list[dict]) -> list[dict]:
         names = [f["name"] for c in m.get("cases", []) for f in c.get("faults", [])]
         cases.update(names)
         meshes_with.update(set(names))
-    return [{"fault": f, "cases": n, "meshes": meshes_with[f]}
-            for f, n in sorted(cases.items(), key=lambda item: (-item[1], item[0]))]
+    return [
+        {"fault": f, "cases": n, "meshes": meshes_with[f]}
+        for f, n in sorted(cases.items(), key=lambda item: (-item[1], item[0]))
+    ]
 
 
 #: Failed cases are worse than vacuous ones, which are worse than passes, whatever their scores
@@ -146,8 +180,18 @@ _VERDICT_RANK = {"fail": 0, "vacuous": 1, "pass": 2}
 def worst_cases(meshes: list[dict], n: int = WORST_N) -> list[dict]:
     """The ``n`` worst cases over the dataset: failed first, then by oracles.runner.worst_key (ties: dataset order)."""
     rows = [c for m in meshes for c in m.get("cases", []) if c.get("compared", {}).get("frames")]
-    keep = ("scene", "camera", "verdict", "max_vertex_error_px", "pixel_f1_0px", "pixel_f1_1px",
-            "silhouette_iou", "depth_error_ratio", "faults", "reasons")
+    keep = (
+        "scene",
+        "camera",
+        "verdict",
+        "max_vertex_error_px",
+        "pixel_f1_0px",
+        "pixel_f1_1px",
+        "silhouette_iou",
+        "depth_error_ratio",
+        "faults",
+        "reasons",
+    )
     ranked = sorted(rows, key=lambda c: (_VERDICT_RANK.get(c["verdict"], 0), worst_key(c)))
     return [{k: c[k] for k in keep if k in c} for c in ranked[:n]]
 
@@ -161,22 +205,42 @@ def summarize(meshes: list[dict], level: str, allow_vacuous: bool, allow_load_er
     verdict = gate.run_verdict(records, compared, level, allow_vacuous)
     if errors and not allow_load_errors:
         verdict = "fail"
-    summary = {"meshes": len(meshes), "passed": counts["pass"], "failed": counts["fail"],
-               "vacuous": counts["vacuous"], "load_errors": len(errors),
-               "cases": len(records), "cases_failed": sum(1 for r in records if r["verdict"] == "fail"),
-               "faults": faults_by_count(meshes), "worst_cases": worst_cases(meshes),
-               "errors": [{"mesh": m["mesh"], "error": m["error"]} for m in errors]}
+    summary = {
+        "meshes": len(meshes),
+        "passed": counts["pass"],
+        "failed": counts["fail"],
+        "vacuous": counts["vacuous"],
+        "load_errors": len(errors),
+        "cases": len(records),
+        "cases_failed": sum(1 for r in records if r["verdict"] == "fail"),
+        "faults": faults_by_count(meshes),
+        "worst_cases": worst_cases(meshes),
+        "errors": [{"mesh": m["mesh"], "error": m["error"]} for m in errors],
+    }
     warned = [{"mesh": m["mesh"], "warning": w} for m in meshes for w in m.get("warnings", [])]
-    if warned:                        # read leniently, and checked (core.scene.files)
+    if warned:  # read leniently, and checked (core.scene.files)
         summary["warnings"] = warned
     return verdict, compared, summary
 
 
-def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=None, turns=(1.0, 1.0, 0.0),
-                tol: Tolerances | None = None, level: str = "pixels", every: int = 1,
-                mode: RenderMode | None = None, candidate_name: str = "candidate",
-                allow_vacuous: bool = False, allow_load_errors: bool = False,
-                executor: ExecutorSpec | None = None, progress=None, memory_budget="auto") -> dict:
+def run_dataset(
+    dataset: Dataset,
+    candidate,
+    *,
+    frames: int = 24,
+    case_names=None,
+    turns=(1.0, 1.0, 0.0),
+    tol: Tolerances | None = None,
+    level: str = "pixels",
+    every: int = 1,
+    mode: RenderMode | None = None,
+    candidate_name: str = "candidate",
+    allow_vacuous: bool = False,
+    allow_load_errors: bool = False,
+    executor: ExecutorSpec | None = None,
+    progress=None,
+    memory_budget="auto",
+) -> dict:
     """Every mesh of ``dataset`` under every case: the report dict (module docstring).
 
     ``candidate`` is as for :func:`oracles.runner.run_crosscheck` (picklable
@@ -195,15 +259,26 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     inputs = gate.run_settings(frames, every, case_names, turns, tol)
     if level == "pixels":
         distorted = {c.name for c in calibrated_cases(1.0) if c.camera.distortion is not None}
-        if set(inputs.case_names) <= distorted:      # as oracles.runner.run_crosscheck says it
-            raise InputError(f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their "
-                             "pixels are not compared (GL draws straight lines), so the run would compare no "
-                             "pixel; expected level vertices or a case without distortion")
-    params = RunParams(frames=inputs.frames, every=inputs.every, level=level, motion=Motion(turns=inputs.turns),
-                        tol=tol, candidate=candidate, mode=mode, keep_frames=False)
+        if set(inputs.case_names) <= distorted:  # as oracles.runner.run_crosscheck says it
+            raise InputError(
+                f"cases {', '.join(inputs.case_names)} at level pixels: lens distortion: their "
+                "pixels are not compared (GL draws straight lines), so the run would compare no "
+                "pixel; expected level vertices or a case without distortion"
+            )
+    params = RunParams(
+        frames=inputs.frames,
+        every=inputs.every,
+        level=level,
+        motion=Motion(turns=inputs.turns),
+        tol=tol,
+        candidate=candidate,
+        mode=mode,
+        keep_frames=False,
+    )
     # "auto": the workers on this machine share it (a remote cluster's machines: one worker's share)
-    budget = (default_budget(executor.jobs if executor.scheduler is None else 1) if memory_budget == "auto"
-              else memory_budget)
+    budget = (
+        default_budget(executor.jobs if executor.scheduler is None else 1) if memory_budget == "auto" else memory_budget
+    )
     entries = list(dataset.entries)
     t_run = time.perf_counter()
     done = 0
@@ -217,7 +292,7 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     if progress:
         progress(0, len(entries))
     with open_executor(executor, len(entries), initializer=worker_init) as (pool, workers):
-        startup_s = time.perf_counter() - t_run        # a Dask cluster's start, or nothing
+        startup_s = time.perf_counter() - t_run  # a Dask cluster's start, or nothing
         if pool is None:
             runner = CaseRunner()
             try:
@@ -234,8 +309,10 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     meshes = [r[0] for r in results]
     if all(m["verdict"] == "error" for m in meshes):
         first = meshes[0]
-        raise NothingLoaded(f"none of the {len(meshes)} meshes could be loaded (first: {first['mesh']}: "
-                            f"{first['error']}): nothing compared")
+        raise NothingLoaded(
+            f"none of the {len(meshes)} meshes could be loaded (first: {first['mesh']}: "
+            f"{first['error']}): nothing compared"
+        )
     verdict, compared, summary = summarize(meshes, level, allow_vacuous, allow_load_errors)
     return {
         "tool": "wirecheck crosscheck",
@@ -247,7 +324,7 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
         "candidate": candidate_name,
         "candidate_settings": candidate.settings() if hasattr(candidate, "settings") else None,
         "level": level,
-        "oracle_gl": next((r[2] for r in results if r[2] is not None), None),   # one driver per machine
+        "oracle_gl": next((r[2] for r in results if r[2] is not None), None),  # one driver per machine
         **mode.to_dict(),
         "oracles": list(LEVEL_ORACLES[level]),
         "frames": inputs.frames,
@@ -262,16 +339,22 @@ def run_dataset(dataset: Dataset, candidate, *, frames: int = 24, case_names=Non
     }
 
 
-def _timing(per_mesh: list[dict], executor: ExecutorSpec, workers: int, wall_s: float, startup_s: float,
-            level: str) -> dict:
+def _timing(
+    per_mesh: list[dict], executor: ExecutorSpec, workers: int, wall_s: float, startup_s: float, level: str
+) -> dict:
     """Times of the run: per-frame stage means over every case (as a plain run's), and meshes per second.
 
     ``meshes_per_s`` counts from the moment the workers were ready (``startup_s``
     is the executor's start: a process pool's or a Dask cluster's).
     """
     cases = [c for m in per_mesh for c in m["cases"]]
-    keys = ["vertex_stage_ms_per_frame", "candidate_ms_per_frame", "opencv_ms_per_frame", "harness_ms_per_frame",
-            "oracles_ms_per_frame"]
+    keys = [
+        "vertex_stage_ms_per_frame",
+        "candidate_ms_per_frame",
+        "opencv_ms_per_frame",
+        "harness_ms_per_frame",
+        "oracles_ms_per_frame",
+    ]
     if level == "pixels":
         keys += ["pixel_stage_ms_per_frame", "pyrender_ms_per_frame", "pixel_metrics_ms_per_frame"]
     timing = {k: overall_ms(cases, k) for k in keys}
@@ -279,7 +362,15 @@ def _timing(per_mesh: list[dict], executor: ExecutorSpec, workers: int, wall_s: 
     timing["harness_overhead_ratio"] = harness_ms / oracles_ms if oracles_ms and harness_ms is not None else None
     busy_s = sum(m["load_s"] + m.get("check_s", 0.0) for m in per_mesh)
     run_s = wall_s - startup_s
-    timing.update({**executor.to_dict(), "workers": workers, "wall_s": wall_s, "startup_s": startup_s,
-                   "meshes_per_s": len(per_mesh) / run_s if run_s > 0 else None,
-                   "mesh_s_mean": busy_s / len(per_mesh), "meshes": per_mesh})
+    timing.update(
+        {
+            **executor.to_dict(),
+            "workers": workers,
+            "wall_s": wall_s,
+            "startup_s": startup_s,
+            "meshes_per_s": len(per_mesh) / run_s if run_s > 0 else None,
+            "mesh_s_mean": busy_s / len(per_mesh),
+            "meshes": per_mesh,
+        }
+    )
     return timing

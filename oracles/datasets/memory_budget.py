@@ -26,7 +26,7 @@ from __future__ import annotations
 import os
 from fractions import Fraction
 
-GIB = 2 ** 30
+GIB = 2**30
 
 #: What any case holds (bytes): the interpreter with numpy, OpenCV, trimesh and pyrender (~0.22 GiB),
 #: an OpenGL context and its buffers, the frames' images and one chunk of the line metrics' pairs
@@ -76,10 +76,12 @@ def over_budget(vertices: int, edges: int, faces: int, budget: int | None) -> st
     need = estimate_bytes(vertices, edges, faces)
     if need <= budget:
         return None
-    return (f"needs about {size_text(need)} to check ({vertices} vertices, {edges} edges, {faces} faces): "
-            f"over the memory budget of {size_text(budget)} a mesh (--memory-budget GIB to change it)")
+    return (
+        f"needs about {size_text(need)} to check ({vertices} vertices, {edges} edges, {faces} faces): "
+        f"over the memory budget of {size_text(budget)} a mesh (--memory-budget GIB to change it)"
+    )
 
 
 def size_text(n_bytes: int) -> str:
     """``1.50 GiB``, or ``513 MiB`` under 1 GiB."""
-    return f"{n_bytes / GIB:.2f} GiB" if n_bytes >= GIB else f"{n_bytes / 2 ** 20:.0f} MiB"
+    return f"{n_bytes / GIB:.2f} GiB" if n_bytes >= GIB else f"{n_bytes / 2**20:.0f} MiB"

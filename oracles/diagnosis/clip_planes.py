@@ -38,8 +38,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import faults as catalogue
-from ..tolerances import EPS
 from ..candidates.candidate import CandidateError, call_candidate
+from ..tolerances import EPS
 
 __all__ = ["probe_planes", "clip_fault", "depth_slack", "FLOAT32_PLANE_ROUNDINGS", "PLANE_REL_TOL"]
 
@@ -84,14 +84,14 @@ def probe_planes(func, camera) -> dict | None:
     """
     near, far = float(camera.near), float(camera.far)
     if not 0 < near < far < np.inf:
-        return None                                   # no positive depth range to probe
+        return None  # no positive depth range to probe
     grid = np.geomspace(1e-9 * near, 1e3 * far, GRID_POINTS)
     grid = np.unique(np.concatenate([grid, [near, far]]))
     try:
         kept = _kept(func, camera, np.concatenate([grid, -grid]))
     except (CandidateError, ValueError, FloatingPointError):
         return None
-    front, behind = kept[:len(grid)], kept[len(grid):]
+    front, behind = kept[: len(grid)], kept[len(grid) :]
     out = {"near_fit": None, "far_fit": None, "front": bool(front.any()), "behind": bool(behind.any())}
     if not front.any():
         return out
@@ -100,9 +100,9 @@ def probe_planes(func, camera) -> dict | None:
     if first == 0:
         out["near_fit"] = 0.0
     else:
-        brackets["near_fit"] = (grid[first - 1], grid[first], False)    # (dropped, kept, rising)
+        brackets["near_fit"] = (grid[first - 1], grid[first], False)  # (dropped, kept, rising)
     if last < len(grid) - 1:
-        brackets["far_fit"] = (grid[last], grid[last + 1], True)        # (kept, dropped, falling)
+        brackets["far_fit"] = (grid[last], grid[last + 1], True)  # (kept, dropped, falling)
     try:
         for _ in range(REFINE_ROUNDS):
             if not brackets:
@@ -111,13 +111,13 @@ def probe_planes(func, camera) -> dict | None:
             got = _kept(func, camera, np.concatenate(list(spans.values())))
             at = 0
             for key, (lo, hi, falling) in list(brackets.items()):
-                depth, k = spans[key], got[at:at + REFINE_POINTS]
+                depth, k = spans[key], got[at : at + REFINE_POINTS]
                 at += REFINE_POINTS
-                if falling:          # kept below, dropped above: the last kept before the first dropped
+                if falling:  # kept below, dropped above: the last kept before the first dropped
                     drop = np.flatnonzero(~k)
                     j = int(drop[0]) if len(drop) else REFINE_POINTS
                     lo, hi = (depth[j - 1] if j else lo), (depth[j] if j < REFINE_POINTS else hi)
-                else:                # dropped below, kept above
+                else:  # dropped below, kept above
                     keep = np.flatnonzero(k)
                     j = int(keep[0]) if len(keep) else REFINE_POINTS
                     lo, hi = (depth[j - 1] if j else lo), (depth[j] if j < REFINE_POINTS else hi)
@@ -153,7 +153,7 @@ def clip_fault(planes: dict | None, camera) -> dict | None:
     if not planes["front"] and not planes["behind"]:
         return {"name": "clipping_plane", "kind": "swapped", **fields, "hint": _hint("swapped")}
     if not planes["front"]:
-        return None                                   # keeps only points behind: a depth flip, named by the pixels
+        return None  # keeps only points behind: a depth flip, named by the pixels
     n_fit, f_fit = planes["near_fit"], planes["far_fit"]
     if n_fit is None or (planes["behind"] and n_fit == 0.0):
         return {"name": "clipping_plane", "kind": "none", **fields, "near_fit": None, "hint": _hint("none")}

@@ -105,8 +105,9 @@ def ray_lengths(camera) -> np.ndarray:
     return np.sqrt(1.0 + x_n[None, :] ** 2 + y_n[:, None] ** 2)
 
 
-def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
-                      limits: DepthLimits = LIMITS, faces=None) -> DepthDiagnosis:
+def name_depth_faults(
+    candidate, reference, bound, camera, encoding=0.0, limits: DepthLimits = LIMITS, faces=None
+) -> DepthDiagnosis:
     """Judge a depth map against the reference and name what is wrong with it (module docstring).
 
     Parameters
@@ -139,8 +140,7 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
         cand_on = np.isfinite(cand) & (cand != 0)
         ref_on = np.isfinite(ref) & (ref > 0)
     both = cand_on & ref_on
-    measured = {"compared_px": int(both.sum()), "candidate_px": int(cand_on.sum()),
-                "reference_px": int(ref_on.sum())}
+    measured = {"compared_px": int(both.sum()), "candidate_px": int(cand_on.sum()), "reference_px": int(ref_on.sum())}
     if not both.any():
         return DepthDiagnosis("vacuous", (), measured)
     full_b = np.broadcast_to(np.asarray(bound, dtype=np.float64), cand.shape)
@@ -153,13 +153,17 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
     ratio = _ratio(err, allow)
     worst = int(np.argmax(ratio))
     rows, cols = np.nonzero(both)
-    measured.update(max_error=float(err.max()), max_error_ratio=float(ratio[worst]),
-                    worst_pixel=[int(rows[worst]), int(cols[worst])],
-                    median_ratio_c_over_r=float(np.median(c / r)), median_c_minus_r=float(np.median(c - r)))
+    measured.update(
+        max_error=float(err.max()),
+        max_error_ratio=float(ratio[worst]),
+        worst_pixel=[int(rows[worst]), int(cols[worst])],
+        median_ratio_c_over_r=float(np.median(c / r)),
+        median_c_minus_r=float(np.median(c - r)),
+    )
     if ratio[worst] <= 1.0:
         return DepthDiagnosis("pass", (), measured)
     rho = ray_lengths(camera)[both]
-    fits = []                                   # (parameters fitted, max residual / allowance, fault)
+    fits = []  # (parameters fitted, max residual / allowance, fault)
     for n_params, model in _models(c, r, rho, b, enc, camera, limits):
         if model is None:
             continue
@@ -169,10 +173,11 @@ def name_depth_faults(candidate, reference, bound, camera, encoding=0.0,
             fits.append((n_params, fit, name, params))
     if faces is not None and not any(f[1] <= limits.fit_slack for f in fits):
         # no value model explains it: the maps that move pixels (tried only then: they cost a fit each)
-        fits += _pixel_fits(np.where(cand_on, cand, np.nan), np.where(ref_on, ref, np.nan),
-                            np.asarray(faces), full_b, full_enc, camera)
+        fits += _pixel_fits(
+            np.where(cand_on, cand, np.nan), np.where(ref_on, ref, np.nan), np.asarray(faces), full_b, full_enc, camera
+        )
     measured["fit_ratios"] = {}
-    for _, fit, name, _ in fits:                # each model's worst residual / allowance (the best of a name's)
+    for _, fit, name, _ in fits:  # each model's worst residual / allowance (the best of a name's)
         measured["fit_ratios"][name] = min(fit, measured["fit_ratios"].get(name, np.inf))
     explained = sorted((f for f in fits if f[1] <= limits.fit_slack), key=lambda f: (f[0], f[1]))
     names = list(dict.fromkeys(f[2] for f in explained))
@@ -222,8 +227,16 @@ def _models(c, r, rho, b, enc, camera, limits):
     # depth_is_range: rays alone, nothing fitted (orthographic rays are all depth)
     if perspective:
         up = np.abs(c - rho * r).max() <= np.abs(c - r / rho).max()
-        yield 0, ("depth_is_range", {"stored": "range along the ray" if up else "depth / ray length"},
-                  rho * r if up else r / rho, rho if up else 1.0 / rho, zero)
+        yield (
+            0,
+            (
+                "depth_is_range",
+                {"stored": "range along the ray" if up else "depth / ray length"},
+                rho * r if up else r / rho,
+                rho if up else 1.0 / rho,
+                zero,
+            ),
+        )
     # depth_precision: float16 values, or one quantisation step
     yield 0, _precision(c, r)
     yield 0, _quantised(c, r, limits)
@@ -240,12 +253,10 @@ def _models(c, r, rho, b, enc, camera, limits):
         with np.errstate(divide="ignore", invalid="ignore"):
             kk = float(np.median(1.0 / c + 1.0 / r))
             c_hat = 1.0 / (k_cam - 1.0 / r)
-        yield 0, ("depth_reversed", {"sum_of_inverses": kk, "camera_1/near+1/far": k_cam},
-                  c_hat, c_hat ** 2 / r ** 2, zero)
+        yield 0, ("depth_reversed", {"sum_of_inverses": kk, "camera_1/near+1/far": k_cam}, c_hat, c_hat**2 / r**2, zero)
     else:
         s = float(np.median(c + r))
-        yield 0, ("depth_reversed", {"sum": s, "camera_near+far": near + far}, near + far - r, np.ones_like(r),
-                  zero)
+        yield 0, ("depth_reversed", {"sum": s, "camera_near+far": near + far}, near + far - r, np.ones_like(r), zero)
     yield 2, _encoding(c, r, camera, limits)
 
 
@@ -256,8 +267,13 @@ def _precision(c, r):
     if not (np.isfinite(c16).all() and (c16.astype(np.float64) == c).all()):
         return None
     ulp = np.spacing(np.abs(r).astype(np.float16)).astype(np.float64)
-    return "depth_precision", {"format": "float16", "step_at_median_depth": float(np.median(ulp))}, r, \
-        np.ones_like(r), ulp
+    return (
+        "depth_precision",
+        {"format": "float16", "step_at_median_depth": float(np.median(ulp))},
+        r,
+        np.ones_like(r),
+        ulp,
+    )
 
 
 def _quantised(c, r, limits):
@@ -270,8 +286,13 @@ def _quantised(c, r, limits):
     units = gaps / q
     if np.abs(units - np.round(units)).max() > limits.step_tolerance:
         return None
-    return "depth_precision", {"format": "quantised", "step": q, "levels": int(len(levels))}, r, \
-        np.ones_like(r), np.full_like(r, q)
+    return (
+        "depth_precision",
+        {"format": "quantised", "step": q, "levels": int(len(levels))},
+        r,
+        np.ones_like(r),
+        np.full_like(r, q),
+    )
 
 
 def _encoding(c, r, camera, limits):
@@ -296,16 +317,19 @@ def _encoding(c, r, camera, limits):
     best = None
     for kind, (v_near, v_far) in candidates.items():
         with np.errstate(divide="ignore", invalid="ignore"):
-            if perspective:                                     # v = a + slope / d  ->  d = slope / (v - a)
+            if perspective:  # v = a + slope / d  ->  d = slope / (v - a)
                 n_fit, f_fit = slope / (v_near - a), slope / (v_far - a)
-            else:                                               # v = a + slope d    ->  d = (v - a) / slope
+            else:  # v = a + slope d    ->  d = (v - a) / slope
                 n_fit, f_fit = (v_near - a) / slope, (v_far - a) / slope
-        miss = abs(np.log(abs(n_fit) / camera.near)) + abs(np.log(abs(f_fit) / camera.far)) \
-            if n_fit and f_fit and np.isfinite(n_fit) and np.isfinite(f_fit) else np.inf
+        miss = (
+            abs(np.log(abs(n_fit) / camera.near)) + abs(np.log(abs(f_fit) / camera.far))
+            if n_fit and f_fit and np.isfinite(n_fit) and np.isfinite(f_fit)
+            else np.inf
+        )
         if best is None or miss < best[0]:
             best = (miss, kind, float(n_fit), float(f_fit))
     _, kind, n_fit, f_fit = best
     c_hat = a + slope * x
-    d_slope = np.abs(slope) / r ** 2 if perspective else np.full_like(r, abs(slope))
+    d_slope = np.abs(slope) / r**2 if perspective else np.full_like(r, abs(slope))
     params = {"stored": kind, "reversed": bool(reversed_z), "near": n_fit, "far": f_fit}
     return "depth_encoding", params, c_hat, d_slope, np.zeros_like(r)

@@ -55,11 +55,19 @@ def pixel_models(cand, ref, faces, camera):
     c_on, r_on = np.isfinite(cand), np.isfinite(ref)
     if c_on.sum() < 3 or r_on.sum() < 3:
         return
-    c_rows_cols, r_rows_cols = np.argwhere(c_on), np.argwhere(r_on)      # once, for every fit below
+    c_rows_cols, r_rows_cols = np.argwhere(c_on), np.argwhere(r_on)  # once, for every fit below
     cy, cx = c_rows_cols.mean(axis=0)
     ry, rx = r_rows_cols.mean(axis=0)
-    d = _fit(cand, ref, faces, camera, np.array([rx - cx, ry - cy]),
-             lambda p, th: p + th, lambda p, th: np.broadcast_to(np.eye(2), (len(p), 2, 2)), c_rows_cols)
+    d = _fit(
+        cand,
+        ref,
+        faces,
+        camera,
+        np.array([rx - cx, ry - cy]),
+        lambda p, th: p + th,
+        lambda p, th: np.broadcast_to(np.eye(2), (len(p), 2, 2)),
+        c_rows_cols,
+    )
     if d is not None:
         yield "pixel_offset", 2, {"dx": float(d[0]), "dy": float(d[1])}, lambda p, d=d: p + d
     if camera.projection != "perspective":
@@ -68,13 +76,20 @@ def pixel_models(cand, ref, faces, camera):
     c0 = np.array([k[0, 2], k[1, 2]])
     spread_c = np.sqrt(((c_rows_cols[:, ::-1] - c0) ** 2).sum(axis=1).mean())
     spread_r = np.sqrt(((r_rows_cols[:, ::-1] - c0) ** 2).sum(axis=1).mean())
-    s = _fit(cand, ref, faces, camera, np.array([spread_r / spread_c]),
-             lambda p, th: c0 + th[0] * (p - c0), lambda p, th: (p - c0)[:, :, None], c_rows_cols)
+    s = _fit(
+        cand,
+        ref,
+        faces,
+        camera,
+        np.array([spread_r / spread_c]),
+        lambda p, th: c0 + th[0] * (p - c0),
+        lambda p, th: (p - c0)[:, :, None],
+        c_rows_cols,
+    )
     if s is not None:
         scale = float(s[0])
         implied = float(np.degrees(2.0 * np.arctan((camera.height / 2.0) / (k[1, 1] / scale))))
-        yield "fov_mismatch", 1, {"scale": scale, "implied_fov_y_deg": implied}, \
-            lambda p, s=scale: c0 + s * (p - c0)
+        yield "fov_mismatch", 1, {"scale": scale, "implied_fov_y_deg": implied}, lambda p, s=scale: c0 + s * (p - c0)
 
 
 def sample(ref, faces, camera, q):
@@ -112,10 +127,13 @@ def _fit(cand, ref, faces, camera, theta, transform, jac_p, c_rows_cols):
     """Gauss-Newton on ``w_cand(p) = w_ref(T(p; theta))`` over the pixels landing inside one face
     (``c_rows_cols``: ``np.argwhere`` of the candidate's surface pixels)."""
     pts = c_rows_cols[:, ::-1].astype(np.float64)
-    pts = pts[::max(1, len(pts) // FIT_PIXELS)]
+    pts = pts[:: max(1, len(pts) // FIT_PIXELS)]
     persp = camera.projection == "perspective"
-    wc = 1.0 / cand[pts[:, 1].astype(int), pts[:, 0].astype(int)] if persp else \
-        cand[pts[:, 1].astype(int), pts[:, 0].astype(int)]
+    wc = (
+        1.0 / cand[pts[:, 1].astype(int), pts[:, 0].astype(int)]
+        if persp
+        else cand[pts[:, 1].astype(int), pts[:, 0].astype(int)]
+    )
     theta = np.asarray(theta, dtype=np.float64)
     for _ in range(STEPS):
         if not np.all(np.isfinite(theta)):

@@ -172,7 +172,7 @@ DEPTH_FLIP_MAX_OVERLAP = 0.01
 DEGENERATE_RATIO = 1e-6
 
 #: Machine epsilon of float32 (oracles.tolerances.EPS), for :func:`rounded_constants`.
-EPS32 = 2.0 ** -23
+EPS32 = 2.0**-23
 
 
 def _sign(x: float) -> int:
@@ -224,10 +224,12 @@ def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> l
     w, h = camera.width, camera.height
     minus_one = {"x": (w - 1) / w, "y": (h - 1) / h}
     if abs(sx - sy) * reach[0] > tol:
-        fault = {"name": "aspect_mismatch", **fields,
-                 "implied_aspect": (w / h) * sy / sx, "scale_x": sx, "scale_y": sy}
-        if (abs(sx - minus_one["x"]) * reach[0] <= tol or abs(sx / sy - minus_one["x"]) * reach[0] <= tol
-                or abs(sy / sx - minus_one["y"]) * reach[1] <= tol):
+        fault = {"name": "aspect_mismatch", **fields, "implied_aspect": (w / h) * sy / sx, "scale_x": sx, "scale_y": sy}
+        if (
+            abs(sx - minus_one["x"]) * reach[0] <= tol
+            or abs(sx / sy - minus_one["x"]) * reach[0] <= tol
+            or abs(sy / sx - minus_one["y"]) * reach[1] <= tol
+        ):
             fault["hint"] = catalogue.hint_text("aspect_mismatch", "minus_one")
         elif abs(sx / sy - (w / h) ** 2) * reach[0] <= tol:
             fault["hint"] = catalogue.hint_text("aspect_mismatch", "inverted")
@@ -249,8 +251,9 @@ def scale_faults(sx: float, sy: float, reach, tol: float, camera, **fields) -> l
     return faults
 
 
-def diagnose(cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float | None = None,
-             planes: dict | None = None) -> list[dict]:
+def diagnose(
+    cand_px, oracle_px, camera, tol_px: float = 1e-6, float32_px: float | None = None, planes: dict | None = None
+) -> list[dict]:
     """Name the faults of a candidate projector; ``[]`` when it agrees.
 
     With ``float32_px`` (the float32 rounding bound of these points,
@@ -284,8 +287,12 @@ def _advised(fault: dict, tol_px: float) -> dict:
     if fault["name"] != "unexplained" or not fault.get("residual_px", 0.0) <= tol_px:
         return fault
     a, b = fault.get("candidate_only", 0), fault.get("oracle_only", 0)
-    return {**fault, "hint": catalogue.hint_text("unexplained", "visible_sets", residual=fault["residual_px"],
-                                                 tol=tol_px, candidate_only=a, oracle_only=b)}
+    return {
+        **fault,
+        "hint": catalogue.hint_text(
+            "unexplained", "visible_sets", residual=fault["residual_px"], tol=tol_px, candidate_only=a, oracle_only=b
+        ),
+    }
 
 
 def _diagnose(cand_px, oracle_px, camera, tol_px, float32_px, planes) -> list[dict]:
@@ -300,9 +307,18 @@ def _diagnose(cand_px, oracle_px, camera, tol_px, float32_px, planes) -> list[di
     coarse_info: dict = {}
     coarse = _diagnose_at(cand_px, oracle_px, camera, float32_px, coarse_info, planes)
     if any(f["name"] in ("unexplained", "depth_flip") for f in coarse) or coarse_info["residual_px"] > float32_px:
-        return faults                  # float32 rounding does not explain it either (e.g. a lens bends the map)
-    return _sorted(coarse + [{"name": "precision_limited", "residual_px": coarse_info["residual_px"],
-                              "float64_bound_px": float(tol_px), "float32_bound_px": float(float32_px)}])
+        return faults  # float32 rounding does not explain it either (e.g. a lens bends the map)
+    return _sorted(
+        coarse
+        + [
+            {
+                "name": "precision_limited",
+                "residual_px": coarse_info["residual_px"],
+                "float64_bound_px": float(tol_px),
+                "float32_bound_px": float(float32_px),
+            }
+        ]
+    )
 
 
 #: Float32 roundings a constant of a float64 projector may carry into the fitted map: a float32 focal
@@ -337,14 +353,27 @@ def rounded_constants(faults: list[dict], camera, info: dict, tol_px: float, flo
     if np.max(np.abs(d - 1.0)) > eps or np.max(np.abs(off)) > eps * reach:
         return faults
     kept = [f for f in faults if f["name"] not in _ROUNDABLE]
-    return _sorted(kept + [{"name": "precision_limited", "kind": "float32_constants",
-                            "residual_px": float(info["residual_px"]), "scale_x": float(d[0]),
-                            "scale_y": float(d[1]), "dx": float(off[0]), "dy": float(off[1]),
-                            "float64_bound_px": float(tol_px), "float32_bound_px": float(float32_px)}])
+    return _sorted(
+        kept
+        + [
+            {
+                "name": "precision_limited",
+                "kind": "float32_constants",
+                "residual_px": float(info["residual_px"]),
+                "scale_x": float(d[0]),
+                "scale_y": float(d[1]),
+                "dx": float(off[0]),
+                "dy": float(off[1]),
+                "float64_bound_px": float(tol_px),
+                "float32_bound_px": float(float32_px),
+            }
+        ]
+    )
 
 
-def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = None,
-                 planes: dict | None = None) -> list[dict]:
+def _diagnose_at(
+    cand_px, oracle_px, camera, tol_px: float, info: dict | None = None, planes: dict | None = None
+) -> list[dict]:
     """:func:`diagnose` at one tolerance; ``info["residual_px"]``: the named model's largest residual,
     ``info["scale"]``, ``info["offset"]``, ``info["reach"]``: the named model's per-axis fit."""
     info = {} if info is None else info
@@ -366,21 +395,31 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     n_both, n_union = int(both.sum()), int((vis_c | vis_o).sum())
     mismatches = int((vis_c != vis_o).sum())
     if n_union == 0:
-        return []                                   # N = 0 or both clip everything
+        return []  # N = 0 or both clip everything
     info["residual_px"] = _max_abs(cand[both] - orac[both])
     if mismatches == 0 and info["residual_px"] <= tol:
         return []
 
     clip = clip_fault(planes, camera) if mismatches else None
     if clip is not None and clip["kind"] == "swapped":
-        return [clip]                               # keeps nothing, in front or behind: not a flip
+        return [clip]  # keeps nothing, in front or behind: not a flip
     # 1. depth flip: visible sets (nearly) swapped
     if mismatches and n_both <= DEPTH_FLIP_MAX_OVERLAP * n_union:
-        return [{"name": "depth_flip", "oracle_visible": int(vis_o.sum()),
-                 "candidate_visible": int(vis_c.sum()), "common_visible": n_both}]
+        return [
+            {
+                "name": "depth_flip",
+                "oracle_visible": int(vis_o.sum()),
+                "candidate_visible": int(vis_c.sum()),
+                "common_visible": n_both,
+            }
+        ]
 
-    vis_fields = {"visibility_mismatches": mismatches, "common_visible": n_both,
-                  "candidate_only": int((vis_c & ~vis_o).sum()), "oracle_only": int((vis_o & ~vis_c).sum())}
+    vis_fields = {
+        "visibility_mismatches": mismatches,
+        "common_visible": n_both,
+        "candidate_only": int((vis_c & ~vis_o).sum()),
+        "oracle_only": int((vis_o & ~vis_c).sum()),
+    }
     cx, cy = camera.principal_point
     centre = np.array([cx, cy])
     o = orac[both] - centre
@@ -401,15 +440,21 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
                 if clip is not None:
                     faults.append(clip)
                 elif mismatches:
-                    faults.append(_unexplained(residual_px=0.0, residual_rms_px=0.0, **vis_fields,
-                                               underdetermined=True))
+                    faults.append(
+                        _unexplained(residual_px=0.0, residual_rms_px=0.0, **vis_fields, underdetermined=True)
+                    )
                 return _sorted(faults)
             res = c - o
         else:
             res = np.zeros((0, 2))
-        return [_unexplained(residual_px=_max_abs(res),
-                             residual_rms_px=float(np.sqrt(np.mean(res ** 2))) if res.size else 0.0,
-                             **vis_fields, underdetermined=True)]
+        return [
+            _unexplained(
+                residual_px=_max_abs(res),
+                residual_rms_px=float(np.sqrt(np.mean(res**2))) if res.size else 0.0,
+                **vis_fields,
+                underdetermined=True,
+            )
+        ]
 
     # 2. affine fit
     a, b = _fit_affine(o, c)
@@ -429,20 +474,27 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     for i in range(2):
         d[i], off[i] = _fit_axis(q[:, i], c[:, i])
     named_res = c - (q * d + off)
-    reach = np.max(np.abs(q), axis=0)               # largest |coordinate| per candidate axis
+    reach = np.max(np.abs(q), axis=0)  # largest |coordinate| per candidate axis
     named_max = info["residual_px"] = _max_abs(named_res)
     info.update(scale=d.copy(), offset=off.copy(), reach=np.max(np.abs(q), axis=0))
-    collapsed = bool(np.any(d * reach <= tol))       # an axis the candidate squashed flat
+    collapsed = bool(np.any(d * reach <= tol))  # an axis the candidate squashed flat
     if named_max > tol or collapsed:
         lens = None if mismatches or collapsed else distortion_fault(cand[both], orac[both], camera, tol)
         if lens is not None:
             return [lens]
         rot = math.degrees(math.atan2(a[1, 0] - a[0, 1], a[0, 0] + a[1, 1]))
-        return [_unexplained(residual_px=named_max,
-                             residual_rms_px=float(np.sqrt(np.mean(named_res ** 2))),
-                             affine_residual_px=_max_abs(affine_res),
-                             affine=a.tolist(), offset=b.tolist(), rotation_deg=rot,
-                             **vis_fields, underdetermined=False)]
+        return [
+            _unexplained(
+                residual_px=named_max,
+                residual_rms_px=float(np.sqrt(np.mean(named_res**2))),
+                affine_residual_px=_max_abs(affine_res),
+                affine=a.tolist(),
+                offset=b.tolist(),
+                rotation_deg=rot,
+                **vis_fields,
+                underdetermined=False,
+            )
+        ]
 
     # 4. read the faults off P, d, b
     faults: list[dict] = []
@@ -454,23 +506,29 @@ def _diagnose_at(cand_px, oracle_px, camera, tol_px: float, info: dict | None = 
     faults += scale_faults(float(d[0]), float(d[1]), reach, tol, camera)
     expected = np.zeros(2)
     if swap:
-        shift = cx - cy                               # a raw swap moves each axis by +-(cx - cy)
+        shift = cx - cy  # a raw swap moves each axis by +-(cx - cy)
         allowed = np.array([-shift, 0.0, shift])
         expected = np.array([allowed[np.argmin(np.abs(allowed - off[i]))] for i in range(2)])
     residual_offset = off - expected
     if _max_abs(residual_offset) > tol:
         faults.append({"name": "pixel_offset", "dx": float(residual_offset[0]), "dy": float(residual_offset[1])})
     if clip is not None:
-        faults.append(clip)                       # the visible sets differ where the probed planes say
+        faults.append(clip)  # the visible sets differ where the probed planes say
     elif mismatches or not faults:
         # visible sets differ without a depth flip (near/far?), or an error too
         # small to name: still a disagreement, so say so
-        faults.append(_unexplained(residual_px=named_max,
-                                   residual_rms_px=float(np.sqrt(np.mean(named_res ** 2))),
-                                   affine_residual_px=_max_abs(affine_res),
-                                   affine=a.tolist(), offset=b.tolist(),
-                                   rotation_deg=math.degrees(math.atan2(a[1, 0] - a[0, 1], a[0, 0] + a[1, 1])),
-                                   **vis_fields, underdetermined=False))
+        faults.append(
+            _unexplained(
+                residual_px=named_max,
+                residual_rms_px=float(np.sqrt(np.mean(named_res**2))),
+                affine_residual_px=_max_abs(affine_res),
+                affine=a.tolist(),
+                offset=b.tolist(),
+                rotation_deg=math.degrees(math.atan2(a[1, 0] - a[0, 1], a[0, 0] + a[1, 1])),
+                **vis_fields,
+                underdetermined=False,
+            )
+        )
     return _sorted(faults)
 
 
@@ -501,17 +559,24 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     tc, to = lines["subpixel_ties"]
     decided = {"candidate_only": int(lines["candidate_only"] - tc), "oracle_only": int(lines["oracle_only"] - to)}
     if not line_failures(lines, tol) or not (decided["candidate_only"] or decided["oracle_only"]):
-        return []                     # no line fault on undecided pixels alone
+        return []  # no line fault on undecided pixels alone
     n = max(lines["lines_compared"], 1)
     places = lines["one_sided_by_place"]
-    net = {p: places[p][0] - places[p][1] for p in places}          # candidate-only minus oracle-only
+    net = {p: places[p][0] - places[p][1] for p in places}  # candidate-only minus oracle-only
     per_line = {"first": net["start"] / n, "last": net["end"] / n}
     ends = [e for e in ("first", "last") if abs(per_line[e]) >= LINE_END_MIN_PX]
     total = lines["imbalance"]
     at_ends = sum(net[{"first": "start", "last": "end"}[e]] for e in ends)
     if ends and abs(at_ends) >= 0.5 * abs(total):
-        return [{"name": "line_end_bias", "end": ends[0] if len(ends) == 1 else "both",
-                 "pixels_per_line": float(sum(per_line[e] for e in ends)), "lines": int(lines["lines_compared"]),
-                 **decided}]
-    return [{"name": "line_pixel_bias", **decided,
-             **{f"net_{p}": int(net[p]) for p in ("start", "end", "middle", "stray")}}]
+        return [
+            {
+                "name": "line_end_bias",
+                "end": ends[0] if len(ends) == 1 else "both",
+                "pixels_per_line": float(sum(per_line[e] for e in ends)),
+                "lines": int(lines["lines_compared"]),
+                **decided,
+            }
+        ]
+    return [
+        {"name": "line_pixel_bias", **decided, **{f"net_{p}": int(net[p]) for p in ("start", "end", "middle", "stray")}}
+    ]

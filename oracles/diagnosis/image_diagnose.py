@@ -73,18 +73,26 @@ scale below ~0.5 or above ~2 may not be recovered from the unit start.
 
 from __future__ import annotations
 
-
 import numpy as np
+from wirecheck.core.camera import Camera
 
 from .. import tolerances as _tolerances
 from ..candidates import draw
 from .image_naming import name_faults, restart_scales, rotation_deg, rule_off_diagonal
-from .model_lines import quantisation_bias
 from .image_visibility import in_place, visibility_fault
-from .registration import (MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, PAIR_CAP_PX, SCREEN_POINTS_PER_CASE,
-                           SCREEN_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame, register,
-                           segments_in_image)
-from wirecheck.core.camera import Camera
+from .model_lines import quantisation_bias
+from .registration import (
+    MAX_POINTS_PER_CASE,
+    MAX_POINTS_PER_FRAME,
+    PAIR_CAP_PX,
+    SCREEN_POINTS_PER_CASE,
+    SCREEN_POINTS_PER_FRAME,
+    Registration,
+    frame_samples,
+    points_per_frame,
+    register,
+    segments_in_image,
+)
 
 __all__ = ["diagnose_images", "oracle_segments", "flipped_camera"]
 
@@ -113,6 +121,7 @@ OFFSET_TOL_PX = _tolerances.OFFSET_TOL_PX
 
 # ---------------------------------------------------------------- the oracle's lines
 
+
 def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera) -> np.ndarray:
     """The lines a correct renderer draws: ``(K, 2, 2)`` pixel segment ends, of the edges with a part in depth.
 
@@ -128,10 +137,19 @@ def oracle_segments(p_world: np.ndarray, edges: np.ndarray, camera) -> np.ndarra
 
 def flipped_camera(camera):
     """The camera looking backward (forward negated, up kept): what a depth-flipped renderer draws."""
-    return Camera(position=camera.position, forward=-np.asarray(camera.forward), up=camera.up,
-                  fov_y_deg=camera.fov_y_deg, width=camera.width, height=camera.height, near=camera.near,
-                  far=camera.far, projection=camera.projection, ortho_height=camera.ortho_height,
-                  intrinsics=getattr(camera, "intrinsics", None))
+    return Camera(
+        position=camera.position,
+        forward=-np.asarray(camera.forward),
+        up=camera.up,
+        fov_y_deg=camera.fov_y_deg,
+        width=camera.width,
+        height=camera.height,
+        near=camera.near,
+        far=camera.far,
+        projection=camera.projection,
+        ortho_height=camera.ortho_height,
+        intrinsics=getattr(camera, "intrinsics", None),
+    )
 
 
 # ---------------------------------------------------------------- geometry helpers
@@ -175,58 +193,113 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
         return []
     if drawn == 0:
         if flipped_drawn == 0:
-            return [{"name": "depth_flip", "confidence": 0.5, "residual_px": 0.0, "candidate_pixels": 0,
-                     "note": "the candidate drew nothing where the oracle draws lines; a camera looking "
-                             "backward sees nothing here either"}]
-        return [{"name": "unexplained", "confidence": 1.0, "residual_px": PAIR_CAP_PX, "candidate_pixels": 0,
-                 "note": "the candidate drew nothing where the oracle draws lines"}]
+            return [
+                {
+                    "name": "depth_flip",
+                    "confidence": 0.5,
+                    "residual_px": 0.0,
+                    "candidate_pixels": 0,
+                    "note": "the candidate drew nothing where the oracle draws lines; a camera looking "
+                    "backward sees nothing here either",
+                }
+            ]
+        return [
+            {
+                "name": "unexplained",
+                "confidence": 1.0,
+                "residual_px": PAIR_CAP_PX,
+                "candidate_pixels": 0,
+                "note": "the candidate drew nothing where the oracle draws lines",
+            }
+        ]
     if drawn < MIN_PIXELS:
-        return [{"name": "unexplained", "confidence": 0.0, "residual_px": None, "candidate_pixels": drawn,
-                 "underdetermined": True,
-                 "note": f"only {drawn} drawn pixels: expected at least {MIN_PIXELS} to register"}]
+        return [
+            {
+                "name": "unexplained",
+                "confidence": 0.0,
+                "residual_px": None,
+                "candidate_pixels": drawn,
+                "underdetermined": True,
+                "note": f"only {drawn} drawn pixels: expected at least {MIN_PIXELS} to register",
+            }
+        ]
 
     limit = points_per_frame(len(cand_images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
     screen = points_per_frame(len(cand_images), SCREEN_POINTS_PER_CASE, SCREEN_POINTS_PER_FRAME)
     frames = frame_samples(cand_images, oracle_segs, camera, limit)
-    nearest = [f.nearest for f in frames]                  # one distance transform per image
+    nearest = [f.nearest for f in frames]  # one distance transform per image
     fine = Registration(frames, camera.width, camera.height, centre)
-    coarse = Registration(frame_samples(cand_images, oracle_segs, camera, screen, nearest),
-                           camera.width, camera.height, centre)
+    coarse = Registration(
+        frame_samples(cand_images, oracle_segs, camera, screen, nearest), camera.width, camera.height, centre
+    )
     ranked = register(coarse, fine)
-    if ranked[0][0] > RESIDUAL_MAX_PX:               # no member fits from the usual starts: a large scale?
+    if ranked[0][0] > RESIDUAL_MAX_PX:  # no member fits from the usual starts: a large scale?
         ranked = restart_scales(coarse, fine, ranked, camera)
     plain = next(r for r in ranked if r[1] == ())
     if plain[0] <= ranked[0][0] * (1.0 + AMBIGUOUS_RATIO):
-        ranked = [plain] + [r for r in ranked if r is not plain]     # a symmetric picture: no permutation
+        ranked = [plain] + [r for r in ranked if r is not plain]  # a symmetric picture: no permutation
     cost, names, p, a, b = ranked[0]
     second = ranked[1][0] if len(ranked) > 1 else PAIR_CAP_PX
     confidence = float(max(0.0, 1.0 - cost / second)) if second > 0 else 0.0
 
     if flipped_segs is not None and flipped_drawn:
-        back = Registration(frame_samples(cand_images, flipped_segs, camera, limit, nearest), camera.width,
-                             camera.height, centre)
+        back = Registration(
+            frame_samples(cand_images, flipped_segs, camera, limit, nearest), camera.width, camera.height, centre
+        )
         b_cost = back.cost(np.eye(2), np.eye(2), np.zeros(2))
         if b_cost < cost and b_cost <= RESIDUAL_MAX_PX:
-            return [{"name": "depth_flip", "confidence": float(max(0.0, 1.0 - b_cost / cost)),
-                     "residual_px": b_cost, "residual_unflipped_px": cost}]
+            return [
+                {
+                    "name": "depth_flip",
+                    "confidence": float(max(0.0, 1.0 - b_cost / cost)),
+                    "residual_px": b_cost,
+                    "residual_unflipped_px": cost,
+                }
+            ]
 
     # the named model against a free affine map: a rotation or shear the family cannot draw
     reach = np.max(np.abs(np.concatenate([f.samples for f in frames]) @ p.T), axis=0)
-    reach = np.minimum(reach, [camera.width / 2.0, camera.height / 2.0])   # the part an image can show
+    reach = np.minimum(reach, [camera.width / 2.0, camera.height / 2.0])  # the part an image can show
     a_free, b_free, cost_free = fine.fit(p, a, b, affine=True)
     off_diagonal = max(abs(a_free[0, 1]) * reach[1], abs(a_free[1, 0]) * reach[0])
-    if cost <= RESIDUAL_MAX_PX and off_diagonal > ROTATION_TOL_PX:     # another aliased rule's own shear?
+    if cost <= RESIDUAL_MAX_PX and off_diagonal > ROTATION_TOL_PX:  # another aliased rule's own shear?
         off_diagonal = rule_off_diagonal(cand_images, oracle_segs, camera, (p, a, b), a_free, reach, off_diagonal)
     if cost > RESIDUAL_MAX_PX or off_diagonal > ROTATION_TOL_PX:
-        fault = {"name": "unexplained", "confidence": confidence, "residual_px": cost,
-                 "best_family": list(names) or ["none"],
-                 "scale": np.diag(a).tolist(), "offset": b.tolist(), "affine": a_free.tolist(),
-                 "affine_residual_px": cost_free, "off_diagonal_px": float(off_diagonal),
-                 "rotation_deg": rotation_deg(a_free)}
-        matched = fine.matched(p, a, b)         # the lines in place, only the drawn sets differ?
-        if in_place(names, np.diag(a), b, off_diagonal, reach, matched,
-                    (scale_tol, offset_tol, ROTATION_TOL_PX, RESIDUAL_MAX_PX)):
+        fault = {
+            "name": "unexplained",
+            "confidence": confidence,
+            "residual_px": cost,
+            "best_family": list(names) or ["none"],
+            "scale": np.diag(a).tolist(),
+            "offset": b.tolist(),
+            "affine": a_free.tolist(),
+            "affine_residual_px": cost_free,
+            "off_diagonal_px": float(off_diagonal),
+            "rotation_deg": rotation_deg(a_free),
+        }
+        matched = fine.matched(p, a, b)  # the lines in place, only the drawn sets differ?
+        if in_place(
+            names,
+            np.diag(a),
+            b,
+            off_diagonal,
+            reach,
+            matched,
+            (scale_tol, offset_tol, ROTATION_TOL_PX, RESIDUAL_MAX_PX),
+        ):
             fault = visibility_fault(fault, cand_images, oracle_segs, camera, matched)
         return [fault]
-    return name_faults(fine, ranked, plain, camera, oracle_segs, reach, quantisation_bias, scale_tol,
-                       offset_tol, AMBIGUOUS_RATIO, cost, cand_images)
+    return name_faults(
+        fine,
+        ranked,
+        plain,
+        camera,
+        oracle_segs,
+        reach,
+        quantisation_bias,
+        scale_tol,
+        offset_tol,
+        AMBIGUOUS_RATIO,
+        cost,
+        cand_images,
+    )

@@ -42,12 +42,28 @@ import math
 import numpy as np
 
 from .. import faults as catalogue
-from .model_lines import model_images, quantisation_bias
-from .rule_read import read_rules, standing_scale_faults
 from .diagnose import scale_faults
-from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, PERMUTATIONS, Registration, SCREEN_ITERATIONS, frame_samples, points_per_frame
+from .model_lines import model_images, quantisation_bias
+from .registration import (
+    MAX_POINTS_PER_CASE,
+    MAX_POINTS_PER_FRAME,
+    PERMUTATIONS,
+    SCREEN_ITERATIONS,
+    Registration,
+    frame_samples,
+    points_per_frame,
+)
+from .rule_read import read_rules, standing_scale_faults
 
-__all__ = ["scale_starts", "name_faults", "ambiguous_fault", "quantisation_bias", "restart_scales", "rule_bias", "rule_off_diagonal"]
+__all__ = [
+    "scale_starts",
+    "name_faults",
+    "ambiguous_fault",
+    "quantisation_bias",
+    "restart_scales",
+    "rule_bias",
+    "rule_off_diagonal",
+]
 
 #: Ratios a convention mistake scales an axis by: H/W and W/H (the aspect or FOV of the other axis),
 #: the common aspects 4/3 and 16/9 and their inverses, and 2 and 1/2 (a half-angle or a half-size).
@@ -68,18 +84,26 @@ def ambiguous_fault(names: tuple, other: tuple, **common) -> tuple[list[dict], d
     shared = [n for n in names if n in other]
     alternatives = ["+".join(n for n in group if n not in shared) or "none" for group in (names, other)]
     each = "; ".join(f"if {alt}: {catalogue.kind(alt.split('+')[0]).hint}" for alt in alternatives if alt != "none")
-    return ([{"name": n, **common} for n in shared],
-            {"name": "ambiguous", **common, "alternatives": alternatives,
-             "hint": catalogue.hint_text("ambiguous", "alternatives", first=alternatives[0], second=alternatives[1],
-                                         each=each)})
+    return (
+        [{"name": n, **common} for n in shared],
+        {
+            "name": "ambiguous",
+            **common,
+            "alternatives": alternatives,
+            "hint": catalogue.hint_text(
+                "ambiguous", "alternatives", first=alternatives[0], second=alternatives[1], each=each
+            ),
+        },
+    )
 
 
 def _confidence(cost: float, without: float) -> float:
     return float(max(0.0, 1.0 - cost / without)) if without > 0 else 0.0
 
 
-def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_tol, offset_tol, ratio,
-                residual, cand_images=None) -> list[dict]:
+def name_faults(
+    reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_tol, offset_tol, ratio, residual, cand_images=None
+) -> list[dict]:
     """The faults of the winner of ``ranked`` (``[(cost, names, P, a, b)]``, best first; ``plain``: the
     identity's fit), in the vocabulary of :func:`oracles.diagnosis.diagnose.scale_faults`.
 
@@ -101,14 +125,14 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
         else:
             faults += [{"name": n, **common} for n in names]
     scale = scale_faults(float(d[0]), float(d[1]), reach, scale_tol, camera, confidence=0.0, residual_px=residual)
-    rules = {}                                    # the aliased rules the pixels may follow (rule_read), read once
+    rules = {}  # the aliased rules the pixels may follow (rule_read), read once
 
     def read():
         if not rules:
             rules.update(read_rules(cand_images, oracle_segs, camera, p, d, b, bias_fn(oracle_segs, camera, p, d)))
         return rules
 
-    if scale and cand_images is not None:        # a scale the rounded ends' own would explain is no fault
+    if scale and cand_images is not None:  # a scale the rounded ends' own would explain is no fault
         scale = standing_scale_faults(scale, d, reach, scale_tol, camera, read())
     for f in scale:
         undo = np.eye(2) if f["name"] == "fov_mismatch" else np.diag([d[1], d[1]])
@@ -116,7 +140,7 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
         faults.append(f)
     expected = np.zeros(2)
     if "axis_swap" in names:
-        shift = cx - cy                               # as oracles.diagnosis.diagnose: a raw swap shifts by +-(cx - cy)
+        shift = cx - cy  # as oracles.diagnosis.diagnose: a raw swap shifts by +-(cx - cy)
         allowed = np.array([-shift, 0.0, shift])
         expected = np.array([allowed[np.argmin(np.abs(allowed - b[i]))] for i in range(2)])
     off = b - expected
@@ -127,9 +151,18 @@ def name_faults(reg, ranked, plain, camera, oracle_segs, reach, bias_fn, scale_t
         read_as = list(read())
         rule, bias = min(read().items(), key=lambda kv: np.max(np.abs(off - kv[1])))
     if np.max(np.abs(off - bias)) > offset_tol:
-        faults.append({"name": "pixel_offset", "confidence": _confidence(cost, reg.cost(p, a, expected + bias)),
-                       "residual_px": residual, "dx": float(off[0]), "dy": float(off[1]),
-                       "uncertainty_px": float(np.max(np.abs(bias))), "bias_rule": rule, "rules_read": read_as})
+        faults.append(
+            {
+                "name": "pixel_offset",
+                "confidence": _confidence(cost, reg.cost(p, a, expected + bias)),
+                "residual_px": residual,
+                "dx": float(off[0]),
+                "dy": float(off[1]),
+                "uncertainty_px": float(np.max(np.abs(bias))),
+                "bias_rule": rule,
+                "rules_read": read_as,
+            }
+        )
     return catalogue.ordered(faults)
 
 
@@ -198,9 +231,10 @@ def rule_off_diagonal(cand_images, oracle_segs, camera, fit, a_free, reach, off_
         return off_diagonal
     images = model_images(oracle_segs, camera, p, d, b - rules["snapped"], snapped=True)
     limit = points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)
-    reg = Registration(frame_samples(images, oracle_segs, camera, limit), camera.width, camera.height,
-                        np.array(camera.principal_point))
+    reg = Registration(
+        frame_samples(images, oracle_segs, camera, limit), camera.width, camera.height, np.array(camera.principal_point)
+    )
     own, _b, _cost = reg.fit(p, a, b, affine=True)
     left = np.asarray(a_free) - own
     snapped = float(max(abs(left[0, 1]) * reach[1], abs(left[1, 0]) * reach[0]))
-    return min(snapped, off_diagonal) if "gl" in rules else snapped     # it stands against every rule read
+    return min(snapped, off_diagonal) if "gl" in rules else snapped  # it stands against every rule read

@@ -20,8 +20,8 @@ rasteriser from the exact segments) with no drawn pixel within 1 px.
 from __future__ import annotations
 
 import numpy as np
-from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
+from wirecheck.core.projector.clipping import clip_to_image
 
 from .. import faults as catalogue
 from ..tolerances import NAMING
@@ -71,13 +71,18 @@ def in_place(names, d, b, off_diagonal, reach, matched, tols) -> bool:
     ``(scale, offset, rotation, residual)`` tolerances in px.
     """
     scale_tol, offset_tol, rotation_tol, residual_max = tols
-    return (not names and float(np.max(np.abs(np.asarray(d) - 1.0) * np.asarray(reach))) <= scale_tol
-            and float(np.max(np.abs(b))) <= offset_tol and off_diagonal <= rotation_tol
-            and matched <= residual_max)
+    return (
+        not names
+        and float(np.max(np.abs(np.asarray(d) - 1.0) * np.asarray(reach))) <= scale_tol
+        and float(np.max(np.abs(b))) <= offset_tol
+        and off_diagonal <= rotation_tol
+        and matched <= residual_max
+    )
 
 
-def visibility_fault(fault: dict, cand_images, oracle_segs, camera, matched_px: float | None,
-                     counts: tuple[int, int] | None = None) -> dict:
+def visibility_fault(
+    fault: dict, cand_images, oracle_segs, camera, matched_px: float | None, counts: tuple[int, int] | None = None
+) -> dict:
     """``fault`` (an ``unexplained``) with the counts of :func:`set_difference` and the visibility ``hint``;
     unchanged when no pixel is on one side only (then nothing says the sets differ).
 
@@ -87,13 +92,21 @@ def visibility_fault(fault: dict, cand_images, oracle_segs, camera, matched_px: 
     cand_only, oracle_only = counts if counts is not None else set_difference(cand_images, oracle_segs, camera)
     if not (cand_only or oracle_only):
         return fault
-    where = ("the drawn lines lie on the oracle's" if matched_px is None else
-             f"the drawn lines lie on the oracle's (paired pixels {matched_px:.2g} px away on average, as a "
-             "correct drawing's)")
-    return {**fault, "candidate_only_px": cand_only, "oracle_only_px": oracle_only,
-            **({} if matched_px is None else {"matched_residual_px": float(matched_px)}),
-            "hint": catalogue.hint_text("unexplained", "drawn_sets", where=where, candidate_only=cand_only,
-                                        oracle_only=oracle_only, near=NEAR_PX)}
+    where = (
+        "the drawn lines lie on the oracle's"
+        if matched_px is None
+        else f"the drawn lines lie on the oracle's (paired pixels {matched_px:.2g} px away on average, as a "
+        "correct drawing's)"
+    )
+    return {
+        **fault,
+        "candidate_only_px": cand_only,
+        "oracle_only_px": oracle_only,
+        **({} if matched_px is None else {"matched_residual_px": float(matched_px)}),
+        "hint": catalogue.hint_text(
+            "unexplained", "drawn_sets", where=where, candidate_only=cand_only, oracle_only=oracle_only, near=NEAR_PX
+        ),
+    }
 
 
 def frames_visibility(faults: list, cand_images, oracle_segs, camera, frames_checked: int) -> list:
@@ -109,8 +122,13 @@ def frames_visibility(faults: list, cand_images, oracle_segs, camera, frames_che
     return visibility_names(faults, counts, len(cand_images), frames_checked)
 
 
-def visibility_names(faults: list, counts: tuple[int, int], frames_diagnosed: int, frames_checked: int,
-                     share: float = NAMING.visibility_share) -> list:
+def visibility_names(
+    faults: list,
+    counts: tuple[int, int],
+    frames_diagnosed: int,
+    frames_checked: int,
+    share: float = NAMING.visibility_share,
+) -> list:
     """:func:`frames_visibility` on the sets already counted (``counts``: :func:`set_difference` over
     ``frames_diagnosed`` frames): a bare ``unexplained`` gets the advice; a ``line_pixel_bias`` becomes it when
     at least ``share`` of its decided one-sided pixels, per frame, lie farther than :data:`NEAR_PX` from the
@@ -121,5 +139,4 @@ def visibility_names(faults: list, counts: tuple[int, int], frames_diagnosed: in
     decided = faults[0]["candidate_only"] + faults[0]["oracle_only"]
     if sum(counts) * frames_checked < share * decided * frames_diagnosed:
         return faults
-    return [visibility_fault({"name": "unexplained", "line_fault": faults[0]["name"]}, None, None, None, None,
-                             counts)]
+    return [visibility_fault({"name": "unexplained", "line_fault": faults[0]["name"]}, None, None, None, None, counts)]

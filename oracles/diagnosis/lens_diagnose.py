@@ -68,7 +68,7 @@ def _project_normalised(n: np.ndarray, dist: np.ndarray) -> tuple[np.ndarray, np
 
     pts = np.column_stack([n, np.ones(len(n))]).reshape(-1, 1, 3)
     out, jac = cv2.projectPoints(pts, np.zeros(3), np.zeros(3), np.eye(3), dist)
-    jac = jac.reshape(len(n), 2, -1)[:, :, 3:5]                 # d(u, v) / d(t_x, t_y)
+    jac = jac.reshape(len(n), 2, -1)[:, :, 3:5]  # d(u, v) / d(t_x, t_y)
     return out.reshape(-1, 2), jac
 
 
@@ -91,8 +91,8 @@ def _profile_design(n: np.ndarray) -> np.ndarray:
     """``(2N, 5)`` design of the radial-tangential profile (x rows, then y rows)."""
     x, y = n[:, 0], n[:, 1]
     r2 = x * x + y * y
-    xs = np.column_stack([x * r2, x * r2 ** 2, x * r2 ** 3, 2 * x * y, r2 + 2 * x * x])
-    ys = np.column_stack([y * r2, y * r2 ** 2, y * r2 ** 3, r2 + 2 * y * y, 2 * x * y])
+    xs = np.column_stack([x * r2, x * r2**2, x * r2**3, 2 * x * y, r2 + 2 * x * x])
+    ys = np.column_stack([y * r2, y * r2**2, y * r2**3, r2 + 2 * y * y, 2 * x * y])
     return np.vstack([xs, ys])
 
 
@@ -100,7 +100,7 @@ def _expected(dist) -> np.ndarray:
     """The camera's ``(k1, k2, k3, p1, p2)``."""
     c = np.zeros(8)
     if dist is not None:
-        c[:len(dist)] = dist
+        c[: len(dist)] = dist
     return np.array([c[0], c[1], c[4], c[2], c[3]])
 
 
@@ -138,10 +138,10 @@ def distortion_fault(cand: np.ndarray, orac: np.ndarray, camera, tol: float) -> 
     model = design @ fitted
     resid_px = np.abs((model - target).reshape(2, -1).T * f)
     if resid_px.max() > tol:
-        return None                                              # not (only) a lens error
+        return None  # not (only) a lens error
     want = design @ _expected(lens)
     if np.abs((model - want).reshape(2, -1).T * f).max() <= tol:
-        return None                                              # the candidate's lens is the camera's
+        return None  # the candidate's lens is the camera's
     moved = np.abs(model.reshape(2, -1).T * f).max()
     k1_true = _expected(lens)[0]
     if lens is None:
@@ -157,7 +157,11 @@ def distortion_fault(cand: np.ndarray, orac: np.ndarray, camera, tol: float) -> 
     err = (d_c - d_o) * f
     radial = np.where(r > 0, (err * n).sum(axis=1) / np.where(r > 0, r, 1.0), 0.0)
     worst = int(np.argmax(np.abs(radial)))
-    return {"name": "distortion_mismatch", "kind": kind,
-            **{name: float(v) for name, v in zip(_COEFFS, fitted)},
-            "radial_error_px": float(radial[worst]), "at_radius_px": float(r[worst] * f[1]),
-            "residual_px": float(resid_px.max())}
+    return {
+        "name": "distortion_mismatch",
+        "kind": kind,
+        **{name: float(v) for name, v in zip(_COEFFS, fitted)},
+        "radial_error_px": float(radial[worst]),
+        "at_radius_px": float(r[worst] * f[1]),
+        "residual_px": float(resid_px.max()),
+    }

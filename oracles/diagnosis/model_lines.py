@@ -9,8 +9,9 @@ Its own module because the naming (oracles.diagnosis.image_naming) and the rule 
 from __future__ import annotations
 
 import numpy as np
-from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector import raster
+from wirecheck.core.projector.clipping import clip_to_image
+
 from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
 
 
@@ -27,7 +28,7 @@ def model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -
     images = []
     for segs in oracle_segs:
         segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
-        segs = ((segs - centre) @ p.T) * d + centre + shift      # the model's lines (identity: the oracle's)
+        segs = ((segs - centre) @ p.T) * d + centre + shift  # the model's lines (identity: the oracle's)
         img = np.zeros((camera.height, camera.width), bool)
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
         rr, cc = draw(q0, q1, camera.width, camera.height)
@@ -56,7 +57,7 @@ def quantisation_bias(oracle_segs, camera, p=None, d=None, snapped: bool = False
     d = np.ones(2) if d is None else np.asarray(d, dtype=np.float64)
     centre = np.array(camera.principal_point)
     images = model_images(oracle_segs, camera, p, d, snapped=snapped)
-    limit = points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)    # as diagnose_images
+    limit = points_per_frame(len(images), MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME)  # as diagnose_images
     reg = Registration(frame_samples(images, oracle_segs, camera, limit), camera.width, camera.height, centre)
     if not any(len(f.cand) for f in reg.frames):
         return np.zeros(2)

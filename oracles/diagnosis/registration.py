@@ -11,9 +11,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from wirecheck.core.projector.clipping import clip_to_image
 
 from ..segment_geometry import nearest_on_segments
-from wirecheck.core.projector.clipping import clip_to_image
 
 __all__ = ["PERMUTATIONS", "Registration", "frame_samples", "points_per_frame", "register", "segments_in_image"]
 
@@ -117,13 +117,13 @@ def _normals(tangent_u: np.ndarray, a: np.ndarray) -> np.ndarray:
 class _Frame:
     """One frame, centred on the principal point: the candidate's pixels and the oracle's lines."""
 
-    cand: np.ndarray        # (N, 2) candidate pixel centres (subsampled)
-    nearest: np.ndarray     # (H * W,) int32 flat index (row * W + col) of each pixel's nearest candidate pixel
-    seg_a: np.ndarray       # (K, 2) oracle segment starts
-    seg_b: np.ndarray       # (K, 2) and ends
-    samples: np.ndarray     # (M, 2) points along the oracle's segments (subsampled)
-    sample_tangents: np.ndarray   # (M, 2) unit tangent of each sample's segment
-    seg_tangents: np.ndarray      # (K, 2) unit tangent of each segment
+    cand: np.ndarray  # (N, 2) candidate pixel centres (subsampled)
+    nearest: np.ndarray  # (H * W,) int32 flat index (row * W + col) of each pixel's nearest candidate pixel
+    seg_a: np.ndarray  # (K, 2) oracle segment starts
+    seg_b: np.ndarray  # (K, 2) and ends
+    samples: np.ndarray  # (M, 2) points along the oracle's segments (subsampled)
+    sample_tangents: np.ndarray  # (M, 2) unit tangent of each sample's segment
+    seg_tangents: np.ndarray  # (K, 2) unit tangent of each segment
 
 
 class Registration:
@@ -172,13 +172,13 @@ class Registration:
         if not self._stacked:
             feet, tangents, start = [], [], 0
             for f in self._fwd_frames:
-                foot, _, j = nearest_on_segments(q[start:start + len(f.cand)], f.seg_a, f.seg_b)
+                foot, _, j = nearest_on_segments(q[start : start + len(f.cand)], f.seg_a, f.seg_b)
                 feet.append(foot)
                 tangents.append(f.seg_tangents[j])
                 start += len(f.cand)
             return np.concatenate(feet), np.concatenate(tangents)
         qx, qy = q[:, 0:1], q[:, 1:2]
-        t = (qx - self._ax) * self._abx                    # the projection onto each segment, clipped
+        t = (qx - self._ax) * self._abx  # the projection onto each segment, clipped
         t += (qy - self._ay) * self._aby
         t /= self._len2
         np.clip(t, 0.0, 1.0, out=t)
@@ -190,13 +190,14 @@ class Registration:
         dy -= qy
         dx *= dx
         dy *= dy
-        dx += dy                                           # squared distance to each segment
+        dx += dy  # squared distance to each segment
         dx[self._pad] = np.inf
         j = np.argmin(dx, axis=1)
         rows = np.arange(len(q))
         tj = t[rows, j]
-        foot = np.stack([self._ax[rows, j] + tj * self._abx[rows, j], self._ay[rows, j] + tj * self._aby[rows, j]],
-                        axis=1)
+        foot = np.stack(
+            [self._ax[rows, j] + tj * self._abx[rows, j], self._ay[rows, j] + tj * self._aby[rows, j]], axis=1
+        )
         return foot, self._seg_tangents[rows, j]
 
     def pairs(self, p: np.ndarray, a: np.ndarray, b: np.ndarray):
@@ -208,8 +209,8 @@ class Registration:
         line's direction at ``u``.
         """
         us, cs, dists, ts = [], [], [], []
-        back = p.T @ np.linalg.inv(a)                      # c -> o (a signed permutation's inverse is P.T)
-        if len(self._cand):                                # candidate pixels -> nearest oracle line point
+        back = p.T @ np.linalg.inv(a)  # c -> o (a signed permutation's inverse is P.T)
+        if len(self._cand):  # candidate pixels -> nearest oracle line point
             foot, tangent = self._forward((self._cand - b) @ back.T)
             u = foot @ p.T
             us.append(u)
@@ -218,7 +219,7 @@ class Registration:
             dists.append(np.hypot(*(u @ a.T + b - self._cand).T))
         n_fwd = len(self._cand)
         n_rev = 0
-        if len(self._samples):                             # oracle samples -> nearest candidate pixel
+        if len(self._samples):  # oracle samples -> nearest candidate pixel
             t = self._samples @ (a @ p).T + (b + self.centre)
             col, row = np.rint(t[:, 0]), np.rint(t[:, 1])
             inside = np.flatnonzero((col >= 0) & (col < self.w) & (row >= 0) & (row < self.h))
@@ -241,8 +242,7 @@ class Registration:
                 n_rev = len(inside)
         if not us:
             return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), 0, 0
-        return (np.concatenate(us), np.concatenate(cs), np.concatenate(dists), np.concatenate(ts),
-                n_fwd, n_rev)
+        return (np.concatenate(us), np.concatenate(cs), np.concatenate(dists), np.concatenate(ts), n_fwd, n_rev)
 
     def cost(self, p, a, b) -> float:
         """Mean capped distance, the two directions weighted equally; the cap when a direction is empty."""
@@ -258,8 +258,7 @@ class Registration:
         means = [d[d < PAIR_CAP_PX].mean() for d in (dist[:n_fwd], dist[n_fwd:]) if (d < PAIR_CAP_PX).any()]
         return float(np.mean(means)) if means else 0.0
 
-    def fit(self, p: np.ndarray, a: np.ndarray, b: np.ndarray, iterations: int = ITERATIONS,
-            affine: bool = False):
+    def fit(self, p: np.ndarray, a: np.ndarray, b: np.ndarray, iterations: int = ITERATIONS, affine: bool = False):
         """ICP from ``(a, b)``: ``(a, b, cost)``; ``a`` stays diagonal unless ``affine``."""
         a, b = np.array(a, dtype=float), np.array(b, dtype=float)
         for _ in range(iterations):
@@ -270,8 +269,9 @@ class Registration:
             u, c, n = u[keep], c[keep], _normals(tangent[keep], a)
             # point to line: n . (a @ u + b - c) = 0, linear in a and b for fixed normals
             if affine:
-                design = np.column_stack([n[:, 0] * u[:, 0], n[:, 0] * u[:, 1], n[:, 1] * u[:, 0],
-                                          n[:, 1] * u[:, 1], n[:, 0], n[:, 1]])
+                design = np.column_stack(
+                    [n[:, 0] * u[:, 0], n[:, 0] * u[:, 1], n[:, 1] * u[:, 0], n[:, 1] * u[:, 1], n[:, 0], n[:, 1]]
+                )
             else:
                 design = np.column_stack([n[:, 0] * u[:, 0], n[:, 1] * u[:, 1], n[:, 0], n[:, 1]])
             x, *_ = np.linalg.lstsq(design, (n * c).sum(axis=1), rcond=None)
@@ -308,7 +308,7 @@ def register(coarse: Registration, fine: Registration):
         best.setdefault(names, (cost, names, p, a, b))
     top = list(best.values())[:2]
     if () not in [names for _c, names, *_ in top]:
-        top.append(best[()])                           # no permutation is always a contender
+        top.append(best[()])  # no permutation is always a contender
     out = []
     for _cost, names, p, a, b in top:
         a, b, cost = fine.fit(p, a, b)
@@ -337,9 +337,17 @@ def frame_samples(cand_images, segments, camera, limit: int = MAX_POINTS_PER_FRA
             near = None
         samples, tangents = _samples(segs, camera.width, camera.height)
         keep = np.unique(np.linspace(0, len(samples) - 1, min(limit, len(samples))).round().astype(int))
-        out.append(_Frame(cand=cand, nearest=near, seg_a=segs[:, 0] - centre, seg_b=segs[:, 1] - centre,
-                          samples=samples[keep] - centre, sample_tangents=tangents[keep],
-                          seg_tangents=_unit(segs[:, 1] - segs[:, 0])))
+        out.append(
+            _Frame(
+                cand=cand,
+                nearest=near,
+                seg_a=segs[:, 0] - centre,
+                seg_b=segs[:, 1] - centre,
+                samples=samples[keep] - centre,
+                sample_tangents=tangents[keep],
+                seg_tangents=_unit(segs[:, 1] - segs[:, 0]),
+            )
+        )
     return out
 
 
@@ -356,11 +364,11 @@ def _nearest_pixel_map(img: np.ndarray, rr: np.ndarray, cc: np.ndarray) -> np.nd
     from scipy.ndimage import distance_transform_edt
 
     h, w = img.shape
-    m = int(math.ceil(PAIR_CAP_PX)) + 1          # > the cap + a rounded sample's 0.71 px from its pixel
+    m = int(math.ceil(PAIR_CAP_PX)) + 1  # > the cap + a rounded sample's 0.71 px from its pixel
     r0, r1 = max(int(rr.min()) - m, 0), min(int(rr.max()) + m + 1, h)
     c0, c1 = max(int(cc.min()) - m, 0), min(int(cc.max()) + m + 1, w)
     rows, cols = distance_transform_edt(~img[r0:r1, c0:c1], return_distances=False, return_indices=True)
-    flat_type = np.int32 if img.size < 2 ** 31 else np.int64
+    flat_type = np.int32 if img.size < 2**31 else np.int64
     near = np.full((h, w), int(rr[0]) * w + int(cc[0]), dtype=flat_type)
     near[r0:r1, c0:c1] = (rows.astype(flat_type, copy=False) + r0) * w + (cols + c0)
     return near.ravel()
@@ -376,6 +384,12 @@ def segments_in_image(segments, camera) -> int:
     n = 0
     for segs in segments:
         s, _ = _samples(np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2), camera.width, camera.height)
-        n += int(((s[:, 0] >= -0.5) & (s[:, 0] <= camera.width - 0.5)
-                  & (s[:, 1] >= -0.5) & (s[:, 1] <= camera.height - 0.5)).sum())
+        n += int(
+            (
+                (s[:, 0] >= -0.5)
+                & (s[:, 0] <= camera.width - 0.5)
+                & (s[:, 1] >= -0.5)
+                & (s[:, 1] <= camera.height - 0.5)
+            ).sum()
+        )
     return n

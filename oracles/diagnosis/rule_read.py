@@ -25,9 +25,10 @@ fit closer (the registration's cost), but the two costs are not always far enoug
 from __future__ import annotations
 
 import numpy as np
-from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
-from .model_lines import JITTER, model_lines, quantisation_bias
+
 from .diagnose import scale_faults
+from .model_lines import JITTER, model_lines, quantisation_bias
+from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
 
 __all__ = ["ROUNDED_END_PX", "RULE_TIE", "read_rules", "standing_scale_faults"]
 
@@ -59,7 +60,7 @@ def _costs(cand_images, oracle_segs, camera, p, d, b):
     def cost(lines):
         nonlocal nearest
         frames = frame_samples(cand_images, lines, camera, limit, nearest)
-        nearest = [f.nearest for f in frames]              # one distance transform per image, reused
+        nearest = [f.nearest for f in frames]  # one distance transform per image, reused
         reg = Registration(frames, camera.width, camera.height, np.array(camera.principal_point))
         return reg.cost(np.eye(2), np.eye(2), np.zeros(2))
 

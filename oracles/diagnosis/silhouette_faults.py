@@ -78,8 +78,18 @@ STEPS = 4
 POLISH_BELOW = 2.0
 
 #: Every name this module gives, the catalogue's order.
-SILHOUETTE_FAULTS = ("depth_flip", "axis_swap", "ambiguous", "axis_flip", "mirror_horizontal", "mirror_vertical",
-                     "aspect_mismatch", "fov_mismatch", "pixel_offset", "unexplained")
+SILHOUETTE_FAULTS = (
+    "depth_flip",
+    "axis_swap",
+    "ambiguous",
+    "axis_flip",
+    "mirror_horizontal",
+    "mirror_vertical",
+    "aspect_mismatch",
+    "fov_mismatch",
+    "pixel_offset",
+    "unexplained",
+)
 
 
 @dataclass(frozen=True)
@@ -160,11 +170,11 @@ def _step(name: str, theta: np.ndarray, m_model: np.ndarray, m_cand: np.ndarray)
     """One fixed-point step: move ``theta`` so that the model's moments become the candidate's."""
     if min(m_model[0], m_cand[0]) == 0:
         return theta
-    if name == "pixel_offset":                       # T = p + d: the candidate's centroid is the reference's - d
+    if name == "pixel_offset":  # T = p + d: the candidate's centroid is the reference's - d
         return theta + (m_model[1:3] / m_model[0] - m_cand[1:3] / m_cand[0])
     spread_model = m_model[3:5] / m_model[0]
     spread_cand = m_cand[3:5] / m_cand[0]
-    if name == "fov_mismatch":                       # T = c + s (p - c): the candidate's spread is the model's / s
+    if name == "fov_mismatch":  # T = c + s (p - c): the candidate's spread is the model's / s
         return theta * math.sqrt(spread_model.sum() / spread_cand.sum()) if spread_cand.sum() > 0 else theta
     ok = spread_cand > 0
     return np.where(ok, theta * np.sqrt(np.where(ok, spread_model / np.where(ok, spread_cand, 1.0), 1.0)), theta)
@@ -278,26 +288,46 @@ def name_silhouette_faults(frames) -> tuple[Fault, ...]:
     if not frames:
         raise ValueError("name_silhouette_faults: no frame to name (expected one or more SilhouetteFrame)")
     for f in frames:
-        if not (np.shape(f.cand) == np.shape(f.inside) == np.shape(f.ties)
-                == (int(f.camera.height), int(f.camera.width))):
-            raise ValueError(f"silhouettes of shapes {np.shape(f.cand)}, {np.shape(f.inside)}, ties "
-                             f"{np.shape(f.ties)}: expected ({f.camera.height}, {f.camera.width}), the camera's")
-    frames = [SilhouetteFrame(np.asarray(f.cand, dtype=bool), np.asarray(f.inside, dtype=bool),
-                              np.asarray(f.ties, dtype=bool), f.camera, np.asarray(f.p_world, dtype=np.float64),
-                              tuple(tuple(face) for face in f.faces)) for f in frames]
+        if not (
+            np.shape(f.cand) == np.shape(f.inside) == np.shape(f.ties) == (int(f.camera.height), int(f.camera.width))
+        ):
+            raise ValueError(
+                f"silhouettes of shapes {np.shape(f.cand)}, {np.shape(f.inside)}, ties "
+                f"{np.shape(f.ties)}: expected ({f.camera.height}, {f.camera.width}), the camera's"
+            )
+    frames = [
+        SilhouetteFrame(
+            np.asarray(f.cand, dtype=bool),
+            np.asarray(f.inside, dtype=bool),
+            np.asarray(f.ties, dtype=bool),
+            f.camera,
+            np.asarray(f.p_world, dtype=np.float64),
+            tuple(tuple(face) for face in f.faces),
+        )
+        for f in frames
+    ]
     if not any(f.cand.any() for f in frames):
-        return (Fault("unexplained", {"note": "the candidate's frames are blank: no silhouette to name"},
-                      "silhouettes"),)
+        return (
+            Fault("unexplained", {"note": "the candidate's frames are blank: no silhouette to name"}, "silhouettes"),
+        )
     preps = [_prepare(f) for f in frames]
     in_place = _misses(preps, "none", None)
     if in_place == 0:
         return ()
     boundary = sum(p.boundary_px for p in preps)
     if boundary == 0:
-        return (Fault("unexplained", {"note": f"{in_place} decided pixels differ, but the reference's silhouette has "
-                                               "no edge in the image (nothing covered, or all of it): no camera "
-                                               "mistake of the family can be seen"}, "silhouettes"),)
-    fits = [("none", 0, np.zeros(0), in_place)]                         # (name, n_params, theta, misses)
+        return (
+            Fault(
+                "unexplained",
+                {
+                    "note": f"{in_place} decided pixels differ, but the reference's silhouette has "
+                    "no edge in the image (nothing covered, or all of it): no camera "
+                    "mistake of the family can be seen"
+                },
+                "silhouettes",
+            ),
+        )
+    fits = [("none", 0, np.zeros(0), in_place)]  # (name, n_params, theta, misses)
     for name in _FIXED[1:]:
         fits.append((name, 0, np.zeros(0), _misses(preps, name, None)))
     for name in _FITTED:
@@ -315,20 +345,50 @@ def name_silhouette_faults(frames) -> tuple[Fault, ...]:
     explaining = sorted((f for f in fits if ratios[f[0]] <= ALLOWANCE), key=lambda f: (f[1], f[3]))
     if not explaining:
         best = min(fits, key=lambda f: f[3])
-        return (Fault("unexplained", {"best": best[0], "fit_ratios": ratios, "boundary_px": boundary,
-                                      "allowance": ALLOWANCE}, "silhouettes"),)
+        return (
+            Fault(
+                "unexplained",
+                {"best": best[0], "fit_ratios": ratios, "boundary_px": boundary, "allowance": ALLOWANCE},
+                "silhouettes",
+            ),
+        )
     first = explaining[0]
     if first[0] == "none":
         if first[3] == 0:
             return ()
-        return (Fault("unexplained", {"note": f"the silhouette is in place: {first[3]} decided pixels differ, "
-                                              "and no camera mistake of the family moves them",
-                                      "fit_ratios": ratios, "boundary_px": boundary}, "silhouettes"),)
+        return (
+            Fault(
+                "unexplained",
+                {
+                    "note": f"the silhouette is in place: {first[3]} decided pixels differ, "
+                    "and no camera mistake of the family moves them",
+                    "fit_ratios": ratios,
+                    "boundary_px": boundary,
+                },
+                "silhouettes",
+            ),
+        )
     rivals = [f for f in explaining if f[1] == first[1] and f[0] != first[0]]
     if rivals:
         names = [first[0]] + [r[0] for r in rivals]
-        return (Fault("ambiguous", {"alternatives": ", ".join(names), "fit_ratios": ratios,
-                                    "boundary_px": boundary}, "silhouettes"),)
+        return (
+            Fault(
+                "ambiguous",
+                {"alternatives": ", ".join(names), "fit_ratios": ratios, "boundary_px": boundary},
+                "silhouettes",
+            ),
+        )
     name, _n, theta, misses = first
-    return (Fault(name, {**_params(name, theta, frames[0].camera), "miss_ratio": ratios[name],
-                         "misses": misses, "boundary_px": boundary, "fit_ratios": ratios}, "silhouettes"),)
+    return (
+        Fault(
+            name,
+            {
+                **_params(name, theta, frames[0].camera),
+                "miss_ratio": ratios[name],
+                "misses": misses,
+                "boundary_px": boundary,
+                "fit_ratios": ratios,
+            },
+            "silhouettes",
+        ),
+    )

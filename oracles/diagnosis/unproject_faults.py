@@ -78,7 +78,7 @@ def _reproject(x_world, camera) -> np.ndarray:
     finite = np.isfinite(x_world).all(axis=1)
     uv = np.full((len(x_world), 2), np.nan)
     if finite.any():
-        uv[finite] = cv_project(x_world[finite], camera)       # NaN outside [near, far]
+        uv[finite] = cv_project(x_world[finite], camera)  # NaN outside [near, far]
     return np.column_stack([uv, d])
 
 
@@ -89,14 +89,17 @@ def _measured(p, d, camera, x_c) -> dict:
     cx, cy = k[0, 2], k[1, 2]
     shift = back[:, :2] - p
     with np.errstate(invalid="ignore", divide="ignore"):
-        far_x = np.abs(p[:, 0] - cx) > 1.0                  # scale read where the point is off the centre
+        far_x = np.abs(p[:, 0] - cx) > 1.0  # scale read where the point is off the centre
         far_y = np.abs(p[:, 1] - cy) > 1.0
         sx = (back[far_x, 0] - cx) / (p[far_x, 0] - cx)
         sy = (back[far_y, 1] - cy) / (p[far_y, 1] - cy)
         ratio = back[:, 2] / d
-    med = lambda a: float(np.nanmedian(a)) if np.isfinite(a).any() else float("nan")   # noqa: E731
-    return {"median_shift_px": [med(shift[:, 0]), med(shift[:, 1])], "median_scale": [med(sx), med(sy)],
-            "median_depth_ratio": med(ratio)}
+    med = lambda a: float(np.nanmedian(a)) if np.isfinite(a).any() else float("nan")  # noqa: E731
+    return {
+        "median_shift_px": [med(shift[:, 0]), med(shift[:, 1])],
+        "median_scale": [med(sx), med(sy)],
+        "median_depth_ratio": med(ratio),
+    }
 
 
 def _mistakes(p, d, camera, measured):
@@ -114,8 +117,11 @@ def _mistakes(p, d, camera, measured):
     if perspective and math.isfinite(sx) and math.isfinite(sy) and sx + sy > 0:
         s = 0.5 * (sx + sy)
         implied = math.degrees(2.0 * math.atan((h / 2.0) / (k[1, 1] / s)))
-        yield "fov_mismatch", {"scale": s, "implied_fov_y_deg": implied}, \
-            unproject(np.column_stack([cx + s * (p[:, 0] - cx), cy + s * (p[:, 1] - cy)]), d, camera)
+        yield (
+            "fov_mismatch",
+            {"scale": s, "implied_fov_y_deg": implied},
+            unproject(np.column_stack([cx + s * (p[:, 0] - cx), cy + s * (p[:, 1] - cy)]), d, camera),
+        )
     p_cv = cam_points(p, d, camera)
     if perspective:
         rho = np.linalg.norm(p_cv, axis=1) / d

@@ -25,18 +25,41 @@ from __future__ import annotations
 
 import time
 
-from .bounds import (DERIVED, EPS, EPS32, EPS64, SAFETY, camera_error, derivation, opencv_camera_error,
-                     pixel_bound)
+from .bounds import DERIVED, EPS, EPS32, EPS64, SAFETY, camera_error, derivation, opencv_camera_error, pixel_bound
 from .cases import CASES
 from .measure import Pyrender
 from .record import CaseRecord
-from .reference import (LD, REFERENCE_EPS, REFERENCE_EXTENDED, reference_basis, reference_focal,
-                        reference_project, reference_world)
+from .reference import (
+    LD,
+    REFERENCE_EPS,
+    REFERENCE_EXTENDED,
+    reference_basis,
+    reference_focal,
+    reference_project,
+    reference_world,
+)
 from .report import extremes_markdown
 
-__all__ = ["EXTREME_CASES", "run_case", "run_extremes", "extremes_markdown", "reference_project",
-           "reference_basis", "reference_focal", "reference_world", "camera_error", "pixel_bound", "opencv_camera_error", "SAFETY",
-           "EPS", "EPS32", "EPS64", "LD", "REFERENCE_EPS", "REFERENCE_EXTENDED"]
+__all__ = [
+    "EXTREME_CASES",
+    "run_case",
+    "run_extremes",
+    "extremes_markdown",
+    "reference_project",
+    "reference_basis",
+    "reference_focal",
+    "reference_world",
+    "camera_error",
+    "pixel_bound",
+    "opencv_camera_error",
+    "SAFETY",
+    "EPS",
+    "EPS32",
+    "EPS64",
+    "LD",
+    "REFERENCE_EPS",
+    "REFERENCE_EXTENDED",
+]
 
 _BY_NAME = {case.__name__: case for case in CASES}
 

@@ -44,8 +44,9 @@ def localize_origin(p_model) -> np.ndarray:
     return centre if np.abs(centre).max() > half.max() else np.zeros(3)
 
 
-def camera_error(dtype: str, p_model, model_matrix, camera, model_err: float = 0.0,
-                 path: str = "model_view") -> np.ndarray:
+def camera_error(
+    dtype: str, p_model, model_matrix, camera, model_err: float = 0.0, path: str = "model_view"
+) -> np.ndarray:
     """``(N, 3)`` bounds ``e_cam`` on the absolute error of core's camera x, y, z.
 
     Parameters
@@ -90,7 +91,7 @@ def camera_error(dtype: str, p_model, model_matrix, camera, model_err: float = 0
     s_local = np.linalg.norm(p - origin, axis=1)
     n_a = float(np.linalg.norm(a, 2))
     t_world_rel = a @ origin + t - np.asarray(camera.position, np.float64)
-    t_mv = np.abs(reference_basis(camera).astype(np.float64) @ t_world_rel)     # |t_mv_i|
+    t_mv = np.abs(reference_basis(camera).astype(np.float64) @ t_world_rel)  # |t_mv_i|
     t_norm = float(np.linalg.norm(t_world_rel))
     far = n_a * float(np.linalg.norm(origin)) + float(np.linalg.norm(t)) + float(np.linalg.norm(camera.position))
     rel = n_a * s_local + t_norm
@@ -179,11 +180,15 @@ def pixel_bound(p_cam, p_px, camera, e_cam, eps: float) -> np.ndarray:
     r = x + y
     px_abs = np.abs(p_px).sum(axis=1)
     kf = focal_condition(camera)
-    with np.errstate(all="ignore"):      # z = 0 rows (clipped points) give inf: never compared
+    with np.errstate(all="ignore"):  # z = 0 rows (clipped points) give inf: never compared
         if camera.projection == "perspective":
             f = camera.focal_px
-            b = (f * (e[:, 0] + e[:, 1] + r * e[:, 2] / z) / z + 2 * eps * f * r / z + eps * px_abs
-                 + kf * EPS64 * f * r / z)
+            b = (
+                f * (e[:, 0] + e[:, 1] + r * e[:, 2] / z) / z
+                + 2 * eps * f * r / z
+                + eps * px_abs
+                + kf * EPS64 * f * r / z
+            )
         else:
             s = camera.height / camera.ortho_height
             b = s * (e[:, 0] + e[:, 1]) + 2 * eps * s * r + eps * px_abs + kf * EPS64 * s * r
@@ -204,7 +209,7 @@ def near_band(ref_cam, camera, e_cam, eps) -> np.ndarray:
     e_z = components(e_cam, len(z))[:, 2]
     out = np.zeros(len(z), bool)
     for plane in (camera.near, camera.far):
-        out |= (np.abs(z - LD(plane)).astype(np.float64) <= e_z + eps * abs(plane))
+        out |= np.abs(z - LD(plane)).astype(np.float64) <= e_z + eps * abs(plane)
     return out
 
 
@@ -242,13 +247,19 @@ def clipped_end_bounds(p0_cam, p1_cam, q_cam, q_px, e_end, camera, eps: float):
     z_bound = 8 * eps * (z0 + z1 + near) + e_end
     seg_len = norm_ld(p1_cam - p0_cam).astype(float)
     kappa = seg_len / np.abs(p1_cam[:, 2] - p0_cam[:, 2]).astype(float)
-    lateral = np.minimum(seg_len, 2 * kappa * e_end) + e_end + 8 * eps * (
-        norm_ld(p0_cam).astype(float) + norm_ld(p1_cam).astype(float))
+    lateral = (
+        np.minimum(seg_len, 2 * kappa * e_end)
+        + e_end
+        + 8 * eps * (norm_ld(p0_cam).astype(float) + norm_ld(p1_cam).astype(float))
+    )
     qc = q_cam.astype(np.float64)
     r = np.abs(qc[:, 0]) + np.abs(qc[:, 1])
-    px_bound = SAFETY * (f / near * lateral * (2 + r / near) + 2 * eps * f * r / near
-                         + eps * np.abs(q_px.astype(float)).sum(axis=1)
-                         + focal_condition(camera) * EPS64 * f * r / near)
+    px_bound = SAFETY * (
+        f / near * lateral * (2 + r / near)
+        + 2 * eps * f * r / near
+        + eps * np.abs(q_px.astype(float)).sum(axis=1)
+        + focal_condition(camera) * EPS64 * f * r / near
+    )
     return z_bound, px_bound, kappa
 
 
@@ -277,5 +288,13 @@ def orthonormality_error() -> float:
 
 
 #: The bound functions whose derivations the report prints, in this order.
-DERIVED = (camera_error, pixel_bound, focal_condition, opencv_camera_error, near_band, clipped_end_bounds,
-           motion_matrix_error, orthonormality_error)
+DERIVED = (
+    camera_error,
+    pixel_bound,
+    focal_condition,
+    opencv_camera_error,
+    near_band,
+    clipped_end_bounds,
+    motion_matrix_error,
+    orthonormality_error,
+)

@@ -10,21 +10,35 @@ printed in the report).
 from __future__ import annotations
 
 import numpy as np
-
-from wirecheck.core.projector import clipping
 from wirecheck.core.camera import look_at
 from wirecheck.core.errors import InputError
+from wirecheck.core.projector import clipping
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import DTYPES, cam_to_px, localize, model_to_cam, project_points
 from wirecheck.core.transforms import Motion, compose, rotate_x, rotate_y, rotate_z, translate
 
 from ..references import opencv_oracle
-from .bounds import (EPS, EPS32, camera_error, clipped_end_bounds, focal_condition, motion_matrix_error,
-                     near_band, orthonormality_error)
+from .bounds import (
+    EPS,
+    EPS32,
+    camera_error,
+    clipped_end_bounds,
+    focal_condition,
+    motion_matrix_error,
+    near_band,
+    orthonormality_error,
+)
 from .measure import Pyrender, err_px, measure
 from .record import CaseRecord, public
-from .reference import (LD, norm_ld, reference_basis, reference_cam_to_px, reference_motion_matrix, reference_project,
-                        reference_world)
+from .reference import (
+    LD,
+    norm_ld,
+    reference_basis,
+    reference_cam_to_px,
+    reference_motion_matrix,
+    reference_project,
+    reference_world,
+)
 
 
 def _cube(half=0.5):
@@ -37,6 +51,7 @@ CUBE_V, CUBE_E = _cube()
 
 
 # ---- 1 ---------------------------------------------------------------------
+
 
 def near_plane(c: CaseRecord, pr: Pyrender) -> None:
     """points exactly at z = near, near +- 1 ulp, near +- 1e-9 (absolute), at far +- 1 ulp, at depth 0
@@ -54,16 +69,28 @@ def near_plane(c: CaseRecord, pr: Pyrender) -> None:
     # exactly, so z_cam = z_world with no rounding in either path.
     cam = look_at((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0), near=near, far=far)
     up_, dn = np.nextafter(near, np.inf), np.nextafter(near, -np.inf)
-    zs = {"near": near, "near+1ulp": up_, "near-1ulp": dn, "near+1e-9": near + 1e-9, "near-1e-9": near - 1e-9,
-          "depth 0": 0.0, "depth -0": -0.0, "depth 5e-324": 5e-324, "behind -near": -near, "behind -1": -1.0,
-          "far": far, "far+1ulp": np.nextafter(far, np.inf), "far-1ulp": np.nextafter(far, -np.inf),
-          "middle 1": 1.0}
+    zs = {
+        "near": near,
+        "near+1ulp": up_,
+        "near-1ulp": dn,
+        "near+1e-9": near + 1e-9,
+        "near-1e-9": near - 1e-9,
+        "depth 0": 0.0,
+        "depth -0": -0.0,
+        "depth 5e-324": 5e-324,
+        "behind -near": -near,
+        "behind -1": -1.0,
+        "far": far,
+        "far+1ulp": np.nextafter(far, np.inf),
+        "far-1ulp": np.nextafter(far, -np.inf),
+        "middle 1": 1.0,
+    }
     labels = list(zs)
     z = np.array([zs[k] for k in labels])
     # x, y within the image for visible ones (|x/z| < 0.5): 0.3 z and -0.2 z, plus a 1/64 offset
     p = np.stack([0.3 * np.abs(z) + 1 / 64, -0.2 * np.abs(z) - 1 / 128, z], axis=1)
     cam_ld, ref_px, ref_vis = reference_project(p, cam)
-    rule = (z >= near) & (z <= far)                  # the rule on the exact depths
+    rule = (z >= near) & (z <= far)  # the rule on the exact depths
     c.check(np.array_equal(ref_vis, rule), "reference visibility differs from the rule (reference bug)")
     c.check(bool((cam_ld[:, 2] == z.astype(LD)).all()), "reference depths are not exact (test design)")
     m = measure(p, None, cam)
@@ -72,8 +99,10 @@ def near_plane(c: CaseRecord, pr: Pyrender) -> None:
     bad = [labels[i] for i in np.flatnonzero(f64.visible != rule)]
     c.check(not bad, f"float64 visibility differs from near <= z <= far at: {', '.join(bad)}")
     c.check(bool(np.array_equal(f64.depth, z)), "float64 depth is not exactly z_cam")
-    c.check(bool(np.isnan(f64.p_px[~rule]).all() and np.isfinite(f64.p_px[rule]).all()),
-            "float64 p_px: expected NaN exactly where clipped")
+    c.check(
+        bool(np.isnan(f64.p_px[~rule]).all() and np.isfinite(f64.p_px[rule]).all()),
+        "float64 p_px: expected NaN exactly where clipped",
+    )
     pp = project_points(p, cam)
     bad_pp = [labels[i] for i in np.flatnonzero(np.isnan(pp[:, 0]) == rule)]
     c.check(not bad_pp, f"project_points visibility differs from the rule at: {', '.join(bad_pp)}")
@@ -82,19 +111,25 @@ def near_plane(c: CaseRecord, pr: Pyrender) -> None:
     f32 = m["frames"]["float32"]
     flips = f32.visible != rule
     band = near_band(cam_ld, cam, camera_error("float32", p, None, cam), EPS32)
-    c.extra = {"near": near, "far": far, "z_offsets": "absolute (near + 1e-9, near - 1e-9) and 1 ulp",
-               "float64_visibility_mismatch": len(bad), "opencv_visibility_mismatch": int((cv_vis != rule).sum()),
-               "float32_visibility_flips": [labels[i] for i in np.flatnonzero(flips)],
-               "float32_points_in_band": [labels[i] for i in np.flatnonzero(band)],
-               "float32_band_at_near": float(camera_error("float32", p, None, cam)[0, 2] + EPS32 * near)}
+    c.extra = {
+        "near": near,
+        "far": far,
+        "z_offsets": "absolute (near + 1e-9, near - 1e-9) and 1 ulp",
+        "float64_visibility_mismatch": len(bad),
+        "opencv_visibility_mismatch": int((cv_vis != rule).sum()),
+        "float32_visibility_flips": [labels[i] for i in np.flatnonzero(flips)],
+        "float32_points_in_band": [labels[i] for i in np.flatnonzero(band)],
+        "float32_band_at_near": float(camera_error("float32", p, None, cam)[0, 2] + EPS32 * near),
+    }
     c.pyrender_note = "no edges: visibility of points only"
 
 
 # ---- 2 ---------------------------------------------------------------------
 
+
 def _grazing_scene(cam, near, slopes):
     """Edges in camera space crossing z = near at each slope, as float64 world points."""
-    basis = reference_basis(cam)                      # rows right, up, forward
+    basis = reference_basis(cam)  # rows right, up, forward
     pos = np.asarray(cam.position, LD)
     ends_cam = []
     k = 0
@@ -102,9 +137,9 @@ def _grazing_scene(cam, near, slopes):
         for variant in range(2):
             y = LD(-0.35 + 0.1 * k)
             k += 1
-            if variant == 0:      # along x, the clipped end first
+            if variant == 0:  # along x, the clipped end first
                 d = np.array([0.25, 0.0], dtype=LD)
-            else:                 # diagonal, the visible end first
+            else:  # diagonal, the visible end first
                 d = np.array([-0.25, -0.05], dtype=LD)
             half_dz = LD(s) * norm_ld(d)
             a = np.array([-d[0], y - d[1], LD(near) - half_dz], dtype=LD)
@@ -133,8 +168,7 @@ def _worst_per_slope(per_slope, dt, slopes, z_err, z_bound, px_err, px_bound, ka
     """Per slope: the worst error and the tightest bound over its two edges."""
     for i, s in enumerate(np.repeat(slopes, 2)):
         d = per_slope.setdefault(f"{s:g}", {})
-        cur = d.setdefault(dt, {"z_error": 0.0, "z_bound": np.inf, "px_error": 0.0, "px_bound": np.inf,
-                                "kappa": 0.0})
+        cur = d.setdefault(dt, {"z_error": 0.0, "z_bound": np.inf, "px_error": 0.0, "px_bound": np.inf, "kappa": 0.0})
         cur["z_error"] = max(cur["z_error"], float(z_err[i]))
         cur["z_bound"] = min(cur["z_bound"], float(z_bound[i]))
         cur["px_error"] = max(cur["px_error"], float(px_err[i]))
@@ -146,7 +180,7 @@ def _grazing_pyrender(c: CaseRecord, pr: Pyrender, world, edges, cam, slopes):
     """pyrender per slope, judged only where float32 GL resolves the crossing."""
     f, near = cam.focal_px, cam.near
     for j, s in enumerate(slopes):
-        e = edges[2 * j:2 * j + 2]
+        e = edges[2 * j : 2 * j + 2]
         frame = render_frame(world, e, cam, np.eye(4))
         scores, note = pr.scores(frame.mask, world, e, cam)
         # judged only where GL's float32 vertex positions (|p| ~ 4.1, rounded by u |p| per coordinate,
@@ -154,9 +188,11 @@ def _grazing_pyrender(c: CaseRecord, pr: Pyrender, world, edges, cam, slopes):
         judged = 1.5 * EPS32 * 4.1 / s * f / near < 0.5
         c.add_pyrender(f"slope {s:g}", scores, note, judged=judged)
     if c.pyrender_parts:
-        c.pyrender_note = ("F1 judged only at slopes where float32 GL resolves the crossing to < 0.5 px "
-                           "(1.5 eps32 |p| / slope * f / near); smaller slopes are information: there GL "
-                           "cannot tell the ends' depths apart and draws the whole edge")
+        c.pyrender_note = (
+            "F1 judged only at slopes where float32 GL resolves the crossing to < 0.5 px "
+            "(1.5 eps32 |p| / slope * f / near); smaller slopes are information: there GL "
+            "cannot tell the ends' depths apart and draws the whole edge"
+        )
 
 
 def near_grazing(c: CaseRecord, pr: Pyrender) -> None:
@@ -176,9 +212,9 @@ def near_grazing(c: CaseRecord, pr: Pyrender) -> None:
     c.add(m)
     ref_cam = m["ref"][0]
     p0, p1 = ref_cam[edges[:, 0]], ref_cam[edges[:, 1]]
-    clipped_first = p0[:, 2] < LD(near)            # which end the near plane cuts
+    clipped_first = p0[:, 2] < LD(near)  # which end the near plane cuts
     t_star = (LD(near) - p0[:, 2]) / (p1[:, 2] - p0[:, 2])
-    q_ref = p0 + t_star[:, None] * (p1 - p0)        # exact intersection (long double)
+    q_ref = p0 + t_star[:, None] * (p1 - p0)  # exact intersection (long double)
     q_px = reference_cam_to_px(q_ref, cam)
     per_slope = {}
     for dt in DTYPES:
@@ -188,26 +224,36 @@ def near_grazing(c: CaseRecord, pr: Pyrender) -> None:
             continue
         end_cam, end_px = ends
         e_cam = camera_error(dt, world, None, cam)
-        e_end = np.maximum(e_cam[edges[:, 0]], e_cam[edges[:, 1]]).max(axis=1)   # worst component
+        e_end = np.maximum(e_cam[edges[:, 0]], e_cam[edges[:, 1]]).max(axis=1)  # worst component
         z_bound, px_bound, kappa = clipped_end_bounds(p0, p1, q_ref, q_px, e_end, cam, EPS[dt])
         z_err = np.abs(end_cam[:, 2] - near)
         px_err = err_px(end_px, q_px)
         _worst_per_slope(per_slope, dt, slopes, z_err, z_bound, px_err, px_bound, kappa)
-        c.check(not (z_err > z_bound).any(), f"{dt}: clipped end off the near plane by {z_err.max():.3g} "
-                                             f"(bound {z_bound[np.argmax(z_err / z_bound)]:.3g})")
-        c.check(not (px_err > px_bound).any(), f"{dt}: clipped end {px_err.max():.3g} px from the exact "
-                                               f"intersection (max error/bound {(px_err / px_bound).max():.3g})")
+        c.check(
+            not (z_err > z_bound).any(),
+            f"{dt}: clipped end off the near plane by {z_err.max():.3g} "
+            f"(bound {z_bound[np.argmax(z_err / z_bound)]:.3g})",
+        )
+        c.check(
+            not (px_err > px_bound).any(),
+            f"{dt}: clipped end {px_err.max():.3g} px from the exact "
+            f"intersection (max error/bound {(px_err / px_bound).max():.3g})",
+        )
         c.stats[dt]["clipped_end_px_error"] = float(px_err.max())
         c.stats[dt]["clipped_end_px_ratio"] = float((px_err / px_bound).max())
         c.stats[dt]["clipped_end_z_error"] = float(z_err.max())
-    c.extra = {"near": near, "per_slope": per_slope,
-               "note": "per slope: worst error and tightest bound over its two edges; float32 cannot "
-                       "resolve depth differences below ~eps32 |p| = 5e-7, so at slopes <= 1e-7 its "
-                       "crossing may be anywhere on the edge (the bound says so via min(|p1-p0|, ...))."}
+    c.extra = {
+        "near": near,
+        "per_slope": per_slope,
+        "note": "per slope: worst error and tightest bound over its two edges; float32 cannot "
+        "resolve depth differences below ~eps32 |p| = 5e-7, so at slopes <= 1e-7 its "
+        "crossing may be anywhere on the edge (the bound says so via min(|p1-p0|, ...)).",
+    }
     _grazing_pyrender(c, pr, world, edges, cam, slopes)
 
 
 # ---- 3 ---------------------------------------------------------------------
+
 
 def fov_extremes(c: CaseRecord, pr: Pyrender) -> None:
     """fov 0.01 deg (f = 2.75e6 px) and 179.9 deg (f = 0.21 px) on a 640x480 image.
@@ -222,8 +268,9 @@ def fov_extremes(c: CaseRecord, pr: Pyrender) -> None:
     """
     # fov 0.01 deg: the image spans 2 * 1e4 * tan(0.005 deg) = 1.75 units vertically at 1e4
     # from an oblique direction: every world axis contributes ~1e4 to x_cam, y_cam (cancelling)
-    cam_small = look_at(1e4 * np.array([0.6, 0.48, 0.64]), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), fov_y_deg=0.01,
-                        near=1.0, far=2e4)
+    cam_small = look_at(
+        1e4 * np.array([0.6, 0.48, 0.64]), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), fov_y_deg=0.01, near=1.0, far=2e4
+    )
     mm = compose(rotate_z(0.3), rotate_y(0.5), rotate_x(0.2))
     m = measure(CUBE_V, mm, cam_small, edges=CUBE_E)
     c.add(m, label="fov 0.01: ")
@@ -241,7 +288,7 @@ def fov_extremes(c: CaseRecord, pr: Pyrender) -> None:
     dirs = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=1)
     p_cam = dirs * rad[:, None]
     basis = np.stack([cam_wide.right, cam_wide.up, cam_wide.forward])
-    pts = p_cam @ basis + cam_wide.position          # inputs (rounded float64 world points)
+    pts = p_cam @ basis + cam_wide.position  # inputs (rounded float64 world points)
     ring = np.arange(len(pts))
     e_wide = np.stack([ring[:-1], ring[1:]], axis=1)
     m2 = measure(pts, None, cam_wide, edges=e_wide)
@@ -251,19 +298,30 @@ def fov_extremes(c: CaseRecord, pr: Pyrender) -> None:
     wide = {dt: public(m2[dt]) for dt in DTYPES}
     wide["opencv"] = public(m2["opencv"])
     wide["project_points"] = {dt: public(m2["pp_" + dt]) for dt in DTYPES}
-    c.extra = {"fov_0.01": dict(small, focal_px=cam_small.focal_px),
-               "fov_179.9": dict(wide, focal_px=cam_wide.focal_px, kappa_f=focal_condition(cam_wide))}
+    c.extra = {
+        "fov_0.01": dict(small, focal_px=cam_small.focal_px),
+        "fov_179.9": dict(wide, focal_px=cam_wide.focal_px, kappa_f=focal_condition(cam_wide)),
+    }
 
 
 # ---- 4 ---------------------------------------------------------------------
 
+
 def _zigzag(width, height, fov=60.0):
     """A camera 4 units up +Z and a zig-zag filling the long side of the image."""
-    cam = look_at((0.0, 0.0, 4.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), fov_y_deg=fov, width=width, height=height,
-                  near=0.1, far=100.0)
+    cam = look_at(
+        (0.0, 0.0, 4.0),
+        (0.0, 0.0, 0.0),
+        (0.0, 1.0, 0.0),
+        fov_y_deg=fov,
+        width=width,
+        height=height,
+        near=0.1,
+        far=100.0,
+    )
     f = cam.focal_px
     n = 41
-    lim_x = 0.95 * (width / 2) / f * 4          # world extent that fills 95 % of each side at depth 4
+    lim_x = 0.95 * (width / 2) / f * 4  # world extent that fills 95 % of each side at depth 4
     lim_y = 0.95 * (height / 2) / f * 4
     if width >= height:
         xs = np.linspace(-lim_x, lim_x, n)
@@ -289,17 +347,24 @@ def aspect_extremes(c: CaseRecord, pr: Pyrender) -> None:
         m = measure(v, mm, cam, edges=e)
         c.add(m, label=f"{w}x{h}: ")
         frame = m["frames"]["float64"]
-        c.check(int(frame.mask.sum()) > max(w, h) // 2, f"{w}x{h}: expected a line across the long side, "
-                                                        f"got {int(frame.mask.sum())} pixels")
+        c.check(
+            int(frame.mask.sum()) > max(w, h) // 2,
+            f"{w}x{h}: expected a line across the long side, got {int(frame.mask.sum())} pixels",
+        )
         scores, note = pr.scores(frame.mask, v, e, cam, mm)
         c.add_pyrender(f"{w}x{h}", scores, note, judged=True)
         if scores is not None:
             c.pyrender_note = "OSMesa renders both 4000x4 and 4x4000 (no size limit hit)"
-        c.extra[f"{w}x{h}"] = {"focal_px": cam.focal_px, "core_pixels": int(frame.mask.sum()),
-                               "float64": public(m["float64"]), "float32": public(m["float32"])}
+        c.extra[f"{w}x{h}"] = {
+            "focal_px": cam.focal_px,
+            "core_pixels": int(frame.mask.sum()),
+            "float64": public(m["float64"]),
+            "float32": public(m["float32"]),
+        }
 
 
 # ---- 5 ---------------------------------------------------------------------
+
 
 def far_from_origin(c: CaseRecord, pr: Pyrender) -> None:
     """a unit cube 1e8 from the world origin seen from 4 units away, placed by the model matrix; by
@@ -313,7 +378,7 @@ def far_from_origin(c: CaseRecord, pr: Pyrender) -> None:
     be rounded), float32 3 eps32 (|p_local| + |t_mv_i|) f / z ~ 5e-4 px (t_mv ~ 4, not 1e8): both
     sub-pixel; OpenCV's bound 8 eps64 (|X| + |position|) f / z (not camera-relative).
     """
-    o = 1e8 * np.array([0.6, 0.48, 0.64])                       # |o| = 1e8
+    o = 1e8 * np.array([0.6, 0.48, 0.64])  # |o| = 1e8
     cam = look_at(o + (0.3, 0.2, 4.0), o, (0.0, 1.0, 0.0), near=0.1, far=100.0)
     rot = compose(rotate_z(0.3), rotate_y(0.5), rotate_x(0.2))
     # (a) unit cube at the model origin, placed by the model matrix's translation
@@ -328,8 +393,13 @@ def far_from_origin(c: CaseRecord, pr: Pyrender) -> None:
     # float64, so here the 3 eps64 F term of the bound is real (core ~ OpenCV's error)
     a_c = compose(rotate_z(0.7), rotate_x(0.4))
     ao = reference_world(o[None, :], a_c[:3, :3], np.zeros(3))[0]
-    cam_c = look_at((ao + np.array([0.3, 0.2, 4.0], dtype=LD)).astype(np.float64), ao.astype(np.float64),
-                    (0.0, 1.0, 0.0), near=0.1, far=100.0)
+    cam_c = look_at(
+        (ao + np.array([0.3, 0.2, 4.0], dtype=LD)).astype(np.float64),
+        ao.astype(np.float64),
+        (0.0, 1.0, 0.0),
+        near=0.1,
+        far=100.0,
+    )
     vc = (reference_world(CUBE_V, rot[:3, :3] @ a_c[:3, :3].T, o)).astype(np.float64)
     mc = measure(vc, a_c, cam_c, edges=CUBE_E)
     c.add(mc, label="vertices at 1e8, rotated: ")
@@ -337,8 +407,10 @@ def far_from_origin(c: CaseRecord, pr: Pyrender) -> None:
     for dt in DTYPES:
         worst = max(ma[dt]["max_error_px"], mb[dt]["max_error_px"], mc[dt]["max_error_px"])
         c.check(worst < 0.5, f"{dt}: {worst:.3g} px: expected sub-pixel")
-    c.check(bool(np.array_equal(ma["frames"]["float64"].mask, mb["frames"]["float64"].mask)),
-            "the two placements draw different float64 frames")
+    c.check(
+        bool(np.array_equal(ma["frames"]["float64"].mask, mb["frames"]["float64"].mask)),
+        "the two placements draw different float64 frames",
+    )
     c.extra = {
         "model_matrix": {dt: public(ma[dt]) for dt in DTYPES} | {"opencv": public(ma["opencv"])},
         "vertices_at_1e8": {dt: public(mb[dt]) for dt in DTYPES} | {"opencv": public(mb["opencv"])},
@@ -350,11 +422,14 @@ def far_from_origin(c: CaseRecord, pr: Pyrender) -> None:
     sb, note = pr.scores(mb["frames"]["float64"].mask, vb, CUBE_E, cam)
     c.add_pyrender("vertices at 1e8", sb, note, judged=False)
     if sa is not None:
-        c.pyrender_note = ("information only: pyrender/GL is float32 and not camera-relative, at 1e8 "
-                           "float32 spacing is 8 units, larger than the cube")
+        c.pyrender_note = (
+            "information only: pyrender/GL is float32 and not camera-relative, at 1e8 "
+            "float32 spacing is 8 units, larger than the cube"
+        )
 
 
 # ---- 6 ---------------------------------------------------------------------
+
 
 def subpixel_object(c: CaseRecord, pr: Pyrender) -> None:
     """a unit cube 1e5 away: the whole cube is < 0.01 px on screen.
@@ -377,7 +452,7 @@ def subpixel_object(c: CaseRecord, pr: Pyrender) -> None:
     extent = float(np.ptp(ref_px, axis=0).max())
     c.extra = {"screen_extent_px": extent, "centre_px": centre_px.tolist()}
     c.check(extent < 0.01, f"the cube covers {extent:.3g} px: expected < 0.01 (test design)")
-    rc = np.floor(ref_px.mean(axis=0) + 0.5)                    # the pixel under the cube
+    rc = np.floor(ref_px.mean(axis=0) + 0.5)  # the pixel under the cube
     for dt in DTYPES:
         mask = m["frames"][dt].mask
         rows, cols = np.nonzero(mask)
@@ -391,11 +466,14 @@ def subpixel_object(c: CaseRecord, pr: Pyrender) -> None:
         c.check(scores["pyrender_pixels"] <= 4, f"pyrender drew {scores['pyrender_pixels']} pixels: expected <= 4")
     c.add_pyrender("cube", scores, note, judged=False)
     if scores is not None:
-        c.pyrender_note = ("F1 not judged: whether a line shorter than 0.01 px lights a pixel is decided "
-                           "by sub-pixel tie rules; both must draw <= 4 pixels")
+        c.pyrender_note = (
+            "F1 not judged: whether a line shorter than 0.01 px lights a pixel is decided "
+            "by sub-pixel tie rules; both must draw <= 4 pixels"
+        )
 
 
 # ---- 7 ---------------------------------------------------------------------
+
 
 def rotation_period(c: CaseRecord, pr: Pyrender) -> None:
     """Motion(turns=(1000, 3000, 500)) over 1,000,000 frames has period 2000: frame k and k + 2000 give
@@ -430,22 +508,34 @@ def rotation_period(c: CaseRecord, pr: Pyrender) -> None:
             same_img = a.image.tobytes() == b.image.tobytes()
             identical["p_px"] &= same_px
             identical["image"] &= same_img
-            c.check(same_px and same_img, f"{dt}: frames {k} and {k + period} differ in "
-                                          f"{'p_px' if not same_px else 'image'}")
-        m = measure(CUBE_V, m0, cam, edges=CUBE_E, model_err=motion_matrix_error(), a_ld=a_ld, t_ld=t_ld,
-                     frames=fr[k])
+            c.check(
+                same_px and same_img,
+                f"{dt}: frames {k} and {k + period} differ in {'p_px' if not same_px else 'image'}",
+            )
+        m = measure(CUBE_V, m0, cam, edges=CUBE_E, model_err=motion_matrix_error(), a_ld=a_ld, t_ld=t_ld, frames=fr[k])
         c.add(m, label=f"frame {k}: ")
-    c.check(mat_err <= motion_matrix_error(), f"model matrix {mat_err:.3g} from the exact rotation: expected <= 16 eps64")
+    c.check(
+        mat_err <= motion_matrix_error(), f"model matrix {mat_err:.3g} from the exact rotation: expected <= 16 eps64"
+    )
     # the last frame of the run closes the loop: frame 1 + frames is frame 1 again
-    c.check(motion.frame_matrix(1, frames).tobytes() == motion.frame_matrix(1 + frames, frames).tobytes(),
-            "frame 1 + frames differs from frame 1")
-    c.extra = {"turns": list(turns), "frames": frames, "period": period, "sampled_k": ks,
-               "bit_identical": identical, "matrix_error_vs_exact": mat_err,
-               "matrix_error_bound": motion_matrix_error()}
+    c.check(
+        motion.frame_matrix(1, frames).tobytes() == motion.frame_matrix(1 + frames, frames).tobytes(),
+        "frame 1 + frames differs from frame 1",
+    )
+    c.extra = {
+        "turns": list(turns),
+        "frames": frames,
+        "period": period,
+        "sampled_k": ks,
+        "bit_identical": identical,
+        "matrix_error_vs_exact": mat_err,
+        "matrix_error_bound": motion_matrix_error(),
+    }
     c.pyrender_note = "not needed: the check is bit-identity between core's own frames"
 
 
 # ---- 8 ---------------------------------------------------------------------
+
 
 def gimbal_lock(c: CaseRecord, pr: Pyrender) -> None:
     """pitch exactly +-90 deg (Ry at 1/4 and 3/4 turn) with roll and yaw; cameras looking straight down
@@ -455,7 +545,7 @@ def gimbal_lock(c: CaseRecord, pr: Pyrender) -> None:
     -----
     R^T R - I: orthonormality_error; pixels: pixel_bound with model_err = motion_matrix_error.
     """
-    turns, frames = (3, 2, 5), 8            # frame 2: phases (3/8, 1/4, 5/8); frame 4: (1/8, 3/4, 7/8)
+    turns, frames = (3, 2, 5), 8  # frame 2: phases (3/8, 1/4, 5/8); frame 4: (1/8, 3/4, 7/8)
     motion = Motion(turns=tuple(float(t) for t in turns), offset=(0.1, -0.2, 0.3))
     cam = look_at((0.3, 0.2, 4.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
     ortho_err = 0.0
@@ -489,5 +579,13 @@ def gimbal_lock(c: CaseRecord, pr: Pyrender) -> None:
 
 
 #: The cases in suite order.
-CASES = (near_plane, near_grazing, fov_extremes, aspect_extremes, far_from_origin, subpixel_object,
-         rotation_period, gimbal_lock)
+CASES = (
+    near_plane,
+    near_grazing,
+    fov_extremes,
+    aspect_extremes,
+    far_from_origin,
+    subpixel_object,
+    rotation_period,
+    gimbal_lock,
+)

@@ -8,15 +8,14 @@ edge-pixel F1.
 from __future__ import annotations
 
 import numpy as np
-
 from wirecheck.core.projector.pipeline import render_frame
 from wirecheck.core.projector.projection import DTYPES, project_points
 
 from ..judge import metrics
 from ..references import opencv_oracle
+from ..references.pyrender_oracle import OracleCache, osmesa_available
 from .bounds import EPS, EPS64, camera_error, near_band, opencv_camera_error, pixel_bound
 from .reference import LD, reference_project, reference_world
-from ..references.pyrender_oracle import OracleCache, osmesa_available
 
 
 def err_px(a_px, ref_px) -> np.ndarray:
@@ -33,10 +32,15 @@ def stats(px, visible, ref_px, ref_visible, bound, band=None) -> dict:
     """
     both = visible & ref_visible
     flips = visible != ref_visible
-    out = {"points": int(len(px)), "compared": int(both.sum()),
-           "visible_mismatch": int(flips.sum()),
-           "visible_mismatch_outside_band": int(flips.sum() if band is None else (flips & ~band).sum()),
-           "max_error_px": None, "bound_px": None, "max_ratio": None}
+    out = {
+        "points": int(len(px)),
+        "compared": int(both.sum()),
+        "visible_mismatch": int(flips.sum()),
+        "visible_mismatch_outside_band": int(flips.sum() if band is None else (flips & ~band).sum()),
+        "max_error_px": None,
+        "bound_px": None,
+        "max_ratio": None,
+    }
     if both.any():
         err = err_px(px[both], ref_px[both])
         b = bound[both]
@@ -53,8 +57,7 @@ def within(s: dict) -> bool:
     return s["max_ratio"] is None or s["max_ratio"] <= 1.0
 
 
-def measure(p_model, model_matrix, camera, *, edges=None, model_err=0.0, a_ld=None, t_ld=None,
-            frames=None) -> dict:
+def measure(p_model, model_matrix, camera, *, edges=None, model_err=0.0, a_ld=None, t_ld=None, frames=None) -> dict:
     """core in both dtypes, its world path and OpenCV against the long-double reference.
 
     Parameters
@@ -85,8 +88,7 @@ def measure(p_model, model_matrix, camera, *, edges=None, model_err=0.0, a_ld=No
         frame = render_frame(p_model, edges, camera, m, dtype=dt) if frames is None else frames[dt]
         e_cam = camera_error(dt, p_model, m, camera, model_err)
         bound = pixel_bound(ref_cam, ref_px, camera, e_cam, EPS[dt])
-        out[dt] = stats(frame.p_px, frame.visible, ref_px, ref_vis, bound,
-                        near_band(ref_cam, camera, e_cam, EPS[dt]))
+        out[dt] = stats(frame.p_px, frame.visible, ref_px, ref_vis, bound, near_band(ref_cam, camera, e_cam, EPS[dt]))
         out["frames"][dt] = frame
     # OpenCV on the world points (rounded to float64 once: part of its input error)
     a = m[:3, :3] if a_ld is None else a_ld
@@ -95,15 +97,21 @@ def measure(p_model, model_matrix, camera, *, edges=None, model_err=0.0, a_ld=No
     cv_px = opencv_oracle.project(p_world, camera)
     e_cv = opencv_camera_error(p_world, camera)
     cv_bound = pixel_bound(ref_cam, ref_px, camera, e_cv, EPS64)
-    out["opencv"] = stats(cv_px, ~np.isnan(cv_px[:, 0]), ref_px, ref_vis, cv_bound,
-                          near_band(ref_cam, camera, e_cv, EPS64))
+    out["opencv"] = stats(
+        cv_px, ~np.isnan(cv_px[:, 0]), ref_px, ref_vis, cv_bound, near_band(ref_cam, camera, e_cv, EPS64)
+    )
     # core's world path (project_points, crosscheck's candidate contract) on the same world points
     for dt in DTYPES:
         pp = project_points(p_world, camera, dt)
-        e_w = camera_error(dt, p_world, None, camera, model_err)     # project_points: model-view path, A = I
-        out["pp_" + dt] = stats(pp, ~np.isnan(pp[:, 0]), ref_px, ref_vis,
-                                pixel_bound(ref_cam, ref_px, camera, e_w, EPS[dt]),
-                                near_band(ref_cam, camera, e_w, EPS[dt]))
+        e_w = camera_error(dt, p_world, None, camera, model_err)  # project_points: model-view path, A = I
+        out["pp_" + dt] = stats(
+            pp,
+            ~np.isnan(pp[:, 0]),
+            ref_px,
+            ref_vis,
+            pixel_bound(ref_cam, ref_px, camera, e_w, EPS[dt]),
+            near_band(ref_cam, camera, e_w, EPS[dt]),
+        )
     f64 = out["frames"]["float64"]
     both = f64.visible & ~np.isnan(cv_px[:, 0])
     out["float64"]["vs_opencv_px"] = float(err_px(f64.p_px[both], cv_px[both]).max()) if both.any() else None
@@ -131,13 +139,18 @@ class Pyrender:
         if not self.enabled:
             return None, self.note
         try:
-            mask, _ = self.oracles.get(camera.width, camera.height).render(vertices, edges, camera,
-                                                                           model_matrix=model_matrix)
+            mask, _ = self.oracles.get(camera.width, camera.height).render(
+                vertices, edges, camera, model_matrix=model_matrix
+            )
         except Exception as exc:  # OSMesa may refuse a size: say so
             return None, f"pyrender failed: {type(exc).__name__}: {exc}"
         s = metrics.pixel_scores(frame_mask, mask)
-        return {"f1_0px": s["f1_0px"], "f1_1px": s["f1_1px"], "core_pixels": s["candidate_pixels"],
-                "pyrender_pixels": s["oracle_pixels"]}, None
+        return {
+            "f1_0px": s["f1_0px"],
+            "f1_1px": s["f1_1px"],
+            "core_pixels": s["candidate_pixels"],
+            "pyrender_pixels": s["oracle_pixels"],
+        }, None
 
     def close(self):
         """Release the GL contexts; :attr:`gl` keeps the GL that drew (None if nothing was drawn)."""

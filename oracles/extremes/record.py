@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from wirecheck.core.projector.projection import DTYPES
 
 from ..tolerances import MIN_F1_1PX_EXTREMES
@@ -22,7 +21,7 @@ def json_float(v):
     v = float(v)
     if math.isnan(v):
         return None
-    return v if math.isfinite(v) else ("inf" if v > 0 else "-inf")     # strict JSON has no inf
+    return v if math.isfinite(v) else ("inf" if v > 0 else "-inf")  # strict JSON has no inf
 
 
 def jsonable(x):
@@ -82,16 +81,22 @@ class CaseRecord:
         for dt in DTYPES + tuple("pp_" + d for d in DTYPES):
             s = m[dt]
             if not within(s):
-                self.fail(f"{label}{dt.replace('pp_', 'project_points ')}: error {s['max_error_px']:.3g} px "
-                          f"exceeds its bound "
-                          f"(max error/bound {s['max_ratio']:.3g})")
+                self.fail(
+                    f"{label}{dt.replace('pp_', 'project_points ')}: error {s['max_error_px']:.3g} px "
+                    f"exceeds its bound "
+                    f"(max error/bound {s['max_ratio']:.3g})"
+                )
             if s["visible_mismatch_outside_band"]:
-                self.fail(f"{label}{dt.replace('pp_', 'project_points ')}: "
-                          f"{s['visible_mismatch_outside_band']} points visible/clipped unlike "
-                          f"the reference, farther than rounding from near/far")
+                self.fail(
+                    f"{label}{dt.replace('pp_', 'project_points ')}: "
+                    f"{s['visible_mismatch_outside_band']} points visible/clipped unlike "
+                    f"the reference, farther than rounding from near/far"
+                )
         if not within(m["opencv"]):
-            self.fail(f"{label}reference and OpenCV disagree beyond OpenCV's bound "
-                      f"(ratio {m['opencv']['max_ratio']:.3g}): check the reference")
+            self.fail(
+                f"{label}reference and OpenCV disagree beyond OpenCV's bound "
+                f"(ratio {m['opencv']['max_ratio']:.3g}): check the reference"
+            )
 
     def check(self, ok: bool, reason: str):
         if not ok:
@@ -114,9 +119,11 @@ class CaseRecord:
         pyr = None
         if self.pyrender_parts:
             parts = self.pyrender_parts
-            pyr = {"f1_0px": min(p["f1_0px"] for p in parts.values()),
-                   "f1_1px": min(p["f1_1px"] for p in parts.values()),
-                   "frames": parts}
+            pyr = {
+                "f1_0px": min(p["f1_0px"] for p in parts.values()),
+                "f1_1px": min(p["f1_1px"] for p in parts.values()),
+                "frames": parts,
+            }
             judged = [p for p in parts.values() if p["judged"]]
             pyr["f1_1px_judged"] = min(p["f1_1px"] for p in judged) if judged else None
         return {
@@ -127,7 +134,8 @@ class CaseRecord:
             "float32": public(self.stats["float32"]),
             "opencv": public(self.stats["opencv"]),
             "project_points": {dt: public(self.stats["pp_" + dt]) for dt in DTYPES}
-            if self.stats["pp_float64"] is not None else None,
+            if self.stats["pp_float64"] is not None
+            else None,
             "pyrender": pyr,
             "pyrender_note": self.pyrender_note,
             "details": jsonable(self.extra),

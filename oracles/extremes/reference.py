@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 LD = np.longdouble
-PI_LD = 4 * np.arctan(LD(1))            # atanl: pi to 64 bits (np.pi is only 53)
+PI_LD = 4 * np.arctan(LD(1))  # atanl: pi to 64 bits (np.pi is only 53)
 #: eps of the reference's long double: 1.1e-19 for x87 80-bit (x86-64 Linux), 1.9e-34 for
 #: IEEE quad (aarch64 Linux), 2.2e-16 where long double is just double (MSVC, macOS arm64):
 #: there the reference is no better than core's float64 and the float64 bounds are not meaningful.
@@ -63,7 +63,7 @@ def reference_project(p_model, camera, model_matrix=None, *, a_ld=None, t_ld=Non
     m = np.eye(4) if model_matrix is None else np.asarray(model_matrix, np.float64)
     a = np.asarray(m[:3, :3] if a_ld is None else a_ld, dtype=LD)
     t = np.asarray(m[:3, 3] if t_ld is None else t_ld, dtype=LD)
-    rel = p @ a.T + (t - np.asarray(camera.position, dtype=LD))        # p_world - position
+    rel = p @ a.T + (t - np.asarray(camera.position, dtype=LD))  # p_world - position
     p_cam = rel @ reference_basis(camera).T
     z = p_cam[:, 2]
     visible = (z >= LD(camera.near)) & (z <= LD(camera.far))

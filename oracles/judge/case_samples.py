@@ -28,11 +28,11 @@ class CaseSamples:
     """
 
     def __init__(self):
-        self.frames = 0                    # frames added
+        self.frames = 0  # frames added
         self.counts = dict.fromkeys(COUNTS, 0)
-        self._cols = None                  # field -> one array of the joined frames' samples
+        self._cols = None  # field -> one array of the joined frames' samples
         self._lens = np.zeros(0, np.intp)  # samples of each joined frame
-        self._new = []                     # frames added since, as measure() gave them
+        self._new = []  # frames added since, as measure() gave them
 
     def __len__(self) -> int:
         return self.frames
@@ -78,5 +78,6 @@ class CaseSamples:
 
     def arrays(self) -> list:
         """Every array held (for a test of what memory the samples keep)."""
-        return ([] if self._cols is None else list(self._cols.values())) + [v for x in self._new for v in x.values()
-                                                                          if isinstance(v, np.ndarray)]
+        return ([] if self._cols is None else list(self._cols.values())) + [
+            v for x in self._new for v in x.values() if isinstance(v, np.ndarray)
+        ]

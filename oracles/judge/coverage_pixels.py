@@ -36,8 +36,8 @@ RIDGE_MIN = int(255 * RIDGE_MIN_WIDTH_PX / 2)
 def drawn(grey: np.ndarray) -> np.ndarray:
     """``(H, W)`` bool: the pixels of the antialiased frame ``grey`` (uint8) drawn (module docstring)."""
     g = np.asarray(grey).astype(np.int16)
-    pad = np.pad(g, 1)                                       # outside the image: background
+    pad = np.pad(g, 1)  # outside the image: background
     ridge = np.zeros(g.shape, bool)
-    for a, b in ((pad[1:-1, :-2], pad[1:-1, 2:]), (pad[:-2, 1:-1], pad[2:, 1:-1])):    # the row, the column
+    for a, b in ((pad[1:-1, :-2], pad[1:-1, 2:]), (pad[:-2, 1:-1], pad[2:, 1:-1])):  # the row, the column
         ridge |= (g >= a) & (g >= b) & ((g > a) | (g > b))
     return (g >= 128) | ((g >= RIDGE_MIN) & ridge)

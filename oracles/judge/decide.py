@@ -33,16 +33,26 @@ from typing import Any
 
 import numpy as np
 
+from .. import faults as catalogue
+from ..diagnosis.diagnose import diagnose_lines
+from ..faults import Fault
+from ..references.oracle_precision import ORACLE_LIMIT_PX
+from ..tolerances import NAMING, Tolerances, line_failures
 from . import gate
 from .evidence import CaseEvidence, Radius, StyleRead
-from ..faults import Fault
-from .. import faults as catalogue
-from ..tolerances import NAMING, Tolerances, line_failures
-from ..diagnosis.diagnose import diagnose_lines
-from ..references.oracle_precision import ORACLE_LIMIT_PX
 
-__all__ = ["Verdict", "StyleJudgement", "decide", "judge_style", "gl_rule_reasons", "rounded_rule_failures",
-           "pixel_fields", "line_faults", "RULE_FAULTS", "ROUNDED_RULE_NAME"]
+__all__ = [
+    "Verdict",
+    "StyleJudgement",
+    "decide",
+    "judge_style",
+    "gl_rule_reasons",
+    "rounded_rule_failures",
+    "pixel_fields",
+    "line_faults",
+    "RULE_FAULTS",
+    "ROUNDED_RULE_NAME",
+]
 
 #: Faults a correct drawing under another aliased rule leaves under GL's: the diagnosis may name only these
 #: for the pixels to be read as the rounded-ends rule's correct drawing (their own names give way to it).
@@ -83,7 +93,6 @@ class StyleJudgement:
 class Verdict:
     """A case's verdict (``"pass"``, ``"fail"``, ``"vacuous"``), its reasons, and the style's judgement."""
 
-
     verdict: str
     reasons: tuple[str, ...]
     style: StyleJudgement | None = None
@@ -99,10 +108,14 @@ def pixel_fields(pixel: dict, worst_frame) -> dict:
     reported beside it. ``worst_frame``: the frame with the lowest (F1@1px, F1@0px).
     """
     return {
-        "pixel_f1_0px": float(min(pixel["f1_0px"])), "pixel_f1_1px": float(min(pixel["f1_1px"])),
-        "pixel_f1_0px_mean": float(np.mean(pixel["f1_0px"])), "pixel_f1_1px_mean": float(np.mean(pixel["f1_1px"])),
-        "pixel_precision_0px": float(min(pixel["precision_0px"])), "pixel_recall_0px": float(min(pixel["recall_0px"])),
-        "pixel_precision_1px": float(min(pixel["precision_1px"])), "pixel_recall_1px": float(min(pixel["recall_1px"])),
+        "pixel_f1_0px": float(min(pixel["f1_0px"])),
+        "pixel_f1_1px": float(min(pixel["f1_1px"])),
+        "pixel_f1_0px_mean": float(np.mean(pixel["f1_0px"])),
+        "pixel_f1_1px_mean": float(np.mean(pixel["f1_1px"])),
+        "pixel_precision_0px": float(min(pixel["precision_0px"])),
+        "pixel_recall_0px": float(min(pixel["recall_0px"])),
+        "pixel_precision_1px": float(min(pixel["precision_1px"])),
+        "pixel_recall_1px": float(min(pixel["recall_1px"])),
         "worst_pixel_frame": worst_frame,
     }
 
@@ -121,24 +134,32 @@ def _vertex_reasons(v, tol: Tolerances) -> list[str]:
         bound = v.get("vertex_bound_px", tol.vertex_px)
         if v["max_vertex_error_px"] > bound:
             judged = (v.get("precision") or {}).get("judged_as", "float64")
-            out.append(f"max vertex error {v['max_vertex_error_px']:.3g} px > {bound:.3g} px "
-                       f"({judged} bound; frame {v['worst_vertex']['frame']}, "
-                       f"vertex {v['worst_vertex']['vertex']})")
+            out.append(
+                f"max vertex error {v['max_vertex_error_px']:.3g} px > {bound:.3g} px "
+                f"({judged} bound; frame {v['worst_vertex']['frame']}, "
+                f"vertex {v['worst_vertex']['vertex']})"
+            )
     vm = v.get("visibility_mismatch")
     if vm is not None and (vm["candidate_only"] or vm["oracle_only"]):
-        out.append(f"visible sets differ: {vm['candidate_only']} points shown only by the candidate, "
-                   f"{vm['oracle_only']} only by the oracle")
+        out.append(
+            f"visible sets differ: {vm['candidate_only']} points shown only by the candidate, "
+            f"{vm['oracle_only']} only by the oracle"
+        )
     return out
 
 
 def _radius_reasons(px: Mapping[str, Any], r: Radius | None, tol: Tolerances) -> list[str]:
     """F1 at the radius the lines' width allows (``r``, oracles.judge.f1_radius; None: F1@1px of the pixel
     fields ``px``), held to ``min_f1_1px``."""
-    radius, f1, frame = ((r.radius_px, r.f1, r.frame) if r is not None
-                         else (1, px["pixel_f1_1px"], px["worst_pixel_frame"]))
+    radius, f1, frame = (
+        (r.radius_px, r.f1, r.frame) if r is not None else (1, px["pixel_f1_1px"], px["worst_pixel_frame"])
+    )
     if f1 < tol.min_f1_1px:
-        return [f"pixel F1@{radius}px {f1:.4f} < {tol.min_f1_1px} (frame {frame}"
-                + ("; lines read wider than 1 px" if radius > 1 else "") + ")"]
+        return [
+            f"pixel F1@{radius}px {f1:.4f} < {tol.min_f1_1px} (frame {frame}"
+            + ("; lines read wider than 1 px" if radius > 1 else "")
+            + ")"
+        ]
     return []
 
 
@@ -160,13 +181,18 @@ def rounded_rule_failures(rounded, tol: Tolerances) -> list[str]:
     out = []
     floor = max(tol.min_f1_0px, tol.rule_f1_0px)
     if rounded["pixel_f1_0px"] < floor:
-        out.append(f"pixel F1@0px {rounded['pixel_f1_0px']:.4f} < {floor} against the rounded-ends "
-                   "rule too")
+        out.append(f"pixel F1@0px {rounded['pixel_f1_0px']:.4f} < {floor} against the rounded-ends rule too")
     return out + [f"{r} (the rounded-ends rule)" for r in line_failures(rounded["lines"], tol)]
 
 
-def judge_style(s: StyleRead, pf0: float, diagnosed: tuple[Fault, ...], tol: Tolerances, gl_reasons: list[str],
-                radius_reasons: list[str]) -> StyleJudgement:
+def judge_style(
+    s: StyleRead,
+    pf0: float,
+    diagnosed: tuple[Fault, ...],
+    tol: Tolerances,
+    gl_reasons: list[str],
+    radius_reasons: list[str],
+) -> StyleJudgement:
     """The style read ``s`` held to ``tol``: the centres' bounds and the rule read (:class:`StyleJudgement`).
 
     ``pf0``: the case's F1@0px against GL's rule; ``diagnosed``: what the diagnosis named
@@ -189,19 +215,28 @@ def judge_style(s: StyleRead, pf0: float, diagnosed: tuple[Fault, ...], tol: Tol
     moved = s.placed and max(abs(d[0]), abs(d[1])) > offset_tol
     warped = s.placed and geo["warp_px"] > warp_tol
     end = geo["end_px"]
-    end_out = bool(s.placed and geo["ends_measured"] >= NAMING.min_ends
-                   and (end < -tol.end_px or end > read["width_px"] / 2 + tol.end_px))
+    end_out = bool(
+        s.placed
+        and geo["ends_measured"] >= NAMING.min_ends
+        and (end < -tol.end_px or end > read["width_px"] / 2 + tol.end_px)
+    )
     failures = []
     if s.placed and not s.by_rule:
         if moved:
-            failures.append(f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {offset_tol:.3g} "
-                            f"({s.style} lines, {geo['samples']} samples)")
+            failures.append(
+                f"line centres offset by ({d[0]:.2f}, {d[1]:.2f}) px > {offset_tol:.3g} "
+                f"({s.style} lines, {geo['samples']} samples)"
+            )
         if end_out:
-            failures.append(f"line ends {end:+.2f} px from the segments' ends: expected "
-                            f"{-tol.end_px} to {read['width_px'] / 2 + tol.end_px:.2f} ({s.style} lines)")
+            failures.append(
+                f"line ends {end:+.2f} px from the segments' ends: expected "
+                f"{-tol.end_px} to {read['width_px'] / 2 + tol.end_px:.2f} ({s.style} lines)"
+            )
         if warped:
-            failures.append(f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
-                            f"or shear > {warp_tol:.3g} ({s.style} lines)")
+            failures.append(
+                f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
+                f"or shear > {warp_tol:.3g} ({s.style} lines)"
+            )
     only_gl = bool(gl_reasons) and not radius_reasons
     only_rule = only_gl and all(f.name in RULE_FAULTS for f in diagnosed)
     rule_read: str | None = None
@@ -210,22 +245,36 @@ def judge_style(s: StyleRead, pf0: float, diagnosed: tuple[Fault, ...], tol: Tol
     if s.by_rule and rounded is not None:
         rounded_failures = tuple(rounded_rule_failures(rounded, tol))
         rf0 = rounded["pixel_f1_0px"]
-        rule_read = "rounded" if (not rounded_failures and not gl_reasons and not moved and not warped
-                                  and rf0 > pf0) else "gl"
+        rule_read = (
+            "rounded" if (not rounded_failures and not gl_reasons and not moved and not warped and rf0 > pf0) else "gl"
+        )
         if not rounded_failures and not moved and not warped and only_rule:
             rule_read, rounded_case = "rounded", "correct"
-            if s.line_rule == "gl":                     # another rule's correct drawing, named; no count deficit
-                failures.append(f"the pixels are a correct drawing by another rule than GL's ({ROUNDED_RULE_NAME}: "
-                                f"F1@0px {rf0:.4f} against it, {pf0:.4f} against GL's)")
+            if s.line_rule == "gl":  # another rule's correct drawing, named; no count deficit
+                failures.append(
+                    f"the pixels are a correct drawing by another rule than GL's ({ROUNDED_RULE_NAME}: "
+                    f"F1@0px {rf0:.4f} against it, {pf0:.4f} against GL's)"
+                )
         elif s.line_rule == "any" and only_rule and pf0 < rf0 and rf0 >= max(tol.min_f1_0px, tol.rule_f1_0px):
             # the rounded-ends rule's pixels but for a bias of its one-sided pixels (a dropped end pixel)
             rule_read, rounded_case = "rounded", "biased"
             failures += rounded_failures
     elif s.by_rule:
         rule_read = "gl"
-    return StyleJudgement(offset_tol, warp_tol, moved, warped, end_out, rounded_failures, rule_read, rounded_case,
-                          pixel_rule=s.by_rule and rule_read != "rounded", gl_reasons=tuple(gl_reasons),
-                          only_gl=only_gl, failures=tuple(failures))
+    return StyleJudgement(
+        offset_tol,
+        warp_tol,
+        moved,
+        warped,
+        end_out,
+        rounded_failures,
+        rule_read,
+        rounded_case,
+        pixel_rule=s.by_rule and rule_read != "rounded",
+        gl_reasons=tuple(gl_reasons),
+        only_gl=only_gl,
+        failures=tuple(failures),
+    )
 
 
 def _blank(frames: list, what: str) -> list[str]:
@@ -233,8 +282,10 @@ def _blank(frames: list, what: str) -> list[str]:
     if not frames:
         return []
     shown = ", ".join(map(str, frames[:5])) + (", ..." if len(frames) > 5 else "")
-    return [f"{what} blank where the reference shows a surface (frame{'s' if len(frames) > 1 else ''} {shown}): "
-            "nothing compared there"]
+    return [
+        f"{what} blank where the reference shows a surface (frame{'s' if len(frames) > 1 else ''} {shown}): "
+        "nothing compared there"
+    ]
 
 
 def depth_map_reasons(d: dict, tol: Tolerances) -> list[str]:
@@ -242,18 +293,26 @@ def depth_map_reasons(d: dict, tol: Tolerances) -> list[str]:
     out = []
     if d["max_error_ratio"] is not None and d["max_error_ratio"] > tol.max_depth_error_ratio:
         r, c = d["worst_pixel"]
-        out.append(f"depth error {d['max_error']:.3g} is {d['max_error_ratio']:.3g} x its bound "
-                   f"(> {tol.max_depth_error_ratio:g}; frame {d['worst_frame']}, row {r}, column {c})")
+        out.append(
+            f"depth error {d['max_error']:.3g} is {d['max_error_ratio']:.3g} x its bound "
+            f"(> {tol.max_depth_error_ratio:g}; frame {d['worst_frame']}, row {r}, column {c})"
+        )
     if d["reference_px"] and not d["compared_px"]:
-        out.append(f"depth maps compare nothing: no pixel shows a surface on both sides "
-                   f"({d['reference_px']} reference pixels): never a pass")
+        out.append(
+            f"depth maps compare nothing: no pixel shows a surface on both sides "
+            f"({d['reference_px']} reference pixels): never a pass"
+        )
     out += _blank(d["blank_frames"], "depth map")
     if d["holes_px"] > tol.max_surface_holes_px:
-        out.append(f"depth map: {d['holes_px']} pixels of the reference's surface left empty away from its "
-                   f"silhouette's boundary (> {tol.max_surface_holes_px}; most in frame {d['holes_worst_frame']})")
+        out.append(
+            f"depth map: {d['holes_px']} pixels of the reference's surface left empty away from its "
+            f"silhouette's boundary (> {tol.max_surface_holes_px}; most in frame {d['holes_worst_frame']})"
+        )
     if d["extra_px"] > tol.max_surface_extra_px:
-        out.append(f"depth map: {d['extra_px']} pixels of surface where the reference has none, away from its "
-                   f"silhouette's boundary (> {tol.max_surface_extra_px}; most in frame {d['extra_worst_frame']})")
+        out.append(
+            f"depth map: {d['extra_px']} pixels of surface where the reference has none, away from its "
+            f"silhouette's boundary (> {tol.max_surface_extra_px}; most in frame {d['extra_worst_frame']})"
+        )
     return out
 
 
@@ -263,31 +322,40 @@ def filled_reasons(f: dict, tol: Tolerances) -> list[str]:
     out = _blank(f["blank_frames"], "filled frame")
     if f["longest_run_px"] > tol.max_silhouette_run_px:
         r, c = f["run_at"]
-        out.append(f"filled silhouette: {f['longest_run_px']} decided pixels missing or added in one run (frame "
-                   f"{f['run_frame']}, row {r}, column {c}; > {tol.max_silhouette_run_px}); {f['holes_px']} holes, "
-                   f"{f['extra_px']} extra in all")
+        out.append(
+            f"filled silhouette: {f['longest_run_px']} decided pixels missing or added in one run (frame "
+            f"{f['run_frame']}, row {r}, column {c}; > {tol.max_silhouette_run_px}); {f['holes_px']} holes, "
+            f"{f['extra_px']} extra in all"
+        )
     if f["min_iou"] is not None and f["min_iou"] < tol.min_iou:
         out.append(f"filled silhouette IoU {f['min_iou']:.4f} < {tol.min_iou} (frame {f['iou_worst_frame']})")
     if f.get("object_id_px") is not None and f["object_id_px"] > tol.max_object_id_px:
-        out.append(f"filled frames: {f['object_id_px']} decided pixels show another object's id than the "
-                   f"reference's (> {tol.max_object_id_px}; most in frame {f['object_id_worst_frame']})")
+        out.append(
+            f"filled frames: {f['object_id_px']} decided pixels show another object's id than the "
+            f"reference's (> {tol.max_object_id_px}; most in frame {f['object_id_worst_frame']})"
+        )
     return out
 
 
 def _shaded_reasons(sh, tol: Tolerances) -> list[str]:
     out = []
     if sh["silhouette_mismatch_inside"]:
-        out.append(f"{sh['silhouette_mismatch_inside']} pixels covered by one side only lie inside its "
-                   "silhouette, not on its boundary (a hole or a misplaced region)")
+        out.append(
+            f"{sh['silhouette_mismatch_inside']} pixels covered by one side only lie inside its "
+            "silhouette, not on its boundary (a hole or a misplaced region)"
+        )
     if sh["silhouette_iou_gated"] is not None and sh["silhouette_iou_gated"] < tol.min_iou:
-        out.append(f"silhouette IoU {sh['silhouette_iou_gated']:.4f} < {tol.min_iou} "
-                   f"(frame {sh['worst_pixel_frame']})")
+        out.append(f"silhouette IoU {sh['silhouette_iou_gated']:.4f} < {tol.min_iou} (frame {sh['worst_pixel_frame']})")
     if sh["face_disagreements_inside"]:
-        out.append(f"{sh['face_disagreements_inside']} pixels show a different face than the oracle "
-                   "away from any boundary between the two faces (a visibility error)")
+        out.append(
+            f"{sh['face_disagreements_inside']} pixels show a different face than the oracle "
+            "away from any boundary between the two faces (a visibility error)"
+        )
     if sh["depth_error_ratio"] is not None and sh["depth_error_ratio"] > 1.0:
-        out.append(f"depth error {sh['depth_max_error']:.3g} > its bound {sh['depth_error_bound']:.3g} "
-                   f"(error/bound up to {sh['depth_error_ratio']:.3g}, frame {sh['depth_worst_frame']})")
+        out.append(
+            f"depth error {sh['depth_max_error']:.3g} > its bound {sh['depth_error_bound']:.3g} "
+            f"(error/bound up to {sh['depth_error_ratio']:.3g}, frame {sh['depth_worst_frame']})"
+        )
     return out
 
 
@@ -324,10 +392,20 @@ def _vertices_only(ev: CaseEvidence, tol: Tolerances, reasons: tuple, style) -> 
     """Past the oracle's precision limit the pixels say nothing of the candidate: the case judged on its
     vertices alone, ``"fail"`` only for a vertex failure (or the candidate's error), else ``"vacuous"`` (which
     fails the run, oracles.judge.gate), with an ``oracle_precision`` reason first."""
-    vertices = dataclasses.replace(ev, level="vertices", pixels=None, lines=None, shaded=None, style=None,
-                                   compared={**ev.compared, "pixels": None}, oracle_bound_px=None)
+    vertices = dataclasses.replace(
+        ev,
+        level="vertices",
+        pixels=None,
+        lines=None,
+        shaded=None,
+        style=None,
+        compared={**ev.compared, "pixels": None},
+        oracle_bound_px=None,
+    )
     alone = decide(vertices, tol)
-    why = (f"oracle_precision: the pyrender oracle's own error bound {ev.oracle_bound_px:.3g} px exceeds "
-           f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged")
+    why = (
+        f"oracle_precision: the pyrender oracle's own error bound {ev.oracle_bound_px:.3g} px exceeds "
+        f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged"
+    )
     vertex_reasons = alone.reasons if alone.verdict == "fail" else ()
     return Verdict("fail" if vertex_reasons else "vacuous", (why,) + vertex_reasons, style, set_aside=reasons)

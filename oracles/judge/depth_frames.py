@@ -30,7 +30,6 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-
 from wirecheck.core.errors import InputError
 
 from ..candidates.depth_map import DEFAULT_PNG_SCALE, read_depth_map
@@ -50,29 +49,42 @@ class DepthFrames:
     def __init__(self, job: dict):
         enc = job["depth_encoding"]
         self.scale = float(enc["scale"]) if enc.get("scale") else DEFAULT_PNG_SCALE
-        self.frames = []              # per-frame numbers
-        self.diagnoses = []           # (k, DepthDiagnosis) of the failing frames
+        self.frames = []  # per-frame numbers
+        self.diagnoses = []  # (k, DepthDiagnosis) of the failing frames
         self.encoding = None
 
     def add(self, k: int, path: Path, camera, ref: ReferenceDepth) -> dict:
         """Frame ``k``'s map at ``path`` against ``ref`` (the frame's reference); its per-frame record."""
         try:
             dm = read_depth_map(path, int(camera.width), int(camera.height), self.scale)
-        except InputError as exc:       # the line names the file; every problem of a job is exit 2
+        except InputError as exc:  # the line names the file; every problem of a job is exit 2
             raise FramesError([str(exc)]) from None
         self.encoding = dm.encoding
         shown = np.isfinite(dm.depth)
         holes, extra = surface_mismatch(shown, ref.covered)
         failing = len(self.diagnoses)
-        diag = name_depth_faults(dm.depth, ref.compared_depth(), ref.bound, camera, dm.encoding_bound(),
-                                 faces=ref.compared_faces() if failing < DIAGNOSED_FRAMES else None)
+        diag = name_depth_faults(
+            dm.depth,
+            ref.compared_depth(),
+            ref.bound,
+            camera,
+            dm.encoding_bound(),
+            faces=ref.compared_faces() if failing < DIAGNOSED_FRAMES else None,
+        )
         m = diag.measured
-        rec = {"frame": k, "verdict": diag.verdict, "compared_px": m["compared_px"],
-               "union_px": int((shown | ref.covered).sum()),
-               "candidate_px": m["candidate_px"], "reference_px": int(ref.covered.sum()),
-               "holes_px": int(holes.sum()), "extra_px": int(extra.sum()),
-               "max_error": m.get("max_error"), "max_error_ratio": _finite(m.get("max_error_ratio")),
-               "worst_pixel": m.get("worst_pixel")}
+        rec = {
+            "frame": k,
+            "verdict": diag.verdict,
+            "compared_px": m["compared_px"],
+            "union_px": int((shown | ref.covered).sum()),
+            "candidate_px": m["candidate_px"],
+            "reference_px": int(ref.covered.sum()),
+            "holes_px": int(holes.sum()),
+            "extra_px": int(extra.sum()),
+            "max_error": m.get("max_error"),
+            "max_error_ratio": _finite(m.get("max_error_ratio")),
+            "worst_pixel": m.get("worst_pixel"),
+        }
         if diag.verdict == "fail":
             self.diagnoses.append((k, diag))
         self.frames.append(rec)
@@ -85,17 +97,23 @@ class DepthFrames:
         ratios = [r["max_error_ratio"] for r in f if r["max_error_ratio"] is not None]
         holes = max(f, key=lambda r: r["holes_px"])
         extra = max(f, key=lambda r: r["extra_px"])
-        return {"frames": len(f), "encoding": self.encoding,
-                "compared_px": sum(r["compared_px"] for r in f), "reference_px": sum(r["reference_px"] for r in f),
-                "candidate_px": sum(r["candidate_px"] for r in f),
-                "max_error_ratio": max(ratios) if ratios else None,
-                "max_error": worst["max_error"] if ratios else None,
-                "worst_frame": worst["frame"] if ratios else None,
-                "worst_pixel": worst["worst_pixel"] if ratios else None,
-                "holes_px": sum(r["holes_px"] for r in f), "holes_worst_frame": holes["frame"],
-                "extra_px": sum(r["extra_px"] for r in f), "extra_worst_frame": extra["frame"],
-                "blank_frames": [r["frame"] for r in f if r["candidate_px"] == 0 and r["reference_px"]],
-                "per_frame": f}
+        return {
+            "frames": len(f),
+            "encoding": self.encoding,
+            "compared_px": sum(r["compared_px"] for r in f),
+            "reference_px": sum(r["reference_px"] for r in f),
+            "candidate_px": sum(r["candidate_px"] for r in f),
+            "max_error_ratio": max(ratios) if ratios else None,
+            "max_error": worst["max_error"] if ratios else None,
+            "worst_frame": worst["frame"] if ratios else None,
+            "worst_pixel": worst["worst_pixel"] if ratios else None,
+            "holes_px": sum(r["holes_px"] for r in f),
+            "holes_worst_frame": holes["frame"],
+            "extra_px": sum(r["extra_px"] for r in f),
+            "extra_worst_frame": extra["frame"],
+            "blank_frames": [r["frame"] for r in f if r["candidate_px"] == 0 and r["reference_px"]],
+            "per_frame": f,
+        }
 
     def faults(self) -> list[dict]:
         """The depth diagnosis' fault of the case (module docstring), as record dicts with their hint; [] if none."""
@@ -105,8 +123,15 @@ class DepthFrames:
         name = names.most_common(1)[0][0]
         k, diag = next((k, d) for k, d in self.diagnoses if d.faults and d.names[0] == name)
         fault = diag.faults[0]
-        return [{**fault.as_dict(), "hint": fault.hint, "depth_frames": sum(names.values()),
-                 "depth_frames_named": names[name], "first_frame": k}]
+        return [
+            {
+                **fault.as_dict(),
+                "hint": fault.hint,
+                "depth_frames": sum(names.values()),
+                "depth_frames_named": names[name],
+                "first_frame": k,
+            }
+        ]
 
 
 def _finite(value):

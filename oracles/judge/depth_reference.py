@@ -24,13 +24,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
 from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion
 
-from ..references import faces as oface
 from ..cases import Case, case_motion
 from ..diagnosis.depth_pixels import UNDECIDED_FACE
+from ..references import faces as oface
 from .metrics import depth_bound, depth_slope, occlusion_boundary
 
 __all__ = ["ReferenceDepth", "from_render", "reference_depth"]
@@ -93,8 +92,7 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
     if not scene.faces:
         raise ValueError(f"scene {scene.name!r} has no faces: a wireframe has no depth map")
     cam = case.camera
-    p_world, matrices, pr_vertices, pr_pose = oface.frame_geometry(scene, case_motion(motion, case),
-                                                                   (k - 1) / frames)
+    p_world, matrices, pr_vertices, pr_pose = oface.frame_geometry(scene, case_motion(motion, case), (k - 1) / frames)
     tris, _owner = oface.fan(scene.faces)
     triangles = oface.gl_triangles(tris, oface.mirrored_vertices(scene, matrices))
     covered, depth, ids = oracle.render_faces(pr_vertices, triangles, cam, model_matrix=pr_pose, with_ids=True)
@@ -107,8 +105,13 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
     slope = depth_slope(depth, covered)
     bound = depth_bound(depth, covered, camera, slope)
     undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope)) & covered
-    return ReferenceDepth(depth=np.where(covered, depth, np.nan), covered=covered, undecided=undecided, bound=bound,
-                          faces=np.where(covered, ids, -1))
+    return ReferenceDepth(
+        depth=np.where(covered, depth, np.nan),
+        covered=covered,
+        undecided=undecided,
+        bound=bound,
+        faces=np.where(covered, ids, -1),
+    )
 
 
 def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:
@@ -119,6 +122,6 @@ def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: n
     h, w = at_plane.shape
     for dy in (-1, 0, 1):
         for dx in (-1, 0, 1):
-            src = at_plane[max(dy, 0):h + min(dy, 0), max(dx, 0):w + min(dx, 0)]
-            out[max(-dy, 0):h + min(-dy, 0), max(-dx, 0):w + min(-dx, 0)] |= src
+            src = at_plane[max(dy, 0) : h + min(dy, 0), max(dx, 0) : w + min(dx, 0)]
+            out[max(-dy, 0) : h + min(-dy, 0), max(-dx, 0) : w + min(-dx, 0)] |= src
     return out

@@ -61,8 +61,9 @@ axis is absorbed by their leans.
 from __future__ import annotations
 
 import numpy as np
-from .line_profile import MIN_SAMPLES, pooled_offset
+
 from ..tolerances import NAMING
+from .line_profile import MIN_SAMPLES, pooled_offset
 
 #: How far (px, along the minor axis) an even band may lean off the exact line: half a pixel.
 LEAN_PX = 0.5
@@ -82,7 +83,7 @@ CHI2_2_P99 = -2.0 * np.log(0.01)
 #: times |n_minor| >= 0.71, leaves under the symmetric band is at least 0.35 px), for a quarter of the
 #: edges. Measured: Pillow 2 px 0.12-0.30 symmetric against 0.02-0.05 leaning; symmetric 2-px bands,
 #: moved or not, 0.000-0.001 against 0.000-0.016.
-LEAN_GAIN_PX2 = 0.25 * 0.25 ** 2
+LEAN_GAIN_PX2 = 0.25 * 0.25**2
 #: Binary lines drawing this many pixels per pixel of the oracle's 1-px lines are wide whatever the
 #: median across them: a 1-px line of any aliased rule draws one pixel per step of its major axis, as
 #: GL's does (the ratio 1, give or take its ends). Pillow's width 2 draws its lines within 30 degrees
@@ -96,8 +97,17 @@ MAX_UNTESTED_EDGES = 3.0
 #: Least samples of an edge for its residual to count (fewer: the edge's mean is noise).
 MIN_EDGE_SAMPLES = 5
 #: What a case record keeps of the fit (line_style.geometry: ``geometry["lean"]``).
-REPORTED = ("leaning", "offset_px", "ms", "ms_symmetric", "leaning_edges", "edges", "edges_eff", "gain_px2",
-            "evidence_px2")
+REPORTED = (
+    "leaning",
+    "offset_px",
+    "ms",
+    "ms_symmetric",
+    "leaning_edges",
+    "edges",
+    "edges_eff",
+    "gain_px2",
+    "evidence_px2",
+)
 
 
 def reference_offsets(normal: np.ndarray, point: np.ndarray, band_px: int) -> np.ndarray:
@@ -137,10 +147,10 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     if len(offset) < MIN_SAMPLES:
         return None
     refs = reference_offsets(normal, point, band_px)
-    resid = offset[None] - refs                                    # (3, M): -1/2, 0, +1/2
+    resid = offset[None] - refs  # (3, M): -1/2, 0, +1/2
     keys, inv, counts, means = _edge_means(edge, resid)
     n_edge = np.zeros((len(keys), 2))
-    n_edge[inv] = normal                                           # one normal per segment
+    n_edge[inv] = normal  # one normal per segment
     used = counts >= MIN_EDGE_SAMPLES
     if used.sum() == 0:
         return None
@@ -155,15 +165,15 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     # times in 100, over the case's edges (their effective number: the weights' (sum w)^2 / sum w^2)
     g = np.arange(-GRID_REACH_PX, GRID_REACH_PX + 1e-9, GRID_STEP_PX)
     grid = np.stack(np.meshgrid(g, g, indexing="ij"), axis=-1).reshape(-1, 2)
-    cost = np.min((r[:, :, None] - (n @ grid.T)[None]) ** 2, axis=0)     # (E, G): each edge's nearest lean
-    between = (w @ cost) / w.sum()                                 # per sample, between the edges' means
-    gain = float(w @ np.min(r ** 2, axis=0)) / w.sum() - float(between.min())
-    edges_eff = float(w.sum() ** 2 / (w ** 2).sum())
+    cost = np.min((r[:, :, None] - (n @ grid.T)[None]) ** 2, axis=0)  # (E, G): each edge's nearest lean
+    between = (w @ cost) / w.sum()  # per sample, between the edges' means
+    gain = float(w @ np.min(r**2, axis=0)) / w.sum() - float(between.min())
+    edges_eff = float(w.sum() ** 2 / (w**2).sum())
     evidence = CHI2_2_P99 * EDGE_NOISE_PX2 / edges_eff
-    tied = np.flatnonzero(between <= between.min() + 1e-12)       # equal fits (a flat direction): the smallest
+    tied = np.flatnonzero(between <= between.min() + 1e-12)  # equal fits (a flat direction): the smallest
     best = grid[tied[np.argmin(np.hypot(grid[tied, 0], grid[tied, 1]))]] if gain > evidence else np.zeros(2)
-    choice = np.argmin((r - (n @ best)[None]) ** 2, axis=0)        # (E_used,) 0, 1, 2
-    edge_choice = np.ones(len(keys), np.intp)                      # edges with too few samples: symmetric
+    choice = np.argmin((r - (n @ best)[None]) ** 2, axis=0)  # (E_used,) 0, 1, 2
+    edge_choice = np.ones(len(keys), np.intp)  # edges with too few samples: symmetric
     edge_choice[np.flatnonzero(used)] = choice
     corrected = resid[edge_choice[inv], np.arange(len(offset))]
     d, _ = pooled_offset(normal, corrected)
@@ -171,6 +181,17 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     # the leaning bands replace the symmetric one where they explain the edges better, or where the edges
     # cannot test the symmetric band (two numbers fitted to at most MAX_UNTESTED_EDGES edges' worth)
     leaning = ms < ms_sym - LEAN_GAIN_PX2 or edges_eff <= MAX_UNTESTED_EDGES
-    return {"leaning": bool(leaning), "offset": d, "offset_px": [float(v) for v in d], "ms": ms, "ms_symmetric": ms_sym,
-            "leaning_edges": int((choice != 1).sum()), "gain_px2": gain, "evidence_px2": evidence,
-            "edges": int(used.sum()), "edges_eff": edges_eff, "samples": int(total), "corrected": corrected}
+    return {
+        "leaning": bool(leaning),
+        "offset": d,
+        "offset_px": [float(v) for v in d],
+        "ms": ms,
+        "ms_symmetric": ms_sym,
+        "leaning_edges": int((choice != 1).sum()),
+        "gain_px2": gain,
+        "evidence_px2": evidence,
+        "edges": int(used.sum()),
+        "edges_eff": edges_eff,
+        "samples": int(total),
+        "corrected": corrected,
+    }

@@ -18,6 +18,7 @@ from ..faults import Fault
 
 __all__ = ["StyleRead", "Radius", "Visibility", "CaseEvidence", "frozen_map"]
 
+
 def frozen_map(values: Mapping | None) -> Mapping | None:
     """A read-only view of a copy of ``values`` (None stays None)."""
     return None if values is None else MappingProxyType(dict(values))
@@ -73,8 +74,11 @@ class StyleRead:
         if self.style != "aliased" or not rs["differing"]:
             return {}
         n = max(rs["oracle_pixels"], 1)
-        return {"share_off_by_one_across": rs["off_by_one_across"] / n,
-                "share_off_by_one_at_ends": rs["off_by_one_at_ends"] / n, "share_farther": rs["farther"] / n}
+        return {
+            "share_off_by_one_across": rs["off_by_one_across"] / n,
+            "share_off_by_one_at_ends": rs["off_by_one_at_ends"] / n,
+            "share_farther": rs["farther"] / n,
+        }
 
 
 @dataclass(frozen=True)

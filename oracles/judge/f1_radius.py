@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import math
 
-from .evidence import Radius
 from ..tolerances import NAMING
+from .evidence import Radius
 from .metrics import pixel_scores
 
 #: The widest radius computed: oracles.tolerances.NAMING.max_radius_px (3: lines up to 5 px across; its reason there).
@@ -54,7 +54,7 @@ def radius_px(read: dict) -> int:
 def frame_scores(fp, scores: dict) -> dict:
     """``{radius: F1}`` of one frame for each of :data:`RADII` (``fp``: its oracles.judge.frame_pixels.FramePixels,
     ``scores``: its oracles.judge.metrics.pixel_scores at 0 and 1 px)."""
-    if scores["f1_1px"] == 1.0:                     # every pixel within 1 px: within any wider radius
+    if scores["f1_1px"] == 1.0:  # every pixel within 1 px: within any wider radius
         return {r: 1.0 for r in RADII}
     wide = pixel_scores(None, None, tols=RADII, pixels=fp)
     return {r: wide[f"f1_{r}px"] for r in RADII}
@@ -69,5 +69,5 @@ def radius_read(read: dict, per_frame: list, frames: list, f1_1px: float, worst_
     radius = radius_px(read)
     if radius == 1 or not per_frame:
         return Radius(radius, f1_1px, worst_frame)
-    worst = min(range(len(per_frame)), key=lambda i: per_frame[i][radius])     # the first of the lowest
+    worst = min(range(len(per_frame)), key=lambda i: per_frame[i][radius])  # the first of the lowest
     return Radius(radius, float(per_frame[worst][radius]), frames[worst])

@@ -31,7 +31,6 @@ from ..diagnosis.silhouette_faults import SilhouetteFrame, name_silhouette_fault
 from ..references.fill_rule import silhouette
 from .silhouette import score_silhouette
 
-
 #: Failing filled frames of a case kept for naming (oracles.diagnosis.silhouette_faults fits one camera mistake
 #: to them together; a fit costs about half a second a frame at 640x480, up to 3 s where the border cuts it).
 NAMED_FRAMES = 2
@@ -55,15 +54,25 @@ class FilledFrames:
         grey = read_frame(path, w, h, job)
         shown = grey >= 1
         several = objects is not None and len(np.unique(objects)) > 1
-        inside, ties, ids = silhouette(p_world, faces, camera, (h, w), face_objects=objects if several else None,
-                                       tie_px=self.tie_px)
+        inside, ties, ids = silhouette(
+            p_world, faces, camera, (h, w), face_objects=objects if several else None, tie_px=self.tie_px
+        )
         s = score_silhouette(shown, inside, ties)
-        rec = {"frame": k, "iou": float(s.iou) if np.isfinite(s.iou) else None, "union_px": s.union_px,
-               "candidate_px": s.cand_px, "reference_px": s.ref_px, "ties_px": s.ties_px,
-               "holes_px": s.holes, "extra_px": s.extra, "longest_run_px": s.longest_run_px,
-               "run_at": list(s.run_at) if s.run_at else None, "vacuous": s.vacuous,
-               "reference_decided_px": int((inside & ~ties).sum()),
-               "object_id_px": object_id_misses(grey, shown & ~ties, ids) if several else None}
+        rec = {
+            "frame": k,
+            "iou": float(s.iou) if np.isfinite(s.iou) else None,
+            "union_px": s.union_px,
+            "candidate_px": s.cand_px,
+            "reference_px": s.ref_px,
+            "ties_px": s.ties_px,
+            "holes_px": s.holes,
+            "extra_px": s.extra,
+            "longest_run_px": s.longest_run_px,
+            "run_at": list(s.run_at) if s.run_at else None,
+            "vacuous": s.vacuous,
+            "reference_decided_px": int((inside & ~ties).sum()),
+            "object_id_px": object_id_misses(grey, shown & ~ties, ids) if several else None,
+        }
         self.frames.append(rec)
         if (s.holes or s.extra) and not s.vacuous and len(self.failing) < NAMED_FRAMES:
             self.failing.append(SilhouetteFrame(shown, inside, ties, camera, p_world, tuple(faces)))
@@ -80,17 +89,27 @@ class FilledFrames:
         gated = [r for r in f if r["iou"] is not None and r["union_px"] >= min_union_px]
         worst = min(gated, key=lambda r: r["iou"]) if gated else None
         run = max(f, key=lambda r: r["longest_run_px"])
-        return {"frames": len(f), "reference": "GL's fill rule, ties left out",
-                "min_iou": worst["iou"] if worst else None, "iou_worst_frame": worst["frame"] if worst else None,
-                "longest_run_px": run["longest_run_px"], "run_frame": run["frame"], "run_at": run["run_at"],
-                "union_px": sum(r["union_px"] for r in f), "candidate_px": sum(r["candidate_px"] for r in f),
-                "reference_px": sum(r["reference_px"] for r in f), "ties_px": sum(r["ties_px"] for r in f),
-                "holes_px": sum(r["holes_px"] for r in f), "extra_px": sum(r["extra_px"] for r in f),
-                "blank_frames": [r["frame"] for r in f if r["candidate_px"] == 0 and r["reference_decided_px"]],
-                "object_id_px": (None if f[0]["object_id_px"] is None else sum(r["object_id_px"] for r in f)),
-                "object_id_worst_frame": (None if f[0]["object_id_px"] is None
-                                          else max(f, key=lambda r: r["object_id_px"])["frame"]),
-                "per_frame": f}
+        return {
+            "frames": len(f),
+            "reference": "GL's fill rule, ties left out",
+            "min_iou": worst["iou"] if worst else None,
+            "iou_worst_frame": worst["frame"] if worst else None,
+            "longest_run_px": run["longest_run_px"],
+            "run_frame": run["frame"],
+            "run_at": run["run_at"],
+            "union_px": sum(r["union_px"] for r in f),
+            "candidate_px": sum(r["candidate_px"] for r in f),
+            "reference_px": sum(r["reference_px"] for r in f),
+            "ties_px": sum(r["ties_px"] for r in f),
+            "holes_px": sum(r["holes_px"] for r in f),
+            "extra_px": sum(r["extra_px"] for r in f),
+            "blank_frames": [r["frame"] for r in f if r["candidate_px"] == 0 and r["reference_decided_px"]],
+            "object_id_px": (None if f[0]["object_id_px"] is None else sum(r["object_id_px"] for r in f)),
+            "object_id_worst_frame": (
+                None if f[0]["object_id_px"] is None else max(f, key=lambda r: r["object_id_px"])["frame"]
+            ),
+            "per_frame": f,
+        }
 
 
 def object_id_misses(grey: np.ndarray, compared: np.ndarray, ids: np.ndarray) -> int:

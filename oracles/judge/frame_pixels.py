@@ -46,7 +46,7 @@ class FramePixels:
         fp = cls.__new__(cls)
         fp.shape = tuple(shape)
         fp.cand_idx, fp.oracle_idx = cand_idx, oracle_idx
-        fp.cand_in_oracle = fp.has(cand_idx, of_candidate=False)       # a binary search each: no sort
+        fp.cand_in_oracle = fp.has(cand_idx, of_candidate=False)  # a binary search each: no sort
         fp.oracle_in_cand = fp.has(oracle_idx, of_candidate=True)
         fp._only = None
         return fp
@@ -66,13 +66,19 @@ class FramePixels:
         at_out = np.searchsorted(self.cand_idx, cand_out)
         at_in = np.searchsorted(self.oracle_idx, cand_in)
         only_c, only_o = ~self.cand_in_oracle, ~self.oracle_in_cand
-        if (len(cand_out) and (np.any(at_out >= len(self.cand_idx))
-                               or np.any(self.cand_idx[np.minimum(at_out, len(self.cand_idx) - 1)] != cand_out)
-                               or not only_c[at_out].all() or np.any(np.diff(cand_out) <= 0))):
+        if len(cand_out) and (
+            np.any(at_out >= len(self.cand_idx))
+            or np.any(self.cand_idx[np.minimum(at_out, len(self.cand_idx) - 1)] != cand_out)
+            or not only_c[at_out].all()
+            or np.any(np.diff(cand_out) <= 0)
+        ):
             return None
-        if (len(cand_in) and (np.any(at_in >= len(self.oracle_idx))
-                              or np.any(self.oracle_idx[np.minimum(at_in, len(self.oracle_idx) - 1)] != cand_in)
-                              or not only_o[at_in].all() or np.any(np.diff(cand_in) <= 0))):
+        if len(cand_in) and (
+            np.any(at_in >= len(self.oracle_idx))
+            or np.any(self.oracle_idx[np.minimum(at_in, len(self.oracle_idx) - 1)] != cand_in)
+            or not only_o[at_in].all()
+            or np.any(np.diff(cand_in) <= 0)
+        ):
             return None
         keep = np.ones(len(self.cand_idx), bool)
         keep[at_out] = False

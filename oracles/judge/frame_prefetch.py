@@ -91,31 +91,33 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: d
     """
     try:
         inputs = frame_inputs(job_dir, job, c["scene"], c["case"], k, cache)
-    except Exception as exc:      # noqa: BLE001 - raised again in the judge's thread, at this frame
+    except Exception as exc:  # noqa: BLE001 - raised again in the judge's thread, at this frame
         return FrameAhead(exc, None, None)
     p_model, edges, camera, m = inputs
     orac = grey = None
     if rel is not None:
         try:
-            orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m,
-                                                                  depth=False)[0]
-        except Exception as exc:      # noqa: BLE001
+            orac = oracles.get(camera.width, camera.height).render(p_model, edges, camera, model_matrix=m, depth=False)[
+                0
+            ]
+        except Exception as exc:  # noqa: BLE001
             return FrameAhead(inputs, exc, None)
         try:
             grey = read_frame(Path(job_dir) / rel, c["width"], c["height"], (job_dir, job))
-        except Exception as exc:      # noqa: BLE001
+        except Exception as exc:  # noqa: BLE001
             return FrameAhead(inputs, orac, exc)
     if not set(job_outputs(job)) & {"filled", "depth"}:
         return FrameAhead(inputs, orac, grey)
     try:
         polygons = frame_faces(job_dir, job, c["scene"], k, cache)
-        if cache.get("fanned") is not polygons:             # a model-space scene's faces: fanned once a case
+        if cache.get("fanned") is not polygons:  # a model-space scene's faces: fanned once a case
             cache.update(fanned=polygons, tris=fan(polygons)[0])
         tris = cache["tris"]
-        drawn = oracles.get(camera.width, camera.height).render_faces(p_model, tris, camera, model_matrix=m,
-                                                                      with_ids=True)
+        drawn = oracles.get(camera.width, camera.height).render_faces(
+            p_model, tris, camera, model_matrix=m, with_ids=True
+        )
         faces = (*drawn, tris, polygons)
-    except Exception as exc:      # noqa: BLE001
+    except Exception as exc:  # noqa: BLE001
         faces = exc
     return FrameAhead(inputs, orac, grey, faces)
 
@@ -140,7 +142,7 @@ class FramePrefetch:
             f = Future()
             try:
                 f.set_result(fn(*args))
-            except Exception as exc:      # noqa: BLE001 - as the pool's future would hold it
+            except Exception as exc:  # noqa: BLE001 - as the pool's future would hold it
                 f.set_exception(exc)
             return f
         with self._lock:
@@ -159,10 +161,10 @@ class FramePrefetch:
 
     def frames(self, job_dir, job, c: dict, numbers: list):
         """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead."""
-        cache: dict = {}            # frame_inputs' OBJ and camera, kept over the case (used on the worker only)
-        todo = iter(zip(numbers, c["frames"] or [None] * len(numbers)))      # no wireframe asked: no PNG
+        cache: dict = {}  # frame_inputs' OBJ and camera, kept over the case (used on the worker only)
+        todo = iter(zip(numbers, c["frames"] or [None] * len(numbers)))  # no wireframe asked: no PNG
         queued: list[Future] = []
-        if self._pool is None:                  # read each frame when it is asked for
+        if self._pool is None:  # read each frame when it is asked for
             for k, rel in todo:
                 yield read_ahead(self.oracles, job_dir, job, c, k, rel, cache)
             return
@@ -177,7 +179,7 @@ class FramePrefetch:
                     return
                 yield queued.pop(0).result()
         finally:
-            for f in queued:                 # the judge stopped early (an error): drop what it will not ask for
+            for f in queued:  # the judge stopped early (an error): drop what it will not ask for
                 f.cancel()
 
     def close(self) -> None:

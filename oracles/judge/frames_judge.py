@@ -33,33 +33,32 @@ its samples are capped per case anyway), and a per-frame record of numbers.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from wirecheck.core.projector import pipeline
 
-from collections.abc import Mapping
-from dataclasses import replace
-
-from . import f1_radius, gate, line_model, metrics
+from ..candidates import frames_candidate
+from ..candidates.draw import oracle_segments as line_segments
+from ..candidates.export import job_outputs
 from ..candidates.frames_candidate import face_objects, read_frame
-from .frame_prefetch import FramePrefetch, reader_for
+from ..diagnosis.diagnose import diagnose_lines
+from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
+from ..diagnosis.image_visibility import set_difference
+from ..faults import Fault
 from ..references import opencv_oracle
+from ..tolerances import MIN_IOU_UNION_PX, Tolerances
+from . import f1_radius, gate, line_model, metrics
 from .decide import decide, pixel_fields
 from .depth_frames import DepthFrames
 from .depth_reference import from_render
 from .evidence import CaseEvidence, Visibility
 from .filled_frames import FilledFrames
+from .frame_prefetch import FramePrefetch, reader_for
 from .line_style import CaseStyle, style_record
 from .name_faults import name_faults, wants_visibility
-from wirecheck.core.projector import pipeline
-from ..candidates.draw import oracle_segments as line_segments
-from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
-from ..diagnosis.diagnose import diagnose_lines
-from ..diagnosis.image_visibility import set_difference
-from ..candidates import frames_candidate
-from ..candidates.export import job_outputs
-from ..faults import Fault
-from ..tolerances import MIN_IOU_UNION_PX, Tolerances
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (oracles.diagnosis.registration.MAX_POINTS_PER_CASE),
@@ -70,8 +69,17 @@ DIAGNOSIS_FRAMES = 24
 LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
 
 
-def candidate_pixels(path: Path, width: int, height: int, style, orac: np.ndarray, frame: tuple,
-                     segs: np.ndarray | None = None, job=None, grey: np.ndarray | None = None) -> np.ndarray:
+def candidate_pixels(
+    path: Path,
+    width: int,
+    height: int,
+    style,
+    orac: np.ndarray,
+    frame: tuple,
+    segs: np.ndarray | None = None,
+    job=None,
+    grey: np.ndarray | None = None,
+) -> np.ndarray:
     """The pixels a frame file draws, as ascending flat indices ``y W + x``: what the judge compares with the oracle's.
 
     Every frame of the frames path goes through here, once: its grey levels
@@ -100,13 +108,13 @@ class _CaseFrames:
     def __init__(self):
         self.pixel = {key: [] for key in metrics.PIXEL_SCORE_KEYS}
         self.core_min = {}
-        self.radius = []                   # each frame's F1 at the wider radii (f1_radius)
+        self.radius = []  # each frame's F1 at the wider radii (f1_radius)
         self.per_frame, self.lines = [], []
         self.batch = metrics.LineBatch()
         self.drawn_px = 0
-        self.worst = None                  # ((f1_1px, f1_0px), frame, candidate, oracle)
-        self.diag = []                     # (KeptImage-like flat indices, shape, segments, flipped)
-        self.rounded_f1 = []               # each frame's F1@0px against the rounded-ends rule (line_model)
+        self.worst = None  # ((f1_1px, f1_0px), frame, candidate, oracle)
+        self.diag = []  # (KeptImage-like flat indices, shape, segments, flipped)
+        self.rounded_f1 = []  # each frame's F1@0px against the rounded-ends rule (line_model)
         self.rounded_batch = metrics.LineBatch()
         self.rounded_lines = []
 
@@ -124,8 +132,7 @@ class _CaseFrames:
         self.rounded_lines.extend(self.rounded_batch.flush())
         if not self.rounded_f1:
             return None
-        return {"pixel_f1_0px": min(self.rounded_f1),
-                "lines": metrics.line_summary(self.rounded_lines)}
+        return {"pixel_f1_0px": min(self.rounded_f1), "lines": metrics.line_summary(self.rounded_lines)}
 
     def visibility_inputs(self) -> tuple[list, list, list]:
         """The kept frames' ``(drawn images, oracle segments, the flipped camera's segments)``, for the image
@@ -156,8 +163,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     numbers = job["frame_numbers"]
     outputs = job_outputs(job)
     wire = "wireframe" in outputs
-    depth = DepthFrames(job) if "depth" in outputs else None         # each frame's depth map (depth_frames)
-    filled = FilledFrames(tol.fill_tie_px) if "filled" in outputs else None     # each filled PNG (filled_frames)
+    depth = DepthFrames(job) if "depth" in outputs else None  # each frame's depth map (depth_frames)
+    filled = FilledFrames(tol.fill_tie_px) if "filled" in outputs else None  # each filled PNG (filled_frames)
     kept = diagnosis_frames(len(numbers)) if diagnose and wire else set()
     acc = _CaseFrames()
     style = CaseStyle(line_rule)
@@ -168,16 +175,34 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     for i, (k, frame) in enumerate(zip(numbers, ahead)):
         p_model, edges, camera, m = frame.inputs()
         if wire:
-            _wireframe(acc, style, Path(job_dir) / c["frames"][i], c, k, frame, (p_model, edges, camera, m),
-                       (job_dir, job), tol, line_rule, i in kept)
+            _wireframe(
+                acc,
+                style,
+                Path(job_dir) / c["frames"][i],
+                c,
+                k,
+                frame,
+                (p_model, edges, camera, m),
+                (job_dir, job),
+                tol,
+                line_rule,
+                i in kept,
+            )
         if depth or filled:
-            covered, z, ids, tris, polygons = frame.faces()     # pyrender's faces: the depth maps' reference
+            covered, z, ids, tris, polygons = frame.faces()  # pyrender's faces: the depth maps' reference
             if depth:
                 rec_k = depth.add(k, Path(job_dir) / c["depth"][i], camera, from_render(covered, z, ids, tris, camera))
                 acc.drawn_px += rec_k["union_px"]
-            if filled:                                          # the fill rule's silhouette (filled_frames)
-                rec_k = filled.add(k, Path(job_dir) / c["filled"][i], p_model @ m[:3, :3].T + m[:3, 3], polygons,
-                                   camera, (job_dir, job), face_objects(job, scene, polygons))
+            if filled:  # the fill rule's silhouette (filled_frames)
+                rec_k = filled.add(
+                    k,
+                    Path(job_dir) / c["filled"][i],
+                    p_model @ m[:3, :3].T + m[:3, 3],
+                    polygons,
+                    camera,
+                    (job_dir, job),
+                    face_objects(job, scene, polygons),
+                )
                 acc.drawn_px += rec_k["union_px"]
         del frame
     ahead.close()
@@ -187,11 +212,17 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         images, segments, flipped = acc.visibility_inputs()
         if diagnose:
             diagnosed = tuple(Fault.of(f) for f in diagnose_images(images, segments, camera, flipped, tol=tol))
-    ev = case_evidence(acc, style if wire else None, numbers, diagnosed, tol,
-                       depth_map=depth.fields() if depth else None,
-                       filled=filled.fields(MIN_IOU_UNION_PX) if filled else None,
-                       depth_faults=tuple(Fault.of(f) for f in depth.faults()) if depth else (),
-                       filled_faults=filled.faults() if filled else ())
+    ev = case_evidence(
+        acc,
+        style if wire else None,
+        numbers,
+        diagnosed,
+        tol,
+        depth_map=depth.fields() if depth else None,
+        filled=filled.fields(MIN_IOU_UNION_PX) if filled else None,
+        depth_faults=tuple(Fault.of(f) for f in depth.faults()) if depth else (),
+        filled_faults=filled.faults() if filled else (),
+    )
     verdict = decide(ev, tol)
     names = name_faults(ev, verdict, tol)
     if diagnose and images and wants_visibility(names, ev, verdict) and _wireframe_fails(ev, tol):
@@ -210,15 +241,16 @@ def _wireframe_fails(ev: CaseEvidence, tol) -> bool:
     return decide(replace(ev, depth_map=None, filled=None), tol).verdict == "fail"
 
 
-def _wireframe(acc: _CaseFrames, style, path: Path, c: dict, k: int, frame, inputs: tuple, job, tol, line_rule: str,
-               keep: bool) -> None:
+def _wireframe(
+    acc: _CaseFrames, style, path: Path, c: dict, k: int, frame, inputs: tuple, job, tol, line_rule: str, keep: bool
+) -> None:
     """Frame ``k``'s wireframe PNG (``path``) scored into ``acc`` (``frame``: its FrameAhead; ``inputs``:
     ``(p_model, edges, camera, model_matrix)``; ``keep``: its drawn pixels kept for the image diagnosis)."""
     p_model, edges, camera, m = inputs
     p_world = p_model @ m[:3, :3].T + m[:3, 3]
     # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
     seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
-    segs = oracle_segments(p_world, edges, camera)             # the lines a correct renderer draws
+    segs = oracle_segments(p_world, edges, camera)  # the lines a correct renderer draws
     orac = frame.oracle()
     cand = candidate_pixels(path, c["width"], c["height"], style, orac, inputs, segs, job, grey=frame.grey())
     core = _drawn(pipeline.render_frame(p_model, edges, camera, m).image)
@@ -235,11 +267,17 @@ def _wireframe(acc: _CaseFrames, style, path: Path, c: dict, k: int, frame, inpu
     for key in metrics.PIXEL_SCORE_KEYS:
         acc.core_min[key] = min(acc.core_min.get(key, 1.0), float(cs[key]))
     acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
-    frame_rec = {"frame": k, "f1_0px": ps["f1_0px"], "f1_1px": ps["f1_1px"],
-                 "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"],
-                 "candidate_pixels": ps["candidate_pixels"], "oracle_pixels": ps["oracle_pixels"]}
+    frame_rec = {
+        "frame": k,
+        "f1_0px": ps["f1_0px"],
+        "f1_1px": ps["f1_1px"],
+        "core_f1_0px": cs["f1_0px"],
+        "core_f1_1px": cs["f1_1px"],
+        "candidate_pixels": ps["candidate_pixels"],
+        "oracle_pixels": ps["oracle_pixels"],
+    }
     acc.per_frame.append(frame_rec)
-    acc.record_lines(acc.batch.add((k, frame_rec), fp, seg0, seg1))    # scored with later frames
+    acc.record_lines(acc.batch.add((k, frame_rec), fp, seg0, seg1))  # scored with later frames
     key = (ps["f1_1px"], ps["f1_0px"])
     if acc.worst is None or key < acc.worst[0]:
         acc.worst = (key, k, _image(cand, orac.shape), orac.copy())
@@ -258,8 +296,17 @@ def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:
     return out.reshape(shape)
 
 
-def case_evidence(acc: _CaseFrames, style: CaseStyle | None, numbers: list, diagnosed: tuple, tol,
-                  depth_map=None, filled=None, depth_faults: tuple = (), filled_faults: tuple = ()) -> CaseEvidence:
+def case_evidence(
+    acc: _CaseFrames,
+    style: CaseStyle | None,
+    numbers: list,
+    diagnosed: tuple,
+    tol,
+    depth_map=None,
+    filled=None,
+    depth_faults: tuple = (),
+    filled_faults: tuple = (),
+) -> CaseEvidence:
     """What a case's frames measured, frozen (oracles.judge.evidence): its pixel scores, lines, F1 radius,
     the diagnosis's faults (``diagnosed``), GL's line faults, the style read and what was compared; its depth
     maps' and filled frames' fields and the faults their values and silhouettes name. ``style`` None: the job asks for no
@@ -271,36 +318,69 @@ def case_evidence(acc: _CaseFrames, style: CaseStyle | None, numbers: list, diag
     pixels = pixel_fields(acc.pixel, acc.worst[1])
     lines = metrics.line_summary(acc.lines)
     line_named = tuple(Fault.of(f) for f in diagnose_lines(lines, tol))
-    radius = f1_radius.radius_read(style.classify(), acc.radius, numbers, pixels["pixel_f1_1px"],
-                                   pixels["worst_pixel_frame"])
-    return CaseEvidence(level="frames", compared=compared,
-                        frames_checked=len(numbers), pixels=pixels, lines=lines, radius=radius,
-                        image_faults=diagnosed, line_faults=line_named,
-                        style=style.read(diagnosed or line_named, tol, acc.rounded()),
-                        drew_pixels=any(f["candidate_pixels"] for f in acc.per_frame), **surfaces)
+    radius = f1_radius.radius_read(
+        style.classify(), acc.radius, numbers, pixels["pixel_f1_1px"], pixels["worst_pixel_frame"]
+    )
+    return CaseEvidence(
+        level="frames",
+        compared=compared,
+        frames_checked=len(numbers),
+        pixels=pixels,
+        lines=lines,
+        radius=radius,
+        image_faults=diagnosed,
+        line_faults=line_named,
+        style=style.read(diagnosed or line_named, tol, acc.rounded()),
+        drew_pixels=any(f["candidate_pixels"] for f in acc.per_frame),
+        **surfaces,
+    )
 
 
-def case_record(job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple,
-                acc: _CaseFrames) -> dict:
+def case_record(
+    job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple, acc: _CaseFrames
+) -> dict:
     """A case's record (its entry in report.json's ``cases``), built once from its evidence, verdict and names;
     beside them core's second opinion (never deciding) and the per-frame numbers (``acc``)."""
-    rec = {"scene": scene, "camera": case, "camera_spec": camera.to_dict(), "frames": job["frames"],
-           "frames_checked": ev.frames_checked, "max_vertex_error_px": None}
+    rec = {
+        "scene": scene,
+        "camera": case,
+        "camera_spec": camera.to_dict(),
+        "frames": job["frames"],
+        "frames_checked": ev.frames_checked,
+        "max_vertex_error_px": None,
+    }
     if ev.pixels is not None:
-        rec.update({**ev.pixels,
-                    "core": {k: acc.core_min[k] for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px",
-                                                          "precision_1px", "recall_1px")},
-                    "lines": dict(ev.lines)})
+        rec.update(
+            {
+                **ev.pixels,
+                "core": {
+                    k: acc.core_min[k]
+                    for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px")
+                },
+                "lines": dict(ev.lines),
+            }
+        )
     rec["faults"] = [f.as_dict() for f in names]
     if ev.pixels is not None:
-        rec.update({"f1_radius_px": ev.radius.radius_px, "pixel_f1_radius": ev.radius.f1,
-                    "pixel_f1_radius_frame": ev.radius.frame,
-                    "line_style": style_record(ev.style, verdict.style, ev.radius.radius_px)})
+        rec.update(
+            {
+                "f1_radius_px": ev.radius.radius_px,
+                "pixel_f1_radius": ev.radius.f1,
+                "pixel_f1_radius_frame": ev.radius.frame,
+                "line_style": style_record(ev.style, verdict.style, ev.radius.radius_px),
+            }
+        )
     for key in ("depth_map", "filled"):
         if getattr(ev, key) is not None:
             rec[key] = _plain(getattr(ev, key))
-    rec.update({"compared": dict(ev.compared), "verdict": verdict.verdict, "reasons": list(verdict.reasons),
-                "per_frame": acc.per_frame})
+    rec.update(
+        {
+            "compared": dict(ev.compared),
+            "verdict": verdict.verdict,
+            "reasons": list(verdict.reasons),
+            "per_frame": acc.per_frame,
+        }
+    )
     return rec
 
 
@@ -313,8 +393,14 @@ def _plain(value):
     return value
 
 
-def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None,
-               allow_vacuous: bool = False, line_rule: str = "any") -> tuple[dict, dict]:
+def run_frames(
+    job_dir,
+    tol=None,
+    diagnose: bool = True,
+    name: str | None = None,
+    allow_vacuous: bool = False,
+    line_rule: str = "any",
+) -> tuple[dict, dict]:
     """Judge the job's frames: the report dict (as crosscheck's) and the worst-frame images.
 
     Every listed frame is checked first (oracles.candidates.frames_candidate.check_frames:
@@ -327,48 +413,67 @@ def run_frames(job_dir, tol=None, diagnose: bool = True, name: str | None = None
     tol = tol or Tolerances()
     t0 = time.perf_counter()
     job = frames_candidate.load_job(job_dir)
-    frames_candidate.check_frames(job_dir, job, decode=False)          # each frame is decoded once, as it is judged
-    reader = FramePrefetch()            # the GL thread: every oracle call, and the frames read ahead of the judge
+    frames_candidate.check_frames(job_dir, job, decode=False)  # each frame is decoded once, as it is judged
+    reader = FramePrefetch()  # the GL thread: every oracle call, and the frames read ahead of the judge
     records, images = [], {}
     try:
         for c in job["cases"]:
-            rec, worst = judge_case(job_dir, job, c["scene"], c["case"], reader, tol, diagnose=diagnose,
-                                    line_rule=line_rule)
+            rec, worst = judge_case(
+                job_dir, job, c["scene"], c["case"], reader, tol, diagnose=diagnose, line_rule=line_rule
+            )
             records.append(rec)
-            if worst is not None:           # a job without wireframes: no line images to show
+            if worst is not None:  # a job without wireframes: no line images to show
                 images[(c["scene"], c["case"])] = worst
         gl = reader.call(reader.oracles.gl_info)
     finally:
         reader.close()
     failed = sum(r["verdict"] == "fail" for r in records)
     vacuous = sum(r["verdict"] == "vacuous" for r in records)
-    compared = {"cases": sum(r["verdict"] != "vacuous" for r in records),
-                "frames": sum(r["compared"]["frames"] for r in records), "vertices": 0,
-                "pixels": sum(r["compared"]["pixels"] for r in records)}
+    compared = {
+        "cases": sum(r["verdict"] != "vacuous" for r in records),
+        "frames": sum(r["compared"]["frames"] for r in records),
+        "vertices": 0,
+        "pixels": sum(r["compared"]["pixels"] for r in records),
+    }
     outputs = job_outputs(job)
     tolerances = {**tol.to_dict(), **tol.lines_dict(), **(tol.surfaces_dict() if outputs != ("wireframe",) else {})}
-    del tolerances["candidate_precision"]                 # no vertex is compared: no precision judged
+    del tolerances["candidate_precision"]  # no vertex is compared: no precision judged
 
-    def lowest(key, sub=None):          # over the cases with wireframes (None: the job asks for none)
+    def lowest(key, sub=None):  # over the cases with wireframes (None: the job asks for none)
         values = [(r[sub] if sub else r)[key] for r in records if "pixel_f1_0px" in r]
         return min(values) if values else None
+
     report = {
-        "tool": "wirecheck crosscheck", "verdict": gate.run_verdict(records, compared, "frames", allow_vacuous),
-        "candidate": name or f"frames:{Path(job_dir).name}", "candidate_settings": None, "level": "frames",
-        "style": "wireframe", "hidden_lines": False, "cull": "none", "oracles": ["pyrender", "core"],
+        "tool": "wirecheck crosscheck",
+        "verdict": gate.run_verdict(records, compared, "frames", allow_vacuous),
+        "candidate": name or f"frames:{Path(job_dir).name}",
+        "candidate_settings": None,
+        "level": "frames",
+        "style": "wireframe",
+        "hidden_lines": False,
+        "cull": "none",
+        "oracles": ["pyrender", "core"],
         "oracle_gl": gl,
-        "frames": job["frames"], "every": job["every"], "frames_checked": len(job["frame_numbers"]),
+        "frames": job["frames"],
+        "every": job["every"],
+        "frames_checked": len(job["frame_numbers"]),
         "motion": job["motion"],
         "tolerances": tolerances,
-        "allow_vacuous": allow_vacuous, "line_rule": line_rule, "compared": compared,
+        "allow_vacuous": allow_vacuous,
+        "line_rule": line_rule,
+        "compared": compared,
         **({} if outputs == ("wireframe",) else {"outputs": list(outputs), "depth_encoding": job["depth_encoding"]}),
-        "summary": {"cases": len(records), "passed": len(records) - failed - vacuous, "failed": failed,
-                    "vacuous": vacuous,
-                    "max_vertex_error_px": None,
-                    "min_pixel_f1_0px": lowest("pixel_f1_0px"),
-                    "min_pixel_f1_1px": lowest("pixel_f1_1px"),
-                    "min_core_f1_0px": lowest("f1_0px", "core"),
-                    "min_core_f1_1px": lowest("f1_1px", "core")},
+        "summary": {
+            "cases": len(records),
+            "passed": len(records) - failed - vacuous,
+            "failed": failed,
+            "vacuous": vacuous,
+            "max_vertex_error_px": None,
+            "min_pixel_f1_0px": lowest("pixel_f1_0px"),
+            "min_pixel_f1_1px": lowest("pixel_f1_1px"),
+            "min_core_f1_0px": lowest("f1_0px", "core"),
+            "min_core_f1_1px": lowest("f1_1px", "core"),
+        },
         "cases": records,
         "timing": {"wall_s": time.perf_counter() - t0},
     }

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import tolerances as _tolerances
-from .line_profile import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX
 from ..segment_geometry import seg_distance
+from .line_profile import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX
 
 #: A segment end is measured when no other segment comes this close to it (px): the profile along the
 #: line (4 px past the end) stays clear of every other line's window.
@@ -74,17 +74,19 @@ def measure_ends(cov: np.ndarray, segs: np.ndarray, level: float = 1.0) -> np.nd
     end = segs[long_enough].reshape(-1, 2)
     out_dir = np.stack([-unit, unit], axis=1).reshape(-1, 2)
     normal = np.repeat(normal, 2, axis=0)
-    free = ((margin <= end[:, 0]) & (end[:, 0] <= w - 1 - margin)
-            & (margin <= end[:, 1]) & (end[:, 1] <= h - 1 - margin))
+    free = (margin <= end[:, 0]) & (end[:, 0] <= w - 1 - margin) & (margin <= end[:, 1]) & (end[:, 1] <= h - 1 - margin)
     if len(segs) > 1 and free.any():
         dist = seg_distance(end, segs[:, 0], segs[:, 1])
-        dist[np.arange(len(end)), seg] = np.inf                 # its own segment
+        dist[np.arange(len(end)), seg] = np.inf  # its own segment
         free &= dist.min(axis=1) > FREE_END_PX
     end, out_dir, normal = end[free], out_dir[free], normal[free]
     if len(end) == 0:
         return np.zeros(0)
-    q = (end[:, None, None, :] + s[None, :, None, None] * out_dir[:, None, None, :]
-         + t[None, None, :, None] * normal[:, None, None, :])                 # (ends, len(s), len(t), 2)
+    q = (
+        end[:, None, None, :]
+        + s[None, :, None, None] * out_dir[:, None, None, :]
+        + t[None, None, :, None] * normal[:, None, None, :]
+    )  # (ends, len(s), len(t), 2)
     masses = _bilinear(cov, q, level).sum(axis=2) * 0.5
     out = []
     for mass in masses:
@@ -93,9 +95,9 @@ def measure_ends(cov: np.ndarray, segs: np.ndarray, level: float = 1.0) -> np.nd
             continue
         above = np.flatnonzero(mass >= inner / 2.0)
         k = above.max()
-        if k + 1 >= len(s):                      # still drawn at the end of the reach
+        if k + 1 >= len(s):  # still drawn at the end of the reach
             out.append(float(s[-1]))
             continue
-        m0, m1 = mass[k], mass[k + 1]         # cross half the inner width between s[k] and s[k + 1]
+        m0, m1 = mass[k], mass[k + 1]  # cross half the inner width between s[k] and s[k + 1]
         out.append(float(s[k] + (s[k + 1] - s[k]) * (m0 - inner / 2.0) / max(m0 - m1, 1e-12)))
     return np.asarray(out)

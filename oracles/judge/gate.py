@@ -34,28 +34,45 @@ from dataclasses import dataclass
 from wirecheck.core.errors import InputError
 from wirecheck.core.limits import MAX_FRAMES, check_turns
 from wirecheck.core.scene import files as scene_files
-from wirecheck.core.scene.model import Scene
 from wirecheck.core.scene.files import builtin_names, load_scene
+from wirecheck.core.scene.model import Scene
 
 from ..cases import ALL_CASE_NAMES, CALIBRATED_CASE_NAMES, CASE_NAMES
 
 #: How each input is called in messages: by the Python API, and by the ``crosscheck`` CLI.
-API_NAMES = {"scenes": "scenes", "frames": "frames", "every": "every", "cases": "cases", "turns": "turns",
-             "vertex_px": "tol_px", "min_f1_1px": "min_f1", "min_f1_0px": "min_f1_0px", "min_iou": "min_iou"}
-CLI_NAMES = {"scenes": "--scene", "frames": "--frames", "every": "--every", "cases": "--cases", "turns": "--spin",
-             "vertex_px": "--tol-px", "min_f1_1px": "--min-f1", "min_f1_0px": "--min-f1-0px",
-             "min_iou": "--min-iou"}
+API_NAMES = {
+    "scenes": "scenes",
+    "frames": "frames",
+    "every": "every",
+    "cases": "cases",
+    "turns": "turns",
+    "vertex_px": "tol_px",
+    "min_f1_1px": "min_f1",
+    "min_f1_0px": "min_f1_0px",
+    "min_iou": "min_iou",
+}
+CLI_NAMES = {
+    "scenes": "--scene",
+    "frames": "--frames",
+    "every": "--every",
+    "cases": "--cases",
+    "turns": "--spin",
+    "vertex_px": "--tol-px",
+    "min_f1_1px": "--min-f1",
+    "min_f1_0px": "--min-f1-0px",
+    "min_iou": "--min-iou",
+}
 
 
 @dataclass(frozen=True)
 class RunInputs:
     """The validated inputs of a run: what every case shares."""
 
-    scenes: tuple            # of core.scene.model.Scene, distinct names
-    frames: int              # >= 1
-    every: int               # 1 <= every <= frames
-    case_names: tuple        # of ALL_CASE_NAMES, distinct, in that order
-    turns: tuple             # three finite floats
+    scenes: tuple  # of core.scene.model.Scene, distinct names
+    frames: int  # >= 1
+    every: int  # 1 <= every <= frames
+    case_names: tuple  # of ALL_CASE_NAMES, distinct, in that order
+    turns: tuple  # three finite floats
 
     @property
     def frames_checked(self) -> int:
@@ -77,25 +94,31 @@ def resolve_scenes(scenes, names: dict = API_NAMES) -> tuple:
     if scenes is None:
         bundled = builtin_names()
         if not bundled:
-            raise InputError(f"no bundled scenes found in {scene_files.SCENE_DIR}: the installation is incomplete "
-                             f"(expected scenes/*.scene); name a scene file with {names['scenes']}")
+            raise InputError(
+                f"no bundled scenes found in {scene_files.SCENE_DIR}: the installation is incomplete "
+                f"(expected scenes/*.scene); name a scene file with {names['scenes']}"
+            )
         scenes = bundled
     elif isinstance(scenes, (str, os.PathLike, Scene)):
         scenes = [scenes]
     given = _listed(scenes, names["scenes"], "a scene name, a path or a Scene, or a list of them")
     odd = [s for s in given if not isinstance(s, (str, os.PathLike, Scene))]
     if odd:
-        raise InputError(f"{names['scenes']}: {odd[0]!r} ({type(odd[0]).__name__}): expected a scene name, "
-                         "a path or a Scene")
+        raise InputError(
+            f"{names['scenes']}: {odd[0]!r} ({type(odd[0]).__name__}): expected a scene name, a path or a Scene"
+        )
     out = tuple(s if isinstance(s, Scene) else load_scene(os.fspath(s)) for s in given)
     if not out:
-        raise InputError(f"{names['scenes']}: no scene given: expected at least one scene "
-                         "(or none at all for every bundled scene)")
+        raise InputError(
+            f"{names['scenes']}: no scene given: expected at least one scene (or none at all for every bundled scene)"
+        )
     seen = {}
     for s in out:
         if s.name in seen:
-            raise InputError(f"{names['scenes']}: two scenes named {s.name!r} ({seen[s.name] or '?'}, "
-                             f"{s.source or '?'}): expected each scene once")
+            raise InputError(
+                f"{names['scenes']}: two scenes named {s.name!r} ({seen[s.name] or '?'}, "
+                f"{s.source or '?'}): expected each scene once"
+            )
         seen[s.name] = s.source
     return out
 
@@ -119,13 +142,18 @@ def resolve_cases(cases, names: dict = API_NAMES) -> tuple:
     name = names["cases"]
     if cases is None:
         return CASE_NAMES
-    given = ([c.strip() for c in cases.split(",") if c.strip()] if isinstance(cases, str)
-             else _listed(cases, name, "a list of case names or a comma-separated string"))
+    given = (
+        [c.strip() for c in cases.split(",") if c.strip()]
+        if isinstance(cases, str)
+        else _listed(cases, name, "a list of case names or a comma-separated string")
+    )
     given = [member for c in given for member in (CASE_GROUPS.get(c, (c,)) if isinstance(c, str) else (c,))]
     bad = [c for c in given if not isinstance(c, str) or c not in ALL_CASE_NAMES]
     if bad or not given:
-        raise InputError(f"{name} {cases!r}: {'unknown ' + ', '.join(map(repr, bad)) if bad else 'no case named'}; "
-                         f"expected some of {', '.join(ALL_CASE_NAMES)} or a group: {', '.join(CASE_GROUPS)}")
+        raise InputError(
+            f"{name} {cases!r}: {'unknown ' + ', '.join(map(repr, bad)) if bad else 'no case named'}; "
+            f"expected some of {', '.join(ALL_CASE_NAMES)} or a group: {', '.join(CASE_GROUPS)}"
+        )
     twice = sorted({c for c in given if given.count(c) > 1})
     if twice:
         raise InputError(f"{name} {cases!r}: {', '.join(twice)} given twice: expected each case once")
@@ -143,8 +171,9 @@ def check_tolerances(tol, names: dict = API_NAMES) -> None:
             raise InputError(f"{names[field]} {v!r}: expected a number in [0, 1]")
 
 
-def run_inputs(scenes, frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None,
-               names: dict = API_NAMES) -> RunInputs:
+def run_inputs(
+    scenes, frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None, names: dict = API_NAMES
+) -> RunInputs:
     """Validate what a run compares, or raise InputError naming the input as ``names`` spells it.
 
     ``cases`` and ``turns`` may be comma-separated strings (as the CLI takes
@@ -154,16 +183,19 @@ def run_inputs(scenes, frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=N
     return dataclasses.replace(settings, scenes=resolve_scenes(scenes, names))
 
 
-def run_settings(frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None,
-                 names: dict = API_NAMES) -> RunInputs:
+def run_settings(frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None, names: dict = API_NAMES) -> RunInputs:
     """:func:`run_inputs` without the scenes (``scenes=()``): a dataset's meshes are checked as they load."""
     frames = _integer(frames, names["frames"], 1)
     if frames > MAX_FRAMES:
-        raise InputError(f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (wirecheck.core.limits)")
+        raise InputError(
+            f"{names['frames']} {frames}: expected an integer in 1..{MAX_FRAMES:,} (wirecheck.core.limits)"
+        )
     every = _integer(every, names["every"], 1)
     if every > frames:
-        raise InputError(f"{names['every']} {every} with {names['frames']} {frames}: only frame 1 would be "
-                         f"checked: expected {names['every']} <= {names['frames']}")
+        raise InputError(
+            f"{names['every']} {every} with {names['frames']} {frames}: only frame 1 would be "
+            f"checked: expected {names['every']} <= {names['frames']}"
+        )
     given = turns
     try:
         turns = tuple(float(x) for x in (turns.split(",") if isinstance(turns, str) else turns))
@@ -179,6 +211,7 @@ def run_settings(frames, every=1, cases=None, turns=(1.0, 1.0, 0.0), tol=None,
 
 # ---------------------------------------------------------------- verdicts
 
+
 def _frames(n: int) -> str:
     return "the one checked frame" if n == 1 else f"any of the {n} checked frames"
 
@@ -193,15 +226,17 @@ def vacuous_reason(compared: dict, level: str, points: int | None = None) -> str
     frames = compared["frames"]
     if frames == 0:
         return "nothing compared: no frame was checked"
-    if level == "frames":            # a renderer's frames: pixels only, no vertex is compared
+    if level == "frames":  # a renderer's frames: pixels only, no vertex is compared
         if not compared["pixels"]:
             return f"vacuous: neither side drew a pixel in {_frames(frames)}: nothing compared"
         return None
     if compared["vertices"] == 0 and points == 0:
         return "vacuous: the scene has no vertices: nothing compared"
     if compared["vertices"] == 0:
-        return (f"vacuous: no vertex visible to both sides in {_frames(frames)} "
-                "(every point clipped by both): nothing compared")
+        return (
+            f"vacuous: no vertex visible to both sides in {_frames(frames)} "
+            "(every point clipped by both): nothing compared"
+        )
     if level == "pixels" and not compared["pixels"]:
         return f"vacuous: neither side drew a pixel in {_frames(frames)}: nothing compared at level pixels"
     return None
@@ -218,18 +253,22 @@ def case_verdict(compared: dict, reasons: list, level: str, points: int | None =
 def compared_totals(records: list, level: str) -> dict:
     """What a run compared: cases that compared something, and frames, vertices, pixels over all cases."""
     counts = [r["compared"] for r in records]
-    return {"cases": sum(1 for r, c in zip(records, counts) if r["verdict"] != "vacuous" and c["frames"]),
-            "frames": sum(c["frames"] for c in counts),
-            "vertices": sum(c["vertices"] for c in counts),
-            "pixels": sum(c["pixels"] or 0 for c in counts) if level == "pixels" else None}
+    return {
+        "cases": sum(1 for r, c in zip(records, counts) if r["verdict"] != "vacuous" and c["frames"]),
+        "frames": sum(c["frames"] for c in counts),
+        "vertices": sum(c["vertices"] for c in counts),
+        "pixels": sum(c["pixels"] or 0 for c in counts) if level == "pixels" else None,
+    }
 
 
 def run_verdict(records: list, compared: dict, level: str, allow_vacuous: bool = False) -> str:
     """``"pass"`` only when the run compared something and no case failed (module docstring)."""
     if not records or compared["frames"] == 0 or any(r["verdict"] == "fail" for r in records):
         return "fail"
-    if not allow_vacuous and (any(r["verdict"] == "vacuous" for r in records)
-                              or (level != "frames" and compared["vertices"] == 0)
-                              or (level in ("pixels", "frames") and not compared["pixels"])):
+    if not allow_vacuous and (
+        any(r["verdict"] == "vacuous" for r in records)
+        or (level != "frames" and compared["vertices"] == 0)
+        or (level in ("pixels", "frames") and not compared["pixels"])
+    ):
         return "fail"
     return "pass"

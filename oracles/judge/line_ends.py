@@ -68,24 +68,25 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
     if not frames:
         return out
     h, w = frames[0][0].shape
-    box = ((-0.5, -0.5), (w - 0.5, h - 0.5))                  # where a line leaving the picture ends
+    box = ((-0.5, -0.5), (w - 0.5, h - 0.5))  # where a line leaving the picture ends
     for side in (0, 1):
         only = [fp.only()[side] for fp, _, _ in frames]
         if not sum(len(o) for o in only):
             continue
         # each pixel's nearest segment within reach (the segments near it only, not all of them)
-        owner, q0, q1, frame = nearest_segments([(p0, p1, o) for (_, p0, p1), o in zip(frames, only)],
-                                                w, h, END_REACH_PX, box)
+        owner, q0, q1, frame = nearest_segments(
+            [(p0, p1, o) for (_, p0, p1), o in zip(frames, only)], w, h, END_REACH_PX, box
+        )
         pix = np.concatenate(only)
         near = owner >= 0
         m, f = owner[near], frame[near]
         c = np.column_stack([pix[near] % w, pix[near] // w]).astype(np.float64)
         tie, partner = line_ties.tie_crossings(c, q0[m], q1[m])
-        if tie.any():                   # a crossing tie needs its partner pixel drawn by the other image
+        if tie.any():  # a crossing tie needs its partner pixel drawn by the other image
             other = [fp.cand_idx if side == 1 else fp.oracle_idx for fp, _, _ in frames]
-            drawn = np.concatenate([o + k * h * w for k, o in enumerate(other)])    # ascending: frame after frame
+            drawn = np.concatenate([o + k * h * w for k, o in enumerate(other)])  # ascending: frame after frame
             tie &= line_ties.partner_drawn(partner, f, (h, w), drawn)
-        tie |= line_ties.tie_ends(c, q0[m], q1[m], box)      # an end within the oracle's precision of its exit
+        tie |= line_ties.tie_ends(c, q0[m], q1[m], box)  # an end within the oracle's precision of its exit
         if tie.any():
             tied, tied_frame = pix[near][tie], f[tie]
             for k in np.unique(tied_frame):
@@ -93,8 +94,12 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
         to_start = np.hypot(*(c - q0[m]).T) <= END_REACH_PX
         to_end = np.hypot(*(c - q1[m]).T) <= END_REACH_PX
         n = len(frames)
-        place = {"tie": tie, "start": ~tie & to_start & ~to_end, "end": ~tie & to_end & ~to_start,
-                 "middle": ~tie & (to_start == to_end)}
+        place = {
+            "tie": tie,
+            "start": ~tie & to_start & ~to_end,
+            "end": ~tie & to_end & ~to_start,
+            "middle": ~tie & (to_start == to_end),
+        }
         for name, hit in place.items():
             for k, v in enumerate(np.bincount(f[hit], minlength=n)):
                 out[k][name][side] += int(v)
@@ -115,7 +120,7 @@ def resolve_ties(fp, ties: tuple):
     cand_ties, oracle_ties = ties
     if not len(cand_ties) and not len(oracle_ties):
         return fp
-    swapped = fp.exchanged(cand_ties, oracle_ties)                 # ties found by frames_end_places: a merge
+    swapped = fp.exchanged(cand_ties, oracle_ties)  # ties found by frames_end_places: a merge
     if swapped is not None:
         return swapped
     kept = fp.cand_idx[~np.isin(fp.cand_idx, cand_ties, assume_unique=True)]

@@ -41,14 +41,21 @@ A binary band of width ``w`` (:func:`band_pixels`): the pixel centres within ``w
 from __future__ import annotations
 
 import numpy as np
-
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector.raster import line_pixels
 
 from ..tolerances import ROUNDED_END_TIE_PX
 
-__all__ = ["RULES", "END_TIE_PX", "rounded_pixels", "rounded_ties", "expected", "band_distances",
-           "band_pixels", "band_holding"]
+__all__ = [
+    "RULES",
+    "END_TIE_PX",
+    "rounded_pixels",
+    "rounded_ties",
+    "expected",
+    "band_distances",
+    "band_pixels",
+    "band_holding",
+]
 
 #: The aliased rules the model draws (module docstring).
 RULES = ("gl", "rounded")
@@ -71,7 +78,7 @@ def _step(a: np.ndarray, b: np.ndarray):
     where the minor coordinate is exactly a half pixel (the pixel itself elsewhere).
     """
     d = b - a
-    x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])        # a diagonal steps y (its minor is exact anyway)
+    x_major = np.abs(d[:, 0]) > np.abs(d[:, 1])  # a diagonal steps y (its minor is exact anyway)
     n = np.maximum(np.abs(d[:, 0]), np.abs(d[:, 1]))
     seg = np.repeat(np.arange(len(a)), n + 1)
     start = np.cumsum(n + 1) - (n + 1)
@@ -85,9 +92,9 @@ def _step(a: np.ndarray, b: np.ndarray):
     d_minor = np.take_along_axis(d[seg], minor_ax[:, None], 1)[:, 0]
     major = a_major + np.sign(d_major) * k
     # exact minor = a_minor + k d_minor / n; nearest pixel floor(exact + 1/2) in integers:
-    num = 2 * k * d_minor + nn                          # 2 n (exact - a_minor) + n
+    num = 2 * k * d_minor + nn  # 2 n (exact - a_minor) + n
     minor = a_minor + np.floor_divide(num, 2 * nn)
-    tied = (np.mod(num, 2 * nn) == 0) & (n[seg] > 0)     # exact minor on a half pixel: minor or minor - 1
+    tied = (np.mod(num, 2 * nn) == 0) & (n[seg] > 0)  # exact minor on a half pixel: minor or minor - 1
     partner = minor - tied
     x = np.where(major_ax == 0, major, minor)
     y = np.where(major_ax == 0, minor, major)
@@ -159,20 +166,31 @@ def _end_choices(q: np.ndarray, cuts: list, outside: np.ndarray, end_tie_px: flo
     by each of :data:`CLIP_MARGINS_PX` (the ends themselves when inside that), ``outside`` whether each
     end lies outside the image.
     """
+
     def corners(lo, hi):
-        return np.stack([np.stack([lo[:, 0], lo[:, 1]], 1), np.stack([hi[:, 0], lo[:, 1]], 1),
-                         np.stack([lo[:, 0], hi[:, 1]], 1), np.stack([hi[:, 0], hi[:, 1]], 1)], axis=1)
+        return np.stack(
+            [
+                np.stack([lo[:, 0], lo[:, 1]], 1),
+                np.stack([hi[:, 0], lo[:, 1]], 1),
+                np.stack([lo[:, 0], hi[:, 1]], 1),
+                np.stack([hi[:, 0], hi[:, 1]], 1),
+            ],
+            axis=1,
+        )
 
     base = _round_half_up(q)
-    fuzzy = np.abs(q - np.floor(q) - 0.5) <= end_tie_px                # per axis
+    fuzzy = np.abs(q - np.floor(q) - 0.5) <= end_tie_px  # per axis
     near = corners(np.where(fuzzy, np.floor(q), base), np.where(fuzzy, np.floor(q) + 1, base))
     # an end outside the image: the renderer may cut the line anywhere out to it, then round either way
     # across the line (along it, the rounding moves the end by a pixel outside the image: nothing drawn)
     out = [near]
     for c in cuts:
         d = c - q
-        minor = np.where(np.abs(d[:, :1]) >= np.abs(d[:, 1:]), [[False, True]], [[True, False]]) \
-            if len(q) else np.zeros((0, 2), bool)
+        minor = (
+            np.where(np.abs(d[:, :1]) >= np.abs(d[:, 1:]), [[False, True]], [[True, False]])
+            if len(q)
+            else np.zeros((0, 2), bool)
+        )
         lo = np.where(minor, np.floor(c), _round_half_up(c))
         hi = np.where(minor, np.floor(c) + 1, _round_half_up(c))
         out.append(np.where(outside[:, None, None], np.stack([lo, hi, lo, hi], axis=1), near))
@@ -192,7 +210,7 @@ def rounded_ties(segs_px: np.ndarray, shape, end_tie_px: float = END_TIE_PX) -> 
     if not len(q0):
         return ties
     h, w = shape
-    seen, _, _ = clip_to_image(q0, q1, w, h)             # segments that reach the image
+    seen, _, _ = clip_to_image(q0, q1, w, h)  # segments that reach the image
     out0 = np.any((q0 < -0.5) | (q0 > np.array([w, h]) - 0.5), axis=1) & seen
     out1 = np.any((q1 < -0.5) | (q1 > np.array([w, h]) - 0.5), axis=1) & seen
     cuts0, cuts1 = [], []
@@ -208,7 +226,7 @@ def rounded_ties(segs_px: np.ndarray, shape, end_tie_px: float = END_TIE_PX) -> 
     across = (tx != x) | (ty != y)
     ties |= _paint(shape, x[across], y[across]) | _paint(shape, tx[across], ty[across])
     groups, a, b, sizes = [], [], [], []
-    for i in np.flatnonzero(fuzzy & seen):              # each fuzzy segment's roundings, drawn in one batch
+    for i in np.flatnonzero(fuzzy & seen):  # each fuzzy segment's roundings, drawn in one batch
         u0, u1 = np.unique(c0[i], axis=0), np.unique(c1[i], axis=0)
         a.append(np.repeat(u0, len(u1), axis=0))
         b.append(np.tile(u1, (len(u0), 1)))
@@ -226,8 +244,9 @@ def rounded_ties(segs_px: np.ndarray, shape, end_tie_px: float = END_TIE_PX) -> 
     return ties
 
 
-def expected(segs_px: np.ndarray, shape, rule: str = "gl", end_tie_px: float = END_TIE_PX
-             ) -> tuple[np.ndarray, np.ndarray]:
+def expected(
+    segs_px: np.ndarray, shape, rule: str = "gl", end_tie_px: float = END_TIE_PX
+) -> tuple[np.ndarray, np.ndarray]:
     """``(drawn, ties)``: two ``(H, W)`` bool masks, a correct drawing of ``segs_px`` under ``rule`` and the
     pixels it cannot decide (for ``"gl"``: none here, :mod:`oracles.judge.line_ties` finds GL's against a
     candidate's pixels)."""
@@ -259,11 +278,11 @@ def band_distances(segs_px: np.ndarray, shape, reach_px: float, lean_px: float =
         hi = np.minimum(np.ceil(np.maximum(a, b) + reach_px), [w - 1, h - 1]).astype(int)
         if np.any(hi < lo):
             continue
-        yy, xx = np.mgrid[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
+        yy, xx = np.mgrid[lo[1] : hi[1] + 1, lo[0] : hi[0] + 1]
         q = np.stack([xx.ravel(), yy.ravel()], axis=1).astype(float)
         t = np.clip(((q - a) @ d) / max(length * length, 1e-300), 0.0, 1.0)
         near = np.hypot(*(q - (a + t[:, None] * d)).T).reshape(yy.shape)
-        window = dist[lo[1]:hi[1] + 1, lo[0]:hi[0] + 1]
+        window = dist[lo[1] : hi[1] + 1, lo[0] : hi[0] + 1]
         np.minimum(window, near, out=window)
     return dist
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 #: Half the window across a line in which its centroid is taken (px): a 3-px line's half width
 #: (1.5) plus an antialiased fringe (1) plus a pixel of slack for a half-pixel offset.
 PROFILE_RADIUS_PX = 3
@@ -38,7 +37,7 @@ def pooled_offset(normal: np.ndarray, offset: np.ndarray):
     if len(offset) < MIN_SAMPLES:
         return np.zeros(2), np.zeros(2, bool)
     nn = normal.T @ normal
-    determined = np.diag(nn) >= 0.05 * len(offset)     # >= 5 % of the samples' weight on that axis
+    determined = np.diag(nn) >= 0.05 * len(offset)  # >= 5 % of the samples' weight on that axis
     d = np.zeros(2)
     idx = np.flatnonzero(determined)
     if len(idx):

@@ -75,19 +75,19 @@ the tolerances, oracles.judge.name_faults names it):
 from __future__ import annotations
 
 import numpy as np
+from wirecheck.core.projector import raster
+from wirecheck.core.projector.clipping import clip_to_image
 
 from .. import faults as catalogue
 from .. import tolerances
-from . import coverage_pixels, even_lean, free_ends, line_model, line_ties, line_windows
 from ..diagnosis.diagnose import diagnose_lines
-from .case_samples import CaseSamples
-from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
 from ..diagnosis.image_diagnose import oracle_segments
-from wirecheck.core.projector.clipping import clip_to_image
-from wirecheck.core.projector import raster
+from ..faults import Fault
+from . import coverage_pixels, even_lean, free_ends, line_model, line_ties, line_windows
+from .case_samples import CaseSamples
 from .decide import ROUNDED_RULE_NAME
 from .evidence import StyleRead
-from ..faults import Fault
+from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
 
 STYLES = ("aliased", "antialiased", "wide")
 #: ``--line-rule``: ``any`` (the default) holds aliased lines to a correct drawing under GL's rule or under
@@ -128,21 +128,21 @@ RULE_OFFSET_MAX_PX = tolerances.RULE_OFFSET_MAX_PX
 
 CAN_SHOW = {
     "aliased": "every pixel: the line rule (GL's or another), the geometry to the pixel, "
-               "pixel offsets pooled over the lines",
+    "pixel offsets pooled over the lines",
     "antialiased": "each line's centre to a fraction of a pixel (the coverage centroid): offsets, scale, "
-                   "missing or extra lines, where free ends stop",
+    "missing or extra lines, where free ends stop",
     "wide": "each line's centre to a fraction of a pixel (the centroid across the line): offsets, scale, "
-            "missing or extra lines, where free ends stop (beyond the cap)",
+    "missing or extra lines, where free ends stop (beyond the cap)",
 }
 CANNOT_SHOW = {
     "aliased": "one line's own centre to a fraction of a pixel (a 1-px line is a choice of pixels: offsets "
-               "are pooled over the lines)",
+    "are pooled over the lines)",
     "antialiased": "GL's pixel rule: coverage is not a choice of pixels, so F1@0px is reported, not judged; an "
-                   "end where lines meet; a line under 0.5 px wide (coverage_pixels: no drawn pixel at a tie)",
+    "end where lines meet; a line under 0.5 px wide (coverage_pixels: no drawn pixel at a tie)",
     "wide": "GL's pixel rule (F1@0px is reported, not judged); an end pixel where lines meet (the other line's "
-            "width covers it); binary: a centre offset under 0.35 px; an even width (2 px), whose lines may lean "
-            "half a pixel either side edge by edge: a move all its lines lean against, a half-pixel move "
-            "to better than 0.3-0.9 px when the ends are rounded to pixels (oracles.judge.even_lean)",
+    "width covers it); binary: a centre offset under 0.35 px; an even width (2 px), whose lines may lean "
+    "half a pixel either side edge by edge: a move all its lines lean against, a half-pixel move "
+    "to better than 0.3-0.9 px when the ends are rounded to pixels (oracles.judge.even_lean)",
 }
 
 
@@ -166,8 +166,9 @@ def windows(segs: np.ndarray, shape) -> dict:
     return line_windows.windows(segs, shape, PROFILE_RADIUS_PX, GUARD_PX)
 
 
-def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME, wins: dict | None = None,
-            level: float = 1.0) -> dict:
+def measure(
+    cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAME, wins: dict | None = None, level: float = 1.0
+) -> dict:
     """The centroid samples of one frame (module docstring), as a dict of arrays of ``M`` samples.
 
     ``cov / level``: ``(H, W)`` coverage (0 background, 1 a fully drawn pixel;
@@ -186,14 +187,19 @@ def measure(cov: np.ndarray, segs: np.ndarray, limit: int = MAX_SAMPLES_PER_FRAM
     mass = g.sum(axis=1)
     centroid = (g * wins["minor"]).sum(axis=1) / np.maximum(mass, 1e-300)
     # a shift s along the normal moves the line's minor coordinate by s / |normal[minor]|
-    out = {"normal": wins["normal"], "offset": (centroid - wins["exact"]) * wins["across"],
-           "width": mass * np.abs(wins["across"]),          # a column crosses the line at 1 / |n_minor|
-           "segment": wins["segment"], "point": wins["point"], "mass": mass}
+    out = {
+        "normal": wins["normal"],
+        "offset": (centroid - wins["exact"]) * wins["across"],
+        "width": mass * np.abs(wins["across"]),  # a column crosses the line at 1 / |n_minor|
+        "segment": wins["segment"],
+        "point": wins["point"],
+        "mass": mass,
+    }
     windows_n = len(out["offset"])
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
     keep = np.flatnonzero((out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5))
     found = len(keep)
-    if found > limit:                                   # evenly thinned: one gather of each field
+    if found > limit:  # evenly thinned: one gather of each field
         keep = keep[np.linspace(0, found - 1, limit).round().astype(int)]
     out = {k: v[keep] for k, v in out.items()}
     out["windows"], out["found"] = windows_n, found
@@ -211,7 +217,7 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
     if len(offset) < MIN_SAMPLES:
         return None
     q = point - centre
-    design = np.column_stack([normal, normal[:, :1] * q, normal[:, 1:] * q])   # d_x, d_y, m_xx, m_xy, m_yx, m_yy
+    design = np.column_stack([normal, normal[:, :1] * q, normal[:, 1:] * q])  # d_x, d_y, m_xx, m_xy, m_yx, m_yy
     scale = np.maximum(np.abs(design).max(axis=0), 1e-12)
     sv = np.linalg.svd(design / scale, compute_uv=False)
     if sv[-1] < 1e-3 * sv[0]:
@@ -246,7 +252,7 @@ def _off_by_one(fp, ends: np.ndarray) -> dict:
     c_only, o_only = fp.only()
     flat = np.concatenate([c_only, o_only])
     rr, cc = np.divmod(flat, w)
-    extra = np.arange(len(flat)) < len(c_only)          # a candidate-only pixel: look in the oracle's, else in the candidate's
+    extra = np.arange(len(flat)) < len(c_only)  # a candidate-only pixel: look in the oracle's, else in the candidate's
     # a pixel of the other side among the 8 neighbours: every neighbour looked up at once
     dy, dx = np.array([-1, -1, -1, 0, 0, 1, 1, 1]), np.array([-1, 0, 1, -1, 1, -1, 0, 1])
     y, x = rr[:, None] + dy, cc[:, None] + dx
@@ -260,11 +266,15 @@ def _off_by_one(fp, ends: np.ndarray) -> dict:
     if len(rr) and len(ends):
         q = np.stack([cc, rr], axis=1).astype(float)
         for k in range(0, len(q), 4096):
-            d = np.hypot(q[k:k + 4096, None, 0] - ends[None, :, 0], q[k:k + 4096, None, 1] - ends[None, :, 1])
-            at_end[k:k + 4096] = d.min(axis=1) <= END_RADIUS_PX
-    return {"oracle_pixels": int(len(fp.oracle_idx)), "differing": int(len(rr)),
-            "off_by_one_across": int((off1 & ~at_end).sum()), "off_by_one_at_ends": int((off1 & at_end).sum()),
-            "farther": int((~off1).sum())}
+            d = np.hypot(q[k : k + 4096, None, 0] - ends[None, :, 0], q[k : k + 4096, None, 1] - ends[None, :, 1])
+            at_end[k : k + 4096] = d.min(axis=1) <= END_RADIUS_PX
+    return {
+        "oracle_pixels": int(len(fp.oracle_idx)),
+        "differing": int(len(rr)),
+        "off_by_one_across": int((off1 & ~at_end).sum()),
+        "off_by_one_at_ends": int((off1 & at_end).sum()),
+        "farther": int((~off1).sum()),
+    }
 
 
 class CaseStyle:
@@ -283,13 +293,18 @@ class CaseStyle:
         self.line_rule = line_rule
         self.hist = np.zeros(256, np.int64)
         self.length_px = 0.0
-        self.samples = CaseSamples()            # measure() of each frame
-        self.ends = []                          # measure_ends() of each frame
-        self.raster = {"oracle_pixels": 0, "differing": 0, "off_by_one_across": 0, "off_by_one_at_ends": 0,
-                       "farther": 0}
-        self.reference = CaseSamples()          # measure() of a correct binary drawing of each binary frame
-        self._kept = 0                          # samples in self.samples and self.reference
-        self.drawn_px = np.zeros(2, np.int64)   # binary frames: the candidate's drawn pixels, the oracle's
+        self.samples = CaseSamples()  # measure() of each frame
+        self.ends = []  # measure_ends() of each frame
+        self.raster = {
+            "oracle_pixels": 0,
+            "differing": 0,
+            "off_by_one_across": 0,
+            "off_by_one_at_ends": 0,
+            "farther": 0,
+        }
+        self.reference = CaseSamples()  # measure() of a correct binary drawing of each binary frame
+        self._kept = 0  # samples in self.samples and self.reference
+        self.drawn_px = np.zeros(2, np.int64)  # binary frames: the candidate's drawn pixels, the oracle's
         self.centre = np.zeros(2)
 
     def frame(self, grey: np.ndarray, orac: np.ndarray, p_model, edges, camera, m, segs=None) -> np.ndarray:
@@ -310,7 +325,7 @@ class CaseStyle:
             grey = grey.astype(np.uint8) * 255
         segs = _segments(p_model, edges, camera, m) if segs is None else segs
         self.centre = np.array(camera.principal_point, dtype=float)
-        nonzero = np.flatnonzero(grey > 0)              # (numpy finds a bool array's nonzero faster than uint8's)
+        nonzero = np.flatnonzero(grey > 0)  # (numpy finds a bool array's nonzero faster than uint8's)
         drawn = grey.reshape(-1)[nonzero]
         # drawn where >= 128 (a bool image compares its True with 128: nothing)
         cand = nonzero[:0] if binary_input else nonzero[drawn >= 128]
@@ -321,26 +336,27 @@ class CaseStyle:
             clipped = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
             _, q0, q1 = clipped
             self.length_px += float(np.hypot(*(q1 - q0).T).sum())
-        level = max(int(drawn.max()) if len(drawn) else 0, 1)              # the frame's line level is 1
-        wins = windows(segs, grey.shape)                # the same windows for the candidate and the reference
+        level = max(int(drawn.max()) if len(drawn) else 0, 1)  # the frame's line level is 1
+        wins = windows(segs, grey.shape)  # the same windows for the candidate and the reference
         got = measure(grey, segs, wins=wins, level=level)
-        got["edge"] = got["segment"] + len(self.samples) * (len(segs) + 1)    # one key per frame and segment
+        got["edge"] = got["segment"] + len(self.samples) * (len(segs) + 1)  # one key per frame and segment
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
         if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
-            cand = np.flatnonzero(coverage_pixels.drawn(grey))    # grey levels: a thin line's ridge is drawn too
+            cand = np.flatnonzero(coverage_pixels.drawn(grey))  # grey levels: a thin line's ridge is drawn too
         else:
-            self.drawn_px += (len(cand), int(np.count_nonzero(orac)))      # binary: pixels drawn, the oracle's
-            width = float(np.median(got["width"])) if len(got["width"]) else 1.0     # this frame's width
-            same = grey.shape == (camera.height, camera.width)          # the clipping above is the reference's
-            ref = measure(_reference(segs, grey.shape, width, clipped if same else None, drawn=len(cand)),
-                          segs, wins=wins)
-            for x in (got, ref):                        # an exact tie: either choice is right (line_ties)
+            self.drawn_px += (len(cand), int(np.count_nonzero(orac)))  # binary: pixels drawn, the oracle's
+            width = float(np.median(got["width"])) if len(got["width"]) else 1.0  # this frame's width
+            same = grey.shape == (camera.height, camera.width)  # the clipping above is the reference's
+            ref = measure(
+                _reference(segs, grey.shape, width, clipped if same else None, drawn=len(cand)), segs, wins=wins
+            )
+            for x in (got, ref):  # an exact tie: either choice is right (line_ties)
                 line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
             self.reference.add(ref)
             self._kept += len(ref["offset"])
-        self.samples.add(got)                           # its ties folded (binary frames)
+        self.samples.add(got)  # its ties folded (binary frames)
         self._kept += len(got["offset"])
-        if self._kept > MAX_SAMPLES_PER_CASE:           # every frame's samples halved (case_samples)
+        if self._kept > MAX_SAMPLES_PER_CASE:  # every frame's samples halved (case_samples)
             self.samples.halve()
             self.reference.halve()
             self._kept = self.samples.kept + self.reference.kept
@@ -362,29 +378,43 @@ class CaseStyle:
         drawn = self.hist[1:]
         n = int(drawn.sum())
         if n == 0:
-            return {"style": "aliased", "width_px": 0.0, "grey_share": 0.0, "level": 0, "coverage_steps": 1,
-                    "band_px": 1, "pixel_ratio": 0.0}
+            return {
+                "style": "aliased",
+                "width_px": 0.0,
+                "grey_share": 0.0,
+                "level": 0,
+                "coverage_steps": 1,
+                "band_px": 1,
+                "pixel_ratio": 0.0,
+            }
         cum = np.cumsum(drawn)
         level = int(np.searchsorted(cum, LEVEL_PERCENTILE / 100.0 * n)) + 1
         values = np.arange(1, 256)
         grey = drawn[(values > level / 8.0) & (values < level * 7.0 / 8.0)].sum()
         widths = self._pooled("width")
-        if len(widths) >= MIN_SAMPLES:          # across the free parts of the lines: no junction or crossing
+        if len(widths) >= MIN_SAMPLES:  # across the free parts of the lines: no junction or crossing
             width = float(np.median(widths))
-        else:                                   # too little free line: all coverage over the lines' length
+        else:  # too little free line: all coverage over the lines' length
             coverage = float((np.minimum(values / level, 1.0) * drawn).sum())
             width = coverage / self.length_px if self.length_px > 0 else 0.0
         grey_share = float(grey) / n
         style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
         ratio = float(self.drawn_px[0] / self.drawn_px[1]) if self.drawn_px[1] else 0.0
         band = max(int(np.floor(width + 0.5)), 1)
-        if style == "aliased" and ratio >= even_lean.WIDE_PIXEL_RATIO:      # no 1-px line draws this many
+        if style == "aliased" and ratio >= even_lean.WIDE_PIXEL_RATIO:  # no 1-px line draws this many
             style, band = "wide", 2
         # coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's step on
         # lines that all sit at one fractional position; that half step is added to the offset's tolerance
         steps = max(int((drawn >= LEVEL_SHARE_MIN * n).sum()), 1)
-        return {"style": style, "width_px": round(width, 3), "grey_share": round(grey_share, 4), "level": level,
-                "coverage_steps": steps, "band_px": band, "pixel_ratio": round(ratio, 3)}
+        return {
+            "style": style,
+            "width_px": round(width, 3),
+            "grey_share": round(grey_share, 4),
+            "level": level,
+            "coverage_steps": steps,
+            "band_px": band,
+            "pixel_ratio": round(ratio, 3),
+        }
 
     def _fit(self, samples):
         """``(d (2,), affine)`` over ``samples``: ``d`` the pooled offset (:func:`pooled_offset`), ``affine``
@@ -407,15 +437,22 @@ class CaseStyle:
         windows, found = self.samples.counts["windows"], self.samples.counts["found"]
         n = len(self._pooled("offset"))
         ends = np.concatenate(self.ends) if self.ends else np.zeros(0)
-        geo = {"samples": n, "windows": windows, "found_share": found / windows if windows else 0.0,
-               "offset_px": None, "bias_px": None, "warp_px": None, "ends_measured": int(len(ends)),
-               "end_px": float(np.median(ends)) if len(ends) else None}
+        geo = {
+            "samples": n,
+            "windows": windows,
+            "found_share": found / windows if windows else 0.0,
+            "offset_px": None,
+            "bias_px": None,
+            "warp_px": None,
+            "ends_measured": int(len(ends)),
+            "end_px": float(np.median(ends)) if len(ends) else None,
+        }
         fit = self._fit(self.samples)
         if fit is None:
             return geo
         d, affine = fit
         ref_d, ref_affine = np.zeros(2), None
-        if read["grey_share"] <= GREY_SHARE_MAX:        # binary: quantised; the same measure on a correct drawing
+        if read["grey_share"] <= GREY_SHARE_MAX:  # binary: quantised; the same measure on a correct drawing
             ref = self._fit(self.reference) if len(self.reference) == len(self.samples) else None
             if ref is not None:
                 ref_d, ref_affine = ref
@@ -427,18 +464,25 @@ class CaseStyle:
             return (normal * (aff[0] + (point - self.centre) @ aff[1].T - const)).sum(axis=1)
 
         warp = np.abs(fitted(affine, d) - fitted(ref_affine, ref_d))
-        lean = even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"]) \
-            if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0 else None
-        if lean is not None:                            # an even band: each edge's lean chosen (even_lean)
+        lean = (
+            even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"])
+            if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0
+            else None
+        )
+        if lean is not None:  # an even band: each edge's lean chosen (even_lean)
             tol = tolerances.Tolerances() if tol is None else tol
-            held = np.max(np.abs(d - ref_d)) <= tol.rule_offset_px and (affine is None or np.percentile(warp, 99)
-                                                                         <= tol.scale_px + tolerances.NAMING.binary_warp_px)   # decide's bounds
+            held = np.max(np.abs(d - ref_d)) <= tol.rule_offset_px and (
+                affine is None or np.percentile(warp, 99) <= tol.scale_px + tolerances.NAMING.binary_warp_px
+            )  # decide's bounds
             geo["lean"] = {**{k: lean[k] for k in even_lean.REPORTED}, "used": bool(lean["leaning"] and not held)}
-            if geo["lean"]["used"]:                     # the lean explains what the symmetric band cannot
+            if geo["lean"]["used"]:  # the lean explains what the symmetric band cannot
                 d, ref_d, affine = lean["offset"], np.zeros(2), fit_lines(normal, lean["corrected"], point, self.centre)
                 warp = np.abs(fitted(affine, d))
-        geo.update(offset_px=[float(v) for v in d - ref_d], bias_px=[float(v) for v in ref_d],
-                   warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0)
+        geo.update(
+            offset_px=[float(v) for v in d - ref_d],
+            bias_px=[float(v) for v in ref_d],
+            warp_px=float(np.percentile(warp, 99)) if affine is not None else 0.0,
+        )
         return geo
 
     def read(self, diagnosed, tol=None, rounded=None) -> StyleRead:
@@ -455,11 +499,15 @@ class CaseStyle:
         tol = tolerances.Tolerances() if tol is None else tol
         read = self.classify()
         geo = self.geometry(read, tol)
-        placed = (geo["offset_px"] is not None and geo["found_share"] >= MIN_FOUND_SHARE
-                  and not any(f.name in PLACEMENT_FAULTS for f in diagnosed))
+        placed = (
+            geo["offset_px"] is not None
+            and geo["found_share"] >= MIN_FOUND_SHARE
+            and not any(f.name in PLACEMENT_FAULTS for f in diagnosed)
+        )
         by_rule = read["style"] == "aliased" and self.line_rule in ("gl", "any")
-        rounded_faults = tuple(Fault.of(f) for f in diagnose_lines(rounded["lines"], tol)) \
-            if by_rule and rounded is not None else ()
+        rounded_faults = (
+            tuple(Fault.of(f) for f in diagnose_lines(rounded["lines"], tol)) if by_rule and rounded is not None else ()
+        )
         return StyleRead(self.line_rule, read, geo, dict(self.raster), rounded, rounded_faults, placed)
 
 
@@ -467,11 +515,17 @@ def style_record(s: StyleRead, j, radius_px: int) -> dict:
     """A case's ``line_style`` field (report.json): the style read ``s`` and its judgement ``j``
     (oracles.judge.decide.StyleJudgement), with what the style can and cannot show and the F1 radius."""
     by_rule = s.by_rule
-    out = {**s.read, "line_rule": s.line_rule,
-           "judged_by": "GL's pixel rule (F1@0px) and the geometry" if by_rule else
-                        "the geometry (line centres); F1@0px is reported, not judged",
-           "can_show": CAN_SHOW[s.style], "cannot_show": CANNOT_SHOW[s.style], "offset_tol_px": j.offset_tol_px,
-           "geometry": dict(s.geometry)}
+    out = {
+        **s.read,
+        "line_rule": s.line_rule,
+        "judged_by": "GL's pixel rule (F1@0px) and the geometry"
+        if by_rule
+        else "the geometry (line centres); F1@0px is reported, not judged",
+        "can_show": CAN_SHOW[s.style],
+        "cannot_show": CANNOT_SHOW[s.style],
+        "offset_tol_px": j.offset_tol_px,
+        "geometry": dict(s.geometry),
+    }
     if by_rule and s.line_rule == "any":
         out["judged_by"] = "a correct drawing by GL's rule or by the rounded-ends rule (F1@0px) and the geometry"
     out["warp_tol_px"] = j.warp_tol_px
@@ -480,9 +534,13 @@ def style_record(s: StyleRead, j, radius_px: int) -> dict:
     if by_rule:
         out["rule_read"] = j.rule_read
         if s.rounded is not None:
-            out["rounded_rule"] = {"pixel_f1_0px": s.rounded["pixel_f1_0px"], "failures": list(j.rounded_failures),
-                                   "lines": {k: s.rounded["lines"][k] for k in ("candidate_only", "oracle_only",
-                                                                                  "subpixel_ties", "imbalance")}}
+            out["rounded_rule"] = {
+                "pixel_f1_0px": s.rounded["pixel_f1_0px"],
+                "failures": list(j.rounded_failures),
+                "lines": {
+                    k: s.rounded["lines"][k] for k in ("candidate_only", "oracle_only", "subpixel_ties", "imbalance")
+                },
+            }
     out.update(pixel_rule=j.pixel_rule, failures=list(j.failures), f1_radius_px=radius_px)
     return out
 
@@ -497,16 +555,24 @@ def summary_lines(cases: list) -> list[str]:
             by.setdefault((ls["style"], ls["line_rule"]), []).append(ls)
     out = []
     for (style, rule), rows in sorted(by.items()):
-        widths = [r["width_px"] for r in rows if r["width_px"] is not None]   # None: not finite, null in report.json
+        widths = [r["width_px"] for r in rows if r["width_px"] is not None]  # None: not finite, null in report.json
         radius = max(r.get("f1_radius_px", 1) for r in rows)  # f1_radius
         wide = f"{min(widths):.2f}-{max(widths):.2f} px wide" if widths else "width -"
-        out.append(f"Line style read: {style} ({len(rows)} case{'s' if len(rows) != 1 else ''}, "
-                   f"{wide}, --line-rule {rule}): judged by {rows[0]['judged_by']}"
-                   f"{f'; F1 at up to {radius} px (the width)' if radius > 1 else ''}; cannot show {CANNOT_SHOW[style]}")
-    read = [c for c in cases if (c.get("line_style") or {}).get("rule_read") == "rounded"
-            and c["line_style"]["line_rule"] == "any" and c.get("verdict") == "pass"]
+        out.append(
+            f"Line style read: {style} ({len(rows)} case{'s' if len(rows) != 1 else ''}, "
+            f"{wide}, --line-rule {rule}): judged by {rows[0]['judged_by']}"
+            f"{f'; F1 at up to {radius} px (the width)' if radius > 1 else ''}; cannot show {CANNOT_SHOW[style]}"
+        )
+    read = [
+        c
+        for c in cases
+        if (c.get("line_style") or {}).get("rule_read") == "rounded"
+        and c["line_style"]["line_rule"] == "any"
+        and c.get("verdict") == "pass"
+    ]
     if read:
-        out.append(f"Line rule read: {RULE_NAMES['rounded']} in {len(read)} case{'s' if len(read) != 1 else ''}, "
-                   "a correct drawing by that rule; --line-rule gl holds them to GL's")
+        out.append(
+            f"Line rule read: {RULE_NAMES['rounded']} in {len(read)} case{'s' if len(read) != 1 else ''}, "
+            "a correct drawing by that rule; --line-rule gl holds them to GL's"
+        )
     return out
-

@@ -60,8 +60,9 @@ import numpy as np
 from ..tolerances import TIE_END_PX
 
 
-def tie_crossings(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray,
-                  end_px: float = TIE_END_PX) -> tuple[np.ndarray, np.ndarray]:
+def tie_crossings(
+    q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray, end_px: float = TIE_END_PX
+) -> tuple[np.ndarray, np.ndarray]:
     """Which pixels lie beside a sub-pixel tie of their segment, and the partner pixel across it.
 
     Parameters
@@ -88,14 +89,14 @@ def tie_crossings(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray,
     d = np.asarray(b_px, np.float64).reshape(-1, 2) - a
     tie = np.zeros(len(q), bool)
     partner = q.astype(np.int64)
-    for major in (1, 0):                                  # y-major (crossing rows) first, then x-major
+    for major in (1, 0):  # y-major (crossing rows) first, then x-major
         minor = 1 - major
         dj, dn = d[:, major], d[:, minor]
         ok = (np.abs(dj) >= np.abs(dn)) & (dj != 0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            t = (q[:, major] - a[:, major]) / dj          # where the segment reaches the pixel's row/column
+            t = (q[:, major] - a[:, major]) / dj  # where the segment reaches the pixel's row/column
             slope = np.abs(dn / dj)
-            off = a[:, minor] + t * dn - q[:, minor]      # crossing minus the pixel centre, across the line
+            off = a[:, minor] + t * dn - q[:, minor]  # crossing minus the pixel centre, across the line
         ok &= (t >= 0.0) & (t <= 1.0)
         hit = ok & ~tie & (np.abs(np.abs(off) - 0.5) <= (1.0 + slope) * end_px)
         tie |= hit
@@ -103,8 +104,9 @@ def tie_crossings(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray,
     return tie, partner
 
 
-def tie_ends(q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray, box: tuple | None = None,
-             end_px: float = TIE_END_PX) -> np.ndarray:
+def tie_ends(
+    q_px: np.ndarray, a_px: np.ndarray, b_px: np.ndarray, box: tuple | None = None, end_px: float = TIE_END_PX
+) -> np.ndarray:
     """``(P,)`` bool: which pixels are decided by an end of their segment within ``end_px`` per coordinate.
 
     Pixel ``q`` is an end tie (module docstring) when an end ``E`` of its
@@ -169,10 +171,10 @@ def fold_ties(samples: dict, band_px: int, end_px: float = TIE_END_PX, segs: np.
     normal, offset, point = samples["normal"], samples["offset"], samples["point"]
     if len(offset) == 0:
         return
-    minor = (np.abs(normal[:, 1]) > np.abs(normal[:, 0])).astype(np.intp)   # the normal's larger component
+    minor = (np.abs(normal[:, 1]) > np.abs(normal[:, 0])).astype(np.intp)  # the normal's larger component
     k = np.arange(len(offset))
     across = normal[k, minor]
-    slope = np.sqrt(np.maximum(1.0 / across ** 2 - 1.0, 0.0))
+    slope = np.sqrt(np.maximum(1.0 / across**2 - 1.0, 0.0))
     edge = point[k, minor] + band_px / 2.0
     tie = np.abs(edge - np.rint(edge)) <= (1.0 + slope) * end_px
     e = offset[tie] / across[tie]
@@ -209,7 +211,7 @@ def drop_end_ties(samples: dict, segs: np.ndarray, end_px: float = TIE_END_PX) -
     if len(samples["offset"]) == 0:
         return
     tied = end_ties(segs, end_px)
-    if tied.all() or not tied.any():                    # every segment tied, or none: every sample kept
+    if tied.all() or not tied.any():  # every segment tied, or none: every sample kept
         return
     keep = ~tied[samples["segment"]]
     n = len(keep)

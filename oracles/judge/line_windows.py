@@ -37,23 +37,22 @@ def _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard)
     widened by a step each side (whatever the rounding of the interval's ends).
     """
     lo_xy, hi_xy = np.minimum(segs[:, 0], segs[:, 1]) - guard - 1, np.maximum(segs[:, 0], segs[:, 1]) + guard + 1
-    ll, jj = np.nonzero(i[:, None] != np.arange(len(segs))[None])         # (long segment, another segment)
+    ll, jj = np.nonzero(i[:, None] != np.arange(len(segs))[None])  # (long segment, another segment)
     k = np.arange(len(i))[ll]
     maj0, maj1 = lo_xy[jj, major[ll]], hi_xy[jj, major[ll]]
     min0, min1 = lo_xy[jj, 1 - major[ll]], hi_xy[jj, 1 - major[ll]]
-    slope = (d_min / d_maj)[k]                                           # |slope| <= 1: the major axis
+    slope = (d_min / d_maj)[k]  # |slope| <= 1: the major axis
     flat = slope == 0
-    step = np.where(flat, 1.0, slope)                 # a flat line's e0, e1 are not used (lo, hi below)
+    step = np.where(flat, 1.0, slope)  # a flat line's e0, e1 are not used (lo, hi below)
     e0 = a_maj[k] + (min0 - a_min[k]) / step
     e1 = a_maj[k] + (min1 - a_min[k]) / step
     inside = (min0 <= a_min[k]) & (a_min[k] <= min1)
     lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(e0, e1))
     hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(e0, e1))
     first = np.maximum(np.ceil(np.maximum(np.maximum(lo, maj0), start[k]) - 1), start[k])
-    last = np.minimum(np.floor(np.minimum(np.minimum(hi, maj1), start[k] + count[k] - 1) + 1),
-                      start[k] + count[k] - 1)
+    last = np.minimum(np.floor(np.minimum(np.minimum(hi, maj1), start[k] + count[k] - 1) + 1), start[k] + count[k] - 1)
     n = np.maximum(last - first + 1, 0).astype(np.intp)
-    base = (np.cumsum(count) - count)[k] + (np.where(n > 0, first, start[k]) - start[k]).astype(np.intp)   # n = 0: any
+    base = (np.cumsum(count) - count)[k] + (np.where(n > 0, first, start[k]) - start[k]).astype(np.intp)  # n = 0: any
     windows = np.repeat(base - (np.cumsum(n) - n), n) + np.arange(int(n.sum()))
     return windows, np.repeat(jj, n)
 
@@ -85,12 +84,12 @@ def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
     k = np.arange(len(i))
     a_maj, b_maj, d_maj = a[k, major], b[k, major], d[k, major]
     a_min, d_min = a[k, minor], d[k, minor]
-    along = guard * np.abs(d_maj) / length                    # guard along the line, on the major axis
+    along = guard * np.abs(d_maj) / length  # guard along the line, on the major axis
     extent = np.where(major == 0, w, h)
     start = np.maximum(np.ceil(np.minimum(a_maj, b_maj) + along), 0)
     stop = np.minimum(np.floor(np.maximum(a_maj, b_maj) - along), extent - 1)
     count = np.maximum(stop - start + 1, 0).astype(np.intp)
-    owner = np.repeat(np.arange(len(i)), count)               # the windows, segment by segment
+    owner = np.repeat(np.arange(len(i)), count)  # the windows, segment by segment
     pos = np.repeat(start - (np.cumsum(count) - count), count) + np.arange(len(owner))
     minor_exact = a_min[owner] + (pos - a_maj[owner]) * d_min[owner] / d_maj[owner]
     centre = np.rint(minor_exact)
@@ -99,30 +98,42 @@ def windows(segs: np.ndarray, shape, radius: int, guard: float) -> dict:
     pt = np.empty((len(pos), 2))
     pt[:, 0] = np.where(horizontal, pos, minor_exact)
     pt[:, 1] = np.where(horizontal, minor_exact, pos)
-    if len(segs) > 1 and keep.any():                          # drop windows near another segment
-        if np.all(np.abs(segs) < 1e150):                      # squares finite: no distance is NaN
+    if len(segs) > 1 and keep.any():  # drop windows near another segment
+        if np.all(np.abs(segs) < 1e150):  # squares finite: no distance is NaN
             win, other = _near_pairs(segs, i, major, a_maj, a_min, d_maj, d_min, start, count, guard)
             near = ~(pair_distance(pt[win], segs[other, 0], segs[other, 1]) > guard)
             keep[win[near]] = False
-        else:                                                 # every pair (a NaN distance drops the window)
+        else:  # every pair (a NaN distance drops the window)
             idx = np.flatnonzero(keep)
             chunk = max(1, CHUNK_ELEMENTS // len(segs))
             for c in range(0, len(idx), chunk):
-                sel = idx[c:c + chunk]
+                sel = idx[c : c + chunk]
                 dist = seg_distance(pt[sel], segs[:, 0], segs[:, 1])
-                dist[np.arange(len(sel)), i[owner[sel]]] = np.inf         # its own segment
+                dist[np.arange(len(sel)), i[owner[sel]]] = np.inf  # its own segment
                 keep[sel] = dist.min(axis=1) > guard
-    owner, pos, minor_exact, centre, horizontal, pt = (owner[keep], pos[keep], minor_exact[keep], centre[keep],
-                                                       horizontal[keep], pt[keep])
+    owner, pos, minor_exact, centre, horizontal, pt = (
+        owner[keep],
+        pos[keep],
+        minor_exact[keep],
+        centre[keep],
+        horizontal[keep],
+        pt[keep],
+    )
     unit = d / length[:, None]
     normal = np.empty_like(unit)
     normal[:, 0], normal[:, 1] = -unit[:, 1], unit[:, 0]
     offsets = np.arange(-r, r + 1)
-    win = centre[:, None] + offsets[None]                     # (n, 2r + 1) minor coordinates
+    win = centre[:, None] + offsets[None]  # (n, 2r + 1) minor coordinates
     # each window's pixels, y W + x: along a row (horizontal line: the window is a column) or a column
     pos_i, centre_i = pos.astype(np.intp), centre.astype(np.intp)
-    step = np.where(horizontal, w, 1)                         # the flat index's step across the line
+    step = np.where(horizontal, w, 1)  # the flat index's step across the line
     first = np.where(horizontal, pos_i + (centre_i - r) * w, pos_i * w + centre_i - r)
-    return {"flat": first[:, None] + step[:, None] * np.arange(2 * r + 1)[None], "minor": win,
-            "exact": minor_exact, "across": normal[owner, minor[owner]], "normal": normal[owner],
-            "segment": i[owner], "point": pt}
+    return {
+        "flat": first[:, None] + step[:, None] * np.arange(2 * r + 1)[None],
+        "minor": win,
+        "exact": minor_exact,
+        "across": normal[owner, minor[owner]],
+        "normal": normal[owner],
+        "segment": i[owner],
+        "point": pt,
+    }

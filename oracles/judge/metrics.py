@@ -20,11 +20,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import tolerances
+from ..references.pyrender_oracle import depth_step
 from .frame_pixels import FramePixels
 from .line_ends import END_REACH_PX, PLACES, end_attribution, frames_end_places, resolve_ties  # noqa: F401
 from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
-from .. import tolerances
-from ..references.pyrender_oracle import depth_step
 
 
 def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
@@ -39,9 +39,12 @@ def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
     out = {
         "points": int(len(cand_px)),
         "visible_both": int(both.sum()),
-        "candidate_only": int((cand_vis & ~orac_vis).sum()),   # shown by the candidate, clipped by the oracle
-        "oracle_only": int((~cand_vis & orac_vis).sum()),      # clipped by the candidate, shown by the oracle
-        "max_px": None, "mean_px": None, "rms_px": None, "worst_index": None,   # None: nothing compared
+        "candidate_only": int((cand_vis & ~orac_vis).sum()),  # shown by the candidate, clipped by the oracle
+        "oracle_only": int((~cand_vis & orac_vis).sum()),  # clipped by the candidate, shown by the oracle
+        "max_px": None,
+        "mean_px": None,
+        "rms_px": None,
+        "worst_index": None,  # None: nothing compared
     }
     if both.any():
         err = np.hypot(*(cand_px[both] - oracle_px[both]).T)
@@ -50,8 +53,12 @@ def vertex_errors(cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
             out["worst_index"] = int(np.flatnonzero(both)[np.flatnonzero(~np.isfinite(err))[0]])
             return out
         k = int(np.argmax(err))
-        out.update(max_px=float(err[k]), mean_px=float(err.mean()),
-                   rms_px=float(np.sqrt((err ** 2).mean())), worst_index=int(np.flatnonzero(both)[k]))
+        out.update(
+            max_px=float(err[k]),
+            mean_px=float(err.mean()),
+            rms_px=float(np.sqrt((err**2).mean())),
+            worst_index=int(np.flatnonzero(both)[k]),
+        )
     return out
 
 
@@ -73,12 +80,19 @@ def vertex_errors_frames(cand_frames: list, oracle_frames: list) -> list[dict]:
         if whole.any():
             e = err[whole]
             k = np.argmax(e, axis=1)
-            mx, mean, rms = e[np.arange(len(e)), k], e.mean(axis=1), np.sqrt((e ** 2).mean(axis=1))
+            mx, mean, rms = e[np.arange(len(e)), k], e.mean(axis=1), np.sqrt((e**2).mean(axis=1))
             n = c.shape[1]
             for j, f in enumerate(np.flatnonzero(whole)):
-                out[f] = {"points": n, "visible_both": n, "candidate_only": 0, "oracle_only": 0,
-                          "max_px": float(mx[j]), "mean_px": float(mean[j]), "rms_px": float(rms[j]),
-                          "worst_index": int(k[j])}
+                out[f] = {
+                    "points": n,
+                    "visible_both": n,
+                    "candidate_only": 0,
+                    "oracle_only": 0,
+                    "max_px": float(mx[j]),
+                    "mean_px": float(mean[j]),
+                    "rms_px": float(rms[j]),
+                    "worst_index": int(k[j]),
+                }
     return [r if r is not None else vertex_errors(c, o) for r, c, o in zip(out, cand_frames, oracle_frames)]
 
 
@@ -168,26 +182,32 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """
     out = np.zeros(ids.shape, bool)
     triangles = np.asarray(triangles).reshape(-1, 3)
-    for dy, dx in _NEIGHBOURS[4:]:         # each unordered neighbour pair once; mark both ends
+    for dy, dx in _NEIGHBOURS[4:]:  # each unordered neighbour pair once; mark both ends
         other = _shifted(ids, dy, dx, -1)
         m = (ids != other) & (ids >= 0) & (other >= 0)
         if not m.any():
             continue
         a, b = triangles[ids[m]], triangles[other[m]]
         shared = np.zeros(len(a), bool)
-        for i in range(3):                               # nine 1-D comparisons: no (n, 3, 3) temporary
+        for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
             for j in range(3):
                 shared |= a[:, i] == b[:, j]
         apart = ~shared
         hit = np.zeros(ids.shape, bool)
-        hit[m] = apart                                   # this pixel, whose neighbour (dy, dx) is apart
-        out |= hit | _shifted(hit, -dy, -dx, False)      # and that neighbour
+        hit[m] = apart  # this pixel, whose neighbour (dy, dx) is apart
+        out |= hit | _shifted(hit, -dy, -dx, False)  # and that neighbour
     return out
 
 
-def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_depth: np.ndarray,
-                  depth_bound: np.ndarray | None = None, exclude: np.ndarray | None = None,
-                  cand_faces: np.ndarray | None = None, oracle_faces: np.ndarray | None = None) -> dict:
+def shaded_scores(
+    cand_depth: np.ndarray,
+    oracle_covered: np.ndarray,
+    oracle_depth: np.ndarray,
+    depth_bound: np.ndarray | None = None,
+    exclude: np.ndarray | None = None,
+    cand_faces: np.ndarray | None = None,
+    oracle_faces: np.ndarray | None = None,
+) -> dict:
     """Silhouette IoU and depth errors of a shaded frame against the oracle's.
 
     ``cand_depth``: the candidate's camera depth, +inf (or NaN) where nothing
@@ -222,12 +242,21 @@ def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_dep
     # covered there): not a boundary decision but a hole or a misplaced region.
     only = cand ^ orac
     inside = (only & cand & interior(cand)) | (only & orac & interior(orac))
-    out = {"candidate_pixels": int(cand.sum()), "oracle_pixels": int(orac.sum()),
-           "silhouette_iou": 1.0 if union == 0 else inter / union, "silhouette_union_px": union,
-           "silhouette_mismatch_inside": int(inside.sum()),
-           "depth_pixels": 0, "depth_max_error": None, "depth_mean_error": None, "depth_error_bound": None,
-           "depth_error_ratio": None, "depth_worst_pixel": None,
-           "face_disagreements": 0, "face_disagreements_inside": 0}
+    out = {
+        "candidate_pixels": int(cand.sum()),
+        "oracle_pixels": int(orac.sum()),
+        "silhouette_iou": 1.0 if union == 0 else inter / union,
+        "silhouette_union_px": union,
+        "silhouette_mismatch_inside": int(inside.sum()),
+        "depth_pixels": 0,
+        "depth_max_error": None,
+        "depth_mean_error": None,
+        "depth_error_bound": None,
+        "depth_error_ratio": None,
+        "depth_worst_pixel": None,
+        "face_disagreements": 0,
+        "face_disagreements_inside": 0,
+    }
     compared = interior(cand) & interior(orac) & cand & orac
     if exclude is not None:
         compared &= ~exclude
@@ -236,7 +265,7 @@ def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_dep
         of = np.asarray(oracle_faces)
         disagree = cand & orac & (cf != of)
         near = np.zeros(cf.shape, bool)
-        for dy, dx in _NEIGHBOURS:     # on a boundary between the two faces in either image
+        for dy, dx in _NEIGHBOURS:  # on a boundary between the two faces in either image
             near |= (_shifted(of, dy, dx, -2) == cf) | (_shifted(cf, dy, dx, -2) == of)
         out["face_disagreements"] = int(disagree.sum())
         out["face_disagreements_inside"] = int((disagree & ~near).sum())
@@ -245,9 +274,12 @@ def shaded_scores(cand_depth: np.ndarray, oracle_covered: np.ndarray, oracle_dep
         err = np.abs(cand_depth[compared] - np.asarray(oracle_depth, np.float64)[compared])
         k = int(np.argmax(err))
         idx = np.flatnonzero(compared.ravel())
-        out.update(depth_pixels=int(compared.sum()), depth_max_error=float(err[k]),
-                   depth_mean_error=float(err.mean()),
-                   depth_worst_pixel=[int(idx[k] // cand.shape[1]), int(idx[k] % cand.shape[1])])
+        out.update(
+            depth_pixels=int(compared.sum()),
+            depth_max_error=float(err[k]),
+            depth_mean_error=float(err.mean()),
+            depth_worst_pixel=[int(idx[k] // cand.shape[1]), int(idx[k] % cand.shape[1])],
+        )
         if depth_bound is not None:
             bound = np.asarray(depth_bound, np.float64)[compared]
             out["depth_error_bound"] = float(bound[k])
@@ -266,11 +298,13 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
     d = np.where(covered, np.asarray(depth, np.float64), np.nan)
     slope = np.zeros(d.shape)
     with np.errstate(invalid="ignore"):
-        for change, first, second in ((np.abs(d[:, 1:] - d[:, :-1]), np.s_[:, :-1], np.s_[:, 1:]),
-                                      (np.abs(d[1:] - d[:-1]), np.s_[:-1], np.s_[1:])):
+        for change, first, second in (
+            (np.abs(d[:, 1:] - d[:, :-1]), np.s_[:, :-1], np.s_[:, 1:]),
+            (np.abs(d[1:] - d[:-1]), np.s_[:-1], np.s_[1:]),
+        ):
             np.fmax(slope[first], change, out=slope[first])
             np.fmax(slope[second], change, out=slope[second])
-    return np.minimum(slope, np.finfo(np.float64).max, out=slope)      # an infinite change: the largest float
+    return np.minimum(slope, np.finfo(np.float64).max, out=slope)  # an infinite change: the largest float
 
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray | None = None) -> np.ndarray:
@@ -278,12 +312,15 @@ def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarra
     ``slope``: :func:`depth_slope` of ``depth`` and ``covered`` when the caller has it already."""
     depth = np.asarray(depth, np.float64)
     eps32 = float(np.finfo(np.float32).eps)
-    return (tolerances.DEPTH_STEPS * depth_step(depth, camera)
-            + tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
-            + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth))
+    return (
+        tolerances.DEPTH_STEPS * depth_step(depth, camera)
+        + tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
+        + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth)
+    )
 
 
 # ---------------------------------------------------------------- one-sided pixels and per-edge counts
+
 
 def sign_test_p(k: int, n: int) -> float:
     """Two-sided sign-test p-value: ``k`` of ``n`` differing pixels candidate-only, each with p = 1/2 under H0.
@@ -293,7 +330,7 @@ def sign_test_p(k: int, n: int) -> float:
     """
     if n <= 0:
         return 1.0
-    from scipy.special import bdtr     # the binomial CDF; scipy.stats costs ~1 s to import
+    from scipy.special import bdtr  # the binomial CDF; scipy.stats costs ~1 s to import
 
     return float(min(1.0, 2.0 * bdtr(min(k, n - k), n, 0.5)))
 
@@ -317,9 +354,14 @@ def balance_scores(candidate_only: int, oracle_only: int, oracle_pixels: int, ti
     """
     tc, to = (int(t) for t in ties)
     c, o = candidate_only - tc, oracle_only - to
-    return {"candidate_only": int(candidate_only), "oracle_only": int(oracle_only), "subpixel_ties": [tc, to],
-            "imbalance": int(c - o), "imbalance_fraction": (c - o) / max(oracle_pixels, 1),
-            "balance_p_value": sign_test_p(c, c + o)}
+    return {
+        "candidate_only": int(candidate_only),
+        "oracle_only": int(oracle_only),
+        "subpixel_ties": [tc, to],
+        "imbalance": int(c - o),
+        "imbalance_fraction": (c - o) / max(oracle_pixels, 1),
+        "balance_p_value": sign_test_p(c, c + o),
+    }
 
 
 def edge_counts(image: np.ndarray, near: tuple, n_edges: int) -> np.ndarray:
@@ -361,17 +403,27 @@ def _diff_scores(diff: np.ndarray, compared: int) -> dict:
     """:func:`edge_count_scores` of the per-edge count differences and the number of edges counted."""
     n_edges = len(diff)
     k = int(np.argmax(np.abs(diff))) if n_edges else 0
-    return {"edges_compared": compared,
-            "edge_count_max_diff": int(abs(diff[k])) if n_edges else 0,
-            "edge_count_worst_edge": k if n_edges and diff[k] != 0 else None,
-            "edge_count_worst_diff": int(diff[k]) if n_edges else 0,
-            "edge_count_diff_sum": int(diff.sum()),
-            "edge_count_diffs": diff}
+    return {
+        "edges_compared": compared,
+        "edge_count_max_diff": int(abs(diff[k])) if n_edges else 0,
+        "edge_count_worst_edge": k if n_edges and diff[k] != 0 else None,
+        "edge_count_worst_diff": int(diff[k]) if n_edges else 0,
+        "edge_count_diff_sum": int(diff.sum()),
+        "edge_count_diffs": diff,
+    }
 
 
-def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: np.ndarray,
-                pixels: FramePixels | None = None, counts: tuple | None = None, ends: dict | None = None,
-                ties: tuple | None = None, resolved: FramePixels | None = None) -> dict:
+def line_scores(
+    cand: np.ndarray,
+    oracle: np.ndarray,
+    p0_px: np.ndarray,
+    p1_px: np.ndarray,
+    pixels: FramePixels | None = None,
+    counts: tuple | None = None,
+    ends: dict | None = None,
+    ties: tuple | None = None,
+    resolved: FramePixels | None = None,
+) -> dict:
     """One wireframe frame against the oracle's: one-sided pixels, per-edge counts, where the one-sided lie.
 
     ``p0_px, p1_px`` : (E, 2) the oracle's segments of the drawn edges (NaN
@@ -402,12 +454,12 @@ def line_scores(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_px: 
         found: list = []
         ends = frames_end_places([(fp, p0_px, p1_px)], found)[0] if c + o else {k: [0, 0] for k in PLACES}
         ties = found[0] if found else None
-    if resolved is not None:                                         # the caller's resolve_ties(fp, ties)
+    if resolved is not None:  # the caller's resolve_ties(fp, ties)
         rp = resolved
     else:
-        rp = resolve_ties(fp, ties) if ties is not None else fp      # the candidate as the oracle at the ties
+        rp = resolve_ties(fp, ties) if ties is not None else fp  # the candidate as the oracle at the ties
     if counts is None:
-        near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=rp.drawn())    # counts look at drawn pixels only
+        near = edge_neighbourhoods(p0_px, p1_px, w, h, pixels=rp.drawn())  # counts look at drawn pixels only
         n_edges = len(np.asarray(p0_px).reshape(-1, 2))
         cc = _counts(rp.has(near[1], True), near, n_edges)
         ec = _count_scores(cc, cc if rp.identical else _counts(rp.has(near[1], False), near, n_edges))
@@ -453,7 +505,7 @@ class LineBatch:
         out, waiting = [], self._waiting
         self._waiting, self._size = [], 0
         start = 0
-        while start < len(waiting):              # runs of one image size, paired together
+        while start < len(waiting):  # runs of one image size, paired together
             shape = waiting[start][1].shape
             stop = start
             while stop < len(waiting) and waiting[stop][1].shape == shape:
@@ -461,11 +513,14 @@ class LineBatch:
             run = waiting[start:stop]
             ties: list = []
             ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run], ties)
-            resolved = [resolve_ties(fp, t) for (_, fp, _, _), t in zip(run, ties)]      # once a frame
-            counts = frames_count_differences([(p0, p1, rp) for (_, _, p0, p1), rp in zip(run, resolved)],
-                                              shape[1], shape[0])       # counted with the ties undecided
-            out.extend((key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e, ties=t, resolved=rp))
-                       for (key, fp, p0, p1), c, e, t, rp in zip(run, counts, ends, ties, resolved))
+            resolved = [resolve_ties(fp, t) for (_, fp, _, _), t in zip(run, ties)]  # once a frame
+            counts = frames_count_differences(
+                [(p0, p1, rp) for (_, _, p0, p1), rp in zip(run, resolved)], shape[1], shape[0]
+            )  # counted with the ties undecided
+            out.extend(
+                (key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e, ties=t, resolved=rp))
+                for (key, fp, p0, p1), c, e, t, rp in zip(run, counts, ends, ties, resolved)
+            )
             start = stop
         return out
 
@@ -478,11 +533,12 @@ def line_summary(frames: list) -> dict:
     out = balance_scores(c, o, sum(s["oracle_pixels"] for _, s in frames), ties)
     k, worst = max(frames, key=lambda e: (e[1]["edge_count_max_diff"], -e[0])) if frames else (None, None)
     ends = {p: [sum(s["ends"][p][i] for _, s in frames) for i in (0, 1)] for p in ("start", "end", "middle", "stray")}
-    out.update(edge_count_max_diff=worst["edge_count_max_diff"] if worst else 0,
-               edge_count_worst={"frame": k, "edge": worst["edge_count_worst_edge"],
-                                 "diff": worst["edge_count_worst_diff"]} if worst else None,
-               lines_compared=int(sum(s["edges_compared"] for _, s in frames)),
-               one_sided_by_place=ends)
+    out.update(
+        edge_count_max_diff=worst["edge_count_max_diff"] if worst else 0,
+        edge_count_worst={"frame": k, "edge": worst["edge_count_worst_edge"], "diff": worst["edge_count_worst_diff"]}
+        if worst
+        else None,
+        lines_compared=int(sum(s["edges_compared"] for _, s in frames)),
+        one_sided_by_place=ends,
+    )
     return out
-
-

@@ -45,7 +45,7 @@ import numpy as np
 from ..segment_geometry import clip_to_box
 
 _EMPTY = np.zeros(0, dtype=np.int64)
-_NONE = np.iinfo(np.int64).max          # no owner yet (:meth:`_Segments.owners`)
+_NONE = np.iinfo(np.int64).max  # no owner yet (:meth:`_Segments.owners`)
 
 #: Pairs of a segment and a pixel (or rows a run of segments spans) measured at once: the pairing
 #: streams its pairs in chunks of about this many, so that its memory is bounded by the image and
@@ -95,9 +95,15 @@ REACH_MARGIN_PX = 1.0
 LEVEL_PIXELS = 1024
 
 
-def edge_neighbourhoods(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int,
-                        radius: float = 1.0, mask: np.ndarray | None = None,
-                        pixels: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def edge_neighbourhoods(
+    p0_px: np.ndarray,
+    p1_px: np.ndarray,
+    width: int,
+    height: int,
+    radius: float = 1.0,
+    mask: np.ndarray | None = None,
+    pixels: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pixels near each segment: ``(edge, pixel, major)`` (module docstring).
 
     ``mask`` ((H, W) bool, optional) keeps only the pixels where it is True
@@ -135,7 +141,7 @@ def frames_neighbourhoods(frames, width: int, height: int, radius: float = 1.0) 
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
     sid, pos = segs.nearest(px, every=True)
     edge, local, major = segs.rows(px, sid, pos)
-    cut = np.searchsorted(pos, np.cumsum(px.counts)[:-1])      # the frames' rows, split
+    cut = np.searchsorted(pos, np.cumsum(px.counts)[:-1])  # the frames' rows, split
     return list(zip(np.split(edge, cut), np.split(local, cut), np.split(major, cut)))
 
 
@@ -179,13 +185,13 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     orac = _Pixels.of_frames([fp.oracle_idx for _, _, fp in frames], width, height)
     drawn = _Pixels.of_frames([fp.drawn() for _, _, fp in frames], width, height)
     one_sided = _Pixels.of_frames([np.sort(np.concatenate(fp.only())) for _, _, fp in frames], width, height)
-    first_edge = np.cumsum(segs.counts) - segs.counts          # frame k's edges in one flat array of all
+    first_edge = np.cumsum(segs.counts) - segs.counts  # frame k's edges in one flat array of all
     diff_all = np.zeros(int(segs.counts.sum()), np.int64)
     compared = np.zeros(len(segs), bool)
     if len(segs) and len(drawn):
-        if len(segs) * DENSE > len(drawn):          # a dense mesh: one pass over every drawn pixel is cheaper
+        if len(segs) * DENSE > len(drawn):  # a dense mesh: one pass over every drawn pixel is cheaper
             sid, pos = segs.nearest(drawn, every=True)
-            compared[sid] = True                    # every drawn pixel is drawn by one image at least
+            compared[sid] = True  # every drawn pixel is drawn by one image at least
             # only the owners of one-sided pixels can count differently: their rows alone are counted
             mine = np.zeros(len(segs), bool)
             mine[sid[one_sided.has(drawn.stacked[pos])]] = True
@@ -219,7 +225,7 @@ def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
     seg_on = np.flatnonzero(on)
     compared = np.zeros(len(segs), bool)
     compared[seg_on] = owner_at[np.searchsorted(mids.stacked, mid_stacked[seg_on])] == seg_on
-    rest = np.flatnonzero(~compared)           # the others: the owners of the drawn pixels near them
+    rest = np.flatnonzero(~compared)  # the others: the owners of the drawn pixels near them
     if len(rest):
         near = drawn.subset(segs.near(drawn, rest))
         compared[_unique(segs.nearest(near)[0])] = True
@@ -238,7 +244,7 @@ def _counts_of(segs: _Segments, cand: _Pixels, orac: _Pixels, near: _Pixels, sid
     """:func:`_counts_near` given the owner ``sid`` of the pixels at positions ``pos`` of ``near``."""
     _, _, major = segs.rows(near, sid, pos)
     cc = _distinct_per_segment(sid, major, len(segs), cand.has(near.stacked[pos]))
-    if np.array_equal(cand.stacked, orac.stacked):          # the frames agree (ties resolved): once
+    if np.array_equal(cand.stacked, orac.stacked):  # the frames agree (ties resolved): once
         return cc, cc
     return cc, _distinct_per_segment(sid, major, len(segs), orac.has(near.stacked[pos]))
 
@@ -295,12 +301,18 @@ def nearest_segments(frames, width: int, height: int, radius: float, box: tuple)
     frame : (sum P,) int64
         Each pixel's frame.
     """
-    frames = [(np.asarray(p0, np.float64).reshape(-1, 2), np.asarray(p1, np.float64).reshape(-1, 2), pixels)
-              for p0, p1, pixels in frames]
-    if sum(len(p0) for p0, _, _ in frames) >= FEW_SEGMENTS:      # only the segments that can reach a pixel
-        frames = [(p0[k], p1[k], pixels) for (p0, p1, pixels), k in
-                  zip(frames, _reaching([(p0, p1, pixels) for p0, p1, pixels in frames], width, height,
-                                        radius + REACH_MARGIN_PX))]
+    frames = [
+        (np.asarray(p0, np.float64).reshape(-1, 2), np.asarray(p1, np.float64).reshape(-1, 2), pixels)
+        for p0, p1, pixels in frames
+    ]
+    if sum(len(p0) for p0, _, _ in frames) >= FEW_SEGMENTS:  # only the segments that can reach a pixel
+        frames = [
+            (p0[k], p1[k], pixels)
+            for (p0, p1, pixels), k in zip(
+                frames,
+                _reaching([(p0, p1, pixels) for p0, p1, pixels in frames], width, height, radius + REACH_MARGIN_PX),
+            )
+        ]
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius, box=box)
     px = _Pixels.of_frames([pixels for _, _, pixels in frames], width, height)
     owner = np.full(len(px), -1, np.int64)
@@ -325,7 +337,7 @@ def _reaching(frames, width: int, height: int, reach: float, cell: int = 8) -> l
             np.cumsum(table, axis=0, out=table)
             np.cumsum(table, axis=1, out=table)
             with np.errstate(invalid="ignore", over="ignore"):
-                total = p0 + p1                    # clip_to_box keeps only the rows where this is finite
+                total = p0 + p1  # clip_to_box keeps only the rows where this is finite
                 finite = np.isfinite(total[:, 0]) & np.isfinite(total[:, 1])
                 ends = []
                 for k, n in ((0, nx), (1, ny)):
@@ -354,9 +366,9 @@ class _Pixels:
 
     def __init__(self, stacked: np.ndarray, width: int, height: int, counts: np.ndarray | None = None):
         self.stacked, self.width, self.height, self.counts = stacked, width, height, counts
-        self.frames = len(counts) if counts is not None else 0      # frames stacked (0: not known)
-        self._xy = None                 # (x, y) of every pixel as float64, made on first use (:meth:`xy`)
-        self._rank = None               # :meth:`rank`'s table, made when it pays
+        self.frames = len(counts) if counts is not None else 0  # frames stacked (0: not known)
+        self._xy = None  # (x, y) of every pixel as float64, made on first use (:meth:`xy`)
+        self._rank = None  # :meth:`rank`'s table, made when it pays
 
     @classmethod
     def of_frames(cls, per_frame, width: int, height: int) -> _Pixels:
@@ -393,7 +405,7 @@ class _Pixels:
         images), built once; a few are binary searches.
         """
         size = self.frames * self.width * self.height
-        if self._rank is None and size and len(stacked) > size // 4 and size < 2 ** 31:
+        if self._rank is None and size and len(stacked) > size // 4 and size < 2**31:
             table = np.zeros(size + 1, np.int32)
             table[self.stacked + 1] = 1
             self._rank = np.cumsum(table, dtype=np.int32)
@@ -424,7 +436,7 @@ class _Segments:
         self.width, self.height, self.radius = width, height, radius
         pad = radius + 1.0
         lo, hi = box if box is not None else ((-pad, -pad), (width - 1 + pad, height - 1 + pad))
-        self.grow = radius + GROW_PX        # each box is grown a little further, against rounding
+        self.grow = radius + GROW_PX  # each box is grown a little further, against rounding
         p0 = [np.asarray(a, np.float64).reshape(-1, 2) for a, _ in per_frame]
         p1 = [np.asarray(b, np.float64).reshape(-1, 2) for _, b in per_frame]
         self.counts = np.array([len(a) for a in p0], np.int64)
@@ -433,7 +445,7 @@ class _Segments:
         p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
         p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
         keep, q0, q1 = clip_to_box(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
-        if keep.all():                           # every segment reaches the box: no copies
+        if keep.all():  # every segment reaches the box: no copies
             self.q0, self.q1, self.frame, self.edge = q0, q1, frame, edge
         else:
             self.q0, self.q1 = q0[keep], q1[keep]
@@ -443,10 +455,10 @@ class _Segments:
         dx, dy = np.ascontiguousarray(self.d[:, 0]), np.ascontiguousarray(self.d[:, 1])
         self.dd = dx * dx + dy * dy
         self._cols = (np.ascontiguousarray(self.q0[:, 0]), np.ascontiguousarray(self.q0[:, 1]), dx, dy, self.dd)
-        self._points = bool((self.dd == 0).any())          # a segment of no length (_near's u is 0 for it)
-        self._cells = None                       # the grid of pairs_any, made on first use
-        self._rows = None                        # _rows_spanned, counted on first use
-        self._y = None                           # _y_range, found on first use
+        self._points = bool((self.dd == 0).any())  # a segment of no length (_near's u is 0 for it)
+        self._cells = None  # the grid of pairs_any, made on first use
+        self._rows = None  # _rows_spanned, counted on first use
+        self._y = None  # _y_range, found on first use
 
     def __len__(self) -> int:
         return len(self.q0)
@@ -473,13 +485,13 @@ class _Segments:
             crowded = self._crowded(CROWDED * len(px))
             levels = [r for r in (CROWDED_LEVELS if crowded else LEVELS) if r < self.radius]
         sid_parts, pos_parts = [], []
-        rest = None                                   # positions in px still without an owner (None: all)
+        rest = None  # positions in px still without an owner (None: all)
         for k, r in enumerate(levels + [self.radius]):
             segs = self.within(r) if r != self.radius else self
             sub = px if rest is None else px.subset(rest)
             if k == 0:
                 chunks = segs.pairs(sub) if every else segs.pairs_any(sub)
-            else:                          # the rest: only the segments whose boxes hold one of them
+            else:  # the rest: only the segments whose boxes hold one of them
                 which = segs.boxes_holding(sub)
                 chunks = segs.pairs_any(sub) if which is None else segs.pairs(sub, which)
             sid, pos = segs.owners(sub, chunks)
@@ -508,7 +520,7 @@ class _Segments:
         table = np.zeros((n_frames, h + 1, w + 1), np.int32)
         keep = frame < n_frames
         table[frame[keep], y[keep] + 1, x[keep] + 1] = 1
-        np.cumsum(table, axis=1, out=table)               # in place: the table is all the memory it takes
+        np.cumsum(table, axis=1, out=table)  # in place: the table is all the memory it takes
         np.cumsum(table, axis=2, out=table)
         y_lo, y_hi = self._y_range()
         x_lo = np.minimum(self.q0[:, 0], self.q1[:, 0])
@@ -518,7 +530,7 @@ class _Segments:
         c1 = np.clip(np.floor(x_hi + self.grow), -1, w - 1).astype(np.int64) + 1
         r0 = np.clip(np.ceil(y_lo - self.grow), 0, h).astype(np.int64)
         r1 = np.clip(np.floor(y_hi + self.grow), -1, h - 1).astype(np.int64) + 1
-        c1, r1 = np.maximum(c1, c0), np.maximum(r1, r0)          # an empty box: no pixel
+        c1, r1 = np.maximum(c1, c0), np.maximum(r1, r0)  # an empty box: no pixel
         f = self.frame
         inside = table[f, r1, c1] - table[f, r0, c1] - table[f, r1, c0] + table[f, r0, c0]
         return np.flatnonzero(inside > 0)
@@ -574,9 +586,9 @@ class _Segments:
             return
         frame = px.at()[0]
         per_frame = np.bincount(self.frame, minlength=int(frame.max()) + 1)
-        n = per_frame[frame]                                 # each pixel against all of its frame's segments
+        n = per_frame[frame]  # each pixel against all of its frame's segments
         if self._cells is None and int(n.sum()) <= 4 * (len(px) + len(self)):
-            first = (np.cumsum(per_frame) - per_frame)[frame]        # segments are in frame order
+            first = (np.cumsum(per_frame) - per_frame)[frame]  # segments are in frame order
             for lo, hi in _cuts(n, CHUNK_PAIRS):
                 nn = n[lo:hi]
                 pos = np.repeat(np.arange(lo, hi), nn)
@@ -584,7 +596,7 @@ class _Segments:
                 yield self._near(px, sid, pos)
             return
         if self._cells is None and len(px) * len(self) <= FEW_PAIRS:
-            yield from self._pairs_boxed(px, frame)          # a few pixels: no grid of every segment
+            yield from self._pairs_boxed(px, frame)  # a few pixels: no grid of every segment
             return
         keys, listed = self._cell_index()
         _, y, x = px.at()
@@ -592,7 +604,7 @@ class _Segments:
         key = (frame * self._cells_y + y // cell) * self._cells_x + x // cell
         a = np.searchsorted(keys, key, side="left")
         n = np.searchsorted(keys, key, side="right") - a
-        if int(n.sum()) > 2 * (self._rows_spanned() + len(px)):     # crowded cells: row by row is cheaper
+        if int(n.sum()) > 2 * (self._rows_spanned() + len(px)):  # crowded cells: row by row is cheaper
             yield from self.pairs(px)
             return
         for lo, hi in _cuts(n, CHUNK_PAIRS):
@@ -605,14 +617,15 @@ class _Segments:
         """:meth:`pairs_any` by a box test of every pixel against every segment of its frame: the pairs
         whose pixel centre is within ``radius`` of the segment's box (all those within ``radius`` of the
         segment), measured. ``frame``: each pixel's."""
-        r = self.grow                   # radius and the margin of :data:`GROW_PX`
+        r = self.grow  # radius and the margin of :data:`GROW_PX`
         lo_x, hi_x = np.minimum(self.q0[:, 0], self.q1[:, 0]) - r, np.maximum(self.q0[:, 0], self.q1[:, 0]) + r
         lo_y, hi_y = np.minimum(self.q0[:, 1], self.q1[:, 1]) - r, np.maximum(self.q0[:, 1], self.q1[:, 1]) + r
         x, y = px.xy()
         for lo, hi in _cuts(np.full(len(px), len(self), np.int64), CHUNK_PAIRS):
             cx, cy = x[lo:hi, None], y[lo:hi, None]
-            inside = ((cx >= lo_x) & (cx <= hi_x) & (cy >= lo_y) & (cy <= hi_y)
-                      & (frame[lo:hi, None] == self.frame[None, :]))
+            inside = (
+                (cx >= lo_x) & (cx <= hi_x) & (cy >= lo_y) & (cy <= hi_y) & (frame[lo:hi, None] == self.frame[None, :])
+            )
             pos, sid = np.nonzero(inside)
             yield self._near(px, sid, pos + lo)
 
@@ -746,8 +759,8 @@ class _Segments:
             before = nearest[pos]
             np.minimum.at(nearest, pos, dist)
             after = nearest[pos]
-            best = dist == after                        # the pairs at their pixel's nearest distance
-            owner[pos[best & (after < before)]] = _NONE       # nearer than every earlier chunk: theirs go
+            best = dist == after  # the pairs at their pixel's nearest distance
+            owner[pos[best & (after < before)]] = _NONE  # nearer than every earlier chunk: theirs go
             np.minimum.at(owner, pos[best], sid[best])
         pos = np.flatnonzero(owner != _NONE)
         return owner[pos], pos
@@ -780,5 +793,5 @@ def _from_segments(p0_px, p1_px, width: int, height: int, radius: float):
     cx = (np.round(pts[:, 0])[:, None] + ox.ravel()[None, :]).astype(np.int64).ravel()
     cy = (np.round(pts[:, 1])[:, None] + oy.ravel()[None, :]).astype(np.int64).ravel()
     inside = (cx >= 0) & (cx < width) & (cy >= 0) & (cy < height)
-    pixels = _unique(cy[inside] * width + cx[inside])     # every candidate pixel, once, ascending
+    pixels = _unique(cy[inside] * width + cx[inside])  # every candidate pixel, once, ascending
     return frames_neighbourhoods([(p0, p1, pixels)], width, height, radius)[0]

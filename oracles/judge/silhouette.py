@@ -64,9 +64,11 @@ class SilhouetteScores:
         out = []
         if self.longest_run_px > tol.max_silhouette_run_px:
             row, col = self.run_at
-            out.append(f"silhouette: {self.longest_run_px} decided pixels missing or added in one run "
-                       f"(at row {row}, column {col}; limit {tol.max_silhouette_run_px}); "
-                       f"{self.holes} holes, {self.extra} extra in all")
+            out.append(
+                f"silhouette: {self.longest_run_px} decided pixels missing or added in one run "
+                f"(at row {row}, column {col}; limit {tol.max_silhouette_run_px}); "
+                f"{self.holes} holes, {self.extra} extra in all"
+            )
         if self.union_px >= MIN_IOU_UNION_PX and not self.iou >= tol.min_iou:
             out.append(f"silhouette IoU {self.iou:.6f} below {tol.min_iou:g} over {self.union_px} decided pixels")
         return out
@@ -88,7 +90,7 @@ def largest_run(mask: np.ndarray) -> tuple[int, tuple[int, int] | None]:
     if n == 0:
         return 0, None
     height, width = mask.shape
-    index = np.full((height + 2, width + 2), -1, dtype=np.int64)     # a border of -1: no wrap-around
+    index = np.full((height + 2, width + 2), -1, dtype=np.int64)  # a border of -1: no wrap-around
     index[rows + 1, cols + 1] = np.arange(n)
     pairs_a, pairs_b = [], []
     for dr, dc in _FORWARD:
@@ -103,7 +105,7 @@ def largest_run(mask: np.ndarray) -> tuple[int, tuple[int, int] | None]:
         new = label.copy()
         np.minimum.at(new, a, low)
         np.minimum.at(new, b, low)
-        new = new[new]                                                # pointer jumping
+        new = new[new]  # pointer jumping
         if np.array_equal(new, label):
             break
         label = new
@@ -130,8 +132,10 @@ def score_silhouette(cand, ref, ties) -> SilhouetteScores:
     """
     cand, ref, ties = (np.asarray(m, dtype=bool) for m in (cand, ref, ties))
     if not cand.shape == ref.shape == ties.shape or cand.ndim != 2:
-        raise ValueError(f"silhouettes of shapes {cand.shape}, {ref.shape} and ties {ties.shape}: "
-                         "expected three (H, W) masks of one shape")
+        raise ValueError(
+            f"silhouettes of shapes {cand.shape}, {ref.shape} and ties {ties.shape}: "
+            "expected three (H, W) masks of one shape"
+        )
     decided = ~ties
     both = int((cand & ref & decided).sum())
     union = int(((cand | ref) & decided).sum())
@@ -148,7 +152,15 @@ def score_silhouette(cand, ref, ties) -> SilhouetteScores:
     elif ref_decided == 0:
         vacuous = "silhouette: the reference covers no decided pixel (nothing to compare the candidate with)"
     return SilhouetteScores(
-        decided_px=n_decided, ties_px=int(ties.sum()), ref_px=int(ref.sum()), cand_px=int(cand.sum()),
-        union_px=union, iou=both / union if union else float("nan"),
-        holes=int(holes_mask.sum()), extra=int(extra_mask.sum()), longest_run_px=run, run_at=at,
-        vacuous=vacuous)
+        decided_px=n_decided,
+        ties_px=int(ties.sum()),
+        ref_px=int(ref.sum()),
+        cand_px=int(cand.sum()),
+        union_px=union,
+        iou=both / union if union else float("nan"),
+        holes=int(holes_mask.sum()),
+        extra=int(extra_mask.sum()),
+        longest_run_px=run,
+        run_at=at,
+        vacuous=vacuous,
+    )

@@ -34,5 +34,5 @@ def _any_near(mask: np.ndarray, outside: bool) -> np.ndarray:
     out = np.zeros((h, w), dtype=bool)
     for dy in range(3):
         for dx in range(3):
-            out |= padded[dy:dy + h, dx:dx + w]
+            out |= padded[dy : dy + h, dx : dx + w]
     return out

@@ -15,14 +15,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.scene.model import Scene
 from wirecheck.core.transforms import Motion
 
+from ..cases import Case, case_motion
 from ..references.opencv_oracle import project as cv_project
 from ..references.unproject_reference import unproject
-from ..cases import Case, case_motion
 
 __all__ = ["DEFAULT_STRIDE", "Samples", "surface_samples"]
 
@@ -42,8 +41,15 @@ class Samples:
         return len(self.depth)
 
 
-def surface_samples(scene: Scene, case: Case, motion: Motion, k: int, frames: int,
-                    stride: int = DEFAULT_STRIDE, renderer: SceneRenderer | None = None) -> Samples:
+def surface_samples(
+    scene: Scene,
+    case: Case,
+    motion: Motion,
+    k: int,
+    frames: int,
+    stride: int = DEFAULT_STRIDE,
+    renderer: SceneRenderer | None = None,
+) -> Samples:
     """The samples of frame ``k`` (1-based, of ``frames``) of ``scene`` through ``case``'s camera (module docstring).
 
     ``renderer``: a ``SceneRenderer(scene, case_motion(motion, case), frames, style="shaded")`` to reuse.
@@ -54,10 +60,10 @@ def surface_samples(scene: Scene, case: Case, motion: Motion, k: int, frames: in
         renderer = SceneRenderer(scene, case_motion(motion, case), frames, style="shaded")
     frame, _ = renderer.render(k, pinhole)
     depth = frame.depth_image
-    if depth is None:                                    # a wireframe: no surface to sample
+    if depth is None:  # a wireframe: no surface to sample
         return Samples(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)))
     start = stride // 2
-    rows, cols = np.mgrid[start:cam.height:stride, start:cam.width:stride]
+    rows, cols = np.mgrid[start : cam.height : stride, start : cam.width : stride]
     d = depth[rows, cols]
     on = np.isfinite(d)
     p_px = np.column_stack([cols[on], rows[on]]).astype(np.float64)

@@ -14,23 +14,32 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import metrics
 from ..candidates.candidate import case_precision
 from ..diagnosis.diagnose import diagnose
-from .decide import decide, line_faults, pixel_fields
-from .evidence import CaseEvidence
-from .name_faults import name_faults
 from ..faults import Fault
 from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
+from . import metrics
+from .decide import decide, line_faults, pixel_fields
+from .evidence import CaseEvidence
+from .name_faults import name_faults
 
 #: Per-frame fields of a wireframe's line comparison (oracles.judge.metrics.line_scores).
 LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
 
 #: Per-frame fields of a shaded comparison (oracles.judge.metrics.shaded_scores).
-SHADED_FRAME_KEYS = ("silhouette_iou", "silhouette_union_px", "silhouette_mismatch_inside", "depth_pixels",
-                     "depth_max_error", "depth_mean_error", "depth_error_bound", "depth_error_ratio",
-                     "face_disagreements", "face_disagreements_inside")
+SHADED_FRAME_KEYS = (
+    "silhouette_iou",
+    "silhouette_union_px",
+    "silhouette_mismatch_inside",
+    "depth_pixels",
+    "depth_max_error",
+    "depth_mean_error",
+    "depth_error_bound",
+    "depth_error_ratio",
+    "face_disagreements",
+    "face_disagreements_inside",
+)
 
 
 def case_record(setup, acc, tol: Tolerances) -> dict:
@@ -44,16 +53,24 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
     to (oracles.tolerances.vertex_bound).
     """
     done = len(acc.cand_px)
-    rec = {"scene": setup.scene.name, "camera": setup.case.name, "camera_spec": setup.cam.to_dict(),
-           "frames": setup.frames, "frames_checked": done}
+    rec = {
+        "scene": setup.scene.name,
+        "camera": setup.case.name,
+        "camera_spec": setup.cam.to_dict(),
+        "frames": setup.frames,
+        "frames_checked": done,
+    }
     precision, source = case_precision(tol.precision, acc.returned)
     if setup.is_core and tol.precision is None and acc.returned:
         source = "core --dtype"
     bound = vertex_bound(precision, acc.scale, tol.vertex_px)
-    rec["precision"] = {"judged_as": precision, "source": source,
-                        "returned": sorted(acc.returned) if acc.returned else None}
+    rec["precision"] = {
+        "judged_as": precision,
+        "source": source,
+        "returned": sorted(acc.returned) if acc.returned else None,
+    }
     rec["vertex_bound_px"] = bound
-    if acc.depth_ties:       # points on near/far to within the candidate's rounding, clipped by one side only
+    if acc.depth_ties:  # points on near/far to within the candidate's rounding, clipped by one side only
         rec["depth_ties"] = acc.depth_ties
     if setup.pixels and setup.mode.hidden_lines:
         rec["hidden_lines"] = setup.faces is not None
@@ -62,14 +79,16 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
         cand, orac = np.concatenate(acc.cand_px), np.concatenate(acc.oracle_px)
         ve = metrics.vertex_errors(cand, orac)
         worst_v = max(acc.frame_errors, key=lambda e: (e[0], -e[1])) if acc.frame_errors else (None, None, None)
-        rec.update({
-            "max_vertex_error_px": ve["max_px"],
-            "mean_vertex_error_px": ve["mean_px"],
-            "rms_vertex_error_px": ve["rms_px"],
-            "worst_vertex": {"frame": worst_v[1], "vertex": worst_v[2], "error_px": worst_v[0]},
-            "visible_points": ve["visible_both"],
-            "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
-        })
+        rec.update(
+            {
+                "max_vertex_error_px": ve["max_px"],
+                "mean_vertex_error_px": ve["mean_px"],
+                "rms_vertex_error_px": ve["rms_px"],
+                "worst_vertex": {"frame": worst_v[1], "vertex": worst_v[2], "error_px": worst_v[0]},
+                "visible_points": ve["visible_both"],
+                "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
+            }
+        )
         bound32 = vertex_bound("float32", acc.scale, tol.vertex_px) if precision == "float64" else None
         faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32, planes=acc.planes)
     else:
@@ -82,71 +101,112 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
         rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
     if setup.pixels and setup.mode.shaded:
         rec.update(shaded_summary(acc.shaded, acc.worst))
-    if acc.lines:                     # a line fault is named only when the vertices agree
+    if acc.lines:  # a line fault is named only when the vertices agree
         faults = line_faults(rec, tol, faults)
     rec["faults"] = faults
-    rec["compared"] = {"frames": done, "vertices": rec.get("visible_points", 0),
-                       "pixels": acc.drawn_px if setup.pixels else None}
+    rec["compared"] = {
+        "frames": done,
+        "vertices": rec.get("visible_points", 0),
+        "pixels": acc.drawn_px if setup.pixels else None,
+    }
     if done and setup.pixels and not setup.mode.plain and setup.faces is None:
-        rec["note"] = {"shaded": "no faces: nothing to shade; only the vertices were checked",
-                       "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe"
-                       }[setup.mode.style]
+        rec["note"] = {
+            "shaded": "no faces: nothing to shade; only the vertices were checked",
+            "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe",
+        }[setup.mode.style]
     return rec
 
 
 def shaded_summary(shaded: list, worst) -> dict:
     """A case's shaded fields from its frames' scores (None where nothing was compared)."""
-    out = {"silhouette_iou": None, "silhouette_iou_mean": None, "depth_max_error": None,
-           "depth_mean_error": None, "depth_error_bound": None, "depth_error_ratio": None,
-           "depth_worst_frame": None, "depth_pixels": 0, "worst_pixel_frame": None,
-           "face_disagreements": 0, "face_disagreements_inside": 0,
-           "silhouette_mismatch_inside": 0, "silhouette_iou_gated": None}
+    out = {
+        "silhouette_iou": None,
+        "silhouette_iou_mean": None,
+        "depth_max_error": None,
+        "depth_mean_error": None,
+        "depth_error_bound": None,
+        "depth_error_ratio": None,
+        "depth_worst_frame": None,
+        "depth_pixels": 0,
+        "worst_pixel_frame": None,
+        "face_disagreements": 0,
+        "face_disagreements_inside": 0,
+        "silhouette_mismatch_inside": 0,
+        "silhouette_iou_gated": None,
+    }
     if not shaded:
         return out
     out["silhouette_mismatch_inside"] = int(sum(s.get("silhouette_mismatch_inside", 0) for _, s in shaded))
     gated = [s["silhouette_iou"] for _, s in shaded if s.get("silhouette_union_px", 0) >= MIN_IOU_UNION_PX]
-    out["silhouette_iou_gated"] = float(min(gated)) if gated else None     # IoU over frames big enough to judge
+    out["silhouette_iou_gated"] = float(min(gated)) if gated else None  # IoU over frames big enough to judge
     out["face_disagreements"] = int(sum(s.get("face_disagreements", 0) for _, s in shaded))
     out["face_disagreements_inside"] = int(sum(s.get("face_disagreements_inside", 0) for _, s in shaded))
     ious = [s["silhouette_iou"] for _, s in shaded]
-    out.update(silhouette_iou=float(min(ious)), silhouette_iou_mean=float(np.mean(ious)),
-               worst_pixel_frame=worst[1] if worst else None)
+    out.update(
+        silhouette_iou=float(min(ious)),
+        silhouette_iou_mean=float(np.mean(ious)),
+        worst_pixel_frame=worst[1] if worst else None,
+    )
     with_depth = [(k, s) for k, s in shaded if s["depth_max_error"] is not None]
     if with_depth:
         pixels = sum(s["depth_pixels"] for _, s in with_depth)
         k_err, s_err = max(with_depth, key=lambda e: (e[1]["depth_max_error"], -e[0]))
         k_ratio, s_ratio = max(with_depth, key=lambda e: (e[1]["depth_error_ratio"], -e[0]))
-        out.update(depth_max_error=s_err["depth_max_error"], depth_error_bound=s_err["depth_error_bound"],
-                   depth_mean_error=float(sum(s["depth_mean_error"] * s["depth_pixels"]
-                                              for _, s in with_depth) / pixels),
-                   depth_error_ratio=s_ratio["depth_error_ratio"], depth_worst_frame=k_ratio,
-                   depth_pixels=int(pixels))
+        out.update(
+            depth_max_error=s_err["depth_max_error"],
+            depth_error_bound=s_err["depth_error_bound"],
+            depth_mean_error=float(sum(s["depth_mean_error"] * s["depth_pixels"] for _, s in with_depth) / pixels),
+            depth_error_ratio=s_ratio["depth_error_ratio"],
+            depth_worst_frame=k_ratio,
+            depth_pixels=int(pixels),
+        )
     return out
 
 
 #: A projector case's vertex and shaded fields, as its evidence holds them (oracles.judge.evidence).
 VERTEX_KEYS = ("max_vertex_error_px", "vertex_bound_px", "worst_vertex", "precision", "visibility_mismatch")
-SHADED_KEYS = ("silhouette_iou", "silhouette_iou_gated", "silhouette_mismatch_inside", "face_disagreements_inside",
-               "depth_error_ratio", "depth_max_error", "depth_error_bound", "depth_worst_frame", "worst_pixel_frame")
+SHADED_KEYS = (
+    "silhouette_iou",
+    "silhouette_iou_gated",
+    "silhouette_mismatch_inside",
+    "face_disagreements_inside",
+    "depth_error_ratio",
+    "depth_max_error",
+    "depth_error_bound",
+    "depth_worst_frame",
+    "worst_pixel_frame",
+)
 PIXEL_KEYS = ("pixel_f1_0px", "pixel_f1_1px", "worst_pixel_frame")
 
 
-def record_evidence(rec: dict, error: str | None = None, points: int | None = None,
-                    oracle_bound_px: float | None = None) -> CaseEvidence:
+def record_evidence(
+    rec: dict, error: str | None = None, points: int | None = None, oracle_bound_px: float | None = None
+) -> CaseEvidence:
     """A projector case's record (:func:`case_record`) as frozen evidence: its vertex, pixel, line and shaded
     fields, the faults the diagnosis named (line faults among them), what it compared, at level ``"vertices"``
     when no pixel was compared, else ``"pixels"``."""
     return CaseEvidence(
-        level="vertices" if rec["compared"]["pixels"] is None else "pixels", compared=rec["compared"],
-        frames_checked=rec["frames_checked"], pixels={k: rec[k] for k in PIXEL_KEYS if k in rec},
-        lines=rec.get("lines"), vertices={k: rec[k] for k in VERTEX_KEYS if k in rec},
+        level="vertices" if rec["compared"]["pixels"] is None else "pixels",
+        compared=rec["compared"],
+        frames_checked=rec["frames_checked"],
+        pixels={k: rec[k] for k in PIXEL_KEYS if k in rec},
+        lines=rec.get("lines"),
+        vertices={k: rec[k] for k in VERTEX_KEYS if k in rec},
         shaded={k: rec[k] for k in SHADED_KEYS if k in rec} if "silhouette_iou" in rec else None,
-        image_faults=tuple(Fault.of(f) for f in rec.get("faults") or []), error=error, points=points,
-        oracle_bound_px=oracle_bound_px)
+        image_faults=tuple(Fault.of(f) for f in rec.get("faults") or []),
+        error=error,
+        points=points,
+        oracle_bound_px=oracle_bound_px,
+    )
 
 
-def judge(rec: dict, tol: Tolerances, error: str | None = None, points: int | None = None,
-          oracle_bound_px: float | None = None) -> None:
+def judge(
+    rec: dict,
+    tol: Tolerances,
+    error: str | None = None,
+    points: int | None = None,
+    oracle_bound_px: float | None = None,
+) -> None:
     """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed; oracles.judge.decide.decide),
     and ``rec["faults"]`` to the names (oracles.judge.name_faults) where they change: a failure nothing
     explains is ``unexplained``; past the oracle's precision limit the names read from pixels go.

@@ -23,12 +23,21 @@ import math
 import os
 
 import numpy as np
-
 from wirecheck.core.camera import Camera
 
-__all__ = ["camera_to_opencv", "opencv_matrices", "opencv_to_camera", "camera_to_pyrender", "intrinsics",
-           "distortion_coefficients",
-           "pyrender_pose_to_camera", "camera_to_gl", "model_matrix", "centre_of", "gl_eye_pose"]
+__all__ = [
+    "camera_to_opencv",
+    "opencv_matrices",
+    "opencv_to_camera",
+    "camera_to_pyrender",
+    "intrinsics",
+    "distortion_coefficients",
+    "pyrender_pose_to_camera",
+    "camera_to_gl",
+    "model_matrix",
+    "centre_of",
+    "gl_eye_pose",
+]
 
 # Relative tolerance for "K describes a centred, square-pixel camera": K built
 # by camera_to_opencv is exact to float64 rounding (~1e-16 relative); 1e-9
@@ -80,6 +89,7 @@ def camera_basis(camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def _cv2():
     import cv2
+
     return cv2
 
 
@@ -92,6 +102,7 @@ def _rotation():
 
 
 # ---- OpenCV ---------------------------------------------------------------
+
 
 def camera_to_opencv(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Our camera as OpenCV extrinsics and intrinsics.
@@ -155,8 +166,9 @@ def opencv_matrices(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return r_cv, -r_cv @ np.asarray(camera.position, dtype=np.float64), k
 
 
-def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: float,
-                     projection: str = "perspective", dist=None) -> Camera:
+def opencv_to_camera(
+    rvec, tvec, K, width: int, height: int, near: float, far: float, projection: str = "perspective", dist=None
+) -> Camera:
     """Inverse of :func:`camera_to_opencv`.
 
     From ``p_cv = R X + t`` (rows of ``R``: right, -up, forward)::
@@ -180,11 +192,14 @@ def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: f
     scale = max(abs(fx), abs(cx0), 1.0)
     if abs(K[0, 1]) > _K_RTOL * scale:
         raise ValueError(f"K {K.tolist()}: expected no skew (K[0][1] = 0)")
-    centred = (math.isclose(fx, fy, rel_tol=_K_RTOL) and abs(cx - cx0) <= _K_RTOL * scale
-               and abs(cy - cy0) <= _K_RTOL * scale)
+    centred = (
+        math.isclose(fx, fy, rel_tol=_K_RTOL) and abs(cx - cx0) <= _K_RTOL * scale and abs(cy - cy0) <= _K_RTOL * scale
+    )
     if not centred and projection != "perspective":
-        raise ValueError(f"K {K.tolist()}: expected square pixels and principal "
-                         f"point ({cx0}, {cy0}) for a {width}x{height} orthographic image")
+        raise ValueError(
+            f"K {K.tolist()}: expected square pixels and principal "
+            f"point ({cx0}, {cy0}) for a {width}x{height} orthographic image"
+        )
     position = -r_cv.T @ tvec
     kwargs = dict(width=width, height=height, near=near, far=far, projection=projection, distortion=dist)
     if projection == "perspective" and centred:
@@ -198,9 +213,11 @@ def opencv_to_camera(rvec, tvec, K, width: int, height: int, near: float, far: f
 
 # ---- pyrender -------------------------------------------------------------
 
+
 def _pyrender():
     os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
     import pyrender
+
     return pyrender
 
 
@@ -248,18 +265,18 @@ def camera_to_pyrender(camera: Camera):
     pose[:3, 3] = camera.position
     w, h = camera.width, camera.height
     if getattr(camera, "distortion", None) is not None:
-        raise ValueError(f"camera distortion {list(camera.distortion)}: pyrender (GL) draws no lens distortion; "
-                         "only the vertices of a distorted camera can be compared")
+        raise ValueError(
+            f"camera distortion {list(camera.distortion)}: pyrender (GL) draws no lens distortion; "
+            "only the vertices of a distorted camera can be compared"
+        )
     if camera.projection == "perspective":
         fx, fy, cx, cy = intrinsics(camera)
-        cam = pyrender.IntrinsicsCamera(fx=fx, fy=fy, cx=cx + 0.5, cy=cy + 0.5,
-                                        znear=camera.near, zfar=camera.far)
+        cam = pyrender.IntrinsicsCamera(fx=fx, fy=fy, cx=cx + 0.5, cy=cy + 0.5, znear=camera.near, zfar=camera.far)
     else:
         if not camera.near > 0:
             raise ValueError(f"camera near {camera.near!r}: pyrender's OrthographicCamera needs znear > 0")
         ymag = camera.ortho_height / 2.0
-        cam = pyrender.OrthographicCamera(xmag=ymag * w / h, ymag=ymag,
-                                          znear=camera.near, zfar=camera.far)
+        cam = pyrender.OrthographicCamera(xmag=ymag * w / h, ymag=ymag, znear=camera.near, zfar=camera.far)
     return pose, cam
 
 
@@ -278,8 +295,7 @@ def pyrender_pose_to_camera(pose, pyrender_camera, width: int, height: int) -> C
     if isinstance(pyrender_camera, pyrender.IntrinsicsCamera):
         c = pyrender_camera
         tol = _K_RTOL * max(c.fx, width, 1.0)
-        if (math.isclose(c.fx, c.fy, rel_tol=_K_RTOL) and abs(c.cx - width / 2) <= tol
-                and abs(c.cy - height / 2) <= tol):
+        if math.isclose(c.fx, c.fy, rel_tol=_K_RTOL) and abs(c.cx - width / 2) <= tol and abs(c.cy - height / 2) <= tol:
             kwargs["fov_y_deg"] = math.degrees(2.0 * math.atan((height / 2.0) / c.fy))
         else:
             kwargs["intrinsics"] = (c.fx, c.fy, c.cx - 0.5, c.cy - 0.5)
@@ -292,6 +308,7 @@ def pyrender_pose_to_camera(pose, pyrender_camera, width: int, height: int) -> C
 
 
 # ---- OpenGL (view and projection matrices) --------------------------------
+
 
 def camera_to_gl(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     """Our camera as OpenGL view and projection matrices (column vectors).
@@ -355,6 +372,7 @@ def camera_to_gl(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
 
 # ---- re-centring for float32 (pyrender) ----------------------------------
 
+
 def centre_of(vertices) -> np.ndarray:
     """``(3,)`` float64: the midpoint of the finite rows' bounding box (zeros when none is finite).
 
@@ -398,6 +416,7 @@ def gl_eye_pose(camera, model_matrix=None, centre=(0.0, 0.0, 0.0)) -> np.ndarray
 
 
 # ---- model motion ---------------------------------------------------------
+
 
 def model_matrix(turns, offset, scale: float, t: float, pivot=(0.0, 0.0, 0.0)) -> np.ndarray:
     """The scene's model matrix at time ``t``, built with scipy.

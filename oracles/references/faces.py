@@ -43,10 +43,10 @@ def fan(faces) -> tuple[np.ndarray, np.ndarray]:
     else:
         lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
         flat = np.fromiter(chain.from_iterable(faces), dtype=np.int64, count=int(lengths.sum()))
-    per = np.maximum(lengths - 2, 0)                          # triangles of each polygon
+    per = np.maximum(lengths - 2, 0)  # triangles of each polygon
     owner = np.repeat(np.arange(len(lengths), dtype=np.int64), per)
-    k = np.arange(len(owner), dtype=np.int64) - np.repeat(np.cumsum(per) - per, per) + 1    # 1 .. n - 2
-    first = (np.cumsum(lengths) - lengths)[owner]             # where each polygon starts in ``flat``
+    k = np.arange(len(owner), dtype=np.int64) - np.repeat(np.cumsum(per) - per, per) + 1  # 1 .. n - 2
+    first = (np.cumsum(lengths) - lengths)[owner]  # where each polygon starts in ``flat``
     tris = np.stack([flat[first], flat[first + k], flat[first + k + 1]], axis=1)
     return tris.reshape(-1, 3), owner
 
@@ -93,8 +93,8 @@ def mirrored_vertices(scene, matrices) -> np.ndarray:
     """``(N,) bool``: vertices of objects whose matrix has a negative determinant."""
     out = np.zeros(len(scene.vertices), dtype=bool)
     for o, m in zip(scene.objects, matrices):
-        if np.linalg.slogdet(m[:3, :3])[0] < 0:       # the sign alone: det() underflows at 1e-110 scales
-            out[o.vertex_start:o.vertex_stop] = True
+        if np.linalg.slogdet(m[:3, :3])[0] < 0:  # the sign alone: det() underflows at 1e-110 scales
+            out[o.vertex_start : o.vertex_stop] = True
     return out
 
 
@@ -106,7 +106,7 @@ def front_faces(p_world: np.ndarray, faces, camera, mirrored: np.ndarray | None 
         return keep
     a, b, c = (p_world[tris[:, i]] for i in range(3))
 
-    def unit_scale(v):          # a positive factor per row: signs unchanged, no under/overflow at 1e+-110
+    def unit_scale(v):  # a positive factor per row: signs unchanged, no under/overflow at 1e+-110
         big = np.abs(v).max(axis=1, keepdims=True)
         return np.where(big > 0, v / np.where(big > 0, big, 1.0), 0.0)
 

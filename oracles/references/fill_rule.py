@@ -58,12 +58,11 @@ from .convert import camera_basis, intrinsics
 from .faces import fan
 from .pyrender_oracle import depth_step
 
-__all__ = ["GL_TIE_PX", "ID_TIE", "NO_OBJECT", "coverage", "silhouette", "project_clipped", "open_edges",
-           "depth_bound"]
+__all__ = ["GL_TIE_PX", "ID_TIE", "NO_OBJECT", "coverage", "silhouette", "project_clipped", "open_edges", "depth_bound"]
 
 #: How far a GL renderer may move a vertex before deciding coverage (px, Euclidean):
 #: sqrt(2) x oracles.tolerances.TIE_END_PX = sqrt(2) x (2^-9 snap + 2^-9 float32), derived there.
-GL_TIE_PX = math.sqrt(2.0) * 2.0 ** -8
+GL_TIE_PX = math.sqrt(2.0) * 2.0**-8
 
 #: ``object_ids`` where no triangle covers the pixel centre.
 NO_OBJECT = -1
@@ -76,7 +75,7 @@ ID_TIE = -2
 _DEPTH_STEPS = 4.0
 _DEPTH_SNAP_PX = 1.0 / 256.0
 _DEPTH_EPS32 = 16.0
-_EPS32 = 2.0 ** -23
+_EPS32 = 2.0**-23
 
 #: Bounding-box samples per batch (~10 float64 temporaries of this length: ~40 MB).
 _CHUNK = 1 << 19
@@ -98,10 +97,10 @@ def _edge_keys(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     The key is the edge's two ends in (x, y) order, so that both triangles of a shared edge get
     the same key; ``third`` is the opposite vertex.
     """
-    p = tris_px + 0.0                                    # -0.0 -> 0.0: equal keys compare equal
-    a = p.reshape(-1, 2)                                 # v0, v1, v2 of each triangle
-    b = np.roll(p, -1, axis=1).reshape(-1, 2)            # v1, v2, v0
-    third = np.roll(p, -2, axis=1).reshape(-1, 2)        # v2, v0, v1
+    p = tris_px + 0.0  # -0.0 -> 0.0: equal keys compare equal
+    a = p.reshape(-1, 2)  # v0, v1, v2 of each triangle
+    b = np.roll(p, -1, axis=1).reshape(-1, 2)  # v1, v2, v0
+    third = np.roll(p, -2, axis=1).reshape(-1, 2)  # v2, v0, v1
     flip = (b[:, 0] < a[:, 0]) | ((b[:, 0] == a[:, 0]) & (b[:, 1] < a[:, 1]))
     lo = np.where(flip[:, None], b, a)
     hi = np.where(flip[:, None], a, b)
@@ -150,12 +149,18 @@ class _Buffers:
         self.inside = np.zeros(n, dtype=bool)
         self.near_open = np.zeros(n, dtype=bool)
         self.robust = np.zeros(n, dtype=bool)
-        self.samples = [] if depth else None        # (cell, object, z, slope) nearest per object and batch
+        self.samples = [] if depth else None  # (cell, object, z, slope) nearest per object and batch
 
 
-def _raster(tris_px: np.ndarray, is_open: np.ndarray, shape, tie_px: float,
-            tri_z: np.ndarray | None = None, tri_object: np.ndarray | None = None,
-            perspective: bool = True) -> _Buffers:
+def _raster(
+    tris_px: np.ndarray,
+    is_open: np.ndarray,
+    shape,
+    tie_px: float,
+    tri_z: np.ndarray | None = None,
+    tri_object: np.ndarray | None = None,
+    perspective: bool = True,
+) -> _Buffers:
     """One pass over the triangles: coverage, centres near open edges, centres held robustly.
 
     With ``tri_z`` and ``tri_object``: also each object's nearest depth (and slope) at the centres it covers.
@@ -190,9 +195,24 @@ def _raster(tris_px: np.ndarray, is_open: np.ndarray, shape, tie_px: float,
         gw, gh = int(b >> 20), int(b & ((1 << 20) - 1))
         per = max(1, _CHUNK // (gw * gh))
         for s in range(0, len(members), per):
-            t = members[s:s + per]
-            _batch(out, tris[t], area2[t], is_open[t], x0[t], y0[t], x1[t], y1[t], gw, gh, width, tie_px,
-                   None if tri_z is None else tri_z[t], None if tri_z is None else tri_object[t], perspective)
+            t = members[s : s + per]
+            _batch(
+                out,
+                tris[t],
+                area2[t],
+                is_open[t],
+                x0[t],
+                y0[t],
+                x1[t],
+                y1[t],
+                gw,
+                gh,
+                width,
+                tie_px,
+                None if tri_z is None else tri_z[t],
+                None if tri_z is None else tri_object[t],
+                perspective,
+            )
     return out
 
 
@@ -207,8 +227,7 @@ def _cells(x0, y0, width, tri, row, col) -> np.ndarray:
     return ((y0[tri] + row) * width + (x0[tri] + col)).astype(np.int64)
 
 
-def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, tie_px, tri_z, tri_object,
-           perspective):
+def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, tie_px, tri_z, tri_object, perspective):
     # The boxes' centres in 3 axes (triangle, row, column): a row shares py and a column px, so each edge
     # function's two products are taken per row and per column and only their difference over the boxes.
     # The longer of the triangle and column axes goes last (numpy's inner loop): (gh, gw, n) for many small
@@ -217,29 +236,30 @@ def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, t
         tri, row, col, tri_major = (1, 1, -1), (-1, 1, 1), (1, -1, 1), (2, 0, 1)
     else:
         tri, row, col, tri_major = (-1, 1, 1), (1, -1, 1), (1, 1, -1), (0, 1, 2)
-    px = x0.reshape(tri) + np.arange(gw).reshape(col)                # centres, float
+    px = x0.reshape(tri) + np.arange(gw).reshape(col)  # centres, float
     py = y0.reshape(tri) + np.arange(gh).reshape(row)
-    valid = (px <= x1.reshape(tri)) & (py <= y1.reshape(tri))       # in the box (clipped to the image)
+    valid = (px <= x1.reshape(tri)) & (py <= y1.reshape(tri))  # in the box (clipped to the image)
     inside = valid & (area2 > 0).reshape(tri)
-    far_from_edges = inside.copy()                                   # farther than tie_px from every edge line
+    far_from_edges = inside.copy()  # farther than tie_px from every edge line
     for k in range(3):
         p, q = tris[:, k], tris[:, (k + 1) % 3]
         dx, dy = q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]
         e = dx.reshape(tri) * (py - p[:, 1].reshape(tri)) - dy.reshape(tri) * (px - p[:, 0].reshape(tri))
         top_left = (dy < 0) | ((dy == 0) & (dx > 0))
-        inside &= e >= 0                                             # E > 0, or E == 0 on a top or left edge:
-        on_line = e == 0                                             # E == 0 is rare off axis-aligned edges
+        inside &= e >= 0  # E > 0, or E == 0 on a top or left edge:
+        on_line = e == 0  # E == 0 is rare off axis-aligned edges
         if on_line.any():
             on_line &= ~top_left.reshape(tri)
             inside &= ~on_line
-        reach = tie_px * np.sqrt(dx * dx + dy * dy)                  # |e| / length <= tie_px, undivided
-        far_from_edges &= e > reach.reshape(tri)                     # inside it: e >= 0, so |e| > reach
+        reach = tie_px * np.sqrt(dx * dx + dy * dy)  # |e| / length <= tie_px, undivided
+        far_from_edges &= e > reach.reshape(tri)  # inside it: e >= 0, so |e| > reach
         # near an open edge (few triangles have one): within tie_px of its line, then of the segment itself
         rows = np.flatnonzero(is_open[:, k])
         if len(rows) == 0:
             continue
-        ii, r, c = np.nonzero((np.abs(e.transpose(tri_major)[rows]) <= reach[rows, None, None])
-                             & valid.transpose(tri_major)[rows])
+        ii, r, c = np.nonzero(
+            (np.abs(e.transpose(tri_major)[rows]) <= reach[rows, None, None]) & valid.transpose(tri_major)[rows]
+        )
         if len(ii):
             ii = rows[ii]
             rx, ry = (x0[ii] + c) - p[ii, 0], (y0[ii] + r) - p[ii, 1]
@@ -249,18 +269,18 @@ def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, t
                 t = np.where(length2 > 0, np.clip((rx * sx + ry * sy) / length2, 0.0, 1.0), 0.0)
             near = np.hypot(rx - t * sx, ry - t * sy) <= tie_px
             out.near_open[_cells(x0, y0, width, ii[near], r[near], c[near])] = True
-    cell = py * width + px                                           # flat pixel index (exact in float)
+    cell = py * width + px  # flat pixel index (exact in float)
     out.inside[cell[inside].astype(np.int64)] = True
     far_from_edges &= inside
     out.robust[cell[far_from_edges].astype(np.int64)] = True
     if tri_z is None or not inside.any():
         return
-    rows, r, cols = np.nonzero(inside.transpose(tri_major))          # covered, triangle by triangle, row-major
+    rows, r, cols = np.nonzero(inside.transpose(tri_major))  # covered, triangle by triangle, row-major
     cells = _cells(x0, y0, width, rows, r, cols)
     # depth at the centres: w = 1/z (perspective) or z (orthographic) on the plane through the vertices
     a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
     w = 1.0 / tri_z if perspective else tri_z
-    det = area2                                                      # > 0 where inside
+    det = area2  # > 0 where inside
     e1, e2 = b - a, c - a
     dw1, dw2 = (w[:, 1] - w[:, 0]), (w[:, 2] - w[:, 0])
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -269,7 +289,7 @@ def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, t
     wp = w[rows, 0] + gx[rows] * ((x0[rows] + cols) - a[rows, 0]) + gy[rows] * ((y0[rows] + r) - a[rows, 1])
     if perspective:
         z = 1.0 / wp
-        slope = z * z * (np.abs(gx) + np.abs(gy))[rows]               # |dz/dx| + |dz/dy| = z^2 |dw|
+        slope = z * z * (np.abs(gx) + np.abs(gy))[rows]  # |dz/dx| + |dz/dy| = z^2 |dw|
     else:
         z = wp
         slope = (np.abs(gx) + np.abs(gy))[rows]
@@ -278,9 +298,9 @@ def _batch(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, gw, gh, width, t
 
 def _nearest_per_object(cells, objects, z, slope):
     """The nearest sample of each (cell, object): ``(cells, objects, z, slope)`` sorted by cell, then z."""
-    key = cells * (objects.max(initial=0) + 1) + objects              # objects are 0, 1, ...: one key per pair
+    key = cells * (objects.max(initial=0) + 1) + objects  # objects are 0, 1, ...: one key per pair
     by_z = np.argsort(z)
-    order = by_z[np.argsort(key[by_z], kind="stable")]                # by key, then z (lexsort is ~5x slower)
+    order = by_z[np.argsort(key[by_z], kind="stable")]  # by key, then z (lexsort is ~5x slower)
     cells, objects, z, slope, key = cells[order], objects[order], z[order], slope[order], key[order]
     first = np.ones(len(cells), dtype=bool)
     first[1:] = key[1:] != key[:-1]
@@ -323,7 +343,7 @@ def _clip_polygon(poly: np.ndarray, z_min: float, z_max: float) -> np.ndarray:
     A cut point on an edge is computed from the edge's ends in a fixed order (the end inside
     first), so two triangles sharing the edge get the same point to the bit.
     """
-    for plane, sign in ((z_min, 1.0), (z_max, -1.0)):      # keep sign (z - plane) >= 0
+    for plane, sign in ((z_min, 1.0), (z_max, -1.0)):  # keep sign (z - plane) >= 0
         if len(poly) == 0:
             break
         out = []
@@ -358,7 +378,7 @@ def project_clipped(p_world, faces, camera) -> tuple[np.ndarray, np.ndarray, np.
     world_to_cam = np.stack([right, up, forward])
     p_cam = (p_world - np.asarray(camera.position, dtype=np.float64)) @ world_to_cam.T
     tris, owner = fan(faces)
-    tri_cam = p_cam[tris]                                              # (T, 3, 3)
+    tri_cam = p_cam[tris]  # (T, 3, 3)
     z = tri_cam[:, :, 2]
     near, far = float(camera.near), float(camera.far)
     whole = ((z >= near) & (z <= far)).all(axis=1)
@@ -382,8 +402,9 @@ def project_clipped(p_world, faces, camera) -> tuple[np.ndarray, np.ndarray, np.
     return tris_px, zc, owner
 
 
-def silhouette(p_world, faces, camera, shape, face_objects=None,
-               tie_px: float = GL_TIE_PX) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def silhouette(
+    p_world, faces, camera, shape, face_objects=None, tie_px: float = GL_TIE_PX
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A frame's reference silhouette: ``(inside, ties, object_ids)``, each ``(H, W)``.
 
     Parameters
@@ -415,10 +436,17 @@ def silhouette(p_world, faces, camera, shape, face_objects=None,
     objects = np.zeros(0, dtype=np.int64)
     if face_objects is not None and len(owner):
         tri_object = np.asarray(face_objects, dtype=np.int64).reshape(-1)[owner]
-        objects, tri_object = np.unique(tri_object, return_inverse=True)    # tri_object: 0, 1, ... here
+        objects, tri_object = np.unique(tri_object, return_inverse=True)  # tri_object: 0, 1, ... here
     several = len(objects) > 1
-    buf = _raster(tris_px, is_open, shape, float(tie_px), tri_z if several else None,
-                  tri_object if several else None, camera.projection == "perspective")
+    buf = _raster(
+        tris_px,
+        is_open,
+        shape,
+        float(tie_px),
+        tri_z if several else None,
+        tri_object if several else None,
+        camera.projection == "perspective",
+    )
     inside = buf.inside.reshape(shape)
     ties = (buf.near_open & ~buf.robust).reshape(shape)
     ids = np.where(buf.inside, 0, NO_OBJECT).astype(np.int64)

@@ -12,17 +12,21 @@ from __future__ import annotations
 
 import os
 import sys
+
 from wirecheck.core.errors import InputError
 
 #: The OpenGL platforms the oracle draws on (``PYOPENGL_PLATFORM``); the first is the default.
 GL_PLATFORMS = ("osmesa", "egl")
 
+
 class GLUnavailable(RuntimeError):
     """The pixel oracle cannot draw here: the message is one line naming the missing piece and its fix."""
 
 
-INSTALL_HINT = {"osmesa": "apt-get install -y libosmesa6",
-                 "egl": "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri"}
+INSTALL_HINT = {
+    "osmesa": "apt-get install -y libosmesa6",
+    "egl": "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri",
+}
 
 
 def gl_platform() -> str:
@@ -44,8 +48,10 @@ def select_gl(name: str | None) -> str:
         raise InputError(f"--gl {name!r}: expected one of {', '.join(GL_PLATFORMS)}")
     current = os.environ.get("PYOPENGL_PLATFORM")
     if "OpenGL.platform" in sys.modules and current != name:
-        raise InputError(f"--gl {name}: OpenGL is already loaded in this process for {current!r}; "
-                         f"set PYOPENGL_PLATFORM={name} before it starts")
+        raise InputError(
+            f"--gl {name}: OpenGL is already loaded in this process for {current!r}; "
+            f"set PYOPENGL_PLATFORM={name} before it starts"
+        )
     os.environ["PYOPENGL_PLATFORM"] = name
     return name
 
@@ -59,19 +65,24 @@ def gl_library_problem(platform: str) -> str | None:
     makes a 1x1 context.
     """
     if platform not in GL_PLATFORMS:
-        return (f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on "
-                f"{' or '.join(repr(p) for p in GL_PLATFORMS)}")
+        return (
+            f"PYOPENGL_PLATFORM={platform!r}; the pyrender oracle draws on {' or '.join(repr(p) for p in GL_PLATFORMS)}"
+        )
     missing = _missing_gl_library(platform)
     if missing is not None:
         return missing
     try:
         import pyrender  # noqa: F401
     except Exception as exc:
-        if "glGetError" in str(exc) or str(exc).startswith("Library "):   # a GL library PyOpenGL could not load
-            return (f"OpenGL's library cannot be loaded on {platform} ({type(exc).__name__}: {exc}); "
-                    f"install it with: {INSTALL_HINT[platform]}")
-        return (f"pyrender cannot be imported ({type(exc).__name__}: {exc}); "
-                "install it with: pip install 'pyrender2>=0.2,<1'")
+        if "glGetError" in str(exc) or str(exc).startswith("Library "):  # a GL library PyOpenGL could not load
+            return (
+                f"OpenGL's library cannot be loaded on {platform} ({type(exc).__name__}: {exc}); "
+                f"install it with: {INSTALL_HINT[platform]}"
+            )
+        return (
+            f"pyrender cannot be imported ({type(exc).__name__}: {exc}); "
+            "install it with: pip install 'pyrender2>=0.2,<1'"
+        )
     return None
 
 
@@ -84,6 +95,7 @@ def _missing_gl_library(platform: str) -> str | None:
     hint = INSTALL_HINT[platform]
     try:
         from OpenGL import platform as gl_platform_module
+
         loaded = gl_platform_module.PLATFORM
     except Exception as exc:  # ImportError, OSError: the platform module itself cannot load
         return f"OpenGL cannot load its {platform} platform ({type(exc).__name__}: {exc}); install it with: {hint}"
@@ -97,15 +109,19 @@ def _missing_gl_library(platform: str) -> str | None:
         if lib is None:
             return f"libOSMesa cannot be loaded (no libOSMesa.so found); install it with: {hint}"
         if not hasattr(lib, "OSMesaCreateContextAttribs"):
-            return (f"libOSMesa ({getattr(lib, '_name', '?')}) lacks OSMesaCreateContextAttribs (Mesa "
-                    f"before 11.2: no core-profile context for pyrender); install a newer one with: {hint}")
+            return (
+                f"libOSMesa ({getattr(lib, '_name', '?')}) lacks OSMesaCreateContextAttribs (Mesa "
+                f"before 11.2: no core-profile context for pyrender); install a newer one with: {hint}"
+            )
         return None
     if _loaded(loaded, "EGL") is None:
         return f"libEGL cannot be loaded (no libEGL.so found: Mesa's EGL); install it with: {hint}"
     gl = _loaded(loaded, "GL")
-    if gl is None or "GLES" in str(getattr(gl, "_name", "")):   # PyOpenGL falls back to GLES: not enough
-        return ("libGL / libOpenGL cannot be loaded (no libGL.so found); install it with: "
-                "apt-get install -y libgl1 libopengl0")
+    if gl is None or "GLES" in str(getattr(gl, "_name", "")):  # PyOpenGL falls back to GLES: not enough
+        return (
+            "libGL / libOpenGL cannot be loaded (no libGL.so found); install it with: "
+            "apt-get install -y libgl1 libopengl0"
+        )
     return None
 
 

@@ -10,7 +10,6 @@ OpenCV ``R, t`` and masked before projecting.
 from __future__ import annotations
 
 import numpy as np
-
 from wirecheck.core.camera import Camera
 
 from .convert import camera_basis, camera_to_opencv, distortion_coefficients
@@ -28,7 +27,7 @@ _last: tuple = (None, None)
 def _conversion(camera: Camera) -> dict:
     global _last
     cached_camera, conv = _last
-    if cached_camera is camera and type(camera) is Camera:     # frozen: same object, same values
+    if cached_camera is camera and type(camera) is Camera:  # frozen: same object, same values
         return conv
     # R rows: right, -up, forward (see convert.camera_to_opencv); built from the
     # camera's vectors rather than through Rodrigues, to keep depth exact.
@@ -36,11 +35,19 @@ def _conversion(camera: Camera) -> dict:
     r_cv = np.stack([right, -up, forward])
     t_cv = -r_cv @ np.asarray(camera.position, dtype=np.float64)
     rvec, tvec, k = camera_to_opencv(camera)
-    conv = {"r": r_cv, "t": t_cv, "rvec": rvec, "tvec": tvec, "k": k, "right": right, "up": up,
-            "dist": distortion_coefficients(camera) if camera.projection == "perspective" else None}
+    conv = {
+        "r": r_cv,
+        "t": t_cv,
+        "rvec": rvec,
+        "tvec": tvec,
+        "k": k,
+        "right": right,
+        "up": up,
+        "dist": distortion_coefficients(camera) if camera.projection == "perspective" else None,
+    }
     for a in conv.values():
         if a is not None:
-            a.setflags(write=False)                     # shared between calls: nobody may change it
+            a.setflags(write=False)  # shared between calls: nobody may change it
     _last = (camera, conv)
     return conv
 
@@ -89,11 +96,12 @@ def project(p_world: np.ndarray, camera: Camera) -> np.ndarray:
     k = conv["k"]
     if camera.projection == "perspective":
         import cv2
+
         pts, _ = cv2.projectPoints(p_world[visible].reshape(-1, 1, 3), conv["rvec"], conv["tvec"], k, conv["dist"])
         p_px[visible] = pts.reshape(-1, 2)
     else:
         d = p_world[visible] - camera.position
-        s = k[0, 0]                                     # H / ortho_height
+        s = k[0, 0]  # H / ortho_height
         right, up = conv["right"], conv["up"]
         p_px[visible, 0] = k[0, 2] + s * (d @ right)
         p_px[visible, 1] = k[1, 2] - s * (d @ up)

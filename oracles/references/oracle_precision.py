@@ -65,14 +65,22 @@ lines by up to 78 px.
 from __future__ import annotations
 
 import numpy as np
+
 from .convert import camera_to_gl
 
-
-__all__ = ["U32", "CLIP_XY_ROUNDINGS", "CLIP_W_ROUNDINGS", "VIEWPORT_ROUNDINGS", "ORACLE_LIMIT_PX", "mesh_radius", "frame_bound_px",
-           "drawn_bound_px"]
+__all__ = [
+    "U32",
+    "CLIP_XY_ROUNDINGS",
+    "CLIP_W_ROUNDINGS",
+    "VIEWPORT_ROUNDINGS",
+    "ORACLE_LIMIT_PX",
+    "mesh_radius",
+    "frame_bound_px",
+    "drawn_bound_px",
+]
 
 #: float32's unit roundoff (half its epsilon): one rounding moves a value v by at most U32 |v|.
-U32 = 2.0 ** -24
+U32 = 2.0**-24
 
 #: Roundings of the magnitude of clip x and y (module docstring: 1 + 1 + 1 + 2 + 4 + 1).
 CLIP_XY_ROUNDINGS = 10
@@ -85,7 +93,7 @@ VIEWPORT_ROUNDINGS = 2
 
 #: The oracle's window coordinates must be within this of exact: the float32 share (2^-9 px) of
 #: oracles.tolerances.TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle.
-ORACLE_LIMIT_PX = 2.0 ** -9
+ORACLE_LIMIT_PX = 2.0**-9
 
 
 def mesh_radius(centred) -> float:
@@ -106,18 +114,18 @@ def frame_bound_px(camera, eye_pose, radius: float) -> float:
     """
     a = np.asarray(eye_pose, dtype=np.float64)
     _view, proj = camera_to_gl(camera)
-    with np.errstate(over="ignore", invalid="ignore"):      # an overflow is no bound: inf below
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is no bound: inf below
         rho = float(np.linalg.norm(a[:3, :3], 2)) * float(radius)
-        mag = np.abs(a[:3, 3]) + rho                              # |e_j| and its terms, every drawn point
-        m_clip = np.abs(proj[:, :3]) @ mag + np.abs(proj[:, 3])   # magnitude of each clip coordinate's terms
-        w_term = CLIP_W_ROUNDINGS * m_clip[3] if camera.projection == "perspective" else 0.0   # ortho: c_w = 1
+        mag = np.abs(a[:3, 3]) + rho  # |e_j| and its terms, every drawn point
+        m_clip = np.abs(proj[:, :3]) @ mag + np.abs(proj[:, 3])  # magnitude of each clip coordinate's terms
+        w_term = CLIP_W_ROUNDINGS * m_clip[3] if camera.projection == "perspective" else 0.0  # ortho: c_w = 1
         w_lo = max(float(camera.near), -float(a[2, 3]) - rho) if camera.projection == "perspective" else 1.0
         bx = U32 * (camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[0] + w_term) / w_lo
         by = U32 * (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[1] + w_term) / w_lo
         bx += VIEWPORT_ROUNDINGS * U32 * camera.width
         by += VIEWPORT_ROUNDINGS * U32 * camera.height
     both = np.array([bx, by], dtype=np.float64)
-    return float(both.max()) if np.isfinite(both).all() else float("inf")   # no finite bound: none at all
+    return float(both.max()) if np.isfinite(both).all() else float("inf")  # no finite bound: none at all
 
 
 def drawn_bound_px(camera, eye_pose, q_model, segments) -> float:
@@ -138,21 +146,23 @@ def drawn_bound_px(camera, eye_pose, q_model, segments) -> float:
     seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
     _view, proj = camera_to_gl(camera)
     perspective = camera.projection == "perspective"
-    viewport = VIEWPORT_ROUNDINGS * U32 * max(camera.width, camera.height)    # the divide, scale and offset
+    viewport = VIEWPORT_ROUNDINGS * U32 * max(camera.width, camera.height)  # the divide, scale and offset
     if not len(seg):
         return float(viewport)
     with np.errstate(over="ignore", invalid="ignore"):
         lin, t = a[:3, :3], a[:3, 3]
-        term = np.abs(q) @ np.abs(lin).T + np.abs(t)                  # (N, 3): magnitude of each e_j's terms
-        m_clip = term @ np.abs(proj[:, :3]).T + np.abs(proj[:, 3])    # (N, 4): each clip coordinate's terms
-        w_term = CLIP_W_ROUNDINGS * m_clip[:, 3] if perspective else 0.0     # orthographic: c_w = 1 exactly
+        term = np.abs(q) @ np.abs(lin).T + np.abs(t)  # (N, 3): magnitude of each e_j's terms
+        m_clip = term @ np.abs(proj[:, :3]).T + np.abs(proj[:, 3])  # (N, 4): each clip coordinate's terms
+        w_term = CLIP_W_ROUNDINGS * m_clip[:, 3] if perspective else 0.0  # orthographic: c_w = 1 exactly
         # each vertex's error in the window times its depth (x and y, the larger): a segment's drawn
         # points (its clipped ends too) are convex combinations of its ends, within the larger end's
-        num = np.maximum((camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 0] + w_term),
-                         (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 1] + w_term))
+        num = np.maximum(
+            (camera.width / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 0] + w_term),
+            (camera.height / 2.0) * (CLIP_XY_ROUNDINGS * m_clip[:, 1] + w_term),
+        )
         num_seg = np.maximum(num[seg[:, 0]], num[seg[:, 1]])
         if perspective:
-            depth = -(q @ lin[2] + t[2])                              # (N,): w = -e_z, float64
+            depth = -(q @ lin[2] + t[2])  # (N,): w = -e_z, float64
             w_a, w_b = depth[seg[:, 0]], depth[seg[:, 1]]
             # behind near by more than the rounding of its depth (2 x its clip w's): GL draws nothing of it
             reach = 2 * CLIP_W_ROUNDINGS * U32 * m_clip[:, 3]
@@ -163,7 +173,5 @@ def drawn_bound_px(camera, eye_pose, q_model, segments) -> float:
             w_lo = 1.0
         both = U32 * num_seg / w_lo
     if not np.isfinite(num).all() or not np.isfinite(both).all():
-        return float("inf")                       # no finite bound: none at all
+        return float("inf")  # no finite bound: none at all
     return float(both.max(initial=0.0)) + viewport
-
-

@@ -51,9 +51,7 @@ is the oracle's own error bound for the last frame (oracles.references.oracle_pr
 
 from __future__ import annotations
 
-
 import numpy as np
-
 from wirecheck.core.camera import Camera
 
 from .convert import camera_to_pyrender, centre_of, gl_eye_pose
@@ -61,8 +59,19 @@ from .gl_platform import GL_PLATFORMS, INSTALL_HINT, GLUnavailable, gl_library_p
 from .oracle_precision import drawn_bound_px
 from .pyrender_programs import stabilise_program_cache
 
-__all__ = ["GLUnavailable", "GL_PLATFORMS", "gl_platform", "select_gl", "gl_available", "osmesa_available", "OracleCache",
-           "PyrenderOracle", "depth_step", "DEPTH_LEVELS"]
+__all__ = [
+    "GLUnavailable",
+    "GL_PLATFORMS",
+    "gl_platform",
+    "select_gl",
+    "gl_available",
+    "osmesa_available",
+    "OracleCache",
+    "PyrenderOracle",
+    "depth_step",
+    "DEPTH_LEVELS",
+]
+
 
 def _spare_the_display(platform) -> None:
     """Closing an EGL context leaves the display initialised, for the other oracles.
@@ -147,12 +156,12 @@ def depth_step(depth, camera: Camera):
     n, f = float(camera.near), float(camera.far)
     depth = np.asarray(depth, dtype=np.float64)
     if camera.projection == "perspective":
-        return depth ** 2 * (f - n) / (f * n) / DEPTH_LEVELS
+        return depth**2 * (f - n) / (f * n) / DEPTH_LEVELS
     return np.full(depth.shape, (f - n) / DEPTH_LEVELS)
 
 
 #: Levels of pyrender's GL_DEPTH_COMPONENT24 buffer: z_win = k / (2^24 - 1).
-DEPTH_LEVELS = float(2 ** 24 - 1)
+DEPTH_LEVELS = float(2**24 - 1)
 
 
 def _id_colours(count: int) -> np.ndarray:
@@ -195,11 +204,12 @@ class PyrenderOracle:
     def __init__(self, width: int, height: int):
         self.platform = gl_platform()
         import pyrender
+
         self._pr = pyrender
         self.width, self.height = int(width), int(height)
         self._renderer = pyrender.OffscreenRenderer(self.width, self.height)
         _single_sample(self._renderer._renderer)
-        stabilise_program_cache(self._renderer._renderer)      # one program per shader, not per frame
+        stabilise_program_cache(self._renderer._renderer)  # one program per shader, not per frame
         if self.platform == "egl":
             _spare_the_display(self._renderer._platform)
         self._gl_info = None
@@ -207,9 +217,9 @@ class PyrenderOracle:
         self._mesh_node = None
         self._mesh_key = None
         self._mesh_faces = None
-        self._mesh_centre = np.zeros(3)                       # of the uploaded vertices (float64)
-        self._mesh_q, self._mesh_segments = np.zeros((0, 3)), np.zeros((0, 2), np.int64)   # what GL draws
-        self._bound_of = None         # drawn_bound_px's arguments for the last frame drawn (last_bound_px)
+        self._mesh_centre = np.zeros(3)  # of the uploaded vertices (float64)
+        self._mesh_q, self._mesh_segments = np.zeros((0, 3)), np.zeros((0, 2), np.int64)  # what GL draws
+        self._bound_of = None  # drawn_bound_px's arguments for the last frame drawn (last_bound_px)
         self._last_bound_px = 0.0
         self._cam_node = None
         self._cam_key = None
@@ -244,13 +254,20 @@ class PyrenderOracle:
         """
         if self._gl_info is None:
             from OpenGL import GL
+
             if self._renderer is None:
                 raise RuntimeError("PyrenderOracle is closed")
             platform = self._renderer._platform
             platform.make_current()
             try:
-                strings = {key: GL.glGetString(name).decode("utf-8", "replace") for key, name in
-                           (("vendor", GL.GL_VENDOR), ("renderer", GL.GL_RENDERER), ("version", GL.GL_VERSION))}
+                strings = {
+                    key: GL.glGetString(name).decode("utf-8", "replace")
+                    for key, name in (
+                        ("vendor", GL.GL_VENDOR),
+                        ("renderer", GL.GL_RENDERER),
+                        ("version", GL.GL_VERSION),
+                    )
+                }
                 draw_fb = 0
                 if platform.supports_framebuffers():
                     self._renderer._renderer._configure_main_framebuffer()
@@ -281,16 +298,20 @@ class PyrenderOracle:
         positions = (vertices - self._mesh_centre).astype(np.float32)
         self._mesh_q = positions.astype(np.float64)
         tris = _fan(faces) if faces is not None and len(faces) else np.zeros((0, 3), np.uint32)
-        t = tris.astype(np.int64)         # the occluding faces decide which line pixels are hidden: theirs too
+        t = tris.astype(np.int64)  # the occluding faces decide which line pixels are hidden: theirs too
         self._mesh_segments = np.concatenate([edges, t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
         if len(edges):
             white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0])
-            prims.append(pr.Primitive(positions=positions, indices=edges.astype(np.uint32),
-                                      mode=pr.constants.GLTF.LINES, material=white))
+            prims.append(
+                pr.Primitive(
+                    positions=positions, indices=edges.astype(np.uint32), mode=pr.constants.GLTF.LINES, material=white
+                )
+            )
         if len(tris):
             black = pr.MetallicRoughnessMaterial(baseColorFactor=[0.0, 0.0, 0.0, 1.0], doubleSided=not cull)
-            prims.append(pr.Primitive(positions=positions, indices=tris,
-                                      mode=pr.constants.GLTF.TRIANGLES, material=black))
+            prims.append(
+                pr.Primitive(positions=positions, indices=tris, mode=pr.constants.GLTF.TRIANGLES, material=black)
+            )
         if prims:
             self._mesh_node = self._scene.add(pr.Mesh(prims))
 
@@ -307,10 +328,12 @@ class PyrenderOracle:
 
     def _set_camera(self, camera: Camera, faces_scene: bool = False) -> None:
         if (camera.width, camera.height) != (self.width, self.height):
-            raise ValueError(f"camera size {camera.width}x{camera.height}: this oracle renders "
-                             f"{self.width}x{self.height}")
-        scene, node_attr, key_attr = ((self._fscene, "_fcam_node", "_fcam_key") if faces_scene
-                                      else (self._scene, "_cam_node", "_cam_key"))
+            raise ValueError(
+                f"camera size {camera.width}x{camera.height}: this oracle renders {self.width}x{self.height}"
+            )
+        scene, node_attr, key_attr = (
+            (self._fscene, "_fcam_node", "_fcam_key") if faces_scene else (self._scene, "_cam_node", "_cam_key")
+        )
         # the camera node stays at the identity: the mesh node's pose takes its vertices to eye space
         # (convert.gl_eye_pose), so the camera's position never reaches float32
         key = (camera.projection, camera.fov_y_deg, camera.ortho_height, camera.near, camera.far, camera.intrinsics)
@@ -339,20 +362,31 @@ class PyrenderOracle:
         centred = vertices - self._fmesh_centre
         positions = centred[triangles.reshape(-1)].astype(np.float32)
         self._fmesh_q = positions.astype(np.float64)
-        corner = np.arange(len(positions), dtype=np.int64).reshape(-1, 3)     # each triangle's three edges
+        corner = np.arange(len(positions), dtype=np.int64).reshape(-1, 3)  # each triangle's three edges
         self._fmesh_segments = np.concatenate([corner[:, [0, 1]], corner[:, [1, 2]], corner[:, [2, 0]]])
         colours = np.repeat(_id_colours(len(triangles)), 3, axis=0)
         colours = np.concatenate([colours, np.full((len(colours), 1), 255, np.uint8)], axis=1)
         white = pr.MetallicRoughnessMaterial(baseColorFactor=[1.0, 1.0, 1.0, 1.0], doubleSided=not cull)
-        prim = pr.Primitive(positions=positions, color_0=colours,
-                            indices=np.arange(len(positions), dtype=np.uint32).reshape(-1, 3),
-                            mode=pr.constants.GLTF.TRIANGLES, material=white)
+        prim = pr.Primitive(
+            positions=positions,
+            color_0=colours,
+            indices=np.arange(len(positions), dtype=np.uint32).reshape(-1, 3),
+            mode=pr.constants.GLTF.TRIANGLES,
+            material=white,
+        )
         self._fmesh_node = self._fscene.add(pr.Mesh([prim]))
 
     # ---- rendering -----------------------------------------------------
-    def render(self, vertices: np.ndarray, edges: np.ndarray, camera: Camera,
-               model_matrix: np.ndarray | None = None, faces=None, cull: bool = False,
-               depth: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    def render(
+        self,
+        vertices: np.ndarray,
+        edges: np.ndarray,
+        camera: Camera,
+        model_matrix: np.ndarray | None = None,
+        faces=None,
+        cull: bool = False,
+        depth: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray | None]:
         """Render a wireframe.
 
         Parameters
@@ -414,6 +448,7 @@ class PyrenderOracle:
         ``glReadPixels`` packs rows tightly (``GL_PACK_ALIGNMENT`` 1).
         """
         from OpenGL import GL
+
         pr, off = self._pr, self._renderer
         inner, platform = off._renderer, off._platform
         platform.make_current()
@@ -437,8 +472,15 @@ class PyrenderOracle:
             platform.make_uncurrent()
         return np.frombuffer(red, dtype=np.uint8).reshape(self.height, self.width)[::-1] > 127
 
-    def render_faces(self, vertices: np.ndarray, triangles: np.ndarray, camera: Camera,
-                     model_matrix: np.ndarray | None = None, cull: bool = False, with_ids: bool = False):
+    def render_faces(
+        self,
+        vertices: np.ndarray,
+        triangles: np.ndarray,
+        camera: Camera,
+        model_matrix: np.ndarray | None = None,
+        cull: bool = False,
+        with_ids: bool = False,
+    ):
         """Render filled triangles: coverage and linear camera depth (and triangle ids).
 
         ``vertices``, ``camera`` and ``model_matrix`` as in :meth:`render`;
@@ -461,7 +503,7 @@ class PyrenderOracle:
         pr = self._pr
         vertices = np.ascontiguousarray(vertices, dtype=np.float64).reshape(-1, 3)
         triangles = np.ascontiguousarray(triangles, dtype=np.int64).reshape(-1, 3)
-        if with_ids and len(triangles) >= 2 ** 24 - 1:
+        if with_ids and len(triangles) >= 2**24 - 1:
             raise ValueError(f"{len(triangles)} triangles: the id image holds at most 2^24 - 2")
         self._set_faces(vertices, triangles, bool(cull))
         self._set_camera(camera, faces_scene=True)
@@ -480,8 +522,10 @@ class PyrenderOracle:
         c = colour.astype(np.int64)
         ids = ((c[:, :, 0] << 16) | (c[:, :, 1] << 8) | c[:, :, 2]) - 1
         if ids.max(initial=-1) >= len(triangles) or ((ids >= 0) != covered).any():
-            raise RuntimeError("pyrender's triangle-id colours came back altered (expected flat, unlit, "
-                               "exact 8-bit colours): cannot find occlusion boundaries")
+            raise RuntimeError(
+                "pyrender's triangle-id colours came back altered (expected flat, unlit, "
+                "exact 8-bit colours): cannot find occlusion boundaries"
+            )
         return covered, depth, ids
 
     def _read_window_depth(self) -> np.ndarray:
@@ -495,6 +539,7 @@ class PyrenderOracle:
         assumes a perspective projection and runs in float32.
         """
         from OpenGL import GL
+
         platform = self._renderer._platform
         platform.make_current()
         try:
@@ -511,6 +556,7 @@ class PyrenderOracle:
 
     def _no_polygon_offset(self) -> None:
         from OpenGL import GL
+
         self._renderer._platform.make_current()
         GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
 
@@ -519,6 +565,7 @@ class PyrenderOracle:
         # context: faces are pushed back by ~1 depth unit and lines on their
         # boundary win the GL_LESS depth test.
         from OpenGL import GL
+
         self._renderer._platform.make_current()
         GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
         GL.glPolygonOffset(1.0, 1.0)
@@ -551,8 +598,10 @@ def gl_available() -> tuple[bool, str]:
             _EGL_CHECKED[platform] = (True, "EGL available")
         except Exception as exc:  # RuntimeError, OSError, ImportError, GLError: no usable EGL
             msg = " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
-            _EGL_CHECKED[platform] = (False, f"no EGL context can be created ({msg}); "
-                                             f"install it with: {INSTALL_HINT['egl']}")
+            _EGL_CHECKED[platform] = (
+                False,
+                f"no EGL context can be created ({msg}); install it with: {INSTALL_HINT['egl']}",
+            )
     return _EGL_CHECKED[platform]
 
 

@@ -40,15 +40,18 @@ def _stable_class():
             defines = {} if defines is None else defines
             files = [x for x in (vertex_shader, fragment_shader, geometry_shader) if x is not None]
             names = [os.path.split(fn)[1] for fn in files]
-            key = tuple([context_key(contextdata.getContext())]
-                        + sorted([(s, 1) for s in names] + [(d, defines[d]) for d in defines]))
+            key = tuple(
+                [context_key(contextdata.getContext())]
+                + sorted([(s, 1) for s in names] + [(d, defines[d]) for d in defines])
+            )
             if key not in self._program_cache:
                 paths = [os.path.join(self.shader_dir, fn) for fn in files]
                 if len(paths) == 2:
                     paths.append(None)
                 vs, fs, gs = paths
-                self._program_cache[key] = ShaderProgram(vertex_shader=vs, fragment_shader=fs,
-                                                         geometry_shader=gs, defines=defines)
+                self._program_cache[key] = ShaderProgram(
+                    vertex_shader=vs, fragment_shader=fs, geometry_shader=gs, defines=defines
+                )
             return self._program_cache[key]
 
     return AddressKeyedProgramCache

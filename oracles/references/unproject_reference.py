@@ -41,9 +41,9 @@ def undistort(p_px: np.ndarray, camera) -> np.ndarray:
     if len(pts) == 0:
         return np.zeros((0, 2))
     criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, UNDISTORT_ITERATIONS, UNDISTORT_EPS)
-    if hasattr(cv2, "undistortPointsIter"):        # OpenCV 4's name for undistortPoints with a criterion
+    if hasattr(cv2, "undistortPointsIter"):  # OpenCV 4's name for undistortPoints with a criterion
         out = cv2.undistortPointsIter(pts, k, distortion_coefficients(camera), None, None, criteria)
-    else:                                           # OpenCV 5 folded it in (equal to the last bit: docs/depth.md)
+    else:  # OpenCV 5 folded it in (equal to the last bit: docs/depth.md)
         out = cv2.undistortPoints(pts, k, distortion_coefficients(camera), R=None, P=None, criteria=criteria)
     return out.reshape(-1, 2)
 
@@ -89,4 +89,4 @@ def unproject(p_px, depth, camera) -> np.ndarray:
     """
     r, t, _k = opencv_matrices(camera)
     p_cv = cam_points(p_px, depth, camera)
-    return (p_cv - t) @ r             # row-stacked R^T (p_cv - t)
+    return (p_cv - t) @ r  # row-stacked R^T (p_cv - t)

@@ -30,25 +30,24 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from wirecheck.core.camera import Camera, look_at
 from wirecheck.core.scene.model import Scene
-from wirecheck.core.transforms import Motion   # core's motion: under test for the core candidate only
+from wirecheck.core.transforms import Motion  # core's motion: under test for the core candidate only
 
 from ..candidates.candidate import CandidateError, call_candidate_precision
 from ..candidates.core_candidate import CoreCandidate
 from ..candidates.draw import draw_candidate
+from ..cases import Case
 from ..diagnosis.clip_planes import FLOAT32_PLANE_ROUNDINGS, PLANE_REL_TOL, clip_fault, depth_slack, probe_planes
 from ..diagnosis.diagnose import diagnose
-from ..cases import Case
-from ..tolerances import EPS, Tolerances, vertex_bound, vertex_scale
 from ..runner import run_crosscheck
+from ..tolerances import EPS, Tolerances, vertex_bound, vertex_scale
 from .matrix import CAMERA, TURNS
 
 W, H = CAMERA["width"], CAMERA["height"]
-CX, CY = (W - 1) / 2, (H - 1) / 2            # 319.5, 239.5: integers are pixel centres
-F90 = 240.0                                  # (480 / 2) / tan(90 deg / 2)
-D = 3.0                                      # the specification's nearer camera distance
+CX, CY = (W - 1) / 2, (H - 1) / 2  # 319.5, 239.5: integers are pixel centres
+F90 = 240.0  # (480 / 2) / tan(90 deg / 2)
+D = 3.0  # the specification's nearer camera distance
 
 
 def spec_camera(z: float = D, fov: float = 90.0) -> Camera:
@@ -65,9 +64,18 @@ class _Check:
     """One check's outcome, built as it runs."""
 
     def __init__(self, name: str, declared: str | None, kind: str, proves: str):
-        self.declared = declared          # --candidate-precision: wins over the dtype the candidate returns
-        self.out = {"name": name, "kind": kind, "proves": proves, "verdict": "pass", "error_px": None,
-                    "bound_px": None, "reasons": [], "faults": [], "expected": {}}
+        self.declared = declared  # --candidate-precision: wins over the dtype the candidate returns
+        self.out = {
+            "name": name,
+            "kind": kind,
+            "proves": proves,
+            "verdict": "pass",
+            "error_px": None,
+            "bound_px": None,
+            "reasons": [],
+            "faults": [],
+            "expected": {},
+        }
 
     def fail(self, reason: str) -> None:
         self.out["verdict"] = "fail"
@@ -124,28 +132,48 @@ def _worst(got: np.ndarray, want: np.ndarray) -> tuple[float, int]:
 # ---------------------------------------------------------------- 1. known-point projection
 
 #: World points seen from (0, 0, 3) and their normalised coordinates (X / z, Y / z), z = 3 - Z:
-KNOWN_POINTS = np.array([
-    [0.0, 0.0, 0.0],         # z = 3: (0, 0), the principal point
-    [1.0, 0.5, 0.0],         # z = 3: (1/3, 1/6)
-    [-1.0, 0.5, 0.0],        # z = 3: (-1/3, 1/6)
-    [1.0, -0.5, 0.0],        # z = 3: (1/3, -1/6)
-    [-1.5, 0.75, -3.0],      # z = 6: (-1/4, 1/8)
-    [1.5, -0.75, -3.0],      # z = 6: (1/4, -1/8)
-    [0.6, -0.9, 1.5],        # z = 1.5: (0.4, -0.6)
-    [-0.3, 0.6, 1.5],        # z = 1.5: (-0.2, 0.4)
-])
-KNOWN_NORMALISED = np.array([[0.0, 0.0], [1 / 3, 1 / 6], [-1 / 3, 1 / 6], [1 / 3, -1 / 6], [-0.25, 0.125],
-                             [0.25, -0.125], [0.4, -0.6], [-0.2, 0.4]])
+KNOWN_POINTS = np.array(
+    [
+        [0.0, 0.0, 0.0],  # z = 3: (0, 0), the principal point
+        [1.0, 0.5, 0.0],  # z = 3: (1/3, 1/6)
+        [-1.0, 0.5, 0.0],  # z = 3: (-1/3, 1/6)
+        [1.0, -0.5, 0.0],  # z = 3: (1/3, -1/6)
+        [-1.5, 0.75, -3.0],  # z = 6: (-1/4, 1/8)
+        [1.5, -0.75, -3.0],  # z = 6: (1/4, -1/8)
+        [0.6, -0.9, 1.5],  # z = 1.5: (0.4, -0.6)
+        [-0.3, 0.6, 1.5],  # z = 1.5: (-0.2, 0.4)
+    ]
+)
+KNOWN_NORMALISED = np.array(
+    [
+        [0.0, 0.0],
+        [1 / 3, 1 / 6],
+        [-1 / 3, 1 / 6],
+        [1 / 3, -1 / 6],
+        [-0.25, 0.125],
+        [0.25, -0.125],
+        [0.4, -0.6],
+        [-0.2, 0.4],
+    ]
+)
 
 
 def known_point(func, declared: str | None = None) -> dict:
-    check = _Check("known_point", declared, "critical",
-                   "points of known depth (1.5, 3, 6) land on their normalised coordinates (X/z, Y/z): "
-                   "the divide, the focal length of the vertical FOV, the principal point and both axes' signs")
+    check = _Check(
+        "known_point",
+        declared,
+        "critical",
+        "points of known depth (1.5, 3, 6) land on their normalised coordinates (X/z, Y/z): "
+        "the divide, the focal length of the vertical FOV, the principal point and both axes' signs",
+    )
     camera = spec_camera()
     want = expected_px(KNOWN_NORMALISED[:, 0], KNOWN_NORMALISED[:, 1])
-    check.out["expected"] = {"camera": "z 3, FOV 90, 640x480", "points": KNOWN_POINTS.tolist(),
-                             "normalised": KNOWN_NORMALISED.tolist(), "pixels": want.tolist()}
+    check.out["expected"] = {
+        "camera": "z 3, FOV 90, 640x480",
+        "points": KNOWN_POINTS.tolist(),
+        "normalised": KNOWN_NORMALISED.tolist(),
+        "pixels": want.tolist(),
+    }
     got = check.call(func, KNOWN_POINTS, camera, "projecting the known points")
     if got is None:
         return check.out
@@ -156,11 +184,14 @@ def known_point(func, declared: str | None = None) -> dict:
     check.out["got_normalised"] = [[(x - CX) / F90, (CY - y) / F90] for x, y in px.tolist()]
     if not err <= bound:
         x_n, y_n = KNOWN_NORMALISED[k]
-        check.fail(f"point {KNOWN_POINTS[k].tolist()} (depth {D - KNOWN_POINTS[k][2]:g}) projects to "
-                   f"{px[k].tolist()}, expected ({x_n:.6g}, {y_n:.6g}) normalised = {want[k].tolist()} px: "
-                   f"{err:.3g} px > {bound:.3g} px")
-        check.faults(_named(func, px, want, camera, precision, vertex_scale(KNOWN_POINTS, want, camera), bound,
-                            clipping=True))
+        check.fail(
+            f"point {KNOWN_POINTS[k].tolist()} (depth {D - KNOWN_POINTS[k][2]:g}) projects to "
+            f"{px[k].tolist()}, expected ({x_n:.6g}, {y_n:.6g}) normalised = {want[k].tolist()} px: "
+            f"{err:.3g} px > {bound:.3g} px"
+        )
+        check.faults(
+            _named(func, px, want, camera, precision, vertex_scale(KNOWN_POINTS, want, camera), bound, clipping=True)
+        )
     return check.out
 
 
@@ -185,11 +216,15 @@ def turn(theta: float) -> np.ndarray:
 
 
 def rotation_invariance(func, declared: str | None = None) -> dict:
-    check = _Check("rotation_invariance", declared, "critical",
-                   "a 360 deg turn returns every vertex to its start: turned in 45 deg steps with the camera "
-                   "turned alike, the picture stays the start's at every step (the projector uses the "
-                   "camera's orientation, not a fixed one), and the scene turned a full turn alone comes "
-                   "back where it began")
+    check = _Check(
+        "rotation_invariance",
+        declared,
+        "critical",
+        "a 360 deg turn returns every vertex to its start: turned in 45 deg steps with the camera "
+        "turned alike, the picture stays the start's at every step (the projector uses the "
+        "camera's orientation, not a fixed one), and the scene turned a full turn alone comes "
+        "back where it began",
+    )
     camera = spec_camera()
     start = check.call(func, UNIT_CUBE, camera, "projecting the cube at rest")
     if start is None:
@@ -199,14 +234,18 @@ def rotation_invariance(func, declared: str | None = None) -> dict:
     # it; the turn's own float64 rounding (ROTATION_ROUNDINGS eps64 x the scale) is ~1e-11 px here.
     scale = vertex_scale(UNIT_CUBE, px0, camera)
     bound = 2.0 * vertex_bound(precision, scale) + ROTATION_ROUNDINGS * EPS["float64"] * scale
-    check.out["expected"] = {"camera": "z 3, FOV 90", "points": "the unit cube's 8 corners",
-                             "steps_deg": [360.0 * k / ROTATION_STEPS for k in range(1, ROTATION_STEPS + 1)],
-                             "pixels": px0.tolist()}
+    check.out["expected"] = {
+        "camera": "z 3, FOV 90",
+        "points": "the unit cube's 8 corners",
+        "steps_deg": [360.0 * k / ROTATION_STEPS for k in range(1, ROTATION_STEPS + 1)],
+        "pixels": px0.tolist(),
+    }
     worst = (0.0, None, None, None)
     for k in range(1, ROTATION_STEPS + 1):
         r = turn(2.0 * math.pi * k / ROTATION_STEPS)
-        turned = Camera(position=r @ camera.position, forward=r @ camera.forward, up=r @ camera.up,
-                        fov_y_deg=90.0, **CAMERA)
+        turned = Camera(
+            position=r @ camera.position, forward=r @ camera.forward, up=r @ camera.up, fov_y_deg=90.0, **CAMERA
+        )
         got = check.call(func, UNIT_CUBE @ r.T, turned, f"projecting the cube turned {360 * k // ROTATION_STEPS} deg")
         if got is None:
             return check.out
@@ -229,13 +268,17 @@ def rotation_invariance(func, declared: str | None = None) -> dict:
     check.error(max(worst[0], err_full), bound)
     if worst[0] > bound:
         _, k, row, px = worst
-        check.fail(f"scene and camera turned {360 * k // ROTATION_STEPS} deg together: corner "
-                   f"{UNIT_CUBE[row].tolist()} at {px[row].tolist()}, at rest {px0[row].tolist()}: "
-                   f"{worst[0]:.3g} px > {bound:.3g} px (the picture must not change)")
+        check.fail(
+            f"scene and camera turned {360 * k // ROTATION_STEPS} deg together: corner "
+            f"{UNIT_CUBE[row].tolist()} at {px[row].tolist()}, at rest {px0[row].tolist()}: "
+            f"{worst[0]:.3g} px > {bound:.3g} px (the picture must not change)"
+        )
         check.faults(_named(func, px, px0, camera, precision, scale, bound, clipping=False))
     if err_full > bound:
-        check.fail(f"after a full turn ({how}) corner {UNIT_CUBE[row_full].tolist()} is at "
-                   f"{got[0][row_full].tolist()}, at rest {px0[row_full].tolist()}: {err_full:.3g} px > {bound:.3g} px")
+        check.fail(
+            f"after a full turn ({how}) corner {UNIT_CUBE[row_full].tolist()} is at "
+            f"{got[0][row_full].tolist()}, at rest {px0[row_full].tolist()}: {err_full:.3g} px > {bound:.3g} px"
+        )
     return check.out
 
 
@@ -248,32 +291,42 @@ MONOTONIC_XY = ((0.25, 0.25), (-0.5, 0.125))
 
 
 def depth_monotonicity(func, declared: str | None = None) -> dict:
-    check = _Check("depth_monotonicity", declared, "critical",
-                   "for identical x, y a farther z lands closer to the centre: the distance from the principal "
-                   "point is f |(x, y)| / z, halving at each doubling of depth from 0.5 to 64")
+    check = _Check(
+        "depth_monotonicity",
+        declared,
+        "critical",
+        "for identical x, y a farther z lands closer to the centre: the distance from the principal "
+        "point is f |(x, y)| / z, halving at each doubling of depth from 0.5 to 64",
+    )
     camera = spec_camera()
     points = np.array([[x, y, D - z] for x, y in MONOTONIC_XY for z in MONOTONIC_DEPTHS])
     # expected distance from (cx, cy): f sqrt(x^2 + y^2) / z; the smallest step, between z 32 and 64 of
     # (0.25, 0.25), is 240 * 0.354 * (1/32 - 1/64) = 1.3 px, far above any precision's bound (~1e-3 px)
     radius = [[F90 * math.hypot(x, y) / z for z in MONOTONIC_DEPTHS] for x, y in MONOTONIC_XY]
-    check.out["expected"] = {"camera": "z 3, FOV 90", "xy": [list(p) for p in MONOTONIC_XY],
-                             "depths": list(MONOTONIC_DEPTHS), "distance_px": radius}
+    check.out["expected"] = {
+        "camera": "z 3, FOV 90",
+        "xy": [list(p) for p in MONOTONIC_XY],
+        "depths": list(MONOTONIC_DEPTHS),
+        "distance_px": radius,
+    }
     got = check.call(func, points, camera, "projecting points along the depth")
     if got is None:
         return check.out
     px, precision = got
     want = np.array([[CX, CY]])
     exact = expected_px(points[:, 0] / (D - points[:, 2]), points[:, 1] / (D - points[:, 2]))
-    bound = 2.0 * _bound(precision, points, exact, camera)     # two points' errors, each within the bound
+    bound = 2.0 * _bound(precision, points, exact, camera)  # two points' errors, each within the bound
     dist = np.linalg.norm(px - want, axis=1).reshape(len(MONOTONIC_XY), len(MONOTONIC_DEPTHS))
     check.out["got_distance_px"] = dist.tolist()
     for i, (x, y) in enumerate(MONOTONIC_XY):
         for j in range(len(MONOTONIC_DEPTHS) - 1):
             a, b = dist[i, j], dist[i, j + 1]
-            if not b < a - bound:      # NaN (clipped) fails too: every depth is inside [near, far]
-                check.fail(f"(x, y) = ({x:g}, {y:g}): depth {MONOTONIC_DEPTHS[j]:g} -> {MONOTONIC_DEPTHS[j + 1]:g} "
-                           f"moves {a:.6g} px -> {b:.6g} px from the centre: expected closer (by "
-                           f"{radius[i][j] - radius[i][j + 1]:.3g} px: {radius[i][j]:.6g} -> {radius[i][j + 1]:.6g})")
+            if not b < a - bound:  # NaN (clipped) fails too: every depth is inside [near, far]
+                check.fail(
+                    f"(x, y) = ({x:g}, {y:g}): depth {MONOTONIC_DEPTHS[j]:g} -> {MONOTONIC_DEPTHS[j + 1]:g} "
+                    f"moves {a:.6g} px -> {b:.6g} px from the centre: expected closer (by "
+                    f"{radius[i][j] - radius[i][j + 1]:.3g} px: {radius[i][j]:.6g} -> {radius[i][j + 1]:.6g})"
+                )
                 break
     return check.out
 
@@ -303,33 +356,46 @@ def _frame(func, points, edges, camera, precision: str) -> np.ndarray:
 
 
 def clip_safety(func, declared: str | None = None) -> dict:
-    check = _Check("clip_safety", declared, "critical",
-                   "points behind the camera are not drawn and do not crash the projection: NaN for them and "
-                   "for a point on the camera's plane (a divide by zero), the points in front beside them "
-                   "unchanged, and an edge that passes behind the camera drawn only in front of it")
+    check = _Check(
+        "clip_safety",
+        declared,
+        "critical",
+        "points behind the camera are not drawn and do not crash the projection: NaN for them and "
+        "for a point on the camera's plane (a divide by zero), the points in front beside them "
+        "unchanged, and an edge that passes behind the camera drawn only in front of it",
+    )
     camera = spec_camera()
-    check.out["expected"] = {"camera": "z 3, FOV 90", "front": FRONT.tolist(), "behind": BEHIND.tolist(),
-                             "behind_depths": (D - BEHIND[:, 2]).tolist(), "behind_pixels": "NaN",
-                             "at_camera": AT_CAMERA.tolist()}
+    check.out["expected"] = {
+        "camera": "z 3, FOV 90",
+        "front": FRONT.tolist(),
+        "behind": BEHIND.tolist(),
+        "behind_depths": (D - BEHIND[:, 2]).tolist(),
+        "behind_pixels": "NaN",
+        "at_camera": AT_CAMERA.tolist(),
+    }
     alone = check.call(func, FRONT, camera, "projecting points in front of the camera")
     got = check.call(func, np.concatenate([FRONT, BEHIND]), camera, "projecting points in front and behind")
     precision = "float64"
     if got is not None:
         px, precision = got
-        shown = np.flatnonzero(np.isfinite(px[len(FRONT):]).any(axis=1))
+        shown = np.flatnonzero(np.isfinite(px[len(FRONT) :]).any(axis=1))
         if len(shown):
             k = int(shown[0])
-            check.fail(f"{len(shown)} of {len(BEHIND)} points behind the camera projected, e.g. "
-                       f"{BEHIND[k].tolist()} (depth {D - BEHIND[k][2]:g}) to {px[len(FRONT) + k].tolist()}: "
-                       "expected NaN (clipped before the divide)")
+            check.fail(
+                f"{len(shown)} of {len(BEHIND)} points behind the camera projected, e.g. "
+                f"{BEHIND[k].tolist()} (depth {D - BEHIND[k][2]:g}) to {px[len(FRONT) + k].tolist()}: "
+                "expected NaN (clipped before the divide)"
+            )
         if alone is not None:
             # the same points, the same camera: the same pixels, to each call's rounding
             bound = 2.0 * _bound(precision, FRONT, alone[0], camera)
-            err, k = _worst(px[:len(FRONT)], alone[0])
+            err, k = _worst(px[: len(FRONT)], alone[0])
             check.error(err, bound)
             if not err <= bound:
-                check.fail(f"front point {FRONT[k].tolist()} projects to {px[k].tolist()} beside points behind "
-                           f"the camera, to {alone[0][k].tolist()} alone: {err:.3g} px > {bound:.3g} px")
+                check.fail(
+                    f"front point {FRONT[k].tolist()} projects to {px[k].tolist()} beside points behind "
+                    f"the camera, to {alone[0][k].tolist()} alone: {err:.3g} px > {bound:.3g} px"
+                )
     got = check.call(func, AT_CAMERA, camera, "projecting a point on the camera's plane (depth 0)")
     if got is not None and np.isfinite(got[0]).any():
         check.fail(f"a point on the camera's plane (depth 0) projects to {got[0][0].tolist()}: expected NaN")
@@ -353,8 +419,10 @@ def _edge_behind(check: _Check, func, camera, precision: str) -> dict:
     ends = check.call(func, np.concatenate([FRONT[:1], ON_EDGE]), camera, "projecting the edge's front part")
     if ends is None or not np.isfinite(ends[0]).all():
         if ends is not None:
-            check.fail(f"points in front of the camera, {FRONT[0].tolist()} and {ON_EDGE[0].tolist()}, project "
-                       f"to {ends[0].tolist()}: expected pixels")
+            check.fail(
+                f"points in front of the camera, {FRONT[0].tolist()} and {ON_EDGE[0].tolist()}, project "
+                f"to {ends[0].tolist()}: expected pixels"
+            )
         return {}
     a, b = ends[0]
     try:
@@ -367,16 +435,21 @@ def _edge_behind(check: _Check, func, camera, precision: str) -> dict:
     along = (cols - a[0]) * u[0] + (rows - a[1]) * u[1]
     behind = along < -1.5
     if behind.any():
-        check.fail(f"the edge through the camera's back drew {int(behind.sum())} pixels beyond its front end "
-                   f"{a.tolist()}, where only its part behind the camera projects (e.g. row "
-                   f"{int(rows[behind][0])}, column {int(cols[behind][0])})")
+        check.fail(
+            f"the edge through the camera's back drew {int(behind.sum())} pixels beyond its front end "
+            f"{a.tolist()}, where only its part behind the camera projects (e.g. row "
+            f"{int(rows[behind][0])}, column {int(cols[behind][0])})"
+        )
     if len(rows) <= 100:
-        check.fail(f"the edge's part in front of the camera drew {len(rows)} pixels: expected it drawn "
-                   "(~280 px from its front end to the top of the image)")
+        check.fail(
+            f"the edge's part in front of the camera drew {len(rows)} pixels: expected it drawn "
+            "(~280 px from its front end to the top of the image)"
+        )
     return {"drawn_px": int(len(rows))}
 
 
 # ---------------------------------------------------------------- edge cases
+
 
 def _near_delta(precision: str) -> float:
     """Relative distance from near that a correct candidate of ``precision`` resolves: twice the plane
@@ -385,9 +458,13 @@ def _near_delta(precision: str) -> float:
 
 
 def near_plane_depth(func, declared: str | None = None) -> dict:
-    check = _Check("near_plane_depth", declared, "edge",
-                   "the near plane is where clipping starts: a point just inside near is kept, one just "
-                   "outside is NaN, one exactly at near may be either (a rounding decides), and none crashes")
+    check = _Check(
+        "near_plane_depth",
+        declared,
+        "edge",
+        "the near plane is where clipping starts: a point just inside near is kept, one just "
+        "outside is NaN, one exactly at near may be either (a rounding decides), and none crashes",
+    )
     # camera at the origin looking down -Z: depth = -Z exactly, so near is hit to the bit; (x, y) = (0.01,
     # -0.005) at depth 0.1 is normalised (0.1, -0.05), (343.5, 251.5) px: inside the image, so a point kept
     # is a finite pixel (where it lands is known_point's business)
@@ -399,8 +476,13 @@ def near_plane_depth(func, declared: str | None = None) -> dict:
         return check.out
     delta = _near_delta(got[1])
     depths = (near * (1 + delta), near * (1 - delta))
-    check.out["expected"] = {"camera": "at the origin looking down -Z, near 0.1, FOV 90", "at_near": "either",
-                             "depths": list(depths), "relative_delta": delta, "kept": [True, False]}
+    check.out["expected"] = {
+        "camera": "at the origin looking down -Z, near 0.1, FOV 90",
+        "at_near": "either",
+        "depths": list(depths),
+        "relative_delta": delta,
+        "kept": [True, False],
+    }
     got = check.call(func, [[*xy, -z] for z in depths], camera, "projecting points about the near plane")
     if got is None:
         return check.out
@@ -408,31 +490,44 @@ def near_plane_depth(func, declared: str | None = None) -> dict:
     if not np.isfinite(px[0]).all():
         check.fail(f"a point at depth near (1 + {delta:.2g}) is clipped: expected it kept (near <= z)")
     if np.isfinite(px[1]).any():
-        check.fail(f"a point at depth near (1 - {delta:.2g}) projects to {px[1].tolist()}: expected NaN "
-                   "(clipped: z < near)")
+        check.fail(
+            f"a point at depth near (1 - {delta:.2g}) projects to {px[1].tolist()}: expected NaN (clipped: z < near)"
+        )
     if check.out["verdict"] == "fail":
         check.clip_faults(func, camera)
     return check.out
 
 
 def behind_camera(func, declared: str | None = None) -> dict:
-    check = _Check("behind_camera", declared, "edge",
-                   "a mesh wholly behind the camera shows nothing: every vertex NaN and an empty frame, "
-                   "where through the divide its mirror image would fill the middle of the picture")
+    check = _Check(
+        "behind_camera",
+        declared,
+        "edge",
+        "a mesh wholly behind the camera shows nothing: every vertex NaN and an empty frame, "
+        "where through the divide its mirror image would fill the middle of the picture",
+    )
     camera = spec_camera()
     # the unit cube centred 3 behind the camera at (0, 0, 3): depths -2.5 to -3.5
     points = UNIT_CUBE + np.array([0.0, 0.0, 6.0])
-    edges = np.array([[i, j] for i in range(8) for j in range(i + 1, 8)
-                      if np.count_nonzero(UNIT_CUBE[i] != UNIT_CUBE[j]) == 1], dtype=np.intp)   # its 12 edges
-    check.out["expected"] = {"camera": "z 3, FOV 90", "depths": sorted({D - z for z in points[:, 2]}),
-                             "pixels": "NaN for all 8", "drawn_px": 0}
+    edges = np.array(
+        [[i, j] for i in range(8) for j in range(i + 1, 8) if np.count_nonzero(UNIT_CUBE[i] != UNIT_CUBE[j]) == 1],
+        dtype=np.intp,
+    )  # its 12 edges
+    check.out["expected"] = {
+        "camera": "z 3, FOV 90",
+        "depths": sorted({D - z for z in points[:, 2]}),
+        "pixels": "NaN for all 8",
+        "drawn_px": 0,
+    }
     got = check.call(func, points, camera, "projecting a cube behind the camera")
     if got is None:
         return check.out
     shown = np.flatnonzero(np.isfinite(got[0]).any(axis=1))
     if len(shown):
-        check.fail(f"{len(shown)} of 8 vertices behind the camera projected, e.g. {points[shown[0]].tolist()} "
-                   f"to {got[0][shown[0]].tolist()}: expected NaN")
+        check.fail(
+            f"{len(shown)} of 8 vertices behind the camera projected, e.g. {points[shown[0]].tolist()} "
+            f"to {got[0][shown[0]].tolist()}: expected NaN"
+        )
     try:
         image = _frame(func, points, edges, camera, got[1])
     except (CandidateError, ValueError, ArithmeticError) as exc:
@@ -451,36 +546,54 @@ EMPTY = Scene(name="empty_mesh", vertices=np.zeros((0, 3)), edges=np.zeros((0, 2
 
 
 def empty_mesh(func, declared: str | None = None) -> dict:
-    check = _Check("empty_mesh", declared, "edge",
-                   "an empty mesh is projected without a crash ((0, 3) points -> (0, 2) pixels), draws nothing, "
-                   "and a crosscheck of it is vacuous: a gate never passes on nothing")
+    check = _Check(
+        "empty_mesh",
+        declared,
+        "edge",
+        "an empty mesh is projected without a crash ((0, 3) points -> (0, 2) pixels), draws nothing, "
+        "and a crosscheck of it is vacuous: a gate never passes on nothing",
+    )
     camera = spec_camera()
-    check.out["expected"] = {"pixels_shape": [0, 2], "drawn_px": 0, "run_verdict": "fail",
-                             "case_verdict": "vacuous"}
+    check.out["expected"] = {"pixels_shape": [0, 2], "drawn_px": 0, "run_verdict": "fail", "case_verdict": "vacuous"}
     got = check.call(func, np.zeros((0, 3)), camera, "projecting an empty mesh")
     try:
-        image = _frame(func, np.zeros((0, 3)), np.zeros((0, 2), dtype=np.intp), camera,
-                       got[1] if got else "float64")
+        image = _frame(func, np.zeros((0, 3)), np.zeros((0, 2), dtype=np.intp), camera, got[1] if got else "float64")
     except (CandidateError, ValueError, ArithmeticError) as exc:
         check.fail(f"drawing an empty mesh: {type(exc).__name__}: {exc}")
     else:
         if image.any():
             check.fail(f"an empty mesh drew {int(image.sum())} pixels: expected none")
     # the runner on it, at level vertices (nothing to draw): the case compares nothing
-    report, _ = run_crosscheck([EMPTY], func, frames=1, level="vertices", turns=TURNS, animation=False,
-                               tol=Tolerances(precision=declared),
-                               cases=(Case("z3_fov90", camera),))
+    report, _ = run_crosscheck(
+        [EMPTY],
+        func,
+        frames=1,
+        level="vertices",
+        turns=TURNS,
+        animation=False,
+        tol=Tolerances(precision=declared),
+        cases=(Case("z3_fov90", camera),),
+    )
     case = report["cases"][0]
     check.out["run"] = {"verdict": report["verdict"], "case_verdict": case["verdict"], "reasons": case["reasons"]}
     if report["verdict"] != "fail" or case["verdict"] != "vacuous":
-        check.fail(f"a crosscheck of the empty mesh is {report['verdict']} (case {case['verdict']}): expected "
-                   "fail, the case vacuous (nothing compared)")
+        check.fail(
+            f"a crosscheck of the empty mesh is {report['verdict']} (case {case['verdict']}): expected "
+            "fail, the case vacuous (nothing compared)"
+        )
     return check.out
 
 
 #: The checks in report order: the four critical cases, then the three edge cases.
-CHECKS = (known_point, rotation_invariance, depth_monotonicity, clip_safety, near_plane_depth, behind_camera,
-          empty_mesh)
+CHECKS = (
+    known_point,
+    rotation_invariance,
+    depth_monotonicity,
+    clip_safety,
+    near_plane_depth,
+    behind_camera,
+    empty_mesh,
+)
 CHECK_NAMES = tuple(c.__name__ for c in CHECKS)
 CRITICAL = CHECK_NAMES[:4]
 

@@ -22,8 +22,8 @@ from wirecheck.core.camera import look_at
 from wirecheck.core.scene.files import load_scene
 
 from ..cases import Case
-from ..tolerances import Tolerances
 from ..runner import run_crosscheck
+from ..tolerances import Tolerances
 
 #: The specification's scenes (A, B), its camera distances, FOVs (degrees, vertical) and frame counts.
 SCENES = ("unit_cube", "offset_pyramid")
@@ -46,13 +46,16 @@ def case_name(z: float, fov: float) -> str:
 
 def spec_cases() -> tuple[Case, ...]:
     """The four cameras of the matrix, each at (0, 0, z) looking at the origin (``renderer --camera-z z --fov F``)."""
-    return tuple(Case(case_name(z, fov), look_at((0.0, 0.0, z), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0),
-                                                 fov_y_deg=fov, **CAMERA))
-                 for z in CAMERA_Z for fov in FOVS)
+    return tuple(
+        Case(case_name(z, fov), look_at((0.0, 0.0, z), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), fov_y_deg=fov, **CAMERA))
+        for z in CAMERA_Z
+        for fov in FOVS
+    )
 
 
-def run_matrix(candidate, level: str = "pixels", candidate_name: str = "core", progress=None,
-               precision: str | None = None) -> dict:
+def run_matrix(
+    candidate, level: str = "pixels", candidate_name: str = "core", progress=None, precision: str | None = None
+) -> dict:
     """The 24 runs: ``{"runs": [record...], "compared": totals, "oracle_gl", "seconds"}``.
 
     Each record is a crosscheck case record (oracles.judge.verdict) with
@@ -65,9 +68,17 @@ def run_matrix(candidate, level: str = "pixels", candidate_name: str = "core", p
     runs, gl, seconds = [], None, 0.0
     totals = {"cases": 0, "frames": 0, "vertices": 0, "pixels": 0 if level == "pixels" else None}
     for i, frames in enumerate(FRAME_COUNTS):
-        report, _ = run_crosscheck(scenes, candidate, frames=frames, level=level, turns=TURNS,
-                                   tol=Tolerances(precision=precision), candidate_name=candidate_name, animation=False,
-                                   cases=spec_cases())
+        report, _ = run_crosscheck(
+            scenes,
+            candidate,
+            frames=frames,
+            level=level,
+            turns=TURNS,
+            tol=Tolerances(precision=precision),
+            candidate_name=candidate_name,
+            animation=False,
+            cases=spec_cases(),
+        )
         gl = gl or report["oracle_gl"]
         seconds += report["timing"]["wall_s"]
         for key in ("cases", "frames", "vertices"):
@@ -75,7 +86,7 @@ def run_matrix(candidate, level: str = "pixels", candidate_name: str = "core", p
         if level == "pixels":
             totals["pixels"] += report["compared"]["pixels"]
         for record in report["cases"]:
-            record.pop("framing")           # the camera is placed by the specification (camera_spec), not framed
+            record.pop("framing")  # the camera is placed by the specification (camera_spec), not framed
             runs.append({"run": f"{record['scene']}/{record['camera']}/{frames}", "frames": frames, **record})
         if progress:
             progress(i + 1, len(FRAME_COUNTS))

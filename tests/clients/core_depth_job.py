@@ -20,7 +20,6 @@ from pathlib import Path
 
 import numpy as np
 from PIL import Image
-
 from wirecheck.core.camera import Camera
 from wirecheck.core.projector.pipeline import render_frame
 
@@ -50,9 +49,9 @@ def window_depth(z: np.ndarray, cam: Camera) -> np.ndarray:
 #: The mistakes ``--mistake`` injects into a depth map ``z`` (linear depth along forward, 0 where none).
 MISTAKES = {
     "none": lambda z, cam: z,
-    "zbuffer": window_depth,                            # the depth buffer's [0, 1] value stored as depth
-    "x1000": lambda z, cam: z * 1000.0,                 # millimetres written where world units were asked
-    "rows_flipped": lambda z, cam: z[::-1],             # GL's bottom row written first
+    "zbuffer": window_depth,  # the depth buffer's [0, 1] value stored as depth
+    "x1000": lambda z, cam: z * 1000.0,  # millimetres written where world units were asked
+    "rows_flipped": lambda z, cam: z[::-1],  # GL's bottom row written first
 }
 
 
@@ -85,8 +84,9 @@ def frames(job_dir: Path):
             yield c, i, Camera(**cam_json["camera"]), v, e, f, np.array(cam_json["model_matrix"])
 
 
-def render_job(job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered, camera=None,
-               object_ids=lambda objects: objects) -> None:
+def render_job(
+    job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered, camera=None, object_ids=lambda objects: objects
+) -> None:
     """Write every file the job lists (module docstring); ``mistake(z, camera)`` makes each depth map from core's
     depth, ``filled(covered)`` each filled frame's surface from core's; ``camera`` (one of
     :data:`CAMERA_MISTAKES`) changes a perspective camera before the faces are drawn. A filled frame of a
@@ -104,11 +104,12 @@ def render_job(job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered
         face_object = np.searchsorted(stops, [face[0] for face in f], side="right")
         seen = np.where(frame.face_ids >= 0, face_object[np.maximum(frame.face_ids, 0)], -1)
         level = np.where(seen >= 0, 1 + object_ids(seen), 0) if len(stops) > 1 else np.full(z.shape, 200)
-        for key, write in (("frames", lambda p: Image.fromarray(render_frame(v, e, cam, m).image).save(p)),
-                           ("filled", lambda p: Image.fromarray(np.where(filled(z > 0), level, 0).astype(np.uint8))
-                            .save(p)),
-                           ("depth", lambda p: _save_depth(p, mistake(z, cam), enc))):
-            for rel in (c.get(key) or [])[i:i + 1]:
+        for key, write in (
+            ("frames", lambda p: Image.fromarray(render_frame(v, e, cam, m).image).save(p)),
+            ("filled", lambda p: Image.fromarray(np.where(filled(z > 0), level, 0).astype(np.uint8)).save(p)),
+            ("depth", lambda p: _save_depth(p, mistake(z, cam), enc)),
+        ):
+            for rel in (c.get(key) or [])[i : i + 1]:
                 (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
                 write(job_dir / rel)
 
@@ -116,7 +117,7 @@ def render_job(job_dir, mistake=MISTAKES["none"], filled=lambda covered: covered
 def _save_depth(path: Path, d: np.ndarray, enc: dict) -> None:
     if enc["format"] == "npy":
         np.save(path, d.astype(np.float32))
-    elif enc["format"] == "png16":                      # rounded to the scale's step, as BOP's writers do
+    elif enc["format"] == "png16":  # rounded to the scale's step, as BOP's writers do
         Image.fromarray(np.rint(d * enc["scale"]).astype(np.uint16)).save(path)
     else:
         Image.fromarray(d.astype(np.float32), mode="F").save(path)

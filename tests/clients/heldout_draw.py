@@ -31,11 +31,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
 from job_files import job_frames
 
-
 # ---- projections (two routes) ----
+
 
 def _clip_param(fa, fb, t0, t1):
     """Liang-Barsky for one half-space ``f >= 0`` along ``f(t) = fa + t (fb - fa)``."""
@@ -58,8 +57,8 @@ def project_gl(v, edges, cam, model=True, half_pixel=False):
     out = []
     for i, j in edges:
         a, b = clip[i], clip[j]
-        t0, t1 = _clip_param(a[3] + a[2], b[3] + b[2], 0.0, 1.0)      # near: z >= -w
-        t0, t1 = _clip_param(a[3] - a[2], b[3] - b[2], t0, t1)        # far: z <= w
+        t0, t1 = _clip_param(a[3] + a[2], b[3] + b[2], 0.0, 1.0)  # near: z >= -w
+        t0, t1 = _clip_param(a[3] - a[2], b[3] - b[2], t0, t1)  # far: z <= w
         if t0 >= t1:
             continue
         ends = np.array([a + (b - a) * t0, a + (b - a) * t1])
@@ -81,8 +80,8 @@ def project_lookat(v, edges, cam, model=True, fov_axis="y", flip_rows=True, aspe
     right /= np.linalg.norm(right)
     up = np.cross(right, fwd)
     rel = p_world - np.array(c["position"])
-    p_cam = np.c_[rel @ right, rel @ up, rel @ fwd]          # x right, y up, z depth along forward
-    span = h if fov_axis == "y" else w                         # the image extent the FOV spans
+    p_cam = np.c_[rel @ right, rel @ up, rel @ fwd]  # x right, y up, z depth along forward
+    span = h if fov_axis == "y" else w  # the image extent the FOV spans
     ortho = c["projection"] != "perspective"
     scale = span / c["ortho_height"] if ortho else (span / 2) / np.tan(np.radians(c["fov_y_deg"]) / 2)
     cx, cy = (w - 1) / 2, (h - 1) / 2
@@ -115,9 +114,11 @@ def clip_rect(segs, w, h, margin=4.0):
 
 # ---- drawers: segments in pixels -> uint8 image ----
 
+
 def draw_pillow(segs, w, h, width=1):
     """Pillow's aliased line; its integer ends are the pixels the float ends round to (Pillow truncates floats)."""
     from PIL import Image, ImageDraw
+
     im = Image.new("L", (w, h), 0)
     d = ImageDraw.Draw(im)
     for a, b in clip_rect(segs, w, h):
@@ -128,10 +129,11 @@ def draw_pillow(segs, w, h, width=1):
 def draw_pillow_supersampled(segs, w, h, ss=4):
     """Pillow at ``ss`` x the size, a line ``ss`` sub-pixels wide, box-filtered down: antialiased 1 px."""
     from PIL import Image, ImageDraw
+
     im = Image.new("L", (w * ss, h * ss), 0)
     d = ImageDraw.Draw(im)
     for a, b in clip_rect(segs, w, h):
-        qa, qb = (a + 0.5) * ss - 0.5, (b + 0.5) * ss - 0.5          # pixel centres in sub-pixels
+        qa, qb = (a + 0.5) * ss - 0.5, (b + 0.5) * ss - 0.5  # pixel centres in sub-pixels
         d.line([tuple(np.floor(qa + 0.5)), tuple(np.floor(qb + 0.5))], fill=255, width=ss)
     big = np.asarray(im).astype(float).reshape(h, ss, w, ss)
     return np.floor(big.mean(axis=(1, 3)) + 0.5).astype(np.uint8)
@@ -144,15 +146,25 @@ def draw_matplotlib(segs, w, h, linewidth_px=1.0, antialiased=True, half_pixel=F
     from matplotlib.lines import Line2D
     from matplotlib.transforms import IdentityTransform
 
-    dpi = 72.0                                   # 1 point = 1 pixel
+    dpi = 72.0  # 1 point = 1 pixel
     fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi, facecolor="black")
     canvas = FigureCanvasAgg(fig)
     segs = clip_rect(segs, w, h)
     s = 0.0 if half_pixel else 0.5
     xs = np.c_[segs[:, :, 0] + s, np.full(len(segs), np.nan)].ravel()
     ys = np.c_[h - segs[:, :, 1] - s, np.full(len(segs), np.nan)].ravel()
-    fig.add_artist(Line2D(xs, ys, transform=IdentityTransform(), color="white", linewidth=linewidth_px,
-                          antialiased=antialiased, solid_capstyle="butt", snap=False))
+    fig.add_artist(
+        Line2D(
+            xs,
+            ys,
+            transform=IdentityTransform(),
+            color="white",
+            linewidth=linewidth_px,
+            antialiased=antialiased,
+            solid_capstyle="butt",
+            snap=False,
+        )
+    )
     canvas.draw()
     rgba = np.asarray(canvas.buffer_rgba())
     assert rgba.shape[:2] == (h, w), rgba.shape
@@ -162,6 +174,7 @@ def draw_matplotlib(segs, w, h, linewidth_px=1.0, antialiased=True, half_pixel=F
 def draw_cv2(segs, w, h, line_type="LINE_8", shift=4):
     """OpenCV's ``cv2.line``, ends in fixed point (``shift`` fractional bits: integers are pixel centres)."""
     import cv2
+
     img = np.zeros((h, w), np.uint8)
     f = 1 << shift
     for a, b in clip_rect(segs, w, h):
@@ -222,6 +235,7 @@ def draw_bresenham(segs, w, h):
 def render(job_dir: Path, draw, project=project_gl, **mistake) -> None:
     """Every listed frame of the job drawn by ``draw(segs, w, h)`` from ``project(..., **mistake)``, as PNG."""
     from PIL import Image
+
     for _case, png, v, e, cam, model in job_frames(job_dir):
         w, h = cam["camera"]["width"], cam["camera"]["height"]
         segs = project(v, e, cam, model=model, **mistake)

@@ -21,10 +21,7 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-
 from job_files import job_frames
-
-
 
 
 def segments(p_world, edges, cam):
@@ -37,7 +34,7 @@ def segments(p_world, edges, cam):
     for i, j in edges:
         a, b = p_cv[i], p_cv[j]
         t0, t1 = 0.0, 1.0
-        for plane, sign in ((near, 1.0), (far, -1.0)):       # keep sign * (z - plane) >= 0
+        for plane, sign in ((near, 1.0), (far, -1.0)):  # keep sign * (z - plane) >= 0
             fa, fb = sign * (a[2] - plane), sign * (b[2] - plane)
             if fa < 0 and fb < 0:
                 t0, t1 = 1.0, 0.0
@@ -70,8 +67,11 @@ def draw(segs, width, height, linewidth_px, mirror_y, path):
     ax.set_axis_off()
     ax.set_xlim(-0.5, width - 0.5)
     ax.set_ylim((-0.5, height - 0.5) if mirror_y else (height - 0.5, -0.5))
-    ax.add_collection(LineCollection(segs, colors="white", linewidths=linewidth_px * 72.0 / dpi,
-                                     antialiaseds=True, capstyle="butt", snap=False))
+    ax.add_collection(
+        LineCollection(
+            segs, colors="white", linewidths=linewidth_px * 72.0 / dpi, antialiaseds=True, capstyle="butt", snap=False
+        )
+    )
     fig.savefig(path, dpi=dpi, facecolor="black")
 
 

@@ -58,12 +58,14 @@ def render_depth(p_world, triangles, camera, mistake=None) -> np.ndarray:
     fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
     ctx.enable(moderngl.DEPTH_TEST)
     pv = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix)
-    prog["pv"].write(pv.T.astype("f4").tobytes())                 # GLSL reads column-major
+    prog["pv"].write(pv.T.astype("f4").tobytes())  # GLSL reads column-major
     tris = np.asarray(p_world, dtype="f4")[np.asarray(triangles).reshape(-1)]
     vbo = ctx.buffer(tris.tobytes())
     vao = ctx.vertex_array(prog, [(vbo, "3f", "in_pos")])
     vao.render(moderngl.TRIANGLES)
-    z_win = np.frombuffer(fbo.read(components=1, attachment=-1, dtype="f4"), dtype="f4").reshape(h, w).astype(np.float64)
+    z_win = (
+        np.frombuffer(fbo.read(components=1, attachment=-1, dtype="f4"), dtype="f4").reshape(h, w).astype(np.float64)
+    )
     vao.release(), vbo.release(), fbo.release()
     drawn = z_win < 1.0
     n, f = float(camera.near), float(camera.far)
@@ -85,12 +87,20 @@ def main(argv=None) -> int:
     folder = Path((sys.argv[1:] if argv is None else argv)[0])
     for request in sorted(folder.glob("*.npz")):
         with np.load(request) as data:
-            camera = SimpleNamespace(projection_matrix=data["projection_matrix"], view_matrix=data["view_matrix"],
-                                     width=int(data["width"]), height=int(data["height"]), near=float(data["near"]),
-                                     far=float(data["far"]), projection=str(data["projection"]))
+            camera = SimpleNamespace(
+                projection_matrix=data["projection_matrix"],
+                view_matrix=data["view_matrix"],
+                width=int(data["width"]),
+                height=int(data["height"]),
+                near=float(data["near"]),
+                far=float(data["far"]),
+                projection=str(data["projection"]),
+            )
             for label, mistake in MISTAKES.items():
-                np.save(folder / f"{request.stem}.{label}.npy",
-                        render_depth(data["p_world"], data["triangles"], camera, mistake))
+                np.save(
+                    folder / f"{request.stem}.{label}.npy",
+                    render_depth(data["p_world"], data["triangles"], camera, mistake),
+                )
     return 0
 
 

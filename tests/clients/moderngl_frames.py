@@ -20,7 +20,6 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-
 from job_files import job_frames
 
 VERTEX = """#version 330
@@ -32,8 +31,6 @@ FRAGMENT = """#version 330
 out vec4 colour;
 void main() { colour = vec4(1.0); }
 """
-
-
 
 
 def main(argv=None) -> int:
@@ -48,7 +45,7 @@ def main(argv=None) -> int:
     job_dir = Path(args.job)
     ctx = moderngl.create_standalone_context(backend="egl")
     prog = ctx.program(vertex_shader=VERTEX, fragment_shader=FRAGMENT)
-    buffers = {}                                                   # (w, h): the framebuffers of that size
+    buffers = {}  # (w, h): the framebuffers of that size
     for c, png, v, e, cam, model in job_frames(job_dir):
         w, h = c["width"], c["height"]
         if (w, h) not in buffers:
@@ -57,7 +54,7 @@ def main(argv=None) -> int:
         fbo, out = buffers[w, h]
         m = np.array(cam["model_matrix"]) if model else np.eye(4)
         mvp = np.array(cam["gl_projection"]) @ np.array(cam["gl_view"]) @ m
-        prog["mvp"].write(mvp.T.astype("f4").tobytes())          # GLSL reads column-major
+        prog["mvp"].write(mvp.T.astype("f4").tobytes())  # GLSL reads column-major
         vbo = ctx.buffer(v[e].reshape(-1, 3).astype("f4").tobytes())
         vao = ctx.vertex_array(prog, [(vbo, "3f", "in_pos")])
         fbo.use()
@@ -66,7 +63,7 @@ def main(argv=None) -> int:
         if args.samples:
             ctx.copy_framebuffer(out, fbo)
         rgb = np.frombuffer(out.read(components=3), np.uint8).reshape(h, w, 3)
-        img = rgb if args.no_flip else rgb[::-1]                   # GL's rows run bottom up
+        img = rgb if args.no_flip else rgb[::-1]  # GL's rows run bottom up
         png.parent.mkdir(parents=True, exist_ok=True)
         Image.fromarray(np.ascontiguousarray(img)).save(png)
         vao.release()

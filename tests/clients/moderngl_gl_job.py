@@ -34,7 +34,6 @@ import os
 from pathlib import Path
 
 import numpy as np
-
 from job_files import job_frames
 
 VERTEX_SHADER = """
@@ -51,16 +50,14 @@ void main() { f_color = vec4(1.0); }
 """
 
 
-
-
 def mvp_matrix(cam: dict, width: int, height: int, aspect_h_over_w: bool, half_pixel: bool) -> np.ndarray:
     """``gl_projection @ gl_view @ model_matrix`` (float64), with the chosen mistake applied to the projection."""
     proj = np.array(cam["gl_projection"], dtype=np.float64)
     if aspect_h_over_w:
-        proj[0] *= (width / height) ** 2        # f / (H / W) where f / (W / H) was right
+        proj[0] *= (width / height) ** 2  # f / (H / W) where f / (W / H) was right
     if half_pixel:
         shift = np.eye(4)
-        shift[0, 3], shift[1, 3] = 1.0 / width, -1.0 / height   # NDC units: 2 / W is one pixel
+        shift[0, 3], shift[1, 3] = 1.0 / width, -1.0 / height  # NDC units: 2 / W is one pixel
         proj = shift @ proj
     return proj @ np.array(cam["gl_view"], dtype=np.float64) @ np.array(cam["model_matrix"], dtype=np.float64)
 
@@ -75,8 +72,9 @@ class Renderer:
         self.prog = self.ctx.program(vertex_shader=VERTEX_SHADER, fragment_shader=FRAGMENT_SHADER)
         self.fbos: dict[tuple[int, int], object] = {}
 
-    def draw(self, p_model: np.ndarray, edges: np.ndarray, mvp: np.ndarray, width: int, height: int,
-             flip: bool) -> np.ndarray:
+    def draw(
+        self, p_model: np.ndarray, edges: np.ndarray, mvp: np.ndarray, width: int, height: int, flip: bool
+    ) -> np.ndarray:
         """The frame as ``(H, W)`` uint8, row 0 at the top when ``flip`` (else GL's bottom row first)."""
         import moderngl
 
@@ -94,7 +92,7 @@ class Renderer:
         vbo = self.ctx.buffer(p_model[edges.reshape(-1)].astype("f4").tobytes())
         vao = self.ctx.vertex_array(self.prog, [(vbo, "3f", "in_position")])
         vao.render(moderngl.LINES)
-        raw = fbo.read(components=1, alignment=1)      # rows from the bottom of the window up
+        raw = fbo.read(components=1, alignment=1)  # rows from the bottom of the window up
         vao.release()
         vbo.release()
         pixels = np.frombuffer(raw, dtype=np.uint8).reshape(height, width)
@@ -115,7 +113,7 @@ def main(argv=None) -> int:
     for c, out, p_model, edges, cam, model in job_frames(job_dir):
         width, height = c["width"], c["height"]
         if not model:
-            cam = dict(cam, model_matrix=np.eye(4).tolist())    # world-space vertices per frame
+            cam = dict(cam, model_matrix=np.eye(4).tolist())  # world-space vertices per frame
         mvp = mvp_matrix(cam, width, height, args.aspect_h_over_w, args.half_pixel)
         pixels = renderer.draw(p_model, edges, mvp, width, height, flip=not args.no_flip)
         out.parent.mkdir(parents=True, exist_ok=True)

@@ -51,8 +51,11 @@ def main():
         n = request["n"]
         rows = np.frombuffer(read_exact(stdin, n * 24), dtype="<f8").reshape(n, 3)
         if request.get("kind") != "unproject" or mistake == "error":
-            stdout.write(b'{"error": "this program only unprojects"}\n' if mistake != "error"
-                         else b'{"error": "refused on purpose"}\n')
+            stdout.write(
+                b'{"error": "this program only unprojects"}\n'
+                if mistake != "error"
+                else b'{"error": "refused on purpose"}\n'
+            )
         else:
             out = unproject(rows, request["camera"], mistake)
             stdout.write(json.dumps({"n": n}).encode() + b"\n" + np.ascontiguousarray(out, dtype="<f8").tobytes())

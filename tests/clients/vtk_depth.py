@@ -32,7 +32,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-_WINDOWS = {}                                                      # (w, h): (window, renderer, grab)
+_WINDOWS = {}  # (w, h): (window, renderer, grab)
 
 
 def _window(w: int, h: int):
@@ -79,10 +79,10 @@ def set_camera(camera, cam, mistake: str | None) -> None:
     camera.SetClippingRange(cam.near, cam.far)
     if cam.projection == "orthographic":
         camera.ParallelProjectionOn()
-        camera.SetParallelScale(cam.ortho_height / 2.0)            # VTK's scale: half the height
+        camera.SetParallelScale(cam.ortho_height / 2.0)  # VTK's scale: half the height
     else:
         camera.ParallelProjectionOff()
-        camera.SetViewAngle(cam.fov_y_deg)                         # vertical unless told otherwise
+        camera.SetViewAngle(cam.fov_y_deg)  # vertical unless told otherwise
         camera.SetUseHorizontalViewAngle(1 if mistake == "horizontal_fov" else 0)
 
 
@@ -108,7 +108,7 @@ def render_depth(p_world, triangles, camera, mistake=None) -> np.ndarray:
     gw, gh, _ = out.GetDimensions()
     z_win = vtk_to_numpy(out.GetPointData().GetScalars()).reshape(gh, gw).astype(np.float64)
     drawn = z_win < 1.0
-    n, f = vcam.GetClippingRange()                                  # what the camera drew with
+    n, f = vcam.GetClippingRange()  # what the camera drew with
     if mistake == "zbuffer":
         depth = np.where(drawn, z_win, 0.0)
     elif vcam.GetParallelProjection():
@@ -116,7 +116,7 @@ def render_depth(p_world, triangles, camera, mistake=None) -> np.ndarray:
     else:
         depth = np.where(drawn, 2.0 * f * n / ((f + n) - (2.0 * z_win - 1.0) * (f - n)), 0.0)
     if mistake != "no_flip":
-        depth = depth[::-1]                                         # VTK's rows run bottom up
+        depth = depth[::-1]  # VTK's rows run bottom up
     return depth.astype(np.float32)
 
 
@@ -128,12 +128,17 @@ def main(argv=None) -> int:
     folder = Path((sys.argv[1:] if argv is None else argv)[0])
     for request in sorted(folder.glob("*.npz")):
         with np.load(request) as data:
-            camera = SimpleNamespace(width=int(data["width"]), height=int(data["height"]),
-                                     projection=str(data["projection"]),
-                                     **{k: (data[k] if data[k].ndim else float(data[k])) for k in FIELDS})
+            camera = SimpleNamespace(
+                width=int(data["width"]),
+                height=int(data["height"]),
+                projection=str(data["projection"]),
+                **{k: (data[k] if data[k].ndim else float(data[k])) for k in FIELDS},
+            )
             for label, mistake in MISTAKES.items():
-                np.save(folder / f"{request.stem}.{label}.npy",
-                        render_depth(data["p_world"], data["triangles"], camera, mistake))
+                np.save(
+                    folder / f"{request.stem}.{label}.npy",
+                    render_depth(data["p_world"], data["triangles"], camera, mistake),
+                )
     return 0
 
 

@@ -30,7 +30,6 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-
 from job_files import job_frames
 
 MISTAKES = ("horizontal_fov", "no_flip")
@@ -63,10 +62,10 @@ def set_camera(camera, cam: dict, mistake: str | None) -> None:
     camera.SetClippingRange(cam["near"], cam["far"])
     if cam["projection"] == "orthographic":
         camera.ParallelProjectionOn()
-        camera.SetParallelScale(cam["ortho_height"] / 2.0)        # VTK's scale: half the height
+        camera.SetParallelScale(cam["ortho_height"] / 2.0)  # VTK's scale: half the height
     else:
         camera.ParallelProjectionOff()
-        camera.SetViewAngle(cam["fov_y_deg"])                     # vertical unless told otherwise
+        camera.SetViewAngle(cam["fov_y_deg"])  # vertical unless told otherwise
         camera.SetUseHorizontalViewAngle(1 if mistake == "horizontal_fov" else 0)
 
 
@@ -79,7 +78,7 @@ def main(argv=None) -> int:
     ap.add_argument("job")
     ap.add_argument("--mistake", choices=MISTAKES)
     args = ap.parse_args(argv)
-    windows = {}                                                   # (w, h): (window, renderer, reader)
+    windows = {}  # (w, h): (window, renderer, reader)
     for c, png, v, e, cam_json, model in job_frames(Path(args.job)):
         cam = cam_json["camera"]
         w, h = cam["width"], cam["height"]
@@ -110,7 +109,7 @@ def main(argv=None) -> int:
         prop.SetSpecular(0.0)
         if model:
             m = vtk.vtkMatrix4x4()
-            m.DeepCopy(np.asarray(cam_json["model_matrix"], dtype=float).ravel().tolist())   # row-major
+            m.DeepCopy(np.asarray(cam_json["model_matrix"], dtype=float).ravel().tolist())  # row-major
             actor.SetUserMatrix(m)
         ren.RemoveAllViewProps()
         ren.AddActor(actor)
@@ -121,7 +120,7 @@ def main(argv=None) -> int:
         out = grab.GetOutput()
         gw, gh, _ = out.GetDimensions()
         rgb = vtk_to_numpy(out.GetPointData().GetScalars()).reshape(gh, gw, -1)[:, :, :3]
-        img = rgb if args.mistake == "no_flip" else rgb[::-1]      # VTK's rows run bottom up
+        img = rgb if args.mistake == "no_flip" else rgb[::-1]  # VTK's rows run bottom up
         png.parent.mkdir(parents=True, exist_ok=True)
         Image.fromarray(np.ascontiguousarray(img, dtype=np.uint8)).save(png)
     return 0

@@ -1,6 +1,6 @@
 """Candidates with known faults, written against the contract only (no core imports)."""
-import numpy as np
 
+import numpy as np
 from user_projector import project
 
 
@@ -84,8 +84,11 @@ def divides_before_clipping(points, camera):
         d = p - camera.position
         x, y, z = float(d @ right), float(d @ camera.up), float(d @ camera.forward)
         u, v = x / z, y / z
-        out.append([np.nan, np.nan] if not camera.near <= z <= camera.far else
-                   [(camera.width - 1) / 2 + f * u, (camera.height - 1) / 2 - f * v])
+        out.append(
+            [np.nan, np.nan]
+            if not camera.near <= z <= camera.far
+            else [(camera.width - 1) / 2 + f * u, (camera.height - 1) / 2 - f * v]
+        )
     return np.array(out, dtype=np.float64).reshape(-1, 2)
 
 

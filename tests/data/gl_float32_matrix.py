@@ -5,6 +5,7 @@ but keeps the float32 rounding of every entry. The clip test is GL's (``-w <= z_
 near plane is the rounded matrix's, ``near (1 + ~1e-8)``, and its far plane likewise. Written against
 the contract only (no wirecheck imports).
 """
+
 import numpy as np
 
 

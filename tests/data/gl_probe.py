@@ -17,15 +17,16 @@ def gl_strings_of_a_fresh_context() -> dict:
 
     r = plain_renderer(8, 8)
     r._platform.make_current()
-    out = {k: GL.glGetString(n).decode() for k, n in
-           (("vendor", GL.GL_VENDOR), ("renderer", GL.GL_RENDERER), ("version", GL.GL_VERSION))}
+    out = {
+        k: GL.glGetString(n).decode()
+        for k, n in (("vendor", GL.GL_VENDOR), ("renderer", GL.GL_RENDERER), ("version", GL.GL_VERSION))
+    }
     return out, r
 
 
 def plain_renderer(width: int, height: int):
     """pyrender's OffscreenRenderer as pyrender sets it up (its 4x buffers), kept from ending the EGL display."""
     import pyrender
-
     from wirecheck.oracles.references.pyrender_oracle import _spare_the_display
 
     r = pyrender.OffscreenRenderer(width, height)
@@ -60,15 +61,26 @@ def colour_only_agrees() -> dict:
             for i in range(12):
                 a = 2 * np.pi * i / 12
                 eye = (3.5 * np.cos(a), 1.2 + 0.3 * (i % 3), 3.5 * np.sin(a))
-                cam = look_at(eye, (0, 0, 0), (0, 1, 0), width=w, height=h, near=0.1, far=20,
-                              projection="orthographic" if i % 4 == 3 else "perspective", ortho_height=3.0)
+                cam = look_at(
+                    eye,
+                    (0, 0, 0),
+                    (0, 1, 0),
+                    width=w,
+                    height=h,
+                    near=0.1,
+                    far=20,
+                    projection="orthographic" if i % 4 == 3 else "perspective",
+                    ortho_height=3.0,
+                )
                 for occluders, cull in ((None, False), (faces, False), (faces, True)):
                     with_depth, _ = oracle.render(cube.vertices, cube.edges, cam, faces=occluders, cull=cull)
-                    colour_only, none = oracle.render(cube.vertices, cube.edges, cam, faces=occluders, cull=cull,
-                                                      depth=False)
+                    colour_only, none = oracle.render(
+                        cube.vertices, cube.edges, cam, faces=occluders, cull=cull, depth=False
+                    )
                     out["compared"] += 1
-                    out["differ"] += (none is not None or colour_only.dtype != bool
-                                      or not np.array_equal(colour_only, with_depth))
+                    out["differ"] += (
+                        none is not None or colour_only.dtype != bool or not np.array_equal(colour_only, with_depth)
+                    )
                     out["drawn"] += int(with_depth.sum())
     return out
 
@@ -90,7 +102,7 @@ def main() -> int:
         mask, _depth = oracle.render(p_world, edges, cam)
         levels = coverage_levels(oracle._renderer, oracle._scene)
         info = oracle.gl_info()
-        other.close()                     # closing one oracle must leave the others working
+        other.close()  # closing one oracle must leave the others working
         again, _ = oracle.render(p_world, edges, cam)
     # control: pyrender's own buffers, as pyrender allocates them, on the same scene
     raw_scene = oracle._scene
@@ -98,10 +110,20 @@ def main() -> int:
     raw_levels = coverage_levels(control, raw_scene)
     control.delete()
     raw.delete()
-    print(json.dumps({"available": True, "fresh": fresh, "info": info, "levels": levels,
-                      "raw_levels": raw_levels, "drawn": int(mask.sum()),
-                      "same_after_close": bool((again == mask).all()),
-                      "colour_only": colour_only_agrees()}))
+    print(
+        json.dumps(
+            {
+                "available": True,
+                "fresh": fresh,
+                "info": info,
+                "levels": levels,
+                "raw_levels": raw_levels,
+                "drawn": int(mask.sum()),
+                "same_after_close": bool((again == mask).all()),
+                "colour_only": colour_only_agrees(),
+            }
+        )
+    )
     return 0
 
 

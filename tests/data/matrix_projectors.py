@@ -6,6 +6,7 @@ the viewport (it has no lens: it is wrong on a distorted camera, and crosscheck
 says ``distortion_mismatch``). Neither computes a focal length or a principal
 point itself. Orthographic cameras: ``K`` is affine there (no division).
 """
+
 import cv2
 import numpy as np
 

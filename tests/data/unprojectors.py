@@ -21,11 +21,13 @@ def _normalised(pixels, camera, cx=None, cy=None, fx=None, fy=None):
     if camera.distortion is not None:
         criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
         if hasattr(cv2, "undistortPointsIter"):
-            xy = cv2.undistortPointsIter(pixels.reshape(-1, 1, 2), k, np.array(camera.distortion), None, None,
-                                         criteria).reshape(-1, 2)
-        else:                       # OpenCV 5: undistortPoints takes the criterion itself
-            xy = cv2.undistortPoints(pixels.reshape(-1, 1, 2), k, np.array(camera.distortion), R=None, P=None,
-                                     criteria=criteria).reshape(-1, 2)
+            xy = cv2.undistortPointsIter(
+                pixels.reshape(-1, 1, 2), k, np.array(camera.distortion), None, None, criteria
+            ).reshape(-1, 2)
+        else:  # OpenCV 5: undistortPoints takes the criterion itself
+            xy = cv2.undistortPoints(
+                pixels.reshape(-1, 1, 2), k, np.array(camera.distortion), R=None, P=None, criteria=criteria
+            ).reshape(-1, 2)
         return xy[:, 0], xy[:, 1]
     return (pixels[:, 0] - cx) / fx, (pixels[:, 1] - cy) / fy
 
@@ -92,7 +94,7 @@ def horizontal_fov(pixels, depth, camera):
 def ray_distance(pixels, depth, camera):
     """Depth taken as distance along the ray: the ray normalised before scaling by it."""
     x_n, y_n = _normalised(pixels, camera)
-    norm = np.sqrt(1 + x_n ** 2 + y_n ** 2)
+    norm = np.sqrt(1 + x_n**2 + y_n**2)
     return _to_world(x_n, y_n, depth / norm, camera)
 
 

@@ -4,6 +4,7 @@
 putting the principal point at (W/2, H/2) (pixel-corner convention), which
 crosscheck reports as pixel_offset dx=0.5, dy=0.5.
 """
+
 import numpy as np
 
 

@@ -29,10 +29,50 @@ import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
-NUMBERS = ["0", "-0", "1", "-1", "2.5", "4", "-4", "60", "179.9", "180", "1e-300", "1e308", "-1e308", "1e-30",
-           "nan", "inf", "-inf", "abc", "", " ", "1,2", "0x10", "1_000", "9007199254740993"]
-VECTORS = ["1,1,0", "0,0,0", "1,2,3", "0,0,4", "1e308,0,0", "nan,0,0", "1,2", "1,2,3,4", "a,b,c", "", ",,",
-           "-1e308,1e308,0", "1e-300,0,0", "0,1,0", "3,3,3", "inf,0,0"]
+NUMBERS = [
+    "0",
+    "-0",
+    "1",
+    "-1",
+    "2.5",
+    "4",
+    "-4",
+    "60",
+    "179.9",
+    "180",
+    "1e-300",
+    "1e308",
+    "-1e308",
+    "1e-30",
+    "nan",
+    "inf",
+    "-inf",
+    "abc",
+    "",
+    " ",
+    "1,2",
+    "0x10",
+    "1_000",
+    "9007199254740993",
+]
+VECTORS = [
+    "1,1,0",
+    "0,0,0",
+    "1,2,3",
+    "0,0,4",
+    "1e308,0,0",
+    "nan,0,0",
+    "1,2",
+    "1,2,3,4",
+    "a,b,c",
+    "",
+    ",,",
+    "-1e308,1e308,0",
+    "1e-300,0,0",
+    "0,1,0",
+    "3,3,3",
+    "inf,0,0",
+]
 INTS = ["0", "1", "2", "3", "-1", "7", "abc", "1.5", "100001", "100000000000000000000", ""]
 SIZES = ["1", "2", "16", "33", "64", "0", "-5", "abc", "16385", "100000", "1e3"]
 FORMATS = ["png", "ascii", "gif", "mp4", "png,gif", "png,ascii,gif", "bogus", "", "png,,", "gif,mp4"]
@@ -45,14 +85,44 @@ SCENE_TEXTS = [
     "object a\nmesh m.obj\nobject b\nmesh m.stl\ntranslate 0 2 0\n",
 ]
 OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nl 1 4\n"
-PLY = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
-STL = ("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
-       "endsolid s\n")
+PLY = (
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+)
+STL = (
+    "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n"
+)
 OFF = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
-TOKENS = ["v", "e", "f", "name", "object", "mesh", "spin", "scale", "translate", "0", "1", "2", "-1", "7",
-          "1e308", "nan", "inf", "x" * 250, "m.obj", "../m.ply", "/etc/passwd", "a/b", ".hidden", "#", "\t",
-          "1" + "0" * 400, "é", "\x00"]
+TOKENS = [
+    "v",
+    "e",
+    "f",
+    "name",
+    "object",
+    "mesh",
+    "spin",
+    "scale",
+    "translate",
+    "0",
+    "1",
+    "2",
+    "-1",
+    "7",
+    "1e308",
+    "nan",
+    "inf",
+    "x" * 250,
+    "m.obj",
+    "../m.ply",
+    "/etc/passwd",
+    "a/b",
+    ".hidden",
+    "#",
+    "\t",
+    "1" + "0" * 400,
+    "é",
+    "\x00",
+]
 
 
 class Pick:
@@ -91,6 +161,7 @@ class HypothesisPick(Pick):
 
 # ---- input files --------------------------------------------------------------------------------
 
+
 def mutate_text(pick: Pick, text: str) -> str:
     lines = text.splitlines()
     for _ in range(pick.integer(0, 3)):
@@ -117,18 +188,31 @@ def glb_bytes(indices=(0, 1, 2)) -> bytes:
 
     pos = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes()
     buf = pos + np.array(indices, np.uint16).tobytes() + b"\0\0"
-    gltf = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-            "buffers": [{"byteLength": len(buf)}],
-            "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
-                            {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
-            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                           "min": [0, 0, 0], "max": [1, 1, 0]},
-                          {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]}
+    gltf = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [{"byteLength": len(buf)}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 6},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
+        ],
+    }
     j = json.dumps(gltf).encode()
     j += b" " * (-len(j) % 4)
-    return (struct.pack("<III", 0x46546C67, 2, 28 + len(j) + len(buf)) + struct.pack("<II", len(j), 0x4E4F534A)
-            + j + struct.pack("<II", len(buf), 0x004E4942) + buf)
+    return (
+        struct.pack("<III", 0x46546C67, 2, 28 + len(j) + len(buf))
+        + struct.pack("<II", len(j), 0x4E4F534A)
+        + j
+        + struct.pack("<II", len(buf), 0x004E4942)
+        + buf
+    )
 
 
 def mutate_bytes(pick: Pick, data: bytes) -> bytes:
@@ -149,8 +233,10 @@ def mutate_bytes(pick: Pick, data: bytes) -> bytes:
 
 def make_scene_arg(pick: Pick, box: Path) -> str:
     """A --scene value: a built-in or bogus name, or a (mutated) file written into ``box/in``."""
-    kind = pick.choice(["builtin"] * 3 + ["bogus", "scene", "scene", "scene", "obj", "ply", "stl", "off", "glb", "long",
-                                          "companion", "dataset"])
+    kind = pick.choice(
+        ["builtin"] * 3
+        + ["bogus", "scene", "scene", "scene", "obj", "ply", "stl", "off", "glb", "long", "companion", "dataset"]
+    )
     if kind == "builtin":
         return pick.choice(["cube", "pyramid", "prism", "orrery"])
     if kind == "bogus":
@@ -171,7 +257,9 @@ def make_scene_arg(pick: Pick, box: Path) -> str:
     if kind == "scene":
         text = mutate_text(pick, pick.choice(SCENE_TEXTS))
         path = folder / pick.choice(["s.scene", "s.txt", f"{'n' * 120}.scene", "s p.scene"])
-        path.write_bytes(text.encode("utf-8", "surrogatepass") if pick.chance(0.9) else text.encode("latin-1", "replace"))
+        path.write_bytes(
+            text.encode("utf-8", "surrogatepass") if pick.chance(0.9) else text.encode("latin-1", "replace")
+        )
         return str(path)
     if kind == "glb":
         data = glb_bytes(pick.choice([(0, 1, 2), (0, 1, 7), (0, 0, 0), (65535, 1, 2)]))
@@ -201,12 +289,25 @@ def fifo_inputs(pick: Pick, box: Path, kind: str) -> str:
             os.mkfifo(folder / "b.png")
             made.append(folder / "b.obj")
         elif which == "gltf":
-            doc = {"asset": {"version": "2.0"}, "buffers": [{"uri": "c.bin", "byteLength": 36}],
-                   "bufferViews": [{"buffer": 0, "byteLength": 36}],
-                   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                                  "max": [1, 1, 0], "min": [0, 0, 0]}],
-                   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "nodes": [{"mesh": 0}],
-                   "scenes": [{"nodes": [0]}], "scene": 0}
+            doc = {
+                "asset": {"version": "2.0"},
+                "buffers": [{"uri": "c.bin", "byteLength": 36}],
+                "bufferViews": [{"buffer": 0, "byteLength": 36}],
+                "accessors": [
+                    {
+                        "bufferView": 0,
+                        "componentType": 5126,
+                        "count": 3,
+                        "type": "VEC3",
+                        "max": [1, 1, 0],
+                        "min": [0, 0, 0],
+                    }
+                ],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+                "nodes": [{"mesh": 0}],
+                "scenes": [{"nodes": [0]}],
+                "scene": 0,
+            }
             (folder / "c.gltf").write_text(json.dumps(doc))
             os.mkfifo(folder / "c.bin")
             made.append(folder / "c.gltf")
@@ -240,8 +341,23 @@ DECOY = b"the user's own bytes\n"
 def setup_out(pick: Pick, box: Path, earlier: Path | None) -> str:
     """Create the output folder's starting state in ``box``; return the --out value."""
     out = box / "out"
-    kind = pick.choice(["absent"] * 3 + ["empty", "decoys", "decoys", "earlier", "earlier", "earlier", "nested",
-                                          "file", "under_file", "long", "foreign_output", "user_in_output"])
+    kind = pick.choice(
+        ["absent"] * 3
+        + [
+            "empty",
+            "decoys",
+            "decoys",
+            "earlier",
+            "earlier",
+            "earlier",
+            "nested",
+            "file",
+            "under_file",
+            "long",
+            "foreign_output",
+            "user_in_output",
+        ]
+    )
     if kind == "absent":
         return str(out)
     if kind == "nested":
@@ -257,7 +373,7 @@ def setup_out(pick: Pick, box: Path, earlier: Path | None) -> str:
     out.mkdir()
     if kind in ("earlier", "user_in_output") and earlier is not None:
         shutil.copytree(earlier, out, dirs_exist_ok=True, symlinks=True)
-    if kind == "user_in_output" and earlier is not None:    # issue 25: the user's file inside a folder of ours
+    if kind == "user_in_output" and earlier is not None:  # issue 25: the user's file inside a folder of ours
         where = pick.choice(["cube-frames/note.txt", "cube-frames/mine/note.txt", "cube-frames/frame_0099.png"])
         (out / where).parent.mkdir(exist_ok=True)
         (out / where).write_bytes(DECOY)
@@ -271,8 +387,18 @@ def setup_out(pick: Pick, box: Path, earlier: Path | None) -> str:
         if not link.exists():
             os.symlink(box / "target.txt", link)
     if kind == "foreign_output":
-        name = pick.choice(["cube-report.txt", "cube-report.json", "cube.gif", "cube-frames", ".wirecheck-manifest.json",
-                            ".wirecheck-lock", "pyramid-report.json", "tri-report.txt"])
+        name = pick.choice(
+            [
+                "cube-report.txt",
+                "cube-report.json",
+                "cube.gif",
+                "cube-frames",
+                ".wirecheck-manifest.json",
+                ".wirecheck-lock",
+                "pyramid-report.json",
+                "tri-report.txt",
+            ]
+        )
         if name == "cube-frames" or pick.chance(0.3):
             (out / name).mkdir(exist_ok=True)
             (out / name / "keep.txt").write_bytes(DECOY)
@@ -286,32 +412,62 @@ def setup_out(pick: Pick, box: Path, earlier: Path | None) -> str:
 #: option -> (ordinary values, hostile values); None for a flag. A drawn option takes an ordinary value
 #: 70 % of the time, so that most runs get past the parser and write outputs.
 RENDERER_OPTIONS = {
-    "--frames": (["1", "2", "3"], INTS), "--camera-z": (["4", "-4", "2.5", "0.5"], NUMBERS),
-    "--camera-pos": (["0,0,4", "3,3,3", "0,1,0"], VECTORS), "--look-at": (["0,0,0", "1,2,3"], VECTORS),
-    "--up": (["0,1,0", "1,0,0"], VECTORS), "--fov": (["60", "1", "179.9", "1e-30"], NUMBERS),
-    "--near": (["0.1", "1", "3.5"], NUMBERS), "--far": (["100", "4", "1e308"], NUMBERS),
-    "--width": (["16", "33", "64"], SIZES), "--height": (["16", "24", "48"], SIZES),
+    "--frames": (["1", "2", "3"], INTS),
+    "--camera-z": (["4", "-4", "2.5", "0.5"], NUMBERS),
+    "--camera-pos": (["0,0,4", "3,3,3", "0,1,0"], VECTORS),
+    "--look-at": (["0,0,0", "1,2,3"], VECTORS),
+    "--up": (["0,1,0", "1,0,0"], VECTORS),
+    "--fov": (["60", "1", "179.9", "1e-30"], NUMBERS),
+    "--near": (["0.1", "1", "3.5"], NUMBERS),
+    "--far": (["100", "4", "1e308"], NUMBERS),
+    "--width": (["16", "33", "64"], SIZES),
+    "--height": (["16", "24", "48"], SIZES),
     "--projection": (["perspective", "orthographic", "both"], ["fisheye", ""]),
-    "--ortho-height": (["4", "0.5", "1e-30"], NUMBERS), "--spin": (["1,1,0", "0,0,0", "1e15,0,0"], VECTORS),
-    "--translate": (["0,0,0", "0,0,3.5", "1e300,0,0"], VECTORS), "--scale": (["1", "-1", "2", "1e-300"], NUMBERS),
-    "--clip": (["clip", "endpoint"], ["x"]), "--dtype": (["float64", "float32"], ["float16"]),
-    "--raster": (["exact", "fast", "aa"], ["x"]), "--cull": (["none", "backface"], ["x"]),
-    "--style": (["wireframe", "shaded"], ["x"]), "--light": (["1,-1,-1", "0,0,1e-300"], VECTORS),
+    "--ortho-height": (["4", "0.5", "1e-30"], NUMBERS),
+    "--spin": (["1,1,0", "0,0,0", "1e15,0,0"], VECTORS),
+    "--translate": (["0,0,0", "0,0,3.5", "1e300,0,0"], VECTORS),
+    "--scale": (["1", "-1", "2", "1e-300"], NUMBERS),
+    "--clip": (["clip", "endpoint"], ["x"]),
+    "--dtype": (["float64", "float32"], ["float16"]),
+    "--raster": (["exact", "fast", "aa"], ["x"]),
+    "--cull": (["none", "backface"], ["x"]),
+    "--style": (["wireframe", "shaded"], ["x"]),
+    "--light": (["1,-1,-1", "0,0,1e-300"], VECTORS),
     "--format": (["png", "ascii", "gif", "mp4", "png,gif", "png,ascii,gif"], ["bogus", "", "png,,", "gif,x"]),
-    "--ascii-cols": (["80", "1", "7"], INTS), "--axes": None, "--hidden-lines": None, "--verbose": None,
-    "--object-culling": None, "--no-object-culling": None, "--plots": None, "--bogus": None, "--help": None,
-    "--profile": None, "--compare": None, "--trace-vertex": (["0", "3"], INTS),
+    "--ascii-cols": (["80", "1", "7"], INTS),
+    "--axes": None,
+    "--hidden-lines": None,
+    "--verbose": None,
+    "--object-culling": None,
+    "--no-object-culling": None,
+    "--plots": None,
+    "--bogus": None,
+    "--help": None,
+    "--profile": None,
+    "--compare": None,
+    "--trace-vertex": (["0", "3"], INTS),
 }
 CROSSCHECK_OPTIONS = {
-    "--frames": (["1", "2"], INTS), "--cases": (["on_axis", "near_plane", "on_axis,wide_fov"], ["x", "", ",,", "oblique"]),
-    "--level": (["vertices"], ["x", ""]), "--oracles": (["opencv"], ["pyrender", "x", ""]),
-    "--every": (["1", "2"], INTS), "--jobs": (["1"], ["0", "-1", "x"]), "--dtype": (["float64", "float32"], ["x"]),
-    "--clip": (["clip", "endpoint"], ["x"]), "--raster": (["exact", "fast", "aa"], ["x"]),
-    "--style": ([], ["wireframe", "shaded", "x"]), "--hidden-lines": None, "--cull": ([], ["none", "backface", "x"]),
-    "--spin": (["1,1,0", "0,0,0", "1e15,0,0"], VECTORS), "--tol-px": (["0.5", "0", "1e308"], NUMBERS),
-    "--min-f1": (["0.9", "0", "1"], NUMBERS), "--min-f1-0px": (["0.5", "1"], NUMBERS),
-    "--min-iou": (["0.9"], NUMBERS), "--suite": ([], ["x"]),
-    "--run": (["r1", "r.2"], ["../escape", ".hidden", "a/b", "x" * 300, ""]), "--bogus": None,
+    "--frames": (["1", "2"], INTS),
+    "--cases": (["on_axis", "near_plane", "on_axis,wide_fov"], ["x", "", ",,", "oblique"]),
+    "--level": (["vertices"], ["x", ""]),
+    "--oracles": (["opencv"], ["pyrender", "x", ""]),
+    "--every": (["1", "2"], INTS),
+    "--jobs": (["1"], ["0", "-1", "x"]),
+    "--dtype": (["float64", "float32"], ["x"]),
+    "--clip": (["clip", "endpoint"], ["x"]),
+    "--raster": (["exact", "fast", "aa"], ["x"]),
+    "--style": ([], ["wireframe", "shaded", "x"]),
+    "--hidden-lines": None,
+    "--cull": ([], ["none", "backface", "x"]),
+    "--spin": (["1,1,0", "0,0,0", "1e15,0,0"], VECTORS),
+    "--tol-px": (["0.5", "0", "1e308"], NUMBERS),
+    "--min-f1": (["0.9", "0", "1"], NUMBERS),
+    "--min-f1-0px": (["0.5", "1"], NUMBERS),
+    "--min-iou": (["0.9"], NUMBERS),
+    "--suite": ([], ["x"]),
+    "--run": (["r1", "r.2"], ["../escape", ".hidden", "a/b", "x" * 300, ""]),
+    "--bogus": None,
 }
 
 
@@ -330,8 +486,14 @@ def _options(pick: Pick, table: dict, rare: set[str]) -> list[str]:
 
 
 def renderer_argv(pick: Pick, box: Path, earlier: Path | None) -> list[str]:
-    argv = ["--frames", pick.choice(["1", "2", "3"]), "--width", pick.choice(["16", "33", "64"]),
-            "--height", pick.choice(["16", "24", "48"])]
+    argv = [
+        "--frames",
+        pick.choice(["1", "2", "3"]),
+        "--width",
+        pick.choice(["16", "33", "64"]),
+        "--height",
+        pick.choice(["16", "24", "48"]),
+    ]
     argv += _options(pick, RENDERER_OPTIONS, rare={"--plots", "--help", "--bogus", "--compare"})
     if pick.chance(0.8):
         argv += ["--scene", make_scene_arg(pick, box)]
@@ -341,17 +503,34 @@ def renderer_argv(pick: Pick, box: Path, earlier: Path | None) -> list[str]:
 
 
 def crosscheck_argv(pick: Pick, box: Path, earlier: Path | None) -> list[str]:
-    argv = ["--frames", pick.choice(["1", "2"]), "--cases", pick.choice(["on_axis", "oblique_roll", "orthographic"]),
-            "--level", "vertices" if pick.chance(0.99) else "pixels"]     # pixels: pyrender, ~1 s a case
+    argv = [
+        "--frames",
+        pick.choice(["1", "2"]),
+        "--cases",
+        pick.choice(["on_axis", "oblique_roll", "orthographic"]),
+        "--level",
+        "vertices" if pick.chance(0.99) else "pixels",
+    ]  # pixels: pyrender, ~1 s a case
     argv += _options(pick, CROSSCHECK_OPTIONS, rare={"--suite", "--bogus", "--hidden-lines"})
     if pick.chance(0.9):
         argv += ["--scene", make_scene_arg(pick, box)]
     if pick.chance(0.15):
-        argv += ["--candidate", pick.choice([
-            f"{Path(__file__).resolve().parent.parent}/data/user_projector.py:project",
-            f"{Path(__file__).resolve().parent.parent}/data/user_projector.py:project_corner",
-            f"{Path(__file__).resolve().parent.parent}/data/user_projector.py:nosuch",
-            "nosuch.py:f", "numpy:zeros", "os:getcwd", ":", "x" * 300 + ".py:f", str(_import_error_candidate(box))])]
+        argv += [
+            "--candidate",
+            pick.choice(
+                [
+                    f"{Path(__file__).resolve().parent.parent}/data/user_projector.py:project",
+                    f"{Path(__file__).resolve().parent.parent}/data/user_projector.py:project_corner",
+                    f"{Path(__file__).resolve().parent.parent}/data/user_projector.py:nosuch",
+                    "nosuch.py:f",
+                    "numpy:zeros",
+                    "os:getcwd",
+                    ":",
+                    "x" * 300 + ".py:f",
+                    str(_import_error_candidate(box)),
+                ]
+            ),
+        ]
     if pick.chance(0.8):
         where = setup_out(pick, box, earlier)
         argv += ["--report-dir", where if pick.chance(0.95) else str(box / "in" / "evil.scene")]
@@ -365,6 +544,7 @@ def _import_error_candidate(box: Path) -> str:
 
 
 # ---- the contract ------------------------------------------------------------------------------------
+
 
 @dataclass
 class Outcome:
@@ -385,17 +565,21 @@ def snapshot(box: Path) -> dict:
                 snap[rel] = ("link", os.readlink(p))
             elif p.is_dir():
                 snap[rel] = ("dir", None)
-            elif not p.is_file():           # a FIFO: never opened (no writer: open blocks forever)
+            elif not p.is_file():  # a FIFO: never opened (no writer: open blocks forever)
                 snap[rel] = ("fifo", None)
             else:
                 snap[rel] = ("file", hashlib.sha256(p.read_bytes()).hexdigest())
     return snap
 
 
-OUTPUT_NAME = re.compile(r"(.+-frames(/(frame_\d{4,}\.(png|txt)|\.wirecheck-output))?|.+-report\.(json|txt)|"
-                         r".+\.(gif|mp4)|.+-plots\.png|.+-compare\.(png|json|txt)|.+-vertices_px(-orthographic)?\.npy|\.wirecheck-manifest\.json)")
-REPORT_NAME = re.compile(r"(report\.(json|md|html)|worst\.gif|vertex_error\.png|worst_points\.png|pixels\.png|img(/.*)?|"
-                         r"\.wirecheck-output|sweep\..*|extremes\..*)")
+OUTPUT_NAME = re.compile(
+    r"(.+-frames(/(frame_\d{4,}\.(png|txt)|\.wirecheck-output))?|.+-report\.(json|txt)|"
+    r".+\.(gif|mp4)|.+-plots\.png|.+-compare\.(png|json|txt)|.+-vertices_px(-orthographic)?\.npy|\.wirecheck-manifest\.json)"
+)
+REPORT_NAME = re.compile(
+    r"(report\.(json|md|html)|worst\.gif|vertex_error\.png|worst_points\.png|pixels\.png|img(/.*)?|"
+    r"\.wirecheck-output|sweep\..*|extremes\..*)"
+)
 
 
 def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
@@ -409,7 +593,7 @@ def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 rc = main(argv)
-            except SystemExit as exc:           # argparse: --help (0) and usage errors (2)
+            except SystemExit as exc:  # argparse: --help (0) and usage errors (2)
                 rc = exc.code if isinstance(exc.code, int) else 2
     finally:
         os.chdir(cwd)
@@ -427,10 +611,15 @@ def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
     new = [p for p in after if p not in before]
     output_root = _output_root(argv, box, cli, o.stdout)
     for p in changed + gone:
-        decoy = before[p] == ("file", hashlib.sha256(DECOY).hexdigest())   # the user's, whatever its name
-        if (rc in (0, 1) and output_root is not None and _inside(box / p, output_root) and not decoy
-                and _is_output(p, box, output_root, cli, before)):
-            continue                          # an earlier output of wirecheck's, replaced
+        decoy = before[p] == ("file", hashlib.sha256(DECOY).hexdigest())  # the user's, whatever its name
+        if (
+            rc in (0, 1)
+            and output_root is not None
+            and _inside(box / p, output_root)
+            and not decoy
+            and _is_output(p, box, output_root, cli, before)
+        ):
+            continue  # an earlier output of wirecheck's, replaced
         o.problems.append(f"user file touched: {p}")
     if rc not in (0, 1) and new:
         o.problems.append(f"left behind after exit {rc}: {sorted(new)[:3]}")
@@ -440,7 +629,7 @@ def run_cli(main, argv: list[str], box: Path, cli: str) -> Outcome:
                 o.problems.append(f"written outside the output: {p}")
             elif _inside(box / p, output_root) and not _is_output(p, box, output_root, cli, before):
                 o.problems.append(f"stray file in the output: {p}")
-        if cli == "renderer" and rc == 0 and output_root is not None and new:   # (--help: rc 0, nothing new)
+        if cli == "renderer" and rc == 0 and output_root is not None and new:  # (--help: rc 0, nothing new)
             o.problems += _partial(output_root, [box / p for p in new], [box / p for p in new + changed])
     return o
 
@@ -457,7 +646,7 @@ def _output_root(argv, box: Path, cli: str, stdout: str) -> Path | None:
     flag = "--out" if cli == "renderer" else "--report-dir"
     if flag in argv and argv.index(flag) + 1 < len(argv):
         root = box / argv[len(argv) - 1 - argv[::-1].index(flag) + 1]
-        if cli == "crosscheck" and "--run" in argv:        # --run with --report-dir: DIR/RUN
+        if cli == "crosscheck" and "--run" in argv:  # --run with --report-dir: DIR/RUN
             return root / argv[len(argv) - 1 - argv[::-1].index("--run") + 1]
         return root
     if cli == "renderer":

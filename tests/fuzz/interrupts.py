@@ -20,16 +20,21 @@ ROOT = Path(__file__).resolve().parent.parent.parent
 
 OBJ = "mtllib m.mtl\nusemtl x\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n"
 #: a 1x1 grey PNG, the material's texture
-TEXTURE = bytes.fromhex("89504e470d0a1a0a0000000d4948445200000001000000010800000000"
-                        "3a7e9b550000000a49444154789c63600000000200015e8a1a6c0000000049454e44ae426082")
+TEXTURE = bytes.fromhex(
+    "89504e470d0a1a0a0000000d4948445200000001000000010800000000"
+    "3a7e9b550000000a49444154789c63600000000200015e8a1a6c0000000049454e44ae426082"
+)
 
 
 def _before_first_line(err: str) -> bool:
     """True when a KeyboardInterrupt traceback has no frame of core/app/cli.py past its interrupts_from_start line."""
     import re
 
-    start = next(n for n, line in enumerate((ROOT / "core" / "cli.py").read_text().splitlines(), 1)
-                 if line.startswith("interrupts_from_start("))
+    start = next(
+        n
+        for n, line in enumerate((ROOT / "core" / "cli.py").read_text().splitlines(), 1)
+        if line.startswith("interrupts_from_start(")
+    )
     lines = [int(m) for m in re.findall(r'core/cli\.py", line (\d+)', err)]
     return "KeyboardInterrupt" in err and all(n <= start for n in lines)
 
@@ -42,10 +47,25 @@ def interrupt_one(pick, box: Path, timeout_s: float = 60) -> tuple[int, list[str
     sig = pick.choice([signal.SIGINT, signal.SIGTERM])
     delay = pick.integer(0, 3000) / 1000
     out = box / "out"
-    renderer = Path(sys.executable).parent / "renderer"        # the console script, as a user starts it
-    proc = subprocess.Popen([str(renderer), "--scene", str(box / "a.obj"), "--frames",
-                             str(pick.integer(1, 30)), "--width", "64", "--height", "48", "--out", str(out)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    renderer = Path(sys.executable).parent / "renderer"  # the console script, as a user starts it
+    proc = subprocess.Popen(
+        [
+            str(renderer),
+            "--scene",
+            str(box / "a.obj"),
+            "--frames",
+            str(pick.integer(1, 30)),
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     time.sleep(delay)
     if proc.poll() is None:
         proc.send_signal(sig)
@@ -57,7 +77,7 @@ def interrupt_one(pick, box: Path, timeout_s: float = 60) -> tuple[int, list[str
         return -1, [f"timeout: over {timeout_s:g} s after {signal.Signals(sig).name}"]
     rc, problems = proc.returncode, []
     if "Traceback" in err:
-        if _before_first_line(err) and not out.exists():     # no code of wirecheck's ran yet: counted apart
+        if _before_first_line(err) and not out.exists():  # no code of wirecheck's ran yet: counted apart
             return rc, ["note: interrupted in Python's own start-up (site, encodings), before wirecheck's first line"]
         problems.append("traceback on stderr (in the run)")
     if rc == 128 + sig and "while starting: nothing written" in err:

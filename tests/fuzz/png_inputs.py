@@ -34,10 +34,10 @@ def scanlines(rows, depth: int) -> bytes:
             data = b"".join(struct.pack(">H", v) for v in row)
         elif depth == 8:
             data = bytes(row)
-        else:                                   # pack most significant bits first, pad the last byte
+        else:  # pack most significant bits first, pad the last byte
             bits = "".join(format(v, f"0{depth}b") for v in row)
             bits += "0" * (-len(bits) % 8)
-            data = bytes(int(bits[i:i + 8], 2) for i in range(0, len(bits), 8))
+            data = bytes(int(bits[i : i + 8], 2) for i in range(0, len(bits), 8))
         out += b"\0" + data
     return out
 
@@ -46,11 +46,13 @@ def hostile_png(pick, width: int, height: int) -> bytes:
     """A PNG of ``width`` x ``height`` (as the camera asks), valid or damaged as ``pick`` draws."""
     colour = pick.choice(sorted(DEPTHS))
     depth = pick.choice(DEPTHS[colour])
-    top = 2 ** depth - 1
+    top = 2**depth - 1
     n_palette = pick.integer(1, min(256, top + 1)) if colour == 3 else 0
     high = n_palette - 1 if colour == 3 else top
-    rows = [[pick.choice([0, high, high // 2, pick.integer(0, high)]) for _ in range(width * CHANNELS[colour])]
-            for _ in range(height)]
+    rows = [
+        [pick.choice([0, high, high // 2, pick.integer(0, high)]) for _ in range(width * CHANNELS[colour])]
+        for _ in range(height)
+    ]
     w, h = (width, height) if pick.chance(0.9) else (pick.integer(1, 3 * width), pick.integer(1, 3 * height))
     head = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, colour, 0, 0, 0))
     body = b""
@@ -64,11 +66,18 @@ def hostile_png(pick, width: int, height: int) -> bytes:
         elif colour == 3:
             body += chunk(b"tRNS", bytes(pick.integer(0, 255) for _ in range(pick.integer(0, n_palette))))
         else:
-            body += chunk(b"tRNS", b"\0\0")                    # not allowed with alpha
+            body += chunk(b"tRNS", b"\0\0")  # not allowed with alpha
     if pick.chance(0.15):
-        body += pick.choice([chunk(b"acTL", struct.pack(">II", pick.integer(0, 3), 0)),
-                             chunk(b"zzZz", b"\x1b[2J"), chunk(b"XYZW", b"\n"), chunk(b"IHDR", b"\0" * 13),
-                             struct.pack(">I", 0xFFFFFFF0) + b"tEXt", chunk(b"tEXt", b"a\0\x1b\n")])
+        body += pick.choice(
+            [
+                chunk(b"acTL", struct.pack(">II", pick.integer(0, 3), 0)),
+                chunk(b"zzZz", b"\x1b[2J"),
+                chunk(b"XYZW", b"\n"),
+                chunk(b"IHDR", b"\0" * 13),
+                struct.pack(">I", 0xFFFFFFF0) + b"tEXt",
+                chunk(b"tEXt", b"a\0\x1b\n"),
+            ]
+        )
     data = head + body + chunk(b"IDAT", zlib.compress(scanlines(rows, depth))) + chunk(b"IEND", b"")
     if pick.chance(0.3):
         data = bytearray(data)
@@ -93,9 +102,11 @@ def check_png(read_png, FrameProblem, path, width: int, height: int) -> list[str
     except FrameProblem as exc:
         text = str(exc)
         return [f"control character in {text!r}"] if _CONTROL.search(text) or not text else []
-    except Exception as exc:            # noqa: BLE001 - the finding
+    except Exception as exc:  # noqa: BLE001 - the finding
         return [f"traceback: {type(exc).__name__}: {exc}"[:300]]
     if getattr(image, "shape", None) != (height, width) or image.dtype != bool:
-        return [f"read as {getattr(image, 'shape', None)} {getattr(image, 'dtype', None)}: expected ({height}, "
-                f"{width}) bool"]
+        return [
+            f"read as {getattr(image, 'shape', None)} {getattr(image, 'dtype', None)}: expected ({height}, "
+            f"{width}) bool"
+        ]
     return []

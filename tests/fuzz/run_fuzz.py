@@ -85,27 +85,44 @@ def fuzz(cli: str, n: int, seed: int, earlier: Path, log, start: int = 0) -> dic
         for p in set(category(p) for p in outcome.problems):
             problems[p] += 1
         if outcome.problems and len(examples) < 20:
-            examples.append({"input": i, "argv": argv, "rc": outcome.rc, "problems": outcome.problems,
-                             "stderr": outcome.stderr[-500:]})
+            examples.append(
+                {
+                    "input": i,
+                    "argv": argv,
+                    "rc": outcome.rc,
+                    "problems": outcome.problems,
+                    "stderr": outcome.stderr[-500:],
+                }
+            )
         if (i + 1 - start) % 500 == 0:
-            print(f"{cli}: {i + 1 - start}/{n} ({time.perf_counter() - t0:.0f} s) exits {dict(sorted(codes.items()))} "
-                  f"problems {dict(problems)}", file=log, flush=True)
-    return {"cli": cli, "inputs": n, "seconds": round(time.perf_counter() - t0), "exit_codes": dict(sorted(codes.items())),
-            "tracebacks": problems["tracebacks"],
-            "exit codes outside {0, 1, 2, 3}": problems["exit codes outside {0, 1, 2, 3}"],
-            "partial outputs or leftovers": problems["partial outputs or leftovers"],
-            "user files touched": problems["user files touched"],
-            "internal errors (exit 3)": problems["internal errors (exit 3)"],
-            "exit 2 without exactly one stderr line": problems["exit 2 without exactly one stderr line"],
-            "timeouts": problems["timeouts"],
-            "inputs outside their folder": problems["inputs outside their folder"],
-            "examples": examples}
+            print(
+                f"{cli}: {i + 1 - start}/{n} ({time.perf_counter() - t0:.0f} s) exits {dict(sorted(codes.items()))} "
+                f"problems {dict(problems)}",
+                file=log,
+                flush=True,
+            )
+    return {
+        "cli": cli,
+        "inputs": n,
+        "seconds": round(time.perf_counter() - t0),
+        "exit_codes": dict(sorted(codes.items())),
+        "tracebacks": problems["tracebacks"],
+        "exit codes outside {0, 1, 2, 3}": problems["exit codes outside {0, 1, 2, 3}"],
+        "partial outputs or leftovers": problems["partial outputs or leftovers"],
+        "user files touched": problems["user files touched"],
+        "internal errors (exit 3)": problems["internal errors (exit 3)"],
+        "exit 2 without exactly one stderr line": problems["exit 2 without exactly one stderr line"],
+        "timeouts": problems["timeouts"],
+        "inputs outside their folder": problems["inputs outside their folder"],
+        "examples": examples,
+    }
 
 
 def fuzz_png(n: int, seed: int, start: int = 0) -> dict:
     """``n`` damaged PNG frames through read_png (tests/fuzz/png_inputs.py): outcomes and problems by kind."""
-    from fuzz.png_inputs import check_png, hostile_png
     from wirecheck.oracles.candidates.png_frame import FrameProblem, read_png
+
+    from fuzz.png_inputs import check_png, hostile_png
 
     outcomes, problems, examples = collections.Counter(), collections.Counter(), []
     t0 = time.perf_counter()
@@ -122,7 +139,7 @@ def fuzz_png(n: int, seed: int, start: int = 0) -> dict:
                 try:
                     read_png(path, width, height)
                     outcomes["read"] += 1
-                except Exception:      # noqa: BLE001 - counted: FrameProblem or the traceback found above
+                except Exception:  # noqa: BLE001 - counted: FrameProblem or the traceback found above
                     outcomes["refused"] += 1
             except FuzzTimeout:
                 found = [f"timeout: over {TIMEOUT_S} s"]
@@ -132,8 +149,14 @@ def fuzz_png(n: int, seed: int, start: int = 0) -> dict:
                 problems[p.split(":")[0]] += 1
             if found and len(examples) < 10:
                 examples.append({"input": i, "problems": found})
-    return {"surface": "png", "inputs": n, "seconds": round(time.perf_counter() - t0), "outcomes": dict(outcomes),
-            "problems": dict(problems), "examples": examples}
+    return {
+        "surface": "png",
+        "inputs": n,
+        "seconds": round(time.perf_counter() - t0),
+        "outcomes": dict(outcomes),
+        "problems": dict(problems),
+        "examples": examples,
+    }
 
 
 def fuzz_interrupts(n: int, seed: int, start: int = 0) -> dict:
@@ -147,25 +170,37 @@ def fuzz_interrupts(n: int, seed: int, start: int = 0) -> dict:
             rc, found = interrupt_one(Pick(random.Random(f"{seed}-interrupt-{i}")), Path(d))
         codes[rc] += 1
         for p in found:
-            (notes if p.startswith("note: ") else problems)[p.split(":")[0] if not p.startswith("note: ") else p[6:]] += 1
+            (notes if p.startswith("note: ") else problems)[
+                p.split(":")[0] if not p.startswith("note: ") else p[6:]
+            ] += 1
         if any(not p.startswith("note: ") for p in found) and len(examples) < 10:
             examples.append({"input": i, "rc": rc, "problems": found})
-    return {"surface": "interrupt", "inputs": n, "seconds": round(time.perf_counter() - t0),
-            "exit_codes": dict(sorted(codes.items())), "problems": dict(problems), "notes": dict(notes),
-            "examples": examples}
+    return {
+        "surface": "interrupt",
+        "inputs": n,
+        "seconds": round(time.perf_counter() - t0),
+        "exit_codes": dict(sorted(codes.items())),
+        "problems": dict(problems),
+        "notes": dict(notes),
+        "examples": examples,
+    }
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--inputs", type=int, default=10_000, help="inputs per CLI (default 10000)")
-    p.add_argument("--cli", choices=("renderer", "crosscheck", "both", "png", "interrupt"), default="both",
-                   help="png: damaged PNG frames for the image rule; interrupt: SIGINT/SIGTERM at random moments "
-                        "of renderer processes reading a textured OBJ")
+    p.add_argument(
+        "--cli",
+        choices=("renderer", "crosscheck", "both", "png", "interrupt"),
+        default="both",
+        help="png: damaged PNG frames for the image rule; interrupt: SIGINT/SIGTERM at random moments "
+        "of renderer processes reading a textured OBJ",
+    )
     p.add_argument("--seed", type=int, default=15)
     p.add_argument("--start", type=int, default=0, help="first input's index (split a run over processes)")
     p.add_argument("--json", default=None, help="also write the results here")
     a = p.parse_args(argv)
-    warnings.simplefilter("ignore")       # the CLIs capture their own; the harness's are not the contract's
+    warnings.simplefilter("ignore")  # the CLIs capture their own; the harness's are not the contract's
     os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
     from wirecheck.core.app import cli as renderer
 
@@ -178,23 +213,43 @@ def main(argv=None) -> int:
     results = []
     with tempfile.TemporaryDirectory(prefix="wirecheck-fuzz-earlier-") as d:
         earlier = Path(d) / "out"
-        assert renderer.main(["--frames", "2", "--width", "32", "--height", "24", "--format", "png,gif",
-                              "--out", str(earlier)]) == 0
-        for cli in (("renderer", "crosscheck") if a.cli == "both" else (a.cli,)):
+        assert (
+            renderer.main(
+                ["--frames", "2", "--width", "32", "--height", "24", "--format", "png,gif", "--out", str(earlier)]
+            )
+            == 0
+        )
+        for cli in ("renderer", "crosscheck") if a.cli == "both" else (a.cli,):
             results.append(fuzz(cli, a.inputs, a.seed, earlier, sys.stderr, a.start))
     for r in results:
         print(f"{r['cli']}: {r['inputs']} inputs in {r['seconds']} s; exit codes {r['exit_codes']}")
-        for key in ("tracebacks", "exit codes outside {0, 1, 2, 3}", "partial outputs or leftovers",
-                    "user files touched", "internal errors (exit 3)", "exit 2 without exactly one stderr line",
-                    "timeouts", "inputs outside their folder"):
+        for key in (
+            "tracebacks",
+            "exit codes outside {0, 1, 2, 3}",
+            "partial outputs or leftovers",
+            "user files touched",
+            "internal errors (exit 3)",
+            "exit 2 without exactly one stderr line",
+            "timeouts",
+            "inputs outside their folder",
+        ):
             print(f"  {key}: {r[key]}")
         for ex in r["examples"][:5]:
             print(f"  e.g. input {ex['input']}: exit {ex['rc']} {ex['problems']}: {ex['argv']}")
     if a.json:
         Path(a.json).write_text(json.dumps(results, indent=1) + "\n")
-    bad = sum(r[k] for r in results for k in ("tracebacks", "exit codes outside {0, 1, 2, 3}",
-                                              "partial outputs or leftovers", "user files touched", "timeouts",
-                                              "inputs outside their folder"))
+    bad = sum(
+        r[k]
+        for r in results
+        for k in (
+            "tracebacks",
+            "exit codes outside {0, 1, 2, 3}",
+            "partial outputs or leftovers",
+            "user files touched",
+            "timeouts",
+            "inputs outside their folder",
+        )
+    )
     return 1 if bad else 0
 
 

@@ -49,16 +49,23 @@ HERE = Path(__file__).resolve().parent
 
 #: The image diagnosis's own test files, less test_image_diagnosis.py's module fixture (80 s): its two tests
 #: that do not use it (a blank candidate, a case of many frames) are selected by node id.
-_IMAGE_TESTS = ["tests/test_image_naming.py", "tests/test_image_registration.py", "tests/test_image_diagnosis_short.py",
-                "tests/test_image_diagnosis_thick.py",
-                "tests/test_image_diagnosis.py::test_blank_candidate_is_a_depth_flip_only_when_the_backward_view_is_empty",
-                "tests/test_image_diagnosis.py::test_a_case_of_many_frames_is_fitted_on_the_points_of_six"]
+_IMAGE_TESTS = [
+    "tests/test_image_naming.py",
+    "tests/test_image_registration.py",
+    "tests/test_image_diagnosis_short.py",
+    "tests/test_image_diagnosis_thick.py",
+    "tests/test_image_diagnosis.py::test_blank_candidate_is_a_depth_flip_only_when_the_backward_view_is_empty",
+    "tests/test_image_diagnosis.py::test_a_case_of_many_frames_is_fitted_on_the_points_of_six",
+]
 
 #: The modules mutated, and the tests that judge each: test files or node ids (``file::test``), with an
 #: optional -k expression over them all. Only the tests that exercise the module: a mutant costs seconds
 #: to a minute, not the whole suite's minutes.
 TARGETS = {
-    "core/projector/projection.py": (["tests/test_projection.py", "tests/test_conventions.py", "tests/test_core_vs_opencv.py"], None),
+    "core/projector/projection.py": (
+        ["tests/test_projection.py", "tests/test_conventions.py", "tests/test_core_vs_opencv.py"],
+        None,
+    ),
     "core/projector/clipping.py": (["tests/test_clipping.py"], None),
     "core/projector/raster.py": (["tests/test_raster.py", "tests/test_raster_modes.py"], None),
     "core/camera.py": (["tests/test_conventions.py", "tests/test_projection.py", "tests/test_scene.py"], None),
@@ -68,41 +75,76 @@ TARGETS = {
     "oracles/judge/frame_pixels.py": (["tests/test_metrics.py", "tests/test_line_gate.py"], None),
     "oracles/tolerances.py": (["tests/test_line_gate.py", "tests/test_precision.py"], None),
     "oracles/diagnosis/diagnose.py": (["tests/test_diagnosis.py", "tests/test_line_gate.py"], "not decides"),
-    "oracles/judge/verdict.py": (["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
-                           "decides or note or empty_scene or faceless or visibility or core_case_fields "
-                           "or shaded_summary"),
+    "oracles/judge/verdict.py": (
+        ["tests/test_line_gate.py", "tests/test_crosscheck.py", "tests/test_crosscheck_styles.py"],
+        "decides or note or empty_scene or faceless or visibility or core_case_fields or shaded_summary",
+    ),
     "oracles/references/convert.py": (["tests/test_oracle_convert.py"], None),
-    "oracles/judge/decide.py": (["tests/test_decide_steps.py", "tests/test_f1_radius.py::test_the_f1_at_the_radius_alone_decides",
-                                 "tests/test_oracle_far.py", "tests/test_frames_judge.py", "tests/test_line_gate.py"],
-                                "steps or radius or oracle or decides or vacuous or line_end_bias or exact"),
+    "oracles/judge/decide.py": (
+        [
+            "tests/test_decide_steps.py",
+            "tests/test_f1_radius.py::test_the_f1_at_the_radius_alone_decides",
+            "tests/test_oracle_far.py",
+            "tests/test_frames_judge.py",
+            "tests/test_line_gate.py",
+        ],
+        "steps or radius or oracle or decides or vacuous or line_end_bias or exact",
+    ),
     # the pure steps (issue 34): decide and name_faults on hand-made evidence first (seconds), then the paths
     # that collect it: the F1 radius by hand, the oracle's precision limit, dim lines and the visible sets
     "oracles/judge/evidence.py": (["tests/test_decide_steps.py"], None),
-    "oracles/judge/name_faults.py": (["tests/test_decide_steps.py", "tests/test_oracle_far.py",
-                                      "tests/test_frames_dim_lines.py", "tests/test_frames_visibility.py"], None),
+    "oracles/judge/name_faults.py": (
+        [
+            "tests/test_decide_steps.py",
+            "tests/test_oracle_far.py",
+            "tests/test_frames_dim_lines.py",
+            "tests/test_frames_visibility.py",
+        ],
+        None,
+    ),
     # the frames path: its judge (run_frames, judge_case) is exercised by test_frames_judge.py (each threshold
     # deciding on PNG frames) and by the run_frames cases of test_frames_candidate.py (pass, named fault, vacuous)
-    "oracles/judge/frames_judge.py": (["tests/test_frames_judge.py",
-                                       "tests/test_frames_candidate.py::test_core_frames_pass",
-                                       "tests/test_frames_candidate.py::test_mirrored_frames_fail_and_are_named",
-                                       "tests/test_frames_candidate.py::test_a_case_where_nothing_is_drawn_is_vacuous"],
-                                      None),
+    "oracles/judge/frames_judge.py": (
+        [
+            "tests/test_frames_judge.py",
+            "tests/test_frames_candidate.py::test_core_frames_pass",
+            "tests/test_frames_candidate.py::test_mirrored_frames_fail_and_are_named",
+            "tests/test_frames_candidate.py::test_a_case_where_nothing_is_drawn_is_vacuous",
+        ],
+        None,
+    ),
     # the frames read ahead on the GL thread: errors at their own frame, the same report, no thread left
-    "oracles/judge/frame_prefetch.py": (["tests/test_frame_prefetch.py",
-                                         "tests/test_frames_candidate.py::test_frames_that_cannot_be_decoded_are_all_listed"],
-                                        None),
+    "oracles/judge/frame_prefetch.py": (
+        [
+            "tests/test_frame_prefetch.py",
+            "tests/test_frames_candidate.py::test_frames_that_cannot_be_decoded_are_all_listed",
+        ],
+        None,
+    ),
     "oracles/judge/line_style.py": (["tests/test_line_style.py"], None),
     "oracles/judge/line_windows.py": (["tests/test_line_windows.py", "tests/test_line_style.py"], None),
     # moved out of line_windows, segment_pixels and the registration: the distances and the box clipper
-    "oracles/segment_geometry.py": (["tests/test_line_windows.py", "tests/test_metrics.py", "tests/test_line_style.py",
-                                     "tests/test_image_registration.py"], None),
+    "oracles/segment_geometry.py": (
+        [
+            "tests/test_line_windows.py",
+            "tests/test_metrics.py",
+            "tests/test_line_style.py",
+            "tests/test_image_registration.py",
+        ],
+        None,
+    ),
     "oracles/judge/line_profile.py": (["tests/test_line_profile.py", "tests/test_line_style.py"], None),
     "oracles/judge/case_samples.py": (["tests/test_case_samples.py", "tests/test_line_style.py"], None),
     # the even-width lean: its unit tests and 2-px jobs in test_even_width.py, then Pillow's 2-px lines on the
     # held-out slanted job (a correct one passes leaning, one with the half-pixel mistake is pixel_offset)
-    "oracles/judge/even_lean.py": (["tests/test_even_width.py",
-                                    "tests/test_frames_heldout.py::test_pillow_wide_lines_pass_on_f1_at_their_width[2]",
-                                    "tests/test_frames_heldout.py::test_pillow_2px_half_pixel_is_pixel_offset"], None),
+    "oracles/judge/even_lean.py": (
+        [
+            "tests/test_even_width.py",
+            "tests/test_frames_heldout.py::test_pillow_wide_lines_pass_on_f1_at_their_width[2]",
+            "tests/test_frames_heldout.py::test_pillow_2px_half_pixel_is_pixel_offset",
+        ],
+        None,
+    ),
     # the image diagnosis: every test file but the 80-s confusion matrix of test_image_diagnosis.py (its
     # module fixture diagnoses ~100 cases); the short job's matrix and the thick lines cover the same names
     "oracles/diagnosis/image_diagnose.py": (_IMAGE_TESTS, None),
@@ -112,20 +154,54 @@ TARGETS = {
     "oracles/diagnosis/model_lines.py": (_IMAGE_TESTS, None),
     # the aliased rules read and what a fault stands against: its unit tests in test_image_naming.py, then the
     # held-out cases it decides (cv2 LINE_8 on prism / on_axis, the wrong-axis FOV on prism / wide_fov, aspect)
-    "oracles/diagnosis/rule_read.py": (["tests/test_image_naming.py", "tests/test_frames_heldout.py"],
-                                       "tie_margin or stands_against or centre_line_is_named or prism_wide_fov "
-                                       "or aspect_mistake"),
+    "oracles/diagnosis/rule_read.py": (
+        ["tests/test_image_naming.py", "tests/test_frames_heldout.py"],
+        "tie_margin or stands_against or centre_line_is_named or prism_wide_fov or aspect_mistake",
+    ),
 }
 
 PER_MUTANT_TIMEOUT_S = 300
 
-_BINOPS = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult,
-           ast.FloorDiv: ast.Div, ast.Pow: ast.Mult}
-_CMPOPS = {ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt, ast.Eq: ast.NotEq,
-           ast.NotEq: ast.Eq, ast.Is: ast.IsNot, ast.IsNot: ast.Is, ast.In: ast.NotIn, ast.NotIn: ast.In}
-_SYMBOL = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.FloorDiv: "//", ast.Pow: "**",
-           ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!=",
-           ast.Is: "is", ast.IsNot: "is not", ast.In: "in", ast.NotIn: "not in", ast.And: "and", ast.Or: "or"}
+_BINOPS = {
+    ast.Add: ast.Sub,
+    ast.Sub: ast.Add,
+    ast.Mult: ast.Div,
+    ast.Div: ast.Mult,
+    ast.FloorDiv: ast.Div,
+    ast.Pow: ast.Mult,
+}
+_CMPOPS = {
+    ast.Lt: ast.LtE,
+    ast.LtE: ast.Lt,
+    ast.Gt: ast.GtE,
+    ast.GtE: ast.Gt,
+    ast.Eq: ast.NotEq,
+    ast.NotEq: ast.Eq,
+    ast.Is: ast.IsNot,
+    ast.IsNot: ast.Is,
+    ast.In: ast.NotIn,
+    ast.NotIn: ast.In,
+}
+_SYMBOL = {
+    ast.Add: "+",
+    ast.Sub: "-",
+    ast.Mult: "*",
+    ast.Div: "/",
+    ast.FloorDiv: "//",
+    ast.Pow: "**",
+    ast.Lt: "<",
+    ast.LtE: "<=",
+    ast.Gt: ">",
+    ast.GtE: ">=",
+    ast.Eq: "==",
+    ast.NotEq: "!=",
+    ast.Is: "is",
+    ast.IsNot: "is not",
+    ast.In: "in",
+    ast.NotIn: "not in",
+    ast.And: "and",
+    ast.Or: "or",
+}
 
 
 @dataclass(frozen=True)
@@ -261,13 +337,18 @@ def run_mutant(site: Site, pkg: Path) -> tuple[str, float]:
     target = pkg / site.module
     original = target.read_text()
     target.write_text(mutant_source(site))
-    env = {**os.environ, "PYTHONPATH": str(pkg.parent), "PYTHONDONTWRITEBYTECODE": "1",
-           "PYOPENGL_PLATFORM": os.environ.get("PYOPENGL_PLATFORM", "osmesa")}
+    env = {
+        **os.environ,
+        "PYTHONPATH": str(pkg.parent),
+        "PYTHONDONTWRITEBYTECODE": "1",
+        "PYOPENGL_PLATFORM": os.environ.get("PYOPENGL_PLATFORM", "osmesa"),
+    }
     cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests] + (["-k", k] if k else [])
     t0 = time.perf_counter()
     try:
-        rc = subprocess.run(cmd, cwd=pkg, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            timeout=PER_MUTANT_TIMEOUT_S).returncode
+        rc = subprocess.run(
+            cmd, cwd=pkg, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=PER_MUTANT_TIMEOUT_S
+        ).returncode
         verdict = "survived" if rc == 0 else "killed"
     except subprocess.TimeoutExpired:
         verdict = "timeout"
@@ -279,8 +360,14 @@ def run_mutant(site: Site, pkg: Path) -> tuple[str, float]:
 def _check_copy_is_imported(pkg: Path) -> None:
     """The tests must import the copy, not the editable install of the working tree."""
     env = {**os.environ, "PYTHONPATH": str(pkg.parent), "PYTHONDONTWRITEBYTECODE": "1"}
-    out = subprocess.run([sys.executable, "-c", "import wirecheck.core.projector.raster as r; print(r.__file__)"],
-                         cwd=pkg, env=env, capture_output=True, text=True, check=True).stdout.strip()
+    out = subprocess.run(
+        [sys.executable, "-c", "import wirecheck.core.projector.raster as r; print(r.__file__)"],
+        cwd=pkg,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
     if not out.startswith(str(pkg)):
         raise SystemExit(f"mutate: the copy is not what gets imported ({out})")
 
@@ -298,20 +385,27 @@ def main(argv=None) -> int:
     chosen: list[Site] = []
     for module in modules:
         all_sites = sites(module)
-        pick = all_sites if args.sample is None or args.sample >= len(all_sites) else \
-            sorted(random.Random(f"{args.seed}:{module}").sample(all_sites, args.sample), key=lambda s: s.index)
+        pick = (
+            all_sites
+            if args.sample is None or args.sample >= len(all_sites)
+            else sorted(random.Random(f"{args.seed}:{module}").sample(all_sites, args.sample), key=lambda s: s.index)
+        )
         chosen += pick
         print(f"{module}: {len(all_sites)} sites, {len(pick)} chosen", flush=True)
     if args.only:
         chosen = [s for m in modules for s in sites(m) if s.id in set(args.only)]
         unknown = [i for i in args.only if i not in {s.id for s in chosen}]
-        if unknown:         # a score over nothing would overwrite the report with "Score: nan%"
-            print(f"mutate: error: --only {unknown[0]!r}: no mutant of {', '.join(modules)} has this id: expected "
-                  "one that --list prints (MODULE:LINE:COL:CHANGE)", file=sys.stderr)
+        if unknown:  # a score over nothing would overwrite the report with "Score: nan%"
+            print(
+                f"mutate: error: --only {unknown[0]!r}: no mutant of {', '.join(modules)} has this id: expected "
+                "one that --list prints (MODULE:LINE:COL:CHANGE)",
+                file=sys.stderr,
+            )
             return 2
     if not chosen:
-        print("mutate: error: no mutant chosen: expected --sample N >= 1 or a module with mutation sites",
-              file=sys.stderr)
+        print(
+            "mutate: error: no mutant chosen: expected --sample N >= 1 or a module with mutation sites", file=sys.stderr
+        )
         return 2
     # round robin over the modules: a run stopped early has looked at each of them
     by_module = [[s for s in chosen if s.module == m] for m in modules]
@@ -332,8 +426,11 @@ def main(argv=None) -> int:
             results.append((site, verdict, seconds))
             print(f"[{n}/{len(chosen)}] {verdict:10s} {seconds:5.1f}s {site.id}", flush=True)
     if not any(r != "equivalent" for _, r, _ in results):
-        print(f"mutate: error: all {len(results)} chosen mutants are listed as equivalent: no score to report; "
-              f"{args.report} left as it was", file=sys.stderr)
+        print(
+            f"mutate: error: all {len(results)} chosen mutants are listed as equivalent: no score to report; "
+            f"{args.report} left as it was",
+            file=sys.stderr,
+        )
         return 2
     write_report(Path(args.report), results, equivalent, args)
     return 0
@@ -343,20 +440,28 @@ def write_report(path: Path, results, equivalent: dict, args) -> None:
     counts = {v: sum(1 for _, r, _ in results if r == v) for v in ("killed", "timeout", "survived", "equivalent")}
     judged = counts["killed"] + counts["timeout"] + counts["survived"]
     score = (counts["killed"] + counts["timeout"]) / judged if judged else float("nan")
-    lines = ["# Mutation report", "",
-             f"Command: `.venv/bin/python tests/mutation/mutate.py"
-             f"{f' --sample {args.sample}' if args.sample else ''}{'' if args.only else f' --seed {args.seed}'}"
-             f"{''.join(f' --module {m}' for m in args.module or [])}"
-             f"{''.join(f' --only {i}' for i in args.only or [])}"
-             f"{'' if Path(args.report) == HERE / 'report.md' else f' --report {args.report}'}`", "",
-             f"Mutants: {len(results)}; killed {counts['killed']} (+{counts['timeout']} by time-out), "
-             f"survived {counts['survived']}, equivalent {counts['equivalent']}. "
-             f"**Score: {score:.1%}** of the non-equivalent mutants killed.", "",
-             "| module | mutants | killed | survived | equivalent |", "|---|---|---|---|---|"]
+    lines = [
+        "# Mutation report",
+        "",
+        f"Command: `.venv/bin/python tests/mutation/mutate.py"
+        f"{f' --sample {args.sample}' if args.sample else ''}{'' if args.only else f' --seed {args.seed}'}"
+        f"{''.join(f' --module {m}' for m in args.module or [])}"
+        f"{''.join(f' --only {i}' for i in args.only or [])}"
+        f"{'' if Path(args.report) == HERE / 'report.md' else f' --report {args.report}'}`",
+        "",
+        f"Mutants: {len(results)}; killed {counts['killed']} (+{counts['timeout']} by time-out), "
+        f"survived {counts['survived']}, equivalent {counts['equivalent']}. "
+        f"**Score: {score:.1%}** of the non-equivalent mutants killed.",
+        "",
+        "| module | mutants | killed | survived | equivalent |",
+        "|---|---|---|---|---|",
+    ]
     for module in dict.fromkeys(s.module for s, _, _ in results):
         rows = [r for s, r, _ in results if s.module == module]
-        lines.append(f"| {module} | {len(rows)} | {sum(r in ('killed', 'timeout') for r in rows)} | "
-                     f"{rows.count('survived')} | {rows.count('equivalent')} |")
+        lines.append(
+            f"| {module} | {len(rows)} | {sum(r in ('killed', 'timeout') for r in rows)} | "
+            f"{rows.count('survived')} | {rows.count('equivalent')} |"
+        )
     lines += ["", "## Survivors", ""]
     lines += [f"- `{s.id}`" for s, r, _ in results if r == "survived"] or ["(none)"]
     lines += ["", "## Equivalent (tests/mutation/equivalent.json)", ""]

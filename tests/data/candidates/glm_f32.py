@@ -11,6 +11,7 @@ is on the float32 view depth ``-z_view``, as a hand-written projector does it.
 - :func:`project_f64_view`: the same arithmetic in float32, returned as float64
   (what a float32 program gives through a float64 interface).
 """
+
 import numpy as np
 
 F32 = np.float32
@@ -80,8 +81,7 @@ def project(points, camera):
     """Correct, in float32: ``x = (ndc_x + 1) W/2 - 0.5``, ``y = (1 - ndc_y) H/2 - 0.5``."""
     ndc, visible = _ndc(points, camera)
     w, h = F32(camera.width), F32(camera.height)
-    out = np.stack([(ndc[:, 0] + F32(1)) * w / F32(2) - F32(0.5),
-                    (F32(1) - ndc[:, 1]) * h / F32(2) - F32(0.5)], axis=1)
+    out = np.stack([(ndc[:, 0] + F32(1)) * w / F32(2) - F32(0.5), (F32(1) - ndc[:, 1]) * h / F32(2) - F32(0.5)], axis=1)
     out[~visible] = np.nan
     return out
 

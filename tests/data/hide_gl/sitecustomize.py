@@ -6,6 +6,7 @@ Python imports ``sitecustomize`` at start-up from ``PYTHONPATH``: with this fold
 loader raises for a library that is not installed. PyOpenGL loads its libraries through
 ``ctypes.CDLL``, so this is a machine without them, as far as wirecheck can tell.
 """
+
 import ctypes
 import os
 

@@ -17,6 +17,7 @@ picture comes out mirrored left-right). ``project`` converts the world to
 left-handed first by negating z of every point and of the camera's vectors,
 which is what D3D samples do with right-handed assets.
 """
+
 import numpy as np
 
 F = np.float32
@@ -70,8 +71,7 @@ def _project(points, camera, flip_z):
     clip = p @ (proj @ view).T
     with np.errstate(divide="ignore", invalid="ignore"):
         ndc = clip[:, :3] / clip[:, 3:4]
-    px = np.stack([(ndc[:, 0] + F(1)) * F(w / 2) - F(0.5),
-                   (F(1) - ndc[:, 1]) * F(h / 2) - F(0.5)], axis=1)
+    px = np.stack([(ndc[:, 0] + F(1)) * F(w / 2) - F(0.5), (F(1) - ndc[:, 1]) * F(h / 2) - F(0.5)], axis=1)
     inside = (clip[:, 3] > 0) & (clip[:, 2] >= 0) & (clip[:, 2] <= clip[:, 3])
     px[~inside] = np.nan
     return px

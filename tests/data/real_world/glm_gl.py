@@ -17,6 +17,7 @@ newcomer does (a vertical mirror and a half-pixel offset against the contract);
 ``project`` converts them: ``x_px = win_x - 0.5``, ``y_px = H - win_y - 0.5``.
 Clipping is GL's: a point is kept when ``-w <= z_clip <= w``, in float32.
 """
+
 import numpy as np
 
 F = np.float32

@@ -14,12 +14,13 @@ written out by hand in numpy, as code that cannot depend on OpenCV does
 stops at ``x', y'`` (the lens forgotten), ``project_k1_sign`` has the sign of
 k1 flipped (a barrel lens taken for a pincushion). Perspective only.
 """
+
 import numpy as np
 
 
 def _distort(xn, yn, coeffs):
     k = np.zeros(8)
-    k[:len(coeffs)] = coeffs
+    k[: len(coeffs)] = coeffs
     k1, k2, p1, p2, k3, k4, k5, k6 = k
     r2 = xn * xn + yn * yn
     radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
@@ -57,4 +58,5 @@ def project_k1_sign(points, camera):
         d = list(d)
         d[0] = -d[0]
         return d
+
     return _project(points, camera, flipped)

@@ -14,6 +14,7 @@ horizontal) and the centre at ``W / 2, H / 2`` (pixel corners); ``project``
 uses the vertical FOV and the pixel-centre principal point of the contract.
 Perspective only: the tutorials have no orthographic view.
 """
+
 import numpy as np
 
 

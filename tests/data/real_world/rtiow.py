@@ -26,26 +26,27 @@ Neither version has an orthographic camera or a far plane; points behind the
 camera, nearer than ``near`` or beyond ``far`` are dropped here as the
 contract asks.
 """
+
 import numpy as np
 
 
 def _camera_space(points, camera):
-    w = -np.asarray(camera.forward, float)          # RTIOW's w points backwards
+    w = -np.asarray(camera.forward, float)  # RTIOW's w points backwards
     u = np.cross(camera.up, w)
     u = u / np.linalg.norm(u)
     v = np.cross(w, u)
     d = np.asarray(points, float) - camera.position
-    return d @ u, d @ v, -(d @ w)                   # right, up, depth
+    return d @ u, d @ v, -(d @ w)  # right, up, depth
 
 
 def project_v4(points, camera):
     x, y, depth = _camera_space(points, camera)
     W, H = camera.width, camera.height
-    vh = 2 * np.tan(np.radians(camera.fov_y_deg) / 2)      # focal_length 1
+    vh = 2 * np.tan(np.radians(camera.fov_y_deg) / 2)  # focal_length 1
     vw = vh * W / H
     with np.errstate(divide="ignore", invalid="ignore"):
-        xs, ys = x / depth, y / depth                      # on the plane at distance 1
-    i = (xs + vw / 2) / (vw / W) - 0.5                     # pixel00 is half a step in
+        xs, ys = x / depth, y / depth  # on the plane at distance 1
+    i = (xs + vw / 2) / (vw / W) - 0.5  # pixel00 is half a step in
     j = (vh / 2 - ys) / (vh / H) - 0.5
     px = np.stack([i, j], axis=1)
     px[(depth < camera.near) | (depth > camera.far)] = np.nan
@@ -60,9 +61,9 @@ def project_v3(points, camera):
     with np.errstate(divide="ignore", invalid="ignore"):
         xs, ys = x / depth, y / depth
     u = (xs + vw / 2) / vw
-    v = (ys + vh / 2) / vh                                 # from the bottom
+    v = (ys + vh / 2) / vh  # from the bottom
     i = u * (W - 1)
-    j = (H - 1) - v * (H - 1)                              # row 0 is the top of the file
+    j = (H - 1) - v * (H - 1)  # row 0 is the top of the file
     px = np.stack([i, j], axis=1)
     px[(depth < camera.near) | (depth > camera.far)] = np.nan
     return px

@@ -1,4 +1,5 @@
 """A user's projector (pinhole, pixel centres at integers, y down) and a mirrored copy of it."""
+
 import numpy as np
 
 
