@@ -65,8 +65,8 @@ from .name_faults import name_faults, wants_visibility
 #: 150 a frame at 24 frames: more frames would add few points each and cost memory.
 DIAGNOSIS_FRAMES = 24
 
-#: Per-frame fields of the line comparison, as the projector path's (oracles.judge.verdict.LINE_FRAME_KEYS).
-LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
+#: Per-frame fields of the line comparison: the projector path's (oracles.judge.metrics.LINE_FRAME_KEYS).
+LINE_FRAME_KEYS = metrics.LINE_FRAME_KEYS
 
 
 def candidate_pixels(

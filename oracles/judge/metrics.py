@@ -104,6 +104,9 @@ def _within(mask_from: np.ndarray, mask_to: np.ndarray, tol: int) -> np.ndarray:
 #: The per-frame scores of :func:`pixel_scores` a case keeps, in report order.
 PIXEL_SCORE_KEYS = ("f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px")
 
+#: The per-frame fields of a wireframe's line comparison (:func:`line_scores`) a case keeps, on both paths.
+LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
+
 
 def pixel_scores(cand: np.ndarray, oracle: np.ndarray, tols=(0, 1), pixels: FramePixels | None = None) -> dict:
     """Precision, recall and F1 of ``cand`` against ``oracle`` (both (H, W) bool) at each tolerance.

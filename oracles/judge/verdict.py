@@ -24,8 +24,8 @@ from .decide import decide, line_faults, pixel_fields
 from .evidence import CaseEvidence
 from .name_faults import name_faults
 
-#: Per-frame fields of a wireframe's line comparison (oracles.judge.metrics.line_scores).
-LINE_FRAME_KEYS = ("candidate_only", "oracle_only", "subpixel_ties", "edge_count_max_diff", "edge_count_worst_edge")
+#: Per-frame fields of a wireframe's line comparison: metrics' (one definition for both paths).
+LINE_FRAME_KEYS = metrics.LINE_FRAME_KEYS
 
 #: Per-frame fields of a shaded comparison (oracles.judge.metrics.shaded_scores).
 SHADED_FRAME_KEYS = (
