@@ -156,3 +156,65 @@ def draw_and_judge(script, job_dir, tmp_path, *args, cases=6, frames=2) -> tuple
     report = json.loads((tmp_path / "rep" / "report.json").read_text())
     assert len(report["cases"]) == cases and all(c["frames_checked"] == frames for c in report["cases"])
     return rc, report
+
+
+def depth_client_judged(folder, client: str, camera_fields, mistakes, motion, k: int = 2, frames: int = 7) -> list:
+    """A real renderer's depth maps, judged: ``[(scene, case, mistake or None, DepthDiagnosis, camera)]``.
+
+    Each bundled scene (cube, prism, pyramid) under each default case camera, frame ``k`` of ``frames`` of
+    ``motion``: its fan triangles, world points and ``camera_fields(camera)`` (the fields the client reads,
+    a dict) written to ``folder/<scene>-<case>.npz``; ``tests/clients/<client>`` run on ``folder`` in its own
+    process, as its users run it, writing ``<scene>-<case>.<mistake>.npy`` for each of ``mistakes``
+    (``"correct"`` among them); each map read by oracles.candidates.depth_map and named against pyrender's
+    depth (oracles.judge.depth_reference) by oracles.diagnosis.depth_faults. The caller skips where the
+    renderer or OSMesa is missing.
+    """
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import numpy as np
+    from wirecheck.core.scene.files import load_scene
+    from wirecheck.core.scene.frames import SceneRenderer
+    from wirecheck.oracles.candidates.depth_map import read_depth_map
+    from wirecheck.oracles.cases import case_motion, cases_for
+    from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
+    from wirecheck.oracles.judge.depth_reference import reference_depth
+    from wirecheck.oracles.references.pyrender_oracle import OracleCache
+
+    refs = []
+    cache = OracleCache()
+    try:
+        for name in ("cube", "prism", "pyramid"):
+            scene = load_scene(name)
+            fan = np.array([(f[0], f[j], f[j + 1]) for f in scene.faces for j in range(1, len(f) - 1)])
+            for case in cases_for(scene):
+                cam = case.camera
+                refs.append(
+                    (name, case, reference_depth(cache.get(cam.width, cam.height), scene, case, motion, k, frames))
+                )
+                np.savez(
+                    Path(folder) / f"{name}-{case.name}.npz",
+                    triangles=fan,
+                    p_world=SceneRenderer(scene, case_motion(motion, case), frames).world_points(k),
+                    width=cam.width,
+                    height=cam.height,
+                    near=cam.near,
+                    far=cam.far,
+                    projection=cam.projection,
+                    **camera_fields(cam),
+                )
+    finally:
+        cache.close()
+    script = Path(__file__).parent / "clients" / client
+    subprocess.run([sys.executable, str(script), str(folder)], check=True, timeout=300)
+    out = []
+    for name, case, ref in refs:
+        cam = case.camera
+        for mistake in mistakes:
+            depth = read_depth_map(Path(folder) / f"{name}-{case.name}.{mistake}.npy", cam.width, cam.height)
+            d = name_depth_faults(
+                depth.depth, ref.compared_depth(), ref.bound, cam, depth.encoding_bound(), faces=ref.compared_faces()
+            )
+            out.append((name, case.name, None if mistake == "correct" else mistake, d, cam))
+    return out

@@ -11,20 +11,9 @@ missing (failed under WIRECHECK_REQUIRE_EGL=1, as the other real-renderer tests)
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import helpers  # tests/ is on sys.path (rootdir conftest)
-import numpy as np
 import pytest
-from wirecheck.core.scene.files import load_scene
-from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
-from wirecheck.oracles.candidates.depth_map import read_depth_map
-from wirecheck.oracles.cases import case_motion, cases_for
-from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
-from wirecheck.oracles.judge.depth_reference import reference_depth
 
 PROBE = "import moderngl; moderngl.create_standalone_context(backend='egl').release()"
 MOTION = Motion(turns=(1.0, 1.0, 0.0))
@@ -33,47 +22,19 @@ MOTION = Motion(turns=(1.0, 1.0, 0.0))
 @pytest.fixture(scope="module")
 def judged(tmp_path_factory):
     helpers.require_renderer(PROBE, "moderngl on EGL")
-    from wirecheck.oracles.references.pyrender_oracle import OracleCache, osmesa_available
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
     ok, msg = osmesa_available()
     if not ok:
         pytest.skip(msg)
     folder = tmp_path_factory.mktemp("moderngl_depth")
-    refs = []
-    cache = OracleCache()
-    try:
-        for name in ("cube", "prism", "pyramid"):
-            scene = load_scene(name)
-            fan = np.array([(f[0], f[k], f[k + 1]) for f in scene.faces for k in range(1, len(f) - 1)])
-            for case in cases_for(scene):
-                cam = case.camera
-                refs.append((name, case, reference_depth(cache.get(cam.width, cam.height), scene, case, MOTION, 2, 7)))
-                np.savez(
-                    folder / f"{name}-{case.name}.npz",
-                    triangles=fan,
-                    p_world=SceneRenderer(scene, case_motion(MOTION, case), 7).world_points(2),
-                    projection_matrix=cam.projection_matrix,
-                    view_matrix=cam.view_matrix,
-                    width=cam.width,
-                    height=cam.height,
-                    near=cam.near,
-                    far=cam.far,
-                    projection=cam.projection,
-                )
-    finally:
-        cache.close()
-    client = Path(__file__).parent / "clients" / "moderngl_depth.py"
-    subprocess.run([sys.executable, str(client), str(folder)], check=True, timeout=300)  # the renderer, as users run it
-    out = []
-    for name, case, ref in refs:
-        cam = case.camera
-        for mistake in ("correct", "zbuffer", "no_flip"):
-            depth = read_depth_map(folder / f"{name}-{case.name}.{mistake}.npy", cam.width, cam.height)
-            d = name_depth_faults(
-                depth.depth, ref.compared_depth(), ref.bound, cam, depth.encoding_bound(), faces=ref.compared_faces()
-            )
-            out.append((name, case.name, None if mistake == "correct" else mistake, d, cam))
-    return out
+    return helpers.depth_client_judged(
+        folder,
+        "moderngl_depth.py",
+        lambda cam: {"projection_matrix": cam.projection_matrix, "view_matrix": cam.view_matrix},
+        ("correct", "zbuffer", "no_flip"),
+        MOTION,
+    )
 
 
 def test_correct_passes(judged):

@@ -14,20 +14,9 @@ orthographic case passes). Skipped where VTK cannot open an offscreen window or 
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import helpers  # tests/ is on sys.path (rootdir conftest)
-import numpy as np
 import pytest
-from wirecheck.core.scene.files import load_scene
-from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
-from wirecheck.oracles.candidates.depth_map import read_depth_map
-from wirecheck.oracles.cases import case_motion, cases_for
-from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
-from wirecheck.oracles.judge.depth_reference import reference_depth
 
 PROBE = (
     "import vtk; w = vtk.vtkRenderWindow(); w.SetOffScreenRendering(1); w.SetSize(8, 8); "
@@ -41,50 +30,25 @@ pytestmark = pytest.mark.slow  # 21 pyrender frames and a renderer process (15-3
 @pytest.fixture(scope="module")
 def judged(tmp_path_factory):
     helpers.require_renderer(PROBE, "VTK offscreen")
-    from wirecheck.oracles.references.pyrender_oracle import OracleCache, osmesa_available
+    from wirecheck.oracles.references.pyrender_oracle import osmesa_available
 
     ok, msg = osmesa_available()
     if not ok:
         pytest.skip(msg)
     folder = tmp_path_factory.mktemp("vtk_depth")
-    refs = []
-    cache = OracleCache()
-    try:
-        for name in ("cube", "prism", "pyramid"):
-            scene = load_scene(name)
-            fan = np.array([(f[0], f[k], f[k + 1]) for f in scene.faces for k in range(1, len(f) - 1)])
-            for case in cases_for(scene):
-                cam = case.camera
-                refs.append((name, case, reference_depth(cache.get(cam.width, cam.height), scene, case, MOTION, 2, 7)))
-                np.savez(
-                    folder / f"{name}-{case.name}.npz",
-                    triangles=fan,
-                    p_world=SceneRenderer(scene, case_motion(MOTION, case), 7).world_points(2),
-                    position=cam.position,
-                    forward=cam.forward,
-                    up=cam.up,
-                    fov_y_deg=cam.fov_y_deg,
-                    ortho_height=cam.ortho_height,
-                    width=cam.width,
-                    height=cam.height,
-                    near=cam.near,
-                    far=cam.far,
-                    projection=cam.projection,
-                )
-    finally:
-        cache.close()
-    client = Path(__file__).parent / "clients" / "vtk_depth.py"
-    subprocess.run([sys.executable, str(client), str(folder)], check=True, timeout=300)  # the renderer, as users run it
-    out = []
-    for name, case, ref in refs:
-        cam = case.camera
-        for mistake in MISTAKES:
-            depth = read_depth_map(folder / f"{name}-{case.name}.{mistake}.npy", cam.width, cam.height)
-            d = name_depth_faults(
-                depth.depth, ref.compared_depth(), ref.bound, cam, depth.encoding_bound(), faces=ref.compared_faces()
-            )
-            out.append((name, case.name, None if mistake == "correct" else mistake, d, cam))
-    return out
+    return helpers.depth_client_judged(
+        folder,
+        "vtk_depth.py",
+        lambda cam: {
+            "position": cam.position,
+            "forward": cam.forward,
+            "up": cam.up,
+            "fov_y_deg": cam.fov_y_deg,
+            "ortho_height": cam.ortho_height,
+        },
+        MISTAKES,
+        MOTION,
+    )
 
 
 def test_correct_passes(judged):
