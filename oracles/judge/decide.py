@@ -21,7 +21,7 @@ missed, one reason each:
   set aside and the case is judged on its vertices alone.
 
 The names are :func:`oracles.judge.name_faults.name_faults`'s, from the same evidence and this verdict.
-:func:`pixel_fields` and :func:`line_faults` are the measurements both paths collect alike.
+:func:`pixel_fields` is the measurement both paths collect alike.
 """
 
 from __future__ import annotations
@@ -34,7 +34,6 @@ from typing import Any
 import numpy as np
 
 from .. import faults as catalogue
-from ..diagnosis.diagnose import diagnose_lines
 from ..faults import Fault
 from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import NAMING, Tolerances, line_failures
@@ -49,7 +48,8 @@ __all__ = [
     "gl_rule_reasons",
     "rounded_rule_failures",
     "pixel_fields",
-    "line_faults",
+    "depth_map_reasons",
+    "filled_reasons",
     "RULE_FAULTS",
     "ROUNDED_RULE_NAME",
 ]
@@ -118,14 +118,6 @@ def pixel_fields(pixel: dict, worst_frame) -> dict:
         "pixel_recall_1px": float(min(pixel["recall_1px"])),
         "worst_pixel_frame": worst_frame,
     }
-
-
-def line_faults(rec: dict, tol: Tolerances, faults: list) -> list:
-    """``faults``, or, when they are none and the case has line fields, the line fault those name
-    (``line_end_bias``, ``line_pixel_bias``: oracles.diagnosis.diagnose.diagnose_lines)."""
-    if faults or "lines" not in rec:
-        return faults
-    return diagnose_lines(rec["lines"], tol)
 
 
 def _vertex_reasons(v, tol: Tolerances) -> list[str]:

@@ -15,12 +15,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..candidates.candidate import case_precision
-from ..diagnosis.diagnose import diagnose
+from ..diagnosis.diagnose import diagnose, diagnose_lines
 from ..faults import Fault
 from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 from . import metrics
-from .decide import decide, line_faults, pixel_fields
+from .decide import decide, pixel_fields
 from .evidence import CaseEvidence
 from .name_faults import name_faults
 
@@ -42,12 +42,14 @@ SHADED_FRAME_KEYS = (
 )
 
 
-def case_record(setup, acc, tol: Tolerances) -> dict:
-    """The case's fields from its frames (``setup``: oracles.judge.case.CaseSetup, ``acc``: its CaseFrames).
+def case_record(setup, acc, tol: Tolerances) -> tuple[dict, list, list]:
+    """The case's fields from its frames (``setup``: oracles.judge.case.CaseSetup, ``acc``: its CaseFrames), and
+    what the diagnosis named: ``(record, vertex faults, line faults)``.
 
-    Vertex errors pooled over the frames, the worst vertex, the faults
-    (oracles.diagnosis.diagnose), the pixel scores' minima and means, the shaded
-    summary, and a note when there was nothing to compare. ``precision``
+    Vertex errors pooled over the frames, the worst vertex, the pixel scores' minima and means, the shaded
+    summary, and a note when there was nothing to compare; its ``faults`` are left empty for :func:`judge`
+    (the names are name_faults', from the evidence). The vertex faults are oracles.diagnosis.diagnose's, the
+    line faults those the line fields name (oracles.diagnosis.diagnose.diagnose_lines). ``precision``
     says what the candidate was judged as (declared, or as it returned; core:
     its ``--dtype``) and ``vertex_bound_px`` the bound its vertices were held
     to (oracles.tolerances.vertex_bound).
@@ -101,9 +103,8 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
         rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
     if setup.pixels and setup.mode.shaded:
         rec.update(shaded_summary(acc.shaded, acc.worst))
-    if acc.lines:  # a line fault is named only when the vertices agree
-        faults = line_faults(rec, tol, faults)
-    rec["faults"] = faults
+    line_named = diagnose_lines(rec["lines"], tol) if acc.lines and "lines" in rec else []
+    rec["faults"] = []  # named by judge (name_faults: a line fault only when the vertices agree)
     rec["compared"] = {
         "frames": done,
         "vertices": rec.get("visible_points", 0),
@@ -114,7 +115,7 @@ def case_record(setup, acc, tol: Tolerances) -> dict:
             "shaded": "no faces: nothing to shade; only the vertices were checked",
             "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe",
         }[setup.mode.style]
-    return rec
+    return rec, faults, line_named
 
 
 def shaded_summary(shaded: list, worst) -> dict:
@@ -180,11 +181,17 @@ PIXEL_KEYS = ("pixel_f1_0px", "pixel_f1_1px", "worst_pixel_frame")
 
 
 def record_evidence(
-    rec: dict, error: str | None = None, points: int | None = None, oracle_bound_px: float | None = None
+    rec: dict,
+    error: str | None = None,
+    points: int | None = None,
+    oracle_bound_px: float | None = None,
+    image_faults=(),
+    line_named=(),
 ) -> CaseEvidence:
-    """A projector case's record (:func:`case_record`) as frozen evidence: its vertex, pixel, line and shaded
-    fields, the faults the diagnosis named (line faults among them), what it compared, at level ``"vertices"``
-    when no pixel was compared, else ``"pixels"``."""
+    """A projector case's measured fields (:func:`case_record`) as frozen evidence: its vertex, pixel, line and
+    shaded fields, the faults the diagnosis named from the vertices (``image_faults``) and from the line
+    fields (``line_named``), what it compared, at level ``"vertices"`` when no pixel was compared, else
+    ``"pixels"``."""
     return CaseEvidence(
         level="vertices" if rec["compared"]["pixels"] is None else "pixels",
         compared=rec["compared"],
@@ -193,7 +200,8 @@ def record_evidence(
         lines=rec.get("lines"),
         vertices={k: rec[k] for k in VERTEX_KEYS if k in rec},
         shaded={k: rec[k] for k in SHADED_KEYS if k in rec} if "silhouette_iou" in rec else None,
-        image_faults=tuple(Fault.of(f) for f in rec.get("faults") or []),
+        image_faults=tuple(Fault.of(f) for f in image_faults),
+        line_faults=tuple(Fault.of(f) for f in line_named),
         error=error,
         points=points,
         oracle_bound_px=oracle_bound_px,
@@ -206,9 +214,12 @@ def judge(
     error: str | None = None,
     points: int | None = None,
     oracle_bound_px: float | None = None,
+    image_faults=(),
+    line_named=(),
 ) -> None:
     """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed; oracles.judge.decide.decide),
-    and ``rec["faults"]`` to the names (oracles.judge.name_faults) where they change: a failure nothing
+    and ``rec["faults"]`` to the names (oracles.judge.name_faults) from the evidence and the diagnosis's
+    ``image_faults`` (from the vertices) and ``line_named`` (from the line fields): a failure nothing
     explains is ``unexplained``; past the oracle's precision limit the names read from pixels go.
 
     "fail" when a limit is missed; else "vacuous" when the case compared nothing
@@ -217,11 +228,11 @@ def judge(
     ``oracle_bound_px`` beside ``oracle_limit_px``; past the limit the case is judged on its vertices alone
     (``oracle_precision``: True).
     """
-    ev = record_evidence(rec, error, points, oracle_bound_px)
+    ev = record_evidence(rec, error, points, oracle_bound_px, image_faults, line_named)
     verdict = decide(ev, tol)
     names = [f.as_dict() for f in name_faults(ev, verdict, tol)]
-    if names != rec.get("faults", []):
-        rec["faults"] = names
+    diagnosed = list(image_faults) or list(line_named)
+    rec["faults"] = diagnosed if names == diagnosed else names  # the diagnosis's own records where it is them
     rec["verdict"], rec["reasons"] = verdict.verdict, list(verdict.reasons)
     if oracle_bound_px is not None:
         rec["oracle_bound_px"] = float(oracle_bound_px)
