@@ -21,35 +21,16 @@ from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 from wirecheck.oracles.judge import line_model
-from wirecheck.oracles.judge.decide import decide
-from wirecheck.oracles.judge.evidence import CaseEvidence
 from wirecheck.oracles.judge.frames_judge import run_frames
-from wirecheck.oracles.judge.line_style import style_record
-from wirecheck.oracles.judge.name_faults import name_faults
 from wirecheck.oracles.tolerances import Tolerances
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "clients"))
 import heldout_draw as hd  # noqa: E402
-from test_line_style import draw_antialiased  # noqa: E402
+from test_line_style import draw_antialiased, free_ends_scene, style_judged  # noqa: E402
 
 # oblique views: the lines slant, so every frame shows both offset components; 6 frames each, so that a
 # pixel dropped at each line's end (hidden at the vertices where another line covers it) is seen often enough
 ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6"]
-
-
-def _judged(style, tol=None):
-    """A CaseStyle's frames judged alone: pixels that agree (F1 1.0), only the style's own limits deciding;
-    ``(verdict, fault names, line_style record)`` (oracles.judge.decide, name_faults, line_style.style_record)."""
-    tol = Tolerances() if tol is None else tol
-    ev = CaseEvidence(
-        level="frames",
-        compared={"frames": 1, "vertices": 0, "pixels": 1},
-        frames_checked=1,
-        pixels={"pixel_f1_0px": 1.0, "pixel_f1_1px": 1.0, "worst_pixel_frame": 1},
-        style=style.read((), tol),
-    )
-    verdict = decide(ev, tol)
-    return verdict, [f.name for f in name_faults(ev, verdict, tol)], style_record(ev.style, verdict.style, 1)
 
 
 @pytest.fixture(scope="module")
@@ -238,37 +219,16 @@ def test_scale_px_decides(job_dir, tmp_path):
 def test_end_px_decides():
     # three separate antialiased lines, each end 1 px short (test_line_style's set-up): the median free end
     # measured -0.54..-0.73; end_px just above its size passes, just below fails
-    from wirecheck.core.camera import Camera
     from wirecheck.oracles.judge.line_style import CaseStyle
 
-    cam = Camera(
-        position=[0.0, 0.0, 10.0],
-        forward=[0.0, 0.0, -1.0],
-        up=[0.0, 1.0, 0.0],
-        width=220,
-        height=140,
-        projection="orthographic",
-        ortho_height=140.0,
-    )
-    p = np.array(
-        [
-            [-90.0, 50.0, 0.0],
-            [10.0, 13.0, 0.0],
-            [-80.0, -30.0, 0.0],
-            [-70.0, 20.0, 0.0],
-            [40.0, 40.0, 0.0],
-            [80.3, -40.7, 0.0],
-        ]
-    )
-    edges = np.array([[0, 1], [2, 3], [4, 5]])
-    segs = oracle_segments(p, edges, cam)
+    cam, p, edges, segs = free_ends_scene()
     u = (segs[:, 1] - segs[:, 0]) / np.hypot(*(segs[:, 1] - segs[:, 0]).T)[:, None]
     image = draw_antialiased(np.stack([segs[:, 0] + u, segs[:, 1] - u], axis=1), 220, 140)
 
     def judged(end_px):
         style = CaseStyle()
         style.frame(image, np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
-        return _judged(style, Tolerances(end_px=end_px))
+        return style_judged(style, Tolerances(end_px=end_px))
 
     end = judged(5.0)[2]["geometry"]["end_px"]
     assert -0.8 < end < -0.5

@@ -32,7 +32,7 @@ from wirecheck.oracles.tolerances import Tolerances
 ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6", "--every", "3"]
 
 
-def _judged(style, tol=None):
+def style_judged(style, tol=None):
     """A CaseStyle's frames judged alone: pixels that agree (F1 1.0), only the style's own limits deciding;
     ``(verdict, fault names, line_style record)`` (oracles.judge.decide, name_faults, line_style.style_record)."""
     tol = Tolerances() if tol is None else tol
@@ -45,6 +45,34 @@ def _judged(style, tol=None):
     )
     verdict = decide(ev, tol)
     return verdict, [f.name for f in name_faults(ev, verdict, tol)], style_record(ev.style, verdict.style, 1)
+
+
+def free_ends_scene():
+    """Three separate lines (six free ends) seen by an orthographic camera at 1 px per unit, 220 x 140:
+    ``(camera, p_world, edges, oracle segments)``."""
+    from wirecheck.core.camera import Camera
+
+    cam = Camera(
+        position=[0.0, 0.0, 10.0],
+        forward=[0.0, 0.0, -1.0],
+        up=[0.0, 1.0, 0.0],
+        width=220,
+        height=140,
+        projection="orthographic",
+        ortho_height=140.0,
+    )
+    p = np.array(
+        [
+            [-90.0, 50.0, 0.0],
+            [10.0, 13.0, 0.0],
+            [-80.0, -30.0, 0.0],
+            [-70.0, 20.0, 0.0],
+            [40.0, 40.0, 0.0],
+            [80.3, -40.7, 0.0],
+        ]
+    )
+    edges = np.array([[0, 1], [2, 3], [4, 5]])
+    return cam, p, edges, oracle_segments(p, edges, cam)
 
 
 def _band(segs, w, h, half, ss):
@@ -257,35 +285,14 @@ def test_a_dropped_or_extra_end_is_named(short_px, named):
     # antialiased (round caps of radius 0.5: the cap's chord is half the width 0.43 px past the end;
     # measured 0.27-0.46 with the end's sub-pixel phase), with 1 px dropped from (or added to) each
     # end: measured -0.73..-0.54 / 1.25..1.51, beyond -END_TOL_PX (-0.5) / width / 2 + END_TOL_PX (1.0)
-    from wirecheck.core.camera import Camera
     from wirecheck.oracles.judge.line_style import CaseStyle
 
-    cam = Camera(
-        position=[0.0, 0.0, 10.0],
-        forward=[0.0, 0.0, -1.0],
-        up=[0.0, 1.0, 0.0],
-        width=220,
-        height=140,
-        projection="orthographic",
-        ortho_height=140.0,
-    )
-    p = np.array(
-        [
-            [-90.0, 50.0, 0.0],
-            [10.0, 13.0, 0.0],
-            [-80.0, -30.0, 0.0],
-            [-70.0, 20.0, 0.0],
-            [40.0, 40.0, 0.0],
-            [80.3, -40.7, 0.0],
-        ]
-    )
-    edges = np.array([[0, 1], [2, 3], [4, 5]])
-    segs = oracle_segments(p, edges, cam)
+    cam, p, edges, segs = free_ends_scene()
     u = (segs[:, 1] - segs[:, 0]) / np.hypot(*(segs[:, 1] - segs[:, 0]).T)[:, None]
     drawn = np.stack([segs[:, 0] + short_px * u, segs[:, 1] - short_px * u], axis=1)
     style = CaseStyle()
     style.frame(draw_antialiased(drawn, 220, 140), np.zeros((140, 220), bool), p, edges, cam, np.eye(4))
-    verdict, names, line_style = _judged(style)
+    verdict, names, line_style = style_judged(style)
     geo = line_style["geometry"]
     assert line_style["style"] == "antialiased" and geo["ends_measured"] == 6
     assert geo["end_px"] == pytest.approx(0.37 - short_px, abs=0.15)
@@ -319,7 +326,7 @@ def test_a_case_keeps_a_bounded_number_of_samples(monkeypatch):
         # the halved samples hold their own memory: a view (x[::2]) would keep every frame's whole arrays
         # alive, and the case's memory would grow with its frames whatever the samples kept
         assert all(v.base is None for v in style.samples.arrays() + style.reference.arrays())
-    _, names, line_style = _judged(style)
+    _, names, line_style = style_judged(style)
     geo = line_style["geometry"]
     assert geo["found_share"] == 1.0 and max(map(abs, geo["offset_px"])) < 0.05 and names == []
 
