@@ -51,7 +51,7 @@ from ..faults import Fault
 from ..references import opencv_oracle
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances
 from . import f1_radius, gate, line_model, metrics
-from .decide import decide, pixel_fields
+from .decide import decide, filled_reasons, pixel_fields
 from .depth_frames import DepthFrames
 from .depth_reference import from_render
 from .evidence import CaseEvidence, Visibility
@@ -212,6 +212,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         images, segments, flipped = acc.visibility_inputs()
         if diagnose:
             diagnosed = tuple(Fault.of(f) for f in diagnose_images(images, segments, camera, flipped, tol=tol))
+    filled_fields = filled.fields(MIN_IOU_UNION_PX) if filled else None
     ev = case_evidence(
         acc,
         style if wire else None,
@@ -219,9 +220,11 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
         diagnosed,
         tol,
         depth_map=depth.fields() if depth else None,
-        filled=filled.fields(MIN_IOU_UNION_PX) if filled else None,
+        filled=filled_fields,
         depth_faults=tuple(Fault.of(f) for f in depth.faults()) if depth else (),
-        filled_faults=filled.faults() if filled else (),
+        # the silhouettes' fit (~0.5 s a frame) only where the filled frames miss a limit: name_faults uses
+        # their names there alone
+        filled_faults=filled.faults() if filled and filled_reasons(filled_fields, tol) else (),
     )
     verdict = decide(ev, tol)
     names = name_faults(ev, verdict, tol)
