@@ -25,7 +25,10 @@ image, the segments and the chunk, never by the segments' drawn length
 nearest segment is looked for within 1/2 px first (1/8 where the segments
 crowd the pixels), and within ``radius`` only for the pixels with none that
 near (:meth:`_Segments.nearest`): a drawn pixel is within 1/2 of the line
-that drew it, and most of its pairs within 1 are farther. The frames of a case are done in one pass: they are stacked
+that drew it, and most of its pairs within 1 are farther. Pairs are compared by their squared distances,
+and their distances (``hypot``, the floats every decision is taken on) are measured only where the two
+could decide differently (:data:`D2_SLACK`): a pair on the radius, a pixel with two candidates as near.
+The frames of a case are done in one pass: they are stacked
 one above the other, and a segment looks only at its own frame's rows, so no
 pair mixes two frames and each frame's rows are the ones it would get alone;
 distances are measured in the frame's own coordinates, so they are the same
@@ -90,6 +93,14 @@ FEW_SEGMENTS = 4096
 #: coordinates of ~10^4 px; a whole pixel of margin keeps every segment that can pair (the pairs are
 #: measured after).
 REACH_MARGIN_PX = 1.0
+#: A pair's squared distance ``d2`` (``ex^2 + ey^2``, three roundings) is within ~4e-16 (relative) of the
+#: square of its distance (``hypot``, under 1 ulp), so a pair whose ``d2`` is more than this (relative) from
+#: ``radius^2``, or from a nearer pair's ``d2``, is on the same side of the radius, or farther, by its
+#: distance too: :meth:`_Segments._near` and :meth:`_Segments.owners` measure ``hypot`` only for the pairs
+#: within it (a radius test on the boundary, a pixel with two candidates as near).
+D2_SLACK = 2.0**-30
+#: ... and an absolute slack for squared distances that underflow (offsets under 1e-154 px).
+D2_TINY = 1e-280
 #: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
 #: (fewer: one search costs less than the calls of several).
 LEVEL_PIXELS = 1024
@@ -710,7 +721,9 @@ class _Segments:
         lo, hi = np.minimum(xa, xb), np.maximum(xa, xb, out=xb)
         lo -= grow
         hi += grow
-        col_lo = np.maximum(np.ceil(lo, out=lo), 0).astype(np.int64)
+        # in [0, w]: a part beyond the right edge (a box grown by more than this radius) lists no column, and
+        # its slice's end ``col_lo`` stays within the stacked frames (:meth:`_Pixels.rank`'s table)
+        col_lo = np.clip(np.ceil(lo, out=lo), 0, w).astype(np.int64)
         col_hi = np.minimum(np.floor(hi, out=hi), w - 1).astype(np.int64)
         return seg, b, col_lo, col_hi
 
@@ -720,12 +733,13 @@ class _Segments:
             self._y = (np.minimum(self.q0[:, 1], self.q1[:, 1]), np.maximum(self.q0[:, 1], self.q1[:, 1]))
         return self._y
 
-    def _near(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
-        """The pairs ``(sid, pos)`` within ``radius``, with their distances."""
+    def _offsets(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
+        """``(ex, ey, spare)``: each pair's pixel centre minus the point of its segment nearest it, and a spare
+        float array of the same length (the pairs' scratch, reused by the caller)."""
         qx, qy, dx, dy, dd = (np.take(c, sid) for c in self._cols)
         # the point of the segment nearest the pixel centre: a + u d, u in [0, 1], in the frame's coordinates
         # (in place, each float as ``clip(where(dd > 0, (ex dx + ey dy) / dd, 0), 0, 1)`` and
-        # ``hypot(ex - u dx, ey - u dy)`` give it)
+        # ``(ex - u dx, ey - u dy)`` give it)
         x, y = px.xy()
         ex, ey = np.take(x, pos), np.take(y, pos)
         ex -= qx
@@ -739,29 +753,71 @@ class _Segments:
         np.clip(u, 0.0, 1.0, out=u)
         ex -= np.multiply(u, dx, out=dx)
         ey -= np.multiply(u, dy, out=dy)
-        dist = np.hypot(ex, ey, out=ex)
-        near = dist <= self.radius
-        return sid[near], pos[near], dist[near]
+        return ex, ey, dd
+
+    def _dist(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray) -> np.ndarray:
+        """The pairs' distances, ``hypot`` of :meth:`_offsets` (the floats every decision is taken on)."""
+        ex, ey, _ = self._offsets(px, sid, pos)
+        return np.hypot(ex, ey, out=ex)
+
+    def _near(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
+        """The pairs ``(sid, pos)`` within ``radius``, with their squared distances ``d2`` (:data:`D2_SLACK`).
+
+        A pair is within ``radius`` when its distance (:meth:`_dist`) is; ``hypot``
+        is computed only for the pairs whose ``d2`` is within :data:`D2_SLACK` of
+        ``radius^2``, where the two could disagree.
+        """
+        ex, ey, d2 = self._offsets(px, sid, pos)
+        np.multiply(ex, ex, out=d2)
+        d2 += np.multiply(ey, ey, out=ey)
+        r2 = self.radius * self.radius
+        keep = d2 <= r2 * (1 + D2_SLACK)
+        border = np.flatnonzero(keep & (d2 >= r2 * (1 - D2_SLACK)))
+        if len(border):
+            keep[border[self._dist(px, sid[border], pos[border]) > self.radius]] = False
+        k = np.flatnonzero(keep)
+        return np.take(sid, k), np.take(pos, k), np.take(d2, k)
 
     def owners(self, px: _Pixels, chunks):
         """``(sid, pos)``, one per pixel that has a pair in ``chunks`` (:meth:`pairs` or :meth:`pairs_any`,
         over all segments), ascending by pixel.
 
-        Each pixel goes to its nearest segment only (ties: the lower index),
-        so that one pixel more or less changes one edge's count by at most one.
-        The chunks are folded into two arrays of one entry per pixel (the
-        nearest distance so far, and its lowest segment): a chunk that brings
-        a pixel nearer replaces its segment, one as near keeps the lower index.
+        Each pixel goes to its nearest segment only (the least distance,
+        :meth:`_dist`; ties: the lower index), so that one pixel more or less
+        changes one edge's count by at most one. The chunks' squared distances
+        are folded into one entry per pixel (the least so far); a pair stays
+        a candidate only while within :data:`D2_SLACK` of it (the nearest
+        segment always is). A pixel left with one candidate has it as its
+        nearest; only the pixels with several have their candidates'
+        distances measured, and the least of those (then the lowest index)
+        wins.
         """
-        nearest = np.full(len(px), np.inf)
+        least = np.full(len(px), np.inf)
+        parts = []
+        for sid, pos, d2 in chunks:
+            np.minimum.at(least, pos, d2)
+            k = np.flatnonzero(d2 <= np.take(least, pos) * (1 + D2_SLACK) + D2_TINY)
+            parts.append((np.take(sid, k), np.take(pos, k), np.take(d2, k)))
+        if not parts:
+            return _EMPTY, _EMPTY
+        if len(parts) == 1:
+            sid, pos = parts[0][:2]
+        else:  # candidates of earlier chunks a later one brought nearer go
+            sid, pos, d2 = (np.concatenate(c) for c in zip(*parts))
+            k = np.flatnonzero(d2 <= np.take(least, pos) * (1 + D2_SLACK) + D2_TINY)
+            sid, pos = np.take(sid, k), np.take(pos, k)
         owner = np.full(len(px), _NONE, np.int64)
-        for sid, pos, dist in chunks:
-            before = nearest[pos]
+        count = np.bincount(pos, minlength=len(px))
+        one = np.flatnonzero(np.take(count, pos) == 1)
+        owner[np.take(pos, one)] = np.take(sid, one)
+        if len(one) < len(pos):  # several candidates: the least distance, then the lowest index
+            many = np.flatnonzero(np.take(count, pos) > 1)
+            sid, pos = np.take(sid, many), np.take(pos, many)
+            dist = self._dist(px, sid, pos)
+            nearest = np.full(len(px), np.inf)
             np.minimum.at(nearest, pos, dist)
-            after = nearest[pos]
-            best = dist == after  # the pairs at their pixel's nearest distance
-            owner[pos[best & (after < before)]] = _NONE  # nearer than every earlier chunk: theirs go
-            np.minimum.at(owner, pos[best], sid[best])
+            best = np.flatnonzero(dist == np.take(nearest, pos))
+            np.minimum.at(owner, np.take(pos, best), np.take(sid, best))
         pos = np.flatnonzero(owner != _NONE)
         return owner[pos], pos
 
