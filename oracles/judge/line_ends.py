@@ -69,15 +69,19 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
         return out
     h, w = frames[0][0].shape
     box = ((-0.5, -0.5), (w - 0.5, h - 0.5))  # where a line leaving the picture ends
-    for side in (0, 1):
-        only = [fp.only()[side] for fp, _, _ in frames]
-        if not sum(len(o) for o in only):
-            continue
-        # each pixel's nearest segment within reach (the segments near it only, not all of them)
-        owner, q0, q1, frame = nearest_segments(
-            [(p0, p1, o) for (_, p0, p1), o in zip(frames, only)], w, h, END_REACH_PX, box
+    n = len(frames)
+    only = [[fp.only()[side] for fp, _, _ in frames] for side in (0, 1)]
+    sides = [side for side in (0, 1) if sum(len(o) for o in only[side])]
+    if sides:  # each pixel's nearest segment within reach (the segments near it only), both sides at once
+        owners, q0, q1, frames_of = nearest_segments(
+            [(p0, p1, o) for side in sides for (_, p0, p1), o in zip(frames, only[side])], w, h, END_REACH_PX, box
         )
-        pix = np.concatenate(only)
+    start = 0
+    for i, side in enumerate(sides):
+        stop = start + sum(len(o) for o in only[side])
+        owner, frame = owners[start:stop], frames_of[start:stop] - i * n  # this side's pixels, in its frames
+        start = stop
+        pix = np.concatenate(only[side])
         near = owner >= 0
         m, f = owner[near], frame[near]
         c = np.column_stack([pix[near] % w, pix[near] // w]).astype(np.float64)
@@ -93,7 +97,6 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
                 found[k][side] = np.sort(tied[tied_frame == k]).astype(np.int64)
         to_start = np.hypot(*(c - q0[m]).T) <= END_REACH_PX
         to_end = np.hypot(*(c - q1[m]).T) <= END_REACH_PX
-        n = len(frames)
         place = {
             "tie": tie,
             "start": ~tie & to_start & ~to_end,
