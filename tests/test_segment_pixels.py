@@ -96,3 +96,21 @@ def test_a_segment_beyond_the_right_edge_in_the_last_row_lists_no_column():
     for a, b in zip(with_it, without):
         np.testing.assert_array_equal(a, b)
     assert len(with_it[1]) == w * h  # each pixel on its column's line
+
+
+def test_a_segment_beyond_the_left_edge_in_the_first_row_pairs_only_its_own_frame(monkeypatch):
+    """Two frames stacked: the first frame's steep segment starts left of its top-left corner, its part near row 0
+    left of x = -1.5, so that row's slice ends at column floor(-1.795 + 1/2) = -2, clipped to -1 (before: the rank
+    table's index -1, its last entry, listed every pixel of both frames for it, and the second frame's pixels
+    near the same place in their own frame, where it has no segment, were given to it). Each frame's rows must
+    be the definition's."""
+    monkeypatch.setattr(segment_pixels, "LEVEL_PIXELS", 0)  # within 1/2 first, as for many pixels
+    w, h = 40, 30
+    line = np.array([[-1.9, -0.6]]), np.array([[1.0, 30.0]])  # x = -1.795 at y = 1/2; in the image from y = 19.5
+    # vertical lines down columns 30..39 of both frames: many slices, so the rank table is used
+    grid = np.array([[30.0 + k, 0.0] for k in range(10)]), np.array([[30.0 + k, h - 1.0] for k in range(10)])
+    first = (np.vstack([line[0], grid[0]]), np.vstack([line[1], grid[1]]), np.arange(w * h))
+    second = (grid[0], grid[1], np.arange(w * h))
+    got = frames_neighbourhoods([first, second], w, h)
+    for (p0, p1, pixels), (edge, pixel, _major) in zip([first, second], got):
+        assert list(zip(edge.tolist(), pixel.tolist())) == _owners_naive(p0, p1, w, h, pixels)[0]

@@ -30,7 +30,8 @@ GIB = 2**30
 
 #: What any case holds (bytes): the interpreter with numpy, OpenCV, trimesh and pyrender (~0.22 GiB),
 #: an OpenGL context and its buffers, the frames' images and one chunk of the line metrics' pairs
-#: (2^19 pairs x ~250 B: 0.12 GiB), with room for the allocator.
+#: (2^15 pairs x ~250 B: 8 MiB; the base was set when a chunk was 2^19 pairs, 0.12 GiB), with room for
+#: the allocator.
 BASE_BYTES = int(0.5 * GIB)
 #: Bytes per vertex: trimesh's and the scene's float64 copies, the frame's world and pixel points
 #: on both sides (OpenCV's and the candidate's), each a few (N, 3) or (N, 2) float64 arrays.

@@ -114,7 +114,8 @@ class FramePixels:
         """Flat indices of the pixels drawn by either image, ascending."""
         if self.identical:
             return self.cand_idx
-        return np.sort(np.concatenate([self.cand_idx, self.oracle_idx[~self.oracle_in_cand]]))
+        extra = self.oracle_idx[~self.oracle_in_cand]  # few, and none of them the candidate's: merged, not sorted
+        return np.insert(self.cand_idx, np.searchsorted(self.cand_idx, extra), extra)
 
     def has(self, flat: np.ndarray, of_candidate: bool = True) -> np.ndarray:
         """``(K,)`` bool: whether the candidate's (else the oracle's) image draws each flat index."""

@@ -53,8 +53,11 @@ _NONE = np.iinfo(np.int64).max  # no owner yet (:meth:`_Segments.owners`)
 #: Pairs of a segment and a pixel (or rows a run of segments spans) measured at once: the pairing
 #: streams its pairs in chunks of about this many, so that its memory is bounded by the image and
 #: this, whatever the drawn length of the segments (a soup of long edges pairs each pixel with
-#: hundreds: 10^8 pairs a frame). 2^19 pairs: ~60 MB of temporaries in _near, ~5 ms of work.
-CHUNK_PAIRS = 1 << 19
+#: hundreds: 10^8 pairs a frame). 2^15 pairs: ~4 MB of temporaries in _near, each array 256 KiB, near the
+#: L2 cache's size: the pairing of every drawn pixel of a 20k-60k face mesh took 16-18 ms of CPU in chunks
+#: of 2^15, 19-28 ms in chunks of 2^19 (its arrays of 1.5-1.8 MB each: cache misses, and pages the
+#: allocator returns to the system and faults in again); a soup's 505 against 590.
+CHUNK_PAIRS = 1 << 15
 #: :meth:`_Segments.pairs_any` tests each pixel against every segment's box when there are at most
 #: this many (pixel, segment) tests (a frame's few one-sided pixels: ~10 ms), rather than list every
 #: segment in a grid of cells first (~100 ms for 30,000 segments).
@@ -352,15 +355,17 @@ def _reaching(frames, width: int, height: int, reach: float, cell: int = 8) -> l
             key = tuple((a.__array_interface__["data"][0], a.shape, a.strides) for a in (p0, p1))
             if key not in cells:
                 cells[key] = _box_cells(p0, p1, reach, cell, nx, ny)
-            finite, c0, c1, r0, r1 = cells[key]
-            hit = ((table[r1, c1] - table[r0, c1] - table[r1, c0] + table[r0, c0]) > 0) & finite
+            finite, corners = cells[key]
+            t = table.reshape(-1)  # the box's four corners in the table, each a flat index
+            hit = ((t[corners[3]] - t[corners[1]] - t[corners[2]] + t[corners[0]]) > 0) & finite
         out.append(hit)
     return out
 
 
 def _box_cells(p0: np.ndarray, p1: np.ndarray, reach: float, cell: int, nx: int, ny: int):
-    """``(finite, c0, c1, r0, r1)``: the rows whose ends are finite, and the cells ``[c0, c1) x [r0, r1)`` of
-    ``cell`` px each segment's box grown by ``reach`` spans (:func:`_reaching`)."""
+    """``(finite, corners)``: the rows whose ends are finite, and the cells ``[c0, c1) x [r0, r1)`` of ``cell`` px
+    each segment's box grown by ``reach`` spans, as the flat indices of ``(r0, c0), (r0, c1), (r1, c0), (r1, c1)``
+    in a ``(ny + 1, nx + 1)`` summed-area table (:func:`_reaching`)."""
     with np.errstate(invalid="ignore", over="ignore"):
         total = p0 + p1  # clip_to_box keeps only the rows where this is finite
         finite = np.isfinite(total[:, 0]) & np.isfinite(total[:, 1])
@@ -377,7 +382,9 @@ def _box_cells(p0: np.ndarray, p1: np.ndarray, reach: float, cell: int, nx: int,
             stop = np.maximum(np.clip(np.floor(hi) + 1, 0, n).astype(np.int64), first)
             ends += [first, stop]
     c0, c1, r0, r1 = ends
-    return finite, c0, c1, r0, r1
+    r0 *= nx + 1
+    r1 *= nx + 1
+    return finite, (r0 + c0, r0 + c1, r1 + c0, r1 + c1)
 
 
 class _Pixels:
@@ -420,15 +427,17 @@ class _Pixels:
             self._xy = (x.astype(np.float64), y.astype(np.float64))
         return self._xy
 
-    def rank(self, stacked: np.ndarray) -> np.ndarray:
+    def rank(self, stacked: np.ndarray, expected: int | None = None) -> np.ndarray:
         """``np.searchsorted(self.stacked, stacked)`` for stacked flat indices in ``[0, frames H W]``.
 
         Many queries (a long segment's rows) look up a table of one entry per
         pixel of the stacked frames (their count so far, int32: bounded by the
-        images), built once; a few are binary searches.
+        images), built once; a few are binary searches. ``expected``: how many
+        queries the caller will make in all (in several calls), when known.
         """
         size = self.frames * self.width * self.height
-        if self._rank is None and size and len(stacked) > size // 4 and size < 2**31:
+        many = len(stacked) if expected is None else expected
+        if self._rank is None and size and many > size // 4 and size < 2**31:
             table = np.zeros(size + 1, np.int32)
             table[self.stacked + 1] = 1
             self._rank = np.cumsum(table, dtype=np.int32)
@@ -573,12 +582,14 @@ class _Segments:
         if len(which) == 0 or len(px) == 0:
             return
         w, h = self.width, self.height
-        for lo, hi in _cuts(self._rows_of(which), CHUNK_PAIRS):
+        rows = self._rows_of(which)
+        queries = 2 * int(rows.sum())  # every run's slices, both ends: one rank table for all of them
+        for lo, hi in _cuts(rows, CHUNK_PAIRS):
             seg, row, col_lo, col_hi = self._spans(which[lo:hi], 1)
             # the pixels of one row between two columns are one slice of ``stacked``
             start = (row + self.frame[seg] * h) * w
-            a = px.rank(start + col_lo)
-            n = np.maximum(px.rank(start + col_hi + 1) - a, 0)
+            a = px.rank(start + col_lo, queries)
+            n = np.maximum(px.rank(start + col_hi + 1, queries) - a, 0)
             for s0, s1 in _cuts(n, CHUNK_PAIRS):
                 nn = n[s0:s1]
                 sid = np.repeat(seg[s0:s1], nn)
@@ -733,10 +744,11 @@ class _Segments:
         lo, hi = np.minimum(xa, xb), np.maximum(xa, xb, out=xb)
         lo -= grow
         hi += grow
-        # in [0, w]: a part beyond the right edge (a box grown by more than this radius) lists no column, and
-        # its slice's end ``col_lo`` stays within the stacked frames (:meth:`_Pixels.rank`'s table)
+        # col_lo in [0, w], col_hi in [-1, w - 1]: a part beyond the right or the left edge (a box grown by more
+        # than this radius) lists no column, and its slice's ends stay within the stacked frames (the rank
+        # table's index -1 is its last entry: a slice of the first frame's first row would list every pixel)
         col_lo = np.clip(np.ceil(lo, out=lo), 0, w).astype(np.int64)
-        col_hi = np.minimum(np.floor(hi, out=hi), w - 1).astype(np.int64)
+        col_hi = np.clip(np.floor(hi, out=hi), -1, w - 1).astype(np.int64)
         return seg, b, col_lo, col_hi
 
     def _y_range(self) -> tuple[np.ndarray, np.ndarray]:
@@ -805,19 +817,20 @@ class _Segments:
         wins.
         """
         least = np.full(len(px), np.inf)
-        parts = []
+        parts: list = []
+        held, limit = 0, len(px) + CHUNK_PAIRS
         for sid, pos, d2 in chunks:
             np.minimum.at(least, pos, d2)
             k = np.flatnonzero(d2 <= np.take(least, pos) * (1 + D2_SLACK) + D2_TINY)
             parts.append((np.take(sid, k), np.take(pos, k), np.take(d2, k)))
+            held += len(k)
+            if held > limit:  # bounded by the pixels (and their ties): the candidates a later chunk beat go
+                parts = [self._still_near(parts, least)]
+                held = len(parts[0][0])
+                limit = max(limit, 2 * held)
         if not parts:
             return _EMPTY, _EMPTY
-        if len(parts) == 1:
-            sid, pos = parts[0][:2]
-        else:  # candidates of earlier chunks a later one brought nearer go
-            sid, pos, d2 = (np.concatenate(c) for c in zip(*parts))
-            k = np.flatnonzero(d2 <= np.take(least, pos) * (1 + D2_SLACK) + D2_TINY)
-            sid, pos = np.take(sid, k), np.take(pos, k)
+        sid, pos = (parts[0] if len(parts) == 1 else self._still_near(parts, least))[:2]
         owner = np.full(len(px), _NONE, np.int64)
         count = np.bincount(pos, minlength=len(px))
         one = np.flatnonzero(np.take(count, pos) == 1)
@@ -832,6 +845,13 @@ class _Segments:
             np.minimum.at(owner, np.take(pos, best), np.take(sid, best))
         pos = np.flatnonzero(owner != _NONE)
         return owner[pos], pos
+
+    @staticmethod
+    def _still_near(parts: list, least: np.ndarray) -> tuple:
+        """``(sid, pos, d2)`` of the candidates in ``parts`` still within :data:`D2_SLACK` of their pixel's ``least``."""
+        sid, pos, d2 = (np.concatenate(c) for c in zip(*parts))
+        k = np.flatnonzero(d2 <= np.take(least, pos) * (1 + D2_SLACK) + D2_TINY)
+        return np.take(sid, k), np.take(pos, k), np.take(d2, k)
 
     def rows(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
         """``(edge, pixel, major)`` of owner pairs (module docstring), pixels flat in their frames."""
