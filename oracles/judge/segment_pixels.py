@@ -568,8 +568,9 @@ class _Segments:
         return np.flatnonzero(inside > 0)
 
     def pairs(self, px: _Pixels, which: np.ndarray | None = None):
-        """``(sid, pos, dist)`` chunks: each pair of a segment (of ``which``, ascending, default all) and a
-        pixel within ``radius``, at most about :data:`CHUNK_PAIRS` pairs a chunk, by ascending segment.
+        """``(sid, pos, d2)`` chunks (``d2``: squared distances, :meth:`_near`): each pair of a segment (of
+        ``which``, ascending, default all) and a pixel within ``radius``, at most about :data:`CHUNK_PAIRS`
+        pairs a chunk, by ascending segment.
 
         Row by row (:meth:`_spans` of 1-row bands): the pixels of a row
         between two columns are one slice of ``stacked``; each is measured.
@@ -599,7 +600,7 @@ class _Segments:
     def near(self, px: _Pixels, which: np.ndarray) -> np.ndarray:
         """Ascending positions of the pixels within ``radius`` of some segment of ``which`` (ascending)."""
         hit = np.zeros(len(px), bool)
-        for _sid, pos, _dist in self.pairs(px, which):
+        for _sid, pos, _d2 in self.pairs(px, which):
             hit[pos] = True
         return np.flatnonzero(hit)
 
