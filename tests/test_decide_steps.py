@@ -548,6 +548,7 @@ def test_the_table_lists_every_step_once_in_order():
         "diagnosis",
         "line_centres",
         "line_rule",
+        "job_read",
         "dim_lines",
         "surfaces",
         "unexplained",

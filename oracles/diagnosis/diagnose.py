@@ -154,7 +154,7 @@ from ..tolerances import line_failures
 from .clip_planes import clip_fault
 from .lens_diagnose import distortion_fault
 
-__all__ = ["diagnose", "diagnose_lines", "primary", "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
+__all__ = ["diagnose", "diagnose_lines", "line_pixel_fields", "primary", "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
 
 #: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
 #: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union
@@ -577,6 +577,16 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
                 **decided,
             }
         ]
-    return [
-        {"name": "line_pixel_bias", **decided, **{f"net_{p}": int(net[p]) for p in ("start", "end", "middle", "stray")}}
-    ]
+    return [{"name": "line_pixel_bias", **line_pixel_fields(lines)}]
+
+
+def line_pixel_fields(lines: dict) -> dict:
+    """``line_pixel_bias``'s fields from a case's pooled line fields (:func:`diagnose_lines`): the decided
+    one-sided pixels (ties left out) and the net pixels, candidate minus oracle, by where they lie."""
+    tc, to = lines["subpixel_ties"]
+    places = lines["one_sided_by_place"]
+    return {
+        "candidate_only": int(lines["candidate_only"] - tc),
+        "oracle_only": int(lines["oracle_only"] - to),
+        **{f"net_{p}": int(places[p][0] - places[p][1]) for p in ("start", "end", "middle", "stray")},
+    }

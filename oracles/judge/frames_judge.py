@@ -57,6 +57,7 @@ from .depth_reference import from_render
 from .evidence import CaseEvidence, Visibility
 from .filled_frames import FilledFrames
 from .frame_prefetch import FramePrefetch, reader_for
+from .job_read import differs, read_job
 from .line_style import CaseStyle, style_record
 from .name_faults import name_faults, wants_visibility
 
@@ -146,7 +147,9 @@ class _CaseFrames:
             frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "any"):
+def judge_case(
+    job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "any", job_read=None
+):
     """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
 
     ``oracles``: the run's oracles.judge.frame_prefetch.FramePrefetch (frames
@@ -157,7 +160,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
 
     Each frame's wireframe, depth map and filled frame, as the job asks for them (module
-    docstring); the worst images are None for a job without wireframes.
+    docstring); the worst images are None for a job without wireframes. ``job_read``: the read of the
+    renderer pooled over the job's cases, imposed on this one (oracles.judge.job_read.JobRead), or None.
     """
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     numbers = job["frame_numbers"]
@@ -167,7 +171,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     filled = FilledFrames(tol.fill_tie_px) if "filled" in outputs else None  # each filled PNG (filled_frames)
     kept = diagnosis_frames(len(numbers)) if diagnose and wire else set()
     acc = _CaseFrames()
-    style = CaseStyle(line_rule)
+    style = CaseStyle(line_rule, job_read.as_dict() if job_read is not None else None)
     camera = None
     # each frame's inputs, pyrender's drawing and its PNG's grey levels, read ahead on the GL thread
     # (frame_prefetch: each step's error raised here, at its frame and step)
@@ -427,6 +431,24 @@ def run_frames(
             records.append(rec)
             if worst is not None:  # a job without wireframes: no line images to show
                 images[(c["scene"], c["case"])] = worst
+        # one renderer, one reading: the cases that read it otherwise than the job are judged again under the
+        # job's read (oracles.judge.job_read)
+        pooled = read_job(records)
+        for i, c in enumerate(job["cases"]):
+            if differs(records[i], pooled):
+                records[i], worst = judge_case(
+                    job_dir,
+                    job,
+                    c["scene"],
+                    c["case"],
+                    reader,
+                    tol,
+                    diagnose=diagnose,
+                    line_rule=line_rule,
+                    job_read=pooled,
+                )
+                if worst is not None:
+                    images[(c["scene"], c["case"])] = worst
         gl = reader.call(reader.oracles.gl_info)
     finally:
         reader.close()

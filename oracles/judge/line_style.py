@@ -287,10 +287,11 @@ class CaseStyle:
     Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
-    def __init__(self, line_rule: str = "any"):
+    def __init__(self, line_rule: str = "any", job: dict | None = None):
         if line_rule not in LINE_RULES:
             raise ValueError(f"line rule {line_rule!r}: expected one of {', '.join(LINE_RULES)}")
         self.line_rule = line_rule
+        self.job = job  # the job's read imposed on the case (oracles.judge.job_read.JobRead.as_dict), or None
         self.hist = np.zeros(256, np.int64)
         self.length_px = 0.0
         self.samples = CaseSamples()  # measure() of each frame
@@ -498,6 +499,9 @@ class CaseStyle:
         """
         tol = tolerances.Tolerances() if tol is None else tol
         read = self.classify()
+        job_style = (self.job or {}).get("style")
+        if job_style is not None and job_style != read["style"]:  # one renderer, one style (job_read)
+            read = {**read, "style": job_style, "style_alone": read["style"]}
         geo = self.geometry(read, tol)
         placed = (
             geo["offset_px"] is not None
@@ -508,7 +512,7 @@ class CaseStyle:
         rounded_faults = (
             tuple(Fault.of(f) for f in diagnose_lines(rounded["lines"], tol)) if by_rule and rounded is not None else ()
         )
-        return StyleRead(self.line_rule, read, geo, dict(self.raster), rounded, rounded_faults, placed)
+        return StyleRead(self.line_rule, read, geo, dict(self.raster), rounded, rounded_faults, placed, self.job)
 
 
 def style_record(s: StyleRead, j, radius_px: int) -> dict:
@@ -542,6 +546,8 @@ def style_record(s: StyleRead, j, radius_px: int) -> dict:
                 },
             }
     out.update(pixel_rule=j.pixel_rule, failures=list(j.failures), f1_radius_px=radius_px)
+    if s.job is not None:
+        out["job_read"] = dict(s.job)
     return out
 
 
