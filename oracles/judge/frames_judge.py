@@ -59,6 +59,7 @@ from .filled_frames import FilledFrames
 from .frame_prefetch import FramePrefetch, reader_for
 from .line_style import CaseStyle, style_record
 from .name_faults import name_faults, wants_visibility
+from .record import finish_record
 from .run_report import run_report, tolerances_field
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
@@ -344,7 +345,8 @@ def case_record(
     job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple, acc: _CaseFrames
 ) -> dict:
     """A case's record (its entry in report.json's ``cases``), built once from its evidence, verdict and names;
-    beside them core's second opinion (never deciding) and the per-frame numbers (``acc``)."""
+    beside them core's second opinion (never deciding) and the per-frame numbers (``acc``). Its faults, verdict,
+    reasons and per-frame numbers are written as every source's are (oracles.judge.record.finish_record)."""
     rec = {
         "scene": scene,
         "camera": case,
@@ -364,7 +366,7 @@ def case_record(
                 "lines": dict(ev.lines),
             }
         )
-    rec["faults"] = [f.as_dict() for f in names]
+    rec["faults"] = []  # its place in the record; the names are written by finish_record
     if ev.pixels is not None:
         rec.update(
             {
@@ -377,15 +379,8 @@ def case_record(
     for key in ("depth_map", "filled"):
         if getattr(ev, key) is not None:
             rec[key] = _plain(getattr(ev, key))
-    rec.update(
-        {
-            "compared": dict(ev.compared),
-            "verdict": verdict.verdict,
-            "reasons": list(verdict.reasons),
-            "per_frame": acc.per_frame,
-        }
-    )
-    return rec
+    rec["compared"] = dict(ev.compared)
+    return finish_record(rec, ev, verdict, names, acc.per_frame)
 
 
 def _plain(value):
