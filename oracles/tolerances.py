@@ -606,9 +606,11 @@ class Tolerances:
 
 @dataclass(frozen=True)
 class NamingThresholds:
-    """The frames path's thresholds that decide a verdict or a name but are not a run's to set (no CLI option):
-    read by oracles.judge.decide and oracles.judge.name_faults, each with its reason. They were module
-    constants of line_style, free_ends, f1_radius, dim_lines and image_visibility; their values are unchanged.
+    """The thresholds that decide a verdict or a name but are not a run's to set (no CLI option), each with
+    its reason: read by oracles.judge.decide and oracles.judge.name_faults (the frames path), by the image
+    diagnosis (oracles.diagnosis.image_diagnose, image_naming, image_visibility, rule_read) and by the vertex
+    diagnosis (oracles.diagnosis.diagnose). They were module constants of line_style, free_ends, f1_radius,
+    dim_lines, image_visibility, image_diagnose, rule_read and diagnose; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
@@ -647,9 +649,72 @@ class NamingThresholds:
     #: difference: at least this share of its decided one-sided pixels (per frame) lie farther than 1 px from
     #: the other side (a line drawn too thick or too thin never leaves a pixel that far).
     visibility_share: float = 0.5
+    #: A pixel is on one side only (image_visibility's set difference: ``candidate_only_px``,
+    #: ``oracle_only_px``) when the other side has no pixel within this distance (px): F1@1px's tolerance,
+    #: so the sets counted are the pixels F1@1px counts against the candidate.
+    near_px: float = 1.0
+
+    # ---- the image diagnosis: a case's frames registered to the oracle's lines (oracles.diagnosis.image_diagnose)
+
+    #: A case needs this many drawn candidate pixels to be registered; fewer are named ``unexplained``
+    #: (``underdetermined``). The fit (a scale and an offset per axis, for each signed permutation) is
+    #: determined by a handful of points; 50 keeps a few stray pixels from being read as a picture.
+    min_registered_px: int = 50
+    #: The registration's cost (px: the mean of its two directions' mean distances) above which no member
+    #: of the family (mirrors, swaps, per-axis scale, offset) draws the pixels: ``unexplained`` (or the
+    #: visibility advice), and the scale restarts are tried. Measured (docs/frames.md, "Limits, measured"):
+    #: correct 1-px aliased lines 0.30-0.33 px (pixel centres lie within 0.5 px of a line across its minor
+    #: axis), anti-aliased 0.41-0.43, 2-px wide 0.44; a transposed rotation 1.2-4.8. 0.85 is ~2x the
+    #: largest correct cost and under the smallest of a rotation the family cannot draw.
+    residual_max_px: float = 0.85
+    #: A permutation other than the identity is named only when the identity's cost exceeds its cost by
+    #: more than this share, and two permutations within this share of each other are ``ambiguous``
+    #: (image_naming): a symmetric picture (a cube seen along an axis, an orthographic view of a centrally
+    #: symmetric scene) fits several with relative differences below 1e-2 (measured); 0.05 is 5x that.
+    ambiguous_ratio: float = 0.05
+    #: The free affine fit's off-diagonal terms (a rotation, a shear) are ``unexplained`` when they move
+    #: some pixel by more than this (px): <= 0.04 px on a correct renderer, 0.77-1.17 px for a 0.5 degree
+    #: roll (measured on tests/test_image_diagnosis.py's cameras); 0.3 is 7x the first and under half
+    #: the second.
+    rotation_px: float = 0.3
+    #: How far (px) a rule that rounds each end to a pixel centre may put a line's farthest end, along each
+    #: axis, from where its scale puts it: half a pixel, the rounding (oracles.diagnosis.rule_read). Under
+    #: that rule a scale is named only when it moves a pixel by more than ``Tolerances.scale_px`` plus
+    #: this. Measured: a correct LINE_8 on prism / on_axis fits an aspect of 0.53 px at 111 px reach (named
+    #: without it); the wrong-axis FOV drawn by Bresenham 0.6-0.73 px; a 3 % aspect mistake 3 px or more.
+    rounded_end_px: float = 0.5
+    #: Both aliased rules (GL's, ends rounded) are read when the farther rule's registration cost is within
+    #: this share of the closer one's (oracles.diagnosis.rule_read): correct rounded-ends renderers fit
+    #: GL's lines closer on 4-5 of 21 cases by up to 30 % of the cost (LINE_8, pyramid / non_square:
+    #: 0.374 against 0.485); 1/3 is above that largest misread.
+    rule_tie: float = 1.0 / 3.0
+
+    # ---- the vertex diagnosis (oracles.diagnosis.diagnose): the candidate's pixels against OpenCV's
+
+    #: ``depth_flip`` when the candidate's and the oracle's visible sets nearly miss each other: at most
+    #: this share of their union in common. A depth flip makes them disjoint exactly when near > 0 (no
+    #: point has both z >= near and -z >= near); 1 % allows a candidate that also differs at the near/far
+    #: boundary or an orthographic [near, far] reaching slightly behind the camera, while a real near/far
+    #: error changes only the few points close to a plane and keeps far more than 1 % in common.
+    depth_flip_max_overlap: float = 0.01
+    #: The common points must span 2D for a linear map to be fitted: the smaller singular value of the
+    #: centred points at least this share of the larger (else only a constant offset is read).
+    #: Collinear points give ~1e-16 (float noise); 1e-6 keeps the fit's condition number <= 1e6, so
+    #: float64 noise moves the fitted map by < 1e-10 relative, far below any fault.
+    degenerate_ratio: float = 1e-6
+    #: Float32 roundings of size eps32 a float64 projector's constant may carry into the fitted map
+    #: (a scale or offset within them is ``precision_limited``, not a fault): a float32 focal length,
+    #: aspect or GL matrix entry is off by <= 0.5 eps32 relative, and a scale composes two such constants
+    #: (fx from f and the aspect): 1 eps32; 2 leaves 2x.
+    constant_roundings: float = 2.0
+    #: A line end is named in ``line_end_bias`` when its net one-sided pixels are at least this many per
+    #: line (oracles.diagnosis.diagnose.diagnose_lines): a quarter pixel on average, far above what an
+    #: unbiased rasterizer leaves (one-sided pixels at ends of both signs cancel), far below the one pixel
+    #: a line that drops (adds) its end pixel leaves.
+    line_end_min_px: float = 0.25
 
 
-#: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults).
+#: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults, the diagnosis).
 NAMING = NamingThresholds()
 
 
