@@ -331,6 +331,14 @@ SUBPIXEL_BITS = 8
 #: half step 2^-(SUBPIXEL_BITS + 1) plus 2^-9 of float32 rounding (derivation above).
 TIE_END_PX = 2.0 ** -(SUBPIXEL_BITS + 1) + 2.0**-9
 
+#: The pyrender oracle's own error bound (oracles.references.oracle_precision: its float32 window
+#: coordinates' distance from exact, per drawn segment) up to which a case's pixels are judged: the
+#: float32 share (2^-9 px) of TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle. Past
+#: it the pixels say nothing of the candidate: the case is judged on its vertices alone (``oracle_precision``,
+#: ``vacuous`` unless they fail; oracles.judge.decide). Measured bound on the bundled scenes and the orrery,
+#: also 1e5 from the origin: 1.6e-4 to 1.2e-3 px (docs/tolerances.md).
+ORACLE_LIMIT_PX = 2.0**-9
+
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)
 
@@ -551,6 +559,7 @@ class Tolerances:
     max_object_id_px: int = MAX_OBJECT_ID_PX
     fill_tie_px: float = FILL_TIE_PX
     max_silhouette_run_px: int = MAX_SILHOUETTE_RUN_PX
+    oracle_limit_px: float = ORACLE_LIMIT_PX
 
     def __post_init__(self):
         if self.precision is not None and self.precision not in PRECISIONS:

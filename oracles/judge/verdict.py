@@ -17,7 +17,6 @@ import numpy as np
 from ..candidates.candidate import case_precision
 from ..diagnosis.diagnose import diagnose, diagnose_lines
 from ..faults import Fault
-from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 from . import metrics
 from .decide import decide, pixel_fields
@@ -236,6 +235,6 @@ def judge(
     rec["verdict"], rec["reasons"] = verdict.verdict, list(verdict.reasons)
     if oracle_bound_px is not None:
         rec["oracle_bound_px"] = float(oracle_bound_px)
-        rec["oracle_limit_px"] = ORACLE_LIMIT_PX
+        rec["oracle_limit_px"] = tol.oracle_limit_px
     if verdict.set_aside is not None:
         rec["oracle_precision"] = True
