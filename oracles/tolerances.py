@@ -618,8 +618,9 @@ class NamingThresholds:
     """The thresholds that decide a verdict or a name but are not a run's to set (no CLI option), each with
     its reason: read by oracles.judge.decide and oracles.judge.name_faults (the frames path), by the image
     diagnosis (oracles.diagnosis.image_diagnose, image_naming, image_visibility, rule_read) and by the vertex
-    diagnosis (oracles.diagnosis.diagnose). They were module constants of line_style, free_ends, f1_radius,
-    dim_lines, image_visibility, image_diagnose, rule_read and diagnose; their values are unchanged.
+    diagnosis (oracles.diagnosis.diagnose, clip_planes) and the unprojector's (unproject_faults). They were
+    module constants of line_style, free_ends, f1_radius, dim_lines, image_visibility, image_diagnose,
+    rule_read, diagnose, clip_planes and unproject_faults; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
@@ -721,6 +722,25 @@ class NamingThresholds:
     #: unbiased rasterizer leaves (one-sided pixels at ends of both signs cancel), far below the one pixel
     #: a line that drops (adds) its end pixel leaves.
     line_end_min_px: float = 0.25
+
+    # ---- the candidate's own clipping planes, probed (oracles.diagnosis.clip_planes; oracles.spec.checks)
+
+    #: A fitted plane within this relative distance of the camera's is the camera's (no
+    #: ``clipping_plane``): float64 rounding of a depth test is a few eps64 (1e-15), the probe's own
+    #: bracket ~1e-11 relative; 1e-9 sits between them and far below float32's rounding of a plane (6e-8).
+    plane_rel_tol: float = 1e-9
+    #: A plane off by at most this many eps32 (relative; the far plane also times far/near, the
+    #: conditioning of a GL matrix's depth row) is float32 rounding (``float32_near``/``float32_far``, and
+    #: the slack the drawn ends are given), not a wrong plane: one rounding of near is 0.5 eps32, a float32
+    #: GL matrix's A and B each add one (measured on PyGLM-style matrices: <= 1.1 eps32 near).
+    float32_plane_roundings: float = 4.0
+
+    # ---- an unprojector's points (oracles.diagnosis.unproject_faults)
+
+    #: A mistaken inverse explains the candidate when every point is within this many of its bounds: the
+    #: mistake's parameters are medians of reprojected points, each within its own bound, so they move the
+    #: model by up to about one bound; doubled for the two sides' roundings: 4.
+    unproject_fit_slack: float = 4.0
 
 
 #: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults, the diagnosis).

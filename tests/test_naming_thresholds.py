@@ -1,5 +1,5 @@
 """Each naming threshold of oracles.tolerances.NamingThresholds that was a module constant of the diagnosis
-(image_diagnose, image_visibility, rule_read, diagnose) decides a name: on a hand-made input the name
+(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults) decides a name: on a hand-made input the name
 flips when the threshold is moved across the value measured on that input, both sides asserted.
 
 The record is moved with dataclasses.replace and put where the diagnosis reads it (each module's ``NAMING``,
@@ -20,9 +20,12 @@ import pytest
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.raster import line_pixels
 from wirecheck.oracles.diagnosis import rule_read
+from wirecheck.oracles.diagnosis.clip_planes import clip_fault
 from wirecheck.oracles.diagnosis.diagnose import diagnose, diagnose_lines, rounded_constants, scale_faults
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
 from wirecheck.oracles.diagnosis.image_visibility import set_difference
+from wirecheck.oracles.diagnosis.unproject_faults import name_unproject_faults
+from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
 
 UP, DOWN = math.inf, -math.inf
@@ -253,3 +256,58 @@ def test_near_px(naming):
     assert set_difference([img], [segs], SMALL)[0] > 0
     naming(near_px=2.0)
     assert set_difference([img], [segs], SMALL) == (0, 0)
+
+
+# ---------------------------------------------------------------- the candidate's planes (clip_planes)
+
+PLANES_CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480, near=4.5, far=6.0)
+
+
+def _kind(near_fit):
+    planes = {"front": True, "behind": False, "near_fit": near_fit, "far_fit": PLANES_CAM.far}
+    fault = clip_fault(planes, PLANES_CAM)
+    return None if fault is None else fault["kind"]
+
+
+def test_plane_rel_tol(naming):
+    # a near plane fitted 3e-9 (relative) inside the camera's: past plane_rel_tol (1e-9) it is off, by float32
+    # rounding at most (4 eps32 = 4.8e-7); within a tolerance of 4e-9 it is the camera's
+    near_fit = PLANES_CAM.near * (1.0 + 3e-9)
+    assert _kind(near_fit) == "float32_near"
+    naming(plane_rel_tol=2e-9)
+    assert _kind(near_fit) == "float32_near"
+    naming(plane_rel_tol=4e-9)
+    assert _kind(near_fit) is None
+
+
+def test_float32_plane_roundings(naming):
+    # a near plane 2 eps32 (relative) off: within float32_plane_roundings (4) eps32 a float32 rounding, past a
+    # bound of 1.9 eps32 a wrong plane
+    near_fit = PLANES_CAM.near * (1.0 + 2.0 * EPS["float32"])
+    assert _kind(near_fit) == "float32_near"
+    naming(float32_plane_roundings=2.1)
+    assert _kind(near_fit) == "float32_near"
+    naming(float32_plane_roundings=1.9)
+    assert _kind(near_fit) == "near"
+
+
+# ---------------------------------------------------------------- an unprojector's points (unproject_faults)
+
+
+def test_unproject_fit_slack(naming):
+    # the points of an inverse with its rows flipped, each moved 3 bounds along x (world units): the rows
+    # flipped explain them within 3 bounds, within unproject_fit_slack (4); with the slack under 3, nothing does
+    cam = look_at((1.0, 2.0, 6.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), fov_y_deg=50, width=320, height=240)
+    u, v = np.meshgrid(np.linspace(20.0, 300.0, 6), np.linspace(15.0, 225.0, 5))
+    p_px = np.stack([u.ravel(), v.ravel()], axis=1)
+    depth = np.linspace(3.0, 8.0, len(p_px))
+    bound = np.full(len(p_px), 1e-3)
+    flipped = unproject(np.stack([p_px[:, 0], cam.height - 1 - p_px[:, 1]], axis=1), depth, cam)
+    cand = flipped + [3e-3, 0.0, 0.0]
+    faults, measured = name_unproject_faults(p_px, depth, cam, cand, bound)
+    assert [f.name for f in faults] == ["mirror_vertical"]
+    assert measured["fit_ratios"]["mirror_vertical"] == pytest.approx(3.0, rel=1e-6)
+    naming(unproject_fit_slack=3.01)
+    assert [f.name for f in name_unproject_faults(p_px, depth, cam, cand, bound)[0]] == ["mirror_vertical"]
+    naming(unproject_fit_slack=2.99)
+    assert [f.name for f in name_unproject_faults(p_px, depth, cam, cand, bound)[0]] == ["unexplained"]
