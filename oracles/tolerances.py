@@ -618,9 +618,10 @@ class NamingThresholds:
     """The thresholds that decide a verdict or a name but are not a run's to set (no CLI option), each with
     its reason: read by oracles.judge.decide and oracles.judge.name_faults (the frames path), by the image
     diagnosis (oracles.diagnosis.image_diagnose, image_naming, image_visibility, rule_read) and by the vertex
-    diagnosis (oracles.diagnosis.diagnose, clip_planes) and the unprojector's (unproject_faults). They were
-    module constants of line_style, free_ends, f1_radius, dim_lines, image_visibility, image_diagnose,
-    rule_read, diagnose, clip_planes and unproject_faults; their values are unchanged.
+    diagnosis (oracles.diagnosis.diagnose, clip_planes), the unprojector's (unproject_faults) and the
+    line measures (oracles.judge.even_lean, line_ends). They were module constants of line_style, free_ends,
+    f1_radius, dim_lines, image_visibility, image_diagnose, rule_read, diagnose, clip_planes,
+    unproject_faults, even_lean and line_ends; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
@@ -741,6 +742,30 @@ class NamingThresholds:
     #: mistake's parameters are medians of reprojected points, each within its own bound, so they move the
     #: model by up to about one bound; doubled for the two sides' roundings: 4.
     unproject_fit_slack: float = 4.0
+
+    # ---- binary lines of an even width (oracles.judge.even_lean): which band each edge is measured against
+
+    #: The leaning bands replace the symmetric one when they lower the mean square residual of the edges'
+    #: means by this (px^2): the square of a quarter pixel (what a leaning edge, 0.5 px on the minor axis
+    #: times |n_minor| >= 0.71, leaves under the symmetric band is at least 0.35 px), for a quarter of the
+    #: edges. Measured: Pillow 2 px 0.12-0.30 symmetric against 0.02-0.05 leaning; symmetric 2-px bands,
+    #: moved or not, 0.000-0.001 against 0.000-0.016.
+    lean_gain_px2: float = 0.25 * 0.25**2
+    #: Cases with at most this many edges' worth of samples (their effective number) cannot test the
+    #: symmetric band: its offset (two numbers) fits two edges exactly and leaves a third one number to
+    #: check, so the leaning fit (the smaller offset, by the lean's ambiguity) is used there.
+    max_untested_edges: float = 3.0
+    #: Least samples of an edge for its mean to count in the fit (fewer: the edge's mean is noise, and the
+    #: edge keeps the symmetric band).
+    min_edge_samples: int = 5
+
+    # ---- a case's one-sided line pixels (oracles.judge.line_ends)
+
+    #: A one-sided pixel within this distance (px) of a segment's start or end counts as at that end
+    #: (``line_end_bias`` reads the ends' counts), and one farther than it from every segment is ``stray``:
+    #: a pixel beside an end pixel (diagonal: sqrt(2) = 1.41 px) is still that end's; 1.5 keeps the next
+    #: pixel along the line (2 px) in the ``middle``.
+    end_reach_px: float = 1.5
 
 
 #: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults, the diagnosis).

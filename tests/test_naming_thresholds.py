@@ -1,5 +1,6 @@
 """Each naming threshold of oracles.tolerances.NamingThresholds that was a module constant of the diagnosis
-(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults) decides a name: on a hand-made input the name
+(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults) or of the line
+measures (even_lean, line_ends) decides a name or which limits hold: on a hand-made input the name
 flips when the threshold is moved across the value measured on that input, both sides asserted.
 
 The record is moved with dataclasses.replace and put where the diagnosis reads it (each module's ``NAMING``,
@@ -25,6 +26,8 @@ from wirecheck.oracles.diagnosis.diagnose import diagnose, diagnose_lines, round
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
 from wirecheck.oracles.diagnosis.image_visibility import set_difference
 from wirecheck.oracles.diagnosis.unproject_faults import name_unproject_faults
+from wirecheck.oracles.judge import even_lean
+from wirecheck.oracles.judge.line_ends import end_attribution
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
 
@@ -311,3 +314,82 @@ def test_unproject_fit_slack(naming):
     assert [f.name for f in name_unproject_faults(p_px, depth, cam, cand, bound)[0]] == ["mirror_vertical"]
     naming(unproject_fit_slack=2.99)
     assert [f.name for f in name_unproject_faults(p_px, depth, cam, cand, bound)[0]] == ["unexplained"]
+
+
+# ---------------------------------------------------------------- binary lines of an even width (even_lean)
+
+
+def _axis_bands(leans_h, leans_v, per_edge=10):
+    """Samples of horizontal (normal (0, 1)) and vertical (normal (1, 0)) 2-px bands at whole-pixel
+    coordinates, leaning ``leans_*[k]`` half pixels: a 2-px band about y = 10 covers rows 9-10 leaning
+    -1/2, 9-11 not leaning (centroid 10), 10-11 leaning +1/2, so its centroid offset is lean / 2 exactly
+    (even_lean's module docstring). ``(normal, offset, point, edge)``."""
+    normal, offset, point, edge = [], [], [], []
+    for k, (n, lean) in enumerate([((0.0, 1.0), s) for s in leans_h] + [((1.0, 0.0), s) for s in leans_v]):
+        along, at = np.linspace(30.0, 300.0, per_edge), np.full(per_edge, 10.0 + 7 * k)
+        normal.append(np.tile(n, (per_edge, 1)))
+        point.append(np.c_[along, at] if n[1] else np.c_[at, along])
+        offset.append(np.full(per_edge, 0.5 * lean))
+        edge.append(np.full(per_edge, k))
+    return tuple(np.concatenate(x) for x in (normal, offset, point, edge))
+
+
+def test_lean_gain_px2(naming):
+    # 40 edges, 2 horizontal and 2 vertical ones leaning +-1/2 px (cancelling per axis): the leans explain
+    # every edge (ms 0), the symmetric band leaves 1/2 px on 4 of 40 (ms_symmetric 1/4 x 4/40 = 0.025 px^2),
+    # over lean_gain_px2 (1/64) the lean is taken; with a gain of 0.026 asked for, it is not
+    samples = _axis_bands([1, -1] + [0] * 18, [1, -1] + [0] * 18)
+    got = even_lean.fit(*samples, 2)
+    assert got["ms"] == pytest.approx(0.0, abs=1e-12) and got["ms_symmetric"] == pytest.approx(0.025, abs=1e-12)
+    assert got["leaning"] and got["edges_eff"] == pytest.approx(40.0)
+    naming(lean_gain_px2=0.024)
+    assert even_lean.fit(*samples, 2)["leaning"]
+    naming(lean_gain_px2=0.026)
+    assert not even_lean.fit(*samples, 2)["leaning"]
+
+
+def test_max_untested_edges(naming):
+    # 3 symmetric edges of equal weight (ms = ms_symmetric = 0): at most max_untested_edges (3) edges' worth
+    # cannot test the symmetric band, so the lean is used; with the bound under 3 they test it
+    samples = _axis_bands([0, 0], [0])
+    got = even_lean.fit(*samples, 2)
+    assert got["edges_eff"] == pytest.approx(3.0) and got["ms"] == 0.0 == got["ms_symmetric"] and got["leaning"]
+    naming(max_untested_edges=3.0)
+    assert even_lean.fit(*samples, 2)["leaning"]
+    naming(max_untested_edges=2.99)
+    assert not even_lean.fit(*samples, 2)["leaning"]
+
+
+def test_min_edge_samples(naming):
+    # 4 edges of 10 samples each: every edge counts while min_edge_samples <= 10; at 11 none does (no fit)
+    samples = _axis_bands([0, 1], [0, -1], per_edge=10)
+    assert even_lean.fit(*samples, 2)["edges"] == 4
+    naming(min_edge_samples=10)
+    assert even_lean.fit(*samples, 2)["edges"] == 4
+    naming(min_edge_samples=11)
+    assert even_lean.fit(*samples, 2) is None
+
+
+# ---------------------------------------------------------------- where one-sided pixels lie (line_ends)
+
+
+def test_end_reach_px(naming):
+    # a line from (1, 2) to (8.3, 2) drawn on row 2, columns 1-8; the candidate drops column 7, 1.3 px from
+    # the line's end: within end_reach_px (1.5) an end pixel, past a reach of 1.29 px one in the middle
+    p0, p1 = np.array([[1.0, 2.0]]), np.array([[8.3, 2.0]])
+    oracle = np.zeros((5, 12), bool)
+    oracle[2, 1:9] = True
+    cand = oracle.copy()
+    cand[2, 7] = False
+    assert end_attribution(cand, oracle, p0, p1) == {
+        "start": [0, 0],
+        "end": [0, 1],
+        "middle": [0, 0],
+        "stray": [0, 0],
+        "tie": [0, 0],
+    }
+    naming(end_reach_px=1.31)
+    assert end_attribution(cand, oracle, p0, p1)["end"] == [0, 1]
+    naming(end_reach_px=1.29)
+    got = end_attribution(cand, oracle, p0, p1)
+    assert got["end"] == [0, 0] and got["middle"] == [0, 1]
