@@ -619,9 +619,9 @@ class NamingThresholds:
     its reason: read by oracles.judge.decide and oracles.judge.name_faults (the frames path), by the image
     diagnosis (oracles.diagnosis.image_diagnose, image_naming, image_visibility, rule_read) and by the vertex
     diagnosis (oracles.diagnosis.diagnose, clip_planes), the unprojector's (unproject_faults) and the
-    line measures (oracles.judge.even_lean, line_ends). They were module constants of line_style, free_ends,
-    f1_radius, dim_lines, image_visibility, image_diagnose, rule_read, diagnose, clip_planes,
-    unproject_faults, even_lean and line_ends; their values are unchanged.
+    line measures (oracles.judge.even_lean, line_ends, coverage_pixels). They were module constants of
+    line_style, free_ends, f1_radius, dim_lines, image_visibility, image_diagnose, rule_read, diagnose,
+    clip_planes, unproject_faults, even_lean, line_ends and coverage_pixels; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
@@ -766,6 +766,15 @@ class NamingThresholds:
     #: a pixel beside an end pixel (diagonal: sqrt(2) = 1.41 px) is still that end's; 1.5 keeps the next
     #: pixel along the line (2 px) in the ``middle``.
     end_reach_px: float = 1.5
+
+    # ---- antialiased frames (oracles.judge.coverage_pixels)
+
+    #: The thinnest antialiased line whose every row (column) keeps a drawn pixel (px): a pixel under the
+    #: drawn level is drawn too where it is a ridge across a line holding at least half this width's
+    #: coverage (a line <= 1 px wide splits its coverage across a row between at most two pixels, the larger
+    #: holding at least half of it). Thinner lines (coverage under a quarter where they fall between two
+    #: pixels) cannot be read; a 1-px line between two pixels (127 | 127) is read.
+    ridge_min_width_px: float = 0.5
 
 
 #: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults, the diagnosis).

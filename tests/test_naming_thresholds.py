@@ -1,6 +1,6 @@
 """Each naming threshold of oracles.tolerances.NamingThresholds that was a module constant of the diagnosis
 (image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults) or of the line
-measures (even_lean, line_ends) decides a name or which limits hold: on a hand-made input the name
+measures (even_lean, line_ends, coverage_pixels) decides a name or which limits hold: on a hand-made input the name
 flips when the threshold is moved across the value measured on that input, both sides asserted.
 
 The record is moved with dataclasses.replace and put where the diagnosis reads it (each module's ``NAMING``,
@@ -26,7 +26,7 @@ from wirecheck.oracles.diagnosis.diagnose import diagnose, diagnose_lines, round
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
 from wirecheck.oracles.diagnosis.image_visibility import set_difference
 from wirecheck.oracles.diagnosis.unproject_faults import name_unproject_faults
-from wirecheck.oracles.judge import even_lean
+from wirecheck.oracles.judge import coverage_pixels, even_lean
 from wirecheck.oracles.judge.line_ends import end_attribution
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
@@ -393,3 +393,18 @@ def test_end_reach_px(naming):
     naming(end_reach_px=1.29)
     got = end_attribution(cand, oracle, p0, p1)
     assert got["end"] == [0, 0] and got["middle"] == [0, 1]
+
+
+# ---------------------------------------------------------------- antialiased frames (coverage_pixels)
+
+
+def test_ridge_min_width_px(naming):
+    # a vertical line between columns 2 and 3 at grey 63 | 63 (a 0.49-px line, 63 / 255 = 0.247 of full
+    # coverage each): ridges from half of ridge_min_width_px's coverage up, int(255 x 0.5 / 2) = 63: drawn;
+    # from 0.502 px on (int(64.0) = 64) they are not
+    grey = np.tile(np.array([0, 0, 63, 63, 0, 0], np.uint8), (5, 1))
+    assert coverage_pixels.drawn(grey)[:, [2, 3]].all()
+    naming(ridge_min_width_px=0.5)
+    assert coverage_pixels.drawn(grey)[:, [2, 3]].all()
+    naming(ridge_min_width_px=0.502)
+    assert not coverage_pixels.drawn(grey).any()
