@@ -350,10 +350,12 @@ def test_the_vertex_bound_decides_on_the_projector_path():
 
 
 def test_past_the_oracles_precision_limit_the_pixels_are_set_aside():
-    # ORACLE_LIMIT_PX (oracles.references.oracle_precision): at the limit the pixels are judged; just past it
-    # they are set aside, the case judged on its vertices alone (vacuous here: they agree), the pixel-read
-    # line fault goes and the reasons the pixels gave stay on record
-    from wirecheck.oracles.references.oracle_precision import ORACLE_LIMIT_PX
+    # Tolerances.oracle_limit_px: at the limit the pixels are judged; just past it they are set aside, the
+    # case judged on its vertices alone (vacuous here: they agree), the pixel-read line fault goes and the
+    # reasons the pixels gave stay on record. The limit is 2^-9 px (docs/tolerances.md: the float32 share of
+    # the tie zone's TIE_END_PX)
+    ORACLE_LIMIT_PX = 2.0**-9
+    assert TOL.oracle_limit_px == ORACLE_LIMIT_PX
 
     def ev(bound):
         return CaseEvidence(
@@ -371,6 +373,9 @@ def test_past_the_oracles_precision_limit_the_pixels_are_set_aside():
     past = decide(ev(math.nextafter(ORACLE_LIMIT_PX, UP)), TOL)
     assert past.verdict == "vacuous" and past.reasons[0].startswith("oracle_precision: the pyrender oracle's")
     assert past.set_aside == at.reasons and _names(ev(math.nextafter(ORACLE_LIMIT_PX, UP))) == []
+    # the limit is the record's: moved just past the bound, the same case's pixels are judged again
+    moved = dataclasses.replace(TOL, oracle_limit_px=math.nextafter(ORACLE_LIMIT_PX, UP))
+    assert decide(ev(math.nextafter(ORACLE_LIMIT_PX, UP)), moved) == at
     # a vertex failure still fails the case, after the oracle_precision reason
     wrong = dataclasses.replace(
         ev(math.nextafter(ORACLE_LIMIT_PX, UP)),

@@ -27,8 +27,10 @@ def test_the_faults_go_in_their_slot_and_the_verdict_and_frames_after_the_measur
 
 def test_the_oracles_own_bound_is_written_where_it_was_measured_and_the_set_aside_pixels_said():
     ev = CaseEvidence(level="pixels", compared=COMPARED, frames_checked=2, oracle_bound_px=0.0078125)
-    rec = finish_record({"faults": []}, ev, Verdict("vacuous", ("oracle_precision: ...",), set_aside=()), (), [])
-    # 2**-9 px: the limit of oracles.references.oracle_precision, written out by hand
+    rec = finish_record(
+        {"faults": []}, ev, Verdict("vacuous", ("oracle_precision: ...",), set_aside=()), (), [], 2.0**-9
+    )
+    # 2**-9 px: the run's Tolerances.oracle_limit_px as handed in, written out by hand
     assert rec["oracle_bound_px"] == 0.0078125 and rec["oracle_limit_px"] == 0.001953125
     assert rec["oracle_precision"] is True and rec["faults"] == []
     plain = finish_record(

@@ -17,7 +17,7 @@ missed, one reason each:
   filled_frames): depth error over its bound, holes and extra surface, blank frames, the silhouette's
   longest run and IoU, object ids;
 - the gate (:mod:`oracles.judge.gate`): a case that misses no limit but compared nothing is ``"vacuous"``;
-- the oracle's own precision: past ``ORACLE_LIMIT_PX`` (oracles.references.oracle_precision) the pixels are
+- the oracle's own precision: past ``tol.oracle_limit_px`` (oracles.references.oracle_precision) the pixels are
   set aside and the case is judged on its vertices alone.
 
 The names are :func:`oracles.judge.name_faults.name_faults`'s, from the same evidence and this verdict.
@@ -35,7 +35,6 @@ import numpy as np
 
 from .. import faults as catalogue
 from ..faults import Fault
-from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import NAMING, Tolerances, line_failures
 from . import gate
 from .evidence import CaseEvidence, Radius, StyleRead
@@ -99,7 +98,7 @@ class Verdict:
     reasons: tuple[str, ...]
     style: StyleJudgement | None = None
     #: The reasons the case had with its pixels, set aside because the pyrender oracle's own error bound
-    #: exceeds ORACLE_LIMIT_PX (its pixels then say nothing of the candidate); None: the pixels were judged.
+    #: exceeds Tolerances.oracle_limit_px (its pixels then say nothing of the candidate); None: the pixels were judged.
     set_aside: tuple[str, ...] | None = None
 
 
@@ -407,7 +406,7 @@ def decide(ev: CaseEvidence, tol: Tolerances) -> Verdict:
     if ev.filled is not None:
         why += filled_reasons(ev.filled, tol)
     verdict, reasons = gate.case_verdict(dict(ev.compared), why, ev.level, ev.points)
-    if ev.oracle_bound_px is not None and ev.oracle_bound_px > ORACLE_LIMIT_PX and verdict != "vacuous":
+    if ev.oracle_bound_px is not None and ev.oracle_bound_px > tol.oracle_limit_px and verdict != "vacuous":
         return _vertices_only(ev, tol, tuple(reasons), style)
     return Verdict(verdict, tuple(reasons), style)
 
@@ -429,7 +428,7 @@ def _vertices_only(ev: CaseEvidence, tol: Tolerances, reasons: tuple, style) -> 
     alone = decide(vertices, tol)
     why = (
         f"oracle_precision: the pyrender oracle's own error bound {ev.oracle_bound_px:.3g} px exceeds "
-        f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged"
+        f"{tol.oracle_limit_px:.3g} px (float32 at this camera and mesh size); its pixels are not judged"
     )
     vertex_reasons = alone.reasons if alone.verdict == "fail" else ()
     return Verdict("fail" if vertex_reasons else "vacuous", (why,) + vertex_reasons, style, set_aside=reasons)

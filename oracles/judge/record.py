@@ -9,20 +9,21 @@ oracle's own precision where pyrender's bound was measured, and the per-frame nu
 
 from __future__ import annotations
 
-from ..references.oracle_precision import ORACLE_LIMIT_PX
 from .evidence import CaseEvidence
 
 
-def finish_record(rec: dict, ev: CaseEvidence, verdict, names: tuple, per_frame: list) -> dict:
+def finish_record(
+    rec: dict, ev: CaseEvidence, verdict, names: tuple, per_frame: list, oracle_limit_px: float | None = None
+) -> dict:
     """``rec`` given its ``faults`` (``names`` as report.json holds them: oracles.faults.Fault.as_dict), then
     ``verdict`` and ``reasons``; ``oracle_bound_px`` and ``oracle_limit_px`` where the evidence has the
-    pyrender oracle's own bound, ``oracle_precision`` where the verdict set the pixels aside past it; then
-    ``per_frame``. Returns ``rec``."""
+    pyrender oracle's own bound (``oracle_limit_px``: the run's Tolerances.oracle_limit_px), ``oracle_precision``
+    where the verdict set the pixels aside past it; then ``per_frame``. Returns ``rec``."""
     rec["faults"] = [f.as_dict() for f in names]
     rec["verdict"], rec["reasons"] = verdict.verdict, list(verdict.reasons)
     if ev.oracle_bound_px is not None:
         rec["oracle_bound_px"] = float(ev.oracle_bound_px)
-        rec["oracle_limit_px"] = ORACLE_LIMIT_PX
+        rec["oracle_limit_px"] = oracle_limit_px
     if verdict.set_aside is not None:
         rec["oracle_precision"] = True
     rec["per_frame"] = per_frame

@@ -224,4 +224,4 @@ def judge(rec: dict, ev: CaseEvidence, tol: Tolerances, per_frame: list) -> None
     (``oracle_precision``: True).
     """
     verdict = decide(ev, tol)
-    finish_record(rec, ev, verdict, name_faults(ev, verdict, tol), per_frame)
+    finish_record(rec, ev, verdict, name_faults(ev, verdict, tol), per_frame, tol.oracle_limit_px)
