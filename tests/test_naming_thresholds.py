@@ -408,3 +408,31 @@ def test_ridge_min_width_px(naming):
     assert coverage_pixels.drawn(grey)[:, [2, 3]].all()
     naming(ridge_min_width_px=0.502)
     assert not coverage_pixels.drawn(grey).any()
+
+
+# ---------------------------------------------------------------- the line style's read (line_style, f1_radius)
+
+
+def test_max_radius_px_caps_the_f1_radius_read_when_called(naming):
+    # a 7-px wide line: 1 + ceil((7 - 1) / 2) = 4 px, capped at max_radius_px (3): 3; moved to 4 it is 4, and the
+    # radii each frame's F1 is computed at follow (2..3, then 2..4)
+    from wirecheck.oracles.judge import f1_radius
+
+    read = {"style": "wide", "width_px": 7.0, "band_px": 7}
+    assert f1_radius.radius_px(read) == 3 and f1_radius.radii() == (2, 3)
+    naming(max_radius_px=4)
+    assert f1_radius.radius_px(read) == 4 and f1_radius.radii() == (2, 3, 4)
+
+
+def test_wide_min_px_decides_a_binary_lines_style_when_called(naming):
+    # a case's histogram by hand: 350 pixels at 255 over 200 px of line, no free-line width sample, so the width
+    # is the coverage over the length: 350 / 200 = 1.75 px, wide from wide_min_px (1.75) on; just above it the
+    # same pixels are "aliased" (no drawn-pixel ratio: no oracle pixel counted)
+    from wirecheck.oracles.judge.line_style import CaseStyle
+
+    style = CaseStyle()
+    style.hist[255] = 350
+    style.length_px = 200.0
+    assert NAMING.wide_min_px == 1.75 and style.classify()["style"] == "wide"
+    naming(wide_min_px=math.nextafter(1.75, UP))
+    assert style.classify()["style"] == "aliased"

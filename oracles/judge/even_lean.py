@@ -22,7 +22,7 @@ the ``[e + 1/2 - h, e + 1/2 + h]`` band is pixel for pixel Pillow's on axis-
 aligned lines: a line up to 1.0 px off its exact position (0.5 rounding, 0.5
 lean) and still correct. Pillow's width 2 draws lines within 30 degrees of an
 axis about 1.2 pixels across: their median width reads 1.0-1.7, so binary
-lines are also read wide where they draw :data:`WIDE_PIXEL_RATIO` times the
+lines are also read wide where they draw :attr:`oracles.tolerances.NamingThresholds.wide_pixel_ratio` times the
 oracle's pixels (:meth:`oracles.judge.line_style.CaseStyle.classify`).
 
 So each edge's centre is known only up to that choice. Its measured centres
@@ -78,12 +78,6 @@ EDGE_NOISE_PX2 = 1.0 / 24.0
 #: The 99th percentile of chi-square with 2 degrees of freedom (-2 ln 0.01): what fitting an offset
 #: ``(dx, dy)`` gains on edges of pure noise, in units of that noise over the edges, 1 time in 100.
 CHI2_2_P99 = -2.0 * np.log(0.01)
-#: Binary lines drawing this many pixels per pixel of the oracle's 1-px lines are wide whatever the
-#: median across them: a 1-px line of any aliased rule draws one pixel per step of its major axis, as
-#: GL's does (the ratio 1, give or take its ends). Pillow's width 2 draws its lines within 30 degrees
-#: of an axis about 1.2 pixels across (half a pixel off, leaning), the others 2-3: a median of 1.0-1.7
-#: on slanted views and 1.85-2.1 times the oracle's pixels (measured on the bundled job): NAMING.wide_pixel_ratio.
-WIDE_PIXEL_RATIO = NAMING.wide_pixel_ratio
 #: What a case record keeps of the fit (line_style.geometry: ``geometry["lean"]``).
 REPORTED = (
     "leaning",
