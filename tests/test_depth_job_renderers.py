@@ -10,10 +10,11 @@ exits 0 with every case's numbers in report.json within the job's limits; one ty
 with its name alone: moderngl's window depth stored as read is ``depth_encoding`` (with the camera's near and
 far), VTK's distance from the eye to each unprojected point is ``depth_is_range``. A 16-bit PNG at scale 1000
 from moderngl passes, on the orrery (three moving objects, one grey level each, an OBJ in world space per frame).
+And the round trip: moderngl's depth maps back-projected by a correct unprojector land on the job's mesh.
 
 Frames 1 and 5 of 7 at phase 0.3 (no quarter-turn pose), the cube and the prism through the oblique_roll and
-orthographic cameras: 8 frames a run. Measured here (2 shared cores): each test 3.3-5.6 s, the module 23 s,
-at light load; 10-16 s and 65 s at load ~2. Skipped where the renderer's headless context or OSMesa is missing (failed under
+orthographic cameras: 8 frames a run. Measured here (2 shared cores): each run (export, render, judge)
+2.7-5.3 s, the module 22 s, at light load; 10-16 s a run and 65 s at load ~2. Skipped where the renderer's headless context or OSMesa is missing (failed under
 WIRECHECK_REQUIRE_EGL=1, as the other real-renderer tests).
 """
 
@@ -27,8 +28,15 @@ from pathlib import Path
 import helpers  # tests/ is on sys.path (rootdir conftest)
 import numpy as np
 import pytest
+import trimesh
+from clients.job_files import job_surfaces
 from PIL import Image
-from wirecheck.oracles.tolerances import Tolerances
+from wirecheck.core.camera import Camera
+from wirecheck.oracles.judge.metrics import depth_bound
+from wirecheck.oracles.tolerances import Tolerances, unproject_bound
+
+sys.path.insert(0, str(Path(__file__).parent / "data"))
+import unprojectors  # noqa: E402
 
 pytestmark = pytest.mark.slow  # three processes a test: export, the renderer, the judge
 
@@ -109,13 +117,61 @@ def assert_within_limits(case: dict, encoding: str) -> None:
     assert f["holes_px"] == f["extra_px"] == 0 and f["blank_frames"] == [], f
 
 
-def test_moderngl_correct_job_passes(ready, tmp_path):
-    code, report, out = rendered_and_judged(ready, tmp_path, "moderngl_depth.py", [*JOB, "--outputs", "filled,depth"])
+@pytest.fixture(scope="module")
+def moderngl_job(ready, tmp_path_factory):
+    """The job drawn correctly by moderngl and judged: ``(exit status, report.json, stdout, job folder)``."""
+    tmp_path = tmp_path_factory.mktemp("moderngl")
+    return (
+        *rendered_and_judged(ready, tmp_path, "moderngl_depth.py", [*JOB, "--outputs", "filled,depth"]),
+        tmp_path / "job",
+    )
+
+
+def test_moderngl_correct_job_passes(moderngl_job):
+    code, report, out, _job = moderngl_job
     assert code == 0, out
     assert report["verdict"] == "pass" and report["outputs"] == ["filled", "depth"]
     for case in report["cases"]:
         assert_within_limits(case, "npy float32")
     # measured: the worst map is 0.45 of its bound (cube, oblique_roll: a 24-bit buffer read as float32)
+
+
+def mesh_distance_ratios(job: Path, unproject) -> list:
+    """Each depth map of ``job``, every 20th surface pixel back-projected by ``unproject``: ``(scene, case,
+    points, the largest distance to the job's mesh over its bound)`` per frame. A depth error e along forward
+    moves the point by rho e along its ray (rho = |(x_n, y_n, 1)|), so its distance to the surface is at most
+    rho e; a 24-bit buffer's map is held to that buffer's bound (metrics.depth_bound, of the map's own depths
+    and slopes), and the unprojection adds its own (tolerances.unproject_bound)."""
+    out = []
+    for c, cam_json, p_world, triangles, _objects, files in job_surfaces(job):
+        cam = Camera(**cam_json["camera"])
+        depth = np.load(files["depth"]).astype(np.float64)
+        covered = depth > 0
+        rows, cols = (a[::20] for a in np.nonzero(covered))
+        p_px = np.column_stack([cols, rows]).astype(float)
+        d = depth[rows, cols]
+        x = unproject(p_px, d, cam)
+        dist = np.full(len(x), np.inf)
+        for tri in p_world[triangles]:  # the nearest point of each triangle (trimesh), the nearest of them
+            closest = trimesh.triangles.closest_point(np.repeat(tri[None], len(x), axis=0), x)
+            dist = np.minimum(dist, np.linalg.norm(closest - x, axis=1))
+        k = cam.K
+        rho = np.hypot(np.hypot((p_px[:, 0] - k[0, 2]) / k[0, 0], (p_px[:, 1] - k[1, 2]) / k[1, 1]), 1.0)
+        rho = rho if cam.projection == "perspective" else 1.0
+        bound = rho * depth_bound(depth, covered, cam)[rows, cols] + unproject_bound(p_px, d, cam)
+        out.append((c["scene"], c["case"], len(x), float((dist / bound).max())))
+    return out
+
+
+def test_moderngl_depth_back_onto_the_mesh(moderngl_job):
+    """The round trip: moderngl's depth maps of the job, back-projected by a correct unprojector
+    (tests/data/unprojectors.py), land on the job's mesh (:func:`mesh_distance_ratios`)."""
+    correct = mesh_distance_ratios(moderngl_job[-1], unprojectors.correct)
+    assert len(correct) == 8 and all(n > 200 for *_, n, _r in correct), correct
+    assert all(r <= 1.0 for *_, r in correct), correct  # measured: 0.26 at most (prism, oblique_roll)
+    # the round trip tells: a half-pixel unprojector (cx = W / 2) misses the mesh in every frame (measured: by
+    # 41 to 223 bounds)
+    assert all(r > 1.0 for *_, r in mesh_distance_ratios(moderngl_job[-1], unprojectors.half_pixel))
 
 
 def test_moderngl_zbuffer_stored_is_depth_encoding_alone(ready, tmp_path):
