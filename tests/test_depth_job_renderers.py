@@ -14,8 +14,9 @@ And the round trip: moderngl's depth maps back-projected by a correct unprojecto
 
 Frames 1 and 5 of 7 at phase 0.3 (no quarter-turn pose), the cube and the prism through the oblique_roll and
 orthographic cameras: 8 frames a run. Measured here (2 shared cores): each run (export, render, judge)
-2.7-5.3 s, the module 22 s, at light load; 10-16 s a run and 65 s at load ~2. Skipped where the renderer's headless context or OSMesa is missing (failed under
-WIRECHECK_REQUIRE_EGL=1, as the other real-renderer tests).
+2.7-5.3 s, the module 22 s, at light load; 10-16 s a run and 65 s at load ~2. Skipped where the renderer's
+headless context or OSMesa is missing (failed under WIRECHECK_REQUIRE_EGL=1, as the other real-renderer
+tests).
 """
 
 from __future__ import annotations
