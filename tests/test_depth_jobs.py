@@ -313,6 +313,42 @@ def test_the_readme_says_what_to_write(tmp_path):
     assert "depth along the camera's forward" in text and "row 0 at the top" in text
     assert "0, NaN or +inf where no face is seen" in text
     assert json.loads((job / "job.json").read_text())["depth_encoding"] == {"format": "png16", "scale": 5000.0}
+    # a GL renderer's depth buffer made linear from gl_projection's standard depth range (the formula a
+    # moderngl client follows and passes with: tests/test_depth_job_renderers.py), the rows flipped
+    assert "`d = 2 f n / ((f + n) - (2 z - 1) (f - n))` (orthographic: `d = n + z (f - n)`)" in text
+    assert "GL's row 0 is the bottom row" in text
+    assert "the fan of triangles from its first vertex" in text
+    assert "world per frame" not in text  # the cube: one OBJ in model space
+
+
+@pytest.mark.parametrize("outputs", [[], ["--outputs", "filled,depth"]])
+def test_the_readme_says_where_a_world_space_scene_is(tmp_path, outputs):
+    """The orrery (several moving objects) has no scenes/orrery.obj: its OBJ per frame is in world space."""
+    job = tmp_path / "job"
+    assert (
+        main(
+            [
+                "export",
+                str(job),
+                "--scene",
+                "orrery",
+                "--scene",
+                "cube",
+                "--cases",
+                "on_axis",
+                "--frames",
+                "2",
+                *outputs,
+            ]
+        )
+        == 0
+    )
+    text = " ".join((job / "README.md").read_text().split())
+    assert "`orrery` (its `space` in job.json: `world per frame`, several moving objects)" in text
+    assert "`scenes/<scene>/frame_NNNN.obj`, its `v` already in world space" in text
+    assert "`model_matrix` is the identity" in text and "`cube`" not in text  # the cube's OBJ is in model space
+    assert (job / "scenes/orrery/frame_0002.obj").is_file() and not (job / "scenes/orrery.obj").exists()
+    assert ("A GL depth buffer read back is not depth" in text) == bool(outputs)  # only where depth is asked
 
 
 @pytest.mark.parametrize(
