@@ -594,3 +594,44 @@ def test_depth_maps_name_their_faults_only_where_their_limits_are_missed():
     assert verdict.verdict == "fail" and [f.name for f in name_faults(ev, verdict, TOL)] == ["depth_scale"]
     ok = dataclasses.replace(ev, depth_map=depth_map(0.5))
     assert decide(ok, TOL).verdict == "pass" and name_faults(ok, decide(ok, TOL), TOL) == ()
+
+
+def test_a_mistake_read_from_the_depth_maps_and_the_silhouettes_is_named_once():
+    # rows not flipped: the depth maps' values and the filled frames' silhouettes both name mirror_vertical
+    # (held-out: moderngl and Open3D jobs read "mirror_vertical; mirror_vertical"); one name, the depth maps'
+    # (read first), beside a name only the silhouettes give
+    depth = {
+        "max_error_ratio": 40.0,
+        "max_error": 4.0,
+        "worst_pixel": [3, 4],
+        "worst_frame": 1,
+        "reference_px": 500,
+        "compared_px": 480,
+        "blank_frames": [],
+        "holes_px": 0,
+        "extra_px": 0,
+        "holes_worst_frame": None,
+        "extra_worst_frame": None,
+    }
+    filled = {
+        "blank_frames": [],
+        "longest_run_px": 90,
+        "run_at": [10, 12],
+        "run_frame": 1,
+        "holes_px": 400,
+        "extra_px": 400,
+        "min_iou": 0.2,
+        "iou_worst_frame": 1,
+    }
+    from_depth = Fault("mirror_vertical", {"source_of": "depth"})
+    ev = CaseEvidence(
+        level="frames",
+        compared={"frames": 1, "vertices": 0, "pixels": 500},
+        frames_checked=1,
+        depth_map=depth,
+        filled=filled,
+        depth_faults=(from_depth,),
+        filled_faults=(Fault("mirror_vertical", {"source_of": "silhouettes"}), Fault("pixel_offset", {"dx": 0.5})),
+    )
+    named = name_faults(ev, decide(ev, TOL), TOL)
+    assert [f.name for f in named] == ["mirror_vertical", "pixel_offset"] and named[0] is from_depth

@@ -74,8 +74,8 @@ PRECEDENCE = (
         "surfaces",
         (),
         "a renderer's depth maps and filled frames whose limits are missed add the faults their values "
-        "(oracles.diagnosis.depth_faults) and silhouettes (oracles.diagnosis.silhouette_faults) name; the "
-        "lines' names stand beside them, each read from its own frames",
+        "(oracles.diagnosis.depth_faults) and silhouettes (oracles.diagnosis.silhouette_faults) name, "
+        "each name once (the depth maps' reading first); the lines' names stand beside them",
     ),
     Precedence(
         "unexplained",
@@ -267,10 +267,13 @@ def _dim_lines(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
 
 def _surfaces(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
     out = list(faults)
+    # one name per fault: a camera mistake that moves pixels (rows flipped, half a pixel) is read from the
+    # depth maps and from the silhouettes alike; the first reading stands (the depth maps' values, then the
+    # silhouettes'), the other says nothing more
     if ev.depth_map is not None and depth_map_reasons(ev.depth_map, tol):
-        out += [f for f in ev.depth_faults if f not in out]
+        out += [f for f in ev.depth_faults if f.name not in {g.name for g in out}]
     if ev.filled is not None and filled_reasons(ev.filled, tol):
-        out += [f for f in ev.filled_faults if f not in out]
+        out += [f for f in ev.filled_faults if f.name not in {g.name for g in out}]
     return out
 
 
