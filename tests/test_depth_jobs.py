@@ -138,6 +138,20 @@ def test_an_all_nan_map_fails(depth_job, tmp_path):
     assert code == 1 and {c["verdict"] for c in report["cases"]} == {"fail"}
 
 
+def test_a_map_whose_surface_never_meets_the_references_fails(depth_job, tmp_path):
+    """Zero overlap through a job: each map shows a surface (1.0) exactly where the reference shows none and
+    nothing where it shows one: no pixel compared on both sides, never a pass (not blank either: the map
+    draws)."""
+    job = fill(copy(depth_job, tmp_path), lambda z, cam: np.where(z > 0, 0.0, 1.0))
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
+    assert code == 1
+    for case in report["cases"]:
+        d = case["depth_map"]
+        assert case["verdict"] == "fail" and d["compared_px"] == 0 and d["reference_px"] > 0
+        assert d["blank_frames"] == []  # each map draws a surface: the failure is the overlap, not a blank
+        assert any("compare nothing" in r for r in case["reasons"])
+
+
 def test_a_hole_inside_the_surface_fails(depth_job, tmp_path):
     """A 3x3 patch of no surface in the middle of a face: 9 holes a frame (the patch and its neighbours are
     covered by the reference: away from any boundary), nothing else."""
