@@ -178,6 +178,28 @@ def test_a_case_named_by_the_other_rule_name_gets_the_jobs():
     assert [f.name for f in name_faults(back, decide(back, TOL), TOL)] == ["raster_rule"]
 
 
+def test_the_summary_says_which_cases_were_judged_under_the_jobs_read():
+    # report.md / stdout: one line, once, naming how many cases were judged again and the job's read, by hand
+    from wirecheck.oracles.judge.line_style import summary_lines
+
+    job = {
+        "cases": 21,
+        "style": "aliased",
+        "rule": "gl",
+        "rule_name": None,
+        "offset_px": [0.5, 0.49],
+        "offset_cases": 19,
+    }
+    base = {"style": "aliased", "line_rule": "any", "width_px": 1.0, "judged_by": "x"}
+    cases = [{"line_style": {**base, "job_read": job}}] * 2 + [{"line_style": base}]
+    lines = [x for x in summary_lines(cases) if x.startswith("One renderer")]
+    assert lines == [
+        "One renderer, one reading: 2 cases read the renderer otherwise than the job's 21 cases together and were "
+        "judged again under the job's read (style aliased, rule gl, offset (0.50, 0.49) px)"
+    ]
+    assert not [x for x in summary_lines([{"line_style": base}]) if x.startswith("One renderer")]
+
+
 # ---------------------------------------------------------------- end to end: one renderer, one name
 
 

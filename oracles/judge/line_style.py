@@ -583,4 +583,16 @@ def summary_lines(cases: list) -> list[str]:
             f"Line rule read: {RULE_NAMES['rounded']} in {len(read)} case{'s' if len(read) != 1 else ''}, "
             "a correct drawing by that rule; --line-rule gl holds them to GL's"
         )
+    pooled = [c for c in cases if (c.get("line_style") or {}).get("job_read")]
+    if pooled:  # oracles.judge.job_read: the cases that read the renderer otherwise, judged again
+        job = pooled[0]["line_style"]["job_read"]
+        parts = [f"{k} {job[k]}" for k in ("style", "rule", "rule_name") if job.get(k)]
+        if job.get("offset_px") is not None:
+            parts.append(f"offset ({job['offset_px'][0]:.2f}, {job['offset_px'][1]:.2f}) px")
+        n = len(pooled)
+        out.append(
+            f"One renderer, one reading: {n} case{'s' if n != 1 else ''} read the renderer otherwise than the "
+            f"job's {job['cases']} cases together and {'were' if n != 1 else 'was'} judged again under the "
+            f"job's read ({', '.join(parts)})"
+        )
     return out
