@@ -18,7 +18,7 @@ from wirecheck.core.errors import InputError
 from wirecheck.core.outputs.output import check_report_dir, claim, release_claim
 
 from . import tolerances
-from .api import checked_flag, checked_report_dir, raise_unless_pass, short_repr
+from .api import checked_flag, checked_report_dir, raise_unless_pass, settings_for, short_repr
 from .candidates.caller_state import caller_state_kept
 from .frames_cli import check_report_outside_job
 from .judge import gate
@@ -35,6 +35,7 @@ def check_frames(
     min_f1_0px: float | None = None,
     allow_vacuous: bool = False,
     report_dir=None,
+    config=None,
 ) -> dict:
     """Judge the frames a renderer drew for a job against pyrender and core; return the report.
 
@@ -56,6 +57,10 @@ def check_frames(
         Write report.json, report.md and report.html there with their pictures, the bytes
         ``crosscheck --candidate-frames DIR --report-dir REPORT_DIR`` writes (timing aside).
         Default None: nothing is written.
+    config : str, Path or False, optional
+        The file whose ``[tool.wirecheck]`` fills ``min_f1`` and ``min_f1_0px`` where not given (its
+        ``min-f1``, ``min-f1-0px``; default: the nearest ``pyproject.toml`` at or above the working
+        directory, as :func:`~wirecheck.oracles.api.check_projector` and ``crosscheck`` read it); False: no file.
 
     Returns
     -------
@@ -89,10 +94,8 @@ def check_frames(
             "lines held to GL's rule or the rounded ends'; gl: to GL's pixel rule; geometry: where "
             "the lines are only)"
         )
-    tol = tolerances.Tolerances(
-        min_f1_1px=tolerances.MIN_F1_1PX if min_f1 is None else min_f1,
-        min_f1_0px=tolerances.MIN_F1_0PX if min_f1_0px is None else min_f1_0px,
-    )
+    settings = settings_for({"min_f1": min_f1, "min_f1_0px": min_f1_0px}, config)  # [tool.wirecheck] beneath
+    tol = tolerances.Tolerances(min_f1_1px=settings["min_f1"], min_f1_0px=settings["min_f1_0px"])
     gate.check_tolerances(tol)  # a NaN floor would pass everything
     run_dir = checked_report_dir(report_dir)
     if run_dir is not None:  # before anything is judged, as crosscheck checks it

@@ -69,6 +69,7 @@ from .cases import CASE_NAMES, Case, case_motion, cases_for
 from .executors import ExecutorSpec, gather_in_order, open_executor
 from .judge import gate, metrics
 from .judge.case import CaseResult, run_case
+from .judge.run_report import run_report, tolerances_field
 from .references import opencv_oracle
 from .references.convert import model_matrix
 from .references.pyrender_oracle import OracleCache, gl_platform
@@ -424,12 +425,6 @@ def run_crosscheck(
             "frames_checked": len(images["animation"]["frames"]),
             "animation": "worst.gif",
         }
-    failed = sum(1 for r in records if r["verdict"] == "fail")
-    vacuous = sum(1 for r in records if r["verdict"] == "vacuous")
-    compared = gate.compared_totals(records, level)
-    vertex_errs = [r["max_vertex_error_px"] for r in records if r.get("max_vertex_error_px") is not None]
-    f1_0 = [r["pixel_f1_0px"] for r in records if r.get("pixel_f1_0px") is not None]
-    f1_1 = [r["pixel_f1_1px"] for r in records if r.get("pixel_f1_1px") is not None]
     timing = {"vertex_stage_ms_per_frame": overall_ms(timing_cases, "vertex_stage_ms_per_frame")}
     if level == "pixels":
         timing["pixel_stage_ms_per_frame"] = overall_ms(timing_cases, "pixel_stage_ms_per_frame")
@@ -456,47 +451,26 @@ def run_crosscheck(
             "cases": timing_cases,
         }
     )
-    summary = {
-        "cases": len(records),
-        "passed": len(records) - failed - vacuous,
-        "failed": failed,
-        "vacuous": vacuous,
-        "max_vertex_error_px": max(vertex_errs) if vertex_errs else None,
-        "min_pixel_f1_0px": min(f1_0) if f1_0 else None,
-        "min_pixel_f1_1px": min(f1_1) if f1_1 else None,
-    }
-    if mode.shaded and level == "pixels":
-        ious = [r["silhouette_iou"] for r in records if r.get("silhouette_iou") is not None]
-        derr = [r["depth_max_error"] for r in records if r.get("depth_max_error") is not None]
-        ratio = [r["depth_error_ratio"] for r in records if r.get("depth_error_ratio") is not None]
-        summary.update(
-            {
-                "min_silhouette_iou": min(ious) if ious else None,
-                "max_depth_error": max(derr) if derr else None,
-                "max_depth_error_ratio": max(ratio) if ratio else None,
-            }
-        )
-    report = {
-        "tool": "wirecheck crosscheck",
-        "verdict": gate.run_verdict(records, compared, level, allow_vacuous),
-        "allow_vacuous": allow_vacuous,
-        "compared": compared,
-        "candidate": candidate_name,
-        "candidate_settings": candidate.settings() if hasattr(candidate, "settings") else None,
-        "level": level,
-        **mode.to_dict(),
-        "oracles": list(LEVEL_ORACLES[level]),
-        "oracle_gl": gl,
-        "frames": frames,
-        "every": every,
-        "frames_checked": len(range(1, frames + 1, every)),
-        "motion": {"turns": list(motion.turns)},
-        "tolerances": tol.to_dict(shaded=mode.shaded),
-        "summary": summary,
-        **({"worst_case": worst_case} if worst_case else {}),
-        "cases": records,
-        "timing": timing,
-    }
+    report = run_report(
+        records,
+        level,
+        allow_vacuous,
+        {
+            "candidate": candidate_name,
+            "candidate_settings": candidate.settings() if hasattr(candidate, "settings") else None,
+            **mode.to_dict(),
+            "oracles": list(LEVEL_ORACLES[level]),
+            "oracle_gl": gl,
+            "frames": frames,
+            "every": every,
+            "frames_checked": len(range(1, frames + 1, every)),
+            "motion": {"turns": list(motion.turns)},
+            "tolerances": tolerances_field(tol, level, shaded=mode.shaded),
+            **({"worst_case": worst_case} if worst_case else {}),
+            "timing": timing,
+        },
+        shaded=mode.shaded,
+    )
     return report, images
 
 

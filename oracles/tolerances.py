@@ -331,6 +331,14 @@ SUBPIXEL_BITS = 8
 #: half step 2^-(SUBPIXEL_BITS + 1) plus 2^-9 of float32 rounding (derivation above).
 TIE_END_PX = 2.0 ** -(SUBPIXEL_BITS + 1) + 2.0**-9
 
+#: The pyrender oracle's own error bound (oracles.references.oracle_precision: its float32 window
+#: coordinates' distance from exact, per drawn segment) up to which a case's pixels are judged: the
+#: float32 share (2^-9 px) of TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle. Past
+#: it the pixels say nothing of the candidate: the case is judged on its vertices alone (``oracle_precision``,
+#: ``vacuous`` unless they fail; oracles.judge.decide). Measured bound on the bundled scenes and the orrery,
+#: also 1e5 from the origin: 1.6e-4 to 1.2e-3 px (docs/tolerances.md).
+ORACLE_LIMIT_PX = 2.0**-9
+
 #: Pixel tolerances at which precision/recall/F1 are reported.
 PIXEL_TOLS = (0, 1)
 
@@ -551,6 +559,7 @@ class Tolerances:
     max_object_id_px: int = MAX_OBJECT_ID_PX
     fill_tie_px: float = FILL_TIE_PX
     max_silhouette_run_px: int = MAX_SILHOUETTE_RUN_PX
+    oracle_limit_px: float = ORACLE_LIMIT_PX
 
     def __post_init__(self):
         if self.precision is not None and self.precision not in PRECISIONS:
@@ -606,9 +615,13 @@ class Tolerances:
 
 @dataclass(frozen=True)
 class NamingThresholds:
-    """The frames path's thresholds that decide a verdict or a name but are not a run's to set (no CLI option):
-    read by oracles.judge.decide and oracles.judge.name_faults, each with its reason. They were module
-    constants of line_style, free_ends, f1_radius, dim_lines and image_visibility; their values are unchanged.
+    """The thresholds that decide a verdict or a name but are not a run's to set (no CLI option), each with
+    its reason: read by oracles.judge.decide and oracles.judge.name_faults (the frames path), by the image
+    diagnosis (oracles.diagnosis.image_diagnose, image_naming, image_visibility, rule_read) and by the vertex
+    diagnosis (oracles.diagnosis.diagnose, clip_planes), the unprojector's (unproject_faults) and the
+    line measures (oracles.judge.even_lean, line_ends, coverage_pixels). They were module constants of
+    line_style, free_ends, f1_radius, dim_lines, image_visibility, image_diagnose, rule_read, diagnose,
+    clip_planes, unproject_faults, even_lean, line_ends and coverage_pixels; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
@@ -647,9 +660,124 @@ class NamingThresholds:
     #: difference: at least this share of its decided one-sided pixels (per frame) lie farther than 1 px from
     #: the other side (a line drawn too thick or too thin never leaves a pixel that far).
     visibility_share: float = 0.5
+    #: A pixel is on one side only (image_visibility's set difference: ``candidate_only_px``,
+    #: ``oracle_only_px``) when the other side has no pixel within this distance (px): F1@1px's tolerance,
+    #: so the sets counted are the pixels F1@1px counts against the candidate.
+    near_px: float = 1.0
+
+    # ---- the image diagnosis: a case's frames registered to the oracle's lines (oracles.diagnosis.image_diagnose)
+
+    #: A case needs this many drawn candidate pixels to be registered; fewer are named ``unexplained``
+    #: (``underdetermined``). The fit (a scale and an offset per axis, for each signed permutation) is
+    #: determined by a handful of points; 50 keeps a few stray pixels from being read as a picture.
+    min_registered_px: int = 50
+    #: The registration's cost (px: the mean of its two directions' mean distances) above which no member
+    #: of the family (mirrors, swaps, per-axis scale, offset) draws the pixels: ``unexplained`` (or the
+    #: visibility advice), and the scale restarts are tried. Measured (docs/frames.md, "Limits, measured"):
+    #: correct 1-px aliased lines 0.30-0.33 px (pixel centres lie within 0.5 px of a line across its minor
+    #: axis), anti-aliased 0.41-0.43, 2-px wide 0.44; a transposed rotation 1.2-4.8. 0.85 is ~2x the
+    #: largest correct cost and under the smallest of a rotation the family cannot draw.
+    residual_max_px: float = 0.85
+    #: A permutation other than the identity is named only when the identity's cost exceeds its cost by
+    #: more than this share, and two permutations within this share of each other are ``ambiguous``
+    #: (image_naming): a symmetric picture (a cube seen along an axis, an orthographic view of a centrally
+    #: symmetric scene) fits several with relative differences below 1e-2 (measured); 0.05 is 5x that.
+    ambiguous_ratio: float = 0.05
+    #: The free affine fit's off-diagonal terms (a rotation, a shear) are ``unexplained`` when they move
+    #: some pixel by more than this (px): <= 0.04 px on a correct renderer, 0.77-1.17 px for a 0.5 degree
+    #: roll (measured on tests/test_image_diagnosis.py's cameras); 0.3 is 7x the first and under half
+    #: the second.
+    rotation_px: float = 0.3
+    #: How far (px) a rule that rounds each end to a pixel centre may put a line's farthest end, along each
+    #: axis, from where its scale puts it: half a pixel, the rounding (oracles.diagnosis.rule_read). Under
+    #: that rule a scale is named only when it moves a pixel by more than ``Tolerances.scale_px`` plus
+    #: this. Measured: a correct LINE_8 on prism / on_axis fits an aspect of 0.53 px at 111 px reach (named
+    #: without it); the wrong-axis FOV drawn by Bresenham 0.6-0.73 px; a 3 % aspect mistake 3 px or more.
+    rounded_end_px: float = 0.5
+    #: Both aliased rules (GL's, ends rounded) are read when the farther rule's registration cost is within
+    #: this share of the closer one's (oracles.diagnosis.rule_read): correct rounded-ends renderers fit
+    #: GL's lines closer on 4-5 of 21 cases by up to 30 % of the cost (LINE_8, pyramid / non_square:
+    #: 0.374 against 0.485); 1/3 is above that largest misread.
+    rule_tie: float = 1.0 / 3.0
+
+    # ---- the vertex diagnosis (oracles.diagnosis.diagnose): the candidate's pixels against OpenCV's
+
+    #: ``depth_flip`` when the candidate's and the oracle's visible sets nearly miss each other: at most
+    #: this share of their union in common. A depth flip makes them disjoint exactly when near > 0 (no
+    #: point has both z >= near and -z >= near); 1 % allows a candidate that also differs at the near/far
+    #: boundary or an orthographic [near, far] reaching slightly behind the camera, while a real near/far
+    #: error changes only the few points close to a plane and keeps far more than 1 % in common.
+    depth_flip_max_overlap: float = 0.01
+    #: The common points must span 2D for a linear map to be fitted: the smaller singular value of the
+    #: centred points at least this share of the larger (else only a constant offset is read).
+    #: Collinear points give ~1e-16 (float noise); 1e-6 keeps the fit's condition number <= 1e6, so
+    #: float64 noise moves the fitted map by < 1e-10 relative, far below any fault.
+    degenerate_ratio: float = 1e-6
+    #: Float32 roundings of size eps32 a float64 projector's constant may carry into the fitted map
+    #: (a scale or offset within them is ``precision_limited``, not a fault): a float32 focal length,
+    #: aspect or GL matrix entry is off by <= 0.5 eps32 relative, and a scale composes two such constants
+    #: (fx from f and the aspect): 1 eps32; 2 leaves 2x.
+    constant_roundings: float = 2.0
+    #: A line end is named in ``line_end_bias`` when its net one-sided pixels are at least this many per
+    #: line (oracles.diagnosis.diagnose.diagnose_lines): a quarter pixel on average, far above what an
+    #: unbiased rasterizer leaves (one-sided pixels at ends of both signs cancel), far below the one pixel
+    #: a line that drops (adds) its end pixel leaves.
+    line_end_min_px: float = 0.25
+
+    # ---- the candidate's own clipping planes, probed (oracles.diagnosis.clip_planes; oracles.spec.checks)
+
+    #: A fitted plane within this relative distance of the camera's is the camera's (no
+    #: ``clipping_plane``): float64 rounding of a depth test is a few eps64 (1e-15), the probe's own
+    #: bracket ~1e-11 relative; 1e-9 sits between them and far below float32's rounding of a plane (6e-8).
+    plane_rel_tol: float = 1e-9
+    #: A plane off by at most this many eps32 (relative; the far plane also times far/near, the
+    #: conditioning of a GL matrix's depth row) is float32 rounding (``float32_near``/``float32_far``, and
+    #: the slack the drawn ends are given), not a wrong plane: one rounding of near is 0.5 eps32, a float32
+    #: GL matrix's A and B each add one (measured on PyGLM-style matrices: <= 1.1 eps32 near).
+    float32_plane_roundings: float = 4.0
+
+    # ---- an unprojector's points (oracles.diagnosis.unproject_faults)
+
+    #: A mistaken inverse explains the candidate when every point is within this many of its bounds: the
+    #: mistake's parameters are medians of reprojected points, each within its own bound, so they move the
+    #: model by up to about one bound; doubled for the two sides' roundings: 4.
+    unproject_fit_slack: float = 4.0
+
+    # ---- binary lines of an even width (oracles.judge.even_lean): which band each edge is measured against
+
+    #: The leaning bands replace the symmetric one when they lower the mean square residual of the edges'
+    #: means by this (px^2): the square of a quarter pixel (what a leaning edge, 0.5 px on the minor axis
+    #: times |n_minor| >= 0.71, leaves under the symmetric band is at least 0.35 px), for a quarter of the
+    #: edges. Measured: Pillow 2 px 0.12-0.30 symmetric against 0.02-0.05 leaning; symmetric 2-px bands,
+    #: moved or not, 0.000-0.001 against 0.000-0.016.
+    lean_gain_px2: float = 0.25 * 0.25**2
+    #: Cases with at most this many edges' worth of samples (their effective number) cannot test the
+    #: symmetric band: its offset (two numbers) fits two edges exactly and leaves a third one number to
+    #: check, so the leaning fit (the smaller offset, by the lean's ambiguity) is used there.
+    max_untested_edges: float = 3.0
+    #: Least samples of an edge for its mean to count in the fit (fewer: the edge's mean is noise, and the
+    #: edge keeps the symmetric band).
+    min_edge_samples: int = 5
+
+    # ---- a case's one-sided line pixels (oracles.judge.line_ends)
+
+    #: A one-sided pixel within this distance (px) of a segment's start or end counts as at that end
+    #: (``line_end_bias`` reads the ends' counts), and one farther than it from every segment is ``stray``:
+    #: a pixel beside an end pixel (diagonal: sqrt(2) = 1.41 px) is still that end's; 1.5 keeps the next
+    #: pixel along the line (2 px) in the ``middle``.
+    end_reach_px: float = 1.5
+
+    # ---- antialiased frames (oracles.judge.coverage_pixels)
+
+    #: The thinnest antialiased line whose every row (column) keeps a drawn pixel (px): a pixel under the
+    #: drawn level is drawn too where it is a ridge across a line holding at least half this width's
+    #: coverage (a line <= 1 px wide splits its coverage across a row between at most two pixels, the larger
+    #: holding at least half of it). Thinner lines (coverage under a quarter where they fall between two
+    #: pixels) cannot be read; a 1-px line between two pixels (127 | 127) is read.
+    ridge_min_width_px: float = 0.5
 
 
-#: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults).
+#: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults, the diagnosis).
 NAMING = NamingThresholds()
 
 

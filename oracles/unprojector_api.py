@@ -289,13 +289,13 @@ def unprojector_failure_text(report: dict) -> str | None:
     return "\n".join(lines)
 
 
-def assert_unprojector(func, **kwargs) -> dict:
+def assert_unprojector(func=None, **kwargs) -> dict:
     """:func:`check_unprojector`, raising AssertionError with the diagnosis unless the verdict is pass.
 
     Parameters
     ----------
-    func : callable or str
-        As for :func:`check_unprojector`.
+    func : callable or str, optional
+        As for :func:`check_unprojector` (or ``cmd=`` among the keywords, as for assert_projector).
     **kwargs
         Any keyword of :func:`check_unprojector`.
 

@@ -1,7 +1,7 @@
 """Which pixels of an antialiased frame are drawn (oracles.judge.coverage_pixels): hand-built rows.
 
 Expected values from the rule: drawn at grey >= 128, or at a ridge (at least
-both neighbours in the row and more than one, or the same in the column) of grey >= RIDGE_MIN =
+both neighbours in the row and more than one, or the same in the column) of grey >= ridge_min() =
 int(255 * 0.5 / 2) = 63, the coverage a 0.5-px line leaves in each of two
 pixels it falls between (0.25 of 255 = 63.75, rounded down).
 """
@@ -16,7 +16,7 @@ def _row(values, rows=5):
 
 
 def test_ridge_min_is_a_quarter_of_full_coverage_rounded_down():
-    assert coverage_pixels.RIDGE_MIN == 63
+    assert coverage_pixels.ridge_min() == 63
 
 
 def test_a_1px_line_between_two_pixels_is_drawn_in_both():

@@ -350,10 +350,12 @@ def test_the_vertex_bound_decides_on_the_projector_path():
 
 
 def test_past_the_oracles_precision_limit_the_pixels_are_set_aside():
-    # ORACLE_LIMIT_PX (oracles.references.oracle_precision): at the limit the pixels are judged; just past it
-    # they are set aside, the case judged on its vertices alone (vacuous here: they agree), the pixel-read
-    # line fault goes and the reasons the pixels gave stay on record
-    from wirecheck.oracles.references.oracle_precision import ORACLE_LIMIT_PX
+    # Tolerances.oracle_limit_px: at the limit the pixels are judged; just past it they are set aside, the
+    # case judged on its vertices alone (vacuous here: they agree), the pixel-read line fault goes and the
+    # reasons the pixels gave stay on record. The limit is 2^-9 px (docs/tolerances.md: the float32 share of
+    # the tie zone's TIE_END_PX)
+    ORACLE_LIMIT_PX = 2.0**-9
+    assert TOL.oracle_limit_px == ORACLE_LIMIT_PX
 
     def ev(bound):
         return CaseEvidence(
@@ -371,6 +373,9 @@ def test_past_the_oracles_precision_limit_the_pixels_are_set_aside():
     past = decide(ev(math.nextafter(ORACLE_LIMIT_PX, UP)), TOL)
     assert past.verdict == "vacuous" and past.reasons[0].startswith("oracle_precision: the pyrender oracle's")
     assert past.set_aside == at.reasons and _names(ev(math.nextafter(ORACLE_LIMIT_PX, UP))) == []
+    # the limit is the record's: moved just past the bound, the same case's pixels are judged again
+    moved = dataclasses.replace(TOL, oracle_limit_px=math.nextafter(ORACLE_LIMIT_PX, UP))
+    assert decide(ev(math.nextafter(ORACLE_LIMIT_PX, UP)), moved) == at
     # a vertex failure still fails the case, after the oracle_precision reason
     wrong = dataclasses.replace(
         ev(math.nextafter(ORACLE_LIMIT_PX, UP)),
@@ -548,6 +553,7 @@ def test_the_table_lists_every_step_once_in_order():
         "diagnosis",
         "line_centres",
         "line_rule",
+        "job_read",
         "dim_lines",
         "surfaces",
         "unexplained",
@@ -588,3 +594,44 @@ def test_depth_maps_name_their_faults_only_where_their_limits_are_missed():
     assert verdict.verdict == "fail" and [f.name for f in name_faults(ev, verdict, TOL)] == ["depth_scale"]
     ok = dataclasses.replace(ev, depth_map=depth_map(0.5))
     assert decide(ok, TOL).verdict == "pass" and name_faults(ok, decide(ok, TOL), TOL) == ()
+
+
+def test_a_mistake_read_from_the_depth_maps_and_the_silhouettes_is_named_once():
+    # rows not flipped: the depth maps' values and the filled frames' silhouettes both name mirror_vertical
+    # (held-out: moderngl and Open3D jobs read "mirror_vertical; mirror_vertical"); one name, the depth maps'
+    # (read first), beside a name only the silhouettes give
+    depth = {
+        "max_error_ratio": 40.0,
+        "max_error": 4.0,
+        "worst_pixel": [3, 4],
+        "worst_frame": 1,
+        "reference_px": 500,
+        "compared_px": 480,
+        "blank_frames": [],
+        "holes_px": 0,
+        "extra_px": 0,
+        "holes_worst_frame": None,
+        "extra_worst_frame": None,
+    }
+    filled = {
+        "blank_frames": [],
+        "longest_run_px": 90,
+        "run_at": [10, 12],
+        "run_frame": 1,
+        "holes_px": 400,
+        "extra_px": 400,
+        "min_iou": 0.2,
+        "iou_worst_frame": 1,
+    }
+    from_depth = Fault("mirror_vertical", {"source_of": "depth"})
+    ev = CaseEvidence(
+        level="frames",
+        compared={"frames": 1, "vertices": 0, "pixels": 500},
+        frames_checked=1,
+        depth_map=depth,
+        filled=filled,
+        depth_faults=(from_depth,),
+        filled_faults=(Fault("mirror_vertical", {"source_of": "silhouettes"}), Fault("pixel_offset", {"dx": 0.5})),
+    )
+    named = name_faults(ev, decide(ev, TOL), TOL)
+    assert [f.name for f in named] == ["mirror_vertical", "pixel_offset"] and named[0] is from_depth

@@ -138,6 +138,20 @@ def test_an_all_nan_map_fails(depth_job, tmp_path):
     assert code == 1 and {c["verdict"] for c in report["cases"]} == {"fail"}
 
 
+def test_a_map_whose_surface_never_meets_the_references_fails(depth_job, tmp_path):
+    """Zero overlap through a job: each map shows a surface (1.0) exactly where the reference shows none and
+    nothing where it shows one: no pixel compared on both sides, never a pass (not blank either: the map
+    draws)."""
+    job = fill(copy(depth_job, tmp_path), lambda z, cam: np.where(z > 0, 0.0, 1.0))
+    code, report, _ = run_crosscheck(tmp_path, "--candidate-frames", str(job))
+    assert code == 1
+    for case in report["cases"]:
+        d = case["depth_map"]
+        assert case["verdict"] == "fail" and d["compared_px"] == 0 and d["reference_px"] > 0
+        assert d["blank_frames"] == []  # each map draws a surface: the failure is the overlap, not a blank
+        assert any("compare nothing" in r for r in case["reasons"])
+
+
 def test_a_hole_inside_the_surface_fails(depth_job, tmp_path):
     """A 3x3 patch of no surface in the middle of a face: 9 holes a frame (the patch and its neighbours are
     covered by the reference: away from any boundary), nothing else."""
@@ -313,6 +327,42 @@ def test_the_readme_says_what_to_write(tmp_path):
     assert "depth along the camera's forward" in text and "row 0 at the top" in text
     assert "0, NaN or +inf where no face is seen" in text
     assert json.loads((job / "job.json").read_text())["depth_encoding"] == {"format": "png16", "scale": 5000.0}
+    # a GL renderer's depth buffer made linear from gl_projection's standard depth range (the formula a
+    # moderngl client follows and passes with: tests/test_depth_job_renderers.py), the rows flipped
+    assert "`d = 2 f n / ((f + n) - (2 z - 1) (f - n))` (orthographic: `d = n + z (f - n)`)" in text
+    assert "GL's row 0 is the bottom row" in text
+    assert "the fan of triangles from its first vertex" in text
+    assert "world per frame" not in text  # the cube: one OBJ in model space
+
+
+@pytest.mark.parametrize("outputs", [[], ["--outputs", "filled,depth"]])
+def test_the_readme_says_where_a_world_space_scene_is(tmp_path, outputs):
+    """The orrery (several moving objects) has no scenes/orrery.obj: its OBJ per frame is in world space."""
+    job = tmp_path / "job"
+    assert (
+        main(
+            [
+                "export",
+                str(job),
+                "--scene",
+                "orrery",
+                "--scene",
+                "cube",
+                "--cases",
+                "on_axis",
+                "--frames",
+                "2",
+                *outputs,
+            ]
+        )
+        == 0
+    )
+    text = " ".join((job / "README.md").read_text().split())
+    assert "`orrery` (its `space` in job.json: `world per frame`, several moving objects)" in text
+    assert "`scenes/<scene>/frame_NNNN.obj`, its `v` already in world space" in text
+    assert "`model_matrix` is the identity" in text and "`cube`" not in text  # the cube's OBJ is in model space
+    assert (job / "scenes/orrery/frame_0002.obj").is_file() and not (job / "scenes/orrery.obj").exists()
+    assert ("A GL depth buffer read back is not depth" in text) == bool(outputs)  # only where depth is asked
 
 
 @pytest.mark.parametrize(

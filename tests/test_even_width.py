@@ -14,8 +14,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from test_line_style import _band, _fill, _judge, draw_pillow, job_dir  # noqa: F401 - job_dir: the module's fixture
-from wirecheck.oracles.judge import even_lean
+from wirecheck.oracles.judge import even_lean  # noqa: F401
 from wirecheck.oracles.judge.line_style import RULE_OFFSET_MAX_PX
+from wirecheck.oracles.tolerances import NAMING
 
 
 def draw_symmetric_2px(segs, w, h):
@@ -145,7 +146,7 @@ def test_correct_2px_lines_pass(job_dir, tmp_path, capsys, draw):  # noqa: F811
         # pyramid / non_square: lines near the x axis, which Pillow draws ~1.2 px across: the median width
         # reads 1.0, but the frames hold 1.5x (WIDE_PIXEL_RATIO) the oracle's pixels or more: read wide
         c = next(c for c in report["cases"] if (c["scene"], c["camera"]) == ("pyramid", "non_square"))
-        assert c["line_style"]["width_px"] < 1.75 and c["line_style"]["pixel_ratio"] >= even_lean.WIDE_PIXEL_RATIO
+        assert c["line_style"]["width_px"] < 1.75 and c["line_style"]["pixel_ratio"] >= NAMING.wide_pixel_ratio
         # every case's edges were explained by leaning bands
         assert all(c["line_style"]["geometry"]["lean"]["leaning"] for c in report["cases"])
 

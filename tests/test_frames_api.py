@@ -261,3 +261,25 @@ def test_the_docs_example_runs(tmp_path, monkeypatch, draws):
         with pytest.raises(AssertionError, match=r"cube / on_axis: faults: \w+"):
             scope["test_my_renderer_draws_the_job"](tmp_path)
     assert (tmp_path / "frames-report" / "report.html").is_file()
+
+
+def test_the_config_table_sets_the_floors_as_for_the_cli(jobs, tmp_path, monkeypatch):
+    # [tool.wirecheck] min-f1 = 0.5, min-f1-0px = 0.25 in the nearest pyproject.toml: the run's tolerances
+    # (report.json) say so, as crosscheck --candidate-frames reads the same table; config=False reads no file
+    # (the defaults 0.999, 0.98 of docs/tolerances.md), a keyword wins over the table (as check_projector's
+    # settings), and a bad value is the line crosscheck prints
+    (tmp_path / "pyproject.toml").write_text("[tool.wirecheck]\nmin-f1 = 0.5\nmin-f1-0px = 0.25\n")
+    monkeypatch.chdir(tmp_path)
+    tols = wirecheck.check_frames(jobs["good"])["tolerances"]
+    assert (tols["min_pixel_f1_1px"], tols["min_pixel_f1_0px"]) == (0.5, 0.25)
+    none = wirecheck.check_frames(jobs["good"], config=False)["tolerances"]
+    assert (none["min_pixel_f1_1px"], none["min_pixel_f1_0px"]) == (0.999, 0.98)
+    given = wirecheck.check_frames(jobs["good"], min_f1_0px=0.75)["tolerances"]
+    assert (given["min_pixel_f1_1px"], given["min_pixel_f1_0px"]) == (0.5, 0.75)
+    cli = tmp_path / "rep"
+    assert main(["--candidate-frames", str(jobs["good"]), "--report-dir", str(cli)]) == 0
+    rep = json.loads((cli / "report.json").read_text())["tolerances"]
+    assert (rep["min_pixel_f1_1px"], rep["min_pixel_f1_0px"]) == (0.5, 0.25)
+    (tmp_path / "bad.toml").write_text("[tool.wirecheck]\nmin-f1 = 2\n")
+    with pytest.raises(ValueError, match=r"bad.toml: \[tool.wirecheck\] min-f1 = 2: expected a number in \[0, 1\]"):
+        wirecheck.check_frames(jobs["good"], config=tmp_path / "bad.toml")

@@ -402,7 +402,7 @@ def test_fov_of_the_wrong_axis_on_prism_wide_fov_is_the_fov_alone(jobs, tmp_path
     # the wrong-axis FOV drawn by a rule that rounds the ends, prism / wide_fov: the registration's offset
     # (0.02, 0.19) px is over GL's bias (-0.01, -0.02) by 0.21 (> 0.2) and within the rounded ends' own
     # (-0.05, 0.14); the pixels fit GL's lines a little closer (cost 0.361 against 0.368), within the tie
-    # margin (rule_read.RULE_TIE): the offset must stand against both rules' biases, and does not.
+    # margin (NAMING.rule_tie): the offset must stand against both rules' biases, and does not.
     # fov_mismatch alone, no pixel_offset beside it
     rc, c = _judge(jobs, tmp_path, "wide_prism", draw, hd.project_lookat, fov_axis="x")
     assert rc == 1 and c["verdict"] == "fail"

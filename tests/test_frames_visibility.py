@@ -111,7 +111,7 @@ def test_the_image_fit_says_its_pairs_are_a_correct_drawings(judged):
     _job, case = judged["near2"]
     (fault,) = case["faults"]
     # the registration's pairs: a correct 1-px drawing sits 0.30-0.33 px from the exact lines (docs/frames.md);
-    # its cost is above RESIDUAL_MAX_PX (0.85) only because of the missing pieces
+    # its cost is above NAMING.residual_max_px (0.85) only because of the missing pieces
     assert fault["residual_px"] > 0.85 and fault["matched_residual_px"] < 0.5, fault
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 from test_image_diagnosis import MAIN_CAMERAS, diagnose_fault, draw_aa, draw_wide
 from wirecheck.oracles.diagnosis.diagnose import primary
-from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX
+from wirecheck.oracles.tolerances import OFFSET_TOL_PX
 
 pytestmark = pytest.mark.slow  # ~1 s per diagnosis of six images
 

@@ -14,7 +14,8 @@ import pytest
 from wirecheck.core.camera import look_at
 from wirecheck.core.projector.raster import line_pixels
 from wirecheck.oracles.diagnosis import image_diagnose, image_naming
-from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX, diagnose_images
+from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
+from wirecheck.oracles.tolerances import OFFSET_TOL_PX
 
 CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
 CX, CY = CAM.principal_point
@@ -146,7 +147,7 @@ def test_a_scale_stands_against_every_rule_read():
     ],
 )
 def test_two_rules_are_read_within_the_tie_margin(monkeypatch, gl_cost, snapped_cost, read):
-    # read_rules reads one rule only when the other's cost exceeds it by more than RULE_TIE (1/3) of it
+    # read_rules reads one rule only when the other's cost exceeds it by more than NAMING.rule_tie (1/3) of it
     # (rule_read's docstring: above the largest misread measured, 30 %); the closer rule first
     from wirecheck.oracles.diagnosis import rule_read
 

@@ -117,7 +117,7 @@ def test_a_dropped_end_pixel_fails_by_default(job_dir, tmp_path, capsys):
     # measured: every case fails on the pixels the rounded-ends rule draws and these lack, all at the lines'
     # ends: line_end_bias at the last end in 3 cases (0.27-0.35 pixels a line: the others are covered by the
     # lines that start there); on cube / non_square the vertices share the lost pixels out between the lines
-    # ending and starting there (-14 at starts, -17 at ends, under LINE_END_MIN_PX a line each):
+    # ending and starting there (-14 at starts, -17 at ends, under NAMING.line_end_min_px a line each):
     # line_pixel_bias, with nothing lost along the lines
     assert len(failed) == len(report["cases"]) == 4
     named = []

@@ -21,12 +21,12 @@ from PIL import Image, ImageDraw
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job, read_grey
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.diagnosis.image_diagnose import OFFSET_TOL_PX, oracle_segments
+from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 from wirecheck.oracles.judge.decide import decide
 from wirecheck.oracles.judge.evidence import CaseEvidence
 from wirecheck.oracles.judge.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset, style_record
 from wirecheck.oracles.judge.name_faults import name_faults
-from wirecheck.oracles.tolerances import Tolerances
+from wirecheck.oracles.tolerances import OFFSET_TOL_PX, Tolerances
 
 # oblique views: the lines slant, so every frame shows both offset components
 ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6", "--every", "3"]

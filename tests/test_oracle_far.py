@@ -17,6 +17,7 @@ from wirecheck.core.camera import Camera
 from wirecheck.oracles.references import oracle_precision as op
 from wirecheck.oracles.references.convert import camera_to_gl, centre_of, gl_eye_pose
 from wirecheck.oracles.references.pyrender_oracle import osmesa_available
+from wirecheck.oracles.tolerances import ORACLE_LIMIT_PX
 
 _OK, _WHY = osmesa_available()
 needs_gl = pytest.mark.skipif(not _OK, reason=f"pyrender/OSMesa unavailable: {_WHY}")
@@ -88,9 +89,9 @@ def test_the_bound_holds_for_a_float32_model_of_the_shader_and_the_old_inputs_br
     err_now = np.abs(_window_f32(p_model, pose, cam, centred=True) - exact).max()
     err_then = np.abs(_window_f32(p_model, np.eye(4), cam, centred=False) - exact).max()
     # the oracle's inputs now: within its bound, and the bound within what the tie zone assumes
-    assert err_now <= bound <= op.ORACLE_LIMIT_PX
+    assert err_now <= bound <= ORACLE_LIMIT_PX
     if offset == FAR:  # the old inputs, far away: rounding of 1e5-sized values, ~1e-2 px and more
-        assert err_then > 10 * op.ORACLE_LIMIT_PX
+        assert err_then > 10 * ORACLE_LIMIT_PX
 
 
 def test_the_bound_of_a_centred_camera_by_hand():
@@ -184,7 +185,7 @@ def test_a_case_beyond_the_oracles_precision_is_named_and_does_not_blame_the_can
             pyrender_oracle=oracle,
         )
     rec = res.record
-    assert rec["oracle_bound_px"] > 100 * op.ORACLE_LIMIT_PX
+    assert rec["oracle_bound_px"] > 100 * ORACLE_LIMIT_PX
     assert rec["verdict"] == "vacuous" and rec["oracle_precision"] is True
     assert rec["reasons"][0].startswith("oracle_precision: the pyrender oracle's own error bound")
 
@@ -193,7 +194,7 @@ def test_a_bound_that_overflows_is_no_bound_and_beyond_the_limit():
     # a radius of 1e308 makes the magnitudes overflow float64: no finite bound, so the case cannot be judged
     cam = _camera((0.0, 0.0, 5.0))
     bound = op.frame_bound_px(cam, gl_eye_pose(cam, None, (0.0, 0.0, 0.0)), 1e308)
-    assert bound == float("inf") and bound > op.ORACLE_LIMIT_PX
+    assert bound == float("inf") and bound > ORACLE_LIMIT_PX
 
 
 @needs_gl

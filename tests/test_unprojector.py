@@ -326,6 +326,14 @@ def test_protocol_client(monkeypatch):
         check_unprojector(U.correct, cmd=CLIENT)
 
 
+def test_assert_unprojector_takes_a_program_as_assert_projector_does(monkeypatch):
+    """``assert_unprojector(cmd=...)``: the same shape as assert_projector's (the candidate optional when a
+    program is given), failing with the program's fault named."""
+    monkeypatch.chdir(ROOT)
+    with pytest.raises(AssertionError, match="mirror_vertical"):
+        assert_unprojector(cmd=f"{CLIENT} --mistake rows_flipped", scenes=["cube"], frames=1, cases=["oblique_roll"])
+
+
 def test_cli_unprojector_cmd():
     ok = crosscheck("--unprojector-cmd", CLIENT, "--scene", "pyramid", "--frames", "1")
     assert ok.returncode == 0 and "PASS: 7/7 cases" in ok.stdout, ok.stderr

@@ -331,6 +331,19 @@ image), more frames, or a number of frames that is not a multiple of 4 (e.g.
     return text + "\n"
 
 
+def world_scenes_note(job: dict) -> str:
+    """The README's bullet for scenes whose OBJ is in world space per frame (several moving objects), or ''."""
+    names = [s["name"] for s in job["scenes"] if s["space"] != "model"]
+    if not names:
+        return ""
+    which = ", ".join(f"`{n}`" for n in names)
+    return f"""
+- {which} ({"its" if len(names) == 1 else "their"} `space` in job.json: `world per frame`, several moving
+  objects): no `scenes/<scene>.obj`, but one OBJ per frame,
+  `scenes/<scene>/frame_NNNN.obj`, its `v` already in world space (the
+  camera files' `model_matrix` is the identity)."""
+
+
 def readme(job: dict) -> str:
     if job_outputs(job) != ("wireframe",):
         return outputs_readme(job)
@@ -356,7 +369,7 @@ depth flip, lines short or long at an end).
 - {len(job["cases"])} cases (a scene under a camera), {n_frames} frames in all.
 - Scenes: `scenes/<scene>.obj` (model space: `v` vertices, `l` edges, `f`
   faces, 1-based). Draw the `l` edges (a line per edge); the faces are for
-  shaded renderers and for hidden lines, which this job does not ask for.
+  shaded renderers and for hidden lines, which this job does not ask for.{world_scenes_note(job)}
 - Cameras: `cameras/<scene>/<case>/frame_NNNN.json` gives the camera as
   position/forward/up/fov_y_deg/width/height/near/far/projection/ortho_height,
   as OpenCV `K`, `R`, `t_cv`, and as OpenGL `gl_view` and `gl_projection`, and
@@ -390,6 +403,19 @@ Pillow's ImageDraw truncates float coordinates: give it rounded ones, or its
 lines read as `pixel_offset` (-0.5, -0.5).
 
 """ + short_job_note(job)
+
+
+def gl_depth_note(job: dict) -> str:
+    """The README's bullet on a GL depth buffer read back, for a job that asks for depth maps, or ''."""
+    if "depth" not in job_outputs(job):
+        return ""
+    return """
+- A GL depth buffer read back is not depth: `gl_projection` is OpenGL's
+  standard projection (glFrustum / glOrtho: near to NDC z -1, far to +1), so
+  a window depth `z` in [0, 1] (glDepthRange 0, 1) is depth
+  `d = 2 f n / ((f + n) - (2 z - 1) (f - n))` (orthographic:
+  `d = n + z (f - n)`) with `n`, `f` the camera's near and far, and 1 where
+  nothing was drawn; GL's row 0 is the bottom row (flip the rows once)."""
 
 
 def outputs_readme(job: dict) -> str:
@@ -439,13 +465,15 @@ half-pixel principal point, K from the horizontal FOV).
 - {len(job["cases"])} cases (a scene under a camera), {n} frame{"s" if n != 1 else ""} each.
 - Scenes: `scenes/<scene>.obj` (model space: `v` vertices, `l` edges, `f`
   faces, 1-based). Wireframes draw the `l` edges; filled frames and depth
-  maps render the `f` faces (both sides: no back-face culling).
+  maps render the `f` faces (both sides: no back-face culling); a face of
+  more than three vertices is the fan of triangles from its first vertex,
+  `(f0, fk, fk+1)`, as the reference draws it.{world_scenes_note(job)}
 - Cameras: `cameras/<scene>/<case>/frame_NNNN.json` gives the camera as
   position/forward/up/fov_y_deg/width/height/near/far/projection/ortho_height,
   as OpenCV `K`, `R`, `t_cv`, and as OpenGL `gl_view` and `gl_projection`, and
   the frame's `model_matrix` (p_world = model_matrix @ [v, 1]). Matrices are
   rows, for column vectors. The conventions are in `job.json` (`conventions`).
-- Clip at the near and far planes (depth along `forward` in [near, far]).
+- Clip at the near and far planes (depth along `forward` in [near, far]).{gl_depth_note(job)}
 
 ## What to write, and where
 

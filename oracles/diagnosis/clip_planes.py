@@ -23,7 +23,7 @@ kind                the candidate ...
                     only those beyond ``near`` (``near_fit`` ~ 0)
 ``float32_near``    clips at ``near`` rounded to float32 (or through a float32
 ``float32_far``     projection matrix): off by more than float64 rounding, at
-                    most :data:`FLOAT32_PLANE_ROUNDINGS` eps32 relative
+                    most ``NAMING.float32_plane_roundings`` eps32 relative
                     (``far``: eps32 far/near, the GL matrix's conditioning)
 ``near``, ``far``   clips at another plane (a wrong value)
 ``none``            never clips: keeps points behind the camera too
@@ -39,24 +39,15 @@ import numpy as np
 
 from .. import faults as catalogue
 from ..candidates.candidate import CandidateError, call_candidate
-from ..tolerances import EPS
+from ..tolerances import EPS, NAMING
 
-__all__ = ["probe_planes", "clip_fault", "depth_slack", "FLOAT32_PLANE_ROUNDINGS", "PLANE_REL_TOL"]
+__all__ = ["probe_planes", "clip_fault", "depth_slack"]
 
 #: Probe depths per sign: geometric from 1e-9 near to 1e3 far (steps of ~16 % for far/near = 1000).
 GRID_POINTS = 240
 #: Points per bracket per refining call, and calls: each call shrinks a bracket 63x, 6 calls 6e10x.
 REFINE_POINTS = 64
 REFINE_ROUNDS = 6
-#: A fitted plane within this relative distance of the camera's is the camera's: float64 rounding of
-#: a depth test (a few eps64) is 1e-15; the probe's own bracket ~1e-11 relative. 1e-9 sits between
-#: them and far below float32's rounding of a plane (6e-8).
-PLANE_REL_TOL = 1e-9
-#: A plane off by at most this many eps32 (relative; the far plane also times far/near, the
-#: conditioning of a GL matrix's depth row) is float32 rounding of the plane or of the matrix: one
-#: rounding of near is 0.5 eps32; a float32 GL matrix's A and B each add one (measured on PyGLM-style
-#: matrices: <= 1.1 eps32 near).
-FLOAT32_PLANE_ROUNDINGS = 4.0
 
 
 def _axis_points(camera, depth: np.ndarray) -> np.ndarray:
@@ -135,7 +126,7 @@ def _rel(fit: float, plane: float) -> float:
 
 def _float32_limit(camera, which: str) -> float:
     """Relative distance of a plane that float32 rounding of the plane or of a GL matrix can explain."""
-    eps = FLOAT32_PLANE_ROUNDINGS * EPS["float32"]
+    eps = NAMING.float32_plane_roundings * EPS["float32"]
     return eps if which == "near" else eps * (1.0 + camera.far / camera.near)
 
 
@@ -158,8 +149,8 @@ def clip_fault(planes: dict | None, camera) -> dict | None:
     if n_fit is None or (planes["behind"] and n_fit == 0.0):
         return {"name": "clipping_plane", "kind": "none", **fields, "near_fit": None, "hint": _hint("none")}
     kind = None
-    if abs(_rel(n_fit, near)) > PLANE_REL_TOL:
-        if n_fit < PLANE_REL_TOL * near:
+    if abs(_rel(n_fit, near)) > NAMING.plane_rel_tol:
+        if n_fit < NAMING.plane_rel_tol * near:
             kind = "z_positive"
         elif abs(_rel(n_fit, near)) <= _float32_limit(camera, "near"):
             kind = "float32_near"
@@ -167,7 +158,7 @@ def clip_fault(planes: dict | None, camera) -> dict | None:
             kind = "near"
     elif f_fit is None:
         kind = "far"
-    elif abs(_rel(f_fit, far)) > PLANE_REL_TOL:
+    elif abs(_rel(f_fit, far)) > NAMING.plane_rel_tol:
         kind = "float32_far" if abs(_rel(f_fit, far)) <= _float32_limit(camera, "far") else "far"
     if kind is None:
         return None
@@ -186,7 +177,7 @@ def depth_slack(planes: dict | None, camera) -> tuple[float, str | None]:
         if fit is None:
             continue
         inward = (fit - plane) if which == "near" else (plane - fit)
-        if PLANE_REL_TOL * plane < inward <= _float32_limit(camera, which) * plane:
+        if NAMING.plane_rel_tol * plane < inward <= _float32_limit(camera, which) * plane:
             slack = max(slack, 2.0 * inward)
             why.append(f"the candidate clips at {which} {fit!r} (camera: {plane!r}; float32 rounding)")
     return slack, ("; ".join(why) or None)

@@ -14,7 +14,7 @@ Method
 ======
 1. **Visibility.** ``vis_c``/``vis_o`` = rows finite in the candidate/oracle.
    If both see something between them and they have (nearly) no visible point
-   in common -- at most ``DEPTH_FLIP_MAX_OVERLAP`` of the union -- the candidate
+   in common -- at most ``NAMING.depth_flip_max_overlap`` of the union -- the candidate
    looks backward: ``depth_flip``, and nothing else is reported (there is
    nothing to fit). This includes "the candidate clips everything the oracle
    shows" (a camera flipped away from a scene that lies wholly in front).
@@ -130,7 +130,7 @@ Details and decisions
   the same (ortho width = ``a * ortho_height``).
 * **Degenerate inputs.** ``N = 0``, or both projectors clipping everything, is
   agreement (``[]``). With fewer than 3 non-collinear common points (see
-  ``DEGENERATE_RATIO``) no linear map can be fitted; only a constant offset is
+  ``NAMING.degenerate_ratio``) no linear map can be fitted; only a constant offset is
   tried (``pixel_offset`` if it explains the points), else ``unexplained`` with
   ``underdetermined = True``.
 * **rotation_deg** (in ``unexplained``) is the rotation part of ``A``,
@@ -150,29 +150,11 @@ import math
 import numpy as np
 
 from .. import faults as catalogue
-from ..tolerances import line_failures
+from ..tolerances import EPS, NAMING, line_failures
 from .clip_planes import clip_fault
 from .lens_diagnose import distortion_fault
 
-__all__ = ["diagnose", "diagnose_lines", "primary", "DEPTH_FLIP_MAX_OVERLAP", "DEGENERATE_RATIO"]
-
-#: A depth flip makes the visible sets disjoint exactly when near > 0 (a point
-#: cannot have both z >= near and -z >= near). "Nearly" allows 1% of the union
-#: in common, for a candidate that also differs at the near/far boundary or an
-#: orthographic camera whose [near, far] reaches slightly behind it; a real
-#: near/far error (the other reason visible sets differ) changes only the few
-#: points close to a plane, so it keeps far more than 1% in common.
-DEPTH_FLIP_MAX_OVERLAP = 0.01
-
-#: The common points must span 2D for a linear fit: the smaller singular value
-#: of the centred point cloud must be at least this fraction of the larger.
-#: Exactly collinear projected points give ~1e-16 (float noise); 1e-6 keeps the
-#: fit's condition number <= 1e6, so float64 noise (1e-16 relative) in the
-#: pixels moves the fitted map by < 1e-10 relative, far below any fault.
-DEGENERATE_RATIO = 1e-6
-
-#: Machine epsilon of float32 (oracles.tolerances.EPS), for :func:`rounded_constants`.
-EPS32 = 2.0**-23
+__all__ = ["diagnose", "diagnose_lines", "line_pixel_fields", "primary"]
 
 
 def _sign(x: float) -> int:
@@ -321,10 +303,6 @@ def _diagnose(cand_px, oracle_px, camera, tol_px, float32_px, planes) -> list[di
     )
 
 
-#: Float32 roundings a constant of a float64 projector may carry into the fitted map: a float32 focal
-#: length, aspect or GL matrix entry is off by <= 0.5 eps32 relative, and a scale or aspect composes two
-#: such constants (fx from f and the aspect): 1 eps32; 2 leaves 2x.
-CONSTANT_ROUNDINGS = 2.0
 #: The named faults a float32 constant can fake (mirrors and swaps are exact in any precision).
 _ROUNDABLE = catalogue.names("scale", "offset")
 
@@ -333,8 +311,8 @@ def rounded_constants(faults: list[dict], camera, info: dict, tol_px: float, flo
     """``faults`` with scale and offset faults replaced by ``precision_limited`` when the fitted map's
     deviation from identity is within float32 rounding of the case's constants.
 
-    Scales within :data:`CONSTANT_ROUNDINGS` eps32 of 1 and an offset within
-    :data:`CONSTANT_ROUNDINGS` eps32 x (the farthest pixel from the principal
+    Scales within ``NAMING.constant_roundings`` eps32 of 1 and an offset within
+    ``NAMING.constant_roundings`` eps32 x (the farthest pixel from the principal
     point) are the rounding of a float32 K, aspect or matrix (``fov_mismatch(scale=1.00000001)``,
     ``aspect_mismatch(implied_aspect=1.3333334)``, ``pixel_offset(dx=-6.1e-06)``); a genuine 1e-4 px
     offset on a 640-px image is above its 7.6e-5 px and stays named.
@@ -342,7 +320,7 @@ def rounded_constants(faults: list[dict], camera, info: dict, tol_px: float, flo
     named = [f for f in faults if f["name"] in _ROUNDABLE]
     if not named or any(f["name"] in ("unexplained", "depth_flip", "clipping_plane") for f in faults):
         return faults
-    eps = CONSTANT_ROUNDINGS * EPS32
+    eps = NAMING.constant_roundings * EPS["float32"]
     d = info.get("scale")
     if d is None:
         return faults
@@ -404,7 +382,7 @@ def _diagnose_at(
     if clip is not None and clip["kind"] == "swapped":
         return [clip]  # keeps nothing, in front or behind: not a flip
     # 1. depth flip: visible sets (nearly) swapped
-    if mismatches and n_both <= DEPTH_FLIP_MAX_OVERLAP * n_union:
+    if mismatches and n_both <= NAMING.depth_flip_max_overlap * n_union:
         return [
             {
                 "name": "depth_flip",
@@ -428,7 +406,7 @@ def _diagnose_at(
     # degenerate: fewer than 3 non-collinear common points -> offset only
     spread = o - o.mean(axis=0) if n_both else o
     sv = np.linalg.svd(spread, compute_uv=False) if n_both >= 2 else np.zeros(2)
-    if n_both < 3 or sv[0] == 0 or sv[-1] < DEGENERATE_RATIO * sv[0]:
+    if n_both < 3 or sv[0] == 0 or sv[-1] < NAMING.degenerate_ratio * sv[0]:
         faults = []
         if n_both:
             off = (c - o).mean(axis=0)
@@ -532,12 +510,6 @@ def _diagnose_at(
     return _sorted(faults)
 
 
-#: A line end is named in ``line_end_bias`` when its net one-sided pixels are
-#: at least this many per line: a quarter pixel on average, far above what an
-#: unbiased rasterizer leaves (one-sided pixels at ends of both signs cancel).
-LINE_END_MIN_PX = 0.25
-
-
 def diagnose_lines(lines: dict, tol) -> list[dict]:
     """Name a systematic line-pixel fault from a case's pooled line fields; [] when they pass.
 
@@ -549,7 +521,7 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     oracle's segments (``one_sided_by_place``): net pixels per line at the
     segment's first point (``start``) and last point (``end``), candidate minus
     oracle (negative: the candidate's lines are short there). Where one end or
-    both carry at least :data:`LINE_END_MIN_PX` per line and together at least
+    both carry at least ``NAMING.line_end_min_px`` per line and together at least
     half of the net imbalance, the fault is ``line_end_bias`` with ``end``
     (``"first"``, ``"last"`` or ``"both"``) and ``pixels_per_line`` (signed);
     otherwise ``line_pixel_bias`` (lines thicker or thinner, or stray pixels),
@@ -564,7 +536,7 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
     places = lines["one_sided_by_place"]
     net = {p: places[p][0] - places[p][1] for p in places}  # candidate-only minus oracle-only
     per_line = {"first": net["start"] / n, "last": net["end"] / n}
-    ends = [e for e in ("first", "last") if abs(per_line[e]) >= LINE_END_MIN_PX]
+    ends = [e for e in ("first", "last") if abs(per_line[e]) >= NAMING.line_end_min_px]
     total = lines["imbalance"]
     at_ends = sum(net[{"first": "start", "last": "end"}[e]] for e in ends)
     if ends and abs(at_ends) >= 0.5 * abs(total):
@@ -577,6 +549,16 @@ def diagnose_lines(lines: dict, tol) -> list[dict]:
                 **decided,
             }
         ]
-    return [
-        {"name": "line_pixel_bias", **decided, **{f"net_{p}": int(net[p]) for p in ("start", "end", "middle", "stray")}}
-    ]
+    return [{"name": "line_pixel_bias", **line_pixel_fields(lines)}]
+
+
+def line_pixel_fields(lines: dict) -> dict:
+    """``line_pixel_bias``'s fields from a case's pooled line fields (:func:`diagnose_lines`): the decided
+    one-sided pixels (ties left out) and the net pixels, candidate minus oracle, by where they lie."""
+    tc, to = lines["subpixel_ties"]
+    places = lines["one_sided_by_place"]
+    return {
+        "candidate_only": int(lines["candidate_only"] - tc),
+        "oracle_only": int(lines["oracle_only"] - to),
+        **{f"net_{p}": int(places[p][0] - places[p][1]) for p in ("start", "end", "middle", "stray")},
+    }

@@ -46,10 +46,10 @@ Method
    (as in the vertex diagnosis). A candidate that draws nothing where the
    oracle draws lines, while the backward camera also sees nothing, is the
    image of "clips everything the oracle shows": ``depth_flip`` too.
-5. **Faults.** With ``residual_px <= RESIDUAL_MAX_PX`` the faults are read off
+5. **Faults.** With ``residual_px <= NAMING.residual_max_px`` the faults are read off
    ``P``, ``d`` and ``b`` as in :mod:`oracles.diagnosis.diagnose` (step 4 there), with the
-   pixel tolerances :data:`SCALE_TOL_PX` (a scale's largest effect on a drawn
-   pixel) and :data:`OFFSET_TOL_PX`; otherwise the answer is ``unexplained``
+   pixel tolerances ``Tolerances.scale_px`` (a scale's largest effect on a drawn
+   pixel) and ``Tolerances.offset_px``; otherwise the answer is ``unexplained``
    (a rotation, a shear, a 3D error: nothing of the family draws these pixels), or, when
    the identity fits and only the drawn sets differ, the visibility advice (:mod:`.image_visibility`).
 
@@ -66,7 +66,7 @@ confidence measures that fault; a fit that no start explains is restarted
 from the scales convention mistakes give (:mod:`oracles.diagnosis.image_naming`).
 
 Limits (measured in tests/test_image_diagnosis.py, stated in docs/frames.md):
-the images must show enough line to fit (:data:`MIN_PIXELS` drawn pixels in a
+the images must show enough line to fit (``NAMING.min_registered_px`` drawn pixels in a
 case), the fault must move lines by more than the tolerances above, and a
 scale below ~0.5 or above ~2 may not be recovered from the unit start.
 """
@@ -76,8 +76,8 @@ from __future__ import annotations
 import numpy as np
 from wirecheck.core.camera import Camera
 
-from .. import tolerances as _tolerances
 from ..candidates import draw
+from ..tolerances import NAMING, Tolerances
 from .image_naming import name_faults, restart_scales, rotation_deg, rule_off_diagonal
 from .image_visibility import in_place, visibility_fault
 from .model_lines import quantisation_bias
@@ -95,28 +95,6 @@ from .registration import (
 )
 
 __all__ = ["diagnose_images", "oracle_segments", "flipped_camera"]
-
-#: A case needs this many drawn candidate pixels to be fitted (a 4-parameter
-#: fit per axis pair is determined far earlier; 50 keeps stray pixels out).
-MIN_PIXELS = 50
-#: A correct 1-px aliased renderer sits ~0.3 px from the exact lines (pixel
-#: centres are within 0.5 px of a line across its minor axis); an anti-aliased
-#: or 2-px-wide one ~0.5 px. A fit worse than this is no member of the family.
-RESIDUAL_MAX_PX = 0.85
-#: A permutation is named only when it fits this much better (relative cost)
-#: than none: a symmetric picture (a cube seen along an axis, an orthographic
-#: view of a centrally symmetric scene) fits several equally well (measured
-#: relative differences below 1e-2), and then no mirror can be seen.
-AMBIGUOUS_RATIO = 0.05
-#: A scale is a fault when it moves some drawn pixel by more than this (px): the default of
-#: Tolerances.scale_px (oracles.tolerances, with its derivation).
-SCALE_TOL_PX = _tolerances.SCALE_TOL_PX
-#: The free affine fit's off-diagonal terms (rotation, shear) are a fault when
-#: they move a pixel by more than this: <= 0.04 px on a correct renderer,
-#: 0.77-1.17 px for a 0.5 degree roll (measured on the tests' cameras).
-ROTATION_TOL_PX = 0.3
-#: An offset is a fault when it exceeds this (px): the default of Tolerances.offset_px.
-OFFSET_TOL_PX = _tolerances.OFFSET_TOL_PX
 
 
 # ---------------------------------------------------------------- the oracle's lines
@@ -171,15 +149,15 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
         is not considered.
     tol : oracles.tolerances.Tolerances, optional
         Its ``scale_px`` and ``offset_px`` name a scale and an offset (default
-        :data:`SCALE_TOL_PX`, :data:`OFFSET_TOL_PX`).
+        ``Tolerances()``'s). The naming thresholds are :data:`oracles.tolerances.NAMING`'s.
 
     Returns
     -------
     list of dict, primary fault first (precedence: oracles.faults);
     every fault has ``confidence`` and ``residual_px``.
     """
-    scale_tol = SCALE_TOL_PX if tol is None else tol.scale_px
-    offset_tol = OFFSET_TOL_PX if tol is None else tol.offset_px
+    tol = Tolerances() if tol is None else tol
+    scale_tol, offset_tol = tol.scale_px, tol.offset_px
     cand_images = list(cand_images)
     oracle_segs = list(oracle_segs)
     if len(cand_images) != len(oracle_segs):
@@ -212,7 +190,7 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
                 "note": "the candidate drew nothing where the oracle draws lines",
             }
         ]
-    if drawn < MIN_PIXELS:
+    if drawn < NAMING.min_registered_px:
         return [
             {
                 "name": "unexplained",
@@ -220,7 +198,7 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
                 "residual_px": None,
                 "candidate_pixels": drawn,
                 "underdetermined": True,
-                "note": f"only {drawn} drawn pixels: expected at least {MIN_PIXELS} to register",
+                "note": f"only {drawn} drawn pixels: expected at least {NAMING.min_registered_px} to register",
             }
         ]
 
@@ -233,10 +211,10 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
         frame_samples(cand_images, oracle_segs, camera, screen, nearest), camera.width, camera.height, centre
     )
     ranked = register(coarse, fine)
-    if ranked[0][0] > RESIDUAL_MAX_PX:  # no member fits from the usual starts: a large scale?
+    if ranked[0][0] > NAMING.residual_max_px:  # no member fits from the usual starts: a large scale?
         ranked = restart_scales(coarse, fine, ranked, camera)
     plain = next(r for r in ranked if r[1] == ())
-    if plain[0] <= ranked[0][0] * (1.0 + AMBIGUOUS_RATIO):
+    if plain[0] <= ranked[0][0] * (1.0 + NAMING.ambiguous_ratio):
         ranked = [plain] + [r for r in ranked if r is not plain]  # a symmetric picture: no permutation
     cost, names, p, a, b = ranked[0]
     second = ranked[1][0] if len(ranked) > 1 else PAIR_CAP_PX
@@ -247,7 +225,7 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
             frame_samples(cand_images, flipped_segs, camera, limit, nearest), camera.width, camera.height, centre
         )
         b_cost = back.cost(np.eye(2), np.eye(2), np.zeros(2))
-        if b_cost < cost and b_cost <= RESIDUAL_MAX_PX:
+        if b_cost < cost and b_cost <= NAMING.residual_max_px:
             return [
                 {
                     "name": "depth_flip",
@@ -262,9 +240,9 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
     reach = np.minimum(reach, [camera.width / 2.0, camera.height / 2.0])  # the part an image can show
     a_free, b_free, cost_free = fine.fit(p, a, b, affine=True)
     off_diagonal = max(abs(a_free[0, 1]) * reach[1], abs(a_free[1, 0]) * reach[0])
-    if cost <= RESIDUAL_MAX_PX and off_diagonal > ROTATION_TOL_PX:  # another aliased rule's own shear?
+    if cost <= NAMING.residual_max_px and off_diagonal > NAMING.rotation_px:  # another aliased rule's own shear?
         off_diagonal = rule_off_diagonal(cand_images, oracle_segs, camera, (p, a, b), a_free, reach, off_diagonal)
-    if cost > RESIDUAL_MAX_PX or off_diagonal > ROTATION_TOL_PX:
+    if cost > NAMING.residual_max_px or off_diagonal > NAMING.rotation_px:
         fault = {
             "name": "unexplained",
             "confidence": confidence,
@@ -285,7 +263,7 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
             off_diagonal,
             reach,
             matched,
-            (scale_tol, offset_tol, ROTATION_TOL_PX, RESIDUAL_MAX_PX),
+            (scale_tol, offset_tol, NAMING.rotation_px, NAMING.residual_max_px),
         ):
             fault = visibility_fault(fault, cand_images, oracle_segs, camera, matched)
         return [fault]
@@ -299,7 +277,7 @@ def diagnose_images(cand_images, oracle_segs, camera, flipped_segs=None, tol=Non
         quantisation_bias,
         scale_tol,
         offset_tol,
-        AMBIGUOUS_RATIO,
+        NAMING.ambiguous_ratio,
         cost,
         cand_images,
     )

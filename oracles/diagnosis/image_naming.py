@@ -5,7 +5,7 @@ permutation ``P`` with per-axis scales ``d`` and an offset ``b``; this module
 reads the faults off the winner, and says what the images cannot decide:
 
 * **Ambiguity.** When a second permutation other than the identity fits
-  within :data:`oracles.diagnosis.image_diagnose.AMBIGUOUS_RATIO` of the best (a
+  within ``NamingThresholds.ambiguous_ratio`` (oracles.tolerances) of the best (a
   horizontal mirror of a view that is also up-down symmetric: a cube
   square-on, an orthographic view), the permutations they do not share are
   reported as one ``ambiguous`` fault with ``alternatives`` (both names) and a

@@ -6,7 +6,7 @@ oracle's lines are, and draws more or fewer of them. The registration
 (:mod:`oracles.diagnosis.image_diagnose`) then fits the identity with no
 scale, offset or rotation, and the pairs it finds are as close as a correct
 drawing's; only the unpaired pixels (whole pieces of line on one side) raise
-its cost above :data:`oracles.diagnosis.image_diagnose.RESIDUAL_MAX_PX`. That
+its cost above ``NAMING.residual_max_px`` (oracles.tolerances). That
 is a visibility, clipping or raster question, not a rotation order: as on the
 projector path (:func:`oracles.diagnosis.diagnose.diagnose`'s advice), the
 ``unexplained`` says which sets differ instead.
@@ -28,9 +28,6 @@ from ..tolerances import NAMING
 
 __all__ = ["set_difference", "visibility_fault", "in_place", "frames_visibility", "visibility_names"]
 
-#: A pixel is on one side only when the other side has no pixel within this distance (px): F1@1px's tolerance.
-NEAR_PX = 1.0
-
 
 def _oracle_image(segs, camera) -> np.ndarray:
     segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
@@ -43,12 +40,12 @@ def _oracle_image(segs, camera) -> np.ndarray:
 
 
 def _beyond(a: np.ndarray, b: np.ndarray) -> int:
-    """Pixels of ``a`` with no pixel of ``b`` within :data:`NEAR_PX` (all of ``a`` when ``b`` is empty)."""
+    """Pixels of ``a`` with no pixel of ``b`` within ``NAMING.near_px`` (all of ``a`` when ``b`` is empty)."""
     from scipy.ndimage import distance_transform_edt
 
     if not b.any():
         return int(np.count_nonzero(a))
-    return int(np.count_nonzero(a & (distance_transform_edt(~b) > NEAR_PX)))
+    return int(np.count_nonzero(a & (distance_transform_edt(~b) > NAMING.near_px)))
 
 
 def set_difference(cand_images, oracle_segs, camera) -> tuple[int, int]:
@@ -104,7 +101,12 @@ def visibility_fault(
         "oracle_only_px": oracle_only,
         **({} if matched_px is None else {"matched_residual_px": float(matched_px)}),
         "hint": catalogue.hint_text(
-            "unexplained", "drawn_sets", where=where, candidate_only=cand_only, oracle_only=oracle_only, near=NEAR_PX
+            "unexplained",
+            "drawn_sets",
+            where=where,
+            candidate_only=cand_only,
+            oracle_only=oracle_only,
+            near=NAMING.near_px,
         ),
     }
 
@@ -131,7 +133,7 @@ def visibility_names(
 ) -> list:
     """:func:`frames_visibility` on the sets already counted (``counts``: :func:`set_difference` over
     ``frames_diagnosed`` frames): a bare ``unexplained`` gets the advice; a ``line_pixel_bias`` becomes it when
-    at least ``share`` of its decided one-sided pixels, per frame, lie farther than :data:`NEAR_PX` from the
+    at least ``share`` of its decided one-sided pixels, per frame, lie farther than ``NAMING.near_px`` from the
     other side (a line drawn too thick or too thin never leaves a pixel that far), its name kept under
     ``line_fault`` (oracles.tolerances.NamingThresholds.visibility_share)."""
     if faults[0]["name"] == "unexplained":

@@ -14,8 +14,8 @@ fit closer (the registration's cost), but the two costs are not always far enoug
   1.3317 for 4/3, puts the model's rounded ends up to a fifth of a pixel from the renderer's near the
   image's edge). Correct GL-rule frames (core's raster) fit the rounded-ends lines closer only where both
   rules draw the same pixels (square-on cubes, by up to 38 %; the same bias). So a rule is read alone only
-  when the other rule's cost exceeds its own by more than :data:`RULE_TIE` of it; within that, both
-  are read (:func:`read_rules`).
+  when the other rule's cost exceeds its own by more than ``NAMING.rule_tie`` of it (oracles.tolerances);
+  within that, both are read (:func:`read_rules`).
 * **Standing against every rule read.** A fault that one rule's own bias would explain is no fault of a
   renderer that may follow that rule: an offset is named only when it stands against the bias of every
   rule read (:func:`oracles.diagnosis.image_naming.name_faults`), a scale only when it stands against the
@@ -26,25 +26,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tolerances import NAMING
 from .diagnose import scale_faults
 from .model_lines import JITTER, model_lines, quantisation_bias
 from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
 
-__all__ = ["ROUNDED_END_PX", "RULE_TIE", "read_rules", "standing_scale_faults"]
-
-#: How far (px) a rule that rounds each end to a pixel centre may put a line's farthest end, along each
-#: axis, from where its scale puts it: half a pixel (the rounding). The registration's reference drawing
-#: of that rule (core's ``line_pixels_fast``) matches a renderer's rounding except at ties (an end on a
-#: half pixel: OpenCV's fixed point, 4 bits, rounds it its own way), so a fitted scale may move the farthest
-#: pixel by that half pixel more than under GL's rule: a scale fault is named under that rule when it moves
-#: a pixel by more than the scale tolerance plus this (as the line-centre measure adds half a pixel to the
-#: warp of binary lines, oracles.judge.line_style). Measured: a correct LINE_8 on prism / on_axis fits
-#: scales (0.99897, 1.00371), an aspect of 0.53 px at 111 px reach; the wrong-axis FOV drawn by
-#: Bresenham 0.6-0.73 px; an aspect mistake of 3 % (fx = 1.03 fy) moves the farthest pixel by 3 px or more.
-ROUNDED_END_PX = 0.5
-#: The relative cost margin within which both rules are read (module docstring): above the largest
-#: misread measured where the rules' biases differ (30 %, a rounded-ends renderer read as GL's).
-RULE_TIE = 1.0 / 3.0
+__all__ = ["read_rules", "standing_scale_faults"]
 
 
 def _costs(cand_images, oracle_segs, camera, p, d, b):
@@ -75,12 +62,12 @@ def read_rules(cand_images, oracle_segs, camera, p, d, b, gl_bias) -> dict:
     ``p, d, b``: the fitted model (signed permutation, per-axis scales, offset); ``gl_bias``: GL's
     bias for it (:func:`oracles.diagnosis.model_lines.quantisation_bias`). The closer rule is the one
     whose model the pixels fit closer (:func:`_costs`), as :func:`oracles.diagnosis.image_naming.rule_bias`
-    reads it; the other is read too when its cost is within :data:`RULE_TIE` of the closer one's.
+    reads it; the other is read too when its cost is within ``NAMING.rule_tie`` of the closer one's.
     """
     snapped_bias, gl, snapped = _costs(cand_images, oracle_segs, camera, p, d, b)
     rules = {"gl": np.asarray(gl_bias, dtype=np.float64), "snapped": snapped_bias}
     order = ["snapped", "gl"] if snapped < gl else ["gl", "snapped"]
-    tie = max(gl, snapped) <= (1.0 + RULE_TIE) * min(gl, snapped)
+    tie = max(gl, snapped) <= (1.0 + NAMING.rule_tie) * min(gl, snapped)
     return {rule: rules[rule] for rule in (order if tie else order[:1])}
 
 
@@ -88,9 +75,9 @@ def standing_scale_faults(faults: list, d, reach, tol: float, camera, rules) -> 
     """The scale faults of ``faults`` that stand under every rule of ``rules`` (:func:`read_rules`).
 
     Under the rule that rounds the ends a scale must move a pixel by more than ``tol`` plus
-    :data:`ROUNDED_END_PX`; under GL's, by more than ``tol`` (``faults`` were named so).
+    ``NAMING.rounded_end_px`` (oracles.tolerances); under GL's, by more than ``tol`` (``faults`` were named so).
     """
     if "snapped" not in rules:
         return faults
-    loose = {f["name"] for f in scale_faults(float(d[0]), float(d[1]), reach, tol + ROUNDED_END_PX, camera)}
+    loose = {f["name"] for f in scale_faults(float(d[0]), float(d[1]), reach, tol + NAMING.rounded_end_px, camera)}
     return [f for f in faults if f["name"] in loose]

@@ -13,7 +13,7 @@ reprojected by the reference projection (OpenCV's ``projectPoints``; ``u', v'``)
     rotation_transposed  R where R^T belongs: X = R (p_cv - t), or R p_cv + C   -
     distortion_mismatch  the lens's distortion not undone                  -
 
-A fault explains the candidate when every point is within :data:`FIT_SLACK` of its bound
+A fault explains the candidate when every point is within ``NAMING.unproject_fit_slack`` (oracles.tolerances) of its bound
 of the mistaken inverse's point. Two names that both explain it (a view where rows flipped
 is also a transposed rotation) are ``ambiguous``; none: ``unexplained``, with the median
 pixel shift, scale and depth ratio measured. Every name is the fault catalogue's (oracles.faults:
@@ -32,13 +32,9 @@ from ..faults import Fault
 from ..references.convert import opencv_matrices
 from ..references.opencv_oracle import project as cv_project
 from ..references.unproject_reference import cam_points, unproject
+from ..tolerances import NAMING
 
-__all__ = ["FIT_SLACK", "UNPROJECT_FAULTS", "name_unproject_faults"]
-
-#: A mistaken inverse explains the candidate within this many bounds: its parameters are
-#: medians of reprojected points, each within its own bound, so they move the model by up to
-#: about one bound; doubled for the two sides' roundings: 4.
-FIT_SLACK = 4.0
+__all__ = ["UNPROJECT_FAULTS", "name_unproject_faults"]
 
 #: Every name this module gives: the catalogue's names read from an unprojector's points, in precedence order.
 UNPROJECT_FAULTS = catalogue.names(source="points")
@@ -63,7 +59,7 @@ def name_unproject_faults(p_px, depth, camera, cand, bound) -> tuple[list, dict]
         if math.isfinite(ratio) and ratio < fits.get(name, (np.inf,))[0]:
             fits[name] = (ratio, params)
     measured["fit_ratios"] = {n: r for n, (r, _) in fits.items()}
-    names = [n for n, (r, _) in sorted(fits.items(), key=lambda kv: kv[1][0]) if r <= FIT_SLACK]
+    names = [n for n, (r, _) in sorted(fits.items(), key=lambda kv: kv[1][0]) if r <= NAMING.unproject_fit_slack]
     if len(names) > 1:
         return [Fault("ambiguous", {"alternatives": ", ".join(names)}, "points")], measured
     if names:

@@ -292,21 +292,14 @@ def run_case(
     t7 = acc.add("vmetric", t7)
     record_lines(acc, acc.line_batch.flush())
     acc.add("pmetric", t7)
-    rec, image_faults, line_named = case_record(setup, acc, tol)
+    rec, ev = case_record(
+        setup, acc, tol, points=len(scene.vertices), oracle_bound_px=acc.oracle_bound_px if setup.pixels else None
+    )
     if setup.slack_why:  # the clipped ends were placed for the candidate's own (float32-rounded) planes
         rec["clipped_ends"] = {"inward_depth": setup.slack, "reason": setup.slack_why}
     if setup.pixels_skipped:
         rec["note"] = PIXELS_NOT_COMPARED
-    judge(
-        rec,
-        tol,
-        acc.error,
-        points=len(scene.vertices),
-        oracle_bound_px=acc.oracle_bound_px if setup.pixels else None,
-        image_faults=image_faults,
-        line_named=line_named,
-    )
-    rec["per_frame"] = acc.per_frame
+    judge(rec, ev, tol, acc.per_frame)
     images = None
     if acc.worst is not None:
         images = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}

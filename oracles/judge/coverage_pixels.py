@@ -11,11 +11,11 @@ For a frame of grey levels (antialiased: oracles.judge.line_style reads it), a
 pixel is also drawn when it is a *ridge* across a line (its coverage at least
 that of both neighbours in its row and more than one of them, or the same in
 its column: not along a line, where the coverage stays level) holding at least
-:data:`RIDGE_MIN` coverage. A line at most 1 px wide splits its coverage
+:func:`ridge_min` coverage. A line at most 1 px wide splits its coverage
 across a row or column between at most two pixels, so the larger of them
 holds at least half of what the line puts there, and that is at least half
 its width (more on a slant: a column crosses it over ``width / |cos|``); so a
-line from :data:`RIDGE_MIN_WIDTH_PX` on has a ridge pixel on every row or
+line from ``NAMING.ridge_min_width_px`` (oracles.tolerances) on has a ridge pixel on every row or
 column it crosses. A fringe pixel beside a brighter one is no ridge, so
 the rule adds no pixel off the line's centre, and binary frames are left to
 the 128 rule (GL's pixel rule judges them).
@@ -25,12 +25,13 @@ from __future__ import annotations
 
 import numpy as np
 
-#: The thinnest antialiased line whose every row (column) keeps a drawn pixel (px): thinner lines
-#: (coverage under a quarter where they fall between two pixels) cannot be read.
-RIDGE_MIN_WIDTH_PX = 0.5
-#: A ridge pixel's least grey level: half of RIDGE_MIN_WIDTH_PX's coverage (0.25 of 255 = 63.75),
-#: rounded down so that a renderer that rounds 63.75 down still draws it.
-RIDGE_MIN = int(255 * RIDGE_MIN_WIDTH_PX / 2)
+from ..tolerances import NAMING
+
+
+def ridge_min() -> int:
+    """A ridge pixel's least grey level: half of ``NAMING.ridge_min_width_px``'s coverage (0.25 of 255 =
+    63.75 for 0.5 px), rounded down so that a renderer that rounds 63.75 down still draws it."""
+    return int(255 * NAMING.ridge_min_width_px / 2)
 
 
 def drawn(grey: np.ndarray) -> np.ndarray:
@@ -40,4 +41,4 @@ def drawn(grey: np.ndarray) -> np.ndarray:
     ridge = np.zeros(g.shape, bool)
     for a, b in ((pad[1:-1, :-2], pad[1:-1, 2:]), (pad[:-2, 1:-1], pad[2:, 1:-1])):  # the row, the column
         ridge |= (g >= a) & (g >= b) & ((g > a) | (g > b))
-    return (g >= 128) | ((g >= RIDGE_MIN) & ridge)
+    return (g >= 128) | ((g >= ridge_min()) & ridge)

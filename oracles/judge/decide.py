@@ -17,7 +17,7 @@ missed, one reason each:
   filled_frames): depth error over its bound, holes and extra surface, blank frames, the silhouette's
   longest run and IoU, object ids;
 - the gate (:mod:`oracles.judge.gate`): a case that misses no limit but compared nothing is ``"vacuous"``;
-- the oracle's own precision: past ``ORACLE_LIMIT_PX`` (oracles.references.oracle_precision) the pixels are
+- the oracle's own precision: past ``tol.oracle_limit_px`` (oracles.references.oracle_precision) the pixels are
   set aside and the case is judged on its vertices alone.
 
 The names are :func:`oracles.judge.name_faults.name_faults`'s, from the same evidence and this verdict.
@@ -35,7 +35,6 @@ import numpy as np
 
 from .. import faults as catalogue
 from ..faults import Fault
-from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import NAMING, Tolerances, line_failures
 from . import gate
 from .evidence import CaseEvidence, Radius, StyleRead
@@ -72,7 +71,8 @@ class StyleJudgement:
     lines); ``rounded_case``: ``"correct"`` (a correct drawing by the rounded-ends rule) or ``"biased"``
     (that rule's drawing but for a bias of its one-sided pixels, ``--line-rule any``), else None;
     ``pixel_rule``: GL's limits decide; ``gl_reasons``: GL's limits missed; ``only_gl``: nothing else of
-    F1 missed; ``failures``: the reasons the style adds.
+    F1 missed; ``failures``: the reasons the style adds; ``job_moved``: the job's pooled offset
+    (oracles.judge.job_read), not the case's own, misses ``offset_tol_px`` (``moved`` is then set too).
     """
 
     offset_tol_px: float
@@ -87,6 +87,7 @@ class StyleJudgement:
     gl_reasons: tuple[str, ...]
     only_gl: bool
     failures: tuple[str, ...]
+    job_moved: bool = False
 
 
 @dataclass(frozen=True)
@@ -97,7 +98,7 @@ class Verdict:
     reasons: tuple[str, ...]
     style: StyleJudgement | None = None
     #: The reasons the case had with its pixels, set aside because the pyrender oracle's own error bound
-    #: exceeds ORACLE_LIMIT_PX (its pixels then say nothing of the candidate); None: the pixels were judged.
+    #: exceeds Tolerances.oracle_limit_px (its pixels then say nothing of the candidate); None: the pixels were judged.
     set_aside: tuple[str, ...] | None = None
 
 
@@ -206,6 +207,16 @@ def judge_style(
     d = s.offset_px
     moved = s.placed and max(abs(d[0]), abs(d[1])) > offset_tol
     warped = s.placed and geo["warp_px"] > warp_tol
+    job = s.job or {}
+    job_d = job.get("offset_px")
+    # one renderer places every case's lines alike (oracles.judge.job_read): the median of the cases' offsets
+    # (where the case's own offset already misses the bound on lines no pixel rule holds, that one is reported)
+    job_moved = bool(
+        job_d is not None
+        and s.placed
+        and not (moved and not s.by_rule)
+        and max(abs(job_d[0]), abs(job_d[1])) > offset_tol
+    )
     end = geo["end_px"]
     end_out = bool(
         s.placed
@@ -229,6 +240,13 @@ def judge_style(
                 f"line centres moved by up to {geo['warp_px']:.2f} px by a scale, rotation "
                 f"or shear > {warp_tol:.3g} ({s.style} lines)"
             )
+    if job_moved:
+        failures.append(
+            f"the job's line centres offset by ({job_d[0]:.2f}, {job_d[1]:.2f}) px > {offset_tol:.3g} (the median "
+            f"of {job['offset_cases']} cases' offsets: one renderer places every case's lines; this case's own "
+            f"({d[0]:.2f}, {d[1]:.2f}))"
+        )
+        moved = True
     only_gl = bool(gl_reasons) and not radius_reasons
     only_rule = only_gl and all(f.name in RULE_FAULTS for f in diagnosed)
     rule_read: str | None = None
@@ -251,6 +269,18 @@ def judge_style(
             # the rounded-ends rule's pixels but for a bias of its one-sided pixels (a dropped end pixel)
             rule_read, rounded_case = "rounded", "biased"
             failures += rounded_failures
+        if (
+            job.get("rule") == "rounded"
+            and rule_read == "gl"
+            and s.line_rule == "any"
+            and only_rule
+            and not moved
+            and not warped
+            and rf0 >= max(tol.min_f1_0px, tol.rule_f1_0px)
+        ):  # the job's cases read the rounded-ends rule: this one is held to it too (oracles.judge.job_read),
+            # where its pixels are that rule's drawing (F1@0px) but for what its limits say
+            rule_read, rounded_case = "rounded", "correct" if not rounded_failures else "biased"
+            failures += rounded_failures
     elif s.by_rule:
         rule_read = "gl"
     return StyleJudgement(
@@ -266,6 +296,7 @@ def judge_style(
         gl_reasons=tuple(gl_reasons),
         only_gl=only_gl,
         failures=tuple(failures),
+        job_moved=job_moved,
     )
 
 
@@ -375,7 +406,7 @@ def decide(ev: CaseEvidence, tol: Tolerances) -> Verdict:
     if ev.filled is not None:
         why += filled_reasons(ev.filled, tol)
     verdict, reasons = gate.case_verdict(dict(ev.compared), why, ev.level, ev.points)
-    if ev.oracle_bound_px is not None and ev.oracle_bound_px > ORACLE_LIMIT_PX and verdict != "vacuous":
+    if ev.oracle_bound_px is not None and ev.oracle_bound_px > tol.oracle_limit_px and verdict != "vacuous":
         return _vertices_only(ev, tol, tuple(reasons), style)
     return Verdict(verdict, tuple(reasons), style)
 
@@ -397,7 +428,7 @@ def _vertices_only(ev: CaseEvidence, tol: Tolerances, reasons: tuple, style) -> 
     alone = decide(vertices, tol)
     why = (
         f"oracle_precision: the pyrender oracle's own error bound {ev.oracle_bound_px:.3g} px exceeds "
-        f"{ORACLE_LIMIT_PX:.3g} px (float32 at this camera and mesh size); its pixels are not judged"
+        f"{tol.oracle_limit_px:.3g} px (float32 at this camera and mesh size); its pixels are not judged"
     )
     vertex_reasons = alone.reasons if alone.verdict == "fail" else ()
     return Verdict("fail" if vertex_reasons else "vacuous", (why,) + vertex_reasons, style, set_aside=reasons)

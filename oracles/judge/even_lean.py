@@ -22,7 +22,7 @@ the ``[e + 1/2 - h, e + 1/2 + h]`` band is pixel for pixel Pillow's on axis-
 aligned lines: a line up to 1.0 px off its exact position (0.5 rounding, 0.5
 lean) and still correct. Pillow's width 2 draws lines within 30 degrees of an
 axis about 1.2 pixels across: their median width reads 1.0-1.7, so binary
-lines are also read wide where they draw :data:`WIDE_PIXEL_RATIO` times the
+lines are also read wide where they draw :attr:`oracles.tolerances.NamingThresholds.wide_pixel_ratio` times the
 oracle's pixels (:meth:`oracles.judge.line_style.CaseStyle.classify`).
 
 So each edge's centre is known only up to that choice. Its measured centres
@@ -36,8 +36,8 @@ times in 100 (:data:`EDGE_NOISE_PX2`, :data:`CHI2_2_P99`, over the case's
 effective number of edges), then refined by least squares with those choices.
 
 The fit (``leaning``) explains the edges' means better than the symmetric band
-by :data:`LEAN_GAIN_PX2` (or the edges are too few to test the symmetric band,
-:data:`MAX_UNTESTED_EDGES`); it replaces the symmetric band's measure only
+by ``NAMING.lean_gain_px2`` (or the edges are too few to test the symmetric band,
+``NAMING.max_untested_edges``; oracles.tolerances); it replaces the symmetric band's measure only
 where that one fails the case (an offset past the binary lines' 0.35 px or a
 warp past theirs: :meth:`oracles.judge.line_style.CaseStyle.geometry`,
 ``geometry["lean"]["used"]``), the lean being the last explanation: a renderer of
@@ -78,24 +78,6 @@ EDGE_NOISE_PX2 = 1.0 / 24.0
 #: The 99th percentile of chi-square with 2 degrees of freedom (-2 ln 0.01): what fitting an offset
 #: ``(dx, dy)`` gains on edges of pure noise, in units of that noise over the edges, 1 time in 100.
 CHI2_2_P99 = -2.0 * np.log(0.01)
-#: The leaning fit replaces the symmetric band's when it lowers the mean square residual of the edges'
-#: means by this (px^2): the square of a quarter pixel (what a leaning edge, 0.5 px on the minor axis
-#: times |n_minor| >= 0.71, leaves under the symmetric band is at least 0.35 px), for a quarter of the
-#: edges. Measured: Pillow 2 px 0.12-0.30 symmetric against 0.02-0.05 leaning; symmetric 2-px bands,
-#: moved or not, 0.000-0.001 against 0.000-0.016.
-LEAN_GAIN_PX2 = 0.25 * 0.25**2
-#: Binary lines drawing this many pixels per pixel of the oracle's 1-px lines are wide whatever the
-#: median across them: a 1-px line of any aliased rule draws one pixel per step of its major axis, as
-#: GL's does (the ratio 1, give or take its ends). Pillow's width 2 draws its lines within 30 degrees
-#: of an axis about 1.2 pixels across (half a pixel off, leaning), the others 2-3: a median of 1.0-1.7
-#: on slanted views and 1.85-2.1 times the oracle's pixels (measured on the bundled job): NAMING.wide_pixel_ratio.
-WIDE_PIXEL_RATIO = NAMING.wide_pixel_ratio
-#: Cases with at most this many edges' worth of samples cannot test the symmetric band: its offset
-#: (two numbers) fits two edges exactly and leaves a third one number to check, so the leaning fit
-#: (the smaller offset, by the lean's ambiguity) is used there.
-MAX_UNTESTED_EDGES = 3.0
-#: Least samples of an edge for its residual to count (fewer: the edge's mean is noise).
-MIN_EDGE_SAMPLES = 5
 #: What a case record keeps of the fit (line_style.geometry: ``geometry["lean"]``).
 REPORTED = (
     "leaning",
@@ -151,7 +133,7 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     keys, inv, counts, means = _edge_means(edge, resid)
     n_edge = np.zeros((len(keys), 2))
     n_edge[inv] = normal  # one normal per segment
-    used = counts >= MIN_EDGE_SAMPLES
+    used = counts >= NAMING.min_edge_samples
     if used.sum() == 0:
         return None
     w, r, n = counts[used].astype(float), means[:, used], n_edge[used]
@@ -179,8 +161,8 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     d, _ = pooled_offset(normal, corrected)
     ms = float(w @ (r[choice, np.arange(len(w))] - n @ d) ** 2) / w.sum()
     # the leaning bands replace the symmetric one where they explain the edges better, or where the edges
-    # cannot test the symmetric band (two numbers fitted to at most MAX_UNTESTED_EDGES edges' worth)
-    leaning = ms < ms_sym - LEAN_GAIN_PX2 or edges_eff <= MAX_UNTESTED_EDGES
+    # cannot test the symmetric band (two numbers fitted to at most NAMING.max_untested_edges edges' worth)
+    leaning = ms < ms_sym - NAMING.lean_gain_px2 or edges_eff <= NAMING.max_untested_edges
     return {
         "leaning": bool(leaning),
         "offset": d,

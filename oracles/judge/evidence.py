@@ -34,7 +34,9 @@ class StyleRead:
     counted by where they lie; ``rounded``: the pixels against a correct drawing by the rounded-ends rule
     (``pixel_f1_0px``, ``lines``; None when not drawn); ``rounded_faults``: the line fault those lines name
     (oracles.diagnosis.diagnose.diagnose_lines); ``placed``: the centres were measured on lines that lie
-    where the oracle's do (enough of them found, no mirror or swap named from the images).
+    where the oracle's do (enough of them found, no mirror or swap named from the images); ``job``: the
+    read of the renderer pooled over the job's cases, where it is imposed on this case
+    (oracles.judge.job_read.JobRead.as_dict; None: the case's own read alone).
     """
 
     line_rule: str
@@ -44,9 +46,10 @@ class StyleRead:
     rounded: Mapping[str, Any] | None
     rounded_faults: tuple[Fault, ...]
     placed: bool
+    job: Mapping[str, Any] | None = None
 
     def __post_init__(self):
-        for name in ("read", "geometry", "raster", "rounded"):
+        for name in ("read", "geometry", "raster", "rounded", "job"):
             object.__setattr__(self, name, frozen_map(getattr(self, name)))
 
     @property

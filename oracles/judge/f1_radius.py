@@ -18,7 +18,7 @@ with no candidate pixel at any radius (recall falls by its share of the
 pixels), and a line moved by a pixel or more is measured from its centres
 (``pixel_offset``: oracles.judge.decide.judge_style, oracles.judge.name_faults), not from F1.
 
-Each frame's F1 is computed at every radius up to :data:`MAX_RADIUS_PX`
+Each frame's F1 is computed at every radius up to :attr:`oracles.tolerances.NamingThresholds.max_radius_px`
 (only where F1@1px is below 1: at 1 every pixel is within any wider radius),
 since the style is read from the whole case, after its frames.
 """
@@ -31,10 +31,12 @@ from ..tolerances import NAMING
 from .evidence import Radius
 from .metrics import pixel_scores
 
+
 #: The widest radius computed: oracles.tolerances.NAMING.max_radius_px (3: lines up to 5 px across; its reason there).
-MAX_RADIUS_PX = NAMING.max_radius_px
 #: The radii computed per frame besides F1@1px.
-RADII = tuple(range(2, MAX_RADIUS_PX + 1))
+def radii() -> tuple[int, ...]:
+    """The radii above 1 px each frame's F1 is computed at: 2 .. NAMING.max_radius_px (read when called)."""
+    return tuple(range(2, NAMING.max_radius_px + 1))
 
 
 def radius_px(read: dict) -> int:
@@ -43,21 +45,21 @@ def radius_px(read: dict) -> int:
     ``aliased``: 1 (F1@1px, as for every 1-px line). ``wide`` or ``antialiased``:
     ``1 + ceil((n - 1) / 2)`` with ``n = round(width_px)`` at least 1, and at least ``band_px`` where the
     read has it (lines read wide by their pixel count, not their median width: 2; module
-    docstring), at most :data:`MAX_RADIUS_PX`.
+    docstring), at most :attr:`oracles.tolerances.NamingThresholds.max_radius_px`.
     """
     if read.get("style") == "aliased":
         return 1
     n = max(int(math.floor(float(read.get("width_px") or 0.0) + 0.5)), int(read.get("band_px") or 1), 1)
-    return min(1 + math.ceil((n - 1) / 2), MAX_RADIUS_PX)
+    return min(1 + math.ceil((n - 1) / 2), NAMING.max_radius_px)
 
 
 def frame_scores(fp, scores: dict) -> dict:
-    """``{radius: F1}`` of one frame for each of :data:`RADII` (``fp``: its oracles.judge.frame_pixels.FramePixels,
+    """``{radius: F1}`` of one frame for each of :func:`radii` (``fp``: its oracles.judge.frame_pixels.FramePixels,
     ``scores``: its oracles.judge.metrics.pixel_scores at 0 and 1 px)."""
     if scores["f1_1px"] == 1.0:  # every pixel within 1 px: within any wider radius
-        return {r: 1.0 for r in RADII}
-    wide = pixel_scores(None, None, tols=RADII, pixels=fp)
-    return {r: wide[f"f1_{r}px"] for r in RADII}
+        return {r: 1.0 for r in radii()}
+    wide = pixel_scores(None, None, tols=radii(), pixels=fp)
+    return {r: wide[f"f1_{r}px"] for r in radii()}
 
 
 def radius_read(read: dict, per_frame: list, frames: list, f1_1px: float, worst_frame) -> Radius:

@@ -1,5 +1,5 @@
 """The frames judge's reading ahead: a frame's inputs, its pyrender drawing and its PNG's grey levels, made
-on one worker thread while the judge scores the frames before it.
+on the run's GL thread while the judge scores the frames before it.
 
 The judge's own work on frame ``k`` (numpy) and the oracle's drawing of frame
 ``k + 1`` (pyrender on OSMesa/EGL: much of it inside the GL library, which
@@ -8,11 +8,10 @@ PyOpenGL's ctypes calls run without the GIL) and the decoding of its PNG
 
 What stays as it was:
 
-- **One GL thread.** A GL context is current on one thread at a time: every
-  GL call of a run (each :class:`~oracles.references.pyrender_oracle.PyrenderOracle`
-  made, every drawing, ``gl_info``, closing them) is made on the worker, in
-  the order it is asked for (a single-thread executor runs its tasks first in,
-  first out).
+- **One GL thread.** Every GL call of a run is made on the references' one
+  GL thread (oracles.references.gl_thread.GLThread: the oracles made, used
+  and closed there, first in, first out); this module only says what is read
+  ahead on it, and when.
 - **The same bytes.** Each frame's inputs, drawing and grey levels are
   computed by the same functions on the same files, one frame after the other,
   as without the thread; only when they are computed changes.
@@ -34,14 +33,13 @@ is handed an OracleCache (its callers' older form).
 
 from __future__ import annotations
 
-import threading
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 from pathlib import Path
 
 from ..candidates.export import job_outputs
 from ..candidates.frames_candidate import frame_faces, frame_inputs, read_frame
 from ..references.faces import fan
-from ..references.pyrender_oracle import OracleCache
+from ..references.gl_thread import GLThread
 
 #: Frames read ahead of the one being judged (each: the oracle's drawing and the PNG's grey levels).
 AHEAD = 2
@@ -123,48 +121,33 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: d
 
 
 class FramePrefetch:
-    """The frames of a run read :data:`AHEAD` ahead on one worker thread that owns every GL call (module docstring).
+    """The frames of a run read :data:`AHEAD` ahead on the run's GL thread (oracles.references.gl_thread), which
+    owns every GL call (module docstring).
 
     ``oracles``: the run's OracleCache (made here when None); it is used and
-    closed on the worker only. ``threaded=False`` reads each frame in the
+    closed on the GL thread only. ``threaded=False`` reads each frame in the
     calling thread when it is asked for (the same results, nothing overlapped).
     """
 
     def __init__(self, oracles=None, threaded: bool = True, ahead: int = AHEAD):
-        self.oracles = OracleCache() if oracles is None else oracles
+        self.gl = GLThread(oracles, threaded)
         self.ahead = int(ahead)
-        self._pool = ThreadPoolExecutor(1, thread_name_prefix="wirecheck-frames") if threaded else None
-        self._pending: set[Future] = set()
-        self._lock = threading.Lock()
 
-    def _submit(self, fn, *args) -> Future:
-        if self._pool is None:
-            f = Future()
-            try:
-                f.set_result(fn(*args))
-            except Exception as exc:  # noqa: BLE001 - as the pool's future would hold it
-                f.set_exception(exc)
-            return f
-        with self._lock:
-            f = self._pool.submit(fn, *args)
-            self._pending.add(f)
-        f.add_done_callback(self._done)
-        return f
-
-    def _done(self, f: Future) -> None:
-        with self._lock:
-            self._pending.discard(f)
+    @property
+    def oracles(self):
+        """The run's OracleCache (used on the GL thread only)."""
+        return self.gl.oracles
 
     def call(self, fn, *args):
         """``fn(*args)`` on the GL thread, waited for (``gl_info``)."""
-        return self._submit(fn, *args).result()
+        return self.gl.call(fn, *args)
 
     def frames(self, job_dir, job, c: dict, numbers: list):
         """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead."""
         cache: dict = {}  # frame_inputs' OBJ and camera, kept over the case (used on the worker only)
         todo = iter(zip(numbers, c["frames"] or [None] * len(numbers)))  # no wireframe asked: no PNG
         queued: list[Future] = []
-        if self._pool is None:  # read each frame when it is asked for
+        if not self.gl.threaded:  # read each frame when it is asked for
             for k, rel in todo:
                 yield read_ahead(self.oracles, job_dir, job, c, k, rel, cache)
             return
@@ -174,7 +157,7 @@ class FramePrefetch:
                     nxt = next(todo, None)
                     if nxt is None:
                         break
-                    queued.append(self._submit(read_ahead, self.oracles, job_dir, job, c, nxt[0], nxt[1], cache))
+                    queued.append(self.gl.submit(read_ahead, self.oracles, job_dir, job, c, nxt[0], nxt[1], cache))
                 if not queued:
                     return
                 yield queued.pop(0).result()
@@ -184,18 +167,7 @@ class FramePrefetch:
 
     def close(self) -> None:
         """Drop the frames not begun, close the oracles (on the GL thread) and join it; no thread is left."""
-        if self._pool is None:
-            self.oracles.close()
-            return
-        pool, self._pool = self._pool, None
-        try:
-            with self._lock:
-                pending = list(self._pending)
-            for f in pending:
-                f.cancel()
-            pool.submit(self.oracles.close).result()
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+        self.gl.close()
 
 
 def reader_for(oracles) -> FramePrefetch:

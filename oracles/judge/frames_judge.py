@@ -50,15 +50,18 @@ from ..diagnosis.image_visibility import set_difference
 from ..faults import Fault
 from ..references import opencv_oracle
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances
-from . import f1_radius, gate, line_model, metrics
+from . import f1_radius, line_model, metrics
 from .decide import decide, filled_reasons, pixel_fields
 from .depth_frames import DepthFrames
 from .depth_reference import from_render
 from .evidence import CaseEvidence, Visibility
 from .filled_frames import FilledFrames
 from .frame_prefetch import FramePrefetch, reader_for
+from .job_read import differs, read_job
 from .line_style import CaseStyle, style_record
 from .name_faults import name_faults, wants_visibility
+from .record import finish_record
+from .run_report import run_report, tolerances_field
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (oracles.diagnosis.registration.MAX_POINTS_PER_CASE),
@@ -146,7 +149,9 @@ class _CaseFrames:
             frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
 
 
-def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "any"):
+def judge_case(
+    job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool = True, line_rule: str = "any", job_read=None
+):
     """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
 
     ``oracles``: the run's oracles.judge.frame_prefetch.FramePrefetch (frames
@@ -157,7 +162,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
 
     Each frame's wireframe, depth map and filled frame, as the job asks for them (module
-    docstring); the worst images are None for a job without wireframes.
+    docstring); the worst images are None for a job without wireframes. ``job_read``: the read of the
+    renderer pooled over the job's cases, imposed on this one (oracles.judge.job_read.JobRead), or None.
     """
     c = next(c for c in job["cases"] if (c["scene"], c["case"]) == (scene, case))
     numbers = job["frame_numbers"]
@@ -167,7 +173,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     filled = FilledFrames(tol.fill_tie_px) if "filled" in outputs else None  # each filled PNG (filled_frames)
     kept = diagnosis_frames(len(numbers)) if diagnose and wire else set()
     acc = _CaseFrames()
-    style = CaseStyle(line_rule)
+    style = CaseStyle(line_rule, job_read.as_dict() if job_read is not None else None)
     camera = None
     # each frame's inputs, pyrender's drawing and its PNG's grey levels, read ahead on the GL thread
     # (frame_prefetch: each step's error raised here, at its frame and step)
@@ -343,7 +349,8 @@ def case_record(
     job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple, acc: _CaseFrames
 ) -> dict:
     """A case's record (its entry in report.json's ``cases``), built once from its evidence, verdict and names;
-    beside them core's second opinion (never deciding) and the per-frame numbers (``acc``)."""
+    beside them core's second opinion (never deciding) and the per-frame numbers (``acc``). Its faults, verdict,
+    reasons and per-frame numbers are written as every source's are (oracles.judge.record.finish_record)."""
     rec = {
         "scene": scene,
         "camera": case,
@@ -363,7 +370,7 @@ def case_record(
                 "lines": dict(ev.lines),
             }
         )
-    rec["faults"] = [f.as_dict() for f in names]
+    rec["faults"] = []  # its place in the record; the names are written by finish_record
     if ev.pixels is not None:
         rec.update(
             {
@@ -376,15 +383,8 @@ def case_record(
     for key in ("depth_map", "filled"):
         if getattr(ev, key) is not None:
             rec[key] = _plain(getattr(ev, key))
-    rec.update(
-        {
-            "compared": dict(ev.compared),
-            "verdict": verdict.verdict,
-            "reasons": list(verdict.reasons),
-            "per_frame": acc.per_frame,
-        }
-    )
-    return rec
+    rec["compared"] = dict(ev.compared)
+    return finish_record(rec, ev, verdict, names, acc.per_frame)
 
 
 def _plain(value):
@@ -427,57 +427,50 @@ def run_frames(
             records.append(rec)
             if worst is not None:  # a job without wireframes: no line images to show
                 images[(c["scene"], c["case"])] = worst
+        # one renderer, one reading: the cases that read it otherwise than the job are judged again under the
+        # job's read (oracles.judge.job_read)
+        pooled = read_job(records)
+        for i, c in enumerate(job["cases"]):
+            if differs(records[i], pooled):
+                records[i], worst = judge_case(
+                    job_dir,
+                    job,
+                    c["scene"],
+                    c["case"],
+                    reader,
+                    tol,
+                    diagnose=diagnose,
+                    line_rule=line_rule,
+                    job_read=pooled,
+                )
+                if worst is not None:
+                    images[(c["scene"], c["case"])] = worst
         gl = reader.call(reader.oracles.gl_info)
     finally:
         reader.close()
-    failed = sum(r["verdict"] == "fail" for r in records)
-    vacuous = sum(r["verdict"] == "vacuous" for r in records)
-    compared = {
-        "cases": sum(r["verdict"] != "vacuous" for r in records),
-        "frames": sum(r["compared"]["frames"] for r in records),
-        "vertices": 0,
-        "pixels": sum(r["compared"]["pixels"] for r in records),
-    }
     outputs = job_outputs(job)
-    tolerances = {**tol.to_dict(), **tol.lines_dict(), **(tol.surfaces_dict() if outputs != ("wireframe",) else {})}
-    del tolerances["candidate_precision"]  # no vertex is compared: no precision judged
-
-    def lowest(key, sub=None):  # over the cases with wireframes (None: the job asks for none)
-        values = [(r[sub] if sub else r)[key] for r in records if "pixel_f1_0px" in r]
-        return min(values) if values else None
-
-    report = {
-        "tool": "wirecheck crosscheck",
-        "verdict": gate.run_verdict(records, compared, "frames", allow_vacuous),
-        "candidate": name or f"frames:{Path(job_dir).name}",
-        "candidate_settings": None,
-        "level": "frames",
-        "style": "wireframe",
-        "hidden_lines": False,
-        "cull": "none",
-        "oracles": ["pyrender", "core"],
-        "oracle_gl": gl,
-        "frames": job["frames"],
-        "every": job["every"],
-        "frames_checked": len(job["frame_numbers"]),
-        "motion": job["motion"],
-        "tolerances": tolerances,
-        "allow_vacuous": allow_vacuous,
-        "line_rule": line_rule,
-        "compared": compared,
-        **({} if outputs == ("wireframe",) else {"outputs": list(outputs), "depth_encoding": job["depth_encoding"]}),
-        "summary": {
-            "cases": len(records),
-            "passed": len(records) - failed - vacuous,
-            "failed": failed,
-            "vacuous": vacuous,
-            "max_vertex_error_px": None,
-            "min_pixel_f1_0px": lowest("pixel_f1_0px"),
-            "min_pixel_f1_1px": lowest("pixel_f1_1px"),
-            "min_core_f1_0px": lowest("f1_0px", "core"),
-            "min_core_f1_1px": lowest("f1_1px", "core"),
+    report = run_report(
+        records,
+        "frames",
+        allow_vacuous,
+        {
+            "candidate": name or f"frames:{Path(job_dir).name}",
+            "candidate_settings": None,
+            "style": "wireframe",
+            "hidden_lines": False,
+            "cull": "none",
+            "oracles": ["pyrender", "core"],
+            "oracle_gl": gl,
+            "frames": job["frames"],
+            "every": job["every"],
+            "frames_checked": len(job["frame_numbers"]),
+            "motion": job["motion"],
+            "tolerances": tolerances_field(tol, "frames", outputs=outputs),
+            "line_rule": line_rule,
+            **(
+                {} if outputs == ("wireframe",) else {"outputs": list(outputs), "depth_encoding": job["depth_encoding"]}
+            ),
+            "timing": {"wall_s": time.perf_counter() - t0},
         },
-        "cases": records,
-        "timing": {"wall_s": time.perf_counter() - t0},
-    }
+    )
     return report, images

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import tolerances as _tolerances
 from ..segment_geometry import seg_distance
 from .line_profile import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX
 
@@ -23,12 +22,6 @@ FREE_END_PX = GUARD_PX + 4.0
 #: Along-line profile of an end: from this far inside the line (px) to END_REACH_PX past its end.
 END_INSIDE_PX = 6.0
 END_REACH_PX = 4.0
-#: An end is short when the line's coverage falls to half before this (px, negative: inside the
-#: segment), long when it stays above half this far past half the width: the default of
-#: Tolerances.end_px (oracles.tolerances, with its derivation).
-END_TOL_PX = _tolerances.END_TOL_PX
-#: Ends a case must have measured for their median to be judged: oracles.tolerances.NAMING.min_ends.
-MIN_ENDS = _tolerances.NAMING.min_ends
 
 
 def _bilinear(cov: np.ndarray, q: np.ndarray, level: float = 1.0) -> np.ndarray:

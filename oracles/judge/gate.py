@@ -251,13 +251,14 @@ def case_verdict(compared: dict, reasons: list, level: str, points: int | None =
 
 
 def compared_totals(records: list, level: str) -> dict:
-    """What a run compared: cases that compared something, and frames, vertices, pixels over all cases."""
+    """What a run compared: cases that compared something, and frames, vertices, pixels over all cases (pixels
+    None at level vertices)."""
     counts = [r["compared"] for r in records]
     return {
         "cases": sum(1 for r, c in zip(records, counts) if r["verdict"] != "vacuous" and c["frames"]),
         "frames": sum(c["frames"] for c in counts),
         "vertices": sum(c["vertices"] for c in counts),
-        "pixels": sum(c["pixels"] or 0 for c in counts) if level == "pixels" else None,
+        "pixels": sum(c["pixels"] or 0 for c in counts) if level in ("pixels", "frames") else None,
     }
 
 

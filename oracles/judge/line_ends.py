@@ -3,7 +3,7 @@
 Each pixel drawn by one image only is given to its nearest segment and
 placed: a sub-pixel ``tie`` of that segment (oracles.judge.line_ties: a crossing or an
 end within the oracle's precision of the pixel's edge), else at its
-``start`` or ``end`` (within :data:`END_REACH_PX` of that point), in the
+``start`` or ``end`` (within ``NAMING.end_reach_px`` of that point, oracles.tolerances), in the
 ``middle``, or ``stray`` (no segment within reach). The line gate's balance
 test and its fault names read the decided places (oracles.judge.metrics,
 oracles.diagnosis.diagnose).
@@ -22,12 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tolerances import NAMING
 from . import line_ties
 from .frame_pixels import FramePixels
 from .segment_pixels import nearest_segments
-
-#: A one-sided pixel within this distance (px) of a segment's start or end counts as at that end.
-END_REACH_PX = 1.5
 
 #: The places of :func:`end_attribution`, ``tie`` last.
 PLACES = ("start", "end", "middle", "stray", "tie")
@@ -40,7 +38,7 @@ def end_attribution(cand: np.ndarray, oracle: np.ndarray, p0_px: np.ndarray, p1_
     (``p0_px[m] -> p1_px[m]``, the edge's first vertex to its second, clipped
     to the near plane, then to the image's edges ``[-1/2, W - 1/2] x [-1/2,
     H - 1/2]``, where a line leaving the picture ends); it is at the ``start`` (``end``) when within
-    :data:`END_REACH_PX` of that segment's first (last) point, else ``middle``
+    ``NAMING.end_reach_px`` of that segment's first (last) point, else ``middle``
     (also: within reach of both ends of a very short segment, or more than
     1.5 px from every segment: ``stray``), or, before any of those, a
     sub-pixel ``tie`` of its nearest segment (oracles.judge.line_ties: the line
@@ -74,7 +72,11 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
     sides = [side for side in (0, 1) if sum(len(o) for o in only[side])]
     if sides:  # each pixel's nearest segment within reach (the segments near it only), both sides at once
         owners, q0, q1, frames_of = nearest_segments(
-            [(p0, p1, o) for side in sides for (_, p0, p1), o in zip(frames, only[side])], w, h, END_REACH_PX, box
+            [(p0, p1, o) for side in sides for (_, p0, p1), o in zip(frames, only[side])],
+            w,
+            h,
+            NAMING.end_reach_px,
+            box,
         )
     start = 0
     for i, side in enumerate(sides):
@@ -95,8 +97,8 @@ def frames_end_places(frames, tie_pixels: list | None = None) -> list[dict]:
             tied, tied_frame = pix[near][tie], f[tie]
             for k in np.unique(tied_frame):
                 found[k][side] = np.sort(tied[tied_frame == k]).astype(np.int64)
-        to_start = np.hypot(*(c - q0[m]).T) <= END_REACH_PX
-        to_end = np.hypot(*(c - q1[m]).T) <= END_REACH_PX
+        to_start = np.hypot(*(c - q0[m]).T) <= NAMING.end_reach_px
+        to_end = np.hypot(*(c - q1[m]).T) <= NAMING.end_reach_px
         place = {
             "tie": tie,
             "start": ~tie & to_start & ~to_end,

@@ -12,8 +12,8 @@ Styles (:func:`classify`, from the images alone, pooled over a case's frames):
 
 - ``aliased``: binary pixels (one level), about one pixel across the line;
 - ``antialiased``: grey levels (coverage), about one pixel across;
-- ``wide``: :data:`WIDE_MIN_PX` or more across (binary or grey), up to ~3 px; binary lines drawing
-  :data:`oracles.judge.even_lean.WIDE_PIXEL_RATIO` times the oracle's pixels too (2 px at least).
+- ``wide``: :attr:`oracles.tolerances.NamingThresholds.wide_min_px` or more across (binary or grey), up to ~3 px; binary lines drawing
+  :attr:`oracles.tolerances.NamingThresholds.wide_pixel_ratio` times the oracle's pixels too (2 px at least).
 
 The width is the median coverage across the line over the samples below (a
 1-px aliased line 0.71 to 1, a 1-px antialiased line 1, a 3-px line 3); with too
@@ -39,14 +39,14 @@ for aliased lines; pixel centres within half the width for wide ones) is subtrac
 fractional position (a cube square-on) sit up to half a pixel off in every correct drawing, as in
 :func:`oracles.diagnosis.model_lines.quantisation_bias`; at an exact tie (a band edge on a pixel
 centre) either choice reads 0 (:func:`oracles.judge.line_ties.fold_ties`). Lines that the registration
-finds mirrored or swapped, or that fill fewer than :data:`MIN_FOUND_SHARE` of
+finds mirrored or swapped, or that fill fewer than :attr:`oracles.tolerances.NamingThresholds.min_found_share` of
 the windows, are not measured (the centroids would be of stray crossings). Binary lines of an even
 width may lean half a pixel either side, edge by edge: where the symmetric band fails them, each
 edge's lean is fitted with one offset for the case (:mod:`oracles.judge.even_lean`).
 
 Ends (:func:`oracles.judge.free_ends.measure_ends`): each free end's coverage along its line, where it
 falls to half the line's width; the median over a case's free ends is judged
-(:data:`oracles.judge.free_ends.END_TOL_PX`, past the cap of half the width a renderer may draw).
+(Tolerances.end_px, past the cap of half the width a renderer may draw).
 
 Raster rule (aliased lines): the pixels where the candidate and pyrender
 differ are counted; one with a pixel of the other side among its 8 neighbours
@@ -99,15 +99,6 @@ RULE_NAMES = {"gl": "GL's diamond exit", "rounded": ROUNDED_RULE_NAME}
 
 #: A differing pixel this close to a segment end (px) is counted "at the end".
 END_RADIUS_PX = 1.5
-#: Coverage per unit length from which a line is ``wide``: oracles.tolerances.NAMING.wide_min_px (its reason there).
-WIDE_MIN_PX = tolerances.NAMING.wide_min_px
-#: A case is binary (aliased) when at most this share of its drawn pixels is an intermediate
-#: grey (between 1/8 and 7/8 of the line's level): antialiased lines have a third or more
-#: (measured: 4x4 supersampled 1-px lines 0.6-0.8).
-GREY_SHARE_MAX = tolerances.NAMING.grey_share_max
-#: A grey value is one of the coverage levels when at least this share of the drawn pixels has it:
-#: oracles.tolerances.NAMING.level_share_min.
-LEVEL_SHARE_MIN = tolerances.NAMING.level_share_min
 #: The line's level: this percentile of the drawn pixels' values (robust to a few bright
 #: crossings of antialiased lines).
 LEVEL_PERCENTILE = 99
@@ -117,9 +108,6 @@ MAX_SAMPLES_PER_FRAME = 4000
 #: ... and per case: past it every frame's samples are halved, so a case's memory stays bounded
 #: whatever its number of frames (the offset is a mean over tens of thousands of samples either way).
 MAX_SAMPLES_PER_CASE = 48_000
-#: The geometry is measured only where at least this share of the windows along the oracle's lines
-#: holds a line (a correct renderer: nearly all; lines mirrored or scaled away: few).
-MIN_FOUND_SHARE = tolerances.NAMING.min_found_share
 #: Registration faults that put the lines elsewhere than the oracle's: their centroids are not measured.
 PLACEMENT_FAULTS = catalogue.names("orientation")
 #: Aliased lines of another rule, and binary wide lines: the largest pooled centre offset (px) that is
@@ -236,7 +224,7 @@ def _reference(segs: np.ndarray, shape, width_px: float, clipped=None, drawn: in
     h, w = shape
     if len(segs) == 0:
         return np.zeros(shape, bool)
-    if width_px < WIDE_MIN_PX:
+    if width_px < tolerances.NAMING.wide_min_px:
         img = np.zeros(shape, bool)
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], w, h) if clipped is None else clipped
         rr, cc = raster.line_pixels(q0, q1, w, h)
@@ -287,10 +275,11 @@ class CaseStyle:
     Only sums and samples (at most :data:`MAX_SAMPLES_PER_CASE`) are kept between frames, never an image.
     """
 
-    def __init__(self, line_rule: str = "any"):
+    def __init__(self, line_rule: str = "any", job: dict | None = None):
         if line_rule not in LINE_RULES:
             raise ValueError(f"line rule {line_rule!r}: expected one of {', '.join(LINE_RULES)}")
         self.line_rule = line_rule
+        self.job = job  # the job's read imposed on the case (oracles.judge.job_read.JobRead.as_dict), or None
         self.hist = np.zeros(256, np.int64)
         self.length_px = 0.0
         self.samples = CaseSamples()  # measure() of each frame
@@ -341,7 +330,11 @@ class CaseStyle:
         got = measure(grey, segs, wins=wins, level=level)
         got["edge"] = got["segment"] + len(self.samples) * (len(segs) + 1)  # one key per frame and segment
         self.ends.append(free_ends.measure_ends(grey, segs, level=level))
-        if not len(drawn) or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0)) > GREY_SHARE_MAX:
+        if (
+            not len(drawn)
+            or np.mean((drawn > drawn.max() / 8.0) & (drawn < drawn.max() * 7.0 / 8.0))
+            > tolerances.NAMING.grey_share_max
+        ):
             cand = np.flatnonzero(coverage_pixels.drawn(grey))  # grey levels: a thin line's ridge is drawn too
         else:
             self.drawn_px += (len(cand), int(np.count_nonzero(orac)))  # binary: pixels drawn, the oracle's
@@ -351,7 +344,7 @@ class CaseStyle:
                 _reference(segs, grey.shape, width, clipped if same else None, drawn=len(cand)), segs, wins=wins
             )
             for x in (got, ref):  # an exact tie: either choice is right (line_ties)
-                line_ties.fold_ties(x, round(width) if width >= WIDE_MIN_PX else 1, segs=segs)
+                line_ties.fold_ties(x, round(width) if width >= tolerances.NAMING.wide_min_px else 1, segs=segs)
             self.reference.add(ref)
             self._kept += len(ref["offset"])
         self.samples.add(got)  # its ties folded (binary frames)
@@ -398,14 +391,20 @@ class CaseStyle:
             coverage = float((np.minimum(values / level, 1.0) * drawn).sum())
             width = coverage / self.length_px if self.length_px > 0 else 0.0
         grey_share = float(grey) / n
-        style = "wide" if width >= WIDE_MIN_PX else "antialiased" if grey_share > GREY_SHARE_MAX else "aliased"
+        style = (
+            "wide"
+            if width >= tolerances.NAMING.wide_min_px
+            else "antialiased"
+            if grey_share > tolerances.NAMING.grey_share_max
+            else "aliased"
+        )
         ratio = float(self.drawn_px[0] / self.drawn_px[1]) if self.drawn_px[1] else 0.0
         band = max(int(np.floor(width + 0.5)), 1)
-        if style == "aliased" and ratio >= even_lean.WIDE_PIXEL_RATIO:  # no 1-px line draws this many
+        if style == "aliased" and ratio >= tolerances.NAMING.wide_pixel_ratio:  # no 1-px line draws this many
             style, band = "wide", 2
         # coverage in few levels (4x MSAA: 0, 1/4, ... 1) moves a centroid by up to half a level's step on
         # lines that all sit at one fractional position; that half step is added to the offset's tolerance
-        steps = max(int((drawn >= LEVEL_SHARE_MIN * n).sum()), 1)
+        steps = max(int((drawn >= tolerances.NAMING.level_share_min * n).sum()), 1)
         return {
             "style": style,
             "width_px": round(width, 3),
@@ -452,7 +451,9 @@ class CaseStyle:
             return geo
         d, affine = fit
         ref_d, ref_affine = np.zeros(2), None
-        if read["grey_share"] <= GREY_SHARE_MAX:  # binary: quantised; the same measure on a correct drawing
+        if (
+            read["grey_share"] <= tolerances.NAMING.grey_share_max
+        ):  # binary: quantised; the same measure on a correct drawing
             ref = self._fit(self.reference) if len(self.reference) == len(self.samples) else None
             if ref is not None:
                 ref_d, ref_affine = ref
@@ -466,7 +467,9 @@ class CaseStyle:
         warp = np.abs(fitted(affine, d) - fitted(ref_affine, ref_d))
         lean = (
             even_lean.fit(normal, self._pooled("offset"), point, self._pooled("edge"), read["band_px"])
-            if read["grey_share"] <= GREY_SHARE_MAX and read["style"] == "wide" and read["band_px"] % 2 == 0
+            if read["grey_share"] <= tolerances.NAMING.grey_share_max
+            and read["style"] == "wide"
+            and read["band_px"] % 2 == 0
             else None
         )
         if lean is not None:  # an even band: each edge's lean chosen (even_lean)
@@ -498,17 +501,20 @@ class CaseStyle:
         """
         tol = tolerances.Tolerances() if tol is None else tol
         read = self.classify()
+        job_style = (self.job or {}).get("style")
+        if job_style is not None and job_style != read["style"]:  # one renderer, one style (job_read)
+            read = {**read, "style": job_style, "style_alone": read["style"]}
         geo = self.geometry(read, tol)
         placed = (
             geo["offset_px"] is not None
-            and geo["found_share"] >= MIN_FOUND_SHARE
+            and geo["found_share"] >= tolerances.NAMING.min_found_share
             and not any(f.name in PLACEMENT_FAULTS for f in diagnosed)
         )
         by_rule = read["style"] == "aliased" and self.line_rule in ("gl", "any")
         rounded_faults = (
             tuple(Fault.of(f) for f in diagnose_lines(rounded["lines"], tol)) if by_rule and rounded is not None else ()
         )
-        return StyleRead(self.line_rule, read, geo, dict(self.raster), rounded, rounded_faults, placed)
+        return StyleRead(self.line_rule, read, geo, dict(self.raster), rounded, rounded_faults, placed, self.job)
 
 
 def style_record(s: StyleRead, j, radius_px: int) -> dict:
@@ -542,6 +548,8 @@ def style_record(s: StyleRead, j, radius_px: int) -> dict:
                 },
             }
     out.update(pixel_rule=j.pixel_rule, failures=list(j.failures), f1_radius_px=radius_px)
+    if s.job is not None:
+        out["job_read"] = dict(s.job)
     return out
 
 
@@ -574,5 +582,17 @@ def summary_lines(cases: list) -> list[str]:
         out.append(
             f"Line rule read: {RULE_NAMES['rounded']} in {len(read)} case{'s' if len(read) != 1 else ''}, "
             "a correct drawing by that rule; --line-rule gl holds them to GL's"
+        )
+    pooled = [c for c in cases if (c.get("line_style") or {}).get("job_read")]
+    if pooled:  # oracles.judge.job_read: the cases that read the renderer otherwise, judged again
+        job = pooled[0]["line_style"]["job_read"]
+        parts = [f"{k} {job[k]}" for k in ("style", "rule", "rule_name") if job.get(k)]
+        if job.get("offset_px") is not None:
+            parts.append(f"offset ({job['offset_px'][0]:.2f}, {job['offset_px'][1]:.2f}) px")
+        n = len(pooled)
+        out.append(
+            f"One renderer, one reading: {n} case{'s' if n != 1 else ''} read the renderer otherwise than the "
+            f"job's {job['cases']} cases together and {'were' if n != 1 else 'was'} judged again under the "
+            f"job's read ({', '.join(parts)})"
         )
     return out

@@ -23,7 +23,7 @@ import numpy as np
 from .. import tolerances
 from ..references.pyrender_oracle import depth_step
 from .frame_pixels import FramePixels
-from .line_ends import END_REACH_PX, PLACES, end_attribution, frames_end_places, resolve_ties  # noqa: F401
+from .line_ends import PLACES, end_attribution, frames_end_places, resolve_ties  # noqa: F401
 from .segment_pixels import edge_neighbourhoods, frames_count_differences, frames_neighbourhoods  # noqa: F401
 
 

@@ -12,11 +12,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .. import faults as catalogue
+from ..diagnosis.diagnose import line_pixel_fields
 from ..diagnosis.image_visibility import visibility_names
 from ..faults import Fault
 from ..tolerances import NAMING, Tolerances
 from .decide import ROUNDED_RULE_NAME, RULE_FAULTS, Verdict, depth_map_reasons, filled_reasons
 from .evidence import CaseEvidence
+from .job_read import RULE_NAMES_FAMILY
 
 __all__ = ["Precedence", "PRECEDENCE", "name_faults", "wants_visibility"]
 
@@ -55,6 +57,14 @@ PRECEDENCE = (
         "rounded-ends rule's own line fault where its pixels are biased (--line-rule any)",
     ),
     Precedence(
+        "job_read",
+        ("unexplained", "offset", "line_count", "raster_rule"),
+        "one renderer draws every case of a frames job (oracles.judge.job_read): where the job's pooled offset "
+        "misses the bound, the case's lines are moved too (pixel_offset, the job's numbers, replacing what "
+        "the other rule or nothing named); a case named alone by the other of raster_rule and "
+        "line_pixel_bias than most of the job's failing cases gets the job's name, with its own numbers",
+    ),
+    Precedence(
         "dim_lines",
         tuple(catalogue.FAMILIES),
         "lines under the 128 level drew nothing by the rule: unexplained with their level replaces every "
@@ -64,8 +74,8 @@ PRECEDENCE = (
         "surfaces",
         (),
         "a renderer's depth maps and filled frames whose limits are missed add the faults their values "
-        "(oracles.diagnosis.depth_faults) and silhouettes (oracles.diagnosis.silhouette_faults) name; the "
-        "lines' names stand beside them, each read from its own frames",
+        "(oracles.diagnosis.depth_faults) and silhouettes (oracles.diagnosis.silhouette_faults) name, "
+        "each name once (the depth maps' reading first); the lines' names stand beside them",
     ),
     Precedence(
         "unexplained",
@@ -107,7 +117,7 @@ def _line_centres(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault
     measured = catalogue.names("scale", "offset")
     faults = [f for f in faults if f.name not in measured or j.warped and f.name != "pixel_offset"]
     geo, d = s.geometry, s.offset_px
-    if j.moved:
+    if j.moved and not j.job_moved:  # (the job's offset: the job_read step names it)
         faults = [f for f in faults if f.name != "unexplained"]
         faults.append(
             Fault(
@@ -201,6 +211,43 @@ def _line_rule(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
     return catalogue.ordered(faults)
 
 
+def _job_read(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
+    s, j = ev.style, verdict.style
+    if s is None or j is None or s.job is None:
+        return faults
+    job = s.job
+    if j.job_moved and not any(f.name == "pixel_offset" for f in faults):
+        replaced = catalogue.names("unexplained", "offset", "line_count") + ("raster_rule",)
+        dx, dy = job["offset_px"]
+        faults = [f for f in faults if f.name not in replaced] + [
+            Fault(
+                "pixel_offset",
+                {
+                    "dx": float(dx),
+                    "dy": float(dy),
+                    "uncertainty_px": None,
+                    "confidence": 1.0,
+                    "residual_px": None,
+                    "measured_by": f"the job's line centroids (median of {job['offset_cases']} cases)",
+                },
+            )
+        ]
+    name = job.get("rule_name")
+    if (
+        name in RULE_NAMES_FAMILY
+        and len(faults) == 1
+        and faults[0].name in RULE_NAMES_FAMILY
+        and faults[0].name != name
+    ):
+        if name == "raster_rule":
+            d = s.offset_px
+            fields = {**s.raster_shares, "confidence": 1.0, "offset_px": [d[0], d[1]], "residual_px": None}
+        else:
+            fields = line_pixel_fields(dict(ev.lines or {}))
+        faults = [Fault(name, {**fields, "read_from": "the job's failing cases (one renderer, one rule)"})]
+    return catalogue.ordered(faults)
+
+
 def _dim_lines(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
     if ev.style is None:
         return faults
@@ -220,10 +267,13 @@ def _dim_lines(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
 
 def _surfaces(faults, ev: CaseEvidence, verdict: Verdict, tol) -> list[Fault]:
     out = list(faults)
+    # one name per fault: a camera mistake that moves pixels (rows flipped, half a pixel) is read from the
+    # depth maps and from the silhouettes alike; the first reading stands (the depth maps' values, then the
+    # silhouettes'), the other says nothing more
     if ev.depth_map is not None and depth_map_reasons(ev.depth_map, tol):
-        out += [f for f in ev.depth_faults if f not in out]
+        out += [f for f in ev.depth_faults if f.name not in {g.name for g in out}]
     if ev.filled is not None and filled_reasons(ev.filled, tol):
-        out += [f for f in ev.filled_faults if f not in out]
+        out += [f for f in ev.filled_faults if f.name not in {g.name for g in out}]
     return out
 
 
@@ -260,6 +310,7 @@ _STEPS = {
     "diagnosis": _diagnosis,
     "line_centres": _line_centres,
     "line_rule": _line_rule,
+    "job_read": _job_read,
     "dim_lines": _dim_lines,
     "surfaces": _surfaces,
     "unexplained": _unexplained,

@@ -17,12 +17,12 @@ import numpy as np
 from ..candidates.candidate import case_precision
 from ..diagnosis.diagnose import diagnose, diagnose_lines
 from ..faults import Fault
-from ..references.oracle_precision import ORACLE_LIMIT_PX
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 from . import metrics
 from .decide import decide, pixel_fields
 from .evidence import CaseEvidence
 from .name_faults import name_faults
+from .record import finish_record
 
 #: Per-frame fields of a wireframe's line comparison: metrics' (one definition for both paths).
 LINE_FRAME_KEYS = metrics.LINE_FRAME_KEYS
@@ -42,15 +42,20 @@ SHADED_FRAME_KEYS = (
 )
 
 
-def case_record(setup, acc, tol: Tolerances) -> tuple[dict, list, list]:
+def case_record(
+    setup, acc, tol: Tolerances, points: int | None = None, oracle_bound_px: float | None = None
+) -> tuple[dict, CaseEvidence]:
     """The case's fields from its frames (``setup``: oracles.judge.case.CaseSetup, ``acc``: its CaseFrames), and
-    what the diagnosis named: ``(record, vertex faults, line faults)``.
+    the same measurements frozen as its evidence: ``(record, evidence)``.
 
     Vertex errors pooled over the frames, the worst vertex, the pixel scores' minima and means, the shaded
-    summary, and a note when there was nothing to compare; its ``faults`` are left empty for :func:`judge`
-    (the names are name_faults', from the evidence). The vertex faults are oracles.diagnosis.diagnose's, the
-    line faults those the line fields name (oracles.diagnosis.diagnose.diagnose_lines). ``precision``
-    says what the candidate was judged as (declared, or as it returned; core:
+    summary, and a note when there was nothing to compare; its ``faults`` slot is left empty for :func:`judge`
+    (the names are name_faults', from the evidence). The evidence holds the vertex, pixel, line and shaded
+    fields, the faults oracles.diagnosis.diagnose names from the vertices (``image_faults``) and those the line
+    fields name (``line_faults``, oracles.diagnosis.diagnose.diagnose_lines), the candidate's error
+    (``acc.error``), the scene's vertex count (``points``) and pyrender's own bound (``oracle_bound_px``, where
+    pixels were drawn); its level is ``"pixels"`` where pixels were compared, else ``"vertices"``.
+    ``precision`` says what the candidate was judged as (declared, or as it returned; core:
     its ``--dtype``) and ``vertex_bound_px`` the bound its vertices were held
     to (oracles.tolerances.vertex_bound).
     """
@@ -72,6 +77,7 @@ def case_record(setup, acc, tol: Tolerances) -> tuple[dict, list, list]:
         "returned": sorted(acc.returned) if acc.returned else None,
     }
     rec["vertex_bound_px"] = bound
+    vertices = {"vertex_bound_px": bound, "precision": rec["precision"]}
     if acc.depth_ties:  # points on near/far to within the candidate's rounding, clipped by one side only
         rec["depth_ties"] = acc.depth_ties
     if setup.pixels and setup.mode.hidden_lines:
@@ -81,29 +87,42 @@ def case_record(setup, acc, tol: Tolerances) -> tuple[dict, list, list]:
         cand, orac = np.concatenate(acc.cand_px), np.concatenate(acc.oracle_px)
         ve = metrics.vertex_errors(cand, orac)
         worst_v = max(acc.frame_errors, key=lambda e: (e[0], -e[1])) if acc.frame_errors else (None, None, None)
+        vertices.update(
+            {
+                "max_vertex_error_px": ve["max_px"],
+                "worst_vertex": {"frame": worst_v[1], "vertex": worst_v[2], "error_px": worst_v[0]},
+                "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
+            }
+        )
         rec.update(
             {
                 "max_vertex_error_px": ve["max_px"],
                 "mean_vertex_error_px": ve["mean_px"],
                 "rms_vertex_error_px": ve["rms_px"],
-                "worst_vertex": {"frame": worst_v[1], "vertex": worst_v[2], "error_px": worst_v[0]},
+                "worst_vertex": vertices["worst_vertex"],
                 "visible_points": ve["visible_both"],
-                "visibility_mismatch": {"candidate_only": ve["candidate_only"], "oracle_only": ve["oracle_only"]},
+                "visibility_mismatch": vertices["visibility_mismatch"],
             }
         )
         bound32 = vertex_bound("float32", acc.scale, tol.vertex_px) if precision == "float64" else None
         faults = diagnose(cand, orac, setup.cam, tol_px=bound, float32_px=bound32, planes=acc.planes)
     else:
+        vertices["max_vertex_error_px"] = None
         rec.update({"max_vertex_error_px": None, "mean_vertex_error_px": None, "rms_vertex_error_px": None})
-    px = acc.pixel
+    px, lines, shaded = acc.pixel, None, None
     if px["f1_0px"]:
-        rec.update(pixel_fields(px, acc.worst[1] if acc.worst else None))
-        rec["lines"] = metrics.line_summary(acc.lines)
+        pixels = pixel_fields(px, acc.worst[1] if acc.worst else None)
+        lines = metrics.line_summary(acc.lines)
+        rec.update(pixels)
+        rec["lines"] = lines
     else:
-        rec.update({"pixel_f1_0px": None, "pixel_f1_1px": None})
+        pixels = {"pixel_f1_0px": None, "pixel_f1_1px": None}
+        rec.update(pixels)
     if setup.pixels and setup.mode.shaded:
-        rec.update(shaded_summary(acc.shaded, acc.worst))
-    line_named = diagnose_lines(rec["lines"], tol) if acc.lines and "lines" in rec else []
+        shaded = shaded_summary(acc.shaded, acc.worst)
+        rec.update(shaded)
+        pixels = {**pixels, "worst_pixel_frame": shaded["worst_pixel_frame"]}
+    line_named = diagnose_lines(lines, tol) if acc.lines and lines is not None else []
     rec["faults"] = []  # named by judge (name_faults: a line fault only when the vertices agree)
     rec["compared"] = {
         "frames": done,
@@ -115,7 +134,21 @@ def case_record(setup, acc, tol: Tolerances) -> tuple[dict, list, list]:
             "shaded": "no faces: nothing to shade; only the vertices were checked",
             "wireframe": "no faces: nothing hides or culls a line; compared as a plain wireframe",
         }[setup.mode.style]
-    return rec, faults, line_named
+    ev = CaseEvidence(
+        level="pixels" if setup.pixels else "vertices",
+        compared=rec["compared"],
+        frames_checked=done,
+        pixels={k: pixels[k] for k in PIXEL_KEYS if k in pixels},
+        lines=lines,
+        vertices={k: vertices[k] for k in VERTEX_KEYS if k in vertices},
+        shaded={k: shaded[k] for k in SHADED_KEYS if k in shaded} if shaded is not None else None,
+        image_faults=tuple(Fault.of(f) for f in faults),
+        line_faults=tuple(Fault.of(f) for f in line_named),
+        error=acc.error,
+        points=points,
+        oracle_bound_px=oracle_bound_px,
+    )
+    return rec, ev
 
 
 def shaded_summary(shaded: list, worst) -> dict:
@@ -180,62 +213,15 @@ SHADED_KEYS = (
 PIXEL_KEYS = ("pixel_f1_0px", "pixel_f1_1px", "worst_pixel_frame")
 
 
-def record_evidence(
-    rec: dict,
-    error: str | None = None,
-    points: int | None = None,
-    oracle_bound_px: float | None = None,
-    image_faults=(),
-    line_named=(),
-) -> CaseEvidence:
-    """A projector case's measured fields (:func:`case_record`) as frozen evidence: its vertex, pixel, line and
-    shaded fields, the faults the diagnosis named from the vertices (``image_faults``) and from the line
-    fields (``line_named``), what it compared, at level ``"vertices"`` when no pixel was compared, else
-    ``"pixels"``."""
-    return CaseEvidence(
-        level="vertices" if rec["compared"]["pixels"] is None else "pixels",
-        compared=rec["compared"],
-        frames_checked=rec["frames_checked"],
-        pixels={k: rec[k] for k in PIXEL_KEYS if k in rec},
-        lines=rec.get("lines"),
-        vertices={k: rec[k] for k in VERTEX_KEYS if k in rec},
-        shaded={k: rec[k] for k in SHADED_KEYS if k in rec} if "silhouette_iou" in rec else None,
-        image_faults=tuple(Fault.of(f) for f in image_faults),
-        line_faults=tuple(Fault.of(f) for f in line_named),
-        error=error,
-        points=points,
-        oracle_bound_px=oracle_bound_px,
-    )
-
-
-def judge(
-    rec: dict,
-    tol: Tolerances,
-    error: str | None = None,
-    points: int | None = None,
-    oracle_bound_px: float | None = None,
-    image_faults=(),
-    line_named=(),
-) -> None:
-    """Set ``rec["verdict"]`` and ``rec["reasons"]`` (one line per limit missed; oracles.judge.decide.decide),
-    and ``rec["faults"]`` to the names (oracles.judge.name_faults) from the evidence and the diagnosis's
-    ``image_faults`` (from the vertices) and ``line_named`` (from the line fields): a failure nothing
-    explains is ``unexplained``; past the oracle's precision limit the names read from pixels go.
+def judge(rec: dict, ev: CaseEvidence, tol: Tolerances, per_frame: list) -> None:
+    """The case decided from its evidence (oracles.judge.decide.decide: one reason per limit missed) and its
+    faults named (oracles.judge.name_faults: a failure nothing explains is ``unexplained``; past the oracle's
+    precision limit the names read from pixels go), written into ``rec`` (oracles.judge.record.finish_record).
 
     "fail" when a limit is missed; else "vacuous" when the case compared nothing
-    (``rec["compared"]``; ``points``: the scene's vertex count), else "pass" (oracles.judge.gate).
-    ``oracle_bound_px``: the pyrender oracle's own error bound where pixels were drawn, recorded as
-    ``oracle_bound_px`` beside ``oracle_limit_px``; past the limit the case is judged on its vertices alone
+    (``rec["compared"]``; ``ev.points``: the scene's vertex count), else "pass" (oracles.judge.gate).
+    Past the oracle's limit (``ev.oracle_bound_px`` beyond it) the case is judged on its vertices alone
     (``oracle_precision``: True).
     """
-    ev = record_evidence(rec, error, points, oracle_bound_px, image_faults, line_named)
     verdict = decide(ev, tol)
-    names = [f.as_dict() for f in name_faults(ev, verdict, tol)]
-    diagnosed = list(image_faults) or list(line_named)
-    rec["faults"] = diagnosed if names == diagnosed else names  # the diagnosis's own records where it is them
-    rec["verdict"], rec["reasons"] = verdict.verdict, list(verdict.reasons)
-    if oracle_bound_px is not None:
-        rec["oracle_bound_px"] = float(oracle_bound_px)
-        rec["oracle_limit_px"] = ORACLE_LIMIT_PX
-    if verdict.set_aside is not None:
-        rec["oracle_precision"] = True
+    finish_record(rec, ev, verdict, name_faults(ev, verdict, tol), per_frame, tol.oracle_limit_px)

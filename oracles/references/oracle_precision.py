@@ -54,7 +54,7 @@ The case's bound is the largest over its frames (the record's
 ``oracle_bound_px``). The line gate's tie zone assumes the oracle's window
 coordinates within ``2^-9`` px of exact (the float32 share of
 oracles.tolerances.TIE_END_PX); a case whose bound exceeds
-:data:`ORACLE_LIMIT_PX` asks for more than the oracle can give, and its
+``Tolerances.oracle_limit_px`` (oracles.tolerances) asks for more than the oracle can give, and its
 pixels are not judged: :func:`oracles.judge.decide.decide` makes it an
 ``oracle_precision`` case that fails the run without blaming the candidate.
 On the bundled scenes the bound is ~1e-4 to 1e-3 px, wherever the scene is
@@ -73,7 +73,6 @@ __all__ = [
     "CLIP_XY_ROUNDINGS",
     "CLIP_W_ROUNDINGS",
     "VIEWPORT_ROUNDINGS",
-    "ORACLE_LIMIT_PX",
     "mesh_radius",
     "frame_bound_px",
     "drawn_bound_px",
@@ -90,10 +89,6 @@ CLIP_W_ROUNDINGS = 7
 
 #: Roundings of the window size W (module docstring: the divide 1/2, the scale and offset 1; 2 kept).
 VIEWPORT_ROUNDINGS = 2
-
-#: The oracle's window coordinates must be within this of exact: the float32 share (2^-9 px) of
-#: oracles.tolerances.TIE_END_PX, which the line gate's sub-pixel ties assume of the oracle.
-ORACLE_LIMIT_PX = 2.0**-9
 
 
 def mesh_radius(centred) -> float:

@@ -38,10 +38,10 @@ from ..candidates.candidate import CandidateError, call_candidate_precision
 from ..candidates.core_candidate import CoreCandidate
 from ..candidates.draw import draw_candidate
 from ..cases import Case
-from ..diagnosis.clip_planes import FLOAT32_PLANE_ROUNDINGS, PLANE_REL_TOL, clip_fault, depth_slack, probe_planes
+from ..diagnosis.clip_planes import clip_fault, depth_slack, probe_planes
 from ..diagnosis.diagnose import diagnose
 from ..runner import run_crosscheck
-from ..tolerances import EPS, Tolerances, vertex_bound, vertex_scale
+from ..tolerances import EPS, NAMING, Tolerances, vertex_bound, vertex_scale
 from .matrix import CAMERA, TURNS
 
 W, H = CAMERA["width"], CAMERA["height"]
@@ -454,7 +454,7 @@ def _edge_behind(check: _Check, func, camera, precision: str) -> dict:
 def _near_delta(precision: str) -> float:
     """Relative distance from near that a correct candidate of ``precision`` resolves: twice the plane
     tolerance crosscheck gives its clipping (oracles.diagnosis.clip_planes: 1e-9 in float64, 4 eps32 in float32)."""
-    return 2.0 * (PLANE_REL_TOL if precision == "float64" else FLOAT32_PLANE_ROUNDINGS * EPS["float32"])
+    return 2.0 * (NAMING.plane_rel_tol if precision == "float64" else NAMING.float32_plane_roundings * EPS["float32"])
 
 
 def near_plane_depth(func, declared: str | None = None) -> dict:

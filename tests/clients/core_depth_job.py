@@ -23,19 +23,10 @@ from PIL import Image
 from wirecheck.core.camera import Camera
 from wirecheck.core.projector.pipeline import render_frame
 
-
-def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray, list]:
-    """The OBJ's ``v`` vertices ``(N, 3)``, ``l`` edges ``(K, 2)`` and ``f`` faces (tuples), 0-based."""
-    verts, edges, faces = [], [], []
-    for line in path.read_text().splitlines():
-        parts = line.split()
-        if parts and parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts and parts[0] == "l":
-            edges.append([int(x) - 1 for x in parts[1:3]])
-        elif parts and parts[0] == "f":
-            faces.append(tuple(int(x) - 1 for x in parts[1:]))
-    return np.array(verts).reshape(-1, 3), np.array(edges, dtype=int).reshape(-1, 2), faces
+if __package__:  # imported by the tests (clients.core_depth_job)
+    from .job_files import read_obj_faces, write_depth
+else:  # run as a script: its folder is on sys.path
+    from job_files import read_obj_faces, write_depth
 
 
 def window_depth(z: np.ndarray, cam: Camera) -> np.ndarray:
@@ -79,7 +70,7 @@ def frames(job_dir: Path):
         scene = scenes[c["scene"]]
         for i, k in enumerate(job["frame_numbers"]):
             obj = scene["obj"] if scene["space"] == "model" else f"scenes/{c['scene']}/frame_{k:04d}.obj"
-            v, e, f = read_obj(job_dir / obj)
+            v, e, f = read_obj_faces(job_dir / obj)
             cam_json = json.loads((job_dir / f"cameras/{c['scene']}/{c['case']}/frame_{k:04d}.json").read_text())
             yield c, i, Camera(**cam_json["camera"]), v, e, f, np.array(cam_json["model_matrix"])
 
@@ -107,20 +98,11 @@ def render_job(
         for key, write in (
             ("frames", lambda p: Image.fromarray(render_frame(v, e, cam, m).image).save(p)),
             ("filled", lambda p: Image.fromarray(np.where(filled(z > 0), level, 0).astype(np.uint8)).save(p)),
-            ("depth", lambda p: _save_depth(p, mistake(z, cam), enc)),
+            ("depth", lambda p: write_depth(p, mistake(z, cam), enc)),
         ):
             for rel in (c.get(key) or [])[i : i + 1]:
                 (job_dir / rel).parent.mkdir(parents=True, exist_ok=True)
                 write(job_dir / rel)
-
-
-def _save_depth(path: Path, d: np.ndarray, enc: dict) -> None:
-    if enc["format"] == "npy":
-        np.save(path, d.astype(np.float32))
-    elif enc["format"] == "png16":  # rounded to the scale's step, as BOP's writers do
-        Image.fromarray(np.rint(d * enc["scale"]).astype(np.uint16)).save(path)
-    else:
-        Image.fromarray(d.astype(np.float32), mode="F").save(path)
 
 
 def main(argv=None) -> int:

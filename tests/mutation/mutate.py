@@ -121,6 +121,12 @@ TARGETS = {
         ],
         None,
     ),
+    # the end of every source's case record
+    "oracles/judge/record.py": (["tests/test_record.py", "tests/test_oracle_precision_drawn.py"], None),
+    # one report builder for both sources: counts, summary, keys and their order
+    "oracles/judge/run_report.py": (["tests/test_run_report.py", "tests/test_gate.py"], None),
+    # the GL thread the frames are read ahead on: every oracle call on it, closed with no thread left
+    "oracles/references/gl_thread.py": (["tests/test_frame_prefetch.py"], None),
     "oracles/judge/line_style.py": (["tests/test_line_style.py"], None),
     "oracles/judge/line_windows.py": (["tests/test_line_windows.py", "tests/test_line_style.py"], None),
     # moved out of line_windows, segment_pixels and the registration: the distances and the box clipper
