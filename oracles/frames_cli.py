@@ -21,7 +21,7 @@ from wirecheck.core.transforms import Motion
 
 from .cases import ALL_CASE_NAMES, CASE_NAMES
 from .judge.line_style import summary_lines
-from .reports.compared import hint_lines, what_text
+from .reports.compared import hint_lines, reason_text, what_text
 from .reports.report_option import report_line
 from .tolerances import Tolerances
 
@@ -219,7 +219,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
         print(line)
     failing = [r for r in report["cases"] if r["verdict"] != "pass"]  # failed, or vacuous (compared nothing)
     for r in failing:
-        print(f"  {r['scene']} / {r['camera']}: " + "; ".join(r["reasons"]))
+        print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
     for line in hint_lines(report, failing):  # what to check and each fault kind's note, once
         print(line)
     print("\n" + verdict_line(report, tol))

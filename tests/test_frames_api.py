@@ -283,3 +283,18 @@ def test_the_config_table_sets_the_floors_as_for_the_cli(jobs, tmp_path, monkeyp
     (tmp_path / "bad.toml").write_text("[tool.wirecheck]\nmin-f1 = 2\n")
     with pytest.raises(ValueError, match=r"bad.toml: \[tool.wirecheck\] min-f1 = 2: expected a number in \[0, 1\]"):
         wirecheck.check_frames(jobs["good"], config=tmp_path / "bad.toml")
+
+
+def test_the_frames_cli_lists_each_failing_case_as_the_projector_cli_does(jobs, tmp_path, capsys):
+    # one way of printing a failing case on both paths: its first two reasons and how many more report.md has
+    # (oracles.reports.compared.reason_text, tested by hand in test_fault_text); the black job fails with more
+    # than two reasons, each listed in report.json
+    from wirecheck.oracles.reports.compared import reason_text
+
+    capsys.readouterr()
+    assert main(["--candidate-frames", str(jobs["black"]), "--report-dir", str(tmp_path / "rep")]) == 1
+    out = capsys.readouterr().out
+    (case,) = json.loads((tmp_path / "rep" / "report.json").read_text())["cases"]
+    assert len(case["reasons"]) > 2, case["reasons"]
+    line = f"  {case['scene']} / {case['camera']}: " + reason_text(case["reasons"])
+    assert line in out.splitlines() and line.endswith(f"+{len(case['reasons']) - 2} more in report.md")
