@@ -515,14 +515,14 @@ RULE_OFFSET_MAX_PX = 0.35
 #: measures 0, a cap up to half the width; a dropped end pixel measures -0.54 to -0.73, an added one 1.25
 #: to 1.51. Half a pixel parts them.
 END_TOL_PX = 0.5
-#: The rounded-ends rule (oracles.judge.line_model, "rounded"): how close to a half pixel (per axis, px)
+#: The rounded-ends rule (oracles.line_model, "rounded"): how close to a half pixel (per axis, px)
 #: an end may round either way (the pixels between those roundings are ties, left out of the comparison).
 #: Half a step of OpenCV's cv2.line fixed point (shift=4: 1/16 px), the coarsest grid among the
 #: rounded-ends renderers tried; an end falls that close for 1/16 of ends on an axis, so a dropped end pixel
 #: is still decided at the other ends.
 ROUNDED_END_TIE_PX = 1.0 / 32.0
 #: A renderer's aliased pixels are read as a correct drawing by another rule of the line model
-#: (oracles.judge.line_model, "rounded") only where their F1@0px against that rule's drawing is at least
+#: (oracles.line_model, "rounded") only where their F1@0px against that rule's drawing is at least
 #: this (or the run's F1@0px floor, if higher): measured 0.999-1.000 in every case of Pillow, Bresenham and
 #: cv2 LINE_8 (21 bundled cases each); GL's own pixels with each line's last pixel dropped measure 0.83-0.92
 #: against it. Without it a run with --min-f1-0px 0 would read any drawing whose one-sided pixels balance

@@ -1,4 +1,4 @@
-"""oracles.judge.line_model: one model of a drawn line, checked case by case and against independent drawers.
+"""oracles.line_model: one model of a drawn line, checked case by case and against independent drawers.
 
 Expected images are built by slicing (hand-derived), or drawn by Pillow's ``ImageDraw.line`` and OpenCV's
 ``cv2.line`` (independent implementations of the rounded-ends rule), never by the model under test.
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from wirecheck.oracles.judge import line_model as lm
+from wirecheck.oracles import line_model as lm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "clients"))
 import heldout_draw as hd  # noqa: E402

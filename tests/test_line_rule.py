@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PIL import Image
+from wirecheck.oracles import line_model
 from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
-from wirecheck.oracles.judge import line_model
 from wirecheck.oracles.judge.frames_judge import run_frames
 from wirecheck.oracles.tolerances import Tolerances
 

@@ -12,6 +12,7 @@ import numpy as np
 from wirecheck.core.projector import raster
 from wirecheck.core.projector.clipping import clip_to_image
 
+from .. import line_model
 from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registration, frame_samples, points_per_frame
 
 
@@ -24,15 +25,18 @@ def model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -
     """
     centre = np.array(camera.principal_point)
     shift = np.zeros(2) if shift is None else np.asarray(shift, dtype=np.float64)
-    draw = raster.line_pixels_fast if snapped else raster.line_pixels
     images = []
     for segs in oracle_segs:
         segs = np.asarray(segs, dtype=np.float64).reshape(-1, 2, 2)
         segs = ((segs - centre) @ p.T) * d + centre + shift  # the model's lines (identity: the oracle's)
-        img = np.zeros((camera.height, camera.width), bool)
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
-        rr, cc = draw(q0, q1, camera.width, camera.height)
-        img[rr, cc] = True
+        shape = (camera.height, camera.width)
+        if snapped:
+            img = np.zeros(shape, bool)
+            rr, cc = raster.line_pixels_fast(q0, q1, camera.width, camera.height)
+            img[rr, cc] = True
+        else:  # GL's rule: the line model's drawing (oracles.line_model)
+            img, _ = line_model.expected(np.stack([q0, q1], axis=1), shape, "gl")
         images.append(img)
     return images
 

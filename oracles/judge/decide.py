@@ -56,7 +56,7 @@ __all__ = [
 #: Faults a correct drawing under another aliased rule leaves under GL's: the diagnosis may name only these
 #: for the pixels to be read as the rounded-ends rule's correct drawing (their own names give way to it).
 RULE_FAULTS = ("unexplained", "pixel_offset", "raster_rule") + catalogue.names("line_count")
-#: The rounded-ends rule, in words (oracles.judge.line_model).
+#: The rounded-ends rule, in words (oracles.line_model).
 ROUNDED_RULE_NAME = "ends rounded to pixel centres (Bresenham, Pillow, cv2.line)"
 
 

@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 from wirecheck.core.projector import pipeline
 
+from .. import line_model
 from ..candidates import frames_candidate
 from ..candidates.draw import oracle_segments as line_segments
 from ..candidates.export import job_outputs
@@ -50,7 +51,7 @@ from ..diagnosis.image_visibility import set_difference
 from ..faults import Fault
 from ..references import opencv_oracle
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances
-from . import f1_radius, line_model, metrics
+from . import f1_radius, metrics
 from .decide import decide, filled_reasons, pixel_fields
 from .depth_frames import DepthFrames
 from .depth_reference import from_render
@@ -123,7 +124,7 @@ class _CaseFrames:
 
     def add_rounded(self, k, cand: np.ndarray, segs: np.ndarray, shape: tuple, seg0, seg1, tol) -> None:
         """Score a frame's drawn pixels ``cand`` (flat) against a correct drawing of ``segs`` by the
-        rounded-ends rule (oracles.judge.line_model), the rule's ties left out of both."""
+        rounded-ends rule (oracles.line_model), the rule's ties left out of both."""
         model, ties = line_model.expected(segs, shape, "rounded", tol.rounded_end_tie_px)
         keep = ~ties.reshape(-1)
         fp = metrics.FramePixels.from_indices(shape, cand[keep[cand]], np.flatnonzero(model.reshape(-1) & keep))
@@ -158,7 +159,7 @@ def judge_case(
     read ahead on its GL thread), or an OracleCache (read in this thread).
 
     ``line_rule``: ``"any"`` holds aliased 1-px lines to a correct drawing by GL's rule or the
-    rounded-ends rule (oracles.judge.line_model), ``"gl"`` to GL's pixel rule alone,
+    rounded-ends rule (oracles.line_model), ``"gl"`` to GL's pixel rule alone,
     ``"geometry"`` judges where the lines are only (oracles.judge.line_style).
 
     Each frame's wireframe, depth map and filled frame, as the job asks for them (module

@@ -79,11 +79,11 @@ from wirecheck.core.projector import raster
 from wirecheck.core.projector.clipping import clip_to_image
 
 from .. import faults as catalogue
-from .. import tolerances
+from .. import line_model, tolerances
 from ..diagnosis.diagnose import diagnose_lines
 from ..diagnosis.image_diagnose import oracle_segments
 from ..faults import Fault
-from . import coverage_pixels, even_lean, free_ends, line_model, line_ties, line_windows
+from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
 from .case_samples import CaseSamples
 from .decide import ROUNDED_RULE_NAME
 from .evidence import StyleRead
@@ -91,7 +91,7 @@ from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, po
 
 STYLES = ("aliased", "antialiased", "wide")
 #: ``--line-rule``: ``any`` (the default) holds aliased lines to a correct drawing under GL's rule or under
-#: the rounded-ends rule (oracles.judge.line_model); ``gl`` to GL's alone (another rule's correct drawing
+#: the rounded-ends rule (oracles.line_model); ``gl`` to GL's alone (another rule's correct drawing
 #: is ``raster_rule``); ``geometry`` judges the lines' centres only.
 LINE_RULES = ("any", "gl", "geometry")
 #: What each rule read from the pixels is, for the report and the summary line.
@@ -217,7 +217,7 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
 
 def _reference(segs: np.ndarray, shape, width_px: float, clipped=None, drawn: int = 0) -> np.ndarray:
     """A correct binary drawing of ``segs``: core's raster (1 px), or a band centred on them holding the
-    candidate's ``drawn`` pixels (oracles.judge.line_model.band_holding; ``drawn`` 0: the width rounded).
+    candidate's ``drawn`` pixels (oracles.line_model.band_holding; ``drawn`` 0: the width rounded).
 
     ``clipped``: ``clip_to_image(segs[:, 0], segs[:, 1], W, H)`` of this ``shape``, when the caller has it.
     """
@@ -497,7 +497,7 @@ class CaseStyle:
         swapped are not measured (a centroid of what lies near the oracle's lines would be of stray
         crossings). ``rounded``: the pixels against a correct drawing by the rounded-ends rule
         (``{"pixel_f1_0px", "lines"}``: the worst frame's F1@0px and the pooled line fields, its ties left
-        out; oracles.judge.line_model), None when not drawn.
+        out; oracles.line_model), None when not drawn.
         """
         tol = tolerances.Tolerances() if tol is None else tol
         read = self.classify()

@@ -44,7 +44,7 @@ import numpy as np
 from wirecheck.core.projector.clipping import clip_to_image
 from wirecheck.core.projector.raster import line_pixels
 
-from ..tolerances import ROUNDED_END_TIE_PX
+from .tolerances import ROUNDED_END_TIE_PX
 
 __all__ = [
     "RULES",
