@@ -117,7 +117,12 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
 def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:
     """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope (``slope``,
     oracles.judge.metrics.depth_slope) of near or far."""
-    at_plane = covered & ((np.abs(depth - camera.near) <= slope) | (np.abs(depth - camera.far) <= slope))
+    d, s = depth[covered], slope[covered]
+    near = (np.abs(d - camera.near) <= s) | (np.abs(d - camera.far) <= s)
+    at_plane = np.zeros(covered.shape, bool)
+    if not near.any():  # most frames: no surface at a clip plane
+        return at_plane
+    at_plane[covered] = near
     out = at_plane.copy()
     h, w = at_plane.shape
     for dy in (-1, 0, 1):
