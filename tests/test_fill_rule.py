@@ -520,6 +520,10 @@ def test_open_edges_equal_a_naive_pairing():
     assert want.any() and not want.all()
     assert not want[-2, 0] and not want[-1, 0]
     np.testing.assert_array_equal(open_edges(tris), want)
+    # numbered corners (one number: one point), each its own or one per distinct point, change nothing
+    _, same = np.unique(tris.reshape(-1, 2) + 0.0, axis=0, return_inverse=True)
+    for corners in (np.arange(tris.size // 2).reshape(-1, 3), same.reshape(-1, 3)):
+        np.testing.assert_array_equal(open_edges(tris, corners), want)
     # NaN corners equal nothing: the edges through one are open, even between triangles that share it
     nan_pair = np.array([[[0.0, 0.0], [np.nan, 4.0], [-3.0, 2.0]], [[np.nan, 4.0], [0.0, 0.0], [3.0, 2.0]]])
     np.testing.assert_array_equal(open_edges(nan_pair), _naive_open_edges(nan_pair))
