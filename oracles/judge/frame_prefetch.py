@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import threading
 from concurrent.futures import Future, ThreadPoolExecutor
+from functools import partial
 from pathlib import Path
 
 from ..candidates.export import job_outputs
@@ -50,10 +51,11 @@ AHEAD = 2
 class FrameAhead:
     """One frame as read ahead: each step's result, or the exception it raised (raised again when asked)."""
 
-    __slots__ = ("_inputs", "_oracle", "_grey", "_faces")
+    __slots__ = ("_inputs", "_oracle", "_grey", "_faces", "_reference")
 
-    def __init__(self, inputs, oracle, grey, faces=None):
+    def __init__(self, inputs, oracle, grey, faces=None, reference=None):
         self._inputs, self._oracle, self._grey, self._faces = inputs, oracle, grey, faces
+        self._reference = reference
 
     @staticmethod
     def _value(step):
@@ -79,15 +81,22 @@ class FrameAhead:
         the job asks for no filled frame nor depth map."""
         return self._value(self._faces)
 
+    def reference(self):
+        """What the judge's ``reference`` made of the frame's drawing of its faces (:meth:`FramePrefetch.frames`);
+        None when it was given none."""
+        return self._value(self._reference)
 
-def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: dict) -> FrameAhead:
+
+def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: dict, reference=None) -> FrameAhead:
     """Frame ``k`` of case ``c`` read as the judge reads it, each step's exception kept in its place.
 
     The steps run in the judge's order: the frame's inputs, pyrender's
     drawing, the PNG (``rel``: the wireframe's, None when the job asks for no
     wireframe), then pyrender's drawing of the faces when the job asks for filled
-    frames or depth maps; a step that fails ends the frame's reading (the judge
-    raises it before it would need the next).
+    frames or depth maps, then ``reference(inputs, faces)`` of the frame's inputs and that
+    drawing when given (the judge's own work on them, done here beside its work on the
+    frames before: :meth:`FramePrefetch.frames`); a step that fails ends the frame's
+    reading (the judge raises it before it would need the next).
     """
     try:
         inputs = frame_inputs(job_dir, job, c["scene"], c["case"], k, cache)
@@ -118,8 +127,14 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: d
         )
         faces = (*drawn, tris, polygons)
     except Exception as exc:  # noqa: BLE001
-        faces = exc
-    return FrameAhead(inputs, orac, grey, faces)
+        return FrameAhead(inputs, orac, grey, exc)
+    made = None
+    if reference is not None:
+        try:
+            made = reference(inputs, faces)
+        except Exception as exc:  # noqa: BLE001
+            made = exc
+    return FrameAhead(inputs, orac, grey, faces, made)
 
 
 class FramePrefetch:
@@ -159,14 +174,20 @@ class FramePrefetch:
         """``fn(*args)`` on the GL thread, waited for (``gl_info``)."""
         return self._submit(fn, *args).result()
 
-    def frames(self, job_dir, job, c: dict, numbers: list):
-        """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead."""
+    def frames(self, job_dir, job, c: dict, numbers: list, reference=None):
+        """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead.
+
+        ``reference``: a function of a frame's inputs and pyrender's drawing of its faces (:meth:`FrameAhead.inputs`,
+        :meth:`FrameAhead.faces`) run on the worker after the drawing (the fill rule's silhouette: the judge's
+        work that needs only the frame's geometry), its result or exception kept for :meth:`FrameAhead.reference`.
+        It must not share state with the judge's thread."""
         cache: dict = {}  # frame_inputs' OBJ and camera, kept over the case (used on the worker only)
         todo = iter(zip(numbers, c["frames"] or [None] * len(numbers)))  # no wireframe asked: no PNG
         queued: list[Future] = []
+        read = read_ahead if reference is None else partial(read_ahead, reference=reference)
         if self._pool is None:  # read each frame when it is asked for
             for k, rel in todo:
-                yield read_ahead(self.oracles, job_dir, job, c, k, rel, cache)
+                yield read(self.oracles, job_dir, job, c, k, rel, cache)
             return
         try:
             while True:
@@ -174,7 +195,7 @@ class FramePrefetch:
                     nxt = next(todo, None)
                     if nxt is None:
                         break
-                    queued.append(self._submit(read_ahead, self.oracles, job_dir, job, c, nxt[0], nxt[1], cache))
+                    queued.append(self._submit(read, self.oracles, job_dir, job, c, nxt[0], nxt[1], cache))
                 if not queued:
                     return
                 yield queued.pop(0).result()

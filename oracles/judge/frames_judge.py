@@ -170,8 +170,9 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     style = CaseStyle(line_rule)
     camera = None
     # each frame's inputs, pyrender's drawing and its PNG's grey levels, read ahead on the GL thread
-    # (frame_prefetch: each step's error raised here, at its frame and step)
-    ahead = reader_for(oracles).frames(job_dir, job, c, numbers)
+    # (frame_prefetch: each step's error raised here, at its frame and step), with the fill rule's silhouette
+    # of each frame made there too, beside this thread's work on the frames before it
+    ahead = reader_for(oracles).frames(job_dir, job, c, numbers, _silhouette_maker(filled, job, scene))
     for i, (k, frame) in enumerate(zip(numbers, ahead)):
         p_model, edges, camera, m = frame.inputs()
         if wire:
@@ -202,6 +203,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
                     camera,
                     (job_dir, job),
                     face_objects(job, scene, polygons),
+                    reference=frame.reference,
                 )
                 acc.drawn_px += rec_k["union_px"]
         del frame
@@ -235,6 +237,22 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     rec = case_record(job, scene, case, camera, ev, verdict, names, acc)
     worst = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]} if wire else None
     return rec, worst
+
+
+def _silhouette_maker(filled, job, scene: str):
+    """The frame reader's ``reference`` for a case's filled frames (None without them): a frame's fill-rule
+    silhouette (FilledFrames.reference, pyrender's triangle ids as its hint), from the frame's inputs and
+    pyrender's drawing of its faces alone."""
+    if filled is None:
+        return None
+
+    def make(inputs, faces):
+        p_model, _edges, camera, m = inputs
+        _covered, _z, ids, _tris, polygons = faces
+        objects = face_objects(job, scene, polygons)
+        return filled.reference(p_model @ m[:3, :3].T + m[:3, 3], polygons, camera, objects, hint=ids)
+
+    return make
 
 
 def _wireframe_fails(ev: CaseEvidence, tol) -> bool:
