@@ -183,37 +183,39 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     rounding of that line shows is decided by each renderer's rounding. Such
     pixels (one on each side) are left out of the depth comparison.
 
-    Each unordered pair of 8-neighbours is taken once, as two views of the rows and columns that hold a
-    triangle (nothing is marked elsewhere), and only the pairs that show two triangles are compared.
+    Each unordered pair of 8-neighbours is taken once, within the rows and columns that hold a triangle
+    (nothing is marked elsewhere), as a pair of flat positions ``(i, i + step)`` in that box with a column of
+    -1 after each row (no pair wraps onto the next row); only the pairs that show two triangles are compared.
     """
     ids = np.asarray(ids)
     out = np.zeros(ids.shape, bool)
-    triangles = np.asarray(triangles).reshape(-1, 3)
     shown = ids >= 0
     rows, cols = np.flatnonzero(shown.any(axis=1)), np.flatnonzero(shown.any(axis=0))
     if len(rows) == 0:
         return out
     r0, c0 = rows[0], cols[0]
-    box = ids[r0 : rows[-1] + 1, c0 : cols[-1] + 1]
-    h, w = box.shape
+    h, w = rows[-1] + 1 - r0, cols[-1] + 1 - c0
+    padded = np.full((h, w + 1), -1, dtype=ids.dtype)
+    padded[:, :w] = ids[r0 : rows[-1] + 1, c0 : cols[-1] + 1]
+    flat = padded.ravel()
+    firsts, steps = [], []
     for dy, dx in _NEIGHBOURS[4:]:  # pixel (y, x) and its neighbour (y + dy, x + dx), dy >= 0
-        xa = slice(max(0, -dx), w - max(0, dx))  # columns of the first pixel with the neighbour's in the box
-        xb = slice(max(0, dx), w + min(0, dx))
-        a, b = box[: h - dy, xa], box[dy:, xb]
-        pair = (a != b) & (a >= 0) & (b >= 0)
-        ta, tb = triangles[a[pair]].T, triangles[b[pair]].T
-        shared = np.zeros(ta.shape[1], bool)
-        for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
-            for j in range(3):
-                shared |= ta[i] == tb[j]
-        apart = ~shared
-        if not apart.any():
+        step = dy * (w + 1) + dx
+        if step >= len(flat):  # one row: no pair below it
             continue
-        pair[pair] = apart
-        y, x = np.nonzero(pair)
-        y, x = y + r0, x + c0 + max(0, -dx)
-        out[y, x] = True  # this pixel, whose neighbour (dy, dx) is apart
-        out[y + dy, x + dx] = True  # and that neighbour
+        a, b = flat[: len(flat) - step], flat[step:]
+        first = np.flatnonzero((a != b) & (a >= 0) & (b >= 0))
+        firsts.append(first)
+        steps.append(np.full(len(first), step))
+    first, step = np.concatenate(firsts), np.concatenate(steps).astype(np.int64)
+    corners = np.ascontiguousarray(np.asarray(triangles).reshape(-1, 3).T)  # (3, T): each corner's row
+    ta, tb = corners[:, flat[first]], corners[:, flat[first + step]]
+    shared = np.zeros(len(first), bool)
+    for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
+        for j in range(3):
+            shared |= ta[i] == tb[j]
+    apart = np.concatenate([first[~shared], (first + step)[~shared]])  # this pixel and its neighbour
+    out[apart // (w + 1) + r0, apart % (w + 1) + c0] = True
     return out
 
 
