@@ -173,6 +173,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
     # (frame_prefetch: each step's error raised here, at its frame and step), with the fill rule's silhouette
     # of each frame made there too, beside this thread's work on the frames before it
     ahead = reader_for(oracles).frames(job_dir, job, c, numbers, _silhouette_maker(filled, job, scene))
+    objects = (None, None)  # (faces, each face's object), kept while the faces are the same object
     for i, (k, frame) in enumerate(zip(numbers, ahead)):
         p_model, edges, camera, m = frame.inputs()
         if wire:
@@ -195,6 +196,8 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
                 rec_k = depth.add(k, Path(job_dir) / c["depth"][i], camera, from_render(covered, z, ids, tris, camera))
                 acc.drawn_px += rec_k["union_px"]
             if filled:  # the fill rule's silhouette (filled_frames)
+                if objects[0] is not polygons:
+                    objects = polygons, face_objects(job, scene, polygons)
                 rec_k = filled.add(
                     k,
                     Path(job_dir) / c["filled"][i],
@@ -202,7 +205,7 @@ def judge_case(job_dir, job, scene: str, case: str, oracles, tol, diagnose: bool
                     polygons,
                     camera,
                     (job_dir, job),
-                    face_objects(job, scene, polygons),
+                    objects[1],
                     reference=frame.reference,
                 )
                 acc.drawn_px += rec_k["union_px"]
@@ -246,11 +249,14 @@ def _silhouette_maker(filled, job, scene: str):
     if filled is None:
         return None
 
+    objects = [None, None]  # (faces, their objects): a model-space scene's faces are one object a case
+
     def make(inputs, faces):
         p_model, _edges, camera, m = inputs
         _covered, _z, ids, _tris, polygons = faces
-        objects = face_objects(job, scene, polygons)
-        return filled.reference(p_model @ m[:3, :3].T + m[:3, 3], polygons, camera, objects, hint=ids)
+        if objects[0] is not polygons:
+            objects[:] = polygons, face_objects(job, scene, polygons)
+        return filled.reference(p_model @ m[:3, :3].T + m[:3, 3], polygons, camera, objects[1], hint=ids)
 
     return make
 

@@ -194,13 +194,14 @@ def _raster(
     is_open = np.where(swapped[:, None], is_open[:, ::-1], is_open)
     if tri_z is not None:
         tri_z = np.where(swapped[:, None], tri_z[:, [0, 2, 1]], tri_z)
-    lo = np.floor(tris.min(axis=1) - tie_px)
-    hi = np.ceil(tris.max(axis=1) + tie_px)
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]  # the corners' least and greatest x and y, one pass each
+    lo = np.floor(np.minimum(np.minimum(a, b), c) - tie_px)
+    hi = np.ceil(np.maximum(np.maximum(a, b), c) + tie_px)
     x0 = np.clip(lo[:, 0], 0, width - 1)
     y0 = np.clip(lo[:, 1], 0, height - 1)
     x1 = np.clip(hi[:, 0], 0, width - 1)
     y1 = np.clip(hi[:, 1], 0, height - 1)
-    finite = np.isfinite(tris).all(axis=(1, 2))
+    finite = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
     seen = finite & (hi[:, 0] >= 0) & (lo[:, 0] <= width - 1) & (hi[:, 1] >= 0) & (lo[:, 1] <= height - 1)
     idx = np.flatnonzero(seen)
     if tri_z is None:  # coverage alone: each box row's centres decided as spans
