@@ -1,7 +1,7 @@
 """Are two versions of the frames judge's outputs the same to the byte? (a change meant to be a speed-up only)
 
-    .venv/bin/python benchmarks/frames_judge_equivalence.py jobs DIR            # export and draw 41 varied jobs
-    .venv/bin/python benchmarks/frames_judge_equivalence.py depth-jobs DIR      # the 14 filled and depth ones alone
+    .venv/bin/python benchmarks/frames_judge_equivalence.py jobs DIR            # export and draw 40 varied jobs
+    .venv/bin/python benchmarks/frames_judge_equivalence.py depth-jobs DIR      # the 13 filled and depth ones alone
     PYTHONPATH=/tmp/base .venv/bin/python benchmarks/frames_judge_equivalence.py judge DIR OUT_BEFORE
     .venv/bin/python benchmarks/frames_judge_equivalence.py judge DIR OUT_AFTER   # (/tmp/base/wirecheck: the old tree)
     .venv/bin/python benchmarks/frames_judge_equivalence.py compare OUT_BEFORE OUT_AFTER

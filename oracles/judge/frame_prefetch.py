@@ -4,7 +4,11 @@ on one worker thread while the judge scores the frames before it.
 The judge's own work on frame ``k`` (numpy) and the oracle's drawing of frame
 ``k + 1`` (pyrender on OSMesa/EGL: much of it inside the GL library, which
 PyOpenGL's ctypes calls run without the GIL) and the decoding of its PNG
-(zlib, also without the GIL) then overlap, on two cores.
+(zlib, also without the GIL) then overlap, on two cores. A job with filled
+frames has the fill rule's silhouette of each frame made there too, after its
+drawing (``reference``: numpy, whose array loops run without the GIL): it needs
+the frame's geometry and pyrender's triangle ids alone, and is about as much
+work as the judge's comparisons of the frame's depth map and filled frame.
 
 What stays as it was:
 

@@ -38,14 +38,19 @@ Object ids (:func:`silhouette`): at each covered centre, the object of the neare
 orthographic). Where the two nearest objects' depths are within their depth bounds
 (:func:`depth_bound`), the pixel's id is :data:`ID_TIE` (either object is correct).
 
-Work is vectorised over batches of triangles whose bounding boxes (clipped to the image, grown
-by ``tie_px``) round up to the same size (by at most a half per side), so it scales with the
-area the triangles cover (each edge function's two products taken once per box row and per box
-column, only their difference per centre); only the few centres within ``tie_px`` of an open
-edge's line, on the triangles that have one, are measured against the segment. With several
-objects, the same pass keeps every covered centre's depth and object, and one sort finds each
-pixel's nearest two objects
-(``benchmarks/bench_fill_rule.py``: 100,000 triangles at 640x480 in ~0.33-0.37 s at load 3).
+Coverage and ties are taken one box row at a time (boxes clipped to the image, grown by
+``tie_px``): along a row each edge function, evaluated in float64 as the rule writes it, is
+monotone, so a triangle's centres on the row are a span, found from the edge lines' crossings
+and checked with the edge functions themselves at its ends; the work scales with the rows the
+triangles cover, and the centres are the same, bit for bit, as a per-centre pass
+(tests/test_fill_rule.py's naive pass). Only the few centres within ``tie_px`` of an open
+edge's line are measured against the segment. :func:`silhouette` may be given a guess of the
+triangle covering each centre (pyrender's triangle ids): each run of one guess along a row is
+checked by the rule at its two ends, and only the triangles whose box holds a centre not held
+so are taken row by row (the same result, whatever the guess). With several objects, a
+per-centre pass over batches of boxes of like size keeps every covered centre's depth and
+object, and one sort finds each pixel's nearest two objects
+(``benchmarks/bench_fill_rule.py``: 100,000 triangles at 640x480).
 """
 
 from __future__ import annotations
