@@ -1,6 +1,7 @@
 """Are two versions of the frames judge's outputs the same to the byte? (a change meant to be a speed-up only)
 
-    .venv/bin/python benchmarks/frames_judge_equivalence.py jobs DIR            # export and draw 27 varied jobs
+    .venv/bin/python benchmarks/frames_judge_equivalence.py jobs DIR            # export and draw 40 varied jobs
+    .venv/bin/python benchmarks/frames_judge_equivalence.py depth-jobs DIR      # the 13 filled and depth ones alone
     PYTHONPATH=/tmp/base .venv/bin/python benchmarks/frames_judge_equivalence.py judge DIR OUT_BEFORE
     .venv/bin/python benchmarks/frames_judge_equivalence.py judge DIR OUT_AFTER   # (/tmp/base/wirecheck: the old tree)
     .venv/bin/python benchmarks/frames_judge_equivalence.py compare OUT_BEFORE OUT_AFTER
@@ -9,7 +10,13 @@
 with a stray pixel, each line's last pixel dropped, mirrored), antialiased (and
 shifted by half a pixel), 3 px wide, by Pillow's rule, by GL's rule shifted by
 half a pixel; core's frames saved as RGB, RGBA, 16-bit grey, grey + alpha,
-palette and 1-bit PNGs; two 96-frame jobs past the line samples' cap.
+palette and 1-bit PNGs; two 96-frame jobs past the line samples' cap. With
+``--outputs filled,depth`` (the ``d_`` jobs, drawn by tests/clients/core_depth_job.py):
+cube, pyramid and prism under the seven cameras as is and as a 16-bit PNG at
+scale 1000; the z-buffer stored, x1000, rows flipped (depth and filled), half a
+pixel and K from the horizontal FOV (the perspective cameras), a band missing
+along the filled frames' top edge; the orrery's three objects with their ids,
+permuted and all one; an icosphere(4) (5,120 faces); one job with wireframes too.
 ``judge``: ``crosscheck --candidate-frames`` on each (``--line-rule gl``, and
 ``geometry`` on nine), with whichever wirecheck is first on the path: each
 report folder plus its exit status and printed lines. ``compare``: every
@@ -56,6 +63,23 @@ B = [
     "0.3",
 ]
 C = ["--scene", "cube", "--cases", "on_axis", "--frames", "96"]
+D = ["--scene", "cube", "--scene", "pyramid", "--scene", "prism", "--frames", "5", "--every", "2", "--phase", "0.3"]
+D_ONE = ["--cases", "oblique_roll,orthographic,near_plane", "--frames", "5", "--every", "2", "--phase", "0.3"]
+
+
+def _exporter(out: Path):
+    """``export(name, args)``: ``crosscheck export out/name args`` (a folder there before is replaced)."""
+    from wirecheck.oracles.cli import main
+
+    def export(name, args):
+        d = out / name
+        out.mkdir(parents=True, exist_ok=True)
+        if d.exists():
+            shutil.rmtree(d)
+        assert main(["export", str(d)] + args) == 0
+        return d
+
+    return export
 
 
 def make_jobs(out: Path) -> None:
@@ -69,15 +93,9 @@ def make_jobs(out: Path) -> None:
     from wirecheck.core.projector.clipping import clip_to_image
     from wirecheck.core.projector.pipeline import render_frame
     from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job
-    from wirecheck.oracles.cli import main
     from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 
-    def export(name, args):
-        d = out / name
-        if d.exists():
-            shutil.rmtree(d)
-        assert main(["export", str(d)] + args) == 0
-        return d
+    export = _exporter(out)
 
     def each(d, fn, save=lambda img, p: Image.fromarray(img).save(p)):
         job = load_job(d)
@@ -138,6 +156,52 @@ def make_jobs(out: Path) -> None:
     each(export("a_aa_rgb", A), styled(draw_antialiased), lambda img, p: Image.fromarray(img).convert("RGB").save(p))
     each(export("c96_core", C), core)
     each(export("c96_aa", C), styled(draw_antialiased))
+    make_depth_jobs(out, export)
+
+
+def make_depth_jobs(out: Path, export) -> None:
+    """The jobs with filled frames and depth maps (module docstring), drawn by core's depth client."""
+    import numpy as np
+    import trimesh
+
+    sys.path[:0] = [str(ROOT / "tests")]
+    from clients.core_depth_job import CAMERA_MISTAKES, MISTAKES, render_job
+
+    fd = ["--outputs", "filled,depth"]
+    render_job(export("d_core", D + fd))
+    render_job(export("d_png16", D + fd + ["--depth-format", "png16", "--depth-scale", "1000"]))
+    for name in ("zbuffer", "x1000"):
+        render_job(export(f"d_{name}", ["--scene", "cube", "--scene", "prism"] + D_ONE + fd), MISTAKES[name])
+    render_job(
+        export("d_rows", ["--scene", "cube", "--scene", "pyramid"] + D_ONE + fd),
+        MISTAKES["rows_flipped"],
+        lambda covered: covered[::-1],
+    )
+    for name, mistake in CAMERA_MISTAKES.items():
+        render_job(
+            export(f"d_{name}", ["--scene", "cube", "--cases", "oblique_roll,wide_fov"] + D_ONE[2:] + fd),
+            camera=mistake,
+        )
+
+    def drop_top(covered):  # each column's top covered pixel left out: a 1-px band along the top edge
+        out = covered.copy()
+        cols = np.flatnonzero(covered.any(axis=0))
+        out[covered.argmax(axis=0)[cols], cols] = False
+        return out
+
+    render_job(export("d_band", ["--scene", "pyramid"] + D_ONE + fd), filled=drop_top)
+    orrery = str(ROOT / "scenes" / "examples" / "orrery.scene")
+    for name, ids in (("", lambda o: o), ("_permuted", lambda o: 2 - o), ("_one_id", np.zeros_like)):
+        render_job(export(f"d_orrery{name}", ["--scene", orrery] + D_ONE + fd), object_ids=ids)
+    mesh = out / "icosphere4.obj"  # a file beside the jobs: judge reads folders only
+    trimesh.creation.icosphere(subdivisions=4).export(str(mesh))
+    render_job(
+        export(
+            "d_icosphere",
+            ["--scene", str(mesh), "--cases", "oblique_roll,near_plane,orthographic", "--frames", "4"] + fd,
+        )
+    )
+    render_job(export("d_wire", ["--scene", "prism"] + D_ONE + ["--outputs", "wireframe,filled,depth"]))
 
 
 def judge(jobs: Path, out: Path) -> None:
@@ -191,6 +255,8 @@ if __name__ == "__main__":
     cmd, *args = sys.argv[1:]
     if cmd == "jobs":
         make_jobs(Path(args[0]))
+    elif cmd == "depth-jobs":  # the filled and depth jobs alone
+        make_depth_jobs(Path(args[0]), _exporter(Path(args[0])))
     elif cmd == "judge":
         judge(Path(args[0]), Path(args[1]))
     else:

@@ -520,7 +520,65 @@ def test_open_edges_equal_a_naive_pairing():
     assert want.any() and not want.all()
     assert not want[-2, 0] and not want[-1, 0]
     np.testing.assert_array_equal(open_edges(tris), want)
+    # numbered corners (one number: one point), each its own or one per distinct point, change nothing
+    _, same = np.unique(tris.reshape(-1, 2) + 0.0, axis=0, return_inverse=True)
+    for corners in (np.arange(tris.size // 2).reshape(-1, 3), same.reshape(-1, 3)):
+        np.testing.assert_array_equal(open_edges(tris, corners), want)
     # NaN corners equal nothing: the edges through one are open, even between triangles that share it
     nan_pair = np.array([[[0.0, 0.0], [np.nan, 4.0], [-3.0, 2.0]], [[np.nan, 4.0], [0.0, 0.0], [3.0, 2.0]]])
     np.testing.assert_array_equal(open_edges(nan_pair), _naive_open_edges(nan_pair))
     assert open_edges(nan_pair)[:, :2].all()
+
+
+# ---- a hint of triangle ids (pyrender's) spares work and changes nothing ----------------------
+
+
+def _grid_and_soup(rng):
+    """A 12 x 9 grid of quads (shared edges: closed) at depth 3 beside a soup of 12 triangles that cross the
+    near and far planes, in camera space; ``(points, faces)``."""
+    xs, ys = np.meshgrid(np.linspace(-2.2, 0.7, 13), np.linspace(-1.4, 1.2, 10))
+    grid = np.stack([xs.ravel(), ys.ravel(), 3.0 + 0.2 * xs.ravel()], axis=1)
+    quads = [(r * 13 + c, r * 13 + c + 1, (r + 1) * 13 + c + 1, (r + 1) * 13 + c) for r in range(9) for c in range(12)]
+    soup = rng.uniform([-3, -2.5, -1.0], [3, 2.5, 10.0], size=(12, 3, 3)).reshape(-1, 3)
+    start = len(grid)
+    faces = quads + [tuple(range(start + 3 * i, start + 3 * i + 3)) for i in range(12)]
+    return np.concatenate([grid, soup]), faces
+
+
+@pytest.mark.parametrize("projection", ["perspective", "orthographic"])
+def test_a_hint_of_triangle_ids_changes_nothing(projection):
+    """silhouette(hint=ids) checks each hinted run of centres against its triangle by the rule and rasterizes
+    the triangles only around the centres it does not hold: the result is the unhinted one (itself the naive
+    pass's, above) whatever the hint says: the fan's first covering triangle per centre, that hint moved by a
+    pixel (runs that overhang their triangle), random ids (out of range too), none."""
+    rng = np.random.default_rng(3)
+    cam = _camera(near=1.0, far=8.0, fov_y_deg=70.0, projection=projection, ortho_height=4.0)
+    p_cam, faces = _grid_and_soup(rng)
+    p_world = _cam_to_world(p_cam)
+    shape = (cam.height, cam.width)
+    want = silhouette(p_world, faces, cam, shape)
+    tris, _owner = oface.fan(faces)
+    first, count = np.full(shape, -1), np.zeros(shape, dtype=int)
+    for t in range(len(tris) - 1, -1, -1):  # the fan's first triangle covering each centre wins
+        alone = silhouette(p_world, [tuple(tris[t])], cam, shape)[0]
+        first[alone] = t
+        count += alone
+    assert (first >= 0).sum() > 0.3 * first.size and len(np.unique(first)) > 100
+    # one centre deep in the grid left unhinted, none of the soup near it: the boxes around it (the grid's
+    # triangles are ~3 px) hold that one centre alone unchecked
+    grid = (first >= 0) & (first < 2 * 108) & (count == 1)
+    y, x = next((y, x) for y, x in np.argwhere(grid) if y > 4 and x > 4 and grid[y - 4 : y + 5, x - 4 : x + 5].all())
+    dropped = first.copy()
+    dropped[y, x] = -1
+    hints = {
+        "first": first,
+        "one dropped": dropped,
+        "moved": np.roll(first, 1, axis=1),
+        "random": rng.integers(-1, len(tris) + 5, size=shape),
+        "none": np.full(shape, -1),
+    }
+    for name, hint in hints.items():
+        got = silhouette(p_world, faces, cam, shape, hint=hint, fanned=(tris, _owner))
+        for a, b in zip(got, want):
+            np.testing.assert_array_equal(a, b, err_msg=name)
+    assert want[1].any()  # ties on the soup's open edges: the hint path decides them too

@@ -154,3 +154,59 @@ def test_frames_are_asked_for_ahead_frames_beyond_the_one_judged(monkeypatch, ah
     finally:
         reader.close()
     assert _workers() == []
+
+
+@pytest.fixture(scope="module")
+def filled_depth(tmp_path_factory) -> Path:
+    """A job of filled frames and depth maps (ARGS' 6 frames), drawn by core's depth client."""
+    from clients.core_depth_job import render_job
+
+    path = tmp_path_factory.mktemp("fd") / "job"
+    assert main(["export", str(path)] + ARGS + ["--outputs", "filled,depth"]) == 0
+    render_job(path)
+    return path
+
+
+@pytest.mark.parametrize("threaded", [True, False])
+def test_a_reference_made_ahead_is_raised_at_its_own_frame(filled_depth, threaded):
+    """The judge's ``reference`` (a filled frame's silhouette) runs on the worker after the frame's drawing of its
+    faces; what it raises is kept with that frame and raised when the judge asks for it there, the frames
+    around it untouched."""
+    job = load_job(filled_depth)
+    case = job["cases"][0]
+    made = []
+
+    def reference(inputs, faces):  # the worker's calls, in frame order: the third one fails
+        made.append(len(made) + 1)
+        if len(made) == 3:
+            raise ValueError("third frame")
+        return len(made), inputs[2].width, faces[0].shape
+
+    reader = frame_prefetch.FramePrefetch(threaded=threaded)
+    try:
+        got = []
+        for i, frame in enumerate(reader.frames(filled_depth, job, case, job["frame_numbers"], reference)):
+            assert frame.faces()[0].shape == (case["height"], case["width"])
+            if i == 2:
+                with pytest.raises(ValueError, match="third frame"):
+                    frame.reference()
+            else:
+                got.append(frame.reference())
+    finally:
+        reader.close()
+    assert [g[0] for g in got] == [1, 2, 4, 5, 6]
+    assert {g[1:] for g in got} == {(case["width"], (case["height"], case["width"]))}
+    assert _workers() == []
+
+
+def test_filled_frames_judged_ahead_give_the_report_of_reading_in_turn(filled_depth, monkeypatch):
+    """The silhouettes made on the worker (with pyrender's ids as their hint) give the report (timing aside) of
+    reading every frame in the judge's thread."""
+    ahead, _ = run_frames(filled_depth)
+    monkeypatch.setattr(frames_judge, "FramePrefetch", lambda: frame_prefetch.FramePrefetch(threaded=False))
+    in_turn, _ = run_frames(filled_depth)
+    for report in (ahead, in_turn):
+        del report["timing"]
+    assert ahead == in_turn
+    (case,) = ahead["cases"]
+    assert case["filled"]["frames"] == 6 and case["filled"]["reference_px"] > 0 and ahead["verdict"] == "pass"

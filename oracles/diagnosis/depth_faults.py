@@ -152,16 +152,12 @@ def name_depth_faults(
     allow = b + enc
     ratio = _ratio(err, allow)
     worst = int(np.argmax(ratio))
-    rows, cols = np.nonzero(both)
-    measured.update(
-        max_error=float(err.max()),
-        max_error_ratio=float(ratio[worst]),
-        worst_pixel=[int(rows[worst]), int(cols[worst])],
-        median_ratio_c_over_r=float(np.median(c / r)),
-        median_c_minus_r=float(np.median(c - r)),
-    )
+    row, col = divmod(int(np.flatnonzero(both)[worst]), cand.shape[1])
+    measured.update(max_error=float(err.max()), max_error_ratio=float(ratio[worst]), worst_pixel=[row, col])
     if ratio[worst] <= 1.0:
         return DepthDiagnosis("pass", (), measured)
+    # a failing map's medians (what scale and offset would fit), measured only where they say something
+    measured.update(median_ratio_c_over_r=float(np.median(c / r)), median_c_minus_r=float(np.median(c - r)))
     rho = ray_lengths(camera)[both]
     fits = []  # (parameters fitted, max residual / allowance, fault)
     for n_params, model in _models(c, r, rho, b, enc, camera, limits):

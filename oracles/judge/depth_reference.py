@@ -117,7 +117,16 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
 def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:
     """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope (``slope``,
     oracles.judge.metrics.depth_slope) of near or far."""
-    at_plane = covered & ((np.abs(depth - camera.near) <= slope) | (np.abs(depth - camera.far) <= slope))
+    at_plane = np.zeros(covered.shape, bool)
+    rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
+    if len(rows) == 0:
+        return at_plane
+    box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # the covered pixels' bounding box
+    d, s = depth[box], slope[box]
+    with np.errstate(invalid="ignore"):
+        at_plane[box] = covered[box] & ((np.abs(d - camera.near) <= s) | (np.abs(d - camera.far) <= s))
+    if not at_plane.any():  # most frames: no surface at a clip plane
+        return at_plane
     out = at_plane.copy()
     h, w = at_plane.shape
     for dy in (-1, 0, 1):

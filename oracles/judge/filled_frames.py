@@ -28,6 +28,7 @@ import numpy as np
 
 from ..candidates.frames_candidate import read_frame
 from ..diagnosis.silhouette_faults import SilhouetteFrame, name_silhouette_faults
+from ..references.faces import fan
 from ..references.fill_rule import silhouette
 from .silhouette import score_silhouette
 
@@ -44,19 +45,44 @@ class FilledFrames:
         self.tie_px = float(tie_px)
         self.frames = []
         self.failing: list[SilhouetteFrame] = []
+        self._fanned = (None, None)  # (faces, fan(faces)): a model-space scene's faces are one object a case
 
-    def add(self, k: int, path: Path, p_world: np.ndarray, faces, camera, job=None, objects=None) -> dict:
+    def reference(self, p_world: np.ndarray, faces, camera, objects=None, hint=None) -> tuple:
+        """The fill rule's silhouette of ``faces`` (index tuples into ``p_world`` (N, 3)) through ``camera``:
+        ``(inside, ties, object ids)`` (oracles.references.fill_rule.silhouette); ``objects``: each face's
+        object (F,), or None; ``hint``: pyrender's triangle ids of the faces' fan, which spare the fill rule
+        work (the silhouette is the same: each id is checked by the rule)."""
+        several = objects is not None and len(np.unique(objects)) > 1
+        if self._fanned[0] is not faces:
+            self._fanned = (faces, fan(faces))
+        return silhouette(
+            p_world,
+            faces,
+            camera,
+            (int(camera.height), int(camera.width)),
+            face_objects=objects if several else None,
+            tie_px=self.tie_px,
+            hint=hint,
+            fanned=self._fanned[1],
+        )
+
+    def add(
+        self, k: int, path: Path, p_world: np.ndarray, faces, camera, job=None, objects=None, hint=None, reference=None
+    ) -> dict:
         """Frame ``k``'s filled PNG at ``path`` against the fill-rule silhouette of ``faces`` (index tuples into
         ``p_world`` (N, 3)) through ``camera``; its per-frame record. ``job``: ``(job_dir, job)``, for
         :func:`read_frame`'s listing of a job's problems; ``objects``: each face's object (F,), when the
-        scene has several (their ids are then judged: :func:`object_id_misses`)."""
+        scene has several (their ids are then judged: :func:`object_id_misses`); ``hint``: as for
+        :meth:`reference`; ``reference``: a function giving :meth:`reference`'s result made already (on the
+        frames judge's reading thread, oracles.judge.frame_prefetch), called once the PNG is read."""
         h, w = int(camera.height), int(camera.width)
         grey = read_frame(path, w, h, job)
         shown = grey >= 1
         several = objects is not None and len(np.unique(objects)) > 1
-        inside, ties, ids = silhouette(
-            p_world, faces, camera, (h, w), face_objects=objects if several else None, tie_px=self.tie_px
-        )
+        if reference is None:
+            inside, ties, ids = self.reference(p_world, faces, camera, objects, hint)
+        else:
+            inside, ties, ids = reference()
         s = score_silhouette(shown, inside, ties)
         rec = {
             "frame": k,

@@ -4,7 +4,11 @@ on the run's GL thread while the judge scores the frames before it.
 The judge's own work on frame ``k`` (numpy) and the oracle's drawing of frame
 ``k + 1`` (pyrender on OSMesa/EGL: much of it inside the GL library, which
 PyOpenGL's ctypes calls run without the GIL) and the decoding of its PNG
-(zlib, also without the GIL) then overlap, on two cores.
+(zlib, also without the GIL) then overlap, on two cores. A job with filled
+frames has the fill rule's silhouette of each frame made there too, after its
+drawing (``reference``: numpy, whose array loops run without the GIL): it needs
+the frame's geometry and pyrender's triangle ids alone, and is about as much
+work as the judge's comparisons of the frame's depth map and filled frame.
 
 What stays as it was:
 
@@ -34,6 +38,7 @@ is handed an OracleCache (its callers' older form).
 from __future__ import annotations
 
 from concurrent.futures import Future
+from functools import partial
 from pathlib import Path
 
 from ..candidates.export import job_outputs
@@ -48,10 +53,11 @@ AHEAD = 2
 class FrameAhead:
     """One frame as read ahead: each step's result, or the exception it raised (raised again when asked)."""
 
-    __slots__ = ("_inputs", "_oracle", "_grey", "_faces")
+    __slots__ = ("_inputs", "_oracle", "_grey", "_faces", "_reference")
 
-    def __init__(self, inputs, oracle, grey, faces=None):
+    def __init__(self, inputs, oracle, grey, faces=None, reference=None):
         self._inputs, self._oracle, self._grey, self._faces = inputs, oracle, grey, faces
+        self._reference = reference
 
     @staticmethod
     def _value(step):
@@ -77,15 +83,22 @@ class FrameAhead:
         the job asks for no filled frame nor depth map."""
         return self._value(self._faces)
 
+    def reference(self):
+        """What the judge's ``reference`` made of the frame's drawing of its faces (:meth:`FramePrefetch.frames`);
+        None when it was given none."""
+        return self._value(self._reference)
 
-def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: dict) -> FrameAhead:
+
+def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: dict, reference=None) -> FrameAhead:
     """Frame ``k`` of case ``c`` read as the judge reads it, each step's exception kept in its place.
 
     The steps run in the judge's order: the frame's inputs, pyrender's
     drawing, the PNG (``rel``: the wireframe's, None when the job asks for no
     wireframe), then pyrender's drawing of the faces when the job asks for filled
-    frames or depth maps; a step that fails ends the frame's reading (the judge
-    raises it before it would need the next).
+    frames or depth maps, then ``reference(inputs, faces)`` of the frame's inputs and that
+    drawing when given (the judge's own work on them, done here beside its work on the
+    frames before: :meth:`FramePrefetch.frames`); a step that fails ends the frame's
+    reading (the judge raises it before it would need the next).
     """
     try:
         inputs = frame_inputs(job_dir, job, c["scene"], c["case"], k, cache)
@@ -116,8 +129,14 @@ def read_ahead(oracles, job_dir, job, c: dict, k: int, rel: str | None, cache: d
         )
         faces = (*drawn, tris, polygons)
     except Exception as exc:  # noqa: BLE001
-        faces = exc
-    return FrameAhead(inputs, orac, grey, faces)
+        return FrameAhead(inputs, orac, grey, exc)
+    made = None
+    if reference is not None:
+        try:
+            made = reference(inputs, faces)
+        except Exception as exc:  # noqa: BLE001
+            made = exc
+    return FrameAhead(inputs, orac, grey, faces, made)
 
 
 class FramePrefetch:
@@ -142,14 +161,20 @@ class FramePrefetch:
         """``fn(*args)`` on the GL thread, waited for (``gl_info``)."""
         return self.gl.call(fn, *args)
 
-    def frames(self, job_dir, job, c: dict, numbers: list):
-        """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead."""
+    def frames(self, job_dir, job, c: dict, numbers: list, reference=None):
+        """Case ``c``'s frames (``numbers``, ``c["frames"]`` in order) as :class:`FrameAhead`, read ahead.
+
+        ``reference``: a function of a frame's inputs and pyrender's drawing of its faces (:meth:`FrameAhead.inputs`,
+        :meth:`FrameAhead.faces`) run on the worker after the drawing (the fill rule's silhouette: the judge's
+        work that needs only the frame's geometry), its result or exception kept for :meth:`FrameAhead.reference`.
+        It must not share state with the judge's thread."""
         cache: dict = {}  # frame_inputs' OBJ and camera, kept over the case (used on the worker only)
         todo = iter(zip(numbers, c["frames"] or [None] * len(numbers)))  # no wireframe asked: no PNG
         queued: list[Future] = []
+        read = read_ahead if reference is None else partial(read_ahead, reference=reference)
         if not self.gl.threaded:  # read each frame when it is asked for
             for k, rel in todo:
-                yield read_ahead(self.oracles, job_dir, job, c, k, rel, cache)
+                yield read(self.oracles, job_dir, job, c, k, rel, cache)
             return
         try:
             while True:
@@ -157,7 +182,7 @@ class FramePrefetch:
                     nxt = next(todo, None)
                     if nxt is None:
                         break
-                    queued.append(self.gl.submit(read_ahead, self.oracles, job_dir, job, c, nxt[0], nxt[1], cache))
+                    queued.append(self.gl.submit(read, self.oracles, job_dir, job, c, nxt[0], nxt[1], cache))
                 if not queued:
                     return
                 yield queued.pop(0).result()

@@ -177,8 +177,10 @@ def judge_case(
     style = CaseStyle(line_rule, job_read.as_dict() if job_read is not None else None)
     camera = None
     # each frame's inputs, pyrender's drawing and its PNG's grey levels, read ahead on the GL thread
-    # (frame_prefetch: each step's error raised here, at its frame and step)
-    ahead = reader_for(oracles).frames(job_dir, job, c, numbers)
+    # (frame_prefetch: each step's error raised here, at its frame and step), with the fill rule's silhouette
+    # of each frame made there too, beside this thread's work on the frames before it
+    ahead = reader_for(oracles).frames(job_dir, job, c, numbers, _silhouette_maker(filled, job, scene))
+    objects = (None, None)  # (faces, each face's object), kept while the faces are the same object
     for i, (k, frame) in enumerate(zip(numbers, ahead)):
         p_model, edges, camera, m = frame.inputs()
         if wire:
@@ -201,6 +203,8 @@ def judge_case(
                 rec_k = depth.add(k, Path(job_dir) / c["depth"][i], camera, from_render(covered, z, ids, tris, camera))
                 acc.drawn_px += rec_k["union_px"]
             if filled:  # the fill rule's silhouette (filled_frames)
+                if objects[0] is not polygons:
+                    objects = polygons, face_objects(job, scene, polygons)
                 rec_k = filled.add(
                     k,
                     Path(job_dir) / c["filled"][i],
@@ -208,7 +212,8 @@ def judge_case(
                     polygons,
                     camera,
                     (job_dir, job),
-                    face_objects(job, scene, polygons),
+                    objects[1],
+                    reference=frame.reference,
                 )
                 acc.drawn_px += rec_k["union_px"]
         del frame
@@ -242,6 +247,25 @@ def judge_case(
     rec = case_record(job, scene, case, camera, ev, verdict, names, acc)
     worst = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]} if wire else None
     return rec, worst
+
+
+def _silhouette_maker(filled, job, scene: str):
+    """The frame reader's ``reference`` for a case's filled frames (None without them): a frame's fill-rule
+    silhouette (FilledFrames.reference, pyrender's triangle ids as its hint), from the frame's inputs and
+    pyrender's drawing of its faces alone."""
+    if filled is None:
+        return None
+
+    objects = [None, None]  # (faces, their objects): a model-space scene's faces are one object a case
+
+    def make(inputs, faces):
+        p_model, _edges, camera, m = inputs
+        _covered, _z, ids, _tris, polygons = faces
+        if objects[0] is not polygons:
+            objects[:] = polygons, face_objects(job, scene, polygons)
+        return filled.reference(p_model @ m[:3, :3].T + m[:3, 3], polygons, camera, objects[1], hint=ids)
+
+    return make
 
 
 def _wireframe_fails(ev: CaseEvidence, tol) -> bool:

@@ -182,23 +182,40 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     another) depth jumps, and which of the two a pixel centre within
     rounding of that line shows is decided by each renderer's rounding. Such
     pixels (one on each side) are left out of the depth comparison.
+
+    Each unordered pair of 8-neighbours is taken once, within the rows and columns that hold a triangle
+    (nothing is marked elsewhere), as a pair of flat positions ``(i, i + step)`` in that box with a column of
+    -1 after each row (no pair wraps onto the next row); only the pairs that show two triangles are compared.
     """
+    ids = np.asarray(ids)
     out = np.zeros(ids.shape, bool)
-    triangles = np.asarray(triangles).reshape(-1, 3)
-    for dy, dx in _NEIGHBOURS[4:]:  # each unordered neighbour pair once; mark both ends
-        other = _shifted(ids, dy, dx, -1)
-        m = (ids != other) & (ids >= 0) & (other >= 0)
-        if not m.any():
+    shown = ids >= 0
+    rows, cols = np.flatnonzero(shown.any(axis=1)), np.flatnonzero(shown.any(axis=0))
+    if len(rows) == 0:
+        return out
+    r0, c0 = rows[0], cols[0]
+    h, w = rows[-1] + 1 - r0, cols[-1] + 1 - c0
+    padded = np.full((h, w + 1), -1, dtype=ids.dtype)
+    padded[:, :w] = ids[r0 : rows[-1] + 1, c0 : cols[-1] + 1]
+    flat = padded.ravel()
+    firsts, steps = [], []
+    for dy, dx in _NEIGHBOURS[4:]:  # pixel (y, x) and its neighbour (y + dy, x + dx), dy >= 0
+        step = dy * (w + 1) + dx
+        if step >= len(flat):  # one row: no pair below it
             continue
-        a, b = triangles[ids[m]], triangles[other[m]]
-        shared = np.zeros(len(a), bool)
-        for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
-            for j in range(3):
-                shared |= a[:, i] == b[:, j]
-        apart = ~shared
-        hit = np.zeros(ids.shape, bool)
-        hit[m] = apart  # this pixel, whose neighbour (dy, dx) is apart
-        out |= hit | _shifted(hit, -dy, -dx, False)  # and that neighbour
+        a, b = flat[: len(flat) - step], flat[step:]
+        first = np.flatnonzero((a != b) & (a >= 0) & (b >= 0))
+        firsts.append(first)
+        steps.append(np.full(len(first), step))
+    first, step = np.concatenate(firsts), np.concatenate(steps).astype(np.int64)
+    corners = np.ascontiguousarray(np.asarray(triangles).reshape(-1, 3).T)  # (3, T): each corner's row
+    ta, tb = corners[:, flat[first]], corners[:, flat[first + step]]
+    shared = np.zeros(len(first), bool)
+    for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
+        for j in range(3):
+            shared |= ta[i] == tb[j]
+    apart = np.concatenate([first[~shared], (first + step)[~shared]])  # this pixel and its neighbour
+    out[apart // (w + 1) + r0, apart % (w + 1) + c0] = True
     return out
 
 
@@ -297,9 +314,16 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
 
     Each neighbouring pair's change is taken once, across columns then rows, and given to both
     pixels of the pair (``fmax`` keeps 0 where the change is NaN: a pixel not covered); an infinite
-    change is the largest float, as ``nan_to_num`` made it."""
-    d = np.where(covered, np.asarray(depth, np.float64), np.nan)
-    slope = np.zeros(d.shape)
+    change is the largest float, as ``nan_to_num`` made it. Taken over the covered pixels' bounding box
+    (0 outside it: no pair there has two covered pixels)."""
+    covered = np.asarray(covered, bool)
+    out = np.zeros(covered.shape)
+    rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
+    if len(rows) == 0:
+        return out
+    box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # every pair with a change lies within
+    d = np.where(covered[box], np.asarray(depth, np.float64)[box], np.nan)
+    slope = out[box]
     with np.errstate(invalid="ignore"):
         for change, first, second in (
             (np.abs(d[:, 1:] - d[:, :-1]), np.s_[:, :-1], np.s_[:, 1:]),
@@ -307,7 +331,8 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
         ):
             np.fmax(slope[first], change, out=slope[first])
             np.fmax(slope[second], change, out=slope[second])
-    return np.minimum(slope, np.finfo(np.float64).max, out=slope)  # an infinite change: the largest float
+    np.minimum(slope, np.finfo(np.float64).max, out=slope)  # an infinite change: the largest float
+    return out
 
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray | None = None) -> np.ndarray:

@@ -38,14 +38,19 @@ Object ids (:func:`silhouette`): at each covered centre, the object of the neare
 orthographic). Where the two nearest objects' depths are within their depth bounds
 (:func:`depth_bound`), the pixel's id is :data:`ID_TIE` (either object is correct).
 
-Work is vectorised over batches of triangles whose bounding boxes (clipped to the image, grown
-by ``tie_px``) round up to the same size (by at most a half per side), so it scales with the
-area the triangles cover (each edge function's two products taken once per box row and per box
-column, only their difference per centre); only the few centres within ``tie_px`` of an open
-edge's line, on the triangles that have one, are measured against the segment. With several
-objects, the same pass keeps every covered centre's depth and object, and one sort finds each
-pixel's nearest two objects
-(``benchmarks/bench_fill_rule.py``: 100,000 triangles at 640x480 in ~0.33-0.37 s at load 3).
+Coverage and ties are taken one box row at a time (boxes clipped to the image, grown by
+``tie_px``): along a row each edge function, evaluated in float64 as the rule writes it, is
+monotone, so a triangle's centres on the row are a span, found from the edge lines' crossings
+and checked with the edge functions themselves at its ends; the work scales with the rows the
+triangles cover, and the centres are the same, bit for bit, as a per-centre pass
+(tests/test_fill_rule.py's naive pass). Only the few centres within ``tie_px`` of an open
+edge's line are measured against the segment. :func:`silhouette` may be given a guess of the
+triangle covering each centre (pyrender's triangle ids): each run of one guess along a row is
+checked by the rule at its two ends, and only the triangles whose box holds a centre not held
+so are taken row by row (the same result, whatever the guess). With several objects, a
+per-centre pass over batches of boxes of like size keeps every covered centre's depth and
+object, and one sort finds each pixel's nearest two objects
+(``benchmarks/bench_fill_rule.py``: 100,000 triangles at 640x480).
 """
 
 from __future__ import annotations
@@ -77,6 +82,9 @@ _DEPTH_SNAP_PX = 1.0 / 256.0
 _DEPTH_EPS32 = 16.0
 _EPS32 = 2.0**-23
 
+#: A hint of triangle ids is checked when the boxes' rows times this exceed the image's pixels (:func:`_rows`).
+_HINT_ROWS_PER_PIXEL = 16
+
 #: Bounding-box samples per batch (~10 float64 temporaries of this length: ~40 MB).
 _CHUNK = 1 << 19
 
@@ -107,11 +115,15 @@ def _edge_keys(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return np.concatenate([lo, hi], axis=1), flip, third
 
 
-def open_edges(tris_px) -> np.ndarray:
+def open_edges(tris_px, corners=None) -> np.ndarray:
     """``(T, 3) bool``: edge ``k`` (``v_k -> v_k+1``) of each triangle is open (module docstring).
 
     Closed: some triangle with the same two end points has its third vertex strictly on one side
-    of the edge's line and some other strictly on the other.
+    of the edge's line and some other strictly on the other. End points are the same when their
+    coordinates are (-0.0 and 0.0 alike; a NaN is the same as nothing): each distinct point gets one
+    number, and an edge's key is its two points' numbers. ``corners`` (``(T, 3)`` int, optional): a
+    number per corner such that corners of one number have the same coordinates (a mesh's vertex
+    indices); then only one corner of each number is compared with the others.
     """
     tris_px = np.asarray(tris_px, dtype=np.float64).reshape(-1, 3, 2)
     if len(tris_px) == 0:
@@ -119,10 +131,21 @@ def open_edges(tris_px) -> np.ndarray:
     key, _flip, third = _edge_keys(tris_px)
     d = key[:, 2:] - key[:, :2]
     side = np.sign(d[:, 0] * (third[:, 1] - key[:, 1]) - d[:, 1] * (third[:, 0] - key[:, 0]))
-    order = np.lexsort((key[:, 3], key[:, 2], key[:, 1], key[:, 0]))
-    ks = key[order]
+    points = np.ascontiguousarray(tris_px + 0.0).reshape(-1, 2).view(np.complex128).ravel()  # (x, y) as one
+    if corners is None:
+        _, point = np.unique(points, return_inverse=True, equal_nan=False)  # by x, then y; NaN each its own
+    else:
+        _, one, number = np.unique(np.asarray(corners).ravel(), return_index=True, return_inverse=True)
+        _, point = np.unique(points[one], return_inverse=True, equal_nan=False)
+        point = point[number]
+    point = point.reshape(-1, 3)
+    a, b = point.ravel(), np.roll(point, -1, axis=1).ravel()  # edge k's two ends, as key's rows
+    n = np.int64(len(points))
+    edge = np.minimum(a, b) * n + np.maximum(a, b)
+    order = np.argsort(edge, kind="stable")
+    ks = edge[order]
     new = np.ones(len(ks), dtype=bool)
-    new[1:] = (ks[1:] != ks[:-1]).any(axis=1)
+    new[1:] = ks[1:] != ks[:-1]
     group = np.cumsum(new) - 1
     pos = np.bincount(group, weights=(side[order] > 0), minlength=group[-1] + 1) > 0
     neg = np.bincount(group, weights=(side[order] < 0), minlength=group[-1] + 1) > 0
@@ -142,7 +165,8 @@ def _orient(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 class _Buffers:
-    """The per-pixel results of one pass, flat over ``H x W``."""
+    """The per-pixel results of one pass, flat over ``H x W`` (``robust`` in full from :func:`_batch`; from
+    :func:`_rows`, on the rows with a ``near_open`` centre only: the ties ask it nothing else)."""
 
     def __init__(self, shape, depth: bool):
         n = shape[0] * shape[1]
@@ -160,10 +184,14 @@ def _raster(
     tri_z: np.ndarray | None = None,
     tri_object: np.ndarray | None = None,
     perspective: bool = True,
+    hint: np.ndarray | None = None,
 ) -> _Buffers:
     """One pass over the triangles: coverage, centres near open edges, centres held robustly.
 
     With ``tri_z`` and ``tri_object``: also each object's nearest depth (and slope) at the centres it covers.
+    Without them, ``hint`` (a function giving ``(first, last, triangles)``: runs of flat centres along a row,
+    and the triangle guessed to cover each run) spares the work of :func:`_rows` where it is right, called
+    where the boxes' rows are many (:data:`_HINT_ROWS_PER_PIXEL`).
     """
     height, width = int(shape[0]), int(shape[1])
     out = _Buffers((height, width), tri_z is not None)
@@ -175,15 +203,30 @@ def _raster(
     is_open = np.where(swapped[:, None], is_open[:, ::-1], is_open)
     if tri_z is not None:
         tri_z = np.where(swapped[:, None], tri_z[:, [0, 2, 1]], tri_z)
-    lo = np.floor(tris.min(axis=1) - tie_px)
-    hi = np.ceil(tris.max(axis=1) + tie_px)
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]  # the corners' least and greatest x and y, one pass each
+    lo = np.floor(np.minimum(np.minimum(a, b), c) - tie_px)
+    hi = np.ceil(np.maximum(np.maximum(a, b), c) + tie_px)
     x0 = np.clip(lo[:, 0], 0, width - 1)
     y0 = np.clip(lo[:, 1], 0, height - 1)
     x1 = np.clip(hi[:, 0], 0, width - 1)
     y1 = np.clip(hi[:, 1], 0, height - 1)
-    finite = np.isfinite(tris).all(axis=(1, 2))
+    finite = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
     seen = finite & (hi[:, 0] >= 0) & (lo[:, 0] <= width - 1) & (hi[:, 1] >= 0) & (lo[:, 1] <= height - 1)
     idx = np.flatnonzero(seen)
+    if tri_z is None:  # coverage alone: each box row's centres decided as spans
+        t = idx
+        guess = None
+        # the hint's checks cost a pass over the image: worth it where the boxes' rows are many (measured: an
+        # icosphere(4)'s 5,120 triangles, ~50,000 rows, 14.0 -> 12.4 ms a frame; the bundled scenes' 12-26
+        # triangles, a few thousand rows, 5.3 -> 6.5 ms with it)
+        if hint is not None and _HINT_ROWS_PER_PIXEL * (y1[t] - y0[t] + 1).sum() > height * width:
+            first, last, guessed = hint()  # the hint's triangles as indices into the seen ones
+            where = np.full(len(tris), -1, dtype=np.int64)
+            where[t] = np.arange(len(t))
+            guessed = where[guessed]
+            guess = first[guessed >= 0], last[guessed >= 0], guessed[guessed >= 0]
+        _rows(out, tris[t], area2[t], is_open[t], x0[t], y0[t], x1[t], y1[t], (height, width), tie_px, guess)
+        return out
     bw = (x1[idx] - x0[idx] + 1).astype(np.int64)
     bh = (y1[idx] - y0[idx] + 1).astype(np.int64)
     # buckets: boxes rounded up to a multiple of half their power of two (<= 2.25x the samples, but fewer
@@ -214,6 +257,178 @@ def _raster(
                 perspective,
             )
     return out
+
+
+def _rows(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, shape, tie_px, guess=None) -> None:
+    """:func:`_batch`'s coverage and near-open centres (no depths), one box row at a time as spans; the robust
+    centres only where there is a near-open one (all that :func:`coverage`'s ties ask of them).
+
+    On a box row (``py`` fixed) an edge function ``E(px) = dx (py - Py) - dy (px - Px)`` evaluated in
+    float64 is monotone in ``px`` (each rounding is monotone: non-increasing for ``dy > 0``, non-decreasing
+    for ``dy < 0``, constant for ``dy == 0``), so the centres where ``E > t`` (or ``E >= t``) are a
+    half-line, found from the line's crossing and checked with ``E`` itself, computed as :func:`_batch`
+    computes it (:func:`_half_line`). The coverage (every edge ``E > 0``, ``E >= 0`` on a top or left
+    edge), each open edge's band (``|E| <= tie_px |PQ|``, then the distance to the segment at each centre)
+    and the robust centres (every ``E > tie_px |PQ|``) are then intersections of spans: the same centres as
+    :func:`_batch`, bit for bit (tests/test_fill_rule.py's naive pass), with work per box row instead of
+    per centre.
+
+    ``guess`` (``(first, last, triangles)``: runs of flat centres along a row, an index into ``tris`` each):
+    each run is checked by the rule against its triangle alone (:func:`_covers`); a centre held so is
+    covered whatever the other triangles do, so the spans are taken only for the triangles whose box holds
+    a centre not held so.
+    """
+    height, width = shape
+    edges = []  # per edge k: (P, dx, dy, reach, top_left), per triangle
+    for k in range(3):
+        p, q = tris[:, k], tris[:, (k + 1) % 3]
+        dx, dy = q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]
+        edges.append((p, dx, dy, tie_px * np.sqrt(dx * dx + dy * dy), (dy < 0) | ((dy == 0) & (dx > 0))))
+    boxes = (x0, y0, x1, y1)
+    every = np.arange(len(tris))
+    todo = every
+    if guess is not None:
+        held = _covers(guess, tris, area2, boxes, edges, height * width, width)
+        out.inside |= held
+        todo = every[_boxes_meet(~held.reshape(shape), boxes)]
+    tri, py = _box_rows(todo, y0, y1)
+    in_lo, in_hi = x0[tri], np.where(area2[tri] > 0, x1[tri], x0[tri] - 1.0)  # zero-area triangles cover nothing
+    for p, dx, dy, _reach, top_left in edges:
+        lo, hi = _half_line(dx[tri] * (py - p[tri, 1]), dy[tri], p[tri, 0], 0.0, ~top_left[tri], x0[tri], x1[tri])
+        np.maximum(in_lo, lo, out=in_lo)
+        np.minimum(in_hi, hi, out=in_hi)
+    _paint(out.inside, py * width, in_lo, in_hi)
+    for k, (p, dx, dy, reach, _top_left) in enumerate(edges):
+        # near an open edge: within tie_px of its line (E >= -reach and not E > reach), then of the segment
+        tri, py = _box_rows(np.flatnonzero(is_open[:, k]), y0, y1)
+        if len(tri) == 0:
+            continue
+        args = (dx[tri] * (py - p[tri, 1]), dy[tri], p[tri, 0])
+        n_lo, n_hi = _half_line(*args, -reach[tri], False, x0[tri], x1[tri])
+        f_lo, f_hi = _half_line(*args, reach[tri], True, x0[tri], x1[tri])
+        dec, inc = args[1] > 0, args[1] < 0
+        n_lo = np.where(dec, np.maximum(n_lo, f_hi + 1.0), n_lo)
+        n_hi = np.where(inc, np.minimum(n_hi, f_lo - 1.0), n_hi)
+        n_hi = np.where(~(dec | inc) & (f_lo <= f_hi), n_lo - 1.0, n_hi)  # flat: the whole row is far, or none
+        ii, px = _span_cells(np.arange(len(tri)), n_lo, n_hi)
+        if len(ii):
+            t, y = tri[ii], py[ii]
+            rx, ry = px - p[t, 0], y - p[t, 1]
+            sx, sy = dx[t], dy[t]
+            length2 = sx * sx + sy * sy
+            with np.errstate(invalid="ignore", divide="ignore"):
+                u = np.where(length2 > 0, np.clip((rx * sx + ry * sy) / length2, 0.0, 1.0), 0.0)
+            near = np.hypot(rx - u * sx, ry - u * sy) <= tie_px
+            out.near_open[(y[near] * width + px[near]).astype(np.int64)] = True
+    band = out.near_open.reshape(shape)
+    if not band.any():
+        return
+    # robust (inside, and every E > reach) on the band's rows, for the triangles whose box meets the band
+    tri, py = _box_rows(every[_boxes_meet(band, boxes)], y0, y1)
+    keep = band.any(axis=1)[py.astype(np.int64)]
+    tri, py = tri[keep], py[keep]
+    far_lo, far_hi = x0[tri], np.where(area2[tri] > 0, x1[tri], x0[tri] - 1.0)
+    for p, dx, dy, reach, top_left in edges:
+        args = (dx[tri] * (py - p[tri, 1]), dy[tri], p[tri, 0])
+        for thr, strict in ((0.0, ~top_left[tri]), (reach[tri], True)):
+            lo, hi = _half_line(*args, thr, strict, x0[tri], x1[tri])
+            far_lo, far_hi = np.maximum(far_lo, lo), np.minimum(far_hi, hi)
+    _paint(out.robust, py * width, far_lo, far_hi)
+
+
+def _box_rows(which, y0, y1):
+    """``(triangle, py)``: one entry per row of each box of the triangles ``which``."""
+    count = (y1[which] - y0[which] + 1).astype(np.int64)
+    tri = np.repeat(which, count)
+    return tri, y0[tri] + (np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count))
+
+
+def _boxes_meet(mask: np.ndarray, boxes) -> np.ndarray:
+    """``(T,) bool``: the boxes ``(x0, y0, x1, y1)`` (inclusive, on the image) holding a True centre of ``mask``
+    (its summed-area table, cv2.integral)."""
+    import cv2  # lazily, as every OpenCV use of the oracles
+
+    table = cv2.integral(mask.view(np.uint8), sdepth=cv2.CV_32S)
+    x0, y0, x1, y1 = (b.astype(np.int64) for b in boxes)
+    return table[y1 + 1, x1 + 1] - table[y0, x1 + 1] - table[y1 + 1, x0] + table[y0, x0] > 0
+
+
+def _covers(guess, tris, area2, boxes, edges, n: int, width: int) -> np.ndarray:
+    """Flat bool (``n`` centres): the runs ``guess`` (``(first, last, triangle)``, along one row each) whose two
+    ends are inside their guessed triangle by the rule (in its box, every edge ``E > 0``, or ``E == 0`` on a
+    top or left edge; each ``E`` computed as :func:`_batch` computes it). On a row a triangle's centres are a
+    span (:func:`_rows`), so a run whose two ends are in it is in it whole."""
+    first, last, t = guess
+    py = (first // width).astype(np.float64)
+    ok = area2[t] > 0
+    x0, y0, x1, y1 = boxes
+    ok &= (py >= y0[t]) & (py <= y1[t])
+    for end in (first, last):
+        px = (end % width).astype(np.float64)
+        ok &= (px >= x0[t]) & (px <= x1[t])
+        for p, dx, dy, _reach, top_left in edges:
+            e = dx[t] * (py - p[t, 1]) - dy[t] * (px - p[t, 0])
+            ok &= (e > 0) | ((e == 0) & top_left[t])
+    held = np.zeros(n, dtype=bool)
+    _paint(
+        held,
+        first[ok] - first[ok] % width,
+        (first[ok] % width).astype(np.float64),
+        (last[ok] % width).astype(np.float64),
+    )
+    return held
+
+
+def _half_line(e_row, dy, px0, thr, strict, bx0, bx1):
+    """``(lo, hi)``: the centres ``px`` in ``[bx0, bx1]`` where ``E = e_row - dy (px - px0)`` is ``> thr``
+    (``strict``) or ``>= thr``, as a span (empty: ``lo > hi``); every argument per entry (or a scalar).
+
+    ``E`` is monotone in ``px`` (:func:`_rows`): the span is the box's centres on one side of the line's
+    crossing ``px0 + (e_row - thr) / dy``. Its last centre inside (``dy > 0``: the span ends there) or its
+    last centre outside (``dy < 0``: the span begins after it) is the crossing rounded down, held to the box,
+    and checked with ``E`` at it and at the next centre (computed exactly as the batched pass computes it);
+    the few entries the check refuses (a crossing within rounding of a centre) are moved a centre at a time.
+    """
+    n = len(e_row)
+    thr, strict = np.broadcast_to(thr, (n,)), np.broadcast_to(strict, (n,))
+
+    def holds(px, i=slice(None)):
+        e = e_row[i] - dy[i] * (px - px0[i])
+        return np.where(strict[i], e > thr[i], e >= thr[i])
+
+    dec = dy > 0  # in: px <= last; dy < 0: in from first = last + 1 on; dy == 0: E is e_row on the whole row
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        cross = px0 + (e_row - thr) / dy
+    flat = ~(dec | (dy < 0))
+    last = np.clip(np.floor(np.where(flat, bx1, cross)), bx0 - 1.0, bx1)  # last centre with dec's E in
+    in_at = holds(last)  # E at ``last`` and at ``last + 1``, by each entry's direction
+    in_next = holds(last + 1.0)
+    below, above = last < bx0, last >= bx1  # past the box: that side's centre is not asked about
+    ok = np.where(dec, (below | in_at) & (above | ~in_next), (below | ~in_at) & (above | in_next))
+    for i in np.flatnonzero(~ok & ~flat):  # a crossing within rounding of a centre: move a centre at a time
+        sign = 1.0 if dec[i] else -1.0  # +: E falls with px
+        while last[i] < bx1[i] and (holds(last[i] + 1.0, i) if sign > 0 else not holds(last[i] + 1.0, i)):
+            last[i] += 1.0
+        while last[i] >= bx0[i] and (not holds(last[i], i) if sign > 0 else holds(last[i], i)):
+            last[i] -= 1.0
+    lo = np.where(dec | flat, bx0, last + 1.0)
+    hi = np.where(dec, last, bx1)
+    hi = np.where(flat & ~holds(px0), lo - 1.0, hi)  # a flat edge: the whole row or none of it
+    return lo, hi
+
+
+def _span_cells(entries, lo, hi):
+    """``(entry, px)`` of every centre of the spans ``[lo, hi]`` (one per entry of ``entries``)."""
+    n = np.maximum(hi - lo + 1.0, 0.0).astype(np.int64)
+    which = np.repeat(np.arange(len(entries)), n)
+    step = np.arange(len(which)) - np.repeat(np.cumsum(n) - n, n)
+    return entries[which], lo[which] + step
+
+
+def _paint(flat: np.ndarray, row_start, lo, hi) -> None:
+    """Set ``flat[row_start + lo : row_start + hi + 1]`` for every non-empty span."""
+    entries, px = _span_cells(np.arange(len(lo)), lo, hi)
+    flat[(row_start[entries] + px).astype(np.int64)] = True
 
 
 def _round_up(n: np.ndarray) -> np.ndarray:
@@ -371,13 +586,20 @@ def project_clipped(p_world, faces, camera) -> tuple[np.ndarray, np.ndarray, np.
     conventions (perspective ``x = cx + fx x/z, y = cy - fy y/z``; orthographic with
     ``s = H / ortho_height`` and the centred principal point). ``owner`` is the face of each.
     """
+    return _project(p_world, fan(faces), camera)[:3]
+
+
+def _project(p_world, fanned, camera):
+    """:func:`project_clipped` of the fan ``fanned`` (``(triangles, owner)``), the fan triangles kept whole
+    (``(T_fan,) bool``: they are the first image triangles, in the fan's order) and the image triangles'
+    corners numbered for :func:`open_edges` (``(T, 3)``: a whole triangle's vertex indices)."""
     if getattr(camera, "distortion", None) is not None:
         raise ValueError("a distorted camera's silhouette is curved: no fill-rule reference for it")
     p_world = np.asarray(p_world, dtype=np.float64).reshape(-1, 3)
     right, up, forward = camera_basis(camera)
     world_to_cam = np.stack([right, up, forward])
     p_cam = (p_world - np.asarray(camera.position, dtype=np.float64)) @ world_to_cam.T
-    tris, owner = fan(faces)
+    tris, owner = fanned
     tri_cam = p_cam[tris]  # (T, 3, 3)
     z = tri_cam[:, :, 2]
     near, far = float(camera.near), float(camera.far)
@@ -391,6 +613,9 @@ def project_clipped(p_world, faces, camera) -> tuple[np.ndarray, np.ndarray, np.
             part_owner.append(np.full(len(poly) - 2, owner[i]))
     tri_cam = np.concatenate(parts).reshape(-1, 3, 3)
     owner = np.concatenate(part_owner).astype(np.int64)
+    # the corners' numbers: a whole triangle's are its vertex indices, each cut corner one of its own
+    cut = 3 * (len(tri_cam) - int(whole.sum()))
+    corners = np.concatenate([tris[whole].ravel(), len(p_cam) + np.arange(cut)]).reshape(-1, 3)
     x, y, zc = tri_cam[..., 0], tri_cam[..., 1], tri_cam[..., 2]
     if camera.projection == "perspective":
         fx, fy, cx, cy = intrinsics(camera)
@@ -399,11 +624,29 @@ def project_clipped(p_world, faces, camera) -> tuple[np.ndarray, np.ndarray, np.
         s = camera.height / camera.ortho_height
         cx, cy = (camera.width - 1) / 2.0, (camera.height - 1) / 2.0
         tris_px = np.stack([cx + s * x, cy - s * y], axis=-1)
-    return tris_px, zc, owner
+    return tris_px, zc, owner, whole, corners
+
+
+def _image_triangles(hint, whole, shape) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``hint``'s runs along each row of one fan triangle kept whole by the clip planes: ``(first, last, triangle)``,
+    flat centres and that triangle's index among the image triangles (the whole ones come first, in the fan's
+    order)."""
+    flat = np.asarray(hint).reshape(shape[0] * shape[1])
+    begins = np.ones(len(flat), dtype=bool)
+    np.not_equal(flat[1:], flat[:-1], out=begins[1:])
+    begins[:: shape[1]] = True  # a run ends with its row
+    first = np.flatnonzero(begins)
+    last = np.append(first[1:], len(flat)) - 1
+    fan_tri = flat[first]
+    index = np.full(len(whole) + 1, -1, dtype=np.int64)
+    index[np.flatnonzero(whole)] = np.arange(int(whole.sum()))
+    tri = index[np.where((fan_tri >= 0) & (fan_tri < len(whole)), fan_tri, len(whole))]
+    keep = tri >= 0
+    return first[keep], last[keep], tri[keep]
 
 
 def silhouette(
-    p_world, faces, camera, shape, face_objects=None, tie_px: float = GL_TIE_PX
+    p_world, faces, camera, shape, face_objects=None, tie_px: float = GL_TIE_PX, hint=None, fanned=None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A frame's reference silhouette: ``(inside, ties, object_ids)``, each ``(H, W)``.
 
@@ -420,6 +663,13 @@ def silhouette(
         The object of each face (0, 1, ...); all faces one object (id 0) if None.
     tie_px : float
         As in :func:`coverage`.
+    hint : (H, W) int, optional
+        A guess of the fan triangle covering each centre, -1 none (pyrender's triangle ids of
+        ``fan(faces)``). Each guess is checked by the rule against its triangle alone, and the
+        triangles are rasterized only where a box holds a centre not held so: the same result
+        as without it, right or wrong, with less work where it is right. Not used with several objects.
+    fanned : ((T, 3), (T,)) int, optional
+        ``oracles.references.faces.fan(faces)``, when the caller has it already.
 
     Returns
     -------
@@ -430,9 +680,11 @@ def silhouette(
     """
     if face_objects is not None and len(face_objects) != len(faces):
         raise ValueError(f"face_objects has {len(face_objects)} entries for {len(faces)} faces: expected one per face")
-    tris_px, tri_z, owner = project_clipped(p_world, faces, camera)
+    tris_px, tri_z, owner, whole, corners = _project(p_world, fan(faces) if fanned is None else fanned, camera)
     shape = (int(shape[0]), int(shape[1]))
-    is_open = open_edges(tris_px)
+    if hint is not None and np.shape(hint) != shape:
+        raise ValueError(f"a hint of shape {np.shape(hint)} for an image of {shape}")
+    is_open = open_edges(tris_px, corners)
     objects = np.zeros(0, dtype=np.int64)
     if face_objects is not None and len(owner):
         tri_object = np.asarray(face_objects, dtype=np.int64).reshape(-1)[owner]
@@ -446,6 +698,7 @@ def silhouette(
         tri_z if several else None,
         tri_object if several else None,
         camera.projection == "perspective",
+        None if hint is None or several else (lambda: _image_triangles(hint, whole, shape)),
     )
     inside = buf.inside.reshape(shape)
     ties = (buf.near_open & ~buf.robust).reshape(shape)
