@@ -70,7 +70,10 @@ class DepthMap:
 
     def encoding_bound(self) -> np.ndarray:
         """``(H, W)`` float64: how far the encoding alone may move a depth, ``step + rel_step |d|`` (0 where none)."""
-        return self.step + self.rel_step * np.where(np.isnan(self.depth), 0.0, np.abs(self.depth))
+        out = np.fmax(np.abs(self.depth), 0.0)  # |d|, 0 where NaN (fmax takes the number)
+        out *= self.rel_step
+        out += self.step
+        return out
 
 
 def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCALE) -> DepthMap:

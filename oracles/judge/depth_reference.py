@@ -103,7 +103,7 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
     """The :class:`ReferenceDepth` of pyrender's drawing of a frame's faces (``render_faces(..., with_ids=True)``
     of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels."""
     slope = depth_slope(depth, covered)
-    bound = depth_bound(depth, covered, camera, slope)
+    bound = _covered_bound(depth, covered, camera, slope)
     undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope)) & covered
     return ReferenceDepth(
         depth=np.where(covered, depth, np.nan),
@@ -112,6 +112,19 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
         bound=bound,
         faces=np.where(covered, ids, -1),
     )
+
+
+def _covered_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:
+    """:func:`oracles.judge.metrics.depth_bound` taken over the covered pixels' bounding box; outside it, where
+    pyrender's depth is 0 (``render_faces``: nothing drawn) and ``slope`` 0, the bound of depth 0 (0 under
+    perspective, four 24-bit steps under orthographic). Only covered pixels' bounds are ever read."""
+    zero = np.zeros((1, 1))
+    bound = np.full(covered.shape, depth_bound(zero, zero.astype(bool), camera, zero)[0, 0])
+    rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
+    if len(rows):
+        box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]
+        bound[box] = depth_bound(depth[box], covered[box], camera, slope[box])
+    return bound
 
 
 def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:

@@ -100,7 +100,7 @@ class FilledFrames:
             "longest_run_px": s.longest_run_px,
             "run_at": list(s.run_at) if s.run_at else None,
             "vacuous": s.vacuous,
-            "reference_decided_px": int((inside & ~ties).sum()),
+            "reference_decided_px": int(np.count_nonzero(inside & ~ties)),
             "object_id_px": object_id_misses(grey, shown & ~ties, ids) if several else None,
         }
         self.frames.append(rec)
