@@ -201,7 +201,8 @@ def _npy_map(data: bytes, path: Path, width: int, height: int) -> DepthMap:
     values = values.reshape((height, width), order="F" if fortran else "C")
     native = np.float32 if dtype.itemsize == 4 else np.float64
     encoding, rel = f"npy {np.dtype(native)}", (_EPS32 if dtype.itemsize == 4 else _EPS64)
-    return depth_from_array(values.astype(native), width, height, str(path), encoding, 0.0, rel)
+    # (a native-order array as it is: depth_from_array copies it to float64)
+    return depth_from_array(values.astype(native, copy=False), width, height, str(path), encoding, 0.0, rel)
 
 
 def _check_size(width, height) -> None:
