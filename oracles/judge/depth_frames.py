@@ -62,15 +62,10 @@ class DepthFrames:
         self.encoding = dm.encoding
         shown = np.isfinite(dm.depth)
         holes, extra = surface_mismatch(shown, ref.covered)
-        failing = len(self.diagnoses)
-        diag = name_depth_faults(
-            dm.depth,
-            ref.compared_depth(),
-            ref.bound,
-            camera,
-            dm.encoding_bound(),
-            faces=ref.compared_faces() if failing < DIAGNOSED_FRAMES else None,
-        )
+        args = (dm.depth, ref.compared_depth(), ref.bound, camera, dm.encoding_bound())
+        diag = name_depth_faults(*args)  # the faces are read only to name a failing map: taken then
+        if diag.verdict == "fail" and len(self.diagnoses) < DIAGNOSED_FRAMES:
+            diag = name_depth_faults(*args, faces=ref.compared_faces())
         m = diag.measured
         rec = {
             "frame": k,
