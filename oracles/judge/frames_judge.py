@@ -214,7 +214,7 @@ def judge_case(
                     (job_dir, job),
                     objects[1],
                     hint=ids,
-                    reference=None if depth else lambda: frame.reference()[1],
+                    reference=None if depth else (lambda made=frame.reference: made()[1]),
                 )
                 acc.drawn_px += rec_k["union_px"]
         del frame

@@ -391,11 +391,11 @@ def _covers(guess, tris, area2, boxes, edges, n: int, width: int) -> np.ndarray:
     x0, y0, x1, y1 = boxes
     ok &= (py >= y0[t]) & (py <= y1[t])
     x0, x1 = x0[t], x1[t]
-    per_edge = [(p[t, 0], dx[t], dy[t], dx[t] * (py - p[t, 1]), top_left[t]) for p, dx, dy, _reach, top_left in edges]
+    per_edge = [(p[t, 0], dy[t], dx[t] * (py - p[t, 1]), top_left[t]) for p, dx, dy, _reach, top_left in edges]
     for end in (first, last):
         px = (end % width).astype(np.float64)
         ok &= (px >= x0) & (px <= x1)
-        for p_x, dx, dy, e_row, top_left in per_edge:  # each taken once for both ends
+        for p_x, dy, e_row, top_left in per_edge:  # each taken once for both ends
             e = e_row - dy * (px - p_x)
             ok &= (e > 0) | ((e == 0) & top_left)
     held = np.zeros(n, dtype=bool)
