@@ -2,6 +2,7 @@
 
     .venv/bin/python benchmarks/bench_depth_frames.py                          # the cube, 12 frames, depth
     .venv/bin/python benchmarks/bench_depth_frames.py --scene ICOSPHERE.obj --outputs filled,depth --frames 24
+    .venv/bin/python benchmarks/bench_depth_frames.py --scene cube --outputs filled,depth --repeat 3   # best of three
 
 (``--scene`` takes a built-in name or a mesh file: README's icosphere(4) is
 ``trimesh.creation.icosphere(subdivisions=4).export('ICOSPHERE.obj')``.)
@@ -19,7 +20,9 @@ pyrender's context made before any clock starts, and in this order on the same f
   (oracles.judge.depth_frames.DepthFrames.add with the reference made from it), per frame.
 
 Printed: the three times per frame, judge / pyrender (the issue's target: within 2x), and the load
-average before and after (the machine is shared: state it with the numbers).
+average before and after (the machine is shared: state it with the numbers). ``--repeat N``: the judge
+and pyrender's drawing each timed N times in turn, the best of each printed (a shared machine's
+noise is all slower).
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ def main(argv=None) -> int:
     p.add_argument("--scene", default="cube")
     p.add_argument("--frames", type=int, default=12)
     p.add_argument("--outputs", default="depth")
+    p.add_argument("--repeat", type=int, default=1, help="time the judge and pyrender N times each: the best")
     args = p.parse_args(argv)
 
     from clients.core_depth_job import render_job
@@ -82,19 +86,21 @@ def main(argv=None) -> int:
         inputs = [frame_inputs(job_dir, job, c["scene"], c["case"], k) for k in job["frame_numbers"]]
         tris = [fan(frame_faces(job_dir, job, c["scene"], k))[0] for k in job["frame_numbers"]]
         run_frames(job_dir)  # warm: pyrender's context, its programs, imports
-        t0 = time.perf_counter()
-        report, _ = run_frames(job_dir)
-        judge = (time.perf_counter() - t0) / n
-        assert report["verdict"] == "pass", report["cases"][0]["reasons"]
         oracles = OracleCache()
         cam = inputs[0][2]
         oracle = oracles.get(cam.width, cam.height)
         oracle.render_faces(inputs[0][0], tris[0], cam, model_matrix=inputs[0][3], with_ids=True)  # warm
-        drawn = []
-        t0 = time.perf_counter()
-        for (p_model, _e, camera, m), t in zip(inputs, tris):
-            drawn.append(oracle.render_faces(p_model, t, camera, model_matrix=m, with_ids=True))
-        pyrender = (time.perf_counter() - t0) / n
+        judge = pyrender = float("inf")
+        for _ in range(max(1, args.repeat)):  # in turn: the judge, then pyrender alone
+            t0 = time.perf_counter()
+            report, _ = run_frames(job_dir)
+            judge = min(judge, (time.perf_counter() - t0) / n)
+            assert report["verdict"] == "pass", report["cases"][0]["reasons"]
+            drawn = []
+            t0 = time.perf_counter()
+            for (p_model, _e, camera, m), t in zip(inputs, tris):
+                drawn.append(oracle.render_faces(p_model, t, camera, model_matrix=m, with_ids=True))
+            pyrender = min(pyrender, (time.perf_counter() - t0) / n)
         oracles.close()
         own = None
         if "depth" in args.outputs:
@@ -108,8 +114,9 @@ def main(argv=None) -> int:
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print(f"{args.scene}, oblique_roll, {n} frames of {cam.width}x{cam.height}, outputs {args.outputs}")
-    print(f"  judge (run_frames, whole)      {judge * 1e3:8.1f} ms a frame")
-    print(f"  pyrender render_faces alone    {pyrender * 1e3:8.1f} ms a frame")
+    best = f" (best of {args.repeat})" if args.repeat > 1 else ""
+    print(f"  judge (run_frames, whole)      {judge * 1e3:8.1f} ms a frame{best}")
+    print(f"  pyrender render_faces alone    {pyrender * 1e3:8.1f} ms a frame{best}")
     if own is not None:
         print(f"  depth own work (read + judge)  {own * 1e3:8.1f} ms a frame")
     print(f"  judge / pyrender: {judge / pyrender:.2f} (target <= 2)")

@@ -19,7 +19,15 @@ from wirecheck.oracles import tolerances
 from wirecheck.oracles.cases import case_motion, cases_for
 from wirecheck.oracles.references import faces as oface
 from wirecheck.oracles.references import fill_rule
-from wirecheck.oracles.references.fill_rule import GL_TIE_PX, ID_TIE, NO_OBJECT, coverage, open_edges, silhouette
+from wirecheck.oracles.references.fill_rule import (
+    GL_TIE_PX,
+    ID_TIE,
+    NO_OBJECT,
+    corner_edges,
+    coverage,
+    open_edges,
+    silhouette,
+)
 
 # ---- a naive reference: one ray per pixel centre, Moller-Trumbore, in camera space -------------
 
@@ -173,6 +181,21 @@ def test_open_edges_closed_only_between_triangles_on_both_sides():
     assert open_edges(fold)[:, 0].all()
 
 
+def test_open_edges_grouped_by_corner_numbers_once_and_by_points_where_two_numbers_meet():
+    # the square (0,0) (4,0) (4,4) (0,4) as two triangles on either side of the diagonal (0,0)-(4,4);
+    # numbered as a mesh (the diagonal's ends shared: 0 and 2) the diagonal is closed, the rim open
+    tris = np.array([[[0, 0], [4, 0], [4, 4]], [[0, 0], [4, 4], [0, 4]]], dtype=np.float64)
+    shared = np.array([[0, 1, 2], [0, 2, 3]])
+    expected = np.array([[True, True, False], [False, True, True]])  # edges v0v1, v1v2, v2v0
+    grouped = corner_edges(shared)
+    np.testing.assert_array_equal(open_edges(tris, shared, grouped), expected)
+    np.testing.assert_array_equal(open_edges(tris, shared), expected)
+    # the same points numbered apart (an OBJ with split vertices: 0 and 4, 2 and 5 are one point each): the
+    # edges are grouped by points again, and the diagonal is still closed, given the split numbers' groups
+    split = np.array([[0, 1, 2], [4, 5, 3]])
+    np.testing.assert_array_equal(open_edges(tris, split, corner_edges(split)), expected)
+
+
 def test_a_shared_edge_through_centres_leaves_no_crack_and_no_tie():
     # a fan of 8 triangles about (10, 10), spokes through centres, rim at (4, 10), (6, 6), (10, 4),
     # ...: the spokes' centres short of the rim are neither holes nor ties
@@ -197,12 +220,18 @@ def test_triangles_crossing_the_near_plane_match_a_ray_caster(projection):
     tri_cam = rng.uniform([-3, -2.5, -1.0], [3, 2.5, 10.0], size=(12, 3, 3))  # many cross near or far
     tri_cam[0] = [[-1.5, -1.0, -2.0], [2.0, -1.2, 3.0], [0.0, 1.5, 3.0]]  # one vertex behind the eye
     faces = [tuple(range(3 * i, 3 * i + 3)) for i in range(len(tri_cam))]
-    inside, ties, _ = silhouette(_cam_to_world(tri_cam.reshape(-1, 3)), faces, cam, (cam.height, cam.width))
+    world = _cam_to_world(tri_cam.reshape(-1, 3))
+    inside, ties, _ = silhouette(world, faces, cam, (cam.height, cam.width))
     expected = _ray_cast(tri_cam, cam)
     decided = ~ties
     assert decided.sum() > 0.95 * decided.size
     np.testing.assert_array_equal(inside[decided], expected[decided])
     assert 0.1 * inside.size < inside.sum() < 0.95 * inside.size  # the frame says something
+    # a case's edges grouped once (corner_edges of the fan) are not used on a frame with cut triangles (their
+    # corners are numbered otherwise): the same silhouette as the one held to the ray caster above
+    again = silhouette(world, faces, cam, (cam.height, cam.width), edges=corner_edges(np.array(faces)))
+    np.testing.assert_array_equal(again[0], inside)
+    np.testing.assert_array_equal(again[1], ties)
 
 
 def test_a_triangle_wholly_behind_or_beyond_is_not_drawn():

@@ -70,7 +70,10 @@ class DepthMap:
 
     def encoding_bound(self) -> np.ndarray:
         """``(H, W)`` float64: how far the encoding alone may move a depth, ``step + rel_step |d|`` (0 where none)."""
-        return self.step + self.rel_step * np.where(np.isnan(self.depth), 0.0, np.abs(self.depth))
+        out = np.fmax(np.abs(self.depth), 0.0)  # |d|, 0 where NaN (fmax takes the number)
+        out *= self.rel_step
+        out += self.step
+        return out
 
 
 def read_depth_map(path, width: int, height: int, scale: float = DEFAULT_PNG_SCALE) -> DepthMap:
@@ -198,7 +201,8 @@ def _npy_map(data: bytes, path: Path, width: int, height: int) -> DepthMap:
     values = values.reshape((height, width), order="F" if fortran else "C")
     native = np.float32 if dtype.itemsize == 4 else np.float64
     encoding, rel = f"npy {np.dtype(native)}", (_EPS32 if dtype.itemsize == 4 else _EPS64)
-    return depth_from_array(values.astype(native), width, height, str(path), encoding, 0.0, rel)
+    # (a native-order array as it is: depth_from_array copies it to float64)
+    return depth_from_array(values.astype(native, copy=False), width, height, str(path), encoding, 0.0, rel)
 
 
 def _check_size(width, height) -> None:

@@ -140,19 +140,24 @@ def name_depth_faults(
         cand_on = np.isfinite(cand) & (cand != 0)
         ref_on = np.isfinite(ref) & (ref > 0)
     both = cand_on & ref_on
-    measured = {"compared_px": int(both.sum()), "candidate_px": int(cand_on.sum()), "reference_px": int(ref_on.sum())}
-    if not both.any():
+    at = np.flatnonzero(both)  # the compared pixels, flat, in row order (as both's mask picks them)
+    measured = {
+        "compared_px": len(at),
+        "candidate_px": int(np.count_nonzero(cand_on)),
+        "reference_px": int(np.count_nonzero(ref_on)),
+    }
+    if not len(at):
         return DepthDiagnosis("vacuous", (), measured)
     full_b = np.broadcast_to(np.asarray(bound, dtype=np.float64), cand.shape)
     full_enc = np.broadcast_to(np.asarray(encoding, dtype=np.float64), cand.shape)
-    c, r = cand[both], ref[both]
-    b = full_b[both]
-    enc = full_enc[both]
+    c, r = _at(cand, at), _at(ref, at)
+    b = _at(full_b, at)
+    enc = _at(full_enc, at)
     err = np.abs(c - r)
     allow = b + enc
     ratio = _ratio(err, allow)
     worst = int(np.argmax(ratio))
-    row, col = divmod(int(np.flatnonzero(both)[worst]), cand.shape[1])
+    row, col = divmod(int(at[worst]), cand.shape[1])
     measured.update(max_error=float(err.max()), max_error_ratio=float(ratio[worst]), worst_pixel=[row, col])
     if ratio[worst] <= 1.0:
         return DepthDiagnosis("pass", (), measured)
@@ -204,6 +209,13 @@ def _pixel_fits(cand, ref, faces, bound, enc, camera) -> list:
         if np.isfinite(fit):
             out.append((n_params, fit, name, params))
     return out
+
+
+def _at(image: np.ndarray, flat: np.ndarray) -> np.ndarray:
+    """``image`` (H, W) at the flat positions ``flat``: ``image.ravel()[flat]`` without copying a broadcast one."""
+    if image.strides == (0, 0):  # one value broadcast (a scalar bound or encoding step)
+        return np.full(len(flat), image[0, 0]) if image.size else np.zeros(0)
+    return image.reshape(-1)[flat]
 
 
 def _ratio(err: np.ndarray, allow: np.ndarray) -> np.ndarray:

@@ -62,25 +62,20 @@ class DepthFrames:
         self.encoding = dm.encoding
         shown = np.isfinite(dm.depth)
         holes, extra = surface_mismatch(shown, ref.covered)
-        failing = len(self.diagnoses)
-        diag = name_depth_faults(
-            dm.depth,
-            ref.compared_depth(),
-            ref.bound,
-            camera,
-            dm.encoding_bound(),
-            faces=ref.compared_faces() if failing < DIAGNOSED_FRAMES else None,
-        )
+        args = (dm.depth, ref.compared_depth(), ref.bound, camera, dm.encoding_bound())
+        diag = name_depth_faults(*args)  # the faces are read only to name a failing map: taken then
+        if diag.verdict == "fail" and len(self.diagnoses) < DIAGNOSED_FRAMES:
+            diag = name_depth_faults(*args, faces=ref.compared_faces())
         m = diag.measured
         rec = {
             "frame": k,
             "verdict": diag.verdict,
             "compared_px": m["compared_px"],
-            "union_px": int((shown | ref.covered).sum()),
+            "union_px": int(np.count_nonzero(shown | ref.covered)),
             "candidate_px": m["candidate_px"],
-            "reference_px": int(ref.covered.sum()),
-            "holes_px": int(holes.sum()),
-            "extra_px": int(extra.sum()),
+            "reference_px": int(np.count_nonzero(ref.covered)),
+            "holes_px": int(np.count_nonzero(holes)),
+            "extra_px": int(np.count_nonzero(extra)),
             "max_error": m.get("max_error"),
             "max_error_ratio": _finite(m.get("max_error_ratio")),
             "worst_pixel": m.get("worst_pixel"),

@@ -103,8 +103,9 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
     """The :class:`ReferenceDepth` of pyrender's drawing of a frame's faces (``render_faces(..., with_ids=True)``
     of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels."""
     slope = depth_slope(depth, covered)
-    bound = depth_bound(depth, covered, camera, slope)
-    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope)) & covered
+    box = _box(covered)
+    bound = _covered_bound(depth, covered, camera, slope, box)
+    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope, box)) & covered
     return ReferenceDepth(
         depth=np.where(covered, depth, np.nan),
         covered=covered,
@@ -114,14 +115,29 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
     )
 
 
-def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray) -> np.ndarray:
-    """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope (``slope``,
-    oracles.judge.metrics.depth_slope) of near or far."""
-    at_plane = np.zeros(covered.shape, bool)
+def _box(covered: np.ndarray):
+    """The covered pixels' bounding box (two slices), None when none is covered."""
     rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
-    if len(rows) == 0:
+    return np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1] if len(rows) else None
+
+
+def _covered_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray, box) -> np.ndarray:
+    """:func:`oracles.judge.metrics.depth_bound` taken over the covered pixels' bounding box ``box``; outside
+    it, where pyrender's depth is 0 (``render_faces``: nothing drawn) and ``slope`` 0, the bound of depth 0
+    (0 under perspective, four 24-bit steps under orthographic). Only covered pixels' bounds are ever read."""
+    zero = np.zeros((1, 1))
+    bound = np.full(covered.shape, depth_bound(zero, zero.astype(bool), camera, zero)[0, 0])
+    if box is not None:
+        bound[box] = depth_bound(depth[box], covered[box], camera, slope[box])
+    return bound
+
+
+def _beside_clip_planes(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray, box) -> np.ndarray:
+    """Pixels within one pixel (8 neighbours) of one whose depth is within its depth slope (``slope``,
+    oracles.judge.metrics.depth_slope) of near or far; ``box``: the covered pixels' bounding box (:func:`_box`)."""
+    at_plane = np.zeros(covered.shape, bool)
+    if box is None:
         return at_plane
-    box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # the covered pixels' bounding box
     d, s = depth[box], slope[box]
     with np.errstate(invalid="ignore"):
         at_plane[box] = covered[box] & ((np.abs(d - camera.near) <= s) | (np.abs(d - camera.far) <= s))

@@ -29,7 +29,7 @@ import numpy as np
 from ..candidates.frames_candidate import read_frame
 from ..diagnosis.silhouette_faults import SilhouetteFrame, name_silhouette_faults
 from ..references.faces import fan
-from ..references.fill_rule import silhouette
+from ..references.fill_rule import corner_edges, silhouette
 from .silhouette import score_silhouette
 
 #: Failing filled frames of a case kept for naming (oracles.diagnosis.silhouette_faults fits one camera mistake
@@ -45,7 +45,9 @@ class FilledFrames:
         self.tie_px = float(tie_px)
         self.frames = []
         self.failing: list[SilhouetteFrame] = []
-        self._fanned = (None, None)  # (faces, fan(faces)): a model-space scene's faces are one object a case
+        # (faces, fan(faces), the fan's edges grouped by vertex indices): a model-space scene's faces are one
+        # object a case
+        self._fanned = (None, None, None)
 
     def reference(self, p_world: np.ndarray, faces, camera, objects=None, hint=None) -> tuple:
         """The fill rule's silhouette of ``faces`` (index tuples into ``p_world`` (N, 3)) through ``camera``:
@@ -54,7 +56,8 @@ class FilledFrames:
         work (the silhouette is the same: each id is checked by the rule)."""
         several = objects is not None and len(np.unique(objects)) > 1
         if self._fanned[0] is not faces:
-            self._fanned = (faces, fan(faces))
+            fanned = fan(faces)
+            self._fanned = (faces, fanned, corner_edges(fanned[0]))
         return silhouette(
             p_world,
             faces,
@@ -64,6 +67,7 @@ class FilledFrames:
             tie_px=self.tie_px,
             hint=hint,
             fanned=self._fanned[1],
+            edges=self._fanned[2],
         )
 
     def add(
@@ -96,7 +100,7 @@ class FilledFrames:
             "longest_run_px": s.longest_run_px,
             "run_at": list(s.run_at) if s.run_at else None,
             "vacuous": s.vacuous,
-            "reference_decided_px": int((inside & ~ties).sum()),
+            "reference_decided_px": int(np.count_nonzero(inside & ~ties)),
             "object_id_px": object_id_misses(grey, shown & ~ties, ids) if several else None,
         }
         self.frames.append(rec)

@@ -5,10 +5,11 @@ The judge's own work on frame ``k`` (numpy) and the oracle's drawing of frame
 ``k + 1`` (pyrender on OSMesa/EGL: much of it inside the GL library, which
 PyOpenGL's ctypes calls run without the GIL) and the decoding of its PNG
 (zlib, also without the GIL) then overlap, on two cores. A job with filled
-frames has the fill rule's silhouette of each frame made there too, after its
-drawing (``reference``: numpy, whose array loops run without the GIL): it needs
-the frame's geometry and pyrender's triangle ids alone, and is about as much
-work as the judge's comparisons of the frame's depth map and filled frame.
+frames or depth maps has more of the judge's work that needs the frame's geometry
+and pyrender's drawing alone made there too, after its drawing (``reference``:
+numpy, whose array loops run without the GIL): the depth reference where the
+job asks for depth maps, else the fill rule's silhouette (oracles.judge.frames_judge
+chooses, to keep the two threads' work near even).
 
 What stays as it was:
 

@@ -198,18 +198,20 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     padded = np.full((h, w + 1), -1, dtype=ids.dtype)
     padded[:, :w] = ids[r0 : rows[-1] + 1, c0 : cols[-1] + 1]
     flat = padded.ravel()
+    shows = flat >= 0
     firsts, steps = [], []
     for dy, dx in _NEIGHBOURS[4:]:  # pixel (y, x) and its neighbour (y + dy, x + dx), dy >= 0
         step = dy * (w + 1) + dx
         if step >= len(flat):  # one row: no pair below it
             continue
         a, b = flat[: len(flat) - step], flat[step:]
-        first = np.flatnonzero((a != b) & (a >= 0) & (b >= 0))
+        first = np.flatnonzero((a != b) & shows[: len(flat) - step] & shows[step:])
         firsts.append(first)
         steps.append(np.full(len(first), step))
     first, step = np.concatenate(firsts), np.concatenate(steps).astype(np.int64)
     corners = np.ascontiguousarray(np.asarray(triangles).reshape(-1, 3).T)  # (3, T): each corner's row
-    ta, tb = corners[:, flat[first]], corners[:, flat[first + step]]
+    at_a, at_b = flat[first], flat[first + step]
+    ta, tb = [c[at_a] for c in corners], [c[at_b] for c in corners]  # each row taken alone: 1-D takes are fast
     shared = np.zeros(len(first), bool)
     for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
         for j in range(3):

@@ -136,14 +136,20 @@ def score_silhouette(cand, ref, ties) -> SilhouetteScores:
             f"silhouettes of shapes {cand.shape}, {ref.shape} and ties {ties.shape}: "
             "expected three (H, W) masks of one shape"
         )
-    decided = ~ties
-    both = int((cand & ref & decided).sum())
-    union = int(((cand | ref) & decided).sum())
+    # every count but the ties' over the box of the pixels either side covers (nothing is counted outside it)
+    ties_px = int(np.count_nonzero(ties))
+    n_decided = ties.size - ties_px
+    box = _covered_box(cand | ref)
+    cand, ref, decided = cand[box], ref[box], ~ties[box]
+    both = int(np.count_nonzero(cand & ref & decided))
+    union = int(np.count_nonzero((cand | ref) & decided))
     holes_mask = ref & ~cand & decided
     extra_mask = cand & ~ref & decided
     run, at = largest_run(holes_mask | extra_mask)
-    n_decided = int(decided.sum())
-    ref_decided = int((ref & decided).sum())
+    if at is not None:
+        at = (at[0] + int(box[0].start), at[1] + int(box[1].start))
+    ref_px = int(np.count_nonzero(ref))
+    ref_decided = int(np.count_nonzero(ref & decided))
     vacuous = None
     if n_decided == 0:
         vacuous = "silhouette: no decided pixel to compare (every pixel is a tie)"
@@ -153,14 +159,22 @@ def score_silhouette(cand, ref, ties) -> SilhouetteScores:
         vacuous = "silhouette: the reference covers no decided pixel (nothing to compare the candidate with)"
     return SilhouetteScores(
         decided_px=n_decided,
-        ties_px=int(ties.sum()),
-        ref_px=int(ref.sum()),
-        cand_px=int(cand.sum()),
+        ties_px=ties_px,
+        ref_px=ref_px,
+        cand_px=int(np.count_nonzero(cand)),
         union_px=union,
         iou=both / union if union else float("nan"),
-        holes=int(holes_mask.sum()),
-        extra=int(extra_mask.sum()),
+        holes=int(np.count_nonzero(holes_mask)),
+        extra=int(np.count_nonzero(extra_mask)),
         longest_run_px=run,
         run_at=at,
         vacuous=vacuous,
     )
+
+
+def _covered_box(mask: np.ndarray) -> tuple[slice, slice]:
+    """The rows and columns of ``mask`` (H, W) that hold a True pixel, as one box (an empty one when none)."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if len(rows) == 0:
+        return np.s_[0:0, 0:0]
+    return np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]

@@ -24,7 +24,17 @@ def surface_mismatch(shown: np.ndarray, covered: np.ndarray) -> tuple[np.ndarray
     has a neighbour across that edge. A band of boundary pixels lost or added is a silhouette measure's to
     find (IoU), not this one's.
     """
-    return covered & ~_any_near(~covered, False) & ~shown, shown & ~_any_near(covered, False)
+    holes, near = np.zeros(covered.shape, dtype=bool), np.zeros(covered.shape, dtype=bool)
+    rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
+    if len(rows):  # both masks differ from nothing only within the covered pixels' box grown by one pixel
+        h, w = covered.shape
+        box = np.s_[max(rows[0] - 1, 0) : min(rows[-1] + 2, h), max(cols[0] - 1, 0) : min(cols[-1] + 2, w)]
+        inside = covered[box]
+        # past the box's own edge: the image's edge (counts as covered, False in ~covered's pad) or an uncovered
+        # pixel beside an uncovered one (no pixel there is covered, so none of them is a hole either way)
+        holes[box] = inside & ~_any_near(~inside, False) & ~shown[box]
+        near[box] = _any_near(inside, False)
+    return holes, shown & ~near
 
 
 def _any_near(mask: np.ndarray, outside: bool) -> np.ndarray:

@@ -63,7 +63,17 @@ from .convert import camera_basis, intrinsics
 from .faces import fan
 from .pyrender_oracle import depth_step
 
-__all__ = ["GL_TIE_PX", "ID_TIE", "NO_OBJECT", "coverage", "silhouette", "project_clipped", "open_edges", "depth_bound"]
+__all__ = [
+    "GL_TIE_PX",
+    "ID_TIE",
+    "NO_OBJECT",
+    "coverage",
+    "silhouette",
+    "project_clipped",
+    "open_edges",
+    "corner_edges",
+    "depth_bound",
+]
 
 #: How far a GL renderer may move a vertex before deciding coverage (px, Euclidean):
 #: sqrt(2) x oracles.tolerances.TIE_END_PX = sqrt(2) x (2^-9 snap + 2^-9 float32), derived there.
@@ -115,7 +125,7 @@ def _edge_keys(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return np.concatenate([lo, hi], axis=1), flip, third
 
 
-def open_edges(tris_px, corners=None) -> np.ndarray:
+def open_edges(tris_px, corners=None, grouped=None) -> np.ndarray:
     """``(T, 3) bool``: edge ``k`` (``v_k -> v_k+1``) of each triangle is open (module docstring).
 
     Closed: some triangle with the same two end points has its third vertex strictly on one side
@@ -123,7 +133,10 @@ def open_edges(tris_px, corners=None) -> np.ndarray:
     coordinates are (-0.0 and 0.0 alike; a NaN is the same as nothing): each distinct point gets one
     number, and an edge's key is its two points' numbers. ``corners`` (``(T, 3)`` int, optional): a
     number per corner such that corners of one number have the same coordinates (a mesh's vertex
-    indices); then only one corner of each number is compared with the others.
+    indices); then only one corner of each number is compared with the others, and where no two
+    numbers have the same coordinates the edges are grouped by the numbers themselves (the same
+    groups). ``grouped``: :func:`corner_edges` of ``corners``, when the caller has it already (a
+    mesh's triangles, frame after frame).
     """
     tris_px = np.asarray(tris_px, dtype=np.float64).reshape(-1, 3, 2)
     if len(tris_px) == 0:
@@ -134,24 +147,38 @@ def open_edges(tris_px, corners=None) -> np.ndarray:
     points = np.ascontiguousarray(tris_px + 0.0).reshape(-1, 2).view(np.complex128).ravel()  # (x, y) as one
     if corners is None:
         _, point = np.unique(points, return_inverse=True, equal_nan=False)  # by x, then y; NaN each its own
+        group = _edge_groups(point.reshape(-1, 3), len(points))
     else:
-        _, one, number = np.unique(np.asarray(corners).ravel(), return_index=True, return_inverse=True)
-        _, point = np.unique(points[one], return_inverse=True, equal_nan=False)
-        point = point[number]
-    point = point.reshape(-1, 3)
-    a, b = point.ravel(), np.roll(point, -1, axis=1).ravel()  # edge k's two ends, as key's rows
-    n = np.int64(len(points))
+        one, number, group = corner_edges(corners) if grouped is None else grouped
+        distinct, point = np.unique(points[one], return_inverse=True, equal_nan=False)
+        if len(distinct) < len(one):  # two numbers at one point: the edges grouped by points
+            group = _edge_groups(point[number].reshape(-1, 3), len(points))
+    pos = np.bincount(group, weights=(side > 0)) > 0
+    neg = np.bincount(group, weights=(side < 0)) > 0
+    return ~(pos & neg)[group].reshape(-1, 3)
+
+
+def corner_edges(corners) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What :func:`open_edges` needs of ``corners`` (``(T, 3)`` int) alone: ``(one, number, group)``, the first
+    corner of each distinct number, each corner's number as an index into them, and each edge's group (edges
+    ``v_k -> v_k+1`` in ``corners.ravel()``'s order, one group per unordered pair of numbers)."""
+    _, one, number = np.unique(np.asarray(corners).ravel(), return_index=True, return_inverse=True)
+    return one, number, _edge_groups(number.reshape(-1, 3), len(one))
+
+
+def _edge_groups(point: np.ndarray, n: int) -> np.ndarray:
+    """``(3T,)`` int: each edge's group, edges ``k`` (``v_k -> v_k+1``) of ``point`` (``(T, 3)`` numbers below
+    ``n``) grouped by their two ends' numbers, either way round."""
+    a, b = point.ravel(), np.roll(point, -1, axis=1).ravel()  # edge k's two ends
+    n = np.int64(n)
     edge = np.minimum(a, b) * n + np.maximum(a, b)
     order = np.argsort(edge, kind="stable")
     ks = edge[order]
     new = np.ones(len(ks), dtype=bool)
     new[1:] = ks[1:] != ks[:-1]
-    group = np.cumsum(new) - 1
-    pos = np.bincount(group, weights=(side[order] > 0), minlength=group[-1] + 1) > 0
-    neg = np.bincount(group, weights=(side[order] < 0), minlength=group[-1] + 1) > 0
-    closed = np.empty(len(key), dtype=bool)
-    closed[order] = (pos & neg)[group]
-    return ~closed.reshape(-1, 3)
+    group = np.empty(len(ks), dtype=np.int64)
+    group[order] = np.cumsum(new) - 1
+    return group
 
 
 def _orient(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -363,12 +390,14 @@ def _covers(guess, tris, area2, boxes, edges, n: int, width: int) -> np.ndarray:
     ok = area2[t] > 0
     x0, y0, x1, y1 = boxes
     ok &= (py >= y0[t]) & (py <= y1[t])
+    x0, x1 = x0[t], x1[t]
+    per_edge = [(p[t, 0], dy[t], dx[t] * (py - p[t, 1]), top_left[t]) for p, dx, dy, _reach, top_left in edges]
     for end in (first, last):
         px = (end % width).astype(np.float64)
-        ok &= (px >= x0[t]) & (px <= x1[t])
-        for p, dx, dy, _reach, top_left in edges:
-            e = dx[t] * (py - p[t, 1]) - dy[t] * (px - p[t, 0])
-            ok &= (e > 0) | ((e == 0) & top_left[t])
+        ok &= (px >= x0) & (px <= x1)
+        for p_x, dy, e_row, top_left in per_edge:  # each taken once for both ends
+            e = e_row - dy * (px - p_x)
+            ok &= (e > 0) | ((e == 0) & top_left)
     held = np.zeros(n, dtype=bool)
     _paint(
         held,
@@ -600,31 +629,39 @@ def _project(p_world, fanned, camera):
     world_to_cam = np.stack([right, up, forward])
     p_cam = (p_world - np.asarray(camera.position, dtype=np.float64)) @ world_to_cam.T
     tris, owner = fanned
-    tri_cam = p_cam[tris]  # (T, 3, 3)
-    z = tri_cam[:, :, 2]
+    z = p_cam[:, 2][tris]  # (T, 3)
     near, far = float(camera.near), float(camera.far)
     whole = ((z >= near) & (z <= far)).all(axis=1)
     gone = (z < near).all(axis=1) | (z > far).all(axis=1)
-    parts, part_owner = [tri_cam[whole]], [owner[whole]]
+    cuts, cut_owner = [np.zeros((0, 3, 3))], [owner[whole]]
     for i in np.flatnonzero(~whole & ~gone):
-        poly = _clip_polygon(tri_cam[i], near, far)
+        poly = _clip_polygon(p_cam[tris[i]], near, far)
         if len(poly) >= 3:
-            parts.append(np.stack([np.stack([poly[0], poly[k], poly[k + 1]]) for k in range(1, len(poly) - 1)]))
-            part_owner.append(np.full(len(poly) - 2, owner[i]))
-    tri_cam = np.concatenate(parts).reshape(-1, 3, 3)
-    owner = np.concatenate(part_owner).astype(np.int64)
+            cuts.append(np.stack([np.stack([poly[0], poly[k], poly[k + 1]]) for k in range(1, len(poly) - 1)]))
+            cut_owner.append(np.full(len(poly) - 2, owner[i]))
+    owner = np.concatenate(cut_owner).astype(np.int64)  # the whole triangles' first, then the cut ones'
+    cut_cam = np.concatenate(cuts).reshape(-1, 3, 3)
     # the corners' numbers: a whole triangle's are its vertex indices, each cut corner one of its own
-    cut = 3 * (len(tri_cam) - int(whole.sum()))
-    corners = np.concatenate([tris[whole].ravel(), len(p_cam) + np.arange(cut)]).reshape(-1, 3)
-    x, y, zc = tri_cam[..., 0], tri_cam[..., 1], tri_cam[..., 2]
+    kept = tris[whole]
+    corners = np.concatenate([kept.ravel(), len(p_cam) + np.arange(3 * len(cut_cam))]).reshape(-1, 3)
+    # a whole triangle's corners are its vertices projected (each vertex once: the same numbers as corner by
+    # corner), a cut one's its own points; a vertex in no whole triangle may be behind the eye (its division
+    # by z <= 0 never used)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tris_px = np.concatenate([_to_px(p_cam, camera)[kept], _to_px(cut_cam, camera)]).reshape(-1, 3, 2)
+    zc = np.concatenate([p_cam[:, 2][kept], cut_cam[..., 2]]).reshape(-1, 3)
+    return tris_px, zc, owner, whole, corners
+
+
+def _to_px(p_cam: np.ndarray, camera) -> np.ndarray:
+    """``(..., 2)``: camera-space points ``(..., 3)`` projected by the conventions (:func:`project_clipped`)."""
+    x, y, zc = p_cam[..., 0], p_cam[..., 1], p_cam[..., 2]
     if camera.projection == "perspective":
         fx, fy, cx, cy = intrinsics(camera)
-        tris_px = np.stack([cx + fx * x / zc, cy - fy * y / zc], axis=-1)
-    else:
-        s = camera.height / camera.ortho_height
-        cx, cy = (camera.width - 1) / 2.0, (camera.height - 1) / 2.0
-        tris_px = np.stack([cx + s * x, cy - s * y], axis=-1)
-    return tris_px, zc, owner, whole, corners
+        return np.stack([cx + fx * x / zc, cy - fy * y / zc], axis=-1)
+    s = camera.height / camera.ortho_height
+    cx, cy = (camera.width - 1) / 2.0, (camera.height - 1) / 2.0
+    return np.stack([cx + s * x, cy - s * y], axis=-1)
 
 
 def _image_triangles(hint, whole, shape) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -646,7 +683,7 @@ def _image_triangles(hint, whole, shape) -> tuple[np.ndarray, np.ndarray, np.nda
 
 
 def silhouette(
-    p_world, faces, camera, shape, face_objects=None, tie_px: float = GL_TIE_PX, hint=None, fanned=None
+    p_world, faces, camera, shape, face_objects=None, tie_px: float = GL_TIE_PX, hint=None, fanned=None, edges=None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A frame's reference silhouette: ``(inside, ties, object_ids)``, each ``(H, W)``.
 
@@ -670,6 +707,9 @@ def silhouette(
         as without it, right or wrong, with less work where it is right. Not used with several objects.
     fanned : ((T, 3), (T,)) int, optional
         ``oracles.references.faces.fan(faces)``, when the caller has it already.
+    edges : tuple, optional
+        :func:`corner_edges` of the fan's triangles (``fanned[0]``), when the caller has it already (a
+        case's frames of one mesh): used on a frame where the clip planes cut no triangle.
 
     Returns
     -------
@@ -684,7 +724,7 @@ def silhouette(
     shape = (int(shape[0]), int(shape[1]))
     if hint is not None and np.shape(hint) != shape:
         raise ValueError(f"a hint of shape {np.shape(hint)} for an image of {shape}")
-    is_open = open_edges(tris_px, corners)
+    is_open = open_edges(tris_px, corners, edges if edges is not None and whole.all() else None)
     objects = np.zeros(0, dtype=np.int64)
     if face_objects is not None and len(owner):
         tri_object = np.asarray(face_objects, dtype=np.int64).reshape(-1)[owner]
