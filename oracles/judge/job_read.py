@@ -29,7 +29,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .. import faults as catalogue
+from .line_style import PLACEMENT_FAULTS  # faults that put the lines elsewhere: their offsets are not pooled
 
 __all__ = ["JobRead", "MIN_OFFSET_CASES", "RULE_NAMES_FAMILY", "read_job", "differs"]
 
@@ -39,9 +39,6 @@ MIN_OFFSET_CASES = 3
 #: The names pixels that follow another rule than GL's get (one per job: :func:`read_job`'s rule name); an
 #: end fault (line_end_bias) is a fault of its own, never renamed.
 RULE_NAMES_FAMILY = ("raster_rule", "line_pixel_bias")
-
-#: Faults that put the lines elsewhere than the oracle's: their cases' offsets are not pooled.
-PLACEMENT_FAULTS = catalogue.names("orientation")
 
 
 @dataclass(frozen=True)
