@@ -25,13 +25,14 @@ pixels too.
 from __future__ import annotations
 
 from wirecheck.core.errors import InputError
-from wirecheck.core.limits import MAX_CANDIDATE_TIMEOUT_S
 from wirecheck.core.outputs.output import claim, release_claim
 
 from . import tolerances
+from .call_args import checked_flag, checked_seconds
 from .candidates.caller_state import caller_state_kept
 from .candidates.isolation import api_candidate
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, closing_started
+from .config import settings_for
 from .judge import gate
 from .references.pyrender_oracle import GLUnavailable, gl_available
 from .reports.compared import hint_lines, what_text
@@ -231,7 +232,7 @@ def run_check(
         "timeout_s": timeout_s,
         "precision": precision,
     }
-    settings = settings_for(given, config)
+    settings = settings_for(given, config, API_DEFAULTS)
     scenes, frames, cases, oracles, tol_px, min_f1, min_f1_0px, turns, timeout_s, precision = (
         settings.get(k) for k in given
     )
@@ -241,7 +242,7 @@ def run_check(
     checked_flag(allow_vacuous, "allow_vacuous")
     if isolate is not None:
         checked_flag(isolate, "isolate", "(or None: the default)")
-    timeout_s = _seconds(timeout_s)
+    timeout_s = checked_seconds(timeout_s)
     oracles = _oracles(oracles)
     tol = Tolerances(tol_px, min_f1, min_f1_0px, precision=_precision(precision))
     inputs = gate.run_inputs(scenes, frames, 1, cases, turns, tol)  # before any OpenGL set-up
@@ -263,27 +264,6 @@ def run_check(
             allow_vacuous=allow_vacuous,
         )
     return {"run": None, **report}, images  # report.json's fields: "run" is crosscheck's --run name
-
-
-def settings_for(given: dict, config=None) -> dict:
-    """``given`` (keywords of :func:`check_projector`, None = not given) over ``[tool.wirecheck]``
-    (``config``: a file, None = the nearest pyproject.toml, False = none) over :data:`API_DEFAULTS`.
-
-    Raises InputError (a ValueError) for a bad table, naming the file, the key and the value.
-    """
-    from pathlib import Path
-
-    from .config import load_config
-
-    table = {}
-    if config is not False:
-        loaded = load_config(Path(config) if config is not None else None)
-        table = loaded.api_kwargs()
-        table["candidate"] = loaded.values.get("candidate")
-        table["candidate_cmd"] = loaded.values.get("candidate-cmd")
-    out = {**API_DEFAULTS, **{k: v for k, v in table.items() if v is not None}}
-    out.update({k: v for k, v in given.items() if v is not None})
-    return out
 
 
 def _candidate_args(func, cmd):
@@ -323,31 +303,6 @@ def _candidate_args(func, cmd):
             "the candidate contract (wirecheck.oracles.candidates.candidate)"
         ) from None
     return func, None
-
-
-def checked_flag(value, name: str, extra: str = "") -> bool:
-    """A bool (numpy's too); TypeError otherwise: ``allow_vacuous="no"`` is truthy and would let nothing pass."""
-    import numpy as np
-
-    if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{name} {short_repr(value)}: expected True or False{' ' + extra if extra else ''}")
-    return bool(value)
-
-
-def _seconds(timeout_s) -> float:
-    """``timeout_s`` as a finite float > 0; ValueError/TypeError naming it otherwise."""
-    import math
-    import numbers
-
-    if isinstance(timeout_s, bool) or not isinstance(timeout_s, numbers.Real):
-        raise TypeError(f"timeout_s {short_repr(timeout_s)}: expected a number of seconds > 0")
-    seconds = float(timeout_s)
-    if not (math.isfinite(seconds) and 0 < seconds <= MAX_CANDIDATE_TIMEOUT_S):
-        raise ValueError(
-            f"timeout_s {timeout_s!r}: expected a finite number of seconds > 0 and at most "
-            f"{MAX_CANDIDATE_TIMEOUT_S:g} (one day)"
-        )
-    return seconds
 
 
 def _oracles(oracles) -> tuple:

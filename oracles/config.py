@@ -353,3 +353,23 @@ def parse_cli(parser, argv=None):
         setattr(args, dest, _cli_value(key, value))
         applied.append(key)
     return args, config, applied
+
+
+def settings_for(given: dict, config, defaults: dict) -> dict:
+    """The public API's settings: ``given`` (a ``check_*`` function's keywords, None = not given) over
+    ``[tool.wirecheck]`` (``config``: a file, None = the nearest pyproject.toml, False = none) over ``defaults``.
+
+    Every ``check_*`` function reads the table this way (oracles.api, oracles.frames_api,
+    oracles.unprojector_api): the keys of :data:`API_KEYWORDS` that are among ``given``, plus the table's
+    ``candidate`` and ``candidate_cmd`` (the projector's, read by oracles.api alone). Raises InputError
+    (a ValueError) for a bad table, naming the file, the key and the value.
+    """
+    table: dict = {}
+    if config is not False:
+        loaded = load_config(Path(config) if config is not None else None)
+        table = {k: v for k, v in loaded.api_kwargs().items() if k in given}
+        table["candidate"] = loaded.values.get("candidate")
+        table["candidate_cmd"] = loaded.values.get("candidate-cmd")
+    out = {**defaults, **{k: v for k, v in table.items() if v is not None}}
+    out.update({k: v for k, v in given.items() if v is not None})
+    return out

@@ -18,13 +18,18 @@ from wirecheck.core.errors import InputError
 from wirecheck.core.outputs.output import check_report_dir, claim, release_claim
 
 from . import tolerances
-from .api import checked_flag, checked_report_dir, raise_unless_pass, settings_for, short_repr
+from .api import checked_report_dir, raise_unless_pass, short_repr
+from .call_args import checked_flag
 from .candidates.caller_state import caller_state_kept
+from .config import settings_for
 from .frames_cli import check_report_outside_job
 from .judge import gate
 from .judge.line_style import LINE_RULES
 from .references.pyrender_oracle import GLUnavailable, gl_available
 from .reports.report import write_report
+
+#: check_frames' F1 floors when neither the call nor ``[tool.wirecheck]`` gives them: crosscheck's.
+FRAMES_DEFAULTS = {"min_f1": tolerances.MIN_F1_1PX, "min_f1_0px": tolerances.MIN_F1_0PX}
 
 
 def check_frames(
@@ -94,7 +99,9 @@ def check_frames(
             "lines held to GL's rule or the rounded ends'; gl: to GL's pixel rule; geometry: where "
             "the lines are only)"
         )
-    settings = settings_for({"min_f1": min_f1, "min_f1_0px": min_f1_0px}, config)  # [tool.wirecheck] beneath
+    settings = settings_for(
+        {"min_f1": min_f1, "min_f1_0px": min_f1_0px}, config, FRAMES_DEFAULTS
+    )  # [tool.wirecheck] beneath
     tol = tolerances.Tolerances(min_f1_1px=settings["min_f1"], min_f1_0px=settings["min_f1_0px"])
     gate.check_tolerances(tol)  # a NaN floor would pass everything
     run_dir = checked_report_dir(report_dir)

@@ -32,9 +32,11 @@ from wirecheck.core.outputs.output import claim, release_claim
 from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 
+from .call_args import checked_flag, checked_seconds
 from .candidates.candidate import load_candidate
 from .candidates.subprocess_candidate import DEFAULT_TIMEOUT_S, SubprocessCandidate, closing_started
 from .cases import case_motion, cases_for
+from .config import settings_for
 from .diagnosis.unproject_faults import name_unproject_faults
 from .judge import gate
 from .judge.unproject_points import DEFAULT_STRIDE, surface_samples
@@ -45,8 +47,9 @@ from .tolerances import unproject_bound
 
 __all__ = ["UNPROJECT_DEFAULTS", "assert_unprojector", "check_unprojector", "flat_faults", "unprojector_failure_text"]
 
-#: Settings when the call gives none: 2 frames of the scenes' spin per case, one sample every 8 px.
-UNPROJECT_DEFAULTS = {"frames": 2, "turns": (1.0, 1.0, 0.0), "stride": DEFAULT_STRIDE}
+#: Settings when neither the call nor ``[tool.wirecheck]`` gives them: 2 frames of the scenes' spin per case,
+#: one sample every 8 px, 10 s a request.
+UNPROJECT_DEFAULTS = {"frames": 2, "turns": (1.0, 1.0, 0.0), "stride": DEFAULT_STRIDE, "timeout_s": DEFAULT_TIMEOUT_S}
 
 
 def check_unprojector(
@@ -56,9 +59,11 @@ def check_unprojector(
     cases=None,
     turns=None,
     stride: int | None = None,
+    allow_vacuous: bool = False,
     *,
     cmd: str | None = None,
-    timeout_s: float = DEFAULT_TIMEOUT_S,
+    timeout_s: float | None = None,
+    config=None,
     report_dir=None,
 ) -> dict:
     """Judge an unprojector against the exact inverse of the conventions and return the report.
@@ -83,8 +88,17 @@ def check_unprojector(
         Instead of ``func``: an unprojector program speaking the candidate protocol's
         ``unproject`` requests (docs/protocol.md), as a command line; it is started once and ends
         with the check.
+    allow_vacuous : bool
+        Let a case with no visible surface point in any frame pass (its verdict ``"vacuous"``); by
+        default it fails the report, as for check_projector and check_frames. A run with no point
+        at all is an error either way (below). True or False only.
     timeout_s : float
-        Seconds each request to ``cmd`` may take (default 10).
+        Seconds each request to ``cmd`` or to a ``"FILE.py:FUNC"`` unprojector may take (default 10).
+    config : str, Path or False, optional
+        The file whose ``[tool.wirecheck]`` fills ``scenes``, ``cases``, ``frames``, ``turns`` (its
+        ``spin``) and ``timeout_s`` (its ``candidate-timeout``) where not given, as for
+        :func:`~wirecheck.oracles.api.check_projector` (default: the nearest ``pyproject.toml`` at or
+        above the working directory); False: no file. Its ``candidate`` is a projector and is not read.
     report_dir : str or Path, optional
         Write report.json and report.md there, pass or fail, as ``crosscheck --unprojector
         --report-dir`` does (oracles.reports.unprojector_report). A folder wirecheck did not write
@@ -108,13 +122,19 @@ def check_unprojector(
         visible surface point at all (a wireframe has none); a ``report_dir`` that is a file or
         holds anything wirecheck did not write.
     TypeError
-        ``func`` neither callable nor a string, ``report_dir`` not a path.
+        ``func`` neither callable nor a string, ``report_dir`` not a path, ``allow_vacuous`` not a
+        bool, ``timeout_s`` not a number.
     """
+    checked_flag(allow_vacuous, "allow_vacuous")
+    given = {"scenes": scenes, "frames": frames, "cases": cases, "turns": turns, "timeout_s": timeout_s}
+    settings = settings_for(given, config, UNPROJECT_DEFAULTS)
+    scenes, frames, cases, turns, timeout_s = (settings.get(k) for k in given)
+    timeout_s = checked_seconds(timeout_s)
     run_dir = checked_report_dir(report_dir)
     if run_dir is not None:
         claim(run_dir, "report_dir")  # checked and held before anything runs: one run per folder
     try:
-        report = _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s)
+        report = _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s, allow_vacuous)
         if run_dir is not None:
             write_unprojector_report(run_dir, report, "report_dir")
     finally:
@@ -123,11 +143,9 @@ def check_unprojector(
     return report
 
 
-def _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s) -> dict:
+def _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s, allow_vacuous) -> dict:
     """:func:`check_unprojector` without its report folder."""
     started = time.perf_counter()
-    frames = UNPROJECT_DEFAULTS["frames"] if frames is None else frames
-    turns = UNPROJECT_DEFAULTS["turns"] if turns is None else turns
     stride = UNPROJECT_DEFAULTS["stride"] if stride is None else stride
     if isinstance(stride, bool) or not isinstance(stride, (int, np.integer)) or stride < 1:
         raise InputError(f"stride {stride!r}: expected an integer >= 1 (pixels between samples)")
@@ -165,13 +183,15 @@ def _check(func, scenes, frames, cases, turns, stride, cmd, timeout_s) -> dict:
             f"unprojector {name}: no visible surface point in {len(records)} case(s) "
             "(scenes without faces?): a check that compares nothing is no pass"
         )
-    verdict = "pass" if all(r["verdict"] == "pass" for r in records) else "fail"
+    allowed = ("pass", "vacuous") if allow_vacuous else ("pass",)
+    verdict = "pass" if all(r["verdict"] in allowed for r in records) else "fail"
     settings = {
         "scenes": [s.name for s in inputs.scenes],
         "cases": list(inputs.case_names),
         "frames": inputs.frames,
         "turns": [float(t) for t in inputs.turns],
         "stride": int(stride),
+        "allow_vacuous": bool(allow_vacuous),
     }
     timing = {
         "wall_s": time.perf_counter() - started,

@@ -1,7 +1,7 @@
 """``crosscheck --unprojector FILE.py:FUNC`` (or ``--unprojector-cmd 'COMMAND'``): an unprojector judged.
 
 Parses nothing of its own: :func:`unprojector_main` takes crosscheck's parsed options
-(``--scene``, ``--cases``, ``--frames``, ``--spin``, ``--report-dir``, ``--run``, ``--no-report``)
+(``--scene``, ``--cases``, ``--frames``, ``--spin``, ``--allow-vacuous``, ``--report-dir``, ``--run``, ``--no-report``)
 and the report folder they name, calls :func:`oracles.unprojector_api.check_unprojector`, writes
 report.json and report.md there (oracles.reports.unprojector_report; ``reports/<UTC time>/`` by
 default, none with ``--no-report``), prints one line per case, what to check and the verdict, and
@@ -25,9 +25,6 @@ from .unprojector_api import check_unprojector
 #: Options of crosscheck that judge something else and cannot go with --unprojector.
 OTHER_MODES = ("candidate", "candidate_cmd", "candidate_frames", "sweep", "suite", "junit_xml")
 
-#: The frames per case when --frames is not given.
-DEFAULT_FRAMES = 2
-
 
 def unprojector_main(args, run_dir: Path, run_option: str) -> int:
     """Judge ``args.unprojector`` on ``args``' scenes and cases; write the report folder ``run_dir`` (named by
@@ -40,7 +37,7 @@ def unprojector_main(args, run_dir: Path, run_option: str) -> int:
         if clash:
             raise InputError(
                 f"{given} with {', '.join(clash)}: expected {given} alone with --scene, --cases, "
-                "--frames, --spin and the report folder's --report-dir, --run or --no-report"
+                "--frames, --spin, --allow-vacuous and the report folder's --report-dir, --run or --no-report"
             )
         check_candidate_timeout(args.candidate_timeout, "--candidate-timeout")  # as for --candidate
         if not args.no_report:
@@ -49,11 +46,13 @@ def unprojector_main(args, run_dir: Path, run_option: str) -> int:
         report = check_unprojector(
             args.unprojector,
             scenes=args.scene,
-            frames=args.frames if args.frames is not None else DEFAULT_FRAMES,
+            frames=args.frames,  # None: the API's default (UNPROJECT_DEFAULTS, 2 frames)
             cases=args.cases,
             turns=args.spin,
+            allow_vacuous=args.allow_vacuous,
             cmd=args.unprojector_cmd,
             timeout_s=args.candidate_timeout,
+            config=False,  # [tool.wirecheck] is in args already (oracles.config.parse_cli)
         )
         if not args.no_report:
             write_unprojector_report(run_dir, {"run": args.run, **report}, run_option)

@@ -83,6 +83,7 @@ def test_report_json_holds_the_returned_report(tmp_path):
         "frames": 1,
         "turns": [1.0, 1.0, 0.0],
         "stride": 8,
+        "allow_vacuous": False,
     }
     assert written["timing"]["wall_s"] == report["timing"]["wall_s"] > 0
     md = (tmp_path / "r" / "report.md").read_text()
