@@ -84,12 +84,10 @@ from .config import parse_cli, trust_line
 from .datasets.memory_budget import gib_bytes
 from .executors import DEFAULT_CONNECT_TIMEOUT_S, ExecutorSpec, check_scheduler_address, dask_failure
 from .judge import gate
-from .reports.compared import hint_lines, reason_text, what_text
-from .reports.junit import check_junit_target, write_junit
+from .reports.console_run import finish_run
+from .reports.junit import check_junit_target
 from .reports.progress import TerminalProgress
-from .reports.report import compared_text, console_table, precision_text, timing_line, vacuous_text, write_report
 from .reports.report_option import check_no_report, report_line
-from .reports.wall import process_age_s
 from .runner import level_for_oracles, run_crosscheck
 from .spec import run_spec, spec_console, spec_markdown
 from .tolerances import Tolerances
@@ -471,50 +469,7 @@ def _main(argv=None) -> int:
     if status is not None:
         return status
     report, images = result
-    report = {"run": args.run, **report}
-    records = report["cases"]
-    try:
-        if not args.no_report:
-            run_dir.parent.mkdir(parents=True, exist_ok=True)  # only now: a failed run leaves no folder
-            write_report(run_dir, report, images)
-    except OSError as exc:
-        return _error(f"writing {str(run_dir)!r} failed: {exc}")
-    if args.junit_xml:
-        try:
-            write_junit(Path(args.junit_xml), report)
-        except InputError as exc:
-            return _error(str(exc))
-        except OSError as exc:
-            return _error(f"--junit-xml {args.junit_xml!r}: writing failed: {exc}")
-    print(what_text(report))
-    print(console_table(records))
-    for r in records:
-        if r["verdict"] != "pass":
-            print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
-    notes = {}  # a passing case's note, once per text: its cases named together
-    for r in records:
-        if r["verdict"] == "pass" and r.get("note"):
-            notes.setdefault(r["note"], []).append(f"{r['scene']} / {r['camera']}")
-    for note, where in notes.items():
-        print(f"  {', '.join(where)}: {note}")
-    for line in hint_lines(report, [r for r in records if r["verdict"] != "pass"]):
-        print(line)
-    s = report["summary"]
-    limits = (
-        f"silhouette IoU >= {tol.min_iou}, depth error <= its bound"
-        if mode.shaded
-        else f"F1@1px >= {tol.min_f1_1px}, F1@0px >= {tol.min_f1_0px}"
-    )
-    vacuous = vacuous_text(report)
-    print(
-        f"\n{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases, {compared_text(report)} "
-        f"(vertex <= {_vertex_limit(report, tol)}, {limits})" + (f"; {vacuous}" if vacuous else "")
-    )
-    if precision_text(report):
-        print(f"Candidate precision: {precision_text(report)}")
-    print(timing_line(report)[:-1] + f"; {process_age_s():.1f} s in all, with start-up and the report)")
-    print(report_line(args, run_dir, "report.json", "report.md, report.html"))
-    return 0 if report["verdict"] == "pass" else 1
+    return finish_run(args, run_dir, {"run": args.run, **report}, images, tol)
 
 
 def _run_guarded(args, progress, run):
@@ -536,12 +491,6 @@ def _run_guarded(args, progress, run):
         return None, _error(dask_failure(exc))
     finally:
         progress.close()
-
-
-def _vertex_limit(report: dict, tol) -> str:
-    """``1e-06 px``, or, when a case's precision raised it, where to find the bounds."""
-    bounds = {c.get("vertex_bound_px", tol.vertex_px) for c in report["cases"]}
-    return f"{tol.vertex_px:g} px" if bounds <= {tol.vertex_px} else "the bound of the candidate's precision"
 
 
 def _memory_budget(gib: float | None):

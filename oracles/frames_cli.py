@@ -20,9 +20,7 @@ from wirecheck.core.scene.files import builtin_names, load_scene
 from wirecheck.core.transforms import Motion
 
 from .cases import ALL_CASE_NAMES, CASE_NAMES
-from .judge.line_style import summary_lines
-from .reports.compared import hint_lines, reason_text, what_text
-from .reports.report_option import report_line
+from .reports.console_run import finish_run
 from .tolerances import Tolerances
 
 
@@ -176,7 +174,6 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
     """
     from .config import CLI_DESTS
     from .judge.frames_judge import run_frames
-    from .reports.report import console_table, write_report
 
     skip = {CLI_DESTS[k] for k in from_config if k in CLI_DESTS}
     given = [f"--{k.replace('_', '-')}" for k in _NOT_WITH_FRAMES if getattr(args, k, None) and k not in skip]
@@ -202,29 +199,7 @@ def frames_main(args, run_dir: Path, from_config=frozenset()) -> int:
         )
     except InputError as exc:
         return _fail(str(exc))
-    try:
-        if not args.no_report:
-            write_report(run_dir, report, images)
-        if args.junit_xml:
-            from .reports.junit import write_junit
-
-            write_junit(Path(args.junit_xml), report)
-    except InputError as exc:
-        return _fail(str(exc))
-    except OSError as exc:
-        return _fail(f"writing {str(run_dir)!r} or the JUnit file failed: {exc}")
-    print(what_text(report))  # what was compared: the first line of every result (docs/pytest.md)
-    print(console_table(report["cases"]))
-    for line in summary_lines(report["cases"]):
-        print(line)
-    failing = [r for r in report["cases"] if r["verdict"] != "pass"]  # failed, or vacuous (compared nothing)
-    for r in failing:
-        print(f"  {r['scene']} / {r['camera']}: " + reason_text(r["reasons"]))
-    for line in hint_lines(report, failing):  # what to check and each fault kind's note, once
-        print(line)
-    print("\n" + verdict_line(report, tol))
-    print(report_line(args, run_dir, "report.json", "report.md, report.html"))
-    return 1 if report["verdict"] != "pass" else 0
+    return finish_run(args, run_dir, report, images, tol)
 
 
 def check_report_outside_job(job_dir: Path, run_dir: Path) -> None:
@@ -246,59 +221,3 @@ def check_report_outside_job(job_dir: Path, run_dir: Path) -> None:
             f"report folder {str(run_dir)!r}: the job {str(job_dir)!r} itself or its frames/ "
             "(the renderer's files, only read): expected a report folder outside them"
         )
-
-
-def verdict_line(report: dict, tol) -> str:
-    """The run's last line: the verdict, the thresholds, and the lowest F1 against core ('-' when not a number)."""
-    s = report["summary"]
-
-    def f1(v) -> str:
-        return "-" if v is None else f"{v:.4f}"
-
-    outputs = report.get("outputs", ["wireframe"])
-    limits = (
-        [f"F1@1px >= {tol.min_f1_1px}, {f1_0px_clause(report['cases'], tol.min_f1_0px)}"]
-        if "wireframe" in outputs
-        else []
-    )
-    limits += (
-        [f"filled IoU >= {tol.min_iou}, runs of decided pixels missing or added <= {tol.max_silhouette_run_px}"]
-        if "filled" in outputs
-        else []
-    )
-    limits += (
-        [
-            f"depth error <= {tol.max_depth_error_ratio:g} x its bound, holes <= {tol.max_surface_holes_px}, "
-            f"extra <= {tol.max_surface_extra_px} px away from the silhouette's boundary"
-        ]
-        if "depth" in outputs
-        else []
-    )
-    core = (
-        f"; against core: F1@0px >= {f1(s['min_core_f1_0px'])}, F1@1px >= {f1(s['min_core_f1_1px'])}"
-        if "wireframe" in outputs
-        else ""
-    )
-    return (
-        f"{report['verdict'].upper()}: {s['passed']}/{s['cases']} cases within tolerance against pyrender "
-        f"({', '.join(limits)}){core}"
-    )
-
-
-def f1_0px_clause(cases: list, min_f1_0px: float) -> str:
-    """The verdict line's F1@0px threshold, said only of the cases it judged: aliased lines held to a pixel
-    rule (``--line-rule any``: GL's or the rounded ends' read; ``gl``); antialiased and wide lines, and
-    ``--line-rule geometry``, report F1@0px only."""
-    held = [
-        c
-        for c in cases
-        if not c.get("line_style")
-        or (c["line_style"]["style"] == "aliased" and c["line_style"]["line_rule"] in ("gl", "any"))
-    ]
-    rounded = sum(1 for c in held if (c.get("line_style") or {}).get("rule_read") == "rounded")
-    which = "GL's pixel rule" if not rounded else f"a pixel rule (GL's, or the rounded ends' in {rounded})"
-    if len(held) == len(cases) and not rounded:
-        return f"F1@0px >= {min_f1_0px}"
-    if not held:
-        return "F1@0px reported, not judged: no case is held to GL's pixel rule"
-    return f"F1@0px >= {min_f1_0px} in the {len(held)} case{'s' if len(held) != 1 else ''} held to {which}"

@@ -37,7 +37,7 @@ def test_the_console_and_junit_follow_the_reports_level():
 
 
 def test_the_verdict_line_claims_f1_at_0px_only_where_it_judged():
-    from wirecheck.oracles.frames_cli import f1_0px_clause
+    from wirecheck.oracles.reports.console_run import f1_0px_clause
 
     def case(style, rule="gl"):
         return {"line_style": {"style": style, "line_rule": rule}}
