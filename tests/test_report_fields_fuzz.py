@@ -11,9 +11,9 @@ import shutil
 import pytest
 from helpers import blank_job
 from wirecheck.oracles import cli
-from wirecheck.oracles.reports.console_run import verdict_line
 from wirecheck.oracles.judge.line_style import summary_lines
 from wirecheck.oracles.reports.compared import hint_lines, what_text
+from wirecheck.oracles.reports.console_run import verdict_line
 from wirecheck.oracles.reports.junit import junit_xml
 from wirecheck.oracles.reports.report import _html, console_table, markdown, write_report
 from wirecheck.oracles.tolerances import Tolerances
