@@ -1,6 +1,6 @@
 """Each naming threshold of oracles.tolerances.NamingThresholds that was a module constant of the diagnosis
 (image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults) or of the line
-measures (even_lean, line_ends, coverage_pixels) decides a name or which limits hold: on a hand-made input the name
+measures (even_lean, line_ends, coverage_pixels, line_profile) decides a name or which limits hold: on a hand-made input the name
 flips when the threshold is moved across the value measured on that input, both sides asserted.
 
 The record is moved with dataclasses.replace and put where the diagnosis reads it (each module's ``NAMING``,
@@ -27,6 +27,9 @@ from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
 from wirecheck.oracles.diagnosis.image_visibility import set_difference
 from wirecheck.oracles.diagnosis.unproject_faults import name_unproject_faults
 from wirecheck.oracles.judge import coverage_pixels, even_lean
+from wirecheck.oracles.judge.free_ends import measure_ends
+from wirecheck.oracles.judge.line_profile import pooled_offset
+from wirecheck.oracles.judge.line_style import measure
 from wirecheck.oracles.judge.line_ends import end_attribution
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
@@ -436,3 +439,41 @@ def test_wide_min_px_decides_a_binary_lines_style_when_called(naming):
     assert NAMING.wide_min_px == 1.75 and style.classify()["style"] == "wide"
     naming(wide_min_px=math.nextafter(1.75, UP))
     assert style.classify()["style"] == "aliased"
+
+
+# ---------------------------------------------------------------- a line's profile across it (line_profile)
+
+
+def test_profile_min_mass_decides_a_sample_and_a_free_end(naming):
+    # one horizontal line from (15, 12) to (45, 12), drawn as row 12 at coverage 1/2 (exact in binary): every
+    # window across it (7 rows, 3 each side) holds a mass of 0.5 centred on the line, a sample from
+    # profile_min_mass (0.5) on; its free ends' inner mass (bilinear every 0.5 px across: 1/4 + 1/2 + 1/4,
+    # times the 0.5 px step) is 0.5 too, measured from the same bound on
+    segs = np.array([[[15.0, 12.0], [45.0, 12.0]]])
+    cov = np.zeros((25, 60))
+    cov[12, 15:46] = 0.5
+    got = measure(cov, segs)
+    assert got["found"] == got["windows"] > 0 and np.all(got["mass"] == 0.5) and np.all(got["offset"] == 0.0)
+    assert len(measure_ends(cov, segs)) == 2
+    naming(profile_min_mass=0.5)
+    assert measure(cov, segs)["found"] == got["windows"] and len(measure_ends(cov, segs)) == 2
+    naming(profile_min_mass=math.nextafter(0.5, UP))
+    assert measure(cov, segs)["found"] == 0 and len(measure_ends(cov, segs)) == 0
+
+
+def test_profile_min_samples_decides_whether_the_geometry_is_measured(naming):
+    # 20 samples, 10 of vertical lines (normal +x) offset 0.25 and 10 of horizontal ones (normal +y) offset
+    # -0.125: the pooled offset is (0.25, -0.125) exactly, both axes determined, from profile_min_samples (20)
+    # on; asked for 21, nothing is measured. even_lean's fit (4 edges of 5 samples) likewise.
+    normal = np.array([[1.0, 0.0]] * 10 + [[0.0, 1.0]] * 10)
+    offset = np.array([0.25] * 10 + [-0.125] * 10)
+    lean = _axis_bands([0, 0], [0, 0], per_edge=5)
+    d, determined = pooled_offset(normal, offset)
+    assert determined.tolist() == [True, True] and d.tolist() == pytest.approx([0.25, -0.125], abs=1e-15)
+    assert even_lean.fit(*lean, 2)["edges"] == 4
+    naming(profile_min_samples=20)
+    assert pooled_offset(normal, offset)[1].tolist() == [True, True] and even_lean.fit(*lean, 2) is not None
+    naming(profile_min_samples=21)
+    d, determined = pooled_offset(normal, offset)
+    assert determined.tolist() == [False, False] and d.tolist() == [0.0, 0.0]
+    assert even_lean.fit(*lean, 2) is None
