@@ -1,5 +1,5 @@
 """Each naming threshold of oracles.tolerances.NamingThresholds that was a module constant of the diagnosis
-(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults) or of the line
+(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults, depth_pixels) or of the line
 measures (even_lean, line_ends, coverage_pixels, line_profile) decides a name or which limits hold: on a hand-made input the name
 flips when the threshold is moved across the value measured on that input, both sides asserted.
 
@@ -22,15 +22,17 @@ from wirecheck.core.camera import look_at
 from wirecheck.core.projector.raster import line_pixels
 from wirecheck.oracles.diagnosis import rule_read
 from wirecheck.oracles.diagnosis.clip_planes import clip_fault
+from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
+from wirecheck.oracles.diagnosis.depth_pixels import UNDECIDED_FACE
 from wirecheck.oracles.diagnosis.diagnose import diagnose, diagnose_lines, rounded_constants, scale_faults
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
 from wirecheck.oracles.diagnosis.image_visibility import set_difference
 from wirecheck.oracles.diagnosis.unproject_faults import name_unproject_faults
 from wirecheck.oracles.judge import coverage_pixels, even_lean
 from wirecheck.oracles.judge.free_ends import measure_ends
+from wirecheck.oracles.judge.line_ends import end_attribution
 from wirecheck.oracles.judge.line_profile import pooled_offset
 from wirecheck.oracles.judge.line_style import measure
-from wirecheck.oracles.judge.line_ends import end_attribution
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
 
@@ -477,3 +479,58 @@ def test_profile_min_samples_decides_whether_the_geometry_is_measured(naming):
     d, determined = pooled_offset(normal, offset)
     assert determined.tolist() == [False, False] and d.tolist() == [0.0, 0.0]
     assert even_lean.fit(*lean, 2) is None
+
+
+# ---------------------------------------------------------------- a depth map's pixel maps (depth_pixels, depth_faults)
+
+DEPTH_CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=64, height=48)
+
+
+def _mirrored_plane(rows, cols, undecided_cols=0, extra=()):
+    """A plane's depth map over ``rows`` x ``cols`` (inclusive; face 0, its first ``undecided_cols`` columns
+    UNDECIDED_FACE) and the candidate: its rows read back bottom first (mirror_vertical), plus a surface pixel
+    of depth 4 at each ``extra`` (x, y). ``1 / depth = 0.2 + 0.001 x + 0.002 y`` is affine in the pixel (a
+    plane under perspective): the mirror lands on whole pixels, so it fits with no residual, and no value
+    model (scale, offset, range, reversed, encoding, precision) nor the fitted offset or scale draws the
+    flipped slope."""
+    yy, xx = np.mgrid[0:48, 0:64].astype(np.float64)
+    (r0, r1), (c0, c1) = rows, cols
+    ref, faces = np.full((48, 64), np.nan), np.full((48, 64), -1)
+    ref[r0 : r1 + 1, c0 : c1 + 1] = 1.0 / (0.2 + 0.001 * xx + 0.002 * yy)[r0 : r1 + 1, c0 : c1 + 1]
+    faces[r0 : r1 + 1, c0 : c1 + 1] = 0
+    faces[r0 : r1 + 1, c0 : c0 + undecided_cols] = UNDECIDED_FACE
+    cand = ref[::-1].copy()
+    for x, y in extra:
+        cand[y, x] = 4.0
+    return cand, ref, faces
+
+
+def _depth_names(cand, ref, faces):
+    return name_depth_faults(cand, ref, 1e-6, DEPTH_CAM, faces=faces).names
+
+
+def test_depth_outside_max(naming):
+    # an 18 x 22 plane (396 px, rows 12-29 over rows 18-35 mirrored: they overlap) and 4 stray candidate pixels in
+    # the top right corner, whose mirrors (rows 45-46) have four empty neighbours: 4 of 400 surface pixels land
+    # on nothing, 0.01, at most depth_outside_max (0.01): mirror_vertical; just under it the map is not tried
+    plane = _mirrored_plane((12, 29), (10, 31), extra=[(60, 1), (61, 1), (62, 1), (60, 2)])
+    assert np.count_nonzero(np.isfinite(plane[0])) == 400
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_outside_max=0.01)
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_outside_max=math.nextafter(0.01, DOWN))
+    assert _depth_names(*plane) == ("unexplained",)
+
+
+def test_depth_interior_min(naming):
+    # a 21 x 40 plane (840 px, rows 13-33, columns 12-51) whose first 18 columns show a surface of an undecided
+    # face: a candidate pixel lands inside one face where its four neighbours are face 0, columns 30-50 and
+    # mirrored rows 13-32, 21 x 20 = 420 of 840, exactly depth_interior_min (0.5): mirror_vertical; just above
+    # it the map is not tried
+    plane = _mirrored_plane((13, 33), (12, 51), undecided_cols=18)
+    assert np.count_nonzero(np.isfinite(plane[0])) == 840
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_interior_min=0.5)
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_interior_min=math.nextafter(0.5, UP))
+    assert _depth_names(*plane) == ("unexplained",)
