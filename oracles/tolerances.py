@@ -619,10 +619,11 @@ class NamingThresholds:
     its reason: read by oracles.judge.decide and oracles.judge.name_faults (the frames path), by the image
     diagnosis (oracles.diagnosis.image_diagnose, image_naming, image_visibility, rule_read) and by the vertex
     diagnosis (oracles.diagnosis.diagnose, clip_planes), the unprojector's (unproject_faults) and the
-    line measures (oracles.judge.even_lean, line_ends, coverage_pixels, line_profile), and by the depth
-    maps' pixel maps (oracles.diagnosis.depth_faults). They were module constants of line_style, free_ends,
-    f1_radius, dim_lines, image_visibility, image_diagnose, rule_read, diagnose, clip_planes, unproject_faults,
-    even_lean, line_ends, coverage_pixels, line_profile and depth_pixels; their values are unchanged.
+    line measures (oracles.judge.even_lean, line_ends, coverage_pixels, line_profile), by the depth maps'
+    pixel maps (oracles.diagnosis.depth_faults) and the filled frames' silhouettes (silhouette_faults). They were
+    module constants of line_style, free_ends, f1_radius, dim_lines, image_visibility, image_diagnose, rule_read,
+    diagnose, clip_planes, unproject_faults, even_lean, line_ends, coverage_pixels, line_profile, depth_pixels and
+    silhouette_faults; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule

@@ -1,11 +1,13 @@
 """Each naming threshold of oracles.tolerances.NamingThresholds that was a module constant of the diagnosis
-(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults, depth_pixels) or of the line
-measures (even_lean, line_ends, coverage_pixels, line_profile) decides a name or which limits hold: on a hand-made input the name
-flips when the threshold is moved across the value measured on that input, both sides asserted.
+(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults, depth_pixels,
+silhouette_faults) or of the line measures (even_lean, line_ends, coverage_pixels, line_profile) decides a
+name or which limits hold: on a hand-made input the name flips when the threshold is moved across the value
+measured on that input, both sides asserted.
 
 The record is moved with dataclasses.replace and put where the diagnosis reads it (each module's ``NAMING``,
 read at call time). The measured values are computed here by hand (numpy on the hand-made points) or read
-from the diagnosis' own output on the unmoved record, and each moved threshold is placed on either side.
+from the diagnosis' own output on the unmoved record (silhouette_polish_below's: with polishing off), and
+each moved threshold is placed on either side.
 The verdict thresholds of Tolerances have theirs beside their fields' other tests
 (tests/test_decide_steps.py: ``oracle_limit_px``; tests/test_line_rule.py: offset, scale, rule offset, ends).
 """
@@ -27,12 +29,14 @@ from wirecheck.oracles.diagnosis.depth_pixels import UNDECIDED_FACE
 from wirecheck.oracles.diagnosis.diagnose import diagnose, diagnose_lines, rounded_constants, scale_faults
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
 from wirecheck.oracles.diagnosis.image_visibility import set_difference
+from wirecheck.oracles.diagnosis.silhouette_faults import SilhouetteFrame, name_silhouette_faults
 from wirecheck.oracles.diagnosis.unproject_faults import name_unproject_faults
 from wirecheck.oracles.judge import coverage_pixels, even_lean
 from wirecheck.oracles.judge.free_ends import measure_ends
 from wirecheck.oracles.judge.line_ends import end_attribution
 from wirecheck.oracles.judge.line_profile import pooled_offset
 from wirecheck.oracles.judge.line_style import measure
+from wirecheck.oracles.references.fill_rule import silhouette
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
 
@@ -534,3 +538,75 @@ def test_depth_interior_min(naming):
     assert _depth_names(*plane) == ("mirror_vertical",)
     naming(depth_interior_min=math.nextafter(0.5, UP))
     assert _depth_names(*plane) == ("unexplained",)
+
+
+# ---------------------------------------------------------------- a filled frame's silhouette (silhouette_faults)
+
+SIL_CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=96, height=72)
+
+
+def _shifted_silhouette(corners_px, holes=(), strays=()):
+    """One face with its corners at ``corners_px`` (pixels, on the plane z = 0 five units in front of SIL_CAM), its
+    reference silhouette (the fill rule's ``inside``, ``ties``), and a candidate: the reference one column to
+    the right (a pixel offset of exactly 1 px: the fill rule is the same under a whole-pixel move), with the
+    pixels ``holes`` (x, y) left out and ``strays`` added. ``(frame, inside)``."""
+    k = np.asarray(SIL_CAM.K, dtype=np.float64)
+    px = np.asarray(corners_px, dtype=np.float64)
+    p_world = np.column_stack(
+        [(px[:, 0] - k[0, 2]) * 5.0 / k[0, 0], -(px[:, 1] - k[1, 2]) * 5.0 / k[1, 1], np.zeros(len(px))]
+    )
+    faces = (tuple(range(len(px))),)
+    inside, ties, _ = silhouette(p_world, faces, SIL_CAM, (SIL_CAM.height, SIL_CAM.width))
+    cand = np.roll(inside, 1, axis=1)
+    for x, y in holes:
+        cand[y, x] = False
+    for x, y in strays:
+        cand[y, x] = True
+    return SilhouetteFrame(cand, inside, ties, SIL_CAM, p_world, faces), inside
+
+
+def test_silhouette_allowance(naming):
+    # a 30 x 20 rectangle between pixel-centre midpoints (x 20.5-50.5, y 20.5-40.5: columns 21-50, rows 21-40, no
+    # tie), moved 1 px right, with 4 of its inner pixels left out: 2 x 30 + 2 x 20 - 4 = 96 boundary pixels, and
+    # the offset (its edges half a pixel from any centre, so the moments' small bias flips none) misses the 4
+    # holes alone: 4 / 96 = 1/24 <= silhouette_allowance (0.05): pixel_offset; just under 1/24, unexplained
+    frame, inside = _shifted_silhouette(
+        [(20.5, 20.5), (50.5, 20.5), (50.5, 40.5), (20.5, 40.5)], holes=[(30, 30), (31, 30), (30, 31), (31, 31)]
+    )
+    hand = np.zeros_like(inside)
+    hand[21:41, 21:51] = True
+    assert np.array_equal(inside, hand) and not frame.ties.any()
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "pixel_offset" and (f.params["misses"], f.params["boundary_px"]) == (4, 96)
+    naming(silhouette_allowance=4 / 96)
+    assert [f.name for f in name_silhouette_faults([frame])] == ["pixel_offset"]
+    naming(silhouette_allowance=math.nextafter(4 / 96, DOWN))
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "unexplained" and f.params["best"] == "pixel_offset"
+
+
+def test_silhouette_polish_below(naming):
+    # a triangle with slanted edges, moved 1 px right, and one stray pixel in the image's far corner: the stray
+    # pulls the moments' offset off 1 px, so the moments' fit misses the stray and the decided centres within
+    # that bias of the slanted edges (measured below, polishing off: more than an allowance); polished on its
+    # misses the offset misses the stray alone. Polished from silhouette_polish_below x silhouette_allowance x
+    # the boundary pixels up to those misses: pixel_offset; with the bound just under them, unexplained
+    frame, _ = _shifted_silhouette([(20.3, 15.2), (70.9, 25.7), (33.1, 60.4)], strays=[(90, 70)])
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "pixel_offset" and f.params["misses"] == 1
+    boundary = f.params["boundary_px"]
+    naming(silhouette_polish_below=0.0)
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "unexplained" and f.params["boundary_px"] == boundary
+    moments_misses = f.params["fit_ratios"]["pixel_offset"] * boundary  # the moments' fit, not polished
+    assert 1 < moments_misses / (NAMING.silhouette_allowance * boundary) < NAMING.silhouette_polish_below
+    # the least float bound whose allowance product (bound x allowance x boundary pixels) reaches those misses
+    at = moments_misses / (NAMING.silhouette_allowance * boundary)
+    while at * NAMING.silhouette_allowance * boundary < moments_misses:
+        at = math.nextafter(at, UP)
+    while math.nextafter(at, DOWN) * NAMING.silhouette_allowance * boundary >= moments_misses:
+        at = math.nextafter(at, DOWN)
+    naming(silhouette_polish_below=at)
+    assert [f.name for f in name_silhouette_faults([frame])] == ["pixel_offset"]
+    naming(silhouette_polish_below=math.nextafter(at, DOWN))
+    assert [f.name for f in name_silhouette_faults([frame])] == ["unexplained"]
