@@ -35,7 +35,7 @@ from wirecheck.oracles.judge import coverage_pixels, even_lean
 from wirecheck.oracles.judge.free_ends import measure_ends
 from wirecheck.oracles.judge.line_ends import end_attribution
 from wirecheck.oracles.judge.line_profile import pooled_offset
-from wirecheck.oracles.judge.line_style import measure
+from wirecheck.oracles.judge.line_style import fit_lines, measure
 from wirecheck.oracles.references.fill_rule import silhouette
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
@@ -468,21 +468,29 @@ def test_profile_min_mass_decides_a_sample_and_a_free_end(naming):
 
 
 def test_profile_min_samples_decides_whether_the_geometry_is_measured(naming):
-    # 20 samples, 10 of vertical lines (normal +x) offset 0.25 and 10 of horizontal ones (normal +y) offset
-    # -0.125: the pooled offset is (0.25, -0.125) exactly, both axes determined, from profile_min_samples (20)
-    # on; asked for 21, nothing is measured. even_lean's fit (4 edges of 5 samples) likewise.
+    # 20 samples, 10 of two vertical lines (normal +x, at x = -50 and 50) offset 0.25 and 10 of two horizontal
+    # ones (normal +y, at y = -30 and 30) offset -0.125: the pooled offset is (0.25, -0.125) exactly, both axes
+    # determined, and the affine fit (lines of two places each way fix its six numbers) the same offset with no
+    # warp, from profile_min_samples (20) on; asked for 21, nothing is measured. even_lean's fit (4 edges of 5
+    # samples) likewise.
     normal = np.array([[1.0, 0.0]] * 10 + [[0.0, 1.0]] * 10)
     offset = np.array([0.25] * 10 + [-0.125] * 10)
+    along = np.linspace(-40.0, 40.0, 10)
+    across = np.tile([-1.0, 1.0], 5)
+    point = np.concatenate([np.c_[50.0 * across, along], np.c_[1.5 * along, 30.0 * across]])
     lean = _axis_bands([0, 0], [0, 0], per_edge=5)
     d, determined = pooled_offset(normal, offset)
     assert determined.tolist() == [True, True] and d.tolist() == pytest.approx([0.25, -0.125], abs=1e-15)
+    d, m = fit_lines(normal, offset, point, np.zeros(2))
+    assert d.tolist() == pytest.approx([0.25, -0.125], abs=1e-12) and np.abs(m).max() < 1e-12
     assert even_lean.fit(*lean, 2)["edges"] == 4
     naming(profile_min_samples=20)
     assert pooled_offset(normal, offset)[1].tolist() == [True, True] and even_lean.fit(*lean, 2) is not None
+    assert fit_lines(normal, offset, point, np.zeros(2)) is not None
     naming(profile_min_samples=21)
     d, determined = pooled_offset(normal, offset)
     assert determined.tolist() == [False, False] and d.tolist() == [0.0, 0.0]
-    assert even_lean.fit(*lean, 2) is None
+    assert even_lean.fit(*lean, 2) is None and fit_lines(normal, offset, point, np.zeros(2)) is None
 
 
 # ---------------------------------------------------------------- a depth map's pixel maps (depth_pixels, depth_faults)
