@@ -619,9 +619,11 @@ class NamingThresholds:
     its reason: read by oracles.judge.decide and oracles.judge.name_faults (the frames path), by the image
     diagnosis (oracles.diagnosis.image_diagnose, image_naming, image_visibility, rule_read) and by the vertex
     diagnosis (oracles.diagnosis.diagnose, clip_planes), the unprojector's (unproject_faults) and the
-    line measures (oracles.judge.even_lean, line_ends, coverage_pixels). They were module constants of
-    line_style, free_ends, f1_radius, dim_lines, image_visibility, image_diagnose, rule_read, diagnose,
-    clip_planes, unproject_faults, even_lean, line_ends and coverage_pixels; their values are unchanged.
+    line measures (oracles.judge.even_lean, line_ends, coverage_pixels, line_profile), by the depth maps'
+    pixel maps (oracles.diagnosis.depth_faults) and the filled frames' silhouettes (silhouette_faults). They were
+    module constants of line_style, free_ends, f1_radius, dim_lines, image_visibility, image_diagnose, rule_read,
+    diagnose, clip_planes, unproject_faults, even_lean, line_ends, coverage_pixels, line_profile, depth_pixels and
+    silhouette_faults; their values are unchanged.
     """
 
     #: A pixel counts as drawn from this coverage (luminance x alpha / 255) up: docs/frames.md's rule
@@ -775,6 +777,52 @@ class NamingThresholds:
     #: holding at least half of it). Thinner lines (coverage under a quarter where they fall between two
     #: pixels) cannot be read; a 1-px line between two pixels (127 | 127) is read.
     ridge_min_width_px: float = 0.5
+
+    # ---- a line's profile across it (oracles.judge.line_profile: line_style, even_lean, free_ends)
+
+    #: A window across a line is a sample of it (line_style.measure), and a free end's inner window holds a
+    #: line (free_ends), from this much coverage on (in units of a fully covered pixel): half a pixel's worth.
+    #: A drawn line of any rule or width puts at least one pixel's coverage in each window across it (a 1-px
+    #: line one pixel per step of its major axis), so a line that is there is a sample; a missing line is no
+    #: sample (F1 fails on it), and a stray half-covered pixel's worth is not read as a line.
+    profile_min_mass: float = 0.5
+    #: A case's line geometry (the pooled offset, the fitted warp, the width across free lines, the lean of
+    #: even-width lines) is measured only from this many samples (line_profile.pooled_offset,
+    #: line_style.fit_lines, even_lean.fit): the fit has up to six numbers (an offset, a 2 x 2 warp), so 20
+    #: leaves over three samples a number; fewer is too little free line, and the geometry is not measured
+    #: (the pixel criteria still judge the case).
+    profile_min_samples: int = 20
+
+    # ---- a depth map's pixel maps (oracles.diagnosis.depth_pixels, read by depth_faults)
+
+    #: A pixel map (flip, offset, scale) keeps the surfaces together while at most this share of the
+    #: candidate's surface pixels lands where the reference shows nothing (all four neighbours empty).
+    #: Measured, each pixel mistake under its own map: at most 0.32 % (prism, near_plane: the near plane's clip
+    #: line); 1 % leaves 3x. This share does not tell the maps apart (a fitted scale can shrink any surface
+    #: inside another): the residuals do.
+    depth_outside_max: float = 0.01
+    #: ... and at least this share of them lands inside one face, for the residuals to speak for the map (a
+    #: few-pixel sliver cannot name a fault): half (measured under the right map: 95 % at least).
+    depth_interior_min: float = 0.5
+
+    # ---- a filled frame's silhouette (oracles.diagnosis.silhouette_faults)
+
+    #: A camera mistake's model explains the frames when its misses (decided pixels where its silhouette and
+    #: the candidate's differ) are at most this share of the reference's boundary pixels. A fitted parameter
+    #: off by ``e`` px (of its move at the silhouette's edge) flips the decided centres within ``e`` of an edge:
+    #: ~``e`` per boundary pixel (one centre per pixel of edge length, each within ``e`` with probability
+    #: ``e``). The polished fit ends on steps of 0.01 px, so 0.05 leaves 5x; the smallest mistake of the
+    #: family, half a pixel, misses ~0.5 per boundary pixel under the identity. Measured
+    #: (tests/test_silhouette_faults.py, 3 scenes x 7 cases): the named model's worst ratio 0.0063, the
+    #: nearest model of another name 0.285 (a scale per axis about ``c`` imitating the pyramid's half-pixel
+    #: shift at wide_fov, where it is small).
+    silhouette_allowance: float = 0.05
+    #: A fitted model's parameters are polished on its misses (coordinate descent, down to 0.01 px steps)
+    #: when the moments' fit misses at most this many allowances (``silhouette_allowance`` x the boundary
+    #: pixels): near enough to explain once polished (measured: offsets of silhouettes cut by the image's
+    #: border, whose moments are biased, miss up to 1.4 allowances before), while a wrong model (>= 5.7
+    #: allowances measured) costs no further pass.
+    silhouette_polish_below: float = 2.0
 
 
 #: The one naming-thresholds record (oracles.judge.decide, oracles.judge.name_faults, the diagnosis).

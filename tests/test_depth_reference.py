@@ -103,7 +103,7 @@ def test_wireframe_scene_has_no_depth(oracles):
 def test_a_flipped_map_lands_on_undecided_pixels_not_on_nothing(oracles):
     # prism / near_plane, frame 2 of 3 of the default spin, rows flipped: 2.2 % of the flipped surface lands
     # on pixels the reference leaves undecided (beside the near plane's clip line: a surface is there, which
-    # one is a rounding decision). Counted as landing on nothing, that passed MAX_OUTSIDE (1 %) and no pixel
+    # one is a rounding decision). Counted as landing on nothing, that passed NAMING.depth_outside_max (1 %) and no pixel
     # model was fitted (unexplained); landing there is neither inside nor outside, and the map is
     # mirror_vertical
     scene = load_scene("prism")

@@ -15,6 +15,7 @@ from wirecheck.core.camera import look_at
 from wirecheck.core.projector.raster import line_pixels
 from wirecheck.oracles.diagnosis import image_diagnose, image_naming
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
+from wirecheck.oracles.diagnosis.model_lines import model_images
 from wirecheck.oracles.tolerances import OFFSET_TOL_PX
 
 CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=640, height=480)
@@ -81,6 +82,17 @@ def test_the_aliased_rule_is_read_from_the_pixels():
         got, bias = image_naming.rule_bias([img, img], segs, CAM, eye, one, b, gl_bias)
         assert got == rule
         np.testing.assert_array_equal(bias, b)
+
+
+def test_the_snapped_model_is_the_line_models_rounded_rule_at_half_pixel_ties():
+    # the diagnosis' rounded-ends model breaks an exact half-pixel tie as oracles.line_model's "rounded" rule does:
+    # the nearest pixel floor(minor + 1/2), to +x and +y alike (core's line_pixels_fast breaks x-minor ties to -x).
+    # By hand: (10, 10) -> (11, 12), y-major, 2 steps: at y = 11 the exact x is 10.5: x = 11, so (10, 10),
+    # (11, 11), (11, 12); (20, 30) -> (22, 31), x-major: at x = 21 the exact y is 30.5: y = 31. Ends at
+    # .2 and .4 from a centre round to it. Identity model (p = I, d = 1, no shift).
+    segs = [np.array([[[10.2, 9.6], [11.0, 12.4]], [[20.0, 30.3], [21.6, 31.0]]])]
+    (img,) = model_images(segs, CAM, np.eye(2), np.ones(2), snapped=True)
+    assert sorted(zip(*np.nonzero(img)[::-1])) == [(10, 10), (11, 11), (11, 12), (20, 30), (21, 31), (22, 31)]
 
 
 def test_scale_starts_are_the_convention_mistakes_ratios():

@@ -24,9 +24,9 @@ from wirecheck.oracles.cli import main
 from wirecheck.oracles.diagnosis.image_diagnose import oracle_segments
 from wirecheck.oracles.judge.decide import decide
 from wirecheck.oracles.judge.evidence import CaseEvidence
-from wirecheck.oracles.judge.line_style import MIN_MASS, RULE_OFFSET_MAX_PX, measure, pooled_offset, style_record
+from wirecheck.oracles.judge.line_style import RULE_OFFSET_MAX_PX, measure, pooled_offset, style_record
 from wirecheck.oracles.judge.name_faults import name_faults
-from wirecheck.oracles.tolerances import OFFSET_TOL_PX, Tolerances
+from wirecheck.oracles.tolerances import NAMING, OFFSET_TOL_PX, Tolerances
 
 # oblique views: the lines slant, so every frame shows both offset components
 ARGS = ["--scene", "cube", "--scene", "pyramid", "--cases", "oblique_roll,non_square", "--frames", "6", "--every", "3"]
@@ -245,7 +245,7 @@ def test_measure_recovers_a_known_offset():
     img = _band(np.array([[a, b]]) + 0.3 * n, 200, 120, 0.5, 4) / 255.0
     got = measure(img, np.array([[a, b]]))
     normal, offset, width = got["normal"], got["offset"], got["width"]
-    assert len(offset) > 100 and MIN_MASS < 1.0
+    assert len(offset) > 100 and NAMING.profile_min_mass < 1.0
     assert np.median(offset) == pytest.approx(0.3, abs=0.01)
     assert np.median(width) == pytest.approx(1.0, abs=0.05)
     d, determined = pooled_offset(normal, offset)

@@ -1,11 +1,13 @@
 """Each naming threshold of oracles.tolerances.NamingThresholds that was a module constant of the diagnosis
-(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults) or of the line
-measures (even_lean, line_ends, coverage_pixels) decides a name or which limits hold: on a hand-made input the name
-flips when the threshold is moved across the value measured on that input, both sides asserted.
+(image_diagnose, image_visibility, rule_read, diagnose, clip_planes, unproject_faults, depth_pixels,
+silhouette_faults) or of the line measures (even_lean, line_ends, coverage_pixels, line_profile) decides a
+name or which limits hold: on a hand-made input the name flips when the threshold is moved across the value
+measured on that input, both sides asserted.
 
 The record is moved with dataclasses.replace and put where the diagnosis reads it (each module's ``NAMING``,
 read at call time). The measured values are computed here by hand (numpy on the hand-made points) or read
-from the diagnosis' own output on the unmoved record, and each moved threshold is placed on either side.
+from the diagnosis' own output on the unmoved record (silhouette_polish_below's: with polishing off), and
+each moved threshold is placed on either side.
 The verdict thresholds of Tolerances have theirs beside their fields' other tests
 (tests/test_decide_steps.py: ``oracle_limit_px``; tests/test_line_rule.py: offset, scale, rule offset, ends).
 """
@@ -22,12 +24,19 @@ from wirecheck.core.camera import look_at
 from wirecheck.core.projector.raster import line_pixels
 from wirecheck.oracles.diagnosis import rule_read
 from wirecheck.oracles.diagnosis.clip_planes import clip_fault
+from wirecheck.oracles.diagnosis.depth_faults import name_depth_faults
+from wirecheck.oracles.diagnosis.depth_pixels import UNDECIDED_FACE
 from wirecheck.oracles.diagnosis.diagnose import diagnose, diagnose_lines, rounded_constants, scale_faults
 from wirecheck.oracles.diagnosis.image_diagnose import diagnose_images
 from wirecheck.oracles.diagnosis.image_visibility import set_difference
+from wirecheck.oracles.diagnosis.silhouette_faults import SilhouetteFrame, name_silhouette_faults
 from wirecheck.oracles.diagnosis.unproject_faults import name_unproject_faults
 from wirecheck.oracles.judge import coverage_pixels, even_lean
+from wirecheck.oracles.judge.free_ends import measure_ends
 from wirecheck.oracles.judge.line_ends import end_attribution
+from wirecheck.oracles.judge.line_profile import pooled_offset
+from wirecheck.oracles.judge.line_style import fit_lines, measure
+from wirecheck.oracles.references.fill_rule import silhouette
 from wirecheck.oracles.references.unproject_reference import unproject
 from wirecheck.oracles.tolerances import EPS, NAMING, NamingThresholds, Tolerances
 
@@ -436,3 +445,176 @@ def test_wide_min_px_decides_a_binary_lines_style_when_called(naming):
     assert NAMING.wide_min_px == 1.75 and style.classify()["style"] == "wide"
     naming(wide_min_px=math.nextafter(1.75, UP))
     assert style.classify()["style"] == "aliased"
+
+
+# ---------------------------------------------------------------- a line's profile across it (line_profile)
+
+
+def test_profile_min_mass_decides_a_sample_and_a_free_end(naming):
+    # one horizontal line from (15, 12) to (45, 12), drawn as row 12 at coverage 1/2 (exact in binary): every
+    # window across it (7 rows, 3 each side) holds a mass of 0.5 centred on the line, a sample from
+    # profile_min_mass (0.5) on; its free ends' inner mass (bilinear every 0.5 px across: 1/4 + 1/2 + 1/4,
+    # times the 0.5 px step) is 0.5 too, measured from the same bound on
+    segs = np.array([[[15.0, 12.0], [45.0, 12.0]]])
+    cov = np.zeros((25, 60))
+    cov[12, 15:46] = 0.5
+    got = measure(cov, segs)
+    assert got["found"] == got["windows"] > 0 and np.all(got["mass"] == 0.5) and np.all(got["offset"] == 0.0)
+    assert len(measure_ends(cov, segs)) == 2
+    naming(profile_min_mass=0.5)
+    assert measure(cov, segs)["found"] == got["windows"] and len(measure_ends(cov, segs)) == 2
+    naming(profile_min_mass=math.nextafter(0.5, UP))
+    assert measure(cov, segs)["found"] == 0 and len(measure_ends(cov, segs)) == 0
+
+
+def test_profile_min_samples_decides_whether_the_geometry_is_measured(naming):
+    # 20 samples, 10 of two vertical lines (normal +x, at x = -50 and 50) offset 0.25 and 10 of two horizontal
+    # ones (normal +y, at y = -30 and 30) offset -0.125: the pooled offset is (0.25, -0.125) exactly, both axes
+    # determined, and the affine fit (lines of two places each way fix its six numbers) the same offset with no
+    # warp, from profile_min_samples (20) on; asked for 21, nothing is measured. even_lean's fit (4 edges of 5
+    # samples) likewise.
+    normal = np.array([[1.0, 0.0]] * 10 + [[0.0, 1.0]] * 10)
+    offset = np.array([0.25] * 10 + [-0.125] * 10)
+    along = np.linspace(-40.0, 40.0, 10)
+    across = np.tile([-1.0, 1.0], 5)
+    point = np.concatenate([np.c_[50.0 * across, along], np.c_[1.5 * along, 30.0 * across]])
+    lean = _axis_bands([0, 0], [0, 0], per_edge=5)
+    d, determined = pooled_offset(normal, offset)
+    assert determined.tolist() == [True, True] and d.tolist() == pytest.approx([0.25, -0.125], abs=1e-15)
+    d, m = fit_lines(normal, offset, point, np.zeros(2))
+    assert d.tolist() == pytest.approx([0.25, -0.125], abs=1e-12) and np.abs(m).max() < 1e-12
+    assert even_lean.fit(*lean, 2)["edges"] == 4
+    naming(profile_min_samples=20)
+    assert pooled_offset(normal, offset)[1].tolist() == [True, True] and even_lean.fit(*lean, 2) is not None
+    assert fit_lines(normal, offset, point, np.zeros(2)) is not None
+    naming(profile_min_samples=21)
+    d, determined = pooled_offset(normal, offset)
+    assert determined.tolist() == [False, False] and d.tolist() == [0.0, 0.0]
+    assert even_lean.fit(*lean, 2) is None and fit_lines(normal, offset, point, np.zeros(2)) is None
+
+
+# ---------------------------------------------------------------- a depth map's pixel maps (depth_pixels, depth_faults)
+
+DEPTH_CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=64, height=48)
+
+
+def _mirrored_plane(rows, cols, undecided_cols=0, extra=()):
+    """A plane's depth map over ``rows`` x ``cols`` (inclusive; face 0, its first ``undecided_cols`` columns
+    UNDECIDED_FACE) and the candidate: its rows read back bottom first (mirror_vertical), plus a surface pixel
+    of depth 4 at each ``extra`` (x, y). ``1 / depth = 0.2 + 0.001 x + 0.002 y`` is affine in the pixel (a
+    plane under perspective): the mirror lands on whole pixels, so it fits with no residual, and no value
+    model (scale, offset, range, reversed, encoding, precision) nor the fitted offset or scale draws the
+    flipped slope."""
+    yy, xx = np.mgrid[0:48, 0:64].astype(np.float64)
+    (r0, r1), (c0, c1) = rows, cols
+    ref, faces = np.full((48, 64), np.nan), np.full((48, 64), -1)
+    ref[r0 : r1 + 1, c0 : c1 + 1] = 1.0 / (0.2 + 0.001 * xx + 0.002 * yy)[r0 : r1 + 1, c0 : c1 + 1]
+    faces[r0 : r1 + 1, c0 : c1 + 1] = 0
+    faces[r0 : r1 + 1, c0 : c0 + undecided_cols] = UNDECIDED_FACE
+    cand = ref[::-1].copy()
+    for x, y in extra:
+        cand[y, x] = 4.0
+    return cand, ref, faces
+
+
+def _depth_names(cand, ref, faces):
+    return name_depth_faults(cand, ref, 1e-6, DEPTH_CAM, faces=faces).names
+
+
+def test_depth_outside_max(naming):
+    # an 18 x 22 plane (396 px, rows 12-29 over rows 18-35 mirrored: they overlap) and 4 stray candidate pixels in
+    # the top right corner, whose mirrors (rows 45-46) have four empty neighbours: 4 of 400 surface pixels land
+    # on nothing, 0.01, at most depth_outside_max (0.01): mirror_vertical; just under it the map is not tried
+    plane = _mirrored_plane((12, 29), (10, 31), extra=[(60, 1), (61, 1), (62, 1), (60, 2)])
+    assert np.count_nonzero(np.isfinite(plane[0])) == 400
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_outside_max=0.01)
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_outside_max=math.nextafter(0.01, DOWN))
+    assert _depth_names(*plane) == ("unexplained",)
+
+
+def test_depth_interior_min(naming):
+    # a 21 x 40 plane (840 px, rows 13-33, columns 12-51) whose first 18 columns show a surface of an undecided
+    # face: a candidate pixel lands inside one face where its four neighbours are face 0, columns 30-50 and
+    # mirrored rows 13-32, 21 x 20 = 420 of 840, exactly depth_interior_min (0.5): mirror_vertical; just above
+    # it the map is not tried
+    plane = _mirrored_plane((13, 33), (12, 51), undecided_cols=18)
+    assert np.count_nonzero(np.isfinite(plane[0])) == 840
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_interior_min=0.5)
+    assert _depth_names(*plane) == ("mirror_vertical",)
+    naming(depth_interior_min=math.nextafter(0.5, UP))
+    assert _depth_names(*plane) == ("unexplained",)
+
+
+# ---------------------------------------------------------------- a filled frame's silhouette (silhouette_faults)
+
+SIL_CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=96, height=72)
+
+
+def _shifted_silhouette(corners_px, holes=(), strays=()):
+    """One face with its corners at ``corners_px`` (pixels, on the plane z = 0 five units in front of SIL_CAM), its
+    reference silhouette (the fill rule's ``inside``, ``ties``), and a candidate: the reference one column to
+    the right (a pixel offset of exactly 1 px: the fill rule is the same under a whole-pixel move), with the
+    pixels ``holes`` (x, y) left out and ``strays`` added. ``(frame, inside)``."""
+    k = np.asarray(SIL_CAM.K, dtype=np.float64)
+    px = np.asarray(corners_px, dtype=np.float64)
+    p_world = np.column_stack(
+        [(px[:, 0] - k[0, 2]) * 5.0 / k[0, 0], -(px[:, 1] - k[1, 2]) * 5.0 / k[1, 1], np.zeros(len(px))]
+    )
+    faces = (tuple(range(len(px))),)
+    inside, ties, _ = silhouette(p_world, faces, SIL_CAM, (SIL_CAM.height, SIL_CAM.width))
+    cand = np.roll(inside, 1, axis=1)
+    for x, y in holes:
+        cand[y, x] = False
+    for x, y in strays:
+        cand[y, x] = True
+    return SilhouetteFrame(cand, inside, ties, SIL_CAM, p_world, faces), inside
+
+
+def test_silhouette_allowance(naming):
+    # a 30 x 20 rectangle between pixel-centre midpoints (x 20.5-50.5, y 20.5-40.5: columns 21-50, rows 21-40, no
+    # tie), moved 1 px right, with 4 of its inner pixels left out: 2 x 30 + 2 x 20 - 4 = 96 boundary pixels, and
+    # the offset (its edges half a pixel from any centre, so the moments' small bias flips none) misses the 4
+    # holes alone: 4 / 96 = 1/24 <= silhouette_allowance (0.05): pixel_offset; just under 1/24, unexplained
+    frame, inside = _shifted_silhouette(
+        [(20.5, 20.5), (50.5, 20.5), (50.5, 40.5), (20.5, 40.5)], holes=[(30, 30), (31, 30), (30, 31), (31, 31)]
+    )
+    hand = np.zeros_like(inside)
+    hand[21:41, 21:51] = True
+    assert np.array_equal(inside, hand) and not frame.ties.any()
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "pixel_offset" and (f.params["misses"], f.params["boundary_px"]) == (4, 96)
+    naming(silhouette_allowance=4 / 96)
+    assert [f.name for f in name_silhouette_faults([frame])] == ["pixel_offset"]
+    naming(silhouette_allowance=math.nextafter(4 / 96, DOWN))
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "unexplained" and f.params["best"] == "pixel_offset"
+
+
+def test_silhouette_polish_below(naming):
+    # a triangle with slanted edges, moved 1 px right, and one stray pixel in the image's far corner: the stray
+    # pulls the moments' offset off 1 px, so the moments' fit misses the stray and the decided centres within
+    # that bias of the slanted edges (measured below, polishing off: more than an allowance); polished on its
+    # misses the offset misses the stray alone. Polished from silhouette_polish_below x silhouette_allowance x
+    # the boundary pixels up to those misses: pixel_offset; with the bound just under them, unexplained
+    frame, _ = _shifted_silhouette([(20.3, 15.2), (70.9, 25.7), (33.1, 60.4)], strays=[(90, 70)])
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "pixel_offset" and f.params["misses"] == 1
+    boundary = f.params["boundary_px"]
+    naming(silhouette_polish_below=0.0)
+    (f,) = name_silhouette_faults([frame])
+    assert f.name == "unexplained" and f.params["boundary_px"] == boundary
+    moments_misses = f.params["fit_ratios"]["pixel_offset"] * boundary  # the moments' fit, not polished
+    assert 1 < moments_misses / (NAMING.silhouette_allowance * boundary) < NAMING.silhouette_polish_below
+    # the least float bound whose allowance product (bound x allowance x boundary pixels) reaches those misses
+    at = moments_misses / (NAMING.silhouette_allowance * boundary)
+    while at * NAMING.silhouette_allowance * boundary < moments_misses:
+        at = math.nextafter(at, UP)
+    while math.nextafter(at, DOWN) * NAMING.silhouette_allowance * boundary >= moments_misses:
+        at = math.nextafter(at, DOWN)
+    naming(silhouette_polish_below=at)
+    assert [f.name for f in name_silhouette_faults([frame])] == ["pixel_offset"]
+    naming(silhouette_polish_below=math.nextafter(at, DOWN))
+    assert [f.name for f in name_silhouette_faults([frame])] == ["unexplained"]

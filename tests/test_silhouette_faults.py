@@ -31,9 +31,7 @@ from wirecheck.core.projector import pipeline
 from wirecheck.core.scene.files import load_scene
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.cases import case_motion, cases_for
-from wirecheck.oracles.diagnosis import silhouette_faults
 from wirecheck.oracles.diagnosis.silhouette_faults import (
-    ALLOWANCE,
     SILHOUETTE_FAULTS,
     SilhouetteFrame,
     name_silhouette_faults,
@@ -41,6 +39,7 @@ from wirecheck.oracles.diagnosis.silhouette_faults import (
 from wirecheck.oracles.faults import CATALOGUE, Fault
 from wirecheck.oracles.references import faces as oface
 from wirecheck.oracles.references.fill_rule import silhouette
+from wirecheck.oracles.tolerances import NAMING
 
 SCENES = ("cube", "prism", "pyramid")
 MOTION = Motion(turns=(1.0, 1.0, 0.0))
@@ -215,11 +214,11 @@ def test_allowance_has_room(results, summary_section):
     summary_section(
         "silhouette fault allowance",
         f"named model's worst miss ratio {worst_named:.4f}, nearest "
-        f"other model's {nearest_other[0]:.3f} {nearest_other[1]}; allowance {ALLOWANCE}",
+        f"other model's {nearest_other[0]:.3f} {nearest_other[1]}; allowance {NAMING.silhouette_allowance}",
     )
-    assert worst_named <= 0.5 * ALLOWANCE, worst_named  # measured 0.0063
+    assert worst_named <= 0.5 * NAMING.silhouette_allowance, worst_named  # measured 0.0063
     # measured 0.285 (pyramid wide_fov, a half-pixel shift against a scale per axis): 5.7 allowances
-    assert nearest_other[0] >= 4 * ALLOWANCE, nearest_other
+    assert nearest_other[0] >= 4 * NAMING.silhouette_allowance, nearest_other
 
 
 def test_a_correct_frame_names_nothing_and_a_blank_one_is_unexplained():
@@ -262,7 +261,7 @@ def test_a_rolled_camera_is_unexplained_with_what_was_measured():
     cand = core_covered(pr_vertices, scene, rolled, pose)
     (fault,) = name_silhouette_faults([SilhouetteFrame(cand, inside, ties, cam, p_world, scene.faces)])
     assert fault.name == "unexplained" and fault.source == "silhouettes"
-    assert min(fault.params["fit_ratios"].values()) > ALLOWANCE
+    assert min(fault.params["fit_ratios"].values()) > NAMING.silhouette_allowance
     assert set(fault.params["fit_ratios"]) == {
         "none",
         "depth_flip",
@@ -298,7 +297,7 @@ def test_names_are_the_catalogues():
     for name in ("mirror_vertical", "pixel_offset", "fov_mismatch", "ambiguous", "unexplained"):
         assert "silhouettes" in CATALOGUE[name].sources
     assert "glReadPixels" in Fault("mirror_vertical", {}, "silhouettes").hint
-    assert silhouette_faults.ALLOWANCE < 0.5  # below a half-pixel shift's ~0.5 per boundary px
+    assert NAMING.silhouette_allowance < 0.5  # below a half-pixel shift's ~0.5 per boundary px
     assert set(SILHOUETTE_FAULTS) == {
         "depth_flip",
         "axis_swap",

@@ -41,7 +41,8 @@ import numpy as np
 
 from .. import faults as catalogue
 from ..faults import Fault
-from .depth_pixels import MAX_OUTSIDE, MIN_INTERIOR, pixel_models, sample
+from ..tolerances import NAMING
+from .depth_pixels import pixel_models, sample
 
 __all__ = ["DEPTH_FAULTS", "DepthDiagnosis", "DepthLimits", "LIMITS", "name_depth_faults", "ray_lengths"]
 
@@ -201,7 +202,7 @@ def _pixel_fits(cand, ref, faces, bound, enc, camera) -> list:
     for name, n_params, params, transform in pixel_models(cand, ref, faces, camera):
         q = transform(pts)
         depth, inside, outside, _grad = sample(ref, faces, camera, q)
-        if outside.mean() > MAX_OUTSIDE or inside.mean() < MIN_INTERIOR:
+        if outside.mean() > NAMING.depth_outside_max or inside.mean() < NAMING.depth_interior_min:
             continue
         qi = np.clip(np.rint(q[inside]).astype(np.int64), 0, [w - 1, h - 1])
         allow = bound[qi[:, 1], qi[:, 0]] + enc[pts[inside, 1].astype(int), pts[inside, 0].astype(int)]

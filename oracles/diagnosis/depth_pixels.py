@@ -15,8 +15,9 @@ orthographic projection) between the four pixel centres around ``T(p)``, used on
 four show the same face (``faces``: one id per planar face, -1 where none, :data:`UNDECIDED_FACE`
 where which face shows is a rounding decision): there the
 interpolation is exact. A model explains the map when the candidate's surface lands on the
-reference's (at most :data:`MAX_OUTSIDE` of its pixels where all four neighbours show no surface),
-at least :data:`MIN_INTERIOR` of them land inside one face, and every one of those is within
+reference's (at most ``NAMING.depth_outside_max`` of its pixels where all four neighbours show no
+surface), at least ``NAMING.depth_interior_min`` of them land inside one face (oracles.tolerances: both
+read by depth_faults when it is called), and every one of those is within
 the slack of its allowance (oracles.diagnosis.depth_faults).
 """
 
@@ -24,19 +25,11 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MAX_OUTSIDE", "MIN_INTERIOR", "UNDECIDED_FACE", "pixel_models"]
+__all__ = ["UNDECIDED_FACE", "pixel_models"]
 
 #: The face id of a pixel that shows a surface whose face is a rounding decision (beside an occlusion edge or a
 #: clip plane's line): neither sampled (not inside one face) nor empty (not outside).
 UNDECIDED_FACE = -2
-#: Share of the candidate's surface pixels that may land where the reference shows nothing
-#: (all four neighbours empty). Measured, each pixel mistake under its own map: at most 0.32 %
-#: (prism, near_plane: the near plane's clip line); 1 % leaves 3x. This share does not tell the
-#: maps apart (a fitted scale can shrink any surface inside another): the residuals do.
-MAX_OUTSIDE = 0.01
-#: Share that must land inside one face for the residuals to speak for the map (a few-pixel
-#: sliver cannot name a fault): half (measured under the right map: 95 % at least).
-MIN_INTERIOR = 0.5
 #: Gauss-Newton steps of the fitted maps (converged to float rounding in 3 on the bundled cases).
 STEPS = 6
 #: Pixels a fit uses at most (every k-th of the candidate's surface): 4,000 fix two parameters

@@ -9,7 +9,6 @@ Its own module because the naming (oracles.diagnosis.image_naming) and the rule 
 from __future__ import annotations
 
 import numpy as np
-from wirecheck.core.projector import raster
 from wirecheck.core.projector.clipping import clip_to_image
 
 from .. import line_model
@@ -19,9 +18,9 @@ from .registration import MAX_POINTS_PER_CASE, MAX_POINTS_PER_FRAME, Registratio
 def model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -> list[np.ndarray]:
     """The fitted model's lines (``u -> d (p u)`` about the principal point, then ``+ shift``) drawn aliased.
 
-    ``snapped``: by the rule that rounds each end to a pixel centre first (core's
-    ``line_pixels_fast``: Bresenham's, OpenCV's LINE_8, Pillow's 1-px line); otherwise by
-    core's exact rule (integer pixel centres, GL's rule on these lines).
+    ``snapped``: by the rule that rounds each end to a pixel centre first (oracles.line_model's
+    ``"rounded"`` rule: Bresenham's, OpenCV's LINE_8, Pillow's 1-px line); otherwise by GL's
+    (oracles.line_model's ``"gl"``). Both drawn on the lines clipped to the image.
     """
     centre = np.array(camera.principal_point)
     shift = np.zeros(2) if shift is None else np.asarray(shift, dtype=np.float64)
@@ -31,9 +30,9 @@ def model_images(oracle_segs, camera, p, d, shift=None, snapped: bool = False) -
         segs = ((segs - centre) @ p.T) * d + centre + shift  # the model's lines (identity: the oracle's)
         _, q0, q1 = clip_to_image(segs[:, 0], segs[:, 1], camera.width, camera.height)
         shape = (camera.height, camera.width)
-        if snapped:
+        if snapped:  # the line model's rounded ends (its drawing alone: the ties are not needed here)
             img = np.zeros(shape, bool)
-            rr, cc = raster.line_pixels_fast(q0, q1, camera.width, camera.height)
+            rr, cc = line_model.rounded_pixels(np.stack([q0, q1], axis=1), shape)
             img[rr, cc] = True
         else:  # GL's rule: the line model's drawing (oracles.line_model)
             img, _ = line_model.expected(np.stack([q0, q1], axis=1), shape, "gl")

@@ -33,7 +33,8 @@ Counted over all frames together (the parameters are shared: one camera mistake)
 *misses* are the decided pixels (not its ties) where its silhouette and the candidate differ,
 and its ``miss_ratio`` is misses over the reference's boundary pixels (decided covered pixels
 with an uncovered 4-neighbour in the image: the silhouette's length in pixels). A model **explains** the
-frames when ``miss_ratio <= ALLOWANCE`` (derivation at :data:`ALLOWANCE`). Among the models that
+frames when ``miss_ratio <= NAMING.silhouette_allowance`` (oracles.tolerances: its derivation; read when
+called, as ``silhouette_polish_below``, which fits are polished). Among the models that
 explain, the fewest parameters win, then the fewest misses; the identity with no miss names
 nothing (a correct frame, or a mistake that moves no decided pixel: a symmetric silhouette under
 its mirror), with a few misses within the allowance ``unexplained`` (in place: no camera mistake
@@ -56,26 +57,14 @@ import numpy as np
 
 from ..faults import Fault, hint_text
 from ..references.fill_rule import coverage, open_edges, project_clipped
+from ..tolerances import NAMING
 from .image_diagnose import flipped_camera
 
-__all__ = ["ALLOWANCE", "STEPS", "SILHOUETTE_FAULTS", "SilhouetteFrame", "name_silhouette_faults"]
+__all__ = ["STEPS", "SILHOUETTE_FAULTS", "SilhouetteFrame", "name_silhouette_faults"]
 
-#: A model explains the frames when its misses are at most this share of the silhouette's
-#: boundary pixels. A fitted parameter off by ``e`` px (of its move at the silhouette's edge)
-#: flips the decided centres within ``e`` of an edge: ~``e`` per boundary pixel (one centre per
-#: pixel of edge length, each within ``e`` with probability ``e``). The polished fit ends on steps
-#: of 0.01 px, so 0.05 leaves 5x; the smallest mistake of the family, half a pixel, misses ~0.5 per
-#: boundary pixel under the identity. Measured (tests/test_silhouette_faults.py, 3 scenes x 7
-#: cases): the named model's worst ratio 0.0063, the nearest model of another name 0.285 (a
-#: scale per axis about ``c`` imitating the pyramid's half-pixel shift at wide_fov, where it is small).
-ALLOWANCE = 0.05
 #: Fixed-point steps of the fitted models (the moments' ratio converges linearly; 6 leave the
 #: bundled cases' parameters moving by under 1e-4 px).
 STEPS = 4
-#: A fitted model's parameters are polished on its misses (:func:`_polish`) when the moments' fit misses
-#: at most this many allowances: near enough to explain once polished (measured: the border-cut offsets
-#: miss up to 1.4 allowances before), while a wrong model (>= 5.7 allowances) costs no further pass.
-POLISH_BELOW = 2.0
 
 #: Every name this module gives, the catalogue's order.
 SILHOUETTE_FAULTS = (
@@ -335,20 +324,25 @@ def name_silhouette_faults(frames) -> tuple[Fault, ...]:
         for theta0 in _starts(name, frames[0].camera):
             theta = _fit(preps, name, theta0)
             misses = _misses(preps, name, theta)
-            if misses <= POLISH_BELOW * ALLOWANCE * boundary:
+            if misses <= NAMING.silhouette_polish_below * NAMING.silhouette_allowance * boundary:
                 theta, misses = _polish(preps, name, theta, misses)
             tried.append((name, len(theta0), theta, misses))
             if tried[-1][3] == 0:
                 break
         fits.append(min(tried, key=lambda f: f[3]))
     ratios = {name: misses / boundary for name, _n, _t, misses in fits}
-    explaining = sorted((f for f in fits if ratios[f[0]] <= ALLOWANCE), key=lambda f: (f[1], f[3]))
+    explaining = sorted((f for f in fits if ratios[f[0]] <= NAMING.silhouette_allowance), key=lambda f: (f[1], f[3]))
     if not explaining:
         best = min(fits, key=lambda f: f[3])
         return (
             Fault(
                 "unexplained",
-                {"best": best[0], "fit_ratios": ratios, "boundary_px": boundary, "allowance": ALLOWANCE},
+                {
+                    "best": best[0],
+                    "fit_ratios": ratios,
+                    "boundary_px": boundary,
+                    "allowance": NAMING.silhouette_allowance,
+                },
                 "silhouettes",
             ),
         )

@@ -63,7 +63,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..tolerances import NAMING
-from .line_profile import MIN_SAMPLES, pooled_offset
+from .line_profile import pooled_offset
 
 #: How far (px, along the minor axis) an even band may lean off the exact line: half a pixel.
 LEAN_PX = 0.5
@@ -126,7 +126,7 @@ def fit(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, edge: np.ndar
     samples' offsets less their edge's chosen band's (``d`` plus noise where
     the fit holds; what the affine warp is measured on).
     """
-    if len(offset) < MIN_SAMPLES:
+    if len(offset) < NAMING.profile_min_samples:
         return None
     refs = reference_offsets(normal, point, band_px)
     resid = offset[None] - refs  # (3, M): -1/2, 0, +1/2

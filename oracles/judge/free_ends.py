@@ -14,7 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..segment_geometry import seg_distance
-from .line_profile import GUARD_PX, MIN_MASS, PROFILE_RADIUS_PX
+from ..tolerances import NAMING
+from .line_profile import GUARD_PX, PROFILE_RADIUS_PX
 
 #: A segment end is measured when no other segment comes this close to it (px): the profile along the
 #: line (4 px past the end) stays clear of every other line's window.
@@ -84,7 +85,7 @@ def measure_ends(cov: np.ndarray, segs: np.ndarray, level: float = 1.0) -> np.nd
     out = []
     for mass in masses:
         inner = float(np.median(mass[s <= -2.5]))
-        if inner < MIN_MASS:
+        if inner < NAMING.profile_min_mass:
             continue
         above = np.flatnonzero(mass >= inner / 2.0)
         k = above.max()

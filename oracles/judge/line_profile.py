@@ -1,5 +1,6 @@
-"""A line's profile across it: the window a sample is taken in, the coverage a sample needs, and the offset
-pooled from a case's samples (:func:`pooled_offset`).
+"""A line's profile across it: the window a sample is taken in and the offset pooled from a case's samples
+(:func:`pooled_offset`). The coverage a sample needs and the samples a case needs are
+:attr:`oracles.tolerances.NamingThresholds.profile_min_mass` and ``profile_min_samples``.
 
 Its own module because the line style (oracles.judge.line_style), the even-width lean
 (oracles.judge.even_lean) and the free ends (oracles.judge.free_ends) all measure with them.
@@ -8,6 +9,8 @@ Its own module because the line style (oracles.judge.line_style), the even-width
 from __future__ import annotations
 
 import numpy as np
+
+from ..tolerances import NAMING
 
 #: Half the window across a line in which its centroid is taken (px): a 3-px line's half width
 #: (1.5) plus an antialiased fringe (1) plus a pixel of slack for a half-pixel offset.
@@ -19,22 +22,15 @@ PROFILE_RADIUS_PX = 3
 GUARD_PX = PROFILE_RADIUS_PX + 1.5
 
 
-#: A sample's window must hold this much coverage (in units of a fully covered pixel) to be a
-#: sample of the line: half a pixel's worth, so a missing line is no sample (F1 fails on it).
-MIN_MASS = 0.5
-
-
-#: Fewer samples than this in a case: the geometry is not measured (too little free line).
-MIN_SAMPLES = 20
-
-
 def pooled_offset(normal: np.ndarray, offset: np.ndarray):
     """``(d (2,), determined (2,) bool)``: the least-squares ``d`` with ``n . d = offset``.
 
     A component the normals do not constrain (every line parallel to it, e.g.
-    only horizontal lines say nothing of ``dx``) is 0 and not determined.
+    only horizontal lines say nothing of ``dx``) is 0 and not determined; so
+    is each with fewer than ``NAMING.profile_min_samples`` samples
+    (oracles.tolerances, read when called).
     """
-    if len(offset) < MIN_SAMPLES:
+    if len(offset) < NAMING.profile_min_samples:
         return np.zeros(2), np.zeros(2, bool)
     nn = normal.T @ normal
     determined = np.diag(nn) >= 0.05 * len(offset)  # >= 5 % of the samples' weight on that axis

@@ -87,7 +87,7 @@ from . import coverage_pixels, even_lean, free_ends, line_ties, line_windows
 from .case_samples import CaseSamples
 from .decide import ROUNDED_RULE_NAME
 from .evidence import StyleRead
-from .line_profile import GUARD_PX, MIN_MASS, MIN_SAMPLES, PROFILE_RADIUS_PX, pooled_offset
+from .line_profile import GUARD_PX, PROFILE_RADIUS_PX, pooled_offset
 
 STYLES = ("aliased", "antialiased", "wide")
 #: ``--line-rule``: ``any`` (the default) holds aliased lines to a correct drawing under GL's rule or under
@@ -185,7 +185,7 @@ def measure(
     }
     windows_n = len(out["offset"])
     # a line is there (half a pixel's coverage), and its centroid is not at the window's edge (another line's)
-    keep = np.flatnonzero((out["mass"] >= MIN_MASS) & (np.abs(out["offset"]) <= r - 0.5))
+    keep = np.flatnonzero((out["mass"] >= tolerances.NAMING.profile_min_mass) & (np.abs(out["offset"]) <= r - 0.5))
     found = len(keep)
     if found > limit:  # evenly thinned: one gather of each field
         keep = keep[np.linspace(0, found - 1, limit).round().astype(int)]
@@ -202,7 +202,7 @@ def fit_lines(normal: np.ndarray, offset: np.ndarray, point: np.ndarray, centre:
     when the samples cannot fix the six numbers (too few, or lines of too few
     directions and places).
     """
-    if len(offset) < MIN_SAMPLES:
+    if len(offset) < tolerances.NAMING.profile_min_samples:
         return None
     q = point - centre
     design = np.column_stack([normal, normal[:, :1] * q, normal[:, 1:] * q])  # d_x, d_y, m_xx, m_xy, m_yx, m_yy
@@ -385,7 +385,8 @@ class CaseStyle:
         values = np.arange(1, 256)
         grey = drawn[(values > level / 8.0) & (values < level * 7.0 / 8.0)].sum()
         widths = self._pooled("width")
-        if len(widths) >= MIN_SAMPLES:  # across the free parts of the lines: no junction or crossing
+        # across the free parts of the lines: no junction or crossing
+        if len(widths) >= tolerances.NAMING.profile_min_samples:
             width = float(np.median(widths))
         else:  # too little free line: all coverage over the lines' length
             coverage = float((np.minimum(values / level, 1.0) * drawn).sum())
@@ -420,7 +421,7 @@ class CaseStyle:
         the ``(d, m)`` of :func:`fit_lines` (None when not fixed); None with too few samples."""
         normal, offset = self._pooled("normal", samples).reshape(-1, 2), self._pooled("offset", samples)
         point = self._pooled("point", samples).reshape(-1, 2)
-        if len(offset) < MIN_SAMPLES:
+        if len(offset) < tolerances.NAMING.profile_min_samples:
             return None
         d, _ = pooled_offset(normal, offset)
         return d, fit_lines(normal, offset, point, self.centre)
