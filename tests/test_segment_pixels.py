@@ -114,3 +114,19 @@ def test_a_segment_beyond_the_left_edge_in_the_first_row_pairs_only_its_own_fram
     got = frames_neighbourhoods([first, second], w, h)
     for (p0, p1, pixels), (edge, pixel, _major) in zip([first, second], got):
         assert list(zip(edge.tolist(), pixel.tolist())) == _owners_naive(p0, p1, w, h, pixels)[0]
+
+
+@pytest.mark.parametrize("table", [True, False], ids=["rank table", "binary search"])
+def test_rank_equals_searchsorted_beyond_the_pixels_first_and_last(table):
+    """_Pixels.rank, the count of pixels before each stacked flat index, is ``np.searchsorted``'s on sparse
+    pixels of two stacked frames, for queries before the first pixel (down to -1, a slice clipped to column
+    -1 of the first row), on and between pixels, and after the last (up to the stack's end, frames H W): its
+    table spans only the pixels' own range, [first, last + 1], and a query outside reads 0 or every pixel."""
+    rng = np.random.default_rng(37)
+    w, h = 30, 20
+    per_frame = [np.sort(rng.choice(np.arange(5 * w, 15 * w), 40, replace=False)) for _ in range(2)]
+    px = segment_pixels._Pixels.of_frames(per_frame, w, h)
+    queries = np.concatenate([np.arange(-1, 2 * w * h + 1), px.stacked, px.stacked + 1, px.stacked - 1])
+    got = px.rank(queries, expected=10**9 if table else 0)
+    assert (px._rank is not None) == table  # the path under test was taken
+    np.testing.assert_array_equal(got, np.searchsorted(px.stacked, queries))

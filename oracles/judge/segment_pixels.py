@@ -195,8 +195,6 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     if not frames:
         return []
     segs = _Segments([(p0, p1) for p0, p1, _ in frames], width, height, radius)
-    cand = _Pixels.of_frames([fp.cand_idx for _, _, fp in frames], width, height)
-    orac = _Pixels.of_frames([fp.oracle_idx for _, _, fp in frames], width, height)
     drawn = _Pixels.of_frames([fp.drawn() for _, _, fp in frames], width, height)
     one_sided = _Pixels.of_frames([np.sort(np.concatenate(fp.only())) for _, _, fp in frames], width, height)
     first_edge = np.cumsum(segs.counts) - segs.counts  # frame k's edges in one flat array of all
@@ -213,16 +211,23 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
             cc = oc = np.zeros(len(segs), np.int64)
             if len(owners):
                 keep = mine[sid]
-                cc, oc = _counts_of(segs, cand, orac, drawn, sid[keep], pos[keep])
+                cc, oc = _counts_of(segs, *_sides(frames, width, height), drawn, sid[keep], pos[keep])
         else:
             compared = _compared(segs, drawn)
             owners = _unique(segs.nearest(one_sided)[0])
             cc = oc = np.zeros(len(segs), np.int64)
             if len(owners):
-                cc, oc = _counts_near(segs, cand, orac, drawn.subset(segs.near(drawn, owners)))
+                cc, oc = _counts_near(segs, *_sides(frames, width, height), drawn.subset(segs.near(drawn, owners)))
         diff_all[first_edge[segs.frame[owners]] + segs.edge[owners]] = (cc - oc)[owners]
     n_compared = np.bincount(segs.frame[compared], minlength=len(frames))
     return [(d, int(n)) for d, n in zip(np.split(diff_all, first_edge[1:]), n_compared)]
+
+
+def _sides(frames, width: int, height: int) -> tuple[_Pixels, _Pixels]:
+    """The candidate's and the oracle's drawn pixels of ``frames`` (:func:`frames_count_differences`'), stacked:
+    made only where some edge can count differently."""
+    cand = _Pixels.of_frames([fp.cand_idx for _, _, fp in frames], width, height)
+    return cand, _Pixels.of_frames([fp.oracle_idx for _, _, fp in frames], width, height)
 
 
 def _compared(segs: _Segments, drawn: _Pixels) -> np.ndarray:
@@ -369,18 +374,21 @@ def _box_cells(p0: np.ndarray, p1: np.ndarray, reach: float, cell: int, nx: int,
     with np.errstate(invalid="ignore", over="ignore"):
         total = p0 + p1  # clip_to_box keeps only the rows where this is finite
         finite = np.isfinite(total[:, 0]) & np.isfinite(total[:, 1])
+        every = bool(finite.all())
         ends = []
         for k, n in ((0, nx), (1, ny)):
-            a, b = np.where(finite, p0[:, k], 0.0), np.where(finite, p1[:, k], 0.0)
+            a, b = (p0[:, k], p1[:, k]) if every else (np.where(finite, p0[:, k], 0.0), np.where(finite, p1[:, k], 0.0))
             lo, hi = np.minimum(a, b), np.maximum(a, b)
             lo -= reach
             hi += reach
             lo /= cell
             hi /= cell
             # x in [lo, hi] has its cell x // cell in [floor(lo / cell), floor(hi / cell)]: [first, stop)
-            first = np.clip(np.floor(lo), 0, n).astype(np.int64)
-            stop = np.maximum(np.clip(np.floor(hi) + 1, 0, n).astype(np.int64), first)
-            ends += [first, stop]
+            first = np.clip(np.floor(lo, out=lo), 0, n, out=lo).astype(np.int64)
+            hi = np.floor(hi, out=hi)
+            hi += 1
+            stop = np.clip(hi, 0, n, out=hi).astype(np.int64)
+            ends += [first, np.maximum(stop, first, out=stop)]
     c0, c1, r0, r1 = ends
     r0 *= nx + 1
     r1 *= nx + 1
@@ -435,14 +443,17 @@ class _Pixels:
         images), built once; a few are binary searches. ``expected``: how many
         queries the caller will make in all (in several calls), when known.
         """
-        size = self.frames * self.width * self.height
+        # the table spans the pixels' own flat indices, [first, last + 1]: a query below is 0, above ``len``
+        size = int(self.stacked[-1] - self.stacked[0]) + 2 if len(self.stacked) else 0
         many = len(stacked) if expected is None else expected
         if self._rank is None and size and many > size // 4 and size < 2**31:
-            table = np.zeros(size + 1, np.int32)
-            table[self.stacked + 1] = 1
-            self._rank = np.cumsum(table, dtype=np.int32)
+            table = np.zeros(size, np.int32)
+            table[self.stacked - (self.stacked[0] - 1)] = 1
+            self._rank = np.cumsum(table, dtype=np.int32, out=table)  # in place: the table is all it takes
         if self._rank is not None:
-            return self._rank[stacked].astype(np.int64)
+            at = stacked - self.stacked[0]
+            np.clip(at, 0, size - 1, out=at)
+            return self._rank[at].astype(np.int64)
         return np.searchsorted(self.stacked, stacked)
 
     def has(self, stacked: np.ndarray) -> np.ndarray:
@@ -472,8 +483,12 @@ class _Segments:
         p0 = [np.asarray(a, np.float64).reshape(-1, 2) for a, _ in per_frame]
         p1 = [np.asarray(b, np.float64).reshape(-1, 2) for _, b in per_frame]
         self.counts = np.array([len(a) for a in p0], np.int64)
-        frame = np.repeat(np.arange(len(p0)), self.counts)
-        edge = np.arange(int(self.counts.sum())) - np.repeat(np.cumsum(self.counts) - self.counts, self.counts)
+        self.one_frame = len(p0) == 1
+        if self.one_frame:  # its edges in order, all of frame 0 (a read-only view of one 0: no memory)
+            frame, edge = np.broadcast_to(np.zeros(1, np.int64), (len(p0[0]),)), np.arange(len(p0[0]), dtype=np.int64)
+        else:
+            frame = np.repeat(np.arange(len(p0), dtype=np.int64), self.counts)
+            edge = np.arange(int(self.counts.sum())) - np.repeat(np.cumsum(self.counts) - self.counts, self.counts)
         p0 = np.concatenate(p0) if p0 else np.zeros((0, 2))
         p1 = np.concatenate(p1) if p1 else np.zeros((0, 2))
         keep, q0, q1 = clip_to_box(p0, p1, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
@@ -482,11 +497,13 @@ class _Segments:
         else:
             self.q0, self.q1 = q0[keep], q1[keep]
             self.frame, self.edge = frame[keep], edge[keep]
-        self.d = self.q1 - self.q0
-        # the columns _near gathers per pair, contiguous (np.take of a 1-D array: the same floats, faster)
-        dx, dy = np.ascontiguousarray(self.d[:, 0]), np.ascontiguousarray(self.d[:, 1])
-        self.dd = dx * dx + dy * dy
-        self._cols = (np.ascontiguousarray(self.q0[:, 0]), np.ascontiguousarray(self.q0[:, 1]), dx, dy, self.dd)
+        # the columns _near gathers per pair, contiguous (np.take of a 1-D array: the same floats, faster);
+        # each difference is the one ``q1 - q0`` gives, taken column by column (no (S, 2) array of them)
+        qx, qy = np.ascontiguousarray(self.q0[:, 0]), np.ascontiguousarray(self.q0[:, 1])
+        dx, dy = np.subtract(self.q1[:, 0], qx), np.subtract(self.q1[:, 1], qy)
+        self.dd = dx * dx
+        self.dd += dy * dy
+        self._cols = (qx, qy, dx, dy, self.dd)
         self._points = bool((self.dd == 0).any())  # a segment of no length (_near's u is 0 for it)
         self._cells = None  # the grid of pairs_any, made on first use
         self._rows = None  # _rows_spanned, counted on first use
@@ -578,17 +595,15 @@ class _Segments:
         and a run's slices in chunks of at most that many pixels (a slice
         over it alone): memory is bounded whatever the segments' length.
         """
-        if which is None:
-            which = np.arange(len(self))
-        if len(which) == 0 or len(px) == 0:
+        if (len(self) if which is None else len(which)) == 0 or len(px) == 0:
             return
         w, h = self.width, self.height
         rows = self._rows_of(which)
         queries = 2 * int(rows.sum())  # every run's slices, both ends: one rank table for all of them
         for lo, hi in _cuts(rows, CHUNK_PAIRS):
-            seg, row, col_lo, col_hi = self._spans(which[lo:hi], 1)
+            seg, row, col_lo, col_hi = self._spans(np.arange(lo, hi) if which is None else which[lo:hi], 1)
             # the pixels of one row between two columns are one slice of ``stacked``
-            start = (row + self.frame[seg] * h) * w
+            start = row * w if self.one_frame else (row + self.frame[seg] * h) * w
             a = px.rank(start + col_lo, queries)
             n = np.maximum(px.rank(start + col_hi + 1, queries) - a, 0)
             for s0, s1 in _cuts(n, CHUNK_PAIRS):
@@ -689,15 +704,20 @@ class _Segments:
     def _rows_spanned(self) -> int:
         """How many (segment, row) slices :meth:`pairs` takes over all segments."""
         if self._rows is None:
-            self._rows = int(self._rows_of(np.arange(len(self))).sum())
+            self._rows = int(self._rows_of(None).sum())
         return self._rows
 
-    def _rows_of(self, which: np.ndarray) -> np.ndarray:
-        """``(len(which),)`` int64: the rows of the frame each segment's grown box spans (:meth:`pairs`' slices)."""
+    def _rows_of(self, which: np.ndarray | None) -> np.ndarray:
+        """``(len(which),)`` int64: the rows of the frame each segment (of ``which``; None: all) grown box spans
+        (:meth:`pairs`' slices)."""
         y_lo, y_hi = self._y_range()
-        lo = np.maximum(np.ceil(y_lo[which] - self.grow), 0)
-        hi = np.minimum(np.floor(y_hi[which] + self.grow), self.height - 1)
-        return np.maximum(hi - lo + 1, 0).astype(np.int64)
+        if which is not None:
+            y_lo, y_hi = y_lo[which], y_hi[which]
+        lo = np.maximum(np.ceil(np.subtract(y_lo, self.grow)), 0)
+        hi = np.minimum(np.floor(np.add(y_hi, self.grow)), self.height - 1)
+        hi -= lo
+        hi += 1
+        return np.maximum(hi, 0, out=hi).astype(np.int64)
 
     def _cell_side(self) -> int:
         """The grid's cell side (px): the segments' median length, a power of two in [4, 32].
@@ -706,7 +726,7 @@ class _Segments:
         crosses, and a cell holds ~(side / length + 1) segments of each line
         through it: a side near the typical length keeps both near 1.
         """
-        lengths = np.sort(np.abs(self.d).max(axis=1))
+        lengths = np.sort(np.maximum(np.abs(self._cols[2]), np.abs(self._cols[3])))
         length = lengths[len(lengths) // 2] if len(lengths) else 16.0
         return int(2 ** np.clip(np.round(np.log2(max(length, 1.0))), 2, 5))
 
@@ -856,7 +876,7 @@ class _Segments:
 
     def rows(self, px: _Pixels, sid: np.ndarray, pos: np.ndarray):
         """``(edge, pixel, major)`` of owner pairs (module docstring), pixels flat in their frames."""
-        x_major = np.abs(self.d[sid, 0]) > np.abs(self.d[sid, 1])
+        x_major = np.abs(np.take(self._cols[2], sid)) > np.abs(np.take(self._cols[3], sid))
         _, y, x = px.at(pos)
         return self.edge[sid], y * self.width + x, np.where(x_major, x, y)
 
