@@ -149,6 +149,77 @@ def test_band_holding_the_candidates_count():
     # 8 centres: row 2 alone (0.3; the 9th is 0.7) -> the 1-px band, whatever width was read
     band = lm.band_holding(segs, (6, 10), 8, 2.0)
     assert band.sum() == 8 and band[2, 1:9].all()
+    # 17 centres: the 17th and 18th nearest are the two caps' row-2 centres, both 1.04 away, so h = 1.04 and
+    # no band holds exactly 17: it holds 18 (rows 2 and 3, and both caps' row 2), not the 16 within 0.7
+    band = lm.band_holding(segs, (6, 10), 17, 1.5)
+    assert band.sum() == 18 and band[2:4, 1:9].all() and band[2, 0] and band[2, 9]
     # no count: the width rounded, 3 -> within 1.5: rows 1-3 of columns 1..8 (24) and each cap's rows 2
     # and 3 (1.04, sqrt(1 + 0.49) = 1.22; row 1's is sqrt(1 + 1.69) = 1.64 away): 28
     assert lm.band_holding(segs, (6, 10), 0, 3.0).sum() == 28
+
+
+def _mask(shape, pixels):
+    out = np.zeros(shape, bool)
+    for x, y in pixels:
+        out[y, x] = True
+    return out
+
+
+@pytest.mark.parametrize("transpose", [False, True], ids=["x_major", "y_major"])
+def test_a_tie_on_the_first_column_or_row_outside_is_dropped(transpose):
+    # (1, 0) -> (3, 1) in a 2-wide image: the minor half pixel is at x = 2 (y = 0.5), the column just past
+    # the image (x == W), where the end (3, 1) also lies: inside, only (1, 0) is drawn, by every rounding
+    # of the outside end (cut at the border: (2, 0) or (2, 1); 1 px out: (3, 0) or (3, 1)); no tie, no
+    # error. Transposed the same at the row just past the image (y == H).
+    seg, shape, pixel = [[1.0, 0.0], [3.0, 1.0]], (3, 2), (1, 0)
+    if transpose:
+        seg, shape, pixel = [p[::-1] for p in seg], shape[::-1], pixel[::-1]
+    drawn, ties = _image([seg], shape)
+    assert (drawn == _mask(shape, [pixel])).all() and not ties.any()
+
+
+@pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
+def test_an_end_inside_the_margin_is_rounded_where_it_lies(reverse):
+    # 3.5 - 2^-51 (the float below 3.5) rounds to 3: pixels 0..3, pixel 4 a tie (within 1/32 px of the
+    # half). Shifted by the clip's margin (6, the image's larger side) and back it would read 3.5 (9.5 - 2^-51
+    # is a quarter of 9.5's ulp 2^-49 from it) and draw pixel 4: an end the margin did not cut is kept exactly
+    seg = [[0.0, 0.0], [3.5 - 2**-51, 0.0]]
+    drawn, ties = _image([seg[::-1] if reverse else seg], (1, 6))
+    assert drawn[0].tolist() == [True] * 4 + [False] * 2
+    assert ties[0].tolist() == [False] * 4 + [True, False]
+
+
+@pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
+def test_an_end_just_outside_the_image_is_cut_either_way(reverse):
+    # (4, 0.4) -> (-0.7, 0.4) in 2 x 6: the end is outside (x < -1/2), so a renderer may draw to it
+    # (rounded to (-1, 0)), or cut the line at the border x = -1/2 (y 0.4: rounded to (0, 0) or, across the
+    # line, (0, 1)), or 1 px out and beyond (at the end itself: (-1, 0) or (-1, 1)). From (4, 0) the lines
+    # to (0, 1) and (-1, 1) step down a row at x = 2 (a half pixel: the lower row) and x = 1: every pixel of
+    # columns 0..2 in rows 0 and 1 is drawn by some roundings, not all; (3, 0) and (4, 0) by all
+    seg = [[4.0, 0.4], [-0.7, 0.4]]
+    drawn, ties = _image([seg[::-1] if reverse else seg], (2, 6))
+    assert (drawn == _mask((2, 6), [(x, 0) for x in range(5)])).all()
+    assert (ties == _mask((2, 6), [(x, y) for x in range(3) for y in range(2)])).all()
+
+
+@pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
+def test_an_end_on_the_images_last_half_pixel_is_inside(reverse):
+    # (0, 0) -> (5.5, 0.9) in 2 x 6: x = 5.5 = W - 1/2 is the image's edge, not outside it, so the end is
+    # rounded only along x (a half pixel: 5 or 6), y 0.9 -> 1: the lines to (5, 1) and (6, 1) draw the same
+    # pixels inside, (0..2, 0) and (3..5, 1); the one tie is across the line to (6, 1) at x = 3 (y = 0.5).
+    # Were the end outside, a cut there rounded across (to (6, 0)) would make all of x = 3..5 ties
+    seg = [[0.0, 0.0], [5.5, 0.9]]
+    drawn, ties = _image([seg[::-1] if reverse else seg], (2, 6))
+    assert (drawn == _mask((2, 6), [(0, 0), (1, 0), (2, 0), (3, 1), (4, 1), (5, 1)])).all()
+    assert (ties == _mask((2, 6), [(3, 0), (3, 1)])).all()
+
+
+def test_an_end_below_the_image_may_be_cut_one_pixel_out():
+    # (1, 1) -> (4, 5.5) in 3 x 4 (y-major, leaving through the bottom). A renderer that clips 1 px below the
+    # image cuts at y = 3.5, x = 1 + 3 * 2.5 / 4.5 = 2.67: rounded across to (2, 4) or (3, 4); from (1, 1) the
+    # line to (2, 4) is at x = 1 + 1/3 on row 2 (pixel (1, 2)); every other rounding (the border: (2, 3),
+    # (3, 3); 2 px out, y = 4.5, x = 3.33: (3, 5), (4, 5); the end, (4, 5 or 6), (5, 6)) is at x >= 1.5 there
+    # (pixel (2, 2)). So (1, 2) and (2, 2) are ties; (1, 1) and (2, 2) drawn (to (4, 6): x = 1.6 on row 2)
+    drawn, ties = _image([[[1.0, 1.0], [4.0, 5.5]]], (3, 4))
+    assert (drawn == _mask((3, 4), [(1, 1), (2, 2)])).all()
+    assert (ties == _mask((3, 4), [(1, 2), (2, 2)])).all()
