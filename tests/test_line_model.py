@@ -179,14 +179,30 @@ def test_a_tie_on_the_first_column_or_row_outside_is_dropped(transpose):
 
 
 @pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
-def test_an_end_inside_the_margin_is_rounded_where_it_lies(reverse):
+@pytest.mark.parametrize("width, below", [(6, 2**-51), (16384, 2**-40)], ids=["narrow", "widest"])
+def test_an_end_inside_the_margin_is_rounded_where_it_lies(reverse, width, below):
     # 3.5 - 2^-51 (the float below 3.5) rounds to 3: pixels 0..3, pixel 4 a tie (within 1/32 px of the
     # half). Shifted by the clip's margin (6, the image's larger side) and back it would read 3.5 (9.5 - 2^-51
-    # is a quarter of 9.5's ulp 2^-49 from it) and draw pixel 4: an end the margin did not cut is kept exactly
-    seg = [[0.0, 0.0], [3.5 - 2**-51, 0.0]]
-    drawn, ties = _image([seg[::-1] if reverse else seg], (1, 6))
-    assert drawn[0].tolist() == [True] * 4 + [False] * 2
-    assert ties[0].tolist() == [False] * 4 + [True, False]
+    # is a quarter of 9.5's ulp 2^-49 from it) and draw pixel 4: an end the margin did not cut is kept exactly.
+    # In the widest image (core.limits.MAX_SIDE 16384) the shift's error is up to half of 16387.5's ulp 2^-38:
+    # 3.5 - 2^-40 (a quarter ulp) reads 3.5 shifted, and must still not count as a cut (the test for a cut
+    # is relative to the margin, 1e-9 x 16387.5 = 1.6e-5 px, not 1e-9 / 16387.5 = 6e-14 px)
+    seg = [[0.0, 0.0], [3.5 - below, 0.0]]
+    drawn, ties = _image([seg[::-1] if reverse else seg], (1, width))
+    assert drawn[0, :6].tolist() == [True] * 4 + [False] * 2 and drawn.sum() == 4
+    assert ties[0, :6].tolist() == [False] * 4 + [True, False] and ties.sum() == 1
+
+
+@pytest.mark.parametrize(
+    "segs",
+    [np.zeros((0, 2, 2)), [[[np.nan, 1.0], [2.0, 2.0]]], [[[100.0, 100.0], [200.0, 100.0]]]],
+    ids=["none", "not_finite", "beyond_the_margin"],
+)
+@pytest.mark.parametrize("rule", lm.RULES)
+def test_no_segment_draws_nothing(segs, rule):
+    # no segment, one with a NaN end, one wholly past the clip's margin (4 px around a 4 x 4 image): no pixel
+    drawn, ties = lm.expected(np.asarray(segs, dtype=float).reshape(-1, 2, 2), (4, 4), rule)
+    assert not drawn.any() and not ties.any()
 
 
 @pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
@@ -200,6 +216,19 @@ def test_an_end_just_outside_the_image_is_cut_either_way(reverse):
     drawn, ties = _image([seg[::-1] if reverse else seg], (2, 6))
     assert (drawn == _mask((2, 6), [(x, 0) for x in range(5)])).all()
     assert (ties == _mask((2, 6), [(x, y) for x in range(3) for y in range(2)])).all()
+
+
+@pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
+def test_an_end_on_the_images_first_half_pixel_is_inside(reverse):
+    # (5, 0) -> (-0.5, 0.9) in 2 x 6: x = -0.5 is the image's edge, not outside it, so the end is rounded
+    # only along x (a half pixel: 0 or -1), y 0.9 -> 1: from (5, 0) the lines to (0, 1) and (-1, 1) both
+    # step down at x = 2 (exact y 0.6 and 0.5 + 1/12), so they draw the same pixels inside and nothing is a
+    # tie (n = 5 steps of 1/5: no half pixel across). Were the end outside, a cut there rounded across
+    # (to (0, 0)) would make columns 0..2 of rows 0 and 1 ties
+    seg = [[5.0, 0.0], [-0.5, 0.9]]
+    drawn, ties = _image([seg[::-1] if reverse else seg], (2, 6))
+    assert (drawn == _mask((2, 6), [(5, 0), (4, 0), (3, 0), (2, 1), (1, 1), (0, 1)])).all()
+    assert not ties.any()
 
 
 @pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
@@ -223,3 +252,19 @@ def test_an_end_below_the_image_may_be_cut_one_pixel_out():
     drawn, ties = _image([[[1.0, 1.0], [4.0, 5.5]]], (3, 4))
     assert (drawn == _mask((3, 4), [(1, 1), (2, 2)])).all()
     assert (ties == _mask((3, 4), [(1, 2), (2, 2)])).all()
+
+
+def test_bands_at_the_images_edges_and_around_a_point():
+    # a line at y = 4.7 from x = 1 to 9.6 in 6 x 10, width 2: rows 4 (0.7 away) and 5 (0.3) of columns 1..9,
+    # the band's reach cut at the image's last row and column (row 3 is 1.7 away; column 0's row 5, 1.04)
+    band = lm.band_pixels(np.array([[[1.0, 4.7], [9.6, 4.7]]]), (6, 10), 2.0)
+    assert (band == _mask((6, 10), [(x, y) for x in range(1, 10) for y in (4, 5)])).all()
+    # a band is closed: a line on row 2 (x = 1..9, 8 px long), width 2: rows 1 and 3 exactly 1 away are in it,
+    # and so is the start cap's (0, 2), 1 from (1, 2)
+    band = lm.band_pixels(np.array([[[1.0, 2.0], [9.0, 2.0]]]), (6, 10), 2.0)
+    assert (band == _mask((6, 10), [(x, y) for x in range(1, 10) for y in (1, 2, 3)] + [(0, 2)])).all()
+    # a segment of no length is a point, its band a disc: around (2, 2.3) within 1, (2, 2) and (2, 3) (0.3
+    # and 0.7; (1, 2) and (3, 2) are 1.04 away); the band holding 2 centres is the same, halfway to 1.04
+    point = np.array([[[2.0, 2.3], [2.0, 2.3]]])
+    assert (lm.band_pixels(point, (5, 5), 2.0) == _mask((5, 5), [(2, 2), (2, 3)])).all()
+    assert (lm.band_holding(point, (5, 5), 2, 2.0) == _mask((5, 5), [(2, 2), (2, 3)])).all()
