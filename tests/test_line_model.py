@@ -268,3 +268,20 @@ def test_bands_at_the_images_edges_and_around_a_point():
     point = np.array([[[2.0, 2.3], [2.0, 2.3]]])
     assert (lm.band_pixels(point, (5, 5), 2.0) == _mask((5, 5), [(2, 2), (2, 3)])).all()
     assert (lm.band_holding(point, (5, 5), 2, 2.0) == _mask((5, 5), [(2, 2), (2, 3)])).all()
+
+
+def test_an_end_exactly_end_tie_px_from_the_half_is_a_tie():
+    # 3.5 + 1/32 (exact in binary) is exactly END_TIE_PX = 1/32 from the half: within it (the bound is closed),
+    # so pixel 4 is a tie; 1/16 past the half it was decided (test_end_on_a_half_pixel_is_a_tie)
+    assert lm.END_TIE_PX == 1 / 32
+    drawn, ties = _image([[[0.0, 0.0], [3.5 + 1 / 32, 0.0]]], (1, 6))
+    assert drawn[0].tolist() == [True] * 5 + [False] and ties[0].tolist() == [False] * 4 + [True, False]
+
+
+def test_an_end_beyond_the_margin_is_cut_at_it():
+    # (1, 2) -> (7, -1.5) in 2 x 3: the margin is the larger side, 3 px, so the line is cut at x = 2.5 + 3 =
+    # 5.5, y = 2 - 3.5 x 4.5 / 6 = -0.625, rounded to (6, -1); from (1, 2) that line (5 steps, y down 3/5 a
+    # step) is at y = 2 - 0.6 = 1.4 at x = 2: pixel (2, 1), the one drawn inside. Drawn to the end itself,
+    # (7, -1.5) -> (7, -1), the line would be at y = 1.5 there and draw (2, 2), outside
+    drawn, _ = _image([[[1.0, 2.0], [7.0, -1.5]]], (2, 3))
+    assert (drawn == _mask((2, 3), [(2, 1)])).all()
