@@ -285,3 +285,25 @@ def test_an_end_beyond_the_margin_is_cut_at_it():
     # (7, -1.5) -> (7, -1), the line would be at y = 1.5 there and draw (2, 2), outside
     drawn, _ = _image([[[1.0, 2.0], [7.0, -1.5]]], (2, 3))
     assert (drawn == _mask((2, 3), [(2, 1)])).all()
+
+
+def test_an_end_a_hair_past_the_margin_is_cut():
+    # (1, 0) -> (-3.5 - 1e-8, 2) in 2 x 3: the end lies 1e-8 px past the margin's border x = -1/2 - 3 (1.5e-9
+    # of margin + |end|, far above the shift's float error, 1e-16 of it): a cut, at x = -3.5 exactly, rounded
+    # up to (-3, 2) (y 2 - 4.4e-9 -> 2). From (1, 0) that line (4 steps, y up 1/2 a step) is at y = 0.5 on
+    # x = 0: (0, 1) drawn, (0, 0) and (0, 1) ties. Were the end kept, (-4, 2): y = 0.4 there, (0, 0) drawn
+    drawn, ties = _image([[[1.0, 0.0], [-3.5 - 1e-8, 2.0]]], (2, 3))
+    assert (drawn == _mask((2, 3), [(1, 0), (0, 1)])).all()
+    assert (ties == _mask((2, 3), [(0, 0), (0, 1)])).all()
+
+
+def test_band_holding_searches_within_half_the_width_plus_a_pixel():
+    # around the point (2, 2.3), a band 2.4 px wide searches centres within 1.2 + 1 = 2.2 px: 16 of them, the
+    # farthest (0, 3) and (4, 3) at sqrt(4 + 0.49) = 2.12 (then (2, 0) at 2.3). Holding 16, h is halfway from
+    # 2.12 to the reach, 2.16: those 16. (Searching within round(2.4) / 2 + 1 = 2.0 instead finds 12, fewer
+    # than 16: the 2-px band, 2 centres)
+    point = np.array([[[2.0, 2.3], [2.0, 2.3]]])
+    yy, xx = np.mgrid[0:5, 0:5]
+    within = np.hypot(xx - 2.0, yy - 2.3) <= 2.2
+    assert within.sum() == 16
+    assert (lm.band_holding(point, (5, 5), 16, 2.4) == within).all()
