@@ -307,3 +307,30 @@ def test_band_holding_searches_within_half_the_width_plus_a_pixel():
     within = np.hypot(xx - 2.0, yy - 2.3) <= 2.2
     assert within.sum() == 16
     assert (lm.band_holding(point, (5, 5), 16, 2.4) == within).all()
+
+
+def test_a_cut_is_rounded_either_way_across_the_line():
+    # (5, 0) -> (8, 7.5) in 3 x 6, a steep line (x 3 over y 7.5) leaving through the right then the bottom:
+    # its cuts are rounded either way in x, across it (the border: (5.5, 1.25) -> (5, 1) or (6, 1); 1 px out,
+    # (6.4, 3.5) -> (6, 4) or (7, 4); 2 px out, (6.8, 4.5) -> (6, 5) or (7, 5); 4 px out, (7.6, 6.5) ->
+    # (7, 7) or (8, 7)); the end itself is rounded either way in y (7.5: (8, 7) or (8, 8)). From (5, 0), the
+    # line to (6, 5) alone stays on x = 5 at y = 2 (x = 5.4 there): (5, 2) is a tie; (5, 1) too (the lines to
+    # (6, 1) and (7, 4) leave x = 5 at once). Rounded in y instead, no rounding keeps (5, 2)
+    drawn, ties = _image([[[5.0, 0.0], [8.0, 7.5]]], (3, 6))
+    assert (drawn == _mask((3, 6), [(5, 0), (5, 1)])).all()
+    assert (ties == _mask((3, 6), [(5, 1), (5, 2)])).all()
+
+
+def test_gl_rule_in_an_image_wider_than_tall():
+    # (1, 0.2) -> (1, 4.6) in 2 x 6: GL draws the pixels whose diamonds the segment leaves, (1, 0) and (1, 1)
+    # inside; the line goes on below the image's 2 rows (not its 6 columns): nothing else drawn
+    drawn, ties = _image([[[1.0, 0.2], [1.0, 4.6]]], (2, 6), rule="gl")
+    assert (drawn == _mask((2, 6), [(1, 0), (1, 1)])).all() and not ties.any()
+
+
+def test_a_band_of_several_segments_is_their_union():
+    # two lines, y = 1.2 from x = 1 to 4 and x = 6.3 from y = 0 to 4, in 5 x 8, width 1: the first takes
+    # row 1 of columns 1..4 (0.2 away), the second column 6 of rows 0..4 (0.3 away); nothing else within 1/2
+    segs = np.array([[[1.0, 1.2], [4.0, 1.2]], [[6.3, 0.0], [6.3, 4.0]]])
+    band = lm.band_pixels(segs, (5, 8), 1.0)
+    assert (band == _mask((5, 8), [(x, 1) for x in range(1, 5)] + [(6, y) for y in range(5)])).all()
