@@ -47,6 +47,11 @@ def test_minor_half_pixel_is_a_tie_both_sides():
     drawn, ties = _image([[[0.0, 0.0], [2.0, 1.0]]], (3, 4))
     assert drawn[0, 0] and drawn[1, 2] and drawn[:, 1].sum() == 1
     assert ties[0, 1] and ties[1, 1] and ties.sum() == 2
+    # transposed, (0, 0) -> (1, 2): at y = 1 the exact x is 0.5, so (0, 1) on the image's first column and
+    # (1, 1) are the ties
+    drawn, ties = _image([[[0.0, 0.0], [1.0, 2.0]]], (4, 3))
+    assert drawn[0, 0] and drawn[2, 1] and drawn[1, :].sum() == 1
+    assert ties[1, 0] and ties[1, 1] and ties.sum() == 2
 
 
 def test_end_on_a_half_pixel_is_a_tie():
@@ -334,3 +339,12 @@ def test_a_band_of_several_segments_is_their_union():
     segs = np.array([[[1.0, 1.2], [4.0, 1.2]], [[6.3, 0.0], [6.3, 4.0]]])
     band = lm.band_pixels(segs, (5, 8), 1.0)
     assert (band == _mask((5, 8), [(x, 1) for x in range(1, 5)] + [(6, y) for y in range(5)])).all()
+
+
+def test_a_band_leaning_far_is_the_whole_segment_moved():
+    # (0, 0) -> (4, 4), width 1, leaning 2 px along the left normal (4, -4) / |d|: the segment moved to
+    # (1.41, -1.41) -> (5.41, 2.59), on the line x - y = 2 sqrt(2). The centres within 1/2 of it have
+    # |x - y - 2.83| <= 0.71, so x - y = 3: (3, 0), (4, 1) and (5, 2) in 6 x 6 (each projects inside the
+    # segment, 0.12 px from it; the caps reach no other centre). (5, 2) lies past both unmoved ends' x
+    drawn = lm.band_pixels(np.array([[[0.0, 0.0], [4.0, 4.0]]]), (6, 6), 1.0, lean_px=2.0)
+    assert (drawn == _mask((6, 6), [(3, 0), (4, 1), (5, 2)])).all()
