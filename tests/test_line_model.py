@@ -114,6 +114,61 @@ def test_ends_outside_the_image_decide_nothing():
         assert not ((clipped ^ drawn) & ~ties).any()
 
 
+def _pillow_clipped(segs, shape, margin_px):
+    """Pillow's line between the rounded ends of ``segs`` clipped to the image grown by ``margin_px`` (its
+    border at -1/2 - margin_px and W - 1/2 + margin_px), by the held-out client's own clipper."""
+    return _pillow_segments(hd.clip_rect(np.asarray(segs, dtype=float), shape[1], shape[0], margin_px + 0.5), shape)
+
+
+def _pillow_segments(segs, shape):
+    from PIL import Image, ImageDraw
+
+    im = Image.new("L", (shape[1], shape[0]), 0)
+    for a, b in segs:
+        ImageDraw.Draw(im).line([tuple(np.floor(a + 0.5)), tuple(np.floor(b + 0.5))], fill=255)
+    return np.asarray(im) > 0
+
+
+@pytest.mark.parametrize(
+    "seg, margin",
+    [
+        # the clipper's end on the border y = 59.5 reads 59.49999999999999 and rounds down: a pixel at
+        # (5, 49) moves across the line (GL-style clipping's float error along the line)
+        ([[-31.97655814642069, -7.080662262852734], [17.893928623567668, 70.89228816925471]], 0.0),
+        # cut 1 px out at y = -1.5 and rounded to (-1, -1): from (29, 31) that line (32 steps in y, 30 in x) is
+        # on a half pixel at rows 23 and 7, where Pillow takes (21, 23) and (6, 7), the model's line (22, 23)
+        # and (7, 7)
+        ([[29.22850262275037, 31.285033946878002], [-1.2161481529916571, -1.9247190446328446]], 1.0),
+        # a segment that passes 0.3 px outside the image's corner, cut 1 px out: its rounded ends' line draws
+        # the corner pixel (0, 0)
+        ([[78.31567102229828, -37.8974861961944], [-7.666534088260306, 2.5467670384520247]], 1.0),
+    ],
+    ids=["cut_on_a_half_pixel", "a_cuts_own_half_pixel", "passing_outside"],
+)
+def test_lines_cut_at_the_border_grown_by_a_margin_decide_nothing(seg, margin):
+    # three segments where the model's drawing, less its ties, missed a pixel of a renderer that clips at the
+    # border grown by one of CLIP_MARGINS_PX and then rounds (found by the random test below, seeds 11 and 3)
+    shape = (60, 70)
+    drawn, ties = _image([seg], shape)
+    assert not ((_pillow_clipped([seg], shape, margin) ^ drawn) & ~ties).any()
+
+
+def test_random_lines_cut_at_every_margin_decide_nothing():
+    # 300 random segments leaving a 60 x 70 image, each clipped at the border grown by each margin of
+    # CLIP_MARGINS_PX and drawn by Pillow between the rounded ends: every pixel either way is the model's or a
+    # tie (before the cut's rounding along the line, its own half pixels and segments passing just outside
+    # were ties: 2 of the 1,500 drawings differed)
+    rng = np.random.default_rng(11)
+    shape = (60, 70)
+    differ = 0
+    for _ in range(300):
+        seg = [rng.uniform(-40, 110, 2), rng.uniform(-40, 110, 2)]
+        drawn, ties = _image([seg], shape)
+        for m in lm.CLIP_MARGINS_PX:
+            differ += int(((_pillow_clipped([seg], shape, m) ^ drawn) & ~ties).any())
+    assert differ == 0
+
+
 def test_a_dropped_end_pixel_is_no_tie():
     # the model's pixels less the line's last one: that pixel is a decided difference (the ends are not ties)
     a, b = np.array([2.2, 3.1]), np.array([30.3, 17.8])
@@ -226,14 +281,14 @@ def test_an_end_just_outside_the_image_is_cut_either_way(reverse):
 @pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
 def test_an_end_on_the_images_first_half_pixel_is_inside(reverse):
     # (5, 0) -> (-0.5, 0.9) in 2 x 6: x = -0.5 is the image's edge, not outside it, so the end is rounded
-    # only along x (a half pixel: 0 or -1), y 0.9 -> 1: from (5, 0) the lines to (0, 1) and (-1, 1) both
-    # step down at x = 2 (exact y 0.6 and 0.5 + 1/12), so they draw the same pixels inside and nothing is a
-    # tie (n = 5 steps of 1/5: no half pixel across). Were the end outside, a cut there rounded across
-    # (to (0, 0)) would make columns 0..2 of rows 0 and 1 ties
+    # only along x (a half pixel: 0 or -1), y 0.9 -> 1: from (5, 0) the line to (0, 1) (5 steps of 1/5)
+    # steps down at x = 2 (y 0.6); the line to (-1, 1) (6 steps of 1/6) is at y = 0.5 there, a half pixel:
+    # (2, 0) and (2, 1) are ties, nothing else. Were the end outside, a cut there rounded across (to (0, 0))
+    # would make columns 0..2 of rows 0 and 1 ties
     seg = [[5.0, 0.0], [-0.5, 0.9]]
     drawn, ties = _image([seg[::-1] if reverse else seg], (2, 6))
     assert (drawn == _mask((2, 6), [(5, 0), (4, 0), (3, 0), (2, 1), (1, 1), (0, 1)])).all()
-    assert not ties.any()
+    assert (ties == _mask((2, 6), [(2, 0), (2, 1)])).all()
 
 
 @pytest.mark.parametrize("reverse", [False, True], ids=["end", "start"])
