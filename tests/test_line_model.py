@@ -142,8 +142,11 @@ def _pillow_segments(segs, shape):
         # a segment that passes 0.3 px outside the image's corner, cut 1 px out: its rounded ends' line draws
         # the corner pixel (0, 0)
         ([[78.31567102229828, -37.8974861961944], [-7.666534088260306, 2.5467670384520247]], 1.0),
+        # leaving through the top at a shallow angle: cut at the border, (53.27, -0.5) -> (53, 0), it draws
+        # (53, 0) and (54, 0), which the line to the far end (rounded from (56, 0)) leaves at once
+        ([[55.54425309821815, 0.4680070645805472], [-33.853971409570796, -37.52085467072064]], 0.0),
     ],
-    ids=["cut_on_a_half_pixel", "a_cuts_own_half_pixel", "passing_outside"],
+    ids=["cut_on_a_half_pixel", "a_cuts_own_half_pixel", "passing_outside", "leaving_at_a_shallow_angle"],
 )
 def test_lines_cut_at_the_border_grown_by_a_margin_decide_nothing(seg, margin):
     # three segments where the model's drawing, less its ties, missed a pixel of a renderer that clips at the
