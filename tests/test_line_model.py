@@ -406,3 +406,15 @@ def test_a_band_leaning_far_is_the_whole_segment_moved():
     # segment, 0.12 px from it; the caps reach no other centre). (5, 2) lies past both unmoved ends' x
     drawn = lm.band_pixels(np.array([[[0.0, 0.0], [4.0, 4.0]]]), (6, 6), 1.0, lean_px=2.0)
     assert (drawn == _mask((6, 6), [(3, 0), (4, 1), (5, 2)])).all()
+
+
+def test_a_cut_exactly_end_tie_px_past_a_half_pixel_along_the_line_is_rounded_either_way():
+    # (3, 1) -> (4, 6.0625) in 6 x 4, steep, leaves through the right border x = 3.5 at y = 1 + 5.0625 / 2 =
+    # 3.53125, exactly END_TIE_PX past the half along the line (the bound is closed): that cut rounds to
+    # (3, 4) or (4, 4) across, and down along it to (4, 3); past 1 px out the end itself, (4, 6) or (4, 7).
+    # From (3, 1): the line to (4, 3) leaves x = 3 at y = 2 (a half pixel there: (3, 2) and (4, 2) ties), the
+    # lines to (4, 4) at y = 3, to (4, 6) and (4, 7) at y = 4, to (3, 4) never. So (3, 2), (3, 3) and (3, 4)
+    # are ties; (3, 1) and, on the line to (4, 6), (3, 2) and (3, 3) drawn
+    drawn, ties = _image([[[3.0, 1.0], [4.0, 6.0625]]], (6, 4))
+    assert (drawn == _mask((6, 4), [(3, 1), (3, 2), (3, 3)])).all()
+    assert (ties == _mask((6, 4), [(3, 2), (3, 3), (3, 4)])).all()
