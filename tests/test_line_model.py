@@ -167,7 +167,7 @@ def test_random_lines_cut_at_every_margin_decide_nothing():
     for _ in range(300):
         seg = [rng.uniform(-40, 110, 2), rng.uniform(-40, 110, 2)]
         drawn, ties = _image([seg], shape)
-        for m in lm.CLIP_MARGINS_PX:
+        for m in (0.0, 1.0, 2.0, 4.0, 8.0):  # the margins the model's docstring promises (CLIP_MARGINS_PX)
             differ += int(((_pillow_clipped([seg], shape, m) ^ drawn) & ~ties).any())
     assert differ == 0
 
@@ -418,3 +418,26 @@ def test_a_cut_exactly_end_tie_px_past_a_half_pixel_along_the_line_is_rounded_ei
     drawn, ties = _image([[[3.0, 1.0], [4.0, 6.0625]]], (6, 4))
     assert (drawn == _mask((6, 4), [(3, 1), (3, 2), (3, 3)])).all()
     assert (ties == _mask((6, 4), [(3, 2), (3, 3), (3, 4)])).all()
+
+
+def test_an_end_past_the_margin_side_inside_the_grown_image_is_kept_exactly():
+    # (0, 0) -> (6.5 - 2^-50, 1) in 2 x 6: the end lies farther out than the margin (6) but inside the grown
+    # image (x <= 5.5 + 6), so it is kept as it is, rounded to 6 (not the 6.5 it reads shifted by 6 and back:
+    # 12.5 - 2^-50 is half of 12.5's ulp below it and rounds to even, 12.5). From (0, 0) to (6, 1): y = 0 up to
+    # x = 2, a half pixel at x = 3 (rounded up: (3, 1)), y = 1 after; to (7, 1) it would be (3, 0)
+    drawn, _ = _image([[[0.0, 0.0], [6.5 - 2**-50, 1.0]]], (2, 6))
+    assert (drawn == _mask((2, 6), [(0, 0), (1, 0), (2, 0), (3, 1), (4, 1), (5, 1)])).all()
+
+
+def test_a_band_in_a_one_column_image():
+    # a vertical line x = 0 from y = 1 to 3 in a 5 x 1 image, width 1: rows 1..3 (on it); rows 0 and 4 are 1
+    # from its ends. The band's window is that one column
+    band = lm.band_pixels(np.array([[[0.0, 1.0], [0.0, 3.0]]]), (5, 1), 1.0)
+    assert band[:, 0].tolist() == [False, True, True, True, False]
+
+
+def test_band_holding_one_centre():
+    # around the point (2, 2.3), the band holding 1 centre: h halfway from 0.3 ((2, 2)) to 0.7 ((2, 3)), 0.5:
+    # (2, 2) alone, whatever the width read
+    point = np.array([[[2.0, 2.3], [2.0, 2.3]]])
+    assert (lm.band_holding(point, (5, 5), 1, 2.0) == _mask((5, 5), [(2, 2)])).all()
