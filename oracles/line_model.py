@@ -24,15 +24,18 @@ What the rules cannot decide (:func:`rounded_ties`), a mask of pixels that a cor
 may not take:
 
 1. *across the line*: where the rounded line's minor coordinate is exactly a half pixel, the pixels
-   either side (Bresenham's error term, Pillow's and OpenCV's each break it their own way);
+   either side (Bresenham's error term, Pillow's and OpenCV's each break it their own way); and so for
+   the line between each rounding of its ends in 2. and 3.;
 2. *at an end*: an end within ``end_tie_px`` of a half pixel on an axis (a fixed-point renderer rounds
    its own way: OpenCV's 4 fraction bits put an end within 1/32 px of the half on it): every pixel that
    differs between the drawings with that end rounded down or up;
 3. *an end made by the image border*: an end outside the image is rounded where it lies by a renderer
    that draws the whole line and drops the pixels outside, and near the border by one that clips first:
-   every pixel that differs between the drawings with that end rounded, or replaced by any of the four
-   pixels around where the line crosses the border grown by a few pixels (:data:`CLIP_MARGINS_PX`). An end outside the image draws no end pixel, so it
-   decides no end fault.
+   every pixel that differs between the drawings with that end rounded, or replaced by the pixels
+   around where the line crosses the border grown by a few pixels (:data:`CLIP_MARGINS_PX`): either way
+   across the line, and along it where the crossing is a half pixel (a renderer's float error rounds it
+   either way). A segment passing within 2 px of the image counts as reaching it. An end outside the
+   image draws no end pixel, so it decides no end fault.
 
 A binary band of width ``w`` (:func:`band_pixels`): the pixel centres within ``w / 2`` of the line
 (across it), moved ``lean`` px along its normal: the symmetric reference of wide binary lines.
@@ -182,7 +185,9 @@ def _end_choices(q: np.ndarray, cuts: list, outside: np.ndarray, end_tie_px: flo
     fuzzy = np.abs(q - np.floor(q) - 0.5) <= end_tie_px  # per axis
     near = corners(np.where(fuzzy, np.floor(q), base), np.where(fuzzy, np.floor(q) + 1, base))
     # an end outside the image: the renderer may cut the line anywhere out to it, then round either way
-    # across the line (along it, the rounding moves the end by a pixel outside the image: nothing drawn)
+    # across the line; along it, a cut on a border across the line lies on a half pixel, which a renderer's
+    # float error rounds down as well as up (the end moves a pixel outside the image, the line's slope with
+    # it: an inner pixel may move)
     out = [near]
     for c in cuts:
         d = c - q
@@ -191,9 +196,11 @@ def _end_choices(q: np.ndarray, cuts: list, outside: np.ndarray, end_tie_px: flo
             if len(q)
             else np.zeros((0, 2), bool)
         )
-        lo = np.where(minor, np.floor(c), _round_half_up(c))
-        hi = np.where(minor, np.floor(c) + 1, _round_half_up(c))
-        out.append(np.where(outside[:, None, None], np.stack([lo, hi, lo, hi], axis=1), near))
+        rounded = _round_half_up(c)
+        lo = np.where(minor, np.floor(c), rounded)
+        hi = np.where(minor, np.floor(c) + 1, rounded)
+        down = np.where(~minor & (np.abs(c - np.floor(c) - 0.5) <= end_tie_px), np.floor(c), rounded)
+        out.append(np.where(outside[:, None, None], np.stack([lo, hi, down, rounded], axis=1), near))
     return np.concatenate(out, axis=1).astype(np.int64)
 
 
@@ -210,7 +217,9 @@ def rounded_ties(segs_px: np.ndarray, shape, end_tie_px: float = END_TIE_PX) -> 
     if not len(q0):
         return ties
     h, w = shape
-    seen, _, _ = clip_to_image(q0, q1, w, h)  # segments that reach the image
+    # segments that reach the image grown by 2 px: a rounding of a segment that passes just outside the
+    # image (ends and pixels move at most a pixel, each pixel within half a pixel of its line) may draw inside
+    seen, _, _ = clip_to_image(q0 + 2, q1 + 2, w + 4, h + 4)
     out0 = np.any((q0 < -0.5) | (q0 > np.array([w, h]) - 0.5), axis=1) & seen
     out1 = np.any((q1 < -0.5) | (q1 > np.array([w, h]) - 0.5), axis=1) & seen
     cuts0, cuts1 = [], []
@@ -233,7 +242,10 @@ def rounded_ties(segs_px: np.ndarray, shape, end_tie_px: float = END_TIE_PX) -> 
         groups += [len(sizes)] * (len(u0) * len(u1))
         sizes.append(len(u0) * len(u1))
     if sizes:
-        px, py, _, _, variant = _step(np.concatenate(a), np.concatenate(b))
+        px, py, vx, vy, variant = _step(np.concatenate(a), np.concatenate(b))
+        # each rounding's own half pixels across the line are ties too (as the main line's above)
+        across = (vx != px) | (vy != py)
+        ties |= _paint(shape, px[across], py[across]) | _paint(shape, vx[across], vy[across])
         ok = (px >= 0) & (px < w) & (py >= 0) & (py < h)
         # each (segment, pixel) counted once per variant that draws it: a tie when some draw it, not all
         key = np.unique((variant[ok].astype(np.int64) * (h * w)) + py[ok] * w + px[ok])

@@ -246,3 +246,45 @@ def test_a_correct_renderer_pooled_stays_a_pass(square_on_job, tmp_path, capsys)
     rc, cases = _judged(square_on_job, tmp_path, hd.draw_pillow)
     assert rc == 0 and all(c["verdict"] == "pass" and c["faults"] == [] for c in cases.values())
     assert not any("job_read" in c["line_style"] for c in cases.values())
+
+
+# ---------------------------------------------------------------- the read's edges, by hand
+
+
+def test_three_cases_are_enough_for_the_jobs_offset():
+    # three: the fewest whose median leaves one case's own move out (two of three agree; of two, the median is
+    # their mean). Per axis: x (0.45, 0.5, 0.6) -> 0.5, y (0.0, 0.4, 2.0) -> 0.4
+    job = read_job([_rec(offset=(0.5, 0.4)), _rec(offset=(0.45, 0.0)), _rec(offset=(0.6, 2.0))])
+    assert job.offset_px == (0.5, 0.4) and job.offset_cases == 3
+
+
+def test_three_styles_read_once_each_impose_none():
+    # a three-way tie is a tie too (the two most common share the top count): no style imposed
+    recs = [_rec(), _rec(style="wide", rule="rounded"), _rec(style="antialiased", rule=None)]
+    assert read_job(recs).style is None
+
+
+@pytest.mark.parametrize("offset", [(0.5, 0.0), (0.0, 0.5), (-0.5, 0.0), (0.0, -0.5)])
+def test_the_jobs_offset_on_either_axis_past_the_cases_bound_differs(offset):
+    # the job's lines moved half a pixel along one axis (either sign), the case's bound 0.35 px and no
+    # pixel_offset of its own: judged again; a job offset exactly at the bound is not beyond it
+    job = JobRead(21, "aliased", "gl", None, offset, 21)
+    assert differs(_rec(), job)
+    assert not differs(_rec(tol_px=0.5), job)
+    assert differs(_rec(tol_px=math.nextafter(0.5, -UP)), job)
+
+
+def test_the_jobs_read_as_a_record_is_plain_json():
+    # report.json's job_read: the offset a list of two Python floats (a tuple would read back as a list and
+    # differ), None kept as None
+    job = JobRead(4, "aliased", "rounded", "raster_rule", (0.5, 0.25), 3)
+    assert job.as_dict() == {
+        "cases": 4,
+        "style": "aliased",
+        "rule": "rounded",
+        "rule_name": "raster_rule",
+        "offset_px": [0.5, 0.25],
+        "offset_cases": 3,
+    }
+    assert json.loads(json.dumps(job.as_dict())) == job.as_dict()
+    assert dataclasses.replace(job, offset_px=None, offset_cases=2).as_dict()["offset_px"] is None

@@ -164,6 +164,15 @@ TARGETS = {
         ["tests/test_image_naming.py", "tests/test_frames_heldout.py"],
         "tie_margin or stands_against or centre_line_is_named or prism_wide_fov or aspect_mistake",
     ),
+    # the one model of a drawn line (issue 34): its hand-made cases and the independent rounded-ends drawers
+    # (Pillow, cv2.line LINE_8, a textbook Bresenham), then the end tie's deciding test (seconds)
+    "oracles/line_model.py": (
+        ["tests/test_line_model.py", "tests/test_line_rule.py::test_rounded_end_tie_px_decides"],
+        None,
+    ),
+    # the job's pooled read: hand-written records and evidence first, then the two small held-out jobs
+    # (a half-pixel renderer pixel_offset in every case, its correct twin a pass)
+    "oracles/judge/job_read.py": (["tests/test_job_read.py"], None),
 }
 
 PER_MUTANT_TIMEOUT_S = 300
