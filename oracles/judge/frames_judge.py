@@ -164,7 +164,8 @@ class JobFrame:
         cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
         for key in metrics.PIXEL_SCORE_KEYS:
             src.core_min[key] = min(src.core_min.get(key, 1.0), float(cs[key]))
-        frame_rec.update({"core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"]})
+        # beside the candidate's F1s, which the measurement writes in their places (report.json's order)
+        frame_rec.update({"f1_0px": None, "f1_1px": None, "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"]})
         if self.i in src.keep:
             src.diag.append((fp.cand_idx, orac.shape, segs, oracle_segments(p_world, edges, flipped_camera(camera))))
         return fp, seg0, seg1, segs
