@@ -25,6 +25,7 @@ from wirecheck.core.projector import raster
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles import tolerances
 from wirecheck.oracles.cli import main
+from wirecheck.oracles.judge import metrics
 from wirecheck.oracles.judge.frames_judge import diagnosis_frames, run_frames
 from wirecheck.oracles.runner import CoreCandidate, Tolerances, run_crosscheck
 
@@ -91,6 +92,14 @@ def test_core_exact_frames_pass_with_line_scores(exact):
         assert abs(lines["imbalance_fraction"]) <= tolerances.MAX_IMBALANCE_FRACTION
         assert lines["edge_count_max_diff"] <= 1 and lines["lines_compared"] > 0
         assert case["faults"] == [] and all("candidate_only" in f for f in case["per_frame"])
+        # each frame's fields in report.json's order: the candidate's F1s, core's second opinion, the counts,
+        # then the lines' (metrics.LINE_FRAME_KEYS)
+        assert all(
+            list(f)
+            == ["frame", "f1_0px", "f1_1px", "core_f1_0px", "core_f1_1px", "candidate_pixels", "oracle_pixels"]
+            + list(metrics.LINE_FRAME_KEYS)
+            for f in case["per_frame"]
+        )
     # the report states every limit the frames were judged by, the line gate's included
     assert report["tolerances"]["max_edge_count_diff"] == tolerances.MAX_EDGE_COUNT_DIFF
     assert report["tolerances"]["balance_alpha"] == tolerances.BALANCE_ALPHA

@@ -324,7 +324,7 @@ def test_line_scores_with_nothing_drawn_near_an_edge_on_screen():
 @pytest.mark.parametrize("how", ["flat", "bits"])
 def test_kept_image_gives_the_image_back(how):
     """worst.gif's kept frames: a wireframe kept as its drawn pixels' indices, a silhouette as bits."""
-    from wirecheck.oracles.judge.case import KeptImage
+    from wirecheck.oracles.judge.wire_frames import KeptImage
 
     image = np.zeros((5, 7), bool)
     image[0, 0] = image[4, 6] = image[2, 3] = True  # the corners and the middle

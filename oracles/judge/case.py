@@ -1,18 +1,20 @@
-"""One case: a scene under one camera, frame by frame, the candidate against the oracles.
+"""One case of a projector or of core: a scene under one camera, frame by frame, the candidate against the oracles.
 
-Frame ``k`` (1-based, at ``t = (k - 1) / frames``) goes through two stages:
+The case's frames come from :class:`ProjectorFrames`, a source of the one case loop
+(oracles.judge.case_loop.measure_frames). Frame ``k`` (1-based, at ``t = (k - 1) / frames``) gives:
 
-1. **vertex stage** (levels ``vertices`` and ``pixels``): the oracle side's world
+1. **vertices** (levels ``vertices`` and ``pixels``): the oracle side's world
    points (oracles.references.faces.frame_geometry: scipy matrices, independent of core),
    OpenCV's ``projectPoints`` of them, and the candidate's pixels of the same
    points: core through its own pipeline (:func:`core.projector.pipeline.render_frame`
    given no edges, so nothing is drawn), any other candidate called on the
-   world points (oracles.candidates.candidate); :func:`vertex_stage` scores them and keeps
-   the case's scale for the precision-derived vertex bound
-   (oracles.tolerances.vertex_scale);
-2. **pixel stage** (level ``pixels``): the candidate's frame (core's full
-   pipeline, or oracles.candidates.draw for another candidate) against pyrender's
-   rendering of the same edges, faces or shading (:func:`pixel_stage`).
+   world points (oracles.candidates.candidate); :meth:`CaseFrames.add_vertices` keeps them
+   (scored for all frames at once, :func:`score_vertices`) and the case's scale for the
+   precision-derived vertex bound (oracles.tolerances.vertex_scale);
+2. **pixels** (level ``pixels``): the candidate's frame (core's full pipeline, or
+   oracles.candidates.draw for another candidate) against pyrender's rendering of the same
+   edges or faces, measured as a wireframe (oracles.judge.wire_frames) or shaded
+   (oracles.judge.shaded_frames).
 
 Then the frames are summed up into the case's record and judged
 (oracles.judge.verdict). The drawing modes are described in oracles.runner.
@@ -38,7 +40,10 @@ from ..references import opencv_oracle
 from ..references.convert import opencv_matrices
 from ..tolerances import Tolerances
 from . import metrics
-from .verdict import LINE_FRAME_KEYS, SHADED_FRAME_KEYS, case_record, judge
+from .case_loop import Measurements, measure_frames
+from .shaded_frames import ShadedFrames
+from .verdict import case_record, judge
+from .wire_frames import SCORE_FRAME_KEYS, WireFrames
 
 #: The note of a case whose camera has lens distortion, run at level pixels.
 PIXELS_NOT_COMPARED = (
@@ -47,31 +52,8 @@ PIXELS_NOT_COMPARED = (
     "distortion coefficients"
 )
 
-
-@dataclass(frozen=True)
-class KeptImage:
-    """A bool image kept for worst.gif: its drawn pixels' flat indices (a wireframe: ~1 % of the
-    image, already found by frame_pixels.FramePixels), or its bits packed (a filled silhouette)."""
-
-    shape: tuple
-    flat: np.ndarray | None = None
-    bits: np.ndarray | None = None
-
-    @classmethod
-    def of(cls, image: np.ndarray, flat: np.ndarray | None = None) -> KeptImage:
-        """``image`` kept: as ``flat`` (its drawn pixels' ascending flat indices) when given, else packed."""
-        if flat is not None:
-            return cls(image.shape, flat=flat)
-        return cls(image.shape, bits=np.packbits(image))
-
-    def image(self) -> np.ndarray:
-        """The ``(H, W)`` bool image back."""
-        h, w = self.shape
-        if self.flat is not None:
-            out = np.zeros(h * w, bool)
-            out[self.flat] = True
-            return out.reshape(h, w)
-        return np.unpackbits(self.bits, count=h * w).reshape(h, w).astype(bool)
+#: Per-frame fields of the vertex comparison (:func:`score_vertices`).
+VERTEX_FRAME_KEYS = ("max_vertex_error_px", "mean_vertex_error_px", "rms_vertex_error_px", "visible_points")
 
 
 @dataclass
@@ -199,14 +181,10 @@ class CaseFrames:
     oracle_px: list = field(default_factory=list)
     frame_errors: list = field(default_factory=list)  # (max error px, frame, worst vertex)
     per_frame: list = field(default_factory=list)  # the record's per_frame items
-    pixel: dict = field(default_factory=lambda: {key: [] for key in metrics.PIXEL_SCORE_KEYS})
-    shaded: list = field(default_factory=list)  # (frame, shaded scores)
-    lines: list = field(default_factory=list)  # (frame, metrics.line_scores) of wireframes
+    wire: WireFrames | None = None  # the wireframes' scores (oracles.judge.wire_frames), at level pixels
+    shaded: ShadedFrames | None = None  # the shaded frames' scores (oracles.judge.shaded_frames), style shaded
     kept: list | None = None  # (frame, KeptImage candidate, KeptImage oracle)
-    worst: tuple | None = None  # (key, frame, candidate image, oracle image)
     error: str | None = None
-    line_batch: metrics.LineBatch = field(default_factory=metrics.LineBatch)  # frames waiting for line scores
-    drawn_px: int = 0  # pixels drawn by either side, over the frames (oracles.judge.gate)
     oracle_bound_px: float = 0.0  # pyrender's own error bound, largest over the frames
     planes: dict | None = None  # the candidate's probed planes (oracles.diagnosis.clip_planes)
     #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + hdraw + pr + pmetric
@@ -214,6 +192,27 @@ class CaseFrames:
     seconds: dict = field(
         default_factory=lambda: dict.fromkeys(("setup", "cv", "proj", "vmetric", "draw", "hdraw", "pr", "pmetric"), 0.0)
     )
+
+    def measurements(self) -> Measurements:
+        """The case loop's measurements (oracles.judge.case_loop): the vertices (this), its wireframes or shaded
+        frames where pixels are compared."""
+        return Measurements(vertices=self, wire=self.wire, shaded=self.shaded, per_frame=self.per_frame)
+
+    @property
+    def drawn_px(self) -> int:
+        """Pixels drawn by either side over the frames (oracles.judge.gate)."""
+        return self.measurements().drawn_px
+
+    def add_vertices(self, k: int, setup: CaseSetup, p_world, cand_px, oracle_px, precision: str, frame_rec: dict):
+        """Frame ``k``'s vertices: the candidate's pixels ``cand_px`` ``(N, 2)`` and OpenCV's ``oracle_px`` of the
+        world points ``p_world``, the candidate judged as ``precision``; their errors are taken for all frames
+        at once (:func:`score_vertices`), their fields in ``frame_rec`` None until then."""
+        if precision != "float64":
+            cand_px, oracle_px = forgive_depth_ties(self, setup, p_world, cand_px, oracle_px, precision)
+        self.cand_px.append(cand_px)
+        self.oracle_px.append(oracle_px)
+        frame_rec.update(dict.fromkeys(VERTEX_FRAME_KEYS))
+        self.scales.add(p_world, oracle_px, setup.cam, setup.cv_matrices)
 
     def add(self, key: str, t0: float) -> float:
         t = time.perf_counter()
@@ -247,50 +246,23 @@ def run_case(
     points of both sides in :attr:`CaseResult.worst_points`.
     """
     setup = CaseSetup(scene, case, frames, candidate, motion, mode or RenderMode(), pyrender_oracle is not None)
-    acc = CaseFrames(kept=[] if keep_frames and setup.pixels else None)
-    for k in range(first, frames + 1, every):
-        t0 = time.perf_counter()
-        geometry = oface.frame_geometry(scene, motion, (k - 1) / frames)
-        t1 = time.perf_counter()
-        oracle_px = opencv_oracle.project(geometry[0], setup.cam)
-        t2 = time.perf_counter()
-        try:
-            cand_px, points, m_core, returned = candidate_vertices(setup, k, geometry[0])
-            acc.returned.add(returned)
-            t3 = time.perf_counter()
-            precision = case_precision(tol.precision, acc.returned)[0]
-            calls_before = setup.timed.seconds if setup.timed else 0.0
-            cand_img, cand_depth = (
-                candidate_frame(setup, points, m_core, geometry[0], precision) if setup.pixels else (None, None)
-            )
-            t4 = time.perf_counter()
-            own_draw = setup.timed.seconds - calls_before if setup.timed else t4 - t3
-        except CandidateError as exc:
-            acc.error = f"frame {k}: {exc}"
-            break
-        acc.seconds["setup"] += t1 - t0
-        acc.seconds["cv"] += t2 - t1
-        acc.seconds["proj"] += t3 - t2
-        acc.seconds["draw"] += own_draw
-        acc.seconds["hdraw"] += t4 - t3 - own_draw
-        t5 = time.perf_counter()
-        projected = oracle_px  # OpenCV's pixels of every point, for the oracle's segments
-        if precision != "float64":
-            cand_px, oracle_px = forgive_depth_ties(acc, setup, geometry[0], cand_px, oracle_px, precision)
-        frame_rec = vertex_stage(acc, k, cand_px, oracle_px)
-        acc.scales.add(geometry[0], oracle_px, setup.cam, setup.cv_matrices)
-        t6 = acc.add("vmetric", t5)
-        if setup.pixels:
-            pixel_stage(
-                setup, acc, k, frame_rec, geometry, cand_img, cand_depth, pyrender_oracle, want_images, t6, projected
-            )
+    kept = [] if keep_frames and setup.pixels else None
+    acc = CaseFrames(kept=kept)
+    if setup.pixels and setup.mode.shaded:
+        tris, owner = (setup.tris, setup.tri_owner) if setup.use_faces else (None, None)
+        acc.shaded = ShadedFrames(setup.cam, tris, owner, want_images, kept)
+    elif setup.pixels:
+        acc.wire = WireFrames(SCORE_FRAME_KEYS, resolve_ties=True, kept=kept)
+    source = ProjectorFrames(setup, acc, tol, pyrender_oracle, range(first, frames + 1, every))
+    measure_frames(source, acc.measurements())
     t7 = time.perf_counter()
     score_vertices(acc)
     if acc.cand_px and not setup.is_core and visibility_differs(acc):
         acc.planes = setup.planes()  # where the candidate clips, to name a clipping_plane
     acc.scale = acc.scales.flush(setup.cam, setup.cv_matrices)
     t7 = acc.add("vmetric", t7)
-    record_lines(acc, acc.line_batch.flush())
+    if acc.wire is not None:
+        acc.wire.flush()
     acc.add("pmetric", t7)
     rec, ev = case_record(
         setup, acc, tol, points=len(scene.vertices), oracle_bound_px=acc.oracle_bound_px if setup.pixels else None
@@ -301,8 +273,8 @@ def run_case(
         rec["note"] = PIXELS_NOT_COMPARED
     judge(rec, ev, tol, acc.per_frame)
     images = None
-    if acc.worst is not None:
-        images = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]}
+    if want_images and setup.pixels:
+        images = (acc.shaded or acc.wire).worst_images()
     return CaseResult(
         record=rec,
         worst_images=images,
@@ -396,25 +368,6 @@ def forgive_depth_ties(
     return cand_px, oracle_px
 
 
-def vertex_stage(acc: CaseFrames, k: int, cand_px: np.ndarray, oracle_px: np.ndarray) -> dict:
-    """Keep frame ``k``'s vertex pixels and OpenCV's for the case; return the frame's record.
-
-    The record's vertex fields are filled by :func:`score_vertices`, for all
-    frames at once (metrics.vertex_errors_frames).
-    """
-    acc.cand_px.append(cand_px)
-    acc.oracle_px.append(oracle_px)
-    frame_rec = {
-        "frame": k,
-        "max_vertex_error_px": None,
-        "mean_vertex_error_px": None,
-        "rms_vertex_error_px": None,
-        "visible_points": None,
-    }
-    acc.per_frame.append(frame_rec)
-    return frame_rec
-
-
 def score_vertices(acc: CaseFrames) -> None:
     """Every kept frame's vertex errors into its record and ``acc.frame_errors``."""
     for frame_rec, ve in zip(acc.per_frame, metrics.vertex_errors_frames(acc.cand_px, acc.oracle_px)):
@@ -430,61 +383,74 @@ def score_vertices(acc: CaseFrames) -> None:
         )
 
 
-def pixel_stage(
-    setup: CaseSetup,
-    acc: CaseFrames,
-    k: int,
-    frame_rec: dict,
-    geometry,
-    cand_img,
-    cand_depth,
-    pyrender_oracle,
-    want_images: bool,
-    t0: float,
-    oracle_px: np.ndarray | None = None,
-) -> None:
-    """pyrender's frame ``k`` against the candidate's: scores into ``frame_rec`` and ``acc`` (time from ``t0``).
+class ProjectorFrames:
+    """A projector's or core's frames, as a source of the case loop (oracles.judge.case_loop): frame by frame,
+    the oracle side's world points (oracles.references.faces.frame_geometry), OpenCV's pixels of them, the
+    candidate's pixels (:func:`candidate_vertices`) and, where pixels are compared, its frame
+    (:func:`candidate_frame`: core draws its own, the harness draws another candidate's); pyrender draws when a
+    measurement asks. A candidate that fails at a frame ends the frames there (``acc.error``)."""
 
-    ``oracle_px``: OpenCV's pixels of the frame's world points, when the vertex stage has them.
-    """
-    p_world, matrices, pr_vertices, pr_pose = geometry
-    mode, cam, scene = setup.mode, setup.cam, setup.scene
-    fp = None  # the wireframe's drawn pixels (frame_pixels.FramePixels)
-    mirrored = oface.mirrored_vertices(scene, matrices) if setup.use_faces and mode.cull == "backface" else None
-    if mode.shaded:
-        if setup.use_faces:
-            triangles = oface.gl_triangles(setup.tris, mirrored)
-            t0 = acc.add("pmetric", t0)  # the harness's inputs to pyrender
-            orac_img, orac_depth, ids = pyrender_oracle.render_faces(
-                pr_vertices, triangles, cam, model_matrix=pr_pose, cull=mode.cull == "backface", with_ids=True
-            )
-        else:
-            orac_img = np.zeros((cam.height, cam.width), bool)
-        t1 = acc.add("pr", t0)
-        if setup.use_faces:
-            acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(pyrender_oracle, "last_bound_px", 0.0))
-        cand_img = np.isfinite(cand_depth)
-        if setup.use_faces:
-            cand_faces = getattr(setup.candidate, "last_face_ids", None)
-            orac_faces = np.where(ids >= 0, setup.tri_owner[np.maximum(ids, 0)], -1)  # triangle -> polygon
-            ss = metrics.shaded_scores(
-                cand_depth,
-                orac_img,
-                orac_depth,
-                metrics.depth_bound(orac_depth, orac_img, cam),
-                metrics.occlusion_boundary(ids, setup.tris),
-                cand_faces=cand_faces,
-                oracle_faces=orac_faces,
-            )
-            acc.shaded.append((k, ss))
-            acc.drawn_px += ss["silhouette_union_px"]
-            frame_rec.update({key: ss[key] for key in SHADED_FRAME_KEYS})
-            key = (ss["silhouette_iou"], -(ss["depth_error_ratio"] or 0.0))
-        else:
-            key = None
-    else:
+    def __init__(self, setup: CaseSetup, acc: CaseFrames, tol: Tolerances, pyrender_oracle, numbers: range):
+        self.setup, self.acc, self.tol, self.oracle, self.numbers = setup, acc, tol, pyrender_oracle, numbers
+
+    def __iter__(self):
+        setup, acc = self.setup, self.acc
+        for k in self.numbers:
+            t0 = time.perf_counter()
+            geometry = oface.frame_geometry(setup.scene, setup.motion, (k - 1) / setup.frames)
+            t1 = time.perf_counter()
+            oracle_px = opencv_oracle.project(geometry[0], setup.cam)
+            t2 = time.perf_counter()
+            try:
+                cand_px, points, m_core, returned = candidate_vertices(setup, k, geometry[0])
+                acc.returned.add(returned)
+                t3 = time.perf_counter()
+                precision = case_precision(self.tol.precision, acc.returned)[0]
+                calls_before = setup.timed.seconds if setup.timed else 0.0
+                cand_img, cand_depth = (
+                    candidate_frame(setup, points, m_core, geometry[0], precision) if setup.pixels else (None, None)
+                )
+                t4 = time.perf_counter()
+                own_draw = setup.timed.seconds - calls_before if setup.timed else t4 - t3
+            except CandidateError as exc:
+                acc.error = f"frame {k}: {exc}"
+                return
+            acc.seconds["setup"] += t1 - t0
+            acc.seconds["cv"] += t2 - t1
+            acc.seconds["proj"] += t3 - t2
+            acc.seconds["draw"] += own_draw
+            acc.seconds["hdraw"] += t4 - t3 - own_draw
+            yield ProjectorFrame(self, k, geometry, oracle_px, cand_px, precision, cand_img, cand_depth)
+
+
+class ProjectorFrame:
+    """One frame of :class:`ProjectorFrames` (oracles.judge.case_loop.SourceFrame)."""
+
+    def __init__(self, source: ProjectorFrames, k: int, geometry, oracle_px, cand_px, precision, cand_img, cand_depth):
+        self.source, self.number, self.geometry = source, k, geometry
+        self.oracle_px, self.cand_px, self.precision = oracle_px, cand_px, precision
+        self.cand_img, self.cand_depth = cand_img, cand_depth
+
+    def vertices(self) -> tuple:
+        """``(setup, p_world, cand_px, oracle_px, precision)``: CaseFrames.add_vertices' inputs."""
+        return self.source.setup, self.geometry[0], self.cand_px, self.oracle_px, self.precision
+
+    def _mirrored(self):
+        setup = self.source.setup
+        if setup.use_faces and setup.mode.cull == "backface":
+            return oface.mirrored_vertices(setup.scene, self.geometry[1])
+        return None
+
+    def wireframe(self, frame_rec: dict) -> tuple:
+        """``(FramePixels, seg0, seg1, None)``: the candidate's frame against pyrender's drawing of the edges the
+        mode draws (hidden lines, culled faces), and where the oracle's lines lie (OpenCV's pixels of the ends)."""
+        setup, acc = self.source.setup, self.source.acc
+        t0 = time.perf_counter()
+        p_world, _matrices, pr_vertices, pr_pose = self.geometry
+        mode, cam = setup.mode, setup.cam
+        mirrored = self._mirrored()
         draw_edges, occluders = setup.edges, None
-        seg0, seg1 = oracle_segments(p_world, setup.edges, cam, oracle_px)  # where the oracle's lines lie
+        seg0, seg1 = oracle_segments(p_world, setup.edges, cam, self.oracle_px)  # where the oracle's lines lie
         if setup.use_faces and mode.cull == "backface":
             kept = setup.owners.kept(oface.front_faces(p_world, setup.faces, cam, mirrored))
             draw_edges = setup.edges[kept]
@@ -494,7 +460,7 @@ def pixel_stage(
         t0 = acc.add("pmetric", t0)  # the oracle's segments and the edges to draw: harness, not pyrender
         # the colour only (the mask pyrender's colour-and-depth read gives, without the depth's read back and
         # linearisation: tests/test_oracle_gl.py)
-        orac_img, _depth = pyrender_oracle.render(
+        orac_img, _depth = self.source.oracle.render(
             pr_vertices,
             draw_edges,
             cam,
@@ -504,42 +470,37 @@ def pixel_stage(
             depth=False,
         )
         t1 = acc.add("pr", t0)
-        acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(pyrender_oracle, "last_bound_px", 0.0))
-        fp = metrics.FramePixels(cand_img, orac_img)  # one scan of each image
-        ps = metrics.pixel_scores(None, None, pixels=fp)
-        acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
-        for name, values in acc.pixel.items():
-            values.append(ps[name])
-        frame_rec.update({name: ps[name] for name in metrics.PIXEL_SCORE_KEYS})
-        at = len(acc.pixel["f1_0px"]) - 1  # this frame's place in acc.pixel
-        record_lines(acc, acc.line_batch.add((k, frame_rec, at), fp, seg0, seg1))  # scored with later frames
-        key = (ps["f1_1px"], ps["f1_0px"])
-    if want_images and key is not None and (acc.worst is None or key < acc.worst[0]):
-        acc.worst = (key, k, cand_img.copy(), orac_img.copy())
-    if acc.kept is not None:
-        acc.kept.append(
-            (
-                k,
-                KeptImage.of(cand_img, fp.cand_idx if fp else None),
-                KeptImage.of(orac_img, fp.oracle_idx if fp else None),
+        acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(self.source.oracle, "last_bound_px", 0.0))
+        fp = metrics.FramePixels(self.cand_img, orac_img)  # one scan of each image
+        acc.add("pmetric", t1)
+        return fp, seg0, seg1, None
+
+    def shaded(self) -> tuple:
+        """``(depth buffer, the faces it shows, pyrender's (covered, depth, triangle ids))``; the drawing None
+        without faces."""
+        setup, acc = self.source.setup, self.source.acc
+        t0 = time.perf_counter()
+        drawing = None
+        if setup.use_faces:
+            _p_world, _matrices, pr_vertices, pr_pose = self.geometry
+            triangles = oface.gl_triangles(setup.tris, self._mirrored())
+            t0 = acc.add("pmetric", t0)  # the harness's inputs to pyrender
+            drawing = self.source.oracle.render_faces(
+                pr_vertices,
+                triangles,
+                setup.cam,
+                model_matrix=pr_pose,
+                cull=setup.mode.cull == "backface",
+                with_ids=True,
             )
-        )
-    acc.add("pmetric", t1)
+        acc.add("pr", t0)
+        if setup.use_faces:
+            acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(self.source.oracle, "last_bound_px", 0.0))
+        return self.cand_depth, getattr(setup.candidate, "last_face_ids", None) if setup.use_faces else None, drawing
 
-
-def record_lines(acc: CaseFrames, scored: list) -> None:
-    """Frames' line scores (metrics.LineBatch: ``[((frame, frame record, place in acc.pixel), scores)]``) into
-    ``acc`` and their records.
-
-    A frame with sub-pixel ties has its scores at 0 px replaced by those with
-    the ties undecided (metrics.line_scores' ``tie_resolved``), in its record
-    and in ``acc.pixel``: F1@0px judges the decided pixels, as the balance does.
-    """
-    for (k, frame_rec, at), ls in scored:
-        acc.lines.append((k, ls))
-        frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
-        for name, value in (ls["tie_resolved"] or {}).items():
-            frame_rec[name] = acc.pixel[name][at] = value
+    def spent(self, kind: str, seconds: float) -> None:
+        """A measurement's seconds: the vertex stage's, or the pixel stage's metrics."""
+        self.source.acc.seconds["vmetric" if kind == "vertices" else "pmetric"] += seconds
 
 
 def _per_frame_ms(seconds: float, frames: int) -> float:

@@ -1,6 +1,6 @@
-"""A renderer's depth maps of a frames job, measured frame by frame inside the frames judge's case loop.
+"""A renderer's depth maps of a frames job, measured frame by frame inside the case loop.
 
-:func:`oracles.judge.frames_judge.judge_case` hands each frame's depth file and the
+The case loop (oracles.judge.case_loop, fed by oracles.judge.frames_judge.JobFrames) hands each frame's depth file and the
 frame's reference (pyrender's faces, :func:`oracles.judge.depth_reference.from_render`:
 linear float64 depth, its per-pixel bound, the undecided pixels) to :meth:`DepthFrames.add`;
 the case's fields go into its record (:meth:`DepthFrames.fields`, ``record["depth_map"]``)

@@ -1,6 +1,6 @@
-"""A renderer's filled frames of a frames job, measured frame by frame inside the frames judge's case loop.
+"""A renderer's filled frames of a frames job, measured frame by frame inside the case loop.
 
-:func:`oracles.judge.frames_judge.judge_case` hands each frame's filled PNG, its world points and
+The case loop (oracles.judge.case_loop, fed by oracles.judge.frames_judge.JobFrames) hands each frame's filled PNG, its world points and
 faces (the job's own OBJ and camera) to :meth:`FilledFrames.add`; the case's fields go into its
 record (:meth:`FilledFrames.fields`, ``record["filled"]``) and :mod:`oracles.judge.decide` alone
 decides on them. Per frame:

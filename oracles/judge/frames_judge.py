@@ -15,8 +15,11 @@ scene (oracles.candidates.draw.oracle_segments). After the frames, the case's me
 at level ``frames``: no vertex compared), its faults named from both (oracles.judge.name_faults: the images'
 names, else the lines'), and its record built once (:func:`case_record`).
 
+The case's frames come from :class:`JobFrames`, a source of the one case loop
+(oracles.judge.case_loop.measure_frames), whose wireframes are measured as a projector's are
+(oracles.judge.wire_frames.WireFrames, judged as drawn, the drawing rule read by the case's style).
 A job that asks for depth maps or filled frames (``outputs``, oracles.candidates.export)
-has them measured in the same frame loop: pyrender draws the frame's faces (on the
+has them measured in the same loop: pyrender draws the frame's faces (on the
 GL thread, read ahead), each depth map is read and judged against that depth
 (oracles.judge.depth_frames), each filled frame against the fill rule's
 silhouette (oracles.judge.filled_frames); their fields join the case's record
@@ -40,19 +43,18 @@ from pathlib import Path
 import numpy as np
 from wirecheck.core.projector import pipeline
 
-from .. import line_model
 from ..candidates import frames_candidate
 from ..candidates.draw import oracle_segments as line_segments
 from ..candidates.export import job_outputs
 from ..candidates.frames_candidate import face_objects, read_frame
-from ..diagnosis.diagnose import diagnose_lines
 from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
 from ..diagnosis.image_visibility import set_difference
 from ..faults import Fault
 from ..references import opencv_oracle
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances
 from . import f1_radius, metrics
-from .decide import decide, filled_reasons, pixel_fields
+from .case_loop import Measurements, measure_frames
+from .decide import decide, filled_reasons
 from .depth_frames import DepthFrames
 from .depth_reference import from_render
 from .evidence import CaseEvidence, Visibility
@@ -61,16 +63,14 @@ from .frame_prefetch import FramePrefetch, reader_for
 from .job_read import differs, read_job
 from .line_style import CaseStyle, style_record
 from .name_faults import name_faults, wants_visibility
-from .record import finish_record
+from .record import finish_record, wire_fields
 from .run_report import run_report, tolerances_field
+from .wire_frames import COUNT_FRAME_KEYS, WireFrames, flat_image
 
 #: Frames of a case kept for the image diagnosis (evenly spaced, first and last included).
 #: The diagnosis samples at most 3,600 points a case (oracles.diagnosis.registration.MAX_POINTS_PER_CASE),
 #: 150 a frame at 24 frames: more frames would add few points each and cost memory.
 DIAGNOSIS_FRAMES = 24
-
-#: Per-frame fields of the line comparison: the projector path's (oracles.judge.metrics.LINE_FRAME_KEYS).
-LINE_FRAME_KEYS = metrics.LINE_FRAME_KEYS
 
 
 def candidate_pixels(
@@ -106,48 +106,97 @@ def diagnosis_frames(n: int, limit: int = DIAGNOSIS_FRAMES) -> set:
     return {int(i) for i in np.round(np.linspace(0, n - 1, limit))}
 
 
-class _CaseFrames:
-    """What a case's frames gathered, frame by frame (no image kept beyond :data:`DIAGNOSIS_FRAMES`)."""
+class JobFrames:
+    """A renderer's frames of one case of a job, as a source of the case loop (oracles.judge.case_loop): each
+    frame's inputs (the job's OBJ, camera and model matrix), pyrender's drawing and the frame's files, read
+    ahead (``ahead``: oracles.judge.frame_prefetch.FramePrefetch.frames; each step's error raised at its frame
+    and step). Beside the measurements, the source keeps core's second opinion on the wireframes
+    (``core_min``: each score's minimum over the frames, never deciding) and the drawn pixels of the frames
+    kept for the image diagnosis (``keep``: their indices, :func:`diagnosis_frames`)."""
 
-    def __init__(self):
-        self.pixel = {key: [] for key in metrics.PIXEL_SCORE_KEYS}
-        self.core_min = {}
-        self.radius = []  # each frame's F1 at the wider radii (f1_radius)
-        self.per_frame, self.lines = [], []
-        self.batch = metrics.LineBatch()
-        self.drawn_px = 0
-        self.worst = None  # ((f1_1px, f1_0px), frame, candidate, oracle)
-        self.diag = []  # (KeptImage-like flat indices, shape, segments, flipped)
-        self.rounded_f1 = []  # each frame's F1@0px against the rounded-ends rule (line_model)
-        self.rounded_batch = metrics.LineBatch()
-        self.rounded_lines = []
+    def __init__(self, job_dir, job, c: dict, ahead, style, keep: set):
+        self.job_dir, self.job, self.c, self.ahead, self.style, self.keep = job_dir, job, c, ahead, style, keep
+        self.core_min: dict = {}
+        self.diag: list = []  # (drawn pixels' flat indices, shape, segments, the flipped camera's segments)
+        self.camera = None  # the last frame's
+        self.objects = (None, None)  # (faces, each face's object), kept while the faces are the same object
 
-    def add_rounded(self, k, cand: np.ndarray, segs: np.ndarray, shape: tuple, seg0, seg1, tol) -> None:
-        """Score a frame's drawn pixels ``cand`` (flat) against a correct drawing of ``segs`` by the
-        rounded-ends rule (oracles.line_model), the rule's ties left out of both."""
-        model, ties = line_model.expected(segs, shape, "rounded", tol.rounded_end_tie_px)
-        keep = ~ties.reshape(-1)
-        fp = metrics.FramePixels.from_indices(shape, cand[keep[cand]], np.flatnonzero(model.reshape(-1) & keep))
-        self.rounded_f1.append(float(metrics.pixel_scores(None, None, tols=(0,), pixels=fp)["f1_0px"]))
-        self.rounded_lines.extend(self.rounded_batch.add(k, fp, seg0, seg1))
-
-    def rounded(self) -> dict | None:
-        """The case's pixels against the rounded-ends rule (CaseStyle.judge's ``rounded``), None without frames."""
-        self.rounded_lines.extend(self.rounded_batch.flush())
-        if not self.rounded_f1:
-            return None
-        return {"pixel_f1_0px": min(self.rounded_f1), "lines": metrics.line_summary(self.rounded_lines)}
+    def __iter__(self):
+        for i, (k, ahead) in enumerate(zip(self.job["frame_numbers"], self.ahead)):
+            yield JobFrame(self, i, k, ahead)
 
     def visibility_inputs(self) -> tuple[list, list, list]:
         """The kept frames' ``(drawn images, oracle segments, the flipped camera's segments)``, for the image
         diagnosis and the visibility advice."""
-        images = [_image(flat, shape) for flat, shape, _, _ in self.diag]
+        images = [flat_image(flat, shape) for flat, shape, _, _ in self.diag]
         return images, [s for _, _, s, _ in self.diag], [f for _, _, _, f in self.diag]
 
-    def record_lines(self, scored: list) -> None:
-        for (k, frame_rec), ls in scored:
-            self.lines.append((k, ls))
-            frame_rec.update({name: ls[name] for name in LINE_FRAME_KEYS})
+
+class JobFrame:
+    """Frame ``k`` (the ``i``-th listed) of :class:`JobFrames` (oracles.judge.case_loop.SourceFrame)."""
+
+    def __init__(self, source: JobFrames, i: int, k: int, ahead):
+        self.source, self.i, self.number, self.ahead = source, i, k, ahead
+        self.inputs = ahead.inputs()  # (p_model, edges, camera, model_matrix)
+        source.camera = self.inputs[2]
+
+    def _path(self, kind: str) -> Path:
+        return Path(self.source.job_dir) / self.source.c[kind][self.i]
+
+    def wireframe(self, frame_rec: dict) -> tuple:
+        """``(FramePixels, seg0, seg1, segs)``: the PNG's drawn pixels (:func:`candidate_pixels`, read by the
+        case's style) against pyrender's, where the oracle's lines lie (OpenCV's pixels of the ends; only edges
+        the depth planes cut are clipped) and the lines a correct renderer draws; core's second opinion into
+        ``frame_rec``."""
+        src, (p_model, edges, camera, m) = self.source, self.inputs
+        p_world = p_model @ m[:3, :3].T + m[:3, 3]
+        seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
+        segs = oracle_segments(p_world, edges, camera)
+        orac = self.ahead.oracle()
+        job = (src.job_dir, src.job)
+        grey = self.ahead.grey()
+        cand = candidate_pixels(
+            self._path("frames"), src.c["width"], src.c["height"], src.style, orac, self.inputs, segs, job, grey=grey
+        )
+        core = _drawn(pipeline.render_frame(p_model, edges, camera, m).image)
+        fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
+        # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
+        cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
+        for key in metrics.PIXEL_SCORE_KEYS:
+            src.core_min[key] = min(src.core_min.get(key, 1.0), float(cs[key]))
+        # beside the candidate's F1s, which the measurement writes in their places (report.json's order)
+        frame_rec.update({"f1_0px": None, "f1_1px": None, "core_f1_0px": cs["f1_0px"], "core_f1_1px": cs["f1_1px"]})
+        if self.i in src.keep:
+            src.diag.append((fp.cand_idx, orac.shape, segs, oracle_segments(p_world, edges, flipped_camera(camera))))
+        return fp, seg0, seg1, segs
+
+    def depth_map(self) -> tuple:
+        """``(path, camera, reference)``: the depth file against the depth reference made of pyrender's faces
+        (oracles.judge.depth_reference.from_render, read ahead)."""
+        self.ahead.faces()  # pyrender's faces: the depth maps' reference (its error raised at this step)
+        return self._path("depth"), self.inputs[2], self.ahead.reference()[0]
+
+    def filled(self) -> dict:
+        """FilledFrames.add's inputs: the filled PNG, the frame's world points and faces (the fill rule's
+        silhouette, read ahead when the job has no depth map), each face's object, pyrender's triangle ids."""
+        src, (p_model, _edges, camera, m) = self.source, self.inputs
+        _covered, _z, ids, _tris, polygons = self.ahead.faces()
+        if src.objects[0] is not polygons:
+            src.objects = polygons, face_objects(src.job, src.c["scene"], polygons)
+        made = self.ahead.reference
+        return {
+            "path": self._path("filled"),
+            "p_world": p_model @ m[:3, :3].T + m[:3, 3],
+            "faces": polygons,
+            "camera": camera,
+            "job": (src.job_dir, src.job),
+            "objects": src.objects[1],
+            "hint": ids,
+            "reference": None if "depth" in job_outputs(src.job) else (lambda: made()[1]),
+        }
+
+    def spent(self, kind: str, seconds: float) -> None:
+        """Nothing: a job's run is timed whole."""
 
 
 def judge_case(
@@ -173,61 +222,30 @@ def judge_case(
     depth = DepthFrames(job) if "depth" in outputs else None  # each frame's depth map (depth_frames)
     filled = FilledFrames(tol.fill_tie_px) if "filled" in outputs else None  # each filled PNG (filled_frames)
     kept = diagnosis_frames(len(numbers)) if diagnose and wire else set()
-    acc = _CaseFrames()
     style = CaseStyle(line_rule, job_read.as_dict() if job_read is not None else None)
-    camera = None
+    # a renderer's frames are judged as drawn, their rule read by the style (oracles.judge.wire_frames.WireFrames)
+    rounded_tie_px = tol.rounded_end_tie_px if line_rule != "geometry" else None
+    wires = (
+        WireFrames(COUNT_FRAME_KEYS, resolve_ties=False, style=style, rounded_tie_px=rounded_tie_px) if wire else None
+    )
+    measured = Measurements(wire=wires, depth=depth, filled=filled)
     # each frame's inputs, pyrender's drawing and its PNG's grey levels, read ahead on the GL thread
     # (frame_prefetch: each step's error raised here, at its frame and step), with the work that needs only the
     # drawing made there too, beside this thread's work on the frames before it (_reference_maker)
     ahead = reader_for(oracles).frames(job_dir, job, c, numbers, _reference_maker(depth, filled, job, scene))
-    objects = (None, None)  # (faces, each face's object), kept while the faces are the same object
-    for i, (k, frame) in enumerate(zip(numbers, ahead)):
-        p_model, edges, camera, m = frame.inputs()
-        if wire:
-            _wireframe(
-                acc,
-                style,
-                Path(job_dir) / c["frames"][i],
-                c,
-                k,
-                frame,
-                (p_model, edges, camera, m),
-                (job_dir, job),
-                tol,
-                line_rule,
-                i in kept,
-            )
-        if depth or filled:
-            covered, z, ids, tris, polygons = frame.faces()  # pyrender's faces: the depth maps' reference
-            if depth:
-                rec_k = depth.add(k, Path(job_dir) / c["depth"][i], camera, frame.reference()[0])
-                acc.drawn_px += rec_k["union_px"]
-            if filled:  # the fill rule's silhouette (filled_frames)
-                if objects[0] is not polygons:
-                    objects = polygons, face_objects(job, scene, polygons)
-                rec_k = filled.add(
-                    k,
-                    Path(job_dir) / c["filled"][i],
-                    p_model @ m[:3, :3].T + m[:3, 3],
-                    polygons,
-                    camera,
-                    (job_dir, job),
-                    objects[1],
-                    hint=ids,
-                    reference=None if depth else (lambda made=frame.reference: made()[1]),
-                )
-                acc.drawn_px += rec_k["union_px"]
-        del frame
+    source = JobFrames(job_dir, job, c, ahead, style, kept)
+    measure_frames(source, measured)
     ahead.close()
+    camera = source.camera
     diagnosed, images, segments = (), [], []
     if wire:
-        acc.record_lines(acc.batch.flush())
-        images, segments, flipped = acc.visibility_inputs()
+        wires.flush()
+        images, segments, flipped = source.visibility_inputs()
         if diagnose:
             diagnosed = tuple(Fault.of(f) for f in diagnose_images(images, segments, camera, flipped, tol=tol))
     filled_fields = filled.fields(MIN_IOU_UNION_PX) if filled else None
     ev = case_evidence(
-        acc,
+        measured,
         style if wire else None,
         numbers,
         diagnosed,
@@ -245,8 +263,8 @@ def judge_case(
         # the images fit the oracle's lines (nothing named from them) and the case fails: which sets differ?
         ev = replace(ev, visibility=Visibility(*set_difference(images, segments, camera), len(images), len(numbers)))
         names = name_faults(ev, verdict, tol)
-    rec = case_record(job, scene, case, camera, ev, verdict, names, acc)
-    worst = {"frame": acc.worst[1], "candidate": acc.worst[2], "oracle": acc.worst[3]} if wire else None
+    rec = case_record(job, scene, case, camera, ev, verdict, names, measured.per_frame, source.core_min)
+    worst = wires.worst_images() if wire else None
     return rec, worst
 
 
@@ -281,63 +299,13 @@ def _wireframe_fails(ev: CaseEvidence, tol) -> bool:
     return decide(replace(ev, depth_map=None, filled=None), tol).verdict == "fail"
 
 
-def _wireframe(
-    acc: _CaseFrames, style, path: Path, c: dict, k: int, frame, inputs: tuple, job, tol, line_rule: str, keep: bool
-) -> None:
-    """Frame ``k``'s wireframe PNG (``path``) scored into ``acc`` (``frame``: its FrameAhead; ``inputs``:
-    ``(p_model, edges, camera, model_matrix)``; ``keep``: its drawn pixels kept for the image diagnosis)."""
-    p_model, edges, camera, m = inputs
-    p_world = p_model @ m[:3, :3].T + m[:3, 3]
-    # where the oracle's lines lie: OpenCV's pixels of the ends; only edges the depth planes cut are clipped
-    seg0, seg1 = line_segments(p_world, edges, camera, opencv_oracle.project(p_world, camera))
-    segs = oracle_segments(p_world, edges, camera)  # the lines a correct renderer draws
-    orac = frame.oracle()
-    cand = candidate_pixels(path, c["width"], c["height"], style, orac, inputs, segs, job, grey=frame.grey())
-    core = _drawn(pipeline.render_frame(p_model, edges, camera, m).image)
-    fp = metrics.FramePixels.from_indices(orac.shape, cand, np.flatnonzero(orac))
-    style.count_rule(fp, segs)
-    if line_rule != "geometry":
-        acc.add_rounded(k, cand, segs, orac.shape, seg0, seg1, tol)
-    ps = metrics.pixel_scores(None, None, pixels=fp)
-    # core's second opinion: the candidate's drawn pixels are fp's (one scan of each image)
-    cs = metrics.pixel_scores(None, None, pixels=metrics.FramePixels.from_indices(orac.shape, fp.cand_idx, core))
-    acc.radius.append(f1_radius.frame_scores(fp, ps))
-    for key, values in acc.pixel.items():
-        values.append(ps[key])
-    for key in metrics.PIXEL_SCORE_KEYS:
-        acc.core_min[key] = min(acc.core_min.get(key, 1.0), float(cs[key]))
-    acc.drawn_px += ps["candidate_pixels"] + ps["oracle_pixels"] - ps["both_pixels"]
-    frame_rec = {
-        "frame": k,
-        "f1_0px": ps["f1_0px"],
-        "f1_1px": ps["f1_1px"],
-        "core_f1_0px": cs["f1_0px"],
-        "core_f1_1px": cs["f1_1px"],
-        "candidate_pixels": ps["candidate_pixels"],
-        "oracle_pixels": ps["oracle_pixels"],
-    }
-    acc.per_frame.append(frame_rec)
-    acc.record_lines(acc.batch.add((k, frame_rec), fp, seg0, seg1))  # scored with later frames
-    key = (ps["f1_1px"], ps["f1_0px"])
-    if acc.worst is None or key < acc.worst[0]:
-        acc.worst = (key, k, _image(cand, orac.shape), orac.copy())
-    if keep:
-        acc.diag.append((fp.cand_idx, orac.shape, segs, oracle_segments(p_world, edges, flipped_camera(camera))))
-
-
 def _drawn(image: np.ndarray) -> np.ndarray:
     """Ascending flat indices of the pixels of ``image`` that are >= 128."""
     return np.flatnonzero(image.reshape(-1) >= 128)
 
 
-def _image(flat: np.ndarray, shape: tuple) -> np.ndarray:
-    out = np.zeros(shape[0] * shape[1], bool)
-    out[flat] = True
-    return out.reshape(shape)
-
-
 def case_evidence(
-    acc: _CaseFrames,
+    measured: Measurements,
     style: CaseStyle | None,
     numbers: list,
     diagnosed: tuple,
@@ -351,15 +319,13 @@ def case_evidence(
     the diagnosis's faults (``diagnosed``), GL's line faults, the style read and what was compared; its depth
     maps' and filled frames' fields and the faults their values and silhouettes name. ``style`` None: the job asks for no
     wireframe (no pixel or line field)."""
-    compared = {"frames": len(numbers), "vertices": 0, "pixels": acc.drawn_px}
+    compared = {"frames": len(numbers), "vertices": 0, "pixels": measured.drawn_px}
     surfaces = {"depth_map": depth_map, "filled": filled, "depth_faults": depth_faults, "filled_faults": filled_faults}
     if style is None:
         return CaseEvidence(level="frames", compared=compared, frames_checked=len(numbers), **surfaces)
-    pixels = pixel_fields(acc.pixel, acc.worst[1])
-    lines = metrics.line_summary(acc.lines)
-    line_named = tuple(Fault.of(f) for f in diagnose_lines(lines, tol))
+    pixels, lines, line_named = wire_fields(measured.wire, tol)
     radius = f1_radius.radius_read(
-        style.classify(), acc.radius, numbers, pixels["pixel_f1_1px"], pixels["worst_pixel_frame"]
+        style.classify(), measured.wire.radius, numbers, pixels["pixel_f1_1px"], pixels["worst_pixel_frame"]
     )
     return CaseEvidence(
         level="frames",
@@ -370,17 +336,17 @@ def case_evidence(
         radius=radius,
         image_faults=diagnosed,
         line_faults=line_named,
-        style=style.read(diagnosed or line_named, tol, acc.rounded()),
-        drew_pixels=any(f["candidate_pixels"] for f in acc.per_frame),
+        style=style.read(diagnosed or line_named, tol, measured.wire.rounded()),
+        drew_pixels=any(f["candidate_pixels"] for f in measured.per_frame),
         **surfaces,
     )
 
 
 def case_record(
-    job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple, acc: _CaseFrames
+    job: dict, scene: str, case: str, camera, ev: CaseEvidence, verdict, names: tuple, per_frame: list, core_min: dict
 ) -> dict:
     """A case's record (its entry in report.json's ``cases``), built once from its evidence, verdict and names;
-    beside them core's second opinion (never deciding) and the per-frame numbers (``acc``). Its faults, verdict,
+    beside them core's second opinion (``core_min``, never deciding) and the per-frame numbers (``per_frame``). Its faults, verdict,
     reasons and per-frame numbers are written as every source's are (oracles.judge.record.finish_record)."""
     rec = {
         "scene": scene,
@@ -395,7 +361,7 @@ def case_record(
             {
                 **ev.pixels,
                 "core": {
-                    k: acc.core_min[k]
+                    k: core_min[k]
                     for k in ("f1_0px", "f1_1px", "precision_0px", "recall_0px", "precision_1px", "recall_1px")
                 },
                 "lines": dict(ev.lines),
@@ -415,7 +381,7 @@ def case_record(
         if getattr(ev, key) is not None:
             rec[key] = _plain(getattr(ev, key))
     rec["compared"] = dict(ev.compared)
-    return finish_record(rec, ev, verdict, names, acc.per_frame)
+    return finish_record(rec, ev, verdict, names, per_frame)
 
 
 def _plain(value):

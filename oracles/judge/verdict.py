@@ -15,31 +15,14 @@ from __future__ import annotations
 import numpy as np
 
 from ..candidates.candidate import case_precision
-from ..diagnosis.diagnose import diagnose, diagnose_lines
+from ..diagnosis.diagnose import diagnose
 from ..faults import Fault
 from ..tolerances import MIN_IOU_UNION_PX, Tolerances, vertex_bound
 from . import metrics
-from .decide import decide, pixel_fields
+from .decide import decide
 from .evidence import CaseEvidence
 from .name_faults import name_faults
-from .record import finish_record
-
-#: Per-frame fields of a wireframe's line comparison: metrics' (one definition for both paths).
-LINE_FRAME_KEYS = metrics.LINE_FRAME_KEYS
-
-#: Per-frame fields of a shaded comparison (oracles.judge.metrics.shaded_scores).
-SHADED_FRAME_KEYS = (
-    "silhouette_iou",
-    "silhouette_union_px",
-    "silhouette_mismatch_inside",
-    "depth_pixels",
-    "depth_max_error",
-    "depth_mean_error",
-    "depth_error_bound",
-    "depth_error_ratio",
-    "face_disagreements",
-    "face_disagreements_inside",
-)
+from .record import finish_record, wire_fields
 
 
 def case_record(
@@ -109,20 +92,18 @@ def case_record(
     else:
         vertices["max_vertex_error_px"] = None
         rec.update({"max_vertex_error_px": None, "mean_vertex_error_px": None, "rms_vertex_error_px": None})
-    px, lines, shaded = acc.pixel, None, None
-    if px["f1_0px"]:
-        pixels = pixel_fields(px, acc.worst[1] if acc.worst else None)
-        lines = metrics.line_summary(acc.lines)
+    lines, shaded, line_faults = None, None, ()
+    if acc.wire is not None and acc.wire.measured:
+        pixels, lines, line_faults = wire_fields(acc.wire, tol)
         rec.update(pixels)
         rec["lines"] = lines
     else:
         pixels = {"pixel_f1_0px": None, "pixel_f1_1px": None}
         rec.update(pixels)
     if setup.pixels and setup.mode.shaded:
-        shaded = shaded_summary(acc.shaded, acc.worst)
+        shaded = shaded_summary(acc.shaded.scores, acc.shaded.worst)
         rec.update(shaded)
         pixels = {**pixels, "worst_pixel_frame": shaded["worst_pixel_frame"]}
-    line_named = diagnose_lines(lines, tol) if acc.lines and lines is not None else []
     rec["faults"] = []  # named by judge (name_faults: a line fault only when the vertices agree)
     rec["compared"] = {
         "frames": done,
@@ -143,7 +124,7 @@ def case_record(
         vertices={k: vertices[k] for k in VERTEX_KEYS if k in vertices},
         shaded={k: shaded[k] for k in SHADED_KEYS if k in shaded} if shaded is not None else None,
         image_faults=tuple(Fault.of(f) for f in faults),
-        line_faults=tuple(Fault.of(f) for f in line_named),
+        line_faults=line_faults,
         error=acc.error,
         points=points,
         oracle_bound_px=oracle_bound_px,

@@ -123,6 +123,10 @@ TARGETS = {
     ),
     # the end of every source's case record
     "oracles/judge/record.py": (["tests/test_record.py", "tests/test_oracle_precision_drawn.py"], None),
+    # one case loop, one wireframe measurement for every frame source: hand-built frames and a stand-in source
+    "oracles/judge/wire_frames.py": (["tests/test_wire_frames.py"], None),
+    "oracles/judge/case_loop.py": (["tests/test_case_loop.py"], None),
+    "oracles/judge/shaded_frames.py": (["tests/test_shaded_frames.py"], None),
     # one report builder for both sources: counts, summary, keys and their order
     "oracles/judge/run_report.py": (["tests/test_run_report.py", "tests/test_gate.py"], None),
     # the GL thread the frames are read ahead on: every oracle call on it, closed with no thread left
