@@ -804,6 +804,20 @@ class NamingThresholds:
     #: ... and at least this share of them lands inside one face, for the residuals to speak for the map (a
     #: few-pixel sliver cannot name a fault): half (measured under the right map: 95 % at least).
     depth_interior_min: float = 0.5
+    #: A value model of a depth map (oracles.diagnosis.depth_faults) explains it when every residual is within
+    #: this many allowances. A parameter fitted (a median) from pixels that each sit within their own bound
+    #: moves the model by up to one bound at another pixel; doubled for the rounding of the stored value
+    #: against the model's float64 one: 4. Measured over core's maps with one mistake each (3 scenes x 7 cases,
+    #: tests/test_depth_faults.py): the named model's worst residual is 0.50 allowances (a float16 map; 0.09
+    #: for the others), the nearest wrong model's 19 (depth_offset on a float16 map).
+    depth_fit_slack: float = 4.0
+    #: Values of a stored depth-buffer encoding (window [0, 1], NDC [-1, 1]) lie within 1 + this of the range:
+    #: float32 rounding of values of size 1 (eps32 = 1.2e-7), with room to spare.
+    depth_encoding_margin: float = 1e-6
+    #: A depth map's quantisation steps are whole multiples of its least gap to this relative tolerance: the
+    #: rescaled levels of an 8-bit map (n + k (f - n) / 255) carry float32 rounding of ~1e-7 of their size;
+    #: 1e-3 leaves the gaps of a float32 map of a smooth surface (no common step) out.
+    depth_step_tolerance: float = 1e-3
 
     # ---- a filled frame's silhouette (oracles.diagnosis.silhouette_faults)
 

@@ -24,9 +24,10 @@ from wirecheck.core.scene.frames import SceneRenderer
 from wirecheck.core.transforms import Motion
 from wirecheck.oracles.candidates.depth_map import depth_from_array, read_depth_map
 from wirecheck.oracles.cases import cases_for
-from wirecheck.oracles.diagnosis.depth_faults import DEPTH_FAULTS, LIMITS, name_depth_faults
+from wirecheck.oracles.diagnosis.depth_faults import DEPTH_FAULTS, name_depth_faults
 from wirecheck.oracles.faults import CATALOGUE, Fault
 from wirecheck.oracles.judge.metrics import depth_bound
+from wirecheck.oracles.tolerances import NAMING
 
 SCENES = ("cube", "prism", "pyramid")
 EPS32 = float(np.finfo(np.float32).eps)
@@ -198,9 +199,9 @@ def test_fit_slack_has_room(results):
         if injected == "pass":
             continue
         ratios = d.measured["fit_ratios"]
-        assert ratios[injected] <= 0.5 * LIMITS.fit_slack, (injected, ratios)
+        assert ratios[injected] <= 0.5 * NAMING.depth_fit_slack, (injected, ratios)
         others = [v for name, v in ratios.items() if name != injected]
-        assert min(others) > 4 * LIMITS.fit_slack, (injected, ratios)  # measured: 19 (offset, float16 map)
+        assert min(others) > 4 * NAMING.depth_fit_slack, (injected, ratios)  # measured: 19 (offset, float16 map)
 
 
 def test_ambiguous_when_one_depth(tmp_path):

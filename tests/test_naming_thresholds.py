@@ -548,6 +548,67 @@ def test_depth_interior_min(naming):
     assert _depth_names(*plane) == ("unexplained",)
 
 
+#: An orthographic camera for the value models of a depth map (depth_faults): no ray lengths, so only the
+#: values decide (depth_is_range is a perspective mistake); near 1, far 11.
+ORTHO_CAM = look_at(
+    (0, 0, 5),
+    (0, 0, 0),
+    (0, 1, 0),
+    projection="orthographic",
+    ortho_height=2.0,
+    width=64,
+    height=48,
+    near=1.0,
+    far=11.0,
+)
+
+
+def test_depth_fit_slack(naming):
+    # a map stored x1000 (millimetres read as metres) with one pixel 4.0 more: the reference 2 + n / 8 (n the
+    # pixel's flat index; eighths, exact in binary), the candidate 1000 times it (exact), the scale fitted as
+    # the median of c / r (exactly 1000), the allowance carried through it 1000 x 0.001 = 1.0 (exact in float):
+    # the worst residual is 4.0 allowances, at depth_fit_slack (4.0): depth_scale; just under it no model
+    # explains the map (offset, reversed, quantised, float16 and encoding miss by orders of magnitude)
+    ref = 2.0 + np.arange(48 * 64, dtype=np.float64).reshape(48, 64) / 8.0
+    cand = 1000.0 * ref
+    cand[20, 30] += 4.0
+    assert name_depth_faults(cand, ref, 1e-3, ORTHO_CAM).names == ("depth_scale",)
+    naming(depth_fit_slack=4.0)
+    assert name_depth_faults(cand, ref, 1e-3, ORTHO_CAM).names == ("depth_scale",)
+    naming(depth_fit_slack=math.nextafter(4.0, DOWN))
+    assert name_depth_faults(cand, ref, 1e-3, ORTHO_CAM).names == ("unexplained",)
+
+
+def test_depth_encoding_margin(naming):
+    # window depth stored from an orthographic camera (near 1, far 11): c = (r - 1) / 10, so r = 1 + 10 c, with
+    # c evenly from 0.05 to 1 + 2^-18 (the farthest pixels a little beyond far). The encoding model is tried
+    # only when every value is within 1 + depth_encoding_margin: at hi - 1 exactly (1 + (hi - 1) == hi in
+    # float) the map is depth_encoding; a margin one float of 1.0 smaller (1 + m < hi) leaves it unexplained
+    hi = 1.0 + 2.0**-18
+    cand = np.linspace(0.05, hi, 48 * 64).reshape(48, 64)
+    ref = 1.0 + 10.0 * cand
+    assert cand.max() == hi
+    naming(depth_encoding_margin=hi - 1.0)
+    assert name_depth_faults(cand, ref, 1e-6, ORTHO_CAM).names == ("depth_encoding",)
+    naming(depth_encoding_margin=math.nextafter(hi, DOWN) - 1.0)
+    assert name_depth_faults(cand, ref, 1e-6, ORTHO_CAM).names == ("unexplained",)
+
+
+def test_depth_step_tolerance(naming):
+    # a map quantised on steps of 0.25 whose upper levels are moved by 2^-12: levels 1 + 0.25 k (k < 24) plus
+    # 2^-12 for k >= 12 (all exact in binary), so the least gap is 0.25 and one gap is 0.25 + 2^-12, 1 + 2^-10
+    # steps: off a whole step by exactly 2^-10. The reference is each level plus up to 0.1 (under the step, so
+    # the quantised model explains the residuals). At depth_step_tolerance 2^-10 the map is depth_precision;
+    # one float under it, the step is no step: unexplained
+    k = np.arange(48 * 64).reshape(48, 64) % 24
+    cand = 1.0 + 0.25 * k + np.where(k >= 12, 2.0**-12, 0.0)
+    ref = cand + 0.1 * np.sin(np.arange(48 * 64).reshape(48, 64) + 0.5)
+    naming(depth_step_tolerance=2.0**-10)
+    assert name_depth_faults(cand, ref, 1e-6, ORTHO_CAM).names == ("depth_precision",)
+    naming(depth_step_tolerance=math.nextafter(2.0**-10, DOWN))
+    assert name_depth_faults(cand, ref, 1e-6, ORTHO_CAM).names == ("unexplained",)
+
+
 # ---------------------------------------------------------------- a filled frame's silhouette (silhouette_faults)
 
 SIL_CAM = look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), fov_y_deg=60, width=96, height=72)

@@ -19,7 +19,7 @@ the pixel's ray per unit of depth (``x_n = (x - cx) / fx``, ``y_n = (y - cy) / f
 A map **passes** when every compared pixel is within its allowance, ``bound + encoding``
 (the reference's per-pixel bound and the candidate encoding's own resolution,
 oracles.candidates.depth_map). A model **explains** a failing map when every compared
-pixel's residual ``|c - g(r)|`` is within :attr:`DepthLimits.fit_slack` of the allowance
+pixel's residual ``|c - g(r)|`` is within ``NAMING.depth_fit_slack`` (oracles.tolerances) allowances
 carried through the model (``|g'(r)| bound + encoding``, plus the model's own step for
 ``depth_precision``). When none does and the reference's face ids are given, the camera
 mistakes that move pixels rather than values are fitted (oracles.diagnosis.depth_pixels:
@@ -44,30 +44,8 @@ from ..faults import Fault
 from ..tolerances import NAMING
 from .depth_pixels import pixel_models, sample
 
-__all__ = ["DEPTH_FAULTS", "DepthDiagnosis", "DepthLimits", "LIMITS", "name_depth_faults", "ray_lengths"]
+__all__ = ["DEPTH_FAULTS", "DepthDiagnosis", "name_depth_faults", "ray_lengths"]
 
-
-@dataclass(frozen=True)
-class DepthLimits:
-    """The thresholds of :func:`name_depth_faults`, each with its derivation."""
-
-    #: A model explains the map when every residual is within this many allowances. A parameter
-    #: fitted (a median) from pixels that each sit within their own bound moves the model by up to
-    #: one bound at another pixel; doubled for the rounding of the stored value against the
-    #: model's float64 one: 4. Measured over core's maps with one mistake each (3 scenes x 7 cases,
-    #: tests/test_depth_faults.py): the named model's worst residual is 0.50 allowances (a float16
-    #: map; 0.09 for the others), the nearest wrong model's 19 (depth_offset on a float16 map).
-    fit_slack: float = 4.0
-    #: Values of a stored encoding (window [0, 1], NDC [-1, 1]) lie within 1 + this of the range:
-    #: float32 rounding of values of size 1 (eps32 = 1.2e-7), with room to spare.
-    encoding_margin: float = 1e-6
-    #: Quantisation steps are whole multiples of the least gap to this relative tolerance: the
-    #: rescaled levels of an 8-bit map (n + k (f - n) / 255) carry float32 rounding of ~1e-7 of
-    #: their size; 1e-3 leaves the gaps of a float32 map of a smooth surface (no common step) out.
-    step_tolerance: float = 1e-3
-
-
-LIMITS = DepthLimits()
 
 #: Every name this module gives: the catalogue's names read from depth maps, in precedence order.
 DEPTH_FAULTS = catalogue.names(source="depth")
@@ -106,9 +84,7 @@ def ray_lengths(camera) -> np.ndarray:
     return np.sqrt(1.0 + x_n[None, :] ** 2 + y_n[:, None] ** 2)
 
 
-def name_depth_faults(
-    candidate, reference, bound, camera, encoding=0.0, limits: DepthLimits = LIMITS, faces=None
-) -> DepthDiagnosis:
+def name_depth_faults(candidate, reference, bound, camera, encoding=0.0, faces=None) -> DepthDiagnosis:
     """Judge a depth map against the reference and name what is wrong with it (module docstring).
 
     Parameters
@@ -123,7 +99,6 @@ def name_depth_faults(
         The frame's camera (rays, near and far).
     encoding : (H, W) array_like of float, or float
         The candidate encoding's resolution (oracles.candidates.depth_map.DepthMap.encoding_bound).
-    limits : DepthLimits
     faces : (H, W) array_like of int, optional
         Which planar face the reference shows at each pixel (-1: none). Given, the camera
         mistakes that move pixels are fitted too (oracles.diagnosis.depth_pixels:
@@ -166,14 +141,14 @@ def name_depth_faults(
     measured.update(median_ratio_c_over_r=float(np.median(c / r)), median_c_minus_r=float(np.median(c - r)))
     rho = ray_lengths(camera)[both]
     fits = []  # (parameters fitted, max residual / allowance, fault)
-    for n_params, model in _models(c, r, rho, b, enc, camera, limits):
+    for n_params, model in _models(c, r, rho, b, enc, camera):
         if model is None:
             continue
         name, params, c_hat, slope, extra = model
         fit = float(_ratio(np.abs(c - c_hat), np.abs(slope) * b + enc + extra).max())
         if np.isfinite(fit):
             fits.append((n_params, fit, name, params))
-    if faces is not None and not any(f[1] <= limits.fit_slack for f in fits):
+    if faces is not None and not any(f[1] <= NAMING.depth_fit_slack for f in fits):
         # no value model explains it: the maps that move pixels (tried only then: they cost a fit each)
         fits += _pixel_fits(
             np.where(cand_on, cand, np.nan), np.where(ref_on, ref, np.nan), np.asarray(faces), full_b, full_enc, camera
@@ -181,7 +156,7 @@ def name_depth_faults(
     measured["fit_ratios"] = {}
     for _, fit, name, _ in fits:  # each model's worst residual / allowance (the best of a name's)
         measured["fit_ratios"][name] = min(fit, measured["fit_ratios"].get(name, np.inf))
-    explained = sorted((f for f in fits if f[1] <= limits.fit_slack), key=lambda f: (f[0], f[1]))
+    explained = sorted((f for f in fits if f[1] <= NAMING.depth_fit_slack), key=lambda f: (f[0], f[1]))
     names = list(dict.fromkeys(f[2] for f in explained))
     if len(names) > 1:
         # the compared depths do not separate the models (one flat surface square-on: scale and offset alike)
@@ -225,7 +200,7 @@ def _ratio(err: np.ndarray, allow: np.ndarray) -> np.ndarray:
         return np.where(err == 0, 0.0, err / allow)
 
 
-def _models(c, r, rho, b, enc, camera, limits):
+def _models(c, r, rho, b, enc, camera):
     """``(parameters fitted, model or None)`` for each fault of the module's table.
 
     A model is ``(name, params, c_hat, |g'(r)|, extra allowance)``.
@@ -248,7 +223,7 @@ def _models(c, r, rho, b, enc, camera, limits):
         )
     # depth_precision: float16 values, or one quantisation step
     yield 0, _precision(c, r)
-    yield 0, _quantised(c, r, limits)
+    yield 0, _quantised(c, r)
     k = float(np.median(c / r))
     yield 1, ("depth_scale", {"k": k}, k * r, np.full_like(r, k), zero)
     off = float(np.median(c - r))
@@ -266,7 +241,7 @@ def _models(c, r, rho, b, enc, camera, limits):
     else:
         s = float(np.median(c + r))
         yield 0, ("depth_reversed", {"sum": s, "camera_near+far": near + far}, near + far - r, np.ones_like(r), zero)
-    yield 2, _encoding(c, r, camera, limits)
+    yield 2, _encoding(c, r, camera)
 
 
 def _precision(c, r):
@@ -285,7 +260,7 @@ def _precision(c, r):
     )
 
 
-def _quantised(c, r, limits):
+def _quantised(c, r):
     """A uniform quantisation: values on a grid of a least gap ``q``, each within ``q`` of the reference."""
     levels = np.unique(c)
     if len(levels) < 2:
@@ -293,7 +268,7 @@ def _quantised(c, r, limits):
     gaps = np.diff(levels)
     q = float(gaps.min())
     units = gaps / q
-    if np.abs(units - np.round(units)).max() > limits.step_tolerance:
+    if np.abs(units - np.round(units)).max() > NAMING.depth_step_tolerance:
         return None
     return (
         "depth_precision",
@@ -304,10 +279,10 @@ def _quantised(c, r, limits):
     )
 
 
-def _encoding(c, r, camera, limits):
+def _encoding(c, r, camera):
     """A stored depth-buffer value: ``c = a + b x`` with ``x = 1/r`` (perspective) or ``r``; near and far read back."""
     lo, hi = float(c.min()), float(c.max())
-    if lo < -1.0 - limits.encoding_margin or hi > 1.0 + limits.encoding_margin:
+    if lo < -1.0 - NAMING.depth_encoding_margin or hi > 1.0 + NAMING.depth_encoding_margin:
         return None
     perspective = camera.projection == "perspective"
     x = 1.0 / r if perspective else r
