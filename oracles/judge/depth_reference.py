@@ -101,17 +101,22 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
 
 def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: np.ndarray, camera) -> ReferenceDepth:
     """The :class:`ReferenceDepth` of pyrender's drawing of a frame's faces (``render_faces(..., with_ids=True)``
-    of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels."""
+    of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels.
+    ``ids`` is -1 exactly where nothing is covered (render_faces refuses any other drawing): the reference's
+    :attr:`~ReferenceDepth.faces` as they are."""
     slope = depth_slope(depth, covered)
     box = _box(covered)
     bound = _covered_bound(depth, covered, camera, slope, box)
-    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope, box)) & covered
+    undecided = _beside_clip_planes(depth, covered, camera, slope, box)
+    if box is not None:  # pyrender's ids are shown exactly where it covers: their box is covered's
+        undecided |= occlusion_boundary(ids, tris, box)
+    undecided &= covered
     return ReferenceDepth(
         depth=np.where(covered, depth, np.nan),
         covered=covered,
         undecided=undecided,
         bound=bound,
-        faces=np.where(covered, ids, -1),
+        faces=ids,
     )
 
 
