@@ -111,8 +111,10 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
     if box is not None:  # pyrender's ids are shown exactly where it covers: their box is covered's
         undecided |= occlusion_boundary(ids, tris, box)
     undecided &= covered
+    ref_depth = np.full(covered.shape, np.nan)  # np.where(covered, depth, nan), in half the time
+    np.copyto(ref_depth, depth, where=covered)
     return ReferenceDepth(
-        depth=np.where(covered, depth, np.nan),
+        depth=ref_depth,
         covered=covered,
         undecided=undecided,
         bound=bound,

@@ -331,7 +331,8 @@ def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
     if len(rows) == 0:
         return out
     box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # every pair with a change lies within
-    d = np.where(covered[box], np.asarray(depth, np.float64)[box], np.nan)
+    d = np.array(np.asarray(depth, np.float64)[box])  # the depth with NaN where not covered
+    np.copyto(d, np.nan, where=~covered[box])
     slope = out[box]
     with np.errstate(invalid="ignore"):
         for change, first, second in (
