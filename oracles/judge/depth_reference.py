@@ -61,7 +61,9 @@ class ReferenceDepth:
 
     def compared_depth(self) -> np.ndarray:
         """``(H, W)`` float64: :attr:`depth` with NaN at the undecided pixels too (what a depth map is judged on)."""
-        return np.where(self.undecided, np.nan, self.depth)
+        out = self.depth.copy()  # np.where(undecided, nan, depth), in half the time
+        np.copyto(out, np.nan, where=self.undecided)
+        return out
 
     def compared_faces(self) -> np.ndarray:
         """``(H, W)``: :attr:`faces` with :data:`UNDECIDED_FACE` (-2) at the undecided pixels: a surface is there,
