@@ -106,8 +106,8 @@ def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: n
     of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels.
     ``ids`` is -1 exactly where nothing is covered (render_faces refuses any other drawing): the reference's
     :attr:`~ReferenceDepth.faces` as they are."""
-    slope = depth_slope(depth, covered)
     box = _box(covered)
+    slope = depth_slope(depth, covered, box) if box is not None else np.zeros(covered.shape)
     bound = _covered_bound(depth, covered, camera, slope, box)
     undecided = _beside_clip_planes(depth, covered, camera, slope, box)
     if box is not None:  # pyrender's ids are shown exactly where it covers: their box is covered's

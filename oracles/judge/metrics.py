@@ -318,43 +318,52 @@ def shaded_scores(
     return out
 
 
-def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
+def depth_slope(depth: np.ndarray, covered: np.ndarray, box=None) -> np.ndarray:
     """Largest |depth change| to a covered 4-neighbour, per pixel (0 where none).
 
     Each neighbouring pair's change is taken once, across columns then rows, and given to both
     pixels of the pair (``fmax`` keeps 0 where the change is NaN: a pixel not covered); an infinite
     change is the largest float, as ``nan_to_num`` made it. Taken over the covered pixels' bounding box
-    (0 outside it: no pair there has two covered pixels)."""
+    (0 outside it: no pair there has two covered pixels); ``box``: that box (two slices), when the caller has
+    it."""
     covered = np.asarray(covered, bool)
     out = np.zeros(covered.shape)
-    rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
-    if len(rows) == 0:
-        return out
-    box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # every pair with a change lies within
+    if box is None:
+        rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
+        if len(rows) == 0:
+            return out
+        box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # every pair with a change lies within
     d = np.array(np.asarray(depth, np.float64)[box])  # the depth with NaN where not covered
     np.copyto(d, np.nan, where=~covered[box])
     slope = out[box]
+    h, w = d.shape
+    change = np.empty(max(h * (w - 1), (h - 1) * w))  # each direction's changes in turn
     with np.errstate(invalid="ignore"):
-        for change, first, second in (
-            (np.abs(d[:, 1:] - d[:, :-1]), np.s_[:, :-1], np.s_[:, 1:]),
-            (np.abs(d[1:] - d[:-1]), np.s_[:-1], np.s_[1:]),
-        ):
-            np.fmax(slope[first], change, out=slope[first])
-            np.fmax(slope[second], change, out=slope[second])
+        for first, second in ((np.s_[:, :-1], np.s_[:, 1:]), (np.s_[:-1], np.s_[1:])):
+            step = change[: d[first].size].reshape(d[first].shape)
+            np.subtract(d[second], d[first], out=step)
+            np.abs(step, out=step)
+            np.fmax(slope[first], step, out=slope[first])
+            np.fmax(slope[second], step, out=slope[second])
     np.minimum(slope, np.finfo(np.float64).max, out=slope)  # an infinite change: the largest float
     return out
 
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray | None = None) -> np.ndarray:
     """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances);
-    ``slope``: :func:`depth_slope` of ``depth`` and ``covered`` when the caller has it already."""
+    ``slope``: :func:`depth_slope` of ``depth`` and ``covered`` when the caller has it already.
+
+    ``DEPTH_STEPS x depth_step + DEPTH_SNAP_PX x slope + DEPTH_EPS32 x eps32 x |depth|``, summed in that order
+    into one array."""
     depth = np.asarray(depth, np.float64)
     eps32 = float(np.finfo(np.float32).eps)
-    return (
-        tolerances.DEPTH_STEPS * depth_step(depth, camera)
-        + tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
-        + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth)
-    )
+    out = depth_step(depth, camera)
+    out *= tolerances.DEPTH_STEPS
+    out += tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
+    term = np.abs(depth)
+    term *= tolerances.DEPTH_EPS32 * eps32
+    out += term
+    return out
 
 
 # ---------------------------------------------------------------- one-sided pixels and per-edge counts
