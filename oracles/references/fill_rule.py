@@ -317,7 +317,7 @@ def _rows(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, shape, tie_px, gu
         held = _covers(guess(ry0, ry1), tab, (rx0, ry0, rx1, ry1), width)
         out.inside.reshape(shape)[ry0 : ry1 + 1, rx0 : rx1 + 1] |= held
         tri, py = _rows_meeting(~held, (rx0, ry0), (x0, y0, x1, y1))
-    in_lo, in_hi = _spans(tab, tri, py, ((0.0, False),))
+    in_lo, in_hi = _spans(tab, tri, py)
     _paint(out.inside, py * width, in_lo, in_hi)
     # near an open edge: within tie_px of its line (E >= -reach and not E > reach), then of the segment
     j = np.flatnonzero(is_open.T.ravel())  # the open edges, as k x T + triangle
@@ -325,7 +325,7 @@ def _rows(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, shape, tie_px, gu
     j, py = _box_rows(j, y0[t], y1[t])
     if len(j) == 0:
         return
-    px_, py_, dx_, dy_, reach_ = (tab.edges[i].ravel() for i in range(5))  # each (3T,): k x T + triangle
+    px_, py_, dx_, dy_, reach_ = tab.edges()  # each (3T,): k x T + triangle
     t = j % len(tris)
     e_row, dy, px0, reach = dx_[j] * (py - py_[j]), dy_[j], px_[j], reach_[j]
     bx0, bx1 = x0[t], x1[t]
@@ -358,56 +358,56 @@ def _rows(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, shape, tie_px, gu
     cx0, cy0, cx1, cy1 = int(col.min()), int(row.min()), int(col.max()), int(row.max())
     band = out.near_open.reshape(shape)[cy0 : cy1 + 1, cx0 : cx1 + 1]
     tri, py = _rows_meeting(band, (cx0, cy0), (x0, y0, x1, y1))
-    far_lo, far_hi = _spans(tab, tri, py, ((0.0, False), (None, True)))
+    far_lo, far_hi = _spans(tab, tri, py, robust=True)
     _paint(out.robust, py * width, far_lo, far_hi)
 
 
 class _Table:
     """What the row spans read of each triangle, one row per quantity (numpy's fast axis the triangles):
-    ``rows`` ``(20, T)`` float64, ``edges`` its first 15 rows as ``(5, 3, T)``: for each edge ``k``
-    (``P = v_k -> Q = v_k+1``) ``Px, Py, dx, dy`` (``Q - P``) and ``reach`` (``tie_px |PQ|``); then the
-    boxes' ``x0, y0, x1, y1`` and the doubled areas; ``top_left`` ``(3, T)`` bool."""
+    ``rows`` ``(20, T)`` float64: for each edge ``k`` (``P = v_k -> Q = v_k+1``) ``Px`` (3 rows), ``Py``,
+    ``dx``, ``dy`` (``Q - P``); the boxes' ``x0``, ``x1``; the doubled areas; each edge's ``reach``
+    (``tie_px |PQ|``, 3 rows); the boxes' ``y0``, ``y1``. A question's rows come first (:meth:`take`).
+    ``top_left`` ``(3, T)`` bool."""
+
+    #: The rows :func:`_spans` reads (the reach's only for the robust centres), and all of them.
+    SPANS, ROBUST, ALL = 15, 18, 20
 
     def __init__(self, tris: np.ndarray, area2, boxes, tie_px: float):
         self.rows = np.empty((20, len(tris)))
-        self.edges = self.rows[:15].reshape(5, 3, len(tris))
-        p_x, p_y, dx, dy, reach = self.edges
+        p_x, p_y, dx, dy = self.rows[:12].reshape(4, 3, len(tris))
         p_x[...], p_y[...] = tris[..., 0].T, tris[..., 1].T
         q = np.roll(tris, -1, axis=1)  # v1, v2, v0
         np.subtract(q[..., 0].T, p_x, out=dx)
         np.subtract(q[..., 1].T, p_y, out=dy)
-        np.multiply(tie_px, np.sqrt(dx * dx + dy * dy), out=reach)
-        self.rows[15:19] = boxes
-        self.rows[19] = area2
+        x0, y0, x1, y1 = boxes
+        self.rows[12], self.rows[13], self.rows[14], self.rows[18], self.rows[19] = x0, x1, area2, y0, y1
+        np.multiply(tie_px, np.sqrt(dx * dx + dy * dy), out=self.rows[15:18])
         self.top_left = (dy < 0) | ((dy == 0) & (dx > 0))
 
-    def take(self, tri) -> tuple[np.ndarray, np.ndarray]:
-        """``(rows (20, M), top_left (3, M))`` of the triangles ``tri``."""
-        return np.take(self.rows, tri, axis=1), np.take(self.top_left, tri, axis=1)
+    def edges(self) -> tuple[np.ndarray, ...]:
+        """``Px, Py, dx, dy, reach``, each ``(3T,)``: edge ``k`` of triangle ``t`` at ``k T + t``."""
+        r = self.rows
+        return r[0:3].ravel(), r[3:6].ravel(), r[6:9].ravel(), r[9:12].ravel(), r[15:18].ravel()
+
+    def take(self, tri, upto: int = ALL) -> tuple[np.ndarray, np.ndarray]:
+        """``(rows (upto, M), top_left (3, M))`` of the triangles ``tri``: the first ``upto`` rows only."""
+        return np.take(self.rows[:upto], tri, axis=1), np.take(self.top_left, tri, axis=1)
 
 
-def _spans(tab: _Table, tri, py, tests) -> tuple[np.ndarray, np.ndarray]:
-    """``(lo, hi)``: on each box row ``(tri, py)`` (float), the centres of the triangle's box where each of its
-    edges passes every test ``(thr, strict)`` (``E > thr`` when strict, else ``E >= thr``; ``thr`` 0 or None,
-    the edge's reach; an edge function 0 counted in on a top or left edge when ``thr`` is 0 and not strict),
-    as one span (empty: ``lo > hi``; empty for a zero-area triangle); one :func:`_half_line` call."""
-    rows, top_left = tab.take(tri)
-    p_x, p_y, dx, dy, reach = rows[:15].reshape(5, 3, -1)
-    bx0, bx1, area2 = rows[15], rows[17], rows[19]
-    e_row = (dx * (py - p_y)).ravel()  # edge by edge, each (M,)
-    n = len(tests)
-    lo, hi = _half_line(
-        np.tile(e_row, n),
-        np.tile(dy.ravel(), n),
-        np.tile(p_x.ravel(), n),
-        np.concatenate([np.zeros(e_row.shape) if t is not None else reach.ravel() for t, _s in tests]),
-        np.concatenate([np.full(e_row.shape, True) if s else ~top_left.ravel() for _t, s in tests]),
-        np.tile(bx0, 3 * n),
-        np.tile(bx1, 3 * n),
-    )
+def _spans(tab: _Table, tri, py, robust: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``(lo, hi)``: on each box row ``(tri, py)`` (float), the centres of the triangle's box inside it by the rule
+    (every edge ``E > 0``, or ``E >= 0`` on a top or left edge), and with ``robust`` also farther than its reach
+    from every edge line (``E > tie_px |PQ|``), as one span (empty: ``lo > hi``; empty for a zero-area
+    triangle); one :func:`_half_line` call a test, over the three edges at once."""
+    rows, top_left = tab.take(tri, _Table.ROBUST if robust else _Table.SPANS)
+    p_x, p_y, dx, dy = rows[:12].reshape(4, 3, -1)  # each (3, M): edge by edge
+    bx0, bx1, area2 = rows[12], rows[13], rows[14]
+    e_row = dx * (py - p_y)
     span_lo, span_hi = bx0, np.where(area2 > 0, bx1, bx0 - 1.0)  # zero-area triangles cover nothing
-    for lo_i, hi_i in zip(lo.reshape(3 * n, -1), hi.reshape(3 * n, -1)):  # each test of each edge
-        span_lo, span_hi = np.maximum(span_lo, lo_i), np.minimum(span_hi, hi_i)
+    for thr, strict in ((0.0, ~top_left), (rows[15:18], True))[: 2 if robust else 1]:
+        lo, hi = _half_line(e_row, dy, p_x, thr, strict, bx0, bx1)
+        for k in range(3):
+            span_lo, span_hi = np.maximum(span_lo, lo[k]), np.minimum(span_hi, hi[k])
     return span_lo, span_hi
 
 
@@ -451,8 +451,8 @@ def _covers(guess, tab: _Table, region, width: int) -> np.ndarray:
     c0, c1 = first - row * width, last - row * width
     py = row.astype(np.float64)
     rows, top_left = tab.take(t)
-    p_x, p_y, dx, dy, _reach = rows[:15].reshape(5, 3, -1)
-    x0, y0, x1, y1, area2 = rows[15:]
+    p_x, p_y, dx, dy = rows[:12].reshape(4, 3, -1)  # each (3, N): edge by edge
+    x0, x1, area2, y0, y1 = rows[12], rows[13], rows[14], rows[18], rows[19]
     ok = (area2 > 0) & (py >= y0) & (py <= y1) & (c0 >= x0) & (c1 <= x1)
     e_row = dx * (py - p_y)
     for end in (c0, c1):
@@ -481,33 +481,37 @@ def _half_line(e_row, dy, px0, thr, strict, bx0, bx1):
     and checked with ``E`` at it and at the next centre (computed exactly as the batched pass computes it);
     the few entries the check refuses (a crossing within rounding of a centre) are moved a centre at a time.
     """
-    n = len(e_row)
-    thr = np.broadcast_to(thr, (n,))
+    shape = np.broadcast_shapes(*(np.shape(a) for a in (e_row, dy, px0, thr, strict, bx0, bx1)))
     # ``E >= thr`` is ``E > the float below thr`` (no float lies between): one comparison for both kinds
-    below_thr = np.where(np.broadcast_to(strict, (n,)), thr, np.nextafter(thr, -np.inf))
+    below_thr = np.where(strict, thr, np.nextafter(thr, -np.inf))
+    e_row, dy, px0, below_thr = (np.broadcast_to(a, shape) for a in (e_row, dy, px0, below_thr))
 
-    def holds(px, i=slice(None)):
+    def holds(px, i=...):
         return e_row[i] - dy[i] * (px - px0[i]) > below_thr[i]
 
     dec = dy > 0  # in: px <= last; dy < 0: in from first = last + 1 on; dy == 0: E is e_row on the whole row
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         cross = px0 + (e_row - thr) / dy
     flat = ~(dec | (dy < 0))
-    last = np.clip(np.floor(np.where(flat, bx1, cross)), bx0 - 1.0, bx1)  # last centre with dec's E in
+    last = np.where(flat, bx1, cross)  # the last centre with dec's E in: the crossing rounded down, in the box
+    np.floor(last, out=last)
+    np.maximum(last, bx0 - 1.0, out=last)
+    np.minimum(last, bx1, out=last)
     in_at = holds(last)  # E at ``last`` and at ``last + 1``: in, then out (dec), or out, then in
     in_next = holds(last + 1.0)
     ok = ((last < bx0) | (in_at == dec)) & ((last >= bx1) | (in_next != dec))  # past the box: not asked
     ok |= flat
-    for i in np.flatnonzero(~ok):  # a crossing within rounding of a centre: move a centre at a time
+    box0, box1 = np.broadcast_to(bx0, shape), np.broadcast_to(bx1, shape)
+    for i in zip(*np.nonzero(~ok)):  # a crossing within rounding of a centre: move a centre at a time
         sign = 1.0 if dec[i] else -1.0  # +: E falls with px
-        while last[i] < bx1[i] and (holds(last[i] + 1.0, i) if sign > 0 else not holds(last[i] + 1.0, i)):
+        while last[i] < box1[i] and (holds(last[i] + 1.0, i) if sign > 0 else not holds(last[i] + 1.0, i)):
             last[i] += 1.0
-        while last[i] >= bx0[i] and (not holds(last[i], i) if sign > 0 else holds(last[i], i)):
+        while last[i] >= box0[i] and (not holds(last[i], i) if sign > 0 else holds(last[i], i)):
             last[i] -= 1.0
     lo = np.where(dec | flat, bx0, last + 1.0)
     hi = np.where(dec, last, bx1)
-    # a flat edge (dy == 0): E is e_row at every centre (``in_at``), the whole row or none of it
-    hi = np.where(flat & ~in_at, lo - 1.0, hi)
+    if flat.any():  # a flat edge (dy == 0): E is e_row at every centre (``in_at``), the whole row or none of it
+        hi = np.where(flat & ~in_at, lo - 1.0, hi)
     return lo, hi
 
 
