@@ -12,6 +12,7 @@ report written.
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from pathlib import Path
 
@@ -21,7 +22,7 @@ from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
 from PIL import Image
 from wirecheck.core.scene.files import load_scene
 from wirecheck.oracles.candidates.export import build_job
-from wirecheck.oracles.candidates.frames_candidate import frame_inputs, load_job, read_obj
+from wirecheck.oracles.candidates.frames_candidate import FramesError, frame_inputs, load_job, read_obj
 from wirecheck.oracles.cli import main
 from wirecheck.oracles.references import opencv_oracle
 
@@ -72,6 +73,103 @@ def test_obj_is_the_scene(job_dir):
     scene = load_scene("cube")
     assert np.array_equal(v, scene.vertices)  # repr() floats: exact round trip
     assert np.array_equal(e, np.asarray(scene.edges))
+
+
+def _read_obj_by_lines(path: Path):
+    """read_obj's reading of a file, line by line, as it read every file before it read export's layout a
+    block at a time (that reading, copied): ``(vertices, edges, faces)``, or the first bad line's message."""
+    verts, edges, faces = [], [], []
+    for lineno, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+        parts = line.split()
+        try:
+            if parts and parts[0] == "v":
+                verts.append([float(x) for x in parts[1:]])
+                if len(parts) != 4 or not all(map(math.isfinite, verts[-1])):
+                    raise ValueError
+            elif parts and parts[0] == "l":
+                edges.append([int(x) - 1 for x in parts[1:]])
+                if len(parts) != 3 or not all(0 <= i < len(verts) for i in edges[-1]):
+                    raise ValueError
+            elif parts and not parts[0].startswith("#"):
+                face = [int(x) - 1 for x in parts[1:] if x.lstrip("-").isdigit()] if parts[0] == "f" else []
+                if len(face) < max(3, len(parts) - 1) or not all(0 <= i < len(verts) for i in face):
+                    return (
+                        f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'f I J K ...' (3 or more "
+                        f"of 1..{len(verts)}), 'v', 'l' or a '#' comment, as 'crosscheck export' wrote"
+                    )
+                faces.append(tuple(face))
+        except ValueError:
+            return (
+                f"{path}:{lineno}: {line.strip()[:60]!r}: expected 'v X Y Z' (finite) or 'l I J' "
+                f"(1..{len(verts)}), as 'crosscheck export' wrote"
+            )
+    return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2), faces
+
+
+#: What a hostile or hand-edited OBJ may hold where export writes a number (each read by float() or int()).
+_ODD_TOKENS = ["1.5", "-1", "+1", "0", "1_0", "\u0663", "nan", "inf", "1e999", "9" * 25, "x", "0x1p3", "1e", "--2"]
+
+
+def _random_obj(rng) -> str:
+    """An OBJ as export lays it out (comments, then v, l, f lines; faces of one size), one in three of them
+    edited once: a token swapped for an odd one, a token dropped or added, two lines swapped, a blank or
+    comment line inserted, a tab for a space, a face of another size, an index past the vertices."""
+    n_v = int(rng.integers(0, 8))
+    lines = ["# scene: model space"] * int(rng.integers(0, 3))
+    lines += [
+        "v " + " ".join(repr(float(x)) for x in rng.normal(size=3).round(int(rng.integers(0, 9)))) for _ in range(n_v)
+    ]
+    if n_v:
+        k = int(rng.integers(3, 6))
+        lines += [f"l {a} {b}" for a, b in rng.integers(1, n_v + 1, size=(int(rng.integers(0, 6)), 2))]
+        lines += ["f " + " ".join(map(str, rng.integers(1, n_v + 1, size=k))) for _ in range(int(rng.integers(0, 5)))]
+    at = int(rng.integers(0, len(lines))) if lines else 0
+    edit = int(rng.integers(0, 24))  # 0 to 7: an edit; the rest: as export wrote it
+    if lines and edit == 0:
+        parts = lines[at].split(" ")
+        parts[int(rng.integers(0, len(parts)))] = str(rng.choice(_ODD_TOKENS))
+        lines[at] = " ".join(parts)
+    elif lines and edit == 1:
+        lines[at] = lines[at].rsplit(" ", 1)[0] if rng.random() < 0.5 else lines[at] + " 1"
+    elif lines and edit == 2:
+        other = int(rng.integers(0, len(lines)))
+        lines[at], lines[other] = lines[other], lines[at]
+    elif edit == 3:
+        lines.insert(at, str(rng.choice(["", "# note", "  # indented", "vn 0 0 1", "o cube"])))
+    elif lines and edit == 4:
+        lines[at] = lines[at].replace(" ", "\t", 1)
+    elif n_v and edit == 5:
+        lines.append("f " + " ".join(map(str, rng.integers(1, n_v + 1, size=int(rng.integers(3, 7))))))
+    elif edit == 6:
+        lines.append(str(rng.choice([f"l 1 {n_v + 1}", f"f 1 2 {n_v + 1}", "l 0 1", "f 0 1 2"])))
+    elif lines and edit == 7:
+        lines[at] = lines[at].replace(" ", "  ")
+    return "\n".join(lines) + ("\n" if rng.random() < 0.8 else "")
+
+
+def test_read_obj_equals_the_line_by_line_reading(tmp_path):
+    """3,000 OBJ texts as export lays them out, one in three edited (_random_obj): read_obj gives what the
+    line-by-line reading gives (its values to the bit, the same index dtype, the faces as tuples), or the same
+    message for the same line."""
+    rng = np.random.default_rng(35)
+    path = tmp_path / "mesh.obj"
+    kinds = {"read": 0, "refused": 0}
+    for _ in range(3000):
+        path.write_text(_random_obj(rng), encoding="utf-8")
+        want = _read_obj_by_lines(path)
+        if isinstance(want, str):
+            with pytest.raises(FramesError) as info:
+                read_obj(path, with_faces=True)
+            assert info.value.problems == FramesError([want]).problems
+            kinds["refused"] += 1
+            continue
+        got = read_obj(path, with_faces=True)
+        for a, b in zip(got[:2], want[:2]):
+            assert a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+            assert np.array_equal(np.signbit(a), np.signbit(b))  # -0.0 read as -0.0
+        assert got[2] == want[2] and all(type(i) is int for face in got[2] for i in face)
+        kinds["read"] += 1
+    assert kinds["read"] > 1500 and kinds["refused"] > 300, kinds
 
 
 @pytest.mark.parametrize("case", ["on_axis", "non_square", "orthographic"])

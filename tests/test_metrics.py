@@ -120,6 +120,46 @@ def test_occlusion_boundary_marks_both_sides_of_triangles_sharing_no_vertex():
     assert not occlusion_boundary(np.array([[-1, 0, 0, -1]]), tris).any()  # -1: no triangle
 
 
+def _naive_occlusion_boundary(ids, triangles):
+    """The definition pixel by pixel: a pixel showing a triangle is marked when one of its 8 neighbours (in the
+    image) shows another triangle with no vertex in common with its own."""
+    h, w = ids.shape
+    corners = [set(t) for t in np.asarray(triangles).tolist()]
+    out = np.zeros((h, w), bool)
+    for y in range(h):
+        for x in range(w):
+            a = ids[y, x]
+            for yy in range(max(y - 1, 0), min(y + 2, h)):
+                for xx in range(max(x - 1, 0), min(x + 2, w)):
+                    b = ids[yy, xx]
+                    if a >= 0 and b >= 0 and a != b and not corners[a] & corners[b]:
+                        out[y, x] = True
+    return out
+
+
+def test_occlusion_boundary_equals_the_definition_on_random_id_images():
+    """3,000 random id images (1 to 9 rows and columns, -1 for none, runs of one id) of up to 12 triangles over
+    3 to 14 vertices (many share one): occlusion_boundary equals the pixel-by-pixel definition, with the
+    shown pixels' box given and found."""
+    from wirecheck.oracles.judge.metrics import occlusion_boundary
+
+    rng = np.random.default_rng(109)
+    marked = 0
+    for _ in range(3000):
+        n_tris, n_verts = int(rng.integers(1, 13)), int(rng.integers(3, 15))
+        tris = np.stack([rng.choice(n_verts, 3, replace=False) for _ in range(n_tris)])
+        h, w = (int(v) for v in rng.integers(1, 10, size=2))
+        ids = np.repeat(rng.integers(-1, n_tris, size=(h, w)), rng.integers(1, 4), axis=1)[:, :w]
+        want = _naive_occlusion_boundary(ids, tris)
+        np.testing.assert_array_equal(occlusion_boundary(ids, tris), want)
+        rows, cols = np.flatnonzero((ids >= 0).any(axis=1)), np.flatnonzero((ids >= 0).any(axis=0))
+        if len(rows):
+            box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]
+            np.testing.assert_array_equal(occlusion_boundary(ids, tris, box), want)
+        marked += int(want.sum())
+    assert marked > 10_000
+
+
 def _within_naive(mask_from, mask_to, tol):
     """The definition, pixel by pixel: a True of mask_to in the (2 tol + 1)^2 window, clipped to the image."""
     h, w = mask_to.shape

@@ -70,7 +70,8 @@ class DepthMap:
 
     def encoding_bound(self) -> np.ndarray:
         """``(H, W)`` float64: how far the encoding alone may move a depth, ``step + rel_step |d|`` (0 where none)."""
-        out = np.fmax(np.abs(self.depth), 0.0)  # |d|, 0 where NaN (fmax takes the number)
+        out = np.abs(self.depth)
+        np.fmax(out, 0.0, out=out)  # |d|, 0 where NaN (fmax takes the number)
         out *= self.rel_step
         out += self.step
         return out

@@ -379,7 +379,6 @@ def read_obj(path: Path, with_faces: bool = False) -> tuple:
     judged, but a renderer may read them) of 3 or more such indices; nothing
     but ``v``, ``l``, ``f`` and ``#`` comments.
     """
-    verts, edges, faces = [], [], []
     problem = file_problem(path, "job mesh")
     if problem is not None:
         raise FramesError([f"{path}: {problem}: expected the OBJ 'crosscheck export' wrote"])
@@ -387,6 +386,15 @@ def read_obj(path: Path, with_faces: bool = False) -> tuple:
         text = read_text(path, "job mesh", encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise FramesError([f"{path}: unreadable ({exc}): expected the OBJ 'crosscheck export' wrote"]) from None
+    read = _obj_blocks(text)
+    verts, edges, faces = _obj_lines(path, text) if read is None else read
+    return (verts, edges, faces) if with_faces else (verts, edges)
+
+
+def _obj_lines(path: Path, text: str) -> tuple:
+    """:func:`read_obj`'s reading of ``text`` (the file ``path``'s), line by line: ``(vertices, edges, faces)``
+    or the first bad line's FramesError."""
+    verts, edges, faces = [], [], []
     for lineno, line in enumerate(text.splitlines(), start=1):
         parts = line.split()
         try:
@@ -417,8 +425,48 @@ def read_obj(path: Path, with_faces: bool = False) -> tuple:
                     f"(1..{len(verts)}), as 'crosscheck export' wrote"
                 ]
             ) from None
-    out = np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2)
-    return (*out, faces) if with_faces else out
+    return np.asarray(verts, dtype=np.float64).reshape(-1, 3), np.asarray(edges, dtype=np.intp).reshape(-1, 2), faces
+
+
+def _obj_blocks(text: str) -> tuple | None:
+    """:func:`_obj_lines`' result for a text laid out as export writes an OBJ, read a block at a time: ``#``
+    lines, then ``v X Y Z`` lines (finite), ``l I J`` lines and ``f`` lines of one length (ASCII indices), every
+    index of a vertex (all come first); None for any other text, which is then read line by line (a
+    5,120-face mesh: ~45 ms line by line, read once a case on the frames judge's reading thread)."""
+    lines = text.splitlines()
+    heads = [line[:2] for line in lines]
+    at = 0
+    while at < len(heads) and heads[at][:1] == "#":
+        at += 1
+    counts = [heads.count(head) for head in ("v ", "l ", "f ")]
+    if at + sum(counts) != len(lines):
+        return None
+    blocks = []
+    for head, n in zip(("v ", "l ", "f "), counts):
+        if heads[at : at + n] != [head] * n:
+            return None
+        blocks.append(" ".join(lines[at : at + n]).split())
+        at += n
+    (v, e, f), (n_v, n_e, n_f) = blocks, counts
+    k = len(f) // n_f if n_f else 4  # tokens a face line
+    if len(v) != 4 * n_v or len(e) != 3 * n_e or len(f) != k * n_f or k < 4:
+        return None
+    if v[::4] != ["v"] * n_v or e[::3] != ["l"] * n_e or f[::k] != ["f"] * n_f:
+        return None
+    del v[::4], e[::3], f[::k]
+    digits = "".join(f)
+    if not (digits.isascii() and digits.isdigit()) and f:  # as a line's 'x.lstrip("-").isdigit()' and int(x)
+        return None
+    try:
+        verts = np.array(list(map(float, v)), dtype=np.float64).reshape(-1, 3)
+        edges = np.array(list(map(int, e)), dtype=np.int64) - 1
+        corners = np.array(list(map(int, f)), dtype=np.int64) - 1
+    except (ValueError, OverflowError):  # a value a line's reading refuses, or an index past int64
+        return None
+    if not np.isfinite(verts).all() or not all(((i >= 0) & (i < n_v)).all() for i in (edges, corners)):
+        return None
+    faces = list(map(tuple, corners.reshape(n_f, k - 1).tolist()))
+    return verts, edges.astype(np.intp).reshape(-1, 2), faces
 
 
 def _frame_camera(path: Path, cache: dict | None = None):

@@ -61,7 +61,9 @@ class ReferenceDepth:
 
     def compared_depth(self) -> np.ndarray:
         """``(H, W)`` float64: :attr:`depth` with NaN at the undecided pixels too (what a depth map is judged on)."""
-        return np.where(self.undecided, np.nan, self.depth)
+        out = self.depth.copy()  # np.where(undecided, nan, depth), in half the time
+        np.copyto(out, np.nan, where=self.undecided)
+        return out
 
     def compared_faces(self) -> np.ndarray:
         """``(H, W)``: :attr:`faces` with :data:`UNDECIDED_FACE` (-2) at the undecided pixels: a surface is there,
@@ -101,17 +103,24 @@ def reference_depth(oracle, scene: Scene, case: Case, motion: Motion, k: int, fr
 
 def from_render(covered: np.ndarray, depth: np.ndarray, ids: np.ndarray, tris: np.ndarray, camera) -> ReferenceDepth:
     """The :class:`ReferenceDepth` of pyrender's drawing of a frame's faces (``render_faces(..., with_ids=True)``
-    of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels."""
-    slope = depth_slope(depth, covered)
+    of the fan triangles ``tris``, (T, 3) vertex indices, through ``camera``): its bound and undecided pixels.
+    ``ids`` is -1 exactly where nothing is covered (render_faces refuses any other drawing): the reference's
+    :attr:`~ReferenceDepth.faces` as they are."""
     box = _box(covered)
+    slope = depth_slope(depth, covered, box) if box is not None else np.zeros(covered.shape)
     bound = _covered_bound(depth, covered, camera, slope, box)
-    undecided = (occlusion_boundary(ids, tris) | _beside_clip_planes(depth, covered, camera, slope, box)) & covered
+    undecided = _beside_clip_planes(depth, covered, camera, slope, box)
+    if box is not None:  # pyrender's ids are shown exactly where it covers: their box is covered's
+        undecided |= occlusion_boundary(ids, tris, box)
+    undecided &= covered
+    ref_depth = np.full(covered.shape, np.nan)  # np.where(covered, depth, nan), in half the time
+    np.copyto(ref_depth, depth, where=covered)
     return ReferenceDepth(
-        depth=np.where(covered, depth, np.nan),
+        depth=ref_depth,
         covered=covered,
         undecided=undecided,
         bound=bound,
-        faces=np.where(covered, ids, -1),
+        faces=ids,
     )
 
 

@@ -173,7 +173,7 @@ def interior(mask: np.ndarray) -> np.ndarray:
     return out
 
 
-def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray, box=None) -> np.ndarray:
     """Pixels next to a pixel that shows a triangle sharing no vertex with theirs.
 
     ``ids`` is a triangle-id image (-1: none). Two triangles that share a vertex
@@ -184,40 +184,47 @@ def occlusion_boundary(ids: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     pixels (one on each side) are left out of the depth comparison.
 
     Each unordered pair of 8-neighbours is taken once, within the rows and columns that hold a triangle
-    (nothing is marked elsewhere), as a pair of flat positions ``(i, i + step)`` in that box with a column of
-    -1 after each row (no pair wraps onto the next row); only the pairs that show two triangles are compared.
+    (nothing is marked elsewhere; ``box``, two slices, when the caller has them), as a pair of flat positions
+    ``(i, i + step)`` in that box with a column of -1 after each row (no pair wraps onto the next row), one
+    direction at a time; only the pairs that show two triangles are compared (in int32 where the vertex
+    numbers fit: half the bytes of int64).
     """
     ids = np.asarray(ids)
     out = np.zeros(ids.shape, bool)
-    shown = ids >= 0
-    rows, cols = np.flatnonzero(shown.any(axis=1)), np.flatnonzero(shown.any(axis=0))
-    if len(rows) == 0:
-        return out
-    r0, c0 = rows[0], cols[0]
-    h, w = rows[-1] + 1 - r0, cols[-1] + 1 - c0
-    padded = np.full((h, w + 1), -1, dtype=ids.dtype)
-    padded[:, :w] = ids[r0 : rows[-1] + 1, c0 : cols[-1] + 1]
+    if box is None:
+        shown = ids >= 0
+        rows, cols = np.flatnonzero(shown.any(axis=1)), np.flatnonzero(shown.any(axis=0))
+        if len(rows) == 0:
+            return out
+        box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]
+    part = ids[box]
+    h, w = part.shape
+    corners = np.asarray(triangles).reshape(-1, 3)
+    small = corners.size == 0 or (int(corners.max()) < 2**31 and len(corners) < 2**31)
+    corners = np.ascontiguousarray(corners.T, dtype=np.int32 if small else np.int64)  # (3, T): each corner's row
+    padded = np.full((h, w + 1), -1, dtype=corners.dtype)
+    padded[:, :w] = part
     flat = padded.ravel()
     shows = flat >= 0
-    firsts, steps = [], []
+    apart = np.zeros(len(flat), bool)  # this pixel and its neighbour, of each pair sharing no vertex
     for dy, dx in _NEIGHBOURS[4:]:  # pixel (y, x) and its neighbour (y + dy, x + dx), dy >= 0
         step = dy * (w + 1) + dx
-        if step >= len(flat):  # one row: no pair below it
+        n = len(flat) - step
+        if n <= 0:  # one row: no pair below it
             continue
-        a, b = flat[: len(flat) - step], flat[step:]
-        first = np.flatnonzero((a != b) & shows[: len(flat) - step] & shows[step:])
-        firsts.append(first)
-        steps.append(np.full(len(first), step))
-    first, step = np.concatenate(firsts), np.concatenate(steps).astype(np.int64)
-    corners = np.ascontiguousarray(np.asarray(triangles).reshape(-1, 3).T)  # (3, T): each corner's row
-    at_a, at_b = flat[first], flat[first + step]
-    ta, tb = [c[at_a] for c in corners], [c[at_b] for c in corners]  # each row taken alone: 1-D takes are fast
-    shared = np.zeros(len(first), bool)
-    for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
-        for j in range(3):
-            shared |= ta[i] == tb[j]
-    apart = np.concatenate([first[~shared], (first + step)[~shared]])  # this pixel and its neighbour
-    out[apart // (w + 1) + r0, apart % (w + 1) + c0] = True
+        a, b = flat[:n], flat[step:]
+        first = np.flatnonzero((a != b) & shows[:n] & shows[step:])
+        at_a, at_b = a[first], b[first]
+        ta, tb = [c[at_a] for c in corners], [c[at_b] for c in corners]  # each row taken alone: 1-D takes are fast
+        shared = ta[0] == tb[0]
+        for i in range(3):  # nine 1-D comparisons: no (n, 3, 3) temporary
+            for j in range(3):
+                if i or j:
+                    shared |= ta[i] == tb[j]
+        first = first[~shared]
+        apart[first] = True
+        apart[first + step] = True
+    out[box] = apart.reshape(h, w + 1)[:, :w]
     return out
 
 
@@ -311,42 +318,52 @@ def shaded_scores(
     return out
 
 
-def depth_slope(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
+def depth_slope(depth: np.ndarray, covered: np.ndarray, box=None) -> np.ndarray:
     """Largest |depth change| to a covered 4-neighbour, per pixel (0 where none).
 
     Each neighbouring pair's change is taken once, across columns then rows, and given to both
     pixels of the pair (``fmax`` keeps 0 where the change is NaN: a pixel not covered); an infinite
     change is the largest float, as ``nan_to_num`` made it. Taken over the covered pixels' bounding box
-    (0 outside it: no pair there has two covered pixels)."""
+    (0 outside it: no pair there has two covered pixels); ``box``: that box (two slices), when the caller has
+    it."""
     covered = np.asarray(covered, bool)
     out = np.zeros(covered.shape)
-    rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
-    if len(rows) == 0:
-        return out
-    box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # every pair with a change lies within
-    d = np.where(covered[box], np.asarray(depth, np.float64)[box], np.nan)
+    if box is None:
+        rows, cols = np.flatnonzero(covered.any(axis=1)), np.flatnonzero(covered.any(axis=0))
+        if len(rows) == 0:
+            return out
+        box = np.s_[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]  # every pair with a change lies within
+    d = np.array(np.asarray(depth, np.float64)[box])  # the depth with NaN where not covered
+    np.copyto(d, np.nan, where=~covered[box])
     slope = out[box]
+    h, w = d.shape
+    change = np.empty(max(h * (w - 1), (h - 1) * w))  # each direction's changes in turn
     with np.errstate(invalid="ignore"):
-        for change, first, second in (
-            (np.abs(d[:, 1:] - d[:, :-1]), np.s_[:, :-1], np.s_[:, 1:]),
-            (np.abs(d[1:] - d[:-1]), np.s_[:-1], np.s_[1:]),
-        ):
-            np.fmax(slope[first], change, out=slope[first])
-            np.fmax(slope[second], change, out=slope[second])
+        for first, second in ((np.s_[:, :-1], np.s_[:, 1:]), (np.s_[:-1], np.s_[1:])):
+            step = change[: d[first].size].reshape(d[first].shape)
+            np.subtract(d[second], d[first], out=step)
+            np.abs(step, out=step)
+            np.fmax(slope[first], step, out=slope[first])
+            np.fmax(slope[second], step, out=slope[second])
     np.minimum(slope, np.finfo(np.float64).max, out=slope)  # an infinite change: the largest float
     return out
 
 
 def depth_bound(depth: np.ndarray, covered: np.ndarray, camera, slope: np.ndarray | None = None) -> np.ndarray:
     """Per-pixel bound on |z_candidate - z_oracle| for the oracle's ``depth`` (oracles.tolerances);
-    ``slope``: :func:`depth_slope` of ``depth`` and ``covered`` when the caller has it already."""
+    ``slope``: :func:`depth_slope` of ``depth`` and ``covered`` when the caller has it already.
+
+    ``DEPTH_STEPS x depth_step + DEPTH_SNAP_PX x slope + DEPTH_EPS32 x eps32 x |depth|``, summed in that order
+    into one array."""
     depth = np.asarray(depth, np.float64)
     eps32 = float(np.finfo(np.float32).eps)
-    return (
-        tolerances.DEPTH_STEPS * depth_step(depth, camera)
-        + tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
-        + tolerances.DEPTH_EPS32 * eps32 * np.abs(depth)
-    )
+    out = depth_step(depth, camera)
+    out *= tolerances.DEPTH_STEPS
+    out += tolerances.DEPTH_SNAP_PX * (depth_slope(depth, covered) if slope is None else slope)
+    term = np.abs(depth)
+    term *= tolerances.DEPTH_EPS32 * eps32
+    out += term
+    return out
 
 
 # ---------------------------------------------------------------- one-sided pixels and per-edge counts

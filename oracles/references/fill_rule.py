@@ -46,8 +46,8 @@ triangles cover, and the centres are the same, bit for bit, as a per-centre pass
 (tests/test_fill_rule.py's naive pass). Only the few centres within ``tie_px`` of an open
 edge's line are measured against the segment. :func:`silhouette` may be given a guess of the
 triangle covering each centre (pyrender's triangle ids): each run of one guess along a row is
-checked by the rule at its two ends, and only the triangles whose box holds a centre not held
-so are taken row by row (the same result, whatever the guess). With several objects, a
+checked by the rule at its two ends, and only the box rows that hold a centre not held so are
+taken as spans (the same result, whatever the guess). With several objects, a
 per-centre pass over batches of boxes of like size keeps every covered centre's depth and
 object, and one sort finds each pixel's nearest two objects
 (``benchmarks/bench_fill_rule.py``: 100,000 triangles at 640x480).
@@ -109,20 +109,17 @@ def depth_bound(z: np.ndarray, slope: np.ndarray, camera) -> np.ndarray:
     return _DEPTH_STEPS * depth_step(z, camera) + _DEPTH_SNAP_PX * slope + _DEPTH_EPS32 * _EPS32 * z
 
 
-def _edge_keys(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each triangle edge ``k`` (``v_k -> v_k+1``) as ``(key (3T, 4), flip (3T,) bool, third (3T, 2))``.
-
-    The key is the edge's two ends in (x, y) order, so that both triangles of a shared edge get
-    the same key; ``third`` is the opposite vertex.
-    """
+def _edge_keys(tris_px: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Each triangle edge ``k`` (``v_k -> v_k+1``), ``(3T,)`` each in the corners' order: its two ends in
+    (x, y) order, ``lo_x, lo_y, hi_x, hi_y`` (both triangles of a shared edge get the same key), and the
+    opposite vertex ``third_x, third_y``."""
     p = tris_px + 0.0  # -0.0 -> 0.0: equal keys compare equal
-    a = p.reshape(-1, 2)  # v0, v1, v2 of each triangle
-    b = np.roll(p, -1, axis=1).reshape(-1, 2)  # v1, v2, v0
-    third = np.roll(p, -2, axis=1).reshape(-1, 2)  # v2, v0, v1
-    flip = (b[:, 0] < a[:, 0]) | ((b[:, 0] == a[:, 0]) & (b[:, 1] < a[:, 1]))
-    lo = np.where(flip[:, None], b, a)
-    hi = np.where(flip[:, None], a, b)
-    return np.concatenate([lo, hi], axis=1), flip, third
+    x, y = p[..., 0].ravel(), p[..., 1].ravel()  # v0, v1, v2 of each triangle
+    k = np.arange(len(x)).reshape(-1, 3)
+    nxt, opp = k[:, [1, 2, 0]].ravel(), k[:, [2, 0, 1]].ravel()  # v1, v2, v0 and v2, v0, v1
+    bx, by = x[nxt], y[nxt]
+    flip = (bx < x) | ((bx == x) & (by < y))
+    return np.where(flip, bx, x), np.where(flip, by, y), np.where(flip, x, bx), np.where(flip, y, by), x[opp], y[opp]
 
 
 def open_edges(tris_px, corners=None, grouped=None) -> np.ndarray:
@@ -141,9 +138,8 @@ def open_edges(tris_px, corners=None, grouped=None) -> np.ndarray:
     tris_px = np.asarray(tris_px, dtype=np.float64).reshape(-1, 3, 2)
     if len(tris_px) == 0:
         return np.zeros((0, 3), dtype=bool)
-    key, _flip, third = _edge_keys(tris_px)
-    d = key[:, 2:] - key[:, :2]
-    side = np.sign(d[:, 0] * (third[:, 1] - key[:, 1]) - d[:, 1] * (third[:, 0] - key[:, 0]))
+    lo_x, lo_y, hi_x, hi_y, third_x, third_y = _edge_keys(tris_px)
+    side = np.sign((hi_x - lo_x) * (third_y - lo_y) - (hi_y - lo_y) * (third_x - lo_x))
     points = np.ascontiguousarray(tris_px + 0.0).reshape(-1, 2).view(np.complex128).ravel()  # (x, y) as one
     if corners is None:
         _, point = np.unique(points, return_inverse=True, equal_nan=False)  # by x, then y; NaN each its own
@@ -193,7 +189,7 @@ def _orient(tris_px: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 class _Buffers:
     """The per-pixel results of one pass, flat over ``H x W`` (``robust`` in full from :func:`_batch`; from
-    :func:`_rows`, on the rows with a ``near_open`` centre only: the ties ask it nothing else)."""
+    :func:`_rows`, on the box rows that hold a ``near_open`` centre only: the ties ask it nothing else)."""
 
     def __init__(self, shape, depth: bool):
         n = shape[0] * shape[1]
@@ -237,7 +233,8 @@ def _raster(
     y0 = np.clip(lo[:, 1], 0, height - 1)
     x1 = np.clip(hi[:, 0], 0, width - 1)
     y1 = np.clip(hi[:, 1], 0, height - 1)
-    finite = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
+    finite = np.isfinite(lo) & np.isfinite(hi)
+    finite = finite[:, 0] & finite[:, 1]
     seen = finite & (hi[:, 0] >= 0) & (lo[:, 0] <= width - 1) & (hi[:, 1] >= 0) & (lo[:, 1] <= height - 1)
     idx = np.flatnonzero(seen)
     if tri_z is None:  # coverage alone: each box row's centres decided as spans
@@ -247,11 +244,14 @@ def _raster(
         # icosphere(4)'s 5,120 triangles, ~50,000 rows, 14.0 -> 12.4 ms a frame; the bundled scenes' 12-26
         # triangles, a few thousand rows, 5.3 -> 6.5 ms with it)
         if hint is not None and _HINT_ROWS_PER_PIXEL * (y1[t] - y0[t] + 1).sum() > height * width:
-            first, last, guessed = hint()  # the hint's triangles as indices into the seen ones
-            where = np.full(len(tris), -1, dtype=np.int64)
-            where[t] = np.arange(len(t))
-            guessed = where[guessed]
-            guess = first[guessed >= 0], last[guessed >= 0], guessed[guessed >= 0]
+
+            def guess(row_lo: int, row_hi: int):  # the hint's runs on these rows, as indices into the seen ones
+                first, last, guessed = hint(row_lo, row_hi)
+                where = np.full(len(tris), -1, dtype=np.int64)
+                where[t] = np.arange(len(t))
+                guessed = where[guessed]
+                return first[guessed >= 0], last[guessed >= 0], guessed[guessed >= 0]
+
         _rows(out, tris[t], area2[t], is_open[t], x0[t], y0[t], x1[t], y1[t], (height, width), tie_px, guess)
         return out
     bw = (x1[idx] - x0[idx] + 1).astype(np.int64)
@@ -298,114 +298,177 @@ def _rows(out: _Buffers, tris, area2, is_open, x0, y0, x1, y1, shape, tie_px, gu
     edge), each open edge's band (``|E| <= tie_px |PQ|``, then the distance to the segment at each centre)
     and the robust centres (every ``E > tie_px |PQ|``) are then intersections of spans: the same centres as
     :func:`_batch`, bit for bit (tests/test_fill_rule.py's naive pass), with work per box row instead of
-    per centre.
+    per centre; the half-lines of one question, every edge's, in one :func:`_half_line` call.
 
-    ``guess`` (``(first, last, triangles)``: runs of flat centres along a row, an index into ``tris`` each):
-    each run is checked by the rule against its triangle alone (:func:`_covers`); a centre held so is
-    covered whatever the other triangles do, so the spans are taken only for the triangles whose box holds
-    a centre not held so.
+    ``guess`` (a function of the first and last image rows the boxes span, giving ``(first, last,
+    triangles)``: runs of flat centres along a row, in row-major order, an index into ``tris`` each): each run
+    is checked by the rule against its triangle alone (:func:`_covers`); a centre held so is covered whatever
+    the other triangles do, so the spans are taken only on the box rows that hold a centre not held so. The
+    robust centres are taken only on the box rows that hold a near-open centre.
     """
-    height, width = shape
-    edges = []  # per edge k: (P, dx, dy, reach, top_left), per triangle
-    for k in range(3):
-        p, q = tris[:, k], tris[:, (k + 1) % 3]
-        dx, dy = q[:, 0] - p[:, 0], q[:, 1] - p[:, 1]
-        edges.append((p, dx, dy, tie_px * np.sqrt(dx * dx + dy * dy), (dy < 0) | ((dy == 0) & (dx > 0))))
-    boxes = (x0, y0, x1, y1)
-    every = np.arange(len(tris))
-    todo = every
-    if guess is not None:
-        held = _covers(guess, tris, area2, boxes, edges, height * width, width)
-        out.inside |= held
-        todo = every[_boxes_meet(~held.reshape(shape), boxes)]
-    tri, py = _box_rows(todo, y0, y1)
-    in_lo, in_hi = x0[tri], np.where(area2[tri] > 0, x1[tri], x0[tri] - 1.0)  # zero-area triangles cover nothing
-    for p, dx, dy, _reach, top_left in edges:
-        lo, hi = _half_line(dx[tri] * (py - p[tri, 1]), dy[tri], p[tri, 0], 0.0, ~top_left[tri], x0[tri], x1[tri])
-        np.maximum(in_lo, lo, out=in_lo)
-        np.minimum(in_hi, hi, out=in_hi)
-    _paint(out.inside, py * width, in_lo, in_hi)
-    for k, (p, dx, dy, reach, _top_left) in enumerate(edges):
-        # near an open edge: within tie_px of its line (E >= -reach and not E > reach), then of the segment
-        tri, py = _box_rows(np.flatnonzero(is_open[:, k]), y0, y1)
-        if len(tri) == 0:
-            continue
-        args = (dx[tri] * (py - p[tri, 1]), dy[tri], p[tri, 0])
-        n_lo, n_hi = _half_line(*args, -reach[tri], False, x0[tri], x1[tri])
-        f_lo, f_hi = _half_line(*args, reach[tri], True, x0[tri], x1[tri])
-        dec, inc = args[1] > 0, args[1] < 0
-        n_lo = np.where(dec, np.maximum(n_lo, f_hi + 1.0), n_lo)
-        n_hi = np.where(inc, np.minimum(n_hi, f_lo - 1.0), n_hi)
-        n_hi = np.where(~(dec | inc) & (f_lo <= f_hi), n_lo - 1.0, n_hi)  # flat: the whole row is far, or none
-        ii, px = _span_cells(np.arange(len(tri)), n_lo, n_hi)
-        if len(ii):
-            t, y = tri[ii], py[ii]
-            rx, ry = px - p[t, 0], y - p[t, 1]
-            sx, sy = dx[t], dy[t]
-            length2 = sx * sx + sy * sy
-            with np.errstate(invalid="ignore", divide="ignore"):
-                u = np.where(length2 > 0, np.clip((rx * sx + ry * sy) / length2, 0.0, 1.0), 0.0)
-            near = np.hypot(rx - u * sx, ry - u * sy) <= tie_px
-            out.near_open[(y[near] * width + px[near]).astype(np.int64)] = True
-    band = out.near_open.reshape(shape)
-    if not band.any():
+    if len(tris) == 0:
         return
-    # robust (inside, and every E > reach) on the band's rows, for the triangles whose box meets the band
-    tri, py = _box_rows(every[_boxes_meet(band, boxes)], y0, y1)
-    keep = band.any(axis=1)[py.astype(np.int64)]
-    tri, py = tri[keep], py[keep]
-    far_lo, far_hi = x0[tri], np.where(area2[tri] > 0, x1[tri], x0[tri] - 1.0)
-    for p, dx, dy, reach, top_left in edges:
-        args = (dx[tri] * (py - p[tri, 1]), dy[tri], p[tri, 0])
-        for thr, strict in ((0.0, ~top_left[tri]), (reach[tri], True)):
-            lo, hi = _half_line(*args, thr, strict, x0[tri], x1[tri])
-            far_lo, far_hi = np.maximum(far_lo, lo), np.minimum(far_hi, hi)
+    height, width = shape
+    tab = _Table(tris, area2, (x0, y0, x1, y1), tie_px)
+    if guess is None:
+        tri, py = _box_rows(np.arange(len(tris)), y0, y1)
+    else:  # over the boxes' bounding box, ``region``
+        rx0, ry0, rx1, ry1 = (int(x0.min()), int(y0.min()), int(x1.max()), int(y1.max()))
+        held = _covers(guess(ry0, ry1), tab, (rx0, ry0, rx1, ry1), width)
+        out.inside.reshape(shape)[ry0 : ry1 + 1, rx0 : rx1 + 1] |= held
+        tri, py = _rows_meeting(~held, (rx0, ry0), (x0, y0, x1, y1))
+    in_lo, in_hi = _spans(tab, tri, py)
+    _paint(out.inside, py * width, in_lo, in_hi)
+    # near an open edge: within tie_px of its line (E >= -reach and not E > reach), then of the segment
+    j = np.flatnonzero(is_open.T.ravel())  # the open edges, as k x T + triangle
+    t = j % len(tris)
+    j, py = _box_rows(j, y0[t], y1[t])
+    if len(j) == 0:
+        return
+    px_, py_, dx_, dy_, reach_ = tab.edges()  # each (3T,): k x T + triangle
+    t = j % len(tris)
+    e_row, dy, px0, reach = dx_[j] * (py - py_[j]), dy_[j], px_[j], reach_[j]
+    bx0, bx1 = x0[t], x1[t]
+    lo, hi = _half_line(  # E >= -reach, then E > reach
+        *(np.concatenate([a, a]) for a in (e_row, dy, px0)),
+        np.concatenate([-reach, reach]),
+        np.repeat([False, True], len(j)),
+        np.concatenate([bx0, bx0]),
+        np.concatenate([bx1, bx1]),
+    )
+    (n_lo, f_lo), (n_hi, f_hi) = lo.reshape(2, -1), hi.reshape(2, -1)
+    dec, inc = dy > 0, dy < 0
+    n_lo = np.where(dec, np.maximum(n_lo, f_hi + 1.0), n_lo)
+    n_hi = np.where(inc, np.minimum(n_hi, f_lo - 1.0), n_hi)
+    n_hi = np.where(~(dec | inc) & (f_lo <= f_hi), n_lo - 1.0, n_hi)  # flat: the whole row is far, or none
+    ii, px = _span_cells(np.arange(len(j)), n_lo, n_hi)
+    e, y = j[ii], py[ii]
+    rx, ry = px - px_[e], y - py_[e]
+    sx, sy = dx_[e], dy_[e]
+    length2 = sx * sx + sy * sy
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = np.where(length2 > 0, np.clip((rx * sx + ry * sy) / length2, 0.0, 1.0), 0.0)
+    at = np.hypot(rx - u * sx, ry - u * sy) <= tie_px
+    near = (y[at] * width + px[at]).astype(np.int64)
+    if len(near) == 0:
+        return
+    out.near_open[near] = True
+    # robust (inside, and every E > reach) on the box rows that hold a near-open centre
+    row, col = near // width, near % width
+    cx0, cy0, cx1, cy1 = int(col.min()), int(row.min()), int(col.max()), int(row.max())
+    band = out.near_open.reshape(shape)[cy0 : cy1 + 1, cx0 : cx1 + 1]
+    tri, py = _rows_meeting(band, (cx0, cy0), (x0, y0, x1, y1))
+    far_lo, far_hi = _spans(tab, tri, py, robust=True)
     _paint(out.robust, py * width, far_lo, far_hi)
 
 
+class _Table:
+    """What the row spans read of each triangle, one row per quantity (numpy's fast axis the triangles):
+    ``rows`` ``(20, T)`` float64: for each edge ``k`` (``P = v_k -> Q = v_k+1``) ``Px`` (3 rows), ``Py``,
+    ``dx``, ``dy`` (``Q - P``); the boxes' ``x0``, ``x1``; the doubled areas; each edge's ``reach``
+    (``tie_px |PQ|``, 3 rows); the boxes' ``y0``, ``y1``. A question's rows come first (:meth:`take`).
+    ``top_left`` ``(3, T)`` bool."""
+
+    #: The rows :func:`_spans` reads (the reach's only for the robust centres), and all of them.
+    SPANS, ROBUST, ALL = 15, 18, 20
+
+    def __init__(self, tris: np.ndarray, area2, boxes, tie_px: float):
+        self.rows = np.empty((20, len(tris)))
+        p_x, p_y, dx, dy = self.rows[:12].reshape(4, 3, len(tris))
+        p_x[...], p_y[...] = tris[..., 0].T, tris[..., 1].T
+        q = np.roll(tris, -1, axis=1)  # v1, v2, v0
+        np.subtract(q[..., 0].T, p_x, out=dx)
+        np.subtract(q[..., 1].T, p_y, out=dy)
+        x0, y0, x1, y1 = boxes
+        self.rows[12], self.rows[13], self.rows[14], self.rows[18], self.rows[19] = x0, x1, area2, y0, y1
+        np.multiply(tie_px, np.sqrt(dx * dx + dy * dy), out=self.rows[15:18])
+        self.top_left = (dy < 0) | ((dy == 0) & (dx > 0))
+
+    def edges(self) -> tuple[np.ndarray, ...]:
+        """``Px, Py, dx, dy, reach``, each ``(3T,)``: edge ``k`` of triangle ``t`` at ``k T + t``."""
+        r = self.rows
+        return r[0:3].ravel(), r[3:6].ravel(), r[6:9].ravel(), r[9:12].ravel(), r[15:18].ravel()
+
+    def take(self, tri, upto: int = ALL) -> tuple[np.ndarray, np.ndarray]:
+        """``(rows (upto, M), top_left (3, M))`` of the triangles ``tri``: the first ``upto`` rows only."""
+        return np.take(self.rows[:upto], tri, axis=1), np.take(self.top_left, tri, axis=1)
+
+
+def _spans(tab: _Table, tri, py, robust: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``(lo, hi)``: on each box row ``(tri, py)`` (float), the centres of the triangle's box inside it by the rule
+    (every edge ``E > 0``, or ``E >= 0`` on a top or left edge), and with ``robust`` also farther than its reach
+    from every edge line (``E > tie_px |PQ|``), as one span (empty: ``lo > hi``; empty for a zero-area
+    triangle); one :func:`_half_line` call a test, over the three edges at once."""
+    rows, top_left = tab.take(tri, _Table.ROBUST if robust else _Table.SPANS)
+    p_x, p_y, dx, dy = rows[:12].reshape(4, 3, -1)  # each (3, M): edge by edge
+    bx0, bx1, area2 = rows[12], rows[13], rows[14]
+    e_row = dx * (py - p_y)
+    span_lo, span_hi = bx0, np.where(area2 > 0, bx1, bx0 - 1.0)  # zero-area triangles cover nothing
+    for thr, strict in ((0.0, ~top_left), (rows[15:18], True))[: 2 if robust else 1]:
+        lo, hi = _half_line(e_row, dy, p_x, thr, strict, bx0, bx1)
+        for k in range(3):
+            span_lo, span_hi = np.maximum(span_lo, lo[k]), np.minimum(span_hi, hi[k])
+    return span_lo, span_hi
+
+
 def _box_rows(which, y0, y1):
-    """``(triangle, py)``: one entry per row of each box of the triangles ``which``."""
-    count = (y1[which] - y0[which] + 1).astype(np.int64)
-    tri = np.repeat(which, count)
-    return tri, y0[tri] + (np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count))
+    """``(which, py)``: one entry per row ``y0[i] .. y1[i]`` of each entry ``which[i]`` (``y0, y1``: per entry)."""
+    count = (y1 - y0 + 1).astype(np.int64)
+    rows = np.repeat(np.arange(len(which)), count)
+    return which[rows], y0[rows] + (np.arange(len(rows)) - np.repeat(np.cumsum(count) - count, count))
 
 
-def _boxes_meet(mask: np.ndarray, boxes) -> np.ndarray:
-    """``(T,) bool``: the boxes ``(x0, y0, x1, y1)`` (inclusive, on the image) holding a True centre of ``mask``
-    (its summed-area table, cv2.integral)."""
+def _rows_meeting(mask: np.ndarray, corner, boxes) -> tuple[np.ndarray, np.ndarray]:
+    """``(tri, py)``: the box rows of the boxes ``(x0, y0, x1, y1)`` (inclusive, on the image; float) that hold
+    a True centre of ``mask``, an ``(h, w)`` part of the image whose first centre is ``corner`` ``(x, y)``.
+
+    Boxes first, then their rows, each by four looks into ``mask``'s summed-area table (cv2.integral)."""
     import cv2  # lazily, as every OpenCV use of the oracles
 
-    table = cv2.integral(mask.view(np.uint8), sdepth=cv2.CV_32S)
-    x0, y0, x1, y1 = (b.astype(np.int64) for b in boxes)
-    return table[y1 + 1, x1 + 1] - table[y0, x1 + 1] - table[y1 + 1, x0] + table[y0, x0] > 0
+    h, w = mask.shape
+    table = cv2.integral(np.ascontiguousarray(mask).view(np.uint8), sdepth=cv2.CV_32S).ravel()
+    x0, y0, x1, y1 = (np.asarray(b).astype(np.int64) for b in boxes)
+    # each box cut to the mask's part (empty: a0 >= a1 or b0 >= b1), as the table's columns and rows
+    a0, a1 = np.clip(x0 - corner[0], 0, w), np.clip(x1 - corner[0] + 1, 0, w)
+    b0, b1 = np.clip(y0 - corner[1], 0, h) * (w + 1), np.clip(y1 - corner[1] + 1, 0, h) * (w + 1)
+    hit = (a0 < a1) & (b0 < b1)
+    hit &= table[b1 + a1] - table[b0 + a1] - table[b1 + a0] + table[b0 + a0] > 0
+    which = np.flatnonzero(hit)
+    which, r = _box_rows(which, b0[which] // (w + 1), b1[which] // (w + 1) - 1)
+    a0, a1, r = a0[which], a1[which], r * (w + 1)
+    keep = table[r + (w + 1) + a1] - table[r + a1] - table[r + (w + 1) + a0] + table[r + a0] > 0
+    return which[keep], (r[keep] // (w + 1) + corner[1]).astype(np.float64)
 
 
-def _covers(guess, tris, area2, boxes, edges, n: int, width: int) -> np.ndarray:
-    """Flat bool (``n`` centres): the runs ``guess`` (``(first, last, triangle)``, along one row each) whose two
-    ends are inside their guessed triangle by the rule (in its box, every edge ``E > 0``, or ``E == 0`` on a
-    top or left edge; each ``E`` computed as :func:`_batch` computes it). On a row a triangle's centres are a
-    span (:func:`_rows`), so a run whose two ends are in it is in it whole."""
+def _covers(guess, tab: _Table, region, width: int) -> np.ndarray:
+    """``(h, w)`` bool over ``region`` ``(x0, y0, x1, y1)`` (inclusive, holding every box): the centres of the
+    runs ``guess`` (``(first, last, triangle)``: flat centres along one row each, in row-major order, none
+    overlapping) whose two ends are inside their guessed triangle by the rule (in its box, every edge ``E >
+    0``, or ``E == 0`` on a top or left edge; each ``E`` computed as :func:`_batch` computes it). On a row a
+    triangle's centres are a span (:func:`_rows`), so a run whose two ends are in it is in it whole."""
     first, last, t = guess
-    py = (first // width).astype(np.float64)
-    ok = area2[t] > 0
-    x0, y0, x1, y1 = boxes
-    ok &= (py >= y0[t]) & (py <= y1[t])
-    x0, x1 = x0[t], x1[t]
-    per_edge = [(p[t, 0], dy[t], dx[t] * (py - p[t, 1]), top_left[t]) for p, dx, dy, _reach, top_left in edges]
-    for end in (first, last):
-        px = (end % width).astype(np.float64)
-        ok &= (px >= x0) & (px <= x1)
-        for p_x, dy, e_row, top_left in per_edge:  # each taken once for both ends
-            e = e_row - dy * (px - p_x)
-            ok &= (e > 0) | ((e == 0) & top_left)
-    held = np.zeros(n, dtype=bool)
-    _paint(
-        held,
-        first[ok] - first[ok] % width,
-        (first[ok] % width).astype(np.float64),
-        (last[ok] % width).astype(np.float64),
-    )
-    return held
+    row = first // width
+    c0, c1 = first - row * width, last - row * width
+    py = row.astype(np.float64)
+    rows, top_left = tab.take(t)
+    p_x, p_y, dx, dy = rows[:12].reshape(4, 3, -1)  # each (3, N): edge by edge
+    x0, x1, area2, y0, y1 = rows[12], rows[13], rows[14], rows[18], rows[19]
+    ok = (area2 > 0) & (py >= y0) & (py <= y1) & (c0 >= x0) & (c1 <= x1)
+    e_row = dx * (py - p_y)
+    for end in (c0, c1):
+        e = e_row - dy * (end.astype(np.float64) - p_x)
+        e_in = (e > 0) | ((e == 0) & top_left)
+        ok &= e_in[0] & e_in[1] & e_in[2]
+    # the held runs painted as the run-length image they make: gap, run, gap, ..., gap
+    rx0, ry0, rx1, ry1 = region
+    w = rx1 - rx0 + 1
+    start = (row[ok] - ry0) * w + (c0[ok] - rx0)
+    bounds = np.empty(2 * len(start) + 2, dtype=np.int64)
+    bounds[0], bounds[-1] = 0, (ry1 - ry0 + 1) * w
+    bounds[1:-1:2], bounds[2:-1:2] = start, start + (c1[ok] - c0[ok] + 1)
+    runs = np.zeros(len(bounds) - 1, dtype=bool)
+    runs[1::2] = True
+    return np.repeat(runs, np.diff(bounds)).reshape(ry1 - ry0 + 1, w)
 
 
 def _half_line(e_row, dy, px0, thr, strict, bx0, bx1):
@@ -418,31 +481,37 @@ def _half_line(e_row, dy, px0, thr, strict, bx0, bx1):
     and checked with ``E`` at it and at the next centre (computed exactly as the batched pass computes it);
     the few entries the check refuses (a crossing within rounding of a centre) are moved a centre at a time.
     """
-    n = len(e_row)
-    thr, strict = np.broadcast_to(thr, (n,)), np.broadcast_to(strict, (n,))
+    shape = np.broadcast_shapes(*(np.shape(a) for a in (e_row, dy, px0, thr, strict, bx0, bx1)))
+    # ``E >= thr`` is ``E > the float below thr`` (no float lies between): one comparison for both kinds
+    below_thr = np.where(strict, thr, np.nextafter(thr, -np.inf))
+    e_row, dy, px0, below_thr = (np.broadcast_to(a, shape) for a in (e_row, dy, px0, below_thr))
 
-    def holds(px, i=slice(None)):
-        e = e_row[i] - dy[i] * (px - px0[i])
-        return np.where(strict[i], e > thr[i], e >= thr[i])
+    def holds(px, i=...):
+        return e_row[i] - dy[i] * (px - px0[i]) > below_thr[i]
 
     dec = dy > 0  # in: px <= last; dy < 0: in from first = last + 1 on; dy == 0: E is e_row on the whole row
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         cross = px0 + (e_row - thr) / dy
     flat = ~(dec | (dy < 0))
-    last = np.clip(np.floor(np.where(flat, bx1, cross)), bx0 - 1.0, bx1)  # last centre with dec's E in
-    in_at = holds(last)  # E at ``last`` and at ``last + 1``, by each entry's direction
+    last = np.where(flat, bx1, cross)  # the last centre with dec's E in: the crossing rounded down, in the box
+    np.floor(last, out=last)
+    np.maximum(last, bx0 - 1.0, out=last)
+    np.minimum(last, bx1, out=last)
+    in_at = holds(last)  # E at ``last`` and at ``last + 1``: in, then out (dec), or out, then in
     in_next = holds(last + 1.0)
-    below, above = last < bx0, last >= bx1  # past the box: that side's centre is not asked about
-    ok = np.where(dec, (below | in_at) & (above | ~in_next), (below | ~in_at) & (above | in_next))
-    for i in np.flatnonzero(~ok & ~flat):  # a crossing within rounding of a centre: move a centre at a time
+    ok = ((last < bx0) | (in_at == dec)) & ((last >= bx1) | (in_next != dec))  # past the box: not asked
+    ok |= flat
+    box0, box1 = np.broadcast_to(bx0, shape), np.broadcast_to(bx1, shape)
+    for i in zip(*np.nonzero(~ok)):  # a crossing within rounding of a centre: move a centre at a time
         sign = 1.0 if dec[i] else -1.0  # +: E falls with px
-        while last[i] < bx1[i] and (holds(last[i] + 1.0, i) if sign > 0 else not holds(last[i] + 1.0, i)):
+        while last[i] < box1[i] and (holds(last[i] + 1.0, i) if sign > 0 else not holds(last[i] + 1.0, i)):
             last[i] += 1.0
-        while last[i] >= bx0[i] and (not holds(last[i], i) if sign > 0 else holds(last[i], i)):
+        while last[i] >= box0[i] and (not holds(last[i], i) if sign > 0 else holds(last[i], i)):
             last[i] -= 1.0
     lo = np.where(dec | flat, bx0, last + 1.0)
     hi = np.where(dec, last, bx1)
-    hi = np.where(flat & ~holds(px0), lo - 1.0, hi)  # a flat edge: the whole row or none of it
+    if flat.any():  # a flat edge (dy == 0): E is e_row at every centre (``in_at``), the whole row or none of it
+        hi = np.where(flat & ~in_at, lo - 1.0, hi)
     return lo, hi
 
 
@@ -629,10 +698,11 @@ def _project(p_world, fanned, camera):
     world_to_cam = np.stack([right, up, forward])
     p_cam = (p_world - np.asarray(camera.position, dtype=np.float64)) @ world_to_cam.T
     tris, owner = fanned
-    z = p_cam[:, 2][tris]  # (T, 3)
+    z = p_cam[:, 2][tris.T]  # (3, T): corner by corner
     near, far = float(camera.near), float(camera.far)
-    whole = ((z >= near) & (z <= far)).all(axis=1)
-    gone = (z < near).all(axis=1) | (z > far).all(axis=1)
+    between, before, beyond = (z >= near) & (z <= far), z < near, z > far
+    whole = between[0] & between[1] & between[2]
+    gone = (before[0] & before[1] & before[2]) | (beyond[0] & beyond[1] & beyond[2])
     cuts, cut_owner = [np.zeros((0, 3, 3))], [owner[whole]]
     for i in np.flatnonzero(~whole & ~gone):
         poly = _clip_polygon(p_cam[tris[i]], near, far)
@@ -664,11 +734,11 @@ def _to_px(p_cam: np.ndarray, camera) -> np.ndarray:
     return np.stack([cx + s * x, cy - s * y], axis=-1)
 
 
-def _image_triangles(hint, whole, shape) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``hint``'s runs along each row of one fan triangle kept whole by the clip planes: ``(first, last, triangle)``,
-    flat centres and that triangle's index among the image triangles (the whole ones come first, in the fan's
-    order)."""
-    flat = np.asarray(hint).reshape(shape[0] * shape[1])
+def _image_triangles(hint, whole, shape, row_lo: int, row_hi: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``hint``'s runs along each row ``row_lo .. row_hi`` of one fan triangle kept whole by the clip planes:
+    ``(first, last, triangle)``, flat centres of the image and that triangle's index among the image triangles
+    (the whole ones come first, in the fan's order)."""
+    flat = np.asarray(hint)[row_lo : row_hi + 1].reshape(-1)
     begins = np.ones(len(flat), dtype=bool)
     np.not_equal(flat[1:], flat[:-1], out=begins[1:])
     begins[:: shape[1]] = True  # a run ends with its row
@@ -679,7 +749,8 @@ def _image_triangles(hint, whole, shape) -> tuple[np.ndarray, np.ndarray, np.nda
     index[np.flatnonzero(whole)] = np.arange(int(whole.sum()))
     tri = index[np.where((fan_tri >= 0) & (fan_tri < len(whole)), fan_tri, len(whole))]
     keep = tri >= 0
-    return first[keep], last[keep], tri[keep]
+    offset = row_lo * shape[1]
+    return first[keep] + offset, last[keep] + offset, tri[keep]
 
 
 def silhouette(
@@ -738,11 +809,11 @@ def silhouette(
         tri_z if several else None,
         tri_object if several else None,
         camera.projection == "perspective",
-        None if hint is None or several else (lambda: _image_triangles(hint, whole, shape)),
+        None if hint is None or several else (lambda lo, hi: _image_triangles(hint, whole, shape, lo, hi)),
     )
     inside = buf.inside.reshape(shape)
     ties = (buf.near_open & ~buf.robust).reshape(shape)
-    ids = np.where(buf.inside, 0, NO_OBJECT).astype(np.int64)
+    ids = np.subtract(buf.inside, 1, dtype=np.int64)  # 0 where covered, NO_OBJECT (-1) where not
     if len(objects):
         if several and buf.samples:
             cells, objs, z, slope = _nearest_per_object(*(np.concatenate(c) for c in zip(*buf.samples)))

@@ -155,8 +155,12 @@ def depth_step(depth, camera: Camera):
     """
     n, f = float(camera.near), float(camera.far)
     depth = np.asarray(depth, dtype=np.float64)
-    if camera.projection == "perspective":
-        return depth**2 * (f - n) / (f * n) / DEPTH_LEVELS
+    if camera.projection == "perspective":  # depth**2 * (f - n) / (f * n) / DEPTH_LEVELS, in one array
+        step = np.square(depth)
+        step *= f - n
+        step /= f * n
+        step /= DEPTH_LEVELS
+        return step
     return np.full(depth.shape, (f - n) / DEPTH_LEVELS)
 
 
