@@ -24,7 +24,7 @@ time is its whole drawing of a frame as pyrender returns it (colour and
 depth); the judge asks for the colour only (``render(depth=False)``), and
 that drawing's time is printed too (the stricter comparison).
 
-The judge reads frames ahead on a worker thread (oracles.judge.frame_prefetch):
+The judge reads frames ahead on a worker thread (oracles.candidates.frame_prefetch):
 the oracle's calls then overlap the judge's own work, so "rest" (the wall
 time less the worker's time in ``PyrenderOracle.render``) is no longer the
 judge's own work alone: it is less than that by the overlap.

@@ -1,4 +1,4 @@
-"""The frames judge reads frames ahead on one GL thread (oracles.judge.frame_prefetch): the same errors at the
+"""The frames judge reads frames ahead on one GL thread (oracles.candidates.frame_prefetch): the same errors at the
 same frame, the same reports, and no thread left behind.
 
 A PNG whose pixels cannot be decoded is read on the worker while the judge
@@ -16,9 +16,10 @@ from pathlib import Path
 
 import pytest
 from helpers import fill_job  # tests/ is on sys.path (rootdir conftest)
+from wirecheck.oracles.candidates import frame_prefetch
 from wirecheck.oracles.candidates.frames_candidate import FramesError, check_frames, load_job
 from wirecheck.oracles.cli import main
-from wirecheck.oracles.judge import frame_prefetch, frames_judge
+from wirecheck.oracles.judge import frames_judge
 from wirecheck.oracles.judge.frames_judge import run_frames
 
 # one case of 6 frames: frame 4 is read ahead (frame_prefetch.AHEAD = 2) while frames 2 and 3 are judged

@@ -4,7 +4,7 @@ A frame source gives a case's frames in order: a projector's or core's
 (oracles.judge.case.ProjectorFrames: the candidate called on the frame's points, its frame
 drawn by core or by the harness, pyrender drawing on request) and a renderer's job
 (oracles.judge.frames_judge.JobFrames: the frame's files and pyrender's drawing read ahead,
-oracles.judge.frame_prefetch). Each frame (:class:`SourceFrame`) has a number and gives,
+oracles.candidates.frame_prefetch). Each frame (:class:`SourceFrame`) has a number and gives,
 for each kind of frame the case measures, the candidate's drawing and the oracle's:
 
 ============  ==================================================  ==========================================

@@ -78,7 +78,7 @@ class FilledFrames:
         :func:`read_frame`'s listing of a job's problems; ``objects``: each face's object (F,), when the
         scene has several (their ids are then judged: :func:`object_id_misses`); ``hint``: as for
         :meth:`reference`; ``reference``: a function giving :meth:`reference`'s result made already (on the
-        frames judge's reading thread, oracles.judge.frame_prefetch), called once the PNG is read."""
+        frames judge's reading thread, oracles.candidates.frame_prefetch), called once the PNG is read."""
         h, w = int(camera.height), int(camera.width)
         grey = read_frame(path, w, h, job)
         shown = grey >= 1

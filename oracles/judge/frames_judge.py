@@ -46,6 +46,7 @@ from wirecheck.core.projector import pipeline
 from ..candidates import frames_candidate
 from ..candidates.draw import oracle_segments as line_segments
 from ..candidates.export import job_outputs
+from ..candidates.frame_prefetch import FramePrefetch, reader_for
 from ..candidates.frames_candidate import face_objects, read_frame
 from ..diagnosis.image_diagnose import diagnose_images, flipped_camera, oracle_segments
 from ..diagnosis.image_visibility import set_difference
@@ -59,7 +60,6 @@ from .depth_frames import DepthFrames
 from .depth_reference import from_render
 from .evidence import CaseEvidence, Visibility
 from .filled_frames import FilledFrames
-from .frame_prefetch import FramePrefetch, reader_for
 from .job_read import differs, read_job
 from .line_style import CaseStyle, style_record
 from .name_faults import name_faults, wants_visibility
@@ -93,7 +93,7 @@ def candidate_pixels(
     and its oracle segments ``segs``), and the pixels compared are those drawn
     by the rule (coverage >= 128; CaseStyle.frame_flat). ``job``: ``(job_dir, job)``, for
     :func:`read_frame`'s listing of a job's problems. ``grey``: the frame's
-    :func:`read_frame` already made (read ahead: oracles.judge.frame_prefetch).
+    :func:`read_frame` already made (read ahead: oracles.candidates.frame_prefetch).
     """
     grey = read_frame(path, width, height, job) if grey is None else grey
     return style.frame_flat(grey, orac, *frame, segs=segs)
@@ -109,7 +109,7 @@ def diagnosis_frames(n: int, limit: int = DIAGNOSIS_FRAMES) -> set:
 class JobFrames:
     """A renderer's frames of one case of a job, as a source of the case loop (oracles.judge.case_loop): each
     frame's inputs (the job's OBJ, camera and model matrix), pyrender's drawing and the frame's files, read
-    ahead (``ahead``: oracles.judge.frame_prefetch.FramePrefetch.frames; each step's error raised at its frame
+    ahead (``ahead``: oracles.candidates.frame_prefetch.FramePrefetch.frames; each step's error raised at its frame
     and step). Beside the measurements, the source keeps core's second opinion on the wireframes
     (``core_min``: each score's minimum over the frames, never deciding) and the drawn pixels of the frames
     kept for the image diagnosis (``keep``: their indices, :func:`diagnosis_frames`)."""
@@ -204,7 +204,7 @@ def judge_case(
 ):
     """One case of a job: ``(record, worst images)``; pyrender is the verdict's oracle, core a second opinion.
 
-    ``oracles``: the run's oracles.judge.frame_prefetch.FramePrefetch (frames
+    ``oracles``: the run's oracles.candidates.frame_prefetch.FramePrefetch (frames
     read ahead on its GL thread), or an OracleCache (read in this thread).
 
     ``line_rule``: ``"any"`` holds aliased 1-px lines to a correct drawing by GL's rule or the

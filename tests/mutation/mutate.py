@@ -114,7 +114,7 @@ TARGETS = {
         None,
     ),
     # the frames read ahead on the GL thread: errors at their own frame, the same report, no thread left
-    "oracles/judge/frame_prefetch.py": (
+    "oracles/candidates/frame_prefetch.py": (
         [
             "tests/test_frame_prefetch.py",
             "tests/test_frames_candidate.py::test_frames_that_cannot_be_decoded_are_all_listed",

@@ -42,10 +42,10 @@ from concurrent.futures import Future
 from functools import partial
 from pathlib import Path
 
-from ..candidates.export import job_outputs
-from ..candidates.frames_candidate import frame_faces, frame_inputs, read_frame
 from ..references.faces import fan
 from ..references.gl_thread import GLThread
+from .export import job_outputs
+from .frames_candidate import frame_faces, frame_inputs, read_frame
 
 #: Frames read ahead of the one being judged (each: the oracle's drawing and the PNG's grey levels).
 AHEAD = 2
