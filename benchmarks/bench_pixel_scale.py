@@ -26,9 +26,11 @@ the next one's):
   does), then one case (``on_axis``, 640x480, frame 1 of 1) runs by the
   runner's own case runner (warm-up included, as a run pays it): the core
   candidate against OpenCV and pyrender. Reported: the pixel stage per frame
-  (``pixel_stage_ms_per_frame``: the candidate's drawing, pyrender's and the
-  pixel metrics), the pixel metrics alone, the process's wall time and its
-  peak RSS (``ru_maxrss``).
+  (``pixel_stage_ms_per_frame``: the candidate's drawing, the pixel metrics and
+  the wait for pyrender's drawing, which runs on the GL thread beside them:
+  oracles.judge.case.ProjectorFrames), the pixel metrics alone, pyrender's own
+  time in the harness and the part of it waited for (JSON), the process's wall
+  time and its peak RSS (``ru_maxrss``).
 * ``pyrender``: what a user would write instead: trimesh reads the PLY, the
   unique edges of its faces go to pyrender as one LINES primitive, one frame
   is drawn at the same size from the same camera distance (its shaders
@@ -151,6 +153,7 @@ def child_wirecheck(path: str, t_start: float) -> dict:
         "pixel_stage_ms": tm.get("pixel_stage_ms_per_frame"),
         "pixel_metrics_ms": tm.get("pixel_metrics_ms_per_frame"),
         "pyrender_in_ms": tm.get("pyrender_ms_per_frame"),
+        "pyrender_wait_ms": tm.get("pyrender_wait_ms_per_frame"),
         "draw_ms": tm.get("candidate_draw_ms_per_frame"),
         "wall_s": time.perf_counter() - t_start,
         "peak_rss": peak_rss_bytes(),

@@ -38,8 +38,9 @@ from ..diagnosis import clip_planes
 from ..references import faces as oface
 from ..references import opencv_oracle
 from ..references.convert import opencv_matrices
+from ..references.gl_thread import ThreadOracle, submit_drawing
 from ..tolerances import Tolerances
-from . import metrics
+from . import metrics, segment_pixels
 from .case_loop import Measurements, measure_frames
 from .shaded_frames import ShadedFrames
 from .verdict import case_record, judge
@@ -187,10 +188,13 @@ class CaseFrames:
     error: str | None = None
     oracle_bound_px: float = 0.0  # pyrender's own error bound, largest over the frames
     planes: dict | None = None  # the candidate's probed planes (oracles.diagnosis.clip_planes)
-    #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + hdraw + pr + pmetric
-    #: (hdraw: the harness drawing an external candidate's frame, less the candidate's own calls)
+    #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + hdraw + prwait + pmetric
+    #: (hdraw: the harness drawing an external candidate's frame, less the candidate's own calls; pr:
+    #: pyrender's own drawing, on the GL thread; prwait: the part of it this thread waited for)
     seconds: dict = field(
-        default_factory=lambda: dict.fromkeys(("setup", "cv", "proj", "vmetric", "draw", "hdraw", "pr", "pmetric"), 0.0)
+        default_factory=lambda: dict.fromkeys(
+            ("setup", "cv", "proj", "vmetric", "draw", "hdraw", "pr", "prwait", "pmetric"), 0.0
+        )
     )
 
     def measurements(self) -> Measurements:
@@ -387,120 +391,188 @@ class ProjectorFrames:
     """A projector's or core's frames, as a source of the case loop (oracles.judge.case_loop): frame by frame,
     the oracle side's world points (oracles.references.faces.frame_geometry), OpenCV's pixels of them, the
     candidate's pixels (:func:`candidate_vertices`) and, where pixels are compared, its frame
-    (:func:`candidate_frame`: core draws its own, the harness draws another candidate's); pyrender draws when a
-    measurement asks. A candidate that fails at a frame ends the frames there (``acc.error``)."""
+    (:func:`candidate_frame`: core draws its own, the harness draws another candidate's) and pyrender's
+    drawing of the same edges or faces. A candidate that fails at a frame ends the frames there (``acc.error``).
+
+    pyrender draws ahead (:meth:`_oracle_side`): a frame's drawing is asked for before the candidate draws
+    the frame, and the next frame's before this one is measured. Given the run's GL thread
+    (oracles.references.gl_thread.ThreadOracle), pyrender draws there while this thread draws the
+    candidate's frame and measures the frame before (much of a drawing runs inside the GL library, without
+    the GIL); given a PyrenderOracle itself, it draws when asked, in this thread. The drawings, and what
+    is measured of them, are the same either way; only when they are made changes.
+    """
 
     def __init__(self, setup: CaseSetup, acc: CaseFrames, tol: Tolerances, pyrender_oracle, numbers: range):
         self.setup, self.acc, self.tol, self.oracle, self.numbers = setup, acc, tol, pyrender_oracle, numbers
 
     def __iter__(self):
         setup, acc = self.setup, self.acc
-        for k in self.numbers:
-            t0 = time.perf_counter()
-            geometry = oface.frame_geometry(setup.scene, setup.motion, (k - 1) / setup.frames)
-            t1 = time.perf_counter()
-            oracle_px = opencv_oracle.project(geometry[0], setup.cam)
-            t2 = time.perf_counter()
-            try:
-                cand_px, points, m_core, returned = candidate_vertices(setup, k, geometry[0])
-                acc.returned.add(returned)
-                t3 = time.perf_counter()
-                precision = case_precision(self.tol.precision, acc.returned)[0]
-                calls_before = setup.timed.seconds if setup.timed else 0.0
-                cand_img, cand_depth = (
-                    candidate_frame(setup, points, m_core, geometry[0], precision) if setup.pixels else (None, None)
-                )
-                t4 = time.perf_counter()
-                own_draw = setup.timed.seconds - calls_before if setup.timed else t4 - t3
-            except CandidateError as exc:
-                acc.error = f"frame {k}: {exc}"
-                return
-            acc.seconds["setup"] += t1 - t0
-            acc.seconds["cv"] += t2 - t1
-            acc.seconds["proj"] += t3 - t2
-            acc.seconds["draw"] += own_draw
-            acc.seconds["hdraw"] += t4 - t3 - own_draw
-            yield ProjectorFrame(self, k, geometry, oracle_px, cand_px, precision, cand_img, cand_depth)
+        numbers = list(self.numbers)
+        ahead = None  # the next frame's oracle side, made while this frame is measured
+        try:
+            for i, k in enumerate(numbers):
+                side = ahead if ahead is not None else self._oracle_side(k)
+                ahead = None
+                t2 = time.perf_counter()
+                try:
+                    cand_px, points, m_core, returned = candidate_vertices(setup, k, side.geometry[0])
+                    acc.returned.add(returned)
+                    t3 = time.perf_counter()
+                    precision = case_precision(self.tol.precision, acc.returned)[0]
+                    calls_before = setup.timed.seconds if setup.timed else 0.0
+                    cand_img, cand_depth = (
+                        candidate_frame(setup, points, m_core, side.geometry[0], precision)
+                        if setup.pixels
+                        else (None, None)
+                    )
+                    t4 = time.perf_counter()
+                    own_draw = setup.timed.seconds - calls_before if setup.timed else t4 - t3
+                except CandidateError as exc:
+                    side.cancel()
+                    acc.error = f"frame {k}: {exc}"
+                    return
+                acc.seconds["proj"] += t3 - t2
+                acc.seconds["draw"] += own_draw
+                acc.seconds["hdraw"] += t4 - t3 - own_draw
+                if i + 1 < len(numbers) and setup.pixels:  # pyrender draws the next frame while this one is measured
+                    ahead = self._oracle_side(numbers[i + 1])
+                yield ProjectorFrame(self, side, cand_px, precision, cand_img, cand_depth)
+        finally:
+            if ahead is not None:  # the loop stopped early: the drawing asked for is not waited for
+                ahead.cancel()
+
+    def _oracle_side(self, k: int) -> OracleSide:
+        """Frame ``k``'s oracle side: its geometry and, where pixels are compared, pyrender's drawing of the
+        edges the mode draws or of the faces asked for first (oracles.references.gl_thread.submit_drawing),
+        then OpenCV's pixels and the oracle's segments of a wireframe (where its lines lie)."""
+        setup, acc = self.setup, self.acc
+        t = time.perf_counter()
+        geometry = oface.frame_geometry(setup.scene, setup.motion, (k - 1) / setup.frames)
+        t = acc.add("setup", t)
+        side = OracleSide(k, geometry)
+        side.threaded = isinstance(self.oracle, ThreadOracle)
+        p_world, _matrices, pr_vertices, pr_pose = geometry
+        mode, cam = setup.mode, setup.cam
+        kept = None  # the edges of front faces (backface culling), None: all
+        if setup.pixels and (setup.use_faces or not mode.shaded):
+            mirrored = None
+            if setup.use_faces and mode.cull == "backface":
+                mirrored = oface.mirrored_vertices(setup.scene, geometry[1])
+            if mode.shaded:
+                method, args = "render_faces", (pr_vertices, oface.gl_triangles(setup.tris, mirrored), cam)
+                kwargs = {"model_matrix": pr_pose, "cull": mode.cull == "backface", "with_ids": True}
+            else:
+                draw_edges, occluders = setup.edges, None
+                if setup.use_faces and mode.cull == "backface":
+                    kept = setup.owners.kept(oface.front_faces(p_world, setup.faces, cam, mirrored))
+                    draw_edges = setup.edges[kept]
+                if setup.use_faces and mode.hidden_lines:
+                    occluders = oface.gl_polygons(setup.faces, mirrored)
+                # the colour only (the mask pyrender's colour-and-depth read gives, without the depth's read
+                # back and linearisation: tests/test_oracle_gl.py)
+                method, args = "render", (pr_vertices, draw_edges, cam)
+                kwargs = {"model_matrix": pr_pose, "faces": occluders, "cull": mode.cull == "backface", "depth": False}
+            t = acc.add("pmetric", t)  # the harness's inputs to pyrender
+            side.drawing = submit_drawing(self.oracle, method, *args, **kwargs)
+            t = acc.add("prwait", t)  # asking for it (all of the drawing, when drawn in this thread)
+        side.oracle_px = opencv_oracle.project(p_world, cam)
+        t = acc.add("cv", t)
+        if setup.pixels and not mode.shaded:
+            seg0, seg1 = oracle_segments(p_world, setup.edges, cam, side.oracle_px)  # where the oracle's lines lie
+            if kept is not None:
+                seg0[~kept] = seg1[~kept] = np.nan
+            side.segments = (seg0, seg1)
+            acc.add("pmetric", t)  # harness, not pyrender
+        return side
+
+
+class OracleSide:
+    """One frame's oracle side (:meth:`ProjectorFrames._oracle_side`): ``geometry`` (frame_geometry's
+    ``(p_world, matrices, pr_vertices, pr_pose)``), ``oracle_px`` (OpenCV's pixels), the oracle's
+    ``segments`` ``(seg0, seg1)`` of a wireframe, and pyrender's ``drawing`` (a Future of
+    ``(result, last_bound_px, seconds)``), None where not drawn."""
+
+    def __init__(self, k: int, geometry: tuple):
+        self.number, self.geometry = k, geometry
+        self.oracle_px: np.ndarray | None = None
+        self.segments: tuple | None = None
+        self.drawing = None
+        #: whether pyrender draws on another thread (the run's GL thread): then the measures that need only the
+        #: candidate's frame are taken while it draws (:func:`candidate_owners`)
+        self.threaded = False
+
+    def drawn(self, acc: CaseFrames):
+        """pyrender's drawing, waited for: the wait is the pixel stage's (``acc.seconds["prwait"]``), the GL
+        thread's own seconds pyrender's (``"pr"``); its error bound joins ``acc.oracle_bound_px``."""
+        t = time.perf_counter()
+        out, bound, seconds = self.drawing.result()
+        acc.add("prwait", t)
+        acc.seconds["pr"] += seconds
+        acc.oracle_bound_px = max(acc.oracle_bound_px, bound)
+        return out
+
+    def cancel(self) -> None:
+        """The drawing asked for is not needed (a queued one is dropped, a running one finishes unread)."""
+        if self.drawing is not None:
+            self.drawing.cancel()
 
 
 class ProjectorFrame:
     """One frame of :class:`ProjectorFrames` (oracles.judge.case_loop.SourceFrame)."""
 
-    def __init__(self, source: ProjectorFrames, k: int, geometry, oracle_px, cand_px, precision, cand_img, cand_depth):
-        self.source, self.number, self.geometry = source, k, geometry
-        self.oracle_px, self.cand_px, self.precision = oracle_px, cand_px, precision
+    def __init__(self, source: ProjectorFrames, side: OracleSide, cand_px, precision, cand_img, cand_depth):
+        self.source, self.side, self.number, self.geometry = source, side, side.number, side.geometry
+        self.oracle_px, self.cand_px, self.precision = side.oracle_px, cand_px, precision
         self.cand_img, self.cand_depth = cand_img, cand_depth
 
     def vertices(self) -> tuple:
         """``(setup, p_world, cand_px, oracle_px, precision)``: CaseFrames.add_vertices' inputs."""
         return self.source.setup, self.geometry[0], self.cand_px, self.oracle_px, self.precision
 
-    def _mirrored(self):
-        setup = self.source.setup
-        if setup.use_faces and setup.mode.cull == "backface":
-            return oface.mirrored_vertices(setup.scene, self.geometry[1])
-        return None
-
     def wireframe(self, frame_rec: dict) -> tuple:
         """``(FramePixels, seg0, seg1, None)``: the candidate's frame against pyrender's drawing of the edges the
         mode draws (hidden lines, culled faces), and where the oracle's lines lie (OpenCV's pixels of the ends)."""
-        setup, acc = self.source.setup, self.source.acc
-        t0 = time.perf_counter()
-        p_world, _matrices, pr_vertices, pr_pose = self.geometry
-        mode, cam = setup.mode, setup.cam
-        mirrored = self._mirrored()
-        draw_edges, occluders = setup.edges, None
-        seg0, seg1 = oracle_segments(p_world, setup.edges, cam, self.oracle_px)  # where the oracle's lines lie
-        if setup.use_faces and mode.cull == "backface":
-            kept = setup.owners.kept(oface.front_faces(p_world, setup.faces, cam, mirrored))
-            draw_edges = setup.edges[kept]
-            seg0[~kept] = seg1[~kept] = np.nan
-        if setup.use_faces and mode.hidden_lines:
-            occluders = oface.gl_polygons(setup.faces, mirrored)
-        t0 = acc.add("pmetric", t0)  # the oracle's segments and the edges to draw: harness, not pyrender
-        # the colour only (the mask pyrender's colour-and-depth read gives, without the depth's read back and
-        # linearisation: tests/test_oracle_gl.py)
-        orac_img, _depth = self.source.oracle.render(
-            pr_vertices,
-            draw_edges,
-            cam,
-            model_matrix=pr_pose,
-            faces=occluders,
-            cull=mode.cull == "backface",
-            depth=False,
-        )
-        t1 = acc.add("pr", t0)
-        acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(self.source.oracle, "last_bound_px", 0.0))
+        acc = self.source.acc
+        owners = None
+        if self.side.threaded:  # while pyrender draws: the candidate's pixels' owners (OracleSide)
+            t0 = time.perf_counter()
+            owners = candidate_owners(self.cand_img, *self.side.segments)
+            acc.add("pmetric", t0)
+        orac_img, _depth = self.side.drawn(acc)
+        t1 = time.perf_counter()
         fp = metrics.FramePixels(self.cand_img, orac_img)  # one scan of each image
+        fp.owners = owners
         acc.add("pmetric", t1)
-        return fp, seg0, seg1, None
+        return (fp, *self.side.segments, None)
 
     def shaded(self) -> tuple:
         """``(depth buffer, the faces it shows, pyrender's (covered, depth, triangle ids))``; the drawing None
         without faces."""
-        setup, acc = self.source.setup, self.source.acc
-        t0 = time.perf_counter()
-        drawing = None
-        if setup.use_faces:
-            _p_world, _matrices, pr_vertices, pr_pose = self.geometry
-            triangles = oface.gl_triangles(setup.tris, self._mirrored())
-            t0 = acc.add("pmetric", t0)  # the harness's inputs to pyrender
-            drawing = self.source.oracle.render_faces(
-                pr_vertices,
-                triangles,
-                setup.cam,
-                model_matrix=pr_pose,
-                cull=setup.mode.cull == "backface",
-                with_ids=True,
-            )
-        acc.add("pr", t0)
-        if setup.use_faces:
-            acc.oracle_bound_px = max(acc.oracle_bound_px, getattr(self.source.oracle, "last_bound_px", 0.0))
+        setup = self.source.setup
+        drawing = self.side.drawn(self.source.acc) if self.side.drawing is not None else None
         return self.cand_depth, getattr(setup.candidate, "last_face_ids", None) if setup.use_faces else None, drawing
 
     def spent(self, kind: str, seconds: float) -> None:
         """A measurement's seconds: the vertex stage's, or the pixel stage's metrics."""
         self.source.acc.seconds["vmetric" if kind == "vertices" else "pmetric"] += seconds
+
+
+#: A candidate frame's pixels have their owning edges found while pyrender draws (:func:`candidate_owners`) from
+#: this many drawn pixels on (a frame of a 20k-60k face mesh: 40,000-60,000, whose owner search is 15-16 ms
+#: of CPU; a frame of the bundled scenes, ~1,000, is scored with the case's other frames in one pass,
+#: metrics.LineBatch, whose per-call overhead a frame's own search would pay again).
+OWNERS_AHEAD_PX = 1 << 13
+
+
+def candidate_owners(cand_img: np.ndarray, seg0: np.ndarray, seg1: np.ndarray) -> tuple | None:
+    """``(flat, edge)``: the candidate's drawn pixels and the edge owning each (-1: none;
+    oracles.judge.segment_pixels.pixel_owners), for a frame whose line scores look for every drawn pixel's
+    owner (``DENSE``); None for a smaller or sparser frame."""
+    flat = np.flatnonzero(cand_img)
+    if len(flat) < OWNERS_AHEAD_PX or len(seg0) * segment_pixels.DENSE <= len(flat):
+        return None
+    h, w = cand_img.shape
+    return flat, segment_pixels.pixel_owners(seg0, seg1, w, h, flat)
 
 
 def _per_frame_ms(seconds: float, frames: int) -> float:
@@ -520,10 +592,14 @@ def case_timing(acc: CaseFrames, pixels: bool) -> dict:
         timing.update(
             {
                 "pixel_stage_ms_per_frame": _per_frame_ms(
-                    sec["draw"] + sec["hdraw"] + sec["pr"] + sec["pmetric"], done
+                    sec["draw"] + sec["hdraw"] + sec["prwait"] + sec["pmetric"], done
                 ),
                 "candidate_draw_ms_per_frame": _per_frame_ms(sec["draw"], done),
+                # pyrender's own drawing, on the GL thread beside this one's work (ProjectorFrames), and the
+                # part of it the stage waited for: vertex stage + pixel stage = harness + candidate + OpenCV +
+                # this wait (docs/performance.md#harness-overhead)
                 "pyrender_ms_per_frame": _per_frame_ms(sec["pr"], done),
+                "pyrender_wait_ms_per_frame": _per_frame_ms(sec["prwait"], done),
                 "pixel_metrics_ms_per_frame": _per_frame_ms(sec["pmetric"], done),
             }
         )

@@ -26,7 +26,12 @@ class FramePixels:
         Flat indices ``y W + x`` of each image's drawn pixels, ascending (row-major).
     cand_in_oracle, oracle_in_cand : (Nc,), (No,) ndarray of bool
         Whether each drawn pixel is drawn in the other image too.
+    owners : (flat, edge) or None
+        Some of these pixels' owning edges, found before the frame was scored (oracles.judge.segment_pixels
+        .pixel_owners: a projector's candidate pixels, while pyrender drew), for its line scores; None.
     """
+
+    owners: tuple | None = None
 
     def __init__(self, cand: np.ndarray, oracle: np.ndarray):
         cand = np.asarray(cand, bool)

@@ -562,8 +562,13 @@ class LineBatch:
             ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run], ties)
             resolved = [resolve_ties(fp, t) for (_, fp, _, _), t in zip(run, ties)]  # once a frame
             counts = frames_count_differences(
-                [(p0, p1, rp) for (_, _, p0, p1), rp in zip(run, resolved)], shape[1], shape[0]
+                [(p0, p1, rp) for (_, _, p0, p1), rp in zip(run, resolved)],
+                shape[1],
+                shape[0],
+                known=[fp.owners for _, fp, _, _ in run],
             )  # counted with the ties undecided
+            for _, fp, _, _ in run:
+                fp.owners = None  # used: not kept with the frame's pixels
             out.extend(
                 (key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e, ties=t, resolved=rp))
                 for (key, fp, p0, p1), c, e, t, rp in zip(run, counts, ends, ties, resolved)

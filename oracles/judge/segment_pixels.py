@@ -46,6 +46,7 @@ import copy
 import numpy as np
 
 from ..segment_geometry import clip_to_box
+from . import owner_kernel
 
 _EMPTY = np.zeros(0, dtype=np.int64)
 _NONE = np.iinfo(np.int64).max  # no owner yet (:meth:`_Segments.owners`)
@@ -104,6 +105,12 @@ REACH_MARGIN_PX = 1.0
 D2_SLACK = 2.0**-30
 #: ... and an absolute slack for squared distances that underflow (offsets under 1e-154 px).
 D2_TINY = 1e-280
+#: :meth:`_Segments.nearest` of every drawn pixel runs the compiled pairing (oracles.judge.owner_kernel: the same
+#: owners) from this many pixels on: a frame of a 20k-60k face mesh (40,000-60,000 drawn pixels) in 5-8 ms of CPU
+#: against 15-18 for the numpy pairing; below, the numpy pairing costs a few ms at most, less than loading
+#: the compiled kernel into a process (~0.3 s, once), which most runs (the bundled scenes' ~1,000-pixel
+#: frames) then never pay.
+KERNEL_PIXELS = 1 << 13
 #: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
 #: (fewer: one search costs less than the calls of several).
 LEVEL_PIXELS = 1024
@@ -159,7 +166,50 @@ def frames_neighbourhoods(frames, width: int, height: int, radius: float = 1.0) 
     return list(zip(np.split(edge, cut), np.split(local, cut), np.split(major, cut)))
 
 
-def frames_count_differences(frames, width: int, height: int, radius: float = 1.0) -> list[tuple]:
+def pixel_owners(p0_px: np.ndarray, p1_px: np.ndarray, width: int, height: int, flat: np.ndarray, radius: float = 1.0):
+    """``(len(flat),)`` int64: the edge each pixel belongs to (module docstring), -1 where none is within
+    ``radius``; ``flat`` ascending flat indices of one frame.
+
+    Owning is a property of the pixel and the frame's segments alone, so these are the owners
+    :func:`frames_count_differences` finds for the same pixels among any others: given them
+    (``known``), it looks only for the rest's (a projector's frame: the candidate's pixels'
+    owners are found while pyrender draws, oracles.judge.case).
+    """
+    flat = np.asarray(flat, np.int64).reshape(-1)
+    edge = np.full(len(flat), -1, np.int64)
+    segs = _Segments([(p0_px, p1_px)], width, height, radius)
+    if len(segs) and len(flat):
+        sid, pos = segs.nearest(_Pixels.of_frames([flat], width, height), every=True)
+        edge[pos] = segs.edge[sid]
+    return edge
+
+
+def _known_owners(segs: _Segments, drawn: _Pixels, known) -> tuple:
+    """``(sid, pos)`` of :meth:`_Segments.nearest` over ``drawn`` (every drawn pixel of the frames), taking
+    the owners of the pixels ``known`` gives (per frame, None or ``(flat, edge)``: :func:`pixel_owners`) and
+    looking only for the others'."""
+    w, h = segs.width, segs.height
+    first_edge = np.cumsum(segs.counts) - segs.counts
+    sid_of = np.full(int(segs.counts.sum()) + 1, -1, np.int64)  # (frame, edge) -> segment; the last: none
+    sid_of[first_edge[segs.frame] + segs.edge] = np.arange(len(segs))
+    # each stacked pixel's known owner (-1: none within the radius), -2 where not known: one image a frame
+    owner_at = np.full(len(known) * w * h, -2, np.int32)
+    for k, given in enumerate(known):
+        if given is not None:
+            flat, edge = given
+            at = np.where(edge < 0, len(sid_of) - 1, first_edge[k] + edge)
+            owner_at[np.asarray(flat, np.int64) + k * w * h] = sid_of[at]
+    owner = owner_at[drawn.stacked].astype(np.int64)
+    rest = np.flatnonzero(owner == -2)
+    if len(rest):  # a few pixels (drawn by the oracle alone)
+        sid_rest, pos_rest = segs.nearest(drawn.subset(rest), large=True)
+        owner[rest] = -1
+        owner[rest[pos_rest]] = sid_rest
+    pos = np.flatnonzero(owner >= 0)
+    return owner[pos], pos
+
+
+def frames_count_differences(frames, width: int, height: int, radius: float = 1.0, known=None) -> list[tuple]:
     """Per-edge count differences of several frames, looking only where they can differ.
 
     An edge's count (oracles.judge.metrics.edge_counts) is the number of distinct
@@ -187,6 +237,10 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
         Each frame's segments and its two images' drawn pixels
         (oracles.judge.frame_pixels.FramePixels: ``cand_idx``, ``oracle_idx``, ``drawn()``, ``only()``).
 
+    known : sequence of None or (flat, edge), one per frame, optional
+        Some of a frame's pixels with their owners found before (:func:`pixel_owners`):
+        a dense frame looks only for the other pixels' owners.
+
     Returns
     -------
     list of (diff (E,) int64, compared int), one per frame: candidate count
@@ -202,7 +256,10 @@ def frames_count_differences(frames, width: int, height: int, radius: float = 1.
     compared = np.zeros(len(segs), bool)
     if len(segs) and len(drawn):
         if len(segs) * DENSE > len(drawn):  # a dense mesh: one pass over every drawn pixel is cheaper
-            sid, pos = segs.nearest(drawn, every=True)
+            if known is not None and any(k is not None for k in known):
+                sid, pos = _known_owners(segs, drawn, known)
+            else:
+                sid, pos = segs.nearest(drawn, every=True)
             compared[sid] = True  # every drawn pixel is drawn by one image at least
             # only the owners of one-sided pixels can count differently: their rows alone are counted
             mine = np.zeros(len(segs), bool)
@@ -519,7 +576,7 @@ class _Segments:
         out._cells = out._rows = None
         return out
 
-    def nearest(self, px: _Pixels, every: bool = False):
+    def nearest(self, px: _Pixels, every: bool = False, large: bool = False):
         """:meth:`owners` of the pixels ``px`` over all segments, looking within :data:`LEVELS` first.
 
         The pixels with a pair within a level's radius have their nearest
@@ -527,12 +584,31 @@ class _Segments:
         one of them); only the others are paired within the next radius.
         ``every``: ``px`` is every drawn pixel (paired row by row, :meth:`pairs`;
         else :meth:`pairs_any`). The same ``(sid, pos)`` as one search within
-        ``radius``.
+        ``radius``. With :data:`KERNEL_PIXELS` pixels or more of ``every``, or ``large`` (some
+        pixels of a frame that large: its other pixels' owners were found so), by the compiled
+        pairing (oracles.judge.owner_kernel) where it is available: the same owners.
         """
         levels = []
         if len(px) >= LEVEL_PIXELS:
             crowded = self._crowded(CROWDED * len(px))
             levels = [r for r in (CROWDED_LEVELS if crowded else LEVELS) if r < self.radius]
+        if (large or (every and len(px) >= KERNEL_PIXELS)) and owner_kernel.available():  # the same owners, compiled
+            owner = owner_kernel.owners(
+                px.stacked,
+                self.width,
+                self.height,
+                px.frames,
+                self.q0,
+                self.q1,
+                self._cols,
+                None if self.one_frame else self.frame,
+                (*levels, self.radius),
+                GROW_PX,
+                D2_SLACK,
+                D2_TINY,
+            )
+            pos = np.flatnonzero(owner >= 0)
+            return owner[pos], pos
         sid_parts, pos_parts = [], []
         rest = None  # positions in px still without an owner (None: all)
         for k, r in enumerate(levels + [self.radius]):

@@ -21,6 +21,7 @@ on the worker and joins it.
 from __future__ import annotations
 
 import threading
+import time
 from concurrent.futures import Future, ThreadPoolExecutor
 
 from .pyrender_oracle import OracleCache
@@ -84,3 +85,51 @@ class GLThread:
             pool.submit(self.oracles.close).result()
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+class ThreadOracle:
+    """The run's :class:`~oracles.references.pyrender_oracle.PyrenderOracle` of one image size, used through the
+    run's GL thread: every call is marshalled there (:meth:`GLThread.call`), and :meth:`submit` asks for a
+    drawing without waiting for it, so that the caller measures one frame while pyrender draws the next."""
+
+    def __init__(self, gl: GLThread, width: int, height: int):
+        self.gl, self.size = gl, (int(width), int(height))
+
+    def _call(self, method: str, args: tuple, kwargs: dict):
+        """``oracle.method(*args, **kwargs)`` on the GL thread: ``(its result, last_bound_px, seconds it took)``."""
+        t = time.perf_counter()
+        oracle = self.gl.oracles.get(*self.size)
+        out = getattr(oracle, method)(*args, **kwargs)
+        return out, getattr(oracle, "last_bound_px", 0.0), time.perf_counter() - t
+
+    def submit(self, method: str, *args, **kwargs) -> Future:
+        """``method`` (``"render"``, ``"render_faces"``) drawn on the GL thread after the calls before it: a Future
+        of ``(its result, the oracle's last_bound_px after it, the seconds the GL thread spent on it)``."""
+        return self.gl.submit(self._call, method, args, kwargs)
+
+    def render(self, *args, **kwargs):
+        """:meth:`PyrenderOracle.render`, waited for."""
+        return self.submit("render", *args, **kwargs).result()[0]
+
+    def render_faces(self, *args, **kwargs):
+        """:meth:`PyrenderOracle.render_faces`, waited for."""
+        return self.submit("render_faces", *args, **kwargs).result()[0]
+
+    def gl_info(self) -> dict:
+        """:meth:`PyrenderOracle.gl_info`, asked on the GL thread."""
+        return self.gl.call(lambda: self.gl.oracles.get(*self.size).gl_info())
+
+
+def submit_drawing(oracle, method: str, *args, **kwargs) -> Future:
+    """``oracle``'s drawing asked for: on its GL thread without waiting (a :class:`ThreadOracle`), or drawn now
+    in this thread (a PyrenderOracle itself); a Future of ``(result, last_bound_px, seconds)`` either way."""
+    if isinstance(oracle, ThreadOracle):
+        return oracle.submit(method, *args, **kwargs)
+    f: Future = Future()
+    t = time.perf_counter()
+    try:
+        out = getattr(oracle, method)(*args, **kwargs)
+        f.set_result((out, getattr(oracle, "last_bound_px", 0.0), time.perf_counter() - t))
+    except Exception as exc:  # noqa: BLE001 - raised where the drawing is waited for, as the thread's would be
+        f.set_exception(exc)
+    return f
