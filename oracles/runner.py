@@ -462,6 +462,7 @@ def run_crosscheck(
             "pyrender_ms_per_frame",
             "pyrender_wait_ms_per_frame",
             "pixel_metrics_ms_per_frame",
+            "pixel_metrics_beside_ms_per_frame",
         ):
             timing[key] = overall_ms(timing_cases, key)
     timing.update(

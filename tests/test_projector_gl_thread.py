@@ -180,3 +180,64 @@ def test_a_candidate_failing_at_a_frame_ends_the_case_there_and_drops_the_drawin
     assert "frame 2" in str(result.record) and "boom" in str(result.record)  # the error names its frame
     assert oracles.calls <= 2  # frames 1 and 2 at most: nothing after the failing frame
     assert _workers() == []
+
+
+@pytest.fixture(scope="module")
+def icosphere(tmp_path_factory):
+    """An icosphere of 5,120 faces (7,680 edges) as a PLY: ~20,000 drawn pixels a 640x480 frame, over
+    case.OWNERS_AHEAD_PX and segment_pixels.KERNEL_PIXELS (the large-frame paths)."""
+    import trimesh
+
+    path = tmp_path_factory.mktemp("ico") / "ico4.ply"
+    trimesh.creation.icosphere(subdivisions=4).export(path)
+    return load_scene(str(path))
+
+
+@needs_gl
+@pytest.mark.parametrize("projector", ["core", "mirrored"])
+def test_a_large_frame_is_measured_alike_with_its_metrics_made_beside_pyrender(monkeypatch, icosphere, projector):
+    """On a large frame the candidate pixels' owners are found while pyrender draws (compiled) and the frame's
+    pixels and their places are made on the GL thread after its drawing (case.pixels_beside): the record is
+    that of pyrender drawing in this thread, where none of that is done beside (the numpy pairing throughout)."""
+    from wirecheck.oracles.judge import case as case_module
+    from wirecheck.oracles.judge import segment_pixels
+
+    calls = {"beside": 0}
+    sizes: list = []
+    made = case_module.pixels_beside
+
+    def counted(*args):
+        calls["beside"] += 1
+        out = made(*args)
+        sizes.append(len(out[0].oracle_idx))
+        return out
+
+    monkeypatch.setattr(case_module, "pixels_beside", counted)
+    candidate = CoreCandidate() if projector == "core" else load_candidate(f"{FAULTY}:mirrored")
+    case = next(c for c in cases_for(icosphere, MOTION) if c.name == "on_axis")
+
+    def run(oracle):
+        return run_case(icosphere, case, 3, candidate, MOTION, Tolerances(), pyrender_oracle=oracle)
+
+    monkeypatch.setattr(segment_pixels, "KERNEL_PIXELS", 10**9)  # the reference: the numpy pairing
+    own = PyrenderOracle(case.camera.width, case.camera.height)
+    try:
+        expected = run(own)
+    finally:
+        own.close()
+    assert calls["beside"] == 0
+    monkeypatch.setattr(segment_pixels, "KERNEL_PIXELS", 1 << 13)
+    gl = GLThread()
+    try:
+        got = run(ThreadOracle(gl, case.camera.width, case.camera.height))
+    finally:
+        gl.close()
+    assert calls["beside"] == 3  # each frame's pixels made beside
+    assert got.record == expected.record
+    frames = got.record["per_frame"]
+    assert min(sizes) >= 1 << 13  # the frames are large
+    if projector == "core":
+        assert got.record["verdict"] == "pass"
+        assert sum(f["candidate_only"] + f["oracle_only"] for f in frames) > 0  # one-sided pixels placed
+    else:
+        assert got.record["verdict"] == "fail"

@@ -42,6 +42,7 @@ from ..references.gl_thread import ThreadOracle, submit_drawing
 from ..tolerances import Tolerances
 from . import metrics, segment_pixels
 from .case_loop import Measurements, measure_frames
+from .line_ends import frames_end_places
 from .shaded_frames import ShadedFrames
 from .verdict import case_record, judge
 from .wire_frames import SCORE_FRAME_KEYS, WireFrames
@@ -190,10 +191,11 @@ class CaseFrames:
     planes: dict | None = None  # the candidate's probed planes (oracles.diagnosis.clip_planes)
     #: seconds: vertex stage = setup + cv + proj + vmetric; pixel stage = draw + hdraw + prwait + pmetric
     #: (hdraw: the harness drawing an external candidate's frame, less the candidate's own calls; pr:
-    #: pyrender's own drawing, on the GL thread; prwait: the part of it this thread waited for)
+    #: pyrender's own drawing, on the GL thread; prwait: the part of it, and of the metrics made beside it,
+    #: this thread waited for; pbeside: the pixel metrics made on the GL thread, pixels_beside)
     seconds: dict = field(
         default_factory=lambda: dict.fromkeys(
-            ("setup", "cv", "proj", "vmetric", "draw", "hdraw", "pr", "prwait", "pmetric"), 0.0
+            ("setup", "cv", "proj", "vmetric", "draw", "hdraw", "pr", "prwait", "pmetric", "pbeside"), 0.0
         )
     )
 
@@ -434,6 +436,10 @@ class ProjectorFrames:
                 acc.seconds["proj"] += t3 - t2
                 acc.seconds["draw"] += own_draw
                 acc.seconds["hdraw"] += t4 - t3 - own_draw
+                if side.threaded and side.segments is not None and np.count_nonzero(cand_img) >= OWNERS_AHEAD_PX:
+                    # a large frame: what needs only its two drawings is made on the GL thread after pyrender's
+                    # drawing, while this thread finds the candidate pixels' owners (ProjectorFrame.wireframe)
+                    side.beside = self.oracle.gl.submit(pixels_beside, side.drawing, cand_img, *side.segments)
                 if i + 1 < len(numbers) and setup.pixels:  # pyrender draws the next frame while this one is measured
                     ahead = self._oracle_side(numbers[i + 1])
                 yield ProjectorFrame(self, side, cand_px, precision, cand_img, cand_depth)
@@ -497,6 +503,7 @@ class OracleSide:
         self.oracle_px: np.ndarray | None = None
         self.segments: tuple | None = None
         self.drawing = None
+        self.beside = None  # a Future of pixels_beside's, where it is made on the GL thread
         #: whether pyrender draws on another thread (the run's GL thread): then the measures that need only the
         #: candidate's frame are taken while it draws (:func:`candidate_owners`)
         self.threaded = False
@@ -534,13 +541,21 @@ class ProjectorFrame:
         mode draws (hidden lines, culled faces), and where the oracle's lines lie (OpenCV's pixels of the ends)."""
         acc = self.source.acc
         owners = None
-        if self.side.threaded:  # while pyrender draws: the candidate's pixels' owners (OracleSide)
+        if self.side.beside is not None:  # while pyrender draws: the candidate's pixels' owners (OracleSide)
             t0 = time.perf_counter()
             owners = candidate_owners(self.cand_img, *self.side.segments)
             acc.add("pmetric", t0)
-        orac_img, _depth = self.side.drawn(acc)
+        if self.side.beside is not None:  # the frame's pixels and their places, made beside (pixels_beside)
+            self.side.drawn(acc)
+            t = time.perf_counter()
+            fp, ends, seconds = self.side.beside.result()
+            acc.add("prwait", t)
+            acc.seconds["pbeside"] += seconds
+            fp.ends = ends
+        else:
+            orac_img, _depth = self.side.drawn(acc)
+            fp = metrics.FramePixels(self.cand_img, orac_img)  # one scan of each image
         t1 = time.perf_counter()
-        fp = metrics.FramePixels(self.cand_img, orac_img)  # one scan of each image
         fp.owners = owners
         acc.add("pmetric", t1)
         return (fp, *self.side.segments, None)
@@ -557,7 +572,8 @@ class ProjectorFrame:
         self.source.acc.seconds["vmetric" if kind == "vertices" else "pmetric"] += seconds
 
 
-#: A candidate frame's pixels have their owning edges found while pyrender draws (:func:`candidate_owners`) from
+#: A candidate frame's pixels have their owning edges found while pyrender draws (:func:`candidate_owners`), and
+#: the frame's pixels and their places made on the GL thread after its drawing (:func:`pixels_beside`), from
 #: this many drawn pixels on (a frame of a 20k-60k face mesh: 40,000-60,000, whose owner search is 15-16 ms
 #: of CPU; a frame of the bundled scenes, ~1,000, is scored with the case's other frames in one pass,
 #: metrics.LineBatch, whose per-call overhead a frame's own search would pay again).
@@ -567,12 +583,26 @@ OWNERS_AHEAD_PX = 1 << 13
 def candidate_owners(cand_img: np.ndarray, seg0: np.ndarray, seg1: np.ndarray) -> tuple | None:
     """``(flat, edge)``: the candidate's drawn pixels and the edge owning each (-1: none;
     oracles.judge.segment_pixels.pixel_owners), for a frame whose line scores look for every drawn pixel's
-    owner (``DENSE``); None for a smaller or sparser frame."""
+    owner (``DENSE``); None for a sparser frame."""
     flat = np.flatnonzero(cand_img)
-    if len(flat) < OWNERS_AHEAD_PX or len(seg0) * segment_pixels.DENSE <= len(flat):
+    if len(seg0) * segment_pixels.DENSE <= len(flat):
         return None
     h, w = cand_img.shape
     return flat, segment_pixels.pixel_owners(seg0, seg1, w, h, flat)
+
+
+def pixels_beside(drawing, cand_img: np.ndarray, seg0: np.ndarray, seg1: np.ndarray) -> tuple:
+    """``(FramePixels, (ends, ties), seconds)``: a wireframe's drawn pixels against pyrender's ``drawing`` (its
+    Future, done: this runs on the GL thread right after it) and where its one-sided pixels lie
+    (oracles.judge.line_ends.frames_end_places, which the frame's line scores take: metrics.LineBatch),
+    made on the GL thread while this frame's candidate pixels' owners are found in the case's thread
+    (:func:`candidate_owners`, compiled: no GIL held)."""
+    t = time.perf_counter()
+    orac_img = drawing.result()[0][0]
+    fp = metrics.FramePixels(cand_img, orac_img)  # one scan of each image
+    ties: list = []
+    ends = frames_end_places([(fp, seg0, seg1)], ties)[0]
+    return fp, (ends, ties[0]), time.perf_counter() - t
 
 
 def _per_frame_ms(seconds: float, frames: int) -> float:
@@ -600,13 +630,15 @@ def case_timing(acc: CaseFrames, pixels: bool) -> dict:
                 # this wait (docs/performance.md#harness-overhead)
                 "pyrender_ms_per_frame": _per_frame_ms(sec["pr"], done),
                 "pyrender_wait_ms_per_frame": _per_frame_ms(sec["prwait"], done),
-                "pixel_metrics_ms_per_frame": _per_frame_ms(sec["pmetric"], done),
+                # the pixel metrics wherever made; of them, those made on the GL thread beside the stage
+                "pixel_metrics_ms_per_frame": _per_frame_ms(sec["pmetric"] + sec["pbeside"], done),
+                "pixel_metrics_beside_ms_per_frame": _per_frame_ms(sec["pbeside"], done),
             }
         )
     timing["candidate_ms_per_frame"] = _per_frame_ms(sec["proj"] + sec["draw"], done)
     # the harness: everything timed that is not the candidate, OpenCV or pyrender
     # (docs/performance.md#harness-overhead), against the oracles' own time
-    harness = sec["setup"] + sec["vmetric"] + sec["hdraw"] + sec["pmetric"]
+    harness = sec["setup"] + sec["vmetric"] + sec["hdraw"] + sec["pmetric"] + sec["pbeside"]
     timing["harness_ms_per_frame"] = _per_frame_ms(harness, done)
     timing["oracles_ms_per_frame"] = _per_frame_ms(sec["cv"] + sec["pr"], done)
     return timing

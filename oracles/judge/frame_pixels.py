@@ -29,9 +29,14 @@ class FramePixels:
     owners : (flat, edge) or None
         Some of these pixels' owning edges, found before the frame was scored (oracles.judge.segment_pixels
         .pixel_owners: a projector's candidate pixels, while pyrender drew), for its line scores; None.
+    ends : (places, ties) or None
+        Where the one-sided pixels lie and the sub-pixel ties among them (oracles.judge.line_ends
+        .frames_end_places' item and tie pixels), made before the frame was scored (oracles.judge.case
+        .pixels_beside), for its line scores; None.
     """
 
     owners: tuple | None = None
+    ends: tuple | None = None
 
     def __init__(self, cand: np.ndarray, oracle: np.ndarray):
         cand = np.asarray(cand, bool)

@@ -559,7 +559,11 @@ class LineBatch:
                 stop += 1
             run = waiting[start:stop]
             ties: list = []
-            ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run], ties)
+            if all(fp.ends is not None for _, fp, _, _ in run):  # made with the frames (FramePixels.ends)
+                ends = [fp.ends[0] for _, fp, _, _ in run]
+                ties = [fp.ends[1] for _, fp, _, _ in run]
+            else:
+                ends = frames_end_places([(fp, p0, p1) for _, fp, p0, p1 in run], ties)
             resolved = [resolve_ties(fp, t) for (_, fp, _, _), t in zip(run, ties)]  # once a frame
             counts = frames_count_differences(
                 [(p0, p1, rp) for (_, _, p0, p1), rp in zip(run, resolved)],
@@ -568,7 +572,7 @@ class LineBatch:
                 known=[fp.owners for _, fp, _, _ in run],
             )  # counted with the ties undecided
             for _, fp, _, _ in run:
-                fp.owners = None  # used: not kept with the frame's pixels
+                fp.owners = fp.ends = None  # used: not kept with the frame's pixels
             out.extend(
                 (key, line_scores(None, None, p0, p1, pixels=fp, counts=c, ends=e, ties=t, resolved=rp))
                 for (key, fp, p0, p1), c, e, t, rp in zip(run, counts, ends, ties, resolved)
