@@ -439,7 +439,7 @@ class ProjectorFrames:
                 if side.threaded and side.segments is not None and np.count_nonzero(cand_img) >= OWNERS_AHEAD_PX:
                     # a large frame: what needs only its two drawings is made on the GL thread after pyrender's
                     # drawing, while this thread finds the candidate pixels' owners (ProjectorFrame.wireframe)
-                    side.beside = self.oracle.gl.submit(pixels_beside, side.drawing, cand_img, *side.segments)
+                    side.beside = self.oracle.after(pixels_beside, side.drawing, cand_img, *side.segments)
                 if i + 1 < len(numbers) and setup.pixels:  # pyrender draws the next frame while this one is measured
                     ahead = self._oracle_side(numbers[i + 1])
                 yield ProjectorFrame(self, side, cand_px, precision, cand_img, cand_depth)

@@ -107,6 +107,11 @@ class ThreadOracle:
         of ``(its result, the oracle's last_bound_px after it, the seconds the GL thread spent on it)``."""
         return self.gl.submit(self._call, method, args, kwargs)
 
+    def after(self, fn, *args) -> Future:
+        """``fn(*args)`` on the GL thread after the drawings asked for before it (work on a drawing, beside the
+        caller's: oracles.judge.case.pixels_beside); its Future."""
+        return self.gl.submit(fn, *args)
+
     def render(self, *args, **kwargs):
         """:meth:`PyrenderOracle.render`, waited for."""
         return self.submit("render", *args, **kwargs).result()[0]
