@@ -205,3 +205,27 @@ def test_count_differences_given_the_candidates_owners_equal_those_found_with_th
         np.testing.assert_array_equal(d_got, d_exp)
         assert n_got == n_exp
     assert any(np.any(d != 0) for d, _ in expected)  # edges that count differently: something compared
+
+
+@pytest.mark.parametrize(
+    "count", [20, 48, 49, 300], ids=["20 px: boxes", "48 px: boxes", "49 px: grid", "300 px: grid"]
+)
+def test_some_pixels_of_a_frame_have_the_definitions_owners_through_boxes_or_the_grid(monkeypatch, count):
+    """Some pixels of a frame (edge midpoints, one-sided pixels) are paired with every segment's box up to
+    BOXED_PIXELS of them, through a grid of cells beyond; either way each pixel's owner is the definition's
+    (numpy pairing: the compiled one is not asked for so few pixels)."""
+    monkeypatch.setattr(segment_pixels, "KERNEL_PIXELS", 10**9)
+    rng = np.random.default_rng(count)
+    w, h = 60, 45
+    owned = 0
+    for _ in range(3):
+        p0, p1 = _hostile(rng, w, h, 0.5)
+        pixels = np.sort(rng.choice(w * h, count, replace=False))
+        segs = segment_pixels._Segments([(p0, p1)], w, h, 1.0)
+        px = segment_pixels._Pixels.of_frames([pixels], w, h)
+        sid, pos = segs.nearest(px)
+        assert (segs._cells is None) == (count <= segment_pixels.BOXED_PIXELS)  # the path under test was taken
+        got = list(zip(segs.edge[sid].tolist(), pixels[pos].tolist()))
+        assert got == _owners_naive(p0, p1, w, h, pixels)[0]
+        owned += len(got)
+    assert owned > 0  # pixels near the segments: owners compared
