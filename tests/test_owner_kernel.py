@@ -22,8 +22,15 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from wirecheck.core.scene.files import load_scene
+from wirecheck.core.transforms import Motion
+from wirecheck.oracles.candidates.core_candidate import CoreCandidate
+from wirecheck.oracles.cases import cases_for
 from wirecheck.oracles.judge import owner_kernel, segment_pixels
 from wirecheck.oracles.judge.segment_pixels import _Pixels, _Segments
+from wirecheck.oracles.references.pyrender_oracle import osmesa_available
+from wirecheck.oracles.runner import CaseRunner, RunParams
+from wirecheck.oracles.tolerances import Tolerances
 
 #: the pairing's paths, forced: (LEVEL_PIXELS, CROWDED) -> radius only; within 1/2 first; within 1/8, 1/2 first
 PATHS = {"radius only": (10**9, 10**9), "1/2 first": (0, 10**9), "1/8 first": (0, 0)}
@@ -295,3 +302,41 @@ def test_numba_disable_jit_turns_the_kernel_off_quietly():
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "False False NUMBA_DISABLE_JIT is set"
     assert done.stderr == ""
+
+
+def _dust(path, triangles: int = 600, size: float = 0.012):
+    """A mesh of ``triangles`` tiny triangles scattered over a cube (1,800 short edges: a few pixels each on the
+    cases' 640 x 480 images, so that its frames are dense: more than one edge per 8 drawn pixels)."""
+    import trimesh
+
+    rng = np.random.default_rng(0)
+    centre = rng.uniform(-1, 1, (triangles, 3))
+    v = (centre[:, None, :] + rng.uniform(-size, size, (triangles, 3, 3))).reshape(-1, 3)
+    trimesh.Trimesh(v, np.arange(3 * triangles).reshape(-1, 3), process=False).export(path)
+    return str(path)
+
+
+@pytest.mark.skipif(not osmesa_available()[0], reason="no OSMesa")
+@pytest.mark.parametrize("scene, frames, used", [("dust", 10, True), ("cube", 24, False)])
+def test_the_runner_loads_the_kernel_before_a_case_that_uses_it_and_never_for_a_small_scene(
+    tmp_path, monkeypatch, scene, frames, used
+):
+    """A scene of 1,800 short edges (under the 2,048 edges from which the kernel was loaded first) over 10
+    frames: its line scores pair ~10,800 drawn pixels of a dense batch with the kernel, which must be loaded
+    (owner_kernel.warm) before the case's first frame, not inside its pixel stage. The bundled cube over 24
+    frames (288 segments: never a dense batch of 8,192 pixels) neither loads nor uses it."""
+    events = []
+    warm, owners = owner_kernel.warm, owner_kernel.owners
+    monkeypatch.setattr(owner_kernel, "warm", lambda: events.append("warm") or warm())
+    monkeypatch.setattr(owner_kernel, "owners", lambda *a: events.append("owners") or owners(*a))
+    s = load_scene(_dust(tmp_path / "dust.ply") if scene == "dust" else scene)
+    motion = Motion(turns=(1.0, 1.0, 0.0))
+    case = next(c for c in cases_for(s, motion) if c.name == "on_axis")
+    params = RunParams(frames, 1, "pixels", motion, Tolerances(), CoreCandidate())
+    runner = CaseRunner()
+    try:
+        runner.run(s, case, params)
+    finally:
+        runner.close()
+    assert events[:1] == (["warm"] if used else [])
+    assert ("owners" in events) == used  # the case did use the kernel (else the test shows nothing)
