@@ -70,7 +70,7 @@ from .candidates.candidate import load_candidate
 from .candidates.core_candidate import CoreCandidate, RenderMode
 from .cases import CASE_NAMES, Case, case_motion, cases_for
 from .executors import ExecutorSpec, gather_in_order, open_executor
-from .judge import gate, metrics, owner_kernel, segment_pixels
+from .judge import gate, metrics
 from .judge.case import CaseResult, run_case
 from .judge.run_report import run_report, tolerances_field
 from .references import opencv_oracle
@@ -113,22 +113,6 @@ class RunParams:
     keep_points: bool = False  # the worst frame's points of each case, for worst_points.png (level vertices)
 
 
-def kernel_may_run(n_edges: int, n_frames: int) -> bool:
-    """Whether a case of ``n_frames`` checked frames of a scene of ``n_edges`` edges can use the compiled owner
-    search (oracles.judge.owner_kernel), which is then loaded before its first frame, as the GL context and the
-    other first calls are (CaseRunner.warm_up), so that a frame's time is the frame's.
-
-    The line scores pair every drawn pixel of a batch of the case's frames (metrics.LineBatch) only on a
-    dense batch, more than one segment per segment_pixels.DENSE drawn pixels, and use the kernel from
-    segment_pixels.KERNEL_PIXELS drawn pixels on; a candidate frame's owners (case.candidate_owners) need as
-    many. So the frames' segments must number KERNEL_PIXELS / DENSE (1,024) or more: never the bundled
-    scenes (29 edges x 24 frames at most), always a 20k-60k face mesh, and also a mesh of 1,800 short edges
-    over 10 frames (which loaded the kernel inside its pixel stage when only scenes of 2,048 edges or more
-    had it loaded first: 4.8 -> 39.6 ms a frame, 219 with no cache to load it from).
-    """
-    return n_edges * n_frames * segment_pixels.DENSE >= segment_pixels.KERNEL_PIXELS
-
-
 class CaseRunner:
     """Runs cases with cached resources: pyrender oracles by image size, loaded candidates by spec.
 
@@ -149,7 +133,6 @@ class CaseRunner:
         self.gl = GLThread(threaded=threaded)
         self.candidates = {}
         self.warm = False
-        self.kernel_warm = False  # oracles.judge.owner_kernel loaded (before a case that may use it: kernel_may_run)
 
     def candidate(self, ref):
         if not isinstance(ref, str):
@@ -194,10 +177,6 @@ class CaseRunner:
         candidate = self.candidate(params.candidate)
         if not self.warm:
             self.warm_up(case.camera, candidate, params.level)
-        checked = len(range(1, params.frames + 1, params.every))
-        if params.level == "pixels" and not self.kernel_warm and kernel_may_run(len(scene.edges), checked):
-            # the compiled owner search a large mesh's frames use, loaded before its first frame (~0.6 s, once)
-            self.kernel_warm = owner_kernel.warm() or True
         pyr = self.renderer(case.camera, params.mode) if params.level == "pixels" else None
         result = run_case(
             scene,

@@ -19,27 +19,31 @@ them, measuring each pair with the same float operations in the same order
 * segments are walked in ascending index, so a pixel's pairs come in ascending
   index and a later pair replaces the best only when strictly nearer.
 
-It is compiled by numba on first use (:func:`warm`: ~2 s, then cached beside this
-module; loading the cache ~0.3 s a process), so oracles.judge.segment_pixels uses it
-only for frames of at least :data:`segment_pixels.KERNEL_PIXELS` drawn pixels, and
-falls back to its numpy pairing where numba cannot be imported
+It is compiled by numba on first use (:func:`available`: ~3 s, then cached beside this
+module; importing numba and loading the cache ~0.6 s a process, :func:`setup_seconds`,
+left out of the per-frame timings as other one-time set-up is), so oracles.judge.segment_pixels
+uses it only for frames of at least :data:`segment_pixels.KERNEL_PIXELS` drawn pixels, and
+falls back to its numpy pairing where numba cannot be imported or compile it
 (:func:`available`). tests/test_owner_kernel.py holds the two to the same owners.
 """
 
 from __future__ import annotations
 
 import math
+import time
 import warnings
 
 import numpy as np
 
 _KERNEL = None  # the compiled function, made on first use
 _STATE = {"tried": False, "why": None}
+_SETUP_S = [0.0]  # seconds this process spent importing numba and compiling or loading the kernel
 
 
 def available() -> bool:
-    """Whether the kernel can be used: numba imports and is not told to run functions uncompiled
-    (``NUMBA_DISABLE_JIT``: the pairing would run as Python, ~1,000 times slower than numpy's)."""
+    """Whether the kernel can be used: numba imports, is not told to run functions uncompiled
+    (``NUMBA_DISABLE_JIT``: the pairing would run as Python, ~1,000 times slower than numpy's) and compiles it.
+    The first call does that (~0.6 s a process with numba's cache, ~3 s without: :func:`setup_seconds`)."""
     _load()
     return _KERNEL is not None
 
@@ -50,11 +54,32 @@ def why_not() -> str | None:
     return _STATE["why"]
 
 
+def setup_seconds() -> float:
+    """The seconds this process spent making the kernel ready (numba's import, the compile or the cache's load):
+    one-time set-up, which the per-frame timings leave out (oracles.judge.case.CaseFrames.add)."""
+    return _SETUP_S[0]
+
+
+def warm() -> bool:
+    """Make the kernel ready now (:func:`available`); whether it is."""
+    return available()
+
+
 def _load() -> None:
-    global _KERNEL
     if _STATE["tried"]:
         return
     _STATE["tried"] = True
+    t = time.perf_counter()
+    try:
+        _make()
+    finally:
+        _SETUP_S[0] += time.perf_counter() - t
+
+
+def _make() -> None:
+    """numba imported, the kernel compiled (or loaded from numba's cache beside this module) on a two-pixel
+    input; ``_STATE["why"]`` says why not."""
+    global _KERNEL
     try:
         import numba
     except ImportError as exc:  # pragma: no cover - numba is a dependency; a platform without its wheels
@@ -63,12 +88,20 @@ def _load() -> None:
     if numba.config.DISABLE_JIT:
         _STATE["why"] = "NUMBA_DISABLE_JIT is set"
         return
+    q0 = np.array([[0.0, 0.0]])
+    q1 = np.array([[3.0, 1.0]])
+    d = q1 - q0
+    cols = (q0[:, 0].copy(), q0[:, 1].copy(), d[:, 0].copy(), d[:, 1].copy(), (d * d).sum(axis=1))
     with warnings.catch_warnings():  # a cache that cannot be written is numba's warning, not the run's
         warnings.simplefilter("ignore")
-        try:
-            _KERNEL = numba.njit(cache=True, nogil=True)(_owners)
-        except Exception:  # noqa: BLE001 - no place to cache it (a read-only install): compiled each process
-            _KERNEL = numba.njit(nogil=True)(_owners)
+        for cache in (True, False):  # no place to cache it (a read-only install): compiled each process
+            try:
+                _KERNEL = numba.njit(cache=cache, nogil=True)(_owners)
+                owners(np.array([0, 1], np.int64), 4, 2, 1, q0, q1, cols, None, (0.5, 1.0), 1e-6, 2.0**-30, 1e-280)
+                _STATE["why"] = None
+                return
+            except Exception as exc:  # noqa: BLE001 - numba cannot compile here: the numpy pairing stays
+                _KERNEL, _STATE["why"] = None, f"numba could not compile it ({type(exc).__name__}: {exc})"
 
 
 def owners(
@@ -123,25 +156,6 @@ def owners(
         out,
     )
     return out
-
-
-def warm() -> bool:
-    """Compile (or load from the cache) the kernel on a two-pixel input; whether it is available."""
-    if not available():
-        return False
-    global _KERNEL
-    q0 = np.array([[0.0, 0.0]])
-    q1 = np.array([[3.0, 1.0]])
-    d = q1 - q0
-    cols = (q0[:, 0].copy(), q0[:, 1].copy(), d[:, 0].copy(), d[:, 1].copy(), (d * d).sum(axis=1))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            owners(np.array([0, 1], np.int64), 4, 2, 1, q0, q1, cols, None, (0.5, 1.0), 1e-6, 2.0**-30, 1e-280)
-        except Exception as exc:  # noqa: BLE001 - numba cannot compile here: the numpy pairing stays
-            _KERNEL, _STATE["why"] = None, f"numba could not compile it ({type(exc).__name__}: {exc})"
-            return False
-    return True
 
 
 def _owners(
