@@ -608,17 +608,17 @@ def candidate_owners(cand_img: np.ndarray, seg0: np.ndarray, seg1: np.ndarray) -
 
 
 def pixels_beside(drawing, cand_img: np.ndarray, seg0: np.ndarray, seg1: np.ndarray) -> tuple:
-    """``(FramePixels, (ends, ties), seconds)``: a wireframe's drawn pixels against pyrender's ``drawing`` (its
+    """``(FramePixels, (ends, ties), CPU seconds)``: a wireframe's drawn pixels against pyrender's ``drawing`` (its
     Future, done: this runs on the GL thread right after it) and where its one-sided pixels lie
     (oracles.judge.line_ends.frames_end_places, which the frame's line scores take: metrics.LineBatch),
     made on the GL thread while this frame's candidate pixels' owners are found in the case's thread
     (:func:`candidate_owners`, compiled: no GIL held)."""
-    t = time.perf_counter()
+    t = time.thread_time()  # this thread's CPU: its wall time beside the case's thread would count that one's too
     orac_img = drawing.result()[0][0]  # (image, depth) of gl_thread.drawing's tuple
     fp = metrics.FramePixels(cand_img, orac_img)  # one scan of each image
     ties: list = []
     ends = frames_end_places([(fp, seg0, seg1)], ties)[0]
-    return fp, (ends, ties[0]), time.perf_counter() - t
+    return fp, (ends, ties[0]), time.thread_time() - t
 
 
 def _per_frame_ms(seconds: float, frames: int) -> float:
