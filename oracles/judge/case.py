@@ -567,13 +567,12 @@ class ProjectorFrame:
             fp, ends, seconds = self.side.beside.result()
             acc.add("prwait", t)
             acc.seconds["pbeside"] += seconds
-            fp.ends = ends
+            fp.ends, fp.owners = ends, owners
         else:
             orac_img, _depth = self.side.drawn(acc)
+            t = time.perf_counter()
             fp = metrics.FramePixels(self.cand_img, orac_img)  # one scan of each image
-        t1 = time.perf_counter()
-        fp.owners = owners
-        acc.add("pmetric", t1)
+            acc.add("pmetric", t)
         return (fp, *self.side.segments, None)
 
     def shaded(self) -> tuple:
