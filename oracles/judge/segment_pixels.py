@@ -112,9 +112,9 @@ D2_SLACK = 2.0**-30
 D2_TINY = 1e-280
 #: :meth:`_Segments.nearest` of every drawn pixel runs the compiled pairing (oracles.judge.owner_kernel: the same
 #: owners) from this many pixels on: a frame of a 20k-60k face mesh (40,000-60,000 drawn pixels) in 5-8 ms of CPU
-#: against 15-18 for the numpy pairing; below, the numpy pairing costs a few ms at most, less than loading
-#: the compiled kernel into a process (~0.3 s, once), which most runs (the bundled scenes' ~1,000-pixel
-#: frames) then never pay.
+#: against 15-22 for the numpy pairing; below, the numpy pairing costs a few ms at most, less than making the
+#: compiled kernel ready in a process (numba's import and its cache's load, ~0.6 s once), which most runs (the
+#: bundled scenes' ~1,000-pixel frames) then never pay.
 KERNEL_PIXELS = 1 << 13
 #: :meth:`_Segments.nearest` looks within :data:`LEVELS` first only for at least this many pixels
 #: (fewer: one search costs less than the calls of several).
